@@ -1,0 +1,80 @@
+"""The ``poro2d`` command line.
+
+Each capability registers its commands here; the command bodies live next to the
+code they drive (``poro2d.porosity_cli``, ...). Bad input anywhere below raises
+:class:`poro2d.errors.InputError`, which :func:`main` prints as one line with
+exit code 2 and no traceback.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import typer
+from rich.console import Console
+
+from poro2d import __version__
+from poro2d.errors import InputError
+
+app = typer.Typer(
+    name="poro2d",
+    help="2D porosities for DEM studies: conversions, DEM engine, the paper's criterion.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+err_console = Console(stderr=True)
+
+
+def _version_callback(value: bool) -> None:
+    if value:
+        typer.echo(f"poro2d {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(
+        False, "--version", callback=_version_callback, is_eager=True, help="Print the version."
+    ),
+) -> None:
+    """poro2d command line."""
+
+
+def _register() -> None:
+    # Imported here so that `poro2d --help` stays cheap and a broken optional
+    # layer cannot take the whole CLI down at import time.
+    from poro2d import porosity_cli
+
+    porosity_cli.register(app)
+
+
+_register()
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Console entry point: run the app, turn InputError into a one-line message."""
+    try:
+        app(args=argv, standalone_mode=False)
+    except InputError as exc:
+        err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
+        sys.exit(2)
+    except KeyboardInterrupt:
+        err_console.print("[yellow]interrupted[/]")
+        sys.exit(130)
+    except SystemExit:
+        raise
+    except Exception as exc:  # click usage errors and friends
+        import click
+
+        if isinstance(exc, click.exceptions.ClickException):
+            exc.show()
+            sys.exit(exc.exit_code)
+        if isinstance(exc, click.exceptions.Abort):
+            err_console.print("[yellow]aborted[/]")
+            sys.exit(1)
+        raise
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()
