@@ -1,0 +1,7 @@
+"""The 2D DEM engine: disks, wall segments, the linear contact law, compiled steps."""
+
+from poro2d.dem.model import ContactModel
+from poro2d.dem.simulation import RunResult, Simulation, SimulationError
+from poro2d.dem.state import Particles, Walls
+
+__all__ = ["ContactModel", "Particles", "RunResult", "Simulation", "SimulationError", "Walls"]

@@ -1,0 +1,80 @@
+"""The linear contact law (Cundall and Strack 1979), as in PFC's linear model.
+
+One contact between a disk ``i`` and a body ``j`` (another disk or a wall):
+
+* unit normal ``n`` from ``i`` towards ``j``, tangent ``t = (-n_y, n_x)``;
+* normal force ``Fn = kn * overlap`` (+ an optional normal dashpot), never tensile;
+* shear force ``Fs`` updated incrementally, ``Fs += ks * vt * dt`` with ``vt`` the
+  tangential velocity of ``j`` relative to ``i`` at the contact point, then capped at
+  ``mu * Fn`` (Coulomb slip).
+
+In 2D the shear force is kept as its component along the current tangent, so it
+turns with the contact frame by construction; that scalar is the contact's history.
+The force on ``i`` is ``-Fn n + Fs t`` and its moment ``a_i * Fs`` with the lever arm
+``a_i = r_i - overlap / 2`` (contact point in the middle of the overlap).
+
+Property combination (PFC 4.0): springs in series, the smaller friction.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+# contact-model modes
+PER_BODY = 0  # PFC 4.0: kn = kA kB / (kA + kB), mu = min(muA, muB)
+PER_PAIR_TYPE = 1  # PFC 5 style: one (kn, ks, mu) for disk-disk, one for disk-wall
+
+
+@njit(inline="always", cache=True)
+def series(ka, kb):
+    """Two springs in series; 0 if either is 0."""
+    s = ka + kb
+    if s <= 0.0:
+        return 0.0
+    return ka * kb / s
+
+
+@njit(inline="always", cache=True)
+def linear_force(overlap, vn, vt, fs_old, kn, ks, mu, cn, dt):
+    """Normal and shear force magnitudes of one touching contact.
+
+    overlap > 0; vn is the normal approach speed (positive when closing);
+    cn the normal dashpot coefficient (0 for none). Returns (fn, fs, sliding).
+    """
+    fn = kn * overlap + cn * vn
+    if fn < 0.0:  # the dashpot may not pull the bodies together
+        fn = 0.0
+    fs = fs_old + ks * vt * dt
+    cap = mu * fn
+    sliding = False
+    if fs > cap:
+        fs = cap
+        sliding = True
+    elif fs < -cap:
+        fs = -cap
+        sliding = True
+    return fn, fs, sliding
+
+
+@njit(inline="always", cache=True)
+def dashpot(beta, kn, m_eff):
+    """Critical-damping fraction ``beta`` to a normal dashpot coefficient."""
+    if beta <= 0.0:
+        return 0.0
+    return 2.0 * beta * math.sqrt(kn * m_eff)
+
+
+@njit(inline="always", cache=True)
+def segment_closest(px, py, ax, ay, bx, by):
+    """Closest point to (px, py) on the segment a-b."""
+    dx = bx - ax
+    dy = by - ay
+    L2 = dx * dx + dy * dy
+    s = ((px - ax) * dx + (py - ay) * dy) / L2
+    if s < 0.0:
+        s = 0.0
+    elif s > 1.0:
+        s = 1.0
+    return ax + s * dx, ay + s * dy

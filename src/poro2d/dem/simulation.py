@@ -1,0 +1,484 @@
+"""The Python-side driver of the DEM engine.
+
+A :class:`Simulation` owns the particle and wall state, the contact lists and
+the time step. :meth:`Simulation.run` hands whole blocks of steps to the
+compiled kernel and only comes back to Python for events: progress updates,
+callbacks (writers, protocol checks) and growing the contact storage.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from poro2d.dem import kernels as K
+from poro2d.dem.model import ContactModel, critical_time_step, inertial_masses, restitution_to_beta
+from poro2d.dem.state import FREE, PRESCRIBED, WALL_SERVO, WALL_VELOCITY, Particles, Walls
+from poro2d.errors import InputError
+
+_THREADING_SET = False
+
+
+def _prefer_openmp() -> None:
+    """numba's OpenMP layer measured fastest here; TBB/workqueue were slower than serial."""
+    global _THREADING_SET
+    if not _THREADING_SET:
+        import numba
+
+        os.environ.setdefault("NUMBA_THREADING_LAYER_PRIORITY", "omp tbb workqueue")
+        try:
+            numba.config.THREADING_LAYER_PRIORITY = ["omp", "tbb", "workqueue"]
+        except Exception:  # pragma: no cover - older numba
+            pass
+        _THREADING_SET = True
+
+
+class SimulationError(RuntimeError):
+    """The run cannot go on (numerical instability, bad state)."""
+
+
+@dataclass
+class RunResult:
+    """What one call of :meth:`Simulation.run` did."""
+
+    steps: int
+    converged: bool
+    max_ratio: float
+    mean_ratio: float
+    wall_time_s: float
+    rebuilds: int
+
+    @property
+    def particle_steps_per_s(self) -> float:
+        return self._ps / self.wall_time_s if self.wall_time_s > 0 else math.nan
+
+    _ps: float = 0.0
+
+
+class Simulation:
+    """2D DEM of disks and wall segments with the linear contact law.
+
+    Parameters
+    ----------
+    particles, walls
+        The bodies (state is held by reference and advanced in place).
+    contact
+        Property convention (:class:`ContactModel`), PFC 4.0 per-body by default.
+    gravity
+        (gx, gy) in m/s^2.
+    local_damping
+        Cundall's local non-viscous damping coefficient alpha in [0, 1):
+        each force and moment component is reduced by ``alpha |F| sign(v)``.
+    restitution
+        Optional normal restitution coefficient in (0, 1] for a viscous normal
+        dashpot (impact problems); ``None`` for no dashpot.
+    dt
+        Fixed time step (s); ``None`` for ``dt_safety * sqrt(m_min / k_max)``.
+    dt_safety
+        Safety factor of the automatic time step, in (0, 1].
+    density_scale
+        Inertial mass multiplier >= 1 (density scaling for quasi-static runs);
+        gravity still acts on the true mass. Reported in every output.
+    skin
+        Verlet skin (m); default 0.2 x the mean radius.
+    threads
+        Threads for the compiled loops (results do not depend on it).
+    """
+
+    def __init__(
+        self,
+        particles: Particles,
+        walls: Walls | None = None,
+        contact: ContactModel | None = None,
+        gravity: tuple[float, float] = (0.0, -9.81),
+        local_damping: float = 0.7,
+        restitution: float | None = None,
+        dt: float | None = None,
+        dt_safety: float = 0.5,
+        density_scale: float = 1.0,
+        skin: float | None = None,
+        threads: int = 1,
+    ) -> None:
+        _prefer_openmp()
+        self.particles = particles
+        self.walls = walls if walls is not None else Walls()
+        self.contact = contact if contact is not None else ContactModel()
+        g = np.asarray(gravity, dtype=float)
+        if g.shape != (2,) or not np.all(np.isfinite(g)):
+            raise InputError("gravity", gravity, "two finite numbers (gx, gy) in m/s^2")
+        self.gravity = (float(g[0]), float(g[1]))
+        if not 0.0 <= local_damping < 1.0:
+            raise InputError("local_damping", local_damping, "[0, 1)")
+        self.local_damping = float(local_damping)
+        self.restitution = None if restitution is None else float(restitution)
+        self._beta = 0.0 if restitution is None else restitution_to_beta(restitution)
+        if not density_scale >= 1.0:
+            raise InputError("density_scale", density_scale, "[1, inf)")
+        self.density_scale = float(density_scale)
+        if not 0.0 < dt_safety <= 1.0:
+            raise InputError("dt_safety", dt_safety, "(0, 1]")
+        self.dt_safety = float(dt_safety)
+        self._fixed_dt = dt
+        if skin is not None and not skin > 0.0:
+            raise InputError("skin", skin, "(0, inf) m")
+        self._skin = skin
+        self.threads = self._check_threads(threads)
+        self.step_count = 0
+        self.time = 0.0
+        self._n_alloc = -1
+        self._refresh()
+
+    # ----------------------------------------------------------------- setup
+    @staticmethod
+    def _check_threads(threads: int) -> int:
+        import numba
+
+        top = numba.config.NUMBA_NUM_THREADS
+        if not (isinstance(threads, (int, np.integer)) and 1 <= threads <= top):
+            raise InputError("threads", threads, f"an integer in [1, {top}]")
+        return int(threads)
+
+    def _refresh(self) -> None:
+        """Recompute masses, time step and (re)allocate storage after a state change."""
+        p = self.particles
+        n = p.n
+        self._mass = np.ascontiguousarray(p.mass)
+        m_in, i_in = inertial_masses(p, self.density_scale)
+        self._inv_mass = np.ascontiguousarray(1.0 / m_in) if n else np.zeros(0)
+        self._inv_inertia = np.ascontiguousarray(1.0 / i_in) if n else np.zeros(0)
+        k_max = self.contact.max_stiffness(p, self.walls)
+        self.dt_critical = critical_time_step(float(m_in.min()) if n else 1.0, k_max)
+        if self._fixed_dt is None:
+            self.dt = self.dt_safety * self.dt_critical if math.isfinite(self.dt_critical) else 1e-4
+        else:
+            dt = float(self._fixed_dt)
+            # sqrt(2) sqrt(m/k): a lone disk spinning on one tangential spring already diverges.
+            limit = math.sqrt(2.0) * self.dt_critical
+            if not (dt > 0.0 and dt < limit):
+                raise InputError(
+                    "dt", dt, f"(0, {limit:.3g}) s",
+                    f"the lightest disk on the stiffest contact is unstable above {limit:.3g} s; "
+                    f"the automatic step would be {self.dt_safety * self.dt_critical:.3g} s",
+                )
+            self.dt = dt
+        if self._skin is None:
+            self.skin = 0.2 * float(p.radius.mean()) if n else 1e-3
+        else:
+            self.skin = float(self._skin)
+        if n != self._n_alloc:
+            self._allocate(n)
+        self._iprm[K.NEED_BUILD] = 1
+
+    def _allocate(self, n: int) -> None:
+        self._n_alloc = n
+        nw = self.walls.n
+        self.force = np.zeros((n, 2))
+        self.moment = np.zeros(n)
+        self._pos_build = np.zeros((n, 2))
+        self._wall_build = np.zeros((nw, 2))
+        self.wall_force_vec = np.zeros((nw, 2))
+        self._wstat = np.zeros((nw, 2))
+        self._nb_start = np.zeros(n + 1, dtype=np.int64)
+        self._new_start = np.zeros(n + 1, dtype=np.int64)
+        self._rev_start = np.zeros(n + 1, dtype=np.int64)
+        self._wb_start = np.zeros(n + 1, dtype=np.int64)
+        self._wnew_start = np.zeros(n + 1, dtype=np.int64)
+        self._alloc_pp(max(16, 4 * n))
+        self._alloc_pw(max(16, n // 4))
+        self._prm = np.zeros(K.N_PRM)
+        self._iprm = np.zeros(K.N_IPRM, dtype=np.int64)
+        self._out = np.zeros(K.N_OUT)
+
+    def _alloc_pp(self, cap: int, keep: int = 0) -> None:
+        def grow(old, dtype=np.float64):
+            a = np.zeros(cap, dtype=dtype)
+            if keep:
+                a[:keep] = old[:keep]
+            return a
+
+        g = getattr
+        self._nb_j = grow(g(self, "_nb_j", None), np.int64)
+        self._nb_fs = grow(g(self, "_nb_fs", None))
+        self._nb_fn = grow(g(self, "_nb_fn", None))
+        self._nb_ov = grow(g(self, "_nb_ov", None))
+        self._nb_nx = grow(g(self, "_nb_nx", None))
+        self._nb_ny = grow(g(self, "_nb_ny", None))
+        self._rev_p = grow(g(self, "_rev_p", None), np.int64)
+        self._new_j = np.zeros(cap, dtype=np.int64)
+        self._new_fs = np.zeros(cap)
+
+    def _alloc_pw(self, cap: int, keep: int = 0) -> None:
+        def grow(old, dtype=np.float64):
+            a = np.zeros(cap, dtype=dtype)
+            if keep:
+                a[:keep] = old[:keep]
+            return a
+
+        g = getattr
+        self._wb_w = grow(g(self, "_wb_w", None), np.int64)
+        self._wb_fs = grow(g(self, "_wb_fs", None))
+        self._wb_fn = grow(g(self, "_wb_fn", None))
+        self._wb_ov = grow(g(self, "_wb_ov", None))
+        self._wb_nx = grow(g(self, "_wb_nx", None))
+        self._wb_ny = grow(g(self, "_wb_ny", None))
+        self._wnew_w = np.zeros(cap, dtype=np.int64)
+        self._wnew_fs = np.zeros(cap)
+
+    # --------------------------------------------------------------- mutation
+    def particles_changed(self) -> None:
+        """Call after editing radii, densities, positions or adding/removing disks."""
+        n_old = self._n_alloc
+        if self.particles.n != n_old:
+            self._n_alloc = -1  # fresh lists: indices changed, old history is void
+        self._refresh()
+
+    def set_particle_friction(self, mu: float) -> None:
+        """Change every disk's friction coefficient (e.g. 0.05 -> 3 after preparation)."""
+        if not (mu >= 0.0 and math.isfinite(mu)):
+            raise InputError("particle friction", mu, "[0, inf)")
+        self.particles.mu[:] = mu
+        if self.contact.convention == "per_pair_type":
+            pp = self.contact.pp
+            assert pp is not None
+            self.contact = ContactModel("per_pair_type", (pp[0], pp[1], float(mu)), self.contact.pw)
+
+    def set_wall_velocity(self, wall: str | int, velocity: tuple[float, float]) -> None:
+        w = self.walls.index(wall)
+        v = np.asarray(velocity, dtype=float)
+        if v.shape != (2,) or not np.all(np.isfinite(v)):
+            raise InputError(f"wall {self.walls.names[w]} velocity", velocity, "two finite numbers (m/s)")
+        self.walls.mode[w] = WALL_VELOCITY
+        self.walls.vel[w] = v
+
+    def set_wall_servo(
+        self,
+        wall: str | int,
+        target_force: float,
+        direction: tuple[float, float],
+        max_speed: float,
+        gain: float = 0.5,
+    ) -> None:
+        """Servo a wall along ``direction`` (the way it moves to compress) to a force.
+
+        Every step: v = gain * (target - F) / (sum of contact kn on the wall * dt),
+        bounded by ``max_speed``; F is the compressive force along ``direction`` (N).
+        """
+        w = self.walls.index(wall)
+        d = np.asarray(direction, dtype=float)
+        nd = float(np.hypot(*d)) if d.shape == (2,) else 0.0
+        if nd == 0.0 or not math.isfinite(nd):
+            raise InputError("servo direction", direction, "a non-zero (x, y) vector")
+        if not (target_force >= 0.0 and math.isfinite(target_force)):
+            raise InputError("servo target force", target_force, "[0, inf) N")
+        if not max_speed > 0.0:
+            raise InputError("servo max_speed", max_speed, "(0, inf) m/s")
+        if not 0.0 < gain <= 1.0:
+            raise InputError("servo gain", gain, "(0, 1]")
+        self.walls.mode[w] = WALL_SERVO
+        self.walls.servo_dir[w] = d / nd
+        self.walls.servo[w] = (target_force, gain, max_speed)
+
+    def fix_particles(self, mask: np.ndarray, velocity=(0.0, 0.0), omega: float = 0.0) -> None:
+        """Prescribe velocity and spin of the disks in ``mask`` (zero = fixed)."""
+        self.particles.mode[mask] = PRESCRIBED
+        self.particles.vel[mask] = velocity
+        self.particles.omega[mask] = omega
+
+    def free_particles(self, mask: np.ndarray) -> None:
+        self.particles.mode[mask] = FREE
+
+    # -------------------------------------------------------------------- run
+    def _args(self):
+        p, w = self.particles, self.walls
+        return (
+            p.pos, p.vel, p.theta, p.omega, self.force, self.moment, p.radius, self._mass,
+            self._inv_mass, self._inv_inertia, p.mode, p.kn, p.ks, p.mu,
+            w.p0, w.p1, w.vel, w.kn, w.ks, w.mu, w.mode, w.servo_dir, w.servo,
+            self.wall_force_vec, self._wstat,
+            self._nb_start, self._nb_j, self._nb_fs, self._nb_fn, self._nb_ov, self._nb_nx,
+            self._nb_ny, self._rev_start, self._rev_p, self._new_start, self._new_j, self._new_fs,
+            self._wb_start, self._wb_w, self._wb_fs, self._wb_fn, self._wb_ov, self._wb_nx,
+            self._wb_ny, self._wnew_start, self._wnew_w, self._wnew_fs,
+            self._pos_build, self._wall_build, self._prm, self._iprm, self._out,
+        )  # fmt: skip
+
+    def _load_params(self, nsteps: int, check_every: int, ratio_target: float) -> None:
+        prm = self._prm
+        prm[K.DT] = self.dt
+        prm[K.GX], prm[K.GY] = self.gravity
+        prm[K.DAMP] = self.local_damping
+        prm[K.SKIN] = self.skin
+        prm[K.BETA] = self._beta
+        if self.contact.convention == "per_pair_type":
+            prm[K.KN_PP], prm[K.KS_PP], prm[K.MU_PP] = self.contact.pp  # type: ignore[misc]
+            prm[K.KN_PW], prm[K.KS_PW], prm[K.MU_PW] = self.contact.pw  # type: ignore[misc]
+        prm[K.RATIO_TARGET] = ratio_target
+        prm[K.TIME] = self.time
+        self._iprm[K.MODE] = self.contact.mode
+        self._iprm[K.NSTEPS] = nsteps
+        self._iprm[K.CHECK_EVERY] = check_every
+
+    def _kernel_block(self, nsteps: int, check_every: int, ratio_target: float) -> tuple[int, int]:
+        """Run up to ``nsteps`` in compiled code; returns (steps done, status)."""
+        import numba
+
+        numba.set_num_threads(self.threads)
+        done = 0
+        status = K.RUNNING
+        rebuilds = 0
+        while done < nsteps:
+            self._load_params(nsteps - done, check_every, ratio_target)
+            self._out[:] = 0.0
+            K.run_steps(*self._args())
+            steps = int(self._out[K.STEPS_DONE])
+            done += steps
+            rebuilds += int(self._out[K.REBUILDS])
+            self.step_count += steps
+            self.time = float(self._prm[K.TIME])
+            status = int(self._out[K.STATUS])
+            if status == K.OVERFLOW:
+                need_pp = int(self._out[K.NEED_PP])
+                need_pw = int(self._out[K.NEED_PW])
+                if need_pp:
+                    self._alloc_pp(int(need_pp * 1.5) + 16, keep=int(self._nb_start[-1]))
+                if need_pw:
+                    self._alloc_pw(int(need_pw * 1.5) + 16, keep=int(self._wb_start[-1]))
+                continue
+            if status == K.UNSTABLE:
+                raise SimulationError(
+                    f"the simulation became unstable (non-finite positions) near step "
+                    f"{self.step_count}, t = {self.time:.6g} s, dt = {self.dt:.3g} s; "
+                    "use a smaller dt or dt_safety"
+                )
+            if status == K.CONVERGED:
+                break
+        self._rebuilds = rebuilds
+        return done, status
+
+    def run(
+        self,
+        steps: int,
+        *,
+        until_ratio: float | None = None,
+        check_every: int = 100,
+        callback: Callable[[Simulation], bool | None] | None = None,
+        every: int | None = None,
+        progress: bool | str = False,
+    ) -> RunResult:
+        """Advance up to ``steps`` steps.
+
+        until_ratio
+            stop as soon as the maximum unbalanced-force ratio drops below this value
+            (tested every ``check_every`` steps inside the kernel).
+        callback, every
+            call ``callback(sim)`` every ``every`` steps (a Python event); if it
+            returns True the run stops.
+        progress
+            show a rich progress bar (steps/s, particle-steps/s, ETA); a string is
+            used as its label.
+        """
+        if not (isinstance(steps, (int, np.integer)) and steps >= 0):
+            raise InputError("steps", steps, "an integer >= 0")
+        if until_ratio is not None and not until_ratio > 0.0:
+            raise InputError("until_ratio", until_ratio, "(0, inf)")
+        if not (isinstance(check_every, (int, np.integer)) and check_every >= 1):
+            raise InputError("check_every", check_every, "an integer >= 1")
+        if every is not None and not (isinstance(every, (int, np.integer)) and every >= 1):
+            raise InputError("every", every, "an integer >= 1")
+        target = 0.0 if until_ratio is None else float(until_ratio)
+        n = self.particles.n
+        t0 = time.perf_counter()
+        done = 0
+        converged = False
+        rebuilds = 0
+        # Block length: the next Python event, or about a quarter second for progress.
+        block = every if every is not None else steps
+        bar = None
+        if progress:
+            from poro2d.progress import StepProgress
+
+            bar = StepProgress(str(progress) if isinstance(progress, str) else "DEM", steps, n)
+            bar.start()
+            if every is None:
+                block = max(check_every, min(steps, 2000))
+        try:
+            while done < steps:
+                nb = min(block, steps - done)
+                k, status = self._kernel_block(nb, check_every, target)
+                done += k
+                rebuilds += self._rebuilds
+                if bar is not None:
+                    bar.update(done, self._out[K.MAX_RATIO] if target else None)
+                if status == K.CONVERGED:
+                    converged = True
+                    break
+                if callback is not None and every is not None and done % every == 0:
+                    if callback(self):
+                        break
+        finally:
+            if bar is not None:
+                bar.stop()
+        wall = time.perf_counter() - t0
+        rmax, rmean = self.unbalanced_ratios()
+        res = RunResult(done, converged, rmax, rmean, wall, rebuilds)
+        res._ps = float(done) * n
+        return res
+
+    def solve(
+        self, ratio: float = 1e-3, max_steps: int = 1_000_000, check_every: int = 100,
+        progress: bool | str = False,
+    ) -> RunResult:
+        """Cycle until the maximum unbalanced-force ratio is below ``ratio``."""
+        return self.run(max_steps, until_ratio=ratio, check_every=check_every, progress=progress)
+
+    # ------------------------------------------------------------ measurement
+    def unbalanced_ratios(self) -> tuple[float, float]:
+        """(max, mean) unbalanced-force ratio of the current state."""
+        if self._iprm[K.NEED_BUILD]:
+            return math.inf, math.inf
+        r = K.unbalanced_ratios(
+            self.force, self.particles.mode, self._nb_start, self._nb_fn, self._nb_fs,
+            self._nb_ov, self._wb_start, self._wb_fn, self._wb_fs, self._wb_ov,
+        )  # fmt: skip
+        return float(r[0]), float(r[1])
+
+    def wall_force(self, wall: str | int) -> np.ndarray:
+        """Resultant contact force that the disks exert on a wall (N), as (fx, fy)."""
+        return self.wall_force_vec[self.walls.index(wall)].copy()
+
+    def wall_force_per_thickness(self, wall: str | int) -> np.ndarray:
+        """Wall force per metre of disk thickness (N/m, the paper's unit)."""
+        return self.wall_force(wall) / self.particles.thickness
+
+    def contacts(self):
+        """Touching contacts as a :class:`poro2d.dem.measure.ContactSet`."""
+        from poro2d.dem.measure import contact_set
+
+        return contact_set(self)
+
+    def summary(self) -> dict:
+        """Settings that every output file should record."""
+        return {
+            "n_particles": self.particles.n,
+            "n_walls": self.walls.n,
+            "wall_names": list(self.walls.names),
+            "thickness_m": self.particles.thickness,
+            "contact": self.contact.to_dict(),
+            "gravity": list(self.gravity),
+            "local_damping": self.local_damping,
+            "restitution": self.restitution,
+            "dt_s": self.dt,
+            "dt_critical_s": self.dt_critical,
+            "dt_mode": "fixed" if self._fixed_dt is not None else f"auto (safety {self.dt_safety})",
+            "density_scale": self.density_scale,
+            "density_scaling": self.density_scale != 1.0,
+            "skin_m": self.skin,
+            "threads": self.threads,
+            "step": self.step_count,
+            "time_s": self.time,
+        }
