@@ -1,0 +1,549 @@
+"""Grading curves (sieve data) and drawing disk radii that follow them.
+
+Units
+-----
+Sieve data come in millimetres (``size_mm``), as a laboratory reports them; a
+:class:`GradingCurve` stores *model* sizes in SI metres (``sizes_m``), i.e. after the
+up-scaling factor and the optional cut-offs. The cut-offs ``d_min_mm``/``d_max_mm`` are
+also in millimetres and act on the up-scaled (model) sizes.
+
+Mass and area
+-------------
+Percent passing is by mass. Disks of one density and one thickness have mass proportional
+to area, so a class's mass fraction is its share of the total disk area.
+
+Between two sieves, percent passing is interpolated linearly in ``log d`` (the way a grading
+curve is drawn on its semi-log chart); this is used only for the cut-offs. Within a sieve
+class, diameters are drawn uniformly in ``d`` (default) or uniformly in ``log d``.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from poro2d.errors import InputError, check_range
+
+__all__ = [
+    "PAPER_UPSCALE",
+    "GradingCurve",
+    "draw_disks",
+    "max_deviation",
+    "paper_grading",
+    "plot_realised",
+    "realised_curve",
+]
+
+#: Up-scaling factor of the paper (section 3: laboratory sizes times 10).
+PAPER_UPSCALE = 10.0
+
+_WITHIN_CLASS = ("uniform", "loguniform")
+_CONFIG_KEYS = ("preset", "csv", "sizes_mm", "percent_passing", "upscale", "d_min_mm", "d_max_mm")
+_TOP_TOL = 1e-6  # percent passing at the largest size must be 100 within this
+
+
+def _as_float_array(name: str, values: Any) -> np.ndarray:
+    try:
+        arr = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InputError(name, values, "a list of numbers") from None
+    if arr.ndim != 1:
+        raise InputError(name, values, "a flat list of numbers")
+    if not np.all(np.isfinite(arr)):
+        raise InputError(name, values, "finite numbers")
+    return arr
+
+
+def _check_curve(
+    sizes: np.ndarray,
+    percent: np.ndarray,
+    size_name: str,
+    percent_name: str,
+    *,
+    need_zero_start: bool,
+) -> None:
+    """Raise InputError unless (sizes, percent) is a valid ascending grading curve."""
+    if sizes.size != percent.size:
+        raise InputError(
+            percent_name, percent.tolist(), f"one value per size ({sizes.size} sizes given)"
+        )
+    if sizes.size < 2:
+        raise InputError(size_name, sizes.tolist(), "at least 2 sieve sizes")
+    if np.any(sizes <= 0.0):
+        raise InputError(size_name, sizes.tolist(), "sizes > 0")
+    if np.any(np.diff(sizes) <= 0.0):
+        raise InputError(
+            size_name,
+            sizes.tolist(),
+            "strictly increasing sizes (a table listed from the coarsest sieve is also accepted)",
+        )
+    if np.any(percent < 0.0) or np.any(percent > 100.0):
+        raise InputError(percent_name, percent.tolist(), "percentages in [0, 100]")
+    if np.any(np.diff(percent) < 0.0):
+        raise InputError(percent_name, percent.tolist(), "percent passing non-decreasing with size")
+    if abs(percent[-1] - 100.0) > _TOP_TOL:
+        raise InputError(
+            percent_name,
+            percent.tolist(),
+            "100 % passing at the largest size",
+            hint="add the sieve that everything passes",
+        )
+    if need_zero_start and percent[0] != 0.0:
+        raise InputError(
+            percent_name,
+            percent.tolist(),
+            "0 % passing at the smallest size",
+            hint="the smallest size bounds the finest class: add the size of the finest "
+            "particles with 0 %, or set d_min_mm above the smallest size to cut the fines",
+        )
+
+
+def _interp_log(x: float, sizes: np.ndarray, percent: np.ndarray) -> float:
+    return float(np.interp(math.log(x), np.log(sizes), percent))
+
+
+@dataclass(frozen=True)
+class GradingCurve:
+    """A grading curve of model sizes (metres) and percent passing by mass.
+
+    Invariants (checked on construction): at least two points, sizes strictly increasing
+    and > 0, percent passing non-decreasing, 0 at the smallest size and 100 at the largest.
+    Build one from laboratory data with :meth:`from_lists`, :meth:`from_csv` or
+    :meth:`from_config`; the plain constructor takes model sizes in metres.
+    """
+
+    sizes_m: tuple[float, ...]
+    percent_passing: tuple[float, ...]
+    upscale: float = 1.0
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        sizes = _as_float_array("sizes_m", self.sizes_m)
+        percent = _as_float_array("percent_passing", self.percent_passing)
+        _check_curve(sizes, percent, "sizes_m", "percent_passing", need_zero_start=True)
+        percent[-1] = 100.0
+        check_range("upscale", self.upscale, 0.0, None, lo_open=True)
+        object.__setattr__(self, "sizes_m", tuple(float(v) for v in sizes))
+        object.__setattr__(self, "percent_passing", tuple(float(v) for v in percent))
+        object.__setattr__(self, "upscale", float(self.upscale))
+
+    # ------------------------------------------------------------------ constructors
+    @classmethod
+    def from_lists(
+        cls,
+        sizes_mm: Sequence[float],
+        percent_passing: Sequence[float],
+        *,
+        upscale: float = 1.0,
+        d_min_mm: float | None = None,
+        d_max_mm: float | None = None,
+        source: str = "inline",
+    ) -> GradingCurve:
+        """Build a curve from laboratory sieve sizes (mm) and percent passing by mass.
+
+        ``upscale`` multiplies every size. ``d_min_mm``/``d_max_mm`` cut the *up-scaled*
+        curve: mass finer than ``d_min_mm`` or coarser than ``d_max_mm`` is removed and the
+        rest renormalised to 0-100 %. A table listed from the coarsest sieve down is
+        accepted and reversed.
+        """
+        sizes = _as_float_array("sizes_mm", sizes_mm)
+        percent = _as_float_array("percent_passing", percent_passing)
+        if sizes.size >= 2 and np.all(np.diff(sizes) < 0.0) and percent.size == sizes.size:
+            sizes, percent = sizes[::-1].copy(), percent[::-1].copy()
+        _check_curve(sizes, percent, "sizes_mm", "percent_passing", need_zero_start=False)
+        percent[-1] = 100.0
+        up = check_range("upscale", upscale, 0.0, None, lo_open=True)
+        if not math.isfinite(up):
+            raise InputError("upscale", upscale, "a finite number > 0")
+        d = sizes * up / 1000.0
+        lo = _cutoff("d_min_mm", d_min_mm)
+        hi = _cutoff("d_max_mm", d_max_mm)
+        if lo is not None and hi is not None and lo >= hi:
+            raise InputError("d_min_mm", d_min_mm, f"< d_max_mm = {d_max_mm}")
+        if percent[0] > 0.0 and (lo is None or lo <= d[0]):
+            _check_curve(sizes, percent, "sizes_mm", "percent_passing", need_zero_start=True)
+        d, percent = _apply_cutoffs(d, percent, lo, hi, d_min_mm, d_max_mm)
+        return cls(tuple(d), tuple(percent), upscale=up, source=source)
+
+    @classmethod
+    def from_csv(
+        cls,
+        path: str | Path,
+        *,
+        upscale: float = 1.0,
+        d_min_mm: float | None = None,
+        d_max_mm: float | None = None,
+    ) -> GradingCurve:
+        """Read a CSV with columns ``size_mm,percent_passing`` (lines starting ``#`` skipped)."""
+        p = Path(path)
+        try:
+            text = p.read_text(encoding="utf-8")
+        except OSError:
+            raise InputError(
+                "csv", str(path), "a readable CSV file with columns size_mm,percent_passing"
+            ) from None
+        sizes, percent = _parse_csv(text, str(p))
+        return cls.from_lists(
+            sizes,
+            percent,
+            upscale=upscale,
+            d_min_mm=d_min_mm,
+            d_max_mm=d_max_mm,
+            source=str(p),
+        )
+
+    @classmethod
+    def from_config(
+        cls, table: Mapping[str, Any], *, base_dir: str | Path | None = None
+    ) -> GradingCurve:
+        """Build a curve from a config table (e.g. ``[grading]`` of a TOML file).
+
+        Keys: exactly one of ``preset = "paper"``, ``csv = "path.csv"`` (relative to
+        ``base_dir``) or ``sizes_mm = [...]`` with ``percent_passing = [...]``; optional
+        ``upscale`` (default 1, or 10 for the paper preset), ``d_min_mm``, ``d_max_mm``.
+        """
+        unknown = sorted(set(table) - set(_CONFIG_KEYS))
+        if unknown:
+            raise InputError(f"grading.{unknown[0]}", table[unknown[0]], ", ".join(_CONFIG_KEYS))
+        sources = [k for k in ("preset", "csv", "sizes_mm") if k in table]
+        if len(sources) != 1:
+            raise InputError(
+                "grading", sorted(table), "exactly one of preset, csv or sizes_mm/percent_passing"
+            )
+        cuts = {"d_min_mm": table.get("d_min_mm"), "d_max_mm": table.get("d_max_mm")}
+        if "preset" in table:
+            if table["preset"] != "paper":
+                raise InputError("grading.preset", table["preset"], '"paper"')
+            if "percent_passing" in table:
+                raise InputError("grading.percent_passing", table["percent_passing"], "unset")
+            return paper_grading(upscale=table.get("upscale", PAPER_UPSCALE), **cuts)
+        upscale = table.get("upscale", 1.0)
+        if "csv" in table:
+            if "percent_passing" in table:
+                raise InputError(
+                    "grading.percent_passing", table["percent_passing"], "unset when csv is given"
+                )
+            path = Path(table["csv"])
+            if base_dir is not None and not path.is_absolute():
+                path = Path(base_dir) / path
+            return cls.from_csv(path, upscale=upscale, **cuts)
+        if "percent_passing" not in table:
+            raise InputError("grading.percent_passing", None, "a list, one value per size")
+        return cls.from_lists(
+            table["sizes_mm"], table["percent_passing"], upscale=upscale, source="config", **cuts
+        )
+
+    # ------------------------------------------------------------------ derived data
+    @property
+    def sizes(self) -> np.ndarray:
+        """Model sieve sizes in metres (a new array)."""
+        return np.array(self.sizes_m)
+
+    @property
+    def percent(self) -> np.ndarray:
+        """Percent passing by mass (a new array)."""
+        return np.array(self.percent_passing)
+
+    @property
+    def d_min_m(self) -> float:
+        return self.sizes_m[0]
+
+    @property
+    def d_max_m(self) -> float:
+        return self.sizes_m[-1]
+
+    @property
+    def class_fractions(self) -> np.ndarray:
+        """Mass (= area) fraction of each class between consecutive sizes; sums to 1."""
+        return np.diff(self.percent) / 100.0
+
+    def mean_disk_area(self, within_class: str = "uniform") -> float:
+        """Expected disk area [m^2] of a drawn set: total area / expected number of disks."""
+        _check_within(within_class)
+        a, b = self.sizes[:-1], self.sizes[1:]
+        f = self.class_fractions
+        keep = f > 0.0
+        return float(1.0 / np.sum(f[keep] / _class_mean_area(a[keep], b[keep], within_class)))
+
+    def expected_count(self, solid_area: float, within_class: str = "uniform") -> float:
+        """Expected number of disks that :func:`draw_disks` returns for ``solid_area``."""
+        return float(solid_area) / self.mean_disk_area(within_class)
+
+
+def _cutoff(name: str, value: float | None) -> float | None:
+    if value is None:
+        return None
+    v = check_range(name, value, 0.0, None, lo_open=True)
+    if not math.isfinite(v):
+        raise InputError(name, value, "a finite size in mm > 0")
+    return v / 1000.0
+
+
+def _apply_cutoffs(
+    d: np.ndarray,
+    percent: np.ndarray,
+    lo: float | None,
+    hi: float | None,
+    lo_raw: Any,
+    hi_raw: Any,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Cut an up-scaled curve at lo/hi (metres), renormalise, trim empty end classes."""
+    if lo is not None and lo >= d[-1]:
+        raise InputError(
+            "d_min_mm",
+            lo_raw,
+            f"< the largest up-scaled size {d[-1] * 1e3:g} mm",
+            hint="the cut-offs leave no particles",
+        )
+    if hi is not None and hi <= d[0]:
+        raise InputError(
+            "d_max_mm",
+            hi_raw,
+            f"> the smallest up-scaled size {d[0] * 1e3:g} mm",
+            hint="the cut-offs leave no particles",
+        )
+    lo_eff = d[0] if lo is None else max(lo, d[0])
+    hi_eff = d[-1] if hi is None else min(hi, d[-1])
+    p_lo = _interp_log(lo_eff, d, percent)
+    p_hi = _interp_log(hi_eff, d, percent)
+    if p_hi - p_lo <= 0.0:
+        raise InputError(
+            "d_min_mm" if lo is not None else "d_max_mm",
+            lo_raw if lo is not None else hi_raw,
+            "cut-offs that keep some mass of the curve",
+            hint=f"no mass between {lo_eff * 1e3:g} and {hi_eff * 1e3:g} mm",
+        )
+    inner = (d > lo_eff) & (d < hi_eff)
+    d_new = np.concatenate(([lo_eff], d[inner], [hi_eff]))
+    p_new = np.concatenate(([p_lo], percent[inner], [p_hi]))
+    p_new = np.clip((p_new - p_lo) / (p_hi - p_lo) * 100.0, 0.0, 100.0)
+    p_new[0], p_new[-1] = 0.0, 100.0
+    # trim classes of zero mass at both ends so d_min_m/d_max_m are the real bounds
+    first = int(np.nonzero(p_new == 0.0)[0][-1])
+    last = int(np.nonzero(p_new == 100.0)[0][0])
+    return d_new[first : last + 1], p_new[first : last + 1]
+
+
+def _parse_csv(text: str, origin: str) -> tuple[list[float], list[float]]:
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    reader = csv.DictReader(io.StringIO("\n".join(lines)))
+    fields = [f.strip() for f in (reader.fieldnames or [])]
+    if "size_mm" not in fields or "percent_passing" not in fields:
+        raise InputError("csv", origin, "a header with columns size_mm,percent_passing")
+    reader.fieldnames = fields
+    sizes: list[float] = []
+    percent: list[float] = []
+    for row_no, row in enumerate(reader, start=2):
+        try:
+            sizes.append(float(row["size_mm"]))
+            percent.append(float(row["percent_passing"]))
+        except (TypeError, ValueError):
+            raise InputError(
+                "csv", f"{origin} data row {row_no - 1}", "numbers in size_mm and percent_passing"
+            ) from None
+    return sizes, percent
+
+
+def paper_grading(
+    *,
+    upscale: float = PAPER_UPSCALE,
+    d_min_mm: float | None = None,
+    d_max_mm: float | None = None,
+) -> GradingCurve:
+    """The built-in grading of the paper preset, up-scaled by 10.
+
+    A documented *reconstruction* of a medium sand (lab d 0.2-0.71 mm), not the measured
+    curve of the paper's Fig. 4; see ``docs/grading.md``. With diameters uniform within each
+    class its mean disk area is 1.256e-5 m^2, which gives about 2589 disks at n2D = 0.14 and
+    2559 at 0.15 in the 0.305 m x 0.124 m box (paper: 2591 and 2552).
+    """
+    text = resources.files("poro2d").joinpath("data/paper_grading.csv").read_text("utf-8")
+    sizes, percent = _parse_csv(text, "poro2d/data/paper_grading.csv")
+    return GradingCurve.from_lists(
+        sizes,
+        percent,
+        upscale=upscale,
+        d_min_mm=d_min_mm,
+        d_max_mm=d_max_mm,
+        source="poro2d/data/paper_grading.csv (reconstruction of the paper's Fig. 4)",
+    )
+
+
+# ---------------------------------------------------------------------- drawing disks
+def _check_within(within_class: str) -> None:
+    if within_class not in _WITHIN_CLASS:
+        raise InputError("within_class", within_class, " or ".join(_WITHIN_CLASS))
+
+
+def _class_mean_area(a: np.ndarray, b: np.ndarray, within_class: str) -> np.ndarray:
+    """Mean disk area in classes [a, b] of diameter for the within-class distribution."""
+    if within_class == "uniform":
+        mean_d2 = (a * a + a * b + b * b) / 3.0
+    else:  # log-uniform: E[d^2] = (b^2 - a^2) / (2 ln(b/a))
+        mean_d2 = (b * b - a * a) / (2.0 * np.log(b / a))
+    return 0.25 * np.pi * mean_d2
+
+
+def _sample_d(rng: np.random.Generator, a: float, b: float, n: int, within: str) -> np.ndarray:
+    u = rng.random(n)
+    if within == "uniform":
+        return a + (b - a) * u
+    return a * (b / a) ** u
+
+
+def _make_rng(seed: int | np.random.Generator) -> np.random.Generator:
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise InputError("seed", seed, "an integer >= 0 or a numpy Generator")
+    return np.random.default_rng(int(seed))
+
+
+def draw_disks(
+    curve: GradingCurve,
+    solid_area: float,
+    seed: int | np.random.Generator,
+    *,
+    within_class: str = "uniform",
+) -> np.ndarray:
+    """Draw disk radii [m] whose total area is ``solid_area`` and whose area follows ``curve``.
+
+    Classes are filled one after the other from the coarsest: each gets the target area
+    ``fraction * solid_area`` plus what the previous classes missed or overshot, and its last
+    disk is kept only if that brings the running total closer to the running target. So the
+    cumulative area tracks the curve to within half a disk of the class being filled, and the
+    total ends within half of one of the finest disks of ``solid_area``. Finally all radii are
+    multiplied by one common factor ``sqrt(solid_area / total)``, within about
+    ``a_fine / (4 solid_area)`` of 1 (a_fine: area of one of the finest disks; ~3e-5 for the
+    paper specimen). That makes the total area exact to rounding (relative error ~1e-15), so
+    the specimen porosity is exactly the trial porosity; a disk drawn at a class bound may be
+    moved across it by that tiny factor.
+
+    Within a class, diameters are uniform in ``d`` (``within_class="uniform"``) or in
+    ``log d`` (``"loguniform"``). Radii are returned in drawing order (coarsest class first).
+    The same seed gives the same radii.
+    """
+    if not isinstance(curve, GradingCurve):
+        raise InputError("curve", type(curve).__name__, "a GradingCurve")
+    area = check_range("solid_area", solid_area, 0.0, None, lo_open=True)
+    if not math.isfinite(area):
+        raise InputError("solid_area", solid_area, "a finite area in m^2 > 0")
+    _check_within(within_class)
+    rng = _make_rng(seed)
+
+    d = curve.sizes
+    fractions = curve.class_fractions
+    lo_all, hi_all = d[:-1], d[1:]
+    mean_areas = _class_mean_area(lo_all, hi_all, within_class)
+    if area / float(mean_areas[fractions > 0].max()) > 5e7:
+        raise InputError("solid_area", solid_area, "at most about 5e7 disks of this grading")
+
+    chunks: list[np.ndarray] = []
+    target_cum = 0.0
+    area_cum = 0.0
+    for i in range(fractions.size - 1, -1, -1):
+        if fractions[i] <= 0.0:
+            continue
+        target_cum += fractions[i] * area
+        a, b = float(lo_all[i]), float(hi_all[i])
+        while True:
+            need = target_cum - area_cum
+            n = max(8, int(1.1 * max(need, 0.0) / mean_areas[i]) + 8)
+            dd = _sample_d(rng, a, b, n, within_class)
+            cum = area_cum + np.cumsum(0.25 * np.pi * dd * dd)
+            over = np.nonzero(cum > target_cum)[0]
+            if over.size == 0:
+                chunks.append(dd)
+                area_cum = float(cum[-1])
+                continue
+            k = int(over[0])
+            before = area_cum if k == 0 else float(cum[k - 1])
+            keep = k + 1 if cum[k] - target_cum < target_cum - before else k
+            chunks.append(dd[:keep])
+            area_cum = float(cum[keep - 1]) if keep > 0 else area_cum
+            break
+
+    diam = np.concatenate(chunks) if chunks else np.empty(0)
+    if diam.size == 0:
+        raise InputError(
+            "solid_area",
+            solid_area,
+            f"at least about one disk area of the finest class ({mean_areas[0]:.3g} m^2)",
+        )
+    radii = 0.5 * diam
+    for _ in range(3):  # one pass is normally enough; repeat to be safe against rounding
+        total = float(np.sum(np.pi * radii * radii))
+        if abs(total - area) <= 1e-14 * area:
+            break
+        radii = radii * math.sqrt(area / total)
+    return radii
+
+
+# ---------------------------------------------------------------------- checking a draw
+def _radii_array(radii: Any) -> np.ndarray:
+    r = _as_float_array("radii", radii)
+    if r.size == 0 or np.any(r <= 0.0):
+        raise InputError("radii", r.size, "a non-empty list of radii > 0")
+    return r
+
+
+def realised_curve(curve: GradingCurve, radii: Any) -> np.ndarray:
+    """Percent passing by area of ``radii`` at the curve's sizes (a disk passes if d <= size)."""
+    r = _radii_array(radii)
+    order = np.argsort(r)
+    d_sorted = 2.0 * r[order]
+    cum = np.concatenate(([0.0], np.cumsum(r[order] ** 2)))
+    idx = np.searchsorted(d_sorted, curve.sizes, side="right")
+    return 100.0 * cum[idx] / cum[-1]
+
+
+def max_deviation(curve: GradingCurve, radii: Any) -> float:
+    """Largest |realised - requested| percent passing over the sieve sizes [percentage points]."""
+    return float(np.max(np.abs(realised_curve(curve, radii) - curve.percent)))
+
+
+def plot_realised(
+    curve: GradingCurve, radii: Any, path: str | Path, *, title: str | None = None
+) -> Path:
+    """Write a PNG of the requested and realised curves (log diameter axis) and return its path."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    r = _radii_array(radii)
+    realised = realised_curve(curve, r)
+    dev = float(np.max(np.abs(realised - curve.percent)))
+    d_mm = curve.sizes * 1e3
+
+    fig = Figure(figsize=(6.4, 4.2), dpi=150)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(1, 1, 1)
+    ax.semilogx(d_mm, curve.percent, "-o", color="k", ms=4, label="requested (by mass)")
+    ax.semilogx(d_mm, realised, "s", color="tab:red", mfc="none", ms=7, label="realised (by area)")
+    ax.set_xlabel("diameter in the model d [mm]")
+    ax.set_ylabel("percent passing [%]")
+    ax.set_ylim(0, 100)
+    ax.set_xticks(d_mm, [f"{v:.3g}" for v in d_mm])
+    ax.set_xticks([], minor=True)
+    ax.grid(True, alpha=0.3)
+    if curve.upscale != 1.0:
+        up = curve.upscale
+        top = ax.secondary_xaxis("top", functions=(lambda x: x / up, lambda x: x * up))
+        top.set_xticks(d_mm / up, [f"{v:.3g}" for v in d_mm / up])
+        top.set_xticks([], minor=True)
+        top.set_xlabel(f"laboratory size [mm] (up-scaling factor {up:g})")
+    ax.legend(loc="upper left", title=f"{r.size} disks, max deviation {dev:.2f} %-points")
+    if title:
+        ax.set_title(title)
+    fig.tight_layout()
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, format="png")
+    return out
