@@ -5,4 +5,4 @@ from poro2d.dem.model import ContactModel
 from poro2d.dem.simulation import RunResult, Simulation, SimulationError
 from poro2d.dem.state import Particles, Walls
 
-__all__ = ["ContactModel", "Particles", "RunResult", "Simulation", "SimulationError", "Walls"]
+__all__ = ["checkpoint", "ContactModel", "Particles", "RunResult", "Simulation", "SimulationError", "Walls"]
