@@ -1,9 +1,368 @@
-"""CLI commands for the 3D-to-2D porosity conversions (filled in by the conversions work)."""
+"""CLI commands for the 3D-to-2D porosity conversions.
+
+``poro2d convert NLAB... [--n-max X --n-min Y] [--dry-density RHO_D --solid-density RHO_S]
+[--nu-reading printed|solid_fraction] [--lattice-exact] [--format table|json|csv]``
+
+``poro2d plot relations [--n-max X --n-min Y] [-o DIR]``
+
+Output formats of ``convert``:
+
+* ``table`` (default): one rich table per laboratory porosity, one row per method (id,
+  name, equation, n2D, flags; skipped methods show the reason), warnings and notes below.
+* ``json``: for one NLAB, one object whose keys are the method ids with the 2D porosity as
+  value (``null`` where skipped or undefined), plus ``n_lab``, ``inputs``, ``relative_density``,
+  ``flags``, ``skipped``, ``warnings``, ``notes``, ``details``, ``methods`` and
+  ``poro2d_version``. For several NLAB values, a JSON list of such objects, in input order.
+* ``csv``: a header row, then one row per (n_lab, method).
+"""
 
 from __future__ import annotations
 
+import csv
+import enum
+import io
+import json
+from pathlib import Path
+from typing import Annotated
+
+import click
 import typer
+from typer.core import TyperCommand
+
+from poro2d import __version__
+from poro2d import porosity as P
+from poro2d.errors import InputError, check_range
+
+_PARAM_ALLOWED = "a number in [0, 1)"
+
+
+class OutputFormat(enum.StrEnum):
+    table = "table"
+    json = "json"
+    csv = "csv"
+
+
+class NuReading(enum.StrEnum):
+    printed = "printed"
+    solid_fraction = "solid_fraction"
+
+
+def _parse_nlab(tokens: list[str]) -> list[float]:
+    """Parse NLAB tokens ourselves so that '-0.1' and 'nan' reach our range check."""
+    values = []
+    for tok in tokens:
+        try:
+            v = float(tok)
+        except ValueError:
+            if tok.startswith("-"):
+                raise click.NoSuchOption(tok) from None
+            raise InputError("NLAB", tok, _PARAM_ALLOWED) from None
+        if not (0.0 <= v < 1.0):  # also catches NaN
+            raise InputError("NLAB", v, "[0, 1)")
+        values.append(v)
+    return values
+
+
+def _lab_porosities(
+    nlab: list[str] | None, dry_density: float | None, solid_density: float | None
+) -> tuple[list[float], dict]:
+    extra: dict = {}
+    have_density = dry_density is not None or solid_density is not None
+    if have_density:
+        if dry_density is None:
+            raise InputError("--dry-density", None, "(0, solid density] kg/m3, with --solid-density")
+        if solid_density is None:
+            raise InputError("--solid-density", None, "(0, inf) kg/m3, with --dry-density")
+        if nlab:
+            raise InputError(
+                "NLAB",
+                " ".join(nlab),
+                "no NLAB values when --dry-density/--solid-density are given",
+            )
+        n = float(P.porosity_from_densities(dry_density, solid_density))
+        extra = {"dry_density_kg_m3": dry_density, "solid_density_kg_m3": solid_density}
+        return [n], extra
+    if not nlab:
+        raise InputError(
+            "NLAB",
+            None,
+            "at least one laboratory porosity in [0, 1), or --dry-density with --solid-density",
+        )
+    return _parse_nlab(nlab), extra
+
+
+def _fmt(v: float | None, digits: int = 4) -> str:
+    return "-" if v is None else f"{v:.{digits}f}"
+
+
+def conversion_to_json(conv: P.Conversion, extra_inputs: dict | None = None) -> dict:
+    """The JSON object of one laboratory porosity (method ids as keys, see module doc)."""
+    obj: dict = {mid: r.value for mid, r in conv.results.items()}
+    dr = None
+    if conv.n_max is not None and conv.n_min is not None:
+        dr = float(P.relative_density(conv.n_lab, conv.n_max, conv.n_min))
+    obj.update(
+        {
+            "n_lab": conv.n_lab,
+            "inputs": {
+                "n_lab": conv.n_lab,
+                "n_max": conv.n_max,
+                "n_min": conv.n_min,
+                **conv.options,
+                **(extra_inputs or {}),
+            },
+            "relative_density": dr,
+            "flags": {mid: r.flags for mid, r in conv.results.items()},
+            "skipped": {mid: r.skipped for mid, r in conv.results.items() if r.skipped},
+            "warnings": conv.warnings,
+            "notes": conv.notes,
+            "details": {mid: r.details for mid, r in conv.results.items() if r.details},
+            "methods": {
+                mid: {"name": r.name, "equation": r.equation, "source": r.source}
+                for mid, r in conv.results.items()
+            },
+            "poro2d_version": __version__,
+        }
+    )
+    return obj
+
+
+def _print_table(conv: P.Conversion, extra_inputs: dict) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    console = Console(highlight=False)
+    if not console.is_terminal:  # files and pipes: do not squeeze the table into 80 columns
+        console = Console(highlight=False, width=120)
+    title = f"n_lab = {conv.n_lab:.4f}"
+    if extra_inputs:
+        title += (
+            f" (from rho_d = {extra_inputs['dry_density_kg_m3']:g}, "
+            f"rho_s = {extra_inputs['solid_density_kg_m3']:g} kg/m3)"
+        )
+    if conv.n_max is not None and conv.n_min is not None:
+        dr = float(P.relative_density(conv.n_lab, conv.n_max, conv.n_min))
+        title += f", n_max = {conv.n_max:g}, n_min = {conv.n_min:g}, D_r = {dr:.3f}"
+    elif conv.n_min is not None:
+        title += f", n_min = {conv.n_min:g}"
+    table = Table(title=title, title_justify="left")
+    table.add_column("id", no_wrap=True)
+    table.add_column("name")
+    table.add_column("equation", no_wrap=True)
+    table.add_column("n2D", justify="right", no_wrap=True)
+    table.add_column("flags")
+    for r in conv.results.values():
+        if r.value is None:
+            n2d = "[dim]skipped[/]"
+            flags = ", ".join(r.flags + [f"skipped: {r.skipped}"])
+        else:
+            n2d = f"[red]{r.value:.4f}[/]" if r.value < 0 else f"{r.value:.4f}"
+            flags = ", ".join(r.flags)
+        table.add_row(r.id, r.name, r.equation, n2d, flags)
+    console.print(table)
+    for w in conv.warnings:
+        console.print(f"[yellow]warning:[/] {w}")
+    for note in conv.notes:
+        console.print(f"note: {note}")
+
+
+_CSV_HEADER = [
+    "n_lab",
+    "n_max",
+    "n_min",
+    "method",
+    "name",
+    "equation",
+    "n2d",
+    "flags",
+    "skipped",
+    "nu_reading",
+    "lattice_exact",
+]
+
+
+def _csv_rows(conv: P.Conversion) -> list[list]:
+    rows = []
+    for r in conv.results.values():
+        rows.append(
+            [
+                repr(conv.n_lab),
+                "" if conv.n_max is None else repr(conv.n_max),
+                "" if conv.n_min is None else repr(conv.n_min),
+                r.id,
+                r.name,
+                r.equation,
+                "" if r.value is None else repr(r.value),
+                ";".join(r.flags),
+                r.skipped or "",
+                conv.options["nu_reading"],
+                str(conv.options["lattice_exact"]).lower(),
+            ]
+        )
+    return rows
+
+
+def convert(
+    nlab: Annotated[
+        list[str] | None,
+        typer.Argument(
+            metavar="NLAB...",
+            help="Laboratory (3D) porosities in [0, 1). Several values are allowed.",
+            show_default=False,
+        ),
+    ] = None,
+    n_max: Annotated[
+        float | None,
+        typer.Option("--n-max", help="Laboratory maximum porosity n_lab,max (loosest state)."),
+    ] = None,
+    n_min: Annotated[
+        float | None,
+        typer.Option("--n-min", help="Laboratory minimum porosity n_lab,min (densest state)."),
+    ] = None,
+    dry_density: Annotated[
+        float | None,
+        typer.Option("--dry-density", help="Dry density rho_d in kg/m3; gives n_lab = 1 - rho_d/rho_s."),
+    ] = None,
+    solid_density: Annotated[
+        float | None,
+        typer.Option("--solid-density", help="Density of the solids rho_s in kg/m3 (e.g. 2650)."),
+    ] = None,
+    nu_reading: Annotated[
+        NuReading,
+        typer.Option(
+            "--nu-reading",
+            help="Eq. 2: nu = n_min/n_FCC as printed, or (1-n_min)/(1-n_FCC) (solid fraction).",
+        ),
+    ] = NuReading.printed,
+    lattice_exact: Annotated[
+        bool,
+        typer.Option(
+            "--lattice-exact",
+            help="Eqs. 7-11: 1-pi/4 and 1-pi/(2 sqrt 3) instead of the printed 0.2146/0.0931.",
+        ),
+    ] = False,
+    fmt: Annotated[
+        OutputFormat, typer.Option("--format", help="Output format: table, json or csv.")
+    ] = OutputFormat.table,
+) -> None:
+    """Convert laboratory porosities to 2D with every method of the paper (Eqs. 1-12)."""
+    values, extra = _lab_porosities(nlab, dry_density, solid_density)
+    if n_max is not None:
+        check_range("--n-max", n_max, 0.0, 1.0, hi_open=True)
+    if n_min is not None:
+        check_range("--n-min", n_min, 0.0, 1.0, hi_open=True)
+    if n_max is not None and n_min is not None and not n_max > n_min:
+        raise InputError("--n-max", n_max, f"greater than --n-min = {n_min}")
+    convs = [
+        P.convert_all(v, n_max, n_min, nu_reading=nu_reading.value, lattice_exact=lattice_exact)
+        for v in values
+    ]
+    if fmt is OutputFormat.json:
+        objs = [conversion_to_json(c, extra) for c in convs]
+        out = objs[0] if len(objs) == 1 else objs
+        typer.echo(json.dumps(out, indent=2, allow_nan=False))
+    elif fmt is OutputFormat.csv:
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(_CSV_HEADER)
+        for c in convs:
+            w.writerows(_csv_rows(c))
+        typer.echo(buf.getvalue(), nl=False)
+    else:
+        for c in convs:
+            _print_table(c, extra)
+
+
+def plot_relations(
+    ctx: typer.Context,
+    n_max: Annotated[float, typer.Option("--n-max", help="Laboratory maximum porosity.")] = P.PAPER_N_MAX,
+    n_min: Annotated[float, typer.Option("--n-min", help="Laboratory minimum porosity.")] = P.PAPER_N_MIN,
+    out_dir: Annotated[
+        Path, typer.Option("-o", "--out-dir", help="Output directory (created if missing).")
+    ] = Path("."),
+    mark_n_lab: Annotated[
+        float | None,
+        typer.Option("--mark-n-lab", help="Mark one laboratory porosity on both figures (e.g. 0.3434)."),
+    ] = None,
+    nu_reading: Annotated[
+        NuReading,
+        typer.Option("--nu-reading", help="Reading of nu in Eq. 2 for the main Eq. 2 curve."),
+    ] = NuReading.printed,
+    lattice_exact: Annotated[
+        bool, typer.Option("--lattice-exact", help="Exact lattice 2D extremes in Eqs. 7-11.")
+    ] = False,
+) -> None:
+    """Write the paper's Fig. 1 and Fig. 2 (PNG and SVG) into DIR."""
+    if ctx.args:
+        raise InputError(
+            "option",
+            ctx.args[0],
+            "--n-max, --n-min, -o/--out-dir, --mark-n-lab, --nu-reading, --lattice-exact",
+        )
+    check_range("--n-max", n_max, 0.0, 1.0, hi_open=True)
+    check_range("--n-min", n_min, 0.0, 1.0, hi_open=True)
+    if not n_max > n_min:
+        raise InputError("--n-max", n_max, f"greater than --n-min = {n_min}")
+    if mark_n_lab is not None:
+        check_range("--mark-n-lab", mark_n_lab, 0.0, 0.5)
+    from poro2d.figures.relations import write_relation_figures
+
+    paths = write_relation_figures(
+        out_dir,
+        n_max,
+        n_min,
+        nu_reading=nu_reading.value,
+        lattice_exact=lattice_exact,
+        mark_n_lab=mark_n_lab,
+    )
+    for p in paths:
+        typer.echo(str(p))
+
+
+try:  # recent typer ships its own copy of click; its errors are not click's
+    from typer._click.exceptions import ClickException as _TyperClickException
+except ImportError:  # pragma: no cover - typer using the click package directly
+    _TyperClickException = None
+
+
+class _Command(TyperCommand):
+    """Turn usage errors of typer's bundled click into ``click.UsageError``.
+
+    The root ``main()`` prints ``click`` exceptions as one line with their exit code (2);
+    a usage error raised by typer's own copy of click would otherwise escape as a
+    traceback.
+    """
+
+    def make_context(self, info_name, args, parent=None, **extra):
+        try:
+            return super().make_context(info_name, args, parent=parent, **extra)
+        except Exception as exc:
+            if (
+                _TyperClickException is not None
+                and isinstance(exc, _TyperClickException)
+                and not isinstance(exc, click.ClickException)
+            ):
+                raise click.UsageError(f"{info_name}: {exc.format_message()}") from None
+            raise
 
 
 def register(app: typer.Typer) -> None:
-    """Attach the conversion commands to the root app."""
+    """Attach ``convert`` and ``plot relations`` to the root app."""
+    app.command(
+        "convert",
+        cls=_Command,
+        context_settings={"ignore_unknown_options": True},
+    )(convert)
+    plot_app = None
+    for group in app.registered_groups:
+        if group.name == "plot" and group.typer_instance is not None:
+            plot_app = group.typer_instance
+            break
+    if plot_app is None:
+        plot_app = typer.Typer(help="Figures.", no_args_is_help=True)
+        app.add_typer(plot_app, name="plot")
+    plot_app.command(
+        "relations",
+        cls=_Command,
+        context_settings={"ignore_unknown_options": True, "allow_extra_args": True},
+    )(plot_relations)

@@ -1,0 +1,1 @@
+"""Figures of poro2d (matplotlib, Agg backend, no pyplot state)."""
