@@ -64,16 +64,32 @@ def main(argv: list[str] | None = None) -> None:
         sys.exit(130)
     except SystemExit:
         raise
-    except Exception as exc:  # click usage errors and friends
-        import click
-
-        if isinstance(exc, click.exceptions.ClickException):
-            exc.show()
-            sys.exit(exc.exit_code)
-        if isinstance(exc, click.exceptions.Abort):
+    except Exception as exc:  # usage errors of click (or the copy of it that typer ships)
+        if _is_click(exc, "ClickException"):
+            exc.show()  # type: ignore[attr-defined]
+            sys.exit(exc.exit_code)  # type: ignore[attr-defined]
+        if _is_click(exc, "Abort"):
             err_console.print("[yellow]aborted[/]")
             sys.exit(1)
         raise
+
+
+def _is_click(exc: BaseException, name: str) -> bool:
+    """True if ``exc`` is click's ``name`` exception, from click itself or typer's bundled copy."""
+    mods = []
+    try:
+        import click
+
+        mods.append(click.exceptions)
+    except ImportError:  # pragma: no cover
+        pass
+    try:
+        from typer._click import exceptions as tce  # typer >= 0.29 bundles click
+
+        mods.append(tce)
+    except ImportError:
+        pass
+    return any(isinstance(exc, getattr(m, name)) for m in mods if hasattr(m, name))
 
 
 if __name__ == "__main__":  # pragma: no cover
