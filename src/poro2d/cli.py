@@ -44,9 +44,12 @@ def _root(
 def _register() -> None:
     # Imported here so that `poro2d --help` stays cheap and a broken optional
     # layer cannot take the whole CLI down at import time.
-    from poro2d import porosity_cli
+    from poro2d import paper, porosity_cli
+    from poro2d.criterion import cli as criterion_cli
 
     porosity_cli.register(app)
+    criterion_cli.register(app)
+    paper.register(app)
 
 
 _register()

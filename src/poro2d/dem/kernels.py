@@ -264,9 +264,11 @@ def run_steps(
                 # compressive force along the servo direction; v = gain * error / (k dt)
                 fc = -(wforce[w, 0] * wdir[w, 0] + wforce[w, 1] * wdir[w, 1])
                 err = wservo[w, 0] - fc
-                k = wstat[w, 1] if wstat[w, 0] > 0.0 else wkn[w]
-                v = wservo[w, 1] * err / (k * dt)
                 vmax = wservo[w, 2]
+                if wstat[w, 0] > 0.0:
+                    v = wservo[w, 1] * err / (wstat[w, 1] * dt)
+                else:  # nothing touches: approach (or retreat) at full speed
+                    v = vmax if err > 0.0 else -vmax
                 if v > vmax:
                     v = vmax
                 elif v < -vmax:

@@ -237,6 +237,28 @@ class Simulation:
             self._n_alloc = -1  # fresh lists: indices changed, old history is void
         self._refresh()
 
+    def add_particles(self, new: Particles) -> np.ndarray:
+        """Append disks; existing contacts keep their history. Returns the new indices."""
+        p = self.particles
+        if new.thickness != p.thickness:
+            raise InputError("thickness", new.thickness, f"{p.thickness} (the thickness of the disks present)")
+        n0 = p.n
+        for f in ("pos", "radius", "density", "kn", "ks", "mu", "vel", "theta", "omega", "mode"):
+            setattr(p, f, np.ascontiguousarray(np.concatenate([getattr(p, f), getattr(new, f)])))
+        n = p.n
+        # Old rows keep their place; the new disks start with empty rows.
+        for name in ("_nb_start", "_wb_start"):
+            old = getattr(self, name)
+            setattr(self, name, np.concatenate([old, np.full(n - n0, old[-1], dtype=np.int64)]))
+        for name in ("_new_start", "_rev_start", "_wnew_start"):
+            setattr(self, name, np.zeros(n + 1, dtype=np.int64))
+        self.force = np.concatenate([self.force, np.zeros((n - n0, 2))])
+        self.moment = np.concatenate([self.moment, np.zeros(n - n0)])
+        self._pos_build = np.concatenate([self._pos_build, new.pos])
+        self._n_alloc = n
+        self._refresh()
+        return np.arange(n0, n)
+
     def set_particle_friction(self, mu: float) -> None:
         """Change every disk's friction coefficient (e.g. 0.05 -> 3 after preparation)."""
         if not (mu >= 0.0 and math.isfinite(mu)):
@@ -255,6 +277,13 @@ class Simulation:
         self.walls.mode[w] = WALL_VELOCITY
         self.walls.vel[w] = v
 
+    def translate_wall(self, wall: str | int, dx: float, dy: float) -> None:
+        """Move a wall rigidly by (dx, dy) at once (a teleport, e.g. a temporary lid)."""
+        w = self.walls.index(wall)
+        self.walls.p0[w] += (dx, dy)
+        self.walls.p1[w] += (dx, dy)
+        self._iprm[K.NEED_BUILD] = 1
+
     def set_wall_servo(
         self,
         wall: str | int,
@@ -267,6 +296,7 @@ class Simulation:
 
         Every step: v = gain * (target - F) / (sum of contact kn on the wall * dt),
         bounded by ``max_speed``; F is the compressive force along ``direction`` (N).
+        A wall that touches nothing moves at ``max_speed`` towards the target.
         """
         w = self.walls.index(wall)
         d = np.asarray(direction, dtype=float)

@@ -1,0 +1,5 @@
+"""The paper's criterion (its Fig. 3) for the final 2D porosity."""
+
+from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
+
+__all__ = ["CriterionSettings", "PorosityCriterion"]

@@ -1,0 +1,56 @@
+"""Config files for the criterion: ``[specimen]``, ``[grading]``, ``[criterion]``, ``seed``.
+
+Example (every key optional; the defaults are the paper preset)::
+
+    seed = 1
+    [specimen]          # SpecimenSpec: box, Table 1 properties, layers, damping
+    width = 0.305
+    layers = 4
+    [grading]           # preset = "paper" | csv = "curve.csv" | sizes_mm + percent_passing
+    preset = "paper"
+    [criterion]         # CriterionSettings: n_lab, thresholds, resolution, servo
+    n_lab = 0.3434
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from poro2d.config import check_keys, dataclass_from_table, load_toml
+from poro2d.criterion.protocol import CriterionSettings
+from poro2d.errors import InputError
+from poro2d.specimen.compaction import SpecimenSpec
+from poro2d.specimen.grading import GradingCurve, paper_grading
+
+TOP_KEYS = {"seed", "specimen", "grading", "criterion", "shear", "title"}
+
+
+def paper_preset() -> dict:
+    """The paper's case as a config dict (Table 1, nLab = 0.3434, reconstructed grading)."""
+    return {"seed": 0, "specimen": {}, "grading": {"preset": "paper"}, "criterion": {"n_lab": 0.3434}}
+
+
+def load_config(path: str | os.PathLike | None = None, preset: str | None = None) -> tuple[dict, Path | None]:
+    if path is not None and preset is not None:
+        raise InputError("--config/--preset", f"{path} and {preset}", "one of the two, not both")
+    if path is None:
+        if preset not in (None, "paper"):
+            raise InputError("preset", preset, "'paper'")
+        return paper_preset(), None
+    cfg = load_toml(path)
+    check_keys("config", cfg, TOP_KEYS)
+    return cfg, Path(path).resolve().parent
+
+
+def build(cfg: dict, base_dir: Path | None = None, **overrides):
+    """(SpecimenSpec, GradingCurve, CriterionSettings, seed) from a config dict."""
+    spec_over = {k: overrides.pop(k) for k in ("threads",) if k in overrides}
+    spec = dataclass_from_table(SpecimenSpec, "specimen", cfg.get("specimen"), **spec_over)
+    g = cfg.get("grading") or {"preset": "paper"}
+    grading = paper_grading() if g == {"preset": "paper"} else GradingCurve.from_config(g, base_dir=base_dir)
+    settings = dataclass_from_table(CriterionSettings, "criterion", cfg.get("criterion"), **overrides)
+    seed = cfg.get("seed", 0)
+    if not isinstance(seed, int) or seed < 0:
+        raise InputError("seed", seed, "an integer >= 0")
+    return spec, grading, settings, seed

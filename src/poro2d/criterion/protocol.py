@@ -1,0 +1,383 @@
+"""The criterion of the paper's Fig. 3, as a protocol that drives the engine.
+
+For a trial 2D porosity n2D (Eq. 12 of the paper unless given):
+
+1. prepare a specimen at n2D by multilayer compaction; the top plate sits at H;
+2. measure the top-plate force F_top; accept at once when 0 < F_top < 1 % of the
+   self weight G = rho_s (1 - n2D) W H g;
+3. otherwise servo the top plate (down when F_top = 0, up when it is too large)
+   until the condition holds at equilibrium, and compute the porosity n' of the
+   new box; accept n2D when |n' - n2D| < 0.005;
+4. else start again from 1 with n' rounded to the porosity resolution (0.01).
+
+Every trial is written to its own folder as it finishes, so an interrupted run
+resumes where it stopped; a run that does not converge stops with a clear
+message and keeps every trial's results.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from poro2d.dem import Simulation, checkpoint
+from poro2d.errors import InputError, check_range
+from poro2d.io_utils import provenance, write_csv, write_json
+from poro2d.porosity import parabolic
+from poro2d.specimen.compaction import SpecimenSpec, box_porosity, prepare_specimen
+from poro2d.specimen.grading import GradingCurve
+
+
+@dataclass
+class CriterionSettings:
+    """Thresholds of Fig. 3 (the paper's values by default) and the plate servo."""
+
+    n_lab: float = 0.3434
+    trial_porosity: float | None = None
+    force_fraction: float = 0.01
+    porosity_tolerance: float = 0.005
+    resolution: float = 0.01
+    max_iterations: int = 6
+    servo_target_fraction: float = 0.5
+    servo_max_speed: float = 0.02
+    servo_gain: float = 0.3
+    max_plate_steps: int = 600_000
+    check_every: int = 500
+
+    def __post_init__(self) -> None:
+        check_range("n_lab", self.n_lab, 0.0, 1.0, hi_open=True)
+        if self.trial_porosity is not None:
+            check_range("trial_porosity", self.trial_porosity, 0.0, 1.0, lo_open=True, hi_open=True)
+        check_range("force_fraction", self.force_fraction, 0.0, 1.0, lo_open=True)
+        check_range("porosity_tolerance", self.porosity_tolerance, 0.0, 0.1, lo_open=True)
+        check_range("resolution", self.resolution, 0.0, 0.1, lo_open=True)
+        if not (isinstance(self.max_iterations, int) and 1 <= self.max_iterations <= 50):
+            raise InputError("max_iterations", self.max_iterations, "an integer in [1, 50]")
+        check_range("servo_target_fraction", self.servo_target_fraction, 0.0, 1.0, lo_open=True, hi_open=True)
+        check_range("servo_max_speed", self.servo_max_speed, 0.0, 10.0, lo_open=True)
+        check_range("servo_gain", self.servo_gain, 0.0, 1.0, lo_open=True)
+
+    def initial_trial(self) -> float:
+        """Eq. 12 (n2D = 0.42 nLab^2 + 0.25 nLab), rounded to the resolution, unless given."""
+        if self.trial_porosity is not None:
+            return float(self.trial_porosity)
+        return round_to(float(parabolic(self.n_lab)), self.resolution)
+
+
+def round_to(x: float, step: float) -> float:
+    return round(round(x / step) * step, 10)
+
+
+def wall_forces(sim: Simulation) -> dict:
+    """Top, bottom and side wall forces per metre of thickness (N/m).
+
+    ``f_top`` is the upward push of the disks on the top plate, ``f_bottom`` the
+    downward push on the bottom wall, ``side_friction_up`` the upward friction of
+    the side walls on the disks (what the side walls carry of the weight).
+    """
+    t = sim.particles.thickness
+    top = sim.wall_force("top") / t
+    bottom = sim.wall_force("bottom") / t
+    left = sim.wall_force("left") / t
+    right = sim.wall_force("right") / t
+    return {
+        "f_top_n_per_m": float(top[1]),
+        "f_bottom_n_per_m": float(-bottom[1]),
+        "side_friction_up_n_per_m": float(-(left[1] + right[1])),
+        "f_left_n_per_m": float(-left[0]),
+        "f_right_n_per_m": float(right[0]),
+    }
+
+
+def in_window(f_top: float, weight: float, fraction: float) -> bool:
+    return 0.0 < f_top < fraction * weight
+
+
+class PorosityCriterion:
+    """Run Fig. 3 for one grading and laboratory porosity, writing results to ``out``.
+
+    ``on_stage(name)`` (optional) is called as each stage starts, for progress display.
+    """
+
+    def __init__(
+        self,
+        spec: SpecimenSpec,
+        grading: GradingCurve,
+        settings: CriterionSettings,
+        seed: int = 0,
+        out: str | Path | None = None,
+        progress: bool = False,
+        config: dict | None = None,
+        figures: bool = True,
+    ) -> None:
+        self.spec = spec
+        self.grading = grading
+        self.settings = settings
+        self.seed = int(seed)
+        self.out = Path(out) if out is not None else None
+        self.progress = progress
+        self.config = config or {}
+        self.figures = figures
+        self.timings: dict[str, float] = {}
+
+    # ------------------------------------------------------------------ stages
+    def _trial_dir(self, k: int, n: float) -> Path | None:
+        if self.out is None:
+            return None
+        return self.out / "trials" / f"{k:02d}_n{n:.4f}"
+
+    def _prepare(self, k: int, n: float) -> tuple[Simulation, dict]:
+        d = self._trial_dir(k, n)
+        if d is not None and (d / "prepared.json").is_file() and (d / "prepared.npz").is_file():
+            rep = json.loads((d / "prepared.json").read_text())
+            return checkpoint.load(d / "prepared.npz", threads=self.spec.threads), rep
+        t0 = time.perf_counter()
+        # the same seed per trial porosity: a rerun of a trial rebuilds the same specimen
+        seed = self.seed * 1_000_003 + int(round(n * 1e6))
+        sim, rep = prepare_specimen(self.spec, self.grading, n, seed, progress=self.progress)
+        rep["seed"] = seed
+        rep["time_s"] = time.perf_counter() - t0
+        rep["weight_n_per_m"] = self.spec.self_weight(n)
+        rep.update(wall_forces(sim))
+        if d is not None:
+            d.mkdir(parents=True, exist_ok=True)
+            checkpoint.save(sim, d / "prepared.npz", extra={"stage": "prepared", "trial_porosity": n})
+            if self.figures:
+                self._figure(sim, d / "forces_trial.png", f"trial n2D = {n:.3f}, top plate at H", rep)
+            write_json(d / "prepared.json", rep)
+        return sim, rep
+
+    def _figure(self, sim: Simulation, path: Path, title: str, forces: dict) -> None:
+        from poro2d.report.force_chains import plot_force_chains
+
+        plot_force_chains(
+            sim, path, title=title, box=(0.0, 0.0, self.spec.width, self.spec.height),
+            notes=[
+                f"F_top = {forces['f_top_n_per_m']:.4g} N/m",
+                f"F_bottom = {forces['f_bottom_n_per_m']:.4g} N/m",
+                f"G = {forces.get('weight_n_per_m', float('nan')):.4g} N/m",
+            ],
+        )  # fmt: skip
+
+    def _move_plate(self, sim: Simulation, n: float, weight: float) -> dict:
+        """Servo the top plate until 0 < F_top < fraction G at equilibrium."""
+        s = self.settings
+        t = sim.particles.thickness
+        cap = s.force_fraction * weight  # N/m
+        target = s.servo_target_fraction * cap * t  # N
+        top = sim.walls.index("top")
+        y_start = float(sim.walls.p0[top, 1])
+        steps = 0
+        rounds = 0
+        ok = False
+        while steps < s.max_plate_steps and not ok:
+            rounds += 1
+            sim.set_wall_servo("top", target, (0.0, -1.0), s.servo_max_speed, s.servo_gain)
+
+            def settled(sm: Simulation) -> bool:
+                f = sm.wall_force(top)[1] / t
+                return in_window(f, weight, s.force_fraction) and sm.unbalanced_ratios()[0] < self.spec.ratio
+
+            res = sim.run(
+                s.max_plate_steps - steps, every=s.check_every, callback=settled,
+                progress=f"top plate (round {rounds})" if self.progress else False,
+            )  # fmt: skip
+            steps += res.steps
+            # hold the plate still and let the specimen come to rest
+            sim.set_wall_velocity("top", (0.0, 0.0))
+            res = sim.solve(self.spec.ratio, max(s.max_plate_steps - steps, 1), progress=False)
+            steps += res.steps
+            f = sim.wall_force(top)[1] / t
+            ok = in_window(f, weight, s.force_fraction) and res.converged
+        y_end = float(sim.walls.p0[top, 1])
+        return {
+            "plate_settled": ok,
+            "plate_steps": steps,
+            "plate_rounds": rounds,
+            "plate_displacement_m": y_end - y_start,
+            "plate_height_m": y_end,
+        }
+
+    def _trial(self, k: int, n: float) -> dict:
+        d = self._trial_dir(k, n)
+        if d is not None and (d / "trial.json").is_file():
+            return json.loads((d / "trial.json").read_text())
+        s = self.settings
+        t0 = time.perf_counter()
+        sim, prep = self._prepare(k, n)
+        t_prep = prep.get("time_s", time.perf_counter() - t0)
+        weight = self.spec.self_weight(n)
+        forces0 = wall_forces(sim)
+        f_top = forces0["f_top_n_per_m"]
+        row: dict = {
+            "iteration": k,
+            "trial_porosity": n,
+            "particle_count": prep["particle_count"],
+            "measured_porosity_after_generation": prep["measured_porosity"],
+            "f_top_n_per_m": f_top,
+            "f_bottom_n_per_m": forces0["f_bottom_n_per_m"],
+            "side_friction_up_n_per_m": forces0["side_friction_up_n_per_m"],
+            "self_weight_n_per_m": weight,
+            "force_limit_n_per_m": s.force_fraction * weight,
+            "preparation_converged": prep["converged"],
+        }
+        t1 = time.perf_counter()
+        if in_window(f_top, weight, s.force_fraction):
+            row.update(plate_moved="no", plate_displacement_m=0.0, new_porosity=n, plate_settled=True)
+            after = forces0
+        else:
+            row["plate_moved"] = "down" if f_top <= 0.0 else "up"
+            row.update(self._move_plate(sim, n, weight))
+            row["new_porosity"] = box_porosity(sim, self.spec.width, row["plate_height_m"])
+            after = wall_forces(sim)
+            if d is not None:
+                checkpoint.save(sim, d / "after_plate.npz", extra={"stage": "after_plate"})
+                if self.figures:
+                    after_fig = dict(after, weight_n_per_m=weight)
+                    self._figure(
+                        sim, d / "forces_after_plate.png",
+                        f"after moving the top plate {row['plate_moved']}: n' = {row['new_porosity']:.4f}",
+                        after_fig,
+                    )  # fmt: skip
+        row["f_top_after_n_per_m"] = after["f_top_n_per_m"]
+        row["f_bottom_after_n_per_m"] = after["f_bottom_n_per_m"]
+        row["side_friction_up_after_n_per_m"] = after["side_friction_up_n_per_m"]
+        row["porosity_change"] = abs(row["new_porosity"] - n)
+        row["accepted"] = bool(row["plate_settled"] and row["porosity_change"] < s.porosity_tolerance)
+        row["time_prepare_s"] = t_prep
+        row["time_plate_s"] = time.perf_counter() - t1
+        if d is not None:
+            write_json(d / "trial.json", row)
+        return row
+
+    # -------------------------------------------------------------------- loop
+    def run(self) -> dict:
+        s = self.settings
+        t_start = time.perf_counter()
+        if self.out is not None:
+            self._check_resume()
+        n = s.initial_trial()
+        rows: list[dict] = []
+        tried: list[float] = []
+        converged = False
+        message = ""
+        for k in range(1, s.max_iterations + 1):
+            tried.append(n)
+            row = self._trial(k, n)
+            rows.append(row)
+            self._write_tables(rows, final=None, converged=False, message="running")
+            if row["accepted"]:
+                converged = True
+                message = f"accepted n2D = {n:.4f} after {k} trial(s)"
+                break
+            if not row.get("plate_settled", True):
+                message = (
+                    f"the top plate did not settle within {s.max_plate_steps} steps at trial n2D = {n:.4f}"
+                )
+                break
+            nxt = round_to(row["new_porosity"], s.resolution)
+            if nxt == n:  # rounding fell back: step one resolution towards n'
+                nxt = round_to(n + math.copysign(s.resolution, row["new_porosity"] - n), s.resolution)
+            if nxt in tried:
+                message = (
+                    f"no convergence: trial {nxt:.4f} was already tried (trials {tried}); "
+                    "try a finer resolution or a larger tolerance"
+                )
+                break
+            n = nxt
+        else:
+            message = f"no convergence within max_iterations = {s.max_iterations} (trials {tried})"
+        final = n if converged else None
+        result = self._write_tables(rows, final=final, converged=converged, message=message)
+        result["time_total_s"] = time.perf_counter() - t_start
+        if self.out is not None:
+            self._final_outputs(rows, converged)
+            write_json(self.out / "result.json", result)
+        return result
+
+    def _check_resume(self) -> None:
+        assert self.out is not None
+        self.out.mkdir(parents=True, exist_ok=True)
+        cfg_path = self.out / "config.json"
+        current = self._config_record()
+        if cfg_path.is_file():
+            old = json.loads(cfg_path.read_text())
+            if old.get("run") != current["run"]:
+                raise InputError(
+                    "out", str(self.out),
+                    "an empty folder or one holding a run of the same config and seed",
+                    "it holds results of a different config; choose another --out",
+                )  # fmt: skip
+        else:
+            write_json(cfg_path, current)
+
+    def _config_record(self) -> dict:
+        return {
+            "run": {
+                "specimen": self.spec.to_dict(),
+                "grading": {
+                    "sizes_m": self.grading.sizes.tolist(),
+                    "percent_passing": self.grading.percent.tolist(),
+                    "source": getattr(self.grading, "source", ""),
+                },
+                "criterion": asdict(self.settings),
+                "seed": self.seed,
+            },
+            "config": self.config,
+            "provenance": provenance(),
+        }
+
+    def _write_tables(self, rows: list[dict], final, converged: bool, message: str) -> dict:
+        result = {
+            "final_porosity": final,
+            "converged": converged,
+            "message": message,
+            "n_lab": self.settings.n_lab,
+            "initial_trial_porosity": self.settings.initial_trial(),
+            "initial_from": "given" if self.settings.trial_porosity is not None else "Eq. 12 (parabola)",
+            "iterations": rows,
+            "seed": self.seed,
+            "settings": asdict(self.settings),
+            "specimen": self.spec.to_dict(),
+            "local_damping_note": f"local damping {self.spec.local_damping} (PFC 4.0 default; "
+            "the paper does not state it)",
+            "provenance": provenance(),
+        }
+        if self.out is not None:
+            write_csv(self.out / "iterations.csv", rows)
+        return result
+
+    def _final_outputs(self, rows: list[dict], converged: bool) -> None:
+        """Copy the paper-style figures and the accepted specimen to the top of ``out``."""
+        import shutil
+
+        from poro2d.dem.export import write_vtu
+
+        assert self.out is not None
+        first = rows[0]
+        d0 = self._trial_dir(first["iteration"], first["trial_porosity"])
+        pairs = [(d0 / "forces_trial.png", "fig5_forces_initial_trial.png")]
+        moved = next((r for r in rows if r.get("plate_moved") != "no"), None)
+        if moved is not None:
+            dm = self._trial_dir(moved["iteration"], moved["trial_porosity"])
+            pairs.append((dm / "forces_after_plate.png", "fig6_forces_after_plate.png"))
+        if converged:
+            last = rows[-1]
+            dl = self._trial_dir(last["iteration"], last["trial_porosity"])
+            pairs.append((dl / "forces_trial.png", "fig7_forces_accepted.png"))
+            shutil.copyfile(dl / "prepared.npz", self.out / ".specimen.npz.tmp")
+            (self.out / ".specimen.npz.tmp").replace(self.out / "specimen.npz")
+            sim = checkpoint.load(self.out / "specimen.npz")
+            write_vtu(sim, self.out / "vtu", "accepted_specimen")
+        for src, dst in pairs:
+            if src.is_file():
+                shutil.copyfile(src, self.out / dst)
+
+
+__all__ = ["CriterionSettings", "PorosityCriterion", "in_window", "round_to", "wall_forces"]
+_ = np

@@ -1,0 +1,123 @@
+"""``poro2d paper``: the paper's case study on built-in defaults, in one command.
+
+Stages: the conversion table for the paper's sand (nLab = 0.3434, n_max = 0.4571,
+n_min = 0.3253) with Figs. 1-2, then the criterion of Fig. 3 with Figs. 5-7. Each
+stage writes into its own sub-folder; a rerun skips the stages already finished.
+``--quick`` runs a reduced specimen (a smaller box, two layers) for a first look.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import typer
+from rich.console import Console
+
+from poro2d.io_utils import provenance, write_csv, write_json
+
+console = Console()
+
+PAPER = {
+    "n_lab": 0.3434,
+    "n_max": 0.4571,
+    "n_min": 0.3253,
+    "dry_density_kg_m3": 1740.0,
+    "solid_density_kg_m3": 2650.0,
+    # numbers the paper reports for its criterion run (section 3)
+    "criterion": {
+        "trials": [0.14, 0.15],
+        "particle_counts": [2591, 2552],
+        "porosity_change_first_trial": 0.008,
+        "f_top_first_trial_kn_per_m": 3854.0,
+        "f_bottom_first_trial_kn_per_m": 3855.0,
+        "self_weight_first_trial_n_per_m": 846.0,
+        "f_top_accepted_n_per_m": 2.7,
+        "f_bottom_accepted_n_per_m": 809.0,
+        "self_weight_accepted_n_per_m": 836.0,
+        "accepted_porosity": 0.15,
+    },
+}
+
+QUICK_SPECIMEN = {"width": 0.08, "height": 0.04, "layers": 2}
+
+
+def run_conversions(out: Path) -> dict:
+    from poro2d.figures.relations import write_relation_figures
+    from poro2d.porosity import convert_all
+
+    out.mkdir(parents=True, exist_ok=True)
+    res = convert_all(PAPER["n_lab"], n_max=PAPER["n_max"], n_min=PAPER["n_min"])
+    rows = [
+        {"method": r.id, "name": r.name, "equation": r.equation, "n2d": r.value, "flags": ";".join(r.flags)}
+        for r in res.results.values()
+    ]
+    write_csv(out / "conversions.csv", rows)
+    figs = write_relation_figures(out, n_max=PAPER["n_max"], n_min=PAPER["n_min"], mark_n_lab=PAPER["n_lab"])
+    data = {"n_lab": PAPER["n_lab"], "n_max": PAPER["n_max"], "n_min": PAPER["n_min"], "methods": rows,
+            "figures": [str(f.name) for f in figs], "provenance": provenance()}  # fmt: skip
+    write_json(out / "conversions.json", data)
+    return data
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("paper")
+    def paper_cmd(
+        out: Path = typer.Option(Path("paper-out"), "--out", "-o", help="Output folder (resumable)."),
+        quick: bool = typer.Option(
+            False, "--quick", help="Reduced specimen for a first look (about a minute)."
+        ),
+        seed: int = typer.Option(0, "--seed", help="Random seed."),
+        threads: int = typer.Option(
+            None, "--threads", help="Threads for the DEM kernels (default: all cores)."
+        ),
+        quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+    ) -> None:
+        """Run the paper's case study: conversions, Figs. 1-2, the criterion of Fig. 3."""
+        import os
+
+        from poro2d.criterion.cli import print_result
+        from poro2d.criterion.config import build, paper_preset
+        from poro2d.criterion.protocol import PorosityCriterion
+        from poro2d.errors import InputError
+
+        if seed < 0:
+            raise InputError("--seed", seed, "an integer >= 0")
+        out.mkdir(parents=True, exist_ok=True)
+        timings: dict[str, float] = {}
+        t0 = time.perf_counter()
+        console.print("[bold]1/2 conversions[/] (Eqs. 1-12, Figs. 1-2)")
+        conv = run_conversions(out / "conversions")
+        timings["conversions_s"] = time.perf_counter() - t0
+        for m in conv["methods"]:
+            v = "skipped" if m["n2d"] is None else f"{m['n2d']:.4f}"
+            console.print(f"  {m['method']:<24} {m['equation']:<10} {v:>8} {m['flags']}")
+
+        cfg = paper_preset()
+        cfg["seed"] = seed
+        if quick:
+            cfg["specimen"] = dict(QUICK_SPECIMEN)
+        nthreads = threads if threads is not None else min(os.cpu_count() or 1, 2)
+        spec, grading, settings, sd = build(cfg, None, threads=nthreads)
+        console.print(f"[bold]2/2 criterion[/] (Fig. 3) for nLab = {settings.n_lab}"
+                      f"{' [quick specimen]' if quick else ''}")  # fmt: skip
+        t1 = time.perf_counter()
+        crit = PorosityCriterion(spec, grading, settings, seed=sd, out=out / "criterion",
+                                 progress=not quiet, config=cfg)  # fmt: skip
+        result = crit.run()
+        timings["criterion_s"] = time.perf_counter() - t1
+        print_result(result, out / "criterion")
+        summary = {
+            "quick": quick,
+            "seed": seed,
+            "conversions": conv,
+            "criterion": {k: result[k] for k in ("final_porosity", "converged", "message", "iterations")},
+            "paper": PAPER,
+            "timings": timings,
+            "provenance": provenance(),
+        }
+        write_json(out / "results.json", json.loads(json.dumps(summary, default=str)))
+        console.print(f"results in {out}/results.json")
+        if not result["converged"]:
+            raise typer.Exit(1)

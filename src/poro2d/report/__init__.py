@@ -1,0 +1,1 @@
+"""Figures and reports: force chains, direct shear overlays, the paper report."""
