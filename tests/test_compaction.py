@@ -1,0 +1,95 @@
+"""Multilayer compaction: porosity after generation, force balance, bad configs."""
+
+import numpy as np
+import pytest
+
+from poro2d.criterion.protocol import wall_forces
+from poro2d.errors import InputError
+from poro2d.specimen import GradingCurve, paper_grading
+from poro2d.specimen.compaction import SpecimenSpec, check_feasible, prepare_specimen
+
+SMALL = {"width": 0.06, "height": 0.03, "layers": 2}
+
+
+@pytest.fixture(scope="module")
+def loose():
+    """A loose specimen: the lid carries almost nothing."""
+    spec = SpecimenSpec(**SMALL)
+    sim, rep = prepare_specimen(spec, paper_grading(), 0.22, seed=3)
+    return spec, sim, rep
+
+
+def test_box_porosity_equals_trial_after_generation(loose):
+    spec, sim, rep = loose
+    assert rep["converged"]
+    assert rep["box_porosity"] == pytest.approx(0.22, abs=1e-12)
+    # disks clipped exactly by the box: equal unless a disk pokes into a wall
+    assert rep["measured_porosity"] == pytest.approx(0.22, abs=2e-3)
+    assert sim.particles.area() == pytest.approx((1 - 0.22) * spec.width * spec.height, rel=1e-12)
+
+
+def test_vertical_force_balance_with_side_friction(loose):
+    spec, sim, rep = loose
+    f = wall_forces(sim)
+    weight = float(np.sum(sim.particles.mass)) * spec.gravity / spec.thickness
+    assert weight == pytest.approx(spec.self_weight(0.22), rel=1e-12)
+    assert f["f_top_n_per_m"] < 0.1 * weight  # the lid barely touches a loose specimen
+    lhs = f["f_bottom_n_per_m"] + f["side_friction_up_n_per_m"]
+    assert lhs == pytest.approx(weight + f["f_top_n_per_m"], rel=0.01)
+    assert f["side_friction_up_n_per_m"] > 0.0  # the frictional side walls carry a little of it
+    assert sim.unbalanced_ratios()[0] < spec.ratio
+
+
+def test_frictionless_side_walls_put_the_weight_on_the_bottom():
+    spec = SpecimenSpec(**SMALL, friction_wall=0.0)
+    sim, rep = prepare_specimen(spec, paper_grading(), 0.22, seed=4)
+    f = wall_forces(sim)
+    assert abs(f["side_friction_up_n_per_m"]) < 1e-9
+    assert f["f_bottom_n_per_m"] == pytest.approx(spec.self_weight(0.22) + f["f_top_n_per_m"], rel=0.01)
+
+
+def test_dense_trial_loads_the_top_plate():
+    spec = SpecimenSpec(**SMALL)
+    sim, rep = prepare_specimen(spec, paper_grading(), 0.14, seed=3)
+    f = wall_forces(sim)
+    assert f["f_top_n_per_m"] > 10 * spec.self_weight(0.14)
+    # balance: bottom + side friction = weight + top, relative to the forces involved
+    lhs = f["f_bottom_n_per_m"] + f["side_friction_up_n_per_m"]
+    assert lhs == pytest.approx(spec.self_weight(0.14) + f["f_top_n_per_m"], rel=1e-3)
+
+
+def test_layers_each_reach_equilibrium(loose):
+    _, _, rep = loose
+    assert [lay["layer"] for lay in rep["layers"]] == [1, 2]
+    assert all(lay["converged"] and lay["max_ratio"] < 1e-3 for lay in rep["layers"])
+    assert sum(lay["n_particles"] for lay in rep["layers"]) == rep["particle_count"]
+
+
+def test_undercompaction_band_tops():
+    spec = SpecimenSpec(height=0.124, layers=4, undercompaction=0.15)
+    tops = spec.layer_tops()
+    h = 0.124 / 4
+    assert tops[0] == pytest.approx(h * 1.15)
+    assert tops[1] == pytest.approx(h * (1 + 1.10))
+    assert tops[-1] == pytest.approx(0.124)
+    assert np.all(np.diff(tops) > 0)
+    np.testing.assert_allclose(SpecimenSpec(layers=4).layer_tops(), [0.031, 0.062, 0.093, 0.124])
+
+
+def test_bad_configs_fail_before_simulating():
+    g = paper_grading()
+    with pytest.raises(InputError, match="box"):
+        check_feasible(SpecimenSpec(width=0.005, height=0.124), g, 0.15)
+    with pytest.raises(InputError, match="box"):
+        check_feasible(SpecimenSpec(height=0.02, layers=4), g, 0.15)
+    with pytest.raises(InputError, match="porosity"):
+        check_feasible(SpecimenSpec(), g, 0.01)
+    with pytest.raises(InputError, match="porosity"):
+        check_feasible(SpecimenSpec(), g, 1.2)
+    with pytest.raises(InputError, match="layers"):
+        SpecimenSpec(layers=0)
+    with pytest.raises(InputError, match="friction_prep"):
+        SpecimenSpec(friction_prep=-1)
+    big = GradingCurve.from_lists([40.0, 80.0], [0, 100])
+    with pytest.raises(InputError, match="largest disk"):
+        check_feasible(SpecimenSpec(), big, 0.15)
