@@ -187,7 +187,7 @@ class PorosityCriterion:
             sim.set_wall_servo("top", target, (0.0, -1.0), s.servo_max_speed, s.servo_gain)
             streak = [0]
 
-            def steady(sm: Simulation) -> bool:
+            def steady(sm: Simulation, streak: list[int] = streak) -> bool:
                 # the servo keeps the plate moving a little, so equilibrium is judged with
                 # the plate held still below; here it only has to stay in the window
                 f = sm.wall_force(top)[1] / t

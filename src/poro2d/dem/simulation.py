@@ -241,7 +241,7 @@ class Simulation:
         """Append disks; existing contacts keep their history. Returns the new indices."""
         p = self.particles
         if new.thickness != p.thickness:
-            raise InputError("thickness", new.thickness, f"{p.thickness} (the thickness of the disks present)")
+            raise InputError("thickness", new.thickness, f"{p.thickness} (that of the disks present)")
         n0 = p.n
         for f in ("pos", "radius", "density", "kn", "ks", "mu", "vel", "theta", "omega", "mode"):
             setattr(p, f, np.ascontiguousarray(np.concatenate([getattr(p, f), getattr(new, f)])))
