@@ -1,0 +1,126 @@
+"""The criterion of Fig. 3: every branch on small specimens, resume, outputs, CLI errors."""
+
+import json
+
+import pytest
+
+from poro2d.cli import main
+from poro2d.criterion import CriterionSettings, PorosityCriterion
+from poro2d.criterion.protocol import round_to
+from poro2d.errors import InputError
+from poro2d.specimen import paper_grading
+from poro2d.specimen.compaction import SpecimenSpec
+
+SMALL = SpecimenSpec(width=0.06, height=0.03, layers=2)
+REQUIRED = {
+    "trial_porosity", "particle_count", "f_top_n_per_m", "f_bottom_n_per_m", "self_weight_n_per_m",
+    "plate_displacement_m", "new_porosity", "porosity_change", "accepted",
+}  # fmt: skip
+
+
+def _run(out, trial, **kw):
+    settings = CriterionSettings(trial_porosity=trial, **kw)
+    return PorosityCriterion(SMALL, paper_grading(), settings, seed=0, out=out).run()
+
+
+@pytest.fixture(scope="module")
+def down(tmp_path_factory):
+    out = tmp_path_factory.mktemp("down")
+    return out, _run(out, 0.25, max_iterations=1)
+
+
+def test_accept_at_once(tmp_path):
+    r = _run(tmp_path, 0.21)
+    assert r["converged"] and r["final_porosity"] == 0.21
+    (it,) = r["iterations"]
+    assert it["plate_moved"] == "no" and it["plate_displacement_m"] == 0.0
+    assert 0.0 < it["f_top_n_per_m"] < 0.01 * it["self_weight_n_per_m"]
+    assert it["accepted"] and it["porosity_change"] == 0.0
+    saved = json.loads((tmp_path / "result.json").read_text())
+    assert saved["final_porosity"] == 0.21 and REQUIRED <= set(saved["iterations"][0])
+    for f in ("iterations.csv", "specimen.npz", "fig5_forces_initial_trial.png", "fig7_forces_accepted.png"):
+        assert (tmp_path / f).stat().st_size > 0
+    assert (tmp_path / "vtu" / "accepted_specimen_contacts.vtu").is_file()
+    assert "poro2d_version" in saved["provenance"]
+
+
+def test_plate_moves_up_when_the_top_force_is_too_large(tmp_path):
+    r = _run(tmp_path, 0.19, max_iterations=1)
+    (it,) = r["iterations"]
+    assert it["f_top_n_per_m"] > 0.01 * it["self_weight_n_per_m"]
+    assert it["plate_moved"] == "up" and it["plate_displacement_m"] > 0
+    assert it["new_porosity"] > 0.19
+    assert 0.0 < it["f_top_after_n_per_m"] < 0.01 * it["self_weight_n_per_m"]
+    # n' follows from the plate height: same solid area in the taller box
+    h = SMALL.height + it["plate_displacement_m"]
+    assert it["new_porosity"] == pytest.approx(1 - (1 - 0.19) * SMALL.height / h, abs=1e-9)
+
+
+def test_plate_moves_down_when_nothing_touches_it(down):
+    _, r = down
+    (it,) = r["iterations"]
+    assert it["f_top_n_per_m"] == 0.0
+    assert it["plate_moved"] == "down" and it["plate_displacement_m"] < 0
+    assert it["new_porosity"] < 0.25
+    assert 0.0 < it["f_top_after_n_per_m"] < 0.01 * it["self_weight_n_per_m"]
+    # force balance of the specimen after the plate moved, within 1 % of its weight
+    lhs = it["f_bottom_after_n_per_m"] + it["side_friction_up_after_n_per_m"]
+    assert lhs == pytest.approx(it["self_weight_n_per_m"] + it["f_top_after_n_per_m"], rel=0.01)
+
+
+def test_no_convergence_keeps_every_iteration(down):
+    out, r = down
+    assert not r["converged"] and r["final_porosity"] is None
+    assert "max_iterations" in r["message"]
+    saved = json.loads((out / "result.json").read_text())
+    assert len(saved["iterations"]) == 1 and not saved["converged"]
+    assert (out / "fig6_forces_after_plate.png").stat().st_size > 0
+    assert not (out / "specimen.npz").exists()
+
+
+def test_resume_skips_finished_trials(down):
+    out, r = down
+    trial_dir = next((out / "trials").iterdir())
+    stamp = (trial_dir / "prepared.npz").stat().st_mtime_ns
+    again = _run(out, 0.25, max_iterations=1)
+    assert again["iterations"] == r["iterations"]
+    assert (trial_dir / "prepared.npz").stat().st_mtime_ns == stamp
+
+
+def test_other_config_in_the_same_folder_is_refused(down):
+    out, _ = down
+    with pytest.raises(InputError, match="out"):
+        _run(out, 0.25, max_iterations=2)
+
+
+def test_next_trial_rounding():
+    assert round_to(0.148, 0.01) == 0.15
+    assert round_to(0.1851, 0.01) == 0.19
+    assert CriterionSettings(n_lab=0.3434).initial_trial() == 0.14  # Eq. 12 gives 0.1354
+
+
+def test_bad_settings():
+    with pytest.raises(InputError, match="force_fraction"):
+        CriterionSettings(force_fraction=0)
+    with pytest.raises(InputError, match="max_iterations"):
+        CriterionSettings(max_iterations=0)
+    with pytest.raises(InputError, match="n_lab"):
+        CriterionSettings(n_lab=1.5)
+
+
+def test_cli_rejects_unknown_keys_before_simulating(tmp_path, capsys):
+    cfg = tmp_path / "bad.toml"
+    cfg.write_text("[specimen]\nwidht = 0.3\n")
+    with pytest.raises(SystemExit) as e:
+        main(["criterion", "--config", str(cfg), "--out", str(tmp_path / "o")])
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert "specimen.widht" in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_cli_rejects_impossible_porosity(tmp_path, capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["criterion", "--preset", "paper", "--trial-porosity", "0.01", "--out", str(tmp_path / "o")])
+    assert e.value.code == 2
+    assert "porosity" in capsys.readouterr().err
