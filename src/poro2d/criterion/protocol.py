@@ -162,8 +162,9 @@ class PorosityCriterion:
     def _figure(self, sim: Simulation, path: Path, title: str, forces: dict) -> None:
         from poro2d.report.force_chains import plot_force_chains
 
+        plate = float(sim.walls.p0[sim.walls.index("top"), 1])
         plot_force_chains(
-            sim, path, title=title, box=(0.0, 0.0, self.spec.width, self.spec.height),
+            sim, path, title=title, box=(0.0, 0.0, self.spec.width, plate),
             notes=[
                 f"F_top = {forces['f_top_n_per_m']:.4g} N/m",
                 f"F_bottom = {forces['f_bottom_n_per_m']:.4g} N/m",
