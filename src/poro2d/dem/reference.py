@@ -1,0 +1,340 @@
+"""A slow, direct NumPy implementation of one DEM step, used only by the tests.
+
+It shares no code with the compiled engine (``kernels.py``, ``neighbors.py``,
+``contact_law.py``): every disk pair and every disk-wall pair is tested directly
+(no neighbour list, no cells, no skin), and the contact history is a plain dict
+keyed by ``(i, j)`` for disk pairs (``i < j``) and ``(i, "wall", w)`` for disk-wall
+pairs. The physics is the documented one:
+
+* normal ``n`` from disk ``i`` to body ``j`` (for a wall: to the closest point of the
+  segment), tangent ``t = (-n_y, n_x)``, overlap ``ov``, lever arm ``r - ov / 2``;
+* ``Fn = max(0, kn ov + cn vn)`` with ``cn = 2 beta sqrt(kn m_eff)`` (``beta = 0``: no
+  dashpot), ``Fs = Fs_old + ks vt dt`` capped at ``mu Fn``; the history ends when the
+  bodies separate;
+* force on ``i``: ``-Fn n + Fs t``, moment ``(r_i - ov / 2) Fs`` on both disks;
+* gravity on the true mass, local damping ``F - alpha |F| sign(v)`` per component of
+  force and moment, then leapfrog ``v += F / m dt``, ``x += v dt``; walls move with
+  their velocity. Prescribed disks keep their velocity and spin.
+
+Servo walls are not modelled (a servo wall is treated as moving with its current
+velocity).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+FREE = 0
+
+
+def _series(ka: np.ndarray, kb: np.ndarray) -> np.ndarray:
+    s = ka + kb
+    out = np.zeros(np.broadcast(ka, kb).shape)
+    ok = s > 0.0
+    ka_b = np.broadcast_to(ka, out.shape)
+    kb_b = np.broadcast_to(kb, out.shape)
+    s_b = np.broadcast_to(s, out.shape)
+    out[ok] = ka_b[ok] * kb_b[ok] / s_b[ok]
+    return out
+
+
+def _contact_forces(ov, vn, vt, fs_old, kn, ks, mu, cn, dt):
+    """Vectorised linear law: (fn, fs, sliding) for touching contacts."""
+    fn = kn * ov + cn * vn
+    fn = np.where(fn < 0.0, 0.0, fn)
+    fs = fs_old + ks * vt * dt
+    cap = mu * fn
+    hi = fs > cap
+    lo = fs < -cap
+    fs = np.where(hi, cap, np.where(lo, -cap, fs))
+    return fn, fs, hi | lo
+
+
+class ReferenceDEM:
+    """Copies of a simulation's state, advanced one step at a time by direct NumPy code.
+
+    Build it with :meth:`from_simulation`; :meth:`step` advances the copy. After a step,
+    ``force``/``moment`` hold the unbalanced force and moment of that step (before
+    damping), ``wall_force`` the force the disks exert on each wall, ``contacts`` a
+    dict of the touching contacts ``key -> (fn, fs, sliding)``.
+    """
+
+    def __init__(
+        self,
+        *,
+        pos,
+        vel,
+        theta,
+        omega,
+        radius,
+        mass,
+        inv_mass,
+        inv_inertia,
+        mode,
+        pkn,
+        pks,
+        pmu,
+        wp0,
+        wp1,
+        wvel,
+        wkn,
+        wks,
+        wmu,
+        gravity: tuple[float, float],
+        damping: float,
+        beta: float,
+        dt: float,
+        per_body: bool = True,
+        pp: tuple[float, float, float] | None = None,
+        pw: tuple[float, float, float] | None = None,
+        history: dict[Any, float] | None = None,
+    ) -> None:
+        c = np.array
+        self.pos = c(pos, dtype=float)
+        self.vel = c(vel, dtype=float)
+        self.theta = c(theta, dtype=float)
+        self.omega = c(omega, dtype=float)
+        self.radius = c(radius, dtype=float)
+        self.mass = c(mass, dtype=float)
+        self.inv_mass = c(inv_mass, dtype=float)
+        self.inv_inertia = c(inv_inertia, dtype=float)
+        self.mode = c(mode, dtype=np.int64)
+        self.pkn, self.pks, self.pmu = c(pkn, dtype=float), c(pks, dtype=float), c(pmu, dtype=float)
+        self.wp0 = c(wp0, dtype=float).reshape(-1, 2)
+        self.wp1 = c(wp1, dtype=float).reshape(-1, 2)
+        self.wvel = c(wvel, dtype=float).reshape(-1, 2)
+        self.wkn, self.wks, self.wmu = c(wkn, dtype=float), c(wks, dtype=float), c(wmu, dtype=float)
+        self.gravity = (float(gravity[0]), float(gravity[1]))
+        self.damping = float(damping)
+        self.beta = float(beta)
+        self.dt = float(dt)
+        self.per_body = bool(per_body)
+        self.pp = pp
+        self.pw = pw
+        self.history: dict[Any, float] = dict(history or {})
+        n, nw = self.pos.shape[0], self.wp0.shape[0]
+        self.force = np.zeros((n, 2))
+        self.moment = np.zeros(n)
+        self.wall_force = np.zeros((nw, 2))
+        self.contacts: dict[Any, tuple[float, float, bool]] = {}
+        self.time = 0.0
+
+    @classmethod
+    def from_simulation(cls, sim) -> ReferenceDEM:
+        """Copy the state of a :class:`~poro2d.dem.simulation.Simulation` (history included)."""
+        p, w = sim.particles, sim.walls
+        history: dict[Any, float] = {}
+        n = p.n
+        npp = int(sim._nb_start[n])
+        rows = np.repeat(np.arange(n), np.diff(sim._nb_start))
+        for k in range(npp):
+            if sim._nb_ov[k] > 0.0:
+                history[(int(rows[k]), int(sim._nb_j[k]))] = float(sim._nb_fs[k])
+        npw = int(sim._wb_start[n])
+        wrows = np.repeat(np.arange(n), np.diff(sim._wb_start))
+        for k in range(npw):
+            if sim._wb_ov[k] > 0.0:
+                history[(int(wrows[k]), "wall", int(sim._wb_w[k]))] = float(sim._wb_fs[k])
+        conv = sim.contact.convention
+        return cls(
+            pos=p.pos, vel=p.vel, theta=p.theta, omega=p.omega, radius=p.radius,
+            mass=sim._mass, inv_mass=sim._inv_mass, inv_inertia=sim._inv_inertia, mode=p.mode,
+            pkn=p.kn, pks=p.ks, pmu=p.mu, wp0=w.p0, wp1=w.p1, wvel=w.vel, wkn=w.kn, wks=w.ks,
+            wmu=w.mu, gravity=sim.gravity, damping=sim.local_damping, beta=sim._beta, dt=sim.dt,
+            per_body=conv == "per_body", pp=sim.contact.pp, pw=sim.contact.pw, history=history,
+        )  # fmt: skip
+
+    # ------------------------------------------------------------------ step
+    def _disk_pairs(self):
+        pos, r = self.pos, self.radius
+        n = pos.shape[0]
+        i, j = np.triu_indices(n, 1)
+        dx = pos[j, 0] - pos[i, 0]
+        dy = pos[j, 1] - pos[i, 1]
+        d = np.sqrt(dx * dx + dy * dy)
+        ov = r[i] + r[j] - d
+        t = ov > 0.0
+        return i[t], j[t], dx[t], dy[t], d[t], ov[t]
+
+    def _wall_pairs(self):
+        pos, r = self.pos, self.radius
+        n, nw = pos.shape[0], self.wp0.shape[0]
+        if nw == 0 or n == 0:
+            e = np.zeros(0)
+            return np.zeros(0, np.int64), np.zeros(0, np.int64), e, e, e, e
+        i = np.repeat(np.arange(n), nw)  # disk-major: i ascending, then w ascending
+        w = np.tile(np.arange(nw), n)
+        px, py = pos[i, 0], pos[i, 1]
+        ax, ay = self.wp0[w, 0], self.wp0[w, 1]
+        bx, by = self.wp1[w, 0], self.wp1[w, 1]
+        sx = bx - ax
+        sy = by - ay
+        s = ((px - ax) * sx + (py - ay) * sy) / (sx * sx + sy * sy)
+        s = np.clip(s, 0.0, 1.0)
+        cx = ax + s * sx
+        cy = ay + s * sy
+        dx = cx - px
+        dy = cy - py
+        d = np.sqrt(dx * dx + dy * dy)
+        ov = r[i] - d
+        t = ov > 0.0
+        return i[t], w[t], dx[t], dy[t], d[t], ov[t]
+
+    def step(self, pair_order: dict[tuple[int, int], int] | None = None) -> None:
+        """Advance the copy by one time step.
+
+        The contributions to each disk's force are summed disk-pair by disk-pair in
+        ascending ``(i, j)`` order, unless ``pair_order`` maps pairs to ranks (e.g. the
+        slots of the engine's neighbour list, :func:`engine_pair_order`): then in
+        ascending rank, pairs without a rank last. Only the order of the sums changes
+        (round-off); which pairs touch is always decided here, directly.
+        """
+        pos, vel, omega, r, m = self.pos, self.vel, self.omega, self.radius, self.mass
+        dt = self.dt
+        n = pos.shape[0]
+        nw = self.wp0.shape[0]
+        new_hist: dict[Any, float] = {}
+        contacts: dict[Any, tuple[float, float, bool]] = {}
+
+        # disk-disk
+        i, j, dx, dy, d, ov = self._disk_pairs()
+        if pair_order is not None and len(i):
+            big = len(pair_order) + 1
+            rank = np.array(
+                [pair_order.get((a, b), big) for a, b in zip(i.tolist(), j.tolist(), strict=True)]
+            )
+            o = np.argsort(rank, kind="stable")
+            i, j, dx, dy, d, ov = i[o], j[o], dx[o], dy[o], d[o], ov[o]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            nx = np.where(d > 0.0, dx / d, 1.0)
+            ny = np.where(d > 0.0, dy / d, 0.0)
+        tx, ty = -ny, nx
+        dvx = vel[j, 0] - vel[i, 0]
+        dvy = vel[j, 1] - vel[i, 1]
+        vn = -(dvx * nx + dvy * ny)
+        vt = dvx * tx + dvy * ty - (r[i] - 0.5 * ov) * omega[i] - (r[j] - 0.5 * ov) * omega[j]
+        if self.per_body:
+            kn = _series(self.pkn[i], self.pkn[j])
+            ks = _series(self.pks[i], self.pks[j])
+            mu = np.minimum(self.pmu[i], self.pmu[j])
+        else:
+            assert self.pp is not None
+            kn = np.full(len(i), float(self.pp[0]))
+            ks = np.full(len(i), float(self.pp[1]))
+            mu = np.full(len(i), float(self.pp[2]))
+        m_eff = m[i] * m[j] / (m[i] + m[j])
+        cn = 2.0 * self.beta * np.sqrt(kn * m_eff) if self.beta > 0.0 else np.zeros(len(i))
+        fs_old = np.array(
+            [self.history.get((a, b), 0.0) for a, b in zip(i.tolist(), j.tolist(), strict=True)]
+        )
+        fn, fs, sl = _contact_forces(ov, vn, vt, fs_old, kn, ks, mu, cn, dt)
+        for k, (a, b) in enumerate(zip(i.tolist(), j.tolist(), strict=True)):
+            new_hist[(a, b)] = float(fs[k])
+            contacts[(a, b)] = (float(fn[k]), float(fs[k]), bool(sl[k]))
+        cfx = -fn * nx - fs * ny  # force on i
+        cfy = -fn * ny + fs * nx
+
+        # disk-wall
+        wi, ww, wdx, wdy, wd, wov = self._wall_pairs()
+        if len(wi):
+            sx = self.wp1[ww, 0] - self.wp0[ww, 0]
+            sy = self.wp1[ww, 1] - self.wp0[ww, 1]
+            sl_ = np.sqrt(sx * sx + sy * sy)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                wnx = np.where(wd > 0.0, wdx / wd, sy / sl_)
+                wny = np.where(wd > 0.0, wdy / wd, -sx / sl_)
+        else:
+            wnx = wny = np.zeros(0)
+        wtx, wty = -wny, wnx
+        wdvx = self.wvel[ww, 0] - vel[wi, 0]
+        wdvy = self.wvel[ww, 1] - vel[wi, 1]
+        wvn = -(wdvx * wnx + wdvy * wny)
+        wvt = wdvx * wtx + wdvy * wty - (r[wi] - 0.5 * wov) * omega[wi]
+        if self.per_body:
+            wkn = _series(self.pkn[wi], self.wkn[ww])
+            wks = _series(self.pks[wi], self.wks[ww])
+            wmu = np.minimum(self.pmu[wi], self.wmu[ww])
+        else:
+            assert self.pw is not None
+            wkn = np.full(len(wi), float(self.pw[0]))
+            wks = np.full(len(wi), float(self.pw[1]))
+            wmu = np.full(len(wi), float(self.pw[2]))
+        wcn = 2.0 * self.beta * np.sqrt(wkn * m[wi]) if self.beta > 0.0 else np.zeros(len(wi))
+        keys = [(a, "wall", b) for a, b in zip(wi.tolist(), ww.tolist(), strict=True)]
+        wfs_old = np.array([self.history.get(key, 0.0) for key in keys])
+        wfn, wfs, wsl = _contact_forces(wov, wvn, wvt, wfs_old, wkn, wks, wmu, wcn, dt)
+        for k, key in enumerate(keys):
+            new_hist[key] = float(wfs[k])
+            contacts[key] = (float(wfn[k]), float(wfs[k]), bool(wsl[k]))
+        wcfx = -wfn * wnx - wfs * wny
+        wcfy = -wfn * wny + wfs * wnx
+
+        # unbalanced force and moment
+        force = np.empty((n, 2))
+        force[:, 0] = m * self.gravity[0]
+        force[:, 1] = m * self.gravity[1]
+        moment = np.zeros(n)
+        np.add.at(force[:, 0], i, cfx)
+        np.add.at(force[:, 1], i, cfy)
+        np.add.at(moment, i, (r[i] - 0.5 * ov) * fs)
+        np.add.at(force[:, 0], j, -cfx)
+        np.add.at(force[:, 1], j, -cfy)
+        np.add.at(moment, j, (r[j] - 0.5 * ov) * fs)
+        np.add.at(force[:, 0], wi, wcfx)
+        np.add.at(force[:, 1], wi, wcfy)
+        np.add.at(moment, wi, (r[wi] - 0.5 * wov) * wfs)
+        wall_force = np.zeros((nw, 2))
+        np.add.at(wall_force[:, 0], ww, -wcfx)
+        np.add.at(wall_force[:, 1], ww, -wcfy)
+
+        # damping and leapfrog integration
+        free = self.mode == FREE
+        fx, fy, mz = force[:, 0].copy(), force[:, 1].copy(), moment.copy()
+        a = self.damping
+        if a > 0.0:
+            fx = fx - a * np.abs(fx) * np.sign(vel[:, 0])
+            fy = fy - a * np.abs(fy) * np.sign(vel[:, 1])
+            mz = mz - a * np.abs(mz) * np.sign(omega)
+        vel[free, 0] += fx[free] * self.inv_mass[free] * dt
+        vel[free, 1] += fy[free] * self.inv_mass[free] * dt
+        omega[free] += mz[free] * self.inv_inertia[free] * dt
+        pos += vel * dt
+        self.theta += omega * dt
+        self.wp0 += self.wvel * dt
+        self.wp1 += self.wvel * dt
+        self.time += dt
+
+        self.force, self.moment, self.wall_force = force, moment, wall_force
+        self.history = new_hist
+        self.contacts = contacts
+
+    def run(self, steps: int) -> None:
+        for _ in range(steps):
+            self.step()
+
+    # ------------------------------------------------------------ measures
+    def n_sliding(self) -> int:
+        return sum(1 for _fn, _fs, s in self.contacts.values() if s)
+
+    def kinetic_energy(self) -> float:
+        m = self.mass
+        inertia = 0.5 * m * self.radius**2
+        return float(0.5 * np.sum(m * np.sum(self.vel**2, axis=1)) + 0.5 * np.sum(inertia * self.omega**2))
+
+
+def engine_pair_order(sim) -> dict[tuple[int, int], int]:
+    """Slot of every disk pair in a simulation's current neighbour list (its sum order)."""
+    n = sim.particles.n
+    total = int(sim._nb_start[n])
+    rows = np.repeat(np.arange(n), np.diff(sim._nb_start))
+    return {(int(a), int(b)): k for k, (a, b) in enumerate(zip(rows, sim._nb_j[:total], strict=True))}
+
+
+def max_rel_diff(a: np.ndarray, b: np.ndarray, scale: float) -> float:
+    """Largest |a - b| over ``scale`` (a helper for lock-step comparisons)."""
+    if a.size == 0:
+        return 0.0
+    return float(np.max(np.abs(np.asarray(a) - np.asarray(b)))) / scale if scale > 0 else math.inf
