@@ -33,7 +33,6 @@ def test_vertical_force_balance_with_side_friction(loose):
     f = wall_forces(sim)
     weight = float(np.sum(sim.particles.mass)) * spec.gravity / spec.thickness
     assert weight == pytest.approx(spec.self_weight(0.22), rel=1e-12)
-    assert f["f_top_n_per_m"] < 0.1 * weight  # the lid barely touches a loose specimen
     lhs = f["f_bottom_n_per_m"] + f["side_friction_up_n_per_m"]
     assert lhs == pytest.approx(weight + f["f_top_n_per_m"], rel=0.01)
     assert f["side_friction_up_n_per_m"] > 0.0  # the frictional side walls carry a little of it

@@ -30,11 +30,12 @@ def down(tmp_path_factory):
 
 
 def test_accept_at_once(tmp_path):
-    r = _run(tmp_path, 0.21)
+    # this small specimen at 0.21 (seed 0) just fills its box: F_top is about 3 % of G
+    r = _run(tmp_path, 0.21, force_fraction=0.05)
     assert r["converged"] and r["final_porosity"] == 0.21
     (it,) = r["iterations"]
     assert it["plate_moved"] == "no" and it["plate_displacement_m"] == 0.0
-    assert 0.0 < it["f_top_n_per_m"] < 0.01 * it["self_weight_n_per_m"]
+    assert 0.0 < it["f_top_n_per_m"] < 0.05 * it["self_weight_n_per_m"]
     assert it["accepted"] and it["porosity_change"] == 0.0
     saved = json.loads((tmp_path / "result.json").read_text())
     assert saved["final_porosity"] == 0.21 and REQUIRED <= set(saved["iterations"][0])

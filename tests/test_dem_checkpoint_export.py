@@ -22,11 +22,11 @@ def _sim(seed=0):
 
 def test_continued_run_equals_uninterrupted(tmp_path):
     a = _sim()
-    a.run(4000)
+    a.run(8000)
     checkpoint.save(a, tmp_path / "c.npz", extra={"stage": "test"})
     a.run(4000)
     b = checkpoint.load(tmp_path / "c.npz")
-    assert b.step_count == 4000
+    assert b.step_count == 8000
     b.run(4000)
     assert len(a.contacts()) > 50  # the comparison covers many live contacts with history
     for name in ("pos", "vel", "omega", "theta"):
@@ -46,7 +46,8 @@ def test_vtu_files_open_with_meshio(tmp_path):
     import meshio
 
     sim = _sim()
-    sim.run(6000)
+    sim.run(15000)
+    assert len(sim.contacts()) > 0
     files = write_vtu(sim, tmp_path, "snap")
     assert [f.name for f in files] == ["snap_particles.vtu", "snap_walls.vtu", "snap_contacts.vtu"]
     m = meshio.read(files[0])

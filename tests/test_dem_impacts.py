@@ -18,9 +18,9 @@ zero (no tension). The linear solution ``delta = A e^{-zeta w t} sin(w_d t)``,
 ``tan(w_d t*) = -2 zeta sqrt(1 - zeta^2) / (1 - 2 zeta^2)``; from there on the force
 stays zero and the bodies leave with ``|delta'(t*)|``:
 ``e_clip = exp(-zeta w t*) |cos(w_d t*) - zeta / sqrt(1 - zeta^2) sin(w_d t*)|``.
-The requested ``restitution`` e maps to zeta by the *unclipped* relation
-``e = exp(-zeta pi / sqrt(1 - zeta^2))``, so the realised restitution is ``e_clip > e``
-(0.551 for e = 0.5). That mismatch is recorded below as an expected failure.
+With zeta from the *unclipped* relation ``e = exp(-zeta pi / sqrt(1 - zeta^2))`` the
+rebound would be ``e_clip > e`` (0.551 for e = 0.5); the engine inverts the clipped
+relation instead, so a requested e is realised, which the tests below check.
 
 Oblique impacts of a disk on a wall (Chung and Ooi tests 4-6)
 -------------------------------------------------------------
@@ -186,22 +186,20 @@ def test_disk_wall_normal_impact_elastic():
 
 
 @pytest.mark.parametrize("e", [0.3, 0.5, 0.8, 0.95])
-def test_dashpot_restitution_matches_no_tension_solution(e):
+def test_dashpot_restitution_is_the_requested_one(e):
+    """restitution=e rebounds with e for the dashpot that never pulls (disk-disk and disk-wall)."""
     r2 = _two_disks(1.0, 1e6, restitution=e)
     rw = _disk_on_wall(1.0, 0.0, 1e6, 1e6, 0.0, restitution=e)
-    expected = clipped_restitution(e)
-    assert r2["e"] == pytest.approx(expected, rel=5e-3)
-    assert rw["e"] == pytest.approx(expected, rel=5e-3)
+    assert r2["e"] == pytest.approx(e, rel=5e-3)
+    assert rw["e"] == pytest.approx(e, rel=5e-3)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="restitution_to_beta ignores the no-tension clip of the dashpot force: "
-    "restitution=0.5 rebounds with e = 0.551 (0.3 -> 0.398)",
-)
-def test_dashpot_restitution_is_the_requested_one():
-    r = _two_disks(1.0, 1e6, restitution=0.5)
-    assert r["e"] == pytest.approx(0.5, rel=1e-2)
+@pytest.mark.parametrize("e", [0.3, 0.5, 0.8, 0.95])
+def test_closed_form_rebound_matches_the_independent_derivation(e):
+    """model.rebound_of_beta against this module's own no-tension solution."""
+    from poro2d.dem.model import rebound_of_beta
+
+    assert rebound_of_beta(_zeta(e)) == pytest.approx(clipped_restitution(e), rel=1e-12)
 
 
 # ---------------------------------------------------------------- oblique

@@ -80,5 +80,9 @@ def write_csv(path: str | os.PathLike, rows: Iterable[Mapping], header: list[str
         w = csv.DictWriter(fh, fieldnames=header, extrasaction="ignore")
         w.writeheader()
         for r in rows:
-            w.writerow({k: _default(v) if not isinstance(v, (str, int, float, type(None))) else v
-                        for k, v in r.items()})
+            w.writerow(
+                {
+                    k: _default(v) if not isinstance(v, (str, int, float, type(None))) else v
+                    for k, v in r.items()
+                }
+            )

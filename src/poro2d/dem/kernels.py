@@ -150,9 +150,12 @@ def run_steps(
                 dvx = vel[j, 0] - vel[i, 0]
                 dvy = vel[j, 1] - vel[i, 1]
                 vn = -(dvx * nx + dvy * ny)
-                vt = dvx * tx + dvy * ty - (radius[i] - 0.5 * ov) * omega[i] - (
-                    radius[j] - 0.5 * ov
-                ) * omega[j]
+                vt = (
+                    dvx * tx
+                    + dvy * ty
+                    - (radius[i] - 0.5 * ov) * omega[i]
+                    - (radius[j] - 0.5 * ov) * omega[j]
+                )
                 if per_body:
                     kn = series(pkn[i], pkn[j])
                     ks = series(pks[i], pks[j])

@@ -61,7 +61,7 @@ def contact_set(sim) -> ContactSet:
     j2 = sim._wb_w[wsel]
     nrm2 = np.column_stack([sim._wb_nx[wsel], sim._wb_ny[wsel]])
     ov2 = sim._wb_ov[wsel]
-    pt2 = pos[i2] + nrm2 * (r[i2] - ov2)[:, None]
+    pt2 = pos[i2] + nrm2 * (r[i2] - 0.5 * ov2)[:, None]  # the kernel's lever arm, as for disks
     br2 = pt2 - pos[i2]
     fn2, fs2 = sim._wb_fn[wsel], sim._wb_fs[wsel]
 

@@ -219,4 +219,3 @@ def brute_force_pairs(pos: np.ndarray, radius: np.ndarray, skin: float) -> set[t
     reach = radius[:, None] + radius[None, :] + skin
     i, j = np.nonzero(np.triu(d < reach, k=1))
     return set(zip(i.tolist(), j.tolist(), strict=True))
-

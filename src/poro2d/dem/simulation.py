@@ -11,13 +11,20 @@ from __future__ import annotations
 import math
 import os
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from poro2d.dem import kernels as K
-from poro2d.dem.model import ContactModel, critical_time_step, inertial_masses, restitution_to_beta
+from poro2d.dem.model import (
+    ContactModel,
+    critical_time_step,
+    inertial_masses,
+    restitution_to_beta,
+    single_contact_limit,
+)
 from poro2d.dem.state import FREE, PRESCRIBED, WALL_SERVO, WALL_VELOCITY, Particles, Walls
 from poro2d.errors import InputError
 
@@ -78,7 +85,8 @@ class Simulation:
         Optional normal restitution coefficient in (0, 1] for a viscous normal
         dashpot (impact problems); ``None`` for no dashpot.
     dt
-        Fixed time step (s); ``None`` for ``dt_safety * sqrt(m_min / k_max)``.
+        Fixed time step (s); ``None`` for ``dt_safety`` times the critical step
+        ``sqrt(m_min / k_sum)`` (see :func:`poro2d.dem.model.critical_time_step`).
     dt_safety
         Safety factor of the automatic time step, in (0, 1].
     density_scale
@@ -99,7 +107,7 @@ class Simulation:
         local_damping: float = 0.7,
         restitution: float | None = None,
         dt: float | None = None,
-        dt_safety: float = 0.5,
+        dt_safety: float = 0.8,
         density_scale: float = 1.0,
         skin: float | None = None,
         threads: int = 1,
@@ -151,19 +159,24 @@ class Simulation:
         m_in, i_in = inertial_masses(p, self.density_scale)
         self._inv_mass = np.ascontiguousarray(1.0 / m_in) if n else np.zeros(0)
         self._inv_inertia = np.ascontiguousarray(1.0 / i_in) if n else np.zeros(0)
-        k_max = self.contact.max_stiffness(p, self.walls)
-        self.dt_critical = critical_time_step(float(m_in.min()) if n else 1.0, k_max)
+        m_min = float(m_in.min()) if n else 1.0
+        self.dt_critical = critical_time_step(m_min, self.contact.stiffness_sum_bound(p, self.walls))
         if self._fixed_dt is None:
             self.dt = self.dt_safety * self.dt_critical if math.isfinite(self.dt_critical) else 1e-4
         else:
             dt = float(self._fixed_dt)
-            # sqrt(2) sqrt(m/k): a lone disk spinning on one tangential spring already diverges.
-            limit = math.sqrt(2.0) * self.dt_critical
+            limit = single_contact_limit(m_min, self.contact.max_stiffness(p, self.walls))
             if not (dt > 0.0 and dt < limit):
                 raise InputError(
                     "dt", dt, f"(0, {limit:.3g}) s",
-                    f"the lightest disk on the stiffest contact is unstable above {limit:.3g} s; "
-                    f"the automatic step would be {self.dt_safety * self.dt_critical:.3g} s",
+                    f"unstable: the lightest disk spinning on one contact diverges above {limit:.3g} s;"
+                    f" the automatic step would be {self.dt_safety * self.dt_critical:.3g} s",
+                )  # fmt: skip
+            if dt > self.dt_critical:
+                warnings.warn(
+                    f"dt = {dt:.3g} s exceeds the critical step {self.dt_critical:.3g} s of a disk "
+                    "with a full set of contacts; dense packings may become unstable",
+                    stacklevel=3,
                 )
             self.dt = dt
         if self._skin is None:
@@ -460,7 +473,10 @@ class Simulation:
         return res
 
     def solve(
-        self, ratio: float = 1e-3, max_steps: int = 1_000_000, check_every: int = 100,
+        self,
+        ratio: float = 1e-3,
+        max_steps: int = 1_000_000,
+        check_every: int = 100,
         progress: bool | str = False,
     ) -> RunResult:
         """Cycle until the maximum unbalanced-force ratio is below ``ratio``."""
@@ -468,8 +484,8 @@ class Simulation:
 
     # ------------------------------------------------------------ measurement
     def unbalanced_ratios(self) -> tuple[float, float]:
-        """(max, mean) unbalanced-force ratio of the current state."""
-        if self._iprm[K.NEED_BUILD]:
+        """(max, mean) unbalanced-force ratio of the last step (inf before the first)."""
+        if self.step_count == 0 or self.force.shape[0] != self.particles.n:
             return math.inf, math.inf
         r = K.unbalanced_ratios(
             self.force, self.particles.mode, self._nb_start, self._nb_fn, self._nb_fs,

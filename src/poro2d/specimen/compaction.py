@@ -53,7 +53,7 @@ class SpecimenSpec:
     growth_increments: int = 40
     growth_steps: int = 150
     max_steps_per_stage: int = 400_000
-    dt_safety: float = 0.5
+    dt_safety: float = 0.8
     threads: int = 1
     extra: dict = field(default_factory=dict)
 

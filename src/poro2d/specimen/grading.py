@@ -72,9 +72,7 @@ def _check_curve(
 ) -> None:
     """Raise InputError unless (sizes, percent) is a valid ascending grading curve."""
     if sizes.size != percent.size:
-        raise InputError(
-            percent_name, percent.tolist(), f"one value per size ({sizes.size} sizes given)"
-        )
+        raise InputError(percent_name, percent.tolist(), f"one value per size ({sizes.size} sizes given)")
     if sizes.size < 2:
         raise InputError(size_name, sizes.tolist(), "at least 2 sieve sizes")
     if np.any(sizes <= 0.0):
@@ -201,9 +199,7 @@ class GradingCurve:
         )
 
     @classmethod
-    def from_config(
-        cls, table: Mapping[str, Any], *, base_dir: str | Path | None = None
-    ) -> GradingCurve:
+    def from_config(cls, table: Mapping[str, Any], *, base_dir: str | Path | None = None) -> GradingCurve:
         """Build a curve from a config table (e.g. ``[grading]`` of a TOML file).
 
         Keys: exactly one of ``preset = "paper"``, ``csv = "path.csv"`` (relative to
@@ -510,9 +506,7 @@ def max_deviation(curve: GradingCurve, radii: Any) -> float:
     return float(np.max(np.abs(realised_curve(curve, radii) - curve.percent)))
 
 
-def plot_realised(
-    curve: GradingCurve, radii: Any, path: str | Path, *, title: str | None = None
-) -> Path:
+def plot_realised(curve: GradingCurve, radii: Any, path: str | Path, *, title: str | None = None) -> Path:
     """Write a PNG of the requested and realised curves (log diameter axis) and return its path."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure

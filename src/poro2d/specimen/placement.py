@@ -219,9 +219,7 @@ def place_disks(
         )
     phi = float(np.sum(np.pi * r * r)) / b.area
     if phi >= 1.0:
-        raise InputError(
-            "radii", f"solid fraction {phi:.4f}", "total disk area below the band area"
-        )
+        raise InputError("radii", f"solid fraction {phi:.4f}", "total disk area below the band area")
 
     order = np.argsort(-r, kind="stable")
     r_sorted = np.ascontiguousarray(r[order])
@@ -260,6 +258,5 @@ def place_disks(
         "max_restarts",
         max_restarts,
         "enough restarts to find a reduction factor",
-        hint=f"stopped at scale {scale / shrink_f:.3g}; lower target_fraction or raise "
-        "max_attempts",
+        hint=f"stopped at scale {scale / shrink_f:.3g}; lower target_fraction or raise max_attempts",
     )
