@@ -1,0 +1,20 @@
+"""Sweeps: many cases (criterion runs, later direct shear tests) as Dask tasks.
+
+``parse_sweep`` turns a config with a ``[sweep]`` table into cases with stable ids;
+``run_sweep`` runs the unfinished ones on a LocalCluster or an existing scheduler
+and gathers one table. New case kinds are added with ``register_kind``.
+"""
+
+from poro2d.sweep.cases import KINDS, Case, SweepConfig, case_id, parse_sweep, register_kind
+from poro2d.sweep.runner import SweepOutcome, run_sweep
+
+__all__ = [
+    "KINDS",
+    "Case",
+    "SweepConfig",
+    "SweepOutcome",
+    "case_id",
+    "parse_sweep",
+    "register_kind",
+    "run_sweep",
+]

@@ -1,0 +1,316 @@
+"""Sweep configs, case ids and the registry of case kinds.
+
+A sweep config is a criterion config (``seed``, ``[specimen]``, ``[grading]``,
+``[criterion]``) plus a ``[sweep]`` table::
+
+    [sweep]
+    kind = "criterion"                       # a key of KINDS
+    n_lab = [0.33, 0.36, 0.39]               # grid axes: every combination is a case
+    specimen.friction_particle = [1.0, 3.0]
+
+or, instead of grid axes, an explicit list of cases::
+
+    [[sweep.cases]]
+    n_lab = 0.33
+    specimen.kn_particle = 2e5
+
+A parameter is a dotted path into the base config (``specimen.kn_particle``,
+``criterion.n_lab``, ``grading.upscale``, ``seed``) or a bare field name of
+:class:`SpecimenSpec` or :class:`CriterionSettings` (``n_lab`` means
+``criterion.n_lab``). Names are resolved once, so ``n_lab`` and
+``criterion.n_lab`` give the same case and the same id.
+
+A case kind is a callable ``run(config, out_dir) -> dict of scalars``; it is
+registered in :data:`KINDS` (and optionally a ``validate(config, base_dir)`` in
+:data:`VALIDATORS`, run before anything is submitted, that raises
+:class:`InputError` on bad input). New kinds (direct shear, ...) only add an entry.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import hashlib
+import itertools
+import json
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from poro2d.config import check_keys
+from poro2d.errors import InputError
+
+#: kind -> run(config, out_dir) -> dict of scalar results
+KINDS: dict[str, Callable[[dict, Path], dict]] = {}
+#: kind -> validate(config, base_dir); raises InputError before any case runs
+VALIDATORS: dict[str, Callable[[dict, Path | None], None]] = {}
+#: tables whose dataclass field names may be used without the table prefix
+BARE_NAME_TABLES: dict[str, type] = {}
+
+#: keys of ``[sweep]`` that are options, not grid axes
+SWEEP_OPTIONS = {"kind", "cases", "figures", "retries", "title"}
+#: top-level tables of a sweep config
+TOP_KEYS = {"seed", "specimen", "grading", "criterion", "shear", "title", "sweep", "relation"}
+#: the tables a case parameter may point into
+CASE_TABLES = {"specimen", "grading", "criterion", "shear"}
+
+
+def register_kind(
+    name: str,
+    run: Callable[[dict, Path], dict],
+    validate: Callable[[dict, Path | None], None] | None = None,
+    tables: tuple[str, ...] = (),
+) -> None:
+    """Add (or replace) a case kind; ``tables``: extra config tables its parameters live in."""
+    KINDS[name] = run
+    CASE_TABLES.update(tables)
+    TOP_KEYS.update(tables)
+    if validate is not None:
+        VALIDATORS[name] = validate
+    else:
+        VALIDATORS.pop(name, None)
+
+
+# --------------------------------------------------------------------------- criterion kind
+def _criterion_objects(config: dict, base_dir: Path | None = None):
+    from poro2d.criterion.config import build
+    from poro2d.specimen.compaction import check_feasible
+
+    cfg = {k: v for k, v in config.items() if k in ("seed", "specimen", "grading", "criterion")}
+    spec, grading, settings, seed = build(copy.deepcopy(cfg), base_dir)
+    check_feasible(spec, grading, settings.initial_trial())
+    return spec, grading, settings, seed
+
+
+def validate_criterion(config: dict, base_dir: Path | None = None) -> None:
+    _criterion_objects(config, base_dir)
+
+
+def run_criterion(config: dict, out_dir: Path) -> dict:
+    """The criterion of Fig. 3 for one case; scalars of its result and of its last trial."""
+    from poro2d.criterion.protocol import PorosityCriterion
+
+    spec, grading, settings, seed = _criterion_objects(config)
+    figures = bool(config.get("sweep_options", {}).get("figures", False))
+    crit = PorosityCriterion(
+        spec, grading, settings, seed=seed, out=out_dir, progress=False, config=config, figures=figures
+    )
+    res = crit.run()
+    last = res["iterations"][-1] if res["iterations"] else {}
+    return {
+        "n_lab": res["n_lab"],
+        "final_porosity": res["final_porosity"],
+        "converged": bool(res["converged"]),
+        "iterations": len(res["iterations"]),
+        "message": res["message"],
+        "initial_trial_porosity": res["initial_trial_porosity"],
+        "last_trial_porosity": last.get("trial_porosity"),
+        "last_new_porosity": last.get("new_porosity"),
+        "particle_count": last.get("particle_count"),
+        "plate_moved": last.get("plate_moved"),
+        "f_top_n_per_m": last.get("f_top_n_per_m"),
+        "f_bottom_n_per_m": last.get("f_bottom_n_per_m"),
+        "f_top_after_n_per_m": last.get("f_top_after_n_per_m"),
+        "f_bottom_after_n_per_m": last.get("f_bottom_after_n_per_m"),
+        "self_weight_n_per_m": last.get("self_weight_n_per_m"),
+        "criterion_time_s": res.get("time_total_s"),
+    }
+
+
+def _register_builtin() -> None:
+    from poro2d.criterion.protocol import CriterionSettings
+    from poro2d.specimen.compaction import SpecimenSpec
+
+    BARE_NAME_TABLES.setdefault("specimen", SpecimenSpec)
+    BARE_NAME_TABLES.setdefault("criterion", CriterionSettings)
+    register_kind("criterion", run_criterion, validate_criterion)
+
+
+# --------------------------------------------------------------------------------- cases
+@dataclass
+class Case:
+    """One case: its kind, the parameters that differ from the base, the merged config."""
+
+    kind: str
+    params: dict[str, Any]
+    config: dict
+    id: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.id:
+            self.id = case_id(self.kind, self.config)
+
+    def to_dict(self) -> dict:
+        return {"id": self.id, "kind": self.kind, "params": self.params, "config": self.config}
+
+
+@dataclass
+class SweepConfig:
+    """A parsed sweep: its cases and options, plus the raw config for the record."""
+
+    kind: str
+    cases: list[Case]
+    raw: dict
+    base_dir: Path | None = None
+    retries: int = 2
+    figures: bool = False
+    title: str = ""
+    axes: list[str] = field(default_factory=list)
+
+
+def canonical_json(obj: Any) -> str:
+    return json.dumps(obj, sort_keys=True, separators=(",", ":"), default=str)
+
+
+def case_id(kind: str, config: dict) -> str:
+    """A stable id: the first 12 hex digits of the SHA-256 of the kind and merged config."""
+    h = hashlib.sha256(canonical_json({"kind": kind, "config": config}).encode())
+    return h.hexdigest()[:12]
+
+
+def _field_names(cls: type) -> set[str]:
+    return {f.name for f in dataclasses.fields(cls) if f.name != "extra"}
+
+
+def resolve_name(name: str) -> str:
+    """``n_lab`` -> ``criterion.n_lab``; dotted names are checked against the case tables."""
+    if not BARE_NAME_TABLES:
+        _register_builtin()
+    parts = name.split(".")
+    if len(parts) == 1:
+        if name == "seed":
+            return name
+        owners = [t for t, cls in BARE_NAME_TABLES.items() if name in _field_names(cls)]
+        if len(owners) == 1:
+            return f"{owners[0]}.{name}"
+        known = sorted({f"{t}.{n}" for t, c in BARE_NAME_TABLES.items() for n in _field_names(c)})
+        if len(owners) > 1:
+            raise InputError(f"sweep.{name}", name, f"one of {', '.join(owners)} prefixed", "ambiguous name")
+        raise InputError(
+            f"sweep.{name}",
+            name,
+            "seed or a field of " + ", ".join(sorted(BARE_NAME_TABLES)),
+            f"or a dotted path such as {known[0]}",
+        )
+    table, key = parts[0], ".".join(parts[1:])
+    if table not in CASE_TABLES or len(parts) != 2:
+        raise InputError(f"sweep.{name}", name, f"seed or <table>.<key> with table in {sorted(CASE_TABLES)}")
+    cls = BARE_NAME_TABLES.get(table)
+    if cls is not None and key not in _field_names(cls):
+        check_keys(table, {key: None}, _field_names(cls))
+    return f"{table}.{key}"
+
+
+def _flatten(prefix: str, table: dict) -> dict[str, Any]:
+    """Nested TOML tables (``specimen.kn = ...`` inside ``[sweep]``) to dotted keys."""
+    out: dict[str, Any] = {}
+    for k, v in table.items():
+        name = f"{prefix}.{k}" if prefix else str(k)
+        if isinstance(v, dict):
+            out.update(_flatten(name, v))
+        else:
+            out[name] = v
+    return out
+
+
+def apply_params(base: dict, params: dict[str, Any]) -> dict:
+    """The base config with the case's parameters set (dotted names already resolved)."""
+    cfg = copy.deepcopy({k: v for k, v in base.items() if k not in ("sweep", "relation", "title")})
+    for name, value in params.items():
+        if "." not in name:
+            cfg[name] = value
+            continue
+        table, key = name.split(".", 1)
+        cfg.setdefault(table, {})[key] = value
+    return cfg
+
+
+def _check_value(name: str, value: Any) -> Any:
+    if isinstance(value, float) and not math.isfinite(value):
+        raise InputError(f"sweep.{name}", value, "a finite number")
+    if isinstance(value, dict):
+        raise InputError(f"sweep.{name}", value, "a value (number, string, bool or list)")
+    return value
+
+
+def _absolute_grading(cfg: dict, base_dir: Path | None) -> dict:
+    g = cfg.get("grading")
+    if isinstance(g, dict) and isinstance(g.get("csv"), str) and base_dir is not None:
+        p = Path(g["csv"])
+        if not p.is_absolute():
+            g["csv"] = str((base_dir / p).resolve())
+    return cfg
+
+
+def parse_sweep(cfg: dict, base_dir: Path | None = None, *, validate: bool = True) -> SweepConfig:
+    """Cases of a sweep config dict; every problem is an :class:`InputError`."""
+    if not BARE_NAME_TABLES:
+        _register_builtin()
+    check_keys("config", cfg, TOP_KEYS)
+    sw = cfg.get("sweep")
+    if not isinstance(sw, dict):
+        raise InputError("sweep", sw, "a [sweep] table with kind and grid axes or cases")
+    kind = sw.get("kind", "criterion")
+    if kind not in KINDS:
+        raise InputError("sweep.kind", kind, ", ".join(sorted(KINDS)))
+    retries = sw.get("retries", 2)
+    if not (isinstance(retries, int) and not isinstance(retries, bool) and 0 <= retries <= 20):
+        raise InputError("sweep.retries", retries, "an integer in [0, 20]")
+    figures = sw.get("figures", False)
+    if not isinstance(figures, bool):
+        raise InputError("sweep.figures", figures, "true or false")
+    title = str(sw.get("title", cfg.get("title", "")))
+
+    axes_raw = _flatten("", {k: v for k, v in sw.items() if k not in SWEEP_OPTIONS})
+    explicit = sw.get("cases")
+    combos: list[dict[str, Any]] = []
+    axes: list[str] = []
+    if axes_raw and explicit is not None:
+        raise InputError("sweep.cases", "cases and grid axes", "either grid axes or a list of cases")
+    if explicit is not None:
+        if not isinstance(explicit, list) or not explicit or not all(isinstance(c, dict) for c in explicit):
+            raise InputError("sweep.cases", explicit, "a non-empty list of tables ([[sweep.cases]])")
+        for c in explicit:
+            flat = {resolve_name(k): _check_value(k, v) for k, v in _flatten("", c).items()}
+            combos.append(flat)
+            axes.extend(k for k in flat if k not in axes)
+    else:
+        grid: dict[str, list] = {}
+        for name, values in axes_raw.items():
+            full = resolve_name(name)
+            if full in grid:
+                raise InputError(f"sweep.{name}", values, "each parameter once", f"{full} is given twice")
+            if not isinstance(values, list) or not values:
+                raise InputError(f"sweep.{name}", values, "a non-empty list of values (a grid axis)")
+            grid[full] = [_check_value(name, v) for v in values]
+        axes = list(grid)
+        combos = [dict(zip(axes, vals, strict=True)) for vals in itertools.product(*grid.values())]
+        if not combos:
+            combos = [{}]
+
+    base = _absolute_grading(copy.deepcopy(cfg), base_dir)
+    cases: list[Case] = []
+    seen: dict[str, int] = {}
+    for i, params in enumerate(combos):
+        merged = apply_params(base, params)
+        if figures:
+            merged["sweep_options"] = {"figures": True}
+        case = Case(kind, params, merged)
+        if case.id in seen:
+            raise InputError(
+                "sweep", params, "distinct cases", f"case {i + 1} repeats case {seen[case.id] + 1}"
+            )
+        seen[case.id] = i
+        if validate and kind in VALIDATORS:
+            try:
+                VALIDATORS[kind](merged, base_dir)
+            except InputError as exc:
+                where = ", ".join(f"{k} = {v!r}" for k, v in params.items()) or "the base case"
+                raise InputError(exc.parameter, exc.value, exc.allowed, f"in the case {where}") from None
+        cases.append(case)
+    return SweepConfig(kind, cases, cfg, base_dir, retries, figures, title, axes)
+
+
+_register_builtin()

@@ -1,0 +1,160 @@
+"""``poro2d sweep`` and ``poro2d relation``."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+console = Console()
+
+_SCHED = "Address of a running Dask scheduler (e.g. tcp://host:8786); default: a LocalCluster."
+_WORKERS = "Worker processes of the LocalCluster (default: one per core, one thread each)."
+
+
+def _check_workers(workers: int | None) -> None:
+    from poro2d.errors import InputError
+
+    if workers is not None and workers < 1:
+        raise InputError("--workers", workers, "an integer >= 1")
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("sweep")
+    def sweep_cmd(
+        config: Path = typer.Argument(..., help="TOML config: base case tables and a \\[sweep] table."),
+        out: Path = typer.Option(
+            Path("sweep-out"), "--out", "-o", help="Output folder (reruns skip done cases)."
+        ),
+        scheduler: str = typer.Option(None, "--scheduler", help=_SCHED),
+        workers: int = typer.Option(None, "--workers", help=_WORKERS),
+        quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
+    ) -> None:
+        """Run a grid or list of cases as Dask tasks; one table of results."""
+        from poro2d.config import load_toml
+        from poro2d.sweep.cases import parse_sweep
+        from poro2d.sweep.runner import run_sweep
+
+        _check_workers(workers)
+        cfg = load_toml(config)
+        sweep = parse_sweep(cfg, Path(config).resolve().parent)
+        console.print(f"{len(sweep.cases)} case(s) of kind {sweep.kind!r} -> {out}")
+        res = run_sweep(sweep, out, scheduler=scheduler, workers=workers, progress=not quiet)
+        print_summary(res, out)
+        if res.failed:
+            raise typer.Exit(1)
+
+    @app.command("relation")
+    def relation_cmd(
+        config: Path = typer.Option(
+            None, "--config", "-c", help="Criterion config; optional \\[relation] table."
+        ),
+        preset: str = typer.Option(None, "--preset", help="Built-in case: 'paper'."),
+        points: int = typer.Option(
+            None, "--points", help="Laboratory porosities from n_max to n_min (default 5)."
+        ),
+        n_max: float = typer.Option(None, "--n-max", help="Loosest laboratory porosity (paper: 0.4571)."),
+        n_min: float = typer.Option(None, "--n-min", help="Densest laboratory porosity (paper: 0.3253)."),
+        out: Path = typer.Option(Path("relation-out"), "--out", "-o", help="Output folder (resumable)."),
+        scheduler: str = typer.Option(None, "--scheduler", help=_SCHED),
+        workers: int = typer.Option(None, "--workers", help=_WORKERS),
+        quick: bool = typer.Option(False, "--quick", help="Small specimen (0.08 m x 0.04 m, 2 layers)."),
+        quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
+    ) -> None:
+        """The grading's n2D(nLab) relation from the criterion at several relative densities."""
+        from poro2d.config import check_keys, load_toml
+        from poro2d.criterion.config import TOP_KEYS, paper_preset
+        from poro2d.errors import InputError
+        from poro2d.sweep import relation as R
+        from poro2d.sweep.cases import parse_sweep
+        from poro2d.sweep.runner import run_sweep
+
+        _check_workers(workers)
+        if config is not None and preset is not None:
+            raise InputError("--config/--preset", f"{config} and {preset}", "one of the two, not both")
+        if config is None:
+            if preset not in (None, "paper"):
+                raise InputError("--preset", preset, "'paper'")
+            base, base_dir = paper_preset(), None
+        else:
+            base = load_toml(config)
+            check_keys("config", base, set(TOP_KEYS) | {"relation"})
+            base_dir = Path(config).resolve().parent
+        settings = R.relation_settings(
+            base.get("relation"), points=points, n_max=n_max, n_min=n_min, preset=config is None
+        )
+        cfg = R.sweep_config(base, settings["n_lab"], quick=quick)
+        sweep = parse_sweep(cfg, base_dir)
+        console.print(
+            f"criterion at nLab = {', '.join(f'{v:g}' for v in settings['n_lab'])} "
+            f"(n_max {settings['n_max']:g}, n_min {settings['n_min']:g})"
+            f"{' [quick]' if quick else ''} -> {out}"
+        )
+        res = run_sweep(sweep, out, scheduler=scheduler, workers=workers, progress=not quiet)
+        rel = R.analyse(res.rows, settings["n_max"], settings["n_min"])
+        extra = {"quick": quick, "sweep_summary": res.summary, "config": base}
+        R.write_relation(rel, out, extra=extra)
+        print_relation(rel, out)
+
+
+def print_summary(res, out: Path) -> None:
+    s = res.summary
+    t = Table(
+        title=f"sweep: {s['cases']} case(s), {s['ran']} run, {s['reused']} already done, {s['failed']} failed"
+    )
+    t.add_column("case")
+    t.add_column("status")
+    t.add_column("time s", justify="right")
+    t.add_column("result / error")
+    for r in res.rows:
+        rs = r.get("results", {}) or {}
+        if r["status"] == "failed":
+            txt = f"[red]{r.get('error')}[/]"
+        elif "final_porosity" in rs:
+            fp = rs.get("final_porosity")
+            txt = f"n2D = {fp:.4f}" if fp is not None else f"not converged ({rs.get('message', '')})"
+        else:
+            txt = ", ".join(f"{k}={v}" for k, v in list(rs.items())[:4])
+        ts = r.get("time_s")
+        t.add_row(r["case_id"], "reused" if r.get("reused") else r["status"], f"{ts:.1f}" if ts else "", txt)
+    console.print(t)
+    eff = s.get("parallel_efficiency")
+    console.print(
+        f"wall {s['wall_time_s']:.1f} s, case time {s['case_time_sum_s']:.1f} s"
+        + (f", parallel efficiency {eff:.0%}" if eff else "")
+        + f"; table in {out}/results.csv"
+    )
+
+
+def print_relation(rel: dict, out: Path) -> None:
+    t = Table(title="n2D(nLab) from the criterion")
+    for c in ("nLab", "Dr", "n2D DEM", "fit", "Eq. 12", "LIM 2D-3D", "LIM 2D-Lab", "flag"):
+        t.add_column(c, justify="right")
+
+    def f(v) -> str:
+        return "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.4f}"
+
+    for p in rel["points"]:
+        t.add_row(
+            f"{p['n_lab']:.4f}",
+            f"{p['relative_density']:.2f}",
+            f(p["n2d_dem"]),
+            f(p["n2d_fit"]),
+            f(p["n2d_parabolic"]),
+            f(p["n2d_lim_3d"]),
+            f(p["n2d_lim_lab"]),
+            p["flag"] or "ok",
+        )
+    console.print(t)
+    fit = rel["fit"]
+    if fit:
+        console.print(
+            f"fit: n2D = {fit['a']:.4f} nLab^2 + {fit['b']:.4f} nLab (Eq. 12: 0.42, 0.25); "
+            f"rms residual {fit['rms_residual']:.4g}, max {fit['max_abs_residual']:.4g}"
+        )
+    else:
+        console.print(f"[yellow]{rel['fit_note']}[/]")
+    console.print(f"figure {out}/relation.png, table {out}/relation.csv")

@@ -1,0 +1,392 @@
+"""Run the cases of a sweep as Dask tasks; gather one tidy table.
+
+Layout of the output folder ``DIR``::
+
+    DIR/sweep.json                 config, cases, cluster, counts, provenance
+    DIR/results.csv                one row per case (also results.parquet)
+    DIR/cases/<id>/params.json     the case: kind, parameters, merged config
+    DIR/cases/<id>/run/...         what the case kind writes (criterion outputs)
+    DIR/cases/<id>/error.txt       traceback of a failed case
+    DIR/cases/<id>/result.json     written atomically last: the case is done
+
+Reliability: a case whose ``result.json`` exists is not run again. A case that
+raises is caught on the worker, its traceback is stored and the error is put in
+the table; the other cases go on. A worker process that dies takes its running
+task with it; the scheduler resubmits that task to another (or the restarted)
+worker, up to ``distributed.scheduler.allowed-failures`` times, and ``retries``
+on submit covers failures outside the case code. A rerun with the same ``DIR``
+skips finished cases and runs the rest (failed ones included).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import time
+import traceback
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from poro2d.io_utils import atomic_path, provenance, write_json
+from poro2d.sweep.cases import KINDS, Case, SweepConfig
+
+RESULT = "result.json"
+PARAMS = "params.json"
+ERROR_TXT = "error.txt"
+ERROR_JSON = "error.json"
+
+#: environment of LocalCluster worker processes: one thread for every numeric library
+SINGLE_THREAD_ENV = {
+    "NUMBA_NUM_THREADS": "1",
+    "OMP_NUM_THREADS": "1",
+    "MKL_NUM_THREADS": "1",
+    "OPENBLAS_NUM_THREADS": "1",
+}
+
+
+def _now() -> str:
+    return datetime.now(UTC).isoformat(timespec="seconds")
+
+
+def _scalar(v: Any) -> Any:
+    """Values of a table cell: numbers, strings, bools or None; anything else as JSON."""
+    if v is None or isinstance(v, (bool, int, float, str)):
+        return v
+    try:
+        import numpy as np
+
+        if isinstance(v, np.generic):
+            return v.item()
+    except ImportError:  # pragma: no cover
+        pass
+    return json.dumps(v, default=str)
+
+
+def load_done(case_dir: Path) -> dict | None:
+    """The stored row of a finished case, or None (missing or unreadable marker)."""
+    p = case_dir / RESULT
+    if not p.is_file():
+        return None
+    try:
+        row = json.loads(p.read_text())
+    except (OSError, json.JSONDecodeError):
+        return None
+    return row if isinstance(row, dict) and row.get("status") == "done" else None
+
+
+# ------------------------------------------------------------------------ worker side
+def run_case_task(case: dict, case_dir: str, func) -> dict:
+    """Run one case on a worker; never raises for errors of the case itself.
+
+    ``func`` is the kind's callable, shipped with the task so that kinds registered
+    at run time (tests, plug-ins) work on any worker.
+    """
+    d = Path(case_dir)
+    done = load_done(d)
+    if done is not None:  # a retry after the marker was written
+        return done
+    d.mkdir(parents=True, exist_ok=True)
+    write_json(d / PARAMS, case)
+    try:
+        import numba
+
+        numba.set_num_threads(1)  # the case kind may raise it again for its own runs
+    except Exception:  # pragma: no cover - numba missing or threading layer unavailable
+        pass
+    row: dict[str, Any] = {
+        "case_id": case["id"],
+        "kind": case["kind"],
+        "params": case["params"],
+        "host": socket.gethostname(),
+        "pid": os.getpid(),
+        "worker": _worker_address(),
+        "started_utc": _now(),
+    }
+    t0 = time.perf_counter()
+    try:
+        results = func(case["config"], d / "run")
+        if not isinstance(results, dict):
+            raise TypeError(f"case kind {case['kind']!r} returned {type(results).__name__}, not a dict")
+        results = {str(k): _scalar(v) for k, v in results.items()}
+    except Exception as exc:
+        row.update(
+            status="failed",
+            error=f"{type(exc).__name__}: {exc}",
+            time_s=time.perf_counter() - t0,
+            finished_utc=_now(),
+            results={},
+        )
+        with atomic_path(d / ERROR_TXT) as tmp:
+            tmp.write_text(traceback.format_exc())
+        write_json(d / ERROR_JSON, row)
+        return row
+    row.update(status="done", error=None, time_s=time.perf_counter() - t0, finished_utc=_now())
+    row["results"] = results
+    for stale in (ERROR_TXT, ERROR_JSON):
+        (d / stale).unlink(missing_ok=True)
+    write_json(d / RESULT, row)  # the done marker, last
+    return row
+
+
+def _worker_address() -> str:
+    try:
+        from distributed import get_worker
+
+        return get_worker().address
+    except Exception:
+        return "local"
+
+
+# ------------------------------------------------------------------------ driver side
+@dataclass
+class SweepOutcome:
+    rows: list[dict]
+    table: Any  # pandas.DataFrame
+    summary: dict = field(default_factory=dict)
+
+    @property
+    def failed(self) -> list[dict]:
+        return [r for r in self.rows if r["status"] == "failed"]
+
+
+def _failed_row(case: Case, d: Path, err: BaseException, tb: str) -> dict:
+    row = {
+        "case_id": case.id,
+        "kind": case.kind,
+        "params": case.params,
+        "status": "failed",
+        "error": f"{type(err).__name__}: {err}",
+        "time_s": None,
+        "results": {},
+        "host": None,
+        "pid": None,
+        "worker": None,
+        "finished_utc": _now(),
+    }
+    d.mkdir(parents=True, exist_ok=True)
+    if not (d / PARAMS).is_file():
+        write_json(d / PARAMS, case.to_dict())
+    with atomic_path(d / ERROR_TXT) as tmp:
+        tmp.write_text(tb or row["error"])
+    write_json(d / ERROR_JSON, row)
+    return row
+
+
+def _start_client(scheduler: str | None, workers: int | None, threads_needed: int):
+    """(client, cluster or None): connect to ``scheduler`` or start a LocalCluster."""
+    from distributed import Client, LocalCluster
+
+    if scheduler:
+        return Client(scheduler, timeout="30s"), None
+    n = workers or os.cpu_count() or 1
+    env = dict(SINGLE_THREAD_ENV, NUMBA_NUM_THREADS=str(max(1, threads_needed)))
+    cluster = LocalCluster(
+        n_workers=n,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=None,
+        env=env,
+    )
+    return Client(cluster), cluster
+
+
+def table_from_rows(rows: list[dict], axes: list[str]):
+    """One row per case: id, kind, parameters, status, results, timing, worker, error."""
+    import pandas as pd
+
+    flat = []
+    result_keys: list[str] = []
+    for r in rows:
+        for k in r.get("results", {}):
+            if k not in result_keys:
+                result_keys.append(k)
+    for r in rows:
+        rec: dict[str, Any] = {"case_id": r["case_id"], "kind": r["kind"]}
+        for a in axes:
+            rec[a] = _scalar(r.get("params", {}).get(a))
+        rec["status"] = r["status"]
+        for k in result_keys:
+            rec[k] = r.get("results", {}).get(k)
+        rec["time_s"] = r.get("time_s")
+        rec["worker"] = r.get("worker")
+        rec["host"] = r.get("host")
+        rec["pid"] = r.get("pid")
+        rec["error"] = r.get("error")
+        flat.append(rec)
+    df = pd.DataFrame(flat)
+    for col in df.columns:  # mixed object columns (None + numbers) become numeric or text
+        if df[col].dtype == object:
+            vals = [v for v in df[col] if v is not None]
+            if vals and all(isinstance(v, bool) for v in vals):
+                df[col] = df[col].astype("boolean")
+            elif vals and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in vals):
+                df[col] = pd.to_numeric(df[col])
+            elif vals:
+                df[col] = df[col].map(lambda v: None if v is None else str(v))
+    return df
+
+
+def write_tables(df, out: Path) -> None:
+    with atomic_path(out / "results.csv") as tmp:
+        df.to_csv(tmp, index=False)
+    with atomic_path(out / "results.parquet") as tmp:
+        df.to_parquet(tmp, index=False)
+
+
+def run_sweep(
+    sweep: SweepConfig,
+    out: str | os.PathLike,
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    client=None,
+    progress: bool = True,
+) -> SweepOutcome:
+    """Run every unfinished case of ``sweep`` into ``out``; returns the rows and the table.
+
+    ``client``: an existing ``distributed.Client`` (tests, notebooks); otherwise one is
+    made for ``scheduler`` (an address such as ``tcp://host:8786``) or for a new
+    LocalCluster with ``workers`` processes (default: one per core) of one thread each.
+    """
+    out = Path(out)
+    cases_dir = out / "cases"
+    cases_dir.mkdir(parents=True, exist_ok=True)
+    t_start = time.perf_counter()
+    record = {
+        "status": "running",
+        "title": sweep.title,
+        "kind": sweep.kind,
+        "axes": sweep.axes,
+        "cases": [{"id": c.id, "params": c.params} for c in sweep.cases],
+        "config": sweep.raw,
+        "base_dir": str(sweep.base_dir) if sweep.base_dir else None,
+        "retries": sweep.retries,
+        "provenance": provenance(),
+    }
+    write_json(out / "sweep.json", record)
+
+    rows: dict[str, dict] = {}
+    pending: list[Case] = []
+    for c in sweep.cases:
+        done = load_done(cases_dir / c.id)
+        if done is not None:
+            done = dict(done, status="done", reused=True)
+            rows[c.id] = done
+        else:
+            pending.append(c)
+    n_reused = len(rows)
+
+    cluster_info: dict[str, Any] = {}
+    if pending:
+        own = client is None
+        cluster = None
+        if own:
+            threads = max(int((c.config.get("specimen") or {}).get("threads", 1) or 1) for c in pending)
+            client, cluster = _start_client(scheduler, workers, threads)
+        try:
+            info = client.scheduler_info()
+            cluster_info = {
+                "scheduler": scheduler or info.get("address"),
+                "workers": len(info.get("workers", {})),
+                "threads": sum(w.get("nthreads", 0) for w in info.get("workers", {}).values()),
+                "local_cluster": cluster is not None,
+            }
+            rows.update(
+                _submit_all(client, pending, cases_dir, sweep.retries, progress, n_reused, len(sweep.cases))
+            )
+        finally:
+            if own:
+                client.close()
+                if cluster is not None:
+                    cluster.close()
+
+    ordered = [dict(rows[c.id], reused=bool(rows[c.id].get("reused", False))) for c in sweep.cases]
+    df = table_from_rows(ordered, sweep.axes)
+    df["reused"] = [r["reused"] for r in ordered]
+    write_tables(df, out)
+    wall = time.perf_counter() - t_start
+    busy = sum(r.get("time_s") or 0.0 for r in ordered if not r["reused"])
+    summary = {
+        "cases": len(ordered),
+        "ran": len(ordered) - n_reused,
+        "reused": n_reused,
+        "done": sum(r["status"] == "done" for r in ordered),
+        "failed": sum(r["status"] == "failed" for r in ordered),
+        "wall_time_s": wall,
+        "case_time_sum_s": busy,
+        "worker_processes": sorted(
+            {f"{r.get('host')}:{r.get('pid')}" for r in ordered if not r["reused"] and r.get("pid")}
+        ),
+    }
+    if cluster_info.get("threads"):
+        summary["parallel_efficiency"] = busy / (wall * cluster_info["threads"]) if wall > 0 else None
+    record.update(status="finished", cluster=cluster_info, summary=summary, finished_utc=_now())
+    write_json(out / "sweep.json", record)
+    return SweepOutcome(ordered, df, summary)
+
+
+def _submit_all(
+    client, pending: list[Case], cases_dir: Path, retries: int, progress: bool, n_reused: int, n_total: int
+) -> dict[str, dict]:
+    from distributed import as_completed
+    from rich.console import Console
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    futures = {}
+    for c in pending:
+        fut = client.submit(
+            run_case_task,
+            c.to_dict(),
+            str(cases_dir / c.id),
+            KINDS[c.kind],
+            key=f"{c.kind}-{c.id}",
+            retries=retries,
+            pure=False,
+        )
+        futures[fut] = c
+    rows: dict[str, dict] = {}
+    bar = Progress(
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("{task.fields[failed]}"),
+        TimeElapsedColumn(),
+        TextColumn("eta"),
+        TimeRemainingColumn(),
+        console=Console(stderr=True),
+        disable=not progress,
+    )
+    with bar:
+        task = bar.add_task(
+            f"sweep ({n_reused} of {n_total} already done)" if n_reused else "sweep",
+            total=len(pending),
+            failed="",
+        )
+        n_failed = 0
+        for fut in as_completed(list(futures)):
+            c = futures[fut]
+            if fut.status == "finished":
+                row = fut.result()
+            else:  # the task itself failed: e.g. KilledWorker after too many worker deaths
+                exc = fut.exception()
+                tb = "".join(traceback.format_tb(fut.traceback())) if fut.traceback() else ""
+                row = _failed_row(c, cases_dir / c.id, exc, f"{tb}{type(exc).__name__}: {exc}\n")
+            rows[c.id] = row
+            if row["status"] == "failed":
+                n_failed += 1
+            bar.update(task, advance=1, failed=f"[red]{n_failed} failed[/]" if n_failed else "")
+            fut.release()
+    return rows
+
+
+__all__ = ["SweepOutcome", "load_done", "run_case_task", "run_sweep", "table_from_rows", "write_tables"]

@@ -1,0 +1,238 @@
+"""Sweeps on a two-process LocalCluster: criterion cases, worker loss, reruns, failures, config errors."""
+
+import json
+import os
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from poro2d.cli import main
+from poro2d.errors import InputError
+from poro2d.sweep import parse_sweep, register_kind, run_sweep
+from poro2d.sweep.runner import SINGLE_THREAD_ENV
+
+distributed = pytest.importorskip("distributed")
+
+TINY = {"width": 0.05, "height": 0.025, "layers": 2}
+# one trial and a short plate servo: each case takes about a second of DEM
+FAST = {"max_iterations": 1, "max_plate_steps": 5000}
+
+
+def probe(config: dict, out_dir: Path) -> dict:
+    """A cheap case kind: counts its runs, can fail, can kill its worker once."""
+    p = config.get("probe", {})
+    out_dir.mkdir(parents=True, exist_ok=True)
+    counter = out_dir / "runs.txt"
+    runs = int(counter.read_text()) + 1 if counter.is_file() else 1
+    counter.write_text(str(runs))
+    marker = p.get("kill_marker")
+    if marker and not Path(marker).exists():
+        Path(marker).write_text(str(os.getpid()))
+        os._exit(1)  # the worker process dies mid-task, as on a lost node
+    if p.get("fail"):
+        raise RuntimeError(f"probe failure x={p.get('x')}")
+    time.sleep(p.get("seconds", 0.2))
+    return {"value": 2 * p.get("x", 0), "runs": runs, "pid": os.getpid()}
+
+
+register_kind("probe", probe, tables=("probe",))
+
+
+@pytest.fixture(scope="module")
+def client():
+    cluster = distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, env=SINGLE_THREAD_ENV
+    )
+    c = distributed.Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+def probe_cfg(xs, **extra):
+    return {"sweep": {"kind": "probe", "probe": {"x": list(xs), **{k: [v] for k, v in extra.items()}}}}
+
+
+def test_criterion_sweep_uses_both_workers_and_rerun_skips(client, tmp_path):
+    cfg = {
+        "seed": 0,
+        "specimen": dict(TINY),
+        "criterion": dict(FAST),
+        "sweep": {
+            "kind": "criterion",
+            "n_lab": [0.33, 0.36, 0.39, 0.42],
+            "specimen": {"friction_particle": [1.0, 3.0]},
+        },
+    }
+    sweep = parse_sweep(cfg)
+    assert len(sweep.cases) == 8 and sweep.axes == ["criterion.n_lab", "specimen.friction_particle"]
+    t0 = time.perf_counter()
+    res = run_sweep(sweep, tmp_path, client=client, progress=False)
+    wall = time.perf_counter() - t0
+    assert [r["status"] for r in res.rows] == ["done"] * 8, [r.get("error") for r in res.rows]
+    pids = {r["pid"] for r in res.rows}
+    assert len(pids) == 2, pids  # both worker processes ran cases
+    print(
+        f"\n8 criterion cases: wall {wall:.1f} s, case time {res.summary['case_time_sum_s']:.1f} s, "
+        f"efficiency {res.summary.get('parallel_efficiency', 0):.0%}, pids {sorted(pids)}"
+    )
+
+    df = pd.read_csv(tmp_path / "results.csv")
+    pq = pd.read_parquet(tmp_path / "results.parquet")
+    assert len(df) == len(pq) == 8
+    for col in (
+        "case_id",
+        "criterion.n_lab",
+        "specimen.friction_particle",
+        "final_porosity",
+        "converged",
+        "iterations",
+        "particle_count",
+        "f_top_n_per_m",
+        "f_bottom_n_per_m",
+        "time_s",
+        "error",
+    ):
+        assert col in df.columns, col
+    assert df["error"].isna().all() and (df["particle_count"] > 0).all() and (df["iterations"] == 1).all()
+    assert sorted(df["criterion.n_lab"].unique()) == [0.33, 0.36, 0.39, 0.42]
+    for c in sweep.cases:
+        d = tmp_path / "cases" / c.id
+        assert json.loads((d / "params.json").read_text())["params"] == c.params
+        assert (d / "run" / "result.json").is_file() and (d / "run" / "iterations.csv").is_file()
+    rec = json.loads((tmp_path / "sweep.json").read_text())
+    assert (
+        rec["status"] == "finished" and rec["summary"]["done"] == 8 and "poro2d_version" in rec["provenance"]
+    )
+
+    stamps = {c.id: (tmp_path / "cases" / c.id / "result.json").stat().st_mtime_ns for c in sweep.cases}
+    again = run_sweep(parse_sweep(cfg), tmp_path, client=client, progress=False)
+    assert again.summary["ran"] == 0 and again.summary["reused"] == 8
+    assert all(r["reused"] for r in again.rows)
+    for c in sweep.cases:
+        assert (tmp_path / "cases" / c.id / "result.json").stat().st_mtime_ns == stamps[c.id]
+    pd.testing.assert_series_equal(
+        pd.read_csv(tmp_path / "results.csv")["final_porosity"], df["final_porosity"]
+    )
+
+
+def test_killed_worker_does_not_lose_the_sweep(client, tmp_path):
+    marker = tmp_path / "killed.txt"
+    cfg = {
+        "sweep": {
+            "kind": "probe",
+            "cases": [
+                {"probe": {"x": 1}},
+                {"probe": {"x": 2, "kill_marker": str(marker)}},
+                {"probe": {"x": 3}},
+                {"probe": {"x": 4}},
+            ],
+        }
+    }
+    res = run_sweep(parse_sweep(cfg), tmp_path / "out", client=client, progress=False)
+    assert marker.is_file()  # the worker really died once
+    assert [r["status"] for r in res.rows] == ["done"] * 4
+    killed = res.rows[1]
+    assert killed["results"]["runs"] == 2  # ran again after the worker was lost
+    assert killed["pid"] != int(marker.read_text())  # on another (or a restarted) process
+    assert [r["results"]["value"] for r in res.rows] == [2, 4, 6, 8]
+
+
+def test_interrupted_sweep_rerun_skips_finished_cases(client, tmp_path):
+    out = tmp_path / "out"
+    first = run_sweep(parse_sweep(probe_cfg([1, 2])), out, client=client, progress=False)
+    assert first.summary["ran"] == 2
+    # the "interrupted" sweep finished two of four cases; the rerun runs only the rest
+    full = parse_sweep(probe_cfg([1, 2, 3, 4]))
+    res = run_sweep(full, out, client=client, progress=False)
+    assert res.summary["reused"] == 2 and res.summary["ran"] == 2
+    assert [r["reused"] for r in res.rows] == [True, True, False, False]
+    for c in full.cases:  # every case ran exactly once
+        assert (out / "cases" / c.id / "run" / "runs.txt").read_text() == "1"
+    df = pd.read_parquet(out / "results.parquet")
+    assert list(df["probe.x"]) == [1, 2, 3, 4] and list(df["value"]) == [2, 4, 6, 8]
+
+
+def test_failing_case_is_reported_and_others_finish(client, tmp_path):
+    cfg = {
+        "sweep": {
+            "kind": "probe",
+            "cases": [
+                {"probe": {"x": 1}},
+                {"probe": {"x": 2, "fail": True}},
+                {"probe": {"x": 3}},
+            ],
+        }
+    }
+    sweep = parse_sweep(cfg)
+    res = run_sweep(sweep, tmp_path, client=client, progress=False)
+    assert [r["status"] for r in res.rows] == ["done", "failed", "done"]
+    bad = tmp_path / "cases" / sweep.cases[1].id
+    assert "RuntimeError: probe failure x=2" in (bad / "error.txt").read_text()
+    assert "Traceback" in (bad / "error.txt").read_text()
+    assert not (bad / "result.json").exists()  # not marked done: a rerun tries it again
+    df = pd.read_csv(tmp_path / "results.csv")
+    assert df["status"].tolist() == ["done", "failed", "done"]
+    assert df["error"].isna().tolist() == [True, False, True]
+    assert "probe failure" in df["error"][1]
+    rerun = run_sweep(sweep, tmp_path, client=client, progress=False)
+    assert rerun.summary["reused"] == 2 and rerun.summary["ran"] == 1 and rerun.summary["failed"] == 1
+
+
+def test_cli_sweep_on_its_own_local_cluster(tmp_path):
+    cfg = tmp_path / "sweep.toml"
+    cfg.write_text('[sweep]\nkind = "probe"\nprobe.x = [5, 6]\nprobe.seconds = [0.0]\n')
+    main(["sweep", str(cfg), "--out", str(tmp_path / "out"), "--workers", "2", "--quiet"])
+    df = pd.read_csv(tmp_path / "out" / "results.csv")
+    assert list(df["value"]) == [10, 12] and (df["status"] == "done").all()
+    rec = json.loads((tmp_path / "out" / "sweep.json").read_text())
+    assert rec["cluster"]["workers"] == 2 and rec["cluster"]["local_cluster"]
+
+
+def test_case_ids_are_stable_and_names_resolve():
+    base = {"specimen": dict(TINY), "criterion": dict(FAST)}
+    a = parse_sweep(dict(base, sweep={"n_lab": [0.33, 0.36]}))
+    b = parse_sweep(dict(base, sweep={"criterion.n_lab": [0.33, 0.36]}))
+    c = parse_sweep(dict(base, sweep={"cases": [{"criterion": {"n_lab": 0.33}}, {"n_lab": 0.36}]}))
+    assert [x.id for x in a.cases] == [x.id for x in b.cases] == [x.id for x in c.cases]
+    assert len({x.id for x in a.cases}) == 2
+    assert a.cases[0].params == {"criterion.n_lab": 0.33}
+    grid = parse_sweep(dict(base, sweep={"kn_particle": [2e5, 4e5], "friction_particle": [1.0, 3.0]}))
+    assert len(grid.cases) == 4
+    assert grid.cases[3].config["specimen"]["kn_particle"] == 4e5
+
+
+@pytest.mark.parametrize(
+    "sweep, parameter",
+    [
+        ({"n_lbo": [0.3]}, "sweep.n_lbo"),
+        ({"specimen": {"kn_particel": [1e5]}}, "specimen.kn_particel"),
+        ({"frobnicate": {"x": [1]}}, "sweep.frobnicate.x"),
+        ({"n_lab": 0.33}, "sweep.n_lab"),
+        ({"n_lab": []}, "sweep.n_lab"),
+        ({"kind": "nope", "n_lab": [0.3]}, "sweep.kind"),
+        ({"retries": -1, "n_lab": [0.3]}, "sweep.retries"),
+        ({"n_lab": [0.33], "cases": [{"n_lab": 0.3}]}, "sweep.cases"),
+        ({"n_lab": [0.33, 1.5]}, "n_lab"),
+        ({"n_lab": [0.33, 0.33]}, "sweep"),
+    ],
+)
+def test_bad_sweep_configs_are_input_errors(sweep, parameter):
+    with pytest.raises(InputError) as ei:
+        parse_sweep({"specimen": dict(TINY), "sweep": sweep})
+    assert ei.value.parameter == parameter
+
+
+def test_bad_top_level_key_and_cli_exit_code(tmp_path, capsys):
+    with pytest.raises(InputError):
+        parse_sweep({"sweeep": {}, "sweep": {"n_lab": [0.3]}})
+    with pytest.raises(InputError):
+        parse_sweep({"specimen": {"widht": 0.05}, "sweep": {"n_lab": [0.3]}})
+    cfg = tmp_path / "bad.toml"
+    cfg.write_text("[sweep]\nn_lab = [0.3]\nnlab = [0.4]\n")
+    with pytest.raises(SystemExit) as ei:
+        main(["sweep", str(cfg), "--out", str(tmp_path / "o")])
+    assert ei.value.code == 2
+    assert "sweep.nlab" in capsys.readouterr().err
