@@ -46,10 +46,14 @@ def _register() -> None:
     # layer cannot take the whole CLI down at import time.
     from poro2d import paper, porosity_cli
     from poro2d.criterion import cli as criterion_cli
+    from poro2d.shear import cli as shear_cli
+    from poro2d.sweep import cli as sweep_cli
 
     porosity_cli.register(app)
     criterion_cli.register(app)
+    shear_cli.register(app)
     paper.register(app)
+    sweep_cli.register(app)
 
 
 _register()

@@ -1,0 +1,286 @@
+"""The grading-specific relation n2D(nLab) from the criterion, run as a sweep.
+
+The paper verified its criterion only for a dense specimen (Dr = 0.89). Here the
+criterion runs at several laboratory porosities between n_max (loose) and n_min
+(dense) for one grading; every accepted n2D is a point of the DEM-derived relation.
+A parabola through the origin, n2D = a nLab^2 + b nLab (the form of Eq. 12), is
+fitted by least squares to the converged points and shown beside Eq. 12 and the
+other conversion methods. Points whose criterion did not converge are kept: they are
+drawn hollow at their last estimate n' (the porosity of the box after the plate
+moved), flagged in the table and left out of the fit.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from poro2d import porosity as P
+from poro2d.config import check_keys
+from poro2d.errors import InputError, check_range
+
+RELATION_KEYS = {"n_max", "n_min", "points", "n_lab"}
+#: the small specimen of ``--quick``
+QUICK_SPECIMEN = {"width": 0.08, "height": 0.04, "layers": 2}
+#: conversion methods drawn beside the DEM points
+COMPARE = ("parabolic", "lim_3d", "lim_lab", "densest_state")
+
+
+def lab_porosities(n_max: float, n_min: float, points: int) -> list[float]:
+    """``points`` laboratory porosities from loose (n_max) to dense (n_min), 4 decimals."""
+    P.relative_density(n_min, n_max, n_min)  # validates the extremes
+    if not (isinstance(points, int) and not isinstance(points, bool) and 2 <= points <= 50):
+        raise InputError("points", points, "an integer in [2, 50]")
+    return [round(float(x), 4) for x in np.linspace(n_max, n_min, points)]
+
+
+def fit_quadratic_origin(n_lab, n2d) -> dict[str, Any]:
+    """Least-squares n2D = a nLab^2 + b nLab (no constant: the curve passes the origin).
+
+    Returns a, b, the residuals (data - fit), their RMS and maximum, and R^2 about the
+    mean. Needs at least two points with distinct, non-zero nLab.
+    """
+    x = np.asarray(n_lab, dtype=float).ravel()
+    y = np.asarray(n2d, dtype=float).ravel()
+    if x.shape != y.shape:
+        raise InputError("n2d", y.shape, f"as many values as n_lab ({x.shape[0]})")
+    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(y))):
+        raise InputError("points", "non-finite", "finite porosities")
+    if len(np.unique(x[x != 0.0])) < 2:
+        raise InputError("points", list(x), "at least two distinct, non-zero laboratory porosities")
+    A = np.column_stack([x * x, x])
+    (a, b), *_ = np.linalg.lstsq(A, y, rcond=None)
+    resid = y - (a * x * x + b * x)
+    ss_tot = float(np.sum((y - y.mean()) ** 2))
+    return {
+        "a": float(a),
+        "b": float(b),
+        "points": int(x.size),
+        "residuals": resid.tolist(),
+        "rms_residual": float(np.sqrt(np.mean(resid**2))),
+        "max_abs_residual": float(np.max(np.abs(resid))),
+        "r2": float(1.0 - np.sum(resid**2) / ss_tot) if ss_tot > 0 else None,
+        "form": "n2D = a nLab^2 + b nLab",
+    }
+
+
+def relation_settings(
+    table: dict | None, *, points: int | None, n_max: float | None, n_min: float | None, preset: bool
+) -> dict:
+    """n_max, n_min and the nLab list from ``[relation]`` and the command-line options."""
+    t = dict(table or {})
+    check_keys("relation", t, RELATION_KEYS)
+    hi = n_max if n_max is not None else t.get("n_max", P.PAPER_N_MAX if preset else None)
+    lo = n_min if n_min is not None else t.get("n_min", P.PAPER_N_MIN if preset else None)
+    if hi is None or lo is None:
+        raise InputError(
+            "relation.n_max/n_min",
+            (hi, lo),
+            "both laboratory extremes",
+            "set them in [relation] or --n-max/--n-min",
+        )
+    hi = check_range("n_max", hi, 0.0, 1.0, lo_open=True, hi_open=True)
+    lo = check_range("n_min", lo, 0.0, 1.0, lo_open=True, hi_open=True)
+    if not hi > lo:
+        raise InputError("n_max", hi, f"greater than n_min = {lo}")
+    if "n_lab" in t and points is None:
+        vals = t["n_lab"]
+        if not isinstance(vals, list) or len(vals) < 2:
+            raise InputError("relation.n_lab", vals, "a list of at least two laboratory porosities")
+        n_labs = [
+            round(check_range("relation.n_lab", v, 0.0, 1.0, lo_open=True, hi_open=True), 4) for v in vals
+        ]
+        n_labs = sorted(set(n_labs), reverse=True)
+    else:
+        n_labs = lab_porosities(hi, lo, points if points is not None else t.get("points", 5))
+    return {"n_max": hi, "n_min": lo, "n_lab": n_labs}
+
+
+def sweep_config(base: dict, n_labs: list[float], *, quick: bool) -> dict:
+    """The criterion sweep over nLab for one grading (``base``: a criterion config)."""
+    cfg = copy.deepcopy({k: v for k, v in base.items() if k not in ("relation", "sweep")})
+    if quick:
+        spec = dict(cfg.get("specimen") or {})
+        spec.update(QUICK_SPECIMEN)
+        cfg["specimen"] = spec
+    crit = dict(cfg.get("criterion") or {})
+    crit.pop("n_lab", None)
+    crit.pop("trial_porosity", None)  # every point starts from Eq. 12 at its own nLab
+    cfg["criterion"] = crit
+    cfg["sweep"] = {"kind": "criterion", "title": "n2D(nLab) relation", "criterion.n_lab": list(n_labs)}
+    return cfg
+
+
+def _num(v: Any) -> float:
+    try:
+        f = float(v)
+    except (TypeError, ValueError):
+        return math.nan
+    return f
+
+
+def analyse(rows: list[dict], n_max: float, n_min: float) -> dict:
+    """Relation points (one per case), the fit through the converged ones, comparisons."""
+    pts = []
+    for r in rows:
+        res = r.get("results", {}) or {}
+        n_lab = _num(res.get("n_lab", (r.get("params") or {}).get("criterion.n_lab")))
+        converged = bool(res.get("converged")) and r["status"] == "done"
+        if converged:
+            n2d, source = _num(res.get("final_porosity")), "accepted"
+        elif r["status"] == "done":
+            n2d, source = _num(res.get("last_new_porosity")), "last estimate n' (not converged)"
+        else:
+            n2d, source = math.nan, "case failed"
+        conv = P.convert_all(n_lab, n_max, n_min)
+        pt = {
+            "case_id": r["case_id"],
+            "n_lab": n_lab,
+            "relative_density": float(P.relative_density(n_lab, n_max, n_min)),
+            "degree_of_density": float(P.degree_of_density(n_lab, n_max, n_min)),
+            "n2d_dem": n2d,
+            "converged": converged,
+            "flag": "" if converged else source,
+            "iterations": res.get("iterations"),
+            "initial_trial_porosity": res.get("initial_trial_porosity"),
+            "particle_count": res.get("particle_count"),
+            "message": res.get("message") or r.get("error"),
+        }
+        for m in COMPARE:
+            pt[f"n2d_{m}"] = conv.results[m].value
+        pts.append(pt)
+    pts.sort(key=lambda p: -p["n_lab"])  # loose to dense
+    good = [p for p in pts if p["converged"] and math.isfinite(p["n2d_dem"])]
+    fit: dict[str, Any] | None = None
+    note = ""
+    try:
+        fit = fit_quadratic_origin([p["n_lab"] for p in good], [p["n2d_dem"] for p in good])
+    except InputError:
+        note = f"no fit: {len(good)} converged point(s); at least two distinct nLab are needed"
+    for p in pts:
+        if fit is not None and math.isfinite(p["n2d_dem"]):
+            p["n2d_fit"] = fit["a"] * p["n_lab"] ** 2 + fit["b"] * p["n_lab"]
+            p["residual"] = p["n2d_dem"] - p["n2d_fit"]
+        else:
+            p["n2d_fit"] = None
+            p["residual"] = None
+        p["dem_minus_parabola"] = p["n2d_dem"] - p["n2d_parabolic"] if math.isfinite(p["n2d_dem"]) else None
+    return {
+        "n_max": n_max,
+        "n_min": n_min,
+        "points": pts,
+        "fit": fit,
+        "fit_note": note
+        or f"fitted to the {len(good)} converged point(s); non-converged points are shown only",
+        "eq12": {"a": 0.42, "b": 0.25},
+        "converged_points": len(good),
+        "flagged_points": len(pts) - len(good),
+    }
+
+
+def plot_relation(rel: dict, title: str = ""):
+    """DEM points (hollow = not converged), the fit, Eq. 12 and other methods vs nLab."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    hi, lo = rel["n_max"], rel["n_min"]
+    pts = rel["points"]
+    xs = [p["n_lab"] for p in pts] + [hi, lo]
+    pad = 0.08 * (max(xs) - min(xs))
+    x = np.linspace(min(xs) - pad, max(xs) + pad, 201)
+    fig = Figure(figsize=(9.5, 6.0), layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    ax.axvspan(lo, hi, color="0.5", alpha=0.07, lw=0)
+    styles = {
+        "parabolic": ("Parabola, Eq. 12 (0.42 n^2 + 0.25 n)", dict(color="black", lw=2.0)),
+        "lim_3d": ("LIM 2D-3D (Sec. 2.2)", dict(color="tab:brown", lw=1.4)),
+        "lim_lab": ("LIM 2D-Lab (Eqs. 6-7)", dict(color="tab:green", lw=1.4)),
+        "densest_state": ("Densest State (Eq. 1)", dict(color="tab:blue", lw=1.2, ls="--")),
+    }
+    funcs = {
+        "parabolic": lambda v: P.parabolic(v),
+        "lim_3d": lambda v: P.lim_3d(v),
+        "lim_lab": lambda v: P.lim_lab(v, hi, lo),
+        "densest_state": lambda v: P.densest_state(v),
+    }
+    for m in COMPARE:
+        label, st = styles[m]
+        ax.plot(x, funcs[m](x), label=label, **st)
+    fit = rel.get("fit")
+    if fit is not None:
+        ax.plot(
+            x,
+            fit["a"] * x * x + fit["b"] * x,
+            color="tab:red",
+            lw=2.0,
+            ls="-.",
+            label=f"fit to DEM: {fit['a']:.3f} n^2 + {fit['b']:.3f} n (rms {fit['rms_residual']:.4f})",
+        )
+    ok = [p for p in pts if p["converged"]]
+    bad = [p for p in pts if not p["converged"] and math.isfinite(p["n2d_dem"])]
+    if ok:
+        ax.plot(
+            [p["n_lab"] for p in ok],
+            [p["n2d_dem"] for p in ok],
+            "o",
+            color="tab:red",
+            ms=8,
+            label="DEM criterion (accepted n2D)",
+        )
+    if bad:
+        ax.plot(
+            [p["n_lab"] for p in bad],
+            [p["n2d_dem"] for p in bad],
+            "o",
+            mfc="none",
+            mec="tab:red",
+            mew=1.8,
+            ms=9,
+            label="DEM, not converged (last n')",
+        )
+    for p in pts:
+        if math.isfinite(p["n2d_dem"]):
+            ax.annotate(
+                f"Dr={p['relative_density']:.2f}",
+                (p["n_lab"], p["n2d_dem"]),
+                textcoords="offset points",
+                xytext=(6, -12),
+                fontsize=8,
+                color="0.25",
+            )
+    failed = [p for p in pts if not math.isfinite(p["n2d_dem"])]
+    for p in failed:
+        ax.axvline(p["n_lab"], color="tab:red", ls=":", lw=1.0)
+    ax.set_xlim(x[0], x[-1])
+    ax.set_xlabel("laboratory porosity nLab [-]   (shaded: between n_min and n_max)")
+    ax.set_ylabel("2D porosity n2D [-]")
+    head = title or "2D porosity from the criterion vs laboratory porosity"
+    sub = f"n_max = {hi:g} (Dr = 0), n_min = {lo:g} (Dr = 1)"
+    if failed:
+        sub += f"; {len(failed)} failed case(s) dotted"
+    ax.set_title(f"{head}\n{sub}", fontsize=11)
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="upper left", fontsize=8.5, frameon=False)
+    return fig
+
+
+def write_relation(rel: dict, out: Path, title: str = "", extra: dict | None = None) -> list[Path]:
+    """relation.csv, relation.json, relation.png and relation.svg in ``out``."""
+    from poro2d.io_utils import atomic_path, provenance, write_csv, write_json
+
+    out.mkdir(parents=True, exist_ok=True)
+    write_csv(out / "relation.csv", rel["points"])
+    write_json(out / "relation.json", dict(rel, **(extra or {}), provenance=provenance()))
+    fig = plot_relation(rel, title)
+    paths = []
+    for ext in ("png", "svg"):
+        p = out / f"relation.{ext}"
+        with atomic_path(p) as tmp:
+            fig.savefig(tmp, dpi=150, format=ext)
+        paths.append(p)
+    return [out / "relation.csv", out / "relation.json", *paths]

@@ -1,0 +1,147 @@
+"""The n2D(nLab) relation: the fit, the analysis of sweep rows, the files, the command."""
+
+import json
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from poro2d import porosity as P
+from poro2d.cli import main
+from poro2d.errors import InputError
+from poro2d.sweep import relation as R
+
+
+def test_fit_recovers_known_coefficients():
+    x = np.linspace(0.32, 0.46, 5)
+    fit = R.fit_quadratic_origin(x, 0.5 * x**2 + 0.2 * x)
+    assert fit["a"] == pytest.approx(0.5, abs=1e-10) and fit["b"] == pytest.approx(0.2, abs=1e-10)
+    assert fit["rms_residual"] < 1e-12 and fit["points"] == 5
+    # Eq. 12 itself, with noise: the least-squares answer of the normal equations
+    rng = np.random.default_rng(3)
+    y = P.parabolic(x) + rng.normal(0, 0.002, x.size)
+    fit = R.fit_quadratic_origin(x, y)
+    A = np.column_stack([x * x, x])
+    a, b = np.linalg.solve(A.T @ A, A.T @ y)
+    assert (fit["a"], fit["b"]) == pytest.approx((a, b), rel=1e-9)
+    assert np.allclose(fit["residuals"], y - (a * x * x + b * x))
+    # two points determine the curve exactly
+    fit = R.fit_quadratic_origin([0.3, 0.4], [0.42 * 0.09 + 0.25 * 0.3, 0.42 * 0.16 + 0.25 * 0.4])
+    assert (fit["a"], fit["b"]) == pytest.approx((0.42, 0.25), abs=1e-12)
+
+
+@pytest.mark.parametrize("x, y", [([0.3], [0.1]), ([0.3, 0.3], [0.1, 0.11]), ([0.3, math.nan], [0.1, 0.2])])
+def test_fit_needs_two_distinct_points(x, y):
+    with pytest.raises(InputError):
+        R.fit_quadratic_origin(x, y)
+
+
+def test_lab_porosities_loose_to_dense_and_settings():
+    pts = R.lab_porosities(P.PAPER_N_MAX, P.PAPER_N_MIN, 5)
+    assert pts[0] == 0.4571 and pts[-1] == 0.3253 and pts == sorted(pts, reverse=True)
+    s = R.relation_settings(None, points=3, n_max=None, n_min=None, preset=True)
+    assert s["n_lab"] == [0.4571, 0.3912, 0.3253]
+    s = R.relation_settings(
+        {"n_max": 0.5, "n_min": 0.3, "n_lab": [0.35, 0.45]}, points=None, n_max=None, n_min=None, preset=False
+    )
+    assert s["n_lab"] == [0.45, 0.35]
+    with pytest.raises(InputError):
+        R.relation_settings({"nmax": 0.5}, points=None, n_max=None, n_min=None, preset=True)
+    with pytest.raises(InputError):
+        R.relation_settings(None, points=None, n_max=0.3, n_min=0.4, preset=True)
+    with pytest.raises(InputError):
+        R.relation_settings(None, points=None, n_max=None, n_min=None, preset=False)
+    with pytest.raises(InputError):
+        R.lab_porosities(0.45, 0.33, 1)
+
+
+def _row(cid, n_lab, status="done", converged=True, final=None, last=None):
+    res = (
+        {}
+        if status == "failed"
+        else {
+            "n_lab": n_lab,
+            "converged": converged,
+            "final_porosity": final,
+            "last_new_porosity": last,
+            "iterations": 2,
+            "message": "m",
+            "particle_count": 100,
+            "initial_trial_porosity": 0.15,
+        }
+    )
+    return {
+        "case_id": cid,
+        "status": status,
+        "results": res,
+        "params": {"criterion.n_lab": n_lab},
+        "error": "RuntimeError: x" if status == "failed" else None,
+    }
+
+
+def test_analysis_flags_points_and_writes_files(tmp_path):
+    a, b = 0.6, 0.1
+    xs = [0.4571, 0.4242, 0.3912, 0.3582]
+    rows = [_row(f"c{i}", x, final=a * x * x + b * x) for i, x in enumerate(xs)]
+    rows.append(_row("nc", 0.3253, converged=False, final=None, last=0.2))
+    rows.append(_row("bad", 0.34, status="failed"))
+    rel = R.analyse(rows, P.PAPER_N_MAX, P.PAPER_N_MIN)
+    assert rel["fit"]["a"] == pytest.approx(a) and rel["fit"]["b"] == pytest.approx(b)
+    assert rel["converged_points"] == 4 and rel["flagged_points"] == 2
+    pts = {p["case_id"]: p for p in rel["points"]}
+    assert not pts["nc"]["converged"] and pts["nc"]["n2d_dem"] == 0.2 and "not converged" in pts["nc"]["flag"]
+    assert pts["nc"]["residual"] == pytest.approx(0.2 - (a * 0.3253**2 + b * 0.3253))
+    assert math.isnan(pts["bad"]["n2d_dem"]) and pts["bad"]["flag"] == "case failed"
+    assert pts["c0"]["relative_density"] == pytest.approx(0.0) and pts["nc"][
+        "relative_density"
+    ] == pytest.approx(1.0)
+    assert pts["c0"]["n2d_parabolic"] == pytest.approx(float(P.parabolic(0.4571)))
+    assert pts["c0"]["n2d_lim_3d"] == pytest.approx(float(P.lim_3d(0.4571)))
+    files = R.write_relation(rel, tmp_path)
+    for f in files:
+        assert f.stat().st_size > 0
+    df = pd.read_csv(tmp_path / "relation.csv")
+    assert len(df) == 6 and set(df["converged"]) == {True, False}
+    saved = json.loads((tmp_path / "relation.json").read_text())
+    assert saved["fit"]["form"] == "n2D = a nLab^2 + b nLab" and "provenance" in saved
+
+
+def test_no_fit_with_one_converged_point():
+    rows = [_row("a", 0.45, final=0.2), _row("b", 0.35, converged=False, last=0.21)]
+    rel = R.analyse(rows, P.PAPER_N_MAX, P.PAPER_N_MIN)
+    assert rel["fit"] is None and "no fit" in rel["fit_note"]
+    assert all(p["n2d_fit"] is None for p in rel["points"])
+    R.plot_relation(rel)  # draws without a fitted curve
+
+
+def test_relation_command_on_tiny_specimens(tmp_path):
+    cfg = tmp_path / "rel.toml"
+    cfg.write_text(
+        "seed = 0\n[specimen]\nwidth = 0.05\nheight = 0.025\nlayers = 2\n"
+        "[criterion]\nmax_iterations = 1\nmax_plate_steps = 5000\n"
+        "[relation]\nn_max = 0.4571\nn_min = 0.3253\n"
+    )
+    out = tmp_path / "out"
+    main(["relation", "--config", str(cfg), "--points", "3", "--out", str(out), "--workers", "2", "--quiet"])
+    for f in ("relation.png", "relation.svg", "relation.csv", "relation.json", "results.csv", "sweep.json"):
+        assert (out / f).stat().st_size > 0, f
+    df = pd.read_csv(out / "relation.csv")
+    assert list(df["n_lab"]) == [0.4571, 0.3912, 0.3253]
+    expected = [float(P.relative_density(x, P.PAPER_N_MAX, P.PAPER_N_MIN)) for x in df["n_lab"]]
+    assert (
+        list(df["relative_density"]) == pytest.approx(expected) and expected[0] == 0.0 and expected[2] == 1.0
+    )
+    # every point is reported, converged or flagged
+    assert all(c or f for c, f in zip(df["converged"], df["flag"].fillna(""), strict=True))
+
+
+def test_relation_cli_errors(tmp_path):
+    with pytest.raises(SystemExit) as ei:
+        main(["relation", "--preset", "paper", "--points", "1", "--out", str(tmp_path)])
+    assert ei.value.code == 2
+    cfg = tmp_path / "c.toml"
+    cfg.write_text("[relation]\npoints = 3\nnmin = 0.3\n")
+    with pytest.raises(SystemExit) as ei:
+        main(["relation", "--config", str(cfg), "--out", str(tmp_path)])
+    assert ei.value.code == 2
