@@ -118,6 +118,9 @@ def register(app: typer.Typer) -> None:
             "provenance": provenance(),
         }
         write_json(out / "results.json", json.loads(json.dumps(summary, default=str)))
-        console.print(f"results in {out}/results.json")
+        from poro2d.report.paper_report import write_paper_report
+
+        md, html = write_paper_report(out, summary)
+        console.print(f"results in {out}/results.json; report: {html} and {md}")
         if not result["converged"]:
             raise typer.Exit(1)
