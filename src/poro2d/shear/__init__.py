@@ -1,0 +1,11 @@
+"""Direct shear tests in a split box of moving walls (the paper's section 4, Fig. 8)."""
+
+from poro2d.shear.box import SplitBox, build_split_box
+from poro2d.shear.fit import MohrCoulombFit, mohr_coulomb, peak, smooth
+from poro2d.shear.lab import LabData, read_lab_csv
+from poro2d.shear.protocol import DirectShearTest, ShearSeries, ShearSettings, inertial_number
+
+__all__ = [
+    "DirectShearTest", "LabData", "MohrCoulombFit", "ShearSeries", "ShearSettings", "SplitBox",
+    "build_split_box", "inertial_number", "mohr_coulomb", "peak", "read_lab_csv", "smooth",
+]  # fmt: skip

@@ -1,0 +1,211 @@
+"""A split shear box made of moving wall segments around a loaded specimen.
+
+The specimen comes from the criterion (walls ``bottom``, ``right``, ``top``, ``left``
+around ``0..W x 0..H``). Its side walls are replaced by four half walls, split at
+``ys = H / 2``::
+
+                 top (servo plate, fixed in x)
+    upper_left |                            | upper_right
+               |        upper half          |________  upper_lip (fixed)
+    ___________|............................|
+    lower_lip  |        lower half          | lower_right
+    lower_left |____________________________|
+                 bottom (moves with the lower half)
+
+The lower half (``bottom``, ``lower_left``, ``lower_right``, ``lower_lip``) moves
+in +x; the upper half (``upper_left``, ``upper_right``, ``upper_lip``) stays; the
+top plate is servo-controlled vertically. When the lower half has moved by ``d``,
+two openings appear along the shear plane: ``[0, d]`` under the upper half, closed
+by ``lower_lip`` (it runs left from the top of ``lower_left``), and
+``[W, W + d]`` above the lower half, closed by ``upper_lip`` (it runs right from
+the bottom of ``upper_right``). Both lips are as long as the largest shear
+displacement plus one largest disk diameter.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from poro2d.dem import ContactModel, Particles, Simulation, Walls
+from poro2d.errors import InputError, check_range
+
+LOWER = ("bottom", "lower_left", "lower_right", "lower_lip")
+UPPER = ("upper_left", "upper_right", "upper_lip", "top")
+SPECIMEN_WALLS = ("bottom", "right", "top", "left")
+
+
+@dataclass(frozen=True)
+class SplitBox:
+    """Geometry of a split box and the force bookkeeping on its two halves.
+
+    ``width`` W and ``height`` H are those of the specimen's box (the top plate's
+    height when the box was built); ``split_y`` is the shear plane, ``gap`` the
+    opening between the lower walls' top and the upper walls' bottom.
+    """
+
+    width: float
+    height: float
+    split_y: float
+    gap: float
+    max_displacement: float
+    thickness: float
+    x0_lower: float = 0.0
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    # ------------------------------------------------------------ kinematics
+    def shear_displacement(self, sim: Simulation) -> float:
+        """How far the lower half has moved in +x (m)."""
+        return float(sim.walls.p0[sim.walls.index("lower_left"), 0]) - self.x0_lower
+
+    def plate_height(self, sim: Simulation) -> float:
+        return float(sim.walls.p0[sim.walls.index("top"), 1])
+
+    # ---------------------------------------------------------------- forces
+    @staticmethod
+    def _sum(sim: Simulation, names) -> np.ndarray:
+        f = np.zeros(2)
+        for name in names:
+            f += sim.wall_force(name)
+        return f
+
+    def upper_force(self, sim: Simulation) -> np.ndarray:
+        """Force of the disks on the upper half: upper walls, upper lip, top plate (N)."""
+        return self._sum(sim, UPPER)
+
+    def lower_force(self, sim: Simulation) -> np.ndarray:
+        """Force of the disks on the lower half: bottom, lower walls, lower lip (N)."""
+        return self._sum(sim, LOWER)
+
+    def plate_force(self, sim: Simulation) -> float:
+        """Upward push of the disks on the top plate (N)."""
+        return float(sim.wall_force("top")[1])
+
+    def plane_force(self, sim: Simulation, contacts=None) -> dict:
+        """Forces carried across the shear plane ``y = split_y`` (N).
+
+        The disks are split by their centres into an upper set (``y >= split_y``)
+        and a lower set. ``across`` is the force that the lower body (lower disks
+        and lower walls) exerts on the upper body (upper disks and upper walls):
+        disk-disk contacts whose branch vector crosses the plane, upper disks on
+        lower walls, and lower disks on upper walls. ``unbalanced`` is the summed
+        unbalanced force on the upper disks; exactly,
+        ``upper_force = across - unbalanced`` (the upper disks' balance), so the
+        three agree when the specimen is in quasi-static equilibrium. ``contacts``
+        (from ``sim.contacts()`` of the current step) saves recomputing them.
+        """
+        c = sim.contacts() if contacts is None else contacts
+        pos = sim.particles.pos
+        up = pos[:, 1] >= self.split_y
+        names = sim.walls.names
+        is_lower_wall = np.array([n in LOWER for n in names])
+        is_upper_wall = np.array([n in UPPER for n in names])
+        pp = c.kind == 0
+        jj = np.where(pp, c.j, 0)
+        ui = up[c.i]
+        uj = up[jj]
+        across = np.zeros(2)
+        # disk-disk: force on the upper member from the lower one
+        m1 = pp & ~ui & uj  # i lower, j upper: force on j is -force on i
+        m2 = pp & ui & ~uj  # i upper: force on i
+        across -= c.force[m1].sum(axis=0)
+        across += c.force[m2].sum(axis=0)
+        # walls: upper disks on lower walls (force on the disk), lower disks on upper walls
+        wl = ~pp & is_lower_wall[np.where(pp, 0, c.j)]
+        wu = ~pp & is_upper_wall[np.where(pp, 0, c.j)]
+        across += c.force[wl & ui].sum(axis=0)
+        across -= c.force[wu & ~ui].sum(axis=0)
+        unbalanced = sim.force[up].sum(axis=0) - sim.particles.mass[up].sum() * np.asarray(sim.gravity)
+        n_cross = int(np.count_nonzero(m1 | m2))
+        return {"across": across, "unbalanced": unbalanced, "contacts_across": n_cross}
+
+
+def _specimen_box(sim: Simulation) -> tuple[float, float]:
+    names = sim.walls.names
+    missing = [n for n in SPECIMEN_WALLS if n not in names]
+    if missing:
+        raise InputError(
+            "specimen walls", names, f"walls named {', '.join(SPECIMEN_WALLS)}",
+            "a specimen saved by poro2d criterion or poro2d.specimen.compaction",
+        )  # fmt: skip
+    w = sim.walls
+    left = float(w.p0[w.index("left"), 0])
+    bottom = float(w.p0[w.index("bottom"), 1])
+    if abs(left) > 1e-9 or abs(bottom) > 1e-9:
+        raise InputError("specimen box", (left, bottom), "a box with its lower left corner at (0, 0)")
+    return float(w.p0[w.index("right"), 0]), float(w.p0[w.index("top"), 1])
+
+
+def build_split_box(
+    specimen: Simulation,
+    max_displacement: float,
+    kn_wall: float = 1e7,
+    ks_wall: float = 1e7,
+    friction_wall: float = 1.5,
+    gap: float = 0.0,
+    particle_friction: float | None = None,
+    density_scale: float = 1.0,
+    dt_safety: float = 0.8,
+    threads: int = 1,
+) -> tuple[Simulation, SplitBox]:
+    """A new simulation of the specimen's disks in a split box (all walls at rest).
+
+    The disks keep their positions, velocities and properties (``particle_friction``
+    replaces their friction when given); the engine settings (contact convention,
+    gravity, damping) are the specimen's. Disk-disk shear histories are not carried
+    over: the consolidation that follows brings the specimen to a new equilibrium.
+    ``max_displacement`` may not exceed W / 2.
+    """
+    W, H = _specimen_box(specimen)
+    check_range("max_displacement", max_displacement, 0.0, W / 2, lo_open=True)
+    check_range("gap", gap, 0.0, H / 4)
+    check_range("kn_wall", kn_wall, 0.0, None, lo_open=True)
+    check_range("ks_wall", ks_wall, 0.0, None)
+    check_range("friction_wall", friction_wall, 0.0, None)
+    if particle_friction is not None:
+        check_range("particle_friction", particle_friction, 0.0, None)
+    p0 = specimen.particles
+    if p0.n == 0:
+        raise InputError("specimen", "no disks", "a specimen with disks")
+    inside = (p0.pos[:, 0] > 0.0) & (p0.pos[:, 0] < W) & (p0.pos[:, 1] > 0.0) & (p0.pos[:, 1] < H)
+    if not inside.all():
+        raise InputError("specimen", f"{int((~inside).sum())} disk centres outside the box", "all inside")
+    ys = 0.5 * H
+    dmax = 2.0 * float(p0.radius.max())
+    e = max(W, H)
+    lip = max_displacement + dmax
+    walls = Walls()
+    k = (kn_wall, ks_wall, friction_wall)
+    walls.add((-e, 0.0), (W + max_displacement + e, 0.0), *k, name="bottom")
+    walls.add((0.0, -e), (0.0, ys), *k, name="lower_left")
+    walls.add((W, -e), (W, ys), *k, name="lower_right")
+    walls.add((-lip, ys), (0.0, ys), *k, name="lower_lip")
+    walls.add((0.0, ys + gap), (0.0, H + e), *k, name="upper_left")
+    walls.add((W, ys + gap), (W, H + e), *k, name="upper_right")
+    walls.add((W, ys + gap), (W + lip, ys + gap), *k, name="upper_lip")
+    walls.add((W + e, H), (-e, H), *k, name="top")
+    particles = Particles(
+        pos=p0.pos.copy(), radius=p0.radius.copy(), density=p0.density.copy(), thickness=p0.thickness,
+        kn=p0.kn.copy(), ks=p0.ks.copy(),
+        mu=p0.mu.copy() if particle_friction is None else np.full(p0.n, float(particle_friction)),
+        vel=p0.vel.copy(), theta=p0.theta.copy(), omega=p0.omega.copy(), mode=p0.mode.copy(),
+    )  # fmt: skip
+    contact = specimen.contact
+    if particle_friction is not None and contact.convention == "per_pair_type":
+        assert contact.pp is not None
+        contact = ContactModel(
+            "per_pair_type", (contact.pp[0], contact.pp[1], float(particle_friction)), contact.pw
+        )
+    sim = Simulation(
+        particles, walls, contact, gravity=specimen.gravity, local_damping=specimen.local_damping,
+        restitution=specimen.restitution, dt_safety=dt_safety, density_scale=density_scale,
+        skin=specimen.skin, threads=threads,
+    )  # fmt: skip
+    box = SplitBox(W, H, ys, float(gap), float(max_displacement), p0.thickness)
+    return sim, box
+
+
+__all__ = ["LOWER", "UPPER", "SplitBox", "build_split_box"]

@@ -1,0 +1,163 @@
+"""``poro2d shear``: direct shear tests on a specimen, the Mohr-Coulomb fit and Fig. 8."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+console = Console()
+
+SHEAR_KEYS_EXTRA = {"normal_stress_kpa", "specimen", "lab", "processes", "rate_check"}
+
+
+def parse_stresses(text: str) -> list[float]:
+    """'50,100,200' -> [50.0, 100.0, 200.0] (kPa); every value > 0."""
+    from poro2d.errors import InputError
+
+    vals = []
+    for part in str(text).split(","):
+        part = part.strip()
+        if not part:
+            continue
+        try:
+            v = float(part)
+        except ValueError:
+            raise InputError(
+                "--normal-stress", text, "comma-separated numbers in kPa, e.g. 50,100,200"
+            ) from None
+        if not v > 0 or v != v or v == float("inf"):
+            raise InputError("--normal-stress", part, "(0, inf) kPa")
+        vals.append(v)
+    if not vals:
+        raise InputError("--normal-stress", text, "at least one value in kPa")
+    return vals
+
+
+def load_shear_config(path: Path | None) -> tuple[dict, Path | None]:
+    """The ``[shear]`` table of a TOML config (the criterion's config file may hold it too)."""
+    from poro2d.config import check_keys, load_toml
+    from poro2d.criterion.config import TOP_KEYS
+    from poro2d.shear.protocol import ShearSettings
+
+    if path is None:
+        return {}, None
+    cfg = load_toml(path)
+    check_keys("config", cfg, TOP_KEYS)
+    table = cfg.get("shear") or {}
+    import dataclasses
+
+    names = {f.name for f in dataclasses.fields(ShearSettings)}
+    check_keys("shear", table, names | SHEAR_KEYS_EXTRA)
+    return dict(table), Path(path).resolve().parent
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("shear")
+    def shear_cmd(
+        specimen: str = typer.Option(
+            None, "--specimen", "-s", help="Specimen checkpoint (.npz) or a criterion output folder."
+        ),
+        normal_stress: str = typer.Option(
+            None, "--normal-stress", "-n", help="Normal stresses in kPa, e.g. 50,100,200."
+        ),
+        lab: Path = typer.Option(None, "--lab", help="Laboratory CSV (curves or peaks), optional."),
+        out: Path = typer.Option(Path("shear-out"), "--out", "-o", help="Output folder (resumable)."),
+        velocity: float = typer.Option(None, "--velocity", help="Shear velocity of the lower half (m/s)."),
+        max_displacement: float = typer.Option(None, "--max-displacement", help="Shear displacement (m)."),
+        rate_check: bool = typer.Option(
+            False, "--rate-check", help="Repeat every test at half the velocity."
+        ),
+        processes: int = typer.Option(
+            None, "--processes", "-p", help="Worker processes (default: CPU count)."
+        ),
+        config: Path = typer.Option(None, "--config", "-c", help="TOML config with a \\[shear] table."),
+        quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+    ) -> None:
+        """Direct shear tests (the paper's Fig. 8): peak strengths, friction angle, figures."""
+        from poro2d.config import dataclass_from_table
+        from poro2d.errors import InputError
+        from poro2d.shear.lab import read_lab_csv
+        from poro2d.shear.protocol import ShearSeries, ShearSettings
+
+        table, base = load_shear_config(config)
+        extra = {k: table.pop(k) for k in list(table) if k in SHEAR_KEYS_EXTRA}
+        if specimen is None:
+            specimen = extra.get("specimen")
+            if specimen is not None and base is not None:
+                specimen = str((base / specimen).resolve())
+        if specimen is None:
+            raise InputError("--specimen", None, "a specimen checkpoint or criterion output folder")
+        if normal_stress is not None:
+            stresses = parse_stresses(normal_stress)
+        elif "normal_stress_kpa" in extra:
+            v = extra["normal_stress_kpa"]
+            stresses = parse_stresses(",".join(str(x) for x in (v if isinstance(v, list) else [v])))
+        else:
+            stresses = [50.0, 100.0, 200.0]
+        if lab is None and extra.get("lab") is not None:
+            lab = Path(extra["lab"]) if base is None else base / extra["lab"]
+        lab_data = read_lab_csv(lab) if lab is not None else None
+        if processes is None:
+            processes = extra.get("processes")
+        rate_check = rate_check or bool(extra.get("rate_check", False))
+        settings = dataclass_from_table(
+            ShearSettings, "shear", table, velocity=velocity, max_displacement=max_displacement
+        )
+        series = ShearSeries(
+            specimen, stresses, settings, out=out, lab=lab_data, rate_check=rate_check, processes=processes,
+            progress=not quiet, config={"shear": table, **extra, "cli": {"velocity": velocity,
+                                        "max_displacement": max_displacement}},
+        )  # fmt: skip
+        try:
+            result = series.run()
+        except RuntimeError as exc:
+            console.print(f"[bold red]failed:[/] {exc}")
+            raise typer.Exit(1) from None
+        print_result(result, out)
+
+
+def print_result(result: dict, out: Path) -> None:
+    t = Table(title="direct shear")
+    for col in (
+        "sigma_n kPa",
+        "peak kPa",
+        "d_peak mm",
+        "tau/sigma",
+        "end kPa",
+        "dy_end mm",
+        "max I",
+        "time s",
+    ):
+        t.add_column(col, justify="right")
+    for r in result["tests"]:
+        t.add_row(
+            f"{r['normal_stress_kpa']:g}", f"{r['peak_shear_stress_kpa']:.2f}",
+            f"{1e3 * r['shear_displacement_at_peak_m']:.2f}", f"{r['peak_stress_ratio']:.3f}",
+            f"{r['end']['shear_stress_kpa']:.2f}", f"{r['end']['plate_displacement_mm']:.3f}",
+            f"{r['max_inertial_number']:.2e}", f"{r['wall_time_s']:.0f}",
+        )  # fmt: skip
+    console.print(t)
+    if result.get("friction_angle_deg") is not None:
+        console.print(
+            f"Mohr-Coulomb: phi = {result['friction_angle_deg']:.2f} deg, "
+            f"c = {result['cohesion_kpa']:.2f} kPa, R2 = {result['r2']:.4f}; "
+            f"through the origin phi = {result['friction_angle_through_origin_deg']:.2f} deg"
+        )
+    qs = result["quasi_static"]
+    console.print(f"max inertial number {qs['max_inertial_number']:.2e} (limit {qs['inertial_limit']:g})")
+    rc = result.get("rate_check")
+    if rc is not None:
+        console.print(
+            f"rate check (v/2): largest peak change {100 * rc['max_abs_relative_change']:.2f} % "
+            f"(tolerance {100 * rc['tolerance']:g} %): {'passed' if rc['passed'] else 'NOT passed'}"
+        )
+    lab = result.get("lab")
+    if lab is not None and lab.get("friction_angle_deg") is not None:
+        console.print(
+            f"lab: phi = {lab['friction_angle_deg']:.2f} deg; "
+            f"DEM - lab = {lab['friction_angle_difference_deg']:+.2f} deg"
+        )
+    console.print(f"results in {out}/result.json, figures fig8a_shear_curves.png, fig8b_peak_strength.png")

@@ -1,0 +1,94 @@
+"""Mohr-Coulomb fits of peak strength against normal stress, and a robust peak."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from poro2d.errors import InputError
+
+
+@dataclass(frozen=True)
+class MohrCoulombFit:
+    """tau = c + sigma tan(phi), least squares over the points (stresses in kPa).
+
+    ``through_origin`` fits are tau = sigma tan(phi) (c = 0). ``r2`` is the
+    coefficient of determination of the fitted line against the points (for the
+    fit through the origin it is taken about the mean as well, so it can be
+    negative when the line is poor).
+    """
+
+    friction_angle_deg: float
+    cohesion_kpa: float
+    r2: float
+    n_points: int
+    through_origin: bool
+
+    @property
+    def tan_phi(self) -> float:
+        return math.tan(math.radians(self.friction_angle_deg))
+
+    def predict(self, sigma_kpa) -> np.ndarray:
+        return self.cohesion_kpa + self.tan_phi * np.asarray(sigma_kpa, float)
+
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d["tan_phi"] = self.tan_phi
+        return d
+
+
+def mohr_coulomb(sigma_kpa, tau_kpa, through_origin: bool = False) -> MohrCoulombFit:
+    """Least-squares Mohr-Coulomb line through (normal stress, peak shear stress) points.
+
+    Needs two points with different normal stresses (one with ``through_origin``).
+    """
+    s = np.asarray(sigma_kpa, float).ravel()
+    t = np.asarray(tau_kpa, float).ravel()
+    if s.shape != t.shape:
+        raise InputError("Mohr-Coulomb points", f"{s.size} stresses, {t.size} strengths", "as many of each")
+    if not (np.all(np.isfinite(s)) and np.all(np.isfinite(t))):
+        raise InputError("Mohr-Coulomb points", "non-finite values", "finite stresses")
+    need = 1 if through_origin else 2
+    if np.unique(s).size < need or s.size < need:
+        raise InputError(
+            "normal stresses", s.tolist(), f"at least {need} different value(s) for a Mohr-Coulomb fit"
+        )
+    if through_origin:
+        slope = float(np.dot(s, t) / np.dot(s, s))
+        c = 0.0
+    else:
+        slope, c = (float(v) for v in np.polyfit(s, t, 1))
+    pred = c + slope * s
+    ss_res = float(np.sum((t - pred) ** 2))
+    ss_tot = float(np.sum((t - t.mean()) ** 2))
+    r2 = 1.0 - ss_res / ss_tot if ss_tot > 0 else (1.0 if ss_res == 0 else 0.0)
+    return MohrCoulombFit(math.degrees(math.atan(slope)), c, r2, int(s.size), through_origin)
+
+
+def smooth(x, y, window: float) -> np.ndarray:
+    """Centred moving average of ``y(x)`` over ``|x' - x| <= window / 2`` (truncated at the ends).
+
+    ``x`` must be non-decreasing; ``window = 0`` returns ``y`` unchanged.
+    """
+    x = np.asarray(x, float)
+    y = np.asarray(y, float)
+    if window <= 0 or y.size == 0:
+        return y.copy()
+    c = np.concatenate([[0.0], np.cumsum(y)])
+    lo = np.searchsorted(x, x - 0.5 * window, side="left")
+    hi = np.searchsorted(x, x + 0.5 * window, side="right")
+    return (c[hi] - c[lo]) / (hi - lo)
+
+
+def peak(x, y, window: float) -> tuple[int, float, float]:
+    """(index, x, smoothed y) of the maximum of ``y`` smoothed over ``window`` (see :func:`smooth`)."""
+    ys = smooth(x, y, window)
+    if ys.size == 0:
+        raise InputError("curve", "empty", "at least one point")
+    k = int(np.argmax(ys))
+    return k, float(np.asarray(x, float)[k]), float(ys[k])
+
+
+__all__ = ["MohrCoulombFit", "mohr_coulomb", "peak", "smooth"]

@@ -1,0 +1,116 @@
+"""Laboratory direct shear data from CSV (optional user input; poro2d ships none).
+
+Two layouts are accepted; the header decides which (extra columns are ignored,
+lines starting with ``#`` are comments):
+
+* curves: ``normal_stress_kpa, shear_displacement_mm, shear_stress_kpa``, one row
+  per reading, one curve per normal stress;
+* peaks: ``normal_stress_kpa, peak_shear_stress_kpa``, one row per test.
+
+The peak of a curve is its largest shear stress as measured (laboratory curves
+are smooth enough; no smoothing is applied).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from poro2d.errors import InputError
+
+CURVE_COLUMNS = ("normal_stress_kpa", "shear_displacement_mm", "shear_stress_kpa")
+PEAK_COLUMNS = ("normal_stress_kpa", "peak_shear_stress_kpa")
+
+
+@dataclass
+class LabData:
+    """Laboratory results: peaks per normal stress, and curves when the CSV had them."""
+
+    source: str
+    peaks: dict[float, float]
+    curves: dict[float, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+
+    @property
+    def kind(self) -> str:
+        return "curves" if self.curves else "peaks"
+
+    def normal_stresses(self) -> list[float]:
+        return sorted(self.peaks)
+
+    def to_dict(self) -> dict:
+        return {
+            "source": self.source,
+            "kind": self.kind,
+            "peaks": [
+                {"normal_stress_kpa": s, "peak_shear_stress_kpa": self.peaks[s]} for s in sorted(self.peaks)
+            ],
+        }
+
+
+def _number(path: str, line: int, col: str, text: str) -> float:
+    try:
+        v = float(text)
+    except (TypeError, ValueError):
+        raise InputError(f"lab {col} (line {line} of {path})", text, "a number") from None
+    if not math.isfinite(v):
+        raise InputError(f"lab {col} (line {line} of {path})", text, "a finite number")
+    return v
+
+
+def read_lab_csv(path: str | os.PathLike) -> LabData:
+    """Read and validate a laboratory CSV (see the module docstring for the columns)."""
+    p = Path(path)
+    if not p.is_file():
+        raise InputError("lab", str(p), "an existing CSV file")
+    with open(p, newline="") as fh:
+        lines = [(k + 1, ln) for k, ln in enumerate(fh) if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        raise InputError("lab", str(p), "a CSV with a header and data rows")
+    reader = csv.reader([ln for _, ln in lines])
+    rows = list(reader)
+    header = [h.strip().lower() for h in rows[0]]
+    if all(c in header for c in CURVE_COLUMNS):
+        cols, kind = CURVE_COLUMNS, "curves"
+    elif all(c in header for c in PEAK_COLUMNS):
+        cols, kind = PEAK_COLUMNS, "peaks"
+    else:
+        raise InputError(
+            "lab columns", ",".join(header),
+            f"the columns {','.join(CURVE_COLUMNS)} (curves) or {','.join(PEAK_COLUMNS)} (peaks)",
+        )  # fmt: skip
+    idx = [header.index(c) for c in cols]
+    data = []
+    for (line, _), row in zip(lines[1:], rows[1:], strict=True):
+        if len(row) < len(header):
+            raise InputError(f"lab row (line {line} of {p})", ",".join(row), f"{len(header)} columns")
+        vals = [_number(str(p), line, c, row[i].strip()) for c, i in zip(cols, idx, strict=True)]
+        for c, v in zip(cols, vals, strict=True):
+            if v < 0:
+                raise InputError(f"lab {c} (line {line} of {p})", v, "[0, inf)")
+        data.append(vals)
+    if not data:
+        raise InputError("lab", str(p), "at least one data row")
+    a = np.array(data)
+    if kind == "peaks":
+        peaks: dict[float, float] = {}
+        for s, t in a:
+            if float(s) in peaks:
+                raise InputError("lab normal_stress_kpa", float(s), "each normal stress once in a peaks CSV")
+            peaks[float(s)] = float(t)
+        return LabData(str(p), peaks)
+    curves: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+    for s in np.unique(a[:, 0]):
+        m = a[:, 0] == s
+        d, t = a[m, 1], a[m, 2]
+        order = np.argsort(d, kind="stable")
+        curves[float(s)] = (d[order] * 1e-3, t[order])  # displacement in m
+    peaks = {s: float(np.max(t)) for s, (_, t) in curves.items()}
+    return LabData(str(p), peaks, curves)
+
+
+__all__ = ["CURVE_COLUMNS", "PEAK_COLUMNS", "LabData", "read_lab_csv"]

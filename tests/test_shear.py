@@ -1,0 +1,235 @@
+"""Direct shear on a small specimen (0.06 m x 0.03 m, about 110 disks): force balance,
+servo, friction, stress dependence, resume, CLI and bad input. Every test runs in seconds."""
+
+import json
+
+import numpy as np
+import pytest
+
+from poro2d.cli import main
+from poro2d.dem import checkpoint
+from poro2d.errors import InputError
+from poro2d.shear import DirectShearTest, ShearSeries, ShearSettings, build_split_box, smooth
+from poro2d.shear.box import LOWER, UPPER
+from poro2d.specimen import paper_grading
+from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
+
+# 2 mm of shear in the 60 mm box: the peak of this small specimen lies near the end
+SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4}
+
+
+@pytest.fixture(scope="module")
+def specimen(tmp_path_factory):
+    sim, rep = prepare_specimen(SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.2, seed=0)
+    assert rep["converged"]
+    path = tmp_path_factory.mktemp("specimen") / "specimen.npz"
+    checkpoint.save(sim, path)
+    return path
+
+
+@pytest.fixture(scope="module")
+def series(specimen, tmp_path_factory):
+    out = tmp_path_factory.mktemp("series")
+    s = ShearSeries(
+        specimen, [50, 100, 200], ShearSettings(**SHORT), out=out, processes=1, progress=False, figures=False
+    )
+    return out, s.run()
+
+
+def _curve(path):
+    import csv
+
+    with open(path, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
+
+
+def test_split_box_walls(specimen):
+    sim, box = build_split_box(checkpoint.load(specimen), 0.01)
+    assert set(sim.walls.names) == set(LOWER) | set(UPPER)
+    assert box.width == pytest.approx(0.06) and box.split_y == pytest.approx(0.015)
+    w = sim.walls
+    # the lips sit on the shear plane and reach past the largest displacement
+    lo, up = w.index("lower_lip"), w.index("upper_lip")
+    assert w.p0[lo, 1] == w.p1[lo, 1] == pytest.approx(0.015)
+    assert min(w.p0[lo, 0], w.p1[lo, 0]) <= -0.01 and max(w.p0[up, 0], w.p1[up, 0]) >= 0.07
+    # the bottom covers the lower half after the full displacement
+    b = w.index("bottom")
+    assert max(w.p0[b, 0], w.p1[b, 0]) >= 0.07
+    assert box.shear_displacement(sim) == 0.0
+
+
+def test_peak_grows_with_normal_stress_and_outputs(series):
+    out, r = series
+    peaks = [t["peak_shear_stress_kpa"] for t in r["tests"]]
+    assert peaks[0] < peaks[1] < peaks[2]
+    assert r["friction_angle_deg"] > 0 and r["r2"] > 0.5
+    assert r["fit_through_origin"]["cohesion_kpa"] == 0.0
+    for t in r["tests"]:
+        assert {"normal_stress_kpa", "peak_shear_stress_kpa", "shear_displacement_at_peak_m", "end"} <= set(t)
+        assert 0 < t["shear_displacement_at_peak_m"] <= 0.0021
+        assert t["max_inertial_number"] < 1e-3
+    for f in ("result.json", "curves.csv", "peaks.csv"):
+        assert (out / f).stat().st_size > 0
+    for sig in ("sn50kPa", "sn100kPa", "sn200kPa"):
+        assert (out / sig / "curve.csv").stat().st_size > 0
+        assert not (out / sig / "shear_checkpoint.npz").exists()  # removed once the test is done
+    assert r["settings"]["velocity"] == r["velocity_m_per_s"] and r["density_scale"] == 1.0
+    assert "poro2d_version" in r["provenance"]
+
+
+def test_force_balance_during_shear(series):
+    """Upper half, lower half and the contact forces across the shear plane agree.
+
+    Exactly, upper = plane - (net contact force on the upper disks); in quasi-static
+    shearing that remainder is small. Tolerance: mean absolute difference within 5 %
+    of the mean shear stress (the lower half also carries the local damping's drag on
+    the moving disks, hence its looser bound of 10 %).
+    """
+    out, _ = series
+    for sig in ("sn50kPa", "sn100kPa", "sn200kPa"):
+        c = _curve(out / sig / "curve.csv")
+        up, plane, low = c["shear_stress_kpa"], c["plane_stress_kpa"], c["lower_half_stress_kpa"]
+        np.testing.assert_allclose(up, plane - c["upper_unbalanced_kpa"], rtol=1e-9, atol=1e-9)
+        late = c["shear_displacement_mm"] > 0.5
+        ref = np.mean(up[late])
+        assert np.mean(np.abs(up - plane)[late]) < 0.05 * ref
+        assert np.mean(np.abs(up - low)[late]) < 0.10 * ref
+        assert np.all(c["contacts_across_plane"] > 0)
+
+
+def test_servo_holds_the_normal_stress(series):
+    out, _ = series
+    for sig, target in (("sn50kPa", 50.0), ("sn100kPa", 100.0), ("sn200kPa", 200.0)):
+        cons = json.loads((out / sig / "consolidation.json").read_text())
+        assert abs(cons["normal_stress_measured_kpa"] / target - 1) < 0.02
+        assert cons["max_unbalanced_ratio"] < 1e-3
+        c = _curve(out / sig / "curve.csv")
+        x = c["shear_displacement_mm"] * 1e-3
+        sm = smooth(x, c["normal_stress_kpa"], 5e-4)
+        assert np.max(np.abs(sm / target - 1)) < 0.02
+
+
+def test_frictionless_disks_are_far_weaker(specimen, series, tmp_path):
+    _, r = series
+    s = ShearSettings(particle_friction=0.0, **SHORT)
+    r0 = DirectShearTest(specimen, 100, s, out=tmp_path, figures=False).run()
+    tau3 = next(t["peak_shear_stress_kpa"] for t in r["tests"] if t["normal_stress_kpa"] == 100)
+    assert r0["peak_shear_stress_kpa"] < 0.5 * tau3
+
+
+class _Stop(Exception):
+    pass
+
+
+def test_killed_test_resumes_from_its_checkpoint(specimen, series, tmp_path):
+    """Interrupted after its second checkpoint, a rerun continues and gives the same curve."""
+    out, _ = series
+
+    def stop(phase, fraction):
+        if phase == "shearing" and fraction > 0.6:
+            raise _Stop
+
+    with pytest.raises(_Stop):
+        DirectShearTest(specimen, 100, ShearSettings(**SHORT), out=tmp_path, progress=stop).run()
+    assert (tmp_path / "shear_checkpoint.npz").is_file() and not (tmp_path / "result.json").exists()
+    r = DirectShearTest(specimen, 100, ShearSettings(**SHORT), out=tmp_path).run()
+    a = _curve(tmp_path / "curve.csv")
+    b = _curve(out / "sn100kPa" / "curve.csv")
+    np.testing.assert_array_equal(a["shear_stress_kpa"], b["shear_stress_kpa"])
+    np.testing.assert_array_equal(a["plate_displacement_mm"], b["plate_displacement_mm"])
+    assert (
+        r["peak_shear_stress_kpa"]
+        == json.loads((out / "sn100kPa" / "result.json").read_text())["peak_shear_stress_kpa"]
+    )
+
+
+def test_cli_parallel_with_lab_peaks_and_skip_on_rerun(specimen, series, tmp_path, capsys):
+    out, r = series
+    lab = tmp_path / "lab.csv"
+    lab.write_text(
+        "# made-up numbers for the test only\nnormal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,75\n"
+    )
+    dest = tmp_path / "cli"
+    args = ["shear", "--specimen", str(specimen), "--normal-stress", "50,100", "--lab", str(lab),
+            "--out", str(dest), "--max-displacement", "0.002", "--processes", "2", "--quiet",
+            "--config", str(_cfg(tmp_path))]  # fmt: skip
+    main(args)
+    res = json.loads((dest / "result.json").read_text())
+    assert res["processes"] == 2
+    for f in ("fig8a_shear_curves.png", "fig8b_peak_strength.png", "sn50kPa/forces_peak.png"):
+        assert (dest / f).stat().st_size > 0
+    assert res["lab"]["friction_angle_deg"] == pytest.approx(np.degrees(np.arctan(35 / 50)))
+    assert res["lab"]["friction_angle_difference_deg"] == pytest.approx(
+        res["friction_angle_deg"] - res["lab"]["friction_angle_deg"]
+    )
+    # same settings as the series fixture: the same peaks, from independent processes
+    for t in res["tests"]:
+        ref = next(u for u in r["tests"] if u["normal_stress_kpa"] == t["normal_stress_kpa"])
+        assert t["peak_shear_stress_kpa"] == ref["peak_shear_stress_kpa"]
+    stamp = (dest / "sn50kPa" / "result.json").stat().st_mtime_ns
+    main(args)  # finished tests are skipped
+    assert (dest / "sn50kPa" / "result.json").stat().st_mtime_ns == stamp
+
+
+def _cfg(tmp_path):
+    p = tmp_path / "shear.toml"
+    p.write_text("[shear]\npeak_window = 5e-4\ncheckpoint_interval = 5e-4\n")
+    return p
+
+
+@pytest.mark.parametrize(
+    ("extra", "needle"),
+    [
+        (["--normal-stress", "50,-100"], "--normal-stress"),
+        (["--normal-stress", "50,abc"], "--normal-stress"),
+        (["--max-displacement", "0.031"], "max_displacement"),
+        (["--velocity", "-1"], "velocity"),
+    ],
+)
+def test_cli_bad_input(specimen, tmp_path, capsys, extra, needle):
+    dest = tmp_path / "out"
+    args = ["shear", "--specimen", str(specimen), "--out", str(dest), "--quiet"]
+    with pytest.raises(SystemExit) as exc:
+        main(args + (extra if "--normal-stress" in extra else ["--normal-stress", "50"] + extra))
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert needle in err and "Traceback" not in err
+    assert not (dest / "result.json").exists()
+
+
+def test_cli_missing_specimen_and_bad_lab(specimen, tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(
+            [
+                "shear",
+                "--specimen",
+                str(tmp_path / "nope"),
+                "--normal-stress",
+                "50",
+                "--out",
+                str(tmp_path / "o"),
+            ]
+        )
+    assert exc.value.code == 2 and "specimen" in capsys.readouterr().err
+    lab = tmp_path / "lab.csv"
+    lab.write_text("sigma,tau\n50,40\n")
+    with pytest.raises(SystemExit) as exc:
+        main(["shear", "--specimen", str(specimen), "--lab", str(lab), "--out", str(tmp_path / "o2")])
+    assert exc.value.code == 2 and "lab columns" in capsys.readouterr().err
+    assert not (tmp_path / "o2" / "result.json").exists()
+
+
+def test_api_bad_input(specimen, tmp_path):
+    with pytest.raises(InputError, match="normal stress"):
+        DirectShearTest(specimen, -50)
+    with pytest.raises(InputError, match="max_displacement"):
+        DirectShearTest(specimen, 50, ShearSettings(max_displacement=0.05))
+    with pytest.raises(InputError, match="specimen"):
+        ShearSeries(tmp_path / "missing.npz", [50])
+    with pytest.raises(InputError, match="normal stress"):
+        ShearSeries(specimen, [50, 50], out=tmp_path)
+    # a folder holding another test is not overwritten
+    DirectShearTest(specimen, 50, ShearSettings(**SHORT), out=tmp_path / "t")._check_resume()
+    with pytest.raises(InputError, match="out"):
+        DirectShearTest(specimen, 100, ShearSettings(**SHORT), out=tmp_path / "t").run()

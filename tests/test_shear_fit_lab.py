@@ -1,0 +1,91 @@
+"""Mohr-Coulomb fits, the smoothed peak and laboratory CSV input (no simulation)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from poro2d.errors import InputError
+from poro2d.shear import inertial_number, mohr_coulomb, peak, read_lab_csv, smooth
+
+
+def test_fit_recovers_an_exact_line():
+    s = np.array([50.0, 100.0, 200.0])
+    f = mohr_coulomb(s, 10.0 + s * math.tan(math.radians(35.0)))
+    assert f.friction_angle_deg == pytest.approx(35.0)
+    assert f.cohesion_kpa == pytest.approx(10.0)
+    assert f.r2 == pytest.approx(1.0)
+    f0 = mohr_coulomb(s, s * 0.7, through_origin=True)
+    assert f0.cohesion_kpa == 0.0 and f0.tan_phi == pytest.approx(0.7) and f0.r2 == pytest.approx(1.0)
+
+
+def test_fit_least_squares_and_errors():
+    s = np.array([50.0, 100.0, 200.0])
+    t = np.array([40.0, 80.0, 150.0])
+    f = mohr_coulomb(s, t)
+    slope, c = np.polyfit(s, t, 1)
+    assert f.tan_phi == pytest.approx(slope) and f.cohesion_kpa == pytest.approx(c)
+    assert 0.9 < f.r2 < 1.0
+    with pytest.raises(InputError, match="normal stresses"):
+        mohr_coulomb([100.0, 100.0], [50.0, 60.0])
+    with pytest.raises(InputError):
+        mohr_coulomb([100.0], [50.0, 60.0])
+
+
+def test_smoothing_and_peak():
+    x = np.linspace(0, 0.01, 201)
+    y = np.sin(np.pi * x / 0.01) * 100 + np.where(np.arange(201) == 60, 50.0, 0.0)  # one spike
+    k, xp, yp = peak(x, y, 0.002)
+    assert xp == pytest.approx(0.005, abs=2e-4)  # the spike does not move the smoothed peak
+    assert yp < 100
+    assert np.array_equal(smooth(x, y, 0.0), y)
+    assert smooth(x, np.full(201, 3.0), 0.002) == pytest.approx(3.0)
+
+
+def test_inertial_number():
+    # I = v / k sqrt(rho / sigma): 0.025 m/s, k = 10, 2650 kg/m3, 50 kPa
+    assert inertial_number(0.025, 50e3, 2650.0, 10.0) == pytest.approx(0.0025 * math.sqrt(0.053))
+    assert inertial_number(0.025, 0.0, 2650.0, 10.0) == math.inf
+
+
+def test_lab_curves(tmp_path):
+    p = tmp_path / "lab.csv"
+    p.write_text(
+        "# comment\nnormal_stress_kpa,shear_displacement_mm,shear_stress_kpa,note\n"
+        "50,0,0,a\n50,2,30,b\n50,1,35,c\n100,0,0,d\n100,3,70,e\n"
+    )
+    lab = read_lab_csv(p)
+    assert lab.kind == "curves" and lab.normal_stresses() == [50.0, 100.0]
+    assert lab.peaks == {50.0: 35.0, 100.0: 70.0}
+    d, t = lab.curves[50.0]
+    assert np.allclose(d, [0.0, 0.001, 0.002]) and np.allclose(t, [0, 35, 30])  # sorted, in m
+
+
+def test_lab_peaks(tmp_path):
+    p = tmp_path / "lab.csv"
+    p.write_text("normal_stress_kpa,peak_shear_stress_kpa\n50,38\n100,72\n200,141\n")
+    lab = read_lab_csv(p)
+    assert lab.kind == "peaks" and lab.peaks[200.0] == 141.0
+
+
+@pytest.mark.parametrize(
+    ("text", "needle"),
+    [
+        ("sigma,tau\n50,40\n", "lab columns"),
+        ("normal_stress_kpa,peak_shear_stress_kpa\n50,abc\n", "peak_shear_stress_kpa"),
+        ("normal_stress_kpa,peak_shear_stress_kpa\n-50,40\n", "normal_stress_kpa"),
+        ("normal_stress_kpa,shear_displacement_mm,shear_stress_kpa\n50,1,-3\n", "shear_stress_kpa"),
+        ("normal_stress_kpa,peak_shear_stress_kpa\n", "data row"),
+        ("normal_stress_kpa,peak_shear_stress_kpa\n50,40\n50,41\n", "once"),
+    ],
+)
+def test_lab_errors(tmp_path, text, needle):
+    p = tmp_path / "lab.csv"
+    p.write_text(text)
+    with pytest.raises(InputError, match=needle):
+        read_lab_csv(p)
+
+
+def test_lab_missing_file(tmp_path):
+    with pytest.raises(InputError, match="lab"):
+        read_lab_csv(tmp_path / "none.csv")
