@@ -43,7 +43,7 @@ register_kind("probe", probe, tables=("probe",))
 @pytest.fixture(scope="module")
 def client():
     cluster = distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, env=SINGLE_THREAD_ENV
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0", env=SINGLE_THREAD_ENV
     )
     c = distributed.Client(cluster)
     yield c

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 console = Console()
@@ -91,13 +92,21 @@ def register(app: typer.Typer) -> None:
         console.print(
             f"criterion at nLab = {', '.join(f'{v:g}' for v in settings['n_lab'])} "
             f"(n_max {settings['n_max']:g}, n_min {settings['n_min']:g})"
-            f"{' [quick]' if quick else ''} -> {out}"
+            f"{' (quick)' if quick else ''} -> {out}"
         )
         res = run_sweep(sweep, out, scheduler=scheduler, workers=workers, progress=not quiet)
         rel = R.analyse(res.rows, settings["n_max"], settings["n_min"])
         extra = {"quick": quick, "sweep_summary": res.summary, "config": base}
-        R.write_relation(rel, out, extra=extra)
+        title = "2D porosity from the criterion vs laboratory porosity"
+        if quick:
+            title += " (quick: 0.08 m x 0.04 m specimen)"
+        R.write_relation(rel, out, title=title, extra=extra)
         print_relation(rel, out)
+        if res.failed:
+            console.print(
+                f"[bold red]{len(res.failed)} case(s) failed[/]; tracebacks in {out}/cases/<id>/error.txt"
+            )
+            raise typer.Exit(1)
 
 
 def print_summary(res, out: Path) -> None:
@@ -112,12 +121,12 @@ def print_summary(res, out: Path) -> None:
     for r in res.rows:
         rs = r.get("results", {}) or {}
         if r["status"] == "failed":
-            txt = f"[red]{r.get('error')}[/]"
+            txt = f"[red]{escape(str(r.get('error')))}[/]"
         elif "final_porosity" in rs:
             fp = rs.get("final_porosity")
-            txt = f"n2D = {fp:.4f}" if fp is not None else f"not converged ({rs.get('message', '')})"
+            txt = f"n2D = {fp:.4f}" if fp is not None else f"not converged ({escape(str(rs.get('message')))})"
         else:
-            txt = ", ".join(f"{k}={v}" for k, v in list(rs.items())[:4])
+            txt = escape(", ".join(f"{k}={v}" for k, v in list(rs.items())[:4]))
         ts = r.get("time_s")
         t.add_row(r["case_id"], "reused" if r.get("reused") else r["status"], f"{ts:.1f}" if ts else "", txt)
     console.print(t)
@@ -156,5 +165,5 @@ def print_relation(rel: dict, out: Path) -> None:
             f"rms residual {fit['rms_residual']:.4g}, max {fit['max_abs_residual']:.4g}"
         )
     else:
-        console.print(f"[yellow]{rel['fit_note']}[/]")
+        console.print(f"[yellow]{escape(rel['fit_note'])}[/]")
     console.print(f"figure {out}/relation.png, table {out}/relation.csv")

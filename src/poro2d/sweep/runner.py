@@ -187,10 +187,17 @@ def _start_client(scheduler: str | None, workers: int | None, threads_needed: in
         n_workers=n,
         threads_per_worker=1,
         processes=True,
-        dashboard_address=None,
+        dashboard_address=":0",
         env=env,
     )
     return Client(cluster), cluster
+
+
+def _dashboard(client) -> str | None:
+    try:
+        return client.dashboard_link
+    except Exception:  # no dashboard (bokeh missing, or disabled on the scheduler)
+        return None
 
 
 def table_from_rows(rows: list[dict], axes: list[str]):
@@ -293,7 +300,12 @@ def run_sweep(
                 "workers": len(info.get("workers", {})),
                 "threads": sum(w.get("nthreads", 0) for w in info.get("workers", {}).values()),
                 "local_cluster": cluster is not None,
+                "dashboard": _dashboard(client),
             }
+            if progress and cluster_info["dashboard"]:
+                from rich.console import Console
+
+                Console(stderr=True).print(f"Dask dashboard: {cluster_info['dashboard']}", highlight=False)
             rows.update(
                 _submit_all(client, pending, cases_dir, sweep.retries, progress, n_reused, len(sweep.cases))
             )
