@@ -230,8 +230,14 @@ def lammps_params(sim) -> dict:
 
 
 def time_lammps(sim, label: str, steps: int, repeats: int, settle: int, threads=1,
-                mpi_ranks=1, wait_policy: str | None = "PASSIVE") -> dict:
-    """LAMMPS on the positions and radii of ``sim``; ``wait_policy`` None: OpenMP default."""
+                mpi_ranks=1, wait_policy: str | None = "PASSIVE", timeout: float = 300.0) -> dict | None:
+    """LAMMPS on the positions and radii of ``sim``; ``wait_policy`` None: OpenMP default.
+
+    Returns None when the run exceeds ``timeout`` seconds (spinning OpenMP threads on a
+    loaded machine ran at ~1e5 particle-steps/s).
+    """
+    import subprocess
+
     from lammps_reference import run_lammps
 
     p = sim.particles
@@ -244,8 +250,11 @@ def time_lammps(sim, label: str, steps: int, repeats: int, settle: int, threads=
         t0 = time.perf_counter()
         res = run_lammps(p.pos[:, 0], p.pos[:, 1], p.radius, wall_box(sim), **lammps_params(sim),
                          settle_steps=settle, measure_steps=steps, repeats=repeats,
-                         threads=threads, mpi_ranks=mpi_ranks)
+                         threads=threads, mpi_ranks=mpi_ranks, timeout=timeout)
         wall = time.perf_counter() - t0
+    except subprocess.TimeoutExpired:
+        print(f"  LAMMPS {label:24s} timed out after {timeout:.0f} s (load {loadavg()[0]})", flush=True)
+        return None
     finally:
         if old is None:
             os.environ.pop("OMP_WAIT_POLICY", None)
@@ -477,8 +486,9 @@ def main(argv=None) -> int:
                 if not args.quick:
                     lm["2 OpenMP threads (default wait)"] = time_lammps(
                         sim, "2 OpenMP threads (default wait)", ls, lrep, lset, threads=2,
-                        wait_policy=None)
+                        wait_policy=None, timeout=120.0)
                 lm["2 MPI ranks"] = time_lammps(sim, "2 MPI ranks", ls, lrep, lset, mpi_ranks=2)
+            lm = {k: v for k, v in lm.items() if v is not None}
             for v in lm.values():
                 v.pop("x", None), v.pop("y", None), v.pop("radius", None)
             case["lammps"] = lm
