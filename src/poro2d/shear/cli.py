@@ -71,7 +71,7 @@ def register(app: typer.Typer) -> None:
             False, "--rate-check", help="Repeat every test at half the velocity."
         ),
         processes: int = typer.Option(
-            None, "--processes", "-p", help="Worker processes (default: CPU count)."
+            None, "--processes", "-p", help="Worker processes (default: one per test, up to 2 x CPUs)."
         ),
         config: Path = typer.Option(None, "--config", "-c", help="TOML config with a \\[shear] table."),
         quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
