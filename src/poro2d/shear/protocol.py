@@ -636,14 +636,23 @@ class ShearSeries:
     def _execute(self) -> dict:
         results: dict = {}
         errors: dict = {}
-        n = min(self.processes, len(self.jobs))
+        todo = []
+        for job in self.jobs:  # finished tests are read here, without starting a process
+            done = Path(job["out"]) / "result.json"
+            if done.is_file():
+                results[job["key"]] = json.loads(done.read_text())
+            else:
+                todo.append(job)
+        if not todo:
+            return results
+        n = min(self.processes, len(todo))
         labels = {
-            j["key"]: (f"{j['sigma']:g} kPa" + (" (v/2)" if j["key"][0] == "rate" else "")) for j in self.jobs
+            j["key"]: (f"{j['sigma']:g} kPa" + (" (v/2)" if j["key"][0] == "rate" else "")) for j in todo
         }
         bar = _Bars(labels) if self.progress else None
         try:
             if n <= 1:
-                for job in self.jobs:
+                for job in todo:
                     q = _DirectQueue(bar)
                     try:
                         results[job["key"]] = _run_job(job, q)
@@ -657,7 +666,7 @@ class ShearSeries:
                 with ctx.Manager() as manager, ProcessPoolExecutor(max_workers=n, mp_context=ctx) as pool:
                     queue = manager.Queue()
                     # the slow (half velocity) tests first, so the pool ends together
-                    order = sorted(self.jobs, key=lambda j: (j["key"][0] != "rate", -j["sigma"]))
+                    order = sorted(todo, key=lambda j: (j["key"][0] != "rate", -j["sigma"]))
                     futs = {pool.submit(_run_job, job, queue): job["key"] for job in order}
                     pending = set(futs)
                     while pending:
@@ -730,7 +739,7 @@ class ShearSeries:
             "density_scale": s.density_scale,
             "specimen": str(self.specimen),
             "specimen_meta": checkpoint.read_meta(self.specimen).get("extra", {}),
-            "processes": min(self.processes, len(self.jobs)),
+            "processes": self.processes,
             "config": self.config,
         }
         if self.rate_check:
