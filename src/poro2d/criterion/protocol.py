@@ -18,6 +18,7 @@ message and keeps every trial's results.
 from __future__ import annotations
 
 import json
+import logging
 import math
 import time
 from dataclasses import asdict, dataclass
@@ -31,6 +32,8 @@ from poro2d.io_utils import provenance, write_csv, write_json
 from poro2d.porosity import parabolic
 from poro2d.specimen.compaction import SpecimenSpec, box_porosity, prepare_specimen
 from poro2d.specimen.grading import GradingCurve
+
+_log = logging.getLogger(__name__)
 
 
 @dataclass
@@ -46,6 +49,10 @@ class CriterionSettings:
     servo_target_fraction: float = 0.5
     servo_max_speed: float = 0.05
     servo_gain: float = 0.3
+    settle_gain: float = 0.02
+    settle_max_speed: float = 0.001
+    settle_checks: int = 20
+    plate_drift: float = 1e-4
     max_plate_steps: int = 600_000
     check_every: int = 500
     window_checks: int = 4
@@ -62,6 +69,11 @@ class CriterionSettings:
         check_range("servo_target_fraction", self.servo_target_fraction, 0.0, 1.0, lo_open=True, hi_open=True)
         check_range("servo_max_speed", self.servo_max_speed, 0.0, 10.0, lo_open=True)
         check_range("servo_gain", self.servo_gain, 0.0, 1.0, lo_open=True)
+        check_range("settle_gain", self.settle_gain, 0.0, 1.0, lo_open=True)
+        check_range("settle_max_speed", self.settle_max_speed, 0.0, 10.0, lo_open=True)
+        check_range("plate_drift", self.plate_drift, 0.0, 0.1, lo_open=True)
+        if not (isinstance(self.settle_checks, int) and self.settle_checks >= 2):
+            raise InputError("settle_checks", self.settle_checks, "an integer >= 2")
         if not (isinstance(self.max_plate_steps, int) and self.max_plate_steps >= 1000):
             raise InputError("max_plate_steps", self.max_plate_steps, "an integer >= 1000")
         if not (isinstance(self.check_every, int) and self.check_every >= 1):
@@ -173,46 +185,83 @@ class PorosityCriterion:
         )  # fmt: skip
 
     def _move_plate(self, sim: Simulation, n: float, weight: float) -> dict:
-        """Servo the top plate until 0 < F_top < fraction G at equilibrium."""
+        """Servo the top plate until 0 < F_top < fraction G holds at equilibrium.
+
+        Each round has two phases. The approach servos the plate briskly towards
+        ``servo_target_fraction`` x the limit until F_top has stayed in the window for
+        ``window_checks`` checks. The settling phase keeps a gentle servo on (a low gain
+        and speed, so the plate follows slow creep of the specimen without shaking it)
+        until, with F_top in the window, the specimen is at equilibrium (maximum
+        unbalanced-force ratio below the specimen's ``ratio``) or the plate has rested
+        for ``settle_checks`` checks (drift below ``plate_drift`` x H: only creep left).
+        The plate is then held still, the specimen cycled towards equilibrium, and
+        F_top checked once more (the final ratio is reported); if it left the window,
+        a new round starts.
+        """
         s = self.settings
         t = sim.particles.thickness
         cap = s.force_fraction * weight  # N/m
-        target = s.servo_target_fraction * cap * t  # N
         top = sim.walls.index("top")
         y_start = float(sim.walls.p0[top, 1])
+        target = s.servo_target_fraction * cap * t  # N
         steps = 0
         rounds = 0
         ok = False
+        final_ratio = float("nan")
+
+        def left() -> int:
+            return max(s.max_plate_steps - steps, 1)
+
         while steps < s.max_plate_steps and not ok:
             rounds += 1
             sim.set_wall_servo("top", target, (0.0, -1.0), s.servo_max_speed, s.servo_gain)
             streak = [0]
 
             def steady(sm: Simulation, streak: list[int] = streak) -> bool:
-                # the servo keeps the plate moving a little, so equilibrium is judged with
-                # the plate held still below; here it only has to stay in the window
                 f = sm.wall_force(top)[1] / t
                 streak[0] = streak[0] + 1 if in_window(f, weight, s.force_fraction) else 0
                 return streak[0] >= s.window_checks
 
-            res = sim.run(
-                s.max_plate_steps - steps,
-                every=s.check_every,
-                callback=steady,
-                progress=f"top plate (round {rounds})" if self.progress else False,
-            )
-            steps += res.steps
-            # hold the plate still and let the specimen come to rest
+            label = f"top plate (round {rounds})" if self.progress else False
+            steps += sim.run(left(), every=s.check_every, callback=steady, progress=label).steps
+            sim.set_wall_servo("top", target, (0.0, -1.0), s.settle_max_speed, s.settle_gain)
+
+            calm: list[float] = []
+
+            def settled(sm: Simulation, calm: list[float] = calm) -> bool:
+                # equilibrium, or a plate that rests in the window while the specimen
+                # only creeps (drift over the last checks below plate_drift x H)
+                f = sm.wall_force(top)[1] / t
+                if not in_window(f, weight, s.force_fraction):
+                    calm.clear()
+                    return False
+                if sm.unbalanced_ratios()[0] < self.spec.ratio:
+                    return True
+                calm.append(float(sm.walls.p0[top, 1]))
+                if len(calm) < s.settle_checks:
+                    return False
+                return (
+                    max(calm[-s.settle_checks :]) - min(calm[-s.settle_checks :])
+                    < s.plate_drift * self.spec.height
+                )
+
+            steps += sim.run(left(), every=s.check_every, callback=settled).steps
             sim.set_wall_velocity("top", (0.0, 0.0))
-            res = sim.solve(self.spec.ratio, max(s.max_plate_steps - steps, 1), progress=False)
+            res = sim.solve(self.spec.ratio, min(left(), 20 * s.check_every))
             steps += res.steps
             f = sim.wall_force(top)[1] / t
-            ok = in_window(f, weight, s.force_fraction) and res.converged
+            ok = in_window(f, weight, s.force_fraction)
+            final_ratio = res.max_ratio
+            _log.debug(
+                "plate round %d: F_top %.4g N/m (limit %.4g), held: converged %s ratio %.3g, %d steps",
+                rounds, f, cap, res.converged, res.max_ratio, steps,
+            )  # fmt: skip
         y_end = float(sim.walls.p0[top, 1])
         return {
             "plate_settled": ok,
             "plate_steps": steps,
             "plate_rounds": rounds,
+            "plate_final_max_ratio": final_ratio,
             "plate_displacement_m": y_end - y_start,
             "plate_height_m": y_end,
         }
