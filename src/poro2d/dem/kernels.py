@@ -6,6 +6,8 @@ One step, in order (the PFC cycle):
 2. disk-disk contact forces (contact law, history update) per pair;
 3. disk-wall contact forces per pair;
 4. gather: each disk sums gravity and its contact forces (the unbalanced force);
+   with one thread, 2-4 are fused (each pair adds to both disks at once), in the
+   same summation order, so the numbers are identical;
 5. wall resultants, then servo walls set their speed from the force error;
 6. local (Cundall) damping and leapfrog integration of the disks; walls move;
 7. flag a rebuild when needed; every ``check_every`` steps test the stop condition.
@@ -29,8 +31,8 @@ from poro2d.dem.state import FREE, WALL_SERVO
 DT, GX, GY, DAMP, SKIN, BETA, KN_PP, KS_PP, MU_PP, KN_PW, KS_PW, MU_PW, RATIO_TARGET, TIME = range(14)
 N_PRM = 14
 # integer parameters (iprm)
-MODE, NSTEPS, CHECK_EVERY, NEED_BUILD = range(4)
-N_IPRM = 4
+MODE, NSTEPS, CHECK_EVERY, NEED_BUILD, SERIAL = range(5)
+N_IPRM = 5
 # outputs (out)
 STATUS, STEPS_DONE, MAX_RATIO, MEAN_RATIO, NEED_PP, NEED_PW, REBUILDS = range(7)
 N_OUT = 7
@@ -81,6 +83,98 @@ def unbalanced_ratios(force, pmode, nb_start, nb_fn, nb_fs, nb_ov, wb_start, wb_
     return fmax / cmax, (fsum / nfree) / (csum / nc)
 
 
+@njit(inline="always", cache=True)
+def _pair_force(
+    i, j, p, pos, vel, omega, radius, mass, pkn, pks, pmu, per_body, prm, beta, dt,
+    nb_fs, nb_fn, nb_ov, nb_nx, nb_ny,
+):  # fmt: skip
+    """Contact law of disk pair slot p (i < j); stores its state, returns True if touching."""
+    dx = pos[j, 0] - pos[i, 0]
+    dy = pos[j, 1] - pos[i, 1]
+    d = math.sqrt(dx * dx + dy * dy)
+    ov = radius[i] + radius[j] - d
+    nb_ov[p] = ov
+    if ov <= 0.0:
+        nb_fn[p] = 0.0
+        nb_fs[p] = 0.0  # contact lost: history ends
+        return False
+    if d > 0.0:
+        nx = dx / d
+        ny = dy / d
+    else:
+        nx = 1.0
+        ny = 0.0
+    tx = -ny
+    ty = nx
+    dvx = vel[j, 0] - vel[i, 0]
+    dvy = vel[j, 1] - vel[i, 1]
+    vn = -(dvx * nx + dvy * ny)
+    vt = dvx * tx + dvy * ty - (radius[i] - 0.5 * ov) * omega[i] - (radius[j] - 0.5 * ov) * omega[j]
+    if per_body:
+        kn = series(pkn[i], pkn[j])
+        ks = series(pks[i], pks[j])
+        mu = min(pmu[i], pmu[j])
+    else:
+        kn = prm[KN_PP]
+        ks = prm[KS_PP]
+        mu = prm[MU_PP]
+    cn = dashpot(beta, kn, mass[i] * mass[j] / (mass[i] + mass[j])) if beta > 0.0 else 0.0
+    fn, fs, _sl = linear_force(ov, vn, vt, nb_fs[p], kn, ks, mu, cn, dt)
+    nb_fn[p] = fn
+    nb_fs[p] = fs
+    nb_nx[p] = nx
+    nb_ny[p] = ny
+    return True
+
+
+@njit(inline="always", cache=True)
+def _wall_force(
+    i, w, p, pos, vel, omega, radius, mass, pkn, pks, pmu, wp0, wp1, wvel, wkn, wks, wmu, per_body,
+    prm, beta, dt, wb_fs, wb_fn, wb_ov, wb_nx, wb_ny,
+):  # fmt: skip
+    """Contact law of disk-wall slot p; stores its state, returns True if touching."""
+    cx, cy = segment_closest(pos[i, 0], pos[i, 1], wp0[w, 0], wp0[w, 1], wp1[w, 0], wp1[w, 1])
+    dx = cx - pos[i, 0]
+    dy = cy - pos[i, 1]
+    d = math.sqrt(dx * dx + dy * dy)
+    ov = radius[i] - d
+    wb_ov[p] = ov
+    if ov <= 0.0:
+        wb_fn[p] = 0.0
+        wb_fs[p] = 0.0
+        return False
+    if d > 0.0:
+        nx = dx / d
+        ny = dy / d
+    else:  # centre on the wall line: push along the wall's normal
+        sx = wp1[w, 0] - wp0[w, 0]
+        sy = wp1[w, 1] - wp0[w, 1]
+        sl = math.sqrt(sx * sx + sy * sy)
+        nx = sy / sl
+        ny = -sx / sl
+    tx = -ny
+    ty = nx
+    dvx = wvel[w, 0] - vel[i, 0]
+    dvy = wvel[w, 1] - vel[i, 1]
+    vn = -(dvx * nx + dvy * ny)
+    vt = dvx * tx + dvy * ty - (radius[i] - 0.5 * ov) * omega[i]
+    if per_body:
+        kn = series(pkn[i], wkn[w])
+        ks = series(pks[i], wks[w])
+        mu = min(pmu[i], wmu[w])
+    else:
+        kn = prm[KN_PW]
+        ks = prm[KS_PW]
+        mu = prm[MU_PW]
+    cn = dashpot(beta, kn, mass[i]) if beta > 0.0 else 0.0
+    fn, fs, _sl = linear_force(ov, vn, vt, wb_fs[p], kn, ks, mu, cn, dt)
+    wb_fn[p] = fn
+    wb_fs[p] = fs
+    wb_nx[p] = nx
+    wb_ny[p] = ny
+    return True
+
+
 @njit(parallel=True, cache=True)
 def run_steps(
     pos, vel, theta, omega, force, moment, radius, mass, inv_mass, inv_inertia, pmode, pkn, pks, pmu,
@@ -126,125 +220,87 @@ def run_steps(
             iprm[NEED_BUILD] = 0
             rebuilds += 1
 
-        # 2. disk-disk contacts
-        for i in prange(n):
-            for p in range(nb_start[i], nb_start[i + 1]):
-                j = nb_j[p]
-                dx = pos[j, 0] - pos[i, 0]
-                dy = pos[j, 1] - pos[i, 1]
-                d = math.sqrt(dx * dx + dy * dy)
-                ov = radius[i] + radius[j] - d
-                nb_ov[p] = ov
-                if ov <= 0.0:
-                    nb_fn[p] = 0.0
-                    nb_fs[p] = 0.0  # contact lost: history ends
-                    continue
-                if d > 0.0:
-                    nx = dx / d
-                    ny = dy / d
-                else:
-                    nx = 1.0
-                    ny = 0.0
-                tx = -ny
-                ty = nx
-                dvx = vel[j, 0] - vel[i, 0]
-                dvy = vel[j, 1] - vel[i, 1]
-                vn = -(dvx * nx + dvy * ny)
-                vt = (
-                    dvx * tx
-                    + dvy * ty
-                    - (radius[i] - 0.5 * ov) * omega[i]
-                    - (radius[j] - 0.5 * ov) * omega[j]
-                )
-                if per_body:
-                    kn = series(pkn[i], pkn[j])
-                    ks = series(pks[i], pks[j])
-                    mu = min(pmu[i], pmu[j])
-                else:
-                    kn = prm[KN_PP]
-                    ks = prm[KS_PP]
-                    mu = prm[MU_PP]
-                cn = dashpot(beta, kn, mass[i] * mass[j] / (mass[i] + mass[j]))
-                fn, fs, _sl = linear_force(ov, vn, vt, nb_fs[p], kn, ks, mu, cn, dt)
-                nb_fn[p] = fn
-                nb_fs[p] = fs
-                nb_nx[p] = nx
-                nb_ny[p] = ny
-
-        # 3. disk-wall contacts
-        for i in prange(n):
-            for p in range(wb_start[i], wb_start[i + 1]):
-                w = wb_w[p]
-                cx, cy = segment_closest(pos[i, 0], pos[i, 1], wp0[w, 0], wp0[w, 1], wp1[w, 0], wp1[w, 1])
-                dx = cx - pos[i, 0]
-                dy = cy - pos[i, 1]
-                d = math.sqrt(dx * dx + dy * dy)
-                ov = radius[i] - d
-                wb_ov[p] = ov
-                if ov <= 0.0:
-                    wb_fn[p] = 0.0
-                    wb_fs[p] = 0.0
-                    continue
-                if d > 0.0:
-                    nx = dx / d
-                    ny = dy / d
-                else:  # centre on the wall line: push along the wall's normal
-                    sx = wp1[w, 0] - wp0[w, 0]
-                    sy = wp1[w, 1] - wp0[w, 1]
-                    sl = math.sqrt(sx * sx + sy * sy)
-                    nx = sy / sl
-                    ny = -sx / sl
-                tx = -ny
-                ty = nx
-                dvx = wvel[w, 0] - vel[i, 0]
-                dvy = wvel[w, 1] - vel[i, 1]
-                vn = -(dvx * nx + dvy * ny)
-                vt = dvx * tx + dvy * ty - (radius[i] - 0.5 * ov) * omega[i]
-                if per_body:
-                    kn = series(pkn[i], wkn[w])
-                    ks = series(pks[i], wks[w])
-                    mu = min(pmu[i], wmu[w])
-                else:
-                    kn = prm[KN_PW]
-                    ks = prm[KS_PW]
-                    mu = prm[MU_PW]
-                cn = dashpot(beta, kn, mass[i])
-                fn, fs, _sl = linear_force(ov, vn, vt, wb_fs[p], kn, ks, mu, cn, dt)
-                wb_fn[p] = fn
-                wb_fs[p] = fs
-                wb_nx[p] = nx
-                wb_ny[p] = ny
-
-        # 4. gather: unbalanced force and moment of each disk
-        for i in prange(n):
-            fx = mass[i] * gx
-            fy = mass[i] * gy
-            mz = 0.0
-            for p in range(nb_start[i], nb_start[i + 1]):
-                if nb_ov[p] > 0.0:
-                    fn = nb_fn[p]
-                    fs = nb_fs[p]
-                    fx += -fn * nb_nx[p] - fs * nb_ny[p]
-                    fy += -fn * nb_ny[p] + fs * nb_nx[p]
-                    mz += (radius[i] - 0.5 * nb_ov[p]) * fs
-            for q in range(rev_start[i], rev_start[i + 1]):
-                p = rev_p[q]
-                if nb_ov[p] > 0.0:
-                    fn = nb_fn[p]
-                    fs = nb_fs[p]
-                    fx -= -fn * nb_nx[p] - fs * nb_ny[p]
-                    fy -= -fn * nb_ny[p] + fs * nb_nx[p]
-                    mz += (radius[i] - 0.5 * nb_ov[p]) * fs
-            for p in range(wb_start[i], wb_start[i + 1]):
-                if wb_ov[p] > 0.0:
-                    fn = wb_fn[p]
-                    fs = wb_fs[p]
-                    fx += -fn * wb_nx[p] - fs * wb_ny[p]
-                    fy += -fn * wb_ny[p] + fs * wb_nx[p]
-                    mz += (radius[i] - 0.5 * wb_ov[p]) * fs
-            force[i, 0] = fx
-            force[i, 1] = fy
-            moment[i] = mz
+        if iprm[SERIAL] != 0:
+            # 2-4 fused for one thread: each pair adds its force to both disks as it is
+            # computed, in the same order as the gather below (partners j < i, own row,
+            # walls), so one and two threads give the same numbers bit for bit.
+            for i in range(n):
+                force[i, 0] = mass[i] * gx
+                force[i, 1] = mass[i] * gy
+                moment[i] = 0.0
+            for i in range(n):
+                for p in range(nb_start[i], nb_start[i + 1]):
+                    j = nb_j[p]
+                    if _pair_force(
+                        i, j, p, pos, vel, omega, radius, mass, pkn, pks, pmu, per_body, prm, beta, dt,
+                        nb_fs, nb_fn, nb_ov, nb_nx, nb_ny,
+                    ):  # fmt: skip
+                        fn = nb_fn[p]
+                        fs = nb_fs[p]
+                        fxp = -fn * nb_nx[p] - fs * nb_ny[p]
+                        fyp = -fn * nb_ny[p] + fs * nb_nx[p]
+                        force[i, 0] += fxp
+                        force[i, 1] += fyp
+                        moment[i] += (radius[i] - 0.5 * nb_ov[p]) * fs
+                        force[j, 0] -= fxp
+                        force[j, 1] -= fyp
+                        moment[j] += (radius[j] - 0.5 * nb_ov[p]) * fs
+            for i in range(n):
+                for p in range(wb_start[i], wb_start[i + 1]):
+                    if _wall_force(
+                        i, wb_w[p], p, pos, vel, omega, radius, mass, pkn, pks, pmu, wp0, wp1, wvel, wkn,
+                        wks, wmu, per_body, prm, beta, dt, wb_fs, wb_fn, wb_ov, wb_nx, wb_ny,
+                    ):  # fmt: skip
+                        fn = wb_fn[p]
+                        fs = wb_fs[p]
+                        force[i, 0] += -fn * wb_nx[p] - fs * wb_ny[p]
+                        force[i, 1] += -fn * wb_ny[p] + fs * wb_nx[p]
+                        moment[i] += (radius[i] - 0.5 * wb_ov[p]) * fs
+        else:
+            # 2. disk-disk contacts, per pair
+            for i in prange(n):
+                for p in range(nb_start[i], nb_start[i + 1]):
+                    _pair_force(
+                        i, nb_j[p], p, pos, vel, omega, radius, mass, pkn, pks, pmu, per_body, prm, beta, dt,
+                        nb_fs, nb_fn, nb_ov, nb_nx, nb_ny,
+                    )  # fmt: skip
+            # 3. disk-wall contacts, per pair
+            for i in prange(n):
+                for p in range(wb_start[i], wb_start[i + 1]):
+                    _wall_force(
+                        i, wb_w[p], p, pos, vel, omega, radius, mass, pkn, pks, pmu, wp0, wp1, wvel, wkn,
+                        wks, wmu, per_body, prm, beta, dt, wb_fs, wb_fn, wb_ov, wb_nx, wb_ny,
+                    )  # fmt: skip
+            # 4. gather: partners j < i (reverse list), own row, walls
+            for i in prange(n):
+                fx = mass[i] * gx
+                fy = mass[i] * gy
+                mz = 0.0
+                for q in range(rev_start[i], rev_start[i + 1]):
+                    p = rev_p[q]
+                    if nb_ov[p] > 0.0:
+                        fn = nb_fn[p]
+                        fs = nb_fs[p]
+                        fx -= -fn * nb_nx[p] - fs * nb_ny[p]
+                        fy -= -fn * nb_ny[p] + fs * nb_nx[p]
+                        mz += (radius[i] - 0.5 * nb_ov[p]) * fs
+                for p in range(nb_start[i], nb_start[i + 1]):
+                    if nb_ov[p] > 0.0:
+                        fn = nb_fn[p]
+                        fs = nb_fs[p]
+                        fx += -fn * nb_nx[p] - fs * nb_ny[p]
+                        fy += -fn * nb_ny[p] + fs * nb_nx[p]
+                        mz += (radius[i] - 0.5 * nb_ov[p]) * fs
+                for p in range(wb_start[i], wb_start[i + 1]):
+                    if wb_ov[p] > 0.0:
+                        fn = wb_fn[p]
+                        fs = wb_fs[p]
+                        fx += -fn * wb_nx[p] - fs * wb_ny[p]
+                        fy += -fn * wb_ny[p] + fs * wb_nx[p]
+                        mz += (radius[i] - 0.5 * wb_ov[p]) * fs
+                force[i, 0] = fx
+                force[i, 1] = fy
+                moment[i] = mz
 
         # 5. wall resultants (fixed order) and servo speeds
         for w in range(nw):

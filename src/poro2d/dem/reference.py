@@ -277,12 +277,13 @@ class ReferenceDEM:
         force[:, 0] = m * self.gravity[0]
         force[:, 1] = m * self.gravity[1]
         moment = np.zeros(n)
-        np.add.at(force[:, 0], i, cfx)
-        np.add.at(force[:, 1], i, cfy)
-        np.add.at(moment, i, (r[i] - 0.5 * ov) * fs)
+        # the engine's order: for each disk, its partners j < i, then its own row, then walls
         np.add.at(force[:, 0], j, -cfx)
         np.add.at(force[:, 1], j, -cfy)
         np.add.at(moment, j, (r[j] - 0.5 * ov) * fs)
+        np.add.at(force[:, 0], i, cfx)
+        np.add.at(force[:, 1], i, cfy)
+        np.add.at(moment, i, (r[i] - 0.5 * ov) * fs)
         np.add.at(force[:, 0], wi, wcfx)
         np.add.at(force[:, 1], wi, wcfy)
         np.add.at(moment, wi, (r[wi] - 0.5 * wov) * wfs)

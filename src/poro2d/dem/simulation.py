@@ -365,6 +365,7 @@ class Simulation:
         self._iprm[K.MODE] = self.contact.mode
         self._iprm[K.NSTEPS] = nsteps
         self._iprm[K.CHECK_EVERY] = check_every
+        self._iprm[K.SERIAL] = 1 if self.threads == 1 else 0
 
     def _kernel_block(self, nsteps: int, check_every: int, ratio_target: float) -> tuple[int, int]:
         """Run up to ``nsteps`` in compiled code; returns (steps done, status)."""
