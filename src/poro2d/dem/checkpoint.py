@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from poro2d.dem import kernels as K
 from poro2d.dem.model import ContactModel
 from poro2d.dem.simulation import Simulation
 from poro2d.dem.state import Particles, Walls
@@ -115,6 +116,10 @@ def load(path: str | os.PathLike, threads: int | None = None) -> Simulation:
     sim.time = s["time"]
     for f in _SIM_ARRAYS:
         setattr(sim, f, np.ascontiguousarray(a[f"sim.{f}"]))
+    # integer settings added by later versions start at zero (their defaults)
+    iprm = np.zeros(K.N_IPRM, dtype=np.int64)
+    iprm[: min(len(sim._iprm), K.N_IPRM)] = sim._iprm[: K.N_IPRM]
+    sim._iprm = iprm
     cap = sim._nb_j.shape[0]
     sim._new_j = np.zeros(cap, dtype=np.int64)
     sim._new_fs = np.zeros(cap)

@@ -29,7 +29,9 @@ PER_PAIR_TYPE = 1  # PFC 5 style: one (kn, ks, mu) for disk-disk, one for disk-w
 
 @njit(inline="always", cache=True)
 def series(ka, kb):
-    """Two springs in series; 0 if either is 0."""
+    """Two springs in series; 0 if either is 0 (equal springs: half, without a division)."""
+    if ka == kb:
+        return 0.5 * ka
     s = ka + kb
     if s <= 0.0:
         return 0.0

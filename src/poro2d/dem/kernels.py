@@ -99,8 +99,9 @@ def _pair_force(
         nb_fs[p] = 0.0  # contact lost: history ends
         return False
     if d > 0.0:
-        nx = dx / d
-        ny = dy / d
+        inv = 1.0 / d
+        nx = dx * inv
+        ny = dy * inv
     else:
         nx = 1.0
         ny = 0.0
@@ -173,6 +174,28 @@ def _wall_force(
     wb_nx[p] = nx
     wb_ny[p] = ny
     return True
+
+
+@njit(inline="always", cache=True)
+def _advance(i, pos, vel, theta, omega, force, moment, inv_mass, inv_inertia, pmode, damp, dt, pos_build):
+    """Local damping and leapfrog update of disk i; returns its squared drift since the last build."""
+    if pmode[i] == FREE:
+        fx = force[i, 0]
+        fy = force[i, 1]
+        mz = moment[i]
+        if damp > 0.0:
+            fx -= damp * abs(fx) * np.sign(vel[i, 0])
+            fy -= damp * abs(fy) * np.sign(vel[i, 1])
+            mz -= damp * abs(mz) * np.sign(omega[i])
+        vel[i, 0] += fx * inv_mass[i] * dt
+        vel[i, 1] += fy * inv_mass[i] * dt
+        omega[i] += mz * inv_inertia[i] * dt
+    pos[i, 0] += vel[i, 0] * dt
+    pos[i, 1] += vel[i, 1] * dt
+    theta[i] += omega[i] * dt
+    ddx = pos[i, 0] - pos_build[i, 0]
+    ddy = pos[i, 1] - pos_build[i, 1]
+    return ddx * ddx + ddy * ddy
 
 
 @njit(parallel=True, cache=True)
@@ -335,22 +358,37 @@ def run_steps(
                 wvel[w, 0] = v * wdir[w, 0]
                 wvel[w, 1] = v * wdir[w, 1]
 
-        # 6. damping and leapfrog integration
-        for i in prange(n):
-            if pmode[i] == FREE:
-                fx = force[i, 0]
-                fy = force[i, 1]
-                mz = moment[i]
-                if damp > 0.0:
-                    fx -= damp * abs(fx) * np.sign(vel[i, 0])
-                    fy -= damp * abs(fy) * np.sign(vel[i, 1])
-                    mz -= damp * abs(mz) * np.sign(omega[i])
-                vel[i, 0] += fx * inv_mass[i] * dt
-                vel[i, 1] += fy * inv_mass[i] * dt
-                omega[i] += mz * inv_inertia[i] * dt
-            pos[i, 0] += vel[i, 0] * dt
-            pos[i, 1] += vel[i, 1] * dt
-            theta[i] += omega[i] * dt
+        # 6. damping and leapfrog integration (the serial loop also tracks the displacement)
+        dmax = 0.0
+        if iprm[SERIAL] != 0:
+            for i in range(n):
+                d2 = _advance(
+                    i,
+                    pos,
+                    vel,
+                    theta,
+                    omega,
+                    force,
+                    moment,
+                    inv_mass,
+                    inv_inertia,
+                    pmode,
+                    damp,
+                    dt,
+                    pos_build,
+                )
+                if d2 > dmax:
+                    dmax = d2
+        else:
+            for i in prange(n):
+                _advance(i, pos, vel, theta, omega, force, moment, inv_mass, inv_inertia, pmode, damp, dt,
+                         pos_build)  # fmt: skip
+            for i in range(n):
+                ddx = pos[i, 0] - pos_build[i, 0]
+                ddy = pos[i, 1] - pos_build[i, 1]
+                d2 = ddx * ddx + ddy * ddy
+                if d2 > dmax:
+                    dmax = d2
         for w in range(nw):
             wp0[w, 0] += wvel[w, 0] * dt
             wp0[w, 1] += wvel[w, 1] * dt
@@ -360,13 +398,6 @@ def run_steps(
         steps += 1
 
         # 7. rebuild flag and stop check
-        dmax = 0.0
-        for i in range(n):
-            ddx = pos[i, 0] - pos_build[i, 0]
-            ddy = pos[i, 1] - pos_build[i, 1]
-            d2 = ddx * ddx + ddy * ddy
-            if d2 > dmax:
-                dmax = d2
         for w in range(nw):
             ddx = wp0[w, 0] - wall_build[w, 0]
             ddy = wp0[w, 1] - wall_build[w, 1]

@@ -38,6 +38,8 @@ def _series(ka: np.ndarray, kb: np.ndarray) -> np.ndarray:
     kb_b = np.broadcast_to(kb, out.shape)
     s_b = np.broadcast_to(s, out.shape)
     out[ok] = ka_b[ok] * kb_b[ok] / s_b[ok]
+    eq = ka_b == kb_b  # as the kernel: equal springs give exactly half
+    out[eq] = 0.5 * ka_b[eq]
     return out
 
 
@@ -209,8 +211,9 @@ class ReferenceDEM:
             o = np.argsort(rank, kind="stable")
             i, j, dx, dy, d, ov = i[o], j[o], dx[o], dy[o], d[o], ov[o]
         with np.errstate(invalid="ignore", divide="ignore"):
-            nx = np.where(d > 0.0, dx / d, 1.0)
-            ny = np.where(d > 0.0, dy / d, 0.0)
+            inv = 1.0 / d  # as the kernel: one division, two products
+            nx = np.where(d > 0.0, dx * inv, 1.0)
+            ny = np.where(d > 0.0, dy * inv, 0.0)
         tx, ty = -ny, nx
         dvx = vel[j, 0] - vel[i, 0]
         dvy = vel[j, 1] - vel[i, 1]
