@@ -120,12 +120,8 @@ def load(path: str | os.PathLike, threads: int | None = None) -> Simulation:
     iprm = np.zeros(K.N_IPRM, dtype=np.int64)
     iprm[: min(len(sim._iprm), K.N_IPRM)] = sim._iprm[: K.N_IPRM]
     sim._iprm = iprm
-    cap = sim._nb_j.shape[0]
-    sim._new_j = np.zeros(cap, dtype=np.int64)
-    sim._new_fs = np.zeros(cap)
-    capw = sim._wb_w.shape[0]
-    sim._wnew_w = np.zeros(capw, dtype=np.int64)
-    sim._wnew_fs = np.zeros(capw)
+    sim._grow((), sim._PP_SCRATCH, sim._nb_j.shape[0], 0)
+    sim._grow((), sim._PW_SCRATCH, sim._wb_w.shape[0], 0)
     return sim
 
 

@@ -207,40 +207,29 @@ class Simulation:
         self._iprm = np.zeros(K.N_IPRM, dtype=np.int64)
         self._out = np.zeros(K.N_OUT)
 
-    def _alloc_pp(self, cap: int, keep: int = 0) -> None:
-        def grow(old, dtype=np.float64):
+    # pair storage: (kept arrays with their dtype, scratch arrays for the rebuild)
+    _PP = (("_nb_j", np.int64), ("_nb_fs", float), ("_nb_fn", float), ("_nb_ov", float),
+           ("_nb_nx", float), ("_nb_ny", float), ("_rev_p", np.int64))  # fmt: skip
+    _PP_SCRATCH = (("_new_j", np.int64), ("_new_fs", float))
+    _PW = (("_wb_w", np.int64), ("_wb_fs", float), ("_wb_fn", float), ("_wb_ov", float),
+           ("_wb_nx", float), ("_wb_ny", float))  # fmt: skip
+    _PW_SCRATCH = (("_wnew_w", np.int64), ("_wnew_fs", float))
+
+    def _grow(self, kept, scratch, cap: int, keep: int) -> None:
+        """(Re)allocate pair arrays with capacity ``cap``, copying the first ``keep`` slots."""
+        for name, dtype in kept:
             a = np.zeros(cap, dtype=dtype)
             if keep:
-                a[:keep] = old[:keep]
-            return a
+                a[:keep] = getattr(self, name)[:keep]
+            setattr(self, name, a)
+        for name, dtype in scratch:
+            setattr(self, name, np.zeros(cap, dtype=dtype))
 
-        g = getattr
-        self._nb_j = grow(g(self, "_nb_j", None), np.int64)
-        self._nb_fs = grow(g(self, "_nb_fs", None))
-        self._nb_fn = grow(g(self, "_nb_fn", None))
-        self._nb_ov = grow(g(self, "_nb_ov", None))
-        self._nb_nx = grow(g(self, "_nb_nx", None))
-        self._nb_ny = grow(g(self, "_nb_ny", None))
-        self._rev_p = grow(g(self, "_rev_p", None), np.int64)
-        self._new_j = np.zeros(cap, dtype=np.int64)
-        self._new_fs = np.zeros(cap)
+    def _alloc_pp(self, cap: int, keep: int = 0) -> None:
+        self._grow(self._PP, self._PP_SCRATCH, cap, keep)
 
     def _alloc_pw(self, cap: int, keep: int = 0) -> None:
-        def grow(old, dtype=np.float64):
-            a = np.zeros(cap, dtype=dtype)
-            if keep:
-                a[:keep] = old[:keep]
-            return a
-
-        g = getattr
-        self._wb_w = grow(g(self, "_wb_w", None), np.int64)
-        self._wb_fs = grow(g(self, "_wb_fs", None))
-        self._wb_fn = grow(g(self, "_wb_fn", None))
-        self._wb_ov = grow(g(self, "_wb_ov", None))
-        self._wb_nx = grow(g(self, "_wb_nx", None))
-        self._wb_ny = grow(g(self, "_wb_ny", None))
-        self._wnew_w = np.zeros(cap, dtype=np.int64)
-        self._wnew_fs = np.zeros(cap)
+        self._grow(self._PW, self._PW_SCRATCH, cap, keep)
 
     # --------------------------------------------------------------- mutation
     def particles_changed(self) -> None:
