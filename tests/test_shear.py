@@ -233,3 +233,26 @@ def test_api_bad_input(specimen, tmp_path):
     DirectShearTest(specimen, 50, ShearSettings(**SHORT), out=tmp_path / "t")._check_resume()
     with pytest.raises(InputError, match="out"):
         DirectShearTest(specimen, 100, ShearSettings(**SHORT), out=tmp_path / "t").run()
+
+
+def test_rate_check_reruns_at_half_velocity(specimen, series, tmp_path):
+    import shutil
+
+    out, r = series
+    shutil.copytree(out / "sn100kPa", tmp_path / "sn100kPa")  # done: only the v/2 rerun runs
+    s = ShearSeries(
+        specimen, [100], ShearSettings(**SHORT), out=tmp_path, rate_check=True, processes=1, progress=False,
+        figures=False,
+    )  # fmt: skip
+    res = s.run()
+    rc = res["rate_check"]
+    assert rc["half_velocity_m_per_s"] == pytest.approx(0.5 * ShearSettings().velocity)
+    (row,) = rc["tests"]
+    half = json.loads((tmp_path / "rate_check" / "sn100kPa" / "result.json").read_text())
+    assert half["velocity_m_per_s"] == pytest.approx(0.5 * ShearSettings().velocity)
+    assert row["relative_change"] == pytest.approx(
+        half["peak_shear_stress_kpa"] / r["tests"][1]["peak_shear_stress_kpa"] - 1
+    )
+    assert row["max_inertial_number_half_velocity"] < r["tests"][1]["max_inertial_number"]
+    assert 0 <= row["mean_abs_change_before_peak"] < 1
+    assert rc["passed"] == (abs(row["relative_change"]) < 0.02)
