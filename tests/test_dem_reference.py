@@ -178,6 +178,8 @@ def test_threads_give_bitwise_identical_results():
     # kept short: two OpenMP threads on a loaded 2-core machine wait at every barrier
     a = jammed_packing(7, threads=1)
     b = jammed_packing(7, threads=2)
+    b.parallel_min_particles = 0  # force the parallel path on this small packing
+    assert a.effective_threads == 1 and b.effective_threads == 2
     a.run(25)
     b.run(25)
     pa, pb = a.particles, b.particles
@@ -187,6 +189,7 @@ def test_threads_give_bitwise_identical_results():
     c = loose_packing(4)
     d = loose_packing(4)
     d.threads = 2
+    d.parallel_min_particles = 0
     rc = c.run(50)
     d.run(50)
     assert rc.rebuilds >= 2

@@ -56,7 +56,9 @@ def build_blocks(out: Path, summary: dict) -> list[Block]:
         "Multilayer compaction by radius expansion inside each band under a temporary lid "
         f"({spec.get('layers', 4)} layers), equilibrium at a maximum unbalanced-force ratio of "
         f"{spec.get('ratio', 1e-3)}.",
-        "Direct shear: the shear velocity is far above the laboratory rate (quasi-static checks below).",
+        "Direct shear: the shear velocity is far above the laboratory rate of 0.384 mm/min "
+        "(quasi-static checks below); no laboratory curves are built in (Fig. 8's data are not "
+        "published as numbers): pass them with --lab.",
     ]))  # fmt: skip
 
     # --- conversions
@@ -184,7 +186,7 @@ def _shear_blocks(out: Path, shear: dict) -> list[Block]:
     )
     sd = out / "shear"
     for name, cap in (
-        ("fig8a_shear_stress.png", "Fig. 8(a): shear stress against shear displacement"),
+        ("fig8a_shear_curves.png", "Fig. 8(a): shear stress against shear displacement"),
         ("fig8b_peak_strength.png", "Fig. 8(b): peak strength against normal stress"),
     ):
         if (sd / name).is_file():
