@@ -62,7 +62,9 @@ _register()
 def main(argv: list[str] | None = None) -> None:
     """Console entry point: run the app, turn InputError into a one-line message."""
     try:
-        app(args=argv, standalone_mode=False)
+        rc = app(args=argv, standalone_mode=False)
+        if isinstance(rc, int) and rc != 0:  # typer.Exit(code) comes back as a return value here
+            sys.exit(rc)
     except InputError as exc:
         err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
         sys.exit(2)
