@@ -105,20 +105,31 @@ def paper_simulation(out: Path, rebuild: bool, threads: int = 2):
     if ck.is_file() and not rebuild:
         sim = checkpoint.load(ck, threads=threads)
         # a cache written by an engine with another time-step rule is stale
-        now = Simulation(sim.particles, sim.walls, sim.contact, gravity=sim.gravity,
-                         local_damping=sim.local_damping, dt_safety=SpecimenSpec().dt_safety)
+        now = Simulation(
+            sim.particles,
+            sim.walls,
+            sim.contact,
+            gravity=sim.gravity,
+            local_damping=sim.local_damping,
+            dt_safety=SpecimenSpec().dt_safety,
+        )
         if math.isclose(now.dt, sim.dt, rel_tol=1e-9):
             print(f"[paper] loaded {ck} ({sim.particles.n} disks)", flush=True)
             return sim, checkpoint.read_meta(ck).get("extra", {}).get("report", {})
-        print(f"[paper] cached dt {sim.dt:.4e} s differs from the engine's {now.dt:.4e} s: "
-              "preparing the specimen again", flush=True)
+        print(
+            f"[paper] cached dt {sim.dt:.4e} s differs from the engine's {now.dt:.4e} s: "
+            "preparing the specimen again",
+            flush=True,
+        )
 
     t0 = time.perf_counter()
     sim, report = prepare_specimen(SpecimenSpec(threads=threads), paper_grading(), 0.15, seed=0)
     report = json.loads(json.dumps(report, default=float))
-    print(f"[paper] prepared {sim.particles.n} disks in {time.perf_counter() - t0:.0f} s "
-          f"(converged={report['converged']}, porosity {report['measured_porosity']:.4f})",
-          flush=True)
+    print(
+        f"[paper] prepared {sim.particles.n} disks in {time.perf_counter() - t0:.0f} s "
+        f"(converged={report['converged']}, porosity {report['measured_porosity']:.4f})",
+        flush=True,
+    )
     out.mkdir(parents=True, exist_ok=True)
     checkpoint.save(sim, ck, extra={"report": report})
     return sim, report
@@ -131,8 +142,12 @@ def wall_box(sim) -> tuple[float, float, float, float]:
     wall lines, not from the segment ends.
     """
     w = sim.walls
-    return (float(w.p0[w.index("left"), 0]), float(w.p0[w.index("right"), 0]),
-            float(w.p0[w.index("bottom"), 1]), float(w.p0[w.index("top"), 1]))
+    return (
+        float(w.p0[w.index("left"), 0]),
+        float(w.p0[w.index("right"), 0]),
+        float(w.p0[w.index("bottom"), 1]),
+        float(w.p0[w.index("top"), 1]),
+    )
 
 
 def tiled_simulation(base, nx: int, ny: int, threads: int = 1):
@@ -150,14 +165,19 @@ def tiled_simulation(base, nx: int, ny: int, threads: int = 1):
     def rep(a):
         return np.tile(a, ncopy)
 
-    parts = Particles(pos, rep(p.radius), rep(p.density), p.thickness, rep(p.kn), rep(p.ks),
-                      rep(p.mu))
+    parts = Particles(pos, rep(p.radius), rep(p.density), p.thickness, rep(p.kn), rep(p.ks), rep(p.mu))
     w = base.walls
-    walls = Walls.box(xlo, ylo, xlo + nx * W, ylo + ny * H, float(w.kn[0]), float(w.ks[0]),
-                      float(w.mu[0]))
-    sim = Simulation(parts, walls, ContactModel(base.contact.convention),
-                     gravity=base.gravity, local_damping=base.local_damping,
-                     dt_safety=base.dt_safety, skin=base.skin, threads=threads)
+    walls = Walls.box(xlo, ylo, xlo + nx * W, ylo + ny * H, float(w.kn[0]), float(w.ks[0]), float(w.mu[0]))
+    sim = Simulation(
+        parts,
+        walls,
+        ContactModel(base.contact.convention),
+        gravity=base.gravity,
+        local_damping=base.local_damping,
+        dt_safety=base.dt_safety,
+        skin=base.skin,
+        threads=threads,
+    )
     # same lightest disk and stiffest contact: the automatic step is the paper case's
     if not math.isclose(sim.dt, base.dt, rel_tol=1e-12):
         raise RuntimeError(f"tiled dt {sim.dt} differs from the paper case's {base.dt}")
@@ -223,15 +243,31 @@ def lammps_params(sim) -> dict:
             raise ValueError(f"LAMMPS reference needs one disk {name}")
     density = float(p.density[0])
     return dict(
-        density=density, thickness=p.thickness,
-        kn_pp=series(kp, kp), kt_pp=series(sp, sp), mu_pp=mp,
-        kn_pw=series(kp, kw), kt_pw=series(sp, sw), mu_pw=min(mp, mw),
-        gravity=-float(sim.gravity[1]), damping_cundall=sim.local_damping, dt=sim.dt,
+        density=density,
+        thickness=p.thickness,
+        kn_pp=series(kp, kp),
+        kt_pp=series(sp, sp),
+        mu_pp=mp,
+        kn_pw=series(kp, kw),
+        kt_pw=series(sp, sw),
+        mu_pw=min(mp, mw),
+        gravity=-float(sim.gravity[1]),
+        damping_cundall=sim.local_damping,
+        dt=sim.dt,
     )
 
 
-def time_lammps(sim, label: str, steps: int, repeats: int, settle: int, threads=1,
-                mpi_ranks=1, wait_policy: str | None = "PASSIVE", timeout: float = 300.0) -> dict | None:
+def time_lammps(
+    sim,
+    label: str,
+    steps: int,
+    repeats: int,
+    settle: int,
+    threads=1,
+    mpi_ranks=1,
+    wait_policy: str | None = "PASSIVE",
+    timeout: float = 300.0,
+) -> dict | None:
     """LAMMPS on the positions and radii of ``sim``; ``wait_policy`` None: OpenMP default.
 
     Returns None when the run exceeds ``timeout`` seconds (spinning OpenMP threads on a
@@ -249,9 +285,19 @@ def time_lammps(sim, label: str, steps: int, repeats: int, settle: int, threads=
         os.environ["OMP_WAIT_POLICY"] = wait_policy
     try:
         t0 = time.perf_counter()
-        res = run_lammps(p.pos[:, 0], p.pos[:, 1], p.radius, wall_box(sim), **lammps_params(sim),
-                         settle_steps=settle, measure_steps=steps, repeats=repeats,
-                         threads=threads, mpi_ranks=mpi_ranks, timeout=timeout)
+        res = run_lammps(
+            p.pos[:, 0],
+            p.pos[:, 1],
+            p.radius,
+            wall_box(sim),
+            **lammps_params(sim),
+            settle_steps=settle,
+            measure_steps=steps,
+            repeats=repeats,
+            threads=threads,
+            mpi_ranks=mpi_ranks,
+            timeout=timeout,
+        )
         wall = time.perf_counter() - t0
     except subprocess.TimeoutExpired:
         print(f"  LAMMPS {label:24s} timed out after {timeout:.0f} s (load {loadavg()[0]})", flush=True)
@@ -264,10 +310,12 @@ def time_lammps(sim, label: str, steps: int, repeats: int, settle: int, threads=
     res["loadavg"] = loadavg()
     res["label"] = label
     res["omp_wait_policy"] = wait_policy or "default"
-    print(f"  LAMMPS {label:24s} {res['particle_steps_per_s']:.3e} p-steps/s "
-          f"(median of {repeats} x {steps} steps, floor force {res['bottom_wall_force']:.1f} N, "
-          f"finite={res['finite']}, {wall:.0f} s incl. setup; load {res['loadavg'][0]})",
-          flush=True)
+    print(
+        f"  LAMMPS {label:24s} {res['particle_steps_per_s']:.3e} p-steps/s "
+        f"(median of {repeats} x {steps} steps, floor force {res['bottom_wall_force']:.1f} N, "
+        f"finite={res['finite']}, {wall:.0f} s incl. setup; load {res['loadavg'][0]})",
+        flush=True,
+    )
     return res
 
 
@@ -304,18 +352,26 @@ def skin_study(ck: Path, factors, steps: int, repeats: int, threads: int = 1) ->
             sim.run(1)
             step1.append(time.perf_counter() - t0)
         row = {
-            "skin_over_rmean": f, "skin_m": f * rmean,
-            "particle_steps_per_s": statistics.median(rates), "all": rates,
-            "rebuilds_per_block": rb, "steps": steps,
-            "step_with_build_s": min(bt), "step_without_build_s": min(step1),
-            **contact_stats(sim), "loadavg": loadavg(),
+            "skin_over_rmean": f,
+            "skin_m": f * rmean,
+            "particle_steps_per_s": statistics.median(rates),
+            "all": rates,
+            "rebuilds_per_block": rb,
+            "steps": steps,
+            "step_with_build_s": min(bt),
+            "step_without_build_s": min(step1),
+            **contact_stats(sim),
+            "loadavg": loadavg(),
         }
         rows.append(row)
-        print(f"  skin {f:.2f} r_mean = {f * rmean * 1e3:.3f} mm: "
-              f"{row['particle_steps_per_s']:.3e} p-steps/s, rebuilds/block {rb}, "
-              f"pairs/disk {row['verlet_pairs_per_disk']:.2f}, one step with/without build "
-              f"{row['step_with_build_s'] * 1e3:.2f}/{row['step_without_build_s'] * 1e3:.2f} ms "
-              f"(load {row['loadavg'][0]})", flush=True)
+        print(
+            f"  skin {f:.2f} r_mean = {f * rmean * 1e3:.3f} mm: "
+            f"{row['particle_steps_per_s']:.3e} p-steps/s, rebuilds/block {rb}, "
+            f"pairs/disk {row['verlet_pairs_per_disk']:.2f}, one step with/without build "
+            f"{row['step_with_build_s'] * 1e3:.2f}/{row['step_without_build_s'] * 1e3:.2f} ms "
+            f"(load {row['loadavg'][0]})",
+            flush=True,
+        )
     return rows
 
 
@@ -331,10 +387,12 @@ def _ratio(a, b):
 
 
 def table(results: dict) -> str:
-    rows = ["| case | N | poro2d 1 thread | poro2d 2 threads | LAMMPS 1 thread | "
-            "LAMMPS 2 (best of omp/mpi) | poro2d 1t / LAMMPS 1t | poro2d 2t / 1t | "
-            "poro2d / paper (1t, 2t) | load avg |",
-            "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
+    rows = [
+        "| case | N | poro2d 1 thread | poro2d 2 threads | LAMMPS 1 thread | "
+        "LAMMPS 2 (best of omp/mpi) | poro2d 1t / LAMMPS 1t | poro2d 2t / 1t | "
+        "poro2d / paper (1t, 2t) | load avg |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
     paper = results["cases"].get("paper", {}).get("poro2d", {})
     for name, c in results["cases"].items():
         pr = c.get("poro2d", {})
@@ -389,19 +447,29 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="paper case only, fewer steps")
     ap.add_argument("--skip-lammps", action="store_true", help="poro2d only")
-    ap.add_argument("--out", default="bench_out",
-                    help="output folder: bench.json and the cached settled packing")
-    ap.add_argument("--rebuild", action="store_true",
-                    help="prepare the paper specimen again instead of loading the cache")
-    ap.add_argument("--cases", default="paper,25k,250k,1M",
-                    help="comma-separated subset of paper,25k,250k,1M")
+    ap.add_argument(
+        "--out", default="bench_out", help="output folder: bench.json and the cached settled packing"
+    )
+    ap.add_argument(
+        "--rebuild", action="store_true", help="prepare the paper specimen again instead of loading the cache"
+    )
+    ap.add_argument(
+        "--cases", default="paper,25k,250k,1M", help="comma-separated subset of paper,25k,250k,1M"
+    )
     ap.add_argument("--repeats", type=int, default=5, help="timed blocks per thread count")
-    ap.add_argument("--omp-wait-policy", default="PASSIVE", choices=("PASSIVE", "ACTIVE", "unset"),
-                    help="OMP_WAIT_POLICY for poro2d's OpenMP threads (set before numba starts "
-                         "them). PASSIVE by default: on a shared, loaded 2-core machine spinning "
-                         "threads made 2 threads 10-50x slower than 1")
-    ap.add_argument("--skin-study", action="store_true",
-                    help="also time the paper case at skins of 0.1-0.5 x the mean radius")
+    ap.add_argument(
+        "--omp-wait-policy",
+        default="PASSIVE",
+        choices=("PASSIVE", "ACTIVE", "unset"),
+        help="OMP_WAIT_POLICY for poro2d's OpenMP threads (set before numba starts "
+        "them). PASSIVE by default: on a shared, loaded 2-core machine spinning "
+        "threads made 2 threads 10-50x slower than 1",
+    )
+    ap.add_argument(
+        "--skin-study",
+        action="store_true",
+        help="also time the paper case at skins of 0.1-0.5 x the mean radius",
+    )
     args = ap.parse_args(argv)
 
     sys.path.insert(0, str(HERE))
@@ -418,8 +486,11 @@ def main(argv=None) -> int:
     if info["numba_threads"] < 2:
         print("numba sees one thread only; the 2-thread columns stay empty")
     threads = (1, 2) if info["numba_threads"] >= 2 else (1,)
-    print(f"{info['cpu']}, {info['cpu_count']} cores, numba {info['numba']} "
-          f"({info['numba_threads']} threads), load average {info['loadavg_start']}", flush=True)
+    print(
+        f"{info['cpu']}, {info['cpu_count']} cores, numba {info['numba']} "
+        f"({info['numba_threads']} threads), load average {info['loadavg_start']}",
+        flush=True,
+    )
 
     names = ["paper"] if args.quick else [c.strip() for c in args.cases.split(",") if c.strip()]
     # steps per timed block and warm-up steps
@@ -433,18 +504,27 @@ def main(argv=None) -> int:
     rep_big = {"paper": rep, "25k": rep, "250k": min(rep, 3), "1M": min(rep, 3)}
 
     base, prep = paper_simulation(out, args.rebuild)
-    results: dict = {"machine": info, "preparation": prep, "cases": {},
-                     "settings": {"dt_s": base.dt, "skin_m": base.skin,
-                                  "mean_radius_m": float(base.particles.radius.mean()),
-                                  "friction_disk": float(base.particles.mu[0]),
-                                  "friction_wall": float(base.walls.mu[0]),
-                                  "local_damping": base.local_damping,
-                                  "gravity": list(base.gravity),
-                                  "omp_wait_policy_poro2d": args.omp_wait_policy,
-                                  "threading_layer": None}}
-    print(f"dt = {base.dt:.4e} s, skin = {base.skin * 1e3:.3f} mm, friction disk "
-          f"{base.particles.mu[0]:g} / wall {base.walls.mu[0]:g}, damping {base.local_damping}",
-          flush=True)
+    results: dict = {
+        "machine": info,
+        "preparation": prep,
+        "cases": {},
+        "settings": {
+            "dt_s": base.dt,
+            "skin_m": base.skin,
+            "mean_radius_m": float(base.particles.radius.mean()),
+            "friction_disk": float(base.particles.mu[0]),
+            "friction_wall": float(base.walls.mu[0]),
+            "local_damping": base.local_damping,
+            "gravity": list(base.gravity),
+            "omp_wait_policy_poro2d": args.omp_wait_policy,
+            "threading_layer": None,
+        },
+    }
+    print(
+        f"dt = {base.dt:.4e} s, skin = {base.skin * 1e3:.3f} mm, friction disk "
+        f"{base.particles.mu[0]:g} / wall {base.walls.mu[0]:g}, damping {base.local_damping}",
+        flush=True,
+    )
 
     for name in names:
         if name == "paper":
@@ -453,10 +533,13 @@ def main(argv=None) -> int:
             nx, ny = TILINGS[name]
             t0 = time.perf_counter()
             sim = tiled_simulation(base, nx, ny)
-            print(f"[{name}] tiled {nx} x {ny} copies: {sim.particles.n} disks in "
-                  f"{wall_box(sim)[1] - wall_box(sim)[0]:.3f} m x "
-                  f"{wall_box(sim)[3] - wall_box(sim)[2]:.3f} m "
-                  f"({time.perf_counter() - t0:.1f} s)", flush=True)
+            print(
+                f"[{name}] tiled {nx} x {ny} copies: {sim.particles.n} disks in "
+                f"{wall_box(sim)[1] - wall_box(sim)[0]:.3f} m x "
+                f"{wall_box(sim)[3] - wall_box(sim)[2]:.3f} m "
+                f"({time.perf_counter() - t0:.1f} s)",
+                flush=True,
+            )
         steps, warm = plan[name]
         t0 = time.perf_counter()
         r = time_poro2d(sim, steps, rep_big[name], warm, threads)
@@ -464,17 +547,24 @@ def main(argv=None) -> int:
             results["settings"]["threading_layer"] = numba.threading_layer()
         except ValueError:
             pass
-        case = {"n": sim.particles.n, "box": wall_box(sim),
-                "poro2d": {str(t): v for t, v in r.items()},
-                "poro2d_floor_force_N": float(-sim.wall_force("bottom")[1]),
-                "weight_N": float(sim.particles.mass.sum() * -sim.gravity[1]),
-                **contact_stats(sim)}
-        line = ", ".join(f"{t} thread(s) {v['particle_steps_per_s']:.3e} (best {v['best']:.3e})"
-                         for t, v in r.items())
-        print(f"  poro2d {line} p-steps/s (median of {rep_big[name]} x {steps} steps; "
-              f"{time.perf_counter() - t0:.0f} s; load {loadavg()[0]}); floor force "
-              f"{case['poro2d_floor_force_N']:.1f} N (weight {case['weight_N']:.1f} N: the "
-              f"packing is held between floor and top plate)", flush=True)
+        case = {
+            "n": sim.particles.n,
+            "box": wall_box(sim),
+            "poro2d": {str(t): v for t, v in r.items()},
+            "poro2d_floor_force_N": float(-sim.wall_force("bottom")[1]),
+            "weight_N": float(sim.particles.mass.sum() * -sim.gravity[1]),
+            **contact_stats(sim),
+        }
+        line = ", ".join(
+            f"{t} thread(s) {v['particle_steps_per_s']:.3e} (best {v['best']:.3e})" for t, v in r.items()
+        )
+        print(
+            f"  poro2d {line} p-steps/s (median of {rep_big[name]} x {steps} steps; "
+            f"{time.perf_counter() - t0:.0f} s; load {loadavg()[0]}); floor force "
+            f"{case['poro2d_floor_force_N']:.1f} N (weight {case['weight_N']:.1f} N: the "
+            f"packing is held between floor and top plate)",
+            flush=True,
+        )
         if not args.skip_lammps and name in ("paper", "25k"):
             lm = {}
             ls, lrep, lset = (steps, rep, 2000) if name == "paper" else (400, 3, 200)
@@ -483,11 +573,19 @@ def main(argv=None) -> int:
             lm["1 thread"] = time_lammps(sim, "1 thread", ls, lrep, lset)
             if name == "paper":
                 lm["2 OpenMP threads (PASSIVE)"] = time_lammps(
-                    sim, "2 OpenMP threads (PASSIVE)", ls, lrep, lset, threads=2)
+                    sim, "2 OpenMP threads (PASSIVE)", ls, lrep, lset, threads=2
+                )
                 if not args.quick:
                     lm["2 OpenMP threads (default wait)"] = time_lammps(
-                        sim, "2 OpenMP threads (default wait)", ls, lrep, lset, threads=2,
-                        wait_policy=None, timeout=120.0)
+                        sim,
+                        "2 OpenMP threads (default wait)",
+                        ls,
+                        lrep,
+                        lset,
+                        threads=2,
+                        wait_policy=None,
+                        timeout=120.0,
+                    )
                 lm["2 MPI ranks"] = time_lammps(sim, "2 MPI ranks", ls, lrep, lset, mpi_ranks=2)
             lm = {k: v for k, v in lm.items() if v is not None}
             for v in lm.values():
@@ -499,8 +597,9 @@ def main(argv=None) -> int:
 
     if args.skin_study:
         print("[skin study] paper case, 1 thread", flush=True)
-        results["skin_study"] = skin_study(out / "paper_settled.npz", (0.1, 0.15, 0.2, 0.3, 0.4, 0.5),
-                                           1000 if args.quick else 3000, 3)
+        results["skin_study"] = skin_study(
+            out / "paper_settled.npz", (0.1, 0.15, 0.2, 0.3, 0.4, 0.5), 1000 if args.quick else 3000, 3
+        )
 
     results["machine"]["loadavg_end"] = loadavg()
     try:
@@ -517,9 +616,11 @@ def main(argv=None) -> int:
     for k, v, t, m in targets(results):
         vs = "-" if v is None else f"{v:.2f}"
         print(f"target {k}: {vs} (>= {t}) {'met' if m else ('not met' if m is not None else '')}")
-    print(f"load average at start {info['loadavg_start']}, at end "
-          f"{results['machine']['loadavg_end']}; peak memory "
-          f"{results['machine'].get('peak_rss_mb', math.nan):.0f} MB")
+    print(
+        f"load average at start {info['loadavg_start']}, at end "
+        f"{results['machine']['loadavg_end']}; peak memory "
+        f"{results['machine'].get('peak_rss_mb', math.nan):.0f} MB"
+    )
     (out / "bench.json").write_text(json.dumps(results, indent=1, default=float))
     print(f"wrote {out / 'bench.json'}")
     return 0

