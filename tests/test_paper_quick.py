@@ -1,6 +1,8 @@
 """`poro2d paper --quick`: the whole pipeline on a reduced specimen, and its report."""
 
 import json
+import shutil
+import subprocess
 
 import pytest
 
@@ -54,3 +56,26 @@ def test_rerun_reuses_finished_stages(quick):
     before = [f.stat().st_mtime_ns for f in done]
     main(["paper", "--quick", "--out", str(quick), "--quiet"])
     assert [f.stat().st_mtime_ns for f in done] == before  # no specimen rebuilt, no test rerun
+
+
+@pytest.mark.skipif(shutil.which("chromium") is None, reason="Debian's chromium is not installed")
+def test_report_renders_in_headless_chromium(quick, tmp_path):
+    """The HTML opens from disk in a browser; nothing spills past the page column."""
+    import numpy as np
+    from matplotlib.image import imread
+
+    shot = tmp_path / "report.png"
+    cmd = [
+        "chromium", "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+        "--disable-background-networking", "--disable-component-update", "--disable-sync",
+        "--hide-scrollbars",
+        f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1200,2400",
+        f"--screenshot={shot}", (quick / "report.html").as_uri(),
+    ]  # fmt: skip
+    subprocess.run(cmd, check=True, capture_output=True, timeout=120)
+    img = imread(shot)[..., :3]
+    assert img.shape[1] == 1200
+    ink = (img < 0.9).any(axis=2)  # pixels that are not (near) white
+    assert ink[:, 100:1100].mean() > 0.02  # text, tables and figures are drawn
+    assert not ink[:, 1120:].any()  # the right margin stays empty: nothing overflows
+    assert np.isfinite(img).all()

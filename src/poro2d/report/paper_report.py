@@ -56,6 +56,16 @@ def build_blocks(out: Path, summary: dict) -> list[Block]:
         "Multilayer compaction by radius expansion inside each band under a temporary lid "
         f"({spec.get('layers', 4)} layers), equilibrium at a maximum unbalanced-force ratio of "
         f"{spec.get('ratio', 1e-3)}.",
+        *(
+            [
+                f"Quick mode: a {spec.get('width')} m x {spec.get('height')} m box in {spec.get('layers')} "
+                "layers, the criterion's force window widened to "
+                f"{crit.get('settings', {}).get('force_fraction', 0.01):.0%} of G (in so small a box 1 % "
+                "of G is about two disks' weight), shear to 4 mm: a first look, not the paper's case.",
+            ]
+            if summary.get("quick")
+            else []
+        ),
         "Direct shear: the shear velocity is far above the laboratory rate of 0.384 mm/min "
         "(quasi-static checks below); no laboratory curves are built in (Fig. 8's data are not "
         "published as numbers): pass them with --lab.",
