@@ -6,14 +6,15 @@ One step, in order (the PFC cycle):
 2. disk-disk contact forces (contact law, history update) per pair;
 3. disk-wall contact forces per pair;
 4. gather: each disk sums gravity and its contact forces (the unbalanced force);
-   with one thread, 2-4 are fused (each pair adds to both disks at once), in the
-   same summation order, so the numbers are identical;
-5. wall resultants, then servo walls set their speed from the force error;
-6. local (Cundall) damping and leapfrog integration of the disks; walls move;
+5. local (Cundall) damping and leapfrog integration of the disks;
+6. wall resultants, servo walls set their speed from the force error; walls move;
 7. flag a rebuild when needed; every ``check_every`` steps test the stop condition.
 
-Loops over disks and pairs run in ``prange``; each writes only its own slots and
-the sums run in a fixed order, so results do not depend on the number of threads.
+On several threads, 2-3 form one ``prange`` loop and 4-5 another (two thread wake-ups
+per step); each iteration writes only its own slots. On one thread, 2-5 are fused: each
+pair adds its force to both disks as it is computed, summed in the same order as the
+gather (partners j < i, own row, walls). Results do not depend on the number of threads,
+bit for bit.
 """
 
 from __future__ import annotations
@@ -220,6 +221,7 @@ def run_steps(
     target = prm[RATIO_TARGET]
     lim2 = (0.5 * skin) ** 2
     out[STATUS] = RUNNING
+    drift = np.empty(n)  # squared drift of each disk since the last build (parallel path)
     steps = 0
     rebuilds = 0
     for _step in range(nsteps):
@@ -279,22 +281,41 @@ def run_steps(
                         force[i, 0] += -fn * wb_nx[p] - fs * wb_ny[p]
                         force[i, 1] += -fn * wb_ny[p] + fs * wb_nx[p]
                         moment[i] += (radius[i] - 0.5 * wb_ov[p]) * fs
+            # 5. damping and leapfrog integration, with the drift since the last build
+            dmax = 0.0
+            for i in range(n):
+                d2 = _advance(
+                    i,
+                    pos,
+                    vel,
+                    theta,
+                    omega,
+                    force,
+                    moment,
+                    inv_mass,
+                    inv_inertia,
+                    pmode,
+                    damp,
+                    dt,
+                    pos_build,
+                )
+                if d2 > dmax:
+                    dmax = d2
         else:
-            # 2. disk-disk contacts, per pair
+            # 2-3. contact forces per pair, disk-disk then disk-wall rows of each disk
             for i in prange(n):
                 for p in range(nb_start[i], nb_start[i + 1]):
                     _pair_force(
                         i, nb_j[p], p, pos, vel, omega, radius, mass, pkn, pks, pmu, per_body, prm, beta, dt,
                         nb_fs, nb_fn, nb_ov, nb_nx, nb_ny,
                     )  # fmt: skip
-            # 3. disk-wall contacts, per pair
-            for i in prange(n):
                 for p in range(wb_start[i], wb_start[i + 1]):
                     _wall_force(
                         i, wb_w[p], p, pos, vel, omega, radius, mass, pkn, pks, pmu, wp0, wp1, wvel, wkn,
                         wks, wmu, per_body, prm, beta, dt, wb_fs, wb_fn, wb_ov, wb_nx, wb_ny,
                     )  # fmt: skip
-            # 4. gather: partners j < i (reverse list), own row, walls
+            # 4-5. gather (partners j < i, own row, walls), then damping and leapfrog of disk i:
+            # the gather reads only pair data, so moving disk i cannot disturb another's sum
             for i in prange(n):
                 fx = mass[i] * gx
                 fy = mass[i] * gy
@@ -324,8 +345,27 @@ def run_steps(
                 force[i, 0] = fx
                 force[i, 1] = fy
                 moment[i] = mz
+                drift[i] = _advance(
+                    i,
+                    pos,
+                    vel,
+                    theta,
+                    omega,
+                    force,
+                    moment,
+                    inv_mass,
+                    inv_inertia,
+                    pmode,
+                    damp,
+                    dt,
+                    pos_build,
+                )
+            dmax = 0.0
+            for i in range(n):
+                if drift[i] > dmax:
+                    dmax = drift[i]
 
-        # 5. wall resultants (fixed order) and servo speeds
+        # 6. wall resultants (fixed order) and servo speeds; walls move
         for w in range(nw):
             wforce[w, 0] = 0.0
             wforce[w, 1] = 0.0
@@ -358,37 +398,6 @@ def run_steps(
                 wvel[w, 0] = v * wdir[w, 0]
                 wvel[w, 1] = v * wdir[w, 1]
 
-        # 6. damping and leapfrog integration (the serial loop also tracks the displacement)
-        dmax = 0.0
-        if iprm[SERIAL] != 0:
-            for i in range(n):
-                d2 = _advance(
-                    i,
-                    pos,
-                    vel,
-                    theta,
-                    omega,
-                    force,
-                    moment,
-                    inv_mass,
-                    inv_inertia,
-                    pmode,
-                    damp,
-                    dt,
-                    pos_build,
-                )
-                if d2 > dmax:
-                    dmax = d2
-        else:
-            for i in prange(n):
-                _advance(i, pos, vel, theta, omega, force, moment, inv_mass, inv_inertia, pmode, damp, dt,
-                         pos_build)  # fmt: skip
-            for i in range(n):
-                ddx = pos[i, 0] - pos_build[i, 0]
-                ddy = pos[i, 1] - pos_build[i, 1]
-                d2 = ddx * ddx + ddy * ddy
-                if d2 > dmax:
-                    dmax = d2
         for w in range(nw):
             wp0[w, 0] += wvel[w, 0] * dt
             wp0[w, 1] += wvel[w, 1] * dt
