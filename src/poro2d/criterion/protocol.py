@@ -24,8 +24,6 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-import numpy as np
-
 from poro2d.dem import Simulation, checkpoint
 from poro2d.errors import InputError, check_range
 from poro2d.io_utils import provenance, write_csv, write_json
@@ -443,4 +441,3 @@ class PorosityCriterion:
 
 
 __all__ = ["CriterionSettings", "PorosityCriterion", "in_window", "round_to", "wall_forces"]
-_ = np

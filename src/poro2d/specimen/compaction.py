@@ -18,7 +18,6 @@ near the target density once the layers above compact them.
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -238,4 +237,3 @@ def box_porosity(sim: Simulation, width: float, top: float, bottom: float = 0.0)
 
 
 __all__ = ["SpecimenSpec", "box_porosity", "check_feasible", "make_walls", "prepare_specimen"]
-_ = math
