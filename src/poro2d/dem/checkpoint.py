@@ -26,7 +26,7 @@ _PARTICLE_FIELDS = ("pos", "radius", "density", "kn", "ks", "mu", "vel", "theta"
 _WALL_FIELDS = ("p0", "p1", "kn", "ks", "mu", "vel", "mode", "servo_dir", "servo")
 _SIM_ARRAYS = (
     "force", "moment", "wall_force_vec", "_wstat", "_pos_build", "_wall_build",
-    "_nb_start", "_nb_j", "_nb_fs", "_nb_fn", "_nb_ov", "_nb_nx", "_nb_ny", "_rev_start", "_rev_p",
+    "_nb_start", "_nb_j", "_nb_fs", "_nb_fn", "_nb_ov", "_nb_nx", "_nb_ny",
     "_wb_start", "_wb_w", "_wb_fs", "_wb_fn", "_wb_ov", "_wb_nx", "_wb_ny", "_iprm",
 )  # fmt: skip
 
@@ -57,6 +57,7 @@ def save(sim: Simulation, path: str | os.PathLike, extra: dict | None = None) ->
             "density_scale": sim.density_scale,
             "skin": sim.skin,
             "threads": sim.threads,
+            "partitions": sim.partitions,
             "step_count": sim.step_count,
             "time": sim.time,
         },
@@ -110,6 +111,7 @@ def load(path: str | os.PathLike, threads: int | None = None) -> Simulation:
         restitution=s["restitution"], dt=s["fixed_dt"], dt_safety=s["dt_safety"],
         density_scale=s["density_scale"], skin=s["skin"],
         threads=threads if threads is not None else min(s["threads"], _max_threads()),
+        partitions=s.get("partitions", 2),
     )  # fmt: skip
     sim.dt = s["dt"]  # exactly as saved, whatever the rule that produced it
     sim.step_count = s["step_count"]

@@ -3,18 +3,27 @@
 One step, in order (the PFC cycle):
 
 1. rebuild the neighbour lists if flagged (a disk or wall moved more than skin / 2);
-2. disk-disk contact forces (contact law, history update) per pair;
-3. disk-wall contact forces per pair;
-4. gather: each disk sums gravity and its contact forces (the unbalanced force);
-5. local (Cundall) damping and leapfrog integration of the disks;
-6. wall resultants, servo walls set their speed from the force error; walls move;
-7. flag a rebuild when needed; every ``check_every`` steps test the stop condition.
+2. contact forces of every disk-disk and disk-wall pair (contact law, history update);
+3. the unbalanced force of each disk: gravity plus its contact forces;
+4. local (Cundall) damping and leapfrog integration of the disks;
+5. wall resultants, servo walls set their speed from the force error; walls move;
+6. flag a rebuild when needed; every ``check_every`` steps test the stop condition.
 
-On several threads, 2-3 form one ``prange`` loop and 4-5 another (two thread wake-ups
-per step); each iteration writes only its own slots. On one thread, 2-5 are fused: each
-pair adds its force to both disks as it is computed, summed in the same order as the
-gather (partners j < i, own row, walls). Results do not depend on the number of threads,
-bit for bit.
+How the work is laid out (see :mod:`poro2d.dem.partition`): the disks form ``P``
+contiguous partitions. Within a partition 2-4 are one pass over the disks in index
+order: each pair adds its force to both disks as it is computed (partners ``j > i``
+only, so when disk ``i``'s row is done its force is complete and it is advanced at
+once; no later row reads it). A pair whose partner lies in a later partition only
+stores its force; that partner is *deferred* and collects such forces after all
+partitions are done (phase 2). The order of every sum is therefore fixed by the
+partitions: for a disk, gravity, then the pairs of earlier rows of its partition,
+its own row, its walls, then its cross pairs; for a wall, partition by partition.
+
+Threads: one worker per thread runs all steps of the call, each on its own
+partitions; workers meet at two barriers per step (after phase 1, after phase 2;
+a third on rebuild and stop-check steps), not at a thread start-up per loop. With
+one thread the same worker runs alone, without barriers. Results do not depend on
+the number of threads, bit for bit.
 """
 
 from __future__ import annotations
@@ -25,20 +34,33 @@ import numpy as np
 from numba import njit, prange
 
 from poro2d.dem.contact_law import PER_BODY, dashpot, linear_force, segment_closest, series
-from poro2d.dem.neighbors import build_pairs, build_reverse, build_wall_pairs
+from poro2d.dem.neighbors import (
+    cell_grid,
+    copy_rows,
+    count_pair_rows,
+    count_wall_rows,
+    fill_pair_rows,
+    fill_wall_rows,
+    prefix_rows,
+)
+from poro2d.dem.partition import partition
 from poro2d.dem.state import FREE, WALL_SERVO
+from poro2d.dem.sync import STATUS_WORD, atomic_load, atomic_store, barrier, start_handshake
 
 # float parameters (prm)
 DT, GX, GY, DAMP, SKIN, BETA, KN_PP, KS_PP, MU_PP, KN_PW, KS_PW, MU_PW, RATIO_TARGET, TIME = range(14)
 N_PRM = 14
-# integer parameters (iprm)
-MODE, NSTEPS, CHECK_EVERY, NEED_BUILD, SERIAL = range(5)
-N_IPRM = 5
+# integer parameters (iprm): MODE / MODE_PW say whether disk-disk / disk-wall contacts combine
+# the bodies' properties (PER_BODY) or use the constants in prm
+MODE, NSTEPS, CHECK_EVERY, NEED_BUILD, THREADS, MODE_PW = range(6)
+N_IPRM = 6
 # outputs (out)
-STATUS, STEPS_DONE, MAX_RATIO, MEAN_RATIO, NEED_PP, NEED_PW, REBUILDS = range(7)
-N_OUT = 7
+STATUS, STEPS_DONE, MAX_RATIO, MEAN_RATIO, NEED_PP, NEED_PW, REBUILDS, THREADS_USED = range(8)
+N_OUT = 8
 # status codes
 RUNNING, CONVERGED, OVERFLOW, UNSTABLE = 0, 1, 2, 3
+# per-partition wall sums (wpart[k, w, :])
+WFX, WFY, WCOUNT, WKSUM = range(4)
 
 
 @njit(cache=True)
@@ -85,20 +107,13 @@ def unbalanced_ratios(force, pmode, nb_start, nb_fn, nb_fs, nb_ov, wb_start, wb_
 
 
 @njit(inline="always", cache=True)
-def _pair_force(
-    i, j, p, pos, vel, omega, radius, mass, pkn, pks, pmu, per_body, prm, beta, dt,
-    nb_fs, nb_fn, nb_ov, nb_nx, nb_ny,
-):  # fmt: skip
-    """Contact law of disk pair slot p (i < j); stores its state, returns True if touching."""
-    dx = pos[j, 0] - pos[i, 0]
-    dy = pos[j, 1] - pos[i, 1]
-    d = math.sqrt(dx * dx + dy * dy)
-    ov = radius[i] + radius[j] - d
-    nb_ov[p] = ov
-    if ov <= 0.0:
-        nb_fn[p] = 0.0
-        nb_fs[p] = 0.0  # contact lost: history ends
-        return False
+def _pair_law(dx, dy, d, ov, dvx, dvy, ai, aj, wi, wj, fs_old, kn, ks, mu, cn, dt):
+    """One touching disk pair: (fn, fs, nx, ny), unit normal from i towards j.
+
+    dx, dy, d: centre offset j - i and distance; ov > 0 the overlap; dvx, dvy the
+    velocity of j relative to i; ai, aj the lever arms r - ov / 2; wi, wj the spins.
+    Scalars only: helpers that take arrays cost reference counting in the pair loop.
+    """
     if d > 0.0:
         inv = 1.0 / d
         nx = dx * inv
@@ -106,307 +121,355 @@ def _pair_force(
     else:
         nx = 1.0
         ny = 0.0
-    tx = -ny
-    ty = nx
-    dvx = vel[j, 0] - vel[i, 0]
-    dvy = vel[j, 1] - vel[i, 1]
     vn = -(dvx * nx + dvy * ny)
-    vt = dvx * tx + dvy * ty - (radius[i] - 0.5 * ov) * omega[i] - (radius[j] - 0.5 * ov) * omega[j]
-    if per_body:
-        kn = series(pkn[i], pkn[j])
-        ks = series(pks[i], pks[j])
-        mu = min(pmu[i], pmu[j])
-    else:
-        kn = prm[KN_PP]
-        ks = prm[KS_PP]
-        mu = prm[MU_PP]
-    cn = dashpot(beta, kn, mass[i] * mass[j] / (mass[i] + mass[j])) if beta > 0.0 else 0.0
-    fn, fs, _sl = linear_force(ov, vn, vt, nb_fs[p], kn, ks, mu, cn, dt)
-    nb_fn[p] = fn
-    nb_fs[p] = fs
-    nb_nx[p] = nx
-    nb_ny[p] = ny
-    return True
+    vt = dvx * -ny + dvy * nx - ai * wi - aj * wj
+    fn, fs, _sl = linear_force(ov, vn, vt, fs_old, kn, ks, mu, cn, dt)
+    return fn, fs, nx, ny
 
 
 @njit(inline="always", cache=True)
-def _wall_force(
-    i, w, p, pos, vel, omega, radius, mass, pkn, pks, pmu, wp0, wp1, wvel, wkn, wks, wmu, per_body,
-    prm, beta, dt, wb_fs, wb_fn, wb_ov, wb_nx, wb_ny,
-):  # fmt: skip
-    """Contact law of disk-wall slot p; stores its state, returns True if touching."""
-    cx, cy = segment_closest(pos[i, 0], pos[i, 1], wp0[w, 0], wp0[w, 1], wp1[w, 0], wp1[w, 1])
-    dx = cx - pos[i, 0]
-    dy = cy - pos[i, 1]
-    d = math.sqrt(dx * dx + dy * dy)
-    ov = radius[i] - d
-    wb_ov[p] = ov
-    if ov <= 0.0:
-        wb_fn[p] = 0.0
-        wb_fs[p] = 0.0
-        return False
+def _wall_law(dx, dy, d, ov, sx, sy, dvx, dvy, ai, wi, fs_old, kn, ks, mu, cn, dt):
+    """One touching disk-wall pair: (fn, fs, nx, ny), unit normal from the disk to the wall.
+
+    dx, dy, d: closest wall point minus centre and its length; sx, sy the wall's
+    direction (used when the centre lies on the wall); dvx, dvy the wall's velocity
+    relative to the disk.
+    """
     if d > 0.0:
         nx = dx / d
         ny = dy / d
     else:  # centre on the wall line: push along the wall's normal
-        sx = wp1[w, 0] - wp0[w, 0]
-        sy = wp1[w, 1] - wp0[w, 1]
         sl = math.sqrt(sx * sx + sy * sy)
         nx = sy / sl
         ny = -sx / sl
-    tx = -ny
-    ty = nx
-    dvx = wvel[w, 0] - vel[i, 0]
-    dvy = wvel[w, 1] - vel[i, 1]
     vn = -(dvx * nx + dvy * ny)
-    vt = dvx * tx + dvy * ty - (radius[i] - 0.5 * ov) * omega[i]
-    if per_body:
-        kn = series(pkn[i], wkn[w])
-        ks = series(pks[i], wks[w])
-        mu = min(pmu[i], wmu[w])
-    else:
-        kn = prm[KN_PW]
-        ks = prm[KS_PW]
-        mu = prm[MU_PW]
-    cn = dashpot(beta, kn, mass[i]) if beta > 0.0 else 0.0
-    fn, fs, _sl = linear_force(ov, vn, vt, wb_fs[p], kn, ks, mu, cn, dt)
-    wb_fn[p] = fn
-    wb_fs[p] = fs
-    wb_nx[p] = nx
-    wb_ny[p] = ny
-    return True
+    vt = dvx * -ny + dvy * nx - ai * wi
+    fn, fs, _sl = linear_force(ov, vn, vt, fs_old, kn, ks, mu, cn, dt)
+    return fn, fs, nx, ny
 
 
 @njit(inline="always", cache=True)
-def _advance(i, pos, vel, theta, omega, force, moment, inv_mass, inv_inertia, pmode, damp, dt, pos_build):
-    """Local damping and leapfrog update of disk i; returns its squared drift since the last build."""
-    if pmode[i] == FREE:
+def _damped(f, v, damp):
+    """Cundall's local damping of one force or moment component."""
+    return f - damp * abs(f) * np.sign(v)
+
+
+@njit(cache=True)
+def _phase_forces(k, P, W, NB, WB, S, prm, pp_body, pw_body, beta, dt, gx, gy, damp):
+    """Phase 1 on partition k: forces of its rows, advance of its non-deferred disks.
+
+    Returns the largest squared drift of the disks advanced.
+    """
+    pos, vel, theta, omega, force, moment, acc, radius, mass, inv_mass, inv_inertia, pmode, pkn, pks, pmu = P
+    wp0, wp1, wvel, wkn, wks, wmu = W[0], W[1], W[2], W[3], W[4], W[5]
+    wpart = W[12]
+    nb_start, nb_j, nb_fs, nb_fn, nb_ov, nb_nx, nb_ny = NB[:7]
+    wb_start, wb_w, wb_fs, wb_fn, wb_ov, wb_nx, wb_ny = WB[:7]
+    pos_build, part, xstart = S[0], S[1], S[2]
+    nw = wpart.shape[1]
+    for w in range(nw):
+        wpart[k, w, WFX] = 0.0
+        wpart[k, w, WFY] = 0.0
+        wpart[k, w, WCOUNT] = 0.0
+        wpart[k, w, WKSUM] = 0.0
+    kn = prm[KN_PP]
+    ks = prm[KS_PP]
+    mu = prm[MU_PP]
+    i0 = part[k]
+    i1 = part[k + 1]
+    dmax = 0.0
+    for i in range(i0, i1):
+        fx = acc[i, 0]
+        fy = acc[i, 1]
+        mz = acc[i, 2]
+        xi = pos[i, 0]
+        yi = pos[i, 1]
+        ri = radius[i]
+        for p in range(nb_start[i], nb_start[i + 1]):
+            j = nb_j[p]
+            dx = pos[j, 0] - xi
+            dy = pos[j, 1] - yi
+            d = math.sqrt(dx * dx + dy * dy)
+            ov = ri + radius[j] - d
+            nb_ov[p] = ov
+            if ov <= 0.0:
+                nb_fn[p] = 0.0
+                nb_fs[p] = 0.0  # contact lost: history ends
+                continue
+            if pp_body:
+                kn = series(pkn[i], pkn[j])
+                ks = series(pks[i], pks[j])
+                mu = min(pmu[i], pmu[j])
+            cn = dashpot(beta, kn, mass[i] * mass[j] / (mass[i] + mass[j])) if beta > 0.0 else 0.0
+            ai = ri - 0.5 * ov
+            aj = radius[j] - 0.5 * ov
+            fn, fs, nx, ny = _pair_law(
+                dx, dy, d, ov, vel[j, 0] - vel[i, 0], vel[j, 1] - vel[i, 1], ai, aj, omega[i], omega[j],
+                nb_fs[p], kn, ks, mu, cn, dt,
+            )  # fmt: skip
+            nb_fn[p] = fn
+            nb_fs[p] = fs
+            nb_nx[p] = nx
+            nb_ny[p] = ny
+            fxp = -fn * nx - fs * ny
+            fyp = -fn * ny + fs * nx
+            fx += fxp
+            fy += fyp
+            mz += ai * fs
+            if j < i1:  # a partner in a later partition collects this in phase 2
+                acc[j, 0] -= fxp
+                acc[j, 1] -= fyp
+                acc[j, 2] += aj * fs
+        for p in range(wb_start[i], wb_start[i + 1]):
+            w = wb_w[p]
+            cx, cy = segment_closest(xi, yi, wp0[w, 0], wp0[w, 1], wp1[w, 0], wp1[w, 1])
+            dx = cx - xi
+            dy = cy - yi
+            d = math.sqrt(dx * dx + dy * dy)
+            ov = ri - d
+            wb_ov[p] = ov
+            if ov <= 0.0:
+                wb_fn[p] = 0.0
+                wb_fs[p] = 0.0
+                continue
+            if pw_body:
+                wkn_ = series(pkn[i], wkn[w])
+                wks_ = series(pks[i], wks[w])
+                wmu_ = min(pmu[i], wmu[w])
+            else:
+                wkn_ = prm[KN_PW]
+                wks_ = prm[KS_PW]
+                wmu_ = prm[MU_PW]
+            cn = dashpot(beta, wkn_, mass[i]) if beta > 0.0 else 0.0
+            ai = ri - 0.5 * ov
+            fn, fs, nx, ny = _wall_law(
+                dx, dy, d, ov, wp1[w, 0] - wp0[w, 0], wp1[w, 1] - wp0[w, 1], wvel[w, 0] - vel[i, 0],
+                wvel[w, 1] - vel[i, 1], ai, omega[i], wb_fs[p], wkn_, wks_, wmu_, cn, dt,
+            )  # fmt: skip
+            wb_fn[p] = fn
+            wb_fs[p] = fs
+            wb_nx[p] = nx
+            wb_ny[p] = ny
+            fxp = -fn * nx - fs * ny
+            fyp = -fn * ny + fs * nx
+            fx += fxp
+            fy += fyp
+            mz += ai * fs
+            wpart[k, w, WFX] -= fxp
+            wpart[k, w, WFY] -= fyp
+            wpart[k, w, WCOUNT] += 1.0
+            wpart[k, w, WKSUM] += wkn_
+        force[i, 0] = fx
+        force[i, 1] = fy
+        moment[i] = mz
+        if xstart[i + 1] > xstart[i]:
+            continue  # deferred: the partial sums wait in force and moment for phase 2
+        # ready for the next step: the earlier rows of its partition add to this
+        acc[i, 0] = mass[i] * gx
+        acc[i, 1] = mass[i] * gy
+        acc[i, 2] = 0.0
+        if pmode[i] == FREE:
+            vel[i, 0] += _damped(fx, vel[i, 0], damp) * inv_mass[i] * dt
+            vel[i, 1] += _damped(fy, vel[i, 1], damp) * inv_mass[i] * dt
+            omega[i] += _damped(mz, omega[i], damp) * inv_inertia[i] * dt
+        pos[i, 0] += vel[i, 0] * dt
+        pos[i, 1] += vel[i, 1] * dt
+        theta[i] += omega[i] * dt
+        ddx = pos[i, 0] - pos_build[i, 0]
+        ddy = pos[i, 1] - pos_build[i, 1]
+        dmax = max(dmax, ddx * ddx + ddy * ddy)
+    return dmax
+
+
+@njit(cache=True)
+def _phase_deferred(k, P, NB, S, gx, gy, damp, dt):
+    """Phase 2 on partition k: its deferred disks add their cross pairs and advance."""
+    pos, vel, theta, omega, force, moment, acc, radius, mass, inv_mass, inv_inertia, pmode = P[:12]
+    nb_fs, nb_fn, nb_ov, nb_nx, nb_ny = NB[2], NB[3], NB[4], NB[5], NB[6]
+    pos_build, xstart, xpair, dlist, dstart = S[0], S[2], S[3], S[4], S[5]
+    dmax = 0.0
+    for m in range(dstart[k], dstart[k + 1]):
+        i = dlist[m]
         fx = force[i, 0]
         fy = force[i, 1]
         mz = moment[i]
-        if damp > 0.0:
-            fx -= damp * abs(fx) * np.sign(vel[i, 0])
-            fy -= damp * abs(fy) * np.sign(vel[i, 1])
-            mz -= damp * abs(mz) * np.sign(omega[i])
-        vel[i, 0] += fx * inv_mass[i] * dt
-        vel[i, 1] += fy * inv_mass[i] * dt
-        omega[i] += mz * inv_inertia[i] * dt
-    pos[i, 0] += vel[i, 0] * dt
-    pos[i, 1] += vel[i, 1] * dt
-    theta[i] += omega[i] * dt
-    ddx = pos[i, 0] - pos_build[i, 0]
-    ddy = pos[i, 1] - pos_build[i, 1]
-    return ddx * ddx + ddy * ddy
+        for q in range(xstart[i], xstart[i + 1]):
+            p = xpair[q]
+            if nb_ov[p] > 0.0:
+                fn = nb_fn[p]
+                fs = nb_fs[p]
+                fx -= -fn * nb_nx[p] - fs * nb_ny[p]
+                fy -= -fn * nb_ny[p] + fs * nb_nx[p]
+                mz += (radius[i] - 0.5 * nb_ov[p]) * fs
+        force[i, 0] = fx
+        force[i, 1] = fy
+        moment[i] = mz
+        acc[i, 0] = mass[i] * gx
+        acc[i, 1] = mass[i] * gy
+        acc[i, 2] = 0.0
+        if pmode[i] == FREE:
+            vel[i, 0] += _damped(fx, vel[i, 0], damp) * inv_mass[i] * dt
+            vel[i, 1] += _damped(fy, vel[i, 1], damp) * inv_mass[i] * dt
+            omega[i] += _damped(mz, omega[i], damp) * inv_inertia[i] * dt
+        pos[i, 0] += vel[i, 0] * dt
+        pos[i, 1] += vel[i, 1] * dt
+        theta[i] += omega[i] * dt
+        ddx = pos[i, 0] - pos_build[i, 0]
+        ddy = pos[i, 1] - pos_build[i, 1]
+        dmax = max(dmax, ddx * ddx + ddy * ddy)
+    return dmax
 
 
-@njit(parallel=True, cache=True)
-def run_steps(
-    pos, vel, theta, omega, force, moment, radius, mass, inv_mass, inv_inertia, pmode, pkn, pks, pmu,
-    wp0, wp1, wvel, wkn, wks, wmu, wmode, wdir, wservo, wforce, wstat,
-    nb_start, nb_j, nb_fs, nb_fn, nb_ov, nb_nx, nb_ny, rev_start, rev_p, new_start, new_j, new_fs,
-    wb_start, wb_w, wb_fs, wb_fn, wb_ov, wb_nx, wb_ny, wnew_start, wnew_w, wnew_fs,
-    pos_build, wall_build, prm, iprm, out,
-):  # fmt: skip
-    n = pos.shape[0]
+@njit(cache=True)
+def _move_walls(W, prm, dt):
+    """Wall resultants (partition by partition), servo speeds, wall motion."""
+    wp0, wp1, wvel, _kn, _ks, _mu, wmode, wdir, wservo, wforce, wstat, _wb, wpart = W
     nw = wp0.shape[0]
+    for w in range(nw):
+        wforce[w, 0] = 0.0
+        wforce[w, 1] = 0.0
+        wstat[w, 0] = 0.0
+        wstat[w, 1] = 0.0
+        for k in range(wpart.shape[0]):
+            wforce[w, 0] += wpart[k, w, WFX]
+            wforce[w, 1] += wpart[k, w, WFY]
+            wstat[w, 0] += wpart[k, w, WCOUNT]
+            wstat[w, 1] += wpart[k, w, WKSUM]
+        if wmode[w] == WALL_SERVO:
+            # compressive force along the servo direction; v = gain * error / (k dt)
+            fc = -(wforce[w, 0] * wdir[w, 0] + wforce[w, 1] * wdir[w, 1])
+            err = wservo[w, 0] - fc
+            vmax = wservo[w, 2]
+            if wstat[w, 0] > 0.0:
+                v = wservo[w, 1] * err / (wstat[w, 1] * dt)
+            else:  # nothing touches: approach (or retreat) at full speed
+                v = vmax if err > 0.0 else -vmax
+            if v > vmax:
+                v = vmax
+            elif v < -vmax:
+                v = -vmax
+            wvel[w, 0] = v * wdir[w, 0]
+            wvel[w, 1] = v * wdir[w, 1]
+    for w in range(nw):
+        wp0[w, 0] += wvel[w, 0] * dt
+        wp0[w, 1] += wvel[w, 1] * dt
+        wp1[w, 0] += wvel[w, 0] * dt
+        wp1[w, 1] += wvel[w, 1] * dt
+
+
+@njit(cache=True)
+def _rebuild(t, nthr, P, W, NB, WB, S, prm, out):
+    """All workers rebuild the lists together; thread 0 does the serial parts.
+
+    Returns False (on every worker) when the pair storage is too small.
+    """
+    pos, radius = P[0], P[7]
+    wp0, wp1, wall_build = W[0], W[1], W[11]
+    nb_start, nb_j, nb_fs, _fn, _ov, _nx, _ny, new_start, new_j, new_fs = NB
+    wb_start, wb_w, wb_fs, _wfn, _wov, _wnx, _wny, wnew_start, wnew_w, wnew_fs = WB
+    pos_build, part, xstart, xpair, dlist, dstart, _tmax, sync = S[:8]
+    cell, members, cstart, cfill, ginfo = S[8:13]
+    skin = prm[SKIN]
+    n = pos.shape[0]
+    lo = t * n // nthr
+    hi = (t + 1) * n // nthr
+    if t == 0:
+        cell_grid(pos, radius, skin, cell, members, cstart, cfill, ginfo)
+    barrier(sync, nthr)
+    count_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, new_start)
+    count_wall_rows(lo, hi, pos, radius, skin, wp0, wp1, wnew_start)
+    barrier(sync, nthr)
+    if t == 0:
+        total = prefix_rows(n, new_start)
+        wtotal = prefix_rows(n, wnew_start)
+        status = RUNNING
+        if total > nb_j.shape[0]:
+            out[NEED_PP] = total
+            status = OVERFLOW
+        if wtotal > wb_w.shape[0]:
+            out[NEED_PW] = wtotal
+            status = OVERFLOW
+        atomic_store(sync, STATUS_WORD, status)
+    barrier(sync, nthr)
+    if atomic_load(sync, STATUS_WORD) != RUNNING:
+        return False
+    fill_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, nb_start, nb_j, nb_fs,
+                   new_start, new_j, new_fs)  # fmt: skip
+    fill_wall_rows(lo, hi, pos, radius, skin, wp0, wp1, wb_start, wb_w, wb_fs, wnew_start, wnew_w, wnew_fs)
+    barrier(sync, nthr)  # the old rows are read by every filler: overwrite them only now
+    copy_rows(lo, hi, new_start, new_j, new_fs, nb_start, nb_j, nb_fs)
+    copy_rows(lo, hi, wnew_start, wnew_w, wnew_fs, wb_start, wb_w, wb_fs)
+    for i in range(lo, hi):
+        pos_build[i, 0] = pos[i, 0]
+        pos_build[i, 1] = pos[i, 1]
+    if t == 0:
+        for w in range(wp0.shape[0]):
+            wall_build[w, 0] = wp0[w, 0]
+            wall_build[w, 1] = wp0[w, 1]
+    barrier(sync, nthr)
+    if t == 0:
+        partition(n, nb_start, nb_j, wb_start, part, xstart, xpair, dlist, dstart)
+    barrier(sync, nthr)
+    return True
+
+
+@njit(cache=True)
+def _worker(t, nthr, P, W, NB, WB, S, prm, iprm, out):
+    """Run the steps of this call on thread t of nthr (partitions t*P/nthr ... (t+1)*P/nthr - 1)."""
+    pos, force, pmode = P[0], P[4], P[11]
+    wp0, wall_build = W[0], W[11]
+    nb_start, nb_fn, nb_fs, nb_ov = NB[0], NB[3], NB[2], NB[4]
+    wb_start, wb_fn, wb_fs, wb_ov = WB[0], WB[3], WB[2], WB[4]
+    part, tmax, sync = S[1], S[6], S[7]
     dt = prm[DT]
     gx = prm[GX]
     gy = prm[GY]
     damp = prm[DAMP]
-    skin = prm[SKIN]
     beta = prm[BETA]
-    per_body = iprm[MODE] == PER_BODY
+    target = prm[RATIO_TARGET]
+    lim2 = (0.5 * prm[SKIN]) ** 2
+    pp_body = iprm[MODE] == PER_BODY
+    pw_body = iprm[MODE_PW] == PER_BODY
     nsteps = iprm[NSTEPS]
     check_every = iprm[CHECK_EVERY]
-    target = prm[RATIO_TARGET]
-    lim2 = (0.5 * skin) ** 2
-    out[STATUS] = RUNNING
-    drift = np.empty(n)  # squared drift of each disk since the last build (parallel path)
+    need_build = iprm[NEED_BUILD] != 0
+    npart = part.shape[0] - 1
+    k0 = t * npart // nthr
+    k1 = (t + 1) * npart // nthr
+    nw = wp0.shape[0]
     steps = 0
     rebuilds = 0
+    status = RUNNING
     for _step in range(nsteps):
-        # 1. neighbour lists
-        if iprm[NEED_BUILD] != 0:
-            got = build_pairs(pos, radius, skin, nb_start, nb_j, nb_fs, new_start, new_j, new_fs)
-            if got < 0:
-                out[NEED_PP] = -got
-                out[STATUS] = OVERFLOW
+        if need_build:
+            if not _rebuild(t, nthr, P, W, NB, WB, S, prm, out):
+                status = OVERFLOW
                 break
-            got = build_wall_pairs(
-                pos, radius, skin, wp0, wp1, wb_start, wb_w, wb_fs, wnew_start, wnew_w, wnew_fs
-            )
-            if got < 0:
-                out[NEED_PW] = -got
-                out[STATUS] = OVERFLOW
-                break
-            build_reverse(n, nb_start, nb_j, rev_start, rev_p)
-            pos_build[:, :] = pos
-            wall_build[:, :] = wp0
-            iprm[NEED_BUILD] = 0
+            need_build = False
             rebuilds += 1
-
-        if iprm[SERIAL] != 0:
-            # 2-4 fused for one thread: each pair adds its force to both disks as it is
-            # computed, in the same order as the gather below (partners j < i, own row,
-            # walls), so one and two threads give the same numbers bit for bit.
-            for i in range(n):
-                force[i, 0] = mass[i] * gx
-                force[i, 1] = mass[i] * gy
-                moment[i] = 0.0
-            for i in range(n):
-                for p in range(nb_start[i], nb_start[i + 1]):
-                    j = nb_j[p]
-                    if _pair_force(
-                        i, j, p, pos, vel, omega, radius, mass, pkn, pks, pmu, per_body, prm, beta, dt,
-                        nb_fs, nb_fn, nb_ov, nb_nx, nb_ny,
-                    ):  # fmt: skip
-                        fn = nb_fn[p]
-                        fs = nb_fs[p]
-                        fxp = -fn * nb_nx[p] - fs * nb_ny[p]
-                        fyp = -fn * nb_ny[p] + fs * nb_nx[p]
-                        force[i, 0] += fxp
-                        force[i, 1] += fyp
-                        moment[i] += (radius[i] - 0.5 * nb_ov[p]) * fs
-                        force[j, 0] -= fxp
-                        force[j, 1] -= fyp
-                        moment[j] += (radius[j] - 0.5 * nb_ov[p]) * fs
-            for i in range(n):
-                for p in range(wb_start[i], wb_start[i + 1]):
-                    if _wall_force(
-                        i, wb_w[p], p, pos, vel, omega, radius, mass, pkn, pks, pmu, wp0, wp1, wvel, wkn,
-                        wks, wmu, per_body, prm, beta, dt, wb_fs, wb_fn, wb_ov, wb_nx, wb_ny,
-                    ):  # fmt: skip
-                        fn = wb_fn[p]
-                        fs = wb_fs[p]
-                        force[i, 0] += -fn * wb_nx[p] - fs * wb_ny[p]
-                        force[i, 1] += -fn * wb_ny[p] + fs * wb_nx[p]
-                        moment[i] += (radius[i] - 0.5 * wb_ov[p]) * fs
-            # 5. damping and leapfrog integration, with the drift since the last build
-            dmax = 0.0
-            for i in range(n):
-                d2 = _advance(
-                    i,
-                    pos,
-                    vel,
-                    theta,
-                    omega,
-                    force,
-                    moment,
-                    inv_mass,
-                    inv_inertia,
-                    pmode,
-                    damp,
-                    dt,
-                    pos_build,
-                )
-                if d2 > dmax:
-                    dmax = d2
-        else:
-            # 2-3. contact forces per pair, disk-disk then disk-wall rows of each disk
-            for i in prange(n):
-                for p in range(nb_start[i], nb_start[i + 1]):
-                    _pair_force(
-                        i, nb_j[p], p, pos, vel, omega, radius, mass, pkn, pks, pmu, per_body, prm, beta, dt,
-                        nb_fs, nb_fn, nb_ov, nb_nx, nb_ny,
-                    )  # fmt: skip
-                for p in range(wb_start[i], wb_start[i + 1]):
-                    _wall_force(
-                        i, wb_w[p], p, pos, vel, omega, radius, mass, pkn, pks, pmu, wp0, wp1, wvel, wkn,
-                        wks, wmu, per_body, prm, beta, dt, wb_fs, wb_fn, wb_ov, wb_nx, wb_ny,
-                    )  # fmt: skip
-            # 4-5. gather (partners j < i, own row, walls), then damping and leapfrog of disk i:
-            # the gather reads only pair data, so moving disk i cannot disturb another's sum
-            for i in prange(n):
-                fx = mass[i] * gx
-                fy = mass[i] * gy
-                mz = 0.0
-                for q in range(rev_start[i], rev_start[i + 1]):
-                    p = rev_p[q]
-                    if nb_ov[p] > 0.0:
-                        fn = nb_fn[p]
-                        fs = nb_fs[p]
-                        fx -= -fn * nb_nx[p] - fs * nb_ny[p]
-                        fy -= -fn * nb_ny[p] + fs * nb_nx[p]
-                        mz += (radius[i] - 0.5 * nb_ov[p]) * fs
-                for p in range(nb_start[i], nb_start[i + 1]):
-                    if nb_ov[p] > 0.0:
-                        fn = nb_fn[p]
-                        fs = nb_fs[p]
-                        fx += -fn * nb_nx[p] - fs * nb_ny[p]
-                        fy += -fn * nb_ny[p] + fs * nb_nx[p]
-                        mz += (radius[i] - 0.5 * nb_ov[p]) * fs
-                for p in range(wb_start[i], wb_start[i + 1]):
-                    if wb_ov[p] > 0.0:
-                        fn = wb_fn[p]
-                        fs = wb_fs[p]
-                        fx += -fn * wb_nx[p] - fs * wb_ny[p]
-                        fy += -fn * wb_ny[p] + fs * wb_nx[p]
-                        mz += (radius[i] - 0.5 * wb_ov[p]) * fs
-                force[i, 0] = fx
-                force[i, 1] = fy
-                moment[i] = mz
-                drift[i] = _advance(
-                    i,
-                    pos,
-                    vel,
-                    theta,
-                    omega,
-                    force,
-                    moment,
-                    inv_mass,
-                    inv_inertia,
-                    pmode,
-                    damp,
-                    dt,
-                    pos_build,
-                )
-            dmax = 0.0
-            for i in range(n):
-                if drift[i] > dmax:
-                    dmax = drift[i]
-
-        # 6. wall resultants (fixed order) and servo speeds; walls move
-        for w in range(nw):
-            wforce[w, 0] = 0.0
-            wforce[w, 1] = 0.0
-            wstat[w, 0] = 0.0
-            wstat[w, 1] = 0.0
-        for i in range(n):
-            for p in range(wb_start[i], wb_start[i + 1]):
-                if wb_ov[p] > 0.0:
-                    w = wb_w[p]
-                    fn = wb_fn[p]
-                    fs = wb_fs[p]
-                    wforce[w, 0] -= -fn * wb_nx[p] - fs * wb_ny[p]
-                    wforce[w, 1] -= -fn * wb_ny[p] + fs * wb_nx[p]
-                    wstat[w, 0] += 1.0
-                    wstat[w, 1] += series(pkn[i], wkn[w]) if per_body else prm[KN_PW]
-        for w in range(nw):
-            if wmode[w] == WALL_SERVO:
-                # compressive force along the servo direction; v = gain * error / (k dt)
-                fc = -(wforce[w, 0] * wdir[w, 0] + wforce[w, 1] * wdir[w, 1])
-                err = wservo[w, 0] - fc
-                vmax = wservo[w, 2]
-                if wstat[w, 0] > 0.0:
-                    v = wservo[w, 1] * err / (wstat[w, 1] * dt)
-                else:  # nothing touches: approach (or retreat) at full speed
-                    v = vmax if err > 0.0 else -vmax
-                if v > vmax:
-                    v = vmax
-                elif v < -vmax:
-                    v = -vmax
-                wvel[w, 0] = v * wdir[w, 0]
-                wvel[w, 1] = v * wdir[w, 1]
-
-        for w in range(nw):
-            wp0[w, 0] += wvel[w, 0] * dt
-            wp0[w, 1] += wvel[w, 1] * dt
-            wp1[w, 0] += wvel[w, 0] * dt
-            wp1[w, 1] += wvel[w, 1] * dt
-        prm[TIME] += dt
+        # phase 1: forces; disks without cross pairs advance at once
+        dmax = 0.0
+        for k in range(k0, k1):
+            d2 = _phase_forces(k, P, W, NB, WB, S, prm, pp_body, pw_body, beta, dt, gx, gy, damp)
+            if d2 > dmax:
+                dmax = d2
+        barrier(sync, nthr)
+        # phase 2: deferred disks; thread 0 also moves the walls
+        for k in range(k0, k1):
+            d2 = _phase_deferred(k, P, NB, S, gx, gy, damp, dt)
+            if d2 > dmax:
+                dmax = d2
+        tmax[t] = dmax
+        if t == 0:
+            _move_walls(W, prm, dt)
+            prm[TIME] += dt
+        barrier(sync, nthr)
         steps += 1
-
-        # 7. rebuild flag and stop check
+        # every worker takes the same decisions from the same shared numbers
+        dmax = 0.0
+        for u in range(nthr):
+            if tmax[u] > dmax:
+                dmax = tmax[u]
         for w in range(nw):
             ddx = wp0[w, 0] - wall_build[w, 0]
             ddy = wp0[w, 1] - wall_build[w, 1]
@@ -414,21 +477,73 @@ def run_steps(
             if d2 > dmax:
                 dmax = d2
         if dmax > lim2:
-            iprm[NEED_BUILD] = 1
+            need_build = True
         if check_every > 0 and steps % check_every == 0:
             if not math.isfinite(dmax):
-                out[STATUS] = UNSTABLE
+                status = UNSTABLE
                 break
             if target > 0.0:
-                rmax, rmean = unbalanced_ratios(
-                    force, pmode, nb_start, nb_fn, nb_fs, nb_ov, wb_start, wb_fn, wb_fs, wb_ov
-                )
-                out[MAX_RATIO] = rmax
-                out[MEAN_RATIO] = rmean
-                if rmax < target:
-                    out[STATUS] = CONVERGED
+                if t == 0:
+                    rmax, rmean = unbalanced_ratios(
+                        force, pmode, nb_start, nb_fn, nb_fs, nb_ov, wb_start, wb_fn, wb_fs, wb_ov
+                    )
+                    out[MAX_RATIO] = rmax
+                    out[MEAN_RATIO] = rmean
+                    atomic_store(sync, STATUS_WORD, CONVERGED if rmax < target else RUNNING)
+                barrier(sync, nthr)  # nobody may change the forces before they are read
+                if atomic_load(sync, STATUS_WORD) == CONVERGED:
+                    status = CONVERGED
                     break
-    out[STEPS_DONE] = steps
-    out[REBUILDS] = rebuilds
-    if out[STATUS] == RUNNING and not math.isfinite(pos.sum()):
-        out[STATUS] = UNSTABLE
+    if t == 0:
+        out[STATUS] = status
+        out[STEPS_DONE] = steps
+        out[REBUILDS] = rebuilds
+        iprm[NEED_BUILD] = 1 if need_build else 0
+        if status == RUNNING and not math.isfinite(pos.sum()):
+            out[STATUS] = UNSTABLE
+
+
+@njit(cache=True)
+def prepare(P, NB, WB, S, prm):
+    """Before a call: gravity in every accumulator, partitions of the current lists."""
+    pos, acc, mass = P[0], P[6], P[8]
+    n = pos.shape[0]
+    for i in range(n):
+        acc[i, 0] = mass[i] * prm[GX]
+        acc[i, 1] = mass[i] * prm[GY]
+        acc[i, 2] = 0.0
+    part, xstart, xpair, dlist, dstart = S[1], S[2], S[3], S[4], S[5]
+    partition(n, NB[0], NB[1], WB[0], part, xstart, xpair, dlist, dstart)
+
+
+@njit(parallel=True, cache=True)
+def _run_threads(nthr, P, W, NB, WB, S, prm, iprm, out):
+    ok = np.zeros(nthr, dtype=np.int64)
+    for t in prange(nthr):
+        if start_handshake(S[7], nthr):
+            ok[t] = 1
+            _worker(t, nthr, P, W, NB, WB, S, prm, iprm, out)
+    return ok.sum() == nthr
+
+
+@njit(cache=True)
+def run_serial(P, W, NB, WB, S, prm, iprm, out):
+    prepare(P, NB, WB, S, prm)
+    _worker(0, 1, P, W, NB, WB, S, prm, iprm, out)
+    out[THREADS_USED] = 1
+
+
+def run_steps(P, W, NB, WB, S, prm, iprm, out) -> None:
+    """Advance up to ``iprm[NSTEPS]`` steps on ``iprm[THREADS]`` threads (see module doc)."""
+    nthr = int(min(iprm[THREADS], S[1].shape[0] - 1))
+    if nthr <= 1:
+        run_serial(P, W, NB, WB, S, prm, iprm, out)
+        return
+    prepare(P, NB, WB, S, prm)
+    S[7][:] = 0
+    if _run_threads(nthr, P, W, NB, WB, S, prm, iprm, out):
+        out[THREADS_USED] = nthr
+    else:  # the threading layer ran the workers one after the other: go on alone
+        S[7][:] = 0
+        _worker(0, 1, P, W, NB, WB, S, prm, iprm, out)
+        out[THREADS_USED] = 1

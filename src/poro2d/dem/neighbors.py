@@ -9,20 +9,49 @@ On a rebuild the shear-force history of every pair that survives is copied
 across by matching ``(i, j)`` in the old row of ``i``. The capacity of the pair
 arrays is fixed by the caller: when it is too small the build reports how much
 it needs and changes nothing, so the caller can grow the arrays and retry.
-Every loop writes to its own row, so the result does not depend on threads.
+
+A build is a sequence of phases (grid, count rows, prefix sums, fill rows, copy
+back). The phases over rows take a disk range ``[lo, hi)`` and write only their own
+rows, so the engine's workers run them side by side between barriers
+(:func:`poro2d.dem.kernels.run_steps`); :func:`build_pairs` and
+:func:`build_wall_pairs` run them one after the other. Either way the lists are the
+same, slot for slot.
+
+Scratch storage (all preallocated by the caller, see :func:`grid_scratch`):
+``cell`` and ``members`` (n), ``cstart`` and ``cfill`` (:func:`max_cells` + 1) and
+``ginfo`` (int64, the grid's cell counts).
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from poro2d.dem.contact_law import segment_closest
 
 
+def max_cells(n: int) -> int:
+    """Most cells the grid may use for ``n`` disks (a runaway disk cannot make it huge)."""
+    return 4 * n + 16
+
+
+def grid_scratch(n: int) -> tuple[np.ndarray, ...]:
+    """(cell, members, cstart, cfill, ginfo) for ``n`` disks."""
+    nc = max_cells(n) + 1
+    i8 = np.int64
+    return np.zeros(n, i8), np.zeros(n, i8), np.zeros(nc, i8), np.zeros(nc, i8), np.zeros(4, i8)
+
+
 @njit(cache=True)
-def _cell_grid(pos, radius, skin):
+def cell_grid(pos, radius, skin, cell, members, cstart, cfill, ginfo):
+    """Bin the disks into square cells of side 2 r_max + skin (members in index order)."""
     n = pos.shape[0]
+    if n == 0:
+        ginfo[0] = 1
+        ginfo[1] = 1
+        cstart[0] = 0
+        cstart[1] = 0
+        return
     xmin = pos[0, 0]
     xmax = pos[0, 0]
     ymin = pos[0, 1]
@@ -47,8 +76,9 @@ def _cell_grid(pos, radius, skin):
         size *= 1.5
     ncx = int((xmax - xmin) / size) + 1
     ncy = int((ymax - ymin) / size) + 1
-    cell = np.empty(n, dtype=np.int64)
-    count = np.zeros(ncx * ncy + 1, dtype=np.int64)
+    ncell = ncx * ncy
+    for c in range(ncell + 1):
+        cstart[c] = 0
     for i in range(n):
         cx = int((pos[i, 0] - xmin) / size)
         cy = int((pos[i, 1] - ymin) / size)
@@ -58,21 +88,21 @@ def _cell_grid(pos, radius, skin):
             cy = ncy - 1
         c = cy * ncx + cx
         cell[i] = c
-        count[c + 1] += 1
-    for c in range(ncx * ncy):
-        count[c + 1] += count[c]
-    start = count.copy()
-    members = np.empty(n, dtype=np.int64)
-    fill = count[:-1].copy()
+        cstart[c + 1] += 1
+    for c in range(ncell):
+        cstart[c + 1] += cstart[c]
+    for c in range(ncell):
+        cfill[c] = cstart[c]
     for i in range(n):  # stable: members of a cell stay in index order
         c = cell[i]
-        members[fill[c]] = i
-        fill[c] += 1
-    return cell, start, members, ncx, ncy
+        members[cfill[c]] = i
+        cfill[c] += 1
+    ginfo[0] = ncx
+    ginfo[1] = ncy
 
 
 @njit(inline="always", cache=True)
-def _scan_row(i, pos, radius, skin, cell, start, members, ncx, ncy, out_j, k0, write):
+def _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, out_j, k0, write):
     """Count (or write from k0) the partners j > i of disk i; returns the count."""
     c = cell[i]
     cx = c % ncx
@@ -84,7 +114,7 @@ def _scan_row(i, pos, radius, skin, cell, start, members, ncx, ncy, out_j, k0, w
     for ny_ in range(max(cy - 1, 0), min(cy + 2, ncy)):
         for nx_ in range(max(cx - 1, 0), min(cx + 2, ncx)):
             cc = ny_ * ncx + nx_
-            for m in range(start[cc], start[cc + 1]):
+            for m in range(cstart[cc], cstart[cc + 1]):
                 j = members[m]
                 if j <= i:
                     continue
@@ -98,31 +128,57 @@ def _scan_row(i, pos, radius, skin, cell, start, members, ncx, ncy, out_j, k0, w
     return k
 
 
-@njit(parallel=True, cache=True)
-def build_pairs(pos, radius, skin, nb_start, nb_j, nb_fs, new_start, new_j, new_fs):
-    """Rebuild the disk-disk half list in place, keeping shear history.
+@njit(inline="always", cache=True)
+def _near_wall(px, py, reach, wp0, wp1, w):
+    cx, cy = segment_closest(px, py, wp0[w, 0], wp0[w, 1], wp1[w, 0], wp1[w, 1])
+    dx = px - cx
+    dy = py - cy
+    return dx * dx + dy * dy < reach * reach
 
-    Returns the number of pairs, or ``-needed`` when the capacity is too small
-    (nothing is changed then).
-    """
-    n = pos.shape[0]
-    cap = nb_j.shape[0]
-    if n == 0:
-        nb_start[:] = 0
-        return 0
-    cell, start, members, ncx, ncy = _cell_grid(pos, radius, skin)
-    counts = np.empty(n, dtype=np.int64)
-    for i in prange(n):
-        counts[i] = _scan_row(i, pos, radius, skin, cell, start, members, ncx, ncy, new_j, 0, False)
-    new_start[0] = 0
+
+@njit(cache=True)
+def count_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, new_start):
+    """Candidate partners of rows lo..hi-1 into ``new_start[i + 1]``."""
+    ncx = ginfo[0]
+    ncy = ginfo[1]
+    for i in range(lo, hi):
+        new_start[i + 1] = _scan_row(
+            i, pos, radius, skin, cell, members, cstart, ncx, ncy, new_start, 0, False
+        )
+
+
+@njit(cache=True)
+def count_wall_rows(lo, hi, pos, radius, skin, wp0, wp1, wnew_start):
+    """Candidate walls of disks lo..hi-1 into ``wnew_start[i + 1]``."""
+    nw = wp0.shape[0]
+    for i in range(lo, hi):
+        c = 0
+        reach = radius[i] + skin
+        for w in range(nw):
+            if _near_wall(pos[i, 0], pos[i, 1], reach, wp0, wp1, w):
+                c += 1
+        wnew_start[i + 1] = c
+
+
+@njit(cache=True)
+def prefix_rows(n, start):
+    """Row counts in ``start[1:]`` to CSR offsets; returns the total."""
+    start[0] = 0
     for i in range(n):
-        new_start[i + 1] = new_start[i] + counts[i]
-    total = new_start[n]
-    if total > cap:
-        return -total
-    for i in prange(n):
+        start[i + 1] += start[i]
+    return start[n]
+
+
+@njit(cache=True)
+def fill_pair_rows(
+    lo, hi, pos, radius, skin, cell, members, cstart, ginfo, nb_start, nb_j, nb_fs, new_start, new_j, new_fs
+):
+    """Write rows lo..hi-1 of the new disk-disk list, each pair with its old shear force (or 0)."""
+    ncx = ginfo[0]
+    ncy = ginfo[1]
+    for i in range(lo, hi):
         k0 = new_start[i]
-        _scan_row(i, pos, radius, skin, cell, start, members, ncx, ncy, new_j, k0, True)
+        _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, new_j, k0, True)
         o0 = nb_start[i]
         o1 = nb_start[i + 1]
         for k in range(k0, new_start[i + 1]):
@@ -133,83 +189,80 @@ def build_pairs(pos, radius, skin, nb_start, nb_j, nb_fs, new_start, new_j, new_
                     h = nb_fs[o]
                     break
             new_fs[k] = h
-    for i in prange(n + 1):
-        nb_start[i] = new_start[i]
-    for k in prange(total):
+
+
+@njit(cache=True)
+def fill_wall_rows(lo, hi, pos, radius, skin, wp0, wp1, wb_start, wb_w, wb_fs, wnew_start, wnew_w, wnew_fs):
+    """Write rows lo..hi-1 of the new disk-wall list, with the old shear forces."""
+    nw = wp0.shape[0]
+    for i in range(lo, hi):
+        k = wnew_start[i]
+        reach = radius[i] + skin
+        o0 = wb_start[i]
+        o1 = wb_start[i + 1]
+        for w in range(nw):
+            if _near_wall(pos[i, 0], pos[i, 1], reach, wp0, wp1, w):
+                wnew_w[k] = w
+                h = 0.0
+                for o in range(o0, o1):
+                    if wb_w[o] == w:
+                        h = wb_fs[o]
+                        break
+                wnew_fs[k] = h
+                k += 1
+
+
+@njit(cache=True)
+def copy_rows(lo, hi, new_start, new_j, new_fs, nb_start, nb_j, nb_fs):
+    """Make rows lo..hi-1 of a new list the current one (once every row is filled)."""
+    for k in range(new_start[lo], new_start[hi]):
         nb_j[k] = new_j[k]
         nb_fs[k] = new_fs[k]
+    for i in range(lo, hi):
+        nb_start[i + 1] = new_start[i + 1]
+    if lo == 0:
+        nb_start[0] = 0
+
+
+@njit(cache=True)
+def build_pairs(pos, radius, skin, nb_start, nb_j, nb_fs, new_start, new_j, new_fs):
+    """Rebuild the disk-disk half list in place, keeping shear history.
+
+    Returns the number of pairs, or ``-needed`` when the capacity is too small
+    (nothing is changed then).
+    """
+    n = pos.shape[0]
+    nc = 4 * n + 17
+    cell = np.empty(n, dtype=np.int64)
+    members = np.empty(n, dtype=np.int64)
+    cstart = np.empty(nc, dtype=np.int64)
+    cfill = np.empty(nc, dtype=np.int64)
+    ginfo = np.zeros(4, dtype=np.int64)
+    cell_grid(pos, radius, skin, cell, members, cstart, cfill, ginfo)
+    count_pair_rows(0, n, pos, radius, skin, cell, members, cstart, ginfo, new_start)
+    total = prefix_rows(n, new_start)
+    if total > nb_j.shape[0]:
+        return -total
+    fill_pair_rows(
+        0, n, pos, radius, skin, cell, members, cstart, ginfo, nb_start, nb_j, nb_fs, new_start, new_j, new_fs
+    )
+    copy_rows(0, n, new_start, new_j, new_fs, nb_start, nb_j, nb_fs)
     return total
 
 
 @njit(cache=True)
-def build_reverse(n, nb_start, nb_j, rev_start, rev_p):
-    """For each disk j, the pair indices p in which it is the second member."""
-    total = nb_start[n]
-    for j in range(n + 1):
-        rev_start[j] = 0
-    for p in range(total):
-        rev_start[nb_j[p] + 1] += 1
-    for j in range(n):
-        rev_start[j + 1] += rev_start[j]
-    fill = rev_start[:n].copy()
-    for i in range(n):  # ascending p per j: deterministic gather order
-        for p in range(nb_start[i], nb_start[i + 1]):
-            j = nb_j[p]
-            rev_p[fill[j]] = p
-            fill[j] += 1
-
-
-@njit(inline="always", cache=True)
-def _near_wall(px, py, reach, a, b):
-    cx, cy = segment_closest(px, py, a[0], a[1], b[0], b[1])
-    dx = px - cx
-    dy = py - cy
-    return dx * dx + dy * dy < reach * reach
-
-
-@njit(parallel=True, cache=True)
 def build_wall_pairs(pos, radius, skin, wp0, wp1, wb_start, wb_w, wb_fs, new_start, new_w, new_fs):
     """Rebuild the disk-wall candidate list in place, keeping shear history.
 
     Returns the number of pairs or ``-needed`` when the capacity is too small.
     """
     n = pos.shape[0]
-    nw = wp0.shape[0]
-    cap = wb_w.shape[0]
-    counts = np.zeros(n, dtype=np.int64)
-    for i in prange(n):
-        c = 0
-        reach = radius[i] + skin
-        for w in range(nw):
-            if _near_wall(pos[i, 0], pos[i, 1], reach, wp0[w], wp1[w]):
-                c += 1
-        counts[i] = c
-    new_start[0] = 0
-    for i in range(n):
-        new_start[i + 1] = new_start[i] + counts[i]
-    total = new_start[n]
-    if total > cap:
+    count_wall_rows(0, n, pos, radius, skin, wp0, wp1, new_start)
+    total = prefix_rows(n, new_start)
+    if total > wb_w.shape[0]:
         return -total
-    for i in prange(n):
-        k = new_start[i]
-        reach = radius[i] + skin
-        o0 = wb_start[i]
-        o1 = wb_start[i + 1]
-        for w in range(nw):
-            if _near_wall(pos[i, 0], pos[i, 1], reach, wp0[w], wp1[w]):
-                new_w[k] = w
-                h = 0.0
-                for o in range(o0, o1):
-                    if wb_w[o] == w:
-                        h = wb_fs[o]
-                        break
-                new_fs[k] = h
-                k += 1
-    for i in prange(n + 1):
-        wb_start[i] = new_start[i]
-    for k in prange(total):
-        wb_w[k] = new_w[k]
-        wb_fs[k] = new_fs[k]
+    fill_wall_rows(0, n, pos, radius, skin, wp0, wp1, wb_start, wb_w, wb_fs, new_start, new_w, new_fs)
+    copy_rows(0, n, new_start, new_w, new_fs, wb_start, wb_w, wb_fs)
     return total
 
 

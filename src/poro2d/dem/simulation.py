@@ -95,13 +95,18 @@ class Simulation:
     skin
         Verlet skin (m); default 0.2 x the mean radius.
     threads
-        Threads for the compiled loops (results do not depend on it). Below
-        ``parallel_min_particles`` disks (5000 by default) the loop runs on one
-        thread anyway: waking threads for every short step costs more than it
-        saves, and on a busy machine far more.
+        Threads for the compiled loop, at most ``partitions`` of them (results do not
+        depend on it). Below ``parallel_min_particles`` disks (1000 by default) the
+        loop runs on one thread anyway: two thread meetings per step cost more than
+        a step of a few hundred disks.
+    partitions
+        Contiguous ranges of disks that fix the order of every force sum
+        (:mod:`poro2d.dem.partition`); each is worked on by one thread. Results are
+        identical, bit for bit, for any number of threads up to ``partitions``;
+        another ``partitions`` changes the round-off. Default 2.
     """
 
-    parallel_min_particles = 5000
+    parallel_min_particles = 1000
 
     def __init__(
         self,
@@ -116,6 +121,7 @@ class Simulation:
         density_scale: float = 1.0,
         skin: float | None = None,
         threads: int = 1,
+        partitions: int = 2,
     ) -> None:
         _prefer_openmp()
         self.particles = particles
@@ -140,7 +146,11 @@ class Simulation:
         if skin is not None and not skin > 0.0:
             raise InputError("skin", skin, "(0, inf) m")
         self._skin = skin
+        if not (isinstance(partitions, (int, np.integer)) and 1 <= partitions <= 256):
+            raise InputError("partitions", partitions, "an integer in [1, 256]")
+        self.partitions = int(partitions)
         self.threads = self._check_threads(threads)
+        self.threads_used = 1
         self.step_count = 0
         self.time = 0.0
         self._n_alloc = -1
@@ -148,8 +158,10 @@ class Simulation:
 
     @property
     def effective_threads(self) -> int:
-        """Threads actually used: 1 for small systems, else ``threads``."""
-        return self.threads if self.particles.n >= self.parallel_min_particles else 1
+        """Threads asked of the kernel: 1 for small systems, else ``threads`` (at most ``partitions``)."""
+        if self.particles.n < self.parallel_min_particles:
+            return 1
+        return min(self.threads, self.partitions)
 
     # ----------------------------------------------------------------- setup
     @staticmethod
@@ -207,20 +219,36 @@ class Simulation:
         self.wall_force_vec = np.zeros((nw, 2))
         self._wstat = np.zeros((nw, 2))
         self._nb_start = np.zeros(n + 1, dtype=np.int64)
-        self._new_start = np.zeros(n + 1, dtype=np.int64)
-        self._rev_start = np.zeros(n + 1, dtype=np.int64)
         self._wb_start = np.zeros(n + 1, dtype=np.int64)
-        self._wnew_start = np.zeros(n + 1, dtype=np.int64)
+        self._alloc_work(n)
         self._alloc_pp(max(16, 4 * n))
         self._alloc_pw(max(16, n // 4))
         self._prm = np.zeros(K.N_PRM)
         self._iprm = np.zeros(K.N_IPRM, dtype=np.int64)
         self._out = np.zeros(K.N_OUT)
 
+    def _alloc_work(self, n: int) -> None:
+        """Per-disk and per-partition work arrays that the kernel derives itself."""
+        from poro2d.dem.neighbors import grid_scratch
+        from poro2d.dem.sync import fresh_sync
+
+        npart = self.partitions
+        self._acc = np.zeros((n, 3))
+        self._new_start = np.zeros(n + 1, dtype=np.int64)
+        self._wnew_start = np.zeros(n + 1, dtype=np.int64)
+        self._xstart = np.zeros(n + 1, dtype=np.int64)
+        self._dlist = np.zeros(n, dtype=np.int64)
+        self._part = np.zeros(npart + 1, dtype=np.int64)
+        self._dstart = np.zeros(npart + 1, dtype=np.int64)
+        self._wpart = np.zeros((npart, self.walls.n, 4))
+        self._tmax = np.zeros(npart)
+        self._sync = fresh_sync()
+        self._grid = grid_scratch(n)
+
     # pair storage: (kept arrays with their dtype, scratch arrays for the rebuild)
     _PP = (("_nb_j", np.int64), ("_nb_fs", float), ("_nb_fn", float), ("_nb_ov", float),
-           ("_nb_nx", float), ("_nb_ny", float), ("_rev_p", np.int64))  # fmt: skip
-    _PP_SCRATCH = (("_new_j", np.int64), ("_new_fs", float))
+           ("_nb_nx", float), ("_nb_ny", float))  # fmt: skip
+    _PP_SCRATCH = (("_new_j", np.int64), ("_new_fs", float), ("_xpair", np.int64))
     _PW = (("_wb_w", np.int64), ("_wb_fs", float), ("_wb_fn", float), ("_wb_ov", float),
            ("_wb_nx", float), ("_wb_ny", float))  # fmt: skip
     _PW_SCRATCH = (("_wnew_w", np.int64), ("_wnew_fs", float))
@@ -262,8 +290,7 @@ class Simulation:
         for name in ("_nb_start", "_wb_start"):
             old = getattr(self, name)
             setattr(self, name, np.concatenate([old, np.full(n - n0, old[-1], dtype=np.int64)]))
-        for name in ("_new_start", "_rev_start", "_wnew_start"):
-            setattr(self, name, np.zeros(n + 1, dtype=np.int64))
+        self._alloc_work(n)
         self.force = np.concatenate([self.force, np.zeros((n - n0, 2))])
         self.moment = np.concatenate([self.moment, np.zeros(n - n0)])
         self._pos_build = np.concatenate([self._pos_build, new.pos])
@@ -336,18 +363,19 @@ class Simulation:
 
     # -------------------------------------------------------------------- run
     def _args(self):
+        """The kernel's argument groups: disks, walls, pair lists, wall lists, work arrays."""
         p, w = self.particles, self.walls
-        return (
-            p.pos, p.vel, p.theta, p.omega, self.force, self.moment, p.radius, self._mass,
-            self._inv_mass, self._inv_inertia, p.mode, p.kn, p.ks, p.mu,
-            w.p0, w.p1, w.vel, w.kn, w.ks, w.mu, w.mode, w.servo_dir, w.servo,
-            self.wall_force_vec, self._wstat,
-            self._nb_start, self._nb_j, self._nb_fs, self._nb_fn, self._nb_ov, self._nb_nx,
-            self._nb_ny, self._rev_start, self._rev_p, self._new_start, self._new_j, self._new_fs,
-            self._wb_start, self._wb_w, self._wb_fs, self._wb_fn, self._wb_ov, self._wb_nx,
-            self._wb_ny, self._wnew_start, self._wnew_w, self._wnew_fs,
-            self._pos_build, self._wall_build, self._prm, self._iprm, self._out,
-        )  # fmt: skip
+        P = (p.pos, p.vel, p.theta, p.omega, self.force, self.moment, self._acc, p.radius, self._mass,
+             self._inv_mass, self._inv_inertia, p.mode, p.kn, p.ks, p.mu)  # fmt: skip
+        W = (w.p0, w.p1, w.vel, w.kn, w.ks, w.mu, w.mode, w.servo_dir, w.servo, self.wall_force_vec,
+             self._wstat, self._wall_build, self._wpart)  # fmt: skip
+        NB = (self._nb_start, self._nb_j, self._nb_fs, self._nb_fn, self._nb_ov, self._nb_nx,
+              self._nb_ny, self._new_start, self._new_j, self._new_fs)  # fmt: skip
+        WB = (self._wb_start, self._wb_w, self._wb_fs, self._wb_fn, self._wb_ov, self._wb_nx,
+              self._wb_ny, self._wnew_start, self._wnew_w, self._wnew_fs)  # fmt: skip
+        S = (self._pos_build, self._part, self._xstart, self._xpair, self._dlist, self._dstart,
+             self._tmax, self._sync, *self._grid)  # fmt: skip
+        return P, W, NB, WB, S, self._prm, self._iprm, self._out
 
     def _load_params(self, nsteps: int, check_every: int, ratio_target: float) -> None:
         prm = self._prm
@@ -359,18 +387,43 @@ class Simulation:
         if self.contact.convention == "per_pair_type":
             prm[K.KN_PP], prm[K.KS_PP], prm[K.MU_PP] = self.contact.pp  # type: ignore[misc]
             prm[K.KN_PW], prm[K.KS_PW], prm[K.MU_PW] = self.contact.pw  # type: ignore[misc]
+            self._iprm[K.MODE] = self._iprm[K.MODE_PW] = self.contact.mode
+        else:
+            self._uniform_constants()
         prm[K.RATIO_TARGET] = ratio_target
         prm[K.TIME] = self.time
-        self._iprm[K.MODE] = self.contact.mode
         self._iprm[K.NSTEPS] = nsteps
         self._iprm[K.CHECK_EVERY] = check_every
-        self._iprm[K.SERIAL] = 1 if self.effective_threads == 1 else 0
+        self._iprm[K.THREADS] = self.effective_threads
+
+    def _uniform_constants(self) -> None:
+        """Per-body properties that are all equal: hand the kernel the combined constants.
+
+        The same numbers as combining per pair (the kernel's own ``series`` and ``min``
+        make them), without reading three properties of both bodies for every pair.
+        """
+        from poro2d.dem.contact_law import PER_BODY, PER_PAIR_TYPE, series
+
+        p, w, prm = self.particles, self.walls, self._prm
+        self._iprm[K.MODE] = self._iprm[K.MODE_PW] = PER_BODY
+        if p.n == 0 or not all(np.all(a == a[0]) for a in (p.kn, p.ks, p.mu)):
+            return
+        kn, ks, mu = float(p.kn[0]), float(p.ks[0]), float(p.mu[0])
+        prm[K.KN_PP], prm[K.KS_PP], prm[K.MU_PP] = series(kn, kn), series(ks, ks), mu
+        self._iprm[K.MODE] = PER_PAIR_TYPE
+        if w.n and all(np.all(a == a[0]) for a in (w.kn, w.ks, w.mu)):
+            prm[K.KN_PW] = series(kn, float(w.kn[0]))
+            prm[K.KS_PW] = series(ks, float(w.ks[0]))
+            prm[K.MU_PW] = min(mu, float(w.mu[0]))
+            self._iprm[K.MODE_PW] = PER_PAIR_TYPE
 
     def _kernel_block(self, nsteps: int, check_every: int, ratio_target: float) -> tuple[int, int]:
         """Run up to ``nsteps`` in compiled code; returns (steps done, status)."""
         import numba
 
-        numba.set_num_threads(self.effective_threads)
+        numba.set_num_threads(max(1, self.effective_threads))
+        if self._part.shape[0] != self.partitions + 1 or self._wpart.shape[1] != self.walls.n:
+            self._alloc_work(self.particles.n)  # partitions or walls changed since allocation
         done = 0
         status = K.RUNNING
         rebuilds = 0
@@ -378,6 +431,7 @@ class Simulation:
             self._load_params(nsteps - done, check_every, ratio_target)
             self._out[:] = 0.0
             K.run_steps(*self._args())
+            self.threads_used = int(self._out[K.THREADS_USED])
             steps = int(self._out[K.STEPS_DONE])
             done += steps
             rebuilds += int(self._out[K.REBUILDS])
@@ -526,6 +580,7 @@ class Simulation:
             "skin_m": self.skin,
             "threads": self.threads,
             "threads_used": self.effective_threads,
+            "partitions": self.partitions,
             "step": self.step_count,
             "time_s": self.time,
         }
