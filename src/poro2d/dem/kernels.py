@@ -178,15 +178,18 @@ def _phase_forces(k, P, W, NB, WB, S, prm, pp_body, pw_body, beta, dt, gx, gy, d
     i0 = part[k]
     i1 = part[k + 1]
     dmax = 0.0
-    for i in range(i0, i1):
+    for i_ in range(i0, i1):
+        i = np.uint64(i_)  # unsigned indices: no negative-index wrap-around code
         fx = acc[i, 0]
         fy = acc[i, 1]
         mz = acc[i, 2]
         xi = pos[i, 0]
         yi = pos[i, 1]
         ri = radius[i]
-        for p in range(nb_start[i], nb_start[i + 1]):
-            j = nb_j[p]
+        for p_ in range(nb_start[i_], nb_start[i_ + 1]):
+            p = np.uint64(p_)
+            js = nb_j[p]
+            j = np.uint64(js)
             dx = pos[j, 0] - xi
             dy = pos[j, 1] - yi
             d = math.sqrt(dx * dx + dy * dy)
@@ -216,12 +219,13 @@ def _phase_forces(k, P, W, NB, WB, S, prm, pp_body, pw_body, beta, dt, gx, gy, d
             fx += fxp
             fy += fyp
             mz += ai * fs
-            if j < i1:  # a partner in a later partition collects this in phase 2
+            if js < i1:  # a partner in a later partition collects this in phase 2
                 acc[j, 0] -= fxp
                 acc[j, 1] -= fyp
                 acc[j, 2] += aj * fs
-        for p in range(wb_start[i], wb_start[i + 1]):
-            w = wb_w[p]
+        for p_ in range(wb_start[i_], wb_start[i_ + 1]):
+            p = np.uint64(p_)
+            w = np.uint64(wb_w[p])
             cx, cy = segment_closest(xi, yi, wp0[w, 0], wp0[w, 1], wp1[w, 0], wp1[w, 1])
             dx = cx - xi
             dy = cy - yi
@@ -262,7 +266,7 @@ def _phase_forces(k, P, W, NB, WB, S, prm, pp_body, pw_body, beta, dt, gx, gy, d
         force[i, 0] = fx
         force[i, 1] = fy
         moment[i] = mz
-        if xstart[i + 1] > xstart[i]:
+        if xstart[i_ + 1] > xstart[i_]:
             continue  # deferred: the partial sums wait in force and moment for phase 2
         # ready for the next step: the earlier rows of its partition add to this
         acc[i, 0] = mass[i] * gx
