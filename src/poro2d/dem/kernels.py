@@ -166,6 +166,13 @@ def _phase_forces(k, P, W, NB, WB, S, prm, pp_body, pw_body, beta, dt, gx, gy, d
     nb_start, nb_j, nb_fs, nb_fn, nb_ov, nb_nx, nb_ny = NB[:7]
     wb_start, wb_w, wb_fs, wb_fn, wb_ov, wb_nx, wb_ny = WB[:7]
     pos_build, part, xstart = S[0], S[1], S[2]
+    # flat views: an (n, 2) index costs a multiplication by a run-time row length
+    posf = pos.reshape(pos.size)
+    velf = vel.reshape(vel.size)
+    accf = acc.reshape(acc.size)
+    U1 = np.uint64(1)
+    U2 = np.uint64(2)
+    U3 = np.uint64(3)
     nw = wpart.shape[1]
     for w in range(nw):
         wpart[k, w, WFX] = 0.0
@@ -180,18 +187,18 @@ def _phase_forces(k, P, W, NB, WB, S, prm, pp_body, pw_body, beta, dt, gx, gy, d
     dmax = 0.0
     for i_ in range(i0, i1):
         i = np.uint64(i_)  # unsigned indices: no negative-index wrap-around code
-        fx = acc[i, 0]
-        fy = acc[i, 1]
-        mz = acc[i, 2]
-        xi = pos[i, 0]
-        yi = pos[i, 1]
+        fx = accf[U3 * i]
+        fy = accf[U3 * i + U1]
+        mz = accf[U3 * i + U2]
+        xi = posf[U2 * i]
+        yi = posf[U2 * i + U1]
         ri = radius[i]
         for p_ in range(nb_start[i_], nb_start[i_ + 1]):
             p = np.uint64(p_)
             js = nb_j[p]
             j = np.uint64(js)
-            dx = pos[j, 0] - xi
-            dy = pos[j, 1] - yi
+            dx = posf[U2 * j] - xi
+            dy = posf[U2 * j + U1] - yi
             d = math.sqrt(dx * dx + dy * dy)
             ov = ri + radius[j] - d
             nb_ov[p] = ov
@@ -207,7 +214,7 @@ def _phase_forces(k, P, W, NB, WB, S, prm, pp_body, pw_body, beta, dt, gx, gy, d
             ai = ri - 0.5 * ov
             aj = radius[j] - 0.5 * ov
             fn, fs, nx, ny = _pair_law(
-                dx, dy, d, ov, vel[j, 0] - vel[i, 0], vel[j, 1] - vel[i, 1], ai, aj, omega[i], omega[j],
+                dx, dy, d, ov, velf[U2 * j] - velf[U2 * i], velf[U2 * j + U1] - velf[U2 * i + U1], ai, aj, omega[i], omega[j],
                 nb_fs[p], kn, ks, mu, cn, dt,
             )  # fmt: skip
             nb_fn[p] = fn
@@ -220,9 +227,9 @@ def _phase_forces(k, P, W, NB, WB, S, prm, pp_body, pw_body, beta, dt, gx, gy, d
             fy += fyp
             mz += ai * fs
             if js < i1:  # a partner in a later partition collects this in phase 2
-                acc[j, 0] -= fxp
-                acc[j, 1] -= fyp
-                acc[j, 2] += aj * fs
+                accf[U3 * j] -= fxp
+                accf[U3 * j + U1] -= fyp
+                accf[U3 * j + U2] += aj * fs
         for p_ in range(wb_start[i_], wb_start[i_ + 1]):
             p = np.uint64(p_)
             w = np.uint64(wb_w[p])
@@ -247,8 +254,8 @@ def _phase_forces(k, P, W, NB, WB, S, prm, pp_body, pw_body, beta, dt, gx, gy, d
             cn = dashpot(beta, wkn_, mass[i]) if beta > 0.0 else 0.0
             ai = ri - 0.5 * ov
             fn, fs, nx, ny = _wall_law(
-                dx, dy, d, ov, wp1[w, 0] - wp0[w, 0], wp1[w, 1] - wp0[w, 1], wvel[w, 0] - vel[i, 0],
-                wvel[w, 1] - vel[i, 1], ai, omega[i], wb_fs[p], wkn_, wks_, wmu_, cn, dt,
+                dx, dy, d, ov, wp1[w, 0] - wp0[w, 0], wp1[w, 1] - wp0[w, 1], wvel[w, 0] - velf[U2 * i],
+                wvel[w, 1] - velf[U2 * i + U1], ai, omega[i], wb_fs[p], wkn_, wks_, wmu_, cn, dt,
             )  # fmt: skip
             wb_fn[p] = fn
             wb_fs[p] = fs
@@ -269,18 +276,18 @@ def _phase_forces(k, P, W, NB, WB, S, prm, pp_body, pw_body, beta, dt, gx, gy, d
         if xstart[i_ + 1] > xstart[i_]:
             continue  # deferred: the partial sums wait in force and moment for phase 2
         # ready for the next step: the earlier rows of its partition add to this
-        acc[i, 0] = mass[i] * gx
-        acc[i, 1] = mass[i] * gy
-        acc[i, 2] = 0.0
+        accf[U3 * i] = mass[i] * gx
+        accf[U3 * i + U1] = mass[i] * gy
+        accf[U3 * i + U2] = 0.0
         if pmode[i] == FREE:
-            vel[i, 0] += _damped(fx, vel[i, 0], damp) * inv_mass[i] * dt
-            vel[i, 1] += _damped(fy, vel[i, 1], damp) * inv_mass[i] * dt
+            velf[U2 * i] += _damped(fx, velf[U2 * i], damp) * inv_mass[i] * dt
+            velf[U2 * i + U1] += _damped(fy, velf[U2 * i + U1], damp) * inv_mass[i] * dt
             omega[i] += _damped(mz, omega[i], damp) * inv_inertia[i] * dt
-        pos[i, 0] += vel[i, 0] * dt
-        pos[i, 1] += vel[i, 1] * dt
+        posf[U2 * i] += velf[U2 * i] * dt
+        posf[U2 * i + U1] += velf[U2 * i + U1] * dt
         theta[i] += omega[i] * dt
-        ddx = pos[i, 0] - pos_build[i, 0]
-        ddy = pos[i, 1] - pos_build[i, 1]
+        ddx = posf[U2 * i] - pos_build[i, 0]
+        ddy = posf[U2 * i + U1] - pos_build[i, 1]
         dmax = max(dmax, ddx * ddx + ddy * ddy)
     return dmax
 
