@@ -30,15 +30,16 @@ def down(tmp_path_factory):
 
 
 def test_accept_at_once(tmp_path):
-    # this small specimen at 0.21 (seed 0) just fills its box: F_top is about 3 % of G
-    r = _run(tmp_path, 0.21, force_fraction=0.05)
-    assert r["converged"] and r["final_porosity"] == 0.21
+    # this small specimen at 0.215 (seed 0) just fills its box: F_top is a fraction of a per cent of G
+    # (chaotic packing: another engine sum order may need another trial porosity here)
+    r = _run(tmp_path, 0.215, force_fraction=0.05)
+    assert r["converged"] and r["final_porosity"] == 0.215
     (it,) = r["iterations"]
     assert it["plate_moved"] == "no" and it["plate_displacement_m"] == 0.0
     assert 0.0 < it["f_top_n_per_m"] < 0.05 * it["self_weight_n_per_m"]
     assert it["accepted"] and it["porosity_change"] == 0.0
     saved = json.loads((tmp_path / "result.json").read_text())
-    assert saved["final_porosity"] == 0.21 and REQUIRED <= set(saved["iterations"][0])
+    assert saved["final_porosity"] == 0.215 and REQUIRED <= set(saved["iterations"][0])
     for f in ("iterations.csv", "specimen.npz", "fig5_forces_initial_trial.png", "fig7_forces_accepted.png"):
         assert (tmp_path / f).stat().st_size > 0
     assert (tmp_path / "vtu" / "accepted_specimen_contacts.vtu").is_file()

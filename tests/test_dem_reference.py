@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
-from poro2d.dem.reference import ReferenceDEM, engine_pair_order
+from poro2d.dem.reference import ReferenceDEM, engine_pair_order, engine_partitions
 
 R = 1e-3  # mean radius (m)
 
@@ -102,7 +102,10 @@ def _lockstep(sim: Simulation, steps: int, engine_order: bool):
     for _ in range(steps):
         res = sim.run(1)
         rebuilds += res.rebuilds
-        ref.step(engine_pair_order(sim) if engine_order else None)
+        if engine_order:
+            ref.step(engine_pair_order(sim), engine_partitions(sim))
+        else:
+            ref.step()
         vs, ws = _scales(sim)
         fscale = max(1e-3, float(np.abs(ref.wall_force).max()))
         worst["pos"] = max(worst["pos"], float(np.abs(p.pos - ref.pos).max()) / R)

@@ -16,7 +16,7 @@ import numpy as np
 from poro2d.dem import kernels as K
 from poro2d.dem.model import ContactModel
 from poro2d.dem.simulation import Simulation
-from poro2d.dem.state import Particles, Walls
+from poro2d.dem.state import SERVO_COLUMNS, Particles, Walls
 from poro2d.errors import InputError
 from poro2d.io_utils import atomic_path, provenance
 
@@ -99,6 +99,9 @@ def load(path: str | os.PathLike, threads: int | None = None) -> Simulation:
     walls = Walls()
     for f in _WALL_FIELDS:
         setattr(walls, f, np.ascontiguousarray(a[f"walls.{f}"]))
+    if walls.servo.shape[1] < SERVO_COLUMNS:  # written before the servo had an integral term
+        pad = np.zeros((walls.n, SERVO_COLUMNS - walls.servo.shape[1]))
+        walls.servo = np.ascontiguousarray(np.hstack([walls.servo.reshape(walls.n, -1), pad]))
     walls.names = list(meta["wall_names"])
     c = s["contact"]
     contact = ContactModel(

@@ -213,10 +213,11 @@ def _phase_forces(k, P, W, NB, WB, S, prm, pp_body, pw_body, beta, dt, gx, gy, d
             cn = dashpot(beta, kn, mass[i] * mass[j] / (mass[i] + mass[j])) if beta > 0.0 else 0.0
             ai = ri - 0.5 * ov
             aj = radius[j] - 0.5 * ov
-            fn, fs, nx, ny = _pair_law(
-                dx, dy, d, ov, velf[U2 * j] - velf[U2 * i], velf[U2 * j + U1] - velf[U2 * i + U1], ai, aj, omega[i], omega[j],
-                nb_fs[p], kn, ks, mu, cn, dt,
-            )  # fmt: skip
+            dvx = velf[U2 * j] - velf[U2 * i]
+            dvy = velf[U2 * j + U1] - velf[U2 * i + U1]
+            wi = omega[i]
+            wj = omega[j]
+            fn, fs, nx, ny = _pair_law(dx, dy, d, ov, dvx, dvy, ai, aj, wi, wj, nb_fs[p], kn, ks, mu, cn, dt)
             nb_fn[p] = fn
             nb_fs[p] = fs
             nb_nx[p] = nx
@@ -352,7 +353,10 @@ def _move_walls(W, prm, dt):
             err = wservo[w, 0] - fc
             vmax = wservo[w, 2]
             if wstat[w, 0] > 0.0:
-                v = wservo[w, 1] * err / (wstat[w, 1] * dt)
+                summed = wservo[w, 4] + err
+                v = wservo[w, 1] * (err + wservo[w, 3] * summed) / (wstat[w, 1] * dt)
+                if -vmax <= v <= vmax:  # no wind-up while the speed is bounded
+                    wservo[w, 4] = summed
             else:  # nothing touches: approach (or retreat) at full speed
                 v = vmax if err > 0.0 else -vmax
             if v > vmax:

@@ -185,14 +185,22 @@ class ReferenceDEM:
         t = ov > 0.0
         return i[t], w[t], dx[t], dy[t], d[t], ov[t]
 
-    def step(self, pair_order: dict[tuple[int, int], int] | None = None) -> None:
+    def step(
+        self,
+        pair_order: dict[tuple[int, int], int] | None = None,
+        partitions: np.ndarray | None = None,
+    ) -> None:
         """Advance the copy by one time step.
 
         The contributions to each disk's force are summed disk-pair by disk-pair in
         ascending ``(i, j)`` order, unless ``pair_order`` maps pairs to ranks (e.g. the
         slots of the engine's neighbour list, :func:`engine_pair_order`): then in
-        ascending rank, pairs without a rank last. Only the order of the sums changes
-        (round-off); which pairs touch is always decided here, directly.
+        ascending rank, pairs without a rank last. With ``partitions`` (the engine's
+        partition boundaries, :func:`engine_partitions`) the sums follow the engine's
+        partitioned order: a pair whose disks lie in different partitions reaches its
+        second disk last, and wall resultants are summed partition by partition. Only
+        the order of the sums changes (round-off); which pairs touch is always decided
+        here, directly.
         """
         pos, vel, omega, r, m = self.pos, self.vel, self.omega, self.radius, self.mass
         dt = self.dt
@@ -280,19 +288,35 @@ class ReferenceDEM:
         force[:, 0] = m * self.gravity[0]
         force[:, 1] = m * self.gravity[1]
         moment = np.zeros(n)
-        # the engine's order: for each disk, its partners j < i, then its own row, then walls
-        np.add.at(force[:, 0], j, -cfx)
-        np.add.at(force[:, 1], j, -cfy)
-        np.add.at(moment, j, (r[j] - 0.5 * ov) * fs)
-        np.add.at(force[:, 0], i, cfx)
-        np.add.at(force[:, 1], i, cfy)
-        np.add.at(moment, i, (r[i] - 0.5 * ov) * fs)
-        np.add.at(force[:, 0], wi, wcfx)
-        np.add.at(force[:, 1], wi, wcfy)
-        np.add.at(moment, wi, (r[wi] - 0.5 * wov) * wfs)
+        # the engine's order: for each disk, its partners j < i of the same partition, its
+        # own row, its walls, then its partners j < i from earlier partitions
+        if partitions is None:
+            part_of = np.zeros(n, dtype=np.int64)
+            bounds = np.array([0, n])
+        else:
+            bounds = np.asarray(partitions)
+            part_of = np.searchsorted(bounds, np.arange(n), side="right") - 1
+        cross = part_of[j] != part_of[i]
+        mj = (r[j] - 0.5 * ov) * fs
+        for sel in (~cross, None, cross):
+            if sel is None:  # own rows, then walls
+                np.add.at(force[:, 0], i, cfx)
+                np.add.at(force[:, 1], i, cfy)
+                np.add.at(moment, i, (r[i] - 0.5 * ov) * fs)
+                np.add.at(force[:, 0], wi, wcfx)
+                np.add.at(force[:, 1], wi, wcfy)
+                np.add.at(moment, wi, (r[wi] - 0.5 * wov) * wfs)
+            else:
+                np.add.at(force[:, 0], j[sel], -cfx[sel])
+                np.add.at(force[:, 1], j[sel], -cfy[sel])
+                np.add.at(moment, j[sel], mj[sel])
         wall_force = np.zeros((nw, 2))
-        np.add.at(wall_force[:, 0], ww, -wcfx)
-        np.add.at(wall_force[:, 1], ww, -wcfy)
+        for k in range(len(bounds) - 1):
+            sel = part_of[wi] == k
+            partial = np.zeros((nw, 2))
+            np.add.at(partial[:, 0], ww[sel], -wcfx[sel])
+            np.add.at(partial[:, 1], ww[sel], -wcfy[sel])
+            wall_force += partial
 
         # damping and leapfrog integration
         free = self.mode == FREE
@@ -327,6 +351,11 @@ class ReferenceDEM:
         m = self.mass
         inertia = 0.5 * m * self.radius**2
         return float(0.5 * np.sum(m * np.sum(self.vel**2, axis=1)) + 0.5 * np.sum(inertia * self.omega**2))
+
+
+def engine_partitions(sim) -> np.ndarray:
+    """The partition boundaries of a simulation's last step (its sum order across partitions)."""
+    return sim._part.copy()
 
 
 def engine_pair_order(sim) -> dict[tuple[int, int], int]:

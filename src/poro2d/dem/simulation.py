@@ -330,11 +330,16 @@ class Simulation:
         direction: tuple[float, float],
         max_speed: float,
         gain: float = 0.5,
+        integral: float = 0.0,
     ) -> None:
         """Servo a wall along ``direction`` (the way it moves to compress) to a force.
 
-        Every step: v = gain * (target - F) / (sum of contact kn on the wall * dt),
-        bounded by ``max_speed``; F is the compressive force along ``direction`` (N).
+        Every step: v = gain * (e + integral * E) / (sum of contact kn on the wall * dt),
+        bounded by ``max_speed``, with e = target - F the force error, F the compressive
+        force along ``direction`` (N) and E the sum of e over the steps so far (not
+        summed while the speed is at its bound). ``integral = 0`` is PFC's proportional
+        servo; it lags behind a specimen that keeps dilating or contracting by
+        e = v k dt / gain, which a small integral gain (e.g. 1e-3 per step) removes.
         A wall that touches nothing moves at ``max_speed`` towards the target.
         """
         w = self.walls.index(wall)
@@ -348,9 +353,11 @@ class Simulation:
             raise InputError("servo max_speed", max_speed, "(0, inf) m/s")
         if not 0.0 < gain <= 1.0:
             raise InputError("servo gain", gain, "(0, 1]")
+        if not 0.0 <= integral <= 0.1:
+            raise InputError("servo integral gain", integral, "[0, 0.1] per step")
         self.walls.mode[w] = WALL_SERVO
         self.walls.servo_dir[w] = d / nd
-        self.walls.servo[w] = (target_force, gain, max_speed)
+        self.walls.servo[w] = (target_force, gain, max_speed, integral, 0.0)
 
     def fix_particles(self, mask: np.ndarray, velocity=(0.0, 0.0), omega: float = 0.0) -> None:
         """Prescribe velocity and spin of the disks in ``mask`` (zero = fixed)."""

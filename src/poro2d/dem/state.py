@@ -20,6 +20,7 @@ PRESCRIBED = 1  # velocity and spin are held at their set values (0 = fixed)
 # Wall modes.
 WALL_VELOCITY = 0  # moves with its prescribed velocity (0 = fixed)
 WALL_SERVO = 1  # velocity set every step by the force servo
+SERVO_COLUMNS = 5  # target, gain, max speed, integral gain, summed error
 
 
 def _as_f64(name: str, a, n: int | None = None, shape_tail: tuple = ()) -> np.ndarray:
@@ -115,10 +116,11 @@ class Walls:
     mu: np.ndarray = field(default_factory=lambda: np.zeros(0))
     vel: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     mode: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
-    # servo: direction the wall moves to compress (unit), target compressive force (N),
-    # gain (fraction of the force error removed per step), maximum speed (m/s)
+    # servo: direction the wall moves to compress (unit); per wall SERVO_COLUMNS: target
+    # compressive force (N), gain (fraction of the force error removed per step), maximum
+    # speed (m/s), integral gain (per step) and the summed force error (N, its state)
     servo_dir: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
-    servo: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    servo: np.ndarray = field(default_factory=lambda: np.zeros((0, SERVO_COLUMNS)))
     names: list[str] = field(default_factory=list)
 
     @property
@@ -167,7 +169,7 @@ class Walls:
         self.vel = np.ascontiguousarray(np.vstack([self.vel, np.asarray(velocity, float)]))
         self.mode = np.append(self.mode, WALL_VELOCITY).astype(np.int64)
         self.servo_dir = np.ascontiguousarray(np.vstack([self.servo_dir, np.zeros(2)]))
-        self.servo = np.ascontiguousarray(np.vstack([self.servo, np.zeros(3)]))
+        self.servo = np.ascontiguousarray(np.vstack([self.servo, np.zeros(SERVO_COLUMNS)]))
         self.names.append(name)
         return self.n - 1
 

@@ -50,7 +50,8 @@ class ShearSettings:
 
     velocity (m/s) and max_displacement (m) of the lower half; record_interval and
     checkpoint_interval (m of shear displacement); consolidation_ratio and
-    consolidation_max_steps for the consolidation stage; servo_gain and
+    consolidation_max_steps for the consolidation stage; servo_gain, servo_integral
+    (per step; it keeps the stress on target while the specimen dilates) and
     servo_max_speed (m/s) of the top plate; kn_wall, ks_wall (N/m), friction_wall and
     gap (m) of the box; particle_friction replaces the specimen's when given;
     local_damping likewise (None: the specimen's); density_scale >= 1 scales the
@@ -66,6 +67,7 @@ class ShearSettings:
     consolidation_ratio: float = 1e-3
     consolidation_max_steps: int = 300_000
     servo_gain: float = 0.5
+    servo_integral: float = 1e-3
     servo_max_speed: float = 0.05
     kn_wall: float = 1e7
     ks_wall: float = 1e7
@@ -89,6 +91,7 @@ class ShearSettings:
         if not (isinstance(self.consolidation_max_steps, int) and self.consolidation_max_steps >= 1000):
             raise InputError("consolidation_max_steps", self.consolidation_max_steps, "an integer >= 1000")
         check_range("servo_gain", self.servo_gain, 0.0, 1.0, lo_open=True)
+        check_range("servo_integral", self.servo_integral, 0.0, 0.1)
         check_range("servo_max_speed", self.servo_max_speed, 0.0, 10.0, lo_open=True)
         check_range("kn_wall", self.kn_wall, 0.0, None, lo_open=True)
         check_range("ks_wall", self.ks_wall, 0.0, None)
@@ -279,7 +282,7 @@ class DirectShearTest:
             sim.local_damping = float(s.local_damping)
         self.box = box
         target = self.sigma_kpa * 1e3 * box.width * box.thickness
-        sim.set_wall_servo("top", target, (0.0, -1.0), s.servo_max_speed, s.servo_gain)
+        sim.set_wall_servo("top", target, (0.0, -1.0), s.servo_max_speed, s.servo_gain, s.servo_integral)
         y0 = box.plate_height(sim)
         check = 500
         state = {"ratio": math.inf, "err": math.inf}
