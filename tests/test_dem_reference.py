@@ -30,7 +30,7 @@ from poro2d.dem.reference import ReferenceDEM, engine_pair_order, engine_partiti
 R = 1e-3  # mean radius (m)
 
 
-def jammed_packing(seed: int, convention="per_body", restitution=None, threads=1) -> Simulation:
+def jammed_packing(seed: int, convention="per_body", restitution=None, threads=1, partitions=2) -> Simulation:
     """~190 disks on a hexagonal lattice with 1-2 % overlaps, squeezed by a moving lid."""
     rng = np.random.default_rng(seed)
     nx, ny = 14, 14
@@ -60,7 +60,7 @@ def jammed_packing(seed: int, convention="per_body", restitution=None, threads=1
         contact = ContactModel("per_pair_type", pp=(6e5, 4e5, 0.15), pw=(8e5, 5e5, 0.35))
     sim = Simulation(
         p, w, contact=contact, gravity=(0.3, -9.81), local_damping=0.7, restitution=restitution,
-        threads=threads,
+        threads=threads, partitions=partitions,
     )  # fmt: skip
     sim.set_wall_velocity("top", (0.0, -0.2))  # 0.4 mm in 300 steps: several list rebuilds
     return sim
@@ -185,6 +185,7 @@ def test_threads_give_bitwise_identical_results():
     assert a.effective_threads == 1 and b.effective_threads == 2
     a.run(25)
     b.run(25)
+    assert b.threads_used == 2  # the workers really ran side by side
     pa, pb = a.particles, b.particles
     for x, y in [(pa.pos, pb.pos), (pa.vel, pb.vel), (pa.omega, pb.omega), (a.force, b.force)]:
         assert np.array_equal(x, y)
@@ -199,3 +200,22 @@ def test_threads_give_bitwise_identical_results():
     assert np.array_equal(c.particles.pos, d.particles.pos)
     assert np.array_equal(c.particles.omega, d.particles.omega)
     assert np.array_equal(c.wall_force_vec, d.wall_force_vec)
+
+
+@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="needs 2 numba threads")
+def test_partitions_fix_the_numbers_not_the_threads():
+    """4 partitions on 1 or 2 threads: bit for bit; 1 vs 4 partitions: round-off only."""
+    runs = {}
+    for parts, threads in ((4, 1), (4, 2), (1, 1)):
+        sim = jammed_packing(5, threads=threads, partitions=parts)
+        sim.parallel_min_particles = 0
+        sim.run(30)
+        assert sim.threads_used == threads
+        runs[parts, threads] = sim
+    a, b, c = runs[4, 1], runs[4, 2], runs[1, 1]
+    assert a._dstart[-1] > 10  # many disks wait for partners of earlier partitions
+    for x, y, z in [(a.particles.pos, b.particles.pos, c.particles.pos), (a.force, b.force, c.force)]:
+        assert np.array_equal(x, y)
+        scale = float(np.abs(z).max())
+        assert np.abs(x - z).max() <= 1e-9 * scale
+    assert np.array_equal(a.wall_force_vec, b.wall_force_vec)
