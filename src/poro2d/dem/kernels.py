@@ -173,7 +173,7 @@ def _phase_forces(k, P, W, NB, WB, S, prm, pp_body, pw_body, beta, dt, gx, gy, d
     U1 = np.uint64(1)
     U2 = np.uint64(2)
     U3 = np.uint64(3)
-    nw = wpart.shape[1]
+    nw = wp0.shape[0]
     for w in range(nw):
         wpart[k, w, WFX] = 0.0
         wpart[k, w, WFY] = 0.0
@@ -294,13 +294,17 @@ def _phase_forces(k, P, W, NB, WB, S, prm, pp_body, pw_body, beta, dt, gx, gy, d
 
 
 @njit(cache=True)
-def _phase_deferred(k, P, NB, S, gx, gy, damp, dt):
-    """Phase 2 on partition k: its deferred disks add their cross pairs and advance."""
+def _phase_deferred(m0, m1, P, NB, S, gx, gy, damp, dt):
+    """Phase 2: deferred disks ``dlist[m0:m1]`` add their cross pairs and advance.
+
+    Each deferred disk only reads its own cross pairs, so the list is shared out
+    evenly among the threads, whatever partition a disk belongs to.
+    """
     pos, vel, theta, omega, force, moment, acc, radius, mass, inv_mass, inv_inertia, pmode = P[:12]
     nb_fs, nb_fn, nb_ov, nb_nx, nb_ny = NB[2], NB[3], NB[4], NB[5], NB[6]
-    pos_build, xstart, xpair, dlist, dstart = S[0], S[2], S[3], S[4], S[5]
+    pos_build, xstart, xpair, dlist = S[0], S[2], S[3], S[4]
     dmax = 0.0
-    for m in range(dstart[k], dstart[k + 1]):
+    for m in range(m0, m1):
         i = dlist[m]
         fx = force[i, 0]
         fy = force[i, 1]
@@ -430,7 +434,7 @@ def _rebuild(t, nthr, P, W, NB, WB, S, prm, out):
 
 @njit(cache=True)
 def _worker(t, nthr, P, W, NB, WB, S, prm, iprm, out):
-    """Run the steps of this call on thread t of nthr (partitions t*P/nthr ... (t+1)*P/nthr - 1)."""
+    """Run the steps of this call on thread t of nthr: partitions t P / nthr to (t + 1) P / nthr - 1."""
     pos, force, pmode = P[0], P[4], P[11]
     wp0, wall_build = W[0], W[11]
     nb_start, nb_fn, nb_fs, nb_ov = NB[0], NB[3], NB[2], NB[4]
@@ -469,11 +473,11 @@ def _worker(t, nthr, P, W, NB, WB, S, prm, iprm, out):
             if d2 > dmax:
                 dmax = d2
         barrier(sync, nthr)
-        # phase 2: deferred disks; thread 0 also moves the walls
-        for k in range(k0, k1):
-            d2 = _phase_deferred(k, P, NB, S, gx, gy, damp, dt)
-            if d2 > dmax:
-                dmax = d2
+        # phase 2: the deferred disks, shared out evenly; thread 0 also moves the walls
+        ndef = S[5][npart]
+        d2 = _phase_deferred(t * ndef // nthr, (t + 1) * ndef // nthr, P, NB, S, gx, gy, damp, dt)
+        if d2 > dmax:
+            dmax = d2
         tmax[t] = dmax
         if t == 0:
             _move_walls(W, prm, dt)

@@ -29,6 +29,7 @@ from poro2d.dem.state import FREE, PRESCRIBED, WALL_SERVO, WALL_VELOCITY, Partic
 from poro2d.errors import InputError
 
 _THREADING_SET = False
+WALL_PAD = 4  # rows of 4 doubles: 128 bytes between the wall sums of two partitions
 
 
 def _prefer_openmp() -> None:
@@ -240,7 +241,9 @@ class Simulation:
         self._dlist = np.zeros(n, dtype=np.int64)
         self._part = np.zeros(npart + 1, dtype=np.int64)
         self._dstart = np.zeros(npart + 1, dtype=np.int64)
-        self._wpart = np.zeros((npart, self.walls.n, 4))
+        # wall sums per partition, WALL_PAD rows apart: two threads adding to the same
+        # cache line would pass it back and forth at every wall contact
+        self._wpart = np.zeros((npart, self.walls.n + WALL_PAD, 4))
         self._tmax = np.zeros(npart)
         self._sync = fresh_sync()
         self._grid = grid_scratch(n)
@@ -429,7 +432,7 @@ class Simulation:
         import numba
 
         numba.set_num_threads(max(1, self.effective_threads))
-        if self._part.shape[0] != self.partitions + 1 or self._wpart.shape[1] != self.walls.n:
+        if self._part.shape[0] != self.partitions + 1 or self._wpart.shape[1] != self.walls.n + WALL_PAD:
             self._alloc_work(self.particles.n)  # partitions or walls changed since allocation
         done = 0
         status = K.RUNNING
