@@ -21,7 +21,8 @@ its own row, its walls, then its cross pairs; for a wall, partition by partition
 
 Threads: one worker per thread runs all steps of the call, each on its own
 partitions; workers meet at two barriers per step (after phase 1, after phase 2;
-a third on rebuild and stop-check steps), not at a thread start-up per loop. With
+one more on stop-check steps, and a few between the phases of a list rebuild), not at
+a thread start-up per loop. With
 one thread the same worker runs alone, without barriers. Results do not depend on
 the number of threads, bit for bit.
 """

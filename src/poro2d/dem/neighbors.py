@@ -30,7 +30,8 @@ from numba import njit
 from poro2d.dem.contact_law import segment_closest
 
 
-def max_cells(n: int) -> int:
+@njit(cache=True)
+def max_cells(n):
     """Most cells the grid may use for ``n`` disks (a runaway disk cannot make it huge)."""
     return 4 * n + 16
 
@@ -72,7 +73,7 @@ def cell_grid(pos, radius, skin, cell, members, cstart, cfill, ginfo):
             rmax = radius[i]
     size = 2.0 * rmax + skin
     # A runaway disk must not make the grid huge: cap the cell count near 4N.
-    while ((xmax - xmin) / size + 1.0) * ((ymax - ymin) / size + 1.0) > 4.0 * n + 16.0:
+    while ((xmax - xmin) / size + 1.0) * ((ymax - ymin) / size + 1.0) > max_cells(n):
         size *= 1.5
     ncx = int((xmax - xmin) / size) + 1
     ncy = int((ymax - ymin) / size) + 1
@@ -232,7 +233,7 @@ def build_pairs(pos, radius, skin, nb_start, nb_j, nb_fs, new_start, new_j, new_
     (nothing is changed then).
     """
     n = pos.shape[0]
-    nc = 4 * n + 17
+    nc = max_cells(n) + 1
     cell = np.empty(n, dtype=np.int64)
     members = np.empty(n, dtype=np.int64)
     cstart = np.empty(nc, dtype=np.int64)
