@@ -192,31 +192,42 @@ def _set_threads(sim, threads: int) -> None:
     sim.parallel_min_particles = 0  # measure what was asked, whatever the size
 
 
-def time_poro2d(sim, steps: int, repeats: int, warmup: int, threads=(1, 2), lammps=None) -> dict:
-    """Median particle-steps/s per thread count; thread counts timed in alternation.
+def time_poro2d(
+    sim, steps: int, repeats: int, warmup: int, threads=(1, 2), lammps=None, paper=None, paper_steps=0
+) -> dict:
+    """Median particle-steps/s per thread count; all runs of a round timed in alternation.
 
-    With ``lammps`` (a :class:`lammps_reference.LammpsSession`) every round also runs
-    one LAMMPS block of the same length; the order within a round flips from round
-    to round, so neither code always runs first.
+    A round runs one block per thread count; with ``lammps`` (a
+    :class:`lammps_reference.LammpsSession`) also one LAMMPS block of the same length,
+    and with ``paper`` (the paper-case simulation) one ``paper_steps`` block of it per
+    thread count, so that ratios to the paper case compare blocks of the same minute.
+    The order within a round flips from round to round: nobody always runs first.
     """
-    rates: dict[int, list[float]] = {t: [] for t in threads}
-    loads: dict[int, list[list[float]]] = {t: [] for t in threads}
-    rebuilds: dict[int, list[int]] = {t: [] for t in threads}
+    runs: list = list(threads)
+    if paper is not None:
+        runs += [("paper", t) for t in threads]
+    if lammps is not None:
+        runs.append("lammps")
+    rates: dict = {r: [] for r in runs if r != "lammps"}
+    loads: dict = {t: [] for t in threads}
+    rebuilds: dict = {t: [] for t in threads}
     for t in threads:  # compile, build the lists, grow the storage: not timed
         _set_threads(sim, t)
         sim.run(warmup)
     for k in range(repeats):
-        runs = [*threads, "lammps"] if lammps is not None else list(threads)
-        for t in runs if k % 2 == 0 else runs[::-1]:
-            if t == "lammps":
+        for r in runs if k % 2 == 0 else runs[::-1]:
+            if r == "lammps":
                 lammps.block(steps)
-                continue
-            _set_threads(sim, t)
-            res = sim.run(steps)
-            rates[t].append(res.particle_steps_per_s)
-            loads[t].append(loadavg())
-            rebuilds[t].append(res.rebuilds)
-    out = {}
+            elif isinstance(r, tuple):
+                _set_threads(paper, r[1])
+                rates[r].append(paper.run(paper_steps).particle_steps_per_s)
+            else:
+                _set_threads(sim, r)
+                res = sim.run(steps)
+                rates[r].append(res.particle_steps_per_s)
+                loads[r].append(loadavg())
+                rebuilds[r].append(res.rebuilds)
+    out: dict = {}
     for t in threads:
         out[t] = {
             "particle_steps_per_s": statistics.median(rates[t]),
@@ -227,6 +238,8 @@ def time_poro2d(sim, steps: int, repeats: int, warmup: int, threads=(1, 2), lamm
             "rebuilds": rebuilds[t],
             "loadavg": loads[t],
         }
+        if paper is not None:
+            out[t]["paper_all"] = rates[("paper", t)]
     return out
 
 
@@ -423,8 +436,12 @@ def table(results: dict) -> str:
         if name == "paper":
             r_p = "1"
         else:
-            a = _ratio(p1, paper.get("1", {}).get("particle_steps_per_s"))
-            b = _ratio(p2, paper.get("2", {}).get("particle_steps_per_s"))
+            a = pair.get("poro2d 1t / paper 1t", {}).get(
+                "median", _ratio(p1, paper.get("1", {}).get("particle_steps_per_s"))
+            )
+            b = pair.get("poro2d 2t / paper 2t", {}).get(
+                "median", _ratio(p2, paper.get("2", {}).get("particle_steps_per_s"))
+            )
             r_p = f"{a:.2f}, {b:.2f}" if a is not None and b is not None else "-"
         loads = [ld[0] for t in pr.values() for ld in t.get("loadavg", [])]
         load = f"{min(loads):.1f}-{max(loads):.1f}" if loads else "-"
@@ -455,8 +472,11 @@ def targets(results: dict) -> list[tuple[str, float | None, float, bool | None]]
         r_t = c.get("paired", {}).get("poro2d 2t / 1t", {}).get("median", _ratio(q2, q1))
         out.append((f"{name}: poro2d 2 threads / 1 thread", r_t, TARGET_THREAD_SPEEDUP))
         if name == "1M":
-            out.append(("1M / paper, 1 thread", _ratio(q1, p1), TARGET_LARGE_RETENTION))
-            out.append(("1M / paper, 2 threads", _ratio(q2, p2), TARGET_LARGE_RETENTION))
+            pc = c.get("paired", {})
+            r1 = pc.get("poro2d 1t / paper 1t", {}).get("median", _ratio(q1, p1))
+            r2 = pc.get("poro2d 2t / paper 2t", {}).get("median", _ratio(q2, p2))
+            out.append(("1M / paper, 1 thread", r1, TARGET_LARGE_RETENTION))
+            out.append(("1M / paper, 2 threads", r2, TARGET_LARGE_RETENTION))
     return [(k, v, t, None if v is None else v >= t) for k, v, t in out]
 
 
@@ -523,7 +543,7 @@ def main(argv=None) -> int:
         "1M": (40, 5),
     }
     rep = max(1, 3 if args.quick else args.repeats)
-    rep_big = {"paper": rep, "25k": rep, "250k": min(rep, 3), "1M": min(rep, 3)}
+    rep_big = {"paper": rep, "25k": rep, "250k": rep, "1M": rep}
 
     base, prep = paper_simulation(out, args.rebuild)
     results: dict = {
@@ -575,7 +595,8 @@ def main(argv=None) -> int:
             )  # fmt: skip
             print(f"  LAMMPS session started and settled ({time.perf_counter() - t0:.0f} s)", flush=True)
         t0 = time.perf_counter()
-        r = time_poro2d(sim, steps, rep_big[name], warm, threads, lammps=session)
+        ref = {} if name == "paper" else {"paper": base, "paper_steps": plan["paper"][0]}
+        r = time_poro2d(sim, steps, rep_big[name], warm, threads, lammps=session, **ref)
         try:
             results["settings"]["threading_layer"] = numba.threading_layer()
         except ValueError:
@@ -601,6 +622,9 @@ def main(argv=None) -> int:
         case["paired"] = {}
         if 2 in r:
             case["paired"]["poro2d 2t / 1t"] = paired(r[2]["all"], r[1]["all"])
+        for t in r:
+            if "paper_all" in r[t]:
+                case["paired"][f"poro2d {t}t / paper {t}t"] = paired(r[t]["all"], r[t]["paper_all"])
         if with_lammps:
             lm = {}
             ls, lrep, lset = (steps, rep, 2000) if name == "paper" else (400, 3, 200)
@@ -621,8 +645,6 @@ def main(argv=None) -> int:
                 f"poro2d's; floor force {ses['bottom_wall_force']:.1f} N, finite={ses['finite']})",
                 flush=True,
             )
-            for k, v in case["paired"].items():
-                print(f"  paired {k}: median {v['median']:.2f} (rounds {v['min']:.2f}-{v['max']:.2f})")
             if name == "paper":
                 lm["2 OpenMP threads (PASSIVE)"] = time_lammps(
                     sim, "2 OpenMP threads (PASSIVE)", ls, lrep, lset, threads=2
@@ -643,6 +665,8 @@ def main(argv=None) -> int:
             for v in lm.values():
                 v.pop("x", None), v.pop("y", None), v.pop("radius", None)
             case["lammps"] = lm
+        for k, v in case["paired"].items():
+            print(f"  paired {k}: median {v['median']:.2f} (rounds {v['min']:.2f}-{v['max']:.2f})")
         results["cases"][name] = case
         if sim is not base:
             del sim
@@ -662,7 +686,7 @@ def main(argv=None) -> int:
         pass
     results["targets"] = [dict(name=k, value=v, target=t, met=m) for k, v, t, m in targets(results)]
     print()
-    print("particle-steps per second (median of the timed blocks)")
+    print("particle-steps per second (median of the timed blocks); ratios: median of per-round ratios")
     print(table(results))
     print()
     for k, v, t, m in targets(results):
