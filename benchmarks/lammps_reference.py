@@ -287,6 +287,13 @@ def _checked_packing(x, y, radius, density, thickness, kn_pp, kn_pw, dt):
     return x, y, radius, dt
 
 
+def _model(radius, dt, skin, kn_pp, kt_pp, mu_pp, kn_pw, kt_pw, mu_pw, gravity, damping_cundall) -> dict:
+    """The model's part of the script parameters (skin default: half the smallest radius)."""
+    skin = 0.5 * float(radius.min()) if skin is None else skin
+    return dict(dt=dt, skin=skin, kn_pp=kn_pp, kt_pp=kt_pp, mu_pp=mu_pp, kn_pw=kn_pw, kt_pw=kt_pw,
+                mu_pw=mu_pw, gravity=gravity, damping_cundall=damping_cundall)  # fmt: skip
+
+
 def _write_inputs(wd: Path, x, y, radius, box, density, thickness, params: dict) -> dict:
     """Data file and ``in.bench`` in ``wd``; returns the full parameter set of the script."""
     xlo, xhi, ylo, yhi = map(float, box)
@@ -441,11 +448,9 @@ def run_lammps(
     try:
         params = _write_inputs(
             wd, x, y, radius, box, density, thickness, dict(
-                dt=dt, skin=0.5 * float(radius.min()) if skin is None else skin, kn_pp=kn_pp, kt_pp=kt_pp,
-                mu_pp=mu_pp, kn_pw=kn_pw, kt_pw=kt_pw, mu_pw=mu_pw, gravity=gravity,
-                damping_cundall=damping_cundall, settle_steps=int(settle_steps),
-                measure_steps=int(measure_steps), procs=f"{mpi_ranks} 1 1", repeats=max(1, int(repeats)),
-                dump="final.dump" if return_positions else None,
+                _model(radius, dt, skin, kn_pp, kt_pp, mu_pp, kn_pw, kt_pw, mu_pw, gravity, damping_cundall),
+                settle_steps=int(settle_steps), measure_steps=int(measure_steps), procs=f"{mpi_ranks} 1 1",
+                repeats=max(1, int(repeats)), dump="final.dump" if return_positions else None,
             ),
         )  # fmt: skip
         n = x.size
@@ -564,10 +569,9 @@ class LammpsSession:
         self._wd = Path(tempfile.mkdtemp(prefix="lmp_session_"))
         _write_inputs(
             self._wd, x, y, radius, box, density, thickness, dict(
-                dt=dt, skin=0.5 * float(radius.min()) if skin is None else skin, kn_pp=kn_pp, kt_pp=kt_pp,
-                mu_pp=mu_pp, kn_pw=kn_pw, kt_pw=kt_pw, mu_pw=mu_pw, gravity=gravity,
-                damping_cundall=damping_cundall, settle_steps=int(settle_steps),
-                measure_steps=int(block_steps), procs="1 1 1", repeats=0, dump=None,
+                _model(radius, dt, skin, kn_pp, kt_pp, mu_pp, kn_pw, kt_pw, mu_pw, gravity, damping_cundall),
+                settle_steps=int(settle_steps), measure_steps=int(block_steps), procs="1 1 1", repeats=0,
+                dump=None,
             ),
         )  # fmt: skip
         args = ["-log", "log.lammps", "-screen", "none"]

@@ -163,7 +163,7 @@ def _phase_forces(k, P, W, NB, WB, S, prm, props, dash, pw_body, dt, gx, gy, dam
     pair, else None (the constants in prm); ``dash`` the critical-damping fraction of
     the contact dashpot, None without one. Being None is a type, so numba compiles a
     variant without that code: those branches and the arrays they need cost
-    registers in the pair loop (about 8 % of its speed), even when never taken.
+    registers in the pair loop (5-7 % of its speed), even when never taken.
 
     Returns the largest squared drift of the disks advanced.
     """
