@@ -99,6 +99,7 @@ def paper_simulation(out: Path, rebuild: bool, threads: int = 2):
 
     ck = out / "paper_settled.npz"
     from poro2d.dem import Simulation
+    from poro2d.dem.ordering import strip_order
     from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
     from poro2d.specimen.grading import paper_grading
 
@@ -115,6 +116,8 @@ def paper_simulation(out: Path, rebuild: bool, threads: int = 2):
         )
         if math.isclose(now.dt, sim.dt, rel_tol=1e-9):
             print(f"[paper] loaded {ck} ({sim.particles.n} disks)", flush=True)
+            # a cache from before the specimen was numbered in strips gets the same layout
+            sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
             return sim, checkpoint.read_meta(ck).get("extra", {}).get("report", {})
         print(
             f"[paper] cached dt {sim.dt:.4e} s differs from the engine's {now.dt:.4e} s: "

@@ -26,20 +26,20 @@ def _run(out, trial, **kw):
 @pytest.fixture(scope="module")
 def down(tmp_path_factory):
     out = tmp_path_factory.mktemp("down")
-    return out, _run(out, 0.28, max_iterations=1)
+    return out, _run(out, 0.30, max_iterations=1)
 
 
 def test_accept_at_once(tmp_path):
-    # this small specimen at 0.215 (seed 0) just fills its box: F_top is a fraction of a per cent of G
+    # this small specimen at 0.21 (seed 0) just fills its box: F_top is about 1 % of G
     # (chaotic packing: another engine sum order may need another trial porosity here)
-    r = _run(tmp_path, 0.215, force_fraction=0.05)
-    assert r["converged"] and r["final_porosity"] == 0.215
+    r = _run(tmp_path, 0.21, force_fraction=0.05)
+    assert r["converged"] and r["final_porosity"] == 0.21
     (it,) = r["iterations"]
     assert it["plate_moved"] == "no" and it["plate_displacement_m"] == 0.0
     assert 0.0 < it["f_top_n_per_m"] < 0.05 * it["self_weight_n_per_m"]
     assert it["accepted"] and it["porosity_change"] == 0.0
     saved = json.loads((tmp_path / "result.json").read_text())
-    assert saved["final_porosity"] == 0.215 and REQUIRED <= set(saved["iterations"][0])
+    assert saved["final_porosity"] == 0.21 and REQUIRED <= set(saved["iterations"][0])
     for f in ("iterations.csv", "specimen.npz", "fig5_forces_initial_trial.png", "fig7_forces_accepted.png"):
         assert (tmp_path / f).stat().st_size > 0
     assert (tmp_path / "vtu" / "accepted_specimen_contacts.vtu").is_file()
@@ -63,7 +63,7 @@ def test_plate_moves_down_when_nothing_touches_it(down):
     (it,) = r["iterations"]
     assert it["f_top_n_per_m"] == 0.0
     assert it["plate_moved"] == "down" and it["plate_displacement_m"] < 0
-    assert it["new_porosity"] < 0.28
+    assert it["new_porosity"] < 0.30
     assert 0.0 < it["f_top_after_n_per_m"] < 0.01 * it["self_weight_n_per_m"]
     # force balance of the specimen after the plate moved, within 1 % of its weight
     lhs = it["f_bottom_after_n_per_m"] + it["side_friction_up_after_n_per_m"]
@@ -84,7 +84,7 @@ def test_resume_skips_finished_trials(down):
     out, r = down
     trial_dir = next((out / "trials").iterdir())
     stamp = (trial_dir / "prepared.npz").stat().st_mtime_ns
-    again = _run(out, 0.28, max_iterations=1)
+    again = _run(out, 0.30, max_iterations=1)
     assert again["iterations"] == r["iterations"]
     assert (trial_dir / "prepared.npz").stat().st_mtime_ns == stamp
 
@@ -92,7 +92,7 @@ def test_resume_skips_finished_trials(down):
 def test_other_config_in_the_same_folder_is_refused(down):
     out, _ = down
     with pytest.raises(InputError, match="out"):
-        _run(out, 0.28, max_iterations=2)
+        _run(out, 0.30, max_iterations=2)
 
 
 def test_next_trial_rounding():

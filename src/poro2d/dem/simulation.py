@@ -301,6 +301,71 @@ class Simulation:
         self._refresh()
         return np.arange(n0, n)
 
+    # per-disk arrays of the Simulation itself (the Particles' fields are permuted too)
+    _PER_DISK = ("force", "moment", "_pos_build", "_mass", "_inv_mass", "_inv_inertia")
+
+    def reorder(self, order) -> None:
+        """Renumber the disks: new disk ``k`` is old disk ``order[k]``; contacts keep their history.
+
+        The motion does not depend on the numbering (up to round-off: sums are added in
+        another order), its speed does (see :mod:`poro2d.dem.ordering`; e.g.
+        ``sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))``). Index
+        arrays held elsewhere must be mapped with ``order`` too.
+        """
+        from poro2d.dem.ordering import is_permutation
+
+        p = self.particles
+        n = p.n
+        order = np.asarray(order)
+        if not is_permutation(order, n):
+            raise InputError("order", f"array of shape {order.shape}", f"a permutation of 0 .. {n - 1}")
+        order = order.astype(np.int64)
+        new_of_old = np.empty(n, dtype=np.int64)
+        new_of_old[order] = np.arange(n)
+        for f in ("pos", "radius", "density", "kn", "ks", "mu", "vel", "theta", "omega", "mode"):
+            setattr(p, f, np.ascontiguousarray(getattr(p, f)[order]))
+        for f in self._PER_DISK:
+            setattr(self, f, np.ascontiguousarray(getattr(self, f)[order]))
+        self._renumber_pairs(new_of_old)
+        self._renumber_wall_pairs(new_of_old)
+        self._iprm[K.NEED_BUILD] = 1  # rows in the kernel's own order before the next step
+
+    def _renumber_pairs(self, new_of_old: np.ndarray) -> None:
+        """Disk-disk list in new numbers: rows by the smaller new index, history unchanged.
+
+        Swapping the two disks of a pair turns its normal and tangent round; the shear
+        force on the (new) first disk, ``fs`` along its tangent, is the same number.
+        """
+        n = new_of_old.shape[0]
+        start = self._nb_start
+        m = int(start[n])
+        a = new_of_old[np.repeat(np.arange(n), np.diff(start))]
+        b = new_of_old[self._nb_j[:m]]
+        swap = a > b
+        first = np.where(swap, b, a)
+        sort = np.argsort(first, kind="stable")
+        self._nb_j[:m] = np.where(swap, a, b)[sort]
+        sign = np.where(swap, -1.0, 1.0)
+        for name, flip in (("_nb_fs", False), ("_nb_fn", False), ("_nb_ov", False),
+                           ("_nb_nx", True), ("_nb_ny", True)):  # fmt: skip
+            arr = getattr(self, name)
+            arr[:m] = (arr[:m] * sign if flip else arr[:m])[sort]
+        start[0] = 0
+        start[1:] = np.cumsum(np.bincount(first, minlength=n))
+
+    def _renumber_wall_pairs(self, new_of_old: np.ndarray) -> None:
+        """Disk-wall rows follow their disks."""
+        n = new_of_old.shape[0]
+        start = self._wb_start
+        m = int(start[n])
+        rows = new_of_old[np.repeat(np.arange(n), np.diff(start))]
+        sort = np.argsort(rows, kind="stable")
+        for name in ("_wb_w", "_wb_fs", "_wb_fn", "_wb_ov", "_wb_nx", "_wb_ny"):
+            arr = getattr(self, name)
+            arr[:m] = arr[:m][sort]
+        start[0] = 0
+        start[1:] = np.cumsum(np.bincount(rows, minlength=n))
+
     def set_particle_friction(self, mu: float) -> None:
         """Change every disk's friction coefficient (e.g. 0.05 -> 3 after preparation)."""
         if not (mu >= 0.0 and math.isfinite(mu)):

@@ -29,6 +29,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
+from poro2d.dem.ordering import strip_order
 from poro2d.errors import InputError, check_range
 
 LOWER = ("bottom", "lower_left", "lower_right", "lower_lip")
@@ -157,6 +158,7 @@ def build_split_box(
     replaces their friction when given); the engine settings (contact convention,
     gravity, damping) are the specimen's. Disk-disk shear histories are not carried
     over: the consolidation that follows brings the specimen to a new equilibrium.
+    The disks are numbered anew (:func:`poro2d.dem.ordering.strip_order`).
     ``max_displacement`` may not exceed W / 2.
     """
     W, H = _specimen_box(specimen)
@@ -204,6 +206,8 @@ def build_split_box(
         restitution=specimen.restitution, dt_safety=dt_safety, density_scale=density_scale,
         skin=specimen.skin, threads=threads,
     )  # fmt: skip
+    # numbered in strips across the short side, whatever order the specimen came in
+    sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
     box = SplitBox(W, H, ys, float(gap), float(max_displacement), p0.thickness)
     return sim, box
 

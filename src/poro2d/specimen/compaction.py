@@ -24,6 +24,7 @@ import numpy as np
 
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
 from poro2d.dem.measure import porosity_rect
+from poro2d.dem.ordering import strip_order
 from poro2d.errors import InputError, check_range
 from poro2d.specimen.grading import GradingCurve, draw_disks
 from poro2d.specimen.placement import Band, place_disks
@@ -191,6 +192,9 @@ def prepare_specimen(
             sim.translate_wall(lid, 0.0, y_top - float(sim.walls.p0[lid, 1]))
             new = sim.add_particles(small)
         steps = _grow(sim, new, radii[idx], scale, spec)
+        # renumber the whole packing in strips across its short side (the new layer was
+        # appended on top): threads then split it along a short cut (dem.ordering)
+        sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
         res = sim.solve(
             spec.ratio, spec.max_steps_per_stage, progress=f"layer {k + 1}" if progress else False
         )
