@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from test_dem_reference import _lockstep, jammed_packing
 
 from poro2d.dem import Particles, Simulation, Walls
 from poro2d.dem.ordering import is_permutation, strip_order
 from poro2d.errors import InputError
+from test_dem_reference import _lockstep, jammed_packing
 
 R = 1e-3
 
