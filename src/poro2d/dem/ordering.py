@@ -14,8 +14,8 @@ motion up to round-off. It matters for speed in two ways.
 :func:`strip_order` numbers the disks strip by strip, the strips running across the
 short side of the packing (columns in a wide box, rows in a tall one), and along each
 strip. Measured on the paper's 0.305 m x 0.124 m specimen (2565 disks): numbered in
-rows, 81 disks wait for the second phase; in columns, 33, and two threads ran about
-10 % faster (one thread about 2 % faster).
+rows, 81 disks wait for the second phase; in columns, 37, and two threads ran 8-12 %
+faster in paired runs (one thread: no change beyond the +-3 % noise).
 """
 
 from __future__ import annotations
