@@ -16,13 +16,12 @@ import numpy as np
 from poro2d.dem import kernels as K
 from poro2d.dem.model import ContactModel
 from poro2d.dem.simulation import Simulation
-from poro2d.dem.state import SERVO_COLUMNS, Particles, Walls
+from poro2d.dem.state import PARTICLE_FIELDS, SERVO_COLUMNS, Particles, Walls
 from poro2d.errors import InputError
 from poro2d.io_utils import atomic_path, provenance
 
 FORMAT = "poro2d-checkpoint-1"
 
-_PARTICLE_FIELDS = ("pos", "radius", "density", "kn", "ks", "mu", "vel", "theta", "omega", "mode")
 _WALL_FIELDS = ("p0", "p1", "kn", "ks", "mu", "vel", "mode", "servo_dir", "servo")
 _SIM_ARRAYS = (
     "force", "moment", "wall_force_vec", "_wstat", "_pos_build", "_wall_build",
@@ -35,7 +34,7 @@ def save(sim: Simulation, path: str | os.PathLike, extra: dict | None = None) ->
     """Write ``sim`` to ``path`` (.npz), atomically. ``extra`` is stored as JSON metadata."""
     path = Path(path)
     arrays: dict[str, np.ndarray] = {}
-    for f in _PARTICLE_FIELDS:
+    for f in PARTICLE_FIELDS:
         arrays[f"particles.{f}"] = getattr(sim.particles, f)
     for f in _WALL_FIELDS:
         arrays[f"walls.{f}"] = getattr(sim.walls, f)
@@ -90,7 +89,7 @@ def load(path: str | os.PathLike, threads: int | None = None) -> Simulation:
             raise InputError("checkpoint format", meta.get("format"), FORMAT)
         a = {k: z[k].copy() for k in z.files if k != "meta"}
     s = meta["settings"]
-    pf = {f: a[f"particles.{f}"] for f in _PARTICLE_FIELDS}
+    pf = {f: a[f"particles.{f}"] for f in PARTICLE_FIELDS}
     particles = Particles(
         pos=pf["pos"], radius=pf["radius"], density=pf["density"], thickness=meta["thickness"],
         kn=pf["kn"], ks=pf["ks"], mu=pf["mu"], vel=pf["vel"], theta=pf["theta"], omega=pf["omega"],

@@ -25,7 +25,7 @@ from poro2d.dem.model import (
     restitution_to_beta,
     single_contact_limit,
 )
-from poro2d.dem.state import FREE, PRESCRIBED, WALL_SERVO, WALL_VELOCITY, Particles, Walls
+from poro2d.dem.state import FREE, PARTICLE_FIELDS, PRESCRIBED, WALL_SERVO, WALL_VELOCITY, Particles, Walls
 from poro2d.errors import InputError
 
 _THREADING_SET = False
@@ -44,6 +44,23 @@ def _prefer_openmp() -> None:
         except Exception:  # pragma: no cover - older numba
             pass
         _THREADING_SET = True
+
+
+def _row_of_slot(start: np.ndarray) -> np.ndarray:
+    """The row (first disk) of every filled slot of a list stored as rows ``start``."""
+    n = start.shape[0] - 1
+    return np.repeat(np.arange(n), np.diff(start))
+
+
+def _regroup(start: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """Rewrite ``start`` for slots that now belong to ``rows``; returns the slot order.
+
+    Slots of one row keep their relative order (a stable sort).
+    """
+    n = start.shape[0] - 1
+    start[0] = 0
+    start[1:] = np.cumsum(np.bincount(rows, minlength=n))
+    return np.argsort(rows, kind="stable")
 
 
 class SimulationError(RuntimeError):
@@ -286,7 +303,7 @@ class Simulation:
         if new.thickness != p.thickness:
             raise InputError("thickness", new.thickness, f"{p.thickness} (that of the disks present)")
         n0 = p.n
-        for f in ("pos", "radius", "density", "kn", "ks", "mu", "vel", "theta", "omega", "mode"):
+        for f in PARTICLE_FIELDS:
             setattr(p, f, np.ascontiguousarray(np.concatenate([getattr(p, f), getattr(new, f)])))
         n = p.n
         # Old rows keep their place; the new disks start with empty rows.
@@ -322,7 +339,7 @@ class Simulation:
         order = order.astype(np.int64)
         new_of_old = np.empty(n, dtype=np.int64)
         new_of_old[order] = np.arange(n)
-        for f in ("pos", "radius", "density", "kn", "ks", "mu", "vel", "theta", "omega", "mode"):
+        for f in PARTICLE_FIELDS:
             setattr(p, f, np.ascontiguousarray(getattr(p, f)[order]))
         for f in self._PER_DISK:
             setattr(self, f, np.ascontiguousarray(getattr(self, f)[order]))
@@ -336,35 +353,26 @@ class Simulation:
         Swapping the two disks of a pair turns its normal and tangent round; the shear
         force on the (new) first disk, ``fs`` along its tangent, is the same number.
         """
-        n = new_of_old.shape[0]
-        start = self._nb_start
-        m = int(start[n])
-        a = new_of_old[np.repeat(np.arange(n), np.diff(start))]
+        m = int(self._nb_start[-1])
+        a = new_of_old[_row_of_slot(self._nb_start)]
         b = new_of_old[self._nb_j[:m]]
         swap = a > b
         first = np.where(swap, b, a)
-        sort = np.argsort(first, kind="stable")
+        sort = _regroup(self._nb_start, first)
         self._nb_j[:m] = np.where(swap, a, b)[sort]
         sign = np.where(swap, -1.0, 1.0)
         for name, flip in (("_nb_fs", False), ("_nb_fn", False), ("_nb_ov", False),
                            ("_nb_nx", True), ("_nb_ny", True)):  # fmt: skip
             arr = getattr(self, name)
             arr[:m] = (arr[:m] * sign if flip else arr[:m])[sort]
-        start[0] = 0
-        start[1:] = np.cumsum(np.bincount(first, minlength=n))
 
     def _renumber_wall_pairs(self, new_of_old: np.ndarray) -> None:
         """Disk-wall rows follow their disks."""
-        n = new_of_old.shape[0]
-        start = self._wb_start
-        m = int(start[n])
-        rows = new_of_old[np.repeat(np.arange(n), np.diff(start))]
-        sort = np.argsort(rows, kind="stable")
+        m = int(self._wb_start[-1])
+        sort = _regroup(self._wb_start, new_of_old[_row_of_slot(self._wb_start)])
         for name in ("_wb_w", "_wb_fs", "_wb_fn", "_wb_ov", "_wb_nx", "_wb_ny"):
             arr = getattr(self, name)
             arr[:m] = arr[:m][sort]
-        start[0] = 0
-        start[1:] = np.cumsum(np.bincount(rows, minlength=n))
 
     def set_particle_friction(self, mu: float) -> None:
         """Change every disk's friction coefficient (e.g. 0.05 -> 3 after preparation)."""

@@ -32,6 +32,10 @@ def _as_f64(name: str, a, n: int | None = None, shape_tail: tuple = ()) -> np.nd
     return arr
 
 
+# the per-disk arrays of Particles (thickness is one number for all disks)
+PARTICLE_FIELDS = ("pos", "radius", "density", "kn", "ks", "mu", "vel", "theta", "omega", "mode")
+
+
 @dataclass
 class Particles:
     """Disks: positions, velocities, spins, sizes and per-body contact properties.
