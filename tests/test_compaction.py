@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from poro2d.criterion.protocol import wall_forces
+from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.specimen import GradingCurve, paper_grading
 from poro2d.specimen.compaction import SpecimenSpec, check_feasible, prepare_specimen
@@ -55,6 +56,24 @@ def test_dense_trial_loads_the_top_plate():
     # balance: bottom + side friction = weight + top, relative to the forces involved
     lhs = f["f_bottom_n_per_m"] + f["side_friction_up_n_per_m"]
     assert lhs == pytest.approx(spec.self_weight(0.14) + f["f_top_n_per_m"], rel=1e-3)
+
+
+def _deferred(sim) -> int:
+    """Disks that wait for the second phase of a step (their pairs cross the partition cut)."""
+    sim.run(1)
+    return int(sim._dstart[-1])
+
+
+def test_specimen_is_numbered_across_its_short_side(loose, tmp_path):
+    # placed layer by layer in rows, renumbered after each layer in columns: the cut
+    # between the two partitions runs across the height, not along the width
+    _, sim, _ = loose
+    checkpoint.save(sim, tmp_path / "s.npz")
+    as_built = checkpoint.load(tmp_path / "s.npz", threads=1)
+    in_rows = checkpoint.load(tmp_path / "s.npz", threads=1)
+    p = in_rows.particles
+    in_rows.reorder(np.lexsort((p.pos[:, 0], np.floor(p.pos[:, 1] / (4.0 * p.radius.max())))))
+    assert _deferred(as_built) < 0.7 * _deferred(in_rows)
 
 
 def test_layers_each_reach_equilibrium(loose):

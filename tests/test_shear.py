@@ -44,6 +44,15 @@ def _curve(path):
     return {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
 
 
+def test_split_box_numbers_the_disks_in_columns(specimen):
+    spec = checkpoint.load(specimen)
+    spec.reorder(np.random.default_rng(0).permutation(spec.particles.n))
+    sim, _ = build_split_box(spec, 0.01)
+    p = sim.particles
+    strip = np.floor((p.pos[:, 0] - p.pos[:, 0].min()) / (4.0 * p.radius.max()))
+    assert np.all(np.diff(strip) >= 0)
+
+
 def test_split_box_walls(specimen):
     sim, box = build_split_box(checkpoint.load(specimen), 0.01)
     assert set(sim.walls.names) == set(LOWER) | set(UPPER)
