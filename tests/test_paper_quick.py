@@ -1,6 +1,8 @@
 """`poro2d paper --quick`: the whole pipeline on a reduced specimen, and its report."""
 
 import json
+import os
+import re
 import shutil
 import subprocess
 
@@ -12,7 +14,12 @@ from poro2d.cli import main
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
     out = tmp_path_factory.mktemp("paper")
-    main(["paper", "--quick", "--out", str(out), "--quiet"])  # raises SystemExit on failure
+    cwd = os.getcwd()
+    os.chdir(out.parent)  # a relative --out, as in the README
+    try:
+        main(["paper", "--quick", "--out", out.name, "--quiet"])  # raises SystemExit on failure
+    finally:
+        os.chdir(cwd)
     return out
 
 
@@ -58,7 +65,33 @@ def test_rerun_reuses_finished_stages(quick):
     assert [f.stat().st_mtime_ns for f in done] == before  # no specimen rebuilt, no test rerun
 
 
-@pytest.mark.skipif(shutil.which("chromium") is None, reason="Debian's chromium is not installed")
+def _md_images(md_path):
+    return re.findall(r"!\[[^\]]*\]\(([^)]+)\)", md_path.read_text())
+
+
+def test_report_md_links_its_figures_relative_to_itself(quick, tmp_path, monkeypatch):
+    """The Markdown report's pictures open where it lies, from any directory, and after a move."""
+    links = _md_images(quick / "report.md")
+    assert len(links) >= 6
+    assert all(not os.path.isabs(x) and not x.startswith(quick.name) for x in links), links
+    monkeypatch.chdir(tmp_path)  # another working directory
+    moved = tmp_path / "elsewhere" / "copy-of-paper-out"
+    shutil.copytree(quick, moved)
+    for folder in (quick, moved):
+        for link in links:
+            assert (folder / link).is_file(), (folder, link)
+
+
+def _chromium() -> str:
+    """Debian's chromium; CI (CI=true) must have it, elsewhere the test is skipped without it."""
+    exe = shutil.which("chromium")
+    if exe is None:
+        if os.environ.get("CI", "").lower() == "true":
+            pytest.fail("CI=true but Debian's chromium is not installed (apt-get install -y chromium)")
+        pytest.skip("Debian's chromium is not installed")
+    return exe
+
+
 def test_report_renders_in_headless_chromium(quick, tmp_path):
     """The HTML opens from disk in a browser; nothing spills past the page column."""
     import numpy as np
@@ -66,7 +99,7 @@ def test_report_renders_in_headless_chromium(quick, tmp_path):
 
     shot = tmp_path / "report.png"
     cmd = [
-        "chromium", "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+        _chromium(), "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
         "--disable-background-networking", "--disable-component-update", "--disable-sync",
         "--hide-scrollbars",
         f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1200,2400",

@@ -61,8 +61,8 @@ def to_markdown(blocks: list[Block], base: Path) -> str:
             out.append("| " + " | ".join("---" for _ in headers) + " |")
             out.extend("| " + " | ".join(_fmt(c) for c in r) + " |" for r in rows)
         elif kind == "img":
-            p = Path(b[1])
-            rel = os.path.relpath(p, base) if p.is_absolute() else str(p)
+            # relative to the report file itself, so the links work wherever the folder goes
+            rel = Path(os.path.relpath(Path(b[1]).resolve(), Path(base).resolve())).as_posix()
             out.append(f"![{b[2]}]({rel})\n\n*{b[2]}*")
         elif kind == "code":
             out.append("```\n" + b[1] + "\n```")
