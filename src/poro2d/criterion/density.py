@@ -1,0 +1,239 @@
+"""Density-controlled preparation: from a laboratory state to a preparation friction.
+
+With the preparation friction fixed, the criterion of Fig. 3 steers every trial back to
+the natural packing of the preparation protocol, whatever laboratory density was asked
+for. Here the preparation friction mu_prep is the control variable of the specimen's
+density (lubricated compaction packs densest, frictional compaction loosest):
+
+1. **Calibration.** For one grading and box, the criterion runs at a few values of
+   mu_prep, several seeds each; its accepted n2D at mu_prep = 0 is the grading's densest
+   2D state n2D,min, at the loosest preparation (``mu_loose``) its loosest n2D,max. Both
+   are measured in the criterion's end state (self-weight, top plate just touching).
+2. **Mapping** (Salot, Gotteland & Villard 2009): the laboratory relative density
+   Dr = (e_max - e_Lab) / (e_max - e_min) from void ratios e = n / (1 - n) sets the 2D
+   void ratio e2D = e2D,max - Dr (e2D,max - e2D,min).
+3. **Inversion.** The mu_prep whose calibrated n2D equals that target is read from a
+   monotone fit of the calibration (isotonic regression of the seed means, then linear
+   interpolation); the criterion run with it is the check, and its accepted n2D, over
+   seeds, is the answer.
+
+This module holds the arithmetic only; running the criterion for the calibration and
+the check is the sweep layer's job (:mod:`poro2d.sweep.density`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from poro2d import porosity as P
+from poro2d.errors import InputError, check_range
+
+#: the preparation frictions of a calibration, densest first; beyond about 0.5 the jamming
+#: porosity of frictional disks hardly rises any more, while large pores appear
+DEFAULT_MUS = (0.0, 0.05, 0.1, 0.2, 0.5)
+
+
+def void_ratio(n: float) -> float:
+    """e = n / (1 - n)."""
+    return n / (1.0 - n)
+
+
+def porosity_from_void_ratio(e: float) -> float:
+    """n = e / (1 + e)."""
+    return e / (1.0 + e)
+
+
+def lab_relative_density(n_lab: float, n_max: float, n_min: float) -> float:
+    """Dr of the laboratory state; refuses nLab outside [n_min, n_max] and n_min >= n_max."""
+    hi = check_range("n_max", n_max, 0.0, 1.0, lo_open=True, hi_open=True)
+    lo = check_range("n_min", n_min, 0.0, 1.0, lo_open=True, hi_open=True)
+    if not lo < hi:
+        raise InputError("n_min", lo, f"below n_max = {hi}")
+    check_range("n_lab", n_lab, lo, hi)
+    return float(P.relative_density(n_lab, hi, lo))
+
+
+def target_porosity_2d(dr: float, n2d_max: float, n2d_min: float) -> float:
+    """The 2D porosity at relative density ``dr`` between the grading's 2D extremes.
+
+    e2D = e2D,max - Dr (e2D,max - e2D,min); the mapping is linear in the void ratio, as
+    Dr is in the laboratory.
+    """
+    if not n2d_min < n2d_max:
+        raise InputError(
+            "calibration", f"n2D,min = {n2d_min:.4f}, n2D,max = {n2d_max:.4f}",
+            "a densest state below the loosest one",
+            "the loosest preparation packs no looser than the densest: raise mu_loose",
+        )  # fmt: skip
+    e_hi, e_lo = void_ratio(n2d_max), void_ratio(n2d_min)
+    return porosity_from_void_ratio(e_hi - dr * (e_hi - e_lo))
+
+
+def isotonic_increasing(y, w=None) -> np.ndarray:
+    """Least-squares non-decreasing fit of ``y`` (pool adjacent violators), weights ``w``."""
+    y = np.asarray(y, dtype=float)
+    w = np.ones_like(y) if w is None else np.asarray(w, dtype=float)
+    blocks: list[list[float]] = []  # [weighted mean, weight, count]
+    for yi, wi in zip(y, w, strict=True):
+        blocks.append([yi, wi, 1])
+        while len(blocks) > 1 and blocks[-2][0] > blocks[-1][0]:
+            m2, w2, c2 = blocks.pop()
+            m1, w1, c1 = blocks.pop()
+            blocks.append([(m1 * w1 + m2 * w2) / (w1 + w2), w1 + w2, c1 + c2])
+    return np.concatenate([np.full(c, m) for m, _, c in blocks])
+
+
+@dataclass
+class Calibration:
+    """mu_prep -> accepted n2D of one grading and box, over seeds.
+
+    ``samples[k]`` holds the accepted n2D of every seed at ``mus[k]`` (None where the
+    criterion did not converge; such seeds are left out of the mean and counted).
+    """
+
+    mus: list[float]
+    samples: list[list[float | None]]
+    seeds: list[int] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        if len(self.mus) < 2 or len(self.mus) != len(self.samples):
+            raise InputError("calibration.mus", self.mus, "at least two frictions, one sample list each")
+        if any(b <= a for a, b in zip(self.mus, self.mus[1:], strict=False)):
+            raise InputError("calibration.mus", self.mus, "strictly increasing preparation frictions")
+
+    # ----------------------------------------------------------- statistics
+    def _good(self, k: int) -> np.ndarray:
+        return np.array([v for v in self.samples[k] if v is not None and math.isfinite(v)], dtype=float)
+
+    @property
+    def mean(self) -> np.ndarray:
+        return np.array([g.mean() if g.size else math.nan for g in map(self._good, range(len(self.mus)))])
+
+    @property
+    def sd(self) -> np.ndarray:
+        """Sample standard deviation over seeds (0 with one seed)."""
+        return np.array([g.std(ddof=1) if g.size > 1 else 0.0 for g in map(self._good, range(len(self.mus)))])
+
+    @property
+    def failed(self) -> list[int]:
+        """Per friction, how many seeds did not give an accepted porosity."""
+        return [len(s) - self._good(k).size for k, s in enumerate(self.samples)]
+
+    # --------------------------------------------------------------- checks
+    def check(self) -> None:
+        """Refuse a calibration that cannot map densities: missing points, or not monotone.
+
+        A decrease of the seed means with rising friction is tolerated as noise when it is
+        within twice the combined standard error of the two means; the fit then pools it.
+        """
+        m, s = self.mean, self.sd
+        bad = [mu for mu, v in zip(self.mus, m, strict=True) if not math.isfinite(v)]
+        if bad:
+            raise InputError(
+                "calibration", f"no accepted porosity at mu_prep = {bad}", "every friction accepted by "
+                "at least one seed", "see the calibration's cases for why the criterion did not converge",
+            )  # fmt: skip
+        n = np.array([max(self._good(k).size, 1) for k in range(len(self.mus))])
+        se = s / np.sqrt(n)
+        for k in range(len(self.mus) - 1):
+            drop = m[k] - m[k + 1]
+            if drop > 2.0 * math.hypot(se[k], se[k + 1]) and drop > 1e-4:
+                raise InputError(
+                    "calibration",
+                    f"n2D {m[k]:.4f} at mu_prep {self.mus[k]:g} > {m[k + 1]:.4f} at {self.mus[k + 1]:g}",
+                    "a porosity that does not fall as the preparation friction rises",
+                    "more seeds, or frictions further apart",
+                )  # fmt: skip
+        if not self.fitted[-1] > self.fitted[0]:
+            raise InputError(
+                "calibration", f"n2D from {m[0]:.4f} to {m[-1]:.4f}", "a looser state at the highest "
+                "preparation friction than at the lowest", "raise the largest mu_prep (mu_loose)",
+            )  # fmt: skip
+
+    @property
+    def fitted(self) -> np.ndarray:
+        """Non-decreasing fit of the seed means (weights: number of accepted seeds)."""
+        w = [max(self._good(k).size, 1) for k in range(len(self.mus))]
+        return isotonic_increasing(self.mean, w)
+
+    @property
+    def n2d_min(self) -> float:
+        """The grading's densest 2D porosity: the fit at the lowest friction."""
+        return float(self.fitted[0])
+
+    @property
+    def n2d_max(self) -> float:
+        """The grading's loosest 2D porosity: the fit at the highest friction."""
+        return float(self.fitted[-1])
+
+    def mu_for(self, n2d: float) -> float:
+        """The preparation friction whose calibrated n2D is ``n2d`` (monotone interpolation)."""
+        f = self.fitted
+        if n2d < f[0] - 1e-12:
+            raise InputError(
+                "target n2D", round(n2d, 5), f"[{f[0]:.4f}, {f[-1]:.4f}] (the calibrated range)",
+                f"denser than the densest preparation (mu_prep = {self.mus[0]:g})",
+            )  # fmt: skip
+        if n2d > f[-1] + 1e-12:
+            raise InputError(
+                "target n2D", round(n2d, 5), f"[{f[0]:.4f}, {f[-1]:.4f}] (the calibrated range)",
+                f"looser than the loosest preparation (mu_prep = {self.mus[-1]:g}): add a larger mu_prep",
+            )  # fmt: skip
+        # flat runs of the fit: take the lowest friction that reaches the value
+        xs, ys = [self.mus[0]], [f[0]]
+        for mu, v in zip(self.mus[1:], f[1:], strict=True):
+            if v > ys[-1]:
+                xs.append(mu)
+                ys.append(v)
+        if len(xs) == 1:
+            return float(xs[0])
+        return float(np.interp(n2d, ys, xs))
+
+    # ------------------------------------------------------------------ io
+    def to_dict(self) -> dict:
+        d = asdict(self)
+        d.update(
+            mean=self.mean.tolist(), sd=self.sd.tolist(), fitted=self.fitted.tolist(), failed=self.failed
+        )
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict) -> Calibration:
+        return cls(list(d["mus"]), [list(s) for s in d["samples"]], list(d.get("seeds", [])))
+
+
+@dataclass
+class StateTarget:
+    """The density-controlled target of one laboratory state."""
+
+    n_lab: float
+    relative_density: float
+    n2d_target: float
+    mu_prep: float
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def state_target(n_lab: float, n_max: float, n_min: float, cal: Calibration) -> StateTarget:
+    """Dr of the laboratory state, its 2D porosity target and the friction that prepares it."""
+    dr = lab_relative_density(n_lab, n_max, n_min)
+    cal.check()
+    n2d = target_porosity_2d(dr, cal.n2d_max, cal.n2d_min)
+    return StateTarget(n_lab, dr, n2d, cal.mu_for(n2d))
+
+
+__all__ = [
+    "DEFAULT_MUS",
+    "Calibration",
+    "StateTarget",
+    "isotonic_increasing",
+    "lab_relative_density",
+    "porosity_from_void_ratio",
+    "state_target",
+    "target_porosity_2d",
+    "void_ratio",
+]
