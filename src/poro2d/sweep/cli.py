@@ -63,9 +63,18 @@ def register(app: typer.Typer) -> None:
         scheduler: str = typer.Option(None, "--scheduler", help=_SCHED),
         workers: int = typer.Option(None, "--workers", help=_WORKERS),
         quick: bool = typer.Option(False, "--quick", help="Small specimen (0.08 m x 0.04 m, 2 layers)."),
+        mode: str = typer.Option(
+            None, "--mode", help="density (default): preparation friction from the state; paper: fixed 0.05."
+        ),
+        seeds: int = typer.Option(None, "--seeds", help="Specimens per state and per calibration point (3)."),
         quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
     ) -> None:
-        """The grading's n2D(nLab) relation from the criterion at several relative densities."""
+        """The grading's n2D(nLab) relation from the criterion at several relative densities.
+
+        Density mode (default): the criterion is first calibrated (preparation friction ->
+        accepted n2D, the grading's densest and loosest 2D states), every laboratory state is
+        mapped between them by its relative density, and checked by the criterion over seeds.
+        """
         from poro2d.config import check_keys, load_toml
         from poro2d.criterion.config import TOP_KEYS, paper_preset
         from poro2d.errors import InputError
@@ -87,25 +96,35 @@ def register(app: typer.Typer) -> None:
         settings = R.relation_settings(
             base.get("relation"), points=points, n_max=n_max, n_min=n_min, preset=config is None
         )
-        cfg = R.sweep_config(base, settings["n_lab"], quick=quick)
-        sweep = parse_sweep(cfg, base_dir)
+        table = base.get("relation") or {}
+        mode = R.check_mode(mode if mode is not None else table.get("mode", "density"))
+        n_seeds = R.check_seeds(seeds if seeds is not None else table.get("seeds", 3))
         console.print(
-            f"criterion at nLab = {', '.join(f'{v:g}' for v in settings['n_lab'])} "
+            f"criterion ({mode} mode) at nLab = {', '.join(f'{v:g}' for v in settings['n_lab'])} "
             f"(n_max {settings['n_max']:g}, n_min {settings['n_min']:g})"
             f"{' (quick)' if quick else ''} -> {out}"
         )
-        res = run_sweep(sweep, out, scheduler=scheduler, workers=workers, progress=not quiet)
-        rel = R.analyse(res.rows, settings["n_max"], settings["n_min"])
-        extra = {"quick": quick, "sweep_summary": res.summary, "config": base}
+        sweep_kw = {"scheduler": scheduler, "workers": workers, "progress": not quiet}
         title = "2D porosity from the criterion vs laboratory porosity"
         if quick:
-            title += " (quick: 0.08 m x 0.04 m specimen)"
+            title += " (quick: 0.08 m x 0.04 m box)"
+        if mode == "density":
+            rel, record = R.density_relation(
+                base, base_dir, settings, out,
+                quick=quick, seeds=n_seeds, mus=table.get("mu_prep"), **sweep_kw,
+            )  # fmt: skip
+            failed = record["failed_cases"]
+            extra = {"quick": quick, "config": base, "sweeps": record}
+        else:
+            sweep = parse_sweep(R.sweep_config(base, settings["n_lab"], quick=quick), base_dir)
+            res = run_sweep(sweep, out, **sweep_kw)
+            rel = R.analyse(res.rows, settings["n_max"], settings["n_min"])
+            failed = len(res.failed)
+            extra = {"quick": quick, "sweep_summary": res.summary, "config": base}
         R.write_relation(rel, out, title=title, extra=extra)
         print_relation(rel, out)
-        if res.failed:
-            console.print(
-                f"[bold red]{len(res.failed)} case(s) failed[/]; tracebacks in {out}/cases/<id>/error.txt"
-            )
+        if failed:
+            console.print(f"[bold red]{failed} case(s) failed[/]; tracebacks in {out}/**/error.txt")
             raise typer.Exit(1)
 
 
@@ -147,10 +166,13 @@ def print_relation(rel: dict, out: Path) -> None:
         return "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.4f}"
 
     for p in rel["points"]:
+        dem = f(p["n2d_dem"])
+        if rel.get("mode") == "density" and dem:
+            dem += f" +- {p['n2d_sd']:.4f} ({p['seeds_converged']}/{p['seeds']})"
         t.add_row(
             f"{p['n_lab']:.4f}",
             f"{p['relative_density']:.2f}",
-            f(p["n2d_dem"]),
+            dem,
             f(p["n2d_fit"]),
             f(p["n2d_parabolic"]),
             f(p["n2d_lim_3d"]),
@@ -158,6 +180,18 @@ def print_relation(rel: dict, out: Path) -> None:
             p["flag"] or "ok",
         )
     console.print(t)
+    if rel.get("mode") == "density":
+        console.print(
+            f"grading's 2D extremes (criterion end state): n2D,min {rel['n2d_min']:.4f} (densest "
+            f"preparation), n2D,max {rel['n2d_max']:.4f} (loosest); mu_prep per state: "
+            + ", ".join(f"{p['mu_prep']:.3f}" for p in rel["points"])
+        )
+        sp = rel.get("spread")
+        if sp:
+            console.print(
+                f"loose - dense: {sp['n2d_loose_minus_dense']:+.4f} +- {sp['sd']:.4f} (measured, not a fit); "
+                f"{'monotone' if sp['monotone'] else 'NOT monotone'} in nLab"
+            )
     fit = rel["fit"]
     if fit:
         console.print(

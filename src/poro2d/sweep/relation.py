@@ -23,11 +23,25 @@ from poro2d import porosity as P
 from poro2d.config import check_keys
 from poro2d.errors import InputError, check_range
 
-RELATION_KEYS = {"n_max", "n_min", "points", "n_lab"}
+RELATION_KEYS = {"n_max", "n_min", "points", "n_lab", "mode", "seeds", "mu_prep"}
+#: how the specimen's density follows the laboratory state (see :mod:`poro2d.criterion.density`)
+MODES = ("density", "paper")
 #: the small specimen of ``--quick``
 QUICK_SPECIMEN = {"width": 0.08, "height": 0.04, "layers": 2}
 #: conversion methods drawn beside the DEM points
 COMPARE = ("parabolic", "lim_3d", "lim_lab", "densest_state")
+
+
+def check_mode(mode) -> str:
+    if mode not in MODES:
+        raise InputError("relation.mode", mode, " or ".join(MODES))
+    return mode
+
+
+def check_seeds(seeds) -> int:
+    if isinstance(seeds, bool) or not isinstance(seeds, int) or not 1 <= seeds <= 50:
+        raise InputError("relation.seeds", seeds, "an integer in [1, 50]")
+    return seeds
 
 
 def lab_porosities(n_max: float, n_min: float, points: int) -> list[float]:
@@ -154,6 +168,80 @@ def analyse(rows: list[dict], n_max: float, n_min: float) -> dict:
             pt[f"n2d_{m}"] = conv.results[m].value
         pts.append(pt)
     pts.sort(key=lambda p: -p["n_lab"])  # loose to dense
+    return dict(_fit_points(pts, n_max, n_min), mode="paper")
+
+
+def _stats(values: list[float]) -> tuple[float, float]:
+    """Mean and sample standard deviation (0 for one value, NaN for none)."""
+    a = np.asarray(values, dtype=float)
+    if a.size == 0:
+        return math.nan, math.nan
+    return float(a.mean()), float(a.std(ddof=1)) if a.size > 1 else 0.0
+
+
+def _why(row: dict) -> str:
+    return str((row.get("results") or {}).get("message") or row.get("error"))
+
+
+def analyse_states(rows: list[dict], targets: list, cal, n_max: float, n_min: float) -> dict:
+    """Density-controlled relation: one point per laboratory state, mean and spread over seeds.
+
+    ``n2d_dem`` is the mean accepted n2D of the seeds whose criterion converged (the
+    criterion's answer, on its trial grid); ``n2d_measured`` the mean measured porosity
+    n' of those accepted trials. Seeds that did not converge are counted, not averaged.
+    """
+    by_lab: dict[float, list[dict]] = {}
+    for r in rows:
+        by_lab.setdefault(round(_num((r.get("params") or {}).get("criterion.n_lab")), 6), []).append(r)
+    pts = []
+    for t in targets:
+        group = by_lab.get(round(t.n_lab, 6), [])
+        ok = [r for r in group if r["status"] == "done" and (r.get("results") or {}).get("converged")]
+        acc = [_num(r["results"]["final_porosity"]) for r in ok]
+        meas = [_num(r["results"]["last_new_porosity"]) for r in ok]
+        mean, sd = _stats(acc)
+        m_mean, m_sd = _stats(meas)
+        conv = P.convert_all(t.n_lab, n_max, n_min)
+        pt = {
+            "n_lab": t.n_lab,
+            "relative_density": t.relative_density,
+            "degree_of_density": float(P.degree_of_density(t.n_lab, n_max, n_min)),
+            "n2d_target": t.n2d_target,
+            "mu_prep": t.mu_prep,
+            "n2d_dem": mean,
+            "n2d_sd": sd,
+            "n2d_seeds": acc,
+            "n2d_measured": m_mean,
+            "n2d_measured_sd": m_sd,
+            "seeds": len(group),
+            "seeds_converged": len(ok),
+            "converged": len(ok) > 0,
+            "flag": "" if group and len(ok) == len(group) else f"{len(group) - len(ok)} seed(s) unconverged",
+            "message": "; ".join(_why(r) for r in group if r not in ok),
+        }  # fmt: skip
+        for m in COMPARE:
+            pt[f"n2d_{m}"] = conv.results[m].value
+        pts.append(pt)
+    pts.sort(key=lambda p: -p["n_lab"])
+    rel = _fit_points(pts, n_max, n_min)
+    good = [p for p in pts if p["converged"]]
+    spread = None
+    if len(good) >= 2:
+        loose, dense = good[0], good[-1]
+        spread = {
+            "loose_n_lab": loose["n_lab"],
+            "dense_n_lab": dense["n_lab"],
+            "n2d_loose_minus_dense": loose["n2d_dem"] - dense["n2d_dem"],
+            "sd": math.hypot(loose["n2d_sd"], dense["n2d_sd"]),
+            "monotone": all(a["n2d_dem"] >= b["n2d_dem"] for a, b in zip(good, good[1:], strict=False)),
+        }
+    rel.update(mode="density", calibration=cal.to_dict(), n2d_max=cal.n2d_max, n2d_min=cal.n2d_min,
+               spread=spread)  # fmt: skip
+    return rel
+
+
+def _fit_points(pts: list[dict], n_max: float, n_min: float) -> dict:
+    """The Eq. 12-form fit through the converged points, residuals and comparisons."""
     good = [p for p in pts if p["converged"] and math.isfinite(p["n2d_dem"])]
     fit: dict[str, Any] | None = None
     note = ""
@@ -223,7 +311,20 @@ def plot_relation(rel: dict, title: str = ""):
         )
     ok = [p for p in pts if p["converged"]]
     bad = [p for p in pts if not p["converged"] and math.isfinite(p["n2d_dem"])]
-    if ok:
+    if ok and rel.get("mode") == "density":
+        ax.errorbar(
+            [p["n_lab"] for p in ok],
+            [p["n2d_dem"] for p in ok],
+            yerr=[p["n2d_sd"] for p in ok],
+            fmt="o",
+            color="tab:red",
+            ms=8,
+            capsize=4,
+            label="DEM criterion, density-controlled (mean accepted n2D +- sd over seeds)",
+        )
+        ax.axhline(rel["n2d_max"], color="0.4", lw=0.8, ls=":", label="2D extremes (calibrated)")
+        ax.axhline(rel["n2d_min"], color="0.4", lw=0.8, ls=":")
+    elif ok:
         ax.plot(
             [p["n_lab"] for p in ok],
             [p["n2d_dem"] for p in ok],
@@ -261,6 +362,9 @@ def plot_relation(rel: dict, title: str = ""):
     ax.set_ylabel("2D porosity n2D [-]")
     head = title or "2D porosity from the criterion vs laboratory porosity"
     sub = f"n_max = {hi:g} (Dr = 0), n_min = {lo:g} (Dr = 1)"
+    if rel.get("mode") == "density":
+        seeds = max((p["seeds"] for p in pts), default=0)
+        sub += f"; density-controlled preparation, {seeds} seed(s) per state"
     if failed:
         sub += f"; {len(failed)} failed case(s) dotted"
     ax.set_title(f"{head}\n{sub}", fontsize=11)
@@ -274,7 +378,9 @@ def write_relation(rel: dict, out: Path, title: str = "", extra: dict | None = N
     from poro2d.io_utils import atomic_path, provenance, write_csv, write_json
 
     out.mkdir(parents=True, exist_ok=True)
-    write_csv(out / "relation.csv", rel["points"])
+    flat = [{k: " ".join(f"{x:.4f}" for x in v) if isinstance(v, list) else v for k, v in p.items()}
+            for p in rel["points"]]  # fmt: skip
+    write_csv(out / "relation.csv", flat)
     write_json(out / "relation.json", dict(rel, **(extra or {}), provenance=provenance()))
     fig = plot_relation(rel, title)
     paths = []
@@ -284,3 +390,38 @@ def write_relation(rel: dict, out: Path, title: str = "", extra: dict | None = N
             fig.savefig(tmp, dpi=150, format=ext)
         paths.append(p)
     return [out / "relation.csv", out / "relation.json", *paths]
+
+
+def density_relation(
+    base: dict,
+    base_dir: Path | None,
+    settings: dict,
+    out: Path,
+    *,
+    quick: bool = False,
+    seeds: int = 3,
+    mus=None,
+    use_cache: bool = True,
+    **sweep_kw,
+) -> tuple[dict, dict]:
+    """The density-controlled relation: calibrate, map every state, check it over seeds.
+
+    ``settings``: from :func:`relation_settings`. Returns the analysed relation and a
+    record of the two sweeps (calibration source, summaries).
+    """
+    from poro2d.criterion.density import DEFAULT_MUS, state_target
+    from poro2d.sweep import density as D
+    from poro2d.sweep.cases import parse_sweep
+    from poro2d.sweep.runner import run_sweep
+
+    cfg = sweep_config(base, settings["n_lab"], quick=quick)
+    cfg.pop("sweep")
+    cal, cal_info = D.calibrate(cfg, base_dir, out, mus=mus or DEFAULT_MUS, seeds=seeds,
+                                use_cache=use_cache, **sweep_kw)  # fmt: skip
+    targets = [state_target(n, settings["n_max"], settings["n_min"], cal) for n in settings["n_lab"]]
+    resolution = float((cfg.get("criterion") or {}).get("resolution", 0.01))
+    sweep = parse_sweep(D.state_sweep(cfg, targets, seeds, resolution), base_dir)
+    res = run_sweep(sweep, out / "states", **sweep_kw)
+    rel = analyse_states(res.rows, targets, cal, settings["n_max"], settings["n_min"])
+    record = {"calibration": cal_info, "states_summary": res.summary, "failed_cases": len(res.failed)}
+    return rel, record

@@ -1,0 +1,187 @@
+"""Density-controlled criterion runs on the sweep runner: calibration and state checks.
+
+The calibration runs the criterion at every preparation friction of a list, for several
+seeds (a grid sweep over ``specimen.friction_prep`` and ``seed``); each case's measured
+porosity n' of its accepted trial (the box porosity with the plate just touching) is
+one sample of mu_prep -> n2D. It is resumable in its own folder and cached per grading
+and settings (:func:`cache_dir`), so the relation and single criterion runs share it.
+
+The state checks run the criterion once per laboratory state and seed, with the
+preparation friction that the calibration gives for the state's 2D target
+(:func:`poro2d.criterion.density.state_target`) and that target as the first trial.
+"""
+
+from __future__ import annotations
+
+import copy
+import hashlib
+import json
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+from poro2d.criterion.density import DEFAULT_MUS, Calibration, StateTarget
+from poro2d.errors import InputError
+from poro2d.io_utils import provenance, write_json
+
+#: seeds per friction and per state unless the config says otherwise
+DEFAULT_SEEDS = 3
+#: settings that change the calibration; n_lab and the first trial do not
+_CRITERION_KEYS_IGNORED = ("n_lab", "trial_porosity")
+#: first trial of every calibration case: the middle of the 2D range of polydisperse disks
+#: (about 0.16 dense to 0.23 loose), whatever the laboratory porosity
+CALIBRATION_FIRST_TRIAL = 0.19
+
+
+def cache_dir() -> Path:
+    """Where calibrations are kept: ``$PORO2D_CACHE``, else the user's cache folder."""
+    env = os.environ.get("PORO2D_CACHE")
+    if env:
+        return Path(env)
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "poro2d"
+
+
+def check_mus(mus: Any) -> list[float]:
+    """At least two finite, non-negative, strictly increasing preparation frictions."""
+    if not isinstance(mus, (list, tuple)) or len(mus) < 2:
+        raise InputError("density.mu_prep", mus, "a list of at least two preparation frictions")
+    out = []
+    for v in mus:
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not (math.isfinite(v) and v >= 0.0):
+            raise InputError("density.mu_prep", mus, "finite frictions >= 0")
+        out.append(float(v))
+    if any(b <= a for a, b in zip(out, out[1:], strict=False)):
+        raise InputError("density.mu_prep", mus, "strictly increasing frictions (densest first)")
+    return out
+
+
+def check_seeds(seeds: Any) -> int:
+    if isinstance(seeds, bool) or not isinstance(seeds, int) or not 1 <= seeds <= 50:
+        raise InputError("density.seeds", seeds, "an integer in [1, 50]")
+    return seeds
+
+
+def calibration_base(base: dict) -> dict:
+    """The parts of a criterion config that fix a calibration (no n_lab, no first trial)."""
+    spec = {k: v for k, v in (base.get("specimen") or {}).items() if k not in ("threads", "friction_prep")}
+    crit = {k: v for k, v in (base.get("criterion") or {}).items() if k not in _CRITERION_KEYS_IGNORED}
+    return {"specimen": spec, "grading": base.get("grading") or {"preset": "paper"}, "criterion": crit}
+
+
+def calibration_key(base: dict, mus: list[float], seeds: int) -> str:
+    """A content key of the calibration: grading, box, settings, frictions, seeds."""
+    rec = {"base": calibration_base(base), "mus": mus, "seeds": seeds}
+    return hashlib.sha256(json.dumps(rec, sort_keys=True, default=str).encode()).hexdigest()[:16]
+
+
+def calibration_sweep(base: dict, mus: list[float], seeds: int) -> dict:
+    """The grid sweep of the calibration: every friction with every seed."""
+    cfg = copy.deepcopy(calibration_base(base))
+    cfg["criterion"]["trial_porosity"] = CALIBRATION_FIRST_TRIAL
+    threads = (base.get("specimen") or {}).get("threads")
+    if threads is not None:
+        cfg["specimen"]["threads"] = threads
+    cfg["sweep"] = {
+        "kind": "criterion",
+        "title": "mu_prep -> n2D calibration",
+        "specimen.friction_prep": list(mus),
+        "seed": list(range(seeds)),
+    }
+    return cfg
+
+
+def _sample(row: dict) -> float | None:
+    """The measured porosity n' of a case's accepted trial; None if it was not accepted."""
+    res = row.get("results") or {}
+    if row.get("status") != "done" or not res.get("converged"):
+        return None
+    v = res.get("last_new_porosity")
+    return float(v) if v is not None and math.isfinite(float(v)) else None
+
+
+def calibration_from_rows(rows: list[dict], mus: list[float], seeds: int) -> Calibration:
+    samples: list[list[float | None]] = [[None] * seeds for _ in mus]
+    for r in rows:
+        p = r.get("params") or {}
+        mu, seed = float(p["specimen.friction_prep"]), int(p["seed"])
+        samples[mus.index(mu)][seed] = _sample(r)
+    return Calibration(list(mus), samples, list(range(seeds)))
+
+
+def calibrate(
+    base: dict,
+    base_dir: Path | None,
+    out: Path,
+    *,
+    mus: tuple[float, ...] | list[float] = DEFAULT_MUS,
+    seeds: int = DEFAULT_SEEDS,
+    use_cache: bool = True,
+    **sweep_kw,
+) -> tuple[Calibration, dict]:
+    """The grading's calibration: from the cache, or run into ``out`` (resumable) and cached.
+
+    Returns the calibration and a record (key, where it came from, sweep summary).
+    """
+    from poro2d.sweep.cases import parse_sweep
+    from poro2d.sweep.runner import run_sweep
+
+    mus, seeds = check_mus(list(mus)), check_seeds(seeds)
+    key = calibration_key(base, mus, seeds)
+    cached = cache_dir() / "calibrations" / f"{key}.json"
+    if use_cache and cached.is_file():
+        rec = json.loads(cached.read_text())
+        cal = Calibration.from_dict(rec["calibration"])
+        write_json(out / "calibration.json", dict(rec, source=f"cache {cached}"))
+        return cal, {"key": key, "source": "cache", "path": str(cached)}
+    sweep = parse_sweep(calibration_sweep(base, mus, seeds), base_dir)
+    res = run_sweep(sweep, out / "calibration", **sweep_kw)
+    cal = calibration_from_rows(res.rows, mus, seeds)
+    rec = {
+        "key": key,
+        "calibration": cal.to_dict(),
+        "settings": calibration_base(base),
+        "sample": "n' of the accepted trial: box porosity, whole disk areas, plate just touching",
+        "sweep_summary": res.summary,
+        "provenance": provenance(),
+    }
+    write_json(out / "calibration.json", dict(rec, source="computed"))
+    if use_cache and not res.failed and not any(cal.failed):
+        try:
+            write_json(cached, rec)
+        except OSError:  # a read-only home: the calibration still stands in ``out``
+            pass
+    return cal, {"key": key, "source": "computed", "summary": res.summary}
+
+
+def state_sweep(base: dict, targets: list[StateTarget], seeds: int, resolution: float) -> dict:
+    """One criterion case per state and seed, at the state's friction, from its target."""
+    from poro2d.criterion.protocol import round_to
+
+    cfg = copy.deepcopy({k: v for k, v in base.items() if k not in ("relation", "sweep", "density")})
+    cfg.setdefault("criterion", {}).pop("trial_porosity", None)
+    cases = []
+    for t in targets:
+        for s in range(seeds):
+            cases.append({
+                "criterion.n_lab": t.n_lab,
+                "specimen.friction_prep": round(t.mu_prep, 6),
+                "criterion.trial_porosity": round_to(t.n2d_target, resolution),
+                "seed": s,
+            })  # fmt: skip
+    cfg["sweep"] = {"kind": "criterion", "title": "density-controlled states", "cases": cases}
+    return cfg
+
+
+__all__ = [
+    "DEFAULT_SEEDS",
+    "cache_dir",
+    "calibrate",
+    "calibration_from_rows",
+    "calibration_key",
+    "calibration_sweep",
+    "check_mus",
+    "check_seeds",
+    "state_sweep",
+]
