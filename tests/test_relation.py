@@ -123,7 +123,8 @@ def test_relation_command_on_tiny_specimens(tmp_path):
         "[relation]\nn_max = 0.4571\nn_min = 0.3253\n"
     )
     out = tmp_path / "out"
-    main(["relation", "--config", str(cfg), "--points", "3", "--out", str(out), "--workers", "2", "--quiet"])
+    main(["relation", "--config", str(cfg), "--points", "3", "--out", str(out), "--workers", "2", "--quiet",
+          "--mode", "paper"])  # fmt: skip
     for f in ("relation.png", "relation.svg", "relation.csv", "relation.json", "results.csv", "sweep.json"):
         assert (out / f).stat().st_size > 0, f
     df = pd.read_csv(out / "relation.csv")
@@ -144,4 +145,77 @@ def test_relation_cli_errors(tmp_path):
     cfg.write_text("[relation]\npoints = 3\nnmin = 0.3\n")
     with pytest.raises(SystemExit) as ei:
         main(["relation", "--config", str(cfg), "--out", str(tmp_path)])
+    assert ei.value.code == 2
+
+
+def _state_row(n_lab, seed, final, last, converged=True):
+    return {
+        "case_id": f"s{n_lab}-{seed}",
+        "status": "done",
+        "params": {"criterion.n_lab": n_lab, "seed": seed},
+        "results": {
+            "converged": converged,
+            "final_porosity": final,
+            "last_new_porosity": last,
+            "message": "m",
+        },
+    }
+
+
+def test_density_states_are_averaged_over_seeds_and_the_spread_is_measured():
+    from poro2d.criterion.density import Calibration, state_target
+
+    cal = Calibration([0.0, 0.1, 0.5], [[0.17, 0.172], [0.19, 0.19], [0.22, 0.224]])
+    labs = [0.4571, 0.3912, 0.3253]
+    targets = [state_target(x, P.PAPER_N_MAX, P.PAPER_N_MIN, cal) for x in labs]
+    rows = [
+        _state_row(0.4571, 0, 0.22, 0.221), _state_row(0.4571, 1, 0.23, 0.226),
+        _state_row(0.3912, 0, 0.20, 0.199), _state_row(0.3912, 1, None, 0.25, converged=False),
+        _state_row(0.3253, 0, 0.17, 0.171), _state_row(0.3253, 1, 0.17, 0.169),
+    ]  # fmt: skip
+    rel = R.analyse_states(rows, targets, cal, P.PAPER_N_MAX, P.PAPER_N_MIN)
+    pts = {p["n_lab"]: p for p in rel["points"]}
+    assert pts[0.4571]["n2d_dem"] == pytest.approx(0.225)
+    assert pts[0.4571]["n2d_sd"] == pytest.approx(np.std([0.22, 0.23], ddof=1))
+    assert pts[0.4571]["n2d_measured"] == pytest.approx(0.2235)
+    assert pts[0.3912]["seeds_converged"] == 1 and "1 seed(s)" in pts[0.3912]["flag"]
+    assert pts[0.3912]["n2d_dem"] == pytest.approx(0.20)  # the unconverged seed is not averaged
+    assert pts[0.4571]["mu_prep"] == pytest.approx(0.5) and pts[0.3253]["mu_prep"] == pytest.approx(0.0)
+    sp = rel["spread"]
+    assert sp["n2d_loose_minus_dense"] == pytest.approx(0.055) and sp["monotone"]
+    assert rel["mode"] == "density" and rel["n2d_min"] == pytest.approx(0.171)
+
+
+def test_density_relation_command_on_tiny_specimens(tmp_path, monkeypatch):
+    """Calibration, mapping and checks end to end; the calibration is reused from the cache."""
+    monkeypatch.setenv("PORO2D_CACHE", str(tmp_path / "cache"))
+    cfg = tmp_path / "rel.toml"
+    cfg.write_text(
+        "seed = 0\n[specimen]\nwidth = 0.05\nheight = 0.025\nlayers = 2\n"
+        "[relation]\nn_max = 0.4571\nn_min = 0.3253\nmu_prep = [0.0, 0.5]\n"
+    )
+    out = tmp_path / "out"
+    args = ["relation", "--config", str(cfg), "--points", "3", "--seeds", "2", "--workers", "2", "--quiet"]
+    main([*args, "--out", str(out)])
+    rel = json.loads((out / "relation.json").read_text())
+    assert rel["mode"] == "density"
+    cal = json.loads((out / "calibration.json").read_text())
+    assert cal["source"] == "computed" and cal["calibration"]["mus"] == [0.0, 0.5]
+    pts = rel["points"]
+    assert [p["mu_prep"] for p in pts][0] == pytest.approx(0.5) and pts[-1]["mu_prep"] == pytest.approx(0.0)
+    assert all(p["seeds"] == 2 for p in pts)
+    # the loosest preparation gives a looser calibrated state than the densest (physics, not the fit)
+    assert rel["n2d_max"] > rel["n2d_min"]
+    out2 = tmp_path / "out2"
+    main([*args, "--out", str(out2)])
+    assert json.loads((out2 / "calibration.json").read_text())["source"].startswith("cache")
+    assert not (out2 / "calibration").exists()
+
+
+def test_density_mode_errors(tmp_path):
+    with pytest.raises(SystemExit) as ei:
+        main(["relation", "--preset", "paper", "--mode", "fast", "--out", str(tmp_path / "o")])
+    assert ei.value.code == 2
+    with pytest.raises(SystemExit) as ei:
+        main(["relation", "--preset", "paper", "--seeds", "0", "--out", str(tmp_path / "o")])
     assert ei.value.code == 2

@@ -147,7 +147,8 @@ def calibrate(
         "provenance": provenance(),
     }
     write_json(out / "calibration.json", dict(rec, source="computed"))
-    if use_cache and not res.failed and not any(cal.failed):
+    # unconverged seeds are results (a rerun gives the same); a crashed case is not cached
+    if use_cache and not res.failed:
         try:
             write_json(cached, rec)
         except OSError:  # a read-only home: the calibration still stands in ``out``
