@@ -25,7 +25,7 @@ import numpy as np
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
 from poro2d.dem.measure import porosity_rect
 from poro2d.dem.ordering import strip_order
-from poro2d.errors import InputError, check_range
+from poro2d.errors import InputError, check_int, check_range
 from poro2d.specimen.grading import GradingCurve, draw_disks
 from poro2d.specimen.placement import Band, place_disks
 
@@ -66,12 +66,16 @@ class SpecimenSpec:
             check_range(k, getattr(self, k), 0, None, lo_open=True)
         for k in ("ks_particle", "ks_wall", "friction_prep", "friction_particle", "friction_wall"):
             check_range(k, getattr(self, k), 0, None)
-        if not (isinstance(self.layers, int) and 1 <= self.layers <= 50):
-            raise InputError("layers", self.layers, "an integer in [1, 50]")
+        check_int("layers", self.layers, 1, 50)
         check_range("undercompaction", self.undercompaction, 0.0, 0.5)
         check_range("ratio", self.ratio, 0.0, 1.0, lo_open=True)
         check_range("local_damping", self.local_damping, 0.0, 1.0, hi_open=True)
         check_range("gravity", self.gravity, 0.0, None)
+        check_int("growth_increments", self.growth_increments, 1)
+        check_int("growth_steps", self.growth_steps, 1)
+        check_int("max_steps_per_stage", self.max_steps_per_stage, 1)
+        check_range("dt_safety", self.dt_safety, 0.0, 1.0, lo_open=True)
+        check_int("threads", self.threads, 1)
 
     def to_dict(self) -> dict:
         return asdict(self)

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from poro2d.errors import InputError, check_range
+from poro2d.errors import InputError, as_float_array, check_range, is_number
 
 __all__ = [
     "PAPER_UPSCALE",
@@ -51,10 +51,7 @@ _TOP_TOL = 1e-6  # percent passing at the largest size must be 100 within this
 
 
 def _as_float_array(name: str, values: Any) -> np.ndarray:
-    try:
-        arr = np.asarray(values, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise InputError(name, values, "a list of numbers") from None
+    arr = as_float_array(name, values)  # numbers only: ["0.2", "0.5"] is refused, not parsed
     if arr.ndim != 1:
         raise InputError(name, values, "a flat list of numbers")
     if not np.all(np.isfinite(arr)):
@@ -188,6 +185,11 @@ class GradingCurve:
             raise InputError(
                 "csv", str(path), "a readable CSV file with columns size_mm,percent_passing"
             ) from None
+        except UnicodeDecodeError as exc:  # a binary file given by mistake
+            raise InputError(
+                "csv", str(path), "a text (UTF-8) CSV file with columns size_mm,percent_passing",
+                f"byte {exc.start} is not text",
+            ) from None  # fmt: skip
         sizes, percent = _parse_csv(text, str(p))
         return cls.from_lists(
             sizes,
@@ -214,6 +216,7 @@ class GradingCurve:
             raise InputError(
                 "grading", sorted(table), "exactly one of preset, csv or sizes_mm/percent_passing"
             )
+        _check_config_types(table)
         cuts = {"d_min_mm": table.get("d_min_mm"), "d_max_mm": table.get("d_max_mm")}
         if "preset" in table:
             if table["preset"] != "paper":
@@ -274,6 +277,19 @@ class GradingCurve:
         return float(solid_area) / self.mean_disk_area(within_class)
 
 
+def _check_config_types(table: Mapping[str, Any]) -> None:
+    """Refuse config values of the wrong type, e.g. ``upscale = "10"`` or ``csv = 5``."""
+    for key in ("preset", "csv"):
+        if key in table and not isinstance(table[key], str):
+            raise InputError(f"grading.{key}", table[key], "a string")
+    for key in ("upscale", "d_min_mm", "d_max_mm"):
+        if key in table and not is_number(table[key]):
+            raise InputError(f"grading.{key}", table[key], "a number")
+    for key in ("sizes_mm", "percent_passing"):
+        if key in table and not isinstance(table[key], list):
+            raise InputError(f"grading.{key}", table[key], "a list of numbers")
+
+
 def _cutoff(name: str, value: float | None) -> float | None:
     if value is None:
         return None
@@ -329,6 +345,9 @@ def _apply_cutoffs(
 
 
 def _parse_csv(text: str, origin: str) -> tuple[list[float], list[float]]:
+    if "\x00" in text:  # valid UTF-8 but binary (the csv module would stop on it with its own error)
+        raise InputError("csv", origin, "a text CSV file with columns size_mm,percent_passing",
+                         "it contains NUL bytes")  # fmt: skip
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     reader = csv.DictReader(io.StringIO("\n".join(lines)))
     fields = [f.strip() for f in (reader.fieldnames or [])]

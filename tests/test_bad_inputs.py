@@ -1,0 +1,208 @@
+"""Bad input anywhere is refused with one line naming it: output folders, damaged
+checkpoints and grading files, config values of the wrong type, API arrays."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+from poro2d.cli import main
+from poro2d.criterion.protocol import CriterionSettings
+from poro2d.dem import Particles, Simulation, Walls, checkpoint
+from poro2d.errors import InputError, check_int, check_range
+from poro2d.specimen.compaction import SpecimenSpec
+from poro2d.specimen.grading import GradingCurve
+
+R = 1e-3
+
+
+def run(argv, capsys):
+    """Run poro2d.cli.main(argv); return (exit code, stdout, stderr)."""
+    code = 0
+    try:
+        main([str(a) for a in argv])
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else 1
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def refused(argv, capsys, *words):
+    """The command exits 2 with one line ``error: ...`` holding every word, no traceback."""
+    code, _, err = run(argv, capsys)
+    assert code == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error:"), err
+    for w in words:
+        assert w in lines[0], (w, lines[0])
+    return lines[0]
+
+
+def criterion_with(tmp_path, capsys, toml: str, *words):
+    cfg = tmp_path / "case.toml"
+    cfg.write_text(toml)
+    out = tmp_path / "out"
+    line = refused(["criterion", "--config", cfg, "--out", out, "--quiet"], capsys, *words)
+    assert not out.exists()  # refused before anything was written
+    return line
+
+
+# ------------------------------------------------------------------ output folders
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["criterion", "--preset", "paper", "--quiet", "--out"],
+        ["paper", "--quick", "--quiet", "--out"],
+        ["shear", "--specimen", "nowhere.npz", "--out"],
+        ["plot", "relations", "-o"],
+    ],
+)
+def test_out_that_is_a_file(argv, tmp_path, capsys):
+    f = tmp_path / "taken"
+    f.write_text("not a folder")
+    refused([*argv, f], capsys, "--out", "a file of that name exists")
+    refused([*argv, f / "sub"], capsys, "--out", "is a file")
+    assert f.read_text() == "not a folder"
+
+
+def test_out_in_a_read_only_folder(tmp_path, capsys, monkeypatch):
+    real = os.access
+
+    def access(path, mode, **kw):  # tests run as root, where permission bits do not stop writes
+        return False if str(path) == str(tmp_path) else real(path, mode, **kw)
+
+    monkeypatch.setattr(os, "access", access)
+    refused(["criterion", "--preset", "paper", "--out", tmp_path / "new"], capsys, "read-only")
+    refused(["plot", "relations", "-o", tmp_path / "figs"], capsys, "read-only")
+    assert not (tmp_path / "new").exists() and not (tmp_path / "figs").exists()
+
+
+# ------------------------------------------------------------------ damaged files
+def _small_sim():
+    p = Particles(
+        pos=[[0.02, 0.02], [0.05, 0.02]], radius=R, density=2650.0, thickness=0.01, kn=1e5, ks=1e5, mu=0.5
+    )
+    return Simulation(p, Walls.box(0.0, 0.0, 0.1, 0.1, 1e5, 1e5, 0.5))
+
+
+def test_damaged_specimen_is_refused(tmp_path, capsys):
+    good = checkpoint.save(_small_sim(), tmp_path / "good.npz")
+    data = good.read_bytes()
+    truncated = tmp_path / "truncated.npz"
+    truncated.write_bytes(data[: len(data) // 2])
+    garbage = tmp_path / "garbage.npz"
+    garbage.write_bytes(os.urandom(3000))
+    for bad in (truncated, garbage):
+        refused(["shear", "--specimen", bad, "--out", tmp_path / "s"], capsys, "checkpoint", str(bad))
+        with pytest.raises(InputError, match="checkpoint"):
+            checkpoint.load(bad)
+        with pytest.raises(InputError, match="checkpoint"):
+            checkpoint.read_meta(bad)
+    assert not (tmp_path / "s").exists()
+    assert checkpoint.load(good).particles.n == 2
+
+
+def test_binary_grading_csv(tmp_path, capsys):
+    (tmp_path / "png.csv").write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\xff\xfe\x00")
+    (tmp_path / "nul.csv").write_bytes(b"size_mm,percent_passing\n0.1\x00,0\n1,100\n")
+    for name in ("png.csv", "nul.csv"):
+        line = criterion_with(tmp_path, capsys, f'[grading]\ncsv = "{name}"\n', "csv", name)
+        assert "text" in line
+        with pytest.raises(InputError, match="csv"):
+            GradingCurve.from_csv(tmp_path / name)
+
+
+# ------------------------------------------------------------------ config types
+@pytest.mark.parametrize(
+    "toml, words",
+    [
+        ("specimen = 5\n", ["specimen = 5", "a table"]),
+        ("grading = 5\n", ["grading = 5", "a table"]),
+        ("criterion = 'x'\n", ["criterion = 'x'", "a table"]),
+        ('[specimen]\nwidth = "0.08"\n', ["specimen.width = '0.08'", "a number"]),
+        ("[specimen]\nlayers = true\n", ["specimen.layers = True", "an integer"]),
+        ("[specimen]\nlayers = 2.0\n", ["specimen.layers = 2.0", "an integer"]),
+        ('[criterion]\nn_lab = "0.33"\n', ["criterion.n_lab = '0.33'", "a number"]),
+        ("[criterion]\nn_lab = true\n", ["criterion.n_lab = True", "a number"]),
+        ("seed = true\n", ["seed = True", "an integer"]),
+        ("seed = 1.5\n", ["seed = 1.5", "an integer"]),
+        ("title = 3\n", ["title = 3", "a string"]),
+        ('[grading]\npreset = "paper"\nupscale = "10"\n', ["grading.upscale = '10'", "a number"]),
+        ('[grading]\nsizes_mm = ["0.2", "1"]\npercent_passing = [0, 100]\n', ["sizes_mm", "numbers"]),
+        ("[grading]\nsizes_mm = 1.0\npercent_passing = [0, 100]\n", ["grading.sizes_mm", "a list"]),
+        ("[grading]\ncsv = 5\n", ["grading.csv = 5", "a string"]),
+    ],
+)
+def test_config_values_of_the_wrong_type(tmp_path, capsys, toml, words):
+    criterion_with(tmp_path, capsys, toml, *words)
+
+
+def test_integers_are_accepted_for_floats(tmp_path):
+    from poro2d.config import dataclass_from_table
+
+    spec = dataclass_from_table(SpecimenSpec, "specimen", {"width": 1, "layers": 2})
+    assert spec.width == 1 and spec.layers == 2
+
+
+def test_shear_config_extras(tmp_path, capsys):
+    good = checkpoint.save(_small_sim(), tmp_path / "good.npz")
+    for toml, word in (
+        ("[shear]\nprocesses = true\n", "shear.processes"),
+        ('[shear]\nrate_check = "yes"\n', "shear.rate_check"),
+        ('[shear]\nnormal_stress_kpa = ["50"]\n', "shear.normal_stress_kpa"),
+        ('[shear]\nvelocity = "0.01"\n', "shear.velocity"),
+    ):
+        cfg = tmp_path / "shear.toml"
+        cfg.write_text(toml)
+        refused(["shear", "--specimen", good, "--config", cfg, "--out", tmp_path / "s"], capsys, word)
+
+
+# ------------------------------------------------------------------ Python API
+def test_strings_and_booleans_are_not_numbers():
+    with pytest.raises(InputError, match="width"):
+        SpecimenSpec(width="0.08")
+    with pytest.raises(InputError, match="layers"):
+        SpecimenSpec(layers=True)
+    with pytest.raises(InputError, match="n_lab"):
+        CriterionSettings(n_lab="0.33")
+    with pytest.raises(InputError, match="x"):
+        check_range("x", "0.3")
+    with pytest.raises(InputError, match="x"):
+        check_range("x", False)
+    assert check_range("x", np.float32(0.5), 0.0, 1.0) == 0.5
+    assert check_range("x", np.array(0.25), 0.0, 1.0) == 0.25
+    assert check_int("k", np.int64(3), 1) == 3
+    with pytest.raises(InputError, match="k"):
+        check_int("k", 3.0, 1)
+
+
+def test_particle_arrays_of_the_wrong_length_or_type():
+    pos = np.array([[0.0, 0.0], [0.01, 0.0], [0.02, 0.0]])
+    kw = dict(density=2650.0, thickness=0.01, kn=1e5, ks=1e5, mu=0.5)
+    for field, value in (("radius", [R, R]), ("radius", ["0.001"] * 3), ("kn", [1e5] * 4), ("mu", "0.5")):
+        args = {"pos": pos, "radius": R, **kw, field: value}
+        with pytest.raises(InputError) as e:
+            Particles(**args)
+        assert e.value.parameter == field
+    with pytest.raises(InputError) as e:
+        Particles(pos=[["0", "0"]], radius=R, **kw)
+    assert e.value.parameter == "positions"
+    with pytest.raises(InputError) as e:
+        Particles(pos=pos, radius=R, **kw, mode=[0, 1])
+    assert e.value.parameter == "mode"
+    with pytest.raises(InputError) as e:
+        Particles(pos=pos, radius=R, **{**kw, "thickness": "0.01"})
+    assert e.value.parameter == "thickness"
+
+
+def test_grading_arrays_of_the_wrong_length_or_type():
+    with pytest.raises(InputError, match="sizes_m"):
+        GradingCurve(sizes_m=("0.001", "0.002"), percent_passing=(0, 100))
+    with pytest.raises(InputError, match="percent_passing"):
+        GradingCurve(sizes_m=(0.001, 0.002), percent_passing=(0, 50, 100))
+    with pytest.raises(InputError, match="sizes_mm"):
+        GradingCurve.from_lists(["0.2", "1"], [0, 100])
+    with pytest.raises(InputError, match="percent_passing"):
+        GradingCurve.from_lists([0.2, 1], [0, True])
