@@ -1,8 +1,10 @@
-"""Bad input anywhere is refused with one line naming it: output folders, damaged
-checkpoints and grading files, config values of the wrong type, API arrays."""
+"""Bad input anywhere is refused with one line naming it: the size guard before drawing disks,
+output folders, damaged checkpoints and grading files, config values of the wrong type,
+API arrays."""
 
 from __future__ import annotations
 
+import logging
 import os
 
 import numpy as np
@@ -12,10 +14,12 @@ from poro2d.cli import main
 from poro2d.criterion.protocol import CriterionSettings
 from poro2d.dem import Particles, Simulation, Walls, checkpoint
 from poro2d.errors import InputError, check_int, check_range
-from poro2d.specimen.compaction import SpecimenSpec
-from poro2d.specimen.grading import GradingCurve
+from poro2d.specimen.compaction import DEFAULT_MAX_DISKS, SpecimenSpec, check_feasible, estimate_size
+from poro2d.specimen.grading import GradingCurve, draw_disks, paper_grading
 
 R = 1e-3
+# the probe's grading: fines of 0.1 um up-scaled by 10 mean about 1.5e8 disks in the paper's box
+HUGE_GRADING = "[grading]\nsizes_mm = [0.0001, 0.002, 0.7]\npercent_passing = [0, 50, 100]\nupscale = 10\n"
 
 
 def run(argv, capsys):
@@ -47,6 +51,53 @@ def criterion_with(tmp_path, capsys, toml: str, *words):
     line = refused(["criterion", "--config", cfg, "--out", out, "--quiet"], capsys, *words)
     assert not out.exists()  # refused before anything was written
     return line
+
+
+# ------------------------------------------------------------------ size guard
+def test_huge_grading_is_refused_before_drawing(tmp_path, capsys):
+    line = criterion_with(tmp_path, capsys, HUGE_GRADING, "specimen size", "max_disks = 2000000")
+    assert "about 1.48e+08 disks (about 148 GB of memory)" in line
+    assert "raise [specimen] max_disks" in line  # printed as text, not taken for markup
+
+
+def test_estimate_matches_the_drawn_count():
+    spec = SpecimenSpec(width=0.08, height=0.04, layers=2)
+    est = estimate_size(spec, paper_grading(), 0.19)
+    radii = draw_disks(paper_grading(), 0.81 * 0.08 * 0.04, 3)
+    assert abs(radii.size - est.disks) < 0.05 * est.disks
+    assert est.memory_bytes == pytest.approx(1000 * est.disks)
+
+
+def test_max_disks_overrides_the_limit(caplog):
+    curve = GradingCurve.from_lists([0.0001, 0.002, 0.7], [0, 50, 100], upscale=10)
+    with pytest.raises(InputError, match="max_disks = 2000000"):
+        check_feasible(SpecimenSpec(), curve, 0.15)
+    # a lower limit refuses the paper's own specimen (about 2600 disks) ...
+    with pytest.raises(InputError, match="max_disks = 1000 disks"):
+        check_feasible(SpecimenSpec(max_disks=1000), paper_grading(), 0.15)
+    # ... and a higher one lets a large specimen through, with a warning of its run time
+    spec = SpecimenSpec(width=3.05, height=1.24, max_disks=DEFAULT_MAX_DISKS)
+    with caplog.at_level(logging.WARNING, logger="poro2d.specimen.compaction"):
+        check_feasible(spec, paper_grading(), 0.15)
+    assert "large specimen: about 2.56e+05 disks" in caplog.text
+    assert "particle-steps/s" in caplog.text and "about 21 min per trial" in caplog.text
+    caplog.clear()
+    with caplog.at_level(logging.WARNING, logger="poro2d.specimen.compaction"):
+        check_feasible(SpecimenSpec(), paper_grading(), 0.15)  # the paper's box: no warning
+    assert caplog.text == ""
+    for bad in (0, 10**9, 2.5, True, "100"):
+        with pytest.raises(InputError, match="max_disks"):
+            SpecimenSpec(max_disks=bad)
+
+
+def test_max_disks_is_a_config_key(tmp_path, capsys):
+    criterion_with(tmp_path, capsys, "[specimen]\nmax_disks = 1000\n", "max_disks = 1000", "specimen size")
+
+
+def test_draw_disks_ceiling_uses_the_expected_count():
+    curve = GradingCurve.from_lists([0.0001, 0.002, 0.7], [0, 50, 100], upscale=10)
+    with pytest.raises(InputError, match="about 1.46e\\+08 disks"):
+        draw_disks(curve, 0.85 * 0.305 * 0.124, 0)
 
 
 # ------------------------------------------------------------------ output folders

@@ -33,6 +33,7 @@ import numpy as np
 from poro2d.errors import InputError, as_float_array, check_range, is_number
 
 __all__ = [
+    "MAX_DRAW",
     "PAPER_UPSCALE",
     "GradingCurve",
     "draw_disks",
@@ -48,6 +49,9 @@ PAPER_UPSCALE = 10.0
 _WITHIN_CLASS = ("uniform", "loguniform")
 _CONFIG_KEYS = ("preset", "csv", "sizes_mm", "percent_passing", "upscale", "d_min_mm", "d_max_mm")
 _TOP_TOL = 1e-6  # percent passing at the largest size must be 100 within this
+#: The most disks :func:`draw_disks` will draw (a hard ceiling against exhausting the memory;
+#: specimens have their own, lower limit: ``SpecimenSpec.max_disks``).
+MAX_DRAW = 50_000_000
 
 
 def _as_float_array(name: str, values: Any) -> np.ndarray:
@@ -458,8 +462,12 @@ def draw_disks(
     fractions = curve.class_fractions
     lo_all, hi_all = d[:-1], d[1:]
     mean_areas = _class_mean_area(lo_all, hi_all, within_class)
-    if area / float(mean_areas[fractions > 0].max()) > 5e7:
-        raise InputError("solid_area", solid_area, "at most about 5e7 disks of this grading")
+    expected = curve.expected_count(area, within_class)
+    if expected > MAX_DRAW:
+        raise InputError(
+            "solid_area", solid_area, f"at most about {MAX_DRAW:.0e} disks of this grading",
+            f"it would take about {expected:.3g} disks",
+        )  # fmt: skip
 
     chunks: list[np.ndarray] = []
     target_cum = 0.0
