@@ -1,6 +1,6 @@
 """Bad input anywhere is refused with one line naming it: the size guard before drawing disks,
 output folders, damaged checkpoints and grading files, config values of the wrong type,
-API arrays."""
+API arrays, and disks placed on one another, on a wall or outside the box."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ import pytest
 from poro2d.cli import main
 from poro2d.criterion.protocol import CriterionSettings
 from poro2d.dem import Particles, Simulation, Walls, checkpoint
+from poro2d.dem.layout import COINCIDENT, coincident_pair
 from poro2d.errors import InputError, check_int, check_range
 from poro2d.specimen.compaction import DEFAULT_MAX_DISKS, SpecimenSpec, check_feasible, estimate_size
 from poro2d.specimen.grading import GradingCurve, draw_disks, paper_grading
@@ -257,3 +258,83 @@ def test_grading_arrays_of_the_wrong_length_or_type():
         GradingCurve.from_lists(["0.2", "1"], [0, 100])
     with pytest.raises(InputError, match="percent_passing"):
         GradingCurve.from_lists([0.2, 1], [0, True])
+
+
+# ------------------------------------------------------------------ disk layout
+def _disks(pos, radius=R):
+    return Particles(pos=pos, radius=radius, density=2650.0, thickness=0.01, kn=1e5, ks=1e5, mu=0.5)
+
+
+def _box():
+    return Walls.box(0.0, 0.0, 0.1, 0.05, 1e5, 1e5, 0.5)
+
+
+def _layout_error(pos, walls=None):
+    with pytest.raises(InputError) as e:
+        Simulation(_disks(pos), walls)
+    return e.value
+
+
+def test_coincident_disks():
+    err = _layout_error([[0.01, 0.01], [0.03, 0.01], [0.01 + 1e-7, 0.01]], _box())
+    assert err.parameter == "disk 2 position" and "disk 0" in str(err)
+    err = _layout_error([[0.01, 0.01], [0.01, 0.01]])  # no walls: still refused
+    assert err.parameter == "disk 1 position"
+    Simulation(_disks([[0.01, 0.01], [0.01 + 0.5 * R, 0.01]]), _box())  # overlapping a lot, not coincident
+
+
+def test_disk_on_a_wall():
+    err = _layout_error([[0.02, 0.02], [0.05, 0.0]], _box())
+    assert err.parameter == "disk 1 position" and "'bottom'" in str(err)
+    err = _layout_error([[0.1, 0.03]], _box())
+    assert "'right'" in str(err)
+
+
+@pytest.mark.parametrize(
+    "where, wall",
+    [((-0.01, 0.02), "left"), ((0.12, 0.02), "right"), ((0.05, 0.06), "top"), ((0.05, -0.01), "bottom")],
+)
+def test_disk_outside_the_box(where, wall):
+    err = _layout_error([[0.02, 0.02], list(where)], _box())
+    assert err.parameter == "disk 1 position" and f"beyond wall '{wall}'" in str(err)
+
+
+def test_open_walls_are_not_a_box():
+    floor = Walls()
+    floor.add((-1.0, 0.0), (1.0, 0.0), 1e5, 1e5, 0.5, "floor")
+    Simulation(_disks([[0.0, 0.01], [0.0, -0.01]]), floor)  # either side of a lone wall is fine
+    cup = Walls()
+    cup.add((-1.0, 0.0), (1.0, 0.0), 1e5, 1e5, 0.5, "bottom")
+    cup.add((0.1, -0.1), (0.1, 0.5), 1e5, 1e5, 0.5, "right")
+    cup.add((0.0, 0.5), (0.0, -0.1), 1e5, 1e5, 0.5, "left")
+    Simulation(_disks([[0.05, 0.01], [0.05, 0.9]]), cup)  # in the cup and above its open top
+
+
+def test_added_disks_are_checked_and_nothing_changes_on_refusal():
+    sim = Simulation(_disks([[0.02, 0.02], [0.05, 0.02]]), _box())
+    with pytest.raises(InputError) as e:
+        sim.add_particles(_disks([[0.07, 0.02], [0.05, 0.02]]))
+    assert e.value.parameter == "disk 3 position"
+    with pytest.raises(InputError, match="beyond wall 'top'"):
+        sim.add_particles(_disks([[0.07, 0.07]]))
+    assert sim.particles.n == 2
+    assert sim.add_particles(_disks([[0.07, 0.02]])).tolist() == [2]
+
+
+def test_coincident_pair_equals_brute_force():
+    rng = np.random.default_rng(5)
+    for _ in range(100):
+        n = int(rng.integers(2, 60))
+        pos = rng.uniform(0.0, 0.01, (n, 2))
+        rad = rng.uniform(1e-4, 1e-3, n)
+        for _ in range(int(rng.integers(0, 3))):
+            i, j = rng.integers(0, n, 2)
+            pos[j] = pos[i] + rng.uniform(-2e-6, 2e-6, 2)
+        close = [
+            (i, j)
+            for i in range(n)
+            for j in range(i + 1, n)
+            if np.hypot(*(pos[i] - pos[j])) < COINCIDENT * min(rad[i], rad[j])
+        ]
+        got = coincident_pair(pos, rad)
+        assert (got[:2] if got else None) == (close[0] if close else None)
