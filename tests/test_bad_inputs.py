@@ -146,8 +146,8 @@ def test_damaged_specimen_is_refused(tmp_path, capsys):
     truncated.write_bytes(data[: len(data) // 2])
     garbage = tmp_path / "garbage.npz"
     garbage.write_bytes(os.urandom(3000))
-    for bad in (truncated, garbage):
-        refused(["shear", "--specimen", bad, "--out", tmp_path / "s"], capsys, "checkpoint", str(bad))
+    for bad, why in ((truncated, "File is not a zip file"), (garbage, "not an .npz archive")):
+        refused(["shear", "--specimen", bad, "--out", tmp_path / "s"], capsys, "checkpoint", str(bad), why)
         with pytest.raises(InputError, match="checkpoint"):
             checkpoint.load(bad)
         with pytest.raises(InputError, match="checkpoint"):

@@ -91,10 +91,13 @@ _UNREADABLE = (OSError, ValueError, EOFError, KeyError, TypeError, zipfile.BadZi
 
 
 def _damaged(path: Path, exc: BaseException) -> InputError:
-    reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    if isinstance(exc, ValueError) and "pickle" in str(exc):
+        reason = "not an .npz archive"  # NumPy's guess for a file of neither format
+    else:
+        reason = (str(exc).splitlines() or [type(exc).__name__])[0][:80]
     return InputError(
         "checkpoint", str(path), "a complete .npz file written by poro2d",
-        f"it cannot be read ({reason[:120]}); truncated or not a poro2d checkpoint?",
+        f"it cannot be read: {reason}; truncated, or not a poro2d checkpoint",
     )  # fmt: skip
 
 
