@@ -12,6 +12,7 @@ import sys
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 
 from poro2d import __version__
 from poro2d.errors import InputError
@@ -66,7 +67,8 @@ def main(argv: list[str] | None = None) -> None:
         if isinstance(rc, int) and rc != 0:  # typer.Exit(code) comes back as a return value here
             sys.exit(rc)
     except InputError as exc:
-        err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
+        # escaped: a message naming a config table ("[specimen] max_disks") is text, not markup
+        err_console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
         sys.exit(2)
     except KeyboardInterrupt:
         err_console.print("[yellow]interrupted[/]")

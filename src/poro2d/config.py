@@ -5,10 +5,12 @@ from __future__ import annotations
 import dataclasses
 import os
 import tomllib
+import types
+import typing
 from pathlib import Path
 from typing import Any
 
-from poro2d.errors import InputError
+from poro2d.errors import InputError, is_integer, is_number
 
 
 def load_toml(path: str | os.PathLike) -> dict:
@@ -33,12 +35,53 @@ def check_keys(section: str, table: dict, allowed: set[str] | list[str]) -> None
 
 
 def dataclass_from_table(cls, section: str, table: dict | None, **overrides: Any):
-    """Build a dataclass from a config table, rejecting unknown keys."""
-    table = dict(table or {})
+    """Build a dataclass from a config table, rejecting unknown keys and values of the wrong type."""
+    table = {} if table is None else table
     names = {f.name for f in dataclasses.fields(cls) if f.name != "extra"}
     check_keys(section, table, names)
+    table = dict(table)
+    check_types(cls, section, table)
     table.update({k: v for k, v in overrides.items() if v is not None})
     try:
         return cls(**table)
     except TypeError as exc:
         raise InputError(section, table, "values of the right type", str(exc)) from None
+
+
+# what a config value of each field type must be, and how the error names it
+_KINDS: dict[type, tuple[Any, str]] = {
+    float: (is_number, "a number"),
+    int: (is_integer, "an integer"),
+    bool: (lambda v: isinstance(v, bool), "true or false"),
+    str: (lambda v: isinstance(v, str), "a string"),
+    dict: (lambda v: isinstance(v, dict), "a table"),
+    list: (lambda v: isinstance(v, list), "a list"),
+}
+
+
+def check_types(cls, section: str, table: dict) -> None:
+    """Refuse config values whose type does not match the dataclass field they set.
+
+    TOML keeps ``"0.33"`` a string and ``true`` a boolean; a dataclass would store them
+    as they are (a string porosity, ``layers = true`` taken as 1 because bool is an int in
+    Python). Numbers are strict here: a float field takes an integer or a float, an int
+    field only an integer, and neither takes a boolean or text.
+    """
+    hints = typing.get_type_hints(cls)
+    for key, value in table.items():
+        kinds = _field_kinds(hints.get(key))
+        if not kinds or (value is None and type(None) in kinds):
+            continue
+        checks = [_KINDS[k] for k in kinds if k in _KINDS]
+        if checks and not any(ok(value) for ok, _ in checks):
+            raise InputError(f"{section}.{key}", value, " or ".join(what for _, what in checks))
+
+
+def _field_kinds(hint: Any) -> tuple:
+    """The plain types a field annotation allows (``float | None`` -> (float, NoneType))."""
+    if hint is None:
+        return ()
+    if isinstance(hint, types.UnionType) or typing.get_origin(hint) is typing.Union:
+        return tuple(k for a in typing.get_args(hint) for k in _field_kinds(a))
+    origin = typing.get_origin(hint)
+    return (origin,) if origin is not None else (hint,)

@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import numbers
 from typing import Any
+
+import numpy as np
 
 
 class InputError(ValueError):
@@ -30,7 +33,14 @@ def check_range(
     lo_open: bool = False,
     hi_open: bool = False,
 ) -> float:
-    """Validate a scalar against an interval; returns it as float or raises InputError."""
+    """Validate a scalar against an interval; returns it as float or raises InputError.
+
+    Any real number is accepted (int, float, NumPy scalars); text and booleans are not,
+    even when they would convert: ``"0.3"`` or ``True`` given for a number is a mistake in
+    the input, not a value.
+    """
+    if not is_number(value):
+        raise InputError(parameter, value, "a number")
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -45,3 +55,71 @@ def check_range(
     if hi is not None and (v > hi or (hi_open and v == hi)):
         raise InputError(parameter, value, allowed)
     return v
+
+
+def is_number(value: Any) -> bool:
+    """True for a real number (int, float, NumPy scalar or 0-d array); False for bool and text."""
+    if isinstance(value, bool | np.bool_ | str | bytes):
+        return False
+    if isinstance(value, numbers.Real):
+        return True
+    return isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf"
+
+
+def is_integer(value: Any) -> bool:
+    """True for an int or NumPy integer; False for bool (``True`` is not the integer 1 here)."""
+    return isinstance(value, int | np.integer) and not isinstance(value, bool | np.bool_)
+
+
+def check_int(parameter: str, value: Any, lo: int | None = None, hi: int | None = None) -> int:
+    """Validate an integer against ``[lo, hi]``; returns it as int or raises InputError.
+
+    Floats are refused even when whole (``4.0`` layers is a typo for 4 or for 4.5), and so
+    are booleans and text.
+    """
+    if lo is not None and hi is not None:
+        allowed = f"an integer in [{lo}, {hi}]"
+    elif lo is not None:
+        allowed = f"an integer >= {lo}"
+    elif hi is not None:
+        allowed = f"an integer <= {hi}"
+    else:
+        allowed = "an integer"
+    if not is_integer(value):
+        raise InputError(parameter, value, allowed)
+    v = int(value)
+    if (lo is not None and v < lo) or (hi is not None and v > hi):
+        raise InputError(parameter, value, allowed)
+    return v
+
+
+def as_float_array(parameter: str, values: Any) -> np.ndarray:
+    """``values`` as a float64 array, or InputError naming ``parameter``.
+
+    Only numbers are converted: text (``["1", "2"]``), booleans and ragged lists are refused
+    rather than parsed, so a column read from the wrong place cannot pass as data.
+    """
+    try:
+        raw = np.asarray(values)
+    except (TypeError, ValueError):  # ragged nesting
+        raise InputError(parameter, _short(values), "an array of numbers") from None
+    if raw.dtype.kind == "O":
+        flat = raw.ravel()
+        if not all(is_number(v) for v in flat):
+            bad = next(v for v in flat if not is_number(v))
+            raise InputError(parameter, _short(values), "an array of numbers", f"found {bad!r}")
+    elif raw.dtype.kind not in "iuf":
+        raise InputError(parameter, _short(values), "an array of numbers", f"got {raw.dtype.name} data")
+    try:
+        return np.asarray(raw, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InputError(parameter, _short(values), "an array of numbers") from None
+
+
+def _short(values: Any, limit: int = 60) -> Any:
+    """A value short enough for a one-line message (long arrays are summarised)."""
+    text = repr(values)
+    if len(text) <= limit:
+        return values
+    shape = getattr(values, "shape", None)
+    return f"array of shape {shape}" if shape is not None else text[: limit - 3] + "..."

@@ -86,3 +86,27 @@ def write_csv(path: str | os.PathLike, rows: Iterable[Mapping], header: list[str
                     for k, v in r.items()
                 }
             )
+
+
+def check_output_dir(parameter: str, path: str | os.PathLike) -> Path:
+    """Refuse an output folder that cannot be created or written, before any work starts.
+
+    ``path`` may exist (a folder) or not (it is created later); an existing file of that
+    name, a file where a parent folder should be, or a parent without write permission is
+    an InputError naming ``parameter``. Nothing is created here.
+    """
+    from poro2d.errors import InputError
+
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        raise InputError(parameter, str(p), "a folder (a file of that name exists)")
+    existing = p
+    while not existing.exists():  # the nearest part of the path that exists
+        if existing.parent == existing:
+            break
+        existing = existing.parent
+    if not existing.is_dir():
+        raise InputError(parameter, str(p), "a path whose parents are folders", f"{existing} is a file")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise InputError(parameter, str(p), "a folder that can be written", f"{existing} is read-only")
+    return p

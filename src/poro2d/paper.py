@@ -87,9 +87,11 @@ def register(app: typer.Typer) -> None:
         from poro2d.criterion.config import build, paper_preset
         from poro2d.criterion.protocol import PorosityCriterion
         from poro2d.errors import InputError
+        from poro2d.io_utils import check_output_dir
 
         if seed < 0:
             raise InputError("--seed", seed, "an integer >= 0")
+        check_output_dir("--out", out)
         out.mkdir(parents=True, exist_ok=True)
         timings: dict[str, float] = {}
         t0 = time.perf_counter()

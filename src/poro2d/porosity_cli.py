@@ -306,6 +306,9 @@ def plot_relations(
     if mark_n_lab is not None:
         check_range("--mark-n-lab", mark_n_lab, 0.0, 0.5)
     from poro2d.figures.relations import write_relation_figures
+    from poro2d.io_utils import check_output_dir
+
+    check_output_dir("--out-dir", out_dir)
 
     paths = write_relation_figures(
         out_dir,

@@ -29,8 +29,10 @@ def register(app: typer.Typer) -> None:
         from poro2d.criterion.config import build, load_config
         from poro2d.criterion.protocol import PorosityCriterion
         from poro2d.errors import InputError
+        from poro2d.io_utils import check_output_dir
         from poro2d.specimen.compaction import check_feasible
 
+        check_output_dir("--out", out)
         cfg, base = load_config(config, preset)
         if seed is not None:
             if seed < 0:

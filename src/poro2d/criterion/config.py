@@ -19,7 +19,7 @@ from pathlib import Path
 
 from poro2d.config import check_keys, dataclass_from_table, load_toml
 from poro2d.criterion.protocol import CriterionSettings
-from poro2d.errors import InputError
+from poro2d.errors import InputError, check_int
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.grading import GradingCurve, paper_grading
 
@@ -48,9 +48,11 @@ def build(cfg: dict, base_dir: Path | None = None, **overrides):
     spec_over = {k: overrides.pop(k) for k in ("threads",) if k in overrides}
     spec = dataclass_from_table(SpecimenSpec, "specimen", cfg.get("specimen"), **spec_over)
     g = cfg.get("grading") or {"preset": "paper"}
+    if not isinstance(g, dict):
+        raise InputError("grading", g, "a table: preset, csv or sizes_mm with percent_passing")
     grading = paper_grading() if g == {"preset": "paper"} else GradingCurve.from_config(g, base_dir=base_dir)
     settings = dataclass_from_table(CriterionSettings, "criterion", cfg.get("criterion"), **overrides)
-    seed = cfg.get("seed", 0)
-    if not isinstance(seed, int) or seed < 0:
-        raise InputError("seed", seed, "an integer >= 0")
+    seed = check_int("seed", cfg.get("seed", 0), 0)
+    if not isinstance(cfg.get("title", ""), str):
+        raise InputError("title", cfg["title"], "a string")
     return spec, grading, settings, seed

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import os
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -70,8 +71,12 @@ def save(sim: Simulation, path: str | os.PathLike, extra: dict | None = None) ->
 
 
 def read_meta(path: str | os.PathLike) -> dict:
-    with np.load(_existing(path)) as z:
-        return json.loads(bytes(z["meta"]).decode())
+    p = _existing(path)
+    try:
+        with np.load(p) as z:
+            return json.loads(bytes(z["meta"]).decode())
+    except _UNREADABLE as exc:
+        raise _damaged(p, exc) from None
 
 
 def _existing(path) -> Path:
@@ -81,13 +86,57 @@ def _existing(path) -> Path:
     return p
 
 
+# what NumPy, zipfile and json raise on a truncated, corrupted or foreign file
+_UNREADABLE = (OSError, ValueError, EOFError, KeyError, TypeError, zipfile.BadZipFile)
+
+
+def _damaged(path: Path, exc: BaseException) -> InputError:
+    if isinstance(exc, ValueError) and "pickle" in str(exc):
+        reason = "not an .npz archive"  # NumPy's guess for a file of neither format
+    else:
+        reason = (str(exc).splitlines() or [type(exc).__name__])[0][:80]
+    return InputError(
+        "checkpoint", str(path), "a complete .npz file written by poro2d",
+        f"it cannot be read: {reason}; truncated, or not a poro2d checkpoint",
+    )  # fmt: skip
+
+
+def read(path: str | os.PathLike) -> tuple[dict, dict[str, np.ndarray]]:
+    """(metadata, arrays) of the checkpoint at ``path``; every array is read in full.
+
+    Reading everything checks the whole file (each member's CRC), so a damaged checkpoint
+    is refused with one InputError naming it, before anything is built from it.
+    """
+    p = _existing(path)
+    try:
+        with np.load(p) as z:
+            meta = json.loads(bytes(z["meta"]).decode())
+            arrays = {k: z[k].copy() for k in z.files if k != "meta"}
+    except _UNREADABLE as exc:
+        raise _damaged(p, exc) from None
+    if not isinstance(meta, dict) or meta.get("format") != FORMAT:
+        raise InputError("checkpoint format", meta.get("format") if isinstance(meta, dict) else None, FORMAT)
+    needed = [f"particles.{f}" for f in PARTICLE_FIELDS] + [f"walls.{f}" for f in _WALL_FIELDS]
+    needed += [f"sim.{f}" for f in _SIM_ARRAYS]
+    missing = [k for k in needed if k not in arrays]
+    if missing or not isinstance(meta.get("settings"), dict):
+        raise _damaged(p, KeyError(f"missing {missing[0] if missing else 'settings'}"))
+    return meta, arrays
+
+
 def load(path: str | os.PathLike, threads: int | None = None) -> Simulation:
     """Rebuild the :class:`Simulation` saved at ``path``, ready to continue."""
-    with np.load(_existing(path)) as z:
-        meta = json.loads(bytes(z["meta"]).decode())
-        if meta.get("format") != FORMAT:
-            raise InputError("checkpoint format", meta.get("format"), FORMAT)
-        a = {k: z[k].copy() for k in z.files if k != "meta"}
+    meta, a = read(path)
+    try:
+        return _build(meta, a, threads)
+    except (KeyError, TypeError, IndexError, ValueError) as exc:
+        if isinstance(exc, InputError):
+            raise
+        raise _damaged(Path(path), exc) from None
+
+
+def _build(meta: dict, a: dict[str, np.ndarray], threads: int | None) -> Simulation:
+    """The Simulation of a checkpoint's metadata and arrays."""
     s = meta["settings"]
     pf = {f: a[f"particles.{f}"] for f in PARTICLE_FIELDS}
     particles = Particles(

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from poro2d.dem import kernels as K
+from poro2d.dem.layout import check_layout
 from poro2d.dem.model import (
     ContactModel,
     critical_time_step,
@@ -172,6 +173,7 @@ class Simulation:
         self.step_count = 0
         self.time = 0.0
         self._n_alloc = -1
+        check_layout(self.particles.pos, self.particles.radius, self.walls)
         self._refresh()
 
     @property
@@ -303,6 +305,8 @@ class Simulation:
         if new.thickness != p.thickness:
             raise InputError("thickness", new.thickness, f"{p.thickness} (that of the disks present)")
         n0 = p.n
+        # checked on the whole packing before anything changes; disk numbers as after the append
+        check_layout(np.concatenate([p.pos, new.pos]), np.concatenate([p.radius, new.radius]), self.walls)
         for f in PARTICLE_FIELDS:
             setattr(p, f, np.ascontiguousarray(np.concatenate([getattr(p, f), getattr(new, f)])))
         n = p.n

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from poro2d.errors import InputError
+from poro2d.errors import InputError, as_float_array, is_number
 
 # Particle kinematic modes.
 FREE = 0
@@ -24,12 +24,22 @@ SERVO_COLUMNS = 5  # target, gain, max speed, integral gain, summed error
 
 
 def _as_f64(name: str, a, n: int | None = None, shape_tail: tuple = ()) -> np.ndarray:
-    arr = np.ascontiguousarray(np.asarray(a, dtype=np.float64))
+    arr = np.ascontiguousarray(as_float_array(name, a))  # numbers only, text is refused
     if n is not None and arr.shape != (n, *shape_tail):
         raise InputError(name, f"shape {arr.shape}", f"shape {(n, *shape_tail)}")
     if not np.all(np.isfinite(arr)):
         raise InputError(name, "non-finite entries", "finite numbers")
     return arr
+
+
+def _per_disk(name: str, a, n: int) -> np.ndarray:
+    """One value per disk: a scalar is repeated ``n`` times, an array must have ``n`` entries."""
+    arr = as_float_array(name, a)
+    if arr.ndim == 0:
+        arr = np.full(n, float(arr))
+    if arr.shape != (n,):
+        raise InputError(name, f"shape {arr.shape}", f"one number or shape ({n},), one per disk")
+    return _as_f64(name, arr.copy())
 
 
 # the per-disk arrays of Particles (thickness is one number for all disks)
@@ -62,18 +72,17 @@ class Particles:
         if self.pos.ndim != 2 or self.pos.shape[1] != 2:
             raise InputError("positions", f"shape {self.pos.shape}", "shape (N, 2)")
         n = self.pos.shape[0]
-        self.radius = _as_f64("radius", np.broadcast_to(self.radius, (n,)).copy(), n)
+        self.radius = _per_disk("radius", self.radius, n)
         if n and self.radius.min() <= 0.0:
             raise InputError("radius", float(self.radius.min()), "(0, inf) for every disk")
-        self.density = _as_f64("density", np.broadcast_to(self.density, (n,)).copy(), n)
+        self.density = _per_disk("density", self.density, n)
         if n and self.density.min() <= 0.0:
             raise InputError("density", float(self.density.min()), "(0, inf) kg/m3")
-        if not (self.thickness > 0.0 and np.isfinite(self.thickness)):
+        if not (is_number(self.thickness) and self.thickness > 0.0 and np.isfinite(self.thickness)):
             raise InputError("thickness", self.thickness, "(0, inf) m")
         self.thickness = float(self.thickness)
         for name in ("kn", "ks", "mu"):
-            arr = _as_f64(name, np.broadcast_to(getattr(self, name), (n,)).copy(), n)
-            setattr(self, name, arr)
+            setattr(self, name, _per_disk(name, getattr(self, name), n))
         if n and self.kn.min() <= 0.0:
             raise InputError("particle kn", float(self.kn.min()), "(0, inf) N/m")
         if n and self.ks.min() < 0.0:
@@ -86,7 +95,12 @@ class Particles:
         if self.mode is None:
             self.mode = np.zeros(n, dtype=np.int64)
         else:
-            self.mode = np.ascontiguousarray(np.asarray(self.mode, dtype=np.int64))
+            mode = np.asarray(self.mode)
+            known = (mode == FREE) | (mode == PRESCRIBED)
+            if mode.shape != (n,) or mode.dtype.kind not in "iu" or not np.all(known):
+                raise InputError("mode", f"{mode.dtype.name} array of shape {mode.shape}",
+                                 f"shape ({n},) of {FREE} (free) or {PRESCRIBED} (prescribed)")  # fmt: skip
+            self.mode = np.ascontiguousarray(mode, dtype=np.int64)
 
     @property
     def n(self) -> int:

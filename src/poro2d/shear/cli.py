@@ -54,6 +54,23 @@ def load_shear_config(path: Path | None) -> tuple[dict, Path | None]:
     return dict(table), Path(path).resolve().parent
 
 
+def check_extra_types(extra: dict) -> None:
+    """Types of the ``[shear]`` keys that are not ShearSettings fields."""
+    from poro2d.errors import InputError, check_int, is_number
+
+    for key in ("specimen", "lab"):
+        if key in extra and not isinstance(extra[key], str):
+            raise InputError(f"shear.{key}", extra[key], "a path (a string)")
+    if "processes" in extra:
+        check_int("shear.processes", extra["processes"], 1)
+    if "rate_check" in extra and not isinstance(extra["rate_check"], bool):
+        raise InputError("shear.rate_check", extra["rate_check"], "true or false")
+    if "normal_stress_kpa" in extra:
+        v = extra["normal_stress_kpa"]
+        if not (is_number(v) or (isinstance(v, list) and v and all(is_number(x) for x in v))):
+            raise InputError("shear.normal_stress_kpa", v, "a number or a list of numbers in kPa")
+
+
 def register(app: typer.Typer) -> None:
     @app.command("shear")
     def shear_cmd(
@@ -78,18 +95,23 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Direct shear tests (the paper's Fig. 8): peak strengths, friction angle, figures."""
         from poro2d.config import dataclass_from_table
+        from poro2d.dem import checkpoint
         from poro2d.errors import InputError
+        from poro2d.io_utils import check_output_dir
         from poro2d.shear.lab import read_lab_csv
-        from poro2d.shear.protocol import ShearSeries, ShearSettings
+        from poro2d.shear.protocol import ShearSeries, ShearSettings, resolve_specimen
 
+        check_output_dir("--out", out)
         table, base = load_shear_config(config)
         extra = {k: table.pop(k) for k in list(table) if k in SHEAR_KEYS_EXTRA}
+        check_extra_types(extra)
         if specimen is None:
             specimen = extra.get("specimen")
             if specimen is not None and base is not None:
                 specimen = str((base / specimen).resolve())
         if specimen is None:
             raise InputError("--specimen", None, "a specimen checkpoint or criterion output folder")
+        checkpoint.read(resolve_specimen(specimen))  # a damaged file is refused here, in one line
         if normal_stress is not None:
             stresses = parse_stresses(normal_stress)
         elif "normal_stress_kpa" in extra:

@@ -18,6 +18,7 @@ near the target density once the layers above compact them.
 
 from __future__ import annotations
 
+import logging
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -25,9 +26,27 @@ import numpy as np
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
 from poro2d.dem.measure import porosity_rect
 from poro2d.dem.ordering import strip_order
-from poro2d.errors import InputError, check_range
-from poro2d.specimen.grading import GradingCurve, draw_disks
+from poro2d.errors import InputError, check_int, check_range
+from poro2d.specimen.grading import MAX_DRAW, GradingCurve, draw_disks
 from poro2d.specimen.placement import Band, place_disks
+
+_log = logging.getLogger(__name__)
+
+#: Specimens of more disks than this are refused before any disk is drawn, unless the
+#: config raises ``[specimen] max_disks`` (up to ``MAX_DRAW``).
+DEFAULT_MAX_DISKS = 2_000_000
+#: Memory per disk for the estimate: the engine holds about 0.5 kB per disk (positions,
+#: properties, forces, neighbour lists with their history); drawing, placement, checkpoints
+#: and figures make copies, so budget twice that.
+BYTES_PER_DISK = 1000
+#: Particle-steps per second for the run-time estimate: one core, rounded down from the
+#: 1.4-2.0e7 measured on the paper's specimen (docs/engine.md).
+THROUGHPUT = 1e7
+#: Steps to bring a stage (a layer, the working friction) to equilibrium, for the estimate;
+#: a typical dense layer needs a few thousand, a loose one many more.
+EQUILIBRIUM_STEPS = 5000
+#: Preparations estimated to take longer than this (seconds) are announced with a warning.
+WARN_SECONDS = 600.0
 
 
 @dataclass
@@ -55,6 +74,7 @@ class SpecimenSpec:
     max_steps_per_stage: int = 400_000
     dt_safety: float = 0.8
     threads: int = 1
+    max_disks: int = DEFAULT_MAX_DISKS
     extra: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -66,15 +86,27 @@ class SpecimenSpec:
             check_range(k, getattr(self, k), 0, None, lo_open=True)
         for k in ("ks_particle", "ks_wall", "friction_prep", "friction_particle", "friction_wall"):
             check_range(k, getattr(self, k), 0, None)
-        if not (isinstance(self.layers, int) and 1 <= self.layers <= 50):
-            raise InputError("layers", self.layers, "an integer in [1, 50]")
+        check_int("layers", self.layers, 1, 50)
         check_range("undercompaction", self.undercompaction, 0.0, 0.5)
         check_range("ratio", self.ratio, 0.0, 1.0, lo_open=True)
         check_range("local_damping", self.local_damping, 0.0, 1.0, hi_open=True)
         check_range("gravity", self.gravity, 0.0, None)
+        check_int("growth_increments", self.growth_increments, 1)
+        check_int("growth_steps", self.growth_steps, 1)
+        check_int("max_steps_per_stage", self.max_steps_per_stage, 1)
+        check_range("dt_safety", self.dt_safety, 0.0, 1.0, lo_open=True)
+        check_int("threads", self.threads, 1)
+        check_int("max_disks", self.max_disks, 1, MAX_DRAW)
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        """The specimen's settings as recorded with results.
+
+        ``max_disks`` is left out: it is a guard, not a property of the specimen, so raising
+        it does not make a resumable output folder look like another config's.
+        """
+        d = asdict(self)
+        del d["max_disks"]
+        return d
 
     def self_weight(self, porosity: float) -> float:
         """G = rho_s (1 - n) W H g per metre of thickness (N/m), as in the paper."""
@@ -115,6 +147,78 @@ def check_feasible(spec: SpecimenSpec, grading: GradingCurve, porosity: float) -
             "porosity", porosity, "[0.05, 1)",
             "disks cannot fill a box to less than about 0.09 porosity without large overlaps",
         )  # fmt: skip
+    check_size(spec, grading, porosity)
+
+
+@dataclass(frozen=True)
+class SizeEstimate:
+    """What a specimen will cost, estimated from the grading without drawing a disk."""
+
+    disks: float
+    memory_bytes: float
+    steps: int
+    seconds: float
+
+
+def estimate_size(spec: SpecimenSpec, grading: GradingCurve, porosity: float) -> SizeEstimate:
+    """Expected disk count, memory and preparation time of a specimen at ``porosity``.
+
+    The count is the box's solid area (1 - n) W H over the grading's mean disk area, the
+    number :func:`draw_disks` will draw on average. The steps are those of radius expansion
+    in every layer plus ``EQUILIBRIUM_STEPS`` per stage; the time assumes ``THROUGHPUT``.
+    """
+    solid_area = (1.0 - porosity) * spec.width * spec.height
+    disks = grading.expected_count(solid_area)
+    steps = spec.layers * (spec.growth_increments * spec.growth_steps + EQUILIBRIUM_STEPS) + EQUILIBRIUM_STEPS
+    return SizeEstimate(disks, disks * BYTES_PER_DISK, steps, disks * steps / THROUGHPUT)
+
+
+def check_size(spec: SpecimenSpec, grading: GradingCurve, porosity: float) -> SizeEstimate:
+    """Refuse a specimen of more than ``spec.max_disks`` disks; warn when it will take long.
+
+    Cheap (no disk is drawn), so a grading that would need 1e8 disks is refused at once
+    instead of filling the memory.
+    """
+    est = estimate_size(spec, grading, porosity)
+    if est.disks > spec.max_disks:
+        raise InputError(
+            "specimen size", f"about {est.disks:.3g} disks ({_gb(est.memory_bytes)})",
+            f"at most max_disks = {spec.max_disks} disks",
+            f"mean disk area {grading.mean_disk_area():.3g} m^2 in {spec.width:g} m x {spec.height:g} m "
+            f"at porosity {porosity:g}; coarsen the grading (upscale, d_min_mm), shrink the box, or "
+            "raise [specimen] max_disks",
+        )  # fmt: skip
+    if est.seconds > WARN_SECONDS:
+        _warn_once(
+            f"large specimen: about {est.disks:.3g} disks ({_gb(est.memory_bytes)}); preparing it "
+            f"takes about {_duration(est.seconds)} per trial (about {est.steps} steps at "
+            f"{THROUGHPUT:.0e} particle-steps/s on one core)"
+        )
+    return est
+
+
+_WARNED: set[str] = set()
+
+
+def _warn_once(message: str) -> None:
+    """Log a warning once per process (the criterion checks before every trial)."""
+    if message not in _WARNED:
+        _WARNED.add(message)
+        _log.warning(message)
+
+
+def _gb(nbytes: float) -> str:
+    if nbytes >= 1e9:
+        return f"about {nbytes / 1e9:.3g} GB of memory"
+    return f"about {nbytes / 1e6:.3g} MB of memory"
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 3600:
+        return f"{seconds / 60:.0f} min"
+    if seconds < 2 * 86400:
+        return f"{seconds / 3600:.1f} h"
+    return f"{seconds / 86400:.1f} days"
 
 
 @dataclass
@@ -240,4 +344,13 @@ def box_porosity(sim: Simulation, width: float, top: float, bottom: float = 0.0)
     return 1.0 - sim.particles.area() / (width * h)
 
 
-__all__ = ["SpecimenSpec", "box_porosity", "check_feasible", "make_walls", "prepare_specimen"]
+__all__ = [
+    "SizeEstimate",
+    "SpecimenSpec",
+    "box_porosity",
+    "check_feasible",
+    "check_size",
+    "estimate_size",
+    "make_walls",
+    "prepare_specimen",
+]

@@ -30,9 +30,10 @@ from typing import Any
 
 import numpy as np
 
-from poro2d.errors import InputError, check_range
+from poro2d.errors import InputError, as_float_array, check_range, is_number
 
 __all__ = [
+    "MAX_DRAW",
     "PAPER_UPSCALE",
     "GradingCurve",
     "draw_disks",
@@ -48,13 +49,13 @@ PAPER_UPSCALE = 10.0
 _WITHIN_CLASS = ("uniform", "loguniform")
 _CONFIG_KEYS = ("preset", "csv", "sizes_mm", "percent_passing", "upscale", "d_min_mm", "d_max_mm")
 _TOP_TOL = 1e-6  # percent passing at the largest size must be 100 within this
+#: The most disks :func:`draw_disks` will draw (a hard ceiling against exhausting the memory;
+#: specimens have their own, lower limit: ``SpecimenSpec.max_disks``).
+MAX_DRAW = 50_000_000
 
 
 def _as_float_array(name: str, values: Any) -> np.ndarray:
-    try:
-        arr = np.asarray(values, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise InputError(name, values, "a list of numbers") from None
+    arr = as_float_array(name, values)  # numbers only: ["0.2", "0.5"] is refused, not parsed
     if arr.ndim != 1:
         raise InputError(name, values, "a flat list of numbers")
     if not np.all(np.isfinite(arr)):
@@ -188,6 +189,11 @@ class GradingCurve:
             raise InputError(
                 "csv", str(path), "a readable CSV file with columns size_mm,percent_passing"
             ) from None
+        except UnicodeDecodeError as exc:  # a binary file given by mistake
+            raise InputError(
+                "csv", str(path), "a text (UTF-8) CSV file with columns size_mm,percent_passing",
+                f"byte {exc.start} is not text",
+            ) from None  # fmt: skip
         sizes, percent = _parse_csv(text, str(p))
         return cls.from_lists(
             sizes,
@@ -214,6 +220,7 @@ class GradingCurve:
             raise InputError(
                 "grading", sorted(table), "exactly one of preset, csv or sizes_mm/percent_passing"
             )
+        _check_config_types(table)
         cuts = {"d_min_mm": table.get("d_min_mm"), "d_max_mm": table.get("d_max_mm")}
         if "preset" in table:
             if table["preset"] != "paper":
@@ -274,6 +281,19 @@ class GradingCurve:
         return float(solid_area) / self.mean_disk_area(within_class)
 
 
+def _check_config_types(table: Mapping[str, Any]) -> None:
+    """Refuse config values of the wrong type, e.g. ``upscale = "10"`` or ``csv = 5``."""
+    for key in ("preset", "csv"):
+        if key in table and not isinstance(table[key], str):
+            raise InputError(f"grading.{key}", table[key], "a string")
+    for key in ("upscale", "d_min_mm", "d_max_mm"):
+        if key in table and not is_number(table[key]):
+            raise InputError(f"grading.{key}", table[key], "a number")
+    for key in ("sizes_mm", "percent_passing"):
+        if key in table and not isinstance(table[key], list):
+            raise InputError(f"grading.{key}", table[key], "a list of numbers")
+
+
 def _cutoff(name: str, value: float | None) -> float | None:
     if value is None:
         return None
@@ -329,6 +349,9 @@ def _apply_cutoffs(
 
 
 def _parse_csv(text: str, origin: str) -> tuple[list[float], list[float]]:
+    if "\x00" in text:  # valid UTF-8 but binary (the csv module would stop on it with its own error)
+        raise InputError("csv", origin, "a text CSV file with columns size_mm,percent_passing",
+                         "it contains NUL bytes")  # fmt: skip
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     reader = csv.DictReader(io.StringIO("\n".join(lines)))
     fields = [f.strip() for f in (reader.fieldnames or [])]
@@ -439,8 +462,12 @@ def draw_disks(
     fractions = curve.class_fractions
     lo_all, hi_all = d[:-1], d[1:]
     mean_areas = _class_mean_area(lo_all, hi_all, within_class)
-    if area / float(mean_areas[fractions > 0].max()) > 5e7:
-        raise InputError("solid_area", solid_area, "at most about 5e7 disks of this grading")
+    expected = curve.expected_count(area, within_class)
+    if expected > MAX_DRAW:
+        raise InputError(
+            "solid_area", solid_area, f"at most about {MAX_DRAW:.0e} disks of this grading",
+            f"it would take about {expected:.3g} disks",
+        )  # fmt: skip
 
     chunks: list[np.ndarray] = []
     target_cum = 0.0

@@ -36,10 +36,12 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Run a grid or list of cases as Dask tasks; one table of results."""
         from poro2d.config import load_toml
+        from poro2d.io_utils import check_output_dir
         from poro2d.sweep.cases import parse_sweep
         from poro2d.sweep.runner import run_sweep
 
         _check_workers(workers)
+        check_output_dir("--out", out)
         cfg = load_toml(config)
         sweep = parse_sweep(cfg, Path(config).resolve().parent)
         console.print(f"{len(sweep.cases)} case(s) of kind {sweep.kind!r} -> {out}")
@@ -78,11 +80,13 @@ def register(app: typer.Typer) -> None:
         from poro2d.config import check_keys, load_toml
         from poro2d.criterion.config import TOP_KEYS, paper_preset
         from poro2d.errors import InputError
+        from poro2d.io_utils import check_output_dir
         from poro2d.sweep import relation as R
         from poro2d.sweep.cases import parse_sweep
         from poro2d.sweep.runner import run_sweep
 
         _check_workers(workers)
+        check_output_dir("--out", out)
         if config is not None and preset is not None:
             raise InputError("--config/--preset", f"{config} and {preset}", "one of the two, not both")
         if config is None:
