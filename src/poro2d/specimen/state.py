@@ -1,0 +1,120 @@
+"""Homogeneity and stress state of a prepared specimen.
+
+The box is cut into horizontal bands of equal height. In each band:
+
+- the porosity, with disks clipped exactly at the band's edges (so a band's value does
+  not depend on where disk centres happen to fall);
+- the average stress of the disks centred in it (Love-Weber, :func:`average_stress`):
+  vertical sigma_v and horizontal sigma_h, compression positive, and K0 = sigma_h / sigma_v;
+- beside sigma_v, the geostatic stress of the material above the band's middle plus the
+  plate: F_top / W + rho_s g (1 - n_above) (z_top - z), per unit area of the 2D box
+  (stresses are forces per metre of thickness per metre of width, i.e. Pa).
+
+A specimen built by gravity deposition should show sigma_v close to the geostatic line
+(less where the side walls carry part of the weight by friction, Janssen's silo effect)
+and K0 of the order of Jaky's 1 - sin(phi); one built by radius expansion locks in a
+stress that does not grow with depth.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from poro2d.dem.measure import average_stress, porosity_rect
+from poro2d.errors import check_int
+
+
+def band_edges(top: float, bands: int) -> np.ndarray:
+    return np.linspace(0.0, top, bands + 1)
+
+
+def specimen_state(sim, width: float, top: float, bands: int = 8) -> dict:
+    """Porosity, sigma_v, sigma_h, K0 and the geostatic sigma_v per band, bottom to top.
+
+    ``top``: the height of the top plate. Returns the bands and a summary (porosity
+    spread, mean K0, the ratio of measured to geostatic sigma_v at the bottom band).
+    """
+    check_int("bands", bands, 2, 200)
+    p = sim.particles
+    edges = band_edges(top, bands)
+    g = -sim.gravity[1]
+    rho_s = float(np.mean(p.density)) if p.n else 0.0
+    f_top = float(sim.wall_force("top")[1]) / p.thickness  # N/m, upward push on the plate
+    rows = []
+    for k in range(bands):
+        y0, y1 = edges[k], edges[k + 1]
+        s = average_stress(sim, 0.0, y0, width, y1)  # tension positive
+        zc = 0.5 * (y0 + y1)
+        n_above = porosity_rect(p.pos, p.radius, 0.0, zc, width, top)
+        geo = f_top / width + rho_s * g * (1.0 - n_above) * (top - zc)
+        sv, sh = -float(s[1, 1]), -float(s[0, 0])
+        rows.append({
+            "z_bottom_m": float(y0),
+            "z_top_m": float(y1),
+            "z_mid_m": float(zc),
+            "porosity": porosity_rect(p.pos, p.radius, 0.0, y0, width, y1),
+            "sigma_v_pa": sv,
+            "sigma_h_pa": sh,
+            "k0": sh / sv if sv > 0 else None,
+            "sigma_v_geostatic_pa": geo,
+        })  # fmt: skip
+    por = np.array([r["porosity"] for r in rows])
+    k0 = np.array([r["k0"] for r in rows if r["k0"] is not None])
+    bottom = rows[0]
+    geo0 = bottom["sigma_v_geostatic_pa"]
+    return {
+        "bands": rows,
+        "porosity_definition": "disk area clipped to the band / band area",
+        "porosity_mean": float(por.mean()),
+        "porosity_sd": float(por.std(ddof=1)),
+        "porosity_range": float(por.max() - por.min()),
+        "k0_mean": float(k0.mean()) if k0.size else None,
+        "k0_sd": float(k0.std(ddof=1)) if k0.size > 1 else None,
+        "sigma_v_bottom_over_geostatic": bottom["sigma_v_pa"] / geo0 if geo0 > 0 else None,
+        "stress_sign": "compression positive; per metre of thickness and of width (Pa)",
+    }
+
+
+def plot_specimen_state(state: dict, path: str | Path, title: str = "") -> Path:
+    """Porosity per band and sigma_v, sigma_h, geostatic sigma_v against height; K0 in the legend."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from poro2d.io_utils import atomic_path
+
+    rows = state["bands"]
+    z = np.array([r["z_mid_m"] for r in rows]) * 1e3
+    fig = Figure(figsize=(9.0, 4.8), layout="constrained")
+    FigureCanvasAgg(fig)
+    a1, a2 = fig.subplots(1, 2, sharey=True)
+    a1.plot([r["porosity"] for r in rows], z, "o-", color="tab:blue")
+    a1.axvline(state["porosity_mean"], color="0.5", ls=":", lw=1)
+    a1.set_xlabel("porosity of the band [-]")
+    a1.set_ylabel("height of the band's middle [mm]")
+    a1.set_title(
+        f"porosity: mean {state['porosity_mean']:.4f}, range {state['porosity_range']:.4f}", fontsize=10
+    )
+    kpa = 1e-3
+    a2.plot([r["sigma_v_pa"] * kpa for r in rows], z, "o-", color="tab:red", label="sigma_v (disks)")
+    a2.plot([r["sigma_h_pa"] * kpa for r in rows], z, "s-", color="tab:green", label="sigma_h (disks)")
+    a2.plot([r["sigma_v_geostatic_pa"] * kpa for r in rows], z, "--", color="black",
+            label="geostatic: F_top / W + rho_s g (1 - n) (H - z)")  # fmt: skip
+    k0 = state.get("k0_mean")
+    a2.set_title(
+        f"stress; K0 = sigma_h / sigma_v: mean {k0:.3f}" if k0 is not None else "stress", fontsize=10
+    )
+    a2.set_xlabel("stress [kPa] (compression positive)")
+    a2.legend(fontsize=8, frameon=False, loc="upper right")
+    for a in (a1, a2):
+        a.grid(True, alpha=0.3)
+    if title:
+        fig.suptitle(title, fontsize=11)
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=130, format=path.suffix.lstrip(".") or "png")
+    return path
+
+
+__all__ = ["band_edges", "plot_specimen_state", "specimen_state"]
