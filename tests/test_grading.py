@@ -251,3 +251,17 @@ def test_paper_grading_particle_counts(n2d, paper_count):
     assert abs(np.mean(counts) - paper_count) / paper_count < 0.015
     assert all(abs(n - paper_count) / paper_count < 0.015 for n in counts)
     assert abs(c.expected_count(solid_area(n2d)) - paper_count) / paper_count < 0.015
+
+
+def test_log_linear_family_has_its_uniformity_and_mean_area():
+    from poro2d.specimen.grading import draw_disks, log_linear_grading, paper_grading
+
+    target = paper_grading().mean_disk_area()
+    for cu in (1.5, 2.5, 4.0):
+        g = log_linear_grading(cu, target)
+        assert g.uniformity == pytest.approx(cu, rel=1e-9)
+        assert g.d_max_m / g.d_min_m == pytest.approx(cu**2, rel=1e-9)
+        radii = draw_disks(g, 2000 * target, np.random.default_rng(0))
+        assert np.mean(np.pi * radii**2) == pytest.approx(target, rel=0.05)  # drawn, not assumed
+    with pytest.raises(InputError, match="cu"):
+        log_linear_grading(1.0, target)

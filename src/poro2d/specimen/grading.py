@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from poro2d.errors import InputError, as_float_array, check_range, is_number
+from poro2d.errors import InputError, as_float_array, check_int, check_range, is_number
 
 __all__ = [
     "MAX_DRAW",
@@ -279,6 +279,34 @@ class GradingCurve:
     def expected_count(self, solid_area: float, within_class: str = "uniform") -> float:
         """Expected number of disks that :func:`draw_disks` returns for ``solid_area``."""
         return float(solid_area) / self.mean_disk_area(within_class)
+
+    def size_at(self, percent: float) -> float:
+        """The size [m] that ``percent`` of the mass passes (log-linear between sieves)."""
+        p = check_range("percent", percent, 0.0, 100.0)
+        logd = np.interp(p, self.percent, np.log(self.sizes))
+        return float(np.exp(logd))
+
+    @property
+    def uniformity(self) -> float:
+        """Coefficient of uniformity Cu = d60 / d10."""
+        return self.size_at(60.0) / self.size_at(10.0)
+
+
+def log_linear_grading(cu: float, mean_disk_area: float, sieves: int = 9) -> GradingCurve:
+    """A grading of uniformity ``cu`` whose drawn disks have mean area ``mean_disk_area``.
+
+    Percent passing grows linearly with log d from 0 at d_min to 100 at d_max, so
+    Cu = d60 / d10 = (d_max / d_min)^0.5; the sizes are then scaled so that disks drawn
+    from it (uniform diameter within each class) have the given mean area. A family of
+    such curves varies the width of a grading at a fixed number of disks in the box.
+    """
+    cu = check_range("cu", cu, 1.0, 20.0, lo_open=True)
+    area = check_range("mean_disk_area", mean_disk_area, 0.0, None, lo_open=True)
+    sieves = check_int("sieves", sieves, 2, 50)
+    unit = np.geomspace(1.0, cu**2, sieves)
+    percent = np.linspace(0.0, 100.0, sieves)
+    scale = math.sqrt(area / GradingCurve(tuple(unit), tuple(percent)).mean_disk_area())
+    return GradingCurve(tuple(unit * scale), tuple(percent), source=f"log-linear, Cu = {cu:g}")
 
 
 def _check_config_types(table: Mapping[str, Any]) -> None:
