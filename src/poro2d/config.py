@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import tomllib
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from poro2d.errors import InputError
 
@@ -42,3 +45,23 @@ def dataclass_from_table(cls, section: str, table: dict | None, **overrides: Any
         return cls(**table)
     except TypeError as exc:
         raise InputError(section, table, "values of the right type", str(exc)) from None
+
+
+def check_finite(section: str, value: Any) -> None:
+    """Every number in ``value`` (nested tables and lists) must be finite.
+
+    TOML accepts ``inf`` and ``nan``, and a range check with an open end lets an
+    infinity through; neither has a meaning in a config, nor a JSON spelling.
+    """
+    if isinstance(value, dict):
+        for k, v in value.items():
+            check_finite(f"{section}.{k}" if section else str(k), v)
+    elif isinstance(value, (list, tuple)):
+        for i, v in enumerate(value):
+            check_finite(f"{section}[{i}]", v)
+    elif isinstance(value, float):  # integers are always finite
+        if not math.isfinite(value):
+            raise InputError(section, value, "a finite number")
+    elif isinstance(value, (np.generic, np.ndarray)) and np.issubdtype(np.asarray(value).dtype, np.number):
+        if not np.all(np.isfinite(value)):
+            raise InputError(section, np.asarray(value).tolist(), "finite numbers")

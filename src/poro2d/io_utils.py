@@ -149,6 +149,15 @@ def _finite_or_null(obj: Any) -> Any:
     return obj
 
 
+def as_json(data: Any) -> Any:
+    """``data`` as :func:`write_json` stores it and ``json.loads`` reads it back.
+
+    Code that uses a result both fresh and, on a resumed run, from its file gets
+    the same types either way (booleans, not NumPy booleans; ``None``, not NaN).
+    """
+    return _finite_or_null(to_json_types(data))
+
+
 def write_json(path: str | os.PathLike, data: Mapping, *, config: bool = False) -> None:
     """Write ``data`` as JSON (atomically); the file is always valid, strict JSON.
 
@@ -157,9 +166,7 @@ def write_json(path: str | os.PathLike, data: Mapping, *, config: bool = False) 
     numbers must all be finite: a non-finite one raises ``ValueError`` (validate
     configs before, see :func:`poro2d.config.check_finite`, for a clear message).
     """
-    plain = to_json_types(data)
-    if not config:
-        plain = _finite_or_null(plain)
+    plain = to_json_types(data) if config else as_json(data)
     text = json.dumps(plain, indent=2, allow_nan=False)
     with atomic_path(path) as tmp:
         tmp.write_text(text + "\n")
