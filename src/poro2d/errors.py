@@ -45,3 +45,11 @@ def check_range(
     if hi is not None and (v > hi or (hi_open and v == hi)):
         raise InputError(parameter, value, allowed)
     return v
+
+
+class Interrupted(Exception):
+    """A command stopped by Ctrl-C (or SIGINT); the message says what was kept.
+
+    Not a ``KeyboardInterrupt`` on purpose: the command line library turns those
+    into a silent exit before :func:`poro2d.cli.main` could say anything.
+    """
