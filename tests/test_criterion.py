@@ -126,3 +126,78 @@ def test_cli_rejects_impossible_porosity(tmp_path, capsys):
         main(["criterion", "--preset", "paper", "--trial-porosity", "0.01", "--out", str(tmp_path / "o")])
     assert e.value.code == 2
     assert "porosity" in capsys.readouterr().err
+
+
+def test_rerun_with_other_threads_resumes(down):
+    # threads change the speed, not the numbers: not part of what a resumed run must match
+    out, r = down
+    trial_dir = next((out / "trials").iterdir())
+    stamp = (trial_dir / "trial.json").stat().st_mtime_ns
+    spec = SpecimenSpec(**dict(SMALL.to_dict(), threads=2))
+    settings = CriterionSettings(trial_porosity=0.30, max_iterations=1)
+    again = PorosityCriterion(spec, paper_grading(), settings, seed=0, out=out).run()
+    assert again["iterations"] == r["iterations"]
+    assert (trial_dir / "trial.json").stat().st_mtime_ns == stamp
+
+
+def test_flags_are_booleans_in_new_and_resumed_trials(down):
+    out, r = down
+    (new,) = r["iterations"]
+    (resumed,) = _run(out, 0.30, max_iterations=1)["iterations"]
+    for key in ("plate_settled", "accepted", "preparation_converged"):
+        assert type(new[key]) is bool and type(resumed[key]) is bool, key
+    assert new == resumed
+    saved = json.loads((out / "result.json").read_text())
+    assert type(saved["iterations"][0]["plate_settled"]) is bool
+    header, row = (out / "iterations.csv").read_text().splitlines()
+    flags = dict(zip(header.split(","), row.split(","), strict=True))
+    assert flags["plate_settled"] in ("True", "False") and flags["accepted"] in ("True", "False")
+
+
+TINY_TOML = """seed = 0
+[specimen]
+width = 0.06
+height = 0.03
+layers = 2
+[criterion]
+trial_porosity = 0.30
+max_iterations = 1
+"""
+
+
+def test_corrected_rerun_after_a_refused_one(tmp_path, capsys):
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(TINY_TOML)
+    out = tmp_path / "o"
+    with pytest.raises(SystemExit) as e:
+        main(["criterion", "--config", str(cfg), "--out", str(out), "--threads", "0", "--quiet"])
+    assert e.value.code == 2 and "threads" in capsys.readouterr().err
+    assert not (out / "config.json").exists()
+    with pytest.raises(SystemExit) as e:  # max_iterations = 1 does not converge: exit 1, not 2
+        main(["criterion", "--config", str(cfg), "--out", str(out), "--threads", "1", "--quiet"])
+    assert e.value.code == 1, capsys.readouterr().err
+    assert (out / "result.json").is_file()
+
+
+def test_config_of_a_run_that_never_started_does_not_bind(tmp_path):
+    # a run stopped before its first trial leaves only config.json: another config may use the folder
+    PorosityCriterion(
+        SMALL, paper_grading(), CriterionSettings(trial_porosity=0.25), out=tmp_path
+    )._check_resume()
+    r = _run(tmp_path, 0.30, max_iterations=1)
+    assert r["iterations"][0]["trial_porosity"] == 0.30
+    stored = json.loads((tmp_path / "config.json").read_text())
+    assert stored["run"]["criterion"]["trial_porosity"] == 0.30
+
+
+def test_non_finite_config_values_are_refused_before_any_output(tmp_path, capsys):
+    cfg = tmp_path / "c.toml"
+    # an open-ended range ((0, inf) for a stiffness) would let an infinity through
+    cfg.write_text(TINY_TOML.replace("layers = 2", "layers = 2\nkn_wall = inf"))
+    with pytest.raises(SystemExit) as e:
+        main(["criterion", "--config", str(cfg), "--out", str(tmp_path / "o"), "--quiet"])
+    err = capsys.readouterr().err
+    assert e.value.code == 2 and "kn_wall" in err and "finite" in err
+    assert not (tmp_path / "o").exists()
+    with pytest.raises(InputError, match="growth_steps"):  # refused as soon as the spec is made
+        SpecimenSpec(**dict(SMALL.to_dict(), growth_steps=float("inf")))

@@ -112,3 +112,12 @@ def test_report_renders_in_headless_chromium(quick, tmp_path):
     assert ink[:, 100:1100].mean() > 0.02  # text, tables and figures are drawn
     assert not ink[:, 1120:].any()  # the right margin stays empty: nothing overflows
     assert np.isfinite(img).all()
+
+
+def test_bad_option_writes_nothing(tmp_path, capsys):
+    # refused before the conversions stage: the corrected command then starts from a clean folder
+    out = tmp_path / "paper"
+    with pytest.raises(SystemExit) as e:
+        main(["paper", "--quick", "--threads", "0", "--out", str(out), "--quiet"])
+    assert e.value.code == 2 and "threads" in capsys.readouterr().err
+    assert not out.exists()

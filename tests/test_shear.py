@@ -238,10 +238,14 @@ def test_api_bad_input(specimen, tmp_path):
         ShearSeries(tmp_path / "missing.npz", [50])
     with pytest.raises(InputError, match="normal stress"):
         ShearSeries(specimen, [50, 50], out=tmp_path)
-    # a folder holding another test is not overwritten
-    DirectShearTest(specimen, 50, ShearSettings(**SHORT), out=tmp_path / "t")._check_resume()
-    with pytest.raises(InputError, match="out"):
-        DirectShearTest(specimen, 100, ShearSettings(**SHORT), out=tmp_path / "t").run()
+
+
+def test_a_folder_holding_another_test_is_not_overwritten(specimen, series):
+    out, _ = series
+    with pytest.raises(InputError, match="another normal stress"):
+        DirectShearTest(specimen, 100, ShearSettings(**SHORT), out=out / "sn50kPa").run()
+    with pytest.raises(InputError, match=r"other settings \(velocity\)"):
+        DirectShearTest(specimen, 50, ShearSettings(**dict(SHORT, velocity=0.02)), out=out / "sn50kPa").run()
 
 
 def test_rate_check_reruns_at_half_velocity(specimen, series, tmp_path):
@@ -265,3 +269,79 @@ def test_rate_check_reruns_at_half_velocity(specimen, series, tmp_path):
     assert row["max_inertial_number_half_velocity"] < r["tests"][1]["max_inertial_number"]
     assert 0 <= row["mean_abs_change_before_peak"] < 1
     assert rc["passed"] == (abs(row["relative_change"]) < 0.02)
+
+
+def _other_state(src, dest):
+    """A copy of the specimen at ``src`` with one disk moved by a micrometre."""
+    sim = checkpoint.load(src)
+    sim.particles.pos[0, 0] += 1e-6
+    checkpoint.save(sim, dest)
+
+
+def test_state_digest_follows_content_not_file(specimen, tmp_path):
+    sim = checkpoint.load(specimen)
+    checkpoint.save(sim, tmp_path / "again.npz")  # other time stamps, same state
+    sim.threads = 2
+    checkpoint.save(sim, tmp_path / "two_threads.npz")
+    _other_state(specimen, tmp_path / "moved_disk.npz")
+    d = checkpoint.state_digest(specimen)
+    assert checkpoint.state_digest(tmp_path / "again.npz") == d
+    assert checkpoint.state_digest(tmp_path / "two_threads.npz") == d
+    assert checkpoint.state_digest(tmp_path / "moved_disk.npz") != d
+
+
+def test_replaced_specimen_is_refused(specimen, series, tmp_path, capsys):
+    import shutil
+
+    out, _ = series
+    folder = tmp_path / "criterion-out"
+    folder.mkdir()
+    _other_state(specimen, folder / "specimen.npz")  # another specimen in the same place
+    dest = tmp_path / "shear"
+    shutil.copytree(out, dest)
+    args = ["shear", "--specimen", str(folder), "--normal-stress", "50,100,200,400", "--out", str(dest),
+            "--max-displacement", "0.002", "--processes", "1", "--quiet",
+            "--config", str(_cfg(tmp_path))]  # fmt: skip
+    with pytest.raises(SystemExit) as exc:
+        main(args)
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert "another specimen" in err and "new --out" in err
+    assert not (dest / "sn400kPa").exists()  # refused before anything was written
+
+
+def test_moved_folders_resume_without_recomputing(specimen, series, tmp_path):
+    import shutil
+
+    out, r = series
+    spec_dir = tmp_path / "elsewhere"
+    spec_dir.mkdir()
+    shutil.copy(specimen, spec_dir / "specimen.npz")
+    dest = tmp_path / "copied"
+    shutil.copytree(out, dest)
+    done = sorted(dest.glob("sn*/result.json"))
+    stamps = [f.stat().st_mtime_ns for f in done]
+    again = ShearSeries(
+        spec_dir, [50, 100, 200], ShearSettings(**SHORT), out=dest, processes=1, progress=False, figures=False
+    ).run()
+    assert [f.stat().st_mtime_ns for f in done] == stamps
+    assert [t["peak_shear_stress_kpa"] for t in again["tests"]] == [
+        t["peak_shear_stress_kpa"] for t in r["tests"]
+    ]
+
+
+def test_settings_bind_only_once_a_test_started(specimen, tmp_path):
+    # a series stopped before any stage began (only the records written) does not hold its folder
+    ShearSeries(
+        specimen, [50, 100], ShearSettings(**dict(SHORT, velocity=0.03)), out=tmp_path, progress=False
+    )
+    s = ShearSeries(specimen, [50, 100], ShearSettings(**SHORT), out=tmp_path, progress=False)
+    stored = json.loads((tmp_path / "sn50kPa" / "test.json").read_text())
+    assert stored["run"]["settings"]["velocity"] == s.settings.velocity
+    assert str(tmp_path) not in json.dumps(stored["run"])  # no paths in what is compared
+
+
+def test_non_finite_shear_settings_are_refused(specimen, tmp_path):
+    with pytest.raises(InputError, match="peak_window"):
+        ShearSeries(specimen, [50], ShearSettings(**dict(SHORT, peak_window=float("inf"))), out=tmp_path)
+    assert not any(tmp_path.iterdir())

@@ -204,6 +204,22 @@ def test_case_ids_are_stable_and_names_resolve():
     assert grid.cases[3].config["specimen"]["kn_particle"] == 4e5
 
 
+def test_thread_count_is_not_part_of_a_case_id():
+    # a rerun with another thread count finds the finished cases: threads never change results
+    grid = {"n_lab": [0.33, 0.36]}
+    runs = [parse_sweep({"specimen": dict(TINY, threads=t), "sweep": grid}) for t in (1, 2)]
+    ids = [[c.id for c in run.cases] for run in runs]
+    assert ids[0] == ids[1]
+    other = parse_sweep({"specimen": dict(TINY, layers=3), "sweep": {"n_lab": [0.33, 0.36]}})
+    assert [c.id for c in other.cases] != ids[0]
+
+
+def test_non_finite_base_values_are_input_errors():
+    with pytest.raises(InputError) as ei:
+        parse_sweep({"specimen": dict(TINY, growth_steps=float("inf")), "sweep": {"n_lab": [0.33]}})
+    assert ei.value.parameter == "config.specimen.growth_steps"
+
+
 @pytest.mark.parametrize(
     "sweep, parameter",
     [

@@ -8,6 +8,7 @@ exit code 2 and no traceback.
 
 from __future__ import annotations
 
+import functools
 import sys
 
 import typer
@@ -15,7 +16,7 @@ from rich.console import Console
 from rich.markup import escape
 
 from poro2d import __version__
-from poro2d.errors import InputError
+from poro2d.errors import InputError, Interrupted
 
 app = typer.Typer(
     name="poro2d",
@@ -55,6 +56,43 @@ def _register() -> None:
     shear_cli.register(app)
     paper.register(app)
     sweep_cli.register(app)
+    for info in app.registered_commands:
+        info.callback = _interruptible(info.name or info.callback.__name__, info.callback)
+
+
+#: what an interrupted command leaves in its --out folder, for the message
+KEPT = {
+    "criterion": "finished trials",
+    "shear": "finished tests and the last checkpoint of each running one",
+    "paper": "finished stages, trials and tests",
+    "sweep": "finished cases",
+    "relation": "finished cases",
+}
+
+
+def interrupt_message(command: str, out) -> str:
+    """One line: what an interrupted ``command`` kept and how to go on."""
+    kept = KEPT.get(command)
+    if kept is None or out is None:
+        return "interrupted"
+    return f"interrupted: {kept} are kept in {out}; rerun the same command to resume"
+
+
+def _interruptible(command: str, callback):
+    """``callback`` with Ctrl-C turned into :class:`Interrupted`, which reaches :func:`main`.
+
+    The command line library catches ``KeyboardInterrupt`` itself and exits with
+    code 130 without a word; an ordinary exception passes through it.
+    """
+
+    @functools.wraps(callback)
+    def run(*args, **kwargs):
+        try:
+            return callback(*args, **kwargs)
+        except KeyboardInterrupt:
+            raise Interrupted(interrupt_message(command, kwargs.get("out"))) from None
+
+    return run
 
 
 _register()
@@ -70,7 +108,10 @@ def main(argv: list[str] | None = None) -> None:
         # escaped: a message naming a config table ("[specimen] max_disks") is text, not markup
         err_console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
         sys.exit(2)
-    except KeyboardInterrupt:
+    except Interrupted as exc:
+        err_console.print(f"[yellow]{exc}[/]", highlight=False, soft_wrap=True)
+        sys.exit(130)
+    except KeyboardInterrupt:  # outside a command (while parsing the options, say)
         err_console.print("[yellow]interrupted[/]")
         sys.exit(130)
     except SystemExit:

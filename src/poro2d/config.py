@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import tomllib
 import types
 import typing
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from poro2d.errors import InputError, is_integer, is_number
 
@@ -85,3 +88,23 @@ def _field_kinds(hint: Any) -> tuple:
         return tuple(k for a in typing.get_args(hint) for k in _field_kinds(a))
     origin = typing.get_origin(hint)
     return (origin,) if origin is not None else (hint,)
+
+
+def check_finite(section: str, value: Any) -> None:
+    """Every number in ``value`` (nested tables and lists) must be finite.
+
+    TOML accepts ``inf`` and ``nan``, and a range check with an open end lets an
+    infinity through; neither has a meaning in a config, nor a JSON spelling.
+    """
+    if isinstance(value, dict):
+        for k, v in value.items():
+            check_finite(f"{section}.{k}" if section else str(k), v)
+    elif isinstance(value, (list, tuple)):
+        for i, v in enumerate(value):
+            check_finite(f"{section}[{i}]", v)
+    elif isinstance(value, float):  # integers are always finite
+        if not math.isfinite(value):
+            raise InputError(section, value, "a finite number")
+    elif isinstance(value, (np.generic, np.ndarray)) and np.issubdtype(np.asarray(value).dtype, np.number):
+        if not np.all(np.isfinite(value)):
+            raise InputError(section, np.asarray(value).tolist(), "finite numbers")

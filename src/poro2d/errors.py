@@ -123,3 +123,11 @@ def _short(values: Any, limit: int = 60) -> Any:
         return values
     shape = getattr(values, "shape", None)
     return f"array of shape {shape}" if shape is not None else text[: limit - 3] + "..."
+
+
+class Interrupted(Exception):
+    """A command stopped by Ctrl-C (or SIGINT); the message says what was kept.
+
+    Not a ``KeyboardInterrupt`` on purpose: the command line library turns those
+    into a silent exit before :func:`poro2d.cli.main` could say anything.
+    """

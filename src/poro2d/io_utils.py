@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 import os
 import platform
 import tempfile
@@ -11,6 +12,7 @@ from collections.abc import Iterable, Mapping
 from contextlib import contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import Any
 
 from poro2d import __version__
 
@@ -20,14 +22,20 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None):
     """Yield a temporary path next to ``path``; rename it onto ``path`` on success.
 
     A crash leaves no file that looks complete: the final name only appears once
-    the content is fully written.
+    the content is fully written. Temporaries of ``path`` left by a killed earlier
+    write are removed first, and the file gets the permissions of an ordinary new
+    file (0666 less the umask), not the 0600 of a temporary.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(
-        prefix=f".{path.name}.", suffix=suffix if suffix is not None else path.suffix, dir=path.parent
-    )
-    os.close(fd)
+    suffix = suffix if suffix is not None else path.suffix
+    remove_stale_temporaries(path, suffix)
+    fd, tmp = tempfile.mkstemp(prefix=_temp_prefix(path), suffix=suffix, dir=path.parent)
+    try:
+        # results often go to shared folders: others must be able to read them
+        os.fchmod(fd, 0o666 & ~current_umask())
+    finally:
+        os.close(fd)
     try:
         yield Path(tmp)
         os.replace(tmp, path)
@@ -37,6 +45,51 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None):
         except FileNotFoundError:
             pass
         raise
+
+
+def _temp_prefix(path: Path) -> str:
+    return f".{path.name}."
+
+
+def remove_stale_temporaries(path: str | os.PathLike, suffix: str | None = None) -> list[Path]:
+    """Delete the temporaries of ``path`` that a killed write left behind; returns them.
+
+    They are named ``.<name>.<random><suffix>`` (see :func:`atomic_path`); the random
+    part never holds a dot, so the temporaries of ``a.png.b.png`` are not taken for
+    those of ``a.png``. One writer per target is assumed, as for any atomic rename.
+    """
+    path = Path(path)
+    suffix = suffix if suffix is not None else path.suffix
+    prefix = _temp_prefix(path)
+    removed = []
+    if not path.parent.is_dir():
+        return removed
+    for entry in path.parent.iterdir():
+        name = entry.name
+        if not (name.startswith(prefix) and name.endswith(suffix)):
+            continue
+        middle = name[len(prefix) : len(name) - len(suffix)]
+        if middle and "." not in middle and "/" not in middle and entry.is_file():
+            try:
+                entry.unlink()
+                removed.append(entry)
+            except FileNotFoundError:  # removed meanwhile
+                pass
+    return removed
+
+
+def current_umask() -> int:
+    """The process umask, read without changing it where the system allows."""
+    try:
+        # Linux reports it in /proc: reading it leaves the umask of other threads alone
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def provenance() -> dict:
@@ -63,9 +116,60 @@ def _default(o):
     raise TypeError(f"not JSON serialisable: {type(o)}")
 
 
-def write_json(path: str | os.PathLike, data: Mapping) -> None:
+def to_json_types(obj: Any) -> Any:
+    """``obj`` with NumPy scalars and arrays, tuples and paths as plain JSON types.
+
+    A NumPy boolean becomes ``True``/``False`` (never the string ``"True"``), so a
+    value reads back with the type it was written with.
+    """
+    if isinstance(obj, Mapping):
+        return {_key(k): to_json_types(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_json_types(v) for v in obj]
+    if isinstance(obj, (str, bool, int, float, type(None))):
+        return obj
+    return to_json_types(_default(obj))
+
+
+def _key(k: Any) -> Any:
+    """A mapping key as JSON accepts it (json itself spells numbers and booleans as text)."""
+    if isinstance(k, (str, bool, int, float, type(None))):
+        return k
+    return str(_default(k)) if isinstance(k, Path) else _default(k)
+
+
+def _finite_or_null(obj: Any) -> Any:
+    """NaN and infinities as ``None``: JSON has no token for them (``NaN`` is not JSON)."""
+    if isinstance(obj, dict):
+        return {k: _finite_or_null(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_finite_or_null(v) for v in obj]
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def as_json(data: Any) -> Any:
+    """``data`` as :func:`write_json` stores it and ``json.loads`` reads it back.
+
+    Code that uses a result both fresh and, on a resumed run, from its file gets
+    the same types either way (booleans, not NumPy booleans; ``None``, not NaN).
+    """
+    return _finite_or_null(to_json_types(data))
+
+
+def write_json(path: str | os.PathLike, data: Mapping, *, config: bool = False) -> None:
+    """Write ``data`` as JSON (atomically); the file is always valid, strict JSON.
+
+    Results may hold NaN or infinities where a quantity is undefined: they are
+    written as ``null``. With ``config=True`` the content is a configuration, whose
+    numbers must all be finite: a non-finite one raises ``ValueError`` (validate
+    configs before, see :func:`poro2d.config.check_finite`, for a clear message).
+    """
+    plain = to_json_types(data) if config else as_json(data)
+    text = json.dumps(plain, indent=2, allow_nan=False)
     with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps(data, indent=2, default=_default, allow_nan=True) + "\n")
+        tmp.write_text(text + "\n")
 
 
 def write_csv(path: str | os.PathLike, rows: Iterable[Mapping], header: list[str] | None = None) -> None:

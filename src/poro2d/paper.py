@@ -8,7 +8,6 @@ stage writes into its own sub-folder; a rerun skips the stages already finished.
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 
@@ -92,16 +91,6 @@ def register(app: typer.Typer) -> None:
         if seed < 0:
             raise InputError("--seed", seed, "an integer >= 0")
         check_output_dir("--out", out)
-        out.mkdir(parents=True, exist_ok=True)
-        timings: dict[str, float] = {}
-        t0 = time.perf_counter()
-        console.print("[bold]1/3 conversions[/] (Eqs. 1-12, Figs. 1-2)")
-        conv = run_conversions(out / "conversions")
-        timings["conversions_s"] = time.perf_counter() - t0
-        for m in conv["methods"]:
-            v = "skipped" if m["n2d"] is None else f"{m['n2d']:.4f}"
-            console.print(f"  {m['method']:<24} {m['equation']:<10} {v:>8} {m['flags']}")
-
         cfg = paper_preset()
         cfg["seed"] = seed
         if quick:
@@ -114,11 +103,23 @@ def register(app: typer.Typer) -> None:
             lab_data = read_lab_csv(lab)  # bad lab files fail here, before any simulation
         nthreads = threads if threads is not None else min(os.cpu_count() or 1, 2)
         spec, grading, settings, sd = build(cfg, None, threads=nthreads)
+        crit = PorosityCriterion(spec, grading, settings, seed=sd, out=out / "criterion",
+                                 progress=not quiet, config=cfg)  # fmt: skip
+        crit.validate()  # every option is checked before the first file is written
+
+        out.mkdir(parents=True, exist_ok=True)
+        timings: dict[str, float] = {}
+        t0 = time.perf_counter()
+        console.print("[bold]1/3 conversions[/] (Eqs. 1-12, Figs. 1-2)")
+        conv = run_conversions(out / "conversions")
+        timings["conversions_s"] = time.perf_counter() - t0
+        for m in conv["methods"]:
+            v = "skipped" if m["n2d"] is None else f"{m['n2d']:.4f}"
+            console.print(f"  {m['method']:<24} {m['equation']:<10} {v:>8} {m['flags']}")
+
         console.print(f"[bold]2/3 criterion[/] (Fig. 3) for nLab = {settings.n_lab}"
                       f"{' [quick specimen]' if quick else ''}")  # fmt: skip
         t1 = time.perf_counter()
-        crit = PorosityCriterion(spec, grading, settings, seed=sd, out=out / "criterion",
-                                 progress=not quiet, config=cfg)  # fmt: skip
         result = crit.run()
         timings["criterion_s"] = time.perf_counter() - t1
         print_result(result, out / "criterion")
@@ -158,7 +159,7 @@ def register(app: typer.Typer) -> None:
             "timings": timings,
             "provenance": provenance(),
         }
-        write_json(out / "results.json", json.loads(json.dumps(summary, default=str)))
+        write_json(out / "results.json", summary)  # NumPy flags as true/false, not as text
         from poro2d.report.paper_report import write_paper_report
 
         md, html = write_paper_report(out, summary)

@@ -24,14 +24,19 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from poro2d.config import check_finite
 from poro2d.dem import Simulation, checkpoint
 from poro2d.errors import InputError, check_range
-from poro2d.io_utils import provenance, write_csv, write_json
+from poro2d.io_utils import as_json, provenance, write_csv, write_json
 from poro2d.porosity import parabolic
 from poro2d.specimen.compaction import SpecimenSpec, box_porosity, prepare_specimen
 from poro2d.specimen.grading import GradingCurve
 
 _log = logging.getLogger(__name__)
+
+#: specimen settings that change how fast a run goes, never its numbers: a rerun with
+#: other values resumes (the engine sums in the same order on any number of threads)
+PERFORMANCE_KEYS = ("threads",)
 
 
 @dataclass
@@ -84,6 +89,14 @@ class CriterionSettings:
         if self.trial_porosity is not None:
             return float(self.trial_porosity)
         return round_to(float(parabolic(self.n_lab)), self.resolution)
+
+
+def binding_part(run: dict | None) -> dict | None:
+    """The part of a config record that a resumed run must share: all but performance settings."""
+    if not isinstance(run, dict):
+        return run
+    spec = {k: v for k, v in (run.get("specimen") or {}).items() if k not in PERFORMANCE_KEYS}
+    return dict(run, specimen=spec)
 
 
 def round_to(x: float, step: float) -> float:
@@ -320,6 +333,7 @@ class PorosityCriterion:
     def run(self) -> dict:
         s = self.settings
         t_start = time.perf_counter()
+        self.validate()
         if self.out is not None:
             self._check_resume()
         n = s.initial_trial()
@@ -329,7 +343,8 @@ class PorosityCriterion:
         message = ""
         for k in range(1, s.max_iterations + 1):
             tried.append(n)
-            row = self._trial(k, n)
+            # as a resumed run reads it back from trial.json: plain booleans and numbers
+            row = as_json(self._trial(k, n))
             rows.append(row)
             self._write_tables(rows, final=None, converged=False, message="running")
             if row["accepted"]:
@@ -361,21 +376,46 @@ class PorosityCriterion:
             write_json(self.out / "result.json", result)
         return result
 
+    def validate(self) -> None:
+        """Reject bad input before anything is written: a corrected rerun then starts clean.
+
+        Checks what the dataclasses cannot check alone: the thread count against this
+        machine, the first trial against the box and grading, and that every number of
+        the config is finite.
+        """
+        from poro2d.specimen.compaction import check_feasible
+
+        Simulation._check_threads(self.spec.threads)
+        check_feasible(self.spec, self.grading, self.settings.initial_trial())
+        record = self._config_record()
+        check_finite("config", record["config"])
+        check_finite("run", record["run"])
+
     def _check_resume(self) -> None:
+        """Refuse an ``out`` whose finished work belongs to another config; else record this one.
+
+        The stored config binds only once a trial has started: a run refused or
+        stopped before that leaves nothing to protect, so the next command (a
+        corrected one, say) replaces the record.
+        """
         assert self.out is not None
         self.out.mkdir(parents=True, exist_ok=True)
         cfg_path = self.out / "config.json"
         current = self._config_record()
-        if cfg_path.is_file():
+        if cfg_path.is_file() and self._work_started():
             old = json.loads(cfg_path.read_text())
-            if old.get("run") != current["run"]:
+            if binding_part(old.get("run")) != binding_part(current["run"]):
                 raise InputError(
                     "out", str(self.out),
                     "an empty folder or one holding a run of the same config and seed",
                     "it holds results of a different config; choose another --out",
                 )  # fmt: skip
         else:
-            write_json(cfg_path, current)
+            write_json(cfg_path, current, config=True)
+
+    def _work_started(self) -> bool:
+        trials = self.out / "trials" if self.out is not None else None
+        return trials is not None and trials.is_dir() and any(trials.iterdir())
 
     def _config_record(self) -> dict:
         return {
@@ -440,4 +480,6 @@ class PorosityCriterion:
                 shutil.copyfile(src, self.out / dst)
 
 
-__all__ = ["CriterionSettings", "PorosityCriterion", "in_window", "round_to", "wall_forces"]
+__all__ = [
+    "CriterionSettings", "PorosityCriterion", "binding_part", "in_window", "round_to", "wall_forces",
+]  # fmt: skip

@@ -7,6 +7,7 @@ as they are, not rebuilt.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import zipfile
@@ -77,6 +78,31 @@ def read_meta(path: str | os.PathLike) -> dict:
             return json.loads(bytes(z["meta"]).decode())
     except _UNREADABLE as exc:
         raise _damaged(p, exc) from None
+
+
+def state_digest(path: str | os.PathLike) -> str:
+    """SHA-256 (hex) of the state saved at ``path``: equal for equal states, wherever saved.
+
+    The file's bytes would not do: the archive and the metadata carry the time of
+    writing. Left out as well are the thread count and the step budget of the last
+    run (``sim._iprm``), which change how a continued run is computed, not its numbers.
+    So a specimen rebuilt from the same config and seed has the same digest, and a
+    specimen moved or copied keeps it.
+    """
+    h = hashlib.sha256()
+    with np.load(_existing(path)) as z:
+        meta = json.loads(bytes(z["meta"]).decode())
+        for name in sorted(k for k in z.files if k != "meta"):
+            a = np.ascontiguousarray(z[name])
+            if name == "sim._iprm":
+                a = a.copy()
+                a[[i for i in (K.NSTEPS, K.CHECK_EVERY, K.THREADS) if i < a.size]] = 0
+            h.update(f"{name}:{a.dtype.str}:{a.shape}\n".encode())
+            h.update(a.tobytes())
+    meta.pop("provenance", None)
+    meta.get("settings", {}).pop("threads", None)
+    h.update(json.dumps(meta, sort_keys=True, separators=(",", ":")).encode())
+    return h.hexdigest()
 
 
 def _existing(path) -> Path:

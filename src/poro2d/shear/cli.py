@@ -141,6 +141,11 @@ def register(app: typer.Typer) -> None:
         print_result(result, out)
 
 
+def _sci(v) -> str:
+    """A number in scientific notation; a stored infinity or NaN reads back as None."""
+    return "inf" if v is None else f"{v:.2e}"
+
+
 def print_result(result: dict, out: Path) -> None:
     t = Table(title="direct shear")
     for col in (
@@ -159,7 +164,7 @@ def print_result(result: dict, out: Path) -> None:
             f"{r['normal_stress_kpa']:g}", f"{r['peak_shear_stress_kpa']:.2f}",
             f"{1e3 * r['shear_displacement_at_peak_m']:.2f}", f"{r['peak_stress_ratio']:.3f}",
             f"{r['end']['shear_stress_kpa']:.2f}", f"{r['end']['plate_displacement_mm']:.3f}",
-            f"{r['max_inertial_number']:.2e}", f"{r['wall_time_s']:.0f}",
+            _sci(r["max_inertial_number"]), f"{r['wall_time_s']:.0f}",
         )  # fmt: skip
     console.print(t)
     if result.get("friction_angle_deg") is not None:

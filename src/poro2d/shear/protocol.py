@@ -20,6 +20,7 @@ strength is the maximum of the curve smoothed by a centred moving average over
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import time
@@ -30,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from poro2d.config import check_finite
 from poro2d.dem import Simulation, checkpoint
 from poro2d.dem.measure import coordination_number
 from poro2d.errors import InputError, check_range
@@ -222,6 +224,7 @@ class DirectShearTest:
         self.specimen = resolve_specimen(specimen)
         self.sigma_kpa = check_range("normal stress (kPa)", normal_stress_kpa, 0.0, None, lo_open=True)
         self.settings = settings if settings is not None else ShearSettings()
+        check_finite("shear", self.settings.to_dict())  # open ranges let an infinity through
         W, _ = specimen_box(self.specimen)
         if self.settings.max_displacement > W / 2:
             raise InputError(
@@ -232,6 +235,7 @@ class DirectShearTest:
         self.figures = figures
         self.threads = threads
         self.box: SplitBox | None = None
+        self._digest: str | None = None
 
     # ------------------------------------------------------------ bookkeeping
     def _report(self, phase: str, fraction: float) -> None:
@@ -241,27 +245,79 @@ class DirectShearTest:
     def _path(self, name: str) -> Path | None:
         return None if self.out is None else self.out / name
 
+    @property
+    def specimen_digest(self) -> str:
+        """Digest of the specimen's state (:func:`poro2d.dem.checkpoint.state_digest`)."""
+        if self._digest is None:
+            self._digest = checkpoint.state_digest(self.specimen)
+        return self._digest
+
     def _record(self) -> dict:
+        """What a stored test must share with this one to be reused: content, never paths."""
         return {
-            "specimen": str(self.specimen.resolve()),
+            "specimen_digest": self.specimen_digest,
             "normal_stress_kpa": self.sigma_kpa,
             "settings": self.settings.to_dict(),
         }
 
+    def _work_started(self) -> bool:
+        """True once the folder holds more than the test's record (a stage has begun)."""
+        assert self.out is not None
+        return self.out.is_dir() and any(p.name != "test.json" for p in self.out.iterdir())
+
+    def _stale_reason(self) -> str | None:
+        """Why the work in ``out`` belongs to another test, or None if it is this test's (or none)."""
+        assert self.out is not None
+        p = self.out / "test.json"
+        if not self._work_started():
+            return None
+        if not p.is_file():
+            return "no record of its specimen and settings"
+        old = json.loads(p.read_text()).get("run") or {}
+        rec = self._record()
+        if "specimen_digest" not in old:
+            return "no content key of its specimen (written by an older poro2d)"
+        if old["specimen_digest"] != rec["specimen_digest"]:
+            return "another specimen (the content of the specimen file differs)"
+        if old.get("normal_stress_kpa") != rec["normal_stress_kpa"]:
+            return f"another normal stress ({old.get('normal_stress_kpa')} kPa)"
+        settings = old.get("settings") or {}
+        now = rec["settings"]
+        changed = sorted(k for k in set(settings) | set(now) if settings.get(k) != now.get(k))
+        if changed:
+            return "other settings (" + ", ".join(changed) + ")"
+        return None
+
+    def check_reusable(self) -> None:
+        """Refuse an ``out`` that holds work of another specimen, normal stress or settings.
+
+        Stale tests are not recomputed: their folder may hold hours of work the user
+        still wants (a mistyped --specimen, say), so the choice of a new folder is left
+        to the user.
+        """
+        assert self.out is not None
+        reason = self._stale_reason()
+        if reason is not None:
+            raise InputError(
+                "out", str(self.out), "an empty folder or one holding the same test",
+                f"it holds a test of {reason}; use a new --out",
+            )  # fmt: skip
+
+    def bind(self) -> None:
+        """Record this test in ``out/test.json`` (unless that folder already holds its work)."""
+        assert self.out is not None
+        if self._work_started() and (self.out / "test.json").is_file():
+            return
+        self.out.mkdir(parents=True, exist_ok=True)
+        run = self._record()
+        key = hashlib.sha256(json.dumps(run, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
+        record = {"key": key, "run": run, "specimen": str(self.specimen), "provenance": provenance()}
+        write_json(self.out / "test.json", record, config=True)
+
     def _check_resume(self) -> None:
         assert self.out is not None
-        self.out.mkdir(parents=True, exist_ok=True)
-        p = self.out / "test.json"
-        rec = self._record()
-        if p.is_file():
-            old = json.loads(p.read_text())
-            if old.get("run") != rec:
-                raise InputError(
-                    "out", str(self.out), "an empty folder or one holding the same test",
-                    "it holds a test with another specimen, normal stress or settings",
-                )  # fmt: skip
-        else:
-            write_json(p, {"run": rec, "provenance": provenance()})
+        self.check_reusable()
+        self.bind()
 
     # ----------------------------------------------------------------- stages
     def consolidate(self) -> tuple[Simulation, dict]:
@@ -525,10 +581,11 @@ class DirectShearTest:
     def run(self) -> dict:
         """Consolidate (or reuse the consolidated state), shear, write and return the result."""
         if self.out is not None:
+            self.check_reusable()  # before a stored result is trusted
             done = self.out / "result.json"
             if done.is_file():
                 return json.loads(done.read_text())
-            self._check_resume()
+            self.bind()
         sim, info = self.consolidate()
         return self.shear(sim, info)
 
@@ -612,12 +669,17 @@ class ShearSeries:
         # the tests are about equally long: one process per test (up to twice the cores)
         # leaves no core idle at the end (3 tests on 2 cores take 1.5 test times, not 2)
         self.processes = processes if processes is not None else min(len(self.jobs), 2 * ncpu)
-        # validate every test (box size, resume consistency) before anything runs
-        for job in self.jobs:
-            t = DirectShearTest(
-                job["specimen"], job["sigma"], ShearSettings(**job["settings"]), out=job["out"]
-            )
-            t._check_resume()
+        # validate every test (box size, then what each folder holds) before anything is written
+        tests = [
+            DirectShearTest(job["specimen"], job["sigma"], ShearSettings(**job["settings"]), out=job["out"])
+            for job in self.jobs
+        ]
+        self.specimen_digest = tests[0].specimen_digest if tests else ""
+        for t in tests:
+            t._digest = self.specimen_digest  # one specimen: hashed once
+            t.check_reusable()
+        for t in tests:
+            t.bind()
 
     def _jobs(self) -> list[dict]:
         base = self.settings.to_dict()
@@ -715,7 +777,8 @@ class ShearSeries:
                 )
             } | {"consolidation_normal_stress_error": t["consolidation"]["normal_stress_error"],
                  "folder": folder_name(t["normal_stress_kpa"])})  # fmt: skip
-        max_i = float(max(t["max_inertial_number"] for t in tests))
+        # a stored infinity reads back as null (JSON has no infinity): the check failed
+        max_i = max(math.inf if t["max_inertial_number"] is None else t["max_inertial_number"] for t in tests)
         result: dict = {
             "normal_stresses_kpa": self.stresses,
             "tests": summary,
@@ -741,6 +804,7 @@ class ShearSeries:
             "velocity_m_per_s": s.velocity,
             "density_scale": s.density_scale,
             "specimen": str(self.specimen),
+            "specimen_digest": self.specimen_digest,
             "specimen_meta": checkpoint.read_meta(self.specimen).get("extra", {}),
             "processes": self.processes,
             "config": self.config,

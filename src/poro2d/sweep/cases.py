@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from poro2d.config import check_keys
+from poro2d.config import check_finite, check_keys
 from poro2d.errors import InputError
 
 #: kind -> run(config, out_dir) -> dict of scalar results
@@ -164,9 +164,21 @@ def canonical_json(obj: Any) -> str:
     return json.dumps(obj, sort_keys=True, separators=(",", ":"), default=str)
 
 
+#: settings that change how fast a case runs, never its results: left out of its id
+PERFORMANCE_KEYS = {"specimen": ("threads",)}
+
+
 def case_id(kind: str, config: dict) -> str:
-    """A stable id: the first 12 hex digits of the SHA-256 of the kind and merged config."""
-    h = hashlib.sha256(canonical_json({"kind": kind, "config": config}).encode())
+    """A stable id: the first 12 hex digits of the SHA-256 of the kind and merged config.
+
+    Performance settings (:data:`PERFORMANCE_KEYS`) are left out, so a rerun with
+    another thread count finds the finished cases.
+    """
+    binding = dict(config)
+    for table, keys in PERFORMANCE_KEYS.items():
+        if isinstance(binding.get(table), dict):
+            binding[table] = {k: v for k, v in binding[table].items() if k not in keys}
+    h = hashlib.sha256(canonical_json({"kind": kind, "config": binding}).encode())
     return h.hexdigest()[:12]
 
 
@@ -249,6 +261,7 @@ def parse_sweep(cfg: dict, base_dir: Path | None = None, *, validate: bool = Tru
     if not BARE_NAME_TABLES:
         _register_builtin()
     check_keys("config", cfg, TOP_KEYS)
+    check_finite("config", cfg)  # nothing non-finite reaches a case id or a stored config
     sw = cfg.get("sweep")
     if not isinstance(sw, dict):
         raise InputError("sweep", sw, "a [sweep] table with kind and grid axes or cases")

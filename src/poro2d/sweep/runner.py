@@ -89,7 +89,7 @@ def run_case_task(case: dict, case_dir: str, func) -> dict:
     if done is not None:  # a retry after the marker was written
         return done
     d.mkdir(parents=True, exist_ok=True)
-    write_json(d / PARAMS, case)
+    write_json(d / PARAMS, case, config=True)
     try:
         import numba
 
@@ -168,7 +168,7 @@ def _failed_row(case: Case, d: Path, err: BaseException, tb: str) -> dict:
     }
     d.mkdir(parents=True, exist_ok=True)
     if not (d / PARAMS).is_file():
-        write_json(d / PARAMS, case.to_dict())
+        write_json(d / PARAMS, case.to_dict(), config=True)
     with atomic_path(d / ERROR_TXT) as tmp:
         tmp.write_text(tb or row["error"])
     write_json(d / ERROR_JSON, row)
