@@ -164,6 +164,17 @@ trial_porosity = 0.30
 max_iterations = 1
 """
 
+QUICK_TOML = """seed = 5
+[specimen]
+width = 0.06
+height = 0.03
+layers = 2
+[criterion]
+trial_porosity = 0.21
+force_fraction = 0.05
+max_iterations = 1
+"""
+
 
 def test_corrected_rerun_after_a_refused_one(tmp_path, capsys):
     cfg = tmp_path / "c.toml"
@@ -201,3 +212,32 @@ def test_non_finite_config_values_are_refused_before_any_output(tmp_path, capsys
     assert not (tmp_path / "o").exists()
     with pytest.raises(InputError, match="growth_steps"):  # refused as soon as the spec is made
         SpecimenSpec(**dict(SMALL.to_dict(), growth_steps=float("inf")))
+
+
+def _untimed(result: dict) -> list[dict]:
+    return [{k: v for k, v in it.items() if not k.startswith("time_")} for it in result["iterations"]]
+
+
+def test_cli_numbers_do_not_depend_on_progress_display(tmp_path, capsys, monkeypatch):
+    # progress updates cut the runs into other kernel calls; were the stop tests counted
+    # per call, the quiet run of this specimen would move its plate in 3 rounds, not 1 (measured)
+    for var in ("COLUMNS", "FORCE_COLOR", "TTY_COMPATIBLE", "TTY_INTERACTIVE"):
+        monkeypatch.delenv(var, raising=False)  # a log, not a terminal
+    cfg = tmp_path / "small.toml"
+    cfg.write_text(QUICK_TOML)
+    runs = {}
+    for flags in (["--quiet"], []):
+        out = tmp_path / ("quiet" if flags else "bars")
+        main(["criterion", "--config", str(cfg), "--out", str(out), *flags])
+        runs[bool(flags)] = json.loads((out / "result.json").read_text()), capsys.readouterr()
+    (quiet, q_out), (shown, s_out) = runs[True], runs[False]
+    assert _untimed(quiet) == _untimed(shown)
+    assert quiet["final_porosity"] == shown["final_porosity"] == 0.21
+    assert q_out.err == ""
+    # in a log: progress as plain lines, one per stage here (each is shorter than the interval)
+    stages = [line.split(":")[0] for line in s_out.err.splitlines()]
+    assert stages == ["layer 1", "layer 2", "working friction", "top plate (round 1)"]
+    assert "\u2026" not in s_out.err + s_out.out and "\x1b" not in s_out.err
+    (it,) = shown["iterations"]
+    row = next(line for line in s_out.out.splitlines() if f"{it['new_porosity']:.4f}" in line)
+    assert f"{it['porosity_change']:.4f}" in row and f"{it['f_top_n_per_m']:.4g}" in row

@@ -12,11 +12,11 @@ import time
 from pathlib import Path
 
 import typer
-from rich.console import Console
 
+from poro2d.console import OutputConsole
 from poro2d.io_utils import provenance, write_csv, write_json
 
-console = Console()
+console = OutputConsole()
 
 PAPER = {
     "n_lab": 0.3434,

@@ -128,12 +128,9 @@ def conversion_to_json(conv: P.Conversion, extra_inputs: dict | None = None) -> 
 
 
 def _print_table(conv: P.Conversion, extra_inputs: dict) -> None:
-    from rich.console import Console
-    from rich.table import Table
+    from poro2d.console import OutputConsole, Table
 
-    console = Console(highlight=False)
-    if not console.is_terminal:  # files and pipes: do not squeeze the table into 80 columns
-        console = Console(highlight=False, width=120)
+    console = OutputConsole(highlight=False)  # files and pipes: the whole table, not 80 columns of it
     title = f"n_lab = {conv.n_lab:.4f}"
     if extra_inputs:
         title += (

@@ -5,10 +5,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import typer
-from rich.console import Console
-from rich.table import Table
 
-console = Console()
+from poro2d.console import OutputConsole, Table
+
+console = OutputConsole()
 
 
 def register(app: typer.Typer) -> None:

@@ -9,6 +9,12 @@ One step, in order (the PFC cycle):
 5. wall resultants, servo walls set their speed from the force error; walls move;
 6. flag a rebuild when needed; every ``check_every`` steps test the stop condition.
 
+The stop test falls on the steps that are multiples of ``check_every`` counted from
+the start of the driver's run (``iprm[CHECK_OFFSET]`` steps of it came before this
+call), not from the start of the call: the driver cuts a run into calls wherever a
+progress update, a callback or a storage overflow needs Python, and those cuts must
+not move the test (a run would stop on another step and give other numbers).
+
 How the work is laid out (see :mod:`poro2d.dem.partition`): the disks form ``P``
 contiguous partitions. Within a partition 2-4 are one pass over the disks in index
 order: each pair adds its force to both disks as it is computed (partners ``j > i``
@@ -52,9 +58,10 @@ from poro2d.dem.sync import STATUS_WORD, atomic_load, atomic_store, barrier, sta
 DT, GX, GY, DAMP, SKIN, BETA, KN_PP, KS_PP, MU_PP, KN_PW, KS_PW, MU_PW, RATIO_TARGET, TIME = range(14)
 N_PRM = 14
 # integer parameters (iprm): MODE / MODE_PW say whether disk-disk / disk-wall contacts combine
-# the bodies' properties (PER_BODY) or use the constants in prm
-MODE, NSTEPS, CHECK_EVERY, NEED_BUILD, THREADS, MODE_PW = range(6)
-N_IPRM = 6
+# the bodies' properties (PER_BODY) or use the constants in prm; CHECK_OFFSET is the number
+# of steps of the driver's run done before this call (the stop test counts from the run's start)
+MODE, NSTEPS, CHECK_EVERY, NEED_BUILD, THREADS, MODE_PW, CHECK_OFFSET = range(7)
+N_IPRM = 7
 # outputs (out)
 STATUS, STEPS_DONE, MAX_RATIO, MEAN_RATIO, NEED_PP, NEED_PW, REBUILDS, THREADS_USED = range(8)
 N_OUT = 8
@@ -460,6 +467,8 @@ def _worker(t, nthr, P, W, NB, WB, S, prm, iprm, out, props, dash):
     pw_body = iprm[MODE_PW] == PER_BODY
     nsteps = iprm[NSTEPS]
     check_every = iprm[CHECK_EVERY]
+    # steps of the run since its last stop test: the test schedule ignores where calls begin
+    since_check = iprm[CHECK_OFFSET] % check_every if check_every > 0 else 0
     need_build = iprm[NEED_BUILD] != 0
     npart = part.shape[0] - 1
     k0 = t * npart // nthr
@@ -493,6 +502,7 @@ def _worker(t, nthr, P, W, NB, WB, S, prm, iprm, out, props, dash):
             prm[TIME] += dt
         barrier(sync, nthr)
         steps += 1
+        since_check += 1
         # every worker takes the same decisions from the same shared numbers
         dmax = 0.0
         for u in range(nthr):
@@ -506,7 +516,8 @@ def _worker(t, nthr, P, W, NB, WB, S, prm, iprm, out, props, dash):
                 dmax = d2
         if dmax > lim2:
             need_build = True
-        if check_every > 0 and steps % check_every == 0:
+        if check_every > 0 and since_check == check_every:
+            since_check = 0
             if not math.isfinite(dmax):
                 status = UNSTABLE
                 break

@@ -172,6 +172,7 @@ class Simulation:
         self.threads_used = 1
         self.step_count = 0
         self.time = 0.0
+        self._checked_ratio: float | None = None  # max ratio at the last stop test of a run
         self._n_alloc = -1
         check_layout(self.particles.pos, self.particles.radius, self.walls)
         self._refresh()
@@ -464,7 +465,7 @@ class Simulation:
              self._tmax, self._sync, *self._grid)  # fmt: skip
         return P, W, NB, WB, S, self._prm, self._iprm, self._out
 
-    def _load_params(self, nsteps: int, check_every: int, ratio_target: float) -> None:
+    def _load_params(self, nsteps: int, check_every: int, ratio_target: float, offset: int) -> None:
         prm = self._prm
         prm[K.DT] = self.dt
         prm[K.GX], prm[K.GY] = self.gravity
@@ -481,6 +482,7 @@ class Simulation:
         prm[K.TIME] = self.time
         self._iprm[K.NSTEPS] = nsteps
         self._iprm[K.CHECK_EVERY] = check_every
+        self._iprm[K.CHECK_OFFSET] = offset
         self._iprm[K.THREADS] = self.effective_threads
 
     def _uniform_constants(self) -> None:
@@ -504,8 +506,15 @@ class Simulation:
             prm[K.MU_PW] = min(mu, float(w.mu[0]))
             self._iprm[K.MODE_PW] = PER_PAIR_TYPE
 
-    def _kernel_block(self, nsteps: int, check_every: int, ratio_target: float) -> tuple[int, int]:
-        """Run up to ``nsteps`` in compiled code; returns (steps done, status)."""
+    def _kernel_block(
+        self, nsteps: int, check_every: int, ratio_target: float, offset: int
+    ) -> tuple[int, int]:
+        """Run up to ``nsteps`` in compiled code; returns (steps done, status).
+
+        ``offset`` is the number of steps of the current :meth:`run` before this block:
+        the kernel tests the stop condition on the run's own multiples of ``check_every``,
+        so neither the block length nor a restart after growing the storage moves a test.
+        """
         import numba
 
         numba.set_num_threads(max(1, self.effective_threads))
@@ -515,11 +524,13 @@ class Simulation:
         status = K.RUNNING
         rebuilds = 0
         while done < nsteps:
-            self._load_params(nsteps - done, check_every, ratio_target)
+            self._load_params(nsteps - done, check_every, ratio_target, offset + done)
             self._out[:] = 0.0
             K.run_steps(*self._args())
             self.threads_used = int(self._out[K.THREADS_USED])
             steps = int(self._out[K.STEPS_DONE])
+            if ratio_target and (offset + done + steps) // check_every > (offset + done) // check_every:
+                self._checked_ratio = float(self._out[K.MAX_RATIO])  # the last stop test's value
             done += steps
             rebuilds += int(self._out[K.REBUILDS])
             self.step_count += steps
@@ -558,13 +569,19 @@ class Simulation:
 
         until_ratio
             stop as soon as the maximum unbalanced-force ratio drops below this value
-            (tested every ``check_every`` steps inside the kernel).
+            (tested inside the kernel on steps ``check_every``, ``2 check_every``, ...
+            of this call).
         callback, every
             call ``callback(sim)`` every ``every`` steps (a Python event); if it
             returns True the run stops.
         progress
-            show a rich progress bar (steps/s, particle-steps/s, ETA); a string is
+            show a rich progress bar (steps/s, particle-steps/s, ETA) on a terminal,
+            plain lines now and then elsewhere (:mod:`poro2d.progress`); a string is
             used as its label.
+
+        Neither ``progress`` nor ``every`` changes a number: callbacks that only read
+        the state leave the run bit for bit as it is without them, and the stop tests
+        fall on the same steps.
         """
         if not (isinstance(steps, (int, np.integer)) and steps >= 0):
             raise InputError("steps", steps, "an integer >= 0")
@@ -580,7 +597,9 @@ class Simulation:
         done = 0
         converged = False
         rebuilds = 0
-        # Block length: the next Python event, or about a quarter second for progress.
+        self._checked_ratio = None
+        # Block length: the next Python event, or about a quarter second for progress. It
+        # changes no number: the kernel counts its stop tests from the start of this run.
         block = every if every is not None else steps
         bar = None
         if progress:
@@ -593,11 +612,11 @@ class Simulation:
         try:
             while done < steps:
                 nb = min(block, steps - done)
-                k, status = self._kernel_block(nb, check_every, target)
+                k, status = self._kernel_block(nb, check_every, target, done)
                 done += k
                 rebuilds += self._rebuilds
                 if bar is not None:
-                    bar.update(done, self._out[K.MAX_RATIO] if target else None)
+                    bar.update(done, self._checked_ratio)
                 if status == K.CONVERGED:
                     converged = True
                     break

@@ -933,10 +933,14 @@ def _read_csv(path: Path) -> list[dict]:
 
 
 class _Bars:
-    """One rich progress bar per test, with elapsed time and ETA."""
+    """One rich progress bar per test, with elapsed time and ETA, on a terminal.
+
+    In a log (stderr not a terminal) one plain line for all tests instead, at most every
+    ``LINE_INTERVAL_S`` seconds and once at the end, e.g.
+    ``direct shear: 50 kPa done; 100 kPa shearing 42 %; 200 kPa consolidating; elapsed 0:03:10``.
+    """
 
     def __init__(self, labels: dict) -> None:
-        from rich.console import Console
         from rich.progress import (
             BarColumn,
             Progress,
@@ -946,27 +950,57 @@ class _Bars:
             TimeRemainingColumn,
         )
 
+        from poro2d.progress import ProgressLines, live_console
+
+        self._state = {k: [v, "waiting", 0.0] for k, v in labels.items()}  # label, phase, fraction
+        self._t0 = time.perf_counter()
+        console = live_console()
+        self._lines = ProgressLines() if console is None else None
+        if self._lines is not None:
+            return
         self._p = Progress(
             TextColumn("[bold]{task.description}"), BarColumn(), TaskProgressColumn(),
             TextColumn("{task.fields[phase]}"), TimeElapsedColumn(), TextColumn("eta"), TimeRemainingColumn(),
-            console=Console(stderr=True),
+            console=console,
         )  # fmt: skip
         self._tasks = {k: self._p.add_task(v, total=1.0, phase="waiting") for k, v in labels.items()}
         self._p.start()
 
     def update(self, key, phase: str, fraction: float) -> None:
-        task = self._tasks.get(key)
-        if task is None:
+        state = self._state.get(key)
+        if state is None:
             return
-        if phase == "shearing":
-            self._p.update(task, completed=fraction, phase=phase)
+        state[1] = phase
+        if phase in ("shearing", "done"):
+            state[2] = 1.0 if phase == "done" else fraction
+        if self._lines is not None:
+            self._lines.write(self.line(), state=self._news())
+        elif phase == "shearing":
+            self._p.update(self._tasks[key], completed=fraction, phase=phase)
         elif phase == "done":
-            self._p.update(task, completed=1.0, phase="done")
+            self._p.update(self._tasks[key], completed=1.0, phase="done")
         else:
-            self._p.update(task, phase=phase)
+            self._p.update(self._tasks[key], phase=phase)
+
+    def line(self) -> str:
+        """Every test's phase (and how far it has sheared) on one line."""
+        from poro2d.progress import clock_text
+
+        tests = "; ".join(
+            f"{label} {phase}" + (f" {100.0 * frac:.0f} %" if phase == "shearing" else "")
+            for label, phase, frac in self._state.values()
+        )
+        return f"direct shear: {tests}; elapsed {clock_text(time.perf_counter() - self._t0)}"
+
+    def _news(self) -> tuple:
+        """What a line reports, as printed (not the clock)."""
+        return tuple((phase, round(100.0 * frac)) for _label, phase, frac in self._state.values())
 
     def stop(self) -> None:
-        self._p.stop()
+        if self._lines is not None:
+            self._lines.write(self.line(), force=True, state=self._news())
+        else:
+            self._p.stop()
 
 
 class _DirectQueue:

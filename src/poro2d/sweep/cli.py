@@ -6,11 +6,11 @@ import math
 from pathlib import Path
 
 import typer
-from rich.console import Console
 from rich.markup import escape
-from rich.table import Table
 
-console = Console()
+from poro2d.console import OutputConsole, Table
+
+console = OutputConsole()
 
 _SCHED = "Address of a running Dask scheduler (e.g. tcp://host:8786); default: a LocalCluster."
 _WORKERS = "Worker processes of the LocalCluster (default: one per core, one thread each)."

@@ -303,9 +303,10 @@ def run_sweep(
                 "dashboard": _dashboard(client),
             }
             if progress and cluster_info["dashboard"]:
-                from rich.console import Console
+                from poro2d.console import OutputConsole
 
-                Console(stderr=True).print(f"Dask dashboard: {cluster_info['dashboard']}", highlight=False)
+                err = OutputConsole(stderr=True)
+                err.print(f"Dask dashboard: {cluster_info['dashboard']}", highlight=False)
             rows.update(
                 _submit_all(client, pending, cases_dir, sweep.retries, progress, n_reused, len(sweep.cases))
             )
@@ -344,15 +345,8 @@ def _submit_all(
     client, pending: list[Case], cases_dir: Path, retries: int, progress: bool, n_reused: int, n_total: int
 ) -> dict[str, dict]:
     from distributed import as_completed
-    from rich.console import Console
-    from rich.progress import (
-        BarColumn,
-        MofNCompleteColumn,
-        Progress,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
+
+    from poro2d.progress import CountProgress
 
     futures = {}
     for c in pending:
@@ -367,23 +361,8 @@ def _submit_all(
         )
         futures[fut] = c
     rows: dict[str, dict] = {}
-    bar = Progress(
-        TextColumn("[bold]{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TextColumn("{task.fields[failed]}"),
-        TimeElapsedColumn(),
-        TextColumn("eta"),
-        TimeRemainingColumn(),
-        console=Console(stderr=True),
-        disable=not progress,
-    )
-    with bar:
-        task = bar.add_task(
-            f"sweep ({n_reused} of {n_total} already done)" if n_reused else "sweep",
-            total=len(pending),
-            failed="",
-        )
+    label = f"sweep ({n_reused} of {n_total} already done)" if n_reused else "sweep"
+    with CountProgress(label, len(pending), "cases", enabled=progress) as bar:
         n_failed = 0
         for fut in as_completed(list(futures)):
             c = futures[fut]
@@ -396,7 +375,7 @@ def _submit_all(
             rows[c.id] = row
             if row["status"] == "failed":
                 n_failed += 1
-            bar.update(task, advance=1, failed=f"[red]{n_failed} failed[/]" if n_failed else "")
+            bar.advance(f"{n_failed} failed" if n_failed else "")
             fut.release()
     return rows
 
