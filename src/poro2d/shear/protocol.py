@@ -619,6 +619,72 @@ def folder_name(sigma_kpa: float) -> str:
     return f"sn{sigma_kpa:g}kPa"
 
 
+def job_label(job: dict) -> str:
+    """How a test is named in progress lines and errors: its normal stress, (v/2) for a rate check."""
+    prefix = f"{job['series']}: " if job.get("series") else ""
+    return prefix + f"{job['sigma']:g} kPa" + (" (v/2)" if "rate" in job["key"] else "")
+
+
+def execute_jobs(jobs: list[dict], processes: int, progress: bool) -> dict:
+    """Run the tests of ``jobs`` (finished ones are read back) in up to ``processes`` processes.
+
+    Returns ``{job["key"]: result}``; the slow (half velocity) tests start first so the pool
+    ends together. An input error of a test is raised as it is; other failures together.
+    """
+    results: dict = {}
+    errors: dict = {}
+    todo = []
+    for job in jobs:  # finished tests are read here, without starting a process
+        done = Path(job["out"]) / "result.json"
+        if done.is_file():
+            results[job["key"]] = json.loads(done.read_text())
+        else:
+            todo.append(job)
+    if not todo:
+        return results
+    n = min(processes, len(todo))
+    labels = {j["key"]: job_label(j) for j in todo}
+    bar = _Bars(labels) if progress else None
+    try:
+        if n <= 1:
+            for job in todo:
+                q = _DirectQueue(bar)
+                try:
+                    results[job["key"]] = _run_job(job, q)
+                except Exception as exc:  # noqa: BLE001 - reported with the test it belongs to
+                    errors[job["key"]] = exc
+        else:
+            import multiprocessing as mp
+            from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+            ctx = mp.get_context("spawn")
+            with ctx.Manager() as manager, ProcessPoolExecutor(max_workers=n, mp_context=ctx) as pool:
+                queue = manager.Queue()
+                # the slow (half velocity) tests first, so the pool ends together
+                order = sorted(todo, key=lambda j: ("rate" not in j["key"], -j["sigma"]))
+                futs = {pool.submit(_run_job, job, queue): job["key"] for job in order}
+                pending = set(futs)
+                while pending:
+                    finished, pending = wait(pending, timeout=0.25, return_when=FIRST_COMPLETED)
+                    _drain(queue, bar)
+                    for f in finished:
+                        try:
+                            results[futs[f]] = f.result()
+                        except Exception as exc:  # noqa: BLE001
+                            errors[futs[f]] = exc
+                _drain(queue, bar)
+    finally:
+        if bar is not None:
+            bar.stop()
+    if errors:
+        key, exc = next(iter(errors.items()))
+        if isinstance(exc, InputError):
+            raise exc
+        msgs = "; ".join(f"{labels[k]}: {e}" for k, e in errors.items())
+        raise RuntimeError(f"{len(errors)} direct shear test(s) failed: {msgs}")
+    return results
+
+
 class ShearSeries:
     """Direct shear tests at several normal stresses, in parallel processes, with the fit.
 
@@ -699,66 +765,16 @@ class ShearSeries:
         return jobs
 
     def _execute(self) -> dict:
-        results: dict = {}
-        errors: dict = {}
-        todo = []
-        for job in self.jobs:  # finished tests are read here, without starting a process
-            done = Path(job["out"]) / "result.json"
-            if done.is_file():
-                results[job["key"]] = json.loads(done.read_text())
-            else:
-                todo.append(job)
-        if not todo:
-            return results
-        n = min(self.processes, len(todo))
-        labels = {
-            j["key"]: (f"{j['sigma']:g} kPa" + (" (v/2)" if j["key"][0] == "rate" else "")) for j in todo
-        }
-        bar = _Bars(labels) if self.progress else None
-        try:
-            if n <= 1:
-                for job in todo:
-                    q = _DirectQueue(bar)
-                    try:
-                        results[job["key"]] = _run_job(job, q)
-                    except Exception as exc:  # noqa: BLE001 - reported with the test it belongs to
-                        errors[job["key"]] = exc
-            else:
-                import multiprocessing as mp
-                from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-
-                ctx = mp.get_context("spawn")
-                with ctx.Manager() as manager, ProcessPoolExecutor(max_workers=n, mp_context=ctx) as pool:
-                    queue = manager.Queue()
-                    # the slow (half velocity) tests first, so the pool ends together
-                    order = sorted(todo, key=lambda j: (j["key"][0] != "rate", -j["sigma"]))
-                    futs = {pool.submit(_run_job, job, queue): job["key"] for job in order}
-                    pending = set(futs)
-                    while pending:
-                        finished, pending = wait(pending, timeout=0.25, return_when=FIRST_COMPLETED)
-                        _drain(queue, bar)
-                        for f in finished:
-                            try:
-                                results[futs[f]] = f.result()
-                            except Exception as exc:  # noqa: BLE001
-                                errors[futs[f]] = exc
-                    _drain(queue, bar)
-        finally:
-            if bar is not None:
-                bar.stop()
-        if errors:
-            key, exc = next(iter(errors.items()))
-            if isinstance(exc, InputError):
-                raise exc
-            msgs = "; ".join(f"{labels[k]}: {e}" for k, e in errors.items())
-            raise RuntimeError(f"{len(errors)} direct shear test(s) failed: {msgs}")
-        return results
+        return execute_jobs(self.jobs, self.processes, self.progress)
 
     def run(self) -> dict:
+        t0 = time.perf_counter()
+        return self.finish(self._execute(), t0)
+
+    def finish(self, results: dict, t0: float) -> dict:
+        """Fit, figures and ``result.json`` from the tests' results (keyed as in :meth:`_jobs`)."""
         from poro2d.shear.fit import mohr_coulomb
 
-        t0 = time.perf_counter()
-        results = self._execute()
         tests = [results[("test", s)] for s in self.stresses]
         sig = np.array([t["normal_stress_kpa"] for t in tests])
         tau = np.array([t["peak_shear_stress_kpa"] for t in tests])

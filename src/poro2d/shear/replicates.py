@@ -1,0 +1,151 @@
+"""Direct shear on replicate specimens: strengths over seeds, a fit with confidence intervals.
+
+A granular specimen's peak strength carries round-off chaos: two specimens that differ
+only in their seed (or in round-off) give peaks a few kPa apart, and a friction angle
+from one specimen is one sample. Here the same tests run on several specimens (one per
+seed); per normal stress the peak strength is reported as mean +- sd over the seeds, and
+the Mohr-Coulomb line is fitted to every (sigma, tau) point, with Student-t confidence
+intervals of phi and c (and of phi through the origin). All tests of all specimens run
+in one process pool, so both cores stay busy.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from poro2d.errors import InputError, check_range
+from poro2d.io_utils import provenance, write_csv, write_json
+from poro2d.shear.fit import mohr_coulomb
+
+
+def mohr_coulomb_ci(sigma_kpa, tau_kpa, through_origin: bool = False, level: float = 0.95) -> dict:
+    """The least-squares Mohr-Coulomb line with ``level`` confidence intervals of phi and c.
+
+    Intervals from the slope's and intercept's standard errors and Student's t with
+    n - 2 degrees of freedom (n - 1 through the origin); phi's interval is the arctangent
+    of the slope's. ``None`` intervals when the points leave no degree of freedom.
+    """
+    from scipy import stats
+
+    level = check_range("confidence level", level, 0.0, 1.0, lo_open=True, hi_open=True)
+    s = np.asarray(sigma_kpa, float).ravel()
+    t = np.asarray(tau_kpa, float).ravel()
+    fit = mohr_coulomb(s, t, through_origin=through_origin)
+    out = fit.to_dict()
+    df = s.size - (1 if through_origin else 2)
+    out.update(level=level, dof=df, friction_angle_ci_deg=None, cohesion_ci_kpa=None)
+    if df < 1:
+        return out
+    resid = t - fit.predict(s)
+    s2 = float(np.sum(resid**2)) / df
+    q = float(stats.t.ppf(0.5 + 0.5 * level, df))
+    if through_origin:
+        se_slope = math.sqrt(s2 / float(np.dot(s, s)))
+    else:
+        sxx = float(np.sum((s - s.mean()) ** 2))
+        se_slope = math.sqrt(s2 / sxx)
+        se_c = math.sqrt(s2 * (1.0 / s.size + s.mean() ** 2 / sxx))
+        out["cohesion_ci_kpa"] = [fit.cohesion_kpa - q * se_c, fit.cohesion_kpa + q * se_c]
+    lo, hi = fit.tan_phi - q * se_slope, fit.tan_phi + q * se_slope
+    out["friction_angle_ci_deg"] = [math.degrees(math.atan(lo)), math.degrees(math.atan(hi))]
+    return out
+
+
+def summarize(series: dict[str, dict], level: float = 0.95) -> dict:
+    """Per normal stress mean +- sd of the peaks over specimens, pooled fits with intervals.
+
+    ``series``: label -> the result of one :class:`ShearSeries` (its ``tests`` list).
+    """
+    if not series:
+        raise InputError("replicates", 0, "at least one specimen's tests")
+    by_sigma: dict[float, list[float]] = {}
+    for res in series.values():
+        for t in res["tests"]:
+            by_sigma.setdefault(float(t["normal_stress_kpa"]), []).append(float(t["peak_shear_stress_kpa"]))
+    rows = []
+    for sig in sorted(by_sigma):
+        v = np.array(by_sigma[sig])
+        rows.append({
+            "normal_stress_kpa": sig,
+            "peak_mean_kpa": float(v.mean()),
+            "peak_sd_kpa": float(v.std(ddof=1)) if v.size > 1 else 0.0,
+            "n": int(v.size),
+            "peaks_kpa": v.tolist(),
+        })  # fmt: skip
+    sig = np.concatenate([[r["normal_stress_kpa"]] * r["n"] for r in rows])
+    tau = np.concatenate([r["peaks_kpa"] for r in rows])
+    phis = [r["friction_angle_deg"] for r in series.values() if r.get("friction_angle_deg") is not None]
+    return {
+        "specimens": list(series),
+        "per_normal_stress": rows,
+        "fit": mohr_coulomb_ci(sig, tau, level=level) if np.unique(sig).size >= 2 else None,
+        "fit_through_origin": mohr_coulomb_ci(sig, tau, through_origin=True, level=level),
+        "friction_angle_per_specimen_deg": phis,
+        "friction_angle_mean_deg": float(np.mean(phis)) if phis else None,
+        "friction_angle_sd_deg": float(np.std(phis, ddof=1)) if len(phis) > 1 else None,
+        "method": "peaks of every specimen pooled; Student-t intervals of the least-squares line",
+    }
+
+
+class ReplicateShear:
+    """The same direct shear tests on several specimens, in one process pool, then the summary.
+
+    ``specimens``: label -> specimen (checkpoint or folder holding ``specimen.npz``); each
+    specimen's tests go to ``out/<label>/`` as a :class:`ShearSeries` would write them, and
+    the summary to ``out/replicates.json`` and ``out/replicates.csv``.
+    """
+
+    def __init__(self, specimens: dict[str, str | Path], normal_stresses_kpa, settings=None, *,
+                 out: str | Path = "shear-out", lab=None, processes: int | None = None,
+                 progress: bool = True, config: dict | None = None) -> None:  # fmt: skip
+        import os
+
+        from poro2d.shear.protocol import ShearSeries
+
+        if not specimens:
+            raise InputError("specimens", {}, "at least one specimen")
+        self.out = Path(out)
+        self.progress = progress
+        self.config = config or {}
+        self.series = {
+            label: ShearSeries(
+                path,
+                normal_stresses_kpa,
+                settings,
+                out=self.out / label,
+                lab=lab,
+                progress=False,
+                processes=1,
+                config=self.config,
+            )  # fmt: skip
+            for label, path in specimens.items()
+        }
+        njobs = sum(len(s.jobs) for s in self.series.values())
+        self.processes = processes if processes is not None else min(njobs, 2 * (os.cpu_count() or 1))
+
+    def run(self) -> dict:
+        from poro2d.shear.protocol import execute_jobs
+
+        t0 = time.perf_counter()
+        jobs = [dict(j, key=(label, *j["key"]), series=label)
+                for label, s in self.series.items() for j in s.jobs]  # fmt: skip
+        results = execute_jobs(jobs, self.processes, self.progress)
+        per = {
+            label: s.finish({k[1:]: v for k, v in results.items() if k[0] == label}, t0)
+            for label, s in self.series.items()
+        }
+        summary = summarize(per)
+        summary.update(wall_time_s=time.perf_counter() - t0, processes=self.processes,
+                       config=self.config, provenance=provenance())  # fmt: skip
+        write_csv(self.out / "replicates.csv", [{k: v for k, v in r.items() if k != "peaks_kpa"}
+                                                 for r in summary["per_normal_stress"]])  # fmt: skip
+        write_json(self.out / "replicates.json", summary)
+        summary["series"] = per
+        return summary
+
+
+__all__ = ["ReplicateShear", "mohr_coulomb_ci", "summarize"]
