@@ -67,3 +67,42 @@ def test_summary_over_specimens():
     ] == pytest.approx(1.0)
     with pytest.raises(InputError):
         summarize({})
+
+
+def test_replicate_series_on_small_specimens(tmp_path):
+    """Two specimens (two seeds), two stresses each, one pool: the summary matches each series."""
+    from poro2d.dem import checkpoint
+    from poro2d.shear import ShearSettings
+    from poro2d.shear.replicates import ReplicateShear
+    from poro2d.specimen import paper_grading
+    from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
+
+    specimens = {}
+    for seed in (0, 1):
+        sim, rep = prepare_specimen(
+            SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.2, seed
+        )
+        assert rep["converged"]
+        specimens[f"seed{seed}"] = tmp_path / f"s{seed}.npz"
+        checkpoint.save(sim, specimens[f"seed{seed}"])
+    short = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4}
+    out = tmp_path / "rep"
+    res = ReplicateShear(
+        specimens, [50, 100], ShearSettings(**short), out=out, processes=2, progress=False
+    ).run()
+    peaks = {k: [t["peak_shear_stress_kpa"] for t in s["tests"]] for k, s in res["series"].items()}
+    assert peaks["seed0"] != peaks["seed1"]  # two specimens, two samples of the strength
+    row = res["per_normal_stress"][0]
+    assert row["normal_stress_kpa"] == 50.0
+    assert row["peak_mean_kpa"] == pytest.approx(np.mean([peaks["seed0"][0], peaks["seed1"][0]]))
+    assert res["fit"]["n_points"] == 4
+    files = [
+        "replicates.json",
+        "replicates.csv",
+        "fig8a_shear_curves_replicates.png",
+        "fig8b_peak_strength_replicates.png",
+        "seed0/result.json",
+        "seed1/sn100kPa/result.json",
+    ]
+    for f in files:
+        assert (out / f).stat().st_size > 0, f

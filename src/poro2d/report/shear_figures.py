@@ -8,6 +8,7 @@ and dashed lines.
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
@@ -128,4 +129,85 @@ def plot_peak_strength(
     return _save(fig, path)
 
 
-__all__ = ["plot_peak_strength", "plot_shear_curves"]
+def curve_band(curves: list[dict[str, np.ndarray]], points: int = 200) -> dict[str, np.ndarray]:
+    """Mean and sd over specimens of shear stress curves, on their common displacement range."""
+    end = min(float(c["shear_displacement_mm"][-1]) for c in curves)
+    x = np.linspace(0.0, end, points)
+    ys = np.array([np.interp(x, c["shear_displacement_mm"], c["shear_stress_kpa"]) for c in curves])
+    sd = ys.std(axis=0, ddof=1) if len(curves) > 1 else np.zeros_like(x)
+    return {"shear_displacement_mm": x, "mean_kpa": ys.mean(axis=0), "sd_kpa": sd}
+
+
+def plot_replicate_curves(
+    bands: dict[float, dict[str, np.ndarray]], path: str | os.PathLike, n_specimens: int, lab=None
+) -> Path:
+    """Fig. 8(a) over specimens: the mean curve per normal stress with a +- sd band."""
+    fig, ax = plt.subplots(figsize=(7.5, 4.8))
+    for k, sigma in enumerate(sorted(bands)):
+        b, col = bands[sigma], _COLORS[k % len(_COLORS)]
+        x = b["shear_displacement_mm"]
+        ax.plot(x, b["mean_kpa"], color=col, lw=1.4, label=f"DEM, {sigma:g} kPa (mean)")
+        ax.fill_between(
+            x, b["mean_kpa"] - b["sd_kpa"], b["mean_kpa"] + b["sd_kpa"], color=col, alpha=0.2, lw=0
+        )
+    if lab is not None and lab.curves:
+        for k, sigma in enumerate(sorted(lab.curves)):
+            d, t = lab.curves[sigma]
+            ax.plot(1e3 * d, t, ls="--", marker="o", mfc="none", ms=3, color=_COLORS[k % len(_COLORS)],
+                    lw=1.0, label=f"lab, {sigma:g} kPa")  # fmt: skip
+    ax.set_xlabel("shear displacement (mm)")
+    ax.set_ylabel("shear stress (kPa)")
+    ax.set_xlim(left=0)
+    ax.set_ylim(bottom=0)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, ncol=2)
+    ax.set_title(f"Direct shear over {n_specimens} specimens: mean and +- sd band", fontsize=10)
+    return _save(fig, path)
+
+
+def plot_replicate_peaks(summary: dict, path: str | os.PathLike, lab=None, lab_fit=None) -> Path:
+    """Fig. 8(b) over specimens: peaks mean +- sd, every specimen's peaks, the pooled fit."""
+    rows = summary["per_normal_stress"]
+    s = np.array([r["normal_stress_kpa"] for r in rows])
+    fig, ax = plt.subplots(figsize=(6.5, 5.0))
+    smax = float(max(s.max(), max(lab.peaks) if lab is not None else 0.0)) * 1.1
+    xs = np.linspace(0.0, smax, 50)
+    for r in rows:
+        ax.plot([r["normal_stress_kpa"]] * r["n"], r["peaks_kpa"], ".", color="0.55", ms=5, zorder=3)
+    ax.errorbar(s, [r["peak_mean_kpa"] for r in rows], yerr=[r["peak_sd_kpa"] for r in rows], fmt="o",
+                color="#d95f02", mec="k", ms=7, capsize=4, zorder=5,
+                label=f"DEM peaks, mean +- sd over {len(summary['specimens'])} specimens")  # fmt: skip
+    for fit, ls in ((summary.get("fit"), "-"), (summary.get("fit_through_origin"), ":")):
+        if fit is None:
+            continue
+        tan = math.tan(math.radians(fit["friction_angle_deg"]))
+        ci = fit.get("friction_angle_ci_deg")
+        txt = f" [{ci[0]:.1f}, {ci[1]:.1f}]" if ci else ""
+        c = f", c = {fit['cohesion_kpa']:.1f} kPa" if not fit["through_origin"] else ", c = 0"
+        ax.plot(xs, fit["cohesion_kpa"] + tan * xs, color="#d95f02", lw=1.3 if ls == "-" else 1.0, ls=ls,
+                label=f"phi = {fit['friction_angle_deg']:.1f} deg{txt} ({fit['level']:.0%}){c}")  # fmt: skip
+    if lab is not None:
+        ls_ = sorted(lab.peaks)
+        ax.plot(
+            ls_, [lab.peaks[v] for v in ls_], "s", mfc="none", mec="#1b9e77", ms=7, mew=1.5, label="lab peaks"
+        )
+        if lab_fit is not None:
+            ax.plot(xs, lab_fit.predict(xs), color="#1b9e77", lw=1.2, ls="--",
+                    label=f"lab: phi = {lab_fit.friction_angle_deg:.1f} deg")  # fmt: skip
+    ax.set_xlim(0, smax)
+    ax.set_ylim(bottom=0)
+    ax.set_xlabel("normal stress (kPa)")
+    ax.set_ylabel("peak shear stress (kPa)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="upper left")
+    ax.set_title("Direct shear: peak strength over specimens", fontsize=10)
+    return _save(fig, path)
+
+
+__all__ = [
+    "curve_band",
+    "plot_peak_strength",
+    "plot_replicate_curves",
+    "plot_replicate_peaks",
+    "plot_shear_curves",
+]

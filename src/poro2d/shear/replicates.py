@@ -144,8 +144,32 @@ class ReplicateShear:
         write_csv(self.out / "replicates.csv", [{k: v for k, v in r.items() if k != "peaks_kpa"}
                                                  for r in summary["per_normal_stress"]])  # fmt: skip
         write_json(self.out / "replicates.json", summary)
+        self._figures(summary)
         summary["series"] = per
         return summary
+
+    def _figures(self, summary: dict) -> None:
+        """fig8a/fig8b over specimens: mean curves with +- sd bands, peaks with the pooled fit."""
+        from poro2d.report.shear_figures import curve_band, plot_replicate_curves, plot_replicate_peaks
+        from poro2d.shear.protocol import _read_csv, folder_name
+
+        bands = {}
+        for row in summary["per_normal_stress"]:
+            sigma = row["normal_stress_kpa"]
+            curves = []
+            for s in self.series.values():
+                rows = _read_csv(s.out / folder_name(sigma) / "curve.csv")
+                curves.append({k: np.array([r[k] for r in rows]) for k in rows[0]})
+            bands[sigma] = curve_band(curves)
+        n = len(self.series)
+        lab = next(iter(self.series.values())).lab
+        plot_replicate_curves(bands, self.out / "fig8a_shear_curves_replicates.png", n, lab=lab)
+        lab_fit = None
+        if lab is not None and len(lab.peaks) >= 2:
+            ls = lab.normal_stresses()
+            lab_fit = mohr_coulomb(ls, [lab.peaks[v] for v in ls])
+        peaks_png = self.out / "fig8b_peak_strength_replicates.png"
+        plot_replicate_peaks(summary, peaks_png, lab=lab, lab_fit=lab_fit)
 
 
 __all__ = ["ReplicateShear", "mohr_coulomb_ci", "summarize"]
