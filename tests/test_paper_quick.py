@@ -33,14 +33,24 @@ def test_every_stage_wrote_its_results(quick):
     tests = res["shear"]["tests"]
     assert [t["normal_stress_kpa"] for t in tests] == [50.0, 100.0, 200.0]
     assert all(t["peak_shear_stress_kpa"] > 0 for t in tests)
-    assert set(res["timings"]) == {"conversions_s", "criterion_s", "shear_s"}
+    assert set(res["timings"]) == {"conversions_s", "criterion_s", "replicates_s", "shear_s"}
+    # three specimens (seeds 0, 1, 2), each accepted by the criterion itself, sheared at three stresses
+    reps = res["shear"]["replicates"]
+    assert reps["specimens"] == ["seed0", "seed1", "seed2"]
+    assert [r["n"] for r in reps["per_normal_stress"]] == [3, 3, 3]
+    assert all(r["converged"] for r in res["replicate_specimens"])
+    lo, hi = reps["fit"]["friction_angle_ci_deg"]
+    assert lo < res["shear"]["friction_angle_deg"] < hi
     assert res["provenance"]["poro2d_version"]
     for f in (
         "conversions/fig1_relations.png",
         "criterion/fig5_forces_initial_trial.png",
         "criterion/specimen.npz",
-        "shear/fig8a_shear_curves.png",
-        "shear/fig8b_peak_strength.png",
+        "shear/seed0/fig8a_shear_curves.png",
+        "shear/fig8b_peak_strength_replicates.png",
+        "shear/fig8a_shear_curves_replicates.png",
+        "replicates/seed1/specimen.npz",
+        "replicates/seed2/specimen.npz",
     ):
         assert (quick / f).stat().st_size > 0, f
 
@@ -57,7 +67,7 @@ def test_report_puts_the_paper_beside_poro2d(quick):
 
 def test_rerun_reuses_finished_stages(quick):
     done = sorted((quick / "criterion" / "trials").glob("*/*.npz")) + sorted(
-        (quick / "shear").glob("sn*/result.json")
+        (quick / "shear").glob("seed*/sn*/result.json")
     )
     assert len(done) >= 4
     before = [f.stat().st_mtime_ns for f in done]

@@ -65,6 +65,159 @@ def run_conversions(out: Path) -> dict:
     return data
 
 
+def replicate_specimens(spec, grading, settings, n2d: float, seeds: list[int], out: Path,
+                        progress: bool) -> tuple[dict[str, Path], list[dict]]:  # fmt: skip
+    """Criterion runs for the replicate seeds, each starting from the accepted ``n2d``.
+
+    Every replicate is a specimen that passed the criterion itself (its own seed may settle
+    on a neighbouring trial porosity: that is part of the seed spread). Returns the accepted
+    specimens by label and one summary row per seed (converged or not).
+    """
+    from dataclasses import replace
+
+    from poro2d.criterion.protocol import PorosityCriterion
+
+    specimens: dict[str, Path] = {}
+    rows = []
+    for sd in seeds:
+        d = out / f"seed{sd}"
+        res = PorosityCriterion(spec, grading, replace(settings, trial_porosity=n2d), seed=sd, out=d,
+                                progress=progress).run()  # fmt: skip
+        rows.append({"seed": sd, "final_porosity": res["final_porosity"], "converged": res["converged"],
+                     "trials": len(res["iterations"]), "message": res["message"]})  # fmt: skip
+        if res["converged"]:
+            specimens[f"seed{sd}"] = d / "specimen.npz"
+    return specimens, rows
+
+
+def run_paper(
+    out: str | Path = "paper-out",
+    *,
+    quick: bool = False,
+    lab: str | Path | None = None,
+    seed: int = 0,
+    threads: int | None = None,
+    replicates: int = 3,
+    progress: bool = True,
+) -> dict:
+    """The paper's case study: conversions, the criterion (Fig. 3), direct shear on replicate
+    specimens (Fig. 8), the report. Resumable: finished stages are read back.
+
+    Returns the summary written to ``out/results.json``; ``summary["criterion"]["converged"]``
+    says whether the criterion found its porosity (no shear tests otherwise).
+    """
+    import os
+
+    from poro2d.criterion.cli import print_result
+    from poro2d.criterion.config import build, paper_preset
+    from poro2d.criterion.protocol import PorosityCriterion
+    from poro2d.errors import check_int
+    from poro2d.io_utils import check_output_dir
+
+    out = Path(out)
+    seed = check_int("--seed", seed, 0)
+    replicates = check_int("--replicates", replicates, 1, 20)
+    check_output_dir("--out", out)
+    cfg = paper_preset()
+    cfg["seed"] = seed
+    if quick:
+        cfg["specimen"] = dict(QUICK_SPECIMEN)
+        cfg["criterion"].update(QUICK_CRITERION)
+    lab_data = None
+    if lab is not None:
+        from poro2d.shear.lab import read_lab_csv
+
+        lab_data = read_lab_csv(lab)  # bad lab files fail here, before any simulation
+    nthreads = threads if threads is not None else min(os.cpu_count() or 1, 2)
+    spec, grading, settings, sd = build(cfg, None, threads=nthreads)
+    crit = PorosityCriterion(spec, grading, settings, seed=sd, out=out / "criterion",
+                             progress=progress, config=cfg)  # fmt: skip
+    crit.validate()  # every option is checked before the first file is written
+
+    out.mkdir(parents=True, exist_ok=True)
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    console.print("[bold]1/3 conversions[/] (Eqs. 1-12, Figs. 1-2)")
+    conv = run_conversions(out / "conversions")
+    timings["conversions_s"] = time.perf_counter() - t0
+    for m in conv["methods"]:
+        v = "skipped" if m["n2d"] is None else f"{m['n2d']:.4f}"
+        console.print(f"  {m['method']:<24} {m['equation']:<10} {v:>8} {m['flags']}")
+
+    console.print(f"[bold]2/3 criterion[/] (Fig. 3) for nLab = {settings.n_lab}"
+                  f"{' [quick specimen]' if quick else ''}")  # fmt: skip
+    t1 = time.perf_counter()
+    result = crit.run()
+    timings["criterion_s"] = time.perf_counter() - t1
+    print_result(result, out / "criterion")
+    shear = reps = None
+    if result["converged"]:
+        t2 = time.perf_counter()
+        specimens = {f"seed{sd}": out / "criterion" / "specimen.npz"}
+        if replicates > 1:
+            extra = list(range(sd + 1, sd + replicates))
+            console.print(f"  replicate specimens: seeds {', '.join(map(str, extra))} from n2D = "
+                          f"{result['final_porosity']:.2f}")  # fmt: skip
+            more, reps = replicate_specimens(spec, grading, settings, result["final_porosity"], extra,
+                                             out / "replicates", progress)  # fmt: skip
+            specimens.update(more)
+        timings["replicates_s"] = time.perf_counter() - t2
+        shear = _shear_stage(specimens, out / "shear", quick, lab_data, progress)
+        timings["shear_s"] = time.perf_counter() - t2 - timings["replicates_s"]
+    else:
+        console.print("[yellow]criterion not converged: direct shear skipped[/]")
+    summary = {
+        "quick": quick,
+        "seed": seed,
+        "conversions": conv,
+        "criterion": {k: result[k] for k in ("final_porosity", "converged", "message", "iterations")},
+        "replicate_specimens": reps,
+        "shear": shear,
+        "paper": PAPER,
+        "timings": timings,
+        "provenance": provenance(),
+    }
+    write_json(out / "results.json", summary)
+    from poro2d.report.paper_report import write_paper_report
+
+    md, html = write_paper_report(out, summary)
+    console.print(f"results in {out}/results.json; report: {html} and {md}")
+    return summary
+
+
+def _shear_stage(specimens: dict[str, Path], out: Path, quick: bool, lab_data, progress: bool) -> dict:
+    """Direct shear at the paper's normal stresses on every specimen; the summary over them."""
+    from poro2d.shear.protocol import ShearSettings
+    from poro2d.shear.replicates import ReplicateShear
+
+    console.print(
+        f"[bold]3/3 direct shear[/] (Fig. 8) at {', '.join(f'{v:g}' for v in NORMAL_STRESSES_KPA)} kPa "
+        f"on {len(specimens)} specimen(s)"
+    )
+    sset = ShearSettings(**(QUICK_SHEAR if quick else {}))
+    rep = ReplicateShear(specimens, NORMAL_STRESSES_KPA, sset, out=out, lab=lab_data, progress=progress).run()
+    first = next(iter(rep["series"].values()))
+    fit = rep["fit"] or {}
+    ci = fit.get("friction_angle_ci_deg")
+    console.print(
+        f"  friction angle {fit.get('friction_angle_deg', float('nan')):.1f} deg"
+        + (f" ({fit['level']:.0%} interval {ci[0]:.1f} to {ci[1]:.1f})" if ci else "")
+        + f", cohesion {fit.get('cohesion_kpa', float('nan')):.1f} kPa over {len(specimens)} specimen(s); "
+        + "per specimen "
+        + ", ".join(f"{v:.1f}" for v in rep["friction_angle_per_specimen_deg"])
+        + " deg"
+    )
+    return {
+        # the pooled fit over every specimen's peaks; "tests" and quasi_static of the first specimen
+        "tests": first["tests"],
+        "friction_angle_deg": fit.get("friction_angle_deg"),
+        "cohesion_kpa": fit.get("cohesion_kpa"),
+        "r2": fit.get("r2"),
+        "quasi_static": first.get("quasi_static"),
+        "replicates": {k: v for k, v in rep.items() if k != "series"},
+    }
+
+
 def register(app: typer.Typer) -> None:
     @app.command("paper")
     def paper_cmd(
@@ -73,96 +226,17 @@ def register(app: typer.Typer) -> None:
             False, "--quick", help="Reduced specimen for a first look (about a minute)."
         ),
         lab: Path = typer.Option(None, "--lab", help="Laboratory direct shear CSV to overlay (Fig. 8)."),
-        seed: int = typer.Option(0, "--seed", help="Random seed."),
+        seed: int = typer.Option(0, "--seed", help="Random seed of the first specimen."),
+        replicates: int = typer.Option(
+            3, "--replicates", help="Specimens (seeds) for the direct shear tests; 1 for one specimen."
+        ),
         threads: int = typer.Option(
             None, "--threads", help="Threads for the DEM kernels (default: all cores)."
         ),
         quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
     ) -> None:
         """Run the paper's case study: conversions, criterion (Fig. 3), direct shear (Fig. 8), report."""
-        import os
-
-        from poro2d.criterion.cli import print_result
-        from poro2d.criterion.config import build, paper_preset
-        from poro2d.criterion.protocol import PorosityCriterion
-        from poro2d.errors import InputError
-        from poro2d.io_utils import check_output_dir
-
-        if seed < 0:
-            raise InputError("--seed", seed, "an integer >= 0")
-        check_output_dir("--out", out)
-        cfg = paper_preset()
-        cfg["seed"] = seed
-        if quick:
-            cfg["specimen"] = dict(QUICK_SPECIMEN)
-            cfg["criterion"].update(QUICK_CRITERION)
-        lab_data = None
-        if lab is not None:
-            from poro2d.shear.lab import read_lab_csv
-
-            lab_data = read_lab_csv(lab)  # bad lab files fail here, before any simulation
-        nthreads = threads if threads is not None else min(os.cpu_count() or 1, 2)
-        spec, grading, settings, sd = build(cfg, None, threads=nthreads)
-        crit = PorosityCriterion(spec, grading, settings, seed=sd, out=out / "criterion",
-                                 progress=not quiet, config=cfg)  # fmt: skip
-        crit.validate()  # every option is checked before the first file is written
-
-        out.mkdir(parents=True, exist_ok=True)
-        timings: dict[str, float] = {}
-        t0 = time.perf_counter()
-        console.print("[bold]1/3 conversions[/] (Eqs. 1-12, Figs. 1-2)")
-        conv = run_conversions(out / "conversions")
-        timings["conversions_s"] = time.perf_counter() - t0
-        for m in conv["methods"]:
-            v = "skipped" if m["n2d"] is None else f"{m['n2d']:.4f}"
-            console.print(f"  {m['method']:<24} {m['equation']:<10} {v:>8} {m['flags']}")
-
-        console.print(f"[bold]2/3 criterion[/] (Fig. 3) for nLab = {settings.n_lab}"
-                      f"{' [quick specimen]' if quick else ''}")  # fmt: skip
-        t1 = time.perf_counter()
-        result = crit.run()
-        timings["criterion_s"] = time.perf_counter() - t1
-        print_result(result, out / "criterion")
-        shear = None
-        if result["converged"]:
-            from poro2d.shear.protocol import ShearSeries, ShearSettings
-
-            console.print(
-                "[bold]3/3 direct shear[/] (Fig. 8) at "
-                + ", ".join(f"{v:g}" for v in NORMAL_STRESSES_KPA)
-                + " kPa"
-            )
-            t2 = time.perf_counter()
-            sset = ShearSettings(**(QUICK_SHEAR if quick else {}))
-            shear = ShearSeries(
-                out / "criterion" / "specimen.npz", NORMAL_STRESSES_KPA, sset,
-                out=out / "shear", lab=lab_data, progress=not quiet,
-            ).run()  # fmt: skip
-            timings["shear_s"] = time.perf_counter() - t2
-            console.print(
-                f"  friction angle {shear['friction_angle_deg']:.1f} deg, "
-                f"cohesion {shear['cohesion_kpa']:.1f} kPa"
-            )
-        else:
-            console.print("[yellow]criterion not converged: direct shear skipped[/]")
-        summary = {
-            "quick": quick,
-            "seed": seed,
-            "conversions": conv,
-            "criterion": {k: result[k] for k in ("final_porosity", "converged", "message", "iterations")},
-            "shear": None
-            if shear is None
-            else {
-                k: shear.get(k) for k in ("tests", "friction_angle_deg", "cohesion_kpa", "r2", "quasi_static")
-            },
-            "paper": PAPER,
-            "timings": timings,
-            "provenance": provenance(),
-        }
-        write_json(out / "results.json", summary)  # NumPy flags as true/false, not as text
-        from poro2d.report.paper_report import write_paper_report
-
-        md, html = write_paper_report(out, summary)
-        console.print(f"results in {out}/results.json; report: {html} and {md}")
-        if not result["converged"]:
+        summary = run_paper(out, quick=quick, lab=lab, seed=seed, threads=threads, replicates=replicates,
+                            progress=not quiet)  # fmt: skip
+        if not summary["criterion"]["converged"]:
             raise typer.Exit(1)

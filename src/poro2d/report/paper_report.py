@@ -17,7 +17,7 @@ def build_blocks(out: Path, summary: dict) -> list[Block]:
     pc = paper["criterion"]
     conv = summary["conversions"]
     crit = _load(out / "criterion" / "result.json") or {}
-    shear = _load(out / "shear" / "result.json")
+    shear = summary.get("shear")
     its = crit.get("iterations", [])
     spec = crit.get("specimen", {})
     b: list[Block] = [("h1", "poro2d: the paper's case study")]
@@ -36,10 +36,19 @@ def build_blocks(out: Path, summary: dict) -> list[Block]:
     if its:
         rows.append(["first trial porosity (Eq. 12, rounded)", its[0]["trial_porosity"], pc["trials"][0]])
         rows.append(["number of trials", len(its), len(pc["trials"])])
+    reps = summary.get("replicate_specimens") or []
+    if reps:
+        n2d = [r["final_porosity"] for r in reps if r["converged"]]
+        rows.append([
+            "accepted n2D of the replicate seeds", ", ".join(f"{v:.2f}" for v in n2d) or "none accepted", "-",
+        ])  # fmt: skip
     if shear:
-        rows.append(
-            ["friction angle from peak strengths (deg)", shear.get("friction_angle_deg"), "not stated"]
-        )
+        fit = (shear.get("replicates") or {}).get("fit") or {}
+        ci = fit.get("friction_angle_ci_deg")
+        phi = shear.get("friction_angle_deg")
+        if phi is not None and ci:
+            phi = f"{phi:.1f} ({fit['level']:.0%} interval {ci[0]:.1f} to {ci[1]:.1f})"
+        rows.append(["friction angle from peak strengths (deg)", phi, "not stated"])
     b.append(("table", ["quantity", "poro2d", "paper"], rows))
     b.append(("note", crit.get("message", "criterion not run")))
 
@@ -180,25 +189,53 @@ def _criterion_discussion(its: list[dict], pc: dict) -> list[Block]:
 
 
 def _shear_blocks(out: Path, shear: dict) -> list[Block]:
+    """Fig. 8 over the replicate specimens: peaks mean +- sd, the pooled fit with its intervals."""
     b: list[Block] = [("h2", "Direct shear tests (Fig. 8)")]
-    tests = shear.get("tests", [])
-    if tests:
-        keys = [k for k in ("normal_stress_kpa", "peak_shear_stress_kpa", "shear_displacement_at_peak_m",
-                            "max_inertial_number") if k in tests[0]]  # fmt: skip
-        b.append(("table", keys, [[t.get(k) for k in keys] for t in tests]))
-    b.append(
-        (
+    rep = shear.get("replicates") or {}
+    rows = rep.get("per_normal_stress", [])
+    n = len(rep.get("specimens", []))
+    if rows:
+        b.append((
             "p",
-            "Mohr-Coulomb fit of the peaks: friction angle "
-            f"{shear.get('friction_angle_deg', float('nan')):.3g} deg, "
-            f"cohesion intercept {shear.get('cohesion_kpa', float('nan')):.3g} kPa.",
+            f"The same tests on {n} specimen(s), one per seed, each accepted by the criterion itself: a "
+            "peak from one specimen is one sample of a chaotic packing, so the peaks are given as mean "
+            "+- sd over the specimens and the Mohr-Coulomb line is fitted to every specimen's peaks.",
+        ))  # fmt: skip
+        b.append((
+            "table",
+            ["normal stress (kPa)", "peak mean (kPa)", "peak sd (kPa)", "specimens", "peaks (kPa)"],
+            [[r["normal_stress_kpa"], r["peak_mean_kpa"], r["peak_sd_kpa"], r["n"],
+              ", ".join(f"{v:.1f}" for v in r["peaks_kpa"])] for r in rows],
+        ))  # fmt: skip
+    fits = []
+    for key, name in (("fit", "least squares"), ("fit_through_origin", "through the origin (c = 0)")):
+        f = rep.get(key)
+        if not f:
+            continue
+        ci = f.get("friction_angle_ci_deg")
+        cci = f.get("cohesion_ci_kpa")
+        fits.append(
+            f"{name}: phi = {f['friction_angle_deg']:.1f} deg"
+            + (f" ({f['level']:.0%} interval {ci[0]:.1f} to {ci[1]:.1f})" if ci else " (too few points)")
+            + (f", c = {f['cohesion_kpa']:.1f} kPa ({cci[0]:.1f} to {cci[1]:.1f})" if cci else "")
+        )  # fmt: skip
+    per = rep.get("friction_angle_per_specimen_deg") or []
+    if per:
+        fits.append("phi of each specimen alone: " + ", ".join(f"{v:.1f}" for v in per) + " deg")
+    if fits:
+        b.append(("ul", fits))
+    elif shear.get("friction_angle_deg") is not None:
+        b.append(
+            ("p", f"Mohr-Coulomb fit of the peaks: friction angle {shear['friction_angle_deg']:.3g} deg.")
         )
-    )
     sd = out / "shear"
     for name, cap in (
-        ("fig8a_shear_curves.png", "Fig. 8(a): shear stress against shear displacement"),
-        ("fig8b_peak_strength.png", "Fig. 8(b): peak strength against normal stress"),
-    ):
+        ("fig8a_shear_curves_replicates.png", "Fig. 8(a): shear stress against shear displacement, mean and "
+         "+- sd band over the specimens"),
+        ("fig8b_peak_strength_replicates.png", "Fig. 8(b): peak strength against normal stress over the "
+         "specimens, with the fitted lines"),
+        ("seed0/fig8a_shear_curves.png", "The first specimen's curves with the plate displacement"),
+    ):  # fmt: skip
         if (sd / name).is_file():
             b.append(("img", sd / name, cap))
     return b
