@@ -175,6 +175,57 @@ def state_sweep(base: dict, targets: list[StateTarget], seeds: int, resolution: 
     return cfg
 
 
+def run_density_state(
+    base: dict,
+    base_dir: Path | None,
+    n_lab: float,
+    n_max: float,
+    n_min: float,
+    out: Path,
+    *,
+    seeds: int = DEFAULT_SEEDS,
+    mus=None,
+    use_cache: bool = True,
+    **sweep_kw,
+) -> dict:
+    """The density-controlled criterion for one laboratory state, over seeds.
+
+    Calibrates (or reads the cached calibration), maps ``n_lab`` to its 2D target and
+    preparation friction, runs the criterion with them for every seed and writes
+    ``out/density.json``: the accepted n2D (mean, sd, per seed), the target, mu_prep and Dr.
+    """
+    from poro2d.criterion.density import lab_relative_density
+    from poro2d.sweep.relation import density_relation
+
+    lab_relative_density(n_lab, n_max, n_min)  # nLab outside [n_min, n_max]: refused before any run
+    settings = {"n_max": n_max, "n_min": n_min, "n_lab": [round(float(n_lab), 4)]}
+    rel, record = density_relation(base, base_dir, settings, out, seeds=seeds, mus=mus,
+                                   use_cache=use_cache, **sweep_kw)  # fmt: skip
+    (point,) = rel["points"]
+    result = {
+        "mode": "density",
+        "n_lab": point["n_lab"],
+        "relative_density": point["relative_density"],
+        "n2d_target": point["n2d_target"],
+        "mu_prep": point["mu_prep"],
+        "final_porosity_mean": point["n2d_dem"],
+        "final_porosity_sd": point["n2d_sd"],
+        "final_porosity_per_seed": point["n2d_seeds"],
+        "measured_porosity_mean": point["n2d_measured"],
+        "seeds": point["seeds"],
+        "seeds_converged": point["seeds_converged"],
+        "converged": point["seeds_converged"] == point["seeds"],
+        "n2d_min": rel["n2d_min"],
+        "n2d_max": rel["n2d_max"],
+        "calibration": rel["calibration"],
+        "sweeps": record,
+        "config": base,
+        "provenance": provenance(),
+    }
+    write_json(out / "density.json", result)
+    return result
+
+
 __all__ = [
     "DEFAULT_SEEDS",
     "cache_dir",
@@ -184,5 +235,6 @@ __all__ = [
     "calibration_sweep",
     "check_mus",
     "check_seeds",
+    "run_density_state",
     "state_sweep",
 ]
