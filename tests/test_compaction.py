@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from poro2d.criterion.protocol import wall_forces
+from poro2d.criterion.protocol import CriterionSettings, specimen_checks, wall_forces
 from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.specimen import GradingCurve, paper_grading
@@ -58,6 +58,66 @@ def test_dense_trial_loads_the_top_plate():
     assert lhs == pytest.approx(spec.self_weight(0.14) + f["f_top_n_per_m"], rel=1e-3)
 
 
+def test_checks_hold_on_a_specimen_at_rest(loose):
+    spec, sim, rep = loose
+    checks, nums = specimen_checks(sim, spec, rep, 0.22, spec.height, wall_forces(sim), CriterionSettings())
+    assert checks == dict.fromkeys(checks, True) and len(checks) == 5
+    # the weight the balance uses, against rho_s g pi r^2 summed over the radii (per metre of thickness)
+    weight = spec.solid_density * spec.gravity * np.pi * float(np.sum(sim.particles.radius**2))
+    assert nums["weight_from_masses_n_per_m"] == pytest.approx(weight, rel=1e-12)
+    assert nums["force_balance_error"] < 0.01
+    assert nums["planned_particle_count"] == sim.particles.n and nums["disks_outside_box"] == 0
+    assert nums["generation_porosity_error"] < 1e-3
+
+
+def test_checks_catch_a_falling_or_broken_specimen(loose, tmp_path):
+    spec, sim, rep = loose
+    checkpoint.save(sim, tmp_path / "s.npz")
+    falling = checkpoint.load(tmp_path / "s.npz", threads=1)
+    falling.translate_wall("top", 0.0, 0.01)
+    falling.particles.pos[:, 1] += 0.002  # off the bottom wall: the weight is not carried
+    falling.particles_changed()
+    falling.run(10)
+    lifted = spec.height + 0.01
+    checks, nums = specimen_checks(
+        falling, spec, rep, 0.22, lifted, wall_forces(falling), CriterionSettings()
+    )
+    assert not checks["force_balance"] and nums["force_balance_error"] > 0.5
+    assert checks["disks_inside_box"] and checks["all_disks_present"]
+    # a disk missing from the plan, the porosity after generation off, a disk through the plate
+    broken = dict(rep, planned_count=rep["particle_count"] + 3, measured_porosity=0.22 + 2e-3)
+    checks, nums = specimen_checks(
+        sim, spec, broken, 0.22, 0.8 * spec.height, wall_forces(sim), CriterionSettings()
+    )
+    assert not checks["all_disks_present"] and not checks["porosity_after_generation"]
+    assert not checks["disks_inside_box"] and nums["disks_outside_box"] > 0
+
+
+def test_a_layer_short_of_steps_gets_the_fallback():
+    # frictionless disks near their jamming density relax slowly: the second layer needs more
+    # than the first budget, finishes in the second one, and the specimen is complete
+    spec = SpecimenSpec(**SMALL, friction_prep=0.0, max_steps_per_stage=20_000)
+    sim, rep = prepare_specimen(spec, paper_grading(), 0.20, seed=200_000)
+    assert rep["converged"] and rep["failed_stage"] is None
+    assert rep["particle_count"] == rep["planned_count"] == sim.particles.n
+    first, second = rep["layers"]
+    assert [a["attempt"] for a in first["attempts"]] == ["normal"]
+    assert [a["attempt"] for a in second["attempts"]] == ["normal", "second budget"]
+    assert second["attempts"][0]["max_ratio"] > 1e-3 > second["max_ratio"]
+    assert second["converged"] and rep["final_stage"]["converged"]
+
+
+def test_a_layer_that_fails_ends_the_preparation():
+    spec = SpecimenSpec(**SMALL, max_steps_per_stage=200, fallback_steps=100, calm_steps=100)
+    sim, rep = prepare_specimen(spec, paper_grading(), 0.20, seed=200_000)
+    assert not rep["converged"] and rep["failed_stage"] == "layer 1" and rep["failed_max_ratio"] > 1e-3
+    (only,) = rep["layers"]
+    assert [a["attempt"] for a in only["attempts"]] == ["normal", "second budget", "calm", "normal again"]
+    assert rep["particle_count"] == only["n_particles"] < rep["planned_count"]
+    assert rep["final_stage"] is None  # the working friction is not applied to a broken specimen
+    assert sim.local_damping == spec.local_damping  # the calm stage's damping is undone
+
+
 def _deferred(sim) -> int:
     """Disks that wait for the second phase of a step (their pairs cross the partition cut)."""
     sim.run(1)
@@ -108,6 +168,10 @@ def test_bad_configs_fail_before_simulating():
         SpecimenSpec(layers=0)
     with pytest.raises(InputError, match="friction_prep"):
         SpecimenSpec(friction_prep=-1)
+    with pytest.raises(InputError, match="fallback_steps"):
+        SpecimenSpec(fallback_steps=0)
+    with pytest.raises(InputError, match="calm_damping"):
+        SpecimenSpec(calm_damping=1.0)
     big = GradingCurve.from_lists([40.0, 80.0], [0, 100])
     with pytest.raises(InputError, match="largest disk"):
         check_feasible(SpecimenSpec(), big, 0.15)

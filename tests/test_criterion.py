@@ -241,3 +241,71 @@ def test_cli_numbers_do_not_depend_on_progress_display(tmp_path, capsys, monkeyp
     (it,) = shown["iterations"]
     row = next(line for line in s_out.out.splitlines() if f"{it['new_porosity']:.4f}" in line)
     assert f"{it['porosity_change']:.4f}" in row and f"{it['f_top_n_per_m']:.4g}" in row
+
+
+def _frictionless(**kw):
+    """Small frictionless preparation whose first layer cannot settle within its step budget."""
+    base = dict(width=0.06, height=0.03, layers=3, friction_prep=0.0, max_steps_per_stage=29_000)
+    return SpecimenSpec(**{**base, "fallback_steps": 1000, "calm_steps": 1000, **kw})
+
+
+def test_half_built_frictionless_specimen_is_refused(tmp_path):
+    # the failure seen on the paper preset with friction_prep = 0, in a small box: a layer that
+    # does not settle used to end the preparation with the lid mid-height and a fraction of the
+    # disks (here 2 layers of 3), and that specimen went on to be accepted (before: 0.23, 75 disks)
+    settings = CriterionSettings(trial_porosity=0.20, force_fraction=0.05)
+    r = PorosityCriterion(
+        _frictionless(), paper_grading(), settings, seed=0, out=tmp_path, figures=False
+    ).run()
+    assert not r["converged"] and r["final_porosity"] is None and r["failed_trial"] == 1
+    (it,) = r["iterations"]
+    assert not it["accepted"] and it["refused"] and not it["converged"]
+    assert it["failed_stage"] == "layer 2" and it["failed_check"] == "preparation_converged"
+    assert it["failed_max_ratio"] > 1e-3 and it["failed_steps"] == 29_000 + 1000 + 1000 + 1000
+    assert it["particle_count"] < it["planned_particle_count"]
+    assert it["checks"]["all_disks_present"] is False and it["checks"]["porosity_after_generation"] is False
+    assert it["plate_moved"] == "not run" and it["new_porosity"] is None
+    assert "trial 1" in r["message"] and "layer 2" in r["message"] and "ratio" in r["message"]
+    # every trial's files are kept, nothing looks like an accepted specimen
+    trial = next((tmp_path / "trials").iterdir())
+    assert (trial / "prepared.npz").is_file() and (trial / "trial.json").is_file()
+    assert not (tmp_path / "specimen.npz").exists()
+    # the refusal is read back on resume, not recomputed into an acceptance
+    again = PorosityCriterion(_frictionless(), paper_grading(), settings, seed=0, out=tmp_path, figures=False)
+    assert again.run()["iterations"] == r["iterations"]
+
+
+def test_layer_forced_to_fail_ends_the_cli_with_one_line(tmp_path, capsys):
+    cfg = tmp_path / "tiny.toml"
+    cfg.write_text(
+        "seed = 0\n[specimen]\nwidth = 0.06\nheight = 0.03\nlayers = 2\n"
+        "max_steps_per_stage = 200\nfallback_steps = 100\ncalm_steps = 100\n"
+        "[criterion]\ntrial_porosity = 0.2\n"
+    )
+    out = tmp_path / "o"
+    with pytest.raises(SystemExit) as e:
+        main(["criterion", "--config", str(cfg), "--out", str(out), "--quiet"])
+    assert e.value.code == 1
+    captured = capsys.readouterr()
+    (line,) = [ln for ln in captured.out.splitlines() if "criterion failed" in ln]
+    assert "trial 1 (n2D = 0.2000)" in line and "layer 1" in line and "ratio" in line
+    assert "Traceback" not in captured.out + captured.err
+    saved = json.loads((out / "result.json").read_text())
+    assert saved["converged"] is False and saved["failed_trial"] == 1
+    (it,) = saved["iterations"]
+    assert it["converged"] is False and it["accepted"] is False
+    csv = (out / "iterations.csv").read_text().splitlines()
+    head = csv[0].split(",")
+    assert "check_preparation_converged" in head and "failed_check" in head
+    row = dict(zip(head, csv[1].split(","), strict=False))
+    assert row["check_preparation_converged"] == "False" and row["accepted"] == "False"
+
+
+def test_plate_that_does_not_settle_refuses_the_trial(tmp_path):
+    r = _run(tmp_path, 0.30, max_plate_steps=1000)
+    (it,) = r["iterations"]
+    assert it["plate_moved"] == "down" and not it["plate_settled"]
+    assert it["refused"] and not it["accepted"] and not it["converged"]
+    assert it["failed_stage"] == "top plate" and it["checks"]["plate_settled"] is False
+    assert not r["converged"] and r["failed_trial"] == 1
+    assert "top plate did not settle within 1000 steps" in r["message"] and "ratio" in r["message"]

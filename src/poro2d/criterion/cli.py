@@ -44,7 +44,9 @@ def register(app: typer.Typer) -> None:
         result = crit.run()
         print_result(result, out)
         if not result["converged"]:
-            console.print(f"[bold red]not converged:[/] {result['message']}")
+            # one line, whole: the reason names the trial, the stage or check, the ratio
+            what = "failed" if result.get("failed_trial") else "not converged"
+            console.print(f"[bold red]criterion {what}:[/] {result['message']}", soft_wrap=True)
             raise typer.Exit(1)
 
 
@@ -57,8 +59,19 @@ def print_result(result: dict, out: Path) -> None:
         t.add_row(
             f"{r['trial_porosity']:.3f}", str(r["particle_count"]), f"{r['f_top_n_per_m']:.4g}",
             f"{r['f_bottom_n_per_m']:.4g}", f"{r['self_weight_n_per_m']:.4g}", r["plate_moved"],
-            f"{1e3 * r['plate_displacement_m']:.3f}", f"{r['new_porosity']:.4f}",
-            f"{r['porosity_change']:.4f}", "yes" if r["accepted"] else "no",
+            f"{1e3 * r['plate_displacement_m']:.3f}", _num(r["new_porosity"]),
+            _num(r["porosity_change"]), _verdict(r),
         )  # fmt: skip
     console.print(t)
     console.print(f"{result['message']}; results in {out}/result.json")
+
+
+def _num(x) -> str:
+    """A porosity for the table; a trial refused before its plate stage has none."""
+    return "-" if x is None else f"{x:.4f}"
+
+
+def _verdict(r: dict) -> str:
+    if r["accepted"]:
+        return "yes"
+    return f"refused ({r.get('failed_stage') or r.get('failed_check')})" if r.get("refused") else "no"

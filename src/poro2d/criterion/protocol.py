@@ -13,6 +13,12 @@ For a trial 2D porosity n2D (Eq. 12 of the paper unless given):
 Every trial is written to its own folder as it finishes, so an interrupted run
 resumes where it stopped; a run that does not converge stops with a clear
 message and keeps every trial's results.
+
+A trial is only accepted when, besides the paper's condition, its specimen passes
+the checks of :func:`specimen_checks` (every planned disk built and inside the box,
+the porosity after generation equal to the trial porosity, the vertical forces in
+balance). A trial whose preparation or plate stage did not reach equilibrium, or
+whose specimen fails a check, is refused and ends the run with the reason.
 """
 
 from __future__ import annotations
@@ -23,6 +29,8 @@ import math
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
+
+import numpy as np
 
 from poro2d.config import check_finite
 from poro2d.dem import Simulation, checkpoint
@@ -59,6 +67,8 @@ class CriterionSettings:
     max_plate_steps: int = 600_000
     check_every: int = 500
     window_checks: int = 4
+    generation_tolerance: float = 1e-3
+    balance_tolerance: float = 0.01
 
     def __post_init__(self) -> None:
         check_range("n_lab", self.n_lab, 0.0, 1.0, hi_open=True)
@@ -83,6 +93,8 @@ class CriterionSettings:
             raise InputError("check_every", self.check_every, "an integer >= 1")
         if not (isinstance(self.window_checks, int) and self.window_checks >= 1):
             raise InputError("window_checks", self.window_checks, "an integer >= 1")
+        check_range("generation_tolerance", self.generation_tolerance, 0.0, 0.05, lo_open=True)
+        check_range("balance_tolerance", self.balance_tolerance, 0.0, 0.5, lo_open=True)
 
     def initial_trial(self) -> float:
         """Eq. 12 (n2D = 0.42 nLab^2 + 0.25 nLab), rounded to the resolution, unless given."""
@@ -126,6 +138,100 @@ def wall_forces(sim: Simulation) -> dict:
 
 def in_window(f_top: float, weight: float, fraction: float) -> bool:
     return 0.0 < f_top < fraction * weight
+
+
+# A disk counts as inside the box while it presses into a wall by less than this
+# fraction of its radius: contact overlaps under the self-weight and plate forces
+# of the paper's stiffnesses are well below 1 % of a radius.
+WALL_OVERLAP_FRACTION = 0.05
+
+# checks that say the specimen itself is broken: a trial failing one is refused
+# (no n' can be trusted from it) and the run stops
+INTEGRITY_CHECKS = (
+    "preparation_converged",
+    "all_disks_present",
+    "disks_inside_box",
+    "porosity_after_generation",
+)
+
+
+def specimen_checks(
+    sim: Simulation,
+    spec: SpecimenSpec,
+    prep: dict,
+    trial: float,
+    plate_height: float,
+    forces: dict,
+    settings: CriterionSettings,
+) -> tuple[dict, dict]:
+    """The checks a trial must pass to be accepted: (booleans, the numbers behind them).
+
+    * ``preparation_converged``: every layer and the working-friction stage reached
+      equilibrium (with the fallback of :func:`poro2d.specimen.compaction.equilibrate`);
+    * ``all_disks_present``: as many disks as drawn for the trial porosity;
+    * ``disks_inside_box``: every disk between the side walls, above the bottom and
+      below the top plate (at ``plate_height``), pressing into a wall by less than
+      ``WALL_OVERLAP_FRACTION`` of its radius;
+    * ``porosity_after_generation``: the porosity measured right after preparation
+      (plate at H) is the trial porosity within ``generation_tolerance``. Measured as
+      1 - (disk area inside the W x H box, each disk clipped by the box) / (W H);
+      overlaps between disks are not subtracted, as in PFC's measurement;
+    * ``force_balance``: on the state the decision is taken on, F_bottom + side
+      friction = weight + F_top within ``balance_tolerance`` of the right-hand side.
+      Signs: F_bottom > 0 when the disks push the bottom wall down, side friction > 0
+      when the side walls hold the disks up, F_top > 0 when the disks push the top
+      plate up; the weight is sum(m) g / t from the disks' masses. With local damping,
+      a specimen that still moves does not balance: damping forces carry the rest.
+    """
+    p = sim.particles
+    x, y, r = p.pos[:, 0], p.pos[:, 1], p.radius
+    slack = WALL_OVERLAP_FRACTION * r
+    outside = (
+        (x - r < -slack) | (x + r > spec.width + slack) | (y - r < -slack) | (y + r > plate_height + slack)
+    )
+    weight = float(np.sum(p.mass)) * spec.gravity / p.thickness
+    rhs = weight + forces["f_top_n_per_m"]
+    lhs = forces["f_bottom_n_per_m"] + forces["side_friction_up_n_per_m"]
+    balance_error = abs(lhs - rhs) / rhs if rhs > 0.0 else math.inf
+    generation_error = abs(prep["measured_porosity"] - trial)
+    numbers = {
+        "planned_particle_count": int(prep["planned_count"]),
+        "disks_outside_box": int(np.count_nonzero(outside)),
+        "porosity_after_generation": float(prep["measured_porosity"]),
+        "generation_porosity_error": float(generation_error),
+        "weight_from_masses_n_per_m": weight,
+        "force_balance_error": float(balance_error),
+    }
+    checks = {
+        "preparation_converged": bool(prep["converged"]),
+        "all_disks_present": bool(p.n == prep["planned_count"]),
+        "disks_inside_box": bool(not outside.any()),
+        "porosity_after_generation": bool(generation_error <= settings.generation_tolerance),
+        "force_balance": bool(balance_error <= settings.balance_tolerance),
+    }
+    return checks, numbers
+
+
+def _check_reason(name: str, row: dict, settings: CriterionSettings) -> str:
+    """One line on why check ``name`` failed, with its numbers."""
+    if name == "preparation_converged":
+        return (
+            f"{row['failed_stage']} did not reach equilibrium: max unbalanced-force ratio "
+            f"{row['failed_max_ratio']:.3g} after {row['failed_steps']} steps (fallback included)"
+        )
+    if name == "all_disks_present":
+        return f"{row['particle_count']} disks built of {row['planned_particle_count']} planned"
+    if name == "disks_inside_box":
+        return f"{row['disks_outside_box']} disk(s) outside the box"
+    if name == "porosity_after_generation":
+        return (
+            f"porosity after generation {row['porosity_after_generation']:.4f} differs from the trial "
+            f"by {row['generation_porosity_error']:.2g} > {settings.generation_tolerance:g}"
+        )
+    return (
+        f"vertical forces out of balance by {100 * row['force_balance_error']:.2f} % "
+        f"> {100 * settings.balance_tolerance:g} % (F_bottom + side friction vs weight + F_top)"
+    )
 
 
 class PorosityCriterion:
@@ -292,6 +398,7 @@ class PorosityCriterion:
             "iteration": k,
             "trial_porosity": n,
             "particle_count": prep["particle_count"],
+            "planned_particle_count": prep["planned_count"],
             "measured_porosity_after_generation": prep["measured_porosity"],
             "f_top_n_per_m": f_top,
             "f_bottom_n_per_m": forces0["f_bottom_n_per_m"],
@@ -299,9 +406,19 @@ class PorosityCriterion:
             "self_weight_n_per_m": weight,
             "force_limit_n_per_m": s.force_fraction * weight,
             "preparation_converged": prep["converged"],
+            "converged": True,
         }
         t1 = time.perf_counter()
-        if in_window(f_top, weight, s.force_fraction):
+        top = sim.walls.index("top")
+        if not prep["converged"]:
+            # a half-built specimen: no plate stage, no n'; refused below
+            row.update(plate_moved="not run", plate_displacement_m=0.0, new_porosity=None)
+            row.update(
+                converged=False, failed_stage=prep["failed_stage"],
+                failed_max_ratio=prep["failed_max_ratio"], failed_steps=prep["failed_steps"],
+            )  # fmt: skip
+            after = forces0
+        elif in_window(f_top, weight, s.force_fraction):
             row.update(plate_moved="no", plate_displacement_m=0.0, new_porosity=n, plate_settled=True)
             after = forces0
         else:
@@ -318,16 +435,66 @@ class PorosityCriterion:
                         f"after moving the top plate {row['plate_moved']}: n' = {row['new_porosity']:.4f}",
                         after_fig,
                     )  # fmt: skip
+            if not row["plate_settled"]:
+                row.update(
+                    converged=False, failed_stage="top plate",
+                    failed_max_ratio=row["plate_final_max_ratio"], failed_steps=row["plate_steps"],
+                )  # fmt: skip
         row["f_top_after_n_per_m"] = after["f_top_n_per_m"]
         row["f_bottom_after_n_per_m"] = after["f_bottom_n_per_m"]
         row["side_friction_up_after_n_per_m"] = after["side_friction_up_n_per_m"]
-        row["porosity_change"] = abs(row["new_porosity"] - n)
-        row["accepted"] = bool(row["plate_settled"] and row["porosity_change"] < s.porosity_tolerance)
+        row["porosity_change"] = None if row["new_porosity"] is None else abs(row["new_porosity"] - n)
+        checks, numbers = specimen_checks(sim, self.spec, prep, n, float(sim.walls.p0[top, 1]), after, s)
+        row.update(numbers)
+        # the plate stage is part of the record: False when it did not settle or never ran
+        checks = {"preparation_converged": checks.pop("preparation_converged"),
+                  "plate_settled": bool(row.get("plate_settled", False)), **checks}  # fmt: skip
+        row["checks"] = checks
+        self._decide(row)
         row["time_prepare_s"] = t_prep
         row["time_plate_s"] = time.perf_counter() - t1
         if d is not None:
             write_json(d / "trial.json", row)
         return row
+
+    def _decide(self, row: dict) -> None:
+        """Accept, reject or refuse a trial; records ``accepted``, ``refused``, ``failed_check``, ``reason``.
+
+        Accepted: the paper's condition (the plate settled with 0 < F_top < 1 % G and
+        |n' - n2D| below the tolerance) and every check passed. Refused (the run stops):
+        a stage that did not reach equilibrium, a broken specimen (an integrity check
+        failed), or the paper's condition met while a check failed.
+        """
+        s = self.settings
+        checks = row["checks"]
+        failed = next((c for c, ok in checks.items() if not ok), "")
+        condition = bool(
+            row["converged"] and bool(row.get("plate_settled", False))
+            and row["porosity_change"] < s.porosity_tolerance
+        )  # fmt: skip
+        row["condition_met"] = condition
+        row["failed_check"] = failed
+        row["accepted"] = condition and not failed
+        if not row["converged"]:
+            if row["failed_stage"] == "top plate":
+                row["reason"] = (
+                    f"the top plate did not settle within {s.max_plate_steps} steps: F_top "
+                    f"{row['f_top_after_n_per_m']:.4g} N/m, window (0, {row['force_limit_n_per_m']:.4g}), "
+                    f"max unbalanced-force ratio {row['failed_max_ratio']:.3g} when held"
+                )
+            else:
+                row["reason"] = _check_reason("preparation_converged", row, s)
+            row["refused"] = True
+        elif failed:
+            row["reason"] = f"check {failed} failed: {_check_reason(failed, row, s)}"
+            row["refused"] = condition or failed in INTEGRITY_CHECKS
+        else:
+            row["refused"] = False
+            row["reason"] = (
+                "0 < F_top < limit with the plate settled, |n' - n2D| below the tolerance, all checks passed"
+                if condition
+                else f"|n' - n2D| = {row['porosity_change']:.4f} >= {s.porosity_tolerance:g}"
+            )
 
     # -------------------------------------------------------------------- loop
     def run(self) -> dict:
@@ -340,6 +507,7 @@ class PorosityCriterion:
         rows: list[dict] = []
         tried: list[float] = []
         converged = False
+        failed_trial = None
         message = ""
         for k in range(1, s.max_iterations + 1):
             tried.append(n)
@@ -351,10 +519,9 @@ class PorosityCriterion:
                 converged = True
                 message = f"accepted n2D = {n:.4f} after {k} trial(s)"
                 break
-            if not row.get("plate_settled", True):
-                message = (
-                    f"the top plate did not settle within {s.max_plate_steps} steps at trial n2D = {n:.4f}"
-                )
+            if row["refused"]:
+                failed_trial = k
+                message = f"trial {k} (n2D = {n:.4f}) refused: {row['reason']}"
                 break
             nxt = round_to(row["new_porosity"], s.resolution)
             if nxt == n:  # rounding fell back: step one resolution towards n'
@@ -370,6 +537,7 @@ class PorosityCriterion:
             message = f"no convergence within max_iterations = {s.max_iterations} (trials {tried})"
         final = n if converged else None
         result = self._write_tables(rows, final=final, converged=converged, message=message)
+        result["failed_trial"] = failed_trial
         result["time_total_s"] = time.perf_counter() - t_start
         if self.out is not None:
             self._final_outputs(rows, converged)
@@ -450,7 +618,7 @@ class PorosityCriterion:
             "provenance": provenance(),
         }
         if self.out is not None:
-            write_csv(self.out / "iterations.csv", rows)
+            write_csv(self.out / "iterations.csv", [_flat(r) for r in rows])
         return result
 
     def _final_outputs(self, rows: list[dict], converged: bool) -> None:
@@ -463,7 +631,7 @@ class PorosityCriterion:
         first = rows[0]
         d0 = self._trial_dir(first["iteration"], first["trial_porosity"])
         pairs = [(d0 / "forces_trial.png", "fig5_forces_initial_trial.png")]
-        moved = next((r for r in rows if r.get("plate_moved") != "no"), None)
+        moved = next((r for r in rows if r.get("plate_moved") in ("up", "down")), None)
         if moved is not None:
             dm = self._trial_dir(moved["iteration"], moved["trial_porosity"])
             pairs.append((dm / "forces_after_plate.png", "fig6_forces_after_plate.png"))
@@ -480,6 +648,14 @@ class PorosityCriterion:
                 shutil.copyfile(src, self.out / dst)
 
 
+def _flat(row: dict) -> dict:
+    """A trial row for the CSV table: the ``checks`` dict as ``check_<name>`` columns."""
+    out = {k: v for k, v in row.items() if k != "checks"}
+    out.update({f"check_{k}": v for k, v in row.get("checks", {}).items()})
+    return out
+
+
 __all__ = [
-    "CriterionSettings", "PorosityCriterion", "binding_part", "in_window", "round_to", "wall_forces",
+    "CriterionSettings", "PorosityCriterion", "binding_part", "in_window", "round_to", "specimen_checks",
+    "wall_forces",
 ]  # fmt: skip

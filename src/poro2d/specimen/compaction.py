@@ -10,6 +10,12 @@ The lid then moves up to the next band's top. After the last band the lid is at
 H and stays there as the top plate; the particle friction is raised to its
 working value and the specimen is cycled to equilibrium once more.
 
+A stage that does not reach equilibrium within its budget gets a fallback
+(:func:`equilibrate`): a second budget of steps, then a calm stage (velocities
+set to zero, higher local damping), then the normal damping and ratio again. A
+stage that still fails ends the preparation there: the report says which stage
+failed and the ratio it reached, and the specimen is never completed silently.
+
 Undercompaction (Ladd 1978; Jiang, Konrad and Leroueil 2003) is optional: band k
 of nt is closed at height (H / nt) (k - 1 + (1 + U_k)), with
 U_k = U_1 - U_1 (k - 1) / (nt - 1), so the lower layers start looser and end
@@ -72,6 +78,9 @@ class SpecimenSpec:
     growth_increments: int = 40
     growth_steps: int = 150
     max_steps_per_stage: int = 400_000
+    fallback_steps: int = 200_000
+    calm_steps: int = 50_000
+    calm_damping: float = 0.9
     dt_safety: float = 0.8
     threads: int = 1
     max_disks: int = DEFAULT_MAX_DISKS
@@ -93,7 +102,9 @@ class SpecimenSpec:
         check_range("gravity", self.gravity, 0.0, None)
         check_int("growth_increments", self.growth_increments, 1)
         check_int("growth_steps", self.growth_steps, 1)
-        check_int("max_steps_per_stage", self.max_steps_per_stage, 1)
+        for k in ("max_steps_per_stage", "fallback_steps", "calm_steps"):
+            check_int(k, getattr(self, k), 1)
+        check_range("calm_damping", self.calm_damping, 0.0, 1.0, hi_open=True)
         check_range("dt_safety", self.dt_safety, 0.0, 1.0, lo_open=True)
         check_int("threads", self.threads, 1)
         check_int("max_disks", self.max_disks, 1, MAX_DRAW)
@@ -230,6 +241,52 @@ class LayerReport:
     steps: int
     max_ratio: float
     converged: bool
+    attempts: list
+
+
+def equilibrate(sim: Simulation, spec: SpecimenSpec, label: str, progress: bool = False) -> dict:
+    """Cycle to equilibrium (maximum unbalanced-force ratio below ``spec.ratio``), with a fallback.
+
+    1. ``normal``: up to ``max_steps_per_stage`` steps;
+    2. ``second budget``: up to ``fallback_steps`` more (a packing near its jamming
+       density relaxes slowly, and often only needs more time);
+    3. ``calm``: velocities set to zero and local damping raised to ``calm_damping``
+       for up to ``calm_steps`` steps (removes the kinetic energy of a packing that
+       keeps rattling);
+    4. ``normal again``: the normal damping restored, up to ``calm_steps`` steps. The
+       ratio is a force measure and does not depend on damping, but an equilibrium only
+       counts once it holds with the damping of the protocol.
+
+    Stops at the first attempt that reaches the ratio. Returns ``converged``, the total
+    ``steps``, the last ``max_ratio`` and every attempt made (name, steps, max ratio).
+    """
+    attempts: list[dict] = []
+
+    def attempt(name: str, budget: int) -> bool:
+        bar = (label if name == "normal" else f"{label} ({name})") if progress else False
+        res = sim.solve(spec.ratio, budget, progress=bar)
+        attempts.append({"attempt": name, "steps": res.steps, "max_ratio": res.max_ratio})
+        return res.converged
+
+    ok = attempt("normal", spec.max_steps_per_stage)
+    if not ok:
+        ok = attempt("second budget", spec.fallback_steps)
+    if not ok:
+        damping = sim.local_damping
+        sim.particles.vel[:] = 0.0
+        sim.particles.omega[:] = 0.0
+        sim.local_damping = spec.calm_damping
+        try:
+            attempt("calm", spec.calm_steps)
+        finally:
+            sim.local_damping = damping
+        ok = attempt("normal again", spec.calm_steps)
+    return {
+        "converged": ok,
+        "steps": sum(a["steps"] for a in attempts),
+        "max_ratio": attempts[-1]["max_ratio"],
+        "attempts": attempts,
+    }
 
 
 def _band_particles(spec: SpecimenSpec, pos, radii) -> Particles:
@@ -250,6 +307,12 @@ def prepare_specimen(
 
     Returns the simulation (top plate = wall "top" at H) and a report with the
     particle count, per-layer cycles and the measured box porosity.
+
+    A layer that does not reach equilibrium even with the fallback of
+    :func:`equilibrate` ends the preparation: the later layers are not built, the
+    lid stays at that layer's top, and the report has ``converged = False``,
+    ``failed_stage`` (e.g. ``"layer 2"``), ``failed_max_ratio`` and fewer disks
+    (``particle_count``) than planned (``planned_count``). Callers must refuse it.
     """
     check_feasible(spec, grading, porosity)
     W, H = spec.width, spec.height
@@ -299,26 +362,41 @@ def prepare_specimen(
         # renumber the whole packing in strips across its short side (the new layer was
         # appended on top): threads then split it along a short cut (dem.ordering)
         sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
-        res = sim.solve(
-            spec.ratio, spec.max_steps_per_stage, progress=f"layer {k + 1}" if progress else False
+        eq = equilibrate(sim, spec, f"layer {k + 1}", progress)
+        steps += eq["steps"]
+        layers.append(
+            asdict(
+                LayerReport(
+                    k + 1, len(idx), y_top, scale, steps, eq["max_ratio"], eq["converged"], eq["attempts"]
+                )
+            )
         )
-        steps += res.steps
-        layers.append(asdict(LayerReport(k + 1, len(idx), y_top, scale, steps, res.max_ratio, res.converged)))
-        if not res.converged:
+        if not eq["converged"]:
+            failed = (f"layer {k + 1}", eq)
             break
+    else:
+        failed = None
     assert sim is not None
-    sim.set_particle_friction(spec.friction_particle)
-    res = sim.solve(spec.ratio, spec.max_steps_per_stage, progress="working friction" if progress else False)
+    final = None
+    if failed is None:
+        sim.set_particle_friction(spec.friction_particle)
+        final = equilibrate(sim, spec, "working friction", progress)
+        if not final["converged"]:
+            failed = ("working friction", final)
     p = sim.particles
     report = {
         "trial_porosity": porosity,
+        "planned_count": int(len(radii)),
         "particle_count": p.n,
         "solid_area_m2": p.area(),
         "box_porosity": 1.0 - p.area() / (W * H),
         "measured_porosity": porosity_rect(p.pos, p.radius, 0.0, 0.0, W, H),
         "layers": layers,
-        "final_stage": {"steps": res.steps, "max_ratio": res.max_ratio, "converged": res.converged},
-        "converged": all(lay["converged"] for lay in layers) and res.converged,
+        "final_stage": final,
+        "converged": failed is None,
+        "failed_stage": None if failed is None else failed[0],
+        "failed_max_ratio": None if failed is None else failed[1]["max_ratio"],
+        "failed_steps": None if failed is None else failed[1]["steps"],
     }
     return sim, report
 
@@ -350,6 +428,7 @@ __all__ = [
     "box_porosity",
     "check_feasible",
     "check_size",
+    "equilibrate",
     "estimate_size",
     "make_walls",
     "prepare_specimen",
