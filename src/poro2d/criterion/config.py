@@ -23,7 +23,7 @@ from poro2d.errors import InputError, check_int
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.grading import GradingCurve, paper_grading
 
-TOP_KEYS = {"seed", "specimen", "grading", "criterion", "shear", "title"}
+TOP_KEYS = {"seed", "specimen", "grading", "criterion", "shear", "title", "density"}
 
 
 def paper_preset() -> dict:

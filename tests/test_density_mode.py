@@ -1,0 +1,43 @@
+"""``poro2d criterion --mode density``: one laboratory state, calibrated friction, seeds."""
+
+import json
+
+import pytest
+
+from poro2d.cli import main
+
+TINY = (
+    "seed = 0\n[specimen]\nwidth = 0.05\nheight = 0.025\nlayers = 2\n"
+    '[density]\nmode = "density"\nn_max = 0.4571\nn_min = 0.3253\nmu_prep = [0.0, 0.5]\nseeds = 2\n'
+)
+
+
+def test_density_mode_of_the_criterion(tmp_path, monkeypatch):
+    monkeypatch.setenv("PORO2D_CACHE", str(tmp_path / "cache"))
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(TINY)
+    out = tmp_path / "o"
+    try:
+        main(["criterion", "--config", str(cfg), "--n-lab", "0.40", "--out", str(out), "--quiet"])
+    except SystemExit as e:  # a seed that did not converge exits 1 after writing its results
+        assert e.code == 1
+    res = json.loads((out / "density.json").read_text())
+    assert res["mode"] == "density" and res["n_lab"] == 0.40 and res["seeds"] == 2
+    # the state lies between the extremes, so its friction lies between the calibrated ones
+    assert 0.0 < res["relative_density"] < 1.0
+    assert res["n2d_min"] < res["n2d_target"] < res["n2d_max"]
+    assert 0.0 < res["mu_prep"] < 0.5
+    assert res["calibration"]["mus"] == [0.0, 0.5]
+    assert "provenance" in res and res["config"]["specimen"]["width"] == 0.05
+
+
+@pytest.mark.parametrize(
+    ("extra", "name"),
+    [(["--mode", "fast"], "mode"), (["--mode", "density", "--n-lab", "0.30"], "n_lab"),
+     (["--mode", "density", "--seeds", "0"], "seeds")],
+)  # fmt: skip
+def test_density_mode_errors(tmp_path, capsys, extra, name):
+    with pytest.raises(SystemExit) as e:
+        main(["criterion", "--preset", "paper", "--out", str(tmp_path / "o"), "--quiet", *extra])
+    assert e.value.code == 2 and name in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
