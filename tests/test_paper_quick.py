@@ -46,6 +46,8 @@ def test_every_stage_wrote_its_results(quick):
         "conversions/fig1_relations.png",
         "criterion/fig5_forces_initial_trial.png",
         "criterion/specimen.npz",
+        "criterion/specimen_state.png",
+        "criterion/specimen_state.json",
         "shear/seed0/fig8a_shear_curves.png",
         "shear/fig8b_peak_strength_replicates.png",
         "shear/fig8a_shear_curves_replicates.png",
@@ -61,6 +63,7 @@ def test_report_puts_the_paper_beside_poro2d(quick):
     assert "| accepted 2D porosity |" in md and "0.15" in md  # the paper's value, beside ours
     assert "reconstruction" in md  # the grading is said to be reconstructed
     assert "Local damping 0.7" in md  # a setting the paper does not state
+    assert "homogeneity and stress state" in md and "K0 = sigma_h / sigma_v" in md
     assert html.count("data:image/png;base64,") >= 6  # figures embedded: no server, no side files
     assert "figure missing" not in html
 

@@ -649,9 +649,23 @@ class PorosityCriterion:
             (self.out / ".specimen.npz.tmp").replace(self.out / "specimen.npz")
             sim = checkpoint.load(self.out / "specimen.npz")
             write_vtu(sim, self.out / "vtu", "accepted_specimen")
+            self._specimen_state(sim, last["trial_porosity"])
         for src, dst in pairs:
             if src.is_file():
                 shutil.copyfile(src, self.out / dst)
+
+
+    def _specimen_state(self, sim: Simulation, n2d: float) -> None:
+        """Homogeneity and stress state of the accepted specimen: specimen_state.json and .png."""
+        from poro2d.specimen.state import plot_specimen_state, specimen_state
+
+        assert self.out is not None
+        top = float(sim.walls.p0[sim.walls.index("top"), 1])
+        state = specimen_state(sim, self.spec.width, top)
+        write_json(self.out / "specimen_state.json", dict(state, trial_porosity=n2d))
+        if self.figures:
+            title = f"accepted specimen, n2D = {n2d:.3f}: bands of equal height"
+            plot_specimen_state(state, self.out / "specimen_state.png", title=title)
 
 
 def _flat(row: dict) -> dict:

@@ -146,6 +146,7 @@ def build_blocks(out: Path, summary: dict) -> list[Block]:
     ):
         if (cd / name).is_file():
             b.append(("img", cd / name, cap))
+    b.extend(_state_blocks(cd))
 
     # --- shear
     if shear:
@@ -186,6 +187,28 @@ def _criterion_discussion(its: list[dict], pc: dict) -> list[Block]:
     )
     out.append(("ul", notes))
     return out
+
+
+def _state_blocks(cd: Path) -> list[Block]:
+    """Homogeneity and stress state of the accepted specimen, when the criterion wrote them."""
+    st = _load(cd / "specimen_state.json")
+    if not st:
+        return []
+    k0 = st.get("k0_mean")
+    ratio = st.get("sigma_v_bottom_over_geostatic")
+    b: list[Block] = [("h3", "The accepted specimen: homogeneity and stress state")]
+    b.append((
+        "p",
+        f"Porosity in {len(st['bands'])} horizontal bands: mean {st['porosity_mean']:.4f}, sd "
+        f"{st['porosity_sd']:.4f}, range {st['porosity_range']:.4f} (disks clipped at the band edges). "
+        + (f"K0 = sigma_h / sigma_v averages {k0:.2f} over the bands; " if k0 is not None else "")
+        + (f"in the bottom band sigma_v is {ratio:.2f} x the geostatic stress "
+           "(F_top / W plus the weight above; the side walls carry the rest by friction)." if ratio else ""),
+    ))  # fmt: skip
+    if (cd / "specimen_state.png").is_file():
+        cap = "Porosity and stresses of the accepted specimen, by height"
+        b.append(("img", cd / "specimen_state.png", cap))
+    return b
 
 
 def _shear_blocks(out: Path, shear: dict) -> list[Block]:
