@@ -110,6 +110,11 @@ def plot_peak_strength(
     if fit_origin is not None:
         ax.plot(xs, fit_origin.predict(xs), color="#d95f02", lw=1.0, ls=":",
                 label=f"DEM, c = 0: phi = {fit_origin.friction_angle_deg:.1f} deg")  # fmt: skip
+    return _finish_peaks(fig, ax, xs, smax, lab, lab_fit, title, path)
+
+
+def _finish_peaks(fig, ax, xs, smax: float, lab, lab_fit, title: str, path) -> Path:
+    """Laboratory peaks and line (when given), axes, legend and title of a Fig. 8(b); saves it."""
     if lab is not None:
         ls = sorted(lab.peaks)
         ax.plot(
@@ -186,22 +191,8 @@ def plot_replicate_peaks(summary: dict, path: str | os.PathLike, lab=None, lab_f
         c = f", c = {fit['cohesion_kpa']:.1f} kPa" if not fit["through_origin"] else ", c = 0"
         ax.plot(xs, fit["cohesion_kpa"] + tan * xs, color="#d95f02", lw=1.3 if ls == "-" else 1.0, ls=ls,
                 label=f"phi = {fit['friction_angle_deg']:.1f} deg{txt} ({fit['level']:.0%}){c}")  # fmt: skip
-    if lab is not None:
-        ls_ = sorted(lab.peaks)
-        ax.plot(
-            ls_, [lab.peaks[v] for v in ls_], "s", mfc="none", mec="#1b9e77", ms=7, mew=1.5, label="lab peaks"
-        )
-        if lab_fit is not None:
-            ax.plot(xs, lab_fit.predict(xs), color="#1b9e77", lw=1.2, ls="--",
-                    label=f"lab: phi = {lab_fit.friction_angle_deg:.1f} deg")  # fmt: skip
-    ax.set_xlim(0, smax)
-    ax.set_ylim(bottom=0)
-    ax.set_xlabel("normal stress (kPa)")
-    ax.set_ylabel("peak shear stress (kPa)")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, loc="upper left")
-    ax.set_title("Direct shear: peak strength over specimens", fontsize=10)
-    return _save(fig, path)
+    title = "Direct shear: peak strength over specimens"
+    return _finish_peaks(fig, ax, xs, smax, lab, lab_fit, title, path)
 
 
 __all__ = [
