@@ -14,7 +14,7 @@ from poro2d.errors import InputError
 from poro2d.interop import csv_table, pfc, yade
 from poro2d.interop import lammps as lmp
 from poro2d.interop.check import DEFAULTS, check_specimen, read_specimen
-from poro2d.interop.specimen_data import from_checkpoint, series
+from poro2d.interop.specimen_data import from_checkpoint, from_simulation, series
 from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
 
@@ -46,6 +46,9 @@ def test_checkpoint_reads_as_the_simulation_holds_it(saved, spec):
     assert spec.thickness == 0.008 and spec.dt == sim.dt and spec.gravity == (0.0, -9.81)
     assert spec.box() == (0.0, 0.06, 0.0, 0.03)
     assert spec.contact_parameters()["top"] == (series(4e5, 1e7), series(4e5, 1e7), 1.5)
+    live = from_simulation(sim)  # a running Simulation gives the same numbers
+    _same_disks(spec, live)
+    assert live.walls == spec.walls and live.dt == spec.dt
 
 
 def test_csv_round_trip_is_exact(spec, tmp_path):
