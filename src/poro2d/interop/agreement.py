@@ -1,0 +1,130 @@
+"""The same specimen in LAMMPS and in poro2d: do the two engines agree at rest?
+
+"The same state" here: both codes start from the exported centres and radii with the
+disks at rest and no contact history (LAMMPS cannot import poro2d's stored shear
+forces, so poro2d starts without them too, from a fresh :class:`Simulation`), with
+the same masses, contact law, walls (the plate fixed where it stands), time step,
+gravity and local damping; each cycles until its maximum unbalanced-force ratio is
+below ``ratio``. Then both measure the wall forces per metre (the plate's F_top, the
+floor's F_bottom, the side walls' upward friction), the mean contact force and the
+coordination number.
+
+Known differences of the two implementations, both small at rest: LAMMPS' Hookean
+styles take the lever arm of a contact as the full radius, poro2d as the radius less
+half the overlap (the contact point in the middle of the overlap), and LAMMPS stores
+the shear displacement as a vector projected on the contact plane each step, poro2d
+the shear force as a component along the contact tangent.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from poro2d.criterion.protocol import wall_forces
+from poro2d.dem.measure import coordination_number
+from poro2d.interop import lammps as lmp
+from poro2d.interop.lammps_run import parse_thermo, read_dump, read_result_line, run_script, version_from_log
+from poro2d.interop.specimen_data import BOX_WALLS, SpecimenData
+
+#: quantities compared, as (key, label) pairs
+QUANTITIES = (
+    ("f_top_n_per_m", "F_top (N/m)"),
+    ("f_bottom_n_per_m", "F_bottom (N/m)"),
+    ("side_friction_up_n_per_m", "side-wall friction up (N/m)"),
+    ("mean_contact_force_n", "mean contact force (N)"),
+    ("coordination_number", "coordination number"),
+)
+
+
+def run_poro2d(spec: SpecimenData, ratio: float, max_steps: int) -> dict:
+    """poro2d from the exported state: disks at rest, no history; cycled until ``ratio``."""
+    sim = spec.to_simulation(dt=spec.dt)
+    t0 = time.perf_counter()
+    res = sim.solve(ratio, max_steps)
+    out = _named_forces(wall_forces(sim))
+    mags = sim.contacts().magnitude
+    out.update(
+        mean_contact_force_n=float(mags.mean()) if mags.size else 0.0,
+        coordination_number=coordination_number(sim),
+        contacts=int(mags.size),
+        steps=res.steps,
+        converged=res.converged,
+        max_ratio=res.max_ratio,
+        seconds=time.perf_counter() - t0,
+    )
+    return out
+
+
+def _named_forces(forces: dict) -> dict:
+    keys = ("f_top_n_per_m", "f_bottom_n_per_m", "side_friction_up_n_per_m")
+    return {k: float(forces[k]) for k in keys}
+
+
+def run_lammps(spec: SpecimenData, workdir: str | os.PathLike, ratio: float, max_steps: int) -> dict:
+    """LAMMPS on the exported files in ``workdir``, run as written but for the stop ratio and step cap."""
+    wd = Path(workdir)
+    lmp.write_specimen(spec, wd, ratio=ratio, max_steps=max_steps)
+    t0 = time.perf_counter()
+    log = run_script(wd, lmp.INPUT_FILE)
+    seconds = time.perf_counter() - t0
+    res = read_result_line(log)
+    pairs = read_dump(wd / lmp.FINAL_CONTACTS)
+    fn, ft = pairs["c_pl[1]"], pairs["c_pl[2]"]
+    touching = fn > 0.0
+    mags = [np.hypot(fn[touching], ft[touching])]
+    disks = read_dump(wd / lmp.FINAL_DISKS)
+    for w in BOX_WALLS:
+        on = disks[f"f_w_{w}[1]"] > 0.0
+        mags.append(np.hypot(disks[f"f_w_{w}[2]"][on], disks[f"f_w_{w}[3]"][on]))
+    allm = np.concatenate(mags)
+    head, rows = parse_thermo(log)[-1]
+    return {
+        "f_top_n_per_m": res["f_top"],
+        "f_bottom_n_per_m": res["f_bottom"],
+        "side_friction_up_n_per_m": res["side_friction_up"],
+        "mean_contact_force_n": float(allm.mean()) if allm.size else 0.0,
+        "coordination_number": res["coordination"],
+        "contacts": int(allm.size),
+        "steps": int(rows[-1][head.index("Step")]),
+        "converged": res["ratio"] < ratio,
+        "max_ratio": res["ratio"],
+        "seconds": seconds,
+        "lammps_version": version_from_log(log),
+    }
+
+
+def compare(spec: SpecimenData, ratio: float = 1e-5, max_steps: int = 2_000_000,
+            workdir: str | os.PathLike | None = None) -> dict:  # fmt: skip
+    """Run both engines from the same state; their results and relative differences.
+
+    ``rel_diff[key]`` is |LAMMPS - poro2d| / |poro2d|; for the wall forces also
+    ``rel_to_weight[key]``, the difference over the self weight G (F_top of an accepted
+    specimen is below 1 % of G, so its own relative difference is a small number over
+    a small number).
+    """
+    if workdir is None:
+        with tempfile.TemporaryDirectory(prefix="poro2d_lmp_") as tmp:
+            return compare(spec, ratio, max_steps, tmp)
+    ours = run_poro2d(spec, ratio, max_steps)
+    theirs = run_lammps(spec, workdir, ratio, max_steps)
+    weight = spec.weight_per_thickness()
+    rel, relg = {}, {}
+    for key, _ in QUANTITIES:
+        a, b = theirs[key], ours[key]
+        rel[key] = abs(a - b) / abs(b) if b != 0.0 else (0.0 if a == 0.0 else float("inf"))
+        if key.endswith("_n_per_m"):
+            relg[key] = abs(a - b) / weight
+    return {
+        "disks": spec.n,
+        "weight_n_per_m": weight,
+        "ratio": ratio,
+        "poro2d": ours,
+        "lammps": theirs,
+        "rel_diff": rel,
+        "rel_to_weight": relg,
+    }

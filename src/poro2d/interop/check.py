@@ -1,0 +1,146 @@
+"""The criterion's check on a specimen brought in from elsewhere, as it stands.
+
+The specimen (a CSV pair, a LAMMPS data file or a poro2d checkpoint) is put in the
+paper's box (:func:`poro2d.specimen.compaction.make_walls`: bottom, sides and the top
+plate at the top of its box, moved so that the box starts at the origin), with its disks
+at rest and no contact history. It is cycled to equilibrium with the plate fixed; then
+F_top, F_bottom and the side walls' upward friction are measured and the window of
+Fig. 3 is tested: 0 < F_top < 1 % of the self weight G. When the specimen fails it, the
+criterion's own plate servo (``PorosityCriterion._move_plate``) finds where the plate
+would settle, and so the porosity n' the box would have there.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import asdict
+from pathlib import Path
+
+import numpy as np
+
+from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion, in_window, wall_forces
+from poro2d.dem import ContactModel, Particles, Simulation
+from poro2d.errors import InputError
+from poro2d.interop import csv_table
+from poro2d.interop import lammps as lmp
+from poro2d.interop.specimen_data import BOX_WALLS, SpecimenData, from_checkpoint
+from poro2d.specimen.compaction import SpecimenSpec, box_porosity, make_walls
+
+#: values for what a file does not say (a LAMMPS data file of another origin): Table 1
+_TABLE1 = SpecimenSpec()
+DEFAULTS = {
+    "thickness": _TABLE1.thickness,
+    "density": _TABLE1.solid_density,
+    "kn": _TABLE1.kn_particle,
+    "ks": _TABLE1.ks_particle,
+    "mu": _TABLE1.friction_particle,
+    "wall_kn": _TABLE1.kn_wall,
+    "wall_ks": _TABLE1.ks_wall,
+    "wall_mu": _TABLE1.friction_wall,
+    "gravity": _TABLE1.gravity,
+    "local_damping": _TABLE1.local_damping,
+}
+
+
+def read_specimen(path: str | os.PathLike, defaults: dict | None = None) -> SpecimenData:
+    """A specimen from a CSV table (``disks.csv`` or its folder), a LAMMPS data file or a checkpoint."""
+    d = dict(DEFAULTS, **(defaults or {}))
+    p = Path(path)
+    if not p.exists():
+        raise InputError("FILE", str(p), "an existing disks.csv, LAMMPS data file, checkpoint or folder")
+    if p.is_dir():
+        if (p / csv_table.DISKS_FILE).is_file():
+            return csv_table.read_specimen(p, d)
+        if (p / lmp.DATA_FILE).is_file():
+            return lmp.read_specimen(p / lmp.DATA_FILE, d)
+        return from_checkpoint(p)
+    if p.suffix == ".csv":
+        return csv_table.read_specimen(p, d)
+    if p.suffix == ".npz":
+        return from_checkpoint(p)
+    return lmp.read_specimen(p, d)
+
+
+def box_spec(spec: SpecimenData, ratio: float) -> SpecimenSpec:
+    """The SpecimenSpec of the imported box: its size, the disks' and walls' properties."""
+    xlo, xhi, ylo, yhi = spec.box()
+    walls = {w.name: w for w in spec.walls}
+    props = {(w.kn, w.ks, w.mu) for name, w in walls.items() if name in BOX_WALLS}
+    if len(props) != 1:
+        raise InputError("walls", sorted(props), "one set of (kn, ks, mu) for the four box walls")
+    kw, sw, mw = props.pop()
+    return SpecimenSpec(
+        width=xhi - xlo, height=yhi - ylo, thickness=spec.thickness,
+        solid_density=float(np.sum(spec.density * spec.radius**2) / np.sum(spec.radius**2)),
+        kn_particle=float(spec.kn.max()), ks_particle=float(spec.ks.max()), kn_wall=kw, ks_wall=sw,
+        friction_wall=mw, friction_particle=float(spec.mu.max()), ratio=ratio,
+        local_damping=spec.local_damping, gravity=float(np.hypot(*spec.gravity)),
+    )  # fmt: skip
+
+
+def build_simulation(spec: SpecimenData, box: SpecimenSpec, threads: int = 1) -> Simulation:
+    """The disks at rest, no contact history, in the paper's box moved to the origin."""
+    xlo, _, ylo, _ = spec.box()
+    p = Particles(
+        np.column_stack([spec.x - xlo, spec.y - ylo]), spec.radius, spec.density, spec.thickness,
+        spec.kn, spec.ks, spec.mu,
+    )  # fmt: skip
+    return Simulation(
+        p, make_walls(box, box.height), ContactModel("per_body"), gravity=(0.0, -box.gravity),
+        local_damping=box.local_damping, dt=spec.dt, threads=threads,
+    )  # fmt: skip
+
+
+def check_specimen(
+    spec: SpecimenData, settings: CriterionSettings | None = None, ratio: float = 1e-3,
+    max_steps: int = 400_000, threads: int = 1, progress: bool = False, at_equilibrium=None,
+) -> tuple[Simulation, dict]:  # fmt: skip
+    """Cycle ``spec`` to equilibrium with the plate fixed and test the window of Fig. 3.
+
+    Returns the simulation (at equilibrium, or after the plate servo for a specimen
+    that fails) and the report: the wall forces (N/m), G, whether it passes, and for a
+    failing specimen where the plate settles and the porosity n' of that box.
+    ``at_equilibrium(sim, report)``, if given, is called before the plate moves (to
+    save the state as it stood).
+    """
+    settings = settings or CriterionSettings()
+    box = box_spec(spec, ratio)
+    xlo, _, ylo, _ = spec.box()
+    sim = build_simulation(spec, box, threads)
+    t0 = time.perf_counter()
+    res = sim.solve(ratio, max_steps, progress="equilibrium" if progress else False)
+    n_box = box_porosity(sim, box.width, box.height)
+    weight = box.self_weight(n_box)
+    forces = wall_forces(sim)
+    passes = bool(res.converged and in_window(forces["f_top_n_per_m"], weight, settings.force_fraction))
+    report = {
+        "source": spec.source,
+        "disks": spec.n,
+        "box_m": {"width": box.width, "height": box.height, "moved_by": [0.0 - xlo, 0.0 - ylo]},
+        "box_porosity": n_box,
+        "self_weight_n_per_m": weight,
+        "force_limit_n_per_m": settings.force_fraction * weight,
+        **forces,
+        "equilibrium": {"steps": res.steps, "max_ratio": res.max_ratio, "converged": res.converged},
+        "passes": passes,
+        "time_s": time.perf_counter() - t0,
+        "specimen": box.to_dict(),
+        "criterion_settings": asdict(settings),
+    }
+    if at_equilibrium is not None:
+        at_equilibrium(sim, report)
+    if passes or not res.converged:
+        return sim, report
+    # the criterion's plate servo; it reads only the box, the ratio and the settings
+    crit = PorosityCriterion(box, grading=None, settings=settings, progress=progress)  # type: ignore[arg-type]
+    plate = crit._move_plate(sim, n_box, weight)
+    after = wall_forces(sim)
+    report["plate"] = {
+        **plate,
+        "moved": "down" if forces["f_top_n_per_m"] <= 0.0 else "up",
+        "new_porosity": box_porosity(sim, box.width, plate["plate_height_m"]),
+        "f_top_after_n_per_m": after["f_top_n_per_m"],
+        "f_bottom_after_n_per_m": after["f_bottom_n_per_m"],
+    }
+    return sim, report

@@ -1,0 +1,511 @@
+"""LAMMPS: a data file of the disks and an input script of the same model.
+
+Translation of poro2d's model into LAMMPS (``units si``, ``dimension 2``, GRANULAR package):
+
+* ``atom_style sphere``: LAMMPS sets ``mass = 4/3 pi r^3 density`` even in 2D, so each
+  atom gets the density ``3 rho t / (4 r)`` (:func:`lammps_density`), which gives the
+  disk mass ``rho pi r^2 t``; ``fix nve/sphere disc`` uses the disk inertia ``m r^2 / 2``.
+* ``pair_style gran/hooke/history Kn Kt gamma_n gamma_t xmu dampflag``: for the Hookean
+  styles Kn and Kt are plain springs in N/m, as in PFC; the per-body stiffnesses of PFC
+  4.0 are combined in series beforehand, the friction is min(mu_a, mu_b). gamma_n is a
+  negligible positive value (:data:`GAMMA_TINY`): the model has no viscous damping, and
+  with a normal damping of exactly 0 LAMMPS gives NaN at the first wall contact.
+* walls: one ``fix wall/gran hooke/history`` per wall (``xplane``/``yplane``, the other
+  side NULL), with the disk-wall contact properties; the plate is a plane fixed at its
+  height. ``contacts`` makes each fix report the force on every disk it touches.
+* local damping: ``fix damping/cundall a a`` reduces each force and torque component by
+  ``a |F| sign(v)``, PFC's local damping. It comes after ``fix gravity`` so the weight is
+  part of the damped unbalanced force, as in PFC and poro2d, and ``fix store/force``
+  just before it keeps the undamped unbalanced force for the stop test.
+
+The stop test of the exported script is PFC's ratio: the largest unbalanced force over the
+largest contact force (for disk-disk contacts the normal force stands for the magnitude,
+since LAMMPS reduces one column at a time), checked every ``check_every`` steps by
+``fix halt``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from poro2d import __version__
+from poro2d.errors import InputError
+from poro2d.interop.specimen_data import BOX_WALLS, SpecimenData, WallData
+
+# positive stand-in for "no normal dashpot" (1/s, times the effective mass)
+GAMMA_TINY = 1e-9
+
+#: files the exported script reads and writes, in its folder
+DATA_FILE = "specimen.data"
+INPUT_FILE = "in.specimen"
+FINAL_DISKS = "final_disks.dump"
+FINAL_CONTACTS = "final_contacts.dump"
+
+#: quantities the script prints on its last line, ``poro2d-result key value ...``
+RESULT_KEYS = ("ratio", "f_top", "f_bottom", "side_friction_up", "f_left", "f_right", "coordination")
+
+#: wall fix of each box wall: (plane style, which side is given)
+_PLANES = {"bottom": ("yplane", 0), "top": ("yplane", 1), "left": ("xplane", 0), "right": ("xplane", 1)}
+
+
+def disk_mass(radius, density, thickness: float) -> np.ndarray:
+    """Mass of disks of thickness ``t``: ``rho pi r^2 t``."""
+    r = np.asarray(radius, dtype=float)
+    return np.asarray(density, dtype=float) * math.pi * r * r * thickness
+
+
+def lammps_density(radius, density, thickness: float) -> np.ndarray:
+    """Per-atom density that makes LAMMPS' ``4/3 pi r^3 density`` the disk mass ``rho pi r^2 t``."""
+    return 3.0 * np.asarray(density, dtype=float) * thickness / (4.0 * np.asarray(radius, dtype=float))
+
+
+def critical_dt(radius, density: float, thickness: float, kn_max: float, factor: float = 0.2) -> float:
+    """Time step ``factor * sqrt(m_min / kn_max)``."""
+    m_min = float(disk_mass(np.min(radius), density, thickness))
+    return factor * math.sqrt(m_min / kn_max)
+
+
+# ------------------------------------------------------------------ data file
+
+
+def write_data(
+    path: str | os.PathLike, x, y, radius, density, thickness: float, box, margin: float,
+    title: str = "poro2d disks", comments: list[str] | None = None,
+) -> None:  # fmt: skip
+    """A LAMMPS data file (``atom_style sphere``) of disks of thickness ``thickness``.
+
+    ``box`` is (xlo, xhi, ylo, yhi); the simulation box is larger by ``margin`` on each
+    side, and spans ``-t/2 .. t/2`` in z. ``comments`` are written below the title as
+    ``#`` lines. Every number is written with ``repr``: it reads back to the same float.
+    """
+    x, y, radius = (np.asarray(a, dtype=float) for a in (x, y, radius))
+    dens = lammps_density(radius, density, thickness)
+    xlo, xhi, ylo, yhi = map(float, box)
+    zt = 0.5 * thickness
+    lines = [title, *(comments or []), ""]
+    lines += [f"{x.size} atoms", "1 atom types", ""]
+    lines += [
+        f"{xlo - margin!r} {xhi + margin!r} xlo xhi",
+        f"{ylo - margin!r} {yhi + margin!r} ylo yhi",
+        f"{-zt!r} {zt!r} zlo zhi",
+        "",
+        "Atoms # sphere",
+        "",
+    ]
+    body = [
+        f"{i + 1} 1 {2.0 * float(radius[i])!r} {float(dens[i])!r} {float(x[i])!r} {float(y[i])!r} 0"
+        for i in range(x.size)
+    ]
+    Path(path).write_text("\n".join(lines + body) + "\n")
+
+
+@dataclass
+class DataFile:
+    """What a LAMMPS data file of disks holds: centres, radii, masses, box, and poro2d's notes."""
+
+    x: np.ndarray
+    y: np.ndarray
+    radius: np.ndarray
+    mass: np.ndarray
+    box: tuple[float, float, float, float]
+    zspan: float
+    notes: list[tuple[str, list[str]]]
+
+
+def read_data(path: str | os.PathLike) -> DataFile:
+    """Read a LAMMPS data file of ``atom_style sphere`` (id type diameter density x y z [images]).
+
+    Any other section (Velocities, ...) is skipped. Lines written by :func:`write_specimen`
+    as ``# poro2d <key> <values>`` are returned in ``notes``. A malformed line is an
+    InputError naming the file, the line and the column.
+    """
+    p = Path(path)
+    try:
+        text = p.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError("LAMMPS data file", str(p), "a readable text file", str(exc)) from None
+    lines = text.splitlines()
+    notes: list[tuple[str, list[str]]] = []
+    header: dict = {}
+    atoms: list[tuple[int, list[float]]] = []
+    section = None
+    for k, raw in enumerate(lines[1:], start=2):
+        if raw.startswith("# poro2d "):
+            key, *vals = raw[len("# poro2d ") :].split() or [""]
+            notes.append((key, vals))
+        line = raw.split("#", 1)[0].strip()
+        if not line:
+            continue
+        words = line.split()
+        if words[0][0].isalpha():  # a section title: Atoms, Velocities, Masses, ...
+            section = words[0]
+            continue
+        if section is None:
+            _header_line(p, k, words, header)
+        elif section == "Atoms":
+            atoms.append((k, _numbers(p, k, words, 7, 10)))
+    n = int(header.get("atoms", -1))
+    if n < 0 or "xlo" not in header or "ylo" not in header:
+        raise InputError(f"{p}", "header", "a LAMMPS data file with 'N atoms', 'xlo xhi' and 'ylo yhi' lines")
+    if len(atoms) != n:
+        raise InputError(f"{p} Atoms section", f"{len(atoms)} lines", f"{n} lines, as the header says")
+    a = np.array([v[:7] for _, v in atoms])
+    order = np.argsort(a[:, 0], kind="stable")
+    a = a[order]
+    diam, dens = a[:, 2], a[:, 3]
+    for col, name, arr in ((3, "diameter", diam), (4, "density", dens)):
+        bad = np.flatnonzero(~(arr > 0.0) | ~np.isfinite(arr))
+        if bad.size:
+            k = atoms[order[bad[0]]][0]
+            raise InputError(f"{p} line {k} column {col}", float(arr[bad[0]]), f"a positive {name}")
+    r = 0.5 * diam
+    zlo, zhi = header.get("zlo", (-0.5, 0.5))
+    return DataFile(
+        x=a[:, 4].copy(), y=a[:, 5].copy(), radius=r, mass=4.0 / 3.0 * math.pi * r**3 * dens,
+        box=(*header["xlo"], *header["ylo"]), zspan=zhi - zlo, notes=notes,
+    )  # fmt: skip
+
+
+def _header_line(p: Path, k: int, words: list[str], header: dict) -> None:
+    """One line of the header: ``N atoms``, ``lo hi xlo xhi``, ...; other keywords are ignored."""
+    if words[-2:] in (["xlo", "xhi"], ["ylo", "yhi"], ["zlo", "zhi"]):
+        header[words[-2]] = tuple(_numbers(p, k, words[:2], 2, 2))
+    elif words[-1] == "atoms" and len(words) == 2:
+        v = _numbers(p, k, words[:1], 1, 1)[0]
+        if v != int(v) or v < 1:
+            raise InputError(f"{p} line {k} column 1", words[0], "a positive whole number of atoms")
+        header["atoms"] = int(v)
+
+
+def _numbers(p: Path, k: int, words: list[str], lo: int, hi: int) -> list[float]:
+    if not lo <= len(words) <= hi:
+        raise InputError(
+            f"{p} line {k}", " ".join(words), f"{lo} to {hi} numbers" if lo != hi else f"{lo} numbers"
+        )
+    out = []
+    for c, w in enumerate(words, start=1):
+        try:
+            v = float(w)
+        except ValueError:
+            raise InputError(f"{p} line {k} column {c}", w, "a number") from None
+        if not math.isfinite(v):
+            raise InputError(f"{p} line {k} column {c}", w, "a finite number")
+        out.append(v)
+    return out
+
+
+# ------------------------------------------------------------------ input script
+
+
+@dataclass
+class WallFix:
+    """One ``fix wall/gran`` plane: its fix id, ``xplane``/``yplane``, lo and hi (None: NULL)."""
+
+    fix_id: str
+    style: str
+    lo: float | None
+    hi: float | None
+    kn: float
+    kt: float
+    mu: float
+    contacts: bool = True
+
+    def command(self, law: str = "granular") -> str:
+        lo = "NULL" if self.lo is None else repr(float(self.lo))
+        hi = "NULL" if self.hi is None else repr(float(self.hi))
+        model = contact_law(law, self.kn, self.kt, self.mu)
+        tail = " contacts" if self.contacts else ""
+        return f"fix             {self.fix_id} all wall/gran {model} {self.style} {lo} {hi}{tail}"
+
+
+def contact_law(law: str, kn: float, kt: float, mu: float) -> str:
+    """The arguments of a linear spring-slider contact for ``pair_coeff``/``fix wall/gran``.
+
+    ``granular``: the sub-model syntax (``hooke kn 0 tangential linear_history kt 0 mu
+    damping mass_velocity``), without viscous damping; its shear spring is rotated with
+    the contact and keeps its length, as poro2d's shear force does. ``classic``: the
+    older ``hooke/history`` form (a vector projected on the contact plane, not rescaled),
+    with a negligible normal dashpot.
+    """
+    if law == "granular":
+        return (f"granular hooke {float(kn)!r} 0 tangential linear_history {float(kt)!r} 0 {float(mu)!r} "
+                "damping mass_velocity")  # fmt: skip
+    return f"hooke/history {float(kn)!r} {float(kt)!r} {GAMMA_TINY!r} {GAMMA_TINY!r} {float(mu)!r} 0"
+
+
+def model_commands(
+    data: str, pp: tuple[float, float, float], walls: list[WallFix], dt: float, skin: float,
+    gravity: tuple[float, float], damping: float, processors: str | None = None, store_force: bool = False,
+    law: str = "granular",
+) -> str:  # fmt: skip
+    """The model part of a script: settings, disks, contact law, walls, gravity, damping, integration.
+
+    ``pp`` is the disk-disk (kn, kt, mu) at contact level; ``gravity`` the (gx, gy) vector.
+    With ``store_force`` the undamped unbalanced force is kept in ``f_unbal``.
+    """
+    g = math.hypot(*gravity)
+    gvec = (gravity[0] / g, gravity[1] / g) if g > 0 else (0.0, -1.0)
+    if law == "granular":
+        pair_style, pair_coeff = "granular", contact_law(law, *pp).split(" ", 1)[1]
+    else:
+        pair_style, pair_coeff = "gran/" + contact_law(law, *pp), ""
+    s = [
+        "units           si",
+        "dimension       2",
+        "boundary        f f p",
+        "atom_style      sphere",
+        "atom_modify     map array",
+        "comm_modify     vel yes",
+        "newton          off",
+    ]
+    if processors:
+        s.append(f"processors      {processors}")
+    s += [
+        f"read_data       {data}",
+        "",
+        f"neighbor        {float(skin)!r} bin",
+        "neigh_modify    delay 0 every 1 check yes",
+        "",
+        f"pair_style      {pair_style}",
+        f"pair_coeff      * * {pair_coeff}".rstrip(),
+        "",
+        f"timestep        {float(dt)!r}",
+        "",
+        "fix             integ all nve/sphere disc",
+        *(w.command(law) for w in walls),
+        f"fix             grav all gravity {g!r} vector {gvec[0]!r} {gvec[1]!r} 0",
+        "fix             e2d all enforce2d",
+    ]
+    if store_force:
+        s.append("fix             unbal all store/force")
+    if damping > 0:
+        s.append(f"fix             damp all damping/cundall {float(damping)!r} {float(damping)!r}")
+    return "\n".join(s) + "\n"
+
+
+def box_wall_fixes(spec: SpecimenData) -> list[WallFix]:
+    """One plane per box wall, at its face, with that wall's disk-wall contact properties."""
+    box = spec.box()
+    params = spec.contact_parameters()
+    faces = {"left": box[0], "right": box[1], "bottom": box[2], "top": box[3]}
+    extra = [w.name for w in spec.walls if w.name not in BOX_WALLS]
+    if extra:
+        raise InputError("walls", [w.name for w in spec.walls], "the four walls of a box (LAMMPS planes)")
+    fixes = []
+    for name in BOX_WALLS:
+        style, side = _PLANES[name]
+        lo, hi = (faces[name], None) if side == 0 else (None, faces[name])
+        kn, kt, mu = params[name]
+        fixes.append(WallFix(f"w_{name}", style, lo, hi, kn, kt, mu))
+    return fixes
+
+
+def input_script(
+    spec: SpecimenData, ratio: float = 1e-3, max_steps: int = 2_000_000, check_every: int = 500
+) -> str:
+    """The exported script: the specimen at rest, the plate fixed, cycled until the ratio is met.
+
+    Prints the unbalanced-force ratio, the wall forces per metre of thickness and the
+    coordination number as it runs, and writes the final disks and contacts.
+    """
+    if spec.dt is None:
+        raise InputError("time step", None, "the time step of the specimen (a poro2d checkpoint has one)")
+    t = spec.thickness
+    model = model_commands(
+        DATA_FILE, spec.contact_parameters()["pp"], box_wall_fixes(spec), spec.dt,
+        0.5 * float(spec.radius.min()), spec.gravity, spec.local_damping, store_force=True,
+    )  # fmt: skip
+    head = "\n".join(spec.header("#")) + "\n"
+    head += f"""# written by poro2d export --to lammps; run: lmp -in {INPUT_FILE}
+# disks start at rest with no shear force stored; the four walls are fixed planes, the
+# top plate at its height. The run stops when the ratio below is met (fix halt) or
+# after max_steps; override on the command line: lmp -in {INPUT_FILE} -var ratio_target 1e-5
+
+variable        ratio_target index {ratio!r}
+variable        max_steps index {int(max_steps)}
+variable        check_every index {int(check_every)}
+variable        thickness equal {t!r}
+
+"""
+    meas = f"""
+# ---- measurements (forces per metre of disk thickness, N/m, the paper's unit)
+compute         pl all pair/local force p4
+compute         cmax_pp all reduce max c_pl[1] inputs local
+variable        fu atom sqrt(f_unbal[1]^2+f_unbal[2]^2)
+compute         fumax all reduce max v_fu
+{_wall_sums()}
+variable        cmax equal {_largest(["c_cmax_pp", *(f"c_cmax_w_{w}" for w in BOX_WALLS)])}
+variable        ratio equal c_fumax/(v_cmax+1e-300)
+variable        f_top equal -c_fy_w_top/v_thickness
+variable        f_bottom equal c_fy_w_bottom/v_thickness
+variable        side_friction_up equal (c_fy_w_left+c_fy_w_right)/v_thickness
+variable        f_left equal c_fx_w_left/v_thickness
+variable        f_right equal -c_fx_w_right/v_thickness
+compute         zpp all contact/atom
+compute         zsum all reduce sum c_zpp
+variable        coordination equal (c_zsum+c_n_w_bottom+c_n_w_top+c_n_w_left+c_n_w_right)/atoms
+
+thermo_style    custom step time ke v_ratio v_f_top v_f_bottom v_side_friction_up v_coordination
+thermo_modify   norm no flush yes format float %.10g
+thermo          ${{check_every}}
+
+fix             stop all halt ${{check_every}} v_ratio < ${{ratio_target}} error continue
+run             ${{max_steps}}
+
+print           "poro2d-result {" ".join(f"{k} ${{{k}}}" for k in RESULT_KEYS)}"
+write_dump      all custom {FINAL_DISKS} id x y radius vx vy omegaz {_wall_columns()} &
+                modify sort id format float %.17g
+write_dump      all local {FINAL_CONTACTS} c_pl[1] c_pl[2] modify format float %.17g
+"""
+    return head + model + meas
+
+
+def _wall_columns() -> str:
+    """Dump columns of every wall's contact on a disk: in contact (1/0), force x, force y."""
+    return " ".join(f"f_w_{w}[{c}]" for w in BOX_WALLS for c in (1, 2, 3))
+
+
+def _largest(terms: list[str]) -> str:
+    """A LAMMPS formula for the largest of ``terms`` (its max() only takes vectors)."""
+    if len(terms) == 1:
+        return terms[0]
+    rest = _largest(terms[1:])
+    return f"ternary({terms[0]}>({rest}),{terms[0]},{rest})"
+
+
+def _wall_sums() -> str:
+    """Per wall: summed x and y force on the disks, contact count, largest contact force."""
+    out = []
+    for name in BOX_WALLS:
+        f = f"w_{name}"
+        out += [
+            f"variable        fx_{f} atom f_{f}[2]",
+            f"variable        fy_{f} atom f_{f}[3]",
+            f"variable        fm_{f} atom sqrt(f_{f}[2]^2+f_{f}[3]^2)",
+            f"variable        in_{f} atom f_{f}[1]",
+            f"compute         fx_{f} all reduce sum v_fx_{f}",
+            f"compute         fy_{f} all reduce sum v_fy_{f}",
+            f"compute         n_{f} all reduce sum v_in_{f}",
+            f"compute         cmax_{f} all reduce max v_fm_{f}",
+        ]
+    return "\n".join(out)
+
+
+def write_specimen(spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e-3,
+                   max_steps: int = 2_000_000, check_every: int = 500) -> list[Path]:  # fmt: skip
+    """Write ``specimen.data`` and ``in.specimen`` into ``out``; returns their paths.
+
+    The data file's comment lines record the thickness, the per-body properties of the
+    disks and every wall (``# poro2d ...``), so that ``poro2d import`` reads the
+    specimen back whole. Each file is written atomically.
+    """
+    from poro2d.io_utils import atomic_path
+
+    out = Path(out)
+    params = spec.contact_parameters()  # refuses disks of differing properties first
+    box = spec.box()
+    script = input_script(spec, ratio, max_steps, check_every)
+    notes = [
+        *spec.header("#"),
+        f"# poro2d thickness {spec.thickness!r}",
+        f"# poro2d disk_properties {float(spec.density[0])!r} {float(spec.kn[0])!r} "
+        f"{float(spec.ks[0])!r} {float(spec.mu[0])!r}",
+        f"# poro2d settings {spec.gravity[0]!r} {spec.gravity[1]!r} {spec.local_damping!r} {spec.dt!r}",
+        *(_wall_note(w) for w in spec.walls),
+        f"# pair contact kn ks mu: {params['pp'][0]!r} {params['pp'][1]!r} {params['pp'][2]!r}",
+    ]
+    paths = []
+    with atomic_path(out / DATA_FILE) as tmp:
+        write_data(
+            tmp, spec.x, spec.y, spec.radius, spec.density, spec.thickness, box,
+            margin=float(spec.radius.max()), title=f"poro2d {__version__} specimen (atom_style sphere)",
+            comments=notes,
+        )  # fmt: skip
+    paths.append(out / DATA_FILE)
+    with atomic_path(out / INPUT_FILE) as tmp:
+        tmp.write_text(script)
+    paths.append(out / INPUT_FILE)
+    return paths
+
+
+def _wall_note(w: WallData) -> str:
+    vals = " ".join(repr(float(v)) for v in (w.x0, w.y0, w.x1, w.y1, w.kn, w.ks, w.mu))
+    return f"# poro2d wall {w.name} {vals}"
+
+
+def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
+    """A specimen from a LAMMPS data file, with its box.
+
+    The disks' density, stiffness and friction, the walls and the run settings come from
+    the ``# poro2d`` notes of an exported file; a file without them takes ``defaults``
+    (keys: thickness, density, kn, ks, mu, wall_kn, wall_ks, wall_mu, gravity,
+    local_damping), its walls at the faces of its simulation box.
+    """
+    d = read_data(path)
+    notes = d.notes
+    keys = {k for k, _ in notes}
+    n = d.x.size
+    t = _note(notes, "thickness", 1, path)[0] if "thickness" in keys else float(defaults["thickness"])
+    if "disk_properties" in keys:
+        rho, kn, ks, mu = _note(notes, "disk_properties", 4, path)
+    else:
+        rho = None
+        kn, ks, mu = (float(defaults[k]) for k in ("kn", "ks", "mu"))
+    # the file's masses define the density; an exported file names it exactly
+    density = np.full(n, rho) if rho is not None else d.mass / (math.pi * d.radius**2 * t)
+    gravity, damping, dt = (0.0, -float(defaults["gravity"])), float(defaults["local_damping"]), None
+    if "settings" in keys:
+        gx, gy, damping, dt = _note(notes, "settings", 4, path)
+        gravity = (gx, gy)
+    walls = [WallData(name, *v) for name, v in _wall_notes(notes, path)]
+    if not walls:
+        xlo, xhi, ylo, yhi = d.box
+        kw = tuple(float(defaults[k]) for k in ("wall_kn", "wall_ks", "wall_mu"))
+        walls = box_walls(xlo, xhi, ylo, yhi, *kw)
+    return SpecimenData(
+        x=d.x, y=d.y, radius=d.radius, density=density, kn=np.full(n, kn), ks=np.full(n, ks),
+        mu=np.full(n, mu), thickness=t, walls=walls, gravity=gravity, local_damping=damping, dt=dt,
+        source=str(path),
+    )  # fmt: skip
+
+
+def box_walls(xlo, xhi, ylo, yhi, kn, ks, mu) -> list[WallData]:
+    """The four walls of a poro2d box (``Walls.box``: sides extended past the corners)."""
+    from poro2d.dem import Walls
+
+    w = Walls.box(xlo, ylo, xhi, yhi, kn, ks, mu)
+    return [
+        WallData(w.names[k], *map(float, (*w.p0[k], *w.p1[k], w.kn[k], w.ks[k], w.mu[k]))) for k in range(w.n)
+    ]
+
+
+def _note(notes: list, key: str, count: int, path) -> list[float]:
+    """The ``count`` numbers of the first ``# poro2d KEY ...`` line."""
+    vals = next(v for k, v in notes if k == key)
+    return _note_numbers(vals, count, f"{path} '# poro2d {key}' line")
+
+
+def _note_numbers(vals: list[str], count: int, where: str) -> list[float]:
+    try:
+        out = [float(v) for v in vals]
+    except ValueError:
+        out = []
+    if len(out) != count or not all(math.isfinite(v) for v in out):
+        raise InputError(where, " ".join(vals), f"{count} finite numbers")
+    return out
+
+
+def _wall_notes(notes: list, path) -> list[tuple[str, list[float]]]:
+    """The ``# poro2d wall NAME x0 y0 x1 y1 kn ks mu`` lines, in file order."""
+    out = []
+    for key, vals in notes:
+        if key == "wall":
+            if not vals:
+                raise InputError(f"{path} '# poro2d wall' line", "", "a name and 7 numbers")
+            out.append((vals[0], _note_numbers(vals[1:], 7, f"{path} '# poro2d wall {vals[0]}' line")))
+    return out

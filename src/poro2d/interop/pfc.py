@@ -1,0 +1,133 @@
+"""PFC2D: a command file for current PFC (5 and later) and one in the PFC 4.0 form.
+
+PFC2D treats a ball as a disk of unit thickness (1 m). To keep every mass as poro2d's
+``rho pi r^2 t``, the density written is ``rho t`` (kg/m^2 per metre of thickness); the
+stiffnesses are those of the disks, so the contact forces read in PFC are poro2d's, in
+N, and divided by ``t`` they give N/m, the paper's unit.
+
+* ``specimen.p2dat`` (PFC 5+): ``ball create id ... position (x,y) radius r``,
+  ``ball attribute density ... damp ... range id i``, ``wall create vertices ... id k
+  name '...'`` and the linear contact model with contact-level properties (PFC 5+
+  does not combine per-body values): springs in series, the smaller friction, as PFC
+  4.0 did, one set for ball-ball and one for ball-facet contacts.
+* ``specimen_pfc4.dat`` (PFC 4.0, the paper's code): ``ball id=i x=... y=... rad=...``
+  with ``property`` lines of the per-body values (density, kn, ks, friction) of Table 1
+  and ``wall id=k kn=... ks=... friction=... nodes (x0,y0) (x1,y1)``. The nodes of each
+  wall are as poro2d stores them: the specimen lies to the left when going from the
+  first node to the second.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from poro2d.errors import InputError
+from poro2d.interop.specimen_data import SpecimenData
+from poro2d.io_utils import atomic_path
+
+CURRENT_FILE = "specimen.p2dat"
+PFC4_FILE = "specimen_pfc4.dat"
+
+
+def _r(v) -> str:
+    return repr(float(v))
+
+
+def current_commands(spec: SpecimenData, ratio: float = 1e-3) -> str:
+    """The PFC 5+ command file (``;`` comments)."""
+    params = spec.contact_parameters()  # refuses disks of differing properties
+    wall_sets = {params[w.name] for w in spec.walls}
+    if len(wall_sets) > 1:
+        raise InputError(
+            "walls", [w.name for w in spec.walls],
+            "walls of one set of properties (one ball-facet contact model in PFC 5+)",
+        )  # fmt: skip
+    box = _extent(spec)
+    t = spec.thickness
+    lines = [
+        *spec.header(";"),
+        "; PFC2D 5+: balls are disks of unit thickness; density below = rho * t so that mass = rho pi r^2 t",
+        "model new",
+        f"model domain extent {_r(box[0])} {_r(box[1])} {_r(box[2])} {_r(box[3])}",
+        f"model gravity {_r(spec.gravity[0])} {_r(spec.gravity[1])}",
+    ]
+    lines += [
+        f"ball create id {i + 1} position ({_r(spec.x[i])},{_r(spec.y[i])}) radius {_r(spec.radius[i])}"
+        for i in range(spec.n)
+    ]
+    lines += [
+        f"ball attribute density {_r(spec.density[i] * t)} damp {_r(spec.local_damping)} range id {i + 1}"
+        for i in range(spec.n)
+    ]
+    for k, w in enumerate(spec.walls, start=1):
+        lines.append(
+            f"wall create vertices {_r(w.x0)} {_r(w.y0)} {_r(w.x1)} {_r(w.y1)} id {k} name '{w.name}'"
+        )
+    kn, ks, mu = params["pp"]
+    lines.append(
+        f"contact cmat default type 'ball-ball' model 'linear' property kn {_r(kn)} ks {_r(ks)} fric {_r(mu)}"
+    )
+    if spec.walls:
+        kn, ks, mu = params[spec.walls[0].name]
+        lines.append(
+            f"contact cmat default type 'ball-facet' model 'linear' property kn {_r(kn)} ks {_r(ks)} "
+            f"fric {_r(mu)}"
+        )
+    if spec.dt:
+        lines.append(f"model mechanical timestep fix {_r(spec.dt)}")
+    lines += [
+        "; every wall, the top plate included, stays where it is: cycle to equilibrium",
+        f"model solve ratio {_r(ratio)}",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def pfc4_commands(spec: SpecimenData) -> str:
+    """The PFC 4.0 command file: per-body properties, as in the paper's Table 1."""
+    t = spec.thickness
+    lines = [
+        *spec.header(";"),
+        "; PFC2D 4.0: 'set disk on' makes balls disks of unit thickness; density = rho * t",
+        "new",
+        "set disk on",
+        f"set gravity {_r(spec.gravity[0])} {_r(spec.gravity[1])}",
+    ]
+    lines += [
+        f"ball id={i + 1} x={_r(spec.x[i])} y={_r(spec.y[i])} rad={_r(spec.radius[i])}" for i in range(spec.n)
+    ]
+    lines += [
+        f"property density={_r(spec.density[i] * t)} kn={_r(spec.kn[i])} ks={_r(spec.ks[i])} "
+        f"friction={_r(spec.mu[i])} range id={i + 1}"
+        for i in range(spec.n)
+    ]
+    lines.append(f"damp local {_r(spec.local_damping)}")
+    for k, w in enumerate(spec.walls, start=1):
+        lines.append(
+            f"wall id={k} kn={_r(w.kn)} ks={_r(w.ks)} friction={_r(w.mu)} "
+            f"nodes ({_r(w.x0)},{_r(w.y0)}) ({_r(w.x1)},{_r(w.y1)}) ; {w.name}"
+        )
+    lines.append("; every wall, the top plate included, stays where it is: cycle to equilibrium")
+    lines.append("solve ratio=1e-3")
+    return "\n".join(lines) + "\n"
+
+
+def _extent(spec: SpecimenData) -> tuple[float, float, float, float]:
+    """A model domain holding every disk and wall, with a margin of a largest diameter."""
+    xs = np.concatenate([spec.x - spec.radius, spec.x + spec.radius, *[[w.x0, w.x1] for w in spec.walls]])
+    ys = np.concatenate([spec.y - spec.radius, spec.y + spec.radius, *[[w.y0, w.y1] for w in spec.walls]])
+    m = 2.0 * float(spec.radius.max())
+    return float(xs.min()) - m, float(xs.max()) + m, float(ys.min()) - m, float(ys.max()) + m
+
+
+def write_specimen(spec: SpecimenData, out: str | os.PathLike) -> list[Path]:
+    """Write ``specimen.p2dat`` and ``specimen_pfc4.dat`` into ``out`` (atomically)."""
+    out = Path(out)
+    paths = []
+    for name, text in ((CURRENT_FILE, current_commands(spec)), (PFC4_FILE, pfc4_commands(spec))):
+        with atomic_path(out / name) as tmp:
+            tmp.write_text(text)
+        paths.append(out / name)
+    return paths

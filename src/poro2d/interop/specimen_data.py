@@ -1,0 +1,218 @@
+"""A specimen as plain numbers: what every export writes and every import reads.
+
+:class:`SpecimenData` holds the disks (centre, radius and the per-body properties of
+PFC 4.0: density, kn, ks, friction), the wall segments with their own per-body
+properties, the disk thickness and the run settings another code needs to continue
+from the same state (gravity, local damping, time step). Velocities, spins and the
+contact history are not part of it: an exported specimen starts at rest with no shear
+force stored, in any code (see docs/export.md).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from poro2d import __version__
+from poro2d.dem import ContactModel, Particles, Simulation, Walls, checkpoint
+from poro2d.errors import InputError
+
+#: names of the walls of a poro2d box (``Walls.box``), in that order
+BOX_WALLS = ("bottom", "right", "top", "left")
+
+
+@dataclass
+class WallData:
+    """One wall segment from (x0, y0) to (x1, y1) with its per-body kn, ks (N/m) and friction."""
+
+    name: str
+    x0: float
+    y0: float
+    x1: float
+    y1: float
+    kn: float
+    ks: float
+    mu: float
+
+    @property
+    def horizontal(self) -> bool:
+        return self.y0 == self.y1 and self.x0 != self.x1
+
+    @property
+    def vertical(self) -> bool:
+        return self.x0 == self.x1 and self.y0 != self.y1
+
+
+@dataclass
+class SpecimenData:
+    """Disks and walls of a specimen, in SI units; arrays have one entry per disk."""
+
+    x: np.ndarray
+    y: np.ndarray
+    radius: np.ndarray
+    density: np.ndarray
+    kn: np.ndarray
+    ks: np.ndarray
+    mu: np.ndarray
+    thickness: float
+    walls: list[WallData] = field(default_factory=list)
+    gravity: tuple[float, float] = (0.0, -9.81)
+    local_damping: float = 0.7
+    dt: float | None = None
+    contact: str = "per_body"
+    source: str = ""
+
+    @property
+    def n(self) -> int:
+        return int(self.x.shape[0])
+
+    @property
+    def mass(self) -> np.ndarray:
+        """Disk masses rho pi r^2 t (kg)."""
+        return self.density * math.pi * self.radius**2 * self.thickness
+
+    def wall(self, name: str) -> WallData:
+        for w in self.walls:
+            if w.name == name:
+                return w
+        raise InputError("wall", name, f"one of {[w.name for w in self.walls]}")
+
+    def box(self) -> tuple[float, float, float, float]:
+        """(xlo, xhi, ylo, yhi): the inner faces of the four box walls.
+
+        Refused (InputError) unless the walls are a poro2d box: a horizontal bottom and
+        top, a vertical left and right, the top above the bottom and the right of the left.
+        """
+        names = [w.name for w in self.walls]
+        if not set(BOX_WALLS) <= set(names):
+            raise InputError("walls", names, f"a box of walls named {', '.join(BOX_WALLS)}")
+        b, r, t, lf = (self.wall(k) for k in BOX_WALLS)
+        if not (b.horizontal and t.horizontal and r.vertical and lf.vertical):
+            raise InputError("walls", names, "a box: horizontal bottom and top, vertical left and right")
+        box = (lf.x0, r.x0, b.y0, t.y0)
+        if not (box[1] > box[0] and box[3] > box[2]):
+            raise InputError("box", box, "xlo < xhi and ylo < yhi (left of right, bottom below top)")
+        return box
+
+    def weight_per_thickness(self) -> float:
+        """Self weight of the disks per metre of thickness (N/m): the paper's G."""
+        g = math.hypot(*self.gravity)
+        return float(np.sum(self.mass)) * g / self.thickness
+
+    def contact_parameters(self) -> dict:
+        """The contact-level (kn, ks, mu) of disk-disk contacts and of each wall's contacts.
+
+        PFC 4.0 (``per_body``): springs in series, kn = kA kB / (kA + kB), the smaller
+        friction. Engines that take one value per contact type need every disk alike:
+        refused otherwise, naming the property that varies.
+        """
+        for name in ("kn", "ks", "mu", "density"):
+            a = getattr(self, name)
+            if self.n and np.ptp(a) != 0.0:
+                raise InputError(
+                    f"disk {name}", f"from {a.min():g} to {a.max():g}",
+                    "one value for every disk (the target takes one set of contact properties)",
+                )  # fmt: skip
+        kn, ks, mu = float(self.kn[0]), float(self.ks[0]), float(self.mu[0])
+        out = {"pp": (series(kn, kn), series(ks, ks), mu)}
+        for w in self.walls:
+            out[w.name] = (series(kn, w.kn), series(ks, w.ks), min(mu, w.mu))
+        return out
+
+    def header(self, comment: str) -> list[str]:
+        """Lines that every exported file starts with: units, thickness convention, version."""
+        lines = [
+            f"poro2d {__version__} specimen: {self.n} disks, {len(self.walls)} walls",
+            "units: SI (m, kg, s, N); stiffness N/m; friction coefficients",
+            f"disk thickness t = {self.thickness!r} m: disk mass rho pi r^2 t, inertia m r^2 / 2",
+            "contact properties per body (PFC 4.0): kn = kA kB / (kA + kB), ks likewise, mu = min(muA, muB)",
+            f"gravity {self.gravity[0]!r} {self.gravity[1]!r} m/s2; local damping {self.local_damping!r}"
+            + (f"; time step {self.dt!r} s" if self.dt else ""),
+        ]
+        if self.source:
+            lines.append(f"from {self.source}")
+        return [f"{comment} {ln}" for ln in lines]
+
+    def to_simulation(self, dt: float | None = None, threads: int = 1) -> Simulation:
+        """A poro2d Simulation at this state: disks at rest, no contact history, walls fixed."""
+        p = Particles(
+            np.column_stack([self.x, self.y]), self.radius, self.density, self.thickness,
+            self.kn, self.ks, self.mu,
+        )  # fmt: skip
+        walls = Walls()
+        for w in self.walls:
+            walls.add((w.x0, w.y0), (w.x1, w.y1), w.kn, w.ks, w.mu, w.name)
+        return Simulation(
+            p, walls, ContactModel("per_body"), gravity=self.gravity, local_damping=self.local_damping,
+            dt=dt, threads=threads,
+        )  # fmt: skip
+
+
+def series(ka: float, kb: float) -> float:
+    """Two springs in series (PFC 4.0 property combination)."""
+    return ka * kb / (ka + kb) if ka + kb > 0 else 0.0
+
+
+def resolve_specimen(path: str | os.PathLike) -> Path:
+    """A checkpoint file, or a folder holding ``specimen.npz`` (a criterion or paper output)."""
+    p = Path(path)
+    if p.is_dir():
+        p = p / "specimen.npz"
+    if not p.is_file():
+        raise InputError(
+            "SPECIMEN", str(path), "a specimen checkpoint (.npz) or a folder holding specimen.npz"
+        )
+    return p
+
+
+def from_simulation(sim: Simulation, source: str = "") -> SpecimenData:
+    """The disks and walls of ``sim`` (copies), with its gravity, damping and time step."""
+    if sim.contact.convention != "per_body":
+        raise InputError(
+            "contact convention", sim.contact.convention, "'per_body' (the properties travel with the bodies)"
+        )
+    p, w = sim.particles, sim.walls
+    walls = [
+        WallData(w.names[k], *map(float, (*w.p0[k], *w.p1[k], w.kn[k], w.ks[k], w.mu[k]))) for k in range(w.n)
+    ]
+    return SpecimenData(
+        x=p.pos[:, 0].copy(), y=p.pos[:, 1].copy(), radius=p.radius.copy(), density=p.density.copy(),
+        kn=p.kn.copy(), ks=p.ks.copy(), mu=p.mu.copy(), thickness=p.thickness, walls=walls,
+        gravity=sim.gravity, local_damping=sim.local_damping, dt=sim.dt, source=source,
+    )  # fmt: skip
+
+
+def from_checkpoint(path: str | os.PathLike) -> SpecimenData:
+    """The specimen saved at ``path`` (a checkpoint or a folder holding ``specimen.npz``).
+
+    Read with :func:`poro2d.dem.checkpoint.read`, which checks the whole file first: a
+    damaged checkpoint is one InputError naming it.
+    """
+    p = resolve_specimen(path)
+    meta, a = checkpoint.read(p)
+    s = meta["settings"]
+    if s["contact"]["convention"] != "per_body":
+        raise InputError(
+            "contact convention", s["contact"]["convention"],
+            "'per_body' (the PFC 4.0 properties that travel with the bodies)",
+        )  # fmt: skip
+    pos = a["particles.pos"]
+    names = list(meta["wall_names"])
+    p0, p1 = a["walls.p0"], a["walls.p1"]
+    walls = [
+        WallData(
+            names[k], *map(float, (*p0[k], *p1[k], a["walls.kn"][k], a["walls.ks"][k], a["walls.mu"][k]))
+        )
+        for k in range(len(names))
+    ]
+    return SpecimenData(
+        x=pos[:, 0].copy(), y=pos[:, 1].copy(), radius=a["particles.radius"].copy(),
+        density=a["particles.density"].copy(), kn=a["particles.kn"].copy(), ks=a["particles.ks"].copy(),
+        mu=a["particles.mu"].copy(), thickness=float(meta["thickness"]), walls=walls,
+        gravity=tuple(float(g) for g in s["gravity"]), local_damping=float(s["local_damping"]),
+        dt=float(s["dt"]), source=str(p),
+    )  # fmt: skip

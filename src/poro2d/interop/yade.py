@@ -1,0 +1,184 @@
+"""YADE: a Python script that builds the same disks and walls with the same contact law.
+
+YADE is 3D. The choices made here:
+
+* each disk is a sphere of the disk's radius with its centre in the plane z = 0; its
+  motion is locked to the plane (``blockedDOFs = 'zXY'``: no z translation, rotation
+  about z only), its mass set to the disk mass ``rho pi r^2 t`` and its inertia to the
+  disk's ``m r^2 / 2``;
+* each sphere gets its own ``FrictMat`` with ``young = kn / (2 r)``: YADE's
+  ``Ip2_FrictMat_FrictMat_FrictPhys`` combines ``2 E_a r_a E_b r_b / (E_a r_a + E_b
+  r_b)``, which is then kn_a kn_b / (kn_a + kn_b), PFC 4.0's springs in series;
+  ``poisson`` holds ks/kn (YADE's ks is kn times the mean of the two ratios: exact
+  when every body has the same ks/kn, as in the paper's Table 1); the friction angle
+  is ``atan(mu)`` and YADE takes the smaller of the two, as PFC 4.0;
+* walls are fixed boxes whose face lies on the poro2d segment, on the side away from
+  the specimen. YADE's stiffness of a box contact depends on the sphere's radius, so a
+  ``PyRunner`` after the interaction loop sets kn, ks and the friction of every
+  disk-wall contact to the PFC 4.0 values (from the step after the contact forms);
+* Cundall's local damping is ``NewtonIntegrator(damping=...)``, gravity its
+  ``gravity``; the time step is poro2d's.
+
+The numbers are in three literals at the top of the script (``SETTINGS``, ``DISKS``,
+``WALLS``), written with ``repr``, so that they can be read back exactly.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from poro2d.errors import InputError
+from poro2d.interop.specimen_data import SpecimenData
+from poro2d.io_utils import atomic_path
+
+SCRIPT_FILE = "specimen_yade.py"
+
+_BODY = '''
+
+import math
+
+from yade import O, utils
+from yade.wrapper import (
+    Bo1_Box_Aabb, Bo1_Sphere_Aabb, ForceResetter, FrictMat, Ig2_Box_Sphere_ScGeom,
+    Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop, Ip2_FrictMat_FrictMat_FrictPhys,
+    Law2_ScGeom_FrictPhys_CundallStrack, NewtonIntegrator, PyRunner,
+)
+from minieigen import Vector3
+
+
+def series(a, b):
+    return a * b / (a + b)
+
+
+T = SETTINGS["thickness"]
+RMAX = max(d[2] for d in DISKS)
+
+disk_ids = []
+for x, y, r, rho, kn, ks, mu in DISKS:
+    mat = O.materials.append(
+        FrictMat(young=kn / (2.0 * r), poisson=ks / kn, frictionAngle=math.atan(mu), density=rho)
+    )
+    b = utils.sphere((x, y, 0.0), r, material=mat)
+    m = rho * math.pi * r * r * T  # the disk mass, not the sphere's
+    b.state.mass = m
+    b.state.inertia = Vector3(0.5 * m * r * r, 0.5 * m * r * r, 0.5 * m * r * r)
+    b.state.blockedDOFs = "zXY"
+    disk_ids.append(O.bodies.append(b))
+disk_props = {i: (kn, ks, mu) for i, (_, _, _, _, kn, ks, mu) in zip(disk_ids, DISKS)}
+
+wall_ids = {}
+wall_props = {}
+for name, x0, y0, x1, y1, kn, ks, mu in WALLS:
+    length = math.hypot(x1 - x0, y1 - y0)
+    nx, ny = -(y1 - y0) / length, (x1 - x0) / length  # towards the specimen
+    h = RMAX  # half thickness of the wall box, behind the segment
+    cx, cy = 0.5 * (x0 + x1) - h * nx, 0.5 * (y0 + y1) - h * ny
+    if abs(nx) < 0.5:  # horizontal
+        extents = (0.5 * length, h, 2.0 * RMAX)
+    else:
+        extents = (h, 0.5 * length, 2.0 * RMAX)
+    mat = O.materials.append(FrictMat(young=kn / (2.0 * RMAX), poisson=ks / kn, frictionAngle=math.atan(mu)))
+    wid = O.bodies.append(utils.box((cx, cy, 0.0), extents, fixed=True, material=mat))
+    wall_ids[name] = wid
+    wall_props[wid] = (kn, ks, mu)
+
+
+def wall_contacts():
+    """PFC 4.0 properties on every disk-wall contact: springs in series, the smaller friction."""
+    for wid, (kw, sw, mw) in wall_props.items():
+        for i in O.interactions.withBody(wid):
+            if not i.isReal:
+                continue
+            d = i.id2 if i.id1 == wid else i.id1
+            kd, sd, md = disk_props[d]
+            i.phys.kn = series(kd, kw)
+            i.phys.ks = series(sd, sw)
+            i.phys.tangensOfFrictionAngle = min(md, mw)
+
+
+def report():
+    """Wall forces per metre of disk thickness (N/m), as poro2d reports them."""
+    f = {name: O.forces.f(wid) for name, wid in wall_ids.items()}
+    out = {
+        "f_top_n_per_m": f["top"][1] / T if "top" in f else float("nan"),
+        "f_bottom_n_per_m": -f["bottom"][1] / T if "bottom" in f else float("nan"),
+        "side_friction_up_n_per_m": -(f["left"][1] + f["right"][1]) / T if "left" in f else float("nan"),
+        "unbalanced_force": utils.unbalancedForce(),
+    }
+    print("poro2d-result", " ".join(f"{k} {v!r}" for k, v in out.items()))
+
+
+def stop_at_rest():
+    # YADE's unbalancedForce() is the mean unbalanced force over the mean contact force
+    if O.iter > 100 and utils.unbalancedForce() < SETTINGS["ratio"]:
+        O.pause()
+
+
+O.engines = [
+    ForceResetter(),
+    InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()]),
+    InteractionLoop(
+        [Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+        [Ip2_FrictMat_FrictMat_FrictPhys()],
+        [Law2_ScGeom_FrictPhys_CundallStrack()],
+    ),
+    PyRunner(command="wall_contacts()", iterPeriod=1),
+    NewtonIntegrator(damping=SETTINGS["damping"], gravity=(*SETTINGS["gravity"], 0.0)),
+    PyRunner(command="stop_at_rest()", iterPeriod=SETTINGS["check_every"]),
+]
+O.dt = SETTINGS["dt"]
+
+if __name__ == "__main__":
+    O.run(SETTINGS["max_steps"], True)
+    report()
+'''
+
+
+def script(
+    spec: SpecimenData, ratio: float = 1e-3, max_steps: int = 2_000_000, check_every: int = 500
+) -> str:
+    """The text of the YADE script (run it with ``yade specimen_yade.py``)."""
+    settings = {
+        "thickness": float(spec.thickness),
+        "gravity": (float(spec.gravity[0]), float(spec.gravity[1])),
+        "damping": float(spec.local_damping),
+        "dt": float(spec.dt) if spec.dt else 0.0,
+        "ratio": float(ratio),
+        "max_steps": int(max_steps),
+        "check_every": int(check_every),
+    }
+    disks = zip(spec.x, spec.y, spec.radius, spec.density, spec.kn, spec.ks, spec.mu, strict=True)
+    lines = [
+        *spec.header("#"),
+        f"# written by poro2d export --to yade; run: yade {SCRIPT_FILE}",
+        "# 2D in YADE: spheres with their centres in z = 0, motion locked to the plane, disk masses",
+        "",
+        f"SETTINGS = {settings!r}",
+        "",
+        "# x, y, radius, density, kn, ks, mu (per body, PFC 4.0)",
+        "DISKS = [",
+        *(f"    ({', '.join(repr(float(v)) for v in d)})," for d in disks),
+        "]",
+        "",
+        "# name, x0, y0, x1, y1, kn, ks, mu (the specimen lies to the left going from (x0, y0) to (x1, y1))",
+        "WALLS = [",
+        *(f"    ({w.name!r}, {', '.join(repr(float(v)) for v in _wall_numbers(w))})," for w in spec.walls),
+        "]",
+    ]
+    return "\n".join(lines) + _BODY
+
+
+def _wall_numbers(w) -> tuple[float, ...]:
+    return (w.x0, w.y0, w.x1, w.y1, w.kn, w.ks, w.mu)
+
+
+def write_specimen(spec: SpecimenData, out: str | os.PathLike) -> list[Path]:
+    """Write ``specimen_yade.py`` into ``out`` (atomically)."""
+    slanted = [w.name for w in spec.walls if not (w.horizontal or w.vertical)]
+    if slanted:
+        raise InputError("walls", slanted, "horizontal or vertical walls (written as YADE boxes)")
+    path = Path(out) / SCRIPT_FILE
+    with atomic_path(path) as tmp:
+        tmp.write_text(script(spec))
+    return [path]

