@@ -309,3 +309,20 @@ def test_plate_that_does_not_settle_refuses_the_trial(tmp_path):
     assert it["failed_stage"] == "top plate" and it["checks"]["plate_settled"] is False
     assert not r["converged"] and r["failed_trial"] == 1
     assert "top plate did not settle within 1000 steps" in r["message"] and "ratio" in r["message"]
+
+
+def test_accepted_specimen_is_the_state_after_the_plate_moved(tmp_path):
+    """The specimen handed on (specimen.npz) is the state the acceptance was decided on."""
+    from poro2d.dem import checkpoint
+
+    cfg = tmp_path / "q.toml"
+    cfg.write_text(QUICK_TOML)
+    out = tmp_path / "o"
+    main(["criterion", "--config", str(cfg), "--out", str(out), "--quiet"])
+    last = json.loads((out / "result.json").read_text())["iterations"][-1]
+    assert last["accepted"] and last["plate_moved"] in ("up", "down")  # this case moves its plate
+    sim = checkpoint.load(out / "specimen.npz")
+    top = float(sim.walls.p0[sim.walls.index("top"), 1])
+    assert top == pytest.approx(last["plate_height_m"], abs=1e-12) and top != pytest.approx(0.03, abs=1e-9)
+    state = json.loads((out / "specimen_state.json").read_text())
+    assert state["bands"][-1]["z_top_m"] == pytest.approx(top)

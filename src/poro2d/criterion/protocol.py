@@ -644,8 +644,13 @@ class PorosityCriterion:
         if converged:
             last = rows[-1]
             dl = self._trial_dir(last["iteration"], last["trial_porosity"])
-            pairs.append((dl / "forces_trial.png", "fig7_forces_accepted.png"))
-            shutil.copyfile(dl / "prepared.npz", self.out / ".specimen.npz.tmp")
+            # the accepted specimen is the state the decision was taken on: after the plate
+            # moved to touch (when it moved), else as prepared with the plate at H
+            moved_last = last.get("plate_moved") in ("up", "down") and (dl / "after_plate.npz").is_file()
+            state = "after_plate" if moved_last else "prepared"
+            figure = "forces_after_plate.png" if moved_last else "forces_trial.png"
+            pairs.append((dl / figure, "fig7_forces_accepted.png"))
+            shutil.copyfile(dl / f"{state}.npz", self.out / ".specimen.npz.tmp")
             (self.out / ".specimen.npz.tmp").replace(self.out / "specimen.npz")
             sim = checkpoint.load(self.out / "specimen.npz")
             write_vtu(sim, self.out / "vtu", "accepted_specimen")
