@@ -208,8 +208,14 @@ def test_density_relation_command_on_tiny_specimens(tmp_path, monkeypatch):
     assert rel["n2d_max"] > rel["n2d_min"]
     out2 = tmp_path / "out2"
     main([*args, "--out", str(out2)])
-    assert json.loads((out2 / "calibration.json").read_text())["source"].startswith("cache")
-    assert not (out2 / "calibration").exists()
+    again = json.loads((out2 / "calibration.json").read_text())
+    assert again["source"] == "cache" and again["ran"] == 0 and again["reused"] == 4
+    assert again["calibration"] == cal["calibration"]
+    # one more seed runs only that seed's cases; the others are read back
+    args3 = [a if a != "2" or args[i - 1] != "--seeds" else "3" for i, a in enumerate(args)]
+    main([*args3, "--out", str(tmp_path / "out3")])
+    third = json.loads((tmp_path / "out3" / "calibration.json").read_text())
+    assert third["ran"] == 2 and third["reused"] == 4
 
 
 def test_density_mode_errors(tmp_path):

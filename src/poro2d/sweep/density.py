@@ -70,9 +70,12 @@ def calibration_base(base: dict) -> dict:
     return {"specimen": spec, "grading": base.get("grading") or {"preset": "paper"}, "criterion": crit}
 
 
-def calibration_key(base: dict, mus: list[float], seeds: int) -> str:
-    """A content key of the calibration: grading, box, settings, frictions, seeds."""
-    rec = {"base": calibration_base(base), "mus": mus, "seeds": seeds}
+def calibration_key(base: dict) -> str:
+    """A content key of the calibration's cases: grading, box, contact and criterion settings,
+    and the poro2d version (another version may compute another criterion)."""
+    from poro2d import __version__
+
+    rec = {"base": calibration_base(base), "version": __version__}
     return hashlib.sha256(json.dumps(rec, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
@@ -120,40 +123,39 @@ def calibrate(
     use_cache: bool = True,
     **sweep_kw,
 ) -> tuple[Calibration, dict]:
-    """The grading's calibration: from the cache, or run into ``out`` (resumable) and cached.
+    """The grading's calibration, its cases run on the sweep runner (resumable).
 
-    Returns the calibration and a record (key, where it came from, sweep summary).
+    With ``use_cache`` the cases live in a folder shared by every run of the same grading and
+    settings (:func:`cache_dir` / ``calibrations`` / key): a case done once, for any list of
+    frictions or number of seeds, is read back, not run again. Without it they go to
+    ``out/calibration``. ``out/calibration.json`` records the calibration and where its
+    cases are. Returns the calibration and a record (key, folder, how many cases ran).
     """
     from poro2d.sweep.cases import parse_sweep
     from poro2d.sweep.runner import run_sweep
 
     mus, seeds = check_mus(list(mus)), check_seeds(seeds)
-    key = calibration_key(base, mus, seeds)
-    cached = cache_dir() / "calibrations" / f"{key}.json"
-    if use_cache and cached.is_file():
-        rec = json.loads(cached.read_text())
-        cal = Calibration.from_dict(rec["calibration"])
-        write_json(out / "calibration.json", dict(rec, source=f"cache {cached}"))
-        return cal, {"key": key, "source": "cache", "path": str(cached)}
+    key = calibration_key(base)
+    folder = cache_dir() / "calibrations" / key if use_cache else out / "calibration"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError:  # a read-only cache: the cases go with the results
+        folder = out / "calibration"
     sweep = parse_sweep(calibration_sweep(base, mus, seeds), base_dir)
-    res = run_sweep(sweep, out / "calibration", **sweep_kw)
+    res = run_sweep(sweep, folder, **sweep_kw)
     cal = calibration_from_rows(res.rows, mus, seeds)
+    info = {"key": key, "cases": str(folder), "ran": res.summary["ran"], "reused": res.summary["reused"],
+            "source": "computed" if res.summary["ran"] else "cache"}  # fmt: skip
     rec = {
-        "key": key,
+        **info,
         "calibration": cal.to_dict(),
         "settings": calibration_base(base),
         "sample": "n' of the accepted trial: box porosity, whole disk areas, plate just touching",
         "sweep_summary": res.summary,
         "provenance": provenance(),
     }
-    write_json(out / "calibration.json", dict(rec, source="computed"))
-    # unconverged seeds are results (a rerun gives the same); a crashed case is not cached
-    if use_cache and not res.failed:
-        try:
-            write_json(cached, rec)
-        except OSError:  # a read-only home: the calibration still stands in ``out``
-            pass
-    return cal, {"key": key, "source": "computed", "summary": res.summary}
+    write_json(out / "calibration.json", rec)
+    return cal, dict(info, summary=res.summary, failed=len(res.failed))
 
 
 def state_sweep(base: dict, targets: list[StateTarget], seeds: int, resolution: float) -> dict:

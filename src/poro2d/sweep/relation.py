@@ -423,5 +423,6 @@ def density_relation(
     sweep = parse_sweep(D.state_sweep(cfg, targets, seeds, resolution), base_dir)
     res = run_sweep(sweep, out / "states", **sweep_kw)
     rel = analyse_states(res.rows, targets, cal, settings["n_max"], settings["n_min"])
-    record = {"calibration": cal_info, "states_summary": res.summary, "failed_cases": len(res.failed)}
+    record = {"calibration": cal_info, "states_summary": res.summary,
+              "failed_cases": len(res.failed) + cal_info["failed"]}  # fmt: skip
     return rel, record
