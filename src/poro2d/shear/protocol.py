@@ -154,18 +154,12 @@ def specimen_box(path: str | Path) -> tuple[float, float]:
 
 
 class _Frame:
-    """A stored state for force-chain figures (what plot_force_chains reads of a simulation)."""
+    """A stored state for force-chain figures: disks, wall segments and contacts as arrays."""
 
     def __init__(self, data: dict) -> None:
-        from types import SimpleNamespace
-
         from poro2d.dem.measure import ContactSet
 
         self.data = data
-        self.particles = SimpleNamespace(
-            pos=data["pos"], radius=data["radius"], thickness=float(data["thickness"])
-        )
-        self.walls = SimpleNamespace(p0=data["wall_p0"], p1=data["wall_p1"], n=int(data["wall_p0"].shape[0]))
         self._contacts = ContactSet(**{k: data["c_" + k] for k in ("i", "j", "kind", "point", "normal", "fn",
                                                                    "fs", "force", "branch")})  # fmt: skip
 
@@ -510,8 +504,10 @@ class DirectShearTest:
             return
         b = self.box
         d = float(fr.data["displacement_mm"])
+        walls = np.stack([fr.data["wall_p0"], fr.data["wall_p1"]], axis=1)
         plot_force_chains(
-            fr, self.out / "forces_peak.png",
+            fr.contacts(), fr.data["pos"], fr.data["radius"], walls, self.out / "forces_peak.png",
+            thickness=float(fr.data["thickness"]),
             title=f"direct shear at {self.sigma_kpa:g} kPa, at the peak: d = {d:.2f} mm",
             box=(-0.02 * b.width, 0.0, b.width + b.max_displacement, b.height),
             notes=[f"tau_peak = {result['peak_shear_stress_kpa']:.1f} kPa (smoothed over "
