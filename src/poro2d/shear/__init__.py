@@ -3,7 +3,9 @@
 from poro2d.shear.box import SplitBox, build_split_box
 from poro2d.shear.fit import MohrCoulombFit, mohr_coulomb, peak, smooth
 from poro2d.shear.lab import LabData, read_lab_csv
-from poro2d.shear.protocol import DirectShearTest, ShearSeries, ShearSettings, inertial_number
+from poro2d.shear.series import ShearSeries
+from poro2d.shear.settings import ShearSettings, inertial_number
+from poro2d.shear.single import DirectShearTest
 
 __all__ = [
     "DirectShearTest", "LabData", "MohrCoulombFit", "ShearSeries", "ShearSettings", "SplitBox",
