@@ -1,15 +1,20 @@
-"""The direct shear package's pieces: the peak's force-chain frame, and the names
-``poro2d.shear.protocol`` still gives. A small specimen (0.06 m x 0.03 m), as in test_shear.py."""
+"""The direct shear package's Python API: ``run_shear``, the peak's force-chain frame, and the
+names ``poro2d.shear.protocol`` still gives. A small specimen (0.06 m x 0.03 m) and 2 mm of
+shear, as in test_shear.py: every test runs in seconds."""
+
+import json
 
 import numpy as np
 import pytest
 
 from poro2d.dem import checkpoint
-from poro2d.shear import build_split_box
+from poro2d.errors import InputError
+from poro2d.shear import ShearSeries, ShearSettings, build_split_box, run_shear
 from poro2d.shear.peak_frame import PeakFrame, PeakTracker
 from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
 
+SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4}
 # the keys of peak_frame.npz as earlier versions of poro2d wrote them: a test they left
 # unfinished resumes with its peak frame
 FRAME_KEYS = {"pos", "radius", "thickness", "wall_p0", "wall_p1", "record", "displacement_mm"} | {
@@ -24,6 +29,67 @@ def specimen(tmp_path_factory):
     path = tmp_path_factory.mktemp("specimen") / "specimen.npz"
     checkpoint.save(sim, path)
     return path
+
+
+def test_run_shear_is_the_series_with_its_files(specimen, tmp_path):
+    lab = tmp_path / "lab.csv"
+    lab.write_text("normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,75\n")
+    out = tmp_path / "api"
+    res = run_shear(specimen.parent, [50, 100], SHORT, out=out, lab=lab, processes=1, progress=False,
+                    config={"note": "kept"})  # fmt: skip
+    assert res == json.loads((out / "result.json").read_text())
+    assert res["config"] == {"note": "kept"} and res["settings"]["max_displacement"] == 0.002
+    assert res["lab"]["friction_angle_deg"] == pytest.approx(np.degrees(np.arctan(35 / 50)))
+    for f in ("curves.csv", "peaks.csv", "fig8a_shear_curves.png", "fig8b_peak_strength.png",
+              "sn50kPa/forces_peak.png", "sn100kPa/curve.csv"):  # fmt: skip
+        assert (out / f).stat().st_size > 0, f
+    assert not (out / "sn50kPa" / "peak_frame.npz").exists()  # removed with the checkpoint
+    ref = ShearSeries(specimen, [50, 100], ShearSettings(**SHORT), out=tmp_path / "series", processes=1,
+                      progress=False, figures=False).run()  # fmt: skip
+    assert [t["peak_shear_stress_kpa"] for t in res["tests"]] == [
+        t["peak_shear_stress_kpa"] for t in ref["tests"]
+    ]
+    again = run_shear(specimen, 100, ShearSettings(**SHORT), out=out / "one", processes=1, progress=False)
+    assert again["tests"][0]["peak_shear_stress_kpa"] == ref["tests"][1]["peak_shear_stress_kpa"]
+
+
+@pytest.mark.parametrize(
+    ("kw", "name"),
+    [
+        ({"normal_stresses_kpa": "50,100"}, "normal_stresses_kpa"),
+        ({"normal_stresses_kpa": [50, -1]}, "normal stress"),
+        ({"normal_stresses_kpa": []}, "normal stress"),
+        ({"settings": {"velocty": 0.01}}, "settings.velocty"),
+        ({"settings": {"velocity": "0.01"}}, "settings.velocity"),
+        ({"settings": 0.01}, "settings"),
+        ({"settings": {"max_displacement": 0.05}}, "max_displacement"),
+        ({"lab": 5}, "lab"),
+        ({"lab": "missing.csv"}, "lab"),
+        ({"rate_check": "yes"}, "rate_check"),
+        ({"progress": None}, "progress"),
+        ({"processes": 0}, "processes"),
+        ({"specimen": "nowhere.npz"}, "specimen"),
+    ],
+)
+def test_run_shear_refuses_bad_input_before_any_test(specimen, tmp_path, kw, name):
+    args = {"specimen": specimen, "normal_stresses_kpa": [50], "settings": SHORT, "progress": False} | kw
+    out = tmp_path / "out"
+    with pytest.raises(InputError, match=name):
+        run_shear(args.pop("specimen"), args.pop("normal_stresses_kpa"), args.pop("settings"), out=out,
+                  **args)  # fmt: skip
+    assert not out.exists()
+
+
+def test_run_shear_refuses_a_file_as_out_and_a_damaged_specimen(specimen, tmp_path):
+    taken = tmp_path / "taken"
+    taken.write_text("x")
+    with pytest.raises(InputError, match="out"):
+        run_shear(specimen, [50], out=taken)
+    bad = tmp_path / "bad.npz"
+    bad.write_bytes(specimen.read_bytes()[:100])
+    with pytest.raises(InputError, match="checkpoint"):
+        run_shear(bad, [50], out=tmp_path / "o")
+    assert not (tmp_path / "o").exists()
 
 
 def test_peak_frame_round_trip_and_figure(specimen, tmp_path):
@@ -82,3 +148,4 @@ def test_protocol_still_gives_the_old_names():
     assert protocol.DirectShearTest is single.DirectShearTest and protocol.execute_jobs is pool.execute_jobs
     assert protocol.folder_name(100.0) == outputs.folder_name(100.0) == "sn100kPa"
     assert protocol._read_csv is outputs.read_curve_csv and protocol._Bars is pool._Bars
+    assert protocol.run_shear is run_shear
