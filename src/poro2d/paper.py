@@ -187,8 +187,8 @@ def run_paper(
 
 def _shear_stage(specimens: dict[str, Path], out: Path, quick: bool, lab_data, progress: bool) -> dict:
     """Direct shear at the paper's normal stresses on every specimen; the summary over them."""
-    from poro2d.shear.protocol import ShearSettings
     from poro2d.shear.replicates import ReplicateShear
+    from poro2d.shear.settings import ShearSettings
 
     console.print(
         f"[bold]3/3 direct shear[/] (Fig. 8) at {', '.join(f'{v:g}' for v in NORMAL_STRESSES_KPA)} kPa "

@@ -295,10 +295,10 @@ class PorosityCriterion:
         return sim, rep
 
     def _figure(self, sim: Simulation, path: Path, title: str, forces: dict) -> None:
-        from poro2d.report.force_chains import plot_force_chains
+        from poro2d.report.force_chains import plot_simulation_force_chains
 
         plate = float(sim.walls.p0[sim.walls.index("top"), 1])
-        plot_force_chains(
+        plot_simulation_force_chains(
             sim, path, title=title, box=(0.0, 0.0, self.spec.width, plate),
             notes=[
                 f"F_top = {forces['f_top_n_per_m']:.4g} N/m",
@@ -658,7 +658,6 @@ class PorosityCriterion:
         for src, dst in pairs:
             if src.is_file():
                 shutil.copyfile(src, self.out / dst)
-
 
     def _specimen_state(self, sim: Simulation, n2d: float) -> None:
         """Homogeneity and stress state of the accepted specimen: specimen_state.json and .png."""

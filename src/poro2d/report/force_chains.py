@@ -1,4 +1,10 @@
-"""Contact force chains like the paper's Figs. 5-7: line width proportional to force."""
+"""Contact force chains like the paper's Figs. 5-7: line width proportional to force.
+
+:func:`plot_force_chains` draws from plain data: a :class:`poro2d.dem.measure.ContactSet`,
+the disks' positions and radii and the wall segments, so a stored state (a frame saved
+during a direct shear test, say) is drawn without a simulation.
+:func:`plot_simulation_force_chains` takes those from a live :class:`poro2d.dem.Simulation`.
+"""
 
 from __future__ import annotations
 
@@ -14,7 +20,12 @@ from matplotlib.collections import LineCollection, PatchCollection  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Circle  # noqa: E402
 
+from poro2d.dem.measure import ContactSet  # noqa: E402
+from poro2d.errors import InputError, check_range  # noqa: E402
 from poro2d.io_utils import atomic_path  # noqa: E402
+
+FORCE_COLOR = "#b2182b"
+WALL_COLOR = "#333333"
 
 
 def _nice(x: float) -> float:
@@ -27,7 +38,120 @@ def _nice(x: float) -> float:
     return float(10 * e)
 
 
+def _check_inputs(contacts, pos, radius, walls) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The arrays as float arrays of the expected shapes; an InputError names the first bad one."""
+    if not isinstance(contacts, ContactSet):
+        raise InputError(
+            "contacts", type(contacts).__name__, "a poro2d.dem.measure.ContactSet",
+            "for a Simulation use plot_simulation_force_chains",
+        )  # fmt: skip
+    pos = np.asarray(pos, dtype=float)
+    if pos.ndim != 2 or pos.shape[1] != 2 or not np.all(np.isfinite(pos)):
+        raise InputError("pos", f"array of shape {pos.shape}", "finite disk centres, shape (n, 2)")
+    radius = np.asarray(radius, dtype=float)
+    if radius.shape != (pos.shape[0],) or not np.all(radius > 0):
+        raise InputError("radius", f"array of shape {radius.shape}", f"{pos.shape[0]} positive radii")
+    walls = np.zeros((0, 2, 2)) if walls is None else np.asarray(walls, dtype=float)
+    if walls.ndim != 3 or walls.shape[1:] != (2, 2):
+        raise InputError("walls", f"array of shape {walls.shape}", "wall segments, shape (m, 2, 2)")
+    n = pos.shape[0]
+    pp = contacts.kind == 0
+    if len(contacts) and (contacts.i.min() < 0 or contacts.i.max() >= n or np.any(contacts.j[pp] >= n)):
+        raise InputError("contacts", f"{len(contacts)} contacts", f"disk indices in [0, {n})")
+    return pos, radius, walls
+
+
+def _contact_lines(contacts: ContactSet, pos: np.ndarray) -> np.ndarray:
+    """One segment per contact: centre to centre (disk-disk), centre to contact point (disk-wall)."""
+    pp = contacts.kind == 0
+    seg_a = pos[contacts.i]
+    seg_b = np.where(pp[:, None], pos[np.where(pp, contacts.j, 0)], contacts.point)
+    return np.stack([seg_a, seg_b], axis=1)
+
+
+def _legend(ax, ref: float, max_width: float, unit: str) -> None:
+    """Three line widths with their force, and the wall, below the drawing."""
+    handles = [
+        Line2D([], [], color=FORCE_COLOR, lw=max_width * v / ref, label=f"{v:,.3g} {unit}")
+        for v in (ref, ref / 2, ref / 10)
+    ]
+    handles.append(Line2D([], [], color=WALL_COLOR, lw=2.5, label="wall"))
+    ax.legend(
+        handles=handles, title="contact force", loc="upper center", bbox_to_anchor=(0.5, -0.14),
+        ncol=len(handles), frameon=False, fontsize=9,
+    )  # fmt: skip
+
+
 def plot_force_chains(
+    contacts: ContactSet,
+    pos,
+    radius,
+    walls,
+    path: str | os.PathLike,
+    *,
+    thickness: float | None = None,
+    title: str = "",
+    box: tuple[float, float, float, float] | None = None,
+    max_width: float = 4.0,
+    show_disks: bool = True,
+    notes: list[str] | None = None,
+) -> Path:
+    """Draw every touching contact as a line, width proportional to its force.
+
+    ``pos`` (n, 2) and ``radius`` (n,) are the disks the contacts index, ``walls`` the wall
+    segments as an (m, 2, 2) array (or None). Disk-disk contacts run centre to centre,
+    disk-wall contacts from the centre to the contact point. With the disks' ``thickness``
+    (m) forces are shown per metre of thickness (N/m, the paper's unit), without it in N.
+    ``box`` = (x0, y0, x1, y1) is the drawn area (default: the disks). Walls are drawn in
+    dark grey; the legend gives the force of three line widths.
+    """
+    pos, radius, walls = _check_inputs(contacts, pos, radius, walls)
+    t = 1.0 if thickness is None else check_range("thickness", thickness, 0.0, None, lo_open=True)
+    unit = "N" if thickness is None else "N/m"
+    f = contacts.magnitude / t
+    fmax = float(f.max()) if len(f) else 0.0
+    ref = _nice(fmax) if fmax > 0 else 1.0
+    widths = max_width * f / ref
+    if box is None:
+        x0, y0 = pos.min(axis=0) - radius.max()
+        x1, y1 = pos.max(axis=0) + radius.max()
+    else:
+        x0, y0, x1, y1 = box
+    fig_w = 9.0
+    fig, ax = plt.subplots(figsize=(fig_w, fig_w * (y1 - y0) / (x1 - x0) + 1.6))
+    if show_disks:
+        disks = PatchCollection(
+            [Circle(xy, r) for xy, r in zip(pos, radius, strict=True)],
+            facecolor="#f2efe6", edgecolor="#c9c2ad", linewidth=0.2,
+        )  # fmt: skip
+        ax.add_collection(disks)
+    order = np.argsort(f)  # strongest on top
+    lines = _contact_lines(contacts, pos)[order]
+    ax.add_collection(LineCollection(lines, linewidths=widths[order], colors=FORCE_COLOR, capstyle="round"))
+    for a, b in walls:
+        ax.plot([a[0], b[0]], [a[1], b[1]], color=WALL_COLOR, lw=2.5, solid_capstyle="butt", zorder=5)
+    pad = 0.02 * (x1 - x0)  # walls beyond the drawing area are clipped by the limits
+    ax.set_xlim(x0 - pad, x1 + pad)
+    ax.set_ylim(y0 - pad, y1 + pad)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    _legend(ax, ref, max_width, unit)
+    ax.set_title(title + ("\n" + "; ".join(notes) if notes else ""), fontsize=10)
+    fig.tight_layout()
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=150, format=path.suffix.lstrip(".") or "png")
+    plt.close(fig)
+    return path
+
+
+def wall_segments(walls) -> np.ndarray:
+    """The segments of a :class:`poro2d.dem.Walls` as an (m, 2, 2) array."""
+    return np.stack([walls.p0, walls.p1], axis=1)
+
+
+def plot_simulation_force_chains(
     sim,
     path: str | os.PathLike,
     title: str = "",
@@ -37,70 +161,16 @@ def plot_force_chains(
     show_disks: bool = True,
     notes: list[str] | None = None,
 ) -> Path:
-    """Draw every touching contact as a line, width proportional to its force.
+    """:func:`plot_force_chains` of a simulation's current contacts, disks and walls.
 
-    Disk-disk contacts run centre to centre, disk-wall contacts from the centre to
-    the contact point. Forces are shown per metre of thickness (N/m, the paper's
-    unit) unless ``per_thickness`` is False. Walls are drawn in dark grey; the
-    legend gives the force of three line widths.
+    Forces per metre of the disks' thickness (N/m) unless ``per_thickness`` is False.
     """
-    c = sim.contacts()
     p = sim.particles
-    t = p.thickness if per_thickness else 1.0
-    unit = "N/m" if per_thickness else "N"
-    f = c.magnitude / t
-    pp = c.kind == 0
-    seg_a = p.pos[c.i]
-    seg_b = np.where(pp[:, None], p.pos[np.where(pp, c.j, 0)], c.point)
-    fmax = float(f.max()) if len(f) else 0.0
-    ref = _nice(fmax) if fmax > 0 else 1.0
-    widths = max_width * f / ref
-
-    if box is None:
-        x0, y0 = p.pos.min(axis=0) - p.radius.max()
-        x1, y1 = p.pos.max(axis=0) + p.radius.max()
-    else:
-        x0, y0, x1, y1 = box
-    aspect = (y1 - y0) / (x1 - x0)
-    fig_w = 9.0
-    fig, ax = plt.subplots(figsize=(fig_w, fig_w * aspect + 1.6))
-    if show_disks:
-        disks = PatchCollection(
-            [Circle(xy, r) for xy, r in zip(p.pos, p.radius, strict=True)],
-            facecolor="#f2efe6", edgecolor="#c9c2ad", linewidth=0.2,
-        )  # fmt: skip
-        ax.add_collection(disks)
-    order = np.argsort(f)  # strongest on top
-    lc = LineCollection(
-        np.stack([seg_a, seg_b], axis=1)[order], linewidths=widths[order], colors="#b2182b", capstyle="round"
-    )
-    ax.add_collection(lc)
-    # walls, clipped to the drawing area
-    for w in range(sim.walls.n):
-        a, b = sim.walls.p0[w], sim.walls.p1[w]
-        ax.plot([a[0], b[0]], [a[1], b[1]], color="#333333", lw=2.5, solid_capstyle="butt", zorder=5)
-    pad = 0.02 * (x1 - x0)
-    ax.set_xlim(x0 - pad, x1 + pad)
-    ax.set_ylim(y0 - pad, y1 + pad)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    handles = [
-        Line2D([], [], color="#b2182b", lw=max_width * v / ref, label=f"{v:,.3g} {unit}")
-        for v in (ref, ref / 2, ref / 10)
-    ]
-    handles.append(Line2D([], [], color="#333333", lw=2.5, label="wall"))
-    ax.legend(
-        handles=handles, title="contact force", loc="upper center", bbox_to_anchor=(0.5, -0.14),
-        ncol=len(handles), frameon=False, fontsize=9,
+    return plot_force_chains(
+        sim.contacts(), p.pos, p.radius, wall_segments(sim.walls), path,
+        thickness=p.thickness if per_thickness else None, title=title, box=box, max_width=max_width,
+        show_disks=show_disks, notes=notes,
     )  # fmt: skip
-    full = title
-    if notes:
-        full += "\n" + "; ".join(notes)
-    ax.set_title(full, fontsize=10)
-    fig.tight_layout()
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=150, format=path.suffix.lstrip(".") or "png")
-    plt.close(fig)
-    return path
+
+
+__all__ = ["plot_force_chains", "plot_simulation_force_chains", "wall_segments"]

@@ -40,7 +40,7 @@ def load_shear_config(path: Path | None) -> tuple[dict, Path | None]:
     """The ``[shear]`` table of a TOML config (the criterion's config file may hold it too)."""
     from poro2d.config import check_keys, load_toml
     from poro2d.criterion.config import TOP_KEYS
-    from poro2d.shear.protocol import ShearSettings
+    from poro2d.shear.settings import ShearSettings
 
     if path is None:
         return {}, None
@@ -94,51 +94,64 @@ def register(app: typer.Typer) -> None:
         quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
     ) -> None:
         """Direct shear tests (the paper's Fig. 8): peak strengths, friction angle, figures."""
-        from poro2d.config import dataclass_from_table
-        from poro2d.dem import checkpoint
-        from poro2d.errors import InputError
         from poro2d.io_utils import check_output_dir
-        from poro2d.shear.lab import read_lab_csv
-        from poro2d.shear.protocol import ShearSeries, ShearSettings, resolve_specimen
+        from poro2d.shear.run import run_shear
 
         check_output_dir("--out", out)
         table, base = load_shear_config(config)
         extra = {k: table.pop(k) for k in list(table) if k in SHEAR_KEYS_EXTRA}
         check_extra_types(extra)
-        if specimen is None:
-            specimen = extra.get("specimen")
-            if specimen is not None and base is not None:
-                specimen = str((base / specimen).resolve())
-        if specimen is None:
-            raise InputError("--specimen", None, "a specimen checkpoint or criterion output folder")
-        checkpoint.read(resolve_specimen(specimen))  # a damaged file is refused here, in one line
-        if normal_stress is not None:
-            stresses = parse_stresses(normal_stress)
-        elif "normal_stress_kpa" in extra:
-            v = extra["normal_stress_kpa"]
-            stresses = parse_stresses(",".join(str(x) for x in (v if isinstance(v, list) else [v])))
-        else:
-            stresses = [50.0, 100.0, 200.0]
-        if lab is None and extra.get("lab") is not None:
-            lab = Path(extra["lab"]) if base is None else base / extra["lab"]
-        lab_data = read_lab_csv(lab) if lab is not None else None
-        if processes is None:
-            processes = extra.get("processes")
-        rate_check = rate_check or bool(extra.get("rate_check", False))
-        settings = dataclass_from_table(
-            ShearSettings, "shear", table, velocity=velocity, max_displacement=max_displacement
-        )
-        series = ShearSeries(
-            specimen, stresses, settings, out=out, lab=lab_data, rate_check=rate_check, processes=processes,
-            progress=not quiet, config={"shear": table, **extra, "cli": {"velocity": velocity,
-                                        "max_displacement": max_displacement}},
-        )  # fmt: skip
+        options = {"velocity": velocity, "max_displacement": max_displacement}
+        recorded = {"shear": table, **extra, "cli": options}
         try:
-            result = series.run()
+            result = run_shear(
+                resolve_path("--specimen", specimen, extra.get("specimen"), base, required=True),
+                resolve_stresses(normal_stress, extra),
+                settings_from_options(table, velocity, max_displacement),
+                out=out,
+                lab=resolve_path("--lab", lab, extra.get("lab"), base),
+                rate_check=rate_check or bool(extra.get("rate_check", False)),
+                processes=processes if processes is not None else extra.get("processes"),
+                progress=not quiet,
+                config=recorded,
+            )
         except RuntimeError as exc:
             console.print(f"[bold red]failed:[/] {exc}")
             raise typer.Exit(1) from None
         print_result(result, out)
+
+
+def resolve_path(option: str, given, from_config: str | None, base: Path | None, required: bool = False):
+    """The command line's path, else the config's (relative to the config file), else None."""
+    from poro2d.errors import InputError
+
+    if given is not None:
+        return given
+    if from_config is not None:
+        return str((base / from_config).resolve()) if base is not None else from_config
+    if required:
+        raise InputError(option, None, "a specimen checkpoint or criterion output folder")
+    return None
+
+
+def resolve_stresses(option_text: str | None, extra: dict) -> list[float]:
+    """--normal-stress, else the config's normal_stress_kpa, else the paper's 50, 100, 200 kPa."""
+    if option_text is not None:
+        return parse_stresses(option_text)
+    if "normal_stress_kpa" in extra:
+        v = extra["normal_stress_kpa"]
+        return parse_stresses(",".join(str(x) for x in (v if isinstance(v, list) else [v])))
+    return [50.0, 100.0, 200.0]
+
+
+def settings_from_options(table: dict, velocity: float | None, max_displacement: float | None):
+    """ShearSettings from the config's [shear] table, --velocity and --max-displacement winning."""
+    from poro2d.config import dataclass_from_table
+    from poro2d.shear.settings import ShearSettings
+
+    return dataclass_from_table(
+        ShearSettings, "shear", table, velocity=velocity, max_displacement=max_displacement
+    )
 
 
 def _sci(v) -> str:

@@ -104,7 +104,7 @@ class ReplicateShear:
                  progress: bool = True, config: dict | None = None) -> None:  # fmt: skip
         import os
 
-        from poro2d.shear.protocol import ShearSeries
+        from poro2d.shear.series import ShearSeries
 
         if not specimens:
             raise InputError("specimens", {}, "at least one specimen")
@@ -128,7 +128,7 @@ class ReplicateShear:
         self.processes = processes if processes is not None else min(njobs, 2 * (os.cpu_count() or 1))
 
     def run(self) -> dict:
-        from poro2d.shear.protocol import execute_jobs
+        from poro2d.shear.pool import execute_jobs
 
         t0 = time.perf_counter()
         jobs = [dict(j, key=(label, *j["key"]), series=label)
@@ -151,25 +151,21 @@ class ReplicateShear:
     def _figures(self, summary: dict) -> None:
         """fig8a/fig8b over specimens: mean curves with +- sd bands, peaks with the pooled fit."""
         from poro2d.report.shear_figures import curve_band, plot_replicate_curves, plot_replicate_peaks
-        from poro2d.shear.protocol import _read_csv, folder_name
+        from poro2d.shear.outputs import folder_name, lab_fit, read_curve_csv
 
         bands = {}
         for row in summary["per_normal_stress"]:
             sigma = row["normal_stress_kpa"]
             curves = []
             for s in self.series.values():
-                rows = _read_csv(s.out / folder_name(sigma) / "curve.csv")
+                rows = read_curve_csv(s.out / folder_name(sigma) / "curve.csv")
                 curves.append({k: np.array([r[k] for r in rows]) for k in rows[0]})
             bands[sigma] = curve_band(curves)
         n = len(self.series)
         lab = next(iter(self.series.values())).lab
         plot_replicate_curves(bands, self.out / "fig8a_shear_curves_replicates.png", n, lab=lab)
-        lab_fit = None
-        if lab is not None and len(lab.peaks) >= 2:
-            ls = lab.normal_stresses()
-            lab_fit = mohr_coulomb(ls, [lab.peaks[v] for v in ls])
         peaks_png = self.out / "fig8b_peak_strength_replicates.png"
-        plot_replicate_peaks(summary, peaks_png, lab=lab, lab_fit=lab_fit)
+        plot_replicate_peaks(summary, peaks_png, lab=lab, lab_fit=lab_fit(lab))
 
 
 __all__ = ["ReplicateShear", "mohr_coulomb_ci", "summarize"]

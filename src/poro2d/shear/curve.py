@@ -1,0 +1,115 @@
+"""The recorded curve of a direct shear test: one row per record, and what is read off it.
+
+Shear stress is the horizontal force of the disks on the upper half (upper walls, upper
+lip and the top plate's friction) over the nominal area ``W t``. The peak strength is
+the maximum of the curve smoothed by a centred moving average over ``peak_window`` of
+shear displacement.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from poro2d.dem import Simulation
+from poro2d.dem.measure import ContactSet
+from poro2d.shear.box import SplitBox
+from poro2d.shear.fit import peak, smooth
+from poro2d.shear.settings import ShearSettings, inertial_number
+
+CURVE_COLUMNS = [
+    "step", "shear_displacement_mm", "shear_stress_kpa", "normal_stress_kpa", "plate_displacement_mm",
+    "coordination_number", "lower_half_stress_kpa", "plane_stress_kpa", "upper_unbalanced_kpa",
+    "plate_friction_kpa", "contacts_across_plane", "max_unbalanced_ratio", "inertial_number",
+]  # fmt: skip
+
+
+def curve_row(
+    sim: Simulation, box: SplitBox, settings: ShearSettings, contacts: ContactSet,
+    y_plate0: float, step0: int, rho: float,
+) -> dict:  # fmt: skip
+    """One record of the curve (:data:`CURVE_COLUMNS`) from the simulation's current state.
+
+    ``contacts`` are the simulation's current contacts, ``y_plate0`` the plate height after
+    consolidation, ``step0`` the step shearing began at, ``rho`` the inertial density.
+    """
+    area = box.width * box.thickness
+    fu = box.upper_force(sim)
+    fl = box.lower_force(sim)
+    pl = box.plane_force(sim, contacts)
+    sigma = box.plate_force(sim) / area
+    c = contacts
+    return {
+        "step": sim.step_count - step0,
+        "shear_displacement_mm": 1e3 * box.shear_displacement(sim),
+        "shear_stress_kpa": fu[0] / area / 1e3,
+        "normal_stress_kpa": sigma / 1e3,
+        "plate_displacement_mm": 1e3 * (box.plate_height(sim) - y_plate0),
+        "coordination_number": float(2 * np.count_nonzero(c.kind == 0) + np.count_nonzero(c.kind == 1))
+        / sim.particles.n,
+        "lower_half_stress_kpa": -fl[0] / area / 1e3,
+        "plane_stress_kpa": pl["across"][0] / area / 1e3,
+        "upper_unbalanced_kpa": pl["unbalanced"][0] / area / 1e3,
+        "plate_friction_kpa": sim.wall_force("top")[0] / area / 1e3,
+        "contacts_across_plane": pl["contacts_across"],
+        "max_unbalanced_ratio": sim.unbalanced_ratios()[0],
+        "inertial_number": inertial_number(settings.velocity, sigma, rho, settings.shear_zone_factor),
+    }
+
+
+def _rel(a: np.ndarray, b: np.ndarray, mask: np.ndarray, ref: float) -> float:
+    return float(np.mean(np.abs(a - b)[mask]) / ref) if ref > 0 else math.nan
+
+
+def force_balance(x: np.ndarray, col: dict[str, np.ndarray], window: float) -> dict:
+    """How far the upper half, the shear plane and the lower half agree, over the test.
+
+    The first moments of shearing (one ``window``, at most half the test) are left out.
+    """
+    tau = col["shear_stress_kpa"]
+    late = x >= min(window, 0.5 * x[-1])
+    ref = float(np.mean(np.abs(tau[late])))
+    return {
+        "mean_abs_upper_minus_plane_rel": _rel(tau, col["plane_stress_kpa"], late, ref),
+        "mean_abs_upper_minus_lower_rel": _rel(tau, col["lower_half_stress_kpa"], late, ref),
+        "mean_upper_kpa": float(np.mean(tau[late])),
+        "mean_plane_kpa": float(np.mean(col["plane_stress_kpa"][late])),
+        "mean_lower_kpa": float(np.mean(col["lower_half_stress_kpa"][late])),
+        "note": "upper = force on the upper half walls; plane = contact forces across y = H/2; "
+        "lower = force on the lower half walls; all over W t, means over the test after the "
+        "first peak_window of displacement",
+    }  # fmt: skip
+
+
+def curve_summary(rows: list[dict], sigma_kpa: float, settings: ShearSettings) -> dict:
+    """Peak, end values, servo error, inertial number and force balance read off the curve."""
+    s = settings
+    x = np.array([r["shear_displacement_mm"] for r in rows]) * 1e-3
+    col = {k: np.array([r[k] for r in rows], float) for k in CURVE_COLUMNS}
+    k, xp, tp = peak(x, col["shear_stress_kpa"], s.peak_window)
+    end = {}
+    for name in ("shear_stress_kpa", "normal_stress_kpa", "plate_displacement_mm", "coordination_number"):
+        end[name] = float(smooth(x, col[name], s.peak_window)[-1])
+    sig_err = np.abs(col["normal_stress_kpa"] / sigma_kpa - 1.0)
+    inertial = col["inertial_number"]
+    return {
+        "normal_stress_kpa": sigma_kpa,
+        "peak_shear_stress_kpa": tp,
+        "shear_displacement_at_peak_m": xp,
+        "peak_stress_ratio": tp / sigma_kpa,
+        "peak_shear_stress_raw_kpa": float(np.max(col["shear_stress_kpa"])),
+        "peak_window_m": s.peak_window,
+        "normal_stress_at_peak_kpa": float(smooth(x, col["normal_stress_kpa"], s.peak_window)[k]),
+        "plate_displacement_at_peak_mm": float(col["plate_displacement_mm"][k]),
+        "end": end,
+        "end_shear_displacement_m": float(x[-1]),
+        "max_inertial_number": float(np.max(inertial)),
+        "inertial_number_ok": bool(np.max(inertial) < s.inertial_limit),
+        "normal_stress_max_error_after_consolidation": float(np.max(sig_err)),
+        "normal_stress_mean_error": float(np.mean(sig_err)),
+        "force_balance": force_balance(x, col, s.peak_window),
+    }
+
+
+__all__ = ["CURVE_COLUMNS", "curve_row", "curve_summary", "force_balance"]

@@ -1,0 +1,97 @@
+"""``run_shear``: the ``poro2d shear`` command as a Python function.
+
+Everything is checked before the first test starts, and bad input raises
+:class:`poro2d.errors.InputError` naming the parameter, as the command does.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable
+from pathlib import Path
+
+from poro2d.config import dataclass_from_table
+from poro2d.dem import checkpoint
+from poro2d.errors import InputError, is_number
+from poro2d.io_utils import check_output_dir
+from poro2d.shear.lab import LabData, read_lab_csv
+from poro2d.shear.series import ShearSeries, check_stresses
+from poro2d.shear.settings import ShearSettings
+from poro2d.shear.specimen_file import resolve_specimen
+
+
+def _stresses(value) -> list[float]:
+    """A number or an iterable of numbers (kPa), each > 0, all different."""
+    if is_number(value):
+        value = [value]
+    if isinstance(value, str | bytes | dict) or not isinstance(value, Iterable):
+        raise InputError("normal_stresses_kpa", value, "a number or a list of numbers in kPa")
+    return check_stresses(list(value))
+
+
+def _settings(value) -> ShearSettings:
+    """ShearSettings as given, from a dict of its fields (unknown keys refused), or the defaults."""
+    if value is None:
+        return ShearSettings()
+    if isinstance(value, ShearSettings):
+        return value
+    if isinstance(value, dict):
+        return dataclass_from_table(ShearSettings, "settings", value)
+    raise InputError("settings", type(value).__name__, "a ShearSettings, a dict of its fields or None")
+
+
+def _lab(value) -> LabData | None:
+    """Laboratory data as given, read from a CSV path, or None."""
+    if value is None or isinstance(value, LabData):
+        return value
+    if isinstance(value, str | os.PathLike):
+        return read_lab_csv(value)
+    raise InputError("lab", type(value).__name__, "a laboratory CSV path, a LabData or None")
+
+
+def run_shear(
+    specimen: str | os.PathLike,
+    normal_stresses_kpa,
+    settings: ShearSettings | dict | None = None,
+    *,
+    out: str | os.PathLike,
+    lab: str | os.PathLike | LabData | None = None,
+    rate_check: bool = False,
+    processes: int | None = None,
+    progress: bool = True,
+    config: dict | None = None,
+) -> dict:
+    """Direct shear tests on ``specimen`` at ``normal_stresses_kpa``, the fit and Fig. 8.
+
+    ``specimen``: a checkpoint (.npz) or a criterion output folder holding ``specimen.npz``.
+    ``normal_stresses_kpa``: a number or a list (kPa). ``settings``: a :class:`ShearSettings`,
+    a dict of its fields, or None for the defaults. ``out``: the output folder; a rerun
+    with the same inputs skips finished tests and resumes a killed one. ``lab``: a
+    laboratory CSV (or :class:`LabData`) to compare with. ``rate_check``: repeat every
+    test at half the velocity. ``processes``: worker processes (default one per test, at
+    most twice the CPU count). ``progress``: bars on a terminal, periodic lines in a log.
+    ``config``: recorded in ``result.json`` as it is.
+
+    Returns what is written to ``out/result.json`` (per test ``tests``, the fit
+    ``friction_angle_deg``, ``cohesion_kpa``, ``r2``, ...; see docs/shear.md). Tests run in
+    spawned processes, which import the calling script: call this under
+    ``if __name__ == "__main__":`` in a script. A test that fails to run (consolidation
+    without equilibrium) raises RuntimeError once the others have finished.
+    """
+    out = check_output_dir("out", out)
+    path = resolve_specimen(specimen)
+    checkpoint.read(path)  # a damaged file is refused here, in one line
+    stresses = _stresses(normal_stresses_kpa)
+    lab_data = _lab(lab)
+    shear_settings = _settings(settings)
+    for name, flag in (("rate_check", rate_check), ("progress", progress)):
+        if not isinstance(flag, bool):
+            raise InputError(name, flag, "True or False")
+    series = ShearSeries(
+        path, stresses, shear_settings, out=Path(out), lab=lab_data, rate_check=rate_check,
+        processes=processes, progress=progress, config=config,
+    )  # fmt: skip
+    return series.run()
+
+
+__all__ = ["run_shear"]

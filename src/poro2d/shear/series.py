@@ -1,0 +1,268 @@
+"""Direct shear tests at several normal stresses on one specimen, and the Mohr-Coulomb fit."""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+from poro2d.dem import checkpoint
+from poro2d.errors import InputError, check_range
+from poro2d.io_utils import provenance, write_json
+from poro2d.shear.fit import mohr_coulomb, smooth
+from poro2d.shear.outputs import (
+    folder_name,
+    lab_fit,
+    read_curve_csv,
+    read_curves,
+    write_figures,
+    write_tables,
+)
+from poro2d.shear.pool import execute_jobs
+from poro2d.shear.settings import ShearSettings
+from poro2d.shear.single import DirectShearTest
+from poro2d.shear.specimen_file import resolve_specimen
+
+#: what a series' ``result.json`` keeps of each test
+SUMMARY_KEYS = (
+    "normal_stress_kpa", "peak_shear_stress_kpa", "shear_displacement_at_peak_m", "peak_stress_ratio",
+    "peak_shear_stress_raw_kpa", "normal_stress_at_peak_kpa", "plate_displacement_at_peak_mm", "end",
+    "end_shear_displacement_m", "max_inertial_number", "inertial_number_ok",
+    "normal_stress_max_error_after_consolidation", "force_balance", "wall_time_s",
+)  # fmt: skip
+RATE_CHECK_NOTE = (
+    "relative_change compares the smoothed peaks; mean_abs_change_before_peak the "
+    "smoothed curves from half a window to the earlier of the two peaks, over the peak. "
+    "Runs whose state differs only by round-off also differ by a few percent after the "
+    "peak forms (the packing's trajectory is chaotic), so a peak change of that size is "
+    "not by itself a rate effect; see docs/shear.md"
+)
+
+
+def check_stresses(normal_stresses_kpa) -> list[float]:
+    """Different normal stresses > 0 (kPa), sorted."""
+    stresses = [check_range("normal stress (kPa)", v, 0.0, None, lo_open=True) for v in normal_stresses_kpa]
+    if not stresses:
+        raise InputError("normal stress", [], "at least one value (kPa)")
+    if len(set(stresses)) != len(stresses):
+        raise InputError("normal stress", stresses, "different values")
+    return sorted(stresses)
+
+
+class ShearSeries:
+    """Direct shear tests at several normal stresses, in parallel processes, with the fit.
+
+    Writes ``out/result.json`` (per test and overall), ``peaks.csv``, ``curves.csv``,
+    ``fig8a_shear_curves.png``, ``fig8b_peak_strength.png`` and one folder per test
+    (see :class:`DirectShearTest`); with ``rate_check`` every test is repeated at half
+    the velocity under ``out/rate_check/`` and the change of the peak is reported.
+    Finished tests are skipped on a rerun; a killed test resumes from its checkpoint.
+    """
+
+    def __init__(
+        self,
+        specimen: str | Path,
+        normal_stresses_kpa,
+        settings: ShearSettings | None = None,
+        out: str | Path = "shear-out",
+        lab=None,
+        rate_check: bool = False,
+        rate_tolerance: float = 0.02,
+        processes: int | None = None,
+        progress: bool = True,
+        config: dict | None = None,
+        figures: bool = True,
+    ) -> None:
+        self.specimen = resolve_specimen(specimen)
+        self.stresses = check_stresses(normal_stresses_kpa)
+        self.settings = settings if settings is not None else ShearSettings()
+        self.out = Path(out)
+        self.lab = lab
+        self.rate_check = bool(rate_check)
+        self.rate_tolerance = check_range("rate_tolerance", rate_tolerance, 0.0, 1.0, lo_open=True)
+        if processes is not None and not (isinstance(processes, int) and 1 <= processes <= 64):
+            raise InputError("processes", processes, "an integer in [1, 64]")
+        self.progress = progress
+        self.config = config or {}
+        self.figures = figures
+        self.jobs = self._jobs()
+        # the tests are about equally long: one process per test (up to twice the cores)
+        # leaves no core idle at the end (3 tests on 2 cores take 1.5 test times, not 2)
+        ncpu = os.cpu_count() or 1
+        self.processes = processes if processes is not None else min(len(self.jobs), 2 * ncpu)
+        self._bind_tests()
+
+    def _bind_tests(self) -> None:
+        """Validate every test (box size, then what each folder holds) before anything is written."""
+        tests = [
+            DirectShearTest(job["specimen"], job["sigma"], ShearSettings(**job["settings"]), out=job["out"])
+            for job in self.jobs
+        ]
+        self.specimen_digest = tests[0].specimen_digest if tests else ""
+        for t in tests:
+            t._digest = self.specimen_digest  # one specimen: hashed once
+            t.check_reusable()
+        for t in tests:
+            t.bind()
+
+    def _jobs(self) -> list[dict]:
+        base = self.settings.to_dict()
+        half = dict(base, velocity=0.5 * base["velocity"])
+        common = {"specimen": str(self.specimen)}
+        jobs = [
+            {"key": ("test", sig), "sigma": sig, "settings": base, "figures": self.figures,
+             "out": str(self.out / folder_name(sig)), **common}
+            for sig in self.stresses
+        ]  # fmt: skip
+        if self.rate_check:
+            jobs += [
+                {"key": ("rate", sig), "sigma": sig, "settings": half, "figures": False,
+                 "out": str(self.out / "rate_check" / folder_name(sig)), **common}
+                for sig in self.stresses
+            ]  # fmt: skip
+        return jobs
+
+    def _execute(self) -> dict:
+        return execute_jobs(self.jobs, self.processes, self.progress)
+
+    def run(self) -> dict:
+        t0 = time.perf_counter()
+        return self.finish(self._execute(), t0)
+
+    # ------------------------------------------------------------------ results
+    def finish(self, results: dict, t0: float) -> dict:
+        """Fit, figures and ``result.json`` from the tests' results (keyed as in :meth:`_jobs`)."""
+        tests = [results[("test", s)] for s in self.stresses]
+        sig = np.array([t["normal_stress_kpa"] for t in tests])
+        tau = np.array([t["peak_shear_stress_kpa"] for t in tests])
+        fit = mohr_coulomb(sig, tau) if len(sig) >= 2 else None
+        fit0 = mohr_coulomb(sig, tau, through_origin=True)
+        s = self.settings
+        summary = [self._test_summary(t) for t in tests]
+        result: dict = {
+            "normal_stresses_kpa": self.stresses,
+            "tests": summary,
+            "friction_angle_deg": fit.friction_angle_deg if fit else None,
+            "cohesion_kpa": fit.cohesion_kpa if fit else None,
+            "r2": fit.r2 if fit else None,
+            "fit": fit.to_dict() if fit else None,
+            "friction_angle_through_origin_deg": fit0.friction_angle_deg,
+            "fit_through_origin": fit0.to_dict(),
+            "quasi_static": self._quasi_static(tests),
+            "peak_definition": f"maximum of the shear stress curve smoothed by a centred moving average over "
+            f"{1e3 * s.peak_window:g} mm of shear displacement",
+            "shear_stress_definition": "horizontal force of the disks on the upper half (upper walls, upper "
+            "lip, top plate friction) / (W t), W the box width (no area correction)",
+            "settings": s.to_dict(),
+            "velocity_m_per_s": s.velocity,
+            "density_scale": s.density_scale,
+            "specimen": str(self.specimen),
+            "specimen_digest": self.specimen_digest,
+            "specimen_meta": checkpoint.read_meta(self.specimen).get("extra", {}),
+            "processes": self.processes,
+            "config": self.config,
+        }
+        if self.rate_check:
+            result["rate_check"] = self._rate_check(tests, results, sig, fit)
+        if self.lab is not None:
+            result["lab"] = self._lab_part(fit)
+        result["wall_time_s"] = time.perf_counter() - t0
+        result["provenance"] = provenance()
+        curves = read_curves(self.out, tests)
+        write_tables(self.out, curves, summary)
+        if self.figures:
+            write_figures(self.out, tests, curves, fit, fit0, self.settings, self.lab)
+        write_json(self.out / "result.json", result)
+        return result
+
+    @staticmethod
+    def _test_summary(t: dict) -> dict:
+        """One test's line of the series' result."""
+        return {k: t[k] for k in SUMMARY_KEYS} | {
+            "consolidation_normal_stress_error": t["consolidation"]["normal_stress_error"],
+            "folder": folder_name(t["normal_stress_kpa"]),
+        }
+
+    def _quasi_static(self, tests: list[dict]) -> dict:
+        s = self.settings
+        # a stored infinity reads back as null (JSON has no infinity): the check failed
+        max_i = max(math.inf if t["max_inertial_number"] is None else t["max_inertial_number"] for t in tests)
+        return {
+            "max_inertial_number": max_i,
+            "inertial_limit": s.inertial_limit,
+            "inertial_number_ok": max_i < s.inertial_limit,
+            "inertial_number_definition": "I = gamma_dot d_mean sqrt(rho_s density_scale / sigma_n), "
+            f"gamma_dot = v / ({s.shear_zone_factor:g} d_mean) (a thin shear zone: conservative), "
+            "sigma_n the measured plate stress at each record",
+        }
+
+    def _rate_check(self, tests: list[dict], results: dict, sig: np.ndarray, fit) -> dict:
+        """How the peaks change at half the velocity (the reruns under ``rate_check/``)."""
+        rows = []
+        for t in tests:
+            h = results[("rate", t["normal_stress_kpa"])]
+            rows.append({
+                "normal_stress_kpa": t["normal_stress_kpa"],
+                "peak_kpa": t["peak_shear_stress_kpa"],
+                "peak_half_velocity_kpa": h["peak_shear_stress_kpa"],
+                "relative_change": h["peak_shear_stress_kpa"] / t["peak_shear_stress_kpa"] - 1.0,
+                "shear_displacement_at_peak_m": t["shear_displacement_at_peak_m"],
+                "shear_displacement_at_peak_half_velocity_m": h["shear_displacement_at_peak_m"],
+                "max_inertial_number_half_velocity": h["max_inertial_number"],
+                "mean_abs_change_before_peak": self._pre_peak_change(t, h),
+                "wall_time_s": h["wall_time_s"],
+            })  # fmt: skip
+        worst = max(abs(r["relative_change"]) for r in rows)
+        fit_h = mohr_coulomb(sig, [r["peak_half_velocity_kpa"] for r in rows]) if len(sig) >= 2 else None
+        return {
+            "velocity_m_per_s": self.settings.velocity,
+            "half_velocity_m_per_s": 0.5 * self.settings.velocity,
+            "tests": rows,
+            "max_abs_relative_change": worst,
+            "tolerance": self.rate_tolerance,
+            "passed": worst < self.rate_tolerance,
+            "friction_angle_half_velocity_deg": fit_h.friction_angle_deg if fit_h else None,
+            "friction_angle_change_deg": (fit_h.friction_angle_deg - fit.friction_angle_deg)
+            if (fit_h and fit)
+            else None,
+            "max_mean_abs_change_before_peak": max(r["mean_abs_change_before_peak"] for r in rows),
+            "note": RATE_CHECK_NOTE,
+        }
+
+    def _pre_peak_change(self, t: dict, h: dict) -> float:
+        """Mean |tau_half - tau| / tau_peak of the smoothed curves up to the earlier peak."""
+        w = self.settings.peak_window
+        a = read_curve_csv(self.out / folder_name(t["normal_stress_kpa"]) / "curve.csv")
+        b = read_curve_csv(self.out / "rate_check" / folder_name(t["normal_stress_kpa"]) / "curve.csv")
+        xa = np.array([r["shear_displacement_mm"] for r in a]) * 1e-3
+        xb = np.array([r["shear_displacement_mm"] for r in b]) * 1e-3
+        ya = smooth(xa, np.array([r["shear_stress_kpa"] for r in a]), w)
+        yb = np.interp(xa, xb, smooth(xb, np.array([r["shear_stress_kpa"] for r in b]), w))
+        end = min(t["shear_displacement_at_peak_m"], h["shear_displacement_at_peak_m"])
+        m = (xa >= 0.5 * w) & (xa <= end)
+        if not m.any():
+            return math.nan
+        return float(np.mean(np.abs(yb[m] - ya[m])) / t["peak_shear_stress_kpa"])
+
+    def _lab_part(self, fit) -> dict:
+        """The laboratory data, their fit and the difference of the friction angles."""
+        lab = self.lab
+        part = lab.to_dict()
+        ls = lab.normal_stresses()
+        lf = lab_fit(lab)
+        part["fit"] = lf.to_dict() if lf else None
+        part["friction_angle_deg"] = lf.friction_angle_deg if lf else None
+        part["cohesion_kpa"] = lf.cohesion_kpa if lf else None
+        part["friction_angle_difference_deg"] = (
+            fit.friction_angle_deg - lf.friction_angle_deg if (fit and lf) else None
+        )
+        part["fit_through_origin"] = mohr_coulomb(
+            ls, [lab.peaks[v] for v in ls], through_origin=True
+        ).to_dict()
+        return part
+
+
+__all__ = ["ShearSeries", "check_stresses"]

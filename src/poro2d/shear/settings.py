@@ -1,0 +1,93 @@
+"""Settings of a direct shear test, and the inertial number that says whether it is quasi-static."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+from poro2d.errors import InputError, check_range
+
+
+@dataclass
+class ShearSettings:
+    """Settings of a direct shear test (SI units; the box walls default to Table 1).
+
+    velocity (m/s) and max_displacement (m) of the lower half; record_interval and
+    checkpoint_interval (m of shear displacement); consolidation_ratio and
+    consolidation_max_steps for the consolidation stage; servo_gain, servo_integral
+    (per step; it keeps the stress on target while the specimen dilates) and
+    servo_max_speed (m/s) of the top plate; kn_wall, ks_wall (N/m), friction_wall and
+    gap (m) of the box; particle_friction replaces the specimen's when given;
+    local_damping likewise (None: the specimen's); density_scale >= 1 scales the
+    inertial masses; dt_safety the automatic time step; peak_window (m) the
+    smoothing of the peak; shear_zone_factor k in gamma_dot = v / (k d_mean);
+    inertial_limit and stress_tolerance the quasi-static and servo checks.
+    """
+
+    velocity: float = 0.025
+    max_displacement: float = 0.02
+    record_interval: float = 5e-5
+    checkpoint_interval: float = 1e-3
+    consolidation_ratio: float = 1e-3
+    consolidation_max_steps: int = 300_000
+    servo_gain: float = 0.5
+    servo_integral: float = 1e-3
+    servo_max_speed: float = 0.05
+    kn_wall: float = 1e7
+    ks_wall: float = 1e7
+    friction_wall: float = 1.5
+    gap: float = 0.0
+    particle_friction: float | None = None
+    local_damping: float | None = None
+    density_scale: float = 1.0
+    dt_safety: float = 0.8
+    peak_window: float = 2e-3
+    shear_zone_factor: float = 10.0
+    inertial_limit: float = 1e-3
+    stress_tolerance: float = 0.02
+
+    def __post_init__(self) -> None:
+        check_range("velocity", self.velocity, 0.0, 10.0, lo_open=True)
+        check_range("max_displacement", self.max_displacement, 0.0, None, lo_open=True)
+        check_range("record_interval", self.record_interval, 0.0, None, lo_open=True)
+        check_range("checkpoint_interval", self.checkpoint_interval, 0.0, None, lo_open=True)
+        check_range("consolidation_ratio", self.consolidation_ratio, 0.0, 1.0, lo_open=True)
+        if not (isinstance(self.consolidation_max_steps, int) and self.consolidation_max_steps >= 1000):
+            raise InputError("consolidation_max_steps", self.consolidation_max_steps, "an integer >= 1000")
+        check_range("servo_gain", self.servo_gain, 0.0, 1.0, lo_open=True)
+        check_range("servo_integral", self.servo_integral, 0.0, 0.1)
+        check_range("servo_max_speed", self.servo_max_speed, 0.0, 10.0, lo_open=True)
+        check_range("kn_wall", self.kn_wall, 0.0, None, lo_open=True)
+        check_range("ks_wall", self.ks_wall, 0.0, None)
+        check_range("friction_wall", self.friction_wall, 0.0, None)
+        check_range("gap", self.gap, 0.0, None)
+        if self.particle_friction is not None:
+            check_range("particle_friction", self.particle_friction, 0.0, None)
+        if self.local_damping is not None:
+            check_range("local_damping", self.local_damping, 0.0, 1.0, hi_open=True)
+        check_range("density_scale", self.density_scale, 1.0, None)
+        check_range("dt_safety", self.dt_safety, 0.0, 1.0, lo_open=True)
+        check_range("peak_window", self.peak_window, 0.0, None)
+        check_range("shear_zone_factor", self.shear_zone_factor, 0.0, None, lo_open=True)
+        check_range("inertial_limit", self.inertial_limit, 0.0, None, lo_open=True)
+        check_range("stress_tolerance", self.stress_tolerance, 0.0, 1.0, lo_open=True)
+        if self.record_interval > self.max_displacement:
+            raise InputError("record_interval", self.record_interval, f"(0, {self.max_displacement}] m")
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def inertial_number(velocity: float, sigma_pa: float, rho_inertial: float, shear_zone_factor: float) -> float:
+    """I = gamma_dot d_mean sqrt(rho / sigma_n) with gamma_dot = v / (k d_mean).
+
+    The shear zone of a direct shear test is about 10 to 20 mean diameters thick;
+    taking k = 10 (the thin end) over-estimates the shear rate, so I is on the safe
+    side. With this estimate d_mean cancels: I = (v / k) sqrt(rho / sigma_n).
+    """
+    if not sigma_pa > 0:
+        return math.inf
+    return velocity / shear_zone_factor * math.sqrt(rho_inertial / sigma_pa)
+
+
+__all__ = ["ShearSettings", "inertial_number"]

@@ -1,0 +1,93 @@
+"""The shear stage of a direct shear test: the lower half moves, one row per record.
+
+Every ``record_interval`` of shear displacement one row of the curve is recorded (and,
+with figures, the state kept for the peak's force chains); every
+``checkpoint_interval`` the whole engine state and the rows so far are saved in
+``shear_checkpoint.npz``, so a killed test continues from there bit for bit.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from poro2d.dem import Simulation, checkpoint
+from poro2d.shear.box import LOWER
+from poro2d.shear.curve import curve_row
+from poro2d.shear.peak_frame import PeakFrame, PeakTracker
+
+if TYPE_CHECKING:
+    from poro2d.shear.single import DirectShearTest
+
+
+class ShearStage:
+    """Shear ``sim`` (consolidated, or from the test's checkpoint) to ``max_displacement``.
+
+    After :meth:`run`: ``rows`` (the curve), ``sim`` (the final state) and ``peak.frame``
+    (the state at the smoothed peak, when the test draws figures).
+    """
+
+    def __init__(self, test: DirectShearTest, sim: Simulation, info: dict) -> None:
+        s = test.settings
+        assert test.box is not None
+        self.test, self.box, self.settings = test, test.box, s
+        self.t0 = time.perf_counter()
+        self.ck = test._path("shear_checkpoint.npz")
+        self.fpath = test._path("peak_frame.npz")
+        self.y_plate0 = info["plate_height_m"]
+        self.sim, self.rows, self.step0, self.wall_before = self._start(sim)
+        dx_step = s.velocity * self.sim.dt
+        self.every = max(1, int(round(s.record_interval / dx_step)))
+        self.total = int(math.ceil(s.max_displacement / dx_step / self.every)) * self.every
+        self.ck_every = max(1, int(round(s.checkpoint_interval / (self.every * dx_step))))
+        self.rho = float(np.mean(self.sim.particles.density)) * self.sim.density_scale
+        self.peak = PeakTracker(s.peak_window)
+        self.peak.restore(self.fpath, self.rows)
+
+    def _start(self, sim: Simulation) -> tuple[Simulation, list[dict], int, float]:
+        """(simulation, rows, step shearing began at, wall time so far): resumed or new."""
+        if self.ck is not None and self.ck.is_file():
+            meta = checkpoint.read_meta(self.ck)["extra"]
+            resumed = checkpoint.load(self.ck, threads=self.test.threads)
+            return resumed, meta["rows"], meta["step0"], meta.get("wall_time_s", 0.0)
+        for name in LOWER:
+            sim.set_wall_velocity(name, (self.settings.velocity, 0.0))
+        return sim, [], sim.step_count, 0.0
+
+    def record(self, sim: Simulation) -> bool:
+        """One record (the engine's callback): a row, the peak's frame, maybe a checkpoint."""
+        rows = self.rows
+        contacts = sim.contacts()
+        rows.append(curve_row(sim, self.box, self.settings, contacts, self.y_plate0, self.step0, self.rho))
+        x_mm = rows[-1]["shear_displacement_mm"]
+        if self.test.figures:
+            self.peak.add(PeakFrame.capture(sim, contacts, len(rows) - 1, x_mm))
+        self.peak.settle(rows, x_mm * 1e-3)
+        done = sim.step_count - self.step0
+        self.test._report("shearing", done / self.total)
+        if self.ck is not None and len(rows) % self.ck_every == 0 and done < self.total:
+            self.peak.save(self.fpath)  # a resumed run still draws the peak's forces
+            wall = self.wall_before + time.perf_counter() - self.t0
+            extra = {"stage": "shear", "rows": rows, "step0": self.step0, "wall_time_s": wall}
+            checkpoint.save(sim, self.ck, extra=extra)
+        return False  # never stop early: the test runs to max_displacement
+
+    def run(self) -> float:
+        """Shear to the end; returns the stage's wall time (s), resumed parts included."""
+        remaining = self.total - (self.sim.step_count - self.step0)
+        if remaining > 0:
+            self.sim.run(remaining, every=self.every, callback=self.record)
+        self.peak.settle(self.rows, None)
+        return self.wall_before + time.perf_counter() - self.t0
+
+    def remove_files(self) -> None:
+        """The checkpoint and the stored frame, once the test's results are written."""
+        for f in (self.ck, self.fpath):
+            if f is not None and f.is_file():
+                f.unlink()
+
+
+__all__ = ["ShearStage"]
