@@ -50,12 +50,14 @@ def _register() -> None:
     from poro2d.criterion import cli as criterion_cli
     from poro2d.shear import cli as shear_cli
     from poro2d.sweep import cli as sweep_cli
+    from poro2d.sweep import sensitivity_cli
 
     porosity_cli.register(app)
     criterion_cli.register(app)
     shear_cli.register(app)
     paper.register(app)
     sweep_cli.register(app)
+    sensitivity_cli.register(app)
     for info in app.registered_commands:
         info.callback = _interruptible(info.name or info.callback.__name__, info.callback)
 
@@ -67,6 +69,7 @@ KEPT = {
     "paper": "finished stages, trials and tests",
     "sweep": "finished cases",
     "relation": "finished cases",
+    "sensitivity": "finished cases",
 }
 
 

@@ -138,6 +138,13 @@ def build_blocks(out: Path, summary: dict) -> list[Block]:
         if (cd / name).is_file():
             b.append(("img", cd / name, cap))
 
+    # --- why the paper gets what it gets (when the run holds a sensitivity study)
+    sens = summary.get("sensitivity")
+    if sens:
+        from poro2d.report.sensitivity_report import report_blocks
+
+        b.extend(report_blocks(sens))
+
     # --- shear
     if shear:
         b.extend(_shear_blocks(out, shear))
