@@ -100,8 +100,9 @@ def test_answer_names_the_matching_width_and_the_closest_friction():
     assert mu["matches"] == [] and mu["closest"] == 0.0
     assert mu["distance"] == pytest.approx(0.025)
     text = " ".join(ans["lines"])
-    assert "Cu = 3 reproduces 0.15 within 0.005" in text
-    assert "no point reproduces 0.15" in text and "0.0250 above" in text
+    assert "within 0.005 of 0.15: Cu = 3: 0.1467 +- 0.0058 (n = 3)" in text
+    assert "no point within 0.005 of 0.15; the closest is mu_prep = 0 with 0.1750" in text
+    assert "0.0250 above" in text
     assert "1 seed(s) did not converge" not in text and "2 seed(s) did not converge" in text
     # the paper's first trial beside poro2d's: 3 854 000 N/m is 3854e3 / 846 G
     assert f"{3854e3 / 846:.4g} G" in text
@@ -247,4 +248,4 @@ def test_paper_report_shows_the_section_only_with_results(tmp_path):
     blocks = build_blocks(tmp_path, dict(summary, sensitivity=sens))
     md, html = to_markdown(blocks, tmp_path), to_html(blocks, "t")
     assert "Why the paper gets 0.15" in md and "Why the paper gets 0.15" in html
-    assert "Cu = 3 reproduces 0.15" in md
+    assert "within 0.005 of 0.15: Cu = 3" in md
