@@ -51,6 +51,7 @@ def _register() -> None:
     from poro2d.interop import cli as interop_cli
     from poro2d.shear import cli as shear_cli
     from poro2d.sweep import cli as sweep_cli
+    from poro2d.sweep import sensitivity_cli
 
     porosity_cli.register(app)
     criterion_cli.register(app)
@@ -58,6 +59,7 @@ def _register() -> None:
     paper.register(app)
     sweep_cli.register(app)
     interop_cli.register(app)
+    sensitivity_cli.register(app)
     for info in app.registered_commands:
         info.callback = _interruptible(info.name or info.callback.__name__, info.callback)
 
@@ -69,6 +71,7 @@ KEPT = {
     "paper": "finished stages, trials and tests",
     "sweep": "finished cases",
     "relation": "finished cases",
+    "sensitivity": "finished cases",
 }
 
 

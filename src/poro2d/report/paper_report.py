@@ -148,6 +148,13 @@ def build_blocks(out: Path, summary: dict) -> list[Block]:
             b.append(("img", cd / name, cap))
     b.extend(_state_blocks(cd))
 
+    # --- why the paper gets what it gets (when the run holds a sensitivity study)
+    sens = summary.get("sensitivity")
+    if sens:
+        from poro2d.report.sensitivity_report import report_blocks
+
+        b.extend(report_blocks(sens))
+
     # --- shear
     if shear:
         b.extend(_shear_blocks(out, shear))

@@ -89,7 +89,7 @@ def validate_criterion(config: dict, base_dir: Path | None = None) -> None:
 
 
 def run_criterion(config: dict, out_dir: Path) -> dict:
-    """The criterion of Fig. 3 for one case; scalars of its result and of its last trial."""
+    """The criterion of Fig. 3 for one case; scalars of its result, of its first and of its last trial."""
     from poro2d.criterion.protocol import PorosityCriterion
 
     spec, grading, settings, seed = _criterion_objects(config)
@@ -98,6 +98,7 @@ def run_criterion(config: dict, out_dir: Path) -> dict:
         spec, grading, settings, seed=seed, out=out_dir, progress=False, config=config, figures=figures
     )
     res = crit.run()
+    first = res["iterations"][0] if res["iterations"] else {}
     last = res["iterations"][-1] if res["iterations"] else {}
     return {
         "n_lab": res["n_lab"],
@@ -115,6 +116,14 @@ def run_criterion(config: dict, out_dir: Path) -> dict:
         "f_top_after_n_per_m": last.get("f_top_after_n_per_m"),
         "f_bottom_after_n_per_m": last.get("f_bottom_after_n_per_m"),
         "self_weight_n_per_m": last.get("self_weight_n_per_m"),
+        # the first trial (Eq. 12 unless given): the paper reports its forces too (its Fig. 5)
+        "first_trial_porosity": first.get("trial_porosity"),
+        "first_particle_count": first.get("particle_count"),
+        "first_f_top_n_per_m": first.get("f_top_n_per_m"),
+        "first_f_bottom_n_per_m": first.get("f_bottom_n_per_m"),
+        "first_self_weight_n_per_m": first.get("self_weight_n_per_m"),
+        "first_plate_moved": first.get("plate_moved"),
+        "first_new_porosity": first.get("new_porosity"),
         "criterion_time_s": res.get("time_total_s"),
     }
 

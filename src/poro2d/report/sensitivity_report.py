@@ -1,0 +1,159 @@
+"""The figure and the report section of the sensitivity study (``poro2d sensitivity``).
+
+Both read only the study's result dict (as written to ``sensitivity.json``), so a
+report can be rebuilt from the file. Values that were undefined (no converged seed)
+come back from JSON as ``None`` and are shown as such.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from poro2d.report.document import Block
+
+
+def _num(v) -> float:
+    return float(v) if v is not None else math.nan
+
+
+def _ok(p: dict) -> bool:
+    return math.isfinite(_num(p.get("n2d_mean")))
+
+
+def plot_sensitivity(sens: dict, stem: Path) -> list[Path]:
+    """Two panels, written as ``stem.png`` and ``stem.svg``: n2D against Cu and against mu_prep."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from poro2d.io_utils import atomic_path
+
+    paper = sens["paper"]
+    target, tol = float(paper["accepted_porosity"]), float(sens["answer"]["tolerance"])
+    fig = Figure(figsize=(12.0, 5.2), layout="constrained")
+    FigureCanvasAgg(fig)
+    ax1, ax2 = fig.subplots(1, 2, sharey=True)
+    for ax in (ax1, ax2):
+        ax.axhspan(target - tol, target + tol, color="tab:green", alpha=0.12, lw=0)
+        ax.axhline(target, color="tab:green", lw=1.5, label=f"paper: accepted n2D = {target:g} (+- {tol:g})")
+        ax.grid(True, alpha=0.3)
+    _grading_panel(ax1, sens)
+    _mu_panel(ax2, sens)
+    s = sens["settings"]
+    fig.suptitle(
+        f"Accepted 2D porosity, paper protocol (nLab = {s['n_lab']:g}, first trial {s['first_trial']:g} "
+        f"from {s['first_trial_from']}); mean +- sd over {s['seeds']} seed(s)"
+        + ("; quick box" if s.get("quick") else ""),
+        fontsize=11,
+    )
+    paths = []
+    for ext in ("png", "svg"):
+        p = stem.with_suffix(f".{ext}")
+        with atomic_path(p) as tmp:
+            fig.savefig(tmp, dpi=150, format=ext)
+        paths.append(p)
+    return paths
+
+
+def _errorbar(ax, pts: list[dict], x: str, **kw) -> None:
+    ok = [p for p in pts if _ok(p)]
+    if ok:
+        ax.errorbar([p[x] for p in ok], [p["n2d_mean"] for p in ok], yerr=[_num(p["n2d_sd"]) for p in ok],
+                    capsize=4, **kw)  # fmt: skip
+    for p in pts:
+        if p["unconverged"]:
+            y = p["n2d_mean"] if _ok(p) else ax.get_ylim()[0]
+            ax.annotate(f"{p['n']}/{p['seeds']} converged", (p[x], y), textcoords="offset points",
+                        xytext=(5, 8), fontsize=8, color="tab:red")  # fmt: skip
+
+
+def _grading_panel(ax, sens: dict) -> None:
+    pts = sens["points"]["grading"]
+    family = [p for p in pts if p["cu_nominal"] is not None]
+    ref = [p for p in pts if p["cu_nominal"] is None]
+    label = "log-linear grading, same mean disk area"
+    _errorbar(ax, family, "cu", fmt="o-", color="tab:blue", ms=7, label=label)
+    _errorbar(ax, ref, "cu", fmt="*", color="tab:red", ms=15,
+              label=f"poro2d's reference grading (Cu = {ref[0]['cu']:.2f})" if ref else None)  # fmt: skip
+    ax.set_xlabel("coefficient of uniformity Cu = d60 / d10 [-]")
+    ax.set_ylabel("accepted 2D porosity n2D [-]")
+    ax.set_title(f"grading width at mu_prep = {sens['settings']['mu_prep']:g}", fontsize=10)
+    ax.legend(loc="best", fontsize=8.5, frameon=False)
+
+
+def _mu_panel(ax, sens: dict) -> None:
+    mu0 = sens["settings"]["mu_prep"]
+    _errorbar(ax, sens["points"]["mu_prep"], "mu_prep", fmt="s-", color="tab:purple", ms=6,
+              label="calibration: n' of the accepted trial (first trial 0.19)")  # fmt: skip
+    # like for like: the measured n' of the paper protocol's accepted trial, beside the calibration's
+    ref = [p for p in sens["points"]["grading"] if p["cu_nominal"] is None]
+    if ref and math.isfinite(_num(ref[0].get("measured_mean"))):
+        first = sens["settings"]["first_trial"]
+        ax.errorbar([mu0], [ref[0]["measured_mean"]], yerr=[_num(ref[0]["measured_sd"])], fmt="*",
+                    color="tab:red", ms=15, capsize=4,
+                    label=f"paper protocol (first trial {first:g}): n' of the accepted trial")  # fmt: skip
+    ax.axvline(mu0, color="0.3", ls=":", lw=1.2, label=f"paper: mu_prep = {mu0:g}")
+    ax.set_xlabel("preparation friction mu_prep [-]")
+    ax.set_title("preparation friction, reference grading", fontsize=10)
+    ax.legend(loc="best", fontsize=8.5, frameon=False)
+
+
+def _pm(p: dict) -> str:
+    if not _ok(p):
+        return "-"
+    return f"{p['n2d_mean']:.4f} +- {_num(p['n2d_sd']):.4f}"
+
+
+def report_blocks(sens: dict, figure: str | Path | None = None) -> list[Block]:
+    """The report section of a sensitivity study, in the blocks of :mod:`poro2d.report.document`.
+
+    ``figure``: the study's PNG; by default the one recorded in ``sens["figure"]``.
+    """
+    s, paper = sens["settings"], sens["paper"]
+    b: list[Block] = [("h2", "Why the paper gets 0.15: grading width and preparation friction")]
+    b.append((
+        "p",
+        f"The criterion with the paper's protocol (mu_prep = {s['mu_prep']:g}, first trial "
+        f"{s['first_trial']:g} from {s['first_trial_from']} at nLab = {s['n_lab']:g}) for gradings of "
+        "several widths at the reference grading's mean disk area (the same number of disks), and the "
+        f"reference grading at several preparation frictions; {s['seeds']} seed(s) per point "
+        f"(seeds {', '.join(map(str, s['seed_list']))}), mean +- sample sd."
+        + (" Quick mode: a reduced box, not the paper's." if s.get("quick") else ""),
+    ))  # fmt: skip
+    g_rows = [
+        [p["label"], p["cu"], p["d_max_mm"], _pm(p), p["n"], p["unconverged"], _num(p["measured_mean"]),
+         _num(p["first_f_top_over_g_mean"])]
+        for p in sens["points"]["grading"]
+    ]  # fmt: skip
+    b.append(("table", ["grading", "Cu", "d_max (mm)", "accepted n2D", "n", "unconverged", "n' accepted",
+                        "first trial F_top / G"], g_rows))  # fmt: skip
+    m_rows = [[p["mu_prep"], _pm(p), p["n"], p["unconverged"]] for p in sens["points"]["mu_prep"]]
+    b.append(("table", ["mu_prep", "n' of the accepted trial", "n", "unconverged"], m_rows))
+    b.extend(_first_trial_table(sens, paper))
+    fig = figure if figure is not None else sens.get("figure")
+    if fig:
+        b.append(("img", Path(fig), "Accepted n2D against grading width (left) and preparation friction "
+                  "(right); the band is the paper's 0.15 +- 0.005"))  # fmt: skip
+    b.append(("ul", list(sens["answer"]["lines"])))
+    return b
+
+
+def _first_trial_table(sens: dict, paper: dict) -> list[Block]:
+    ref = next((p for p in sens["points"]["grading"] if p["cu_nominal"] is None), None)
+    if ref is None or not math.isfinite(_num(ref.get("first_f_top_mean"))):
+        return []
+    paper_f = 1e3 * paper["f_top_first_trial_kn_per_m"]
+    paper_g = paper["self_weight_first_trial_n_per_m"]
+    rows = [
+        ["first trial n2D", ref["first_trial_porosity"], paper["trials"][0]],
+        ["F_top at H (N/m)", _num(ref["first_f_top_mean"]), paper_f],
+        ["G (N/m)", _num(ref["first_g_mean"]), paper_g],
+        ["F_top / G", _num(ref["first_f_top_over_g_mean"]), paper_f / paper_g],
+        ["n' after the plate moved", _num(ref["first_n_prime_mean"]),
+         paper["trials"][0] + paper["porosity_change_first_trial"]],
+        ["F_top, accepted trial (N/m)", _num(ref["accepted_f_top_mean"]), paper["f_top_accepted_n_per_m"]],
+    ]  # fmt: skip
+    return [("table", ["first trial, reference grading", "poro2d (mean over seeds)", "paper"], rows)]
+
+
+__all__ = ["plot_sensitivity", "report_blocks"]

@@ -1,0 +1,527 @@
+"""Why the paper's case gives what it gives: the criterion against grading width and mu_prep.
+
+The criterion of Fig. 3 steers every trial to the porosity at which the prepared specimen
+fills the box without being forced; that porosity is a property of the grading and of
+the preparation. The built-in paper grading is a reconstruction (narrow, Cu about 1.7),
+so this study measures, with the paper's own protocol (preparation friction 0.05, first
+trial from Eq. 12 at nLab = 0.3434):
+
+a. the accepted n2D against the width of the grading: a log-linear family of given Cu at
+   the reconstructed grading's mean disk area (the same number of disks in the box), and
+   the reconstructed grading itself (:func:`grading_study`);
+b. the accepted n2D against the preparation friction mu_prep, for the reconstructed
+   grading: the density calibration of :mod:`poro2d.sweep.density` (cached per grading);
+c. every point over seeds (mean, sample sd, n; unconverged seeds counted, not averaged);
+d. the first trial's F_top and G beside the paper's (3854 kN/m against 846 N/m).
+
+The answer (:func:`answer`) is computed from the numbers: which grading width or friction
+accepts the paper's 0.15 within 0.005, or which comes closest and by how much.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from poro2d.config import check_keys
+from poro2d.errors import InputError, check_int, is_number
+
+#: grading widths of the full study (Cu = d60 / d10), and of ``--quick``: at the paper
+#: grading's mean disk area Cu = 4 has disks of about 26 mm, taller than the 20 mm layer
+#: bands of the quick box (0.04 m in 2 layers), so the quick list stops at Cu = 3
+DEFAULT_CUS = (1.5, 2.0, 2.5, 3.0, 4.0)
+QUICK_CUS = (1.5, 2.0, 2.5, 3.0)
+DEFAULT_SEEDS = 3
+QUICK_SEEDS = 2
+#: keys of the optional ``[sensitivity]`` table of a config
+SENSITIVITY_KEYS = {"cu", "mu_prep", "seeds"}
+#: how close an accepted n2D must be to the paper's to count as reproducing it: the
+#: criterion's own porosity tolerance
+MATCH_TOLERANCE = 0.005
+#: label of the grading given in the config (for the paper preset: the reconstruction)
+REFERENCE = "reference"
+
+
+def paper_numbers() -> dict:
+    """The numbers the paper reports for its criterion run (held by ``poro2d.paper``)."""
+    from poro2d.paper import PAPER  # the case study keeps the paper's facts in one place
+
+    return {"n_lab": PAPER["n_lab"], **PAPER["criterion"]}
+
+
+def quick_criterion() -> dict:
+    """The criterion settings of a quick run: those of ``poro2d paper --quick``."""
+    from poro2d.paper import QUICK_CRITERION
+
+    return dict(QUICK_CRITERION)
+
+
+# ------------------------------------------------------------------------------ settings
+def check_cus(cus: Any) -> list[float]:
+    """Distinct grading widths Cu > 1 (a single size has Cu = 1), at most 20, ascending."""
+    if not isinstance(cus, (list, tuple)) or not cus:
+        raise InputError("sensitivity.cu", cus, "a non-empty list of uniformity coefficients Cu")
+    out = []
+    for v in cus:
+        if not is_number(v) or not math.isfinite(float(v)) or not 1.0 < float(v) <= 20.0:
+            raise InputError("sensitivity.cu", v, "Cu in (1, 20] (Cu = d60/d10; 1 is a single size)")
+        out.append(float(v))
+    if len(set(out)) != len(out):
+        raise InputError("sensitivity.cu", cus, "distinct values")
+    return sorted(out)
+
+
+def check_seeds(seeds: Any, name: str = "sensitivity.seeds") -> int:
+    return check_int(name, seeds, 1, 50)
+
+
+def study_settings(table: dict | None, *, quick: bool, seeds: int | None) -> dict:
+    """Cu list, mu_prep list and seeds from ``[sensitivity]`` and the command line."""
+    from poro2d.criterion.density import DEFAULT_MUS
+    from poro2d.sweep.density import check_mus
+
+    t = dict(table or {})
+    check_keys("sensitivity", t, SENSITIVITY_KEYS)
+    cus = check_cus(t.get("cu", list(QUICK_CUS if quick else DEFAULT_CUS)))
+    mus = check_mus(t.get("mu_prep", list(DEFAULT_MUS)))
+    if seeds is not None:
+        n = check_seeds(seeds, "--seeds")
+    else:
+        n = check_seeds(t.get("seeds", QUICK_SEEDS if quick else DEFAULT_SEEDS))
+    return {"cus": cus, "mus": mus, "seeds": n, "quick": bool(quick)}
+
+
+def study_base(base: dict, *, quick: bool) -> dict:
+    """The criterion config every case starts from: the given one, smaller in quick mode."""
+    from poro2d.sweep.relation import QUICK_SPECIMEN
+
+    cfg = copy.deepcopy({k: v for k, v in base.items() if k not in ("sensitivity", "relation", "sweep")})
+    if quick:
+        cfg["specimen"] = dict(cfg.get("specimen") or {}, **QUICK_SPECIMEN)
+        # in a box of a few hundred disks 1 % of G is about two disks' weight: the quick
+        # look widens the window as `poro2d paper --quick` does (a config's own value wins)
+        cfg["criterion"] = dict(quick_criterion(), **(cfg.get("criterion") or {}))
+    return cfg
+
+
+# ------------------------------------------------------------------------------ gradings
+@dataclass
+class GradingCase:
+    """One grading of the study: how it is described to a case, and its sizes."""
+
+    label: str
+    cu_nominal: float | None
+    params: dict[str, Any]
+    curve: Any  # GradingCurve
+
+    def describe(self) -> dict:
+        c = self.curve
+        return {
+            "label": self.label,
+            "cu_nominal": self.cu_nominal,
+            "cu": c.uniformity,
+            "d10_mm": 1e3 * c.size_at(10.0),
+            "d50_mm": 1e3 * c.size_at(50.0),
+            "d_min_mm": 1e3 * c.d_min_m,
+            "d_max_mm": 1e3 * c.d_max_m,
+            "mean_disk_area_m2": c.mean_disk_area(),
+            "sizes_m": list(c.sizes_m),
+            "percent_passing": list(c.percent_passing),
+            "source": c.source,
+        }
+
+
+def _reference_params(base: dict, base_dir: Path | None) -> dict[str, Any]:
+    g = dict(base.get("grading") or {"preset": "paper"})
+    if isinstance(g.get("csv"), str) and base_dir is not None and not Path(g["csv"]).is_absolute():
+        g["csv"] = str((base_dir / g["csv"]).resolve())
+    return {f"grading.{k}": v for k, v in g.items()}
+
+
+def gradings(base: dict, base_dir: Path | None, cus: list[float]) -> list[GradingCase]:
+    """The config's grading, then the log-linear family at its mean disk area."""
+    from poro2d.criterion.config import build
+    from poro2d.specimen.grading import log_linear_grading
+
+    _, ref, _, _ = build(copy.deepcopy(base), base_dir)
+    out = [GradingCase(REFERENCE, None, _reference_params(base, base_dir), ref)]
+    area = ref.mean_disk_area()
+    for cu in cus:
+        g = log_linear_grading(cu, area)
+        # model sizes in mm, up-scale 1: the case rebuilds exactly this curve
+        params = {
+            "grading.sizes_mm": [1e3 * s for s in g.sizes_m],
+            "grading.percent_passing": list(g.percent),
+        }
+        out.append(GradingCase(f"Cu {cu:g}", cu, params, g))
+    return out
+
+
+def check_gradings(base: dict, base_dir: Path | None, cases: list[GradingCase]) -> None:
+    """Every grading must fit the box: one clear line naming the Cu, before anything runs."""
+    from poro2d.criterion.config import build
+    from poro2d.specimen.compaction import check_feasible
+
+    spec, _, settings, _ = build(copy.deepcopy(base), base_dir)
+    band = spec.height / spec.layers
+    for g in cases:
+        d_max = g.curve.d_max_m
+        if d_max >= min(spec.width, band):
+            raise InputError(
+                "sensitivity.cu" if g.cu_nominal is not None else "grading",
+                g.cu_nominal if g.cu_nominal is not None else g.label,
+                f"a grading whose largest disk fits the {1e3 * band:.4g} mm layer band "
+                f"({spec.height} m in {spec.layers} layers) and the {spec.width} m width",
+                f"its largest disk is {1e3 * d_max:.4g} mm: use a smaller Cu or a taller box",
+            )
+        check_feasible(spec, g.curve, settings.initial_trial())
+
+
+def grading_sweep(base: dict, cases: list[GradingCase], seeds: int) -> dict:
+    """One criterion case per grading and seed, everything else as in ``base``."""
+    cfg = copy.deepcopy(base)
+    cfg["grading"] = {}  # each case names its own grading
+    cfg["sweep"] = {
+        "kind": "criterion",
+        "title": "accepted n2D against grading width",
+        "cases": [dict(g.params, seed=s) for g in cases for s in range(seeds)],
+    }
+    return cfg
+
+
+# ------------------------------------------------------------------------------ analysis
+def summarise(values: list) -> dict:
+    """Mean, sample sd (0 for one value) and n of the finite values; NaN when there are none."""
+    a = np.array([float(v) for v in values if v is not None and math.isfinite(float(v))], dtype=float)
+    if a.size == 0:
+        return {"mean": math.nan, "sd": math.nan, "n": 0}
+    return {"mean": float(a.mean()), "sd": float(a.std(ddof=1)) if a.size > 1 else 0.0, "n": int(a.size)}
+
+
+def _ratio(a, b) -> float | None:
+    if a is None or b is None or not b:
+        return None
+    return float(a) / float(b)
+
+
+def seed_record(row: dict, grading: dict, seed: int) -> dict:
+    """One criterion run of the grading study, flattened: accepted n2D, first and last trial."""
+    res = row.get("results") or {}
+    ok = row.get("status") == "done" and bool(res.get("converged"))
+    return {
+        "grading": grading["label"],
+        "cu": grading["cu"],
+        "seed": seed,
+        "status": row.get("status"),
+        "converged": ok,
+        "accepted_n2d": res.get("final_porosity") if ok else None,
+        "accepted_measured_n2d": res.get("last_new_porosity") if ok else None,
+        "last_estimate_n2d": res.get("last_new_porosity"),
+        "iterations": res.get("iterations"),
+        "first_trial_porosity": res.get("first_trial_porosity", res.get("initial_trial_porosity")),
+        "first_f_top_n_per_m": res.get("first_f_top_n_per_m"),
+        "first_self_weight_n_per_m": res.get("first_self_weight_n_per_m"),
+        "first_f_top_over_g": _ratio(res.get("first_f_top_n_per_m"), res.get("first_self_weight_n_per_m")),
+        "first_plate_moved": res.get("first_plate_moved"),
+        "first_new_porosity": res.get("first_new_porosity"),
+        "accepted_f_top_n_per_m": res.get("f_top_after_n_per_m") if ok else None,
+        "accepted_f_bottom_n_per_m": res.get("f_bottom_after_n_per_m") if ok else None,
+        "accepted_self_weight_n_per_m": res.get("self_weight_n_per_m") if ok else None,
+        "message": res.get("message") or row.get("error"),
+        "time_s": row.get("time_s"),
+    }
+
+
+def grading_points(records: list[dict], grads: list[dict]) -> list[dict]:
+    """One point per grading: accepted n2D and first-trial forces over its seeds."""
+    pts = []
+    for g in grads:
+        recs = [r for r in records if r["grading"] == g["label"]]
+        acc = summarise([r["accepted_n2d"] for r in recs])
+        pts.append({
+            "axis": "grading",
+            "label": g["label"],
+            "cu": g["cu"],
+            "cu_nominal": g["cu_nominal"],
+            "d50_mm": g["d50_mm"],
+            "d_max_mm": g["d_max_mm"],
+            "n2d_mean": acc["mean"],
+            "n2d_sd": acc["sd"],
+            "n": acc["n"],
+            "seeds": len(recs),
+            "unconverged": len(recs) - acc["n"],
+            "quantity": "accepted trial n2D",
+            **_prefixed("measured", summarise([r["accepted_measured_n2d"] for r in recs])),
+            **_prefixed("first_f_top", summarise([r["first_f_top_n_per_m"] for r in recs])),
+            **_prefixed("first_g", summarise([r["first_self_weight_n_per_m"] for r in recs])),
+            **_prefixed("first_f_top_over_g", summarise([r["first_f_top_over_g"] for r in recs])),
+            **_prefixed("first_n_prime", summarise([r["first_new_porosity"] for r in recs])),
+            **_prefixed("accepted_f_top", summarise([r["accepted_f_top_n_per_m"] for r in recs])),
+            "first_trial_porosity": next((r["first_trial_porosity"] for r in recs), None),
+        })  # fmt: skip
+    return pts
+
+
+def _prefixed(name: str, s: dict) -> dict:
+    return {f"{name}_mean": s["mean"], f"{name}_sd": s["sd"]}
+
+
+def mu_points(cal: dict) -> list[dict]:
+    """One point per preparation friction, from a calibration's samples (n' per seed)."""
+    pts = []
+    for mu, samples in zip(cal["mus"], cal["samples"], strict=True):
+        s = summarise(samples)
+        pts.append({
+            "axis": "mu_prep", "label": f"mu_prep {mu:g}", "mu_prep": mu,
+            "n2d_mean": s["mean"], "n2d_sd": s["sd"], "n": s["n"], "seeds": len(samples),
+            "unconverged": len(samples) - s["n"], "quantity": "n' of the accepted trial (first trial 0.19)",
+        })  # fmt: skip
+    return pts
+
+
+# -------------------------------------------------------------------------------- answer
+def closest_match(points: list[dict], x: str, target: float, tol: float = MATCH_TOLERANCE) -> dict:
+    """Points within ``tol`` of ``target``, the closest point, and where the means cross it.
+
+    ``x`` names the swept quantity. The crossing is a linear interpolation between two
+    neighbouring points (sorted by ``x``) whose means lie on either side of the target.
+    """
+    good = sorted((p for p in points if math.isfinite(p["n2d_mean"])), key=lambda p: p[x])
+    if not good:
+        return {"matches": [], "closest": None, "distance": None, "crossing": None}
+    best = min(good, key=lambda p: abs(p["n2d_mean"] - target))
+    crossing = None
+    for a, b in zip(good, good[1:], strict=False):
+        ya, yb = a["n2d_mean"] - target, b["n2d_mean"] - target
+        if ya * yb <= 0.0 and ya != yb:
+            crossing = a[x] + (b[x] - a[x]) * ya / (ya - yb)
+            break
+    return {
+        "matches": [p[x] for p in good if abs(p["n2d_mean"] - target) <= tol + 1e-12],
+        "closest": best[x],
+        "closest_mean": best["n2d_mean"],
+        "closest_sd": best["n2d_sd"],
+        "closest_n": best["n"],
+        "distance": best["n2d_mean"] - target,
+        "crossing": crossing,
+        "ends": [[good[0][x], good[0]["n2d_mean"]], [good[-1][x], good[-1]["n2d_mean"]]],
+    }
+
+
+def _pm(p_mean: float, sd: float, n: int) -> str:
+    return f"{p_mean:.4f} +- {sd:.4f} (n = {n})"
+
+
+def _axis_text(name: str, unit: str, m: dict, points: list[dict], x: str, target: float, tol: float) -> str:
+    if m["closest"] is None:
+        return f"{name}: no point was accepted by any seed."
+    if m["matches"]:
+        hits = [p for p in points if p[x] in m["matches"]]
+        vals = "; ".join(f"{unit}{p[x]:g}: {_pm(p['n2d_mean'], p['n2d_sd'], p['n'])}" for p in hits)
+        text = f"{name}: within {tol:g} of {target:g}: {vals}"
+    else:
+        best = _pm(m["closest_mean"], m["closest_sd"], m["closest_n"])
+        side = "above" if m["distance"] > 0 else "below"
+        text = f"{name}: no point within {tol:g} of {target:g}; the closest is {unit}{m['closest']:g} with "
+        text += f"{best}, {abs(m['distance']):.4f} {side}"
+    if m["crossing"] is not None:
+        text += f"; the means cross {target:g} at {unit}{m['crossing']:.3g} (linear interpolation)"
+    else:
+        (x0, y0), (x1, y1) = m["ends"]
+        text += f"; from {unit}{x0:g} to {unit}{x1:g} the means run from {y0:.4f} to {y1:.4f}"
+    return text + "."
+
+
+def answer(sens: dict, tol: float = MATCH_TOLERANCE) -> dict:
+    """Which grading width and which mu_prep accept the paper's n2D, from the measured points."""
+    paper = sens["paper"]
+    target = float(paper["accepted_porosity"])
+    g_pts = sens["points"]["grading"]
+    family = [p for p in g_pts if p["cu_nominal"] is not None]
+    ref = next((p for p in g_pts if p["cu_nominal"] is None), None)
+    g = closest_match(family, "cu", target, tol)
+    mu = closest_match(sens["points"]["mu_prep"], "mu_prep", target, tol)
+    lines = [
+        _axis_text("Grading width (log-linear family)", "Cu = ", g, family, "cu", target, tol),
+        _axis_text("Preparation friction (reference grading)", "mu_prep = ", mu, sens["points"]["mu_prep"],
+                   "mu_prep", target, tol),
+    ]  # fmt: skip
+    if ref is not None and math.isfinite(ref["n2d_mean"]):
+        d = ref["n2d_mean"] - target
+        acc = _pm(ref["n2d_mean"], ref["n2d_sd"], ref["n"])
+        lines.append(
+            f"The reference grading (Cu = {ref['cu']:.3g}) accepts {acc} with the paper's protocol, "
+            f"{abs(d):.4f} {'above' if d > 0 else 'below'} the paper's {target:g}"
+            f"{'' if abs(d) > tol else ' (within the tolerance)'}."
+        )
+    lines.extend(_protocol_lines(sens, ref))
+    lines.extend(_first_trial_lines(ref, paper))
+    unconv = sum(p["unconverged"] for p in g_pts + sens["points"]["mu_prep"])
+    if unconv:
+        lines.append(f"{unconv} seed(s) did not converge; they are counted, not averaged.")
+    return {"target": target, "tolerance": tol, "grading": g, "mu_prep": mu, "lines": lines}
+
+
+def _protocol_lines(sens: dict, ref: dict | None) -> list[str]:
+    """The paper's protocol (first trial from Eq. 12) against the calibration's (first trial 0.19)."""
+    mu0 = sens["settings"]["mu_prep"]
+    cal = next((p for p in sens["points"]["mu_prep"] if abs(p["mu_prep"] - mu0) < 1e-12), None)
+    if ref is None or cal is None:
+        return []
+    a, b = ref["measured_mean"], cal["n2d_mean"]
+    if not (math.isfinite(a) and math.isfinite(b)):
+        return []
+    # each trial is a fresh specimen seeded by the seed and the trial porosity: where the two
+    # protocols reach the same trial porosity they prepare the same specimen
+    return [
+        f"At mu_prep = {mu0:g} the measured porosity n' of the accepted trial is {a:.4f} starting from "
+        f"the first trial {ref['first_trial_porosity']:g} and {b:.4f} starting from 0.19 (the "
+        f"calibration), a difference of {a - b:+.4f}; every trial is prepared afresh, so the first trial "
+        "acts only through the trial porosity it leads to."
+    ]
+
+
+def _first_trial_lines(ref: dict | None, paper: dict) -> list[str]:
+    if ref is None or not math.isfinite(ref["first_f_top_mean"]):
+        return []
+    paper_f = 1e3 * paper["f_top_first_trial_kn_per_m"]
+    paper_g = paper["self_weight_first_trial_n_per_m"]
+    paper_n = paper["trials"][0] + paper["porosity_change_first_trial"]
+    f, sd, g = ref["first_f_top_mean"], ref["first_f_top_sd"], ref["first_g_mean"]
+    return [
+        f"First trial ({ref['first_trial_porosity']:g}) with the reference grading: F_top = {f:.4g} +- "
+        f"{sd:.3g} N/m = {ref['first_f_top_over_g_mean']:.4g} G (G = {g:.4g} N/m); the paper: {paper_f:.4g} "
+        f"N/m = {paper_f / paper_g:.4g} G (G = {paper_g:g} N/m), {paper_f / f:.3g} times poro2d's; after "
+        f"the plate moved n' = {ref['first_n_prime_mean']:.4f} (paper: {paper_n:.3f})."
+    ]
+
+
+# ----------------------------------------------------------------------------------- run
+def run_sensitivity(
+    base: dict,
+    base_dir: Path | None,
+    out: Path,
+    *,
+    quick: bool = False,
+    seeds: int | None = None,
+    use_cache: bool = True,
+    **sweep_kw,
+) -> dict:
+    """The whole study into ``out``; returns the result dict (also ``out/sensitivity.json``).
+
+    ``base``: a criterion config, optionally with a ``[sensitivity]`` table (``cu``,
+    ``mu_prep``, ``seeds``). Everything is checked before the first case runs.
+    ``sweep_kw``: ``scheduler``, ``workers``, ``client``, ``progress`` of the sweep runner.
+    """
+    from poro2d.criterion.config import build
+    from poro2d.sweep import density as D
+    from poro2d.sweep.cases import parse_sweep
+    from poro2d.sweep.runner import run_sweep
+
+    settings = study_settings(base.get("sensitivity"), quick=quick, seeds=seeds)
+    cfg = study_base(base, quick=quick)
+    _, _, crit, _ = build(copy.deepcopy(cfg), base_dir)
+    cases = gradings(cfg, base_dir, settings["cus"])
+    check_gradings(cfg, base_dir, cases)
+    sweep = parse_sweep(grading_sweep(cfg, cases, settings["seeds"]), base_dir)
+    parse_sweep(D.calibration_sweep(cfg, settings["mus"], settings["seeds"]), base_dir)  # checked now
+
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    res = run_sweep(sweep, out / "grading", **sweep_kw)
+    timings["grading_s"] = time.perf_counter() - t0
+    t1 = time.perf_counter()
+    cal, cal_info = D.calibrate(cfg, base_dir, out / "mu_prep", mus=settings["mus"], seeds=settings["seeds"],
+                                use_cache=use_cache, **sweep_kw)  # fmt: skip
+    timings["mu_prep_s"] = time.perf_counter() - t1
+
+    grads = [g.describe() for g in cases]
+    labels = [(g, s) for g in grads for s in range(settings["seeds"])]
+    records = [seed_record(r, g, s) for r, (g, s) in zip(res.rows, labels, strict=True)]
+    spec = cfg.get("specimen") or {}
+    sens = {
+        "title": "accepted n2D against grading width and preparation friction (paper protocol)",
+        "settings": dict(
+            settings,
+            seed_list=list(range(settings["seeds"])),
+            mu_prep=float(spec.get("friction_prep", 0.05)),
+            n_lab=crit.n_lab,
+            first_trial=crit.initial_trial(),
+            first_trial_from=_first_from(crit),
+        ),
+        "gradings": grads,
+        "seeds": records,
+        "points": {"grading": grading_points(records, grads), "mu_prep": mu_points(cal.to_dict())},
+        "calibration": dict(cal.to_dict(), **cal_info),
+        "paper": paper_numbers(),
+        "config": cfg,
+        "sweeps": {"grading": res.summary, "failed_cases": len(res.failed)},
+        "timings": timings,
+    }
+    sens["answer"] = answer(sens)
+    timings["total_s"] = time.perf_counter() - t0
+    return write_sensitivity(sens, out)
+
+
+def _first_from(crit) -> str:
+    return "given" if crit.trial_porosity is not None else "Eq. 12"
+
+
+def write_sensitivity(sens: dict, out: Path) -> dict:
+    """sensitivity.json, sensitivity.csv (points), sensitivity_seeds.csv and the figure."""
+    from poro2d.io_utils import provenance, write_csv, write_json
+    from poro2d.report.sensitivity_report import plot_sensitivity
+
+    out.mkdir(parents=True, exist_ok=True)
+    figs = plot_sensitivity(sens, out / "sensitivity")
+    sens = dict(sens, figure=str(figs[0]), provenance=provenance())
+    write_csv(out / "sensitivity_seeds.csv", sens["seeds"])
+    points = sens["points"]["grading"] + sens["points"]["mu_prep"]
+    write_csv(out / "sensitivity.csv", [_csv_row(p, sens) for p in points])
+    write_json(out / "sensitivity.json", sens)
+    return sens
+
+
+def _csv_row(p: dict, sens: dict) -> dict:
+    target, tol = sens["answer"]["target"], sens["answer"]["tolerance"]
+    row = {k: v for k, v in p.items()}
+    row["reproduces_paper"] = math.isfinite(p["n2d_mean"]) and abs(p["n2d_mean"] - target) <= tol + 1e-12
+    row["seed_list"] = " ".join(map(str, sens["settings"]["seed_list"]))
+    row["poro2d_version"] = sens["provenance"]["poro2d_version"]
+    return row
+
+
+def load_sensitivity(folder: Path) -> dict:
+    """A finished study read back, its figure path pointing into ``folder``."""
+    import json
+
+    p = Path(folder) / "sensitivity.json"
+    if not p.is_file():
+        raise InputError("sensitivity", str(folder), "a folder holding sensitivity.json")
+    sens = json.loads(p.read_text())
+    sens["figure"] = str(Path(folder) / "sensitivity.png")
+    return sens
+
+
+__all__ = [
+    "DEFAULT_CUS",
+    "QUICK_CUS",
+    "answer",
+    "check_cus",
+    "closest_match",
+    "grading_points",
+    "gradings",
+    "load_sensitivity",
+    "mu_points",
+    "run_sensitivity",
+    "seed_record",
+    "study_settings",
+    "summarise",
+    "write_sensitivity",
+]

@@ -1,0 +1,100 @@
+"""``poro2d sensitivity``: the accepted n2D against grading width and preparation friction."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import typer
+
+from poro2d.console import OutputConsole, Table
+
+console = OutputConsole()
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("sensitivity")
+    def sensitivity_cmd(
+        config: Path = typer.Option(
+            None,
+            "--config",
+            "-c",
+            help="Criterion config; optional \\[sensitivity] table (cu, mu_prep, seeds).",
+        ),
+        preset: str = typer.Option(None, "--preset", help="Built-in case: 'paper' (the default)."),
+        out: Path = typer.Option(Path("sensitivity-out"), "--out", "-o", help="Output folder (resumable)."),
+        quick: bool = typer.Option(
+            False, "--quick", help="Small box (0.08 m x 0.04 m, 2 layers), Cu up to 3, 2 seeds."
+        ),
+        seeds: int = typer.Option(None, "--seeds", help="Specimens per point (default 3, quick 2)."),
+        scheduler: str = typer.Option(None, "--scheduler", help="Address of a running Dask scheduler."),
+        workers: int = typer.Option(None, "--workers", help="Worker processes of the local cluster."),
+        quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
+    ) -> None:
+        """Why the paper's case gives what it gives: the criterion in the paper's protocol
+        (mu_prep 0.05, first trial from Eq. 12) against grading width (Cu) and against
+        preparation friction, over seeds, beside the paper's 0.15."""
+        from poro2d.config import check_keys, load_toml
+        from poro2d.criterion.config import TOP_KEYS, paper_preset
+        from poro2d.errors import InputError
+        from poro2d.io_utils import check_output_dir
+        from poro2d.sweep.sensitivity import run_sensitivity
+
+        if workers is not None and workers < 1:
+            raise InputError("--workers", workers, "an integer >= 1")
+        if seeds is not None and not 1 <= seeds <= 50:
+            raise InputError("--seeds", seeds, "an integer in [1, 50]")
+        check_output_dir("--out", out)
+        if config is not None and preset is not None:
+            raise InputError("--config/--preset", f"{config} and {preset}", "one of the two, not both")
+        if config is None:
+            if preset not in (None, "paper"):
+                raise InputError("--preset", preset, "'paper'")
+            base, base_dir = paper_preset(), None
+        else:
+            base = load_toml(config)
+            check_keys("config", base, set(TOP_KEYS) | {"sensitivity"})
+            base_dir = Path(config).resolve().parent
+        console.print(f"sensitivity study{' (quick)' if quick else ''} -> {out}")
+        sens = run_sensitivity(base, base_dir, out, quick=quick, seeds=seeds, scheduler=scheduler,
+                               workers=workers, progress=not quiet)  # fmt: skip
+        print_sensitivity(sens, out)
+        failed = sens["sweeps"]["failed_cases"]
+        if failed:
+            console.print(
+                f"[bold red]{failed} case(s) failed[/]; tracebacks in {out}/grading/cases/*/error.txt"
+            )
+            raise typer.Exit(1)
+
+
+def _f(v, digits: int = 4) -> str:
+    return "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.{digits}f}"
+
+
+def print_sensitivity(sens: dict, out: Path) -> None:
+    """The two tables of points, the answer, and where the files are."""
+    t = Table(title=f"accepted n2D against grading width (mu_prep = {sens['settings']['mu_prep']:g})")
+    for c in ("grading", "Cu", "d_max mm", "accepted n2D", "sd", "n", "unconv.", "n' accepted",
+              "1st F_top N/m", "1st G N/m", "1st F_top/G", "1st n'"):  # fmt: skip
+        t.add_column(c, justify="right")
+    for p in sens["points"]["grading"]:
+        t.add_row(
+            p["label"], _f(p["cu"], 3), _f(p["d_max_mm"], 2), _f(p["n2d_mean"]), _f(p["n2d_sd"]),
+            str(p["n"]), str(p["unconverged"]), _f(p["measured_mean"]), _f(p["first_f_top_mean"], 1),
+            _f(p["first_g_mean"], 1), _f(p["first_f_top_over_g_mean"], 1), _f(p["first_n_prime_mean"]),
+        )  # fmt: skip
+    console.print(t)
+    t = Table(title="n' of the accepted trial against preparation friction (reference grading)")
+    for c in ("mu_prep", "n2D", "sd", "n", "unconv."):
+        t.add_column(c, justify="right")
+    for p in sens["points"]["mu_prep"]:
+        t.add_row(f"{p['mu_prep']:g}", _f(p["n2d_mean"]), _f(p["n2d_sd"]), str(p["n"]), str(p["unconverged"]))
+    console.print(t)
+    for line in sens["answer"]["lines"]:
+        console.print(f"- {line}", highlight=False)
+    tm = sens["timings"]
+    console.print(
+        f"time: grading sweep {tm['grading_s']:.0f} s, mu_prep {tm['mu_prep_s']:.0f} s "
+        f"(calibration from {sens['calibration'].get('source')}), total {tm['total_s']:.0f} s"
+    )
+    console.print(f"figure {out}/sensitivity.png, tables {out}/sensitivity.csv, {out}/sensitivity.json")
