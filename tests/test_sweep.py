@@ -252,3 +252,25 @@ def test_bad_top_level_key_and_cli_exit_code(tmp_path, capsys):
         main(["sweep", str(cfg), "--out", str(tmp_path / "o")])
     assert ei.value.code == 2
     assert "sweep.nlab" in capsys.readouterr().err
+
+
+def test_worker_pins_numba_threads_so_a_compile_does_not_fail(monkeypatch):
+    """A worker's environment may say another NUMBA_NUM_THREADS than the one its numba started
+    with (the cluster's environment is applied after start-up); numba re-reads it when it
+    compiles and refuses a change once its threads run, which failed every case of a sweep
+    whose kernels were not cached yet. The worker pins the variable before a case runs."""
+    import numba
+    from numba.core.config import reload_config
+    from numba.np.ufunc.parallel import _launch_threads
+
+    from poro2d.sweep.runner import _pin_numba_threads
+
+    _launch_threads()
+    running = numba.config.NUMBA_NUM_THREADS
+    monkeypatch.setenv("NUMBA_NUM_THREADS", str(running % 2 + 1))  # not the running value
+    with pytest.raises(RuntimeError, match="NUMBA_NUM_THREADS"):
+        reload_config()
+    _pin_numba_threads()
+    reload_config()  # what every compile does: no error now
+    assert numba.config.NUMBA_NUM_THREADS == running and numba.get_num_threads() == 1
+    numba.set_num_threads(running)

@@ -90,12 +90,7 @@ def run_case_task(case: dict, case_dir: str, func) -> dict:
         return done
     d.mkdir(parents=True, exist_ok=True)
     write_json(d / PARAMS, case, config=True)
-    try:
-        import numba
-
-        numba.set_num_threads(1)  # the case kind may raise it again for its own runs
-    except Exception:  # pragma: no cover - numba missing or threading layer unavailable
-        pass
+    _pin_numba_threads()
     row: dict[str, Any] = {
         "case_id": case["id"],
         "kind": case["kind"],
@@ -129,6 +124,24 @@ def run_case_task(case: dict, case_dir: str, func) -> dict:
         (d / stale).unlink(missing_ok=True)
     write_json(d / RESULT, row)  # the done marker, last
     return row
+
+
+def _pin_numba_threads() -> None:
+    """One numba thread for the case (its kind may raise it again for its own runs).
+
+    numba re-reads ``NUMBA_NUM_THREADS`` from the environment whenever it compiles, and once
+    its threads run, another value there is an error. A worker process may see a value in
+    its environment other than the one its numba started with (the cluster's environment is
+    applied after start-up), so the first compile in a fresh worker (an empty kernel cache)
+    failed every case. The environment is pinned to the running value first.
+    """
+    try:
+        import numba
+
+        os.environ["NUMBA_NUM_THREADS"] = str(numba.config.NUMBA_NUM_THREADS)
+        numba.set_num_threads(1)
+    except Exception:  # pragma: no cover - numba missing or threading layer unavailable
+        pass
 
 
 def _worker_address() -> str:
