@@ -26,7 +26,21 @@ from poro2d.dem.model import (
     restitution_to_beta,
     single_contact_limit,
 )
-from poro2d.dem.state import FREE, PARTICLE_FIELDS, PRESCRIBED, WALL_SERVO, WALL_VELOCITY, Particles, Walls
+from poro2d.dem.records import kernel_records
+from poro2d.dem.state import (
+    FREE,
+    PARTICLE_FIELDS,
+    PRESCRIBED,
+    SERVO_ERROR_SUM,
+    SERVO_GAIN,
+    SERVO_INTEGRAL,
+    SERVO_MAX_SPEED,
+    SERVO_TARGET,
+    WALL_SERVO,
+    WALL_VELOCITY,
+    Particles,
+    Walls,
+)
 from poro2d.errors import InputError
 
 _THREADING_SET = False
@@ -438,7 +452,12 @@ class Simulation:
             raise InputError("servo integral gain", integral, "[0, 0.1] per step")
         self.walls.mode[w] = WALL_SERVO
         self.walls.servo_dir[w] = d / nd
-        self.walls.servo[w] = (target_force, gain, max_speed, integral, 0.0)
+        servo = self.walls.servo[w]
+        servo[SERVO_TARGET] = target_force
+        servo[SERVO_GAIN] = gain
+        servo[SERVO_MAX_SPEED] = max_speed
+        servo[SERVO_INTEGRAL] = integral
+        servo[SERVO_ERROR_SUM] = 0.0  # a new servo starts without a summed error
 
     def fix_particles(self, mask: np.ndarray, velocity=(0.0, 0.0), omega: float = 0.0) -> None:
         """Prescribe velocity and spin of the disks in ``mask`` (zero = fixed)."""
@@ -450,21 +469,6 @@ class Simulation:
         self.particles.mode[mask] = FREE
 
     # -------------------------------------------------------------------- run
-    def _args(self):
-        """The kernel's argument groups: disks, walls, pair lists, wall lists, work arrays."""
-        p, w = self.particles, self.walls
-        P = (p.pos, p.vel, p.theta, p.omega, self.force, self.moment, self._acc, p.radius, self._mass,
-             self._inv_mass, self._inv_inertia, p.mode, p.kn, p.ks, p.mu)  # fmt: skip
-        W = (w.p0, w.p1, w.vel, w.kn, w.ks, w.mu, w.mode, w.servo_dir, w.servo, self.wall_force_vec,
-             self._wstat, self._wall_build, self._wpart)  # fmt: skip
-        NB = (self._nb_start, self._nb_j, self._nb_fs, self._nb_fn, self._nb_ov, self._nb_nx,
-              self._nb_ny, self._new_start, self._new_j, self._new_fs)  # fmt: skip
-        WB = (self._wb_start, self._wb_w, self._wb_fs, self._wb_fn, self._wb_ov, self._wb_nx,
-              self._wb_ny, self._wnew_start, self._wnew_w, self._wnew_fs)  # fmt: skip
-        S = (self._pos_build, self._part, self._xstart, self._xpair, self._dlist, self._dstart,
-             self._tmax, self._sync, *self._grid)  # fmt: skip
-        return P, W, NB, WB, S, self._prm, self._iprm, self._out
-
     def _load_params(self, nsteps: int, check_every: int, ratio_target: float, offset: int) -> None:
         prm = self._prm
         prm[K.DT] = self.dt
@@ -526,7 +530,7 @@ class Simulation:
         while done < nsteps:
             self._load_params(nsteps - done, check_every, ratio_target, offset + done)
             self._out[:] = 0.0
-            K.run_steps(*self._args())
+            K.run_steps(kernel_records(self), self._prm, self._iprm, self._out)
             self.threads_used = int(self._out[K.THREADS_USED])
             steps = int(self._out[K.STEPS_DONE])
             if ratio_target and (offset + done + steps) // check_every > (offset + done) // check_every:
