@@ -335,7 +335,7 @@ class DirectShearTest:
             s.particle_friction, s.density_scale, s.dt_safety, self.threads,
         )  # fmt: skip
         if s.local_damping is not None:
-            sim.local_damping = float(s.local_damping)
+            sim.set_local_damping(float(s.local_damping))
         self.box = box
         target = self.sigma_kpa * 1e3 * box.width * box.thickness
         sim.set_wall_servo("top", target, (0.0, -1.0), s.servo_max_speed, s.servo_gain, s.servo_integral)
@@ -350,7 +350,7 @@ class DirectShearTest:
             self._report("consolidating", min(sm.step_count / s.consolidation_max_steps, 1.0))
             return rmax < s.consolidation_ratio and err < s.stress_tolerance
 
-        sim.step_count = 0
+        sim.reset_clock()
         res = sim.run(s.consolidation_max_steps, every=check, callback=settled)
         converged = state["ratio"] < s.consolidation_ratio and state["err"] < s.stress_tolerance
         if not converged:
