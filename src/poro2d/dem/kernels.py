@@ -179,10 +179,9 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, pw_body, dt, 
 
     ``props`` holds the disks' (kn, ks, mu) (:class:`~poro2d.dem.records.BodyProps`) when
     disk-disk contacts combine them per pair, else None (the constants in prm); ``dash``
-    the critical-damping fraction of
-    the contact dashpot, None without one. Being None is a type, so numba compiles a
-    variant without that code: those branches and the arrays they need cost
-    registers in the pair loop (5-7 % of its speed), even when never taken.
+    the critical-damping fraction of the contact dashpot, None without one. Being None is
+    a type, so numba compiles a variant without that code: those branches and the arrays
+    they need cost registers in the pair loop (5-7 % of its speed), even when never taken.
 
     Returns the largest squared drift of the disks advanced.
     """

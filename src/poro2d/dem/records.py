@@ -7,9 +7,10 @@ type can no longer be swapped by counting positions wrong.
 
 The records are named tuples. numba compiles them as heterogeneous named tuples: a
 field access is resolved at compile time and costs nothing in the loop, and the types
-pickle by reference, so ``cache=True`` works. Their fields are views of the arrays
-held by the :class:`~poro2d.dem.simulation.Simulation` and the :class:`~poro2d.dem.state`
-objects, never copies: the kernels advance the state in place.
+pickle by reference, so ``cache=True`` works. Their fields are the arrays held by the
+:class:`~poro2d.dem.simulation.Simulation` and its ``Particles`` and ``Walls``, never
+copies: the kernels advance the state in place. A record of records is not used: numba's
+parallel loop cannot take one as an argument.
 
 :func:`kernel_records` is the one place that fills them. It is called before every
 kernel call, since growing the pair storage, adding disks or walls and renumbering
