@@ -23,6 +23,7 @@ import pytest
 
 from poro2d.dem import Particles, Simulation, Walls
 from poro2d.dem import kernels as K
+from poro2d.dem.state import SERVO_ERROR_SUM
 
 R = 1e-3
 STOP_RATIO = 0.12
@@ -84,7 +85,7 @@ def one_block():
     sim, state = _settle()
     assert state["converged"] and state["steps"] < MAX_STEPS
     assert state["steps"] % CHECK_EVERY == 0
-    assert sim.walls.servo[sim.walls.index("top"), 4] != 0.0  # the integral term took part
+    assert sim.walls.servo[sim.walls.index("top"), SERVO_ERROR_SUM] != 0.0  # the integral term took part
     return state
 
 

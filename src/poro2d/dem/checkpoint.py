@@ -35,6 +35,7 @@ _SIM_ARRAYS = (
 def save(sim: Simulation, path: str | os.PathLike, extra: dict | None = None) -> Path:
     """Write ``sim`` to ``path`` (.npz), atomically. ``extra`` is stored as JSON metadata."""
     path = Path(path)
+    sim._sync_walls()  # walls added since the last run: their rows in the per-wall arrays
     arrays: dict[str, np.ndarray] = {}
     for f in PARTICLE_FIELDS:
         arrays[f"particles.{f}"] = getattr(sim.particles, f)

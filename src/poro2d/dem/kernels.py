@@ -51,7 +51,16 @@ from poro2d.dem.neighbors import (
     prefix_rows,
 )
 from poro2d.dem.partition import partition
-from poro2d.dem.state import FREE, WALL_SERVO
+from poro2d.dem.records import BodyProps, KernelRecords
+from poro2d.dem.state import (
+    FREE,
+    SERVO_ERROR_SUM,
+    SERVO_GAIN,
+    SERVO_INTEGRAL,
+    SERVO_MAX_SPEED,
+    SERVO_TARGET,
+    WALL_SERVO,
+)
 from poro2d.dem.sync import STATUS_WORD, atomic_load, atomic_store, barrier, start_handshake
 
 # float parameters (prm)
@@ -67,8 +76,10 @@ STATUS, STEPS_DONE, MAX_RATIO, MEAN_RATIO, NEED_PP, NEED_PW, REBUILDS, THREADS_U
 N_OUT = 8
 # status codes
 RUNNING, CONVERGED, OVERFLOW, UNSTABLE = 0, 1, 2, 3
-# per-partition wall sums (wpart[k, w, :])
+# per-partition wall sums (walls.part_sums[k, w, :])
 WFX, WFY, WCOUNT, WKSUM = range(4)
+# columns of walls.stat: disks touching the wall, their summed contact kn (the servo's stiffness)
+STAT_COUNT, STAT_KSUM = range(2)
 
 
 @njit(cache=True)
@@ -163,23 +174,27 @@ def _damped(f, v, damp):
 
 
 @njit(cache=True)
-def _phase_forces(k, P, W, NB, WB, S, prm, props, dash, pw_body, dt, gx, gy, damp):
+def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, pw_body, dt, gx, gy, damp):
     """Phase 1 on partition k: forces of its rows, advance of its non-deferred disks.
 
-    ``props`` holds the disks' (kn, ks, mu) when disk-disk contacts combine them per
-    pair, else None (the constants in prm); ``dash`` the critical-damping fraction of
-    the contact dashpot, None without one. Being None is a type, so numba compiles a
-    variant without that code: those branches and the arrays they need cost
-    registers in the pair loop (5-7 % of its speed), even when never taken.
+    ``props`` holds the disks' (kn, ks, mu) (:class:`~poro2d.dem.records.BodyProps`) when
+    disk-disk contacts combine them per pair, else None (the constants in prm); ``dash``
+    the critical-damping fraction of the contact dashpot, None without one. Being None is
+    a type, so numba compiles a variant without that code: those branches and the arrays
+    they need cost registers in the pair loop (5-7 % of its speed), even when never taken.
 
     Returns the largest squared drift of the disks advanced.
     """
-    pos, vel, theta, omega, force, moment, acc, radius, mass, inv_mass, inv_inertia, pmode, pkn, pks, pmu = P
-    wp0, wp1, wvel, wkn, wks, wmu = W[0], W[1], W[2], W[3], W[4], W[5]
-    wpart = W[12]
-    nb_start, nb_j, nb_fs, nb_fn, nb_ov, nb_nx, nb_ny = NB[:7]
-    wb_start, wb_w, wb_fs, wb_fn, wb_ov, wb_nx, wb_ny = WB[:7]
-    pos_build, part, xstart = S[0], S[1], S[2]
+    # local names for the arrays of the loop (the records' fields, read once)
+    pos, vel, theta, omega = disks.pos, disks.vel, disks.theta, disks.omega
+    force, moment, acc, radius = disks.force, disks.moment, disks.acc, disks.radius
+    mass, inv_mass, inv_inertia, pmode = disks.mass, disks.inv_mass, disks.inv_inertia, disks.mode
+    pkn, pks, pmu = disks.kn, disks.ks, disks.mu
+    wp0, wp1, wvel, wkn, wks, wmu = walls.p0, walls.p1, walls.vel, walls.kn, walls.ks, walls.mu
+    wpart = walls.part_sums
+    nb_start, nb_j, nb_fs, nb_fn, nb_ov, nb_nx, nb_ny = nb.start, nb.j, nb.fs, nb.fn, nb.ov, nb.nx, nb.ny
+    wb_start, wb_w, wb_fs, wb_fn, wb_ov, wb_nx, wb_ny = wb.start, wb.w, wb.fs, wb.fn, wb.ov, wb.nx, wb.ny
+    pos_build, part, xstart = work.pos_build, work.part, work.xstart
     # flat views: an (n, 2) index costs a multiplication by a run-time row length
     posf = pos.reshape(pos.size)
     velf = vel.reshape(vel.size)
@@ -221,9 +236,9 @@ def _phase_forces(k, P, W, NB, WB, S, prm, props, dash, pw_body, dt, gx, gy, dam
                 nb_fs[p] = 0.0  # contact lost: history ends
                 continue
             if props is not None:
-                kn = series(props[0][i], props[0][j])
-                ks = series(props[1][i], props[1][j])
-                mu = min(props[2][i], props[2][j])
+                kn = series(props.kn[i], props.kn[j])
+                ks = series(props.ks[i], props.ks[j])
+                mu = min(props.mu[i], props.mu[j])
             cn = 0.0
             if dash is not None:
                 cn = dashpot(dash, kn, mass[i] * mass[j] / (mass[i] + mass[j]))
@@ -312,15 +327,17 @@ def _phase_forces(k, P, W, NB, WB, S, prm, props, dash, pw_body, dt, gx, gy, dam
 
 
 @njit(cache=True)
-def _phase_deferred(m0, m1, P, NB, S, gx, gy, damp, dt):
+def _phase_deferred(m0, m1, disks, nb, work, gx, gy, damp, dt):
     """Phase 2: deferred disks ``dlist[m0:m1]`` add their cross pairs and advance.
 
     Each deferred disk only reads its own cross pairs, so the list is shared out
     evenly among the threads, whatever partition a disk belongs to.
     """
-    pos, vel, theta, omega, force, moment, acc, radius, mass, inv_mass, inv_inertia, pmode = P[:12]
-    nb_fs, nb_fn, nb_ov, nb_nx, nb_ny = NB[2], NB[3], NB[4], NB[5], NB[6]
-    pos_build, xstart, xpair, dlist = S[0], S[2], S[3], S[4]
+    pos, vel, theta, omega = disks.pos, disks.vel, disks.theta, disks.omega
+    force, moment, acc, radius = disks.force, disks.moment, disks.acc, disks.radius
+    mass, inv_mass, inv_inertia, pmode = disks.mass, disks.inv_mass, disks.inv_inertia, disks.mode
+    nb_fs, nb_fn, nb_ov, nb_nx, nb_ny = nb.fs, nb.fn, nb.ov, nb.nx, nb.ny
+    pos_build, xstart, xpair, dlist = work.pos_build, work.xstart, work.xpair, work.dlist
     dmax = 0.0
     for m in range(m0, m1):
         i = dlist[m]
@@ -355,30 +372,34 @@ def _phase_deferred(m0, m1, P, NB, S, gx, gy, damp, dt):
 
 
 @njit(cache=True)
-def _move_walls(W, prm, dt):
+def _move_walls(walls, dt):
     """Wall resultants (partition by partition), servo speeds, wall motion."""
-    wp0, wp1, wvel, _kn, _ks, _mu, wmode, wdir, wservo, wforce, wstat, _wb, wpart = W
+    wp0, wp1, wvel, wmode = walls.p0, walls.p1, walls.vel, walls.mode
+    wdir, wservo = walls.servo_dir, walls.servo
+    wforce, wstat, wpart = walls.force, walls.stat, walls.part_sums
     nw = wp0.shape[0]
     for w in range(nw):
         wforce[w, 0] = 0.0
         wforce[w, 1] = 0.0
-        wstat[w, 0] = 0.0
-        wstat[w, 1] = 0.0
+        wstat[w, STAT_COUNT] = 0.0
+        wstat[w, STAT_KSUM] = 0.0
         for k in range(wpart.shape[0]):
             wforce[w, 0] += wpart[k, w, WFX]
             wforce[w, 1] += wpart[k, w, WFY]
-            wstat[w, 0] += wpart[k, w, WCOUNT]
-            wstat[w, 1] += wpart[k, w, WKSUM]
+            wstat[w, STAT_COUNT] += wpart[k, w, WCOUNT]
+            wstat[w, STAT_KSUM] += wpart[k, w, WKSUM]
         if wmode[w] == WALL_SERVO:
             # compressive force along the servo direction; v = gain * error / (k dt)
             fc = -(wforce[w, 0] * wdir[w, 0] + wforce[w, 1] * wdir[w, 1])
-            err = wservo[w, 0] - fc
-            vmax = wservo[w, 2]
-            if wstat[w, 0] > 0.0:
-                summed = wservo[w, 4] + err
-                v = wservo[w, 1] * (err + wservo[w, 3] * summed) / (wstat[w, 1] * dt)
+            err = wservo[w, SERVO_TARGET] - fc
+            vmax = wservo[w, SERVO_MAX_SPEED]
+            if wstat[w, STAT_COUNT] > 0.0:
+                summed = wservo[w, SERVO_ERROR_SUM] + err
+                gain = wservo[w, SERVO_GAIN]
+                integral = wservo[w, SERVO_INTEGRAL]
+                v = gain * (err + integral * summed) / (wstat[w, STAT_KSUM] * dt)
                 if -vmax <= v <= vmax:  # no wind-up while the speed is bounded
-                    wservo[w, 4] = summed
+                    wservo[w, SERVO_ERROR_SUM] = summed
             else:  # nothing touches: approach (or retreat) at full speed
                 v = vmax if err > 0.0 else -vmax
             if v > vmax:
@@ -395,17 +416,20 @@ def _move_walls(W, prm, dt):
 
 
 @njit(cache=True)
-def _rebuild(t, nthr, P, W, NB, WB, S, prm, out):
+def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out):
     """All workers rebuild the lists together; thread 0 does the serial parts.
 
     Returns False (on every worker) when the pair storage is too small.
     """
-    pos, radius = P[0], P[7]
-    wp0, wp1, wall_build = W[0], W[1], W[11]
-    nb_start, nb_j, nb_fs, _fn, _ov, _nx, _ny, new_start, new_j, new_fs = NB
-    wb_start, wb_w, wb_fs, _wfn, _wov, _wnx, _wny, wnew_start, wnew_w, wnew_fs = WB
-    pos_build, part, xstart, xpair, dlist, dstart, _tmax, sync = S[:8]
-    cell, members, cstart, cfill, ginfo = S[8:13]
+    pos, radius = disks.pos, disks.radius
+    wp0, wp1, wall_build = walls.p0, walls.p1, walls.p0_build
+    nb_start, nb_j, nb_fs = nb.start, nb.j, nb.fs
+    new_start, new_j, new_fs = nb.new_start, nb.new_j, nb.new_fs
+    wb_start, wb_w, wb_fs = wb.start, wb.w, wb.fs
+    wnew_start, wnew_w, wnew_fs = wb.new_start, wb.new_w, wb.new_fs
+    pos_build, sync = work.pos_build, work.sync
+    part, xstart, xpair, dlist, dstart = work.part, work.xstart, work.xpair, work.dlist, work.dstart
+    cell, members, cstart, cfill, ginfo = work.cell, work.members, work.cstart, work.cfill, work.ginfo
     skin = prm[SKIN]
     n = pos.shape[0]
     lo = t * n // nthr
@@ -451,13 +475,13 @@ def _rebuild(t, nthr, P, W, NB, WB, S, prm, out):
 
 
 @njit(cache=True)
-def _worker(t, nthr, P, W, NB, WB, S, prm, iprm, out, props, dash):
+def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash):
     """Run the steps of this call on thread t of nthr: partitions t P / nthr to (t + 1) P / nthr - 1."""
-    pos, force, pmode = P[0], P[4], P[11]
-    wp0, wall_build = W[0], W[11]
-    nb_start, nb_fn, nb_fs, nb_ov = NB[0], NB[3], NB[2], NB[4]
-    wb_start, wb_fn, wb_fs, wb_ov = WB[0], WB[3], WB[2], WB[4]
-    part, tmax, sync = S[1], S[6], S[7]
+    pos, force, pmode = disks.pos, disks.force, disks.mode
+    wp0, wall_build = walls.p0, walls.p0_build
+    nb_start, nb_fn, nb_fs, nb_ov = nb.start, nb.fn, nb.fs, nb.ov
+    wb_start, wb_fn, wb_fs, wb_ov = wb.start, wb.fn, wb.fs, wb.ov
+    part, dstart, tmax, sync = work.part, work.dstart, work.tmax, work.sync
     dt = prm[DT]
     gx = prm[GX]
     gy = prm[GY]
@@ -479,7 +503,7 @@ def _worker(t, nthr, P, W, NB, WB, S, prm, iprm, out, props, dash):
     status = RUNNING
     for _step in range(nsteps):
         if need_build:
-            if not _rebuild(t, nthr, P, W, NB, WB, S, prm, out):
+            if not _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out):
                 status = OVERFLOW
                 break
             need_build = False
@@ -487,18 +511,18 @@ def _worker(t, nthr, P, W, NB, WB, S, prm, iprm, out, props, dash):
         # phase 1: forces; disks without cross pairs advance at once
         dmax = 0.0
         for k in range(k0, k1):
-            d2 = _phase_forces(k, P, W, NB, WB, S, prm, props, dash, pw_body, dt, gx, gy, damp)
+            d2 = _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, pw_body, dt, gx, gy, damp)
             if d2 > dmax:
                 dmax = d2
         barrier(sync, nthr)
         # phase 2: the deferred disks, shared out evenly; thread 0 also moves the walls
-        ndef = S[5][npart]
-        d2 = _phase_deferred(t * ndef // nthr, (t + 1) * ndef // nthr, P, NB, S, gx, gy, damp, dt)
+        ndef = dstart[npart]
+        d2 = _phase_deferred(t * ndef // nthr, (t + 1) * ndef // nthr, disks, nb, work, gx, gy, damp, dt)
         if d2 > dmax:
             dmax = d2
         tmax[t] = dmax
         if t == 0:
-            _move_walls(W, prm, dt)
+            _move_walls(walls, dt)
             prm[TIME] += dt
         barrier(sync, nthr)
         steps += 1
@@ -543,48 +567,52 @@ def _worker(t, nthr, P, W, NB, WB, S, prm, iprm, out, props, dash):
 
 
 @njit(cache=True)
-def prepare(P, NB, WB, S, prm):
+def prepare(disks, nb, wb, work, prm):
     """Before a call: gravity in every accumulator, partitions of the current lists."""
-    pos, acc, mass = P[0], P[6], P[8]
-    n = pos.shape[0]
+    acc, mass = disks.acc, disks.mass
+    n = disks.pos.shape[0]
     for i in range(n):
         acc[i, 0] = mass[i] * prm[GX]
         acc[i, 1] = mass[i] * prm[GY]
         acc[i, 2] = 0.0
-    part, xstart, xpair, dlist, dstart = S[1], S[2], S[3], S[4], S[5]
-    partition(n, NB[0], NB[1], WB[0], part, xstart, xpair, dlist, dstart)
+    partition(n, nb.start, nb.j, wb.start, work.part, work.xstart, work.xpair, work.dlist, work.dstart)
 
 
 @njit(parallel=True, cache=True)
-def _run_threads(nthr, P, W, NB, WB, S, prm, iprm, out, props, dash):
+def _run_threads(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash):
+    # prepare here, not in a call of its own: each call costs the dispatch of every array
+    prepare(disks, nb, wb, work, prm)
     ok = np.zeros(nthr, dtype=np.int64)
     for t in prange(nthr):
-        if start_handshake(S[7], nthr):
+        if start_handshake(work.sync, nthr):
             ok[t] = 1
-            _worker(t, nthr, P, W, NB, WB, S, prm, iprm, out, props, dash)
+            _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash)
     return ok.sum() == nthr
 
 
 @njit(cache=True)
-def run_serial(P, W, NB, WB, S, prm, iprm, out, props, dash):
-    prepare(P, NB, WB, S, prm)
-    _worker(0, 1, P, W, NB, WB, S, prm, iprm, out, props, dash)
+def run_serial(disks, walls, nb, wb, work, prm, iprm, out, props, dash):
+    prepare(disks, nb, wb, work, prm)
+    _worker(0, 1, disks, walls, nb, wb, work, prm, iprm, out, props, dash)
     out[THREADS_USED] = 1
 
 
-def run_steps(P, W, NB, WB, S, prm, iprm, out) -> None:
-    """Advance up to ``iprm[NSTEPS]`` steps on ``iprm[THREADS]`` threads (see module doc)."""
-    nthr = int(min(iprm[THREADS], S[1].shape[0] - 1))
-    props = (P[12], P[13], P[14]) if iprm[MODE] == PER_BODY else None
+def run_steps(rec: KernelRecords, prm, iprm, out) -> None:
+    """Advance up to ``iprm[NSTEPS]`` steps on ``iprm[THREADS]`` threads (see module doc).
+
+    ``rec`` holds the arrays (:func:`poro2d.dem.records.kernel_records`).
+    """
+    disks, walls, nb, wb, work = rec.disks, rec.walls, rec.nb, rec.wb, rec.work
+    nthr = int(min(iprm[THREADS], work.part.shape[0] - 1))
+    props = BodyProps(disks.kn, disks.ks, disks.mu) if iprm[MODE] == PER_BODY else None
     dash = float(prm[BETA]) if prm[BETA] > 0.0 else None
     if nthr <= 1:
-        run_serial(P, W, NB, WB, S, prm, iprm, out, props, dash)
+        run_serial(disks, walls, nb, wb, work, prm, iprm, out, props, dash)
         return
-    prepare(P, NB, WB, S, prm)
-    S[7][:] = 0
-    if _run_threads(nthr, P, W, NB, WB, S, prm, iprm, out, props, dash):
+    work.sync[:] = 0
+    if _run_threads(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash):
         out[THREADS_USED] = nthr
     else:  # the threading layer ran the workers one after the other: go on alone
-        S[7][:] = 0
-        _worker(0, 1, P, W, NB, WB, S, prm, iprm, out, props, dash)
+        work.sync[:] = 0
+        _worker(0, 1, disks, walls, nb, wb, work, prm, iprm, out, props, dash)
         out[THREADS_USED] = 1

@@ -24,6 +24,8 @@ Scratch storage (all preallocated by the caller, see :func:`grid_scratch`):
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
@@ -36,11 +38,21 @@ def max_cells(n):
     return 4 * n + 16
 
 
-def grid_scratch(n: int) -> tuple[np.ndarray, ...]:
-    """(cell, members, cstart, cfill, ginfo) for ``n`` disks."""
+class GridScratch(NamedTuple):
+    """The cell grid's storage (int64): see the module doc."""
+
+    cell: np.ndarray  # (n) cell of each disk
+    members: np.ndarray  # (n) disks ordered by cell
+    cstart: np.ndarray  # (max_cells + 1) first member of each cell
+    cfill: np.ndarray  # (max_cells + 1) fill counters
+    ginfo: np.ndarray  # (4) the grid's cell counts
+
+
+def grid_scratch(n: int) -> GridScratch:
+    """The grid storage for ``n`` disks."""
     nc = max_cells(n) + 1
     i8 = np.int64
-    return np.zeros(n, i8), np.zeros(n, i8), np.zeros(nc, i8), np.zeros(nc, i8), np.zeros(4, i8)
+    return GridScratch(np.zeros(n, i8), np.zeros(n, i8), np.zeros(nc, i8), np.zeros(nc, i8), np.zeros(4, i8))
 
 
 @njit(cache=True)

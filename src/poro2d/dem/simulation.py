@@ -26,8 +26,22 @@ from poro2d.dem.model import (
     restitution_to_beta,
     single_contact_limit,
 )
-from poro2d.dem.state import FREE, PARTICLE_FIELDS, PRESCRIBED, WALL_SERVO, WALL_VELOCITY, Particles, Walls
-from poro2d.errors import InputError
+from poro2d.dem.records import kernel_records
+from poro2d.dem.state import (
+    FREE,
+    PARTICLE_FIELDS,
+    PRESCRIBED,
+    SERVO_ERROR_SUM,
+    SERVO_GAIN,
+    SERVO_INTEGRAL,
+    SERVO_MAX_SPEED,
+    SERVO_TARGET,
+    WALL_SERVO,
+    WALL_VELOCITY,
+    Particles,
+    Walls,
+)
+from poro2d.errors import InputError, is_number
 
 _THREADING_SET = False
 WALL_PAD = 4  # rows of 4 doubles: 128 bytes between the wall sums of two partitions
@@ -78,12 +92,11 @@ class RunResult:
     mean_ratio: float
     wall_time_s: float
     rebuilds: int
+    particle_steps: int  # steps x disks
 
     @property
     def particle_steps_per_s(self) -> float:
-        return self._ps / self.wall_time_s if self.wall_time_s > 0 else math.nan
-
-    _ps: float = 0.0
+        return self.particle_steps / self.wall_time_s if self.wall_time_s > 0 else math.nan
 
 
 class Simulation:
@@ -150,9 +163,7 @@ class Simulation:
         if g.shape != (2,) or not np.all(np.isfinite(g)):
             raise InputError("gravity", gravity, "two finite numbers (gx, gy) in m/s^2")
         self.gravity = (float(g[0]), float(g[1]))
-        if not 0.0 <= local_damping < 1.0:
-            raise InputError("local_damping", local_damping, "[0, 1)")
-        self.local_damping = float(local_damping)
+        self.set_local_damping(local_damping)
         self.restitution = None if restitution is None else float(restitution)
         self._beta = 0.0 if restitution is None else restitution_to_beta(restitution)
         if not density_scale >= 1.0:
@@ -169,13 +180,37 @@ class Simulation:
             raise InputError("partitions", partitions, "an integer in [1, 256]")
         self.partitions = int(partitions)
         self.threads = self._check_threads(threads)
-        self.threads_used = 1
+        self.threads_used = 0  # threads the kernel ran on in its last call (0: not called yet)
         self.step_count = 0
         self.time = 0.0
+        # the forces (and so the unbalanced ratios) are those of a step; false before the
+        # first one unless the state came from a run (a checkpoint's step_count > 0)
+        self._stepped = False
         self._checked_ratio: float | None = None  # max ratio at the last stop test of a run
         self._n_alloc = -1
         check_layout(self.particles.pos, self.particles.radius, self.walls)
         self._refresh()
+
+    @property
+    def local_damping(self) -> float:
+        """Cundall's local damping coefficient alpha (:meth:`set_local_damping` changes it)."""
+        return self._local_damping
+
+    def set_local_damping(self, alpha: float) -> None:
+        """Set the local damping coefficient alpha in [0, 1); it acts from the next step on."""
+        if not (is_number(alpha) and 0.0 <= alpha < 1.0):
+            raise InputError("local_damping", alpha, "[0, 1)")
+        self._local_damping = float(alpha)
+
+    def reset_clock(self) -> None:
+        """Count steps and time from zero from here on (a protocol stage's own clock).
+
+        Nothing else changes: the state, the lists, the servo's summed error and the
+        unbalanced ratios of the last step stay as they are.
+        """
+        self._stepped = self._stepped or self.step_count > 0
+        self.step_count = 0
+        self.time = 0.0
 
     @property
     def effective_threads(self) -> int:
@@ -291,6 +326,31 @@ class Simulation:
 
     def _alloc_pw(self, cap: int, keep: int = 0) -> None:
         self._grow(self._PW, self._PW_SCRATCH, cap, keep)
+
+    def _sync_walls(self) -> None:
+        """Take in walls added to ``self.walls`` (``Walls.add``) since the arrays were sized.
+
+        Called before every run and measurement of a wall; a comparison of two counts
+        when nothing was added. The new walls are checked against the disks as at
+        construction, get their rows in the per-wall arrays, and take part from the next
+        step: the time step follows their stiffness and the lists are rebuilt. Walls
+        cannot be taken away: the disk-wall lists hold wall numbers.
+        """
+        nw_old, nw = self.wall_force_vec.shape[0], self.walls.n
+        if nw == nw_old:
+            return
+        if nw < nw_old:
+            raise InputError(
+                "walls", f"{nw} walls", f"at least the {nw_old} this simulation was run with",
+                "walls can be added (Walls.add), not removed",
+            )  # fmt: skip
+        check_layout(self.particles.pos, self.particles.radius, self.walls)
+        new = nw - nw_old
+        self.wall_force_vec = np.concatenate([self.wall_force_vec, np.zeros((new, 2))])
+        self._wstat = np.concatenate([self._wstat, np.zeros((new, 2))])
+        self._wall_build = np.ascontiguousarray(np.concatenate([self._wall_build, self.walls.p0[nw_old:]]))
+        self._alloc_work(self.particles.n)  # the per-partition wall sums
+        self._refresh()  # time step and a list rebuild before the next step
 
     # --------------------------------------------------------------- mutation
     def particles_changed(self) -> None:
@@ -438,7 +498,12 @@ class Simulation:
             raise InputError("servo integral gain", integral, "[0, 0.1] per step")
         self.walls.mode[w] = WALL_SERVO
         self.walls.servo_dir[w] = d / nd
-        self.walls.servo[w] = (target_force, gain, max_speed, integral, 0.0)
+        servo = self.walls.servo[w]
+        servo[SERVO_TARGET] = target_force
+        servo[SERVO_GAIN] = gain
+        servo[SERVO_MAX_SPEED] = max_speed
+        servo[SERVO_INTEGRAL] = integral
+        servo[SERVO_ERROR_SUM] = 0.0  # a new servo starts without a summed error
 
     def fix_particles(self, mask: np.ndarray, velocity=(0.0, 0.0), omega: float = 0.0) -> None:
         """Prescribe velocity and spin of the disks in ``mask`` (zero = fixed)."""
@@ -450,21 +515,6 @@ class Simulation:
         self.particles.mode[mask] = FREE
 
     # -------------------------------------------------------------------- run
-    def _args(self):
-        """The kernel's argument groups: disks, walls, pair lists, wall lists, work arrays."""
-        p, w = self.particles, self.walls
-        P = (p.pos, p.vel, p.theta, p.omega, self.force, self.moment, self._acc, p.radius, self._mass,
-             self._inv_mass, self._inv_inertia, p.mode, p.kn, p.ks, p.mu)  # fmt: skip
-        W = (w.p0, w.p1, w.vel, w.kn, w.ks, w.mu, w.mode, w.servo_dir, w.servo, self.wall_force_vec,
-             self._wstat, self._wall_build, self._wpart)  # fmt: skip
-        NB = (self._nb_start, self._nb_j, self._nb_fs, self._nb_fn, self._nb_ov, self._nb_nx,
-              self._nb_ny, self._new_start, self._new_j, self._new_fs)  # fmt: skip
-        WB = (self._wb_start, self._wb_w, self._wb_fs, self._wb_fn, self._wb_ov, self._wb_nx,
-              self._wb_ny, self._wnew_start, self._wnew_w, self._wnew_fs)  # fmt: skip
-        S = (self._pos_build, self._part, self._xstart, self._xpair, self._dlist, self._dstart,
-             self._tmax, self._sync, *self._grid)  # fmt: skip
-        return P, W, NB, WB, S, self._prm, self._iprm, self._out
-
     def _load_params(self, nsteps: int, check_every: int, ratio_target: float, offset: int) -> None:
         prm = self._prm
         prm[K.DT] = self.dt
@@ -508,8 +558,8 @@ class Simulation:
 
     def _kernel_block(
         self, nsteps: int, check_every: int, ratio_target: float, offset: int
-    ) -> tuple[int, int]:
-        """Run up to ``nsteps`` in compiled code; returns (steps done, status).
+    ) -> tuple[int, int, int]:
+        """Run up to ``nsteps`` in compiled code; returns (steps done, status, list rebuilds).
 
         ``offset`` is the number of steps of the current :meth:`run` before this block:
         the kernel tests the stop condition on the run's own multiples of ``check_every``,
@@ -518,15 +568,15 @@ class Simulation:
         import numba
 
         numba.set_num_threads(max(1, self.effective_threads))
-        if self._part.shape[0] != self.partitions + 1 or self._wpart.shape[1] != self.walls.n + WALL_PAD:
-            self._alloc_work(self.particles.n)  # partitions or walls changed since allocation
+        if self._part.shape[0] != self.partitions + 1:
+            self._alloc_work(self.particles.n)  # partitions changed since allocation
         done = 0
         status = K.RUNNING
         rebuilds = 0
         while done < nsteps:
             self._load_params(nsteps - done, check_every, ratio_target, offset + done)
             self._out[:] = 0.0
-            K.run_steps(*self._args())
+            K.run_steps(kernel_records(self), self._prm, self._iprm, self._out)
             self.threads_used = int(self._out[K.THREADS_USED])
             steps = int(self._out[K.STEPS_DONE])
             if ratio_target and (offset + done + steps) // check_every > (offset + done) // check_every:
@@ -535,6 +585,7 @@ class Simulation:
             rebuilds += int(self._out[K.REBUILDS])
             self.step_count += steps
             self.time = float(self._prm[K.TIME])
+            self._stepped = self._stepped or steps > 0
             status = int(self._out[K.STATUS])
             if status == K.OVERFLOW:
                 need_pp = int(self._out[K.NEED_PP])
@@ -552,8 +603,7 @@ class Simulation:
                 )
             if status == K.CONVERGED:
                 break
-        self._rebuilds = rebuilds
-        return done, status
+        return done, status, rebuilds
 
     def run(
         self,
@@ -573,7 +623,8 @@ class Simulation:
             of this call).
         callback, every
             call ``callback(sim)`` every ``every`` steps (a Python event); if it
-            returns True the run stops.
+            returns True the run stops. A callback needs ``every``; ``every``
+            alone only cuts the run into blocks (which changes no number).
         progress
             show a rich progress bar (steps/s, particle-steps/s, ETA) on a terminal,
             plain lines now and then elsewhere (:mod:`poro2d.progress`); a string is
@@ -591,6 +642,9 @@ class Simulation:
             raise InputError("check_every", check_every, "an integer >= 1")
         if every is not None and not (isinstance(every, (int, np.integer)) and every >= 1):
             raise InputError("every", every, "an integer >= 1")
+        if callback is not None and every is None:
+            raise InputError("every", None, "an integer >= 1 with a callback: the steps between its calls")
+        self._sync_walls()
         target = 0.0 if until_ratio is None else float(until_ratio)
         n = self.particles.n
         t0 = time.perf_counter()
@@ -612,9 +666,9 @@ class Simulation:
         try:
             while done < steps:
                 nb = min(block, steps - done)
-                k, status = self._kernel_block(nb, check_every, target, done)
+                k, status, block_rebuilds = self._kernel_block(nb, check_every, target, done)
                 done += k
-                rebuilds += self._rebuilds
+                rebuilds += block_rebuilds
                 if bar is not None:
                     bar.update(done, self._checked_ratio)
                 if status == K.CONVERGED:
@@ -628,9 +682,7 @@ class Simulation:
                 bar.stop()
         wall = time.perf_counter() - t0
         rmax, rmean = self.unbalanced_ratios()
-        res = RunResult(done, converged, rmax, rmean, wall, rebuilds)
-        res._ps = float(done) * n
-        return res
+        return RunResult(done, converged, rmax, rmean, wall, rebuilds, particle_steps=done * n)
 
     def solve(
         self,
@@ -645,7 +697,7 @@ class Simulation:
     # ------------------------------------------------------------ measurement
     def unbalanced_ratios(self) -> tuple[float, float]:
         """(max, mean) unbalanced-force ratio of the last step (inf before the first)."""
-        if self.step_count == 0 or self.force.shape[0] != self.particles.n:
+        if not (self._stepped or self.step_count > 0) or self.force.shape[0] != self.particles.n:
             return math.inf, math.inf
         r = K.unbalanced_ratios(
             self.force, self.particles.mode, self._nb_start, self._nb_fn, self._nb_fs,
@@ -655,6 +707,7 @@ class Simulation:
 
     def wall_force(self, wall: str | int) -> np.ndarray:
         """Resultant contact force that the disks exert on a wall (N), as (fx, fy)."""
+        self._sync_walls()
         return self.wall_force_vec[self.walls.index(wall)].copy()
 
     def wall_force_per_thickness(self, wall: str | int) -> np.ndarray:
@@ -685,7 +738,8 @@ class Simulation:
             "density_scaling": self.density_scale != 1.0,
             "skin_m": self.skin,
             "threads": self.threads,
-            "threads_used": self.effective_threads,
+            "threads_intended": self.effective_threads,
+            "threads_used": self.threads_used,  # by the kernel's last call (0: none yet)
             "partitions": self.partitions,
             "step": self.step_count,
             "time_s": self.time,

@@ -20,7 +20,14 @@ PRESCRIBED = 1  # velocity and spin are held at their set values (0 = fixed)
 # Wall modes.
 WALL_VELOCITY = 0  # moves with its prescribed velocity (0 = fixed)
 WALL_SERVO = 1  # velocity set every step by the force servo
-SERVO_COLUMNS = 5  # target, gain, max speed, integral gain, summed error
+
+# Columns of Walls.servo, one row per wall (see Simulation.set_wall_servo).
+SERVO_TARGET = 0  # compressive force the servo holds (N)
+SERVO_GAIN = 1  # fraction of the force error removed per step
+SERVO_MAX_SPEED = 2  # bound on the wall's speed (m/s)
+SERVO_INTEGRAL = 3  # integral gain (per step)
+SERVO_ERROR_SUM = 4  # summed force error (N): the servo's state, carried from step to step
+SERVO_COLUMNS = 5
 
 
 def _as_f64(name: str, a, n: int | None = None, shape_tail: tuple = ()) -> np.ndarray:
@@ -134,9 +141,8 @@ class Walls:
     mu: np.ndarray = field(default_factory=lambda: np.zeros(0))
     vel: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     mode: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
-    # servo: direction the wall moves to compress (unit); per wall SERVO_COLUMNS: target
-    # compressive force (N), gain (fraction of the force error removed per step), maximum
-    # speed (m/s), integral gain (per step) and the summed force error (N, its state)
+    # servo_dir: direction the wall moves to compress (unit); servo: the servo's settings and
+    # state, columns SERVO_TARGET, SERVO_GAIN, SERVO_MAX_SPEED, SERVO_INTEGRAL, SERVO_ERROR_SUM
     servo_dir: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     servo: np.ndarray = field(default_factory=lambda: np.zeros((0, SERVO_COLUMNS)))
     names: list[str] = field(default_factory=list)

@@ -113,7 +113,7 @@ class DirectShearTest:
             s.particle_friction, s.density_scale, s.dt_safety, self.threads,
         )  # fmt: skip
         if s.local_damping is not None:
-            sim.local_damping = float(s.local_damping)
+            sim.set_local_damping(float(s.local_damping))
         return sim, box
 
     def consolidate(self) -> tuple[Simulation, dict]:
@@ -139,7 +139,7 @@ class DirectShearTest:
             self._report("consolidating", min(sm.step_count / s.consolidation_max_steps, 1.0))
             return rmax < s.consolidation_ratio and err < s.stress_tolerance
 
-        sim.step_count = 0
+        sim.reset_clock()
         res = sim.run(s.consolidation_max_steps, every=CONSOLIDATION_CHECK, callback=settled)
         if not (state["ratio"] < s.consolidation_ratio and state["err"] < s.stress_tolerance):
             raise RuntimeError(

@@ -275,11 +275,11 @@ def equilibrate(sim: Simulation, spec: SpecimenSpec, label: str, progress: bool 
         damping = sim.local_damping
         sim.particles.vel[:] = 0.0
         sim.particles.omega[:] = 0.0
-        sim.local_damping = spec.calm_damping
+        sim.set_local_damping(spec.calm_damping)
         try:
             attempt("calm", spec.calm_steps)
         finally:
-            sim.local_damping = damping
+            sim.set_local_damping(damping)
         ok = attempt("normal again", spec.calm_steps)
     return {
         "converged": ok,
