@@ -13,13 +13,29 @@ def _load(p: Path) -> dict | None:
 
 
 def build_blocks(out: Path, summary: dict) -> list[Block]:
+    """The report's blocks: summary, inputs, conversions, criterion, sensitivity, shear, provenance."""
+    crit = _load(out / "criterion" / "result.json") or {}
+    b = _intro_blocks(summary, crit)
+    b += _inputs_blocks(summary, crit)
+    b += _conversion_blocks(out, summary["conversions"])
+    b += _criterion_blocks(out, crit, summary["paper"]["criterion"])
+    sens = summary.get("sensitivity")
+    if sens:  # why the paper gets what it gets, when the run holds a sensitivity study
+        from poro2d.report.sensitivity_report import report_blocks
+
+        b += report_blocks(sens)
+    if summary.get("shear"):
+        b += _shear_blocks(out, summary["shear"])
+    b += _provenance_blocks(summary, crit)
+    return b
+
+
+def _intro_blocks(summary: dict, crit: dict) -> list[Block]:
+    """The title, the paper's case in one paragraph, and the summary table beside the paper."""
     paper = summary["paper"]
     pc = paper["criterion"]
-    conv = summary["conversions"]
-    crit = _load(out / "criterion" / "result.json") or {}
-    shear = summary.get("shear")
     its = crit.get("iterations", [])
-    spec = crit.get("specimen", {})
+    shear = summary.get("shear")
     b: list[Block] = [("h1", "poro2d: the paper's case study")]
     b.append((
         "p",
@@ -29,8 +45,6 @@ def build_blocks(out: Path, summary: dict) -> list[Block]:
         f"nLab,min = {paper['n_min']}."
         + (" Quick mode: a reduced specimen, not the paper's box." if summary.get("quick") else ""),
     ))  # fmt: skip
-
-    # --- summary
     b.append(("h2", "Summary"))
     rows = [["accepted 2D porosity", crit.get("final_porosity"), pc["accepted_porosity"]]]
     if its:
@@ -51,10 +65,19 @@ def build_blocks(out: Path, summary: dict) -> list[Block]:
         rows.append(["friction angle from peak strengths (deg)", phi, "not stated"])
     b.append(("table", ["quantity", "poro2d", "paper"], rows))
     b.append(("note", crit.get("message", "criterion not run")))
+    return b
 
-    # --- what is reconstructed or assumed
-    b.append(("h2", "Inputs the paper does not give"))
-    b.append(("ul", [
+
+def _inputs_blocks(summary: dict, crit: dict) -> list[Block]:
+    """What is reconstructed or assumed where the paper is silent."""
+    spec = crit.get("specimen", {})
+    quick = [
+        f"Quick mode: a {spec.get('width')} m x {spec.get('height')} m box in {spec.get('layers')} "
+        "layers, the criterion's force window widened to "
+        f"{crit.get('settings', {}).get('force_fraction', 0.01):.0%} of G (in so small a box 1 % "
+        "of G is about two disks' weight), shear to 4 mm: a first look, not the paper's case.",
+    ] if summary.get("quick") else []  # fmt: skip
+    return [("h2", "Inputs the paper does not give"), ("ul", [
         "Grading curve: a reconstruction of the paper's Fig. 4 (a medium sand, up-scaled x10), matched "
         "to the paper's particle counts (2591 disks at 0.14, 2552 at 0.15); see docs/grading.md. The "
         "real curve can replace it ([grading] csv = ...).",
@@ -65,45 +88,33 @@ def build_blocks(out: Path, summary: dict) -> list[Block]:
         "Multilayer compaction by radius expansion inside each band under a temporary lid "
         f"({spec.get('layers', 4)} layers), equilibrium at a maximum unbalanced-force ratio of "
         f"{spec.get('ratio', 1e-3)}.",
-        *(
-            [
-                f"Quick mode: a {spec.get('width')} m x {spec.get('height')} m box in {spec.get('layers')} "
-                "layers, the criterion's force window widened to "
-                f"{crit.get('settings', {}).get('force_fraction', 0.01):.0%} of G (in so small a box 1 % "
-                "of G is about two disks' weight), shear to 4 mm: a first look, not the paper's case.",
-            ]
-            if summary.get("quick")
-            else []
-        ),
+        *quick,
         "Direct shear: the shear velocity is far above the laboratory rate of 0.384 mm/min "
         "(quasi-static checks below); no laboratory curves are built in (Fig. 8's data are not "
         "published as numbers): pass them with --lab.",
-    ]))  # fmt: skip
+    ])]  # fmt: skip
 
-    # --- conversions
-    b.append(("h2", "3D-to-2D conversions (Eqs. 1-12)"))
-    b.append(
-        (
-            "table",
-            ["method", "equation", "n2D", "flags"],
-            [[m["method"], m["equation"], m["n2d"], m["flags"]] for m in conv["methods"]],
-        )
-    )
+
+def _conversion_blocks(out: Path, conv: dict) -> list[Block]:
+    """The table of Eqs. 1-12 and Figs. 1-2."""
     cdir = out / "conversions"
-    b.append(
-        ("img", cdir / "fig1_relations.png", "Fig. 1: 2D porosity against laboratory porosity, all methods")
-    )
-    b.append(
-        ("img", cdir / "fig2_lim_parabola.png", "Fig. 2: LIM 2D-Lab, LIM 2D-3D and the parabola of Eq. 12")
-    )
+    return [
+        ("h2", "3D-to-2D conversions (Eqs. 1-12)"),
+        ("table", ["method", "equation", "n2D", "flags"],
+         [[m["method"], m["equation"], m["n2d"], m["flags"]] for m in conv["methods"]]),
+        ("img", cdir / "fig1_relations.png", "Fig. 1: 2D porosity against laboratory porosity, all methods"),
+        ("img", cdir / "fig2_lim_parabola.png", "Fig. 2: LIM 2D-Lab, LIM 2D-3D and the parabola of Eq. 12"),
+    ]  # fmt: skip
 
-    # --- criterion
-    b.append(("h2", "The criterion (Fig. 3)"))
+
+def _criterion_blocks(out: Path, crit: dict, pc: dict) -> list[Block]:
+    """poro2d's trials beside the paper's, the discussion, Figs. 5-7 and the specimen's state."""
+    its = crit.get("iterations", [])
+    b: list[Block] = [("h2", "The criterion (Fig. 3)")]
     if its:
-        head = ["", *[f"trial {r['iteration']}" for r in its]]
         b.append((
             "table",
-            head,
+            ["", *[f"trial {r['iteration']}" for r in its]],
             [
                 ["trial n2D", *[r["trial_porosity"] for r in its]],
                 ["disks", *[r["particle_count"] for r in its]],
@@ -137,36 +148,27 @@ def build_blocks(out: Path, summary: dict) -> list[Block]:
         b.extend(_criterion_discussion(its, pc))
     cd = out / "criterion"
     for name, cap in (
-        (
-            "fig5_forces_initial_trial.png",
-            "Fig. 5: contact forces at the initial trial porosity, top plate at H",
-        ),
+        ("fig5_forces_initial_trial.png",
+         "Fig. 5: contact forces at the initial trial porosity, top plate at H"),
         ("fig6_forces_after_plate.png", "Fig. 6: contact forces after the top plate moved"),
         ("fig7_forces_accepted.png", "Fig. 7: contact forces at the accepted porosity"),
-    ):
+    ):  # fmt: skip
         if (cd / name).is_file():
             b.append(("img", cd / name, cap))
-    b.extend(_state_blocks(cd))
+    return b + _state_blocks(cd)
 
-    # --- why the paper gets what it gets (when the run holds a sensitivity study)
-    sens = summary.get("sensitivity")
-    if sens:
-        from poro2d.report.sensitivity_report import report_blocks
 
-        b.extend(report_blocks(sens))
-
-    # --- shear
-    if shear:
-        b.extend(_shear_blocks(out, shear))
-
-    # --- provenance
-    b.append(("h2", "Provenance"))
+def _provenance_blocks(summary: dict, crit: dict) -> list[Block]:
+    """Version, machine, seed, timings and the settings of the run."""
     prov = summary.get("provenance", {})
-    b.append(("table", ["item", "value"], [[k, str(v)] for k, v in prov.items()]
-              + [["seed", summary.get("seed")]]
-              + [[f"time: {k}", v] for k, v in summary.get("timings", {}).items()]))  # fmt: skip
-    b.append(("code", json.dumps({"specimen": spec, "criterion": crit.get("settings", {})}, indent=1)))
-    return b
+    spec = crit.get("specimen", {})
+    return [
+        ("h2", "Provenance"),
+        ("table", ["item", "value"], [[k, str(v)] for k, v in prov.items()]
+         + [["seed", summary.get("seed")]]
+         + [[f"time: {k}", v] for k, v in summary.get("timings", {}).items()]),
+        ("code", json.dumps({"specimen": spec, "criterion": crit.get("settings", {})}, indent=1)),
+    ]  # fmt: skip
 
 
 def _criterion_discussion(its: list[dict], pc: dict) -> list[Block]:
