@@ -109,7 +109,7 @@ def run_paper(
     import os
 
     from poro2d.criterion.cli import print_result
-    from poro2d.criterion.config import build, paper_preset
+    from poro2d.criterion.config import build
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.errors import check_int
     from poro2d.io_utils import check_output_dir
@@ -118,11 +118,7 @@ def run_paper(
     seed = check_int("--seed", seed, 0)
     replicates = check_int("--replicates", replicates, 1, 20)
     check_output_dir("--out", out)
-    cfg = paper_preset()
-    cfg["seed"] = seed
-    if quick:
-        cfg["specimen"] = dict(QUICK_SPECIMEN)
-        cfg["criterion"].update(QUICK_CRITERION)
+    cfg = paper_config(quick, seed)
     lab_data = None
     if lab is not None:
         from poro2d.shear.lab import read_lab_csv
@@ -137,13 +133,8 @@ def run_paper(
     out.mkdir(parents=True, exist_ok=True)
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
-    console.print("[bold]1/3 conversions[/] (Eqs. 1-12, Figs. 1-2)")
-    conv = run_conversions(out / "conversions")
+    conv = _conversions_stage(out)
     timings["conversions_s"] = time.perf_counter() - t0
-    for m in conv["methods"]:
-        v = "skipped" if m["n2d"] is None else f"{m['n2d']:.4f}"
-        console.print(f"  {m['method']:<24} {m['equation']:<10} {v:>8} {m['flags']}")
-
     console.print(f"[bold]2/3 criterion[/] (Fig. 3) for nLab = {settings.n_lab}"
                   f"{' [quick specimen]' if quick else ''}")  # fmt: skip
     t1 = time.perf_counter()
@@ -153,14 +144,8 @@ def run_paper(
     shear = reps = None
     if result["converged"]:
         t2 = time.perf_counter()
-        specimens = {f"seed{sd}": out / "criterion" / "specimen.npz"}
-        if replicates > 1:
-            extra = list(range(sd + 1, sd + replicates))
-            console.print(f"  replicate specimens: seeds {', '.join(map(str, extra))} from n2D = "
-                          f"{result['final_porosity']:.2f}")  # fmt: skip
-            more, reps = replicate_specimens(spec, grading, settings, result["final_porosity"], extra,
-                                             out / "replicates", progress)  # fmt: skip
-            specimens.update(more)
+        specimens, reps = _specimens(spec, grading, settings, result["final_porosity"], sd, replicates, out,
+                                     progress)  # fmt: skip
         timings["replicates_s"] = time.perf_counter() - t2
         shear = _shear_stage(specimens, out / "shear", quick, lab_data, progress)
         timings["shear_s"] = time.perf_counter() - t2 - timings["replicates_s"]
@@ -183,6 +168,40 @@ def run_paper(
     md, html = write_paper_report(out, summary)
     console.print(f"results in {out}/results.json; report: {html} and {md}")
     return summary
+
+
+def paper_config(quick: bool, seed: int) -> dict:
+    """The paper preset as a config (``--quick``: the small box and the widened force window)."""
+    from poro2d.criterion.config import paper_preset
+
+    cfg = paper_preset()
+    cfg["seed"] = seed
+    if quick:
+        cfg["specimen"] = dict(QUICK_SPECIMEN)
+        cfg["criterion"].update(QUICK_CRITERION)
+    return cfg
+
+
+def _conversions_stage(out: Path) -> dict:
+    """Stage 1: every conversion of the paper's sand, printed as a table and written with Figs. 1-2."""
+    console.print("[bold]1/3 conversions[/] (Eqs. 1-12, Figs. 1-2)")
+    conv = run_conversions(out / "conversions")
+    for m in conv["methods"]:
+        v = "skipped" if m["n2d"] is None else f"{m['n2d']:.4f}"
+        console.print(f"  {m['method']:<24} {m['equation']:<10} {v:>8} {m['flags']}")
+    return conv
+
+
+def _specimens(spec, grading, settings, n2d: float, seed: int, replicates: int, out: Path,
+               progress: bool) -> tuple[dict[str, Path], list[dict] | None]:  # fmt: skip
+    """The accepted specimen of ``seed`` and, with replicates, those of the next seeds."""
+    specimens = {f"seed{seed}": out / "criterion" / "specimen.npz"}
+    if replicates == 1:
+        return specimens, None
+    extra = list(range(seed + 1, seed + replicates))
+    console.print(f"  replicate specimens: seeds {', '.join(map(str, extra))} from n2D = {n2d:.2f}")
+    more, reps = replicate_specimens(spec, grading, settings, n2d, extra, out / "replicates", progress)
+    return {**specimens, **more}, reps
 
 
 def _shear_stage(specimens: dict[str, Path], out: Path, quick: bool, lab_data, progress: bool) -> dict:
