@@ -94,8 +94,22 @@ def test_unconverged_seeds_are_counted_and_a_friction_without_any_is_refused():
     cal = Calibration([0.0, 0.5], [[0.17, None, 0.172], [0.22, 0.221, 0.219]])
     assert cal.failed == [1, 0]
     assert cal.mean[0] == pytest.approx(0.171)
-    with pytest.raises(InputError, match="no accepted porosity"):
+    with pytest.raises(InputError, match="at least two frictions"):
         Calibration([0.0, 0.5], [[None], [0.22]]).check()
+
+
+def test_a_friction_that_could_not_be_prepared_is_left_out():
+    """Frictionless layers that never settle give no sample: the extremes are those of the
+    frictions that were prepared, and the left-out friction is recorded."""
+    cal = Calibration([0.0, 0.05, 0.2, 0.5], [[None, None], [0.19, 0.188], [0.19, 0.192], [0.21, 0.209]])
+    cal.check()
+    assert cal.dropped == [0.0]
+    assert cal.n2d_min == pytest.approx(0.189) and cal.n2d_max == pytest.approx(0.2095)
+    assert 0.2 < cal.mu_for(0.2) < 0.5
+    d = cal.to_dict()
+    assert d["dropped"] == [0.0] and np.isnan(d["fitted"][0])
+    t = state_target(0.3253, 0.4571, 0.3253, cal)  # the densest laboratory state: the densest prepared
+    assert t.mu_prep == pytest.approx(0.05) and t.n2d_target == pytest.approx(0.189)
 
 
 def test_state_target_round_trip():

@@ -122,32 +122,49 @@ class Calibration:
         """Per friction, how many seeds did not give an accepted porosity."""
         return [len(s) - self._good(k).size for k, s in enumerate(self.samples)]
 
+    @property
+    def dropped(self) -> list[float]:
+        """Frictions at which no seed was accepted: they could not be prepared, and are left out."""
+        return [mu for k, mu in enumerate(self.mus) if self._good(k).size == 0]
+
+    def usable(self) -> Calibration:
+        """The calibration of the frictions with at least one accepted seed.
+
+        A friction whose every seed was refused (e.g. frictionless layers that never reach
+        equilibrium within the compaction's fallback) gives no sample; the grading's extremes
+        are then those of the frictions that could be prepared. Fewer than two is an error.
+        """
+        keep = [k for k in range(len(self.mus)) if self._good(k).size]
+        if len(keep) < 2:
+            raise InputError(
+                "calibration", f"accepted porosities at mu_prep = {[self.mus[k] for k in keep]} only "
+                f"(none at {self.dropped})", "at least two frictions accepted by at least one seed",
+                "see the calibration's cases for why the criterion did not converge",
+            )  # fmt: skip
+        return Calibration([self.mus[k] for k in keep], [self.samples[k] for k in keep], self.seeds)
+
     # --------------------------------------------------------------- checks
     def check(self) -> None:
-        """Refuse a calibration that cannot map densities: missing points, or not monotone.
+        """Refuse a calibration that cannot map densities: too few frictions, or not monotone.
 
-        A decrease of the seed means with rising friction is tolerated as noise when it is
-        within twice the combined standard error of the two means; the fit then pools it.
+        Frictions without an accepted seed are left out (:meth:`usable`). A decrease of the
+        seed means with rising friction is tolerated as noise when it is within twice the
+        combined standard error of the two means; the fit then pools it.
         """
-        m, s = self.mean, self.sd
-        bad = [mu for mu, v in zip(self.mus, m, strict=True) if not math.isfinite(v)]
-        if bad:
-            raise InputError(
-                "calibration", f"no accepted porosity at mu_prep = {bad}", "every friction accepted by "
-                "at least one seed", "see the calibration's cases for why the criterion did not converge",
-            )  # fmt: skip
-        n = np.array([max(self._good(k).size, 1) for k in range(len(self.mus))])
+        cal = self.usable()
+        m, s = cal.mean, cal.sd
+        n = np.array([max(cal._good(k).size, 1) for k in range(len(cal.mus))])
         se = s / np.sqrt(n)
-        for k in range(len(self.mus) - 1):
+        for k in range(len(cal.mus) - 1):
             drop = m[k] - m[k + 1]
             if drop > 2.0 * math.hypot(se[k], se[k + 1]) and drop > 1e-4:
                 raise InputError(
                     "calibration",
-                    f"n2D {m[k]:.4f} at mu_prep {self.mus[k]:g} > {m[k + 1]:.4f} at {self.mus[k + 1]:g}",
+                    f"n2D {m[k]:.4f} at mu_prep {cal.mus[k]:g} > {m[k + 1]:.4f} at {cal.mus[k + 1]:g}",
                     "a porosity that does not fall as the preparation friction rises",
                     "more seeds, or frictions further apart",
                 )  # fmt: skip
-        if not self.fitted[-1] > self.fitted[0]:
+        if not cal.fitted[-1] > cal.fitted[0]:
             raise InputError(
                 "calibration", f"n2D from {m[0]:.4f} to {m[-1]:.4f}", "a looser state at the highest "
                 "preparation friction than at the lowest", "raise the largest mu_prep (mu_loose)",
@@ -155,36 +172,40 @@ class Calibration:
 
     @property
     def fitted(self) -> np.ndarray:
-        """Non-decreasing fit of the seed means (weights: number of accepted seeds)."""
-        w = [max(self._good(k).size, 1) for k in range(len(self.mus))]
-        return isotonic_increasing(self.mean, w)
+        """Non-decreasing fit of the seed means (weights: accepted seeds); NaN where none was."""
+        keep = [k for k in range(len(self.mus)) if self._good(k).size]
+        out = np.full(len(self.mus), math.nan)
+        if keep:
+            out[keep] = isotonic_increasing(self.mean[keep], [self._good(k).size for k in keep])
+        return out
 
     @property
     def n2d_min(self) -> float:
-        """The grading's densest 2D porosity: the fit at the lowest friction."""
-        return float(self.fitted[0])
+        """The grading's densest 2D porosity: the fit at the lowest friction that was prepared."""
+        return float(self.usable().fitted[0])
 
     @property
     def n2d_max(self) -> float:
-        """The grading's loosest 2D porosity: the fit at the highest friction."""
-        return float(self.fitted[-1])
+        """The grading's loosest 2D porosity: the fit at the highest friction that was prepared."""
+        return float(self.usable().fitted[-1])
 
     def mu_for(self, n2d: float) -> float:
         """The preparation friction whose calibrated n2D is ``n2d`` (monotone interpolation)."""
-        f = self.fitted
+        cal = self.usable()
+        f, mus = cal.fitted, cal.mus
         if n2d < f[0] - 1e-12:
             raise InputError(
                 "target n2D", round(n2d, 5), f"[{f[0]:.4f}, {f[-1]:.4f}] (the calibrated range)",
-                f"denser than the densest preparation (mu_prep = {self.mus[0]:g})",
+                f"denser than the densest preparation (mu_prep = {mus[0]:g})",
             )  # fmt: skip
         if n2d > f[-1] + 1e-12:
             raise InputError(
                 "target n2D", round(n2d, 5), f"[{f[0]:.4f}, {f[-1]:.4f}] (the calibrated range)",
-                f"looser than the loosest preparation (mu_prep = {self.mus[-1]:g}): add a larger mu_prep",
+                f"looser than the loosest preparation (mu_prep = {mus[-1]:g}): add a larger mu_prep",
             )  # fmt: skip
         # flat runs of the fit: take the lowest friction that reaches the value
-        xs, ys = [self.mus[0]], [f[0]]
-        for mu, v in zip(self.mus[1:], f[1:], strict=True):
+        xs, ys = [mus[0]], [f[0]]
+        for mu, v in zip(mus[1:], f[1:], strict=True):
             if v > ys[-1]:
                 xs.append(mu)
                 ys.append(v)
@@ -195,9 +216,8 @@ class Calibration:
     # ------------------------------------------------------------------ io
     def to_dict(self) -> dict:
         d = asdict(self)
-        d.update(
-            mean=self.mean.tolist(), sd=self.sd.tolist(), fitted=self.fitted.tolist(), failed=self.failed
-        )
+        d.update(mean=self.mean.tolist(), sd=self.sd.tolist(), fitted=self.fitted.tolist(),
+                 failed=self.failed, dropped=self.dropped)  # fmt: skip
         return d
 
     @classmethod

@@ -190,6 +190,12 @@ def print_relation(rel: dict, out: Path) -> None:
             f"preparation), n2D,max {rel['n2d_max']:.4f} (loosest); mu_prep per state: "
             + ", ".join(f"{p['mu_prep']:.3f}" for p in rel["points"])
         )
+        dropped = rel["calibration"].get("dropped") or []
+        if dropped:
+            console.print(
+                f"[yellow]left out of the calibration (no seed could be prepared): mu_prep = {dropped}[/]; "
+                "the extremes are those of the frictions that were"
+            )
         sp = rel.get("spread")
         if sp:
             console.print(
