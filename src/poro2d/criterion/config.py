@@ -31,7 +31,14 @@ def paper_preset() -> dict:
     return {"seed": 0, "specimen": {}, "grading": {"preset": "paper"}, "criterion": {"n_lab": 0.3434}}
 
 
-def load_config(path: str | os.PathLike | None = None, preset: str | None = None) -> tuple[dict, Path | None]:
+def load_config(
+    path: str | os.PathLike | None = None, preset: str | None = None, extra_tables: tuple[str, ...] = ()
+) -> tuple[dict, Path | None]:
+    """(config, folder of the file) from ``--config`` or ``--preset`` (the paper's case by default).
+
+    ``extra_tables``: top-level tables a command reads besides the criterion's own
+    (``relation``, ``sensitivity``).
+    """
     if path is not None and preset is not None:
         raise InputError("--config/--preset", f"{path} and {preset}", "one of the two, not both")
     if path is None:
@@ -39,7 +46,7 @@ def load_config(path: str | os.PathLike | None = None, preset: str | None = None
             raise InputError("preset", preset, "'paper'")
         return paper_preset(), None
     cfg = load_toml(path)
-    check_keys("config", cfg, TOP_KEYS)
+    check_keys("config", cfg, TOP_KEYS | set(extra_tables))
     return cfg, Path(path).resolve().parent
 
 

@@ -77,9 +77,7 @@ def register(app: typer.Typer) -> None:
         accepted n2D, the grading's densest and loosest 2D states), every laboratory state is
         mapped between them by its relative density, and checked by the criterion over seeds.
         """
-        from poro2d.config import check_keys, load_toml
-        from poro2d.criterion.config import TOP_KEYS, paper_preset
-        from poro2d.errors import InputError
+        from poro2d.criterion.config import load_config
         from poro2d.io_utils import check_output_dir
         from poro2d.sweep import relation as R
         from poro2d.sweep.cases import parse_sweep
@@ -87,16 +85,7 @@ def register(app: typer.Typer) -> None:
 
         _check_workers(workers)
         check_output_dir("--out", out)
-        if config is not None and preset is not None:
-            raise InputError("--config/--preset", f"{config} and {preset}", "one of the two, not both")
-        if config is None:
-            if preset not in (None, "paper"):
-                raise InputError("--preset", preset, "'paper'")
-            base, base_dir = paper_preset(), None
-        else:
-            base = load_toml(config)
-            check_keys("config", base, set(TOP_KEYS) | {"relation"})
-            base_dir = Path(config).resolve().parent
+        base, base_dir = load_config(config, preset, extra_tables=("relation",))
         settings = R.relation_settings(
             base.get("relation"), points=points, n_max=n_max, n_min=n_min, preset=config is None
         )

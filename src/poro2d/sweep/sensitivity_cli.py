@@ -34,8 +34,7 @@ def register(app: typer.Typer) -> None:
         """Why the paper's case gives what it gives: the criterion in the paper's protocol
         (mu_prep 0.05, first trial from Eq. 12) against grading width (Cu) and against
         preparation friction, over seeds, beside the paper's 0.15."""
-        from poro2d.config import check_keys, load_toml
-        from poro2d.criterion.config import TOP_KEYS, paper_preset
+        from poro2d.criterion.config import load_config
         from poro2d.errors import InputError
         from poro2d.io_utils import check_output_dir
         from poro2d.sweep.sensitivity import run_sensitivity
@@ -45,16 +44,7 @@ def register(app: typer.Typer) -> None:
         if seeds is not None and not 1 <= seeds <= 50:
             raise InputError("--seeds", seeds, "an integer in [1, 50]")
         check_output_dir("--out", out)
-        if config is not None and preset is not None:
-            raise InputError("--config/--preset", f"{config} and {preset}", "one of the two, not both")
-        if config is None:
-            if preset not in (None, "paper"):
-                raise InputError("--preset", preset, "'paper'")
-            base, base_dir = paper_preset(), None
-        else:
-            base = load_toml(config)
-            check_keys("config", base, set(TOP_KEYS) | {"sensitivity"})
-            base_dir = Path(config).resolve().parent
+        base, base_dir = load_config(config, preset, extra_tables=("sensitivity",))
         console.print(f"sensitivity study{' (quick)' if quick else ''} -> {out}")
         sens = run_sensitivity(base, base_dir, out, quick=quick, seeds=seeds, scheduler=scheduler,
                                workers=workers, progress=not quiet)  # fmt: skip
