@@ -15,34 +15,10 @@ import typer
 
 from poro2d.console import OutputConsole
 from poro2d.io_utils import provenance, write_csv, write_json
+from poro2d.paper_data import PAPER, QUICK_CRITERION, QUICK_SPECIMEN
 
 console = OutputConsole()
 
-PAPER = {
-    "n_lab": 0.3434,
-    "n_max": 0.4571,
-    "n_min": 0.3253,
-    "dry_density_kg_m3": 1740.0,
-    "solid_density_kg_m3": 2650.0,
-    # numbers the paper reports for its criterion run (section 3)
-    "criterion": {
-        "trials": [0.14, 0.15],
-        "particle_counts": [2591, 2552],
-        "porosity_change_first_trial": 0.008,
-        "f_top_first_trial_kn_per_m": 3854.0,
-        "f_bottom_first_trial_kn_per_m": 3855.0,
-        "self_weight_first_trial_n_per_m": 846.0,
-        "f_top_accepted_n_per_m": 2.7,
-        "f_bottom_accepted_n_per_m": 809.0,
-        "self_weight_accepted_n_per_m": 836.0,
-        "accepted_porosity": 0.15,
-    },
-}
-
-QUICK_SPECIMEN = {"width": 0.08, "height": 0.04, "layers": 2}
-# a small specimen's 1 % of G is the weight of about two disks: granular noise, so the
-# quick look uses a wider window (stated in its report)
-QUICK_CRITERION = {"force_fraction": 0.05}
 NORMAL_STRESSES_KPA = (50.0, 100.0, 200.0)
 QUICK_SHEAR = {"max_displacement": 0.004}
 

@@ -20,6 +20,7 @@ from pathlib import Path
 from poro2d.config import check_keys, dataclass_from_table, load_toml
 from poro2d.criterion.protocol import CriterionSettings
 from poro2d.errors import InputError, check_int
+from poro2d.porosity import PAPER_N_LAB
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.grading import GradingCurve, paper_grading
 
@@ -28,7 +29,7 @@ TOP_KEYS = {"seed", "specimen", "grading", "criterion", "shear", "title", "densi
 
 def paper_preset() -> dict:
     """The paper's case as a config dict (Table 1, nLab = 0.3434, reconstructed grading)."""
-    return {"seed": 0, "specimen": {}, "grading": {"preset": "paper"}, "criterion": {"n_lab": 0.3434}}
+    return {"seed": 0, "specimen": {}, "grading": {"preset": "paper"}, "criterion": {"n_lab": PAPER_N_LAB}}
 
 
 def load_config(

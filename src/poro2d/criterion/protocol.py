@@ -36,7 +36,7 @@ from poro2d.config import check_finite
 from poro2d.dem import Simulation, checkpoint
 from poro2d.errors import InputError, check_range
 from poro2d.io_utils import as_json, provenance, write_csv, write_json
-from poro2d.porosity import parabolic
+from poro2d.porosity import PAPER_N_LAB, parabolic
 from poro2d.specimen.compaction import SpecimenSpec, box_porosity, prepare_specimen
 from poro2d.specimen.grading import GradingCurve
 
@@ -51,7 +51,7 @@ PERFORMANCE_KEYS = ("threads",)
 class CriterionSettings:
     """Thresholds of Fig. 3 (the paper's values by default) and the plate servo."""
 
-    n_lab: float = 0.3434
+    n_lab: float = PAPER_N_LAB
     trial_porosity: float | None = None
     force_fraction: float = 0.01
     porosity_tolerance: float = 0.005

@@ -22,12 +22,13 @@ import numpy as np
 from poro2d import porosity as P
 from poro2d.config import check_keys
 from poro2d.errors import InputError, check_range
+from poro2d.paper_data import QUICK_SPECIMEN as PAPER_QUICK_SPECIMEN
 
 RELATION_KEYS = {"n_max", "n_min", "points", "n_lab", "mode", "seeds", "mu_prep"}
 #: how the specimen's density follows the laboratory state (see :mod:`poro2d.criterion.density`)
 MODES = ("density", "paper")
-#: the small specimen of ``--quick``
-QUICK_SPECIMEN = {"width": 0.08, "height": 0.04, "layers": 2}
+#: the small specimen of ``--quick`` (that of ``poro2d paper --quick``)
+QUICK_SPECIMEN = dict(PAPER_QUICK_SPECIMEN)
 #: conversion methods drawn beside the DEM points
 COMPARE = ("parabolic", "lim_3d", "lim_lab", "densest_state")
 

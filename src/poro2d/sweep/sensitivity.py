@@ -49,15 +49,15 @@ REFERENCE = "reference"
 
 
 def paper_numbers() -> dict:
-    """The numbers the paper reports for its criterion run (held by ``poro2d.paper``)."""
-    from poro2d.paper import PAPER  # the case study keeps the paper's facts in one place
+    """The numbers the paper reports for its criterion run (held by ``poro2d.paper_data``)."""
+    from poro2d.paper_data import PAPER
 
     return {"n_lab": PAPER["n_lab"], **PAPER["criterion"]}
 
 
 def quick_criterion() -> dict:
     """The criterion settings of a quick run: those of ``poro2d paper --quick``."""
-    from poro2d.paper import QUICK_CRITERION
+    from poro2d.paper_data import QUICK_CRITERION
 
     return dict(QUICK_CRITERION)
 

@@ -1,0 +1,41 @@
+"""The paper's facts in one place: its sand, its criterion run, its quick-look settings.
+
+Numbers the paper states (Wang, Jacobs and Ziegler, sections 2.2, 3 and 4, Table 1); the
+porosities and densities are :mod:`poro2d.porosity`'s constants. Held below every layer
+that quotes them (the case study, its report, the sensitivity study), so none of those
+reaches up into another to read them. Table 1's stiffnesses and frictions are the defaults
+of :class:`poro2d.specimen.compaction.SpecimenSpec`.
+"""
+
+from __future__ import annotations
+
+from poro2d import porosity as P
+
+PAPER = {
+    "n_lab": P.PAPER_N_LAB,
+    "n_max": P.PAPER_N_MAX,
+    "n_min": P.PAPER_N_MIN,
+    "dry_density_kg_m3": P.PAPER_DRY_DENSITY,
+    "solid_density_kg_m3": P.PAPER_SOLID_DENSITY,
+    # numbers the paper reports for its criterion run (section 3)
+    "criterion": {
+        "trials": [0.14, 0.15],
+        "particle_counts": [2591, 2552],
+        "porosity_change_first_trial": 0.008,
+        "f_top_first_trial_kn_per_m": 3854.0,
+        "f_bottom_first_trial_kn_per_m": 3855.0,
+        "self_weight_first_trial_n_per_m": 846.0,
+        "f_top_accepted_n_per_m": 2.7,
+        "f_bottom_accepted_n_per_m": 809.0,
+        "self_weight_accepted_n_per_m": 836.0,
+        "accepted_porosity": 0.15,
+    },
+}
+
+#: ``--quick``: a small box of two layers
+QUICK_SPECIMEN = {"width": 0.08, "height": 0.04, "layers": 2}
+#: a small specimen's 1 % of G is the weight of about two disks: granular noise, so the
+#: quick look uses a wider window (stated in its report)
+QUICK_CRITERION = {"force_fraction": 0.05}
+
+__all__ = ["PAPER", "QUICK_CRITERION", "QUICK_SPECIMEN"]
