@@ -59,6 +59,7 @@ import numpy as np
 from poro2d.interop.lammps import WallFix, critical_dt, disk_mass, model_commands, write_data
 from poro2d.interop.lammps_run import (
     LOOP_RE,
+    checked_log,
     find_lammps,
     find_mpirun,
     lammps_env,
@@ -335,14 +336,7 @@ def run_lammps(
             cmd, cwd=wd, env=lammps_env(threads), capture_output=True, text=True, timeout=timeout
         )
         wall_total = time.perf_counter() - t0
-        logf = wd / "log.lammps"
-        log = logf.read_text() if logf.exists() else ""
-        if proc.returncode != 0 or "ERROR" in log:
-            err = [ln for ln in log.splitlines() if "ERROR" in ln]
-            raise RuntimeError(
-                f"LAMMPS failed (rc={proc.returncode}): "
-                f"{' | '.join(err) or proc.stderr[-2000:] or proc.stdout[-2000:]}"
-            )
+        log = checked_log(proc, wd)
         loops = LOOP_RE.findall(log)
         nrep = params["repeats"]
         if len(loops) < 1 + nrep:
@@ -385,7 +379,7 @@ def run_lammps(
             lost_atoms=n - natoms,
         )
         if not own_dir:
-            out["log"] = str(logf)
+            out["log"] = str(wd / "log.lammps")
         if return_positions:
             out.update(_read_dump(wd / "final.dump"))
         return out

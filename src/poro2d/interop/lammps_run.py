@@ -98,7 +98,12 @@ def run_script(workdir: str | os.PathLike, script: str, variables: dict | None =
     for k, v in (variables or {}).items():
         cmd += ["-var", str(k), str(v)]
     proc = subprocess.run(cmd, cwd=wd, env=lammps_env(), capture_output=True, text=True, timeout=timeout)
-    logf = wd / "log.lammps"
+    return checked_log(proc, wd)
+
+
+def checked_log(proc: subprocess.CompletedProcess, workdir: str | Path) -> str:
+    """The text of ``workdir/log.lammps`` of a finished run; LammpsError with its ERROR lines."""
+    logf = Path(workdir) / "log.lammps"
     log = logf.read_text() if logf.exists() else ""
     if proc.returncode != 0 or "ERROR" in log:
         err = [ln for ln in log.splitlines() if "ERROR" in ln]
