@@ -285,76 +285,8 @@ def plot_relation(rel: dict, title: str = ""):
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     ax.axvspan(lo, hi, color="0.5", alpha=0.07, lw=0)
-    styles = {
-        "parabolic": ("Parabola, Eq. 12 (0.42 n^2 + 0.25 n)", dict(color="black", lw=2.0)),
-        "lim_3d": ("LIM 2D-3D (Sec. 2.2)", dict(color="tab:brown", lw=1.4)),
-        "lim_lab": ("LIM 2D-Lab (Eqs. 6-7)", dict(color="tab:green", lw=1.4)),
-        "densest_state": ("Densest State (Eq. 1)", dict(color="tab:blue", lw=1.2, ls="--")),
-    }
-    funcs = {
-        "parabolic": lambda v: P.parabolic(v),
-        "lim_3d": lambda v: P.lim_3d(v),
-        "lim_lab": lambda v: P.lim_lab(v, hi, lo),
-        "densest_state": lambda v: P.densest_state(v),
-    }
-    for m in COMPARE:
-        label, st = styles[m]
-        ax.plot(x, funcs[m](x), label=label, **st)
-    fit = rel.get("fit")
-    if fit is not None:
-        ax.plot(
-            x,
-            fit["a"] * x * x + fit["b"] * x,
-            color="tab:red",
-            lw=2.0,
-            ls="-.",
-            label=f"fit to DEM: {fit['a']:.3f} n^2 + {fit['b']:.3f} n (rms {fit['rms_residual']:.4f})",
-        )
-    ok = [p for p in pts if p["converged"]]
-    bad = [p for p in pts if not p["converged"] and math.isfinite(p["n2d_dem"])]
-    if ok and rel.get("mode") == "density":
-        ax.errorbar(
-            [p["n_lab"] for p in ok],
-            [p["n2d_dem"] for p in ok],
-            yerr=[p["n2d_sd"] for p in ok],
-            fmt="o",
-            color="tab:red",
-            ms=8,
-            capsize=4,
-            label="DEM criterion, density-controlled (mean accepted n2D +- sd over seeds)",
-        )
-        ax.axhline(rel["n2d_max"], color="0.4", lw=0.8, ls=":", label="2D extremes (calibrated)")
-        ax.axhline(rel["n2d_min"], color="0.4", lw=0.8, ls=":")
-    elif ok:
-        ax.plot(
-            [p["n_lab"] for p in ok],
-            [p["n2d_dem"] for p in ok],
-            "o",
-            color="tab:red",
-            ms=8,
-            label="DEM criterion (accepted n2D)",
-        )
-    if bad:
-        ax.plot(
-            [p["n_lab"] for p in bad],
-            [p["n2d_dem"] for p in bad],
-            "o",
-            mfc="none",
-            mec="tab:red",
-            mew=1.8,
-            ms=9,
-            label="DEM, not converged (last n')",
-        )
-    for p in pts:
-        if math.isfinite(p["n2d_dem"]):
-            ax.annotate(
-                f"Dr={p['relative_density']:.2f}",
-                (p["n_lab"], p["n2d_dem"]),
-                textcoords="offset points",
-                xytext=(6, -12),
-                fontsize=8,
-                color="0.25",
-            )
+    _method_curves(ax, x, hi, lo, rel.get("fit"))
+    _dem_points(ax, rel)
     failed = [p for p in pts if not math.isfinite(p["n2d_dem"])]
     for p in failed:
         ax.axvline(p["n_lab"], color="tab:red", ls=":", lw=1.0)
@@ -372,6 +304,51 @@ def plot_relation(rel: dict, title: str = ""):
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper left", fontsize=8.5, frameon=False)
     return fig
+
+
+def _method_curves(ax, x: np.ndarray, hi: float, lo: float, fit: dict | None) -> None:
+    """Eq. 12 and the other conversion methods over ``x``, and the parabola fitted to the DEM."""
+    styles = {
+        "parabolic": ("Parabola, Eq. 12 (0.42 n^2 + 0.25 n)", dict(color="black", lw=2.0)),
+        "lim_3d": ("LIM 2D-3D (Sec. 2.2)", dict(color="tab:brown", lw=1.4)),
+        "lim_lab": ("LIM 2D-Lab (Eqs. 6-7)", dict(color="tab:green", lw=1.4)),
+        "densest_state": ("Densest State (Eq. 1)", dict(color="tab:blue", lw=1.2, ls="--")),
+    }
+    funcs = {
+        "parabolic": lambda v: P.parabolic(v),
+        "lim_3d": lambda v: P.lim_3d(v),
+        "lim_lab": lambda v: P.lim_lab(v, hi, lo),
+        "densest_state": lambda v: P.densest_state(v),
+    }
+    for m in COMPARE:
+        label, st = styles[m]
+        ax.plot(x, funcs[m](x), label=label, **st)
+    if fit is not None:
+        label = f"fit to DEM: {fit['a']:.3f} n^2 + {fit['b']:.3f} n (rms {fit['rms_residual']:.4f})"
+        ax.plot(x, fit["a"] * x * x + fit["b"] * x, color="tab:red", lw=2.0, ls="-.", label=label)
+
+
+def _dem_points(ax, rel: dict) -> None:
+    """Accepted points (with seed error bars in density mode), unconverged ones hollow, Dr labels."""
+    pts = rel["points"]
+    ok = [p for p in pts if p["converged"]]
+    bad = [p for p in pts if not p["converged"] and math.isfinite(p["n2d_dem"])]
+    ox, oy = [p["n_lab"] for p in ok], [p["n2d_dem"] for p in ok]
+    if ok and rel.get("mode") == "density":
+        label = "DEM criterion, density-controlled (mean accepted n2D +- sd over seeds)"
+        ax.errorbar(ox, oy, yerr=[p["n2d_sd"] for p in ok], fmt="o", color="tab:red", ms=8, capsize=4,
+                    label=label)  # fmt: skip
+        ax.axhline(rel["n2d_max"], color="0.4", lw=0.8, ls=":", label="2D extremes (calibrated)")
+        ax.axhline(rel["n2d_min"], color="0.4", lw=0.8, ls=":")
+    elif ok:
+        ax.plot(ox, oy, "o", color="tab:red", ms=8, label="DEM criterion (accepted n2D)")
+    if bad:
+        ax.plot([p["n_lab"] for p in bad], [p["n2d_dem"] for p in bad], "o", mfc="none", mec="tab:red",
+                mew=1.8, ms=9, label="DEM, not converged (last n')")  # fmt: skip
+    for p in pts:
+        if math.isfinite(p["n2d_dem"]):
+            ax.annotate(f"Dr={p['relative_density']:.2f}", (p["n_lab"], p["n2d_dem"]),
+                        textcoords="offset points", xytext=(6, -12), fontsize=8, color="0.25")  # fmt: skip
 
 
 def write_relation(rel: dict, out: Path, title: str = "", extra: dict | None = None) -> list[Path]:
