@@ -316,66 +316,19 @@ def prepare_specimen(
     """
     check_feasible(spec, grading, porosity)
     W, H = spec.width, spec.height
-    solid_area = (1.0 - porosity) * W * H
     rng = np.random.default_rng(seed)
-    radii = draw_disks(grading, solid_area, rng)
-    order = rng.permutation(len(radii))
-    radii = radii[order]
-    # Each band gets its share of the solid area (the bands' heights decide the shares).
+    radii = draw_disks(grading, (1.0 - porosity) * W * H, rng)
+    radii = radii[rng.permutation(len(radii))]
     tops = spec.layer_tops()
-    bottoms = np.concatenate([[0.0], tops[:-1]])
-    share = np.full(spec.layers, 1.0 / spec.layers)
-    cum = np.cumsum(np.pi * radii**2) / (np.pi * np.sum(radii**2))
-    cuts = np.searchsorted(cum, np.cumsum(share)[:-1])
-    groups = np.split(np.arange(len(radii)), cuts)
-
     sim: Simulation | None = None
     layers: list[dict] = []
-    contact = ContactModel("per_body")
-    for k, idx in enumerate(groups):
-        y_top = float(tops[k])
-        y_bot = float(bottoms[k])
-        if sim is not None:
-            # the previous layer's disks may not sit above its lid: start the band on them
-            p = sim.particles
-            y_bot = max(y_bot, float(np.max(p.pos[:, 1] + p.radius)) if p.n else 0.0)
-            y_bot = min(y_bot, y_top - 2.0 * float(radii[idx].max()))
-        plc = place_disks(radii[idx], Band(0.0, W, y_bot, y_top), seed=int(rng.integers(2**31)))
-        scale = plc.scale
-        # number the disks along horizontal strips of about two diameters: neighbours in
-        # space are then near in memory, which keeps the contact loops in cache
-        strip = 4.0 * float(plc.radii.max())
-        order = np.lexsort((plc.positions[:, 0], np.floor(plc.positions[:, 1] / strip)))
-        idx = idx[order]
-        small = _band_particles(spec, plc.positions[order], plc.radii[order])
-        if sim is None:
-            sim = Simulation(
-                small, make_walls(spec, y_top), contact, gravity=(0.0, -spec.gravity),
-                local_damping=spec.local_damping, dt_safety=spec.dt_safety, threads=spec.threads,
-            )  # fmt: skip
-            new = np.arange(small.n)
-        else:
-            lid = sim.walls.index("top")
-            sim.translate_wall(lid, 0.0, y_top - float(sim.walls.p0[lid, 1]))
-            new = sim.add_particles(small)
-        steps = _grow(sim, new, radii[idx], scale, spec)
-        # renumber the whole packing in strips across its short side (the new layer was
-        # appended on top): threads then split it along a short cut (dem.ordering)
-        sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
-        eq = equilibrate(sim, spec, f"layer {k + 1}", progress)
-        steps += eq["steps"]
-        layers.append(
-            asdict(
-                LayerReport(
-                    k + 1, len(idx), y_top, scale, steps, eq["max_ratio"], eq["converged"], eq["attempts"]
-                )
-            )
-        )
+    failed = None
+    for k, idx in enumerate(_layer_groups(radii, spec.layers)):
+        sim, layer, eq = _build_layer(sim, spec, k, idx, radii, tops, rng, progress)
+        layers.append(layer)
         if not eq["converged"]:
             failed = (f"layer {k + 1}", eq)
             break
-    else:
-        failed = None
     assert sim is not None
     final = None
     if failed is None:
@@ -399,6 +352,58 @@ def prepare_specimen(
         "failed_steps": None if failed is None else failed[1]["steps"],
     }
     return sim, report
+
+
+def _layer_groups(radii: np.ndarray, layers: int) -> list[np.ndarray]:
+    """Disk indices of each layer: every band gets an equal share of the solid area."""
+    share = np.full(layers, 1.0 / layers)
+    cum = np.cumsum(np.pi * radii**2) / (np.pi * np.sum(radii**2))
+    cuts = np.searchsorted(cum, np.cumsum(share)[:-1])
+    return np.split(np.arange(len(radii)), cuts)
+
+
+def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.ndarray, tops: np.ndarray,
+                 rng: np.random.Generator, progress: bool) -> tuple[Simulation, dict, dict]:  # fmt: skip
+    """Place layer ``k`` in its band under the lid, grow it to size, bring it to equilibrium.
+
+    Returns the simulation (made with the first layer), the layer's report and the result of
+    :func:`equilibrate`.
+    """
+    W = spec.width
+    y_top = float(tops[k])
+    y_bot = float(tops[k - 1]) if k else 0.0
+    if sim is not None:
+        # the previous layer's disks may not sit above its lid: start the band on them
+        p = sim.particles
+        y_bot = max(y_bot, float(np.max(p.pos[:, 1] + p.radius)) if p.n else 0.0)
+        y_bot = min(y_bot, y_top - 2.0 * float(radii[idx].max()))
+    plc = place_disks(radii[idx], Band(0.0, W, y_bot, y_top), seed=int(rng.integers(2**31)))
+    # number the disks along horizontal strips of about two diameters: neighbours in
+    # space are then near in memory, which keeps the contact loops in cache
+    strip = 4.0 * float(plc.radii.max())
+    order = np.lexsort((plc.positions[:, 0], np.floor(plc.positions[:, 1] / strip)))
+    idx = idx[order]
+    small = _band_particles(spec, plc.positions[order], plc.radii[order])
+    if sim is None:
+        sim = Simulation(
+            small, make_walls(spec, y_top), ContactModel("per_body"), gravity=(0.0, -spec.gravity),
+            local_damping=spec.local_damping, dt_safety=spec.dt_safety, threads=spec.threads,
+        )  # fmt: skip
+        new = np.arange(small.n)
+    else:
+        lid = sim.walls.index("top")
+        sim.translate_wall(lid, 0.0, y_top - float(sim.walls.p0[lid, 1]))
+        new = sim.add_particles(small)
+    steps = _grow(sim, new, radii[idx], plc.scale, spec)
+    # renumber the whole packing in strips across its short side (the new layer was
+    # appended on top): threads then split it along a short cut (dem.ordering)
+    sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
+    eq = equilibrate(sim, spec, f"layer {k + 1}", progress)
+    steps += eq["steps"]
+    report = LayerReport(k + 1, len(idx), y_top, plc.scale, steps, eq["max_ratio"], eq["converged"],
+                         eq["attempts"])  # fmt: skip
+    layer = asdict(report)
+    return sim, layer, eq
 
 
 def _grow(sim: Simulation, idx: np.ndarray, full: np.ndarray, scale: float, spec: SpecimenSpec) -> int:
