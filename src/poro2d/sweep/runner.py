@@ -293,47 +293,61 @@ def run_sweep(
     for c in sweep.cases:
         done = load_done(cases_dir / c.id)
         if done is not None:
-            done = dict(done, status="done", reused=True)
-            rows[c.id] = done
+            rows[c.id] = dict(done, status="done", reused=True)
         else:
             pending.append(c)
     n_reused = len(rows)
-
     cluster_info: dict[str, Any] = {}
     if pending:
-        own = client is None
-        cluster = None
-        if own:
-            threads = max(int((c.config.get("specimen") or {}).get("threads", 1) or 1) for c in pending)
-            client, cluster = _start_client(scheduler, workers, threads)
-        try:
-            info = client.scheduler_info()
-            cluster_info = {
-                "scheduler": scheduler or info.get("address"),
-                "workers": len(info.get("workers", {})),
-                "threads": sum(w.get("nthreads", 0) for w in info.get("workers", {}).values()),
-                "local_cluster": cluster is not None,
-                "dashboard": _dashboard(client),
-            }
-            if progress and cluster_info["dashboard"]:
-                from poro2d.console import OutputConsole
-
-                err = OutputConsole(stderr=True)
-                err.print(f"Dask dashboard: {cluster_info['dashboard']}", highlight=False)
-            rows.update(
-                _submit_all(client, pending, cases_dir, sweep.retries, progress, n_reused, len(sweep.cases))
-            )
-        finally:
-            if own:
-                client.close()
-                if cluster is not None:
-                    cluster.close()
-
+        cluster_info = _run_pending(sweep, pending, rows, cases_dir, n_reused, client=client,
+                                    scheduler=scheduler, workers=workers, progress=progress)  # fmt: skip
     ordered = [dict(rows[c.id], reused=bool(rows[c.id].get("reused", False))) for c in sweep.cases]
     df = table_from_rows(ordered, sweep.axes)
     df["reused"] = [r["reused"] for r in ordered]
     write_tables(df, out)
-    wall = time.perf_counter() - t_start
+    summary = _summary(ordered, n_reused, time.perf_counter() - t_start, cluster_info)
+    record.update(status="finished", cluster=cluster_info, summary=summary, finished_utc=_now())
+    write_json(out / "sweep.json", record)
+    return SweepOutcome(ordered, df, summary)
+
+
+def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases_dir: Path, n_reused: int, *,
+                 client, scheduler, workers, progress: bool) -> dict:  # fmt: skip
+    """Run the unfinished cases on ``client`` (or a cluster made for them) into ``rows``.
+
+    Returns what is recorded of the cluster (scheduler, workers, threads, dashboard).
+    """
+    own = client is None
+    cluster = None
+    if own:
+        threads = max(int((c.config.get("specimen") or {}).get("threads", 1) or 1) for c in pending)
+        client, cluster = _start_client(scheduler, workers, threads)
+    try:
+        info = client.scheduler_info()
+        cluster_info = {
+            "scheduler": scheduler or info.get("address"),
+            "workers": len(info.get("workers", {})),
+            "threads": sum(w.get("nthreads", 0) for w in info.get("workers", {}).values()),
+            "local_cluster": cluster is not None,
+            "dashboard": _dashboard(client),
+        }
+        if progress and cluster_info["dashboard"]:
+            from poro2d.console import OutputConsole
+
+            err = OutputConsole(stderr=True)
+            err.print(f"Dask dashboard: {cluster_info['dashboard']}", highlight=False)
+        n_total = len(sweep.cases)
+        rows.update(_submit_all(client, pending, cases_dir, sweep.retries, progress, n_reused, n_total))
+    finally:
+        if own:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    return cluster_info
+
+
+def _summary(ordered: list[dict], n_reused: int, wall: float, cluster_info: dict) -> dict:
+    """Counts, wall and case time, the worker processes and the parallel efficiency of a sweep."""
     busy = sum(r.get("time_s") or 0.0 for r in ordered if not r["reused"])
     summary = {
         "cases": len(ordered),
@@ -349,9 +363,7 @@ def run_sweep(
     }
     if cluster_info.get("threads"):
         summary["parallel_efficiency"] = busy / (wall * cluster_info["threads"]) if wall > 0 else None
-    record.update(status="finished", cluster=cluster_info, summary=summary, finished_utc=_now())
-    write_json(out / "sweep.json", record)
-    return SweepOutcome(ordered, df, summary)
+    return summary
 
 
 def _submit_all(
