@@ -13,98 +13,97 @@ console = OutputConsole()
 TARGETS = ("lammps", "yade", "pfc", "csv")
 
 
+def export_cmd(
+    specimen: str = typer.Argument(..., help="Specimen checkpoint (.npz) or a folder holding specimen.npz."),
+    to: str = typer.Option(..., "--to", help="Target: lammps, yade, pfc or csv."),
+    out: Path = typer.Option(..., "--out", "-o", help="Output folder."),
+    ratio: float = typer.Option(
+        1e-3,
+        "--ratio",
+        help="Stop ratio written into the LAMMPS and YADE scripts (max unbalanced force).",
+    ),
+) -> None:
+    """Write an accepted specimen for another DEM code (disks, walls, contact properties)."""
+    from poro2d.errors import InputError, check_range
+    from poro2d.interop import csv_table, lammps, pfc, yade
+    from poro2d.interop.specimen_data import from_checkpoint
+    from poro2d.io_utils import check_output_dir
+
+    if to not in TARGETS:
+        raise InputError("--to", to, "one of " + ", ".join(TARGETS))
+    check_range("--ratio", ratio, 0.0, 1.0, lo_open=True)
+    check_output_dir("--out", out)
+    spec = from_checkpoint(specimen)
+    writers = {
+        "lammps": lambda: lammps.write_specimen(spec, out, ratio=ratio),
+        "yade": lambda: yade.write_specimen(spec, out),
+        "pfc": lambda: pfc.write_specimen(spec, out),
+        "csv": lambda: csv_table.write_specimen(spec, out),
+    }
+    paths = writers[to]()
+    t = Table(title=f"export --to {to}")
+    t.add_column("file")
+    t.add_column("bytes", justify="right")
+    for p in paths:
+        t.add_row(str(p), f"{p.stat().st_size:,}")
+    console.print(t)
+    console.print(
+        f"{spec.n} disks, {len(spec.walls)} walls; thickness t = {spec.thickness:g} m "
+        "(disk masses rho pi r^2 t); SI units; see docs/export.md"
+    )
+
+
+def import_cmd(
+    file: Path = typer.Argument(
+        ..., help="disks.csv (walls.csv beside it), a LAMMPS data file or a checkpoint."
+    ),
+    out: Path = typer.Option(Path("import-out"), "--out", "-o", help="Output folder."),
+    ratio: float = typer.Option(1e-3, "--ratio", help="Equilibrium: max unbalanced-force ratio."),
+    max_steps: int = typer.Option(400_000, "--max-steps", help="Step limit of each stage."),
+    thickness: float = typer.Option(None, "--thickness", help="Disk thickness (m) if the file has none."),
+    density: float = typer.Option(None, "--density", help="Disk density (kg/m3) if the file has none."),
+    kn: float = typer.Option(None, "--kn", help="Disk kn (N/m) if the file has none."),
+    ks: float = typer.Option(None, "--ks", help="Disk ks (N/m) if the file has none."),
+    mu: float = typer.Option(None, "--friction", help="Disk friction if the file has none."),
+    wall_mu: float = typer.Option(None, "--wall-friction", help="Wall friction if the file has none."),
+    threads: int = typer.Option(1, "--threads", help="Threads for the DEM kernels."),
+    quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+) -> None:
+    """Bring a specimen into poro2d and run the criterion's check on it as it stands."""
+    from poro2d.dem import checkpoint
+    from poro2d.errors import check_int, check_range
+    from poro2d.interop.check import check_specimen, read_specimen
+    from poro2d.io_utils import check_output_dir, provenance, write_json
+
+    check_range("--ratio", ratio, 0.0, 1.0, lo_open=True)
+    check_int("--max-steps", max_steps, 1000)
+    given = {"thickness": thickness, "density": density, "kn": kn, "ks": ks, "mu": mu, "wall_mu": wall_mu}
+    for name, v in given.items():
+        if v is not None:
+            check_range(f"--{name.replace('_', '-')}", v, 0.0, None, lo_open=name not in ("mu", "wall_mu"))
+    check_output_dir("--out", out)
+    spec = read_specimen(file, {k: v for k, v in given.items() if v is not None})
+
+    def save_state(sim, report) -> None:
+        out.mkdir(parents=True, exist_ok=True)
+        checkpoint.save(sim, out / "specimen.npz", extra={"stage": "imported", "source": str(file)})
+
+    sim, report = check_specimen(
+        spec, ratio=ratio, max_steps=max_steps, threads=threads, progress=not quiet,
+        at_equilibrium=save_state,
+    )  # fmt: skip
+    if "plate" in report:
+        checkpoint.save(sim, out / "after_plate.npz", extra={"stage": "after_plate", "source": str(file)})
+    report["provenance"] = provenance()
+    write_json(out / "check.json", report)
+    print_check(report, out)
+    if not report["passes"]:
+        raise typer.Exit(1)
+
+
 def register(app: typer.Typer) -> None:
-    @app.command("export")
-    def export_cmd(
-        specimen: str = typer.Argument(
-            ..., help="Specimen checkpoint (.npz) or a folder holding specimen.npz."
-        ),
-        to: str = typer.Option(..., "--to", help="Target: lammps, yade, pfc or csv."),
-        out: Path = typer.Option(..., "--out", "-o", help="Output folder."),
-        ratio: float = typer.Option(
-            1e-3,
-            "--ratio",
-            help="Stop ratio written into the LAMMPS and YADE scripts (max unbalanced force).",
-        ),
-    ) -> None:
-        """Write an accepted specimen for another DEM code (disks, walls, contact properties)."""
-        from poro2d.errors import InputError, check_range
-        from poro2d.interop import csv_table, lammps, pfc, yade
-        from poro2d.interop.specimen_data import from_checkpoint
-        from poro2d.io_utils import check_output_dir
-
-        if to not in TARGETS:
-            raise InputError("--to", to, "one of " + ", ".join(TARGETS))
-        check_range("--ratio", ratio, 0.0, 1.0, lo_open=True)
-        check_output_dir("--out", out)
-        spec = from_checkpoint(specimen)
-        writers = {
-            "lammps": lambda: lammps.write_specimen(spec, out, ratio=ratio),
-            "yade": lambda: yade.write_specimen(spec, out),
-            "pfc": lambda: pfc.write_specimen(spec, out),
-            "csv": lambda: csv_table.write_specimen(spec, out),
-        }
-        paths = writers[to]()
-        t = Table(title=f"export --to {to}")
-        t.add_column("file")
-        t.add_column("bytes", justify="right")
-        for p in paths:
-            t.add_row(str(p), f"{p.stat().st_size:,}")
-        console.print(t)
-        console.print(
-            f"{spec.n} disks, {len(spec.walls)} walls; thickness t = {spec.thickness:g} m "
-            "(disk masses rho pi r^2 t); SI units; see docs/export.md"
-        )
-
-    @app.command("import")
-    def import_cmd(
-        file: Path = typer.Argument(
-            ..., help="disks.csv (walls.csv beside it), a LAMMPS data file or a checkpoint."
-        ),
-        out: Path = typer.Option(Path("import-out"), "--out", "-o", help="Output folder."),
-        ratio: float = typer.Option(1e-3, "--ratio", help="Equilibrium: max unbalanced-force ratio."),
-        max_steps: int = typer.Option(400_000, "--max-steps", help="Step limit of each stage."),
-        thickness: float = typer.Option(None, "--thickness", help="Disk thickness (m) if the file has none."),
-        density: float = typer.Option(None, "--density", help="Disk density (kg/m3) if the file has none."),
-        kn: float = typer.Option(None, "--kn", help="Disk kn (N/m) if the file has none."),
-        ks: float = typer.Option(None, "--ks", help="Disk ks (N/m) if the file has none."),
-        mu: float = typer.Option(None, "--friction", help="Disk friction if the file has none."),
-        wall_mu: float = typer.Option(None, "--wall-friction", help="Wall friction if the file has none."),
-        threads: int = typer.Option(1, "--threads", help="Threads for the DEM kernels."),
-        quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
-    ) -> None:
-        """Bring a specimen into poro2d and run the criterion's check on it as it stands."""
-        from poro2d.dem import checkpoint
-        from poro2d.errors import check_int, check_range
-        from poro2d.interop.check import check_specimen, read_specimen
-        from poro2d.io_utils import check_output_dir, provenance, write_json
-
-        check_range("--ratio", ratio, 0.0, 1.0, lo_open=True)
-        check_int("--max-steps", max_steps, 1000)
-        given = {"thickness": thickness, "density": density, "kn": kn, "ks": ks, "mu": mu, "wall_mu": wall_mu}
-        for name, v in given.items():
-            if v is not None:
-                check_range(
-                    f"--{name.replace('_', '-')}", v, 0.0, None, lo_open=name not in ("mu", "wall_mu")
-                )
-        check_output_dir("--out", out)
-        spec = read_specimen(file, {k: v for k, v in given.items() if v is not None})
-
-        def save_state(sim, report) -> None:
-            out.mkdir(parents=True, exist_ok=True)
-            checkpoint.save(sim, out / "specimen.npz", extra={"stage": "imported", "source": str(file)})
-
-        sim, report = check_specimen(
-            spec, ratio=ratio, max_steps=max_steps, threads=threads, progress=not quiet,
-            at_equilibrium=save_state,
-        )  # fmt: skip
-        if "plate" in report:
-            checkpoint.save(sim, out / "after_plate.npz", extra={"stage": "after_plate", "source": str(file)})
-        report["provenance"] = provenance()
-        write_json(out / "check.json", report)
-        print_check(report, out)
-        if not report["passes"]:
-            raise typer.Exit(1)
+    app.command("export")(export_cmd)
+    app.command("import")(import_cmd)
 
 
 def print_check(report: dict, out: Path) -> None:

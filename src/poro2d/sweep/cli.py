@@ -23,102 +23,105 @@ def _check_workers(workers: int | None) -> None:
         raise InputError("--workers", workers, "an integer >= 1")
 
 
+def sweep_cmd(
+    config: Path = typer.Argument(..., help="TOML config: base case tables and a \\[sweep] table."),
+    out: Path = typer.Option(
+        Path("sweep-out"), "--out", "-o", help="Output folder (reruns skip done cases)."
+    ),
+    scheduler: str = typer.Option(None, "--scheduler", help=_SCHED),
+    workers: int = typer.Option(None, "--workers", help=_WORKERS),
+    quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
+) -> None:
+    """Run a grid or list of cases as Dask tasks; one table of results."""
+    from poro2d.config import load_toml
+    from poro2d.io_utils import check_output_dir
+    from poro2d.sweep.cases import parse_sweep
+    from poro2d.sweep.runner import run_sweep
+
+    _check_workers(workers)
+    check_output_dir("--out", out)
+    cfg = load_toml(config)
+    sweep = parse_sweep(cfg, Path(config).resolve().parent)
+    console.print(f"{len(sweep.cases)} case(s) of kind {sweep.kind!r} -> {out}")
+    res = run_sweep(sweep, out, scheduler=scheduler, workers=workers, progress=not quiet)
+    print_summary(res, out)
+    if res.failed:
+        raise typer.Exit(1)
+
+
+def relation_cmd(
+    config: Path = typer.Option(
+        None, "--config", "-c", help="Criterion config; optional \\[relation] table."
+    ),
+    preset: str = typer.Option(None, "--preset", help="Built-in case: 'paper'."),
+    points: int = typer.Option(
+        None, "--points", help="Laboratory porosities from n_max to n_min (default 5)."
+    ),
+    n_max: float = typer.Option(None, "--n-max", help="Loosest laboratory porosity (paper: 0.4571)."),
+    n_min: float = typer.Option(None, "--n-min", help="Densest laboratory porosity (paper: 0.3253)."),
+    out: Path = typer.Option(Path("relation-out"), "--out", "-o", help="Output folder (resumable)."),
+    scheduler: str = typer.Option(None, "--scheduler", help=_SCHED),
+    workers: int = typer.Option(None, "--workers", help=_WORKERS),
+    quick: bool = typer.Option(False, "--quick", help="Small specimen (0.08 m x 0.04 m, 2 layers)."),
+    mode: str = typer.Option(
+        None, "--mode", help="density (default): preparation friction from the state; paper: fixed 0.05."
+    ),
+    seeds: int = typer.Option(None, "--seeds", help="Specimens per state and per calibration point (3)."),
+    quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
+) -> None:
+    """The grading's n2D(nLab) relation from the criterion at several relative densities.
+
+    Density mode (default): the criterion is first calibrated (preparation friction ->
+    accepted n2D, the grading's densest and loosest 2D states), every laboratory state is
+    mapped between them by its relative density, and checked by the criterion over seeds.
+    """
+    from poro2d.criterion.config import load_config
+    from poro2d.io_utils import check_output_dir
+    from poro2d.sweep import relation as R
+    from poro2d.sweep.cases import parse_sweep
+    from poro2d.sweep.runner import run_sweep
+
+    _check_workers(workers)
+    check_output_dir("--out", out)
+    base, base_dir = load_config(config, preset, extra_tables=("relation",))
+    settings = R.relation_settings(
+        base.get("relation"), points=points, n_max=n_max, n_min=n_min, preset=config is None
+    )
+    table = base.get("relation") or {}
+    mode = R.check_mode(mode if mode is not None else table.get("mode", "density"))
+    n_seeds = R.check_seeds(seeds if seeds is not None else table.get("seeds", 3))
+    console.print(
+        f"criterion ({mode} mode) at nLab = {', '.join(f'{v:g}' for v in settings['n_lab'])} "
+        f"(n_max {settings['n_max']:g}, n_min {settings['n_min']:g})"
+        f"{' (quick)' if quick else ''} -> {out}"
+    )
+    sweep_kw = {"scheduler": scheduler, "workers": workers, "progress": not quiet}
+    title = "2D porosity from the criterion vs laboratory porosity"
+    if quick:
+        title += " (quick: 0.08 m x 0.04 m box)"
+    if mode == "density":
+        rel, record = R.density_relation(
+            base, base_dir, settings, out,
+            quick=quick, seeds=n_seeds, mus=table.get("mu_prep"), **sweep_kw,
+        )  # fmt: skip
+        failed = record["failed_cases"]
+        extra = {"quick": quick, "config": base, "sweeps": record}
+    else:
+        sweep = parse_sweep(R.sweep_config(base, settings["n_lab"], quick=quick), base_dir)
+        res = run_sweep(sweep, out, **sweep_kw)
+        rel = R.analyse(res.rows, settings["n_max"], settings["n_min"])
+        failed = len(res.failed)
+        extra = {"quick": quick, "sweep_summary": res.summary, "config": base}
+    R.write_relation(rel, out, title=title, extra=extra)
+    print_relation(rel, out)
+    if failed:
+        console.print(f"[bold red]{failed} case(s) failed[/]; tracebacks in {out}/**/error.txt")
+        raise typer.Exit(1)
+
+
 def register(app: typer.Typer) -> None:
-    @app.command("sweep")
-    def sweep_cmd(
-        config: Path = typer.Argument(..., help="TOML config: base case tables and a \\[sweep] table."),
-        out: Path = typer.Option(
-            Path("sweep-out"), "--out", "-o", help="Output folder (reruns skip done cases)."
-        ),
-        scheduler: str = typer.Option(None, "--scheduler", help=_SCHED),
-        workers: int = typer.Option(None, "--workers", help=_WORKERS),
-        quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
-    ) -> None:
-        """Run a grid or list of cases as Dask tasks; one table of results."""
-        from poro2d.config import load_toml
-        from poro2d.io_utils import check_output_dir
-        from poro2d.sweep.cases import parse_sweep
-        from poro2d.sweep.runner import run_sweep
-
-        _check_workers(workers)
-        check_output_dir("--out", out)
-        cfg = load_toml(config)
-        sweep = parse_sweep(cfg, Path(config).resolve().parent)
-        console.print(f"{len(sweep.cases)} case(s) of kind {sweep.kind!r} -> {out}")
-        res = run_sweep(sweep, out, scheduler=scheduler, workers=workers, progress=not quiet)
-        print_summary(res, out)
-        if res.failed:
-            raise typer.Exit(1)
-
-    @app.command("relation")
-    def relation_cmd(
-        config: Path = typer.Option(
-            None, "--config", "-c", help="Criterion config; optional \\[relation] table."
-        ),
-        preset: str = typer.Option(None, "--preset", help="Built-in case: 'paper'."),
-        points: int = typer.Option(
-            None, "--points", help="Laboratory porosities from n_max to n_min (default 5)."
-        ),
-        n_max: float = typer.Option(None, "--n-max", help="Loosest laboratory porosity (paper: 0.4571)."),
-        n_min: float = typer.Option(None, "--n-min", help="Densest laboratory porosity (paper: 0.3253)."),
-        out: Path = typer.Option(Path("relation-out"), "--out", "-o", help="Output folder (resumable)."),
-        scheduler: str = typer.Option(None, "--scheduler", help=_SCHED),
-        workers: int = typer.Option(None, "--workers", help=_WORKERS),
-        quick: bool = typer.Option(False, "--quick", help="Small specimen (0.08 m x 0.04 m, 2 layers)."),
-        mode: str = typer.Option(
-            None, "--mode", help="density (default): preparation friction from the state; paper: fixed 0.05."
-        ),
-        seeds: int = typer.Option(None, "--seeds", help="Specimens per state and per calibration point (3)."),
-        quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
-    ) -> None:
-        """The grading's n2D(nLab) relation from the criterion at several relative densities.
-
-        Density mode (default): the criterion is first calibrated (preparation friction ->
-        accepted n2D, the grading's densest and loosest 2D states), every laboratory state is
-        mapped between them by its relative density, and checked by the criterion over seeds.
-        """
-        from poro2d.criterion.config import load_config
-        from poro2d.io_utils import check_output_dir
-        from poro2d.sweep import relation as R
-        from poro2d.sweep.cases import parse_sweep
-        from poro2d.sweep.runner import run_sweep
-
-        _check_workers(workers)
-        check_output_dir("--out", out)
-        base, base_dir = load_config(config, preset, extra_tables=("relation",))
-        settings = R.relation_settings(
-            base.get("relation"), points=points, n_max=n_max, n_min=n_min, preset=config is None
-        )
-        table = base.get("relation") or {}
-        mode = R.check_mode(mode if mode is not None else table.get("mode", "density"))
-        n_seeds = R.check_seeds(seeds if seeds is not None else table.get("seeds", 3))
-        console.print(
-            f"criterion ({mode} mode) at nLab = {', '.join(f'{v:g}' for v in settings['n_lab'])} "
-            f"(n_max {settings['n_max']:g}, n_min {settings['n_min']:g})"
-            f"{' (quick)' if quick else ''} -> {out}"
-        )
-        sweep_kw = {"scheduler": scheduler, "workers": workers, "progress": not quiet}
-        title = "2D porosity from the criterion vs laboratory porosity"
-        if quick:
-            title += " (quick: 0.08 m x 0.04 m box)"
-        if mode == "density":
-            rel, record = R.density_relation(
-                base, base_dir, settings, out,
-                quick=quick, seeds=n_seeds, mus=table.get("mu_prep"), **sweep_kw,
-            )  # fmt: skip
-            failed = record["failed_cases"]
-            extra = {"quick": quick, "config": base, "sweeps": record}
-        else:
-            sweep = parse_sweep(R.sweep_config(base, settings["n_lab"], quick=quick), base_dir)
-            res = run_sweep(sweep, out, **sweep_kw)
-            rel = R.analyse(res.rows, settings["n_max"], settings["n_min"])
-            failed = len(res.failed)
-            extra = {"quick": quick, "sweep_summary": res.summary, "config": base}
-        R.write_relation(rel, out, title=title, extra=extra)
-        print_relation(rel, out)
-        if failed:
-            console.print(f"[bold red]{failed} case(s) failed[/]; tracebacks in {out}/**/error.txt")
-            raise typer.Exit(1)
+    app.command("sweep")(sweep_cmd)
+    app.command("relation")(relation_cmd)
 
 
 def print_summary(res, out: Path) -> None:
