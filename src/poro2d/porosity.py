@@ -557,6 +557,71 @@ class Conversion:
         return {k: r.value for k, r in self.results.items()}
 
 
+def _conversion_options(options: dict) -> tuple[str, bool]:
+    """(nu_reading, lattice_exact) of :func:`convert_all`; unknown options are errors."""
+    unknown = set(options) - {"nu_reading", "lattice_exact"}
+    if unknown:
+        name = sorted(unknown)[0]
+        raise InputError(name, options[name], "options nu_reading, lattice_exact")
+    nu_reading = options.get("nu_reading", "printed")
+    if nu_reading not in NU_READINGS:
+        raise InputError("nu_reading", nu_reading, " or ".join(NU_READINGS))
+    return nu_reading, bool(options.get("lattice_exact", False))
+
+
+def _method_result(m, n: float, hi, lo, nu_reading: str, lattice_exact: bool) -> MethodResult:
+    """One method's value at ``n`` with its details, flags and warnings (see :func:`convert_all`)."""
+    r = MethodResult(m.id, m.name, m.equation, m.source, value=None)
+    given = {"n_max": hi, "n_min": lo}
+    if any(given[k] is None for k in m.needs):
+        r.skipped = "needs " + " and ".join(m.needs)
+        return r
+    val = float(m.func(n, hi, lo, {"nu_reading": nu_reading, "lattice_exact": lattice_exact}))
+    if m.id == "densest_state_modified":
+        nu = nu_factor(lo, nu_reading)
+        r.details.update(nu_reading=nu_reading, nu=nu, n_3d_min=FCC_3D)
+        other = "solid_fraction" if nu_reading == "printed" else "printed"
+        other_val = float(densest_state_modified(n, lo, other))
+        r.details["other_reading"] = {"nu_reading": other, "n2d": other_val}
+        r.flags.append(f"nu={nu_reading}")
+    if m.interpolates:
+        r.details["D_r" if m.id == "combination" else "D"] = float(
+            relative_density(n, hi, lo) if m.id == "combination" else degree_of_density(n, hi, lo)
+        )
+        if not lo <= n <= hi:
+            r.flags.append("extrapolated")
+            r.warnings.append(
+                f"{m.id}: n_lab = {n:g} lies outside [n_min, n_max] = [{lo:g}, {hi:g}]; "
+                "the value is an extrapolation of the method"
+            )
+    if m.id in ("lim_lab", "quasi_3d"):
+        hi2, lo2 = _n2d_extremes(None, None, lattice_exact)
+        r.details.update(n2d_max=hi2, n2d_min=lo2, lattice_exact=lattice_exact)
+    if m.id == "lim_3d" and not FCC_3D <= n <= SIMPLE_CUBIC_3D:
+        r.flags.append("beyond_lattice")
+        r.warnings.append(
+            f"lim_3d: n_lab = {n:g} lies outside the lattice segment "
+            f"[{FCC_3D:.4f}, {SIMPLE_CUBIC_3D:.4f}] (FCC to simple cubic); extrapolated line"
+        )
+    if m.id == "combination":
+        r.details["xi"] = float(combination_xi(n, hi, lo))
+        if float(combination_slope_sign(n, hi, lo)) < 0:
+            r.flags.append("decreasing")
+    if math.isnan(val):
+        r.flags.append("undefined")
+        r.skipped = "no real value (xi <= 0 for this extrapolated relative density)"
+        r.warnings.append(f"{m.id}: no real 2D porosity at n_lab = {n:g} (xi <= 0)")
+        return r
+    r.value = val
+    if val < 0.0:
+        r.flags.append("negative")
+        r.warnings.append(
+            f"{m.id}: negative 2D porosity {val:.4f} at n_lab = {n:g} "
+            "(physically impossible; reported, not clipped)"
+        )
+    return r
+
+
 def convert_all(
     n_lab: float,
     n_max: float | None = None,
@@ -575,14 +640,7 @@ def convert_all(
     Combination Method falls with n_lab at this point), ``"beyond_lattice"`` (LIM_2D-3D
     outside [n_FCC, n_SC]), ``"undefined"`` (no real value, e.g. xi <= 0 in Eq. 5).
     """
-    unknown = set(options) - {"nu_reading", "lattice_exact"}
-    if unknown:
-        name = sorted(unknown)[0]
-        raise InputError(name, options[name], "options nu_reading, lattice_exact")
-    nu_reading = options.get("nu_reading", "printed")
-    if nu_reading not in NU_READINGS:
-        raise InputError("nu_reading", nu_reading, " or ".join(NU_READINGS))
-    lattice_exact = bool(options.get("lattice_exact", False))
+    nu_reading, lattice_exact = _conversion_options(options)
     if np.ndim(n_lab) != 0:
         raise InputError("n_lab", n_lab, "a single number in [0, 1) (call once per value)")
     n = float(_check_porosity("n_lab", n_lab))
@@ -590,63 +648,8 @@ def convert_all(
     lo = None if n_min is None else float(_check_porosity("n_min", n_min))
     if hi is not None and lo is not None:
         _check_extremes(hi, lo)
-    given = {"n_max": hi, "n_min": lo}
-
+    results = {m.id: _method_result(m, n, hi, lo, nu_reading, lattice_exact) for m in METHODS.values()}
     notes: list[str] = []
-    results: dict[str, MethodResult] = {}
-    for m in METHODS.values():
-        r = MethodResult(m.id, m.name, m.equation, m.source, value=None)
-        missing = [k for k in m.needs if given[k] is None]
-        if missing:
-            r.skipped = "needs " + " and ".join(m.needs)
-            results[m.id] = r
-            continue
-        val = float(m.func(n, hi, lo, {"nu_reading": nu_reading, "lattice_exact": lattice_exact}))
-        if m.id == "densest_state_modified":
-            nu = nu_factor(lo, nu_reading)
-            r.details.update(nu_reading=nu_reading, nu=nu, n_3d_min=FCC_3D)
-            other = "solid_fraction" if nu_reading == "printed" else "printed"
-            other_val = float(densest_state_modified(n, lo, other))
-            r.details["other_reading"] = {"nu_reading": other, "n2d": other_val}
-            r.flags.append(f"nu={nu_reading}")
-        if m.interpolates:
-            r.details["D_r" if m.id == "combination" else "D"] = float(
-                relative_density(n, hi, lo) if m.id == "combination" else degree_of_density(n, hi, lo)
-            )
-            if not lo <= n <= hi:
-                r.flags.append("extrapolated")
-                r.warnings.append(
-                    f"{m.id}: n_lab = {n:g} lies outside [n_min, n_max] = [{lo:g}, {hi:g}]; "
-                    "the value is an extrapolation of the method"
-                )
-        if m.id in ("lim_lab", "quasi_3d"):
-            hi2, lo2 = _n2d_extremes(None, None, lattice_exact)
-            r.details.update(n2d_max=hi2, n2d_min=lo2, lattice_exact=lattice_exact)
-        if m.id == "lim_3d" and not FCC_3D <= n <= SIMPLE_CUBIC_3D:
-            r.flags.append("beyond_lattice")
-            r.warnings.append(
-                f"lim_3d: n_lab = {n:g} lies outside the lattice segment "
-                f"[{FCC_3D:.4f}, {SIMPLE_CUBIC_3D:.4f}] (FCC to simple cubic); extrapolated line"
-            )
-        if m.id == "combination":
-            r.details["xi"] = float(combination_xi(n, hi, lo))
-            if float(combination_slope_sign(n, hi, lo)) < 0:
-                r.flags.append("decreasing")
-        if math.isnan(val):
-            r.flags.append("undefined")
-            r.skipped = "no real value (xi <= 0 for this extrapolated relative density)"
-            r.warnings.append(f"{m.id}: no real 2D porosity at n_lab = {n:g} (xi <= 0)")
-            results[m.id] = r
-            continue
-        r.value = val
-        if val < 0.0:
-            r.flags.append("negative")
-            r.warnings.append(
-                f"{m.id}: negative 2D porosity {val:.4f} at n_lab = {n:g} "
-                "(physically impossible; reported, not clipped)"
-            )
-        results[m.id] = r
-
     if lo is not None:
         notes.append(
             f"Eq. 2 uses nu_reading = {nu_reading!r} "
