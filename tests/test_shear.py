@@ -11,20 +11,9 @@ from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.shear import DirectShearTest, ShearSeries, ShearSettings, build_split_box, smooth
 from poro2d.shear.box import LOWER, UPPER
-from poro2d.specimen import paper_grading
-from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
 
 # 2 mm of shear in the 60 mm box: the peak of this small specimen lies near the end
 SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4}
-
-
-@pytest.fixture(scope="module")
-def specimen(tmp_path_factory):
-    sim, rep = prepare_specimen(SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.2, seed=0)
-    assert rep["converged"]
-    path = tmp_path_factory.mktemp("specimen") / "specimen.npz"
-    checkpoint.save(sim, path)
-    return path
 
 
 @pytest.fixture(scope="module")

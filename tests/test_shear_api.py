@@ -11,8 +11,6 @@ from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.shear import ShearSeries, ShearSettings, build_split_box, run_shear
 from poro2d.shear.peak_frame import PeakFrame, PeakTracker
-from poro2d.specimen import paper_grading
-from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
 
 SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4}
 # the keys of peak_frame.npz as earlier versions of poro2d wrote them: a test they left
@@ -20,15 +18,6 @@ SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 
 FRAME_KEYS = {"pos", "radius", "thickness", "wall_p0", "wall_p1", "record", "displacement_mm"} | {
     "c_" + k for k in ("i", "j", "kind", "point", "normal", "fn", "fs", "force", "branch")
 }
-
-
-@pytest.fixture(scope="module")
-def specimen(tmp_path_factory):
-    sim, rep = prepare_specimen(SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.2, seed=0)
-    assert rep["converged"]
-    path = tmp_path_factory.mktemp("specimen") / "specimen.npz"
-    checkpoint.save(sim, path)
-    return path
 
 
 def test_run_shear_is_the_series_with_its_files(specimen, tmp_path):

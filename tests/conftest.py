@@ -1,0 +1,17 @@
+"""Fixtures shared by several test modules."""
+
+import pytest
+
+from poro2d.dem import checkpoint
+from poro2d.specimen import paper_grading
+from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
+
+
+@pytest.fixture(scope="module")
+def specimen(tmp_path_factory):
+    """A small prepared specimen (0.06 m x 0.03 m, about 110 disks) saved as a checkpoint; one per module."""
+    sim, rep = prepare_specimen(SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.2, seed=0)
+    assert rep["converged"]
+    path = tmp_path_factory.mktemp("specimen") / "specimen.npz"
+    checkpoint.save(sim, path)
+    return path
