@@ -334,3 +334,23 @@ def test_non_finite_shear_settings_are_refused(specimen, tmp_path):
     with pytest.raises(InputError, match="peak_window"):
         ShearSeries(specimen, [50], ShearSettings(**dict(SHORT, peak_window=float("inf"))), out=tmp_path)
     assert not any(tmp_path.iterdir())
+
+
+def test_stop_after_peak_ends_the_test_with_the_same_peak(specimen):
+    """Stopping once the peak is passed changes nothing before the stop: the curve is a prefix
+    of the full one, the peak is the same, and the result says why it ended."""
+    base = {"max_displacement": 0.004, "peak_window": 5e-4}
+    full = DirectShearTest(specimen, 100, ShearSettings(**base, stop_after_peak=0.0)).run()
+    short = DirectShearTest(specimen, 100, ShearSettings(**base, stop_after_peak=5e-4)).run()
+    assert full["ended_by"] == "max_displacement"
+    assert short["ended_by"].startswith("peak passed by 0.5 mm")
+    assert short["records"] < full["records"]
+    assert short["end_shear_displacement_m"] >= short["shear_displacement_at_peak_m"] + 5e-4
+    assert short["peak_shear_stress_kpa"] == full["peak_shear_stress_kpa"]
+    assert short["shear_displacement_at_peak_m"] == full["shear_displacement_at_peak_m"]
+
+
+@pytest.mark.parametrize("value", [-1e-3, 1e-4])
+def test_stop_after_peak_shorter_than_the_smoothing_is_refused(value):
+    with pytest.raises(InputError, match="stop_after_peak"):
+        ShearSettings(stop_after_peak=value)

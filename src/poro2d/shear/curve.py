@@ -82,6 +82,13 @@ def force_balance(x: np.ndarray, col: dict[str, np.ndarray], window: float) -> d
     }  # fmt: skip
 
 
+def ended_by(x: np.ndarray, x_peak: float, s: ShearSettings) -> str:
+    """Why the test stopped where its curve ends: the peak passed or the full displacement."""
+    if s.stop_after_peak > 0.0 and x[-1] >= x_peak + s.stop_after_peak:
+        return f"peak passed by {1e3 * s.stop_after_peak:g} mm (stop_after_peak)"
+    return "max_displacement"
+
+
 def curve_summary(rows: list[dict], sigma_kpa: float, settings: ShearSettings) -> dict:
     """Peak, end values, servo error, inertial number and force balance read off the curve."""
     s = settings
@@ -104,6 +111,7 @@ def curve_summary(rows: list[dict], sigma_kpa: float, settings: ShearSettings) -
         "plate_displacement_at_peak_mm": float(col["plate_displacement_mm"][k]),
         "end": end,
         "end_shear_displacement_m": float(x[-1]),
+        "ended_by": ended_by(x, xp, s),
         "max_inertial_number": float(np.max(inertial)),
         "inertial_number_ok": bool(np.max(inertial) < s.inertial_limit),
         "normal_stress_max_error_after_consolidation": float(np.max(sig_err)),

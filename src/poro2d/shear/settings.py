@@ -12,7 +12,9 @@ from poro2d.errors import InputError, check_range
 class ShearSettings:
     """Settings of a direct shear test (SI units; the box walls default to Table 1).
 
-    velocity (m/s) and max_displacement (m) of the lower half; record_interval and
+    velocity (m/s) and max_displacement (m) of the lower half; stop_after_peak (m): the
+    test ends once the smoothed peak lies that far behind (0: always run to
+    max_displacement); record_interval and
     checkpoint_interval (m of shear displacement); consolidation_ratio and
     consolidation_max_steps for the consolidation stage; servo_gain, servo_integral
     (per step; it keeps the stress on target while the specimen dilates) and
@@ -26,6 +28,7 @@ class ShearSettings:
 
     velocity: float = 0.025
     max_displacement: float = 0.02
+    stop_after_peak: float = 0.005
     record_interval: float = 5e-5
     checkpoint_interval: float = 1e-3
     consolidation_ratio: float = 1e-3
@@ -50,6 +53,7 @@ class ShearSettings:
         check_range("velocity", self.velocity, 0.0, 10.0, lo_open=True)
         check_range("max_displacement", self.max_displacement, 0.0, None, lo_open=True)
         check_range("record_interval", self.record_interval, 0.0, None, lo_open=True)
+        check_range("stop_after_peak", self.stop_after_peak, 0.0, None)
         check_range("checkpoint_interval", self.checkpoint_interval, 0.0, None, lo_open=True)
         check_range("consolidation_ratio", self.consolidation_ratio, 0.0, 1.0, lo_open=True)
         if not (isinstance(self.consolidation_max_steps, int) and self.consolidation_max_steps >= 1000):
@@ -71,6 +75,10 @@ class ShearSettings:
         check_range("shear_zone_factor", self.shear_zone_factor, 0.0, None, lo_open=True)
         check_range("inertial_limit", self.inertial_limit, 0.0, None, lo_open=True)
         check_range("stress_tolerance", self.stress_tolerance, 0.0, 1.0, lo_open=True)
+        if 0.0 < self.stop_after_peak < self.peak_window:
+            # the smoothed value at a peak needs half a window of curve after it to be final
+            allowed = f"0 (off) or >= peak_window = {self.peak_window} m"
+            raise InputError("stop_after_peak", self.stop_after_peak, allowed)
         if self.record_interval > self.max_displacement:
             raise InputError("record_interval", self.record_interval, f"(0, {self.max_displacement}] m")
 

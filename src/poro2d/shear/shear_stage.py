@@ -17,6 +17,7 @@ import numpy as np
 from poro2d.dem import Simulation, checkpoint
 from poro2d.shear.box import LOWER
 from poro2d.shear.curve import curve_row
+from poro2d.shear.fit import peak
 from poro2d.shear.peak_frame import PeakFrame, PeakTracker
 
 if TYPE_CHECKING:
@@ -24,7 +25,9 @@ if TYPE_CHECKING:
 
 
 class ShearStage:
-    """Shear ``sim`` (consolidated, or from the test's checkpoint) to ``max_displacement``.
+    """Shear ``sim`` (consolidated, or from the test's checkpoint) to ``max_displacement``,
+    or until the peak is passed by ``stop_after_peak``: past it the curve only serves the
+    residual part of Fig. 8, and it is a third or more of a test's cost.
 
     After :meth:`run`: ``rows`` (the curve), ``sim`` (the final state) and ``peak.frame``
     (the state at the smoothed peak, when the test draws figures).
@@ -73,12 +76,24 @@ class ShearStage:
             wall = self.wall_before + time.perf_counter() - self.t0
             extra = {"stage": "shear", "rows": rows, "step0": self.step0, "wall_time_s": wall}
             checkpoint.save(sim, self.ck, extra=extra)
-        return False  # never stop early: the test runs to max_displacement
+        return self.peak_passed()
+
+    def peak_passed(self) -> bool:
+        """True once the smoothed peak lies ``stop_after_peak`` behind the last record.
+
+        The rows alone decide it, so a resumed test stops where an uninterrupted one does.
+        """
+        after = self.settings.stop_after_peak
+        if after <= 0.0:
+            return False
+        x = np.array([r["shear_displacement_mm"] for r in self.rows]) * 1e-3
+        tau = np.array([r["shear_stress_kpa"] for r in self.rows])
+        return bool(x[-1] >= peak(x, tau, self.settings.peak_window)[1] + after)
 
     def run(self) -> float:
         """Shear to the end; returns the stage's wall time (s), resumed parts included."""
         remaining = self.total - (self.sim.step_count - self.step0)
-        if remaining > 0:
+        if remaining > 0 and not (self.rows and self.peak_passed()):
             self.sim.run(remaining, every=self.every, callback=self.record)
         self.peak.settle(self.rows, None)
         return self.wall_before + time.perf_counter() - self.t0
