@@ -225,3 +225,38 @@ def test_density_mode_errors(tmp_path):
     with pytest.raises(SystemExit) as ei:
         main(["relation", "--preset", "paper", "--seeds", "0", "--out", str(tmp_path / "o")])
     assert ei.value.code == 2
+
+
+def test_a_state_check_that_is_a_calibration_case_is_read_back(tmp_path):
+    """The densest state's check (lowest friction, the calibration's first trial) is the same
+    criterion run as a calibration case: it is read back, relabelled, not run again. A check
+    at another friction or first trial is not."""
+    from poro2d.criterion.density import StateTarget
+    from poro2d.io_utils import write_json
+    from poro2d.sweep import density as D
+    from poro2d.sweep.cases import parse_sweep
+
+    base = {"seed": 0, "specimen": {"width": 0.05, "height": 0.025, "layers": 2}}
+    cal = parse_sweep(D.calibration_sweep(base, [0.05, 0.5], 2))
+    folder = tmp_path / "cal"
+    for c in cal.cases:
+        mu = c.params["specimen.friction_prep"]
+        row = {"id": c.id, "status": "done", "params": c.params,
+               "results": {"n_lab": 0.3434, "converged": True, "final_porosity": 0.19 + mu / 10,
+                           "last_new_porosity": 0.188 + mu / 10}}  # fmt: skip
+        write_json(folder / "cases" / c.id / "result.json", row)
+    dense = StateTarget(0.33, 1.0, 0.1883, 0.05)  # first trial rounds to 0.19, the calibration's
+    other = StateTarget(0.40, 0.4, 0.2, 0.3)
+    loose_trial = StateTarget(0.45, 0.0, 0.2095, 0.5)  # a calibration friction, another first trial
+    states = parse_sweep(D.state_sweep(base, [dense, other, loose_trial], 2, 0.01))
+    twins = D.calibration_twins(cal, states, None, folder)
+    assert len(twins) == 2
+    for row in twins.values():
+        assert row["params"]["criterion.n_lab"] == 0.33 and row["results"]["n_lab"] == 0.33
+        assert row["params"]["specimen.friction_prep"] == 0.05
+        assert row["results"]["final_porosity"] == pytest.approx(0.195)
+        assert row["reused_calibration_case"] in {c.id for c in cal.cases}
+    assert {r["params"]["seed"] for r in twins.values()} == {0, 1}
+    # an unfinished calibration case is not a twin: the check then runs
+    (folder / "cases" / cal.cases[0].id / "result.json").unlink()
+    assert len(D.calibration_twins(cal, states, None, folder)) == 1

@@ -18,6 +18,7 @@ import hashlib
 import json
 import math
 import os
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -177,6 +178,50 @@ def state_sweep(base: dict, targets: list[StateTarget], seeds: int, resolution: 
     return cfg
 
 
+def _run_key(case, base_dir: Path | None) -> str:
+    """What a criterion case computes, as text: specimen, grading, settings but nLab, seed.
+
+    nLab only chooses the first trial when none is given, and every case here has one; the
+    thread count changes no number.
+    """
+    from poro2d.sweep.cases import _criterion_objects, canonical_json
+
+    spec, grading, settings, seed = _criterion_objects(case.config, base_dir)
+    sp = spec.to_dict()
+    sp.pop("threads", None)
+    st = asdict(settings)
+    st.pop("n_lab", None)
+    return canonical_json([sp, grading.sizes.tolist(), grading.percent.tolist(), st, seed])
+
+
+def calibration_twins(calibration, states, base_dir: Path | None, folder: Path) -> dict[str, dict]:
+    """Finished calibration cases that are state checks too, as rows of those checks.
+
+    The check of the densest state (Dr = 1) runs at the calibration's lowest usable friction
+    from the calibration's first trial: the same criterion run, seed for seed, as a
+    calibration case. Whether two cases are the same run is decided on the specimen, grading
+    and criterion settings they build, never assumed. Returns ``{state case id: row}``, the
+    calibration case's finished row relabelled with the check's parameters.
+    """
+    from poro2d.sweep.runner import load_done
+
+    done = {}
+    for c in calibration.cases:
+        row = load_done(folder / "cases" / c.id)
+        if row is not None:
+            done[_run_key(c, base_dir)] = (c, row)
+    twins = {}
+    for c in states.cases:
+        hit = done.get(_run_key(c, base_dir))
+        if hit is None:
+            continue
+        cal_case, row = hit
+        results = dict(row.get("results") or {}, n_lab=c.config["criterion"]["n_lab"])
+        twins[c.id] = dict(row, id=c.id, params=dict(c.params), results=results, reused=True,
+                           reused_calibration_case=cal_case.id)  # fmt: skip
+    return twins
+
+
 def run_density_state(
     base: dict,
     base_dir: Path | None,
@@ -235,6 +280,7 @@ __all__ = [
     "calibration_from_rows",
     "calibration_key",
     "calibration_sweep",
+    "calibration_twins",
     "check_mus",
     "check_seeds",
     "run_density_state",

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import copy
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -399,8 +400,15 @@ def density_relation(
     targets = [state_target(n, settings["n_max"], settings["n_min"], cal) for n in settings["n_lab"]]
     resolution = float((cfg.get("criterion") or {}).get("resolution", 0.01))
     sweep = parse_sweep(D.state_sweep(cfg, targets, seeds, resolution), base_dir)
-    res = run_sweep(sweep, out / "states", **sweep_kw)
-    rel = analyse_states(res.rows, targets, cal, settings["n_max"], settings["n_min"])
-    record = {"calibration": cal_info, "states_summary": res.summary,
-              "failed_cases": len(res.failed) + cal_info["failed"]}  # fmt: skip
+    cal_sweep = parse_sweep(D.calibration_sweep(cfg, list(mus or DEFAULT_MUS), seeds), base_dir)
+    twins = D.calibration_twins(cal_sweep, sweep, base_dir, Path(cal_info["cases"]))
+    rows, summary, failed = list(twins.values()), {"ran": 0, "reused": 0}, []
+    if len(twins) < len(sweep.cases):
+        res = run_sweep(replace(sweep, cases=[c for c in sweep.cases if c.id not in twins]), out / "states",
+                        **sweep_kw)  # fmt: skip
+        rows, summary, failed = res.rows + rows, res.summary, res.failed
+    summary = dict(summary, from_calibration=len(twins))
+    rel = analyse_states(rows, targets, cal, settings["n_max"], settings["n_min"])
+    record = {"calibration": cal_info, "states_summary": summary,
+              "failed_cases": len(failed) + cal_info["failed"]}  # fmt: skip
     return rel, record
