@@ -217,7 +217,7 @@ def calibration_twins(calibration, states, base_dir: Path | None, folder: Path) 
             continue
         cal_case, row = hit
         results = dict(row.get("results") or {}, n_lab=c.config["criterion"]["n_lab"])
-        twins[c.id] = dict(row, id=c.id, params=dict(c.params), results=results, reused=True,
+        twins[c.id] = dict(row, case_id=c.id, params=dict(c.params), results=results, reused=True,
                            reused_calibration_case=cal_case.id)  # fmt: skip
     return twins
 
