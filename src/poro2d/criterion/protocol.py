@@ -27,6 +27,7 @@ import json
 import logging
 import math
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -310,75 +311,26 @@ class PorosityCriterion:
     def _move_plate(self, sim: Simulation, n: float, weight: float) -> dict:
         """Servo the top plate until 0 < F_top < fraction G holds at equilibrium.
 
-        Each round has two phases. The approach servos the plate briskly towards
-        ``servo_target_fraction`` x the limit until F_top has stayed in the window for
-        ``window_checks`` checks. The settling phase keeps a gentle servo on (a low gain
-        and speed, so the plate follows slow creep of the specimen without shaking it)
-        until, with F_top in the window, the specimen is at equilibrium (maximum
-        unbalanced-force ratio below the specimen's ``ratio``) or the plate has rested
-        for ``settle_checks`` checks (drift below ``plate_drift`` x H: only creep left).
-        The plate is then held still, the specimen cycled towards equilibrium, and
-        F_top checked once more (the final ratio is reported); if it left the window,
-        a new round starts.
+        Each round (:meth:`_plate_round`) has two phases. The approach servos the plate
+        briskly towards ``servo_target_fraction`` x the limit until F_top has stayed in the
+        window for ``window_checks`` checks. The settling phase keeps a gentle servo on (a
+        low gain and speed, so the plate follows slow creep of the specimen without shaking
+        it) until, with F_top in the window, the specimen is at equilibrium (maximum
+        unbalanced-force ratio below the specimen's ``ratio``) or the plate has rested for
+        ``settle_checks`` checks (drift below ``plate_drift`` x H: only creep left). The
+        plate is then held still, the specimen cycled towards equilibrium, and F_top checked
+        once more (the final ratio is reported); if it left the window, a new round starts.
         """
         s = self.settings
-        t = sim.particles.thickness
-        cap = s.force_fraction * weight  # N/m
         top = sim.walls.index("top")
         y_start = float(sim.walls.p0[top, 1])
-        target = s.servo_target_fraction * cap * t  # N
         steps = 0
         rounds = 0
         ok = False
         final_ratio = float("nan")
-
-        def left() -> int:
-            return max(s.max_plate_steps - steps, 1)
-
         while steps < s.max_plate_steps and not ok:
             rounds += 1
-            sim.set_wall_servo("top", target, (0.0, -1.0), s.servo_max_speed, s.servo_gain)
-            streak = [0]
-
-            def steady(sm: Simulation, streak: list[int] = streak) -> bool:
-                f = sm.wall_force(top)[1] / t
-                streak[0] = streak[0] + 1 if in_window(f, weight, s.force_fraction) else 0
-                return streak[0] >= s.window_checks
-
-            label = f"top plate (round {rounds})" if self.progress else False
-            steps += sim.run(left(), every=s.check_every, callback=steady, progress=label).steps
-            sim.set_wall_servo("top", target, (0.0, -1.0), s.settle_max_speed, s.settle_gain)
-
-            calm: list[float] = []
-
-            def settled(sm: Simulation, calm: list[float] = calm) -> bool:
-                # equilibrium, or a plate that rests in the window while the specimen
-                # only creeps (drift over the last checks below plate_drift x H)
-                f = sm.wall_force(top)[1] / t
-                if not in_window(f, weight, s.force_fraction):
-                    calm.clear()
-                    return False
-                if sm.unbalanced_ratios()[0] < self.spec.ratio:
-                    return True
-                calm.append(float(sm.walls.p0[top, 1]))
-                if len(calm) < s.settle_checks:
-                    return False
-                return (
-                    max(calm[-s.settle_checks :]) - min(calm[-s.settle_checks :])
-                    < s.plate_drift * self.spec.height
-                )
-
-            steps += sim.run(left(), every=s.check_every, callback=settled).steps
-            sim.set_wall_velocity("top", (0.0, 0.0))
-            res = sim.solve(self.spec.ratio, min(left(), 20 * s.check_every))
-            steps += res.steps
-            f = sim.wall_force(top)[1] / t
-            ok = in_window(f, weight, s.force_fraction)
-            final_ratio = res.max_ratio
-            _log.debug(
-                "plate round %d: F_top %.4g N/m (limit %.4g), held: converged %s ratio %.3g, %d steps",
-                rounds, f, cap, res.converged, res.max_ratio, steps,
-            )  # fmt: skip
+            steps, ok, final_ratio = self._plate_round(sim, weight, rounds, steps)
         y_end = float(sim.walls.p0[top, 1])
         return {
             "plate_settled": ok,
@@ -388,6 +340,79 @@ class PorosityCriterion:
             "plate_displacement_m": y_end - y_start,
             "plate_height_m": y_end,
         }
+
+    def _plate_round(
+        self, sim: Simulation, weight: float, rounds: int, steps: int
+    ) -> tuple[int, bool, float]:
+        """One round of :meth:`_move_plate`: approach, settle, hold the plate still.
+
+        ``steps``: the plate steps before this round (every phase stops at
+        ``max_plate_steps`` in all). Returns the steps after it, whether F_top is in the
+        window once held, and the maximum unbalanced-force ratio reached while held.
+        """
+        s = self.settings
+        t = sim.particles.thickness
+        cap = s.force_fraction * weight  # N/m
+        top = sim.walls.index("top")
+        target = s.servo_target_fraction * cap * t  # N
+
+        def left() -> int:
+            return max(s.max_plate_steps - steps, 1)
+
+        sim.set_wall_servo("top", target, (0.0, -1.0), s.servo_max_speed, s.servo_gain)
+        label = f"top plate (round {rounds})" if self.progress else False
+        steady = self._in_window_check(top, t, weight)
+        steps += sim.run(left(), every=s.check_every, callback=steady, progress=label).steps
+        sim.set_wall_servo("top", target, (0.0, -1.0), s.settle_max_speed, s.settle_gain)
+        steps += sim.run(left(), every=s.check_every, callback=self._settled_check(top, t, weight)).steps
+        sim.set_wall_velocity("top", (0.0, 0.0))
+        res = sim.solve(self.spec.ratio, min(left(), 20 * s.check_every))
+        steps += res.steps
+        f = sim.wall_force(top)[1] / t
+        _log.debug(
+            "plate round %d: F_top %.4g N/m (limit %.4g), held: converged %s ratio %.3g, %d steps",
+            rounds, f, cap, res.converged, res.max_ratio, steps,
+        )  # fmt: skip
+        return steps, in_window(f, weight, s.force_fraction), res.max_ratio
+
+    def _in_window_check(self, top: int, t: float, weight: float) -> Callable[[Simulation], bool]:
+        """The approach's stop test: F_top in the window for ``window_checks`` checks running."""
+        s = self.settings
+        streak = [0]
+
+        def steady(sm: Simulation) -> bool:
+            f = sm.wall_force(top)[1] / t
+            streak[0] = streak[0] + 1 if in_window(f, weight, s.force_fraction) else 0
+            return streak[0] >= s.window_checks
+
+        return steady
+
+    def _settled_check(self, top: int, t: float, weight: float) -> Callable[[Simulation], bool]:
+        """The settling phase's stop test: F_top in the window and the specimen at rest.
+
+        At rest means at equilibrium, or a plate that rests in the window while the
+        specimen only creeps (its drift over the last ``settle_checks`` checks below
+        ``plate_drift`` x H).
+        """
+        s = self.settings
+        calm: list[float] = []
+
+        def settled(sm: Simulation) -> bool:
+            f = sm.wall_force(top)[1] / t
+            if not in_window(f, weight, s.force_fraction):
+                calm.clear()
+                return False
+            if sm.unbalanced_ratios()[0] < self.spec.ratio:
+                return True
+            calm.append(float(sm.walls.p0[top, 1]))
+            if len(calm) < s.settle_checks:
+                return False
+            return (
+                max(calm[-s.settle_checks :]) - min(calm[-s.settle_checks :])
+                < s.plate_drift * self.spec.height
+            )
+
+        return settled
 
     def _trial(self, k: int, n: float) -> dict:
         d = self._trial_dir(k, n)
