@@ -88,3 +88,50 @@ def test_a_subclass_is_a_dataclass_of_its_keys():
     s = Small(1)
     assert s.to_dict() == {"a": 1, "b": "x"} and s == {"a": 1, "b": "x"} and s != {"a": 2, "b": "x"}
     assert Small.from_dict({"b": "y", "a": 2, "c": 3}).to_dict() == {"a": 2, "b": "y", "c": 3}
+
+
+def _folder(tmp_path, files: dict) -> Path:
+    for dst, src in files.items():
+        (tmp_path / dst).write_text((DATA / src).read_text())
+    return tmp_path
+
+
+def test_a_criterion_folder_written_before_is_read_back_and_still_binds(tmp_path):
+    from poro2d.criterion import CriterionSettings, PorosityCriterion
+    from poro2d.errors import InputError
+    from poro2d.specimen import paper_grading
+    from poro2d.specimen.compaction import SpecimenSpec
+
+    out = _folder(tmp_path, {"config.json": "criterion_config.json", "result.json": "criterion_result.json"})
+    run = json.loads((out / "config.json").read_text())["run"]
+
+    def crit(threads=1, **changes):
+        spec = SpecimenSpec(**dict(run["specimen"], threads=threads))
+        settings = CriterionSettings(**dict(run["criterion"], **changes))
+        return PorosityCriterion(spec, paper_grading(), settings, seed=run["seed"], out=out)
+
+    stored = json.loads((DATA / "criterion_result.json").read_text())
+    assert crit().run() == stored  # read back, nothing computed
+    assert crit(threads=2).stage().stored() == stored
+    with pytest.raises(InputError, match=r"different config \(criterion.max_iterations\)"):
+        crit(max_iterations=7).run()
+
+
+def test_a_shear_test_folder_written_before_is_read_back_and_still_binds(tmp_path):
+    from poro2d.errors import InputError
+    from poro2d.shear import record
+
+    out = _folder(tmp_path, {"test.json": "shear_test_record.json", "result.json": "shear_test_result.json"})
+    old = json.loads((out / "test.json").read_text())
+    stage = record.folder_stage(out, old["run"], Path("moved") / "specimen.npz")
+    assert ShearTestResult.from_dict(stage.stored()) == json.loads(
+        (DATA / "shear_test_result.json").read_text()
+    )
+    assert record.folder_stage(out, old["run"], Path("x")).fingerprint.digest == old["key"]
+    other = record.folder_stage(out, dict(old["run"], normal_stress_kpa=100.0), Path("x"))
+    with pytest.raises(InputError, match=r"another normal stress \(50.0 kPa\); use a new --out"):
+        other.check()
+    older = dict(old, run={k: v for k, v in old["run"].items() if k != "specimen_digest"})
+    (out / "test.json").write_text(json.dumps(older))
+    with pytest.raises(InputError, match="written by an older poro2d"):
+        stage.check()
