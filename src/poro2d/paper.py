@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 
@@ -21,6 +21,9 @@ from poro2d.io_utils import provenance, write_csv, write_json
 from poro2d.paper_data import PAPER, QUICK_CRITERION, QUICK_SPECIMEN
 from poro2d.resumable import Fingerprint, ResumableStage
 from poro2d.typed_result import TypedResult
+
+if TYPE_CHECKING:
+    from poro2d.criterion.protocol import PorosityCriterion
 
 console = OutputConsole()
 
@@ -168,8 +171,8 @@ def run_paper(
     return summary
 
 
-def _run_stages(out: Path, stage: ResumableStage, crit, *, quick: bool, replicates: int, lab_data,
-                progress: bool) -> PaperSummary:  # fmt: skip
+def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, quick: bool, replicates: int,
+                lab_data, progress: bool) -> PaperSummary:  # fmt: skip
     """Conversions, criterion, replicate specimens and direct shear (each read back when done)."""
     from poro2d.criterion.cli import print_result
 
