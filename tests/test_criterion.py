@@ -194,7 +194,7 @@ def test_config_of_a_run_that_never_started_does_not_bind(tmp_path):
     # a run stopped before its first trial leaves only config.json: another config may use the folder
     PorosityCriterion(
         SMALL, paper_grading(), CriterionSettings(trial_porosity=0.25), out=tmp_path
-    )._check_resume()
+    ).stage().bind()
     r = _run(tmp_path, 0.30, max_iterations=1)
     assert r["iterations"][0]["trial_porosity"] == 0.30
     stored = json.loads((tmp_path / "config.json").read_text())

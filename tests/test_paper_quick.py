@@ -78,6 +78,17 @@ def test_rerun_reuses_finished_stages(quick):
     assert [f.stat().st_mtime_ns for f in done] == before  # no specimen rebuilt, no test rerun
 
 
+def test_a_folder_of_another_paper_run_is_refused(quick, capsys):
+    files = sorted(p for p in quick.rglob("*") if p.is_file())
+    before = [p.stat().st_mtime_ns for p in files]
+    with pytest.raises(SystemExit) as e:
+        main(["paper", "--quick", "--seed", "1", "--out", str(quick), "--quiet"])
+    err = capsys.readouterr().err
+    assert e.value.code == 2 and "other --seed" in err and "choose another --out" in err
+    assert [p.stat().st_mtime_ns for p in files] == before  # refused before anything was written
+    assert json.loads((quick / "paper.json").read_text())["run"] == {"quick": True, "seed": 0}
+
+
 def _md_images(md_path):
     return re.findall(r"!\[[^\]]*\]\(([^)]+)\)", md_path.read_text())
 

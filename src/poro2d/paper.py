@@ -1,21 +1,29 @@
 """``poro2d paper``: the paper's case study on built-in defaults, in one command.
 
 Stages: the conversion table for the paper's sand (nLab = 0.3434, n_max = 0.4571,
-n_min = 0.3253) with Figs. 1-2, then the criterion of Fig. 3 with Figs. 5-7. Each
-stage writes into its own sub-folder; a rerun skips the stages already finished.
+n_min = 0.3253) with Figs. 1-2, the criterion of Fig. 3 with Figs. 5-7, replicate
+specimens, direct shear (Fig. 8) and the report. Each stage writes into its own
+sub-folder; a rerun skips the stages already finished (see :func:`paper_stage`).
 ``--quick`` runs a reduced specimen (a smaller box, two layers) for a first look.
 """
 
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import typer
 
 from poro2d.console import OutputConsole
 from poro2d.io_utils import provenance, write_csv, write_json
 from poro2d.paper_data import PAPER, QUICK_CRITERION, QUICK_SPECIMEN
+from poro2d.resumable import Fingerprint, ResumableStage
+from poro2d.typed_result import TypedResult
+
+if TYPE_CHECKING:
+    from poro2d.criterion.protocol import PorosityCriterion
 
 console = OutputConsole()
 
@@ -23,7 +31,56 @@ NORMAL_STRESSES_KPA = (50.0, 100.0, 200.0)
 QUICK_SHEAR = {"max_displacement": 0.004}
 
 
-def run_conversions(out: Path) -> dict:
+@dataclass(eq=False)
+class PaperSummary(TypedResult):
+    """The case study's summary (``results.json``), as :func:`run_paper` returns it.
+
+    ``criterion``: the accepted porosity, ``converged``, ``message`` and the trials (the
+    whole result is ``criterion/result.json``); ``replicate_specimens``: one row per extra
+    seed (None with one specimen); ``shear``: the pooled fit over the specimens, the first
+    specimen's ``tests`` and ``quasi_static``, and ``replicates`` (None when the criterion
+    did not converge); ``paper``: what the paper states, for the comparison.
+    """
+
+    quick: bool
+    seed: int
+    conversions: dict[str, Any]
+    criterion: dict[str, Any]
+    replicate_specimens: list[dict[str, Any]] | None
+    shear: dict[str, Any] | None
+    paper: dict[str, Any]
+    timings: dict[str, float]
+    provenance: dict[str, Any]
+
+
+def paper_stage(out: Path, quick: bool, seed: int) -> ResumableStage:
+    """The case study's folder, bound by ``paper.json`` to ``--quick`` and ``--seed``.
+
+    Its parts bind their own folders too (the criterion's ``config.json``, each test's
+    ``test.json``) and are read back when finished; the summary and the report are made
+    again on every run, so ``--replicates`` and ``--lab`` may change between runs (the
+    specimens and tests already done are reused). A folder written before ``paper.json``
+    existed is adopted.
+    """
+    return ResumableStage(
+        out,
+        Fingerprint({"quick": quick, "seed": seed}),
+        record="paper.json",
+        extra={"provenance": provenance()},
+        parameter="--out",
+        allowed="an empty folder or one holding a paper run of the same --quick and --seed",
+        explain=lambda keys, _: (
+            f"it holds a paper run with other {', '.join(f'--{k}' for k in keys or [])}; choose another --out"
+        ),
+        unrecorded="adopt",
+    )
+
+
+def conversion_files(out: Path) -> dict:
+    """The conversion table (``conversions.csv``) and Figs. 1-2 in ``out``; the summary of both.
+
+    The summary is the stage's ``conversions.json``, written after the files by the stage.
+    """
     from poro2d.figures.relations import write_relation_figures
     from poro2d.porosity import convert_all
 
@@ -35,10 +92,8 @@ def run_conversions(out: Path) -> dict:
     ]
     write_csv(out / "conversions.csv", rows)
     figs = write_relation_figures(out, n_max=PAPER["n_max"], n_min=PAPER["n_min"], mark_n_lab=PAPER["n_lab"])
-    data = {"n_lab": PAPER["n_lab"], "n_max": PAPER["n_max"], "n_min": PAPER["n_min"], "methods": rows,
+    return {"n_lab": PAPER["n_lab"], "n_max": PAPER["n_max"], "n_min": PAPER["n_min"], "methods": rows,
             "figures": [str(f.name) for f in figs], "provenance": provenance()}  # fmt: skip
-    write_json(out / "conversions.json", data)
-    return data
 
 
 def replicate_specimens(spec, grading, settings, n2d: float, seeds: list[int], out: Path,
@@ -75,16 +130,15 @@ def run_paper(
     threads: int | None = None,
     replicates: int = 3,
     progress: bool = True,
-) -> dict:
+) -> PaperSummary:
     """The paper's case study: conversions, the criterion (Fig. 3), direct shear on replicate
     specimens (Fig. 8), the report. Resumable: finished stages are read back.
 
-    Returns the summary written to ``out/results.json``; ``summary["criterion"]["converged"]``
+    Returns the summary written to ``out/results.json``; ``summary.criterion["converged"]``
     says whether the criterion found its porosity (no shear tests otherwise).
     """
     import os
 
-    from poro2d.criterion.cli import print_result
     from poro2d.criterion.config import build
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.errors import check_int
@@ -105,45 +159,54 @@ def run_paper(
     crit = PorosityCriterion(spec, grading, settings, seed=sd, out=out / "criterion",
                              progress=progress, config=cfg)  # fmt: skip
     crit.validate()  # every option is checked before the first file is written
-
-    out.mkdir(parents=True, exist_ok=True)
-    timings: dict[str, float] = {}
-    t0 = time.perf_counter()
-    conv = _conversions_stage(out)
-    timings["conversions_s"] = time.perf_counter() - t0
-    console.print(f"[bold]2/3 criterion[/] (Fig. 3) for nLab = {settings.n_lab}"
-                  f"{' [quick specimen]' if quick else ''}")  # fmt: skip
-    t1 = time.perf_counter()
-    result = crit.run()
-    timings["criterion_s"] = time.perf_counter() - t1
-    print_result(result, out / "criterion")
-    shear = reps = None
-    if result["converged"]:
-        t2 = time.perf_counter()
-        specimens, reps = _specimens(spec, grading, settings, result["final_porosity"], sd, replicates, out,
-                                     progress)  # fmt: skip
-        timings["replicates_s"] = time.perf_counter() - t2
-        shear = _shear_stage(specimens, out / "shear", quick, lab_data, progress)
-        timings["shear_s"] = time.perf_counter() - t2 - timings["replicates_s"]
-    else:
-        console.print("[yellow]criterion not converged: direct shear skipped[/]")
-    summary = {
-        "quick": quick,
-        "seed": seed,
-        "conversions": conv,
-        "criterion": {k: result[k] for k in ("final_porosity", "converged", "message", "iterations")},
-        "replicate_specimens": reps,
-        "shear": shear,
-        "paper": PAPER,
-        "timings": timings,
-        "provenance": provenance(),
-    }
+    stage = paper_stage(out, quick, seed)
+    stage.check()  # and the folder: one of another paper run is refused before anything is written
+    summary = _run_stages(out, stage, crit, quick=quick, replicates=replicates, lab_data=lab_data,
+                          progress=progress)  # fmt: skip
     write_json(out / "results.json", summary)
     from poro2d.report.paper_report import write_paper_report
 
     md, html = write_paper_report(out, summary)
     console.print(f"results in {out}/results.json; report: {html} and {md}")
     return summary
+
+
+def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, quick: bool, replicates: int,
+                lab_data, progress: bool) -> PaperSummary:  # fmt: skip
+    """Conversions, criterion, replicate specimens and direct shear (each read back when done)."""
+    from poro2d.criterion.cli import print_result
+
+    timings: dict[str, float] = {}
+    t0 = time.perf_counter()
+    conv = _conversions_stage(out, stage)
+    timings["conversions_s"] = time.perf_counter() - t0
+    console.print(f"[bold]2/3 criterion[/] (Fig. 3) for nLab = {crit.settings.n_lab}"
+                  f"{' [quick specimen]' if quick else ''}")  # fmt: skip
+    t1 = time.perf_counter()
+    result = crit.run()
+    timings["criterion_s"] = time.perf_counter() - t1
+    print_result(result, out / "criterion")
+    shear = reps = None
+    if result.converged:
+        t2 = time.perf_counter()
+        specimens, reps = _specimens(crit.spec, crit.grading, crit.settings, result.final_porosity, crit.seed,
+                                     replicates, out, progress)  # fmt: skip
+        timings["replicates_s"] = time.perf_counter() - t2
+        shear = _shear_stage(specimens, out / "shear", quick, lab_data, progress)
+        timings["shear_s"] = time.perf_counter() - t2 - timings["replicates_s"]
+    else:
+        console.print("[yellow]criterion not converged: direct shear skipped[/]")
+    return PaperSummary(
+        quick=quick,
+        seed=crit.seed,
+        conversions=conv,
+        criterion={k: result[k] for k in ("final_porosity", "converged", "message", "iterations")},
+        replicate_specimens=reps,
+        shear=shear,
+        paper=PAPER,
+        timings=timings,
+        provenance=provenance(),
+    )
 
 
 def paper_config(quick: bool, seed: int) -> dict:
@@ -158,10 +221,10 @@ def paper_config(quick: bool, seed: int) -> dict:
     return cfg
 
 
-def _conversions_stage(out: Path) -> dict:
+def _conversions_stage(out: Path, stage: ResumableStage) -> dict:
     """Stage 1: every conversion of the paper's sand, printed as a table and written with Figs. 1-2."""
     console.print("[bold]1/3 conversions[/] (Eqs. 1-12, Figs. 1-2)")
-    conv = run_conversions(out / "conversions")
+    conv = stage.run(lambda: conversion_files(out / "conversions"), "conversions/conversions.json")
     for m in conv["methods"]:
         v = "skipped" if m["n2d"] is None else f"{m['n2d']:.4f}"
         console.print(f"  {m['method']:<24} {m['equation']:<10} {v:>8} {m['flags']}")
@@ -233,5 +296,5 @@ def register(app: typer.Typer) -> None:
         """Run the paper's case study: conversions, criterion (Fig. 3), direct shear (Fig. 8), report."""
         summary = run_paper(out, quick=quick, lab=lab, seed=seed, threads=threads, replicates=replicates,
                             progress=not quiet)  # fmt: skip
-        if not summary["criterion"]["converged"]:
+        if not summary.criterion["converged"]:
             raise typer.Exit(1)

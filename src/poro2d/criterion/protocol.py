@@ -23,20 +23,22 @@ whose specimen fails a check, is refused and ends the run with the reason.
 
 from __future__ import annotations
 
-import json
 import logging
 import math
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
 
 from poro2d.config import check_finite
+from poro2d.criterion.result import CriterionResult
 from poro2d.dem import Simulation, checkpoint
 from poro2d.errors import InputError, check_range
 from poro2d.io_utils import as_json, provenance, write_csv, write_json
 from poro2d.porosity import PAPER_N_LAB, parabolic
+from poro2d.resumable import Fingerprint, ResumableStage
 from poro2d.specimen.compaction import SpecimenSpec, box_porosity, prepare_specimen
 from poro2d.specimen.grading import GradingCurve
 
@@ -101,14 +103,6 @@ class CriterionSettings:
         if self.trial_porosity is not None:
             return float(self.trial_porosity)
         return round_to(float(parabolic(self.n_lab)), self.resolution)
-
-
-def binding_part(run: dict | None) -> dict | None:
-    """The part of a config record that a resumed run must share: all but performance settings."""
-    if not isinstance(run, dict):
-        return run
-    spec = {k: v for k, v in (run.get("specimen") or {}).items() if k not in PERFORMANCE_KEYS}
-    return dict(run, specimen=spec)
 
 
 def round_to(x: float, step: float) -> float:
@@ -266,18 +260,63 @@ class PorosityCriterion:
         self.config = config or {}
         self.figures = figures
         self.timings: dict[str, float] = {}
+        self._stage: ResumableStage | None = None
 
     # ------------------------------------------------------------------ stages
+    def stage(self) -> ResumableStage:
+        """The run's stages in ``out``: ``config.json`` binds it to the config and seed.
+
+        The binding leaves out the performance settings (``PERFORMANCE_KEYS``: a rerun on
+        another thread count resumes). A folder whose trials lack that record (it was
+        deleted) is adopted: its finished trials are read back, the rest run.
+        """
+        assert self.out is not None
+        if self._stage is None:
+            record = self._config_record()
+            self._stage = ResumableStage(
+                self.out,
+                Fingerprint(record["run"], ignore=tuple(f"specimen.{k}" for k in PERFORMANCE_KEYS)),
+                record="config.json",
+                extra={"config": record["config"], "provenance": record["provenance"]},
+                parameter="out",
+                allowed="an empty folder or one holding a run of the same config and seed",
+                explain=_other_config,
+                unrecorded="adopt",
+            )
+        return self._stage
+
+    def _trial_name(self, k: int, n: float) -> str:
+        """Trial ``k``'s folder, relative to ``out`` (``trials/02_n0.2300``)."""
+        return f"trials/{k:02d}_n{n:.4f}"
+
     def _trial_dir(self, k: int, n: float) -> Path | None:
         if self.out is None:
             return None
-        return self.out / "trials" / f"{k:02d}_n{n:.4f}"
+        return self.out / self._trial_name(k, n)
 
     def _prepare(self, k: int, n: float) -> tuple[Simulation, dict]:
+        """Trial ``k``'s specimen and its preparation report: built, or read back once saved."""
         d = self._trial_dir(k, n)
-        if d is not None and (d / "prepared.json").is_file() and (d / "prepared.npz").is_file():
-            rep = json.loads((d / "prepared.json").read_text())
-            return checkpoint.load(d / "prepared.npz", threads=self.spec.threads), rep
+        if d is None:
+            return self._build(n)
+        npz = d / "prepared.npz"
+        built: list[Simulation] = []
+
+        def compute() -> dict:
+            sim, rep = self._build(n)
+            d.mkdir(parents=True, exist_ok=True)
+            checkpoint.save(sim, npz, extra={"stage": "prepared", "trial_porosity": n})
+            if self.figures:
+                self._figure(sim, d / "forces_trial.png", f"trial n2D = {n:.3f}, top plate at H", rep)
+            built.append(sim)
+            return rep
+
+        marker = f"{self._trial_name(k, n)}/prepared.json"
+        rep = self.stage().run(compute, marker, accept=lambda _: npz.is_file())
+        return (built[0] if built else checkpoint.load(npz, threads=self.spec.threads)), rep
+
+    def _build(self, n: float) -> tuple[Simulation, dict]:
+        """A specimen at trial porosity ``n``, with its report (seed, time, weight, wall forces)."""
         t0 = time.perf_counter()
         # the same seed per trial porosity: a rerun of a trial rebuilds the same specimen
         seed = self.seed * 1_000_003 + int(round(n * 1e6))
@@ -286,12 +325,6 @@ class PorosityCriterion:
         rep["time_s"] = time.perf_counter() - t0
         rep["weight_n_per_m"] = self.spec.self_weight(n)
         rep.update(wall_forces(sim))
-        if d is not None:
-            d.mkdir(parents=True, exist_ok=True)
-            checkpoint.save(sim, d / "prepared.npz", extra={"stage": "prepared", "trial_porosity": n})
-            if self.figures:
-                self._figure(sim, d / "forces_trial.png", f"trial n2D = {n:.3f}, top plate at H", rep)
-            write_json(d / "prepared.json", rep)
         return sim, rep
 
     def _figure(self, sim: Simulation, path: Path, title: str, forces: dict) -> None:
@@ -310,75 +343,26 @@ class PorosityCriterion:
     def _move_plate(self, sim: Simulation, n: float, weight: float) -> dict:
         """Servo the top plate until 0 < F_top < fraction G holds at equilibrium.
 
-        Each round has two phases. The approach servos the plate briskly towards
-        ``servo_target_fraction`` x the limit until F_top has stayed in the window for
-        ``window_checks`` checks. The settling phase keeps a gentle servo on (a low gain
-        and speed, so the plate follows slow creep of the specimen without shaking it)
-        until, with F_top in the window, the specimen is at equilibrium (maximum
-        unbalanced-force ratio below the specimen's ``ratio``) or the plate has rested
-        for ``settle_checks`` checks (drift below ``plate_drift`` x H: only creep left).
-        The plate is then held still, the specimen cycled towards equilibrium, and
-        F_top checked once more (the final ratio is reported); if it left the window,
-        a new round starts.
+        Each round (:meth:`_plate_round`) has two phases. The approach servos the plate
+        briskly towards ``servo_target_fraction`` x the limit until F_top has stayed in the
+        window for ``window_checks`` checks. The settling phase keeps a gentle servo on (a
+        low gain and speed, so the plate follows slow creep of the specimen without shaking
+        it) until, with F_top in the window, the specimen is at equilibrium (maximum
+        unbalanced-force ratio below the specimen's ``ratio``) or the plate has rested for
+        ``settle_checks`` checks (drift below ``plate_drift`` x H: only creep left). The
+        plate is then held still, the specimen cycled towards equilibrium, and F_top checked
+        once more (the final ratio is reported); if it left the window, a new round starts.
         """
         s = self.settings
-        t = sim.particles.thickness
-        cap = s.force_fraction * weight  # N/m
         top = sim.walls.index("top")
         y_start = float(sim.walls.p0[top, 1])
-        target = s.servo_target_fraction * cap * t  # N
         steps = 0
         rounds = 0
         ok = False
         final_ratio = float("nan")
-
-        def left() -> int:
-            return max(s.max_plate_steps - steps, 1)
-
         while steps < s.max_plate_steps and not ok:
             rounds += 1
-            sim.set_wall_servo("top", target, (0.0, -1.0), s.servo_max_speed, s.servo_gain)
-            streak = [0]
-
-            def steady(sm: Simulation, streak: list[int] = streak) -> bool:
-                f = sm.wall_force(top)[1] / t
-                streak[0] = streak[0] + 1 if in_window(f, weight, s.force_fraction) else 0
-                return streak[0] >= s.window_checks
-
-            label = f"top plate (round {rounds})" if self.progress else False
-            steps += sim.run(left(), every=s.check_every, callback=steady, progress=label).steps
-            sim.set_wall_servo("top", target, (0.0, -1.0), s.settle_max_speed, s.settle_gain)
-
-            calm: list[float] = []
-
-            def settled(sm: Simulation, calm: list[float] = calm) -> bool:
-                # equilibrium, or a plate that rests in the window while the specimen
-                # only creeps (drift over the last checks below plate_drift x H)
-                f = sm.wall_force(top)[1] / t
-                if not in_window(f, weight, s.force_fraction):
-                    calm.clear()
-                    return False
-                if sm.unbalanced_ratios()[0] < self.spec.ratio:
-                    return True
-                calm.append(float(sm.walls.p0[top, 1]))
-                if len(calm) < s.settle_checks:
-                    return False
-                return (
-                    max(calm[-s.settle_checks :]) - min(calm[-s.settle_checks :])
-                    < s.plate_drift * self.spec.height
-                )
-
-            steps += sim.run(left(), every=s.check_every, callback=settled).steps
-            sim.set_wall_velocity("top", (0.0, 0.0))
-            res = sim.solve(self.spec.ratio, min(left(), 20 * s.check_every))
-            steps += res.steps
-            f = sim.wall_force(top)[1] / t
-            ok = in_window(f, weight, s.force_fraction)
-            final_ratio = res.max_ratio
-            _log.debug(
-                "plate round %d: F_top %.4g N/m (limit %.4g), held: converged %s ratio %.3g, %d steps",
-                rounds, f, cap, res.converged, res.max_ratio, steps,
-            )  # fmt: skip
+            steps, ok, final_ratio = self._plate_round(sim, weight, rounds, steps)
         y_end = float(sim.walls.p0[top, 1])
         return {
             "plate_settled": ok,
@@ -389,10 +373,88 @@ class PorosityCriterion:
             "plate_height_m": y_end,
         }
 
+    def _plate_round(
+        self, sim: Simulation, weight: float, rounds: int, steps: int
+    ) -> tuple[int, bool, float]:
+        """One round of :meth:`_move_plate`: approach, settle, hold the plate still.
+
+        ``steps``: the plate steps before this round (every phase stops at
+        ``max_plate_steps`` in all). Returns the steps after it, whether F_top is in the
+        window once held, and the maximum unbalanced-force ratio reached while held.
+        """
+        s = self.settings
+        t = sim.particles.thickness
+        cap = s.force_fraction * weight  # N/m
+        top = sim.walls.index("top")
+        target = s.servo_target_fraction * cap * t  # N
+
+        def left() -> int:
+            return max(s.max_plate_steps - steps, 1)
+
+        sim.set_wall_servo("top", target, (0.0, -1.0), s.servo_max_speed, s.servo_gain)
+        label = f"top plate (round {rounds})" if self.progress else False
+        steady = self._in_window_check(top, t, weight)
+        steps += sim.run(left(), every=s.check_every, callback=steady, progress=label).steps
+        sim.set_wall_servo("top", target, (0.0, -1.0), s.settle_max_speed, s.settle_gain)
+        steps += sim.run(left(), every=s.check_every, callback=self._settled_check(top, t, weight)).steps
+        sim.set_wall_velocity("top", (0.0, 0.0))
+        res = sim.solve(self.spec.ratio, min(left(), 20 * s.check_every))
+        steps += res.steps
+        f = sim.wall_force(top)[1] / t
+        _log.debug(
+            "plate round %d: F_top %.4g N/m (limit %.4g), held: converged %s ratio %.3g, %d steps",
+            rounds, f, cap, res.converged, res.max_ratio, steps,
+        )  # fmt: skip
+        return steps, in_window(f, weight, s.force_fraction), res.max_ratio
+
+    def _in_window_check(self, top: int, t: float, weight: float) -> Callable[[Simulation], bool]:
+        """The approach's stop test: F_top in the window for ``window_checks`` checks running."""
+        s = self.settings
+        streak = [0]
+
+        def steady(sm: Simulation) -> bool:
+            f = sm.wall_force(top)[1] / t
+            streak[0] = streak[0] + 1 if in_window(f, weight, s.force_fraction) else 0
+            return streak[0] >= s.window_checks
+
+        return steady
+
+    def _settled_check(self, top: int, t: float, weight: float) -> Callable[[Simulation], bool]:
+        """The settling phase's stop test: F_top in the window and the specimen at rest.
+
+        At rest means at equilibrium, or a plate that rests in the window while the
+        specimen only creeps (its drift over the last ``settle_checks`` checks below
+        ``plate_drift`` x H).
+        """
+        s = self.settings
+        calm: list[float] = []
+
+        def settled(sm: Simulation) -> bool:
+            f = sm.wall_force(top)[1] / t
+            if not in_window(f, weight, s.force_fraction):
+                calm.clear()
+                return False
+            if sm.unbalanced_ratios()[0] < self.spec.ratio:
+                return True
+            calm.append(float(sm.walls.p0[top, 1]))
+            if len(calm) < s.settle_checks:
+                return False
+            return (
+                max(calm[-s.settle_checks :]) - min(calm[-s.settle_checks :])
+                < s.plate_drift * self.spec.height
+            )
+
+        return settled
+
     def _trial(self, k: int, n: float) -> dict:
+        """Trial ``k`` at porosity ``n``: its row, read back from its ``trial.json`` once written."""
+        if self.out is None:
+            return as_json(self._run_trial(k, n))
+        return self.stage().run(lambda: self._run_trial(k, n), f"{self._trial_name(k, n)}/trial.json")
+
+    def _run_trial(self, k: int, n: float) -> dict:
+        """Prepare the specimen, move the plate when F_top is out of the window, check, decide."""
         d = self._trial_dir(k, n)
-        if d is not None and (d / "trial.json").is_file():
-            return json.loads((d / "trial.json").read_text())
         s = self.settings
         t0 = time.perf_counter()
         sim, prep = self._prepare(k, n)
@@ -459,8 +521,6 @@ class PorosityCriterion:
         self._decide(row)
         row["time_prepare_s"] = t_prep
         row["time_plate_s"] = time.perf_counter() - t1
-        if d is not None:
-            write_json(d / "trial.json", row)
         return row
 
     def _decide(self, row: dict) -> None:
@@ -503,12 +563,21 @@ class PorosityCriterion:
             )
 
     # -------------------------------------------------------------------- loop
-    def run(self) -> dict:
+    def run(self) -> CriterionResult:
+        """Run Fig. 3, or read a finished run back from ``out/result.json``.
+
+        Every input is checked first (:meth:`validate`), then ``out`` (:meth:`stage`): a
+        folder holding a run of another config is refused before anything is written.
+        """
+        self.validate()
+        if self.out is None:
+            return CriterionResult.from_dict(as_json(self._search()))
+        return self.stage().run(self._search, decode=CriterionResult.from_dict)
+
+    def _search(self) -> CriterionResult:
+        """The loop of Fig. 3: trials until one is accepted or refused, or the trials run out."""
         s = self.settings
         t_start = time.perf_counter()
-        self.validate()
-        if self.out is not None:
-            self._check_resume()
         n = s.initial_trial()
         rows: list[dict] = []
         tried: list[float] = []
@@ -520,7 +589,7 @@ class PorosityCriterion:
             # as a resumed run reads it back from trial.json: plain booleans and numbers
             row = as_json(self._trial(k, n))
             rows.append(row)
-            self._write_tables(rows, final=None, converged=False, message="running")
+            self._write_table(rows)
             if row["accepted"]:
                 converged = True
                 message = f"accepted n2D = {n:.4f} after {k} trial(s)"
@@ -541,13 +610,11 @@ class PorosityCriterion:
             n = nxt
         else:
             message = f"no convergence within max_iterations = {s.max_iterations} (trials {tried})"
-        final = n if converged else None
-        result = self._write_tables(rows, final=final, converged=converged, message=message)
-        result["failed_trial"] = failed_trial
-        result["time_total_s"] = time.perf_counter() - t_start
+        result = self._result(rows, final=n if converged else None, converged=converged, message=message)
+        result.failed_trial = failed_trial
+        result.time_total_s = time.perf_counter() - t_start
         if self.out is not None:
             self._final_outputs(rows, converged)
-            write_json(self.out / "result.json", result)
         return result
 
     def validate(self) -> None:
@@ -565,32 +632,6 @@ class PorosityCriterion:
         check_finite("config", record["config"])
         check_finite("run", record["run"])
 
-    def _check_resume(self) -> None:
-        """Refuse an ``out`` whose finished work belongs to another config; else record this one.
-
-        The stored config binds only once a trial has started: a run refused or
-        stopped before that leaves nothing to protect, so the next command (a
-        corrected one, say) replaces the record.
-        """
-        assert self.out is not None
-        self.out.mkdir(parents=True, exist_ok=True)
-        cfg_path = self.out / "config.json"
-        current = self._config_record()
-        if cfg_path.is_file() and self._work_started():
-            old = json.loads(cfg_path.read_text())
-            if binding_part(old.get("run")) != binding_part(current["run"]):
-                raise InputError(
-                    "out", str(self.out),
-                    "an empty folder or one holding a run of the same config and seed",
-                    "it holds results of a different config; choose another --out",
-                )  # fmt: skip
-        else:
-            write_json(cfg_path, current, config=True)
-
-    def _work_started(self) -> bool:
-        trials = self.out / "trials" if self.out is not None else None
-        return trials is not None and trials.is_dir() and any(trials.iterdir())
-
     def _config_record(self) -> dict:
         return {
             "run": {
@@ -607,25 +648,27 @@ class PorosityCriterion:
             "provenance": provenance(),
         }
 
-    def _write_tables(self, rows: list[dict], final, converged: bool, message: str) -> dict:
-        result = {
-            "final_porosity": final,
-            "converged": converged,
-            "message": message,
-            "n_lab": self.settings.n_lab,
-            "initial_trial_porosity": self.settings.initial_trial(),
-            "initial_from": "given" if self.settings.trial_porosity is not None else "Eq. 12 (parabola)",
-            "iterations": rows,
-            "seed": self.seed,
-            "settings": asdict(self.settings),
-            "specimen": self.spec.to_dict(),
-            "local_damping_note": f"local damping {self.spec.local_damping} (PFC 4.0 default; "
+    def _result(self, rows: list[dict], final, converged: bool, message: str) -> CriterionResult:
+        return CriterionResult(
+            final_porosity=final,
+            converged=converged,
+            message=message,
+            n_lab=self.settings.n_lab,
+            initial_trial_porosity=self.settings.initial_trial(),
+            initial_from="given" if self.settings.trial_porosity is not None else "Eq. 12 (parabola)",
+            iterations=rows,
+            seed=self.seed,
+            settings=asdict(self.settings),
+            specimen=self.spec.to_dict(),
+            local_damping_note=f"local damping {self.spec.local_damping} (PFC 4.0 default; "
             "the paper does not state it)",
-            "provenance": provenance(),
-        }
+            provenance=provenance(),
+        )
+
+    def _write_table(self, rows: list[dict]) -> None:
+        """``iterations.csv``: the trials so far, rewritten as each one finishes."""
         if self.out is not None:
             write_csv(self.out / "iterations.csv", [_flat(r) for r in rows])
-        return result
 
     def _final_outputs(self, rows: list[dict], converged: bool) -> None:
         """Copy the paper-style figures and the accepted specimen to the top of ``out``."""
@@ -672,6 +715,11 @@ class PorosityCriterion:
             plot_specimen_state(state, self.out / "specimen_state.png", title=title)
 
 
+def _other_config(keys: list[str] | None, stored) -> str:
+    """Why a criterion folder is refused: the config keys in which its run differs."""
+    return f"it holds results of a different config ({', '.join(keys or [])}); choose another --out"
+
+
 def _flat(row: dict) -> dict:
     """A trial row for the CSV table: the ``checks`` dict as ``check_<name>`` columns."""
     out = {k: v for k, v in row.items() if k != "checks"}
@@ -680,6 +728,6 @@ def _flat(row: dict) -> dict:
 
 
 __all__ = [
-    "CriterionSettings", "PorosityCriterion", "binding_part", "in_window", "round_to", "specimen_checks",
+    "CriterionResult", "CriterionSettings", "PorosityCriterion", "in_window", "round_to", "specimen_checks",
     "wall_forces",
 ]  # fmt: skip

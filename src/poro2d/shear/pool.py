@@ -9,9 +9,7 @@ bar per test on a terminal, plain periodic lines in a log.
 
 from __future__ import annotations
 
-import json
 import time
-from pathlib import Path
 
 from poro2d.errors import InputError
 from poro2d.shear.settings import ShearSettings
@@ -31,11 +29,7 @@ def _run_job(job: dict, queue=None) -> dict:
             last[0], last[1] = now, phase
             queue.put((job["key"], phase, fraction))
 
-    test = DirectShearTest(
-        job["specimen"], job["sigma"], ShearSettings(**job["settings"]), out=job["out"],
-        progress=report, figures=job.get("figures", True), threads=1,
-    )  # fmt: skip
-    res = test.run()
+    res = job_test(job, progress=report).run()
     if queue is not None:
         queue.put((job["key"], "done", 1.0))
     return res
@@ -47,14 +41,27 @@ def job_label(job: dict) -> str:
     return prefix + f"{job['sigma']:g} kPa" + (" (v/2)" if "rate" in job["key"] else "")
 
 
+def job_test(job: dict, specimen_digest: str | None = None, progress=None) -> DirectShearTest:
+    """The test of ``job``, on one thread (``specimen_digest``: when the caller has hashed the specimen)."""
+    return DirectShearTest(
+        job["specimen"], job["sigma"], ShearSettings(**job["settings"]), out=job["out"], progress=progress,
+        figures=job.get("figures", True), threads=1, specimen_digest=specimen_digest,
+    )  # fmt: skip
+
+
 def _finished(jobs: list[dict]) -> tuple[dict, list[dict]]:
     """Results of the finished tests (read back, no process started) and the jobs still to run."""
+    from poro2d.dem.checkpoint import state_digest
+
     results: dict = {}
     todo = []
+    digests: dict[str, str] = {}  # each specimen hashed once
     for job in jobs:
-        done = Path(job["out"]) / "result.json"
-        if done.is_file():
-            results[job["key"]] = json.loads(done.read_text())
+        if job["specimen"] not in digests:
+            digests[job["specimen"]] = state_digest(job["specimen"])
+        done = job_test(job, digests[job["specimen"]]).stored()
+        if done is not None:
+            results[job["key"]] = done
         else:
             todo.append(job)
     return results, todo
@@ -216,4 +223,4 @@ def _drain(queue, bar: _Bars | None) -> None:
             bar.update(*item)
 
 
-__all__ = ["execute_jobs", "job_label"]
+__all__ = ["execute_jobs", "job_label", "job_test"]

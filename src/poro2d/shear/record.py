@@ -2,17 +2,18 @@
 
 The record holds what a test's results depend on: a digest of the specimen's state, the
 normal stress and the settings. It holds no path, so a moved or copied folder resumes
-without recomputing; a folder whose work belongs to another test is refused.
+without recomputing; a folder whose work belongs to another test is refused. The rules
+(record, markers, binding once work has started) are those of
+:class:`poro2d.resumable.ResumableStage`; this module words them for a test.
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
+from collections.abc import Mapping
 from pathlib import Path
 
-from poro2d.errors import InputError
-from poro2d.io_utils import provenance, write_json
+from poro2d.io_utils import provenance
+from poro2d.resumable import Fingerprint, ResumableStage
 
 RECORD = "test.json"
 
@@ -22,55 +23,43 @@ def content_record(specimen_digest: str, sigma_kpa: float, settings: dict) -> di
     return {"specimen_digest": specimen_digest, "normal_stress_kpa": sigma_kpa, "settings": settings}
 
 
-def work_started(out: Path) -> bool:
-    """True once the folder holds more than the test's record (a stage has begun)."""
-    return out.is_dir() and any(p.name != RECORD for p in out.iterdir())
-
-
-def stale_reason(out: Path, record: dict) -> str | None:
-    """Why the work in ``out`` belongs to another test, or None if it is this test's (or none)."""
-    p = out / RECORD
-    if not work_started(out):
-        return None
-    if not p.is_file():
+def stale_reason(keys: list[str] | None, old: Mapping | None) -> str:
+    """Why a folder's test is another one, from the keys its record differs in (None: no record)."""
+    if keys is None or old is None:
         return "no record of its specimen and settings"
-    old = json.loads(p.read_text()).get("run") or {}
     if "specimen_digest" not in old:
         return "no content key of its specimen (written by an older poro2d)"
-    if old["specimen_digest"] != record["specimen_digest"]:
+    if "specimen_digest" in keys:
         return "another specimen (the content of the specimen file differs)"
-    if old.get("normal_stress_kpa") != record["normal_stress_kpa"]:
+    if "normal_stress_kpa" in keys:
         return f"another normal stress ({old.get('normal_stress_kpa')} kPa)"
-    settings = old.get("settings") or {}
-    now = record["settings"]
-    changed = sorted(k for k in set(settings) | set(now) if settings.get(k) != now.get(k))
-    if changed:
-        return "other settings (" + ", ".join(changed) + ")"
-    return None
+    return "other settings (" + ", ".join(k.removeprefix("settings.") for k in keys) + ")"
 
 
-def check_reusable(out: Path, record: dict) -> None:
-    """Refuse an ``out`` that holds work of another specimen, normal stress or settings.
+def _explain(keys: list[str] | None, old: Mapping | None) -> str:
+    # stale tests are not recomputed: their folder may hold hours of work the user still
+    # wants (a mistyped --specimen, say), so the choice of a new folder is left to the user
+    return f"it holds a test of {stale_reason(keys, old)}; use a new --out"
 
-    Stale tests are not recomputed: their folder may hold hours of work the user still
-    wants (a mistyped --specimen, say), so the choice of a new folder is left to the user.
+
+def folder_stage(out: Path, record: dict, specimen: Path) -> ResumableStage:
+    """The stages of one test in ``out`` (consolidation, shearing), bound by ``test.json``.
+
+    ``record``: :func:`content_record`; the record file keeps its digest (``key``) and the
+    specimen's path (for information: not compared) beside it.
     """
-    reason = stale_reason(out, record)
-    if reason is not None:
-        raise InputError(
-            "out", str(out), "an empty folder or one holding the same test",
-            f"it holds a test of {reason}; use a new --out",
-        )  # fmt: skip
+    fingerprint = Fingerprint(record)
+    return ResumableStage(
+        out,
+        fingerprint,
+        record=RECORD,
+        key="run",
+        extra={"key": fingerprint.digest, "specimen": str(specimen), "provenance": provenance()},
+        parameter="out",
+        allowed="an empty folder or one holding the same test",
+        explain=_explain,
+        unrecorded="refuse",
+    )
 
 
-def bind(out: Path, record: dict, specimen: Path) -> None:
-    """Write the record to ``out/test.json`` (unless that folder already holds its work)."""
-    if work_started(out) and (out / RECORD).is_file():
-        return
-    out.mkdir(parents=True, exist_ok=True)
-    key = hashlib.sha256(json.dumps(record, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
-    data = {"key": key, "run": record, "specimen": str(specimen), "provenance": provenance()}
-    write_json(out / RECORD, data, config=True)
-
-
-__all__ = ["bind", "check_reusable", "content_record", "stale_reason", "work_started"]
+__all__ = ["content_record", "folder_stage", "stale_reason"]

@@ -21,9 +21,9 @@ from poro2d.shear.outputs import (
     write_figures,
     write_tables,
 )
-from poro2d.shear.pool import execute_jobs
+from poro2d.shear.pool import execute_jobs, job_test
+from poro2d.shear.results import ShearSeriesResult
 from poro2d.shear.settings import ShearSettings
-from poro2d.shear.single import DirectShearTest
 from poro2d.shear.specimen_file import resolve_specimen
 
 #: what a series' ``result.json`` keeps of each test
@@ -97,16 +97,12 @@ class ShearSeries:
 
     def _bind_tests(self) -> None:
         """Validate every test (box size, then what each folder holds) before anything is written."""
-        tests = [
-            DirectShearTest(job["specimen"], job["sigma"], ShearSettings(**job["settings"]), out=job["out"])
-            for job in self.jobs
-        ]
-        self.specimen_digest = tests[0].specimen_digest if tests else ""
-        for t in tests:
-            t._digest = self.specimen_digest  # one specimen: hashed once
-            t.check_reusable()
-        for t in tests:
-            t.bind()
+        self.specimen_digest = checkpoint.state_digest(self.specimen)  # one specimen: hashed once
+        stages = [job_test(job, self.specimen_digest).stage() for job in self.jobs]
+        for stage in stages:
+            stage.check()
+        for stage in stages:
+            stage.bind()
 
     def _jobs(self) -> list[dict]:
         base = self.settings.to_dict()
@@ -128,12 +124,13 @@ class ShearSeries:
     def _execute(self) -> dict:
         return execute_jobs(self.jobs, self.processes, self.progress)
 
-    def run(self) -> dict:
+    def run(self) -> ShearSeriesResult:
+        """Run the tests (finished ones are read back), then the fit, figures and ``result.json``."""
         t0 = time.perf_counter()
         return self.finish(self._execute(), t0)
 
     # ------------------------------------------------------------------ results
-    def finish(self, results: dict, t0: float) -> dict:
+    def finish(self, results: dict, t0: float) -> ShearSeriesResult:
         """Fit, figures and ``result.json`` from the tests' results (keyed as in :meth:`_jobs`)."""
         tests = [results[("test", s)] for s in self.stresses]
         sig = np.array([t["normal_stress_kpa"] for t in tests])
@@ -142,35 +139,35 @@ class ShearSeries:
         fit0 = mohr_coulomb(sig, tau, through_origin=True)
         s = self.settings
         summary = [self._test_summary(t) for t in tests]
-        result: dict = {
-            "normal_stresses_kpa": self.stresses,
-            "tests": summary,
-            "friction_angle_deg": fit.friction_angle_deg if fit else None,
-            "cohesion_kpa": fit.cohesion_kpa if fit else None,
-            "r2": fit.r2 if fit else None,
-            "fit": fit.to_dict() if fit else None,
-            "friction_angle_through_origin_deg": fit0.friction_angle_deg,
-            "fit_through_origin": fit0.to_dict(),
-            "quasi_static": self._quasi_static(tests),
-            "peak_definition": f"maximum of the shear stress curve smoothed by a centred moving average over "
+        result = ShearSeriesResult(
+            normal_stresses_kpa=self.stresses,
+            tests=summary,
+            friction_angle_deg=fit.friction_angle_deg if fit else None,
+            cohesion_kpa=fit.cohesion_kpa if fit else None,
+            r2=fit.r2 if fit else None,
+            fit=fit.to_dict() if fit else None,
+            friction_angle_through_origin_deg=fit0.friction_angle_deg,
+            fit_through_origin=fit0.to_dict(),
+            quasi_static=self._quasi_static(tests),
+            peak_definition=f"maximum of the shear stress curve smoothed by a centred moving average over "
             f"{1e3 * s.peak_window:g} mm of shear displacement",
-            "shear_stress_definition": "horizontal force of the disks on the upper half (upper walls, upper "
+            shear_stress_definition="horizontal force of the disks on the upper half (upper walls, upper "
             "lip, top plate friction) / (W t), W the box width (no area correction)",
-            "settings": s.to_dict(),
-            "velocity_m_per_s": s.velocity,
-            "density_scale": s.density_scale,
-            "specimen": str(self.specimen),
-            "specimen_digest": self.specimen_digest,
-            "specimen_meta": checkpoint.read_meta(self.specimen).get("extra", {}),
-            "processes": self.processes,
-            "config": self.config,
-        }
+            settings=s.to_dict(),
+            velocity_m_per_s=s.velocity,
+            density_scale=s.density_scale,
+            specimen=str(self.specimen),
+            specimen_digest=self.specimen_digest,
+            specimen_meta=checkpoint.read_meta(self.specimen).get("extra", {}),
+            processes=self.processes,
+            config=self.config,
+        )
         if self.rate_check:
-            result["rate_check"] = self._rate_check(tests, results, sig, fit)
+            result.rate_check = self._rate_check(tests, results, sig, fit)
         if self.lab is not None:
-            result["lab"] = self._lab_part(fit)
-        result["wall_time_s"] = time.perf_counter() - t0
-        result["provenance"] = provenance()
+            result.lab = self._lab_part(fit)
+        result.wall_time_s = time.perf_counter() - t0
+        result.provenance = provenance()
         curves = read_curves(self.out, tests)
         write_tables(self.out, curves, summary)
         if self.figures:

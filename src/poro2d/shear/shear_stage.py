@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import time
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -22,6 +23,10 @@ from poro2d.shear.peak_frame import PeakFrame, PeakTracker
 
 if TYPE_CHECKING:
     from poro2d.shear.single import DirectShearTest
+
+#: the files that let a killed shear stage continue: the engine state and the peak's frame
+CHECKPOINT = "shear_checkpoint.npz"
+PEAK_FRAME = "peak_frame.npz"
 
 
 class ShearStage:
@@ -38,8 +43,8 @@ class ShearStage:
         assert test.box is not None
         self.test, self.box, self.settings = test, test.box, s
         self.t0 = time.perf_counter()
-        self.ck = test._path("shear_checkpoint.npz")
-        self.fpath = test._path("peak_frame.npz")
+        self.ck = test._path(CHECKPOINT)
+        self.fpath = test._path(PEAK_FRAME)
         self.y_plate0 = info["plate_height_m"]
         self.sim, self.rows, self.step0, self.wall_before = self._start(sim)
         dx_step = s.velocity * self.sim.dt
@@ -98,11 +103,11 @@ class ShearStage:
         self.peak.settle(self.rows, None)
         return self.wall_before + time.perf_counter() - self.t0
 
-    def remove_files(self) -> None:
-        """The checkpoint and the stored frame, once the test's results are written."""
-        for f in (self.ck, self.fpath):
-            if f is not None and f.is_file():
-                f.unlink()
+
+def remove_stage_files(out: Path) -> None:
+    """The checkpoint and the stored frame of a test in ``out``, once its results are written."""
+    for name in (CHECKPOINT, PEAK_FRAME):
+        (out / name).unlink(missing_ok=True)
 
 
-__all__ = ["ShearStage"]
+__all__ = ["CHECKPOINT", "PEAK_FRAME", "ShearStage", "remove_stage_files"]

@@ -13,7 +13,6 @@
 
 from __future__ import annotations
 
-import json
 import math
 import time
 from collections.abc import Callable
@@ -25,13 +24,15 @@ from poro2d.config import check_finite
 from poro2d.dem import Simulation, checkpoint
 from poro2d.dem.measure import coordination_number
 from poro2d.errors import InputError, check_range
-from poro2d.io_utils import provenance, write_csv, write_json
+from poro2d.io_utils import as_json, provenance, write_csv
+from poro2d.resumable import ResumableStage
 from poro2d.shear import record
 from poro2d.shear.box import SplitBox, build_split_box
 from poro2d.shear.curve import CURVE_COLUMNS, curve_summary
 from poro2d.shear.peak_frame import PeakFrame
+from poro2d.shear.results import ShearTestResult
 from poro2d.shear.settings import ShearSettings, inertial_number
-from poro2d.shear.shear_stage import ShearStage
+from poro2d.shear.shear_stage import ShearStage, remove_stage_files
 from poro2d.shear.specimen_file import resolve_specimen, specimen_box
 
 ProgressFn = Callable[[str, float], None]
@@ -58,6 +59,7 @@ class DirectShearTest:
         progress: ProgressFn | None = None,
         figures: bool = True,
         threads: int = 1,
+        specimen_digest: str | None = None,
     ) -> None:
         self.specimen = resolve_specimen(specimen)
         self.sigma_kpa = check_range("normal stress (kPa)", normal_stress_kpa, 0.0, None, lo_open=True)
@@ -73,7 +75,8 @@ class DirectShearTest:
         self.figures = figures
         self.threads = threads
         self.box: SplitBox | None = None
-        self._digest: str | None = None
+        self._digest = specimen_digest
+        self._stage: ResumableStage | None = None
 
     # ------------------------------------------------------------ bookkeeping
     def _report(self, phase: str, fraction: float) -> None:
@@ -93,15 +96,21 @@ class DirectShearTest:
     def _record(self) -> dict:
         return record.content_record(self.specimen_digest, self.sigma_kpa, self.settings.to_dict())
 
-    def check_reusable(self) -> None:
-        """Refuse an ``out`` that holds work of another specimen, normal stress or settings."""
-        assert self.out is not None
-        record.check_reusable(self.out, self._record())
+    def stage(self) -> ResumableStage:
+        """The test's stages in ``out``, bound by ``test.json`` to its specimen, stress and settings.
 
-    def bind(self) -> None:
-        """Record this test in ``out/test.json`` (unless that folder already holds its work)."""
+        ``stage().check()`` refuses an ``out`` holding work of another test; ``stage().bind()``
+        records this one (a series checks every folder before it binds any).
+        """
         assert self.out is not None
-        record.bind(self.out, self._record(), self.specimen)
+        if self._stage is None:
+            self._stage = record.folder_stage(self.out, self._record(), self.specimen)
+        return self._stage
+
+    def stored(self) -> ShearTestResult | None:
+        """The result of this test when ``out`` holds it finished, else None (it has to run)."""
+        data = self.stage().stored() if self.out is not None else None
+        return None if data is None else ShearTestResult.from_dict(data)
 
     # ----------------------------------------------------------------- stages
     def _build_box(self) -> tuple[Simulation, SplitBox]:
@@ -117,13 +126,30 @@ class DirectShearTest:
         return sim, box
 
     def consolidate(self) -> tuple[Simulation, dict]:
+        """The consolidated specimen and its record; with ``out`` read back once done.
+
+        Done means ``consolidation.json`` (written last) beside ``consolidated.npz``.
+        """
+        if self.out is None:
+            return self._consolidate()
+        npz = self.out / "consolidated.npz"
+        fresh: list[Simulation] = []
+
+        def compute() -> dict:
+            sim, info = self._consolidate()
+            checkpoint.save(sim, npz, extra={"stage": "consolidated", "normal_stress_kpa": self.sigma_kpa})
+            fresh.append(sim)
+            return info
+
+        info = self.stage().run(compute, "consolidation.json", accept=lambda _: npz.is_file())
+        if fresh:
+            return fresh[0], info
+        self.box = SplitBox(**info["box"])
+        return checkpoint.load(npz, threads=self.threads), info
+
+    def _consolidate(self) -> tuple[Simulation, dict]:
         """Build the split box and servo the top plate to the normal stress until equilibrium."""
         s = self.settings
-        cpath, jpath = self._path("consolidated.npz"), self._path("consolidation.json")
-        if cpath is not None and jpath is not None and cpath.is_file() and jpath.is_file():
-            info = json.loads(jpath.read_text())
-            self.box = SplitBox(**info["box"])
-            return checkpoint.load(cpath, threads=self.threads), info
         t0 = time.perf_counter()
         sim, box = self._build_box()
         self.box = box
@@ -156,13 +182,14 @@ class DirectShearTest:
             "coordination_number": coordination_number(sim), "wall_time_s": time.perf_counter() - t0,
             "box": box.to_dict(), "engine": sim.summary(),
         }  # fmt: skip
-        if cpath is not None and jpath is not None:
-            checkpoint.save(sim, cpath, extra={"stage": "consolidated", "normal_stress_kpa": self.sigma_kpa})
-            write_json(jpath, info)
         return sim, info
 
-    def shear(self, sim: Simulation, info: dict) -> dict:
-        """Shear the consolidated specimen to ``max_displacement``; returns the test result."""
+    def shear(self, sim: Simulation, info: dict) -> ShearTestResult:
+        """Shear the consolidated specimen to ``max_displacement``; returns the test result.
+
+        With ``out``: ``curve.csv`` and ``forces_peak.png`` are written here, ``result.json``
+        after them by :meth:`run`.
+        """
         stage = ShearStage(self, sim, info)
         wall = stage.run()
         result = self._result(stage.rows, info, stage.sim, wall)
@@ -170,8 +197,6 @@ class DirectShearTest:
             write_csv(self.out / "curve.csv", stage.rows, header=CURVE_COLUMNS)
             if self.figures and stage.peak.frame is not None:
                 self._figure(stage.peak.frame, result)
-            write_json(self.out / "result.json", result)
-            stage.remove_files()
         return result
 
     def _figure(self, frame: PeakFrame, result: dict) -> None:
@@ -186,40 +211,44 @@ class DirectShearTest:
                    f"{1e3 * self.settings.peak_window:g} mm)"],
         )  # fmt: skip
 
-    def _result(self, rows: list[dict], info: dict, sim: Simulation, wall: float) -> dict:
+    def _result(self, rows: list[dict], info: dict, sim: Simulation, wall: float) -> ShearTestResult:
         """The test's ``result.json``: what the curve says, and how it was obtained."""
         s = self.settings
         rho = float(np.mean(sim.particles.density)) * sim.density_scale
-        result = curve_summary(rows, self.sigma_kpa, s)
-        result.update({
-            "inertial_number_at_target_stress": inertial_number(
+        return ShearTestResult(
+            **curve_summary(rows, self.sigma_kpa, s),
+            inertial_number_at_target_stress=inertial_number(
                 s.velocity, self.sigma_kpa * 1e3, rho, s.shear_zone_factor
             ),
-            "consolidation": {k: v for k, v in info.items() if k != "engine"},
-            "velocity_m_per_s": s.velocity,
-            "density_scale": sim.density_scale,
-            "local_damping": sim.local_damping,
-            "dt_s": sim.dt,
-            "d_mean_m": float(2.0 * np.mean(sim.particles.radius)),
-            "shear_steps": int(rows[-1]["step"]) if rows else 0,
-            "records": len(rows),
-            "wall_time_shear_s": wall,
-            "wall_time_s": wall + float(info.get("wall_time_s", 0.0)),
-            "settings": s.to_dict(),
-            "specimen": str(self.specimen),
-            "engine": sim.summary(),
-            "provenance": provenance(),
-        })  # fmt: skip
+            consolidation={k: v for k, v in info.items() if k != "engine"},
+            velocity_m_per_s=s.velocity,
+            density_scale=sim.density_scale,
+            local_damping=sim.local_damping,
+            dt_s=sim.dt,
+            d_mean_m=float(2.0 * np.mean(sim.particles.radius)),
+            shear_steps=int(rows[-1]["step"]) if rows else 0,
+            records=len(rows),
+            wall_time_shear_s=wall,
+            wall_time_s=wall + float(info.get("wall_time_s", 0.0)),
+            settings=s.to_dict(),
+            specimen=str(self.specimen),
+            engine=sim.summary(),
+            provenance=provenance(),
+        )
+
+    def run(self) -> ShearTestResult:
+        """Consolidate, shear, write and return the result; with ``out`` resume what is done.
+
+        A finished test (its ``result.json``) is read back; a consolidated one shears from
+        ``consolidated.npz``; a test killed while shearing continues from its checkpoint.
+        """
+        if self.out is None:
+            return ShearTestResult.from_dict(as_json(self._consolidate_and_shear()))
+        result = self.stage().run(self._consolidate_and_shear, decode=ShearTestResult.from_dict)
+        remove_stage_files(self.out)  # the shear stage's checkpoints, once result.json is written
         return result
 
-    def run(self) -> dict:
-        """Consolidate (or reuse the consolidated state), shear, write and return the result."""
-        if self.out is not None:
-            self.check_reusable()  # before a stored result is trusted
-            done = self.out / "result.json"
-            if done.is_file():
-                return json.loads(done.read_text())
-            self.bind()
+    def _consolidate_and_shear(self) -> ShearTestResult:
         sim, info = self.consolidate()
         return self.shear(sim, info)
 

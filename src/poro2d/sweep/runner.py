@@ -31,7 +31,8 @@ from pathlib import Path
 from typing import Any
 
 from poro2d.io_utils import atomic_path, provenance, write_json
-from poro2d.sweep.cases import KINDS, Case, SweepConfig
+from poro2d.resumable import Fingerprint, ResumableStage
+from poro2d.sweep.cases import KINDS, PERFORMANCE_KEYS, Case, SweepConfig
 
 RESULT = "result.json"
 PARAMS = "params.json"
@@ -65,16 +66,33 @@ def _scalar(v: Any) -> Any:
     return json.dumps(v, default=str)
 
 
-def load_done(case_dir: Path) -> dict | None:
-    """The stored row of a finished case, or None (missing or unreadable marker)."""
-    p = case_dir / RESULT
-    if not p.is_file():
-        return None
-    try:
-        row = json.loads(p.read_text())
-    except (OSError, json.JSONDecodeError):
-        return None
-    return row if isinstance(row, dict) and row.get("status") == "done" else None
+def case_stage(case: dict, case_dir: Path) -> ResumableStage:
+    """A case's folder as a resumable stage: ``params.json`` binds it, ``result.json`` marks it done.
+
+    The binding is the case's kind and merged config, as its id (which names the folder)
+    is: the parameters (labels relative to a sweep's base case) and the performance
+    settings are recorded, not compared, so a rerun with another thread count finds it.
+    """
+    performance = tuple(f"config.{table}.{k}" for table, keys in PERFORMANCE_KEYS.items() for k in keys)
+    return ResumableStage(
+        case_dir,
+        Fingerprint(case, ignore=("id", "params", *performance)),
+        record=PARAMS,
+        key=None,
+        parameter="--out",
+        allowed="a sweep folder whose case folders hold the cases their ids name",
+        unrecorded="adopt",
+    )
+
+
+def _is_done(row: dict) -> bool:
+    """A ``result.json`` marks a finished case only with ``status`` done (what the runner writes)."""
+    return row.get("status") == "done"
+
+
+def finished_row(case: dict, case_dir: Path) -> dict | None:
+    """The stored row of a finished case, or None (no marker, unreadable, or another case's)."""
+    return case_stage(case, case_dir).stored(RESULT, accept=_is_done)
 
 
 # ------------------------------------------------------------------------ worker side
@@ -85,11 +103,10 @@ def run_case_task(case: dict, case_dir: str, func) -> dict:
     at run time (tests, plug-ins) work on any worker.
     """
     d = Path(case_dir)
-    done = load_done(d)
+    stage = case_stage(case, d)
+    done = stage.stored(RESULT, accept=_is_done)
     if done is not None:  # a retry after the marker was written
         return done
-    d.mkdir(parents=True, exist_ok=True)
-    write_json(d / PARAMS, case, config=True)
     _pin_numba_threads()
     row: dict[str, Any] = {
         "case_id": case["id"],
@@ -102,10 +119,7 @@ def run_case_task(case: dict, case_dir: str, func) -> dict:
     }
     t0 = time.perf_counter()
     try:
-        results = func(case["config"], d / "run")
-        if not isinstance(results, dict):
-            raise TypeError(f"case kind {case['kind']!r} returned {type(results).__name__}, not a dict")
-        results = {str(k): _scalar(v) for k, v in results.items()}
+        return stage.run(lambda: _done_row(case, d, func, row, t0), RESULT, accept=_is_done)
     except Exception as exc:
         row.update(
             status="failed",
@@ -118,12 +132,19 @@ def run_case_task(case: dict, case_dir: str, func) -> dict:
             tmp.write_text(traceback.format_exc())
         write_json(d / ERROR_JSON, row)
         return row
+
+
+def _done_row(case: dict, d: Path, func, row: dict, t0: float) -> dict:
+    """Run the case's kind into ``d/run``; its row (``status`` done, the results as table cells)."""
+    results = func(case["config"], d / "run")
+    if not isinstance(results, dict):
+        raise TypeError(f"case kind {case['kind']!r} returned {type(results).__name__}, not a dict")
+    results = {str(k): _scalar(v) for k, v in results.items()}
     row.update(status="done", error=None, time_s=time.perf_counter() - t0, finished_utc=_now())
     row["results"] = results
     for stale in (ERROR_TXT, ERROR_JSON):
         (d / stale).unlink(missing_ok=True)
-    write_json(d / RESULT, row)  # the done marker, last
-    return row
+    return row  # written as result.json, the done marker, last
 
 
 def _pin_numba_threads() -> None:
@@ -179,9 +200,7 @@ def _failed_row(case: Case, d: Path, err: BaseException, tb: str) -> dict:
         "worker": None,
         "finished_utc": _now(),
     }
-    d.mkdir(parents=True, exist_ok=True)
-    if not (d / PARAMS).is_file():
-        write_json(d / PARAMS, case.to_dict(), config=True)
+    case_stage(case.to_dict(), d).bind()
     with atomic_path(d / ERROR_TXT) as tmp:
         tmp.write_text(tb or row["error"])
     write_json(d / ERROR_JSON, row)
@@ -291,7 +310,7 @@ def run_sweep(
     rows: dict[str, dict] = {}
     pending: list[Case] = []
     for c in sweep.cases:
-        done = load_done(cases_dir / c.id)
+        done = finished_row(c.to_dict(), cases_dir / c.id)
         if done is not None:
             rows[c.id] = dict(done, status="done", reused=True)
         else:
@@ -405,4 +424,12 @@ def _submit_all(
     return rows
 
 
-__all__ = ["SweepOutcome", "load_done", "run_case_task", "run_sweep", "table_from_rows", "write_tables"]
+__all__ = [
+    "SweepOutcome",
+    "case_stage",
+    "finished_row",
+    "run_case_task",
+    "run_sweep",
+    "table_from_rows",
+    "write_tables",
+]

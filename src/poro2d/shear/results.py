@@ -1,0 +1,91 @@
+"""Typed results of direct shear: one test's ``result.json`` and a series' ``result.json``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+from poro2d.typed_result import TypedResult
+
+
+@dataclass(eq=False)
+class ShearTestResult(TypedResult):
+    """One test (a test folder's ``result.json``): what its curve says, and how it was obtained.
+
+    The first fields are read off the curve (:func:`poro2d.shear.curve.curve_summary`):
+    the smoothed peak and where it lies, the end values (``end``: smoothed over one peak
+    window), the servo's stress error, the inertial number and the force balance. Stresses
+    in kPa, lengths in m unless the name says mm.
+    """
+
+    normal_stress_kpa: float
+    peak_shear_stress_kpa: float
+    shear_displacement_at_peak_m: float
+    peak_stress_ratio: float
+    peak_shear_stress_raw_kpa: float
+    peak_window_m: float
+    normal_stress_at_peak_kpa: float
+    plate_displacement_at_peak_mm: float
+    end: dict[str, float]
+    end_shear_displacement_m: float
+    max_inertial_number: float | None
+    inertial_number_ok: bool
+    normal_stress_max_error_after_consolidation: float
+    normal_stress_mean_error: float
+    force_balance: dict[str, Any]
+    inertial_number_at_target_stress: float
+    consolidation: dict[str, Any]
+    velocity_m_per_s: float
+    density_scale: float
+    local_damping: float
+    dt_s: float
+    d_mean_m: float
+    shear_steps: int
+    records: int
+    wall_time_shear_s: float
+    wall_time_s: float
+    settings: dict[str, Any]
+    specimen: str
+    engine: dict[str, Any]
+    provenance: dict[str, Any]
+
+
+@dataclass(eq=False)
+class ShearSeriesResult(TypedResult):
+    """Tests at several normal stresses on one specimen (a series' ``result.json``), with the fit.
+
+    ``tests``: one summary dict per test (:data:`poro2d.shear.series.SUMMARY_KEYS`, the
+    consolidation's stress error, the test's folder). The Mohr-Coulomb fit (``fit``, and
+    its ``friction_angle_deg``, ``cohesion_kpa``, ``r2``) needs two stresses or more, else
+    they are None. ``rate_check`` and ``lab`` are in the file only when the series ran with
+    them.
+    """
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("rate_check", "lab")
+
+    normal_stresses_kpa: list[float]
+    tests: list[dict[str, Any]]
+    friction_angle_deg: float | None
+    cohesion_kpa: float | None
+    r2: float | None
+    fit: dict[str, Any] | None
+    friction_angle_through_origin_deg: float
+    fit_through_origin: dict[str, Any]
+    quasi_static: dict[str, Any]
+    peak_definition: str
+    shear_stress_definition: str
+    settings: dict[str, Any]
+    velocity_m_per_s: float
+    density_scale: float
+    specimen: str
+    specimen_digest: str
+    specimen_meta: dict[str, Any]
+    processes: int
+    config: dict[str, Any]
+    rate_check: dict[str, Any] | None = None
+    lab: dict[str, Any] | None = None
+    wall_time_s: float | None = None
+    provenance: dict[str, Any] | None = None
+
+
+__all__ = ["ShearSeriesResult", "ShearTestResult"]

@@ -1,0 +1,80 @@
+"""Typed results: dataclasses that are written to, and read back from, a run's JSON files.
+
+A result class lists the keys of its file as dataclass fields, in the file's order, so
+code and readers see in one place what a file holds and of which type. The files do not
+change: :meth:`TypedResult.to_dict` gives exactly the keys written before results were
+typed, and :meth:`TypedResult.from_dict` reads any such file back so that writing it again
+gives the same dict. Keys a class does not model are kept in ``extra`` (a file of a newer
+or older poro2d, a key added by another tool); keys it models that a file lacks stay
+absent; keys listed in ``OPTIONAL`` are written only when set (parts a run has only with
+an option, such as a shear series' ``rate_check``).
+
+A result is also a read-only mapping (``result["final_porosity"]``, ``result.get(...)``,
+``dict(result)``, ``"lab" in result``) that equals the dict of its file: code written when
+results were plain dicts, and readers of the files, keep working. New code uses attributes
+(``result.final_porosity``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field, fields
+from functools import cache
+from typing import Any, ClassVar, Self
+
+
+@cache
+def _keys(cls: type) -> tuple[str, ...]:
+    """The file keys a result class models: its fields but ``extra``, in declaration order."""
+    return tuple(f.name for f in fields(cls) if f.name != "extra")
+
+
+@dataclass(eq=False)
+class TypedResult(Mapping):
+    """Base of typed results; subclasses are ``@dataclass(eq=False)`` with one field per key."""
+
+    #: keys written only when their value is not None
+    OPTIONAL: ClassVar[tuple[str, ...]] = ()
+
+    #: keys of the file that the class does not model, written back after the modelled ones
+    extra: dict[str, Any] = field(default_factory=dict, kw_only=True, repr=False)
+
+    def __post_init__(self) -> None:
+        # keys a file read by from_dict lacked: they stay out of to_dict() while unset
+        self._absent: frozenset[str] = frozenset()
+
+    def _present(self, key: str) -> bool:
+        """Whether ``key`` is in the file: unless unset (None) where a file lacked it or it is optional."""
+        return getattr(self, key) is not None or (key not in self._absent and key not in self.OPTIONAL)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The keys and values of the file, in its order (a shallow copy: nested values are shared)."""
+        out = {k: getattr(self, k) for k in _keys(type(self)) if self._present(k)}
+        out.update(self.extra)
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Self:
+        """A result from the dict of its file (``json.loads`` of it, or a result's ``to_dict()``)."""
+        keys = _keys(cls)
+        obj = cls(**{k: data.get(k) for k in keys}, extra={k: v for k, v in data.items() if k not in keys})
+        obj._absent = frozenset(k for k in keys if k not in data)
+        return obj
+
+    # read-only mapping access, for code that reads results as dicts
+    def __getitem__(self, key: str) -> Any:
+        if key in _keys(type(self)):
+            if self._present(key):
+                return getattr(self, key)
+        elif key in self.extra:
+            return self.extra[key]
+        raise KeyError(key)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.to_dict())
+
+    def __len__(self) -> int:
+        return len(self.to_dict())
+
+
+__all__ = ["TypedResult"]
