@@ -96,31 +96,6 @@ def conversion_files(out: Path) -> dict:
             "figures": [str(f.name) for f in figs], "provenance": provenance()}  # fmt: skip
 
 
-def replicate_specimens(spec, grading, settings, n2d: float, seeds: list[int], out: Path,
-                        progress: bool) -> tuple[dict[str, Path], list[dict]]:  # fmt: skip
-    """Criterion runs for the replicate seeds, each starting from the accepted ``n2d``.
-
-    Every replicate is a specimen that passed the criterion itself (its own seed may settle
-    on a neighbouring trial porosity: that is part of the seed spread). Returns the accepted
-    specimens by label and one summary row per seed (converged or not).
-    """
-    from dataclasses import replace
-
-    from poro2d.criterion.protocol import PorosityCriterion
-
-    specimens: dict[str, Path] = {}
-    rows = []
-    for sd in seeds:
-        d = out / f"seed{sd}"
-        res = PorosityCriterion(spec, grading, replace(settings, trial_porosity=n2d), seed=sd, out=d,
-                                progress=progress).run()  # fmt: skip
-        rows.append({"seed": sd, "final_porosity": res["final_porosity"], "converged": res["converged"],
-                     "trials": len(res["iterations"]), "message": res["message"]})  # fmt: skip
-        if res["converged"]:
-            specimens[f"seed{sd}"] = d / "specimen.npz"
-    return specimens, rows
-
-
 def run_paper(
     out: str | Path = "paper-out",
     *,
@@ -233,13 +208,20 @@ def _conversions_stage(out: Path, stage: ResumableStage) -> dict:
 
 def _specimens(spec, grading, settings, n2d: float, seed: int, replicates: int, out: Path,
                progress: bool) -> tuple[dict[str, Path], list[dict] | None]:  # fmt: skip
-    """The accepted specimen of ``seed`` and, with replicates, those of the next seeds."""
+    """The accepted specimen of ``seed`` and, with replicates, those of the next seeds.
+
+    The replicates are criterion runs from the accepted ``n2d``, one process per core
+    (:func:`poro2d.criterion.replicates.run_replicates`).
+    """
+    from poro2d.criterion.replicates import run_replicates
+
     specimens = {f"seed{seed}": out / "criterion" / "specimen.npz"}
     if replicates == 1:
         return specimens, None
     extra = list(range(seed + 1, seed + replicates))
     console.print(f"  replicate specimens: seeds {', '.join(map(str, extra))} from n2D = {n2d:.2f}")
-    more, reps = replicate_specimens(spec, grading, settings, n2d, extra, out / "replicates", progress)
+    more, reps = run_replicates(spec, grading, settings, n2d, extra, out / "replicates",
+                                processes=spec.threads, progress=progress)  # fmt: skip
     return {**specimens, **more}, reps
 
 

@@ -28,6 +28,7 @@ class ShearTestResult(TypedResult):
     plate_displacement_at_peak_mm: float
     end: dict[str, float]
     end_shear_displacement_m: float
+    ended_by: str | None
     max_inertial_number: float | None
     inertial_number_ok: bool
     normal_stress_max_error_after_consolidation: float

@@ -30,7 +30,7 @@ from poro2d.shear.specimen_file import resolve_specimen
 SUMMARY_KEYS = (
     "normal_stress_kpa", "peak_shear_stress_kpa", "shear_displacement_at_peak_m", "peak_stress_ratio",
     "peak_shear_stress_raw_kpa", "normal_stress_at_peak_kpa", "plate_displacement_at_peak_mm", "end",
-    "end_shear_displacement_m", "max_inertial_number", "inertial_number_ok",
+    "end_shear_displacement_m", "ended_by", "max_inertial_number", "inertial_number_ok",
     "normal_stress_max_error_after_consolidation", "force_balance", "wall_time_s",
 )  # fmt: skip
 RATE_CHECK_NOTE = (
@@ -178,7 +178,8 @@ class ShearSeries:
     @staticmethod
     def _test_summary(t: dict) -> dict:
         """One test's line of the series' result."""
-        return {k: t[k] for k in SUMMARY_KEYS} | {
+        # tests written before a test said why it ended lack ``ended_by``
+        return {k: t.get(k) if k == "ended_by" else t[k] for k in SUMMARY_KEYS} | {
             "consolidation_normal_stress_error": t["consolidation"]["normal_stress_error"],
             "folder": folder_name(t["normal_stress_kpa"]),
         }

@@ -203,11 +203,11 @@ def calibration_twins(calibration, states, base_dir: Path | None, folder: Path) 
     and criterion settings they build, never assumed. Returns ``{state case id: row}``, the
     calibration case's finished row relabelled with the check's parameters.
     """
-    from poro2d.sweep.runner import load_done
+    from poro2d.sweep.runner import finished_row
 
     done = {}
     for c in calibration.cases:
-        row = load_done(folder / "cases" / c.id)
+        row = finished_row(c.to_dict(), folder / "cases" / c.id)
         if row is not None:
             done[_run_key(c, base_dir)] = (c, row)
     twins = {}
