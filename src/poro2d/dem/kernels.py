@@ -475,12 +475,58 @@ def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out):
 
 
 @njit(cache=True)
+def _largest_drift(tmax, nthr, wp0, wall_build):
+    """Largest squared drift of a disk or wall since the lists were built.
+
+    Every worker computes it from the same shared numbers, so all take the same rebuild
+    and stop decisions without another barrier. Arrays, not records: a record passed to a
+    helper costs a reference count per array at every step.
+    """
+    dmax = 0.0
+    for u in range(nthr):
+        if tmax[u] > dmax:
+            dmax = tmax[u]
+    for w in range(wp0.shape[0]):
+        ddx = wp0[w, 0] - wall_build[w, 0]
+        ddy = wp0[w, 1] - wall_build[w, 1]
+        d2 = ddx * ddx + ddy * ddy
+        if d2 > dmax:
+            dmax = d2
+    return dmax
+
+
+@njit(cache=True)
+def _converged(t, nthr, disks, nb, wb, sync, out, target):
+    """The stop test: thread 0 computes the ratios once, and every worker reads its verdict.
+
+    It takes whole records (a reference count per array) since it runs on check steps only.
+    """
+    if t == 0:
+        rmax, rmean = unbalanced_ratios(
+            disks.force, disks.mode, nb.start, nb.fn, nb.fs, nb.ov, wb.start, wb.fn, wb.fs, wb.ov
+        )
+        out[MAX_RATIO] = rmax
+        out[MEAN_RATIO] = rmean
+        atomic_store(sync, STATUS_WORD, CONVERGED if rmax < target else RUNNING)
+    barrier(sync, nthr)  # nobody may change the forces before they are read
+    return atomic_load(sync, STATUS_WORD) == CONVERGED
+
+
+@njit(cache=True)
+def _report(status, steps, rebuilds, need_build, pos, iprm, out):
+    """The call's outcome for the driver, written once by thread 0 after the last step."""
+    out[STATUS] = status
+    out[STEPS_DONE] = steps
+    out[REBUILDS] = rebuilds
+    iprm[NEED_BUILD] = 1 if need_build else 0
+    if status == RUNNING and not math.isfinite(pos.sum()):
+        out[STATUS] = UNSTABLE
+
+
+@njit(cache=True)
 def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash):
     """Run the steps of this call on thread t of nthr: partitions t P / nthr to (t + 1) P / nthr - 1."""
-    pos, force, pmode = disks.pos, disks.force, disks.mode
     wp0, wall_build = walls.p0, walls.p0_build
-    nb_start, nb_fn, nb_fs, nb_ov = nb.start, nb.fn, nb.fs, nb.ov
-    wb_start, wb_fn, wb_fs, wb_ov = wb.start, wb.fn, wb.fs, wb.ov
     part, dstart, tmax, sync = work.part, work.dstart, work.tmax, work.sync
     dt = prm[DT]
     gx = prm[GX]
@@ -497,7 +543,6 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash):
     npart = part.shape[0] - 1
     k0 = t * npart // nthr
     k1 = (t + 1) * npart // nthr
-    nw = wp0.shape[0]
     steps = 0
     rebuilds = 0
     status = RUNNING
@@ -508,7 +553,8 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash):
                 break
             need_build = False
             rebuilds += 1
-        # phase 1: forces; disks without cross pairs advance at once
+        # phase 1: forces; disks without cross pairs advance at once. Both phases stay here:
+        # a helper taking the records would add a reference count per array at every step
         dmax = 0.0
         for k in range(k0, k1):
             d2 = _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, pw_body, dt, gx, gy, damp)
@@ -527,17 +573,7 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash):
         barrier(sync, nthr)
         steps += 1
         since_check += 1
-        # every worker takes the same decisions from the same shared numbers
-        dmax = 0.0
-        for u in range(nthr):
-            if tmax[u] > dmax:
-                dmax = tmax[u]
-        for w in range(nw):
-            ddx = wp0[w, 0] - wall_build[w, 0]
-            ddy = wp0[w, 1] - wall_build[w, 1]
-            d2 = ddx * ddx + ddy * ddy
-            if d2 > dmax:
-                dmax = d2
+        dmax = _largest_drift(tmax, nthr, wp0, wall_build)
         if dmax > lim2:
             need_build = True
         if check_every > 0 and since_check == check_every:
@@ -545,25 +581,11 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash):
             if not math.isfinite(dmax):
                 status = UNSTABLE
                 break
-            if target > 0.0:
-                if t == 0:
-                    rmax, rmean = unbalanced_ratios(
-                        force, pmode, nb_start, nb_fn, nb_fs, nb_ov, wb_start, wb_fn, wb_fs, wb_ov
-                    )
-                    out[MAX_RATIO] = rmax
-                    out[MEAN_RATIO] = rmean
-                    atomic_store(sync, STATUS_WORD, CONVERGED if rmax < target else RUNNING)
-                barrier(sync, nthr)  # nobody may change the forces before they are read
-                if atomic_load(sync, STATUS_WORD) == CONVERGED:
-                    status = CONVERGED
-                    break
+            if target > 0.0 and _converged(t, nthr, disks, nb, wb, sync, out, target):
+                status = CONVERGED
+                break
     if t == 0:
-        out[STATUS] = status
-        out[STEPS_DONE] = steps
-        out[REBUILDS] = rebuilds
-        iprm[NEED_BUILD] = 1 if need_build else 0
-        if status == RUNNING and not math.isfinite(pos.sum()):
-            out[STATUS] = UNSTABLE
+        _report(status, steps, rebuilds, need_build, disks.pos, iprm, out)
 
 
 @njit(cache=True)

@@ -41,22 +41,19 @@ def _check_extremes(n_max: float, n_min: float) -> None:
     P.relative_density(n_min, n_max, n_min)  # validates both, raises InputError
 
 
-def fig1_relations(
-    n_max: float = P.PAPER_N_MAX,
-    n_min: float = P.PAPER_N_MIN,
-    *,
-    nu_reading: str = "printed",
-    lattice_exact: bool = False,
-    mark_n_lab: float | None = None,
-    num: int = 201,
-) -> Figure:
-    """Fig. 1: 2D porosity of every method against n_lab over [n_min, n_max]."""
-    _check_extremes(n_max, n_min)
-    if nu_reading not in P.NU_READINGS:
-        raise InputError("nu_reading", nu_reading, " or ".join(P.NU_READINGS))
-    x = np.linspace(n_min, n_max, num)
+def _new_axes(figsize: tuple[float, float]):
+    """A figure with its own Agg canvas, so that no pyplot state is touched."""
+    fig = Figure(figsize=figsize, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig, fig.add_subplot()
+
+
+def _fig1_curves(
+    x: np.ndarray, n_max: float, n_min: float, nu_reading: str, lattice_exact: bool
+) -> list[tuple[str, str, np.ndarray]]:
+    """Every method's line as (style key, legend label, n2D): the limits follow from all of them."""
     other = "solid_fraction" if nu_reading == "printed" else "printed"
-    curves = [
+    return [
         ("densest_state", "Densest State (Eq. 1)", P.densest_state(x)),
         (
             "densest_state_modified",
@@ -85,12 +82,9 @@ def fig1_relations(
         ("parabolic", "Parabola (Eq. 12)", P.parabolic(x)),
     ]
 
-    fig = Figure(figsize=(10.5, 6.0), layout="constrained")
-    FigureCanvasAgg(fig)
-    ax = fig.add_subplot()
-    lo_y = min(0.0, min(float(np.nanmin(y)) for _, _, y in curves))
-    hi_y = max(float(np.nanmax(y)) for _, _, y in curves)
-    pad = 0.04 * (hi_y - lo_y)
+
+def _fig1_negative_band(ax, lo_y: float, pad: float) -> None:
+    """Shade n2D < 0: several methods go negative there, and the reader must see that it is impossible."""
     ax.axhspan(lo_y - pad, 0.0, color="tab:red", alpha=0.07, lw=0)
     ax.axhline(0.0, color="0.2", lw=1.0)
     ax.text(
@@ -103,19 +97,47 @@ def fig1_relations(
         ha="right",
         va="bottom",
     )
+
+
+def _fig1_mark(ax, mark_n_lab: float, y_text: float) -> None:
+    """A vertical line at the user's n_lab, to read every method's n2D off the same abscissa."""
+    check_range("mark_n_lab", mark_n_lab, 0.0, 1.0, hi_open=True)
+    ax.axvline(mark_n_lab, color="0.4", ls=":", lw=1.2)
+    ax.text(
+        mark_n_lab,
+        y_text,
+        f" n_lab = {mark_n_lab:g}",
+        color="0.3",
+        fontsize=9,
+        va="top",
+    )
+
+
+def fig1_relations(
+    n_max: float = P.PAPER_N_MAX,
+    n_min: float = P.PAPER_N_MIN,
+    *,
+    nu_reading: str = "printed",
+    lattice_exact: bool = False,
+    mark_n_lab: float | None = None,
+    num: int = 201,
+) -> Figure:
+    """Fig. 1: 2D porosity of every method against n_lab over [n_min, n_max]."""
+    _check_extremes(n_max, n_min)
+    if nu_reading not in P.NU_READINGS:
+        raise InputError("nu_reading", nu_reading, " or ".join(P.NU_READINGS))
+    x = np.linspace(n_min, n_max, num)
+    curves = _fig1_curves(x, n_max, n_min, nu_reading, lattice_exact)
+
+    fig, ax = _new_axes((10.5, 6.0))
+    lo_y = min(0.0, min(float(np.nanmin(y)) for _, _, y in curves))
+    hi_y = max(float(np.nanmax(y)) for _, _, y in curves)
+    pad = 0.04 * (hi_y - lo_y)
+    _fig1_negative_band(ax, lo_y, pad)
     for key, label, y in curves:
         ax.plot(x, y, label=label, **{"lw": 1.8, **_STYLE[key]})
     if mark_n_lab is not None:
-        check_range("mark_n_lab", mark_n_lab, 0.0, 1.0, hi_open=True)
-        ax.axvline(mark_n_lab, color="0.4", ls=":", lw=1.2)
-        ax.text(
-            mark_n_lab,
-            hi_y + pad * 0.5,
-            f" n_lab = {mark_n_lab:g}",
-            color="0.3",
-            fontsize=9,
-            va="top",
-        )
+        _fig1_mark(ax, mark_n_lab, hi_y + pad * 0.5)
     ax.set_xlim(n_min, n_max)
     ax.set_ylim(lo_y - pad, hi_y + pad)
     ax.set_xlabel("laboratory porosity n_lab [-]")
@@ -128,22 +150,13 @@ def fig1_relations(
     return fig
 
 
-def fig2_lim_parabola(
-    n_max: float = P.PAPER_N_MAX,
-    n_min: float = P.PAPER_N_MIN,
-    *,
-    lattice_exact: bool = False,
-    mark_n_lab: float | None = None,
-    x_max: float = 0.5,
-    num: int = 201,
-) -> Figure:
-    """Fig. 2: LIM_2D-Lab, LIM_2D-3D and the parabola of Eq. 12, with its three points."""
-    _check_extremes(n_max, n_min)
-    x = np.linspace(0.0, x_max, num)
-    fig = Figure(figsize=(9.5, 6.0), layout="constrained")
-    FigureCanvasAgg(fig)
-    ax = fig.add_subplot()
+def _fig2_lines(
+    ax, x: np.ndarray, n_max: float, n_min: float, lattice_exact: bool
+) -> tuple[np.ndarray, np.ndarray]:
+    """The two LIM lines solid only where they are defined (dashed beyond), and the parabola.
 
+    Returns both LIM lines: the y limits are taken from them.
+    """
     lab = P.lim_lab(x, n_max, n_min, lattice_exact=lattice_exact)
     inside = (x >= n_min) & (x <= n_max)
     st = _STYLE["lim_lab"]
@@ -160,7 +173,11 @@ def fig2_lim_parabola(
     ax.plot(x, l3, color="tab:brown", ls="--", lw=1.2, alpha=0.8)
     ax.plot(x[seg], l3[seg], color="tab:brown", lw=2.5, label="LIM 2D-3D, solid from FCC to SC")
     ax.plot(x, P.parabolic(x), color="black", lw=2.2, label="Parabola 0.42 n^2 + 0.25 n (Eq. 12)")
+    return lab, l3
 
+
+def _fig2_construction_points(ax) -> None:
+    """The three points Eq. 12 was built on, each with the parabola's miss, so the fit can be checked."""
     pts = [
         (0.0, 0.0, "origin"),
         (P.FCC_3D, P.HEXAGONAL_2D, "FCC / hexagonal"),
@@ -190,32 +207,54 @@ def fig2_lim_parabola(
             fontsize=8.5,
             color="tab:red",
         )
+
+
+def _fig2_mark(ax, mark_n_lab: float, n_max: float, n_min: float, lattice_exact: bool, x_max: float) -> None:
+    """The three lines' values at the user's n_lab, printed too: the gap between them is the point."""
+    check_range("mark_n_lab", mark_n_lab, 0.0, x_max)
+    marks = [
+        ("LIM 2D-3D", float(P.lim_3d(mark_n_lab)), "tab:brown"),
+        ("parabola", float(P.parabolic(mark_n_lab)), "black"),
+        (
+            "LIM 2D-Lab",
+            float(P.lim_lab(mark_n_lab, n_max, n_min, lattice_exact=lattice_exact)),
+            "tab:green",
+        ),
+    ]
+    for _, y, c in marks:
+        ax.plot([mark_n_lab], [y], "s", color=c, ms=6, zorder=6)
+    lines = [f"at n_lab = {mark_n_lab:g}:"] + [f"{name}: {y:.3f}" for name, y, _ in marks]
+    ax.text(
+        0.98,
+        0.04,
+        "\n".join(lines),
+        transform=ax.transAxes,
+        ha="right",
+        va="bottom",
+        fontsize=9,
+        bbox=dict(boxstyle="round", fc="white", ec="0.6"),
+    )
+    ax.axvline(mark_n_lab, color="0.4", ls=":", lw=1.2)
+    ax.text(mark_n_lab, 0.005, f" n_lab = {mark_n_lab:g}", color="0.3", fontsize=9)
+
+
+def fig2_lim_parabola(
+    n_max: float = P.PAPER_N_MAX,
+    n_min: float = P.PAPER_N_MIN,
+    *,
+    lattice_exact: bool = False,
+    mark_n_lab: float | None = None,
+    x_max: float = 0.5,
+    num: int = 201,
+) -> Figure:
+    """Fig. 2: LIM_2D-Lab, LIM_2D-3D and the parabola of Eq. 12, with its three points."""
+    _check_extremes(n_max, n_min)
+    x = np.linspace(0.0, x_max, num)
+    fig, ax = _new_axes((9.5, 6.0))
+    lab, l3 = _fig2_lines(ax, x, n_max, n_min, lattice_exact)
+    _fig2_construction_points(ax)
     if mark_n_lab is not None:
-        check_range("mark_n_lab", mark_n_lab, 0.0, x_max)
-        marks = [
-            ("LIM 2D-3D", float(P.lim_3d(mark_n_lab)), "tab:brown"),
-            ("parabola", float(P.parabolic(mark_n_lab)), "black"),
-            (
-                "LIM 2D-Lab",
-                float(P.lim_lab(mark_n_lab, n_max, n_min, lattice_exact=lattice_exact)),
-                "tab:green",
-            ),
-        ]
-        for _, y, c in marks:
-            ax.plot([mark_n_lab], [y], "s", color=c, ms=6, zorder=6)
-        lines = [f"at n_lab = {mark_n_lab:g}:"] + [f"{name}: {y:.3f}" for name, y, _ in marks]
-        ax.text(
-            0.98,
-            0.04,
-            "\n".join(lines),
-            transform=ax.transAxes,
-            ha="right",
-            va="bottom",
-            fontsize=9,
-            bbox=dict(boxstyle="round", fc="white", ec="0.6"),
-        )
-        ax.axvline(mark_n_lab, color="0.4", ls=":", lw=1.2)
-        ax.text(mark_n_lab, 0.005, f" n_lab = {mark_n_lab:g}", color="0.3", fontsize=9)
+        _fig2_mark(ax, mark_n_lab, n_max, n_min, lattice_exact, x_max)
     ax.axhline(0.0, color="0.2", lw=1.0)
     ax.set_xlim(0.0, x_max)
     y_all = np.concatenate([lab, l3, P.parabolic(x)])

@@ -380,6 +380,7 @@ def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.nda
     plc = place_disks(radii[idx], Band(0.0, W, y_bot, y_top), seed=int(rng.integers(2**31)))
     # number the disks along horizontal strips of about two diameters: neighbours in
     # space are then near in memory, which keeps the contact loops in cache
+    # kept though reorder() renumbers after _grow: growth sums forces in this order; another changes results
     strip = 4.0 * float(plc.radii.max())
     order = np.lexsort((plc.positions[:, 0], np.floor(plc.positions[:, 1] / strip)))
     idx = idx[order]

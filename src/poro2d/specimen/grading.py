@@ -454,6 +454,52 @@ def _make_rng(seed: int | np.random.Generator) -> np.random.Generator:
     return np.random.default_rng(int(seed))
 
 
+def _fill_class(
+    rng: np.random.Generator,
+    a: float,
+    b: float,
+    mean_area: float,
+    target_cum: float,
+    area_cum: float,
+    within_class: str,
+) -> tuple[list[np.ndarray], float]:
+    """Diameters of one class [a, b] until the running area passes ``target_cum``.
+
+    Drawn in batches 10 % above the expected need (plus 8 disks), so one batch nearly always
+    does instead of a draw per disk; the batch sizes decide which random numbers each disk
+    gets, so changing them changes the radii of a seed. The last disk is kept only if it
+    brings the running area closer to the target (the cumulative curve is then tracked to
+    half a disk). Returns the batches and the new running area.
+    """
+    chunks: list[np.ndarray] = []
+    while True:
+        need = target_cum - area_cum
+        n = max(8, int(1.1 * max(need, 0.0) / mean_area) + 8)
+        dd = _sample_d(rng, a, b, n, within_class)
+        cum = area_cum + np.cumsum(0.25 * np.pi * dd * dd)
+        over = np.nonzero(cum > target_cum)[0]
+        if over.size == 0:
+            chunks.append(dd)
+            area_cum = float(cum[-1])
+            continue
+        k = int(over[0])
+        before = area_cum if k == 0 else float(cum[k - 1])
+        keep = k + 1 if cum[k] - target_cum < target_cum - before else k
+        chunks.append(dd[:keep])
+        area_cum = float(cum[keep - 1]) if keep > 0 else area_cum
+        return chunks, area_cum
+
+
+def _to_exact_area(radii: np.ndarray, area: float) -> np.ndarray:
+    """One common factor on all radii, so the total area and with it the porosity are exact to rounding."""
+    for _ in range(3):  # one pass is normally enough; repeat to be safe against rounding
+        total = float(np.sum(np.pi * radii * radii))
+        if abs(total - area) <= 1e-14 * area:
+            break
+        radii = radii * math.sqrt(area / total)
+    return radii
+
+
 def draw_disks(
     curve: GradingCurve,
     solid_area: float,
@@ -505,22 +551,8 @@ def draw_disks(
             continue
         target_cum += fractions[i] * area
         a, b = float(lo_all[i]), float(hi_all[i])
-        while True:
-            need = target_cum - area_cum
-            n = max(8, int(1.1 * max(need, 0.0) / mean_areas[i]) + 8)
-            dd = _sample_d(rng, a, b, n, within_class)
-            cum = area_cum + np.cumsum(0.25 * np.pi * dd * dd)
-            over = np.nonzero(cum > target_cum)[0]
-            if over.size == 0:
-                chunks.append(dd)
-                area_cum = float(cum[-1])
-                continue
-            k = int(over[0])
-            before = area_cum if k == 0 else float(cum[k - 1])
-            keep = k + 1 if cum[k] - target_cum < target_cum - before else k
-            chunks.append(dd[:keep])
-            area_cum = float(cum[keep - 1]) if keep > 0 else area_cum
-            break
+        drawn, area_cum = _fill_class(rng, a, b, mean_areas[i], target_cum, area_cum, within_class)
+        chunks.extend(drawn)
 
     diam = np.concatenate(chunks) if chunks else np.empty(0)
     if diam.size == 0:
@@ -529,13 +561,7 @@ def draw_disks(
             solid_area,
             f"at least about one disk area of the finest class ({mean_areas[0]:.3g} m^2)",
         )
-    radii = 0.5 * diam
-    for _ in range(3):  # one pass is normally enough; repeat to be safe against rounding
-        total = float(np.sum(np.pi * radii * radii))
-        if abs(total - area) <= 1e-14 * area:
-            break
-        radii = radii * math.sqrt(area / total)
-    return radii
+    return _to_exact_area(0.5 * diam, area)
 
 
 # ---------------------------------------------------------------------- checking a draw

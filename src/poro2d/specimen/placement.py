@@ -177,6 +177,57 @@ def _restart_rng(seed: int, restart: int) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence([seed, restart]))
 
 
+def _check_options(
+    seed: Any, target_fraction: Any, shrink: Any, max_attempts: Any, max_restarts: Any
+) -> tuple[float, float]:
+    """Refuse bad options before any disk is placed; returns (target_fraction, shrink) as floats."""
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise InputError("seed", seed, "an integer >= 0")
+    target = check_range("target_fraction", target_fraction, 0.0, 0.8, lo_open=True)
+    shrink_f = check_range("shrink", shrink, 0.0, 1.0, lo_open=True, hi_open=True)
+    if isinstance(max_attempts, bool) or not isinstance(max_attempts, int | np.integer):
+        raise InputError("max_attempts", max_attempts, "an integer >= 1")
+    if max_attempts < 1:
+        raise InputError("max_attempts", max_attempts, "an integer >= 1")
+    if isinstance(max_restarts, bool) or not isinstance(max_restarts, int | np.integer):
+        raise InputError("max_restarts", max_restarts, "an integer >= 0")
+    if max_restarts < 0:
+        raise InputError("max_restarts", max_restarts, "an integer >= 0")
+    return target, shrink_f
+
+
+def _fitting_fraction(r: np.ndarray, b: Band) -> float:
+    """Solid fraction of the disks in the band, refusing a band that no placement could fill."""
+    d_max = 2.0 * float(r.max())
+    if d_max > b.height or d_max > b.width:
+        raise InputError(
+            "radii",
+            f"largest diameter {d_max:.6g} m",
+            f"diameters <= band height {b.height:.6g} m and width {b.width:.6g} m",
+        )
+    phi = float(np.sum(np.pi * r * r)) / b.area
+    if phi >= 1.0:
+        raise InputError("radii", f"solid fraction {phi:.4f}", "total disk area below the band area")
+    return phi
+
+
+def _no_placement(full_size: bool, phi: float, max_restarts: int, last_scale: float) -> InputError:
+    """The error when every try failed: it says which option to change."""
+    if full_size:
+        return InputError(
+            "full_size",
+            True,
+            "only for bands loose enough for random placement at full size",
+            hint=f"solid fraction {phi:.3f} here; use full_size=False to place at reduced radius",
+        )
+    return InputError(
+        "max_restarts",
+        max_restarts,
+        "enough restarts to find a reduction factor",
+        hint=f"stopped at scale {last_scale:.3g}; lower target_fraction or raise max_attempts",
+    )
+
+
 def place_disks(
     radii: Any,
     band: Band | tuple[float, float, float, float],
@@ -197,29 +248,8 @@ def place_disks(
     """
     r = _as_radii(radii)
     b = _as_band(band)
-    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
-        raise InputError("seed", seed, "an integer >= 0")
-    target = check_range("target_fraction", target_fraction, 0.0, 0.8, lo_open=True)
-    shrink_f = check_range("shrink", shrink, 0.0, 1.0, lo_open=True, hi_open=True)
-    if isinstance(max_attempts, bool) or not isinstance(max_attempts, int | np.integer):
-        raise InputError("max_attempts", max_attempts, "an integer >= 1")
-    if max_attempts < 1:
-        raise InputError("max_attempts", max_attempts, "an integer >= 1")
-    if isinstance(max_restarts, bool) or not isinstance(max_restarts, int | np.integer):
-        raise InputError("max_restarts", max_restarts, "an integer >= 0")
-    if max_restarts < 0:
-        raise InputError("max_restarts", max_restarts, "an integer >= 0")
-
-    d_max = 2.0 * float(r.max())
-    if d_max > b.height or d_max > b.width:
-        raise InputError(
-            "radii",
-            f"largest diameter {d_max:.6g} m",
-            f"diameters <= band height {b.height:.6g} m and width {b.width:.6g} m",
-        )
-    phi = float(np.sum(np.pi * r * r)) / b.area
-    if phi >= 1.0:
-        raise InputError("radii", f"solid fraction {phi:.4f}", "total disk area below the band area")
+    target, shrink_f = _check_options(seed, target_fraction, shrink, max_attempts, max_restarts)
+    phi = _fitting_fraction(r, b)
 
     order = np.argsort(-r, kind="stable")
     r_sorted = np.ascontiguousarray(r[order])
@@ -247,16 +277,4 @@ def place_disks(
             return Placement(positions=positions, radii=r * scale, scale=scale, restarts=k)
         if not full_size:
             scale *= shrink_f
-    if full_size:
-        raise InputError(
-            "full_size",
-            True,
-            "only for bands loose enough for random placement at full size",
-            hint=f"solid fraction {phi:.3f} here; use full_size=False to place at reduced radius",
-        )
-    raise InputError(
-        "max_restarts",
-        max_restarts,
-        "enough restarts to find a reduction factor",
-        hint=f"stopped at scale {scale / shrink_f:.3g}; lower target_fraction or raise max_attempts",
-    )
+    raise _no_placement(full_size, phi, max_restarts, scale / shrink_f)
