@@ -37,26 +37,15 @@ def register(app: typer.Typer) -> None:
         grading (preparation friction -> accepted n2D, cached), sets the preparation friction
         from the laboratory relative density and runs the criterion over seeds.
         """
-        from poro2d.criterion.config import build, load_config
-        from poro2d.criterion.protocol import PorosityCriterion
-        from poro2d.errors import InputError
-        from poro2d.io_utils import check_output_dir
-        from poro2d.specimen.compaction import check_feasible
+        from poro2d.criterion.run import run_criterion
 
-        check_output_dir("--out", out)
-        cfg, base = load_config(config, preset)
-        if seed is not None:
-            if seed < 0:
-                raise InputError("--seed", seed, "an integer >= 0")
-            cfg["seed"] = seed
-        dens = density_settings(cfg, mode, n_max, n_min, seeds, preset=config is None)
-        spec, grading, settings, sd = build(cfg, base, n_lab=n_lab, trial_porosity=trial, threads=threads)
-        check_feasible(spec, grading, settings.initial_trial())
-        if dens["mode"] == "density":
-            _density_mode(cfg, base, settings.n_lab, dens, out, quiet)
+        result = run_criterion(
+            config, preset=preset, out=out, seed=seed, n_lab=n_lab, trial_porosity=trial, threads=threads,
+            mode=mode, n_max=n_max, n_min=n_min, seeds=seeds, progress=not quiet,
+        )  # fmt: skip
+        if result.get("mode") == "density":
+            _print_density(result, out)
             return
-        crit = PorosityCriterion(spec, grading, settings, seed=sd, out=out, progress=not quiet, config=cfg)
-        result = crit.run()
         print_result(result, out)
         if not result["converged"]:
             # one line, whole: the reason names the trial, the stage or check, the ratio
@@ -65,42 +54,8 @@ def register(app: typer.Typer) -> None:
             raise typer.Exit(1)
 
 
-DENSITY_KEYS = {"mode", "n_max", "n_min", "mu_prep", "seeds"}
-
-
-def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> dict:
-    """Mode and density-mode settings from ``[density]`` and the options (options win)."""
-    from poro2d import porosity as P
-    from poro2d.config import check_keys
-    from poro2d.errors import InputError, check_int, check_range
-
-    t = dict(cfg.get("density") or {})
-    check_keys("density", t, DENSITY_KEYS)
-    mode = mode if mode is not None else t.get("mode", "paper")
-    if mode not in ("paper", "density"):
-        raise InputError("mode", mode, "paper or density")
-    out = {"mode": mode, "mu_prep": t.get("mu_prep")}
-    if mode == "paper":
-        return out
-    hi = n_max if n_max is not None else t.get("n_max", P.PAPER_N_MAX if preset else None)
-    lo = n_min if n_min is not None else t.get("n_min", P.PAPER_N_MIN if preset else None)
-    if hi is None or lo is None:
-        raise InputError("density.n_max/n_min", (hi, lo), "both laboratory extremes",
-                         "set them in [density] or with --n-max/--n-min")  # fmt: skip
-    out["n_max"] = check_range("n_max", hi, 0.0, 1.0, lo_open=True, hi_open=True)
-    out["n_min"] = check_range("n_min", lo, 0.0, 1.0, lo_open=True, hi_open=True)
-    out["seeds"] = check_int("seeds", seeds if seeds is not None else t.get("seeds", 3), 1, 50)
-    return out
-
-
-def _density_mode(cfg: dict, base_dir, n_lab: float, dens: dict, out: Path, quiet: bool) -> None:
-    """The density-controlled criterion (it runs its specimens on the sweep runner)."""
-    from poro2d.sweep.density import run_density_state
-
-    res = run_density_state(
-        {k: v for k, v in cfg.items() if k != "density"}, base_dir, n_lab, dens["n_max"], dens["n_min"],
-        out, seeds=dens["seeds"], mus=dens["mu_prep"], progress=not quiet,
-    )  # fmt: skip
+def _print_density(res: dict, out: Path) -> None:
+    """The density-controlled criterion's answer: its state, friction and accepted n2D over seeds."""
     t = Table(title=f"criterion, density mode: nLab = {res['n_lab']} (Dr = {res['relative_density']:.3f})")
     for col in ("2D target", "mu_prep", "accepted n2D (mean +- sd)", "per seed", "converged", "n2D,min",
                 "n2D,max"):  # fmt: skip

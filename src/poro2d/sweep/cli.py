@@ -75,47 +75,17 @@ def relation_cmd(
     accepted n2D, the grading's densest and loosest 2D states), every laboratory state is
     mapped between them by its relative density, and checked by the criterion over seeds.
     """
-    from poro2d.criterion.config import load_config
-    from poro2d.io_utils import check_output_dir
-    from poro2d.sweep import relation as R
-    from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.runner import run_sweep
+    from poro2d.sweep.relation import run_relation
 
     _check_workers(workers)
-    check_output_dir("--out", out)
-    base, base_dir = load_config(config, preset, extra_tables=("relation",))
-    settings = R.relation_settings(
-        base.get("relation"), points=points, n_max=n_max, n_min=n_min, preset=config is None
-    )
-    table = base.get("relation") or {}
-    mode = R.check_mode(mode if mode is not None else table.get("mode", "density"))
-    n_seeds = R.check_seeds(seeds if seeds is not None else table.get("seeds", 3))
-    console.print(
-        f"criterion ({mode} mode) at nLab = {', '.join(f'{v:g}' for v in settings['n_lab'])} "
-        f"(n_max {settings['n_max']:g}, n_min {settings['n_min']:g})"
-        f"{' (quick)' if quick else ''} -> {out}"
-    )
-    sweep_kw = {"scheduler": scheduler, "workers": workers, "progress": not quiet}
-    title = "2D porosity from the criterion vs laboratory porosity"
-    if quick:
-        title += " (quick: 0.08 m x 0.04 m box)"
-    if mode == "density":
-        rel, record = R.density_relation(
-            base, base_dir, settings, out,
-            quick=quick, seeds=n_seeds, mus=table.get("mu_prep"), **sweep_kw,
-        )  # fmt: skip
-        failed = record["failed_cases"]
-        extra = {"quick": quick, "config": base, "sweeps": record}
-    else:
-        sweep = parse_sweep(R.sweep_config(base, settings["n_lab"], quick=quick), base_dir)
-        res = run_sweep(sweep, out, **sweep_kw)
-        rel = R.analyse(res.rows, settings["n_max"], settings["n_min"])
-        failed = len(res.failed)
-        extra = {"quick": quick, "sweep_summary": res.summary, "config": base}
-    R.write_relation(rel, out, title=title, extra=extra)
+    console.print(f"criterion relation{' (quick)' if quick else ''} -> {out}")
+    rel = run_relation(
+        config, preset=preset, out=out, points=points, n_max=n_max, n_min=n_min, mode=mode, seeds=seeds,
+        quick=quick, scheduler=scheduler, workers=workers, progress=not quiet,
+    )  # fmt: skip
     print_relation(rel, out)
-    if failed:
-        console.print(f"[bold red]{failed} case(s) failed[/]; tracebacks in {out}/**/error.txt")
+    if rel["failed_cases"]:
+        console.print(f"[bold red]{rel['failed_cases']} case(s) failed[/]; tracebacks in {out}/**/error.txt")
         raise typer.Exit(1)
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import copy
 import math
+import os
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -412,3 +413,59 @@ def density_relation(
     record = {"calibration": cal_info, "states_summary": summary,
               "failed_cases": len(failed) + cal_info["failed"]}  # fmt: skip
     return rel, record
+
+
+def run_relation(
+    config=None,
+    *,
+    preset: str | None = None,
+    out: str | os.PathLike = "relation-out",
+    points: int | None = None,
+    n_max: float | None = None,
+    n_min: float | None = None,
+    mode: str | None = None,
+    seeds: int | None = None,
+    quick: bool = False,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: bool = True,
+) -> dict:
+    """``poro2d relation`` as one call: the grading's n2D(nLab) relation, written to ``out``.
+
+    ``config``: a criterion config (a dict, a TOML file, or the paper preset when None) with
+    an optional ``[relation]`` table, which the keyword options override. Density mode (the
+    default) calibrates the grading, maps every laboratory state by its relative density and
+    checks it over ``seeds``; paper mode runs the criterion once per state at the fixed
+    preparation friction. Returns the relation as written to ``out/relation.json``, with
+    ``failed_cases`` (cases that raised; their tracebacks are in ``out``).
+    """
+    from poro2d.criterion.run import load
+    from poro2d.io_utils import check_output_dir
+    from poro2d.sweep.cases import parse_sweep
+    from poro2d.sweep.runner import run_sweep
+
+    out = Path(out)
+    check_output_dir("--out", out)
+    base, base_dir = load(config, preset, extra_tables=("relation",))
+    table = base.get("relation") or {}
+    settings = relation_settings(
+        table or None, points=points, n_max=n_max, n_min=n_min, preset=config is None
+    )
+    mode = check_mode(mode if mode is not None else table.get("mode", "density"))
+    n_seeds = check_seeds(seeds if seeds is not None else table.get("seeds", 3))
+    sweep_kw = {"scheduler": scheduler, "workers": workers, "progress": progress}
+    title = "2D porosity from the criterion vs laboratory porosity" + (
+        " (quick: 0.08 m x 0.04 m box)" if quick else ""
+    )
+    if mode == "density":
+        rel, record = density_relation(base, base_dir, settings, out, quick=quick, seeds=n_seeds,
+                                       mus=table.get("mu_prep"), **sweep_kw)  # fmt: skip
+        failed, extra = record["failed_cases"], {"quick": quick, "config": base, "sweeps": record}
+    else:
+        res = run_sweep(
+            parse_sweep(sweep_config(base, settings["n_lab"], quick=quick), base_dir), out, **sweep_kw
+        )
+        rel = analyse(res.rows, settings["n_max"], settings["n_min"])
+        failed, extra = len(res.failed), {"quick": quick, "sweep_summary": res.summary, "config": base}
+    write_relation(rel, out, title=title, extra=extra)
+    return dict(rel, failed_cases=failed)

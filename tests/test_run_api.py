@@ -1,0 +1,54 @@
+"""``run_criterion`` and ``run_relation``: the commands as calls, with the commands' checks."""
+
+import pytest
+
+from poro2d.criterion import run_criterion
+from poro2d.errors import InputError
+from poro2d.sweep.relation import run_relation
+
+SMALL = {
+    "seed": 0,
+    "specimen": {"width": 0.05, "height": 0.025, "layers": 2},
+    "criterion": {"force_fraction": 0.05},
+}
+
+
+@pytest.mark.parametrize(
+    ("kw", "name"),
+    [({"seed": -1}, "--seed"), ({"mode": "fast"}, "mode"), ({"n_lab": 1.5}, "n_lab"),
+     ({"preset": "paper"}, "config/preset"), ({"mode": "density"}, "density.n_max/n_min")],
+)  # fmt: skip
+def test_run_criterion_refuses_bad_input_before_writing(tmp_path, kw, name):
+    out = tmp_path / "o"
+    with pytest.raises(InputError) as e:
+        run_criterion(SMALL, out=out, progress=False, **kw)
+    assert e.value.parameter == name
+    assert not out.exists()
+
+
+def test_run_criterion_matches_the_command(tmp_path):
+    """The call and ``poro2d criterion`` write the same result for the same config."""
+    import json
+
+    from poro2d.cli import main
+
+    res = run_criterion(SMALL, out=tmp_path / "api", progress=False)
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(
+        "seed = 0\n[specimen]\nwidth = 0.05\nheight = 0.025\nlayers = 2\n[criterion]\nforce_fraction = 0.05\n"
+    )
+    main(["criterion", "--config", str(cfg), "--out", str(tmp_path / "cli"), "--quiet"])
+    cli = json.loads((tmp_path / "cli" / "result.json").read_text())
+    assert res.final_porosity == cli["final_porosity"] and res.converged
+    assert [r["new_porosity"] for r in res.iterations] == [r["new_porosity"] for r in cli["iterations"]]
+
+
+@pytest.mark.parametrize(
+    ("kw", "name"), [({"points": 1}, "points"), ({"mode": "fast"}, "mode"), ({"seeds": 0}, "seeds")]
+)
+def test_run_relation_refuses_bad_input_before_writing(tmp_path, kw, name):
+    out = tmp_path / "o"
+    with pytest.raises(InputError) as e:
+        run_relation(None, out=out, quick=True, progress=False, **kw)
+    assert name in e.value.parameter
+    assert not out.exists()
