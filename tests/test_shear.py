@@ -183,6 +183,7 @@ def _cfg(tmp_path):
         (["--normal-stress", "50,abc"], "--normal-stress"),
         (["--max-displacement", "0.031"], "max_displacement"),
         (["--velocity", "-1"], "velocity"),
+        (["--stop-after-peak", "1e-4"], "stop_after_peak"),
     ],
 )
 def test_cli_bad_input(specimen, tmp_path, capsys, extra, needle):
@@ -354,3 +355,15 @@ def test_stop_after_peak_ends_the_test_with_the_same_peak(specimen):
 def test_stop_after_peak_shorter_than_the_smoothing_is_refused(value):
     with pytest.raises(InputError, match="stop_after_peak"):
         ShearSettings(stop_after_peak=value)
+
+
+def test_cli_stop_after_peak_option(specimen, tmp_path):
+    """--stop-after-peak reaches the test: it ends past the peak and says so."""
+    dest = tmp_path / "out"
+    opts = ["--max-displacement", "0.004", "--stop-after-peak", "5e-4", "--config", str(_cfg(tmp_path))]
+    main(
+        ["shear", "--specimen", str(specimen), "--normal-stress", "100", *opts, "--out", str(dest), "--quiet"]
+    )
+    r = json.loads((dest / "sn100kPa" / "result.json").read_text())
+    assert r["ended_by"].startswith("peak passed") and r["settings"]["stop_after_peak"] == 5e-4
+    assert r["end_shear_displacement_m"] < 0.004

@@ -84,6 +84,9 @@ def register(app: typer.Typer) -> None:
         out: Path = typer.Option(Path("shear-out"), "--out", "-o", help="Output folder (resumable)."),
         velocity: float = typer.Option(None, "--velocity", help="Shear velocity of the lower half (m/s)."),
         max_displacement: float = typer.Option(None, "--max-displacement", help="Shear displacement (m)."),
+        stop_after_peak: float = typer.Option(
+            None, "--stop-after-peak", help="End once the smoothed peak lies this far behind (m; 0: never)."
+        ),
         rate_check: bool = typer.Option(
             False, "--rate-check", help="Repeat every test at half the velocity."
         ),
@@ -101,13 +104,17 @@ def register(app: typer.Typer) -> None:
         table, base = load_shear_config(config)
         extra = {k: table.pop(k) for k in list(table) if k in SHEAR_KEYS_EXTRA}
         check_extra_types(extra)
-        options = {"velocity": velocity, "max_displacement": max_displacement}
+        options = {
+            "velocity": velocity,
+            "max_displacement": max_displacement,
+            "stop_after_peak": stop_after_peak,
+        }
         recorded = {"shear": table, **extra, "cli": options}
         try:
             result = run_shear(
                 resolve_path("--specimen", specimen, extra.get("specimen"), base, required=True),
                 resolve_stresses(normal_stress, extra),
-                settings_from_options(table, velocity, max_displacement),
+                settings_from_options(table, velocity, max_displacement, stop_after_peak),
                 out=out,
                 lab=resolve_path("--lab", lab, extra.get("lab"), base),
                 rate_check=rate_check or bool(extra.get("rate_check", False)),
@@ -144,14 +151,18 @@ def resolve_stresses(option_text: str | None, extra: dict) -> list[float]:
     return [50.0, 100.0, 200.0]
 
 
-def settings_from_options(table: dict, velocity: float | None, max_displacement: float | None):
-    """ShearSettings from the config's [shear] table, --velocity and --max-displacement winning."""
+def settings_from_options(
+    table: dict, velocity: float | None, max_displacement: float | None, stop_after_peak: float | None = None
+):
+    """ShearSettings from the config's [shear] table, --velocity, --max-displacement and
+    --stop-after-peak winning."""
     from poro2d.config import dataclass_from_table
     from poro2d.shear.settings import ShearSettings
 
     return dataclass_from_table(
-        ShearSettings, "shear", table, velocity=velocity, max_displacement=max_displacement
-    )
+        ShearSettings, "shear", table, velocity=velocity, max_displacement=max_displacement,
+        stop_after_peak=stop_after_peak,
+    )  # fmt: skip
 
 
 def _sci(v) -> str:
