@@ -91,7 +91,9 @@ def _inputs_blocks(summary: dict, crit: dict) -> list[Block]:
         *quick,
         "Direct shear: the shear velocity is far above the laboratory rate of 0.384 mm/min "
         "(quasi-static checks below); no laboratory curves are built in (Fig. 8's data are not "
-        "published as numbers): pass them with --lab.",
+        "published as numbers): pass them with --lab. A test ends once its smoothed peak lies "
+        "stop_after_peak (5 mm by default) behind, or at max_displacement (20 mm); each test's "
+        "result.json says which (ended_by).",
     ])]  # fmt: skip
 
 
