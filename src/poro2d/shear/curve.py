@@ -82,9 +82,14 @@ def force_balance(x: np.ndarray, col: dict[str, np.ndarray], window: float) -> d
     }  # fmt: skip
 
 
+def peak_passed(x: np.ndarray, x_peak: float, s: ShearSettings) -> bool:
+    """The stop rule: the smoothed peak at ``x_peak`` lies ``stop_after_peak`` behind the last record."""
+    return s.stop_after_peak > 0.0 and bool(x[-1] >= x_peak + s.stop_after_peak)
+
+
 def ended_by(x: np.ndarray, x_peak: float, s: ShearSettings) -> str:
     """Why the test stopped where its curve ends: the peak passed or the full displacement."""
-    if s.stop_after_peak > 0.0 and x[-1] >= x_peak + s.stop_after_peak:
+    if peak_passed(x, x_peak, s):
         return f"peak passed by {1e3 * s.stop_after_peak:g} mm (stop_after_peak)"
     return "max_displacement"
 
@@ -120,4 +125,4 @@ def curve_summary(rows: list[dict], sigma_kpa: float, settings: ShearSettings) -
     }
 
 
-__all__ = ["CURVE_COLUMNS", "curve_row", "curve_summary", "force_balance"]
+__all__ = ["CURVE_COLUMNS", "curve_row", "curve_summary", "ended_by", "force_balance", "peak_passed"]

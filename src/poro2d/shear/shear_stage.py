@@ -17,7 +17,7 @@ import numpy as np
 
 from poro2d.dem import Simulation, checkpoint
 from poro2d.shear.box import LOWER
-from poro2d.shear.curve import curve_row
+from poro2d.shear.curve import curve_row, peak_passed
 from poro2d.shear.fit import peak
 from poro2d.shear.peak_frame import PeakFrame, PeakTracker
 
@@ -88,12 +88,12 @@ class ShearStage:
 
         The rows alone decide it, so a resumed test stops where an uninterrupted one does.
         """
-        after = self.settings.stop_after_peak
-        if after <= 0.0:
+        s = self.settings
+        if s.stop_after_peak <= 0.0:
             return False
         x = np.array([r["shear_displacement_mm"] for r in self.rows]) * 1e-3
         tau = np.array([r["shear_stress_kpa"] for r in self.rows])
-        return bool(x[-1] >= peak(x, tau, self.settings.peak_window)[1] + after)
+        return peak_passed(x, peak(x, tau, s.peak_window)[1], s)
 
     def run(self) -> float:
         """Shear to the end; returns the stage's wall time (s), resumed parts included."""
