@@ -216,8 +216,9 @@ def _check_reason(name: str, row: dict, settings: CriterionSettings) -> str:
     """One line on why check ``name`` failed, with its numbers."""
     if name == "preparation_converged":
         return (
-            f"{row['failed_stage']} did not reach equilibrium: max unbalanced-force ratio "
-            f"{row['failed_max_ratio']:.3g} after {row['failed_steps']} steps (fallback included)"
+            f"{row['failed_stage']} did not reach equilibrium: {row.get('equilibrium', 'max')} "
+            f"unbalanced-force ratio {row.get('failed_ratio', row['failed_max_ratio']):.3g} after {row['failed_steps']} steps "
+            "(fallback included)"
         )
     if name == "all_disks_present":
         return f"{row['particle_count']} disks built of {row['planned_particle_count']} planned"
@@ -398,14 +399,14 @@ class PorosityCriterion:
         sim.set_wall_servo("top", target, (0.0, -1.0), s.settle_max_speed, s.settle_gain)
         steps += sim.run(left(), every=s.check_every, callback=self._settled_check(top, t, weight)).steps
         sim.set_wall_velocity("top", (0.0, 0.0))
-        res = sim.solve(self.spec.ratio, min(left(), 20 * s.check_every))
+        res = sim.solve(self.spec.ratio, min(left(), 20 * s.check_every), measure=self.spec.equilibrium)
         steps += res.steps
         f = sim.wall_force(top)[1] / t
         _log.debug(
             "plate round %d: F_top %.4g N/m (limit %.4g), held: converged %s ratio %.3g, %d steps",
             rounds, f, cap, res.converged, res.max_ratio, steps,
         )  # fmt: skip
-        return steps, in_window(f, weight, s.force_fraction), res.max_ratio
+        return steps, in_window(f, weight, s.force_fraction), sim.ratio_of(self.spec.equilibrium)
 
     def _in_window_check(self, top: int, t: float, weight: float) -> Callable[[Simulation], bool]:
         """The approach's stop test: F_top in the window for ``window_checks`` checks running."""
@@ -434,7 +435,7 @@ class PorosityCriterion:
             if not in_window(f, weight, s.force_fraction):
                 calm.clear()
                 return False
-            if sm.unbalanced_ratios()[0] < self.spec.ratio:
+            if sm.ratio_of(self.spec.equilibrium) < self.spec.ratio:
                 return True
             calm.append(float(sm.walls.p0[top, 1]))
             if len(calm) < s.settle_checks:
@@ -484,6 +485,8 @@ class PorosityCriterion:
             row.update(
                 converged=False, failed_stage=prep["failed_stage"],
                 failed_max_ratio=prep["failed_max_ratio"], failed_steps=prep["failed_steps"],
+                failed_ratio=prep.get("failed_ratio", prep["failed_max_ratio"]),
+                equilibrium=self.spec.equilibrium,
             )  # fmt: skip
             after = forces0
         elif in_window(f_top, weight, s.force_fraction):

@@ -69,11 +69,18 @@ N_PRM = 14
 # integer parameters (iprm): MODE / MODE_PW say whether disk-disk / disk-wall contacts combine
 # the bodies' properties (PER_BODY) or use the constants in prm; CHECK_OFFSET is the number
 # of steps of the driver's run done before this call (the stop test counts from the run's start)
-MODE, NSTEPS, CHECK_EVERY, NEED_BUILD, THREADS, MODE_PW, CHECK_OFFSET = range(7)
-N_IPRM = 7
+# MEASURE: which equilibrium measure the stop test compares with RATIO_TARGET (below)
+MODE, NSTEPS, CHECK_EVERY, NEED_BUILD, THREADS, MODE_PW, CHECK_OFFSET, MEASURE = range(8)
+N_IPRM = 8
 # outputs (out)
 STATUS, STEPS_DONE, MAX_RATIO, MEAN_RATIO, NEED_PP, NEED_PW, REBUILDS, THREADS_USED = range(8)
-N_OUT = 8
+LOADED_RATIO, RATTLERS = 8, 9
+N_OUT = 10
+# equilibrium measures of the stop test: the maximum ratio over every free disk (PFC's maximum
+# ratio, the paper's), the mean ratio (mean unbalanced / mean contact force, PFC's average
+# ratio), the maximum ratio over the load-bearing disks (two contacts or more: rattlers, which
+# never carry a balanced load, left out)
+MEASURE_MAX, MEASURE_MEAN, MEASURE_LOADED = 0, 1, 2
 # status codes
 RUNNING, CONVERGED, OVERFLOW, UNSTABLE = 0, 1, 2, 3
 # per-partition wall sums (walls.part_sums[k, w, :])
@@ -83,46 +90,56 @@ STAT_COUNT, STAT_KSUM = range(2)
 
 
 @njit(cache=True)
-def unbalanced_ratios(force, pmode, nb_start, nb_fn, nb_fs, nb_ov, wb_start, wb_fn, wb_fs, wb_ov):
-    """(max, mean) unbalanced-force ratios.
+def equilibrium_measures(force, pmode, nb_start, nb_j, nb_fn, nb_fs, nb_ov, wb_start, wb_fn, wb_fs, wb_ov):
+    """(max, mean, loaded max, rattlers): the unbalanced-force ratios of a step.
 
-    max: largest unbalanced force on a free disk / largest contact force (PFC's
-    maximum ratio); mean: mean unbalanced force / mean contact force. ``inf`` when
-    nothing touches.
+    max: largest unbalanced force on a free disk / largest contact force (PFC's maximum
+    ratio); mean: mean unbalanced force / mean contact force (PFC's average ratio); loaded
+    max: the maximum ratio over the free disks touching two bodies or more; rattlers: the
+    number of free disks touching fewer than two. Ratios are ``inf`` when nothing touches.
     """
     n = force.shape[0]
+    touches = np.zeros(n, dtype=np.int64)
+    cmax = 0.0
+    csum = 0.0
+    nc = 0
+    for i in range(n):
+        for p in range(nb_start[i], nb_start[i + 1]):
+            if nb_ov[p] > 0.0:
+                touches[i] += 1
+                touches[nb_j[p]] += 1
+                f = math.sqrt(nb_fn[p] ** 2 + nb_fs[p] ** 2)
+                csum += f
+                nc += 1
+                cmax = max(cmax, f)
+    for i in range(n):  # walls after every pair: the sums in the order of the ratios before
+        for p in range(wb_start[i], wb_start[i + 1]):
+            if wb_ov[p] > 0.0:
+                touches[i] += 1
+                f = math.sqrt(wb_fn[p] ** 2 + wb_fs[p] ** 2)
+                csum += f
+                nc += 1
+                cmax = max(cmax, f)
     fmax = 0.0
+    floaded = 0.0
     fsum = 0.0
     nfree = 0
+    rattlers = 0
     for i in range(n):
         if pmode[i] == FREE:
             f = math.sqrt(force[i, 0] ** 2 + force[i, 1] ** 2)
             fsum += f
             nfree += 1
-            if f > fmax:
-                fmax = f
-    cmax = 0.0
-    csum = 0.0
-    nc = 0
-    for p in range(nb_start[n]):
-        if nb_ov[p] > 0.0:
-            f = math.sqrt(nb_fn[p] ** 2 + nb_fs[p] ** 2)
-            csum += f
-            nc += 1
-            if f > cmax:
-                cmax = f
-    for p in range(wb_start[n]):
-        if wb_ov[p] > 0.0:
-            f = math.sqrt(wb_fn[p] ** 2 + wb_fs[p] ** 2)
-            csum += f
-            nc += 1
-            if f > cmax:
-                cmax = f
-    if nc == 0 or cmax <= 0.0 or nfree == 0:
-        if nfree == 0:
-            return 0.0, 0.0
-        return np.inf, np.inf
-    return fmax / cmax, (fsum / nfree) / (csum / nc)
+            fmax = max(fmax, f)
+            if touches[i] >= 2:
+                floaded = max(floaded, f)
+            else:
+                rattlers += 1
+    if nfree == 0:
+        return 0.0, 0.0, 0.0, 0
+    if nc == 0 or cmax <= 0.0:
+        return np.inf, np.inf, np.inf, rattlers
+    return fmax / cmax, (fsum / nfree) / (csum / nc), floaded / cmax, rattlers
 
 
 @njit(inline="always", cache=True)
@@ -496,18 +513,23 @@ def _largest_drift(tmax, nthr, wp0, wall_build):
 
 
 @njit(cache=True)
-def _converged(t, nthr, disks, nb, wb, sync, out, target):
+def _converged(t, nthr, disks, nb, wb, sync, out, target, measure):
     """The stop test: thread 0 computes the ratios once, and every worker reads its verdict.
 
-    It takes whole records (a reference count per array) since it runs on check steps only.
+    ``measure`` (``MEASURE_MAX``, ``MEASURE_MEAN`` or ``MEASURE_LOADED``) is the ratio
+    compared with ``target``. It takes whole records (a reference count per array) since it
+    runs on check steps only.
     """
     if t == 0:
-        rmax, rmean = unbalanced_ratios(
-            disks.force, disks.mode, nb.start, nb.fn, nb.fs, nb.ov, wb.start, wb.fn, wb.fs, wb.ov
+        rmax, rmean, rloaded, rattlers = equilibrium_measures(
+            disks.force, disks.mode, nb.start, nb.j, nb.fn, nb.fs, nb.ov, wb.start, wb.fn, wb.fs, wb.ov
         )
         out[MAX_RATIO] = rmax
         out[MEAN_RATIO] = rmean
-        atomic_store(sync, STATUS_WORD, CONVERGED if rmax < target else RUNNING)
+        out[LOADED_RATIO] = rloaded
+        out[RATTLERS] = rattlers
+        r = rmean if measure == MEASURE_MEAN else (rloaded if measure == MEASURE_LOADED else rmax)
+        atomic_store(sync, STATUS_WORD, CONVERGED if r < target else RUNNING)
     barrier(sync, nthr)  # nobody may change the forces before they are read
     return atomic_load(sync, STATUS_WORD) == CONVERGED
 
@@ -533,6 +555,7 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash):
     gy = prm[GY]
     damp = prm[DAMP]
     target = prm[RATIO_TARGET]
+    measure = iprm[MEASURE]
     lim2 = (0.5 * prm[SKIN]) ** 2
     pw_body = iprm[MODE_PW] == PER_BODY
     nsteps = iprm[NSTEPS]
@@ -581,7 +604,7 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash):
             if not math.isfinite(dmax):
                 status = UNSTABLE
                 break
-            if target > 0.0 and _converged(t, nthr, disks, nb, wb, sync, out, target):
+            if target > 0.0 and _converged(t, nthr, disks, nb, wb, sync, out, target, measure):
                 status = CONVERGED
                 break
     if t == 0:

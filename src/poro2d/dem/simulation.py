@@ -61,6 +61,18 @@ def _prefer_openmp() -> None:
         _THREADING_SET = True
 
 
+#: the equilibrium measures of :meth:`Simulation.run`, by name: the kernel's code for each
+MEASURES = {"max": K.MEASURE_MAX, "mean": K.MEASURE_MEAN, "loaded_max": K.MEASURE_LOADED}
+_MEASURE_OUT = {K.MEASURE_MAX: K.MAX_RATIO, K.MEASURE_MEAN: K.MEAN_RATIO, K.MEASURE_LOADED: K.LOADED_RATIO}
+
+
+def measure_code(measure: str) -> int:
+    """The kernel's code of an equilibrium measure; refuses an unknown name."""
+    if measure not in MEASURES:
+        raise InputError("equilibrium measure", measure, "one of " + ", ".join(repr(m) for m in MEASURES))
+    return MEASURES[measure]
+
+
 def _row_of_slot(start: np.ndarray) -> np.ndarray:
     """The row (first disk) of every filled slot of a list stored as rows ``start``."""
     n = start.shape[0] - 1
@@ -93,6 +105,9 @@ class RunResult:
     wall_time_s: float
     rebuilds: int
     particle_steps: int  # steps x disks
+    loaded_ratio: float = math.nan  # max ratio over disks touching two bodies or more
+    rattler_fraction: float = math.nan  # free disks touching fewer than two bodies
+    measure: str = "max"  # the ratio the stop test compared with its target
 
     @property
     def particle_steps_per_s(self) -> float:
@@ -515,7 +530,9 @@ class Simulation:
         self.particles.mode[mask] = FREE
 
     # -------------------------------------------------------------------- run
-    def _load_params(self, nsteps: int, check_every: int, ratio_target: float, offset: int) -> None:
+    def _load_params(
+        self, nsteps: int, check_every: int, ratio_target: float, offset: int, measure: int = 0
+    ) -> None:
         prm = self._prm
         prm[K.DT] = self.dt
         prm[K.GX], prm[K.GY] = self.gravity
@@ -533,6 +550,7 @@ class Simulation:
         self._iprm[K.NSTEPS] = nsteps
         self._iprm[K.CHECK_EVERY] = check_every
         self._iprm[K.CHECK_OFFSET] = offset
+        self._iprm[K.MEASURE] = measure
         self._iprm[K.THREADS] = self.effective_threads
 
     def _uniform_constants(self) -> None:
@@ -557,7 +575,7 @@ class Simulation:
             self._iprm[K.MODE_PW] = PER_PAIR_TYPE
 
     def _kernel_block(
-        self, nsteps: int, check_every: int, ratio_target: float, offset: int
+        self, nsteps: int, check_every: int, ratio_target: float, offset: int, measure: int = 0
     ) -> tuple[int, int, int]:
         """Run up to ``nsteps`` in compiled code; returns (steps done, status, list rebuilds).
 
@@ -574,13 +592,14 @@ class Simulation:
         status = K.RUNNING
         rebuilds = 0
         while done < nsteps:
-            self._load_params(nsteps - done, check_every, ratio_target, offset + done)
+            self._load_params(nsteps - done, check_every, ratio_target, offset + done, measure)
             self._out[:] = 0.0
             K.run_steps(kernel_records(self), self._prm, self._iprm, self._out)
             self.threads_used = int(self._out[K.THREADS_USED])
             steps = int(self._out[K.STEPS_DONE])
             if ratio_target and (offset + done + steps) // check_every > (offset + done) // check_every:
-                self._checked_ratio = float(self._out[K.MAX_RATIO])  # the last stop test's value
+                # the last stop test's value of the measure it compared
+                self._checked_ratio = float(self._out[_MEASURE_OUT[measure]])
             done += steps
             rebuilds += int(self._out[K.REBUILDS])
             self.step_count += steps
@@ -614,13 +633,20 @@ class Simulation:
         callback: Callable[[Simulation], bool | None] | None = None,
         every: int | None = None,
         progress: bool | str = False,
+        measure: str = "max",
     ) -> RunResult:
         """Advance up to ``steps`` steps.
 
         until_ratio
-            stop as soon as the maximum unbalanced-force ratio drops below this value
-            (tested inside the kernel on steps ``check_every``, ``2 check_every``, ...
-            of this call).
+            stop as soon as the unbalanced-force ratio named by ``measure`` drops below
+            this value (tested inside the kernel on steps ``check_every``, ``2
+            check_every``, ... of this call).
+        measure
+            ``"max"`` (largest unbalanced force / largest contact force, PFC's maximum
+            ratio, the paper's), ``"mean"`` (mean unbalanced / mean contact force, PFC's
+            average ratio) or ``"loaded_max"`` (the maximum over the disks touching two
+            bodies or more: rattlers, which never carry a balanced load, left out); see
+            :func:`poro2d.dem.kernels.equilibrium_measures`.
         callback, every
             call ``callback(sim)`` every ``every`` steps (a Python event); if it
             returns True the run stops. A callback needs ``every``; ``every``
@@ -640,6 +666,7 @@ class Simulation:
             raise InputError("until_ratio", until_ratio, "(0, inf)")
         if not (isinstance(check_every, (int, np.integer)) and check_every >= 1):
             raise InputError("check_every", check_every, "an integer >= 1")
+        code = measure_code(measure)
         if every is not None and not (isinstance(every, (int, np.integer)) and every >= 1):
             raise InputError("every", every, "an integer >= 1")
         if callback is not None and every is None:
@@ -666,7 +693,7 @@ class Simulation:
         try:
             while done < steps:
                 nb = min(block, steps - done)
-                k, status, block_rebuilds = self._kernel_block(nb, check_every, target, done)
+                k, status, block_rebuilds = self._kernel_block(nb, check_every, target, done, code)
                 done += k
                 rebuilds += block_rebuilds
                 if bar is not None:
@@ -681,8 +708,11 @@ class Simulation:
             if bar is not None:
                 bar.stop()
         wall = time.perf_counter() - t0
-        rmax, rmean = self.unbalanced_ratios()
-        return RunResult(done, converged, rmax, rmean, wall, rebuilds, particle_steps=done * n)
+        m = self.equilibrium_measures()
+        return RunResult(
+            done, converged, m["max"], m["mean"], wall, rebuilds, particle_steps=done * n,
+            loaded_ratio=m["loaded_max"], rattler_fraction=m["rattler_fraction"], measure=measure,
+        )  # fmt: skip
 
     def solve(
         self,
@@ -690,20 +720,44 @@ class Simulation:
         max_steps: int = 1_000_000,
         check_every: int = 100,
         progress: bool | str = False,
+        measure: str = "max",
     ) -> RunResult:
-        """Cycle until the maximum unbalanced-force ratio is below ``ratio``."""
-        return self.run(max_steps, until_ratio=ratio, check_every=check_every, progress=progress)
+        """Cycle until the unbalanced-force ratio ``measure`` (see :meth:`run`) is below ``ratio``."""
+        return self.run(
+            max_steps, until_ratio=ratio, check_every=check_every, progress=progress, measure=measure
+        )
 
     # ------------------------------------------------------------ measurement
     def unbalanced_ratios(self) -> tuple[float, float]:
         """(max, mean) unbalanced-force ratio of the last step (inf before the first)."""
-        if not (self._stepped or self.step_count > 0) or self.force.shape[0] != self.particles.n:
-            return math.inf, math.inf
-        r = K.unbalanced_ratios(
-            self.force, self.particles.mode, self._nb_start, self._nb_fn, self._nb_fs,
+        m = self.equilibrium_measures()
+        return m["max"], m["mean"]
+
+    def equilibrium_measures(self) -> dict:
+        """The ratios of the last step (inf before the first) by measure name, and the rattlers.
+
+        ``max``, ``mean``, ``loaded_max`` (see :meth:`run`) and ``rattler_fraction``: the
+        share of free disks touching fewer than two bodies.
+        """
+        n = self.particles.n
+        if not (self._stepped or self.step_count > 0) or self.force.shape[0] != n:
+            return {"max": math.inf, "mean": math.inf, "loaded_max": math.inf, "rattler_fraction": math.nan}
+        r = K.equilibrium_measures(
+            self.force, self.particles.mode, self._nb_start, self._nb_j, self._nb_fn, self._nb_fs,
             self._nb_ov, self._wb_start, self._wb_fn, self._wb_fs, self._wb_ov,
         )  # fmt: skip
-        return float(r[0]), float(r[1])
+        free = int(np.count_nonzero(self.particles.mode == FREE))
+        return {
+            "max": float(r[0]),
+            "mean": float(r[1]),
+            "loaded_max": float(r[2]),
+            "rattler_fraction": float(r[3]) / free if free else 0.0,
+        }
+
+    def ratio_of(self, measure: str) -> float:
+        """The last step's unbalanced-force ratio by ``measure`` (``max``, ``mean``, ``loaded_max``)."""
+        measure_code(measure)
+        return self.equilibrium_measures()[measure]
 
     def wall_force(self, wall: str | int) -> np.ndarray:
         """Resultant contact force that the disks exert on a wall (N), as (fx, fy)."""

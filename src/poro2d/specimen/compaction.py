@@ -32,6 +32,7 @@ import numpy as np
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
 from poro2d.dem.measure import porosity_rect
 from poro2d.dem.ordering import strip_order
+from poro2d.dem.simulation import MEASURES
 from poro2d.errors import InputError, check_int, check_range
 from poro2d.specimen.grading import MAX_DRAW, GradingCurve, draw_disks
 from poro2d.specimen.placement import Band, place_disks
@@ -55,6 +56,10 @@ EQUILIBRIUM_STEPS = 5000
 WARN_SECONDS = 600.0
 
 
+#: settings recorded with results only when they differ from these defaults (see ``to_dict``)
+OMITTED_AT_DEFAULT = {"equilibrium": "max"}
+
+
 @dataclass
 class SpecimenSpec:
     """Box, material and preparation settings; defaults are the paper's Table 1."""
@@ -73,6 +78,7 @@ class SpecimenSpec:
     layers: int = 4
     undercompaction: float = 0.0
     ratio: float = 1e-3
+    equilibrium: str = "max"
     local_damping: float = 0.7
     gravity: float = 9.81
     growth_increments: int = 40
@@ -98,6 +104,9 @@ class SpecimenSpec:
         check_int("layers", self.layers, 1, 50)
         check_range("undercompaction", self.undercompaction, 0.0, 0.5)
         check_range("ratio", self.ratio, 0.0, 1.0, lo_open=True)
+        if self.equilibrium not in MEASURES:
+            allowed = "one of " + ", ".join(repr(m) for m in MEASURES)
+            raise InputError("equilibrium", self.equilibrium, allowed)
         check_range("local_damping", self.local_damping, 0.0, 1.0, hi_open=True)
         check_range("gravity", self.gravity, 0.0, None)
         check_int("growth_increments", self.growth_increments, 1)
@@ -113,10 +122,15 @@ class SpecimenSpec:
         """The specimen's settings as recorded with results.
 
         ``max_disks`` is left out: it is a guard, not a property of the specimen, so raising
-        it does not make a resumable output folder look like another config's.
+        it does not make a resumable output folder look like another config's. Settings added
+        after results were first written (``OMITTED_AT_DEFAULT``) are left out while they hold
+        their default: folders written before them still resume.
         """
         d = asdict(self)
         del d["max_disks"]
+        for key, default in OMITTED_AT_DEFAULT.items():
+            if d[key] == default:
+                del d[key]
         return d
 
     def self_weight(self, porosity: float) -> float:
@@ -245,7 +259,11 @@ class LayerReport:
 
 
 def equilibrate(sim: Simulation, spec: SpecimenSpec, label: str, progress: bool = False) -> dict:
-    """Cycle to equilibrium (maximum unbalanced-force ratio below ``spec.ratio``), with a fallback.
+    """Cycle to equilibrium (the ratio ``spec.equilibrium`` below ``spec.ratio``), with a fallback.
+
+    The measure is the maximum unbalanced-force ratio by default (the paper's); ``mean``
+    and ``loaded_max`` are the alternatives of :meth:`poro2d.dem.Simulation.run`. Every
+    attempt records all three ratios and the rattler fraction, whichever one decides.
 
     1. ``normal``: up to ``max_steps_per_stage`` steps;
     2. ``second budget``: up to ``fallback_steps`` more (a packing near its jamming
@@ -264,8 +282,11 @@ def equilibrate(sim: Simulation, spec: SpecimenSpec, label: str, progress: bool 
 
     def attempt(name: str, budget: int) -> bool:
         bar = (label if name == "normal" else f"{label} ({name})") if progress else False
-        res = sim.solve(spec.ratio, budget, progress=bar)
-        attempts.append({"attempt": name, "steps": res.steps, "max_ratio": res.max_ratio})
+        res = sim.solve(spec.ratio, budget, progress=bar, measure=spec.equilibrium)
+        attempts.append({
+            "attempt": name, "steps": res.steps, "max_ratio": res.max_ratio, "mean_ratio": res.mean_ratio,
+            "loaded_max_ratio": res.loaded_ratio, "rattler_fraction": res.rattler_fraction,
+        })  # fmt: skip
         return res.converged
 
     ok = attempt("normal", spec.max_steps_per_stage)
@@ -281,12 +302,20 @@ def equilibrate(sim: Simulation, spec: SpecimenSpec, label: str, progress: bool 
         finally:
             sim.set_local_damping(damping)
         ok = attempt("normal again", spec.calm_steps)
+    last = attempts[-1]
     return {
         "converged": ok,
         "steps": sum(a["steps"] for a in attempts),
-        "max_ratio": attempts[-1]["max_ratio"],
+        "max_ratio": last["max_ratio"],
+        "measure": spec.equilibrium,
+        "measured_ratio": last[_ATTEMPT_KEY[spec.equilibrium]],
+        "rattler_fraction": last["rattler_fraction"],
         "attempts": attempts,
     }
+
+
+#: the key of each measure's ratio in an attempt's record
+_ATTEMPT_KEY = {"max": "max_ratio", "mean": "mean_ratio", "loaded_max": "loaded_max_ratio"}
 
 
 def _band_particles(spec: SpecimenSpec, pos, radii) -> Particles:
@@ -350,6 +379,8 @@ def prepare_specimen(
         "failed_stage": None if failed is None else failed[0],
         "failed_max_ratio": None if failed is None else failed[1]["max_ratio"],
         "failed_steps": None if failed is None else failed[1]["steps"],
+        "failed_ratio": None if failed is None else failed[1].get("measured_ratio", failed[1]["max_ratio"]),
+        "equilibrium": spec.equilibrium,
     }
     return sim, report
 
