@@ -217,8 +217,8 @@ def _check_reason(name: str, row: dict, settings: CriterionSettings) -> str:
     if name == "preparation_converged":
         return (
             f"{row['failed_stage']} did not reach equilibrium: {row.get('equilibrium', 'max')} "
-            f"unbalanced-force ratio {row.get('failed_ratio', row['failed_max_ratio']):.3g} after {row['failed_steps']} steps "
-            "(fallback included)"
+            f"unbalanced-force ratio {row.get('failed_ratio', row['failed_max_ratio']):.3g} "
+            f"after {row['failed_steps']} steps (fallback included)"
         )
     if name == "all_disks_present":
         return f"{row['particle_count']} disks built of {row['planned_particle_count']} planned"
