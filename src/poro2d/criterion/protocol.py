@@ -71,6 +71,7 @@ class CriterionSettings:
     window_checks: int = 4
     generation_tolerance: float = 1e-3
     balance_tolerance: float = 0.01
+    refine_tolerance: float | None = None
 
     def __post_init__(self) -> None:
         check_range("n_lab", self.n_lab, 0.0, 1.0, hi_open=True)
@@ -97,6 +98,23 @@ class CriterionSettings:
             raise InputError("window_checks", self.window_checks, "an integer >= 1")
         check_range("generation_tolerance", self.generation_tolerance, 0.0, 0.05, lo_open=True)
         check_range("balance_tolerance", self.balance_tolerance, 0.0, 0.5, lo_open=True)
+        if self.refine_tolerance is not None:
+            check_range("refine_tolerance", self.refine_tolerance, 1e-4, self.porosity_tolerance)
+
+    @property
+    def tolerance(self) -> float:
+        """|n' - n2D| below this accepts a trial: the paper's 0.005, or ``refine_tolerance``."""
+        return self.porosity_tolerance if self.refine_tolerance is None else self.refine_tolerance
+
+    def to_record(self) -> dict:
+        """The settings as recorded with results; ``refine_tolerance`` only when set.
+
+        Left out while unset, so folders written before the option existed still resume.
+        """
+        d = asdict(self)
+        if d["refine_tolerance"] is None:
+            del d["refine_tolerance"]
+        return d
 
     def initial_trial(self) -> float:
         """Eq. 12 (n2D = 0.42 nLab^2 + 0.25 nLab), rounded to the resolution, unless given."""
@@ -107,6 +125,35 @@ class CriterionSettings:
 
 def round_to(x: float, step: float) -> float:
     return round(round(x / step) * step, 10)
+
+
+def next_trial(rows: list[dict], s: CriterionSettings) -> float:
+    """The next trial porosity after the trials ``rows`` (none accepted).
+
+    The paper's rule: n' rounded to the resolution (0.01), one resolution towards n' when
+    rounding falls back on the trial. With ``refine_tolerance``, n' rounded to half that
+    tolerance; once two trials bracket the fixed point (one whose plate settled looser than
+    the trial, n' > n2D, and one denser), a trial outside the bracket or already tried is
+    replaced by the bracket's midpoint: bisection, which converges where the paper's rule
+    can cycle between two values a resolution apart.
+    """
+    row = rows[-1]
+    n, new = row["trial_porosity"], row["new_porosity"]
+    if s.refine_tolerance is None:
+        nxt = round_to(new, s.resolution)
+        if nxt == n:  # rounding fell back: step one resolution towards n'
+            nxt = round_to(n + math.copysign(s.resolution, new - n), s.resolution)
+        return nxt
+    step = s.refine_tolerance / 2.0
+    nxt = round_to(new, step)
+    if nxt == n:
+        nxt = round_to(n + math.copysign(step, new - n), step)
+    lo = max((r["trial_porosity"] for r in rows if r["new_porosity"] > r["trial_porosity"]), default=None)
+    hi = min((r["trial_porosity"] for r in rows if r["new_porosity"] < r["trial_porosity"]), default=None)
+    tried = {r["trial_porosity"] for r in rows}
+    if lo is not None and hi is not None and lo < hi and (not lo < nxt < hi or nxt in tried):
+        nxt = round_to(0.5 * (lo + hi), step / 2.0)
+    return nxt
 
 
 def wall_forces(sim: Simulation) -> dict:
@@ -539,7 +586,7 @@ class PorosityCriterion:
         failed = next((c for c, ok in checks.items() if not ok), "")
         condition = bool(
             row["converged"] and bool(row.get("plate_settled", False))
-            and row["porosity_change"] < s.porosity_tolerance
+            and row["porosity_change"] < s.tolerance
         )  # fmt: skip
         row["condition_met"] = condition
         row["failed_check"] = failed
@@ -562,7 +609,7 @@ class PorosityCriterion:
             row["reason"] = (
                 "0 < F_top < limit with the plate settled, |n' - n2D| below the tolerance, all checks passed"
                 if condition
-                else f"|n' - n2D| = {row['porosity_change']:.4f} >= {s.porosity_tolerance:g}"
+                else f"|n' - n2D| = {row['porosity_change']:.4f} >= {s.tolerance:g}"
             )
 
     # -------------------------------------------------------------------- loop
@@ -601,9 +648,7 @@ class PorosityCriterion:
                 failed_trial = k
                 message = f"trial {k} (n2D = {n:.4f}) refused: {row['reason']}"
                 break
-            nxt = round_to(row["new_porosity"], s.resolution)
-            if nxt == n:  # rounding fell back: step one resolution towards n'
-                nxt = round_to(n + math.copysign(s.resolution, row["new_porosity"] - n), s.resolution)
+            nxt = next_trial(rows, s)
             if nxt in tried:
                 message = (
                     f"no convergence: trial {nxt:.4f} was already tried (trials {tried}); "
@@ -644,7 +689,7 @@ class PorosityCriterion:
                     "percent_passing": self.grading.percent.tolist(),
                     "source": getattr(self.grading, "source", ""),
                 },
-                "criterion": asdict(self.settings),
+                "criterion": self.settings.to_record(),
                 "seed": self.seed,
             },
             "config": self.config,
@@ -661,7 +706,7 @@ class PorosityCriterion:
             initial_from="given" if self.settings.trial_porosity is not None else "Eq. 12 (parabola)",
             iterations=rows,
             seed=self.seed,
-            settings=asdict(self.settings),
+            settings=self.settings.to_record(),
             specimen=self.spec.to_dict(),
             local_damping_note=f"local damping {self.spec.local_damping} (PFC 4.0 default; "
             "the paper does not state it)",
