@@ -223,11 +223,12 @@ class GradingCurve:
         _check_config_types(table)
         cuts = {"d_min_mm": table.get("d_min_mm"), "d_max_mm": table.get("d_max_mm")}
         if "preset" in table:
-            if table["preset"] != "paper":
-                raise InputError("grading.preset", table["preset"], '"paper"')
+            if table["preset"] not in GRADING_PRESETS:
+                allowed = " or ".join(f'"{k}"' for k in GRADING_PRESETS)
+                raise InputError("grading.preset", table["preset"], allowed)
             if "percent_passing" in table:
                 raise InputError("grading.percent_passing", table["percent_passing"], "unset")
-            return paper_grading(upscale=table.get("upscale", PAPER_UPSCALE), **cuts)
+            return preset_grading(table["preset"], upscale=table.get("upscale", PAPER_UPSCALE), **cuts)
         upscale = table.get("upscale", 1.0)
         if "csv" in table:
             if "percent_passing" in table:
@@ -422,6 +423,36 @@ def paper_grading(
         d_max_mm=d_max_mm,
         source="poro2d/data/paper_grading.csv (reconstruction of the paper's Fig. 4)",
     )
+
+
+#: built-in gradings: the paper's reconstruction and two wide illustrative curves with fines
+#: (``data/*.csv``; none of them is a measured sand, see docs/grading.md)
+GRADING_PRESETS = {
+    "paper": ("paper_grading.csv", "reconstruction of the paper's Fig. 4"),
+    "wide_cu4": ("wide_cu4_grading.csv", "illustrative wide grading with fines, Cu 4.3"),
+    "wide_cu6": ("wide_cu6_grading.csv", "illustrative very wide grading, Cu 6.3"),
+}
+
+
+def preset_grading(
+    name: str,
+    *,
+    upscale: float = PAPER_UPSCALE,
+    d_min_mm: float | None = None,
+    d_max_mm: float | None = None,
+) -> GradingCurve:
+    """A built-in grading by name (``GRADING_PRESETS``), up-scaled by 10 unless told otherwise."""
+    if name == "paper":
+        return paper_grading(upscale=upscale, d_min_mm=d_min_mm, d_max_mm=d_max_mm)
+    if name not in GRADING_PRESETS:
+        raise InputError("grading preset", name, " or ".join(f'"{k}"' for k in GRADING_PRESETS))
+    file, what = GRADING_PRESETS[name]
+    text = resources.files("poro2d").joinpath(f"data/{file}").read_text("utf-8")
+    sizes, percent = _parse_csv(text, f"poro2d/data/{file}")
+    return GradingCurve.from_lists(
+        sizes, percent, upscale=upscale, d_min_mm=d_min_mm, d_max_mm=d_max_mm,
+        source=f"poro2d/data/{file} ({what})",
+    )  # fmt: skip
 
 
 # ---------------------------------------------------------------------- drawing disks
