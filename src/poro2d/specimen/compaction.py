@@ -325,45 +325,17 @@ def _band_particles(spec: SpecimenSpec, pos, radii) -> Particles:
     )  # fmt: skip
 
 
-@dataclass(frozen=True)
-class LidServo:
-    """A light servo load on the lid while the last layer forms: the specimen fills its box.
-
-    Without it the last layer grows under a fixed lid at H and settles away from it: the
-    plate then rests on a few high disks over a rough surface. With it the lid presses on
-    the last layer from its placement on (``target_n``, N, brisk: ``speed``, ``gain``),
-    follows it gently while it comes to equilibrium (``settle_speed``, ``settle_gain``),
-    and is held still for the working-friction stage, so the surface forms against it.
-    """
-
-    target_n: float
-    speed: float = 0.05
-    gain: float = 0.3
-    settle_speed: float = 0.001
-    settle_gain: float = 0.02
-
-    def __post_init__(self) -> None:
-        check_range("lid target force", self.target_n, 0.0, None, lo_open=True)
-        check_range("lid servo speed", self.speed, 0.0, 10.0, lo_open=True)
-        check_range("lid servo settle speed", self.settle_speed, 0.0, 10.0, lo_open=True)
-        check_range("lid servo gain", self.gain, 0.0, 1.0, lo_open=True)
-        check_range("lid servo settle gain", self.settle_gain, 0.0, 1.0, lo_open=True)
-
-
 def prepare_specimen(
     spec: SpecimenSpec,
     grading: GradingCurve,
     porosity: float,
     seed: int,
     progress: bool = False,
-    lid: LidServo | None = None,
 ) -> tuple[Simulation, dict]:
     """Build a specimen at trial ``porosity`` by multilayer compaction.
 
     Returns the simulation (top plate = wall "top" at H) and a report with the
-    particle count, per-layer cycles and the measured box porosity. With ``lid`` the
-    last layer forms under a light servo load (:class:`LidServo`) and the plate ends
-    where that load holds it, not at H (``plate_height_m`` in the report).
+    particle count, per-layer cycles and the measured box porosity.
 
     A layer that does not reach equilibrium even with the fallback of
     :func:`equilibrate` ends the preparation: the later layers are not built, the
@@ -381,8 +353,7 @@ def prepare_specimen(
     layers: list[dict] = []
     failed = None
     for k, idx in enumerate(_layer_groups(radii, spec.layers)):
-        last = lid if k == spec.layers - 1 else None
-        sim, layer, eq = _build_layer(sim, spec, k, idx, radii, tops, rng, progress, last)
+        sim, layer, eq = _build_layer(sim, spec, k, idx, radii, tops, rng, progress)
         layers.append(layer)
         if not eq["converged"]:
             failed = (f"layer {k + 1}", eq)
@@ -391,8 +362,6 @@ def prepare_specimen(
     final = None
     if failed is None:
         sim.set_particle_friction(spec.friction_particle)
-        if lid is not None:
-            sim.set_wall_velocity("top", (0.0, 0.0))
         final = equilibrate(sim, spec, "working friction", progress)
         if not final["converged"]:
             failed = ("working friction", final)
@@ -404,8 +373,6 @@ def prepare_specimen(
         "solid_area_m2": p.area(),
         "box_porosity": 1.0 - p.area() / (W * H),
         "measured_porosity": porosity_rect(p.pos, p.radius, 0.0, 0.0, W, H),
-        "plate_height_m": float(sim.walls.p0[sim.walls.index("top"), 1]),
-        "lid_servo_n": None if lid is None else lid.target_n,
         "layers": layers,
         "final_stage": final,
         "converged": failed is None,
@@ -427,8 +394,7 @@ def _layer_groups(radii: np.ndarray, layers: int) -> list[np.ndarray]:
 
 
 def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.ndarray, tops: np.ndarray,
-                 rng: np.random.Generator, progress: bool,
-                 servo: LidServo | None = None) -> tuple[Simulation, dict, dict]:  # fmt: skip
+                 rng: np.random.Generator, progress: bool) -> tuple[Simulation, dict, dict]:  # fmt: skip
     """Place layer ``k`` in its band under the lid, grow it to size, bring it to equilibrium.
 
     Returns the simulation (made with the first layer), the layer's report and the result of
@@ -460,14 +426,10 @@ def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.nda
         lid = sim.walls.index("top")
         sim.translate_wall(lid, 0.0, y_top - float(sim.walls.p0[lid, 1]))
         new = sim.add_particles(small)
-    if servo is not None:
-        sim.set_wall_servo("top", servo.target_n, (0.0, -1.0), servo.speed, servo.gain)
     steps = _grow(sim, new, radii[idx], plc.scale, spec)
     # renumber the whole packing in strips across its short side (the new layer was
     # appended on top): threads then split it along a short cut (dem.ordering)
     sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
-    if servo is not None:
-        sim.set_wall_servo("top", servo.target_n, (0.0, -1.0), servo.settle_speed, servo.settle_gain)
     eq = equilibrate(sim, spec, f"layer {k + 1}", progress)
     steps += eq["steps"]
     report = LayerReport(k + 1, len(idx), y_top, plc.scale, steps, eq["max_ratio"], eq["converged"],
@@ -498,7 +460,6 @@ def box_porosity(sim: Simulation, width: float, top: float, bottom: float = 0.0)
 
 
 __all__ = [
-    "LidServo",
     "SizeEstimate",
     "SpecimenSpec",
     "box_porosity",
