@@ -227,8 +227,13 @@ def test_surface_level_sits_below_the_tops_and_decides_the_interior():
     assert np.min(gaps + np.eye(reg.count) * 1e9) >= 2 * reg.circle_radius_m - 1e-12  # no overlap
 
 
-def test_too_small_a_specimen_is_refused_naming_the_margin():
-    pos, r, W, H = hex_lattice(20, 12)
+def test_small_specimens_get_smaller_circles_then_a_refusal_naming_the_margin():
+    pos, r, W, H = hex_lattice(20, 12)  # 20 d x 10.4 d: no room for 3 circles of 4 d50
+    m = measure_specimen(pos, r, W, H)
+    assert m.interior_regions >= 3
+    assert 1.5 * m.d50_m <= m.circle_radius_m < 4.0 * m.d50_m
+    assert m.interior_porosity == pytest.approx(1.0 - np.pi / (2.0 * np.sqrt(3.0)), abs=0.01)
+    pos, r, W, H = hex_lattice(12, 7)  # 12 d x 6 d: not even 3 circles of 1.5 d50
     with pytest.raises(InputError, match="margin_d50") as err:
         measure_specimen(pos, r, W, H)
     assert "too small" in str(err.value)
@@ -247,7 +252,7 @@ def test_measure_specimen_box_porosity_and_dict_round_trip(tmp_path):
     assert m.box_porosity == 1.0 - float(np.sum(np.pi * r**2)) / (W * plate)
     assert m.interior_porosity_min <= m.interior_porosity <= m.interior_porosity_max
     assert m.interior_porosity < m.box_porosity  # the 3 d gap under the plate belongs to the box only
-    assert m.d50_m == mass_d50(r) and m.margin_d50 == 3.0
+    assert m.d50_m == mass_d50(r) and m.margin_d50 == 2.0
     d = m.to_dict()
     assert all(type(v) in (float, int) for v in d.values())
     assert type(d["interior_regions"]) is int and type(d["plate_touching_disks"]) is int

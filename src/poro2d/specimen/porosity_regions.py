@@ -36,9 +36,11 @@ from poro2d.dem.measure import porosity_circle, porosity_rect
 from poro2d.errors import InputError, as_float_array, check_int, check_range
 
 #: distance kept from the walls and the free surface, in median diameters (see interior_regions)
-DEFAULT_MARGIN_D50 = 3.0
+DEFAULT_MARGIN_D50 = 2.0
 #: radius of a measurement circle, in median diameters
 DEFAULT_CIRCLE_D50 = 4.0
+#: the smallest circle a small specimen's circles may shrink to (about 15 disks of the paper grading)
+MIN_CIRCLE_D50 = 1.5
 #: samples of the surface profile per median diameter
 PROFILE_SAMPLES_PER_D50 = 16
 #: width of the running mean that takes the grain-scale valleys out of the surface, in d50
@@ -302,6 +304,21 @@ def interior_rect(
     return rect
 
 
+def fitted_radius(rect: tuple[float, float, float, float], R: float, R_min: float) -> float:
+    """The largest circle radius up to ``R`` (not below ``R_min``) that fits three circles in ``rect``.
+
+    A small specimen (the quick box is 9 d50 tall) has no room for three circles of 4 d50:
+    there the circles shrink, down to ``R_min``, rather than the measurement being refused.
+    When even ``R_min`` does not fit three, ``R`` is returned and :func:`interior_rect` refuses.
+    """
+    wi, hi = rect[2] - rect[0], rect[3] - rect[1]
+    if wi <= 0 or hi <= 0:
+        return R
+    # m rows of ceil(3 / m) circles: the radius each arrangement allows, the largest wins
+    best = max(min(R, hi / (2.0 * m), wi / (2.0 * math.ceil(3 / m))) for m in (1, 2, 3))
+    return best if best >= R_min else R
+
+
 def _grid_shape(rect: tuple[float, float, float, float], R: float) -> tuple[int, int]:
     """How many circles of radius R fit side by side across and up the rectangle."""
     wi, hi = rect[2] - rect[0], rect[3] - rect[1]
@@ -340,13 +357,14 @@ def interior_regions(
 
     The interior keeps ``margin_d50`` median diameters from the left, right and bottom
     walls and from the free surface's lowest level (:func:`surface_level`). The default,
-    3 d50: against a flat wall disks cannot interlock with a layer beyond it, so the first
-    layer, 0.5-1 d thick, is loose, and the ordering it imposes decays over the next
-    diameter or two in a polydisperse packing; the top of the packing, under a plate that
-    rests on a few disks, is loose over a similar depth. Three d50 clears both while
-    leaving most of a specimen tens of d50 across to measure. Each circle has radius
-    ``circle_d50`` d50 (default 4: some 60 disks of the paper grading, enough for a stable value, small
-    enough for several circles to show the spread). ``profile`` is (x, h) of
+    2 d50: against a flat wall disks cannot interlock with a layer beyond it, so the first
+    layer, 0.5-1 d thick, is loose; the top of the packing, under a plate that rests on a
+    few disks, is loose over a similar depth. On the paper specimen the interior rectangle's
+    porosity moves by less than 0.002 between margins of 0.5 and 4 d50, so 2 d50 clears the
+    wall layers and leaves room for circles in the quick box (9 d50 tall). Each circle has radius
+        ``circle_d50`` d50 (default 4: some 60 disks of the paper grading, enough for a stable
+    value, small enough for several circles to show the spread), smaller where three such
+    circles do not fit (:func:`fitted_radius`, not below ``MIN_CIRCLE_D50``). ``profile`` is (x, h) of
     :func:`surface_profile` if already computed. Disks are clipped exactly at each circle
     and at the rectangle.
     """
@@ -357,6 +375,7 @@ def interior_regions(
     R = check_range("circle_d50", circle_d50, 0.0, lo_open=True) * d50
     x, h = profile if profile is not None else surface_profile(pos, radius, width, _profile_bins(width, d50))
     level = min(surface_level(x, h, d50), plate_y)
+    R = fitted_radius((margin, margin, width - margin, level - margin), R, MIN_CIRCLE_D50 * d50)
     rect = interior_rect(width, level, margin, R)
     centres = circle_centres(rect, R)
     values = np.array([_circle_porosity(pos, radius, c, R) for c in centres])
