@@ -76,23 +76,37 @@ def _print_density(res: dict, out: Path) -> None:
 
 def print_result(result: dict, out: Path) -> None:
     t = Table(title=f"criterion (Fig. 3): nLab = {result['n_lab']}")
-    for col in ("trial n2D", "disks", "F_top N/m", "F_bottom N/m", "G N/m", "plate", "dz (mm)", "n'",
-                "|n'-n2D|", "accepted"):  # fmt: skip
+    for col in ("trial n2D", "disks", "F_top N/m", "F_bottom N/m", "G N/m", "plate", "dz (mm)", "n' (box)",
+                "|n'-n2D|", "interior n", "gap/d50", "accepted"):  # fmt: skip
         t.add_column(col, justify="right")
     for r in result["iterations"]:
         t.add_row(
             f"{r['trial_porosity']:.3f}", str(r["particle_count"]), f"{r['f_top_n_per_m']:.4g}",
             f"{r['f_bottom_n_per_m']:.4g}", f"{r['self_weight_n_per_m']:.4g}", r["plate_moved"],
             f"{1e3 * r['plate_displacement_m']:.3f}", _num(r["new_porosity"]),
-            _num(r["porosity_change"]), _verdict(r),
+            _num(r["porosity_change"]), _interior(r), _num(r.get("surface_gap_mean_d50"), 2), _verdict(r),
         )  # fmt: skip
     console.print(t)
     console.print(f"{result['message']}; results in {out}/result.json")
+    if result.get("interior_porosity") is not None:
+        console.print(
+            f"accepted specimen: box porosity n' {result['box_porosity']:.4f} (the paper's, gap under the "
+            f"plate included), interior porosity {result['interior_porosity']:.4f} +- "
+            f"{result['interior_porosity_std']:.4f} (the packing's own; docs/porosity.md)",
+            soft_wrap=True,
+        )
 
 
-def _num(x) -> str:
+def _interior(r: dict) -> str:
+    """The interior porosity of a trial's decision state with its spread over the circles."""
+    if r.get("interior_porosity") is None:
+        return "-"
+    return f"{r['interior_porosity']:.4f}+-{r['interior_porosity_std']:.4f}"
+
+
+def _num(x, digits: int = 4) -> str:
     """A porosity for the table; a trial refused before its plate stage has none."""
-    return "-" if x is None else f"{x:.4f}"
+    return "-" if x is None else f"{x:.{digits}f}"
 
 
 def _verdict(r: dict) -> str:

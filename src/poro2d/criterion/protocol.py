@@ -259,6 +259,32 @@ def specimen_checks(
     return checks, numbers
 
 
+#: the measures of a trial's decision state that its row carries (see :func:`porosity_numbers`)
+POROSITY_KEYS = (
+    "box_porosity", "interior_porosity", "interior_porosity_std", "interior_regions",
+    "laguerre_interior_porosity", "surface_gap_mean_d50", "plate_contact_fraction",
+)  # fmt: skip
+
+
+def porosity_numbers(sim: Simulation, width: float, plate_y: float) -> dict:
+    """The specimen's porosities beside the paper's n' (:mod:`poro2d.specimen.porosity_regions`).
+
+    ``box_porosity`` is the paper's: W x plate height, the gap under the plate included;
+    ``interior_porosity`` (mean over measurement circles 2 d50 clear of every wall and of the
+    free surface, with its spread) is the packing's own. A specimen too small to measure
+    gets ``interior_porosity = None`` and the reason in ``interior_porosity_note``.
+    """
+    from poro2d.specimen.porosity_regions import measure_specimen
+
+    p = sim.particles
+    try:
+        m = measure_specimen(p.pos, p.radius, width, plate_y).to_dict()
+    except InputError as e:
+        return {"box_porosity": 1.0 - p.area() / (width * plate_y), "interior_porosity": None,
+                "interior_porosity_note": str(e)}  # fmt: skip
+    return {k: m[k] for k in POROSITY_KEYS}
+
+
 def _check_reason(name: str, row: dict, settings: CriterionSettings) -> str:
     """One line on why check ``name`` failed, with its numbers."""
     if name == "preparation_converged":
@@ -564,6 +590,8 @@ class PorosityCriterion:
         row["porosity_change"] = None if row["new_porosity"] is None else abs(row["new_porosity"] - n)
         checks, numbers = specimen_checks(sim, self.spec, prep, n, float(sim.walls.p0[top, 1]), after, s)
         row.update(numbers)
+        if row["converged"]:
+            row.update(porosity_numbers(sim, self.spec.width, float(sim.walls.p0[top, 1])))
         # the plate stage is part of the record: False when it did not settle or never ran
         checks = {"preparation_converged": checks.pop("preparation_converged"),
                   "plate_settled": bool(row.get("plate_settled", False)), **checks}  # fmt: skip
@@ -660,6 +688,9 @@ class PorosityCriterion:
             message = f"no convergence within max_iterations = {s.max_iterations} (trials {tried})"
         result = self._result(rows, final=n if converged else None, converged=converged, message=message)
         result.failed_trial = failed_trial
+        if converged:
+            for key in CriterionResult.OPTIONAL:
+                setattr(result, key, rows[-1].get(key))
         result.time_total_s = time.perf_counter() - t_start
         if self.out is not None:
             self._final_outputs(rows, converged)
@@ -761,6 +792,26 @@ class PorosityCriterion:
         if self.figures:
             title = f"accepted specimen, n2D = {n2d:.3f}: bands of equal height"
             plot_specimen_state(state, self.out / "specimen_state.png", title=title)
+        self._specimen_porosity(sim, n2d, top)
+
+    def _specimen_porosity(self, sim: Simulation, n2d: float, top: float) -> None:
+        """The accepted specimen's porosities: specimen_porosity.json and the local porosity map."""
+        from poro2d.specimen.porosity_regions import measure_specimen, plot_local_porosity
+
+        assert self.out is not None
+        p = sim.particles
+        try:
+            m = measure_specimen(p.pos, p.radius, self.spec.width, top)
+        except InputError as e:
+            write_json(self.out / "specimen_porosity.json", {"trial_porosity": n2d, "note": str(e),
+                                                              "provenance": provenance()})  # fmt: skip
+            return
+        write_json(self.out / "specimen_porosity.json", dict(m.to_dict(), trial_porosity=n2d,
+                                                            provenance=provenance()))  # fmt: skip
+        if self.figures:
+            title = f"accepted specimen, n2D = {n2d:.3f}: local porosity (Laguerre cells)"
+            plot_local_porosity(p.pos, p.radius, self.spec.width, top, m, self.out / "local_porosity.png",
+                                title=title)  # fmt: skip
 
 
 def _other_config(keys: list[str] | None, stored) -> str:
