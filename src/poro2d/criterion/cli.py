@@ -57,13 +57,15 @@ def register(app: typer.Typer) -> None:
 def _print_density(res: dict, out: Path) -> None:
     """The density-controlled criterion's answer: its state, friction and accepted n2D over seeds."""
     t = Table(title=f"criterion, density mode: nLab = {res['n_lab']} (Dr = {res['relative_density']:.3f})")
-    for col in ("2D target", "mu_prep", "accepted n2D (mean +- sd)", "per seed", "converged", "n2D,min",
-                "n2D,max"):  # fmt: skip
+    for col in ("2D target", "mu_prep", "accepted n2D (mean +- sd)", "interior n (mean +- sd)", "per seed",
+                "converged", "n2D,min", "n2D,max"):  # fmt: skip
         t.add_column(col, justify="right")
     mean = res["final_porosity_mean"]
+    inner = res.get("interior_porosity_mean")
     t.add_row(
         f"{res['n2d_target']:.4f}", f"{res['mu_prep']:.3f}",
         "" if mean != mean else f"{mean:.4f} +- {res['final_porosity_sd']:.4f}",
+        "" if inner is None or inner != inner else f"{inner:.4f} +- {res['interior_porosity_sd']:.4f}",
         ", ".join(f"{v:.2f}" for v in res["final_porosity_per_seed"]),
         f"{res['seeds_converged']}/{res['seeds']}", f"{res['n2d_min']:.4f}", f"{res['n2d_max']:.4f}",
     )  # fmt: skip

@@ -125,6 +125,12 @@ def run_criterion(config: dict, out_dir: Path) -> dict:
         "first_plate_moved": first.get("plate_moved"),
         "first_new_porosity": first.get("new_porosity"),
         "criterion_time_s": res.get("time_total_s"),
+        # the accepted specimen's own porosity beside the paper's box porosity n'
+        "box_porosity": res.get("box_porosity"),
+        "interior_porosity": res.get("interior_porosity"),
+        "interior_porosity_std": res.get("interior_porosity_std"),
+        "surface_gap_mean_d50": res.get("surface_gap_mean_d50"),
+        "plate_contact_fraction": res.get("plate_contact_fraction"),
     }
 
 

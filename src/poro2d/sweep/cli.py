@@ -123,9 +123,28 @@ def print_summary(res, out: Path) -> None:
     )
 
 
+def _print_interior_spread(sp: dict) -> None:
+    """The loose-to-dense spread of the interior porosity (the packing's own, no gap under the plate)."""
+    d = sp.get("interior_loose_minus_dense")
+    if d is None or not math.isfinite(d):
+        return
+    order = "monotone" if sp["interior_monotone"] else "NOT monotone"
+    console.print(f"interior porosity, loose - dense: {d:+.4f} +- {sp['interior_sd']:.4f}; {order} in nLab")
+
+
 def print_relation(rel: dict, out: Path) -> None:
     t = Table(title="n2D(nLab) from the criterion")
-    for c in ("nLab", "Dr", "n2D DEM", "fit", "Eq. 12", "LIM 2D-3D", "LIM 2D-Lab", "flag"):
+    for c in (
+        "nLab",
+        "Dr",
+        "n2D DEM (box n')",
+        "interior n",
+        "fit",
+        "Eq. 12",
+        "LIM 2D-3D",
+        "LIM 2D-Lab",
+        "flag",
+    ):
         t.add_column(c, justify="right")
 
     def f(v) -> str:
@@ -135,10 +154,14 @@ def print_relation(rel: dict, out: Path) -> None:
         dem = f(p["n2d_dem"])
         if rel.get("mode") == "density" and dem:
             dem += f" +- {p['n2d_sd']:.4f} ({p['seeds_converged']}/{p['seeds']})"
+        inner = f(p.get("n2d_interior"))
+        if inner and p.get("n2d_interior_sd") is not None:
+            inner += f" +- {p['n2d_interior_sd']:.4f}"
         t.add_row(
             f"{p['n_lab']:.4f}",
             f"{p['relative_density']:.2f}",
             dem,
+            inner,
             f(p["n2d_fit"]),
             f(p["n2d_parabolic"]),
             f(p["n2d_lim_3d"]),
@@ -164,6 +187,7 @@ def print_relation(rel: dict, out: Path) -> None:
                 f"loose - dense: {sp['n2d_loose_minus_dense']:+.4f} +- {sp['sd']:.4f} (measured, not a fit); "
                 f"{'monotone' if sp['monotone'] else 'NOT monotone'} in nLab"
             )
+            _print_interior_spread(sp)
     fit = rel["fit"]
     if fit:
         console.print(

@@ -202,8 +202,10 @@ def analyse_states(rows: list[dict], targets: list, cal, n_max: float, n_min: fl
         ok = [r for r in group if r["status"] == "done" and (r.get("results") or {}).get("converged")]
         acc = [_num(r["results"]["final_porosity"]) for r in ok]
         meas = [_num(r["results"]["last_new_porosity"]) for r in ok]
+        inner = [_num(r["results"].get("interior_porosity")) for r in ok]
         mean, sd = _stats(acc)
         m_mean, m_sd = _stats(meas)
+        i_mean, i_sd = _stats(inner)
         conv = P.convert_all(t.n_lab, n_max, n_min)
         pt = {
             "n_lab": t.n_lab,
@@ -216,6 +218,9 @@ def analyse_states(rows: list[dict], targets: list, cal, n_max: float, n_min: fl
             "n2d_seeds": acc,
             "n2d_measured": m_mean,
             "n2d_measured_sd": m_sd,
+            "n2d_interior": i_mean,
+            "n2d_interior_sd": i_sd,
+            "n2d_interior_seeds": inner,
             "seeds": len(group),
             "seeds_converged": len(ok),
             "converged": len(ok) > 0,
@@ -237,6 +242,12 @@ def analyse_states(rows: list[dict], targets: list, cal, n_max: float, n_min: fl
             "n2d_loose_minus_dense": loose["n2d_dem"] - dense["n2d_dem"],
             "sd": math.hypot(loose["n2d_sd"], dense["n2d_sd"]),
             "monotone": all(a["n2d_dem"] >= b["n2d_dem"] for a, b in zip(good, good[1:], strict=False)),
+            # the same for the interior porosity (the packing's own, no gap under the plate)
+            "interior_loose_minus_dense": loose["n2d_interior"] - dense["n2d_interior"],
+            "interior_sd": math.hypot(loose["n2d_interior_sd"], dense["n2d_interior_sd"]),
+            "interior_monotone": all(
+                a["n2d_interior"] >= b["n2d_interior"] for a, b in zip(good, good[1:], strict=False)
+            ),
         }
     rel.update(mode="density", calibration=cal.to_dict(), n2d_max=cal.n2d_max, n2d_min=cal.n2d_min,
                spread=spread)  # fmt: skip
@@ -330,6 +341,15 @@ def _method_curves(ax, x: np.ndarray, hi: float, lo: float, fit: dict | None) ->
         ax.plot(x, fit["a"] * x * x + fit["b"] * x, color="tab:red", lw=2.0, ls="-.", label=label)
 
 
+def _interior_points(ax, ok: list[dict]) -> None:
+    """The accepted specimens' interior porosity (the packing's own) beside the box porosity."""
+    ins = [p for p in ok if math.isfinite(p.get("n2d_interior", math.nan))]
+    if ins:
+        ax.errorbar([p["n_lab"] for p in ins], [p["n2d_interior"] for p in ins],
+                    yerr=[p["n2d_interior_sd"] for p in ins], fmt="s", color="tab:purple", ms=6, capsize=3,
+                    label="DEM interior porosity (2 d50 clear of walls, surface; mean +- sd)")  # fmt: skip
+
+
 def _dem_points(ax, rel: dict) -> None:
     """Accepted points (with seed error bars in density mode), unconverged ones hollow, Dr labels."""
     pts = rel["points"]
@@ -342,6 +362,7 @@ def _dem_points(ax, rel: dict) -> None:
                     label=label)  # fmt: skip
         ax.axhline(rel["n2d_max"], color="0.4", lw=0.8, ls=":", label="2D extremes (calibrated)")
         ax.axhline(rel["n2d_min"], color="0.4", lw=0.8, ls=":")
+        _interior_points(ax, ok)
     elif ok:
         ax.plot(ox, oy, "o", color="tab:red", ms=8, label="DEM criterion (accepted n2D)")
     if bad:
