@@ -135,7 +135,32 @@ class SpecimenData:
         ]
         if self.source:
             lines.append(f"from {self.source}")
+        lines += self.porosity_lines()
         return [f"{comment} {ln}" for ln in lines]
+
+    def porosity_lines(self) -> list[str]:
+        """The two porosities of the specimen, named so that neither is taken for the other.
+
+        The box porosity is the paper's n' (box W x plate height, the gap under the plate
+        included); the interior porosity is the packing's own, 2 d50 clear of every wall and
+        of the free surface (:mod:`poro2d.specimen.porosity_regions`). None for a specimen
+        without a box or too small to measure.
+        """
+        from poro2d.specimen.porosity_regions import measure_specimen
+
+        try:
+            xlo, xhi, ylo, yhi = self.box()
+            pos = np.column_stack([self.x - xlo, self.y - ylo])
+            m = measure_specimen(pos, self.radius, xhi - xlo, yhi - ylo)
+        except InputError:
+            return []
+        return [
+            f"box porosity n' = {m.box_porosity:.4f} (the paper's: box {xhi - xlo:.4g} m x {yhi - ylo:.4g} m "
+            f"to the top plate, the gap under the plate included: mean {m.surface_gap_mean_d50:.2f} d50)",
+            f"interior porosity = {m.interior_porosity:.4f} +- {m.interior_porosity_std:.4f} "
+            f"({m.interior_regions} circles 2 d50 clear of walls and surface): the packing's own; "
+            "generate this specimen elsewhere at this porosity (docs/porosity.md)",
+        ]
 
     def to_simulation(self, dt: float | None = None, threads: int = 1) -> Simulation:
         """A poro2d Simulation at this state: disks at rest, no contact history, walls fixed."""
