@@ -46,7 +46,12 @@ def _intro_blocks(summary: dict, crit: dict) -> list[Block]:
         + (" Quick mode: a reduced specimen, not the paper's box." if summary.get("quick") else ""),
     ))  # fmt: skip
     b.append(("h2", "Summary"))
-    rows = [["accepted 2D porosity", crit.get("final_porosity"), pc["accepted_porosity"]]]
+    rows = [["accepted 2D porosity (trial n2D)", crit.get("final_porosity"), pc["accepted_porosity"]]]
+    if crit.get("interior_porosity") is not None:
+        rows.append(["box porosity n' of the accepted specimen (gap under the plate included)",
+                     crit.get("box_porosity"), "-"])  # fmt: skip
+        inner = f"{crit['interior_porosity']:.4f} +- {crit['interior_porosity_std']:.4f}"
+        rows.append(["interior porosity of the accepted specimen (the packing's own)", inner, "-"])
     if its:
         rows.append(["first trial porosity (Eq. 12, rounded)", its[0]["trial_porosity"], pc["trials"][0]])
         rows.append(["number of trials", len(its), len(pc["trials"])])
@@ -129,6 +134,8 @@ def _criterion_blocks(out: Path, crit: dict, pc: dict) -> list[Block]:
                 ["F_bottom after (N/m)", *[r.get("f_bottom_after_n_per_m") for r in its]],
                 ["n'", *[r["new_porosity"] for r in its]],
                 ["|n' - n2D|", *[r["porosity_change"] for r in its]],
+                ["interior porosity", *[r.get("interior_porosity") for r in its]],
+                ["mean gap under the plate (d50)", *[r.get("surface_gap_mean_d50") for r in its]],
                 ["accepted", *["yes" if r["accepted"] else "no" for r in its]],
             ],
         ))  # fmt: skip
@@ -157,7 +164,7 @@ def _criterion_blocks(out: Path, crit: dict, pc: dict) -> list[Block]:
     ):  # fmt: skip
         if (cd / name).is_file():
             b.append(("img", cd / name, cap))
-    return b + _state_blocks(cd)
+    return b + _state_blocks(cd) + _porosity_blocks(cd)
 
 
 def _provenance_blocks(summary: dict, crit: dict) -> list[Block]:
@@ -219,6 +226,40 @@ def _state_blocks(cd: Path) -> list[Block]:
     if (cd / "specimen_state.png").is_file():
         cap = "Porosity and stresses of the accepted specimen, by height"
         b.append(("img", cd / "specimen_state.png", cap))
+    return b
+
+
+def _porosity_blocks(cd: Path) -> list[Block]:
+    """Box against interior porosity of the accepted specimen, the plate's surface, the local map."""
+    m = _load(cd / "specimen_porosity.json")
+    if not m or m.get("interior_porosity") is None:
+        return []
+    b: list[Block] = [("h3", "The accepted specimen: box porosity and the specimen's own porosity")]
+    regions = f"{m['interior_regions']} circles, {m['margin_d50']:g} d50 clear of walls and surface"
+    gap = f"{1e3 * m['surface_gap_mean_m']:.2f} mm = {m['surface_gap_mean_d50']:.2f} d50"
+    contact = f"{100 * m['plate_contact_fraction']:.1f} % ({m['plate_touching_disks']} disks)"
+    rows = [
+        ["box porosity n' (the paper's: W x plate height)", m["box_porosity"]],
+        [f"interior porosity ({regions})",
+         f"{m['interior_porosity']:.4f} +- {m['interior_porosity_std']:.4f}"],
+        ["interior rectangle / Laguerre cells",
+         f"{m['interior_rect_porosity']:.4f} / {m['laguerre_interior_porosity']:.4f}"],
+        ["mean gap under the plate", gap],
+        ["plate width in contact", contact],
+    ]  # fmt: skip
+    b.append(("table", ["measure", "value"], rows))
+    b.append(
+        (
+            "p",
+            "The paper's n' counts the gap between the plate and the rough surface of the specimen; the "
+            "interior porosity is the packing's own and does not depend on the box's size. To build this "
+            "specimen in another code, take the interior porosity (docs/porosity.md).",
+        )
+    )
+    if (cd / "local_porosity.png").is_file():
+        b.append(
+            ("img", cd / "local_porosity.png", "Local porosity of the accepted specimen (Laguerre cells)")
+        )
     return b
 
 
