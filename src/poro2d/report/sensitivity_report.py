@@ -122,11 +122,11 @@ def report_blocks(sens: dict, figure: str | Path | None = None) -> list[Block]:
     ))  # fmt: skip
     g_rows = [
         [p["label"], p["cu"], p["d_max_mm"], _pm(p), p["n"], p["unconverged"], _num(p["measured_mean"]),
-         _num(p["first_f_top_over_g_mean"])]
+         _num(p.get("interior_mean")), _num(p["first_f_top_over_g_mean"])]
         for p in sens["points"]["grading"]
     ]  # fmt: skip
     b.append(("table", ["grading", "Cu", "d_max (mm)", "accepted n2D", "n", "unconverged", "n' accepted",
-                        "first trial F_top / G"], g_rows))  # fmt: skip
+                        "interior porosity", "first trial F_top / G"], g_rows))  # fmt: skip
     m_rows = [[p["mu_prep"], _pm(p), p["n"], p["unconverged"]] for p in sens["points"]["mu_prep"]]
     b.append(("table", ["mu_prep", "n' of the accepted trial", "n", "unconverged"], m_rows))
     b.extend(_first_trial_table(sens, paper))

@@ -65,12 +65,13 @@ def print_sensitivity(sens: dict, out: Path) -> None:
     """The two tables of points, the answer, and where the files are."""
     t = Table(title=f"accepted n2D against grading width (mu_prep = {sens['settings']['mu_prep']:g})")
     for c in ("grading", "Cu", "d_max mm", "accepted n2D", "sd", "n", "unconv.", "n' accepted",
-              "1st F_top N/m", "1st G N/m", "1st F_top/G", "1st n'"):  # fmt: skip
+              "interior n", "1st F_top N/m", "1st G N/m", "1st F_top/G", "1st n'"):  # fmt: skip
         t.add_column(c, justify="right")
     for p in sens["points"]["grading"]:
         t.add_row(
             p["label"], _f(p["cu"], 3), _f(p["d_max_mm"], 2), _f(p["n2d_mean"]), _f(p["n2d_sd"]),
-            str(p["n"]), str(p["unconverged"]), _f(p["measured_mean"]), _f(p["first_f_top_mean"], 1),
+            str(p["n"]), str(p["unconverged"]), _f(p["measured_mean"]), _f(p.get("interior_mean")),
+            _f(p["first_f_top_mean"], 1),
             _f(p["first_g_mean"], 1), _f(p["first_f_top_over_g_mean"], 1), _f(p["first_n_prime_mean"]),
         )  # fmt: skip
     console.print(t)
