@@ -5,7 +5,8 @@
 
 Prepares the same specimen (grading, preparation friction, trial porosity, seed) once per
 equilibrium measure and prints, per measure: the steps of every layer and of the
-working-friction stage, whether each reached its measure, the wall time, the rattler
+working-friction stage (``s``: the layer ended settled, not by its ratio), whether every stage
+reached its measure, the wall time, the rattler
 fraction of the last layer, and the interior porosity of the result (2 d50 clear of walls
 and surface), so the cost of a measure can be weighed against what it changes in the
 packing. The numba kernels are compiled (or loaded from cache) before the clock starts.
@@ -29,6 +30,12 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="the quick box (0.08 m x 0.04 m, 2 layers)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--budget", type=int, default=400_000, help="steps per stage before the fallback")
+    ap.add_argument(
+        "--settle-drift",
+        type=float,
+        default=None,
+        help="end a layer once settled: its centre of mass moves < this many d50 per 10 000 steps",
+    )
     args = ap.parse_args()
 
     from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
@@ -44,12 +51,15 @@ def main() -> None:
           f"{'all':>4} {'wall s':>7} {'rattlers':>8} {'interior n':>16} {'box n':>7}")  # fmt: skip
     for measure in args.measures.split(","):
         limit = args.mean_ratio if measure == "mean" else args.ratio
-        spec = SpecimenSpec(friction_prep=args.mu, equilibrium=measure, ratio=limit,
-                            max_steps_per_stage=args.budget, **box)  # fmt: skip
+        spec = SpecimenSpec(
+            friction_prep=args.mu, equilibrium=measure, ratio=limit, max_steps_per_stage=args.budget,
+            settle_drift=args.settle_drift, **box,
+        )  # fmt: skip
         t0 = time.perf_counter()
         sim, rep = prepare_specimen(spec, grading, args.porosity, seed=args.seed)
         wall = time.perf_counter() - t0
-        stages = [layer["steps"] for layer in rep["layers"]]
+        stages = [f"{layer['steps']}{'s' if layer['attempts'][-1]['ended_by'] == 'settled' else ''}"
+                  for layer in rep["layers"]]  # fmt: skip
         if rep["final_stage"]:
             stages.append(rep["final_stage"]["steps"])
         rattlers = rep["layers"][-1]["attempts"][-1]["rattler_fraction"]

@@ -57,7 +57,7 @@ WARN_SECONDS = 600.0
 
 
 #: settings recorded with results only when they differ from these defaults (see ``to_dict``)
-OMITTED_AT_DEFAULT = {"equilibrium": "max"}
+OMITTED_AT_DEFAULT = {"equilibrium": "max", "settle_drift": None, "settle_window": 10_000, "settle_checks": 3}
 
 
 @dataclass
@@ -79,6 +79,9 @@ class SpecimenSpec:
     undercompaction: float = 0.0
     ratio: float = 1e-3
     equilibrium: str = "max"
+    settle_drift: float | None = None
+    settle_window: int = 10_000
+    settle_checks: int = 3
     local_damping: float = 0.7
     gravity: float = 9.81
     growth_increments: int = 40
@@ -107,6 +110,10 @@ class SpecimenSpec:
         if self.equilibrium not in MEASURES:
             allowed = "one of " + ", ".join(repr(m) for m in MEASURES)
             raise InputError("equilibrium", self.equilibrium, allowed)
+        if self.settle_drift is not None:
+            check_range("settle_drift", self.settle_drift, 0.0, 0.1, lo_open=True)
+        check_int("settle_window", self.settle_window, 100)
+        check_int("settle_checks", self.settle_checks, 1, 100)
         check_range("local_damping", self.local_damping, 0.0, 1.0, hi_open=True)
         check_range("gravity", self.gravity, 0.0, None)
         check_int("growth_increments", self.growth_increments, 1)
@@ -258,7 +265,9 @@ class LayerReport:
     attempts: list
 
 
-def equilibrate(sim: Simulation, spec: SpecimenSpec, label: str, progress: bool = False) -> dict:
+def equilibrate(
+    sim: Simulation, spec: SpecimenSpec, label: str, progress: bool = False, settle: bool = False
+) -> dict:
     """Cycle to equilibrium (the ratio ``spec.equilibrium`` below ``spec.ratio``), with a fallback.
 
     The measure is the maximum unbalanced-force ratio by default (the paper's); ``mean``
@@ -275,19 +284,37 @@ def equilibrate(sim: Simulation, spec: SpecimenSpec, label: str, progress: bool 
        ratio is a force measure and does not depend on damping, but an equilibrium only
        counts once it holds with the damping of the protocol.
 
-    Stops at the first attempt that reaches the ratio. Returns ``converged``, the total
-    ``steps``, the last ``max_ratio`` and every attempt made (name, steps, max ratio).
+    With ``settle`` and ``spec.settle_drift`` set (stages at the preparation friction), a
+    stage also ends once it has **settled**: the disks' mean height (mass-weighted) moved
+    less than ``settle_drift`` median diameters in each of ``settle_checks`` windows of
+    ``settle_window`` steps running (:func:`settled_test`). A low-friction packing near
+    jamming keeps creeping with an unbalanced-force ratio of 1e-2 for hundreds of thousands
+    of steps while its density no longer changes; the working-friction stage that follows,
+    judged by the ratio alone, then brings the whole specimen to equilibrium.
+
+    Stops at the first attempt that reaches the ratio (or settles). Returns ``converged``,
+    the total ``steps``, the last ``max_ratio``, ``ended_by`` (``ratio``, ``settled`` or
+    ``budget``) and every attempt made (name, steps, ratios, rattler fraction, how it ended).
     """
     attempts: list[dict] = []
+    drift = spec.settle_drift if settle else None
 
     def attempt(name: str, budget: int) -> bool:
         bar = (label if name == "normal" else f"{label} ({name})") if progress else False
-        res = sim.solve(spec.ratio, budget, progress=bar, measure=spec.equilibrium)
+        if drift is None:
+            res = sim.solve(spec.ratio, budget, progress=bar, measure=spec.equilibrium)
+            calm = False
+        else:
+            test = settled_test(sim, drift, spec.settle_checks)
+            res = sim.run(budget, until_ratio=spec.ratio, measure=spec.equilibrium, every=spec.settle_window,
+                          callback=test, progress=bar)  # fmt: skip
+            calm = test.settled  # type: ignore[attr-defined]
+        ended = "ratio" if res.converged else ("settled" if calm else "budget")
         attempts.append({
             "attempt": name, "steps": res.steps, "max_ratio": res.max_ratio, "mean_ratio": res.mean_ratio,
-            "loaded_max_ratio": res.loaded_ratio, "rattler_fraction": res.rattler_fraction,
+            "loaded_max_ratio": res.loaded_ratio, "rattler_fraction": res.rattler_fraction, "ended_by": ended,
         })  # fmt: skip
-        return res.converged
+        return res.converged or calm
 
     ok = attempt("normal", spec.max_steps_per_stage)
     if not ok:
@@ -310,8 +337,37 @@ def equilibrate(sim: Simulation, spec: SpecimenSpec, label: str, progress: bool 
         "measure": spec.equilibrium,
         "measured_ratio": last[_ATTEMPT_KEY[spec.equilibrium]],
         "rattler_fraction": last["rattler_fraction"],
+        "ended_by": last["ended_by"],
         "attempts": attempts,
     }
+
+
+def settled_test(sim: Simulation, drift_d50: float, checks: int):
+    """A run callback: True once the disks' mean height moved < ``drift_d50`` d50 in ``checks`` calls running.
+
+    The height is mass-weighted (the packing's centre of mass: it falls while the packing
+    compacts under gravity); d50 is the median diameter by area of the disks. The callback's
+    ``settled`` attribute says whether it stopped the run.
+    """
+    from poro2d.specimen.porosity_regions import mass_d50
+
+    p = sim.particles
+    tol = drift_d50 * mass_d50(p.radius)
+    last: list[float] = []
+    calm = [0]
+
+    def height() -> float:
+        return float(np.sum(p.mass * p.pos[:, 1]) / np.sum(p.mass))
+
+    def test(_sim: Simulation) -> bool:
+        y = height()
+        calm[0] = calm[0] + 1 if last and abs(y - last[0]) < tol else 0
+        last[:] = [y]
+        test.settled = calm[0] >= checks  # type: ignore[attr-defined]
+        return test.settled  # type: ignore[attr-defined]
+
+    test.settled = False  # type: ignore[attr-defined]
+    return test
 
 
 #: the key of each measure's ratio in an attempt's record
@@ -430,7 +486,7 @@ def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.nda
     # renumber the whole packing in strips across its short side (the new layer was
     # appended on top): threads then split it along a short cut (dem.ordering)
     sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
-    eq = equilibrate(sim, spec, f"layer {k + 1}", progress)
+    eq = equilibrate(sim, spec, f"layer {k + 1}", progress, settle=True)
     steps += eq["steps"]
     report = LayerReport(k + 1, len(idx), y_top, plc.scale, steps, eq["max_ratio"], eq["converged"],
                          eq["attempts"])  # fmt: skip
