@@ -415,7 +415,7 @@ def density_relation(
     from poro2d.sweep.cases import parse_sweep
     from poro2d.sweep.runner import run_sweep
 
-    cfg = sweep_config(base, settings["n_lab"], quick=quick)
+    cfg = D.with_density_defaults(sweep_config(base, settings["n_lab"], quick=quick))
     cfg.pop("sweep")
     cal, cal_info = D.calibrate(cfg, base_dir, out, mus=mus or DEFAULT_MUS, seeds=seeds,
                                 use_cache=use_cache, **sweep_kw)  # fmt: skip
