@@ -125,6 +125,14 @@ _STATUS_NAMES = ("zero_energy", "force_balance", "max_steps")
 
 
 # ----------------------------------------------------------------------------- compiled kernels
+@njit(inline="always", cache=True)
+def _nearest_image(pos, i, j, lx, ly):
+    """The separation from disk i to the nearest periodic image of disk j."""
+    dx = pos[j, 0] - pos[i, 0]
+    dy = pos[j, 1] - pos[i, 1]
+    return dx - lx * np.rint(dx / lx), dy - ly * np.rint(dy / ly)
+
+
 @njit(cache=True)
 def _cell_index(x: float, length: float, ncell: int) -> int:
     """The cell of coordinate ``x`` in a periodic row of ``ncell`` cells of total ``length``."""
@@ -170,10 +178,7 @@ def _scan_pairs(pos, rad, lx, ly, skin, nx, ny, cell, start, order, pi, pj, fill
                     j = order[k]
                     if j <= i:
                         continue
-                    dx = pos[j, 0] - pos[i, 0]
-                    dy = pos[j, 1] - pos[i, 1]
-                    dx -= lx * np.rint(dx / lx)
-                    dy -= ly * np.rint(dy / ly)
+                    dx, dy = _nearest_image(pos, i, j, lx, ly)
                     cut = rad[i] + rad[j] + skin
                     if dx * dx + dy * dy < cut * cut:
                         if fill:
@@ -211,10 +216,7 @@ def _forces(pos, rad, lx, ly, pi, pj, force, stats):
     for k in range(pi.shape[0]):
         i = pi[k]
         j = pj[k]
-        dx = pos[j, 0] - pos[i, 0]
-        dy = pos[j, 1] - pos[i, 1]
-        dx -= lx * np.rint(dx / lx)
-        dy -= ly * np.rint(dy / ly)
+        dx, dy = _nearest_image(pos, i, j, lx, ly)
         s = rad[i] + rad[j]
         r2 = dx * dx + dy * dy
         if r2 >= s * s:
@@ -350,10 +352,7 @@ def _contact_counts(pos, rad, lx, ly):
     for k in range(pi.shape[0]):
         i = pi[k]
         j = pj[k]
-        dx = pos[j, 0] - pos[i, 0]
-        dy = pos[j, 1] - pos[i, 1]
-        dx -= lx * np.rint(dx / lx)
-        dy -= ly * np.rint(dy / ly)
+        dx, dy = _nearest_image(pos, i, j, lx, ly)
         s = rad[i] + rad[j]
         r = math.sqrt(dx * dx + dy * dy)
         if r < s:
