@@ -420,7 +420,10 @@ def density_relation(
     cal, cal_info = D.calibrate(cfg, base_dir, out, mus=mus or DEFAULT_MUS, seeds=seeds,
                                 use_cache=use_cache, **sweep_kw)  # fmt: skip
     targets = [state_target(n, settings["n_max"], settings["n_min"], cal) for n in settings["n_lab"]]
-    resolution = float((cfg.get("criterion") or {}).get("resolution", 0.01))
+    crit = cfg.get("criterion") or {}
+    # the first trial on the grid the criterion steps on: half the refined tolerance, else the resolution
+    refine = crit.get("refine_tolerance")
+    resolution = float(refine) / 2.0 if refine else float(crit.get("resolution", 0.01))
     sweep = parse_sweep(D.state_sweep(cfg, targets, seeds, resolution), base_dir)
     cal_sweep = parse_sweep(D.calibration_sweep(cfg, list(mus or DEFAULT_MUS), seeds), base_dir)
     twins = D.calibration_twins(cal_sweep, sweep, base_dir, Path(cal_info["cases"]))
