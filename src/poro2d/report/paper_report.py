@@ -46,7 +46,7 @@ def _intro_blocks(summary: dict, crit: dict) -> list[Block]:
         + (" Quick mode: a reduced specimen, not the paper's box." if summary.get("quick") else ""),
     ))  # fmt: skip
     b.append(("h2", "Summary"))
-    rows = [["accepted 2D porosity (trial n2D)", crit.get("final_porosity"), pc["accepted_porosity"]]]
+    rows = [["accepted 2D porosity", crit.get("final_porosity"), pc["accepted_porosity"]]]
     if crit.get("interior_porosity") is not None:
         rows.append(["box porosity n' of the accepted specimen (gap under the plate included)",
                      crit.get("box_porosity"), "-"])  # fmt: skip
