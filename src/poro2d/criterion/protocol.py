@@ -279,7 +279,7 @@ def porosity_numbers(sim: Simulation, width: float, plate_y: float) -> dict:
     p = sim.particles
     try:
         m = measure_specimen(p.pos, p.radius, width, plate_y).to_dict()
-    except InputError as e:
+    except (InputError, RuntimeError) as e:  # too small to measure; a degenerate tessellation
         return {"box_porosity": 1.0 - p.area() / (width * plate_y), "interior_porosity": None,
                 "interior_porosity_note": str(e)}  # fmt: skip
     return {k: m[k] for k in POROSITY_KEYS}
@@ -802,7 +802,7 @@ class PorosityCriterion:
         p = sim.particles
         try:
             m = measure_specimen(p.pos, p.radius, self.spec.width, top)
-        except InputError as e:
+        except (InputError, RuntimeError) as e:
             write_json(self.out / "specimen_porosity.json", {"trial_porosity": n2d, "note": str(e),
                                                               "provenance": provenance()})  # fmt: skip
             return

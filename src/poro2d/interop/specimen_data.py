@@ -152,7 +152,7 @@ class SpecimenData:
             xlo, xhi, ylo, yhi = self.box()
             pos = np.column_stack([self.x - xlo, self.y - ylo])
             m = measure_specimen(pos, self.radius, xhi - xlo, yhi - ylo)
-        except InputError:
+        except (InputError, RuntimeError):  # no box, too small, or a degenerate tessellation
             return []
         return [
             f"box porosity n' = {m.box_porosity:.4f} (the paper's: box {xhi - xlo:.4g} m x {yhi - ylo:.4g} m "
