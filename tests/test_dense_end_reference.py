@@ -55,8 +55,9 @@ def test_dense_end_interior_matches_the_jamming_reference(name):
 
 
 CU_2_5_GAP = (
-    "log-linear Cu 2.5: the dense end is 0.010-0.015 looser than the reference "
-    "(measured 0.148 and 0.151 against 0.1375; docs/jamming.md); not yet explained"
+    "log-linear Cu 2.5: the criterion reaches the dense end from the loose side, and its "
+    "gravity-settled frictionless packing is 0.010-0.015 looser than the compressed one "
+    "(0.148 and 0.151 against 0.1375; from the dense side 0.138; docs/jamming.md)"
 )
 
 
