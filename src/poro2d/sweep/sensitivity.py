@@ -445,8 +445,10 @@ def run_sensitivity(
     res = run_sweep(sweep, out / "grading", **sweep_kw)
     timings["grading_s"] = time.perf_counter() - t0
     t1 = time.perf_counter()
-    cal, cal_info = D.calibrate(cfg, base_dir, out / "mu_prep", mus=settings["mus"], seeds=settings["seeds"],
-                                use_cache=use_cache, **sweep_kw)  # fmt: skip
+    # the friction axis is the density calibration, with its settings (layers that settle):
+    # the same cases as the relation's, read back from the shared cache when it ran them
+    cal, cal_info = D.calibrate(D.with_density_defaults(cfg), base_dir, out / "mu_prep", mus=settings["mus"],
+                                seeds=settings["seeds"], use_cache=use_cache, **sweep_kw)  # fmt: skip
     timings["mu_prep_s"] = time.perf_counter() - t1
 
     grads = [g.describe() for g in cases]
