@@ -9,7 +9,7 @@ from poro2d.criterion.protocol import wall_forces
 from poro2d.dem import Simulation
 from poro2d.dem.measure import contact_set
 from poro2d.errors import InputError
-from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen, settled_test
+from poro2d.specimen.compaction import SettledTest, SpecimenSpec, prepare_specimen
 from poro2d.specimen.grading import preset_grading
 
 
@@ -83,7 +83,7 @@ def test_new_settings_are_recorded_only_when_changed():
 def test_settled_test_needs_its_windows_running():
     sim = _column()
     sim.run(30000)
-    test = settled_test(sim, 1e-3, checks=3)
+    test = SettledTest(sim, 1e-3, checks=3)
     calls = [test(sim) for _ in range(4)]  # the state does not move between calls
     assert calls == [False, False, False, True]
     assert test.settled

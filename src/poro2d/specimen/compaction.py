@@ -287,7 +287,7 @@ def equilibrate(
     With ``settle`` and ``spec.settle_drift`` set (stages at the preparation friction), a
     stage also ends once it has **settled**: the disks' mean height (mass-weighted) moved
     less than ``settle_drift`` median diameters in each of ``settle_checks`` windows of
-    ``settle_window`` steps running (:func:`settled_test`). A low-friction packing near
+    ``settle_window`` steps running (:class:`SettledTest`). A low-friction packing near
     jamming keeps creeping with an unbalanced-force ratio of 1e-2 for hundreds of thousands
     of steps while its density no longer changes; the working-friction stage that follows,
     judged by the ratio alone, then brings the whole specimen to equilibrium.
@@ -305,10 +305,10 @@ def equilibrate(
             res = sim.solve(spec.ratio, budget, progress=bar, measure=spec.equilibrium)
             calm = False
         else:
-            test = settled_test(sim, drift, spec.settle_checks)
+            test = SettledTest(sim, drift, spec.settle_checks)
             res = sim.run(budget, until_ratio=spec.ratio, measure=spec.equilibrium, every=spec.settle_window,
                           callback=test, progress=bar)  # fmt: skip
-            calm = test.settled  # type: ignore[attr-defined]
+            calm = test.settled
         ended = "ratio" if res.converged else ("settled" if calm else "budget")
         attempts.append({
             "attempt": name, "steps": res.steps, "max_ratio": res.max_ratio, "mean_ratio": res.mean_ratio,
@@ -342,32 +342,30 @@ def equilibrate(
     }
 
 
-def settled_test(sim: Simulation, drift_d50: float, checks: int):
+class SettledTest:
     """A run callback: True once the disks' mean height moved < ``drift_d50`` d50 in ``checks`` calls running.
 
     The height is mass-weighted (the packing's centre of mass: it falls while the packing
-    compacts under gravity); d50 is the median diameter by area of the disks. The callback's
-    ``settled`` attribute says whether it stopped the run.
+    compacts under gravity); d50 is the median diameter by area of the disks. ``settled``
+    says whether it stopped the run.
     """
-    from poro2d.specimen.porosity_regions import mass_d50
 
-    p = sim.particles
-    tol = drift_d50 * mass_d50(p.radius)
-    last: list[float] = []
-    calm = [0]
+    def __init__(self, sim: Simulation, drift_d50: float, checks: int) -> None:
+        from poro2d.specimen.porosity_regions import mass_d50
 
-    def height() -> float:
-        return float(np.sum(p.mass * p.pos[:, 1]) / np.sum(p.mass))
+        self.tol = drift_d50 * mass_d50(sim.particles.radius)
+        self.checks = checks
+        self.calm = 0
+        self.last: float | None = None
+        self.settled = False
 
-    def test(_sim: Simulation) -> bool:
-        y = height()
-        calm[0] = calm[0] + 1 if last and abs(y - last[0]) < tol else 0
-        last[:] = [y]
-        test.settled = calm[0] >= checks  # type: ignore[attr-defined]
-        return test.settled  # type: ignore[attr-defined]
-
-    test.settled = False  # type: ignore[attr-defined]
-    return test
+    def __call__(self, sim: Simulation) -> bool:
+        p = sim.particles
+        y = float(np.sum(p.mass * p.pos[:, 1]) / np.sum(p.mass))
+        self.calm = self.calm + 1 if self.last is not None and abs(y - self.last) < self.tol else 0
+        self.last = y
+        self.settled = self.calm >= self.checks
+        return self.settled
 
 
 #: the key of each measure's ratio in an attempt's record
