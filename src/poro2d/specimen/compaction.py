@@ -514,6 +514,7 @@ def box_porosity(sim: Simulation, width: float, top: float, bottom: float = 0.0)
 
 
 __all__ = [
+    "SettledTest",
     "SizeEstimate",
     "SpecimenSpec",
     "box_porosity",
