@@ -61,6 +61,7 @@ def test_the_stop_test_compares_the_measure_it_is_given():
         res = _column(seed=2).run(horizon, until_ratio=target, check_every=100, measure=measure)
         assert res.converged and res.measure == measure
         assert res.steps == first, measure
+        assert res.measured_ratio == seen[first // 100 - 1][measure] < target
 
 
 def test_an_unknown_measure_is_refused_by_name():

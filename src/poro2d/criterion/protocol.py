@@ -127,6 +127,11 @@ def round_to(x: float, step: float) -> float:
     return round(round(x / step) * step, 10)
 
 
+def trial_grid(resolution: float, refine_tolerance: float | None) -> float:
+    """The grid trials step on: the resolution (0.01), or half the refined tolerance."""
+    return resolution if refine_tolerance is None else refine_tolerance / 2.0
+
+
 def next_trial(rows: list[dict], s: CriterionSettings) -> float:
     """The next trial porosity after the trials ``rows`` (none accepted).
 
@@ -144,7 +149,7 @@ def next_trial(rows: list[dict], s: CriterionSettings) -> float:
         if nxt == n:  # rounding fell back: step one resolution towards n'
             nxt = round_to(n + math.copysign(s.resolution, new - n), s.resolution)
         return nxt
-    step = s.refine_tolerance / 2.0
+    step = trial_grid(s.resolution, s.refine_tolerance)
     nxt = round_to(new, step)
     if nxt == n:
         nxt = round_to(n + math.copysign(step, new - n), step)
@@ -479,7 +484,7 @@ class PorosityCriterion:
             "plate round %d: F_top %.4g N/m (limit %.4g), held: converged %s ratio %.3g, %d steps",
             rounds, f, cap, res.converged, res.max_ratio, steps,
         )  # fmt: skip
-        return steps, in_window(f, weight, s.force_fraction), sim.ratio_of(self.spec.equilibrium)
+        return steps, in_window(f, weight, s.force_fraction), res.measured_ratio
 
     def _in_window_check(self, top: int, t: float, weight: float) -> Callable[[Simulation], bool]:
         """The approach's stop test: F_top in the window for ``window_checks`` checks running."""

@@ -110,6 +110,11 @@ class RunResult:
     measure: str = "max"  # the ratio the stop test compared with its target
 
     @property
+    def measured_ratio(self) -> float:
+        """The ratio of the measure the stop test compared (``max``, ``mean`` or ``loaded_max``)."""
+        return {"max": self.max_ratio, "mean": self.mean_ratio, "loaded_max": self.loaded_ratio}[self.measure]
+
+    @property
     def particle_steps_per_s(self) -> float:
         return self.particle_steps / self.wall_time_s if self.wall_time_s > 0 else math.nan
 

@@ -312,7 +312,8 @@ def equilibrate(
         ended = "ratio" if res.converged else ("settled" if calm else "budget")
         attempts.append({
             "attempt": name, "steps": res.steps, "max_ratio": res.max_ratio, "mean_ratio": res.mean_ratio,
-            "loaded_max_ratio": res.loaded_ratio, "rattler_fraction": res.rattler_fraction, "ended_by": ended,
+            "loaded_max_ratio": res.loaded_ratio, "measured_ratio": res.measured_ratio,
+            "rattler_fraction": res.rattler_fraction, "ended_by": ended,
         })  # fmt: skip
         return res.converged or calm
 
@@ -335,7 +336,7 @@ def equilibrate(
         "steps": sum(a["steps"] for a in attempts),
         "max_ratio": last["max_ratio"],
         "measure": spec.equilibrium,
-        "measured_ratio": last[_ATTEMPT_KEY[spec.equilibrium]],
+        "measured_ratio": last["measured_ratio"],
         "rattler_fraction": last["rattler_fraction"],
         "ended_by": last["ended_by"],
         "attempts": attempts,
@@ -366,10 +367,6 @@ class SettledTest:
         self.last = y
         self.settled = self.calm >= self.checks
         return self.settled
-
-
-#: the key of each measure's ratio in an attempt's record
-_ATTEMPT_KEY = {"max": "max_ratio", "mean": "mean_ratio", "loaded_max": "loaded_max_ratio"}
 
 
 def _band_particles(spec: SpecimenSpec, pos, radii) -> Particles:
@@ -433,7 +430,7 @@ def prepare_specimen(
         "failed_stage": None if failed is None else failed[0],
         "failed_max_ratio": None if failed is None else failed[1]["max_ratio"],
         "failed_steps": None if failed is None else failed[1]["steps"],
-        "failed_ratio": None if failed is None else failed[1].get("measured_ratio", failed[1]["max_ratio"]),
+        "failed_ratio": None if failed is None else failed[1]["measured_ratio"],
         "equilibrium": spec.equilibrium,
     }
     return sim, report

@@ -411,6 +411,7 @@ def density_relation(
     record of the two sweeps (calibration source, summaries).
     """
     from poro2d.criterion.density import DEFAULT_MUS, state_target
+    from poro2d.criterion.protocol import trial_grid
     from poro2d.sweep import density as D
     from poro2d.sweep.cases import parse_sweep
     from poro2d.sweep.runner import run_sweep
@@ -422,8 +423,7 @@ def density_relation(
     targets = [state_target(n, settings["n_max"], settings["n_min"], cal) for n in settings["n_lab"]]
     crit = cfg.get("criterion") or {}
     # the first trial on the grid the criterion steps on: half the refined tolerance, else the resolution
-    refine = crit.get("refine_tolerance")
-    resolution = float(refine) / 2.0 if refine else float(crit.get("resolution", 0.01))
+    resolution = trial_grid(float(crit.get("resolution", 0.01)), crit.get("refine_tolerance"))
     sweep = parse_sweep(D.state_sweep(cfg, targets, seeds, resolution), base_dir)
     cal_sweep = parse_sweep(D.calibration_sweep(cfg, list(mus or DEFAULT_MUS), seeds), base_dir)
     twins = D.calibration_twins(cal_sweep, sweep, base_dir, Path(cal_info["cases"]))
