@@ -33,6 +33,17 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.config import check_finite
+from poro2d.criterion.lid import (
+    FlatPlate,
+    SegmentedLid,
+    fill_porosity,
+    flat_top,
+    lid_force,
+    lid_indices,
+    lid_numbers,
+    lid_profile,
+    lid_window_note,
+)
 from poro2d.criterion.result import CriterionResult
 from poro2d.dem import Simulation, checkpoint
 from poro2d.errors import InputError, check_range
@@ -41,12 +52,19 @@ from poro2d.porosity import PAPER_N_LAB, parabolic
 from poro2d.resumable import Fingerprint, ResumableStage
 from poro2d.specimen.compaction import SpecimenSpec, box_porosity, prepare_specimen
 from poro2d.specimen.grading import GradingCurve
+from poro2d.specimen.porosity_regions import lid_height_at, mass_d50
 
 _log = logging.getLogger(__name__)
 
 #: specimen settings that change how fast a run goes, never its numbers: a rerun with
 #: other values resumes (the engine sums in the same order on any number of threads)
 PERFORMANCE_KEYS = ("threads",)
+
+
+#: how a trial's specimen is judged full: "plate", the paper's rigid top plate (its n' includes
+#: the gap under the plate); "fill", a segmented lid that rests on the grains over the width
+#: (:mod:`poro2d.criterion.lid`; n' is the porosity of the box the specimen fills)
+ACCEPTANCE_MODES = ("plate", "fill")
 
 
 @dataclass
@@ -72,6 +90,7 @@ class CriterionSettings:
     generation_tolerance: float = 1e-3
     balance_tolerance: float = 0.01
     refine_tolerance: float | None = None
+    acceptance: str = "plate"
 
     def __post_init__(self) -> None:
         check_range("n_lab", self.n_lab, 0.0, 1.0, hi_open=True)
@@ -100,6 +119,8 @@ class CriterionSettings:
         check_range("balance_tolerance", self.balance_tolerance, 0.0, 0.5, lo_open=True)
         if self.refine_tolerance is not None:
             check_range("refine_tolerance", self.refine_tolerance, 1e-4, self.porosity_tolerance)
+        if self.acceptance not in ACCEPTANCE_MODES:
+            raise InputError("acceptance", self.acceptance, f"one of {', '.join(ACCEPTANCE_MODES)}")
 
     @property
     def tolerance(self) -> float:
@@ -109,11 +130,14 @@ class CriterionSettings:
     def to_record(self) -> dict:
         """The settings as recorded with results; ``refine_tolerance`` only when set.
 
-        Left out while unset, so folders written before the option existed still resume.
+        Left out while unset (and ``acceptance`` while "plate"), so folders written before
+        the options existed still resume.
         """
         d = asdict(self)
         if d["refine_tolerance"] is None:
             del d["refine_tolerance"]
+        if d["acceptance"] == "plate":
+            del d["acceptance"]
         return d
 
     def initial_trial(self) -> float:
@@ -164,12 +188,14 @@ def next_trial(rows: list[dict], s: CriterionSettings) -> float:
 def wall_forces(sim: Simulation) -> dict:
     """Top, bottom and side wall forces per metre of thickness (N/m).
 
-    ``f_top`` is the upward push of the disks on the top plate, ``f_bottom`` the
+    ``f_top`` is the upward push of the disks on the top plate (and lid), ``f_bottom`` the
     downward push on the bottom wall, ``side_friction_up`` the upward friction of
     the side walls on the disks (what the side walls carry of the weight).
     """
     t = sim.particles.thickness
     top = sim.wall_force("top") / t
+    if lid_indices(sim):  # the fill acceptance's lid carries what the parked plate does not
+        top = top + np.array([0.0, lid_force(sim) / t])
     bottom = sim.wall_force("bottom") / t
     left = sim.wall_force("left") / t
     right = sim.wall_force("right") / t
@@ -271,19 +297,22 @@ POROSITY_KEYS = (
 )  # fmt: skip
 
 
-def porosity_numbers(sim: Simulation, width: float, plate_y: float) -> dict:
+def porosity_numbers(
+    sim: Simulation, width: float, plate_y: float, lid: tuple[np.ndarray, np.ndarray] | None = None
+) -> dict:
     """The specimen's porosities beside the paper's n' (:mod:`poro2d.specimen.porosity_regions`).
 
     ``box_porosity`` is the paper's: W x plate height, the gap under the plate included;
     ``interior_porosity`` (mean over measurement circles 2 d50 clear of every wall and of the
     free surface, with its spread) is the packing's own. A specimen too small to measure
-    gets ``interior_porosity = None`` and the reason in ``interior_porosity_note``.
+    gets ``interior_porosity = None`` and the reason in ``interior_porosity_note``. With a
+    ``lid`` (edges, heights), the box porosity and the gap are those under the lid.
     """
     from poro2d.specimen.porosity_regions import measure_specimen
 
     p = sim.particles
     try:
-        m = measure_specimen(p.pos, p.radius, width, plate_y).to_dict()
+        m = measure_specimen(p.pos, p.radius, width, plate_y, lid=lid).to_dict()
     except (InputError, RuntimeError) as e:  # too small to measure; a degenerate tessellation
         return {"box_porosity": 1.0 - p.area() / (width * plate_y), "interior_porosity": None,
                 "interior_porosity_note": str(e)}  # fmt: skip
@@ -409,7 +438,8 @@ class PorosityCriterion:
     def _figure(self, sim: Simulation, path: Path, title: str, forces: dict) -> None:
         from poro2d.report.force_chains import plot_simulation_force_chains
 
-        plate = float(sim.walls.p0[sim.walls.index("top"), 1])
+        lid = self._lid(sim)
+        plate = float(sim.walls.p0[sim.walls.index("top"), 1]) if lid is None else float(lid[1].max())
         plot_simulation_force_chains(
             sim, path, title=title, box=(0.0, 0.0, self.spec.width, plate),
             notes=[
@@ -419,8 +449,10 @@ class PorosityCriterion:
             ],
         )  # fmt: skip
 
-    def _move_plate(self, sim: Simulation, n: float, weight: float) -> dict:
-        """Servo the top plate until 0 < F_top < fraction G holds at equilibrium.
+    def _move_plate(
+        self, sim: Simulation, n: float, weight: float, top: FlatPlate | SegmentedLid | None = None
+    ) -> dict:
+        """Servo the top plate (or the lid) until 0 < F_top < fraction G holds at equilibrium.
 
         Each round (:meth:`_plate_round`) has two phases. The approach servos the plate
         briskly towards ``servo_target_fraction`` x the limit until F_top has stayed in the
@@ -431,18 +463,21 @@ class PorosityCriterion:
         ``settle_checks`` checks (drift below ``plate_drift`` x H: only creep left). The
         plate is then held still, the specimen cycled towards equilibrium, and F_top checked
         once more (the final ratio is reported); if it left the window, a new round starts.
+        A lid (:class:`~poro2d.criterion.lid.SegmentedLid`) is driven the same way, its
+        segments each to their share of the force, and counts as in the window only while
+        it rests on the specimen over most of the width.
         """
         s = self.settings
-        top = sim.walls.index("top")
-        y_start = float(sim.walls.p0[top, 1])
+        top = FlatPlate(sim) if top is None else top
+        y_start = top.height(sim)
         steps = 0
         rounds = 0
         ok = False
         final_ratio = float("nan")
         while steps < s.max_plate_steps and not ok:
             rounds += 1
-            steps, ok, final_ratio = self._plate_round(sim, weight, rounds, steps)
-        y_end = float(sim.walls.p0[top, 1])
+            steps, ok, final_ratio = self._plate_round(sim, weight, rounds, steps, top)
+        y_end = top.height(sim)
         return {
             "plate_settled": ok,
             "plate_steps": steps,
@@ -453,7 +488,7 @@ class PorosityCriterion:
         }
 
     def _plate_round(
-        self, sim: Simulation, weight: float, rounds: int, steps: int
+        self, sim: Simulation, weight: float, rounds: int, steps: int, top: FlatPlate | SegmentedLid
     ) -> tuple[int, bool, float]:
         """One round of :meth:`_move_plate`: approach, settle, hold the plate still.
 
@@ -464,41 +499,48 @@ class PorosityCriterion:
         s = self.settings
         t = sim.particles.thickness
         cap = s.force_fraction * weight  # N/m
-        top = sim.walls.index("top")
         target = s.servo_target_fraction * cap * t  # N
 
         def left() -> int:
             return max(s.max_plate_steps - steps, 1)
 
-        sim.set_wall_servo("top", target, (0.0, -1.0), s.servo_max_speed, s.servo_gain)
-        label = f"top plate (round {rounds})" if self.progress else False
-        steady = self._in_window_check(top, t, weight)
+        top.servo(sim, target, s.servo_max_speed, s.servo_gain)
+        label = f"top {top.name} (round {rounds})" if self.progress else False
+        steady = self._in_window_check(top, target, weight)
         steps += sim.run(left(), every=s.check_every, callback=steady, progress=label).steps
-        sim.set_wall_servo("top", target, (0.0, -1.0), s.settle_max_speed, s.settle_gain)
-        steps += sim.run(left(), every=s.check_every, callback=self._settled_check(top, t, weight)).steps
-        sim.set_wall_velocity("top", (0.0, 0.0))
+        top.servo(sim, target, s.settle_max_speed, s.settle_gain)
+        steps += sim.run(left(), every=s.check_every, callback=self._settled_check(top, target, weight)).steps
+        top.hold(sim)
         res = sim.solve(self.spec.ratio, min(left(), 20 * s.check_every), measure=self.spec.equilibrium)
         steps += res.steps
-        f = sim.wall_force(top)[1] / t
+        f = top.force(sim) / t
         _log.debug(
             "plate round %d: F_top %.4g N/m (limit %.4g), held: converged %s ratio %.3g, %d steps",
             rounds, f, cap, res.converged, res.max_ratio, steps,
         )  # fmt: skip
-        return steps, in_window(f, weight, s.force_fraction), res.measured_ratio
+        ok = in_window(f, weight, s.force_fraction) and top.resting(sim, target)
+        return steps, ok, res.measured_ratio
 
-    def _in_window_check(self, top: int, t: float, weight: float) -> Callable[[Simulation], bool]:
+    def _in_window(self, sm: Simulation, top: FlatPlate | SegmentedLid, target: float, weight: float) -> bool:
+        f = top.force(sm) / sm.particles.thickness
+        return in_window(f, weight, self.settings.force_fraction) and top.resting(sm, target)
+
+    def _in_window_check(
+        self, top: FlatPlate | SegmentedLid, target: float, weight: float
+    ) -> Callable[[Simulation], bool]:
         """The approach's stop test: F_top in the window for ``window_checks`` checks running."""
         s = self.settings
         streak = [0]
 
         def steady(sm: Simulation) -> bool:
-            f = sm.wall_force(top)[1] / t
-            streak[0] = streak[0] + 1 if in_window(f, weight, s.force_fraction) else 0
+            streak[0] = streak[0] + 1 if self._in_window(sm, top, target, weight) else 0
             return streak[0] >= s.window_checks
 
         return steady
 
-    def _settled_check(self, top: int, t: float, weight: float) -> Callable[[Simulation], bool]:
+    def _settled_check(
+        self, top: FlatPlate | SegmentedLid, target: float, weight: float
+    ) -> Callable[[Simulation], bool]:
         """The settling phase's stop test: F_top in the window and the specimen at rest.
 
         At rest means at equilibrium, or a plate that rests in the window while the
@@ -509,13 +551,12 @@ class PorosityCriterion:
         calm: list[float] = []
 
         def settled(sm: Simulation) -> bool:
-            f = sm.wall_force(top)[1] / t
-            if not in_window(f, weight, s.force_fraction):
+            if not self._in_window(sm, top, target, weight):
                 calm.clear()
                 return False
             if sm.ratio_of(self.spec.equilibrium) < self.spec.ratio:
                 return True
-            calm.append(float(sm.walls.p0[top, 1]))
+            calm.append(top.height(sm))
             if len(calm) < s.settle_checks:
                 return False
             return (
@@ -567,36 +608,19 @@ class PorosityCriterion:
                 equilibrium=self.spec.equilibrium,
             )  # fmt: skip
             after = forces0
-        elif in_window(f_top, weight, s.force_fraction):
+        elif s.acceptance == "plate" and in_window(f_top, weight, s.force_fraction):
             row.update(plate_moved="no", plate_displacement_m=0.0, new_porosity=n, plate_settled=True)
             after = forces0
         else:
-            row["plate_moved"] = "down" if f_top <= 0.0 else "up"
-            row.update(self._move_plate(sim, n, weight))
-            row["new_porosity"] = box_porosity(sim, self.spec.width, row["plate_height_m"])
-            after = wall_forces(sim)
-            if d is not None:
-                checkpoint.save(sim, d / "after_plate.npz", extra={"stage": "after_plate"})
-                if self.figures:
-                    after_fig = dict(after, weight_n_per_m=weight)
-                    self._figure(
-                        sim, d / "forces_after_plate.png",
-                        f"after moving the top plate {row['plate_moved']}: n' = {row['new_porosity']:.4f}",
-                        after_fig,
-                    )  # fmt: skip
-            if not row["plate_settled"]:
-                row.update(
-                    converged=False, failed_stage="top plate",
-                    failed_max_ratio=row["plate_final_max_ratio"], failed_steps=row["plate_steps"],
-                )  # fmt: skip
+            after = self._top_stage(sim, n, weight, row, d)
         row["f_top_after_n_per_m"] = after["f_top_n_per_m"]
         row["f_bottom_after_n_per_m"] = after["f_bottom_n_per_m"]
         row["side_friction_up_after_n_per_m"] = after["side_friction_up_n_per_m"]
         row["porosity_change"] = None if row["new_porosity"] is None else abs(row["new_porosity"] - n)
-        checks, numbers = specimen_checks(sim, self.spec, prep, n, float(sim.walls.p0[top, 1]), after, s)
+        checks, numbers = specimen_checks(sim, self.spec, prep, n, self._top_at_disks(sim), after, s)
         row.update(numbers)
         if row["converged"]:
-            row.update(porosity_numbers(sim, self.spec.width, float(sim.walls.p0[top, 1])))
+            row.update(porosity_numbers(sim, self.spec.width, float(sim.walls.p0[top, 1]), self._lid(sim)))
         # the plate stage is part of the record: False when it did not settle or never ran
         checks = {"preparation_converged": checks.pop("preparation_converged"),
                   "plate_settled": bool(row.get("plate_settled", False)), **checks}  # fmt: skip
@@ -605,6 +629,80 @@ class PorosityCriterion:
         row["time_prepare_s"] = t_prep
         row["time_plate_s"] = time.perf_counter() - t1
         return row
+
+    def _top_stage(self, sim: Simulation, n: float, weight: float, row: dict, d: Path | None) -> dict:
+        """Move the plate (or rest the lid) until the force window holds; returns the wall forces.
+
+        Paper acceptance: the plate moves down when F_top = 0 and up when it is too large,
+        and n' is the box porosity under it. Fill acceptance: the lid replaces the plate
+        and n' is the porosity of the area under it (:func:`~poro2d.criterion.lid.fill_porosity`).
+        """
+        f_top = row["f_top_n_per_m"]
+        if self.settings.acceptance == "fill":
+            row["plate_moved"] = "lid"
+            if not in_window(f_top, weight, self.settings.force_fraction):
+                # the plate first takes the specimen to the window (a dense trial pushes hard
+                # and swells for long): the lid then only has the surface left to follow
+                plate = self._move_plate(sim, n, weight)
+                if not plate["plate_settled"]:
+                    row.update(plate)
+                    row["new_porosity"] = box_porosity(sim, self.spec.width, row["plate_height_m"])
+                    return self._after_top(sim, weight, row, d)
+            lid = SegmentedLid(sim, self.spec.width, mass_d50(sim.particles.radius))
+            row.update(self._move_plate(sim, n, weight, lid))
+            profile = lid_profile(sim, self.spec.width)
+            row["new_porosity"] = fill_porosity(sim.particles.radius, profile)
+            row.update(lid_numbers(sim, profile, self._lid_target(weight, sim)))
+            row["lid_note"] = lid_window_note(sim, profile, row["force_limit_n_per_m"])
+        else:
+            row["plate_moved"] = "down" if f_top <= 0.0 else "up"
+            row.update(self._move_plate(sim, n, weight))
+            row["new_porosity"] = box_porosity(sim, self.spec.width, row["plate_height_m"])
+        return self._after_top(sim, weight, row, d)
+
+    def _after_top(self, sim: Simulation, weight: float, row: dict, d: Path | None) -> dict:
+        """Save the state after the plate or lid stage, and mark a stage that did not settle."""
+        after = wall_forces(sim)
+        if d is not None:
+            checkpoint.save(sim, d / "after_plate.npz", extra={"stage": "after_plate"})
+            if self.figures:
+                after_fig = dict(after, weight_n_per_m=weight)
+                what = (
+                    "resting the lid"
+                    if row["plate_moved"] == "lid"
+                    else f"moving the top plate {row['plate_moved']}"
+                )
+                self._figure(
+                    sim,
+                    d / "forces_after_plate.png",
+                    f"after {what}: n' = {row['new_porosity']:.4f}",
+                    after_fig,
+                )
+        if not row["plate_settled"]:
+            row.update(
+                converged=False, failed_stage="top plate",
+                failed_max_ratio=row["plate_final_max_ratio"], failed_steps=row["plate_steps"],
+            )  # fmt: skip
+        return after
+
+    def _lid_target(self, weight: float, sim: Simulation) -> float:
+        """The force (N) the plate or lid servos to: a share of the window's limit."""
+        s = self.settings
+        return s.servo_target_fraction * s.force_fraction * weight * sim.particles.thickness
+
+    def _lid(self, sim: Simulation) -> tuple[np.ndarray, np.ndarray] | None:
+        """The lid's (edges, heights) when the trial rested one, else None."""
+        if not lid_indices(sim):
+            return None
+        profile = lid_profile(sim, self.spec.width)
+        return profile.edges, profile.heights
+
+    def _top_at_disks(self, sim: Simulation) -> float | np.ndarray:
+        """The height of the plate, or of the lid above each disk, for the in-box check."""
+        lid = self._lid(sim)
+        if lid is None:
+            return float(sim.walls.p0[sim.walls.index("top"), 1])
+        return lid_height_at(lid[0], lid[1], sim.particles.pos[:, 0])
 
     def _decide(self, row: dict) -> None:
         """Accept, reject or refuse a trial; records ``accepted``, ``refused``, ``failed_check``, ``reason``.
@@ -626,11 +724,12 @@ class PorosityCriterion:
         row["accepted"] = condition and not failed
         if not row["converged"]:
             if row["failed_stage"] == "top plate":
+                what = "lid" if row.get("plate_moved") == "lid" else "top plate"
                 row["reason"] = (
-                    f"the top plate did not settle within {s.max_plate_steps} steps: F_top "
+                    f"the {what} did not settle within {s.max_plate_steps} steps: F_top "
                     f"{row['f_top_after_n_per_m']:.4g} N/m, window (0, {row['force_limit_n_per_m']:.4g}), "
                     f"max unbalanced-force ratio {row['failed_max_ratio']:.3g} when held"
-                )
+                ) + row.get("lid_note", "")
             else:
                 row["reason"] = _check_reason("preparation_converged", row, s)
             row["refused"] = True
@@ -764,7 +863,7 @@ class PorosityCriterion:
         first = rows[0]
         d0 = self._trial_dir(first["iteration"], first["trial_porosity"])
         pairs = [(d0 / "forces_trial.png", "fig5_forces_initial_trial.png")]
-        moved = next((r for r in rows if r.get("plate_moved") in ("up", "down")), None)
+        moved = next((r for r in rows if r.get("plate_moved") in ("up", "down", "lid")), None)
         if moved is not None:
             dm = self._trial_dir(moved["iteration"], moved["trial_porosity"])
             pairs.append((dm / "forces_after_plate.png", "fig6_forces_after_plate.png"))
@@ -773,13 +872,20 @@ class PorosityCriterion:
             dl = self._trial_dir(last["iteration"], last["trial_porosity"])
             # the accepted specimen is the state the decision was taken on: after the plate
             # moved to touch (when it moved), else as prepared with the plate at H
-            moved_last = last.get("plate_moved") in ("up", "down") and (dl / "after_plate.npz").is_file()
+            moved_last = (
+                last.get("plate_moved") in ("up", "down", "lid") and (dl / "after_plate.npz").is_file()
+            )
             state = "after_plate" if moved_last else "prepared"
             figure = "forces_after_plate.png" if moved_last else "forces_trial.png"
             pairs.append((dl / figure, "fig7_forces_accepted.png"))
-            shutil.copyfile(dl / f"{state}.npz", self.out / ".specimen.npz.tmp")
-            (self.out / ".specimen.npz.tmp").replace(self.out / "specimen.npz")
-            sim = checkpoint.load(self.out / "specimen.npz")
+            sim = checkpoint.load(dl / f"{state}.npz")
+            lid = self._lid(sim)
+            if lid is None:
+                shutil.copyfile(dl / f"{state}.npz", self.out / ".specimen.npz.tmp")
+                (self.out / ".specimen.npz.tmp").replace(self.out / "specimen.npz")
+            else:  # what leaves is a box of four walls (lid.flat_top); the lid is measured here
+                checkpoint.save(flat_top(sim, self.spec.width), self.out / "specimen.npz",
+                                extra={"stage": "accepted", "lid_heights_m": lid[1].tolist()})  # fmt: skip
             write_vtu(sim, self.out / "vtu", "accepted_specimen")
             self._specimen_state(sim, last["trial_porosity"])
         for src, dst in pairs:
@@ -791,7 +897,8 @@ class PorosityCriterion:
         from poro2d.specimen.state import plot_specimen_state, specimen_state
 
         assert self.out is not None
-        top = float(sim.walls.p0[sim.walls.index("top"), 1])
+        lid = self._lid(sim)
+        top = float(sim.walls.p0[sim.walls.index("top"), 1]) if lid is None else float(lid[1].max())
         state = specimen_state(sim, self.spec.width, top)
         write_json(self.out / "specimen_state.json", dict(state, trial_porosity=n2d))
         if self.figures:
@@ -806,7 +913,7 @@ class PorosityCriterion:
         assert self.out is not None
         p = sim.particles
         try:
-            m = measure_specimen(p.pos, p.radius, self.spec.width, top)
+            m = measure_specimen(p.pos, p.radius, self.spec.width, top, lid=self._lid(sim))
         except (InputError, RuntimeError) as e:
             write_json(self.out / "specimen_porosity.json", {"trial_porosity": n2d, "note": str(e),
                                                               "provenance": provenance()})  # fmt: skip

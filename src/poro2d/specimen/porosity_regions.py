@@ -236,9 +236,12 @@ def plate_surface(
     return _plate_from_profile(h, pos, radius, plate_y, d50, tol)
 
 
-def _plate_from_profile(h, pos, radius, plate_y, d50, tol) -> PlateSurface:
+def _plate_from_profile(h, pos, radius, plate_y, d50, tol, plate_at_disks=None) -> PlateSurface:
+    """Gap and contact of the surface ``h`` under a plate at ``plate_y`` (one height, or one
+    per profile bin for a lid, with ``plate_at_disks`` its height above each disk)."""
     gap = np.maximum(plate_y - h, 0.0)
-    touching = int(np.count_nonzero(pos[:, 1] + radius >= plate_y - TOUCH_TOL_D50 * d50))
+    over = plate_y if plate_at_disks is None else plate_at_disks
+    touching = int(np.count_nonzero(pos[:, 1] + radius >= over - TOUCH_TOL_D50 * d50))
     return PlateSurface(
         gap_mean_m=float(gap.mean()),
         gap_mean_d50=float(gap.mean() / d50),
@@ -642,11 +645,15 @@ def measure_specimen(
     margin_d50: Any = DEFAULT_MARGIN_D50,
     circle_d50: Any = DEFAULT_CIRCLE_D50,
     contact_tol_d50: Any = 0.05,
+    lid: tuple[Any, Any] | None = None,
 ) -> SpecimenPorosity:
     """All porosity measures of a specimen in the box [0, width] x [0, plate_y].
 
     ``d50`` defaults to :func:`mass_d50` of the disks; ``margin_d50`` and ``circle_d50``
     as in :func:`interior_regions`, ``contact_tol_d50`` as in :func:`plate_surface`.
+    ``lid``: (edges, heights) of a segmented lid under ``plate_y`` (the fill acceptance,
+    :mod:`poro2d.criterion.lid`): the box porosity is then that of the area under the
+    lid, and the gap and contact are measured to the lid instead of the flat plate.
     """
     pos, radius = _check_disks(pos, radius)
     width, plate_y = _check_box(pos, width, plate_y)
@@ -654,11 +661,25 @@ def measure_specimen(
     margin_d50 = check_range("margin_d50", margin_d50, 0.0)
     tol = check_range("contact_tol_d50", contact_tol_d50, 0.0) * d50
     x, h = surface_profile(pos, radius, width, _profile_bins(width, d50))
-    plate = _plate_from_profile(h, pos, radius, plate_y, d50, tol)
+    if lid is None:
+        plate = _plate_from_profile(h, pos, radius, plate_y, d50, tol)
+        box = box_porosity(radius, width, plate_y)
+    else:
+        edges, heights = _check_lid(lid, width, plate_y)
+        plate = _plate_from_profile(
+            h,
+            pos,
+            radius,
+            lid_height_at(edges, heights, x),
+            d50,
+            tol,
+            lid_height_at(edges, heights, pos[:, 0]),
+        )
+        box = 1.0 - float(np.sum(np.pi * radius**2)) / float(np.sum(np.diff(edges) * heights))
     interior = interior_regions(pos, radius, width, plate_y, d50, margin_d50, circle_d50, profile=(x, h))
     cells = laguerre_cells(pos, radius, width, plate_y)
     return SpecimenPorosity(
-        box_porosity=box_porosity(radius, width, plate_y),
+        box_porosity=box,
         interior_porosity=interior.mean,
         interior_porosity_std=interior.std,
         interior_porosity_min=float(np.min(interior.porosity)),
@@ -677,6 +698,25 @@ def measure_specimen(
         surface_level_m=interior.surface_level_m,
         details=PorosityDetails(surface_x=x, surface_h=h, interior=interior, cells=cells),
     )
+
+
+def _check_lid(lid: tuple[Any, Any], width: float, plate_y: float) -> tuple[np.ndarray, np.ndarray]:
+    """A lid's (edges, heights): K + 1 rising edges from 0 to the width, K heights in (0, plate_y]."""
+    edges = as_float_array("lid edges", lid[0])
+    heights = as_float_array("lid heights", lid[1])
+    if edges.ndim != 1 or heights.shape != (edges.size - 1,) or heights.size < 1:
+        raise InputError("lid", f"{edges.size} edges, {heights.size} heights", "K + 1 edges and K heights")
+    if not (np.all(np.diff(edges) > 0) and np.isclose(edges[0], 0.0) and np.isclose(edges[-1], width)):
+        raise InputError("lid edges", edges.tolist(), f"rising from 0 to the width {width:g} m")
+    if not (np.all(heights > 0.0) and np.all(heights <= plate_y)):
+        raise InputError("lid heights", heights.tolist(), f"(0, {plate_y:g}] m")
+    return edges, heights
+
+
+def lid_height_at(edges: np.ndarray, heights: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """The height of the lid segment above each x."""
+    k = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, heights.size - 1)
+    return heights[k]
 
 
 # --------------------------------------------------------------------------- figure

@@ -41,7 +41,8 @@ CALIBRATION_FIRST_TRIAL = 0.19
 #: density no longer changes; docs/criterion.md has the measurements)
 DENSITY_DEFAULTS = {
     "specimen": {"settle_drift": 1e-3},
-    "criterion": {"refine_tolerance": 0.002, "max_iterations": 10},
+    # the lid's n' is the porosity of the box the specimen fills (poro2d.criterion.lid)
+    "criterion": {"refine_tolerance": 0.002, "max_iterations": 10, "acceptance": "fill"},
 }
 
 

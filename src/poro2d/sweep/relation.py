@@ -120,11 +120,14 @@ def relation_settings(
 def sweep_config(base: dict, n_labs: list[float], *, quick: bool) -> dict:
     """The criterion sweep over nLab for one grading (``base``: a criterion config)."""
     cfg = copy.deepcopy({k: v for k, v in base.items() if k not in ("relation", "sweep")})
+    crit = dict(cfg.get("criterion") or {})
     if quick:
         spec = dict(cfg.get("specimen") or {})
         spec.update(QUICK_SPECIMEN)
         cfg["specimen"] = spec
-    crit = dict(cfg.get("criterion") or {})
+        # the small box's window is the weight of a few grains: too coarse for the lid's
+        # dozens of segments to rest at (docs/porosity.md), so the quick look keeps the plate
+        crit.setdefault("acceptance", "plate")
     crit.pop("n_lab", None)
     crit.pop("trial_porosity", None)  # every point starts from Eq. 12 at its own nLab
     cfg["criterion"] = crit
