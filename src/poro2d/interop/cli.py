@@ -36,7 +36,7 @@ def export_cmd(
     spec = from_checkpoint(specimen)
     writers = {
         "lammps": lambda: lammps.write_specimen(spec, out, ratio=ratio),
-        "yade": lambda: yade.write_specimen(spec, out),
+        "yade": lambda: yade.write_specimen(spec, out, ratio=ratio),
         "pfc": lambda: pfc.write_specimen(spec, out),
         "csv": lambda: csv_table.write_specimen(spec, out),
     }
