@@ -187,7 +187,6 @@ def read_data(path: str | os.PathLike) -> DataFile:
         where = f"{p} Atoms section (lines {atoms[0][0]}-{atoms[-1][0]})" if atoms else f"{p} Atoms section"
         raise InputError(where, f"{len(atoms)} atoms", f"{n} atoms, as line {n_line} says")
     a = np.array([v[:7] for _, v in atoms])
-    _check_atoms(p, atoms, a)
     order = np.argsort(a[:, 0], kind="stable")
     a = a[order]
     atom_lines = np.array([atoms[i][0] for i in order])
@@ -197,6 +196,7 @@ def read_data(path: str | os.PathLike) -> DataFile:
         if bad.size:
             k = atom_lines[bad[0]]
             raise InputError(f"{p} line {k} column {col} ({name})", float(arr[bad[0]]), f"a positive {name}")
+    _check_atoms(p, atoms, np.array([v[:7] for _, v in atoms]))
     r = 0.5 * diam
     zlo, zhi = header.get("zlo", ((-0.5, 0.5), 0))[0]
     return DataFile(
