@@ -340,3 +340,16 @@ def test_export_carries_the_window_and_import_uses_it(saved, tmp_path, capsys):
         )
     assert e.value.code == 1
     assert json.loads((tmp_path / "strict" / "check.json").read_text())["window_from"] == "--window"
+
+
+def test_the_box_of_a_file_of_another_origin_is_checked_on_its_line(spec, tmp_path, capsys):
+    lmp.write_specimen(spec, tmp_path)
+    data = tmp_path / lmp.DATA_FILE
+    text = "\n".join(ln for ln in data.read_text().splitlines() if not ln.startswith("#")) + "\n"
+    xline = next(ln for ln in text.splitlines() if ln.endswith("xlo xhi"))
+    lo, hi = xline.split()[:2]
+    for new, words in ((f"{hi} {lo} xlo xhi", ["column 2 (xhi)", "above xlo"]),
+                       ("-1e308 1e308 xlo xhi", ["column 1 (xlo)", "[-1000, 1000] m"])):  # fmt: skip
+        data.write_text(text.replace(xline, new))
+        k = _line_of(data, new)
+        refused(["import", data, "--out", tmp_path / "out"], capsys, f"specimen.data line {k}", *words)

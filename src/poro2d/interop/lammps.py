@@ -36,7 +36,7 @@ import numpy as np
 from poro2d import __version__
 from poro2d.errors import InputError
 from poro2d.interop.specimen_data import BOX_WALLS, SpecimenData, WallData
-from poro2d.interop.validate import text_of
+from poro2d.interop.validate import LIMITS, check_value, text_of
 
 # positive stand-in for "no normal dashpot" (1/s, times the effective mass)
 GAMMA_TINY = 1e-9
@@ -246,7 +246,12 @@ def _check_atoms(p: Path, atoms: list[tuple[int, list[float]]], a: np.ndarray) -
 def _header_line(p: Path, k: int, words: list[str], header: dict) -> None:
     """One line of the header: ``N atoms``, ``lo hi xlo xhi``, ...; other keywords are ignored."""
     if words[-2:] in (["xlo", "xhi"], ["ylo", "yhi"], ["zlo", "zhi"]):
-        header[words[-2]] = (tuple(_numbers(p, k, words[:2], 2, 2)), k)
+        lo, hi = _numbers(p, k, words[:2], 2, 2)
+        for c, v in ((1, lo), (2, hi)):
+            check_value(f"{p} line {k} column {c} ({words[1 + c]})", v, LIMITS["coordinate"])
+        if not lo < hi:
+            raise InputError(f"{p} line {k} column 2 ({words[3]})", hi, f"above {words[2]} = {lo!r}")
+        header[words[-2]] = ((lo, hi), k)
     elif words[-1] == "atoms" and len(words) == 2:
         v = _numbers(p, k, words[:1], 1, 1)[0]
         if v != int(v) or v < 1:
