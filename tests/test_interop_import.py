@@ -353,3 +353,13 @@ def test_the_box_of_a_file_of_another_origin_is_checked_on_its_line(spec, tmp_pa
         data.write_text(text.replace(xline, new))
         k = _line_of(data, new)
         refused(["import", data, "--out", tmp_path / "out"], capsys, f"specimen.data line {k}", *words)
+
+
+def test_an_option_for_what_the_file_sets_is_refused_not_ignored(spec, saved, tmp_path, capsys):
+    disks, _ = _csv(spec, tmp_path / "csv")
+    refused(["import", disks, "--out", tmp_path / "out", "--kn", "1e6"], capsys, "--kn = 1000000.0",
+            "the file sets it", "column 6 (kn_n_per_m)")  # fmt: skip
+    lmp.write_specimen(spec, tmp_path / "lmp")
+    refused(["import", tmp_path / "lmp" / lmp.DATA_FILE, "--out", tmp_path / "out", "--wall-friction", "0.3"],
+            capsys, "--wall-friction = 0.3", "(wall top mu)")  # fmt: skip
+    refused(["import", saved, "--out", tmp_path / "out", "--thickness", "0.01"], capsys, "a checkpoint")

@@ -114,6 +114,7 @@ def import_cmd(
         check_value("--window", window, LIMITS["window"], "a fraction of G in")
     check_output_dir("--out", out)
     spec = read_specimen(file, {**given, "density_given": "density" in given})
+    _refuse_options_the_file_overrides(spec, {o: values[o] for o, key, _ in IMPORT_OPTIONS if key in given})
     fraction = window if window is not None else (spec.force_fraction or CriterionSettings.force_fraction)
     window_from = "--window" if window is not None else ("the file" if spec.force_fraction else "the paper's")
 
@@ -133,6 +134,24 @@ def import_cmd(
     print_check(report, out)
     if not report["passes"]:
         raise typer.Exit(1)
+
+
+#: the value each option stands for, as ``SpecimenData.locate`` names it
+_OPTION_QUANTITY = {
+    "--thickness": ("thickness", None), "--density": ("density", 0), "--kn": ("kn", 0), "--ks": ("ks", 0),
+    "--friction": ("mu", 0), "--wall-friction": ("wall:top:mu", None),
+}  # fmt: skip
+
+
+def _refuse_options_the_file_overrides(spec, options: dict) -> None:
+    """An option is for what the file does not say: one the file overrides would be ignored
+    without a word, so it is refused, naming where the file gives the value."""
+    from poro2d.errors import InputError
+
+    for option, value in options.items():
+        where = spec.locate(*_OPTION_QUANTITY[option]) if spec.locate else f"{spec.source} (a checkpoint)"
+        if where != option:
+            raise InputError(option, value, f"not given: the file sets it ({where})")
 
 
 def register(app: typer.Typer) -> None:

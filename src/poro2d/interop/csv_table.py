@@ -127,7 +127,11 @@ def _locator(disks_path: Path, walls_path: Path, drows, wrows, notes: dict):
             if key in notes:
                 file, line, _ = notes[key]
                 return f"{file} line {line} column {column} ({quantity})"
-            return f"{quantity} (not in {disks_path.name}: the command-line option, else Table 1)"
+            return (
+                "--thickness"
+                if quantity == "thickness"
+                else f"{quantity} (not in {disks_path.name}: Table 1)"
+            )
         if quantity == "walls":
             return str(walls_path)
         return f"{disks_path} ({quantity})"
