@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -49,7 +50,7 @@ def refused(argv, capsys, *words) -> str:
     assert len(lines) == 1 and lines[0].startswith("error:"), err
     for w in words:
         assert w in lines[0], (w, lines[0])
-    assert not any(p.exists() for p in map(__import__("pathlib").Path, out))
+    assert not any(Path(p).exists() for p in out)
     return lines[0]
 
 

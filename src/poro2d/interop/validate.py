@@ -44,9 +44,7 @@ class Limit:
     hi_open: bool = False
 
     def holds(self, v: float) -> bool:
-        above = v > self.lo if self.lo_open else v >= self.lo
-        below = v < self.hi if self.hi_open else v <= self.hi
-        return bool(above and below)  # NaN fails both
+        return bool(_holds(np.float64(v), self))  # NaN fails
 
     @property
     def text(self) -> str:
