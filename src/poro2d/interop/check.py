@@ -25,6 +25,7 @@ from poro2d.errors import InputError
 from poro2d.interop import csv_table
 from poro2d.interop import lammps as lmp
 from poro2d.interop.specimen_data import BOX_WALLS, SpecimenData, from_checkpoint
+from poro2d.interop.validate import check_imported
 from poro2d.specimen.compaction import SpecimenSpec, box_porosity, make_walls
 
 #: values for what a file does not say (a LAMMPS data file of another origin): Table 1
@@ -44,9 +45,20 @@ DEFAULTS = {
 
 
 def read_specimen(path: str | os.PathLike, defaults: dict | None = None) -> SpecimenData:
-    """A specimen from a CSV table (``disks.csv`` or its folder), a LAMMPS data file or a checkpoint."""
-    d = dict(DEFAULTS, **(defaults or {}))
-    p = Path(path)
+    """A specimen from a CSV table (``disks.csv`` or its folder), a LAMMPS data file or a checkpoint.
+
+    Every value is checked before any work (:func:`poro2d.interop.validate.check_imported`):
+    a refusal names the file, line and column it was read from.
+    """
+    spec = _read(Path(path), dict(DEFAULTS, **(defaults or {})))
+    locate = spec.locate or (
+        lambda quantity, i=None: f"{spec.source} ({quantity}{'' if i is None else f' of disk {i}'})"
+    )
+    check_imported(spec, locate)
+    return spec
+
+
+def _read(p: Path, d: dict) -> SpecimenData:
     if not p.exists():
         raise InputError("FILE", str(p), "an existing disks.csv, LAMMPS data file, checkpoint or folder")
     if p.is_dir():
@@ -54,6 +66,10 @@ def read_specimen(path: str | os.PathLike, defaults: dict | None = None) -> Spec
             return csv_table.read_specimen(p, d)
         if (p / lmp.DATA_FILE).is_file():
             return lmp.read_specimen(p / lmp.DATA_FILE, d)
+        if not (p / "specimen.npz").is_file():
+            raise InputError(
+                "FILE", str(p), f"a folder holding {csv_table.DISKS_FILE}, {lmp.DATA_FILE} or specimen.npz"
+            )
         return from_checkpoint(p)
     if p.suffix == ".csv":
         return csv_table.read_specimen(p, d)
@@ -82,14 +98,25 @@ def box_spec(spec: SpecimenData, ratio: float) -> SpecimenSpec:
 def build_simulation(spec: SpecimenData, box: SpecimenSpec, threads: int = 1) -> Simulation:
     """The disks at rest, no contact history, in the paper's box moved to the origin."""
     xlo, _, ylo, _ = spec.box()
-    p = Particles(
-        np.column_stack([spec.x - xlo, spec.y - ylo]), spec.radius, spec.density, spec.thickness,
-        spec.kn, spec.ks, spec.mu,
-    )  # fmt: skip
-    return Simulation(
-        p, make_walls(box, box.height), ContactModel("per_body"), gravity=(0.0, -box.gravity),
-        local_damping=box.local_damping, dt=spec.dt, threads=threads,
-    )  # fmt: skip
+
+    def simulation(dt: float | None) -> Simulation:
+        p = Particles(
+            np.column_stack([spec.x - xlo, spec.y - ylo]), spec.radius, spec.density, spec.thickness,
+            spec.kn, spec.ks, spec.mu,
+        )  # fmt: skip
+        return Simulation(
+            p, make_walls(box, box.height), ContactModel("per_body"), gravity=(0.0, -box.gravity),
+            local_damping=box.local_damping, dt=dt, threads=threads,
+        )  # fmt: skip
+
+    sim = simulation(None)
+    if spec.dt is None:
+        return sim
+    # a given step must be stable for this packing: at most the critical step the engine computes
+    if not spec.dt <= sim.dt_critical:
+        where = spec.locate("dt") if spec.locate else "dt"
+        raise InputError(where, spec.dt, f"(0, {sim.dt_critical:.4g}] s, the critical step of these disks")
+    return simulation(spec.dt)
 
 
 def check_specimen(

@@ -36,7 +36,7 @@ def export_cmd(
     spec = from_checkpoint(specimen)
     writers = {
         "lammps": lambda: lammps.write_specimen(spec, out, ratio=ratio),
-        "yade": lambda: yade.write_specimen(spec, out),
+        "yade": lambda: yade.write_specimen(spec, out, ratio=ratio),
         "pfc": lambda: pfc.write_specimen(spec, out),
         "csv": lambda: csv_table.write_specimen(spec, out),
     }
@@ -53,6 +53,19 @@ def export_cmd(
     )
 
 
+#: import options that give what a file does not say: (option as typed, key of the defaults, limit)
+IMPORT_OPTIONS = (
+    ("--thickness", "thickness", "thickness"),
+    ("--density", "density", "density"),
+    ("--kn", "kn", "kn"),
+    ("--ks", "ks", "ks"),
+    ("--friction", "mu", "mu"),
+    ("--wall-friction", "wall_mu", "mu"),
+)
+#: the longest equilibrium stage ``--max-steps`` may ask for
+MAX_STEPS_LIMIT = 100_000_000
+
+
 def import_cmd(
     file: Path = typer.Argument(
         ..., help="disks.csv (walls.csv beside it), a LAMMPS data file or a checkpoint."
@@ -61,37 +74,59 @@ def import_cmd(
     ratio: float = typer.Option(1e-3, "--ratio", help="Equilibrium: max unbalanced-force ratio."),
     max_steps: int = typer.Option(400_000, "--max-steps", help="Step limit of each stage."),
     thickness: float = typer.Option(None, "--thickness", help="Disk thickness (m) if the file has none."),
-    density: float = typer.Option(None, "--density", help="Disk density (kg/m3) if the file has none."),
+    density: float = typer.Option(
+        None,
+        "--density",
+        help="Disk density (kg/m3) if the file has none (a LAMMPS file's masses otherwise).",
+    ),
     kn: float = typer.Option(None, "--kn", help="Disk kn (N/m) if the file has none."),
     ks: float = typer.Option(None, "--ks", help="Disk ks (N/m) if the file has none."),
     mu: float = typer.Option(None, "--friction", help="Disk friction if the file has none."),
     wall_mu: float = typer.Option(None, "--wall-friction", help="Wall friction if the file has none."),
+    window: float = typer.Option(
+        None,
+        "--window",
+        help="Force window: F_top below this fraction of G (default: the file's, else the paper's 0.01).",
+    ),  # fmt: skip
     threads: int = typer.Option(1, "--threads", help="Threads for the DEM kernels."),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
 ) -> None:
     """Bring a specimen into poro2d and run the criterion's check on it as it stands."""
+    import numba
+
+    from poro2d.criterion.protocol import CriterionSettings
     from poro2d.dem import checkpoint
     from poro2d.errors import check_int, check_range
     from poro2d.interop.check import check_specimen, read_specimen
+    from poro2d.interop.validate import LIMITS, check_value
     from poro2d.io_utils import check_output_dir, provenance, write_json
 
     check_range("--ratio", ratio, 0.0, 1.0, lo_open=True)
-    check_int("--max-steps", max_steps, 1000)
-    given = {"thickness": thickness, "density": density, "kn": kn, "ks": ks, "mu": mu, "wall_mu": wall_mu}
-    for name, v in given.items():
-        if v is not None:
-            check_range(f"--{name.replace('_', '-')}", v, 0.0, None, lo_open=name not in ("mu", "wall_mu"))
+    check_int("--max-steps", max_steps, 1000, MAX_STEPS_LIMIT)
+    check_int("--threads", threads, 1, numba.config.NUMBA_NUM_THREADS)
+    values = {"--thickness": thickness, "--density": density, "--kn": kn, "--ks": ks, "--friction": mu,
+              "--wall-friction": wall_mu}  # fmt: skip
+    given = {}
+    for option, key, limit in IMPORT_OPTIONS:
+        if values[option] is not None:
+            given[key] = check_value(option, values[option], LIMITS[limit])
+    if window is not None:
+        check_value("--window", window, LIMITS["window"], "a fraction of G in")
     check_output_dir("--out", out)
-    spec = read_specimen(file, {k: v for k, v in given.items() if v is not None})
+    spec = read_specimen(file, {**given, "density_given": "density" in given})
+    _refuse_options_the_file_overrides(spec, {o: values[o] for o, key, _ in IMPORT_OPTIONS if key in given})
+    fraction = window if window is not None else (spec.force_fraction or CriterionSettings.force_fraction)
+    window_from = "--window" if window is not None else ("the file" if spec.force_fraction else "the paper's")
 
     def save_state(sim, report) -> None:
         out.mkdir(parents=True, exist_ok=True)
         checkpoint.save(sim, out / "specimen.npz", extra={"stage": "imported", "source": str(file)})
 
     sim, report = check_specimen(
-        spec, ratio=ratio, max_steps=max_steps, threads=threads, progress=not quiet,
-        at_equilibrium=save_state,
+        spec, settings=CriterionSettings(force_fraction=fraction), ratio=ratio, max_steps=max_steps,
+        threads=threads, progress=not quiet, at_equilibrium=save_state,
     )  # fmt: skip
+    report["window_from"] = window_from
     if "plate" in report:
         checkpoint.save(sim, out / "after_plate.npz", extra={"stage": "after_plate", "source": str(file)})
     report["provenance"] = provenance()
@@ -99,6 +134,24 @@ def import_cmd(
     print_check(report, out)
     if not report["passes"]:
         raise typer.Exit(1)
+
+
+#: the value each option stands for, as ``SpecimenData.locate`` names it
+_OPTION_QUANTITY = {
+    "--thickness": ("thickness", None), "--density": ("density", 0), "--kn": ("kn", 0), "--ks": ("ks", 0),
+    "--friction": ("mu", 0), "--wall-friction": ("wall:top:mu", None),
+}  # fmt: skip
+
+
+def _refuse_options_the_file_overrides(spec, options: dict) -> None:
+    """An option is for what the file does not say: one the file overrides would be ignored
+    without a word, so it is refused, naming where the file gives the value."""
+    from poro2d.errors import InputError
+
+    for option, value in options.items():
+        where = spec.locate(*_OPTION_QUANTITY[option]) if spec.locate else f"{spec.source} (a checkpoint)"
+        if where != option:
+            raise InputError(option, value, f"not given: the file sets it ({where})")
 
 
 def register(app: typer.Typer) -> None:
@@ -119,6 +172,7 @@ def print_check(report: dict, out: Path) -> None:
     ):
         t.add_column(col, justify="right")
     eq = report["equilibrium"]
+    fraction = report["criterion_settings"]["force_fraction"]
     t.add_row(
         f"{report['f_top_n_per_m']:.4g}", f"{report['f_bottom_n_per_m']:.4g}",
         f"{report['side_friction_up_n_per_m']:.4g}", f"{report['self_weight_n_per_m']:.4g}",
@@ -127,6 +181,7 @@ def print_check(report: dict, out: Path) -> None:
         "yes" if report["passes"] else "no",
     )  # fmt: skip
     console.print(t)
+    console.print(f"window: 0 < F_top < {100 * fraction:g} % of G ({report.get('window_from', 'given')})")
     plate = report.get("plate")
     if plate:
         console.print(

@@ -20,6 +20,7 @@ import numpy as np
 
 from poro2d.errors import InputError
 from poro2d.interop.specimen_data import SpecimenData, WallData
+from poro2d.interop.validate import text_of
 from poro2d.io_utils import atomic_path
 
 DISKS_FILE = "disks.csv"
@@ -34,6 +35,7 @@ def _notes(spec: SpecimenData) -> list[str]:
         f"# poro2d thickness {spec.thickness!r}",
         f"# poro2d settings {spec.gravity[0]!r} {spec.gravity[1]!r} {spec.local_damping!r} "
         f"{spec.dt if spec.dt is not None else 0.0!r}",
+        *([f"# poro2d window {spec.force_fraction!r}"] if spec.force_fraction is not None else []),
     ]
 
 
@@ -60,7 +62,9 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
     """The specimen of ``disks.csv`` (or a folder holding it) and the ``walls.csv`` beside it.
 
     A missing thickness or settings line takes ``defaults`` (thickness, gravity,
-    local_damping). A bad cell is an InputError naming the file, line and column.
+    local_damping). A bad cell is an InputError naming the file, line and column; the
+    specimen's ``locate`` names where each value was read, for the checks that follow
+    (:func:`poro2d.interop.validate.check_imported`).
     """
     p = Path(path)
     disks_path = p / DISKS_FILE if p.is_dir() else p
@@ -74,36 +78,100 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
     wnotes, wrows = _read_table(walls_path, WALL_COLUMNS)
     notes.update({k: v for k, v in wnotes.items() if k not in notes})
     if not drows:
-        raise InputError(str(disks_path), "no disks", "at least one disk row")
+        raise InputError(str(disks_path), "no disks", "at least one disk row below the header")
+    _check_ids(disks_path, drows)
     a = np.array([[_number(disks_path, k, c, v) for c, v in enumerate(r[1:], start=2)] for k, r in drows])
     walls = []
     for k, r in wrows:
         walls.append(WallData(r[0], *(_number(walls_path, k, c, v) for c, v in enumerate(r[1:], start=2))))
-    t = _setting(notes, "thickness", 1, disks_path)
-    settings = _setting(notes, "settings", 4, disks_path)
+    t = _setting(notes, "thickness", 1)
+    settings = _setting(notes, "settings", 4)
+    window = _setting(notes, "window", 1)
     gravity = (settings[0], settings[1]) if settings else (0.0, -float(defaults["gravity"]))
+    dt = settings[3] if settings else None
     return SpecimenData(
         x=a[:, 0], y=a[:, 1], radius=a[:, 2], density=a[:, 3], kn=a[:, 4], ks=a[:, 5], mu=a[:, 6],
         thickness=t[0] if t else float(defaults["thickness"]), walls=walls, gravity=gravity,
         local_damping=settings[2] if settings else float(defaults["local_damping"]),
-        dt=settings[3] if settings and settings[3] > 0 else None, source=str(disks_path),
+        dt=dt if dt != 0.0 else None,  # 0: the automatic step (written when the specimen had none)
+        source=str(disks_path), force_fraction=window[0] if window else None,
+        locate=_locator(disks_path, walls_path, drows, wrows, notes),
     )  # fmt: skip
 
 
+#: the column of each quantity in disks.csv and walls.csv, and in the ``# poro2d`` note lines
+_DISK_COLUMN = {name: c for c, name in enumerate(("id", "x", "y", "radius", "density", "kn", "ks", "mu"), 1)}
+_WALL_COLUMN = {name: c for c, name in enumerate(("name", "x0", "y0", "x1", "y1", "kn", "ks", "mu"), 1)}
+_NOTE_COLUMN = {
+    "thickness": ("thickness", 4), "gravity_x": ("settings", 4), "gravity_y": ("settings", 5),
+    "local_damping": ("settings", 6), "dt": ("settings", 7), "window": ("window", 4),
+}  # fmt: skip
+
+
+def _locator(disks_path: Path, walls_path: Path, drows, wrows, notes: dict):
+    """``locate(quantity, disk)``: the file, line and column a value was read from."""
+    wall_line = {r[0]: k for k, r in wrows}
+
+    def locate(quantity: str, i: int | None = None) -> str:
+        if quantity == "disk":
+            return f"{disks_path} line {drows[i][0]}"
+        if quantity in _DISK_COLUMN:
+            name = DISK_COLUMNS[_DISK_COLUMN[quantity] - 1]
+            return f"{disks_path} line {drows[i][0]} column {_DISK_COLUMN[quantity]} ({name})"
+        if quantity.startswith("wall:"):
+            _, wall, field = quantity.split(":")
+            name = WALL_COLUMNS[_WALL_COLUMN[field] - 1]
+            return f"{walls_path} line {wall_line[wall]} column {_WALL_COLUMN[field]} ({name})"
+        if quantity in _NOTE_COLUMN:
+            key, column = _NOTE_COLUMN[quantity]
+            if key in notes:
+                file, line, _ = notes[key]
+                return f"{file} line {line} column {column} ({quantity})"
+            return (
+                "--thickness"
+                if quantity == "thickness"
+                else f"{quantity} (not in {disks_path.name}: Table 1)"
+            )
+        if quantity == "walls":
+            return str(walls_path)
+        return f"{disks_path} ({quantity})"
+
+    return locate
+
+
+def _check_ids(path: Path, rows: list[tuple[int, list[str]]]) -> None:
+    """Every id a whole number >= 1, none twice."""
+    seen: dict[int, int] = {}
+    for k, r in rows:
+        try:
+            ident = int(r[0])
+        except ValueError:
+            ident = 0
+        if ident < 1:
+            raise InputError(f"{path} line {k} column 1 (id)", r[0], "a whole number >= 1")
+        if ident in seen:
+            raise InputError(
+                f"{path} line {k} column 1 (id)", r[0], f"an id of its own (line {seen[ident]} has it)"
+            )
+        seen[ident] = k
+
+
 def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[dict, list[tuple[int, list[str]]]]:
-    """(``# poro2d`` notes, numbered rows) of a table whose header must be ``columns``."""
+    """(``# poro2d`` notes as key: (file, line, values), numbered rows) of a table whose
+    header must be ``columns``."""
     notes: dict = {}
     rows: list[tuple[int, list[str]]] = []
     header_seen = False
-    try:
-        lines = path.read_text().splitlines()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError("CSV specimen", str(path), "a readable text file", str(exc)) from None
+    lines = text_of(path, "CSV specimen").splitlines()
     for k, line in enumerate(lines, start=1):
         if line.startswith("#"):
             if line.startswith("# poro2d "):
                 key, *vals = line[len("# poro2d ") :].split() or [""]
-                notes[key] = vals
+                if key in notes:
+                    raise InputError(
+                        f"{path} line {k}", line, f"one '# poro2d {key}' line (line {notes[key][1]} has one)"
+                    )
+                notes[key] = (path, k, vals)
             continue
         if not line.strip():
             continue
@@ -114,10 +182,18 @@ def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[dict, list[tuple[
             header_seen = True
             continue
         if len(cells) != len(columns):
-            raise InputError(f"{path} line {k}", line, f"{len(columns)} comma-separated cells")
+            column = min(len(cells), len(columns)) + 1
+            found = "an extra cell" if len(cells) > len(columns) else "no cell"
+            raise InputError(
+                f"{path} line {k} column {column}",
+                found,
+                f"{len(columns)} comma-separated cells, as the header",
+            )
         rows.append((k, [c.strip() for c in cells]))
     if not header_seen:
-        raise InputError(str(path), "no header", "the header " + ",".join(columns))
+        raise InputError(
+            str(path), "an empty table" if not rows else "no header", "the header " + ",".join(columns)
+        )
     return notes, rows
 
 
@@ -131,14 +207,11 @@ def _number(path: Path, line: int, column: int, text: str) -> float:
     return v
 
 
-def _setting(notes: dict, key: str, count: int, path: Path) -> list[float] | None:
+def _setting(notes: dict, key: str, count: int) -> list[float] | None:
+    """The ``count`` numbers of the ``# poro2d KEY`` line, None without one."""
     if key not in notes:
         return None
-    vals = notes[key]
-    try:
-        out = [float(v) for v in vals]
-    except ValueError:
-        out = []
-    if len(out) != count or not all(math.isfinite(v) for v in out):
-        raise InputError(f"{path} '# poro2d {key}' line", " ".join(vals), f"{count} finite numbers")
-    return out
+    path, line, vals = notes[key]
+    if len(vals) != count:
+        raise InputError(f"{path} line {line}", " ".join(vals), f"{count} numbers after '# poro2d {key}'")
+    return [_number(path, line, c, v) for c, v in enumerate(vals, start=4)]

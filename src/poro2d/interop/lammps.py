@@ -36,6 +36,7 @@ import numpy as np
 from poro2d import __version__
 from poro2d.errors import InputError
 from poro2d.interop.specimen_data import BOX_WALLS, SpecimenData, WallData
+from poro2d.interop.validate import LIMITS, check_value, text_of
 
 # positive stand-in for "no normal dashpot" (1/s, times the effective mass)
 GAMMA_TINY = 1e-9
@@ -106,7 +107,12 @@ def write_data(
 
 @dataclass
 class DataFile:
-    """What a LAMMPS data file of disks holds: centres, radii, masses, box, and poro2d's notes."""
+    """What a LAMMPS data file of disks holds: centres, radii, masses, box, and poro2d's notes.
+
+    ``atom_lines`` is the line of each atom (in id order), ``note_lines`` the line of each
+    ``# poro2d`` note (the first, and ``wall NAME`` per wall), ``box_line`` the lines of the
+    ``xlo xhi`` and ``ylo yhi`` header lines: where a value came from, for the checks.
+    """
 
     x: np.ndarray
     y: np.ndarray
@@ -115,6 +121,20 @@ class DataFile:
     box: tuple[float, float, float, float]
     zspan: float
     notes: list[tuple[str, list[str]]]
+    atom_lines: np.ndarray | None = None
+    note_lines: dict | None = None
+    box_line: dict | None = None
+
+
+#: section titles of a LAMMPS data file (any other line that starts with a letter is malformed)
+SECTIONS = {
+    "Atoms", "Velocities", "Masses", "Ellipsoids", "Lines", "Triangles", "Bodies", "Bonds", "Angles",
+    "Dihedrals", "Impropers", "Pair", "PairIJ", "Bond", "Angle", "Dihedral", "Improper", "BondBond",
+    "BondAngle", "MiddleBondTorsion", "EndBondTorsion", "AngleTorsion", "AngleAngleTorsion",
+    "BondBond13", "AngleAngle",
+}  # fmt: skip
+#: a z spread larger than this fraction of the smallest radius makes a file 3D
+Z_TOLERANCE = 1e-3
 
 
 def read_data(path: str | os.PathLike) -> DataFile:
@@ -122,15 +142,14 @@ def read_data(path: str | os.PathLike) -> DataFile:
 
     Any other section (Velocities, ...) is skipped. Lines written by :func:`write_specimen`
     as ``# poro2d <key> <values>`` are returned in ``notes``. A malformed line is an
-    InputError naming the file, the line and the column.
+    InputError naming the file, the line and the column: ids and types must be whole numbers
+    (ids >= 1, none twice), the atoms must lie in one plane (z constant) and in the box's
+    own image (image flags 0 in x and y), and their count must be the header's.
     """
     p = Path(path)
-    try:
-        text = p.read_text()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError("LAMMPS data file", str(p), "a readable text file", str(exc)) from None
-    lines = text.splitlines()
+    lines = text_of(p, "LAMMPS data file").splitlines()
     notes: list[tuple[str, list[str]]] = []
+    note_lines: dict = {}
     header: dict = {}
     atoms: list[tuple[int, list[float]]] = []
     section = None
@@ -138,54 +157,113 @@ def read_data(path: str | os.PathLike) -> DataFile:
         if raw.startswith("# poro2d "):
             key, *vals = raw[len("# poro2d ") :].split() or [""]
             notes.append((key, vals))
+            note_lines.setdefault(f"wall {vals[0]}" if key == "wall" and vals else key, k)
         line = raw.split("#", 1)[0].strip()
         if not line:
             continue
         words = line.split()
-        if words[0][0].isalpha():  # a section title: Atoms, Velocities, Masses, ...
+        if words[0] in SECTIONS:
             section = words[0]
+            if section == "Atoms":
+                _atom_style(p, k, raw)
             continue
         if section is None:
             _header_line(p, k, words, header)
         elif section == "Atoms":
             atoms.append((k, _numbers(p, k, words, 7, 10)))
-    n = int(header.get("atoms", -1))
-    if n < 0 or "xlo" not in header or "ylo" not in header:
-        raise InputError(f"{p}", "header", "a LAMMPS data file with 'N atoms', 'xlo xhi' and 'ylo yhi' lines")
+    missing = [
+        what
+        for key, what in (("atoms", "N atoms"), ("xlo", "xlo xhi"), ("ylo", "ylo yhi"))
+        if key not in header
+    ]
+    if missing:
+        raise InputError(
+            f"{p} header",
+            f"no '{missing[0]}' line",
+            "a LAMMPS data file with 'N atoms', 'xlo xhi' and 'ylo yhi' lines",
+        )
+    n, n_line = header["atoms"]
     if len(atoms) != n:
-        raise InputError(f"{p} Atoms section", f"{len(atoms)} lines", f"{n} lines, as the header says")
+        where = f"{p} Atoms section (lines {atoms[0][0]}-{atoms[-1][0]})" if atoms else f"{p} Atoms section"
+        raise InputError(where, f"{len(atoms)} atoms", f"{n} atoms, as line {n_line} says")
     a = np.array([v[:7] for _, v in atoms])
     order = np.argsort(a[:, 0], kind="stable")
     a = a[order]
+    atom_lines = np.array([atoms[i][0] for i in order])
     diam, dens = a[:, 2], a[:, 3]
     for col, name, arr in ((3, "diameter", diam), (4, "density", dens)):
         bad = np.flatnonzero(~(arr > 0.0) | ~np.isfinite(arr))
         if bad.size:
-            k = atoms[order[bad[0]]][0]
-            raise InputError(f"{p} line {k} column {col}", float(arr[bad[0]]), f"a positive {name}")
+            k = atom_lines[bad[0]]
+            raise InputError(f"{p} line {k} column {col} ({name})", float(arr[bad[0]]), f"a positive {name}")
+    _check_atoms(p, atoms, np.array([v[:7] for _, v in atoms]))
     r = 0.5 * diam
-    zlo, zhi = header.get("zlo", (-0.5, 0.5))
+    zlo, zhi = header.get("zlo", ((-0.5, 0.5), 0))[0]
     return DataFile(
         x=a[:, 4].copy(), y=a[:, 5].copy(), radius=r, mass=4.0 / 3.0 * math.pi * r**3 * dens,
-        box=(*header["xlo"], *header["ylo"]), zspan=zhi - zlo, notes=notes,
+        box=(*header["xlo"][0], *header["ylo"][0]), zspan=zhi - zlo, notes=notes, atom_lines=atom_lines,
+        note_lines=note_lines, box_line={"x": header["xlo"][1], "y": header["ylo"][1]},
     )  # fmt: skip
+
+
+def _atom_style(p: Path, k: int, raw: str) -> None:
+    """``Atoms`` or ``Atoms # sphere``: the columns read are those of atom_style sphere."""
+    style = raw.split("#", 1)[1].strip() if "#" in raw else "sphere"
+    if style not in ("sphere", ""):
+        raise InputError(f"{p} line {k}", raw.strip(), "'Atoms # sphere' (id type diameter density x y z)")
+
+
+def _check_atoms(p: Path, atoms: list[tuple[int, list[float]]], a: np.ndarray) -> None:
+    """Whole ids (>= 1, unique) and types (>= 1), one plane in z, image flags 0 in x and y."""
+    seen: dict[float, int] = {}
+    for k, v in atoms:
+        for c, name in ((1, "id"), (2, "type")):
+            if v[c - 1] != int(v[c - 1]) or v[c - 1] < 1:
+                raise InputError(f"{p} line {k} column {c} ({name})", v[c - 1], "a whole number >= 1")
+        if v[0] in seen:
+            raise InputError(
+                f"{p} line {k} column 1 (id)", int(v[0]), f"an id of its own (line {seen[v[0]]} has it)"
+            )
+        seen[v[0]] = k
+        for c in (8, 9):
+            if len(v) >= c and v[c - 1] != 0.0:
+                raise InputError(
+                    f"{p} line {k} column {c} (image flag {'xy'[c - 8]})", v[c - 1],
+                    "0: the atom in the box itself (the criterion's box is closed, not periodic)",
+                )  # fmt: skip
+    z = a[:, 6]
+    tolerance = Z_TOLERANCE * 0.5 * float(a[:, 2].min())
+    off = np.flatnonzero(np.abs(z - z[0]) > tolerance)
+    if off.size:
+        k = atoms[off[0]][0]
+        raise InputError(
+            f"{p} line {k} column 7 (z)", float(z[off[0]]),
+            f"{float(z[0])!r} within {tolerance:.3g} m, as line {atoms[0][0]}: a 2D file has every atom "
+            f"in one plane (z spread here {np.ptp(z):.4g} m)",
+        )  # fmt: skip
 
 
 def _header_line(p: Path, k: int, words: list[str], header: dict) -> None:
     """One line of the header: ``N atoms``, ``lo hi xlo xhi``, ...; other keywords are ignored."""
     if words[-2:] in (["xlo", "xhi"], ["ylo", "yhi"], ["zlo", "zhi"]):
-        header[words[-2]] = tuple(_numbers(p, k, words[:2], 2, 2))
+        lo, hi = _numbers(p, k, words[:2], 2, 2)
+        for c, v in ((1, lo), (2, hi)):
+            check_value(f"{p} line {k} column {c} ({words[1 + c]})", v, LIMITS["coordinate"])
+        if not lo < hi:
+            raise InputError(f"{p} line {k} column 2 ({words[3]})", hi, f"above {words[2]} = {lo!r}")
+        header[words[-2]] = ((lo, hi), k)
     elif words[-1] == "atoms" and len(words) == 2:
         v = _numbers(p, k, words[:1], 1, 1)[0]
         if v != int(v) or v < 1:
             raise InputError(f"{p} line {k} column 1", words[0], "a positive whole number of atoms")
-        header["atoms"] = int(v)
+        header["atoms"] = (int(v), k)
 
 
 def _numbers(p: Path, k: int, words: list[str], lo: int, hi: int) -> list[float]:
     if not lo <= len(words) <= hi:
+        column, found = (len(words) + 1, "the end of the line") if len(words) < lo else (hi + 1, words[hi])
         raise InputError(
-            f"{p} line {k}", " ".join(words), f"{lo} to {hi} numbers" if lo != hi else f"{lo} numbers"
+            f"{p} line {k} column {column}", found, f"{lo} to {hi} numbers" if lo != hi else f"{lo} numbers"
         )
     out = []
     for c, w in enumerate(words, start=1):
@@ -417,6 +495,7 @@ def write_specimen(spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e
         f"{float(spec.ks[0])!r} {float(spec.mu[0])!r}",
         f"# poro2d settings {spec.gravity[0]!r} {spec.gravity[1]!r} {spec.local_damping!r} {spec.dt!r}",
         *(_wall_note(w) for w in spec.walls),
+        *([f"# poro2d window {spec.force_fraction!r}"] if spec.force_fraction is not None else []),
         f"# pair contact kn ks mu: {params['pp'][0]!r} {params['pp'][1]!r} {params['pp'][2]!r}",
     ]
     paths = []
@@ -444,34 +523,93 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
     The disks' density, stiffness and friction, the walls and the run settings come from
     the ``# poro2d`` notes of an exported file; a file without them takes ``defaults``
     (keys: thickness, density, kn, ks, mu, wall_kn, wall_ks, wall_mu, gravity,
-    local_damping), its walls at the faces of its simulation box.
+    local_damping), its walls at the faces of its simulation box. Its disk masses are the
+    file's (LAMMPS' ``4/3 pi r^3 density``) unless ``defaults`` says ``density_given``.
+    The specimen's ``locate`` names the line and column each value was read from.
     """
     d = read_data(path)
     notes = d.notes
     keys = {k for k, _ in notes}
     n = d.x.size
-    t = _note(notes, "thickness", 1, path)[0] if "thickness" in keys else float(defaults["thickness"])
+    t = (
+        _note(notes, "thickness", 1, path, d.note_lines)[0]
+        if "thickness" in keys
+        else float(defaults["thickness"])
+    )
     if "disk_properties" in keys:
-        rho, kn, ks, mu = _note(notes, "disk_properties", 4, path)
+        rho, kn, ks, mu = _note(notes, "disk_properties", 4, path, d.note_lines)
     else:
-        rho = None
+        rho = float(defaults["density"]) if defaults.get("density_given") else None
         kn, ks, mu = (float(defaults[k]) for k in ("kn", "ks", "mu"))
-    # the file's masses define the density; an exported file names it exactly
+    # the file's masses define the density unless it is named (an exported file, or --density)
     density = np.full(n, rho) if rho is not None else d.mass / (math.pi * d.radius**2 * t)
     gravity, damping, dt = (0.0, -float(defaults["gravity"])), float(defaults["local_damping"]), None
     if "settings" in keys:
-        gx, gy, damping, dt = _note(notes, "settings", 4, path)
+        gx, gy, damping, dt = _note(notes, "settings", 4, path, d.note_lines)
         gravity = (gx, gy)
-    walls = [WallData(name, *v) for name, v in _wall_notes(notes, path)]
+    window = _note(notes, "window", 1, path, d.note_lines)[0] if "window" in keys else None
+    walls = [WallData(name, *v) for name, v in _wall_notes(notes, path, d.note_lines)]
     if not walls:
         xlo, xhi, ylo, yhi = d.box
         kw = tuple(float(defaults[k]) for k in ("wall_kn", "wall_ks", "wall_mu"))
         walls = box_walls(xlo, xhi, ylo, yhi, *kw)
     return SpecimenData(
         x=d.x, y=d.y, radius=d.radius, density=density, kn=np.full(n, kn), ks=np.full(n, ks),
-        mu=np.full(n, mu), thickness=t, walls=walls, gravity=gravity, local_damping=damping, dt=dt,
-        source=str(path),
+        mu=np.full(n, mu), thickness=t, walls=walls, gravity=gravity, local_damping=damping,
+        dt=dt if dt else None, source=str(path), force_fraction=window,
+        locate=_locator(Path(path), d, keys, from_masses=rho is None),
     )  # fmt: skip
+
+
+#: where each value sits: an Atoms column, or a ``# poro2d`` note and its word
+_ATOM_COLUMN = {
+    "id": (1, "id"),
+    "radius": (3, "diameter"),
+    "density": (4, "density"),
+    "x": (5, "x"),
+    "y": (6, "y"),
+}
+_NOTE_WORD = {
+    "thickness": ("thickness", 4), "density": ("disk_properties", 4), "kn": ("disk_properties", 5),
+    "ks": ("disk_properties", 6), "mu": ("disk_properties", 7), "gravity_x": ("settings", 4),
+    "gravity_y": ("settings", 5), "local_damping": ("settings", 6), "dt": ("settings", 7),
+    "window": ("window", 4),
+}  # fmt: skip
+_WALL_WORD = {name: c for c, name in enumerate(("x0", "y0", "x1", "y1", "kn", "ks", "mu"), start=5)}
+#: the command-line option behind each value a file of another origin does not hold
+_OPTION = {"thickness": "--thickness", "density": "--density", "kn": "--kn", "ks": "--ks", "mu": "--friction"}
+
+
+def _locator(p: Path, d: DataFile, keys: set, from_masses: bool):
+    """``locate(quantity, atom)``: the line and column of a value, or the option that gave it."""
+    lines = d.note_lines or {}
+
+    def locate(quantity: str, i: int | None = None) -> str:
+        if quantity == "disk":
+            return f"{p} line {d.atom_lines[i]}"
+        if quantity in _ATOM_COLUMN and (quantity != "density" or from_masses):
+            column, name = _ATOM_COLUMN[quantity]
+            extra = ", the disk density m / (pi r^2 t)" if quantity == "density" else ""
+            return f"{p} line {d.atom_lines[i]} column {column} ({name}{extra})"
+        if quantity in _NOTE_WORD and _NOTE_WORD[quantity][0] in keys:
+            key, word = _NOTE_WORD[quantity]
+            return f"{p} line {lines[key]} column {word} ({quantity})"
+        if quantity.startswith("wall:"):
+            _, wall, field = quantity.split(":")
+            if f"wall {wall}" in lines:
+                column = _WALL_WORD.get(field, 4)
+                return f"{p} line {lines[f'wall {wall}']} column {column} (wall {wall} {field})"
+            if field == "mu":
+                return "--wall-friction"
+            if field in ("kn", "ks"):
+                return f"wall {field} (Table 1)"
+            axis = "x" if wall in ("left", "right") else "y"
+            return f"{p} line {d.box_line[axis]} ({axis}lo {axis}hi, the {wall} wall)"
+        if quantity in _OPTION:
+            return _OPTION[quantity]
+        return f"{p} ({quantity})"
+
+    return locate
 
 
 def box_walls(xlo, xhi, ylo, yhi, kn, ks, mu) -> list[WallData]:
@@ -484,28 +622,37 @@ def box_walls(xlo, xhi, ylo, yhi, kn, ks, mu) -> list[WallData]:
     ]
 
 
-def _note(notes: list, key: str, count: int, path) -> list[float]:
+def _note(notes: list, key: str, count: int, path, lines: dict | None = None) -> list[float]:
     """The ``count`` numbers of the first ``# poro2d KEY ...`` line."""
     vals = next(v for k, v in notes if k == key)
-    return _note_numbers(vals, count, f"{path} '# poro2d {key}' line")
+    line = f" line {lines[key]}" if lines and key in lines else ""
+    return _note_numbers(vals, count, f"{path}{line} '# poro2d {key}'")
 
 
-def _note_numbers(vals: list[str], count: int, where: str) -> list[float]:
-    try:
-        out = [float(v) for v in vals]
-    except ValueError:
-        out = []
-    if len(out) != count or not all(math.isfinite(v) for v in out):
-        raise InputError(where, " ".join(vals), f"{count} finite numbers")
+def _note_numbers(vals: list[str], count: int, where: str, first: int = 4) -> list[float]:
+    """Numbers of a note line; a bad word is named by its column (``first``: that of vals[0])."""
+    if len(vals) != count:
+        raise InputError(where, " ".join(vals), f"{count} numbers")
+    out = []
+    for c, v in enumerate(vals, start=first):
+        try:
+            x = float(v)
+        except ValueError:
+            x = math.nan
+        if not math.isfinite(x):
+            raise InputError(f"{where} column {c}", v, "a finite number")
+        out.append(x)
     return out
 
 
-def _wall_notes(notes: list, path) -> list[tuple[str, list[float]]]:
+def _wall_notes(notes: list, path, lines: dict | None = None) -> list[tuple[str, list[float]]]:
     """The ``# poro2d wall NAME x0 y0 x1 y1 kn ks mu`` lines, in file order."""
     out = []
     for key, vals in notes:
         if key == "wall":
             if not vals:
                 raise InputError(f"{path} '# poro2d wall' line", "", "a name and 7 numbers")
-            out.append((vals[0], _note_numbers(vals[1:], 7, f"{path} '# poro2d wall {vals[0]}' line")))
+            line = f" line {lines[f'wall {vals[0]}']}" if lines and f"wall {vals[0]}" in lines else ""
+            where = f"{path}{line} '# poro2d wall {vals[0]}'"
+            out.append((vals[0], _note_numbers(vals[1:], 7, where, first=5)))
     return out

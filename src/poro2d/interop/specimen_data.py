@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -65,6 +66,10 @@ class SpecimenData:
     dt: float | None = None
     contact: str = "per_body"
     source: str = ""
+    #: the criterion's window the specimen was accepted with (F_top below this fraction of G)
+    force_fraction: float | None = None
+    #: where each value was read (set by the importers): ``locate(quantity, disk_index)``
+    locate: Callable[..., str] | None = field(default=None, repr=False, compare=False)
 
     @property
     def n(self) -> int:
@@ -135,6 +140,10 @@ class SpecimenData:
         ]
         if self.source:
             lines.append(f"from {self.source}")
+        if self.force_fraction is not None:
+            lines.append(
+                f"accepted by the criterion with F_top below {self.force_fraction:g} of G (its window)"
+            )
         lines += self.porosity_lines()
         return [f"{comment} {ln}" for ln in lines]
 
@@ -239,5 +248,23 @@ def from_checkpoint(path: str | os.PathLike) -> SpecimenData:
         density=a["particles.density"].copy(), kn=a["particles.kn"].copy(), ks=a["particles.ks"].copy(),
         mu=a["particles.mu"].copy(), thickness=float(meta["thickness"]), walls=walls,
         gravity=tuple(float(g) for g in s["gravity"]), local_damping=float(s["local_damping"]),
-        dt=float(s["dt"]), source=str(p),
+        dt=float(s["dt"]), source=str(p), force_fraction=accepted_window(p),
     )  # fmt: skip
+
+
+def accepted_window(checkpoint_path: Path) -> float | None:
+    """The force window of the criterion run whose folder holds the checkpoint, if any.
+
+    A criterion folder (or a replicate's) has ``result.json`` beside ``specimen.npz``; its
+    ``settings.force_fraction`` is the window the specimen was accepted with (1 % in the
+    paper, 5 % for ``paper --quick``). None for a checkpoint without one.
+    """
+    import json
+
+    result = Path(checkpoint_path).parent / "result.json"
+    try:
+        value = json.loads(result.read_text())["settings"]["force_fraction"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    ok = isinstance(value, int | float) and not isinstance(value, bool) and 0.0 < value <= 1.0
+    return float(value) if ok else None

@@ -37,6 +37,7 @@ SCRIPT_FILE = "specimen_yade.py"
 _BODY = '''
 
 import math
+import sys
 
 from yade import O, utils
 from yade.wrapper import (
@@ -44,7 +45,18 @@ from yade.wrapper import (
     Ig2_Sphere_Sphere_ScGeom, InsertionSortCollider, InteractionLoop, Ip2_FrictMat_FrictMat_FrictPhys,
     Law2_ScGeom_FrictPhys_CundallStrack, NewtonIntegrator, PyRunner,
 )
-from minieigen import Vector3
+
+try:  # YADE 2020 and later ship minieigen as yade.minieigenHP
+    from yade.minieigenHP import Vector3
+except ImportError:  # older YADE used the separate minieigen package
+    from minieigen import Vector3
+
+# the run settings may be overridden on the command line: yade -n -x THIS_FILE ratio=1e-6 max_steps=100000
+for arg in sys.argv[1:]:
+    key, _, value = arg.partition("=")
+    if key not in ("ratio", "max_steps", "check_every"):
+        raise SystemExit(f"unknown setting {arg!r}: use ratio=R, max_steps=N or check_every=N")
+    SETTINGS[key] = float(value) if key == "ratio" else int(value)
 
 
 def series(a, b):
@@ -105,6 +117,7 @@ def report():
         "f_bottom_n_per_m": -f["bottom"][1] / T if "bottom" in f else float("nan"),
         "side_friction_up_n_per_m": -(f["left"][1] + f["right"][1]) / T if "left" in f else float("nan"),
         "unbalanced_force": utils.unbalancedForce(),
+        "steps": O.iter,
     }
     print("poro2d-result", " ".join(f"{k} {v!r}" for k, v in out.items()))
 
@@ -138,7 +151,7 @@ if __name__ == "__main__":
 def script(
     spec: SpecimenData, ratio: float = 1e-3, max_steps: int = 2_000_000, check_every: int = 500
 ) -> str:
-    """The text of the YADE script (run it with ``yade specimen_yade.py``)."""
+    """The text of the YADE script (run it with ``yade -n -x specimen_yade.py``)."""
     settings = {
         "thickness": float(spec.thickness),
         "gravity": (float(spec.gravity[0]), float(spec.gravity[1])),
@@ -151,7 +164,8 @@ def script(
     disks = zip(spec.x, spec.y, spec.radius, spec.density, spec.kn, spec.ks, spec.mu, strict=True)
     lines = [
         *spec.header("#"),
-        f"# written by poro2d export --to yade; run: yade {SCRIPT_FILE}",
+        f"# written by poro2d export --to yade; run: yade -n -x {SCRIPT_FILE} (no window, exit at the end)",
+        f"# other stop settings: yade -n -x {SCRIPT_FILE} ratio=1e-6 max_steps=100000",
         "# 2D in YADE: spheres with their centres in z = 0, motion locked to the plane, disk masses",
         "",
         f"SETTINGS = {settings!r}",
@@ -173,12 +187,17 @@ def _wall_numbers(w) -> tuple[float, ...]:
     return (w.x0, w.y0, w.x1, w.y1, w.kn, w.ks, w.mu)
 
 
-def write_specimen(spec: SpecimenData, out: str | os.PathLike) -> list[Path]:
-    """Write ``specimen_yade.py`` into ``out`` (atomically)."""
+def write_specimen(
+    spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e-3, max_steps: int = 2_000_000,
+    check_every: int = 500,
+) -> list[Path]:  # fmt: skip
+    """Write ``specimen_yade.py`` into ``out`` (atomically), stopping at ``ratio`` (YADE's mean ratio)."""
+    if not spec.dt:
+        raise InputError("time step", spec.dt, "the time step of the specimen (a poro2d checkpoint has one)")
     slanted = [w.name for w in spec.walls if not (w.horizontal or w.vertical)]
     if slanted:
         raise InputError("walls", slanted, "horizontal or vertical walls (written as YADE boxes)")
     path = Path(out) / SCRIPT_FILE
     with atomic_path(path) as tmp:
-        tmp.write_text(script(spec))
+        tmp.write_text(script(spec, ratio, max_steps, check_every))
     return [path]
