@@ -89,7 +89,7 @@ def validate_criterion(config: dict, base_dir: Path | None = None) -> None:
 
 
 def run_criterion(config: dict, out_dir: Path) -> dict:
-    """The criterion of Fig. 3 for one case; scalars of its result, of its first and of its last trial."""
+    """The criterion of Fig. 3 for one case; scalars of its result, of its first and of its accepted trial."""
     from poro2d.criterion.protocol import PorosityCriterion
 
     spec, grading, settings, seed = _criterion_objects(config)
@@ -99,7 +99,9 @@ def run_criterion(config: dict, out_dir: Path) -> dict:
     )
     res = crit.run()
     first = res["iterations"][0] if res["iterations"] else {}
-    last = res["iterations"][-1] if res["iterations"] else {}
+    # the accepted trial (not always the last: see PorosityCriterion._closed_bracket), else the last
+    its = res["iterations"]
+    last = next((r for r in its if r.get("accepted")), its[-1] if its else {})
     return {
         "n_lab": res["n_lab"],
         "final_porosity": res["final_porosity"],
