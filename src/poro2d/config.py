@@ -14,12 +14,14 @@ from typing import Any
 import numpy as np
 
 from poro2d.errors import InputError, is_integer, is_number
+from poro2d.io_utils import check_input_file
 
 
 def load_toml(path: str | os.PathLike) -> dict:
     p = Path(path)
     if not p.is_file():
         raise InputError("config", str(p), "an existing TOML file")
+    check_input_file("config", p)
     try:
         return tomllib.loads(p.read_text())
     except tomllib.TOMLDecodeError as exc:

@@ -20,7 +20,7 @@ import numpy as np
 
 from poro2d.errors import InputError
 from poro2d.interop.specimen_data import SpecimenData, WallData
-from poro2d.io_utils import atomic_path
+from poro2d.io_utils import atomic_path, check_input_file
 
 DISKS_FILE = "disks.csv"
 WALLS_FILE = "walls.csv"
@@ -95,6 +95,7 @@ def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[dict, list[tuple[
     notes: dict = {}
     rows: list[tuple[int, list[str]]] = []
     header_seen = False
+    check_input_file("CSV specimen", path)
     try:
         lines = path.read_text().splitlines()
     except (OSError, UnicodeDecodeError) as exc:

@@ -36,6 +36,7 @@ import numpy as np
 from poro2d import __version__
 from poro2d.errors import InputError
 from poro2d.interop.specimen_data import BOX_WALLS, SpecimenData, WallData
+from poro2d.io_utils import check_input_file
 
 # positive stand-in for "no normal dashpot" (1/s, times the effective mass)
 GAMMA_TINY = 1e-9
@@ -124,7 +125,7 @@ def read_data(path: str | os.PathLike) -> DataFile:
     as ``# poro2d <key> <values>`` are returned in ``notes``. A malformed line is an
     InputError naming the file, the line and the column.
     """
-    p = Path(path)
+    p = check_input_file("LAMMPS data file", path)
     try:
         text = p.read_text()
     except (OSError, UnicodeDecodeError) as exc:

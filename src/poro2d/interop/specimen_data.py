@@ -10,6 +10,7 @@ force stored, in any code (see docs/export.md).
 
 from __future__ import annotations
 
+import json
 import math
 import os
 from dataclasses import dataclass, field
@@ -20,6 +21,7 @@ import numpy as np
 from poro2d import __version__
 from poro2d.dem import ContactModel, Particles, Simulation, Walls, checkpoint
 from poro2d.errors import InputError
+from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
 
 #: names of the walls of a poro2d box (``Walls.box``), in that order
 BOX_WALLS = ("bottom", "right", "top", "left")
@@ -191,7 +193,35 @@ def resolve_specimen(path: str | os.PathLike) -> Path:
         raise InputError(
             "SPECIMEN", str(path), "a specimen checkpoint (.npz) or a folder holding specimen.npz"
         )
-    return p
+    return check_input_file("SPECIMEN", p, CHECKPOINT_FILE_LIMIT)
+
+
+def check_accepted(path: str | os.PathLike) -> None:
+    """Refuse a specimen that the criterion beside it did not accept.
+
+    A criterion folder (or the folder of the checkpoint given) holds ``result.json``;
+    when it says ``converged = false`` or lists no accepted trial, the specimen must not
+    leave as if valid. A checkpoint without a criterion result beside it (a shear test's,
+    an imported one) is taken as it is.
+    """
+    p = Path(path)
+    result_file = (p if p.is_dir() else p.parent) / "result.json"
+    if not result_file.is_file():
+        return
+    try:
+        data = json.loads(check_input_file("SPECIMEN", result_file).read_text())
+    except (OSError, ValueError) as exc:
+        raise InputError("SPECIMEN", str(path), "a specimen with a readable result.json", str(exc)) from None
+    if not isinstance(data, dict) or "converged" not in data:
+        return  # not a criterion result
+    trials = data.get("iterations") if isinstance(data.get("iterations"), list) else []
+    accepted = any(isinstance(row, dict) and row.get("accepted") is True for row in trials)
+    if data["converged"] is not True or not accepted:
+        state = "no accepted trial" if data["converged"] is True else f"converged = {data['converged']}"
+        raise InputError(
+            "SPECIMEN", str(path), "a specimen the criterion accepted",
+            f"{result_file} says {state}; nothing written",
+        )  # fmt: skip
 
 
 def from_simulation(sim: Simulation, source: str = "") -> SpecimenData:

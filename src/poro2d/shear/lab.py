@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.errors import InputError
+from poro2d.io_utils import check_input_file
 
 CURVE_COLUMNS = ("normal_stress_kpa", "shear_displacement_mm", "shear_stress_kpa")
 PEAK_COLUMNS = ("normal_stress_kpa", "peak_shear_stress_kpa")
@@ -67,6 +68,7 @@ def read_lab_csv(path: str | os.PathLike) -> LabData:
     p = Path(path)
     if not p.is_file():
         raise InputError("lab", str(p), "an existing CSV file")
+    check_input_file("lab", p)
     with open(p, newline="") as fh:
         lines = [(k + 1, ln) for k, ln in enumerate(fh) if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
