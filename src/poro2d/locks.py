@@ -157,22 +157,32 @@ def _hold(parameter: str, folder: Path, *, wait: bool) -> Iterator[Path]:
 
 def _acquire(parameter: str, folder: Path, *, wait: bool, created: bool) -> FileLock:
     lock = FileLock(folder / LOCK_NAME, thread_local=False)
-    try:
-        lock.acquire(timeout=0)
-        return lock
-    except Timeout:
-        pass
-    holder = owner_text(folder)
-    if not wait:
-        if created:
-            _remove_if_empty(folder)
-        raise InputError(
-            parameter, str(folder), "a folder no other poro2d run is writing",
-            f"in use by another poro2d run ({holder}); wait for it or choose another folder",
-        )  # fmt: skip
-    print(f"{folder} is in use by another poro2d run ({holder}); waiting for it", file=sys.stderr, flush=True)
-    lock.acquire()
-    return lock
+    announced = False
+    while True:
+        folder.mkdir(parents=True, exist_ok=True)  # again: a holder removes a folder it made empty
+        try:
+            lock.acquire(timeout=1.0 if announced else 0)
+            return lock
+        except FileNotFoundError:
+            continue
+        except Timeout:
+            pass
+        if announced:
+            continue
+        holder = owner_text(folder)
+        if not wait:
+            if created:
+                _remove_if_empty(folder)
+            raise InputError(
+                parameter, str(folder), "a folder no other poro2d run is writing",
+                f"in use by another poro2d run ({holder}); wait for it or choose another folder",
+            )  # fmt: skip
+        print(
+            f"{folder} is in use by another poro2d run ({holder}); waiting for it",
+            file=sys.stderr,
+            flush=True,
+        )
+        announced = True
 
 
 def _release(lock: FileLock, folder: Path, created: bool) -> None:
