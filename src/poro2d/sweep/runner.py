@@ -215,7 +215,8 @@ DEFAULT_DASHBOARD = "127.0.0.1:0"
 
 def check_dashboard(value: str | None, parameter: str = "--dashboard") -> str | None:
     """A dashboard address ``HOST:PORT`` (``:PORT`` for every interface), or None for no dashboard
-    (``none``/``off``); the default when ``value`` is None is :data:`DEFAULT_DASHBOARD`."""
+    (``none``/``off``); the default when ``value`` is None is :data:`DEFAULT_DASHBOARD`.
+    """
     from poro2d.errors import InputError
 
     if value is None:
@@ -245,7 +246,10 @@ def _start_client(scheduler: str | None, workers: int | None, threads_needed: in
         n_workers=n,
         threads_per_worker=1,
         processes=True,
-        dashboard_address=dashboard,
+        # the scheduler's web server (health, metrics) runs in any case: on this machine, with
+        # the dashboard's pages only when one is asked for
+        dashboard_address=dashboard if dashboard is not None else DEFAULT_DASHBOARD,
+        scheduler_kwargs={"dashboard": dashboard is not None},
         env=env,
     )
     return Client(cluster), cluster
@@ -378,7 +382,7 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases_dir:
             "workers": len(info.get("workers", {})),
             "threads": sum(w.get("nthreads", 0) for w in info.get("workers", {}).values()),
             "local_cluster": cluster is not None,
-            "dashboard": _dashboard(client),
+            "dashboard": _dashboard(client) if dashboard is not None or scheduler else None,
         }
         if progress and cluster_info["dashboard"]:
             from poro2d.console import OutputConsole
