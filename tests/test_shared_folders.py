@@ -329,9 +329,11 @@ def _count(folder: Path, name: str) -> int:
     return sum(1 for _ in folder.rglob(name)) if folder.exists() else 0
 
 
-def _kill_at(proc: subprocess.Popen, stage: str, delay: float, folders: list[Path]) -> None:
-    """SIGKILL the run (its whole process group) ``delay`` s after it reaches ``stage``:
-    a case started (a new params.json) or a case finished (a new result.json)."""
+def _kill_at(proc: subprocess.Popen, stage: str, delay: float, folders: list[Path], *, group: bool) -> None:
+    """SIGKILL the run ``delay`` s after it reaches ``stage``: a case started (a new
+    params.json) or a case finished (a new result.json). ``group``: the whole run, its
+    cluster's workers with it, as when a job is killed; else the command alone, whose
+    workers may go on with the cases they hold."""
     name = "params.json" if stage == "case started" else "result.json"
     before = sum(_count(f, name) for f in folders)
     deadline = time.monotonic() + 120
@@ -340,10 +342,17 @@ def _kill_at(proc: subprocess.Popen, stage: str, delay: float, folders: list[Pat
         time.sleep(0.05)
     time.sleep(delay)
     try:
-        os.killpg(proc.pid, signal.SIGKILL)  # the cluster's workers go with it, as when a job is killed
+        os.killpg(proc.pid, signal.SIGKILL) if group else proc.kill()
     except ProcessLookupError:
         pass
     proc.communicate()
+
+
+def _kill_group(pgid: int) -> None:
+    try:
+        os.killpg(pgid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass
 
 
 def test_a_relation_killed_at_random_moments_resumes_to_the_same_result(two_relations, tmp_path):
@@ -351,14 +360,18 @@ def test_a_relation_killed_at_random_moments_resumes_to_the_same_result(two_rela
     env = _env(tmp_path / "cache")
     out = tmp_path / "rel"
     rng = random.Random(23)
-    for _ in range(2):
-        stage, delay = rng.choice(["case started", "case finished"]), rng.uniform(0.0, 1.5)
-        proc = _relation(cfg, out, env, start_new_session=True)
-        _kill_at(proc, stage, delay, [out, tmp_path / "cache"])
-        assert not (out / "relation.json").exists(), (
-            f"the run ended before the kill ({stage} + {delay:.2f} s)"
-        )
-    rc, err = _finish(_relation(cfg, out, env))
+    groups = []
+    try:
+        for group in (False, True):
+            stage, delay = rng.choice(["case started", "case finished"]), rng.uniform(0.0, 1.5)
+            proc = _relation(cfg, out, env, start_new_session=True)
+            groups.append(proc.pid)
+            _kill_at(proc, stage, delay, [out, tmp_path / "cache"], group=group)
+            assert not (out / "relation.json").exists(), f"it ended before the kill ({stage} + {delay:.2f} s)"
+        rc, err = _finish(_relation(cfg, out, env))
+    finally:
+        for pgid in groups:  # workers left by the command killed alone
+            _kill_group(pgid)
     assert rc == 0 and "Traceback" not in err, err
     assert _result(out / "relation.json") == _result(reference_dir / "r1" / "relation.json")
     assert _lock_files(out, tmp_path / "cache") == []

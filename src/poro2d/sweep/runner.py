@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from poro2d.io_utils import atomic_path, provenance, write_json
-from poro2d.locks import holds_output
+from poro2d.locks import cache_entry, holds_output
 from poro2d.resumable import Fingerprint, ResumableStage
 from poro2d.sweep.cases import KINDS, PERFORMANCE_KEYS, Case, SweepConfig
 
@@ -101,8 +101,15 @@ def run_case_task(case: dict, case_dir: str, func) -> dict:
     """Run one case on a worker; never raises for errors of the case itself.
 
     ``func`` is the kind's callable, shipped with the task so that kinds registered
-    at run time (tests, plug-ins) work on any worker.
+    at run time (tests, plug-ins) work on any worker. The case folder is held while the
+    case runs: a worker left running by a killed sweep may still compute it, and a rerun's
+    worker then waits for it and reads its result back instead of writing beside it.
     """
+    with cache_entry(case_dir, parameter="case folder"):
+        return _run_case(case, case_dir, func)
+
+
+def _run_case(case: dict, case_dir: str, func) -> dict:
     d = Path(case_dir)
     stage = case_stage(case, d)
     done = stage.stored(RESULT, accept=_is_done)
