@@ -140,6 +140,38 @@ def test_a_cache_entry_held_elsewhere_is_waited_for(tmp_path):
         assert proc.wait(60) == 0
 
 
+_CASE = {"id": "c1", "kind": "probe", "params": {}, "config": {"x": 1}}
+_CASE_HOLDER = """
+import json, sys, time
+from pathlib import Path
+from poro2d.io_utils import write_json
+from poro2d.locks import cache_entry
+from poro2d.sweep.runner import RESULT, case_stage
+
+folder, held = Path(sys.argv[1]), Path(sys.argv[2])
+case = json.loads(sys.argv[3])
+with cache_entry(folder, parameter="case folder"):  # a worker of a killed sweep, still running the case
+    held.touch()
+    time.sleep(1.0)  # computing
+    case_stage(case, folder).bind()
+    write_json(folder / RESULT, {"case_id": "c1", "status": "done", "results": {"by": "the first worker"}})
+"""
+
+
+def test_a_case_still_running_elsewhere_is_waited_for_and_read_back(tmp_path):
+    from poro2d.sweep.runner import run_case_task
+
+    folder = tmp_path / "cases" / "c1"
+    cmd = [sys.executable, "-c", _CASE_HOLDER, str(folder), str(tmp_path / "held"), json.dumps(_CASE)]
+    proc = subprocess.Popen(cmd, env=_env())
+    try:
+        _wait_for(tmp_path / "held", proc)
+        row = run_case_task(_CASE, str(folder), lambda config, out: {"by": "a second worker"})
+    finally:
+        assert proc.wait(60) == 0
+    assert row["results"] == {"by": "the first worker"}
+
+
 def test_links_leading_out_of_the_output_folder_are_refused(tmp_path, capsys):
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
