@@ -66,9 +66,10 @@ def _number(path: str, line: int, col: str, text: str) -> float:
 def read_lab_csv(path: str | os.PathLike) -> LabData:
     """Read and validate a laboratory CSV (see the module docstring for the columns)."""
     p = Path(path)
+    if p.exists():  # a device, a FIFO or a folder is named as such
+        check_input_file("lab", p)
     if not p.is_file():
         raise InputError("lab", str(p), "an existing CSV file")
-    check_input_file("lab", p)
     with open(p, newline="") as fh:
         lines = [(k + 1, ln) for k, ln in enumerate(fh) if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
