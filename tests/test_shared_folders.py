@@ -328,6 +328,18 @@ def test_export_refuses_a_specimen_the_criterion_did_not_accept(
         assert "SPECIMEN" in err and ("converged = False" in err or "no accepted trial" in err)
         assert not (tmp_path / "lmp").exists()
     main(["export", str(reference), "--to", "csv", "--out", str(tmp_path / "ok")])  # the accepted one leaves
+
+
+def test_export_refuses_a_rejected_trial(criterion_reference, tmp_path, capsys):
+    _, reference = criterion_reference
+    trials = sorted((reference / "trials").iterdir())
+    rejected = next(t for t in trials if not json.loads((t / "trial.json").read_text())["accepted"])
+    err = _refused(["export", str(rejected / "prepared.npz"), "--to", "csv", "--out", str(tmp_path / "x")],
+                   capsys)  # fmt: skip
+    assert "trial.json says accepted = False" in err and not (tmp_path / "x").exists()
+    accepted = next(t for t in trials if json.loads((t / "trial.json").read_text())["accepted"])
+    main(["export", str(accepted / "prepared.npz"), "--to", "csv", "--out", str(tmp_path / "ok")])
+    assert (tmp_path / "ok" / "disks.csv").is_file()
     assert (tmp_path / "ok" / "disks.csv").is_file()
 
 

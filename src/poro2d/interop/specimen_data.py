@@ -201,27 +201,43 @@ def check_accepted(path: str | os.PathLike) -> None:
 
     A criterion folder (or the folder of the checkpoint given) holds ``result.json``;
     when it says ``converged = false`` or lists no accepted trial, the specimen must not
-    leave as if valid. A checkpoint without a criterion result beside it (a shear test's,
-    an imported one) is taken as it is.
+    leave as if valid. A trial's checkpoint has ``trial.json`` beside it, which must say
+    ``accepted = true``. A checkpoint with neither beside it (a shear test's, an imported
+    one) is taken as it is.
     """
     p = Path(path)
-    result_file = (p if p.is_dir() else p.parent) / "result.json"
-    if not result_file.is_file():
-        return
+    folder = p if p.is_dir() else p.parent
+    result = _record(path, folder / "result.json")
+    if result is not None and "converged" in result:
+        trials = result.get("iterations") if isinstance(result.get("iterations"), list) else []
+        accepted = any(isinstance(row, dict) and row.get("accepted") is True for row in trials)
+        if result["converged"] is not True or not accepted:
+            state = (
+                "no accepted trial" if result["converged"] is True else f"converged = {result['converged']}"
+            )
+            _refuse_unaccepted(path, folder / "result.json", state)
+    trial = _record(path, folder / "trial.json")
+    if trial is not None and "accepted" in trial and trial["accepted"] is not True:
+        _refuse_unaccepted(path, folder / "trial.json", f"accepted = {trial['accepted']}")
+
+
+def _record(path: str | os.PathLike, record: Path) -> dict | None:
+    """The JSON object in ``record``, None if there is none (or it holds something else)."""
+    if not record.is_file():
+        return None
     try:
-        data = json.loads(check_input_file("SPECIMEN", result_file).read_text())
+        data = json.loads(check_input_file("SPECIMEN", record).read_text())
     except (OSError, ValueError) as exc:
-        raise InputError("SPECIMEN", str(path), "a specimen with a readable result.json", str(exc)) from None
-    if not isinstance(data, dict) or "converged" not in data:
-        return  # not a criterion result
-    trials = data.get("iterations") if isinstance(data.get("iterations"), list) else []
-    accepted = any(isinstance(row, dict) and row.get("accepted") is True for row in trials)
-    if data["converged"] is not True or not accepted:
-        state = "no accepted trial" if data["converged"] is True else f"converged = {data['converged']}"
         raise InputError(
-            "SPECIMEN", str(path), "a specimen the criterion accepted",
-            f"{result_file} says {state}; nothing written",
-        )  # fmt: skip
+            "SPECIMEN", str(path), f"a specimen with a readable {record.name}", str(exc)
+        ) from None
+    return data if isinstance(data, dict) else None
+
+
+def _refuse_unaccepted(path: str | os.PathLike, record: Path, state: str) -> None:
+    raise InputError(
+        "SPECIMEN", str(path), "a specimen the criterion accepted", f"{record} says {state}; nothing written"
+    )
 
 
 def from_simulation(sim: Simulation, source: str = "") -> SpecimenData:
