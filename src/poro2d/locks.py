@@ -37,7 +37,7 @@ LOCK_NAME = ".poro2d.lock"
 #: who holds the lock (pid and host), for the refusal message; written once the lock is held
 OWNER_NAME = ".poro2d.lock.owner"
 
-#: folders this process holds: resolved path -> [lock, depth of nesting]
+#: folders this process holds: resolved path -> [lock, holders still inside]
 _held: dict[Path, list] = {}
 _guard = threading.Lock()
 
@@ -132,27 +132,30 @@ def _hold(parameter: str, folder: Path, *, wait: bool) -> Iterator[Path]:
     folder.mkdir(parents=True, exist_ok=True)
     key = folder.resolve()
     with _guard:
-        entry = _held.get(key)
-        if entry is not None:
-            entry[1] += 1
-    if entry is not None:  # this process holds it already: an inner run of the same folder
+        held = _held.get(key)
+        if held is not None:  # this process holds it already: an inner run of the same folder
+            held[1] += 1
+    if held is None:
+        lock = _acquire(parameter, folder, wait=wait, created=created)
         try:
-            yield folder
-        finally:
-            with _guard:
-                entry[1] -= 1
-        return
-    lock = _acquire(parameter, folder, wait=wait, created=created)
-    with _guard:
-        _held[key] = [lock, 1]
+            check_no_escape(parameter, folder)
+            _write_owner(folder)
+        except BaseException:
+            _release(lock, folder, created)
+            raise
+        held = [lock, 1]
+        with _guard:
+            _held[key] = held
     try:
-        check_no_escape(parameter, folder)
-        _write_owner(folder)
         yield folder
     finally:
         with _guard:
-            del _held[key]
-        _release(lock, folder, created)
+            held[1] -= 1
+            last = held[1] == 0
+            if last:
+                del _held[key]
+        if last:  # the outermost holder lets go
+            _release(held[0], folder, created)
 
 
 def _acquire(parameter: str, folder: Path, *, wait: bool, created: bool) -> FileLock:
