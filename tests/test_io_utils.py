@@ -3,10 +3,14 @@
 import json
 import os
 import stat
+import subprocess
+import sys
+import time
 
 import numpy as np
 import pytest
 
+from poro2d import io_utils
 from poro2d.io_utils import atomic_path, current_umask, write_csv, write_json
 
 
@@ -39,23 +43,82 @@ def test_current_umask_reads_without_changing_it(umask_022):
     assert current_umask() == 0o022
 
 
+def _dead_pid() -> int:
+    """The pid of a process that has ended (reaped, so no longer running)."""
+    proc = subprocess.Popen([sys.executable, "-c", "pass"])
+    proc.wait()
+    return proc.pid
+
+
+def _age(path, days: float) -> None:
+    t = time.time() - days * 86400
+    os.utime(path, (t, t))
+
+
 def test_leftover_temporaries_of_the_target_are_removed(tmp_path):
-    # what a killed write of fig.png leaves behind, and files that must stay
-    stale = [tmp_path / ".fig.png.ab12cd_x.png", tmp_path / ".fig.png.xxxx.png"]
+    # what killed writes of fig.png leave behind, and files that must stay
+    host = io_utils._host_tag()
+    dead = _dead_pid()
+    stale = [
+        tmp_path / f".fig.png.{dead}-{host}-ab12cd_x.png",  # its writer is dead
+        tmp_path / ".fig.png.xxxx.png",  # no writer in its name, untouched for two days
+        tmp_path / ".fig.png.7-otherhost-ab12.png",  # another host's, untouched for two days
+    ]
     keep = [
-        tmp_path / ".fig.png.b.png.k3j4l5m6.png",  # a temporary of the target fig.png.b.png
-        tmp_path / ".other.png.ab12cd_x.png",  # of another target
-        tmp_path / "fig.png.ab12cd_x.png",  # not hidden: not a temporary
-        tmp_path / ".fig.png.ab12cd_x.svg",  # another suffix
+        tmp_path / f".fig.png.{os.getpid()}-{host}-ab12cd_x.png",  # a live writer's (this process)
+        tmp_path / f".fig.png.{os.getppid()}-{host}-k3j4.png",  # another live process's
+        tmp_path / ".fig.png.8-otherhost-ab12.png",  # another host's, recent: it may be writing
+        tmp_path / ".fig.png.yyyy.png",  # no writer in its name, recent
+        tmp_path / f".fig.png.b.png.{dead}-{host}-k3j4l5m6.png",  # a temporary of the target fig.png.b.png
+        tmp_path / f".other.png.{dead}-{host}-ab12cd_x.png",  # of another target
+        tmp_path / f"fig.png.{dead}-{host}-ab12cd_x.png",  # not hidden: not a temporary
+        tmp_path / f".fig.png.{dead}-{host}-ab12cd_x.svg",  # another suffix
     ]
     for p in stale + keep:
         p.write_bytes(b"partial")
+    _age(stale[1], 2)
+    _age(stale[2], 2)
     with atomic_path(tmp_path / "fig.png") as tmp:
         tmp.write_bytes(b"complete")
     assert (tmp_path / "fig.png").read_bytes() == b"complete"
     assert not any(p.exists() for p in stale)
     assert all(p.exists() for p in keep)
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["fig.png"] + [p.name for p in keep])
+
+
+_SLOW_WRITER = """
+import sys, time
+from pathlib import Path
+from poro2d.io_utils import atomic_path
+
+target, started = Path(sys.argv[1]), Path(sys.argv[2])
+with atomic_path(target) as tmp:
+    tmp.write_text("first")
+    started.write_text(tmp.name)
+    while not (target.parent / "go").exists():
+        time.sleep(0.02)
+"""
+
+
+def test_a_live_writers_temporary_survives_another_write(tmp_path):
+    # two processes write one target: the second must not remove the first one's temporary,
+    # whose rename would then fail (FileNotFoundError on a shared calibration cache)
+    target, started = tmp_path / "results.csv", tmp_path / "started"
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path))
+    first = subprocess.Popen([sys.executable, "-c", _SLOW_WRITER, str(target), str(started)], env=env)
+    try:
+        deadline = time.monotonic() + 60
+        while not started.exists() and first.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.02)
+        temporary = tmp_path / started.read_text()
+        with atomic_path(target) as tmp:
+            tmp.write_text("second")
+        assert temporary.is_file()
+        (tmp_path / "go").touch()
+        assert first.wait(60) == 0
+    finally:
+        first.kill()
+    assert target.read_text() == "first"  # the first writer's rename went through
 
 
 def test_a_failed_write_leaves_neither_target_nor_temporary(tmp_path):

@@ -14,10 +14,13 @@ from typing import Any
 import numpy as np
 
 from poro2d.errors import InputError, is_integer, is_number
+from poro2d.io_utils import check_input_file
 
 
 def load_toml(path: str | os.PathLike) -> dict:
     p = Path(path)
+    if p.exists():  # a device, a FIFO or a folder is named as such
+        check_input_file("config", p)
     if not p.is_file():
         raise InputError("config", str(p), "an existing TOML file")
     try:

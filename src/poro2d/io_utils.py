@@ -7,7 +7,10 @@ import json
 import math
 import os
 import platform
+import socket
+import stat
 import tempfile
+import time
 from collections.abc import Iterable, Mapping
 from contextlib import contextmanager
 from datetime import UTC, datetime
@@ -23,14 +26,15 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None):
 
     A crash leaves no file that looks complete: the final name only appears once
     the content is fully written. Temporaries of ``path`` left by a killed earlier
-    write are removed first, and the file gets the permissions of an ordinary new
-    file (0666 less the umask), not the 0600 of a temporary.
+    write are removed first (never one whose writer still runs, see
+    :func:`remove_stale_temporaries`), and the file gets the permissions of an ordinary
+    new file (0666 less the umask), not the 0600 of a temporary.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     suffix = suffix if suffix is not None else path.suffix
     remove_stale_temporaries(path, suffix)
-    fd, tmp = tempfile.mkstemp(prefix=_temp_prefix(path), suffix=suffix, dir=path.parent)
+    fd, tmp = tempfile.mkstemp(prefix=_temp_prefix(path) + _writer_tag(), suffix=suffix, dir=path.parent)
     try:
         # results often go to shared folders: others must be able to read them
         os.fchmod(fd, 0o666 & ~current_umask())
@@ -47,16 +51,56 @@ def atomic_path(path: str | os.PathLike, suffix: str | None = None):
         raise
 
 
+#: a temporary whose writer cannot be checked (another host, or an unnamed writer) is
+#: taken for a leftover once it has not changed for this long (seconds)
+FOREIGN_TEMPORARY_AGE = 24 * 3600.0
+
+
 def _temp_prefix(path: Path) -> str:
     return f".{path.name}."
+
+
+def _host_tag() -> str:
+    """This host's name with every character but letters, digits and ``_`` as ``_``."""
+    return "".join(c if c.isalnum() or c == "_" else "_" for c in socket.gethostname()) or "_"
+
+
+def _writer_tag() -> str:
+    """``<pid>-<host>-``: who writes a temporary, so that no other process removes it while it runs."""
+    return f"{os.getpid()}-{_host_tag()}-"
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    except (OverflowError, ValueError):
+        return False
+    return True
+
+
+def _is_leftover(entry: Path, middle: str) -> bool:
+    """Whether the temporary ``entry`` (``middle``: between prefix and suffix) was left by a dead writer."""
+    parts = middle.split("-")
+    if len(parts) == 3 and parts[0].isdigit() and parts[1] == _host_tag():
+        return not _pid_alive(int(parts[0]))
+    try:  # another host's writer, or a name without one: only when long untouched
+        return time.time() - entry.stat().st_mtime > FOREIGN_TEMPORARY_AGE
+    except OSError:
+        return False
 
 
 def remove_stale_temporaries(path: str | os.PathLike, suffix: str | None = None) -> list[Path]:
     """Delete the temporaries of ``path`` that a killed write left behind; returns them.
 
-    They are named ``.<name>.<random><suffix>`` (see :func:`atomic_path`); the random
-    part never holds a dot, so the temporaries of ``a.png.b.png`` are not taken for
-    those of ``a.png``. One writer per target is assumed, as for any atomic rename.
+    They are named ``.<name>.<pid>-<host>-<random><suffix>`` (see :func:`atomic_path`);
+    that part never holds a dot, so the temporaries of ``a.png.b.png`` are not taken for
+    those of ``a.png``. A temporary is removed only when its writer is known dead: its
+    pid no longer runs on this host. Another host's (a shared cache on a cluster) or one
+    without a writer is removed once untouched for ``FOREIGN_TEMPORARY_AGE``.
     """
     path = Path(path)
     suffix = suffix if suffix is not None else path.suffix
@@ -69,7 +113,9 @@ def remove_stale_temporaries(path: str | os.PathLike, suffix: str | None = None)
         if not (name.startswith(prefix) and name.endswith(suffix)):
             continue
         middle = name[len(prefix) : len(name) - len(suffix)]
-        if middle and "." not in middle and "/" not in middle and entry.is_file():
+        if not middle or "." in middle or "/" in middle or not entry.is_file():
+            continue
+        if _is_leftover(entry, middle):
             try:
                 entry.unlink()
                 removed.append(entry)
@@ -214,3 +260,43 @@ def check_output_dir(parameter: str, path: str | os.PathLike) -> Path:
     if not os.access(existing, os.W_OK | os.X_OK):
         raise InputError(parameter, str(p), "a folder that can be written", f"{existing} is read-only")
     return p
+
+
+#: the largest text table or config poro2d reads (a line of a specimen table or LAMMPS data
+#: file takes about 100 bytes: several hundred thousand disks fit)
+TEXT_FILE_LIMIT = 64 * 2**20
+#: the largest checkpoint (.npz) poro2d reads (a few hundred bytes per disk)
+CHECKPOINT_FILE_LIMIT = 1024 * 2**20
+
+
+def _size_text(n: int) -> str:
+    return f"{n // 2**20} MiB"
+
+
+def check_input_file(parameter: str, path: str | os.PathLike, limit: int = TEXT_FILE_LIMIT) -> Path:
+    """Refuse an input that is not a regular file, or one larger than ``limit`` bytes.
+
+    Every file poro2d reads from the user passes here first: a device (``/dev/zero``), a
+    FIFO or a folder would be read without end, and a huge file would fill the memory
+    before any check of its content.
+    """
+    from poro2d.errors import InputError
+
+    p = Path(path)
+    allowed = f"a regular file of at most {_size_text(limit)}"
+    try:
+        st = p.stat()
+    except OSError:
+        raise InputError(parameter, str(p), allowed, "it does not exist or cannot be read") from None
+    if not stat.S_ISREG(st.st_mode):
+        raise InputError(parameter, str(p), allowed, f"it is {_file_kind(st.st_mode)}")
+    if st.st_size > limit:
+        raise InputError(parameter, str(p), allowed, f"it holds {st.st_size:,} bytes")
+    return p
+
+
+def _file_kind(mode: int) -> str:
+    kinds = [(stat.S_ISDIR, "a folder"), (stat.S_ISCHR, "a character device"),
+             (stat.S_ISBLK, "a block device"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
+             (stat.S_ISSOCK, "a socket")]  # fmt: skip
+    return next((name for test, name in kinds if test(mode)), "not a regular file")

@@ -18,6 +18,7 @@ import typer
 
 from poro2d.console import OutputConsole
 from poro2d.io_utils import provenance, write_csv, write_json
+from poro2d.locks import holds_output
 from poro2d.paper_data import PAPER, QUICK_CRITERION, QUICK_SPECIMEN
 from poro2d.resumable import Fingerprint, ResumableStage
 from poro2d.typed_result import TypedResult
@@ -96,6 +97,7 @@ def conversion_files(out: Path) -> dict:
             "figures": [str(f.name) for f in figs], "provenance": provenance()}  # fmt: skip
 
 
+@holds_output("out")
 def run_paper(
     out: str | Path = "paper-out",
     *,

@@ -35,6 +35,7 @@ from typing import Any, Literal
 
 from poro2d.errors import InputError
 from poro2d.io_utils import as_json, write_json
+from poro2d.locks import is_lock_file
 
 #: ``explain(keys, stored)``: the InputError's hint for a refused folder; ``keys`` are the
 #: fingerprint's differing keys, None when the folder's work has no record at all
@@ -145,7 +146,10 @@ class ResumableStage:
         if not self.folder.is_dir():
             return False
         temporary = f".{self.record}."  # see poro2d.io_utils.atomic_path
-        return any(p.name != self.record and not p.name.startswith(temporary) for p in self.folder.iterdir())
+        return any(
+            p.name != self.record and not p.name.startswith(temporary) and not is_lock_file(p.name)
+            for p in self.folder.iterdir()
+        )
 
     def recorded(self) -> Mapping | None:
         """The fingerprint in the record (``{}`` for a record of another shape), None without one."""

@@ -11,6 +11,8 @@ import os
 from pathlib import Path
 from typing import Any
 
+from poro2d.locks import holds_output
+
 ConfigLike = dict | str | os.PathLike | None
 
 
@@ -60,6 +62,7 @@ def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> d
     return out
 
 
+@holds_output("out")
 def run_criterion(
     config: ConfigLike = None,
     *,

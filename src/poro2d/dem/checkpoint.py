@@ -20,7 +20,7 @@ from poro2d.dem.model import ContactModel
 from poro2d.dem.simulation import Simulation
 from poro2d.dem.state import PARTICLE_FIELDS, SERVO_COLUMNS, Particles, Walls
 from poro2d.errors import InputError
-from poro2d.io_utils import atomic_path, provenance
+from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, atomic_path, check_input_file, provenance
 
 FORMAT = "poro2d-checkpoint-1"
 
@@ -110,7 +110,7 @@ def _existing(path) -> Path:
     p = Path(path)
     if not p.is_file():
         raise InputError("checkpoint", str(p), "an existing .npz file written by poro2d")
-    return p
+    return check_input_file("checkpoint", p, CHECKPOINT_FILE_LIMIT)
 
 
 # what NumPy, zipfile and json raise on a truncated, corrupted or foreign file

@@ -7,12 +7,14 @@ from pathlib import Path
 import typer
 
 from poro2d.console import OutputConsole, Table
+from poro2d.locks import holds_output
 
 console = OutputConsole()
 
 TARGETS = ("lammps", "yade", "pfc", "csv")
 
 
+@holds_output("out")
 def export_cmd(
     specimen: str = typer.Argument(..., help="Specimen checkpoint (.npz) or a folder holding specimen.npz."),
     to: str = typer.Option(..., "--to", help="Target: lammps, yade, pfc or csv."),
@@ -26,13 +28,14 @@ def export_cmd(
     """Write an accepted specimen for another DEM code (disks, walls, contact properties)."""
     from poro2d.errors import InputError, check_range
     from poro2d.interop import csv_table, lammps, pfc, yade
-    from poro2d.interop.specimen_data import from_checkpoint
+    from poro2d.interop.specimen_data import check_accepted, from_checkpoint
     from poro2d.io_utils import check_output_dir
 
     if to not in TARGETS:
         raise InputError("--to", to, "one of " + ", ".join(TARGETS))
     check_range("--ratio", ratio, 0.0, 1.0, lo_open=True)
     check_output_dir("--out", out)
+    check_accepted(specimen)
     spec = from_checkpoint(specimen)
     writers = {
         "lammps": lambda: lammps.write_specimen(spec, out, ratio=ratio),
@@ -66,6 +69,7 @@ IMPORT_OPTIONS = (
 MAX_STEPS_LIMIT = 100_000_000
 
 
+@holds_output("out")
 def import_cmd(
     file: Path = typer.Argument(
         ..., help="disks.csv (walls.csv beside it), a LAMMPS data file or a checkpoint."

@@ -10,6 +10,7 @@ force stored, in any code (see docs/export.md).
 
 from __future__ import annotations
 
+import json
 import math
 import os
 from collections.abc import Callable
@@ -21,6 +22,7 @@ import numpy as np
 from poro2d import __version__
 from poro2d.dem import ContactModel, Particles, Simulation, Walls, checkpoint
 from poro2d.errors import InputError
+from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
 
 #: names of the walls of a poro2d box (``Walls.box``), in that order
 BOX_WALLS = ("bottom", "right", "top", "left")
@@ -200,7 +202,51 @@ def resolve_specimen(path: str | os.PathLike) -> Path:
         raise InputError(
             "SPECIMEN", str(path), "a specimen checkpoint (.npz) or a folder holding specimen.npz"
         )
-    return p
+    return check_input_file("SPECIMEN", p, CHECKPOINT_FILE_LIMIT)
+
+
+def check_accepted(path: str | os.PathLike) -> None:
+    """Refuse a specimen that the criterion beside it did not accept.
+
+    A criterion folder (or the folder of the checkpoint given) holds ``result.json``;
+    when it says ``converged = false`` or lists no accepted trial, the specimen must not
+    leave as if valid. A trial's checkpoint has ``trial.json`` beside it, which must say
+    ``accepted = true``. A checkpoint with neither beside it (a shear test's, an imported
+    one) is taken as it is.
+    """
+    p = Path(path)
+    folder = p if p.is_dir() else p.parent
+    result = _record(path, folder / "result.json")
+    if result is not None and "converged" in result:
+        trials = result.get("iterations") if isinstance(result.get("iterations"), list) else []
+        accepted = any(isinstance(row, dict) and row.get("accepted") is True for row in trials)
+        if result["converged"] is not True or not accepted:
+            state = (
+                "no accepted trial" if result["converged"] is True else f"converged = {result['converged']}"
+            )
+            _refuse_unaccepted(path, folder / "result.json", state)
+    trial = _record(path, folder / "trial.json")
+    if trial is not None and "accepted" in trial and trial["accepted"] is not True:
+        _refuse_unaccepted(path, folder / "trial.json", f"accepted = {trial['accepted']}")
+
+
+def _record(path: str | os.PathLike, record: Path) -> dict | None:
+    """The JSON object in ``record``, None if there is none (or it holds something else)."""
+    if not record.is_file():
+        return None
+    try:
+        data = json.loads(check_input_file("SPECIMEN", record).read_text())
+    except (OSError, ValueError) as exc:
+        raise InputError(
+            "SPECIMEN", str(path), f"a specimen with a readable {record.name}", str(exc)
+        ) from None
+    return data if isinstance(data, dict) else None
+
+
+def _refuse_unaccepted(path: str | os.PathLike, record: Path, state: str) -> None:
+    raise InputError(
+        "SPECIMEN", str(path), "a specimen the criterion accepted", f"{record} says {state}; nothing written"
+    )
 
 
 def from_simulation(sim: Simulation, source: str = "") -> SpecimenData:

@@ -27,6 +27,7 @@ import numpy as np
 
 from poro2d.errors import InputError
 from poro2d.interop.specimen_data import BOX_WALLS, SpecimenData
+from poro2d.io_utils import check_input_file
 
 #: ``locate(quantity, disk_index)``: where a value was read ("FILE line L column C (name)"),
 #: or the option that gave it
@@ -216,7 +217,9 @@ def _solid_area(spec: SpecimenData, box, locate: Locate) -> None:
 
 def text_of(path, what: str) -> str:
     """The text of ``path`` (UTF-8, a byte-order mark allowed), or an InputError naming the file,
-    line and column of the first byte that is not text."""
+    line and column of the first byte that is not text. Only a regular file of a sane size is
+    read (:func:`poro2d.io_utils.check_input_file`)."""
+    check_input_file(what, path)
     try:
         with open(path, "rb") as fh:
             data = fh.read()

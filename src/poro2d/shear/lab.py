@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.errors import InputError
+from poro2d.io_utils import check_input_file
 
 CURVE_COLUMNS = ("normal_stress_kpa", "shear_displacement_mm", "shear_stress_kpa")
 PEAK_COLUMNS = ("normal_stress_kpa", "peak_shear_stress_kpa")
@@ -65,6 +66,8 @@ def _number(path: str, line: int, col: str, text: str) -> float:
 def read_lab_csv(path: str | os.PathLike) -> LabData:
     """Read and validate a laboratory CSV (see the module docstring for the columns)."""
     p = Path(path)
+    if p.exists():  # a device, a FIFO or a folder is named as such
+        check_input_file("lab", p)
     if not p.is_file():
         raise InputError("lab", str(p), "an existing CSV file")
     with open(p, newline="") as fh:

@@ -14,6 +14,7 @@ from poro2d.config import dataclass_from_table
 from poro2d.dem import checkpoint
 from poro2d.errors import InputError, is_number
 from poro2d.io_utils import check_output_dir
+from poro2d.locks import holds_output
 from poro2d.shear.lab import LabData, read_lab_csv
 from poro2d.shear.series import ShearSeries, check_stresses
 from poro2d.shear.settings import ShearSettings
@@ -49,6 +50,7 @@ def _lab(value) -> LabData | None:
     raise InputError("lab", type(value).__name__, "a laboratory CSV path, a LabData or None")
 
 
+@holds_output("out")
 def run_shear(
     specimen: str | os.PathLike,
     normal_stresses_kpa,

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.errors import InputError
+from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
 
 
 def resolve_specimen(path: str | Path) -> Path:
@@ -21,7 +22,7 @@ def resolve_specimen(path: str | Path) -> Path:
             str(path),
             "a specimen checkpoint (.npz) or a criterion output folder with specimen.npz",
         )
-    return p
+    return check_input_file("specimen", p, CHECKPOINT_FILE_LIMIT)
 
 
 def specimen_box(path: str | Path) -> tuple[float, float]:

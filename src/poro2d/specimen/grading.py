@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from poro2d.errors import InputError, as_float_array, check_int, check_range, is_number
+from poro2d.io_utils import check_input_file
 
 __all__ = [
     "MAX_DRAW",
@@ -182,7 +183,7 @@ class GradingCurve:
         d_max_mm: float | None = None,
     ) -> GradingCurve:
         """Read a CSV with columns ``size_mm,percent_passing`` (lines starting ``#`` skipped)."""
-        p = Path(path)
+        p = check_input_file("csv", path)
         try:
             text = p.read_text(encoding="utf-8")
         except OSError:

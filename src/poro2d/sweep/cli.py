@@ -14,6 +14,7 @@ console = OutputConsole()
 
 _SCHED = "Address of a running Dask scheduler (e.g. tcp://host:8786); default: a LocalCluster."
 _WORKERS = "Worker processes of the LocalCluster (default: one per core, one thread each)."
+_DASHBOARD = "LocalCluster dashboard: HOST:PORT or none (default 127.0.0.1:0, this machine only)."
 
 
 def _check_workers(workers: int | None) -> None:
@@ -30,20 +31,23 @@ def sweep_cmd(
     ),
     scheduler: str = typer.Option(None, "--scheduler", help=_SCHED),
     workers: int = typer.Option(None, "--workers", help=_WORKERS),
+    dashboard: str = typer.Option(None, "--dashboard", help=_DASHBOARD),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
 ) -> None:
     """Run a grid or list of cases as Dask tasks; one table of results."""
     from poro2d.config import load_toml
     from poro2d.io_utils import check_output_dir
     from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.runner import run_sweep
+    from poro2d.sweep.runner import check_dashboard, run_sweep
 
     _check_workers(workers)
+    dashboard_address = check_dashboard(dashboard)
     check_output_dir("--out", out)
     cfg = load_toml(config)
     sweep = parse_sweep(cfg, Path(config).resolve().parent)
     console.print(f"{len(sweep.cases)} case(s) of kind {sweep.kind!r} -> {out}")
-    res = run_sweep(sweep, out, scheduler=scheduler, workers=workers, progress=not quiet)
+    res = run_sweep(sweep, out, scheduler=scheduler, workers=workers, progress=not quiet,
+                    dashboard=dashboard_address)  # fmt: skip
     print_summary(res, out)
     if res.failed:
         raise typer.Exit(1)
@@ -67,6 +71,7 @@ def relation_cmd(
         None, "--mode", help="density (default): preparation friction from the state; paper: fixed 0.05."
     ),
     seeds: int = typer.Option(None, "--seeds", help="Specimens per state and per calibration point (3)."),
+    dashboard: str = typer.Option(None, "--dashboard", help=_DASHBOARD),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
 ) -> None:
     """The grading's n2D(nLab) relation from the criterion at several relative densities.
@@ -81,7 +86,7 @@ def relation_cmd(
     console.print(f"criterion relation{' (quick)' if quick else ''} -> {out}")
     rel = run_relation(
         config, preset=preset, out=out, points=points, n_max=n_max, n_min=n_min, mode=mode, seeds=seeds,
-        quick=quick, scheduler=scheduler, workers=workers, progress=not quiet,
+        quick=quick, scheduler=scheduler, workers=workers, progress=not quiet, dashboard=dashboard,
     )  # fmt: skip
     print_relation(rel, out)
     if rel["failed_cases"]:

@@ -25,6 +25,7 @@ from typing import Any
 from poro2d.criterion.density import DEFAULT_MUS, Calibration, StateTarget
 from poro2d.errors import InputError
 from poro2d.io_utils import provenance, write_json
+from poro2d.locks import cache_entry
 
 #: seeds per friction and per state unless the config says otherwise
 DEFAULT_SEEDS = 3
@@ -162,7 +163,9 @@ def calibrate(
     except OSError:  # a read-only cache: the cases go with the results
         folder = out / "calibration"
     sweep = parse_sweep(calibration_sweep(base, mus, seeds), base_dir)
-    res = run_sweep(sweep, folder, **sweep_kw)
+    # another run of the same grading may be computing this entry: wait, then reuse its cases
+    with cache_entry(folder):
+        res = run_sweep(sweep, folder, **sweep_kw)
     cal = calibration_from_rows(res.rows, mus, seeds)
     info = {"key": key, "cases": str(folder), "ran": res.summary["ran"], "reused": res.summary["reused"],
             "source": "computed" if res.summary["ran"] else "cache"}  # fmt: skip

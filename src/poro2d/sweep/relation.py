@@ -24,6 +24,7 @@ import numpy as np
 from poro2d import porosity as P
 from poro2d.config import check_keys
 from poro2d.errors import InputError, check_range
+from poro2d.locks import holds_output
 from poro2d.paper_data import QUICK_SPECIMEN as PAPER_QUICK_SPECIMEN
 
 RELATION_KEYS = {"n_max", "n_min", "points", "n_lab", "mode", "seeds", "mu_prep"}
@@ -442,6 +443,7 @@ def density_relation(
     return rel, record
 
 
+@holds_output("out")
 def run_relation(
     config=None,
     *,
@@ -456,6 +458,7 @@ def run_relation(
     scheduler: str | None = None,
     workers: int | None = None,
     progress: bool = True,
+    dashboard: str | None = None,
 ) -> dict:
     """``poro2d relation`` as one call: the grading's n2D(nLab) relation, written to ``out``.
 
@@ -464,15 +467,17 @@ def run_relation(
     default) calibrates the grading, maps every laboratory state by its relative density and
     checks it over ``seeds``; paper mode runs the criterion once per state at the fixed
     preparation friction. Returns the relation as written to ``out/relation.json``, with
-    ``failed_cases`` (cases that raised; their tracebacks are in ``out``).
+    ``failed_cases`` (cases that raised; their tracebacks are in ``out``). ``dashboard``: where a
+    LocalCluster serves its dashboard (default 127.0.0.1:0, this machine; ``"none"``: none).
     """
     from poro2d.criterion.run import load
     from poro2d.io_utils import check_output_dir
     from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.runner import run_sweep
+    from poro2d.sweep.runner import check_dashboard, run_sweep
 
     out = Path(out)
     check_output_dir("--out", out)
+    dashboard_address = check_dashboard(dashboard)
     base, base_dir = load(config, preset, extra_tables=("relation",))
     table = base.get("relation") or {}
     settings = relation_settings(
@@ -480,7 +485,8 @@ def run_relation(
     )
     mode = check_mode(mode if mode is not None else table.get("mode", "density"))
     n_seeds = check_seeds(seeds if seeds is not None else table.get("seeds", 3))
-    sweep_kw = {"scheduler": scheduler, "workers": workers, "progress": progress}
+    sweep_kw = {"scheduler": scheduler, "workers": workers, "progress": progress,
+                "dashboard": dashboard_address}  # fmt: skip
     title = "2D porosity from the criterion vs laboratory porosity" + (
         " (quick: 0.08 m x 0.04 m box)" if quick else ""
     )

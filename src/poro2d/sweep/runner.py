@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from poro2d.io_utils import atomic_path, provenance, write_json
+from poro2d.locks import cache_entry, holds_output
 from poro2d.resumable import Fingerprint, ResumableStage
 from poro2d.sweep.cases import KINDS, PERFORMANCE_KEYS, Case, SweepConfig
 
@@ -100,8 +101,15 @@ def run_case_task(case: dict, case_dir: str, func) -> dict:
     """Run one case on a worker; never raises for errors of the case itself.
 
     ``func`` is the kind's callable, shipped with the task so that kinds registered
-    at run time (tests, plug-ins) work on any worker.
+    at run time (tests, plug-ins) work on any worker. The case folder is held while the
+    case runs: a worker left running by a killed sweep may still compute it, and a rerun's
+    worker then waits for it and reads its result back instead of writing beside it.
     """
+    with cache_entry(case_dir, parameter="case folder"):
+        return _run_case(case, case_dir, func)
+
+
+def _run_case(case: dict, case_dir: str, func) -> dict:
     d = Path(case_dir)
     stage = case_stage(case, d)
     done = stage.stored(RESULT, accept=_is_done)
@@ -207,8 +215,34 @@ def _failed_row(case: Case, d: Path, err: BaseException, tb: str) -> dict:
     return row
 
 
-def _start_client(scheduler: str | None, workers: int | None, threads_needed: int):
-    """(client, cluster or None): connect to ``scheduler`` or start a LocalCluster."""
+#: where a LocalCluster serves its dashboard: this machine only (a port the system picks), so
+#: that other users of a shared login node cannot watch the run or read its logs
+DEFAULT_DASHBOARD = "127.0.0.1:0"
+
+
+def check_dashboard(value: str | None, parameter: str = "--dashboard") -> str | None:
+    """A dashboard address ``HOST:PORT`` (``:PORT`` for every interface), or None for no dashboard
+    (``none``/``off``); the default when ``value`` is None is :data:`DEFAULT_DASHBOARD`.
+    """
+    from poro2d.errors import InputError
+
+    if value is None:
+        return DEFAULT_DASHBOARD
+    text = str(value).strip()
+    if text.lower() in ("none", "off"):
+        return None
+    host, sep, port = text.rpartition(":")
+    if not sep or not port.isdigit() or int(port) > 65535 or any(c.isspace() or c == "/" for c in host):
+        raise InputError(parameter, value, "HOST:PORT (port 0 to 65535, 0: any free one), :PORT, or none")
+    return text
+
+
+def _start_client(scheduler: str | None, workers: int | None, threads_needed: int,
+                  dashboard: str | None = DEFAULT_DASHBOARD):  # fmt: skip
+    """(client, cluster or None): connect to ``scheduler`` or start a LocalCluster.
+
+    The LocalCluster's dashboard listens on ``dashboard`` (None: no dashboard).
+    """
     from distributed import Client, LocalCluster
 
     if scheduler:
@@ -219,7 +253,10 @@ def _start_client(scheduler: str | None, workers: int | None, threads_needed: in
         n_workers=n,
         threads_per_worker=1,
         processes=True,
-        dashboard_address=":0",
+        # the scheduler's web server (health, metrics) runs in any case: on this machine, with
+        # the dashboard's pages only when one is asked for
+        dashboard_address=dashboard if dashboard is not None else DEFAULT_DASHBOARD,
+        scheduler_kwargs={"dashboard": dashboard is not None},
         env=env,
     )
     return Client(cluster), cluster
@@ -275,6 +312,7 @@ def write_tables(df, out: Path) -> None:
         df.to_parquet(tmp, index=False)
 
 
+@holds_output("out")
 def run_sweep(
     sweep: SweepConfig,
     out: str | os.PathLike,
@@ -283,12 +321,14 @@ def run_sweep(
     workers: int | None = None,
     client=None,
     progress: bool = True,
+    dashboard: str | None = DEFAULT_DASHBOARD,
 ) -> SweepOutcome:
     """Run every unfinished case of ``sweep`` into ``out``; returns the rows and the table.
 
     ``client``: an existing ``distributed.Client`` (tests, notebooks); otherwise one is
     made for ``scheduler`` (an address such as ``tcp://host:8786``) or for a new
-    LocalCluster with ``workers`` processes (default: one per core) of one thread each.
+    LocalCluster with ``workers`` processes (default: one per core) of one thread each,
+    its dashboard on ``dashboard`` (this machine only by default; None: none).
     """
     out = Path(out)
     cases_dir = out / "cases"
@@ -319,7 +359,8 @@ def run_sweep(
     cluster_info: dict[str, Any] = {}
     if pending:
         cluster_info = _run_pending(sweep, pending, rows, cases_dir, n_reused, client=client,
-                                    scheduler=scheduler, workers=workers, progress=progress)  # fmt: skip
+                                    scheduler=scheduler, workers=workers, progress=progress,
+                                    dashboard=dashboard)  # fmt: skip
     ordered = [dict(rows[c.id], reused=bool(rows[c.id].get("reused", False))) for c in sweep.cases]
     df = table_from_rows(ordered, sweep.axes)
     df["reused"] = [r["reused"] for r in ordered]
@@ -331,7 +372,7 @@ def run_sweep(
 
 
 def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases_dir: Path, n_reused: int, *,
-                 client, scheduler, workers, progress: bool) -> dict:  # fmt: skip
+                 client, scheduler, workers, progress: bool, dashboard: str | None) -> dict:  # fmt: skip
     """Run the unfinished cases on ``client`` (or a cluster made for them) into ``rows``.
 
     Returns what is recorded of the cluster (scheduler, workers, threads, dashboard).
@@ -340,7 +381,7 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases_dir:
     cluster = None
     if own:
         threads = max(int((c.config.get("specimen") or {}).get("threads", 1) or 1) for c in pending)
-        client, cluster = _start_client(scheduler, workers, threads)
+        client, cluster = _start_client(scheduler, workers, threads, dashboard)
     try:
         info = client.scheduler_info()
         cluster_info = {
@@ -348,7 +389,7 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases_dir:
             "workers": len(info.get("workers", {})),
             "threads": sum(w.get("nthreads", 0) for w in info.get("workers", {}).values()),
             "local_cluster": cluster is not None,
-            "dashboard": _dashboard(client),
+            "dashboard": _dashboard(client) if dashboard is not None or scheduler else None,
         }
         if progress and cluster_info["dashboard"]:
             from poro2d.console import OutputConsole

@@ -31,6 +31,7 @@ import numpy as np
 
 from poro2d.config import check_keys
 from poro2d.errors import InputError, check_int, is_number
+from poro2d.locks import holds_output
 
 #: grading widths of the full study (Cu = d60 / d10), and of ``--quick``: at the paper
 #: grading's mean disk area Cu = 4 has disks of about 26 mm, taller than the 20 mm layer
@@ -411,6 +412,7 @@ def _first_trial_lines(ref: dict | None, paper: dict) -> list[str]:
 
 
 # ----------------------------------------------------------------------------------- run
+@holds_output("out")
 def run_sensitivity(
     base: dict,
     base_dir: Path | None,

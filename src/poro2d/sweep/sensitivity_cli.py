@@ -29,6 +29,9 @@ def register(app: typer.Typer) -> None:
         seeds: int = typer.Option(None, "--seeds", help="Specimens per point (default 3, quick 2)."),
         scheduler: str = typer.Option(None, "--scheduler", help="Address of a running Dask scheduler."),
         workers: int = typer.Option(None, "--workers", help="Worker processes of the local cluster."),
+        dashboard: str = typer.Option(
+            None, "--dashboard", help="Local cluster dashboard: HOST:PORT or none (default 127.0.0.1:0)."
+        ),
         quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
     ) -> None:
         """Why the paper's case gives what it gives: the criterion in the paper's protocol
@@ -37,6 +40,7 @@ def register(app: typer.Typer) -> None:
         from poro2d.criterion.config import load_config
         from poro2d.errors import InputError
         from poro2d.io_utils import check_output_dir
+        from poro2d.sweep.runner import check_dashboard
         from poro2d.sweep.sensitivity import run_sensitivity
 
         if workers is not None and workers < 1:
@@ -44,10 +48,11 @@ def register(app: typer.Typer) -> None:
         if seeds is not None and not 1 <= seeds <= 50:
             raise InputError("--seeds", seeds, "an integer in [1, 50]")
         check_output_dir("--out", out)
+        dashboard_address = check_dashboard(dashboard)
         base, base_dir = load_config(config, preset, extra_tables=("sensitivity",))
         console.print(f"sensitivity study{' (quick)' if quick else ''} -> {out}")
         sens = run_sensitivity(base, base_dir, out, quick=quick, seeds=seeds, scheduler=scheduler,
-                               workers=workers, progress=not quiet)  # fmt: skip
+                               workers=workers, progress=not quiet, dashboard=dashboard_address)  # fmt: skip
         print_sensitivity(sens, out)
         failed = sens["sweeps"]["failed_cases"]
         if failed:
