@@ -123,12 +123,45 @@ def main(argv: list[str] | None = None) -> None:
         raise
     except Exception as exc:  # usage errors of click (or the copy of it that typer ships)
         if _is_click(exc, "ClickException"):
-            exc.show()  # type: ignore[attr-defined]
+            # one line as for every other refusal: no usage banner, no "Try --help" line
+            line = usage_line(exc, sys.argv[1:] if argv is None else argv)
+            err_console.print(f"[bold red]error:[/] {escape(line)}", highlight=False, soft_wrap=True)
             sys.exit(exc.exit_code)  # type: ignore[attr-defined]
         if _is_click(exc, "Abort"):
             err_console.print("[yellow]aborted[/]")
             sys.exit(1)
         raise
+
+
+def usage_line(exc, argv: list[str]) -> str:
+    """A usage error of the command line library as one line.
+
+    A value that does not convert (``--seed 1e3``) reads like every other refusal: the
+    option, the value given and what is allowed; an unknown option lists the command's own.
+    """
+    param = getattr(exc, "param", None)
+    if _is_click(exc, "BadParameter") and not _is_click(exc, "MissingParameter") and param is not None:
+        name = max(param.opts, key=len) if param.opts else param.name
+        allowed = str(exc.message).removeprefix("Input should be ").split(", unable to")[0]
+        return f"{name} = {_given(argv, param.opts)!r} is invalid; allowed: {allowed}"
+    line = " ".join(str(exc.format_message()).split())
+    ctx = getattr(exc, "ctx", None)
+    if _is_click(exc, "NoSuchOption") and ctx is not None:
+        known = sorted(o for p in ctx.command.params for o in p.opts if o.startswith("--"))
+        line = f"no such option: {exc.option_name}; the options of {ctx.info_name}: {', '.join(known)}"
+    return line
+
+
+def _given(argv: list[str], opts: list[str]) -> str | None:
+    """What followed the last of ``opts`` in ``argv`` (``--opt value`` or ``--opt=value``)."""
+    given = None
+    for k, arg in enumerate(argv):
+        for opt in opts:
+            if arg == opt and k + 1 < len(argv):
+                given = argv[k + 1]
+            elif arg.startswith(opt + "=") and opt.startswith("--"):
+                given = arg[len(opt) + 1 :]
+    return given
 
 
 def _is_click(exc: BaseException, name: str) -> bool:

@@ -214,3 +214,27 @@ def check_output_dir(parameter: str, path: str | os.PathLike) -> Path:
     if not os.access(existing, os.W_OK | os.X_OK):
         raise InputError(parameter, str(p), "a folder that can be written", f"{existing} is read-only")
     return p
+
+
+def read_utf8(parameter: str, path: str | os.PathLike, allowed: str) -> str:
+    """The text of a UTF-8 file; a file of other bytes (binary, Latin-1) is an InputError.
+
+    The message names the file and the line and column of the first byte that is not
+    UTF-8, so the user can find it.
+    """
+    from poro2d.errors import InputError
+
+    p = Path(path)
+    data = p.read_bytes()
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line, column = text_position(data, exc.start)
+        where = f"byte 0x{data[exc.start]:02x} at line {line}, column {column} is not UTF-8"
+        raise InputError(parameter, str(p), allowed, where) from None
+
+
+def text_position(data: bytes, offset: int) -> tuple[int, int]:
+    """(line, column), both from 1, of byte ``offset`` of ``data``."""
+    line_start = data.rfind(b"\n", 0, offset) + 1
+    return data.count(b"\n", 0, offset) + 1, offset - line_start + 1

@@ -40,15 +40,22 @@ def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> d
     from poro2d import porosity as P
     from poro2d.config import check_keys
     from poro2d.errors import InputError, check_int, check_range
+    from poro2d.sweep.density import check_mus
 
     t = dict(cfg.get("density") or {})
     check_keys("density", t, DENSITY_KEYS)
     mode = mode if mode is not None else t.get("mode", "paper")
     if mode not in ("paper", "density"):
         raise InputError("mode", mode, "paper or density")
-    out = {"mode": mode, "mu_prep": t.get("mu_prep")}
     if mode == "paper":
-        return out
+        # the paper's protocol prepares at friction_prep and uses no laboratory extremes: an
+        # option of density mode given with it would be ignored, so it is refused instead
+        for option, value in (("--n-max", n_max), ("--n-min", n_min), ("--seeds", seeds)):
+            if value is not None:
+                raise InputError(option, value, "only with --mode density (paper mode: the paper's protocol)")
+        return {"mode": mode, "mu_prep": None}
+    mus = t.get("mu_prep")
+    out = {"mode": mode, "mu_prep": None if mus is None else check_mus(mus, "density.mu_prep")}
     hi = n_max if n_max is not None else t.get("n_max", P.PAPER_N_MAX if preset else None)
     lo = n_min if n_min is not None else t.get("n_min", P.PAPER_N_MIN if preset else None)
     if hi is None or lo is None:

@@ -16,13 +16,6 @@ _SCHED = "Address of a running Dask scheduler (e.g. tcp://host:8786); default: a
 _WORKERS = "Worker processes of the LocalCluster (default: one per core, one thread each)."
 
 
-def _check_workers(workers: int | None) -> None:
-    from poro2d.errors import InputError
-
-    if workers is not None and workers < 1:
-        raise InputError("--workers", workers, "an integer >= 1")
-
-
 def sweep_cmd(
     config: Path = typer.Argument(..., help="TOML config: base case tables and a \\[sweep] table."),
     out: Path = typer.Option(
@@ -36,9 +29,9 @@ def sweep_cmd(
     from poro2d.config import load_toml
     from poro2d.io_utils import check_output_dir
     from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.runner import run_sweep
+    from poro2d.sweep.runner import check_cluster_options, run_sweep
 
-    _check_workers(workers)
+    check_cluster_options(scheduler, workers)
     check_output_dir("--out", out)
     cfg = load_toml(config)
     sweep = parse_sweep(cfg, Path(config).resolve().parent)
@@ -77,11 +70,12 @@ def relation_cmd(
     """
     from poro2d.sweep.relation import run_relation
 
-    _check_workers(workers)
-    console.print(f"criterion relation{' (quick)' if quick else ''} -> {out}")
+    def banner() -> None:  # once every input is checked: a refusal is the only line
+        console.print(f"criterion relation{' (quick)' if quick else ''} -> {out}")
+
     rel = run_relation(
         config, preset=preset, out=out, points=points, n_max=n_max, n_min=n_min, mode=mode, seeds=seeds,
-        quick=quick, scheduler=scheduler, workers=workers, progress=not quiet,
+        quick=quick, scheduler=scheduler, workers=workers, progress=not quiet, announce=banner,
     )  # fmt: skip
     print_relation(rel, out)
     if rel["failed_cases"]:

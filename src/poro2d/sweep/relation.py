@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from poro2d import porosity as P
-from poro2d.config import check_keys
+from poro2d.config import check_keys, check_number_list
 from poro2d.errors import InputError, check_range
 from poro2d.paper_data import QUICK_SPECIMEN as PAPER_QUICK_SPECIMEN
 
@@ -106,11 +106,9 @@ def relation_settings(
         raise InputError("n_max", hi, f"greater than n_min = {lo}")
     if "n_lab" in t and points is None:
         vals = t["n_lab"]
-        if not isinstance(vals, list) or len(vals) < 2:
-            raise InputError("relation.n_lab", vals, "a list of at least two laboratory porosities")
-        n_labs = [
-            round(check_range("relation.n_lab", v, 0.0, 1.0, lo_open=True, hi_open=True), 4) for v in vals
-        ]
+        # every state between the extremes: its relative density is what the relation is about
+        n_labs = [round(v, 4) for v in check_number_list("relation.n_lab", vals, lo, hi, min_items=2,
+                                                         what="laboratory porosities")]  # fmt: skip
         n_labs = sorted(set(n_labs), reverse=True)
     else:
         n_labs = lab_porosities(hi, lo, points if points is not None else t.get("points", 5))
@@ -439,6 +437,23 @@ def density_relation(
     return rel, record
 
 
+def refuse_density_options(table: dict, seeds: int | None) -> None:
+    """Paper mode prepares every state at friction_prep, once: seeds and frictions would be ignored."""
+    if seeds is not None:
+        raise InputError("--seeds", seeds, "only in density mode (paper mode runs each state once)")
+    for key in ("seeds", "mu_prep"):
+        if key in table:
+            raise InputError(f"relation.{key}", table[key], "only in density mode (paper mode: leave it out)")
+
+
+def check_cases(base: dict, base_dir: Path | None, settings: dict, *, quick: bool) -> None:
+    """Every criterion case of the relation built once, without running: a bad specimen, grading
+    or criterion setting is refused before the calibration starts, not when its case comes up."""
+    from poro2d.sweep.cases import parse_sweep
+
+    parse_sweep(sweep_config(base, settings["n_lab"], quick=quick), base_dir)
+
+
 def run_relation(
     config=None,
     *,
@@ -453,6 +468,7 @@ def run_relation(
     scheduler: str | None = None,
     workers: int | None = None,
     progress: bool = True,
+    announce=None,
 ) -> dict:
     """``poro2d relation`` as one call: the grading's n2D(nLab) relation, written to ``out``.
 
@@ -461,29 +477,40 @@ def run_relation(
     default) calibrates the grading, maps every laboratory state by its relative density and
     checks it over ``seeds``; paper mode runs the criterion once per state at the fixed
     preparation friction. Returns the relation as written to ``out/relation.json``, with
-    ``failed_cases`` (cases that raised; their tracebacks are in ``out``).
+    ``failed_cases`` (cases that raised; their tracebacks are in ``out``). Every input is
+    checked before the first case runs; ``announce`` (no arguments) is called then, before
+    any work (the command prints its banner there, so a refusal stays one line).
     """
     from poro2d.criterion.run import load
     from poro2d.io_utils import check_output_dir
     from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.runner import run_sweep
+    from poro2d.sweep.density import check_mus
+    from poro2d.sweep.runner import check_cluster_options, run_sweep
 
     out = Path(out)
     check_output_dir("--out", out)
+    check_cluster_options(scheduler, workers)
     base, base_dir = load(config, preset, extra_tables=("relation",))
     table = base.get("relation") or {}
     settings = relation_settings(
         table or None, points=points, n_max=n_max, n_min=n_min, preset=config is None
     )
     mode = check_mode(mode if mode is not None else table.get("mode", "density"))
-    n_seeds = check_seeds(seeds if seeds is not None else table.get("seeds", 3))
+    if mode == "density":
+        n_seeds = check_seeds(seeds if seeds is not None else table.get("seeds", 3))
+        mus = check_mus(table["mu_prep"], "relation.mu_prep") if "mu_prep" in table else None
+    else:
+        refuse_density_options(table, seeds)
+    check_cases(base, base_dir, settings, quick=quick)
+    if announce is not None:
+        announce()
     sweep_kw = {"scheduler": scheduler, "workers": workers, "progress": progress}
     title = "2D porosity from the criterion vs laboratory porosity" + (
         " (quick: 0.08 m x 0.04 m box)" if quick else ""
     )
     if mode == "density":
-        rel, record = density_relation(base, base_dir, settings, out, quick=quick, seeds=n_seeds,
-                                       mus=table.get("mu_prep"), **sweep_kw)  # fmt: skip
+        rel, record = density_relation(base, base_dir, settings, out, quick=quick, seeds=n_seeds, mus=mus,
+                                       **sweep_kw)  # fmt: skip
         failed, extra = record["failed_cases"], {"quick": quick, "config": base, "sweeps": record}
     else:
         res = run_sweep(

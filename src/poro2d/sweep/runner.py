@@ -212,7 +212,7 @@ def _start_client(scheduler: str | None, workers: int | None, threads_needed: in
     from distributed import Client, LocalCluster
 
     if scheduler:
-        return Client(scheduler, timeout="30s"), None
+        return connect(scheduler), None
     n = workers or os.cpu_count() or 1
     env = dict(SINGLE_THREAD_ENV, NUMBA_NUM_THREADS=str(max(1, threads_needed)))
     cluster = LocalCluster(
@@ -223,6 +223,73 @@ def _start_client(scheduler: str | None, workers: int | None, threads_needed: in
         env=env,
     )
     return Client(cluster), cluster
+
+
+#: seconds to wait for a running scheduler to answer (distributed's own default is 30)
+CONNECT_TIMEOUT_S = 10
+#: address schemes of a Dask scheduler that a user can type
+SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+SCHEDULER_FORM = "an address such as tcp://host:8786 (scheme tcp, tls, ws, wss or ucx; port 1-65535)"
+
+
+def max_workers() -> int:
+    """The most worker processes a local cluster may start: two per core (more only queue)."""
+    return 2 * (os.cpu_count() or 1)
+
+
+def check_cluster_options(scheduler: str | None, workers: int | None) -> None:
+    """``--scheduler`` of the right form and ``--workers`` in range, checked before any work.
+
+    ``--workers`` sizes the local cluster; with ``--scheduler`` the running cluster's own
+    workers take the cases, so the two together are refused rather than one ignored.
+    """
+    from poro2d.errors import InputError, check_int
+
+    if workers is not None:
+        check_int("--workers", workers, 1, max_workers())
+    if scheduler is None:
+        return
+    if workers is not None:
+        raise InputError("--workers", workers, "nothing with --scheduler (its own workers run the cases)")
+    check_scheduler_address(scheduler)
+
+
+def check_scheduler_address(address: str) -> str:
+    """``address`` if it has the form ``[scheme://]host:port``; otherwise InputError."""
+    from urllib.parse import urlsplit
+
+    from poro2d.errors import InputError
+
+    text = address.strip()
+    full = text if "://" in text else f"tcp://{text}"
+    try:
+        parts = urlsplit(full)
+        port = parts.port
+    except ValueError:
+        raise InputError("--scheduler", address, SCHEDULER_FORM) from None
+    if parts.scheme not in SCHEDULER_SCHEMES or not parts.hostname or port is None or not 0 < port < 65536:
+        raise InputError("--scheduler", address, SCHEDULER_FORM)
+    if parts.path not in ("", "/") or parts.query or parts.fragment:
+        raise InputError("--scheduler", address, SCHEDULER_FORM)
+    return full
+
+
+def connect(scheduler: str):
+    """A client of the running scheduler at ``scheduler``; one that does not answer is an InputError."""
+    from distributed import Client
+
+    from poro2d.errors import InputError
+
+    address = check_scheduler_address(scheduler)
+    try:
+        return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
+    except (OSError, TimeoutError) as exc:  # refused, unreachable, or no answer in time
+        raise InputError(
+            "--scheduler",
+            scheduler,
+            f"a running Dask scheduler that answers within {CONNECT_TIMEOUT_S} s",
+            f"{type(exc).__name__}: {exc}".splitlines()[0],
+        ) from None
 
 
 def _dashboard(client) -> str | None:
@@ -291,6 +358,8 @@ def run_sweep(
     LocalCluster with ``workers`` processes (default: one per core) of one thread each.
     """
     out = Path(out)
+    if client is None:
+        check_cluster_options(scheduler, workers)
     cases_dir = out / "cases"
     cases_dir.mkdir(parents=True, exist_ok=True)
     t_start = time.perf_counter()
@@ -427,6 +496,8 @@ def _submit_all(
 __all__ = [
     "SweepOutcome",
     "case_stage",
+    "check_cluster_options",
+    "connect",
     "finished_row",
     "run_case_task",
     "run_sweep",
