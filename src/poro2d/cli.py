@@ -17,6 +17,10 @@ from rich.markup import escape
 
 from poro2d import __version__
 from poro2d.errors import InputError, Interrupted
+from poro2d.worker_signals import ignore_interrupts_in_dask_worker
+
+# a worker process of the local cluster imports this module first (as its main module)
+ignore_interrupts_in_dask_worker()
 
 app = typer.Typer(
     name="poro2d",

@@ -21,8 +21,11 @@ skips finished cases and runs the rest (failed ones included).
 from __future__ import annotations
 
 import json
+import logging
 import os
+import signal
 import socket
+import threading
 import time
 import traceback
 from dataclasses import dataclass, field
@@ -33,6 +36,9 @@ from typing import Any
 from poro2d.io_utils import atomic_path, provenance, write_json
 from poro2d.resumable import Fingerprint, ResumableStage
 from poro2d.sweep.cases import KINDS, PERFORMANCE_KEYS, Case, SweepConfig
+from poro2d.worker_signals import ignore_interrupts_in_dask_worker
+
+ignore_interrupts_in_dask_worker()  # a worker started by a script imports this to run its cases
 
 RESULT = "result.json"
 PARAMS = "params.json"
@@ -292,6 +298,42 @@ def connect(scheduler: str):
         ) from None
 
 
+def hold_interrupts() -> set | None:
+    """Block SIGINT in this thread while a local cluster starts; returns what to restore.
+
+    A Ctrl-C in the middle of the cluster's start-up left it half built, to be closed at
+    exit with a traceback. Blocked here, the signal waits until :func:`release_interrupts`,
+    when the cluster is whole and the command can close it. (The worker processes start
+    with no signal blocked; they ignore SIGINT themselves: :mod:`poro2d.worker_signals`.)
+    """
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "pthread_sigmask"):
+        return None
+    return signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+
+
+def release_interrupts(previous: set | None) -> None:
+    """Undo :func:`hold_interrupts`; a Ctrl-C that came meanwhile is raised now."""
+    if previous is not None and signal.SIGINT not in previous:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+def quiet_shutdown_logs(client) -> None:
+    """Silence Dask's logging here and on the workers before an interrupted run closes them.
+
+    Closing workers in the middle of their cases makes the worker, nanny and scheduler log
+    warnings (cancelled tasks, workers killed) that say only that the run was stopped.
+    """
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
+    try:
+        client.run(_silence_distributed_logs)
+    except Exception:  # a client already closed or never connected: nothing to silence there
+        pass
+
+
+def _silence_distributed_logs() -> None:
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
+
+
 def _dashboard(client) -> str | None:
     try:
         return client.dashboard_link
@@ -407,10 +449,17 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases_dir:
     """
     own = client is None
     cluster = None
+    held = None
     if own:
         threads = max(int((c.config.get("specimen") or {}).get("threads", 1) or 1) for c in pending)
-        client, cluster = _start_client(scheduler, workers, threads)
+        held = hold_interrupts() if not scheduler else None
+        try:
+            client, cluster = _start_client(scheduler, workers, threads)
+        except BaseException:
+            release_interrupts(held)
+            raise
     try:
+        release_interrupts(held)  # a Ctrl-C of the start-up arrives here, with the cluster in hand to close
         info = client.scheduler_info()
         cluster_info = {
             "scheduler": scheduler or info.get("address"),
@@ -426,6 +475,10 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases_dir:
             err.print(f"Dask dashboard: {cluster_info['dashboard']}", highlight=False)
         n_total = len(sweep.cases)
         rows.update(_submit_all(client, pending, cases_dir, sweep.retries, progress, n_reused, n_total))
+    except KeyboardInterrupt:
+        if own:  # the command says it was interrupted; the cluster's shutdown has nothing to add
+            quiet_shutdown_logs(client)
+        raise
     finally:
         if own:
             client.close()
