@@ -14,6 +14,7 @@ import poro2d.sweep.density as density_sweep
 import poro2d.sweep.runner as runner
 from poro2d.cli import main
 from poro2d.criterion.protocol import PorosityCriterion
+from poro2d.dem import Particles, Simulation, Walls, checkpoint
 from poro2d.shear.replicates import ReplicateShear
 from poro2d.shear.series import ShearSeries
 
@@ -42,6 +43,13 @@ FILES: dict[str, str | bytes] = {
     "lab_latin1.csv": b"normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,\xe9\n",
     "lab_wide.csv": "normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,75,3\n",
     "shear_empty_item.toml": "[shear]\nnormal_stress_kpa = [50, 1e9]\n",
+    "record.toml": "[shear]\nrecord_interval = 1e-300\n",
+    "checkpoints.toml": "[shear]\ncheckpoint_interval = 1e-300\n",
+    "steps.toml": "[shear]\nconsolidation_max_steps = 100000000000\n",
+    "density_scale.toml": "[shear]\ndensity_scale = 1e300\n",
+    "kn_wall.toml": "[shear]\nkn_wall = 1e300\n",
+    "gap.toml": "[shear]\ngap = 0.05\n",
+    "friction.toml": "[shear]\nfriction_wall = 1e300\n",
 }
 
 #: (command line, words of the one line); {d} is the folder holding FILES, {out} a new folder
@@ -101,10 +109,26 @@ CASES = [
         ["shear", "-s", "x.npz", "-c", "{d}/shear_empty_item.toml"],
         ["shear.normal_stress_kpa", "out of range"],
     ),
+    # shear settings with no physical meaning or no end (a real specimen: 0.1 m x 0.1 m box)
+    (["shear", "-s", "{d}/sp.npz", "--max-displacement", "1e300"], ["max_displacement = 1e+300", "1.0]"]),
+    (["shear", "-s", "{d}/sp.npz", "--stop-after-peak", "1e300"], ["stop_after_peak = 1e+300", "0.02]"]),
+    (["shear", "-s", "{d}/sp.npz", "-c", "{d}/record.toml"], ["record_interval = 1e-300", "1000000"]),
+    (["shear", "-s", "{d}/sp.npz", "-c", "{d}/checkpoints.toml"], ["checkpoint_interval = 1e-300"]),
+    (["shear", "-s", "{d}/sp.npz", "-c", "{d}/steps.toml"], ["consolidation_max_steps", "10000000]"]),
+    (["shear", "-s", "{d}/sp.npz", "-c", "{d}/density_scale.toml"], ["density_scale = 1e+300"]),
+    (["shear", "-s", "{d}/sp.npz", "-c", "{d}/kn_wall.toml"], ["kn_wall = 1e+300"]),
+    (["shear", "-s", "{d}/sp.npz", "-c", "{d}/gap.toml"], ["gap = 0.05", "0.025]"]),
+    (["shear", "-s", "{d}/sp.npz", "-c", "{d}/friction.toml"], ["friction_wall = 1e+300", "10.0]"]),
+    (["shear", "-s", "{d}/sp.npz", "--normal-stress", "1e9"], ["--normal-stress = '1e9'"]),
     # usage errors of the option parser: one line too
     (["shear", "--stop-after-peak", "abc"], ["--stop-after-peak = 'abc'", "a valid number"]),
     (["criterion", "--seed", "1e3"], ["--seed = '1e3'", "integer"]),
-    (["criterion", "--n-lab="], ["--n-lab = ''", "number"]),
+    (["criterion", "--n-lab="], ["--n-lab = ''", "a non-empty value"]),
+    # an empty path is the current folder to the option parser: refused, not written into
+    (["criterion", "--preset", "paper", "--out", ""], ["--out = ''"]),
+    (["relation", "--preset", "paper", "-o", ""], ["-o = ''"]),
+    (["plot", "relations", "-o", ""], ["-o = ''"]),
+    (["shear", "-s", "", "--normal-stress", "50"], ["-s = ''"]),
     (["relation", "--points", "many"], ["--points = 'many'"]),
     (["criterion", "--bogus"], ["--bogus", "--preset"]),
     (["criterion", "--config"], ["--config"]),
@@ -128,12 +152,20 @@ def no_work(monkeypatch):
 
 
 def _write_files(folder) -> None:
+    _specimen(folder / "sp.npz")
     for name, content in FILES.items():
         path = folder / name
         if isinstance(content, bytes):
             path.write_bytes(content)
         else:
             path.write_text(content, encoding="utf-8")
+
+
+def _specimen(path) -> None:
+    """A two-disk specimen in a 0.1 m x 0.1 m box: enough for the checks made before a test."""
+    p = Particles(pos=[[0.02, 0.02], [0.05, 0.02]], radius=1e-3, density=2650.0, thickness=0.01, kn=1e5,
+                  ks=1e5, mu=0.5)  # fmt: skip
+    checkpoint.save(Simulation(p, Walls.box(0.0, 0.0, 0.1, 0.1, 1e5, 1e5, 0.5)), path)
 
 
 @pytest.mark.parametrize(("argv", "words"), CASES, ids=[" ".join(a)[:60] for a, _ in CASES])

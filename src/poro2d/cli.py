@@ -110,6 +110,7 @@ _register()
 def main(argv: list[str] | None = None) -> None:
     """Console entry point: run the app, turn InputError into a one-line message."""
     try:
+        refuse_empty_values(sys.argv[1:] if argv is None else argv)
         rc = app(args=argv, standalone_mode=False)
         if isinstance(rc, int) and rc != 0:  # typer.Exit(code) comes back as a return value here
             sys.exit(rc)
@@ -135,6 +136,32 @@ def main(argv: list[str] | None = None) -> None:
             err_console.print("[yellow]aborted[/]")
             sys.exit(1)
         raise
+
+
+def refuse_empty_values(argv: list[str]) -> None:
+    """An option given an empty value (``--out ""``, ``--n-lab=``) is refused.
+
+    No option of poro2d has a meaning for an empty text, and a path option would take it
+    for the current folder (``Path("")`` is ``.``): ``--out ""`` wrote into it.
+    """
+    for k, arg in enumerate(argv):
+        if arg == "--":
+            return
+        if not arg.startswith("-") or arg == "-":
+            continue
+        name, eq, value = arg.partition("=")
+        if eq and not value and name.startswith("--"):
+            raise InputError(name, "", "a non-empty value")
+        if not eq and k + 1 < len(argv) and argv[k + 1] == "" and not _is_flag(name):
+            raise InputError(name, "", "a non-empty value")
+
+
+#: options without a value: an empty text after them is an argument of its own (refused as such)
+FLAGS = {"--quiet", "--quick", "--rate-check", "--lattice-exact", "--version", "--help"}
+
+
+def _is_flag(name: str) -> bool:
+    return name in FLAGS or name.startswith("--no-")
 
 
 def usage_line(exc, argv: list[str]) -> str:

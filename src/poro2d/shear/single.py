@@ -65,11 +65,13 @@ class DirectShearTest:
         self.sigma_kpa = check_range("normal stress (kPa)", normal_stress_kpa, *NORMAL_STRESS_RANGE_KPA)
         self.settings = settings if settings is not None else ShearSettings()
         check_finite("shear", self.settings.to_dict())  # open ranges let an infinity through
-        W, _ = specimen_box(self.specimen)
+        W, H = specimen_box(self.specimen)
         if self.settings.max_displacement > W / 2:
             raise InputError(
                 "max_displacement", self.settings.max_displacement, f"(0, {W / 2:.4g}] m (half the box width)"
             )
+        # the box refuses a wider gap when it is built, in the test's process: here, before any test
+        check_range("gap", self.settings.gap, 0.0, H / 4)
         self.out = Path(out) if out is not None else None
         self.progress = progress
         self.figures = figures
