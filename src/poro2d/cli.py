@@ -110,7 +110,9 @@ _register()
 def main(argv: list[str] | None = None) -> None:
     """Console entry point: run the app, turn InputError into a one-line message."""
     try:
-        refuse_empty_values(sys.argv[1:] if argv is None else argv)
+        args = sys.argv[1:] if argv is None else argv
+        refuse_empty_values(args)
+        refuse_repeated_options(args)
         rc = app(args=argv, standalone_mode=False)
         if isinstance(rc, int) and rc != 0:  # typer.Exit(code) comes back as a return value here
             sys.exit(rc)
@@ -154,6 +156,35 @@ def refuse_empty_values(argv: list[str]) -> None:
             raise InputError(name, "", "a non-empty value")
         if not eq and k + 1 < len(argv) and argv[k + 1] == "" and not _is_flag(name):
             raise InputError(name, "", "a non-empty value")
+
+
+def refuse_repeated_options(argv: list[str]) -> None:
+    """An option given twice (``--n-lab 0.3 ... --n-lab 0.4``, ``-o a --out b``) is refused.
+
+    The option parser keeps the last value without a word; which one was meant is the
+    user's to say.
+    """
+    import typer.main
+
+    command = typer.main.get_command(app)
+    for arg in argv:  # down to the (sub)command the arguments name
+        commands = getattr(command, "commands", None)
+        if not commands or arg not in commands:
+            break
+        command = commands[arg]
+    spelling = {o: p for p in getattr(command, "params", []) for o in p.opts}
+    seen: dict[object, list[str]] = {}
+    for k, arg in enumerate(argv):
+        if arg == "--":
+            break
+        param = spelling.get(arg.partition("=")[0])
+        if param is None:
+            continue
+        bare = "=" in arg or getattr(param, "is_flag", False) or k + 1 == len(argv)
+        seen.setdefault(param, []).append(arg if bare else f"{arg} {argv[k + 1]}")
+    for param, given in seen.items():
+        if len(given) > 1:
+            raise InputError(max(param.opts, key=len), ", ".join(given), "the option once")
 
 
 #: options without a value: an empty text after them is an argument of its own (refused as such)

@@ -77,7 +77,8 @@ class ShearSettings:
         # at most MAX_RECORDS rows and MAX_CHECKPOINTS checkpoints a test: a finer interval
         # (1e-300 m) asks for more rows than memory holds, or a checkpoint every step
         self._check_interval("record_interval", self.record_interval, MAX_RECORDS)
-        check_range("stop_after_peak", self.stop_after_peak, 0.0, self.max_displacement)
+        # beyond max_displacement it never ends a test (as a short quick test with the default)
+        check_range("stop_after_peak", self.stop_after_peak, 0.0, MAX_DISPLACEMENT)
         self._check_interval("checkpoint_interval", self.checkpoint_interval, MAX_CHECKPOINTS)
         check_range("consolidation_ratio", self.consolidation_ratio, 0.0, 1.0, lo_open=True)
         check_int("consolidation_max_steps", self.consolidation_max_steps, 1000, MAX_CONSOLIDATION_STEPS)

@@ -29,12 +29,13 @@ def sweep_cmd(
     from poro2d.config import load_toml
     from poro2d.io_utils import check_output_dir
     from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.runner import check_cluster_options, run_sweep
+    from poro2d.sweep.runner import check_cluster_options, check_reachable, run_sweep
 
     check_cluster_options(scheduler, workers)
     check_output_dir("--out", out)
     cfg = load_toml(config)
     sweep = parse_sweep(cfg, Path(config).resolve().parent)
+    check_reachable(scheduler)  # before the first line: an unreachable scheduler is the only one
     console.print(f"{len(sweep.cases)} case(s) of kind {sweep.kind!r} -> {out}")
     res = run_sweep(sweep, out, scheduler=scheduler, workers=workers, progress=not quiet)
     print_summary(res, out)

@@ -485,7 +485,7 @@ def run_relation(
     from poro2d.io_utils import check_output_dir
     from poro2d.sweep.cases import parse_sweep
     from poro2d.sweep.density import check_mus
-    from poro2d.sweep.runner import check_cluster_options, run_sweep
+    from poro2d.sweep.runner import check_cluster_options, check_reachable, run_sweep
 
     out = Path(out)
     check_output_dir("--out", out)
@@ -502,6 +502,7 @@ def run_relation(
     else:
         refuse_density_options(table, seeds)
     check_cases(base, base_dir, settings, quick=quick)
+    check_reachable(scheduler)
     if announce is not None:
         announce()
     sweep_kw = {"scheduler": scheduler, "workers": workers, "progress": progress}

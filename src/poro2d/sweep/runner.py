@@ -334,6 +334,16 @@ def _silence_distributed_logs() -> None:
     logging.getLogger("distributed").setLevel(logging.CRITICAL)
 
 
+def check_reachable(scheduler: str | None) -> None:
+    """Connect to ``scheduler`` once and let go: an unreachable one is refused before any work.
+
+    A command calls it before it prints its first line, so that a scheduler that does not
+    answer is its only line; the sweeps connect again when they start.
+    """
+    if scheduler:
+        connect(scheduler).close()
+
+
 def _dashboard(client) -> str | None:
     try:
         return client.dashboard_link
@@ -550,6 +560,7 @@ __all__ = [
     "SweepOutcome",
     "case_stage",
     "check_cluster_options",
+    "check_reachable",
     "connect",
     "finished_row",
     "run_case_task",

@@ -428,7 +428,7 @@ def run_sensitivity(
     from poro2d.criterion.config import build
     from poro2d.sweep import density as D
     from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.runner import check_cluster_options, run_sweep
+    from poro2d.sweep.runner import check_cluster_options, check_reachable, run_sweep
 
     if sweep_kw.get("client") is None:
         check_cluster_options(sweep_kw.get("scheduler"), sweep_kw.get("workers"))
@@ -439,6 +439,7 @@ def run_sensitivity(
     check_gradings(cfg, base_dir, cases)
     sweep = parse_sweep(grading_sweep(cfg, cases, settings["seeds"]), base_dir)
     parse_sweep(D.calibration_sweep(cfg, settings["mus"], settings["seeds"]), base_dir)  # checked now
+    check_reachable(sweep_kw.get("scheduler"))
     if announce is not None:
         announce()
 
