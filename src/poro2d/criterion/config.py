@@ -48,7 +48,21 @@ def load_config(
         return paper_preset(), None
     cfg = load_toml(path)
     check_keys("config", cfg, TOP_KEYS | set(extra_tables))
+    check_tables(cfg)
     return cfg, Path(path).resolve().parent
+
+
+#: top-level names of a config that hold tables (``[grading]`` is checked with its own words)
+TABLES = ("specimen", "criterion", "density", "shear", "relation", "sensitivity", "sweep")
+
+
+def check_tables(cfg: dict) -> None:
+    """Each table of a config is a table (``relation = 5`` is not), and ``title`` is text."""
+    for name in TABLES:
+        if name in cfg and not isinstance(cfg[name], dict):
+            raise InputError(name, cfg[name], "a table of key = value pairs")
+    if not isinstance(cfg.get("title", ""), str):
+        raise InputError("title", cfg["title"], "a string")
 
 
 def build(cfg: dict, base_dir: Path | None = None, **overrides):

@@ -28,6 +28,9 @@ def load(
             from poro2d.errors import InputError
 
             raise InputError("config/preset", f"a dict and {preset}", "one of the two, not both")
+        from poro2d.criterion.config import check_tables
+
+        check_tables(config)
         return copy.deepcopy(config), None
     return load_config(config, preset, extra_tables=extra_tables)
 
@@ -42,8 +45,8 @@ def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> d
     from poro2d.errors import InputError, check_int, check_range
     from poro2d.sweep.density import check_mus
 
+    check_keys("density", cfg.get("density") or {}, DENSITY_KEYS)
     t = dict(cfg.get("density") or {})
-    check_keys("density", t, DENSITY_KEYS)
     mode = mode if mode is not None else t.get("mode", "paper")
     if mode not in ("paper", "density"):
         raise InputError("mode", mode, "paper or density")

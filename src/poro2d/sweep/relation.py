@@ -89,8 +89,11 @@ def relation_settings(
     table: dict | None, *, points: int | None, n_max: float | None, n_min: float | None, preset: bool
 ) -> dict:
     """n_max, n_min and the nLab list from ``[relation]`` and the command-line options."""
+    check_keys("relation", table or {}, RELATION_KEYS)
     t = dict(table or {})
-    check_keys("relation", t, RELATION_KEYS)
+    for key in ("n_max", "n_min"):  # a wrong value in the file is refused, even when an option wins
+        if key in t:
+            check_range(f"relation.{key}", t[key], 0.0, 1.0, lo_open=True, hi_open=True)
     hi = n_max if n_max is not None else t.get("n_max", P.PAPER_N_MAX if preset else None)
     lo = n_min if n_min is not None else t.get("n_min", P.PAPER_N_MIN if preset else None)
     if hi is None or lo is None:
@@ -109,7 +112,9 @@ def relation_settings(
         # every state between the extremes: its relative density is what the relation is about
         n_labs = [round(v, 4) for v in check_number_list("relation.n_lab", vals, lo, hi, min_items=2,
                                                          what="laboratory porosities")]  # fmt: skip
-        n_labs = sorted(set(n_labs), reverse=True)
+        if len(set(n_labs)) < len(n_labs):  # one state twice is a typo, not a second point
+            raise InputError("relation.n_lab", vals, "distinct laboratory porosities (to 4 decimals)")
+        n_labs = sorted(n_labs, reverse=True)
     else:
         n_labs = lab_porosities(hi, lo, points if points is not None else t.get("points", 5))
     return {"n_max": hi, "n_min": lo, "n_lab": n_labs}
