@@ -88,6 +88,8 @@ CASES = [
     # options of density mode given to paper mode would be ignored
     (["criterion", "--preset", "paper", "--n-max", "0.5"], ["--n-max = 0.5", "--mode density"]),
     (["criterion", "--preset", "paper", "--seeds", "2"], ["--seeds = 2", "--mode density"]),
+    (["criterion", "--preset", "paper", "--mode", "density", "--seed", "3"], ["--seed = 3", "paper mode"]),
+    (["criterion", "--mode", "density", "--trial-porosity", "0.2"], ["--trial-porosity = 0.2", "paper mode"]),
     # the cluster: the address's form and the number of workers, before anything runs
     (["relation", "--preset", "paper", "--scheduler", "notanaddress"], ["--scheduler = 'notanaddress'"]),
     (["sensitivity", "--scheduler", "http://host:8786"], ["--scheduler", "tcp://host:8786"]),

@@ -225,7 +225,10 @@ def read_utf8(parameter: str, path: str | os.PathLike, allowed: str) -> str:
     from poro2d.errors import InputError
 
     p = Path(path)
-    data = p.read_bytes()
+    try:
+        data = p.read_bytes()
+    except OSError as exc:  # no permission, or gone since it was found
+        raise InputError(parameter, str(p), allowed, exc.strerror or type(exc).__name__) from None
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as exc:

@@ -112,9 +112,17 @@ def run_criterion(
     )
     check_feasible(spec, grading, settings.initial_trial())
     if dens["mode"] == "density":
+        from poro2d.errors import InputError
         from poro2d.sweep.density import run_density_state
 
+        # density mode runs seeds 0 .. seeds-1, each from its state's 2D target: a seed or a
+        # first trial of its own would be ignored, so they are refused
+        for option, value in (("--seed", seed), ("--trial-porosity", trial_porosity)):
+            if value is not None:
+                raise InputError(option, value, "only in paper mode (density: --seeds and the 2D target)")
         rest = {k: v for k, v in cfg.items() if k != "density"}
+        if threads is not None:
+            rest["specimen"] = dict(rest.get("specimen") or {}, threads=spec.threads)
         return run_density_state(rest, base, settings.n_lab, dens["n_max"], dens["n_min"], out,
                                  seeds=dens["seeds"], mus=dens["mu_prep"], progress=progress)  # fmt: skip
     return PorosityCriterion(spec, grading, settings, seed=sd, out=out, progress=progress, config=cfg).run()
