@@ -137,6 +137,7 @@ CASES = [
     (["shear", "-s", "{d}/sp.npz", "-c", "{d}/gap.toml"], ["gap = 0.05", "0.025]"]),
     (["shear", "-s", "{d}/sp.npz", "-c", "{d}/friction.toml"], ["friction_wall = 1e+300", "10.0]"]),
     (["shear", "-s", "{d}/sp.npz", "--normal-stress", "1e9"], ["--normal-stress = '1e9'"]),
+    (["convert", "--dry-density", "1600", "--solid-density", "1e300"], ["--solid-density = 1e+300", "23000"]),
     # usage errors of the option parser: one line too
     (["shear", "--stop-after-peak", "abc"], ["--stop-after-peak = 'abc'", "a valid number"]),
     (["criterion", "--seed", "1e3"], ["--seed = '1e3'", "integer"]),
