@@ -111,8 +111,7 @@ def main(argv: list[str] | None = None) -> None:
     """Console entry point: run the app, turn InputError into a one-line message."""
     try:
         args = sys.argv[1:] if argv is None else argv
-        refuse_empty_values(args)
-        refuse_repeated_options(args)
+        check_raw_arguments(args)
         rc = app(args=argv, standalone_mode=False)
         if isinstance(rc, int) and rc != 0:  # typer.Exit(code) comes back as a return value here
             sys.exit(rc)
@@ -140,59 +139,45 @@ def main(argv: list[str] | None = None) -> None:
         raise
 
 
-def refuse_empty_values(argv: list[str]) -> None:
-    """An option given an empty value (``--out ""``, ``--n-lab=``) is refused.
+def check_raw_arguments(argv: list[str]) -> None:
+    """What the option parser would let pass without a word, refused on one line.
 
-    No option of poro2d has a meaning for an empty text, and a path option would take it
-    for the current folder (``Path("")`` is ``.``): ``--out ""`` wrote into it.
+    An empty value (``--out ""``, ``--n-lab=``): no option of poro2d has a meaning for
+    it, and a path option takes it for the current folder (``Path("")`` is ``.``). An
+    option given twice (``--n-lab 0.3 ... --n-lab 0.4``, ``-o a --out b``): the parser
+    keeps the last; which one was meant is the user's to say.
     """
-    for k, arg in enumerate(argv):
-        if arg == "--":
-            return
-        if not arg.startswith("-") or arg == "-":
-            continue
-        name, eq, value = arg.partition("=")
-        if eq and not value and name.startswith("--"):
-            raise InputError(name, "", "a non-empty value")
-        if not eq and k + 1 < len(argv) and argv[k + 1] == "" and not _is_flag(name):
-            raise InputError(name, "", "a non-empty value")
-
-
-def refuse_repeated_options(argv: list[str]) -> None:
-    """An option given twice (``--n-lab 0.3 ... --n-lab 0.4``, ``-o a --out b``) is refused.
-
-    The option parser keeps the last value without a word; which one was meant is the
-    user's to say.
-    """
-    import typer.main
-
-    command = typer.main.get_command(app)
-    for arg in argv:  # down to the (sub)command the arguments name
-        commands = getattr(command, "commands", None)
-        if not commands or arg not in commands:
-            break
-        command = commands[arg]
-    spelling = {o: p for p in getattr(command, "params", []) for o in p.opts}
+    spelling = _option_spellings(argv)
     seen: dict[object, list[str]] = {}
     for k, arg in enumerate(argv):
         if arg == "--":
             break
-        param = spelling.get(arg.partition("=")[0])
-        if param is None:
+        name, eq, value = arg.partition("=")
+        param = spelling.get(name)
+        if param is None:  # not an option of the command (its value, an argument, a typo)
             continue
-        bare = "=" in arg or getattr(param, "is_flag", False) or k + 1 == len(argv)
+        is_flag = bool(getattr(param, "is_flag", False))
+        has_next = k + 1 < len(argv)
+        if not is_flag and ((eq and not value) or (not eq and has_next and argv[k + 1] == "")):
+            raise InputError(name, "", "a non-empty value")
+        bare = eq or is_flag or not has_next
         seen.setdefault(param, []).append(arg if bare else f"{arg} {argv[k + 1]}")
     for param, given in seen.items():
         if len(given) > 1:
             raise InputError(max(param.opts, key=len), ", ".join(given), "the option once")
 
 
-#: options without a value: an empty text after them is an argument of its own (refused as such)
-FLAGS = {"--quiet", "--quick", "--rate-check", "--lattice-exact", "--version", "--help"}
+def _option_spellings(argv: list[str]) -> dict[str, object]:
+    """``{"-o": param, "--out": param, ...}`` of the (sub)command that ``argv`` names."""
+    import typer.main
 
-
-def _is_flag(name: str) -> bool:
-    return name in FLAGS or name.startswith("--no-")
+    command = typer.main.get_command(app)
+    for arg in argv:
+        commands = getattr(command, "commands", None)
+        if not commands or arg not in commands:
+            break
+        command = commands[arg]
+    return {o: p for p in getattr(command, "params", []) for o in p.opts}
 
 
 def usage_line(exc, argv: list[str]) -> str:
