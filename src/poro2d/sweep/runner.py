@@ -321,7 +321,9 @@ def quiet_shutdown_logs(client) -> None:
     """Silence Dask's logging here and on the workers before an interrupted run closes them.
 
     Closing workers in the middle of their cases makes the worker, nanny and scheduler log
-    warnings (cancelled tasks, workers killed) that say only that the run was stopped.
+    warnings (cancelled tasks, workers killed) that say only that the run was stopped. The
+    level stays raised in this process: some of those lines come from the cluster's threads
+    after it is closed, and an interrupted command is ending anyway.
     """
     logging.getLogger("distributed").setLevel(logging.CRITICAL)
     try:
