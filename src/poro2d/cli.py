@@ -17,6 +17,10 @@ from rich.markup import escape
 
 from poro2d import __version__
 from poro2d.errors import InputError, Interrupted
+from poro2d.worker_signals import ignore_interrupts_in_dask_worker
+
+# a worker process of the local cluster imports this module first (as its main module)
+ignore_interrupts_in_dask_worker()
 
 app = typer.Typer(
     name="poro2d",
@@ -106,6 +110,8 @@ _register()
 def main(argv: list[str] | None = None) -> None:
     """Console entry point: run the app, turn InputError into a one-line message."""
     try:
+        args = sys.argv[1:] if argv is None else argv
+        check_raw_arguments(args)
         rc = app(args=argv, standalone_mode=False)
         if isinstance(rc, int) and rc != 0:  # typer.Exit(code) comes back as a return value here
             sys.exit(rc)
@@ -123,12 +129,86 @@ def main(argv: list[str] | None = None) -> None:
         raise
     except Exception as exc:  # usage errors of click (or the copy of it that typer ships)
         if _is_click(exc, "ClickException"):
-            exc.show()  # type: ignore[attr-defined]
+            # one line as for every other refusal: no usage banner, no "Try --help" line
+            line = usage_line(exc, sys.argv[1:] if argv is None else argv)
+            err_console.print(f"[bold red]error:[/] {escape(line)}", highlight=False, soft_wrap=True)
             sys.exit(exc.exit_code)  # type: ignore[attr-defined]
         if _is_click(exc, "Abort"):
             err_console.print("[yellow]aborted[/]")
             sys.exit(1)
         raise
+
+
+def check_raw_arguments(argv: list[str]) -> None:
+    """What the option parser would let pass without a word, refused on one line.
+
+    An empty value (``--out ""``, ``--n-lab=``): no option of poro2d has a meaning for
+    it, and a path option takes it for the current folder (``Path("")`` is ``.``). An
+    option given twice (``--n-lab 0.3 ... --n-lab 0.4``, ``-o a --out b``): the parser
+    keeps the last; which one was meant is the user's to say.
+    """
+    spelling = _option_spellings(argv)
+    seen: dict[object, list[str]] = {}
+    for k, arg in enumerate(argv):
+        if arg == "--":
+            break
+        name, eq, value = arg.partition("=")
+        param = spelling.get(name)
+        if param is None:  # not an option of the command (its value, an argument, a typo)
+            continue
+        is_flag = bool(getattr(param, "is_flag", False))
+        has_next = k + 1 < len(argv)
+        if not is_flag and ((eq and not value) or (not eq and has_next and argv[k + 1] == "")):
+            raise InputError(name, "", "a non-empty value")
+        bare = eq or is_flag or not has_next
+        seen.setdefault(param, []).append(arg if bare else f"{arg} {argv[k + 1]}")
+    for param, given in seen.items():
+        if len(given) > 1:
+            raise InputError(max(param.opts, key=len), ", ".join(given), "the option once")
+
+
+def _option_spellings(argv: list[str]) -> dict[str, object]:
+    """``{"-o": param, "--out": param, ...}`` of the (sub)command that ``argv`` names."""
+    import typer.main
+
+    command = typer.main.get_command(app)
+    for arg in argv:
+        commands = getattr(command, "commands", None)
+        if not commands or arg not in commands:
+            break
+        command = commands[arg]
+    return {o: p for p in getattr(command, "params", []) for o in p.opts}
+
+
+def usage_line(exc, argv: list[str]) -> str:
+    """A usage error of the command line library as one line.
+
+    A value that does not convert (``--seed 1e3``) reads like every other refusal: the
+    option, the value given and what is allowed; an unknown option lists the command's own.
+    """
+    param = getattr(exc, "param", None)
+    if _is_click(exc, "BadParameter") and not _is_click(exc, "MissingParameter") and param is not None:
+        name = max(param.opts, key=len) if param.opts else param.name
+        allowed = str(exc.message).removeprefix("Input should be ").split(", unable to")[0]
+        return f"{name} = {_given(argv, param.opts)!r} is invalid; allowed: {allowed}"
+    line = " ".join(str(exc.format_message()).split())
+    ctx = getattr(exc, "ctx", None)
+    if _is_click(exc, "NoSuchOption") and ctx is not None:
+        known = sorted(o for p in ctx.command.params for o in p.opts if o.startswith("--"))
+        line = f"no such option: {exc.option_name}; the options of {ctx.info_name}: {', '.join(known)}"
+    return line
+
+
+def _given(argv: list[str], opts: list[str]) -> str | None:
+    """What followed the last of ``opts`` in ``argv`` (``--opt value`` or ``--opt=value``)."""
+    given = None
+    for k, arg in enumerate(argv):
+        for opt in opts:
+            if arg == opt and k + 1 < len(argv):
+                given = argv[k + 1]
+            elif arg.startswith(opt + "=") and opt.startswith("--"):
+                given = arg[len(opt) + 1 :]
+    return given
 
 
 def _is_click(exc: BaseException, name: str) -> bool:

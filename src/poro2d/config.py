@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from poro2d.errors import InputError, is_integer, is_number
-from poro2d.io_utils import check_input_file
+from poro2d.io_utils import check_input_file, read_utf8
 
 
 def load_toml(path: str | os.PathLike) -> dict:
@@ -23,8 +23,9 @@ def load_toml(path: str | os.PathLike) -> dict:
         check_input_file("config", p)
     if not p.is_file():
         raise InputError("config", str(p), "an existing TOML file")
+    text = read_utf8("config", p, "a UTF-8 TOML file")
     try:
-        return tomllib.loads(p.read_text())
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError("config", str(p), "valid TOML", str(exc)) from None
 
@@ -111,3 +112,40 @@ def check_finite(section: str, value: Any) -> None:
     elif isinstance(value, (np.generic, np.ndarray)) and np.issubdtype(np.asarray(value).dtype, np.number):
         if not np.all(np.isfinite(value)):
             raise InputError(section, np.asarray(value).tolist(), "finite numbers")
+
+
+def check_number_list(
+    parameter: str,
+    values: Any,
+    lo: float,
+    hi: float,
+    *,
+    min_items: int = 1,
+    max_items: int = 50,
+    lo_open: bool = False,
+    increasing: bool = False,
+    what: str = "numbers",
+) -> list[float]:
+    """A list of ``min_items`` to ``max_items`` numbers, each in ``[lo, hi]``; or InputError.
+
+    TOML hands over what was written: a scalar (``mu_prep = 0.1``), a boolean, a string
+    (which would iterate as its letters) or an empty list are mistakes in the list's shape,
+    refused here with the range a value must lie in, not fallen back on or iterated.
+    ``increasing``: the values must rise strictly (a calibration's frictions, densest first).
+    """
+    lo_s = "(" if lo_open else "["
+    allowed = f"a list of {min_items} to {max_items} {what} in {lo_s}{lo:g}, {hi:g}]"
+    if increasing:
+        allowed += ", strictly increasing"
+    if not isinstance(values, list | tuple) or not min_items <= len(values) <= max_items:
+        raise InputError(parameter, values, allowed)
+    out = []
+    for v in values:
+        if not is_number(v):
+            raise InputError(parameter, values, allowed, f"{v!r} is not a number")
+        if not (math.isfinite(float(v)) and (lo < v if lo_open else lo <= v) and v <= hi):
+            raise InputError(parameter, values, allowed, f"{v!r} is out of range")
+        out.append(float(v))
+    if increasing and any(b <= a for a, b in zip(out, out[1:], strict=False)):
+        raise InputError(parameter, values, allowed)
+    return out

@@ -300,3 +300,31 @@ def _file_kind(mode: int) -> str:
              (stat.S_ISBLK, "a block device"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
              (stat.S_ISSOCK, "a socket")]  # fmt: skip
     return next((name for test, name in kinds if test(mode)), "not a regular file")
+
+
+def read_utf8(parameter: str, path: str | os.PathLike, allowed: str) -> str:
+    """The text of a UTF-8 file (a regular file of a sane size: :func:`check_input_file`);
+    a file of other bytes (binary, Latin-1) is an InputError.
+
+    The message names the file and the line and column of the first byte that is not
+    UTF-8, so the user can find it.
+    """
+    from poro2d.errors import InputError
+
+    p = check_input_file(parameter, path)
+    try:
+        data = p.read_bytes()
+    except OSError as exc:  # no permission, or gone since it was found
+        raise InputError(parameter, str(p), allowed, exc.strerror or type(exc).__name__) from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line, column = text_position(data, exc.start)
+        where = f"byte 0x{data[exc.start]:02x} at line {line}, column {column} is not UTF-8"
+        raise InputError(parameter, str(p), allowed, where) from None
+
+
+def text_position(data: bytes, offset: int) -> tuple[int, int]:
+    """(line, column), both from 1, of byte ``offset`` of ``data``."""
+    line_start = data.rfind(b"\n", 0, offset) + 1
+    return data.count(b"\n", 0, offset) + 1, offset - line_start + 1

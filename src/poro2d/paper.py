@@ -40,8 +40,11 @@ class PaperSummary(TypedResult):
     whole result is ``criterion/result.json``); ``replicate_specimens``: one row per extra
     seed (None with one specimen); ``shear``: the pooled fit over the specimens, the first
     specimen's ``tests`` and ``quasi_static``, and ``replicates`` (None when the criterion
-    did not converge); ``paper``: what the paper states, for the comparison.
+    did not converge); ``paper``: what the paper states, for the comparison; ``lab``: the
+    laboratory data given with ``--lab`` (source, kind, peaks), written only then.
     """
+
+    OPTIONAL = ("lab",)
 
     quick: bool
     seed: int
@@ -52,6 +55,7 @@ class PaperSummary(TypedResult):
     paper: dict[str, Any]
     timings: dict[str, float]
     provenance: dict[str, Any]
+    lab: dict[str, Any] | None = None
 
 
 def paper_stage(out: Path, quick: bool, seed: int) -> ResumableStage:
@@ -183,6 +187,7 @@ def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, qu
         paper=PAPER,
         timings=timings,
         provenance=provenance(),
+        lab=lab_data.to_dict() if lab_data is not None else None,
     )
 
 

@@ -14,6 +14,7 @@ Example (every key optional; the defaults are the paper preset)::
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
@@ -48,7 +49,53 @@ def load_config(
         return paper_preset(), None
     cfg = load_toml(path)
     check_keys("config", cfg, TOP_KEYS | set(extra_tables))
+    check_tables(cfg)
     return cfg, Path(path).resolve().parent
+
+
+#: top-level names of a config that hold tables (``[grading]`` is checked with its own words)
+TABLES = ("specimen", "criterion", "density", "shear", "relation", "sensitivity", "sweep")
+
+
+def check_tables(cfg: dict) -> None:
+    """Each table of a config is a table (``relation = 5`` is not), and ``title`` is text."""
+    for name in TABLES:
+        if name in cfg and not isinstance(cfg[name], dict):
+            raise InputError(name, cfg[name], "a table of key = value pairs")
+    if not isinstance(cfg.get("title", ""), str):
+        raise InputError("title", cfg["title"], "a string")
+
+
+#: upper (and for the solid density lower) bounds of a config's settings, beyond which a value
+#: is a typo or a run that cannot end: stiffnesses (N/m) 1e5 times the paper's particles (the
+#: time step falls with their square root: 300 times as many steps), friction coefficients of
+#: 10 (a contact that never slides), up to 100 g of gravity (a centrifuge's), the solids of
+#: ``poro2d convert``, disks up to 1 m thick, and step budgets of 1e8 (days of one core)
+SPECIMEN_BOUNDS: dict[str, tuple[float, float]] = {
+    **{k: (0.0, 1e12) for k in ("kn_particle", "ks_particle", "kn_wall", "ks_wall")},
+    **{k: (0.0, 10.0) for k in ("friction_prep", "friction_particle", "friction_wall")},
+    "gravity": (0.0, 981.0),
+    "solid_density": (500.0, 23000.0),
+    "thickness": (0.0, 1.0),
+    **{k: (1, 100_000_000) for k in ("max_steps_per_stage", "fallback_steps", "calm_steps")},
+    "growth_increments": (1, 10_000),
+    "growth_steps": (1, 1_000_000),
+    "settle_window": (100, 10_000_000),
+}
+CRITERION_BOUNDS: dict[str, tuple[float, float]] = {
+    "max_plate_steps": (1000, 100_000_000),
+    "check_every": (1, 1_000_000),
+    "window_checks": (1, 1000),
+    "settle_checks": (2, 1000),
+}
+
+
+def check_config_bounds(obj, section: str, bounds: dict[str, tuple[float, float]]) -> None:
+    """Each bounded setting of ``obj`` (already checked for type and sign) inside its bounds."""
+    for key, (lo, hi) in bounds.items():
+        value = getattr(obj, key)
+        if math.isfinite(value) and not lo <= value <= hi:  # an infinity is refused as such later
+            raise InputError(f"{section}.{key}", value, f"[{lo:g}, {hi:g}]")
 
 
 def build(cfg: dict, base_dir: Path | None = None, **overrides):
@@ -59,7 +106,9 @@ def build(cfg: dict, base_dir: Path | None = None, **overrides):
     if not isinstance(g, dict):
         raise InputError("grading", g, "a table: preset, csv or sizes_mm with percent_passing")
     grading = paper_grading() if g == {"preset": "paper"} else GradingCurve.from_config(g, base_dir=base_dir)
+    check_config_bounds(spec, "specimen", SPECIMEN_BOUNDS)
     settings = dataclass_from_table(CriterionSettings, "criterion", cfg.get("criterion"), **overrides)
+    check_config_bounds(settings, "criterion", CRITERION_BOUNDS)
     seed = check_int("seed", cfg.get("seed", 0), 0)
     if not isinstance(cfg.get("title", ""), str):
         raise InputError("title", cfg["title"], "a string")

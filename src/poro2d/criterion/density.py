@@ -37,6 +37,10 @@ from poro2d.errors import InputError, check_range
 #: falling near mu = 1, Silbert 2010; on the paper grading the interior porosity is about 0.152
 #: at 0 and 0.21 at 1.0)
 DEFAULT_MUS = (0.0, 0.05, 0.1, 0.2, 0.5, 1.0)
+#: the highest preparation friction a calibration may ask for: frictional disks jam no looser
+#: above mu = 1 (Silbert 2010), so a higher friction adds run time and no looser state, and a
+#: value far beyond (2.5, 1e6) is a typo, not a preparation
+MU_PREP_MAX = 1.0
 
 
 def void_ratio(n: float) -> float:

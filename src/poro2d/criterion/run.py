@@ -30,6 +30,9 @@ def load(
             from poro2d.errors import InputError
 
             raise InputError("config/preset", f"a dict and {preset}", "one of the two, not both")
+        from poro2d.criterion.config import check_tables
+
+        check_tables(config)
         return copy.deepcopy(config), None
     return load_config(config, preset, extra_tables=extra_tables)
 
@@ -42,15 +45,22 @@ def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> d
     from poro2d import porosity as P
     from poro2d.config import check_keys
     from poro2d.errors import InputError, check_int, check_range
+    from poro2d.sweep.density import check_mus
 
+    check_keys("density", cfg.get("density") or {}, DENSITY_KEYS)
     t = dict(cfg.get("density") or {})
-    check_keys("density", t, DENSITY_KEYS)
     mode = mode if mode is not None else t.get("mode", "paper")
     if mode not in ("paper", "density"):
         raise InputError("mode", mode, "paper or density")
-    out = {"mode": mode, "mu_prep": t.get("mu_prep")}
     if mode == "paper":
-        return out
+        # the paper's protocol prepares at friction_prep and uses no laboratory extremes: an
+        # option of density mode given with it would be ignored, so it is refused instead
+        for option, value in (("--n-max", n_max), ("--n-min", n_min), ("--seeds", seeds)):
+            if value is not None:
+                raise InputError(option, value, "only with --mode density (paper mode: the paper's protocol)")
+        return {"mode": mode, "mu_prep": None}
+    mus = t.get("mu_prep")
+    out = {"mode": mode, "mu_prep": None if mus is None else check_mus(mus, "density.mu_prep")}
     hi = n_max if n_max is not None else t.get("n_max", P.PAPER_N_MAX if preset else None)
     lo = n_min if n_min is not None else t.get("n_min", P.PAPER_N_MIN if preset else None)
     if hi is None or lo is None:
@@ -105,9 +115,17 @@ def run_criterion(
     )
     check_feasible(spec, grading, settings.initial_trial())
     if dens["mode"] == "density":
+        from poro2d.errors import InputError
         from poro2d.sweep.density import run_density_state
 
+        # density mode runs seeds 0 .. seeds-1, each from its state's 2D target: a seed or a
+        # first trial of its own would be ignored, so they are refused
+        for option, value in (("--seed", seed), ("--trial-porosity", trial_porosity)):
+            if value is not None:
+                raise InputError(option, value, "only in paper mode (density: --seeds and the 2D target)")
         rest = {k: v for k, v in cfg.items() if k != "density"}
+        if threads is not None:
+            rest["specimen"] = dict(rest.get("specimen") or {}, threads=spec.threads)
         return run_density_state(rest, base, settings.n_lab, dens["n_max"], dens["n_min"], out,
                                  seeds=dens["seeds"], mus=dens["mu_prep"], progress=progress)  # fmt: skip
     return PorosityCriterion(spec, grading, settings, seed=sd, out=out, progress=progress, config=cfg).run()

@@ -95,11 +95,25 @@ def _inputs_blocks(summary: dict, crit: dict) -> list[Block]:
         f"{spec.get('ratio', 1e-3)}.",
         *quick,
         "Direct shear: the shear velocity is far above the laboratory rate of 0.384 mm/min "
-        "(quasi-static checks below); no laboratory curves are built in (Fig. 8's data are not "
-        "published as numbers): pass them with --lab. A test ends once its smoothed peak lies "
+        f"(quasi-static checks below); {_lab_text(summary)} A test ends once its smoothed peak lies "
         "stop_after_peak (5 mm by default) behind, or at max_displacement (20 mm); each test's "
         "result.json says which (ended_by).",
     ])]  # fmt: skip
+
+
+def _lab_text(summary: dict) -> str:
+    """Where the laboratory shear data of Fig. 8 come from in this run, if from anywhere."""
+    lab = summary.get("lab")
+    if not lab:
+        return (
+            "no laboratory curves are built in (Fig. 8's data are not published as numbers): "
+            "pass them with --lab."
+        )
+    peaks = len(lab.get("peaks") or [])
+    what = f"laboratory {lab.get('kind', 'data')} from {lab.get('source')} ({peaks} peak(s))"
+    if not summary.get("shear"):
+        return f"{what} were given, but no test ran to compare them with."
+    return f"{what} are drawn beside the DEM's in Fig. 8."
 
 
 def _conversion_blocks(out: Path, conv: dict) -> list[Block]:

@@ -13,26 +13,26 @@ console = OutputConsole()
 SHEAR_KEYS_EXTRA = {"normal_stress_kpa", "specimen", "lab", "processes", "rate_check"}
 
 
-def parse_stresses(text: str) -> list[float]:
-    """'50,100,200' -> [50.0, 100.0, 200.0] (kPa); every value > 0."""
-    from poro2d.errors import InputError
+def parse_stresses(text: str, parameter: str = "--normal-stress") -> list[float]:
+    """'50,100,200' -> [50.0, 100.0, 200.0] (kPa), each in the range a test can hold.
 
+    An empty item (``50,,100``, a trailing comma) is refused: it is a value left out, and
+    the tests run would not be the ones asked for.
+    """
+    from poro2d.errors import InputError
+    from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA
+
+    lo, hi = NORMAL_STRESS_RANGE_KPA
+    allowed = f"comma-separated numbers in [{lo:g}, {hi:g}] kPa, e.g. 50,100,200"
     vals = []
     for part in str(text).split(","):
-        part = part.strip()
-        if not part:
-            continue
         try:
-            v = float(part)
+            v = float(part.strip())
         except ValueError:
-            raise InputError(
-                "--normal-stress", text, "comma-separated numbers in kPa, e.g. 50,100,200"
-            ) from None
-        if not v > 0 or v != v or v == float("inf"):
-            raise InputError("--normal-stress", part, "(0, inf) kPa")
+            raise InputError(parameter, text, allowed, f"{part.strip()!r} is not a number") from None
+        if not lo <= v <= hi:  # NaN fails too
+            raise InputError(parameter, text, allowed, f"{part.strip()} is out of range")
         vals.append(v)
-    if not vals:
-        raise InputError("--normal-stress", text, "at least one value in kPa")
     return vals
 
 
@@ -147,7 +147,8 @@ def resolve_stresses(option_text: str | None, extra: dict) -> list[float]:
         return parse_stresses(option_text)
     if "normal_stress_kpa" in extra:
         v = extra["normal_stress_kpa"]
-        return parse_stresses(",".join(str(x) for x in (v if isinstance(v, list) else [v])))
+        text = ",".join(str(x) for x in (v if isinstance(v, list) else [v]))
+        return parse_stresses(text, "shear.normal_stress_kpa")
     return [50.0, 100.0, 200.0]
 
 

@@ -1,7 +1,8 @@
 """Laboratory direct shear data from CSV (optional user input; poro2d ships none).
 
-Two layouts are accepted; the header decides which (extra columns are ignored,
-lines starting with ``#`` are comments):
+Two layouts are accepted; the header decides which (extra columns of the header are
+ignored, every row has as many cells as the header, lines starting with ``#`` are
+comments; the file is UTF-8 text):
 
 * curves: ``normal_stress_kpa, shear_displacement_mm, shear_stress_kpa``, one row
   per reading, one curve per normal stress;
@@ -22,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.errors import InputError
-from poro2d.io_utils import check_input_file
+from poro2d.io_utils import check_input_file, read_utf8
 
 CURVE_COLUMNS = ("normal_stress_kpa", "shear_displacement_mm", "shear_stress_kpa")
 PEAK_COLUMNS = ("normal_stress_kpa", "peak_shear_stress_kpa")
@@ -70,8 +71,12 @@ def read_lab_csv(path: str | os.PathLike) -> LabData:
         check_input_file("lab", p)
     if not p.is_file():
         raise InputError("lab", str(p), "an existing CSV file")
-    with open(p, newline="") as fh:
-        lines = [(k + 1, ln) for k, ln in enumerate(fh) if ln.strip() and not ln.lstrip().startswith("#")]
+    text = read_utf8("lab", p, "a UTF-8 CSV file")
+    lines = [
+        (k + 1, ln)
+        for k, ln in enumerate(text.splitlines())
+        if ln.strip() and not ln.lstrip().startswith("#")
+    ]
     if not lines:
         raise InputError("lab", str(p), "a CSV with a header and data rows")
     reader = csv.reader([ln for _, ln in lines])
@@ -89,8 +94,9 @@ def read_lab_csv(path: str | os.PathLike) -> LabData:
     idx = [header.index(c) for c in cols]
     data = []
     for (line, _), row in zip(lines[1:], rows[1:], strict=True):
-        if len(row) < len(header):
-            raise InputError(f"lab row (line {line} of {p})", ",".join(row), f"{len(header)} columns")
+        if len(row) != len(header):  # a cell too many is as unclear as one too few: which column moved?
+            where = f"line {line}, column {min(len(row), len(header)) + 1} of {p}"
+            raise InputError(f"lab row ({where})", ",".join(row), f"{len(header)} columns, as the header")
         vals = [_number(str(p), line, c, row[i].strip()) for c, i in zip(cols, idx, strict=True)]
         for c, v in zip(cols, vals, strict=True):
             if v < 0:

@@ -23,7 +23,7 @@ from poro2d.shear.outputs import (
 )
 from poro2d.shear.pool import execute_jobs, job_test
 from poro2d.shear.results import ShearSeriesResult
-from poro2d.shear.settings import ShearSettings
+from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings
 from poro2d.shear.specimen_file import resolve_specimen
 
 #: what a series' ``result.json`` keeps of each test
@@ -43,8 +43,9 @@ RATE_CHECK_NOTE = (
 
 
 def check_stresses(normal_stresses_kpa) -> list[float]:
-    """Different normal stresses > 0 (kPa), sorted."""
-    stresses = [check_range("normal stress (kPa)", v, 0.0, None, lo_open=True) for v in normal_stresses_kpa]
+    """Different normal stresses (kPa) in ``NORMAL_STRESS_RANGE_KPA``, sorted."""
+    lo, hi = NORMAL_STRESS_RANGE_KPA
+    stresses = [check_range("normal stress (kPa)", v, lo, hi) for v in normal_stresses_kpa]
     if not stresses:
         raise InputError("normal stress", [], "at least one value (kPa)")
     if len(set(stresses)) != len(stresses):

@@ -5,7 +5,28 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
-from poro2d.errors import InputError, check_range
+from poro2d.errors import InputError, check_int, check_range
+
+#: the normal stresses (kPa) a test may be run at. A contact carries about sigma d t, so two
+#: disks of the paper's stiffness (kn = 4e5 N/m each, in series 2e5; 8 mm thick) overlap by
+#: sigma t / k = 4 % of their diameter at 1 MPa, and more above: beyond what a soft-contact
+#: model describes. Below 1 kPa the plate pushes less than the specimen's own weight does at
+#: mid-height (about 1.3 kPa in the paper's box), so the stress held is not the one the shear
+#: plane feels. docs/shear.md has the reasoning.
+NORMAL_STRESS_RANGE_KPA = (1.0, 1000.0)
+#: the longest shear displacement (m) of any test
+MAX_DISPLACEMENT = 1.0
+#: most rows of a test's curve, and most checkpoints, that its intervals may ask for
+MAX_RECORDS = 1_000_000
+MAX_CHECKPOINTS = 1000
+#: 30 times the default step budget of the consolidation (hours of one core for the paper's box)
+MAX_CONSOLIDATION_STEPS = 10_000_000
+#: wall stiffness (N/m): 1000 times Table 1's 1e7; the time step falls with its square root
+MAX_WALL_STIFFNESS = 1e10
+#: friction coefficients beyond 10 hold as a rough wall does; larger ones are typos
+MAX_FRICTION = 10.0
+#: inertial masses up to 1000 times the real ones: the inertial number grows with its root
+MAX_DENSITY_SCALE = 1000.0
 
 
 @dataclass
@@ -51,25 +72,28 @@ class ShearSettings:
 
     def __post_init__(self) -> None:
         check_range("velocity", self.velocity, 0.0, 10.0, lo_open=True)
-        check_range("max_displacement", self.max_displacement, 0.0, None, lo_open=True)
-        check_range("record_interval", self.record_interval, 0.0, None, lo_open=True)
-        check_range("stop_after_peak", self.stop_after_peak, 0.0, None)
-        check_range("checkpoint_interval", self.checkpoint_interval, 0.0, None, lo_open=True)
+        # half the width of a 2 m box; a test checks it against its own specimen's half width too
+        check_range("max_displacement", self.max_displacement, 0.0, MAX_DISPLACEMENT, lo_open=True)
+        # at most MAX_RECORDS rows and MAX_CHECKPOINTS checkpoints a test: a finer interval
+        # (1e-300 m) asks for more rows than memory holds, or a checkpoint every step
+        self._check_interval("record_interval", self.record_interval, MAX_RECORDS)
+        # beyond max_displacement it never ends a test (as a short quick test with the default)
+        check_range("stop_after_peak", self.stop_after_peak, 0.0, MAX_DISPLACEMENT)
+        self._check_interval("checkpoint_interval", self.checkpoint_interval, MAX_CHECKPOINTS)
         check_range("consolidation_ratio", self.consolidation_ratio, 0.0, 1.0, lo_open=True)
-        if not (isinstance(self.consolidation_max_steps, int) and self.consolidation_max_steps >= 1000):
-            raise InputError("consolidation_max_steps", self.consolidation_max_steps, "an integer >= 1000")
+        check_int("consolidation_max_steps", self.consolidation_max_steps, 1000, MAX_CONSOLIDATION_STEPS)
         check_range("servo_gain", self.servo_gain, 0.0, 1.0, lo_open=True)
         check_range("servo_integral", self.servo_integral, 0.0, 0.1)
         check_range("servo_max_speed", self.servo_max_speed, 0.0, 10.0, lo_open=True)
-        check_range("kn_wall", self.kn_wall, 0.0, None, lo_open=True)
-        check_range("ks_wall", self.ks_wall, 0.0, None)
-        check_range("friction_wall", self.friction_wall, 0.0, None)
+        check_range("kn_wall", self.kn_wall, 0.0, MAX_WALL_STIFFNESS, lo_open=True)
+        check_range("ks_wall", self.ks_wall, 0.0, MAX_WALL_STIFFNESS)
+        check_range("friction_wall", self.friction_wall, 0.0, MAX_FRICTION)
         check_range("gap", self.gap, 0.0, None)
         if self.particle_friction is not None:
-            check_range("particle_friction", self.particle_friction, 0.0, None)
+            check_range("particle_friction", self.particle_friction, 0.0, MAX_FRICTION)
         if self.local_damping is not None:
             check_range("local_damping", self.local_damping, 0.0, 1.0, hi_open=True)
-        check_range("density_scale", self.density_scale, 1.0, None)
+        check_range("density_scale", self.density_scale, 1.0, MAX_DENSITY_SCALE)
         check_range("dt_safety", self.dt_safety, 0.0, 1.0, lo_open=True)
         check_range("peak_window", self.peak_window, 0.0, None)
         check_range("shear_zone_factor", self.shear_zone_factor, 0.0, None, lo_open=True)
@@ -81,6 +105,13 @@ class ShearSettings:
             raise InputError("stop_after_peak", self.stop_after_peak, allowed)
         if self.record_interval > self.max_displacement:
             raise InputError("record_interval", self.record_interval, f"(0, {self.max_displacement}] m")
+
+    def _check_interval(self, name: str, interval: float, most: int) -> None:
+        """An interval of shear displacement (m) that comes at most ``most`` times a test."""
+        check_range(name, interval, 0.0, None, lo_open=True)
+        shortest = self.max_displacement / most
+        if interval < shortest:
+            raise InputError(name, interval, f"[max_displacement / {most} = {shortest:.3g}, inf) m")
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -98,4 +129,4 @@ def inertial_number(velocity: float, sigma_pa: float, rho_inertial: float, shear
     return velocity / shear_zone_factor * math.sqrt(rho_inertial / sigma_pa)
 
 
-__all__ = ["ShearSettings", "inertial_number"]
+__all__ = ["NORMAL_STRESS_RANGE_KPA", "ShearSettings", "inertial_number"]

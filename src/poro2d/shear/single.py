@@ -31,7 +31,7 @@ from poro2d.shear.box import SplitBox, build_split_box
 from poro2d.shear.curve import CURVE_COLUMNS, curve_summary
 from poro2d.shear.peak_frame import PeakFrame
 from poro2d.shear.results import ShearTestResult
-from poro2d.shear.settings import ShearSettings, inertial_number
+from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings, inertial_number
 from poro2d.shear.shear_stage import ShearStage, remove_stage_files
 from poro2d.shear.specimen_file import resolve_specimen, specimen_box
 
@@ -62,14 +62,16 @@ class DirectShearTest:
         specimen_digest: str | None = None,
     ) -> None:
         self.specimen = resolve_specimen(specimen)
-        self.sigma_kpa = check_range("normal stress (kPa)", normal_stress_kpa, 0.0, None, lo_open=True)
+        self.sigma_kpa = check_range("normal stress (kPa)", normal_stress_kpa, *NORMAL_STRESS_RANGE_KPA)
         self.settings = settings if settings is not None else ShearSettings()
         check_finite("shear", self.settings.to_dict())  # open ranges let an infinity through
-        W, _ = specimen_box(self.specimen)
+        W, H = specimen_box(self.specimen)
         if self.settings.max_displacement > W / 2:
             raise InputError(
                 "max_displacement", self.settings.max_displacement, f"(0, {W / 2:.4g}] m (half the box width)"
             )
+        # the box refuses a wider gap when it is built, in the test's process: here, before any test
+        check_range("gap", self.settings.gap, 0.0, H / 4)
         self.out = Path(out) if out is not None else None
         self.progress = progress
         self.figures = figures

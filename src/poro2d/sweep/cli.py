@@ -17,13 +17,6 @@ _WORKERS = "Worker processes of the LocalCluster (default: one per core, one thr
 _DASHBOARD = "LocalCluster dashboard: HOST:PORT or none (default 127.0.0.1:0, this machine only)."
 
 
-def _check_workers(workers: int | None) -> None:
-    from poro2d.errors import InputError
-
-    if workers is not None and workers < 1:
-        raise InputError("--workers", workers, "an integer >= 1")
-
-
 def sweep_cmd(
     config: Path = typer.Argument(..., help="TOML config: base case tables and a \\[sweep] table."),
     out: Path = typer.Option(
@@ -38,13 +31,14 @@ def sweep_cmd(
     from poro2d.config import load_toml
     from poro2d.io_utils import check_output_dir
     from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.runner import check_dashboard, run_sweep
+    from poro2d.sweep.runner import check_cluster_options, check_dashboard, check_reachable, run_sweep
 
-    _check_workers(workers)
+    check_cluster_options(scheduler, workers)
     dashboard_address = check_dashboard(dashboard)
     check_output_dir("--out", out)
     cfg = load_toml(config)
     sweep = parse_sweep(cfg, Path(config).resolve().parent)
+    check_reachable(scheduler)  # before the first line: an unreachable scheduler is the only one
     console.print(f"{len(sweep.cases)} case(s) of kind {sweep.kind!r} -> {out}")
     res = run_sweep(sweep, out, scheduler=scheduler, workers=workers, progress=not quiet,
                     dashboard=dashboard_address)  # fmt: skip
@@ -82,11 +76,13 @@ def relation_cmd(
     """
     from poro2d.sweep.relation import run_relation
 
-    _check_workers(workers)
-    console.print(f"criterion relation{' (quick)' if quick else ''} -> {out}")
+    def banner() -> None:  # once every input is checked: a refusal is the only line
+        console.print(f"criterion relation{' (quick)' if quick else ''} -> {out}")
+
     rel = run_relation(
         config, preset=preset, out=out, points=points, n_max=n_max, n_min=n_min, mode=mode, seeds=seeds,
         quick=quick, scheduler=scheduler, workers=workers, progress=not quiet, dashboard=dashboard,
+        announce=banner,
     )  # fmt: skip
     print_relation(rel, out)
     if rel["failed_cases"]:

@@ -22,7 +22,8 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
-from poro2d.criterion.density import DEFAULT_MUS, Calibration, StateTarget
+from poro2d.config import check_number_list
+from poro2d.criterion.density import DEFAULT_MUS, MU_PREP_MAX, Calibration, StateTarget
 from poro2d.errors import InputError
 from poro2d.io_utils import provenance, write_json
 from poro2d.locks import cache_entry
@@ -64,18 +65,10 @@ def cache_dir() -> Path:
     return Path(base) / "poro2d"
 
 
-def check_mus(mus: Any) -> list[float]:
-    """At least two finite, non-negative, strictly increasing preparation frictions."""
-    if not isinstance(mus, (list, tuple)) or len(mus) < 2:
-        raise InputError("density.mu_prep", mus, "a list of at least two preparation frictions")
-    out = []
-    for v in mus:
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not (math.isfinite(v) and v >= 0.0):
-            raise InputError("density.mu_prep", mus, "finite frictions >= 0")
-        out.append(float(v))
-    if any(b <= a for a, b in zip(out, out[1:], strict=False)):
-        raise InputError("density.mu_prep", mus, "strictly increasing frictions (densest first)")
-    return out
+def check_mus(mus: Any, parameter: str = "density.mu_prep") -> list[float]:
+    """Two to 20 preparation frictions in [0, MU_PREP_MAX], strictly increasing (densest first)."""
+    return check_number_list(parameter, mus, 0.0, MU_PREP_MAX, min_items=2, max_items=20, increasing=True,
+                             what="preparation frictions")  # fmt: skip
 
 
 def check_seeds(seeds: Any) -> int:
@@ -155,7 +148,7 @@ def calibrate(
     from poro2d.sweep.cases import parse_sweep
     from poro2d.sweep.runner import run_sweep
 
-    mus, seeds = check_mus(list(mus)), check_seeds(seeds)
+    mus, seeds = check_mus(mus), check_seeds(seeds)
     key = calibration_key(base)
     folder = cache_dir() / "calibrations" / key if use_cache else out / "calibration"
     try:

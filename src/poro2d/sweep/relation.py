@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from poro2d import porosity as P
-from poro2d.config import check_keys
+from poro2d.config import check_keys, check_number_list
 from poro2d.errors import InputError, check_range
 from poro2d.locks import holds_output
 from poro2d.paper_data import QUICK_SPECIMEN as PAPER_QUICK_SPECIMEN
@@ -90,8 +90,11 @@ def relation_settings(
     table: dict | None, *, points: int | None, n_max: float | None, n_min: float | None, preset: bool
 ) -> dict:
     """n_max, n_min and the nLab list from ``[relation]`` and the command-line options."""
+    check_keys("relation", table or {}, RELATION_KEYS)
     t = dict(table or {})
-    check_keys("relation", t, RELATION_KEYS)
+    for key in ("n_max", "n_min"):  # a wrong value in the file is refused, even when an option wins
+        if key in t:
+            check_range(f"relation.{key}", t[key], 0.0, 1.0, lo_open=True, hi_open=True)
     hi = n_max if n_max is not None else t.get("n_max", P.PAPER_N_MAX if preset else None)
     lo = n_min if n_min is not None else t.get("n_min", P.PAPER_N_MIN if preset else None)
     if hi is None or lo is None:
@@ -107,12 +110,12 @@ def relation_settings(
         raise InputError("n_max", hi, f"greater than n_min = {lo}")
     if "n_lab" in t and points is None:
         vals = t["n_lab"]
-        if not isinstance(vals, list) or len(vals) < 2:
-            raise InputError("relation.n_lab", vals, "a list of at least two laboratory porosities")
-        n_labs = [
-            round(check_range("relation.n_lab", v, 0.0, 1.0, lo_open=True, hi_open=True), 4) for v in vals
-        ]
-        n_labs = sorted(set(n_labs), reverse=True)
+        # every state between the extremes: its relative density is what the relation is about
+        n_labs = [round(v, 4) for v in check_number_list("relation.n_lab", vals, lo, hi, min_items=2,
+                                                         what="laboratory porosities")]  # fmt: skip
+        if len(set(n_labs)) < len(n_labs):  # one state twice is a typo, not a second point
+            raise InputError("relation.n_lab", vals, "distinct laboratory porosities (to 4 decimals)")
+        n_labs = sorted(n_labs, reverse=True)
     else:
         n_labs = lab_porosities(hi, lo, points if points is not None else t.get("points", 5))
     return {"n_max": hi, "n_min": lo, "n_lab": n_labs}
@@ -443,6 +446,23 @@ def density_relation(
     return rel, record
 
 
+def refuse_density_options(table: dict, seeds: int | None) -> None:
+    """Paper mode prepares every state at friction_prep, once: seeds and frictions would be ignored."""
+    if seeds is not None:
+        raise InputError("--seeds", seeds, "only in density mode (paper mode runs each state once)")
+    for key in ("seeds", "mu_prep"):
+        if key in table:
+            raise InputError(f"relation.{key}", table[key], "only in density mode (paper mode: leave it out)")
+
+
+def check_cases(base: dict, base_dir: Path | None, settings: dict, *, quick: bool) -> None:
+    """Every criterion case of the relation built once, without running: a bad specimen, grading
+    or criterion setting is refused before the calibration starts, not when its case comes up."""
+    from poro2d.sweep.cases import parse_sweep
+
+    parse_sweep(sweep_config(base, settings["n_lab"], quick=quick), base_dir)
+
+
 @holds_output("out")
 def run_relation(
     config=None,
@@ -459,6 +479,7 @@ def run_relation(
     workers: int | None = None,
     progress: bool = True,
     dashboard: str | None = None,
+    announce=None,
 ) -> dict:
     """``poro2d relation`` as one call: the grading's n2D(nLab) relation, written to ``out``.
 
@@ -467,16 +488,20 @@ def run_relation(
     default) calibrates the grading, maps every laboratory state by its relative density and
     checks it over ``seeds``; paper mode runs the criterion once per state at the fixed
     preparation friction. Returns the relation as written to ``out/relation.json``, with
-    ``failed_cases`` (cases that raised; their tracebacks are in ``out``). ``dashboard``: where a
+    ``failed_cases`` (cases that raised; their tracebacks are in ``out``). Every input is
+    checked before the first case runs; ``announce`` (no arguments) is called then, before
+    any work (the command prints its banner there, so a refusal stays one line). ``dashboard``: where a
     LocalCluster serves its dashboard (default 127.0.0.1:0, this machine; ``"none"``: none).
     """
     from poro2d.criterion.run import load
     from poro2d.io_utils import check_output_dir
     from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.runner import check_dashboard, run_sweep
+    from poro2d.sweep.density import check_mus
+    from poro2d.sweep.runner import check_cluster_options, check_dashboard, check_reachable, run_sweep
 
     out = Path(out)
     check_output_dir("--out", out)
+    check_cluster_options(scheduler, workers)
     dashboard_address = check_dashboard(dashboard)
     base, base_dir = load(config, preset, extra_tables=("relation",))
     table = base.get("relation") or {}
@@ -484,15 +509,23 @@ def run_relation(
         table or None, points=points, n_max=n_max, n_min=n_min, preset=config is None
     )
     mode = check_mode(mode if mode is not None else table.get("mode", "density"))
-    n_seeds = check_seeds(seeds if seeds is not None else table.get("seeds", 3))
+    if mode == "density":
+        n_seeds = check_seeds(seeds if seeds is not None else table.get("seeds", 3))
+        mus = check_mus(table["mu_prep"], "relation.mu_prep") if "mu_prep" in table else None
+    else:
+        refuse_density_options(table, seeds)
+    check_cases(base, base_dir, settings, quick=quick)
+    check_reachable(scheduler)
+    if announce is not None:
+        announce()
     sweep_kw = {"scheduler": scheduler, "workers": workers, "progress": progress,
                 "dashboard": dashboard_address}  # fmt: skip
     title = "2D porosity from the criterion vs laboratory porosity" + (
         " (quick: 0.08 m x 0.04 m box)" if quick else ""
     )
     if mode == "density":
-        rel, record = density_relation(base, base_dir, settings, out, quick=quick, seeds=n_seeds,
-                                       mus=table.get("mu_prep"), **sweep_kw)  # fmt: skip
+        rel, record = density_relation(base, base_dir, settings, out, quick=quick, seeds=n_seeds, mus=mus,
+                                       **sweep_kw)  # fmt: skip
         failed, extra = record["failed_cases"], {"quick": quick, "config": base, "sweeps": record}
     else:
         res = run_sweep(

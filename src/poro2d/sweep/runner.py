@@ -21,8 +21,11 @@ skips finished cases and runs the rest (failed ones included).
 from __future__ import annotations
 
 import json
+import logging
 import os
+import signal
 import socket
+import threading
 import time
 import traceback
 from dataclasses import dataclass, field
@@ -34,6 +37,9 @@ from poro2d.io_utils import atomic_path, provenance, write_json
 from poro2d.locks import cache_entry, holds_output
 from poro2d.resumable import Fingerprint, ResumableStage
 from poro2d.sweep.cases import KINDS, PERFORMANCE_KEYS, Case, SweepConfig
+from poro2d.worker_signals import ignore_interrupts_in_dask_worker
+
+ignore_interrupts_in_dask_worker()  # a worker started by a script imports this to run its cases
 
 RESULT = "result.json"
 PARAMS = "params.json"
@@ -246,7 +252,7 @@ def _start_client(scheduler: str | None, workers: int | None, threads_needed: in
     from distributed import Client, LocalCluster
 
     if scheduler:
-        return Client(scheduler, timeout="30s"), None
+        return connect(scheduler), None
     n = workers or os.cpu_count() or 1
     env = dict(SINGLE_THREAD_ENV, NUMBA_NUM_THREADS=str(max(1, threads_needed)))
     cluster = LocalCluster(
@@ -260,6 +266,121 @@ def _start_client(scheduler: str | None, workers: int | None, threads_needed: in
         env=env,
     )
     return Client(cluster), cluster
+
+
+#: seconds to wait for a running scheduler to answer (distributed's own default is 30)
+CONNECT_TIMEOUT_S = 10
+#: address schemes of a Dask scheduler that a user can type
+SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+SCHEDULER_FORM = "an address such as tcp://host:8786 (scheme tcp, tls, ws, wss or ucx; port 1-65535)"
+
+
+def max_workers() -> int:
+    """The most worker processes a local cluster may start: two per core (more only queue)."""
+    return 2 * (os.cpu_count() or 1)
+
+
+def check_cluster_options(scheduler: str | None, workers: int | None) -> None:
+    """``--scheduler`` of the right form and ``--workers`` in range, checked before any work.
+
+    ``--workers`` sizes the local cluster; with ``--scheduler`` the running cluster's own
+    workers take the cases, so the two together are refused rather than one ignored.
+    """
+    from poro2d.errors import InputError, check_int
+
+    if workers is not None:
+        check_int("--workers", workers, 1, max_workers())
+    if scheduler is None:
+        return
+    if workers is not None:
+        raise InputError("--workers", workers, "nothing with --scheduler (its own workers run the cases)")
+    check_scheduler_address(scheduler)
+
+
+def check_scheduler_address(address: str) -> str:
+    """``address`` if it has the form ``[scheme://]host:port``; otherwise InputError."""
+    from urllib.parse import urlsplit
+
+    from poro2d.errors import InputError
+
+    text = address.strip()
+    full = text if "://" in text else f"tcp://{text}"
+    try:
+        parts = urlsplit(full)
+        port = parts.port
+    except ValueError:
+        raise InputError("--scheduler", address, SCHEDULER_FORM) from None
+    if parts.scheme not in SCHEDULER_SCHEMES or not parts.hostname or port is None or not 0 < port < 65536:
+        raise InputError("--scheduler", address, SCHEDULER_FORM)
+    if parts.path not in ("", "/") or parts.query or parts.fragment:
+        raise InputError("--scheduler", address, SCHEDULER_FORM)
+    return full
+
+
+def connect(scheduler: str):
+    """A client of the running scheduler at ``scheduler``; one that does not answer is an InputError."""
+    from distributed import Client
+
+    from poro2d.errors import InputError
+
+    address = check_scheduler_address(scheduler)
+    try:
+        return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
+    except (OSError, TimeoutError) as exc:  # refused, unreachable, or no answer in time
+        raise InputError(
+            "--scheduler",
+            scheduler,
+            f"a running Dask scheduler that answers within {CONNECT_TIMEOUT_S} s",
+            f"{type(exc).__name__}: {exc}".splitlines()[0],
+        ) from None
+
+
+def hold_interrupts() -> set | None:
+    """Block SIGINT in this thread while a local cluster starts; returns what to restore.
+
+    A Ctrl-C in the middle of the cluster's start-up left it half built, to be closed at
+    exit with a traceback. Blocked here, the signal waits until :func:`release_interrupts`,
+    when the cluster is whole and the command can close it. (The worker processes start
+    with no signal blocked; they ignore SIGINT themselves: :mod:`poro2d.worker_signals`.)
+    """
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "pthread_sigmask"):
+        return None
+    return signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+
+
+def release_interrupts(previous: set | None) -> None:
+    """Undo :func:`hold_interrupts`; a Ctrl-C that came meanwhile is raised now."""
+    if previous is not None and signal.SIGINT not in previous:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+
+
+def quiet_shutdown_logs(client) -> None:
+    """Silence Dask's logging here and on the workers before an interrupted run closes them.
+
+    Closing workers in the middle of their cases makes the worker, nanny and scheduler log
+    warnings (cancelled tasks, workers killed) that say only that the run was stopped. The
+    level stays raised in this process: some of those lines come from the cluster's threads
+    after it is closed, and an interrupted command is ending anyway.
+    """
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
+    try:
+        client.run(_silence_distributed_logs)
+    except Exception:  # a client already closed or never connected: nothing to silence there
+        pass
+
+
+def _silence_distributed_logs() -> None:
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
+
+
+def check_reachable(scheduler: str | None) -> None:
+    """Connect to ``scheduler`` once and let go: an unreachable one is refused before any work.
+
+    A command calls it before it prints its first line, so that a scheduler that does not
+    answer is its only line; the sweeps connect again when they start.
+    """
+    if scheduler:
+        connect(scheduler).close()
 
 
 def _dashboard(client) -> str | None:
@@ -331,6 +452,8 @@ def run_sweep(
     its dashboard on ``dashboard`` (this machine only by default; None: none).
     """
     out = Path(out)
+    if client is None:
+        check_cluster_options(scheduler, workers)
     cases_dir = out / "cases"
     cases_dir.mkdir(parents=True, exist_ok=True)
     t_start = time.perf_counter()
@@ -379,10 +502,17 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases_dir:
     """
     own = client is None
     cluster = None
+    held = None
     if own:
         threads = max(int((c.config.get("specimen") or {}).get("threads", 1) or 1) for c in pending)
-        client, cluster = _start_client(scheduler, workers, threads, dashboard)
+        held = hold_interrupts() if not scheduler else None
+        try:
+            client, cluster = _start_client(scheduler, workers, threads, dashboard)
+        except BaseException:
+            release_interrupts(held)
+            raise
     try:
+        release_interrupts(held)  # a Ctrl-C of the start-up arrives here, with the cluster in hand to close
         info = client.scheduler_info()
         cluster_info = {
             "scheduler": scheduler or info.get("address"),
@@ -398,6 +528,10 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases_dir:
             err.print(f"Dask dashboard: {cluster_info['dashboard']}", highlight=False)
         n_total = len(sweep.cases)
         rows.update(_submit_all(client, pending, cases_dir, sweep.retries, progress, n_reused, n_total))
+    except KeyboardInterrupt:
+        if own:  # the command says it was interrupted; the cluster's shutdown has nothing to add
+            quiet_shutdown_logs(client)
+        raise
     finally:
         if own:
             client.close()
@@ -468,6 +602,9 @@ def _submit_all(
 __all__ = [
     "SweepOutcome",
     "case_stage",
+    "check_cluster_options",
+    "check_reachable",
+    "connect",
     "finished_row",
     "run_case_task",
     "run_sweep",

@@ -29,8 +29,8 @@ from typing import Any
 
 import numpy as np
 
-from poro2d.config import check_keys
-from poro2d.errors import InputError, check_int, is_number
+from poro2d.config import check_keys, check_number_list
+from poro2d.errors import InputError, check_int
 from poro2d.locks import holds_output
 
 #: grading widths of the full study (Cu = d60 / d10), and of ``--quick``: at the paper
@@ -66,13 +66,9 @@ def quick_criterion() -> dict:
 # ------------------------------------------------------------------------------ settings
 def check_cus(cus: Any) -> list[float]:
     """Distinct grading widths Cu > 1 (a single size has Cu = 1), at most 20, ascending."""
-    if not isinstance(cus, (list, tuple)) or not cus:
-        raise InputError("sensitivity.cu", cus, "a non-empty list of uniformity coefficients Cu")
-    out = []
-    for v in cus:
-        if not is_number(v) or not math.isfinite(float(v)) or not 1.0 < float(v) <= 20.0:
-            raise InputError("sensitivity.cu", v, "Cu in (1, 20] (Cu = d60/d10; 1 is a single size)")
-        out.append(float(v))
+    # Cu = d60/d10: 1 is a single size
+    out = check_number_list("sensitivity.cu", cus, 1.0, 20.0, lo_open=True, max_items=20,
+                            what="uniformity coefficients Cu")  # fmt: skip
     if len(set(out)) != len(out):
         raise InputError("sensitivity.cu", cus, "distinct values")
     return sorted(out)
@@ -90,7 +86,7 @@ def study_settings(table: dict | None, *, quick: bool, seeds: int | None) -> dic
     t = dict(table or {})
     check_keys("sensitivity", t, SENSITIVITY_KEYS)
     cus = check_cus(t.get("cu", list(QUICK_CUS if quick else DEFAULT_CUS)))
-    mus = check_mus(t.get("mu_prep", list(DEFAULT_MUS)))
+    mus = check_mus(t.get("mu_prep", list(DEFAULT_MUS)), "sensitivity.mu_prep")
     if seeds is not None:
         n = check_seeds(seeds, "--seeds")
     else:
@@ -421,19 +417,23 @@ def run_sensitivity(
     quick: bool = False,
     seeds: int | None = None,
     use_cache: bool = True,
+    announce=None,
     **sweep_kw,
 ) -> dict:
     """The whole study into ``out``; returns the result dict (also ``out/sensitivity.json``).
 
     ``base``: a criterion config, optionally with a ``[sensitivity]`` table (``cu``,
-    ``mu_prep``, ``seeds``). Everything is checked before the first case runs.
+    ``mu_prep``, ``seeds``). Everything is checked before the first case runs; ``announce``
+    (no arguments) is called then, before any work.
     ``sweep_kw``: ``scheduler``, ``workers``, ``client``, ``progress`` of the sweep runner.
     """
     from poro2d.criterion.config import build
     from poro2d.sweep import density as D
     from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.runner import run_sweep
+    from poro2d.sweep.runner import check_cluster_options, check_reachable, run_sweep
 
+    if sweep_kw.get("client") is None:
+        check_cluster_options(sweep_kw.get("scheduler"), sweep_kw.get("workers"))
     settings = study_settings(base.get("sensitivity"), quick=quick, seeds=seeds)
     cfg = study_base(base, quick=quick)
     _, _, crit, _ = build(copy.deepcopy(cfg), base_dir)
@@ -441,6 +441,9 @@ def run_sensitivity(
     check_gradings(cfg, base_dir, cases)
     sweep = parse_sweep(grading_sweep(cfg, cases, settings["seeds"]), base_dir)
     parse_sweep(D.calibration_sweep(cfg, settings["mus"], settings["seeds"]), base_dir)  # checked now
+    check_reachable(sweep_kw.get("scheduler"))
+    if announce is not None:
+        announce()
 
     timings: dict[str, float] = {}
     t0 = time.perf_counter()

@@ -38,21 +38,24 @@ def register(app: typer.Typer) -> None:
         (mu_prep 0.05, first trial from Eq. 12) against grading width (Cu) and against
         preparation friction, over seeds, beside the paper's 0.15."""
         from poro2d.criterion.config import load_config
-        from poro2d.errors import InputError
+        from poro2d.errors import check_int
         from poro2d.io_utils import check_output_dir
-        from poro2d.sweep.runner import check_dashboard
+        from poro2d.sweep.runner import check_cluster_options, check_dashboard
         from poro2d.sweep.sensitivity import run_sensitivity
 
-        if workers is not None and workers < 1:
-            raise InputError("--workers", workers, "an integer >= 1")
-        if seeds is not None and not 1 <= seeds <= 50:
-            raise InputError("--seeds", seeds, "an integer in [1, 50]")
+        check_cluster_options(scheduler, workers)
+        if seeds is not None:
+            check_int("--seeds", seeds, 1, 50)
         check_output_dir("--out", out)
         dashboard_address = check_dashboard(dashboard)
         base, base_dir = load_config(config, preset, extra_tables=("sensitivity",))
-        console.print(f"sensitivity study{' (quick)' if quick else ''} -> {out}")
+
+        def banner() -> None:  # once every input is checked: a refusal is the only line
+            console.print(f"sensitivity study{' (quick)' if quick else ''} -> {out}")
+
         sens = run_sensitivity(base, base_dir, out, quick=quick, seeds=seeds, scheduler=scheduler,
-                               workers=workers, progress=not quiet, dashboard=dashboard_address)  # fmt: skip
+                               workers=workers, progress=not quiet, dashboard=dashboard_address,
+                               announce=banner)  # fmt: skip
         print_sensitivity(sens, out)
         failed = sens["sweeps"]["failed_cases"]
         if failed:

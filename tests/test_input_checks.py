@@ -1,0 +1,136 @@
+"""The checks behind the one-line refusals: lists of numbers, scheduler addresses, UTF-8
+files, normal stresses; and the paper report's word on laboratory data."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from poro2d.config import check_number_list
+from poro2d.errors import InputError
+from poro2d.io_utils import read_utf8, text_position
+from poro2d.shear.cli import parse_stresses
+from poro2d.sweep import runner
+from poro2d.sweep.density import check_mus
+
+
+@pytest.mark.parametrize(
+    ("value", "why"),
+    [
+        (0.1, "= 0.1 is invalid"),
+        (True, "= True is invalid"),
+        ("abc", "= 'abc' is invalid"),
+        ([], "= [] is invalid"),
+        ([0.1], "= [0.1] is invalid"),
+        ([0.0, "0.5"], "'0.5' is not a number"),
+        ([0.0, True], "True is not a number"),
+        ([0.05, 0.5, 2.5], "2.5 is out of range"),
+        ([0.0, 1e6], "1000000.0 is out of range"),
+        ([-0.1, 0.5], "-0.1 is out of range"),
+        ([0.0, float("nan")], "nan is out of range"),
+        ([0.0, float("inf")], "inf is out of range"),
+        ([0.5, 0.1], "strictly increasing"),
+        ([0.1, 0.1], "strictly increasing"),
+        ({"a": 1}, "is invalid"),
+    ],
+)
+def test_preparation_frictions(value, why):
+    with pytest.raises(InputError, match="relation.mu_prep") as exc:
+        check_mus(value, "relation.mu_prep")
+    assert why in str(exc.value)
+    assert "a list of 2 to 20 preparation frictions in [0, 1]" in str(exc.value)
+
+
+def test_frictions_accepted_as_floats():
+    assert check_mus((0, 0.05, 1)) == [0.0, 0.05, 1.0]
+    assert check_number_list("x", [0.3, 0.4], 0.3, 0.4) == [0.3, 0.4]
+    with pytest.raises(InputError, match=r"in \(1, 20\]"):
+        check_number_list("cu", [1.0, 2.0], 1.0, 20.0, lo_open=True)
+
+
+@pytest.mark.parametrize(
+    "address",
+    ["notanaddress", "", "tcp://", "http://host:8786", "tcp://host:0", "tcp://host:x", "host:8786/a"],
+)
+def test_scheduler_address_form(address):
+    with pytest.raises(InputError, match="--scheduler"):
+        runner.check_scheduler_address(address)
+
+
+def test_scheduler_address_accepted():
+    assert runner.check_scheduler_address("localhost:8786") == "tcp://localhost:8786"
+    assert runner.check_scheduler_address("tls://10.0.0.2:8786") == "tls://10.0.0.2:8786"
+    assert runner.check_scheduler_address("tcp://[::1]:8786") == "tcp://[::1]:8786"
+
+
+def test_unreachable_scheduler_is_one_line(monkeypatch):
+    pytest.importorskip("distributed")
+    monkeypatch.setattr(runner, "CONNECT_TIMEOUT_S", 1)
+    t0 = time.perf_counter()
+    with pytest.raises(InputError) as exc:
+        runner.connect("tcp://127.0.0.1:1")  # nothing listens on port 1
+    msg = str(exc.value)
+    assert msg.startswith("--scheduler = 'tcp://127.0.0.1:1' is invalid")
+    assert "answers within 1 s" in msg and "\n" not in msg
+    assert time.perf_counter() - t0 < 20  # the short timeout, not distributed's 30 s
+
+
+def test_workers_bounded():
+    with pytest.raises(InputError, match="--workers"):
+        runner.check_cluster_options(None, runner.max_workers() + 1)
+    with pytest.raises(InputError, match="--workers = 1 is invalid; allowed: nothing with --scheduler"):
+        runner.check_cluster_options("tcp://h:1", 1)
+    runner.check_cluster_options(None, runner.max_workers())
+
+
+def test_non_utf8_located(tmp_path):
+    f = tmp_path / "x.txt"
+    f.write_bytes(b"abc\ndef\xffg\n")
+    with pytest.raises(InputError, match=r"byte 0xff at line 2, column 4 is not UTF-8") as exc:
+        read_utf8("thing", f, "UTF-8 text")
+    assert str(f) in str(exc.value)
+    assert text_position(b"a\nb\nc", 4) == (3, 1)
+    f.write_text("é ok\n", encoding="utf-8")
+    assert read_utf8("thing", f, "UTF-8 text") == "é ok\n"
+
+
+@pytest.mark.parametrize(
+    "text", ["50,,100", "50,", ",50", "1e9", "1e-9", "0.5", "1001", "nan", "inf", "-50", ""]
+)
+def test_normal_stresses_refused(text):
+    with pytest.raises(InputError, match="--normal-stress"):
+        parse_stresses(text)
+
+
+def test_normal_stresses_at_the_ends():
+    assert parse_stresses(" 1, 50 ,1000") == [1.0, 50.0, 1000.0]
+
+
+def _report_text(tmp_path, **summary) -> str:
+    from poro2d.paper import PAPER
+    from poro2d.report.document import to_markdown
+    from poro2d.report.paper_report import build_blocks
+
+    base = {"paper": PAPER, "conversions": {"methods": []}, "provenance": {}}
+    return to_markdown(build_blocks(tmp_path, dict(base, **summary)), tmp_path)
+
+
+def test_report_names_the_lab_data_given(tmp_path):
+    lab = {"source": "mylab.csv", "kind": "peaks", "peaks": [{"normal_stress_kpa": 50.0}] * 2}
+    assert "pass them with --lab" in _report_text(tmp_path)
+    with_lab = _report_text(tmp_path, lab=lab, shear={"tests": []})
+    assert "pass them with --lab" not in with_lab
+    assert "laboratory peaks from mylab.csv (2 peak(s)) are drawn beside the DEM's in Fig. 8" in with_lab
+    unused = _report_text(tmp_path, lab=lab, shear=None)
+    assert "were given, but no test ran to compare them with" in unused
+
+
+def test_paper_summary_keeps_lab_only_when_given():
+    from poro2d.paper import PaperSummary
+
+    keys = dict(quick=True, seed=0, conversions={}, criterion={}, replicate_specimens=None, shear=None,
+                paper={}, timings={}, provenance={})  # fmt: skip
+    assert "lab" not in PaperSummary(**keys).to_dict()
+    lab = {"source": "a.csv", "kind": "peaks", "peaks": []}
+    assert PaperSummary(**keys, lab=lab).to_dict()["lab"] == lab
