@@ -266,3 +266,26 @@ def test_mu_r_zero_is_bit_identical_to_the_engine_before(case):
     assert len(keys) == 9
     for key in keys:
         assert np.array_equal(saved[key], now[key]), key
+
+
+# ------------------------------------------------------------------ LAMMPS export
+def test_lammps_export_carries_the_rolling_spring(tmp_path):
+    """k_roll = the contact's ks, mu_roll = the smaller mu_r, no rolling dashpot; none at mu_r = 0."""
+    from poro2d.interop import lammps as lmp
+    from poro2d.interop.specimen_data import from_simulation
+
+    pos = [[2 * R, 1.5 * R], [5 * R, 1.5 * R], [8 * R, 1.5 * R]]
+    p = Particles(pos=pos, radius=R, density=RHO, thickness=T, kn=KN, ks=KS, mu=0.5, mu_r=0.3)
+    sim = Simulation(p, Walls.box(0.0, 0.0, 10 * R, 4 * R, 2 * KN, 2 * KS, 0.4, mu_r=0.1))
+    spec = from_simulation(sim)
+    ks_pp, ks_pw = _series(KS, KS), _series(KS, 2 * KS)
+    script = lmp.input_script(spec)
+    assert f"damping mass_velocity rolling sds {ks_pp!r} 0 0.3\n" in script  # pair_coeff
+    assert script.count(f"damping mass_velocity rolling sds {ks_pw!r} 0 0.1 ") == 4  # the walls
+    lmp.write_specimen(spec, tmp_path)
+    assert "# poro2d rolling_friction 0.3 0.1 0.1 0.1 0.1\n" in (tmp_path / lmp.DATA_FILE).read_text()
+    sim.set_rolling_friction(0.0)
+    plain = lmp.input_script(from_simulation(sim))
+    assert "rolling" not in plain
+    with pytest.raises(InputError, match="granular"):
+        lmp.contact_law("classic", KN, KS, 0.5, 0.3)
