@@ -289,3 +289,19 @@ def test_lammps_export_carries_the_rolling_spring(tmp_path):
     assert "rolling" not in plain
     with pytest.raises(InputError, match="granular"):
         lmp.contact_law("classic", KN, KS, 0.5, 0.3)
+
+
+# ------------------------------------------------------------------ specimen settings
+def test_specimen_rolling_friction_is_set_with_the_working_friction():
+    from poro2d.specimen import paper_grading
+    from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
+
+    assert "rolling_friction" not in SpecimenSpec().to_dict()  # results written before keep their keys
+    assert SpecimenSpec(rolling_friction=0.2).to_dict()["rolling_friction"] == 0.2
+    with pytest.raises(InputError, match="rolling_friction"):
+        SpecimenSpec(rolling_friction=-0.1)
+    spec = SpecimenSpec(width=0.06, height=0.03, layers=2, rolling_friction=0.2)
+    sim, report = prepare_specimen(spec, paper_grading(), 0.21, seed=3)
+    assert report["converged"]
+    assert np.all(sim.particles.mu_r == 0.2) and np.all(sim.walls.rolling_friction() == 0.2)
+    assert np.count_nonzero(sim.rolling_moments()[0]) > 0.5 * sim.rolling_moments()[0].size

@@ -24,8 +24,8 @@ stores its force; that partner is *deferred* and collects such forces after all
 partitions are done (phase 2). The order of every sum is therefore fixed by the
 partitions: for a disk, gravity, then the pairs of earlier rows of its partition,
 its own row, its walls, then its cross pairs; for a wall, partition by partition.
-A disk's moment adds, in the same order, each contact's shear moment and (with rolling
-resistance) right after it that contact's rolling moment.
+With rolling resistance a contact's moment on a disk is its shear moment plus (or, on the
+second disk, minus) its rolling moment, added as one term.
 
 Threads: one worker per thread runs all steps of the call, each on its own
 partitions; workers meet at two barriers per step (after phase 1, after phase 2;
@@ -244,6 +244,9 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
         xi = posf[U2 * i]
         yi = posf[U2 * i + U1]
         ri = radius[i]
+        mur_i = 0.0
+        if roll is not None:
+            mur_i = roll.disk_mu_r[i]
         for p_ in range(nb_start[i_], nb_start[i_ + 1]):
             p = np.uint64(p_)
             js = nb_j[p]
@@ -281,20 +284,20 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
             fyp = -fn * ny + fs * nx
             fx += fxp
             fy += fyp
-            mz += ai * fs
-            mr = 0.0
+            mi = ai * fs  # the contact's moments on i and on j
+            mj = aj * fs
             if roll is not None:
-                mur = min(roll.disk_mu_r[i], roll.disk_mu_r[j])
+                mur = min(mur_i, roll.disk_mu_r[j])
                 reff = ri * radius[j] / (ri + radius[j])
                 mr = rolling_moment(nb_mr[p], ks * reff * reff, (wi - wj) * dt, mur * reff * fn)
                 nb_mr[p] = mr
-                mz += mr
+                mi += mr
+                mj -= mr
+            mz += mi
             if js < i1:  # a partner in a later partition collects this in phase 2
                 accf[U3 * j] -= fxp
                 accf[U3 * j + U1] -= fyp
-                accf[U3 * j + U2] += aj * fs
-                if roll is not None:
-                    accf[U3 * j + U2] -= mr
+                accf[U3 * j + U2] += mj
         for p_ in range(wb_start[i_], wb_start[i_ + 1]):
             p = np.uint64(p_)
             w = np.uint64(wb_w[p])
@@ -334,12 +337,13 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
             fyp = -fn * ny + fs * nx
             fx += fxp
             fy += fyp
-            mz += ai * fs
+            mi = ai * fs
             if roll is not None:  # a wall does not turn: the disk's spin is the relative one
-                mur = min(roll.disk_mu_r[i], roll.wall_mu_r[w])
+                mur = min(mur_i, roll.wall_mu_r[w])
                 mr = rolling_moment(wb_mr[p], wks_ * ri * ri, omega[i] * dt, mur * ri * fn)
                 wb_mr[p] = mr
-                mz += mr
+                mi += mr
+            mz += mi
             wpart[k, w, WFX] -= fxp
             wpart[k, w, WFY] -= fyp
             wpart[k, w, WCOUNT] += 1.0
@@ -391,9 +395,10 @@ def _phase_deferred(m0, m1, disks, nb, work, roll, gx, gy, damp, dt):
                 fs = nb_fs[p]
                 fx -= -fn * nb_nx[p] - fs * nb_ny[p]
                 fy -= -fn * nb_ny[p] + fs * nb_nx[p]
-                mz += (radius[i] - 0.5 * nb_ov[p]) * fs
+                mj = (radius[i] - 0.5 * nb_ov[p]) * fs
                 if roll is not None:
-                    mz -= nb_mr[p]
+                    mj -= nb_mr[p]
+                mz += mj
         force[i, 0] = fx
         force[i, 1] = fy
         moment[i] = mz

@@ -15,7 +15,8 @@ pairs. The physics is the documented one:
 * rolling resistance: ``Mr = Mr_old - kr (omega_i - omega_j) dt`` (``omega_j = 0`` for a
   wall) capped at ``mu_r R Fn``, ``kr = ks R^2``, ``R = r_i r_j / (r_i + r_j)`` (a wall:
   ``r_i``), ``mu_r`` the smaller of the two bodies'; ``Mr`` on ``i``, ``-Mr`` on ``j``,
-  each added right after the contact's shear moment; its history is a second dict;
+  each added to the contact's shear moment before that reaches the disk's sum; its
+  history is a second dict;
 * gravity on the true mass, local damping ``F - alpha |F| sign(v)`` per component of
   force and moment, then leapfrog ``v += F / m dt``, ``x += v dt``; walls move with
   their velocity. Prescribed disks keep their velocity and spin.
@@ -51,14 +52,6 @@ def _rolling_moments(mr_old, kr, dtheta, cap):
     """Vectorised elastic-plastic rolling spring: the moments on the first bodies."""
     mr = mr_old - kr * dtheta
     return np.where(mr > cap, cap, np.where(mr < -cap, -cap, mr))
-
-
-def _interleaved(first, second):
-    """``[first[0], second[0], first[1], ...]``: two contributions per contact, in contact order."""
-    out = np.empty(2 * len(first))
-    out[0::2] = first
-    out[1::2] = second
-    return out
 
 
 def _contact_forces(ov, vn, vt, fs_old, kn, ks, mu, cn, dt):
@@ -346,25 +339,22 @@ class ReferenceDEM:
         mj = (r[j] - 0.5 * ov) * fs
         mi = (r[i] - 0.5 * ov) * fs
         mw = (r[wi] - 0.5 * wov) * wfs
+        if rolls:  # one term per contact and disk: shear moment and rolling moment together
+            mi = mi + mr
+            mj = mj - mr
+            mw = mw + wmr
         for sel in (~cross, None, cross):
             if sel is None:  # own rows, then walls
                 np.add.at(force[:, 0], i, cfx)
                 np.add.at(force[:, 1], i, cfy)
+                np.add.at(moment, i, mi)
                 np.add.at(force[:, 0], wi, wcfx)
                 np.add.at(force[:, 1], wi, wcfy)
-                if rolls:  # each contact's rolling moment right after its shear moment
-                    np.add.at(moment, np.repeat(i, 2), _interleaved(mi, mr))
-                    np.add.at(moment, np.repeat(wi, 2), _interleaved(mw, wmr))
-                else:
-                    np.add.at(moment, i, mi)
-                    np.add.at(moment, wi, mw)
+                np.add.at(moment, wi, mw)
             else:
                 np.add.at(force[:, 0], j[sel], -cfx[sel])
                 np.add.at(force[:, 1], j[sel], -cfy[sel])
-                if rolls:
-                    np.add.at(moment, np.repeat(j[sel], 2), _interleaved(mj[sel], -mr[sel]))
-                else:
-                    np.add.at(moment, j[sel], mj[sel])
+                np.add.at(moment, j[sel], mj[sel])
         wall_force = np.zeros((nw, 2))
         for k in range(len(bounds) - 1):
             sel = part_of[wi] == k
