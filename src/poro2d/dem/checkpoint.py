@@ -35,8 +35,7 @@ _SIM_ARRAYS = (
     "_nb_start", "_nb_j", "_nb_fs", "_nb_fn", "_nb_ov", "_nb_nx", "_nb_ny",
     "_wb_start", "_wb_w", "_wb_fs", "_wb_fn", "_wb_ov", "_wb_nx", "_wb_ny", "_iprm",
 )  # fmt: skip
-# stored only with rolling resistance (see the module's doc); absent ones load as zeros
-_ROLLING_ARRAYS = ("particles.mu_r", "walls.mu_r", "sim._nb_mr", "sim._wb_mr")
+# every particle field but mu_r, which is stored only with rolling resistance (module doc)
 _CORE_PARTICLE_FIELDS = tuple(f for f in PARTICLE_FIELDS if f != "mu_r")
 
 
