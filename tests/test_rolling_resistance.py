@@ -298,6 +298,9 @@ def test_specimen_rolling_friction_is_set_with_the_working_friction():
 
     assert "rolling_friction" not in SpecimenSpec().to_dict()  # results written before keep their keys
     assert SpecimenSpec(rolling_friction=0.2).to_dict()["rolling_friction"] == 0.2
+    from poro2d.config import dataclass_from_table
+
+    assert dataclass_from_table(SpecimenSpec, "specimen", {"rolling_friction": 0.3}).rolling_friction == 0.3
     with pytest.raises(InputError, match="rolling_friction"):
         SpecimenSpec(rolling_friction=-0.1)
     spec = SpecimenSpec(width=0.06, height=0.03, layers=2, rolling_friction=0.2)
