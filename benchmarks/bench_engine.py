@@ -28,6 +28,12 @@ median is reported. The machine's load average is recorded with every number.
     python benchmarks/bench_engine.py --quick            # paper case only, fewer steps
     python benchmarks/bench_engine.py --skip-lammps --out bench_out
     python benchmarks/bench_engine.py --skin-study       # also: paper case vs. Verlet skin
+    python benchmarks/bench_engine.py --quick --skip-lammps --rolling-friction 0.3
+
+``--rolling-friction MU_R`` gives every disk and wall that rolling friction (rolling
+resistance on, see docs/engine.md) and keeps the time step of the case without it, so
+that a block does the same steps either way and the figures compare the cost of a step.
+LAMMPS is not run then.
 """
 
 from __future__ import annotations
@@ -185,6 +191,14 @@ def tiled_simulation(base, nx: int, ny: int, threads: int = 1):
     if not math.isclose(sim.dt, base.dt, rel_tol=1e-12):
         raise RuntimeError(f"tiled dt {sim.dt} differs from the paper case's {base.dt}")
     return sim
+
+
+def with_rolling(sim, mu_r: float) -> None:
+    """Rolling friction ``mu_r`` on every disk and wall, at the time step the case had without it."""
+    if mu_r > 0.0:
+        dt = sim.dt
+        sim.set_rolling_friction(mu_r, walls=mu_r)
+        sim.dt = dt
 
 
 # ------------------------------------------------------------------ timing
@@ -515,7 +529,18 @@ def main(argv=None) -> int:
         action="store_true",
         help="also time the paper case at skins of 0.1-0.5 x the mean radius",
     )
+    ap.add_argument(
+        "--rolling-friction",
+        type=float,
+        default=0.0,
+        help="rolling friction of every disk and wall (0: none); the time step stays that without it",
+    )
     args = ap.parse_args(argv)
+    if not (args.rolling_friction >= 0.0 and math.isfinite(args.rolling_friction)):
+        ap.error(f"--rolling-friction {args.rolling_friction}: allowed [0, inf)")
+    if args.rolling_friction > 0.0 and not args.skip_lammps:
+        print("--rolling-friction: LAMMPS is not run (the timed LAMMPS model has no rolling resistance)")
+        args.skip_lammps = True
 
     sys.path.insert(0, str(HERE))
     # libgomp reads the wait policy when numba first starts its OpenMP threads
@@ -563,6 +588,7 @@ def main(argv=None) -> int:
             "gravity": list(base.gravity),
             "omp_wait_policy_poro2d": args.omp_wait_policy,
             "threading_layer": None,
+            "rolling_friction": args.rolling_friction,
         },
     }
     print(
@@ -585,6 +611,7 @@ def main(argv=None) -> int:
                 f"({time.perf_counter() - t0:.1f} s)",
                 flush=True,
             )
+        with_rolling(sim, args.rolling_friction)
         steps, warm = plan[name]
         session = None
         with_lammps = not args.skip_lammps and name in ("paper", "25k")

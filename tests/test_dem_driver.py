@@ -138,7 +138,7 @@ def test_summary_reports_the_threads_used():
 def test_summary_tells_a_fallback_to_one_thread(monkeypatch):
     # a threading layer that ran the workers one after the other: the start handshake
     # fails after prepare, and the call goes on with one thread
-    def sequential(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash):
+    def sequential(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll):
         K.prepare(disks, nb, wb, work, prm)
         return False
 

@@ -30,8 +30,14 @@ from poro2d.dem.reference import ReferenceDEM, engine_pair_order, engine_partiti
 R = 1e-3  # mean radius (m)
 
 
-def jammed_packing(seed: int, convention="per_body", restitution=None, threads=1, partitions=2) -> Simulation:
-    """~190 disks on a hexagonal lattice with 1-2 % overlaps, squeezed by a moving lid."""
+def jammed_packing(
+    seed: int, convention="per_body", restitution=None, threads=1, partitions=2, rolling=False
+) -> Simulation:
+    """~190 disks on a hexagonal lattice with 1-2 % overlaps, squeezed by a moving lid.
+
+    ``rolling``: rolling frictions 0.02-0.3 on the disks (some contacts then reach their
+    rolling limit, others stay elastic), 0.1 on the walls.
+    """
     rng = np.random.default_rng(seed)
     nx, ny = 14, 14
     pts = [
@@ -54,7 +60,9 @@ def jammed_packing(seed: int, convention="per_body", restitution=None, threads=1
         omega=rng.normal(0.0, 5.0, n),
     )
     p.mode[n // 2] = 1  # prescribed velocity
-    w = Walls.box(0.0, 0.0, 2 * nx * R, pos[:, 1].max() + R, 2e6, 1.5e6, 0.3)
+    w = Walls.box(0.0, 0.0, 2 * nx * R, pos[:, 1].max() + R, 2e6, 1.5e6, 0.3, mu_r=0.1 if rolling else 0.0)
+    if rolling:  # drawn last: the packing without rolling is unchanged
+        p.mu_r[:] = rng.uniform(0.02, 0.3, n)
     contact = None
     if convention == "per_pair_type":
         contact = ContactModel("per_pair_type", pp=(6e5, 4e5, 0.15), pw=(8e5, 5e5, 0.35))
@@ -66,7 +74,7 @@ def jammed_packing(seed: int, convention="per_body", restitution=None, threads=1
     return sim
 
 
-def loose_packing(seed: int) -> Simulation:
+def loose_packing(seed: int, rolling=False) -> Simulation:
     """A square grid with large random overlaps: disks fly apart (many rebuilds)."""
     rng = np.random.default_rng(seed)
     gx, gy = np.meshgrid(np.arange(15), np.arange(13))
@@ -84,7 +92,9 @@ def loose_packing(seed: int) -> Simulation:
         vel=rng.normal(0.0, 0.05, (n, 2)),
         omega=rng.normal(0.0, 20.0, n),
     )
-    w = Walls.box(0.0, 0.0, 30 * R, 26.5 * R, 2e6, 1.5e6, 0.3)
+    w = Walls.box(0.0, 0.0, 30 * R, 26.5 * R, 2e6, 1.5e6, 0.3, mu_r=0.2 if rolling else 0.0)
+    if rolling:
+        p.mu_r[:] = rng.uniform(0.05, 0.5, n)
     return Simulation(p, w, gravity=(0.0, -9.81), local_damping=0.7)
 
 
@@ -152,6 +162,64 @@ def test_loose_packing_matches_reference_bitwise():
     assert _contact_keys(sim) == set(ref.contacts)
 
 
+def _rolling_limits(ref) -> tuple[int, int]:
+    """(contacts at their rolling limit, contacts below it) of the reference's last step."""
+    at_limit = below = 0
+    for key, (fn, _fs, _s) in ref.contacts.items():
+        a = key[0]
+        if len(key) == 2:
+            b = key[1]
+            reff = ref.radius[a] * ref.radius[b] / (ref.radius[a] + ref.radius[b])
+            mur = min(ref.pmu_r[a], ref.pmu_r[b])
+        else:
+            reff = ref.radius[a]
+            mur = min(ref.pmu_r[a], ref.wmu_r[key[2]])
+        if abs(ref.rolling[key]) >= mur * reff * fn * (1 - 1e-12):
+            at_limit += 1
+        else:
+            below += 1
+    return at_limit, below
+
+
+@pytest.mark.parametrize("make", [jammed_packing, loose_packing])
+def test_rolling_resistance_matches_reference(make):
+    """The kernel's rolling moments and their effect on the motion, against the reference."""
+    sim = make(5, rolling=True)
+    steps = 200
+    limited = elastic = 0
+    ref = ReferenceDEM.from_simulation(sim)
+    p = sim.particles
+    worst = 0.0
+    for _ in range(steps):
+        sim.run(1)
+        ref.step(engine_pair_order(sim), engine_partitions(sim))
+        vs, ws = _scales(sim)
+        worst = max(
+            worst,
+            float(np.abs(p.pos - ref.pos).max()) / R,
+            float(np.abs(p.vel - ref.vel).max()) / vs,
+            float(np.abs(p.omega - ref.omega).max()) / ws,
+        )
+        a, b = _rolling_limits(ref)
+        limited += a
+        elastic += b
+    assert worst <= 1e-13, worst
+    assert limited > 500 and elastic > 500, (limited, elastic)  # both branches of the law
+    # the kernel's stored moments are the reference's, contact by contact
+    pp, pw = sim.rolling_moments()
+    c = sim.contacts()
+    kernel = {}
+    for k, (a, b, kind) in enumerate(zip(c.i.tolist(), c.j.tolist(), c.kind.tolist(), strict=True)):
+        kernel[(a, b) if kind == 0 else (a, "wall", b)] = k
+    assert set(kernel) == set(ref.rolling)
+    assert len(pp) + len(pw) == len(ref.rolling)
+    got = np.concatenate([pp, pw])
+    # sim.contacts() lists disk pairs, then wall contacts, in list order, as rolling_moments()
+    want = np.array([ref.rolling[key] for key in sorted(kernel, key=kernel.get)])
+    scale = float(np.abs(want).max())
+    assert scale > 0.0 and float(np.abs(got - want).max()) <= 1e-12 * scale
+
+
 @pytest.mark.parametrize("make", [jammed_packing, loose_packing])
 def test_one_step_from_shared_state_independent_order(make):
     """Every step restarts the reference from the engine's state (history included)."""
@@ -198,6 +266,13 @@ def test_threads_give_bitwise_identical_results():
     d.run(50)
     assert rc.rebuilds >= 2
     assert np.array_equal(c.particles.pos, d.particles.pos)
+    e = jammed_packing(8, threads=1, partitions=4, rolling=True)
+    f = jammed_packing(8, threads=2, partitions=4, rolling=True)
+    f.parallel_min_particles = 0
+    e.run(25)
+    f.run(25)
+    assert f.threads_used == 2
+    assert np.array_equal(e.particles.omega, f.particles.omega) and np.array_equal(e.moment, f.moment)
     assert np.array_equal(c.particles.omega, d.particles.omega)
     assert np.array_equal(c.wall_force_vec, d.wall_force_vec)
 

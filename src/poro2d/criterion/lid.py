@@ -248,6 +248,7 @@ def flat_top(sim: Simulation, width: float) -> Simulation:
     """
     prof = lid_profile(sim, width)
     old_w, p = sim.walls, sim.particles
+    wall_mu_r = old_w.rolling_friction()
     walls = Walls()
     for k, name in enumerate(old_w.names):
         if _is_lid(name):
@@ -255,10 +256,10 @@ def flat_top(sim: Simulation, width: float) -> Simulation:
         a, b = old_w.p0[k].copy(), old_w.p1[k].copy()
         if name == "top":
             a[1] = b[1] = float(prof.heights.max())
-        walls.add(a, b, old_w.kn[k], old_w.ks[k], old_w.mu[k], name)
+        walls.add(a, b, old_w.kn[k], old_w.ks[k], old_w.mu[k], name, mu_r=float(wall_mu_r[k]))
     particles = Particles(
         p.pos.copy(), p.radius.copy(), p.density.copy(), p.thickness, p.kn.copy(), p.ks.copy(), p.mu.copy(),
-        vel=p.vel.copy(), theta=p.theta.copy(), omega=p.omega.copy(), mode=p.mode.copy(),
+        vel=p.vel.copy(), theta=p.theta.copy(), omega=p.omega.copy(), mode=p.mode.copy(), mu_r=p.mu_r.copy(),
     )  # fmt: skip
     return Simulation(
         particles, walls, sim.contact, gravity=sim.gravity, local_damping=sim.local_damping,

@@ -3,6 +3,11 @@
 A run continued from a checkpoint gives the same numbers as an uninterrupted run:
 the neighbour lists, their shear histories and the rebuild bookkeeping are stored
 as they are, not rebuilt.
+
+Rolling resistance (``mu_r`` of disks and walls, the contacts' rolling moments) is
+stored only when some disk has a rolling friction: a checkpoint without it, and every
+checkpoint written before it existed, loads with zeros, and a state without rolling
+resistance keeps its file contents and its :func:`state_digest`.
 """
 
 from __future__ import annotations
@@ -30,6 +35,8 @@ _SIM_ARRAYS = (
     "_nb_start", "_nb_j", "_nb_fs", "_nb_fn", "_nb_ov", "_nb_nx", "_nb_ny",
     "_wb_start", "_wb_w", "_wb_fs", "_wb_fn", "_wb_ov", "_wb_nx", "_wb_ny", "_iprm",
 )  # fmt: skip
+# every particle field but mu_r, which is stored only with rolling resistance (module doc)
+_CORE_PARTICLE_FIELDS = tuple(f for f in PARTICLE_FIELDS if f != "mu_r")
 
 
 def save(sim: Simulation, path: str | os.PathLike, extra: dict | None = None) -> Path:
@@ -37,12 +44,17 @@ def save(sim: Simulation, path: str | os.PathLike, extra: dict | None = None) ->
     path = Path(path)
     sim._sync_walls()  # walls added since the last run: their rows in the per-wall arrays
     arrays: dict[str, np.ndarray] = {}
-    for f in PARTICLE_FIELDS:
+    for f in _CORE_PARTICLE_FIELDS:
         arrays[f"particles.{f}"] = getattr(sim.particles, f)
     for f in _WALL_FIELDS:
         arrays[f"walls.{f}"] = getattr(sim.walls, f)
     for f in _SIM_ARRAYS:
         arrays[f"sim.{f}"] = getattr(sim, f)
+    if K.rolling_active(sim.particles.mu_r):
+        arrays["particles.mu_r"] = sim.particles.mu_r
+        arrays["walls.mu_r"] = sim.walls.rolling_friction()
+        arrays["sim._nb_mr"] = sim._nb_mr
+        arrays["sim._wb_mr"] = sim._wb_mr
     meta = {
         "format": FORMAT,
         "provenance": provenance(),
@@ -143,7 +155,7 @@ def read(path: str | os.PathLike) -> tuple[dict, dict[str, np.ndarray]]:
         raise _damaged(p, exc) from None
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
         raise InputError("checkpoint format", meta.get("format") if isinstance(meta, dict) else None, FORMAT)
-    needed = [f"particles.{f}" for f in PARTICLE_FIELDS] + [f"walls.{f}" for f in _WALL_FIELDS]
+    needed = [f"particles.{f}" for f in _CORE_PARTICLE_FIELDS] + [f"walls.{f}" for f in _WALL_FIELDS]
     needed += [f"sim.{f}" for f in _SIM_ARRAYS]
     missing = [k for k in needed if k not in arrays]
     if missing or not isinstance(meta.get("settings"), dict):
@@ -165,11 +177,11 @@ def load(path: str | os.PathLike, threads: int | None = None) -> Simulation:
 def _build(meta: dict, a: dict[str, np.ndarray], threads: int | None) -> Simulation:
     """The Simulation of a checkpoint's metadata and arrays."""
     s = meta["settings"]
-    pf = {f: a[f"particles.{f}"] for f in PARTICLE_FIELDS}
+    pf = {f: a[f"particles.{f}"] for f in _CORE_PARTICLE_FIELDS}
     particles = Particles(
         pos=pf["pos"], radius=pf["radius"], density=pf["density"], thickness=meta["thickness"],
         kn=pf["kn"], ks=pf["ks"], mu=pf["mu"], vel=pf["vel"], theta=pf["theta"], omega=pf["omega"],
-        mode=pf["mode"],
+        mode=pf["mode"], mu_r=a.get("particles.mu_r"),
     )  # fmt: skip
     walls = Walls()
     for f in _WALL_FIELDS:
@@ -178,6 +190,7 @@ def _build(meta: dict, a: dict[str, np.ndarray], threads: int | None) -> Simulat
         pad = np.zeros((walls.n, SERVO_COLUMNS - walls.servo.shape[1]))
         walls.servo = np.ascontiguousarray(np.hstack([walls.servo.reshape(walls.n, -1), pad]))
     walls.names = list(meta["wall_names"])
+    walls.mu_r = np.ascontiguousarray(a.get("walls.mu_r", np.zeros(walls.n)), dtype=float)
     c = s["contact"]
     contact = ContactModel(
         c["convention"],
@@ -200,6 +213,11 @@ def _build(meta: dict, a: dict[str, np.ndarray], threads: int | None) -> Simulat
     iprm = np.zeros(K.N_IPRM, dtype=np.int64)
     iprm[: min(len(sim._iprm), K.N_IPRM)] = sim._iprm[: K.N_IPRM]
     sim._iprm = iprm
+    # the rolling moments: zero for a checkpoint without rolling resistance
+    sim._nb_mr = np.ascontiguousarray(a.get("sim._nb_mr", np.zeros(sim._nb_j.shape[0])), dtype=float)
+    sim._wb_mr = np.ascontiguousarray(a.get("sim._wb_mr", np.zeros(sim._wb_w.shape[0])), dtype=float)
+    if sim._nb_mr.shape != sim._nb_j.shape or sim._wb_mr.shape != sim._wb_w.shape:
+        raise ValueError("rolling moments of another length than the contact lists")
     sim._grow((), sim._PP_SCRATCH, sim._nb_j.shape[0], 0)
     sim._grow((), sim._PW_SCRATCH, sim._wb_w.shape[0], 0)
     return sim

@@ -14,6 +14,15 @@ The force on ``i`` is ``-Fn n + Fs t`` and its moment ``a_i * Fs`` with the leve
 ``a_i = r_i - overlap / 2`` (contact point in the middle of the overlap).
 
 Property combination (PFC 4.0): springs in series, the smaller friction.
+
+Rolling resistance (optional; the elastic-plastic spring of Iwashita and Oda 1998, type
+A of Ai et al. 2011, PFC's rolling-resistance linear model): a contact also carries a
+rolling moment ``Mr``, its second piece of history, updated incrementally from the
+relative rotation, ``Mr -= kr (omega_i - omega_j) dt`` (a wall does not turn), with the
+rolling stiffness ``kr = ks R^2`` and capped at ``mu_r R Fn``; ``R = ri rj / (ri + rj)``
+for two disks, the disk's radius against a wall, ``mu_r`` the smaller of the two bodies'
+rolling frictions. ``Mr`` acts on ``i`` and ``-Mr`` on ``j``: a pure couple, so it
+changes no force.
 """
 
 from __future__ import annotations
@@ -58,6 +67,17 @@ def linear_force(overlap, vn, vt, fs_old, kn, ks, mu, cn, dt):
         fs = -cap
         sliding = True
     return fn, fs, sliding
+
+
+@njit(inline="always", cache=True)
+def rolling_moment(m_old, kr, dtheta, cap):
+    """Rolling moment on disk ``i`` after a relative rotation ``dtheta`` of ``i`` against ``j``.
+
+    The elastic spring ``kr`` resists the rotation; beyond ``cap`` (>= 0) it slips.
+    """
+    # min / max rather than branches: a packing holds contacts on and below the limit in
+    # no order, and a mispredicted branch per contact costs more than both comparisons
+    return min(max(m_old - kr * dtheta, -cap), cap)
 
 
 @njit(inline="always", cache=True)

@@ -24,6 +24,8 @@ stores its force; that partner is *deferred* and collects such forces after all
 partitions are done (phase 2). The order of every sum is therefore fixed by the
 partitions: for a disk, gravity, then the pairs of earlier rows of its partition,
 its own row, its walls, then its cross pairs; for a wall, partition by partition.
+With rolling resistance a contact's moment on a disk is its shear moment plus (or, on the
+second disk, minus) its rolling moment, added as one term.
 
 Threads: one worker per thread runs all steps of the call, each on its own
 partitions; workers meet at two barriers per step (after phase 1, after phase 2;
@@ -40,7 +42,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from poro2d.dem.contact_law import PER_BODY, dashpot, linear_force, segment_closest, series
+from poro2d.dem.contact_law import PER_BODY, dashpot, linear_force, rolling_moment, segment_closest, series
 from poro2d.dem.neighbors import (
     cell_grid,
     copy_rows,
@@ -51,7 +53,7 @@ from poro2d.dem.neighbors import (
     prefix_rows,
 )
 from poro2d.dem.partition import partition
-from poro2d.dem.records import BodyProps, KernelRecords
+from poro2d.dem.records import BodyProps, KernelRecords, RollingProps
 from poro2d.dem.state import (
     FREE,
     SERVO_ERROR_SUM,
@@ -191,7 +193,7 @@ def _damped(f, v, damp):
 
 
 @njit(cache=True)
-def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, pw_body, dt, gx, gy, damp):
+def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp):
     """Phase 1 on partition k: forces of its rows, advance of its non-deferred disks.
 
     ``props`` holds the disks' (kn, ks, mu) (:class:`~poro2d.dem.records.BodyProps`) when
@@ -199,6 +201,8 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, pw_body, dt, 
     the critical-damping fraction of the contact dashpot, None without one. Being None is
     a type, so numba compiles a variant without that code: those branches and the arrays
     they need cost registers in the pair loop (5-7 % of its speed), even when never taken.
+    ``roll`` likewise: the bodies' rolling frictions (:class:`~poro2d.dem.records.RollingProps`),
+    None when no disk has one, and then no rolling moment is computed or stored.
 
     Returns the largest squared drift of the disks advanced.
     """
@@ -211,6 +215,7 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, pw_body, dt, 
     wpart = walls.part_sums
     nb_start, nb_j, nb_fs, nb_fn, nb_ov, nb_nx, nb_ny = nb.start, nb.j, nb.fs, nb.fn, nb.ov, nb.nx, nb.ny
     wb_start, wb_w, wb_fs, wb_fn, wb_ov, wb_nx, wb_ny = wb.start, wb.w, wb.fs, wb.fn, wb.ov, wb.nx, wb.ny
+    nb_mr, wb_mr = nb.mr, wb.mr
     pos_build, part, xstart = work.pos_build, work.part, work.xstart
     # flat views: an (n, 2) index costs a multiplication by a run-time row length
     posf = pos.reshape(pos.size)
@@ -239,6 +244,9 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, pw_body, dt, 
         xi = posf[U2 * i]
         yi = posf[U2 * i + U1]
         ri = radius[i]
+        mur_i = 0.0
+        if roll is not None:
+            mur_i = roll.disk_mu_r[i]
         for p_ in range(nb_start[i_], nb_start[i_ + 1]):
             p = np.uint64(p_)
             js = nb_j[p]
@@ -251,6 +259,8 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, pw_body, dt, 
             if ov <= 0.0:
                 nb_fn[p] = 0.0
                 nb_fs[p] = 0.0  # contact lost: history ends
+                if roll is not None:
+                    nb_mr[p] = 0.0
                 continue
             if props is not None:
                 kn = series(props.kn[i], props.kn[j])
@@ -274,11 +284,20 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, pw_body, dt, 
             fyp = -fn * ny + fs * nx
             fx += fxp
             fy += fyp
-            mz += ai * fs
+            mi = ai * fs  # the contact's moments on i and on j
+            mj = aj * fs
+            if roll is not None:
+                mur = min(mur_i, roll.disk_mu_r[j])
+                reff = ri * radius[j] / (ri + radius[j])
+                mr = rolling_moment(nb_mr[p], ks * reff * reff, (wi - wj) * dt, mur * reff * fn)
+                nb_mr[p] = mr
+                mi += mr
+                mj -= mr
+            mz += mi
             if js < i1:  # a partner in a later partition collects this in phase 2
                 accf[U3 * j] -= fxp
                 accf[U3 * j + U1] -= fyp
-                accf[U3 * j + U2] += aj * fs
+                accf[U3 * j + U2] += mj
         for p_ in range(wb_start[i_], wb_start[i_ + 1]):
             p = np.uint64(p_)
             w = np.uint64(wb_w[p])
@@ -291,6 +310,8 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, pw_body, dt, 
             if ov <= 0.0:
                 wb_fn[p] = 0.0
                 wb_fs[p] = 0.0
+                if roll is not None:
+                    wb_mr[p] = 0.0
                 continue
             if pw_body:
                 wkn_ = series(pkn[i], wkn[w])
@@ -316,7 +337,13 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, pw_body, dt, 
             fyp = -fn * ny + fs * nx
             fx += fxp
             fy += fyp
-            mz += ai * fs
+            mi = ai * fs
+            if roll is not None:  # a wall does not turn: the disk's spin is the relative one
+                mur = min(mur_i, roll.wall_mu_r[w])
+                mr = rolling_moment(wb_mr[p], wks_ * ri * ri, omega[i] * dt, mur * ri * fn)
+                wb_mr[p] = mr
+                mi += mr
+            mz += mi
             wpart[k, w, WFX] -= fxp
             wpart[k, w, WFY] -= fyp
             wpart[k, w, WCOUNT] += 1.0
@@ -344,7 +371,7 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, pw_body, dt, 
 
 
 @njit(cache=True)
-def _phase_deferred(m0, m1, disks, nb, work, gx, gy, damp, dt):
+def _phase_deferred(m0, m1, disks, nb, work, roll, gx, gy, damp, dt):
     """Phase 2: deferred disks ``dlist[m0:m1]`` add their cross pairs and advance.
 
     Each deferred disk only reads its own cross pairs, so the list is shared out
@@ -353,7 +380,7 @@ def _phase_deferred(m0, m1, disks, nb, work, gx, gy, damp, dt):
     pos, vel, theta, omega = disks.pos, disks.vel, disks.theta, disks.omega
     force, moment, acc, radius = disks.force, disks.moment, disks.acc, disks.radius
     mass, inv_mass, inv_inertia, pmode = disks.mass, disks.inv_mass, disks.inv_inertia, disks.mode
-    nb_fs, nb_fn, nb_ov, nb_nx, nb_ny = nb.fs, nb.fn, nb.ov, nb.nx, nb.ny
+    nb_fs, nb_fn, nb_ov, nb_nx, nb_ny, nb_mr = nb.fs, nb.fn, nb.ov, nb.nx, nb.ny, nb.mr
     pos_build, xstart, xpair, dlist = work.pos_build, work.xstart, work.xpair, work.dlist
     dmax = 0.0
     for m in range(m0, m1):
@@ -368,7 +395,10 @@ def _phase_deferred(m0, m1, disks, nb, work, gx, gy, damp, dt):
                 fs = nb_fs[p]
                 fx -= -fn * nb_nx[p] - fs * nb_ny[p]
                 fy -= -fn * nb_ny[p] + fs * nb_nx[p]
-                mz += (radius[i] - 0.5 * nb_ov[p]) * fs
+                mj = (radius[i] - 0.5 * nb_ov[p]) * fs
+                if roll is not None:
+                    mj -= nb_mr[p]
+                mz += mj
         force[i, 0] = fx
         force[i, 1] = fy
         moment[i] = mz
@@ -440,10 +470,10 @@ def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out):
     """
     pos, radius = disks.pos, disks.radius
     wp0, wp1, wall_build = walls.p0, walls.p1, walls.p0_build
-    nb_start, nb_j, nb_fs = nb.start, nb.j, nb.fs
-    new_start, new_j, new_fs = nb.new_start, nb.new_j, nb.new_fs
-    wb_start, wb_w, wb_fs = wb.start, wb.w, wb.fs
-    wnew_start, wnew_w, wnew_fs = wb.new_start, wb.new_w, wb.new_fs
+    nb_start, nb_j, nb_fs, nb_mr = nb.start, nb.j, nb.fs, nb.mr
+    new_start, new_j, new_fs, new_mr = nb.new_start, nb.new_j, nb.new_fs, nb.new_mr
+    wb_start, wb_w, wb_fs, wb_mr = wb.start, wb.w, wb.fs, wb.mr
+    wnew_start, wnew_w, wnew_fs, wnew_mr = wb.new_start, wb.new_w, wb.new_fs, wb.new_mr
     pos_build, sync = work.pos_build, work.sync
     part, xstart, xpair, dlist, dstart = work.part, work.xstart, work.xpair, work.dlist, work.dstart
     cell, members, cstart, cfill, ginfo = work.cell, work.members, work.cstart, work.cfill, work.ginfo
@@ -472,11 +502,12 @@ def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out):
     if atomic_load(sync, STATUS_WORD) != RUNNING:
         return False
     fill_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, nb_start, nb_j, nb_fs,
-                   new_start, new_j, new_fs)  # fmt: skip
-    fill_wall_rows(lo, hi, pos, radius, skin, wp0, wp1, wb_start, wb_w, wb_fs, wnew_start, wnew_w, wnew_fs)
+                   new_start, new_j, new_fs, nb_mr, new_mr)  # fmt: skip
+    fill_wall_rows(lo, hi, pos, radius, skin, wp0, wp1, wb_start, wb_w, wb_fs, wnew_start, wnew_w, wnew_fs,
+                   wb_mr, wnew_mr)  # fmt: skip
     barrier(sync, nthr)  # the old rows are read by every filler: overwrite them only now
-    copy_rows(lo, hi, new_start, new_j, new_fs, nb_start, nb_j, nb_fs)
-    copy_rows(lo, hi, wnew_start, wnew_w, wnew_fs, wb_start, wb_w, wb_fs)
+    copy_rows(lo, hi, new_start, new_j, new_fs, nb_start, nb_j, nb_fs, new_mr, nb_mr)
+    copy_rows(lo, hi, wnew_start, wnew_w, wnew_fs, wb_start, wb_w, wb_fs, wnew_mr, wb_mr)
     for i in range(lo, hi):
         pos_build[i, 0] = pos[i, 0]
         pos_build[i, 1] = pos[i, 1]
@@ -546,7 +577,7 @@ def _report(status, steps, rebuilds, need_build, pos, iprm, out):
 
 
 @njit(cache=True)
-def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash):
+def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll):
     """Run the steps of this call on thread t of nthr: partitions t P / nthr to (t + 1) P / nthr - 1."""
     wp0, wall_build = walls.p0, walls.p0_build
     part, dstart, tmax, sync = work.part, work.dstart, work.tmax, work.sync
@@ -580,13 +611,16 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash):
         # a helper taking the records would add a reference count per array at every step
         dmax = 0.0
         for k in range(k0, k1):
-            d2 = _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, pw_body, dt, gx, gy, damp)
+            d2 = _phase_forces(
+                k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp
+            )
             if d2 > dmax:
                 dmax = d2
         barrier(sync, nthr)
         # phase 2: the deferred disks, shared out evenly; thread 0 also moves the walls
         ndef = dstart[npart]
-        d2 = _phase_deferred(t * ndef // nthr, (t + 1) * ndef // nthr, disks, nb, work, gx, gy, damp, dt)
+        m0, m1 = t * ndef // nthr, (t + 1) * ndef // nthr
+        d2 = _phase_deferred(m0, m1, disks, nb, work, roll, gx, gy, damp, dt)
         if d2 > dmax:
             dmax = d2
         tmax[t] = dmax
@@ -624,22 +658,28 @@ def prepare(disks, nb, wb, work, prm):
 
 
 @njit(parallel=True, cache=True)
-def _run_threads(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash):
+def _run_threads(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll):
     # prepare here, not in a call of its own: each call costs the dispatch of every array
     prepare(disks, nb, wb, work, prm)
     ok = np.zeros(nthr, dtype=np.int64)
     for t in prange(nthr):
         if start_handshake(work.sync, nthr):
             ok[t] = 1
-            _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash)
+            _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll)
     return ok.sum() == nthr
 
 
 @njit(cache=True)
-def run_serial(disks, walls, nb, wb, work, prm, iprm, out, props, dash):
+def run_serial(disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll):
     prepare(disks, nb, wb, work, prm)
-    _worker(0, 1, disks, walls, nb, wb, work, prm, iprm, out, props, dash)
+    _worker(0, 1, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll)
     out[THREADS_USED] = 1
+
+
+def rolling_active(disk_mu_r: np.ndarray) -> bool:
+    """Whether any contact can carry a rolling moment: a contact takes the smaller ``mu_r``
+    of its bodies, so without a disk above 0 there is none (and the kernel skips the law)."""
+    return bool(disk_mu_r.size and disk_mu_r.max() > 0.0)
 
 
 def run_steps(rec: KernelRecords, prm, iprm, out) -> None:
@@ -651,13 +691,14 @@ def run_steps(rec: KernelRecords, prm, iprm, out) -> None:
     nthr = int(min(iprm[THREADS], work.part.shape[0] - 1))
     props = BodyProps(disks.kn, disks.ks, disks.mu) if iprm[MODE] == PER_BODY else None
     dash = float(prm[BETA]) if prm[BETA] > 0.0 else None
+    roll = RollingProps(disks.mu_r, walls.mu_r) if rolling_active(disks.mu_r) else None
     if nthr <= 1:
-        run_serial(disks, walls, nb, wb, work, prm, iprm, out, props, dash)
+        run_serial(disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll)
         return
     work.sync[:] = 0
-    if _run_threads(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash):
+    if _run_threads(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll):
         out[THREADS_USED] = nthr
     else:  # the threading layer ran the workers one after the other: go on alone
         work.sync[:] = 0
-        _worker(0, 1, disks, walls, nb, wb, work, prm, iprm, out, props, dash)
+        _worker(0, 1, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll)
         out[THREADS_USED] = 1

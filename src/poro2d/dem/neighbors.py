@@ -5,8 +5,8 @@ partners ``j > i``); disk-wall candidates as a CSR list of wall indices per disk
 A pair is a candidate while the gap between the two surfaces is below ``skin``;
 the lists stay valid until a disk or a wall has moved more than ``skin / 2``.
 
-On a rebuild the shear-force history of every pair that survives is copied
-across by matching ``(i, j)`` in the old row of ``i``. The capacity of the pair
+On a rebuild the history of every pair that survives (its shear force and its
+rolling moment) is copied across by matching ``(i, j)`` in the old row of ``i``. The capacity of the pair
 arrays is fixed by the caller: when it is too small the build reports how much
 it needs and changes nothing, so the caller can grow the arrays and retry.
 
@@ -184,9 +184,11 @@ def prefix_rows(n, start):
 
 @njit(cache=True)
 def fill_pair_rows(
-    lo, hi, pos, radius, skin, cell, members, cstart, ginfo, nb_start, nb_j, nb_fs, new_start, new_j, new_fs
-):
-    """Write rows lo..hi-1 of the new disk-disk list, each pair with its old shear force (or 0)."""
+    lo, hi, pos, radius, skin, cell, members, cstart, ginfo, nb_start, nb_j, nb_fs, new_start, new_j, new_fs,
+    nb_mr, new_mr,
+):  # fmt: skip
+    """Write rows lo..hi-1 of the new disk-disk list, each pair with its old shear force and
+    rolling moment (or 0)."""
     ncx = ginfo[0]
     ncy = ginfo[1]
     for i in range(lo, hi):
@@ -197,16 +199,21 @@ def fill_pair_rows(
         for k in range(k0, new_start[i + 1]):
             j = new_j[k]
             h = 0.0
+            hr = 0.0
             for o in range(o0, o1):
                 if nb_j[o] == j:
                     h = nb_fs[o]
+                    hr = nb_mr[o]
                     break
             new_fs[k] = h
+            new_mr[k] = hr
 
 
 @njit(cache=True)
-def fill_wall_rows(lo, hi, pos, radius, skin, wp0, wp1, wb_start, wb_w, wb_fs, wnew_start, wnew_w, wnew_fs):
-    """Write rows lo..hi-1 of the new disk-wall list, with the old shear forces."""
+def fill_wall_rows(
+    lo, hi, pos, radius, skin, wp0, wp1, wb_start, wb_w, wb_fs, wnew_start, wnew_w, wnew_fs, wb_mr, wnew_mr
+):
+    """Write rows lo..hi-1 of the new disk-wall list, with the old shear forces and rolling moments."""
     nw = wp0.shape[0]
     for i in range(lo, hi):
         k = wnew_start[i]
@@ -217,20 +224,24 @@ def fill_wall_rows(lo, hi, pos, radius, skin, wp0, wp1, wb_start, wb_w, wb_fs, w
             if _near_wall(pos[i, 0], pos[i, 1], reach, wp0, wp1, w):
                 wnew_w[k] = w
                 h = 0.0
+                hr = 0.0
                 for o in range(o0, o1):
                     if wb_w[o] == w:
                         h = wb_fs[o]
+                        hr = wb_mr[o]
                         break
                 wnew_fs[k] = h
+                wnew_mr[k] = hr
                 k += 1
 
 
 @njit(cache=True)
-def copy_rows(lo, hi, new_start, new_j, new_fs, nb_start, nb_j, nb_fs):
+def copy_rows(lo, hi, new_start, new_j, new_fs, nb_start, nb_j, nb_fs, new_mr, nb_mr):
     """Make rows lo..hi-1 of a new list the current one (once every row is filled)."""
     for k in range(new_start[lo], new_start[hi]):
         nb_j[k] = new_j[k]
         nb_fs[k] = new_fs[k]
+        nb_mr[k] = new_mr[k]
     for i in range(lo, hi):
         nb_start[i + 1] = new_start[i + 1]
     if lo == 0:
@@ -256,10 +267,13 @@ def build_pairs(pos, radius, skin, nb_start, nb_j, nb_fs, new_start, new_j, new_
     total = prefix_rows(n, new_start)
     if total > nb_j.shape[0]:
         return -total
+    nb_mr = np.zeros(nb_j.shape[0])  # no rolling history in this stand-alone build
+    new_mr = np.zeros(nb_j.shape[0])
     fill_pair_rows(
-        0, n, pos, radius, skin, cell, members, cstart, ginfo, nb_start, nb_j, nb_fs, new_start, new_j, new_fs
-    )
-    copy_rows(0, n, new_start, new_j, new_fs, nb_start, nb_j, nb_fs)
+        0, n, pos, radius, skin, cell, members, cstart, ginfo, nb_start, nb_j, nb_fs,
+        new_start, new_j, new_fs, nb_mr, new_mr,
+    )  # fmt: skip
+    copy_rows(0, n, new_start, new_j, new_fs, nb_start, nb_j, nb_fs, new_mr, nb_mr)
     return total
 
 
@@ -274,8 +288,12 @@ def build_wall_pairs(pos, radius, skin, wp0, wp1, wb_start, wb_w, wb_fs, new_sta
     total = prefix_rows(n, new_start)
     if total > wb_w.shape[0]:
         return -total
-    fill_wall_rows(0, n, pos, radius, skin, wp0, wp1, wb_start, wb_w, wb_fs, new_start, new_w, new_fs)
-    copy_rows(0, n, new_start, new_w, new_fs, wb_start, wb_w, wb_fs)
+    wb_mr = np.zeros(wb_w.shape[0])  # no rolling history in this stand-alone build
+    new_mr = np.zeros(wb_w.shape[0])
+    fill_wall_rows(
+        0, n, pos, radius, skin, wp0, wp1, wb_start, wb_w, wb_fs, new_start, new_w, new_fs, wb_mr, new_mr
+    )
+    copy_rows(0, n, new_start, new_w, new_fs, wb_start, wb_w, wb_fs, new_mr, wb_mr)
     return total
 
 

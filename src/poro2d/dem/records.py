@@ -45,6 +45,7 @@ class DiskArrays(NamedTuple):
     kn: np.ndarray  # per-body properties, combined per contact under PER_BODY
     ks: np.ndarray
     mu: np.ndarray
+    mu_r: np.ndarray  # rolling friction
 
 
 class BodyProps(NamedTuple):
@@ -53,6 +54,13 @@ class BodyProps(NamedTuple):
     kn: np.ndarray
     ks: np.ndarray
     mu: np.ndarray
+
+
+class RollingProps(NamedTuple):
+    """The bodies' rolling frictions, handed over only when some disk has one above 0."""
+
+    disk_mu_r: np.ndarray
+    wall_mu_r: np.ndarray
 
 
 class WallArrays(NamedTuple):
@@ -64,6 +72,7 @@ class WallArrays(NamedTuple):
     kn: np.ndarray
     ks: np.ndarray
     mu: np.ndarray
+    mu_r: np.ndarray
     mode: np.ndarray  # int64: WALL_VELOCITY or WALL_SERVO
     servo_dir: np.ndarray  # (nw, 2) unit direction a servo wall moves to compress
     servo: np.ndarray  # (nw, SERVO_COLUMNS): columns named in poro2d.dem.state (SERVO_TARGET, ...)
@@ -83,9 +92,11 @@ class PairList(NamedTuple):
     ov: np.ndarray  # overlap (m), negative when apart
     nx: np.ndarray  # unit normal from i towards j
     ny: np.ndarray
-    new_start: np.ndarray  # the list being built, copied over start/j/fs when complete
+    new_start: np.ndarray  # the list being built, copied over start/j/fs/mr when complete
     new_j: np.ndarray
     new_fs: np.ndarray
+    mr: np.ndarray  # rolling moment on i (N m; -mr on j): history too, 0 without rolling
+    new_mr: np.ndarray
 
 
 class WallPairList(NamedTuple):
@@ -101,6 +112,8 @@ class WallPairList(NamedTuple):
     new_start: np.ndarray
     new_w: np.ndarray
     new_fs: np.ndarray
+    mr: np.ndarray  # rolling moment on the disk (N m)
+    new_mr: np.ndarray
 
 
 class WorkArrays(NamedTuple):
@@ -137,20 +150,22 @@ def kernel_records(sim: Simulation) -> KernelRecords:
     disks = DiskArrays(
         pos=p.pos, vel=p.vel, theta=p.theta, omega=p.omega, force=sim.force, moment=sim.moment,
         acc=sim._acc, radius=p.radius, mass=sim._mass, inv_mass=sim._inv_mass,
-        inv_inertia=sim._inv_inertia, mode=p.mode, kn=p.kn, ks=p.ks, mu=p.mu,
+        inv_inertia=sim._inv_inertia, mode=p.mode, kn=p.kn, ks=p.ks, mu=p.mu, mu_r=p.mu_r,
     )  # fmt: skip
     walls = WallArrays(
-        p0=w.p0, p1=w.p1, vel=w.vel, kn=w.kn, ks=w.ks, mu=w.mu, mode=w.mode, servo_dir=w.servo_dir,
-        servo=w.servo, force=sim.wall_force_vec, stat=sim._wstat, p0_build=sim._wall_build,
-        part_sums=sim._wpart,
+        p0=w.p0, p1=w.p1, vel=w.vel, kn=w.kn, ks=w.ks, mu=w.mu, mu_r=w.rolling_friction(), mode=w.mode,
+        servo_dir=w.servo_dir, servo=w.servo, force=sim.wall_force_vec, stat=sim._wstat,
+        p0_build=sim._wall_build, part_sums=sim._wpart,
     )  # fmt: skip
     nb = PairList(
         start=sim._nb_start, j=sim._nb_j, fs=sim._nb_fs, fn=sim._nb_fn, ov=sim._nb_ov, nx=sim._nb_nx,
-        ny=sim._nb_ny, new_start=sim._new_start, new_j=sim._new_j, new_fs=sim._new_fs,
+        ny=sim._nb_ny, new_start=sim._new_start, new_j=sim._new_j, new_fs=sim._new_fs, mr=sim._nb_mr,
+        new_mr=sim._new_mr,
     )  # fmt: skip
     wb = WallPairList(
         start=sim._wb_start, w=sim._wb_w, fs=sim._wb_fs, fn=sim._wb_fn, ov=sim._wb_ov, nx=sim._wb_nx,
-        ny=sim._wb_ny, new_start=sim._wnew_start, new_w=sim._wnew_w, new_fs=sim._wnew_fs,
+        ny=sim._wb_ny, new_start=sim._wnew_start, new_w=sim._wnew_w, new_fs=sim._wnew_fs, mr=sim._wb_mr,
+        new_mr=sim._wnew_mr,
     )  # fmt: skip
     g = sim._grid
     work = WorkArrays(

@@ -12,6 +12,11 @@ pairs. The physics is the documented one:
   dashpot), ``Fs = Fs_old + ks vt dt`` capped at ``mu Fn``; the history ends when the
   bodies separate;
 * force on ``i``: ``-Fn n + Fs t``, moment ``(r_i - ov / 2) Fs`` on both disks;
+* rolling resistance: ``Mr = Mr_old - kr (omega_i - omega_j) dt`` (``omega_j = 0`` for a
+  wall) capped at ``mu_r R Fn``, ``kr = ks R^2``, ``R = r_i r_j / (r_i + r_j)`` (a wall:
+  ``r_i``), ``mu_r`` the smaller of the two bodies'; ``Mr`` on ``i``, ``-Mr`` on ``j``,
+  each added to the contact's shear moment before that reaches the disk's sum; its
+  history is a second dict;
 * gravity on the true mass, local damping ``F - alpha |F| sign(v)`` per component of
   force and moment, then leapfrog ``v += F / m dt``, ``x += v dt``; walls move with
   their velocity. Prescribed disks keep their velocity and spin.
@@ -41,6 +46,12 @@ def _series(ka: np.ndarray, kb: np.ndarray) -> np.ndarray:
     eq = ka_b == kb_b  # as the kernel: equal springs give exactly half
     out[eq] = 0.5 * ka_b[eq]
     return out
+
+
+def _rolling_moments(mr_old, kr, dtheta, cap):
+    """Vectorised elastic-plastic rolling spring: the moments on the first bodies."""
+    mr = mr_old - kr * dtheta
+    return np.where(mr > cap, cap, np.where(mr < -cap, -cap, mr))
 
 
 def _contact_forces(ov, vn, vt, fs_old, kn, ks, mu, cn, dt):
@@ -93,6 +104,9 @@ class ReferenceDEM:
         pp: tuple[float, float, float] | None = None,
         pw: tuple[float, float, float] | None = None,
         history: dict[Any, float] | None = None,
+        pmu_r=None,
+        wmu_r=None,
+        rolling: dict[Any, float] | None = None,
     ) -> None:
         c = np.array
         self.pos = c(pos, dtype=float)
@@ -118,6 +132,9 @@ class ReferenceDEM:
         self.pw = pw
         self.history: dict[Any, float] = dict(history or {})
         n, nw = self.pos.shape[0], self.wp0.shape[0]
+        self.pmu_r = np.zeros(n) if pmu_r is None else c(pmu_r, dtype=float)
+        self.wmu_r = np.zeros(nw) if wmu_r is None else c(wmu_r, dtype=float)
+        self.rolling: dict[Any, float] = dict(rolling or {})  # rolling moment on the first body
         self.force = np.zeros((n, 2))
         self.moment = np.zeros(n)
         self.wall_force = np.zeros((nw, 2))
@@ -129,17 +146,20 @@ class ReferenceDEM:
         """Copy the state of a :class:`~poro2d.dem.simulation.Simulation` (history included)."""
         p, w = sim.particles, sim.walls
         history: dict[Any, float] = {}
+        rolling: dict[Any, float] = {}
         n = p.n
         npp = int(sim._nb_start[n])
         rows = np.repeat(np.arange(n), np.diff(sim._nb_start))
         for k in range(npp):
             if sim._nb_ov[k] > 0.0:
                 history[(int(rows[k]), int(sim._nb_j[k]))] = float(sim._nb_fs[k])
+                rolling[(int(rows[k]), int(sim._nb_j[k]))] = float(sim._nb_mr[k])
         npw = int(sim._wb_start[n])
         wrows = np.repeat(np.arange(n), np.diff(sim._wb_start))
         for k in range(npw):
             if sim._wb_ov[k] > 0.0:
                 history[(int(wrows[k]), "wall", int(sim._wb_w[k]))] = float(sim._wb_fs[k])
+                rolling[(int(wrows[k]), "wall", int(sim._wb_w[k]))] = float(sim._wb_mr[k])
         conv = sim.contact.convention
         return cls(
             pos=p.pos, vel=p.vel, theta=p.theta, omega=p.omega, radius=p.radius,
@@ -147,6 +167,7 @@ class ReferenceDEM:
             pkn=p.kn, pks=p.ks, pmu=p.mu, wp0=w.p0, wp1=w.p1, wvel=w.vel, wkn=w.kn, wks=w.ks,
             wmu=w.mu, gravity=sim.gravity, damping=sim.local_damping, beta=sim._beta, dt=sim.dt,
             per_body=conv == "per_body", pp=sim.contact.pp, pw=sim.contact.pw, history=history,
+            pmu_r=p.mu_r, wmu_r=w.rolling_friction(), rolling=rolling,
         )  # fmt: skip
 
     # ------------------------------------------------------------------ step
@@ -207,6 +228,8 @@ class ReferenceDEM:
         n = pos.shape[0]
         nw = self.wp0.shape[0]
         new_hist: dict[Any, float] = {}
+        new_rolling: dict[Any, float] = {}
+        rolls = bool(n and self.pmu_r.max() > 0.0)
         contacts: dict[Any, tuple[float, float, bool]] = {}
 
         # disk-disk
@@ -247,6 +270,15 @@ class ReferenceDEM:
             contacts[(a, b)] = (float(fn[k]), float(fs[k]), bool(sl[k]))
         cfx = -fn * nx - fs * ny  # force on i
         cfy = -fn * ny + fs * nx
+        mr = np.zeros(len(i))
+        if rolls:
+            reff = r[i] * r[j] / (r[i] + r[j])
+            pairs = list(zip(i.tolist(), j.tolist(), strict=True))
+            mr_old = np.array([self.rolling.get(pair, 0.0) for pair in pairs])
+            mur = np.minimum(self.pmu_r[i], self.pmu_r[j])
+            mr = _rolling_moments(mr_old, ks * reff * reff, (omega[i] - omega[j]) * dt, mur * reff * fn)
+            for k, pair in enumerate(pairs):
+                new_rolling[pair] = float(mr[k])
 
         # disk-wall
         wi, ww, wdx, wdy, wd, wov = self._wall_pairs()
@@ -282,6 +314,13 @@ class ReferenceDEM:
             contacts[key] = (float(wfn[k]), float(wfs[k]), bool(wsl[k]))
         wcfx = -wfn * wnx - wfs * wny
         wcfy = -wfn * wny + wfs * wnx
+        wmr = np.zeros(len(wi))
+        if rolls:
+            wmr_old = np.array([self.rolling.get(key, 0.0) for key in keys])
+            wmur = np.minimum(self.pmu_r[wi], self.wmu_r[ww])
+            wmr = _rolling_moments(wmr_old, wks * r[wi] * r[wi], omega[wi] * dt, wmur * r[wi] * wfn)
+            for k, key in enumerate(keys):
+                new_rolling[key] = float(wmr[k])
 
         # unbalanced force and moment
         force = np.empty((n, 2))
@@ -298,14 +337,20 @@ class ReferenceDEM:
             part_of = np.searchsorted(bounds, np.arange(n), side="right") - 1
         cross = part_of[j] != part_of[i]
         mj = (r[j] - 0.5 * ov) * fs
+        mi = (r[i] - 0.5 * ov) * fs
+        mw = (r[wi] - 0.5 * wov) * wfs
+        if rolls:  # one term per contact and disk: shear moment and rolling moment together
+            mi = mi + mr
+            mj = mj - mr
+            mw = mw + wmr
         for sel in (~cross, None, cross):
             if sel is None:  # own rows, then walls
                 np.add.at(force[:, 0], i, cfx)
                 np.add.at(force[:, 1], i, cfy)
-                np.add.at(moment, i, (r[i] - 0.5 * ov) * fs)
+                np.add.at(moment, i, mi)
                 np.add.at(force[:, 0], wi, wcfx)
                 np.add.at(force[:, 1], wi, wcfy)
-                np.add.at(moment, wi, (r[wi] - 0.5 * wov) * wfs)
+                np.add.at(moment, wi, mw)
             else:
                 np.add.at(force[:, 0], j[sel], -cfx[sel])
                 np.add.at(force[:, 1], j[sel], -cfy[sel])
@@ -337,6 +382,7 @@ class ReferenceDEM:
 
         self.force, self.moment, self.wall_force = force, moment, wall_force
         self.history = new_hist
+        self.rolling = new_rolling
         self.contacts = contacts
 
     def run(self, steps: int) -> None:

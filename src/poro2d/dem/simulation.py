@@ -44,6 +44,10 @@ from poro2d.dem.state import (
 from poro2d.errors import InputError, is_number
 
 _THREADING_SET = False
+# With rolling resistance a contact's rolling spring kr = ks R^2 adds at most 2 ks / m to the
+# stiffness over inertial mass a disk feels through that contact (R <= its radius, I = m r^2 / 2),
+# beside the 3 ks / m of the shear spring: the bound of the time step grows by 5 / 3.
+ROLLING_STIFFNESS_FACTOR = 5.0 / 3.0
 WALL_PAD = 4  # rows of 4 doubles: 128 bytes between the wall sums of two partitions
 
 
@@ -258,7 +262,10 @@ class Simulation:
         self._inv_mass = np.ascontiguousarray(1.0 / m_in) if n else np.zeros(0)
         self._inv_inertia = np.ascontiguousarray(1.0 / i_in) if n else np.zeros(0)
         m_min = float(m_in.min()) if n else 1.0
-        self.dt_critical = critical_time_step(m_min, self.contact.stiffness_sum_bound(p, self.walls))
+        k_sum = self.contact.stiffness_sum_bound(p, self.walls)
+        if K.rolling_active(p.mu_r):
+            k_sum *= ROLLING_STIFFNESS_FACTOR
+        self.dt_critical = critical_time_step(m_min, k_sum)
         if self._fixed_dt is None:
             self.dt = self.dt_safety * self.dt_critical if math.isfinite(self.dt_critical) else 1e-4
         else:
@@ -325,11 +332,11 @@ class Simulation:
 
     # pair storage: (kept arrays with their dtype, scratch arrays for the rebuild)
     _PP = (("_nb_j", np.int64), ("_nb_fs", float), ("_nb_fn", float), ("_nb_ov", float),
-           ("_nb_nx", float), ("_nb_ny", float))  # fmt: skip
-    _PP_SCRATCH = (("_new_j", np.int64), ("_new_fs", float), ("_xpair", np.int64))
+           ("_nb_nx", float), ("_nb_ny", float), ("_nb_mr", float))  # fmt: skip
+    _PP_SCRATCH = (("_new_j", np.int64), ("_new_fs", float), ("_xpair", np.int64), ("_new_mr", float))
     _PW = (("_wb_w", np.int64), ("_wb_fs", float), ("_wb_fn", float), ("_wb_ov", float),
-           ("_wb_nx", float), ("_wb_ny", float))  # fmt: skip
-    _PW_SCRATCH = (("_wnew_w", np.int64), ("_wnew_fs", float))
+           ("_wb_nx", float), ("_wb_ny", float), ("_wb_mr", float))  # fmt: skip
+    _PW_SCRATCH = (("_wnew_w", np.int64), ("_wnew_fs", float), ("_wnew_mr", float))
 
     def _grow(self, kept, scratch, cap: int, keep: int) -> None:
         """(Re)allocate pair arrays with capacity ``cap``, copying the first ``keep`` slots."""
@@ -446,8 +453,9 @@ class Simulation:
         sort = _regroup(self._nb_start, first)
         self._nb_j[:m] = np.where(swap, a, b)[sort]
         sign = np.where(swap, -1.0, 1.0)
+        # the rolling moment is the one on the first disk: the other disk's is its opposite
         for name, flip in (("_nb_fs", False), ("_nb_fn", False), ("_nb_ov", False),
-                           ("_nb_nx", True), ("_nb_ny", True)):  # fmt: skip
+                           ("_nb_nx", True), ("_nb_ny", True), ("_nb_mr", True)):  # fmt: skip
             arr = getattr(self, name)
             arr[:m] = (arr[:m] * sign if flip else arr[:m])[sort]
 
@@ -455,7 +463,7 @@ class Simulation:
         """Disk-wall rows follow their disks."""
         m = int(self._wb_start[-1])
         sort = _regroup(self._wb_start, new_of_old[_row_of_slot(self._wb_start)])
-        for name in ("_wb_w", "_wb_fs", "_wb_fn", "_wb_ov", "_wb_nx", "_wb_ny"):
+        for name in ("_wb_w", "_wb_fs", "_wb_fn", "_wb_ov", "_wb_nx", "_wb_ny", "_wb_mr"):
             arr = getattr(self, name)
             arr[:m] = arr[:m][sort]
 
@@ -468,6 +476,33 @@ class Simulation:
             pp = self.contact.pp
             assert pp is not None
             self.contact = ContactModel("per_pair_type", (pp[0], pp[1], float(mu)), self.contact.pw)
+
+    def set_rolling_friction(self, mu_r: float, walls: float | None = None) -> None:
+        """Give every disk (and, with ``walls``, every wall) the rolling friction ``mu_r``.
+
+        A contact takes the smaller of its two bodies' values. The time step is chosen again
+        (rolling springs stiffen the packing, see ``ROLLING_STIFFNESS_FACTOR``); going to 0
+        everywhere ends every contact's rolling history.
+        """
+        for name, value in (("rolling friction", mu_r), ("wall rolling friction", walls)):
+            if value is not None and not (is_number(value) and 0.0 <= value < math.inf):
+                raise InputError(name, value, "[0, inf)")
+        self.particles.mu_r[:] = mu_r
+        if walls is not None:
+            self.walls.rolling_friction()[:] = walls
+        if not K.rolling_active(self.particles.mu_r):
+            self._nb_mr[:] = 0.0
+            self._wb_mr[:] = 0.0
+        self._refresh()
+
+    def rolling_moments(self) -> tuple[np.ndarray, np.ndarray]:
+        """The rolling moments of the touching contacts (N m): (disk-disk, disk-wall) in list order.
+
+        A disk-disk entry is the moment on the row's disk (its partner gets the opposite).
+        """
+        pp = self._nb_mr[: int(self._nb_start[-1])][self._nb_ov[: int(self._nb_start[-1])] > 0.0]
+        pw = self._wb_mr[: int(self._wb_start[-1])][self._wb_ov[: int(self._wb_start[-1])] > 0.0]
+        return pp.copy(), pw.copy()
 
     def set_wall_velocity(self, wall: str | int, velocity: tuple[float, float]) -> None:
         w = self.walls.index(wall)
@@ -779,6 +814,20 @@ class Simulation:
 
         return contact_set(self)
 
+    def _rolling_summary(self) -> dict:
+        """The rolling frictions, only when some disk has one (outputs without it stay as they were)."""
+        if not K.rolling_active(self.particles.mu_r):
+            return {}
+        p, w = self.particles, self.walls
+        return {
+            "rolling_friction": {
+                "disks": [float(p.mu_r.min()), float(p.mu_r.max())],
+                "walls": [float(v) for v in w.rolling_friction()],
+                "combination": "min",
+                "stiffness": "ks R^2",
+            }
+        }
+
     def summary(self) -> dict:
         """Settings that every output file should record."""
         return {
@@ -790,6 +839,7 @@ class Simulation:
             "gravity": list(self.gravity),
             "local_damping": self.local_damping,
             "restitution": self.restitution,
+            **self._rolling_summary(),
             "dt_s": self.dt,
             "dt_critical_s": self.dt_critical,
             "dt_mode": "fixed" if self._fixed_dt is not None else f"auto (safety {self.dt_safety})",

@@ -50,7 +50,7 @@ def _per_disk(name: str, a, n: int) -> np.ndarray:
 
 
 # the per-disk arrays of Particles (thickness is one number for all disks)
-PARTICLE_FIELDS = ("pos", "radius", "density", "kn", "ks", "mu", "vel", "theta", "omega", "mode")
+PARTICLE_FIELDS = ("pos", "radius", "density", "kn", "ks", "mu", "vel", "theta", "omega", "mode", "mu_r")
 
 
 @dataclass
@@ -59,7 +59,8 @@ class Particles:
 
     ``kn``, ``ks`` and ``mu`` are per-body values (PFC 4.0 convention); the
     contact model decides whether they are combined or replaced by contact-level
-    values.
+    values. ``mu_r`` is the rolling friction coefficient (0 by default: no rolling
+    resistance); a contact takes the smaller of its two bodies' values, as for ``mu``.
     """
 
     pos: np.ndarray
@@ -73,6 +74,7 @@ class Particles:
     theta: np.ndarray = field(default=None)  # type: ignore[assignment]
     omega: np.ndarray = field(default=None)  # type: ignore[assignment]
     mode: np.ndarray = field(default=None)  # type: ignore[assignment]
+    mu_r: np.ndarray = field(default=None)  # type: ignore[assignment]
 
     def __post_init__(self) -> None:
         self.pos = _as_f64("positions", self.pos)
@@ -108,6 +110,9 @@ class Particles:
                 raise InputError("mode", f"{mode.dtype.name} array of shape {mode.shape}",
                                  f"shape ({n},) of {FREE} (free) or {PRESCRIBED} (prescribed)")  # fmt: skip
             self.mode = np.ascontiguousarray(mode, dtype=np.int64)
+        self.mu_r = np.zeros(n) if self.mu_r is None else _per_disk("rolling friction", self.mu_r, n)
+        if n and self.mu_r.min() < 0.0:
+            raise InputError("rolling friction", float(self.mu_r.min()), "[0, inf)")
 
     @property
     def n(self) -> int:
@@ -131,7 +136,8 @@ class Walls:
     """Straight wall segments that are bodies: fixed, moving or servo-controlled.
 
     A wall pushes on any disk that overlaps the segment (either side, end caps
-    included). Its stiffness and friction are per-body values, as in PFC 4.0.
+    included). Its stiffness and frictions (sliding ``mu``, rolling ``mu_r``) are
+    per-body values, as in PFC 4.0.
     """
 
     p0: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
@@ -146,10 +152,20 @@ class Walls:
     servo_dir: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     servo: np.ndarray = field(default_factory=lambda: np.zeros((0, SERVO_COLUMNS)))
     names: list[str] = field(default_factory=list)
+    mu_r: np.ndarray = field(default_factory=lambda: np.zeros(0))  # rolling friction
 
     @property
     def n(self) -> int:
         return int(self.p0.shape[0])
+
+    def rolling_friction(self) -> np.ndarray:
+        """``mu_r`` with one entry per wall: walls set up field by field (an old checkpoint) get 0."""
+        if self.mu_r.shape != (self.n,):
+            mu_r = np.zeros(self.n)
+            k = min(self.n, self.mu_r.size)
+            mu_r[:k] = self.mu_r.reshape(-1)[:k]
+            self.mu_r = mu_r
+        return self.mu_r
 
     def add(
         self,
@@ -160,8 +176,9 @@ class Walls:
         mu: float,
         name: str | None = None,
         velocity=(0.0, 0.0),
+        mu_r: float = 0.0,
     ) -> int:
-        """Add a segment from ``p0`` to ``p1``; returns its index."""
+        """Add a segment from ``p0`` to ``p1``; returns its index. ``mu_r``: rolling friction."""
         a = _as_f64("wall p0", p0, None)
         b = _as_f64("wall p1", p1, None)
         name = name or f"wall{self.n}"
@@ -175,6 +192,8 @@ class Walls:
             raise InputError(f"wall {name} ks", ks, "[0, inf) N/m")
         if not mu >= 0.0:
             raise InputError(f"wall {name} friction", mu, "[0, inf)")
+        if not (is_number(mu_r) and 0.0 <= mu_r < np.inf):
+            raise InputError(f"wall {name} rolling friction", mu_r, "[0, inf)")
         if name in self.names:
             raise InputError("wall name", name, "a name not used by another wall")
         for i in range(self.n):
@@ -185,11 +204,13 @@ class Walls:
                     f"a segment that does not lie along wall {self.names[i]!r}",
                     "collinear overlapping walls would double the contact force",
                 )
+        mu_r_before = self.rolling_friction()  # one entry per wall present, before this one
         self.p0 = np.ascontiguousarray(np.vstack([self.p0, a]))
         self.p1 = np.ascontiguousarray(np.vstack([self.p1, b]))
         self.kn = np.append(self.kn, float(kn))
         self.ks = np.append(self.ks, float(ks))
         self.mu = np.append(self.mu, float(mu))
+        self.mu_r = np.append(mu_r_before, float(mu_r))
         self.vel = np.ascontiguousarray(np.vstack([self.vel, np.asarray(velocity, float)]))
         self.mode = np.append(self.mode, WALL_VELOCITY).astype(np.int64)
         self.servo_dir = np.ascontiguousarray(np.vstack([self.servo_dir, np.zeros(2)]))
@@ -208,7 +229,9 @@ class Walls:
             raise InputError("wall", name_or_index, f"one of {self.names}") from None
 
     @classmethod
-    def box(cls, x0: float, y0: float, x1: float, y1: float, kn: float, ks: float, mu: float) -> Walls:
+    def box(
+        cls, x0: float, y0: float, x1: float, y1: float, kn: float, ks: float, mu: float, mu_r: float = 0.0
+    ) -> Walls:
         """Four walls named bottom, right, top, left around [x0, x1] x [y0, y1].
 
         The side walls are extended past the top and bottom by the box size so a
@@ -218,10 +241,10 @@ class Walls:
             raise InputError("box", (x0, y0, x1, y1), "x1 > x0 and y1 > y0")
         w = cls()
         ext = max(x1 - x0, y1 - y0)
-        w.add((x0 - ext, y0), (x1 + ext, y0), kn, ks, mu, "bottom")
-        w.add((x1, y0 - ext), (x1, y1 + ext), kn, ks, mu, "right")
-        w.add((x1 + ext, y1), (x0 - ext, y1), kn, ks, mu, "top")
-        w.add((x0, y1 + ext), (x0, y0 - ext), kn, ks, mu, "left")
+        w.add((x0 - ext, y0), (x1 + ext, y0), kn, ks, mu, "bottom", mu_r=mu_r)
+        w.add((x1, y0 - ext), (x1, y1 + ext), kn, ks, mu, "right", mu_r=mu_r)
+        w.add((x1 + ext, y1), (x0 - ext, y1), kn, ks, mu, "top", mu_r=mu_r)
+        w.add((x0, y1 + ext), (x0, y0 - ext), kn, ks, mu, "left", mu_r=mu_r)
         return w
 
 

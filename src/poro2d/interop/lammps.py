@@ -13,6 +13,14 @@ Translation of poro2d's model into LAMMPS (``units si``, ``dimension 2``, GRANUL
 * walls: one ``fix wall/gran hooke/history`` per wall (``xplane``/``yplane``, the other
   side NULL), with the disk-wall contact properties; the plate is a plane fixed at its
   height. ``contacts`` makes each fix report the force on every disk it touches.
+* rolling resistance (disks with ``mu_r > 0``, ``granular`` law only): the sub-model
+  ``rolling sds k_roll 0 mu_roll``. LAMMPS accumulates a rolling displacement
+  ``R_eff (omega_i - omega_j) dt`` (``R_eff = r_i r_j / (r_i + r_j)``, a flat wall: ``r_i``),
+  pushes back with ``k_roll`` times it, capped at ``mu_roll Fn``, and applies the torque
+  ``R_eff`` times that force: a moment ``k_roll R_eff^2`` per unit of relative rotation up to
+  ``mu_roll R_eff Fn``. So ``k_roll = ks`` (the contact's shear stiffness) and
+  ``mu_roll = mu_r`` give poro2d's rolling spring ``kr = ks R^2`` capped at ``mu_r R Fn``;
+  no rolling dashpot (``gamma_roll = 0``), as in poro2d.
 * local damping: ``fix damping/cundall a a`` reduces each force and torque component by
   ``a |F| sign(v)``, PFC's local damping. It comes after ``fix gravity`` so the weight is
   part of the damped unbalanced force, as in PFC and poro2d, and ``fix store/force``
@@ -292,44 +300,50 @@ class WallFix:
     kt: float
     mu: float
     contacts: bool = True
+    mu_r: float = 0.0  # rolling friction of the disk-wall contacts
 
     def command(self, law: str = "granular") -> str:
         lo = "NULL" if self.lo is None else repr(float(self.lo))
         hi = "NULL" if self.hi is None else repr(float(self.hi))
-        model = contact_law(law, self.kn, self.kt, self.mu)
+        model = contact_law(law, self.kn, self.kt, self.mu, self.mu_r)
         tail = " contacts" if self.contacts else ""
         return f"fix             {self.fix_id} all wall/gran {model} {self.style} {lo} {hi}{tail}"
 
 
-def contact_law(law: str, kn: float, kt: float, mu: float) -> str:
+def contact_law(law: str, kn: float, kt: float, mu: float, mu_r: float = 0.0) -> str:
     """The arguments of a linear spring-slider contact for ``pair_coeff``/``fix wall/gran``.
 
     ``granular``: the sub-model syntax (``hooke kn 0 tangential linear_history kt 0 mu
     damping mass_velocity``), without viscous damping; its shear spring is rotated with
     the contact and keeps its length, as poro2d's shear force does. ``classic``: the
     older ``hooke/history`` form (a vector projected on the contact plane, not rescaled),
-    with a negligible normal dashpot.
+    with a negligible normal dashpot. ``mu_r > 0`` adds the rolling spring (``granular``
+    only; see the module's doc for the mapping).
     """
     if law == "granular":
+        rolling = f" rolling sds {float(kt)!r} 0 {float(mu_r)!r}" if mu_r > 0.0 else ""
         return (f"granular hooke {float(kn)!r} 0 tangential linear_history {float(kt)!r} 0 {float(mu)!r} "
-                "damping mass_velocity")  # fmt: skip
+                f"damping mass_velocity{rolling}")  # fmt: skip
+    if mu_r > 0.0:
+        raise InputError("LAMMPS contact law", law, "'granular' (the only one with rolling resistance)")
     return f"hooke/history {float(kn)!r} {float(kt)!r} {GAMMA_TINY!r} {GAMMA_TINY!r} {float(mu)!r} 0"
 
 
 def model_commands(
     data: str, pp: tuple[float, float, float], walls: list[WallFix], dt: float, skin: float,
     gravity: tuple[float, float], damping: float, processors: str | None = None, store_force: bool = False,
-    law: str = "granular",
+    law: str = "granular", pp_mu_r: float = 0.0,
 ) -> str:  # fmt: skip
     """The model part of a script: settings, disks, contact law, walls, gravity, damping, integration.
 
-    ``pp`` is the disk-disk (kn, kt, mu) at contact level; ``gravity`` the (gx, gy) vector.
+    ``pp`` is the disk-disk (kn, kt, mu) at contact level, ``pp_mu_r`` its rolling friction;
+    ``gravity`` the (gx, gy) vector.
     With ``store_force`` the undamped unbalanced force is kept in ``f_unbal``.
     """
     g = math.hypot(*gravity)
     gvec = (gravity[0] / g, gravity[1] / g) if g > 0 else (0.0, -1.0)
     if law == "granular":
-        pair_style, pair_coeff = "granular", contact_law(law, *pp).split(" ", 1)[1]
+        pair_style, pair_coeff = "granular", contact_law(law, *pp, pp_mu_r).split(" ", 1)[1]
     else:
         pair_style, pair_coeff = "gran/" + contact_law(law, *pp), ""
     s = [
@@ -370,6 +384,7 @@ def box_wall_fixes(spec: SpecimenData) -> list[WallFix]:
     """One plane per box wall, at its face, with that wall's disk-wall contact properties."""
     box = spec.box()
     params = spec.contact_parameters()
+    rolling = spec.rolling_parameters()
     faces = {"left": box[0], "right": box[1], "bottom": box[2], "top": box[3]}
     extra = [w.name for w in spec.walls if w.name not in BOX_WALLS]
     if extra:
@@ -379,7 +394,7 @@ def box_wall_fixes(spec: SpecimenData) -> list[WallFix]:
         style, side = _PLANES[name]
         lo, hi = (faces[name], None) if side == 0 else (None, faces[name])
         kn, kt, mu = params[name]
-        fixes.append(WallFix(f"w_{name}", style, lo, hi, kn, kt, mu))
+        fixes.append(WallFix(f"w_{name}", style, lo, hi, kn, kt, mu, mu_r=rolling[name]))
     return fixes
 
 
@@ -397,6 +412,7 @@ def input_script(
     model = model_commands(
         DATA_FILE, spec.contact_parameters()["pp"], box_wall_fixes(spec), spec.dt,
         0.5 * float(spec.radius.min()), spec.gravity, spec.local_damping, store_force=True,
+        pp_mu_r=spec.rolling_parameters()["pp"],
     )  # fmt: skip
     head = "\n".join(spec.header("#")) + "\n"
     head += f"""# written by poro2d export --to lammps; run: lmp -in {INPUT_FILE}
@@ -498,6 +514,9 @@ def write_specimen(spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e
         *([f"# poro2d window {spec.force_fraction!r}"] if spec.force_fraction is not None else []),
         f"# pair contact kn ks mu: {params['pp'][0]!r} {params['pp'][1]!r} {params['pp'][2]!r}",
     ]
+    if spec.rolling_parameters()["pp"] > 0.0:  # the disks', then each wall's, in wall-line order
+        values = [spec.rolling_parameters()["pp"], *(w.mu_r for w in spec.walls)]
+        notes.append("# poro2d rolling_friction " + " ".join(repr(float(v)) for v in values))
     paths = []
     with atomic_path(out / DATA_FILE) as tmp:
         write_data(

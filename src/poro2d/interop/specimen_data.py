@@ -40,6 +40,7 @@ class WallData:
     kn: float
     ks: float
     mu: float
+    mu_r: float = 0.0  # rolling friction
 
     @property
     def horizontal(self) -> bool:
@@ -68,6 +69,7 @@ class SpecimenData:
     dt: float | None = None
     contact: str = "per_body"
     source: str = ""
+    mu_r: np.ndarray | None = None  # rolling friction per disk; None: 0 for every disk
     #: the criterion's window the specimen was accepted with (F_top below this fraction of G)
     force_fraction: float | None = None
     #: where each value was read (set by the importers): ``locate(quantity, disk_index)``
@@ -130,6 +132,21 @@ class SpecimenData:
             out[w.name] = (series(kn, w.kn), series(ks, w.ks), min(mu, w.mu))
         return out
 
+    def rolling_parameters(self) -> dict:
+        """The contact-level rolling friction of disk-disk contacts (``pp``) and of each wall's.
+
+        The smaller of the two bodies' values, as for ``mu``; every disk alike, as in
+        :meth:`contact_parameters`.
+        """
+        mu_r = np.zeros(self.n) if self.mu_r is None else np.asarray(self.mu_r, dtype=float)
+        if self.n and np.ptp(mu_r) != 0.0:
+            raise InputError(
+                "disk rolling friction", f"from {mu_r.min():g} to {mu_r.max():g}",
+                "one value for every disk (the target takes one set of contact properties)",
+            )  # fmt: skip
+        disk = float(mu_r[0]) if self.n else 0.0
+        return {"pp": disk, **{w.name: min(disk, w.mu_r) for w in self.walls}}
+
     def header(self, comment: str) -> list[str]:
         """Lines that every exported file starts with: units, thickness convention, version."""
         lines = [
@@ -177,11 +194,11 @@ class SpecimenData:
         """A poro2d Simulation at this state: disks at rest, no contact history, walls fixed."""
         p = Particles(
             np.column_stack([self.x, self.y]), self.radius, self.density, self.thickness,
-            self.kn, self.ks, self.mu,
+            self.kn, self.ks, self.mu, mu_r=self.mu_r,
         )  # fmt: skip
         walls = Walls()
         for w in self.walls:
-            walls.add((w.x0, w.y0), (w.x1, w.y1), w.kn, w.ks, w.mu, w.name)
+            walls.add((w.x0, w.y0), (w.x1, w.y1), w.kn, w.ks, w.mu, w.name, mu_r=w.mu_r)
         return Simulation(
             p, walls, ContactModel("per_body"), gravity=self.gravity, local_damping=self.local_damping,
             dt=dt, threads=threads,
@@ -256,13 +273,16 @@ def from_simulation(sim: Simulation, source: str = "") -> SpecimenData:
             "contact convention", sim.contact.convention, "'per_body' (the properties travel with the bodies)"
         )
     p, w = sim.particles, sim.walls
+    wall_mu_r = w.rolling_friction()
     walls = [
-        WallData(w.names[k], *map(float, (*w.p0[k], *w.p1[k], w.kn[k], w.ks[k], w.mu[k]))) for k in range(w.n)
+        WallData(w.names[k], *map(float, (*w.p0[k], *w.p1[k], w.kn[k], w.ks[k], w.mu[k], wall_mu_r[k])))
+        for k in range(w.n)
     ]
     return SpecimenData(
         x=p.pos[:, 0].copy(), y=p.pos[:, 1].copy(), radius=p.radius.copy(), density=p.density.copy(),
         kn=p.kn.copy(), ks=p.ks.copy(), mu=p.mu.copy(), thickness=p.thickness, walls=walls,
         gravity=sim.gravity, local_damping=sim.local_damping, dt=sim.dt, source=source,
+        mu_r=p.mu_r.copy() if p.mu_r.any() else None,
     )  # fmt: skip
 
 
@@ -283,9 +303,11 @@ def from_checkpoint(path: str | os.PathLike) -> SpecimenData:
     pos = a["particles.pos"]
     names = list(meta["wall_names"])
     p0, p1 = a["walls.p0"], a["walls.p1"]
+    wall_mu_r = a.get("walls.mu_r", np.zeros(len(names)))  # stored only with rolling resistance
     walls = [
         WallData(
-            names[k], *map(float, (*p0[k], *p1[k], a["walls.kn"][k], a["walls.ks"][k], a["walls.mu"][k]))
+            names[k],
+            *map(float, (*p0[k], *p1[k], a["walls.kn"][k], a["walls.ks"][k], a["walls.mu"][k], wall_mu_r[k])),
         )
         for k in range(len(names))
     ]
@@ -295,6 +317,7 @@ def from_checkpoint(path: str | os.PathLike) -> SpecimenData:
         mu=a["particles.mu"].copy(), thickness=float(meta["thickness"]), walls=walls,
         gravity=tuple(float(g) for g in s["gravity"]), local_damping=float(s["local_damping"]),
         dt=float(s["dt"]), source=str(p), force_fraction=accepted_window(p),
+        mu_r=a["particles.mu_r"].copy() if "particles.mu_r" in a else None,
     )  # fmt: skip
 
 

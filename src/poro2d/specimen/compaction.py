@@ -57,7 +57,10 @@ WARN_SECONDS = 600.0
 
 
 #: settings recorded with results only when they differ from these defaults (see ``to_dict``)
-OMITTED_AT_DEFAULT = {"equilibrium": "max", "settle_drift": None, "settle_window": 10_000, "settle_checks": 3}
+OMITTED_AT_DEFAULT = {
+    "equilibrium": "max", "settle_drift": None, "settle_window": 10_000, "settle_checks": 3,
+    "rolling_friction": 0.0,
+}  # fmt: skip
 
 
 @dataclass
@@ -75,6 +78,9 @@ class SpecimenSpec:
     friction_prep: float = 0.05
     friction_particle: float = 3.0
     friction_wall: float = 1.5
+    # rolling resistance of the working material (docs/engine.md), set with friction_particle
+    # on disks and walls; 0: none, the paper's round disks
+    rolling_friction: float = 0.0
     layers: int = 4
     undercompaction: float = 0.0
     ratio: float = 1e-3
@@ -104,6 +110,7 @@ class SpecimenSpec:
             check_range(k, getattr(self, k), 0, None, lo_open=True)
         for k in ("ks_particle", "ks_wall", "friction_prep", "friction_particle", "friction_wall"):
             check_range(k, getattr(self, k), 0, None)
+        check_range("rolling_friction", self.rolling_friction, 0, None)
         check_int("layers", self.layers, 1, 50)
         check_range("undercompaction", self.undercompaction, 0.0, 0.5)
         check_range("ratio", self.ratio, 0.0, 1.0, lo_open=True)
@@ -413,6 +420,8 @@ def prepare_specimen(
     final = None
     if failed is None:
         sim.set_particle_friction(spec.friction_particle)
+        if spec.rolling_friction > 0.0:
+            sim.set_rolling_friction(spec.rolling_friction, walls=spec.rolling_friction)
         final = equilibrate(sim, spec, "working friction", progress)
         if not final["converged"]:
             failed = ("working friction", final)
