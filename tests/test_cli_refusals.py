@@ -125,7 +125,7 @@ CASES = [
     (["shear", "-s", "x.npz", "-c", "{d}/latin1.toml"], ["latin1.toml", "UTF-8"]),
     (["relation", "-c", "{d}/unknown.toml"], ["relation.n_maxx", "known keys"]),
     (["relation", "-c", "{d}/missing.toml"], ["missing.toml", "an existing TOML file"]),
-    (["sensitivity", "-c", "{d}"], ["an existing TOML file"]),
+    (["sensitivity", "-c", "{d}"], ["a regular file", "it is a folder"]),
     # laboratory files
     (["paper", "--lab", "{d}/lab_binary.csv"], ["lab_binary.csv", "line 1, column 1", "UTF-8"]),
     (["paper", "--lab", "{d}/lab_latin1.csv"], ["lab_latin1.csv", "line 3, column 5"]),
