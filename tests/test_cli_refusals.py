@@ -130,7 +130,7 @@ CASES = [
     (["paper", "--lab", "{d}/lab_binary.csv"], ["lab_binary.csv", "line 1, column 1", "UTF-8"]),
     (["paper", "--lab", "{d}/lab_latin1.csv"], ["lab_latin1.csv", "line 3, column 5"]),
     (["paper", "--lab", "{d}/lab_wide.csv"], ["lab_wide.csv", "line 3, column 3", "2 columns"]),
-    (["paper", "--lab", "{d}"], ["an existing CSV file"]),
+    (["paper", "--lab", "{d}"], ["a regular file", "it is a folder"]),
     # normal stresses: a physical range, no empty item
     (["shear", "-s", "x.npz", "--normal-stress", "1e9"], ["--normal-stress = '1e9'", "[1, 1000] kPa"]),
     (["shear", "-s", "x.npz", "--normal-stress", "1e-9"], ["--normal-stress", "1e-9 is out of range"]),
