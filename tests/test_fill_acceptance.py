@@ -100,7 +100,7 @@ def both():
 def test_the_lid_rests_on_the_grains_over_the_width(both):
     plate, fill = both
     assert fill["plate_moved"] == "lid" and fill["plate_settled"] and fill["converged"]
-    assert fill["lid_contact_share"] >= 0.9
+    assert fill["lid_contact_share"] >= 0.75
     # the flat plate touches a few disks; the lid leaves a gap of a fraction of a grain
     assert plate["surface_gap_mean_d50"] > 0.3
     assert fill["surface_gap_mean_d50"] < 0.7 * plate["surface_gap_mean_d50"]
