@@ -91,9 +91,15 @@ def print_result(result: dict, out: Path) -> None:
     console.print(t)
     console.print(f"{result['message']}; results in {out}/result.json")
     if result.get("interior_porosity") is not None:
+        under_lid = result["settings"].get("acceptance") == "fill"
+        what = (
+            "under the lid: the box the specimen fills"
+            if under_lid
+            else "the paper's, gap under the plate included"
+        )
         console.print(
-            f"accepted specimen: box porosity n' {result['box_porosity']:.4f} (the paper's, gap under the "
-            f"plate included), interior porosity {result['interior_porosity']:.4f} +- "
+            f"accepted specimen: box porosity n' {result['box_porosity']:.4f} ({what}), interior porosity "
+            f"{result['interior_porosity']:.4f} +- "
             f"{result['interior_porosity_std']:.4f} (the packing's own; docs/porosity.md)",
             soft_wrap=True,
         )
