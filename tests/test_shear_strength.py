@@ -99,3 +99,13 @@ def test_study_refuses_bad_grids(specimen, tmp_path):
         StrengthStudy({"a": specimen}, [0.0, 1.5], [0.5], [50], out=tmp_path)
     with pytest.raises(InputError, match="particle friction"):
         StrengthStudy({"a": specimen}, [0.0], [], [50], out=tmp_path)
+
+
+def test_cli_runs_a_tiny_study_and_records_its_grid(specimen, tmp_path, capsys):
+    out = tmp_path / "out"
+    main(["strength", "-s", str(specimen), "--mu-r", "0,0.2", "--friction", "0.5", "-n", "50",
+          "--max-displacement", "0.002", "-p", "1", "--out", str(out), "--quiet"])  # fmt: skip
+    result = json.loads((out / "strength.json").read_text())
+    assert [c["mu_r"] for c in result["cases"]] == [0.0, 0.2]
+    assert result["config"]["particle_friction"] == [0.5] and result["settings"]["stop_after_peak"] == 0.0
+    assert "phi residual" in capsys.readouterr().out
