@@ -80,8 +80,9 @@ def test_a_rerun_reads_the_tests_back(specimen, study):
         (["--quick", "--friction", "0.5,0.5"], ["--friction", "repeated"]),
         (["--quick", "--normal-stress", "50,-1"], ["--normal-stress"]),
         (["--quick", "--seeds", "0"], ["--seeds", "0"]),
-        (["--seeds", "2", "--specimen", "x.npz"], ["--seeds", "only with --quick"]),
-        ([], ["--specimen/--quick"]),
+        (["--seeds", "2", "x.npz"], ["--seeds", "only with --quick"]),
+        (["--quick", "x.npz"], ["SPECIMEN.../--quick"]),
+        ([], ["SPECIMEN.../--quick"]),
     ],
 )
 def test_cli_refuses_bad_input_before_any_work(tmp_path, capsys, args, words):
@@ -103,9 +104,28 @@ def test_study_refuses_bad_grids(specimen, tmp_path):
 
 def test_cli_runs_a_tiny_study_and_records_its_grid(specimen, tmp_path, capsys):
     out = tmp_path / "out"
-    main(["strength", "-s", str(specimen), "--mu-r", "0,0.2", "--friction", "0.5", "-n", "50",
+    main(["strength", str(specimen), "--mu-r", "0,0.2", "--friction", "0.5", "-n", "50",
           "--max-displacement", "0.002", "-p", "1", "--out", str(out), "--quiet"])  # fmt: skip
     result = json.loads((out / "strength.json").read_text())
     assert [c["mu_r"] for c in result["cases"]] == [0.0, 0.2]
     assert result["config"]["particle_friction"] == [0.5] and result["settings"]["stop_after_peak"] == 0.0
     assert "phi residual" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("extra", "words"),
+    [
+        (["{missing}"], ["specimen", "missing.npz"]),
+        (["--max-displacement", "0.05"], ["max_displacement", "0.05"]),
+    ],
+)
+def test_cli_refuses_a_bad_specimen_before_any_folder(specimen, tmp_path, capsys, extra, words):
+    out = tmp_path / "out"
+    args = [a.format(missing=tmp_path / "missing.npz") for a in extra]
+    with pytest.raises(SystemExit) as exc:
+        main(["strength", str(specimen), *args, "--mu-r", "0,0.2", "--friction", "0.5", "-n", "50",
+              "--out", str(out), "--quiet"])  # fmt: skip
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and all(w in err for w in words), err
+    assert not out.exists()

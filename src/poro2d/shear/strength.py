@@ -145,6 +145,21 @@ def case_summary(rep: ReplicateShear, summary: dict, mu_r: float, friction: floa
 
 
 # ---------------------------------------------------------------------- the study
+def check_specimens(specimens: dict, normal_stresses_kpa, settings: ShearSettings) -> None:
+    """Every specimen and stress as a test would take them, before any case binds a folder.
+
+    A case's series writes its tests' records as it is built, so a bad second specimen found
+    while building the cases would leave the first one's folders behind.
+    """
+    from poro2d.shear.single import DirectShearTest
+
+    if not specimens:
+        raise InputError("specimens", {}, "at least one specimen")
+    for path in specimens.values():
+        for sigma in normal_stresses_kpa:
+            DirectShearTest(path, sigma, settings)  # no folder: checks only
+
+
 class StrengthStudy:
     """Direct shear over the grid ``mu_r`` x ``friction`` on every specimen, in one process pool.
 
@@ -164,6 +179,7 @@ class StrengthStudy:
         self.friction = check_grid("particle friction", friction, MAX_FRICTION)
         base = settings if settings is not None else ShearSettings()
         self.settings = base
+        check_specimens(specimens, normal_stresses_kpa, base)
         self.out = Path(out)
         self.progress = progress
         self.config = config or {}

@@ -54,8 +54,8 @@ def quick_specimens(out: Path, seeds: int, progress: bool) -> dict[str, Path]:
 def register(app: typer.Typer) -> None:
     @app.command("strength")
     def strength_cmd(
-        specimen: list[str] = typer.Option(
-            None, "--specimen", "-s", help="Specimen (checkpoint or criterion folder); repeat for replicates."
+        specimen: list[str] = typer.Argument(
+            None, help="Replicate specimens (checkpoints or criterion folders), one per seed; or --quick."
         ),
         quick: bool = typer.Option(
             False, "--quick", help="The paper's quick specimen on --seeds seeds, a short grid (minutes)."
@@ -79,9 +79,11 @@ def register(app: typer.Typer) -> None:
         # everything is checked before the first specimen or test is made
         check_output_dir("--out", out)
         if bool(quick) == bool(specimen):
-            raise InputError("--specimen/--quick", specimen or None, "one of them: specimens, or --quick")
+            raise InputError(
+                "SPECIMEN.../--quick", specimen or None, "one of them: specimen paths, or --quick"
+            )
         if seeds is not None and not quick:
-            raise InputError("--seeds", seeds, "only with --quick (give one --specimen per replicate)")
+            raise InputError("--seeds", seeds, "only with --quick (give one specimen path per replicate)")
         n_seeds = check_int("--seeds", seeds, 1, 20) if seeds is not None else st.QUICK_SEEDS
         mu_values = parse_values(mu_r, "--mu-r", MAX_ROLLING_FRICTION) if mu_r else list(st.QUICK_MU_R)
         fp_values = (
