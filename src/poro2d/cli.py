@@ -54,12 +54,14 @@ def _register() -> None:
     from poro2d.criterion import cli as criterion_cli
     from poro2d.interop import cli as interop_cli
     from poro2d.shear import cli as shear_cli
+    from poro2d.shear import strength_cli
     from poro2d.sweep import cli as sweep_cli
     from poro2d.sweep import sensitivity_cli
 
     porosity_cli.register(app)
     criterion_cli.register(app)
     shear_cli.register(app)
+    strength_cli.register(app)
     paper.register(app)
     sweep_cli.register(app)
     interop_cli.register(app)
@@ -76,6 +78,7 @@ KEPT = {
     "sweep": "finished cases",
     "relation": "finished cases",
     "sensitivity": "finished cases",
+    "strength": "finished specimens and tests",
 }
 
 

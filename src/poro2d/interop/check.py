@@ -96,16 +96,24 @@ def box_spec(spec: SpecimenData, ratio: float) -> SpecimenSpec:
 
 
 def build_simulation(spec: SpecimenData, box: SpecimenSpec, threads: int = 1) -> Simulation:
-    """The disks at rest, no contact history, in the paper's box moved to the origin."""
+    """The disks at rest, no contact history, in the paper's box moved to the origin.
+
+    The disks keep their rolling friction, the box's walls that of the specimen's walls of
+    the same name (0 for a wall the specimen does not have).
+    """
     xlo, _, ylo, _ = spec.box()
 
     def simulation(dt: float | None) -> Simulation:
         p = Particles(
             np.column_stack([spec.x - xlo, spec.y - ylo]), spec.radius, spec.density, spec.thickness,
-            spec.kn, spec.ks, spec.mu,
+            spec.kn, spec.ks, spec.mu, mu_r=spec.mu_r,
         )  # fmt: skip
+        walls = make_walls(box, box.height)
+        # the box's walls keep the rolling friction of the specimen's walls of the same name
+        wall_mu_r = {w.name: w.mu_r for w in spec.walls}
+        walls.rolling_friction()[:] = [wall_mu_r.get(name, 0.0) for name in walls.names]
         return Simulation(
-            p, make_walls(box, box.height), ContactModel("per_body"), gravity=(0.0, -box.gravity),
+            p, walls, ContactModel("per_body"), gravity=(0.0, -box.gravity),
             local_damping=box.local_damping, dt=dt, threads=threads,
         )  # fmt: skip
 

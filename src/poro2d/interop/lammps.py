@@ -568,6 +568,7 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
         gravity = (gx, gy)
     window = _note(notes, "window", 1, path, d.note_lines)[0] if "window" in keys else None
     walls = [WallData(name, *v) for name, v in _wall_notes(notes, path, d.note_lines)]
+    mu_r = _rolling_note(notes, walls, path, d.note_lines) if "rolling_friction" in keys else None
     if not walls:
         xlo, xhi, ylo, yhi = d.box
         kw = tuple(float(defaults[k]) for k in ("wall_kn", "wall_ks", "wall_mu"))
@@ -576,8 +577,22 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
         x=d.x, y=d.y, radius=d.radius, density=density, kn=np.full(n, kn), ks=np.full(n, ks),
         mu=np.full(n, mu), thickness=t, walls=walls, gravity=gravity, local_damping=damping,
         dt=dt if dt else None, source=str(path), force_fraction=window,
+        mu_r=None if mu_r is None else np.full(n, mu_r),
         locate=_locator(Path(path), d, keys, from_masses=rho is None),
     )  # fmt: skip
+
+
+def _rolling_note(notes: list, walls: list[WallData], path, lines: dict | None) -> float:
+    """The disks' rolling friction from ``# poro2d rolling_friction DISKS WALL...``; each wall
+    (in the order of the wall lines) takes its own value here."""
+    values = _note(notes, "rolling_friction", 1 + len(walls), path, lines)
+    for column, v in enumerate(values, start=4):
+        if v < 0.0:
+            line = f" line {lines['rolling_friction']}" if lines and "rolling_friction" in lines else ""
+            raise InputError(f"{path}{line} '# poro2d rolling_friction' column {column}", v, "[0, inf)")
+    for wall, v in zip(walls, values[1:], strict=True):
+        wall.mu_r = v
+    return values[0]
 
 
 #: where each value sits: an Atoms column, or a ``# poro2d`` note and its word

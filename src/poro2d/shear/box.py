@@ -151,11 +151,15 @@ def build_split_box(
     density_scale: float = 1.0,
     dt_safety: float = 0.8,
     threads: int = 1,
+    rolling_friction: float | None = None,
 ) -> tuple[Simulation, SplitBox]:
     """A new simulation of the specimen's disks in a split box (all walls at rest).
 
     The disks keep their positions, velocities and properties (``particle_friction``
-    replaces their friction when given); the engine settings (contact convention,
+    replaces their friction when given, ``rolling_friction`` their rolling friction mu_r);
+    the box walls take the disks' largest mu_r, so that under the engine's rule (a contact
+    takes the smaller of its two bodies' values) a disk meets a wall with its own mu_r, as
+    it meets another disk of its kind. The engine settings (contact convention,
     gravity, damping) are the specimen's. Disk-disk shear histories are not carried
     over: the consolidation that follows brings the specimen to a new equilibrium.
     The disks are numbered anew (:func:`poro2d.dem.ordering.strip_order`).
@@ -169,6 +173,8 @@ def build_split_box(
     check_range("friction_wall", friction_wall, 0.0, None)
     if particle_friction is not None:
         check_range("particle_friction", particle_friction, 0.0, None)
+    if rolling_friction is not None:
+        check_range("rolling_friction", rolling_friction, 0.0, None)
     p0 = specimen.particles
     if p0.n == 0:
         raise InputError("specimen", "no disks", "a specimen with disks")
@@ -179,21 +185,23 @@ def build_split_box(
     dmax = 2.0 * float(p0.radius.max())
     e = max(W, H)
     lip = max_displacement + dmax
+    mu_r = p0.mu_r.copy() if rolling_friction is None else np.full(p0.n, float(rolling_friction))
+    wall_mu_r = float(mu_r.max())
     walls = Walls()
     k = (kn_wall, ks_wall, friction_wall)
-    walls.add((-e, 0.0), (W + max_displacement + e, 0.0), *k, name="bottom")
-    walls.add((0.0, -e), (0.0, ys), *k, name="lower_left")
-    walls.add((W, -e), (W, ys), *k, name="lower_right")
-    walls.add((-lip, ys), (0.0, ys), *k, name="lower_lip")
-    walls.add((0.0, ys + gap), (0.0, H + e), *k, name="upper_left")
-    walls.add((W, ys + gap), (W, H + e), *k, name="upper_right")
-    walls.add((W, ys + gap), (W + lip, ys + gap), *k, name="upper_lip")
-    walls.add((W + e, H), (-e, H), *k, name="top")
+    walls.add((-e, 0.0), (W + max_displacement + e, 0.0), *k, name="bottom", mu_r=wall_mu_r)
+    walls.add((0.0, -e), (0.0, ys), *k, name="lower_left", mu_r=wall_mu_r)
+    walls.add((W, -e), (W, ys), *k, name="lower_right", mu_r=wall_mu_r)
+    walls.add((-lip, ys), (0.0, ys), *k, name="lower_lip", mu_r=wall_mu_r)
+    walls.add((0.0, ys + gap), (0.0, H + e), *k, name="upper_left", mu_r=wall_mu_r)
+    walls.add((W, ys + gap), (W, H + e), *k, name="upper_right", mu_r=wall_mu_r)
+    walls.add((W, ys + gap), (W + lip, ys + gap), *k, name="upper_lip", mu_r=wall_mu_r)
+    walls.add((W + e, H), (-e, H), *k, name="top", mu_r=wall_mu_r)
     particles = Particles(
         pos=p0.pos.copy(), radius=p0.radius.copy(), density=p0.density.copy(), thickness=p0.thickness,
         kn=p0.kn.copy(), ks=p0.ks.copy(),
         mu=p0.mu.copy() if particle_friction is None else np.full(p0.n, float(particle_friction)),
-        vel=p0.vel.copy(), theta=p0.theta.copy(), omega=p0.omega.copy(), mode=p0.mode.copy(),
+        vel=p0.vel.copy(), theta=p0.theta.copy(), omega=p0.omega.copy(), mode=p0.mode.copy(), mu_r=mu_r,
     )  # fmt: skip
     contact = specimen.contact
     if particle_friction is not None and contact.convention == "per_pair_type":

@@ -87,6 +87,14 @@ def register(app: typer.Typer) -> None:
         stop_after_peak: float = typer.Option(
             None, "--stop-after-peak", help="End once the smoothed peak lies this far behind (m; 0: never)."
         ),
+        particle_friction: float = typer.Option(
+            None, "--particle-friction", help="Disk friction for the tests (default: the specimen's)."
+        ),
+        rolling_friction: float = typer.Option(
+            None,
+            "--rolling-friction",
+            help="Disk rolling friction mu_r for the tests (default: the specimen's).",
+        ),
         rate_check: bool = typer.Option(
             False, "--rate-check", help="Repeat every test at half the velocity."
         ),
@@ -101,6 +109,7 @@ def register(app: typer.Typer) -> None:
         from poro2d.shear.run import run_shear
 
         check_output_dir("--out", out)
+        check_friction_options(particle_friction, rolling_friction)
         table, base = load_shear_config(config)
         extra = {k: table.pop(k) for k in list(table) if k in SHEAR_KEYS_EXTRA}
         check_extra_types(extra)
@@ -108,13 +117,22 @@ def register(app: typer.Typer) -> None:
             "velocity": velocity,
             "max_displacement": max_displacement,
             "stop_after_peak": stop_after_peak,
+            "particle_friction": particle_friction,
+            "rolling_friction": rolling_friction,
         }
         recorded = {"shear": table, **extra, "cli": options}
         try:
             result = run_shear(
                 resolve_path("--specimen", specimen, extra.get("specimen"), base, required=True),
                 resolve_stresses(normal_stress, extra),
-                settings_from_options(table, velocity, max_displacement, stop_after_peak),
+                settings_from_options(
+                    table,
+                    velocity,
+                    max_displacement,
+                    stop_after_peak,
+                    particle_friction=particle_friction,
+                    rolling_friction=rolling_friction,
+                ),  # fmt: skip
                 out=out,
                 lab=resolve_path("--lab", lab, extra.get("lab"), base),
                 rate_check=rate_check or bool(extra.get("rate_check", False)),
@@ -152,17 +170,34 @@ def resolve_stresses(option_text: str | None, extra: dict) -> list[float]:
     return [50.0, 100.0, 200.0]
 
 
+def check_friction_options(particle_friction: float | None, rolling_friction: float | None) -> None:
+    """--particle-friction and --rolling-friction in the ranges ShearSettings takes, named as typed."""
+    from poro2d.errors import check_range
+    from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION
+
+    if particle_friction is not None:
+        check_range("--particle-friction", particle_friction, 0.0, MAX_FRICTION)
+    if rolling_friction is not None:
+        check_range("--rolling-friction", rolling_friction, 0.0, MAX_ROLLING_FRICTION)
+
+
 def settings_from_options(
-    table: dict, velocity: float | None, max_displacement: float | None, stop_after_peak: float | None = None
+    table: dict,
+    velocity: float | None,
+    max_displacement: float | None,
+    stop_after_peak: float | None = None,
+    particle_friction: float | None = None,
+    rolling_friction: float | None = None,
 ):
-    """ShearSettings from the config's [shear] table, --velocity, --max-displacement and
-    --stop-after-peak winning."""
+    """ShearSettings from the config's [shear] table, the command line's options winning
+    (--velocity, --max-displacement, --stop-after-peak, --particle-friction, --rolling-friction)."""
     from poro2d.config import dataclass_from_table
     from poro2d.shear.settings import ShearSettings
 
     return dataclass_from_table(
         ShearSettings, "shear", table, velocity=velocity, max_displacement=max_displacement,
-        stop_after_peak=stop_after_peak,
+        stop_after_peak=stop_after_peak, particle_friction=particle_friction,
+        rolling_friction=rolling_friction,
     )  # fmt: skip
 
 

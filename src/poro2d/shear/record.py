@@ -18,9 +18,16 @@ from poro2d.resumable import Fingerprint, ResumableStage
 RECORD = "test.json"
 
 
+#: settings added after tests were first recorded, left out of the record while they hold their
+#: default (None: the specimen's own value, which the specimen's digest already covers), so
+#: a folder written before they existed still resumes as the same test
+LATER_SETTINGS = ("rolling_friction",)
+
+
 def content_record(specimen_digest: str, sigma_kpa: float, settings: dict) -> dict:
     """What a stored test must share with this one to be reused: content, never paths."""
-    return {"specimen_digest": specimen_digest, "normal_stress_kpa": sigma_kpa, "settings": settings}
+    kept = {k: v for k, v in settings.items() if not (k in LATER_SETTINGS and v is None)}
+    return {"specimen_digest": specimen_digest, "normal_stress_kpa": sigma_kpa, "settings": kept}
 
 
 def stale_reason(keys: list[str] | None, old: Mapping | None) -> str:

@@ -100,8 +100,8 @@ class ReplicateShear:
     """
 
     def __init__(self, specimens: dict[str, str | Path], normal_stresses_kpa, settings=None, *,
-                 out: str | Path = "shear-out", lab=None, processes: int | None = None,
-                 progress: bool = True, config: dict | None = None) -> None:  # fmt: skip
+                 out: str | Path = "shear-out", lab=None, processes: int | None = None, progress: bool = True,
+                 config: dict | None = None, figures: bool = True) -> None:  # fmt: skip
         import os
 
         from poro2d.shear.series import ShearSeries
@@ -111,6 +111,7 @@ class ReplicateShear:
         self.out = Path(out)
         self.progress = progress
         self.config = config or {}
+        self.figures = figures
         self.series = {
             label: ShearSeries(
                 path,
@@ -121,19 +122,26 @@ class ReplicateShear:
                 progress=False,
                 processes=1,
                 config=self.config,
+                figures=figures,
             )  # fmt: skip
             for label, path in specimens.items()
         }
         njobs = sum(len(s.jobs) for s in self.series.values())
         self.processes = processes if processes is not None else min(njobs, 2 * (os.cpu_count() or 1))
 
+    def jobs(self) -> list[dict]:
+        """Every specimen's tests as pool jobs, keyed ``(label, *key)`` (a caller may pool several)."""
+        return [dict(j, key=(label, *j["key"]), series=label)
+                for label, s in self.series.items() for j in s.jobs]  # fmt: skip
+
     def run(self) -> dict:
         from poro2d.shear.pool import execute_jobs
 
         t0 = time.perf_counter()
-        jobs = [dict(j, key=(label, *j["key"]), series=label)
-                for label, s in self.series.items() for j in s.jobs]  # fmt: skip
-        results = execute_jobs(jobs, self.processes, self.progress)
+        return self.finish(execute_jobs(self.jobs(), self.processes, self.progress), t0)
+
+    def finish(self, results: dict, t0: float) -> dict:
+        """Each specimen's fit and files, then the summary, from the results keyed as by :meth:`jobs`."""
         per = {
             label: s.finish({k[1:]: v for k, v in results.items() if k[0] == label}, t0)
             for label, s in self.series.items()
@@ -144,7 +152,8 @@ class ReplicateShear:
         write_csv(self.out / "replicates.csv", [{k: v for k, v in r.items() if k != "peaks_kpa"}
                                                  for r in summary["per_normal_stress"]])  # fmt: skip
         write_json(self.out / "replicates.json", summary)
-        self._figures(summary)
+        if self.figures:
+            self._figures(summary)
         summary["series"] = per
         return summary
 

@@ -25,6 +25,10 @@ MAX_CONSOLIDATION_STEPS = 10_000_000
 MAX_WALL_STIFFNESS = 1e10
 #: friction coefficients beyond 10 hold as a rough wall does; larger ones are typos
 MAX_FRICTION = 10.0
+#: rolling frictions beyond 1 hold a disk against any tilt it meets in a shear band (a disk
+#: rolls when the moment arm of its contact force exceeds mu_r R: at 1 the force would have to
+#: lean past 45 degrees); larger ones are typos
+MAX_ROLLING_FRICTION = 1.0
 #: inertial masses up to 1000 times the real ones: the inertial number grows with its root
 MAX_DENSITY_SCALE = 1000.0
 
@@ -41,6 +45,8 @@ class ShearSettings:
     (per step; it keeps the stress on target while the specimen dilates) and
     servo_max_speed (m/s) of the top plate; kn_wall, ks_wall (N/m), friction_wall and
     gap (m) of the box; particle_friction replaces the specimen's when given;
+    rolling_friction likewise replaces every disk's rolling friction mu_r (None: the
+    specimen's own), and the box walls take the disks' largest mu_r;
     local_damping likewise (None: the specimen's); density_scale >= 1 scales the
     inertial masses; dt_safety the automatic time step; peak_window (m) the
     smoothing of the peak; shear_zone_factor k in gamma_dot = v / (k d_mean);
@@ -62,6 +68,7 @@ class ShearSettings:
     friction_wall: float = 1.5
     gap: float = 0.0
     particle_friction: float | None = None
+    rolling_friction: float | None = None
     local_damping: float | None = None
     density_scale: float = 1.0
     dt_safety: float = 0.8
@@ -91,6 +98,8 @@ class ShearSettings:
         check_range("gap", self.gap, 0.0, None)
         if self.particle_friction is not None:
             check_range("particle_friction", self.particle_friction, 0.0, MAX_FRICTION)
+        if self.rolling_friction is not None:
+            check_range("rolling_friction", self.rolling_friction, 0.0, MAX_ROLLING_FRICTION)
         if self.local_damping is not None:
             check_range("local_damping", self.local_damping, 0.0, 1.0, hi_open=True)
         check_range("density_scale", self.density_scale, 1.0, MAX_DENSITY_SCALE)
@@ -129,4 +138,4 @@ def inertial_number(velocity: float, sigma_pa: float, rho_inertial: float, shear
     return velocity / shear_zone_factor * math.sqrt(rho_inertial / sigma_pa)
 
 
-__all__ = ["NORMAL_STRESS_RANGE_KPA", "ShearSettings", "inertial_number"]
+__all__ = ["MAX_ROLLING_FRICTION", "NORMAL_STRESS_RANGE_KPA", "ShearSettings", "inertial_number"]

@@ -1,0 +1,249 @@
+"""How strength depends on the micro-parameters: direct shear over a grid of (mu_r, f_p), over seeds.
+
+Every case (a rolling friction mu_r and a particle friction f_p) runs the same direct shear
+tests on every replicate specimen (:class:`poro2d.shear.replicates.ReplicateShear`), and all
+tests of all cases share one process pool. Each test's folder is bound to its specimen,
+normal stress and settings (``test.json``): a rerun reads finished tests back and resumes a
+killed one, and a folder of other settings is refused. Per case the study reports:
+
+* peak friction angle: the Mohr-Coulomb line (with cohesion) through each specimen's peaks,
+  mean and sd over the specimens, and the pooled fit over all peaks with its interval;
+* residual friction angle: per test the mean shear stress over the mean measured normal stress
+  over the last ``RESIDUAL_FRACTION`` of the shear displacement, and per specimen the line
+  through the origin fitted to those (sigma, tau) points;
+* dilation: per test the largest mean slope of the plate rise over a ``peak_window`` of
+  shear displacement, as an angle psi_max = atan(max d(dy) / d(dx)).
+
+The tests run to the full displacement (``stop_after_peak = 0``) so every curve has the same
+residual window. docs/shear.md ("Strength against mu_r and f_p") has the measured numbers.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from poro2d.errors import InputError, check_range
+from poro2d.io_utils import provenance, write_csv, write_json
+from poro2d.shear.fit import mohr_coulomb
+from poro2d.shear.outputs import folder_name, read_curve_csv
+from poro2d.shear.replicates import ReplicateShear, mohr_coulomb_ci
+from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
+
+#: the part of each test's shear displacement, at its end, that the residual strength averages
+RESIDUAL_FRACTION = 0.2
+#: the quick study: the paper's quick specimen sheared over a fifth of its 80 mm width (16 mm, about
+#: 4.6 d50): over 8 mm the curves with rolling resistance were still rising at the end (docs/shear.md)
+QUICK_STRENGTH_SHEAR = {"max_displacement": 0.016, "stop_after_peak": 0.0}
+QUICK_MU_R = (0.0, 0.1, 0.2, 0.4)
+QUICK_FRICTION = (0.5, 3.0)
+QUICK_NORMAL_STRESSES = (50.0, 100.0, 200.0)
+QUICK_SEEDS = 3
+
+
+def case_label(mu_r: float, friction: float) -> str:
+    """The folder of a case: ``mur0.1_fp3``."""
+    return f"mur{mu_r:g}_fp{friction:g}"
+
+
+def check_grid(name: str, values, hi: float) -> list[float]:
+    """Different values in [0, hi], sorted; at least one."""
+    out = [check_range(name, v, 0.0, hi) for v in values]
+    if not out:
+        raise InputError(name, [], "at least one value")
+    if len(set(out)) != len(out):
+        raise InputError(name, out, "different values")
+    return sorted(out)
+
+
+# ---------------------------------------------------------------------- per test
+def residual_point(curve: dict[str, np.ndarray]) -> tuple[float, float]:
+    """(mean normal stress, mean shear stress) in kPa over the last RESIDUAL_FRACTION of the curve."""
+    x = curve["shear_displacement_mm"]
+    tail = x >= (1.0 - RESIDUAL_FRACTION) * x[-1]
+    return float(curve["normal_stress_kpa"][tail].mean()), float(curve["shear_stress_kpa"][tail].mean())
+
+
+def max_dilation_angle(curve: dict[str, np.ndarray], window_m: float) -> float:
+    """atan of the largest mean slope of the plate rise over ``window_m`` of shear displacement (deg).
+
+    The slope is the secant (dy(x + w/2) - dy(x - w/2)) / w, for every recorded x at least half
+    a window from the ends: the plate's record is a jittery servo signal whose step-to-step
+    slope is noise, and a moving average of a curve sampled at a fixed interval does not cure
+    it (the window holds one sample more or less from row to row).
+    """
+    x = curve["shear_displacement_mm"] * 1e-3
+    dy = curve["plate_displacement_mm"] * 1e-3
+    centre = x[(x >= x[0] + 0.5 * window_m) & (x <= x[-1] - 0.5 * window_m)]
+    if centre.size == 0:  # a curve shorter than the window: its overall slope
+        return math.degrees(math.atan(float((dy[-1] - dy[0]) / (x[-1] - x[0]))))
+    rise = np.interp(centre + 0.5 * window_m, x, dy) - np.interp(centre - 0.5 * window_m, x, dy)
+    return math.degrees(math.atan(float(rise.max() / window_m)))
+
+
+def _curve(path: Path) -> dict[str, np.ndarray]:
+    rows = read_curve_csv(path)
+    return {k: np.array([r[k] for r in rows]) for k in rows[0]}
+
+
+# ---------------------------------------------------------------------- per case
+def _mean_sd(values: list[float]) -> tuple[float, float | None]:
+    v = np.asarray(values, float)
+    return float(v.mean()), (float(v.std(ddof=1)) if v.size > 1 else None)
+
+
+def case_summary(rep: ReplicateShear, summary: dict, mu_r: float, friction: float, window_m: float) -> tuple:
+    """One case's row (means and spreads over the specimens) and its per-test rows."""
+    tests = []
+    per_specimen = []
+    for label, series in rep.series.items():
+        res = summary["series"][label]
+        res_pts = []
+        psis = []
+        for t in res["tests"]:
+            sigma = t["normal_stress_kpa"]
+            curve = _curve(series.out / folder_name(sigma) / "curve.csv")
+            s_res, tau_res = residual_point(curve)
+            psi = max_dilation_angle(curve, window_m)
+            res_pts.append((s_res, tau_res))
+            psis.append(psi)
+            tests.append({
+                "mu_r": mu_r, "particle_friction": friction, "specimen": label, "normal_stress_kpa": sigma,
+                "peak_shear_stress_kpa": t["peak_shear_stress_kpa"],
+                "peak_stress_ratio": t["peak_stress_ratio"],
+                "residual_normal_stress_kpa": s_res, "residual_shear_stress_kpa": tau_res,
+                "residual_stress_ratio": tau_res / s_res, "max_dilation_angle_deg": psi,
+                "end_shear_displacement_m": t["end_shear_displacement_m"],
+            })  # fmt: skip
+        s, tau = np.array(res_pts).T
+        per_specimen.append({
+            "peak": res["friction_angle_deg"],
+            "residual": mohr_coulomb(s, tau, through_origin=True).friction_angle_deg,
+            "dilation": float(np.mean(psis)),
+        })  # fmt: skip
+    row = {"mu_r": mu_r, "particle_friction": friction, "specimens": len(per_specimen)}
+    for key in ("peak", "residual", "dilation"):
+        name = "max_dilation_angle" if key == "dilation" else f"{key}_friction_angle"
+        values = [p[key] for p in per_specimen if p[key] is not None]
+        row[f"{name}_mean_deg"], row[f"{name}_sd_deg"] = _mean_sd(values) if values else (None, None)
+    pooled = summary["fit"] or {}
+    row["peak_friction_angle_pooled_deg"] = pooled.get("friction_angle_deg")
+    row["peak_friction_angle_pooled_ci_deg"] = pooled.get("friction_angle_ci_deg")
+    row["cohesion_pooled_kpa"] = pooled.get("cohesion_kpa")
+    res_fit = mohr_coulomb_ci(
+        [r["residual_normal_stress_kpa"] for r in tests], [r["residual_shear_stress_kpa"] for r in tests],
+        through_origin=True,
+    )  # fmt: skip
+    row["residual_friction_angle_pooled_deg"] = res_fit["friction_angle_deg"]
+    row["residual_friction_angle_pooled_ci_deg"] = res_fit["friction_angle_ci_deg"]
+    row["residual_stress_ratio_mean"] = float(np.mean([r["residual_stress_ratio"] for r in tests]))
+    return row, tests
+
+
+# ---------------------------------------------------------------------- the study
+def check_specimens(specimens: dict, normal_stresses_kpa, settings: ShearSettings) -> None:
+    """Every specimen and stress as a test would take them, before any case binds a folder.
+
+    A case's series writes its tests' records as it is built, so a bad second specimen found
+    while building the cases would leave the first one's folders behind.
+    """
+    from poro2d.shear.single import DirectShearTest
+
+    if not specimens:
+        raise InputError("specimens", {}, "at least one specimen")
+    for path in specimens.values():
+        for sigma in normal_stresses_kpa:
+            DirectShearTest(path, sigma, settings)  # no folder: checks only
+
+
+class StrengthStudy:
+    """Direct shear over the grid ``mu_r`` x ``friction`` on every specimen, in one process pool.
+
+    ``specimens``: label -> specimen (checkpoint or criterion folder); ``settings``: the shear
+    settings every case starts from (its ``particle_friction`` and ``rolling_friction`` are
+    the case's). Writes ``out/<case>/`` (a :class:`ReplicateShear` each), ``strength.csv``
+    (one row per case), ``strength_tests.csv`` (one per test), ``strength.json`` and
+    ``fig_strength.png``.
+    """
+
+    def __init__(self, specimens: dict[str, str | Path], mu_r, friction, normal_stresses_kpa,
+                 settings: ShearSettings | None = None, *, out: str | Path, processes: int | None = None,
+                 progress: bool = True, config: dict | None = None) -> None:  # fmt: skip
+        import os
+
+        self.mu_r = check_grid("mu_r", mu_r, MAX_ROLLING_FRICTION)
+        self.friction = check_grid("particle friction", friction, MAX_FRICTION)
+        base = settings if settings is not None else ShearSettings()
+        self.settings = base
+        check_specimens(specimens, normal_stresses_kpa, base)
+        self.out = Path(out)
+        self.progress = progress
+        self.config = config or {}
+        self.cases = {
+            (m, f): ReplicateShear(
+                specimens,
+                normal_stresses_kpa,
+                replace(base, rolling_friction=m, particle_friction=f),
+                out=self.out / case_label(m, f),
+                progress=False,
+                config=self.config,
+                figures=False,
+            )  # fmt: skip
+            for m in self.mu_r
+            for f in self.friction
+        }
+        njobs = sum(len(rep.jobs()) for rep in self.cases.values())
+        self.processes = processes if processes is not None else min(njobs, 2 * (os.cpu_count() or 1))
+
+    def run(self) -> dict:
+        from poro2d.shear.pool import execute_jobs
+
+        t0 = time.perf_counter()
+        jobs = [dict(j, key=(case, *j["key"]), series=f"{case_label(*case)} {j['series']}")
+                for case, rep in self.cases.items() for j in rep.jobs()]  # fmt: skip
+        results = execute_jobs(jobs, self.processes, self.progress)
+        rows, tests = [], []
+        for case, rep in self.cases.items():
+            summary = rep.finish({k[1:]: v for k, v in results.items() if k[0] == case}, t0)
+            row, case_tests = case_summary(rep, summary, *case, self.settings.peak_window)
+            rows.append(row)
+            tests += case_tests
+        result = {
+            "cases": rows,
+            "mu_r": self.mu_r,
+            "particle_friction": self.friction,
+            "specimens": list(next(iter(self.cases.values())).series),
+            "settings": self.settings.to_dict(),
+            "definitions": DEFINITIONS,
+            "wall_time_s": time.perf_counter() - t0,
+            "processes": self.processes,
+            "config": self.config,
+            "provenance": provenance(),
+        }
+        write_csv(self.out / "strength_tests.csv", tests)
+        write_csv(self.out / "strength.csv", [{k: v for k, v in r.items() if not k.endswith("_ci_deg")}
+                                              for r in rows])  # fmt: skip
+        write_json(self.out / "strength.json", result)
+        from poro2d.report.strength_figure import plot_strength
+
+        plot_strength(rows, self.out / "fig_strength.png")
+        return result
+
+
+DEFINITIONS = {
+    "peak_friction_angle": "Mohr-Coulomb line (with cohesion) through one specimen's smoothed peaks over the "
+    "normal stresses; mean and sd over the specimens; pooled: one line through every specimen's peaks, "
+    "95 % Student-t interval",
+    "residual_friction_angle": f"per test mean shear stress / mean measured normal stress over the last "
+    f"{RESIDUAL_FRACTION:.0%} of the shear displacement; per specimen atan of the slope of the line "
+    "through the origin fitted to those points; mean and sd over the specimens",
+    "max_dilation_angle": "per test atan of the largest mean slope of the plate rise over peak_window of "
+    "shear displacement (a secant); per specimen the mean over the normal stresses",
+}
+
+
+__all__ = ["RESIDUAL_FRACTION", "StrengthStudy", "case_label", "max_dilation_angle", "residual_point"]

@@ -1,0 +1,142 @@
+"""``poro2d strength``: peak and residual friction angles and dilation against mu_r and f_p."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from poro2d.console import OutputConsole, Table
+
+console = OutputConsole()
+
+
+def parse_values(text: str, option: str, hi: float) -> list[float]:
+    """'0,0.1,0.2' -> [0.0, 0.1, 0.2], each in [0, hi], all different; refused on one line."""
+    from poro2d.errors import InputError
+
+    allowed = f"comma-separated different numbers in [0, {hi:g}], e.g. 0,0.1,0.2"
+    values = []
+    for part in str(text).split(","):
+        try:
+            v = float(part.strip())
+        except ValueError:
+            raise InputError(option, text, allowed, f"{part.strip()!r} is not a number") from None
+        if not 0.0 <= v <= hi:  # NaN fails too
+            raise InputError(option, text, allowed, f"{part.strip()} is out of range")
+        values.append(v)
+    if len(set(values)) != len(values):
+        raise InputError(option, text, allowed, "a value is repeated")
+    return values
+
+
+def quick_specimens(out: Path, seeds: int, progress: bool) -> dict[str, Path]:
+    """The paper's quick specimen (``poro2d paper --quick``) of seed 0 and those of the next seeds.
+
+    The criterion and its replicate runs are the paper's own stages, resumable in ``out``.
+    """
+    from poro2d.criterion.config import build
+    from poro2d.criterion.protocol import PorosityCriterion
+    from poro2d.paper import _specimens, paper_config
+
+    cfg = paper_config(True, 0)
+    spec, grading, settings, seed = build(cfg, None, threads=1)
+    crit = PorosityCriterion(spec, grading, settings, seed=seed, out=out / "criterion", progress=progress,
+                             config=cfg)  # fmt: skip
+    result = crit.run()
+    if not result.converged:
+        raise RuntimeError(f"the quick specimen was not accepted: {result.message}")
+    specimens, _ = _specimens(crit.spec, crit.grading, crit.settings, result.final_porosity, crit.seed, seeds,
+                              out, progress)  # fmt: skip
+    return specimens
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("strength")
+    def strength_cmd(
+        specimen: list[str] = typer.Argument(
+            None, help="Replicate specimens (checkpoints or criterion folders), one per seed; or --quick."
+        ),
+        quick: bool = typer.Option(
+            False, "--quick", help="The paper's quick specimen on --seeds seeds, a short grid (minutes)."
+        ),
+        seeds: int = typer.Option(None, "--seeds", help="With --quick: replicate specimens (default 3)."),
+        mu_r: str = typer.Option(None, "--mu-r", help="Rolling frictions, e.g. 0,0.1,0.2,0.4."),
+        friction: str = typer.Option(None, "--friction", help="Particle frictions f_p, e.g. 0.5,1,3."),
+        normal_stress: str = typer.Option(None, "--normal-stress", "-n", help="Normal stresses (kPa)."),
+        max_displacement: float = typer.Option(None, "--max-displacement", help="Shear displacement (m)."),
+        out: Path = typer.Option(Path("strength-out"), "--out", "-o", help="Output folder (resumable)."),
+        processes: int = typer.Option(None, "--processes", "-p", help="Worker processes (default 2 x CPUs)."),
+        quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+    ) -> None:
+        """Peak and residual friction angles and dilation against rolling and particle friction."""
+        from poro2d.errors import InputError, check_int
+        from poro2d.io_utils import check_output_dir
+        from poro2d.shear import strength as st
+        from poro2d.shear.cli import parse_stresses
+        from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
+
+        # everything is checked before the first specimen or test is made
+        check_output_dir("--out", out)
+        if bool(quick) == bool(specimen):
+            raise InputError(
+                "SPECIMEN.../--quick", specimen or None, "one of them: specimen paths, or --quick"
+            )
+        if seeds is not None and not quick:
+            raise InputError("--seeds", seeds, "only with --quick (give one specimen path per replicate)")
+        n_seeds = check_int("--seeds", seeds, 1, 20) if seeds is not None else st.QUICK_SEEDS
+        mu_values = parse_values(mu_r, "--mu-r", MAX_ROLLING_FRICTION) if mu_r else list(st.QUICK_MU_R)
+        fp_values = (
+            parse_values(friction, "--friction", MAX_FRICTION) if friction else list(st.QUICK_FRICTION)
+        )
+        stresses = parse_stresses(normal_stress) if normal_stress else list(st.QUICK_NORMAL_STRESSES)
+        if processes is not None:
+            check_int("--processes", processes, 1, 64)
+        shear = dict(st.QUICK_STRENGTH_SHEAR) if quick else {"stop_after_peak": 0.0}
+        if max_displacement is not None:
+            shear["max_displacement"] = max_displacement
+        settings = ShearSettings(**shear)
+        config = {"quick": quick, "seeds": n_seeds if quick else None, "specimens": specimen or None,
+                  "mu_r": mu_values, "particle_friction": fp_values, "normal_stress_kpa": stresses,
+                  "shear": shear}  # fmt: skip
+        if quick:
+            console.print(f"[bold]quick specimens[/] (the paper's quick preset), {n_seeds} seed(s)")
+            specimens = quick_specimens(out / "specimens", n_seeds, not quiet)
+        else:
+            specimens = {f"specimen{k + 1}": Path(p) for k, p in enumerate(specimen)}
+        study = st.StrengthStudy(specimens, mu_values, fp_values, stresses, settings, out=out,
+                                 processes=processes, progress=not quiet, config=config)  # fmt: skip
+        console.print(
+            f"[bold]direct shear[/] over {len(study.cases)} (mu_r, f_p) cases x {len(specimens)} specimen(s) "
+            f"x {len(stresses)} normal stresses on {study.processes} processes"
+        )
+        try:
+            result = study.run()
+        except RuntimeError as exc:
+            console.print(f"[bold red]failed:[/] {exc}")
+            raise typer.Exit(1) from None
+        print_strength(result, out)
+
+
+def _deg(mean, sd) -> str:
+    if mean is None:
+        return "-"
+    return f"{mean:.1f}" + ("" if sd is None else f" +- {sd:.1f}")
+
+
+def print_strength(result: dict, out: Path) -> None:
+    t = Table(title="strength against rolling and particle friction (mean +- sd over specimens)")
+    for col in ("mu_r", "f_p", "phi peak deg", "phi residual deg", "psi max deg", "tau/sigma residual"):
+        t.add_column(col, justify="right")
+    for r in result["cases"]:
+        t.add_row(
+            f"{r['mu_r']:g}", f"{r['particle_friction']:g}",
+            _deg(r["peak_friction_angle_mean_deg"], r["peak_friction_angle_sd_deg"]),
+            _deg(r["residual_friction_angle_mean_deg"], r["residual_friction_angle_sd_deg"]),
+            _deg(r["max_dilation_angle_mean_deg"], r["max_dilation_angle_sd_deg"]),
+            f"{r['residual_stress_ratio_mean']:.3f}",
+        )  # fmt: skip
+    console.print(t)
+    console.print(
+        f"results in {out}/strength.json, strength.csv, strength_tests.csv; figure fig_strength.png"
+    )
