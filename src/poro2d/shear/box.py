@@ -151,6 +151,7 @@ def build_split_box(
     density_scale: float = 1.0,
     dt_safety: float = 0.8,
     threads: int = 1,
+    rolling_friction: float | None = None,
 ) -> tuple[Simulation, SplitBox]:
     """A new simulation of the specimen's disks in a split box (all walls at rest).
 
@@ -158,6 +159,7 @@ def build_split_box(
     replaces their friction when given); the engine settings (contact convention,
     gravity, damping) are the specimen's. Disk-disk shear histories are not carried
     over: the consolidation that follows brings the specimen to a new equilibrium.
+    ``rolling_friction`` replaces the disks' mu_r when given.
     The disks are numbered anew (:func:`poro2d.dem.ordering.strip_order`).
     ``max_displacement`` may not exceed W / 2.
     """
@@ -194,6 +196,7 @@ def build_split_box(
         kn=p0.kn.copy(), ks=p0.ks.copy(),
         mu=p0.mu.copy() if particle_friction is None else np.full(p0.n, float(particle_friction)),
         vel=p0.vel.copy(), theta=p0.theta.copy(), omega=p0.omega.copy(), mode=p0.mode.copy(),
+        mu_r=p0.mu_r.copy() if rolling_friction is None else np.full(p0.n, float(rolling_friction)),
     )  # fmt: skip
     contact = specimen.contact
     if particle_friction is not None and contact.convention == "per_pair_type":

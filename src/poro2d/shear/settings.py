@@ -40,7 +40,8 @@ class ShearSettings:
     consolidation_max_steps for the consolidation stage; servo_gain, servo_integral
     (per step; it keeps the stress on target while the specimen dilates) and
     servo_max_speed (m/s) of the top plate; kn_wall, ks_wall (N/m), friction_wall and
-    gap (m) of the box; particle_friction replaces the specimen's when given;
+    gap (m) of the box; particle_friction replaces the specimen's when given, and
+    rolling_friction (mu_r) likewise;
     local_damping likewise (None: the specimen's); density_scale >= 1 scales the
     inertial masses; dt_safety the automatic time step; peak_window (m) the
     smoothing of the peak; shear_zone_factor k in gamma_dot = v / (k d_mean);
@@ -62,6 +63,7 @@ class ShearSettings:
     friction_wall: float = 1.5
     gap: float = 0.0
     particle_friction: float | None = None
+    rolling_friction: float | None = None
     local_damping: float | None = None
     density_scale: float = 1.0
     dt_safety: float = 0.8
@@ -91,6 +93,8 @@ class ShearSettings:
         check_range("gap", self.gap, 0.0, None)
         if self.particle_friction is not None:
             check_range("particle_friction", self.particle_friction, 0.0, MAX_FRICTION)
+        if self.rolling_friction is not None:
+            check_range("rolling_friction", self.rolling_friction, 0.0, 1.0)
         if self.local_damping is not None:
             check_range("local_damping", self.local_damping, 0.0, 1.0, hi_open=True)
         check_range("density_scale", self.density_scale, 1.0, MAX_DENSITY_SCALE)

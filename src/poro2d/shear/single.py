@@ -121,7 +121,7 @@ class DirectShearTest:
         spec = checkpoint.load(self.specimen, threads=self.threads)
         sim, box = build_split_box(
             spec, s.max_displacement, s.kn_wall, s.ks_wall, s.friction_wall, s.gap,
-            s.particle_friction, s.density_scale, s.dt_safety, self.threads,
+            s.particle_friction, s.density_scale, s.dt_safety, self.threads, s.rolling_friction,
         )  # fmt: skip
         if s.local_damping is not None:
             sim.set_local_damping(float(s.local_damping))
