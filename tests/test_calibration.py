@@ -46,6 +46,7 @@ def test_two_independent_observables_pin_both_parameters_within_narrow_intervals
     mr_lo, mr_hi = post.interval("mu_r", 0.95)
     assert fp_lo <= truth[0] <= fp_hi and mr_lo <= truth[1] <= mr_hi
     assert math.log(fp_hi / fp_lo) < 0.2 * math.log(10.0) and mr_hi - mr_lo < 0.1
+    assert fp_lo <= post.median("fp") <= fp_hi and mr_lo <= post.median("mu_r") <= mr_hi
     best = post.best()
     assert best[0] == pytest.approx(truth[0], rel=0.05) and best[1] == pytest.approx(truth[1], abs=0.01)
 
@@ -113,6 +114,7 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     for name, value in TRUTH.items():
         lo, hi = res.intervals[name]
         assert lo <= value <= hi, (name, value, lo, hi)
+        assert lo <= res.posterior["median"][name] <= hi
     assert res == json.loads((out / "result.json").read_text())
     assert len(res.evaluations) == 10 and res.cluster["tests_run"] == 10 * 2 * 2
     assert {o["observable"] for o in res.posterior["observables"]} == {"peak", "end"}

@@ -106,13 +106,10 @@ def register(app: typer.Typer) -> None:
 
 
 def print_result(result, out: Path) -> None:
-    from poro2d.report.calibration_report import identifiability_note
+    from poro2d.report.calibration_report import identifiability_note, interval_text
 
     for name, label in (("particle_friction", "f_p"), ("rolling_friction", "mu_r")):
-        lo, hi = result.intervals[name]
-        console.print(
-            f"  {label:<5} {result.best[name]:.3g}  ({result.level:.0%} interval {lo:.3g} to {hi:.3g})"
-        )
+        console.print(f"  {label:<5} {interval_text(result, name)}")
     console.print(f"  {identifiability_note(result)}")
     console.print(
         f"results in {out}/result.json; config {out}/calibrated.toml; report {out}/calibration.html"

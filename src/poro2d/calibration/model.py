@@ -150,6 +150,10 @@ class Posterior:
         hi = values[min(int(np.searchsorted(cdf, 1.0 - tail)), len(values) - 1)]
         return float(lo), float(hi)
 
+    def median(self, axis: str) -> float:
+        """The median of one parameter's marginal ("fp" or "mu_r")."""
+        return self.interval(axis, 0.0)[0]
+
     def correlation(self) -> float:
         """The posterior correlation of the design coordinates (near +-1: a ridge)."""
         uu, vv = np.meshgrid(self.u, self.v)

@@ -45,7 +45,9 @@ CALIBRATED = ("particle_friction", "rolling_friction")
 class CalibrationResult(TypedResult):
     """A calibration (``result.json``): the best parameters, their intervals, the posterior.
 
-    ``best``: the posterior maximum (``particle_friction``, ``rolling_friction``);
+    ``best``: the posterior maximum (``particle_friction``, ``rolling_friction``): the pair
+    that reproduces the laboratory best; on a ridge or at a range's end it may lie outside
+    the central intervals, which ``posterior["median"]`` never does;
     ``intervals``: central credible intervals at ``level``; ``posterior``: its correlation
     (near +-1: a ridge), whether each interval is wide, the observables fitted;
     ``evaluations``: one row per design point (replicate means per observable);
@@ -321,6 +323,7 @@ def _result(
         intervals=intervals,
         level=level,
         posterior={
+            "median": {"particle_friction": post.median("fp"), "rolling_friction": post.median("mu_r")},
             "correlation": post.correlation(),
             "wide": wide,
             "grid": model.GRID,

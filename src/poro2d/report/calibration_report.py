@@ -7,9 +7,13 @@ from pathlib import Path
 from poro2d.report.document import write_report
 
 
-def _interval_text(result, name: str) -> str:
+def interval_text(result, name: str) -> str:
     lo, hi = result.intervals[name]
-    return f"{result.best[name]:.3g} ({result.level:.0%} interval {lo:.3g} to {hi:.3g})"
+    median = result.posterior["median"][name]
+    return (
+        f"{result.best[name]:.3g} at the posterior maximum; marginal median {median:.3g},"
+        f" {result.level:.0%} interval {lo:.3g} to {hi:.3g}"
+    )
 
 
 def identifiability_note(result) -> str:
@@ -53,8 +57,8 @@ def calibration_blocks(result, out: Path) -> list[tuple]:
         (
             "ul",
             [
-                f"particle friction f_p = {_interval_text(result, 'particle_friction')}",
-                f"rolling friction mu_r = {_interval_text(result, 'rolling_friction')}",
+                f"particle friction f_p = {interval_text(result, 'particle_friction')}",
+                f"rolling friction mu_r = {interval_text(result, 'rolling_friction')}",
             ],
         ),
         ("p", identifiability_note(result)),
@@ -85,4 +89,4 @@ def write_calibration_report(out: Path, result) -> list[Path]:
     return write_report(calibration_blocks(result, out), out, "calibration", "poro2d calibration")
 
 
-__all__ = ["calibration_blocks", "identifiability_note", "write_calibration_report"]
+__all__ = ["calibration_blocks", "interval_text", "identifiability_note", "write_calibration_report"]
