@@ -173,6 +173,7 @@ def _refusal(argv: list[str], capsys) -> str:
         (["--mu-r-range", "0.2,0.1"], ["--mu-r-range"]),
         (["--points", "2"], ["--points"]),
         (["--preset", "paper"], ["--specimen"]),
+        (["--specimen", "damaged"], ["checkpoint"]),
     ],
 )
 def test_the_command_refuses_bad_input_on_one_line(tiny, tmp_path, capsys, extra, words):
@@ -180,6 +181,8 @@ def test_the_command_refuses_bad_input_on_one_line(tiny, tmp_path, capsys, extra
     bad = tmp_path / "lab.csv"
     bad.write_text("normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,abc\n" if not extra else
                    "normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,70\n")  # fmt: skip
+    (tmp_path / "damaged.npz").write_bytes(paths[0].read_bytes()[:100])
+    extra = [str(tmp_path / "damaged.npz") if e == "damaged" else e for e in extra]
     out = tmp_path / "out"
     line = _refusal(["calibrate", "--lab", str(bad), "--specimen", str(paths[0]), "--out", str(out), *extra],
                     capsys)  # fmt: skip

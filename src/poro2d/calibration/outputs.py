@@ -136,6 +136,11 @@ def _posterior_figure(path: Path, result, post) -> None:
     lo, hi = result.intervals["rolling_friction"]
     ax.axhspan(lo, hi, color="w", alpha=0.12)
     ax.set_xscale("log")
+    from matplotlib.ticker import FormatStrFormatter
+
+    ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
+    ax.xaxis.set_minor_formatter(FormatStrFormatter("%g"))
+    ax.tick_params(axis="x", which="minor", labelsize=7)
     ax.set_xlabel("particle friction f_p")
     ax.set_ylabel("rolling friction mu_r")
     ax.set_title(

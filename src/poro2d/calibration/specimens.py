@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from poro2d.dem import checkpoint
 from poro2d.errors import InputError, check_int
 from poro2d.shear.specimen_file import resolve_specimen
 
@@ -24,6 +25,7 @@ def given_specimens(paths: list[str | os.PathLike]) -> dict[str, Path]:
     found: dict[str, Path] = {}
     for given in paths:
         path = resolve_specimen(given)
+        checkpoint.read(path)  # a damaged file is refused here, in one line
         label = path.parent.name if path.name == "specimen.npz" else path.stem
         label = label or "specimen"
         unique, k = label, 1
