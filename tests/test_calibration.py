@@ -127,6 +127,20 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
                             dashboard=None, progress=False)  # fmt: skip
     assert again.cluster["tests_run"] == 0 and again.cluster["tests_reused"] == 40
     assert again.best == res.best
+    # a weaker 'laboratory' (the same specimen at lower frictions) moves the answer to weaker
+    # parameters: the calibration follows its data (round 1 comes from the cache)
+    weak_lab = synthetic_lab(paths[2], [50, 100], 0.3, 0.0, tmp_path / "weak.csv", settings=SHORT)
+    weak = run_calibration(weak_lab, [paths[0], paths[1]], out=out, points=8, refine=2, settings=SHORT,
+                           workers=1, dashboard=None, progress=False)  # fmt: skip
+    peaks = {
+        o["normal_stress_kpa"]: o["model_kpa"]
+        for o in res.posterior["observables"]
+        if o["observable"] == "peak"
+    }
+    for o in weak.posterior["observables"]:
+        if o["observable"] == "peak":
+            assert o["model_kpa"] < peaks[o["normal_stress_kpa"]]
+    assert weak.posterior["median"]["particle_friction"] < res.posterior["median"]["particle_friction"]
 
 
 @pytest.mark.parametrize(
