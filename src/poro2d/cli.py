@@ -51,6 +51,7 @@ def _register() -> None:
     # Imported here so that `poro2d --help` stays cheap and a broken optional
     # layer cannot take the whole CLI down at import time.
     from poro2d import paper, porosity_cli
+    from poro2d.calibration import cli as calibration_cli
     from poro2d.criterion import cli as criterion_cli
     from poro2d.interop import cli as interop_cli
     from poro2d.shear import cli as shear_cli
@@ -66,6 +67,7 @@ def _register() -> None:
     sweep_cli.register(app)
     interop_cli.register(app)
     sensitivity_cli.register(app)
+    calibration_cli.register(app)
     for info in app.registered_commands:
         info.callback = _interruptible(info.name or info.callback.__name__, info.callback)
 
@@ -166,7 +168,7 @@ def check_raw_arguments(argv: list[str]) -> None:
         bare = eq or is_flag or not has_next
         seen.setdefault(param, []).append(arg if bare else f"{arg} {argv[k + 1]}")
     for param, given in seen.items():
-        if len(given) > 1:
+        if len(given) > 1 and not getattr(param, "multiple", False):  # a repeatable option keeps each
             raise InputError(max(param.opts, key=len), ", ".join(given), "the option once")
 
 

@@ -1,0 +1,119 @@
+"""``poro2d calibrate``: particle and rolling friction from laboratory direct shear."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from poro2d.console import OutputConsole
+
+console = OutputConsole()
+
+_SCHED = "Address of a running Dask scheduler (e.g. tcp://host:8786); default: a LocalCluster."
+_WORKERS = "LocalCluster worker processes (default: one per core)."
+_DASHBOARD = "LocalCluster dashboard: HOST:PORT or none (default 127.0.0.1:0, this machine only)."
+
+
+def parse_range(option: str, text: str | None, default: tuple[float, float]) -> tuple[float, float]:
+    """``LOW,HIGH`` as two numbers (checked against the allowed range later), or the default."""
+    from poro2d.errors import InputError
+
+    if text is None:
+        return default
+    parts = [p.strip() for p in str(text).split(",")]
+    try:
+        low, high = (float(p) for p in parts)
+    except ValueError:
+        raise InputError(option, text, "two numbers LOW,HIGH") from None
+    return low, high
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("calibrate")
+    def calibrate_cmd(
+        lab: Path = typer.Option(
+            ..., "--lab", help="Laboratory CSV: peaks, or whole curves (docs/shear.md)."
+        ),
+        specimen: list[str] = typer.Option(
+            None, "--specimen", "-s", help="A specimen (.npz or criterion folder); repeat for replicates."
+        ),
+        preset: str = typer.Option(None, "--preset", help="paper: replicate specimens of the paper's case."),
+        quick: bool = typer.Option(False, "--quick", help="With --preset paper: the small specimen."),
+        replicates: int = typer.Option(3, "--replicates", help="Seeds of the preset's specimens (1-20)."),
+        seed: int = typer.Option(0, "--seed", help="First seed of the preset's specimens."),
+        fp_range: str = typer.Option(None, "--fp-range", help="Particle friction range LOW,HIGH (0.3,3)."),
+        mu_r_range: str = typer.Option(None, "--mu-r-range", help="Rolling friction range LOW,HIGH (0,0.5)."),
+        points: int = typer.Option(12, "--points", help="Design points of round 1 (6-500)."),
+        refine: int = typer.Option(
+            6, "--refine", help="Points of round 2, drawn from the posterior (0: none)."
+        ),
+        design_seed: int = typer.Option(0, "--design-seed", help="Seed of the design and of round 2's draw."),
+        lab_error: float = typer.Option(
+            0.0, "--lab-error", help="Laboratory error, a fraction of each value."
+        ),
+        level: float = typer.Option(0.95, "--level", help="Level of the credible intervals."),
+        max_displacement: float = typer.Option(None, "--max-displacement", help="Shear displacement (m)."),
+        out: Path = typer.Option(Path("calibrate-out"), "--out", "-o", help="Output folder (resumable)."),
+        scheduler: str = typer.Option(None, "--scheduler", help=_SCHED),
+        workers: int = typer.Option(None, "--workers", help=_WORKERS),
+        dashboard: str = typer.Option(None, "--dashboard", help=_DASHBOARD),
+        quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+    ) -> None:
+        """Calibrate particle friction f_p and rolling friction mu_r against laboratory direct shear."""
+        from poro2d.calibration.run import DEFAULT_FP_RANGE, DEFAULT_MU_R_RANGE, run_calibration
+        from poro2d.sweep.runner import check_dashboard
+
+        settings = None if max_displacement is None else {"max_displacement": max_displacement}
+        options = {
+            "lab": str(lab),
+            "specimen": specimen or None,
+            "preset": preset,
+            "quick": quick,
+            "replicates": replicates,
+            "seed": seed,
+            "fp_range": fp_range,
+            "mu_r_range": mu_r_range,
+            "max_displacement": max_displacement,
+        }
+        try:
+            result = run_calibration(
+                lab,
+                list(specimen or []),
+                out=out,
+                preset=preset,
+                quick=quick,
+                replicates=replicates,
+                seed=seed,
+                fp_range=parse_range("--fp-range", fp_range, DEFAULT_FP_RANGE),
+                mu_r_range=parse_range("--mu-r-range", mu_r_range, DEFAULT_MU_R_RANGE),
+                points=points,
+                refine=refine,
+                design_seed=design_seed,
+                lab_error=lab_error,
+                level=level,
+                settings=settings,
+                scheduler=scheduler,
+                workers=workers,
+                dashboard=check_dashboard(dashboard),
+                progress=not quiet,
+                config={"cli": options},
+            )
+        except RuntimeError as exc:
+            console.print(f"[bold red]failed:[/] {exc}")
+            raise typer.Exit(1) from None
+        print_result(result, out)
+
+
+def print_result(result, out: Path) -> None:
+    from poro2d.report.calibration_report import identifiability_note, interval_text
+
+    for name, label in (("particle_friction", "f_p"), ("rolling_friction", "mu_r")):
+        console.print(f"  {label:<5} {interval_text(result, name)}")
+    console.print(f"  {identifiability_note(result)}")
+    console.print(
+        f"results in {out}/result.json; config {out}/calibrated.toml; report {out}/calibration.html"
+    )
+
+
+__all__ = ["register"]

@@ -1,0 +1,348 @@
+"""``run_calibration``: the micro-parameters (f_p, mu_r) that reproduce laboratory direct shear.
+
+Every evaluation of a parameter pair is a shear test per replicate specimen and per
+laboratory normal stress (the units, :mod:`poro2d.calibration.units`), run on Dask.
+Round 1 evaluates a space-filling design; the surrogate and the posterior follow
+(:mod:`poro2d.calibration.model`); round 2 (``refine`` > 0) evaluates points drawn from
+that posterior, and the surrogate and posterior are fitted again on every point.
+Everything is checked before the first test starts.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from poro2d.calibration import model
+from poro2d.calibration.cluster import UnitRunner
+from poro2d.calibration.specimens import check_preset, given_specimens, preset_specimens
+from poro2d.calibration.units import unit_job
+from poro2d.errors import InputError, check_int, check_range, is_number
+from poro2d.io_utils import check_output_dir, provenance
+from poro2d.locks import holds_output
+from poro2d.shear.lab import LabData, read_lab_csv
+from poro2d.shear.series import check_stresses
+from poro2d.shear.settings import MAX_FRICTION, ShearSettings
+from poro2d.sweep.runner import DEFAULT_DASHBOARD, check_cluster_options, check_reachable
+from poro2d.typed_result import TypedResult
+
+DEFAULT_FP_RANGE = (0.3, 3.0)
+DEFAULT_MU_R_RANGE = (0.0, 0.5)
+#: most design points of a round (each is replicates x stresses shear tests)
+MAX_POINTS = 500
+#: the quadratic surrogate has 6 coefficients: fewer points leave it undetermined
+MIN_POINTS = model.N_COEFFICIENTS
+#: the settings calibrated here: given ones would be overridden, so they are refused
+CALIBRATED = ("particle_friction", "rolling_friction")
+
+
+@dataclass(eq=False)
+class CalibrationResult(TypedResult):
+    """A calibration (``result.json``): the best parameters, their intervals, the posterior.
+
+    ``best``: the posterior maximum (``particle_friction``, ``rolling_friction``): the pair
+    that reproduces the laboratory best; on a ridge or at a range's end it may lie outside
+    the central intervals, which ``posterior["median"]`` never does;
+    ``intervals``: central credible intervals at ``level``; ``posterior``: its correlation
+    (near +-1: a ridge), whether each interval is wide, the observables fitted;
+    ``evaluations``: one row per design point (replicate means per observable);
+    ``fit``: the surrogate per observable; ``lab``: the laboratory values fitted.
+    """
+
+    best: dict[str, float]
+    intervals: dict[str, list[float]]
+    level: float
+    posterior: dict[str, Any]
+    evaluations: list[dict[str, Any]]
+    fit: dict[str, Any]
+    lab: dict[str, Any]
+    specimens: dict[str, str]
+    ranges: dict[str, list[float]]
+    settings: dict[str, Any]
+    cluster: dict[str, Any]
+    failures: list[dict[str, Any]]
+    timings: dict[str, float]
+    config: dict[str, Any]
+    provenance: dict[str, Any]
+
+
+def check_range_pair(name: str, value, lo: float, hi: float, lo_open: bool = False) -> tuple[float, float]:
+    """A (low, high) pair inside [lo, hi] with low < high."""
+    if isinstance(value, str | bytes) or not hasattr(value, "__len__") or len(value) != 2:
+        raise InputError(name, value, f"two numbers LOW,HIGH in [{lo}, {hi}]")
+    a, b = value
+    for v in (a, b):
+        if not is_number(v):
+            raise InputError(name, value, f"two numbers LOW,HIGH in [{lo}, {hi}]")
+        check_range(name, float(v), lo, hi, lo_open=lo_open)
+    if not float(a) < float(b):
+        raise InputError(name, value, "LOW < HIGH")
+    return float(a), float(b)
+
+
+def _base_settings(settings: dict | None) -> dict:
+    """The shear settings of every test (frictions apart); ``stop_after_peak`` 0 by default so
+    that every test ends at ``max_displacement``, where the end stress is compared."""
+    given = dict(settings or {})
+    if not isinstance(settings, dict | None):
+        raise InputError("settings", type(settings).__name__, "a dict of shear settings or None")
+    for name in CALIBRATED:
+        if name in given:
+            raise InputError(f"settings.{name}", given[name], "not given: it is calibrated")
+    given.setdefault("stop_after_peak", 0.0)
+    from poro2d.config import dataclass_from_table
+
+    return dataclass_from_table(ShearSettings, "settings", given).to_dict()
+
+
+def _lab_targets(lab: LabData, base: dict) -> list[tuple[str, float, float]]:
+    """(observable, normal stress, laboratory value) fitted: every peak, and with curves the end stress.
+
+    The end stress of a laboratory curve is its mean over the last peak window before the
+    tests' ``max_displacement`` (the simulated end value is smoothed over the same window).
+    """
+    targets = [("peak", s, lab.peaks[s]) for s in lab.normal_stresses()]
+    end, window = base["max_displacement"], base["peak_window"]
+    for s in lab.normal_stresses() if lab.curves else []:
+        d, t = lab.curves[s]
+        if d[-1] < end:
+            raise InputError(
+                "settings.max_displacement",
+                end,
+                f"at most {d[-1]:g} m, where the lab curve at {s:g} kPa ends",
+            )
+        inside = (d >= end - window) & (d <= end)
+        value = float(np.mean(t[inside])) if inside.any() else float(np.interp(end, d, t))
+        targets.append(("end", s, value))
+    return targets
+
+
+@holds_output("out")
+def run_calibration(
+    lab: str | os.PathLike | LabData,
+    specimens: list[str | os.PathLike] | None = None,
+    *,
+    out: str | os.PathLike,
+    preset: str | None = None,
+    quick: bool = False,
+    replicates: int = 3,
+    seed: int = 0,
+    fp_range=DEFAULT_FP_RANGE,
+    mu_r_range=DEFAULT_MU_R_RANGE,
+    points: int = 12,
+    refine: int = 6,
+    design_seed: int = 0,
+    lab_error: float = 0.0,
+    level: float = 0.95,
+    settings: dict | None = None,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    dashboard: str | None = DEFAULT_DASHBOARD,
+    progress: bool = True,
+    config: dict | None = None,
+) -> CalibrationResult:
+    """Calibrate f_p and mu_r against ``lab`` on replicate specimens; writes ``out/result.json``.
+
+    ``specimens``: checkpoints or criterion folders, or ``preset="paper"`` (``quick``: the
+    small box) with ``replicates`` seeds from ``seed``. ``fp_range``, ``mu_r_range``: the
+    search ranges. ``points``: the space-filling design's size; ``refine``: points of the
+    second round, drawn from the posterior (0: none). ``lab_error``: the laboratory's own
+    error as a fraction of each value, added to the seed scatter. ``level``: of the
+    credible intervals. ``settings``: shear settings of every test (the quick preset's
+    ``max_displacement`` 4 mm by default). ``scheduler``/``workers``/``dashboard``: as the sweeps.
+    A rerun reuses every finished shear test (cached by content under ``out/cache``).
+    """
+    t0 = time.perf_counter()
+    out = check_output_dir("--out", out)
+    lab_data = lab if isinstance(lab, LabData) else read_lab_csv(lab)
+    check_stresses(lab_data.normal_stresses())
+    check_preset(preset, quick, replicates)
+    if preset is not None and specimens:
+        raise InputError("--specimen", ", ".join(map(str, specimens)), "nothing with --preset")
+    given = given_specimens(list(specimens or [])) if preset is None else None
+    ranges = model.Ranges(
+        check_range_pair("--fp-range", fp_range, 0.0, MAX_FRICTION, lo_open=True),
+        check_range_pair("--mu-r-range", mu_r_range, 0.0, 1.0),
+    )
+    points = check_int("--points", points, MIN_POINTS, MAX_POINTS)
+    refine = check_int("--refine", refine, 0, MAX_POINTS)
+    design_seed = check_int("--design-seed", design_seed, 0)
+    check_range("--lab-error", lab_error, 0.0, 1.0)
+    check_range("--level", level, 0.0, 1.0, lo_open=True, hi_open=True)
+    if settings is None and quick:
+        from poro2d.paper import QUICK_SHEAR
+
+        settings = dict(QUICK_SHEAR)
+    base = _base_settings(settings)
+    targets = _lab_targets(lab_data, base)
+    check_cluster_options(scheduler, workers)
+    check_reachable(scheduler)
+
+    found = (
+        given
+        if given is not None
+        else preset_specimens(
+            out / "specimens", quick=quick, seed=seed, replicates=replicates, progress=progress
+        )
+    )
+    from poro2d.dem.checkpoint import state_digest
+
+    digests = {label: state_digest(path) for label, path in found.items()}
+    runner = UnitRunner(scheduler, workers, progress=progress, dashboard=dashboard)
+    stresses = lab_data.normal_stresses()
+    try:
+        design = model.space_filling(ranges, points, design_seed)
+        rows = runner.run(_jobs(design, found, digests, stresses, base, out), "round 1")
+        post, surrogates, table = _infer(
+            ranges, design, found, digests, stresses, base, out, rows, targets, lab_error
+        )
+        if refine:
+            extra = [p for p in post.draw(refine, design_seed + 1) if p not in design]
+            design = design + extra
+            rows.update(runner.run(_jobs(extra, found, digests, stresses, base, out), "round 2"))
+            post, surrogates, table = _infer(
+                ranges, design, found, digests, stresses, base, out, rows, targets, lab_error
+            )
+    finally:
+        runner.close()
+    result = _result(
+        post,
+        surrogates,
+        table,
+        targets,
+        level,
+        lab_data,
+        found,
+        ranges,
+        base,
+        runner,
+        t0,
+        config or {},
+        lab_error,
+        design_seed,
+        points,
+        refine,
+    )
+    from poro2d.calibration.outputs import write_outputs
+
+    write_outputs(out, result, post, surrogates, lab_data, found, digests, base)
+    return result
+
+
+def _jobs(design, found, digests, stresses, base, out: Path) -> list[dict]:
+    cache = out / "cache"
+    return [
+        unit_job(path, digests[label], s, base, fp, mu_r, cache)
+        for fp, mu_r in design
+        for label, path in found.items()
+        for s in stresses
+    ]
+
+
+def _infer(ranges, design, found, digests, stresses, base, out, rows, targets, lab_error):
+    """The surrogates (one per target), the posterior and the table of replicate values per design point."""
+    table = []
+    for fp, mu_r in design:
+        entry: dict[str, Any] = {"particle_friction": fp, "rolling_friction": mu_r}
+        for obs, s, _ in targets:
+            values = []
+            for label, path in found.items():
+                job = unit_job(path, digests[label], s, base, fp, mu_r, out / "cache")
+                row = rows.get(job["key"])
+                values.append(row[obs] if row is not None else float("nan"))
+            entry[f"{obs}_{s:g}kPa"] = values
+        table.append(entry)
+    unit = ranges.to_unit([e["particle_friction"] for e in table], [e["rolling_friction"] for e in table])
+    values = np.array([[e[f"{obs}_{s:g}kPa"] for obs, s, _ in targets] for e in table], float)
+    surrogates = []
+    for k, (obs, s, _) in enumerate(targets):
+        ok = np.isfinite(values[:, k]).any(axis=1)
+        if ok.sum() < MIN_POINTS:
+            raise RuntimeError(
+                f"only {int(ok.sum())} design points have a {obs} at {s:g} kPa; "
+                f"the surrogate needs {MIN_POINTS}"
+            )
+        surrogates.append(model.fit_surrogate(unit[ok], values[ok, k]))
+    lab_values = [y for *_, y in targets]
+    cov = model.noise_covariance(surrogates, model.seed_covariance(values), lab_values, lab_error)
+    post = model.posterior(ranges, surrogates, lab_values, cov)
+    post.noise_sd = np.sqrt(np.diag(cov)).tolist()
+    post.noise_correlation = (cov / np.sqrt(np.outer(np.diag(cov), np.diag(cov)))).round(3).tolist()
+    return post, surrogates, table
+
+
+def _result(
+    post,
+    surrogates,
+    table,
+    targets,
+    level,
+    lab_data,
+    found,
+    ranges,
+    base,
+    runner,
+    t0,
+    config,
+    lab_error,
+    design_seed,
+    points,
+    refine,
+) -> CalibrationResult:
+    fp, mu_r = post.best()
+    intervals = {
+        "particle_friction": list(post.interval("fp", level)),
+        "rolling_friction": list(post.interval("mu_r", level)),
+    }
+    spans = {"particle_friction": ranges.fp, "rolling_friction": ranges.mu_r}
+    wide = {}
+    for name, (lo, hi) in intervals.items():
+        r_lo, r_hi = spans[name]
+        if name == "particle_friction":  # the fraction of the range in the coordinate searched: log f_p
+            wide[name] = bool(np.log(hi / lo) > model.WIDE_FRACTION * np.log(r_hi / r_lo))
+        else:
+            wide[name] = bool(hi - lo > model.WIDE_FRACTION * (r_hi - r_lo))
+    best_unit = ranges.to_unit([fp], [mu_r])
+    fitted = [
+        {
+            "observable": obs,
+            "normal_stress_kpa": s,
+            "lab_kpa": y,
+            "model_kpa": float(sg.mean(best_unit)[0]),
+            "noise_sd_kpa": sd,
+        }
+        for (obs, s, y), sg, sd in zip(targets, surrogates, post.noise_sd, strict=True)
+    ]
+    return CalibrationResult(
+        best={"particle_friction": fp, "rolling_friction": mu_r},
+        intervals=intervals,
+        level=level,
+        posterior={
+            "median": {"particle_friction": post.median("fp"), "rolling_friction": post.median("mu_r")},
+            "correlation": post.correlation(),
+            "wide": wide,
+            "grid": model.GRID,
+            "prior": "uniform in log(f_p) and mu_r over the ranges",
+            "observables": fitted,
+            "noise_correlation": post.noise_correlation,
+        },
+        evaluations=table,
+        fit={f"{obs}_{s:g}kPa": sg.to_dict() for (obs, s, _), sg in zip(targets, surrogates, strict=True)},
+        lab=lab_data.to_dict(),
+        specimens={k: str(v) for k, v in found.items()},
+        ranges=ranges.to_dict(),
+        settings=base,
+        cluster=runner.info(),
+        failures=runner.failures,
+        timings={"wall_time_s": time.perf_counter() - t0},
+        config=dict(config, points=points, refine=refine, design_seed=design_seed, lab_error=lab_error),
+        provenance=provenance(),
+    )
+
+
+__all__ = ["DEFAULT_FP_RANGE", "DEFAULT_MU_R_RANGE", "CalibrationResult", "run_calibration"]

@@ -1,0 +1,88 @@
+"""The replicate specimens a calibration shears: given folders, or the paper preset over seeds.
+
+``--preset paper`` runs the criterion of ``poro2d paper`` on the first seed (its accepted
+porosity is the first trial of the others) and replicate criterion runs on the next seeds,
+as ``poro2d paper`` does; both are resumable, so a rerun reads the specimens back.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from poro2d.dem import checkpoint
+from poro2d.errors import InputError, check_int
+from poro2d.shear.specimen_file import resolve_specimen
+
+#: the most replicate specimens of the preset (each is a criterion run)
+MAX_REPLICATES = 20
+
+
+def given_specimens(paths: list[str | os.PathLike]) -> dict[str, Path]:
+    """Specimens by label (their folder or file name; made unique) from ``--specimen`` paths."""
+    if not paths:
+        raise InputError("--specimen", "none", "at least one specimen (or --preset paper)")
+    found: dict[str, Path] = {}
+    for given in paths:
+        path = resolve_specimen(given)
+        checkpoint.read(path)  # a damaged file is refused here, in one line
+        label = path.parent.name if path.name == "specimen.npz" else path.stem
+        label = label or "specimen"
+        unique, k = label, 1
+        while unique in found:
+            k += 1
+            unique = f"{label}-{k}"
+        found[unique] = path
+    return found
+
+
+def check_preset(preset: str | None, quick: bool, replicates: int) -> None:
+    """``--preset`` is ``paper`` (the only one), ``--quick`` only with it, replicates in range."""
+    if preset is not None and preset != "paper":
+        raise InputError("--preset", preset, "paper")
+    if quick and preset is None:
+        raise InputError("--quick", True, "only with --preset paper")
+    check_int("--replicates", replicates, 1, MAX_REPLICATES)
+
+
+def preset_specimens(
+    out: Path, *, quick: bool, seed: int, replicates: int, progress: bool
+) -> dict[str, Path]:
+    """The paper preset's accepted specimens for ``replicates`` seeds from ``seed``, under ``out``.
+
+    The criterion runs once on ``seed`` (``out/criterion``), then on the next seeds from its
+    accepted porosity (``out/replicates``); seeds whose criterion does not converge are left out.
+    """
+    from poro2d.criterion.config import build
+    from poro2d.criterion.protocol import PorosityCriterion
+    from poro2d.criterion.replicates import run_replicates
+    from poro2d.paper import paper_config
+
+    seed = check_int("--seed", seed, 0)
+    cfg = paper_config(quick, seed)
+    spec, grading, settings, sd = build(cfg, None, threads=min(os.cpu_count() or 1, 2))
+    crit = PorosityCriterion(
+        spec, grading, settings, seed=sd, out=out / "criterion", progress=progress, config=cfg
+    )
+    crit.validate()
+    result = crit.run()
+    if not result.converged:
+        raise RuntimeError(f"the criterion of seed {seed} did not converge: {result.message}")
+    specimens = {f"seed{seed}": out / "criterion" / "specimen.npz"}
+    if replicates > 1:
+        extra = list(range(seed + 1, seed + replicates))
+        more, _ = run_replicates(
+            spec,
+            grading,
+            settings,
+            result.final_porosity,
+            extra,
+            out / "replicates",
+            processes=spec.threads,
+            progress=progress,
+        )
+        specimens.update(more)
+    return specimens
+
+
+__all__ = ["MAX_REPLICATES", "check_preset", "given_specimens", "preset_specimens"]

@@ -1,0 +1,67 @@
+"""Synthetic "laboratory" data: poro2d's own direct shear at known (f_p, mu_r).
+
+Used to check that a calibration recovers what it claims (never as real laboratory data):
+the CSV says so in its header, with the parameters, specimen and settings that made it.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from poro2d.io_utils import atomic_path
+from poro2d.shear.settings import ShearSettings
+from poro2d.shear.single import DirectShearTest
+
+
+def synthetic_lab(
+    specimen: str | os.PathLike,
+    normal_stresses_kpa,
+    particle_friction: float,
+    rolling_friction: float,
+    path: str | os.PathLike,
+    *,
+    settings: dict | None = None,
+    work: str | os.PathLike | None = None,
+    curves: bool = True,
+) -> Path:
+    """Shear ``specimen`` at each stress with the given frictions; write the lab CSV at ``path``.
+
+    ``curves``: the whole curves (the lab curve layout), else one peak per stress.
+    ``work``: where the tests run (default: beside ``path``).
+    """
+    base = dict(settings or {}, particle_friction=particle_friction, rolling_friction=rolling_friction)
+    base.setdefault("stop_after_peak", 0.0)
+    sset = ShearSettings(**base)
+    path = Path(path)
+    work = Path(work) if work is not None else path.with_name(path.stem + "-tests")
+    header = [
+        "# SYNTHETIC laboratory data, not measured: made by poro2d's own direct shear",
+        f"# at particle_friction = {particle_friction}, rolling_friction = {rolling_friction}",
+        f"# on the specimen {specimen}",
+        f"# shear settings: max_displacement = {sset.max_displacement} m, velocity = {sset.velocity} m/s",
+    ]
+    lines = [
+        "normal_stress_kpa,shear_displacement_mm,shear_stress_kpa"
+        if curves
+        else "normal_stress_kpa,peak_shear_stress_kpa"
+    ]
+    for sigma in sorted(float(s) for s in normal_stresses_kpa):
+        res = DirectShearTest(
+            specimen, sigma, sset, out=work / f"sn{sigma:g}kPa", figures=False, threads=1
+        ).run()
+        if not curves:
+            lines.append(f"{sigma:g},{res['peak_shear_stress_kpa']:.4f}")
+            continue
+        import pandas as pd
+
+        table = pd.read_csv(work / f"sn{sigma:g}kPa" / "curve.csv")
+        for d, t in zip(table["shear_displacement_mm"], table["shear_stress_kpa"], strict=True):
+            lines.append(f"{sigma:g},{d:.5f},{t:.4f}")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(path) as tmp:
+        tmp.write_text("\n".join(header + lines) + "\n")
+    return path
+
+
+__all__ = ["synthetic_lab"]

@@ -1,0 +1,99 @@
+"""One shear test of a calibration: (specimen, normal stress, f_p, mu_r), cached by content.
+
+A unit's folder under ``cache/`` is named by a hash of what decides its result (the
+specimen's content, the normal stress, every shear setting with the two frictions), so
+a rerun, a second round or another calibration on the same specimens reuses it; inside,
+:class:`poro2d.shear.single.DirectShearTest` resumes a test that was killed.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+import numpy as np
+
+from poro2d.shear.settings import ShearSettings
+from poro2d.shear.single import DirectShearTest
+
+#: what a unit returns besides its identity: the observables a calibration may fit
+OBSERVABLES = ("peak", "end")
+
+
+def unit_key(specimen_digest: str, sigma: float, settings: dict) -> str:
+    """The content hash naming a unit's folder."""
+    text = json.dumps({"specimen": specimen_digest, "sigma": sigma, "settings": settings}, sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:20]
+
+
+def unit_job(
+    specimen: Path, digest: str, sigma: float, base: dict, fp: float, mu_r: float, cache: Path
+) -> dict:
+    """The job of one unit (a plain dict: it travels to a Dask worker)."""
+    settings = dict(base, particle_friction=fp, rolling_friction=mu_r)
+    ShearSettings(**settings)  # refused here, on the driver, before any work
+    key = unit_key(digest, sigma, settings)
+    return {
+        "key": key,
+        "specimen": str(specimen),
+        "digest": digest,
+        "sigma": float(sigma),
+        "fp": fp,
+        "mu_r": mu_r,
+        "settings": settings,
+        "out": str(cache / key),
+    }
+
+
+def _test(job: dict, threads: int = 1) -> DirectShearTest:
+    return DirectShearTest(
+        job["specimen"],
+        job["sigma"],
+        ShearSettings(**job["settings"]),
+        out=job["out"],
+        figures=False,
+        threads=threads,
+        specimen_digest=job["digest"],
+    )
+
+
+def _row(job: dict, res) -> dict:
+    return {
+        "key": job["key"],
+        "sigma": job["sigma"],
+        "fp": job["fp"],
+        "mu_r": job["mu_r"],
+        "specimen": job["specimen"],
+        "peak": float(res["peak_shear_stress_kpa"]),
+        "end": float(res["end"]["shear_stress_kpa"]),
+        "wall_time_s": float(res["wall_time_s"]),
+    }
+
+
+def stored_row(job: dict) -> dict | None:
+    """The unit's row when its folder holds the finished test, else None."""
+    res = _test(job).stored()
+    return None if res is None else _row(job, res)
+
+
+def run_unit(job: dict) -> dict:
+    """Run (or finish) one unit, on one numba thread: the task a Dask worker runs."""
+    from poro2d.sweep.runner import _pin_numba_threads
+
+    _pin_numba_threads()
+    return _row(job, _test(job).run())
+
+
+def unit_curve(job: dict) -> tuple[np.ndarray, np.ndarray] | None:
+    """The unit's curve (shear displacement m, shear stress kPa), or None when it has none."""
+    path = Path(job["out"]) / "curve.csv"
+    if not path.is_file():
+        return None
+    import pandas as pd
+
+    table = pd.read_csv(path)
+    return table["shear_displacement_mm"].to_numpy() * 1e-3, table["shear_stress_kpa"].to_numpy()
+
+
+__all__ = ["OBSERVABLES", "run_unit", "stored_row", "unit_curve", "unit_job", "unit_key"]

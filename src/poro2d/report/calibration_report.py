@@ -1,0 +1,92 @@
+"""The calibration section of a report: ``calibration.md`` and ``calibration.html`` beside result.json."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from poro2d.report.document import write_report
+
+
+def interval_text(result, name: str) -> str:
+    lo, hi = result.intervals[name]
+    median = result.posterior["median"][name]
+    return (
+        f"{result.best[name]:.3g} at the posterior maximum; marginal median {median:.3g},"
+        f" {result.level:.0%} interval {lo:.3g} to {hi:.3g}"
+    )
+
+
+def identifiability_note(result) -> str:
+    """What the posterior says about identifiability, in words."""
+    wide = [n for n, w in result.posterior["wide"].items() if w]
+    corr = result.posterior["correlation"]
+    text = f"The posterior correlation of log(f_p) and mu_r is {corr:+.2f}."
+    if abs(corr) > 0.7:
+        text += (
+            " The laboratory values fix a combination of the two frictions (a ridge in the posterior"
+            " figure) better than either one."
+        )
+    if wide:
+        names = " and ".join("f_p" if n == "particle_friction" else "mu_r" for n in wide)
+        verb = "spans" if len(wide) == 1 else "span"
+        text += (
+            f" The interval of {names} {verb} more than half the search range: these data do not identify"
+            " it well. Peak strengths alone often cannot separate sliding from rolling resistance;"
+            " whole curves that soften (the end stress), more normal stresses or more replicate"
+            " specimens narrow it."
+        )
+    else:
+        text += " Both intervals are narrower than half their search ranges."
+    return text
+
+
+def calibration_blocks(result, out: Path) -> list[tuple]:
+    """The section's blocks: best values, identifiability, the fit table and the two figures."""
+    rows = [
+        [o["observable"], o["normal_stress_kpa"], o["lab_kpa"], o["model_kpa"], o["noise_sd_kpa"]]
+        for o in result.posterior["observables"]
+    ]
+    info = result.cluster
+    return [
+        ("h2", "Calibration of particle and rolling friction"),
+        (
+            "p",
+            f"Laboratory data: {result.lab['source']} ({result.lab['kind']}); "
+            f"{len(result.specimens)} replicate specimen(s); {len(result.evaluations)} design points.",
+        ),
+        (
+            "ul",
+            [
+                f"particle friction f_p = {interval_text(result, 'particle_friction')}",
+                f"rolling friction mu_r = {interval_text(result, 'rolling_friction')}",
+            ],
+        ),
+        ("p", identifiability_note(result)),
+        (
+            "table",
+            ["observable", "normal stress (kPa)", "laboratory (kPa)", "model (kPa)", "noise sd (kPa)"],
+            rows,
+        ),
+        (
+            "img",
+            str(out / "calibration_fit.png"),
+            "The calibrated model beside the laboratory values and curves.",
+        ),
+        (
+            "img",
+            str(out / "calibration_posterior.png"),
+            "The posterior over (f_p, mu_r), with the evaluated points.",
+        ),
+        (
+            "p",
+            f"Shear tests: {info['tests_run']} run, {info['tests_reused']} reused from the cache, "
+            f"{info['tests_failed']} failed; wall time {result.timings['wall_time_s']:.0f} s.",
+        ),
+    ]
+
+
+def write_calibration_report(out: Path, result) -> list[Path]:
+    return write_report(calibration_blocks(result, out), out, "calibration", "poro2d calibration")
+
+
+__all__ = ["calibration_blocks", "interval_text", "identifiability_note", "write_calibration_report"]

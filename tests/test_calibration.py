@@ -1,0 +1,235 @@
+"""``poro2d calibrate``: the statistics on known surfaces, the refusals, and the identifiability
+check of the whole command: "laboratory" data made by poro2d at known (f_p, mu_r) on another
+seed are recovered within the reported intervals (synthetic data, never measured ones)."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from poro2d.calibration import model, run_calibration, synthetic_lab
+from poro2d.cli import main
+from poro2d.dem import checkpoint
+from poro2d.errors import InputError
+from poro2d.shear.cli import load_shear_config
+from poro2d.specimen import paper_grading
+from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
+
+RANGES = model.Ranges((0.3, 3.0), (0.0, 0.5))
+
+
+def _quadratic(unit: np.ndarray, a: float, b: float) -> np.ndarray:
+    u, v = unit[:, 0], unit[:, 1]
+    return 40.0 + a * u + b * v - 10.0 * u * u + 5.0 * u * v
+
+
+def _surrogates(funcs, design: np.ndarray) -> list[model.Surrogate]:
+    # two replicates per point, +-0.5 kPa around the surface: the scatter is 0.5 * sqrt(2)
+    return [model.fit_surrogate(design, np.column_stack([f(design) - 0.5, f(design) + 0.5])) for f in funcs]
+
+
+def _posterior(funcs, truth_unit: np.ndarray) -> model.Posterior:
+    design = RANGES.to_unit(*np.array(model.space_filling(RANGES, 12, 0)).T)
+    surrogates = _surrogates(funcs, design)
+    lab = [float(f(truth_unit)[0]) for f in funcs]
+    values = np.stack([np.column_stack([f(design) - 0.5, f(design) + 0.5]) for f in funcs], axis=1)
+    cov = model.noise_covariance(surrogates, model.seed_covariance(values), lab, 0.0)
+    return model.posterior(RANGES, surrogates, lab, cov)
+
+
+def test_two_independent_observables_pin_both_parameters_within_narrow_intervals():
+    truth = (0.8, 0.15)
+    unit = RANGES.to_unit([truth[0]], [truth[1]])
+    post = _posterior([lambda x: _quadratic(x, 30.0, 5.0), lambda x: _quadratic(x, 2.0, 40.0)], unit)
+    fp_lo, fp_hi = post.interval("fp", 0.95)
+    mr_lo, mr_hi = post.interval("mu_r", 0.95)
+    assert fp_lo <= truth[0] <= fp_hi and mr_lo <= truth[1] <= mr_hi
+    assert math.log(fp_hi / fp_lo) < 0.2 * math.log(10.0) and mr_hi - mr_lo < 0.1
+    assert fp_lo <= post.median("fp") <= fp_hi and mr_lo <= post.median("mu_r") <= mr_hi
+    best = post.best()
+    assert best[0] == pytest.approx(truth[0], rel=0.05) and best[1] == pytest.approx(truth[1], abs=0.01)
+
+
+def test_one_combination_of_the_parameters_is_a_ridge_with_wide_intervals():
+    # both observables depend on u + v only: the data cannot tell f_p from mu_r
+    def along(x):
+        return 40.0 + 30.0 * (x[:, 0] + x[:, 1])
+
+    def along2(x):
+        return 80.0 + 50.0 * (x[:, 0] + x[:, 1])
+
+    post = _posterior([along, along2], RANGES.to_unit([0.8], [0.2]))
+    assert post.correlation() < -0.9
+    lo, hi = post.interval("mu_r", 0.95)
+    assert hi - lo > 0.5 * 0.5
+
+
+def test_seed_covariance_sees_a_specimen_strong_at_every_stress():
+    rng = np.random.default_rng(0)
+    level = rng.normal(0.0, 5.0, size=(20, 1, 3))  # one shift per specimen, the same at both stresses
+    values = 50.0 + level + np.zeros((20, 2, 3))
+    cov = model.seed_covariance(values)
+    corr = cov[0, 1] / math.sqrt(cov[0, 0] * cov[1, 1])
+    assert corr == pytest.approx(1.0 - model.SHRINK)
+
+
+def test_space_filling_design_lies_in_the_ranges_and_repeats_with_its_seed():
+    a = model.space_filling(RANGES, 10, 3)
+    assert a == model.space_filling(RANGES, 10, 3) and a != model.space_filling(RANGES, 10, 4)
+    fp, mu_r = np.array(a).T
+    assert (fp >= 0.3).all() and (fp <= 3.0).all() and (mu_r >= 0.0).all() and (mu_r <= 0.5).all()
+    # a Latin hypercube: one point in each tenth of either axis
+    unit = RANGES.to_unit(fp, mu_r)
+    assert sorted(np.floor(unit[:, 0] * 10).astype(int).clip(0, 9)) == list(range(10))
+
+
+# ------------------------------------------------------------------ the command, end to end
+SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4, "record_interval": 5e-5}
+TRUTH = {"particle_friction": 0.8, "rolling_friction": 0.15}
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    """Three small specimens (0.06 m x 0.03 m): seeds 0 and 1 calibrate, seed 2 is the 'laboratory'."""
+    root = tmp_path_factory.mktemp("tiny")
+    paths = {}
+    for seed in (0, 1, 2):
+        sim, rep = prepare_specimen(SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.2,
+                                    seed=seed)  # fmt: skip
+        assert rep["converged"]
+        paths[seed] = root / f"seed{seed}.npz"
+        checkpoint.save(sim, paths[seed])
+    lab = synthetic_lab(paths[2], [50, 100], TRUTH["particle_friction"], TRUTH["rolling_friction"],
+                        root / "lab.csv", settings=SHORT)  # fmt: skip
+    return paths, lab
+
+
+def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tmp_path):
+    paths, lab = tiny
+    assert lab.read_text().startswith("# SYNTHETIC")
+    out = tmp_path / "cal"
+    res = run_calibration(lab, [paths[0], paths[1]], out=out, points=8, refine=2, settings=SHORT, workers=1,
+                          dashboard=None, progress=False)  # fmt: skip
+    for name, value in TRUTH.items():
+        lo, hi = res.intervals[name]
+        assert lo <= value <= hi, (name, value, lo, hi)
+        assert lo <= res.posterior["median"][name] <= hi
+    assert res == json.loads((out / "result.json").read_text())
+    assert len(res.evaluations) == 10 and res.cluster["tests_run"] == 10 * 2 * 2
+    assert {o["observable"] for o in res.posterior["observables"]} == {"peak", "end"}
+    for f in ("calibration_fit.png", "calibration_posterior.png", "calibration.md", "calibration.html"):
+        assert (out / f).stat().st_size > 0, f
+    table, _ = load_shear_config(out / "calibrated.toml")
+    assert table["particle_friction"] == res.best["particle_friction"]
+    assert table["rolling_friction"] == res.best["rolling_friction"]
+    again = run_calibration(lab, [paths[0], paths[1]], out=out, points=8, refine=2, settings=SHORT, workers=1,
+                            dashboard=None, progress=False)  # fmt: skip
+    assert again.cluster["tests_run"] == 0 and again.cluster["tests_reused"] == 40
+    assert again.best == res.best
+    # a weaker 'laboratory' (the same specimen at lower frictions) moves the answer to weaker
+    # parameters: the calibration follows its data (round 1 comes from the cache)
+    weak_lab = synthetic_lab(paths[2], [50, 100], 0.3, 0.0, tmp_path / "weak.csv", settings=SHORT)
+    weak = run_calibration(weak_lab, [paths[0], paths[1]], out=out, points=8, refine=2, settings=SHORT,
+                           workers=1, dashboard=None, progress=False)  # fmt: skip
+    peaks = {
+        o["normal_stress_kpa"]: o["model_kpa"]
+        for o in res.posterior["observables"]
+        if o["observable"] == "peak"
+    }
+    for o in weak.posterior["observables"]:
+        if o["observable"] == "peak":
+            assert o["model_kpa"] < peaks[o["normal_stress_kpa"]]
+    assert weak.posterior["median"]["particle_friction"] < res.posterior["median"]["particle_friction"]
+
+
+@pytest.mark.parametrize(
+    ("kw", "name"),
+    [
+        ({"fp_range": (0.0, 3.0)}, "--fp-range"),
+        ({"fp_range": (2.0, 1.0)}, "--fp-range"),
+        ({"mu_r_range": (0.0, 1.5)}, "--mu-r-range"),
+        ({"points": 5}, "--points"),
+        ({"refine": -1}, "--refine"),
+        ({"lab_error": 2.0}, "--lab-error"),
+        ({"level": 1.0}, "--level"),
+        ({"settings": {"particle_friction": 1.0}}, "settings.particle_friction"),
+        ({"settings": {"max_displacement": 0.05}}, "max_displacement"),
+        ({"workers": 0}, "--workers"),
+        ({"quick": True}, "--quick"),
+        ({"preset": "other"}, "--preset"),
+    ],
+)
+def test_bad_input_is_refused_before_any_test(tiny, tmp_path, kw, name):
+    paths, lab = tiny
+    out = tmp_path / "out"
+    args = {"settings": SHORT, "progress": False} | kw
+    with pytest.raises(InputError, match=name):
+        run_calibration(lab, [paths[0]], out=out, **args)
+    assert not (out / "result.json").exists() and not (out / "cache").exists()
+
+
+def _refusal(argv: list[str], capsys) -> str:
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    out, err = capsys.readouterr()
+    assert exc.value.code == 2 and not out
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, lines
+    return lines[0]
+
+
+@pytest.mark.parametrize(
+    ("extra", "words"),
+    [
+        ([], ["line 3", "lab.csv"]),
+        (["--fp-range", "1"], ["--fp-range"]),
+        (["--mu-r-range", "0.2,0.1"], ["--mu-r-range"]),
+        (["--points", "2"], ["--points"]),
+        (["--preset", "paper"], ["--specimen"]),
+        (["--specimen", "damaged"], ["checkpoint"]),
+    ],
+)
+def test_the_command_refuses_bad_input_on_one_line(tiny, tmp_path, capsys, extra, words):
+    paths, _ = tiny
+    bad = tmp_path / "lab.csv"
+    bad.write_text("normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,abc\n" if not extra else
+                   "normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,70\n")  # fmt: skip
+    (tmp_path / "damaged.npz").write_bytes(paths[0].read_bytes()[:100])
+    extra = [str(tmp_path / "damaged.npz") if e == "damaged" else e for e in extra]
+    out = tmp_path / "out"
+    line = _refusal(["calibrate", "--lab", str(bad), "--specimen", str(paths[0]), "--out", str(out), *extra],
+                    capsys)  # fmt: skip
+    assert all(w in line for w in words), line
+    assert not (out / "cache").exists() and not (out / "specimens").exists()
+
+
+def test_shear_settings_take_a_rolling_friction_for_every_disk(tiny):
+    from poro2d.shear import ShearSettings, build_split_box
+
+    with pytest.raises(InputError, match="rolling_friction"):
+        ShearSettings(rolling_friction=1.5)
+    spec = checkpoint.load(tiny[0][0])
+    sim, _ = build_split_box(spec, 0.002, rolling_friction=0.25)
+    assert (sim.particles.mu_r == 0.25).all()
+    spec.particles.mu_r[:] = 0.1  # a specimen prepared with rolling resistance keeps it in the box
+    kept, _ = build_split_box(spec, 0.002)
+    assert (kept.particles.mu_r == 0.1).all()
+
+
+def test_lab_curves_shorter_than_the_tests_are_refused_and_their_end_is_the_last_window(tiny, tmp_path):
+    from poro2d.calibration.run import _lab_targets
+    from poro2d.shear.lab import read_lab_csv
+
+    paths, _ = tiny
+    short = tmp_path / "short.csv"
+    short.write_text("normal_stress_kpa,shear_displacement_mm,shear_stress_kpa\n50,0.5,20\n50,1.0,30\n")
+    with pytest.raises(InputError, match="settings.max_displacement"):
+        run_calibration(short, [paths[0]], out=tmp_path / "o", settings=SHORT, progress=False)
+    assert not (tmp_path / "o" / "cache").exists()
+    curves = tmp_path / "curves.csv"
+    curves.write_text("normal_stress_kpa,shear_displacement_mm,shear_stress_kpa\n"
+                      "50,0.5,40\n50,1.0,30\n50,1.7,22\n50,2.0,18\n50,2.5,5\n")  # fmt: skip
+    targets = _lab_targets(read_lab_csv(curves), {"max_displacement": 0.002, "peak_window": 5e-4})
+    # the peak, and the mean of the readings within the last window before 2 mm (1.5 to 2 mm)
+    assert targets == [("peak", 50.0, 40.0), ("end", 50.0, 20.0)]
