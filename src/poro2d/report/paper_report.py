@@ -26,8 +26,24 @@ def build_blocks(out: Path, summary: dict) -> list[Block]:
         b += report_blocks(sens)
     if summary.get("shear"):
         b += _shear_blocks(out, summary["shear"])
+    b += _calibration_blocks(out / CALIBRATION_FOLDER)
     b += _provenance_blocks(summary, crit)
     return b
+
+
+#: where ``poro2d calibrate --out`` puts a calibration the paper report shows (``paper-out/calibration``)
+CALIBRATION_FOLDER = "calibration"
+
+
+def _calibration_blocks(cal: Path) -> list[Block]:
+    """The calibration's section, when ``poro2d calibrate --out <paper-out>/calibration`` has run."""
+    record = _load(cal / "result.json")
+    if record is None:
+        return []
+    from poro2d.calibration.run import CalibrationResult
+    from poro2d.report.calibration_report import calibration_blocks
+
+    return calibration_blocks(CalibrationResult.from_dict(record), cal)
 
 
 def _intro_blocks(summary: dict, crit: dict) -> list[Block]:
