@@ -15,3 +15,12 @@ def specimen(tmp_path_factory):
     path = tmp_path_factory.mktemp("specimen") / "specimen.npz"
     checkpoint.save(sim, path)
     return path
+
+
+def default_sigint() -> None:
+    """``preexec_fn`` for a child that must answer Ctrl-C: a shell without job control starts
+    its background commands (``cmd &``, as a CI runner may) with SIGINT ignored, children
+    inherit that, and Python then installs no KeyboardInterrupt handler."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)

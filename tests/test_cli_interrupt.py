@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from conftest import default_sigint
 from poro2d.cli import main
 from poro2d.criterion import PorosityCriterion
 
@@ -33,7 +34,8 @@ def test_sigint_during_a_run(tmp_path):
     out = tmp_path / "o"
     env = dict(os.environ, PYTHONPATH=str(SRC))
     cmd = [sys.executable, "-m", "poro2d.cli", "criterion", "--preset", "paper", "--out", str(out), "--quiet"]
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=default_sigint)  # fmt: skip
     try:
         deadline = time.monotonic() + 120
         while not (out / "config.json").is_file():  # written once the options are checked

@@ -16,6 +16,8 @@ from pathlib import Path
 
 import pytest
 
+from conftest import default_sigint
+
 SRC = Path(__file__).resolve().parents[1] / "src"
 
 
@@ -26,7 +28,7 @@ def test_ctrl_c_prints_one_line(tmp_path, after_s):
     cmd = [sys.executable, "-m", "poro2d.cli", "relation", "--preset", "paper", "--quick", "--workers", "1",
            "--out", str(out), "--quiet"]  # fmt: skip
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)  # fmt: skip
+                            start_new_session=True, preexec_fn=default_sigint)  # fmt: skip
     try:
         time.sleep(after_s)
         assert proc.poll() is None, proc.communicate()  # the quick relation takes minutes
