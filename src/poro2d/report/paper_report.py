@@ -40,10 +40,13 @@ def _calibration_blocks(cal: Path) -> list[Block]:
     record = _load(cal / "result.json")
     if record is None:
         return []
-    from poro2d.calibration.run import CalibrationResult
+    from types import SimpleNamespace
+
     from poro2d.report.calibration_report import calibration_blocks
 
-    return calibration_blocks(CalibrationResult.from_dict(record), cal)
+    # the section reads the record's fields by name; the calibration package sits above the
+    # report (it runs the paper's specimens), so its result class is not imported here
+    return calibration_blocks(SimpleNamespace(**record), cal)
 
 
 def _intro_blocks(summary: dict, crit: dict) -> list[Block]:
