@@ -56,11 +56,11 @@ def prepared():
     return spec, sim
 
 
-def test_the_lid_replaces_the_plate_and_its_force_is_the_top_force(prepared):
+def test_the_lid_replaces_the_plate_and_its_force_is_the_top_force(prepared, tmp_path):
     spec, sim0 = prepared
     from poro2d.dem import checkpoint
 
-    sim = checkpoint.load(checkpoint.save(sim0, _tmp_npz()))
+    sim = checkpoint.load(checkpoint.save(sim0, tmp_path / "s.npz"))
     top_y = float(sim.walls.p0[sim.walls.index("top"), 1])
     idx = install_lid(sim, spec.width, mass_d50(sim.particles.radius))
     assert len(idx) == segment_count(spec.width, mass_d50(sim.particles.radius))
@@ -74,13 +74,6 @@ def test_the_lid_replaces_the_plate_and_its_force_is_the_top_force(prepared):
         float(sim.wall_force("top")[1]) / t + lid_force(sim) / t
     )
     assert lid_indices(sim) == idx
-
-
-def _tmp_npz():
-    import tempfile
-    from pathlib import Path
-
-    return Path(tempfile.mkdtemp()) / "s.npz"
 
 
 def _one_trial(spec, acceptance: str) -> dict:
@@ -131,11 +124,11 @@ def test_the_acceptance_mode_is_checked_and_left_out_of_old_records():
     assert CriterionSettings(acceptance="fill").to_record()["acceptance"] == "fill"
 
 
-def test_a_lid_counts_as_resting_only_while_it_bears_on_most_of_the_width(prepared):
+def test_a_lid_counts_as_resting_only_while_it_bears_on_most_of_the_width(prepared, tmp_path):
     spec, sim0 = prepared
     from poro2d.dem import checkpoint
 
-    sim = checkpoint.load(checkpoint.save(sim0, _tmp_npz()))
+    sim = checkpoint.load(checkpoint.save(sim0, tmp_path / "s.npz"))
     lid = SegmentedLid(sim, spec.width, mass_d50(sim.particles.radius))
     total = 0.005 * float(np.sum(sim.particles.mass)) * 9.81
     for i in lid_indices(sim):

@@ -499,7 +499,7 @@ class PorosityCriterion:
         s = self.settings
         t = sim.particles.thickness
         cap = s.force_fraction * weight  # N/m
-        target = s.servo_target_fraction * cap * t  # N
+        target = self._servo_target(weight, sim)  # N
 
         def left() -> int:
             return max(s.max_plate_steps - steps, 1)
@@ -652,7 +652,7 @@ class PorosityCriterion:
             row.update(self._move_plate(sim, n, weight, lid))
             profile = lid_profile(sim, self.spec.width)
             row["new_porosity"] = fill_porosity(sim.particles.radius, profile)
-            row.update(lid_numbers(sim, profile, self._lid_target(weight, sim)))
+            row.update(lid_numbers(sim, profile, self._servo_target(weight, sim)))
             row["lid_note"] = lid_window_note(sim, profile, row["force_limit_n_per_m"])
         else:
             row["plate_moved"] = "down" if f_top <= 0.0 else "up"
@@ -685,10 +685,10 @@ class PorosityCriterion:
             )  # fmt: skip
         return after
 
-    def _lid_target(self, weight: float, sim: Simulation) -> float:
-        """The force (N) the plate or lid servos to: a share of the window's limit."""
+    def _servo_target(self, weight: float, sim: Simulation) -> float:
+        """The force (N) the plate or lid servos to: ``servo_target_fraction`` of the window's limit."""
         s = self.settings
-        return s.servo_target_fraction * s.force_fraction * weight * sim.particles.thickness
+        return s.servo_target_fraction * (s.force_fraction * weight) * sim.particles.thickness
 
     def _lid(self, sim: Simulation) -> tuple[np.ndarray, np.ndarray] | None:
         """The lid's (edges, heights) when the trial rested one, else None."""
