@@ -143,3 +143,37 @@ def test_a_lid_counts_as_resting_only_while_it_bears_on_most_of_the_width(prepar
     sim.run(30_000)
     assert lid.resting(sim, total)
     assert 0.5 * total < lid.force(sim) < 3.0 * total  # converging on its target
+
+
+def test_what_leaves_the_criterion_is_a_box_of_four_walls_with_the_plate_on_the_highest_segment(
+    prepared, tmp_path
+):
+    from poro2d.criterion.lid import flat_top
+    from poro2d.dem import checkpoint
+
+    spec, sim0 = prepared
+    sim = checkpoint.load(checkpoint.save(sim0, tmp_path / "s.npz"))
+    sim.set_rolling_friction(0.1, walls=0.1)  # a rolling specimen keeps its rolling friction
+    SegmentedLid(sim, spec.width, mass_d50(sim.particles.radius))
+    for k, i in enumerate(lid_indices(sim)):
+        sim.translate_wall(i, 0.0, -0.001 * (k % 3))  # a stepped lid
+    box = flat_top(sim, spec.width)
+    assert box.walls.names == ["bottom", "right", "top", "left"]
+    top = float(box.walls.p0[box.walls.index("top"), 1])
+    assert top == pytest.approx(lid_profile(sim, spec.width).heights.max(), abs=1e-15)
+    assert np.array_equal(box.particles.pos, sim.particles.pos)
+    assert np.all(box.particles.mu_r == 0.1)
+
+
+def test_a_window_finer_than_the_lid_can_rest_in_is_named_in_the_refusal(prepared, tmp_path):
+    from poro2d.criterion.lid import lid_window_note
+    from poro2d.dem import checkpoint
+
+    spec, sim0 = prepared
+    sim = checkpoint.load(checkpoint.save(sim0, tmp_path / "s.npz"))
+    SegmentedLid(sim, spec.width, mass_d50(sim.particles.radius))
+    profile = lid_profile(sim, spec.width)
+    weight = float(np.sum(sim.particles.mass)) * 9.81 / sim.particles.thickness
+    assert lid_window_note(sim, profile, 0.05 * weight) == ""  # a window of many grain weights
+    note = lid_window_note(sim, profile, 1e-4 * weight)
+    assert "lid segments" in note and "acceptance = 'plate'" in note
