@@ -205,7 +205,7 @@ def with_rolling(sim, mu_r: float) -> None:
 
 
 def _set_threads(sim, threads: int) -> None:
-    sim.threads = sim._check_threads(threads)
+    sim.threads = sim.check_threads(threads)
     sim.parallel_min_particles = 0  # measure what was asked, whatever the size
 
 
@@ -267,12 +267,12 @@ def paired(a: list[float], b: list[float]) -> dict:
 
 
 def contact_stats(sim) -> dict:
-    nb = int(sim._nb_start[-1])
-    touching = int(np.count_nonzero(sim._nb_ov[:nb] > 0.0))
+    nb = sim.pairs.used
+    touching = len(sim.pairs.touching())
     return {
         "verlet_pairs_per_disk": nb / sim.particles.n,
         "touching_pairs_per_disk": touching / sim.particles.n,
-        "wall_pairs": int(sim._wb_start[-1]),
+        "wall_pairs": sim.wall_pairs.used,
     }
 
 
@@ -388,7 +388,7 @@ def skin_study(ck: Path, factors, steps: int, repeats: int, threads: int = 1) ->
         bt = []
         for _ in range(5):
             t0 = time.perf_counter()
-            sim._iprm[K.NEED_BUILD] = 1
+            sim.kernel_params.iprm[K.NEED_BUILD] = 1
             sim.run(1)
             bt.append(time.perf_counter() - t0)
         step1 = []

@@ -53,7 +53,7 @@ def baseline_state(cases=tuple(CASES)) -> dict[str, np.ndarray]:
         fields = {
             "pos": p.pos, "vel": p.vel, "theta": p.theta, "omega": p.omega, "force": sim.force,
             "moment": sim.moment, "wall_force": sim.wall_force_vec,
-            "nb_fs": sim._nb_fs[: sim._nb_start[-1]], "wb_fs": sim._wb_fs[: sim._wb_start[-1]],
+            "nb_fs": sim.pairs.fs[: sim.pairs.used], "wb_fs": sim.wall_pairs.fs[: sim.wall_pairs.used],
         }  # fmt: skip
         for name, arr in fields.items():
             out[f"{case}.{name}"] = np.array(arr)

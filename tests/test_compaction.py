@@ -122,7 +122,7 @@ def test_a_layer_that_fails_ends_the_preparation():
 def _deferred(sim) -> int:
     """Disks that wait for the second phase of a step (their pairs cross the partition cut)."""
     sim.run(1)
-    return int(sim._dstart[-1])
+    return int(sim.work.dstart[-1])
 
 
 def test_specimen_is_numbered_across_its_short_side(loose, tmp_path):

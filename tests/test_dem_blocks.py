@@ -22,7 +22,6 @@ import numpy as np
 import pytest
 
 from poro2d.dem import Particles, Simulation, Walls
-from poro2d.dem import kernels as K
 from poro2d.dem.state import SERVO_ERROR_SUM
 
 R = 1e-3
@@ -58,14 +57,14 @@ def _settling_box(nx: int = 12, ny: int = 22, cls: type[Simulation] = Simulation
 def _state(sim: Simulation, res) -> dict:
     """Everything a later step depends on, and what the run reported."""
     p, w = sim.particles, sim.walls
-    m = sim._nb_start[-1]
+    m = sim.pairs.used
     return {
         "pos": p.pos.copy(), "vel": p.vel.copy(), "theta": p.theta.copy(), "omega": p.omega.copy(),
         "force": sim.force.copy(), "moment": sim.moment.copy(), "wall_p0": w.p0.copy(),
         "wall_p1": w.p1.copy(), "wall_vel": w.vel.copy(), "wall_force": sim.wall_force_vec.copy(),
         "servo": w.servo.copy(), "time": np.array(sim.time), "step_count": np.array(sim.step_count),
         "steps": np.array(res.steps), "converged": np.array(res.converged),
-        "pairs": sim._nb_j[:m].copy(), "shear_history": sim._nb_fs[:m].copy(),
+        "pairs": sim.pairs.other[:m].copy(), "shear_history": sim.pairs.fs[:m].copy(),
     }  # fmt: skip
 
 
@@ -110,18 +109,18 @@ def test_callbacks_change_nothing(one_block, every):
 class _TightStorage(Simulation):
     """Pair storage grown to exactly what the last list build needed: it overflows again and again."""
 
-    def _alloc_pp(self, cap: int, keep: int = 0) -> None:
-        out = getattr(self, "_out", None)
-        if out is not None and out[K.NEED_PP] > 0:
+    def grow_pairs(self, capacity: int, keep: int = 0) -> None:
+        pairs = getattr(self, "pairs", None)
+        if pairs is not None and pairs.overflow:
             self.grown_at.append(self.step_count)
-            cap = int(out[K.NEED_PP])
-        super()._alloc_pp(cap, keep)
+            capacity = pairs.needed
+        super().grow_pairs(capacity, keep)
 
 
 def test_storage_overflows_change_nothing(one_block):
     sim = _settling_box(cls=_TightStorage)
     sim.grown_at = []
-    sim._alloc_pp(16)
+    sim.grow_pairs(16)
     _, state = _settle(sim=sim)
     _assert_same(one_block, state)
     late = [s for s in sim.grown_at if s % CHECK_EVERY]

@@ -16,7 +16,6 @@ import pytest
 
 from poro2d.dem import Particles, Simulation, Walls, checkpoint
 from poro2d.dem import kernels as K
-from poro2d.dem.records import kernel_records
 from poro2d.errors import InputError
 
 R = 1e-3
@@ -200,11 +199,13 @@ def test_reset_clock_restarts_the_count_and_nothing_else():
 def test_kernel_records_hold_the_simulations_arrays():
     sim = _grid_box()
     sim.run(10)
-    rec = kernel_records(sim)
+    rec = sim.kernel_records()
     n, nw = sim.particles.n, sim.walls.n
     # views, not copies: the kernel advances the state in place
     assert rec.disks.pos is sim.particles.pos and rec.walls.servo is sim.walls.servo
-    assert rec.nb.fs is sim._nb_fs and rec.wb.w is sim._wb_w and rec.work.dstart is sim._dstart
+    assert rec.nb.fs is sim.pairs.fs and rec.wb.w is sim.wall_pairs.other
+    assert rec.work.dstart is sim.work.dstart
+    assert rec.work.xpair is sim.pairs.cross and rec.disks.inv_mass is sim.masses.inv_mass
     ints = {"mode", "start", "j", "w", "new_start", "new_j", "new_w", "part", "xstart", "xpair",
             "dlist", "dstart", "sync", "cell", "members", "cstart", "cfill", "ginfo"}  # fmt: skip
     for record in rec:

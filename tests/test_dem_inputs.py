@@ -231,15 +231,15 @@ def test_contact_capacity_growth_drops_nothing():
     ref = _falling_heap()
     ref.run(30000)
     sim = _falling_heap()
-    sim._alloc_pp(16)
-    sim._alloc_pw(2)
+    sim.grow_pairs(16)
+    sim.grow_wall_pairs(2)
     sim.run(15000)
     # shrink again to exactly what is in use: the next rebuild overflows mid-run with history
-    used_pp, used_pw = int(sim._nb_start[-1]), int(sim._wb_start[-1])
-    sim._alloc_pp(used_pp, keep=used_pp)
-    sim._alloc_pw(max(used_pw, 1), keep=used_pw)
+    used_pp, used_pw = sim.pairs.used, sim.wall_pairs.used
+    sim.grow_pairs(used_pp, keep=used_pp)
+    sim.grow_wall_pairs(max(used_pw, 1), keep=used_pw)
     sim.run(15000)
-    assert len(sim._nb_j) > used_pp  # it did grow
+    assert sim.pairs.capacity > used_pp  # it did grow
     assert np.array_equal(sim.particles.pos, ref.particles.pos)
     assert np.array_equal(sim.particles.omega, ref.particles.omega)
     assert np.array_equal(sim.wall_force_vec, ref.wall_force_vec)

@@ -142,9 +142,9 @@ def test_strip_order_shortens_the_cross_band():
     p = Particles(pos=pos, radius=R * 1.001, density=2650.0, thickness=0.01, kn=1e6, ks=1e6, mu=0.3)
     sim = Simulation(p, Walls.box(0.0, 0.0, 120 * R, 24 * R, 1e6, 1e6, 0.3), gravity=(0.0, -9.81))
     sim.run(1)
-    deferred_rows = int(sim._dstart[-1])
+    deferred_rows = int(sim.work.dstart[-1])
     sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
     sim.run(1)
-    deferred_cols = int(sim._dstart[-1])
+    deferred_cols = int(sim.work.dstart[-1])
     assert deferred_rows >= 55  # about one row of 60
     assert deferred_cols <= 20  # about one column of 12 (plus the cut's step)

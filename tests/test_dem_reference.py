@@ -288,7 +288,7 @@ def test_partitions_fix_the_numbers_not_the_threads():
         assert sim.threads_used == threads
         runs[parts, threads] = sim
     a, b, c = runs[4, 1], runs[4, 2], runs[1, 1]
-    assert a._dstart[-1] > 10  # many disks wait for partners of earlier partitions
+    assert a.work.dstart[-1] > 10  # many disks wait for partners of earlier partitions
     for x, y, z in [(a.particles.pos, b.particles.pos, c.particles.pos), (a.force, b.force, c.force)]:
         assert np.array_equal(x, y)
         scale = float(np.abs(z).max())

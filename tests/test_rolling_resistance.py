@@ -239,7 +239,7 @@ def test_checkpoint_keeps_the_rolling_history(tmp_path):
     assert np.array_equal(b.particles.mu_r, a.particles.mu_r)
     a.run(2000)
     b.run(2000)
-    assert np.array_equal(a.moment, b.moment) and np.array_equal(a._nb_mr, b._nb_mr)
+    assert np.array_equal(a.moment, b.moment) and np.array_equal(a.pairs.mr, b.pairs.mr)
 
 
 def test_checkpoint_without_rolling_is_as_before(tmp_path):
@@ -253,7 +253,7 @@ def test_checkpoint_without_rolling_is_as_before(tmp_path):
     loaded = checkpoint.load(path)
     assert np.array_equal(loaded.particles.mu_r, [0.0, 0.0])
     assert loaded.walls.rolling_friction().tolist() == [0.0]
-    assert not loaded._nb_mr.any() and loaded._nb_mr.shape == loaded._nb_j.shape
+    assert not loaded.pairs.mr.any() and loaded.pairs.mr.shape == loaded.pairs.other.shape
 
 
 # ------------------------------------------------------------- bit for bit at 0

@@ -848,7 +848,7 @@ class PorosityCriterion:
         """
         from poro2d.specimen.compaction import check_feasible
 
-        Simulation._check_threads(self.spec.threads)
+        Simulation.check_threads(self.spec.threads)
         check_feasible(self.spec, self.grading, self.settings.initial_trial())
         record = self._config_record()
         check_finite("config", record["config"])

@@ -30,11 +30,30 @@ from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, atomic_path, check_input_file
 FORMAT = "poro2d-checkpoint-1"
 
 _WALL_FIELDS = ("p0", "p1", "kn", "ks", "mu", "vel", "mode", "servo_dir", "servo")
-_SIM_ARRAYS = (
-    "force", "moment", "wall_force_vec", "_wstat", "_pos_build", "_wall_build",
-    "_nb_start", "_nb_j", "_nb_fs", "_nb_fn", "_nb_ov", "_nb_nx", "_nb_ny",
-    "_wb_start", "_wb_w", "_wb_fs", "_wb_fn", "_wb_ov", "_wb_nx", "_wb_ny", "_iprm",
-)  # fmt: skip
+# The simulation's arrays by their names in the file ("sim.<name>", the names of the first
+# format, kept so that every checkpoint loads) and where they live: (store, field), the
+# store an attribute of the Simulation or None for the Simulation's own field.
+_SIM_ARRAYS = {
+    "force": (None, "force"), "moment": (None, "moment"), "wall_force_vec": (None, "wall_force_vec"),
+    "_wstat": ("work", "wall_stat"), "_pos_build": ("work", "pos_build"),
+    "_wall_build": ("work", "wall_build"),
+    "_nb_start": ("pairs", "start"), "_nb_j": ("pairs", "other"), "_nb_fs": ("pairs", "fs"),
+    "_nb_fn": ("pairs", "fn"), "_nb_ov": ("pairs", "ov"), "_nb_nx": ("pairs", "nx"),
+    "_nb_ny": ("pairs", "ny"),
+    "_wb_start": ("wall_pairs", "start"), "_wb_w": ("wall_pairs", "other"), "_wb_fs": ("wall_pairs", "fs"),
+    "_wb_fn": ("wall_pairs", "fn"), "_wb_ov": ("wall_pairs", "ov"), "_wb_nx": ("wall_pairs", "nx"),
+    "_wb_ny": ("wall_pairs", "ny"),
+    "_iprm": ("kernel_params", "iprm"),
+}  # fmt: skip
+# the contacts' rolling moments, stored only with rolling resistance (module doc)
+_ROLLING_ARRAYS = {"_nb_mr": "pairs", "_wb_mr": "wall_pairs"}
+
+
+def _key(name: str) -> str:
+    """The file key of one of the simulation's arrays."""
+    return f"sim.{name}"
+
+
 # every particle field but mu_r, which is stored only with rolling resistance (module doc)
 _CORE_PARTICLE_FIELDS = tuple(f for f in PARTICLE_FIELDS if f != "mu_r")
 
@@ -42,19 +61,19 @@ _CORE_PARTICLE_FIELDS = tuple(f for f in PARTICLE_FIELDS if f != "mu_r")
 def save(sim: Simulation, path: str | os.PathLike, extra: dict | None = None) -> Path:
     """Write ``sim`` to ``path`` (.npz), atomically. ``extra`` is stored as JSON metadata."""
     path = Path(path)
-    sim._sync_walls()  # walls added since the last run: their rows in the per-wall arrays
+    sim.sync_walls()  # walls added since the last run: their rows in the per-wall arrays
     arrays: dict[str, np.ndarray] = {}
     for f in _CORE_PARTICLE_FIELDS:
         arrays[f"particles.{f}"] = getattr(sim.particles, f)
     for f in _WALL_FIELDS:
         arrays[f"walls.{f}"] = getattr(sim.walls, f)
-    for f in _SIM_ARRAYS:
-        arrays[f"sim.{f}"] = getattr(sim, f)
+    for name, (store, field) in _SIM_ARRAYS.items():
+        arrays[_key(name)] = getattr(_holder(sim, store), field)
     if K.rolling_active(sim.particles.mu_r):
         arrays["particles.mu_r"] = sim.particles.mu_r
         arrays["walls.mu_r"] = sim.walls.rolling_friction()
-        arrays["sim._nb_mr"] = sim._nb_mr
-        arrays["sim._wb_mr"] = sim._wb_mr
+        for name, store in _ROLLING_ARRAYS.items():
+            arrays[_key(name)] = getattr(sim, store).mr
     meta = {
         "format": FORMAT,
         "provenance": provenance(),
@@ -66,7 +85,7 @@ def save(sim: Simulation, path: str | os.PathLike, extra: dict | None = None) ->
             "local_damping": sim.local_damping,
             "restitution": sim.restitution,
             "dt": sim.dt,
-            "fixed_dt": sim._fixed_dt,
+            "fixed_dt": sim.fixed_dt,
             "dt_safety": sim.dt_safety,
             "density_scale": sim.density_scale,
             "skin": sim.skin,
@@ -98,16 +117,16 @@ def state_digest(path: str | os.PathLike) -> str:
 
     The file's bytes would not do: the archive and the metadata carry the time of
     writing. Left out as well are the thread count and the step budget of the last
-    run (``sim._iprm``), which change how a continued run is computed, not its numbers.
-    So a specimen rebuilt from the same config and seed has the same digest, and a
-    specimen moved or copied keeps it.
+    run (in the kernel's integer settings, ``kernel_params.iprm``), which change how a
+    continued run is computed, not its numbers. So a specimen rebuilt from the same config
+    and seed has the same digest, and a specimen moved or copied keeps it.
     """
     h = hashlib.sha256()
     with np.load(_existing(path)) as z:
         meta = json.loads(bytes(z["meta"]).decode())
         for name in sorted(k for k in z.files if k != "meta"):
             a = np.ascontiguousarray(z[name])
-            if name == "sim._iprm":
+            if name == _key("_iprm"):
                 a = a.copy()
                 a[[i for i in (K.NSTEPS, K.CHECK_EVERY, K.THREADS) if i < a.size]] = 0
             h.update(f"{name}:{a.dtype.str}:{a.shape}\n".encode())
@@ -156,7 +175,7 @@ def read(path: str | os.PathLike) -> tuple[dict, dict[str, np.ndarray]]:
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
         raise InputError("checkpoint format", meta.get("format") if isinstance(meta, dict) else None, FORMAT)
     needed = [f"particles.{f}" for f in _CORE_PARTICLE_FIELDS] + [f"walls.{f}" for f in _WALL_FIELDS]
-    needed += [f"sim.{f}" for f in _SIM_ARRAYS]
+    needed += [_key(f) for f in _SIM_ARRAYS]
     missing = [k for k in needed if k not in arrays]
     if missing or not isinstance(meta.get("settings"), dict):
         raise _damaged(p, KeyError(f"missing {missing[0] if missing else 'settings'}"))
@@ -207,20 +226,26 @@ def _build(meta: dict, a: dict[str, np.ndarray], threads: int | None) -> Simulat
     sim.dt = s["dt"]  # exactly as saved, whatever the rule that produced it
     sim.step_count = s["step_count"]
     sim.time = s["time"]
-    for f in _SIM_ARRAYS:
-        setattr(sim, f, np.ascontiguousarray(a[f"sim.{f}"]))
+    for name, (store, field) in _SIM_ARRAYS.items():
+        setattr(_holder(sim, store), field, np.ascontiguousarray(a[_key(name)]))
     # integer settings added by later versions start at zero (their defaults)
+    params = sim.kernel_params
     iprm = np.zeros(K.N_IPRM, dtype=np.int64)
-    iprm[: min(len(sim._iprm), K.N_IPRM)] = sim._iprm[: K.N_IPRM]
-    sim._iprm = iprm
+    iprm[: min(len(params.iprm), K.N_IPRM)] = params.iprm[: K.N_IPRM]
+    params.iprm = iprm
     # the rolling moments: zero for a checkpoint without rolling resistance
-    sim._nb_mr = np.ascontiguousarray(a.get("sim._nb_mr", np.zeros(sim._nb_j.shape[0])), dtype=float)
-    sim._wb_mr = np.ascontiguousarray(a.get("sim._wb_mr", np.zeros(sim._wb_w.shape[0])), dtype=float)
-    if sim._nb_mr.shape != sim._nb_j.shape or sim._wb_mr.shape != sim._wb_w.shape:
-        raise ValueError("rolling moments of another length than the contact lists")
-    sim._grow((), sim._PP_SCRATCH, sim._nb_j.shape[0], 0)
-    sim._grow((), sim._PW_SCRATCH, sim._wb_w.shape[0], 0)
+    for name, store_name in _ROLLING_ARRAYS.items():
+        store = getattr(sim, store_name)
+        store.mr = np.ascontiguousarray(a.get(_key(name), np.zeros(store.capacity)), dtype=float)
+        if store.mr.shape != store.other.shape:
+            raise ValueError("rolling moments of another length than the contact lists")
+        store.renew_scratch()  # as long as the lists just read
     return sim
+
+
+def _holder(sim: Simulation, store: str | None):
+    """The object that holds a stored array: the Simulation or one of its stores."""
+    return sim if store is None else getattr(sim, store)
 
 
 def _max_threads() -> int:

@@ -41,29 +41,25 @@ class ContactSet:
 
 def contact_set(sim) -> ContactSet:
     p = sim.particles
-    n = p.n
     pos, r = p.pos, p.radius
-    rows = np.repeat(np.arange(n), np.diff(sim._nb_start))
-    npp = int(sim._nb_start[-1])
-    sel = np.nonzero(sim._nb_ov[:npp] > 0.0)[0]
-    i1 = rows[sel]
-    j1 = sim._nb_j[sel]
-    nrm1 = np.column_stack([sim._nb_nx[sel], sim._nb_ny[sel]])
-    ov1 = sim._nb_ov[sel]
+    nb, wb = sim.pairs, sim.wall_pairs
+    sel = nb.touching()
+    i1 = nb.rows()[sel]
+    j1 = nb.other[sel]
+    nrm1 = np.column_stack([nb.nx[sel], nb.ny[sel]])
+    ov1 = nb.ov[sel]
     pt1 = pos[i1] + nrm1 * (r[i1] - 0.5 * ov1)[:, None]
     br1 = pos[j1] - pos[i1]
-    fn1, fs1 = sim._nb_fn[sel], sim._nb_fs[sel]
+    fn1, fs1 = nb.fn[sel], nb.fs[sel]
 
-    wrows = np.repeat(np.arange(n), np.diff(sim._wb_start))
-    npw = int(sim._wb_start[-1])
-    wsel = np.nonzero(sim._wb_ov[:npw] > 0.0)[0]
-    i2 = wrows[wsel]
-    j2 = sim._wb_w[wsel]
-    nrm2 = np.column_stack([sim._wb_nx[wsel], sim._wb_ny[wsel]])
-    ov2 = sim._wb_ov[wsel]
+    wsel = wb.touching()
+    i2 = wb.rows()[wsel]
+    j2 = wb.other[wsel]
+    nrm2 = np.column_stack([wb.nx[wsel], wb.ny[wsel]])
+    ov2 = wb.ov[wsel]
     pt2 = pos[i2] + nrm2 * (r[i2] - 0.5 * ov2)[:, None]  # the kernel's lever arm, as for disks
     br2 = pt2 - pos[i2]
-    fn2, fs2 = sim._wb_fn[wsel], sim._wb_fs[wsel]
+    fn2, fs2 = wb.fn[wsel], wb.fs[wsel]
 
     i = np.concatenate([i1, i2])
     nrm = np.vstack([nrm1, nrm2])

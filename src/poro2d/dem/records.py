@@ -7,10 +7,11 @@ type can no longer be swapped by counting positions wrong.
 
 The records are named tuples. numba compiles them as heterogeneous named tuples: a
 field access is resolved at compile time and costs nothing in the loop, and the types
-pickle by reference, so ``cache=True`` works. Their fields are the arrays held by the
-:class:`~poro2d.dem.simulation.Simulation` and its ``Particles`` and ``Walls``, never
-copies: the kernels advance the state in place. A record of records is not used: numba's
-parallel loop cannot take one as an argument.
+pickle by reference, so ``cache=True`` works. Their fields are the arrays of the
+simulation's ``Particles`` and ``Walls`` and of its public stores (:mod:`poro2d.dem.stores`:
+the two contact lists, the masses, the kernel's work arrays), never copies: the kernels
+advance the state in place. A record of records is not used: numba's parallel loop
+cannot take one as an argument.
 
 :func:`kernel_records` is the one place that fills them. It is called before every
 kernel call, since growing the pair storage, adding disks or walls and renumbering
@@ -24,7 +25,8 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 if TYPE_CHECKING:  # pragma: no cover
-    from poro2d.dem.simulation import Simulation
+    from poro2d.dem.state import Particles, Walls
+    from poro2d.dem.stores import ContactStore, DiskMasses, KernelWork
 
 
 class DiskArrays(NamedTuple):
@@ -144,33 +146,46 @@ class KernelRecords(NamedTuple):
     work: WorkArrays
 
 
-def kernel_records(sim: Simulation) -> KernelRecords:
-    """The records of ``sim``'s current arrays (views, nothing is copied)."""
-    p, w = sim.particles, sim.walls
+def kernel_records(
+    particles: Particles,
+    walls: Walls,
+    force: np.ndarray,
+    moment: np.ndarray,
+    wall_force: np.ndarray,
+    masses: DiskMasses,
+    pairs: ContactStore,
+    wall_pairs: ContactStore,
+    work: KernelWork,
+) -> KernelRecords:
+    """The records of a simulation's current arrays (views, nothing is copied).
+
+    ``force``, ``moment`` and ``wall_force`` are the unbalanced forces and moments of the
+    disks and the walls' resultants, which the kernel writes at every step.
+    """
+    p, w = particles, walls
     disks = DiskArrays(
-        pos=p.pos, vel=p.vel, theta=p.theta, omega=p.omega, force=sim.force, moment=sim.moment,
-        acc=sim._acc, radius=p.radius, mass=sim._mass, inv_mass=sim._inv_mass,
-        inv_inertia=sim._inv_inertia, mode=p.mode, kn=p.kn, ks=p.ks, mu=p.mu, mu_r=p.mu_r,
+        pos=p.pos, vel=p.vel, theta=p.theta, omega=p.omega, force=force, moment=moment,
+        acc=work.acc, radius=p.radius, mass=masses.mass, inv_mass=masses.inv_mass,
+        inv_inertia=masses.inv_inertia, mode=p.mode, kn=p.kn, ks=p.ks, mu=p.mu, mu_r=p.mu_r,
     )  # fmt: skip
-    walls = WallArrays(
+    walls_rec = WallArrays(
         p0=w.p0, p1=w.p1, vel=w.vel, kn=w.kn, ks=w.ks, mu=w.mu, mu_r=w.rolling_friction(), mode=w.mode,
-        servo_dir=w.servo_dir, servo=w.servo, force=sim.wall_force_vec, stat=sim._wstat,
-        p0_build=sim._wall_build, part_sums=sim._wpart,
+        servo_dir=w.servo_dir, servo=w.servo, force=wall_force, stat=work.wall_stat,
+        p0_build=work.wall_build, part_sums=work.part_sums,
     )  # fmt: skip
-    nb = PairList(
-        start=sim._nb_start, j=sim._nb_j, fs=sim._nb_fs, fn=sim._nb_fn, ov=sim._nb_ov, nx=sim._nb_nx,
-        ny=sim._nb_ny, new_start=sim._new_start, new_j=sim._new_j, new_fs=sim._new_fs, mr=sim._nb_mr,
-        new_mr=sim._new_mr,
+    nb, wb = pairs, wall_pairs
+    nb_rec = PairList(
+        start=nb.start, j=nb.other, fs=nb.fs, fn=nb.fn, ov=nb.ov, nx=nb.nx, ny=nb.ny,
+        new_start=nb.new_start, new_j=nb.new_other, new_fs=nb.new_fs, mr=nb.mr, new_mr=nb.new_mr,
     )  # fmt: skip
-    wb = WallPairList(
-        start=sim._wb_start, w=sim._wb_w, fs=sim._wb_fs, fn=sim._wb_fn, ov=sim._wb_ov, nx=sim._wb_nx,
-        ny=sim._wb_ny, new_start=sim._wnew_start, new_w=sim._wnew_w, new_fs=sim._wnew_fs, mr=sim._wb_mr,
-        new_mr=sim._wnew_mr,
+    wb_rec = WallPairList(
+        start=wb.start, w=wb.other, fs=wb.fs, fn=wb.fn, ov=wb.ov, nx=wb.nx, ny=wb.ny,
+        new_start=wb.new_start, new_w=wb.new_other, new_fs=wb.new_fs, mr=wb.mr, new_mr=wb.new_mr,
     )  # fmt: skip
-    g = sim._grid
-    work = WorkArrays(
-        pos_build=sim._pos_build, part=sim._part, xstart=sim._xstart, xpair=sim._xpair, dlist=sim._dlist,
-        dstart=sim._dstart, tmax=sim._tmax, sync=sim._sync, cell=g.cell, members=g.members,
+    g = work.grid
+    work_rec = WorkArrays(
+        pos_build=work.pos_build, part=work.part, xstart=work.xstart, xpair=nb.cross, dlist=work.dlist,
+        dstart=work.dstart, tmax=work.tmax, sync=work.sync, cell=g.cell, members=g.members,
         cstart=g.cstart, cfill=g.cfill, ginfo=g.ginfo,
     )  # fmt: skip
-    return KernelRecords(disks, walls, nb, wb, work)
+    return KernelRecords(disks, walls_rec, nb_rec, wb_rec, work_rec)

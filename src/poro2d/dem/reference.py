@@ -147,25 +147,22 @@ class ReferenceDEM:
         p, w = sim.particles, sim.walls
         history: dict[Any, float] = {}
         rolling: dict[Any, float] = {}
-        n = p.n
-        npp = int(sim._nb_start[n])
-        rows = np.repeat(np.arange(n), np.diff(sim._nb_start))
-        for k in range(npp):
-            if sim._nb_ov[k] > 0.0:
-                history[(int(rows[k]), int(sim._nb_j[k]))] = float(sim._nb_fs[k])
-                rolling[(int(rows[k]), int(sim._nb_j[k]))] = float(sim._nb_mr[k])
-        npw = int(sim._wb_start[n])
-        wrows = np.repeat(np.arange(n), np.diff(sim._wb_start))
-        for k in range(npw):
-            if sim._wb_ov[k] > 0.0:
-                history[(int(wrows[k]), "wall", int(sim._wb_w[k]))] = float(sim._wb_fs[k])
-                rolling[(int(wrows[k]), "wall", int(sim._wb_w[k]))] = float(sim._wb_mr[k])
+        nb, wb = sim.pairs, sim.wall_pairs
+        rows = nb.rows()
+        for k in nb.touching():
+            history[(int(rows[k]), int(nb.other[k]))] = float(nb.fs[k])
+            rolling[(int(rows[k]), int(nb.other[k]))] = float(nb.mr[k])
+        wrows = wb.rows()
+        for k in wb.touching():
+            history[(int(wrows[k]), "wall", int(wb.other[k]))] = float(wb.fs[k])
+            rolling[(int(wrows[k]), "wall", int(wb.other[k]))] = float(wb.mr[k])
         conv = sim.contact.convention
+        m = sim.masses
         return cls(
             pos=p.pos, vel=p.vel, theta=p.theta, omega=p.omega, radius=p.radius,
-            mass=sim._mass, inv_mass=sim._inv_mass, inv_inertia=sim._inv_inertia, mode=p.mode,
+            mass=m.mass, inv_mass=m.inv_mass, inv_inertia=m.inv_inertia, mode=p.mode,
             pkn=p.kn, pks=p.ks, pmu=p.mu, wp0=w.p0, wp1=w.p1, wvel=w.vel, wkn=w.kn, wks=w.ks,
-            wmu=w.mu, gravity=sim.gravity, damping=sim.local_damping, beta=sim._beta, dt=sim.dt,
+            wmu=w.mu, gravity=sim.gravity, damping=sim.local_damping, beta=sim.beta, dt=sim.dt,
             per_body=conv == "per_body", pp=sim.contact.pp, pw=sim.contact.pw, history=history,
             pmu_r=p.mu_r, wmu_r=w.rolling_friction(), rolling=rolling,
         )  # fmt: skip
@@ -401,15 +398,13 @@ class ReferenceDEM:
 
 def engine_partitions(sim) -> np.ndarray:
     """The partition boundaries of a simulation's last step (its sum order across partitions)."""
-    return sim._part.copy()
+    return sim.work.part.copy()
 
 
 def engine_pair_order(sim) -> dict[tuple[int, int], int]:
     """Slot of every disk pair in a simulation's current neighbour list (its sum order)."""
-    n = sim.particles.n
-    total = int(sim._nb_start[n])
-    rows = np.repeat(np.arange(n), np.diff(sim._nb_start))
-    return {(int(a), int(b)): k for k, (a, b) in enumerate(zip(rows, sim._nb_j[:total], strict=True))}
+    nb = sim.pairs
+    return {(int(a), int(b)): k for k, (a, b) in enumerate(zip(nb.rows(), nb.other[: nb.used], strict=True))}
 
 
 def max_rel_diff(a: np.ndarray, b: np.ndarray, scale: float) -> float:

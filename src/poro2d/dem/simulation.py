@@ -4,6 +4,10 @@ A :class:`Simulation` owns the particle and wall state, the contact lists and
 the time step. :meth:`Simulation.run` hands whole blocks of steps to the
 compiled kernel and only comes back to Python for events: progress updates,
 callbacks (writers, protocol checks) and growing the contact storage.
+
+Beside ``particles`` and ``walls`` it holds its arrays in public stores
+(:mod:`poro2d.dem.stores`): ``pairs`` and ``wall_pairs`` (the contact lists), ``masses``,
+``kernel_params`` and ``work``. Other modules read those, never its private names.
 """
 
 from __future__ import annotations
@@ -26,7 +30,7 @@ from poro2d.dem.model import (
     restitution_to_beta,
     single_contact_limit,
 )
-from poro2d.dem.records import kernel_records
+from poro2d.dem.records import KernelRecords, kernel_records
 from poro2d.dem.state import (
     FREE,
     PARTICLE_FIELDS,
@@ -41,6 +45,7 @@ from poro2d.dem.state import (
     Particles,
     Walls,
 )
+from poro2d.dem.stores import ContactStore, DiskMasses, KernelParams, KernelWork
 from poro2d.errors import InputError, is_number
 
 _THREADING_SET = False
@@ -75,12 +80,6 @@ def measure_code(measure: str) -> int:
     if measure not in MEASURES:
         raise InputError("equilibrium measure", measure, "one of " + ", ".join(repr(m) for m in MEASURES))
     return MEASURES[measure]
-
-
-def _row_of_slot(start: np.ndarray) -> np.ndarray:
-    """The row (first disk) of every filled slot of a list stored as rows ``start``."""
-    n = start.shape[0] - 1
-    return np.repeat(np.arange(n), np.diff(start))
 
 
 def _regroup(start: np.ndarray, rows: np.ndarray) -> np.ndarray:
@@ -203,7 +202,7 @@ class Simulation:
         if not (isinstance(partitions, (int, np.integer)) and 1 <= partitions <= 256):
             raise InputError("partitions", partitions, "an integer in [1, 256]")
         self.partitions = int(partitions)
-        self.threads = self._check_threads(threads)
+        self.threads = self.check_threads(threads)
         self.threads_used = 0  # threads the kernel ran on in its last call (0: not called yet)
         self.step_count = 0
         self.time = 0.0
@@ -214,6 +213,16 @@ class Simulation:
         self._n_alloc = -1
         check_layout(self.particles.pos, self.particles.radius, self.walls)
         self._refresh()
+
+    @property
+    def beta(self) -> float:
+        """Damping ratio of the normal dashpot, from ``restitution`` (0 without a dashpot)."""
+        return self._beta
+
+    @property
+    def fixed_dt(self) -> float | None:
+        """The time step given at construction (``None``: chosen from the critical step)."""
+        return self._fixed_dt
 
     @property
     def local_damping(self) -> float:
@@ -245,7 +254,8 @@ class Simulation:
 
     # ----------------------------------------------------------------- setup
     @staticmethod
-    def _check_threads(threads: int) -> int:
+    def check_threads(threads: int) -> int:
+        """``threads`` as an int, refused unless in [1, the threads numba may use]."""
         import numba
 
         top = numba.config.NUMBA_NUM_THREADS
@@ -257,10 +267,12 @@ class Simulation:
         """Recompute masses, time step and (re)allocate storage after a state change."""
         p = self.particles
         n = p.n
-        self._mass = np.ascontiguousarray(p.mass)
         m_in, i_in = inertial_masses(p, self.density_scale)
-        self._inv_mass = np.ascontiguousarray(1.0 / m_in) if n else np.zeros(0)
-        self._inv_inertia = np.ascontiguousarray(1.0 / i_in) if n else np.zeros(0)
+        self.masses = DiskMasses(
+            mass=np.ascontiguousarray(p.mass),
+            inv_mass=np.ascontiguousarray(1.0 / m_in) if n else np.zeros(0),
+            inv_inertia=np.ascontiguousarray(1.0 / i_in) if n else np.zeros(0),
+        )
         m_min = float(m_in.min()) if n else 1.0
         k_sum = self.contact.stiffness_sum_bound(p, self.walls)
         if K.rolling_active(p.mu_r):
@@ -290,71 +302,38 @@ class Simulation:
             self.skin = float(self._skin)
         if n != self._n_alloc:
             self._allocate(n)
-        self._iprm[K.NEED_BUILD] = 1
+        self.kernel_params.iprm[K.NEED_BUILD] = 1
 
     def _allocate(self, n: int) -> None:
+        """Fresh stores for ``n`` disks: empty contact lists (no history), zeroed sums."""
         self._n_alloc = n
         nw = self.walls.n
         self.force = np.zeros((n, 2))
         self.moment = np.zeros(n)
-        self._pos_build = np.zeros((n, 2))
-        self._wall_build = np.zeros((nw, 2))
         self.wall_force_vec = np.zeros((nw, 2))
-        self._wstat = np.zeros((nw, 2))
-        self._nb_start = np.zeros(n + 1, dtype=np.int64)
-        self._wb_start = np.zeros(n + 1, dtype=np.int64)
-        self._alloc_work(n)
-        self._alloc_pp(max(16, 4 * n))
-        self._alloc_pw(max(16, n // 4))
-        self._prm = np.zeros(K.N_PRM)
-        self._iprm = np.zeros(K.N_IPRM, dtype=np.int64)
-        self._out = np.zeros(K.N_OUT)
+        #: the disk-disk and disk-wall contact lists (:class:`~poro2d.dem.stores.ContactStore`)
+        self.pairs = ContactStore.empty(n, max(16, 4 * n), with_cross=True)
+        self.wall_pairs = ContactStore.empty(n, max(16, n // 4))
+        self.work = KernelWork.empty(n, nw, self.partitions, WALL_PAD)
+        self.kernel_params = KernelParams(
+            prm=np.zeros(K.N_PRM), iprm=np.zeros(K.N_IPRM, dtype=np.int64), out=np.zeros(K.N_OUT)
+        )
 
-    def _alloc_work(self, n: int) -> None:
+    def _renew_work(self, n: int) -> None:
         """Per-disk and per-partition work arrays that the kernel derives itself."""
-        from poro2d.dem.neighbors import grid_scratch
-        from poro2d.dem.sync import fresh_sync
+        self.work.renew(n, self.walls.n, self.partitions, WALL_PAD)
+        self.pairs.renew_row_scratch(n)
+        self.wall_pairs.renew_row_scratch(n)
 
-        npart = self.partitions
-        self._acc = np.zeros((n, 3))
-        self._new_start = np.zeros(n + 1, dtype=np.int64)
-        self._wnew_start = np.zeros(n + 1, dtype=np.int64)
-        self._xstart = np.zeros(n + 1, dtype=np.int64)
-        self._dlist = np.zeros(n, dtype=np.int64)
-        self._part = np.zeros(npart + 1, dtype=np.int64)
-        self._dstart = np.zeros(npart + 1, dtype=np.int64)
-        # wall sums per partition, WALL_PAD rows apart: two threads adding to the same
-        # cache line would pass it back and forth at every wall contact
-        self._wpart = np.zeros((npart, self.walls.n + WALL_PAD, 4))
-        self._tmax = np.zeros(npart)
-        self._sync = fresh_sync()
-        self._grid = grid_scratch(n)
+    def grow_pairs(self, capacity: int, keep: int = 0) -> None:
+        """Give the disk-disk list ``capacity`` slots, keeping the first ``keep`` (their history)."""
+        self.pairs.grow(capacity, keep)
 
-    # pair storage: (kept arrays with their dtype, scratch arrays for the rebuild)
-    _PP = (("_nb_j", np.int64), ("_nb_fs", float), ("_nb_fn", float), ("_nb_ov", float),
-           ("_nb_nx", float), ("_nb_ny", float), ("_nb_mr", float))  # fmt: skip
-    _PP_SCRATCH = (("_new_j", np.int64), ("_new_fs", float), ("_xpair", np.int64), ("_new_mr", float))
-    _PW = (("_wb_w", np.int64), ("_wb_fs", float), ("_wb_fn", float), ("_wb_ov", float),
-           ("_wb_nx", float), ("_wb_ny", float), ("_wb_mr", float))  # fmt: skip
-    _PW_SCRATCH = (("_wnew_w", np.int64), ("_wnew_fs", float), ("_wnew_mr", float))
+    def grow_wall_pairs(self, capacity: int, keep: int = 0) -> None:
+        """Give the disk-wall list ``capacity`` slots, keeping the first ``keep`` (their history)."""
+        self.wall_pairs.grow(capacity, keep)
 
-    def _grow(self, kept, scratch, cap: int, keep: int) -> None:
-        """(Re)allocate pair arrays with capacity ``cap``, copying the first ``keep`` slots."""
-        for name, dtype in kept:
-            a = np.zeros(cap, dtype=dtype)
-            if keep:
-                a[:keep] = getattr(self, name)[:keep]
-            setattr(self, name, a)
-        for name, dtype in scratch:
-            setattr(self, name, np.zeros(cap, dtype=dtype))
-
-    def _alloc_pp(self, cap: int, keep: int = 0) -> None:
-        self._grow(self._PP, self._PP_SCRATCH, cap, keep)
-
-    def _alloc_pw(self, cap: int, keep: int = 0) -> None:
-        self._grow(self._PW, self._PW_SCRATCH, cap, keep)
-
-    def _sync_walls(self) -> None:
+    def sync_walls(self) -> None:
         """Take in walls added to ``self.walls`` (``Walls.add``) since the arrays were sized.
 
         Called before every run and measurement of a wall; a comparison of two counts
@@ -374,9 +353,10 @@ class Simulation:
         check_layout(self.particles.pos, self.particles.radius, self.walls)
         new = nw - nw_old
         self.wall_force_vec = np.concatenate([self.wall_force_vec, np.zeros((new, 2))])
-        self._wstat = np.concatenate([self._wstat, np.zeros((new, 2))])
-        self._wall_build = np.ascontiguousarray(np.concatenate([self._wall_build, self.walls.p0[nw_old:]]))
-        self._alloc_work(self.particles.n)  # the per-partition wall sums
+        work = self.work
+        work.wall_stat = np.concatenate([work.wall_stat, np.zeros((new, 2))])
+        work.wall_build = np.ascontiguousarray(np.concatenate([work.wall_build, self.walls.p0[nw_old:]]))
+        self._renew_work(self.particles.n)  # the per-partition wall sums
         self._refresh()  # time step and a list rebuild before the next step
 
     # --------------------------------------------------------------- mutation
@@ -399,19 +379,19 @@ class Simulation:
             setattr(p, f, np.ascontiguousarray(np.concatenate([getattr(p, f), getattr(new, f)])))
         n = p.n
         # Old rows keep their place; the new disks start with empty rows.
-        for name in ("_nb_start", "_wb_start"):
-            old = getattr(self, name)
-            setattr(self, name, np.concatenate([old, np.full(n - n0, old[-1], dtype=np.int64)]))
-        self._alloc_work(n)
+        self.pairs.add_rows(n - n0)
+        self.wall_pairs.add_rows(n - n0)
+        self._renew_work(n)
         self.force = np.concatenate([self.force, np.zeros((n - n0, 2))])
         self.moment = np.concatenate([self.moment, np.zeros(n - n0)])
-        self._pos_build = np.concatenate([self._pos_build, new.pos])
+        self.work.pos_build = np.concatenate([self.work.pos_build, new.pos])
         self._n_alloc = n
         self._refresh()
         return np.arange(n0, n)
 
-    # per-disk arrays of the Simulation itself (the Particles' fields are permuted too)
-    _PER_DISK = ("force", "moment", "_pos_build", "_mass", "_inv_mass", "_inv_inertia")
+    # per-disk arrays beside the Particles' fields, by holder and name (all are permuted)
+    _PER_DISK = ((None, "force"), (None, "moment"), ("work", "pos_build"), ("masses", "mass"),
+                 ("masses", "inv_mass"), ("masses", "inv_inertia"))  # fmt: skip
 
     def reorder(self, order) -> None:
         """Renumber the disks: new disk ``k`` is old disk ``order[k]``; contacts keep their history.
@@ -433,11 +413,12 @@ class Simulation:
         new_of_old[order] = np.arange(n)
         for f in PARTICLE_FIELDS:
             setattr(p, f, np.ascontiguousarray(getattr(p, f)[order]))
-        for f in self._PER_DISK:
-            setattr(self, f, np.ascontiguousarray(getattr(self, f)[order]))
+        for holder_name, f in self._PER_DISK:
+            holder = self if holder_name is None else getattr(self, holder_name)
+            setattr(holder, f, np.ascontiguousarray(getattr(holder, f)[order]))
         self._renumber_pairs(new_of_old)
         self._renumber_wall_pairs(new_of_old)
-        self._iprm[K.NEED_BUILD] = 1  # rows in the kernel's own order before the next step
+        self.kernel_params.iprm[K.NEED_BUILD] = 1  # rows in the kernel's own order before the next step
 
     def _renumber_pairs(self, new_of_old: np.ndarray) -> None:
         """Disk-disk list in new numbers: rows by the smaller new index, history unchanged.
@@ -445,26 +426,26 @@ class Simulation:
         Swapping the two disks of a pair turns its normal and tangent round; the shear
         force on the (new) first disk, ``fs`` along its tangent, is the same number.
         """
-        m = int(self._nb_start[-1])
-        a = new_of_old[_row_of_slot(self._nb_start)]
-        b = new_of_old[self._nb_j[:m]]
+        nb = self.pairs
+        m = nb.used
+        a = new_of_old[nb.rows()]
+        b = new_of_old[nb.other[:m]]
         swap = a > b
         first = np.where(swap, b, a)
-        sort = _regroup(self._nb_start, first)
-        self._nb_j[:m] = np.where(swap, a, b)[sort]
+        sort = _regroup(nb.start, first)
+        nb.other[:m] = np.where(swap, a, b)[sort]
         sign = np.where(swap, -1.0, 1.0)
         # the rolling moment is the one on the first disk: the other disk's is its opposite
-        for name, flip in (("_nb_fs", False), ("_nb_fn", False), ("_nb_ov", False),
-                           ("_nb_nx", True), ("_nb_ny", True), ("_nb_mr", True)):  # fmt: skip
-            arr = getattr(self, name)
+        for arr, flip in ((nb.fs, False), (nb.fn, False), (nb.ov, False),
+                          (nb.nx, True), (nb.ny, True), (nb.mr, True)):  # fmt: skip
             arr[:m] = (arr[:m] * sign if flip else arr[:m])[sort]
 
     def _renumber_wall_pairs(self, new_of_old: np.ndarray) -> None:
         """Disk-wall rows follow their disks."""
-        m = int(self._wb_start[-1])
-        sort = _regroup(self._wb_start, new_of_old[_row_of_slot(self._wb_start)])
-        for name in ("_wb_w", "_wb_fs", "_wb_fn", "_wb_ov", "_wb_nx", "_wb_ny", "_wb_mr"):
-            arr = getattr(self, name)
+        wb = self.wall_pairs
+        m = wb.used
+        sort = _regroup(wb.start, new_of_old[wb.rows()])
+        for arr in (wb.other, wb.fs, wb.fn, wb.ov, wb.nx, wb.ny, wb.mr):
             arr[:m] = arr[:m][sort]
 
     def set_particle_friction(self, mu: float) -> None:
@@ -491,8 +472,8 @@ class Simulation:
         if walls is not None:
             self.walls.rolling_friction()[:] = walls
         if not K.rolling_active(self.particles.mu_r):
-            self._nb_mr[:] = 0.0
-            self._wb_mr[:] = 0.0
+            self.pairs.mr[:] = 0.0
+            self.wall_pairs.mr[:] = 0.0
         self._refresh()
 
     def rolling_moments(self) -> tuple[np.ndarray, np.ndarray]:
@@ -500,9 +481,7 @@ class Simulation:
 
         A disk-disk entry is the moment on the row's disk (its partner gets the opposite).
         """
-        pp = self._nb_mr[: int(self._nb_start[-1])][self._nb_ov[: int(self._nb_start[-1])] > 0.0]
-        pw = self._wb_mr[: int(self._wb_start[-1])][self._wb_ov[: int(self._wb_start[-1])] > 0.0]
-        return pp.copy(), pw.copy()
+        return self.pairs.mr[self.pairs.touching()], self.wall_pairs.mr[self.wall_pairs.touching()]
 
     def set_wall_velocity(self, wall: str | int, velocity: tuple[float, float]) -> None:
         w = self.walls.index(wall)
@@ -517,7 +496,7 @@ class Simulation:
         w = self.walls.index(wall)
         self.walls.p0[w] += (dx, dy)
         self.walls.p1[w] += (dx, dy)
-        self._iprm[K.NEED_BUILD] = 1
+        self.kernel_params.iprm[K.NEED_BUILD] = 1
 
     def set_wall_servo(
         self,
@@ -573,7 +552,7 @@ class Simulation:
     def _load_params(
         self, nsteps: int, check_every: int, ratio_target: float, offset: int, measure: int = 0
     ) -> None:
-        prm = self._prm
+        prm, iprm = self.kernel_params.prm, self.kernel_params.iprm
         prm[K.DT] = self.dt
         prm[K.GX], prm[K.GY] = self.gravity
         prm[K.DAMP] = self.local_damping
@@ -582,16 +561,16 @@ class Simulation:
         if self.contact.convention == "per_pair_type":
             prm[K.KN_PP], prm[K.KS_PP], prm[K.MU_PP] = self.contact.pp  # type: ignore[misc]
             prm[K.KN_PW], prm[K.KS_PW], prm[K.MU_PW] = self.contact.pw  # type: ignore[misc]
-            self._iprm[K.MODE] = self._iprm[K.MODE_PW] = self.contact.mode
+            iprm[K.MODE] = iprm[K.MODE_PW] = self.contact.mode
         else:
             self._uniform_constants()
         prm[K.RATIO_TARGET] = ratio_target
         prm[K.TIME] = self.time
-        self._iprm[K.NSTEPS] = nsteps
-        self._iprm[K.CHECK_EVERY] = check_every
-        self._iprm[K.CHECK_OFFSET] = offset
-        self._iprm[K.MEASURE] = measure
-        self._iprm[K.THREADS] = self.effective_threads
+        iprm[K.NSTEPS] = nsteps
+        iprm[K.CHECK_EVERY] = check_every
+        iprm[K.CHECK_OFFSET] = offset
+        iprm[K.MEASURE] = measure
+        iprm[K.THREADS] = self.effective_threads
 
     def _uniform_constants(self) -> None:
         """Per-body properties that are all equal: hand the kernel the combined constants.
@@ -601,18 +580,26 @@ class Simulation:
         """
         from poro2d.dem.contact_law import PER_BODY, PER_PAIR_TYPE, series
 
-        p, w, prm = self.particles, self.walls, self._prm
-        self._iprm[K.MODE] = self._iprm[K.MODE_PW] = PER_BODY
+        p, w = self.particles, self.walls
+        prm, iprm = self.kernel_params.prm, self.kernel_params.iprm
+        iprm[K.MODE] = iprm[K.MODE_PW] = PER_BODY
         if p.n == 0 or not all(np.all(a == a[0]) for a in (p.kn, p.ks, p.mu)):
             return
         kn, ks, mu = float(p.kn[0]), float(p.ks[0]), float(p.mu[0])
         prm[K.KN_PP], prm[K.KS_PP], prm[K.MU_PP] = series(kn, kn), series(ks, ks), mu
-        self._iprm[K.MODE] = PER_PAIR_TYPE
+        iprm[K.MODE] = PER_PAIR_TYPE
         if w.n and all(np.all(a == a[0]) for a in (w.kn, w.ks, w.mu)):
             prm[K.KN_PW] = series(kn, float(w.kn[0]))
             prm[K.KS_PW] = series(ks, float(w.ks[0]))
             prm[K.MU_PW] = min(mu, float(w.mu[0]))
-            self._iprm[K.MODE_PW] = PER_PAIR_TYPE
+            iprm[K.MODE_PW] = PER_PAIR_TYPE
+
+    def kernel_records(self) -> KernelRecords:
+        """The kernel's records of the current arrays (views: the kernel advances them in place)."""
+        return kernel_records(
+            self.particles, self.walls, self.force, self.moment, self.wall_force_vec,
+            self.masses, self.pairs, self.wall_pairs, self.work,
+        )  # fmt: skip
 
     def _kernel_block(
         self, nsteps: int, check_every: int, ratio_target: float, offset: int, measure: int = 0
@@ -626,33 +613,35 @@ class Simulation:
         import numba
 
         numba.set_num_threads(max(1, self.effective_threads))
-        if self._part.shape[0] != self.partitions + 1:
-            self._alloc_work(self.particles.n)  # partitions changed since allocation
+        if self.work.part.shape[0] != self.partitions + 1:
+            self._renew_work(self.particles.n)  # partitions changed since allocation
         done = 0
         status = K.RUNNING
         rebuilds = 0
+        params = self.kernel_params
+        out = params.out
         while done < nsteps:
             self._load_params(nsteps - done, check_every, ratio_target, offset + done, measure)
-            self._out[:] = 0.0
-            K.run_steps(kernel_records(self), self._prm, self._iprm, self._out)
-            self.threads_used = int(self._out[K.THREADS_USED])
-            steps = int(self._out[K.STEPS_DONE])
+            out[:] = 0.0
+            K.run_steps(self.kernel_records(), params.prm, params.iprm, out)
+            self.threads_used = int(out[K.THREADS_USED])
+            steps = int(out[K.STEPS_DONE])
             if ratio_target and (offset + done + steps) // check_every > (offset + done) // check_every:
                 # the last stop test's value of the measure it compared
-                self._checked_ratio = float(self._out[_MEASURE_OUT[measure]])
+                self._checked_ratio = float(out[_MEASURE_OUT[measure]])
             done += steps
-            rebuilds += int(self._out[K.REBUILDS])
+            rebuilds += int(out[K.REBUILDS])
             self.step_count += steps
-            self.time = float(self._prm[K.TIME])
+            self.time = float(params.prm[K.TIME])
             self._stepped = self._stepped or steps > 0
-            status = int(self._out[K.STATUS])
+            status = int(out[K.STATUS])
+            self.pairs.note_demand(int(out[K.NEED_PP]))
+            self.wall_pairs.note_demand(int(out[K.NEED_PW]))
             if status == K.OVERFLOW:
-                need_pp = int(self._out[K.NEED_PP])
-                need_pw = int(self._out[K.NEED_PW])
-                if need_pp:
-                    self._alloc_pp(int(need_pp * 1.5) + 16, keep=int(self._nb_start[-1]))
-                if need_pw:
-                    self._alloc_pw(int(need_pw * 1.5) + 16, keep=int(self._wb_start[-1]))
+                if self.pairs.overflow:
+                    self.grow_pairs(int(self.pairs.needed * 1.5) + 16, keep=self.pairs.used)
+                if self.wall_pairs.overflow:
+                    self.grow_wall_pairs(int(self.wall_pairs.needed * 1.5) + 16, keep=self.wall_pairs.used)
                 continue
             if status == K.UNSTABLE:
                 raise SimulationError(
@@ -711,7 +700,7 @@ class Simulation:
             raise InputError("every", every, "an integer >= 1")
         if callback is not None and every is None:
             raise InputError("every", None, "an integer >= 1 with a callback: the steps between its calls")
-        self._sync_walls()
+        self.sync_walls()
         target = 0.0 if until_ratio is None else float(until_ratio)
         n = self.particles.n
         t0 = time.perf_counter()
@@ -782,9 +771,10 @@ class Simulation:
         n = self.particles.n
         if not (self._stepped or self.step_count > 0) or self.force.shape[0] != n:
             return {"max": math.inf, "mean": math.inf, "loaded_max": math.inf, "rattler_fraction": math.nan}
+        nb, wb = self.pairs, self.wall_pairs
         r = K.equilibrium_measures(
-            self.force, self.particles.mode, self._nb_start, self._nb_j, self._nb_fn, self._nb_fs,
-            self._nb_ov, self._wb_start, self._wb_fn, self._wb_fs, self._wb_ov,
+            self.force, self.particles.mode, nb.start, nb.other, nb.fn, nb.fs, nb.ov,
+            wb.start, wb.fn, wb.fs, wb.ov,
         )  # fmt: skip
         free = int(np.count_nonzero(self.particles.mode == FREE))
         return {
@@ -801,7 +791,7 @@ class Simulation:
 
     def wall_force(self, wall: str | int) -> np.ndarray:
         """Resultant contact force that the disks exert on a wall (N), as (fx, fy)."""
-        self._sync_walls()
+        self.sync_walls()
         return self.wall_force_vec[self.walls.index(wall)].copy()
 
     def wall_force_per_thickness(self, wall: str | int) -> np.ndarray:
