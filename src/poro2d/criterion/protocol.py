@@ -6,8 +6,8 @@ For a trial 2D porosity n2D (Eq. 12 of the paper unless given):
 2. measure the top-plate force F_top; accept at once when 0 < F_top < 1 % of the
    self weight G = rho_s (1 - n2D) W H g;
 3. otherwise servo the top plate (down when F_top = 0, up when it is too large)
-   until the condition holds at equilibrium, and compute the porosity n' of the
-   new box; accept n2D when |n' - n2D| < 0.005;
+   until the condition holds at equilibrium (:class:`~poro2d.criterion.servo.PlateServo`),
+   and compute the porosity n' of the new box; accept n2D when |n' - n2D| < 0.005;
 4. else start again from 1 with n' rounded to the porosity resolution (0.01).
 
 Every trial is written to its own folder as it finishes, so an interrupted run

@@ -138,7 +138,7 @@ class PlateServo:
         ok = in_window(f, weight, s.force_fraction) and top.resting(sim, target)
         return steps, ok, res.measured_ratio
 
-    def in_window(self, sim: Simulation, top: FlatPlate | SegmentedLid, target: float, weight: float) -> bool:
+    def holds(self, sim: Simulation, top: FlatPlate | SegmentedLid, target: float, weight: float) -> bool:
         """F_top in the window, with a lid resting on the specimen over most of the width."""
         f = top.force(sim) / sim.particles.thickness
         return in_window(f, weight, self.settings.force_fraction) and top.resting(sim, target)
@@ -151,7 +151,7 @@ class PlateServo:
         streak = [0]
 
         def steady(sm: Simulation) -> bool:
-            streak[0] = streak[0] + 1 if self.in_window(sm, top, target, weight) else 0
+            streak[0] = streak[0] + 1 if self.holds(sm, top, target, weight) else 0
             return streak[0] >= s.window_checks
 
         return steady
@@ -169,7 +169,7 @@ class PlateServo:
         calm: list[float] = []
 
         def settled(sm: Simulation) -> bool:
-            if not self.in_window(sm, top, target, weight):
+            if not self.holds(sm, top, target, weight):
                 calm.clear()
                 return False
             if sm.ratio_of(self.equilibrium) < self.ratio:
