@@ -155,7 +155,7 @@ def test_run_progress_in_a_log_writes_periodic_lines(capsys, monkeypatch):
 
 
 def test_shear_bars_in_a_log(capsys):
-    from poro2d.shear.protocol import _Bars
+    from poro2d.shear.pool import _Bars
 
     labels = {("test", 50.0): "50 kPa", ("test", 100.0): "100 kPa"}
     bars = _Bars(labels)

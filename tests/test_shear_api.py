@@ -1,6 +1,6 @@
-"""The direct shear package's Python API: ``run_shear``, the peak's force-chain frame, and the
-names ``poro2d.shear.protocol`` still gives. A small specimen (0.06 m x 0.03 m) and 2 mm of
-shear, as in test_shear.py: every test runs in seconds."""
+"""The direct shear package's Python API: ``run_shear`` and the peak's force-chain frame.
+A small specimen (0.06 m x 0.03 m) and 2 mm of shear, as in test_shear.py: every test
+runs in seconds."""
 
 import json
 
@@ -128,13 +128,3 @@ def test_peak_tracker_keeps_the_frame_of_the_smoothed_maximum(tmp_path):
     assert resumed.frame.record == 8 and resumed.value == pytest.approx(tracker.value)
     resumed.save(tmp_path / "g.npz")  # nothing new since the restore: nothing written
     assert not (tmp_path / "g.npz").exists()
-
-
-def test_protocol_still_gives_the_old_names():
-    from poro2d.shear import outputs, pool, protocol, series, settings, single
-
-    assert protocol.ShearSeries is series.ShearSeries and protocol.ShearSettings is settings.ShearSettings
-    assert protocol.DirectShearTest is single.DirectShearTest and protocol.execute_jobs is pool.execute_jobs
-    assert protocol.folder_name(100.0) == outputs.folder_name(100.0) == "sn100kPa"
-    assert protocol._read_csv is outputs.read_curve_csv and protocol._Bars is pool._Bars
-    assert protocol.run_shear is run_shear

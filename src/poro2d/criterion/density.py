@@ -112,27 +112,30 @@ class Calibration:
             raise InputError("calibration.mus", self.mus, "strictly increasing preparation frictions")
 
     # ----------------------------------------------------------- statistics
-    def _good(self, k: int) -> np.ndarray:
+    def accepted(self, k: int) -> np.ndarray:
+        """The accepted n2D of the seeds at ``mus[k]``: the finite samples, in seed order."""
         return np.array([v for v in self.samples[k] if v is not None and math.isfinite(v)], dtype=float)
 
     @property
     def mean(self) -> np.ndarray:
-        return np.array([g.mean() if g.size else math.nan for g in map(self._good, range(len(self.mus)))])
+        return np.array([g.mean() if g.size else math.nan for g in map(self.accepted, range(len(self.mus)))])
 
     @property
     def sd(self) -> np.ndarray:
         """Sample standard deviation over seeds (0 with one seed)."""
-        return np.array([g.std(ddof=1) if g.size > 1 else 0.0 for g in map(self._good, range(len(self.mus)))])
+        return np.array(
+            [g.std(ddof=1) if g.size > 1 else 0.0 for g in map(self.accepted, range(len(self.mus)))]
+        )
 
     @property
     def failed(self) -> list[int]:
         """Per friction, how many seeds did not give an accepted porosity."""
-        return [len(s) - self._good(k).size for k, s in enumerate(self.samples)]
+        return [len(s) - self.accepted(k).size for k, s in enumerate(self.samples)]
 
     @property
     def dropped(self) -> list[float]:
         """Frictions at which no seed was accepted: they could not be prepared, and are left out."""
-        return [mu for k, mu in enumerate(self.mus) if self._good(k).size == 0]
+        return [mu for k, mu in enumerate(self.mus) if self.accepted(k).size == 0]
 
     def usable(self) -> Calibration:
         """The calibration of the frictions with at least one accepted seed.
@@ -141,7 +144,7 @@ class Calibration:
         equilibrium within the compaction's fallback) gives no sample; the grading's extremes
         are then those of the frictions that could be prepared. Fewer than two is an error.
         """
-        keep = [k for k in range(len(self.mus)) if self._good(k).size]
+        keep = [k for k in range(len(self.mus)) if self.accepted(k).size]
         if len(keep) < 2:
             raise InputError(
                 "calibration", f"accepted porosities at mu_prep = {[self.mus[k] for k in keep]} only "
@@ -160,7 +163,7 @@ class Calibration:
         """
         cal = self.usable()
         m, s = cal.mean, cal.sd
-        n = np.array([max(cal._good(k).size, 1) for k in range(len(cal.mus))])
+        n = np.array([max(cal.accepted(k).size, 1) for k in range(len(cal.mus))])
         se = s / np.sqrt(n)
         for k in range(len(cal.mus) - 1):
             drop = m[k] - m[k + 1]
@@ -180,10 +183,10 @@ class Calibration:
     @property
     def fitted(self) -> np.ndarray:
         """Non-decreasing fit of the seed means (weights: accepted seeds); NaN where none was."""
-        keep = [k for k in range(len(self.mus)) if self._good(k).size]
+        keep = [k for k in range(len(self.mus)) if self.accepted(k).size]
         out = np.full(len(self.mus), math.nan)
         if keep:
-            out[keep] = isotonic_increasing(self.mean[keep], [self._good(k).size for k in keep])
+            out[keep] = isotonic_increasing(self.mean[keep], [self.accepted(k).size for k in keep])
         return out
 
     @property

@@ -152,15 +152,19 @@ def fill_porosity(radius: np.ndarray, profile: LidProfile) -> float:
 
 # --------------------------------------------------------------------------- controllers
 class FlatPlate:
-    """The paper's top plate as the criterion's plate stage drives it (one rigid wall)."""
+    """A box's top plate (the wall ``top``), as the criterion's plate servo and the shear test's
+    consolidation drive it: one rigid wall that moves down to compress."""
 
     name = "plate"
 
     def __init__(self, sim: Simulation) -> None:
         self.index = sim.walls.index("top")
 
-    def servo(self, sim: Simulation, total: float, max_speed: float, gain: float) -> None:
-        sim.set_wall_servo(self.index, total, (0.0, -1.0), max_speed, gain)
+    def servo(
+        self, sim: Simulation, total: float, max_speed: float, gain: float, integral: float = 0.0
+    ) -> None:
+        """Servo the plate to ``total`` newtons (:meth:`poro2d.dem.Simulation.set_wall_servo`)."""
+        sim.set_wall_servo(self.index, total, (0.0, -1.0), max_speed, gain, integral)
 
     def hold(self, sim: Simulation) -> None:
         sim.set_wall_velocity(self.index, (0.0, 0.0))

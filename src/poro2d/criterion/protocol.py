@@ -6,8 +6,8 @@ For a trial 2D porosity n2D (Eq. 12 of the paper unless given):
 2. measure the top-plate force F_top; accept at once when 0 < F_top < 1 % of the
    self weight G = rho_s (1 - n2D) W H g;
 3. otherwise servo the top plate (down when F_top = 0, up when it is too large)
-   until the condition holds at equilibrium, and compute the porosity n' of the
-   new box; accept n2D when |n' - n2D| < 0.005;
+   until the condition holds at equilibrium (:class:`~poro2d.criterion.servo.PlateServo`),
+   and compute the porosity n' of the new box; accept n2D when |n' - n2D| < 0.005;
 4. else start again from 1 with n' rounded to the porosity resolution (0.01).
 
 Every trial is written to its own folder as it finishes, so an interrupted run
@@ -26,7 +26,6 @@ from __future__ import annotations
 import logging
 import math
 import time
-from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -34,7 +33,6 @@ import numpy as np
 
 from poro2d.config import check_finite
 from poro2d.criterion.lid import (
-    FlatPlate,
     SegmentedLid,
     fill_porosity,
     flat_top,
@@ -45,6 +43,7 @@ from poro2d.criterion.lid import (
     lid_window_note,
 )
 from poro2d.criterion.result import CriterionResult
+from poro2d.criterion.servo import PlateServo, in_window
 from poro2d.dem import Simulation, checkpoint
 from poro2d.errors import InputError, check_range
 from poro2d.io_utils import as_json, provenance, write_csv, write_json
@@ -206,10 +205,6 @@ def wall_forces(sim: Simulation) -> dict:
         "f_left_n_per_m": float(-left[0]),
         "f_right_n_per_m": float(right[0]),
     }
-
-
-def in_window(f_top: float, weight: float, fraction: float) -> bool:
-    return 0.0 < f_top < fraction * weight
 
 
 # A disk counts as inside the box while it presses into a wall by less than this
@@ -449,122 +444,10 @@ class PorosityCriterion:
             ],
         )  # fmt: skip
 
-    def _move_plate(
-        self, sim: Simulation, n: float, weight: float, top: FlatPlate | SegmentedLid | None = None
-    ) -> dict:
-        """Servo the top plate (or the lid) until 0 < F_top < fraction G holds at equilibrium.
-
-        Each round (:meth:`_plate_round`) has two phases. The approach servos the plate
-        briskly towards ``servo_target_fraction`` x the limit until F_top has stayed in the
-        window for ``window_checks`` checks. The settling phase keeps a gentle servo on (a
-        low gain and speed, so the plate follows slow creep of the specimen without shaking
-        it) until, with F_top in the window, the specimen is at equilibrium (maximum
-        unbalanced-force ratio below the specimen's ``ratio``) or the plate has rested for
-        ``settle_checks`` checks (drift below ``plate_drift`` x H: only creep left). The
-        plate is then held still, the specimen cycled towards equilibrium, and F_top checked
-        once more (the final ratio is reported); if it left the window, a new round starts.
-        A lid (:class:`~poro2d.criterion.lid.SegmentedLid`) is driven the same way, its
-        segments each to their share of the force, and counts as in the window only while
-        it rests on the specimen over most of the width.
-        """
-        s = self.settings
-        top = FlatPlate(sim) if top is None else top
-        y_start = top.height(sim)
-        steps = 0
-        rounds = 0
-        ok = False
-        final_ratio = float("nan")
-        while steps < s.max_plate_steps and not ok:
-            rounds += 1
-            steps, ok, final_ratio = self._plate_round(sim, weight, rounds, steps, top)
-        y_end = top.height(sim)
-        return {
-            "plate_settled": ok,
-            "plate_steps": steps,
-            "plate_rounds": rounds,
-            "plate_final_max_ratio": final_ratio,
-            "plate_displacement_m": y_end - y_start,
-            "plate_height_m": y_end,
-        }
-
-    def _plate_round(
-        self, sim: Simulation, weight: float, rounds: int, steps: int, top: FlatPlate | SegmentedLid
-    ) -> tuple[int, bool, float]:
-        """One round of :meth:`_move_plate`: approach, settle, hold the plate still.
-
-        ``steps``: the plate steps before this round (every phase stops at
-        ``max_plate_steps`` in all). Returns the steps after it, whether F_top is in the
-        window once held, and the maximum unbalanced-force ratio reached while held.
-        """
-        s = self.settings
-        t = sim.particles.thickness
-        cap = s.force_fraction * weight  # N/m
-        target = self._servo_target(weight, sim)  # N
-
-        def left() -> int:
-            return max(s.max_plate_steps - steps, 1)
-
-        top.servo(sim, target, s.servo_max_speed, s.servo_gain)
-        label = f"top {top.name} (round {rounds})" if self.progress else False
-        steady = self._in_window_check(top, target, weight)
-        steps += sim.run(left(), every=s.check_every, callback=steady, progress=label).steps
-        top.servo(sim, target, s.settle_max_speed, s.settle_gain)
-        steps += sim.run(left(), every=s.check_every, callback=self._settled_check(top, target, weight)).steps
-        top.hold(sim)
-        res = sim.solve(self.spec.ratio, min(left(), 20 * s.check_every), measure=self.spec.equilibrium)
-        steps += res.steps
-        f = top.force(sim) / t
-        _log.debug(
-            "plate round %d: F_top %.4g N/m (limit %.4g), held: converged %s ratio %.3g, %d steps",
-            rounds, f, cap, res.converged, res.max_ratio, steps,
-        )  # fmt: skip
-        ok = in_window(f, weight, s.force_fraction) and top.resting(sim, target)
-        return steps, ok, res.measured_ratio
-
-    def _in_window(self, sm: Simulation, top: FlatPlate | SegmentedLid, target: float, weight: float) -> bool:
-        f = top.force(sm) / sm.particles.thickness
-        return in_window(f, weight, self.settings.force_fraction) and top.resting(sm, target)
-
-    def _in_window_check(
-        self, top: FlatPlate | SegmentedLid, target: float, weight: float
-    ) -> Callable[[Simulation], bool]:
-        """The approach's stop test: F_top in the window for ``window_checks`` checks running."""
-        s = self.settings
-        streak = [0]
-
-        def steady(sm: Simulation) -> bool:
-            streak[0] = streak[0] + 1 if self._in_window(sm, top, target, weight) else 0
-            return streak[0] >= s.window_checks
-
-        return steady
-
-    def _settled_check(
-        self, top: FlatPlate | SegmentedLid, target: float, weight: float
-    ) -> Callable[[Simulation], bool]:
-        """The settling phase's stop test: F_top in the window and the specimen at rest.
-
-        At rest means at equilibrium, or a plate that rests in the window while the
-        specimen only creeps (its drift over the last ``settle_checks`` checks below
-        ``plate_drift`` x H).
-        """
-        s = self.settings
-        calm: list[float] = []
-
-        def settled(sm: Simulation) -> bool:
-            if not self._in_window(sm, top, target, weight):
-                calm.clear()
-                return False
-            if sm.ratio_of(self.spec.equilibrium) < self.spec.ratio:
-                return True
-            calm.append(top.height(sm))
-            if len(calm) < s.settle_checks:
-                return False
-            return (
-                max(calm[-s.settle_checks :]) - min(calm[-s.settle_checks :])
-                < s.plate_drift * self.spec.height
-            )
-
-        return settled
+    def plate_servo(self) -> PlateServo:
+        """The plate (and lid) servo of step 3, with this run's settings and equilibrium."""
+        sp = self.spec
+        return PlateServo(self.settings, sp.ratio, sp.equilibrium, sp.height, progress=self.progress)
 
     def _trial(self, k: int, n: float) -> dict:
         """Trial ``k`` at porosity ``n``: its row, read back from its ``trial.json`` once written."""
@@ -638,25 +521,26 @@ class PorosityCriterion:
         and n' is the porosity of the area under it (:func:`~poro2d.criterion.lid.fill_porosity`).
         """
         f_top = row["f_top_n_per_m"]
+        servo = self.plate_servo()
         if self.settings.acceptance == "fill":
             row["plate_moved"] = "lid"
             if not in_window(f_top, weight, self.settings.force_fraction):
                 # the plate first takes the specimen to the window (a dense trial pushes hard
                 # and swells for long): the lid then only has the surface left to follow
-                plate = self._move_plate(sim, n, weight)
+                plate = servo.settle(sim, weight)
                 if not plate["plate_settled"]:
                     row.update(plate)
                     row["new_porosity"] = box_porosity(sim, self.spec.width, row["plate_height_m"])
                     return self._after_top(sim, weight, row, d)
             lid = SegmentedLid(sim, self.spec.width, mass_d50(sim.particles.radius))
-            row.update(self._move_plate(sim, n, weight, lid))
+            row.update(servo.settle(sim, weight, lid))
             profile = lid_profile(sim, self.spec.width)
             row["new_porosity"] = fill_porosity(sim.particles.radius, profile)
-            row.update(lid_numbers(sim, profile, self._servo_target(weight, sim)))
+            row.update(lid_numbers(sim, profile, servo.target(sim, weight)))
             row["lid_note"] = lid_window_note(sim, profile, row["force_limit_n_per_m"])
         else:
             row["plate_moved"] = "down" if f_top <= 0.0 else "up"
-            row.update(self._move_plate(sim, n, weight))
+            row.update(servo.settle(sim, weight))
             row["new_porosity"] = box_porosity(sim, self.spec.width, row["plate_height_m"])
         return self._after_top(sim, weight, row, d)
 
@@ -684,11 +568,6 @@ class PorosityCriterion:
                 failed_max_ratio=row["plate_final_max_ratio"], failed_steps=row["plate_steps"],
             )  # fmt: skip
         return after
-
-    def _servo_target(self, weight: float, sim: Simulation) -> float:
-        """The force (N) the plate or lid servos to: ``servo_target_fraction`` of the window's limit."""
-        s = self.settings
-        return s.servo_target_fraction * (s.force_fraction * weight) * sim.particles.thickness
 
     def _lid(self, sim: Simulation) -> tuple[np.ndarray, np.ndarray] | None:
         """The lid's (edges, heights) when the trial rested one, else None."""

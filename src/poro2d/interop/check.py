@@ -6,8 +6,8 @@ plate at the top of its box, moved so that the box starts at the origin), with i
 at rest and no contact history. It is cycled to equilibrium with the plate fixed; then
 F_top, F_bottom and the side walls' upward friction are measured and the window of
 Fig. 3 is tested: 0 < F_top < 1 % of the self weight G. When the specimen fails it, the
-criterion's own plate servo (``PorosityCriterion._move_plate``) finds where the plate
-would settle, and so the porosity n' the box would have there.
+criterion's own plate servo (:class:`poro2d.criterion.servo.PlateServo`) finds where the
+plate would settle, and so the porosity n' the box would have there.
 """
 
 from __future__ import annotations
@@ -19,7 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion, in_window, wall_forces
+from poro2d.criterion.protocol import CriterionSettings, wall_forces
+from poro2d.criterion.servo import PlateServo, in_window
 from poro2d.dem import ContactModel, Particles, Simulation
 from poro2d.errors import InputError
 from poro2d.interop import csv_table
@@ -167,9 +168,9 @@ def check_specimen(
         at_equilibrium(sim, report)
     if passes or not res.converged:
         return sim, report
-    # the criterion's plate servo; it reads only the box, the ratio and the settings
-    crit = PorosityCriterion(box, grading=None, settings=settings, progress=progress)  # type: ignore[arg-type]
-    plate = crit._move_plate(sim, n_box, weight)
+    # the criterion's plate servo, with the imported box's height and equilibrium ratio
+    servo = PlateServo(settings, box.ratio, box.equilibrium, box.height, progress=progress)
+    plate = servo.settle(sim, weight)
     after = wall_forces(sim)
     report["plate"] = {
         **plate,

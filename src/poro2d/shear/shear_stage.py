@@ -11,18 +11,16 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from poro2d.dem import Simulation, checkpoint
-from poro2d.shear.box import LOWER
+from poro2d.shear.box import SplitBox
+from poro2d.shear.controllers import ProgressFn, ShearDrive
 from poro2d.shear.curve import curve_row, peak_passed
 from poro2d.shear.fit import peak
 from poro2d.shear.peak_frame import PeakFrame, PeakTracker
-
-if TYPE_CHECKING:
-    from poro2d.shear.single import DirectShearTest
+from poro2d.shear.settings import ShearSettings
 
 #: the files that let a killed shear stage continue: the engine state and the peak's frame
 CHECKPOINT = "shear_checkpoint.npz"
@@ -30,22 +28,38 @@ PEAK_FRAME = "peak_frame.npz"
 
 
 class ShearStage:
-    """Shear ``sim`` (consolidated, or from the test's checkpoint) to ``max_displacement``,
+    """Shear ``sim`` (consolidated, or from the checkpoint in ``folder``) to ``max_displacement``,
     or until the peak is passed by ``stop_after_peak``: past it the curve only serves the
     residual part of Fig. 8, and it is a third or more of a test's cost.
 
+    ``box``: the split box ``sim`` stands in; ``y_plate0``: the plate's height after
+    consolidation (the dilation's zero); ``folder``: where the checkpoint and the peak's
+    frame are kept (None: nowhere); ``threads``: for a state read back from the checkpoint;
+    ``figures``: keep the state at the peak for its force chains; ``progress(phase,
+    fraction)``: called at every record.
+
     After :meth:`run`: ``rows`` (the curve), ``sim`` (the final state) and ``peak.frame``
-    (the state at the smoothed peak, when the test draws figures).
+    (the state at the smoothed peak, when ``figures``).
     """
 
-    def __init__(self, test: DirectShearTest, sim: Simulation, info: dict) -> None:
-        s = test.settings
-        assert test.box is not None
-        self.test, self.box, self.settings = test, test.box, s
+    def __init__(
+        self,
+        sim: Simulation,
+        box: SplitBox,
+        settings: ShearSettings,
+        y_plate0: float,
+        folder: Path | None = None,
+        threads: int = 1,
+        figures: bool = True,
+        progress: ProgressFn | None = None,
+    ) -> None:
+        s = settings
+        self.box, self.settings = box, s
+        self.threads, self.figures, self.progress = threads, figures, progress
         self.t0 = time.perf_counter()
-        self.ck = test._path(CHECKPOINT)
-        self.fpath = test._path(PEAK_FRAME)
-        self.y_plate0 = info["plate_height_m"]
+        self.ck = None if folder is None else folder / CHECKPOINT
+        self.fpath = None if folder is None else folder / PEAK_FRAME
+        self.y_plate0 = y_plate0
         self.sim, self.rows, self.step0, self.wall_before = self._start(sim)
         dx_step = s.velocity * self.sim.dt
         self.every = max(1, int(round(s.record_interval / dx_step)))
@@ -59,10 +73,9 @@ class ShearStage:
         """(simulation, rows, step shearing began at, wall time so far): resumed or new."""
         if self.ck is not None and self.ck.is_file():
             meta = checkpoint.read_meta(self.ck)["extra"]
-            resumed = checkpoint.load(self.ck, threads=self.test.threads)
+            resumed = checkpoint.load(self.ck, threads=self.threads)
             return resumed, meta["rows"], meta["step0"], meta.get("wall_time_s", 0.0)
-        for name in LOWER:
-            sim.set_wall_velocity(name, (self.settings.velocity, 0.0))
+        ShearDrive(self.settings.velocity).start(sim)
         return sim, [], sim.step_count, 0.0
 
     def record(self, sim: Simulation) -> bool:
@@ -71,11 +84,12 @@ class ShearStage:
         contacts = sim.contacts()
         rows.append(curve_row(sim, self.box, self.settings, contacts, self.y_plate0, self.step0, self.rho))
         x_mm = rows[-1]["shear_displacement_mm"]
-        if self.test.figures:
+        if self.figures:
             self.peak.add(PeakFrame.capture(sim, contacts, len(rows) - 1, x_mm))
         self.peak.settle(rows, x_mm * 1e-3)
         done = sim.step_count - self.step0
-        self.test._report("shearing", done / self.total)
+        if self.progress is not None:
+            self.progress("shearing", done / self.total)
         if self.ck is not None and len(rows) % self.ck_every == 0 and done < self.total:
             self.peak.save(self.fpath)  # a resumed run still draws the peak's forces
             wall = self.wall_before + time.perf_counter() - self.t0

@@ -2,10 +2,12 @@
 
 1. load the specimen checkpoint and build the split box around it
    (:func:`poro2d.shear.box.build_split_box`);
-2. consolidate: servo the top plate to ``sigma_n W t`` until the specimen is in
-   equilibrium (maximum unbalanced-force ratio below ``consolidation_ratio``) and
-   the plate's stress is within ``stress_tolerance`` of the target, the servo on;
-3. shear (:class:`poro2d.shear.shear_stage.ShearStage`): the lower half moves at
+2. consolidate (:class:`poro2d.shear.controllers.Consolidation`): servo the top plate
+   to ``sigma_n W t`` until the specimen is in equilibrium (maximum unbalanced-force
+   ratio below ``consolidation_ratio``) and the plate's stress is within
+   ``stress_tolerance`` of the target, the servo on;
+3. shear (:class:`poro2d.shear.shear_stage.ShearStage`, driven by
+   :class:`poro2d.shear.controllers.ShearDrive`): the lower half moves at
    ``velocity`` in +x, the upper half is fixed, the plate servo stays on; one row per
    ``record_interval`` (see :data:`poro2d.shear.curve.CURVE_COLUMNS`), a checkpoint per
    ``checkpoint_interval``.
@@ -13,9 +15,7 @@
 
 from __future__ import annotations
 
-import math
 import time
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -28,16 +28,13 @@ from poro2d.io_utils import as_json, provenance, write_csv
 from poro2d.resumable import ResumableStage
 from poro2d.shear import record
 from poro2d.shear.box import SplitBox, build_split_box
+from poro2d.shear.controllers import Consolidation, ProgressFn
 from poro2d.shear.curve import CURVE_COLUMNS, curve_summary
 from poro2d.shear.peak_frame import PeakFrame
 from poro2d.shear.results import ShearTestResult
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings, inertial_number
 from poro2d.shear.shear_stage import ShearStage, remove_stage_files
 from poro2d.shear.specimen_file import resolve_specimen, specimen_box
-
-ProgressFn = Callable[[str, float], None]
-#: how often (steps) consolidation checks for equilibrium
-CONSOLIDATION_CHECK = 500
 
 
 class DirectShearTest:
@@ -81,13 +78,6 @@ class DirectShearTest:
         self._stage: ResumableStage | None = None
 
     # ------------------------------------------------------------ bookkeeping
-    def _report(self, phase: str, fraction: float) -> None:
-        if self.progress is not None:
-            self.progress(phase, fraction)
-
-    def _path(self, name: str) -> Path | None:
-        return None if self.out is None else self.out / name
-
     @property
     def specimen_digest(self) -> str:
         """Digest of the specimen's state (:func:`poro2d.dem.checkpoint.state_digest`)."""
@@ -157,30 +147,19 @@ class DirectShearTest:
         sim, box = self._build_box()
         self.box = box
         target = self.sigma_kpa * 1e3 * box.width * box.thickness
-        sim.set_wall_servo("top", target, (0.0, -1.0), s.servo_max_speed, s.servo_gain, s.servo_integral)
-        y0 = box.plate_height(sim)
-        state = {"ratio": math.inf, "err": math.inf}
-
-        def settled(sm: Simulation) -> bool:
-            rmax, _ = sm.unbalanced_ratios()
-            err = abs(box.plate_force(sm) / target - 1.0)
-            state.update(ratio=rmax, err=err)
-            self._report("consolidating", min(sm.step_count / s.consolidation_max_steps, 1.0))
-            return rmax < s.consolidation_ratio and err < s.stress_tolerance
-
-        sim.reset_clock()
-        res = sim.run(s.consolidation_max_steps, every=CONSOLIDATION_CHECK, callback=settled)
-        if not (state["ratio"] < s.consolidation_ratio and state["err"] < s.stress_tolerance):
+        done = Consolidation(s, progress=self.progress).settle(sim, target)
+        if not done["settled"]:
             raise RuntimeError(
                 f"consolidation at {self.sigma_kpa:g} kPa did not reach equilibrium within "
-                f"{s.consolidation_max_steps} steps (ratio {state['ratio']:.2e}, "
-                f"stress error {state['err']:.2%})"
+                f"{s.consolidation_max_steps} steps (ratio {done['max_unbalanced_ratio']:.2e}, "
+                f"stress error {done['normal_stress_error']:.2%})"
             )
+        y0 = done["plate_height_before_m"]
         info = {
-            "normal_stress_kpa": self.sigma_kpa, "target_force_n": target, "steps": res.steps,
-            "max_unbalanced_ratio": state["ratio"],
+            "normal_stress_kpa": self.sigma_kpa, "target_force_n": target, "steps": done["steps"],
+            "max_unbalanced_ratio": done["max_unbalanced_ratio"],
             "normal_stress_measured_kpa": box.plate_force(sim) / (box.width * box.thickness) / 1e3,
-            "normal_stress_error": state["err"], "plate_height_before_m": y0,
+            "normal_stress_error": done["normal_stress_error"], "plate_height_before_m": y0,
             "plate_height_m": box.plate_height(sim), "plate_settlement_m": y0 - box.plate_height(sim),
             "coordination_number": coordination_number(sim), "wall_time_s": time.perf_counter() - t0,
             "box": box.to_dict(), "engine": sim.summary(),
@@ -193,7 +172,11 @@ class DirectShearTest:
         With ``out``: ``curve.csv`` and ``forces_peak.png`` are written here, ``result.json``
         after them by :meth:`run`.
         """
-        stage = ShearStage(self, sim, info)
+        assert self.box is not None
+        stage = ShearStage(
+            sim, self.box, self.settings, info["plate_height_m"],
+            folder=self.out, threads=self.threads, figures=self.figures, progress=self.progress,
+        )  # fmt: skip
         wall = stage.run()
         result = self._result(stage.rows, info, stage.sim, wall)
         if self.out is not None:

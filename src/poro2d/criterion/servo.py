@@ -1,0 +1,185 @@
+"""The criterion's plate servo as a controller of its own: the top settles in the force window.
+
+Step 3 of Fig. 3 moves the top plate (down when F_top = 0, up when it is too large) until
+0 < F_top < ``force_fraction`` x G holds at equilibrium. :class:`PlateServo` does that on
+any simulation whose top is one of the controllers of :mod:`poro2d.criterion.lid` (the
+paper's :class:`~poro2d.criterion.lid.FlatPlate`, or the fill acceptance's
+:class:`~poro2d.criterion.lid.SegmentedLid`): the criterion's trials use it, and so does
+the check of an imported specimen (:mod:`poro2d.interop.check`), with the same settings
+and so the same steps.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Protocol
+
+from poro2d.criterion.lid import FlatPlate, SegmentedLid
+from poro2d.dem import Simulation
+
+_log = logging.getLogger(__name__)
+
+
+def in_window(f_top: float, weight: float, fraction: float) -> bool:
+    """The window of Fig. 3: 0 < F_top < ``fraction`` x G (both per metre of thickness)."""
+    return 0.0 < f_top < fraction * weight
+
+
+class ServoSettings(Protocol):
+    """What the servo reads of the criterion's settings (``CriterionSettings`` has them all)."""
+
+    force_fraction: float
+    servo_target_fraction: float
+    servo_max_speed: float
+    servo_gain: float
+    settle_gain: float
+    settle_max_speed: float
+    settle_checks: int
+    plate_drift: float
+    max_plate_steps: int
+    check_every: int
+    window_checks: int
+
+
+@dataclass(frozen=True)
+class PlateServo:
+    """Servo the top of a box until 0 < F_top < ``force_fraction`` G holds at equilibrium.
+
+    ``settings``: the thresholds and servo gains (``CriterionSettings``); ``ratio`` and
+    ``equilibrium``: when the specimen counts as at equilibrium (its maximum, mean or
+    load-bearing unbalanced-force ratio below ``ratio``, as the specimen's preparation
+    judged it); ``height``: the box height H, the scale of the allowed plate drift;
+    ``progress``: a bar per approach when True.
+    """
+
+    settings: ServoSettings
+    ratio: float
+    equilibrium: str
+    height: float
+    progress: bool = False
+
+    def target(self, sim: Simulation, weight: float) -> float:
+        """The force (N) the plate or lid servos to: ``servo_target_fraction`` of the window's limit."""
+        s = self.settings
+        return s.servo_target_fraction * (s.force_fraction * weight) * sim.particles.thickness
+
+    def settle(self, sim: Simulation, weight: float, top: FlatPlate | SegmentedLid | None = None) -> dict:
+        """Servo ``top`` (the flat plate by default) until the window holds at equilibrium.
+
+        Each round (:meth:`round`) has two phases. The approach servos the plate briskly
+        towards ``servo_target_fraction`` x the limit until F_top has stayed in the window
+        for ``window_checks`` checks. The settling phase keeps a gentle servo on (a low gain
+        and speed, so the plate follows slow creep of the specimen without shaking it)
+        until, with F_top in the window, the specimen is at equilibrium or the plate has
+        rested for ``settle_checks`` checks (drift below ``plate_drift`` x H: only creep
+        left). The plate is then held still, the specimen cycled towards equilibrium, and
+        F_top checked once more (the final ratio is reported); if it left the window, a new
+        round starts. A lid is driven the same way, its segments each to their share of
+        the force, and counts as in the window only while it rests on the specimen over
+        most of the width. ``weight``: the self weight G (N/m).
+
+        Returns the plate stage's record: ``plate_settled``, ``plate_steps``,
+        ``plate_rounds``, ``plate_final_max_ratio``, ``plate_displacement_m``,
+        ``plate_height_m``.
+        """
+        s = self.settings
+        top = FlatPlate(sim) if top is None else top
+        y_start = top.height(sim)
+        steps = 0
+        rounds = 0
+        ok = False
+        final_ratio = float("nan")
+        while steps < s.max_plate_steps and not ok:
+            rounds += 1
+            steps, ok, final_ratio = self.round(sim, weight, rounds, steps, top)
+        y_end = top.height(sim)
+        return {
+            "plate_settled": ok,
+            "plate_steps": steps,
+            "plate_rounds": rounds,
+            "plate_final_max_ratio": final_ratio,
+            "plate_displacement_m": y_end - y_start,
+            "plate_height_m": y_end,
+        }
+
+    def round(
+        self, sim: Simulation, weight: float, rounds: int, steps: int, top: FlatPlate | SegmentedLid
+    ) -> tuple[int, bool, float]:
+        """One round of :meth:`settle`: approach, settle, hold the plate still.
+
+        ``steps``: the plate steps before this round (every phase stops at
+        ``max_plate_steps`` in all). Returns the steps after it, whether F_top is in the
+        window once held, and the maximum unbalanced-force ratio reached while held.
+        """
+        s = self.settings
+        t = sim.particles.thickness
+        cap = s.force_fraction * weight  # N/m
+        target = self.target(sim, weight)  # N
+
+        def left() -> int:
+            return max(s.max_plate_steps - steps, 1)
+
+        top.servo(sim, target, s.servo_max_speed, s.servo_gain)
+        label = f"top {top.name} (round {rounds})" if self.progress else False
+        steady = self._approached(top, target, weight)
+        steps += sim.run(left(), every=s.check_every, callback=steady, progress=label).steps
+        top.servo(sim, target, s.settle_max_speed, s.settle_gain)
+        steps += sim.run(left(), every=s.check_every, callback=self._settled(top, target, weight)).steps
+        top.hold(sim)
+        res = sim.solve(self.ratio, min(left(), 20 * s.check_every), measure=self.equilibrium)
+        steps += res.steps
+        f = top.force(sim) / t
+        _log.debug(
+            "plate round %d: F_top %.4g N/m (limit %.4g), held: converged %s ratio %.3g, %d steps",
+            rounds, f, cap, res.converged, res.max_ratio, steps,
+        )  # fmt: skip
+        ok = in_window(f, weight, s.force_fraction) and top.resting(sim, target)
+        return steps, ok, res.measured_ratio
+
+    def holds(self, sim: Simulation, top: FlatPlate | SegmentedLid, target: float, weight: float) -> bool:
+        """F_top in the window, with a lid resting on the specimen over most of the width."""
+        f = top.force(sim) / sim.particles.thickness
+        return in_window(f, weight, self.settings.force_fraction) and top.resting(sim, target)
+
+    def _approached(
+        self, top: FlatPlate | SegmentedLid, target: float, weight: float
+    ) -> Callable[[Simulation], bool]:
+        """The approach's stop test: F_top in the window for ``window_checks`` checks running."""
+        s = self.settings
+        streak = [0]
+
+        def steady(sm: Simulation) -> bool:
+            streak[0] = streak[0] + 1 if self.holds(sm, top, target, weight) else 0
+            return streak[0] >= s.window_checks
+
+        return steady
+
+    def _settled(
+        self, top: FlatPlate | SegmentedLid, target: float, weight: float
+    ) -> Callable[[Simulation], bool]:
+        """The settling phase's stop test: F_top in the window and the specimen at rest.
+
+        At rest means at equilibrium, or a plate that rests in the window while the
+        specimen only creeps (its drift over the last ``settle_checks`` checks below
+        ``plate_drift`` x H).
+        """
+        s = self.settings
+        calm: list[float] = []
+
+        def settled(sm: Simulation) -> bool:
+            if not self.holds(sm, top, target, weight):
+                calm.clear()
+                return False
+            if sm.ratio_of(self.equilibrium) < self.ratio:
+                return True
+            calm.append(top.height(sm))
+            if len(calm) < s.settle_checks:
+                return False
+            return max(calm[-s.settle_checks :]) - min(calm[-s.settle_checks :]) < s.plate_drift * self.height
+
+        return settled
+
+
+__all__ = ["PlateServo", "ServoSettings", "in_window"]

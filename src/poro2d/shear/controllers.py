@@ -1,0 +1,84 @@
+"""The direct shear test's two controllers: the consolidation and the shear drive.
+
+Both have the shape of the criterion's plate servo (:class:`poro2d.criterion.servo.PlateServo`):
+a small object holding its settings, with one public method that drives a simulation.
+The consolidation servoes the test's top plate through the criterion's own plate
+controller (:class:`poro2d.criterion.lid.FlatPlate`); its stop rule is the shear test's
+(equilibrium and the normal stress on target), not the criterion's force window.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from poro2d.criterion.lid import FlatPlate
+from poro2d.dem import Simulation
+from poro2d.shear.box import LOWER
+from poro2d.shear.settings import ShearSettings
+
+#: ``progress(phase, fraction)``: called between blocks of steps, for a progress display
+ProgressFn = Callable[[str, float], None]
+
+#: how often (steps) consolidation checks for equilibrium
+CONSOLIDATION_CHECK = 500
+
+
+@dataclass(frozen=True)
+class Consolidation:
+    """Servo the top plate to a normal force until the specimen is at equilibrium under it.
+
+    Settled means the maximum unbalanced-force ratio below ``consolidation_ratio`` and the
+    plate's force within ``stress_tolerance`` of the target, the servo on (``servo_gain``,
+    ``servo_integral``, ``servo_max_speed``); at most ``consolidation_max_steps`` steps.
+    """
+
+    settings: ShearSettings
+    progress: ProgressFn | None = None
+
+    def settle(self, sim: Simulation, target: float) -> dict:
+        """Consolidate ``sim`` under ``target`` newtons on its top plate; the servo stays on after.
+
+        Returns ``settled``, ``steps``, ``max_unbalanced_ratio`` (at the last check),
+        ``normal_stress_error`` (|F / target - 1| at the last check) and
+        ``plate_height_before_m``. The engine's clock starts again at 0.
+        """
+        s = self.settings
+        plate = FlatPlate(sim)
+        plate.servo(sim, target, s.servo_max_speed, s.servo_gain, s.servo_integral)
+        y0 = plate.height(sim)
+        state = {"ratio": math.inf, "err": math.inf}
+
+        def settled(sm: Simulation) -> bool:
+            rmax, _ = sm.unbalanced_ratios()
+            err = abs(plate.force(sm) / target - 1.0)
+            state.update(ratio=rmax, err=err)
+            if self.progress is not None:
+                self.progress("consolidating", min(sm.step_count / s.consolidation_max_steps, 1.0))
+            return rmax < s.consolidation_ratio and err < s.stress_tolerance
+
+        sim.reset_clock()
+        res = sim.run(s.consolidation_max_steps, every=CONSOLIDATION_CHECK, callback=settled)
+        return {
+            "settled": state["ratio"] < s.consolidation_ratio and state["err"] < s.stress_tolerance,
+            "steps": res.steps,
+            "max_unbalanced_ratio": state["ratio"],
+            "normal_stress_error": state["err"],
+            "plate_height_before_m": y0,
+        }
+
+
+@dataclass(frozen=True)
+class ShearDrive:
+    """The lower half of the split box (:data:`poro2d.shear.box.LOWER`) moving at ``velocity`` in +x."""
+
+    velocity: float
+
+    def start(self, sim: Simulation) -> None:
+        """Set every wall of the lower half moving; the upper half and the plate's servo stay as they are."""
+        for name in LOWER:
+            sim.set_wall_velocity(name, (self.velocity, 0.0))
+
+
+__all__ = ["CONSOLIDATION_CHECK", "Consolidation", "ProgressFn", "ShearDrive"]

@@ -1,0 +1,155 @@
+"""The protocols from public parts: the controllers the criterion, the shear test and the import
+check share, no reads of another module's private attributes, no import circle in a package.
+
+The specimen is the small one of ``conftest.py`` (0.06 m x 0.03 m, about 110 disks)."""
+
+import ast
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import poro2d
+from poro2d.criterion.density import Calibration
+from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion, wall_forces
+from poro2d.criterion.servo import PlateServo, in_window
+from poro2d.dem import checkpoint
+from poro2d.shear import DirectShearTest, ShearSettings
+from poro2d.shear.controllers import Consolidation, ShearDrive
+from poro2d.shear.curve import curve_summary
+from poro2d.shear.shear_stage import ShearStage
+from poro2d.specimen import paper_grading
+from poro2d.specimen.compaction import SpecimenSpec, box_porosity
+
+SRC = Path(poro2d.__file__).parent
+PROTOCOL_PACKAGES = ("criterion", "shear", "interop")
+#: the engine's thread check, still private to ``Simulation``: the one read left to make public
+KNOWN_PRIVATE_READS = {"Simulation._check_threads"}
+SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4}
+
+
+def _modules(package: str):
+    for f in sorted((SRC / package).glob("*.py")):
+        yield f"poro2d.{package}.{f.stem}", ast.parse(f.read_text())
+
+
+def test_no_protocol_module_reads_a_private_attribute_of_another_object():
+    reads = set()
+    for package in PROTOCOL_PACKAGES:
+        for name, tree in _modules(package):
+            for node in ast.walk(tree):
+                if not (isinstance(node, ast.Attribute) and node.attr.startswith("_")):
+                    continue
+                own = isinstance(node.value, ast.Name) and node.value.id == "self"
+                if node.attr.startswith("__") or own:
+                    continue
+                reads.add(f"{name}: {ast.unparse(node)}")
+    assert {r.split(": ")[1] for r in reads} <= KNOWN_PRIVATE_READS, sorted(reads)
+
+
+def _import_graph(package: str) -> dict[str, set[str]]:
+    """Module -> the modules of the same package it imports (guarded and local imports too).
+
+    The package's ``__init__`` is left out: Python runs it before any of its modules anyway.
+    """
+    graph = {}
+    for name, tree in _modules(package):
+        deps = set()
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and node.module:
+                deps.add(node.module)
+                deps.update(f"{node.module}.{a.name}" for a in node.names)
+            elif isinstance(node, ast.Import):
+                deps.update(a.name for a in node.names)
+        graph[name] = deps
+    inside = {m for m in graph if not m.endswith(".__init__")}
+    return {m: {d for d in deps if d in inside and d != m} for m, deps in graph.items()}
+
+
+def _circle(graph: dict[str, set[str]]) -> list[str]:
+    """One import circle of ``graph`` (the modules around it), or [] when there is none."""
+    state: dict[str, int] = {}
+    path: list[str] = []
+
+    def visit(m: str) -> list[str]:
+        state[m] = 1
+        path.append(m)
+        for d in sorted(graph[m]):
+            if state.get(d) == 1:
+                return path[path.index(d) :] + [d]
+            if d not in state and (found := visit(d)):
+                return found
+        path.pop()
+        state[m] = 2
+        return []
+
+    for m in sorted(graph):
+        if m not in state and (found := visit(m)):
+            return found
+    return []
+
+
+@pytest.mark.parametrize("package", PROTOCOL_PACKAGES)
+def test_no_import_circle_inside_a_protocol_package(package):
+    assert _circle(_import_graph(package)) == []
+
+
+def test_the_circle_finder_finds_one():
+    assert _circle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+
+
+def test_calibration_names_its_accepted_samples():
+    cal = Calibration([0.0, 0.5], [[0.20, None, math.nan, 0.22], [0.25]])
+    assert cal.accepted(0).tolist() == [0.20, 0.22] and cal.accepted(1).tolist() == [0.25]
+    assert cal.failed == [2, 0]
+
+
+def test_the_criterion_drives_its_plate_with_the_public_servo():
+    spec = SpecimenSpec(width=0.06, height=0.03, layers=2, ratio=2e-3, equilibrium="mean")
+    settings = CriterionSettings(force_fraction=0.02)
+    servo = PorosityCriterion(spec, paper_grading(), settings).plate_servo()
+    assert servo == PlateServo(settings, 2e-3, "mean", 0.03)
+
+
+def test_the_plate_servo_brings_a_raised_plate_into_the_window(specimen):
+    sim = checkpoint.load(specimen)
+    width, height = 0.06, 0.03
+    sim.translate_wall("top", 0.0, 0.002)  # off the specimen: F_top = 0, out of the window
+    settings = CriterionSettings()
+    weight = SpecimenSpec(width=width, height=height).self_weight(box_porosity(sim, width, height))
+    plate = PlateServo(settings, 1e-3, "max", height).settle(sim, weight)
+    assert plate["plate_settled"] and plate["plate_displacement_m"] < 0.0
+    assert plate["plate_height_m"] == float(sim.walls.p0[sim.walls.index("top"), 1])
+    assert in_window(wall_forces(sim)["f_top_n_per_m"], weight, settings.force_fraction)
+
+
+def test_the_shear_test_is_its_controllers(specimen):
+    """Consolidation, then the shear stage driven by ShearDrive: the test's own curve, number for number."""
+    settings = ShearSettings(**SHORT)
+    whole = DirectShearTest(specimen, 50.0, settings, figures=False).run()
+
+    test = DirectShearTest(specimen, 50.0, settings, figures=False)
+    sim, info = test.consolidate()
+    phases = []
+    stage = ShearStage(
+        sim, test.box, settings, info["plate_height_m"], figures=False, progress=lambda p, f: phases.append(p)
+    )
+    stage.run()
+    assert len(stage.rows) == whole["records"] and set(phases) == {"shearing"}
+    summary = curve_summary(stage.rows, 50.0, settings)
+    assert summary["peak_shear_stress_kpa"] == whole["peak_shear_stress_kpa"]
+    lower = [stage.sim.walls.vel[stage.sim.walls.index(n), 0] for n in ("bottom", "lower_left")]
+    assert lower == [settings.velocity] * 2  # ShearDrive set the lower half moving
+
+
+def test_consolidation_reports_a_specimen_it_could_not_settle(specimen):
+    from poro2d.shear.box import build_split_box
+
+    sim, box = build_split_box(checkpoint.load(specimen), 0.002)
+    settings = ShearSettings(consolidation_max_steps=1000, **SHORT)
+    done = Consolidation(settings).settle(sim, 50e3 * box.width * box.thickness)
+    assert not done["settled"] and done["steps"] == 1000
+    assert done["plate_height_before_m"] == pytest.approx(box.height)
+    ShearDrive(0.01).start(sim)
+    assert np.all(sim.walls.vel[[sim.walls.index(n) for n in ("bottom", "lower_lip")], 0] == 0.01)
