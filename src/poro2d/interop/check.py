@@ -21,10 +21,11 @@ import numpy as np
 
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion, in_window, wall_forces
 from poro2d.dem import ContactModel, Particles, Simulation
+from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
 from poro2d.interop import csv_table
 from poro2d.interop import lammps as lmp
-from poro2d.interop.specimen_data import BOX_WALLS, SpecimenData, from_checkpoint
+from poro2d.interop.specimen_data import SpecimenData, from_checkpoint
 from poro2d.interop.validate import check_imported
 from poro2d.specimen.compaction import SpecimenSpec, box_porosity, make_walls
 

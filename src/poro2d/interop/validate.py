@@ -25,8 +25,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
-from poro2d.interop.specimen_data import BOX_WALLS, SpecimenData
+from poro2d.interop.specimen_data import SpecimenData
 from poro2d.io_utils import check_input_file
 
 #: ``locate(quantity, disk_index)``: where a value was read ("FILE line L column C (name)"),
