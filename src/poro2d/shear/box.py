@@ -31,6 +31,7 @@ import numpy as np
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
 from poro2d.dem.ordering import strip_order
 from poro2d.errors import InputError, check_range
+from poro2d.paper_data import TABLE_1
 from poro2d.specimen.box import box_faces
 
 LOWER = ("bottom", "lower_left", "lower_right", "lower_lip")
@@ -135,9 +136,9 @@ def _specimen_box(sim: Simulation) -> tuple[float, float]:
 def build_split_box(
     specimen: Simulation,
     max_displacement: float,
-    kn_wall: float = 1e7,
-    ks_wall: float = 1e7,
-    friction_wall: float = 1.5,
+    kn_wall: float = TABLE_1.kn_wall,
+    ks_wall: float = TABLE_1.ks_wall,
+    friction_wall: float = TABLE_1.friction_wall,
     gap: float = 0.0,
     particle_friction: float | None = None,
     density_scale: float = 1.0,
