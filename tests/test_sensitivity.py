@@ -80,9 +80,9 @@ def test_points_are_mean_sd_and_n_over_converged_seeds():
     assert mu[1]["n2d_sd"] == pytest.approx(np.std([0.19, 0.185], ddof=1))
 
 
-def test_summarise_edge_cases():
-    assert S.summarise([0.2]) == {"mean": 0.2, "sd": 0.0, "n": 1}
-    s = S.summarise([None, float("nan")])
+def test_finite_mean_sd_edge_cases():
+    assert S.finite_mean_sd([0.2]) == {"mean": 0.2, "sd": 0.0, "n": 1}
+    s = S.finite_mean_sd([None, float("nan")])
     assert s["n"] == 0 and math.isnan(s["mean"]) and math.isnan(s["sd"])
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from poro2d.errors import InputError
-from poro2d.shear.replicates import mohr_coulomb_ci, summarize
+from poro2d.shear.replicates import mohr_coulomb_ci, summarize_replicate_peaks
 
 
 @pytest.mark.parametrize("through_origin", [False, True])
@@ -54,7 +54,7 @@ def test_summary_over_specimens():
         "seed1": _series({50.0: 44.0, 100.0: 71.0, 200.0: 140.0}, 34.0),
         "seed2": _series({50.0: 42.0, 100.0: 79.0, 200.0: 145.0}, 35.0),
     }
-    s = summarize(series)
+    s = summarize_replicate_peaks(series)
     rows = {r["normal_stress_kpa"]: r for r in s["per_normal_stress"]}
     assert rows[50.0]["peak_mean_kpa"] == pytest.approx(42.0)
     assert rows[50.0]["peak_sd_kpa"] == pytest.approx(2.0)
@@ -66,7 +66,7 @@ def test_summary_over_specimens():
         "friction_angle_sd_deg"
     ] == pytest.approx(1.0)
     with pytest.raises(InputError):
-        summarize({})
+        summarize_replicate_peaks({})
 
 
 def test_replicate_series_on_small_specimens(tmp_path):

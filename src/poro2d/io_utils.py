@@ -195,6 +195,15 @@ def _finite_or_null(obj: Any) -> Any:
     return obj
 
 
+def float_or_nan(value: Any) -> float:
+    """A number read back from a result: NaN for ``None`` (how :func:`write_json` stores NaN)
+    or for anything that is not a number (a value a failed case never wrote)."""
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return math.nan
+
+
 def as_json(data: Any) -> Any:
     """``data`` as :func:`write_json` stores it and ``json.loads`` reads it back.
 

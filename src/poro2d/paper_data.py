@@ -3,13 +3,36 @@
 Numbers the paper states (Wang, Jacobs and Ziegler, sections 2.2, 3 and 4, Table 1); the
 porosities and densities are :mod:`poro2d.porosity`'s constants. Held below every layer
 that quotes them (the case study, its report, the sensitivity study), so none of those
-reaches up into another to read them. Table 1's stiffnesses and frictions are the defaults
-of :class:`poro2d.specimen.compaction.SpecimenSpec`.
+reaches up into another to read them. Table 1's per-body properties are ``TABLE_1``: the
+defaults of :class:`poro2d.specimen.compaction.SpecimenSpec`, of the shear box's walls and of
+an imported file that does not state them.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from poro2d import porosity as P
+
+
+@dataclass(frozen=True)
+class Table1:
+    """Table 1: the per-body properties of the disks and the box walls (PFC 4.0; SI units).
+
+    A contact combines its two bodies' stiffnesses as springs in series and takes the
+    smaller friction (docs/engine.md).
+    """
+
+    solid_density: float = P.PAPER_SOLID_DENSITY  # kg/m3
+    kn_particle: float = 4e5  # N/m
+    ks_particle: float = 4e5  # N/m
+    friction_particle: float = 3.0  # after preparation
+    kn_wall: float = 1e7  # N/m
+    ks_wall: float = 1e7  # N/m
+    friction_wall: float = 1.5
+
+
+TABLE_1 = Table1()
 
 PAPER = {
     "n_lab": P.PAPER_N_LAB,
@@ -39,4 +62,4 @@ QUICK_SPECIMEN = {"width": 0.08, "height": 0.04, "layers": 2}
 #: acceptance's lid needs a window of many grain weights (docs/criterion.md)
 QUICK_CRITERION = {"force_fraction": 0.05, "acceptance": "plate"}
 
-__all__ = ["PAPER", "QUICK_CRITERION", "QUICK_SPECIMEN"]
+__all__ = ["PAPER", "QUICK_CRITERION", "QUICK_SPECIMEN", "TABLE_1", "Table1"]

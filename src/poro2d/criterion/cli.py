@@ -85,8 +85,9 @@ def print_result(result: dict, out: Path) -> None:
         t.add_row(
             f"{r['trial_porosity']:.3f}", str(r["particle_count"]), f"{r['f_top_n_per_m']:.4g}",
             f"{r['f_bottom_n_per_m']:.4g}", f"{r['self_weight_n_per_m']:.4g}", r["plate_moved"],
-            f"{1e3 * r['plate_displacement_m']:.3f}", _num(r["new_porosity"]),
-            _num(r["porosity_change"]), _interior(r), _num(r.get("surface_gap_mean_d50"), 2), _verdict(r),
+            f"{1e3 * r['plate_displacement_m']:.3f}", _fixed_or_dash(r["new_porosity"]),
+            _fixed_or_dash(r["porosity_change"]), _interior(r),
+            _fixed_or_dash(r.get("surface_gap_mean_d50"), 2), _verdict(r),
         )  # fmt: skip
     console.print(t)
     console.print(f"{result['message']}; results in {out}/result.json")
@@ -112,8 +113,9 @@ def _interior(r: dict) -> str:
     return f"{r['interior_porosity']:.4f}+-{r['interior_porosity_std']:.4f}"
 
 
-def _num(x, digits: int = 4) -> str:
-    """A porosity for the table; a trial refused before its plate stage has none."""
+def _fixed_or_dash(x, digits: int = 4) -> str:
+    """A value for the table with ``digits`` decimals; a trial refused before its plate stage
+    has none ("-")."""
     return "-" if x is None else f"{x:.{digits}f}"
 
 

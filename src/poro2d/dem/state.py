@@ -29,6 +29,10 @@ SERVO_INTEGRAL = 3  # integral gain (per step)
 SERVO_ERROR_SUM = 4  # summed force error (N): the servo's state, carried from step to step
 SERVO_COLUMNS = 5
 
+#: the walls of a box (``Walls.box``), in the order it adds them; every layer that reads a
+#: box back from its walls (the criterion's plate, the split shear box, the exports) uses these
+BOX_WALLS = ("bottom", "right", "top", "left")
+
 
 def _as_f64(name: str, a, n: int | None = None, shape_tail: tuple = ()) -> np.ndarray:
     arr = np.ascontiguousarray(as_float_array(name, a))  # numbers only, text is refused

@@ -27,9 +27,10 @@ import numpy as np
 
 from poro2d.criterion.protocol import wall_forces
 from poro2d.dem.measure import coordination_number
+from poro2d.dem.state import BOX_WALLS
 from poro2d.interop import lammps as lmp
 from poro2d.interop.lammps_run import parse_thermo, read_dump, read_result_line, run_script, version_from_log
-from poro2d.interop.specimen_data import BOX_WALLS, SpecimenData
+from poro2d.interop.specimen_data import SpecimenData
 
 #: quantities compared, as (key, label) pairs
 QUANTITIES = (

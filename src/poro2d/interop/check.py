@@ -22,26 +22,29 @@ import numpy as np
 from poro2d.criterion.protocol import CriterionSettings, wall_forces
 from poro2d.criterion.servo import PlateServo, in_window
 from poro2d.dem import ContactModel, Particles, Simulation
+from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
 from poro2d.interop import csv_table
 from poro2d.interop import lammps as lmp
-from poro2d.interop.specimen_data import BOX_WALLS, SpecimenData, from_checkpoint
+from poro2d.interop.specimen_data import SpecimenData, from_checkpoint
 from poro2d.interop.validate import check_imported
+from poro2d.paper_data import TABLE_1
 from poro2d.specimen.compaction import SpecimenSpec, box_porosity, make_walls
 
-#: values for what a file does not say (a LAMMPS data file of another origin): Table 1
-_TABLE1 = SpecimenSpec()
+#: values for what a file does not say (a LAMMPS data file of another origin): Table 1, and
+#: the specimen's defaults for the rest
+_PREPARED = SpecimenSpec()
 DEFAULTS = {
-    "thickness": _TABLE1.thickness,
-    "density": _TABLE1.solid_density,
-    "kn": _TABLE1.kn_particle,
-    "ks": _TABLE1.ks_particle,
-    "mu": _TABLE1.friction_particle,
-    "wall_kn": _TABLE1.kn_wall,
-    "wall_ks": _TABLE1.ks_wall,
-    "wall_mu": _TABLE1.friction_wall,
-    "gravity": _TABLE1.gravity,
-    "local_damping": _TABLE1.local_damping,
+    "thickness": _PREPARED.thickness,
+    "density": TABLE_1.solid_density,
+    "kn": TABLE_1.kn_particle,
+    "ks": TABLE_1.ks_particle,
+    "mu": TABLE_1.friction_particle,
+    "wall_kn": TABLE_1.kn_wall,
+    "wall_ks": TABLE_1.ks_wall,
+    "wall_mu": TABLE_1.friction_wall,
+    "gravity": _PREPARED.gravity,
+    "local_damping": _PREPARED.local_damping,
 }
 
 

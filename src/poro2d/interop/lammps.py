@@ -42,8 +42,9 @@ from pathlib import Path
 import numpy as np
 
 from poro2d import __version__
+from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
-from poro2d.interop.specimen_data import BOX_WALLS, SpecimenData, WallData
+from poro2d.interop.specimen_data import SpecimenData, WallData
 from poro2d.interop.validate import LIMITS, check_value, text_of
 
 # positive stand-in for "no normal dashpot" (1/s, times the effective mass)

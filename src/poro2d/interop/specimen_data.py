@@ -6,6 +6,15 @@ properties, the disk thickness and the run settings another code needs to contin
 from the same state (gravity, local damping, time step). Velocities, spins and the
 contact history are not part of it: an exported specimen starts at rest with no shear
 force stored, in any code (see docs/export.md).
+
+It is a view in the files' terms, not a second engine record: an importer fills it with
+the numbers as its file states them, unchecked, so that
+:func:`poro2d.interop.validate.check_imported` can refuse a bad one naming its file and
+line (the engine's ``Particles`` and ``Walls`` would refuse it first, in their own words,
+and they hold what no file carries: velocities, spins, modes, servos). It is made from
+the engine's records in one place (``_from_records``, for a simulation or a checkpoint),
+turned into them in one (:meth:`SpecimenData.to_simulation`), and reads its box with
+:func:`poro2d.specimen.box.box_faces`.
 """
 
 from __future__ import annotations
@@ -21,11 +30,10 @@ import numpy as np
 
 from poro2d import __version__
 from poro2d.dem import ContactModel, Particles, Simulation, Walls, checkpoint
+from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
 from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
-
-#: names of the walls of a poro2d box (``Walls.box``), in that order
-BOX_WALLS = ("bottom", "right", "top", "left")
+from poro2d.specimen.box import box_faces
 
 
 @dataclass
@@ -97,12 +105,10 @@ class SpecimenData:
         top, a vertical left and right, the top above the bottom and the right of the left.
         """
         names = [w.name for w in self.walls]
-        if not set(BOX_WALLS) <= set(names):
-            raise InputError("walls", names, f"a box of walls named {', '.join(BOX_WALLS)}")
+        box = box_faces(names, [(w.x0, w.y0) for w in self.walls])
         b, r, t, lf = (self.wall(k) for k in BOX_WALLS)
         if not (b.horizontal and t.horizontal and r.vertical and lf.vertical):
             raise InputError("walls", names, "a box: horizontal bottom and top, vertical left and right")
-        box = (lf.x0, r.x0, b.y0, t.y0)
         if not (box[1] > box[0] and box[3] > box[2]):
             raise InputError("box", box, "xlo < xhi and ylo < yhi (left of right, bottom below top)")
         return box
@@ -268,21 +274,15 @@ def _refuse_unaccepted(path: str | os.PathLike, record: Path, state: str) -> Non
 
 def from_simulation(sim: Simulation, source: str = "") -> SpecimenData:
     """The disks and walls of ``sim`` (copies), with its gravity, damping and time step."""
-    if sim.contact.convention != "per_body":
-        raise InputError(
-            "contact convention", sim.contact.convention, "'per_body' (the properties travel with the bodies)"
-        )
+    _check_per_body(sim.contact.convention, "'per_body' (the properties travel with the bodies)")
     p, w = sim.particles, sim.walls
-    wall_mu_r = w.rolling_friction()
-    walls = [
-        WallData(w.names[k], *map(float, (*w.p0[k], *w.p1[k], w.kn[k], w.ks[k], w.mu[k], wall_mu_r[k])))
-        for k in range(w.n)
-    ]
-    return SpecimenData(
-        x=p.pos[:, 0].copy(), y=p.pos[:, 1].copy(), radius=p.radius.copy(), density=p.density.copy(),
-        kn=p.kn.copy(), ks=p.ks.copy(), mu=p.mu.copy(), thickness=p.thickness, walls=walls,
-        gravity=sim.gravity, local_damping=sim.local_damping, dt=sim.dt, source=source,
-        mu_r=p.mu_r.copy() if p.mu_r.any() else None,
+    disks = {f: getattr(p, f) for f in _DISK_FIELDS}
+    if p.mu_r.any():
+        disks["mu_r"] = p.mu_r
+    walls = {f: getattr(w, f) for f in _WALL_FIELDS} | {"mu_r": w.rolling_friction()}
+    return _from_records(
+        disks, walls, w.names, thickness=p.thickness, gravity=sim.gravity, local_damping=sim.local_damping,
+        dt=sim.dt, source=source,
     )  # fmt: skip
 
 
@@ -295,29 +295,50 @@ def from_checkpoint(path: str | os.PathLike) -> SpecimenData:
     p = resolve_specimen(path)
     meta, a = checkpoint.read(p)
     s = meta["settings"]
-    if s["contact"]["convention"] != "per_body":
-        raise InputError(
-            "contact convention", s["contact"]["convention"],
-            "'per_body' (the PFC 4.0 properties that travel with the bodies)",
-        )  # fmt: skip
-    pos = a["particles.pos"]
-    names = list(meta["wall_names"])
-    p0, p1 = a["walls.p0"], a["walls.p1"]
-    wall_mu_r = a.get("walls.mu_r", np.zeros(len(names)))  # stored only with rolling resistance
-    walls = [
-        WallData(
-            names[k],
-            *map(float, (*p0[k], *p1[k], a["walls.kn"][k], a["walls.ks"][k], a["walls.mu"][k], wall_mu_r[k])),
-        )
-        for k in range(len(names))
-    ]
-    return SpecimenData(
-        x=pos[:, 0].copy(), y=pos[:, 1].copy(), radius=a["particles.radius"].copy(),
-        density=a["particles.density"].copy(), kn=a["particles.kn"].copy(), ks=a["particles.ks"].copy(),
-        mu=a["particles.mu"].copy(), thickness=float(meta["thickness"]), walls=walls,
+    convention = s["contact"]["convention"]
+    _check_per_body(convention, "'per_body' (the PFC 4.0 properties that travel with the bodies)")
+    # a checkpoint keys its arrays "particles.<field>" and "walls.<field>" (mu_r only with rolling resistance)
+    disks = {k.removeprefix("particles."): v for k, v in a.items() if k.startswith("particles.")}
+    walls = {k.removeprefix("walls."): v for k, v in a.items() if k.startswith("walls.")}
+    return _from_records(
+        disks, walls, list(meta["wall_names"]), thickness=float(meta["thickness"]),
         gravity=tuple(float(g) for g in s["gravity"]), local_damping=float(s["local_damping"]),
         dt=float(s["dt"]), source=str(p), force_fraction=accepted_window(p),
-        mu_r=a["particles.mu_r"].copy() if "particles.mu_r" in a else None,
+    )  # fmt: skip
+
+
+#: the engine's fields a specimen file holds: its disks' (``Particles``) and walls' (``Walls``)
+_DISK_FIELDS = ("pos", "radius", "density", "kn", "ks", "mu")
+_WALL_FIELDS = ("p0", "p1", "kn", "ks", "mu")
+
+
+def _check_per_body(convention: str, allowed: str) -> None:
+    if convention != "per_body":
+        raise InputError("contact convention", convention, allowed)
+
+
+def _from_records(disks: dict, walls: dict, wall_names: list[str], **settings) -> SpecimenData:
+    """The file view of the engine's disk and wall records, copied (the view shares no memory).
+
+    ``disks`` and ``walls`` map the fields of ``Particles`` and ``Walls`` to arrays; ``mu_r``
+    may be missing from either (no rolling resistance: None for the disks, 0 for the walls).
+    ``settings``: the remaining fields of :class:`SpecimenData`, as they are.
+    """
+    p0, p1 = walls["p0"], walls["p1"]
+    wall_mu_r = walls.get("mu_r", np.zeros(len(wall_names)))
+    wall_list = [
+        WallData(
+            wall_names[k],
+            *map(float, (*p0[k], *p1[k], walls["kn"][k], walls["ks"][k], walls["mu"][k], wall_mu_r[k])),
+        )
+        for k in range(len(wall_names))
+    ]
+    pos = disks["pos"]
+    return SpecimenData(
+        x=pos[:, 0].copy(), y=pos[:, 1].copy(), radius=disks["radius"].copy(),
+        density=disks["density"].copy(), kn=disks["kn"].copy(), ks=disks["ks"].copy(), mu=disks["mu"].copy(),
+        walls=wall_list,
+        mu_r=disks["mu_r"].copy() if "mu_r" in disks else None, **settings,
     )  # fmt: skip
 
 

@@ -25,8 +25,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
-from poro2d.interop.specimen_data import BOX_WALLS, SpecimenData
+from poro2d.interop.specimen_data import SpecimenData
 from poro2d.io_utils import check_input_file
 
 #: ``locate(quantity, disk_index)``: where a value was read ("FILE line L column C (name)"),
@@ -72,7 +73,7 @@ OVERLAP_LIMIT = 0.2
 def check_value(where: str, value: float, limit: Limit, what: str = "") -> float:
     """``value`` within ``limit``, or an InputError naming ``where``."""
     if not limit.holds(float(value)):
-        raise InputError(where, _num(value), (what + " " if what else "") + limit.text)
+        raise InputError(where, _message_value(value), (what + " " if what else "") + limit.text)
     return float(value)
 
 
@@ -88,7 +89,8 @@ def check_imported(spec: SpecimenData, locate: Locate) -> None:
         _disk_values(spec, locate, ("density", "kn", "ks", "mu"))
 
 
-def _num(v) -> float | int:
+def _message_value(v) -> float | int:
+    """A value as an error message shows it: an int stays an int, a NumPy number is a float."""
     return v if isinstance(v, int) else float(v)
 
 
@@ -98,12 +100,13 @@ def _settings(spec: SpecimenData, locate: Locate) -> None:
     g = LIMITS["gravity"]
     down = f"downward, -{g.hi:g} to -{g.lo:g} {g.unit} (the plate is on top; zero gravity never settles)"
     if not (gy < 0 and g.holds(-gy)):
-        raise InputError(locate("gravity_y"), _num(gy), down)
+        raise InputError(locate("gravity_y"), _message_value(gy), down)
     if abs(gx) > 1e-9 * abs(gy):
-        raise InputError(locate("gravity_x"), _num(gx), "0 (gravity along -y, the box's vertical)")
+        raise InputError(locate("gravity_x"), _message_value(gx), "0 (gravity along -y, the box's vertical)")
     check_value(locate("local_damping"), spec.local_damping, LIMITS["local_damping"])
     if spec.dt is not None and not spec.dt > 0.0:
-        raise InputError(locate("dt"), _num(spec.dt), "a time step > 0 s, or 0 for the automatic step")
+        automatic = "a time step > 0 s, or 0 for the automatic step"
+        raise InputError(locate("dt"), _message_value(spec.dt), automatic)
     if spec.force_fraction is not None:
         check_value(locate("window"), spec.force_fraction, LIMITS["window"], "a fraction of G in")
 
@@ -125,7 +128,7 @@ def _disk_values(spec: SpecimenData, locate: Locate, names: tuple[str, ...]) -> 
         limit = LIMITS.get(name, LIMITS["coordinate"])
         i = _first_bad(np.asarray(values, dtype=float), limit)
         if i is not None:
-            raise InputError(locate(name, i), _num(values[i]), limit.text)
+            raise InputError(locate(name, i), _message_value(values[i]), limit.text)
 
 
 def _walls(spec: SpecimenData, locate: Locate) -> tuple[float, float, float, float]:
@@ -147,7 +150,7 @@ def _walls(spec: SpecimenData, locate: Locate) -> tuple[float, float, float, flo
         for field in ("kn", "ks", "mu"):
             if getattr(w, field) != getattr(first, field):
                 raise InputError(
-                    locate(f"wall:{w.name}:{field}"), _num(getattr(w, field)),
+                    locate(f"wall:{w.name}:{field}"), _message_value(getattr(w, field)),
                     f"{getattr(first, field)!r} as the {first.name} wall (one set of properties for the box)",
                 )  # fmt: skip
     return box
@@ -162,7 +165,7 @@ def _disks_in_box(spec: SpecimenData, box, locate: Locate) -> None:
     if big.size:
         i = int(big[0])
         raise InputError(
-            locate("radius", i), _num(r[i]),
+            locate("radius", i), _message_value(r[i]),
             f"a disk that fits the box {xhi - xlo:.4g} m x {yhi - ylo:.4g} m (radius at most "
             f"{half / (1.0 - limit):.4g} m)",
         )  # fmt: skip
@@ -172,7 +175,7 @@ def _disks_in_box(spec: SpecimenData, box, locate: Locate) -> None:
         if bad.size:
             i = int(bad[0])
             raise InputError(
-                locate(name, i), _num(c[i]),
+                locate(name, i), _message_value(c[i]),
                 f"[{lo_c[i]:.6g}, {hi_c[i]:.6g}] m: inside the box [{lo:.6g}, {hi:.6g}] m, overlapping a "
                 f"wall by at most {limit:g} of the radius {r[i]:.4g} m",
             )  # fmt: skip
@@ -197,7 +200,7 @@ def _overlaps(spec: SpecimenData, locate: Locate) -> None:
         k = too_deep[np.argmin(np.maximum(i, j)[too_deep])]  # the pair whose later disk comes first
         a, b = sorted((int(i[k]), int(j[k])))
         raise InputError(
-            locate("x", b), _num(spec.x[b]),
+            locate("x", b), _message_value(spec.x[b]),
             f"a centre apart from that of the disk of {locate('disk', a)}",
             f"the two overlap by {overlap[k]:.3g} m, more than {OVERLAP_LIMIT:g} of the smaller radius "
             f"{min(r[a], r[b]):.3g} m",

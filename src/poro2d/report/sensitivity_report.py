@@ -10,15 +10,12 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+from poro2d.io_utils import float_or_nan
 from poro2d.report.document import Block
 
 
-def _num(v) -> float:
-    return float(v) if v is not None else math.nan
-
-
 def _ok(p: dict) -> bool:
-    return math.isfinite(_num(p.get("n2d_mean")))
+    return math.isfinite(float_or_nan(p.get("n2d_mean")))
 
 
 def plot_sensitivity(sens: dict, stem: Path) -> list[Path]:
@@ -58,8 +55,8 @@ def plot_sensitivity(sens: dict, stem: Path) -> list[Path]:
 def _errorbar(ax, pts: list[dict], x: str, **kw) -> None:
     ok = [p for p in pts if _ok(p)]
     if ok:
-        ax.errorbar([p[x] for p in ok], [p["n2d_mean"] for p in ok], yerr=[_num(p["n2d_sd"]) for p in ok],
-                    capsize=4, **kw)  # fmt: skip
+        ax.errorbar([p[x] for p in ok], [p["n2d_mean"] for p in ok],
+                    yerr=[float_or_nan(p["n2d_sd"]) for p in ok], capsize=4, **kw)  # fmt: skip
     for p in pts:
         if p["unconverged"]:
             y = p["n2d_mean"] if _ok(p) else ax.get_ylim()[0]
@@ -87,9 +84,9 @@ def _mu_panel(ax, sens: dict) -> None:
               label="calibration: n' of the accepted trial (first trial 0.19)")  # fmt: skip
     # like for like: the measured n' of the paper protocol's accepted trial, beside the calibration's
     ref = [p for p in sens["points"]["grading"] if p["cu_nominal"] is None]
-    if ref and math.isfinite(_num(ref[0].get("measured_mean"))):
+    if ref and math.isfinite(float_or_nan(ref[0].get("measured_mean"))):
         first = sens["settings"]["first_trial"]
-        ax.errorbar([mu0], [ref[0]["measured_mean"]], yerr=[_num(ref[0]["measured_sd"])], fmt="*",
+        ax.errorbar([mu0], [ref[0]["measured_mean"]], yerr=[float_or_nan(ref[0]["measured_sd"])], fmt="*",
                     color="tab:red", ms=15, capsize=4,
                     label=f"paper protocol (first trial {first:g}): n' of the accepted trial")  # fmt: skip
     ax.axvline(mu0, color="0.3", ls=":", lw=1.2, label=f"paper: mu_prep = {mu0:g}")
@@ -101,7 +98,7 @@ def _mu_panel(ax, sens: dict) -> None:
 def _pm(p: dict) -> str:
     if not _ok(p):
         return "-"
-    return f"{p['n2d_mean']:.4f} +- {_num(p['n2d_sd']):.4f}"
+    return f"{p['n2d_mean']:.4f} +- {float_or_nan(p['n2d_sd']):.4f}"
 
 
 def report_blocks(sens: dict, figure: str | Path | None = None) -> list[Block]:
@@ -121,8 +118,9 @@ def report_blocks(sens: dict, figure: str | Path | None = None) -> list[Block]:
         + (" Quick mode: a reduced box, not the paper's." if s.get("quick") else ""),
     ))  # fmt: skip
     g_rows = [
-        [p["label"], p["cu"], p["d_max_mm"], _pm(p), p["n"], p["unconverged"], _num(p["measured_mean"]),
-         _num(p.get("interior_mean")), _num(p["first_f_top_over_g_mean"])]
+        [p["label"], p["cu"], p["d_max_mm"], _pm(p), p["n"], p["unconverged"],
+         float_or_nan(p["measured_mean"]), float_or_nan(p.get("interior_mean")),
+         float_or_nan(p["first_f_top_over_g_mean"])]
         for p in sens["points"]["grading"]
     ]  # fmt: skip
     b.append(("table", ["grading", "Cu", "d_max (mm)", "accepted n2D", "n", "unconverged", "n' accepted",
@@ -140,18 +138,19 @@ def report_blocks(sens: dict, figure: str | Path | None = None) -> list[Block]:
 
 def _first_trial_table(sens: dict, paper: dict) -> list[Block]:
     ref = next((p for p in sens["points"]["grading"] if p["cu_nominal"] is None), None)
-    if ref is None or not math.isfinite(_num(ref.get("first_f_top_mean"))):
+    if ref is None or not math.isfinite(float_or_nan(ref.get("first_f_top_mean"))):
         return []
     paper_f = 1e3 * paper["f_top_first_trial_kn_per_m"]
     paper_g = paper["self_weight_first_trial_n_per_m"]
     rows = [
         ["first trial n2D", ref["first_trial_porosity"], paper["trials"][0]],
-        ["F_top at H (N/m)", _num(ref["first_f_top_mean"]), paper_f],
-        ["G (N/m)", _num(ref["first_g_mean"]), paper_g],
-        ["F_top / G", _num(ref["first_f_top_over_g_mean"]), paper_f / paper_g],
-        ["n' after the plate moved", _num(ref["first_n_prime_mean"]),
+        ["F_top at H (N/m)", float_or_nan(ref["first_f_top_mean"]), paper_f],
+        ["G (N/m)", float_or_nan(ref["first_g_mean"]), paper_g],
+        ["F_top / G", float_or_nan(ref["first_f_top_over_g_mean"]), paper_f / paper_g],
+        ["n' after the plate moved", float_or_nan(ref["first_n_prime_mean"]),
          paper["trials"][0] + paper["porosity_change_first_trial"]],
-        ["F_top, accepted trial (N/m)", _num(ref["accepted_f_top_mean"]), paper["f_top_accepted_n_per_m"]],
+        ["F_top, accepted trial (N/m)", float_or_nan(ref["accepted_f_top_mean"]),
+         paper["f_top_accepted_n_per_m"]],
     ]  # fmt: skip
     return [("table", ["first trial, reference grading", "poro2d (mean over seeds)", "paper"], rows)]
 

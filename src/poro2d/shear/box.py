@@ -31,10 +31,11 @@ import numpy as np
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
 from poro2d.dem.ordering import strip_order
 from poro2d.errors import InputError, check_range
+from poro2d.paper_data import TABLE_1
+from poro2d.specimen.box import box_faces
 
 LOWER = ("bottom", "lower_left", "lower_right", "lower_lip")
 UPPER = ("upper_left", "upper_right", "upper_lip", "top")
-SPECIMEN_WALLS = ("bottom", "right", "top", "left")
 
 
 @dataclass(frozen=True)
@@ -125,27 +126,19 @@ class SplitBox:
 
 
 def _specimen_box(sim: Simulation) -> tuple[float, float]:
-    names = sim.walls.names
-    missing = [n for n in SPECIMEN_WALLS if n not in names]
-    if missing:
-        raise InputError(
-            "specimen walls", names, f"walls named {', '.join(SPECIMEN_WALLS)}",
-            "a specimen saved by poro2d criterion or poro2d.specimen.compaction",
-        )  # fmt: skip
-    w = sim.walls
-    left = float(w.p0[w.index("left"), 0])
-    bottom = float(w.p0[w.index("bottom"), 1])
+    hint = "a specimen saved by poro2d criterion or poro2d.specimen.compaction"
+    left, right, bottom, top = box_faces(sim.walls.names, sim.walls.p0, "specimen walls", hint)
     if abs(left) > 1e-9 or abs(bottom) > 1e-9:
         raise InputError("specimen box", (left, bottom), "a box with its lower left corner at (0, 0)")
-    return float(w.p0[w.index("right"), 0]), float(w.p0[w.index("top"), 1])
+    return right, top
 
 
 def build_split_box(
     specimen: Simulation,
     max_displacement: float,
-    kn_wall: float = 1e7,
-    ks_wall: float = 1e7,
-    friction_wall: float = 1.5,
+    kn_wall: float = TABLE_1.kn_wall,
+    ks_wall: float = TABLE_1.ks_wall,
+    friction_wall: float = TABLE_1.friction_wall,
     gap: float = 0.0,
     particle_friction: float | None = None,
     density_scale: float = 1.0,

@@ -55,7 +55,7 @@ def mohr_coulomb_ci(sigma_kpa, tau_kpa, through_origin: bool = False, level: flo
     return out
 
 
-def summarize(series: dict[str, dict], level: float = 0.95) -> dict:
+def summarize_replicate_peaks(series: dict[str, dict], level: float = 0.95) -> dict:
     """Per normal stress mean +- sd of the peaks over specimens, pooled fits with intervals.
 
     ``series``: label -> the result of one :class:`ShearSeries` (its ``tests`` list).
@@ -146,7 +146,7 @@ class ReplicateShear:
             label: s.finish({k[1:]: v for k, v in results.items() if k[0] == label}, t0)
             for label, s in self.series.items()
         }
-        summary = summarize(per)
+        summary = summarize_replicate_peaks(per)
         summary.update(wall_time_s=time.perf_counter() - t0, processes=self.processes,
                        config=self.config, provenance=provenance())  # fmt: skip
         write_csv(self.out / "replicates.csv", [{k: v for k, v in r.items() if k != "peaks_kpa"}
@@ -177,4 +177,4 @@ class ReplicateShear:
         plot_replicate_peaks(summary, peaks_png, lab=lab, lab_fit=lab_fit(lab))
 
 
-__all__ = ["ReplicateShear", "mohr_coulomb_ci", "summarize"]
+__all__ = ["ReplicateShear", "mohr_coulomb_ci", "summarize_replicate_peaks"]

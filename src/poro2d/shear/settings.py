@@ -6,6 +6,7 @@ import math
 from dataclasses import asdict, dataclass
 
 from poro2d.errors import InputError, check_int, check_range
+from poro2d.paper_data import TABLE_1
 
 #: the normal stresses (kPa) a test may be run at. A contact carries about sigma d t, so two
 #: disks of the paper's stiffness (kn = 4e5 N/m each, in series 2e5; 8 mm thick) overlap by
@@ -21,7 +22,7 @@ MAX_RECORDS = 1_000_000
 MAX_CHECKPOINTS = 1000
 #: 30 times the default step budget of the consolidation (hours of one core for the paper's box)
 MAX_CONSOLIDATION_STEPS = 10_000_000
-#: wall stiffness (N/m): 1000 times Table 1's 1e7; the time step falls with its square root
+#: wall stiffness (N/m): 1000 times Table 1's; the time step falls with its square root
 MAX_WALL_STIFFNESS = 1e10
 #: friction coefficients beyond 10 hold as a rough wall does; larger ones are typos
 MAX_FRICTION = 10.0
@@ -63,9 +64,9 @@ class ShearSettings:
     servo_gain: float = 0.5
     servo_integral: float = 1e-3
     servo_max_speed: float = 0.05
-    kn_wall: float = 1e7
-    ks_wall: float = 1e7
-    friction_wall: float = 1.5
+    kn_wall: float = TABLE_1.kn_wall
+    ks_wall: float = TABLE_1.ks_wall
+    friction_wall: float = TABLE_1.friction_wall
     gap: float = 0.0
     particle_friction: float | None = None
     rolling_friction: float | None = None

@@ -9,6 +9,7 @@ import numpy as np
 
 from poro2d.errors import InputError
 from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
+from poro2d.specimen.box import box_faces
 
 
 def resolve_specimen(path: str | Path) -> Path:
@@ -31,9 +32,8 @@ def specimen_box(path: str | Path) -> tuple[float, float]:
         meta = json.loads(bytes(z["meta"]).decode())
         names = meta.get("wall_names", [])
         p0 = z["walls.p0"]
-    if "right" not in names or "top" not in names:
-        raise InputError("specimen walls", names, "walls named bottom, right, top, left (a poro2d specimen)")
-    return float(p0[names.index("right"), 0]), float(p0[names.index("top"), 1])
+    _, right, _, top = box_faces(names, p0, "specimen walls", "a poro2d specimen")
+    return right, top
 
 
 __all__ = ["resolve_specimen", "specimen_box"]

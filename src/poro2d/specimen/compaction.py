@@ -34,6 +34,7 @@ from poro2d.dem.measure import porosity_rect
 from poro2d.dem.ordering import strip_order
 from poro2d.dem.simulation import MEASURES
 from poro2d.errors import InputError, check_int, check_range
+from poro2d.paper_data import TABLE_1
 from poro2d.specimen.grading import MAX_DRAW, GradingCurve, draw_disks
 from poro2d.specimen.placement import Band, place_disks
 
@@ -65,19 +66,20 @@ OMITTED_AT_DEFAULT = {
 
 @dataclass
 class SpecimenSpec:
-    """Box, material and preparation settings; defaults are the paper's Table 1."""
+    """Box, material and preparation settings; the disks' and walls' defaults are the paper's
+    Table 1 (:data:`poro2d.paper_data.TABLE_1`)."""
 
     width: float = 0.305
     height: float = 0.124
     thickness: float = 0.008
-    solid_density: float = 2650.0
-    kn_particle: float = 4e5
-    ks_particle: float = 4e5
-    kn_wall: float = 1e7
-    ks_wall: float = 1e7
+    solid_density: float = TABLE_1.solid_density
+    kn_particle: float = TABLE_1.kn_particle
+    ks_particle: float = TABLE_1.ks_particle
+    kn_wall: float = TABLE_1.kn_wall
+    ks_wall: float = TABLE_1.ks_wall
     friction_prep: float = 0.05
-    friction_particle: float = 3.0
-    friction_wall: float = 1.5
+    friction_particle: float = TABLE_1.friction_particle
+    friction_wall: float = TABLE_1.friction_wall
     # rolling resistance of the working material (docs/engine.md), set with friction_particle
     # on disks and walls; 0: none, the paper's round disks
     rolling_friction: float = 0.0

@@ -88,7 +88,7 @@ def validate_criterion(config: dict, base_dir: Path | None = None) -> None:
     _criterion_objects(config, base_dir)
 
 
-def run_criterion(config: dict, out_dir: Path) -> dict:
+def criterion_case(config: dict, out_dir: Path) -> dict:
     """The criterion of Fig. 3 for one case; scalars of its result, of its first and of its accepted trial."""
     from poro2d.criterion.protocol import PorosityCriterion
 
@@ -142,7 +142,7 @@ def _register_builtin() -> None:
 
     BARE_NAME_TABLES.setdefault("specimen", SpecimenSpec)
     BARE_NAME_TABLES.setdefault("criterion", CriterionSettings)
-    register_kind("criterion", run_criterion, validate_criterion)
+    register_kind("criterion", criterion_case, validate_criterion)
 
 
 # --------------------------------------------------------------------------------- cases

@@ -24,7 +24,7 @@ from typing import Any
 
 from poro2d.config import check_number_list
 from poro2d.criterion.density import DEFAULT_MUS, MU_PREP_MAX, Calibration, StateTarget
-from poro2d.errors import InputError
+from poro2d.errors import check_int
 from poro2d.io_utils import provenance, write_json
 from poro2d.locks import cache_entry
 
@@ -78,10 +78,9 @@ def check_mus(mus: Any, parameter: str = "density.mu_prep") -> list[float]:
                              what="preparation frictions")  # fmt: skip
 
 
-def check_seeds(seeds: Any) -> int:
-    if isinstance(seeds, bool) or not isinstance(seeds, int) or not 1 <= seeds <= 50:
-        raise InputError("density.seeds", seeds, "an integer in [1, 50]")
-    return seeds
+def check_seeds(seeds: Any, parameter: str = "density.seeds") -> int:
+    """Specimens per state or per case, the sweeps' seeds: an integer in [1, 50]."""
+    return check_int(parameter, seeds, 1, 50)
 
 
 def calibration_base(base: dict) -> dict:

@@ -24,6 +24,7 @@ import numpy as np
 from poro2d import porosity as P
 from poro2d.config import check_keys, check_number_list
 from poro2d.errors import InputError, check_range
+from poro2d.io_utils import float_or_nan
 from poro2d.locks import holds_output
 from poro2d.paper_data import QUICK_SPECIMEN as PAPER_QUICK_SPECIMEN
 
@@ -40,12 +41,6 @@ def check_mode(mode) -> str:
     if mode not in MODES:
         raise InputError("relation.mode", mode, " or ".join(MODES))
     return mode
-
-
-def check_seeds(seeds) -> int:
-    if isinstance(seeds, bool) or not isinstance(seeds, int) or not 1 <= seeds <= 50:
-        raise InputError("relation.seeds", seeds, "an integer in [1, 50]")
-    return seeds
 
 
 def lab_porosities(n_max: float, n_min: float, points: int) -> list[float]:
@@ -139,25 +134,17 @@ def sweep_config(base: dict, n_labs: list[float], *, quick: bool) -> dict:
     return cfg
 
 
-def _num(v: Any) -> float:
-    try:
-        f = float(v)
-    except (TypeError, ValueError):
-        return math.nan
-    return f
-
-
 def analyse(rows: list[dict], n_max: float, n_min: float) -> dict:
     """Relation points (one per case), the fit through the converged ones, comparisons."""
     pts = []
     for r in rows:
         res = r.get("results", {}) or {}
-        n_lab = _num(res.get("n_lab", (r.get("params") or {}).get("criterion.n_lab")))
+        n_lab = float_or_nan(res.get("n_lab", (r.get("params") or {}).get("criterion.n_lab")))
         converged = bool(res.get("converged")) and r["status"] == "done"
         if converged:
-            n2d, source = _num(res.get("final_porosity")), "accepted"
+            n2d, source = float_or_nan(res.get("final_porosity")), "accepted"
         elif r["status"] == "done":
-            n2d, source = _num(res.get("last_new_porosity")), "last estimate n' (not converged)"
+            n2d, source = float_or_nan(res.get("last_new_porosity")), "last estimate n' (not converged)"
         else:
             n2d, source = math.nan, "case failed"
         conv = P.convert_all(n_lab, n_max, n_min)
@@ -202,14 +189,15 @@ def analyse_states(rows: list[dict], targets: list, cal, n_max: float, n_min: fl
     """
     by_lab: dict[float, list[dict]] = {}
     for r in rows:
-        by_lab.setdefault(round(_num((r.get("params") or {}).get("criterion.n_lab")), 6), []).append(r)
+        n_lab = float_or_nan((r.get("params") or {}).get("criterion.n_lab"))
+        by_lab.setdefault(round(n_lab, 6), []).append(r)
     pts = []
     for t in targets:
         group = by_lab.get(round(t.n_lab, 6), [])
         ok = [r for r in group if r["status"] == "done" and (r.get("results") or {}).get("converged")]
-        acc = [_num(r["results"]["final_porosity"]) for r in ok]
-        meas = [_num(r["results"]["last_new_porosity"]) for r in ok]
-        inner = [_num(r["results"].get("interior_porosity")) for r in ok]
+        acc = [float_or_nan(r["results"]["final_porosity"]) for r in ok]
+        meas = [float_or_nan(r["results"]["last_new_porosity"]) for r in ok]
+        inner = [float_or_nan(r["results"].get("interior_porosity")) for r in ok]
         mean, sd = _stats(acc)
         m_mean, m_sd = _stats(meas)
         i_mean, i_sd = _stats(inner)
@@ -496,7 +484,7 @@ def run_relation(
     from poro2d.criterion.run import load
     from poro2d.io_utils import check_output_dir
     from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.density import check_mus
+    from poro2d.sweep.density import check_mus, check_seeds
     from poro2d.sweep.runner import check_cluster_options, check_dashboard, check_reachable, run_sweep
 
     out = Path(out)
@@ -510,7 +498,7 @@ def run_relation(
     )
     mode = check_mode(mode if mode is not None else table.get("mode", "density"))
     if mode == "density":
-        n_seeds = check_seeds(seeds if seeds is not None else table.get("seeds", 3))
+        n_seeds = check_seeds(seeds if seeds is not None else table.get("seeds", 3), "relation.seeds")
         mus = check_mus(table["mu_prep"], "relation.mu_prep") if "mu_prep" in table else None
     else:
         refuse_density_options(table, seeds)

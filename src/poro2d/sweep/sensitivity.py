@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from poro2d.config import check_keys, check_number_list
-from poro2d.errors import InputError, check_int
+from poro2d.errors import InputError
 from poro2d.locks import holds_output
 
 #: grading widths of the full study (Cu = d60 / d10), and of ``--quick``: at the paper
@@ -74,14 +74,10 @@ def check_cus(cus: Any) -> list[float]:
     return sorted(out)
 
 
-def check_seeds(seeds: Any, name: str = "sensitivity.seeds") -> int:
-    return check_int(name, seeds, 1, 50)
-
-
 def study_settings(table: dict | None, *, quick: bool, seeds: int | None) -> dict:
     """Cu list, mu_prep list and seeds from ``[sensitivity]`` and the command line."""
     from poro2d.criterion.density import DEFAULT_MUS
-    from poro2d.sweep.density import check_mus
+    from poro2d.sweep.density import check_mus, check_seeds
 
     t = dict(table or {})
     check_keys("sensitivity", t, SENSITIVITY_KEYS)
@@ -90,7 +86,7 @@ def study_settings(table: dict | None, *, quick: bool, seeds: int | None) -> dic
     if seeds is not None:
         n = check_seeds(seeds, "--seeds")
     else:
-        n = check_seeds(t.get("seeds", QUICK_SEEDS if quick else DEFAULT_SEEDS))
+        n = check_seeds(t.get("seeds", QUICK_SEEDS if quick else DEFAULT_SEEDS), "sensitivity.seeds")
     return {"cus": cus, "mus": mus, "seeds": n, "quick": bool(quick)}
 
 
@@ -199,7 +195,7 @@ def grading_sweep(base: dict, cases: list[GradingCase], seeds: int) -> dict:
 
 
 # ------------------------------------------------------------------------------ analysis
-def summarise(values: list) -> dict:
+def finite_mean_sd(values: list) -> dict:
     """Mean, sample sd (0 for one value) and n of the finite values; NaN when there are none."""
     a = np.array([float(v) for v in values if v is not None and math.isfinite(float(v))], dtype=float)
     if a.size == 0:
@@ -247,7 +243,7 @@ def grading_points(records: list[dict], grads: list[dict]) -> list[dict]:
     pts = []
     for g in grads:
         recs = [r for r in records if r["grading"] == g["label"]]
-        acc = summarise([r["accepted_n2d"] for r in recs])
+        acc = finite_mean_sd([r["accepted_n2d"] for r in recs])
         pts.append({
             "axis": "grading",
             "label": g["label"],
@@ -261,13 +257,13 @@ def grading_points(records: list[dict], grads: list[dict]) -> list[dict]:
             "seeds": len(recs),
             "unconverged": len(recs) - acc["n"],
             "quantity": "accepted trial n2D",
-            **_prefixed("measured", summarise([r["accepted_measured_n2d"] for r in recs])),
-            **_prefixed("interior", summarise([r.get("accepted_interior_porosity") for r in recs])),
-            **_prefixed("first_f_top", summarise([r["first_f_top_n_per_m"] for r in recs])),
-            **_prefixed("first_g", summarise([r["first_self_weight_n_per_m"] for r in recs])),
-            **_prefixed("first_f_top_over_g", summarise([r["first_f_top_over_g"] for r in recs])),
-            **_prefixed("first_n_prime", summarise([r["first_new_porosity"] for r in recs])),
-            **_prefixed("accepted_f_top", summarise([r["accepted_f_top_n_per_m"] for r in recs])),
+            **_prefixed("measured", finite_mean_sd([r["accepted_measured_n2d"] for r in recs])),
+            **_prefixed("interior", finite_mean_sd([r.get("accepted_interior_porosity") for r in recs])),
+            **_prefixed("first_f_top", finite_mean_sd([r["first_f_top_n_per_m"] for r in recs])),
+            **_prefixed("first_g", finite_mean_sd([r["first_self_weight_n_per_m"] for r in recs])),
+            **_prefixed("first_f_top_over_g", finite_mean_sd([r["first_f_top_over_g"] for r in recs])),
+            **_prefixed("first_n_prime", finite_mean_sd([r["first_new_porosity"] for r in recs])),
+            **_prefixed("accepted_f_top", finite_mean_sd([r["accepted_f_top_n_per_m"] for r in recs])),
             "first_trial_porosity": next((r["first_trial_porosity"] for r in recs), None),
         })  # fmt: skip
     return pts
@@ -281,7 +277,7 @@ def mu_points(cal: dict) -> list[dict]:
     """One point per preparation friction, from a calibration's samples (n' per seed)."""
     pts = []
     for mu, samples in zip(cal["mus"], cal["samples"], strict=True):
-        s = summarise(samples)
+        s = finite_mean_sd(samples)
         pts.append({
             "axis": "mu_prep", "label": f"mu_prep {mu:g}", "mu_prep": mu,
             "n2d_mean": s["mean"], "n2d_sd": s["sd"], "n": s["n"], "seeds": len(samples),
@@ -537,6 +533,6 @@ __all__ = [
     "run_sensitivity",
     "seed_record",
     "study_settings",
-    "summarise",
+    "finite_mean_sd",
     "write_sensitivity",
 ]
