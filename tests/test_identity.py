@@ -171,3 +171,10 @@ def test_specimen_records_keep_their_keys():
     # the former ``extra`` field could not be set; its key stays in records and result files
     assert SpecimenSpec().to_dict()["extra"] == {}
     assert "extra" not in each_field(SpecimenSpec)
+
+
+def test_a_record_gives_back_its_spec():
+    spec = SpecimenSpec(threads=2, layers=3)
+    assert SpecimenSpec.from_record(json.loads(json.dumps(spec.to_dict()))) == SpecimenSpec(
+        threads=2, layers=3
+    )

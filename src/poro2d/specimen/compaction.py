@@ -152,6 +152,11 @@ class SpecimenSpec:
         d["extra"] = {}
         return d
 
+    @classmethod
+    def from_record(cls, record: dict) -> SpecimenSpec:
+        """The spec a record (:meth:`to_dict`, a ``config.json``'s ``run.specimen``) describes."""
+        return cls(**{k: v for k, v in record.items() if k != "extra"})
+
     def self_weight(self, porosity: float) -> float:
         """G = rho_s (1 - n) W H g per metre of thickness (N/m), as in the paper."""
         return self.solid_density * (1.0 - porosity) * self.width * self.height * self.gravity
