@@ -1,6 +1,7 @@
 """The criterion of Fig. 3: every branch on small specimens, resume, outputs, CLI errors."""
 
 import json
+from dataclasses import replace
 
 import pytest
 
@@ -133,7 +134,7 @@ def test_rerun_with_other_threads_resumes(down):
     out, r = down
     trial_dir = next((out / "trials").iterdir())
     stamp = (trial_dir / "trial.json").stat().st_mtime_ns
-    spec = SpecimenSpec(**dict(SMALL.to_dict(), threads=2))
+    spec = replace(SMALL, threads=2)
     settings = CriterionSettings(trial_porosity=0.30, max_iterations=1)
     again = PorosityCriterion(spec, paper_grading(), settings, seed=0, out=out).run()
     assert again["iterations"] == r["iterations"]
@@ -211,7 +212,7 @@ def test_non_finite_config_values_are_refused_before_any_output(tmp_path, capsys
     assert e.value.code == 2 and "kn_wall" in err and "finite" in err
     assert not (tmp_path / "o").exists()
     with pytest.raises(InputError, match="growth_steps"):  # refused as soon as the spec is made
-        SpecimenSpec(**dict(SMALL.to_dict(), growth_steps=float("inf")))
+        replace(SMALL, growth_steps=float("inf"))
 
 
 def _untimed(result: dict) -> list[dict]:

@@ -268,9 +268,9 @@ def test_the_local_dashboard_listens_on_this_machine_only(monkeypatch):
 
     monkeypatch.setattr(distributed, "LocalCluster", FakeCluster)
     monkeypatch.setattr(distributed, "Client", lambda cluster: None)
-    runner._start_client(None, 1, 1)
+    runner.start_client(None, 1, 1)
     assert seen["dashboard_address"] == "127.0.0.1:0" and seen["scheduler_kwargs"] == {"dashboard": True}
-    runner._start_client(None, 1, 1, dashboard=None)  # no dashboard: its web server stays local
+    runner.start_client(None, 1, 1, dashboard=None)  # no dashboard: its web server stays local
     assert seen["dashboard_address"] == "127.0.0.1:0" and seen["scheduler_kwargs"] == {"dashboard": False}
     assert runner.check_dashboard(None) == "127.0.0.1:0"
     assert runner.check_dashboard("0.0.0.0:8787") == "0.0.0.0:8787"

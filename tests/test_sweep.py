@@ -263,14 +263,14 @@ def test_worker_pins_numba_threads_so_a_compile_does_not_fail(monkeypatch):
     from numba.core.config import reload_config
     from numba.np.ufunc.parallel import _launch_threads
 
-    from poro2d.sweep.runner import _pin_numba_threads
+    from poro2d.sweep.runner import pin_numba_threads
 
     _launch_threads()
     running = numba.config.NUMBA_NUM_THREADS
     monkeypatch.setenv("NUMBA_NUM_THREADS", str(running % 2 + 1))  # not the running value
     with pytest.raises(RuntimeError, match="NUMBA_NUM_THREADS"):
         reload_config()
-    _pin_numba_threads()
+    pin_numba_threads()
     reload_config()  # what every compile does: no error now
     assert numba.config.NUMBA_NUM_THREADS == running and numba.get_num_threads() == 1
     numba.set_num_threads(running)

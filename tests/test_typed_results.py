@@ -106,7 +106,7 @@ def test_a_criterion_folder_written_before_is_read_back_and_still_binds(tmp_path
     run = json.loads((out / "config.json").read_text())["run"]
 
     def crit(threads=1, **changes):
-        spec = SpecimenSpec(**dict(run["specimen"], threads=threads))
+        spec = SpecimenSpec.from_record(dict(run["specimen"], threads=threads))
         settings = CriterionSettings(**dict(run["criterion"], **changes))
         return PorosityCriterion(spec, paper_grading(), settings, seed=run["seed"], out=out)
 

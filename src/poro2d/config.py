@@ -44,7 +44,7 @@ def check_keys(section: str, table: dict, allowed: set[str] | list[str]) -> None
 def dataclass_from_table(cls, section: str, table: dict | None, **overrides: Any):
     """Build a dataclass from a config table, rejecting unknown keys and values of the wrong type."""
     table = {} if table is None else table
-    names = {f.name for f in dataclasses.fields(cls) if f.name != "extra"}
+    names = {f.name for f in dataclasses.fields(cls)}
     check_keys(section, table, names)
     table = dict(table)
     check_types(cls, section, table)

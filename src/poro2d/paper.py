@@ -17,9 +17,11 @@ from typing import TYPE_CHECKING, Any
 import typer
 
 from poro2d.console import OutputConsole
+from poro2d.criterion.config import paper_config
+from poro2d.criterion.replicates import accepted_and_replicates
 from poro2d.io_utils import provenance, write_csv, write_json
 from poro2d.locks import holds_output
-from poro2d.paper_data import PAPER, QUICK_CRITERION, QUICK_SPECIMEN
+from poro2d.paper_data import PAPER
 from poro2d.resumable import Fingerprint, ResumableStage
 from poro2d.typed_result import TypedResult
 
@@ -170,8 +172,9 @@ def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, qu
     shear = reps = None
     if result.converged:
         t2 = time.perf_counter()
-        specimens, reps = _specimens(crit.spec, crit.grading, crit.settings, result.final_porosity, crit.seed,
-                                     replicates, out, progress)  # fmt: skip
+        n2d = result.final_porosity
+        specimens, reps = accepted_and_replicates(crit.spec, crit.grading, crit.settings, n2d, crit.seed,
+                                                  replicates, out, progress=progress)  # fmt: skip
         timings["replicates_s"] = time.perf_counter() - t2
         shear = _shear_stage(specimens, out / "shear", quick, lab_data, progress)
         timings["shear_s"] = time.perf_counter() - t2 - timings["replicates_s"]
@@ -191,18 +194,6 @@ def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, qu
     )
 
 
-def paper_config(quick: bool, seed: int) -> dict:
-    """The paper preset as a config (``--quick``: the small box and the widened force window)."""
-    from poro2d.criterion.config import paper_preset
-
-    cfg = paper_preset()
-    cfg["seed"] = seed
-    if quick:
-        cfg["specimen"] = dict(QUICK_SPECIMEN)
-        cfg["criterion"].update(QUICK_CRITERION)
-    return cfg
-
-
 def _conversions_stage(out: Path, stage: ResumableStage) -> dict:
     """Stage 1: every conversion of the paper's sand, printed as a table and written with Figs. 1-2."""
     console.print("[bold]1/3 conversions[/] (Eqs. 1-12, Figs. 1-2)")
@@ -211,25 +202,6 @@ def _conversions_stage(out: Path, stage: ResumableStage) -> dict:
         v = "skipped" if m["n2d"] is None else f"{m['n2d']:.4f}"
         console.print(f"  {m['method']:<24} {m['equation']:<10} {v:>8} {m['flags']}")
     return conv
-
-
-def _specimens(spec, grading, settings, n2d: float, seed: int, replicates: int, out: Path,
-               progress: bool) -> tuple[dict[str, Path], list[dict] | None]:  # fmt: skip
-    """The accepted specimen of ``seed`` and, with replicates, those of the next seeds.
-
-    The replicates are criterion runs from the accepted ``n2d``, one process per core
-    (:func:`poro2d.criterion.replicates.run_replicates`).
-    """
-    from poro2d.criterion.replicates import run_replicates
-
-    specimens = {f"seed{seed}": out / "criterion" / "specimen.npz"}
-    if replicates == 1:
-        return specimens, None
-    extra = list(range(seed + 1, seed + replicates))
-    console.print(f"  replicate specimens: seeds {', '.join(map(str, extra))} from n2D = {n2d:.2f}")
-    more, reps = run_replicates(spec, grading, settings, n2d, extra, out / "replicates",
-                                processes=spec.threads, progress=progress)  # fmt: skip
-    return {**specimens, **more}, reps
 
 
 def _shear_stage(specimens: dict[str, Path], out: Path, quick: bool, lab_data, progress: bool) -> dict:

@@ -26,7 +26,6 @@ trials, a shear test's consolidation and the test): each stage has its own marke
 
 from __future__ import annotations
 
-import hashlib
 import json
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -34,6 +33,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from poro2d.errors import InputError
+from poro2d.identity import identity_view, run_digest
 from poro2d.io_utils import as_json, write_json
 from poro2d.locks import is_lock_file
 
@@ -58,38 +58,30 @@ def differing_keys(old: Any, new: Any, prefix: str = "") -> list[str]:
     return keys
 
 
-def _without(data: Any, path: list[str]) -> Any:
-    """``data`` with the dotted ``path`` removed (a copy along the path; absent paths are fine)."""
-    if not isinstance(data, Mapping) or path[0] not in data:
-        return data
-    if len(path) == 1:
-        return {k: v for k, v in data.items() if k != path[0]}
-    return {**data, path[0]: _without(data[path[0]], path[1:])}
-
-
 @dataclass(frozen=True)
 class Fingerprint:
     """What a stage's results depend on, as a JSON-able dict.
 
-    ``ignore``: dotted keys kept in the record but never compared (settings that change the
-    speed, not the numbers, such as ``specimen.threads``; labels derived from the rest).
+    Compared and hashed by the one identity rule (:mod:`poro2d.identity`): ``tables`` names
+    the dataclass each table of the content stands for (``{"specimen": SpecimenSpec}``), whose
+    fields marked as not changing results (``specimen.threads``) are kept in the record but
+    never compared; ``ignore``: further dotted keys kept but not compared (labels derived
+    from the rest).
     """
 
     content: Mapping[str, Any]
     ignore: tuple[str, ...] = ()
+    tables: Mapping[str, type] | None = None
 
     def compared(self, content: Mapping | None = None) -> Any:
-        """``content`` (default: this fingerprint's) as JSON, without the ignored keys."""
-        data = as_json(self.content if content is None else content)
-        for key in self.ignore:
-            data = _without(data, key.split("."))
-        return data
+        """``content`` (default: this fingerprint's) as JSON, without what is not compared."""
+        data = self.content if content is None else content
+        return identity_view(data, tables=self.tables, ignore=self.ignore)
 
     @property
     def digest(self) -> str:
-        """SHA-256 of the compared content (sorted keys, no spaces): equal content, equal digest."""
-        text = json.dumps(self.compared(), sort_keys=True, separators=(",", ":"))
-        return hashlib.sha256(text.encode()).hexdigest()
+        """The digest of the compared content (:func:`poro2d.identity.run_digest`)."""
+        return run_digest(self.content, tables=self.tables, ignore=self.ignore)
 
     def differences(self, stored: Mapping) -> list[str]:
         """The keys in which a recorded fingerprint differs from this one (none: the same work)."""

@@ -12,10 +12,10 @@ import traceback
 from poro2d.calibration.units import run_unit, stored_row
 from poro2d.sweep.runner import (
     DEFAULT_DASHBOARD,
-    _start_client,
     hold_interrupts,
     quiet_shutdown_logs,
     release_interrupts,
+    start_client,
 )
 
 
@@ -43,7 +43,7 @@ class UnitRunner:
         if self.client is None:
             held = hold_interrupts() if not self.scheduler else None
             try:
-                self.client, self.cluster = _start_client(self.scheduler, self.workers, 1, self.dashboard)
+                self.client, self.cluster = start_client(self.scheduler, self.workers, 1, self.dashboard)
                 self.local_cluster = self.cluster is not None
                 self.n_workers = len(self.client.scheduler_info().get("workers", {}))
             finally:

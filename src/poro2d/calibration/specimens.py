@@ -53,10 +53,9 @@ def preset_specimens(
     The criterion runs once on ``seed`` (``out/criterion``), then on the next seeds from its
     accepted porosity (``out/replicates``); seeds whose criterion does not converge are left out.
     """
-    from poro2d.criterion.config import build
+    from poro2d.criterion.config import build, paper_config
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.criterion.replicates import run_replicates
-    from poro2d.paper import paper_config
 
     seed = check_int("--seed", seed, 0)
     cfg = paper_config(quick, seed)

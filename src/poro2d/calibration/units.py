@@ -8,23 +8,27 @@ a rerun, a second round or another calibration on the same specimens reuses it; 
 
 from __future__ import annotations
 
-import hashlib
-import json
 from pathlib import Path
 
 import numpy as np
 
+from poro2d.identity import run_digest
 from poro2d.shear.settings import ShearSettings
 from poro2d.shear.single import DirectShearTest
+from poro2d.sweep.runner import pin_numba_threads
 
 #: what a unit returns besides its identity: the observables a calibration may fit
 OBSERVABLES = ("peak", "end")
 
 
 def unit_key(specimen_digest: str, sigma: float, settings: dict) -> str:
-    """The content hash naming a unit's folder."""
-    text = json.dumps({"specimen": specimen_digest, "sigma": sigma, "settings": settings}, sort_keys=True)
-    return hashlib.sha256(text.encode()).hexdigest()[:20]
+    """The run digest naming a unit's folder (:func:`poro2d.identity.run_digest`).
+
+    Spaced as these keys were first written, so the folders of earlier calibrations keep
+    their names and are reused.
+    """
+    unit = {"specimen": specimen_digest, "sigma": sigma, "settings": settings}
+    return run_digest(unit, tables={"settings": ShearSettings}, length=20, layout="spaced")
 
 
 def unit_job(
@@ -79,9 +83,7 @@ def stored_row(job: dict) -> dict | None:
 
 def run_unit(job: dict) -> dict:
     """Run (or finish) one unit, on one numba thread: the task a Dask worker runs."""
-    from poro2d.sweep.runner import _pin_numba_threads
-
-    _pin_numba_threads()
+    pin_numba_threads()
     return _row(job, _test(job).run())
 
 

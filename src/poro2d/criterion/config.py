@@ -21,6 +21,7 @@ from pathlib import Path
 from poro2d.config import check_keys, dataclass_from_table, load_toml
 from poro2d.criterion.protocol import CriterionSettings
 from poro2d.errors import InputError, check_int
+from poro2d.paper_data import QUICK_CRITERION, QUICK_SPECIMEN
 from poro2d.porosity import PAPER_N_LAB
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.grading import GradingCurve, paper_grading
@@ -31,6 +32,16 @@ TOP_KEYS = {"seed", "specimen", "grading", "criterion", "shear", "title", "densi
 def paper_preset() -> dict:
     """The paper's case as a config dict (Table 1, nLab = 0.3434, reconstructed grading)."""
     return {"seed": 0, "specimen": {}, "grading": {"preset": "paper"}, "criterion": {"n_lab": PAPER_N_LAB}}
+
+
+def paper_config(quick: bool, seed: int) -> dict:
+    """The paper preset as a config of ``seed`` (``quick``: the small box and the widened force window)."""
+    cfg = paper_preset()
+    cfg["seed"] = seed
+    if quick:
+        cfg["specimen"] = dict(QUICK_SPECIMEN)
+        cfg["criterion"].update(QUICK_CRITERION)
+    return cfg
 
 
 def load_config(

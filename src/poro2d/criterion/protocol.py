@@ -55,11 +55,6 @@ from poro2d.specimen.porosity_regions import lid_height_at, mass_d50
 
 _log = logging.getLogger(__name__)
 
-#: specimen settings that change how fast a run goes, never its numbers: a rerun with
-#: other values resumes (the engine sums in the same order on any number of threads)
-PERFORMANCE_KEYS = ("threads",)
-
-
 #: how a trial's specimen is judged full: "plate", the paper's rigid top plate (its n' includes
 #: the gap under the plate); "fill", a segmented lid that rests on the grains over the width
 #: (:mod:`poro2d.criterion.lid`; n' is the porosity of the box the specimen fills)
@@ -369,16 +364,16 @@ class PorosityCriterion:
     def stage(self) -> ResumableStage:
         """The run's stages in ``out``: ``config.json`` binds it to the config and seed.
 
-        The binding leaves out the performance settings (``PERFORMANCE_KEYS``: a rerun on
-        another thread count resumes). A folder whose trials lack that record (it was
-        deleted) is adopted: its finished trials are read back, the rest run.
+        The binding leaves out the specimen's fields marked as not changing results
+        (:mod:`poro2d.identity`: a rerun on another thread count resumes). A folder whose
+        trials lack that record (it was deleted) is adopted: its finished trials are read back, the rest run.
         """
         assert self.out is not None
         if self._stage is None:
             record = self._config_record()
             self._stage = ResumableStage(
                 self.out,
-                Fingerprint(record["run"], ignore=tuple(f"specimen.{k}" for k in PERFORMANCE_KEYS)),
+                Fingerprint(record["run"], tables={"specimen": SpecimenSpec}),
                 record="config.json",
                 extra={"config": record["config"], "provenance": record["provenance"]},
                 parameter="out",

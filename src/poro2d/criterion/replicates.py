@@ -15,9 +15,12 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+from poro2d.console import OutputConsole
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.grading import GradingCurve
+
+console = OutputConsole()
 
 
 def _run_one(
@@ -59,6 +62,32 @@ def run_replicates(
     rows = [rows[sd] for sd in seeds]
     specimens = {f"seed{r['seed']}": Path(out) / r["folder"] / "specimen.npz" for r in rows if r["converged"]}
     return specimens, rows
+
+
+def accepted_and_replicates(
+    spec: SpecimenSpec,
+    grading: GradingCurve,
+    settings: CriterionSettings,
+    n2d: float,
+    seed: int,
+    replicates: int,
+    out: Path,
+    *,
+    progress: bool,
+) -> tuple[dict[str, Path], list[dict] | None]:
+    """The specimen ``seed`` accepted in ``out/criterion`` and, with replicates, those of the next seeds.
+
+    The replicates are criterion runs from the accepted ``n2d`` in ``out/replicates``, one
+    process per thread of ``spec`` (:func:`run_replicates`); their rows are None without any.
+    """
+    specimens = {f"seed{seed}": out / "criterion" / "specimen.npz"}
+    if replicates == 1:
+        return specimens, None
+    more_seeds = list(range(seed + 1, seed + replicates))
+    console.print(f"  replicate specimens: seeds {', '.join(map(str, more_seeds))} from n2D = {n2d:.2f}")
+    more, rows = run_replicates(spec, grading, settings, n2d, more_seeds, out / "replicates",
+                                processes=spec.threads, progress=progress)  # fmt: skip
+    return {**specimens, **more}, rows
 
 
 class _Display:
@@ -122,4 +151,4 @@ def _pool(jobs: dict, processes: int, display: _Display | None) -> dict[int, dic
     return rows
 
 
-__all__ = ["run_replicates"]
+__all__ = ["accepted_and_replicates", "run_replicates"]

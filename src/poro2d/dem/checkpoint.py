@@ -120,6 +120,10 @@ def state_digest(path: str | os.PathLike) -> str:
     run (in the kernel's integer settings, ``kernel_params.iprm``), which change how a
     continued run is computed, not its numbers. So a specimen rebuilt from the same config
     and seed has the same digest, and a specimen moved or copied keeps it.
+
+    A content hash, not a run identity (:mod:`poro2d.identity`): it says what a file holds,
+    whichever run wrote it, since a shear test depends on the state it starts from, not on
+    how that state was made. It enters run descriptions as a value.
     """
     h = hashlib.sha256()
     with np.load(_existing(path)) as z:

@@ -14,6 +14,7 @@ from pathlib import Path
 
 from poro2d.io_utils import provenance
 from poro2d.resumable import Fingerprint, ResumableStage
+from poro2d.shear.settings import ShearSettings
 
 RECORD = "test.json"
 
@@ -55,7 +56,7 @@ def folder_stage(out: Path, record: dict, specimen: Path) -> ResumableStage:
     ``record``: :func:`content_record`; the record file keeps its digest (``key``) and the
     specimen's path (for information: not compared) beside it.
     """
-    fingerprint = Fingerprint(record)
+    fingerprint = Fingerprint(record, tables={"settings": ShearSettings})
     return ResumableStage(
         out,
         fingerprint,

@@ -35,9 +35,9 @@ def quick_specimens(out: Path, seeds: int, progress: bool) -> dict[str, Path]:
 
     The criterion and its replicate runs are the paper's own stages, resumable in ``out``.
     """
-    from poro2d.criterion.config import build
+    from poro2d.criterion.config import build, paper_config
     from poro2d.criterion.protocol import PorosityCriterion
-    from poro2d.paper import _specimens, paper_config
+    from poro2d.criterion.replicates import accepted_and_replicates
 
     cfg = paper_config(True, 0)
     spec, grading, settings, seed = build(cfg, None, threads=1)
@@ -46,8 +46,8 @@ def quick_specimens(out: Path, seeds: int, progress: bool) -> dict[str, Path]:
     result = crit.run()
     if not result.converged:
         raise RuntimeError(f"the quick specimen was not accepted: {result.message}")
-    specimens, _ = _specimens(crit.spec, crit.grading, crit.settings, result.final_porosity, crit.seed, seeds,
-                              out, progress)  # fmt: skip
+    specimens, _ = accepted_and_replicates(crit.spec, crit.grading, crit.settings, result.final_porosity,
+                                           crit.seed, seeds, out, progress=progress)  # fmt: skip
     return specimens
 
 

@@ -25,7 +25,7 @@ near the target density once the layers above compact them.
 from __future__ import annotations
 
 import logging
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
@@ -34,6 +34,7 @@ from poro2d.dem.measure import porosity_rect
 from poro2d.dem.ordering import strip_order
 from poro2d.dem.simulation import MEASURES
 from poro2d.errors import InputError, check_int, check_range
+from poro2d.identity import outside_identity
 from poro2d.paper_data import TABLE_1
 from poro2d.specimen.grading import MAX_DRAW, GradingCurve, draw_disks
 from poro2d.specimen.placement import Band, place_disks
@@ -99,9 +100,10 @@ class SpecimenSpec:
     calm_steps: int = 50_000
     calm_damping: float = 0.9
     dt_safety: float = 0.8
-    threads: int = 1
+    # how many threads run the engine: the same numbers on any count (docs/engine.md), so
+    # outside the run's identity (a rerun on other threads resumes)
+    threads: int = outside_identity(1)
     max_disks: int = DEFAULT_MAX_DISKS
-    extra: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         check_range("width", self.width, 0, None, lo_open=True)
@@ -147,7 +149,15 @@ class SpecimenSpec:
         for key, default in OMITTED_AT_DEFAULT.items():
             if d[key] == default:
                 del d[key]
+        # the key of a former field that could not be set: always empty, still written so
+        # that records and result files keep their keys and earlier folders resume
+        d["extra"] = {}
         return d
+
+    @classmethod
+    def from_record(cls, record: dict) -> SpecimenSpec:
+        """The spec a record (:meth:`to_dict`, a ``config.json``'s ``run.specimen``) describes."""
+        return cls(**{k: v for k, v in record.items() if k != "extra"})
 
     def self_weight(self, porosity: float) -> float:
         """G = rho_s (1 - n) W H g per metre of thickness (N/m), as in the paper."""

@@ -30,9 +30,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
-import hashlib
 import itertools
-import json
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -41,6 +39,7 @@ from typing import Any
 
 from poro2d.config import check_finite, check_keys
 from poro2d.errors import InputError
+from poro2d.identity import run_digest
 
 #: kind -> run(config, out_dir) -> dict of scalar results
 KINDS: dict[str, Callable[[dict, Path], dict]] = {}
@@ -74,7 +73,8 @@ def register_kind(
 
 
 # --------------------------------------------------------------------------- criterion kind
-def _criterion_objects(config: dict, base_dir: Path | None = None):
+def criterion_objects(config: dict, base_dir: Path | None = None):
+    """(spec, grading, settings, seed) of a criterion case's config, checked feasible."""
     from poro2d.criterion.config import build
     from poro2d.specimen.compaction import check_feasible
 
@@ -85,14 +85,14 @@ def _criterion_objects(config: dict, base_dir: Path | None = None):
 
 
 def validate_criterion(config: dict, base_dir: Path | None = None) -> None:
-    _criterion_objects(config, base_dir)
+    criterion_objects(config, base_dir)
 
 
 def criterion_case(config: dict, out_dir: Path) -> dict:
     """The criterion of Fig. 3 for one case; scalars of its result, of its first and of its accepted trial."""
     from poro2d.criterion.protocol import PorosityCriterion
 
-    spec, grading, settings, seed = _criterion_objects(config)
+    spec, grading, settings, seed = criterion_objects(config)
     figures = bool(config.get("sweep_options", {}).get("figures", False))
     crit = PorosityCriterion(
         spec, grading, settings, seed=seed, out=out_dir, progress=False, config=config, figures=figures
@@ -177,30 +177,28 @@ class SweepConfig:
     axes: list[str] = field(default_factory=list)
 
 
-def canonical_json(obj: Any) -> str:
-    return json.dumps(obj, sort_keys=True, separators=(",", ":"), default=str)
+def config_tables(prefix: str = "") -> dict[str, type]:
+    """The dataclass each table of a case's config stands for, keyed ``prefix`` + table name.
 
-
-#: settings that change how fast a case runs, never its results: left out of its id
-PERFORMANCE_KEYS = {"specimen": ("threads",)}
+    Their fields marked as not changing results (:mod:`poro2d.identity`: the thread count)
+    are left out of a case's identity.
+    """
+    if not BARE_NAME_TABLES:
+        _register_builtin()
+    return {f"{prefix}{table}": cls for table, cls in BARE_NAME_TABLES.items()}
 
 
 def case_id(kind: str, config: dict) -> str:
-    """A stable id: the first 12 hex digits of the SHA-256 of the kind and merged config.
+    """A stable id: the first 12 hex digits of the run digest of the kind and merged config.
 
-    Performance settings (:data:`PERFORMANCE_KEYS`) are left out, so a rerun with
-    another thread count finds the finished cases.
+    The identity rule (:func:`poro2d.identity.run_digest`) leaves out the settings that
+    change no result, so a rerun with another thread count finds the finished cases.
     """
-    binding = dict(config)
-    for table, keys in PERFORMANCE_KEYS.items():
-        if isinstance(binding.get(table), dict):
-            binding[table] = {k: v for k, v in binding[table].items() if k not in keys}
-    h = hashlib.sha256(canonical_json({"kind": kind, "config": binding}).encode())
-    return h.hexdigest()[:12]
+    return run_digest({"kind": kind, "config": config}, tables=config_tables("config."), length=12)
 
 
 def _field_names(cls: type) -> set[str]:
-    return {f.name for f in dataclasses.fields(cls) if f.name != "extra"}
+    return {f.name for f in dataclasses.fields(cls)}
 
 
 def resolve_name(name: str) -> str:

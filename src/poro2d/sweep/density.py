@@ -14,19 +14,20 @@ preparation friction that the calibration gives for the state's 2D target
 from __future__ import annotations
 
 import copy
-import hashlib
-import json
 import math
 import os
-from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
+from poro2d import __version__
 from poro2d.config import check_number_list
 from poro2d.criterion.density import DEFAULT_MUS, MU_PREP_MAX, Calibration, StateTarget
 from poro2d.errors import check_int
+from poro2d.identity import outside_fields, run_digest
 from poro2d.io_utils import provenance, write_json
 from poro2d.locks import cache_entry
+from poro2d.specimen.compaction import SpecimenSpec
+from poro2d.sweep.cases import criterion_objects
 
 #: seeds per friction and per state unless the config says otherwise
 DEFAULT_SEEDS = 3
@@ -85,18 +86,21 @@ def check_seeds(seeds: Any, parameter: str = "density.seeds") -> int:
 
 def calibration_base(base: dict) -> dict:
     """The parts of a criterion config that fix a calibration (no n_lab, no first trial)."""
-    spec = {k: v for k, v in (base.get("specimen") or {}).items() if k not in ("threads", "friction_prep")}
+    # friction_prep is the calibration's own axis; the marked fields change no result
+    left_out = ("friction_prep", *outside_fields(SpecimenSpec))
+    spec = {k: v for k, v in (base.get("specimen") or {}).items() if k not in left_out}
     crit = {k: v for k, v in (base.get("criterion") or {}).items() if k not in _CRITERION_KEYS_IGNORED}
     return {"specimen": spec, "grading": base.get("grading") or {"preset": "paper"}, "criterion": crit}
 
 
 def calibration_key(base: dict) -> str:
-    """A content key of the calibration's cases: grading, box, contact and criterion settings,
-    and the poro2d version (another version may compute another criterion)."""
-    from poro2d import __version__
+    """The run digest of the calibration's cases: grading, box, contact and criterion settings,
+    and the poro2d version (another version may compute another criterion).
 
+    Spaced as these keys were first written, so cached calibrations keep their folders.
+    """
     rec = {"base": calibration_base(base), "version": __version__}
-    return hashlib.sha256(json.dumps(rec, sort_keys=True, default=str).encode()).hexdigest()[:16]
+    return run_digest(rec, tables={"base.specimen": SpecimenSpec}, length=16, layout="spaced")
 
 
 def calibration_sweep(base: dict, mus: list[float], seeds: int) -> dict:
@@ -200,19 +204,15 @@ def state_sweep(base: dict, targets: list[StateTarget], seeds: int, resolution: 
 
 
 def _run_key(case, base_dir: Path | None) -> str:
-    """What a criterion case computes, as text: specimen, grading, settings but nLab, seed.
+    """The run digest of what a criterion case computes: specimen, grading, settings, seed.
 
-    nLab only chooses the first trial when none is given, and every case here has one; the
-    thread count changes no number.
+    The objects the case builds are compared, not its config's text, so defaults spelled
+    out or left implicit give the same key. nLab is left out: it only chooses the first
+    trial when none is given, and every case here has one.
     """
-    from poro2d.sweep.cases import _criterion_objects, canonical_json
-
-    spec, grading, settings, seed = _criterion_objects(case.config, base_dir)
-    sp = spec.to_dict()
-    sp.pop("threads", None)
-    st = asdict(settings)
-    st.pop("n_lab", None)
-    return canonical_json([sp, grading.sizes.tolist(), grading.percent.tolist(), st, seed])
+    spec, grading, settings, seed = criterion_objects(case.config, base_dir)
+    run = {"specimen": spec, "grading": [grading.sizes, grading.percent], "criterion": settings, "seed": seed}
+    return run_digest(run, ignore=("criterion.n_lab",))
 
 
 def calibration_twins(calibration, states, base_dir: Path | None, folder: Path) -> dict[str, dict]:

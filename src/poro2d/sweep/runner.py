@@ -36,7 +36,7 @@ from typing import Any
 from poro2d.io_utils import atomic_path, provenance, write_json
 from poro2d.locks import cache_entry, holds_output
 from poro2d.resumable import Fingerprint, ResumableStage
-from poro2d.sweep.cases import KINDS, PERFORMANCE_KEYS, Case, SweepConfig
+from poro2d.sweep.cases import KINDS, Case, SweepConfig, config_tables
 from poro2d.worker_signals import ignore_interrupts_in_dask_worker
 
 ignore_interrupts_in_dask_worker()  # a worker started by a script imports this to run its cases
@@ -77,13 +77,13 @@ def case_stage(case: dict, case_dir: Path) -> ResumableStage:
     """A case's folder as a resumable stage: ``params.json`` binds it, ``result.json`` marks it done.
 
     The binding is the case's kind and merged config, as its id (which names the folder)
-    is: the parameters (labels relative to a sweep's base case) and the performance
-    settings are recorded, not compared, so a rerun with another thread count finds it.
+    is: the parameters (labels relative to a sweep's base case) and the settings that
+    change no result (:mod:`poro2d.identity`) are recorded, not compared, so a rerun with
+    another thread count finds it.
     """
-    performance = tuple(f"config.{table}.{k}" for table, keys in PERFORMANCE_KEYS.items() for k in keys)
     return ResumableStage(
         case_dir,
-        Fingerprint(case, ignore=("id", "params", *performance)),
+        Fingerprint(case, ignore=("id", "params"), tables=config_tables("config.")),
         record=PARAMS,
         key=None,
         parameter="--out",
@@ -121,7 +121,7 @@ def _run_case(case: dict, case_dir: str, func) -> dict:
     done = stage.stored(RESULT, accept=_is_done)
     if done is not None:  # a retry after the marker was written
         return done
-    _pin_numba_threads()
+    pin_numba_threads()
     row: dict[str, Any] = {
         "case_id": case["id"],
         "kind": case["kind"],
@@ -161,7 +161,7 @@ def _done_row(case: dict, d: Path, func, row: dict, t0: float) -> dict:
     return row  # written as result.json, the done marker, last
 
 
-def _pin_numba_threads() -> None:
+def pin_numba_threads() -> None:
     """One numba thread for the case (its kind may raise it again for its own runs).
 
     numba re-reads ``NUMBA_NUM_THREADS`` from the environment whenever it compiles, and once
@@ -243,7 +243,7 @@ def check_dashboard(value: str | None, parameter: str = "--dashboard") -> str | 
     return text
 
 
-def _start_client(scheduler: str | None, workers: int | None, threads_needed: int,
+def start_client(scheduler: str | None, workers: int | None, threads_needed: int,
                   dashboard: str | None = DEFAULT_DASHBOARD):  # fmt: skip
     """(client, cluster or None): connect to ``scheduler`` or start a LocalCluster.
 
@@ -507,7 +507,7 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases_dir:
         threads = max(int((c.config.get("specimen") or {}).get("threads", 1) or 1) for c in pending)
         held = hold_interrupts() if not scheduler else None
         try:
-            client, cluster = _start_client(scheduler, workers, threads, dashboard)
+            client, cluster = start_client(scheduler, workers, threads, dashboard)
         except BaseException:
             release_interrupts(held)
             raise
@@ -606,8 +606,10 @@ __all__ = [
     "check_reachable",
     "connect",
     "finished_row",
+    "pin_numba_threads",
     "run_case_task",
     "run_sweep",
+    "start_client",
     "table_from_rows",
     "write_tables",
 ]
