@@ -16,6 +16,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
+from poro2d.criterion.result import ReplicatesResult
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.grading import GradingCurve
 
@@ -41,11 +42,12 @@ def run_replicates(
     *,
     processes: int = 2,
     progress: bool = True,
-) -> tuple[dict[str, Path], list[dict]]:
+) -> ReplicatesResult:
     """Criterion runs of ``seeds`` from the first trial ``n2d``, ``processes`` at a time.
 
-    Returns the accepted specimens by label (``seed1``, ...) and one summary row per seed
-    (accepted or not, the criterion's message, its folder under ``out``), in seed order.
+    Returns one summary row per seed (accepted or not, the criterion's message, its folder
+    under ``out``), in seed order, and the accepted specimens by label (``seed1``, ...) as
+    the result's ``specimens``.
     """
     spec1 = replace(spec, threads=1)
     first = replace(settings, trial_porosity=n2d)
@@ -56,9 +58,7 @@ def run_replicates(
     finally:
         if display is not None:
             display.stop()
-    rows = [rows[sd] for sd in seeds]
-    specimens = {f"seed{r['seed']}": Path(out) / r["folder"] / "specimen.npz" for r in rows if r["converged"]}
-    return specimens, rows
+    return ReplicatesResult([rows[sd] for sd in seeds], out=Path(out))
 
 
 class _Display:

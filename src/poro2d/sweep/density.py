@@ -22,11 +22,11 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
-from poro2d.config import check_number_list
-from poro2d.criterion.density import DEFAULT_MUS, MU_PREP_MAX, Calibration, StateTarget
+from poro2d.criterion.density import DEFAULT_MUS, Calibration, StateTarget, check_mus
 from poro2d.errors import InputError
 from poro2d.io_utils import provenance, write_json
 from poro2d.locks import cache_entry
+from poro2d.sweep.results import DensityStateResult
 
 #: seeds per friction and per state unless the config says otherwise
 DEFAULT_SEEDS = 3
@@ -70,12 +70,6 @@ def cache_dir() -> Path:
         return Path(env)
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
     return Path(base) / "poro2d"
-
-
-def check_mus(mus: Any, parameter: str = "density.mu_prep") -> list[float]:
-    """Two to 20 preparation frictions in [0, MU_PREP_MAX], strictly increasing (densest first)."""
-    return check_number_list(parameter, mus, 0.0, MU_PREP_MAX, min_items=2, max_items=20, increasing=True,
-                             what="preparation frictions")  # fmt: skip
 
 
 def check_seeds(seeds: Any) -> int:
@@ -256,22 +250,23 @@ def run_density_state(
     mus=None,
     use_cache: bool = True,
     **sweep_kw,
-) -> dict:
+) -> DensityStateResult:
     """The density-controlled criterion for one laboratory state, over seeds.
 
     Calibrates (or reads the cached calibration), maps ``n_lab`` to its 2D target and
     preparation friction, runs the criterion with them for every seed and writes
-    ``out/density.json``: the accepted n2D (mean, sd, per seed), the target, mu_prep and Dr.
+    ``out/density.json``: the accepted n2D (mean, sd, per seed), the target, mu_prep and Dr,
+    returned as a :class:`~poro2d.sweep.results.DensityStateResult`.
     """
     from poro2d.criterion.density import lab_relative_density
     from poro2d.sweep.relation import density_relation
 
     lab_relative_density(n_lab, n_max, n_min)  # nLab outside [n_min, n_max]: refused before any run
     settings = {"n_max": n_max, "n_min": n_min, "n_lab": [round(float(n_lab), 4)]}
-    rel, record = density_relation(base, base_dir, settings, out, seeds=seeds, mus=mus,
+    rel, sweeps = density_relation(base, base_dir, settings, out, seeds=seeds, mus=mus,
                                    use_cache=use_cache, **sweep_kw)  # fmt: skip
     (point,) = rel["points"]
-    result = {
+    record = {
         "mode": "density",
         "n_lab": point["n_lab"],
         "relative_density": point["relative_density"],
@@ -290,11 +285,12 @@ def run_density_state(
         "n2d_min": rel["n2d_min"],
         "n2d_max": rel["n2d_max"],
         "calibration": rel["calibration"],
-        "sweeps": record,
+        "sweeps": sweeps,
         "config": base,
         "provenance": provenance(),
     }
-    write_json(out / "density.json", result)
+    result = DensityStateResult.from_dict(record)
+    write_json(out / "density.json", result.to_dict())
     return result
 
 
