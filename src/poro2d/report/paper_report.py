@@ -1,9 +1,12 @@
 """The report of ``poro2d paper``: poro2d's numbers beside the paper's, with every figure.
 
 The report is made from the results themselves, never from files: the case study's
-summary (a ``PaperSummary``), the criterion's results (a ``CriterionOutputs``), the shear
-figures the run wrote, and a calibration or a sensitivity study when there is one. The
-command that resumes a finished run reads them through their result classes.
+summary (a ``PaperSummary``), the criterion's results (a
+:class:`~poro2d.criterion.result.CriterionOutputs`), the shear figures the run wrote, and a
+calibration or a sensitivity study when there is one. The command that resumes a finished
+run reads them through their result classes. The report layer sits below the criterion (the
+criterion draws its force chains here), so it reads those objects by their fields and
+imports none of their classes.
 """
 
 from __future__ import annotations
@@ -12,7 +15,6 @@ import json
 from pathlib import Path
 from typing import Any
 
-from poro2d.criterion.result import CriterionOutputs, CriterionResult
 from poro2d.report.document import Block, write_report
 
 #: where ``poro2d calibrate --out`` puts a calibration the paper report shows (``paper-out/calibration``)
@@ -35,7 +37,7 @@ CONVERSION_FIGURES = {
 def build_blocks(
     out: Path,
     summary,
-    criterion: CriterionOutputs | None,
+    criterion,
     *,
     shear_figures: dict[str, Path] | None = None,
     calibration: Any = None,
@@ -44,11 +46,11 @@ def build_blocks(
     """The report's blocks: summary, inputs, conversions, criterion, sensitivity, shear, provenance.
 
     ``summary``: the case study's ``PaperSummary``; ``criterion``: its criterion's results
-    (None: not run); ``shear_figures``: the shear figures written, by a name of
+    (a ``CriterionOutputs``); ``shear_figures``: the shear figures written, by a name of
     :data:`SHEAR_FIGURES`; ``calibration``: a ``CalibrationResult`` kept in
     ``out/calibration``; ``sensitivity``: a ``SensitivityResult`` to explain the paper's value.
     """
-    crit = criterion.result if criterion is not None else CriterionResult.from_dict({})
+    crit = criterion.result
     b = _intro_blocks(summary, crit)
     b += _inputs_blocks(summary, crit)
     b += _conversion_blocks(out, summary.conversions)
@@ -73,7 +75,7 @@ def _calibration_blocks(calibration: Any, folder: Path) -> list[Block]:
     return calibration_blocks(calibration, folder)
 
 
-def _intro_blocks(summary, crit: CriterionResult) -> list[Block]:
+def _intro_blocks(summary, crit) -> list[Block]:
     """The title, the paper's case in one paragraph, and the summary table beside the paper."""
     paper = summary.paper
     pc = paper["criterion"]
@@ -116,10 +118,8 @@ def _intro_blocks(summary, crit: CriterionResult) -> list[Block]:
     return b
 
 
-def _inputs_blocks(summary, crit: CriterionResult) -> list[Block]:
+def _inputs_blocks(summary, crit) -> list[Block]:
     """What is reconstructed or assumed where the paper is silent."""
-    if crit.specimen is None:  # no criterion run: nothing of its specimen to state
-        return []
     spec, pc = crit.specimen, summary.paper["criterion"]
     pairs = enumerate(zip(pc["particle_counts"], pc["trials"], strict=True))
     counts = ", ".join(f"{n} disks at {t:g}" if i == 0 else f"{n} at {t:g}" for i, (n, t) in pairs)
@@ -184,11 +184,9 @@ CRITERION_CAPTIONS = {
 }
 
 
-def _criterion_blocks(criterion: CriterionOutputs | None, pc: dict) -> list[Block]:
+def _criterion_blocks(criterion, pc: dict) -> list[Block]:
     """poro2d's trials beside the paper's, the discussion, Figs. 5-7 and the specimen's state."""
     b: list[Block] = [("h2", "The criterion (Fig. 3)")]
-    if criterion is None:
-        return b
     its = criterion.result.iterations or []
     if its:
         b.append((
@@ -233,7 +231,7 @@ def _criterion_blocks(criterion: CriterionOutputs | None, pc: dict) -> list[Bloc
     return b + _state_blocks(criterion) + _porosity_blocks(criterion)
 
 
-def _provenance_blocks(summary, crit: CriterionResult) -> list[Block]:
+def _provenance_blocks(summary, crit) -> list[Block]:
     """Version, machine, seed, timings and the settings of the run."""
     return [
         ("h2", "Provenance"),
@@ -274,7 +272,7 @@ def _criterion_discussion(its: list[dict], pc: dict) -> list[Block]:
     return out
 
 
-def _state_blocks(criterion: CriterionOutputs) -> list[Block]:
+def _state_blocks(criterion) -> list[Block]:
     """Homogeneity and stress state of the accepted specimen, when the criterion wrote them."""
     st = criterion.state
     if st is None:
@@ -296,7 +294,7 @@ def _state_blocks(criterion: CriterionOutputs) -> list[Block]:
     return b
 
 
-def _porosity_blocks(criterion: CriterionOutputs) -> list[Block]:
+def _porosity_blocks(criterion) -> list[Block]:
     """Box against interior porosity of the accepted specimen, the plate's surface, the local map."""
     m = criterion.porosity
     if m is None or m.interior_porosity is None:
@@ -380,7 +378,7 @@ def _shear_blocks(shear: dict, figures: dict[str, Path]) -> list[Block]:
     return b
 
 
-def write_paper_report(out: str | Path, summary, criterion: CriterionOutputs | None, **parts) -> list[Path]:
+def write_paper_report(out: str | Path, summary, criterion, **parts) -> list[Path]:
     """report.md and report.html in ``out``; ``parts``: the keywords of :func:`build_blocks`."""
     out = Path(out)
     blocks = build_blocks(out, summary, criterion, **parts)
