@@ -13,7 +13,7 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from poro2d.criterion.protocol import CriterionSettings
+from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.criterion.result import CriterionResult
 from poro2d.locks import holds_output
 from poro2d.specimen.compaction import SpecimenSpec
@@ -132,8 +132,6 @@ def criterion_inputs(
 
 def run_paper_mode(inputs: CriterionInputs, out: Path, *, progress: bool = True) -> CriterionResult:
     """The criterion of Fig. 3 once, on checked inputs, into ``out`` (resumable)."""
-    from poro2d.criterion.protocol import PorosityCriterion
-
     return PorosityCriterion(inputs.spec, inputs.grading, inputs.settings, seed=inputs.seed, out=out,
                              progress=progress, config=inputs.config).run()  # fmt: skip
 
