@@ -196,8 +196,7 @@ def _public_runs():
     from poro2d.paper import run_paper
     from poro2d.shear.replicates import ReplicateShear
     from poro2d.shear.run import run_shear
-    from poro2d.sweep.density import run_density_state
-    from poro2d.sweep.density_criterion import run_criterion_modes, run_density_criterion
+    from poro2d.sweep.density_criterion import run_criterion_modes, run_density_criterion, run_density_state
     from poro2d.sweep.relation import run_relation
     from poro2d.sweep.sensitivity import run_sensitivity
 

@@ -4,6 +4,10 @@ Density mode runs its calibration and its seeds as sweeps, so it lives on the sw
 the criterion layer checks both modes' inputs (:func:`poro2d.criterion.run.criterion_inputs`)
 and runs paper mode. :func:`run_criterion_modes` is the command's one call: it checks the
 inputs once and runs the mode they ask for.
+
+:func:`run_density_state` runs one laboratory state on the relation's sweeps
+(:func:`poro2d.sweep.relation.density_relation`); it sits here, above both the relation and
+the calibration (:mod:`poro2d.sweep.density`), so that neither imports the other back.
 """
 
 from __future__ import annotations
@@ -11,13 +15,68 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from poro2d.criterion.density import lab_relative_density
 from poro2d.criterion.result import CriterionResult
 from poro2d.criterion.run import ConfigLike, CriterionInputs, criterion_inputs, run_paper_mode
 from poro2d.errors import InputError
-from poro2d.io_utils import check_output_dir
+from poro2d.io_utils import check_output_dir, provenance, write_json
 from poro2d.locks import holds_output
-from poro2d.sweep.density import run_density_state
+from poro2d.sweep.density import DEFAULT_SEEDS
+from poro2d.sweep.relation import density_relation
 from poro2d.sweep.results import DensityStateResult
+
+
+def run_density_state(
+    base: dict,
+    base_dir: Path | None,
+    n_lab: float,
+    n_max: float,
+    n_min: float,
+    out: Path,
+    *,
+    seeds: int = DEFAULT_SEEDS,
+    mus=None,
+    use_cache: bool = True,
+    **sweep_kw,
+) -> DensityStateResult:
+    """The density-controlled criterion for one laboratory state, over seeds.
+
+    Calibrates (or reads the cached calibration), maps ``n_lab`` to its 2D target and
+    preparation friction, runs the criterion with them for every seed and writes
+    ``out/density.json``: the accepted n2D (mean, sd, per seed), the target, mu_prep and Dr,
+    returned as a :class:`~poro2d.sweep.results.DensityStateResult`.
+    """
+    lab_relative_density(n_lab, n_max, n_min)  # nLab outside [n_min, n_max]: refused before any run
+    settings = {"n_max": n_max, "n_min": n_min, "n_lab": [round(float(n_lab), 4)]}
+    rel, sweeps = density_relation(base, base_dir, settings, out, seeds=seeds, mus=mus,
+                                   use_cache=use_cache, **sweep_kw)  # fmt: skip
+    (point,) = rel["points"]
+    record = {
+        "mode": "density",
+        "n_lab": point["n_lab"],
+        "relative_density": point["relative_density"],
+        "n2d_target": point["n2d_target"],
+        "mu_prep": point["mu_prep"],
+        "final_porosity_mean": point["n2d_dem"],
+        "final_porosity_sd": point["n2d_sd"],
+        "final_porosity_per_seed": point["n2d_seeds"],
+        "measured_porosity_mean": point["n2d_measured"],
+        "interior_porosity_mean": point.get("n2d_interior"),
+        "interior_porosity_sd": point.get("n2d_interior_sd"),
+        "interior_porosity_per_seed": point.get("n2d_interior_seeds"),
+        "seeds": point["seeds"],
+        "seeds_converged": point["seeds_converged"],
+        "converged": point["seeds_converged"] == point["seeds"],
+        "n2d_min": rel["n2d_min"],
+        "n2d_max": rel["n2d_max"],
+        "calibration": rel["calibration"],
+        "sweeps": sweeps,
+        "config": base,
+        "provenance": provenance(),
+    }
+    result = DensityStateResult.from_dict(record)
+    write_json(out / "density.json", result.to_dict())
+    return result
 
 
 def _run_density_mode(inputs: CriterionInputs, out: Path, *, threads: int | None,
@@ -97,4 +156,4 @@ def run_criterion_modes(
     return _run_density_mode(inputs, out, threads=threads, progress=progress)
 
 
-__all__ = ["run_criterion_modes", "run_density_criterion"]
+__all__ = ["run_criterion_modes", "run_density_criterion", "run_density_state"]
