@@ -65,6 +65,7 @@ def test_narrow_terminal_folds_numbers_instead_of_cutting_them():
 
 def test_criterion_table_numbers_in_full(capsys):
     from poro2d.criterion.cli import print_result
+    from poro2d.criterion.result import CriterionResult
 
     it = {
         "trial_porosity": 0.21, "particle_count": 2591, "f_top_n_per_m": 3854.123456,
@@ -72,7 +73,10 @@ def test_criterion_table_numbers_in_full(capsys):
         "plate_displacement_m": -0.001234567, "new_porosity": 0.2187654, "porosity_change": 0.0087654,
         "accepted": False,
     }  # fmt: skip
-    print_result({"n_lab": 0.3434, "iterations": [it], "message": "accepted n2D = 0.15"}, "out")
+    result = CriterionResult.from_dict(
+        {"n_lab": 0.3434, "iterations": [it], "message": "accepted n2D = 0.15"}
+    )
+    print_result(result, "out")
     out = capsys.readouterr().out
     assert ELLIPSIS not in out
     row = next(line for line in out.splitlines() if "2591" in line)

@@ -4,6 +4,7 @@ import numpy as np
 
 from poro2d.criterion.protocol import CriterionSettings
 from poro2d.criterion.replicates import run_replicates
+from poro2d.criterion.result import ReplicatesResult
 from poro2d.dem import checkpoint
 from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec
@@ -15,11 +16,12 @@ SETTINGS = CriterionSettings(force_fraction=0.05)
 def test_processes_give_the_specimens_of_a_serial_run(tmp_path):
     """Two processes with one thread each build, seed for seed, the specimens of a serial run."""
     seeds = [1, 2]
-    par, rows_par = run_replicates(
-        SPEC, paper_grading(), SETTINGS, 0.2, seeds, tmp_path / "p", progress=False
-    )
-    ser, rows_ser = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, tmp_path / "s", processes=1,
-                                   progress=False)  # fmt: skip
+    res = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, tmp_path / "p", progress=False)
+    assert isinstance(res, ReplicatesResult)
+    par, rows_par = res.specimens, res.rows
+    res = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, tmp_path / "s", processes=1,
+                         progress=False)  # fmt: skip
+    ser, rows_ser = res.specimens, res.rows
     assert [r["seed"] for r in rows_par] == seeds and [r["folder"] for r in rows_par] == ["seed1", "seed2"]
     for a, b in zip(rows_par, rows_ser, strict=True):
         assert (a["final_porosity"], a["converged"], a["trials"]) == (
@@ -33,9 +35,8 @@ def test_processes_give_the_specimens_of_a_serial_run(tmp_path):
         np.testing.assert_array_equal(pa.pos, pb.pos)
         np.testing.assert_array_equal(pa.radius, pb.radius)
     # a rerun reads every seed back from its folder
-    again, rows_again = run_replicates(
-        SPEC, paper_grading(), SETTINGS, 0.2, seeds, tmp_path / "p", progress=False
-    )
+    res = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, tmp_path / "p", progress=False)
+    again, rows_again = res.specimens, res.rows
     assert again == par and [r["final_porosity"] for r in rows_again] == [
         r["final_porosity"] for r in rows_par
     ]

@@ -108,12 +108,19 @@ def test_normal_stresses_at_the_ends():
 
 
 def _report_text(tmp_path, **summary) -> str:
-    from poro2d.paper import PAPER
+    import json
+    from pathlib import Path
+
+    from poro2d.criterion.result import CriterionOutputs, CriterionResult
+    from poro2d.paper import PAPER, PaperSummary
     from poro2d.report.document import to_markdown
     from poro2d.report.paper_report import build_blocks
 
-    base = {"paper": PAPER, "conversions": {"methods": []}, "provenance": {}}
-    return to_markdown(build_blocks(tmp_path, dict(base, **summary)), tmp_path)
+    base = dict(quick=False, seed=0, conversions={"methods": []}, criterion={}, replicate_specimens=None,
+                shear=None, paper=PAPER, timings={}, provenance={})  # fmt: skip
+    stored = Path(__file__).parent / "data" / "before_typed_results" / "criterion_result.json"
+    crit = CriterionOutputs(CriterionResult.from_dict(json.loads(stored.read_text())))
+    return to_markdown(build_blocks(tmp_path, PaperSummary(**dict(base, **summary)), crit), tmp_path)
 
 
 def test_report_names_the_lab_data_given(tmp_path):

@@ -3,7 +3,9 @@
 import pytest
 
 from poro2d.criterion import run_criterion
+from poro2d.criterion.result import CriterionResult
 from poro2d.errors import InputError
+from poro2d.sweep.density_criterion import run_criterion_modes, run_density_criterion
 from poro2d.sweep.relation import run_relation
 
 SMALL = {
@@ -14,14 +16,20 @@ SMALL = {
 
 
 @pytest.mark.parametrize(
-    ("kw", "name"),
-    [({"seed": -1}, "--seed"), ({"mode": "fast"}, "mode"), ({"n_lab": 1.5}, "n_lab"),
-     ({"preset": "paper"}, "config/preset"), ({"mode": "density"}, "density.n_max/n_min")],
+    ("run", "kw", "name"),
+    [(run_criterion, {"seed": -1}, "--seed"), (run_criterion_modes, {"mode": "fast"}, "mode"),
+     (run_criterion, {"n_lab": 1.5}, "n_lab"), (run_criterion, {"preset": "paper"}, "config/preset"),
+     (run_criterion_modes, {"mode": "density"}, "density.n_max/n_min"),
+     (run_density_criterion, {}, "density.n_max/n_min"),
+     (run_criterion, {"config": dict(SMALL, density={"mode": "density"})}, "density.n_max/n_min"),
+     (run_criterion, {"config": dict(SMALL, density={"mode": "density", "n_max": 0.45, "n_min": 0.33})},
+      "density.mode")],
 )  # fmt: skip
-def test_run_criterion_refuses_bad_input_before_writing(tmp_path, kw, name):
+def test_run_criterion_refuses_bad_input_before_writing(tmp_path, run, kw, name):
     out = tmp_path / "o"
+    kw = {"config": SMALL, **kw}
     with pytest.raises(InputError) as e:
-        run_criterion(SMALL, out=out, progress=False, **kw)
+        run(kw.pop("config"), out=out, progress=False, **kw)
     assert e.value.parameter == name
     assert not out.exists()
 
@@ -33,6 +41,7 @@ def test_run_criterion_matches_the_command(tmp_path):
     from poro2d.cli import main
 
     res = run_criterion(SMALL, out=tmp_path / "api", progress=False)
+    assert isinstance(res, CriterionResult)
     cfg = tmp_path / "c.toml"
     cfg.write_text(
         "seed = 0\n[specimen]\nwidth = 0.05\nheight = 0.025\nlayers = 2\n[criterion]\nforce_fraction = 0.05\n"

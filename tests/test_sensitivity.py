@@ -2,6 +2,7 @@
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -239,13 +240,17 @@ def test_command_end_to_end_on_tiny_specimens(tmp_path, monkeypatch):
 
 
 def test_paper_report_shows_the_section_only_with_results(tmp_path):
-    from poro2d.paper import PAPER
+    from poro2d.criterion.result import CriterionOutputs, CriterionResult
+    from poro2d.paper import PAPER, PaperSummary
 
     sens, _ = _synthetic_sens()
-    summary = {"paper": PAPER, "conversions": {"methods": []}, "provenance": {}}
-    without = to_markdown(build_blocks(tmp_path, summary), tmp_path)
+    parts = {"conversions": {"methods": []}, "criterion": {}, "paper": PAPER, "timings": {}, "provenance": {}}
+    summary = PaperSummary(quick=False, seed=0, replicate_specimens=None, shear=None, **parts)
+    stored = Path(__file__).parent / "data" / "before_typed_results" / "criterion_result.json"
+    crit = CriterionOutputs(CriterionResult.from_dict(json.loads(stored.read_text())))
+    without = to_markdown(build_blocks(tmp_path, summary, crit), tmp_path)
     assert "Why the paper gets 0.15" not in without
-    blocks = build_blocks(tmp_path, dict(summary, sensitivity=sens))
+    blocks = build_blocks(tmp_path, summary, crit, sensitivity=sens)
     md, html = to_markdown(blocks, tmp_path), to_html(blocks, "t")
     assert "Why the paper gets 0.15" in md and "Why the paper gets 0.15" in html
     assert "within 0.005 of 0.15: Cu = 3" in md

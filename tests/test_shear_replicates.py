@@ -1,5 +1,6 @@
 """Direct shear over replicate specimens: seed statistics and the fit's confidence intervals."""
 
+import json
 import math
 
 import numpy as np
@@ -74,6 +75,7 @@ def test_replicate_series_on_small_specimens(tmp_path):
     from poro2d.dem import checkpoint
     from poro2d.shear import ShearSettings
     from poro2d.shear.replicates import ReplicateShear
+    from poro2d.shear.results import ReplicateShearResult
     from poro2d.specimen import paper_grading
     from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
 
@@ -90,7 +92,9 @@ def test_replicate_series_on_small_specimens(tmp_path):
     res = ReplicateShear(
         specimens, [50, 100], ShearSettings(**short), out=out, processes=2, progress=False
     ).run()
-    peaks = {k: [t["peak_shear_stress_kpa"] for t in s["tests"]] for k, s in res["series"].items()}
+    assert isinstance(res, ReplicateShearResult) and "series" not in res.to_dict()
+    assert res.to_dict() == json.loads((out / "replicates.json").read_text())
+    peaks = {k: [t["peak_shear_stress_kpa"] for t in s.tests] for k, s in res.series.items()}
     assert peaks["seed0"] != peaks["seed1"]  # two specimens, two samples of the strength
     row = res["per_normal_stress"][0]
     assert row["normal_stress_kpa"] == 50.0

@@ -3,7 +3,11 @@
 The files under tests/data/before_typed_results/ were written by poro2d before results were
 typed (a criterion run and a direct shear series on a 0.05 m x 0.025 m box, a series with
 laboratory data and a rate check, ``poro2d paper --quick --replicates 1``); only the folder
-part of their paths was shortened.
+part of their paths was shortened. Written before the sweeps' results were typed: the
+density mode of ``poro2d criterion`` (density_state.json), ``poro2d sensitivity`` and
+``poro2d relation --mode paper`` on that box, ``poro2d relation --preset paper --quick``
+(relation_density_mode.json), and from ``poro2d paper --quick`` the replicate specimens'
+shear summary and the accepted specimen's state and porosity files.
 """
 
 import json
@@ -12,9 +16,15 @@ from pathlib import Path
 
 import pytest
 
-from poro2d.criterion.result import CriterionResult
+from poro2d.criterion.result import (
+    CriterionResult,
+    ReplicatesResult,
+    SpecimenPorosityResult,
+    SpecimenStateResult,
+)
 from poro2d.paper import PaperSummary
-from poro2d.shear.results import ShearSeriesResult, ShearTestResult
+from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult, ShearTestResult
+from poro2d.sweep.results import DensityStateResult, RelationResult, SensitivityResult
 from poro2d.typed_result import TypedResult
 
 DATA = Path(__file__).parent / "data" / "before_typed_results"
@@ -23,6 +33,13 @@ FILES = [
     (ShearTestResult, "shear_test_result.json"),
     (ShearSeriesResult, "shear_series_result.json"),
     (PaperSummary, "paper_results.json"),
+    (DensityStateResult, "density_state.json"),
+    (RelationResult, "relation_paper_mode.json"),
+    (RelationResult, "relation_density_mode.json"),
+    (SensitivityResult, "sensitivity.json"),
+    (ReplicateShearResult, "shear_replicates.json"),
+    (SpecimenStateResult, "specimen_state.json"),
+    (SpecimenPorosityResult, "specimen_porosity.json"),
 ]
 
 
@@ -135,3 +152,69 @@ def test_a_shear_test_folder_written_before_is_read_back_and_still_binds(tmp_pat
     (out / "test.json").write_text(json.dumps(older))
     with pytest.raises(InputError, match="written by an older poro2d"):
         stage.check()
+
+
+def _stored(name: str) -> dict:
+    return json.loads((DATA / name).read_text())
+
+
+def test_a_relation_counts_its_failed_cases_in_either_mode():
+    density, paper = RelationResult.from_dict(_stored("relation_density_mode.json")), None
+    paper = RelationResult.from_dict(_stored("relation_paper_mode.json"))
+    assert density.failed_cases == density.sweeps["failed_cases"] == 0
+    assert paper.failed_cases == paper.sweep_summary["failed"] == 0 and paper.sweeps is None
+    assert "sweeps" not in paper and "sweep_summary" not in density  # each mode writes its own keys
+    failed = dict(_stored("relation_paper_mode.json"))
+    failed["sweep_summary"] = dict(failed["sweep_summary"], failed=2)
+    assert RelationResult.from_dict(failed).failed_cases == 2
+
+
+def test_a_density_relation_without_a_spread_still_writes_the_key():
+    stored = dict(_stored("relation_density_mode.json"), spread=None)  # fewer than two converged states
+    assert RelationResult.from_dict(stored).to_dict() == stored
+
+
+def test_fields_not_in_the_file_stay_out_of_it():
+    stored = _stored("shear_replicates.json")
+    rep = ReplicateShearResult.from_dict(stored)
+    assert rep.series == {}
+    rep.series = {"seed0": ShearSeriesResult.from_dict(_stored("shear_series_result.json"))}
+    assert rep.to_dict() == stored and "series" not in rep and rep.series["seed0"].tests
+    # one accepted seed and one refused, as run_replicates reports them
+    row = {"seed": 1, "final_porosity": 0.2, "converged": True, "trials": 2, "message": "", "folder": "seed1",
+           "time_s": 1.0}  # fmt: skip
+    rows = [row, dict(row, seed=2, final_porosity=None, converged=False, folder="seed2")]
+    reps = ReplicatesResult(rows, out=Path("reps"))
+    assert reps.to_dict() == {"rows": rows}
+    assert reps.specimens == {"seed1": Path("reps") / "seed1" / "specimen.npz"}
+
+
+def _public_runs():
+    from poro2d.calibration.run import CalibrationResult, run_calibration
+    from poro2d.criterion.replicates import run_replicates
+    from poro2d.criterion.run import run_criterion
+    from poro2d.paper import run_paper
+    from poro2d.shear.replicates import ReplicateShear
+    from poro2d.shear.run import run_shear
+    from poro2d.sweep.density_criterion import run_criterion_modes, run_density_criterion, run_density_state
+    from poro2d.sweep.relation import run_relation
+    from poro2d.sweep.sensitivity import run_sensitivity
+
+    return [
+        (run_criterion, CriterionResult), (run_density_criterion, DensityStateResult),
+        (run_density_state, DensityStateResult), (run_criterion_modes, CriterionResult | DensityStateResult),
+        (run_replicates, ReplicatesResult), (run_shear, ShearSeriesResult),
+        (ReplicateShear.run, ReplicateShearResult), (run_relation, RelationResult),
+        (run_sensitivity, SensitivityResult), (run_paper, PaperSummary), (run_calibration, CalibrationResult),
+    ]  # fmt: skip
+
+
+def test_every_public_run_is_annotated_with_its_typed_result():
+    import inspect
+    import typing
+
+    for func, cls in _public_runs():
+        hint = typing.get_type_hints(inspect.unwrap(func))["return"]
+        assert hint == cls, (func.__qualname__, hint)
+        for part in typing.get_args(hint) or (hint,):
+            assert issubclass(part, TypedResult), part

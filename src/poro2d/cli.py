@@ -52,12 +52,11 @@ def _register() -> None:
     # layer cannot take the whole CLI down at import time.
     from poro2d import paper, porosity_cli
     from poro2d.calibration import cli as calibration_cli
-    from poro2d.criterion import cli as criterion_cli
     from poro2d.interop import cli as interop_cli
     from poro2d.shear import cli as shear_cli
     from poro2d.shear import strength_cli
     from poro2d.sweep import cli as sweep_cli
-    from poro2d.sweep import sensitivity_cli
+    from poro2d.sweep import criterion_cli, sensitivity_cli
 
     porosity_cli.register(app)
     criterion_cli.register(app)

@@ -27,6 +27,7 @@ from poro2d.typed_result import TypedResult
 
 if TYPE_CHECKING:
     from poro2d.criterion.protocol import PorosityCriterion
+    from poro2d.criterion.result import CriterionOutputs
 
 console = OutputConsole()
 
@@ -144,20 +145,40 @@ def run_paper(
     crit.validate()  # every option is checked before the first file is written
     stage = paper_stage(out, quick, seed)
     stage.check()  # and the folder: one of another paper run is refused before anything is written
-    summary = _run_stages(out, stage, crit, quick=quick, replicates=replicates, lab_data=lab_data,
-                          progress=progress)  # fmt: skip
-    write_json(out / "results.json", summary)
-    from poro2d.report.paper_report import write_paper_report
+    summary, criterion, shear_figures = _run_stages(out, stage, crit, quick=quick, replicates=replicates,
+                                                    lab_data=lab_data, progress=progress)  # fmt: skip
+    write_json(out / "results.json", summary.to_dict())
+    from poro2d.report.paper_report import CALIBRATION_FOLDER, write_paper_report
 
-    md, html = write_paper_report(out, summary)
+    # the report takes objects and opens no file: a calibration kept beside the run is read here
+    md, html = write_paper_report(out, summary, criterion, shear_figures=shear_figures,
+                                  calibration=read_calibration(out / CALIBRATION_FOLDER))  # fmt: skip
     console.print(f"results in {out}/results.json; report: {html} and {md}")
     return summary
 
 
+def read_calibration(folder: Path):
+    """The calibration kept in ``folder`` (``poro2d calibrate --out <paper-out>/calibration``), or None.
+
+    Read by field names: the calibration package runs the paper's specimens
+    (:func:`paper_config`), so this module does not import its result class.
+    """
+    import json
+    from types import SimpleNamespace
+
+    path = folder / "result.json"
+    return SimpleNamespace(**json.loads(path.read_text())) if path.is_file() else None
+
+
 def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, quick: bool, replicates: int,
-                lab_data, progress: bool) -> PaperSummary:  # fmt: skip
-    """Conversions, criterion, replicate specimens and direct shear (each read back when done)."""
+                lab_data, progress: bool) -> tuple[PaperSummary, CriterionOutputs, dict]:  # fmt: skip
+    """Conversions, criterion, replicate specimens and direct shear (each read back when done).
+
+    Returns the summary, the criterion's results (its side files read through their classes)
+    and the shear figures written (by the names of the report's ``SHEAR_FIGURES``).
+    """
     from poro2d.criterion.cli import print_result
+    from poro2d.criterion.result import CriterionOutputs
 
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
@@ -170,21 +191,27 @@ def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, qu
     timings["criterion_s"] = time.perf_counter() - t1
     print_result(result, out / "criterion")
     shear = reps = None
+    shear_figures: dict[str, Path] = {}
     if result.converged:
         t2 = time.perf_counter()
         n2d = result.final_porosity
         specimens, reps = accepted_and_replicates(crit.spec, crit.grading, crit.settings, n2d, crit.seed,
                                                   replicates, out, progress=progress)  # fmt: skip
         timings["replicates_s"] = time.perf_counter() - t2
-        shear = _shear_stage(specimens, out / "shear", quick, lab_data, progress)
+        shear, shear_figures = _shear_stage(specimens, out / "shear", quick, lab_data, progress)
         timings["shear_s"] = time.perf_counter() - t2 - timings["replicates_s"]
     else:
         console.print("[yellow]criterion not converged: direct shear skipped[/]")
-    return PaperSummary(
+    summary = PaperSummary(
         quick=quick,
         seed=crit.seed,
         conversions=conv,
-        criterion={k: result[k] for k in ("final_porosity", "converged", "message", "iterations")},
+        criterion={
+            "final_porosity": result.final_porosity,
+            "converged": result.converged,
+            "message": result.message,
+            "iterations": result.iterations,
+        },  # fmt: skip
         replicate_specimens=reps,
         shear=shear,
         paper=PAPER,
@@ -192,6 +219,7 @@ def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, qu
         provenance=provenance(),
         lab=lab_data.to_dict() if lab_data is not None else None,
     )
+    return summary, CriterionOutputs.read(out / "criterion", result), shear_figures
 
 
 def _conversions_stage(out: Path, stage: ResumableStage) -> dict:
@@ -204,8 +232,10 @@ def _conversions_stage(out: Path, stage: ResumableStage) -> dict:
     return conv
 
 
-def _shear_stage(specimens: dict[str, Path], out: Path, quick: bool, lab_data, progress: bool) -> dict:
-    """Direct shear at the paper's normal stresses on every specimen; the summary over them."""
+def _shear_stage(specimens: dict[str, Path], out: Path, quick: bool, lab_data,
+                 progress: bool) -> tuple[dict, dict[str, Path]]:  # fmt: skip
+    """Direct shear at the paper's normal stresses on every specimen; the summary over them and
+    the figures written (Fig. 8 over the specimens, the first specimen's curves)."""
     from poro2d.shear.replicates import ReplicateShear
     from poro2d.shear.settings import ShearSettings
 
@@ -215,26 +245,32 @@ def _shear_stage(specimens: dict[str, Path], out: Path, quick: bool, lab_data, p
     )
     sset = ShearSettings(**(QUICK_SHEAR if quick else {}))
     rep = ReplicateShear(specimens, NORMAL_STRESSES_KPA, sset, out=out, lab=lab_data, progress=progress).run()
-    first = next(iter(rep["series"].values()))
-    fit = rep["fit"] or {}
+    first_label, first = next(iter(rep.series.items()))
+    fit = rep.fit or {}
     ci = fit.get("friction_angle_ci_deg")
     console.print(
         f"  friction angle {fit.get('friction_angle_deg', float('nan')):.1f} deg"
         + (f" ({fit['level']:.0%} interval {ci[0]:.1f} to {ci[1]:.1f})" if ci else "")
         + f", cohesion {fit.get('cohesion_kpa', float('nan')):.1f} kPa over {len(specimens)} specimen(s); "
         + "per specimen "
-        + ", ".join(f"{v:.1f}" for v in rep["friction_angle_per_specimen_deg"])
+        + ", ".join(f"{v:.1f}" for v in rep.friction_angle_per_specimen_deg)
         + " deg"
     )
-    return {
+    summary = {
         # the pooled fit over every specimen's peaks; "tests" and quasi_static of the first specimen
-        "tests": first["tests"],
+        "tests": first.tests,
         "friction_angle_deg": fit.get("friction_angle_deg"),
         "cohesion_kpa": fit.get("cohesion_kpa"),
         "r2": fit.get("r2"),
-        "quasi_static": first.get("quasi_static"),
-        "replicates": {k: v for k, v in rep.items() if k != "series"},
+        "quasi_static": first.quasi_static,
+        "replicates": rep.to_dict(),
     }
+    figures = {
+        "curves_replicates": out / "fig8a_shear_curves_replicates.png",
+        "peaks_replicates": out / "fig8b_peak_strength_replicates.png",
+        "curves_first": out / first_label / "fig8a_shear_curves.png",
+    }
+    return summary, figures
 
 
 def register(app: typer.Typer) -> None:

@@ -7,7 +7,10 @@ typed, and :meth:`TypedResult.from_dict` reads any such file back so that writin
 gives the same dict. Keys a class does not model are kept in ``extra`` (a file of a newer
 or older poro2d, a key added by another tool); keys it models that a file lacks stay
 absent; keys listed in ``OPTIONAL`` are written only when set (parts a run has only with
-an option, such as a shear series' ``rate_check``).
+an option, such as a shear series' ``rate_check``). A field declared with
+``field(metadata=NOT_IN_FILE)`` (and a default) is not a key of the file: it carries what a
+run hands its caller beside the file (a replicate study's per-specimen series), and
+``from_dict`` leaves it at its default.
 
 A result is also a read-only mapping (``result["final_porosity"]``, ``result.get(...)``,
 ``dict(result)``, ``"lab" in result``) that equals the dict of its file: code written when
@@ -22,11 +25,14 @@ from dataclasses import dataclass, field, fields
 from functools import cache
 from typing import Any, ClassVar, Self
 
+#: the metadata of a field that is not a key of the result's file
+NOT_IN_FILE = {"in_file": False}
+
 
 @cache
 def _keys(cls: type) -> tuple[str, ...]:
-    """The file keys a result class models: its fields but ``extra``, in declaration order."""
-    return tuple(f.name for f in fields(cls) if f.name != "extra")
+    """The file keys a result class models: its fields but ``extra`` and those not in the file."""
+    return tuple(f.name for f in fields(cls) if f.name != "extra" and f.metadata.get("in_file", True))
 
 
 @dataclass(eq=False)
@@ -77,4 +83,4 @@ class TypedResult(Mapping):
         return len(self.to_dict())
 
 
-__all__ = ["TypedResult"]
+__all__ = ["NOT_IN_FILE", "TypedResult"]

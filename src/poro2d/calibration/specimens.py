@@ -70,7 +70,7 @@ def preset_specimens(
     specimens = {f"seed{seed}": out / "criterion" / "specimen.npz"}
     if replicates > 1:
         extra = list(range(seed + 1, seed + replicates))
-        more, _ = run_replicates(
+        more = run_replicates(
             spec,
             grading,
             settings,
@@ -80,7 +80,7 @@ def preset_specimens(
             processes=spec.threads,
             progress=progress,
         )
-        specimens.update(more)
+        specimens.update(more.specimens)
     return specimens
 
 

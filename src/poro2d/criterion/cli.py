@@ -1,87 +1,25 @@
-"""``poro2d criterion``: the paper's Fig. 3 from a config file or the paper preset."""
+"""The criterion's answer as a table: the trials of Fig. 3 (``poro2d criterion``, ``poro2d paper``).
+
+The command itself (its two modes) is :mod:`poro2d.sweep.criterion_cli`: density mode runs on
+the sweep layer.
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-import typer
-
 from poro2d.console import OutputConsole, Table
+from poro2d.criterion.result import CriterionResult
 
 console = OutputConsole()
 
 
-def register(app: typer.Typer) -> None:
-    @app.command("criterion")
-    def criterion_cmd(
-        config: Path = typer.Option(
-            None, "--config", "-c", help="TOML config with \\[specimen], \\[grading], \\[criterion] tables."
-        ),
-        preset: str = typer.Option(None, "--preset", help="Built-in case: 'paper'."),
-        out: Path = typer.Option(Path("criterion-out"), "--out", "-o", help="Output folder (resumable)."),
-        seed: int = typer.Option(None, "--seed", help="Random seed (overrides the config)."),
-        n_lab: float = typer.Option(None, "--n-lab", help="Laboratory porosity (overrides the config)."),
-        trial: float = typer.Option(None, "--trial-porosity", help="First trial n2D instead of Eq. 12."),
-        threads: int = typer.Option(None, "--threads", help="Threads for the DEM kernels."),
-        mode: str = typer.Option(
-            None, "--mode", help="paper (default: preparation friction 0.05) or density (friction from Dr)."
-        ),
-        n_max: float = typer.Option(None, "--n-max", help="Density mode: loosest laboratory porosity."),
-        n_min: float = typer.Option(None, "--n-min", help="Density mode: densest laboratory porosity."),
-        seeds: int = typer.Option(None, "--seeds", help="Density mode: specimens per state (3)."),
-        quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
-    ) -> None:
-        """Find the final 2D porosity with the criterion of the paper's Fig. 3.
-
-        Paper mode runs it once, as the paper does. Density mode first calibrates the
-        grading (preparation friction -> accepted n2D, cached), sets the preparation friction
-        from the laboratory relative density and runs the criterion over seeds.
-        """
-        from poro2d.criterion.run import run_criterion
-
-        result = run_criterion(
-            config, preset=preset, out=out, seed=seed, n_lab=n_lab, trial_porosity=trial, threads=threads,
-            mode=mode, n_max=n_max, n_min=n_min, seeds=seeds, progress=not quiet,
-        )  # fmt: skip
-        if result.get("mode") == "density":
-            _print_density(result, out)
-            return
-        print_result(result, out)
-        if not result["converged"]:
-            # one line, whole: the reason names the trial, the stage or check, the ratio
-            what = "failed" if result.get("failed_trial") else "not converged"
-            console.print(f"[bold red]criterion {what}:[/] {result['message']}", soft_wrap=True)
-            raise typer.Exit(1)
-
-
-def _print_density(res: dict, out: Path) -> None:
-    """The density-controlled criterion's answer: its state, friction and accepted n2D over seeds."""
-    t = Table(title=f"criterion, density mode: nLab = {res['n_lab']} (Dr = {res['relative_density']:.3f})")
-    for col in ("2D target", "mu_prep", "accepted n2D (mean +- sd)", "interior n (mean +- sd)", "per seed",
-                "converged", "n2D,min", "n2D,max"):  # fmt: skip
-        t.add_column(col, justify="right")
-    mean = res["final_porosity_mean"]
-    inner = res.get("interior_porosity_mean")
-    t.add_row(
-        f"{res['n2d_target']:.4f}", f"{res['mu_prep']:.3f}",
-        "" if mean != mean else f"{mean:.4f} +- {res['final_porosity_sd']:.4f}",
-        "" if inner is None or inner != inner else f"{inner:.4f} +- {res['interior_porosity_sd']:.4f}",
-        ", ".join(f"{v:.2f}" for v in res["final_porosity_per_seed"]),
-        f"{res['seeds_converged']}/{res['seeds']}", f"{res['n2d_min']:.4f}", f"{res['n2d_max']:.4f}",
-    )  # fmt: skip
-    console.print(t)
-    console.print(f"results in {out}/density.json (calibration {out}/calibration.json)", soft_wrap=True)
-    if not res["converged"]:
-        console.print(f"[bold red]criterion not converged for every seed[/] (see {out}/states)")
-        raise typer.Exit(1)
-
-
-def print_result(result: dict, out: Path) -> None:
-    t = Table(title=f"criterion (Fig. 3): nLab = {result['n_lab']}")
+def print_result(result: CriterionResult, out: Path) -> None:
+    t = Table(title=f"criterion (Fig. 3): nLab = {result.n_lab}")
     for col in ("trial n2D", "disks", "F_top N/m", "F_bottom N/m", "G N/m", "plate", "dz (mm)", "n' (box)",
                 "|n'-n2D|", "interior n", "gap/d50", "accepted"):  # fmt: skip
         t.add_column(col, justify="right")
-    for r in result["iterations"]:
+    for r in result.iterations:
         t.add_row(
             f"{r['trial_porosity']:.3f}", str(r["particle_count"]), f"{r['f_top_n_per_m']:.4g}",
             f"{r['f_bottom_n_per_m']:.4g}", f"{r['self_weight_n_per_m']:.4g}", r["plate_moved"],
@@ -90,18 +28,18 @@ def print_result(result: dict, out: Path) -> None:
             _fixed_or_dash(r.get("surface_gap_mean_d50"), 2), _verdict(r),
         )  # fmt: skip
     console.print(t)
-    console.print(f"{result['message']}; results in {out}/result.json")
-    if result.get("interior_porosity") is not None:
-        under_lid = result["settings"].get("acceptance") == "fill"
+    console.print(f"{result.message}; results in {out}/result.json")
+    if result.interior_porosity is not None:
+        under_lid = result.settings.get("acceptance") == "fill"
         what = (
             "under the lid: the box the specimen fills"
             if under_lid
             else "the paper's, gap under the plate included"
         )
         console.print(
-            f"accepted specimen: box porosity n' {result['box_porosity']:.4f} ({what}), interior porosity "
-            f"{result['interior_porosity']:.4f} +- "
-            f"{result['interior_porosity_std']:.4f} (the packing's own; docs/porosity.md)",
+            f"accepted specimen: box porosity n' {result.box_porosity:.4f} ({what}), interior porosity "
+            f"{result.interior_porosity:.4f} +- "
+            f"{result.interior_porosity_std:.4f} (the packing's own; docs/porosity.md)",
             soft_wrap=True,
         )
 

@@ -29,6 +29,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from poro2d import porosity as P
+from poro2d.config import check_number_list
 from poro2d.errors import InputError, check_range
 
 #: the preparation frictions of a calibration, densest first: frictionless preparation gives
@@ -256,10 +257,17 @@ def state_target(n_lab: float, n_max: float, n_min: float, cal: Calibration) -> 
     return StateTarget(n_lab, dr, n2d, cal.mu_for(n2d))
 
 
+def check_mus(mus, parameter: str = "density.mu_prep") -> list[float]:
+    """Two to 20 preparation frictions in [0, MU_PREP_MAX], strictly increasing (densest first)."""
+    return check_number_list(parameter, mus, 0.0, MU_PREP_MAX, min_items=2, max_items=20, increasing=True,
+                             what="preparation frictions")  # fmt: skip
+
+
 __all__ = [
     "DEFAULT_MUS",
     "Calibration",
     "StateTarget",
+    "check_mus",
     "isotonic_increasing",
     "lab_relative_density",
     "porosity_from_void_ratio",

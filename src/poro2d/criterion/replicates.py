@@ -17,6 +17,7 @@ from pathlib import Path
 
 from poro2d.console import OutputConsole
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
+from poro2d.criterion.result import ReplicatesResult
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.grading import GradingCurve
 
@@ -44,11 +45,12 @@ def run_replicates(
     *,
     processes: int = 2,
     progress: bool = True,
-) -> tuple[dict[str, Path], list[dict]]:
+) -> ReplicatesResult:
     """Criterion runs of ``seeds`` from the first trial ``n2d``, ``processes`` at a time.
 
-    Returns the accepted specimens by label (``seed1``, ...) and one summary row per seed
-    (accepted or not, the criterion's message, its folder under ``out``), in seed order.
+    Returns one summary row per seed (accepted or not, the criterion's message, its folder
+    under ``out``), in seed order, and the accepted specimens by label (``seed1``, ...) as
+    the result's ``specimens``.
     """
     spec1 = replace(spec, threads=1)
     first = replace(settings, trial_porosity=n2d)
@@ -59,9 +61,7 @@ def run_replicates(
     finally:
         if display is not None:
             display.stop()
-    rows = [rows[sd] for sd in seeds]
-    specimens = {f"seed{r['seed']}": Path(out) / r["folder"] / "specimen.npz" for r in rows if r["converged"]}
-    return specimens, rows
+    return ReplicatesResult([rows[sd] for sd in seeds], out=Path(out))
 
 
 def accepted_and_replicates(
@@ -85,9 +85,9 @@ def accepted_and_replicates(
         return specimens, None
     more_seeds = list(range(seed + 1, seed + replicates))
     console.print(f"  replicate specimens: seeds {', '.join(map(str, more_seeds))} from n2D = {n2d:.2f}")
-    more, rows = run_replicates(spec, grading, settings, n2d, more_seeds, out / "replicates",
-                                processes=spec.threads, progress=progress)  # fmt: skip
-    return {**specimens, **more}, rows
+    more = run_replicates(spec, grading, settings, n2d, more_seeds, out / "replicates",
+                          processes=spec.threads, progress=progress)  # fmt: skip
+    return {**specimens, **more.specimens}, more.rows
 
 
 class _Display:

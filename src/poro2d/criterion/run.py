@@ -1,17 +1,23 @@
-"""``run_criterion``: the criterion of ``poro2d criterion`` as one Python call.
+"""``run_criterion``: the criterion of ``poro2d criterion`` (paper mode) as one Python call.
 
-The command only parses its options and prints; everything it computes is here, so a
-script gets the same checks, files and resuming.
+The command only parses its options and prints; the checks of every input of both modes
+(:func:`criterion_inputs`) and the paper mode's run are here, so a script gets the same
+checks, files and resuming. Density mode runs its specimens on the sweep layer
+(:mod:`poro2d.sweep.density_criterion`, which also dispatches the command's two modes).
 """
 
 from __future__ import annotations
 
 import copy
 import os
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
+from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
+from poro2d.criterion.result import CriterionResult
 from poro2d.locks import holds_output
+from poro2d.specimen.compaction import SpecimenSpec
+from poro2d.specimen.grading import GradingCurve
 
 ConfigLike = dict | str | os.PathLike | None
 
@@ -44,8 +50,8 @@ def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> d
     """Mode and density-mode settings from ``[density]`` and the options (options win)."""
     from poro2d import porosity as P
     from poro2d.config import check_keys
+    from poro2d.criterion.density import check_mus
     from poro2d.errors import InputError, check_int, check_range
-    from poro2d.sweep.density import check_mus
 
     check_keys("density", cfg.get("density") or {}, DENSITY_KEYS)
     t = dict(cfg.get("density") or {})
@@ -72,6 +78,64 @@ def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> d
     return out
 
 
+@dataclass(frozen=True)
+class CriterionInputs:
+    """A criterion config checked and built, before anything runs (both modes start here).
+
+    ``config``: the config as loaded, with the seed option applied; ``base``: the folder its
+    relative paths start from; ``density``: the mode and, in density mode, its settings
+    (:func:`density_settings`); ``spec``, ``grading``, ``settings``, ``seed``: the objects
+    the criterion runs on.
+    """
+
+    config: dict
+    base: Path | None
+    density: dict
+    spec: SpecimenSpec
+    grading: GradingCurve
+    settings: CriterionSettings
+    seed: int
+
+    @property
+    def mode(self) -> str:
+        return self.density["mode"]
+
+
+def criterion_inputs(
+    config: ConfigLike = None,
+    *,
+    preset: str | None = None,
+    seed: int | None = None,
+    n_lab: float | None = None,
+    trial_porosity: float | None = None,
+    threads: int | None = None,
+    mode: str | None = None,
+    n_max: float | None = None,
+    n_min: float | None = None,
+    seeds: int | None = None,
+) -> CriterionInputs:
+    """Every input of ``poro2d criterion`` checked, the specimen's feasibility too (InputError if not)."""
+    from poro2d.criterion.config import build
+    from poro2d.errors import check_int
+    from poro2d.specimen.compaction import check_feasible
+
+    cfg, base = load(config, preset)
+    if seed is not None:
+        cfg["seed"] = check_int("--seed", seed, 0)
+    dens = density_settings(cfg, mode, n_max, n_min, seeds, preset=config is None)
+    spec, grading, settings, sd = build(
+        cfg, base, n_lab=n_lab, trial_porosity=trial_porosity, threads=threads
+    )
+    check_feasible(spec, grading, settings.initial_trial())
+    return CriterionInputs(cfg, base, dens, spec, grading, settings, sd)
+
+
+def run_paper_mode(inputs: CriterionInputs, out: Path, *, progress: bool = True) -> CriterionResult:
+    """The criterion of Fig. 3 once, on checked inputs, into ``out`` (resumable)."""
+    return PorosityCriterion(inputs.spec, inputs.grading, inputs.settings, seed=inputs.seed, out=out,
+                             progress=progress, config=inputs.config).run()  # fmt: skip
+
+
 @holds_output("out")
 def run_criterion(
     config: ConfigLike = None,
@@ -82,53 +146,29 @@ def run_criterion(
     n_lab: float | None = None,
     trial_porosity: float | None = None,
     threads: int | None = None,
-    mode: str | None = None,
-    n_max: float | None = None,
-    n_min: float | None = None,
-    seeds: int | None = None,
     progress: bool = True,
-) -> Any:
+) -> CriterionResult:
     """The criterion of Fig. 3 for a config (a dict, a TOML file, or the paper preset when None).
 
-    Paper mode (the default, or ``[density] mode``) runs it once, as the paper does, and
-    returns the :class:`~poro2d.criterion.result.CriterionResult` written to
-    ``out/result.json``. Density mode calibrates the grading (cached), sets the preparation
-    friction from the laboratory relative density between ``n_max`` and ``n_min`` and runs
-    the criterion over ``seeds``; it returns the dict written to ``out/density.json``.
-    The keyword options override the config as the command's options do. Bad input
-    raises :class:`~poro2d.errors.InputError` before anything is written.
+    Runs it once, as the paper does, and returns the
+    :class:`~poro2d.criterion.result.CriterionResult` written to ``out/result.json``. The
+    keyword options override the config as the command's options do. Density mode (a
+    config whose ``[density]`` table says ``mode = "density"``) runs on the sweep layer:
+    :func:`poro2d.sweep.density_criterion.run_density_criterion` is its call, and it is
+    refused here. Bad input raises :class:`~poro2d.errors.InputError` before anything is
+    written.
     """
-    from poro2d.criterion.config import build
-    from poro2d.criterion.protocol import PorosityCriterion
-    from poro2d.errors import check_int
+    from poro2d.errors import InputError
     from poro2d.io_utils import check_output_dir
-    from poro2d.specimen.compaction import check_feasible
 
     out = Path(out)
     check_output_dir("--out", out)
-    cfg, base = load(config, preset)
-    if seed is not None:
-        cfg["seed"] = check_int("--seed", seed, 0)
-    dens = density_settings(cfg, mode, n_max, n_min, seeds, preset=config is None)
-    spec, grading, settings, sd = build(
-        cfg, base, n_lab=n_lab, trial_porosity=trial_porosity, threads=threads
-    )
-    check_feasible(spec, grading, settings.initial_trial())
-    if dens["mode"] == "density":
-        from poro2d.errors import InputError
-        from poro2d.sweep.density import run_density_state
-
-        # density mode runs seeds 0 .. seeds-1, each from its state's 2D target: a seed or a
-        # first trial of its own would be ignored, so they are refused
-        for option, value in (("--seed", seed), ("--trial-porosity", trial_porosity)):
-            if value is not None:
-                raise InputError(option, value, "only in paper mode (density: --seeds and the 2D target)")
-        rest = {k: v for k, v in cfg.items() if k != "density"}
-        if threads is not None:
-            rest["specimen"] = dict(rest.get("specimen") or {}, threads=spec.threads)
-        return run_density_state(rest, base, settings.n_lab, dens["n_max"], dens["n_min"], out,
-                                 seeds=dens["seeds"], mus=dens["mu_prep"], progress=progress)  # fmt: skip
-    return PorosityCriterion(spec, grading, settings, seed=sd, out=out, progress=progress, config=cfg).run()
+    inputs = criterion_inputs(config, preset=preset, seed=seed, n_lab=n_lab, trial_porosity=trial_porosity,
+                              threads=threads)  # fmt: skip
+    if inputs.mode == "density":
+        raise InputError("density.mode", "density", "paper here (density mode: "
+                         "poro2d.sweep.density_criterion.run_density_criterion)")  # fmt: skip
+    return run_paper_mode(inputs, out, progress=progress)
 
 
-__all__ = ["run_criterion"]
+__all__ = ["CriterionInputs", "criterion_inputs", "run_criterion", "run_paper_mode"]

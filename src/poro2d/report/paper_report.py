@@ -1,60 +1,86 @@
-"""The report of ``poro2d paper``: poro2d's numbers beside the paper's, with every figure."""
+"""The report of ``poro2d paper``: poro2d's numbers beside the paper's, with every figure.
+
+The report is made from the results themselves, never from files: the case study's
+summary (a ``PaperSummary``), the criterion's results (a
+:class:`~poro2d.criterion.result.CriterionOutputs`), the shear figures the run wrote, and a
+calibration or a sensitivity study when there is one. The command that resumes a finished
+run reads them through their result classes. The report layer sits below the criterion (the
+criterion draws its force chains here), so it reads those objects by their fields and
+imports none of their classes.
+"""
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 from poro2d.report.document import Block, write_report
 
+#: where ``poro2d calibrate --out`` puts a calibration the paper report shows (``paper-out/calibration``)
+CALIBRATION_FOLDER = "calibration"
+#: the shear figures of the report, by the name the case study gives them, with their captions
+SHEAR_FIGURES = {
+    "curves_replicates": "Fig. 8(a): shear stress against shear displacement, mean and +- sd band over the "
+    "specimens",
+    "peaks_replicates": "Fig. 8(b): peak strength against normal stress over the specimens, with the fitted "
+    "lines",
+    "curves_first": "The first specimen's curves with the plate displacement",
+}
+#: the conversion figures, by file name, with their captions
+CONVERSION_FIGURES = {
+    "fig1_relations.png": "Fig. 1: 2D porosity against laboratory porosity, all methods",
+    "fig2_lim_parabola.png": "Fig. 2: LIM 2D-Lab, LIM 2D-3D and the parabola of Eq. 12",
+}
 
-def _load(p: Path) -> dict | None:
-    return json.loads(p.read_text()) if p.is_file() else None
 
+def build_blocks(
+    out: Path,
+    summary,
+    criterion,
+    *,
+    shear_figures: dict[str, Path] | None = None,
+    calibration: Any = None,
+    sensitivity: Any = None,
+) -> list[Block]:
+    """The report's blocks: summary, inputs, conversions, criterion, sensitivity, shear, provenance.
 
-def build_blocks(out: Path, summary: dict) -> list[Block]:
-    """The report's blocks: summary, inputs, conversions, criterion, sensitivity, shear, provenance."""
-    crit = _load(out / "criterion" / "result.json") or {}
+    ``summary``: the case study's ``PaperSummary``; ``criterion``: its criterion's results
+    (a ``CriterionOutputs``); ``shear_figures``: the shear figures written, by a name of
+    :data:`SHEAR_FIGURES`; ``calibration``: a ``CalibrationResult`` kept in
+    ``out/calibration``; ``sensitivity``: a ``SensitivityResult`` to explain the paper's value.
+    """
+    crit = criterion.result
     b = _intro_blocks(summary, crit)
     b += _inputs_blocks(summary, crit)
-    b += _conversion_blocks(out, summary["conversions"])
-    b += _criterion_blocks(out, crit, summary["paper"]["criterion"])
-    sens = summary.get("sensitivity")
-    if sens:  # why the paper gets what it gets, when the run holds a sensitivity study
+    b += _conversion_blocks(out, summary.conversions)
+    b += _criterion_blocks(criterion, summary.paper["criterion"])
+    if sensitivity is not None:  # why the paper gets what it gets, when the run holds a sensitivity study
         from poro2d.report.sensitivity_report import report_blocks
 
-        b += report_blocks(sens)
-    if summary.get("shear"):
-        b += _shear_blocks(out, summary["shear"])
-    b += _calibration_blocks(out / CALIBRATION_FOLDER)
+        b += report_blocks(sensitivity)
+    if summary.shear:
+        b += _shear_blocks(summary.shear, shear_figures or {})
+    b += _calibration_blocks(calibration, out / CALIBRATION_FOLDER)
     b += _provenance_blocks(summary, crit)
     return b
 
 
-#: where ``poro2d calibrate --out`` puts a calibration the paper report shows (``paper-out/calibration``)
-CALIBRATION_FOLDER = "calibration"
-
-
-def _calibration_blocks(cal: Path) -> list[Block]:
+def _calibration_blocks(calibration: Any, folder: Path) -> list[Block]:
     """The calibration's section, when ``poro2d calibrate --out <paper-out>/calibration`` has run."""
-    record = _load(cal / "result.json")
-    if record is None:
+    if calibration is None:
         return []
-    from types import SimpleNamespace
-
     from poro2d.report.calibration_report import calibration_blocks
 
-    # the section reads the record's fields by name; the calibration package sits above the
-    # report (it runs the paper's specimens), so its result class is not imported here
-    return calibration_blocks(SimpleNamespace(**record), cal)
+    return calibration_blocks(calibration, folder)
 
 
-def _intro_blocks(summary: dict, crit: dict) -> list[Block]:
+def _intro_blocks(summary, crit) -> list[Block]:
     """The title, the paper's case in one paragraph, and the summary table beside the paper."""
-    paper = summary["paper"]
+    paper = summary.paper
     pc = paper["criterion"]
-    its = crit.get("iterations", [])
-    shear = summary.get("shear")
+    its = crit.iterations or []
+    shear = summary.shear
     b: list[Block] = [("h1", "poro2d: the paper's case study")]
     b.append((
         "p",
@@ -62,19 +88,19 @@ def _intro_blocks(summary: dict, crit: dict) -> list[Block]:
         f"laboratory porosity nLab = {paper['n_lab']} (dry density {paper['dry_density_kg_m3']:.0f} "
         f"kg/m3, solid density {paper['solid_density_kg_m3']:.0f} kg/m3), nLab,max = {paper['n_max']}, "
         f"nLab,min = {paper['n_min']}."
-        + (" Quick mode: a reduced specimen, not the paper's box." if summary.get("quick") else ""),
+        + (" Quick mode: a reduced specimen, not the paper's box." if summary.quick else ""),
     ))  # fmt: skip
     b.append(("h2", "Summary"))
-    rows = [["accepted 2D porosity", crit.get("final_porosity"), pc["accepted_porosity"]]]
-    if crit.get("interior_porosity") is not None:
+    rows = [["accepted 2D porosity", crit.final_porosity, pc["accepted_porosity"]]]
+    if crit.interior_porosity is not None:
         rows.append(["box porosity n' of the accepted specimen (gap under the plate included)",
-                     crit.get("box_porosity"), "-"])  # fmt: skip
-        inner = f"{crit['interior_porosity']:.4f} +- {crit['interior_porosity_std']:.4f}"
+                     crit.box_porosity, "-"])  # fmt: skip
+        inner = f"{crit.interior_porosity:.4f} +- {crit.interior_porosity_std:.4f}"
         rows.append(["interior porosity of the accepted specimen (the packing's own)", inner, "-"])
     if its:
         rows.append(["first trial porosity (Eq. 12, rounded)", its[0]["trial_porosity"], pc["trials"][0]])
         rows.append(["number of trials", len(its), len(pc["trials"])])
-    reps = summary.get("replicate_specimens") or []
+    reps = summary.replicate_specimens or []
     if reps:
         n2d = [r["final_porosity"] for r in reps if r["converged"]]
         rows.append([
@@ -88,30 +114,32 @@ def _intro_blocks(summary: dict, crit: dict) -> list[Block]:
             phi = f"{phi:.1f} ({fit['level']:.0%} interval {ci[0]:.1f} to {ci[1]:.1f})"
         rows.append(["friction angle from peak strengths (deg)", phi, "not stated"])
     b.append(("table", ["quantity", "poro2d", "paper"], rows))
-    b.append(("note", crit.get("message", "criterion not run")))
+    b.append(("note", crit.message if crit.message is not None else "criterion not run"))
     return b
 
 
-def _inputs_blocks(summary: dict, crit: dict) -> list[Block]:
+def _inputs_blocks(summary, crit) -> list[Block]:
     """What is reconstructed or assumed where the paper is silent."""
-    spec = crit.get("specimen", {})
+    spec, pc = crit.specimen, summary.paper["criterion"]
+    pairs = enumerate(zip(pc["particle_counts"], pc["trials"], strict=True))
+    counts = ", ".join(f"{n} disks at {t:g}" if i == 0 else f"{n} at {t:g}" for i, (n, t) in pairs)
     quick = [
-        f"Quick mode: a {spec.get('width')} m x {spec.get('height')} m box in {spec.get('layers')} "
+        f"Quick mode: a {spec['width']} m x {spec['height']} m box in {spec['layers']} "
         "layers, the criterion's force window widened to "
-        f"{crit.get('settings', {}).get('force_fraction', 0.01):.0%} of G (in so small a box 1 % "
+        f"{crit.settings['force_fraction']:.0%} of G (in so small a box 1 % "
         "of G is about two disks' weight), shear to 4 mm: a first look, not the paper's case.",
-    ] if summary.get("quick") else []  # fmt: skip
+    ] if summary.quick else []  # fmt: skip
     return [("h2", "Inputs the paper does not give"), ("ul", [
         "Grading curve: a reconstruction of the paper's Fig. 4 (a medium sand, up-scaled x10), matched "
-        "to the paper's particle counts (2591 disks at 0.14, 2552 at 0.15); see docs/grading.md. The "
+        f"to the paper's particle counts ({counts}); see docs/grading.md. The "
         "real curve can replace it ([grading] csv = ...).",
-        f"Local damping {spec.get('local_damping', 0.7)} (PFC 4.0's default; the paper does not state it).",
+        f"Local damping {spec['local_damping']} (PFC 4.0's default; the paper does not state it).",
         "Contact properties combined PFC 4.0 style (springs in series, smaller friction), as Table 1 lists "
         "them per body.",
-        f"Disk thickness {spec.get('thickness', 0.008)} m (the paper's 8 mm); forces per metre of thickness.",
+        f"Disk thickness {spec['thickness']} m (the paper's 8 mm); forces per metre of thickness.",
         "Multilayer compaction by radius expansion inside each band under a temporary lid "
-        f"({spec.get('layers', 4)} layers), equilibrium at a maximum unbalanced-force ratio of "
-        f"{spec.get('ratio', 1e-3)}.",
+        f"({spec['layers']} layers), equilibrium at a maximum unbalanced-force ratio of "
+        f"{spec['ratio']}.",
         *quick,
         "Direct shear: the shear velocity is far above the laboratory rate of 0.384 mm/min "
         f"(quasi-static checks below); {_lab_text(summary)} A test ends once its smoothed peak lies "
@@ -120,9 +148,9 @@ def _inputs_blocks(summary: dict, crit: dict) -> list[Block]:
     ])]  # fmt: skip
 
 
-def _lab_text(summary: dict) -> str:
+def _lab_text(summary) -> str:
     """Where the laboratory shear data of Fig. 8 come from in this run, if from anywhere."""
-    lab = summary.get("lab")
+    lab = summary.lab
     if not lab:
         return (
             "no laboratory curves are built in (Fig. 8's data are not published as numbers): "
@@ -130,27 +158,36 @@ def _lab_text(summary: dict) -> str:
         )
     peaks = len(lab.get("peaks") or [])
     what = f"laboratory {lab.get('kind', 'data')} from {lab.get('source')} ({peaks} peak(s))"
-    if not summary.get("shear"):
+    if not summary.shear:
         return f"{what} were given, but no test ran to compare them with."
     return f"{what} are drawn beside the DEM's in Fig. 8."
 
 
 def _conversion_blocks(out: Path, conv: dict) -> list[Block]:
-    """The table of Eqs. 1-12 and Figs. 1-2."""
+    """The table of Eqs. 1-12 and Figs. 1-2 (the figures the conversions stage lists)."""
     cdir = out / "conversions"
+    figures = [("img", cdir / name, CONVERSION_FIGURES[name]) for name in conv.get("figures", [])
+               if name in CONVERSION_FIGURES]  # fmt: skip
     return [
         ("h2", "3D-to-2D conversions (Eqs. 1-12)"),
         ("table", ["method", "equation", "n2D", "flags"],
          [[m["method"], m["equation"], m["n2d"], m["flags"]] for m in conv["methods"]]),
-        ("img", cdir / "fig1_relations.png", "Fig. 1: 2D porosity against laboratory porosity, all methods"),
-        ("img", cdir / "fig2_lim_parabola.png", "Fig. 2: LIM 2D-Lab, LIM 2D-3D and the parabola of Eq. 12"),
+        *figures,
     ]  # fmt: skip
 
 
-def _criterion_blocks(out: Path, crit: dict, pc: dict) -> list[Block]:
+#: the criterion's figures in the report, by file name, with their captions
+CRITERION_CAPTIONS = {
+    "fig5_forces_initial_trial.png": "Fig. 5: contact forces at the initial trial porosity, top plate at H",
+    "fig6_forces_after_plate.png": "Fig. 6: contact forces after the top plate moved",
+    "fig7_forces_accepted.png": "Fig. 7: contact forces at the accepted porosity",
+}
+
+
+def _criterion_blocks(criterion, pc: dict) -> list[Block]:
     """poro2d's trials beside the paper's, the discussion, Figs. 5-7 and the specimen's state."""
-    its = crit.get("iterations", [])
     b: list[Block] = [("h2", "The criterion (Fig. 3)")]
+    its = criterion.result.iterations or []
     if its:
         b.append((
             "table",
@@ -188,28 +225,20 @@ def _criterion_blocks(out: Path, crit: dict, pc: dict) -> list[Block]:
             ],
         ))  # fmt: skip
         b.extend(_criterion_discussion(its, pc))
-    cd = out / "criterion"
-    for name, cap in (
-        ("fig5_forces_initial_trial.png",
-         "Fig. 5: contact forces at the initial trial porosity, top plate at H"),
-        ("fig6_forces_after_plate.png", "Fig. 6: contact forces after the top plate moved"),
-        ("fig7_forces_accepted.png", "Fig. 7: contact forces at the accepted porosity"),
-    ):  # fmt: skip
-        if (cd / name).is_file():
-            b.append(("img", cd / name, cap))
-    return b + _state_blocks(cd) + _porosity_blocks(cd)
+    for name, cap in CRITERION_CAPTIONS.items():
+        if name in criterion.figures:
+            b.append(("img", criterion.figures[name], cap))
+    return b + _state_blocks(criterion) + _porosity_blocks(criterion)
 
 
-def _provenance_blocks(summary: dict, crit: dict) -> list[Block]:
+def _provenance_blocks(summary, crit) -> list[Block]:
     """Version, machine, seed, timings and the settings of the run."""
-    prov = summary.get("provenance", {})
-    spec = crit.get("specimen", {})
     return [
         ("h2", "Provenance"),
-        ("table", ["item", "value"], [[k, str(v)] for k, v in prov.items()]
-         + [["seed", summary.get("seed")]]
-         + [[f"time: {k}", v] for k, v in summary.get("timings", {}).items()]),
-        ("code", json.dumps({"specimen": spec, "criterion": crit.get("settings", {})}, indent=1)),
+        ("table", ["item", "value"], [[k, str(v)] for k, v in (summary.provenance or {}).items()]
+         + [["seed", summary.seed]]
+         + [[f"time: {k}", v] for k, v in (summary.timings or {}).items()]),
+        ("code", json.dumps({"specimen": crit.specimen or {}, "criterion": crit.settings or {}}, indent=1)),
     ]  # fmt: skip
 
 
@@ -220,63 +249,66 @@ def _criterion_discussion(its: list[dict], pc: dict) -> list[Block]:
     ratio = first["f_top_n_per_m"] / (1e3 * pc["f_top_first_trial_kn_per_m"])
     notes.append(
         f"At the first trial the top plate carries {first['f_top_n_per_m']:.4g} N/m, "
-        f"{ratio:.2g} times the paper's 3854 kN/m; both are far above the self weight, so the "
+        f"{ratio:.2g} times the paper's {pc['f_top_first_trial_kn_per_m']:g} kN/m; both are far above the "
+        "self weight, so the "
         "branch taken is the same (the plate moves up)."
     )
     if first.get("plate_moved") == "up":
         notes.append(
             f"After the plate moved, n' = {first['new_porosity']:.4f} "
             f"(change {first['porosity_change']:.4f}; "
-            f"paper: 0.148, change 0.008). The reconstructed grading is narrow (Cu about 1.7): disks of "
-            "similar size leave larger voids than a well-graded sand, so the specimen relaxes to a looser "
-            "state than the paper's. The accepted porosity follows from the grading; with the real Fig. 4 "
-            "curve the result may differ."
+            f"paper: {pc['trials'][0] + pc['porosity_change_first_trial']:.3f}, change "
+            f"{pc['porosity_change_first_trial']:g}). The reconstructed grading is narrow (Cu about 1.7): "
+            "disks of similar size leave larger voids than a well-graded sand, so the specimen relaxes to a "
+            "looser state than the paper's. The accepted porosity follows from the grading; with the real "
+            "Fig. 4 curve the result may differ."
         )
     notes.append(
-        "The paper's F_bottom (809 N/m) is close to G (836 N/m). poro2d reports F_bottom and the vertical "
+        f"The paper's F_bottom ({pc['f_bottom_accepted_n_per_m']:g} N/m) is close to G "
+        f"({pc['self_weight_accepted_n_per_m']:g} N/m). poro2d reports F_bottom and the vertical "
         "friction of the side walls separately: their sum balances the weight plus F_top."
     )
     out.append(("ul", notes))
     return out
 
 
-def _state_blocks(cd: Path) -> list[Block]:
+def _state_blocks(criterion) -> list[Block]:
     """Homogeneity and stress state of the accepted specimen, when the criterion wrote them."""
-    st = _load(cd / "specimen_state.json")
-    if not st:
+    st = criterion.state
+    if st is None:
         return []
-    k0 = st.get("k0_mean")
-    ratio = st.get("sigma_v_bottom_over_geostatic")
+    k0 = st.k0_mean
+    ratio = st.sigma_v_bottom_over_geostatic
     b: list[Block] = [("h3", "The accepted specimen: homogeneity and stress state")]
     b.append((
         "p",
-        f"Porosity in {len(st['bands'])} horizontal bands: mean {st['porosity_mean']:.4f}, sd "
-        f"{st['porosity_sd']:.4f}, range {st['porosity_range']:.4f} (disks clipped at the band edges). "
+        f"Porosity in {len(st.bands)} horizontal bands: mean {st.porosity_mean:.4f}, sd "
+        f"{st.porosity_sd:.4f}, range {st.porosity_range:.4f} (disks clipped at the band edges). "
         + (f"K0 = sigma_h / sigma_v averages {k0:.2f} over the bands; " if k0 is not None else "")
         + (f"in the bottom band sigma_v is {ratio:.2f} x the geostatic stress "
            "(F_top / W plus the weight above; the side walls carry the rest by friction)." if ratio else ""),
     ))  # fmt: skip
-    if (cd / "specimen_state.png").is_file():
+    if "specimen_state.png" in criterion.figures:
         cap = "Porosity and stresses of the accepted specimen, by height"
-        b.append(("img", cd / "specimen_state.png", cap))
+        b.append(("img", criterion.figures["specimen_state.png"], cap))
     return b
 
 
-def _porosity_blocks(cd: Path) -> list[Block]:
+def _porosity_blocks(criterion) -> list[Block]:
     """Box against interior porosity of the accepted specimen, the plate's surface, the local map."""
-    m = _load(cd / "specimen_porosity.json")
-    if not m or m.get("interior_porosity") is None:
+    m = criterion.porosity
+    if m is None or m.interior_porosity is None:
         return []
     b: list[Block] = [("h3", "The accepted specimen: box porosity and the specimen's own porosity")]
-    regions = f"{m['interior_regions']} circles, {m['margin_d50']:g} d50 clear of walls and surface"
-    gap = f"{1e3 * m['surface_gap_mean_m']:.2f} mm = {m['surface_gap_mean_d50']:.2f} d50"
-    contact = f"{100 * m['plate_contact_fraction']:.1f} % ({m['plate_touching_disks']} disks)"
+    regions = f"{m.interior_regions} circles, {m.margin_d50:g} d50 clear of walls and surface"
+    gap = f"{1e3 * m.surface_gap_mean_m:.2f} mm = {m.surface_gap_mean_d50:.2f} d50"
+    contact = f"{100 * m.plate_contact_fraction:.1f} % ({m.plate_touching_disks} disks)"
     rows = [
-        ["box porosity n' (the paper's: W x plate height)", m["box_porosity"]],
+        ["box porosity n' (the paper's: W x plate height)", m.box_porosity],
         [f"interior porosity ({regions})",
-         f"{m['interior_porosity']:.4f} +- {m['interior_porosity_std']:.4f}"],
+         f"{m.interior_porosity:.4f} +- {m.interior_porosity_std:.4f}"],
         ["interior rectangle / Laguerre cells",
-         f"{m['interior_rect_porosity']:.4f} / {m['laguerre_interior_porosity']:.4f}"],
+         f"{m.interior_rect_porosity:.4f} / {m.laguerre_interior_porosity:.4f}"],
         ["mean gap under the plate", gap],
         ["plate width in contact", contact],
     ]  # fmt: skip
@@ -289,14 +321,18 @@ def _porosity_blocks(cd: Path) -> list[Block]:
             "specimen in another code, take the interior porosity (docs/porosity.md).",
         )
     )
-    if (cd / "local_porosity.png").is_file():
+    if "local_porosity.png" in criterion.figures:
         b.append(
-            ("img", cd / "local_porosity.png", "Local porosity of the accepted specimen (Laguerre cells)")
+            (
+                "img",
+                criterion.figures["local_porosity.png"],
+                "Local porosity of the accepted specimen (Laguerre cells)",
+            )
         )
     return b
 
 
-def _shear_blocks(out: Path, shear: dict) -> list[Block]:
+def _shear_blocks(shear: dict, figures: dict[str, Path]) -> list[Block]:
     """Fig. 8 over the replicate specimens: peaks mean +- sd, the pooled fit with its intervals."""
     b: list[Block] = [("h2", "Direct shear tests (Fig. 8)")]
     rep = shear.get("replicates") or {}
@@ -336,19 +372,14 @@ def _shear_blocks(out: Path, shear: dict) -> list[Block]:
         b.append(
             ("p", f"Mohr-Coulomb fit of the peaks: friction angle {shear['friction_angle_deg']:.3g} deg.")
         )
-    sd = out / "shear"
-    for name, cap in (
-        ("fig8a_shear_curves_replicates.png", "Fig. 8(a): shear stress against shear displacement, mean and "
-         "+- sd band over the specimens"),
-        ("fig8b_peak_strength_replicates.png", "Fig. 8(b): peak strength against normal stress over the "
-         "specimens, with the fitted lines"),
-        ("seed0/fig8a_shear_curves.png", "The first specimen's curves with the plate displacement"),
-    ):  # fmt: skip
-        if (sd / name).is_file():
-            b.append(("img", sd / name, cap))
+    for name, cap in SHEAR_FIGURES.items():
+        if name in figures:
+            b.append(("img", figures[name], cap))
     return b
 
 
-def write_paper_report(out: str | Path, summary: dict) -> list[Path]:
+def write_paper_report(out: str | Path, summary, criterion, **parts) -> list[Path]:
+    """report.md and report.html in ``out``; ``parts``: the keywords of :func:`build_blocks`."""
     out = Path(out)
-    return write_report(build_blocks(out, summary), out, "report", "poro2d: the paper's case study")
+    blocks = build_blocks(out, summary, criterion, **parts)
+    return write_report(blocks, out, "report", "poro2d: the paper's case study")

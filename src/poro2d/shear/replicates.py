@@ -20,6 +20,7 @@ import numpy as np
 from poro2d.errors import InputError, check_range
 from poro2d.io_utils import provenance, write_csv, write_json
 from poro2d.shear.fit import mohr_coulomb
+from poro2d.shear.results import ReplicateShearResult
 
 
 def mohr_coulomb_ci(sigma_kpa, tau_kpa, through_origin: bool = False, level: float = 0.95) -> dict:
@@ -134,36 +135,37 @@ class ReplicateShear:
         return [dict(j, key=(label, *j["key"]), series=label)
                 for label, s in self.series.items() for j in s.jobs]  # fmt: skip
 
-    def run(self) -> dict:
+    def run(self) -> ReplicateShearResult:
         from poro2d.shear.pool import execute_jobs
 
         t0 = time.perf_counter()
         return self.finish(execute_jobs(self.jobs(), self.processes, self.progress), t0)
 
-    def finish(self, results: dict, t0: float) -> dict:
+    def finish(self, results: dict, t0: float) -> ReplicateShearResult:
         """Each specimen's fit and files, then the summary, from the results keyed as by :meth:`jobs`."""
         per = {
             label: s.finish({k[1:]: v for k, v in results.items() if k[0] == label}, t0)
             for label, s in self.series.items()
         }
-        summary = summarize_replicate_peaks(per)
-        summary.update(wall_time_s=time.perf_counter() - t0, processes=self.processes,
-                       config=self.config, provenance=provenance())  # fmt: skip
+        timing = {"wall_time_s": time.perf_counter() - t0, "processes": self.processes}
+        summary = ReplicateShearResult.from_dict(
+            dict(summarize_replicate_peaks(per), **timing, config=self.config, provenance=provenance())
+        )
         write_csv(self.out / "replicates.csv", [{k: v for k, v in r.items() if k != "peaks_kpa"}
-                                                 for r in summary["per_normal_stress"]])  # fmt: skip
-        write_json(self.out / "replicates.json", summary)
+                                                 for r in summary.per_normal_stress])  # fmt: skip
+        write_json(self.out / "replicates.json", summary.to_dict())
         if self.figures:
             self._figures(summary)
-        summary["series"] = per
+        summary.series = per
         return summary
 
-    def _figures(self, summary: dict) -> None:
+    def _figures(self, summary: ReplicateShearResult) -> None:
         """fig8a/fig8b over specimens: mean curves with +- sd bands, peaks with the pooled fit."""
         from poro2d.report.shear_figures import curve_band, plot_replicate_curves, plot_replicate_peaks
         from poro2d.shear.outputs import folder_name, lab_fit, read_curve_csv
 
         bands = {}
-        for row in summary["per_normal_stress"]:
+        for row in summary.per_normal_stress:
             sigma = row["normal_stress_kpa"]
             curves = []
             for s in self.series.values():

@@ -1,11 +1,12 @@
-"""Typed results of direct shear: one test's ``result.json`` and a series' ``result.json``."""
+"""Typed results of direct shear: one test's ``result.json``, a series' ``result.json`` and the
+replicate specimens' ``replicates.json``."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
-from poro2d.typed_result import TypedResult
+from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
 @dataclass(eq=False)
@@ -89,4 +90,30 @@ class ShearSeriesResult(TypedResult):
     provenance: dict[str, Any] | None = None
 
 
-__all__ = ["ShearSeriesResult", "ShearTestResult"]
+@dataclass(eq=False)
+class ReplicateShearResult(TypedResult):
+    """The same tests on several specimens (``replicates.json``): peaks over specimens, pooled fits.
+
+    ``per_normal_stress``: per stress the peaks' mean, sd, count and values; ``fit`` (None
+    with one stress) and ``fit_through_origin``: the Mohr-Coulomb line through every
+    specimen's peaks with Student-t intervals; ``friction_angle_per_specimen_deg`` and its
+    mean and sd. ``series`` (not in the file): each specimen's :class:`ShearSeriesResult`
+    by label, as the run computed or read them.
+    """
+
+    specimens: list[str]
+    per_normal_stress: list[dict[str, Any]]
+    fit: dict[str, Any] | None
+    fit_through_origin: dict[str, Any]
+    friction_angle_per_specimen_deg: list[float]
+    friction_angle_mean_deg: float | None
+    friction_angle_sd_deg: float | None
+    method: str
+    wall_time_s: float | None = None
+    processes: int | None = None
+    config: dict[str, Any] | None = None
+    provenance: dict[str, Any] | None = None
+    series: dict[str, ShearSeriesResult] = field(default_factory=dict, kw_only=True, metadata=NOT_IN_FILE)
+
+
+__all__ = ["ReplicateShearResult", "ShearSeriesResult", "ShearTestResult"]

@@ -16,6 +16,7 @@ from poro2d.errors import InputError, is_number
 from poro2d.io_utils import check_output_dir
 from poro2d.locks import holds_output
 from poro2d.shear.lab import LabData, read_lab_csv
+from poro2d.shear.results import ShearSeriesResult
 from poro2d.shear.series import ShearSeries, check_stresses
 from poro2d.shear.settings import ShearSettings
 from poro2d.shear.specimen_file import resolve_specimen
@@ -62,7 +63,7 @@ def run_shear(
     processes: int | None = None,
     progress: bool = True,
     config: dict | None = None,
-) -> dict:
+) -> ShearSeriesResult:
     """Direct shear tests on ``specimen`` at ``normal_stresses_kpa``, the fit and Fig. 8.
 
     ``specimen``: a checkpoint (.npz) or a criterion output folder holding ``specimen.npz``.
@@ -74,7 +75,7 @@ def run_shear(
     most twice the CPU count). ``progress``: bars on a terminal, periodic lines in a log.
     ``config``: recorded in ``result.json`` as it is.
 
-    Returns what is written to ``out/result.json`` (per test ``tests``, the fit
+    Returns the :class:`ShearSeriesResult` written to ``out/result.json`` (per test ``tests``, the fit
     ``friction_angle_deg``, ``cohesion_kpa``, ``r2``, ...; see docs/shear.md). Tests run in
     spawned processes, which import the calling script: call this under
     ``if __name__ == "__main__":`` in a script. A test that fails to run (consolidation

@@ -32,6 +32,7 @@ from poro2d.io_utils import provenance, write_csv, write_json
 from poro2d.shear.fit import mohr_coulomb
 from poro2d.shear.outputs import folder_name, read_curve_csv
 from poro2d.shear.replicates import ReplicateShear, mohr_coulomb_ci
+from poro2d.shear.results import ReplicateShearResult
 from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
 
 #: the part of each test's shear displacement, at its end, that the residual strength averages
@@ -96,12 +97,13 @@ def _mean_sd(values: list[float]) -> tuple[float, float | None]:
     return float(v.mean()), (float(v.std(ddof=1)) if v.size > 1 else None)
 
 
-def case_summary(rep: ReplicateShear, summary: dict, mu_r: float, friction: float, window_m: float) -> tuple:
+def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float, friction: float,
+                 window_m: float) -> tuple:  # fmt: skip
     """One case's row (means and spreads over the specimens) and its per-test rows."""
     tests = []
     per_specimen = []
     for label, series in rep.series.items():
-        res = summary["series"][label]
+        res = summary.series[label]
         res_pts = []
         psis = []
         for t in res["tests"]:
@@ -130,7 +132,7 @@ def case_summary(rep: ReplicateShear, summary: dict, mu_r: float, friction: floa
         name = "max_dilation_angle" if key == "dilation" else f"{key}_friction_angle"
         values = [p[key] for p in per_specimen if p[key] is not None]
         row[f"{name}_mean_deg"], row[f"{name}_sd_deg"] = _mean_sd(values) if values else (None, None)
-    pooled = summary["fit"] or {}
+    pooled = summary.fit or {}
     row["peak_friction_angle_pooled_deg"] = pooled.get("friction_angle_deg")
     row["peak_friction_angle_pooled_ci_deg"] = pooled.get("friction_angle_ci_deg")
     row["cohesion_pooled_kpa"] = pooled.get("cohesion_kpa")

@@ -85,8 +85,8 @@ def relation_cmd(
         announce=banner,
     )  # fmt: skip
     print_relation(rel, out)
-    if rel["failed_cases"]:
-        console.print(f"[bold red]{rel['failed_cases']} case(s) failed[/]; tracebacks in {out}/**/error.txt")
+    if rel.failed_cases:
+        console.print(f"[bold red]{rel.failed_cases} case(s) failed[/]; tracebacks in {out}/**/error.txt")
         raise typer.Exit(1)
 
 

@@ -20,8 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from poro2d import __version__
-from poro2d.config import check_number_list
-from poro2d.criterion.density import DEFAULT_MUS, MU_PREP_MAX, Calibration, StateTarget
+from poro2d.criterion.density import DEFAULT_MUS, Calibration, StateTarget, check_mus
 from poro2d.errors import check_int
 from poro2d.identity import outside_fields, run_digest
 from poro2d.io_utils import provenance, write_json
@@ -71,12 +70,6 @@ def cache_dir() -> Path:
         return Path(env)
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
     return Path(base) / "poro2d"
-
-
-def check_mus(mus: Any, parameter: str = "density.mu_prep") -> list[float]:
-    """Two to 20 preparation frictions in [0, MU_PREP_MAX], strictly increasing (densest first)."""
-    return check_number_list(parameter, mus, 0.0, MU_PREP_MAX, min_items=2, max_items=20, increasing=True,
-                             what="preparation frictions")  # fmt: skip
 
 
 def check_seeds(seeds: Any, parameter: str = "density.seeds") -> int:
@@ -243,60 +236,6 @@ def calibration_twins(calibration, states, base_dir: Path | None, folder: Path) 
     return twins
 
 
-def run_density_state(
-    base: dict,
-    base_dir: Path | None,
-    n_lab: float,
-    n_max: float,
-    n_min: float,
-    out: Path,
-    *,
-    seeds: int = DEFAULT_SEEDS,
-    mus=None,
-    use_cache: bool = True,
-    **sweep_kw,
-) -> dict:
-    """The density-controlled criterion for one laboratory state, over seeds.
-
-    Calibrates (or reads the cached calibration), maps ``n_lab`` to its 2D target and
-    preparation friction, runs the criterion with them for every seed and writes
-    ``out/density.json``: the accepted n2D (mean, sd, per seed), the target, mu_prep and Dr.
-    """
-    from poro2d.criterion.density import lab_relative_density
-    from poro2d.sweep.relation import density_relation
-
-    lab_relative_density(n_lab, n_max, n_min)  # nLab outside [n_min, n_max]: refused before any run
-    settings = {"n_max": n_max, "n_min": n_min, "n_lab": [round(float(n_lab), 4)]}
-    rel, record = density_relation(base, base_dir, settings, out, seeds=seeds, mus=mus,
-                                   use_cache=use_cache, **sweep_kw)  # fmt: skip
-    (point,) = rel["points"]
-    result = {
-        "mode": "density",
-        "n_lab": point["n_lab"],
-        "relative_density": point["relative_density"],
-        "n2d_target": point["n2d_target"],
-        "mu_prep": point["mu_prep"],
-        "final_porosity_mean": point["n2d_dem"],
-        "final_porosity_sd": point["n2d_sd"],
-        "final_porosity_per_seed": point["n2d_seeds"],
-        "measured_porosity_mean": point["n2d_measured"],
-        "interior_porosity_mean": point.get("n2d_interior"),
-        "interior_porosity_sd": point.get("n2d_interior_sd"),
-        "interior_porosity_per_seed": point.get("n2d_interior_seeds"),
-        "seeds": point["seeds"],
-        "seeds_converged": point["seeds_converged"],
-        "converged": point["seeds_converged"] == point["seeds"],
-        "n2d_min": rel["n2d_min"],
-        "n2d_max": rel["n2d_max"],
-        "calibration": rel["calibration"],
-        "sweeps": record,
-        "config": base,
-        "provenance": provenance(),
-    }
-    write_json(out / "density.json", result)
-    return result
-
-
 __all__ = [
     "DEFAULT_SEEDS",
     "cache_dir",
@@ -307,6 +246,5 @@ __all__ = [
     "calibration_twins",
     "check_mus",
     "check_seeds",
-    "run_density_state",
     "state_sweep",
 ]

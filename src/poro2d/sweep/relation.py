@@ -24,9 +24,10 @@ import numpy as np
 from poro2d import porosity as P
 from poro2d.config import check_keys, check_number_list
 from poro2d.errors import InputError, check_range
-from poro2d.io_utils import float_or_nan
+from poro2d.io_utils import float_or_nan, provenance
 from poro2d.locks import holds_output
 from poro2d.paper_data import QUICK_SPECIMEN as PAPER_QUICK_SPECIMEN
+from poro2d.sweep.results import RelationResult
 
 RELATION_KEYS = {"n_max", "n_min", "points", "n_lab", "mode", "seeds", "mu_prep"}
 #: how the specimen's density follows the laboratory state (see :mod:`poro2d.criterion.density`)
@@ -370,14 +371,19 @@ def _dem_points(ax, rel: dict) -> None:
 
 
 def write_relation(rel: dict, out: Path, title: str = "", extra: dict | None = None) -> list[Path]:
-    """relation.csv, relation.json, relation.png and relation.svg in ``out``."""
-    from poro2d.io_utils import atomic_path, provenance, write_csv, write_json
+    """relation.csv, relation.json, relation.png and relation.svg in ``out``.
+
+    ``rel``: an analysed relation (with ``extra`` keys for the file) or a :class:`RelationResult`.
+    """
+    from poro2d.io_utils import atomic_path, write_csv, write_json
 
     out.mkdir(parents=True, exist_ok=True)
     flat = [{k: " ".join(f"{x:.4f}" for x in v) if isinstance(v, list) else v for k, v in p.items()}
             for p in rel["points"]]  # fmt: skip
     write_csv(out / "relation.csv", flat)
-    write_json(out / "relation.json", dict(rel, **(extra or {}), provenance=provenance()))
+    record = dict(rel, **(extra or {}))
+    record.setdefault("provenance", provenance())  # a RelationResult carries its own
+    write_json(out / "relation.json", record)
     fig = plot_relation(rel, title)
     paths = []
     for ext in ("png", "svg"):
@@ -468,23 +474,24 @@ def run_relation(
     progress: bool = True,
     dashboard: str | None = None,
     announce=None,
-) -> dict:
+) -> RelationResult:
     """``poro2d relation`` as one call: the grading's n2D(nLab) relation, written to ``out``.
 
     ``config``: a criterion config (a dict, a TOML file, or the paper preset when None) with
     an optional ``[relation]`` table, which the keyword options override. Density mode (the
     default) calibrates the grading, maps every laboratory state by its relative density and
     checks it over ``seeds``; paper mode runs the criterion once per state at the fixed
-    preparation friction. Returns the relation as written to ``out/relation.json``, with
-    ``failed_cases`` (cases that raised; their tracebacks are in ``out``). Every input is
+    preparation friction. Returns the :class:`RelationResult` written to ``out/relation.json``;
+    its ``failed_cases`` counts the cases that raised (their tracebacks are in ``out``). Every input is
     checked before the first case runs; ``announce`` (no arguments) is called then, before
     any work (the command prints its banner there, so a refusal stays one line). ``dashboard``: where a
     LocalCluster serves its dashboard (default 127.0.0.1:0, this machine; ``"none"``: none).
     """
+    from poro2d.criterion.density import check_mus
     from poro2d.criterion.run import load
     from poro2d.io_utils import check_output_dir
     from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.density import check_mus, check_seeds
+    from poro2d.sweep.density import check_seeds
     from poro2d.sweep.runner import check_cluster_options, check_dashboard, check_reachable, run_sweep
 
     out = Path(out)
@@ -514,12 +521,13 @@ def run_relation(
     if mode == "density":
         rel, record = density_relation(base, base_dir, settings, out, quick=quick, seeds=n_seeds, mus=mus,
                                        **sweep_kw)  # fmt: skip
-        failed, extra = record["failed_cases"], {"quick": quick, "config": base, "sweeps": record}
+        extra = {"quick": quick, "config": base, "sweeps": record}
     else:
         res = run_sweep(
             parse_sweep(sweep_config(base, settings["n_lab"], quick=quick), base_dir), out, **sweep_kw
         )
         rel = analyse(res.rows, settings["n_max"], settings["n_min"])
-        failed, extra = len(res.failed), {"quick": quick, "sweep_summary": res.summary, "config": base}
-    write_relation(rel, out, title=title, extra=extra)
-    return dict(rel, failed_cases=failed)
+        extra = {"quick": quick, "sweep_summary": res.summary, "config": base}
+    result = RelationResult.from_dict(dict(rel, **extra, provenance=provenance()))
+    write_relation(result, out, title=title)
+    return result

@@ -32,6 +32,7 @@ import numpy as np
 from poro2d.config import check_keys, check_number_list
 from poro2d.errors import InputError
 from poro2d.locks import holds_output
+from poro2d.sweep.results import SensitivityResult
 
 #: grading widths of the full study (Cu = d60 / d10), and of ``--quick``: at the paper
 #: grading's mean disk area Cu = 4 has disks of about 26 mm, taller than the 20 mm layer
@@ -415,8 +416,8 @@ def run_sensitivity(
     use_cache: bool = True,
     announce=None,
     **sweep_kw,
-) -> dict:
-    """The whole study into ``out``; returns the result dict (also ``out/sensitivity.json``).
+) -> SensitivityResult:
+    """The whole study into ``out``; returns the :class:`SensitivityResult` of ``out/sensitivity.json``.
 
     ``base``: a criterion config, optionally with a ``[sensitivity]`` table (``cu``,
     ``mu_prep``, ``seeds``). Everything is checked before the first case runs; ``announce``
@@ -484,8 +485,8 @@ def _first_from(crit) -> str:
     return "given" if crit.trial_porosity is not None else "Eq. 12"
 
 
-def write_sensitivity(sens: dict, out: Path) -> dict:
-    """sensitivity.json, sensitivity.csv (points), sensitivity_seeds.csv and the figure."""
+def write_sensitivity(sens: dict, out: Path) -> SensitivityResult:
+    """sensitivity.json, sensitivity.csv (points), sensitivity_seeds.csv and the figure; the study typed."""
     from poro2d.io_utils import provenance, write_csv, write_json
     from poro2d.report.sensitivity_report import plot_sensitivity
 
@@ -495,8 +496,9 @@ def write_sensitivity(sens: dict, out: Path) -> dict:
     write_csv(out / "sensitivity_seeds.csv", sens["seeds"])
     points = sens["points"]["grading"] + sens["points"]["mu_prep"]
     write_csv(out / "sensitivity.csv", [_csv_row(p, sens) for p in points])
-    write_json(out / "sensitivity.json", sens)
-    return sens
+    result = SensitivityResult.from_dict(sens)
+    write_json(out / "sensitivity.json", result.to_dict())
+    return result
 
 
 def _csv_row(p: dict, sens: dict) -> dict:
@@ -508,15 +510,15 @@ def _csv_row(p: dict, sens: dict) -> dict:
     return row
 
 
-def load_sensitivity(folder: Path) -> dict:
+def load_sensitivity(folder: Path) -> SensitivityResult:
     """A finished study read back, its figure path pointing into ``folder``."""
     import json
 
     p = Path(folder) / "sensitivity.json"
     if not p.is_file():
         raise InputError("sensitivity", str(folder), "a folder holding sensitivity.json")
-    sens = json.loads(p.read_text())
-    sens["figure"] = str(Path(folder) / "sensitivity.png")
+    sens = SensitivityResult.from_dict(json.loads(p.read_text()))
+    sens.figure = str(Path(folder) / "sensitivity.png")
     return sens
 
 

@@ -57,7 +57,7 @@ def register(app: typer.Typer) -> None:
                                workers=workers, progress=not quiet, dashboard=dashboard_address,
                                announce=banner)  # fmt: skip
         print_sensitivity(sens, out)
-        failed = sens["sweeps"]["failed_cases"]
+        failed = sens.sweeps["failed_cases"]
         if failed:
             console.print(
                 f"[bold red]{failed} case(s) failed[/]; tracebacks in {out}/grading/cases/*/error.txt"

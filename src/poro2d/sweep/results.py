@@ -1,0 +1,113 @@
+"""Typed results of the sweeps: ``density.json``, ``relation.json`` and ``sensitivity.json``.
+
+Each class lists its file's keys as fields, in the file's order (see
+:mod:`poro2d.typed_result`); the runs build the dict they wrote before and return it as
+``Class.from_dict(...)``, so the files stay what they were and a key a mode does not write
+stays out of the file.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from poro2d.typed_result import TypedResult
+
+
+@dataclass(eq=False)
+class DensityStateResult(TypedResult):
+    """The density-controlled criterion for one laboratory state (``density.json``).
+
+    The state (``n_lab``, ``relative_density``), its 2D target and preparation friction
+    from the calibration, and the accepted n2D over seeds (mean, sd, per seed; NaN mean
+    when no seed converged), the measured n' and the interior porosity beside it.
+    ``converged``: every seed accepted. ``sweeps``: where the calibration came from and
+    the state sweep's summary.
+    """
+
+    mode: str
+    n_lab: float
+    relative_density: float
+    n2d_target: float
+    mu_prep: float
+    final_porosity_mean: float
+    final_porosity_sd: float
+    final_porosity_per_seed: list[float]
+    measured_porosity_mean: float
+    interior_porosity_mean: float | None
+    interior_porosity_sd: float | None
+    interior_porosity_per_seed: list[float] | None
+    seeds: int
+    seeds_converged: int
+    converged: bool
+    n2d_min: float
+    n2d_max: float
+    calibration: dict[str, Any]
+    sweeps: dict[str, Any]
+    config: dict[str, Any]
+    provenance: dict[str, Any]
+
+
+@dataclass(eq=False)
+class RelationResult(TypedResult):
+    """The relation n2D(nLab) of one grading (``relation.json``).
+
+    ``points``: one dict per laboratory state, loose to dense; ``fit``: the Eq. 12-form
+    parabola through the converged points (None with fewer than two). Density mode adds
+    the calibration, the calibrated 2D extremes, the loose-dense ``spread`` and ``sweeps``
+    (calibration and state sweeps); paper mode the one sweep's ``sweep_summary``.
+    """
+
+    n_max: float
+    n_min: float
+    points: list[dict[str, Any]]
+    fit: dict[str, Any] | None
+    fit_note: str
+    eq12: dict[str, float]
+    converged_points: int
+    flagged_points: int
+    mode: str
+    calibration: dict[str, Any] | None = None
+    n2d_max: float | None = None
+    n2d_min: float | None = None
+    spread: dict[str, Any] | None = None
+    quick: bool | None = None
+    sweep_summary: dict[str, Any] | None = None
+    config: dict[str, Any] | None = None
+    sweeps: dict[str, Any] | None = None
+    provenance: dict[str, Any] | None = None
+
+    @property
+    def failed_cases(self) -> int:
+        """Cases that raised (their tracebacks are in the output folder), over every sweep."""
+        if self.sweeps is not None:
+            return int(self.sweeps["failed_cases"])
+        return int((self.sweep_summary or {}).get("failed", 0))
+
+
+@dataclass(eq=False)
+class SensitivityResult(TypedResult):
+    """The accepted n2D against grading width and preparation friction (``sensitivity.json``).
+
+    ``points``: ``grading`` (one per Cu, the reference first) and ``mu_prep`` (one per
+    friction, from the density calibration); ``seeds``: one record per grading and seed;
+    ``answer``: which width or friction reproduces the paper's 0.15, in lines of text;
+    ``figure``: the figure's path (a study read back points it into its folder).
+    """
+
+    title: str
+    settings: dict[str, Any]
+    gradings: list[dict[str, Any]]
+    seeds: list[dict[str, Any]]
+    points: dict[str, list[dict[str, Any]]]
+    calibration: dict[str, Any]
+    paper: dict[str, Any]
+    config: dict[str, Any]
+    sweeps: dict[str, Any]
+    timings: dict[str, float]
+    answer: dict[str, Any]
+    figure: str | None = None
+    provenance: dict[str, Any] | None = None
+
+
+__all__ = ["DensityStateResult", "RelationResult", "SensitivityResult"]
