@@ -136,5 +136,5 @@ def test_protocol_still_gives_the_old_names():
     assert protocol.ShearSeries is series.ShearSeries and protocol.ShearSettings is settings.ShearSettings
     assert protocol.DirectShearTest is single.DirectShearTest and protocol.execute_jobs is pool.execute_jobs
     assert protocol.folder_name(100.0) == outputs.folder_name(100.0) == "sn100kPa"
-    assert protocol._read_csv is outputs.read_curve_csv and protocol._Bars is pool._Bars
+    assert protocol._read_csv is outputs.read_curve_csv
     assert protocol.run_shear is run_shear
