@@ -14,14 +14,13 @@ on a cluster. The direct shear tests of a series and the replicate criterion run
 Each worker is a fresh interpreter (the spawn start method) so that numba starts there
 with the thread count the job sets, not the parent's. The workers ignore Ctrl-C, as
 Dask's do (:mod:`poro2d.worker_signals`): the command takes it, cancels the jobs not
-started and ends the workers it started, by their process ids. A job's result depends
+started and ends the worker processes this pool started. A job's result depends
 on the job alone, so results are the same, and in the same (job) order, whatever the
 process count.
 """
 
 from __future__ import annotations
 
-import os
 import signal
 import time
 from collections.abc import Callable, Sequence
@@ -34,8 +33,6 @@ from poro2d.worker_signals import hold_interrupts, release_interrupts
 REPORT_INTERVAL_S = 0.5
 #: seconds the parent waits for a job to finish before it reads the workers' messages again
 POLL_S = 0.25
-#: most seconds an interrupted pool waits for a starting worker to say its process id
-END_PATIENCE_S = 10.0
 
 #: in a worker process: the queue its messages go to (set when the worker starts)
 _queue = None
@@ -113,7 +110,7 @@ def _run_in_pool(
 
     ctx = mp.get_context("spawn")  # a fresh interpreter: numba takes the thread count the job sets
     queue = ctx.Queue()
-    workers: set[int] = set()  # process ids, as each worker announces itself
+    before = {child.pid for child in ctx.active_children()}  # processes started before this pool
     pool = ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_start_worker, initargs=(queue,))
     # the workers start as the jobs are submitted; with SIGINT blocked meanwhile they start with it
     # blocked (a Ctrl-C then reaches the command alone, which ends them)
@@ -124,7 +121,7 @@ def _run_in_pool(
         pending = set(futures)
         while pending:
             finished, pending = wait(pending, timeout=POLL_S, return_when=FIRST_COMPLETED)
-            _drain(queue, on_report, workers)
+            _drain(queue, on_report)
             for future in sorted(finished, key=futures.get):
                 i = futures[future]
                 try:
@@ -137,19 +134,18 @@ def _run_in_pool(
     except BaseException:  # Ctrl-C (or a failing display): no job is started any more
         release_interrupts(held)
         pool.shutdown(wait=False, cancel_futures=True)
-        _end_workers(queue, workers, n)
+        _end_workers(before)
         raise
     finally:
         pool.shutdown(wait=True)
-    _drain(queue, on_report, workers)
+    _drain(queue, on_report)
 
 
 def _start_worker(queue) -> None:
-    """In a new worker: Ctrl-C is the command's to handle; say which process this is."""
+    """In a new worker: Ctrl-C is the command's to handle; messages go to ``queue``."""
     global _queue
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _queue = queue
-    queue.put((None, os.getpid()))
 
 
 def _run_reporting(task, job, index: int):
@@ -173,8 +169,8 @@ class _Throttle:
         self._send(phase, *rest)
 
 
-def _drain(queue, on_report, workers: set[int]) -> None:
-    """Hand every message waiting in ``queue`` on (a worker's process id goes to ``workers``)."""
+def _drain(queue, on_report) -> None:
+    """Hand every message waiting in ``queue`` on to ``on_report``."""
     import queue as queue_module
 
     while True:
@@ -182,31 +178,20 @@ def _drain(queue, on_report, workers: set[int]) -> None:
             index, *msg = queue.get_nowait()
         except (queue_module.Empty, EOFError, OSError):
             return
-        if index is None:
-            workers.add(msg[0])
-        elif on_report is not None:
+        if on_report is not None:
             on_report(index, *msg)
 
 
-def _end_workers(queue, workers: set[int], started: int) -> None:
-    """Stop the ``started`` worker processes of this pool (they ignore Ctrl-C), by their ids.
+def _end_workers(before: set[int]) -> None:
+    """Stop the worker processes of this pool (they ignore Ctrl-C): the children not in ``before``.
 
-    A worker still starting has not said its id yet: it is waited for, up to
-    :data:`END_PATIENCE_S`. A job stopped here resumes from its files when the command is rerun.
+    A job stopped here resumes from its files when the command is rerun.
     """
-    ended: set[int] = set()
-    deadline = time.monotonic() + END_PATIENCE_S
-    while True:
-        _drain(queue, None, workers)
-        for pid in workers - ended:
-            try:
-                os.kill(pid, signal.SIGTERM)
-            except ProcessLookupError:  # already gone
-                pass
-            ended.add(pid)
-        if len(ended) >= started or time.monotonic() > deadline:
-            return
-        time.sleep(0.05)
+    import multiprocessing as mp
+
+    for child in mp.active_children():
+        if child.pid not in before:
+            child.terminate()
 
 
 def _ignore(*_msg) -> None:
