@@ -1,4 +1,4 @@
-"""Jobs on this machine, one fresh process each at a time: the pool of the shear tests and replicates.
+"""Jobs in worker processes on this machine: the direct shear tests and the replicate criterion runs.
 
 The sweeps, relations and calibrations run on Dask (:mod:`poro2d.sweep.runner`), locally or
 on a cluster. The direct shear tests of a series and the replicate criterion runs of
@@ -7,8 +7,9 @@ on a cluster. The direct shear tests of a series and the replicate criterion run
 - their workers report each test's phase and fraction a few times a second, and the
   command draws one bar per job from them: one queue to this process, where on Dask every
   message would go through the scheduler's publish/subscribe;
-- they are steps of a command that runs on one machine with a ``--processes`` count and
-  no cluster options, and calibrations call them between their own Dask rounds;
+- they are steps of commands that run on one machine (``poro2d paper``, ``shear``,
+  ``strength``: a ``--processes`` count, no cluster options); a calibration makes its
+  preset specimens with them before its Dask cluster starts;
 - with one process (``processes=1``) they run right here, with no worker at all.
 
 Each worker is a fresh interpreter (the spawn start method) so that numba starts there
