@@ -159,23 +159,22 @@ def test_run_progress_in_a_log_writes_periodic_lines(capsys, monkeypatch):
 
 
 def test_shear_bars_in_a_log(capsys):
-    from poro2d.shear.pool import _Bars
-
-    labels = {("test", 50.0): "50 kPa", ("test", 100.0): "100 kPa"}
-    bars = _Bars(labels)
-    bars.update(("test", 50.0), "shearing", 0.42)
-    bars.update(("test", 100.0), "consolidating", 0.0)
+    bars = progress.JobsProgress("direct shear", ["50 kPa", "100 kPa"])
+    bars.start()
+    bars.update(0, "shearing", 0.42)
+    bars.update(1, "consolidating")
     assert capsys.readouterr().err == ""  # less than an interval since the start
     bars.stop()
     (line,) = capsys.readouterr().err.splitlines()
-    assert re.match(r"^direct shear: 50 kPa shearing 42 %; 100 kPa consolidating; elapsed [\d:]+$", line)
+    assert re.match(r"^direct shear: 50 kPa shearing 42 %, 100 kPa consolidating, elapsed [\d:]+$", line)
 
-    bars = _Bars(labels)
+    bars = progress.JobsProgress("direct shear", ["50 kPa", "100 kPa"])
+    bars.start()
     bars._lines.interval = 0.0  # a line at every update
-    bars.update(("test", 50.0), "done", 1.0)
+    bars.done(0)
     bars.stop()  # nothing new to report: no second line
     (line,) = capsys.readouterr().err.splitlines()
-    assert line.startswith("direct shear: 50 kPa done; 100 kPa waiting; elapsed ") and "\x1b" not in line
+    assert line.startswith("direct shear: 50 kPa done, 100 kPa waiting, elapsed ") and "\x1b" not in line
 
 
 def test_count_progress_in_a_log(capsys, monkeypatch):

@@ -18,10 +18,15 @@ class InputError(ValueError):
         self.parameter = parameter
         self.value = value
         self.allowed = allowed
+        self.hint = hint
         msg = f"{parameter} = {value!r} is invalid; allowed: {allowed}"
         if hint:
             msg += f" ({hint})"
         super().__init__(msg)
+
+    def __reduce__(self):
+        # rebuilt from its fields, so that one raised in a worker process reaches the command whole
+        return type(self), (self.parameter, self.value, self.allowed, self.hint)
 
 
 def check_range(

@@ -1,16 +1,18 @@
-"""Ctrl-C in the worker processes of a local Dask cluster: left to the command that started them.
+"""Ctrl-C in worker processes (a local Dask cluster's, the process pool's): left to the command.
 
 A Ctrl-C at a terminal reaches every process of its group: the command and each worker
 process of its local cluster. A worker that takes it as an interruption dies with a
 traceback of its own (dozens of lines, for a worker still starting, before the command's
 one-line message). The command alone handles it: it closes its cluster, which stops the
-workers. The worker processes ignore SIGINT from the moment they import poro2d.
+workers. Dask's worker processes ignore SIGINT from the moment they import poro2d, those of
+:mod:`poro2d.process_pool` from their start.
 """
 
 from __future__ import annotations
 
 import multiprocessing
 import signal
+import threading
 
 #: how distributed names the process a nanny starts for its worker
 DASK_WORKER_PROCESS = "Dask Worker process"
@@ -22,3 +24,23 @@ def ignore_interrupts_in_dask_worker() -> bool:
         return False
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     return True
+
+
+def hold_interrupts() -> set | None:
+    """Block SIGINT in this thread while a local cluster or a process pool starts; returns what to restore.
+
+    A Ctrl-C in the middle of the cluster's start-up left it half built, to be closed at
+    exit with a traceback. Blocked here, the signal waits until :func:`release_interrupts`,
+    when the cluster is whole and the command can close it. (Dask's worker processes start
+    with no signal blocked and ignore SIGINT themselves; a process pool's start from this
+    thread, with it blocked.)
+    """
+    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "pthread_sigmask"):
+        return None
+    return signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+
+
+def release_interrupts(previous: set | None) -> None:
+    """Undo :func:`hold_interrupts`; a Ctrl-C that came meanwhile is raised now."""
+    if previous is not None and signal.SIGINT not in previous:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})

@@ -4,9 +4,10 @@ A strength from one specimen is one sample of a chaotic packing, so the case stu
 several specimens of the same accepted porosity. Each replicate is a criterion run of its
 own seed, first trial the porosity the main seed accepted, in ``out/seed<N>``; it must
 pass the criterion itself (a seed may settle on a neighbouring trial porosity: that is
-part of the spread). The runs go to spawned processes with one numba thread each: two
-threads on one specimen of a few thousand disks run only about 1.6 times as fast as one,
-two processes twice. Each run resumes from its own folder, so a rerun continues.
+part of the spread). The runs go to the workers of :mod:`poro2d.process_pool` with one
+numba thread each: two threads on one specimen of a few thousand disks run only about 1.6
+times as fast as one, two processes twice. Each run resumes from its own folder, so a
+rerun continues.
 """
 
 from __future__ import annotations
@@ -18,16 +19,18 @@ from pathlib import Path
 from poro2d.console import OutputConsole
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.criterion.result import ReplicatesResult
+from poro2d.process_pool import run_jobs
+from poro2d.progress import JobsProgress
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.grading import GradingCurve
 
 console = OutputConsole()
 
 
-def _run_one(
-    spec: SpecimenSpec, grading: GradingCurve, settings: CriterionSettings, seed: int, out: Path
-) -> dict:
+def _run_one(job: tuple, report) -> dict:
     """One replicate's criterion run (in a worker process); its summary row."""
+    spec, grading, settings, seed, out = job
+    report("running")
     t0 = time.perf_counter()
     res = PorosityCriterion(spec, grading, settings, seed=seed, out=out, progress=False).run()
     return {"seed": seed, "final_porosity": res["final_porosity"], "converged": bool(res["converged"]),
@@ -54,14 +57,14 @@ def run_replicates(
     """
     spec1 = replace(spec, threads=1)
     first = replace(settings, trial_porosity=n2d)
-    jobs = {sd: (spec1, grading, first, sd, Path(out) / f"seed{sd}") for sd in seeds}
-    display = _Display(seeds) if progress else None
-    try:
-        rows = _pool(jobs, processes, display) if processes > 1 and len(seeds) > 1 else _here(jobs, display)
-    finally:
-        if display is not None:
-            display.stop()
-    return ReplicatesResult([rows[sd] for sd in seeds], out=Path(out))
+    jobs = [(spec1, grading, first, sd, Path(out) / f"seed{sd}") for sd in seeds]
+    names = [f"seed {sd}" for sd in seeds]
+    with JobsProgress("replicate criterion", names, enabled=progress) as display:
+        rows = run_jobs(
+            _run_one, jobs, processes, names=names, what="replicate criterion run(s)",
+            on_report=display.update, on_done=lambda index, row: display.done(index, _outcome(row)),
+        )  # fmt: skip
+    return ReplicatesResult(rows, out=Path(out))
 
 
 def accepted_and_replicates(
@@ -90,65 +93,14 @@ def accepted_and_replicates(
     return {**specimens, **more.specimens}, more.rows
 
 
-class _Display:
-    """A spinner and the elapsed time per seed on a terminal; a line per finished seed in a log."""
-
-    def __init__(self, seeds: list[int]) -> None:
-        from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
-
-        from poro2d.progress import ProgressLines, live_console
-
-        console = live_console()
-        self._lines = ProgressLines() if console is None else None
-        self._left = len(seeds)
-        if self._lines is None:
-            self._p = Progress(SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn(),
-                               console=console)  # fmt: skip
-            self._tasks = {
-                sd: self._p.add_task(f"replicate seed {sd}: criterion running", total=1) for sd in seeds
-            }
-            self._p.start()
-
-    def done(self, row: dict) -> None:
-        self._left -= 1
-        what = (
-            f"accepted n2D = {row['final_porosity']:.4f}"
-            if row["converged"]
-            else f"not accepted: {row['message']}"
-        )
-        text = f"replicate seed {row['seed']}: {what} ({row['trials']} trial(s), {row['time_s']:.0f} s)"
-        if self._lines is not None:
-            self._lines.write(f"  {text}; {self._left} still running", force=True)
-        else:
-            self._p.update(self._tasks[row["seed"]], description=text, completed=1)
-
-    def stop(self) -> None:
-        if self._lines is None:
-            self._p.stop()
-
-
-def _here(jobs: dict, display: _Display | None) -> dict[int, dict]:
-    rows = {}
-    for sd, job in jobs.items():
-        rows[sd] = _run_one(*job)
-        if display is not None:
-            display.done(rows[sd])
-    return rows
-
-
-def _pool(jobs: dict, processes: int, display: _Display | None) -> dict[int, dict]:
-    import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor, as_completed
-
-    rows = {}
-    ctx = mp.get_context("spawn")  # a fresh interpreter: numba starts with one thread there
-    with ProcessPoolExecutor(max_workers=min(processes, len(jobs)), mp_context=ctx) as pool:
-        futs = {pool.submit(_run_one, *job): sd for sd, job in jobs.items()}
-        for f in as_completed(futs):
-            rows[futs[f]] = f.result()
-            if display is not None:
-                display.done(rows[futs[f]])
-    return rows
+def _outcome(row: dict) -> str:
+    """How a replicate ended, as its progress shows it."""
+    what = (
+        f"accepted n2D = {row['final_porosity']:.4f}"
+        if row["converged"]
+        else f"not accepted: {row['message']}"
+    )
+    return f"{what} ({row['trials']} trial(s) in {row['time_s']:.0f} s)"
 
 
 __all__ = ["accepted_and_replicates", "run_replicates"]

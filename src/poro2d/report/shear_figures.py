@@ -20,10 +20,12 @@ import numpy as np  # noqa: E402
 
 from poro2d.io_utils import atomic_path  # noqa: E402
 
-_COLORS = ["#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#666666"]
+#: the colours of the normal stresses (or series), in turn
+COLORS = ["#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#666666"]
 
 
-def _save(fig, path: str | os.PathLike) -> Path:
+def save_figure(fig, path: str | os.PathLike) -> Path:
+    """Write ``fig`` to ``path`` (the format its suffix names) atomically, and close it."""
     path = Path(path)
     fig.tight_layout()
     with atomic_path(path) as tmp:
@@ -51,7 +53,7 @@ def plot_shear_curves(
     ax = axes[0, 0]
     for k, sigma in enumerate(sorted(curves)):
         c = curves[sigma]
-        col = _COLORS[k % len(_COLORS)]
+        col = COLORS[k % len(COLORS)]
         ax.plot(c["shear_displacement_mm"], c["shear_stress_kpa"], color=col, lw=1.2,
                 label=f"DEM, {sigma:g} kPa")  # fmt: skip
         if peaks and sigma in peaks:
@@ -68,7 +70,7 @@ def plot_shear_curves(
                 if sigma in sig_sorted
                 else len(sig_sorted) + sorted(lab.curves).index(sigma)
             )
-            ax.plot(1e3 * d, t, ls="--", marker="o", mfc="none", ms=3, color=_COLORS[k % len(_COLORS)],
+            ax.plot(1e3 * d, t, ls="--", marker="o", mfc="none", ms=3, color=COLORS[k % len(COLORS)],
                     lw=1.0, label=f"lab, {sigma:g} kPa")  # fmt: skip
     ax.set_ylabel("shear stress (kPa)")
     ax.set_ylim(bottom=0)
@@ -82,7 +84,7 @@ def plot_shear_curves(
         axes[1, 0].axhline(0.0, color="k", lw=0.5)
     axes[-1, 0].set_xlabel("shear displacement (mm)")
     axes[-1, 0].set_xlim(left=0)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_peak_strength(
@@ -131,7 +133,7 @@ def _finish_peaks(fig, ax, xs, smax: float, lab, lab_fit, title: str, path) -> P
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper left")
     ax.set_title(title, fontsize=10)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def curve_band(curves: list[dict[str, np.ndarray]], points: int = 200) -> dict[str, np.ndarray]:
@@ -149,7 +151,7 @@ def plot_replicate_curves(
     """Fig. 8(a) over specimens: the mean curve per normal stress with a +- sd band."""
     fig, ax = plt.subplots(figsize=(7.5, 4.8))
     for k, sigma in enumerate(sorted(bands)):
-        b, col = bands[sigma], _COLORS[k % len(_COLORS)]
+        b, col = bands[sigma], COLORS[k % len(COLORS)]
         x = b["shear_displacement_mm"]
         ax.plot(x, b["mean_kpa"], color=col, lw=1.4, label=f"DEM, {sigma:g} kPa (mean)")
         ax.fill_between(
@@ -158,7 +160,7 @@ def plot_replicate_curves(
     if lab is not None and lab.curves:
         for k, sigma in enumerate(sorted(lab.curves)):
             d, t = lab.curves[sigma]
-            ax.plot(1e3 * d, t, ls="--", marker="o", mfc="none", ms=3, color=_COLORS[k % len(_COLORS)],
+            ax.plot(1e3 * d, t, ls="--", marker="o", mfc="none", ms=3, color=COLORS[k % len(COLORS)],
                     lw=1.0, label=f"lab, {sigma:g} kPa")  # fmt: skip
     ax.set_xlabel("shear displacement (mm)")
     ax.set_ylabel("shear stress (kPa)")
@@ -167,7 +169,7 @@ def plot_replicate_curves(
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, ncol=2)
     ax.set_title(f"Direct shear over {n_specimens} specimens: mean and +- sd band", fontsize=10)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_replicate_peaks(summary: dict, path: str | os.PathLike, lab=None, lab_fit=None) -> Path:
@@ -196,9 +198,11 @@ def plot_replicate_peaks(summary: dict, path: str | os.PathLike, lab=None, lab_f
 
 
 __all__ = [
+    "COLORS",
     "curve_band",
     "plot_peak_strength",
     "plot_replicate_curves",
     "plot_replicate_peaks",
     "plot_shear_curves",
+    "save_figure",
 ]

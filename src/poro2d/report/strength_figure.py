@@ -10,7 +10,12 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from poro2d.report.shear_figures import _COLORS, _save, plt
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from poro2d.report.shear_figures import COLORS, save_figure  # noqa: E402
 
 
 def _series(rows: list[dict], friction: float, key: str) -> tuple[list, list, list]:
@@ -29,7 +34,7 @@ def plot_strength(rows: list[dict], path: str | os.PathLike) -> Path:
     frictions = sorted({r["particle_friction"] for r in rows})
     fig, (ax_phi, ax_psi) = plt.subplots(1, 2, figsize=(10, 4.2))
     for k, fp in enumerate(frictions):
-        color = _COLORS[k % len(_COLORS)]
+        color = COLORS[k % len(COLORS)]
         x, y, e = _series(rows, fp, "peak_friction_angle")
         ax_phi.errorbar(x, y, yerr=e, color=color, marker="o", capsize=3, label=f"peak, f_p = {fp:g}")
         x, y, e = _series(rows, fp, "residual_friction_angle")
@@ -46,7 +51,7 @@ def plot_strength(rows: list[dict], path: str | os.PathLike) -> Path:
     for ax in (ax_phi, ax_psi):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 __all__ = ["plot_strength"]

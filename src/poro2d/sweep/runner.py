@@ -23,9 +23,7 @@ from __future__ import annotations
 import json
 import logging
 import os
-import signal
 import socket
-import threading
 import time
 import traceback
 from dataclasses import dataclass, field
@@ -37,7 +35,7 @@ from poro2d.io_utils import atomic_path, provenance, write_json
 from poro2d.locks import cache_entry, holds_output
 from poro2d.resumable import Fingerprint, ResumableStage
 from poro2d.sweep.cases import KINDS, Case, SweepConfig, config_tables
-from poro2d.worker_signals import ignore_interrupts_in_dask_worker
+from poro2d.worker_signals import hold_interrupts, ignore_interrupts_in_dask_worker, release_interrupts
 
 ignore_interrupts_in_dask_worker()  # a worker started by a script imports this to run its cases
 
@@ -333,25 +331,6 @@ def connect(scheduler: str):
             f"a running Dask scheduler that answers within {CONNECT_TIMEOUT_S} s",
             f"{type(exc).__name__}: {exc}".splitlines()[0],
         ) from None
-
-
-def hold_interrupts() -> set | None:
-    """Block SIGINT in this thread while a local cluster starts; returns what to restore.
-
-    A Ctrl-C in the middle of the cluster's start-up left it half built, to be closed at
-    exit with a traceback. Blocked here, the signal waits until :func:`release_interrupts`,
-    when the cluster is whole and the command can close it. (The worker processes start
-    with no signal blocked; they ignore SIGINT themselves: :mod:`poro2d.worker_signals`.)
-    """
-    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "pthread_sigmask"):
-        return None
-    return signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-
-
-def release_interrupts(previous: set | None) -> None:
-    """Undo :func:`hold_interrupts`; a Ctrl-C that came meanwhile is raised now."""
-    if previous is not None and signal.SIGINT not in previous:
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
 def quiet_shutdown_logs(client) -> None:

@@ -1,0 +1,143 @@
+"""The process pool of the shear tests and replicates: job order, errors, messages, Ctrl-C."""
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+from conftest import default_sigint
+from poro2d import progress
+from poro2d.errors import InputError
+from poro2d.process_pool import JobsFailed, run_jobs
+
+SRC = Path(__file__).resolve().parents[1] / "src"
+
+
+def square_late_first(job: int, report) -> tuple:
+    """A job whose result depends on the job alone; the first jobs end last."""
+    report("working", job / 10)
+    time.sleep(0.05 * (4 - job))
+    return job, job * job, os.getpid()
+
+
+def fail_on_odd(job: int, report) -> int:
+    if job == 3:
+        raise InputError("--thing", 3, "an even number")
+    if job % 2:
+        raise ValueError(f"odd job {job}")
+    return job
+
+
+@pytest.mark.parametrize("processes", [1, 2, 3])
+def test_results_come_in_job_order_whatever_the_process_count(processes):
+    jobs = [0, 1, 2, 3]
+    ended, messages = [], []
+    results = run_jobs(
+        square_late_first, jobs, processes, names=[str(j) for j in jobs], start_first=lambda j: -j,
+        on_report=lambda i, *msg: messages.append((i, *msg)), on_done=lambda i, res: ended.append(i),
+    )  # fmt: skip
+    assert [r[:2] for r in results] == [(0, 0), (1, 1), (2, 4), (3, 9)]
+    assert sorted(ended) == jobs
+    assert sorted(messages) == [(j, "working", j / 10) for j in jobs]  # every job's message, tagged
+    in_this_process = {r[2] for r in results} == {os.getpid()}
+    assert in_this_process == (processes == 1)
+
+
+@pytest.mark.parametrize("processes", [1, 2])
+def test_failing_jobs_are_named_with_their_errors_after_every_job_ran(processes):
+    ended = []
+    with pytest.raises(JobsFailed) as err:
+        run_jobs(fail_on_odd, [0, 1, 2, 5], processes, names=["a", "b", "c", "d"], what="toy job(s)",
+                 on_done=lambda i, res: ended.append(i))  # fmt: skip
+    assert str(err.value) == "2 toy job(s) failed: b: odd job 1; d: odd job 5"
+    assert sorted(ended) == [0, 2]
+
+
+def test_an_input_error_of_a_job_is_raised_as_it_is():
+    with pytest.raises(InputError, match="--thing"):
+        run_jobs(fail_on_odd, [1, 3, 0], 2, names=["a", "b", "c"])
+
+
+def test_one_message_per_phase_and_interval(monkeypatch):
+    def chatty(job, report):
+        for k in range(5):
+            report("phase one", k / 5)
+        report("phase two", 0.0)
+        return job
+
+    seen = []
+    run_jobs(chatty, [7], 1, names=["x"], on_report=lambda i, *msg: seen.append(msg))
+    assert seen == [("phase one", 0.0), ("phase two", 0.0)]
+
+
+def test_jobs_progress_line_in_a_log(capsys):
+    with progress.JobsProgress("direct shear", ["50 kPa", "100 kPa", "200 kPa"]) as bars:
+        bars.update(0, "shearing", 0.42)
+        bars.update(1, "consolidating")
+        assert capsys.readouterr().err == ""  # less than an interval since the start
+    (line,) = capsys.readouterr().err.splitlines()
+    assert re.match(
+        r"^direct shear: 50 kPa shearing 42 %, 100 kPa consolidating, 200 kPa waiting, elapsed [\d:]+$",
+        line,
+    )
+    with progress.JobsProgress("direct shear", ["50 kPa", "100 kPa"]) as bars:
+        bars.done(0)  # a job's end is written at once
+        assert capsys.readouterr().err.startswith("direct shear: 50 kPa done, 100 kPa waiting, elapsed ")
+    assert capsys.readouterr().err == ""  # nothing new at the end: no second line
+    with progress.JobsProgress("direct shear", ["50 kPa"], enabled=False) as bars:
+        bars.done(0)
+    assert capsys.readouterr().err == ""
+
+
+def test_progress_lines_share_one_format():
+    assert progress.progress_line("sweep", ["3/10 cases (30 %)", "1 failed"], 760.0, 1773.0) == (
+        "sweep: 3/10 cases (30 %), 1 failed, elapsed 0:12:40, eta 0:29:33"
+    )
+    assert progress.progress_line("drop", ["5 steps"], 3.0) == "drop: 5 steps, elapsed 0:00:03"
+
+
+SLEEPER = """
+    import sys, time
+    from pathlib import Path
+    from poro2d.process_pool import run_jobs
+
+    def sleep_long(job, report):
+        Path(job).write_text("started")
+        time.sleep(120)
+
+    if __name__ == "__main__":
+        try:
+            run_jobs(sleep_long, [sys.argv[1] + "/a", sys.argv[1] + "/b", sys.argv[1] + "/c"], 2,
+                     names=["a", "b", "c"])
+        except KeyboardInterrupt:
+            print("interrupted", file=sys.stderr)
+            sys.exit(130)
+"""
+
+
+def test_ctrl_c_ends_the_workers_and_starts_no_more_jobs(tmp_path):
+    script = tmp_path / "sleeper.py"
+    script.write_text(textwrap.dedent(SLEEPER))
+    env = dict(os.environ, PYTHONPATH=str(SRC))
+    proc = subprocess.Popen([sys.executable, str(script), str(tmp_path)], env=env, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True, preexec_fn=default_sigint)  # fmt: skip
+    try:
+        deadline = time.monotonic() + 120
+        while not ((tmp_path / "a").exists() and (tmp_path / "b").exists()):
+            assert proc.poll() is None, proc.communicate()
+            assert time.monotonic() < deadline, "the jobs did not start"
+            time.sleep(0.1)
+        os.killpg(proc.pid, signal.SIGINT)  # what a Ctrl-C at a terminal does: the whole group
+        _, err = proc.communicate(timeout=60)  # the jobs would sleep for minutes
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130 and err.strip() == "interrupted", err  # no worker's traceback
+    assert not (tmp_path / "c").exists()  # the job not started stays so
