@@ -23,7 +23,6 @@ whose specimen fails a check, is refused and ends the run with the reason.
 
 from __future__ import annotations
 
-import logging
 import math
 import time
 from dataclasses import asdict, dataclass
@@ -52,8 +51,6 @@ from poro2d.resumable import Fingerprint, ResumableStage
 from poro2d.specimen.compaction import SpecimenSpec, box_porosity, prepare_specimen
 from poro2d.specimen.grading import GradingCurve
 from poro2d.specimen.porosity_regions import lid_height_at, mass_d50
-
-_log = logging.getLogger(__name__)
 
 #: how a trial's specimen is judged full: "plate", the paper's rigid top plate (its n' includes
 #: the gap under the plate); "fill", a segmented lid that rests on the grains over the width
