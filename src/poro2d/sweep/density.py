@@ -22,6 +22,8 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from poro2d.config import check_number_list
 from poro2d.criterion.density import DEFAULT_MUS, MU_PREP_MAX, Calibration, StateTarget
 from poro2d.errors import InputError
@@ -32,9 +34,16 @@ from poro2d.locks import cache_entry
 DEFAULT_SEEDS = 3
 #: settings that change the calibration; n_lab and the first trial do not
 _CRITERION_KEYS_IGNORED = ("n_lab", "trial_porosity")
-#: first trial of every calibration case: the middle of the 2D range of polydisperse disks
-#: (about 0.16 dense to 0.23 loose), whatever the laboratory porosity
+#: first trial of every calibration case under the paper's plate: the middle of the 2D range of
+#: polydisperse disks (about 0.16 dense to 0.23 loose), whatever the laboratory porosity
 CALIBRATION_FIRST_TRIAL = 0.19
+#: first trials under the fill acceptance, per preparation friction (mu_prep, n2D): the porosity
+#: under the lid that the paper grading's calibration accepted (mean over seeds, docs/sweeps.md),
+#: linear in between. A trial far from the answer costs most of a case: 0.19 is too loose for a
+#: frictionless preparation (its layers take 1 000 000 steps to settle, 250 000 at the answer)
+#: and too dense for mu_prep 1.0 (the plate and lid then take 640 000 steps, 320 000 at the
+#: answer). A grading that packs otherwise only takes a trial or two more from these.
+FILL_FIRST_TRIALS = ((0.0, 0.163), (0.05, 0.171), (0.1, 0.176), (0.2, 0.185), (0.5, 0.202), (1.0, 0.216))
 
 
 #: settings density mode uses unless the config sets them: trials refined to 0.002 (the paper's
@@ -100,19 +109,44 @@ def calibration_key(base: dict) -> str:
     return hashlib.sha256(json.dumps(rec, sort_keys=True, default=str).encode()).hexdigest()[:16]
 
 
+def first_trial(criterion: dict, mu: float) -> float:
+    """The first trial of the calibration case at preparation friction ``mu``.
+
+    Under the paper's plate every case starts at ``CALIBRATION_FIRST_TRIAL``; under the fill
+    acceptance at the porosity ``FILL_FIRST_TRIALS`` gives for ``mu``, rounded to the grid the
+    criterion steps on (``criterion``: the calibration's criterion table).
+    """
+    from poro2d.criterion.protocol import CriterionSettings, round_to, trial_grid
+
+    if criterion.get("acceptance", "plate") != "fill":
+        return CALIBRATION_FIRST_TRIAL
+    mu_ref, n_ref = zip(*FILL_FIRST_TRIALS, strict=True)
+    grid = trial_grid(float(criterion.get("resolution", CriterionSettings.resolution)),
+                      criterion.get("refine_tolerance"))  # fmt: skip
+    return round_to(float(np.interp(mu, mu_ref, n_ref)), grid)
+
+
 def calibration_sweep(base: dict, mus: list[float], seeds: int) -> dict:
-    """The grid sweep of the calibration: every friction with every seed."""
+    """The sweep of the calibration: every friction with every seed, from its first trial.
+
+    Under the paper's plate a grid sweep (one first trial for all); under the fill acceptance
+    a list of cases, each friction from its own first trial (:func:`first_trial`).
+    """
     cfg = copy.deepcopy(calibration_base(base))
-    cfg["criterion"]["trial_porosity"] = CALIBRATION_FIRST_TRIAL
     threads = (base.get("specimen") or {}).get("threads")
     if threads is not None:
         cfg["specimen"]["threads"] = threads
-    cfg["sweep"] = {
-        "kind": "criterion",
-        "title": "mu_prep -> n2D calibration",
-        "specimen.friction_prep": list(mus),
-        "seed": list(range(seeds)),
-    }
+    cfg["sweep"] = {"kind": "criterion", "title": "mu_prep -> n2D calibration"}
+    if cfg["criterion"].get("acceptance", "plate") != "fill":
+        cfg["criterion"]["trial_porosity"] = CALIBRATION_FIRST_TRIAL
+        cfg["sweep"].update({"specimen.friction_prep": list(mus), "seed": list(range(seeds))})
+        return cfg
+    firsts = {mu: first_trial(cfg["criterion"], mu) for mu in mus}
+    cfg["sweep"]["cases"] = [
+        {"specimen.friction_prep": mu, "criterion.trial_porosity": firsts[mu], "seed": s}
+        for mu in mus
+        for s in range(seeds)
+    ]
     return cfg
 
 
@@ -308,6 +342,7 @@ __all__ = [
     "calibration_twins",
     "check_mus",
     "check_seeds",
+    "first_trial",
     "run_density_state",
     "state_sweep",
 ]
