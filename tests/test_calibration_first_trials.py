@@ -49,7 +49,8 @@ def test_a_fill_calibration_reads_back_per_friction_and_seed():
     assert cal.samples == [[0.163, 0.163], [0.216, 0.216]]
 
 
-def test_the_densest_state_starting_where_its_calibration_case_did_is_read_back(tmp_path):
+def test_under_the_fill_a_check_at_a_calibration_friction_is_its_calibration_case(tmp_path):
+    """Seed for seed, whatever its first trial; a check at a friction between is run."""
     from poro2d.criterion.density import StateTarget
     from poro2d.io_utils import write_json
 
@@ -58,13 +59,26 @@ def test_the_densest_state_starting_where_its_calibration_case_did_is_read_back(
     folder = tmp_path / "cal"
     for c in cal.cases:
         row = {"id": c.id, "status": "done", "params": c.params,
-               "results": {"n_lab": 0.3434, "converged": True, "final_porosity": 0.163,
+               "results": {"n_lab": 0.3434, "converged": True, "final_porosity": c.params["seed"] + 0.1,
                            "last_new_porosity": 0.1631}}  # fmt: skip
         write_json(folder / "cases" / c.id / "params.json", c.to_dict(), config=True)
         write_json(folder / "cases" / c.id / "result.json", row)
     dense = StateTarget(0.3253, 1.0, 0.1632, 0.0)  # rounds to 0.163, the frictionless first trial
     loose = StateTarget(0.4571, 0.0, 0.2130, 1.0)  # 0.213: not the calibration's 0.216
-    states = parse_sweep(D.state_sweep(cfg, [dense, loose], 2, 0.001))
+    between = StateTarget(0.40, 0.5, 0.19, 0.5)
+    states = parse_sweep(D.state_sweep(cfg, [dense, loose, between], 2, 0.001))
     twins = D.calibration_twins(cal, states, None, folder)
-    assert len(twins) == 2
-    assert {r["params"]["criterion.n_lab"] for r in twins.values()} == {0.3253}
+    assert len(twins) == 4
+    got = {(r["params"]["criterion.n_lab"], r["params"]["seed"]): r for r in twins.values()}
+    assert set(got) == {(0.3253, 0), (0.3253, 1), (0.4571, 0), (0.4571, 1)}
+    for (n_lab, seed), r in got.items():
+        assert r["results"]["n_lab"] == n_lab and r["results"]["final_porosity"] == seed + 0.1
+    # under the paper's plate only the same first trial makes a twin (none here: 0.19 vs 0.213)
+    plate = dict(BASE, criterion={"refine_tolerance": 0.002})
+    cal_p = parse_sweep(D.calibration_sweep(plate, [0.0, 1.0], 2))
+    for c in cal_p.cases:
+        row = {"id": c.id, "status": "done", "params": c.params, "results": {"converged": True}}
+        write_json(tmp_path / "p" / "cases" / c.id / "params.json", c.to_dict(), config=True)
+        write_json(tmp_path / "p" / "cases" / c.id / "result.json", row)
+    states_p = parse_sweep(D.state_sweep(plate, [loose], 2, 0.001))
+    assert D.calibration_twins(cal_p, states_p, None, tmp_path / "p") == {}

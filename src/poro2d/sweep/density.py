@@ -18,7 +18,7 @@ import hashlib
 import json
 import math
 import os
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
@@ -250,14 +250,32 @@ def _run_key(case, base_dir: Path | None) -> str:
     return canonical_json([sp, grading.sizes.tolist(), grading.percent.tolist(), st, seed])
 
 
+def _check_key(case, base_dir: Path | None) -> str:
+    """What makes a calibration case a state's check: the run (:func:`_run_key`), and under the
+    fill acceptance the run whatever its first trial.
+
+    There each calibration case starts from its friction's expected answer
+    (:func:`first_trial`), as a check starts from its target: at the same friction and seed
+    both ask the criterion the same question from neighbouring first trials, and every trial
+    is prepared afresh (seeded by its porosity), so the first trial only steers the search.
+    """
+    crit = case.config.get("criterion") or {}
+    if crit.get("acceptance", "plate") != "fill":
+        return _run_key(case, base_dir)
+    config = dict(case.config, criterion={k: v for k, v in crit.items() if k != "trial_porosity"})
+    return _run_key(replace(case, config=config, id=case.id), base_dir)
+
+
 def calibration_twins(calibration, states, base_dir: Path | None, folder: Path) -> dict[str, dict]:
     """Finished calibration cases that are state checks too, as rows of those checks.
 
-    The check of the densest state (Dr = 1) runs at the calibration's lowest usable friction
-    from the calibration's first trial: the same criterion run, seed for seed, as a
-    calibration case. Whether two cases are the same run is decided on the specimen, grading
-    and criterion settings they build, never assumed. Returns ``{state case id: row}``, the
-    calibration case's finished row relabelled with the check's parameters.
+    The check of the densest state (Dr = 1) runs at the calibration's lowest usable friction,
+    that of the loosest (Dr = 0) at its highest: at a calibration friction, seed for seed,
+    the same criterion run as a calibration case (:func:`_check_key`: under the paper's plate
+    only from the same first trial). Whether two cases are the same run is decided on the
+    specimen, grading and criterion settings they build, never assumed. Returns
+    ``{state case id: row}``, the calibration case's finished row relabelled with the check's
+    parameters.
     """
     from poro2d.sweep.runner import finished_row
 
@@ -265,10 +283,10 @@ def calibration_twins(calibration, states, base_dir: Path | None, folder: Path) 
     for c in calibration.cases:
         row = finished_row(c.to_dict(), folder / "cases" / c.id)
         if row is not None:
-            done[_run_key(c, base_dir)] = (c, row)
+            done[_check_key(c, base_dir)] = (c, row)
     twins = {}
     for c in states.cases:
-        hit = done.get(_run_key(c, base_dir))
+        hit = done.get(_check_key(c, base_dir))
         if hit is None:
             continue
         cal_case, row = hit
