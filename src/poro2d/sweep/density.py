@@ -39,10 +39,10 @@ _CRITERION_KEYS_IGNORED = ("n_lab", "trial_porosity")
 CALIBRATION_FIRST_TRIAL = 0.19
 #: first trials under the fill acceptance, per preparation friction (mu_prep, n2D): the porosity
 #: under the lid that the paper grading's calibration accepted when every case started from 0.19
-#: (mean over three seeds), linear in between. A trial far from the answer costs most of a case: 0.19 is too loose for a
-#: frictionless preparation (its layers take 1 000 000 steps to settle, 260 000 at the answer)
-#: and too dense for mu_prep 1.0 (the plate and lid then take 640 000 steps, 320 000 at the
-#: answer). A grading that packs otherwise only takes a trial or two more from these.
+#: (mean over three seeds), linear in between. A trial far from the answer costs most of a case:
+#: 0.19 is too loose for a frictionless preparation (its layers take 1 000 000 steps to settle,
+#: 260 000 at the answer) and too dense for mu_prep 1.0 (the plate and lid then take 640 000
+#: steps, 320 000 at the answer). A grading that packs otherwise only takes a trial or two more from these.
 FILL_FIRST_TRIALS = ((0.0, 0.163), (0.05, 0.171), (0.1, 0.176), (0.2, 0.185), (0.5, 0.202), (1.0, 0.216))
 
 
