@@ -42,7 +42,8 @@ CALIBRATION_FIRST_TRIAL = 0.19
 #: (mean over three seeds), linear in between. A trial far from the answer costs most of a case:
 #: 0.19 is too loose for a frictionless preparation (its layers take 1 000 000 steps to settle,
 #: 260 000 at the answer) and too dense for mu_prep 1.0 (the plate and lid then take 640 000
-#: steps, 320 000 at the answer). A grading that packs otherwise only takes a trial or two more from these.
+#: steps, 320 000 at the answer). A grading that packs otherwise starts further from its answer
+#: (the trials still converge to it, in more steps).
 FILL_FIRST_TRIALS = ((0.0, 0.163), (0.05, 0.171), (0.1, 0.176), (0.2, 0.185), (0.5, 0.202), (1.0, 0.216))
 
 
