@@ -254,3 +254,13 @@ def test_paper_report_shows_the_section_only_with_results(tmp_path):
     md, html = to_markdown(blocks, tmp_path), to_html(blocks, "t")
     assert "Why the paper gets 0.15" in md and "Why the paper gets 0.15" in html
     assert "within 0.005 of 0.15: Cu = 3" in md
+
+
+def test_the_protocol_line_names_the_calibrations_own_first_trial():
+    """The calibration (fill acceptance by default) starts mu_prep 0.05 at 0.171, the plate at 0.19."""
+    sens, _ = _synthetic_sens()
+    ref = {"measured_mean": 0.19, "first_trial_porosity": 0.14}
+    fill = " ".join(S._protocol_lines(dict(sens, config={}), ref))
+    assert "starting from 0.171 (the calibration)" in fill
+    plate = " ".join(S._protocol_lines(dict(sens, config={"criterion": {"acceptance": "plate"}}), ref))
+    assert "starting from 0.19 (the calibration)" in plate

@@ -16,8 +16,11 @@ from __future__ import annotations
 import copy
 import math
 import os
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from poro2d import __version__
 from poro2d.criterion.density import DEFAULT_MUS, Calibration, StateTarget, check_mus
@@ -32,9 +35,17 @@ from poro2d.sweep.cases import criterion_objects
 DEFAULT_SEEDS = 3
 #: settings that change the calibration; n_lab and the first trial do not
 _CRITERION_KEYS_IGNORED = ("n_lab", "trial_porosity")
-#: first trial of every calibration case: the middle of the 2D range of polydisperse disks
-#: (about 0.16 dense to 0.23 loose), whatever the laboratory porosity
+#: first trial of every calibration case under the paper's plate: the middle of the 2D range of
+#: polydisperse disks (about 0.16 dense to 0.23 loose), whatever the laboratory porosity
 CALIBRATION_FIRST_TRIAL = 0.19
+#: first trials under the fill acceptance, per preparation friction (mu_prep, n2D): the porosity
+#: under the lid that the paper grading's calibration accepted when every case started from 0.19
+#: (mean over three seeds), linear in between. A trial far from the answer costs most of a case:
+#: 0.19 is too loose for a frictionless preparation (its layers take 1 000 000 steps to settle,
+#: 260 000 at the answer) and too dense for mu_prep 1.0 (the plate and lid then take 640 000
+#: steps, 320 000 at the answer). A grading that packs otherwise starts further from its answer
+#: (the trials still converge to it, in more steps).
+FILL_FIRST_TRIALS = ((0.0, 0.163), (0.05, 0.171), (0.1, 0.176), (0.2, 0.185), (0.5, 0.202), (1.0, 0.216))
 
 
 #: settings density mode uses unless the config sets them: trials refined to 0.002 (the paper's
@@ -96,19 +107,44 @@ def calibration_key(base: dict) -> str:
     return run_digest(rec, tables={"base.specimen": SpecimenSpec}, length=16, layout="spaced")
 
 
+def first_trial(criterion: dict, mu: float) -> float:
+    """The first trial of the calibration case at preparation friction ``mu``.
+
+    Under the paper's plate every case starts at ``CALIBRATION_FIRST_TRIAL``; under the fill
+    acceptance at the porosity ``FILL_FIRST_TRIALS`` gives for ``mu``, rounded to the grid the
+    criterion steps on (``criterion``: the calibration's criterion table).
+    """
+    from poro2d.criterion.protocol import CriterionSettings, round_to, trial_grid
+
+    if criterion.get("acceptance", "plate") != "fill":
+        return CALIBRATION_FIRST_TRIAL
+    mu_ref, n_ref = zip(*FILL_FIRST_TRIALS, strict=True)
+    grid = trial_grid(float(criterion.get("resolution", CriterionSettings.resolution)),
+                      criterion.get("refine_tolerance"))  # fmt: skip
+    return round_to(float(np.interp(mu, mu_ref, n_ref)), grid)
+
+
 def calibration_sweep(base: dict, mus: list[float], seeds: int) -> dict:
-    """The grid sweep of the calibration: every friction with every seed."""
+    """The sweep of the calibration: every friction with every seed, from its first trial.
+
+    Under the paper's plate a grid sweep (one first trial for all); under the fill acceptance
+    a list of cases, each friction from its own first trial (:func:`first_trial`).
+    """
     cfg = copy.deepcopy(calibration_base(base))
-    cfg["criterion"]["trial_porosity"] = CALIBRATION_FIRST_TRIAL
     threads = (base.get("specimen") or {}).get("threads")
     if threads is not None:
         cfg["specimen"]["threads"] = threads
-    cfg["sweep"] = {
-        "kind": "criterion",
-        "title": "mu_prep -> n2D calibration",
-        "specimen.friction_prep": list(mus),
-        "seed": list(range(seeds)),
-    }
+    cfg["sweep"] = {"kind": "criterion", "title": "mu_prep -> n2D calibration"}
+    if cfg["criterion"].get("acceptance", "plate") != "fill":
+        cfg["criterion"]["trial_porosity"] = CALIBRATION_FIRST_TRIAL
+        cfg["sweep"].update({"specimen.friction_prep": list(mus), "seed": list(range(seeds))})
+        return cfg
+    firsts = {mu: first_trial(cfg["criterion"], mu) for mu in mus}
+    cfg["sweep"]["cases"] = [
+        {"specimen.friction_prep": mu, "criterion.trial_porosity": firsts[mu], "seed": s}
+        for mu in mus
+        for s in range(seeds)
+    ]
     return cfg
 
 
@@ -208,14 +244,32 @@ def _run_key(case, base_dir: Path | None) -> str:
     return run_digest(run, ignore=("criterion.n_lab",))
 
 
+def _check_key(case, base_dir: Path | None) -> str:
+    """What makes a calibration case a state's check: the run (:func:`_run_key`), and under the
+    fill acceptance the run whatever its first trial.
+
+    There each calibration case starts from its friction's expected answer
+    (:func:`first_trial`), as a check starts from its target: at the same friction and seed
+    both ask the criterion the same question from neighbouring first trials, and every trial
+    is prepared afresh (seeded by its porosity), so the first trial only steers the search.
+    """
+    crit = case.config.get("criterion") or {}
+    if crit.get("acceptance", "plate") != "fill":
+        return _run_key(case, base_dir)
+    config = dict(case.config, criterion={k: v for k, v in crit.items() if k != "trial_porosity"})
+    return _run_key(replace(case, config=config, id=case.id), base_dir)
+
+
 def calibration_twins(calibration, states, base_dir: Path | None, folder: Path) -> dict[str, dict]:
     """Finished calibration cases that are state checks too, as rows of those checks.
 
-    The check of the densest state (Dr = 1) runs at the calibration's lowest usable friction
-    from the calibration's first trial: the same criterion run, seed for seed, as a
-    calibration case. Whether two cases are the same run is decided on the specimen, grading
-    and criterion settings they build, never assumed. Returns ``{state case id: row}``, the
-    calibration case's finished row relabelled with the check's parameters.
+    The check of the densest state (Dr = 1) runs at the calibration's lowest usable friction,
+    that of the loosest (Dr = 0) at its highest: at a calibration friction, seed for seed,
+    the same criterion run as a calibration case (:func:`_check_key`: under the paper's plate
+    only from the same first trial). Whether two cases are the same run is decided on the
+    specimen, grading and criterion settings they build, never assumed. Returns
+    ``{state case id: row}``, the calibration case's finished row relabelled with the check's
+    parameters.
     """
     from poro2d.sweep.runner import finished_row
 
@@ -223,10 +277,10 @@ def calibration_twins(calibration, states, base_dir: Path | None, folder: Path) 
     for c in calibration.cases:
         row = finished_row(c.to_dict(), folder / "cases" / c.id)
         if row is not None:
-            done[_run_key(c, base_dir)] = (c, row)
+            done[_check_key(c, base_dir)] = (c, row)
     twins = {}
     for c in states.cases:
-        hit = done.get(_run_key(c, base_dir))
+        hit = done.get(_check_key(c, base_dir))
         if hit is None:
             continue
         cal_case, row = hit
@@ -246,5 +300,6 @@ __all__ = [
     "calibration_twins",
     "check_mus",
     "check_seeds",
+    "first_trial",
     "state_sweep",
 ]

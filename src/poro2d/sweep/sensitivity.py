@@ -371,7 +371,9 @@ def answer(sens: dict, tol: float = MATCH_TOLERANCE) -> dict:
 
 
 def _protocol_lines(sens: dict, ref: dict | None) -> list[str]:
-    """The paper's protocol (first trial from Eq. 12) against the calibration's (first trial 0.19)."""
+    """The paper's protocol (first trial from Eq. 12) against the calibration's (its own first trial)."""
+    from poro2d.sweep.density import first_trial, with_density_defaults
+
     mu0 = sens["settings"]["mu_prep"]
     cal = next((p for p in sens["points"]["mu_prep"] if abs(p["mu_prep"] - mu0) < 1e-12), None)
     if ref is None or cal is None:
@@ -381,9 +383,10 @@ def _protocol_lines(sens: dict, ref: dict | None) -> list[str]:
         return []
     # each trial is a fresh specimen seeded by the seed and the trial porosity: where the two
     # protocols reach the same trial porosity they prepare the same specimen
+    first = first_trial(with_density_defaults(sens.get("config") or {})["criterion"], mu0)
     return [
         f"At mu_prep = {mu0:g} the measured porosity n' of the accepted trial is {a:.4f} starting from "
-        f"the first trial {ref['first_trial_porosity']:g} and {b:.4f} starting from 0.19 (the "
+        f"the first trial {ref['first_trial_porosity']:g} and {b:.4f} starting from {first:g} (the "
         f"calibration), a difference of {a - b:+.4f}; every trial is prepared afresh, so the first trial "
         "acts only through the trial porosity it leads to."
     ]

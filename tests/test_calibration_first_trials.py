@@ -1,0 +1,84 @@
+"""The calibration's first trials: one for all under the paper's plate, per friction under the fill."""
+
+import pytest
+
+from poro2d.sweep import density as D
+from poro2d.sweep.cases import parse_sweep
+
+BASE = {"seed": 0, "specimen": {"width": 0.05, "height": 0.025, "layers": 2}}
+
+
+def _fill(**criterion):
+    return dict(BASE, criterion={"acceptance": "fill", "refine_tolerance": 0.002, **criterion})
+
+
+def _trials(cfg, mus, seeds):
+    sweep = parse_sweep(D.calibration_sweep(cfg, mus, seeds))
+    return {(c.params["specimen.friction_prep"], c.params["seed"]): c.config["criterion"]["trial_porosity"]
+            for c in sweep.cases}  # fmt: skip
+
+
+def test_under_the_plate_every_case_starts_at_0_19():
+    trials = _trials(BASE, [0.0, 0.5, 1.0], 2)
+    assert len(trials) == 6 and set(trials.values()) == {D.CALIBRATION_FIRST_TRIAL}
+    assert D.first_trial({"acceptance": "plate"}, 0.0) == 0.19
+
+
+def test_under_the_fill_each_friction_starts_from_its_own_first_trial():
+    trials = _trials(_fill(), [0.0, 0.05, 0.5, 0.75, 1.0], 3)
+    assert len(trials) == 15
+    by_mu = {mu: {t for (m, _), t in trials.items() if m == mu} for mu in (0.0, 0.05, 0.5, 0.75, 1.0)}
+    # the table's values at its frictions; linear in between (0.75: halfway from 0.202 to 0.216)
+    assert by_mu == {0.0: {0.163}, 0.05: {0.171}, 0.5: {0.202}, 0.75: {0.209}, 1.0: {0.216}}
+
+
+def test_the_first_trial_lies_on_the_grid_the_criterion_steps_on():
+    # the paper's 0.01 grid without refinement, half the refined tolerance with it
+    assert D.first_trial({"acceptance": "fill"}, 0.0) == 0.16
+    assert D.first_trial({"acceptance": "fill", "refine_tolerance": 0.002}, 0.03) == pytest.approx(0.168)
+    assert D.first_trial({"acceptance": "fill", "refine_tolerance": 0.004}, 0.03) == pytest.approx(0.168)
+    assert D.first_trial({"acceptance": "fill", "resolution": 0.02}, 1.0) == 0.22
+
+
+def test_a_fill_calibration_reads_back_per_friction_and_seed():
+    sweep = parse_sweep(D.calibration_sweep(_fill(), [0.0, 1.0], 2))
+    rows = [{"status": "done", "params": c.params,
+             "results": {"converged": True, "last_new_porosity": c.config["criterion"]["trial_porosity"]}}
+            for c in sweep.cases]  # fmt: skip
+    cal = D.calibration_from_rows(rows, [0.0, 1.0], 2)
+    assert cal.samples == [[0.163, 0.163], [0.216, 0.216]]
+
+
+def test_under_the_fill_a_check_at_a_calibration_friction_is_its_calibration_case(tmp_path):
+    """Seed for seed, whatever its first trial; a check at a friction between is run."""
+    from poro2d.criterion.density import StateTarget
+    from poro2d.io_utils import write_json
+
+    cfg = _fill()
+    cal = parse_sweep(D.calibration_sweep(cfg, [0.0, 1.0], 2))
+    folder = tmp_path / "cal"
+    for c in cal.cases:
+        row = {"id": c.id, "status": "done", "params": c.params,
+               "results": {"n_lab": 0.3434, "converged": True, "final_porosity": c.params["seed"] + 0.1,
+                           "last_new_porosity": 0.1631}}  # fmt: skip
+        write_json(folder / "cases" / c.id / "params.json", c.to_dict(), config=True)
+        write_json(folder / "cases" / c.id / "result.json", row)
+    dense = StateTarget(0.3253, 1.0, 0.1632, 0.0)  # rounds to 0.163, the frictionless first trial
+    loose = StateTarget(0.4571, 0.0, 0.2130, 1.0)  # 0.213: not the calibration's 0.216
+    between = StateTarget(0.40, 0.5, 0.19, 0.5)
+    states = parse_sweep(D.state_sweep(cfg, [dense, loose, between], 2, 0.001))
+    twins = D.calibration_twins(cal, states, None, folder)
+    assert len(twins) == 4
+    got = {(r["params"]["criterion.n_lab"], r["params"]["seed"]): r for r in twins.values()}
+    assert set(got) == {(0.3253, 0), (0.3253, 1), (0.4571, 0), (0.4571, 1)}
+    for (n_lab, seed), r in got.items():
+        assert r["results"]["n_lab"] == n_lab and r["results"]["final_porosity"] == seed + 0.1
+    # under the paper's plate only the same first trial makes a twin (none here: 0.19 vs 0.213)
+    plate = dict(BASE, criterion={"refine_tolerance": 0.002})
+    cal_p = parse_sweep(D.calibration_sweep(plate, [0.0, 1.0], 2))
+    for c in cal_p.cases:
+        row = {"id": c.id, "status": "done", "params": c.params, "results": {"converged": True}}
+        write_json(tmp_path / "p" / "cases" / c.id / "params.json", c.to_dict(), config=True)
+        write_json(tmp_path / "p" / "cases" / c.id / "result.json", row)
+    states_p = parse_sweep(D.state_sweep(plate, [loose], 2, 0.001))
+    assert D.calibration_twins(cal_p, states_p, None, tmp_path / "p") == {}
