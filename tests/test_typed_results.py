@@ -12,6 +12,7 @@ shear summary and the accepted specimen's state and porosity files.
 
 import json
 import pickle
+import typing
 from pathlib import Path
 
 import pytest
@@ -218,3 +219,44 @@ def test_every_public_run_is_annotated_with_its_typed_result():
         assert hint == cls, (func.__qualname__, hint)
         for part in typing.get_args(hint) or (hint,):
             assert issubclass(part, TypedResult), part
+
+
+def _run_definitions() -> list[tuple[str, str]]:
+    """(module, qualified name) of every public ``run_*`` function and method defined in src."""
+    import ast
+
+    src = Path(__file__).parent.parent / "src"
+    found = []
+    for path in sorted((src / "poro2d").rglob("*.py")):
+        module = ".".join(path.relative_to(src).with_suffix("").parts)
+        tree = ast.parse(path.read_text())
+        defs = [("", node) for node in tree.body]
+        defs += [(f"{c.name}.", node) for c in tree.body if isinstance(c, ast.ClassDef) for node in c.body]
+        for prefix, node in defs:
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef) and node.name.startswith("run_"):
+                found.append((module, prefix + node.name))
+    return found
+
+
+def test_every_run_defined_in_src_returns_a_typed_result():
+    """A function named run_* is a run of the Python API: its result is typed (else name it otherwise)."""
+    import importlib
+    import inspect
+    import types
+
+    runs = _run_definitions()
+    assert ("poro2d.sweep.runner", "run_sweep") in runs and ("poro2d.paper", "run_paper") in runs
+    for module_name, qualname in runs:
+        module = importlib.import_module(module_name)
+        func = module
+        for part in qualname.split("."):
+            func = getattr(func, part)
+        hint = inspect.unwrap(func).__annotations__.get("return")
+        if isinstance(hint, str):  # postponed annotations: resolved in the defining module
+            hint = eval(hint, vars(module))  # noqa: S307 - an annotation of our own source
+        parts = typing.get_args(hint) if isinstance(hint, types.UnionType) else (hint,)
+        assert all(isinstance(p, type) and issubclass(p, TypedResult) for p in parts), (
+            module_name,
+            qualname,
+            hint,
+        )
