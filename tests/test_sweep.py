@@ -10,7 +10,7 @@ import pytest
 
 from poro2d.cli import main
 from poro2d.errors import InputError
-from poro2d.sweep import parse_sweep, register_kind, run_sweep
+from poro2d.sweep import SweepResult, parse_sweep, register_kind, run_sweep
 from poro2d.sweep.runner import SINGLE_THREAD_ENV
 
 distributed = pytest.importorskip("distributed")
@@ -72,6 +72,9 @@ def test_criterion_sweep_uses_both_workers_and_rerun_skips(client, tmp_path):
     res = run_sweep(sweep, tmp_path, client=client, progress=False)
     wall = time.perf_counter() - t0
     assert [r["status"] for r in res.rows] == ["done"] * 8, [r.get("error") for r in res.rows]
+    # the result is sweep.json's content, typed, with the rows and the table beside the file
+    assert isinstance(res, SweepResult) and res == json.loads((tmp_path / "sweep.json").read_text())
+    assert res.status == "finished" and len(res.table) == 8 and res.failed == []
     pids = {r["pid"] for r in res.rows}
     assert len(pids) == 2, pids  # both worker processes ran cases
     print(

@@ -260,3 +260,18 @@ def test_every_run_defined_in_src_returns_a_typed_result():
             qualname,
             hint,
         )
+
+
+def test_a_settled_run_writes_the_keys_each_engine_reported():
+    from poro2d.interop.settled import SettledRun
+
+    forces = {"f_top_n_per_m": 1.0, "f_bottom_n_per_m": 2.0, "side_friction_up_n_per_m": 0.5}
+    yade = SettledRun(**forces, unbalanced_force=1e-6, steps=10, converged=True, seconds=0.1,
+                      yade_version="2023.02a", workdir="w")  # fmt: skip
+    yade_keys = ["unbalanced_force", "steps", "converged", "seconds", "yade_version", "workdir"]
+    assert list(yade) == [*forces, *yade_keys]
+    ours = SettledRun(**forces, mean_contact_force_n=3.0, coordination_number=3.5, contacts=7, steps=10,
+                      converged=True, max_ratio=1e-9, seconds=0.1)  # fmt: skip
+    assert list(ours) == [*forces, "mean_contact_force_n", "coordination_number", "contacts", "steps",
+                          "converged", "max_ratio", "seconds"]  # fmt: skip
+    assert ours["contacts"] == 7 and "yade_version" not in ours and pickle.loads(pickle.dumps(ours)) == ours

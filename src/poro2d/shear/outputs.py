@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
@@ -16,12 +15,6 @@ from poro2d.shear.lab import LabData
 def folder_name(sigma_kpa: float) -> str:
     """The folder of the test at ``sigma_kpa`` in a series' output (``sn100kPa``)."""
     return f"sn{sigma_kpa:g}kPa"
-
-
-def read_curve_csv(path: Path) -> list[dict]:
-    """The rows of a ``curve.csv`` (or any all-numeric CSV) as dicts of floats."""
-    with open(path, newline="") as fh:
-        return [{k: float(v) for k, v in r.items()} for r in csv.DictReader(fh)]
 
 
 def lab_fit(lab: LabData | None) -> MohrCoulombFit | None:
@@ -65,4 +58,4 @@ def write_figures(
     )  # fmt: skip
 
 
-__all__ = ["folder_name", "lab_fit", "read_curve_csv", "write_figures", "write_tables"]
+__all__ = ["folder_name", "lab_fit", "write_figures", "write_tables"]
