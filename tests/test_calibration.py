@@ -121,13 +121,15 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     for f in ("calibration_fit.png", "calibration_posterior.png", "calibration.md", "calibration.html"):
         assert (out / f).stat().st_size > 0, f
     # the paper report shows a calibration kept in its output folder (paper-out/calibration)
-    from poro2d.paper import read_calibration
+    from poro2d.calibration.run import CalibrationResult
     from poro2d.report.paper_report import _calibration_blocks
 
-    blocks = _calibration_blocks(read_calibration(out), out)
+    kept = CalibrationResult.read(out)
+    assert isinstance(kept, CalibrationResult) and kept == res
+    blocks = _calibration_blocks(kept, out)
     assert blocks[0] == ("h2", "Calibration of particle and rolling friction")
     assert any(b[0] == "img" and str(b[1]).endswith("calibration_posterior.png") for b in blocks)
-    assert read_calibration(tmp_path / "nothing") is None and _calibration_blocks(None, tmp_path) == []
+    assert CalibrationResult.read(tmp_path / "nothing") is None and _calibration_blocks(None, tmp_path) == []
     table, _ = load_shear_config(out / "calibrated.toml")
     assert table["particle_friction"] == res.best["particle_friction"]
     assert table["rolling_friction"] == res.best["rolling_friction"]

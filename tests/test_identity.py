@@ -14,7 +14,7 @@ import pytest
 from poro2d import __version__
 from poro2d.calibration.units import unit_key
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
-from poro2d.identity import outside_fields, outside_identity, run_digest
+from poro2d.identity import identity_digest, outside_fields, outside_identity
 from poro2d.resumable import Fingerprint
 from poro2d.shear.record import content_record, folder_stage
 from poro2d.shear.settings import ShearSettings
@@ -77,11 +77,11 @@ def test_a_marked_field_is_recorded_but_not_compared():
         size: float = 1.0
         workers: int = outside_identity(1)
 
-    assert run_digest(Run(workers=4)) == run_digest(Run())
-    assert run_digest(Run(size=2.0)) != run_digest(Run())
+    assert identity_digest(Run(workers=4)) == identity_digest(Run())
+    assert identity_digest(Run(size=2.0)) != identity_digest(Run())
     # a plain table stands for its dataclass through ``tables``
     tables = {"run": Run}
-    assert run_digest({"run": {"size": 1.0, "workers": 4}}, tables=tables) == run_digest(
+    assert identity_digest({"run": {"size": 1.0, "workers": 4}}, tables=tables) == identity_digest(
         {"run": {"size": 1.0, "workers": 1}}, tables=tables
     )
     assert (

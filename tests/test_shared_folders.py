@@ -166,14 +166,14 @@ with cache_entry(folder, parameter="case folder"):  # a worker of a killed sweep
 
 
 def test_a_case_still_running_elsewhere_is_waited_for_and_read_back(tmp_path):
-    from poro2d.sweep.runner import run_case_task
+    from poro2d.sweep.runner import compute_case
 
     folder = tmp_path / "cases" / "c1"
     cmd = [sys.executable, "-c", _CASE_HOLDER, str(folder), str(tmp_path / "held"), json.dumps(_CASE)]
     proc = subprocess.Popen(cmd, env=_env())
     try:
         _wait_for(tmp_path / "held", proc)
-        row = run_case_task(_CASE, str(folder), lambda config, out: {"by": "a second worker"})
+        row = compute_case(_CASE, str(folder), lambda config, out: {"by": "a second worker"})
     finally:
         assert proc.wait(60) == 0
     assert row["results"] == {"by": "the first worker"}

@@ -76,6 +76,32 @@ def test_peak_grows_with_normal_stress_and_outputs(series):
     assert "poro2d_version" in r["provenance"]
 
 
+def test_each_curve_travels_in_the_result_as_its_file_holds_it(specimen, series):
+    """The series' result carries every test's curve (not in result.json); a rerun reads them back
+    through ShearTestResult.read, with the same values bit for bit, and they pickle (the pool's way)."""
+    import pickle
+
+    from poro2d.shear.results import ShearTestResult
+
+    out, r = series
+    assert set(r.curves) == {50.0, 100.0, 200.0} and "curves" not in r.to_dict()
+    for sigma, curve in r.curves.items():
+        on_file = _curve(out / f"sn{sigma:g}kPa" / "curve.csv")
+        assert list(curve) == list(on_file)
+        for k in curve:
+            np.testing.assert_array_equal(curve[k], on_file[k])
+        read = ShearTestResult.read(out / f"sn{sigma:g}kPa")
+        assert read.normal_stress_kpa == sigma and read.curve["step"].size == read.records
+        back = pickle.loads(pickle.dumps(read))
+        np.testing.assert_array_equal(back.curve["shear_stress_kpa"], curve["shear_stress_kpa"])
+    again = ShearSeries(
+        specimen, [50, 100, 200], ShearSettings(**SHORT), out=out, processes=1, progress=False, figures=False
+    ).run()  # every test finished: read back, nothing run
+    for sigma, curve in r.curves.items():
+        for k in curve:
+            np.testing.assert_array_equal(again.curves[sigma][k], curve[k])
+
+
 def test_force_balance_during_shear(series):
     """Upper half, lower half and the contact forces across the shear plane agree.
 

@@ -10,7 +10,7 @@ import pytest
 
 from poro2d.cli import main
 from poro2d.errors import InputError
-from poro2d.sweep import parse_sweep, register_kind, run_sweep
+from poro2d.sweep import SweepResult, parse_sweep, register_kind, run_sweep
 from poro2d.sweep.runner import SINGLE_THREAD_ENV
 
 distributed = pytest.importorskip("distributed")
@@ -72,6 +72,9 @@ def test_criterion_sweep_uses_both_workers_and_rerun_skips(client, tmp_path):
     res = run_sweep(sweep, tmp_path, client=client, progress=False)
     wall = time.perf_counter() - t0
     assert [r["status"] for r in res.rows] == ["done"] * 8, [r.get("error") for r in res.rows]
+    # the result is sweep.json's content, typed, with the rows and the table beside the file
+    assert isinstance(res, SweepResult) and res == json.loads((tmp_path / "sweep.json").read_text())
+    assert res.status == "finished" and len(res.table) == 8 and res.failed == []
     pids = {r["pid"] for r in res.rows}
     assert len(pids) == 2, pids  # both worker processes ran cases
     print(
@@ -277,14 +280,14 @@ def test_worker_pins_numba_threads_so_a_compile_does_not_fail(monkeypatch):
 
 
 def test_a_case_runs_in_this_process_once_and_its_folder_binds(tmp_path):
-    from poro2d.sweep.runner import finished_row, run_case_task
+    from poro2d.sweep.runner import compute_case, finished_row
 
     case = parse_sweep(probe_cfg([3], seconds=0.0)).cases[0].to_dict()
     case["config"]["specimen"] = {"threads": 1}
     d = tmp_path / case["id"]
-    row = run_case_task(case, str(d), probe)
+    row = compute_case(case, str(d), probe)
     assert row["status"] == "done" and row["results"]["value"] == 6
-    assert run_case_task(case, str(d), probe) == row == finished_row(case, d)  # read back: ran once
+    assert compute_case(case, str(d), probe) == row == finished_row(case, d)  # read back: ran once
     assert (d / "run" / "runs.txt").read_text() == "1"
     assert json.loads((d / "params.json").read_text()) == case
     threads = dict(case, config=dict(case["config"], specimen={"threads": 2}))
@@ -292,5 +295,5 @@ def test_a_case_runs_in_this_process_once_and_its_folder_binds(tmp_path):
     assert finished_row(relabelled, d) == row  # labels and threads are not what the case depends on
     other = dict(case, config={"probe": {"x": 4, "seconds": 0.0}})
     assert finished_row(other, d) is None
-    failed = run_case_task(other, str(d), probe)  # a case folder holding another case
+    failed = compute_case(other, str(d), probe)  # a case folder holding another case
     assert failed["status"] == "failed" and "probe.x" in failed["error"]

@@ -12,6 +12,7 @@ shear summary and the accepted specimen's state and porosity files.
 
 import json
 import pickle
+import typing
 from pathlib import Path
 
 import pytest
@@ -218,3 +219,59 @@ def test_every_public_run_is_annotated_with_its_typed_result():
         assert hint == cls, (func.__qualname__, hint)
         for part in typing.get_args(hint) or (hint,):
             assert issubclass(part, TypedResult), part
+
+
+def _run_definitions() -> list[tuple[str, str]]:
+    """(module, qualified name) of every public ``run_*`` function and method defined in src."""
+    import ast
+
+    src = Path(__file__).parent.parent / "src"
+    found = []
+    for path in sorted((src / "poro2d").rglob("*.py")):
+        module = ".".join(path.relative_to(src).with_suffix("").parts)
+        tree = ast.parse(path.read_text())
+        defs = [("", node) for node in tree.body]
+        defs += [(f"{c.name}.", node) for c in tree.body if isinstance(c, ast.ClassDef) for node in c.body]
+        for prefix, node in defs:
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef) and node.name.startswith("run_"):
+                found.append((module, prefix + node.name))
+    return found
+
+
+def test_every_run_defined_in_src_returns_a_typed_result():
+    """A function named run_* is a run of the Python API: its result is typed (else name it otherwise)."""
+    import importlib
+    import inspect
+    import types
+
+    runs = _run_definitions()
+    assert ("poro2d.sweep.runner", "run_sweep") in runs and ("poro2d.paper", "run_paper") in runs
+    for module_name, qualname in runs:
+        module = importlib.import_module(module_name)
+        func = module
+        for part in qualname.split("."):
+            func = getattr(func, part)
+        hint = inspect.unwrap(func).__annotations__.get("return")
+        if isinstance(hint, str):  # postponed annotations: resolved in the defining module
+            hint = eval(hint, vars(module))  # noqa: S307 - an annotation of our own source
+        parts = typing.get_args(hint) if isinstance(hint, types.UnionType) else (hint,)
+        assert all(isinstance(p, type) and issubclass(p, TypedResult) for p in parts), (
+            module_name,
+            qualname,
+            hint,
+        )
+
+
+def test_a_settled_run_writes_the_keys_each_engine_reported():
+    from poro2d.interop.settled import SettledRun
+
+    forces = {"f_top_n_per_m": 1.0, "f_bottom_n_per_m": 2.0, "side_friction_up_n_per_m": 0.5}
+    yade = SettledRun(**forces, unbalanced_force=1e-6, steps=10, converged=True, seconds=0.1,
+                      yade_version="2023.02a", workdir="w")  # fmt: skip
+    yade_keys = ["unbalanced_force", "steps", "converged", "seconds", "yade_version", "workdir"]
+    assert list(yade) == [*forces, *yade_keys]
+    ours = SettledRun(**forces, mean_contact_force_n=3.0, coordination_number=3.5, contacts=7, steps=10,
+                      converged=True, max_ratio=1e-9, seconds=0.1)  # fmt: skip
+    assert list(ours) == [*forces, "mean_contact_force_n", "coordination_number", "contacts", "steps",
+                          "converged", "max_ratio", "seconds"]  # fmt: skip
+    assert ours["contacts"] == 7 and "yade_version" not in ours and pickle.loads(pickle.dumps(ours)) == ours

@@ -12,7 +12,7 @@ Every place that asks "is this the same run?" asks here: a resumable folder's re
 (:class:`poro2d.resumable.Fingerprint`), a sweep case's id and folder, a cached
 calibration, a calibration's shear test, the density checks that are calibration cases
 already. :func:`identity_view` gives the description as compared (to name the keys that
-differ), :func:`run_digest` its SHA-256.
+differ), :func:`identity_digest` its SHA-256.
 
 A plain config table carries no marks of its own: ``tables`` says which dataclass a table
 of the description stands for (``{"config.specimen": SpecimenSpec}``), and that class's
@@ -102,7 +102,7 @@ def identity_view(
     return data
 
 
-def run_digest(
+def identity_digest(
     description: Any,
     *,
     tables: Mapping[str, type] | None = None,
@@ -121,4 +121,11 @@ def run_digest(
     return hashlib.sha256(text.encode()).hexdigest()[:length]
 
 
-__all__ = ["IDENTITY", "identity_view", "outside_fields", "outside_identity", "outside_keys", "run_digest"]
+__all__ = [
+    "IDENTITY",
+    "identity_digest",
+    "identity_view",
+    "outside_fields",
+    "outside_identity",
+    "outside_keys",
+]

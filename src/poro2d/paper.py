@@ -21,7 +21,7 @@ from poro2d.criterion.config import paper_config
 from poro2d.criterion.replicates import accepted_and_replicates
 from poro2d.io_utils import provenance, write_csv, write_json
 from poro2d.locks import holds_output
-from poro2d.paper_data import PAPER
+from poro2d.paper_data import PAPER, QUICK_SHEAR
 from poro2d.resumable import Fingerprint, ResumableStage
 from poro2d.typed_result import TypedResult
 
@@ -32,7 +32,6 @@ if TYPE_CHECKING:
 console = OutputConsole()
 
 NORMAL_STRESSES_KPA = (50.0, 100.0, 200.0)
-QUICK_SHEAR = {"max_displacement": 0.004}
 
 
 @dataclass(eq=False)
@@ -148,26 +147,14 @@ def run_paper(
     summary, criterion, shear_figures = _run_stages(out, stage, crit, quick=quick, replicates=replicates,
                                                     lab_data=lab_data, progress=progress)  # fmt: skip
     write_json(out / "results.json", summary.to_dict())
+    from poro2d.calibration.run import CalibrationResult
     from poro2d.report.paper_report import CALIBRATION_FOLDER, write_paper_report
 
     # the report takes objects and opens no file: a calibration kept beside the run is read here
     md, html = write_paper_report(out, summary, criterion, shear_figures=shear_figures,
-                                  calibration=read_calibration(out / CALIBRATION_FOLDER))  # fmt: skip
+                                  calibration=CalibrationResult.read(out / CALIBRATION_FOLDER))  # fmt: skip
     console.print(f"results in {out}/results.json; report: {html} and {md}")
     return summary
-
-
-def read_calibration(folder: Path):
-    """The calibration kept in ``folder`` (``poro2d calibrate --out <paper-out>/calibration``), or None.
-
-    Read by field names: the calibration package runs the paper's specimens
-    (:func:`paper_config`), so this module does not import its result class.
-    """
-    import json
-    from types import SimpleNamespace
-
-    path = folder / "result.json"
-    return SimpleNamespace(**json.loads(path.read_text())) if path.is_file() else None
 
 
 def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, quick: bool, replicates: int,

@@ -61,5 +61,7 @@ QUICK_SPECIMEN = {"width": 0.08, "height": 0.04, "layers": 2}
 #: quick look uses a wider window (stated in its report), and the paper's plate: the fill
 #: acceptance's lid needs a window of many grain weights (docs/criterion.md)
 QUICK_CRITERION = {"force_fraction": 0.05, "acceptance": "plate"}
+#: the quick look's direct shear (and the quick calibration's): sheared to 4 mm
+QUICK_SHEAR = {"max_displacement": 0.004}
 
-__all__ = ["PAPER", "QUICK_CRITERION", "QUICK_SPECIMEN", "TABLE_1", "Table1"]
+__all__ = ["PAPER", "QUICK_CRITERION", "QUICK_SHEAR", "QUICK_SPECIMEN", "TABLE_1", "Table1"]

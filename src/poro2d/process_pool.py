@@ -48,7 +48,7 @@ class JobsFailed(RuntimeError):
         super().__init__(f"{len(errors)} {what} failed: {details}")
 
 
-def run_jobs(
+def map_jobs(
     task: Callable[..., Any],
     jobs: Sequence[Any],
     processes: int,
@@ -199,4 +199,4 @@ def _ignore(*_msg) -> None:
     pass
 
 
-__all__ = ["REPORT_INTERVAL_S", "JobsFailed", "run_jobs"]
+__all__ = ["REPORT_INTERVAL_S", "JobsFailed", "map_jobs"]

@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from poro2d.errors import InputError
-from poro2d.identity import identity_view, run_digest
+from poro2d.identity import identity_digest, identity_view
 from poro2d.io_utils import as_json, write_json
 from poro2d.locks import is_lock_file
 
@@ -80,8 +80,8 @@ class Fingerprint:
 
     @property
     def digest(self) -> str:
-        """The digest of the compared content (:func:`poro2d.identity.run_digest`)."""
-        return run_digest(self.content, tables=self.tables, ignore=self.ignore)
+        """The digest of the compared content (:func:`poro2d.identity.identity_digest`)."""
+        return identity_digest(self.content, tables=self.tables, ignore=self.ignore)
 
     def differences(self, stored: Mapping) -> list[str]:
         """The keys in which a recorded fingerprint differs from this one (none: the same work)."""

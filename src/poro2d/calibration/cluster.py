@@ -9,7 +9,7 @@ from __future__ import annotations
 import time
 import traceback
 
-from poro2d.calibration.units import run_unit, stored_row
+from poro2d.calibration.units import compute_unit, stored_row
 from poro2d.sweep.runner import (
     DEFAULT_DASHBOARD,
     hold_interrupts,
@@ -70,7 +70,7 @@ class UnitRunner:
         t0 = time.perf_counter()
         client = self._client()
         futures = {
-            client.submit(run_unit, job, key=f"calibrate-{job['key']}", pure=False): job for job in todo
+            client.submit(compute_unit, job, key=f"calibrate-{job['key']}", pure=False): job for job in todo
         }
         done_before = f" ({len(rows)} of {len(jobs)} cached)" if rows else ""
         try:

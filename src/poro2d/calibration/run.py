@@ -10,6 +10,7 @@ Everything is checked before the first test starts.
 
 from __future__ import annotations
 
+import json
 import os
 import time
 from dataclasses import dataclass
@@ -25,6 +26,7 @@ from poro2d.calibration.units import unit_job
 from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.io_utils import check_output_dir, provenance
 from poro2d.locks import holds_output
+from poro2d.paper_data import QUICK_SHEAR
 from poro2d.shear.lab import LabData, read_lab_csv
 from poro2d.shear.series import check_stresses
 from poro2d.shear.settings import MAX_FRICTION, ShearSettings
@@ -69,6 +71,12 @@ class CalibrationResult(TypedResult):
     timings: dict[str, float]
     config: dict[str, Any]
     provenance: dict[str, Any]
+
+    @classmethod
+    def read(cls, folder: str | os.PathLike) -> CalibrationResult | None:
+        """The calibration finished in ``folder`` (its ``result.json``), or None when there is none."""
+        path = Path(folder) / "result.json"
+        return cls.from_dict(json.loads(path.read_text())) if path.is_file() else None
 
 
 def check_range_pair(name: str, value, lo: float, hi: float, lo_open: bool = False) -> tuple[float, float]:
@@ -175,8 +183,6 @@ def run_calibration(
     check_range("--lab-error", lab_error, 0.0, 1.0)
     check_range("--level", level, 0.0, 1.0, lo_open=True, hi_open=True)
     if settings is None and quick:
-        from poro2d.paper import QUICK_SHEAR
-
         settings = dict(QUICK_SHEAR)
     base = _base_settings(settings)
     targets = _lab_targets(lab_data, base)

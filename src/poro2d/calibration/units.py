@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from poro2d.identity import run_digest
+from poro2d.identity import identity_digest
 from poro2d.shear.settings import ShearSettings
 from poro2d.shear.single import DirectShearTest
 from poro2d.sweep.runner import pin_numba_threads
@@ -22,13 +22,13 @@ OBSERVABLES = ("peak", "end")
 
 
 def unit_key(specimen_digest: str, sigma: float, settings: dict) -> str:
-    """The run digest naming a unit's folder (:func:`poro2d.identity.run_digest`).
+    """The run digest naming a unit's folder (:func:`poro2d.identity.identity_digest`).
 
     Spaced as these keys were first written, so the folders of earlier calibrations keep
     their names and are reused.
     """
     unit = {"specimen": specimen_digest, "sigma": sigma, "settings": settings}
-    return run_digest(unit, tables={"settings": ShearSettings}, length=20, layout="spaced")
+    return identity_digest(unit, tables={"settings": ShearSettings}, length=20, layout="spaced")
 
 
 def unit_job(
@@ -81,7 +81,7 @@ def stored_row(job: dict) -> dict | None:
     return None if res is None else _row(job, res)
 
 
-def run_unit(job: dict) -> dict:
+def compute_unit(job: dict) -> dict:
     """Run (or finish) one unit, on one numba thread: the task a Dask worker runs."""
     pin_numba_threads()
     return _row(job, _test(job).run())
@@ -98,4 +98,4 @@ def unit_curve(job: dict) -> tuple[np.ndarray, np.ndarray] | None:
     return table["shear_displacement_mm"].to_numpy() * 1e-3, table["shear_stress_kpa"].to_numpy()
 
 
-__all__ = ["OBSERVABLES", "run_unit", "stored_row", "unit_curve", "unit_job", "unit_key"]
+__all__ = ["OBSERVABLES", "compute_unit", "stored_row", "unit_curve", "unit_job", "unit_key"]

@@ -19,7 +19,7 @@ from pathlib import Path
 from poro2d.console import OutputConsole
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.criterion.result import ReplicatesResult
-from poro2d.process_pool import run_jobs
+from poro2d.process_pool import map_jobs
 from poro2d.progress import JobsProgress
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.grading import GradingCurve
@@ -60,7 +60,7 @@ def run_replicates(
     jobs = [(spec1, grading, first, sd, Path(out) / f"seed{sd}") for sd in seeds]
     names = [f"seed {sd}" for sd in seeds]
     with JobsProgress("replicate criterion", names, enabled=progress) as display:
-        rows = run_jobs(
+        rows = map_jobs(
             _run_one, jobs, processes, names=names, what="replicate criterion run(s)",
             on_report=display.update, on_done=lambda index, row: display.done(index, _outcome(row)),
         )  # fmt: skip

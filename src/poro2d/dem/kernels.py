@@ -670,7 +670,7 @@ def _run_threads(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, 
 
 
 @njit(cache=True)
-def run_serial(disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll):
+def step_block_serial(disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll):
     prepare(disks, nb, wb, work, prm)
     _worker(0, 1, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll)
     out[THREADS_USED] = 1
@@ -682,7 +682,7 @@ def rolling_active(disk_mu_r: np.ndarray) -> bool:
     return bool(disk_mu_r.size and disk_mu_r.max() > 0.0)
 
 
-def run_steps(rec: KernelRecords, prm, iprm, out) -> None:
+def step_block(rec: KernelRecords, prm, iprm, out) -> None:
     """Advance up to ``iprm[NSTEPS]`` steps on ``iprm[THREADS]`` threads (see module doc).
 
     ``rec`` holds the arrays (:func:`poro2d.dem.records.kernel_records`).
@@ -693,7 +693,7 @@ def run_steps(rec: KernelRecords, prm, iprm, out) -> None:
     dash = float(prm[BETA]) if prm[BETA] > 0.0 else None
     roll = RollingProps(disks.mu_r, walls.mu_r) if rolling_active(disks.mu_r) else None
     if nthr <= 1:
-        run_serial(disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll)
+        step_block_serial(disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll)
         return
     work.sync[:] = 0
     if _run_threads(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll):

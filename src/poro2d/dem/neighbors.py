@@ -13,7 +13,7 @@ it needs and changes nothing, so the caller can grow the arrays and retry.
 A build is a sequence of phases (grid, count rows, prefix sums, fill rows, copy
 back). The phases over rows take a disk range ``[lo, hi)`` and write only their own
 rows, so the engine's workers run them side by side between barriers
-(:func:`poro2d.dem.kernels.run_steps`); :func:`build_pairs` and
+(:func:`poro2d.dem.kernels.step_block`); :func:`build_pairs` and
 :func:`build_wall_pairs` run them one after the other. Either way the lists are the
 same, slot for slot.
 

@@ -623,7 +623,7 @@ class Simulation:
         while done < nsteps:
             self._load_params(nsteps - done, check_every, ratio_target, offset + done, measure)
             out[:] = 0.0
-            K.run_steps(self.kernel_records(), params.prm, params.iprm, out)
+            K.step_block(self.kernel_records(), params.prm, params.iprm, out)
             self.threads_used = int(out[K.THREADS_USED])
             steps = int(out[K.STEPS_DONE])
             if ratio_target and (offset + done + steps) // check_every > (offset + done) // check_every:

@@ -29,7 +29,14 @@ from poro2d.criterion.protocol import wall_forces
 from poro2d.dem.measure import coordination_number
 from poro2d.dem.state import BOX_WALLS
 from poro2d.interop import lammps as lmp
-from poro2d.interop.lammps_run import parse_thermo, read_dump, read_result_line, run_script, version_from_log
+from poro2d.interop.lammps_run import (
+    execute_script,
+    parse_thermo,
+    read_dump,
+    read_result_line,
+    version_from_log,
+)
+from poro2d.interop.settled import SettledRun
 from poro2d.interop.specimen_data import SpecimenData
 
 #: quantities compared, as (key, label) pairs
@@ -42,14 +49,14 @@ QUANTITIES = (
 )
 
 
-def run_poro2d(spec: SpecimenData, ratio: float, max_steps: int) -> dict:
+def run_poro2d(spec: SpecimenData, ratio: float, max_steps: int) -> SettledRun:
     """poro2d from the exported state: disks at rest, no history; cycled until ``ratio``."""
     sim = spec.to_simulation(dt=spec.dt)
     t0 = time.perf_counter()
     res = sim.solve(ratio, max_steps)
-    out = _named_forces(wall_forces(sim))
     mags = sim.contacts().magnitude
-    out.update(
+    return SettledRun(
+        **_named_forces(wall_forces(sim)),
         mean_contact_force_n=float(mags.mean()) if mags.size else 0.0,
         coordination_number=coordination_number(sim),
         contacts=int(mags.size),
@@ -58,7 +65,6 @@ def run_poro2d(spec: SpecimenData, ratio: float, max_steps: int) -> dict:
         max_ratio=res.max_ratio,
         seconds=time.perf_counter() - t0,
     )
-    return out
 
 
 def _named_forces(forces: dict) -> dict:
@@ -66,12 +72,12 @@ def _named_forces(forces: dict) -> dict:
     return {k: float(forces[k]) for k in keys}
 
 
-def run_lammps(spec: SpecimenData, workdir: str | os.PathLike, ratio: float, max_steps: int) -> dict:
+def run_lammps(spec: SpecimenData, workdir: str | os.PathLike, ratio: float, max_steps: int) -> SettledRun:
     """LAMMPS on the exported files in ``workdir``, run as written but for the stop ratio and step cap."""
     wd = Path(workdir)
     lmp.write_specimen(spec, wd, ratio=ratio, max_steps=max_steps)
     t0 = time.perf_counter()
-    log = run_script(wd, lmp.INPUT_FILE)
+    log = execute_script(wd, lmp.INPUT_FILE)
     seconds = time.perf_counter() - t0
     res = read_result_line(log)
     pairs = read_dump(wd / lmp.FINAL_CONTACTS)
@@ -84,19 +90,19 @@ def run_lammps(spec: SpecimenData, workdir: str | os.PathLike, ratio: float, max
         mags.append(np.hypot(disks[f"f_w_{w}[2]"][on], disks[f"f_w_{w}[3]"][on]))
     allm = np.concatenate(mags)
     head, rows = parse_thermo(log)[-1]
-    return {
-        "f_top_n_per_m": res["f_top"],
-        "f_bottom_n_per_m": res["f_bottom"],
-        "side_friction_up_n_per_m": res["side_friction_up"],
-        "mean_contact_force_n": float(allm.mean()) if allm.size else 0.0,
-        "coordination_number": res["coordination"],
-        "contacts": int(allm.size),
-        "steps": int(rows[-1][head.index("Step")]),
-        "converged": res["ratio"] < ratio,
-        "max_ratio": res["ratio"],
-        "seconds": seconds,
-        "lammps_version": version_from_log(log),
-    }
+    return SettledRun(
+        f_top_n_per_m=res["f_top"],
+        f_bottom_n_per_m=res["f_bottom"],
+        side_friction_up_n_per_m=res["side_friction_up"],
+        mean_contact_force_n=float(allm.mean()) if allm.size else 0.0,
+        coordination_number=res["coordination"],
+        contacts=int(allm.size),
+        steps=int(rows[-1][head.index("Step")]),
+        converged=res["ratio"] < ratio,
+        max_ratio=res["ratio"],
+        seconds=seconds,
+        lammps_version=version_from_log(log),
+    )
 
 
 def compare(spec: SpecimenData, ratio: float = 1e-5, max_steps: int = 2_000_000,

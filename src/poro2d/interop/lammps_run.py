@@ -86,8 +86,8 @@ def version_from_log(log: str) -> str:
     return m.group(1) if m else "unknown"
 
 
-def run_script(workdir: str | os.PathLike, script: str, variables: dict | None = None,
-               timeout: float = 3600.0) -> str:  # fmt: skip
+def execute_script(workdir: str | os.PathLike, script: str, variables: dict | None = None,
+                   timeout: float = 3600.0) -> str:  # fmt: skip
     """Run ``lmp -in script`` in ``workdir`` (log in ``log.lammps``); returns the log's text.
 
     ``variables`` are passed as ``-var NAME VALUE`` (they override the script's ``index``

@@ -16,6 +16,7 @@ import time
 from pathlib import Path
 
 from poro2d.interop import yade
+from poro2d.interop.settled import SettledRun
 from poro2d.interop.specimen_data import SpecimenData
 
 #: the tag of the line the exported script prints last
@@ -46,7 +47,7 @@ def yade_env(threads: int = 1) -> dict:
     return env
 
 
-def run_script(workdir: str | os.PathLike, settings: dict | None = None, timeout: float = 3600.0) -> str:
+def execute_script(workdir: str | os.PathLike, settings: dict | None = None, timeout: float = 3600.0) -> str:
     """Run ``yade -n -x specimen_yade.py key=value ...`` in ``workdir``; returns its output.
 
     ``settings`` override the script's stop settings (ratio, max_steps, check_every).
@@ -76,7 +77,7 @@ def version_from_output(output: str) -> str:
     return m.group(1) if m else "unknown"
 
 
-def run_yade(spec: SpecimenData, workdir: str | os.PathLike, ratio: float, max_steps: int) -> dict:
+def run_yade(spec: SpecimenData, workdir: str | os.PathLike, ratio: float, max_steps: int) -> SettledRun:
     """YADE on the exported script in ``workdir``, run as written but for the stop settings.
 
     ``ratio`` is YADE's own measure of rest (``utils.unbalancedForce()``: the mean
@@ -84,16 +85,16 @@ def run_yade(spec: SpecimenData, workdir: str | os.PathLike, ratio: float, max_s
     """
     yade.write_specimen(spec, workdir, ratio=ratio, max_steps=max_steps)
     t0 = time.perf_counter()
-    output = run_script(workdir)
+    output = execute_script(workdir)
     res = read_result(output)
-    return {
-        "f_top_n_per_m": res["f_top_n_per_m"],
-        "f_bottom_n_per_m": res["f_bottom_n_per_m"],
-        "side_friction_up_n_per_m": res["side_friction_up_n_per_m"],
-        "unbalanced_force": res["unbalanced_force"],
-        "steps": int(res["steps"]),
-        "converged": res["unbalanced_force"] < ratio,
-        "seconds": time.perf_counter() - t0,
-        "yade_version": version_from_output(output),
-        "workdir": str(Path(workdir)),
-    }
+    return SettledRun(
+        f_top_n_per_m=res["f_top_n_per_m"],
+        f_bottom_n_per_m=res["f_bottom_n_per_m"],
+        side_friction_up_n_per_m=res["side_friction_up_n_per_m"],
+        unbalanced_force=res["unbalanced_force"],
+        steps=int(res["steps"]),
+        converged=res["unbalanced_force"] < ratio,
+        seconds=time.perf_counter() - t0,
+        yade_version=version_from_output(output),
+        workdir=str(Path(workdir)),
+    )

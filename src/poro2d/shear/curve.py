@@ -25,6 +25,34 @@ CURVE_COLUMNS = [
 ]  # fmt: skip
 
 
+def curve_columns(rows: list[dict]) -> dict[str, np.ndarray]:
+    """A curve's records as one float array per column of :data:`CURVE_COLUMNS` (none without rows).
+
+    Every value goes through ``float`` as ``curve.csv`` stores it (an integer column reads
+    back as floats), so a curve in memory and one read from its file are the same arrays.
+    """
+    if not rows:
+        return {}
+    return {k: np.array([float(r[k]) for r in rows]) for k in CURVE_COLUMNS}
+
+
+def curve_rows(curve: dict[str, np.ndarray]) -> list[dict]:
+    """The records of a curve held as columns (:func:`curve_columns`), as rows of Python floats."""
+    names = list(curve)
+    return [
+        dict(zip(names, values, strict=True))
+        for values in zip(*(curve[k].tolist() for k in names), strict=True)
+    ]
+
+
+def read_curve(path) -> dict[str, np.ndarray]:
+    """The columns of a test's ``curve.csv`` (as :func:`curve_columns`)."""
+    import csv
+
+    with open(path, newline="") as fh:
+        return curve_columns(list(csv.DictReader(fh)))
+
+
 def curve_row(
     sim: Simulation, box: SplitBox, settings: ShearSettings, contacts: ContactSet,
     y_plate0: float, step0: int, rho: float,

@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
 
 from poro2d.io_utils import write_csv
-from poro2d.shear.curve import CURVE_COLUMNS
+from poro2d.shear.curve import CURVE_COLUMNS, curve_rows
 from poro2d.shear.fit import MohrCoulombFit, mohr_coulomb
 from poro2d.shear.lab import LabData
 
@@ -16,12 +15,6 @@ from poro2d.shear.lab import LabData
 def folder_name(sigma_kpa: float) -> str:
     """The folder of the test at ``sigma_kpa`` in a series' output (``sn100kPa``)."""
     return f"sn{sigma_kpa:g}kPa"
-
-
-def read_curve_csv(path: Path) -> list[dict]:
-    """The rows of a ``curve.csv`` (or any all-numeric CSV) as dicts of floats."""
-    with open(path, newline="") as fh:
-        return [{k: float(v) for k, v in r.items()} for r in csv.DictReader(fh)]
 
 
 def lab_fit(lab: LabData | None) -> MohrCoulombFit | None:
@@ -32,32 +25,30 @@ def lab_fit(lab: LabData | None) -> MohrCoulombFit | None:
     return mohr_coulomb(ls, [lab.peaks[v] for v in ls])
 
 
-def read_curves(out: Path, tests: list[dict]) -> dict[float, list[dict]]:
-    """The curve rows of every test of a series, by normal stress."""
-    return {t["normal_stress_kpa"]: read_curve_csv(out / folder_name(t["normal_stress_kpa"]) / "curve.csv")
-            for t in tests}  # fmt: skip
+def write_tables(out: Path, curves: dict[float, dict[str, np.ndarray]], summary: list[dict]) -> None:
+    """``curves.csv`` (every curve, long format) and ``peaks.csv`` (one row per test).
 
-
-def write_tables(out: Path, curves: dict[float, list[dict]], summary: list[dict]) -> None:
-    """``curves.csv`` (every curve, long format) and ``peaks.csv`` (one row per test)."""
-    long_rows = [{"normal_stress_kpa": sigma, **r} for sigma, rows in curves.items() for r in rows]
+    ``curves``: each test's curve (:attr:`ShearTestResult.curve`) by normal stress.
+    """
+    long_rows = [
+        {"normal_stress_kpa": sigma, **row} for sigma, curve in curves.items() for row in curve_rows(curve)
+    ]
     write_csv(out / "curves.csv", long_rows, header=["normal_stress_kpa"] + CURVE_COLUMNS)
     write_csv(out / "peaks.csv", [{k: v for k, v in r.items() if not isinstance(v, dict)} for r in summary])
 
 
 def write_figures(
-    out: Path, tests: list[dict], curves: dict[float, list[dict]], fit, fit0, settings, lab: LabData | None
-) -> None:
+    out: Path, tests: list[dict], curves: dict[float, dict[str, np.ndarray]], fit, fit0, settings,
+    lab: LabData | None,
+) -> None:  # fmt: skip
     """``fig8a_shear_curves.png`` (curves, peaks marked) and ``fig8b_peak_strength.png`` (the fits)."""
     from poro2d.report.shear_figures import plot_peak_strength, plot_shear_curves
 
-    arrays = {sigma: {k: np.array([r[k] for r in rows]) for k in rows[0]} if rows else {}
-              for sigma, rows in curves.items()}  # fmt: skip
     peaks = {
         t["normal_stress_kpa"]: (t["shear_displacement_at_peak_m"], t["peak_shear_stress_kpa"]) for t in tests
     }
     plot_shear_curves(
-        arrays, out / "fig8a_shear_curves.png", lab=lab, peaks=peaks,
+        curves, out / "fig8a_shear_curves.png", lab=lab, peaks=peaks,
         smoothing_note=f"v = {1e3 * settings.velocity:g} mm/s; peaks (dots) smoothed over "
         f"{1e3 * settings.peak_window:g} mm",
     )  # fmt: skip
@@ -67,4 +58,4 @@ def write_figures(
     )  # fmt: skip
 
 
-__all__ = ["folder_name", "lab_fit", "read_curve_csv", "read_curves", "write_figures", "write_tables"]
+__all__ = ["folder_name", "lab_fit", "write_figures", "write_tables"]

@@ -10,7 +10,7 @@ periodic lines in a log.
 
 from __future__ import annotations
 
-from poro2d.process_pool import run_jobs
+from poro2d.process_pool import map_jobs
 from poro2d.progress import JobsProgress
 from poro2d.shear.settings import ShearSettings
 from poro2d.shear.single import DirectShearTest
@@ -74,7 +74,7 @@ def execute_jobs(jobs: list[dict], processes: int, progress: bool) -> dict:
         def show(index: int, phase: str, fraction: float) -> None:
             bars.update(index, phase, fraction if phase == "shearing" else None)
 
-        done = run_jobs(
+        done = map_jobs(
             _run_job, todo, processes, names=names, what="direct shear test(s)", start_first=_slowest_first,
             on_report=show, on_done=lambda index, _result: bars.done(index),
         )  # fmt: skip

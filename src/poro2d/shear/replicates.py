@@ -154,24 +154,20 @@ class ReplicateShear:
         write_csv(self.out / "replicates.csv", [{k: v for k, v in r.items() if k != "peaks_kpa"}
                                                  for r in summary.per_normal_stress])  # fmt: skip
         write_json(self.out / "replicates.json", summary.to_dict())
+        summary.series = per
         if self.figures:
             self._figures(summary)
-        summary.series = per
         return summary
 
     def _figures(self, summary: ReplicateShearResult) -> None:
         """fig8a/fig8b over specimens: mean curves with +- sd bands, peaks with the pooled fit."""
         from poro2d.report.shear_figures import curve_band, plot_replicate_curves, plot_replicate_peaks
-        from poro2d.shear.outputs import folder_name, lab_fit, read_curve_csv
+        from poro2d.shear.outputs import lab_fit
 
         bands = {}
         for row in summary.per_normal_stress:
             sigma = row["normal_stress_kpa"]
-            curves = []
-            for s in self.series.values():
-                rows = read_curve_csv(s.out / folder_name(sigma) / "curve.csv")
-                curves.append({k: np.array([r[k] for r in rows]) for k in rows[0]})
-            bands[sigma] = curve_band(curves)
+            bands[sigma] = curve_band([res.curves[sigma] for res in summary.series.values()])
         n = len(self.series)
         lab = next(iter(self.series.values())).lab
         plot_replicate_curves(bands, self.out / "fig8a_shear_curves_replicates.png", n, lab=lab)

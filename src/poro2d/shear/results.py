@@ -3,8 +3,12 @@ replicate specimens' ``replicates.json``."""
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, ClassVar
+
+import numpy as np
 
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
@@ -16,7 +20,8 @@ class ShearTestResult(TypedResult):
     The first fields are read off the curve (:func:`poro2d.shear.curve.curve_summary`):
     the smoothed peak and where it lies, the end values (``end``: smoothed over one peak
     window), the servo's stress error, the inertial number and the force balance. Stresses
-    in kPa, lengths in m unless the name says mm.
+    in kPa, lengths in m unless the name says mm. ``curve`` (not in the file): the recorded
+    curve, one float array per column of ``curve.csv`` (empty when the test is not at hand).
     """
 
     normal_stress_kpa: float
@@ -50,6 +55,20 @@ class ShearTestResult(TypedResult):
     specimen: str
     engine: dict[str, Any]
     provenance: dict[str, Any]
+    curve: dict[str, np.ndarray] = field(default_factory=dict, kw_only=True, repr=False, metadata=NOT_IN_FILE)
+
+    @classmethod
+    def read(cls, folder: str | Path, data: dict[str, Any] | None = None) -> ShearTestResult:
+        """A finished test read back from ``folder``: its ``result.json`` and its ``curve.csv``.
+
+        ``data``: the content of ``result.json`` when the caller has read it already.
+        """
+        from poro2d.shear.curve import read_curve
+
+        folder = Path(folder)
+        result = cls.from_dict(data if data is not None else json.loads((folder / "result.json").read_text()))
+        result.curve = read_curve(folder / "curve.csv")
+        return result
 
 
 @dataclass(eq=False)
@@ -60,7 +79,8 @@ class ShearSeriesResult(TypedResult):
     consolidation's stress error, the test's folder). The Mohr-Coulomb fit (``fit``, and
     its ``friction_angle_deg``, ``cohesion_kpa``, ``r2``) needs two stresses or more, else
     they are None. ``rate_check`` and ``lab`` are in the file only when the series ran with
-    them.
+    them. ``curves`` (not in the file): each test's curve (:attr:`ShearTestResult.curve`)
+    by normal stress, for figures and summaries made from the result.
     """
 
     OPTIONAL: ClassVar[tuple[str, ...]] = ("rate_check", "lab")
@@ -88,6 +108,9 @@ class ShearSeriesResult(TypedResult):
     lab: dict[str, Any] | None = None
     wall_time_s: float | None = None
     provenance: dict[str, Any] | None = None
+    curves: dict[float, dict[str, np.ndarray]] = field(
+        default_factory=dict, kw_only=True, repr=False, metadata=NOT_IN_FILE
+    )
 
 
 @dataclass(eq=False)

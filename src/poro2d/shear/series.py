@@ -16,13 +16,11 @@ from poro2d.shear.fit import mohr_coulomb, smooth
 from poro2d.shear.outputs import (
     folder_name,
     lab_fit,
-    read_curve_csv,
-    read_curves,
     write_figures,
     write_tables,
 )
 from poro2d.shear.pool import execute_jobs, job_test
-from poro2d.shear.results import ShearSeriesResult
+from poro2d.shear.results import ShearSeriesResult, ShearTestResult
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings
 from poro2d.shear.specimen_file import resolve_specimen
 
@@ -169,11 +167,12 @@ class ShearSeries:
             result.lab = self._lab_part(fit)
         result.wall_time_s = time.perf_counter() - t0
         result.provenance = provenance()
-        curves = read_curves(self.out, tests)
+        curves = {t["normal_stress_kpa"]: t.curve for t in tests}
         write_tables(self.out, curves, summary)
         if self.figures:
             write_figures(self.out, tests, curves, fit, fit0, self.settings, self.lab)
         write_json(self.out / "result.json", result)
+        result.curves = curves
         return result
 
     @staticmethod
@@ -198,7 +197,7 @@ class ShearSeries:
             "sigma_n the measured plate stress at each record",
         }
 
-    def _rate_check(self, tests: list[dict], results: dict, sig: np.ndarray, fit) -> dict:
+    def _rate_check(self, tests: list[ShearTestResult], results: dict, sig: np.ndarray, fit) -> dict:
         """How the peaks change at half the velocity (the reruns under ``rate_check/``)."""
         rows = []
         for t in tests:
@@ -231,15 +230,14 @@ class ShearSeries:
             "note": RATE_CHECK_NOTE,
         }
 
-    def _pre_peak_change(self, t: dict, h: dict) -> float:
+    def _pre_peak_change(self, t: ShearTestResult, h: ShearTestResult) -> float:
         """Mean |tau_half - tau| / tau_peak of the smoothed curves up to the earlier peak."""
         w = self.settings.peak_window
-        a = read_curve_csv(self.out / folder_name(t["normal_stress_kpa"]) / "curve.csv")
-        b = read_curve_csv(self.out / "rate_check" / folder_name(t["normal_stress_kpa"]) / "curve.csv")
-        xa = np.array([r["shear_displacement_mm"] for r in a]) * 1e-3
-        xb = np.array([r["shear_displacement_mm"] for r in b]) * 1e-3
-        ya = smooth(xa, np.array([r["shear_stress_kpa"] for r in a]), w)
-        yb = np.interp(xa, xb, smooth(xb, np.array([r["shear_stress_kpa"] for r in b]), w))
+        a, b = t.curve, h.curve
+        xa = a["shear_displacement_mm"] * 1e-3
+        xb = b["shear_displacement_mm"] * 1e-3
+        ya = smooth(xa, a["shear_stress_kpa"], w)
+        yb = np.interp(xa, xb, smooth(xb, b["shear_stress_kpa"], w))
         end = min(t["shear_displacement_at_peak_m"], h["shear_displacement_at_peak_m"])
         m = (xa >= 0.5 * w) & (xa <= end)
         if not m.any():

@@ -29,7 +29,7 @@ from poro2d.resumable import ResumableStage
 from poro2d.shear import record
 from poro2d.shear.box import SplitBox, build_split_box
 from poro2d.shear.controllers import Consolidation, ProgressFn
-from poro2d.shear.curve import CURVE_COLUMNS, curve_summary
+from poro2d.shear.curve import CURVE_COLUMNS, curve_columns, curve_summary
 from poro2d.shear.peak_frame import PeakFrame
 from poro2d.shear.results import ShearTestResult
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings, inertial_number
@@ -102,7 +102,7 @@ class DirectShearTest:
     def stored(self) -> ShearTestResult | None:
         """The result of this test when ``out`` holds it finished, else None (it has to run)."""
         data = self.stage().stored() if self.out is not None else None
-        return None if data is None else ShearTestResult.from_dict(data)
+        return None if data is None else ShearTestResult.read(self.out, data)
 
     # ----------------------------------------------------------------- stages
     def _build_box(self) -> tuple[Simulation, SplitBox]:
@@ -179,6 +179,7 @@ class DirectShearTest:
         )  # fmt: skip
         wall = stage.run()
         result = self._result(stage.rows, info, stage.sim, wall)
+        result.curve = curve_columns(stage.rows)
         if self.out is not None:
             write_csv(self.out / "curve.csv", stage.rows, header=CURVE_COLUMNS)
             if self.figures and stage.peak.frame is not None:
@@ -229,10 +230,24 @@ class DirectShearTest:
         ``consolidated.npz``; a test killed while shearing continues from its checkpoint.
         """
         if self.out is None:
-            return ShearTestResult.from_dict(as_json(self._consolidate_and_shear()))
-        result = self.stage().run(self._consolidate_and_shear, decode=ShearTestResult.from_dict)
+            return self._as_stored(self._consolidate_and_shear())
+        fresh: list[ShearTestResult] = []
+
+        def compute() -> ShearTestResult:
+            fresh.append(self._consolidate_and_shear())
+            return fresh[0]
+
+        data = self.stage().run(compute)
         remove_stage_files(self.out)  # the shear stage's checkpoints, once result.json is written
-        return result
+        # a test run now keeps its curve in memory; a finished one is read back with its curve.csv
+        return self._as_stored(fresh[0], data) if fresh else ShearTestResult.read(self.out, data)
+
+    @staticmethod
+    def _as_stored(result: ShearTestResult, data: dict | None = None) -> ShearTestResult:
+        """``result`` as its ``result.json`` holds it (``data``, else JSON types), with its curve."""
+        stored = ShearTestResult.from_dict(data if data is not None else as_json(result))
+        stored.curve = result.curve
+        return stored
 
     def _consolidate_and_shear(self) -> ShearTestResult:
         sim, info = self.consolidate()

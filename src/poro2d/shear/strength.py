@@ -30,7 +30,6 @@ import numpy as np
 from poro2d.errors import InputError, check_range
 from poro2d.io_utils import provenance, write_csv, write_json
 from poro2d.shear.fit import mohr_coulomb
-from poro2d.shear.outputs import folder_name, read_curve_csv
 from poro2d.shear.replicates import ReplicateShear, mohr_coulomb_ci
 from poro2d.shear.results import ReplicateShearResult
 from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
@@ -86,11 +85,6 @@ def max_dilation_angle(curve: dict[str, np.ndarray], window_m: float) -> float:
     return math.degrees(math.atan(float(rise.max() / window_m)))
 
 
-def _curve(path: Path) -> dict[str, np.ndarray]:
-    rows = read_curve_csv(path)
-    return {k: np.array([r[k] for r in rows]) for k in rows[0]}
-
-
 # ---------------------------------------------------------------------- per case
 def _mean_sd(values: list[float]) -> tuple[float, float | None]:
     v = np.asarray(values, float)
@@ -102,13 +96,12 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
     """One case's row (means and spreads over the specimens) and its per-test rows."""
     tests = []
     per_specimen = []
-    for label, series in rep.series.items():
-        res = summary.series[label]
+    for label, res in summary.series.items():
         res_pts = []
         psis = []
         for t in res["tests"]:
             sigma = t["normal_stress_kpa"]
-            curve = _curve(series.out / folder_name(sigma) / "curve.csv")
+            curve = res.curves[sigma]
             s_res, tau_res = residual_point(curve)
             psi = max_dilation_angle(curve, window_m)
             res_pts.append((s_res, tau_res))

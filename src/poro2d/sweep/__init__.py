@@ -6,13 +6,14 @@ and gathers one table. New case kinds are added with ``register_kind``.
 """
 
 from poro2d.sweep.cases import KINDS, Case, SweepConfig, case_id, parse_sweep, register_kind
-from poro2d.sweep.runner import SweepOutcome, run_sweep
+from poro2d.sweep.results import SweepResult
+from poro2d.sweep.runner import run_sweep
 
 __all__ = [
     "KINDS",
     "Case",
     "SweepConfig",
-    "SweepOutcome",
+    "SweepResult",
     "case_id",
     "parse_sweep",
     "register_kind",

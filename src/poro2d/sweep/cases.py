@@ -39,7 +39,7 @@ from typing import Any
 
 from poro2d.config import check_finite, check_keys
 from poro2d.errors import InputError
-from poro2d.identity import run_digest
+from poro2d.identity import identity_digest
 
 #: kind -> run(config, out_dir) -> dict of scalar results
 KINDS: dict[str, Callable[[dict, Path], dict]] = {}
@@ -191,10 +191,10 @@ def config_tables(prefix: str = "") -> dict[str, type]:
 def case_id(kind: str, config: dict) -> str:
     """A stable id: the first 12 hex digits of the run digest of the kind and merged config.
 
-    The identity rule (:func:`poro2d.identity.run_digest`) leaves out the settings that
+    The identity rule (:func:`poro2d.identity.identity_digest`) leaves out the settings that
     change no result, so a rerun with another thread count finds the finished cases.
     """
-    return run_digest({"kind": kind, "config": config}, tables=config_tables("config."), length=12)
+    return identity_digest({"kind": kind, "config": config}, tables=config_tables("config."), length=12)
 
 
 def _field_names(cls: type) -> set[str]:

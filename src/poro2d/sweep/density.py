@@ -25,7 +25,7 @@ import numpy as np
 from poro2d import __version__
 from poro2d.criterion.density import DEFAULT_MUS, Calibration, StateTarget, check_mus
 from poro2d.errors import check_int
-from poro2d.identity import outside_fields, run_digest
+from poro2d.identity import identity_digest, outside_fields
 from poro2d.io_utils import provenance, write_json
 from poro2d.locks import cache_entry
 from poro2d.specimen.compaction import SpecimenSpec
@@ -104,7 +104,7 @@ def calibration_key(base: dict) -> str:
     Spaced as these keys were first written, so cached calibrations keep their folders.
     """
     rec = {"base": calibration_base(base), "version": __version__}
-    return run_digest(rec, tables={"base.specimen": SpecimenSpec}, length=16, layout="spaced")
+    return identity_digest(rec, tables={"base.specimen": SpecimenSpec}, length=16, layout="spaced")
 
 
 def first_trial(criterion: dict, mu: float) -> float:
@@ -241,7 +241,7 @@ def _run_key(case, base_dir: Path | None) -> str:
     """
     spec, grading, settings, seed = criterion_objects(case.config, base_dir)
     run = {"specimen": spec, "grading": [grading.sizes, grading.percent], "criterion": settings, "seed": seed}
-    return run_digest(run, ignore=("criterion.n_lab",))
+    return identity_digest(run, ignore=("criterion.n_lab",))
 
 
 def _check_key(case, base_dir: Path | None) -> str:

@@ -1,4 +1,4 @@
-"""Typed results of the sweeps: ``density.json``, ``relation.json`` and ``sensitivity.json``.
+"""Typed results of the sweeps: ``sweep.json``, ``density.json``, ``relation.json`` and ``sensitivity.json``.
 
 Each class lists its file's keys as fields, in the file's order (see
 :mod:`poro2d.typed_result`); the runs build the dict they wrote before and return it as
@@ -8,10 +8,42 @@ stays out of the file.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
-from poro2d.typed_result import TypedResult
+from poro2d.typed_result import NOT_IN_FILE, TypedResult
+
+
+@dataclass(eq=False)
+class SweepResult(TypedResult):
+    """A finished sweep (its ``sweep.json``), with every case's row and the table of them.
+
+    ``cases``: id and parameters of each case; ``config``: the sweep's config as given;
+    ``cluster``: where the cases ran (empty when every case was reused); ``summary``: cases
+    run, reused and failed, their times. ``rows`` (not in the file): one row per case in
+    the sweep's order (``status``, ``results``, ``reused``, where and when it ran);
+    ``table``: the same as a pandas DataFrame (``results.csv``).
+    """
+
+    status: str
+    title: str
+    kind: str
+    axes: list[str]
+    cases: list[dict[str, Any]]
+    config: dict[str, Any]
+    base_dir: str | None
+    retries: int
+    provenance: dict[str, Any]
+    cluster: dict[str, Any]
+    summary: dict[str, Any]
+    finished_utc: str
+    rows: list[dict[str, Any]] = field(default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE)
+    table: Any = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
+
+    @property
+    def failed(self) -> list[dict[str, Any]]:
+        """The rows of the cases that failed."""
+        return [r for r in self.rows if r["status"] == "failed"]
 
 
 @dataclass(eq=False)
@@ -110,4 +142,4 @@ class SensitivityResult(TypedResult):
     provenance: dict[str, Any] | None = None
 
 
-__all__ = ["DensityStateResult", "RelationResult", "SensitivityResult"]
+__all__ = ["DensityStateResult", "RelationResult", "SensitivityResult", "SweepResult"]

@@ -26,7 +26,6 @@ import os
 import socket
 import time
 import traceback
-from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -35,6 +34,7 @@ from poro2d.io_utils import atomic_path, provenance, write_json
 from poro2d.locks import cache_entry, holds_output
 from poro2d.resumable import Fingerprint, ResumableStage
 from poro2d.sweep.cases import KINDS, Case, SweepConfig, config_tables
+from poro2d.sweep.results import SweepResult
 from poro2d.worker_signals import hold_interrupts, ignore_interrupts_in_dask_worker, release_interrupts
 
 ignore_interrupts_in_dask_worker()  # a worker started by a script imports this to run its cases
@@ -101,7 +101,7 @@ def finished_row(case: dict, case_dir: Path) -> dict | None:
 
 
 # ------------------------------------------------------------------------ worker side
-def run_case_task(case: dict, case_dir: str, func) -> dict:
+def compute_case(case: dict, case_dir: str, func) -> dict:
     """Run one case on a worker; never raises for errors of the case itself.
 
     ``func`` is the kind's callable, shipped with the task so that kinds registered
@@ -187,17 +187,6 @@ def _worker_address() -> str:
 
 
 # ------------------------------------------------------------------------ driver side
-@dataclass
-class SweepOutcome:
-    rows: list[dict]
-    table: Any  # pandas.DataFrame
-    summary: dict = field(default_factory=dict)
-
-    @property
-    def failed(self) -> list[dict]:
-        return [r for r in self.rows if r["status"] == "failed"]
-
-
 def _failed_row(case: Case, d: Path, err: BaseException, tb: str) -> dict:
     row = {
         "case_id": case.id,
@@ -422,8 +411,8 @@ def run_sweep(
     client=None,
     progress: bool = True,
     dashboard: str | None = DEFAULT_DASHBOARD,
-) -> SweepOutcome:
-    """Run every unfinished case of ``sweep`` into ``out``; returns the rows and the table.
+) -> SweepResult:
+    """Run every unfinished case of ``sweep`` into ``out``; returns its ``sweep.json``, rows and table.
 
     ``client``: an existing ``distributed.Client`` (tests, notebooks); otherwise one is
     made for ``scheduler`` (an address such as ``tcp://host:8786``) or for a new
@@ -470,7 +459,9 @@ def run_sweep(
     summary = _summary(ordered, n_reused, time.perf_counter() - t_start, cluster_info)
     record.update(status="finished", cluster=cluster_info, summary=summary, finished_utc=_now())
     write_json(out / "sweep.json", record)
-    return SweepOutcome(ordered, df, summary)
+    result = SweepResult.from_dict(record)
+    result.rows, result.table = ordered, df
+    return result
 
 
 def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases_dir: Path, n_reused: int, *,
@@ -549,7 +540,7 @@ def _submit_all(
     futures = {}
     for c in pending:
         fut = client.submit(
-            run_case_task,
+            compute_case,
             c.to_dict(),
             str(cases_dir / c.id),
             KINDS[c.kind],
@@ -579,14 +570,14 @@ def _submit_all(
 
 
 __all__ = [
-    "SweepOutcome",
+    "SweepResult",
     "case_stage",
     "check_cluster_options",
     "check_reachable",
     "connect",
     "finished_row",
     "pin_numba_threads",
-    "run_case_task",
+    "compute_case",
     "run_sweep",
     "start_client",
     "table_from_rows",
