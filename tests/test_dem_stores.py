@@ -2,14 +2,11 @@
 
 Other modules read a simulation's contact lists, masses and kernel settings through
 ``Simulation.pairs``, ``wall_pairs``, ``masses``, ``kernel_params`` and ``work``
-(:mod:`poro2d.dem.stores`): no module of the engine reads another object's private
-names, and the engine's modules import each other without a circle.
+(:mod:`poro2d.dem.stores`); ``tests/test_architecture.py`` checks that no module reads
+another object's private names and that no import circle remains.
 """
 
 from __future__ import annotations
-
-import ast
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -17,8 +14,6 @@ import pytest
 from poro2d.dem import Particles, Simulation, Walls, checkpoint
 from poro2d.dem.stores import ContactStore
 from poro2d.errors import InputError
-
-DEM = Path(__file__).resolve().parents[1] / "src" / "poro2d" / "dem"
 
 
 def _heap() -> Simulation:
@@ -96,48 +91,3 @@ def test_checkpoint_keys_are_those_of_the_first_format(tmp_path):
     }  # fmt: skip
     loaded = checkpoint.load(path)
     assert np.array_equal(loaded.pairs.fs, sim.pairs.fs) and loaded.pairs.new_fs.shape == sim.pairs.fs.shape
-
-
-def _private_reads(tree: ast.AST) -> list[str]:
-    """``x._name`` reads where ``x`` is not ``self`` or ``cls`` (dunders aside)."""
-    found = []
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Attribute) and node.attr.startswith("_") and not node.attr.startswith("__"):
-            owner = node.value
-            if not (isinstance(owner, ast.Name) and owner.id in ("self", "cls")):
-                found.append(f"{ast.unparse(node)} (line {node.lineno})")
-    return found
-
-
-def test_no_engine_module_reads_private_names_of_another_object():
-    reads = {f.name: _private_reads(ast.parse(f.read_text())) for f in sorted(DEM.glob("*.py"))}
-    assert {name: r for name, r in reads.items() if r} == {}
-
-
-def _dem_imports(path: Path) -> set[str]:
-    """The engine modules ``path`` imports, wherever the import stands (functions, type checks)."""
-    names = set()
-    for node in ast.walk(ast.parse(path.read_text())):
-        if isinstance(node, ast.ImportFrom) and node.module == "poro2d.dem":
-            names.update(a.name for a in node.names)
-        elif isinstance(node, ast.ImportFrom) and (node.module or "").startswith("poro2d.dem."):
-            names.add(node.module.split(".")[2])
-        elif isinstance(node, ast.Import):
-            names.update(a.name.split(".")[2] for a in node.names if a.name.startswith("poro2d.dem."))
-    return {n for n in names if (DEM / f"{n}.py").is_file()}
-
-
-def test_engine_modules_import_each_other_without_a_circle():
-    graph = {f.stem: _dem_imports(f) for f in DEM.glob("*.py") if f.stem != "__init__"}
-    done: set[str] = set()
-
-    def visit(module: str, path: tuple[str, ...]) -> None:
-        assert module not in path, " -> ".join((*path, module))
-        if module in done:
-            return
-        for dep in sorted(graph[module]):
-            visit(dep, (*path, module))
-        done.add(module)
-
-    for module in sorted(graph):
-        visit(module, ())

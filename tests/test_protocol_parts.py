@@ -1,9 +1,9 @@
 """The protocols from public parts: the controllers the criterion, the shear test and the import
-check share, no reads of another module's private attributes, no import circle in a package.
+check share (the static checks of the whole package, no private reads and no import circle,
+are in ``tests/test_architecture.py``).
 
 The specimen is the small one of ``conftest.py`` (0.06 m x 0.03 m, about 110 disks)."""
 
-import ast
 import math
 from pathlib import Path
 
@@ -23,80 +23,7 @@ from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec, box_porosity
 
 SRC = Path(poro2d.__file__).parent
-PROTOCOL_PACKAGES = ("criterion", "shear", "interop")
-#: the engine's thread check, still private to ``Simulation``: the one read left to make public
-KNOWN_PRIVATE_READS = {"Simulation._check_threads"}
 SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4}
-
-
-def _modules(package: str):
-    for f in sorted((SRC / package).glob("*.py")):
-        yield f"poro2d.{package}.{f.stem}", ast.parse(f.read_text())
-
-
-def test_no_protocol_module_reads_a_private_attribute_of_another_object():
-    reads = set()
-    for package in PROTOCOL_PACKAGES:
-        for name, tree in _modules(package):
-            for node in ast.walk(tree):
-                if not (isinstance(node, ast.Attribute) and node.attr.startswith("_")):
-                    continue
-                own = isinstance(node.value, ast.Name) and node.value.id == "self"
-                if node.attr.startswith("__") or own:
-                    continue
-                reads.add(f"{name}: {ast.unparse(node)}")
-    assert {r.split(": ")[1] for r in reads} <= KNOWN_PRIVATE_READS, sorted(reads)
-
-
-def _import_graph(package: str) -> dict[str, set[str]]:
-    """Module -> the modules of the same package it imports (guarded and local imports too).
-
-    The package's ``__init__`` is left out: Python runs it before any of its modules anyway.
-    """
-    graph = {}
-    for name, tree in _modules(package):
-        deps = set()
-        for node in ast.walk(tree):
-            if isinstance(node, ast.ImportFrom) and node.module:
-                deps.add(node.module)
-                deps.update(f"{node.module}.{a.name}" for a in node.names)
-            elif isinstance(node, ast.Import):
-                deps.update(a.name for a in node.names)
-        graph[name] = deps
-    inside = {m for m in graph if not m.endswith(".__init__")}
-    return {m: {d for d in deps if d in inside and d != m} for m, deps in graph.items()}
-
-
-def _circle(graph: dict[str, set[str]]) -> list[str]:
-    """One import circle of ``graph`` (the modules around it), or [] when there is none."""
-    state: dict[str, int] = {}
-    path: list[str] = []
-
-    def visit(m: str) -> list[str]:
-        state[m] = 1
-        path.append(m)
-        for d in sorted(graph[m]):
-            if state.get(d) == 1:
-                return path[path.index(d) :] + [d]
-            if d not in state and (found := visit(d)):
-                return found
-        path.pop()
-        state[m] = 2
-        return []
-
-    for m in sorted(graph):
-        if m not in state and (found := visit(m)):
-            return found
-    return []
-
-
-@pytest.mark.parametrize("package", PROTOCOL_PACKAGES)
-def test_no_import_circle_inside_a_protocol_package(package):
-    assert _circle(_import_graph(package)) == []
-
-
-def test_the_circle_finder_finds_one():
-    assert _circle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
 
 
 def test_calibration_names_its_accepted_samples():
