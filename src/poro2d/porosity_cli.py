@@ -32,6 +32,7 @@ from typer.core import TyperCommand
 from poro2d import __version__
 from poro2d import porosity as P
 from poro2d.errors import InputError, check_range
+from poro2d.lab_state import SOLID_DENSITY_RANGE
 
 _PARAM_ALLOWED = "a number in [0, 1)"
 
@@ -63,10 +64,6 @@ def _parse_nlab(tokens: list[str]) -> list[float]:
     return values
 
 
-#: kg/m3, the solid densities ``convert`` accepts
-SOLID_DENSITY_RANGE = (500.0, 23000.0)
-
-
 def _lab_porosities(
     nlab: list[str] | None, dry_density: float | None, solid_density: float | None
 ) -> tuple[list[float], dict]:
@@ -83,8 +80,7 @@ def _lab_porosities(
                 " ".join(nlab),
                 "no NLAB values when --dry-density/--solid-density are given",
             )
-        # the densities of solids: from light volcanic grains to the densest metal (osmium,
-        # 22 590 kg/m3); 1e300 would give a porosity of 1 and an answer about n_lab instead
+        # the densities of solids (lab_state.SOLID_DENSITY_RANGE)
         check_range("--solid-density", solid_density, *SOLID_DENSITY_RANGE)
         n = float(P.porosity_from_densities(dry_density, solid_density))
         extra = {"dry_density_kg_m3": dry_density, "solid_density_kg_m3": solid_density}
