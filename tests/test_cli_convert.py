@@ -159,3 +159,174 @@ def test_range_error_names_allowed_range(capsys):
     code, _, err = run(["convert", "1.2"], capsys)
     assert code == 2
     assert "NLAB" in err and "1.2" in err and "[0, 1)" in err
+
+
+# ------------------------------------------------------------------ the state in geotechnical terms
+TOYOURA = ["--e-max", "0.977", "--e-min", "0.597"]
+
+
+def test_void_ratio_state_line_before_the_table(capsys):
+    code, out, err = run(["convert", "--e", "0.7", *TOYOURA], capsys)
+    assert code == 0, err
+    lines = out.splitlines()
+    # n = 0.7 / 1.7 = 0.41176, Dr = (0.977 - 0.7) / 0.38 = 0.7289
+    assert lines[0].startswith("lab state (given as e = 0.7): e = 0.7000, n_lab = 0.4118, D_r = 0.729")
+    assert "e_max = 0.977, e_min = 0.597 (n_max = 0.4942, n_min = 0.3738)" in lines[0]
+    assert lines[1].startswith("n_lab = 0.4118, e = 0.7000,") and "D_r = 0.729" in lines[1]
+    for mid in METHODS:
+        assert mid in out
+
+
+def test_relative_density_with_void_ratio_extremes(capsys):
+    code, out, _ = run(["convert", "--dr", "0.8", *TOYOURA, "--format", "json"], capsys)
+    assert code == 0
+    obj = json.loads(out)
+    # e = 0.977 - 0.8 * 0.38 = 0.673, n = 0.673 / 1.673 = 0.402271
+    assert obj["e"] == pytest.approx(0.673, rel=1e-14)
+    assert obj["n_lab"] == pytest.approx(0.402271, abs=1e-6)
+    assert obj["relative_density"] == 0.8
+    assert obj["lab_state"] == {
+        "n_lab": obj["n_lab"],
+        "e": obj["e"],
+        "n_max": pytest.approx(0.977 / 1.977, rel=1e-15),
+        "n_min": pytest.approx(0.597 / 1.597, rel=1e-15),
+        "relative_density": 0.8,
+        "given": "Dr",
+    }
+    assert obj["inputs"]["e_max"] == 0.977 and obj["inputs"]["e_min"] == 0.597
+    assert obj["parabolic"] == pytest.approx(0.42 * obj["n_lab"] ** 2 + 0.25 * obj["n_lab"], rel=1e-14)
+
+
+def test_relative_density_with_porosity_extremes_gives_the_same_conversion(capsys):
+    # Dr = 0.8864513 is the paper's n_lab = 0.3434 between 0.4571 and 0.3253
+    dr = "0.8864513100780821"
+    code, out, _ = run(["convert", "--dr", dr, *PAPER, "--format", "json"], capsys)
+    assert code == 0
+    by_dr = json.loads(out)
+    code, out, _ = run(["convert", "0.3434", *PAPER, "--format", "json"], capsys)
+    by_n = json.loads(out)
+    assert by_dr["n_lab"] == pytest.approx(0.3434, abs=1e-12)
+    for mid in METHODS:
+        assert by_dr[mid] == pytest.approx(by_n[mid], abs=1e-10)
+
+
+def test_several_void_ratios_in_csv(capsys):
+    argv = ["convert", "--e", "0.65", "--e", "0.7", "--e", "0.8", *TOYOURA, "--format", "csv"]
+    code, out, err = run(argv, capsys)
+    assert code == 0, err
+    assert out.splitlines()[0] == ",".join(
+        ["n_lab", "n_max", "n_min", "method", "name", "equation", "n2d", "flags", "skipped", "nu_reading"]
+        + ["lattice_exact", "e", "relative_density", "given"]
+    )
+    rows = list(csv.DictReader(io.StringIO(out)))
+    assert len(rows) == 3 * len(METHODS)
+    assert [float(r["e"]) for r in rows[:: len(METHODS)]] == [0.65, 0.7, 0.8]
+    by = {(r["e"], r["method"]): r for r in rows}
+    assert float(by[("0.7", "lim_3d")]["relative_density"]) == pytest.approx(0.277 / 0.38, rel=1e-13)
+    assert float(by[("0.7", "lim_3d")]["n_lab"]) == pytest.approx(0.7 / 1.7, rel=1e-15)
+    assert {r["given"] for r in rows} == {"e"}
+
+
+def test_several_void_ratios_json_list(capsys):
+    code, out, _ = run(["convert", "--e", "0.65", "--e", "0.8", *TOYOURA, "--format", "json"], capsys)
+    assert code == 0
+    objs = json.loads(out)
+    assert [o["e"] for o in objs] == [0.65, 0.8]
+    # Dr = (0.977 - 0.65) / 0.38 = 0.860526, (0.977 - 0.8) / 0.38 = 0.465789
+    assert [o["relative_density"] for o in objs] == pytest.approx([0.860526, 0.465789], abs=1e-6)
+
+
+def test_void_ratio_without_extremes(capsys):
+    code, out, _ = run(["convert", "--e", "0.7", "--format", "json"], capsys)
+    assert code == 0
+    obj = json.loads(out)
+    assert obj["e"] == 0.7 and obj["relative_density"] is None and obj["lim_lab"] is None
+    code, out, _ = run(["convert", "--e", "0.7"], capsys)
+    assert (
+        out.splitlines()[0]
+        == "lab state (given as e = 0.7): e = 0.7000, n_lab = 0.4118, D_r: no extremes given"
+    )
+
+
+def test_porosity_and_dry_density_with_void_ratio_extremes(capsys):
+    code, out, _ = run(["convert", "0.41", *TOYOURA, "--format", "json"], capsys)
+    assert code == 0
+    obj = json.loads(out)
+    assert obj["lab_state"]["given"] == "n" and obj["e"] == pytest.approx(0.41 / 0.59, rel=1e-15)
+    argv = ["convert", "--dry-density", "1590", "--solid-density", "2650", *TOYOURA]
+    code, out, _ = run(argv, capsys)
+    assert code == 0
+    # n = 1 - 1590 / 2650 = 0.4, e = 2650 / 1590 - 1 = 0.666667, Dr = (0.977 - 0.666667) / 0.38 = 0.816667
+    assert out.startswith(
+        "lab state (given as rho_d = 1590, rho_s = 2650 kg/m3): e = 0.6667, n_lab = 0.4000, D_r = 0.817;"
+    )
+    code, out, _ = run([*argv, "--format", "json"], capsys)
+    obj = json.loads(out)
+    assert obj["inputs"]["dry_density_kg_m3"] == 1590.0 and obj["lab_state"]["given"] == "dry_density"
+    assert obj["e"] == pytest.approx(2650 / 1590 - 1, rel=1e-13)
+
+
+def test_porosity_options_keep_their_output(capsys):
+    """The geotechnical state's additions appear only when it is asked for."""
+    code, out, _ = run(["convert", "0.3434", *PAPER], capsys)
+    assert not out.startswith("lab state") and "e = " not in out.splitlines()[0]
+    code, out, _ = run(["convert", "0.3434", *PAPER, "--format", "json"], capsys)
+    obj = json.loads(out)
+    assert "e" not in obj and "lab_state" not in obj
+    code, out, _ = run(
+        ["convert", "--dry-density", "1740", "--solid-density", "2650", "--format", "csv"], capsys
+    )
+    assert out.splitlines()[0].endswith(",nu_reading,lattice_exact")
+
+
+@pytest.mark.parametrize(
+    "argv,needle",
+    [
+        (["convert", "0.3", "--e", "0.7"], "--e = '0.7' is invalid; allowed: no --e when NLAB is given"),
+        (["convert", "0.3", "0.4", "--e", "0.7", *TOYOURA], "no --e when NLAB is given"),
+        (["convert", "--e", "0.7", "--dr", "0.5", *TOYOURA], "no --dr when --e is given"),
+        (["convert", "--e", "0.7", "--dry-density", "1600", "--solid-density", "2650"], "no --dry-density"),
+        (["convert", "--e", "0.99", *TOYOURA], "--e = 0.99 is invalid; allowed: [0.597, 0.977]"),
+        (["convert", "--e", "0.7", "--e", "0.5", *TOYOURA], "--e = 0.5"),
+        (["convert", "0.3", *TOYOURA], "NLAB = 0.3 is invalid; allowed: [0.373826, 0.494183]"),
+        (
+            ["convert", "--dr", "0.8"],
+            "--dr = 0.8 is invalid; allowed: a relative density with the extremes --e-max",
+        ),
+        (["convert", "--dr", "1.3", *TOYOURA], "--dr = 1.3 is invalid; allowed: [0, 1]"),
+        (["convert", "--dr", "-0.1", *PAPER], "--dr = -0.1"),
+        (["convert", "--e", "0.7", "--e-max", "0.977"], "--e-min = None"),
+        (["convert", "--e", "0.7", "--e-min", "0.597"], "--e-max = None"),
+        (
+            ["convert", "--e", "0.7", *TOYOURA, "--n-max", "0.45"],
+            "--n-max = 0.45 is invalid; allowed: either",
+        ),
+        (
+            ["convert", "--e", "0.7", "--e-max", "0.5", "--e-min", "0.6"],
+            "--e-max = 0.5 is invalid; allowed: greater",
+        ),
+        (["convert", "--e", "0.7", "--e-max", "0.9", "--e-min", "-0.1"], "--e-min = -0.1"),
+        (["convert", "--e", "-0.1"], "--e = -0.1 is invalid; allowed: a finite void ratio in [0, inf)"),
+        (["convert", "--e", "nan"], "--e = nan"),
+        (["convert", "--e", "inf"], "--e = inf"),
+        (["convert", "--e", "abc"], "--e"),
+        (["convert", *TOYOURA], "NLAB = None is invalid; allowed: a laboratory state"),
+        (["convert", "--e", "0.7", "--solid-density", "2650"], "--solid-density = 2650.0"),
+        (["convert", "--dry-density", "1600", *TOYOURA], "--solid-density = None"),
+        (
+            ["convert", "--dry-density", "1000", "--solid-density", "2650", *TOYOURA],
+            "[1340.41, 1659.36] kg/m3",
+        ),
+        (
+            ["convert", "--dry-density", "1600", "--solid-density", "1e300", *TOYOURA],
+            "--solid-density = 1e+300",
+        ),
+        (["convert", "--e", "0.7", "--e-max", "0.977", "--e-max", "0.9", "--e-min", "0.5"], "--e-max"),
+    ],
+)
+def test_geotechnical_errors_exit_2_one_line(argv, needle, capsys):
+    code, out, err = run(argv, capsys)
+    assert code == 2, (out, err)
+    assert "Traceback" not in out + err
+    assert needle in err, err
+    assert len(err.strip().splitlines()) == 1

@@ -266,12 +266,10 @@ def lab_state(
         if ex is None:
             raise InputError(
                 "dr", dr, "a relative density with the extremes e_max and e_min (or n_max and n_min)",
-                "Dr = (e_max - e) / (e_max - e_min) needs them",
+                "Dr is defined between the loosest and the densest state",
             )  # fmt: skip
         if not is_number(dr) or not 0.0 <= float(dr) <= 1.0:
-            raise InputError(
-                "dr", dr, "[0, 1]", "Dr = 1 is the densest state e_min, Dr = 0 the loosest e_max"
-            )
+            raise InputError("dr", dr, "[0, 1]", "Dr = 1 is the densest state, Dr = 0 the loosest")
         d = float(dr)
         ev = ex.e_max - d * (ex.e_max - ex.e_min)
         nv = float(P.porosity_from_void_ratio(ev))

@@ -3,6 +3,12 @@
 ``poro2d convert NLAB... [--n-max X --n-min Y] [--dry-density RHO_D --solid-density RHO_S]
 [--nu-reading printed|solid_fraction] [--lattice-exact] [--format table|json|csv]``
 
+``poro2d convert --e E [--e E ...] | --dr DR [--dr DR ...] | NLAB... | --dry-density RHO_D
+--solid-density RHO_S, [--e-max X --e-min Y | --n-max X --n-min Y]``: the laboratory state in
+geotechnical terms (:mod:`poro2d.lab_state`), selected by any of ``--e``, ``--dr``,
+``--e-max``, ``--e-min``. The state must lie within the extremes; the command prints the state
+it understood (e, n, D_r) before each table, and its json and csv carry e and D_r.
+
 ``poro2d plot relations [--n-max X --n-min Y] [-o DIR]``
 
 Output formats of ``convert``:
@@ -14,6 +20,11 @@ Output formats of ``convert``:
   ``flags``, ``skipped``, ``warnings``, ``notes``, ``details``, ``methods`` and
   ``poro2d_version``. For several NLAB values, a JSON list of such objects, in input order.
 * ``csv``: a header row, then one row per (n_lab, method).
+
+Given in geotechnical terms, the json objects also hold ``e`` and ``lab_state``
+(:meth:`poro2d.lab_state.LabState.to_dict`), ``relative_density`` is the state's and
+``inputs`` holds ``e_max``/``e_min`` when given; the csv has three more columns, ``e``,
+``relative_density`` and ``given``. Without those options every output is as before.
 """
 
 from __future__ import annotations
@@ -22,6 +33,7 @@ import csv
 import enum
 import io
 import json
+import re
 from pathlib import Path
 from typing import Annotated
 
@@ -32,7 +44,7 @@ from typer.core import TyperCommand
 from poro2d import __version__
 from poro2d import porosity as P
 from poro2d.errors import InputError, check_range
-from poro2d.lab_state import SOLID_DENSITY_RANGE
+from poro2d.lab_state import SOLID_DENSITY_RANGE, LabState, lab_state
 
 _PARAM_ALLOWED = "a number in [0, 1)"
 
@@ -94,19 +106,131 @@ def _lab_porosities(
     return _parse_nlab(nlab), extra
 
 
+#: the command's names of :func:`poro2d.lab_state.lab_state`'s keywords
+_CLI_NAMES = {
+    "e": "--e",
+    "n": "NLAB",
+    "dr": "--dr",
+    "dry_density": "--dry-density",
+    "solid_density": "--solid-density",
+    "e_max": "--e-max",
+    "e_min": "--e-min",
+    "n_max": "--n-max",
+    "n_min": "--n-min",
+}
+_CLI_WORDS = re.compile(r"\b(dry_density|solid_density|e_max|e_min|n_max|n_min)\b")
+_STATE_KINDS = (
+    "NLAB porosities, --e void ratios, --dr relative densities, or --dry-density with --solid-density"
+)
+
+
+def _cli_error(exc: InputError) -> InputError:
+    """``exc`` of :mod:`poro2d.lab_state` in the command's words (``e_max`` -> ``--e-max``)."""
+
+    def words(text: str) -> str:
+        return _CLI_WORDS.sub(lambda m: _CLI_NAMES[m.group(1)], text)
+
+    return InputError(
+        _CLI_NAMES.get(exc.parameter, exc.parameter), exc.value, words(exc.allowed), words(exc.hint)
+    )
+
+
+def _is_geotechnical(e: list[float] | None, dr: list[float] | None, e_max, e_min) -> bool:
+    """The geotechnical description is asked for by any of --e, --dr, --e-max, --e-min."""
+    return bool(e) or bool(dr) or e_max is not None or e_min is not None
+
+
+def _lab_states(
+    nlab: list[str] | None,
+    e: list[float] | None,
+    dr: list[float] | None,
+    dry_density: float | None,
+    solid_density: float | None,
+    extremes: dict,
+) -> tuple[list[LabState], dict]:
+    """The laboratory states of the geotechnical description, one kind of state only."""
+    kinds = {
+        "NLAB": " ".join(nlab) if nlab else None,
+        "--e": " ".join(f"{v:g}" for v in e) if e else None,
+        "--dr": " ".join(f"{v:g}" for v in dr) if dr else None,
+        "--dry-density": None if dry_density is None else f"{dry_density:g}",
+    }
+    given = [k for k, v in kinds.items() if v is not None]
+    if not given:
+        raise InputError("NLAB", None, f"a laboratory state: {_STATE_KINDS}")
+    if len(given) > 1:
+        first, second = given[:2]
+        raise InputError(
+            second,
+            kinds[second],
+            f"no {second} when {first} is given",
+            f"give the state once: {_STATE_KINDS}",
+        )
+    kind = given[0]
+    if kind == "NLAB":
+        states = [dict(n=v) for v in _parse_nlab(nlab)]
+    elif kind == "--e":
+        states = [dict(e=v) for v in e]
+    elif kind == "--dr":
+        states = [dict(dr=v) for v in dr]
+    else:
+        states = [dict(dry_density=dry_density)]
+    try:
+        out = [lab_state(**st, solid_density=solid_density, **extremes) for st in states]
+    except InputError as exc:
+        raise _cli_error(exc) from None
+    extra: dict = {}
+    if dry_density is not None:
+        extra = {"dry_density_kg_m3": dry_density, "solid_density_kg_m3": solid_density}
+    for key in ("e_max", "e_min"):
+        if extremes[key] is not None:
+            extra[key] = extremes[key]
+    return out, extra
+
+
+def _state_line(state: LabState, extra: dict) -> str:
+    """The state the command understood, in one line: what was given, then e, n and D_r."""
+    if state.given == "e":
+        given = f"e = {state.e:g}"
+    elif state.given == "n":
+        given = f"n = {state.n_lab:g}"
+    elif state.given == "Dr":
+        given = f"D_r = {state.relative_density:g}"
+    else:
+        rho_d, rho_s = extra["dry_density_kg_m3"], extra["solid_density_kg_m3"]
+        given = f"rho_d = {rho_d:g}, rho_s = {rho_s:g} kg/m3"
+    line = f"lab state (given as {given}): e = {state.e:.4f}, n_lab = {state.n_lab:.4f}"
+    if state.relative_density is None:
+        return line + ", D_r: no extremes given"
+    e_max, e_min = float(P.void_ratio(state.n_max)), float(P.void_ratio(state.n_min))
+    return (
+        line + f", D_r = {state.relative_density:.3f}; "
+        f"e_max = {e_max:.4g}, e_min = {e_min:.4g} (n_max = {state.n_max:.4f}, n_min = {state.n_min:.4f})"
+    )
+
+
 def _fmt(v: float | None, digits: int = 4) -> str:
     return "-" if v is None else f"{v:.{digits}f}"
 
 
-def conversion_to_json(conv: P.Conversion, extra_inputs: dict | None = None) -> dict:
-    """The JSON object of one laboratory porosity (method ids as keys, see module doc)."""
+def conversion_to_json(
+    conv: P.Conversion, extra_inputs: dict | None = None, state: LabState | None = None
+) -> dict:
+    """The JSON object of one laboratory porosity (method ids as keys, see module doc).
+
+    With ``state`` (the :class:`~poro2d.lab_state.LabState` that ``conv`` converted) the
+    object also holds ``e`` and ``lab_state``, and its ``relative_density`` is the state's.
+    """
     obj: dict = {mid: r.value for mid, r in conv.results.items()}
     dr = None
-    if conv.n_max is not None and conv.n_min is not None:
+    if state is not None:
+        dr = state.relative_density
+    elif conv.n_max is not None and conv.n_min is not None:
         dr = float(P.relative_density(conv.n_lab, conv.n_max, conv.n_min))
     obj.update(
         {
             "n_lab": conv.n_lab,
+            **({} if state is None else {"e": state.e}),
             "inputs": {
                 "n_lab": conv.n_lab,
                 "n_max": conv.n_max,
@@ -115,6 +239,7 @@ def conversion_to_json(conv: P.Conversion, extra_inputs: dict | None = None) -> 
                 **(extra_inputs or {}),
             },
             "relative_density": dr,
+            **({} if state is None else {"lab_state": state.to_dict()}),
             "flags": {mid: r.flags for mid, r in conv.results.items()},
             "skipped": {mid: r.skipped for mid, r in conv.results.items() if r.skipped},
             "warnings": conv.warnings,
@@ -130,18 +255,24 @@ def conversion_to_json(conv: P.Conversion, extra_inputs: dict | None = None) -> 
     return obj
 
 
-def _print_table(conv: P.Conversion, extra_inputs: dict) -> None:
+def _print_table(conv: P.Conversion, extra_inputs: dict, state: LabState | None = None) -> None:
     from poro2d.console import OutputConsole, Table
 
     console = OutputConsole(highlight=False)  # files and pipes: the whole table, not 80 columns of it
+    if state is not None:
+        console.print(_state_line(state, extra_inputs))
     title = f"n_lab = {conv.n_lab:.4f}"
-    if extra_inputs:
+    if state is not None:
+        title += f", e = {state.e:.4f}"
+    if state is None and extra_inputs:  # a state given in geotechnical terms: its line says it all
         title += (
             f" (from rho_d = {extra_inputs['dry_density_kg_m3']:g}, "
             f"rho_s = {extra_inputs['solid_density_kg_m3']:g} kg/m3)"
         )
     if conv.n_max is not None and conv.n_min is not None:
         dr = float(P.relative_density(conv.n_lab, conv.n_max, conv.n_min))
+        if state is not None and state.relative_density is not None:
+            dr = state.relative_density
         title += f", n_max = {conv.n_max:g}, n_min = {conv.n_min:g}, D_r = {dr:.3f}"
     elif conv.n_min is not None:
         title += f", n_min = {conv.n_min:g}"
@@ -181,8 +312,16 @@ _CSV_HEADER = [
 ]
 
 
-def _csv_rows(conv: P.Conversion) -> list[list]:
+#: the columns a state given in geotechnical terms adds to the csv
+_CSV_STATE_HEADER = ["e", "relative_density", "given"]
+
+
+def _csv_rows(conv: P.Conversion, state: LabState | None = None) -> list[list]:
     rows = []
+    more = []
+    if state is not None:
+        dr = state.relative_density
+        more = [repr(state.e), "" if dr is None else repr(dr), state.given]
     for r in conv.results.values():
         rows.append(
             [
@@ -197,6 +336,7 @@ def _csv_rows(conv: P.Conversion) -> list[list]:
                 r.skipped or "",
                 conv.options["nu_reading"],
                 str(conv.options["lattice_exact"]).lower(),
+                *more,
             ]
         )
     return rows
@@ -210,6 +350,26 @@ def convert(
             help="Laboratory (3D) porosities in [0, 1). Several values are allowed.",
             show_default=False,
         ),
+    ] = None,
+    e: Annotated[
+        list[float] | None,
+        typer.Option("--e", help="Void ratio e of the laboratory state (repeat for several states)."),
+    ] = None,
+    dr: Annotated[
+        list[float] | None,
+        typer.Option(
+            "--dr",
+            help="Relative density Dr = (e_max - e)/(e_max - e_min) in [0, 1], with the extremes "
+            "(repeat for several states).",
+        ),
+    ] = None,
+    e_max: Annotated[
+        float | None,
+        typer.Option("--e-max", help="Laboratory maximum void ratio e_max (loosest state), with --e-min."),
+    ] = None,
+    e_min: Annotated[
+        float | None,
+        typer.Option("--e-min", help="Laboratory minimum void ratio e_min (densest state), with --e-max."),
     ] = None,
     n_max: Annotated[
         float | None,
@@ -245,7 +405,17 @@ def convert(
         OutputFormat, typer.Option("--format", help="Output format: table, json or csv.")
     ] = OutputFormat.table,
 ) -> None:
-    """Convert laboratory porosities to 2D with every method of the paper (Eqs. 1-12)."""
+    """Convert laboratory porosities to 2D with every method of the paper (Eqs. 1-12).
+
+    The laboratory state is NLAB porosities, --dry-density with --solid-density, or, in
+    geotechnical terms, --e void ratios or --dr relative densities with the extremes
+    --e-max/--e-min (or --n-max/--n-min).
+    """
+    if _is_geotechnical(e, dr, e_max, e_min):
+        extremes = {"e_max": e_max, "e_min": e_min, "n_max": n_max, "n_min": n_min}
+        states, extra = _lab_states(nlab, e, dr, dry_density, solid_density, extremes)
+        _write_conversions(states, extra, nu_reading, lattice_exact, fmt)
+        return
     values, extra = _lab_porosities(nlab, dry_density, solid_density)
     if n_max is not None:
         check_range("--n-max", n_max, 0.0, 1.0, hi_open=True)
@@ -271,6 +441,29 @@ def convert(
     else:
         for c in convs:
             _print_table(c, extra)
+
+
+def _write_conversions(
+    states: list[LabState], extra: dict, nu_reading: NuReading, lattice_exact: bool, fmt: OutputFormat
+) -> None:
+    """Every conversion of each laboratory state, in the format asked for, with e and D_r."""
+    convs = [
+        P.convert_all(s.n_lab, s.n_max, s.n_min, nu_reading=nu_reading.value, lattice_exact=lattice_exact)
+        for s in states
+    ]
+    if fmt is OutputFormat.json:
+        objs = [conversion_to_json(c, extra, state=s) for s, c in zip(states, convs, strict=True)]
+        typer.echo(json.dumps(objs[0] if len(objs) == 1 else objs, indent=2, allow_nan=False))
+    elif fmt is OutputFormat.csv:
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(_CSV_HEADER + _CSV_STATE_HEADER)
+        for s, c in zip(states, convs, strict=True):
+            w.writerows(_csv_rows(c, s))
+        typer.echo(buf.getvalue(), nl=False)
+    else:
+        for s, c in zip(states, convs, strict=True):
+            _print_table(c, extra, s)
 
 
 def plot_relations(
