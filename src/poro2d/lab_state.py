@@ -36,7 +36,7 @@ from poro2d.errors import InputError, check_range, is_number
 SOLID_DENSITY_RANGE = (500.0, 23000.0)
 
 #: the ways a state can be given, as ``LabState.given`` records them (keyword -> name)
-GIVEN = {"e": "e", "n": "n", "dr": "Dr", "dry_density": "dry_density"}
+_GIVEN = {"e": "e", "n": "n", "dr": "Dr", "dry_density": "dry_density"}
 
 #: the keys of a ``[lab]`` table (:func:`lab_state_from_table`)
 TABLE_KEYS = (
@@ -273,11 +273,11 @@ def lab_state(
         d = float(dr)
         ev = ex.e_max - d * (ex.e_max - ex.e_min)
         nv = float(P.porosity_from_void_ratio(ev))
-        return LabState(nv, ev, ex.n_max, ex.n_min, d, GIVEN[key])
+        return LabState(nv, ev, ex.n_max, ex.n_min, d, _GIVEN[key])
     if ex is None:
-        return LabState(nv, ev, None, None, None, GIVEN[key])
+        return LabState(nv, ev, None, None, None, _GIVEN[key])
     _check_within(key, value, nv, ev, ex, None if key != "dry_density" else float(solid_density))
-    return LabState(nv, ev, ex.n_max, ex.n_min, _dr_of(ev, ex), GIVEN[key])
+    return LabState(nv, ev, ex.n_max, ex.n_min, _dr_of(ev, ex), _GIVEN[key])
 
 
 def lab_state_from_table(table: Mapping) -> LabState:
