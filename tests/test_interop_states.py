@@ -195,9 +195,9 @@ def test_export_by_state_names_the_soil_in_every_file(relation, tmp_path, capsys
 def test_the_same_specimen_by_its_folder_gets_the_same_provenance(relation, tmp_path):
     """Exported by the case's own folder, the state is looked up above it; with the provenance
     lines left out, the files are those of a specimen without provenance."""
-    by_state = export_specimen(str(relation), tmp_path / "a", dr=1.0)
-    by_path = export_specimen(str(relation / "states" / "cases" / "zz" / "run"), tmp_path / "b")
-    assert by_state.origin == by_path.origin
+    by_state, state = export_specimen(str(relation), tmp_path / "a", dr=1.0)
+    by_path, none = export_specimen(str(relation / "states" / "cases" / "zz" / "run"), tmp_path / "b")
+    assert by_state.origin == by_path.origin and none is None and state.seed == 0
     bare = from_checkpoint(relation / "states" / "cases" / "zz" / "run")
     bare.origin = None
     for write in (lambda s, o: lammps.write_specimen(s, o), csv_table.write_specimen, pfc.write_specimen,

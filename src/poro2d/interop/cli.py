@@ -41,7 +41,7 @@ def export_cmd(
     if to not in TARGETS:
         raise InputError("--to", to, "one of " + ", ".join(TARGETS))
     check_range("--ratio", ratio, 0.0, 1.0, lo_open=True)
-    spec = export_specimen(specimen, out, n_lab=n_lab, dr=dr, seed=seed)
+    spec, state = export_specimen(specimen, out, n_lab=n_lab, dr=dr, seed=seed)
     writers = {
         "lammps": lambda: lammps.write_specimen(spec, out, ratio=ratio),
         "yade": lambda: yade.write_specimen(spec, out, ratio=ratio),
@@ -55,6 +55,12 @@ def export_cmd(
     for p in paths:
         t.add_row(str(p), f"{p.stat().st_size:,}")
     console.print(t)
+    if state is not None:
+        dr_text = "unknown" if state.relative_density is None else f"{state.relative_density:.4f}"
+        console.print(
+            f"state n_lab = {state.n_lab:g} (Dr = {dr_text}), seed {state.seed} of {state.record}: "
+            f"{state.folder}"
+        )
     console.print(
         f"{spec.n} disks, {len(spec.walls)} walls; thickness t = {spec.thickness:g} m "
         "(disk masses rho pi r^2 t); SI units; see docs/export.md"
@@ -62,8 +68,9 @@ def export_cmd(
 
 
 def export_specimen(specimen, out: Path, *, n_lab=None, dr=None, seed=None):
-    """The specimen ``export`` writes, with its provenance lines: a checkpoint or criterion
-    folder as given, or the accepted specimen of one state and seed of a folder of states.
+    """(specimen, state) of ``export``: the specimen with its provenance lines, and the
+    :class:`~poro2d.interop.state_specimen.StateSpecimen` it was found by (None for a checkpoint
+    or criterion folder given as such).
 
     A specimen the criterion did not accept is refused; so are the options of a folder of
     states given with anything else (rather than ignored).
@@ -84,13 +91,13 @@ def export_specimen(specimen, out: Path, *, n_lab=None, dr=None, seed=None):
                 raise InputError(option, value, allowed, f"{specimen} {what}")
         check_output_dir("--out", out)
         check_accepted(specimen)
-        return from_checkpoint(specimen)
+        return from_checkpoint(specimen), None
     state = state_specimen(specimen, n_lab=n_lab, dr=dr, seed=0 if seed is None else seed)
     check_output_dir("--out", out)
     check_accepted(state.folder)
     spec = from_checkpoint(state.folder)
     spec.origin = origin_lines(resolve_specimen(state.folder), state.as_dict())
-    return spec
+    return spec, state
 
 
 #: import options that give what a file does not say: (option as typed, key of the defaults, limit)
