@@ -164,12 +164,8 @@ def state_specimen(
         )
     accepted = [c for c in cases if c.accepted]
     if not accepted:
-        raise InputError(
-            "--seed",
-            seed,
-            f"a seed whose specimen the criterion accepted ({record}: {index.listing()})",
-            f"n_lab {state[0]:g} seed {seed}: {cases[0].why_not}",
-        )
+        allowed = f"a seed whose specimen the criterion accepted; states of {record}: {index.listing()}"
+        raise InputError("--seed", seed, allowed, f"n_lab {state[0]:g} seed {seed}: {cases[0].why_not}")
     if len(accepted) > 1:
         where = ", ".join(str(c.folder) for c in accepted)
         raise InputError(
@@ -346,20 +342,23 @@ def _calibration_twins(
 
 
 def _calibration_cases(record: Path, data: dict) -> list[tuple[dict, Path]]:
-    """(parameters, case folder) of every finished case of the state's calibration."""
+    """(parameters, case folder) of every case in the state's calibration folder.
+
+    Each case's ``params.json`` says what it ran: a cached calibration serves every run of its
+    grading and settings, and its ``sweep.json`` lists only the last run's cases.
+    """
     cal = (
         ((data.get("sweeps") or {}).get("calibration") or {}) if isinstance(data.get("sweeps"), dict) else {}
     )
     places = [Path(cal["cases"])] if isinstance(cal.get("cases"), str) else []
     places.append(record.parent / "calibration")
     for place in places:
-        if (place / "sweep.json").is_file():
-            sweep = _json(place / "sweep.json", "SPECIMEN")
+        if (place / "sweep.json").is_file() and (place / "cases").is_dir():
             out = []
-            for case in sweep.get("cases") or []:
-                cid = case.get("id") if isinstance(case, dict) else None
-                if isinstance(cid, str) and cid and Path(cid).name == cid:
-                    out.append((case.get("params") or {}, place / "cases" / cid))
+            for params_file in sorted((place / "cases").glob("*/params.json")):
+                case = _json(params_file, "SPECIMEN")
+                params = case.get("params") if isinstance(case.get("params"), dict) else {}
+                out.append((params, params_file.parent))
             return out
     return []
 
