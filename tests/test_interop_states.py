@@ -3,6 +3,7 @@ provenance lines of every target. The folders are built by hand from one small s
 their JSON files as the relation, the criterion's density mode and the sweep runner write them."""
 
 import json
+import os
 import shutil
 
 import pytest
@@ -163,6 +164,19 @@ def test_a_sand_folder(tmp_path, specimen):
     with pytest.raises(InputError) as e:
         find_state_specimen(sand, n_lab=0.33)
     assert e.value.parameter == "--seed" and "no accepted seed" in e.value.allowed
+
+
+def test_a_sand_folder_that_does_not_say_the_mode_takes_that_of_its_case(relation, tmp_path):
+    sand = tmp_path / "sand"
+    sand.mkdir()
+    case = relation / "states" / "cases" / "zz" / "run"
+    rel_path = os.path.relpath(case, sand)  # the specimen's folder, relative to the sand folder
+    states = [{"n_lab": 0.3253, "relative_density": 1.0, "seed": 0, "specimen": rel_path}]
+    (sand / "sand.json").write_text(json.dumps({"states": states}))
+    spec, state = export_specimen(str(sand), tmp_path / "out", n_lab=0.3253)
+    assert state.folder.resolve() == case.resolve() and state.mode is None
+    assert any("mode density" in ln for ln in spec.origin)
+    assert any(f"state read from {sand / 'sand.json'}" in ln for ln in spec.origin)
 
 
 PROVENANCE = (

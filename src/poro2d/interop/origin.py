@@ -40,6 +40,8 @@ def origin_lines(checkpoint: str | Path, state: dict[str, Any] | None = None) ->
         ]
     if state is None:
         state = _state_of_case(folder)
+    elif not state.get("mode"):  # a sand folder that does not say: the state folder of the case
+        state = dict(state, mode=(_state_of_case(folder) or {}).get("mode"))
     result, config = result or {}, config or {}
     lines = [f"{PREFIX} grading {_grading(config)}"]
     lines.append(f"{PREFIX} laboratory state {_state(result, config, state, folder)}")
@@ -146,7 +148,7 @@ def _state_of_case(folder: Path) -> dict | None:
             continue
         try:
             index = read_state_index(record)
-        except InputError:
+        except InputError:  # a damaged record above the case: its state is not known from there
             continue
         for case in index.cases:
             if case.folder is not None and case.folder.resolve() == folder.resolve():

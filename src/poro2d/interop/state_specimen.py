@@ -259,7 +259,7 @@ def _sweep_cases(sweep: Path, relation_seed: int | None = None) -> list[StateCas
         cid = case.get("id") if isinstance(case, dict) else None
         if not isinstance(cid, str) or not cid or Path(cid).name != cid:
             continue
-        out.append(_case(sweep / "cases" / cid, case.get("params") or {}, relation_seed))
+        out.append(_case(sweep / "cases" / cid, _dict(case.get("params")), relation_seed))
     return out
 
 
@@ -269,7 +269,7 @@ def _case(case_dir: Path, params: dict, relation_seed: int | None, n_lab: float 
     row = _json(case_dir / "result.json", "SPECIMEN") if (case_dir / "result.json").is_file() else None
     if row is None and (case_dir / "error.json").is_file():
         row = _json(case_dir / "error.json", "SPECIMEN")
-    params = dict(params, **((row or {}).get("params") or {}))
+    params = {**params, **_dict((row or {}).get("params"))}
     run = case_dir / CASE_RUN
     crit = _json(run / "result.json", "SPECIMEN") if (run / "result.json").is_file() else {}
     if n_lab is None:
@@ -347,9 +347,7 @@ def _calibration_cases(record: Path, data: dict) -> list[tuple[dict, Path]]:
     Each case's ``params.json`` says what it ran: a cached calibration serves every run of its
     grading and settings, and its ``sweep.json`` lists only the last run's cases.
     """
-    cal = (
-        ((data.get("sweeps") or {}).get("calibration") or {}) if isinstance(data.get("sweeps"), dict) else {}
-    )
+    cal = _dict(_dict(data.get("sweeps")).get("calibration"))
     places = [Path(cal["cases"])] if isinstance(cal.get("cases"), str) else []
     places.append(record.parent / "calibration")
     for place in places:
@@ -357,14 +355,13 @@ def _calibration_cases(record: Path, data: dict) -> list[tuple[dict, Path]]:
             out = []
             for params_file in sorted((place / "cases").glob("*/params.json")):
                 case = _json(params_file, "SPECIMEN")
-                params = case.get("params") if isinstance(case.get("params"), dict) else {}
-                out.append((params, params_file.parent))
+                out.append((_dict(case.get("params")), params_file.parent))
             return out
     return []
 
 
 def _config_seed(data: dict) -> int | None:
-    seed = (data.get("config") or {}).get("seed", 0) if isinstance(data.get("config"), dict) else 0
+    seed = _dict(data.get("config")).get("seed", 0)
     return seed if isinstance(seed, int) and not isinstance(seed, bool) else None
 
 
@@ -378,6 +375,11 @@ def _json(path: Path, parameter: str) -> dict:
     if not isinstance(data, dict):
         raise InputError(parameter, str(path), "a JSON file holding an object")
     return data
+
+
+def _dict(value) -> dict:
+    """``value`` if it is a dict, else an empty one (a record of another shape names nothing)."""
+    return value if isinstance(value, dict) else {}
 
 
 def _number(value) -> float | None:
