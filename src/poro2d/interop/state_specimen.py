@@ -210,7 +210,8 @@ def read_state_index(record: Path) -> StateIndex:
             "SPECIMEN", str(record.parent), f"a folder whose {record.name} lists laboratory states"
         )
     folder = record.parent
-    if mode == "paper":
+    # paper mode runs its sweep in the folder itself (a relation of before "mode" was recorded too)
+    if mode == "paper" or (mode is None and (folder / "sweep.json").is_file()):
         cases = _sweep_cases(folder, relation_seed=_config_seed(data))
     else:
         cases = _sweep_cases(folder / "states") if (folder / "states" / "sweep.json").is_file() else []
