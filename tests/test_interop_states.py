@@ -235,6 +235,13 @@ def test_provenance_of_a_csv_grading_and_of_a_bare_checkpoint(tmp_path, specimen
         in text
     )
     assert "relative density Dr = unknown; mode paper (a criterion folder of its own)" in text
+    # the laboratory extremes of the config's [density] give the relative density
+    record = json.loads((crit / "config.json").read_text())
+    record["config"]["density"] = {"n_max": 0.4571, "n_min": 0.3253}
+    (crit / "config.json").write_text(json.dumps(record))
+    assert "n_lab = 0.38, relative density Dr = 0.6366; mode paper" in "\n".join(
+        from_checkpoint(crit).header("#")
+    )
     assert "interior porosity unknown" in text and "seed 2;" in text
     # a checkpoint with no criterion record beside it: said, not made up
     (tmp_path / "bare").mkdir()

@@ -99,7 +99,7 @@ def _grading(config: dict) -> str:
 def _state(result: dict, config: dict, state: dict | None, folder: Path) -> str:
     """n_lab, Dr and the mode."""
     n_lab = state.get("n_lab") if state else _num(result.get("n_lab"))
-    dr = state.get("relative_density") if state else None
+    dr = state.get("relative_density") if state else _config_dr(n_lab, config)
     if state is not None:
         mode = state.get("mode") or "unknown"
     elif (folder.parent / "params.json").is_file():  # a sweep case not found in a state folder above it
@@ -110,6 +110,21 @@ def _state(result: dict, config: dict, state: dict | None, folder: Path) -> str:
         mode = _text(mode) + " (a criterion folder of its own)"
     dr_text = "unknown" if dr is None else f"{dr:.4f}"
     return f"n_lab = {_value(_num(n_lab))}, relative density Dr = {dr_text}; mode {mode}"
+
+
+def _config_dr(n_lab: float | None, config: dict) -> float | None:
+    """Dr of ``n_lab`` between the laboratory extremes the config's ``[density]`` gives, if it does."""
+    from poro2d.errors import InputError
+    from poro2d.porosity import relative_density
+
+    dens = (config.get("config") or {}).get("density")
+    hi, lo = (_num(dens.get(k)) for k in ("n_max", "n_min")) if isinstance(dens, dict) else (None, None)
+    if n_lab is None or hi is None or lo is None:
+        return None
+    try:
+        return float(relative_density(n_lab, hi, lo))
+    except InputError:
+        return None
 
 
 def _porosities(result: dict) -> str:
