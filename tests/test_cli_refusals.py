@@ -48,6 +48,8 @@ FILES: dict[str, str | bytes] = {
     "criterion_number.toml": "criterion = 5\n",
     "sensitivity_text.toml": 'sensitivity = "x"\n',
     "title_number.toml": "title = 5\n",
+    "dens/density.json": '{"mode": "density", "n_lab": 0.4, "relative_density": 0.4872, "mu_prep": 0.26, '
+    '"seeds": 2}',
     "n_lab_twice.toml": "[relation]\nn_lab = [0.40, 0.40]\n" + EXTREMES,
     "n_max_text.toml": '[relation]\nn_max = "0.45"\nn_min = 0.3\n',
     "kn.toml": "[specimen]\nkn_particle = 1e300\n",
@@ -67,6 +69,17 @@ FILES: dict[str, str | bytes] = {
 
 #: (command line, words of the one line); {d} is the folder holding FILES, {out} a new folder
 CASES = [
+    # export by laboratory state: the state and seed named, the ones there are listed
+    (["export", "{d}/dens", "--to", "csv", "--out", "x"], ["--n-lab/--dr = None", "n_lab 0.4 (Dr 0.4872)"]),
+    (
+        ["export", "{d}/dens", "--to", "csv", "--out", "x", "--n-lab", "0.4"],
+        ["--seed = 0", "no accepted seed"],
+    ),
+    (["export", "{d}/dens", "--to", "csv", "--out", "x", "--dr", "0.3"], ["--dr = 0.3", "n_lab 0.4"]),
+    (
+        ["export", "{d}/sp.npz", "--to", "csv", "--out", "x", "--dr", "0.5"],
+        ["--dr = 0.5", "a folder of states"],
+    ),
     # list-valued config keys: one check of shape, type and range
     (["relation", "-c", "{d}/mu_scalar.toml"], ["relation.mu_prep = 0.1", "[0, 1]"]),
     (["relation", "-c", "{d}/mu_true.toml"], ["relation.mu_prep = True", "[0, 1]"]),
@@ -194,6 +207,7 @@ def _write_files(folder) -> None:
     _specimen(folder / "sp.npz")
     for name, content in FILES.items():
         path = folder / name
+        path.parent.mkdir(parents=True, exist_ok=True)
         if isinstance(content, bytes):
             path.write_bytes(content)
         else:

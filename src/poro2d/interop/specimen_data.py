@@ -32,6 +32,7 @@ from poro2d import __version__
 from poro2d.dem import ContactModel, Particles, Simulation, Walls, checkpoint
 from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
+from poro2d.interop.origin import origin_lines
 from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
 from poro2d.specimen.box import box_faces
 
@@ -80,6 +81,9 @@ class SpecimenData:
     mu_r: np.ndarray | None = None  # rolling friction per disk; None: 0 for every disk
     #: the criterion's window the specimen was accepted with (F_top below this fraction of G)
     force_fraction: float | None = None
+    #: where the specimen came from (grading, laboratory state, mode, mu_prep, n2D, seed, version):
+    #: the ``provenance:`` lines of :func:`poro2d.interop.origin.origin_lines`; None: not known
+    origin: list[str] | None = None
     #: where each value was read (set by the importers): ``locate(quantity, disk_index)``
     locate: Callable[..., str] | None = field(default=None, repr=False, compare=False)
 
@@ -165,6 +169,11 @@ class SpecimenData:
         ]
         if self.source:
             lines.append(f"from {self.source}")
+        lines += (
+            self.origin
+            if self.origin is not None
+            else ["provenance: unknown (not read from a specimen's folder)"]
+        )
         if self.force_fraction is not None:
             lines.append(
                 f"accepted by the criterion with F_top below {self.force_fraction:g} of G (its window)"
@@ -303,7 +312,7 @@ def from_checkpoint(path: str | os.PathLike) -> SpecimenData:
     return _from_records(
         disks, walls, list(meta["wall_names"]), thickness=float(meta["thickness"]),
         gravity=tuple(float(g) for g in s["gravity"]), local_damping=float(s["local_damping"]),
-        dt=float(s["dt"]), source=str(p), force_fraction=accepted_window(p),
+        dt=float(s["dt"]), source=str(p), force_fraction=accepted_window(p), origin=origin_lines(p),
     )  # fmt: skip
 
 
