@@ -53,6 +53,7 @@ def _register() -> None:
     from poro2d import paper, porosity_cli
     from poro2d.calibration import cli as calibration_cli
     from poro2d.interop import cli as interop_cli
+    from poro2d.sand import cli as sand_cli
     from poro2d.shear import cli as shear_cli
     from poro2d.shear import strength_cli
     from poro2d.sweep import cli as sweep_cli
@@ -67,6 +68,7 @@ def _register() -> None:
     interop_cli.register(app)
     sensitivity_cli.register(app)
     calibration_cli.register(app)
+    sand_cli.register(app)
     for info in app.registered_commands:
         info.callback = _interruptible(info.name or info.callback.__name__, info.callback)
 
@@ -80,6 +82,7 @@ KEPT = {
     "relation": "finished cases",
     "sensitivity": "finished cases",
     "strength": "finished specimens and tests",
+    "sand": "finished calibration cases and specimens",
 }
 
 

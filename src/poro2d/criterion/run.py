@@ -47,7 +47,11 @@ DENSITY_KEYS = {"mode", "n_max", "n_min", "mu_prep", "seeds"}
 
 
 def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> dict:
-    """Mode and density-mode settings from ``[density]`` and the options (options win)."""
+    """Mode and density-mode settings from ``[density]`` and the options (options win).
+
+    With no mode given, density mode when both laboratory extremes are (``[density]`` or the
+    options), else paper mode.
+    """
     from poro2d import porosity as P
     from poro2d.config import check_keys
     from poro2d.criterion.density import check_mus
@@ -55,6 +59,12 @@ def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> d
 
     check_keys("density", cfg.get("density") or {}, DENSITY_KEYS)
     t = dict(cfg.get("density") or {})
+    if mode is None and "mode" not in t:
+        # density-aware by default: a config or options that give both laboratory extremes ask
+        # for the answer at the laboratory density, which paper mode cannot give
+        both = all((opt if opt is not None else t.get(key)) is not None
+                   for opt, key in ((n_max, "n_max"), (n_min, "n_min")))  # fmt: skip
+        mode = "density" if both else "paper"
     mode = mode if mode is not None else t.get("mode", "paper")
     if mode not in ("paper", "density"):
         raise InputError("mode", mode, "paper or density")

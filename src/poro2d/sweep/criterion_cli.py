@@ -17,6 +17,13 @@ from poro2d.sweep.results import DensityStateResult
 
 console = OutputConsole()
 
+#: what paper mode's answer does not depend on, said after every paper-mode run
+PAPER_MODE_NOTE = (
+    "[yellow]paper mode:[/] the specimen is prepared at the fixed friction_prep, so the accepted n2D "
+    "does not follow the laboratory density (nLab only sets Eq. 12's first trial); for the answer at "
+    "your density give both laboratory extremes (--n-max/--n-min or [density]) or use poro2d sand"
+)
+
 
 def register(app: typer.Typer) -> None:
     @app.command("criterion")
@@ -31,7 +38,10 @@ def register(app: typer.Typer) -> None:
         trial: float = typer.Option(None, "--trial-porosity", help="First trial n2D instead of Eq. 12."),
         threads: int = typer.Option(None, "--threads", help="Threads for the DEM kernels."),
         mode: str = typer.Option(
-            None, "--mode", help="paper (default: preparation friction 0.05) or density (friction from Dr)."
+            None,
+            "--mode",
+            help="density (friction from Dr; the default when both laboratory extremes are "
+            "given) or paper (preparation friction 0.05; the default otherwise).",
         ),
         n_max: float = typer.Option(None, "--n-max", help="Density mode: loosest laboratory porosity."),
         n_min: float = typer.Option(None, "--n-min", help="Density mode: densest laboratory porosity."),
@@ -54,6 +64,7 @@ def register(app: typer.Typer) -> None:
             print_density(result, out)
             return
         print_result(result, out)
+        console.print(PAPER_MODE_NOTE, soft_wrap=True)
         if not result.converged:
             # one line, whole: the reason names the trial, the stage or check, the ratio
             what = "failed" if result.failed_trial else "not converged"

@@ -46,6 +46,30 @@ CALIBRATION_FIRST_TRIAL = 0.19
 #: steps, 320 000 at the answer). A grading that packs otherwise starts further from its answer
 #: (the trials still converge to it, in more steps).
 FILL_FIRST_TRIALS = ((0.0, 0.163), (0.05, 0.171), (0.1, 0.176), (0.2, 0.185), (0.5, 0.202), (1.0, 0.216))
+#: the paper grading's frictionless jamming porosity (docs/jamming.md: 0.1532 +- 0.0012), the dense
+#: end ``FILL_FIRST_TRIALS`` sits above. Another grading's table is this one moved by the difference
+#: of the two jamming porosities (:func:`first_trial` with ``dense_end``): the preparation's dense
+#: end follows the grading's jamming porosity (0.001-0.007 above it on every grading tried), while
+#: the rise with friction and the walls' share change far less between sands.
+PAPER_JAMMING_POROSITY = 0.1532
+#: the share of ``FILL_FIRST_TRIALS``' dense end above the jamming porosity (0.163 - 0.1532) that
+#: the loose layer along the walls adds in the paper's box; it scales with the walls' length over
+#: the box's area times d50 (:func:`wall_share`): 0.0098 / (22.7 m^-1 x 4.44 mm)
+WALL_SHARE_PER_D50 = 0.0098 / ((2 * 0.305 + 2 * 0.124) / (0.305 * 0.124) * 4.4366e-3)
+
+
+def wall_share(width: float, height: float, d50: float) -> float:
+    """What the walls (bottom, sides, lid) add to a box's porosity n' at the dense end.
+
+    A loose layer about half a grain thick lines every wall, so its share of the box is the
+    walls' length over the area times d50, with the coefficient measured on the paper's box
+    (``WALL_SHARE_PER_D50``): 0.0098 there, 0.025 in a box of 46 x 23 mm with d50 = 2 mm.
+    """
+    return WALL_SHARE_PER_D50 * (2.0 * width + 2.0 * height) / (width * height) * d50
+
+
+#: the paper box's share, the one the table's values hold
+PAPER_WALL_SHARE = 0.0098
 
 
 #: settings density mode uses unless the config sets them: trials refined to 0.002 (the paper's
@@ -107,12 +131,17 @@ def calibration_key(base: dict) -> str:
     return identity_digest(rec, tables={"base.specimen": SpecimenSpec}, length=16, layout="spaced")
 
 
-def first_trial(criterion: dict, mu: float) -> float:
+def first_trial(
+    criterion: dict, mu: float, dense_end: float | None = None, walls: float | None = None
+) -> float:
     """The first trial of the calibration case at preparation friction ``mu``.
 
     Under the paper's plate every case starts at ``CALIBRATION_FIRST_TRIAL``; under the fill
     acceptance at the porosity ``FILL_FIRST_TRIALS`` gives for ``mu``, rounded to the grid the
-    criterion steps on (``criterion``: the calibration's criterion table).
+    criterion steps on (``criterion``: the calibration's criterion table). ``dense_end``: the
+    grading's own frictionless jamming porosity (:mod:`poro2d.specimen.jamming`); the table is
+    then moved by its difference from the paper grading's (``PAPER_JAMMING_POROSITY``), and
+    ``walls`` (the box's :func:`wall_share`) by its difference from the paper box's.
     """
     from poro2d.criterion.protocol import CriterionSettings, round_to, trial_grid
 
@@ -121,14 +150,22 @@ def first_trial(criterion: dict, mu: float) -> float:
     mu_ref, n_ref = zip(*FILL_FIRST_TRIALS, strict=True)
     grid = trial_grid(float(criterion.get("resolution", CriterionSettings.resolution)),
                       criterion.get("refine_tolerance"))  # fmt: skip
-    return round_to(float(np.interp(mu, mu_ref, n_ref)), grid)
+    n = float(np.interp(mu, mu_ref, n_ref))
+    if dense_end is not None:
+        n += float(dense_end) - PAPER_JAMMING_POROSITY
+    if walls is not None:
+        n += float(walls) - PAPER_WALL_SHARE
+    return round_to(n, grid)
 
 
-def calibration_sweep(base: dict, mus: list[float], seeds: int) -> dict:
+def calibration_sweep(
+    base: dict, mus: list[float], seeds: int, dense_end: float | None = None, walls: float | None = None
+) -> dict:
     """The sweep of the calibration: every friction with every seed, from its first trial.
 
     Under the paper's plate a grid sweep (one first trial for all); under the fill acceptance
-    a list of cases, each friction from its own first trial (:func:`first_trial`).
+    a list of cases, each friction from its own first trial (:func:`first_trial`, moved to the
+    grading's ``dense_end`` and the box's ``walls`` when given).
     """
     cfg = copy.deepcopy(calibration_base(base))
     threads = (base.get("specimen") or {}).get("threads")
@@ -139,7 +176,7 @@ def calibration_sweep(base: dict, mus: list[float], seeds: int) -> dict:
         cfg["criterion"]["trial_porosity"] = CALIBRATION_FIRST_TRIAL
         cfg["sweep"].update({"specimen.friction_prep": list(mus), "seed": list(range(seeds))})
         return cfg
-    firsts = {mu: first_trial(cfg["criterion"], mu) for mu in mus}
+    firsts = {mu: first_trial(cfg["criterion"], mu, dense_end, walls) for mu in mus}
     cfg["sweep"]["cases"] = [
         {"specimen.friction_prep": mu, "criterion.trial_porosity": firsts[mu], "seed": s}
         for mu in mus
@@ -174,6 +211,9 @@ def calibrate(
     mus: tuple[float, ...] | list[float] = DEFAULT_MUS,
     seeds: int = DEFAULT_SEEDS,
     use_cache: bool = True,
+    dense_end: float | None = None,
+    walls: float | None = None,
+    record: str = "calibration.json",
     **sweep_kw,
 ) -> tuple[Calibration, dict]:
     """The grading's calibration, its cases run on the sweep runner (resumable).
@@ -194,7 +234,7 @@ def calibrate(
         folder.mkdir(parents=True, exist_ok=True)
     except OSError:  # a read-only cache: the cases go with the results
         folder = out / "calibration"
-    sweep = parse_sweep(calibration_sweep(base, mus, seeds), base_dir)
+    sweep = parse_sweep(calibration_sweep(base, mus, seeds, dense_end, walls), base_dir)
     # another run of the same grading may be computing this entry: wait, then reuse its cases
     with cache_entry(folder):
         res = run_sweep(sweep, folder, **sweep_kw)
@@ -209,7 +249,7 @@ def calibrate(
         "sweep_summary": res.summary,
         "provenance": provenance(),
     }
-    write_json(out / "calibration.json", rec)
+    write_json(out / record, rec)
     return cal, dict(info, summary=res.summary, failed=len(res.failed))
 
 
@@ -292,6 +332,8 @@ def calibration_twins(calibration, states, base_dir: Path | None, folder: Path) 
 
 __all__ = [
     "DEFAULT_SEEDS",
+    "PAPER_JAMMING_POROSITY",
+    "PAPER_WALL_SHARE",
     "cache_dir",
     "calibrate",
     "calibration_from_rows",
@@ -302,4 +344,5 @@ __all__ = [
     "check_seeds",
     "first_trial",
     "state_sweep",
+    "wall_share",
 ]

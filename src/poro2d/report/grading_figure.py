@@ -1,0 +1,77 @@
+"""The grading a run used: the laboratory curve, its cuts, and the disks that were drawn.
+
+One panel, laboratory sizes on a log axis: the sieve curve as given (by mass), the curve
+after the ``d_min_mm`` / ``d_max_mm`` cuts (renormalised: the soil the specimen is made of),
+the cuts as vertical lines, and the drawn disks of one specimen (percent passing by area,
+the 2D counterpart of mass).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from poro2d.report.shear_figures import save_figure  # noqa: E402
+from poro2d.specimen.grading import GradingCurve  # noqa: E402
+
+
+def uncut_curve(table: dict, base_dir: str | os.PathLike | None, used: GradingCurve) -> GradingCurve:
+    """The grading of a config table before its cuts (the used curve if it has none)."""
+    if "d_min_mm" not in table and "d_max_mm" not in table:
+        return used
+    whole = {k: v for k, v in table.items() if k not in ("d_min_mm", "d_max_mm")}
+    return GradingCurve.from_config(whole, base_dir=base_dir)
+
+
+def drawn_curve(radii: np.ndarray, sizes_m: np.ndarray) -> np.ndarray:
+    """Percent passing by area of disks of ``radii`` at diameters ``sizes_m``."""
+    d = np.sort(2.0 * np.asarray(radii))
+    cum = np.concatenate(([0.0], np.cumsum((d / 2.0) ** 2)))
+    return 100.0 * cum[np.searchsorted(d, sizes_m, side="right")] / cum[-1]
+
+
+def grading_figure(
+    table: dict,
+    base_dir: str | os.PathLike | None,
+    used: GradingCurve,
+    radii: np.ndarray | None,
+    path: str | os.PathLike,
+    *,
+    title: str = "",
+) -> Path:
+    """Write the grading figure (module docstring) to ``path``; returns the path."""
+    whole = uncut_curve(table, base_dir, used)
+    up = used.upscale
+    fig, ax = plt.subplots(figsize=(7.0, 4.4))
+    ax.semilogx(
+        whole.sizes * 1e3 / up, whole.percent, "-o", color="0.55", ms=4, label="laboratory curve (mass)"
+    )
+    if whole is not used:
+        ax.semilogx(used.sizes * 1e3 / up, used.percent, "-s", color="k", ms=4, label="after the cuts (mass)")
+        for name in ("d_min_mm", "d_max_mm"):
+            if name in table:
+                ax.axvline(float(table[name]) / up, color="tab:orange", ls="--", lw=1)
+        ax.plot([], [], color="tab:orange", ls="--", label="cuts (d_min_mm, d_max_mm)")
+    if radii is not None and len(radii):
+        d = np.geomspace(used.d_min_m, used.d_max_m, 60)
+        ax.semilogx(d * 1e3 / up, drawn_curve(radii, d), color="tab:red", lw=2,
+                    label=f"drawn disks, one specimen ({len(radii)}, by area)")  # fmt: skip
+    ax.set_xlabel("laboratory size [mm]")
+    ax.set_ylabel("percent passing [%]")
+    ax.set_ylim(0, 100)
+    ax.grid(True, which="both", alpha=0.3)
+    if up != 1.0:
+        top = ax.secondary_xaxis("top", functions=(lambda x: x * up, lambda x: x / up))
+        top.set_xlabel(f"disk diameter in the model [mm] (up-scaling x{up:g})")
+    ax.legend(loc="upper left", fontsize=8)
+    ax.set_title(f"{title}: Cu = {used.uniformity:.2f}, d_max/d_min = {used.d_max_m / used.d_min_m:.0f}")
+    return save_figure(fig, path)
+
+
+__all__ = ["drawn_curve", "grading_figure", "uncut_curve"]

@@ -1,0 +1,179 @@
+"""A user's soil as one value: its laboratory description and how ``poro2d sand`` runs it.
+
+A sand config is a criterion config (``[grading]``, ``[specimen]``, ``[criterion]``) with
+three tables of its own::
+
+    [soil]                 # who the soil is: printed and written with every result
+    name = "Toyoura sand"
+    reference = "Verdugo & Ishihara (1996)"
+    [lab]                  # the laboratory description (poro2d.lab_state)
+    e_max = 0.977          # or n_max / n_min
+    e_min = 0.597
+    dr = 0.5               # or e, n, or dry_density with solid_density
+    [sand]                 # how to run it (all optional)
+    seeds = 3              # specimens at full size
+    calibration_disks = 1500
+    mu_prep = [0.0, 0.05, 0.1, 0.2, 0.5, 1.0]
+
+:func:`load_sand_case` turns it into a :class:`SandCase` once; nothing below reads the
+TOML again.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from poro2d.config import check_keys
+from poro2d.criterion.density import DEFAULT_MUS, check_mus
+from poro2d.errors import InputError, check_int
+from poro2d.lab_state import LabState, lab_state_from_table
+from poro2d.specimen.compaction import SpecimenSpec
+from poro2d.specimen.grading import GradingCurve
+from poro2d.sweep.density import DEFAULT_SEEDS, with_density_defaults
+
+#: the tables a sand config adds to a criterion config
+SAND_TABLES = ("soil", "lab", "sand")
+SOIL_KEYS = {"name", "reference"}
+SAND_KEYS = {"seeds", "calibration_disks", "mu_prep"}
+#: disks in the calibration box unless ``[sand] calibration_disks`` says otherwise: the dense and
+#: loose ends of the paper grading moved by less than their seed spread between this box and the
+#: full one (docs/sand.md)
+CALIBRATION_DISKS = 1500
+
+ConfigLike = dict | str | os.PathLike
+
+
+@dataclass(frozen=True)
+class SandCase:
+    """Everything ``poro2d sand`` needs, checked: the soil, its state, the specimens' config.
+
+    ``config`` is the criterion config of the full-size specimens (density mode's defaults
+    filled in, ``criterion.n_lab`` the laboratory state), ``base_dir`` the folder its relative
+    paths start from; ``spec`` and ``grading`` are built from it.
+    """
+
+    name: str
+    reference: str
+    lab: LabState
+    config: dict = field(repr=False)
+    base_dir: Path | None
+    spec: SpecimenSpec
+    grading: GradingCurve
+    seeds: int = DEFAULT_SEEDS
+    calibration_disks: int = CALIBRATION_DISKS
+    mus: tuple[float, ...] = DEFAULT_MUS
+
+    @property
+    def n_max(self) -> float:
+        assert self.lab.n_max is not None
+        return self.lab.n_max
+
+    @property
+    def n_min(self) -> float:
+        assert self.lab.n_min is not None
+        return self.lab.n_min
+
+    def soil_record(self) -> dict:
+        """The soil as every result file names it."""
+        return {
+            "name": self.name,
+            "reference": self.reference,
+            "grading": dict(self.config.get("grading") or {}),
+            "grading_source": self.grading.source,
+            "upscale": self.grading.upscale,
+            "lab": self.lab.to_dict(),
+        }
+
+
+def _soil(table: dict) -> tuple[str, str]:
+    check_keys("soil", table, SOIL_KEYS)
+    for key in SOIL_KEYS:
+        if key in table and not isinstance(table[key], str):
+            raise InputError(f"soil.{key}", table[key], "a string")
+    return table.get("name", "unnamed soil"), table.get("reference", "")
+
+
+def _lab(table) -> LabState:
+    if table is None:
+        raise InputError(
+            "lab",
+            None,
+            "a [lab] table: e_max and e_min (or n_max and n_min) and the state "
+            "(e, n, dr, or dry_density with solid_density)",
+        )
+    if not isinstance(table, dict):
+        raise InputError("lab", table, "a table of key = value pairs")
+    lab = lab_state_from_table(table)
+    if lab.n_max is None or lab.n_min is None:
+        raise InputError(
+            "lab.e_max/e_min",
+            None,
+            "both laboratory extremes (e_max and e_min, or n_max and n_min)",
+            "the density-aware answer maps the state between them; without them use "
+            "poro2d criterion (the paper's mode)",
+        )
+    return lab
+
+
+def _criterion_config(cfg: dict, lab: LabState) -> dict:
+    """The criterion config of the full-size specimens: the state's nLab, density mode's defaults."""
+    if "density" in cfg:
+        raise InputError(
+            "density",
+            cfg["density"],
+            "no [density] table in a sand config",
+            "the laboratory extremes go in [lab], seeds and frictions in [sand]",
+        )
+    crit = {k: copy.deepcopy(v) for k, v in cfg.items() if k not in SAND_TABLES}
+    table = dict(crit.get("criterion") or {})
+    given = table.get("n_lab")
+    if given is not None and not math.isclose(float(given), lab.n_lab, abs_tol=5e-5):
+        raise InputError("criterion.n_lab", given, f"unset or the [lab] state's n = {lab.n_lab:.4f}")
+    table["n_lab"] = round(lab.n_lab, 6)
+    crit["criterion"] = table
+    return with_density_defaults(crit)
+
+
+def load_sand_case(config: ConfigLike, *, seeds: int | None = None) -> SandCase:
+    """A :class:`SandCase` from a sand config (a TOML file or a dict), every value checked.
+
+    ``seeds`` overrides ``[sand] seeds``. Raises :class:`~poro2d.errors.InputError` naming
+    the key, its value and what is allowed.
+    """
+    from poro2d.criterion.config import build, check_tables, load_config
+
+    if isinstance(config, dict):
+        check_keys("config", config, {"seed", "specimen", "grading", "criterion", "title", *SAND_TABLES})
+        check_tables(config)
+        cfg, base_dir = copy.deepcopy(config), None
+    else:
+        cfg, base_dir = load_config(config, extra_tables=SAND_TABLES)
+    for name in SAND_TABLES:
+        if name in cfg and not isinstance(cfg[name], dict):
+            raise InputError(name, cfg[name], "a table of key = value pairs")
+    name, reference = _soil(cfg.get("soil") or {})
+    lab = _lab(cfg.get("lab"))
+    sand = cfg.get("sand") or {}
+    check_keys("sand", sand, SAND_KEYS)
+    n_seeds = check_int(
+        "--seeds" if seeds is not None else "sand.seeds",
+        seeds if seeds is not None else sand.get("seeds", DEFAULT_SEEDS),
+        1,
+        50,
+    )
+    cal_disks = check_int(
+        "sand.calibration_disks", sand.get("calibration_disks", CALIBRATION_DISKS), 200, 50_000
+    )
+    mus = tuple(check_mus(sand["mu_prep"], "sand.mu_prep")) if "mu_prep" in sand else DEFAULT_MUS
+    if "grading" not in cfg:
+        raise InputError("grading", None, "a [grading] table: csv, sizes_mm with percent_passing, or preset")
+    crit = _criterion_config(cfg, lab)
+    spec, grading, _settings, _seed = build(crit, base_dir)
+    return SandCase(name, reference, lab, crit, base_dir, spec, grading, n_seeds, cal_disks, mus)
+
+
+__all__ = ["CALIBRATION_DISKS", "SandCase", "load_sand_case"]

@@ -1,0 +1,166 @@
+"""``poro2d sand``: a user's soil, from its laboratory description to the 2D porosity to use."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import typer
+from rich.markup import escape
+
+from poro2d.console import OutputConsole, Table
+
+console = OutputConsole()
+
+
+def print_preflight(case, pf) -> None:
+    """The pre-flight table, printed before any DEM work."""
+    lab = case.lab
+    t = Table(title=f"pre-flight: {case.name}")
+    t.add_column("quantity")
+    t.add_column("value", justify="right")
+    dr = "" if lab.relative_density is None else f", Dr = {lab.relative_density:.3f}"
+    rows = [
+        ("laboratory state", f"n = {lab.n_lab:.4f}, e = {lab.e:.4f}{dr} (given as {lab.given})"),
+        (
+            "grading",
+            f"d {pf.d_min_m * 1e3:.3g}-{pf.d_max_m * 1e3:.3g} mm in the model (x{pf.upscale:g}), "
+            f"d50 {pf.d50_m * 1e3:.3g} mm, Cu {pf.cu:.2f}, d_max/d_min {pf.size_ratio:.0f}",
+        ),
+        (
+            "full box",
+            f"{pf.box.width:g} x {pf.box.height:g} m, {pf.box.layers} layers, about {pf.box.disks:.0f} disks",
+        ),
+        ("layer band", f"{pf.box.band_height * 1e3:.1f} mm = {pf.band_over_d_max:.1f} d_max"),
+        (
+            "calibration box",
+            f"{pf.calibration_box.width:g} x {pf.calibration_box.height:g} m, "
+            f"{pf.calibration_box.layers} layers, about {pf.calibration_box.disks:.0f} disks",
+        ),
+        (
+            "time step",
+            f"{pf.time_step_s:.3g} s ({pf.time_step_s / pf.time_step_paper_s:.2f} x the paper grading's)",
+        ),
+        (
+            "jamming porosity",
+            "n/a: " + pf.jamming.note
+            if pf.jamming.porosity is None
+            else f"{pf.jamming.porosity:.4f} +- {pf.jamming.sd:.4f} "
+            f"({pf.jamming.seeds} seeds, {pf.jamming.disks} disks)",
+        ),
+        (
+            "first trial (densest preparation)",
+            f"{pf.first_trial:.3f} (Eq. 12 would start at {pf.eq12_trial:.3f})",
+        ),
+        ("cases", f"calibration {pf.cases_calibration} at most, specimens {pf.cases_specimens}"),
+        ("estimated particle-steps", f"{sum(pf.particle_steps.values()):.3g}"),
+        (
+            "estimated run time",
+            f"{pf.seconds['total'] / 60:.0f} min on {pf.workers} core(s) (a model: "
+            "the run prints its measured pace)",
+        ),
+    ]
+    if pf.suggestion:
+        rows.append(("budget", pf.suggestion))
+    for k, v in rows:
+        t.add_row(k, escape(v))
+    console.print(t)
+    for note in pf.notes:
+        console.print(f"[yellow]note:[/] {escape(note)}", soft_wrap=True)
+
+
+def print_result(res, out: Path) -> None:
+    """The answer: the interior porosity first, then n', the friction, every seed."""
+    st = res.state
+    dr = st.get("relative_density")
+    head = f"{res.soil.get('name')} at nLab = {st['n_lab']:.4f}" + (
+        f" (Dr = {dr:.3f})" if dr is not None else ""
+    )
+    if math.isfinite(res.interior_porosity_mean):
+        console.print(
+            f"[bold]interior porosity {res.interior_porosity_mean:.4f} +- {res.interior_porosity_sd:.4f}[/] "
+            f"({res.seeds_accepted} of {res.seeds} seeds): the 2D porosity of {escape(head)}",
+            soft_wrap=True,
+        )
+    t = Table(title="poro2d sand")
+    for col in ("seed", "accepted", "interior n", "box n'", "disks", "specimen folder"):
+        t.add_column(col, justify="right")
+    for k in res.specimens:
+        t.add_row(
+            str(k.seed),
+            "yes" if k.accepted else "no",
+            _f(k.interior_porosity),
+            _f(k.box_porosity),
+            str(k.particle_count or ""),
+            escape(str(out / k.folder)) if k.folder else "",
+        )
+    console.print(t)
+    console.print(
+        f"box porosity n' {res.box_porosity_mean:.4f} +- {res.box_porosity_sd:.4f}; "
+        f"mu_prep {res.mu_prep:.3f}; "
+        f"2D extremes {res.n2d_min:.4f}-{res.n2d_max:.4f}; jamming porosity "
+        + ("n/a" if res.jamming_porosity is None else f"{res.jamming_porosity:.4f}"),
+        soft_wrap=True,
+    )
+    console.print(
+        f"summary: {escape(str(out / 'summary.md'))} (also summary.csv, sand.json, fig_grading.png)",
+        soft_wrap=True,
+    )
+    for k in res.specimens:
+        if not k.accepted:
+            console.print(f"[bold red]seed {k.seed} not accepted:[/] {escape(k.message)}", soft_wrap=True)
+
+
+def _f(v) -> str:
+    return "" if v is None else f"{v:.4f}"
+
+
+def sand_cmd(
+    config: Path = typer.Argument(
+        ..., help="Sand config: \\[soil], \\[grading], \\[lab] (and \\[specimen], \\[sand])."
+    ),
+    out: Path = typer.Option(Path("sand-out"), "--out", "-o", help="Output folder (resumable)."),
+    seeds: int = typer.Option(None, "--seeds", help="Specimens at full size (default 3, or \\[sand] seeds)."),
+    budget: float = typer.Option(
+        None, "--budget", help="Target run time in minutes: the pre-flight says what fits."
+    ),
+    preflight_only: bool = typer.Option(
+        False, "--preflight", help="Print the pre-flight and stop (no DEM work)."
+    ),
+    workers: int = typer.Option(None, "--workers", help="Worker processes (default: one per core)."),
+    scheduler: str = typer.Option(None, "--scheduler", help="Address of a running Dask scheduler."),
+    quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+) -> None:
+    """The density-aware 2D porosity of your soil at its laboratory state, over seeds.
+
+    From a grading and e_max/e_min (or n_max/n_min) with the state as e, n, Dr or dry
+    density: a pre-flight (disks, time step, jamming porosity, run time), a calibration in a
+    small box, specimens at full size, and the interior porosity to use in other codes.
+    """
+    from poro2d.sand.run import run_preflight, run_sand
+
+    if preflight_only:
+        case, pf = run_preflight(config, seeds=seeds, workers=workers, budget_minutes=budget)
+        print_preflight(case, pf)
+        return
+    res = run_sand(
+        config,
+        out=out,
+        seeds=seeds,
+        budget_minutes=budget,
+        workers=workers,
+        scheduler=scheduler,
+        progress=not quiet,
+        announce=lambda line: console.print(escape(line), soft_wrap=True),
+        on_preflight=print_preflight,
+    )
+    print_result(res, out)
+    if not res.converged:
+        raise typer.Exit(1)
+
+
+def register(app: typer.Typer) -> None:
+    app.command("sand")(sand_cmd)
+
+
+__all__ = ["print_preflight", "print_result", "register", "sand_cmd"]

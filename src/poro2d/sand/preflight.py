@@ -1,0 +1,375 @@
+"""What a soil will cost before any DEM work: disks, time step, first trials, run time.
+
+The pre-flight reads only the grading and the box (no disk is simulated): the disk count
+is the box's solid area over the grading's mean disk area, the time step is the engine's
+critical step for the lightest disk (:func:`poro2d.dem.model.critical_time_step`), and the
+grading's frictionless jamming porosity (:mod:`poro2d.specimen.jamming`, an energy
+minimisation, not a DEM run) places the first trials. The run time is a model:
+
+    particle-steps = disks x steps per trial x trials per case
+
+with the steps per trial measured on this engine (``PLATE_STEPS``, ``SETTLE_STEPS``; both
+scale with 1 / dt, since the lid travels at a set speed and layers settle in physical time)
+and ``THROUGHPUT`` particle-steps per second per core. It is an estimate to choose a box
+and an up-scaling with, printed as such; the run prints its own measured pace.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field, replace
+
+import numpy as np
+
+from poro2d.errors import InputError
+from poro2d.porosity import parabolic
+from poro2d.sand.case import SandCase
+from poro2d.specimen.compaction import SpecimenSpec, check_feasible, estimate_size
+from poro2d.specimen.grading import GradingCurve, paper_grading
+
+#: particle-steps per second per core assumed by the estimate (measured 1.0e7-2.5e7 on dense
+#: sand specimens on the 2-core machines of this project; benchmarks/README.md)
+THROUGHPUT = 1.2e7
+#: lid/plate steps of one trial at the paper grading's time step (the fill acceptance's lid
+#: approach and settling: 258 000 steps per trial on a uniform fine sand whose step is 0.53 of
+#: the paper grading's, 100 000-140 000 on the paper grading)
+PLATE_STEPS = 136_000
+#: settling steps of one layer after its growth, at the paper grading's time step
+SETTLE_STEPS = 3_000
+#: criterion trials per case: the first trial, then the refined one (fill acceptance, 0.002)
+TRIALS_PER_CASE = 2.0
+#: the jamming reference's disks: enough for phi_J within its seed spread (docs/jamming.md);
+#: a wide grading whose largest disks need a bigger cell gets up to ``JAMMING_MAX_DISKS``
+JAMMING_DISKS = 1500
+JAMMING_MAX_DISKS = 8000
+
+
+@dataclass(frozen=True)
+class BoxPlan:
+    """A box the run prepares specimens in, and what one specimen holds."""
+
+    width: float
+    height: float
+    layers: int
+    disks: float
+
+    @property
+    def band_height(self) -> float:
+        return self.height / self.layers
+
+
+@dataclass(frozen=True)
+class Jamming:
+    """The grading's frictionless jamming porosity (n_J = 1 - phi_J) over seeds, or why not."""
+
+    porosity: float | None
+    sd: float | None
+    disks: int
+    seeds: int
+    seconds: float
+    note: str = ""
+
+
+@dataclass(frozen=True)
+class Preflight:
+    """The pre-flight of one soil: printed before any DEM work, kept as ``preflight.json``."""
+
+    soil: str
+    d_min_m: float
+    d50_m: float
+    d_max_m: float
+    cu: float
+    size_ratio: float
+    upscale: float
+    box: BoxPlan
+    calibration_box: BoxPlan
+    band_over_d_max: float
+    time_step_s: float
+    time_step_paper_s: float
+    jamming: Jamming
+    first_trial: float
+    eq12_trial: float
+    cases_calibration: int
+    cases_specimens: int
+    particle_steps: dict
+    seconds: dict
+    workers: int
+    budget_minutes: float | None
+    suggestion: str
+    notes: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def time_step(spec: SpecimenSpec, r_min: float) -> float:
+    """The engine's automatic step for disks as small as ``r_min`` in ``spec``'s box."""
+    from poro2d.dem.model import ContactModel, critical_time_step
+    from poro2d.dem.state import Particles
+    from poro2d.specimen.compaction import make_walls
+
+    disk = Particles(
+        np.zeros((1, 2)),
+        np.array([r_min]),
+        spec.solid_density,
+        spec.thickness,
+        spec.kn_particle,
+        spec.ks_particle,
+        spec.friction_prep,
+    )
+    k_sum = ContactModel("per_body").stiffness_sum_bound(disk, make_walls(spec, spec.height))
+    return spec.dt_safety * critical_time_step(float(disk.mass[0]), k_sum)
+
+
+#: a lid must rest in the calibration box: its force window at least this many times the
+#: grain weights its segments need (:data:`poro2d.criterion.lid.GRAINS_PER_SEGMENT` per segment)
+LID_MARGIN = 2.0
+
+
+def calibration_box(
+    spec: SpecimenSpec, grading: GradingCurve, disks: int, porosity: float, *, lid_window: float | None = None
+) -> BoxPlan:
+    """A box of the full box's shape holding about ``disks`` disks (the full box if that is smaller).
+
+    Its layers keep about the full box's band height in grain sizes, and every band holds at
+    least three of the largest disks, the box at least ten across. ``lid_window``: the
+    criterion's force fraction when the fill acceptance's lid must rest in the box; the box is
+    then wide enough that the window holds ``LID_MARGIN`` times the grain weights its segments
+    need (a small box's window is the weight of a few grains: its lid never settles).
+    """
+    from poro2d.criterion.lid import GRAINS_PER_SEGMENT, SEGMENT_D50
+
+    full = estimate_size(spec, grading, porosity).disks
+    scale = math.sqrt(disks / full)
+    if lid_window is not None:
+        # window = lid_window x N grains, N = full x scale^2; segments = scale W / (SEGMENT_D50 d50)
+        per_width = LID_MARGIN * GRAINS_PER_SEGMENT / (SEGMENT_D50 * grading.size_at(50.0) * lid_window)
+        scale = max(scale, per_width * spec.width / full)
+    if scale >= 1.0:
+        return BoxPlan(spec.width, spec.height, spec.layers, full)
+    d_max = grading.d_max_m
+    layers = max(1, round(spec.layers * scale))
+    height = max(spec.height * scale, 3.0 * d_max * layers)
+    width = max(spec.width * scale, 10.0 * d_max)
+    width, height = round(width, 4), round(height, 4)
+    if width >= spec.width or height >= spec.height:
+        return BoxPlan(spec.width, spec.height, spec.layers, full)
+    small = replace(spec, width=width, height=height, layers=layers)
+    return BoxPlan(width, height, layers, estimate_size(small, grading, porosity).disks)
+
+
+def jamming_of(grading: GradingCurve, seeds: int = 3, *, use_cache: bool = True) -> Jamming:
+    """The grading's jamming porosity, with disks enough for its largest grains (or a note why not).
+
+    Kept in the cache folder (:func:`poro2d.sweep.density.cache_dir`) by grading, disks and
+    seeds: a second pre-flight of the same grading reads it back (checked: finite numbers of
+    the right kind, else computed again).
+    """
+    if not use_cache:
+        return _compute_jamming(grading, seeds)
+    import json
+
+    from poro2d import __version__
+    from poro2d.identity import identity_digest
+    from poro2d.io_utils import write_json
+    from poro2d.sweep.density import cache_dir
+
+    key = identity_digest(
+        {
+            "sizes": grading.sizes_m,
+            "percent": grading.percent_passing,
+            "seeds": seeds,
+            "disks": JAMMING_DISKS,
+            "version": __version__,
+        },
+        length=16,
+    )
+    path = cache_dir() / "jamming" / f"{key}.json"
+    try:
+        jam = _jamming_from(json.loads(path.read_text(encoding="utf-8")))
+    except (OSError, ValueError, TypeError, KeyError):
+        jam = None
+    if jam is not None:
+        return jam
+    jam = _compute_jamming(grading, seeds)
+    try:
+        write_json(path, asdict(jam))
+    except OSError:  # a read-only cache: the reference is simply computed again next time
+        pass
+    return jam
+
+
+def _jamming_from(d: dict) -> Jamming | None:
+    """A cached reference, or None when the entry is not one (damaged, edited, of another kind)."""
+    por, sd = d["porosity"], d["sd"]
+    if por is not None and not (
+        isinstance(por, float)
+        and 0.0 < por < 1.0
+        and isinstance(sd, float)
+        and math.isfinite(sd)
+        and sd >= 0.0
+    ):
+        return None
+    return Jamming(por, sd, int(d["disks"]), int(d["seeds"]), float(d["seconds"]), str(d["note"]))
+
+
+def _compute_jamming(grading: GradingCurve, seeds: int) -> Jamming:
+    import time
+
+    from poro2d.specimen.jamming import jamming_reference
+
+    # the periodic cell must be wider than four of the largest radii: N mean disks at phi 0.85
+    need = (4.0 * grading.d_max_m / 2.0) ** 2 * 4.0 * 0.85 / grading.mean_disk_area()
+    n = int(max(JAMMING_DISKS, math.ceil(need * 1.2)))
+    t0 = time.perf_counter()
+    if n > JAMMING_MAX_DISKS:
+        note = (
+            f"not computed: the largest grains need a periodic cell of about {n} disks "
+            f"(at most {JAMMING_MAX_DISKS} here)"
+        )
+        return Jamming(None, None, n, 0, 0.0, note)
+    try:
+        ref = jamming_reference(grading, n_disks=n, seeds=tuple(range(seeds)))
+    except InputError as exc:
+        return Jamming(None, None, n, 0, time.perf_counter() - t0, f"not computed: {exc}")
+    note = "" if ref.converged else "a minimisation stalled (docs/jamming.md)"
+    return Jamming(ref.porosity_mean, ref.porosity_std, n, seeds, ref.seconds, note)
+
+
+def _steps_per_trial(spec: SpecimenSpec, dt: float, dt_paper: float) -> float:
+    slow = dt_paper / dt
+    per_layer = spec.growth_increments * spec.growth_steps + SETTLE_STEPS * slow
+    return spec.layers * per_layer + PLATE_STEPS * slow
+
+
+def _cases(case: SandCase) -> tuple[int, int]:
+    """Calibration cases (the ends and the two frictions around the state, per seed) and specimens."""
+    frictions = min(len(case.mus), 4)
+    return frictions * case.seeds, case.seeds
+
+
+def _seconds(particle_steps: float, cases: int, workers: int) -> float:
+    """Wall time of ``cases`` equal cases on ``workers`` cores (whole rounds)."""
+    if cases == 0:
+        return 0.0
+    per_case = particle_steps / cases / THROUGHPUT
+    return per_case * math.ceil(cases / workers)
+
+
+def budget_suggestion(case: SandCase, seconds: float, budget_min: float | None) -> str:
+    """A box or up-scaling that fits ``budget_min``, with what each costs the answer."""
+    if budget_min is None:
+        return ""
+    budget = budget_min * 60.0
+    if seconds <= budget:
+        return f"fits the budget of {budget_min:g} min (estimate {seconds / 60:.0f} min)"
+    ratio = seconds / budget
+    # disks ~ 1 / upscale^2 and steps ~ 1 / dt ~ 1 / upscale: time ~ upscale^-3
+    up = case.grading.upscale * ratio ** (1.0 / 3.0)
+    area = 1.0 / ratio
+    return (
+        f"estimate {seconds / 60:.0f} min exceeds the budget of {budget_min:g} min: either up-scale by "
+        f"{up:.3g} instead of {case.grading.upscale:g} (fewer, larger disks: fewer grains across the "
+        f"box and a coarser surface), or a box of {area:.2f} times the area at this up-scaling (the "
+        f"walls' loose layer then weighs more in n'; the interior porosity is less affected), or "
+        f"fewer seeds (a wider confidence interval)"
+    )
+
+
+def preflight(case: SandCase, *, workers: int = 2, budget_minutes: float | None = None) -> Preflight:
+    """The pre-flight of ``case``: every number from the grading and the box, no DEM run.
+
+    Refuses (InputError) a box whose layers cannot hold the largest disk.
+    """
+    spec, g = case.spec, case.grading
+    jam = jamming_of(g)
+    from poro2d.sweep.density import first_trial, wall_share
+
+    crit = case.config.get("criterion") or {}
+    first = first_trial(crit, case.mus[0], jam.porosity, wall_share(spec.width, spec.height, g.size_at(50.0)))
+    check_feasible(spec, g, first)
+    full = BoxPlan(spec.width, spec.height, spec.layers, estimate_size(spec, g, first).disks)
+    fill = crit.get("acceptance", "plate") == "fill"
+    cal = calibration_box(
+        spec,
+        g,
+        case.calibration_disks,
+        first,
+        lid_window=float(crit.get("force_fraction", 0.01)) if fill else None,
+    )
+    dt = time_step(spec, g.d_min_m / 2.0)
+    dt_paper = time_step(spec, paper_grading().d_min_m / 2.0)
+    steps = _steps_per_trial(spec, dt, dt_paper) * TRIALS_PER_CASE
+    n_cal, n_spec = _cases(case)
+    cal_spec = replace(spec, width=cal.width, height=cal.height, layers=cal.layers)
+    cal_steps = _steps_per_trial(cal_spec, dt, dt_paper) * TRIALS_PER_CASE
+    same_box = (cal.width, cal.height) == (spec.width, spec.height)
+    psteps = {
+        "calibration": cal.disks * cal_steps * n_cal,
+        "specimens": 0.0 if same_box else full.disks * steps * n_spec,
+    }
+    secs = {
+        "calibration": _seconds(psteps["calibration"], n_cal, workers),
+        "specimens": _seconds(psteps["specimens"], n_spec, workers),
+    }
+    secs["total"] = secs["calibration"] + secs["specimens"]
+    eq12 = float(parabolic(case.lab.n_lab))
+    notes = _notes(case, jam, eq12, dt, dt_paper, full)
+    return Preflight(
+        soil=case.name,
+        d_min_m=g.d_min_m,
+        d50_m=g.size_at(50.0),
+        d_max_m=g.d_max_m,
+        cu=g.uniformity,
+        size_ratio=g.d_max_m / g.d_min_m,
+        upscale=g.upscale,
+        box=full,
+        calibration_box=cal,
+        band_over_d_max=full.band_height / g.d_max_m,
+        time_step_s=dt,
+        time_step_paper_s=dt_paper,
+        jamming=jam,
+        first_trial=first,
+        eq12_trial=eq12,
+        cases_calibration=n_cal,
+        cases_specimens=n_spec,
+        particle_steps=psteps,
+        seconds=secs,
+        workers=workers,
+        budget_minutes=budget_minutes,
+        suggestion=budget_suggestion(case, secs["total"], budget_minutes),
+        notes=notes,
+    )
+
+
+def _notes(case: SandCase, jam: Jamming, eq12: float, dt: float, dt_paper: float, full: BoxPlan) -> list[str]:
+    notes = []
+    if jam.porosity is not None and eq12 < jam.porosity:
+        notes.append(
+            f"Eq. 12's trial {eq12:.3f} is denser than this grading can pack (jamming porosity "
+            f"{jam.porosity:.3f}): paper mode would start from an over-full box"
+        )
+    if jam.porosity is None:
+        notes.append(f"jamming porosity {jam.note}; first trials from the paper grading's table")
+    if dt < 0.25 * dt_paper:
+        notes.append(
+            f"the finest disks set a time step {dt_paper / dt:.1f} times smaller than the paper grading's: "
+            "cutting fines (d_min_mm) or up-scaling more shortens every stage"
+        )
+    band = full.band_height / case.grading.d_max_m
+    if band < 4.0:
+        notes.append(f"each layer is only {band:.1f} largest grains tall: fewer layers pack more evenly")
+    return notes
+
+
+__all__ = [
+    "THROUGHPUT",
+    "BoxPlan",
+    "Jamming",
+    "Preflight",
+    "budget_suggestion",
+    "calibration_box",
+    "jamming_of",
+    "preflight",
+    "time_step",
+]

@@ -1,0 +1,259 @@
+"""The answer of ``poro2d sand``: ``sand.json`` and the paste-ready summary beside it.
+
+The first number is the specimen's own (interior) porosity, mean +- sd over seeds: the
+porosity to give another code that fills a closed box (docs/porosity.md). The box porosity
+n' (the criterion's, under the lid) follows it.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from poro2d.io_utils import atomic_path, provenance, write_json
+from poro2d.typed_result import NOT_IN_FILE, TypedResult
+
+
+def _stats(values: list[float | None]) -> tuple[float, float]:
+    v = np.array([x for x in values if x is not None and math.isfinite(x)], dtype=float)
+    if v.size == 0:
+        return math.nan, math.nan
+    return float(v.mean()), float(v.std(ddof=1)) if v.size > 1 else 0.0
+
+
+@dataclass(frozen=True)
+class SeedSpecimen:
+    """One seed's specimen at full size: accepted or why not, its porosities, its folder."""
+
+    seed: int
+    accepted: bool
+    box_porosity: float | None
+    interior_porosity: float | None
+    particle_count: int | None
+    trials: int | None
+    folder: str | None
+    message: str = ""
+
+    @classmethod
+    def from_row(cls, seed: int, row: dict, folder: str | None) -> SeedSpecimen:
+        res = row.get("results") or {}
+        ok = row.get("status") == "done" and bool(res.get("converged")) and folder is not None
+
+        def num(key):
+            v = res.get(key)
+            return float(v) if v is not None and math.isfinite(float(v)) else None
+
+        why = res.get("message") or row.get("error") or ""
+        return cls(
+            seed,
+            ok,
+            num("last_new_porosity"),
+            num("interior_porosity"),
+            res.get("particle_count"),
+            res.get("iterations"),
+            folder,
+            "" if ok else str(why),
+        )
+
+    def to_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+@dataclass(eq=False)
+class SandResult(TypedResult):
+    """``sand.json``: the soil, its state, the answer over seeds and where every part is."""
+
+    soil: dict[str, Any]
+    state: dict[str, Any]
+    interior_porosity_mean: float
+    interior_porosity_sd: float
+    box_porosity_mean: float
+    box_porosity_sd: float
+    solid_fraction_mean: float
+    seeds: int
+    seeds_accepted: int
+    converged: bool
+    mu_prep: float
+    n2d_target: float
+    first_trial_full_box: float
+    n2d_min: float
+    n2d_max: float
+    jamming_porosity: float | None
+    jamming_porosity_sd: float | None
+    calibration: dict[str, Any]
+    states: list[dict[str, Any]]
+    preflight: dict[str, Any]
+    wall_seconds: float
+    config: dict[str, Any]
+    provenance: dict[str, Any]
+    specimens: list[SeedSpecimen] = field(default_factory=list, metadata=NOT_IN_FILE)
+
+    @classmethod
+    def build(
+        cls, case, pf, target, trial: float, cal_record: dict, kept: list[SeedSpecimen], seconds: float
+    ) -> SandResult:
+        inner_m, inner_sd = _stats([k.interior_porosity for k in kept if k.accepted])
+        box_m, box_sd = _stats([k.box_porosity for k in kept if k.accepted])
+        lab = case.lab
+        states = [
+            {
+                "n_lab": lab.n_lab,
+                "relative_density": lab.relative_density,
+                "seed": k.seed,
+                "specimen": k.folder,
+                "box_porosity": k.box_porosity,
+                "interior_porosity": k.interior_porosity,
+            }
+            for k in kept
+            if k.accepted
+        ]
+        n_ok = sum(k.accepted for k in kept)
+        return cls(
+            soil=case.soil_record(),
+            state=lab.to_dict(),
+            interior_porosity_mean=inner_m,
+            interior_porosity_sd=inner_sd,
+            box_porosity_mean=box_m,
+            box_porosity_sd=box_sd,
+            solid_fraction_mean=1.0 - inner_m if math.isfinite(inner_m) else math.nan,
+            seeds=len(kept),
+            seeds_accepted=n_ok,
+            converged=n_ok == len(kept) and n_ok > 0,
+            mu_prep=target.mu_prep,
+            n2d_target=target.n2d_target,
+            first_trial_full_box=trial,
+            n2d_min=cal_record["n2d_min"],
+            n2d_max=cal_record["n2d_max"],
+            jamming_porosity=pf.jamming.porosity,
+            jamming_porosity_sd=pf.jamming.sd,
+            calibration=cal_record,
+            states=states,
+            preflight=pf.to_dict(),
+            wall_seconds=seconds,
+            config=case.config,
+            provenance=provenance(),
+            specimens=list(kept),
+        )
+
+
+def _pm(mean: float, sd: float) -> str:
+    return "n/a" if not math.isfinite(mean) else f"{mean:.4f} +- {sd:.4f}"
+
+
+SUMMARY_COLUMNS = (
+    "soil",
+    "upscale",
+    "disks",
+    "n_lab",
+    "e",
+    "Dr",
+    "mu_prep",
+    "interior_porosity",
+    "interior_sd",
+    "box_porosity",
+    "box_sd",
+    "solid_fraction",
+    "jamming_porosity",
+    "seeds",
+    "seeds_accepted",
+)
+
+
+def summary_row(res: SandResult) -> dict:
+    """One row of the summary table (the CSV's, the markdown's)."""
+    st, pf = res.state, res.preflight
+    return {
+        "soil": res.soil.get("name"),
+        "upscale": res.soil.get("upscale"),
+        "disks": round(pf["box"]["disks"]),
+        "n_lab": st["n_lab"],
+        "e": st["e"],
+        "Dr": st.get("relative_density"),
+        "mu_prep": res.mu_prep,
+        "interior_porosity": res.interior_porosity_mean,
+        "interior_sd": res.interior_porosity_sd,
+        "box_porosity": res.box_porosity_mean,
+        "box_sd": res.box_porosity_sd,
+        "solid_fraction": res.solid_fraction_mean,
+        "jamming_porosity": res.jamming_porosity,
+        "seeds": res.seeds,
+        "seeds_accepted": res.seeds_accepted,
+    }
+
+
+def summary_markdown(res: SandResult, out: Path) -> str:
+    """The paste-ready summary: the answer first, then the soil, the run and the specimens."""
+    st, soil = res.state, res.soil
+    dr = st.get("relative_density")
+    jam = res.jamming_porosity
+    lines = [
+        f"# {soil.get('name')}: 2D porosity at nLab = {st['n_lab']:.4f}"
+        + (f" (Dr = {dr:.3f})" if dr is not None else ""),
+        "",
+        "**Interior porosity (use this in other codes): "
+        f"{_pm(res.interior_porosity_mean, res.interior_porosity_sd)}**"
+        f" over {res.seeds_accepted} of {res.seeds} seeds",
+        "",
+        "| quantity | value |",
+        "| --- | --- |",
+        f"| soil | {soil.get('name')} ({soil.get('reference') or 'no reference given'}) |",
+        f"| grading | {soil.get('grading_source')}, up-scaled x{soil.get('upscale'):g} |",
+        f"| disks (full box) | {res.preflight['box']['disks']:.0f} |",
+        f"| laboratory state | n = {st['n_lab']:.4f}, e = {st['e']:.4f}"
+        + (f", Dr = {dr:.3f}" if dr is not None else "")
+        + f" (given as {st['given']}) |",
+        f"| preparation friction mu_prep | {res.mu_prep:.3f} |",
+        f"| interior porosity | {_pm(res.interior_porosity_mean, res.interior_porosity_sd)} |",
+        f"| box porosity n' (under the lid) | {_pm(res.box_porosity_mean, res.box_porosity_sd)} |",
+        f"| solid fraction (interior) | {res.solid_fraction_mean:.4f} |",
+        "| jamming porosity of the grading | "
+        + ("n/a" if jam is None else f"{jam:.4f} +- {res.jamming_porosity_sd or 0.0:.4f}")
+        + " |",
+        f"| 2D extremes (calibration box) | {res.n2d_min:.4f} dense, {res.n2d_max:.4f} loose |",
+        f"| wall time | {res.wall_seconds / 60:.1f} min |",
+        "",
+        "| seed | accepted | interior | box n' | disks | folder |",
+        "| --- | --- | --- | --- | --- | --- |",
+    ]
+    for k in res.specimens:
+        lines.append(
+            f"| {k.seed} | {'yes' if k.accepted else 'no: ' + k.message} | {_fmt(k.interior_porosity)} | "
+            f"{_fmt(k.box_porosity)} | {k.particle_count or ''} | {k.folder or ''} |"
+        )
+    first = next((k for k in res.specimens if k.accepted), None)
+    if first is not None:
+        lines += [
+            "",
+            "Export, e.g.:",
+            "",
+            "```bash",
+            f"poro2d export {out / first.folder} --to lammps --out {out / 'lammps'}",
+            f"poro2d export {out / first.folder} --to yade --out {out / 'yade'}",
+            "```",
+        ]
+    return "\n".join(lines) + "\n"
+
+
+def _fmt(v: float | None) -> str:
+    return "" if v is None else f"{v:.4f}"
+
+
+def write_summary(res: SandResult, out: Path) -> None:
+    """``summary.md``, ``summary.csv`` and, last (it marks the run done), ``sand.json``."""
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=SUMMARY_COLUMNS, lineterminator="\n")
+    w.writeheader()
+    w.writerow(summary_row(res))
+    for name, text in (("summary.md", summary_markdown(res, out)), ("summary.csv", buf.getvalue())):
+        with atomic_path(out / name) as tmp:
+            tmp.write_text(text, encoding="utf-8")
+    write_json(out / "sand.json", res.to_dict())
+
+
+__all__ = ["SandResult", "SeedSpecimen", "summary_markdown", "summary_row", "write_summary"]

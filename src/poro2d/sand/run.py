@@ -1,0 +1,297 @@
+"""``poro2d sand``: the density-aware 2D porosity of a user's soil at one laboratory state.
+
+Stages (each resumable: rerun the same command to go on):
+
+1. **Pre-flight** (:mod:`poro2d.sand.preflight`): disks, time step, the grading's jamming
+   porosity, the first trials and an estimate of the run time, before any DEM work.
+2. **Calibration in a small box** of the full box's shape (``[sand] calibration_disks``):
+   first the densest and loosest preparations (mu_prep at both ends of ``[sand] mu_prep``),
+   which fix the 2D extremes and so the state's 2D target; then only the two frictions around
+   the target (predicted from the ends), which fix its preparation friction. Each case starts
+   from the grading's own first trial (:func:`poro2d.sweep.density.first_trial` moved to its
+   jamming porosity). Cases are cached per grading and box, as the relation's are.
+3. **Specimens at full size**, one per seed, at that friction, from the target moved by the
+   walls' share of the two boxes (:func:`full_box_trial`).
+4. **The answer**: the interior porosity (the number for other codes) and the box
+   porosity n' over seeds, the accepted specimens in named folders, a grading figure and
+   one summary (``summary.md``, ``summary.csv``, ``sand.json``).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import time
+from collections.abc import Callable
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from poro2d.criterion.density import Calibration, StateTarget, state_target
+from poro2d.io_utils import check_output_dir, provenance, write_json
+from poro2d.locks import holds_output
+from poro2d.sand.case import ConfigLike, SandCase, load_sand_case
+from poro2d.sand.preflight import Preflight, preflight
+from poro2d.sand.result import SandResult, SeedSpecimen, write_summary
+from poro2d.sweep import density as D
+
+Announce = Callable[[str], None]
+
+
+def _quiet(_: str) -> None:
+    pass
+
+
+class StageClock:
+    """Elapsed time and an overall ETA across the stages, from the pre-flight's estimate
+    corrected by the pace measured so far."""
+
+    def __init__(self, estimate: dict, say: Announce) -> None:
+        self.t0 = time.perf_counter()
+        self.estimate = dict(estimate)
+        self.say = say
+        self.pace = 1.0  # measured / estimated, from finished stages
+
+    def begin(self, stage: str, what: str) -> float:
+        left = sum(v for k, v in self.estimate.items() if k != "total") * self.pace
+        self.say(f"{what}; elapsed {_clock(self.elapsed())}, about {_clock(left)} left (estimate)")
+        return time.perf_counter()
+
+    def end(self, stage: str, started: float) -> None:
+        took = time.perf_counter() - started
+        est = self.estimate.pop(stage, 0.0)
+        if est > 0.0 and took > 1.0:
+            self.pace = took / est
+
+    def elapsed(self) -> float:
+        return time.perf_counter() - self.t0
+
+
+def _clock(seconds: float) -> str:
+    s = int(round(max(seconds, 0.0)))
+    return f"{s // 3600:d}:{s % 3600 // 60:02d}:{s % 60:02d}"
+
+
+def calibration_config(case: SandCase, pf: Preflight) -> dict:
+    """The criterion config of the calibration's cases: the sand's, in the calibration box."""
+    import copy
+
+    cfg = copy.deepcopy(case.config)
+    box = pf.calibration_box
+    cfg["specimen"] = dict(cfg.get("specimen") or {}, width=box.width, height=box.height, layers=box.layers)
+    return cfg
+
+
+def predicted_mu(cal_ends: Calibration, n2d_target: float) -> float:
+    """The preparation friction that the two ends predict for ``n2d_target``.
+
+    The rise of n2D with friction has one shape across gradings (steep at low friction,
+    flat towards 1; ``FILL_FIRST_TRIALS``): scaled between the measured ends, it is inverted
+    for the target.
+    """
+    mu_ref, n_ref = (np.array(v) for v in zip(*D.FILL_FIRST_TRIALS, strict=True))
+    mus = cal_ends.usable().mus
+    lo, hi = cal_ends.n2d_min, cal_ends.n2d_max
+    u = 0.0 if hi <= lo else min(max((n2d_target - lo) / (hi - lo), 0.0), 1.0)
+    shape = (n_ref - n_ref[0]) / (n_ref[-1] - n_ref[0])
+    mu = float(np.interp(u, shape, mu_ref))
+    return min(max(mu, mus[0]), mus[-1])
+
+
+def bracket(mus: tuple[float, ...], mu: float) -> list[float]:
+    """The calibration frictions that enclose ``mu``: the ends and its two neighbours."""
+    inner = [m for m in mus if m <= mu][-1:] + [m for m in mus if m > mu][:1]
+    return sorted({mus[0], mus[-1], *inner})
+
+
+def full_box_trial(target: float, dense_end: float | None, cal_dense: float, pf: Preflight) -> float:
+    """The full box's first trial: the target less the walls' share it loses in the larger box.
+
+    The dense end of the calibration box lies above the grading's jamming porosity by the loose
+    layer along its walls (bottom, sides, lid), a share that falls with the perimeter over the
+    area; the full box keeps that share times the ratio of the two boxes' perimeter / area.
+    """
+    if dense_end is None:
+        return target
+    small, big = pf.calibration_box, pf.box
+    ratio = ((2 * big.width + 2 * big.height) / (big.width * big.height)) / (
+        (2 * small.width + 2 * small.height) / (small.width * small.height)
+    )
+    excess = max(cal_dense - dense_end, 0.0)
+    return target - excess * (1.0 - ratio)
+
+
+def _calibrate(case, pf, out, mus, record, cal_kw) -> tuple[Calibration, dict]:
+    cfg = calibration_config(case, pf)
+    box = pf.calibration_box
+    walls = D.wall_share(box.width, box.height, pf.d50_m)
+    return D.calibrate(
+        cfg,
+        case.base_dir,
+        out,
+        mus=mus,
+        seeds=case.seeds,
+        dense_end=pf.jamming.porosity,
+        walls=walls,
+        record=record,
+        **cal_kw,
+    )
+
+
+def run_calibration_stage(case: SandCase, pf: Preflight, out: Path, cal_kw: dict) -> tuple[StateTarget, dict]:
+    """The ends, then the two frictions around the state: its target and friction.
+
+    ``cal_kw``: the sweep's options and ``use_cache`` (:func:`poro2d.sweep.density.calibrate`).
+    """
+    ends = [case.mus[0], case.mus[-1]]
+    cal_ends, _ = _calibrate(case, pf, out, ends, "calibration_ends.json", cal_kw)
+    first = state_target(case.lab.n_lab, case.n_max, case.n_min, cal_ends)
+    mus = bracket(case.mus, predicted_mu(cal_ends, first.n2d_target))
+    cal, info = (cal_ends, {}) if mus == ends else _calibrate(case, pf, out, mus, "calibration.json", cal_kw)
+    if not info:
+        write_json(
+            out / "calibration.json", {"calibration": cal.to_dict(), "mus": mus, "note": "the ends only"}
+        )
+    target = state_target(case.lab.n_lab, case.n_max, case.n_min, cal)
+    return target, {"mus": mus, "calibration": cal.to_dict(), "n2d_min": cal.n2d_min, "n2d_max": cal.n2d_max}
+
+
+def run_specimen_stage(case: SandCase, trial: StateTarget, out: Path, sweep_kw: dict) -> list[dict]:
+    """One criterion case per seed at full size, at the state's friction, from ``trial``."""
+    from poro2d.criterion.protocol import trial_grid
+    from poro2d.sweep.cases import parse_sweep
+    from poro2d.sweep.runner import run_sweep
+
+    crit = case.config.get("criterion") or {}
+    grid = trial_grid(float(crit.get("resolution", 0.01)), crit.get("refine_tolerance"))
+    sweep = parse_sweep(D.state_sweep(case.config, [trial], case.seeds, grid), case.base_dir)
+    res = run_sweep(sweep, out / "states", **sweep_kw)
+    return sorted(res.rows, key=lambda r: int((r.get("params") or {}).get("seed", 0)))
+
+
+def keep_specimens(rows: list[dict], out: Path, label: str) -> list[SeedSpecimen]:
+    """Each seed's accepted specimen in a named folder (``specimens/<label>-seed<k>``)."""
+    kept = []
+    for r in rows:
+        seed = int((r.get("params") or {}).get("seed", 0))
+        res = r.get("results") or {}
+        ok = r.get("status") == "done" and bool(res.get("converged"))
+        src = out / "states" / "cases" / str(r.get("case_id")) / "run"  # the criterion's folder of the case
+        folder = None
+        if ok and (src / "specimen.npz").is_file():
+            dest = out / "specimens" / f"{label}-seed{seed}"
+            dest.mkdir(parents=True, exist_ok=True)
+            for f in src.iterdir():
+                if f.is_file() and not f.name.startswith("."):
+                    shutil.copy2(f, dest / f.name)
+            folder = str(dest.relative_to(out))
+        kept.append(SeedSpecimen.from_row(seed, r, folder))
+    return kept
+
+
+def _state_label(case: SandCase) -> str:
+    dr = case.lab.relative_density
+    return f"Dr{dr:.2f}" if dr is not None else f"n{case.lab.n_lab:.4f}"
+
+
+def run_preflight(
+    config: ConfigLike,
+    *,
+    seeds: int | None = None,
+    workers: int | None = None,
+    budget_minutes: float | None = None,
+) -> tuple[SandCase, Preflight]:
+    """The soil checked and its pre-flight, with no DEM work (``poro2d sand --preflight``)."""
+    case = load_sand_case(config, seeds=seeds)
+    if budget_minutes is not None:
+        from poro2d.errors import check_range
+
+        check_range("--budget", budget_minutes, 0.0, 7 * 24 * 60.0, lo_open=True)
+    return case, preflight(case, workers=workers or os.cpu_count() or 1, budget_minutes=budget_minutes)
+
+
+@holds_output("out")
+def run_sand(
+    config: ConfigLike,
+    *,
+    out: str | os.PathLike = "sand-out",
+    seeds: int | None = None,
+    budget_minutes: float | None = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: bool = True,
+    use_cache: bool = True,
+    announce: Announce = _quiet,
+    on_preflight: Callable[[SandCase, Preflight], None] | None = None,
+) -> SandResult:
+    """The density-aware 2D porosity of a soil at its laboratory state, over seeds.
+
+    ``config``: a sand config (:mod:`poro2d.sand.case`), a TOML file or a dict. Writes
+    ``preflight.json`` before any DEM work, then the calibration, the specimens
+    (``specimens/<state>-seed<k>``), ``fig_grading.png``, ``summary.md``, ``summary.csv`` and
+    ``sand.json`` (returned as a :class:`~poro2d.sand.result.SandResult`). ``on_preflight``
+    is called with the case and its pre-flight before any DEM work (the command prints it
+    there), ``announce`` with one line per stage, with the elapsed time and an overall ETA.
+    Rerun to resume: finished cases are read back.
+    """
+    from poro2d.sweep.runner import check_cluster_options
+
+    out = Path(out)
+    check_output_dir("--out", out)
+    check_cluster_options(scheduler, workers)
+    case, pf = run_preflight(config, seeds=seeds, workers=workers, budget_minutes=budget_minutes)
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(
+        out / "preflight.json",
+        {"preflight": pf.to_dict(), "soil": case.soil_record(), "provenance": provenance()},
+    )
+    if on_preflight is not None:
+        on_preflight(case, pf)
+    sweep_kw = {"scheduler": scheduler, "workers": workers, "progress": progress}
+    clock = StageClock(pf.seconds, announce)
+    t = clock.begin(
+        "calibration",
+        f"calibration: {pf.cases_calibration} cases at most, {pf.calibration_box.disks:.0f} disks each",
+    )
+    target, cal_record = run_calibration_stage(case, pf, out, dict(sweep_kw, use_cache=use_cache))
+    clock.end("calibration", t)
+    trial = full_box_trial(target.n2d_target, pf.jamming.porosity, cal_record["n2d_min"], pf)
+    t = clock.begin(
+        "specimens",
+        f"specimens: {case.seeds} at full size ({pf.box.disks:.0f} disks), "
+        f"mu_prep {target.mu_prep:.3f}, first trial {trial:.4f}",
+    )
+    rows = run_specimen_stage(case, replace(target, n2d_target=trial), out, sweep_kw)
+    clock.end("specimens", t)
+    kept = keep_specimens(rows, out, _state_label(case))
+    radii = _drawn_radii(out, kept)
+    _grading_figure(case, radii, out)
+    result = SandResult.build(case, pf, target, trial, cal_record, kept, clock.elapsed())
+    write_summary(result, out)
+    return result
+
+
+def _drawn_radii(out: Path, kept: list[SeedSpecimen]) -> np.ndarray | None:
+    from poro2d.dem import checkpoint
+
+    for k in kept:
+        if k.folder:
+            return checkpoint.load(out / k.folder / "specimen.npz").particles.radius.copy()
+    return None
+
+
+def _grading_figure(case: SandCase, radii, out: Path) -> None:
+    from poro2d.report.grading_figure import grading_figure
+
+    grading_figure(
+        case.config.get("grading") or {},
+        case.base_dir,
+        case.grading,
+        radii,
+        out / "fig_grading.png",
+        title=case.name,
+    )
+
+
+__all__ = ["bracket", "full_box_trial", "predicted_mu", "run_preflight", "run_sand"]

@@ -1,0 +1,200 @@
+"""``poro2d sand``: a user's soil from its laboratory description to the density-aware answer."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from poro2d.criterion.density import Calibration
+from poro2d.errors import InputError
+from poro2d.sand import load_sand_case
+from poro2d.sand import preflight as PF
+from poro2d.sand.run import bracket, full_box_trial, predicted_mu
+from poro2d.specimen.compaction import SpecimenSpec, estimate_size
+from poro2d.specimen.grading import paper_grading
+
+LAB = {"e_max": 0.977, "e_min": 0.597, "dr": 0.5}
+
+
+def _config(**tables) -> dict:
+    cfg = {"soil": {"name": "test sand"}, "grading": {"preset": "paper"}, "lab": dict(LAB)}
+    cfg.update(tables)
+    return cfg
+
+
+def test_case_reads_the_laboratory_state_and_fills_density_defaults():
+    case = load_sand_case(_config())
+    assert case.lab.relative_density == pytest.approx(0.5)
+    # e = 0.977 - 0.5 (0.977 - 0.597) = 0.787, n = e / (1 + e)
+    assert case.lab.n_lab == pytest.approx(0.787 / 1.787)
+    assert case.config["criterion"]["n_lab"] == pytest.approx(0.787 / 1.787, abs=1e-6)
+    assert case.config["criterion"]["acceptance"] == "fill"  # density mode's defaults
+    assert case.seeds == 3 and case.mus[0] == 0.0 and case.mus[-1] == 1.0
+
+
+@pytest.mark.parametrize(
+    "cfg, parameter",
+    [
+        ({"lab": None}, "lab"),
+        ({"lab": {"e": 0.7}}, "lab.e_max/e_min"),
+        ({"density": {"n_max": 0.45}}, "config.density"),
+        ({"sand": {"seeds": 0}}, "sand.seeds"),
+        ({"sand": {"speed": 2}}, "sand.speed"),
+        ({"sand": {"calibration_disks": 10}}, "sand.calibration_disks"),
+        ({"soil": {"name": 3}}, "soil.name"),
+        ({"criterion": {"n_lab": 0.30}}, "criterion.n_lab"),
+    ],
+)
+def test_case_refuses_bad_input_naming_it(cfg, parameter):
+    base = _config()
+    for k, v in cfg.items():
+        if v is None:
+            base.pop(k)
+        else:
+            base[k] = v
+    with pytest.raises(InputError) as e:
+        load_sand_case(base)
+    assert e.value.parameter == parameter
+
+
+def test_time_step_is_the_engines():
+    """The pre-flight's step is the one the engine picks for the same smallest disk."""
+    from poro2d.dem import Simulation
+    from poro2d.dem.model import ContactModel
+    from poro2d.specimen.compaction import _band_particles, make_walls
+
+    spec = SpecimenSpec(width=0.05, height=0.03, layers=1)
+    r = np.array([0.0005, 0.002])
+    sim = Simulation(_band_particles(spec, np.array([[0.01, 0.01], [0.03, 0.01]]), r), make_walls(spec, 0.03),
+                     ContactModel("per_body"), gravity=(0.0, -9.81), dt_safety=spec.dt_safety)  # fmt: skip
+    assert PF.time_step(spec, 0.0005) == pytest.approx(sim.dt, rel=1e-12)
+
+
+def test_calibration_box_holds_about_the_disks_asked_for():
+    spec, g = SpecimenSpec(), paper_grading()
+    box = PF.calibration_box(spec, g, 800, 0.17)
+    assert box.disks == pytest.approx(800, rel=0.1)
+    assert box.width / box.height == pytest.approx(spec.width / spec.height, rel=0.05)
+    assert box.band_height >= 3 * g.d_max_m
+    full = PF.calibration_box(spec, g, 100_000, 0.17)  # more than the full box holds: the full box
+    assert (full.width, full.height, full.layers) == (spec.width, spec.height, spec.layers)
+    assert full.disks == pytest.approx(estimate_size(spec, g, 0.17).disks)
+
+
+def _calibration(means: dict[float, float]) -> Calibration:
+    mus = sorted(means)
+    return Calibration(mus, [[means[m] + d for d in (-0.001, 0.0, 0.001)] for m in mus], [0, 1, 2])
+
+
+def test_predicted_friction_and_its_bracket():
+    ends = _calibration({0.0: 0.16, 1.0: 0.22})
+    assert predicted_mu(ends, 0.16) == 0.0 and predicted_mu(ends, 0.22) == 1.0
+    mid = predicted_mu(ends, 0.19)
+    # the rise is steep at low friction: half the range is reached well below mu = 0.5
+    assert 0.05 < mid < 0.5
+    assert bracket((0.0, 0.05, 0.1, 0.2, 0.5, 1.0), 0.15) == [0.0, 0.1, 0.2, 1.0]
+    assert bracket((0.0, 0.05, 0.1, 0.2, 0.5, 1.0), 1.0) == [0.0, 1.0]
+    assert bracket((0.0, 1.0), 0.3) == [0.0, 1.0]
+
+
+def test_full_box_trial_removes_the_walls_extra_share():
+    small = PF.BoxPlan(0.1, 0.04, 2, 1000)
+    big = PF.BoxPlan(0.305, 0.124, 4, 10000)
+    pf = type("P", (), {"calibration_box": small, "box": big})()
+    # dense end 0.170 in the small box against a jamming porosity of 0.155: 0.015 from the walls,
+    # of which the larger box keeps its perimeter-over-area share
+    got = full_box_trial(0.19, 0.155, 0.170, pf)
+    ratio = (2 * 0.305 + 2 * 0.124) / (0.305 * 0.124) / ((2 * 0.1 + 2 * 0.04) / (0.1 * 0.04))
+    assert got == pytest.approx(0.19 - 0.015 * (1 - ratio))
+    assert full_box_trial(0.19, None, 0.170, pf) == 0.19
+    pf_same = type("P", (), {"calibration_box": big, "box": big})()
+    assert full_box_trial(0.19, 0.155, 0.170, pf_same) == pytest.approx(0.19)
+
+
+def test_first_trials_follow_the_gradings_jamming_porosity():
+    from poro2d.sweep.density import FILL_FIRST_TRIALS, PAPER_JAMMING_POROSITY, first_trial
+
+    crit = {"acceptance": "fill", "refine_tolerance": 0.002}
+    assert first_trial(crit, 0.0) == pytest.approx(FILL_FIRST_TRIALS[0][1])  # the paper grading's, unchanged
+    wide = first_trial(crit, 0.0, dense_end=0.12)
+    assert wide == pytest.approx(FILL_FIRST_TRIALS[0][1] + 0.12 - PAPER_JAMMING_POROSITY, abs=0.0011)
+    assert first_trial({"acceptance": "plate"}, 0.0, dense_end=0.12) == 0.19  # the plate's one start
+
+
+def test_jamming_cache_is_read_back_and_a_damaged_entry_recomputed(tmp_path, monkeypatch):
+    monkeypatch.setenv("PORO2D_CACHE", str(tmp_path))
+    monkeypatch.setattr(PF, "JAMMING_DISKS", 200)
+    g = paper_grading()
+    first = PF.jamming_of(g, seeds=1)
+    assert first.porosity is not None and 0.1 < first.porosity < 0.2
+    (entry,) = (tmp_path / "jamming").glob("*.json")
+    assert PF.jamming_of(g, seeds=1) == first  # read back
+    data = json.loads(entry.read_text())
+    entry.write_text(json.dumps(dict(data, porosity=5.0)))
+    again = PF.jamming_of(g, seeds=1)  # a damaged entry is computed again: the same numbers
+    assert (again.porosity, again.sd, again.disks) == (first.porosity, first.sd, first.disks)
+
+
+def test_preflight_reports_before_any_dem_work(tmp_path, monkeypatch):
+    monkeypatch.setenv("PORO2D_CACHE", str(tmp_path))
+    monkeypatch.setattr(PF, "JAMMING_DISKS", 200)
+    case = load_sand_case(_config())
+    pf = PF.preflight(case, workers=2, budget_minutes=1.0)
+    assert pf.box.disks == pytest.approx(2560, rel=0.05)  # the paper's box at the first trial
+    assert pf.first_trial < pf.eq12_trial
+    assert pf.seconds["total"] > 60.0 and "exceeds the budget" in pf.suggestion
+    assert math.isclose(pf.band_over_d_max, 0.031 / paper_grading().d_max_m, rel_tol=1e-9)
+
+
+# the sand's whole path on a box small enough for a test: the paper's plate (a lid cannot rest
+# in a box this small) and two calibration frictions
+TINY = {
+    "seed": 0,
+    "soil": {"name": "tiny paper sand", "reference": "the paper's reconstructed grading"},
+    "grading": {"preset": "paper"},
+    "lab": {"n_max": 0.4571, "n_min": 0.3253, "n": 0.40},
+    "specimen": {"width": 0.05, "height": 0.025, "layers": 2},
+    "criterion": {"acceptance": "plate"},
+    "sand": {"seeds": 2, "mu_prep": [0.0, 0.5], "calibration_disks": 10_000},
+}
+
+
+@pytest.mark.slow
+def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
+    from poro2d.sand import SandResult, run_sand
+    from poro2d.sand.run import StageClock
+
+    monkeypatch.setenv("PORO2D_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setattr(PF, "JAMMING_DISKS", 200)
+    lines: list[str] = []
+    seen = []
+    out = tmp_path / "sand"
+    res = run_sand(
+        TINY, out=out, progress=False, announce=lines.append, on_preflight=lambda c, p: seen.append(p)
+    )
+    assert isinstance(res, SandResult) and seen and len(lines) == 2 and "left (estimate)" in lines[0]
+    assert isinstance(StageClock, type)
+    assert (out / "preflight.json").is_file() and (out / "fig_grading.png").stat().st_size > 0
+    data = json.loads((out / "sand.json").read_text())
+    assert data["soil"]["name"] == "tiny paper sand" and data["provenance"]["poro2d_version"]
+    assert data["calibration"]["mus"] == [0.0, 0.5]
+    assert res.n2d_min < res.n2d_target < res.n2d_max
+    accepted = [k for k in res.specimens if k.accepted]
+    for k in accepted:
+        assert (out / k.folder / "specimen.npz").is_file() and k.folder.startswith("specimens/n0.4000-seed")
+    if accepted:
+        vals = [k.interior_porosity for k in accepted]
+        assert res.interior_porosity_mean == pytest.approx(np.mean(vals))
+        assert 0.1 < res.interior_porosity_mean < 0.3
+    md = (out / "summary.md").read_text()
+    assert md.splitlines()[2].startswith("**Interior porosity")
+    assert (
+        (out / "summary.csv")
+        .read_text()
+        .startswith("soil,upscale,disks,n_lab,e,Dr,mu_prep,interior_porosity")
+    )
+    # a rerun reads every finished case back: the same numbers
+    again = run_sand(TINY, out=out, progress=False)
+    assert again.interior_porosity_mean == res.interior_porosity_mean or not accepted
+    assert again.mu_prep == res.mu_prep
