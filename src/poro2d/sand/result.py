@@ -69,6 +69,7 @@ class SeedSpecimen:
 class SandResult(TypedResult):
     """``sand.json``: the soil, its state, the answer over seeds and where every part is."""
 
+    mode: str
     soil: dict[str, Any]
     state: dict[str, Any]
     interior_porosity_mean: float
@@ -115,6 +116,7 @@ class SandResult(TypedResult):
         ]
         n_ok = sum(k.accepted for k in kept)
         return cls(
+            mode="density",
             soil=case.soil_record(),
             state=lab.to_dict(),
             interior_porosity_mean=inner_m,
@@ -211,7 +213,7 @@ def summary_markdown(res: SandResult, out: Path) -> str:
         f"| preparation friction mu_prep | {res.mu_prep:.3f} |",
         f"| interior porosity | {_pm(res.interior_porosity_mean, res.interior_porosity_sd)} |",
         f"| box porosity n' (under the lid) | {_pm(res.box_porosity_mean, res.box_porosity_sd)} |",
-        f"| solid fraction (interior) | {res.solid_fraction_mean:.4f} |",
+        f"| solid fraction (interior) | {_fmt(res.solid_fraction_mean)} |",
         "| jamming porosity of the grading | "
         + ("n/a" if jam is None else f"{jam:.4f} +- {res.jamming_porosity_sd or 0.0:.4f}")
         + " |",
@@ -228,12 +230,13 @@ def summary_markdown(res: SandResult, out: Path) -> str:
         )
     first = next((k for k in res.specimens if k.accepted), None)
     if first is not None:
+        state = f"--n-lab {st['n_lab']:.6g} --seed {first.seed}"
         lines += [
             "",
             "Export, e.g.:",
             "",
             "```bash",
-            f"poro2d export {out / first.folder} --to lammps --out {out / 'lammps'}",
+            f"poro2d export {out} {state} --to lammps --out {out / 'lammps'}",
             f"poro2d export {out / first.folder} --to yade --out {out / 'yade'}",
             "```",
         ]
@@ -241,7 +244,7 @@ def summary_markdown(res: SandResult, out: Path) -> str:
 
 
 def _fmt(v: float | None) -> str:
-    return "" if v is None else f"{v:.4f}"
+    return "n/a" if v is None or not math.isfinite(v) else f"{v:.4f}"
 
 
 def write_summary(res: SandResult, out: Path) -> None:

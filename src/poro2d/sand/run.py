@@ -144,17 +144,43 @@ def run_calibration_stage(case: SandCase, pf: Preflight, out: Path, cal_kw: dict
 
     ``cal_kw``: the sweep's options and ``use_cache`` (:func:`poro2d.sweep.density.calibrate`).
     """
-    ends = [case.mus[0], case.mus[-1]]
-    cal_ends, _ = _calibrate(case, pf, out, ends, "calibration_ends.json", cal_kw)
+    cal_ends, usable = calibrate_ends(case, pf, out, cal_kw)
+    ends = [usable[0], usable[-1]]
     first = state_target(case.lab.n_lab, case.n_max, case.n_min, cal_ends)
-    mus = bracket(case.mus, predicted_mu(cal_ends, first.n2d_target))
+    mus = bracket(usable, predicted_mu(cal_ends, first.n2d_target))
     cal, info = (cal_ends, {}) if mus == ends else _calibrate(case, pf, out, mus, "calibration.json", cal_kw)
     if not info:
         write_json(
             out / "calibration.json", {"calibration": cal.to_dict(), "mus": mus, "note": "the ends only"}
         )
     target = state_target(case.lab.n_lab, case.n_max, case.n_min, cal)
-    return target, {"mus": mus, "calibration": cal.to_dict(), "n2d_min": cal.n2d_min, "n2d_max": cal.n2d_max}
+    dropped = [mu for mu in case.mus if mu < ends[0] or mu > ends[1]]
+    return target, {
+        "mus": mus,
+        "calibration": cal.to_dict(),
+        "n2d_min": cal.n2d_min,
+        "n2d_max": cal.n2d_max,
+        "dropped_ends": dropped,
+    }
+
+
+def calibrate_ends(case: SandCase, pf: Preflight, out: Path, cal_kw: dict) -> tuple[Calibration, tuple]:
+    """The densest and loosest preparations that at least one seed could prepare.
+
+    An end whose every seed was refused (e.g. a lid that does not settle on a very frictional
+    preparation) gives way to the next friction inwards, as the relation drops such a friction;
+    the frictions left are returned with the calibration. Fewer than two is an error.
+    """
+    lo, hi = 0, len(case.mus) - 1
+    while True:
+        cal, _ = _calibrate(case, pf, out, [case.mus[lo], case.mus[hi]], "calibration_ends.json", cal_kw)
+        ok_lo, ok_hi = cal.accepted(0).size > 0, cal.accepted(1).size > 0
+        if ok_lo and ok_hi:
+            return cal, case.mus[lo : hi + 1]
+        lo, hi = lo + (not ok_lo), hi - (not ok_hi)
+        if hi <= lo:
+            cal.usable()  # raises: the frictions that could be prepared, and where to look
+            raise AssertionError("unreachable: usable() refuses fewer than two frictions")
 
 
 def run_specimen_stage(case: SandCase, trial: StateTarget, out: Path, sweep_kw: dict) -> list[dict]:
@@ -192,7 +218,7 @@ def keep_specimens(rows: list[dict], out: Path, label: str) -> list[SeedSpecimen
 
 def _state_label(case: SandCase) -> str:
     dr = case.lab.relative_density
-    return f"Dr{dr:.2f}" if dr is not None else f"n{case.lab.n_lab:.4f}"
+    return f"Dr{dr:.3f}" if dr is not None else f"n{case.lab.n_lab:.4f}"
 
 
 def run_preflight(
