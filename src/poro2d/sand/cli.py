@@ -60,11 +60,11 @@ def print_preflight(case, pf) -> None:
             "the run prints its measured pace)",
         ),
     ]
-    if pf.suggestion:
-        rows.append(("budget", pf.suggestion))
     for k, v in rows:
         t.add_row(k, escape(v))
     console.print(t)
+    if pf.suggestion:
+        console.print(f"[bold]budget:[/] {escape(pf.suggestion)}", soft_wrap=True)
     for note in pf.notes:
         console.print(f"[yellow]note:[/] {escape(note)}", soft_wrap=True)
 

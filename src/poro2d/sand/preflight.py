@@ -148,7 +148,8 @@ def calibration_box(
     if scale >= 1.0:
         return BoxPlan(spec.width, spec.height, spec.layers, full)
     d_max = grading.d_max_m
-    layers = max(1, round(spec.layers * scale))
+    # as many layers as keep the full box's band height (rounded up: thinner bands, not thicker)
+    layers = max(1, min(spec.layers, math.ceil(spec.layers * scale - 1e-9)))
     height = max(spec.height * scale, 3.0 * d_max * layers)
     width = max(spec.width * scale, 10.0 * d_max)
     width, height = round(width, 4), round(height, 4)

@@ -217,7 +217,9 @@ def summary_markdown(res: SandResult, out: Path) -> str:
         "| jamming porosity of the grading | "
         + ("n/a" if jam is None else f"{jam:.4f} +- {res.jamming_porosity_sd or 0.0:.4f}")
         + " |",
-        f"| 2D extremes (calibration box) | {res.n2d_min:.4f} dense, {res.n2d_max:.4f} loose |",
+        f"| 2D extremes n' (calibration box) | {res.n2d_min:.4f} dense, {res.n2d_max:.4f} loose |",
+        f"| dense end, interior (calibration box) | {_fmt(res.calibration.get('dense_end_interior'))} "
+        f"(against the jamming porosity {_fmt(jam)}) |",
         f"| wall time | {res.wall_seconds / 60:.1f} min |",
         "",
         "| seed | accepted | interior | box n' | disks | folder |",

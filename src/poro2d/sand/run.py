@@ -144,39 +144,47 @@ def run_calibration_stage(case: SandCase, pf: Preflight, out: Path, cal_kw: dict
 
     ``cal_kw``: the sweep's options and ``use_cache`` (:func:`poro2d.sweep.density.calibrate`).
     """
-    cal_ends, usable = calibrate_ends(case, pf, out, cal_kw)
+    cal_ends, usable, ends_info = calibrate_ends(case, pf, out, cal_kw)
     ends = [usable[0], usable[-1]]
     first = state_target(case.lab.n_lab, case.n_max, case.n_min, cal_ends)
     mus = bracket(usable, predicted_mu(cal_ends, first.n2d_target))
-    cal, info = (cal_ends, {}) if mus == ends else _calibrate(case, pf, out, mus, "calibration.json", cal_kw)
-    if not info:
+    cal, info = (
+        (cal_ends, ends_info) if mus == ends else _calibrate(case, pf, out, mus, "calibration.json", cal_kw)
+    )
+    if mus == ends:
         write_json(
             out / "calibration.json", {"calibration": cal.to_dict(), "mus": mus, "note": "the ends only"}
         )
     target = state_target(case.lab.n_lab, case.n_max, case.n_min, cal)
     dropped = [mu for mu in case.mus if mu < ends[0] or mu > ends[1]]
+    dense = [v for v in info["interior"][0] if v is not None]
     return target, {
         "mus": mus,
         "calibration": cal.to_dict(),
         "n2d_min": cal.n2d_min,
         "n2d_max": cal.n2d_max,
         "dropped_ends": dropped,
+        "cases": info["cases"],
+        "interior_by_friction": info["interior"],
+        # the densest preparation's own porosity: to hold against the jamming porosity
+        "dense_end_interior": float(np.mean(dense)) if dense else None,
+        "dense_end_interior_sd": float(np.std(dense, ddof=1)) if len(dense) > 1 else None,
     }
 
 
-def calibrate_ends(case: SandCase, pf: Preflight, out: Path, cal_kw: dict) -> tuple[Calibration, tuple]:
+def calibrate_ends(case: SandCase, pf: Preflight, out: Path, cal_kw: dict) -> tuple[Calibration, tuple, dict]:
     """The densest and loosest preparations that at least one seed could prepare.
 
     An end whose every seed was refused (e.g. a lid that does not settle on a very frictional
     preparation) gives way to the next friction inwards, as the relation drops such a friction;
-    the frictions left are returned with the calibration. Fewer than two is an error.
+    the frictions left are returned with the calibration and its record. Fewer than two is an error.
     """
     lo, hi = 0, len(case.mus) - 1
     while True:
-        cal, _ = _calibrate(case, pf, out, [case.mus[lo], case.mus[hi]], "calibration_ends.json", cal_kw)
+        cal, info = _calibrate(case, pf, out, [case.mus[lo], case.mus[hi]], "calibration_ends.json", cal_kw)
         ok_lo, ok_hi = cal.accepted(0).size > 0, cal.accepted(1).size > 0
         if ok_lo and ok_hi:
-            return cal, case.mus[lo : hi + 1]
+            return cal, case.mus[lo : hi + 1], info
         lo, hi = lo + (not ok_lo), hi - (not ok_hi)
         if hi <= lo:
             cal.usable()  # raises: the frictions that could be prepared, and where to look

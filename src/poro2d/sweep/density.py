@@ -194,6 +194,21 @@ def _sample(row: dict) -> float | None:
     return float(v) if v is not None and math.isfinite(float(v)) else None
 
 
+def interior_by_friction(rows: list[dict], mus: list[float], seeds: int) -> list[list[float | None]]:
+    """The interior porosity of every calibration case's accepted specimen, per friction and seed.
+
+    Beside the calibration's samples (box porosities n'), the packing's own porosity: at the
+    lowest friction it is the dense end to hold against the grading's jamming porosity.
+    """
+    out: list[list[float | None]] = [[None] * seeds for _ in mus]
+    for r in rows:
+        p, res = r.get("params") or {}, r.get("results") or {}
+        v = res.get("interior_porosity")
+        if _sample(r) is not None and v is not None and math.isfinite(float(v)):
+            out[mus.index(float(p["specimen.friction_prep"]))][int(p["seed"])] = float(v)
+    return out
+
+
 def calibration_from_rows(rows: list[dict], mus: list[float], seeds: int) -> Calibration:
     samples: list[list[float | None]] = [[None] * seeds for _ in mus]
     for r in rows:
@@ -241,6 +256,8 @@ def calibrate(
     cal = calibration_from_rows(res.rows, mus, seeds)
     info = {"key": key, "cases": str(folder), "ran": res.summary["ran"], "reused": res.summary["reused"],
             "source": "computed" if res.summary["ran"] else "cache"}  # fmt: skip
+    if dense_end is not None or walls is not None:  # new callers only: earlier records keep their keys
+        info["interior"] = interior_by_friction(res.rows, mus, seeds)
     rec = {
         **info,
         "calibration": cal.to_dict(),
@@ -343,6 +360,7 @@ __all__ = [
     "check_mus",
     "check_seeds",
     "first_trial",
+    "interior_by_friction",
     "state_sweep",
     "wall_share",
 ]
