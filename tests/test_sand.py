@@ -203,3 +203,14 @@ def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
     assert again.box_porosity_mean == res.box_porosity_mean
     assert [k.box_porosity for k in again.specimens] == [k.box_porosity for k in res.specimens]
     assert again.mu_prep == res.mu_prep
+
+
+def test_preflight_says_what_a_cut_of_fines_does(tmp_path, monkeypatch):
+    monkeypatch.setenv("PORO2D_CACHE", str(tmp_path))
+    monkeypatch.setattr(PF, "JAMMING_DISKS", 200)
+    cfg = _config(grading={"preset": "paper", "d_min_mm": 3.0})  # the up-scaled curve cut at 3 mm
+    pf = PF.preflight(load_sand_case(cfg), workers=1)
+    (note,) = [n for n in pf.notes if n.startswith("d_min_mm")]
+    g = paper_grading()
+    share = float(np.interp(np.log(0.003), np.log(g.sizes), g.percent))
+    assert f"removes {share:.1f} % of the mass" in note and "same relative density" in note

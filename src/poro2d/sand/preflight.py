@@ -357,9 +357,34 @@ def _notes(case: SandCase, jam: Jamming, eq12: float, dt: float, dt_paper: float
             f"the finest disks set a time step {dt_paper / dt:.1f} times smaller than the paper grading's: "
             "cutting fines (d_min_mm) or up-scaling more shortens every stage"
         )
+    notes += _cut_notes(case)
     band = full.band_height / case.grading.d_max_m
     if band < 4.0:
         notes.append(f"each layer is only {band:.1f} largest grains tall: fewer layers pack more evenly")
+    return notes
+
+
+def _cut_notes(case: SandCase) -> list[str]:
+    """What a d_min_mm / d_max_mm cut does to the soil, and how the laboratory state is read then."""
+    table = case.config.get("grading") or {}
+    cuts = {k: table[k] for k in ("d_min_mm", "d_max_mm") if k in table}
+    if not cuts:
+        return []
+    whole = GradingCurve.from_config(
+        {k: v for k, v in table.items() if k not in cuts}, base_dir=case.base_dir
+    )
+    log_d, pct = np.log(whole.sizes), whole.percent
+    notes = []
+    for key, value in cuts.items():
+        p = float(np.interp(np.log(float(value) / 1000.0), log_d, pct))
+        share = p if key == "d_min_mm" else 100.0 - p
+        what = "finer" if key == "d_min_mm" else "coarser"
+        notes.append(
+            f"{key} = {value:g} removes {share:.1f} % of the mass (everything {what}): the specimens are "
+            "made of the rest; e_max/e_min and the state are the laboratory's for the whole soil, and "
+            "poro2d maps the state's Dr onto the cut grading's own 2D extremes (its calibration), so "
+            "the answer is the cut soil's at the same relative density, not at the same void ratio"
+        )
     return notes
 
 
