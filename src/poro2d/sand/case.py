@@ -138,6 +138,39 @@ def _criterion_config(cfg: dict, lab: LabState) -> dict:
     return with_density_defaults(crit)
 
 
+#: step budgets (setting: the paper's default) that bound a stage in simulated time; they were
+#: set for the paper grading's time step, so a grading whose finest disks set a smaller step gets
+#: them in proportion (the lid of a frictional preparation on a fine sand did not settle within
+#: 600 000 steps at 0.53 of the paper's step, i.e. half the simulated time)
+STEP_BUDGETS = {
+    ("criterion", "max_plate_steps"): 600_000,
+    ("specimen", "max_steps_per_stage"): 400_000,
+    ("specimen", "fallback_steps"): 200_000,
+    ("specimen", "calm_steps"): 50_000,
+}
+
+
+def with_step_budgets(config: dict, spec: SpecimenSpec, grading: GradingCurve) -> dict:
+    """``config`` with every step budget it leaves unset scaled to the grading's time step.
+
+    The factor is the paper grading's step over this one's (at least 1): the same simulated
+    time for the lid to settle and the layers to come to rest. The paper's grading keeps the
+    defaults exactly.
+    """
+    from poro2d.sand.preflight import time_step
+    from poro2d.specimen.grading import paper_grading
+
+    slow = time_step(spec, paper_grading().d_min_m / 2.0) / time_step(spec, grading.d_min_m / 2.0)
+    if slow <= 1.0 + 1e-9:
+        return config
+    out = copy.deepcopy(config)
+    for (table, key), default in STEP_BUDGETS.items():
+        section = out.setdefault(table, {})
+        if key not in section:
+            section[key] = int(math.ceil(default * slow / 1000.0) * 1000)
+    return out
+
+
 def load_sand_case(config: ConfigLike, *, seeds: int | None = None) -> SandCase:
     """A :class:`SandCase` from a sand config (a TOML file or a dict), every value checked.
 
@@ -172,6 +205,8 @@ def load_sand_case(config: ConfigLike, *, seeds: int | None = None) -> SandCase:
     if "grading" not in cfg:
         raise InputError("grading", None, "a [grading] table: csv, sizes_mm with percent_passing, or preset")
     crit = _criterion_config(cfg, lab)
+    spec, grading, _settings, _seed = build(crit, base_dir)
+    crit = with_step_budgets(crit, spec, grading)
     spec, grading, _settings, _seed = build(crit, base_dir)
     return SandCase(name, reference, lab, crit, base_dir, spec, grading, n_seeds, cal_disks, mus)
 
