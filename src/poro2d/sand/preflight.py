@@ -257,24 +257,102 @@ def _seconds(particle_steps: float, cases: int, workers: int) -> float:
     return per_case * math.ceil(cases / workers)
 
 
-def budget_suggestion(case: SandCase, seconds: float, budget_min: float | None) -> str:
-    """A box or up-scaling that fits ``budget_min``, with what each costs the answer."""
+def budget_suggestion(
+    case: SandCase, seconds: float, budget_min: float | None, first: float = 0.2, workers: int = 2
+) -> str:
+    """A box, up-scaling or cut of fines that fits ``budget_min``, with what each costs the answer.
+
+    Disks grow with 1 / upscale^2 and steps with 1 / dt ~ 1 / upscale, so the time goes with
+    upscale^-3; an up-scaling is offered only while the largest grain still fits half a layer.
+    A cut of fines is offered at the smallest d_min that fits, with the mass it removes.
+    """
     if budget_min is None:
         return ""
     budget = budget_min * 60.0
     if seconds <= budget:
         return f"fits the budget of {budget_min:g} min (estimate {seconds / 60:.0f} min)"
     ratio = seconds / budget
-    # disks ~ 1 / upscale^2 and steps ~ 1 / dt ~ 1 / upscale: time ~ upscale^-3
-    up = case.grading.upscale * ratio ** (1.0 / 3.0)
-    area = 1.0 / ratio
-    return (
-        f"estimate {seconds / 60:.0f} min exceeds the budget of {budget_min:g} min: either up-scale by "
-        f"{up:.3g} instead of {case.grading.upscale:g} (fewer, larger disks: fewer grains across the "
-        f"box and a coarser surface), or a box of {area:.2f} times the area at this up-scaling (the "
-        f"walls' loose layer then weighs more in n'; the interior porosity is less affected), or "
-        f"fewer seeds (a wider confidence interval)"
+    g, spec = case.grading, case.spec
+    options = []
+    up = g.upscale * ratio ** (1.0 / 3.0)
+    if g.d_max_m * up / g.upscale <= 0.5 * spec.height / spec.layers:
+        options.append(
+            f"up-scale by {up:.3g} instead of {g.upscale:g} (fewer, larger disks: fewer grains across "
+            "the box and a coarser surface)"
+        )
+    else:
+        options.append(
+            f"no up-scaling fits: by {up:.3g} the largest grain would exceed half a layer "
+            f"({0.5 * spec.height / spec.layers * 1e3:.3g} mm)"
+        )
+    cut = _fines_cut_for(case, budget, first, workers)
+    if cut is not None:
+        options.append(
+            f"cut the fines with [grading] d_min_mm = {cut[0]:.3g} (removes {cut[1]:.1f} % of the mass; "
+            "the specimens are then the coarser soil, see the note on cuts)"
+        )
+    side = math.sqrt(1.0 / ratio)
+    if side * spec.height / spec.layers >= 2.0 * g.d_max_m and side * spec.width >= 10.0 * g.d_max_m:
+        options.append(
+            f"a box of {1.0 / ratio:.2f} times the area at this up-scaling (the walls' loose layer then "
+            "weighs more in n'; the interior porosity is less affected)"
+        )
+    options.append("fewer seeds (a wider confidence interval)")
+    return f"estimate {seconds / 60:.0f} min exceeds the budget of {budget_min:g} min: " + "; or ".join(
+        options
     )
+
+
+def _fines_cut_for(case: SandCase, budget: float, first: float, workers: int) -> tuple[float, float] | None:
+    """(d_min_mm, % of the mass removed) of the smallest cut of fines whose estimate fits ``budget``."""
+    g = case.grading
+    table = dict(case.config.get("grading") or {})
+    for d in np.geomspace(g.d_min_m, g.size_at(50.0), 25)[1:]:
+        d_mm = float(f"{d * 1e3:.3g}")
+        try:
+            cut = GradingCurve.from_config(dict(table, d_min_mm=d_mm), base_dir=case.base_dir)
+            secs = workload(case, case.spec, cut, first, workers).seconds["total"]
+        except InputError:
+            continue
+        if secs <= budget:
+            removed = float(np.interp(np.log(d_mm / 1e3), np.log(g.sizes), g.percent))
+            return d_mm, removed
+    return None
+
+
+@dataclass(frozen=True)
+class Workload:
+    """The boxes, time steps and estimated work of a run (:func:`workload`)."""
+
+    full: BoxPlan
+    calibration: BoxPlan
+    dt: float
+    dt_paper: float
+    particle_steps: dict
+    seconds: dict
+
+
+def workload(case: SandCase, spec: SpecimenSpec, g: GradingCurve, first: float, workers: int) -> Workload:
+    """What ``case`` costs with ``spec`` and grading ``g`` from first trial ``first`` (the model above)."""
+    crit = case.config.get("criterion") or {}
+    full = BoxPlan(spec.width, spec.height, spec.layers, estimate_size(spec, g, first).disks)
+    fill = crit.get("acceptance", "plate") == "fill"
+    window = float(crit.get("force_fraction", 0.01)) if fill else None
+    cal = calibration_box(spec, g, case.calibration_disks, first, lid_window=window)
+    dt = time_step(spec, g.d_min_m / 2.0)
+    dt_paper = time_step(spec, paper_grading().d_min_m / 2.0)
+    n_cal, n_spec = _cases(case)
+    cal_spec = replace(spec, width=cal.width, height=cal.height, layers=cal.layers)
+    psteps = {
+        "calibration": cal.disks * _steps_per_trial(cal_spec, dt, dt_paper) * TRIALS_PER_CASE * n_cal,
+        "specimens": full.disks * _steps_per_trial(spec, dt, dt_paper) * TRIALS_PER_CASE * n_spec,
+    }
+    secs = {
+        "calibration": _seconds(psteps["calibration"], n_cal, workers),
+        "specimens": _seconds(psteps["specimens"], n_spec, workers),
+    }
+    secs["total"] = secs["calibration"] + secs["specimens"]
+    return Workload(full, cal, dt, dt_paper, psteps, secs)
 
 
 def preflight(case: SandCase, *, workers: int = 2, budget_minutes: float | None = None) -> Preflight:
@@ -289,31 +367,10 @@ def preflight(case: SandCase, *, workers: int = 2, budget_minutes: float | None 
     crit = case.config.get("criterion") or {}
     first = first_trial(crit, case.mus[0], jam.porosity, wall_share(spec.width, spec.height, g.size_at(50.0)))
     check_feasible(spec, g, first)
-    full = BoxPlan(spec.width, spec.height, spec.layers, estimate_size(spec, g, first).disks)
-    fill = crit.get("acceptance", "plate") == "fill"
-    cal = calibration_box(
-        spec,
-        g,
-        case.calibration_disks,
-        first,
-        lid_window=float(crit.get("force_fraction", 0.01)) if fill else None,
-    )
-    dt = time_step(spec, g.d_min_m / 2.0)
-    dt_paper = time_step(spec, paper_grading().d_min_m / 2.0)
-    steps = _steps_per_trial(spec, dt, dt_paper) * TRIALS_PER_CASE
+    work = workload(case, spec, g, first, workers)
+    full, cal, dt, dt_paper = work.full, work.calibration, work.dt, work.dt_paper
+    psteps, secs = work.particle_steps, work.seconds
     n_cal, n_spec = _cases(case)
-    cal_spec = replace(spec, width=cal.width, height=cal.height, layers=cal.layers)
-    cal_steps = _steps_per_trial(cal_spec, dt, dt_paper) * TRIALS_PER_CASE
-    same_box = (cal.width, cal.height) == (spec.width, spec.height)
-    psteps = {
-        "calibration": cal.disks * cal_steps * n_cal,
-        "specimens": 0.0 if same_box else full.disks * steps * n_spec,
-    }
-    secs = {
-        "calibration": _seconds(psteps["calibration"], n_cal, workers),
-        "specimens": _seconds(psteps["specimens"], n_spec, workers),
-    }
-    secs["total"] = secs["calibration"] + secs["specimens"]
     eq12 = float(parabolic(case.lab.n_lab))
     notes = _notes(case, jam, eq12, dt, dt_paper, full)
     return Preflight(
@@ -338,7 +395,7 @@ def preflight(case: SandCase, *, workers: int = 2, budget_minutes: float | None 
         seconds=secs,
         workers=workers,
         budget_minutes=budget_minutes,
-        suggestion=budget_suggestion(case, secs["total"], budget_minutes),
+        suggestion=budget_suggestion(case, secs["total"], budget_minutes, first, workers),
         notes=notes,
     )
 
@@ -390,6 +447,8 @@ def _cut_notes(case: SandCase) -> list[str]:
 
 __all__ = [
     "THROUGHPUT",
+    "Workload",
+    "workload",
     "BoxPlan",
     "Jamming",
     "Preflight",
