@@ -109,6 +109,11 @@ def print_result(res, out: Path) -> None:
     for k in res.specimens:
         if not k.accepted:
             console.print(f"[bold red]seed {k.seed} not accepted:[/] {escape(k.message)}", soft_wrap=True)
+    from poro2d.sand.result import warnings
+
+    for w in warnings(res):
+        if not w.startswith("seed(s)"):  # the refused seeds were named above, with why
+            console.print(f"[yellow]note:[/] {escape(w)}", soft_wrap=True)
 
 
 def _f(v) -> str:

@@ -222,6 +222,7 @@ def summary_markdown(res: SandResult, out: Path) -> str:
         f"(against the jamming porosity {_fmt(jam)}) |",
         f"| wall time | {res.wall_seconds / 60:.1f} min |",
         "",
+        *[f"**Note:** {w}" for w in warnings(res)],
         "| seed | accepted | interior | box n' | disks | folder |",
         "| --- | --- | --- | --- | --- | --- |",
     ]
@@ -245,6 +246,23 @@ def summary_markdown(res: SandResult, out: Path) -> str:
     return "\n".join(lines) + "\n"
 
 
+def warnings(res: SandResult) -> list[str]:
+    """What the answer must be read with: preparations that could not be made, seeds refused."""
+    out = []
+    dropped = res.calibration.get("dropped_ends") or []
+    if dropped:
+        mus = res.calibration.get("mus") or []
+        out.append(
+            f"no seed could be prepared at mu_prep {', '.join(f'{m:g}' for m in dropped)}: the 2D extremes "
+            f"are those of mu_prep {mus[0]:g} to {mus[-1]:g}, so a state's Dr is mapped onto a narrower "
+            "range than the preparation can span (see the calibration's cases for why)"
+        )
+    refused = [k.seed for k in res.specimens if not k.accepted]
+    if refused:
+        out.append(f"seed(s) {', '.join(map(str, refused))} not accepted: the spread is over fewer specimens")
+    return out
+
+
 def _fmt(v: float | None) -> str:
     return "n/a" if v is None or not math.isfinite(v) else f"{v:.4f}"
 
@@ -261,4 +279,4 @@ def write_summary(res: SandResult, out: Path) -> None:
     write_json(out / "sand.json", res.to_dict())
 
 
-__all__ = ["SandResult", "SeedSpecimen", "summary_markdown", "summary_row", "write_summary"]
+__all__ = ["SandResult", "SeedSpecimen", "summary_markdown", "summary_row", "warnings", "write_summary"]
