@@ -214,3 +214,30 @@ def test_preflight_says_what_a_cut_of_fines_does(tmp_path, monkeypatch):
     g = paper_grading()
     share = float(np.interp(np.log(0.003), np.log(g.sizes), g.percent))
     assert f"removes {share:.1f} % of the mass" in note and "same relative density" in note
+
+
+def test_step_budgets_follow_the_time_step():
+    from poro2d.sand.case import STEP_BUDGETS, with_step_budgets
+    from poro2d.specimen.grading import GradingCurve
+
+    spec = SpecimenSpec()
+    paper = {"criterion": {}, "specimen": {}}
+    assert with_step_budgets(paper, spec, paper_grading()) is paper  # the paper grading: the defaults
+    fine = GradingCurve.from_lists([0.1, 0.2, 0.4], [0, 50, 100], upscale=10)  # d_min 1 mm: half the step
+    slow = PF.time_step(spec, 0.001) / PF.time_step(spec, 0.0005)
+    assert slow == pytest.approx(2.0)
+    cfg = with_step_budgets({"criterion": {"max_plate_steps": 1234}}, spec, fine)
+    assert cfg["criterion"]["max_plate_steps"] == 1234  # what the user set stays
+    for (table, key), default in STEP_BUDGETS.items():
+        if (table, key) != ("criterion", "max_plate_steps"):
+            assert cfg[table][key] == pytest.approx(default * 2.0, rel=0.01)
+
+
+def test_budget_suggestion_offers_only_what_fits_the_box():
+    case = load_sand_case(_config())
+    text = PF.budget_suggestion(case, 3600.0, 10.0, first=0.17, workers=2)
+    assert text.startswith("estimate 60 min exceeds the budget of 10 min")
+    assert "up-scale by" in text and "fewer seeds" in text
+    assert PF.budget_suggestion(case, 300.0, 10.0) == "fits the budget of 10 min (estimate 5 min)"
+    huge = load_sand_case(_config(grading={"preset": "paper", "upscale": 40}))  # d_max 28 mm in a 31 mm band
+    assert "no up-scaling fits" in PF.budget_suggestion(huge, 3600.0, 10.0, first=0.17, workers=2)
