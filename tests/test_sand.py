@@ -241,3 +241,21 @@ def test_budget_suggestion_offers_only_what_fits_the_box():
     assert PF.budget_suggestion(case, 300.0, 10.0) == "fits the budget of 10 min (estimate 5 min)"
     huge = load_sand_case(_config(grading={"preset": "paper", "upscale": 40}))  # d_max 28 mm in a 31 mm band
     assert "no up-scaling fits" in PF.budget_suggestion(huge, 3600.0, 10.0, first=0.17, workers=2)
+
+
+def test_a_named_specimen_exports_with_its_soil(tmp_path, specimen):
+    """A folder ``poro2d sand`` named carries the soil and state into every export header."""
+    import shutil
+
+    from poro2d.interop.origin import SOIL_FILE, origin_lines
+
+    folder = tmp_path / "Dr0.800-seed1"
+    folder.mkdir()
+    shutil.copy(specimen, folder / "specimen.npz")
+    soil = {"name": "Toyoura sand", "reference": "Verdugo & Ishihara (1996)"}
+    state = {"n_lab": 0.4023, "relative_density": 0.8}
+    (folder / SOIL_FILE).write_text(json.dumps({"soil": soil, "state": state, "mode": "density", "seed": 1}))
+    lines = origin_lines(folder / "specimen.npz")
+    assert lines[0] == "provenance: soil Toyoura sand (Verdugo & Ishihara (1996))"
+    text = "\n".join(lines)
+    assert "n_lab = 0.4023, relative density Dr = 0.8000; mode density" in text and "seed 1" in text

@@ -21,6 +21,8 @@ from typing import Any
 
 #: every provenance line starts with this (after the target's comment sign)
 PREFIX = "provenance:"
+#: written by ``poro2d sand`` beside each specimen it names: the soil, its state, mode and seed
+SOIL_FILE = "soil.json"
 
 
 def origin_lines(checkpoint: str | Path, state: dict[str, Any] | None = None) -> list[str]:
@@ -33,17 +35,26 @@ def origin_lines(checkpoint: str | Path, state: dict[str, Any] | None = None) ->
     folder = p.parent
     result = _criterion_record(folder / "result.json", ("iterations", "specimen"))
     config = _criterion_record(folder / "config.json", ("run",))
-    if result is None and config is None:
+    soil = _criterion_record(folder / SOIL_FILE, ("soil", "state"))
+    if result is None and config is None and soil is None:
         return [
             f"{PREFIX} unknown (no criterion record, result.json or config.json, beside {_text(p.name)}: "
             "grading, laboratory state, mode and seed not recorded)"
         ]
+    if state is None and soil is not None:  # a specimen folder that poro2d sand named
+        lab = soil["state"] if isinstance(soil["state"], dict) else {}
+        state = {"mode": soil.get("mode"), "n_lab": lab.get("n_lab"),
+                 "relative_density": lab.get("relative_density"), "seed": soil.get("seed")}  # fmt: skip
     if state is None:
         state = _state_of_case(folder)
     elif not state.get("mode"):  # a sand folder that does not say: the state folder of the case
         state = dict(state, mode=(_state_of_case(folder) or {}).get("mode"))
     result, config = result or {}, config or {}
     lines = [f"{PREFIX} grading {_grading(config)}"]
+    if soil is not None and isinstance(soil["soil"], dict):
+        who = soil["soil"]
+        ref = f" ({_text(who.get('reference'))})" if who.get("reference") else ""
+        lines.insert(0, f"{PREFIX} soil {_text(who.get('name'))}{ref}")
     lines.append(f"{PREFIX} laboratory state {_state(result, config, state, folder)}")
     spec = result.get("specimen") or (config.get("run") or {}).get("specimen") or {}
     mu = _num(spec.get("friction_prep")) if isinstance(spec, dict) else None

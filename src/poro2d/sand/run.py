@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.criterion.density import Calibration, StateTarget, state_target
+from poro2d.interop.origin import SOIL_FILE
 from poro2d.io_utils import check_output_dir, provenance, write_json
 from poro2d.locks import holds_output
 from poro2d.sand.case import ConfigLike, SandCase, load_sand_case
@@ -204,8 +205,9 @@ def run_specimen_stage(case: SandCase, trial: StateTarget, out: Path, sweep_kw: 
     return sorted(res.rows, key=lambda r: int((r.get("params") or {}).get("seed", 0)))
 
 
-def keep_specimens(rows: list[dict], out: Path, label: str) -> list[SeedSpecimen]:
-    """Each seed's accepted specimen in a named folder (``specimens/<label>-seed<k>``)."""
+def keep_specimens(rows: list[dict], out: Path, label: str, soil: dict, state: dict) -> list[SeedSpecimen]:
+    """Each seed's accepted specimen in a named folder (``specimens/<label>-seed<k>``), with a
+    ``soil.json`` naming the soil and its laboratory state."""
     kept = []
     for r in rows:
         seed = int((r.get("params") or {}).get("seed", 0))
@@ -219,6 +221,8 @@ def keep_specimens(rows: list[dict], out: Path, label: str) -> list[SeedSpecimen
             for f in src.iterdir():
                 if f.is_file() and not f.name.startswith("."):
                     shutil.copy2(f, dest / f.name)
+            # who the specimen is, for the export headers (poro2d.interop.origin)
+            write_json(dest / SOIL_FILE, {"soil": soil, "state": state, "mode": "density", "seed": seed})
             folder = str(dest.relative_to(out))
         kept.append(SeedSpecimen.from_row(seed, r, folder))
     return kept
@@ -298,7 +302,7 @@ def run_sand(
     )
     rows = run_specimen_stage(case, replace(target, n2d_target=trial), out, sweep_kw)
     clock.end("specimens", t)
-    kept = keep_specimens(rows, out, _state_label(case))
+    kept = keep_specimens(rows, out, _state_label(case), case.soil_record(), case.lab.to_dict())
     radii = _drawn_radii(out, kept)
     _grading_figure(case, radii, out)
     result = SandResult.build(case, pf, target, trial, cal_record, kept, clock.elapsed())
