@@ -23,7 +23,7 @@ import numpy as np
 
 from poro2d.errors import InputError
 from poro2d.porosity import parabolic
-from poro2d.sand.case import SandCase
+from poro2d.sand.case import SandCase, time_step
 from poro2d.specimen.compaction import SpecimenSpec, check_feasible, estimate_size
 from poro2d.specimen.grading import GradingCurve, paper_grading
 
@@ -100,25 +100,6 @@ class Preflight:
 
     def to_dict(self) -> dict:
         return asdict(self)
-
-
-def time_step(spec: SpecimenSpec, r_min: float) -> float:
-    """The engine's automatic step for disks as small as ``r_min`` in ``spec``'s box."""
-    from poro2d.dem.model import ContactModel, critical_time_step
-    from poro2d.dem.state import Particles
-    from poro2d.specimen.compaction import make_walls
-
-    disk = Particles(
-        np.zeros((1, 2)),
-        np.array([r_min]),
-        spec.solid_density,
-        spec.thickness,
-        spec.kn_particle,
-        spec.ks_particle,
-        spec.friction_prep,
-    )
-    k_sum = ContactModel("per_body").stiffness_sum_bound(disk, make_walls(spec, spec.height))
-    return spec.dt_safety * critical_time_step(float(disk.mass[0]), k_sum)
 
 
 #: a lid must rest in the calibration box: its force window at least this many times the
