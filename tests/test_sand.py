@@ -179,6 +179,10 @@ def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
     data = json.loads((out / "sand.json").read_text())
     assert data["soil"]["name"] == "tiny paper sand" and data["provenance"]["poro2d_version"]
     assert data["calibration"]["mus"] == [0.0, 0.5]
+    # where the time went: every trial of the 4 calibration cases and the 2 specimens, counted
+    prof, spec_prof = data["calibration"]["time_profile"], data["calibration"]["specimens_time_profile"]
+    assert prof["trials"] >= 4 and spec_prof["trials"] >= 2
+    assert prof["plate"]["steps"] > 0 and prof["prepare"]["particle_steps_per_s"] > 0
     assert res.n2d_min < res.n2d_target < res.n2d_max
     md = (out / "summary.md").read_text()
     accepted = [k for k in res.specimens if k.accepted]

@@ -221,6 +221,7 @@ def summary_markdown(res: SandResult, out: Path) -> str:
         f"| dense end, interior (calibration box) | {_fmt(res.calibration.get('dense_end_interior'))} "
         f"(against the jamming porosity {_fmt(jam)}) |",
         f"| wall time | {res.wall_seconds / 60:.1f} min |",
+        *_profile_rows(res),
         "",
         *[f"**Note:** {w}" for w in warnings(res)],
         "| seed | accepted | interior | box n' | disks | folder |",
@@ -244,6 +245,23 @@ def summary_markdown(res: SandResult, out: Path) -> str:
             "```",
         ]
     return "\n".join(lines) + "\n"
+
+
+def _profile_rows(res: SandResult) -> list[str]:
+    """Where the time went: per stage (calibration, specimens) and phase (preparation, lid)."""
+    rows = []
+    for label, key in (("calibration", "time_profile"), ("specimens", "specimens_time_profile")):
+        prof = res.calibration.get(key)
+        if not prof:
+            continue
+        parts = []
+        for phase in ("prepare", "plate"):
+            p = prof[phase]
+            rate = p["particle_steps_per_s"]
+            pace = "" if not math.isfinite(rate) else f" ({rate:.3g} particle-steps/s)"
+            parts.append(f"{phase} {p['steps']:,} steps in {p['seconds'] / 60:.1f} min{pace}")
+        rows.append(f"| {label}: {prof['trials']} trials | {'; '.join(parts)} |")
+    return rows
 
 
 def warnings(res: SandResult) -> list[str]:

@@ -34,6 +34,7 @@ from poro2d.io_utils import check_output_dir, provenance, write_json
 from poro2d.locks import holds_output
 from poro2d.sand.case import ConfigLike, SandCase, load_sand_case
 from poro2d.sand.preflight import Preflight, preflight
+from poro2d.sand.profile import calibration_runs, stage_profile
 from poro2d.sand.result import SandResult, SeedSpecimen, write_summary
 from poro2d.sweep import density as D
 
@@ -303,6 +304,9 @@ def run_sand(
     rows = run_specimen_stage(case, replace(target, n2d_target=trial), out, sweep_kw)
     clock.end("specimens", t)
     kept = keep_specimens(rows, out, _state_label(case), case.soil_record(), case.lab.to_dict())
+    cal_runs = calibration_runs(Path(cal_record["cases"]), [float(m) for m in cal_record["mus"]], case.seeds)
+    cal_record["time_profile"] = stage_profile(cal_runs)
+    cal_record["specimens_time_profile"] = stage_profile(sorted((out / "states" / "cases").glob("*/run")))
     radii = _drawn_radii(out, kept)
     _grading_figure(case, radii, out)
     result = SandResult.build(case, pf, target, trial, cal_record, kept, clock.elapsed())
