@@ -44,3 +44,12 @@ def test_paper_mode_says_its_answer_does_not_follow_the_density(tmp_path, capsys
     text = " ".join(capsys.readouterr().out.split())
     assert "paper mode: the specimen is prepared at the fixed friction_prep" in text
     assert "poro2d sand" in text
+
+
+def test_a_relation_config_serves_the_criterion_too(tmp_path):
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(
+        "seed = 0\n[criterion]\nn_lab = 0.40\n[relation]\npoints = 3\nn_max = 0.4571\nn_min = 0.3253\n"
+    )
+    inputs = criterion_inputs(cfg)
+    assert inputs.mode == "paper" and inputs.config["relation"]["points"] == 3

@@ -129,7 +129,8 @@ def criterion_inputs(
     from poro2d.errors import check_int
     from poro2d.specimen.compaction import check_feasible
 
-    cfg, base = load(config, preset)
+    # a [relation] table is the relation's: one config serves both commands
+    cfg, base = load(config, preset, extra_tables=("relation",))
     if seed is not None:
         cfg["seed"] = check_int("--seed", seed, 0)
     dens = density_settings(cfg, mode, n_max, n_min, seeds, preset=config is None)
