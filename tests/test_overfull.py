@@ -178,3 +178,30 @@ def test_an_overfull_first_trial_ends_in_a_looser_accepted_trial(tmp_path):
     assert res.converged and res.final_porosity > 0.07
     assert "layers end once settled" in res.preparation_note
     assert res.to_dict()["preparation_note"] == res.preparation_note
+
+
+@pytest.mark.slow
+def test_an_overfull_first_trial_under_the_lid_leads_to_a_looser_trial(tmp_path):
+    """The fill acceptance on the same over-full trial: the plate takes the specimen into the
+    window, the lid rests on it, n' is measured under the lid and the next trial is looser
+    (measured: 0.07 -> n' 0.178, then 0.18; 10 s for the first trial)."""
+    from poro2d.criterion.protocol import PorosityCriterion
+
+    cfg = {
+        "grading": {"preset": "wide_cu4"},
+        "specimen": {"width": 0.08, "height": 0.04, "layers": 2},
+        "criterion": {
+            "trial_porosity": 0.07,
+            "force_fraction": 0.05,
+            "acceptance": "fill",
+            "max_iterations": 2,
+        },  # fmt: skip
+    }
+    spec, grading, settings, seed = build(cfg)
+    res = PorosityCriterion(spec, grading, settings, seed=seed, out=tmp_path / "c").run()
+    first = res.iterations[0]
+    assert first["overfull_m"] > 0.0 and first["plate_moved"] == "lid"
+    assert not first["refused"] and first["checks"]["disks_inside_box"] and first["disks_outside_box"] == 0
+    assert first["new_porosity"] > 0.07
+    assert len(res.iterations) == 2 and res.iterations[1]["trial_porosity"] > 0.07
+    assert not res.iterations[1]["refused"]
