@@ -28,6 +28,15 @@ def print_result(result: CriterionResult, out: Path) -> None:
             _fixed_or_dash(r.get("surface_gap_mean_d50"), 2), _verdict(r),
         )  # fmt: skip
     console.print(t)
+    for r in result.iterations:
+        if r.get("overfull_m"):
+            console.print(
+                f"trial {r['iteration']} (n2D = {r['trial_porosity']:.4f}): over-full box, the specimen "
+                f"stood {1e3 * r['overfull_m']:.3g} mm above H; n' from where the plate settled",
+                soft_wrap=True,
+            )
+    if result.preparation_note:
+        console.print(f"preparation: {result.preparation_note}", soft_wrap=True)
     console.print(f"{result.message}; results in {out}/result.json")
     if result.interior_porosity is not None:
         under_lid = result.settings.get("acceptance") == "fill"

@@ -23,7 +23,7 @@ from poro2d.criterion.protocol import CriterionSettings
 from poro2d.errors import InputError, check_int
 from poro2d.paper_data import QUICK_CRITERION, QUICK_SPECIMEN
 from poro2d.porosity import PAPER_N_LAB
-from poro2d.specimen.compaction import SpecimenSpec
+from poro2d.specimen.compaction import SpecimenSpec, wide_grading_spec
 from poro2d.specimen.grading import GradingCurve, paper_grading
 
 TOP_KEYS = {"seed", "specimen", "grading", "criterion", "shear", "title", "density"}
@@ -118,6 +118,9 @@ def build(cfg: dict, base_dir: Path | None = None, **overrides):
         raise InputError("grading", g, "a table: preset, csv or sizes_mm with percent_passing")
     grading = paper_grading() if g == {"preset": "paper"} else GradingCurve.from_config(g, base_dir=base_dir)
     check_config_bounds(spec, "specimen", SPECIMEN_BOUNDS)
+    # a wide grading's preparation: the settled test unless the config says otherwise (the
+    # paper's grading is not wide: its spec is unchanged)
+    spec = wide_grading_spec(spec, grading, cfg.get("specimen"))
     settings = dataclass_from_table(CriterionSettings, "criterion", cfg.get("criterion"), **overrides)
     check_config_bounds(settings, "criterion", CRITERION_BOUNDS)
     seed = check_int("seed", cfg.get("seed", 0), 0)

@@ -100,6 +100,10 @@ def install_lid(sim: Simulation, width: float, d50: float) -> list[int]:
     y = float(w.p0[top, 1])
     park = 4.0 * float(sim.particles.radius.max()) + 0.1 * y
     sim.translate_wall("top", 0.0, park)
+    # the side walls close the box up to the parked plate and beyond (an over-full specimen's
+    # plate may stand above where the box was built): no disk can leave over them
+    for side in ("left", "right"):
+        sim.extend_wall_up(side, y + 2.0 * park)
     edges = np.linspace(0.0, width, segment_count(width, d50) + 1)
     for k in range(len(edges) - 1):
         # right to left, like the plate: the normal points down into the specimen

@@ -23,6 +23,7 @@ whose specimen fails a check, is refused and ends the run with the reason.
 
 from __future__ import annotations
 
+import logging
 import math
 import time
 from dataclasses import asdict, dataclass
@@ -48,7 +49,7 @@ from poro2d.errors import InputError, check_range
 from poro2d.io_utils import as_json, provenance, write_csv, write_json
 from poro2d.porosity import PAPER_N_LAB, parabolic
 from poro2d.resumable import Fingerprint, ResumableStage
-from poro2d.specimen.compaction import SpecimenSpec, box_porosity, prepare_specimen
+from poro2d.specimen.compaction import SpecimenSpec, box_porosity, preparation_note, prepare_specimen
 from poro2d.specimen.grading import GradingCurve
 from poro2d.specimen.porosity_regions import lid_height_at, mass_d50
 
@@ -56,6 +57,8 @@ from poro2d.specimen.porosity_regions import lid_height_at, mass_d50
 #: the gap under the plate); "fill", a segmented lid that rests on the grains over the width
 #: (:mod:`poro2d.criterion.lid`; n' is the porosity of the box the specimen fills)
 ACCEPTANCE_MODES = ("plate", "fill")
+
+_log = logging.getLogger(__name__)
 
 
 @dataclass
@@ -329,6 +332,14 @@ def _check_reason(name: str, row: dict, settings: CriterionSettings) -> str:
     )
 
 
+def overfull_note(overfull_m: float) -> str:
+    """What a trial's reason says of an over-full box (the trial denser than its layers fit in H)."""
+    return (
+        f"over-full box: at this trial porosity the layers did not fit below H, the specimen stood "
+        f"{1000.0 * overfull_m:.3g} mm above H and the plate started there"
+    )
+
+
 class PorosityCriterion:
     """Run Fig. 3 for one grading and laboratory porosity, writing results to ``out``.
 
@@ -471,6 +482,9 @@ class PorosityCriterion:
             "preparation_converged": prep["converged"],
             "converged": True,
         }
+        overfull = float(prep.get("overfull_m") or 0.0)
+        if overfull > 0.0:  # recorded only when it happens: ordinary rows keep their keys
+            row["overfull_m"] = overfull
         t1 = time.perf_counter()
         top = sim.walls.index("top")
         if not prep["converged"]:
@@ -483,7 +497,8 @@ class PorosityCriterion:
                 equilibrium=self.spec.equilibrium,
             )  # fmt: skip
             after = forces0
-        elif s.acceptance == "plate" and in_window(f_top, weight, s.force_fraction):
+        elif s.acceptance == "plate" and overfull == 0.0 and in_window(f_top, weight, s.force_fraction):
+            # an over-full box has its plate above H: n' is measured where the plate settles
             row.update(plate_moved="no", plate_displacement_m=0.0, new_porosity=n, plate_settled=True)
             after = forces0
         else:
@@ -614,6 +629,8 @@ class PorosityCriterion:
                 if condition
                 else f"|n' - n2D| = {row['porosity_change']:.4f} >= {s.tolerance:g}"
             )
+        if row.get("overfull_m"):
+            row["reason"] += "; " + overfull_note(row["overfull_m"])
 
     # -------------------------------------------------------------------- loop
     def run(self) -> CriterionResult:
@@ -632,6 +649,9 @@ class PorosityCriterion:
         s = self.settings
         t_start = time.perf_counter()
         n = s.initial_trial()
+        note = preparation_note(self.spec, self.grading)
+        if note:
+            _log.warning("preparation: %s", note)
         rows: list[dict] = []
         tried: list[float] = []
         accepted: dict | None = None
@@ -675,6 +695,7 @@ class PorosityCriterion:
         if accepted is not None:
             for key in CriterionResult.OPTIONAL:
                 setattr(result, key, accepted.get(key))
+        result.preparation_note = preparation_note(self.spec, self.grading)
         result.time_total_s = time.perf_counter() - t_start
         if self.out is not None:
             self._final_outputs(rows, accepted)

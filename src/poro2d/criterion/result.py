@@ -24,7 +24,7 @@ class CriterionResult(TypedResult):
 
     OPTIONAL = (
         "box_porosity", "interior_porosity", "interior_porosity_std", "surface_gap_mean_d50",
-        "plate_contact_fraction",
+        "plate_contact_fraction", "preparation_note",
     )  # fmt: skip
 
     final_porosity: float | None
@@ -46,6 +46,8 @@ class CriterionResult(TypedResult):
     interior_porosity_std: float | None = None
     surface_gap_mean_d50: float | None = None
     plate_contact_fraction: float | None = None
+    # a wide grading's equilibrium test and why (poro2d.specimen.compaction.preparation_note)
+    preparation_note: str | None = None
 
 
 @dataclass(eq=False)

@@ -491,6 +491,21 @@ class Simulation:
         self.walls.mode[w] = WALL_VELOCITY
         self.walls.vel[w] = v
 
+    def extend_wall_up(self, wall: str | int, height: float) -> None:
+        """Move the upper end of a vertical wall up to ``height`` (m) when it ends below it.
+
+        A box's side walls reach past its top by the box size; a lid or plate raised above
+        that (an over-full specimen) needs them longer, or disks could leave over them.
+        """
+        w = self.walls.index(wall)
+        p0, p1 = self.walls.p0, self.walls.p1
+        if p0[w, 0] != p1[w, 0]:
+            raise InputError(f"wall {self.walls.names[w]}", "not vertical", "a vertical wall (a box's side)")
+        end = p0 if p0[w, 1] >= p1[w, 1] else p1
+        if end[w, 1] < height:
+            end[w, 1] = float(height)
+            self.kernel_params.iprm[K.NEED_BUILD] = 1
+
     def translate_wall(self, wall: str | int, dx: float, dy: float) -> None:
         """Move a wall rigidly by (dx, dy) at once (a teleport, e.g. a temporary lid)."""
         w = self.walls.index(wall)

@@ -25,7 +25,8 @@ near the target density once the layers above compact them.
 from __future__ import annotations
 
 import logging
-from dataclasses import asdict, dataclass
+import math
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
@@ -56,6 +57,9 @@ THROUGHPUT = 1e7
 EQUILIBRIUM_STEPS = 5000
 #: Preparations estimated to take longer than this (seconds) are announced with a warning.
 WARN_SECONDS = 600.0
+#: Preparations estimated to take longer than this (seconds) per trial are refused: a run of
+#: several trials would take weeks (the estimate is of dense layers; loose ones take longer).
+REFUSE_SECONDS = 86400.0
 
 
 #: settings recorded with results only when they differ from these defaults (see ``to_dict``)
@@ -175,6 +179,68 @@ class SpecimenSpec:
         return np.array(tops)
 
 
+#: a grading is **wide** when its Cu or its d_max / d_min is above these. Measured boundary:
+#: the paper's grading (Cu 1.69, d_max / d_min 3.5) and log-linear gradings up to Cu 4
+#: (d_max / d_min 15.7) reach the paper's maximum-ratio equilibrium in every seed of the
+#: sensitivity study (docs/criterion.md); ``wide_cu4`` (Cu 4.3 with fines, d_max / d_min 25)
+#: does not (a layer creeps at a ratio of 1e-2 through the whole fallback)
+WIDE_CU = 4.0
+WIDE_SIZE_RATIO = 20.0
+#: what a wide grading's preparation uses unless the config sets ``settle_drift`` or
+#: ``equilibrium``: layers that end once settled (density mode's value) and the ratio over the
+#: load-bearing disks (rattlers, common among the fines, never carry a balanced load)
+WIDE_PREPARATION = {"settle_drift": 1e-3, "equilibrium": "loaded_max"}
+
+
+def is_wide(grading: GradingCurve) -> bool:
+    """Whether ``grading`` is wide: Cu above ``WIDE_CU`` or d_max / d_min above ``WIDE_SIZE_RATIO``."""
+    return grading.uniformity > WIDE_CU or grading.d_max_m / grading.d_min_m > WIDE_SIZE_RATIO
+
+
+def _grading_words(grading: GradingCurve) -> str:
+    return (
+        f"Cu {grading.uniformity:.3g}, d_max/d_min {grading.d_max_m / grading.d_min_m:.3g} (wide: Cu > "
+        f"{WIDE_CU:g} or d_max/d_min > {WIDE_SIZE_RATIO:g})"
+    )
+
+
+def wide_grading_spec(spec: SpecimenSpec, grading: GradingCurve, table: dict | None) -> SpecimenSpec:
+    """The spec a config's ``[specimen]`` table gives, with ``WIDE_PREPARATION`` for a wide grading.
+
+    Only when the grading is wide (:func:`is_wide`) and the table sets neither ``settle_drift``
+    nor ``equilibrium``: a config that sets either keeps its settings as they are (set
+    ``equilibrium = "max"`` to keep the paper's test on a wide grading). The paper's grading is
+    not wide: its spec is returned unchanged.
+    """
+    table = table or {}
+    if not is_wide(grading) or "settle_drift" in table or "equilibrium" in table:
+        return spec
+    return replace(spec, **WIDE_PREPARATION)
+
+
+def preparation_note(spec: SpecimenSpec, grading: GradingCurve) -> str | None:
+    """What a run says of its equilibrium test on a wide grading (None for a narrow one)."""
+    if not is_wide(grading):
+        return None
+    if spec.settle_drift is not None or spec.equilibrium != "max":
+        drift = (
+            ""
+            if spec.settle_drift is None
+            else f"layers end once settled (settle_drift {spec.settle_drift:g} d50), "
+        )
+        return (
+            f"wide grading ({_grading_words(grading)}): {drift}equilibrium judged by the {spec.equilibrium} "
+            "unbalanced-force ratio: rattlers among the fines never carry a balanced load, and a "
+            "low-friction layer near jamming creeps at a maximum ratio of 1e-2 for hundreds of "
+            "thousands of steps while its density no longer changes (docs/criterion.md)"
+        )
+    return (
+        f"wide grading ({_grading_words(grading)}): the paper's maximum-ratio test, as the config sets it; "
+        "its layers may creep through the whole fallback without reaching it (leave settle_drift and "
+        "equilibrium unset to let poro2d use the settled test)"
+    )
+
+
 def make_walls(spec: SpecimenSpec, lid_height: float) -> Walls:
     """Bottom, right, top (the lid / top plate) and left walls of the box."""
     return Walls.box(0.0, 0.0, spec.width, lid_height, spec.kn_wall, spec.ks_wall, spec.friction_wall)
@@ -198,17 +264,109 @@ def check_feasible(spec: SpecimenSpec, grading: GradingCurve, porosity: float) -
             "porosity", porosity, "[0.05, 1)",
             "disks cannot fill a box to less than about 0.09 porosity without large overlaps",
         )  # fmt: skip
+    check_densest(spec, grading, porosity)
     check_size(spec, grading, porosity)
+
+
+#: a trial porosity more than this below the grading's frictionless jamming porosity n_J is
+#: refused before any DEM work. A trial denser than n_J is an over-full box, which the
+#: criterion handles as Fig. 3 does (the plate moves up, the next trial is looser): the paper's
+#: own first trial is 0.013 below n_J of its grading, Eq. 12's 0.08 for a Cu 18 gravel (n_J
+#: about 0.12) 0.04 below. 0.05 below, the disks hold 6 % more solid than the grading's densest
+#: packing fits in the box, and the swelling specimen outruns the plate: ``wide_cu4`` at 0.06
+#: (0.053 below) in a 0.08 m x 0.04 m box pushed the plate up 8.4 mm, and it had not settled
+#: after its 600 000 steps (measured; at 0.07 it settles and the next trial is accepted).
+OVERFULL_MARGIN = 0.05
+#: no disk set jams looser than this without friction (bidisperse 1 : 1.4: 0.159, the paper's
+#: grading 0.153; wider gradings and monodisperse crystals pack denser): trials at or above
+#: JAMMING_CEILING - OVERFULL_MARGIN need no jamming estimate
+JAMMING_CEILING = 0.17
+#: the quick jamming estimate of the pre-flight check: disks, bisection tolerance and the
+#: compression step (about 2 s; n_J within about 0.003 of the full reference, docs/jamming.md)
+PREFLIGHT_JAMMING = {"n_disks": 400, "tol": 1e-3, "dphi": 0.01}
+
+_DENSEST: dict[tuple, float | None] = {}
+
+
+def densest_porosity(grading: GradingCurve) -> float | None:
+    """A quick estimate of the grading's frictionless jamming porosity n_J (None if it cannot be made).
+
+    One seed of :func:`poro2d.specimen.jamming.jamming_reference` on ``PREFLIGHT_JAMMING``
+    disks, cached per grading. None when the grading is too wide for that many disks in the
+    periodic cell (the largest disks would span it).
+    """
+    from poro2d.specimen.jamming import jamming_reference
+
+    key = (tuple(grading.sizes.tolist()), tuple(grading.percent.tolist()))
+    if key not in _DENSEST:
+        o = PREFLIGHT_JAMMING
+        try:
+            ref = jamming_reference(grading, n_disks=o["n_disks"], seeds=(0,), tol=o["tol"], dphi=o["dphi"])
+            n_j = float(ref.porosity_mean)
+            _DENSEST[key] = n_j if math.isfinite(n_j) else None
+        except InputError as e:
+            _log.info("no quick jamming estimate for this grading: %s", e)
+            _DENSEST[key] = None
+    return _DENSEST[key]
+
+
+def check_densest(spec: SpecimenSpec, grading: GradingCurve, porosity: float) -> None:
+    """Refuse a trial porosity more than ``OVERFULL_MARGIN`` below the grading's densest packing."""
+    if porosity >= JAMMING_CEILING - OVERFULL_MARGIN:
+        return
+    n_j = densest_porosity(grading)
+    if n_j is None or porosity >= n_j - OVERFULL_MARGIN:
+        return
+    excess = (1.0 - porosity) / (1.0 - n_j) - 1.0
+    raise InputError(
+        "trial porosity", porosity,
+        f">= {n_j - OVERFULL_MARGIN:.3f}: at most {OVERFULL_MARGIN:g} below the grading's frictionless "
+        f"jamming porosity n_J = {n_j:.3f}",
+        f"at {porosity:g} the disks hold {100 * excess:.1f} % more solid than the grading's densest packing "
+        f"fits in the box (the specimen would stand about {1000 * excess * spec.height:.3g} mm above H): no "
+        f"plate could settle it; give [criterion] trial_porosity near n_J (e.g. "
+        f"{math.ceil(n_j * 100) / 100:.2f}), from which the loop finds the answer, or check n_lab",
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)
 class SizeEstimate:
-    """What a specimen will cost, estimated from the grading without drawing a disk."""
+    """What a specimen will cost, estimated from the grading without drawing a disk.
+
+    ``dt_s``: the time step the engine will take (set by the smallest disk);
+    ``stage_steps``: the steps a stage is estimated to need at that step.
+    """
 
     disks: float
     memory_bytes: float
     steps: int
     seconds: float
+    dt_s: float = math.nan
+    stage_steps: int = EQUILIBRIUM_STEPS
+
+
+def time_step(spec: SpecimenSpec, d_min: float) -> float:
+    """The time step (s) the engine picks for disks as small as ``d_min`` (m) in this box.
+
+    As :class:`poro2d.dem.Simulation` picks it: ``dt_safety`` x the critical step
+    sqrt(2 m_min / (3 k_sum)) (:func:`poro2d.dem.model.critical_time_step`), m_min the mass
+    of the smallest disk, k_sum the summed stiffness bound of a disk's contacts
+    (:meth:`poro2d.dem.ContactModel.stiffness_sum_bound`, per-body springs in series).
+    """
+    m_min = spec.solid_density * math.pi * (0.5 * d_min) ** 2 * spec.thickness
+    kp = max(spec.kn_particle, spec.ks_particle)
+    kw = max(spec.kn_wall, spec.ks_wall)
+    kpp = 0.5 * kp
+    kpw = kp * kw / (kp + kw)
+    k_sum = max(6.0 * kpp, 4.0 * kpp + kpw)
+    return spec.dt_safety * math.sqrt(2.0 * m_min / (3.0 * k_sum))
+
+
+#: the simulated time a stage takes to come to equilibrium, for the estimate: ``EQUILIBRIUM_STEPS``
+#: at the time step of the paper's specimen (Table 1, the reconstructed grading's 2.0 mm disks).
+#: Settling takes about the same time whatever the disks, so a grading with finer disks (a
+#: smaller step) needs proportionally more steps.
+PAPER_D_MIN = 0.002
 
 
 def estimate_size(spec: SpecimenSpec, grading: GradingCurve, porosity: float) -> SizeEstimate:
@@ -216,12 +374,18 @@ def estimate_size(spec: SpecimenSpec, grading: GradingCurve, porosity: float) ->
 
     The count is the box's solid area (1 - n) W H over the grading's mean disk area, the
     number :func:`draw_disks` will draw on average. The steps are those of radius expansion
-    in every layer plus ``EQUILIBRIUM_STEPS`` per stage; the time assumes ``THROUGHPUT``.
+    in every layer plus a stage's equilibrium per stage: ``EQUILIBRIUM_STEPS`` at the paper's
+    time step, more in proportion when the smallest disk sets a smaller one (:func:`time_step`;
+    the paper's grading and Table 1 give exactly ``EQUILIBRIUM_STEPS``). The time assumes
+    ``THROUGHPUT``.
     """
     solid_area = (1.0 - porosity) * spec.width * spec.height
     disks = grading.expected_count(solid_area)
-    steps = spec.layers * (spec.growth_increments * spec.growth_steps + EQUILIBRIUM_STEPS) + EQUILIBRIUM_STEPS
-    return SizeEstimate(disks, disks * BYTES_PER_DISK, steps, disks * steps / THROUGHPUT)
+    dt = time_step(spec, grading.d_min_m)
+    dt_paper = time_step(SpecimenSpec(), PAPER_D_MIN)
+    stage = max(EQUILIBRIUM_STEPS, math.ceil(EQUILIBRIUM_STEPS * dt_paper / dt - 1e-9))
+    steps = spec.layers * (spec.growth_increments * spec.growth_steps + stage) + stage
+    return SizeEstimate(disks, disks * BYTES_PER_DISK, steps, disks * steps / THROUGHPUT, dt, stage)
 
 
 def check_size(spec: SpecimenSpec, grading: GradingCurve, porosity: float) -> SizeEstimate:
@@ -238,6 +402,24 @@ def check_size(spec: SpecimenSpec, grading: GradingCurve, porosity: float) -> Si
             f"mean disk area {grading.mean_disk_area():.3g} m^2 in {spec.width:g} m x {spec.height:g} m "
             f"at porosity {porosity:g}; coarsen the grading (upscale, d_min_mm), shrink the box, or "
             "raise [specimen] max_disks",
+        )  # fmt: skip
+    budget = spec.max_steps_per_stage + spec.fallback_steps + 2 * spec.calm_steps
+    if est.stage_steps > EQUILIBRIUM_STEPS and est.stage_steps > budget:  # the smallest disk is the cause
+        raise InputError(
+            "time step",
+            f"{est.dt_s:.3g} s, set by the smallest disk (d_min {1000 * grading.d_min_m:.3g} mm)",
+            f"a step at which a stage comes to rest within its budget of {budget} steps "
+            f"(it needs about {est.stage_steps})",
+            "the time step falls with the smallest disk's diameter: cut the fines with [grading] d_min_mm, "
+            "up-scale the grading (upscale), or raise [specimen] max_steps_per_stage",
+        )  # fmt: skip
+    if est.seconds > REFUSE_SECONDS:
+        raise InputError(
+            "specimen size", f"about {est.disks:.3g} disks, time step {est.dt_s:.3g} s",
+            f"a preparation estimated below {_duration(REFUSE_SECONDS)} per trial (estimated: "
+            f"{_duration(est.seconds)}, about {est.steps} steps at {THROUGHPUT:.0e} particle-steps/s)",
+            f"d_min {1000 * grading.d_min_m:.3g} mm sets the step and the disk count: cut the fines with "
+            "[grading] d_min_mm, up-scale the grading (upscale), use fewer layers or a smaller box",
         )  # fmt: skip
     if est.seconds > WARN_SECONDS:
         _warn_once(
@@ -454,6 +636,12 @@ def prepare_specimen(
         "failed_ratio": None if failed is None else failed[1]["measured_ratio"],
         "equilibrium": spec.equilibrium,
     }
+    lid_y = float(sim.walls.p0[sim.walls.index("top"), 1])
+    if any("band_raised_m" in layer for layer in layers) and lid_y > H:
+        # an over-full box: the trial is denser than its layers could be built in H; the top
+        # plate stands at lid_y, and the criterion's plate stage measures where it settles
+        report["overfull_m"] = lid_y - H
+        report["top_height_m"] = lid_y
     return sim, report
 
 
@@ -473,13 +661,7 @@ def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.nda
     :func:`equilibrate`.
     """
     W = spec.width
-    y_top = float(tops[k])
-    y_bot = float(tops[k - 1]) if k else 0.0
-    if sim is not None:
-        # the previous layer's disks may not sit above its lid: start the band on them
-        p = sim.particles
-        y_bot = max(y_bot, float(np.max(p.pos[:, 1] + p.radius)) if p.n else 0.0)
-        y_bot = min(y_bot, y_top - 2.0 * float(radii[idx].max()))
+    y_bot, y_top, raised = layer_band(sim, spec, k, radii[idx], tops)
     plc = place_disks(radii[idx], Band(0.0, W, y_bot, y_top), seed=int(rng.integers(2**31)))
     # number the disks along horizontal strips of about two diameters: neighbours in
     # space are then near in memory, which keeps the contact loops in cache
@@ -498,6 +680,10 @@ def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.nda
         lid = sim.walls.index("top")
         sim.translate_wall(lid, 0.0, y_top - float(sim.walls.p0[lid, 1]))
         new = sim.add_particles(small)
+    # the side walls close the box above the lid, with room for the plate to move up and for
+    # the fill acceptance's lid to park it higher (criterion.lid): needed above an over-full
+    # band and in boxes taller than wide; the paper's box is closed far above that already
+    side_walls_reach(sim, SIDE_WALL_REACH * y_top + 4.0 * float(radii.max()))
     steps = _grow(sim, new, radii[idx], plc.scale, spec)
     # renumber the whole packing in strips across its short side (the new layer was
     # appended on top): threads then split it along a short cut (dem.ordering)
@@ -507,7 +693,59 @@ def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.nda
     report = LayerReport(k + 1, len(idx), y_top, plc.scale, steps, eq["max_ratio"], eq["converged"],
                          eq["attempts"])  # fmt: skip
     layer = asdict(report)
+    if raised > 0.0:  # recorded only when it happens: the reports of ordinary layers keep their keys
+        layer["band_raised_m"] = raised
     return sim, layer, eq
+
+
+#: the densest solid fraction a layer's band is filled to at full size. A band is planned for
+#: its share of the solid area at the trial porosity (about 0.86 on the paper's trials); a
+#: trial denser than the grading can pack (its frictionless jamming fraction: 0.85 for the
+#: paper's grading, 0.88-0.90 for Cu 4-6, docs/jamming.md), under layers that spring up above
+#: their band tops, leaves the last bands too little room. Above this fraction the band's top
+#: (and the lid) is raised until the layer fits at it: the specimen then stands above H, an
+#: over-full box, which the criterion's plate stage measures as Fig. 3 does (plate up, a
+#: looser next trial). Every band of the paper's trials lies below it (0.859-0.868 at 0.14).
+BAND_FRACTION_MAX = 0.90
+
+
+def layer_band(sim: Simulation | None, spec: SpecimenSpec, k: int, radii: np.ndarray,
+               tops: np.ndarray) -> tuple[float, float, float]:  # fmt: skip
+    """The band (y_bot, y_top) of layer ``k`` of disks ``radii``, and how far its top was raised.
+
+    The band runs from the previous band's top, or from the top of the disks below when they
+    stand above it, to the layer's planned top. When the layer's disks would fill that band to
+    more than ``BAND_FRACTION_MAX`` (or it is lower than the largest disk), the band starts on
+    the disks below and its top is raised until they fit: the third value is the rise (m), 0
+    for an ordinary band.
+    """
+    y_top = float(tops[k])
+    y_bot = float(tops[k - 1]) if k else 0.0
+    d_max = 2.0 * float(radii.max())
+    if sim is not None:
+        # the previous layer's disks may not sit above its lid: start the band on them (on
+        # those in the box: a disk squeezed out of an over-dense layer is left to the checks)
+        p = sim.particles
+        lid = float(sim.walls.p0[sim.walls.index("top"), 1])
+        x, y = p.pos[:, 0], p.pos[:, 1]
+        inside = (x >= 0.0) & (x <= spec.width) & (y <= lid)
+        y_bot = max(y_bot, float(np.max(y[inside] + p.radius[inside])) if inside.any() else 0.0)
+    area = float(np.sum(np.pi * radii * radii))
+    need = max(area / (spec.width * BAND_FRACTION_MAX), d_max)
+    if y_top - y_bot >= need:
+        return y_bot, y_top, 0.0
+    raised_top = y_bot + need
+    return y_bot, raised_top, raised_top - y_top
+
+
+#: the side walls reach at least this many times the lid's height (plus two largest diameters)
+SIDE_WALL_REACH = 1.5
+
+
+def side_walls_reach(sim: Simulation, height: float) -> None:
+    """Lengthen the side walls (``left``, ``right``) upwards where they end below ``height``."""
+    for name in ("left", "right"):
+        sim.extend_wall_up(name, height)
 
 
 def _grow(sim: Simulation, idx: np.ndarray, full: np.ndarray, scale: float, spec: SpecimenSpec) -> int:
@@ -537,6 +775,9 @@ __all__ = [
     "SpecimenSpec",
     "box_porosity",
     "check_feasible",
+    "is_wide",
+    "preparation_note",
+    "wide_grading_spec",
     "check_size",
     "equilibrate",
     "estimate_size",
