@@ -59,7 +59,7 @@ def test_case_refuses_bad_input_naming_it(cfg, parameter):
 
 
 def test_time_step_is_the_engines():
-    """The pre-flight's step is the one the engine picks for the same smallest disk."""
+    """The pre-flight's step (compaction.time_step) is the one the engine picks for the same smallest disk."""
     from poro2d.dem import Simulation
     from poro2d.dem.model import ContactModel
     from poro2d.specimen.compaction import _band_particles, make_walls
@@ -68,7 +68,7 @@ def test_time_step_is_the_engines():
     r = np.array([0.0005, 0.002])
     sim = Simulation(_band_particles(spec, np.array([[0.01, 0.01], [0.03, 0.01]]), r), make_walls(spec, 0.03),
                      ContactModel("per_body"), gravity=(0.0, -9.81), dt_safety=spec.dt_safety)  # fmt: skip
-    assert PF.time_step(spec, 0.0005) == pytest.approx(sim.dt, rel=1e-12)
+    assert PF.time_step(spec, 0.001) == pytest.approx(sim.dt, rel=1e-12)
 
 
 def test_calibration_box_holds_about_the_disks_asked_for():
@@ -228,7 +228,7 @@ def test_step_budgets_follow_the_time_step():
     paper = {"criterion": {}, "specimen": {}}
     assert with_step_budgets(paper, spec, paper_grading()) is paper  # the paper grading: the defaults
     fine = GradingCurve.from_lists([0.1, 0.2, 0.4], [0, 50, 100], upscale=10)  # d_min 1 mm: half the step
-    slow = PF.time_step(spec, 0.001) / PF.time_step(spec, 0.0005)
+    slow = PF.time_step(spec, 0.002) / PF.time_step(spec, 0.001)
     assert slow == pytest.approx(2.0)
     cfg = with_step_budgets({"criterion": {"max_plate_steps": 1234}}, spec, fine)
     assert cfg["criterion"]["max_plate_steps"] == 1234  # what the user set stays

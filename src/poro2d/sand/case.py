@@ -27,13 +27,11 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from poro2d.config import check_keys
 from poro2d.criterion.density import DEFAULT_MUS, check_mus
 from poro2d.errors import InputError, check_int
 from poro2d.lab_state import LabState, lab_state_from_table
-from poro2d.specimen.compaction import SpecimenSpec
+from poro2d.specimen.compaction import SpecimenSpec, time_step
 from poro2d.specimen.grading import GradingCurve
 from poro2d.sweep.density import DEFAULT_SEEDS, with_density_defaults
 
@@ -140,25 +138,6 @@ def _criterion_config(cfg: dict, lab: LabState) -> dict:
     return with_density_defaults(crit)
 
 
-def time_step(spec: SpecimenSpec, r_min: float) -> float:
-    """The engine's automatic step for disks as small as ``r_min`` in ``spec``'s box."""
-    from poro2d.dem.model import ContactModel, critical_time_step
-    from poro2d.dem.state import Particles
-    from poro2d.specimen.compaction import make_walls
-
-    disk = Particles(
-        np.zeros((1, 2)),
-        np.array([r_min]),
-        spec.solid_density,
-        spec.thickness,
-        spec.kn_particle,
-        spec.ks_particle,
-        spec.friction_prep,
-    )
-    k_sum = ContactModel("per_body").stiffness_sum_bound(disk, make_walls(spec, spec.height))
-    return spec.dt_safety * critical_time_step(float(disk.mass[0]), k_sum)
-
-
 #: step budgets (setting: the paper's default) that bound a stage in simulated time; they were
 #: set for the paper grading's time step, so a grading whose finest disks set a smaller step gets
 #: them in proportion (the lid of a frictional preparation on a fine sand did not settle within
@@ -180,7 +159,7 @@ def with_step_budgets(config: dict, spec: SpecimenSpec, grading: GradingCurve) -
     """
     from poro2d.specimen.grading import paper_grading
 
-    slow = time_step(spec, paper_grading().d_min_m / 2.0) / time_step(spec, grading.d_min_m / 2.0)
+    slow = time_step(spec, paper_grading().d_min_m) / time_step(spec, grading.d_min_m)
     if slow <= 1.0 + 1e-9:
         return config
     out = copy.deepcopy(config)

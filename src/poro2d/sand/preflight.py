@@ -2,7 +2,7 @@
 
 The pre-flight reads only the grading and the box (no disk is simulated): the disk count
 is the box's solid area over the grading's mean disk area, the time step is the engine's
-critical step for the lightest disk (:func:`poro2d.dem.model.critical_time_step`), and the
+critical step for the lightest disk (:func:`poro2d.specimen.compaction.time_step`), and the
 grading's frictionless jamming porosity (:mod:`poro2d.specimen.jamming`, an energy
 minimisation, not a DEM run) places the first trials. The run time is a model:
 
@@ -23,8 +23,8 @@ import numpy as np
 
 from poro2d.errors import InputError
 from poro2d.porosity import parabolic
-from poro2d.sand.case import SandCase, time_step
-from poro2d.specimen.compaction import SpecimenSpec, check_feasible, estimate_size
+from poro2d.sand.case import SandCase
+from poro2d.specimen.compaction import SpecimenSpec, check_feasible, estimate_size, time_step
 from poro2d.specimen.grading import GradingCurve, paper_grading
 
 #: particle-steps per second per core assumed by the estimate (measured 1.0e7-2.5e7 on dense
@@ -324,8 +324,8 @@ def workload(case: SandCase, spec: SpecimenSpec, g: GradingCurve, first: float, 
     fill = crit.get("acceptance", "plate") == "fill"
     window = float(crit.get("force_fraction", 0.01)) if fill else None
     cal = calibration_box(spec, g, case.calibration_disks, first, lid_window=window)
-    dt = time_step(spec, g.d_min_m / 2.0)
-    dt_paper = time_step(spec, paper_grading().d_min_m / 2.0)
+    dt = time_step(spec, g.d_min_m)
+    dt_paper = time_step(spec, paper_grading().d_min_m)
     n_cal, n_spec = _cases(case)
     cal_spec = replace(spec, width=cal.width, height=cal.height, layers=cal.layers)
     psteps = {
@@ -457,5 +457,4 @@ __all__ = [
     "calibration_box",
     "jamming_of",
     "preflight",
-    "time_step",
 ]
