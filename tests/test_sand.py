@@ -263,3 +263,14 @@ def test_a_named_specimen_exports_with_its_soil(tmp_path, specimen):
     assert lines[0] == "provenance: soil Toyoura sand (Verdugo & Ishihara (1996))"
     text = "\n".join(lines)
     assert "n_lab = 0.4023, relative density Dr = 0.8000; mode density" in text and "seed 1" in text
+
+
+def test_frictional_first_trials_start_on_the_loose_side():
+    from poro2d.sand.run import LOOSE_BIAS
+    from poro2d.sweep.density import first_trial
+
+    crit = {"acceptance": "fill", "refine_tolerance": 0.002}
+    assert first_trial(crit, 0.0, 0.15, 0.01, LOOSE_BIAS) == first_trial(crit, 0.0, 0.15, 0.01)
+    assert first_trial(crit, 1.0, 0.15, 0.01, LOOSE_BIAS) == pytest.approx(
+        first_trial(crit, 1.0, 0.15, 0.01) + LOOSE_BIAS, abs=0.0011
+    )

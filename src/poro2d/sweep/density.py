@@ -132,7 +132,11 @@ def calibration_key(base: dict) -> str:
 
 
 def first_trial(
-    criterion: dict, mu: float, dense_end: float | None = None, walls: float | None = None
+    criterion: dict,
+    mu: float,
+    dense_end: float | None = None,
+    walls: float | None = None,
+    loose_bias: float = 0.0,
 ) -> float:
     """The first trial of the calibration case at preparation friction ``mu``.
 
@@ -142,6 +146,9 @@ def first_trial(
     grading's own frictionless jamming porosity (:mod:`poro2d.specimen.jamming`); the table is
     then moved by its difference from the paper grading's (``PAPER_JAMMING_POROSITY``), and
     ``walls`` (the box's :func:`wall_share`) by its difference from the paper box's.
+    ``loose_bias`` x ``mu`` is added on top: a frictional preparation prepared denser than it
+    packs by itself is over-compressed under the lid, which then may not settle (a start on the
+    loose side lets the lid come down onto the specimen instead).
     """
     from poro2d.criterion.protocol import CriterionSettings, round_to, trial_grid
 
@@ -155,11 +162,16 @@ def first_trial(
         n += float(dense_end) - PAPER_JAMMING_POROSITY
     if walls is not None:
         n += float(walls) - PAPER_WALL_SHARE
-    return round_to(n, grid)
+    return round_to(n + loose_bias * mu, grid)
 
 
 def calibration_sweep(
-    base: dict, mus: list[float], seeds: int, dense_end: float | None = None, walls: float | None = None
+    base: dict,
+    mus: list[float],
+    seeds: int,
+    dense_end: float | None = None,
+    walls: float | None = None,
+    loose_bias: float = 0.0,
 ) -> dict:
     """The sweep of the calibration: every friction with every seed, from its first trial.
 
@@ -176,7 +188,7 @@ def calibration_sweep(
         cfg["criterion"]["trial_porosity"] = CALIBRATION_FIRST_TRIAL
         cfg["sweep"].update({"specimen.friction_prep": list(mus), "seed": list(range(seeds))})
         return cfg
-    firsts = {mu: first_trial(cfg["criterion"], mu, dense_end, walls) for mu in mus}
+    firsts = {mu: first_trial(cfg["criterion"], mu, dense_end, walls, loose_bias) for mu in mus}
     cfg["sweep"]["cases"] = [
         {"specimen.friction_prep": mu, "criterion.trial_porosity": firsts[mu], "seed": s}
         for mu in mus
@@ -228,6 +240,7 @@ def calibrate(
     use_cache: bool = True,
     dense_end: float | None = None,
     walls: float | None = None,
+    loose_bias: float = 0.0,
     record: str = "calibration.json",
     **sweep_kw,
 ) -> tuple[Calibration, dict]:
@@ -249,7 +262,7 @@ def calibrate(
         folder.mkdir(parents=True, exist_ok=True)
     except OSError:  # a read-only cache: the cases go with the results
         folder = out / "calibration"
-    sweep = parse_sweep(calibration_sweep(base, mus, seeds, dense_end, walls), base_dir)
+    sweep = parse_sweep(calibration_sweep(base, mus, seeds, dense_end, walls, loose_bias), base_dir)
     # another run of the same grading may be computing this entry: wait, then reuse its cases
     with cache_entry(folder):
         res = run_sweep(sweep, folder, **sweep_kw)
