@@ -2,6 +2,6 @@
 
 from poro2d.sand.case import SandCase, load_sand_case
 from poro2d.sand.result import SandResult
-from poro2d.sand.run import run_preflight, run_sand
+from poro2d.sand.run import check_soil, run_sand
 
-__all__ = ["SandCase", "SandResult", "load_sand_case", "run_preflight", "run_sand"]
+__all__ = ["SandCase", "SandResult", "load_sand_case", "check_soil", "run_sand"]

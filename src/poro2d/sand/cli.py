@@ -142,10 +142,10 @@ def sand_cmd(
     density: a pre-flight (disks, time step, jamming porosity, run time), a calibration in a
     small box, specimens at full size, and the interior porosity to use in other codes.
     """
-    from poro2d.sand.run import run_preflight, run_sand
+    from poro2d.sand.run import check_soil, run_sand
 
     if preflight_only:
-        case, pf = run_preflight(config, seeds=seeds, workers=workers, budget_minutes=budget)
+        case, pf = check_soil(config, seeds=seeds, workers=workers, budget_minutes=budget)
         print_preflight(case, pf)
         return
     res = run_sand(

@@ -148,7 +148,7 @@ def _calibrate(case, pf, out, mus, record, cal_kw) -> tuple[Calibration, dict]:
     )
 
 
-def run_calibration_stage(case: SandCase, pf: Preflight, out: Path, cal_kw: dict) -> tuple[StateTarget, dict]:
+def calibration_stage(case: SandCase, pf: Preflight, out: Path, cal_kw: dict) -> tuple[StateTarget, dict]:
     """The ends, then the two frictions around the state: its target and friction.
 
     ``cal_kw``: the sweep's options and ``use_cache`` (:func:`poro2d.sweep.density.calibrate`).
@@ -200,7 +200,7 @@ def calibrate_ends(case: SandCase, pf: Preflight, out: Path, cal_kw: dict) -> tu
             raise AssertionError("unreachable: usable() refuses fewer than two frictions")
 
 
-def run_specimen_stage(case: SandCase, trial: StateTarget, out: Path, sweep_kw: dict) -> list[dict]:
+def specimen_stage(case: SandCase, trial: StateTarget, out: Path, sweep_kw: dict) -> list[dict]:
     """One criterion case per seed at full size, at the state's friction, from ``trial``."""
     from poro2d.criterion.protocol import trial_grid
     from poro2d.sweep.cases import parse_sweep
@@ -241,7 +241,7 @@ def _state_label(case: SandCase) -> str:
     return f"Dr{dr:.3f}" if dr is not None else f"n{case.lab.n_lab:.4f}"
 
 
-def run_preflight(
+def check_soil(
     config: ConfigLike,
     *,
     seeds: int | None = None,
@@ -286,7 +286,7 @@ def run_sand(
     out = Path(out)
     check_output_dir("--out", out)
     check_cluster_options(scheduler, workers)
-    case, pf = run_preflight(config, seeds=seeds, workers=workers, budget_minutes=budget_minutes)
+    case, pf = check_soil(config, seeds=seeds, workers=workers, budget_minutes=budget_minutes)
     out.mkdir(parents=True, exist_ok=True)
     write_json(
         out / "preflight.json",
@@ -300,7 +300,7 @@ def run_sand(
         "calibration",
         f"calibration: {pf.cases_calibration} cases at most, {pf.calibration_box.disks:.0f} disks each",
     )
-    target, cal_record = run_calibration_stage(case, pf, out, dict(sweep_kw, use_cache=use_cache))
+    target, cal_record = calibration_stage(case, pf, out, dict(sweep_kw, use_cache=use_cache))
     clock.end("calibration", t)
     trial = full_box_trial(target.n2d_target, pf.jamming.porosity, cal_record["n2d_min"], pf)
     t = clock.begin(
@@ -308,7 +308,7 @@ def run_sand(
         f"specimens: {case.seeds} at full size ({pf.box.disks:.0f} disks), "
         f"mu_prep {target.mu_prep:.3f}, first trial {trial:.4f}",
     )
-    rows = run_specimen_stage(case, replace(target, n2d_target=trial), out, sweep_kw)
+    rows = specimen_stage(case, replace(target, n2d_target=trial), out, sweep_kw)
     clock.end("specimens", t)
     kept = keep_specimens(rows, out, _state_label(case), case.soil_record(), case.lab.to_dict())
     cal_runs = calibration_runs(Path(cal_record["cases"]), [float(m) for m in cal_record["mus"]], case.seeds)
@@ -343,4 +343,4 @@ def _grading_figure(case: SandCase, radii, out: Path) -> None:
     )
 
 
-__all__ = ["bracket", "full_box_trial", "predicted_mu", "run_preflight", "run_sand"]
+__all__ = ["bracket", "full_box_trial", "predicted_mu", "check_soil", "run_sand"]
