@@ -326,7 +326,7 @@ def brute_force_pairs(pos: np.ndarray, radius: np.ndarray, skin: float) -> set[t
 # round-off only. The engine uses it only for wide size ratios (Simulation.level_ratio).
 
 #: radii of one size level lie within this factor of each other
-LEVEL_FACTOR = 2.0
+LEVEL_FACTOR = 4.0
 #: most size levels (the last one takes every radius above LEVEL_FACTOR ** 15 r_min)
 MAX_LEVELS = 16
 #: cells a level's grid may use per disk of the level (a runaway disk cannot make it huge)
