@@ -331,8 +331,9 @@ LEVEL_FACTOR = 4.0
 MAX_LEVELS = 16
 #: cells a level's grid may use per disk of the level (a runaway disk cannot make it huge)
 LEVEL_CELLS_PER_DISK = 16
-# columns of the level table ``geo`` (float64): cell side, grid origin, largest radius
-LV_SIZE, LV_X0, LV_Y0, LV_RMAX = range(4)
+# columns of the level table ``geo`` (float64): cell side and its inverse, grid origin,
+# largest radius
+LV_SIZE, LV_INV, LV_X0, LV_Y0, LV_RMAX = range(5)
 # columns of ``info`` (int64): cells along x and y, first cell of the level, disks in it
 LV_NCX, LV_NCY, LV_CELL0, LV_COUNT = range(4)
 # margin (times the cell side) that keeps a row's cell range whole despite rounding
@@ -353,7 +354,7 @@ class LevelScratch(NamedTuple):
     members: np.ndarray  # (n) disks ordered by cell
     cstart: np.ndarray  # (max_level_cells + 1) first member of each cell
     cfill: np.ndarray  # (max_level_cells + 1) fill counters
-    geo: np.ndarray  # (MAX_LEVELS, 4) float64: LV_SIZE, LV_X0, LV_Y0, LV_RMAX of each level
+    geo: np.ndarray  # (MAX_LEVELS, 5) float64: LV_SIZE, LV_INV, LV_X0, LV_Y0, LV_RMAX of each level
     info: np.ndarray  # (MAX_LEVELS, 4): LV_NCX, LV_NCY, LV_CELL0, LV_COUNT of each level
     count: np.ndarray  # (1) levels in use
 
@@ -364,14 +365,15 @@ def level_scratch(n: int) -> LevelScratch:
     i8 = np.int64
     return LevelScratch(
         np.zeros(n, i8), np.zeros(n, i8), np.zeros(n, i8), np.zeros(nc, i8), np.zeros(nc, i8),
-        np.zeros((MAX_LEVELS, 4)), np.zeros((MAX_LEVELS, 4), i8), np.zeros(1, i8),
+        np.zeros((MAX_LEVELS, 5)), np.zeros((MAX_LEVELS, 4), i8), np.zeros(1, i8),
     )  # fmt: skip
 
 
 @njit(inline="always", cache=True)
-def _cell_index(offset, size, nc):
-    """The cell (0 .. nc - 1) of a coordinate ``offset`` from the grid's origin, clamped."""
-    q = offset / size
+def _cell_index(offset, inv, nc):
+    """The cell (0 .. nc - 1) of a coordinate ``offset`` from the grid's origin, clamped
+    (``inv`` the inverse cell side: a product costs less than a division in the scan)."""
+    q = offset * inv
     if not q >= 0.0:  # below the grid (or not a number)
         return 0
     if q >= nc:
@@ -446,6 +448,7 @@ def level_grid(pos, radius, skin, lv):
         info[b, LV_NCX] = int((xmax - xmin) / size) + 1
         info[b, LV_NCY] = int((ymax - ymin) / size) + 1
         geo[b, LV_SIZE] = size
+        geo[b, LV_INV] = 1.0 / size
         geo[b, LV_X0] = xmin
         geo[b, LV_Y0] = ymin
         ncell += info[b, LV_NCX] * info[b, LV_NCY]
@@ -453,9 +456,9 @@ def level_grid(pos, radius, skin, lv):
         cstart[c] = 0
     for i in range(n):
         b = level[i]
-        size = geo[b, LV_SIZE]
-        cx = _cell_index(pos[i, 0] - xmin, size, info[b, LV_NCX])
-        cy = _cell_index(pos[i, 1] - ymin, size, info[b, LV_NCY])
+        inv = geo[b, LV_INV]
+        cx = _cell_index(pos[i, 0] - xmin, inv, info[b, LV_NCX])
+        cy = _cell_index(pos[i, 1] - ymin, inv, info[b, LV_NCY])
         c = info[b, LV_CELL0] + cy * info[b, LV_NCX] + cx
         cell[i] = c
         cstart[c + 1] += 1
@@ -488,19 +491,20 @@ def _scan_level_row(i, pos, radius, skin, members, cstart, geo, info, nlev, out_
             continue
         ncy = info[b, LV_NCY]
         size = geo[b, LV_SIZE]
+        inv = geo[b, LV_INV]
         x0 = geo[b, LV_X0]
         y0 = geo[b, LV_Y0]
         pad = _LEVEL_PAD * size
         reach = ri + geo[b, LV_RMAX] + skin + pad  # no partner of this level lies farther
-        for cy in range(_cell_index(yi - reach - y0, size, ncy), _cell_index(yi + reach - y0, size, ncy) + 1):
+        for cy in range(_cell_index(yi - reach - y0, inv, ncy), _cell_index(yi + reach - y0, inv, ncy) + 1):
             ylo = y0 + cy * size  # the row's disks lie at least gy away in y
             gy = max(ylo - yi, yi - (ylo + size), 0.0)
             if gy >= reach:
                 continue
             half = math.sqrt(reach * reach - gy * gy) + pad
             row = info[b, LV_CELL0] + cy * ncx
-            c0 = row + _cell_index(xi - half - x0, size, ncx)
-            c1 = row + _cell_index(xi + half - x0, size, ncx)
+            c0 = row + _cell_index(xi - half - x0, inv, ncx)
+            c1 = row + _cell_index(xi + half - x0, inv, ncx)
             for m in range(cstart[c0], cstart[c1 + 1]):
                 j = members[m]
                 if j <= i:
