@@ -8,9 +8,10 @@ compacted under gravity; then blocks of steps of the two are timed in alternatio
 
 Each box is square; the disks are placed at full size as densely as random placement gets
 (solid fraction 0.55, else less) and cycled with friction 0.5 under a gravity raised so that
-a free disk would fall 50 % of the box in the settling steps, then 5 % (the same compaction
-per step in both cases; the wide grading's time step is 20 times shorter): the timed blocks
-are a dense packing compacting under its weight, under the second gravity. For each case the script
+a free disk would fall 50 % of the box in the settling steps, then 15 %, then 5 % (the same
+compaction per step in both cases; the wide grading's time step is 20 times shorter), the
+speeds set to zero between stages: the timed blocks are a packing compacting under its
+weight, under the last gravity. For each case the script
 prints particle-steps per second (disks x steps / wall-clock second of the step loop, median
 of the blocks), the wall time of a block, list rebuilds per 1000 steps, Verlet pairs and
 touching pairs per disk, and the cost of one list build measured apart (a one-step run with a
@@ -42,9 +43,10 @@ import numpy as np
 WIDE_SIZES_MM = (0.1, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 18.9)
 WIDE_PASSING = (0.0, 5.0, 12.0, 20.0, 32.0, 45.0, 62.0, 92.0, 100.0)
 # how far (a fraction of the box side) gravity would drop a free disk in each settling stage:
-# first far (the packing collapses into contact), then a gravity 10 times lower (kept for
-# the timed blocks: the weight's overlaps stay a few per cent of the fines' radius)
-FALL_FRACTIONS = (0.5, 0.05)
+# first far (the packing collapses into contact), then lower gravities, each stage calmed
+# (the last one is kept for the timed blocks: the weight's overlaps stay a few per cent of
+# the fines' radius)
+FALL_FRACTIONS = (0.5, 0.15, 0.05)
 
 
 def grading(name: str):

@@ -531,6 +531,22 @@ def count_level_rows(lo, hi, pos, radius, skin, lv, new_start):
 
 
 @njit(inline="always", cache=True)
+def _sort_row(a, k0, k1):
+    """Sort a[k0:k1] in place: insertion for the short rows of most disks (no call of a
+    library sort per row), the library's sort for a coarse disk's long row."""
+    if k1 - k0 > 24:
+        a[k0:k1].sort()
+        return
+    for k in range(k0 + 1, k1):
+        v = a[k]
+        m = k - 1
+        while m >= k0 and a[m] > v:
+            a[m + 1] = a[m]
+            m -= 1
+        a[m + 1] = v
+
+
+@njit(inline="always", cache=True)
 def _ascending(a, k0, k1):
     """Whether a[k0:k1] is in ascending order."""
     for k in range(k0 + 1, k1):
@@ -571,7 +587,7 @@ def fill_level_rows(
         k0 = new_start[i]
         k1 = new_start[i + 1]
         _scan_level_row(i, pos, radius, skin, members, cstart, geo, info, nlev, new_j, k0, True)
-        new_j[k0:k1].sort()
+        _sort_row(new_j, k0, k1)
         o0 = nb_start[i]
         o1 = nb_start[i + 1]
         if _ascending(nb_j, o0, o1):
