@@ -281,3 +281,15 @@ def test_wide_checkpoint_continues_bitwise(tmp_path):
     assert ra.rebuilds >= 2
     assert np.array_equal(a.particles.pos, b.particles.pos)
     assert np.array_equal(a.particles.omega, b.particles.omega)
+
+
+def test_kernel_records_hold_the_level_grids():
+    """A wide grading's records carry its grids by size level, contiguous int64 (geo float64)."""
+    sim = wide_packing(5)
+    sim.run(2)
+    rec = sim.kernel_records()
+    assert rec.levels is sim.work.levels
+    for name, arr in rec.levels._asdict().items():
+        assert isinstance(arr, np.ndarray) and arr.flags.c_contiguous, name
+        assert arr.dtype == (np.float64 if name == "geo" else np.int64), name
+    assert rec.levels.count[0] >= 3  # r_max / r_min ~ 150: four levels of a factor 4
