@@ -20,6 +20,11 @@ same, slot for slot.
 Scratch storage (all preallocated by the caller, see :func:`grid_scratch`):
 ``cell`` and ``members`` (n), ``cstart`` and ``cfill`` (:func:`max_cells` + 1) and
 ``ginfo`` (int64, the grid's cell counts).
+
+For wide size ratios the disk-disk rows are built from grids by size level instead
+(:func:`level_grid`, :func:`count_level_rows`, :func:`fill_level_rows`; storage in
+:func:`level_scratch`): the same candidates, found without crowding a coarse disk's cells
+with fines (see the section at the end of the module).
 """
 
 from __future__ import annotations
