@@ -2,7 +2,8 @@
 
 One step, in order (the PFC cycle):
 
-1. rebuild the neighbour lists if flagged (a disk or wall moved more than skin / 2);
+1. rebuild the neighbour lists if flagged (a disk or wall moved more than skin / 2), from
+   one cell grid or, for wide size ratios, from grids by size level (:mod:`poro2d.dem.neighbors`);
 2. contact forces of every disk-disk and disk-wall pair (contact law, history update);
 3. the unbalanced force of each disk: gravity plus its contact forces;
 4. local (Cundall) damping and leapfrog integration of the disks;
@@ -46,10 +47,13 @@ from poro2d.dem.contact_law import PER_BODY, dashpot, linear_force, rolling_mome
 from poro2d.dem.neighbors import (
     cell_grid,
     copy_rows,
+    count_level_rows,
     count_pair_rows,
     count_wall_rows,
+    fill_level_rows,
     fill_pair_rows,
     fill_wall_rows,
+    level_grid,
     prefix_rows,
 )
 from poro2d.dem.partition import partition
@@ -463,9 +467,12 @@ def _move_walls(walls, dt):
 
 
 @njit(cache=True)
-def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out):
+def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out, levels):
     """All workers rebuild the lists together; thread 0 does the serial parts.
 
+    ``levels`` is None for the one cell grid, else the grids by size level
+    (:class:`~poro2d.dem.neighbors.LevelScratch`): a type, so each search compiles
+    into its own variant and the one grid's code is the same as without the other.
     Returns False (on every worker) when the pair storage is too small.
     """
     pos, radius = disks.pos, disks.radius
@@ -482,9 +489,15 @@ def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out):
     lo = t * n // nthr
     hi = (t + 1) * n // nthr
     if t == 0:
-        cell_grid(pos, radius, skin, cell, members, cstart, cfill, ginfo)
+        if levels is None:
+            cell_grid(pos, radius, skin, cell, members, cstart, cfill, ginfo)
+        else:
+            level_grid(pos, radius, skin, levels)
     barrier(sync, nthr)
-    count_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, new_start)
+    if levels is None:
+        count_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, new_start)
+    else:
+        count_level_rows(lo, hi, pos, radius, skin, levels, new_start)
     count_wall_rows(lo, hi, pos, radius, skin, wp0, wp1, wnew_start)
     barrier(sync, nthr)
     if t == 0:
@@ -501,8 +514,12 @@ def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out):
     barrier(sync, nthr)
     if atomic_load(sync, STATUS_WORD) != RUNNING:
         return False
-    fill_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, nb_start, nb_j, nb_fs,
-                   new_start, new_j, new_fs, nb_mr, new_mr)  # fmt: skip
+    if levels is None:
+        fill_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, nb_start, nb_j, nb_fs,
+                       new_start, new_j, new_fs, nb_mr, new_mr)  # fmt: skip
+    else:
+        fill_level_rows(lo, hi, pos, radius, skin, levels, nb_start, nb_j, nb_fs, nb_mr, new_start,
+                        new_j, new_fs, new_mr)  # fmt: skip
     fill_wall_rows(lo, hi, pos, radius, skin, wp0, wp1, wb_start, wb_w, wb_fs, wnew_start, wnew_w, wnew_fs,
                    wb_mr, wnew_mr)  # fmt: skip
     barrier(sync, nthr)  # the old rows are read by every filler: overwrite them only now
@@ -577,7 +594,7 @@ def _report(status, steps, rebuilds, need_build, pos, iprm, out):
 
 
 @njit(cache=True)
-def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll):
+def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll, levels):
     """Run the steps of this call on thread t of nthr: partitions t P / nthr to (t + 1) P / nthr - 1."""
     wp0, wall_build = walls.p0, walls.p0_build
     part, dstart, tmax, sync = work.part, work.dstart, work.tmax, work.sync
@@ -602,7 +619,7 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, ro
     status = RUNNING
     for _step in range(nsteps):
         if need_build:
-            if not _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out):
+            if not _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out, levels):
                 status = OVERFLOW
                 break
             need_build = False
@@ -658,21 +675,21 @@ def prepare(disks, nb, wb, work, prm):
 
 
 @njit(parallel=True, cache=True)
-def _run_threads(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll):
+def _run_threads(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll, levels):
     # prepare here, not in a call of its own: each call costs the dispatch of every array
     prepare(disks, nb, wb, work, prm)
     ok = np.zeros(nthr, dtype=np.int64)
     for t in prange(nthr):
         if start_handshake(work.sync, nthr):
             ok[t] = 1
-            _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll)
+            _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll, levels)
     return ok.sum() == nthr
 
 
 @njit(cache=True)
-def step_block_serial(disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll):
+def step_block_serial(disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll, levels):
     prepare(disks, nb, wb, work, prm)
-    _worker(0, 1, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll)
+    _worker(0, 1, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll, levels)
     out[THREADS_USED] = 1
 
 
@@ -692,13 +709,14 @@ def step_block(rec: KernelRecords, prm, iprm, out) -> None:
     props = BodyProps(disks.kn, disks.ks, disks.mu) if iprm[MODE] == PER_BODY else None
     dash = float(prm[BETA]) if prm[BETA] > 0.0 else None
     roll = RollingProps(disks.mu_r, walls.mu_r) if rolling_active(disks.mu_r) else None
+    levels = rec.levels  # None: the one cell grid
     if nthr <= 1:
-        step_block_serial(disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll)
+        step_block_serial(disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll, levels)
         return
     work.sync[:] = 0
-    if _run_threads(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll):
+    if _run_threads(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll, levels):
         out[THREADS_USED] = nthr
     else:  # the threading layer ran the workers one after the other: go on alone
         work.sync[:] = 0
-        _worker(0, 1, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll)
+        _worker(0, 1, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll, levels)
         out[THREADS_USED] = 1

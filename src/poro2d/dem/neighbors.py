@@ -20,10 +20,16 @@ same, slot for slot.
 Scratch storage (all preallocated by the caller, see :func:`grid_scratch`):
 ``cell`` and ``members`` (n), ``cstart`` and ``cfill`` (:func:`max_cells` + 1) and
 ``ginfo`` (int64, the grid's cell counts).
+
+For wide size ratios the disk-disk rows are built from grids by size level instead
+(:func:`level_grid`, :func:`count_level_rows`, :func:`fill_level_rows`; storage in
+:func:`level_scratch`): the same candidates, found without crowding a coarse disk's cells
+with fines (see the section at the end of the module).
 """
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -196,17 +202,24 @@ def fill_pair_rows(
         _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, new_j, k0, True)
         o0 = nb_start[i]
         o1 = nb_start[i + 1]
-        for k in range(k0, new_start[i + 1]):
-            j = new_j[k]
-            h = 0.0
-            hr = 0.0
-            for o in range(o0, o1):
-                if nb_j[o] == j:
-                    h = nb_fs[o]
-                    hr = nb_mr[o]
-                    break
-            new_fs[k] = h
-            new_mr[k] = hr
+        _carry_history(k0, new_start[i + 1], o0, o1, nb_j, nb_fs, nb_mr, new_j, new_fs, new_mr)
+
+
+@njit(inline="always", cache=True)
+def _carry_history(k0, k1, o0, o1, nb_j, nb_fs, nb_mr, new_j, new_fs, new_mr):
+    """Slots k0..k1-1 of a new row take the shear force and rolling moment their pair had in
+    the old row's slots o0..o1-1 (0 for a new pair)."""
+    for k in range(k0, k1):
+        j = new_j[k]
+        h = 0.0
+        hr = 0.0
+        for o in range(o0, o1):
+            if nb_j[o] == j:
+                h = nb_fs[o]
+                hr = nb_mr[o]
+                break
+        new_fs[k] = h
+        new_mr[k] = hr
 
 
 @njit(cache=True)
@@ -303,3 +316,305 @@ def brute_force_pairs(pos: np.ndarray, radius: np.ndarray, skin: float) -> set[t
     reach = radius[:, None] + radius[None, :] + skin
     i, j = np.nonzero(np.triu(d < reach, k=1))
     return set(zip(i.tolist(), j.tolist(), strict=True))
+
+
+# ------------------------------------------------------------------ cells by size level
+#
+# One grid of cells 2 r_max + skin wide suits disks of one size. With fines among coarse
+# grains (r_max / r_min of 100 and more) its cells hold hundreds of fines, and every fine
+# disk would test them all. Cells by size level (as LAMMPS's ``neighbor multi``) bin each
+# disk in the grid of its level, whose cells suit the largest disk of that level: a row
+# then looks, in every level's grid, only at the cells within reach of its own disk.
+# Rows still hold the partners j > i, now ordered by j, and the lists are the candidate
+# set of the single grid (tests/test_dem_neighbors_levels.py); the force sums follow
+# the slot order, so a run with this search differs from one with the single grid by
+# round-off only. The engine uses it only for wide size ratios (Simulation.level_ratio).
+
+#: radii of one size level lie within this factor of each other
+LEVEL_FACTOR = 4.0
+#: most size levels (the last one takes every radius above LEVEL_FACTOR ** 15 r_min)
+MAX_LEVELS = 16
+#: cells a level's grid may use per disk of the level (a runaway disk cannot make it huge)
+LEVEL_CELLS_PER_DISK = 16
+# columns of the level table ``geo`` (float64): cell side and its inverse, grid origin,
+# largest radius
+LV_SIZE, LV_INV, LV_X0, LV_Y0, LV_RMAX = range(5)
+# columns of ``info`` (int64): cells along x and y, first cell of the level, disks in it
+LV_NCX, LV_NCY, LV_CELL0, LV_COUNT = range(4)
+# margin (times the cell side) that keeps a row's cell range whole despite rounding
+_LEVEL_PAD = 1e-9
+
+
+@njit(cache=True)
+def max_level_cells(n):
+    """Most cells all levels' grids may use together for ``n`` disks."""
+    return LEVEL_CELLS_PER_DISK * n + 16 * MAX_LEVELS
+
+
+class LevelScratch(NamedTuple):
+    """The grids by size level (int64 unless said): see the section's comment."""
+
+    level: np.ndarray  # (n) size level of each disk
+    cell: np.ndarray  # (n) cell of each disk, counted over all levels' grids
+    members: np.ndarray  # (n) disks ordered by cell
+    cstart: np.ndarray  # (max_level_cells + 1) first member of each cell
+    cfill: np.ndarray  # (max_level_cells + 1) fill counters
+    geo: np.ndarray  # (MAX_LEVELS, 5) float64: LV_SIZE, LV_INV, LV_X0, LV_Y0, LV_RMAX of each level
+    info: np.ndarray  # (MAX_LEVELS, 4): LV_NCX, LV_NCY, LV_CELL0, LV_COUNT of each level
+    count: np.ndarray  # (1) levels in use
+
+
+def level_scratch(n: int) -> LevelScratch:
+    """The storage of the grids by size level for ``n`` disks."""
+    nc = max_level_cells(n) + 1
+    i8 = np.int64
+    return LevelScratch(
+        np.zeros(n, i8), np.zeros(n, i8), np.zeros(n, i8), np.zeros(nc, i8), np.zeros(nc, i8),
+        np.zeros((MAX_LEVELS, 5)), np.zeros((MAX_LEVELS, 4), i8), np.zeros(1, i8),
+    )  # fmt: skip
+
+
+@njit(inline="always", cache=True)
+def _cell_index(offset, inv, nc):
+    """The cell (0 .. nc - 1) of a coordinate ``offset`` from the grid's origin, clamped
+    (``inv`` the inverse cell side: a product costs less than a division in the scan)."""
+    q = offset * inv
+    if not q >= 0.0:  # below the grid (or not a number)
+        return 0
+    if q >= nc:
+        return nc - 1
+    return int(q)
+
+
+@njit(cache=True)
+def _level_bounds(pos, radius):
+    """(xmin, xmax, ymin, ymax, rmin, rmax) of the disks (n >= 1)."""
+    xmin = xmax = pos[0, 0]
+    ymin = ymax = pos[0, 1]
+    rmin = rmax = radius[0]
+    for i in range(1, pos.shape[0]):
+        xmin = min(xmin, pos[i, 0])
+        xmax = max(xmax, pos[i, 0])
+        ymin = min(ymin, pos[i, 1])
+        ymax = max(ymax, pos[i, 1])
+        rmin = min(rmin, radius[i])
+        rmax = max(rmax, radius[i])
+    return xmin, xmax, ymin, ymax, rmin, rmax
+
+
+@njit(cache=True)
+def _assign_levels(radius, rmin, rmax, level, geo, info):
+    """Each disk's level (radii in [rmin F^b, rmin F^(b+1)) are level b); returns the count."""
+    nlev = 1
+    while nlev < MAX_LEVELS and rmin * LEVEL_FACTOR**nlev <= rmax:
+        nlev += 1
+    for b in range(MAX_LEVELS):
+        info[b, LV_COUNT] = 0
+        geo[b, LV_RMAX] = 0.0
+    for i in range(radius.shape[0]):
+        b = 0
+        edge = rmin * LEVEL_FACTOR
+        while b < nlev - 1 and radius[i] >= edge:
+            b += 1
+            edge *= LEVEL_FACTOR
+        level[i] = b
+        info[b, LV_COUNT] += 1
+        geo[b, LV_RMAX] = max(geo[b, LV_RMAX], radius[i])
+    return nlev
+
+
+@njit(cache=True)
+def level_grid(pos, radius, skin, lv):
+    """Bin every disk in the grid of its size level (members of a cell in index order).
+
+    A level's cells are 2 r_max(level) + skin wide, at most ``LEVEL_CELLS_PER_DISK`` per
+    disk of the level; all grids share the bounding box of the disks and one ``cstart``.
+    """
+    n = pos.shape[0]
+    level, cell, members, cstart, cfill = lv.level, lv.cell, lv.members, lv.cstart, lv.cfill
+    geo, info = lv.geo, lv.info
+    if n == 0:
+        lv.count[0] = 0
+        cstart[0] = 0
+        return
+    xmin, xmax, ymin, ymax, rmin, rmax = _level_bounds(pos, radius)
+    nlev = _assign_levels(radius, rmin, rmax, level, geo, info)
+    ncell = 0
+    for b in range(nlev):
+        info[b, LV_CELL0] = ncell
+        if info[b, LV_COUNT] == 0:
+            info[b, LV_NCX] = 0
+            info[b, LV_NCY] = 0
+            continue
+        size = 2.0 * geo[b, LV_RMAX] + skin
+        cap = LEVEL_CELLS_PER_DISK * info[b, LV_COUNT] + 16
+        while ((xmax - xmin) / size + 1.0) * ((ymax - ymin) / size + 1.0) > cap:
+            size *= 1.5
+        info[b, LV_NCX] = int((xmax - xmin) / size) + 1
+        info[b, LV_NCY] = int((ymax - ymin) / size) + 1
+        geo[b, LV_SIZE] = size
+        geo[b, LV_INV] = 1.0 / size
+        geo[b, LV_X0] = xmin
+        geo[b, LV_Y0] = ymin
+        ncell += info[b, LV_NCX] * info[b, LV_NCY]
+    for c in range(ncell + 1):
+        cstart[c] = 0
+    for i in range(n):
+        b = level[i]
+        inv = geo[b, LV_INV]
+        cx = _cell_index(pos[i, 0] - xmin, inv, info[b, LV_NCX])
+        cy = _cell_index(pos[i, 1] - ymin, inv, info[b, LV_NCY])
+        c = info[b, LV_CELL0] + cy * info[b, LV_NCX] + cx
+        cell[i] = c
+        cstart[c + 1] += 1
+    for c in range(ncell):
+        cstart[c + 1] += cstart[c]
+        cfill[c] = cstart[c]
+    for i in range(n):  # stable: members of a cell stay in index order
+        c = cell[i]
+        members[cfill[c]] = i
+        cfill[c] += 1
+    lv.count[0] = nlev
+
+
+@njit(inline="always", cache=True)
+def _scan_level_row(i, pos, radius, skin, members, cstart, geo, info, nlev, out_j, k0, write):
+    """Count (or write from k0) the partners j > i of disk i, level by level.
+
+    In each level's grid only the cells that a circle of the largest reach to that level
+    touches are read: cell rows within reach, and in each row the run of cells that the
+    circle crosses (members of consecutive cells are consecutive). A coarse disk thus
+    reads the fines around it, not the many cells of fines a square around it would hold.
+    """
+    xi = pos[i, 0]
+    yi = pos[i, 1]
+    ri = radius[i]
+    k = 0
+    for b in range(nlev):
+        ncx = info[b, LV_NCX]
+        if ncx == 0:
+            continue
+        ncy = info[b, LV_NCY]
+        size = geo[b, LV_SIZE]
+        inv = geo[b, LV_INV]
+        x0 = geo[b, LV_X0]
+        y0 = geo[b, LV_Y0]
+        pad = _LEVEL_PAD * size
+        reach = ri + geo[b, LV_RMAX] + skin + pad  # no partner of this level lies farther
+        for cy in range(_cell_index(yi - reach - y0, inv, ncy), _cell_index(yi + reach - y0, inv, ncy) + 1):
+            ylo = y0 + cy * size  # the row's disks lie at least gy away in y
+            gy = max(ylo - yi, yi - (ylo + size), 0.0)
+            if gy >= reach:
+                continue
+            half = math.sqrt(reach * reach - gy * gy) + pad
+            row = info[b, LV_CELL0] + cy * ncx
+            c0 = row + _cell_index(xi - half - x0, inv, ncx)
+            c1 = row + _cell_index(xi + half - x0, inv, ncx)
+            for m in range(cstart[c0], cstart[c1 + 1]):
+                j = members[m]
+                if j <= i:
+                    continue
+                dx = pos[j, 0] - xi
+                dy = pos[j, 1] - yi
+                rij = ri + radius[j] + skin
+                if dx * dx + dy * dy < rij * rij:
+                    if write:
+                        out_j[k0 + k] = j
+                    k += 1
+    return k
+
+
+@njit(cache=True)
+def count_level_rows(lo, hi, pos, radius, skin, lv, new_start):
+    """Candidate partners of rows lo..hi-1 into ``new_start[i + 1]`` (grids by size level)."""
+    members, cstart, geo, info = lv.members, lv.cstart, lv.geo, lv.info
+    nlev = lv.count[0]
+    for i in range(lo, hi):
+        new_start[i + 1] = _scan_level_row(
+            i, pos, radius, skin, members, cstart, geo, info, nlev, new_start, 0, False
+        )
+
+
+@njit(inline="always", cache=True)
+def _sort_row(a, k0, k1):
+    """Sort a[k0:k1] in place: insertion for the short rows of most disks (no call of a
+    library sort per row), the library's sort for a coarse disk's long row."""
+    if k1 - k0 > 24:
+        a[k0:k1].sort()
+        return
+    for k in range(k0 + 1, k1):
+        v = a[k]
+        m = k - 1
+        while m >= k0 and a[m] > v:
+            a[m + 1] = a[m]
+            m -= 1
+        a[m + 1] = v
+
+
+@njit(inline="always", cache=True)
+def _ascending(a, k0, k1):
+    """Whether a[k0:k1] is in ascending order."""
+    for k in range(k0 + 1, k1):
+        if a[k] < a[k - 1]:
+            return False
+    return True
+
+
+@njit(inline="always", cache=True)
+def _merge_history(k0, k1, o0, o1, nb_j, nb_fs, nb_mr, new_j, new_fs, new_mr):
+    """As :func:`_carry_history` for a new row and an old row both ascending: one pass."""
+    o = o0
+    for k in range(k0, k1):
+        j = new_j[k]
+        while o < o1 and nb_j[o] < j:
+            o += 1
+        if o < o1 and nb_j[o] == j:
+            new_fs[k] = nb_fs[o]
+            new_mr[k] = nb_mr[o]
+        else:
+            new_fs[k] = 0.0
+            new_mr[k] = 0.0
+
+
+@njit(cache=True)
+def fill_level_rows(
+    lo, hi, pos, radius, skin, lv, nb_start, nb_j, nb_fs, nb_mr, new_start, new_j, new_fs, new_mr
+):
+    """Write rows lo..hi-1 of the new disk-disk list (grids by size level), each row in
+    ascending j, each pair with its old shear force and rolling moment (or 0).
+
+    A coarse disk's row holds hundreds of fines: ascending rows let the history be
+    matched in one pass (an old row from elsewhere, e.g. renumbered, is searched).
+    """
+    members, cstart, geo, info = lv.members, lv.cstart, lv.geo, lv.info
+    nlev = lv.count[0]
+    for i in range(lo, hi):
+        k0 = new_start[i]
+        k1 = new_start[i + 1]
+        _scan_level_row(i, pos, radius, skin, members, cstart, geo, info, nlev, new_j, k0, True)
+        _sort_row(new_j, k0, k1)
+        o0 = nb_start[i]
+        o1 = nb_start[i + 1]
+        if _ascending(nb_j, o0, o1):
+            _merge_history(k0, k1, o0, o1, nb_j, nb_fs, nb_mr, new_j, new_fs, new_mr)
+        else:
+            _carry_history(k0, k1, o0, o1, nb_j, nb_fs, nb_mr, new_j, new_fs, new_mr)
+
+
+@njit(cache=True)
+def build_level_pairs(pos, radius, skin, lv, nb_start, nb_j, nb_fs, new_start, new_j, new_fs):
+    """Rebuild the disk-disk half list in place with the grids by size level (stand-alone,
+    as :func:`build_pairs`). Returns the number of pairs, or ``-needed`` (nothing changed)."""
+    n = pos.shape[0]
+    level_grid(pos, radius, skin, lv)
+    count_level_rows(0, n, pos, radius, skin, lv, new_start)
+    total = prefix_rows(n, new_start)
+    if total > nb_j.shape[0]:
+        return -total
+    nb_mr = np.zeros(nb_j.shape[0])  # no rolling history in this stand-alone build
+    new_mr = np.zeros(nb_j.shape[0])
+    fill_level_rows(
+        0, n, pos, radius, skin, lv, nb_start, nb_j, nb_fs, nb_mr, new_start, new_j, new_fs, new_mr
+    )
+    copy_rows(0, n, new_start, new_j, new_fs, nb_start, nb_j, nb_fs, new_mr, nb_mr)
+    return total

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 if TYPE_CHECKING:  # pragma: no cover
+    from poro2d.dem.neighbors import LevelScratch
     from poro2d.dem.state import Particles, Walls
     from poro2d.dem.stores import ContactStore, DiskMasses, KernelWork
 
@@ -144,6 +145,8 @@ class KernelRecords(NamedTuple):
     nb: PairList
     wb: WallPairList
     work: WorkArrays
+    # the grids by size level of a wide grading's list builds; None: the one cell grid
+    levels: LevelScratch | None = None
 
 
 def kernel_records(
@@ -188,4 +191,4 @@ def kernel_records(
         dstart=work.dstart, tmax=work.tmax, sync=work.sync, cell=g.cell, members=g.members,
         cstart=g.cstart, cfill=g.cfill, ginfo=g.ginfo,
     )  # fmt: skip
-    return KernelRecords(disks, walls_rec, nb_rec, wb_rec, work_rec)
+    return KernelRecords(disks, walls_rec, nb_rec, wb_rec, work_rec, work.levels)

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from poro2d.dem.neighbors import GridScratch, grid_scratch
+from poro2d.dem.neighbors import GridScratch, LevelScratch, grid_scratch, level_scratch
 from poro2d.dem.sync import fresh_sync
 
 # the arrays of a list that hold contacts (kept when it grows) and their types
@@ -160,6 +160,7 @@ class KernelWork:
     tmax: np.ndarray  # (partitions) largest squared drift per thread
     sync: np.ndarray  # barrier and status words (poro2d.dem.sync)
     grid: GridScratch  # the cell grid of a list build
+    levels: LevelScratch | None = None  # the grids by size level (wide gradings), else None
 
     @classmethod
     def empty(cls, n: int, nw: int, partitions: int, wall_pad: int) -> KernelWork:
@@ -182,3 +183,12 @@ class KernelWork:
         self.tmax = np.zeros(partitions)
         self.sync = fresh_sync()
         self.grid = grid_scratch(n)
+        if self.levels is not None:
+            self.levels = level_scratch(n)
+
+    def use_levels(self, on: bool, n: int) -> None:
+        """Build the lists from grids by size level (``on``) or from the one cell grid."""
+        if not on:
+            self.levels = None
+        elif self.levels is None or self.levels.level.shape[0] != n:
+            self.levels = level_scratch(n)
