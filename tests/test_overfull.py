@@ -120,10 +120,10 @@ def test_a_time_step_too_small_for_the_step_budget_is_refused():
     assert "allowed: a step at which a stage comes to rest" in str(e.value)
 
 
-def test_a_preparation_of_more_than_a_day_is_refused():
+def test_a_preparation_of_more_than_six_hours_is_refused():
     fines = GradingCurve.from_lists([0.05, 0.1, 2.0], [0, 10, 100])  # about 0.7 million disks
     spec = SpecimenSpec(layers=8, max_steps_per_stage=10**8)
-    with pytest.raises(InputError, match=r"specimen size = .*preparation estimated below 24\.0 h.*d_min_mm"):
+    with pytest.raises(InputError, match=r"specimen size = .*preparation estimated below 6\.0 h.*d_min_mm"):
         check_feasible(spec, fines, 0.2)
 
 

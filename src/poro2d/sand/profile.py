@@ -67,17 +67,10 @@ def stage_profile(runs: list[Path]) -> dict:
     return out
 
 
-def calibration_runs(cases: Path, mus: list[float], seeds: int) -> list[Path]:
-    """The criterion folders of a calibration's cases at ``mus`` and seeds below ``seeds``
-    (a shared cache folder may hold other frictions and seeds of the same grading and box)."""
-    runs = []
-    for case in sorted(Path(cases).glob("cases/*")):
-        record = _read(case / "params.json") or {}
-        params = record.get("params") or {}
-        mu, seed = params.get("specimen.friction_prep"), params.get("seed")
-        if mu is not None and seed is not None and float(mu) in mus and int(seed) < seeds:
-            runs.append(case / "run")
-    return runs
+def case_runs(folder: Path, case_ids: list[str]) -> list[Path]:
+    """The criterion folders of the cases ``case_ids`` of a sweep folder (a shared calibration
+    cache may hold other cases of the same grading and box: other frictions, seeds or first trials)."""
+    return [Path(folder) / "cases" / cid / "run" for cid in case_ids]
 
 
-__all__ = ["calibration_runs", "stage_profile"]
+__all__ = ["case_runs", "stage_profile"]

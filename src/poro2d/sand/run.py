@@ -34,7 +34,7 @@ from poro2d.io_utils import check_output_dir, provenance, write_json
 from poro2d.locks import holds_output
 from poro2d.sand.case import ConfigLike, SandCase, load_sand_case
 from poro2d.sand.preflight import Preflight, preflight
-from poro2d.sand.profile import calibration_runs, stage_profile
+from poro2d.sand.profile import case_runs, stage_profile
 from poro2d.sand.result import SandResult, SeedSpecimen, write_summary
 from poro2d.sweep import density as D
 
@@ -130,19 +130,31 @@ def full_box_trial(target: float, dense_end: float | None, cal_dense: float, pf:
     return target - excess * (1.0 - ratio)
 
 
+def _first_trial_shifts(pf: Preflight) -> dict:
+    """What moves the calibration's first trials: the grading's jamming porosity, the box's walls."""
+    box = pf.calibration_box
+    return {"dense_end": pf.jamming.porosity, "walls": D.wall_share(box.width, box.height, pf.d50_m),
+            "loose_bias": LOOSE_BIAS}  # fmt: skip
+
+
+def calibration_cases(case: SandCase, pf: Preflight, mus: list[float]) -> list:
+    """The calibration's cases at ``mus`` (their ids name their folders in the cache)."""
+    from poro2d.sweep.cases import parse_sweep
+
+    sweep = D.calibration_sweep(calibration_config(case, pf), mus, case.seeds, **_first_trial_shifts(pf))
+    return parse_sweep(sweep, case.base_dir).cases
+
+
 def _calibrate(case, pf, out, mus, record, cal_kw) -> tuple[Calibration, dict]:
     cfg = calibration_config(case, pf)
-    box = pf.calibration_box
-    walls = D.wall_share(box.width, box.height, pf.d50_m)
+    shifts = _first_trial_shifts(pf)
     return D.calibrate(
         cfg,
         case.base_dir,
         out,
         mus=mus,
         seeds=case.seeds,
-        dense_end=pf.jamming.porosity,
-        walls=walls,
-        loose_bias=LOOSE_BIAS,
+        **shifts,
         record=record,
         **cal_kw,
     )
@@ -311,8 +323,8 @@ def run_sand(
     rows = specimen_stage(case, replace(target, n2d_target=trial), out, sweep_kw)
     clock.end("specimens", t)
     kept = keep_specimens(rows, out, _state_label(case), case.soil_record(), case.lab.to_dict())
-    cal_runs = calibration_runs(Path(cal_record["cases"]), [float(m) for m in cal_record["mus"]], case.seeds)
-    cal_record["time_profile"] = stage_profile(cal_runs)
+    cal_ids = [c.id for c in calibration_cases(case, pf, [float(m) for m in cal_record["mus"]])]
+    cal_record["time_profile"] = stage_profile(case_runs(Path(cal_record["cases"]), cal_ids))
     cal_record["specimens_time_profile"] = stage_profile(sorted((out / "states" / "cases").glob("*/run")))
     radii = _drawn_radii(out, kept)
     _grading_figure(case, radii, out)
