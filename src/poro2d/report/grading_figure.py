@@ -16,6 +16,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 from poro2d.report.shear_figures import save_figure  # noqa: E402
 from poro2d.specimen.grading import GradingCurve  # noqa: E402
@@ -62,13 +63,19 @@ def grading_figure(
         d = np.geomspace(used.d_min_m, used.d_max_m, 60)
         ax.semilogx(d * 1e3 / up, drawn_curve(radii, d), color="tab:red", lw=2,
                     label=f"drawn disks, one specimen ({len(radii)}, by area)")  # fmt: skip
+    plain = FuncFormatter(lambda v, _: f"{v:g}")  # 0.2, not 2 x 10^-1
     ax.set_xlabel("laboratory size [mm]")
     ax.set_ylabel("percent passing [%]")
     ax.set_ylim(0, 100)
     ax.grid(True, which="both", alpha=0.3)
     if up != 1.0:
         top = ax.secondary_xaxis("top", functions=(lambda x: x * up, lambda x: x / up))
+        top.xaxis.set_major_formatter(plain)
+        top.xaxis.set_minor_formatter(plain)
         top.set_xlabel(f"disk diameter in the model [mm] (up-scaling x{up:g})")
+    # after the secondary axis, which resets the parent's tick labels
+    ax.xaxis.set_major_formatter(plain)
+    ax.xaxis.set_minor_formatter(plain)
     ax.legend(loc="upper left", fontsize=8)
     ax.set_title(f"{title}: Cu = {used.uniformity:.2f}, d_max/d_min = {used.d_max_m / used.d_min_m:.0f}")
     return save_figure(fig, path)
