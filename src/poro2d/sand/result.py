@@ -223,7 +223,7 @@ def summary_markdown(res: SandResult, out: Path) -> str:
         f"| wall time | {res.wall_seconds / 60:.1f} min |",
         *_profile_rows(res),
         "",
-        *[f"**Note:** {w}" for w in warnings(res)],
+        *[line for w in warnings(res) for line in (f"**Note:** {w}", "")],
         "| seed | accepted | interior | box n' | disks | folder |",
         "| --- | --- | --- | --- | --- | --- |",
     ]
