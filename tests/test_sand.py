@@ -179,6 +179,9 @@ def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
     data = json.loads((out / "sand.json").read_text())
     assert data["soil"]["name"] == "tiny paper sand" and data["provenance"]["poro2d_version"]
     assert data["calibration"]["mus"] == [0.0, 0.5]
+    # every seed is recorded, accepted or not, with its folder or the reason it was refused
+    assert [r["seed"] for r in data["seed_results"]] == [0, 1]
+    assert all(r["accepted"] == bool(r["folder"]) for r in data["seed_results"])
     # where the time went: every trial of the 4 calibration cases and the 2 specimens, counted
     prof, spec_prof = data["calibration"]["time_profile"], data["calibration"]["specimens_time_profile"]
     assert prof["trials"] >= 4 and spec_prof["trials"] >= 2

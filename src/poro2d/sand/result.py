@@ -89,6 +89,7 @@ class SandResult(TypedResult):
     jamming_porosity_sd: float | None
     calibration: dict[str, Any]
     states: list[dict[str, Any]]
+    seed_results: list[dict[str, Any]]
     preflight: dict[str, Any]
     wall_seconds: float
     config: dict[str, Any]
@@ -136,6 +137,7 @@ class SandResult(TypedResult):
             jamming_porosity_sd=pf.jamming.sd,
             calibration=cal_record,
             states=states,
+            seed_results=[k.to_dict() for k in kept],
             preflight=pf.to_dict(),
             wall_seconds=seconds,
             config=case.config,

@@ -62,7 +62,7 @@ class StageClock:
         self.say = say
         self.pace = 1.0  # measured / estimated, from finished stages
 
-    def begin(self, stage: str, what: str) -> float:
+    def begin(self, what: str) -> float:
         left = sum(v for k, v in self.estimate.items() if k != "total") * self.pace
         self.say(f"{what}; elapsed {_clock(self.elapsed())}, about {_clock(left)} left (estimate)")
         return time.perf_counter()
@@ -310,14 +310,12 @@ def run_sand(
     sweep_kw = {"scheduler": scheduler, "workers": workers, "progress": progress}
     clock = StageClock(pf.seconds, announce)
     t = clock.begin(
-        "calibration",
         f"calibration: {pf.cases_calibration} cases at most, {pf.calibration_box.disks:.0f} disks each",
     )
     target, cal_record = calibration_stage(case, pf, out, dict(sweep_kw, use_cache=use_cache))
     clock.end("calibration", t)
     trial = full_box_trial(target.n2d_target, pf.jamming.porosity, cal_record["n2d_min"], pf)
     t = clock.begin(
-        "specimens",
         f"specimens: {case.seeds} at full size ({pf.box.disks:.0f} disks), "
         f"mu_prep {target.mu_prep:.3f}, first trial {trial:.4f}",
     )
