@@ -31,6 +31,21 @@ def test_case_reads_the_laboratory_state_and_fills_density_defaults():
     assert case.config["criterion"]["n_lab"] == pytest.approx(0.787 / 1.787, abs=1e-6)
     assert case.config["criterion"]["acceptance"] == "fill"  # density mode's defaults
     assert case.seeds == 3 and case.mus[0] == 0.0 and case.mus[-1] == 1.0
+    assert case.calibration_seeds == 2
+    assert load_sand_case(_config(sand={"calibration_seeds": 3})).calibration_seeds == 3
+
+
+def test_calibration_cases_run_the_loosest_first():
+    """The most frictional cases take longest: the workers start them first."""
+    from poro2d.sweep.density import calibration_sweep
+
+    case = load_sand_case(_config())
+    listed = calibration_sweep(case.config, [0.0, 0.1, 1.0], 2)["sweep"]["cases"]
+    first = calibration_sweep(case.config, [0.0, 0.1, 1.0], 2, loosest_first=True)["sweep"]["cases"]
+    assert [c["specimen.friction_prep"] for c in listed] == [0.0, 0.0, 0.1, 0.1, 1.0, 1.0]
+    assert [c["specimen.friction_prep"] for c in first] == [1.0, 1.0, 0.1, 0.1, 0.0, 0.0]
+    key = lambda c: (c["specimen.friction_prep"], c["seed"])  # noqa: E731
+    assert sorted(first, key=key) == sorted(listed, key=key)  # the same cases, first trials included
 
 
 @pytest.mark.parametrize(
@@ -42,6 +57,7 @@ def test_case_reads_the_laboratory_state_and_fills_density_defaults():
         ({"sand": {"seeds": 0}}, "sand.seeds"),
         ({"sand": {"speed": 2}}, "sand.speed"),
         ({"sand": {"calibration_disks": 10}}, "sand.calibration_disks"),
+        ({"sand": {"calibration_seeds": 0}}, "sand.calibration_seeds"),
         ({"soil": {"name": 3}}, "soil.name"),
         ({"criterion": {"n_lab": 0.30}}, "criterion.n_lab"),
     ],

@@ -229,9 +229,10 @@ def _steps_per_trial(spec: SpecimenSpec, dt: float, dt_paper: float) -> float:
 
 
 def _cases(case: SandCase) -> tuple[int, int]:
-    """Calibration cases (the ends and the two frictions around the state, per seed) and specimens."""
+    """Calibration cases (the ends and the two frictions around the state, per calibration seed)
+    and specimens."""
     frictions = min(len(case.mus), 4)
-    return frictions * case.seeds, case.seeds
+    return frictions * case.calibration_seeds, case.seeds
 
 
 def _seconds(particle_steps: float, cases: int, workers: int) -> float:

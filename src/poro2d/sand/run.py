@@ -142,7 +142,8 @@ def calibration_cases(case: SandCase, pf: Preflight, mus: list[float]) -> list:
     """The calibration's cases at ``mus`` (their ids name their folders in the cache)."""
     from poro2d.sweep.cases import parse_sweep
 
-    sweep = D.calibration_sweep(calibration_config(case, pf), mus, case.seeds, **_first_trial_shifts(pf))
+    cfg = calibration_config(case, pf)
+    sweep = D.calibration_sweep(cfg, mus, case.calibration_seeds, **_first_trial_shifts(pf))
     return parse_sweep(sweep, case.base_dir).cases
 
 
@@ -154,8 +155,9 @@ def _calibrate(case, pf, out, mus, record, cal_kw) -> tuple[Calibration, dict]:
         case.base_dir,
         out,
         mus=mus,
-        seeds=case.seeds,
+        seeds=case.calibration_seeds,
         **shifts,
+        loosest_first=True,
         record=record,
         **cal_kw,
     )

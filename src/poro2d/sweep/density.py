@@ -172,12 +172,15 @@ def calibration_sweep(
     dense_end: float | None = None,
     walls: float | None = None,
     loose_bias: float = 0.0,
+    loosest_first: bool = False,
 ) -> dict:
     """The sweep of the calibration: every friction with every seed, from its first trial.
 
     Under the paper's plate a grid sweep (one first trial for all); under the fill acceptance
     a list of cases, each friction from its own first trial (:func:`first_trial`, moved to the
-    grading's ``dense_end`` and the box's ``walls`` when given).
+    grading's ``dense_end`` and the box's ``walls`` when given). ``loosest_first`` lists the
+    most frictional cases first: they take longest (their lid waits for a creeping surface),
+    so the workers start them first and fill in with the quick dense ones.
     """
     cfg = copy.deepcopy(calibration_base(base))
     threads = (base.get("specimen") or {}).get("threads")
@@ -189,9 +192,10 @@ def calibration_sweep(
         cfg["sweep"].update({"specimen.friction_prep": list(mus), "seed": list(range(seeds))})
         return cfg
     firsts = {mu: first_trial(cfg["criterion"], mu, dense_end, walls, loose_bias) for mu in mus}
+    order = sorted(mus, reverse=True) if loosest_first else mus
     cfg["sweep"]["cases"] = [
         {"specimen.friction_prep": mu, "criterion.trial_porosity": firsts[mu], "seed": s}
-        for mu in mus
+        for mu in order
         for s in range(seeds)
     ]
     return cfg
@@ -241,6 +245,7 @@ def calibrate(
     dense_end: float | None = None,
     walls: float | None = None,
     loose_bias: float = 0.0,
+    loosest_first: bool = False,
     record: str = "calibration.json",
     **sweep_kw,
 ) -> tuple[Calibration, dict]:
@@ -250,7 +255,8 @@ def calibrate(
     settings (:func:`cache_dir` / ``calibrations`` / key): a case done once, for any list of
     frictions or number of seeds, is read back, not run again. Without it they go to
     ``out/calibration``. ``out/calibration.json`` records the calibration and where its
-    cases are. Returns the calibration and a record (key, folder, how many cases ran).
+    cases are; ``loosest_first``: see :func:`calibration_sweep`. Returns the calibration and
+    a record (key, folder, how many cases ran).
     """
     from poro2d.sweep.cases import parse_sweep
     from poro2d.sweep.runner import run_sweep
@@ -262,7 +268,8 @@ def calibrate(
         folder.mkdir(parents=True, exist_ok=True)
     except OSError:  # a read-only cache: the cases go with the results
         folder = out / "calibration"
-    sweep = parse_sweep(calibration_sweep(base, mus, seeds, dense_end, walls, loose_bias), base_dir)
+    cases = calibration_sweep(base, mus, seeds, dense_end, walls, loose_bias, loosest_first)
+    sweep = parse_sweep(cases, base_dir)
     # another run of the same grading may be computing this entry: wait, then reuse its cases
     with cache_entry(folder):
         res = run_sweep(sweep, folder, **sweep_kw)
