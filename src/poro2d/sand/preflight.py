@@ -27,9 +27,10 @@ from poro2d.sand.case import SandCase
 from poro2d.specimen.compaction import SpecimenSpec, check_feasible, estimate_size, time_step
 from poro2d.specimen.grading import GradingCurve, paper_grading
 
-#: particle-steps per second per core assumed by the estimate (measured 1.0e7-2.5e7 on dense
-#: sand specimens on the 2-core machines of this project; benchmarks/README.md)
-THROUGHPUT = 1.2e7
+#: particle-steps per second per core assumed by the estimate: measured 2.0e7 (lid) to 2.7e7
+#: (preparation) per core with both cores running cases (Toyoura sand, 4 100 and 10 800 disks,
+#: docs/sand.md), less on a machine busy with other work (1.2e7-1.9e7 seen)
+THROUGHPUT = 2.0e7
 #: lid/plate steps of one trial at the paper grading's time step (the fill acceptance's lid
 #: approach and settling: 258 000 steps per trial on a uniform fine sand whose step is 0.53 of
 #: the paper grading's, 100 000-140 000 on the paper grading)
