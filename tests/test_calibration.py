@@ -10,9 +10,9 @@ import pytest
 
 from poro2d.calibration import model, run_calibration, synthetic_lab
 from poro2d.cli import main
+from poro2d.cli.shear import load_shear_config
 from poro2d.dem import checkpoint
 from poro2d.errors import InputError
-from poro2d.shear.cli import load_shear_config
 from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
 

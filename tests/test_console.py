@@ -64,8 +64,8 @@ def test_narrow_terminal_folds_numbers_instead_of_cutting_them():
 
 
 def test_criterion_table_numbers_in_full(capsys):
-    from poro2d.criterion.cli import print_result
     from poro2d.criterion.result import CriterionResult
+    from poro2d.criterion.table import print_result
 
     it = {
         "trial_porosity": 0.21, "particle_count": 2591, "f_top_n_per_m": 3854.123456,
@@ -85,8 +85,8 @@ def test_criterion_table_numbers_in_full(capsys):
 
 
 def test_shear_and_relation_tables_in_full(capsys):
-    from poro2d.shear.cli import print_result
-    from poro2d.sweep.cli import print_relation
+    from poro2d.cli.relation import print_relation
+    from poro2d.cli.shear import print_result
 
     test = {
         "normal_stress_kpa": 100.0, "peak_shear_stress_kpa": 87.654321,

@@ -7,10 +7,10 @@ import time
 
 import pytest
 
+from poro2d.cli.shear import parse_stresses
 from poro2d.config import check_number_list
 from poro2d.errors import InputError
 from poro2d.io_utils import read_utf8, text_position
-from poro2d.shear.cli import parse_stresses
 from poro2d.sweep import runner
 from poro2d.sweep.density import check_mus
 

@@ -10,10 +10,10 @@ import pytest
 
 from poro2d import __version__
 from poro2d.cli import main
+from poro2d.cli.export import export_specimen
 from poro2d.errors import InputError
 from poro2d.interop import csv_table, lammps, pfc, yade
 from poro2d.interop.check import DEFAULTS
-from poro2d.interop.cli import export_specimen
 from poro2d.interop.specimen_data import from_checkpoint
 from poro2d.interop.state_specimen import find_state_specimen, state_specimen
 

@@ -323,6 +323,6 @@ def test_table_must_be_a_table(table):
 
 
 def test_solid_density_range_is_the_command_s():
-    from poro2d import porosity_cli
+    from poro2d.cli import convert
 
-    assert porosity_cli.SOLID_DENSITY_RANGE == SOLID_DENSITY_RANGE
+    assert convert.SOLID_DENSITY_RANGE == SOLID_DENSITY_RANGE

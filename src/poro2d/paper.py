@@ -1,10 +1,10 @@
-"""``poro2d paper``: the paper's case study on built-in defaults, in one command.
+"""The paper's case study on built-in defaults, in one call (:func:`run_paper`; ``poro2d paper``).
 
 Stages: the conversion table for the paper's sand (nLab = 0.3434, n_max = 0.4571,
 n_min = 0.3253) with Figs. 1-2, the criterion of Fig. 3 with Figs. 5-7, replicate
 specimens, direct shear (Fig. 8) and the report. Each stage writes into its own
 sub-folder; a rerun skips the stages already finished (see :func:`paper_stage`).
-``--quick`` runs a reduced specimen (a smaller box, two layers) for a first look.
+``quick`` (``--quick``) runs a reduced specimen (a smaller box, two layers) for a first look.
 """
 
 from __future__ import annotations
@@ -13,8 +13,6 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
-
-import typer
 
 from poro2d.console import OutputConsole
 from poro2d.criterion.config import paper_config
@@ -164,8 +162,8 @@ def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, qu
     Returns the summary, the criterion's results (its side files read through their classes)
     and the shear figures written (by the names of the report's ``SHEAR_FIGURES``).
     """
-    from poro2d.criterion.cli import print_result
     from poro2d.criterion.result import CriterionOutputs
+    from poro2d.criterion.table import print_result
 
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
@@ -258,27 +256,3 @@ def _shear_stage(specimens: dict[str, Path], out: Path, quick: bool, lab_data,
         "curves_first": out / first_label / "fig8a_shear_curves.png",
     }
     return summary, figures
-
-
-def register(app: typer.Typer) -> None:
-    @app.command("paper")
-    def paper_cmd(
-        out: Path = typer.Option(Path("paper-out"), "--out", "-o", help="Output folder (resumable)."),
-        quick: bool = typer.Option(
-            False, "--quick", help="Reduced specimen for a first look (about a minute)."
-        ),
-        lab: Path = typer.Option(None, "--lab", help="Laboratory direct shear CSV to overlay (Fig. 8)."),
-        seed: int = typer.Option(0, "--seed", help="Random seed of the first specimen."),
-        replicates: int = typer.Option(
-            3, "--replicates", help="Specimens (seeds) for the direct shear tests; 1 for one specimen."
-        ),
-        threads: int = typer.Option(
-            None, "--threads", help="Threads for the DEM kernels (default: all cores)."
-        ),
-        quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
-    ) -> None:
-        """Run the paper's case study: conversions, criterion (Fig. 3), direct shear (Fig. 8), report."""
-        summary = run_paper(out, quick=quick, lab=lab, seed=seed, threads=threads, replicates=replicates,
-                            progress=not quiet)  # fmt: skip
-        if not summary.criterion["converged"]:
-            raise typer.Exit(1)

@@ -70,10 +70,10 @@ def register(app: typer.Typer) -> None:
         quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
     ) -> None:
         """Peak and residual friction angles and dilation against rolling and particle friction."""
+        from poro2d.cli.shear import parse_stresses
         from poro2d.errors import InputError, check_int
         from poro2d.io_utils import check_output_dir
         from poro2d.shear import strength as st
-        from poro2d.shear.cli import parse_stresses
         from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
 
         # everything is checked before the first specimen or test is made

@@ -1,4 +1,4 @@
-"""CLI commands for the 3D-to-2D porosity conversions.
+"""``poro2d convert``: the 3D-to-2D porosity conversions of the paper (Eqs. 1-12).
 
 ``poro2d convert NLAB... [--n-max X --n-min Y] [--dry-density RHO_D --solid-density RHO_S]
 [--nu-reading printed|solid_fraction] [--lattice-exact] [--format table|json|csv]``
@@ -8,8 +8,6 @@
 geotechnical terms (:mod:`poro2d.lab_state`), selected by any of ``--e``, ``--dr``,
 ``--e-max``, ``--e-min``. The state must lie within the extremes; the command prints the state
 it understood (e, n, D_r) before each table, and its json and csv carry e and D_r.
-
-``poro2d plot relations [--n-max X --n-min Y] [-o DIR]``
 
 Output formats of ``convert``:
 
@@ -34,7 +32,6 @@ import enum
 import io
 import json
 import re
-from pathlib import Path
 from typing import Annotated
 
 import click
@@ -466,62 +463,13 @@ def _write_conversions(
             _print_table(c, extra, s)
 
 
-def plot_relations(
-    ctx: typer.Context,
-    n_max: Annotated[float, typer.Option("--n-max", help="Laboratory maximum porosity.")] = P.PAPER_N_MAX,
-    n_min: Annotated[float, typer.Option("--n-min", help="Laboratory minimum porosity.")] = P.PAPER_N_MIN,
-    out_dir: Annotated[
-        Path, typer.Option("-o", "--out-dir", help="Output directory (created if missing).")
-    ] = Path("."),
-    mark_n_lab: Annotated[
-        float | None,
-        typer.Option("--mark-n-lab", help="Mark one laboratory porosity on both figures (e.g. 0.3434)."),
-    ] = None,
-    nu_reading: Annotated[
-        NuReading,
-        typer.Option("--nu-reading", help="Reading of nu in Eq. 2 for the main Eq. 2 curve."),
-    ] = NuReading.printed,
-    lattice_exact: Annotated[
-        bool, typer.Option("--lattice-exact", help="Exact lattice 2D extremes in Eqs. 7-11.")
-    ] = False,
-) -> None:
-    """Write the paper's Fig. 1 and Fig. 2 (PNG and SVG) into DIR."""
-    if ctx.args:
-        raise InputError(
-            "option",
-            ctx.args[0],
-            "--n-max, --n-min, -o/--out-dir, --mark-n-lab, --nu-reading, --lattice-exact",
-        )
-    check_range("--n-max", n_max, 0.0, 1.0, hi_open=True)
-    check_range("--n-min", n_min, 0.0, 1.0, hi_open=True)
-    if not n_max > n_min:
-        raise InputError("--n-max", n_max, f"greater than --n-min = {n_min}")
-    if mark_n_lab is not None:
-        check_range("--mark-n-lab", mark_n_lab, 0.0, 0.5)
-    from poro2d.figures.relations import write_relation_figures
-    from poro2d.io_utils import check_output_dir
-
-    check_output_dir("--out-dir", out_dir)
-
-    paths = write_relation_figures(
-        out_dir,
-        n_max,
-        n_min,
-        nu_reading=nu_reading.value,
-        lattice_exact=lattice_exact,
-        mark_n_lab=mark_n_lab,
-    )
-    for p in paths:
-        typer.echo(str(p))
-
-
 try:  # recent typer ships its own copy of click; its errors are not click's
     from typer._click.exceptions import ClickException as _TyperClickException
 except ImportError:  # pragma: no cover - typer using the click package directly
     _TyperClickException = None
 
 
-class _Command(TyperCommand):
+class OneLineUsageCommand(TyperCommand):
     """Turn usage errors of typer's bundled click into ``click.UsageError``.
 
     The root ``main()`` prints ``click`` exceptions as one line with their exit code (2);
@@ -543,22 +491,9 @@ class _Command(TyperCommand):
 
 
 def register(app: typer.Typer) -> None:
-    """Attach ``convert`` and ``plot relations`` to the root app."""
+    """Attach ``convert`` to the root app."""
     app.command(
         "convert",
-        cls=_Command,
+        cls=OneLineUsageCommand,
         context_settings={"ignore_unknown_options": True},
     )(convert)
-    plot_app = None
-    for group in app.registered_groups:
-        if group.name == "plot" and group.typer_instance is not None:
-            plot_app = group.typer_instance
-            break
-    if plot_app is None:
-        plot_app = typer.Typer(help="Figures.", no_args_is_help=True)
-        app.add_typer(plot_app, name="plot")
-    plot_app.command(
-        "relations",
-        cls=_Command,
-        context_settings={"ignore_unknown_options": True, "allow_extra_args": True},
-    )(plot_relations)

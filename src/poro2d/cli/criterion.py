@@ -1,8 +1,8 @@
 """``poro2d criterion``: the paper's Fig. 3 from a config file or the paper preset, in either mode.
 
-The command sits on the sweep layer because its density mode runs there
-(:mod:`poro2d.sweep.density_criterion`); paper mode's table is the criterion layer's
-(:func:`poro2d.criterion.cli.print_result`).
+Both modes run through :func:`poro2d.sweep.density_criterion.run_criterion_modes`; paper
+mode's table is the criterion layer's (:func:`poro2d.criterion.table.print_result`), which
+``poro2d paper`` prints too.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from pathlib import Path
 import typer
 
 from poro2d.console import OutputConsole, Table
-from poro2d.criterion.cli import print_result
+from poro2d.criterion.table import print_result
 from poro2d.sweep.results import DensityStateResult
 
 console = OutputConsole()

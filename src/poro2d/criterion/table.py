@@ -1,7 +1,7 @@
 """The criterion's answer as a table: the trials of Fig. 3 (``poro2d criterion``, ``poro2d paper``).
 
-The command itself (its two modes) is :mod:`poro2d.sweep.criterion_cli`: density mode runs on
-the sweep layer.
+It lives on the criterion's floor because :func:`poro2d.paper.run_paper` prints it too; the
+command itself (its two modes) is :mod:`poro2d.cli.criterion`.
 """
 
 from __future__ import annotations

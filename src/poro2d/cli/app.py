@@ -1,7 +1,7 @@
-"""The ``poro2d`` command line.
+"""The ``poro2d`` app: every command registered, and :func:`main`, the console entry point.
 
-Each capability registers its commands here; the command bodies live next to the
-code they drive (``poro2d.porosity_cli``, ...). Bad input anywhere below raises
+The commands are the modules beside this one (``poro2d.cli.convert``, ...); each drives
+the Python function of its layer. Bad input anywhere below raises
 :class:`poro2d.errors.InputError`, which :func:`main` prints as one line with
 exit code 2 and no traceback.
 """
@@ -50,25 +50,35 @@ def _root(
 def _register() -> None:
     # Imported here so that `poro2d --help` stays cheap and a broken optional
     # layer cannot take the whole CLI down at import time.
-    from poro2d import paper, porosity_cli
-    from poro2d.calibration import cli as calibration_cli
-    from poro2d.interop import cli as interop_cli
-    from poro2d.sand import cli as sand_cli
-    from poro2d.shear import cli as shear_cli
-    from poro2d.shear import strength_cli
-    from poro2d.sweep import cli as sweep_cli
-    from poro2d.sweep import criterion_cli, sensitivity_cli
+    from poro2d.cli import (
+        calibrate,
+        convert,
+        criterion,
+        export,
+        import_specimen,
+        paper,
+        plot,
+        relation,
+        sand,
+        sensitivity,
+        shear,
+        strength,
+        sweep,
+    )
 
-    porosity_cli.register(app)
-    criterion_cli.register(app)
-    shear_cli.register(app)
-    strength_cli.register(app)
+    convert.register(app)
+    plot.register(app)
+    criterion.register(app)
+    shear.register(app)
+    strength.register(app)
     paper.register(app)
-    sweep_cli.register(app)
-    interop_cli.register(app)
-    sensitivity_cli.register(app)
-    calibration_cli.register(app)
-    sand_cli.register(app)
+    sweep.register(app)
+    relation.register(app)
+    export.register(app)
+    import_specimen.register(app)
+    sensitivity.register(app)
+    calibrate.register(app)
+    sand.register(app)
     for info in app.registered_commands:
         info.callback = _interruptible(info.name or info.callback.__name__, info.callback)
 

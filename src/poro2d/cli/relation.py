@@ -1,4 +1,4 @@
-"""``poro2d sweep`` and ``poro2d relation``."""
+"""``poro2d relation``: the grading's n2D(nLab) relation from the criterion at several densities."""
 
 from __future__ import annotations
 
@@ -8,43 +8,10 @@ from pathlib import Path
 import typer
 from rich.markup import escape
 
+from poro2d.cli.dask_options import DASHBOARD_HELP, SCHEDULER_HELP, WORKERS_HELP
 from poro2d.console import OutputConsole, Table
 
 console = OutputConsole()
-
-_SCHED = "Address of a running Dask scheduler (e.g. tcp://host:8786); default: a LocalCluster."
-_WORKERS = "Worker processes of the LocalCluster (default: one per core, one thread each)."
-_DASHBOARD = "LocalCluster dashboard: HOST:PORT or none (default 127.0.0.1:0, this machine only)."
-
-
-def sweep_cmd(
-    config: Path = typer.Argument(..., help="TOML config: base case tables and a \\[sweep] table."),
-    out: Path = typer.Option(
-        Path("sweep-out"), "--out", "-o", help="Output folder (reruns skip done cases)."
-    ),
-    scheduler: str = typer.Option(None, "--scheduler", help=_SCHED),
-    workers: int = typer.Option(None, "--workers", help=_WORKERS),
-    dashboard: str = typer.Option(None, "--dashboard", help=_DASHBOARD),
-    quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
-) -> None:
-    """Run a grid or list of cases as Dask tasks; one table of results."""
-    from poro2d.config import load_toml
-    from poro2d.io_utils import check_output_dir
-    from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.runner import check_cluster_options, check_dashboard, check_reachable, run_sweep
-
-    check_cluster_options(scheduler, workers)
-    dashboard_address = check_dashboard(dashboard)
-    check_output_dir("--out", out)
-    cfg = load_toml(config)
-    sweep = parse_sweep(cfg, Path(config).resolve().parent)
-    check_reachable(scheduler)  # before the first line: an unreachable scheduler is the only one
-    console.print(f"{len(sweep.cases)} case(s) of kind {sweep.kind!r} -> {out}")
-    res = run_sweep(sweep, out, scheduler=scheduler, workers=workers, progress=not quiet,
-                    dashboard=dashboard_address)  # fmt: skip
-    print_summary(res, out)
-    if res.failed:
-        raise typer.Exit(1)
 
 
 def relation_cmd(
@@ -58,14 +25,14 @@ def relation_cmd(
     n_max: float = typer.Option(None, "--n-max", help="Loosest laboratory porosity (paper: 0.4571)."),
     n_min: float = typer.Option(None, "--n-min", help="Densest laboratory porosity (paper: 0.3253)."),
     out: Path = typer.Option(Path("relation-out"), "--out", "-o", help="Output folder (resumable)."),
-    scheduler: str = typer.Option(None, "--scheduler", help=_SCHED),
-    workers: int = typer.Option(None, "--workers", help=_WORKERS),
+    scheduler: str = typer.Option(None, "--scheduler", help=SCHEDULER_HELP),
+    workers: int = typer.Option(None, "--workers", help=WORKERS_HELP),
     quick: bool = typer.Option(False, "--quick", help="Small specimen (0.08 m x 0.04 m, 2 layers)."),
     mode: str = typer.Option(
         None, "--mode", help="density (default): preparation friction from the state; paper: fixed 0.05."
     ),
     seeds: int = typer.Option(None, "--seeds", help="Specimens per state and per calibration point (3)."),
-    dashboard: str = typer.Option(None, "--dashboard", help=_DASHBOARD),
+    dashboard: str = typer.Option(None, "--dashboard", help=DASHBOARD_HELP),
     quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
 ) -> None:
     """The grading's n2D(nLab) relation from the criterion at several relative densities.
@@ -91,37 +58,7 @@ def relation_cmd(
 
 
 def register(app: typer.Typer) -> None:
-    app.command("sweep")(sweep_cmd)
     app.command("relation")(relation_cmd)
-
-
-def print_summary(res, out: Path) -> None:
-    s = res.summary
-    t = Table(
-        title=f"sweep: {s['cases']} case(s), {s['ran']} run, {s['reused']} already done, {s['failed']} failed"
-    )
-    t.add_column("case")
-    t.add_column("status")
-    t.add_column("time s", justify="right")
-    t.add_column("result / error")
-    for r in res.rows:
-        rs = r.get("results", {}) or {}
-        if r["status"] == "failed":
-            txt = f"[red]{escape(str(r.get('error')))}[/]"
-        elif "final_porosity" in rs:
-            fp = rs.get("final_porosity")
-            txt = f"n2D = {fp:.4f}" if fp is not None else f"not converged ({escape(str(rs.get('message')))})"
-        else:
-            txt = escape(", ".join(f"{k}={v}" for k, v in list(rs.items())[:4]))
-        ts = r.get("time_s")
-        t.add_row(r["case_id"], "reused" if r.get("reused") else r["status"], f"{ts:.1f}" if ts else "", txt)
-    console.print(t)
-    eff = s.get("parallel_efficiency")
-    console.print(
-        f"wall {s['wall_time_s']:.1f} s, case time {s['case_time_sum_s']:.1f} s"
-        + (f", parallel efficiency {eff:.0%}" if eff else "")
-        + f"; table in {out}/results.csv"
-    )
 
 
 def _print_interior_spread(sp: dict) -> None:

@@ -1,4 +1,4 @@
-"""``poro2d export`` (a specimen for LAMMPS, YADE, PFC2D or a CSV table) and ``poro2d import``."""
+"""``poro2d import``: a specimen from another DEM code, checked by the criterion as it stands."""
 
 from __future__ import annotations
 
@@ -10,94 +10,6 @@ from poro2d.console import OutputConsole, Table
 from poro2d.locks import holds_output
 
 console = OutputConsole()
-
-TARGETS = ("lammps", "yade", "pfc", "csv")
-
-
-@holds_output("out")
-def export_cmd(
-    specimen: str = typer.Argument(
-        ...,
-        help="Specimen checkpoint (.npz), a folder holding specimen.npz, or a relation, density-mode "
-        "criterion or sand folder (with --n-lab or --dr).",
-    ),
-    to: str = typer.Option(..., "--to", help="Target: lammps, yade, pfc or csv."),
-    out: Path = typer.Option(..., "--out", "-o", help="Output folder."),
-    ratio: float = typer.Option(
-        1e-3,
-        "--ratio",
-        help="Stop ratio written into the LAMMPS and YADE scripts (max unbalanced force).",
-    ),
-    n_lab: float = typer.Option(
-        None, "--n-lab", help="The state by its laboratory porosity (a folder of states)."
-    ),
-    dr: float = typer.Option(None, "--dr", help="The state by its relative density (a folder of states)."),
-    seed: int = typer.Option(None, "--seed", help="The state's specimen by its seed (default 0)."),
-) -> None:
-    """Write an accepted specimen for another DEM code (disks, walls, contact properties)."""
-    from poro2d.errors import InputError, check_range
-    from poro2d.interop import csv_table, lammps, pfc, yade
-
-    if to not in TARGETS:
-        raise InputError("--to", to, "one of " + ", ".join(TARGETS))
-    check_range("--ratio", ratio, 0.0, 1.0, lo_open=True)
-    spec, state = export_specimen(specimen, out, n_lab=n_lab, dr=dr, seed=seed)
-    writers = {
-        "lammps": lambda: lammps.write_specimen(spec, out, ratio=ratio),
-        "yade": lambda: yade.write_specimen(spec, out, ratio=ratio),
-        "pfc": lambda: pfc.write_specimen(spec, out),
-        "csv": lambda: csv_table.write_specimen(spec, out),
-    }
-    paths = writers[to]()
-    t = Table(title=f"export --to {to}")
-    t.add_column("file")
-    t.add_column("bytes", justify="right")
-    for p in paths:
-        t.add_row(str(p), f"{p.stat().st_size:,}")
-    console.print(t)
-    if state is not None:
-        dr_text = "unknown" if state.relative_density is None else f"{state.relative_density:.4f}"
-        console.print(
-            f"state n_lab = {state.n_lab:g} (Dr = {dr_text}), seed {state.seed} of {state.record}: "
-            f"{state.folder}"
-        )
-    console.print(
-        f"{spec.n} disks, {len(spec.walls)} walls; thickness t = {spec.thickness:g} m "
-        "(disk masses rho pi r^2 t); SI units; see docs/export.md"
-    )
-
-
-def export_specimen(specimen, out: Path, *, n_lab=None, dr=None, seed=None):
-    """(specimen, state) of ``export``: the specimen with its provenance lines, and the
-    :class:`~poro2d.interop.state_specimen.StateSpecimen` it was found by (None for a checkpoint
-    or criterion folder given as such).
-
-    A specimen the criterion did not accept is refused; so are the options of a folder of
-    states given with anything else (rather than ignored).
-    """
-    from poro2d.errors import InputError
-    from poro2d.interop.origin import origin_lines
-    from poro2d.interop.specimen_data import check_accepted, from_checkpoint, resolve_specimen
-    from poro2d.interop.state_specimen import STATE_RECORDS, state_record, state_specimen
-    from poro2d.io_utils import check_output_dir
-
-    has_specimen = Path(specimen).is_file() or (Path(specimen) / "specimen.npz").is_file()
-    record = None if has_specimen else state_record(specimen)
-    if record is None:
-        for option, value in (("--n-lab", n_lab), ("--dr", dr), ("--seed", seed)):
-            if value is not None:
-                what = "is a specimen" if has_specimen else "holds neither a specimen nor a record of states"
-                allowed = "only with a folder of states (" + ", ".join(STATE_RECORDS) + ")"
-                raise InputError(option, value, allowed, f"{specimen} {what}")
-        check_output_dir("--out", out)
-        check_accepted(specimen)
-        return from_checkpoint(specimen), None
-    state = state_specimen(specimen, n_lab=n_lab, dr=dr, seed=0 if seed is None else seed)
-    check_output_dir("--out", out)
-    check_accepted(state.folder)
-    spec = from_checkpoint(state.folder)
-    spec.origin = origin_lines(resolve_specimen(state.folder), state.as_dict())
-    return spec, state
 
 
 #: import options that give what a file does not say: (option as typed, key of the defaults, limit)
@@ -203,7 +115,6 @@ def _refuse_options_the_file_overrides(spec, options: dict) -> None:
 
 
 def register(app: typer.Typer) -> None:
-    app.command("export")(export_cmd)
     app.command("import")(import_cmd)
 
 

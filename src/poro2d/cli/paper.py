@@ -1,0 +1,33 @@
+"""``poro2d paper``: the paper's case study in one resumable command (:func:`poro2d.paper.run_paper`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from poro2d.paper import run_paper
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("paper")
+    def paper_cmd(
+        out: Path = typer.Option(Path("paper-out"), "--out", "-o", help="Output folder (resumable)."),
+        quick: bool = typer.Option(
+            False, "--quick", help="Reduced specimen for a first look (about a minute)."
+        ),
+        lab: Path = typer.Option(None, "--lab", help="Laboratory direct shear CSV to overlay (Fig. 8)."),
+        seed: int = typer.Option(0, "--seed", help="Random seed of the first specimen."),
+        replicates: int = typer.Option(
+            3, "--replicates", help="Specimens (seeds) for the direct shear tests; 1 for one specimen."
+        ),
+        threads: int = typer.Option(
+            None, "--threads", help="Threads for the DEM kernels (default: all cores)."
+        ),
+        quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+    ) -> None:
+        """Run the paper's case study: conversions, criterion (Fig. 3), direct shear (Fig. 8), report."""
+        summary = run_paper(out, quick=quick, lab=lab, seed=seed, threads=threads, replicates=replicates,
+                            progress=not quiet)  # fmt: skip
+        if not summary.criterion["converged"]:
+            raise typer.Exit(1)

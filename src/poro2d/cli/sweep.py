@@ -1,0 +1,76 @@
+"""``poro2d sweep``: a grid or list of cases as Dask tasks, one table of results."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+from rich.markup import escape
+
+from poro2d.cli.dask_options import DASHBOARD_HELP, SCHEDULER_HELP, WORKERS_HELP
+from poro2d.console import OutputConsole, Table
+
+console = OutputConsole()
+
+
+def sweep_cmd(
+    config: Path = typer.Argument(..., help="TOML config: base case tables and a \\[sweep] table."),
+    out: Path = typer.Option(
+        Path("sweep-out"), "--out", "-o", help="Output folder (reruns skip done cases)."
+    ),
+    scheduler: str = typer.Option(None, "--scheduler", help=SCHEDULER_HELP),
+    workers: int = typer.Option(None, "--workers", help=WORKERS_HELP),
+    dashboard: str = typer.Option(None, "--dashboard", help=DASHBOARD_HELP),
+    quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
+) -> None:
+    """Run a grid or list of cases as Dask tasks; one table of results."""
+    from poro2d.config import load_toml
+    from poro2d.io_utils import check_output_dir
+    from poro2d.sweep.cases import parse_sweep
+    from poro2d.sweep.runner import check_cluster_options, check_dashboard, check_reachable, run_sweep
+
+    check_cluster_options(scheduler, workers)
+    dashboard_address = check_dashboard(dashboard)
+    check_output_dir("--out", out)
+    cfg = load_toml(config)
+    sweep = parse_sweep(cfg, Path(config).resolve().parent)
+    check_reachable(scheduler)  # before the first line: an unreachable scheduler is the only one
+    console.print(f"{len(sweep.cases)} case(s) of kind {sweep.kind!r} -> {out}")
+    res = run_sweep(sweep, out, scheduler=scheduler, workers=workers, progress=not quiet,
+                    dashboard=dashboard_address)  # fmt: skip
+    print_summary(res, out)
+    if res.failed:
+        raise typer.Exit(1)
+
+
+def register(app: typer.Typer) -> None:
+    app.command("sweep")(sweep_cmd)
+
+
+def print_summary(res, out: Path) -> None:
+    s = res.summary
+    t = Table(
+        title=f"sweep: {s['cases']} case(s), {s['ran']} run, {s['reused']} already done, {s['failed']} failed"
+    )
+    t.add_column("case")
+    t.add_column("status")
+    t.add_column("time s", justify="right")
+    t.add_column("result / error")
+    for r in res.rows:
+        rs = r.get("results", {}) or {}
+        if r["status"] == "failed":
+            txt = f"[red]{escape(str(r.get('error')))}[/]"
+        elif "final_porosity" in rs:
+            fp = rs.get("final_porosity")
+            txt = f"n2D = {fp:.4f}" if fp is not None else f"not converged ({escape(str(rs.get('message')))})"
+        else:
+            txt = escape(", ".join(f"{k}={v}" for k, v in list(rs.items())[:4]))
+        ts = r.get("time_s")
+        t.add_row(r["case_id"], "reused" if r.get("reused") else r["status"], f"{ts:.1f}" if ts else "", txt)
+    console.print(t)
+    eff = s.get("parallel_efficiency")
+    console.print(
+        f"wall {s['wall_time_s']:.1f} s, case time {s['case_time_sum_s']:.1f} s"
+        + (f", parallel efficiency {eff:.0%}" if eff else "")
+        + f"; table in {out}/results.csv"
+    )
