@@ -18,7 +18,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import FuncFormatter  # noqa: E402
 
-from poro2d.report.shear_figures import save_figure  # noqa: E402
+from poro2d.report.figure_file import save_figure  # noqa: E402
 from poro2d.specimen.grading import GradingCurve  # noqa: E402
 
 
@@ -78,6 +78,7 @@ def grading_figure(
     ax.xaxis.set_minor_formatter(plain)
     ax.legend(loc="upper left", fontsize=8)
     ax.set_title(f"{title}: Cu = {used.uniformity:.2f}, d_max/d_min = {used.d_max_m / used.d_min_m:.0f}")
+    fig.tight_layout()
     return save_figure(fig, path)
 
 
