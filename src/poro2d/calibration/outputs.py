@@ -26,8 +26,9 @@ def write_outputs(out: Path, result, post, surrogates, lab, found, digests, base
     write_json(out / "result.json", result)
 
 
-def _best_curves(result, lab, found, digests, base, out: Path) -> dict[float, list]:
-    """The curves of the design point nearest the best parameters, per normal stress (all specimens)."""
+def _best_curves(result, lab, found, digests, base, out: Path) -> tuple[dict[float, list], dict]:
+    """The curves of the design point nearest the best parameters, per normal stress (all
+    specimens), and that design point: what the fit figure draws."""
     from poro2d.calibration.units import unit_curve, unit_job
 
     best = result.best
