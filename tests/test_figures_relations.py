@@ -6,7 +6,7 @@ import pytest
 
 from poro2d import porosity as P
 from poro2d.cli import main
-from poro2d.figures.relations import fig1_relations, fig2_lim_parabola, write_relation_figures
+from poro2d.report.conversion_figures import fig1_relations, fig2_lim_parabola, write_relation_figures
 
 NAMES = ["fig1_relations", "fig2_lim_parabola"]
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"

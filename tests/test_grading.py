@@ -10,12 +10,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from poro2d.errors import InputError
+from poro2d.report.grading_figure import plot_realised
 from poro2d.specimen.grading import (
     GradingCurve,
     draw_disks,
     max_deviation,
     paper_grading,
-    plot_realised,
     realised_curve,
 )
 

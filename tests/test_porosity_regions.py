@@ -9,6 +9,7 @@ import pytest
 from scipy.spatial import Voronoi
 
 from poro2d.errors import InputError
+from poro2d.report.specimen_figures import plot_local_porosity
 from poro2d.specimen import porosity_regions as pr
 from poro2d.specimen.porosity_regions import (
     SpecimenPorosity,
@@ -17,7 +18,6 @@ from poro2d.specimen.porosity_regions import (
     mass_d50,
     measure_specimen,
     plate_surface,
-    plot_local_porosity,
     surface_profile,
 )
 

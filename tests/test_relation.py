@@ -10,6 +10,7 @@ import pytest
 from poro2d import porosity as P
 from poro2d.cli import main
 from poro2d.errors import InputError
+from poro2d.report.relation_figure import plot_relation
 from poro2d.sweep import relation as R
 
 
@@ -112,7 +113,7 @@ def test_no_fit_with_one_converged_point():
     rel = R.analyse(rows, P.PAPER_N_MAX, P.PAPER_N_MIN)
     assert rel["fit"] is None and "no fit" in rel["fit_note"]
     assert all(p["n2d_fit"] is None for p in rel["points"])
-    R.plot_relation(rel)  # draws without a fitted curve
+    plot_relation(rel)  # draws without a fitted curve
 
 
 def test_relation_command_on_tiny_specimens(tmp_path):

@@ -48,3 +48,26 @@ def test_write_report_writes_both(tmp_path):
     files = write_report([("h1", "x")], tmp_path, "report", "T")
     assert [f.name for f in files] == ["report.md", "report.html"]
     assert all(f.stat().st_size > 0 for f in files)
+
+
+def test_save_figure_writes_each_format_atomically_and_closes(tmp_path):
+    from poro2d.report.figure_file import save_figure
+
+    fig, ax = plt.subplots(figsize=(2, 1))
+    ax.plot([0, 1], [0, 1])
+    png, svg = tmp_path / "sub" / "f.png", tmp_path / "sub" / "f.svg"
+    assert save_figure(fig, png, svg) == png
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and "<svg" in svg.read_text()
+    assert sorted(p.name for p in png.parent.iterdir()) == ["f.png", "f.svg"]  # no temporaries left
+    assert not plt.fignum_exists(fig.number)
+
+
+def test_figures_are_drawn_and_saved_only_in_report():
+    """Every figure is drawn in report/ and written by report/figure_file.py (one dpi, atomic)."""
+    from pathlib import Path
+
+    package = Path(__file__).resolve().parents[1] / "src" / "poro2d"
+    drawing = [p for p in package.rglob("*.py") if "matplotlib" in p.read_text()]
+    assert drawing and all(p.parent.name == "report" for p in drawing), drawing
+    saving = [p.name for p in package.rglob("*.py") if ".savefig(" in p.read_text()]
+    assert saving == ["figure_file.py"]

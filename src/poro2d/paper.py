@@ -86,8 +86,8 @@ def conversion_files(out: Path) -> dict:
 
     The summary is the stage's ``conversions.json``, written after the files by the stage.
     """
-    from poro2d.figures.relations import write_relation_figures
     from poro2d.porosity import convert_all
+    from poro2d.report.conversion_figures import write_relation_figures
 
     out.mkdir(parents=True, exist_ok=True)
     res = convert_all(PAPER["n_lab"], n_max=PAPER["n_max"], n_min=PAPER["n_min"])

@@ -44,8 +44,8 @@ def plot_relations(
         raise InputError("--n-max", n_max, f"greater than --n-min = {n_min}")
     if mark_n_lab is not None:
         check_range("--mark-n-lab", mark_n_lab, 0.0, 0.5)
-    from poro2d.figures.relations import write_relation_figures
     from poro2d.io_utils import check_output_dir
+    from poro2d.report.conversion_figures import write_relation_figures
 
     check_output_dir("--out-dir", out_dir)
 

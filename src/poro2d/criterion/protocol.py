@@ -825,7 +825,8 @@ class PorosityCriterion:
 
     def _specimen_state(self, sim: Simulation, n2d: float) -> None:
         """Homogeneity and stress state of the accepted specimen: specimen_state.json and .png."""
-        from poro2d.specimen.state import plot_specimen_state, specimen_state
+        from poro2d.report.specimen_figures import plot_specimen_state
+        from poro2d.specimen.state import specimen_state
 
         assert self.out is not None
         lid = self._lid(sim)
@@ -839,7 +840,8 @@ class PorosityCriterion:
 
     def _specimen_porosity(self, sim: Simulation, n2d: float, top: float) -> None:
         """The accepted specimen's porosities: specimen_porosity.json and the local porosity map."""
-        from poro2d.specimen.porosity_regions import measure_specimen, plot_local_porosity
+        from poro2d.report.specimen_figures import plot_local_porosity
+        from poro2d.specimen.porosity_regions import measure_specimen
 
         assert self.out is not None
         p = sim.particles

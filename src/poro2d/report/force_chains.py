@@ -22,7 +22,7 @@ from matplotlib.patches import Circle  # noqa: E402
 
 from poro2d.dem.measure import ContactSet  # noqa: E402
 from poro2d.errors import InputError, check_range  # noqa: E402
-from poro2d.io_utils import atomic_path  # noqa: E402
+from poro2d.report.figure_file import save_figure  # noqa: E402
 
 FORCE_COLOR = "#b2182b"
 WALL_COLOR = "#333333"
@@ -139,11 +139,7 @@ def plot_force_chains(
     _legend(ax, ref, max_width, unit)
     ax.set_title(title + ("\n" + "; ".join(notes) if notes else ""), fontsize=10)
     fig.tight_layout()
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=150, format=path.suffix.lstrip(".") or "png")
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def wall_segments(walls) -> np.ndarray:

@@ -1,9 +1,12 @@
 """The grading a run used: the laboratory curve, its cuts, and the disks that were drawn.
 
-One panel, laboratory sizes on a log axis: the sieve curve as given (by mass), the curve
-after the ``d_min_mm`` / ``d_max_mm`` cuts (renormalised: the soil the specimen is made of),
-the cuts as vertical lines, and the drawn disks of one specimen (percent passing by area,
-the 2D counterpart of mass).
+:func:`grading_figure`: one panel, laboratory sizes on a log axis: the sieve curve as given
+(by mass), the curve after the ``d_min_mm`` / ``d_max_mm`` cuts (renormalised: the soil the
+specimen is made of), the cuts as vertical lines, and the drawn disks of one specimen
+(percent passing by area, the 2D counterpart of mass).
+
+:func:`plot_realised`: a curve against the disks drawn from it, at the curve's own sieve
+sizes in the model (the check of :func:`poro2d.specimen.grading.realised_curve`).
 """
 
 from __future__ import annotations
@@ -16,10 +19,12 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.ticker import FuncFormatter  # noqa: E402
 
-from poro2d.report.shear_figures import save_figure  # noqa: E402
-from poro2d.specimen.grading import GradingCurve  # noqa: E402
+from poro2d.report.figure_file import DPI, save_figure  # noqa: E402
+from poro2d.specimen.grading import GradingCurve, realised_curve  # noqa: E402
 
 
 def uncut_curve(table: dict, base_dir: str | os.PathLike | None, used: GradingCurve) -> GradingCurve:
@@ -78,7 +83,39 @@ def grading_figure(
     ax.xaxis.set_minor_formatter(plain)
     ax.legend(loc="upper left", fontsize=8)
     ax.set_title(f"{title}: Cu = {used.uniformity:.2f}, d_max/d_min = {used.d_max_m / used.d_min_m:.0f}")
+    fig.tight_layout()
     return save_figure(fig, path)
 
 
-__all__ = ["drawn_curve", "grading_figure", "uncut_curve"]
+def plot_realised(curve: GradingCurve, radii, path: str | os.PathLike, *, title: str | None = None) -> Path:
+    """Write the requested and realised curves (log diameter axis) to ``path``; returns the path."""
+    realised = realised_curve(curve, radii)  # checks the radii
+    r = np.asarray(radii, dtype=float)
+    dev = float(np.max(np.abs(realised - curve.percent)))
+    d_mm = curve.sizes * 1e3
+
+    fig = Figure(figsize=(6.4, 4.2), dpi=DPI)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot(1, 1, 1)
+    ax.semilogx(d_mm, curve.percent, "-o", color="k", ms=4, label="requested (by mass)")
+    ax.semilogx(d_mm, realised, "s", color="tab:red", mfc="none", ms=7, label="realised (by area)")
+    ax.set_xlabel("diameter in the model d [mm]")
+    ax.set_ylabel("percent passing [%]")
+    ax.set_ylim(0, 100)
+    ax.set_xticks(d_mm, [f"{v:.3g}" for v in d_mm])
+    ax.set_xticks([], minor=True)
+    ax.grid(True, alpha=0.3)
+    if curve.upscale != 1.0:
+        up = curve.upscale
+        top = ax.secondary_xaxis("top", functions=(lambda x: x / up, lambda x: x * up))
+        top.set_xticks(d_mm / up, [f"{v:.3g}" for v in d_mm / up])
+        top.set_xticks([], minor=True)
+        top.set_xlabel(f"laboratory size [mm] (up-scaling factor {up:g})")
+    ax.legend(loc="upper left", title=f"{r.size} disks, max deviation {dev:.2f} %-points")
+    if title:
+        ax.set_title(title)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+__all__ = ["drawn_curve", "grading_figure", "plot_realised", "uncut_curve"]

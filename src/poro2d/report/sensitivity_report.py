@@ -23,7 +23,7 @@ def plot_sensitivity(sens: dict, stem: Path) -> list[Path]:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from poro2d.io_utils import atomic_path
+    from poro2d.report.figure_file import save_figure
 
     paper = sens["paper"]
     target, tol = float(paper["accepted_porosity"]), float(sens["answer"]["tolerance"])
@@ -43,12 +43,8 @@ def plot_sensitivity(sens: dict, stem: Path) -> list[Path]:
         + ("; quick box" if s.get("quick") else ""),
         fontsize=11,
     )
-    paths = []
-    for ext in ("png", "svg"):
-        p = stem.with_suffix(f".{ext}")
-        with atomic_path(p) as tmp:
-            fig.savefig(tmp, dpi=150, format=ext)
-        paths.append(p)
+    paths = [stem.with_suffix(".png"), stem.with_suffix(".svg")]
+    save_figure(fig, *paths)
     return paths
 
 

@@ -18,20 +18,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from poro2d.io_utils import atomic_path  # noqa: E402
+from poro2d.report.figure_file import save_figure  # noqa: E402
 
 #: the colours of the normal stresses (or series), in turn
 COLORS = ["#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#666666"]
-
-
-def save_figure(fig, path: str | os.PathLike) -> Path:
-    """Write ``fig`` to ``path`` (the format its suffix names) atomically, and close it."""
-    path = Path(path)
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=150, format=path.suffix.lstrip(".") or "png")
-    plt.close(fig)
-    return path
 
 
 def plot_shear_curves(
@@ -84,6 +74,7 @@ def plot_shear_curves(
         axes[1, 0].axhline(0.0, color="k", lw=0.5)
     axes[-1, 0].set_xlabel("shear displacement (mm)")
     axes[-1, 0].set_xlim(left=0)
+    fig.tight_layout()
     return save_figure(fig, path)
 
 
@@ -133,6 +124,7 @@ def _finish_peaks(fig, ax, xs, smax: float, lab, lab_fit, title: str, path) -> P
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper left")
     ax.set_title(title, fontsize=10)
+    fig.tight_layout()
     return save_figure(fig, path)
 
 
@@ -169,6 +161,7 @@ def plot_replicate_curves(
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, ncol=2)
     ax.set_title(f"Direct shear over {n_specimens} specimens: mean and +- sd band", fontsize=10)
+    fig.tight_layout()
     return save_figure(fig, path)
 
 
@@ -204,5 +197,4 @@ __all__ = [
     "plot_replicate_curves",
     "plot_replicate_peaks",
     "plot_shear_curves",
-    "save_figure",
 ]

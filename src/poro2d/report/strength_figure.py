@@ -15,7 +15,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from poro2d.report.shear_figures import COLORS, save_figure  # noqa: E402
+from poro2d.report.figure_file import save_figure  # noqa: E402
+from poro2d.report.shear_figures import COLORS  # noqa: E402
 
 
 def _series(rows: list[dict], friction: float, key: str) -> tuple[list, list, list]:
@@ -51,6 +52,7 @@ def plot_strength(rows: list[dict], path: str | os.PathLike) -> Path:
     for ax in (ax_phi, ax_psi):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
+    fig.tight_layout()
     return save_figure(fig, path)
 
 

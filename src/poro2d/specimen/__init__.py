@@ -11,7 +11,6 @@ from poro2d.specimen.grading import (
     draw_disks,
     max_deviation,
     paper_grading,
-    plot_realised,
     realised_curve,
 )
 from poro2d.specimen.placement import Band, Placement, place_disks, solid_fraction
@@ -25,7 +24,6 @@ __all__ = [
     "max_deviation",
     "paper_grading",
     "place_disks",
-    "plot_realised",
     "realised_curve",
     "solid_fraction",
 ]

@@ -40,7 +40,6 @@ __all__ = [
     "draw_disks",
     "max_deviation",
     "paper_grading",
-    "plot_realised",
     "realised_curve",
 ]
 
@@ -617,40 +616,3 @@ def realised_curve(curve: GradingCurve, radii: Any) -> np.ndarray:
 def max_deviation(curve: GradingCurve, radii: Any) -> float:
     """Largest |realised - requested| percent passing over the sieve sizes [percentage points]."""
     return float(np.max(np.abs(realised_curve(curve, radii) - curve.percent)))
-
-
-def plot_realised(curve: GradingCurve, radii: Any, path: str | Path, *, title: str | None = None) -> Path:
-    """Write a PNG of the requested and realised curves (log diameter axis) and return its path."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    r = _radii_array(radii)
-    realised = realised_curve(curve, r)
-    dev = float(np.max(np.abs(realised - curve.percent)))
-    d_mm = curve.sizes * 1e3
-
-    fig = Figure(figsize=(6.4, 4.2), dpi=150)
-    FigureCanvasAgg(fig)
-    ax = fig.add_subplot(1, 1, 1)
-    ax.semilogx(d_mm, curve.percent, "-o", color="k", ms=4, label="requested (by mass)")
-    ax.semilogx(d_mm, realised, "s", color="tab:red", mfc="none", ms=7, label="realised (by area)")
-    ax.set_xlabel("diameter in the model d [mm]")
-    ax.set_ylabel("percent passing [%]")
-    ax.set_ylim(0, 100)
-    ax.set_xticks(d_mm, [f"{v:.3g}" for v in d_mm])
-    ax.set_xticks([], minor=True)
-    ax.grid(True, alpha=0.3)
-    if curve.upscale != 1.0:
-        up = curve.upscale
-        top = ax.secondary_xaxis("top", functions=(lambda x: x / up, lambda x: x * up))
-        top.set_xticks(d_mm / up, [f"{v:.3g}" for v in d_mm / up])
-        top.set_xticks([], minor=True)
-        top.set_xlabel(f"laboratory size [mm] (up-scaling factor {up:g})")
-    ax.legend(loc="upper left", title=f"{r.size} disks, max deviation {dev:.2f} %-points")
-    if title:
-        ax.set_title(title)
-    fig.tight_layout()
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, format="png")
-    return out

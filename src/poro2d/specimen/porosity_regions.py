@@ -16,8 +16,8 @@ neither reaches. This module gives:
 - the Laguerre (power, radical) tessellation of the disks in the box: one convex cell per
   disk, tiling the box exactly, giving a local porosity per disk and a third interior
   estimate;
-- :func:`measure_specimen`, all of it in one :class:`SpecimenPorosity`, and
-  :func:`plot_local_porosity`, its figure.
+- :func:`measure_specimen`, all of it in one :class:`SpecimenPorosity` (its figure is
+  :func:`poro2d.report.specimen_figures.plot_local_porosity`).
 
 Disks are clipped exactly at the edges of every region (no counting of centres), so a
 value does not depend on where centres happen to fall.
@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -45,8 +44,6 @@ MIN_CIRCLE_D50 = 1.5
 PROFILE_SAMPLES_PER_D50 = 16
 #: width of the running mean that takes the grain-scale valleys out of the surface, in d50
 SURFACE_SMOOTHING_D50 = 2.0
-#: the figure writes each circle's value when there are at most this many circles
-MAX_LABELLED_CIRCLES = 60
 #: a disk whose top is this close below the plate (in d50) touches it: floating-point rounding only
 TOUCH_TOL_D50 = 1e-9
 #: the Laguerre cells must tile the box to this relative precision, else the tessellation failed
@@ -719,144 +716,6 @@ def lid_height_at(edges: np.ndarray, heights: np.ndarray, x: np.ndarray) -> np.n
     return heights[k]
 
 
-# --------------------------------------------------------------------------- figure
-
-
-def plot_local_porosity(
-    pos: Any,
-    radius: Any,
-    width: Any,
-    plate_y: Any,
-    measures: SpecimenPorosity,
-    path: str | Path,
-    title: str | None = None,
-) -> Path:
-    """The Laguerre cells coloured by local porosity, with the measurement regions.
-
-    Drawn in mm: cells (colour range 0-0.5, values outside it clipped in the drawing only),
-    disk outlines, the free surface, the plate, the interior rectangle and its circles with
-    their porosity, and a box with the summary numbers. PNG (or the suffix's format), 150 dpi.
-    """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    from poro2d.io_utils import atomic_path
-
-    pos, radius = _check_disks(pos, radius)
-    width, plate_y = _check_box(pos, width, plate_y)
-    if measures.details is None:
-        raise InputError("measures", "a SpecimenPorosity without details", "the result of measure_specimen")
-    d = measures.details
-    map_h = 11.0 * plate_y / width
-    fig = Figure(figsize=(11.0, map_h + 1.9), layout="constrained")
-    FigureCanvasAgg(fig)
-    axes = fig.subplot_mosaic(
-        [["map", "map", "map"], ["legend", "bar", "text"]],
-        height_ratios=[map_h, 1.3],
-        width_ratios=[1.0, 1.0, 1.9],
-    )
-    ax = axes["map"]
-    cells = _draw_cells(ax, d.cells)
-    _draw_disks(ax, pos, radius)
-    handles = _draw_regions(ax, d, plate_y, width)
-    ax.set_xlim(0.0, width * 1e3)
-    ax.set_ylim(0.0, plate_y * 1e3 * 1.02)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x [mm]")
-    ax.set_ylabel("y [mm]")
-    ax.set_title(title or "local porosity (Laguerre cells) and interior measurement circles", fontsize=11)
-    axes["legend"].axis("off")
-    axes["legend"].legend(handles=handles, loc="center left", fontsize=8, frameon=False)
-    _draw_colorbar(fig, axes["bar"], cells)
-    axes["text"].axis("off")
-    axes["text"].text(0.0, 0.5, _summary_text(measures), ha="left", va="center", fontsize=8.5,
-                      family="monospace", transform=axes["text"].transAxes,
-                      bbox={"boxstyle": "round", "facecolor": "white", "edgecolor": "0.6"})  # fmt: skip
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=150, format=path.suffix.lstrip(".") or "png")
-    return path
-
-
-def _draw_cells(ax, cells: LaguerreCells):
-    from matplotlib.collections import PolyCollection
-
-    keep = cells.area > 0
-    polys = [p * 1e3 for p, k in zip(cells.polygons(), keep, strict=True) if k]
-    coll = PolyCollection(polys, cmap="viridis", edgecolors="face", linewidths=0.2)
-    coll.set_array(cells.local_porosity[keep])
-    coll.set_clim(0.0, 0.5)
-    ax.add_collection(coll)
-    return coll
-
-
-def _draw_disks(ax, pos: np.ndarray, radius: np.ndarray) -> None:
-    from matplotlib.collections import EllipseCollection
-
-    size = 2e3 * radius
-    ax.add_collection(EllipseCollection(
-        size, size, np.zeros_like(size), units="xy", offsets=pos * 1e3, offset_transform=ax.transData,
-        facecolors="none", edgecolors="black", linewidths=0.25, alpha=0.6,
-    ))  # fmt: skip
-
-
-def _draw_regions(ax, d: PorosityDetails, plate_y: float, width: float) -> list:
-    """Interior rectangle, circles (with their value, when few enough to read), free surface
-    and plate; returns the legend's handles."""
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Circle, Rectangle
-
-    x0, y0, x1, y1 = (v * 1e3 for v in d.interior.rect)
-    ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, edgecolor="white", lw=1.4, ls="--"))
-    R = d.interior.circle_radius_m * 1e3
-    labelled = d.interior.count <= MAX_LABELLED_CIRCLES
-    for (cx, cy), value in zip(d.interior.centres * 1e3, d.interior.porosity, strict=True):
-        ax.add_patch(Circle((cx, cy), R, fill=False, edgecolor="red", lw=1.3))
-        if labelled:
-            label_box = {"boxstyle": "round,pad=0.15", "facecolor": "white", "alpha": 0.8, "lw": 0}
-            ax.text(cx, cy, f"{value:.3f}", ha="center", va="center", fontsize=7.5, bbox=label_box)
-    ax.plot(d.surface_x * 1e3, d.surface_h * 1e3, color="darkorange", lw=0.9)
-    ax.plot([0.0, width * 1e3], [plate_y * 1e3] * 2, color="black", lw=2.5)
-    return [
-        Line2D([], [], color="black", lw=2.5, label="top plate"),
-        Line2D([], [], color="darkorange", lw=0.9, label="free surface h(x)"),
-        Line2D([], [], color="0.35", ls="--", lw=1.4, label="interior: margin from walls, surface"),
-        Line2D([], [], color="red", lw=1.3, label="measurement circles (porosity)"),
-    ]
-
-
-def _draw_colorbar(fig, cax, cells) -> None:
-    bar = fig.colorbar(cells, cax=cax, orientation="horizontal", extend="both")
-    bar.set_label("local porosity 1 - pi r^2 / cell area [-]", fontsize=9)
-    cax.set_box_aspect(0.08)
-
-
-def _summary_text(m: SpecimenPorosity) -> str:
-    """The numbers of the figure, label and value aligned in two columns."""
-    mm = 1e3
-    touching = f"{m.plate_touching_disks} disk{'s' if m.plate_touching_disks != 1 else ''}"
-    g, mn = m.surface_gap_mean_m * mm, m.surface_gap_mean_d50
-    rows = [
-        ("box porosity n' (W x H_plate)", f"{m.box_porosity:.4f}"),
-        (
-            f"interior, {m.interior_regions} circles",
-            f"{m.interior_porosity:.4f} +/- {m.interior_porosity_std:.4f}",
-        ),
-        (
-            "interior rectangle / Laguerre",
-            f"{m.interior_rect_porosity:.4f} / {m.laguerre_interior_porosity:.4f}",
-        ),
-        (
-            "margin, circle radius, d50",
-            f"{m.margin_d50:g} d50, {m.circle_radius_m * mm:.1f} mm, {m.d50_m * mm:.2f} mm",
-        ),
-        ("plate gap: mean, max", f"{g:.2f} mm ({mn:.2f} d50), {m.surface_gap_max_m * mm:.2f} mm"),
-        ("plate in contact", f"{100 * m.plate_contact_fraction:.1f} % of the width, {touching} touching"),
-    ]
-    width = max(len(label) for label, _ in rows)
-    return "\n".join(f"{label:<{width}}  {value}" for label, value in rows)
-
-
 __all__ = [
     "DEFAULT_CIRCLE_D50",
     "DEFAULT_MARGIN_D50",
@@ -874,7 +733,6 @@ __all__ = [
     "mass_d50",
     "measure_specimen",
     "plate_surface",
-    "plot_local_porosity",
     "surface_level",
     "surface_profile",
 ]

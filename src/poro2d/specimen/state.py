@@ -18,8 +18,6 @@ stress that does not grow with depth.
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
 from poro2d.dem.measure import average_stress, porosity_rect
@@ -77,44 +75,4 @@ def specimen_state(sim, width: float, top: float, bands: int = 8) -> dict:
     }
 
 
-def plot_specimen_state(state: dict, path: str | Path, title: str = "") -> Path:
-    """Porosity per band and sigma_v, sigma_h, geostatic sigma_v against height; K0 in the legend."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    from poro2d.io_utils import atomic_path
-
-    rows = state["bands"]
-    z = np.array([r["z_mid_m"] for r in rows]) * 1e3
-    fig = Figure(figsize=(9.0, 4.8), layout="constrained")
-    FigureCanvasAgg(fig)
-    a1, a2 = fig.subplots(1, 2, sharey=True)
-    a1.plot([r["porosity"] for r in rows], z, "o-", color="tab:blue")
-    a1.axvline(state["porosity_mean"], color="0.5", ls=":", lw=1)
-    a1.set_xlabel("porosity of the band [-]")
-    a1.set_ylabel("height of the band's middle [mm]")
-    a1.set_title(
-        f"porosity: mean {state['porosity_mean']:.4f}, range {state['porosity_range']:.4f}", fontsize=10
-    )
-    kpa = 1e-3
-    a2.plot([r["sigma_v_pa"] * kpa for r in rows], z, "o-", color="tab:red", label="sigma_v (disks)")
-    a2.plot([r["sigma_h_pa"] * kpa for r in rows], z, "s-", color="tab:green", label="sigma_h (disks)")
-    a2.plot([r["sigma_v_geostatic_pa"] * kpa for r in rows], z, "--", color="black",
-            label="geostatic: F_top / W + rho_s g (1 - n) (H - z)")  # fmt: skip
-    k0 = state.get("k0_mean")
-    a2.set_title(
-        f"stress; K0 = sigma_h / sigma_v: mean {k0:.3f}" if k0 is not None else "stress", fontsize=10
-    )
-    a2.set_xlabel("stress [kPa] (compression positive)")
-    a2.legend(fontsize=8, frameon=False, loc="upper right")
-    for a in (a1, a2):
-        a.grid(True, alpha=0.3)
-    if title:
-        fig.suptitle(title, fontsize=11)
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=130, format=path.suffix.lstrip(".") or "png")
-    return path
-
-
-__all__ = ["band_edges", "plot_specimen_state", "specimen_state"]
+__all__ = ["band_edges", "specimen_state"]

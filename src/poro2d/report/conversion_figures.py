@@ -14,6 +14,7 @@ from matplotlib.figure import Figure
 
 from poro2d import porosity as P
 from poro2d.errors import InputError, check_range
+from poro2d.report.figure_file import save_figure
 
 # name, function of n_lab, style
 _STYLE = {
@@ -277,7 +278,6 @@ def write_relation_figures(
     nu_reading: str = "printed",
     lattice_exact: bool = False,
     mark_n_lab: float | None = None,
-    dpi: int = 150,
 ) -> list[Path]:
     """Write fig1_relations.png/.svg and fig2_lim_parabola.png/.svg; return the paths."""
     out = Path(out_dir)
@@ -296,10 +296,7 @@ def write_relation_figures(
     out.mkdir(parents=True, exist_ok=True)
     written: list[Path] = []
     for stem, fig in figs.items():
-        for ext in ("png", "svg"):
-            path = out / f"{stem}.{ext}"
-            tmp = path.with_name(f".{path.name}.tmp")
-            fig.savefig(tmp, dpi=dpi, format=ext)
-            tmp.replace(path)
-            written.append(path)
+        png, svg = out / f"{stem}.png", out / f"{stem}.svg"
+        save_figure(fig, png, svg)
+        written += [png, svg]
     return written

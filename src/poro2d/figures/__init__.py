@@ -1,1 +1,0 @@
-"""Figures of poro2d (matplotlib, Agg backend, no pyplot state)."""

@@ -1,0 +1,120 @@
+"""The calibration's figures: the fit against the laboratory, and the posterior.
+
+``calibration_fit.png`` and ``calibration_posterior.png`` of ``poro2d calibrate``, drawn from
+the :class:`poro2d.calibration.run.CalibrationResult`, its posterior grid and the curves the
+calibration found for its best design point (the calibration reads those from its cache).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.ticker import FormatStrFormatter  # noqa: E402
+
+from poro2d.report.figure_file import save_figure  # noqa: E402
+
+
+def plot_calibration_fit(
+    result, lab, curves: dict[float, list], nearest: dict, path: str | os.PathLike
+) -> Path:
+    """Left: laboratory peaks (and ends) against the calibrated model's; right: the model's curves
+    at the design point ``nearest`` the best parameters (``curves[sigma]``: (d, tau) per specimen)
+    against the laboratory curves, or its peak as a dotted line where the laboratory gave no curve.
+
+    ``result`` is a :class:`poro2d.calibration.run.CalibrationResult`, ``lab`` its laboratory data.
+    """
+    fig, (ax_peak, ax_curve) = plt.subplots(1, 2, figsize=(11, 4.2))
+    obs = [o for o in result.posterior["observables"] if o["observable"] == "peak"]
+    s = np.array([o["normal_stress_kpa"] for o in obs])
+    ax_peak.plot(s, [o["lab_kpa"] for o in obs], "ks", label="laboratory peak")
+    ax_peak.errorbar(
+        s,
+        [o["model_kpa"] for o in obs],
+        yerr=[2 * o["noise_sd_kpa"] for o in obs],
+        fmt="o",
+        color="#b2182b",
+        capsize=3,
+        label="calibrated model (surrogate, +-2 sd)",
+    )
+    ends = [o for o in result.posterior["observables"] if o["observable"] == "end"]
+    if ends:
+        se = [o["normal_stress_kpa"] for o in ends]
+        ax_peak.plot(se, [o["lab_kpa"] for o in ends], "k^", mfc="none", label="laboratory end")
+        ax_peak.plot(se, [o["model_kpa"] for o in ends], "v", color="#2166ac", label="model end")
+    ax_peak.set_xlabel("normal stress (kPa)")
+    ax_peak.set_ylabel("shear stress (kPa)")
+    ax_peak.set_xlim(left=0)
+    ax_peak.set_ylim(bottom=0)
+    ax_peak.legend(fontsize=8)
+    b = result.best
+    ax_peak.set_title(f"f_p = {b['particle_friction']:.3g}, mu_r = {b['rolling_friction']:.3g}", fontsize=10)
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for k, sigma in enumerate(lab.normal_stresses()):
+        c = colors[k % len(colors)]
+        for j, (d, t) in enumerate(curves.get(sigma, [])):
+            ax_curve.plot(
+                d * 1e3, t, color=c, lw=0.8, alpha=0.7, label=f"model {sigma:g} kPa" if j == 0 else None
+            )
+        if sigma in lab.curves:
+            d, t = lab.curves[sigma]
+            ax_curve.plot(d * 1e3, t, "k--", lw=1.0, label="laboratory" if k == 0 else None)
+        else:
+            ax_curve.axhline(lab.peaks[sigma], color=c, ls=":", lw=1.0)
+    ax_curve.set_xlabel("shear displacement (mm)")
+    ax_curve.set_ylabel("shear stress (kPa)")
+    ax_curve.set_title(
+        f"curves at the design point nearest the best (f_p = {nearest['particle_friction']:.3g}, "
+        f"mu_r = {nearest['rolling_friction']:.3g})",
+        fontsize=9,
+    )
+    ax_curve.legend(fontsize=7)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def plot_calibration_posterior(result, post, path: str | os.PathLike) -> Path:
+    """The posterior density over (f_p, mu_r) with the evaluated design points, its maximum and
+    the intervals of ``result`` shaded; ``post`` holds the grid (``fp_values``, ``mu_r_values``,
+    ``density``)."""
+    fig, ax = plt.subplots(figsize=(6.2, 4.8))
+    fp, mu_r = post.fp_values, post.mu_r_values
+    mesh = ax.pcolormesh(fp, mu_r, post.density / post.density.max(), shading="auto", cmap="viridis")
+    fig.colorbar(mesh, ax=ax, label="posterior density / its maximum")
+    ev = result.evaluations
+    ax.plot(
+        [e["particle_friction"] for e in ev],
+        [e["rolling_friction"] for e in ev],
+        "w.",
+        ms=7,
+        mec="k",
+        label="evaluated design points",
+    )
+    b = result.best
+    ax.plot(b["particle_friction"], b["rolling_friction"], "r*", ms=13, label="posterior maximum")
+    lo, hi = result.intervals["particle_friction"]
+    ax.axvspan(lo, hi, color="w", alpha=0.12)
+    lo, hi = result.intervals["rolling_friction"]
+    ax.axhspan(lo, hi, color="w", alpha=0.12)
+    ax.set_xscale("log")
+    ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
+    ax.xaxis.set_minor_formatter(FormatStrFormatter("%g"))
+    ax.tick_params(axis="x", which="minor", labelsize=7)
+    ax.set_xlabel("particle friction f_p")
+    ax.set_ylabel("rolling friction mu_r")
+    ax.set_title(
+        f"posterior (correlation {result.posterior['correlation']:+.2f}); shaded: "
+        f"{result.level:.0%} intervals",
+        fontsize=9,
+    )
+    ax.legend(fontsize=7, loc="upper right")
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+__all__ = ["plot_calibration_fit", "plot_calibration_posterior"]
