@@ -69,6 +69,27 @@ def test_failing_jobs_are_values_named_with_their_errors_after_every_job_ran(pro
     assert str(err.value) == "2 toy job(s) failed: b: odd job 1; d: odd job 5"
 
 
+def test_the_dask_backend_gives_the_same_outcomes_in_job_order():
+    import distributed
+
+    ended = []
+    jobs = [Job(fail_on_odd, (j,), name, reports=True) for j, name in zip([0, 1, 2, 5], "abcd", strict=True)]
+    with distributed.Client(
+        processes=False, n_workers=1, threads_per_worker=2, dashboard_address=":0"
+    ) as client:
+        executor = Executor(Backend.dask(), client=client)
+        outcomes = executor.map(jobs, on_done=lambda i, res: ended.append(i))
+        assert executor.cluster_info()["workers"] == 1 and not executor.cluster_info()["local_cluster"]
+        executor.close()  # a given client stays open
+        assert client.status == "running"
+    assert sorted(ended) == [0, 1, 2, 3]
+    assert outcomes[0] == 0 and outcomes[2] == 2
+    assert [(o.label, str(o.error)) for o in (outcomes[1], outcomes[3])] == [
+        ("b", "odd job 1"),
+        ("d", "odd job 5"),
+    ]
+
+
 def test_an_input_error_of_a_job_is_raised_as_it_is():
     with pytest.raises(InputError, match="--thing"):
         results_or_raise(map_local(fail_on_odd, [1, 3, 0], 2))
