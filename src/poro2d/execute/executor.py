@@ -17,7 +17,7 @@ from typing import Any
 
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD
 from poro2d.execute.jobs import Job
-from poro2d.execute.local import run_in_processes, run_inline
+from poro2d.execute.local import map_in_processes, map_inline
 
 #: the backends: this process, spawned processes on this machine, a Dask cluster
 KINDS = ("inline", "processes", "dask")
@@ -93,11 +93,11 @@ class Executor:
         if self._dask is not None:
             return self._dask.map(jobs, on_done)
         if self.backend.kind == "inline" or self.backend.processes <= 1 or len(jobs) <= 1:
-            return run_inline(jobs, on_report, on_done)
+            return map_inline(jobs, on_report, on_done)
         order = list(range(len(jobs)))
         if start_first is not None:
             order.sort(key=lambda i: start_first(jobs[i]))
-        return run_in_processes(jobs, order, min(self.backend.processes, len(jobs)), on_report, on_done)
+        return map_in_processes(jobs, order, min(self.backend.processes, len(jobs)), on_report, on_done)
 
     def start(self) -> None:
         """Start the Dask cluster now (before the first job), for its dashboard and workers."""

@@ -30,7 +30,7 @@ POLL_S = 0.25
 _queue = None
 
 
-def run_inline(jobs: Sequence[Job], on_report, on_done) -> list:
+def map_inline(jobs: Sequence[Job], on_report, on_done) -> list:
     """The jobs one after the other in this process; outcomes in job order."""
     outcomes: list = []
     for i, job in enumerate(jobs):
@@ -45,7 +45,7 @@ def run_inline(jobs: Sequence[Job], on_report, on_done) -> list:
     return outcomes
 
 
-def run_in_processes(jobs: Sequence[Job], order: list[int], n: int, on_report, on_done) -> list:
+def map_in_processes(jobs: Sequence[Job], order: list[int], n: int, on_report, on_done) -> list:
     """The jobs in ``n`` spawned worker processes, started in ``order``; outcomes in job order."""
     import multiprocessing as mp
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
@@ -141,4 +141,4 @@ def _ignore(*_msg) -> None:
     pass
 
 
-__all__ = ["REPORT_INTERVAL_S", "run_in_processes", "run_inline"]
+__all__ = ["REPORT_INTERVAL_S", "map_in_processes", "map_inline"]
