@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import pytest
 
+import poro2d.execute.dask_cluster as dask_cluster
 import poro2d.sweep.density as density_sweep
 import poro2d.sweep.runner as runner
 from poro2d.cli import main
@@ -250,7 +251,7 @@ def test_refused_on_one_line(argv, words, tmp_path, capsys, no_work, monkeypatch
 )
 def test_unreachable_scheduler_is_the_only_line(argv, tmp_path, capsys, no_work, monkeypatch):
     pytest.importorskip("distributed")
-    monkeypatch.setattr(runner, "CONNECT_TIMEOUT_S", 1)
+    monkeypatch.setattr(dask_cluster, "CONNECT_TIMEOUT_S", 1)
     monkeypatch.chdir(tmp_path)
     (tmp_path / "sweep.toml").write_text(
         '[specimen]\nlayers = 2\n[sweep]\nkind = "criterion"\nseed = [0, 1]\n'

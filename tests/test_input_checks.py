@@ -10,8 +10,8 @@ import pytest
 from poro2d.cli.shear import parse_stresses
 from poro2d.config import check_number_list
 from poro2d.errors import InputError
+from poro2d.execute import cluster_options, dask_cluster
 from poro2d.io_utils import read_utf8, text_position
-from poro2d.sweep import runner
 from poro2d.sweep.density import check_mus
 
 
@@ -55,21 +55,21 @@ def test_frictions_accepted_as_floats():
 )
 def test_scheduler_address_form(address):
     with pytest.raises(InputError, match="--scheduler"):
-        runner.check_scheduler_address(address)
+        cluster_options.check_scheduler_address(address)
 
 
 def test_scheduler_address_accepted():
-    assert runner.check_scheduler_address("localhost:8786") == "tcp://localhost:8786"
-    assert runner.check_scheduler_address("tls://10.0.0.2:8786") == "tls://10.0.0.2:8786"
-    assert runner.check_scheduler_address("tcp://[::1]:8786") == "tcp://[::1]:8786"
+    assert cluster_options.check_scheduler_address("localhost:8786") == "tcp://localhost:8786"
+    assert cluster_options.check_scheduler_address("tls://10.0.0.2:8786") == "tls://10.0.0.2:8786"
+    assert cluster_options.check_scheduler_address("tcp://[::1]:8786") == "tcp://[::1]:8786"
 
 
 def test_unreachable_scheduler_is_one_line(monkeypatch):
     pytest.importorskip("distributed")
-    monkeypatch.setattr(runner, "CONNECT_TIMEOUT_S", 1)
+    monkeypatch.setattr(dask_cluster, "CONNECT_TIMEOUT_S", 1)
     t0 = time.perf_counter()
     with pytest.raises(InputError) as exc:
-        runner.connect("tcp://127.0.0.1:1")  # nothing listens on port 1
+        dask_cluster.connect("tcp://127.0.0.1:1")  # nothing listens on port 1
     msg = str(exc.value)
     assert msg.startswith("--scheduler = 'tcp://127.0.0.1:1' is invalid")
     assert "answers within 1 s" in msg and "\n" not in msg
@@ -78,10 +78,10 @@ def test_unreachable_scheduler_is_one_line(monkeypatch):
 
 def test_workers_bounded():
     with pytest.raises(InputError, match="--workers"):
-        runner.check_cluster_options(None, runner.max_workers() + 1)
+        cluster_options.check_cluster_options(None, cluster_options.max_workers() + 1)
     with pytest.raises(InputError, match="--workers = 1 is invalid; allowed: nothing with --scheduler"):
-        runner.check_cluster_options("tcp://h:1", 1)
-    runner.check_cluster_options(None, runner.max_workers())
+        cluster_options.check_cluster_options("tcp://h:1", 1)
+    cluster_options.check_cluster_options(None, cluster_options.max_workers())
 
 
 def test_non_utf8_located(tmp_path):

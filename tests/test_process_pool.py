@@ -1,4 +1,4 @@
-"""The process pool of the shear tests and replicates: job order, errors, messages, Ctrl-C."""
+"""The executor's local backends (the shear tests, the replicates): job order, errors, messages, Ctrl-C."""
 
 import os
 import re
@@ -14,9 +14,15 @@ import pytest
 from conftest import default_sigint
 from poro2d import progress
 from poro2d.errors import InputError
-from poro2d.process_pool import JobsFailed, map_jobs
+from poro2d.execute import Backend, Executor, Failed, Job, JobsFailed, results_or_raise
 
 SRC = Path(__file__).resolve().parents[1] / "src"
+
+
+def map_local(func, args, processes, **kw):
+    """``func(arg, report)`` for every argument on ``processes`` local processes; the outcomes."""
+    jobs = [Job(func, (a,), str(a), reports=True) for a in args]
+    return Executor(Backend.local(processes)).map(jobs, **kw)
 
 
 def square_late_first(job: int, report) -> tuple:
@@ -38,8 +44,8 @@ def fail_on_odd(job: int, report) -> int:
 def test_results_come_in_job_order_whatever_the_process_count(processes):
     jobs = [0, 1, 2, 3]
     ended, messages = [], []
-    results = map_jobs(
-        square_late_first, jobs, processes, names=[str(j) for j in jobs], start_first=lambda j: -j,
+    results = map_local(
+        square_late_first, jobs, processes, start_first=lambda j: -j.args[0],
         on_report=lambda i, *msg: messages.append((i, *msg)), on_done=lambda i, res: ended.append(i),
     )  # fmt: skip
     assert [r[:2] for r in results] == [(0, 0), (1, 1), (2, 4), (3, 9)]
@@ -50,18 +56,43 @@ def test_results_come_in_job_order_whatever_the_process_count(processes):
 
 
 @pytest.mark.parametrize("processes", [1, 2])
-def test_failing_jobs_are_named_with_their_errors_after_every_job_ran(processes):
+def test_failing_jobs_are_values_named_with_their_errors_after_every_job_ran(processes):
     ended = []
+    jobs = [Job(fail_on_odd, (j,), name, reports=True) for j, name in zip([0, 1, 2, 5], "abcd", strict=True)]
+    outcomes = Executor(Backend.local(processes)).map(jobs, on_done=lambda i, res: ended.append(i))
+    assert sorted(ended) == [0, 1, 2, 3]  # every job ends, failed or not
+    assert [o for o in outcomes if not isinstance(o, Failed)] == [0, 2]
+    failed = [(o.label, str(o.error)) for o in outcomes if isinstance(o, Failed)]
+    assert failed == [("b", "odd job 1"), ("d", "odd job 5")]
     with pytest.raises(JobsFailed) as err:
-        map_jobs(fail_on_odd, [0, 1, 2, 5], processes, names=["a", "b", "c", "d"], what="toy job(s)",
-                 on_done=lambda i, res: ended.append(i))  # fmt: skip
+        results_or_raise(outcomes, "toy job(s)")
     assert str(err.value) == "2 toy job(s) failed: b: odd job 1; d: odd job 5"
-    assert sorted(ended) == [0, 2]
+
+
+def test_the_dask_backend_gives_the_same_outcomes_in_job_order():
+    import distributed
+
+    ended = []
+    jobs = [Job(fail_on_odd, (j,), name, reports=True) for j, name in zip([0, 1, 2, 5], "abcd", strict=True)]
+    with distributed.Client(
+        processes=False, n_workers=1, threads_per_worker=2, dashboard_address=":0"
+    ) as client:
+        executor = Executor(Backend.dask(), client=client)
+        outcomes = executor.map(jobs, on_done=lambda i, res: ended.append(i))
+        assert executor.cluster_info()["workers"] == 1 and not executor.cluster_info()["local_cluster"]
+        executor.close()  # a given client stays open
+        assert client.status == "running"
+    assert sorted(ended) == [0, 1, 2, 3]
+    assert outcomes[0] == 0 and outcomes[2] == 2
+    assert [(o.label, str(o.error)) for o in (outcomes[1], outcomes[3])] == [
+        ("b", "odd job 1"),
+        ("d", "odd job 5"),
+    ]
 
 
 def test_an_input_error_of_a_job_is_raised_as_it_is():
     with pytest.raises(InputError, match="--thing"):
-        map_jobs(fail_on_odd, [1, 3, 0], 2, names=["a", "b", "c"])
+        results_or_raise(map_local(fail_on_odd, [1, 3, 0], 2))
 
 
 def test_one_message_per_phase_and_interval(monkeypatch):
@@ -72,7 +103,7 @@ def test_one_message_per_phase_and_interval(monkeypatch):
         return job
 
     seen = []
-    map_jobs(chatty, [7], 1, names=["x"], on_report=lambda i, *msg: seen.append(msg))
+    map_local(chatty, [7], 1, on_report=lambda i, *msg: seen.append(msg))
     assert seen == [("phase one", 0.0), ("phase two", 0.0)]
 
 
@@ -105,16 +136,16 @@ def test_progress_lines_share_one_format():
 SLEEPER = """
     import sys, time
     from pathlib import Path
-    from poro2d.process_pool import map_jobs
+    from poro2d.execute import Backend, Executor, Job
 
-    def sleep_long(job, report):
-        Path(job).write_text("started")
+    def sleep_long(path):
+        Path(path).write_text("started")
         time.sleep(120)
 
     if __name__ == "__main__":
         try:
-            map_jobs(sleep_long, [sys.argv[1] + "/a", sys.argv[1] + "/b", sys.argv[1] + "/c"], 2,
-                     names=["a", "b", "c"])
+            jobs = [Job(sleep_long, (sys.argv[1] + "/" + name,), name) for name in "abc"]
+            Executor(Backend.local(2)).map(jobs)
         except KeyboardInterrupt:
             print("interrupted", file=sys.stderr)
             sys.exit(130)

@@ -258,7 +258,7 @@ def test_a_huge_input_is_refused_before_reading(tmp_path, capsys):
 def test_the_local_dashboard_listens_on_this_machine_only(monkeypatch):
     import distributed
 
-    from poro2d.sweep import runner
+    from poro2d.execute import cluster_options, dask_cluster
 
     seen = {}
 
@@ -268,16 +268,16 @@ def test_the_local_dashboard_listens_on_this_machine_only(monkeypatch):
 
     monkeypatch.setattr(distributed, "LocalCluster", FakeCluster)
     monkeypatch.setattr(distributed, "Client", lambda cluster: None)
-    runner.start_client(None, 1, 1)
+    dask_cluster.start_client(None, 1, 1)
     assert seen["dashboard_address"] == "127.0.0.1:0" and seen["scheduler_kwargs"] == {"dashboard": True}
-    runner.start_client(None, 1, 1, dashboard=None)  # no dashboard: its web server stays local
+    dask_cluster.start_client(None, 1, 1, dashboard=None)  # no dashboard: its web server stays local
     assert seen["dashboard_address"] == "127.0.0.1:0" and seen["scheduler_kwargs"] == {"dashboard": False}
-    assert runner.check_dashboard(None) == "127.0.0.1:0"
-    assert runner.check_dashboard("0.0.0.0:8787") == "0.0.0.0:8787"
-    assert runner.check_dashboard("none") is None
+    assert cluster_options.check_dashboard(None) == "127.0.0.1:0"
+    assert cluster_options.check_dashboard("0.0.0.0:8787") == "0.0.0.0:8787"
+    assert cluster_options.check_dashboard("none") is None
     for bad in ("8787", "host:port", "a b:1", "h:70000"):
         with pytest.raises(InputError, match="--dashboard"):
-            runner.check_dashboard(bad)
+            cluster_options.check_dashboard(bad)
 
 
 def test_a_bad_dashboard_address_is_refused_before_any_work(tmp_path, capsys):

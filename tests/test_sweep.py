@@ -10,8 +10,8 @@ import pytest
 
 from poro2d.cli import main
 from poro2d.errors import InputError
+from poro2d.execute.dask_cluster import SINGLE_THREAD_ENV
 from poro2d.sweep import SweepResult, parse_sweep, register_kind, run_sweep
-from poro2d.sweep.runner import SINGLE_THREAD_ENV
 
 distributed = pytest.importorskip("distributed")
 
@@ -266,7 +266,7 @@ def test_worker_pins_numba_threads_so_a_compile_does_not_fail(monkeypatch):
     from numba.core.config import reload_config
     from numba.np.ufunc.parallel import _launch_threads
 
-    from poro2d.sweep.runner import pin_numba_threads
+    from poro2d.execute.dask_cluster import pin_numba_threads
 
     _launch_threads()
     running = numba.config.NUMBA_NUM_THREADS

@@ -1,11 +1,11 @@
 """The progress display of every command: rich's live bars on a terminal, plain lines in a log.
 
 One family with one look: :class:`StepProgress` (a run of DEM steps), :class:`CountProgress`
-(the cases of a sweep, a calibration's tests) and :class:`JobsProgress` (the jobs of
-:mod:`poro2d.process_pool`, one bar each). On a terminal each draws the same bars, redrawn
-in place: the label, the bar, what it counts, a note, the elapsed time and the ETA.
-Written to a file or a pipe, rich's live display would leave only its last state, cut to
-80 columns; there every display prints plain lines of one format instead (see
+(the cases of a sweep, a calibration's tests) and :class:`JobsProgress` (the jobs of the
+executor's local processes, :mod:`poro2d.execute.local`, one bar each). On a terminal each
+draws the same bars, redrawn in place: the label, the bar, what it counts, a note, the
+elapsed time and the ETA. Written to a file or a pipe, rich's live display would leave only
+its last state, cut to 80 columns; there every display prints plain lines of one format instead (see
 :func:`progress_line`): at most one every :data:`LINE_INTERVAL_S` seconds while it runs,
 and one when it ends, e.g.::
 

@@ -1,11 +1,11 @@
-"""Ctrl-C in worker processes (a local Dask cluster's, the process pool's): left to the command.
+"""Ctrl-C in worker processes (a local Dask cluster's, the local process pool's): left to the command.
 
 A Ctrl-C at a terminal reaches every process of its group: the command and each worker
 process of its local cluster. A worker that takes it as an interruption dies with a
 traceback of its own (dozens of lines, for a worker still starting, before the command's
 one-line message). The command alone handles it: it closes its cluster, which stops the
-workers. Dask's worker processes ignore SIGINT from the moment they import poro2d, those of
-:mod:`poro2d.process_pool` from their start.
+workers. Dask's worker processes ignore SIGINT from the moment they import the executor's Dask
+backend, those of its local processes (:mod:`poro2d.execute.local`) from their start.
 """
 
 from __future__ import annotations

@@ -24,13 +24,14 @@ from poro2d.calibration.cluster import UnitRunner
 from poro2d.calibration.specimens import check_preset, given_specimens, preset_specimens
 from poro2d.calibration.units import unit_job
 from poro2d.errors import InputError, check_int, check_range, is_number
+from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
+from poro2d.execute.dask_cluster import check_reachable
 from poro2d.io_utils import check_output_dir, provenance
 from poro2d.locks import holds_output
 from poro2d.paper_data import QUICK_SHEAR
 from poro2d.shear.lab import LabData, read_lab_csv
 from poro2d.shear.series import check_stresses
 from poro2d.shear.settings import MAX_FRICTION, ShearSettings
-from poro2d.sweep.runner import DEFAULT_DASHBOARD, check_cluster_options, check_reachable
 from poro2d.typed_result import TypedResult
 
 DEFAULT_FP_RANGE = (0.3, 3.0)

@@ -12,10 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
+from poro2d.execute.dask_cluster import pin_numba_threads
 from poro2d.identity import identity_digest
 from poro2d.shear.settings import ShearSettings
 from poro2d.shear.single import DirectShearTest
-from poro2d.sweep.runner import pin_numba_threads
 
 #: what a unit returns besides its identity: the observables a calibration may fit
 OBSERVABLES = ("peak", "end")

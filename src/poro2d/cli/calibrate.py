@@ -62,7 +62,7 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Calibrate particle friction f_p and rolling friction mu_r against laboratory direct shear."""
         from poro2d.calibration.run import DEFAULT_FP_RANGE, DEFAULT_MU_R_RANGE, run_calibration
-        from poro2d.sweep.runner import check_dashboard
+        from poro2d.execute.cluster_options import check_dashboard
 
         settings = None if max_displacement is None else {"max_displacement": max_displacement}
         options = {

@@ -39,8 +39,8 @@ def register(app: typer.Typer) -> None:
         preparation friction, over seeds, beside the paper's 0.15."""
         from poro2d.criterion.config import load_config
         from poro2d.errors import check_int
+        from poro2d.execute.cluster_options import check_cluster_options, check_dashboard
         from poro2d.io_utils import check_output_dir
-        from poro2d.sweep.runner import check_cluster_options, check_dashboard
         from poro2d.sweep.sensitivity import run_sensitivity
 
         check_cluster_options(scheduler, workers)

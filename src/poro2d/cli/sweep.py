@@ -25,9 +25,11 @@ def sweep_cmd(
 ) -> None:
     """Run a grid or list of cases as Dask tasks; one table of results."""
     from poro2d.config import load_toml
+    from poro2d.execute.cluster_options import check_cluster_options, check_dashboard
+    from poro2d.execute.dask_cluster import check_reachable
     from poro2d.io_utils import check_output_dir
     from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.runner import check_cluster_options, check_dashboard, check_reachable, run_sweep
+    from poro2d.sweep.runner import run_sweep
 
     check_cluster_options(scheduler, workers)
     dashboard_address = check_dashboard(dashboard)

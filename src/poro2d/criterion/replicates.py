@@ -4,10 +4,10 @@ A strength from one specimen is one sample of a chaotic packing, so the case stu
 several specimens of the same accepted porosity. Each replicate is a criterion run of its
 own seed, first trial the porosity the main seed accepted, in ``out/seed<N>``; it must
 pass the criterion itself (a seed may settle on a neighbouring trial porosity: that is
-part of the spread). The runs go to the workers of :mod:`poro2d.process_pool` with one
-numba thread each: two threads on one specimen of a few thousand disks run only about 1.6
-times as fast as one, two processes twice. Each run resumes from its own folder, so a
-rerun continues.
+part of the spread). The runs are jobs of the executor's local processes
+(:mod:`poro2d.execute`) with one numba thread each: two threads on one specimen of a few
+thousand disks run only about 1.6 times as fast as one, two processes twice. Each run
+resumes from its own folder, so a rerun continues.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from pathlib import Path
 from poro2d.console import OutputConsole
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.criterion.result import ReplicatesResult
-from poro2d.process_pool import map_jobs
+from poro2d.execute import Backend, Executor, Failed, Job, results_or_raise
 from poro2d.progress import JobsProgress
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.grading import GradingCurve
@@ -27,9 +27,9 @@ from poro2d.specimen.grading import GradingCurve
 console = OutputConsole()
 
 
-def _run_one(job: tuple, report) -> dict:
+def _run_one(spec: SpecimenSpec, grading: GradingCurve, settings: CriterionSettings, seed: int, out: Path,
+             report) -> dict:  # fmt: skip
     """One replicate's criterion run (in a worker process); its summary row."""
-    spec, grading, settings, seed, out = job
     report("running")
     t0 = time.perf_counter()
     res = PorosityCriterion(spec, grading, settings, seed=seed, out=out, progress=False).run()
@@ -57,13 +57,17 @@ def run_replicates(
     """
     spec1 = replace(spec, threads=1)
     first = replace(settings, trial_porosity=n2d)
-    jobs = [(spec1, grading, first, sd, Path(out) / f"seed{sd}") for sd in seeds]
-    names = [f"seed {sd}" for sd in seeds]
+    jobs = [Job(_run_one, (spec1, grading, first, sd, Path(out) / f"seed{sd}"), f"seed {sd}", reports=True)
+            for sd in seeds]  # fmt: skip
+    names = [job.label for job in jobs]
+
+    def ended(index: int, outcome) -> None:
+        if not isinstance(outcome, Failed):
+            display.done(index, _outcome(outcome))
+
     with JobsProgress("replicate criterion", names, enabled=progress) as display:
-        rows = map_jobs(
-            _run_one, jobs, processes, names=names, what="replicate criterion run(s)",
-            on_report=display.update, on_done=lambda index, row: display.done(index, _outcome(row)),
-        )  # fmt: skip
+        outcomes = Executor(Backend.local(processes)).map(jobs, on_report=display.update, on_done=ended)
+        rows = results_or_raise(outcomes, "replicate criterion run(s)")
     return ReplicatesResult(rows, out=Path(out))
 
 

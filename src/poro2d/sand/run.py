@@ -296,7 +296,7 @@ def run_sand(
     there), ``announce`` with one line per stage, with the elapsed time and an overall ETA.
     Rerun to resume: finished cases are read back.
     """
-    from poro2d.sweep.runner import check_cluster_options
+    from poro2d.execute.cluster_options import check_cluster_options
 
     out = Path(out)
     check_output_dir("--out", out)

@@ -1,16 +1,16 @@
-"""Direct shear tests in the process pool, with their progress.
+"""Direct shear tests on the executor's local processes, with their progress.
 
 A job is a dict: ``key`` (how its result is returned), ``specimen``, ``sigma`` (kPa),
 ``settings`` (a :class:`ShearSettings` as a dict), ``out``, ``figures`` and optionally
-``series`` (a label in progress lines). Each test runs in a worker of
-:mod:`poro2d.process_pool` (a fresh process, one numba thread) and reports its phase
-there; :class:`poro2d.progress.JobsProgress` shows a bar per test on a terminal, plain
-periodic lines in a log.
+``series`` (a label in progress lines). Each test is a job of the executor's local
+processes (:mod:`poro2d.execute.local`: a fresh process, one numba thread) and reports its
+phase there; :class:`poro2d.progress.JobsProgress` shows a bar per test on a terminal,
+plain periodic lines in a log.
 """
 
 from __future__ import annotations
 
-from poro2d.process_pool import map_jobs
+from poro2d.execute import Backend, Executor, Failed, Job, results_or_raise
 from poro2d.progress import JobsProgress
 from poro2d.shear.settings import ShearSettings
 from poro2d.shear.single import DirectShearTest
@@ -63,7 +63,7 @@ def execute_jobs(jobs: list[dict], processes: int, progress: bool) -> dict:
 
     Returns ``{job["key"]: result}`` in job order. Every test runs even when one fails;
     then an input error of a test is raised as it is, other failures together
-    (:class:`poro2d.process_pool.JobsFailed`, each test named).
+    (:class:`poro2d.execute.JobsFailed`, each test named).
     """
     results, todo = _finished(jobs)
     if not todo:
@@ -74,10 +74,15 @@ def execute_jobs(jobs: list[dict], processes: int, progress: bool) -> dict:
         def show(index: int, phase: str, fraction: float) -> None:
             bars.update(index, phase, fraction if phase == "shearing" else None)
 
-        done = map_jobs(
-            _run_job, todo, processes, names=names, what="direct shear test(s)", start_first=_slowest_first,
-            on_report=show, on_done=lambda index, _result: bars.done(index),
+        def ended(index: int, outcome) -> None:
+            if not isinstance(outcome, Failed):
+                bars.done(index)
+
+        outcomes = Executor(Backend.local(processes)).map(
+            [Job(_run_job, (job,), name, reports=True) for job, name in zip(todo, names, strict=True)],
+            on_report=show, on_done=ended, start_first=lambda j: _slowest_first(j.args[0]),
         )  # fmt: skip
+        done = results_or_raise(outcomes, "direct shear test(s)")
     results.update((job["key"], res) for job, res in zip(todo, done, strict=True))
     return {j["key"]: results[j["key"]] for j in jobs}
 

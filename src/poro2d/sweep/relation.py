@@ -394,10 +394,12 @@ def run_relation(
     """
     from poro2d.criterion.density import check_mus
     from poro2d.criterion.run import load
+    from poro2d.execute.cluster_options import check_cluster_options, check_dashboard
+    from poro2d.execute.dask_cluster import check_reachable
     from poro2d.io_utils import check_output_dir
     from poro2d.sweep.cases import parse_sweep
     from poro2d.sweep.density import check_seeds
-    from poro2d.sweep.runner import check_cluster_options, check_dashboard, check_reachable, run_sweep
+    from poro2d.sweep.runner import run_sweep
 
     out = Path(out)
     check_output_dir("--out", out)

@@ -21,7 +21,6 @@ skips finished cases and runs the rest (failed ones included).
 from __future__ import annotations
 
 import json
-import logging
 import os
 import socket
 import time
@@ -30,27 +29,19 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from poro2d.execute import Backend, Executor, Failed, Job
+from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
+from poro2d.execute.dask_cluster import pin_numba_threads
 from poro2d.io_utils import atomic_path, provenance, write_json
 from poro2d.locks import cache_entry, holds_output
 from poro2d.resumable import Fingerprint, ResumableStage
 from poro2d.sweep.cases import KINDS, Case, SweepConfig, config_tables
 from poro2d.sweep.results import SweepResult
-from poro2d.worker_signals import hold_interrupts, ignore_interrupts_in_dask_worker, release_interrupts
-
-ignore_interrupts_in_dask_worker()  # a worker started by a script imports this to run its cases
 
 RESULT = "result.json"
 PARAMS = "params.json"
 ERROR_TXT = "error.txt"
 ERROR_JSON = "error.json"
-
-#: environment of LocalCluster worker processes: one thread for every numeric library
-SINGLE_THREAD_ENV = {
-    "NUMBA_NUM_THREADS": "1",
-    "OMP_NUM_THREADS": "1",
-    "MKL_NUM_THREADS": "1",
-    "OPENBLAS_NUM_THREADS": "1",
-}
 
 
 def _now() -> str:
@@ -159,24 +150,6 @@ def _done_row(case: dict, d: Path, func, row: dict, t0: float) -> dict:
     return row  # written as result.json, the done marker, last
 
 
-def pin_numba_threads() -> None:
-    """One numba thread for the case (its kind may raise it again for its own runs).
-
-    numba re-reads ``NUMBA_NUM_THREADS`` from the environment whenever it compiles, and once
-    its threads run, another value there is an error. A worker process may see a value in
-    its environment other than the one its numba started with (the cluster's environment is
-    applied after start-up), so the first compile in a fresh worker (an empty kernel cache)
-    failed every case. The environment is pinned to the running value first.
-    """
-    try:
-        import numba
-
-        os.environ["NUMBA_NUM_THREADS"] = str(numba.config.NUMBA_NUM_THREADS)
-        numba.set_num_threads(1)
-    except Exception:  # pragma: no cover - numba missing or threading layer unavailable
-        pass
-
-
 def _worker_address() -> str:
     try:
         from distributed import get_worker
@@ -206,156 +179,6 @@ def _failed_row(case: Case, d: Path, err: BaseException, tb: str) -> dict:
         tmp.write_text(tb or row["error"])
     write_json(d / ERROR_JSON, row)
     return row
-
-
-#: where a LocalCluster serves its dashboard: this machine only (a port the system picks), so
-#: that other users of a shared login node cannot watch the run or read its logs
-DEFAULT_DASHBOARD = "127.0.0.1:0"
-
-
-def check_dashboard(value: str | None, parameter: str = "--dashboard") -> str | None:
-    """A dashboard address ``HOST:PORT`` (``:PORT`` for every interface), or None for no dashboard
-    (``none``/``off``); the default when ``value`` is None is :data:`DEFAULT_DASHBOARD`.
-    """
-    from poro2d.errors import InputError
-
-    if value is None:
-        return DEFAULT_DASHBOARD
-    text = str(value).strip()
-    if text.lower() in ("none", "off"):
-        return None
-    host, sep, port = text.rpartition(":")
-    if not sep or not port.isdigit() or int(port) > 65535 or any(c.isspace() or c == "/" for c in host):
-        raise InputError(parameter, value, "HOST:PORT (port 0 to 65535, 0: any free one), :PORT, or none")
-    return text
-
-
-def start_client(scheduler: str | None, workers: int | None, threads_needed: int,
-                  dashboard: str | None = DEFAULT_DASHBOARD):  # fmt: skip
-    """(client, cluster or None): connect to ``scheduler`` or start a LocalCluster.
-
-    The LocalCluster's dashboard listens on ``dashboard`` (None: no dashboard).
-    """
-    from distributed import Client, LocalCluster
-
-    if scheduler:
-        return connect(scheduler), None
-    n = workers or os.cpu_count() or 1
-    env = dict(SINGLE_THREAD_ENV, NUMBA_NUM_THREADS=str(max(1, threads_needed)))
-    cluster = LocalCluster(
-        n_workers=n,
-        threads_per_worker=1,
-        processes=True,
-        # the scheduler's web server (health, metrics) runs in any case: on this machine, with
-        # the dashboard's pages only when one is asked for
-        dashboard_address=dashboard if dashboard is not None else DEFAULT_DASHBOARD,
-        scheduler_kwargs={"dashboard": dashboard is not None},
-        env=env,
-    )
-    return Client(cluster), cluster
-
-
-#: seconds to wait for a running scheduler to answer (distributed's own default is 30)
-CONNECT_TIMEOUT_S = 10
-#: address schemes of a Dask scheduler that a user can type
-SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
-SCHEDULER_FORM = "an address such as tcp://host:8786 (scheme tcp, tls, ws, wss or ucx; port 1-65535)"
-
-
-def max_workers() -> int:
-    """The most worker processes a local cluster may start: two per core (more only queue)."""
-    return 2 * (os.cpu_count() or 1)
-
-
-def check_cluster_options(scheduler: str | None, workers: int | None) -> None:
-    """``--scheduler`` of the right form and ``--workers`` in range, checked before any work.
-
-    ``--workers`` sizes the local cluster; with ``--scheduler`` the running cluster's own
-    workers take the cases, so the two together are refused rather than one ignored.
-    """
-    from poro2d.errors import InputError, check_int
-
-    if workers is not None:
-        check_int("--workers", workers, 1, max_workers())
-    if scheduler is None:
-        return
-    if workers is not None:
-        raise InputError("--workers", workers, "nothing with --scheduler (its own workers run the cases)")
-    check_scheduler_address(scheduler)
-
-
-def check_scheduler_address(address: str) -> str:
-    """``address`` if it has the form ``[scheme://]host:port``; otherwise InputError."""
-    from urllib.parse import urlsplit
-
-    from poro2d.errors import InputError
-
-    text = address.strip()
-    full = text if "://" in text else f"tcp://{text}"
-    try:
-        parts = urlsplit(full)
-        port = parts.port
-    except ValueError:
-        raise InputError("--scheduler", address, SCHEDULER_FORM) from None
-    if parts.scheme not in SCHEDULER_SCHEMES or not parts.hostname or port is None or not 0 < port < 65536:
-        raise InputError("--scheduler", address, SCHEDULER_FORM)
-    if parts.path not in ("", "/") or parts.query or parts.fragment:
-        raise InputError("--scheduler", address, SCHEDULER_FORM)
-    return full
-
-
-def connect(scheduler: str):
-    """A client of the running scheduler at ``scheduler``; one that does not answer is an InputError."""
-    from distributed import Client
-
-    from poro2d.errors import InputError
-
-    address = check_scheduler_address(scheduler)
-    try:
-        return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
-    except (OSError, TimeoutError) as exc:  # refused, unreachable, or no answer in time
-        raise InputError(
-            "--scheduler",
-            scheduler,
-            f"a running Dask scheduler that answers within {CONNECT_TIMEOUT_S} s",
-            f"{type(exc).__name__}: {exc}".splitlines()[0],
-        ) from None
-
-
-def quiet_shutdown_logs(client) -> None:
-    """Silence Dask's logging here and on the workers before an interrupted run closes them.
-
-    Closing workers in the middle of their cases makes the worker, nanny and scheduler log
-    warnings (cancelled tasks, workers killed) that say only that the run was stopped. The
-    level stays raised in this process: some of those lines come from the cluster's threads
-    after it is closed, and an interrupted command is ending anyway.
-    """
-    logging.getLogger("distributed").setLevel(logging.CRITICAL)
-    try:
-        client.run(_silence_distributed_logs)
-    except Exception:  # a client already closed or never connected: nothing to silence there
-        pass
-
-
-def _silence_distributed_logs() -> None:
-    logging.getLogger("distributed").setLevel(logging.CRITICAL)
-
-
-def check_reachable(scheduler: str | None) -> None:
-    """Connect to ``scheduler`` once and let go: an unreachable one is refused before any work.
-
-    A command calls it before it prints its first line, so that a scheduler that does not
-    answer is its only line; the sweeps connect again when they start.
-    """
-    if scheduler:
-        connect(scheduler).close()
-
-
-def _dashboard(client) -> str | None:
-    try:
-        return client.dashboard_link
-    except Exception:  # no dashboard (bokeh missing, or disabled on the scheduler)
-        return None
 
 
 def table_from_rows(rows: list[dict], axes: list[str]):
@@ -470,43 +293,18 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases_dir:
 
     Returns what is recorded of the cluster (scheduler, workers, threads, dashboard).
     """
-    own = client is None
-    cluster = None
-    held = None
-    if own:
-        threads = max(int((c.config.get("specimen") or {}).get("threads", 1) or 1) for c in pending)
-        held = hold_interrupts() if not scheduler else None
-        try:
-            client, cluster = start_client(scheduler, workers, threads, dashboard)
-        except BaseException:
-            release_interrupts(held)
-            raise
-    try:
-        release_interrupts(held)  # a Ctrl-C of the start-up arrives here, with the cluster in hand to close
-        info = client.scheduler_info()
-        cluster_info = {
-            "scheduler": scheduler or info.get("address"),
-            "workers": len(info.get("workers", {})),
-            "threads": sum(w.get("nthreads", 0) for w in info.get("workers", {}).values()),
-            "local_cluster": cluster is not None,
-            "dashboard": _dashboard(client) if dashboard is not None or scheduler else None,
-        }
+    threads = max(int((c.config.get("specimen") or {}).get("threads", 1) or 1) for c in pending)
+    backend = Backend.dask(scheduler, workers, dashboard=dashboard, threads=threads)
+    with Executor(backend, client=client) as executor:
+        executor.start()
+        cluster_info = executor.cluster_info()
         if progress and cluster_info["dashboard"]:
             from poro2d.console import OutputConsole
 
             err = OutputConsole(stderr=True)
             err.print(f"Dask dashboard: {cluster_info['dashboard']}", highlight=False)
         n_total = len(sweep.cases)
-        rows.update(_submit_all(client, pending, cases_dir, sweep.retries, progress, n_reused, n_total))
-    except KeyboardInterrupt:
-        if own:  # the command says it was interrupted; the cluster's shutdown has nothing to add
-            quiet_shutdown_logs(client)
-        raise
-    finally:
-        if own:
-            client.close()
-            if cluster is not None:
-                cluster.close()
+        rows.update(_submit_all(executor, pending, cases_dir, sweep.retries, progress, n_reused, n_total))
     return cluster_info
 
 
@@ -531,55 +329,47 @@ def _summary(ordered: list[dict], n_reused: int, wall: float, cluster_info: dict
 
 
 def _submit_all(
-    client, pending: list[Case], cases_dir: Path, retries: int, progress: bool, n_reused: int, n_total: int
+    executor: Executor,
+    pending: list[Case],
+    cases_dir: Path,
+    retries: int,
+    progress: bool,
+    n_reused: int,
+    n_total: int,
 ) -> dict[str, dict]:
-    from distributed import as_completed
-
+    """Every pending case as a job; its row (a failed task's as an error row) as it ends."""
     from poro2d.progress import CountProgress
 
-    futures = {}
-    for c in pending:
-        fut = client.submit(
-            compute_case,
-            c.to_dict(),
-            str(cases_dir / c.id),
-            KINDS[c.kind],
-            key=f"{c.kind}-{c.id}",
-            retries=retries,
-            pure=False,
-        )
-        futures[fut] = c
+    jobs = [
+        Job(compute_case, (c.to_dict(), str(cases_dir / c.id), KINDS[c.kind]), c.id, key=f"{c.kind}-{c.id}",
+            retries=retries)
+        for c in pending
+    ]  # fmt: skip
     rows: dict[str, dict] = {}
     label = f"sweep ({n_reused} of {n_total} already done)" if n_reused else "sweep"
     with CountProgress(label, len(pending), "cases", enabled=progress) as bar:
-        n_failed = 0
-        for fut in as_completed(list(futures)):
-            c = futures[fut]
-            if fut.status == "finished":
-                row = fut.result()
-            else:  # the task itself failed: e.g. KilledWorker after too many worker deaths
-                exc = fut.exception()
-                tb = "".join(traceback.format_tb(fut.traceback())) if fut.traceback() else ""
-                row = _failed_row(c, cases_dir / c.id, exc, f"{tb}{type(exc).__name__}: {exc}\n")
-            rows[c.id] = row
-            if row["status"] == "failed":
-                n_failed += 1
+
+        def ended(index: int, outcome) -> None:
+            c = pending[index]
+            if isinstance(outcome, Failed):  # the task itself failed: e.g. KilledWorker after worker deaths
+                exc = outcome.error
+                outcome = _failed_row(
+                    c, cases_dir / c.id, exc, f"{outcome.traceback}{type(exc).__name__}: {exc}\n"
+                )
+            rows[c.id] = outcome
+            n_failed = sum(r["status"] == "failed" for r in rows.values())
             bar.advance(f"{n_failed} failed" if n_failed else "")
-            fut.release()
+
+        executor.map(jobs, on_done=ended)
     return rows
 
 
 __all__ = [
     "SweepResult",
     "case_stage",
-    "check_cluster_options",
-    "check_reachable",
-    "connect",
     "finished_row",
-    "pin_numba_threads",
     "compute_case",
     "run_sweep",
-    "start_client",
     "table_from_rows",
     "write_tables",
 ]

@@ -428,9 +428,11 @@ def run_sensitivity(
     ``sweep_kw``: ``scheduler``, ``workers``, ``client``, ``progress`` of the sweep runner.
     """
     from poro2d.criterion.config import build
+    from poro2d.execute.cluster_options import check_cluster_options
+    from poro2d.execute.dask_cluster import check_reachable
     from poro2d.sweep import density as D
     from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.runner import check_cluster_options, check_reachable, run_sweep
+    from poro2d.sweep.runner import run_sweep
 
     if sweep_kw.get("client") is None:
         check_cluster_options(sweep_kw.get("scheduler"), sweep_kw.get("workers"))

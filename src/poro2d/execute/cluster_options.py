@@ -1,0 +1,86 @@
+"""The cluster options of a command, checked before any work: dashboard, scheduler, workers.
+
+A LocalCluster serves its dashboard on this machine unless asked otherwise; a running
+scheduler is named by an address the checks here read without connecting (whether it
+answers is :func:`poro2d.execute.dask_cluster.check_reachable`'s question).
+"""
+
+from __future__ import annotations
+
+import os
+from urllib.parse import urlsplit
+
+from poro2d.errors import InputError, check_int
+
+#: where a LocalCluster serves its dashboard: this machine only (a port the system picks), so
+#: that other users of a shared login node cannot watch the run or read its logs
+DEFAULT_DASHBOARD = "127.0.0.1:0"
+
+
+def check_dashboard(value: str | None, parameter: str = "--dashboard") -> str | None:
+    """A dashboard address ``HOST:PORT`` (``:PORT`` for every interface), or None for no dashboard
+    (``none``/``off``); the default when ``value`` is None is :data:`DEFAULT_DASHBOARD`.
+    """
+    if value is None:
+        return DEFAULT_DASHBOARD
+    text = str(value).strip()
+    if text.lower() in ("none", "off"):
+        return None
+    host, sep, port = text.rpartition(":")
+    if not sep or not port.isdigit() or int(port) > 65535 or any(c.isspace() or c == "/" for c in host):
+        raise InputError(parameter, value, "HOST:PORT (port 0 to 65535, 0: any free one), :PORT, or none")
+    return text
+
+
+#: seconds to wait for a running scheduler to answer (distributed's own default is 30)
+CONNECT_TIMEOUT_S = 10
+#: address schemes of a Dask scheduler that a user can type
+SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+SCHEDULER_FORM = "an address such as tcp://host:8786 (scheme tcp, tls, ws, wss or ucx; port 1-65535)"
+
+
+def max_workers() -> int:
+    """The most worker processes a local cluster may start: two per core (more only queue)."""
+    return 2 * (os.cpu_count() or 1)
+
+
+def check_cluster_options(scheduler: str | None, workers: int | None) -> None:
+    """``--scheduler`` of the right form and ``--workers`` in range, checked before any work.
+
+    ``--workers`` sizes the local cluster; with ``--scheduler`` the running cluster's own
+    workers take the cases, so the two together are refused rather than one ignored.
+    """
+    if workers is not None:
+        check_int("--workers", workers, 1, max_workers())
+    if scheduler is None:
+        return
+    if workers is not None:
+        raise InputError("--workers", workers, "nothing with --scheduler (its own workers run the cases)")
+    check_scheduler_address(scheduler)
+
+
+def check_scheduler_address(address: str) -> str:
+    """``address`` if it has the form ``[scheme://]host:port``; otherwise InputError."""
+    text = address.strip()
+    full = text if "://" in text else f"tcp://{text}"
+    try:
+        parts = urlsplit(full)
+        port = parts.port
+    except ValueError:
+        raise InputError("--scheduler", address, SCHEDULER_FORM) from None
+    if parts.scheme not in SCHEDULER_SCHEMES or not parts.hostname or port is None or not 0 < port < 65536:
+        raise InputError("--scheduler", address, SCHEDULER_FORM)
+    if parts.path not in ("", "/") or parts.query or parts.fragment:
+        raise InputError("--scheduler", address, SCHEDULER_FORM)
+    return full
+
+
+__all__ = [
+    "CONNECT_TIMEOUT_S",
+    "DEFAULT_DASHBOARD",
+    "SCHEDULER_FORM",
+    "check_cluster_options",
+    "check_dashboard",
+    "check_scheduler_address",
+    "max_workers",
+]
