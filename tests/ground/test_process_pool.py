@@ -11,12 +11,12 @@ from pathlib import Path
 
 import pytest
 
-from conftest import default_sigint
 from poro2d import progress
 from poro2d.errors import InputError
 from poro2d.process_pool import JobsFailed, map_jobs
+from tests.conftest import default_sigint
 
-SRC = Path(__file__).resolve().parents[1] / "src"
+SRC = Path(__file__).resolve().parents[2] / "src"
 
 
 def square_late_first(job: int, report) -> tuple:

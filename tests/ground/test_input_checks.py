@@ -118,7 +118,7 @@ def _report_text(tmp_path, **summary) -> str:
 
     base = dict(quick=False, seed=0, conversions={"methods": []}, criterion={}, replicate_specimens=None,
                 shear=None, paper=PAPER, timings={}, provenance={})  # fmt: skip
-    stored = Path(__file__).parent / "data" / "before_typed_results" / "criterion_result.json"
+    stored = Path(__file__).parents[1] / "data" / "before_typed_results" / "criterion_result.json"
     crit = CriterionOutputs(CriterionResult.from_dict(json.loads(stored.read_text())))
     return to_markdown(build_blocks(tmp_path, PaperSummary(**dict(base, **summary)), crit), tmp_path)
 
