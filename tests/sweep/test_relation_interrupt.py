@@ -18,6 +18,8 @@ import pytest
 
 from tests.conftest import default_sigint
 
+pytestmark = pytest.mark.scenario
+
 SRC = Path(__file__).resolve().parents[2] / "src"
 
 
