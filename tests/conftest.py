@@ -1,4 +1,4 @@
-"""Fixtures shared by several test modules."""
+"""Fixtures shared by several test modules: each is built once per session, then only read."""
 
 import pytest
 
@@ -7,9 +7,12 @@ from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def specimen(tmp_path_factory):
-    """A small prepared specimen (0.06 m x 0.03 m, about 110 disks) saved as a checkpoint; one per module."""
+    """A small prepared specimen (0.06 m x 0.03 m, about 110 disks) saved as a checkpoint.
+
+    Built once for the whole session: the shear, strength, rolling, protocol, export and
+    calibration tests read it (a test that needs to change it works on a copy)."""
     sim, rep = prepare_specimen(SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.2, seed=0)
     assert rep["converged"]
     path = tmp_path_factory.mktemp("specimen") / "specimen.npz"

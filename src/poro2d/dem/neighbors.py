@@ -326,7 +326,7 @@ def brute_force_pairs(pos: np.ndarray, radius: np.ndarray, skin: float) -> set[t
 # disk in the grid of its level, whose cells suit the largest disk of that level: a row
 # then looks, in every level's grid, only at the cells within reach of its own disk.
 # Rows still hold the partners j > i, now ordered by j, and the lists are the candidate
-# set of the single grid (tests/test_dem_neighbors_levels.py); the force sums follow
+# set of the single grid (tests/dem/test_neighbors_levels.py); the force sums follow
 # the slot order, so a run with this search differs from one with the single grid by
 # round-off only. The engine uses it only for wide size ratios (Simulation.level_ratio).
 

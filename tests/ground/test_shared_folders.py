@@ -25,7 +25,7 @@ from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.locks import LOCK_NAME, cache_entry, check_no_escape, output_folder
 
-SRC = Path(__file__).resolve().parents[1] / "src"
+SRC = Path(__file__).resolve().parents[2] / "src"
 TINY_SPECIMEN = "seed = 0\n[specimen]\nwidth = 0.05\nheight = 0.025\nlayers = 2\n"
 # a box this small cannot rest the lid of the fill acceptance: the paper's plate (docs/criterion.md)
 TINY_RELATION = (
@@ -363,6 +363,7 @@ def two_relations(tmp_path_factory):
     return tmp, cfg, ends
 
 
+@pytest.mark.scenario
 def test_two_relations_on_one_fresh_cache(two_relations):
     tmp, _, ends = two_relations
     for rc, err in ends:
@@ -406,6 +407,7 @@ def _kill_group(pgid: int) -> None:
         pass
 
 
+@pytest.mark.scenario
 def test_a_relation_killed_at_random_moments_resumes_to_the_same_result(two_relations, tmp_path):
     reference_dir, cfg, _ = two_relations
     env = _env(tmp_path / "cache")

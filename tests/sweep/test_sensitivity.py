@@ -246,7 +246,7 @@ def test_paper_report_shows_the_section_only_with_results(tmp_path):
     sens, _ = _synthetic_sens()
     parts = {"conversions": {"methods": []}, "criterion": {}, "paper": PAPER, "timings": {}, "provenance": {}}
     summary = PaperSummary(quick=False, seed=0, replicate_specimens=None, shear=None, **parts)
-    stored = Path(__file__).parent / "data" / "before_typed_results" / "criterion_result.json"
+    stored = Path(__file__).parents[1] / "data" / "before_typed_results" / "criterion_result.json"
     crit = CriterionOutputs(CriterionResult.from_dict(json.loads(stored.read_text())))
     without = to_markdown(build_blocks(tmp_path, summary, crit), tmp_path)
     assert "Why the paper gets 0.15" not in without

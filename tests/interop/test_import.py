@@ -12,26 +12,12 @@ import numpy as np
 import pytest
 
 from poro2d.cli import main
-from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.interop import csv_table
 from poro2d.interop import lammps as lmp
 from poro2d.interop.check import read_specimen
 from poro2d.interop.specimen_data import from_checkpoint
 from poro2d.interop.validate import OVERLAP_LIMIT, check_imported
-from poro2d.specimen import paper_grading
-from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
-
-
-@pytest.fixture(scope="module")
-def saved(tmp_path_factory):
-    """A small specimen at n = 0.21 whose top plate carries about 1.3 % of G."""
-    sim, _ = prepare_specimen(
-        SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.21, seed=210000
-    )
-    path = tmp_path_factory.mktemp("specimen") / "specimen.npz"
-    checkpoint.save(sim, path)
-    return path
 
 
 @pytest.fixture(scope="module")

@@ -22,9 +22,9 @@ from poro2d.dem import checkpoint
 from poro2d.dem.simulation import Simulation
 from poro2d.dem.state import Particles, Walls
 from poro2d.errors import InputError
-from rolling_baseline import CASES, baseline_state
+from tests.rolling_baseline import CASES, baseline_state
 
-DATA = Path(__file__).parent / "data"
+DATA = Path(__file__).parents[1] / "data"
 R = 1e-3
 RHO = 2650.0
 T = 0.01
@@ -207,7 +207,7 @@ def test_energy_dissipated_over_a_rotation_cycle():
 # ----------------------------------------------------------------- stability, inputs
 def test_rolling_springs_stay_stable_at_the_automatic_step():
     """Rolling springs that never yield (mu_r huge) in a dense packing, without damping."""
-    from rolling_baseline import packing
+    from tests.rolling_baseline import packing
 
     sim = packing(1, 2)
     sim.set_local_damping(0.0)

@@ -15,19 +15,6 @@ from poro2d.interop import csv_table, pfc, yade
 from poro2d.interop import lammps as lmp
 from poro2d.interop.check import DEFAULTS, check_specimen, read_specimen
 from poro2d.interop.specimen_data import from_checkpoint, from_simulation, series
-from poro2d.specimen import paper_grading
-from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
-
-SMALL = SpecimenSpec(width=0.06, height=0.03, layers=2)
-
-
-@pytest.fixture(scope="module")
-def saved(tmp_path_factory):
-    """A small specimen at n = 0.21 whose top plate carries a force (about 1.3 % of G)."""
-    sim, _ = prepare_specimen(SMALL, paper_grading(), 0.21, seed=210000)
-    path = tmp_path_factory.mktemp("specimen") / "specimen.npz"
-    checkpoint.save(sim, path)
-    return path
 
 
 @pytest.fixture(scope="module")

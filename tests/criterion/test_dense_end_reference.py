@@ -16,6 +16,8 @@ from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.grading import log_linear_grading, paper_grading, preset_grading
 from poro2d.specimen.jamming import jamming_reference
 
+pytestmark = pytest.mark.scenario
+
 BOX = {"width": 0.12, "height": 0.06, "layers": 2}
 
 
@@ -62,7 +64,8 @@ CU_2_5_GAP = (
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason=CU_2_5_GAP)
 def test_dense_end_of_a_log_linear_cu_2_5_grading_is_looser_than_the_reference():
+    """The known gap, measured: a change of protocol that closes it fails here, to be noticed."""
     grading = log_linear_grading(2.5, paper_grading().mean_disk_area())
-    assert abs(_dense_end(grading, seeds=(0,)) - _reference(grading)) < 0.01
+    gap = _dense_end(grading, seeds=(0,)) - _reference(grading)
+    assert gap >= 0.01, (gap, CU_2_5_GAP)

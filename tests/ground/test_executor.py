@@ -11,12 +11,12 @@ from pathlib import Path
 
 import pytest
 
-from conftest import default_sigint
 from poro2d import progress
 from poro2d.errors import InputError
 from poro2d.execute import Backend, Executor, Failed, Job, JobsFailed, results_or_raise
+from tests.conftest import default_sigint
 
-SRC = Path(__file__).resolve().parents[1] / "src"
+SRC = Path(__file__).resolve().parents[2] / "src"
 
 
 def map_local(func, args, processes, **kw):

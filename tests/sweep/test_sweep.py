@@ -5,6 +5,7 @@ import os
 import time
 from pathlib import Path
 
+import distributed
 import pandas as pd
 import pytest
 
@@ -12,8 +13,6 @@ from poro2d.cli import main
 from poro2d.errors import InputError
 from poro2d.execute.dask_cluster import SINGLE_THREAD_ENV
 from poro2d.sweep import SweepResult, parse_sweep, register_kind, run_sweep
-
-distributed = pytest.importorskip("distributed")
 
 TINY = {"width": 0.05, "height": 0.025, "layers": 2}
 # one trial and a short plate servo: each case takes about a second of DEM

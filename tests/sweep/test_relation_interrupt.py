@@ -16,9 +16,11 @@ from pathlib import Path
 
 import pytest
 
-from conftest import default_sigint
+from tests.conftest import default_sigint
 
-SRC = Path(__file__).resolve().parents[1] / "src"
+pytestmark = pytest.mark.scenario
+
+SRC = Path(__file__).resolve().parents[2] / "src"
 
 
 @pytest.mark.parametrize("after_s", [2.0, 5.0, 12.0])

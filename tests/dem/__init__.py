@@ -1,0 +1,1 @@
+"""Tests of ``poro2d.dem``: the engine against its references and laws."""

@@ -1,0 +1,1 @@
+"""Tests of the modules at the package root: errors, console, files, locks, identity, porosity."""

@@ -1,0 +1,1 @@
+"""Tests of ``poro2d.paper``: the case study in one command."""

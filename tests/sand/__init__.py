@@ -1,0 +1,1 @@
+"""Tests of ``poro2d.sand``: ``poro2d sand``."""

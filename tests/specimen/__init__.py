@@ -1,0 +1,1 @@
+"""Tests of ``poro2d.specimen``: gradings, placement, compaction, porosity regions, jamming."""
