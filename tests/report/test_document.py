@@ -66,7 +66,7 @@ def test_figures_are_drawn_and_saved_only_in_report():
     """Every figure is drawn in report/ and written by report/figure_file.py (one dpi, atomic)."""
     from pathlib import Path
 
-    package = Path(__file__).resolve().parents[1] / "src" / "poro2d"
+    package = Path(__file__).resolve().parents[2] / "src" / "poro2d"
     drawing = [p for p in package.rglob("*.py") if "matplotlib" in p.read_text()]
     assert drawing and all(p.parent.name == "report" for p in drawing), drawing
     saving = [p.name for p in package.rglob("*.py") if ".savefig(" in p.read_text()]
