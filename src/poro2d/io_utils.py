@@ -316,7 +316,8 @@ def read_utf8(parameter: str, path: str | os.PathLike, allowed: str) -> str:
     a file of other bytes (binary, Latin-1) is an InputError.
 
     The message names the file and the line and column of the first byte that is not
-    UTF-8, so the user can find it.
+    UTF-8, so the user can find it. A byte order mark at the start is dropped: spreadsheets
+    write one before UTF-8 CSV files.
     """
     from poro2d.errors import InputError
 
@@ -326,7 +327,7 @@ def read_utf8(parameter: str, path: str | os.PathLike, allowed: str) -> str:
     except OSError as exc:  # no permission, or gone since it was found
         raise InputError(parameter, str(p), allowed, exc.strerror or type(exc).__name__) from None
     try:
-        return data.decode("utf-8")
+        return data.decode("utf-8").removeprefix("\ufeff")
     except UnicodeDecodeError as exc:
         line, column = text_position(data, exc.start)
         where = f"byte 0x{data[exc.start]:02x} at line {line}, column {column} is not UTF-8"

@@ -158,3 +158,13 @@ def test_a_config_with_a_non_finite_number_is_not_written(tmp_path):
     assert list(tmp_path.iterdir()) == []
     write_json(tmp_path / "config.json", {"specimen": {"width": np.float64(0.3)}}, config=True)
     assert json.loads((tmp_path / "config.json").read_text()) == {"specimen": {"width": 0.3}}
+
+
+def test_a_byte_order_mark_is_dropped_from_utf8_files(tmp_path):
+    from poro2d.config import load_toml
+    from poro2d.io_utils import read_utf8
+
+    p = tmp_path / "case.toml"
+    p.write_bytes(b"\xef\xbb\xbfseed = 3\n")
+    assert read_utf8("config", p, "a UTF-8 file") == "seed = 3\n"
+    assert load_toml(p) == {"seed": 3}

@@ -68,6 +68,14 @@ def test_lab_peaks(tmp_path):
     assert lab.kind == "peaks" and lab.peaks[200.0] == 141.0
 
 
+def test_a_lab_file_with_a_byte_order_mark_is_read(tmp_path):
+    """Spreadsheets save UTF-8 CSV with a byte order mark: the header must still be found."""
+    p = tmp_path / "lab.csv"
+    p.write_bytes(b"\xef\xbb\xbf" + b"normal_stress_kpa,peak_shear_stress_kpa\r\n50,38\r\n100,72\r\n")
+    lab = read_lab_csv(p)
+    assert lab.kind == "peaks" and lab.peaks == {50.0: 38.0, 100.0: 72.0}
+
+
 @pytest.mark.parametrize(
     ("text", "needle"),
     [
