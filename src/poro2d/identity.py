@@ -9,7 +9,7 @@ marked where it is declared, with :func:`outside_identity`, so the rule travels 
 field; nobody drops keys by hand.
 
 Every place that asks "is this the same run?" asks here: a resumable folder's record
-(:class:`poro2d.resumable.Fingerprint`), a sweep case's id and folder, a cached
+(:class:`poro2d.store.stage.Fingerprint`), a sweep case's id and folder, a cached
 calibration, a calibration's shear test, the density checks that are calibration cases
 already. :func:`identity_view` gives the description as compared (to name the keys that
 differ), :func:`identity_digest` its SHA-256.

@@ -20,7 +20,7 @@ from poro2d.criterion.replicates import accepted_and_replicates
 from poro2d.io_utils import provenance, write_csv, write_json
 from poro2d.locks import holds_output
 from poro2d.paper_data import PAPER, QUICK_SHEAR
-from poro2d.resumable import Fingerprint, ResumableStage
+from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.typed_result import TypedResult
 
 if TYPE_CHECKING:

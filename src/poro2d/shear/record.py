@@ -4,7 +4,7 @@ The record holds what a test's results depend on: a digest of the specimen's sta
 normal stress and the settings. It holds no path, so a moved or copied folder resumes
 without recomputing; a folder whose work belongs to another test is refused. The rules
 (record, markers, binding once work has started) are those of
-:class:`poro2d.resumable.ResumableStage`; this module words them for a test.
+:class:`poro2d.store.stage.ResumableStage`; this module words them for a test.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from poro2d.io_utils import provenance
-from poro2d.resumable import Fingerprint, ResumableStage
+from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.shear.settings import ShearSettings
 
 RECORD = "test.json"

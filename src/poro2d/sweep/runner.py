@@ -34,7 +34,7 @@ from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_opti
 from poro2d.execute.dask_cluster import pin_numba_threads
 from poro2d.io_utils import atomic_path, provenance, write_json
 from poro2d.locks import cache_entry, holds_output
-from poro2d.resumable import Fingerprint, ResumableStage
+from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.sweep.cases import KINDS, Case, SweepConfig, config_tables
 from poro2d.sweep.results import SweepResult
 

@@ -6,7 +6,7 @@ import shutil
 import pytest
 
 from poro2d.errors import InputError
-from poro2d.resumable import Fingerprint, ResumableStage, differing_keys
+from poro2d.store.stage import Fingerprint, ResumableStage, differing_keys
 
 SETTINGS = {"specimen": {"width": 0.06, "threads": 1}, "criterion": {"max_iterations": 2}, "seed": 0}
 

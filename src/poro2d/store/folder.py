@@ -1,0 +1,247 @@
+"""The store: the one place that reads and writes result files.
+
+Protocols (the criterion, a shear test, a sweep's case, a calibration unit) compute typed
+results; they never form a path. A protocol that keeps files, or resumes from them, is
+handed a :class:`Store` and asks it by *name* for what it keeps: a JSON result, a table,
+arrays, a saved simulation state, a checkpoint. ``store=None`` means nothing is kept.
+
+A store is a folder and the rules every result file follows:
+
+* every file is written atomically (:func:`poro2d.io_utils.atomic_path`): a killed run
+  leaves no file that looks complete;
+* JSON is strict (NaN written as ``null``), a typed result is written with its
+  ``to_dict()`` and read back with ``from_dict()``;
+* a stage's marker is written last (:class:`~poro2d.store.stage.ResumableStage`, reached
+  through :meth:`Store.stage`), so a finished stage is one whose marker is there;
+* what is read back is checked: a file that cannot be parsed is reported as missing
+  (``None``), never half-used.
+
+Sub-stores (:meth:`Store.child`) are the folders of the parts of a run (a trial, a test):
+the names a protocol uses are relative, so a moved or copied folder resumes.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import zipfile
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypeVar
+
+import numpy as np
+
+from poro2d.dem import checkpoint
+from poro2d.io_utils import atomic_path, write_csv, write_json
+from poro2d.store.stage import Fingerprint, ResumableStage
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from poro2d.dem.simulation import Simulation
+
+R = TypeVar("R")
+
+
+class Store:
+    """Result files under one folder, named relative to it.
+
+    ``parameter`` names the option the folder came from (``--out``), for refusals.
+    """
+
+    def __init__(self, root: str | os.PathLike, *, parameter: str = "--out") -> None:
+        self._root = Path(root)
+        self.parameter = parameter
+
+    def __repr__(self) -> str:
+        return f"Store({str(self._root)!r})"
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Store) and other.root == self._root
+
+    def __hash__(self) -> int:
+        return hash(self._root)
+
+    @property
+    def root(self) -> Path:
+        """The folder (for messages, and for tools that write whole folders: figures, VTU)."""
+        return self._root
+
+    def child(self, *parts: str) -> Store:
+        """The store of a part of the run (``trials/02_n0.2300``), in a sub-folder."""
+        return Store(self._root.joinpath(*parts), parameter=self.parameter)
+
+    def path(self, name: str) -> Path:
+        """Where ``name`` lives; its folder is made, so writers of other formats can use it."""
+        p = self._root / name
+        p.parent.mkdir(parents=True, exist_ok=True)
+        return p
+
+    def has(self, name: str) -> bool:
+        """True when ``name`` is a file of this store."""
+        return (self._root / name).is_file()
+
+    def exists(self) -> bool:
+        """True when the store's folder exists."""
+        return self._root.is_dir()
+
+    def names(self, pattern: str = "*") -> list[str]:
+        """The store's entries matching ``pattern``, sorted (sub-stores included)."""
+        if not self._root.is_dir():
+            return []
+        return sorted(p.name for p in self._root.glob(pattern))
+
+    # -- JSON and typed results -------------------------------------------------------
+
+    def write_json(self, name: str, data: Mapping, *, config: bool = False) -> Path:
+        """``data`` as strict JSON in ``name``, atomically (see :func:`poro2d.io_utils.write_json`)."""
+        path = self._root / name
+        write_json(path, data, config=config)
+        return path
+
+    def read_json(self, name: str) -> Any:
+        """The JSON in ``name``; None when it is missing or cannot be parsed."""
+        try:
+            return json.loads((self._root / name).read_text())
+        except (OSError, ValueError):
+            return None
+
+    def write_result(self, name: str, result: Any) -> Path:
+        """A typed result's file (``result.to_dict()``), atomically."""
+        return self.write_json(name, result.to_dict())
+
+    def read_result(self, name: str, decode: Callable[[dict], R]) -> R | None:
+        """``decode`` of the JSON object in ``name`` (a result class's ``from_dict``); None without one."""
+        data = self.read_json(name)
+        return decode(data) if isinstance(data, dict) else None
+
+    # -- tables ---------------------------------------------------------------------------
+
+    def write_csv(self, name: str, rows: Iterable[Mapping], header: list[str] | None = None) -> Path:
+        """Rows of dicts as CSV, atomically (columns in first-seen order unless ``header``)."""
+        path = self._root / name
+        write_csv(path, rows, header)
+        return path
+
+    def write_frame(self, name: str, frame: pd.DataFrame, **kw: Any) -> Path:
+        """A pandas table as CSV, atomically (``kw`` go to ``DataFrame.to_csv``; no index by default)."""
+        path = self._root / name
+        kw.setdefault("index", False)
+        with atomic_path(path) as tmp:
+            frame.to_csv(tmp, **kw)
+        return path
+
+    def read_frame(self, name: str, **kw: Any) -> pd.DataFrame:
+        """The CSV ``name`` as a pandas table (``kw`` go to ``pandas.read_csv``)."""
+        import pandas as pd
+
+        return pd.read_csv(self._root / name, **kw)
+
+    def write_text(self, name: str, text: str) -> Path:
+        """A text file (a report, a script), atomically."""
+        path = self._root / name
+        with atomic_path(path) as tmp:
+            tmp.write_text(text)
+        return path
+
+    def read_text(self, name: str) -> str | None:
+        """The text in ``name``; None when it is missing or unreadable."""
+        try:
+            return (self._root / name).read_text()
+        except (OSError, UnicodeDecodeError):
+            return None
+
+    # -- arrays and simulation states -------------------------------------------------
+
+    def write_arrays(self, name: str, **arrays: Any) -> Path:
+        """Named arrays in one ``.npz``, atomically."""
+        path = self._root / name
+        with atomic_path(path, suffix=".npz") as tmp:
+            np.savez(tmp, **arrays)
+        return path
+
+    def read_arrays(self, name: str) -> dict[str, np.ndarray] | None:
+        """The arrays of ``name`` (all read now, so the file is closed); None when missing or damaged."""
+        try:
+            with np.load(self._root / name, allow_pickle=False) as z:
+                return {k: z[k] for k in z.files}
+        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
+            return None
+
+    def save_state(self, name: str, sim: Simulation, extra: dict | None = None) -> Path:
+        """A simulation's whole state (:func:`poro2d.dem.checkpoint.save`)."""
+        return checkpoint.save(sim, self._root / name, extra=extra)
+
+    def load_state(self, name: str, threads: int | None = None) -> Simulation:
+        """A saved state as a simulation (:func:`poro2d.dem.checkpoint.load`; a damaged file is refused)."""
+        return checkpoint.load(self._root / name, threads=threads)
+
+    def state_meta(self, name: str) -> dict:
+        """The metadata of a saved state (:func:`poro2d.dem.checkpoint.read_meta`)."""
+        return checkpoint.read_meta(self._root / name)
+
+    def copy(self, name: str, to: str | Store, as_name: str | None = None) -> Path:
+        """Copy ``name`` atomically to ``to``: a name here, or a store (as ``as_name``, default the same)."""
+        dest_store, dest = (to, as_name or name) if isinstance(to, Store) else (self, to)
+        target = dest_store.root / dest
+        with atomic_path(target) as tmp:
+            shutil.copyfile(self._root / name, tmp)
+        return target
+
+    def remove(self, name: str) -> None:
+        """Remove the file ``name`` if it is there."""
+        try:
+            (self._root / name).unlink()
+        except FileNotFoundError:
+            pass
+
+    # -- stages ---------------------------------------------------------------------------
+
+    def stage(self, fingerprint: Fingerprint, **kw: Any) -> ResumableStage:
+        """The resumable stages of this store bound to ``fingerprint`` (``kw``: see ResumableStage)."""
+        kw.setdefault("parameter", self.parameter)
+        return ResumableStage(self._root, fingerprint, **kw)
+
+    def checkpoints(self, name: str = "checkpoint.npz") -> Checkpoints:
+        """A checkpoint reporter for a long run kept in ``name`` (see :class:`Checkpoints`)."""
+        return Checkpoints(self, name)
+
+
+class Checkpoints:
+    """Saves a long run's state at its Python events and gives it back on a rerun.
+
+    A protocol that runs long (a shear test's drive) takes one of these instead of a
+    folder: :meth:`resume` returns the saved state and its metadata (None on a first run),
+    :meth:`save` keeps the state now, :meth:`clear` drops it once the stage's result is
+    written.
+    """
+
+    def __init__(self, store: Store, name: str) -> None:
+        self.store = store
+        self.name = name
+
+    def resume(self, threads: int | None = None) -> tuple[Simulation, dict] | None:
+        """The saved state and the ``extra`` it was saved with; None when there is none."""
+        if not self.store.has(self.name):
+            return None
+        extra = self.store.state_meta(self.name).get("extra", {})
+        return self.store.load_state(self.name, threads=threads), extra
+
+    def save(self, sim: Simulation, extra: dict | None = None) -> None:
+        """Keep ``sim``'s state now (atomically), with ``extra`` (where the protocol was)."""
+        self.store.save_state(self.name, sim, extra=extra)
+
+    def clear(self) -> None:
+        """Drop the checkpoint (the stage it served is finished)."""
+        self.store.remove(self.name)
+
+
+def walk(store: Store, pattern: str) -> Iterator[Store]:
+    """The sub-stores of ``store`` whose folder names match ``pattern``, sorted."""
+    for name in store.names(pattern):
+        if (store.root / name).is_dir():
+            yield store.child(name)
+
+
+__all__ = ["Checkpoints", "Store", "walk"]
