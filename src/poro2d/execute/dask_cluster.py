@@ -14,11 +14,13 @@ import logging
 import os
 import traceback
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 from poro2d.errors import InputError
 from poro2d.execute.cluster_options import CONNECT_TIMEOUT_S, DEFAULT_DASHBOARD, check_scheduler_address
 from poro2d.execute.jobs import Failed, Job
+from poro2d.typed_result import TypedResult
 from poro2d.worker_signals import hold_interrupts, ignore_interrupts_in_dask_worker, release_interrupts
 
 ignore_interrupts_in_dask_worker()  # a worker imports this module to run its first task
@@ -127,6 +129,17 @@ def _dashboard(client) -> str | None:
         return None
 
 
+@dataclass(eq=False)
+class ClusterInfo(TypedResult):
+    """What a sweep records of the Dask cluster it ran on (the ``cluster`` key of its record)."""
+
+    scheduler: str | None
+    workers: int
+    threads: int
+    local_cluster: bool
+    dashboard: str | None
+
+
 class DaskCluster:
     """A Dask client for the executor: ``client`` as given, or one started at the first job.
 
@@ -163,23 +176,23 @@ class DaskCluster:
         self.scheduler_info = self.client.scheduler_info()
         return self.client
 
-    def info(self) -> dict:
-        """Scheduler, workers, threads, whether it is a local cluster, the dashboard; {} before the start.
+    def info(self) -> ClusterInfo | None:
+        """Scheduler, workers, threads, whether it is a local cluster, the dashboard; None before the start.
 
         The dashboard is asked of the client, so before it is closed.
         """
         if self.scheduler_info is None:
-            return {}
+            return None
         workers = self.scheduler_info.get("workers", {})
-        return {
-            "scheduler": self.scheduler or self.scheduler_info.get("address"),
-            "workers": len(workers),
-            "threads": sum(w.get("nthreads", 0) for w in workers.values()),
-            "local_cluster": self.local_cluster,
-            "dashboard": _dashboard(self.client)
+        return ClusterInfo(
+            scheduler=self.scheduler or self.scheduler_info.get("address"),
+            workers=len(workers),
+            threads=sum(w.get("nthreads", 0) for w in workers.values()),
+            local_cluster=self.local_cluster,
+            dashboard=_dashboard(self.client)
             if self.client is not None and (self.dashboard is not None or self.scheduler)
             else None,
-        }
+        )
 
     def map(self, jobs: Sequence[Job], on_done: Callable[[int, Any], None] | None) -> list:
         """Every job as a task; ``on_done(index, outcome)`` as each ends; outcomes in job order."""
@@ -227,6 +240,7 @@ def _run_task(job: Job):
 
 __all__ = [
     "SINGLE_THREAD_ENV",
+    "ClusterInfo",
     "DaskCluster",
     "check_reachable",
     "connect",
