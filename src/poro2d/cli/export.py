@@ -55,6 +55,8 @@ def export_cmd(
     for p in paths:
         t.add_row(str(p), f"{p.stat().st_size:,}")
     console.print(t)
+    if to == "pfc" and pfc.pfc4_refusal(spec):
+        console.print(pfc.pfc4_refusal(spec))
     if state is not None:
         dr_text = "unknown" if state.relative_density is None else f"{state.relative_density:.4f}"
         console.print(

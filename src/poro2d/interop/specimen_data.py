@@ -92,6 +92,12 @@ class SpecimenData:
         return int(self.x.shape[0])
 
     @property
+    def rolled(self) -> bool:
+        """True when any disk or wall has rolling friction (a target must carry it or refuse)."""
+        disks = self.mu_r is not None and bool(np.any(np.asarray(self.mu_r) > 0.0))
+        return disks or any(w.mu_r > 0.0 for w in self.walls)
+
+    @property
     def mass(self) -> np.ndarray:
         """Disk masses rho pi r^2 t (kg)."""
         return self.density * math.pi * self.radius**2 * self.thickness
