@@ -273,11 +273,21 @@ def test_the_local_dashboard_listens_on_this_machine_only(monkeypatch):
     dask_cluster.start_client(None, 1, 1, dashboard=None)  # no dashboard: its web server stays local
     assert seen["dashboard_address"] == "127.0.0.1:0" and seen["scheduler_kwargs"] == {"dashboard": False}
     assert cluster_options.check_dashboard(None) == "127.0.0.1:0"
-    assert cluster_options.check_dashboard("0.0.0.0:8787") == "0.0.0.0:8787"
+    free = _free_port()
+    assert cluster_options.check_dashboard(f"0.0.0.0:{free}") == f"0.0.0.0:{free}"
     assert cluster_options.check_dashboard("none") is None
     for bad in ("8787", "host:port", "a b:1", "h:70000"):
         with pytest.raises(InputError, match="--dashboard"):
             cluster_options.check_dashboard(bad)
+
+
+def _free_port() -> int:
+    """A port no one listens on now (the system's pick, released)."""
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("0.0.0.0", 0))
+        return s.getsockname()[1]
 
 
 def test_a_bad_dashboard_address_is_refused_before_any_work(tmp_path, capsys):

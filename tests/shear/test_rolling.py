@@ -16,9 +16,9 @@ from poro2d.interop import lammps as lmp
 from poro2d.interop.check import box_spec, build_simulation
 from poro2d.interop.check import read_specimen as import_specimen
 from poro2d.interop.specimen_data import from_checkpoint
-from poro2d.store.stage import Fingerprint
 from poro2d.shear import DirectShearTest, ShearSettings, build_split_box
 from poro2d.shear.record import content_record
+from poro2d.store.stage import Fingerprint
 
 
 @pytest.fixture(scope="module")

@@ -48,10 +48,10 @@ from poro2d.dem import Simulation, checkpoint
 from poro2d.errors import InputError, check_range
 from poro2d.io_utils import as_json, provenance, write_csv, write_json
 from poro2d.porosity import PAPER_N_LAB, parabolic
-from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.specimen.compaction import SpecimenSpec, box_porosity, preparation_note, prepare_specimen
 from poro2d.specimen.grading import GradingCurve
 from poro2d.specimen.porosity_regions import lid_height_at, mass_d50
+from poro2d.store.stage import Fingerprint, ResumableStage
 
 #: how a trial's specimen is judged full: "plate", the paper's rigid top plate (its n' includes
 #: the gap under the plate); "fill", a segmented lid that rests on the grains over the width

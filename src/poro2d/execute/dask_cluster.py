@@ -12,10 +12,13 @@ from __future__ import annotations
 
 import logging
 import os
+import socket
+import struct
 import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
+from urllib.parse import urlsplit
 
 from poro2d.errors import InputError
 from poro2d.execute.cluster_options import CONNECT_TIMEOUT_S, DEFAULT_DASHBOARD, check_scheduler_address
@@ -82,6 +85,14 @@ def connect(scheduler: str):
     from distributed import Client
 
     address = check_scheduler_address(scheduler)
+    silent = not_a_scheduler(address)
+    if silent:
+        raise InputError(
+            "--scheduler",
+            scheduler,
+            f"a running Dask scheduler that answers within {CONNECT_TIMEOUT_S} s",
+            silent,
+        )
     try:
         return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
     except (OSError, TimeoutError) as exc:  # refused, unreachable, or no answer in time
@@ -91,6 +102,46 @@ def connect(scheduler: str):
             f"a running Dask scheduler that answers within {CONNECT_TIMEOUT_S} s",
             f"{type(exc).__name__}: {exc}".splitlines()[0],
         ) from None
+
+
+def not_a_scheduler(address: str, timeout: float = CONNECT_TIMEOUT_S) -> str | None:
+    """Why the server at a ``tcp://`` ``address`` is not a Dask scheduler; None when it may be.
+
+    A Dask server speaks first: on a new connection it sends its handshake, a message whose
+    first two 8-byte words are its length and its count of frames. A server of another kind
+    (a web server waiting for a request) sends nothing, and the Dask client would wait on it
+    for ever; one that sends something else is not Dask either. Other schemes (tls, ws, ucx)
+    start with their own handshake and are left to the client's timeout.
+    """
+    parts = urlsplit(address)
+    if parts.scheme != "tcp":
+        return None
+    try:
+        with socket.create_connection((parts.hostname, parts.port), timeout=timeout) as sock:
+            greeting = _receive(sock, 16, timeout)
+    except OSError as exc:  # refused or unreachable: the client says so in its own words
+        return None if not isinstance(exc, TimeoutError) else f"no connection in {timeout:g} s"
+    if len(greeting) < 16:
+        return f"the server at {parts.hostname}:{parts.port} sent no Dask handshake in {timeout:g} s"
+    length, frames = struct.unpack("<QQ", greeting)
+    if not (16 <= length < 1 << 30 and 1 <= frames < 1 << 16):
+        return f"the server at {parts.hostname}:{parts.port} does not speak Dask's protocol"
+    return None
+
+
+def _receive(sock: socket.socket, count: int, timeout: float) -> bytes:
+    """Up to ``count`` bytes, as many as arrive before ``timeout`` or the end of the stream."""
+    sock.settimeout(timeout)
+    data = b""
+    try:
+        while len(data) < count:
+            chunk = sock.recv(count - len(data))
+            if not chunk:
+                break
+            data += chunk
+    except TimeoutError:
+        pass
+    return data
 
 
 def quiet_shutdown_logs(client) -> None:
@@ -244,6 +295,7 @@ __all__ = [
     "DaskCluster",
     "check_reachable",
     "connect",
+    "not_a_scheduler",
     "pin_numba_threads",
     "quiet_shutdown_logs",
     "start_client",

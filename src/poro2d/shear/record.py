@@ -13,8 +13,8 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from poro2d.io_utils import provenance
-from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.shear.settings import ShearSettings
+from poro2d.store.stage import Fingerprint, ResumableStage
 
 RECORD = "test.json"
 

@@ -25,7 +25,6 @@ from poro2d.dem import Simulation, checkpoint
 from poro2d.dem.measure import coordination_number
 from poro2d.errors import InputError, check_range
 from poro2d.io_utils import as_json, provenance, write_csv
-from poro2d.store.stage import ResumableStage
 from poro2d.shear import record
 from poro2d.shear.box import SplitBox, build_split_box
 from poro2d.shear.controllers import Consolidation, ProgressFn
@@ -35,6 +34,7 @@ from poro2d.shear.results import ShearTestResult
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings, inertial_number
 from poro2d.shear.shear_stage import ShearStage, remove_stage_files
 from poro2d.shear.specimen_file import resolve_specimen, specimen_box
+from poro2d.store.stage import ResumableStage
 
 
 class DirectShearTest:
