@@ -29,6 +29,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
+from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
 from poro2d.dem.ordering import strip_order
 from poro2d.errors import InputError, check_range
 from poro2d.paper_data import TABLE_1
@@ -167,7 +168,7 @@ def build_split_box(
     if particle_friction is not None:
         check_range("particle_friction", particle_friction, 0.0, None)
     if rolling_friction is not None:
-        check_range("rolling_friction", rolling_friction, 0.0, None)
+        check_range("rolling_friction", rolling_friction, 0.0, MAX_ROLLING_FRICTION)
     p0 = specimen.particles
     if p0.n == 0:
         raise InputError("specimen", "no disks", "a specimen with disks")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
+from poro2d.dem.contact_law import MAX_ROLLING_FRICTION as ENGINE_MAX_ROLLING_FRICTION
 from poro2d.errors import InputError, check_int, check_range
 from poro2d.paper_data import TABLE_1
 
@@ -26,10 +27,8 @@ MAX_CONSOLIDATION_STEPS = 10_000_000
 MAX_WALL_STIFFNESS = 1e10
 #: friction coefficients beyond 10 hold as a rough wall does; larger ones are typos
 MAX_FRICTION = 10.0
-#: rolling frictions beyond 1 hold a disk against any tilt it meets in a shear band (a disk
-#: rolls when the moment arm of its contact force exceeds mu_r R: at 1 the force would have to
-#: lean past 45 degrees); larger ones are typos
-MAX_ROLLING_FRICTION = 1.0
+#: the largest rolling friction (the engine's bound, see poro2d.dem.contact_law)
+MAX_ROLLING_FRICTION = ENGINE_MAX_ROLLING_FRICTION
 #: inertial masses up to 1000 times the real ones: the inertial number grows with its root
 MAX_DENSITY_SCALE = 1000.0
 

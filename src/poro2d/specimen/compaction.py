@@ -31,6 +31,7 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
+from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
 from poro2d.dem.measure import porosity_rect
 from poro2d.dem.ordering import strip_order
 from poro2d.dem.simulation import MEASURES
@@ -120,7 +121,7 @@ class SpecimenSpec:
             check_range(k, getattr(self, k), 0, None, lo_open=True)
         for k in ("ks_particle", "ks_wall", "friction_prep", "friction_particle", "friction_wall"):
             check_range(k, getattr(self, k), 0, None)
-        check_range("rolling_friction", self.rolling_friction, 0, None)
+        check_range("rolling_friction", self.rolling_friction, 0, MAX_ROLLING_FRICTION)
         check_int("layers", self.layers, 1, 50)
         check_range("undercompaction", self.undercompaction, 0.0, 0.5)
         check_range("ratio", self.ratio, 0.0, 1.0, lo_open=True)
