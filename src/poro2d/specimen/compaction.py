@@ -35,7 +35,7 @@ from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
 from poro2d.dem.measure import porosity_rect
 from poro2d.dem.ordering import strip_order
 from poro2d.dem.simulation import MEASURES
-from poro2d.errors import InputError, check_int, check_range
+from poro2d.errors import InputError, Integer, OneOf, Ranges, Real, check_fields, check_range
 from poro2d.identity import outside_identity
 from poro2d.paper_data import TABLE_1
 from poro2d.specimen.grading import MAX_DRAW, GradingCurve, draw_disks
@@ -70,6 +70,35 @@ OMITTED_AT_DEFAULT = {
     "equilibrium": "max", "settle_drift": None, "settle_window": 10_000, "settle_checks": 3,
     "rolling_friction": 0.0,
 }  # fmt: skip
+
+
+#: what each setting of a :class:`SpecimenSpec` may be (checked in this order)
+SPECIMEN_RANGES: Ranges = {
+    **{k: Real(0, None, lo_open=True) for k in ("width", "height", "thickness", "solid_density")},
+    **{k: Real(0, None, lo_open=True) for k in ("kn_particle", "kn_wall")},
+    **{
+        k: Real(0, None)
+        for k in ("ks_particle", "ks_wall", "friction_prep", "friction_particle", "friction_wall")
+    },
+    "rolling_friction": Real(0, MAX_ROLLING_FRICTION),
+    "layers": Integer(1, 50),
+    "undercompaction": Real(0.0, 0.5),
+    "ratio": Real(0.0, 1.0, lo_open=True),
+    "equilibrium": OneOf(tuple(MEASURES), quoted=True),
+    "settle_drift": Real(0.0, 0.1, lo_open=True, or_none=True),
+    "settle_window": Integer(100),
+    "settle_checks": Integer(1, 100),
+    "local_damping": Real(0.0, 1.0, hi_open=True),
+    "gravity": Real(0.0, None),
+    **{
+        k: Integer(1)
+        for k in ("growth_increments", "growth_steps", "max_steps_per_stage", "fallback_steps", "calm_steps")
+    },
+    "calm_damping": Real(0.0, 1.0, hi_open=True),
+    "dt_safety": Real(0.0, 1.0, lo_open=True),
+    "threads": Integer(1),
+    "max_disks": Integer(1, MAX_DRAW),
+}
 
 
 @dataclass
@@ -113,35 +142,7 @@ class SpecimenSpec:
     max_disks: int = DEFAULT_MAX_DISKS
 
     def __post_init__(self) -> None:
-        check_range("width", self.width, 0, None, lo_open=True)
-        check_range("height", self.height, 0, None, lo_open=True)
-        check_range("thickness", self.thickness, 0, None, lo_open=True)
-        check_range("solid_density", self.solid_density, 0, None, lo_open=True)
-        for k in ("kn_particle", "kn_wall"):
-            check_range(k, getattr(self, k), 0, None, lo_open=True)
-        for k in ("ks_particle", "ks_wall", "friction_prep", "friction_particle", "friction_wall"):
-            check_range(k, getattr(self, k), 0, None)
-        check_range("rolling_friction", self.rolling_friction, 0, MAX_ROLLING_FRICTION)
-        check_int("layers", self.layers, 1, 50)
-        check_range("undercompaction", self.undercompaction, 0.0, 0.5)
-        check_range("ratio", self.ratio, 0.0, 1.0, lo_open=True)
-        if self.equilibrium not in MEASURES:
-            allowed = "one of " + ", ".join(repr(m) for m in MEASURES)
-            raise InputError("equilibrium", self.equilibrium, allowed)
-        if self.settle_drift is not None:
-            check_range("settle_drift", self.settle_drift, 0.0, 0.1, lo_open=True)
-        check_int("settle_window", self.settle_window, 100)
-        check_int("settle_checks", self.settle_checks, 1, 100)
-        check_range("local_damping", self.local_damping, 0.0, 1.0, hi_open=True)
-        check_range("gravity", self.gravity, 0.0, None)
-        check_int("growth_increments", self.growth_increments, 1)
-        check_int("growth_steps", self.growth_steps, 1)
-        for k in ("max_steps_per_stage", "fallback_steps", "calm_steps"):
-            check_int(k, getattr(self, k), 1)
-        check_range("calm_damping", self.calm_damping, 0.0, 1.0, hi_open=True)
-        check_range("dt_safety", self.dt_safety, 0.0, 1.0, lo_open=True)
-        check_int("threads", self.threads, 1)
-        check_int("max_disks", self.max_disks, 1, MAX_DRAW)
+        check_fields(self, SPECIMEN_RANGES)
 
     def to_dict(self) -> dict:
         """The specimen's settings as recorded with results.
