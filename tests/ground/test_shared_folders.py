@@ -440,3 +440,33 @@ def test_a_relation_killed_at_random_moments_resumes_to_the_same_result(two_rela
     assert _lock_files(out, tmp_path / "cache") == []
     cases = list((tmp_path / "cache").rglob("params.json"))
     assert cases and all((c.parent / "result.json").is_file() for c in cases)  # every case finished
+
+
+# ------------------------------------------------------- a folder belongs to one kind of run
+def test_a_folder_of_another_kind_of_run_is_refused_before_any_work(tmp_path):
+    from poro2d.locks import KIND_NAME, folder_kind, output_folder
+
+    out = tmp_path / "out"
+    with output_folder("--out", out, kind="criterion"):
+        (out / "result.json").write_text("{}")
+    assert folder_kind(out) == "criterion"
+    with output_folder("--out", out, kind="criterion"):  # the same kind: resumes
+        pass
+    with pytest.raises(InputError, match="holds the results of a criterion run") as e:
+        with output_folder("--out", out, kind="calibrate"):
+            raise AssertionError("no work may start")
+    assert e.value.parameter == "--out"
+    assert sorted(p.name for p in out.iterdir()) == sorted([KIND_NAME, "result.json"])
+
+
+def test_a_run_that_wrote_nothing_leaves_no_kind_behind(tmp_path):
+    from poro2d.locks import output_folder
+
+    empty = tmp_path / "given"
+    empty.mkdir()
+    with output_folder("--out", empty, kind="shear"):
+        pass
+    assert list(empty.iterdir()) == []  # a later run of any kind may use it
+    with output_folder("--out", tmp_path / "new", kind="shear"):
+        pass
+    assert not (tmp_path / "new").exists()

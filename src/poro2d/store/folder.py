@@ -56,6 +56,9 @@ class Store:
         self._root = Path(root)
         self.parameter = parameter
 
+    def __fspath__(self) -> str:
+        return str(self._root)
+
     def __repr__(self) -> str:
         return f"Store({str(self._root)!r})"
 
