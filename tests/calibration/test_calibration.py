@@ -236,7 +236,8 @@ def test_lab_curves_shorter_than_the_tests_are_refused_and_their_end_is_the_last
 
     paths, _ = tiny
     short = tmp_path / "short.csv"
-    short.write_text("normal_stress_kpa,shear_displacement_mm,shear_stress_kpa\n50,0.5,20\n50,1.0,30\n")
+    short.write_text("normal_stress_kpa,shear_displacement_mm,shear_stress_kpa\n"
+                     "50,0.2,10\n50,0.4,20\n50,0.6,25\n50,0.8,28\n50,1.0,30\n")  # fmt: skip
     with pytest.raises(InputError, match="settings.max_displacement"):
         run_calibration(short, [paths[0]], out=tmp_path / "o", settings=SHORT, progress=False)
     assert not (tmp_path / "o" / "cache").exists()
