@@ -9,17 +9,13 @@ import pytest
 from scipy.spatial import Voronoi
 
 from poro2d.errors import InputError
+from poro2d.measure import surface
+from poro2d.measure.disks import mass_d50
+from poro2d.measure.interior import interior_regions
+from poro2d.measure.laguerre import laguerre_cells
+from poro2d.measure.specimen_porosity import SpecimenPorosity, measure_specimen
+from poro2d.measure.surface import plate_surface, surface_profile
 from poro2d.report.specimen_figures import plot_local_porosity
-from poro2d.specimen import porosity_regions as pr
-from poro2d.specimen.porosity_regions import (
-    SpecimenPorosity,
-    interior_regions,
-    laguerre_cells,
-    mass_d50,
-    measure_specimen,
-    plate_surface,
-    surface_profile,
-)
 
 HEX_POROSITY = 1.0 - math.pi / (2.0 * math.sqrt(3.0))
 SQUARE_POROSITY = 1.0 - math.pi / 4.0
@@ -211,7 +207,7 @@ def test_surface_profile_matches_a_loop_and_does_not_depend_on_chunks(monkeypatc
         inside = np.abs(x - cx) <= ri
         expected[inside] = np.maximum(expected[inside], cy + np.sqrt(ri**2 - (x[inside] - cx) ** 2))
     assert np.allclose(h, expected, rtol=0, atol=1e-12)
-    monkeypatch.setattr(pr, "_PAIRS_PER_CHUNK", 37)
+    monkeypatch.setattr(surface, "_PAIRS_PER_CHUNK", 37)
     assert np.array_equal(surface_profile(pos, r, W, 500)[1], h)
 
 
