@@ -35,7 +35,7 @@ def check_box(pos: np.ndarray, width: Any, plate_y: Any) -> tuple[float, float]:
     """The box [0, width] x [0, plate_y], with every disk centre strictly inside it.
 
     The tessellation needs it: a centre outside the box would leave part of the box to the
-    mirror image of a disk (see :func:`laguerre_cells`).
+    mirror image of a disk (see :func:`poro2d.measure.laguerre.laguerre_cells`).
     """
     width = check_range("width", width, 0.0, lo_open=True)
     plate_y = check_range("plate_y", plate_y, 0.0, lo_open=True)
@@ -53,6 +53,7 @@ def check_box(pos: np.ndarray, width: Any, plate_y: Any) -> tuple[float, float]:
 
 
 def check_d50(d50: Any, radius: np.ndarray) -> float:
+    """The median diameter a measure is scaled by: the one given, else the disks' own (:func:`mass_d50`)."""
     return mass_d50(radius) if d50 is None else check_range("d50", d50, 0.0, lo_open=True)
 
 
