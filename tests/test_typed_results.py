@@ -20,9 +20,9 @@ import pytest
 from poro2d.criterion.result import (
     CriterionResult,
     ReplicatesResult,
-    SpecimenPorosityResult,
     SpecimenStateResult,
 )
+from poro2d.measure.specimen_porosity import SpecimenPorosity
 from poro2d.paper import PaperSummary
 from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult, ShearTestResult
 from poro2d.sweep.results import DensityStateResult, RelationResult, SensitivityResult
@@ -40,7 +40,7 @@ FILES = [
     (SensitivityResult, "sensitivity.json"),
     (ReplicateShearResult, "shear_replicates.json"),
     (SpecimenStateResult, "specimen_state.json"),
-    (SpecimenPorosityResult, "specimen_porosity.json"),
+    (SpecimenPorosity, "specimen_porosity.json"),
 ]
 
 

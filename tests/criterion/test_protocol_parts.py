@@ -15,12 +15,13 @@ from poro2d.criterion.density import Calibration
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion, wall_forces
 from poro2d.criterion.servo import PlateServo, in_window
 from poro2d.dem import checkpoint
+from poro2d.measure.porosity import box_porosity
 from poro2d.shear import DirectShearTest, ShearSettings
 from poro2d.shear.controllers import Consolidation, ShearDrive
 from poro2d.shear.curve import curve_summary
 from poro2d.shear.shear_stage import ShearStage
 from poro2d.specimen import paper_grading
-from poro2d.specimen.compaction import SpecimenSpec, box_porosity
+from poro2d.specimen.compaction import SpecimenSpec
 
 SRC = Path(poro2d.__file__).parent
 SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4}
@@ -44,7 +45,9 @@ def test_the_plate_servo_brings_a_raised_plate_into_the_window(specimen):
     width, height = 0.06, 0.03
     sim.translate_wall("top", 0.0, 0.002)  # off the specimen: F_top = 0, out of the window
     settings = CriterionSettings()
-    weight = SpecimenSpec(width=width, height=height).self_weight(box_porosity(sim, width, height))
+    weight = SpecimenSpec(width=width, height=height).self_weight(
+        box_porosity(sim.particles.area(), width, height)
+    )
     plate = PlateServo(settings, 1e-3, "max", height).settle(sim, weight)
     assert plate["plate_settled"] and plate["plate_displacement_m"] < 0.0
     assert plate["plate_height_m"] == float(sim.walls.p0[sim.walls.index("top"), 1])

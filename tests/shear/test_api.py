@@ -102,7 +102,7 @@ def test_peak_frame_round_trip_and_figure(specimen, tmp_path):
 
 def _frame(k: int) -> PeakFrame:
     empty = np.zeros((0, 2))
-    from poro2d.dem.measure import ContactSet
+    from poro2d.dem.contacts import ContactSet
 
     c = ContactSet(np.zeros(0, int), np.zeros(0, int), np.zeros(0, int), empty, empty, np.zeros(0),
                    np.zeros(0), empty, empty)  # fmt: skip

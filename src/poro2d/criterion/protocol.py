@@ -47,10 +47,12 @@ from poro2d.criterion.servo import PlateServo, in_window
 from poro2d.dem import Simulation, checkpoint
 from poro2d.errors import InputError, Integer, OneOf, Ranges, Real, check_fields, check_range
 from poro2d.io_utils import as_json, provenance, write_csv, write_json
+from poro2d.measure.disks import mass_d50
+from poro2d.measure.porosity import box_porosity
+from poro2d.measure.surface import lid_height_at
 from poro2d.porosity import PAPER_N_LAB, parabolic
-from poro2d.specimen.compaction import SpecimenSpec, box_porosity, preparation_note, prepare_specimen
+from poro2d.specimen.compaction import SpecimenSpec, preparation_note, prepare_specimen
 from poro2d.specimen.grading import GradingCurve
-from poro2d.specimen.porosity_regions import lid_height_at, mass_d50
 from poro2d.store.stage import Fingerprint, ResumableStage
 
 #: how a trial's specimen is judged full: "plate", the paper's rigid top plate (its n' includes
@@ -290,7 +292,7 @@ POROSITY_KEYS = (
 def porosity_numbers(
     sim: Simulation, width: float, plate_y: float, lid: tuple[np.ndarray, np.ndarray] | None = None
 ) -> dict:
-    """The specimen's porosities beside the paper's n' (:mod:`poro2d.specimen.porosity_regions`).
+    """The specimen's porosities beside the paper's n' (:mod:`poro2d.measure.specimen_porosity`).
 
     ``box_porosity`` is the paper's: W x plate height, the gap under the plate included;
     ``interior_porosity`` (mean over measurement circles 2 d50 clear of every wall and of the
@@ -298,13 +300,13 @@ def porosity_numbers(
     gets ``interior_porosity = None`` and the reason in ``interior_porosity_note``. With a
     ``lid`` (edges, heights), the box porosity and the gap are those under the lid.
     """
-    from poro2d.specimen.porosity_regions import measure_specimen
+    from poro2d.measure.specimen_porosity import measure_specimen
 
     p = sim.particles
     try:
         m = measure_specimen(p.pos, p.radius, width, plate_y, lid=lid).to_dict()
     except (InputError, RuntimeError) as e:  # too small to measure; a degenerate tessellation
-        return {"box_porosity": 1.0 - p.area() / (width * plate_y), "interior_porosity": None,
+        return {"box_porosity": box_porosity(p.area(), width, plate_y), "interior_porosity": None,
                 "interior_porosity_note": str(e)}  # fmt: skip
     return {k: m[k] for k in POROSITY_KEYS}
 
@@ -537,7 +539,9 @@ class PorosityCriterion:
                 plate = servo.settle(sim, weight)
                 if not plate["plate_settled"]:
                     row.update(plate)
-                    row["new_porosity"] = box_porosity(sim, self.spec.width, row["plate_height_m"])
+                    row["new_porosity"] = box_porosity(
+                        sim.particles.area(), self.spec.width, row["plate_height_m"]
+                    )
                     return self._after_top(sim, weight, row, d)
             lid = SegmentedLid(sim, self.spec.width, mass_d50(sim.particles.radius))
             row.update(servo.settle(sim, weight, lid))
@@ -548,7 +552,7 @@ class PorosityCriterion:
         else:
             row["plate_moved"] = "down" if f_top <= 0.0 else "up"
             row.update(servo.settle(sim, weight))
-            row["new_porosity"] = box_porosity(sim, self.spec.width, row["plate_height_m"])
+            row["new_porosity"] = box_porosity(sim.particles.area(), self.spec.width, row["plate_height_m"])
         return self._after_top(sim, weight, row, d)
 
     def _after_top(self, sim: Simulation, weight: float, row: dict, d: Path | None) -> dict:
@@ -825,8 +829,8 @@ class PorosityCriterion:
 
     def _specimen_state(self, sim: Simulation, n2d: float) -> None:
         """Homogeneity and stress state of the accepted specimen: specimen_state.json and .png."""
+        from poro2d.measure.specimen_state import specimen_state
         from poro2d.report.specimen_figures import plot_specimen_state
-        from poro2d.specimen.state import specimen_state
 
         assert self.out is not None
         lid = self._lid(sim)
@@ -840,8 +844,8 @@ class PorosityCriterion:
 
     def _specimen_porosity(self, sim: Simulation, n2d: float, top: float) -> None:
         """The accepted specimen's porosities: specimen_porosity.json and the local porosity map."""
+        from poro2d.measure.specimen_porosity import measure_specimen
         from poro2d.report.specimen_figures import plot_local_porosity
-        from poro2d.specimen.porosity_regions import measure_specimen
 
         assert self.out is not None
         p = sim.particles

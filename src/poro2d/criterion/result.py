@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from poro2d.measure.specimen_porosity import SpecimenPorosity
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
@@ -86,33 +87,6 @@ class SpecimenStateResult(TypedResult):
     trial_porosity: float
 
 
-@dataclass(eq=False)
-class SpecimenPorosityResult(TypedResult):
-    """The accepted specimen's box and interior porosity, its surface under the plate
-    (``specimen_porosity.json``); a specimen too small to measure has only ``note``."""
-
-    box_porosity: float | None = None
-    interior_porosity: float | None = None
-    interior_porosity_std: float | None = None
-    interior_porosity_min: float | None = None
-    interior_porosity_max: float | None = None
-    interior_regions: int | None = None
-    interior_rect_porosity: float | None = None
-    laguerre_interior_porosity: float | None = None
-    margin_d50: float | None = None
-    circle_radius_m: float | None = None
-    surface_gap_mean_m: float | None = None
-    surface_gap_mean_d50: float | None = None
-    surface_gap_max_m: float | None = None
-    plate_contact_fraction: float | None = None
-    plate_touching_disks: int | None = None
-    d50_m: float | None = None
-    surface_level_m: float | None = None
-    trial_porosity: float | None = None
-    note: str | None = None
-    provenance: dict[str, Any] | None = None
-
-
 #: the figures a criterion run may leave at the top of its folder, by name
 CRITERION_FIGURES = (
     "fig5_forces_initial_trial.png", "fig6_forces_after_plate.png", "fig7_forces_accepted.png",
@@ -131,7 +105,7 @@ class CriterionOutputs:
 
     result: CriterionResult
     state: SpecimenStateResult | None = None
-    porosity: SpecimenPorosityResult | None = None
+    porosity: SpecimenPorosity | None = None
     figures: dict[str, Path] = field(default_factory=dict)
 
     @classmethod
@@ -145,7 +119,7 @@ class CriterionOutputs:
         return cls(
             result,
             None if state is None else SpecimenStateResult.from_dict(state),
-            None if porosity is None else SpecimenPorosityResult.from_dict(porosity),
+            None if porosity is None else SpecimenPorosity.from_dict(porosity),
             {name: folder / name for name in CRITERION_FIGURES if (folder / name).is_file()},
         )
 
@@ -159,6 +133,5 @@ __all__ = [
     "CriterionOutputs",
     "CriterionResult",
     "ReplicatesResult",
-    "SpecimenPorosityResult",
     "SpecimenStateResult",
 ]

@@ -192,10 +192,10 @@ class SpecimenData:
 
         The box porosity is the paper's n' (box W x plate height, the gap under the plate
         included); the interior porosity is the packing's own, 2 d50 clear of every wall and
-        of the free surface (:mod:`poro2d.specimen.porosity_regions`). None for a specimen
+        of the free surface (:mod:`poro2d.measure.specimen_porosity`). None for a specimen
         without a box or too small to measure.
         """
-        from poro2d.specimen.porosity_regions import measure_specimen
+        from poro2d.measure.specimen_porosity import measure_specimen
 
         try:
             xlo, xhi, ylo, yhi = self.box()

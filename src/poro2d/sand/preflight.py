@@ -3,7 +3,7 @@
 The pre-flight reads only the grading and the box (no disk is simulated): the disk count
 is the box's solid area over the grading's mean disk area, the time step is the engine's
 critical step for the lightest disk (:func:`poro2d.specimen.compaction.time_step`), and the
-grading's frictionless jamming porosity (:mod:`poro2d.specimen.jamming`, an energy
+grading's frictionless jamming porosity (:mod:`poro2d.oracles.jamming`, an energy
 minimisation, not a DEM run) places the first trials. The run time is a model:
 
     particle-steps = disks x steps per trial x trials per case
@@ -203,7 +203,7 @@ def _jamming_from(d: dict) -> Jamming | None:
 def _compute_jamming(grading: GradingCurve, seeds: int) -> Jamming:
     import time
 
-    from poro2d.specimen.jamming import jamming_reference
+    from poro2d.oracles.jamming import jamming_reference
 
     # the periodic cell must be wider than four of the largest radii: N mean disks at phi 0.85
     need = (4.0 * grading.d_max_m / 2.0) ** 2 * 4.0 * 0.85 / grading.mean_disk_area()

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from poro2d.dem import Simulation
-from poro2d.dem.measure import ContactSet
+from poro2d.dem.contacts import ContactSet
 from poro2d.shear.box import SplitBox
 from poro2d.shear.fit import peak, smooth
 from poro2d.shear.settings import ShearSettings, inertial_number

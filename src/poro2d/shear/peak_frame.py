@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.dem import Simulation
-from poro2d.dem.measure import ContactSet
+from poro2d.dem.contacts import ContactSet
 from poro2d.io_utils import atomic_path
 from poro2d.shear.fit import smooth
 

@@ -22,9 +22,9 @@ import numpy as np
 
 from poro2d.config import check_finite
 from poro2d.dem import Simulation, checkpoint
-from poro2d.dem.measure import coordination_number
 from poro2d.errors import InputError, check_range
 from poro2d.io_utils import as_json, provenance, write_csv
+from poro2d.measure.coordination import coordination_number
 from poro2d.shear import record
 from poro2d.shear.box import SplitBox, build_split_box
 from poro2d.shear.controllers import Consolidation, ProgressFn

@@ -32,11 +32,11 @@ import numpy as np
 
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
 from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
-from poro2d.dem.measure import porosity_rect
 from poro2d.dem.ordering import strip_order
 from poro2d.dem.simulation import MEASURES
 from poro2d.errors import InputError, Integer, OneOf, Ranges, Real, check_fields, check_range
 from poro2d.identity import outside_identity
+from poro2d.measure.porosity import box_porosity, porosity_rect
 from poro2d.paper_data import TABLE_1
 from poro2d.specimen.grading import MAX_DRAW, GradingCurve, draw_disks
 from poro2d.specimen.placement import Band, place_disks
@@ -295,11 +295,11 @@ _DENSEST: dict[tuple, float | None] = {}
 def densest_porosity(grading: GradingCurve) -> float | None:
     """A quick estimate of the grading's frictionless jamming porosity n_J (None if it cannot be made).
 
-    One seed of :func:`poro2d.specimen.jamming.jamming_reference` on ``PREFLIGHT_JAMMING``
+    One seed of :func:`poro2d.oracles.jamming.jamming_reference` on ``PREFLIGHT_JAMMING``
     disks, cached per grading. None when the grading is too wide for that many disks in the
     periodic cell (the largest disks would span it).
     """
-    from poro2d.specimen.jamming import jamming_reference
+    from poro2d.oracles.jamming import jamming_reference
 
     key = (tuple(grading.sizes.tolist()), tuple(grading.percent.tolist()))
     if key not in _DENSEST:
@@ -557,7 +557,7 @@ class SettledTest:
     """
 
     def __init__(self, sim: Simulation, drift_d50: float, checks: int) -> None:
-        from poro2d.specimen.porosity_regions import mass_d50
+        from poro2d.measure.disks import mass_d50
 
         self.tol = drift_d50 * mass_d50(sim.particles.radius)
         self.checks = checks
@@ -629,7 +629,7 @@ def prepare_specimen(
         "planned_count": int(len(radii)),
         "particle_count": p.n,
         "solid_area_m2": p.area(),
-        "box_porosity": 1.0 - p.area() / (W * H),
+        "box_porosity": box_porosity(p.area(), W, H),
         "measured_porosity": porosity_rect(p.pos, p.radius, 0.0, 0.0, W, H),
         "layers": layers,
         "final_stage": final,
@@ -765,19 +765,10 @@ def _grow(sim: Simulation, idx: np.ndarray, full: np.ndarray, scale: float, spec
     return steps
 
 
-def box_porosity(sim: Simulation, width: float, top: float, bottom: float = 0.0) -> float:
-    """Porosity of the box between the bottom wall and the top plate (disk area / box area)."""
-    h = top - bottom
-    if not h > 0:
-        raise InputError("box height", h, "(0, inf) m")
-    return 1.0 - sim.particles.area() / (width * h)
-
-
 __all__ = [
     "SettledTest",
     "SizeEstimate",
     "SpecimenSpec",
-    "box_porosity",
     "check_feasible",
     "is_wide",
     "preparation_note",
