@@ -223,13 +223,15 @@ def _shear_stage(specimens: dict[str, Path], out: Path, quick: bool, lab_data,
     the figures written (Fig. 8 over the specimens, the first specimen's curves)."""
     from poro2d.shear.replicates import ReplicateShear
     from poro2d.shear.settings import ShearSettings
+    from poro2d.store import Store
 
     console.print(
         f"[bold]3/3 direct shear[/] (Fig. 8) at {', '.join(f'{v:g}' for v in NORMAL_STRESSES_KPA)} kPa "
         f"on {len(specimens)} specimen(s)"
     )
     sset = ShearSettings(**(QUICK_SHEAR if quick else {}))
-    rep = ReplicateShear(specimens, NORMAL_STRESSES_KPA, sset, out=out, lab=lab_data, progress=progress).run()
+    rep = ReplicateShear(specimens, NORMAL_STRESSES_KPA, sset, store=Store(out), lab=lab_data,
+                         progress=progress).run()  # fmt: skip
     first_label, first = next(iter(rep.series.items()))
     fit = rep.fit or {}
     ci = fit.get("friction_angle_ci_deg")

@@ -15,7 +15,7 @@ from poro2d.criterion.density import Calibration
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion, wall_forces
 from poro2d.criterion.servo import PlateServo, in_window
 from poro2d.dem import checkpoint
-from poro2d.shear import DirectShearTest, ShearSettings
+from poro2d.shear import DirectShearTest, ShearCase, ShearSettings
 from poro2d.shear.controllers import Consolidation, ShearDrive
 from poro2d.shear.curve import curve_summary
 from poro2d.shear.shear_stage import ShearStage
@@ -54,9 +54,9 @@ def test_the_plate_servo_brings_a_raised_plate_into_the_window(specimen):
 def test_the_shear_test_is_its_controllers(specimen):
     """Consolidation, then the shear stage driven by ShearDrive: the test's own curve, number for number."""
     settings = ShearSettings(**SHORT)
-    whole = DirectShearTest(specimen, 50.0, settings, figures=False).run()
+    whole = DirectShearTest(ShearCase.of(specimen, 50.0, settings), figures=False).run()
 
-    test = DirectShearTest(specimen, 50.0, settings, figures=False)
+    test = DirectShearTest(ShearCase.of(specimen, 50.0, settings), figures=False)
     sim, info = test.consolidate()
     phases = []
     stage = ShearStage(

@@ -17,6 +17,7 @@ from poro2d.dem.measure import ContactSet
 from poro2d.shear.box import SplitBox
 from poro2d.shear.fit import peak, smooth
 from poro2d.shear.settings import ShearSettings, inertial_number
+from poro2d.store import Store
 
 CURVE_COLUMNS = [
     "step", "shear_displacement_mm", "shear_stress_kpa", "normal_stress_kpa", "plate_displacement_mm",
@@ -45,12 +46,10 @@ def curve_rows(curve: dict[str, np.ndarray]) -> list[dict]:
     ]
 
 
-def read_curve(path) -> dict[str, np.ndarray]:
-    """The columns of a test's ``curve.csv`` (as :func:`curve_columns`)."""
-    import csv
-
-    with open(path, newline="") as fh:
-        return curve_columns(list(csv.DictReader(fh)))
+def read_curve(store: Store, name: str = "curve.csv") -> dict[str, np.ndarray]:
+    """The columns of a test's ``curve.csv`` in ``store`` (as :func:`curve_columns`; none without it)."""
+    rows = store.read_rows(name)
+    return {} if rows is None else curve_columns(rows)
 
 
 def curve_row(

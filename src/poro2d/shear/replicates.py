@@ -13,14 +13,18 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from poro2d.errors import InputError, check_range
-from poro2d.io_utils import provenance, write_csv, write_json
+from poro2d.io_utils import provenance
 from poro2d.shear.fit import mohr_coulomb
+from poro2d.shear.pool import ShearJob
 from poro2d.shear.results import ReplicateShearResult
+from poro2d.shear.specimen_file import Specimen
+from poro2d.store import Store
 
 
 def mohr_coulomb_ci(sigma_kpa, tau_kpa, through_origin: bool = False, level: float = 0.95) -> dict:
@@ -95,13 +99,14 @@ def summarize_replicate_peaks(series: dict[str, dict], level: float = 0.95) -> d
 class ReplicateShear:
     """The same direct shear tests on several specimens, in one process pool, then the summary.
 
-    ``specimens``: label -> specimen (checkpoint or folder holding ``specimen.npz``); each
-    specimen's tests go to ``out/<label>/`` as a :class:`ShearSeries` would write them, and
-    the summary to ``out/replicates.json`` and ``out/replicates.csv``.
+    ``specimens``: label -> specimen (a :class:`~poro2d.shear.specimen_file.Specimen`, or a
+    checkpoint or folder holding ``specimen.npz``, read once); with ``store`` each
+    specimen's tests are kept in ``<label>/`` as a :class:`ShearSeries` keeps them, and the
+    summary in ``replicates.json`` and ``replicates.csv`` (``store=None``: nothing is kept).
     """
 
-    def __init__(self, specimens: dict[str, str | Path], normal_stresses_kpa, settings=None, *,
-                 out: str | Path = "shear-out", lab=None, processes: int | None = None, progress: bool = True,
+    def __init__(self, specimens: dict[str, Specimen | str | Path], normal_stresses_kpa, settings=None, *,
+                 store: Store | None = None, lab=None, processes: int | None = None, progress: bool = True,
                  config: dict | None = None, figures: bool = True) -> None:  # fmt: skip
         import os
 
@@ -109,7 +114,7 @@ class ReplicateShear:
 
         if not specimens:
             raise InputError("specimens", {}, "at least one specimen")
-        self.out = Path(out)
+        self.store = store
         self.progress = progress
         self.config = config or {}
         self.figures = figures
@@ -118,7 +123,7 @@ class ReplicateShear:
                 path,
                 normal_stresses_kpa,
                 settings,
-                out=self.out / label,
+                store=store.child(label) if store is not None else None,
                 lab=lab,
                 progress=False,
                 processes=1,
@@ -130,9 +135,9 @@ class ReplicateShear:
         njobs = sum(len(s.jobs) for s in self.series.values())
         self.processes = processes if processes is not None else min(njobs, 2 * (os.cpu_count() or 1))
 
-    def jobs(self) -> list[dict]:
+    def jobs(self) -> list[ShearJob]:
         """Every specimen's tests as pool jobs, keyed ``(label, *key)`` (a caller may pool several)."""
-        return [dict(j, key=(label, *j["key"]), series=label)
+        return [replace(j, key=(label, *j.key), series=label)
                 for label, s in self.series.items() for j in s.jobs]  # fmt: skip
 
     def run(self) -> ReplicateShearResult:
@@ -151,15 +156,17 @@ class ReplicateShear:
         summary = ReplicateShearResult.from_dict(
             dict(summarize_replicate_peaks(per), **timing, config=self.config, provenance=provenance())
         )
-        write_csv(self.out / "replicates.csv", [{k: v for k, v in r.items() if k != "peaks_kpa"}
-                                                 for r in summary.per_normal_stress])  # fmt: skip
-        write_json(self.out / "replicates.json", summary.to_dict())
         summary.series = per
+        if self.store is None:
+            return summary
+        self.store.write_csv("replicates.csv", [{k: v for k, v in r.items() if k != "peaks_kpa"}
+                                                for r in summary.per_normal_stress])  # fmt: skip
+        self.store.write_json("replicates.json", summary.to_dict())
         if self.figures:
-            self._figures(summary)
+            self._figures(summary, self.store)
         return summary
 
-    def _figures(self, summary: ReplicateShearResult) -> None:
+    def _figures(self, summary: ReplicateShearResult, store: Store) -> None:
         """fig8a/fig8b over specimens: mean curves with +- sd bands, peaks with the pooled fit."""
         from poro2d.report.shear_figures import curve_band, plot_replicate_curves, plot_replicate_peaks
         from poro2d.shear.outputs import lab_fit
@@ -170,8 +177,8 @@ class ReplicateShear:
             bands[sigma] = curve_band([res.curves[sigma] for res in summary.series.values()])
         n = len(self.series)
         lab = next(iter(self.series.values())).lab
-        plot_replicate_curves(bands, self.out / "fig8a_shear_curves_replicates.png", n, lab=lab)
-        peaks_png = self.out / "fig8b_peak_strength_replicates.png"
+        plot_replicate_curves(bands, store.path("fig8a_shear_curves_replicates.png"), n, lab=lab)
+        peaks_png = store.path("fig8b_peak_strength_replicates.png")
         plot_replicate_peaks(summary, peaks_png, lab=lab, lab_fit=lab_fit(lab))
 
 

@@ -1,15 +1,14 @@
 """Typed results of direct shear: one test's ``result.json``, a series' ``result.json`` and the
-replicate specimens' ``replicates.json``."""
+replicate specimens' ``replicates.json`` and a strength study's ``strength.json``."""
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
 
+from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
@@ -58,16 +57,19 @@ class ShearTestResult(TypedResult):
     curve: dict[str, np.ndarray] = field(default_factory=dict, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     @classmethod
-    def read(cls, folder: str | Path, data: dict[str, Any] | None = None) -> ShearTestResult:
-        """A finished test read back from ``folder``: its ``result.json`` and its ``curve.csv``.
+    def read(cls, store: Store, data: dict[str, Any] | None = None) -> ShearTestResult:
+        """A finished test read back from ``store``: its ``result.json`` and its ``curve.csv``.
 
         ``data``: the content of ``result.json`` when the caller has read it already.
         """
         from poro2d.shear.curve import read_curve
 
-        folder = Path(folder)
-        result = cls.from_dict(data if data is not None else json.loads((folder / "result.json").read_text()))
-        result.curve = read_curve(folder / "curve.csv")
+        if data is None:
+            data = store.read_json("result.json")
+        if not isinstance(data, dict):
+            raise FileNotFoundError(f"no finished direct shear test in {store.root} (result.json)")
+        result = cls.from_dict(data)
+        result.curve = read_curve(store)
         return result
 
 
@@ -139,4 +141,25 @@ class ReplicateShearResult(TypedResult):
     series: dict[str, ShearSeriesResult] = field(default_factory=dict, kw_only=True, metadata=NOT_IN_FILE)
 
 
-__all__ = ["ReplicateShearResult", "ShearSeriesResult", "ShearTestResult"]
+@dataclass(eq=False)
+class StrengthResult(TypedResult):
+    """Strength against rolling and particle friction (a strength study's ``strength.json``).
+
+    ``cases``: one row per (mu_r, f_p) (the rows of ``strength.csv`` with the pooled fits'
+    intervals): peak and residual friction angles and the dilation angle, mean and sd over
+    the specimens; ``definitions``: how each is measured.
+    """
+
+    cases: list[dict[str, Any]]
+    mu_r: list[float]
+    particle_friction: list[float]
+    specimens: list[str]
+    settings: dict[str, Any]
+    definitions: dict[str, str]
+    wall_time_s: float | None = None
+    processes: int | None = None
+    config: dict[str, Any] | None = None
+    provenance: dict[str, Any] | None = None
+
+
+__all__ = ["ReplicateShearResult", "ShearSeriesResult", "ShearTestResult", "StrengthResult"]

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import numpy as np
 
-from poro2d.dem import checkpoint
 from poro2d.errors import InputError, check_range
-from poro2d.io_utils import provenance, write_json
+from poro2d.io_utils import provenance
+from poro2d.shear.case import ShearCase
 from poro2d.shear.fit import mohr_coulomb, smooth
 from poro2d.shear.outputs import (
     folder_name,
@@ -19,10 +19,11 @@ from poro2d.shear.outputs import (
     write_figures,
     write_tables,
 )
-from poro2d.shear.pool import execute_jobs, job_test
+from poro2d.shear.pool import ShearJob, execute_jobs
 from poro2d.shear.results import ShearSeriesResult, ShearTestResult
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings
-from poro2d.shear.specimen_file import resolve_specimen
+from poro2d.shear.specimen_file import Specimen
+from poro2d.store import Store
 
 #: what a series' ``result.json`` keeps of each test
 SUMMARY_KEYS = (
@@ -54,19 +55,21 @@ def check_stresses(normal_stresses_kpa) -> list[float]:
 class ShearSeries:
     """Direct shear tests at several normal stresses, in parallel processes, with the fit.
 
-    Writes ``out/result.json`` (per test and overall), ``peaks.csv``, ``curves.csv``,
-    ``fig8a_shear_curves.png``, ``fig8b_peak_strength.png`` and one folder per test
-    (see :class:`DirectShearTest`); with ``rate_check`` every test is repeated at half
-    the velocity under ``out/rate_check/`` and the change of the peak is reported.
-    Finished tests are skipped on a rerun; a killed test resumes from its checkpoint.
+    ``specimen``: a :class:`~poro2d.shear.specimen_file.Specimen`, or its path (read once,
+    here). With ``store`` it keeps ``result.json`` (per test and overall), ``peaks.csv``,
+    ``curves.csv``, ``fig8a_shear_curves.png``, ``fig8b_peak_strength.png`` and one sub-store
+    per test (see :class:`DirectShearTest`); with ``rate_check`` every test is repeated at
+    half the velocity under ``rate_check/`` and the change of the peak is reported. Finished
+    tests are skipped on a rerun; a killed test resumes from its checkpoint. ``store=None``:
+    nothing is kept.
     """
 
     def __init__(
         self,
-        specimen: str | Path,
+        specimen: Specimen | str | Path,
         normal_stresses_kpa,
         settings: ShearSettings | None = None,
-        out: str | Path = "shear-out",
+        store: Store | None = None,
         lab=None,
         rate_check: bool = False,
         rate_tolerance: float = 0.02,
@@ -75,10 +78,10 @@ class ShearSeries:
         config: dict | None = None,
         figures: bool = True,
     ) -> None:
-        self.specimen = resolve_specimen(specimen)
+        self.specimen = Specimen.of(specimen)
         self.stresses = check_stresses(normal_stresses_kpa)
         self.settings = settings if settings is not None else ShearSettings()
-        self.out = Path(out)
+        self.store = store
         self.lab = lab
         self.rate_check = bool(rate_check)
         self.rate_tolerance = check_range("rate_tolerance", rate_tolerance, 0.0, 1.0, lo_open=True)
@@ -94,30 +97,37 @@ class ShearSeries:
         self.processes = processes if processes is not None else min(len(self.jobs), 2 * ncpu)
         self._bind_tests()
 
+    @property
+    def specimen_digest(self) -> str:
+        """Digest of the specimen's state (:func:`poro2d.dem.checkpoint.state_digest`)."""
+        return self.specimen.digest
+
     def _bind_tests(self) -> None:
         """Validate every test (box size, then what each folder holds) before anything is written."""
-        self.specimen_digest = checkpoint.state_digest(self.specimen)  # one specimen: hashed once
-        stages = [job_test(job, self.specimen_digest).stage() for job in self.jobs]
+        if self.store is None:
+            return
+        stages = [job.test().stage() for job in self.jobs]
         for stage in stages:
             stage.check()
         for stage in stages:
             stage.bind()
 
-    def _jobs(self) -> list[dict]:
-        base = self.settings.to_dict()
-        half = dict(base, velocity=0.5 * base["velocity"])
-        common = {"specimen": str(self.specimen)}
+    def _folder(self, *parts: str) -> str | None:
+        """The folder of a test's store, as a string a worker makes its store from."""
+        return None if self.store is None else str(self.store.child(*parts).root)
+
+    def _jobs(self) -> list[ShearJob]:
+        base = ShearCase(self.specimen, self.stresses[0], self.settings)
+        half = base.with_settings(velocity=0.5 * self.settings.velocity)
         jobs = [
-            {"key": ("test", sig), "sigma": sig, "settings": base, "figures": self.figures,
-             "out": str(self.out / folder_name(sig)), **common}
+            ShearJob(("test", sig), base.at(sig), self._folder(folder_name(sig)), self.figures)
             for sig in self.stresses
-        ]  # fmt: skip
+        ]
         if self.rate_check:
             jobs += [
-                {"key": ("rate", sig), "sigma": sig, "settings": half, "figures": False,
-                 "out": str(self.out / "rate_check" / folder_name(sig)), **common}
+                ShearJob(("rate", sig), half.at(sig), self._folder("rate_check", folder_name(sig)), False)
                 for sig in self.stresses
-            ]  # fmt: skip
+            ]
         return jobs
 
     def _execute(self) -> dict:
@@ -155,9 +165,9 @@ class ShearSeries:
             settings=s.to_dict(),
             velocity_m_per_s=s.velocity,
             density_scale=s.density_scale,
-            specimen=str(self.specimen),
-            specimen_digest=self.specimen_digest,
-            specimen_meta=checkpoint.read_meta(self.specimen).get("extra", {}),
+            specimen=self.specimen.source,
+            specimen_digest=self.specimen.digest,
+            specimen_meta=self.specimen.extra,
             processes=self.processes,
             config=self.config,
         )
@@ -168,10 +178,11 @@ class ShearSeries:
         result.wall_time_s = time.perf_counter() - t0
         result.provenance = provenance()
         curves = {t["normal_stress_kpa"]: t.curve for t in tests}
-        write_tables(self.out, curves, summary)
-        if self.figures:
-            write_figures(self.out, tests, curves, fit, fit0, self.settings, self.lab)
-        write_json(self.out / "result.json", result)
+        if self.store is not None:
+            write_tables(self.store, curves, summary)
+            if self.figures:
+                write_figures(self.store, tests, curves, fit, fit0, self.settings, self.lab)
+            self.store.write_json("result.json", result)
         result.curves = curves
         return result
 
