@@ -245,11 +245,11 @@ def _shear_stage(specimens: dict[str, Path], out: Path, quick: bool, lab_data,
     )
     summary = {
         # the pooled fit over every specimen's peaks; "tests" and quasi_static of the first specimen
-        "tests": first.tests,
+        "tests": [t.to_dict() for t in first.tests],
         "friction_angle_deg": fit.get("friction_angle_deg"),
         "cohesion_kpa": fit.get("cohesion_kpa"),
         "r2": fit.get("r2"),
-        "quasi_static": first.quasi_static,
+        "quasi_static": first.quasi_static.to_dict(),
         "replicates": rep.to_dict(),
     }
     figures = {

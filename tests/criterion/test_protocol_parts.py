@@ -65,7 +65,7 @@ def test_the_shear_test_is_its_controllers(specimen):
     stage.run()
     assert len(stage.rows) == whole["records"] and set(phases) == {"shearing"}
     summary = curve_summary(stage.rows, 50.0, settings)
-    assert summary["peak_shear_stress_kpa"] == whole["peak_shear_stress_kpa"]
+    assert summary.peak_shear_stress_kpa == whole["peak_shear_stress_kpa"]
     lower = [stage.sim.walls.vel[stage.sim.walls.index(n), 0] for n in ("bottom", "lower_left")]
     assert lower == [settings.velocity] * 2  # ShearDrive set the lower half moving
 
@@ -76,7 +76,7 @@ def test_consolidation_reports_a_specimen_it_could_not_settle(specimen):
     sim, box = build_split_box(checkpoint.load(specimen), 0.002)
     settings = ShearSettings(consolidation_max_steps=1000, **SHORT)
     done = Consolidation(settings).settle(sim, 50e3 * box.width * box.thickness)
-    assert not done["settled"] and done["steps"] == 1000
-    assert done["plate_height_before_m"] == pytest.approx(box.height)
+    assert not done.settled and done.steps == 1000
+    assert done.plate_height_before_m == pytest.approx(box.height)
     ShearDrive(0.01).start(sim)
     assert np.all(sim.walls.vel[[sim.walls.index(n) for n in ("bottom", "lower_lip")], 0] == 0.01)

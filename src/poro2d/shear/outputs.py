@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from poro2d.shear.curve import CURVE_COLUMNS, curve_rows
 from poro2d.shear.fit import MohrCoulombFit, mohr_coulomb
 from poro2d.shear.lab import LabData
+from poro2d.shear.parts import TestSummary
 from poro2d.store import Store
 
 
@@ -23,7 +26,9 @@ def lab_fit(lab: LabData | None) -> MohrCoulombFit | None:
     return mohr_coulomb(ls, [lab.peaks[v] for v in ls])
 
 
-def write_tables(store: Store, curves: dict[float, dict[str, np.ndarray]], summary: list[dict]) -> None:
+def write_tables(
+    store: Store, curves: dict[float, dict[str, np.ndarray]], summary: list[TestSummary]
+) -> None:
     """``curves.csv`` (every curve, long format) and ``peaks.csv`` (one row per test).
 
     ``curves``: each test's curve (:attr:`ShearTestResult.curve`) by normal stress.
@@ -32,7 +37,10 @@ def write_tables(store: Store, curves: dict[float, dict[str, np.ndarray]], summa
         {"normal_stress_kpa": sigma, **row} for sigma, curve in curves.items() for row in curve_rows(curve)
     ]
     store.write_csv("curves.csv", long_rows, header=["normal_stress_kpa"] + CURVE_COLUMNS)
-    store.write_csv("peaks.csv", [{k: v for k, v in r.items() if not isinstance(v, dict)} for r in summary])
+    # the nested parts of a test's summary (end values, force balance) are in result.json only
+    store.write_csv(
+        "peaks.csv", [{k: v for k, v in r.items() if not isinstance(v, Mapping)} for r in summary]
+    )
 
 
 def write_figures(

@@ -21,13 +21,14 @@ import numpy as np
 from poro2d.errors import InputError, check_range
 from poro2d.io_utils import provenance
 from poro2d.shear.fit import mohr_coulomb
+from poro2d.shear.parts import FitInterval, StressPeaks
 from poro2d.shear.pool import ShearJob
-from poro2d.shear.results import ReplicateShearResult
+from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult
 from poro2d.shear.specimen_file import Specimen
 from poro2d.store import Store
 
 
-def mohr_coulomb_ci(sigma_kpa, tau_kpa, through_origin: bool = False, level: float = 0.95) -> dict:
+def mohr_coulomb_ci(sigma_kpa, tau_kpa, through_origin: bool = False, level: float = 0.95) -> FitInterval:
     """The least-squares Mohr-Coulomb line with ``level`` confidence intervals of phi and c.
 
     Intervals from the slope's and intercept's standard errors and Student's t with
@@ -40,9 +41,8 @@ def mohr_coulomb_ci(sigma_kpa, tau_kpa, through_origin: bool = False, level: flo
     s = np.asarray(sigma_kpa, float).ravel()
     t = np.asarray(tau_kpa, float).ravel()
     fit = mohr_coulomb(s, t, through_origin=through_origin)
-    out = fit.to_dict()
     df = s.size - (1 if through_origin else 2)
-    out.update(level=level, dof=df, friction_angle_ci_deg=None, cohesion_ci_kpa=None)
+    out = FitInterval(**fit.record(), level=level, dof=df)
     if df < 1:
         return out
     resid = t - fit.predict(s)
@@ -54,16 +54,19 @@ def mohr_coulomb_ci(sigma_kpa, tau_kpa, through_origin: bool = False, level: flo
         sxx = float(np.sum((s - s.mean()) ** 2))
         se_slope = math.sqrt(s2 / sxx)
         se_c = math.sqrt(s2 * (1.0 / s.size + s.mean() ** 2 / sxx))
-        out["cohesion_ci_kpa"] = [fit.cohesion_kpa - q * se_c, fit.cohesion_kpa + q * se_c]
+        out.cohesion_ci_kpa = [fit.cohesion_kpa - q * se_c, fit.cohesion_kpa + q * se_c]
     lo, hi = fit.tan_phi - q * se_slope, fit.tan_phi + q * se_slope
-    out["friction_angle_ci_deg"] = [math.degrees(math.atan(lo)), math.degrees(math.atan(hi))]
+    out.friction_angle_ci_deg = [math.degrees(math.atan(lo)), math.degrees(math.atan(hi))]
     return out
 
 
-def summarize_replicate_peaks(series: dict[str, dict], level: float = 0.95) -> dict:
+def summarize_replicate_peaks(
+    series: dict[str, ShearSeriesResult], level: float = 0.95
+) -> ReplicateShearResult:
     """Per normal stress mean +- sd of the peaks over specimens, pooled fits with intervals.
 
-    ``series``: label -> the result of one :class:`ShearSeries` (its ``tests`` list).
+    ``series``: label -> the result of one :class:`ShearSeries` (its ``tests`` list). The
+    summary's run fields (wall time, processes, config, provenance) are left for the caller.
     """
     if not series:
         raise InputError("replicates", 0, "at least one specimen's tests")
@@ -74,26 +77,26 @@ def summarize_replicate_peaks(series: dict[str, dict], level: float = 0.95) -> d
     rows = []
     for sig in sorted(by_sigma):
         v = np.array(by_sigma[sig])
-        rows.append({
-            "normal_stress_kpa": sig,
-            "peak_mean_kpa": float(v.mean()),
-            "peak_sd_kpa": float(v.std(ddof=1)) if v.size > 1 else 0.0,
-            "n": int(v.size),
-            "peaks_kpa": v.tolist(),
-        })  # fmt: skip
-    sig = np.concatenate([[r["normal_stress_kpa"]] * r["n"] for r in rows])
-    tau = np.concatenate([r["peaks_kpa"] for r in rows])
+        rows.append(StressPeaks(
+            normal_stress_kpa=sig,
+            peak_mean_kpa=float(v.mean()),
+            peak_sd_kpa=float(v.std(ddof=1)) if v.size > 1 else 0.0,
+            n=int(v.size),
+            peaks_kpa=v.tolist(),
+        ))  # fmt: skip
+    sig = np.concatenate([[r.normal_stress_kpa] * r.n for r in rows])
+    tau = np.concatenate([r.peaks_kpa for r in rows])
     phis = [r["friction_angle_deg"] for r in series.values() if r.get("friction_angle_deg") is not None]
-    return {
-        "specimens": list(series),
-        "per_normal_stress": rows,
-        "fit": mohr_coulomb_ci(sig, tau, level=level) if np.unique(sig).size >= 2 else None,
-        "fit_through_origin": mohr_coulomb_ci(sig, tau, through_origin=True, level=level),
-        "friction_angle_per_specimen_deg": phis,
-        "friction_angle_mean_deg": float(np.mean(phis)) if phis else None,
-        "friction_angle_sd_deg": float(np.std(phis, ddof=1)) if len(phis) > 1 else None,
-        "method": "peaks of every specimen pooled; Student-t intervals of the least-squares line",
-    }
+    return ReplicateShearResult(
+        specimens=list(series),
+        per_normal_stress=rows,
+        fit=mohr_coulomb_ci(sig, tau, level=level) if np.unique(sig).size >= 2 else None,
+        fit_through_origin=mohr_coulomb_ci(sig, tau, through_origin=True, level=level),
+        friction_angle_per_specimen_deg=phis,
+        friction_angle_mean_deg=float(np.mean(phis)) if phis else None,
+        friction_angle_sd_deg=float(np.std(phis, ddof=1)) if len(phis) > 1 else None,
+        method="peaks of every specimen pooled; Student-t intervals of the least-squares line",
+    )
 
 
 class ReplicateShear:
@@ -152,10 +155,11 @@ class ReplicateShear:
             label: s.finish({k[1:]: v for k, v in results.items() if k[0] == label}, t0)
             for label, s in self.series.items()
         }
-        timing = {"wall_time_s": time.perf_counter() - t0, "processes": self.processes}
-        summary = ReplicateShearResult.from_dict(
-            dict(summarize_replicate_peaks(per), **timing, config=self.config, provenance=provenance())
-        )
+        summary = summarize_replicate_peaks(per)
+        summary.wall_time_s = time.perf_counter() - t0
+        summary.processes = self.processes
+        summary.config = self.config
+        summary.provenance = provenance()
         summary.series = per
         if self.store is None:
             return summary

@@ -19,6 +19,7 @@ from poro2d.shear.outputs import (
     write_figures,
     write_tables,
 )
+from poro2d.shear.parts import LabComparison, QuasiStatic, RateCheck, RateCheckRow, TestSummary
 from poro2d.shear.pool import ShearJob, execute_jobs
 from poro2d.shear.results import ShearSeriesResult, ShearTestResult
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings
@@ -130,16 +131,13 @@ class ShearSeries:
             ]
         return jobs
 
-    def _execute(self) -> dict:
-        return execute_jobs(self.jobs, self.processes, self.progress)
-
     def run(self) -> ShearSeriesResult:
         """Run the tests (finished ones are read back), then the fit, figures and ``result.json``."""
         t0 = time.perf_counter()
-        return self.finish(self._execute(), t0)
+        return self.finish(execute_jobs(self.jobs, self.processes, self.progress), t0)
 
     # ------------------------------------------------------------------ results
-    def finish(self, results: dict, t0: float) -> ShearSeriesResult:
+    def finish(self, results: dict[tuple, ShearTestResult], t0: float) -> ShearSeriesResult:
         """Fit, figures and ``result.json`` from the tests' results (keyed as in :meth:`_jobs`)."""
         tests = [results[("test", s)] for s in self.stresses]
         sig = np.array([t["normal_stress_kpa"] for t in tests])
@@ -154,9 +152,9 @@ class ShearSeries:
             friction_angle_deg=fit.friction_angle_deg if fit else None,
             cohesion_kpa=fit.cohesion_kpa if fit else None,
             r2=fit.r2 if fit else None,
-            fit=fit.to_dict() if fit else None,
+            fit=fit.record() if fit else None,
             friction_angle_through_origin_deg=fit0.friction_angle_deg,
-            fit_through_origin=fit0.to_dict(),
+            fit_through_origin=fit0.record(),
             quasi_static=self._quasi_static(tests),
             peak_definition=f"maximum of the shear stress curve smoothed by a centred moving average over "
             f"{1e3 * s.peak_window:g} mm of shear displacement",
@@ -187,59 +185,62 @@ class ShearSeries:
         return result
 
     @staticmethod
-    def _test_summary(t: dict) -> dict:
+    def _test_summary(t: ShearTestResult) -> TestSummary:
         """One test's line of the series' result."""
         # tests written before a test said why it ended lack ``ended_by``
-        return {k: t.get(k) if k == "ended_by" else t[k] for k in SUMMARY_KEYS} | {
-            "consolidation_normal_stress_error": t["consolidation"]["normal_stress_error"],
-            "folder": folder_name(t["normal_stress_kpa"]),
-        }
+        return TestSummary(
+            **{k: t.get(k) if k == "ended_by" else t[k] for k in SUMMARY_KEYS},
+            consolidation_normal_stress_error=t.consolidation["normal_stress_error"],
+            folder=folder_name(t.normal_stress_kpa),
+        )
 
-    def _quasi_static(self, tests: list[dict]) -> dict:
+    def _quasi_static(self, tests: list[ShearTestResult]) -> QuasiStatic:
         s = self.settings
         # a stored infinity reads back as null (JSON has no infinity): the check failed
         max_i = max(math.inf if t["max_inertial_number"] is None else t["max_inertial_number"] for t in tests)
-        return {
-            "max_inertial_number": max_i,
-            "inertial_limit": s.inertial_limit,
-            "inertial_number_ok": max_i < s.inertial_limit,
-            "inertial_number_definition": "I = gamma_dot d_mean sqrt(rho_s density_scale / sigma_n), "
+        return QuasiStatic(
+            max_inertial_number=max_i,
+            inertial_limit=s.inertial_limit,
+            inertial_number_ok=max_i < s.inertial_limit,
+            inertial_number_definition="I = gamma_dot d_mean sqrt(rho_s density_scale / sigma_n), "
             f"gamma_dot = v / ({s.shear_zone_factor:g} d_mean) (a thin shear zone: conservative), "
             "sigma_n the measured plate stress at each record",
-        }
+        )
 
-    def _rate_check(self, tests: list[ShearTestResult], results: dict, sig: np.ndarray, fit) -> dict:
+    def _rate_check(
+        self, tests: list[ShearTestResult], results: dict[tuple, ShearTestResult], sig: np.ndarray, fit
+    ) -> RateCheck:
         """How the peaks change at half the velocity (the reruns under ``rate_check/``)."""
         rows = []
         for t in tests:
             h = results[("rate", t["normal_stress_kpa"])]
-            rows.append({
-                "normal_stress_kpa": t["normal_stress_kpa"],
-                "peak_kpa": t["peak_shear_stress_kpa"],
-                "peak_half_velocity_kpa": h["peak_shear_stress_kpa"],
-                "relative_change": h["peak_shear_stress_kpa"] / t["peak_shear_stress_kpa"] - 1.0,
-                "shear_displacement_at_peak_m": t["shear_displacement_at_peak_m"],
-                "shear_displacement_at_peak_half_velocity_m": h["shear_displacement_at_peak_m"],
-                "max_inertial_number_half_velocity": h["max_inertial_number"],
-                "mean_abs_change_before_peak": self._pre_peak_change(t, h),
-                "wall_time_s": h["wall_time_s"],
-            })  # fmt: skip
-        worst = max(abs(r["relative_change"]) for r in rows)
-        fit_h = mohr_coulomb(sig, [r["peak_half_velocity_kpa"] for r in rows]) if len(sig) >= 2 else None
-        return {
-            "velocity_m_per_s": self.settings.velocity,
-            "half_velocity_m_per_s": 0.5 * self.settings.velocity,
-            "tests": rows,
-            "max_abs_relative_change": worst,
-            "tolerance": self.rate_tolerance,
-            "passed": worst < self.rate_tolerance,
-            "friction_angle_half_velocity_deg": fit_h.friction_angle_deg if fit_h else None,
-            "friction_angle_change_deg": (fit_h.friction_angle_deg - fit.friction_angle_deg)
+            rows.append(RateCheckRow(
+                normal_stress_kpa=t.normal_stress_kpa,
+                peak_kpa=t.peak_shear_stress_kpa,
+                peak_half_velocity_kpa=h.peak_shear_stress_kpa,
+                relative_change=h.peak_shear_stress_kpa / t.peak_shear_stress_kpa - 1.0,
+                shear_displacement_at_peak_m=t.shear_displacement_at_peak_m,
+                shear_displacement_at_peak_half_velocity_m=h.shear_displacement_at_peak_m,
+                max_inertial_number_half_velocity=h.max_inertial_number,
+                mean_abs_change_before_peak=self._pre_peak_change(t, h),
+                wall_time_s=h.wall_time_s,
+            ))  # fmt: skip
+        worst = max(abs(r.relative_change) for r in rows)
+        fit_h = mohr_coulomb(sig, [r.peak_half_velocity_kpa for r in rows]) if len(sig) >= 2 else None
+        return RateCheck(
+            velocity_m_per_s=self.settings.velocity,
+            half_velocity_m_per_s=0.5 * self.settings.velocity,
+            tests=rows,
+            max_abs_relative_change=worst,
+            tolerance=self.rate_tolerance,
+            passed=worst < self.rate_tolerance,
+            friction_angle_half_velocity_deg=fit_h.friction_angle_deg if fit_h else None,
+            friction_angle_change_deg=(fit_h.friction_angle_deg - fit.friction_angle_deg)
             if (fit_h and fit)
             else None,
-            "max_mean_abs_change_before_peak": max(r["mean_abs_change_before_peak"] for r in rows),
-            "note": RATE_CHECK_NOTE,
-        }
+            max_mean_abs_change_before_peak=max(r.mean_abs_change_before_peak for r in rows),
+            note=RATE_CHECK_NOTE,
+        )
 
     def _pre_peak_change(self, t: ShearTestResult, h: ShearTestResult) -> float:
         """Mean |tau_half - tau| / tau_peak of the smoothed curves up to the earlier peak."""
@@ -255,22 +256,23 @@ class ShearSeries:
             return math.nan
         return float(np.mean(np.abs(yb[m] - ya[m])) / t["peak_shear_stress_kpa"])
 
-    def _lab_part(self, fit) -> dict:
+    def _lab_part(self, fit) -> LabComparison:
         """The laboratory data, their fit and the difference of the friction angles."""
         lab = self.lab
-        part = lab.to_dict()
         ls = lab.normal_stresses()
         lf = lab_fit(lab)
-        part["fit"] = lf.to_dict() if lf else None
-        part["friction_angle_deg"] = lf.friction_angle_deg if lf else None
-        part["cohesion_kpa"] = lf.cohesion_kpa if lf else None
-        part["friction_angle_difference_deg"] = (
-            fit.friction_angle_deg - lf.friction_angle_deg if (fit and lf) else None
+        return LabComparison(
+            source=lab.source,
+            kind=lab.kind,
+            peaks=lab.peak_rows(),
+            fit=lf.record() if lf else None,
+            friction_angle_deg=lf.friction_angle_deg if lf else None,
+            cohesion_kpa=lf.cohesion_kpa if lf else None,
+            friction_angle_difference_deg=fit.friction_angle_deg - lf.friction_angle_deg
+            if (fit and lf)
+            else None,
+            fit_through_origin=mohr_coulomb(ls, [lab.peaks[v] for v in ls], through_origin=True).record(),
         )
-        part["fit_through_origin"] = mohr_coulomb(
-            ls, [lab.peaks[v] for v in ls], through_origin=True
-        ).to_dict()
-        return part
 
 
 __all__ = ["ShearSeries", "check_stresses"]

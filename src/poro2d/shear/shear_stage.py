@@ -108,7 +108,7 @@ class ShearStage:
             return False
         x = np.array([r["shear_displacement_mm"] for r in self.rows]) * 1e-3
         tau = np.array([r["shear_stress_kpa"] for r in self.rows])
-        return peak_passed(x, peak(x, tau, s.peak_window)[1], s)
+        return peak_passed(x, peak(x, tau, s.peak_window).x, s)
 
     def run(self) -> float:
         """Shear to the end; returns the stage's wall time (s), resumed parts included."""

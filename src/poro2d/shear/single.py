@@ -16,6 +16,7 @@
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 
@@ -27,6 +28,7 @@ from poro2d.shear.box import SplitBox, build_split_box
 from poro2d.shear.case import ShearCase
 from poro2d.shear.controllers import Consolidation, ProgressFn
 from poro2d.shear.curve import CURVE_COLUMNS, curve_columns, curve_summary
+from poro2d.shear.parts import ConsolidationRecord
 from poro2d.shear.peak_frame import PeakFrame
 from poro2d.shear.results import ShearTestResult
 from poro2d.shear.settings import inertial_number
@@ -103,7 +105,7 @@ class DirectShearTest:
             sim.set_local_damping(float(s.local_damping))
         return sim, box
 
-    def consolidate(self) -> tuple[Simulation, dict]:
+    def consolidate(self) -> tuple[Simulation, ConsolidationRecord]:
         """The consolidated specimen and its record; with ``store`` read back once done.
 
         Done means ``consolidation.json`` (written last) beside ``consolidated.npz``.
@@ -113,20 +115,23 @@ class DirectShearTest:
             return self._consolidate()
         fresh: list[Simulation] = []
 
-        def compute() -> dict:
+        def compute() -> ConsolidationRecord:
             sim, info = self._consolidate()
             extra = {"stage": "consolidated", "normal_stress_kpa": self.sigma_kpa}
             store.save_state(CONSOLIDATED, sim, extra=extra)
             fresh.append(sim)
             return info
 
-        info = self.stage().run(compute, "consolidation.json", accept=lambda _: store.has(CONSOLIDATED))
+        info = self.stage().run(
+            compute, "consolidation.json", accept=lambda _: store.has(CONSOLIDATED),
+            decode=ConsolidationRecord.from_dict,
+        )  # fmt: skip
         if fresh:
             return fresh[0], info
-        self.box = SplitBox(**info["box"])
+        self.box = SplitBox(**info.box)
         return store.load_state(CONSOLIDATED, threads=self.threads), info
 
-    def _consolidate(self) -> tuple[Simulation, dict]:
+    def _consolidate(self) -> tuple[Simulation, ConsolidationRecord]:
         """Build the split box and servo the top plate to the normal stress until equilibrium."""
         s = self.settings
         t0 = time.perf_counter()
@@ -134,25 +139,25 @@ class DirectShearTest:
         self.box = box
         target = self.sigma_kpa * 1e3 * box.width * box.thickness
         done = Consolidation(s, progress=self.progress).settle(sim, target)
-        if not done["settled"]:
+        if not done.settled:
             raise RuntimeError(
                 f"consolidation at {self.sigma_kpa:g} kPa did not reach equilibrium within "
-                f"{s.consolidation_max_steps} steps (ratio {done['max_unbalanced_ratio']:.2e}, "
-                f"stress error {done['normal_stress_error']:.2%})"
+                f"{s.consolidation_max_steps} steps (ratio {done.max_unbalanced_ratio:.2e}, "
+                f"stress error {done.normal_stress_error:.2%})"
             )
-        y0 = done["plate_height_before_m"]
-        info = {
-            "normal_stress_kpa": self.sigma_kpa, "target_force_n": target, "steps": done["steps"],
-            "max_unbalanced_ratio": done["max_unbalanced_ratio"],
-            "normal_stress_measured_kpa": box.plate_force(sim) / (box.width * box.thickness) / 1e3,
-            "normal_stress_error": done["normal_stress_error"], "plate_height_before_m": y0,
-            "plate_height_m": box.plate_height(sim), "plate_settlement_m": y0 - box.plate_height(sim),
-            "coordination_number": coordination_number(sim), "wall_time_s": time.perf_counter() - t0,
-            "box": box.to_dict(), "engine": sim.summary(),
-        }  # fmt: skip
+        y0 = done.plate_height_before_m
+        info = ConsolidationRecord(
+            normal_stress_kpa=self.sigma_kpa, target_force_n=target, steps=done.steps,
+            max_unbalanced_ratio=done.max_unbalanced_ratio,
+            normal_stress_measured_kpa=box.plate_force(sim) / (box.width * box.thickness) / 1e3,
+            normal_stress_error=done.normal_stress_error, plate_height_before_m=y0,
+            plate_height_m=box.plate_height(sim), plate_settlement_m=y0 - box.plate_height(sim),
+            coordination_number=coordination_number(sim), wall_time_s=time.perf_counter() - t0,
+            box=box.to_dict(), engine=sim.summary(),
+        )  # fmt: skip
         return sim, info
 
-    def shear(self, sim: Simulation, info: dict) -> ShearTestResult:
+    def shear(self, sim: Simulation, info: ConsolidationRecord) -> ShearTestResult:
         """Shear the consolidated specimen to ``max_displacement``; returns the test result.
 
         With ``store``: ``curve.csv`` and ``forces_peak.png`` are written here, ``result.json``
@@ -160,7 +165,7 @@ class DirectShearTest:
         """
         assert self.box is not None
         stage = ShearStage(
-            sim, self.box, self.settings, info["plate_height_m"],
+            sim, self.box, self.settings, info.plate_height_m,
             store=self.store, threads=self.threads, figures=self.figures, progress=self.progress,
         )  # fmt: skip
         wall = stage.run()
@@ -184,16 +189,18 @@ class DirectShearTest:
                    f"{1e3 * self.settings.peak_window:g} mm)"],
         )  # fmt: skip
 
-    def _result(self, rows: list[dict], info: dict, sim: Simulation, wall: float) -> ShearTestResult:
+    def _result(
+        self, rows: list[dict], info: ConsolidationRecord, sim: Simulation, wall: float
+    ) -> ShearTestResult:
         """The test's ``result.json``: what the curve says, and how it was obtained."""
         s = self.settings
         rho = float(np.mean(sim.particles.density)) * sim.density_scale
         return ShearTestResult(
-            **curve_summary(rows, self.sigma_kpa, s),
+            **curve_summary(rows, self.sigma_kpa, s)._asdict(),
             inertial_number_at_target_stress=inertial_number(
                 s.velocity, self.sigma_kpa * 1e3, rho, s.shear_zone_factor
             ),
-            consolidation={k: v for k, v in info.items() if k != "engine"},
+            consolidation=replace(info, engine=None),
             velocity_m_per_s=s.velocity,
             density_scale=sim.density_scale,
             local_damping=sim.local_damping,
@@ -202,7 +209,7 @@ class DirectShearTest:
             shear_steps=int(rows[-1]["step"]) if rows else 0,
             records=len(rows),
             wall_time_shear_s=wall,
-            wall_time_s=wall + float(info.get("wall_time_s", 0.0)),
+            wall_time_s=wall + float(info.wall_time_s or 0.0),
             settings=s.to_dict(),
             specimen=self.case.specimen.source,
             engine=sim.summary(),
