@@ -9,6 +9,8 @@ shear displacement.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -28,18 +30,52 @@ CURVE_COLUMNS = [
 ]  # fmt: skip
 
 
-def curve_columns(rows: list[dict]) -> dict[str, np.ndarray]:
-    """A curve's records as one float array per column of :data:`CURVE_COLUMNS` (none without rows).
+@dataclass(frozen=True, eq=False)
+class ShearCurve(Mapping):
+    """A test's recorded curve: one float array per column of ``curve.csv`` (:data:`CURVE_COLUMNS`).
+
+    Also a read-only mapping of the column names to the arrays, in the file's order (the
+    figures take a curve as such).
+    """
+
+    step: np.ndarray
+    shear_displacement_mm: np.ndarray
+    shear_stress_kpa: np.ndarray
+    normal_stress_kpa: np.ndarray
+    plate_displacement_mm: np.ndarray
+    coordination_number: np.ndarray
+    lower_half_stress_kpa: np.ndarray
+    plane_stress_kpa: np.ndarray
+    upper_unbalanced_kpa: np.ndarray
+    plate_friction_kpa: np.ndarray
+    contacts_across_plane: np.ndarray
+    max_unbalanced_ratio: np.ndarray
+    inertial_number: np.ndarray
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in CURVE_COLUMNS:
+            raise KeyError(name)
+        return getattr(self, name)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(CURVE_COLUMNS)
+
+    def __len__(self) -> int:
+        return len(CURVE_COLUMNS)
+
+
+def curve_columns(rows: list[Mapping]) -> ShearCurve | None:
+    """A curve's records as one float array per column of :data:`CURVE_COLUMNS` (None without rows).
 
     Every value goes through ``float`` as ``curve.csv`` stores it (an integer column reads
     back as floats), so a curve in memory and one read from its file are the same arrays.
     """
     if not rows:
-        return {}
-    return {k: np.array([float(r[k]) for r in rows]) for k in CURVE_COLUMNS}
+        return None
+    return ShearCurve(**{k: np.array([float(r[k]) for r in rows]) for k in CURVE_COLUMNS})
 
 
-def curve_rows(curve: dict[str, np.ndarray]) -> list[dict]:
+def curve_rows(curve: Mapping[str, np.ndarray]) -> list[dict]:
     """The records of a curve held as columns (:func:`curve_columns`), as rows of Python floats."""
     names = list(curve)
     return [
@@ -48,10 +84,10 @@ def curve_rows(curve: dict[str, np.ndarray]) -> list[dict]:
     ]
 
 
-def read_curve(store: Store, name: str = "curve.csv") -> dict[str, np.ndarray]:
-    """The columns of a test's ``curve.csv`` in ``store`` (as :func:`curve_columns`; none without it)."""
+def read_curve(store: Store, name: str = "curve.csv") -> ShearCurve | None:
+    """The curve in a test's ``curve.csv`` in ``store`` (as :func:`curve_columns`; None without it)."""
     rows = store.read_rows(name)
-    return {} if rows is None else curve_columns(rows)
+    return None if rows is None else curve_columns(rows)
 
 
 def curve_row(
@@ -177,6 +213,7 @@ def curve_summary(rows: list[dict], sigma_kpa: float, settings: ShearSettings) -
 
 __all__ = [
     "CURVE_COLUMNS",
+    "ShearCurve",
     "CurveSummary",
     "curve_row",
     "curve_summary",

@@ -4,9 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-import numpy as np
-
-from poro2d.shear.curve import CURVE_COLUMNS, curve_rows
+from poro2d.shear.curve import CURVE_COLUMNS, ShearCurve, curve_rows
 from poro2d.shear.fit import MohrCoulombFit, mohr_coulomb
 from poro2d.shear.lab import LabData
 from poro2d.shear.parts import TestSummary
@@ -26,9 +24,7 @@ def lab_fit(lab: LabData | None) -> MohrCoulombFit | None:
     return mohr_coulomb(ls, [lab.peaks[v] for v in ls])
 
 
-def write_tables(
-    store: Store, curves: dict[float, dict[str, np.ndarray]], summary: list[TestSummary]
-) -> None:
+def write_tables(store: Store, curves: dict[float, ShearCurve], summary: list[TestSummary]) -> None:
     """``curves.csv`` (every curve, long format) and ``peaks.csv`` (one row per test).
 
     ``curves``: each test's curve (:attr:`ShearTestResult.curve`) by normal stress.
@@ -44,7 +40,7 @@ def write_tables(
 
 
 def write_figures(
-    store: Store, tests: list[dict], curves: dict[float, dict[str, np.ndarray]], fit, fit0, settings,
+    store: Store, tests: list[dict], curves: dict[float, ShearCurve], fit, fit0, settings,
     lab: LabData | None,
 ) -> None:  # fmt: skip
     """``fig8a_shear_curves.png`` (curves, peaks marked) and ``fig8b_peak_strength.png`` (the fits)."""

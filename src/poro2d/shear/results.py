@@ -7,8 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
-import numpy as np
-
+from poro2d.shear.curve import ShearCurve, read_curve
 from poro2d.shear.parts import (
     ConsolidationRecord,
     EndValues,
@@ -36,7 +35,7 @@ class ShearTestResult(Nested):
     the smoothed peak and where it lies, the end values (``end``: smoothed over one peak
     window), the servo's stress error, the inertial number and the force balance. Stresses
     in kPa, lengths in m unless the name says mm. ``curve`` (not in the file): the recorded
-    curve, one float array per column of ``curve.csv`` (empty when the test is not at hand).
+    curve (:class:`~poro2d.shear.curve.ShearCurve`; None when the test is not at hand).
     """
 
     normal_stress_kpa: float
@@ -70,7 +69,7 @@ class ShearTestResult(Nested):
     specimen: str
     engine: dict[str, Any]
     provenance: dict[str, Any]
-    curve: dict[str, np.ndarray] = field(default_factory=dict, kw_only=True, repr=False, metadata=NOT_IN_FILE)
+    curve: ShearCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> ShearTestResult:
@@ -86,8 +85,6 @@ class ShearTestResult(Nested):
 
         ``data``: the content of ``result.json`` when the caller has read it already.
         """
-        from poro2d.shear.curve import read_curve
-
         if data is None:
             data = store.read_json("result.json")
         if not isinstance(data, dict):
@@ -133,7 +130,7 @@ class ShearSeriesResult(Nested):
     lab: LabComparison | None = None
     wall_time_s: float | None = None
     provenance: dict[str, Any] | None = None
-    curves: dict[float, dict[str, np.ndarray]] = field(
+    curves: dict[float, ShearCurve] = field(
         default_factory=dict, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
 

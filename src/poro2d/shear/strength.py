@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
 
@@ -64,14 +65,14 @@ def check_grid(name: str, values, hi: float) -> list[float]:
 
 
 # ---------------------------------------------------------------------- per test
-def residual_point(curve: dict[str, np.ndarray]) -> tuple[float, float]:
+def residual_point(curve: Mapping[str, np.ndarray]) -> tuple[float, float]:
     """(mean normal stress, mean shear stress) in kPa over the last RESIDUAL_FRACTION of the curve."""
     x = curve["shear_displacement_mm"]
     tail = x >= (1.0 - RESIDUAL_FRACTION) * x[-1]
     return float(curve["normal_stress_kpa"][tail].mean()), float(curve["shear_stress_kpa"][tail].mean())
 
 
-def max_dilation_angle(curve: dict[str, np.ndarray], window_m: float) -> float:
+def max_dilation_angle(curve: Mapping[str, np.ndarray], window_m: float) -> float:
     """atan of the largest mean slope of the plate rise over ``window_m`` of shear displacement (deg).
 
     The slope is the secant (dy(x + w/2) - dy(x - w/2)) / w, for every recorded x at least half
