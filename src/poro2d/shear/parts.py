@@ -228,7 +228,33 @@ class StressPeaks(Nested):
     peaks_kpa: list[float]
 
 
+@dataclass(eq=False)
+class StrengthCase(Nested):
+    """One (mu_r, f_p) case of a strength study (a row of ``strength.csv``, with the pooled intervals).
+
+    Peak and residual friction angles and the dilation angle, mean and sd over the specimens
+    (None when no specimen gave one; the sd None with one specimen); the pooled fits over
+    every specimen's points with their intervals; the mean residual stress ratio.
+    """
+
+    mu_r: float
+    particle_friction: float
+    specimens: int
+    peak_friction_angle_mean_deg: float | None
+    peak_friction_angle_sd_deg: float | None
+    residual_friction_angle_mean_deg: float | None
+    residual_friction_angle_sd_deg: float | None
+    max_dilation_angle_mean_deg: float | None
+    max_dilation_angle_sd_deg: float | None
+    peak_friction_angle_pooled_deg: float | None
+    peak_friction_angle_pooled_ci_deg: list[float] | None
+    cohesion_pooled_kpa: float | None
+    residual_friction_angle_pooled_deg: float
+    residual_friction_angle_pooled_ci_deg: list[float] | None
+    residual_stress_ratio_mean: float
+
+
 __all__ = [
     "ConsolidationRecord", "EndValues", "FitInterval", "FitRecord", "ForceBalance", "LabComparison", "Nested",
-    "QuasiStatic", "RateCheck", "RateCheckRow", "StressPeaks", "TestSummary", "part", "parts",
+    "QuasiStatic", "RateCheck", "RateCheckRow", "StrengthCase", "StressPeaks", "TestSummary", "part", "parts",
 ]  # fmt: skip

@@ -18,13 +18,14 @@ from poro2d.shear.parts import (
     Nested,
     QuasiStatic,
     RateCheck,
+    StrengthCase,
     StressPeaks,
     TestSummary,
     part,
     parts,
 )
 from poro2d.store import Store
-from poro2d.typed_result import NOT_IN_FILE, TypedResult
+from poro2d.typed_result import NOT_IN_FILE
 
 
 @dataclass(eq=False)
@@ -181,7 +182,7 @@ class ReplicateShearResult(Nested):
 
 
 @dataclass(eq=False)
-class StrengthResult(TypedResult):
+class StrengthResult(Nested):
     """Strength against rolling and particle friction (a strength study's ``strength.json``).
 
     ``cases``: one row per (mu_r, f_p) (the rows of ``strength.csv`` with the pooled fits'
@@ -189,7 +190,7 @@ class StrengthResult(TypedResult):
     the specimens; ``definitions``: how each is measured.
     """
 
-    cases: list[dict[str, Any]]
+    cases: list[StrengthCase]
     mu_r: list[float]
     particle_friction: list[float]
     specimens: list[str]
@@ -199,6 +200,12 @@ class StrengthResult(TypedResult):
     processes: int | None = None
     config: dict[str, Any] | None = None
     provenance: dict[str, Any] | None = None
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> StrengthResult:
+        obj = super().from_dict(data)
+        obj.cases = parts(StrengthCase, obj.cases)
+        return obj
 
 
 __all__ = ["ReplicateShearResult", "ShearSeriesResult", "ShearTestResult", "StrengthResult"]

@@ -32,6 +32,7 @@ from poro2d.errors import InputError, check_range
 from poro2d.io_utils import provenance
 from poro2d.shear.case import ShearCase
 from poro2d.shear.fit import mohr_coulomb
+from poro2d.shear.parts import StrengthCase
 from poro2d.shear.replicates import ReplicateShear, mohr_coulomb_ci
 from poro2d.shear.results import ReplicateShearResult, StrengthResult
 from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
@@ -96,8 +97,8 @@ def _mean_sd(values: list[float]) -> tuple[float, float | None]:
 
 
 def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float, friction: float,
-                 window_m: float) -> tuple:  # fmt: skip
-    """One case's row (means and spreads over the specimens) and its per-test rows."""
+                 window_m: float) -> tuple[StrengthCase, list[dict]]:  # fmt: skip
+    """One case's row (means and spreads over the specimens) and its rows of ``strength_tests.csv``."""
     tests = []
     per_specimen = []
     for label, res in summary.series.items():
@@ -124,22 +125,32 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
             "residual": mohr_coulomb(s, tau, through_origin=True).friction_angle_deg,
             "dilation": float(np.mean(psis)),
         })  # fmt: skip
-    row = {"mu_r": mu_r, "particle_friction": friction, "specimens": len(per_specimen)}
+    spread = {}
     for key in ("peak", "residual", "dilation"):
-        name = "max_dilation_angle" if key == "dilation" else f"{key}_friction_angle"
         values = [p[key] for p in per_specimen if p[key] is not None]
-        row[f"{name}_mean_deg"], row[f"{name}_sd_deg"] = _mean_sd(values) if values else (None, None)
-    pooled = summary.fit or {}
-    row["peak_friction_angle_pooled_deg"] = pooled.get("friction_angle_deg")
-    row["peak_friction_angle_pooled_ci_deg"] = pooled.get("friction_angle_ci_deg")
-    row["cohesion_pooled_kpa"] = pooled.get("cohesion_kpa")
+        spread[key] = _mean_sd(values) if values else (None, None)
+    pooled = summary.fit
     res_fit = mohr_coulomb_ci(
         [r["residual_normal_stress_kpa"] for r in tests], [r["residual_shear_stress_kpa"] for r in tests],
         through_origin=True,
     )  # fmt: skip
-    row["residual_friction_angle_pooled_deg"] = res_fit["friction_angle_deg"]
-    row["residual_friction_angle_pooled_ci_deg"] = res_fit["friction_angle_ci_deg"]
-    row["residual_stress_ratio_mean"] = float(np.mean([r["residual_stress_ratio"] for r in tests]))
+    row = StrengthCase(
+        mu_r=mu_r,
+        particle_friction=friction,
+        specimens=len(per_specimen),
+        peak_friction_angle_mean_deg=spread["peak"][0],
+        peak_friction_angle_sd_deg=spread["peak"][1],
+        residual_friction_angle_mean_deg=spread["residual"][0],
+        residual_friction_angle_sd_deg=spread["residual"][1],
+        max_dilation_angle_mean_deg=spread["dilation"][0],
+        max_dilation_angle_sd_deg=spread["dilation"][1],
+        peak_friction_angle_pooled_deg=pooled.friction_angle_deg if pooled else None,
+        peak_friction_angle_pooled_ci_deg=pooled.friction_angle_ci_deg if pooled else None,
+        cohesion_pooled_kpa=pooled.cohesion_kpa if pooled else None,
+        residual_friction_angle_pooled_deg=res_fit.friction_angle_deg,
+        residual_friction_angle_pooled_ci_deg=res_fit.friction_angle_ci_deg,
+        residual_stress_ratio_mean=float(np.mean([r["residual_stress_ratio"] for r in tests])),
+    )
     return row, tests
 
 
