@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numpy as np
 
@@ -159,7 +158,8 @@ def ended_by(x: np.ndarray, x_peak: float, s: ShearSettings) -> str:
     return "max_displacement"
 
 
-class CurveSummary(NamedTuple):
+@dataclass(frozen=True)
+class CurveSummary:
     """What a test's curve says (the first keys of its ``result.json``, in their order)."""
 
     normal_stress_kpa: float

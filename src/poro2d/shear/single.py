@@ -196,7 +196,7 @@ class DirectShearTest:
         s = self.settings
         rho = float(np.mean(sim.particles.density)) * sim.density_scale
         return ShearTestResult(
-            **curve_summary(rows, self.sigma_kpa, s)._asdict(),
+            **vars(curve_summary(rows, self.sigma_kpa, s)),
             inertial_number_at_target_stress=inertial_number(
                 s.velocity, self.sigma_kpa * 1e3, rho, s.shear_zone_factor
             ),
