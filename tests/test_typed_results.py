@@ -138,15 +138,16 @@ def test_a_criterion_folder_written_before_is_read_back_and_still_binds(tmp_path
 def test_a_shear_test_folder_written_before_is_read_back_and_still_binds(tmp_path):
     from poro2d.errors import InputError
     from poro2d.shear import record
+    from poro2d.store import Store
 
     out = _folder(tmp_path, {"test.json": "shear_test_record.json", "result.json": "shear_test_result.json"})
     old = json.loads((out / "test.json").read_text())
-    stage = record.folder_stage(out, old["run"], Path("moved") / "specimen.npz")
+    stage = record.folder_stage(Store(out), old["run"], str(Path("moved") / "specimen.npz"))
     assert ShearTestResult.from_dict(stage.stored()) == json.loads(
         (DATA / "shear_test_result.json").read_text()
     )
-    assert record.folder_stage(out, old["run"], Path("x")).fingerprint.digest == old["key"]
-    other = record.folder_stage(out, dict(old["run"], normal_stress_kpa=100.0), Path("x"))
+    assert record.folder_stage(Store(out), old["run"], "x").fingerprint.digest == old["key"]
+    other = record.folder_stage(Store(out), dict(old["run"], normal_stress_kpa=100.0), "x")
     with pytest.raises(InputError, match=r"another normal stress \(50.0 kPa\); use a new --out"):
         other.check()
     older = dict(old, run={k: v for k, v in old["run"].items() if k != "specimen_digest"})

@@ -223,13 +223,15 @@ def _shear_stage(specimens: dict[str, Path], out: Path, quick: bool, lab_data,
     the figures written (Fig. 8 over the specimens, the first specimen's curves)."""
     from poro2d.shear.replicates import ReplicateShear
     from poro2d.shear.settings import ShearSettings
+    from poro2d.store import Store
 
     console.print(
         f"[bold]3/3 direct shear[/] (Fig. 8) at {', '.join(f'{v:g}' for v in NORMAL_STRESSES_KPA)} kPa "
         f"on {len(specimens)} specimen(s)"
     )
     sset = ShearSettings(**(QUICK_SHEAR if quick else {}))
-    rep = ReplicateShear(specimens, NORMAL_STRESSES_KPA, sset, out=out, lab=lab_data, progress=progress).run()
+    rep = ReplicateShear(specimens, NORMAL_STRESSES_KPA, sset, store=Store(out), lab=lab_data,
+                         progress=progress).run()  # fmt: skip
     first_label, first = next(iter(rep.series.items()))
     fit = rep.fit or {}
     ci = fit.get("friction_angle_ci_deg")
@@ -243,11 +245,11 @@ def _shear_stage(specimens: dict[str, Path], out: Path, quick: bool, lab_data,
     )
     summary = {
         # the pooled fit over every specimen's peaks; "tests" and quasi_static of the first specimen
-        "tests": first.tests,
+        "tests": [t.to_dict() for t in first.tests],
         "friction_angle_deg": fit.get("friction_angle_deg"),
         "cohesion_kpa": fit.get("cohesion_kpa"),
         "r2": fit.get("r2"),
-        "quasi_static": first.quasi_static,
+        "quasi_static": first.quasi_static.to_dict(),
         "replicates": rep.to_dict(),
     }
     figures = {

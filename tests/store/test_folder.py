@@ -122,3 +122,33 @@ def test_a_stage_whose_marker_was_edited_runs_again(tmp_path):
     assert stage.run(compute) == {"peak_kpa": 42.0} and len(calls) == 1  # resumed
     (tmp_path / "result.json").write_text('{"peak_kpa": 4200.0}')
     assert stage.run(compute) == {"peak_kpa": 42.0} and len(calls) == 2  # recomputed, not used
+
+
+def test_a_state_read_once_starts_runs_as_its_file_does(tmp_path):
+    from poro2d.dem import checkpoint
+
+    p = Particles(
+        np.array([[0.01, 0.01], [0.0141, 0.01]]), np.array([0.002, 0.002]), 2650.0, 0.008, 4e5, 4e5, 0.5
+    )
+    sim = Simulation(p, Walls.box(0, 0, 0.05, 0.05, 1e7, 1e7, 0.5))
+    sim.run(100)
+    s = Store(tmp_path)
+    s.save_state("state.npz", sim)
+    meta, arrays = s.read_state("state.npz")
+    assert checkpoint.content_digest(meta, arrays) == checkpoint.state_digest(tmp_path / "state.npz")
+    a = checkpoint.from_content(meta, arrays)
+    a.run(100)
+    b = s.load_state("state.npz")
+    b.run(100)
+    assert np.array_equal(a.particles.pos, b.particles.pos)
+    again = checkpoint.from_content(meta, arrays)  # the content is unchanged by the first run
+    assert np.array_equal(again.particles.pos, s.load_state("state.npz").particles.pos)
+
+
+def test_csv_rows_read_back_as_written(tmp_path):
+    s = Store(tmp_path)
+    x = 0.1 + 0.2  # a float whose shortest repr has 17 digits
+    s.write_csv("t.csv", [{"a": 1, "b": x}, {"a": 2, "b": "text, quoted"}])
+    assert s.read_rows("t.csv") == [{"a": "1", "b": repr(x)}, {"a": "2", "b": "text, quoted"}]
+    assert float(s.read_rows("t.csv")[0]["b"]) == x
+    assert s.read_rows("missing.csv") is None

@@ -10,8 +10,11 @@ import os
 from pathlib import Path
 
 from poro2d.io_utils import atomic_path
+from poro2d.shear.case import ShearCase
 from poro2d.shear.settings import ShearSettings
 from poro2d.shear.single import DirectShearTest
+from poro2d.shear.specimen_file import Specimen
+from poro2d.store import Store
 
 
 def synthetic_lab(
@@ -46,9 +49,10 @@ def synthetic_lab(
         if curves
         else "normal_stress_kpa,peak_shear_stress_kpa"
     ]
+    value = Specimen.read(specimen)  # read once for every test
     for sigma in sorted(float(s) for s in normal_stresses_kpa):
         res = DirectShearTest(
-            specimen, sigma, sset, out=work / f"sn{sigma:g}kPa", figures=False, threads=1
+            ShearCase(value, sigma, sset), Store(work / f"sn{sigma:g}kPa"), figures=False, threads=1
         ).run()
         if not curves:
             lines.append(f"{sigma:g},{res['peak_shear_stress_kpa']:.4f}")

@@ -14,8 +14,11 @@ import numpy as np
 
 from poro2d.execute.dask_cluster import pin_numba_threads
 from poro2d.identity import identity_digest
+from poro2d.shear.case import ShearCase
 from poro2d.shear.settings import ShearSettings
 from poro2d.shear.single import DirectShearTest
+from poro2d.shear.specimen_file import Specimen
+from poro2d.store import Store
 
 #: what a unit returns besides its identity: the observables a calibration may fit
 OBSERVABLES = ("peak", "end")
@@ -51,15 +54,10 @@ def unit_job(
 
 
 def _test(job: dict, threads: int = 1) -> DirectShearTest:
-    return DirectShearTest(
-        job["specimen"],
-        job["sigma"],
-        ShearSettings(**job["settings"]),
-        out=job["out"],
-        figures=False,
-        threads=threads,
-        specimen_digest=job["digest"],
+    case = ShearCase(
+        Specimen.read(job["specimen"], job["digest"]), job["sigma"], ShearSettings(**job["settings"])
     )
+    return DirectShearTest(case, Store(job["out"]), figures=False, threads=threads)
 
 
 def _row(job: dict, res) -> dict:

@@ -25,6 +25,7 @@ displacement plus one largest disk diameter.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -37,6 +38,14 @@ from poro2d.specimen.box import box_faces
 
 LOWER = ("bottom", "lower_left", "lower_right", "lower_lip")
 UPPER = ("upper_left", "upper_right", "upper_lip", "top")
+
+
+class PlaneForce(NamedTuple):
+    """What crosses the shear plane (:meth:`SplitBox.plane_force`): forces (N, x and y) and contacts."""
+
+    across: np.ndarray
+    unbalanced: np.ndarray
+    contacts_across: int
 
 
 @dataclass(frozen=True)
@@ -87,7 +96,7 @@ class SplitBox:
         """Upward push of the disks on the top plate (N)."""
         return float(sim.wall_force("top")[1])
 
-    def plane_force(self, sim: Simulation, contacts=None) -> dict:
+    def plane_force(self, sim: Simulation, contacts=None) -> PlaneForce:
         """Forces carried across the shear plane ``y = split_y`` (N).
 
         The disks are split by their centres into an upper set (``y >= split_y``)
@@ -123,7 +132,7 @@ class SplitBox:
         across -= c.force[wu & ~ui].sum(axis=0)
         unbalanced = sim.force[up].sum(axis=0) - sim.particles.mass[up].sum() * np.asarray(sim.gravity)
         n_cross = int(np.count_nonzero(m1 | m2))
-        return {"across": across, "unbalanced": unbalanced, "contacts_across": n_cross}
+        return PlaneForce(across, unbalanced, n_cross)
 
 
 def _specimen_box(sim: Simulation) -> tuple[float, float]:
@@ -214,4 +223,4 @@ def build_split_box(
     return sim, box
 
 
-__all__ = ["LOWER", "UPPER", "SplitBox", "build_split_box"]
+__all__ = ["LOWER", "UPPER", "PlaneForce", "SplitBox", "build_split_box"]

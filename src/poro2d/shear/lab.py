@@ -47,14 +47,12 @@ class LabData:
     def normal_stresses(self) -> list[float]:
         return sorted(self.peaks)
 
+    def peak_rows(self) -> list[dict[str, float]]:
+        """The peaks as rows (``normal_stress_kpa``, ``peak_shear_stress_kpa``), by normal stress."""
+        return [{"normal_stress_kpa": s, "peak_shear_stress_kpa": self.peaks[s]} for s in sorted(self.peaks)]
+
     def to_dict(self) -> dict:
-        return {
-            "source": self.source,
-            "kind": self.kind,
-            "peaks": [
-                {"normal_stress_kpa": s, "peak_shear_stress_kpa": self.peaks[s]} for s in sorted(self.peaks)
-            ],
-        }
+        return {"source": self.source, "kind": self.kind, "peaks": self.peak_rows()}
 
 
 def _number(path: str, line: int, col: str, text: str) -> float:

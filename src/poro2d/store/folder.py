@@ -22,6 +22,7 @@ the names a protocol uses are relative, so a moved or copied folder resumes.
 
 from __future__ import annotations
 
+import csv
 import json
 import os
 import shutil
@@ -130,6 +131,21 @@ class Store:
         write_csv(self._root / name, rows, header)
         return self._written(name)
 
+    def read_rows(self, name: str) -> list[dict[str, str]] | None:
+        """The rows of the CSV ``name`` as dicts of strings, as :meth:`write_csv` wrote them; None if missing.
+
+        The text is left to the caller to convert: ``float()`` of it gives back the very
+        numbers written (a table parser may round the last digit). A table changed since
+        it was written reads as missing.
+        """
+        if not self.intact(name):
+            return None
+        try:
+            with open(self._root / name, newline="") as fh:
+                return list(csv.DictReader(fh))
+        except (OSError, UnicodeDecodeError):
+            return None
+
     def write_frame(self, name: str, frame: pd.DataFrame, **kw: Any) -> Path:
         """A pandas table as CSV, atomically (``kw`` go to ``DataFrame.to_csv``; no index by default)."""
         path = self._root / name
@@ -189,6 +205,15 @@ class Store:
         """A saved state as a simulation (:func:`poro2d.dem.checkpoint.load`; a damaged file is refused)."""
         self.check_intact(name)
         return checkpoint.load(self._root / name, threads=threads)
+
+    def read_state(self, name: str) -> tuple[dict, dict[str, np.ndarray]]:
+        """(metadata, arrays) of a saved state, read once in full (:func:`poro2d.dem.checkpoint.read`).
+
+        For a state that starts several runs: build each with
+        :func:`poro2d.dem.checkpoint.from_content` instead of reading the file again.
+        """
+        self.check_intact(name)
+        return checkpoint.read(self._root / name)
 
     def state_meta(self, name: str) -> dict:
         """The metadata of a saved state (:func:`poro2d.dem.checkpoint.read_meta`)."""
