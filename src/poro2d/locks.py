@@ -106,7 +106,10 @@ def cache_entry(folder: str | os.PathLike, parameter: str = "PORO2D_CACHE") -> I
 
 
 def holds_output(argument: str = "out", parameter: str = "--out"):
-    """Decorator: the call holds its ``argument`` folder (see :func:`output_folder`) throughout."""
+    """Decorator: the call holds its ``argument`` folder (see :func:`output_folder`) throughout.
+
+    ``argument`` may be a folder or a store (held by its folder); None holds nothing.
+    """
 
     def decorate(func):
         signature = inspect.signature(func)
@@ -115,7 +118,12 @@ def holds_output(argument: str = "out", parameter: str = "--out"):
         def run(*args, **kwargs):
             bound = signature.bind(*args, **kwargs)
             bound.apply_defaults()
-            with output_folder(parameter, bound.arguments[argument]):
+            target = bound.arguments[argument]
+            if target is None:  # a store of None keeps nothing: there is no folder to hold
+                return func(*args, **kwargs)
+            # a store (poro2d.store.Store) is held by its folder, under the option it came from
+            folder, name = getattr(target, "root", target), getattr(target, "parameter", parameter)
+            with output_folder(name, folder):
                 return func(*args, **kwargs)
 
         return run

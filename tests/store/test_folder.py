@@ -76,5 +76,7 @@ def test_checkpoints_resume_the_saved_state(tmp_path):
     back, extra = ck.resume()
     assert extra == {"done": 200} and back.step_count == 200
     assert np.array_equal(back.particles.pos, sim.particles.pos)
+    meta, arrays = Store(tmp_path).read_state("stage.npz")  # the whole file read and checked
+    assert meta["extra"] == {"done": 200} and arrays
     ck.clear()
     assert ck.resume() is None

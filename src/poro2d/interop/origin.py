@@ -14,10 +14,11 @@ saying its provenance is unknown: nothing is made up.
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Any
+
+from poro2d.store import Store
 
 #: every provenance line starts with this (after the target's comment sign)
 PREFIX = "provenance:"
@@ -33,9 +34,10 @@ def origin_lines(checkpoint: str | Path, state: dict[str, Any] | None = None) ->
     """
     p = Path(checkpoint)
     folder = p.parent
-    result = _criterion_record(folder / "result.json", ("iterations", "specimen"))
-    config = _criterion_record(folder / "config.json", ("run",))
-    soil = _criterion_record(folder / SOIL_FILE, ("soil", "state"))
+    records = Store(folder)
+    result = _criterion_record(records, "result.json", ("iterations", "specimen"))
+    config = _criterion_record(records, "config.json", ("run",))
+    soil = _criterion_record(records, SOIL_FILE, ("soil", "state"))
     if result is None and config is None and soil is None:
         return [
             f"{PREFIX} unknown (no criterion record, result.json or config.json, beside {_text(p.name)}: "
@@ -66,14 +68,11 @@ def origin_lines(checkpoint: str | Path, state: dict[str, Any] | None = None) ->
     return lines
 
 
-def _criterion_record(path: Path, keys: tuple[str, ...]) -> dict | None:
+def _criterion_record(records: Store, name: str, keys: tuple[str, ...]) -> dict | None:
     """The JSON object of a criterion's record file, None if missing, unreadable or of another kind."""
-    if not path.is_file() or path.stat().st_size > 50_000_000:
+    if not records.has(name) or (records.root / name).stat().st_size > 50_000_000:
         return None
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None
+    data = records.read_json(name)
     return data if isinstance(data, dict) and all(k in data for k in keys) else None
 
 

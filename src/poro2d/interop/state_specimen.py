@@ -26,7 +26,6 @@ and the states and seeds there are.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from dataclasses import dataclass
@@ -35,6 +34,7 @@ from typing import Any
 
 from poro2d.errors import InputError, check_int, check_range
 from poro2d.io_utils import check_input_file
+from poro2d.store import Store
 
 #: the record files of a folder of specimens by state, in the order they are looked for
 STATE_RECORDS = ("sand.json", "relation.json", "density.json")
@@ -367,12 +367,11 @@ def _config_seed(data: dict) -> int | None:
 
 
 def _json(path: Path, parameter: str) -> dict:
-    try:
-        data = json.loads(check_input_file(parameter, path).read_text())
-    except (OSError, ValueError) as exc:
-        if isinstance(exc, InputError):
-            raise
-        raise InputError(parameter, str(path), "a readable JSON file", str(exc).splitlines()[0]) from None
+    """The JSON object of a record the user pointed at (checked as every input file is)."""
+    check_input_file(parameter, path)
+    data = Store(path.parent, parameter=parameter).read_json(path.name)
+    if data is None:
+        raise InputError(parameter, str(path), "a readable JSON file", "it cannot be read or parsed")
     if not isinstance(data, dict):
         raise InputError(parameter, str(path), "a JSON file holding an object")
     return data

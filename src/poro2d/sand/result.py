@@ -11,12 +11,12 @@ import csv
 import io
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from poro2d.io_utils import atomic_path, provenance, write_json
+from poro2d.io_utils import provenance
+from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
@@ -191,8 +191,10 @@ def summary_row(res: SandResult) -> dict:
     }
 
 
-def summary_markdown(res: SandResult, out: Path) -> str:
-    """The paste-ready summary: the answer first, then the soil, the run and the specimens."""
+def summary_markdown(res: SandResult, store: Store) -> str:
+    """The paste-ready summary: the answer first, then the soil, the run and the specimens
+    (the export commands name the store's folder)."""
+    out = store.root
     st, soil = res.state, res.soil
     dr = st.get("relative_density")
     jam = res.jamming_porosity
@@ -287,16 +289,15 @@ def _fmt(v: float | None) -> str:
     return "n/a" if v is None or not math.isfinite(v) else f"{v:.4f}"
 
 
-def write_summary(res: SandResult, out: Path) -> None:
+def write_summary(res: SandResult, store: Store) -> None:
     """``summary.md``, ``summary.csv`` and, last (it marks the run done), ``sand.json``."""
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=SUMMARY_COLUMNS, lineterminator="\n")
     w.writeheader()
     w.writerow(summary_row(res))
-    for name, text in (("summary.md", summary_markdown(res, out)), ("summary.csv", buf.getvalue())):
-        with atomic_path(out / name) as tmp:
-            tmp.write_text(text, encoding="utf-8")
-    write_json(out / "sand.json", res.to_dict())
+    for name, text in (("summary.md", summary_markdown(res, store)), ("summary.csv", buf.getvalue())):
+        store.write_text(name, text)
+    store.write_result("sand.json", res)
 
 
 __all__ = ["SandResult", "SeedSpecimen", "summary_markdown", "summary_row", "warnings", "write_summary"]

@@ -177,6 +177,10 @@ class Store:
         """A saved state as a simulation (:func:`poro2d.dem.checkpoint.load`; a damaged file is refused)."""
         return checkpoint.load(self._root / name, threads=threads)
 
+    def read_state(self, name: str) -> tuple[dict, dict[str, np.ndarray]]:
+        """A saved state's metadata and arrays, the whole file checked (``checkpoint.read``)."""
+        return checkpoint.read(self._root / name)
+
     def state_meta(self, name: str) -> dict:
         """The metadata of a saved state (:func:`poro2d.dem.checkpoint.read_meta`)."""
         return checkpoint.read_meta(self._root / name)
