@@ -121,8 +121,10 @@ def holds_output(argument: str = "out", parameter: str = "--out"):
             target = bound.arguments[argument]
             if target is None:  # a store of None keeps nothing: there is no folder to hold
                 return func(*args, **kwargs)
-            # a store (poro2d.store.Store) is held by its folder, under the option it came from
-            folder, name = getattr(target, "root", target), getattr(target, "parameter", parameter)
+            # a store (poro2d.store.Store: a root and the option it came from) is held by its folder
+            folder, name = (
+                (target.root, target.parameter) if hasattr(target, "parameter") else (target, parameter)
+            )
             with output_folder(name, folder):
                 return func(*args, **kwargs)
 

@@ -80,3 +80,15 @@ def test_checkpoints_resume_the_saved_state(tmp_path):
     assert meta["extra"] == {"done": 200} and arrays
     ck.clear()
     assert ck.resume() is None
+
+
+def test_a_call_holds_the_folder_of_the_store_it_is_given(tmp_path):
+    """``holds_output`` holds a store by its folder; None holds nothing."""
+    from poro2d.locks import holds_output
+
+    @holds_output("store")
+    def run(store):
+        return None if store is None else store.root.is_dir()  # held: made for the call
+
+    assert run(None) is None and not list(tmp_path.iterdir())
+    assert run(Store(tmp_path / "out", parameter="--into"))

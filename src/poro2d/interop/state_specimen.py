@@ -30,7 +30,6 @@ import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from poro2d.errors import InputError, check_int, check_range
 from poro2d.io_utils import check_input_file
@@ -44,6 +43,21 @@ N_LAB_TOLERANCE = 5e-5
 DR_TOLERANCE = 5e-4
 #: the folder holding a sweep case's criterion outputs (:mod:`poro2d.sweep.runner`)
 CASE_RUN = "run"
+
+
+@dataclass(frozen=True)
+class KnownState:
+    """The laboratory state a specimen belongs to, as far as its records say (None: not said).
+
+    ``record``: the state folder's record it was read from (``sand.json``, ``relation.json``,
+    ``density.json``), None when the specimen's own ``soil.json`` says it.
+    """
+
+    mode: str | None
+    n_lab: float | None
+    relative_density: float | None
+    seed: int | None
+    record: str | None = None
 
 
 @dataclass(frozen=True)
@@ -76,14 +90,9 @@ class StateSpecimen:
     relative_density: float | None
     seed: int
 
-    def as_dict(self) -> dict[str, Any]:
-        return {
-            "record": str(self.record),
-            "mode": self.mode,
-            "n_lab": self.n_lab,
-            "relative_density": self.relative_density,
-            "seed": self.seed,
-        }
+    def known(self) -> KnownState:
+        """The state as the export's provenance lines name it (:func:`poro2d.interop.origin.origin_lines`)."""
+        return KnownState(self.mode, self.n_lab, self.relative_density, self.seed, record=str(self.record))
 
 
 @dataclass
@@ -398,6 +407,7 @@ def _dr_text(dr: float | None) -> str:
 
 __all__ = [
     "STATE_RECORDS",
+    "KnownState",
     "StateSpecimen",
     "find_state_specimen",
     "read_state_index",

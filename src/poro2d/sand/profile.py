@@ -13,10 +13,11 @@ from dataclasses import dataclass
 from typing import Any
 
 from poro2d.store import Store, walk
+from poro2d.typed_result import TypedResult
 
 
-@dataclass(frozen=True)
-class PhaseProfile:
+@dataclass(eq=False)
+class PhaseProfile(TypedResult):
     """One phase's work (the preparation, or the plate/lid stage): steps, seconds, particle-steps."""
 
     steps: int
@@ -24,21 +25,30 @@ class PhaseProfile:
     particle_steps: float
     particle_steps_per_s: float
 
-    def to_dict(self) -> dict[str, Any]:
-        return dict(self.__dict__)
 
-
-@dataclass(frozen=True)
-class StageProfile:
-    """Where a stage's time went: its trials, and the work of its preparation and plate phases."""
+@dataclass(eq=False)
+class StageProfile(TypedResult):
+    """Where a stage's time went (``time_profile``, ``specimens_time_profile`` in ``sand.json``):
+    its trials, and the work of its preparation and plate phases."""
 
     trials: int
     prepare: PhaseProfile
     plate: PhaseProfile
 
     def to_dict(self) -> dict[str, Any]:
-        """As ``sand.json`` records it (``time_profile``, ``specimens_time_profile``)."""
-        return {"trials": self.trials, "prepare": self.prepare.to_dict(), "plate": self.plate.to_dict()}
+        out = super().to_dict()
+        for key in ("prepare", "plate"):
+            if isinstance(out.get(key), PhaseProfile):
+                out[key] = out[key].to_dict()
+        return out
+
+    @classmethod
+    def from_dict(cls, data) -> StageProfile:
+        obj = super().from_dict(data)
+        for key in ("prepare", "plate"):
+            if isinstance(getattr(obj, key), dict):
+                setattr(obj, key, PhaseProfile.from_dict(getattr(obj, key)))
+        return obj
 
 
 def _read(store: Store, name: str) -> dict | None:

@@ -11,11 +11,12 @@ import csv
 import io
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from poro2d.io_utils import provenance
+from poro2d.sand.profile import StageProfile
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
@@ -66,6 +67,50 @@ class SeedSpecimen:
 
 
 @dataclass(eq=False)
+class SandCalibration(TypedResult):
+    """The calibration in the small box (``calibration`` in ``sand.json``).
+
+    ``mus``: the preparation frictions of the final calibration; ``calibration``: its record
+    (:meth:`poro2d.criterion.density.Calibration.to_dict`); ``n2d_min``/``n2d_max``: the 2D
+    extremes; ``dropped_ends``: frictions no seed could prepare; ``cases``: the sweep's folder;
+    ``interior_by_friction``: interior porosities per friction and seed; the densest
+    preparation's own porosity (to hold against the jamming porosity); where the time went
+    in the calibration and in the specimens at full size.
+    """
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("time_profile", "specimens_time_profile")
+
+    mus: list[float]
+    calibration: dict[str, Any]
+    n2d_min: float
+    n2d_max: float
+    dropped_ends: list[float]
+    cases: str
+    interior_by_friction: list[list[float | None]]
+    dense_end_interior: float | None
+    dense_end_interior_sd: float | None
+    time_profile: StageProfile | None = None
+    specimens_time_profile: StageProfile | None = None
+
+    PROFILES: ClassVar[tuple[str, ...]] = ("time_profile", "specimens_time_profile")
+
+    def to_dict(self) -> dict[str, Any]:
+        out = super().to_dict()
+        for key in self.PROFILES:
+            if isinstance(out.get(key), StageProfile):
+                out[key] = out[key].to_dict()
+        return out
+
+    @classmethod
+    def from_dict(cls, data) -> SandCalibration:
+        obj = super().from_dict(data)
+        for key in cls.PROFILES:
+            if isinstance(getattr(obj, key), dict):
+                setattr(obj, key, StageProfile.from_dict(getattr(obj, key)))
+        return obj
+
+
+@dataclass(eq=False)
 class SandResult(TypedResult):
     """``sand.json``: the soil, its state, the answer over seeds and where every part is."""
 
@@ -87,7 +132,7 @@ class SandResult(TypedResult):
     n2d_max: float
     jamming_porosity: float | None
     jamming_porosity_sd: float | None
-    calibration: dict[str, Any]
+    calibration: SandCalibration
     states: list[dict[str, Any]]
     seed_results: list[dict[str, Any]]
     preflight: dict[str, Any]
@@ -96,9 +141,29 @@ class SandResult(TypedResult):
     provenance: dict[str, Any]
     specimens: list[SeedSpecimen] = field(default_factory=list, metadata=NOT_IN_FILE)
 
+    def to_dict(self) -> dict[str, Any]:
+        out = super().to_dict()
+        if isinstance(out.get("calibration"), SandCalibration):
+            out["calibration"] = out["calibration"].to_dict()
+        return out
+
+    @classmethod
+    def from_dict(cls, data) -> SandResult:
+        obj = super().from_dict(data)
+        if isinstance(obj.calibration, dict):
+            obj.calibration = SandCalibration.from_dict(obj.calibration)
+        return obj
+
     @classmethod
     def build(
-        cls, case, pf, target, trial: float, cal_record: dict, kept: list[SeedSpecimen], seconds: float
+        cls,
+        case,
+        pf,
+        target,
+        trial: float,
+        cal_record: SandCalibration,
+        kept: list[SeedSpecimen],
+        seconds: float,
     ) -> SandResult:
         inner_m, inner_sd = _stats([k.interior_porosity for k in kept if k.accepted])
         box_m, box_sd = _stats([k.box_porosity for k in kept if k.accepted])
@@ -131,8 +196,8 @@ class SandResult(TypedResult):
             mu_prep=target.mu_prep,
             n2d_target=target.n2d_target,
             first_trial_full_box=trial,
-            n2d_min=cal_record["n2d_min"],
-            n2d_max=cal_record["n2d_max"],
+            n2d_min=cal_record.n2d_min,
+            n2d_max=cal_record.n2d_max,
             jamming_porosity=pf.jamming.porosity,
             jamming_porosity_sd=pf.jamming.sd,
             calibration=cal_record,
@@ -300,4 +365,12 @@ def write_summary(res: SandResult, store: Store) -> None:
     store.write_result("sand.json", res)
 
 
-__all__ = ["SandResult", "SeedSpecimen", "summary_markdown", "summary_row", "warnings", "write_summary"]
+__all__ = [
+    "SandCalibration",
+    "SandResult",
+    "SeedSpecimen",
+    "summary_markdown",
+    "summary_row",
+    "warnings",
+    "write_summary",
+]

@@ -24,6 +24,7 @@ import time
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -34,7 +35,7 @@ from poro2d.locks import holds_output
 from poro2d.sand.case import ConfigLike, SandCase, load_sand_case
 from poro2d.sand.preflight import Preflight, preflight
 from poro2d.sand.profile import case_runs, stage_profile
-from poro2d.sand.result import SandResult, SeedSpecimen, write_summary
+from poro2d.sand.result import SandCalibration, SandResult, SeedSpecimen, write_summary
 from poro2d.store import Store, walk
 from poro2d.sweep import density as D
 
@@ -131,11 +132,18 @@ def full_box_trial(target: float, dense_end: float | None, cal_dense: float, pf:
     return target - excess * (1.0 - ratio)
 
 
-def _first_trial_shifts(pf: Preflight) -> dict:
-    """What moves the calibration's first trials: the grading's jamming porosity, the box's walls."""
+class FirstTrialShifts(NamedTuple):
+    """What moves the calibration's first trials: the grading's jamming porosity (the dense
+    end), the box's walls' share and the loose bias (:func:`poro2d.sweep.density.calibrate`)."""
+
+    dense_end: float | None
+    walls: float
+    loose_bias: float
+
+
+def _first_trial_shifts(pf: Preflight) -> FirstTrialShifts:
     box = pf.calibration_box
-    return {"dense_end": pf.jamming.porosity, "walls": D.wall_share(box.width, box.height, pf.d50_m),
-            "loose_bias": LOOSE_BIAS}  # fmt: skip
+    return FirstTrialShifts(pf.jamming.porosity, D.wall_share(box.width, box.height, pf.d50_m), LOOSE_BIAS)
 
 
 def calibration_cases(case: SandCase, pf: Preflight, mus: list[float]) -> list:
@@ -143,7 +151,7 @@ def calibration_cases(case: SandCase, pf: Preflight, mus: list[float]) -> list:
     from poro2d.sweep.cases import parse_sweep
 
     cfg = calibration_config(case, pf)
-    sweep = D.calibration_sweep(cfg, mus, case.calibration_seeds, **_first_trial_shifts(pf))
+    sweep = D.calibration_sweep(cfg, mus, case.calibration_seeds, **_first_trial_shifts(pf)._asdict())
     return parse_sweep(sweep, case.base_dir).cases
 
 
@@ -156,14 +164,16 @@ def _calibrate(case, pf, store: Store, mus, record, cal_kw) -> tuple[Calibration
         store.root,
         mus=mus,
         seeds=case.calibration_seeds,
-        **shifts,
+        **shifts._asdict(),
         loosest_first=True,
         record=record,
         **cal_kw,
     )
 
 
-def calibration_stage(case: SandCase, pf: Preflight, store: Store, cal_kw: dict) -> tuple[StateTarget, dict]:
+def calibration_stage(
+    case: SandCase, pf: Preflight, store: Store, cal_kw: dict
+) -> tuple[StateTarget, SandCalibration]:
     """The ends, then the two frictions around the state: its target and friction.
 
     ``cal_kw``: the sweep's options and ``use_cache`` (:func:`poro2d.sweep.density.calibrate`).
@@ -182,18 +192,18 @@ def calibration_stage(case: SandCase, pf: Preflight, store: Store, cal_kw: dict)
     target = state_target(case.lab.n_lab, case.n_max, case.n_min, cal)
     dropped = [mu for mu in case.mus if mu < ends[0] or mu > ends[1]]
     dense = [v for v in info["interior"][0] if v is not None]
-    return target, {
-        "mus": mus,
-        "calibration": cal.to_dict(),
-        "n2d_min": cal.n2d_min,
-        "n2d_max": cal.n2d_max,
-        "dropped_ends": dropped,
-        "cases": info["cases"],
-        "interior_by_friction": info["interior"],
+    return target, SandCalibration(
+        mus=mus,
+        calibration=cal.to_dict(),
+        n2d_min=cal.n2d_min,
+        n2d_max=cal.n2d_max,
+        dropped_ends=dropped,
+        cases=info["cases"],
+        interior_by_friction=info["interior"],
         # the densest preparation's own porosity: to hold against the jamming porosity
-        "dense_end_interior": float(np.mean(dense)) if dense else None,
-        "dense_end_interior_sd": float(np.std(dense, ddof=1)) if len(dense) > 1 else None,
-    }
+        dense_end_interior=float(np.mean(dense)) if dense else None,
+        dense_end_interior_sd=float(np.std(dense, ddof=1)) if len(dense) > 1 else None,
+    )
 
 
 def calibrate_ends(
@@ -318,7 +328,7 @@ def run_sand(
     )
     target, cal_record = calibration_stage(case, pf, store, dict(sweep_kw, use_cache=use_cache))
     clock.end("calibration", t)
-    trial = full_box_trial(target.n2d_target, pf.jamming.porosity, cal_record["n2d_min"], pf)
+    trial = full_box_trial(target.n2d_target, pf.jamming.porosity, cal_record.n2d_min, pf)
     t = clock.begin(
         f"specimens: {case.seeds} at full size ({pf.box.disks:.0f} disks), "
         f"mu_prep {target.mu_prep:.3f}, first trial {trial:.4f}",
@@ -326,10 +336,13 @@ def run_sand(
     rows = specimen_stage(case, replace(target, n2d_target=trial), store, sweep_kw)
     clock.end("specimens", t)
     kept = keep_specimens(rows, store, _state_label(case), case.soil_record(), case.lab.to_dict())
-    cal_ids = [c.id for c in calibration_cases(case, pf, [float(m) for m in cal_record["mus"]])]
-    cal_record["time_profile"] = stage_profile(case_runs(Store(cal_record["cases"]), cal_ids)).to_dict()
-    runs = [case.child("run") for case in walk(store.child("states", "cases"), "*")]
-    cal_record["specimens_time_profile"] = stage_profile(runs).to_dict()
+    cal_ids = [c.id for c in calibration_cases(case, pf, [float(m) for m in cal_record.mus])]
+    runs = [c.child("run") for c in walk(store.child("states", "cases"), "*")]
+    cal_record = replace(
+        cal_record,
+        time_profile=stage_profile(case_runs(Store(cal_record.cases), cal_ids)),
+        specimens_time_profile=stage_profile(runs),
+    )
     radii = _drawn_radii(store, kept)
     _grading_figure(case, radii, store)
     result = SandResult.build(case, pf, target, trial, cal_record, kept, clock.elapsed())
