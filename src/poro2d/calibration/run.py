@@ -44,6 +44,53 @@ CALIBRATED = ("particle_friction", "rolling_friction")
 
 
 @dataclass(eq=False)
+class FittedObservable(TypedResult):
+    """One laboratory value fitted: the observable (``peak`` or ``end``) at a normal stress, the
+    laboratory's value, the surrogate's at the best parameters and the noise it was given (kPa)."""
+
+    observable: str
+    normal_stress_kpa: float
+    lab_kpa: float
+    model_kpa: float
+    noise_sd_kpa: float
+
+
+@dataclass(eq=False)
+class PosteriorSummary(TypedResult):
+    """What ``result.json`` keeps of the posterior (``posterior``).
+
+    ``median``: per parameter (inside its interval, unlike the maximum on a ridge);
+    ``correlation``: of the two parameters (near +-1: a ridge); ``wide``: per parameter,
+    whether its interval spans more than :data:`~poro2d.calibration.model.WIDE_FRACTION` of
+    its range; ``grid``: points per axis; ``prior``: in words; ``observables``: the values
+    fitted; ``noise_correlation``: of the observables' noise.
+    """
+
+    median: dict[str, float]
+    correlation: float
+    wide: dict[str, bool]
+    grid: int
+    prior: str
+    observables: list[FittedObservable]
+    noise_correlation: list[list[float]]
+
+    def to_dict(self) -> dict[str, Any]:
+        out = super().to_dict()
+        if self.observables is not None:
+            out["observables"] = [o.to_dict() if isinstance(o, TypedResult) else o for o in self.observables]
+        return out
+
+    @classmethod
+    def from_dict(cls, data) -> PosteriorSummary:
+        obj = super().from_dict(data)
+        if isinstance(obj.observables, list):
+            obj.observables = [
+                FittedObservable.from_dict(o) if isinstance(o, dict) else o for o in obj.observables
+            ]
+        return obj
+
+
+@dataclass(eq=False)
 class CalibrationResult(TypedResult):
     """A calibration (``result.json``): the best parameters, their intervals, the posterior.
 
@@ -59,7 +106,7 @@ class CalibrationResult(TypedResult):
     best: dict[str, float]
     intervals: dict[str, list[float]]
     level: float
-    posterior: dict[str, Any]
+    posterior: PosteriorSummary
     evaluations: list[dict[str, Any]]
     fit: dict[str, Any]
     lab: dict[str, Any]
@@ -75,8 +122,9 @@ class CalibrationResult(TypedResult):
     def to_dict(self) -> dict[str, Any]:
         """The file's keys; the cluster and the failures as the dicts they are written as."""
         out = super().to_dict()
-        if isinstance(self.cluster, ClusterRecord):
-            out["cluster"] = self.cluster.to_dict()
+        for key in ("posterior", "cluster"):
+            if isinstance(out.get(key), TypedResult):
+                out[key] = out[key].to_dict()
         if self.failures is not None:
             out["failures"] = [f.to_dict() if isinstance(f, UnitFailure) else f for f in self.failures]
         return out
@@ -85,6 +133,8 @@ class CalibrationResult(TypedResult):
     def from_dict(cls, data) -> CalibrationResult:
         """A result from its file's dict; the cluster and the failures read as their records."""
         obj = super().from_dict(data)
+        if isinstance(obj.posterior, dict):
+            obj.posterior = PosteriorSummary.from_dict(obj.posterior)
         if isinstance(obj.cluster, dict):
             obj.cluster = ClusterRecord.from_dict(obj.cluster)
         if isinstance(obj.failures, list):
@@ -337,28 +387,28 @@ def _result(
             wide[name] = bool(hi - lo > model.WIDE_FRACTION * (r_hi - r_lo))
     best_unit = ranges.to_unit([fp], [mu_r])
     fitted = [
-        {
-            "observable": obs,
-            "normal_stress_kpa": s,
-            "lab_kpa": y,
-            "model_kpa": float(sg.mean(best_unit)[0]),
-            "noise_sd_kpa": sd,
-        }
+        FittedObservable(
+            observable=obs,
+            normal_stress_kpa=s,
+            lab_kpa=y,
+            model_kpa=float(sg.mean(best_unit)[0]),
+            noise_sd_kpa=sd,
+        )
         for (obs, s, y), sg, sd in zip(targets, surrogates, post.noise_sd, strict=True)
     ]
     return CalibrationResult(
         best={"particle_friction": fp, "rolling_friction": mu_r},
         intervals=intervals,
         level=level,
-        posterior={
-            "median": {"particle_friction": post.median("fp"), "rolling_friction": post.median("mu_r")},
-            "correlation": post.correlation(),
-            "wide": wide,
-            "grid": model.GRID,
-            "prior": "uniform in log(f_p) and mu_r over the ranges",
-            "observables": fitted,
-            "noise_correlation": post.noise_correlation,
-        },
+        posterior=PosteriorSummary(
+            median={"particle_friction": post.median("fp"), "rolling_friction": post.median("mu_r")},
+            correlation=post.correlation(),
+            wide=wide,
+            grid=model.GRID,
+            prior="uniform in log(f_p) and mu_r over the ranges",
+            observables=fitted,
+            noise_correlation=post.noise_correlation,
+        ),
         evaluations=table,
         fit={f"{obs}_{s:g}kPa": sg.to_dict() for (obs, s, _), sg in zip(targets, surrogates, strict=True)},
         lab=lab_data.to_dict(),
@@ -373,4 +423,11 @@ def _result(
     )
 
 
-__all__ = ["DEFAULT_FP_RANGE", "DEFAULT_MU_R_RANGE", "CalibrationResult", "run_calibration"]
+__all__ = [
+    "DEFAULT_FP_RANGE",
+    "DEFAULT_MU_R_RANGE",
+    "CalibrationResult",
+    "FittedObservable",
+    "PosteriorSummary",
+    "run_calibration",
+]
