@@ -22,9 +22,8 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
-from typing import NamedTuple
 
 import numpy as np
 
@@ -132,7 +131,8 @@ def full_box_trial(target: float, dense_end: float | None, cal_dense: float, pf:
     return target - excess * (1.0 - ratio)
 
 
-class FirstTrialShifts(NamedTuple):
+@dataclass(frozen=True)
+class FirstTrialShifts:
     """What moves the calibration's first trials: the grading's jamming porosity (the dense
     end), the box's walls' share and the loose bias (:func:`poro2d.sweep.density.calibrate`)."""
 
@@ -151,7 +151,7 @@ def calibration_cases(case: SandCase, pf: Preflight, mus: list[float]) -> list:
     from poro2d.sweep.cases import parse_sweep
 
     cfg = calibration_config(case, pf)
-    sweep = D.calibration_sweep(cfg, mus, case.calibration_seeds, **_first_trial_shifts(pf)._asdict())
+    sweep = D.calibration_sweep(cfg, mus, case.calibration_seeds, **asdict(_first_trial_shifts(pf)))
     return parse_sweep(sweep, case.base_dir).cases
 
 
@@ -164,7 +164,7 @@ def _calibrate(case, pf, store: Store, mus, record, cal_kw) -> tuple[Calibration
         store.root,
         mus=mus,
         seeds=case.calibration_seeds,
-        **shifts._asdict(),
+        **asdict(shifts),
         loosest_first=True,
         record=record,
         **cal_kw,
