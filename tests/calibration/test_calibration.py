@@ -120,7 +120,7 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
         assert lo <= value <= hi, (name, value, lo, hi)
         assert lo <= res.posterior["median"][name] <= hi
     assert res == json.loads((out / "result.json").read_text())
-    assert len(res.evaluations) == 10 and res.cluster["tests_run"] == 10 * 2 * 2
+    assert len(res.evaluations) == 10 and res.cluster.tests_run == 10 * 2 * 2
     assert {o["observable"] for o in res.posterior["observables"]} == {"peak", "end"}
     for f in ("calibration_fit.png", "calibration_posterior.png", "calibration.md", "calibration.html"):
         assert (out / f).stat().st_size > 0, f
@@ -142,7 +142,7 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     assert table["rolling_friction"] == res.best["rolling_friction"]
     again = run_calibration(lab, [paths[0], paths[1]], store=Store(out), points=8, refine=2, settings=SHORT,
                             workers=1, dashboard=None, progress=False)  # fmt: skip
-    assert again.cluster["tests_run"] == 0 and again.cluster["tests_reused"] == 40
+    assert again.cluster.tests_run == 0 and again.cluster.tests_reused == 40
     assert again.best == res.best
     # a weaker 'laboratory' (the same specimen at lower frictions) moves the answer to weaker
     # parameters: the calibration follows its data (round 1 comes from the cache)

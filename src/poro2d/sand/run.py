@@ -248,9 +248,8 @@ def keep_specimens(rows: list[dict], store: Store, label: str, soil: dict, state
         seed = int((r.get("params") or {}).get("seed", 0))
         res = r.get("results") or {}
         ok = r.get("status") == "done" and bool(res.get("converged"))
-        src = store.child(
-            "states", "cases", str(r.get("case_id")), "run"
-        )  # the criterion's store of the case
+        # the criterion's store of the case
+        src = store.child("states", "cases", str(r.get("case_id")), "run")
         folder = None
         if ok and src.has("specimen.npz"):
             name = f"{label}-seed{seed}"
