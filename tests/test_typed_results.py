@@ -285,9 +285,10 @@ def test_a_settled_run_writes_the_keys_each_engine_reported():
 
 def test_parts_of_a_result_are_typed_and_written_as_before():
     """Known structures inside a result (the paper summary's criterion, a calibration's posterior
-    and cluster, the sand's calibration and time profiles) are typed parts; the file is the same."""
+    and cluster, the sand's calibration, time profiles and soil) are typed parts; the file is the same."""
     from poro2d.calibration.cluster import ClusterRecord
     from poro2d.calibration.run import PosteriorSummary
+    from poro2d.sand.case import SoilRecord
     from poro2d.sand.profile import StageProfile
     from poro2d.sand.result import SandCalibration
 
@@ -297,7 +298,7 @@ def test_parts_of_a_result_are_typed_and_written_as_before():
     assert isinstance(cal.posterior, PosteriorSummary) and isinstance(cal.cluster, ClusterRecord)
     assert cal.posterior.observables[0].observable == "peak" and cal.cluster.tests_run > 0
     sand = SandResult.from_dict(json.loads((DATA / "sand_result.json").read_text()))
-    assert isinstance(sand.calibration, SandCalibration)
+    assert isinstance(sand.calibration, SandCalibration) and isinstance(sand.soil, SoilRecord)
     assert isinstance(sand.calibration.time_profile, StageProfile)
     assert sand.calibration.time_profile.plate.steps == sand.calibration["time_profile"]["plate"]["steps"]
     for result, name in (

@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from poro2d.console import OutputConsole
 from poro2d.criterion.config import paper_config
@@ -103,7 +103,11 @@ class PaperSummary(TypedResult):
     lab: dict[str, Any] | None = None
 
     #: the typed parts, as their classes read them
-    PARTS = {"conversions": ConversionsRecord, "criterion": CriterionResult, "shear": PaperShear}
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "conversions": ConversionsRecord,
+        "criterion": CriterionResult,
+        "shear": PaperShear,
+    }
 
     def to_dict(self) -> dict[str, Any]:
         """The file's keys; the typed parts as the dicts they are written as."""

@@ -16,6 +16,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from poro2d.io_utils import provenance
+from poro2d.sand.case import SoilRecord
 from poro2d.sand.profile import StageProfile
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
@@ -115,7 +116,7 @@ class SandResult(TypedResult):
     """``sand.json``: the soil, its state, the answer over seeds and where every part is."""
 
     mode: str
-    soil: dict[str, Any]
+    soil: SoilRecord
     state: dict[str, Any]
     interior_porosity_mean: float
     interior_porosity_sd: float
@@ -141,17 +142,22 @@ class SandResult(TypedResult):
     provenance: dict[str, Any]
     specimens: list[SeedSpecimen] = field(default_factory=list, metadata=NOT_IN_FILE)
 
+    #: the typed parts, as their classes read them
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"soil": SoilRecord, "calibration": SandCalibration}
+
     def to_dict(self) -> dict[str, Any]:
         out = super().to_dict()
-        if isinstance(out.get("calibration"), SandCalibration):
-            out["calibration"] = out["calibration"].to_dict()
+        for key in self.PARTS:
+            if isinstance(out.get(key), TypedResult):
+                out[key] = out[key].to_dict()
         return out
 
     @classmethod
     def from_dict(cls, data) -> SandResult:
         obj = super().from_dict(data)
-        if isinstance(obj.calibration, dict):
-            obj.calibration = SandCalibration.from_dict(obj.calibration)
+        for key, part in cls.PARTS.items():
+            if isinstance(getattr(obj, key), dict):
+                setattr(obj, key, part.from_dict(getattr(obj, key)))
         return obj
 
     @classmethod
