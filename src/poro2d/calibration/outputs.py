@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from poro2d.calibration.units import CalibrationUnit, unit_curve
+from poro2d.calibration.units import CACHE, CalibrationUnit, unit_curve
 from poro2d.store import Store
 
 FIT_PNG = "calibration_fit.png"
@@ -16,7 +16,7 @@ def write_outputs(store: Store, result, post, surrogates, lab, found, digests, b
     """Figures, config and report first; ``result.json`` last (its presence says: finished)."""
     from poro2d.report.calibration_figures import plot_calibration_fit, plot_calibration_posterior
 
-    curves, nearest = _best_curves(result, lab, found, digests, base, store.child("cache"))
+    curves, nearest = _best_curves(result, lab, found, digests, base, store.child(CACHE))
     plot_calibration_fit(result, lab, curves, nearest, store.path(FIT_PNG))
     plot_calibration_posterior(result, post, store.path(POSTERIOR_PNG))
     store.write_text(CONFIG_TOML, _config(result, lab))

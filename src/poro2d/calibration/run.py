@@ -20,7 +20,7 @@ import numpy as np
 from poro2d.calibration import model
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
 from poro2d.calibration.specimens import check_preset, given_specimens, preset_specimens
-from poro2d.calibration.units import CalibrationUnit, UnitRow
+from poro2d.calibration.units import CACHE, CalibrationUnit, UnitRow
 from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
 from poro2d.execute.dask_cluster import check_reachable
@@ -273,7 +273,7 @@ def run_calibration(
     digests = {label: state_digest(path) for label, path in found.items()}
     runner = UnitRunner(scheduler, workers, progress=progress, dashboard=dashboard)
     stresses = lab_data.normal_stresses()
-    cache = _child(store, "cache")
+    cache = _child(store, CACHE)
     try:
         design = model.space_filling(ranges, points, design_seed)
         rows = runner.run(_units(design, found, digests, stresses, base), cache, "round 1")

@@ -23,6 +23,8 @@ from poro2d.store import Store
 
 #: what a unit returns besides its identity: the observables a calibration may fit
 OBSERVABLES = ("peak", "end")
+#: the sub-store of a calibration's store that holds its units, each under its key
+CACHE = "cache"
 
 
 def unit_key(specimen_digest: str, sigma: float, settings: dict) -> str:
@@ -142,6 +144,7 @@ def unit_curve(unit: CalibrationUnit, cache: Store | None) -> tuple[np.ndarray, 
 
 
 __all__ = [
+    "CACHE",
     "OBSERVABLES",
     "CalibrationUnit",
     "UnitRow",
