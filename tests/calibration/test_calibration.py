@@ -269,3 +269,9 @@ def test_a_units_identity_is_the_digest_its_cache_folder_was_named_by():
     assert dataclasses.replace(unit, sigma=50.0).key != unit.key
     with pytest.raises(dataclasses.FrozenInstanceError):
         unit.sigma = 1.0  # type: ignore[misc]
+
+
+def test_the_preset_needs_a_store_to_keep_its_specimens(tiny):
+    _, lab = tiny
+    with pytest.raises(InputError, match="store"):
+        run_calibration(lab, preset="paper", quick=True, store=None, progress=False)
