@@ -124,20 +124,25 @@ class StateIndex:
         return "; ".join(parts) if parts else "none"
 
 
-def state_record(folder: str | os.PathLike) -> Path | None:
+def _store(folder: str | os.PathLike | Store) -> Store:
+    """The finished run a state is read from: a store, or the folder the user named."""
+    return folder if isinstance(folder, Store) else Store(folder, parameter="SPECIMEN")
+
+
+def state_record(folder: str | os.PathLike | Store) -> Path | None:
     """The record file of a folder of specimens by state, None for any other folder or a file."""
-    p = Path(folder)
-    if not p.is_dir():
+    store = _store(folder)
+    if not store.exists():
         return None
-    return next((p / name for name in STATE_RECORDS if (p / name).is_file()), None)
+    return next((store.root / name for name in STATE_RECORDS if store.has(name)), None)
 
 
 def find_state_specimen(
-    folder: str | os.PathLike, n_lab: float | None = None, dr: float | None = None, seed: int = 0
+    folder: str | os.PathLike | Store, n_lab: float | None = None, dr: float | None = None, seed: int = 0
 ) -> Path:
     """The criterion folder holding the accepted ``specimen.npz`` of one state and seed.
 
-    ``folder``: a relation folder, a density-mode criterion folder or a sand folder; the
+    ``folder``: a relation, a density-mode criterion or a sand run (its store or folder); the
     state by its laboratory porosity ``n_lab`` or its relative density ``dr`` (one of the
     two), ``seed`` the specimen among the state's. Refused (InputError naming ``--n-lab``,
     ``--dr`` or ``--seed``, with the states and accepted seeds there are) when the state or
@@ -147,13 +152,16 @@ def find_state_specimen(
 
 
 def state_specimen(
-    folder: str | os.PathLike, n_lab: float | None = None, dr: float | None = None, seed: int = 0
+    folder: str | os.PathLike | Store, n_lab: float | None = None, dr: float | None = None, seed: int = 0
 ) -> StateSpecimen:
     """:func:`find_state_specimen` with the state it belongs to (mode, n_lab, Dr, seed)."""
-    record = state_record(folder)
+    store = _store(folder)
+    record = state_record(store)
     if record is None:
         raise InputError(
-            "SPECIMEN", str(folder), "a folder holding " + ", ".join(STATE_RECORDS) + " (a folder of states)"
+            "SPECIMEN",
+            str(store.root),
+            "a folder holding " + ", ".join(STATE_RECORDS) + " (a folder of states)",
         )
     if n_lab is not None and dr is not None:
         raise InputError("--n-lab/--dr", (n_lab, dr), "one of the two, not both")
