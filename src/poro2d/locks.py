@@ -143,8 +143,8 @@ def cache_entry(folder: str | os.PathLike, parameter: str = "PORO2D_CACHE") -> I
 def holds_output(argument: str = "out", parameter: str = "--out", kind: str | None = None):
     """Decorator: the call holds its ``argument`` folder (see :func:`output_folder`) throughout.
 
-    ``argument`` may be a path or a store (anything ``os.fspath`` takes); ``kind`` marks the
-    folder as that kind of run's (see :func:`claim_kind`).
+    ``argument`` may be a folder or a store (held by its folder); None holds nothing.
+    ``kind`` marks the folder as that kind of run's (see :func:`claim_kind`).
     """
 
     def decorate(func):
@@ -154,7 +154,14 @@ def holds_output(argument: str = "out", parameter: str = "--out", kind: str | No
         def run(*args, **kwargs):
             bound = signature.bind(*args, **kwargs)
             bound.apply_defaults()
-            with output_folder(parameter, bound.arguments[argument], kind=kind):
+            target = bound.arguments[argument]
+            if target is None:  # a store of None keeps nothing: there is no folder to hold
+                return func(*args, **kwargs)
+            # a store (poro2d.store.Store: a root and the option it came from) is held by its folder
+            folder, name = (
+                (target.root, target.parameter) if hasattr(target, "parameter") else (target, parameter)
+            )
+            with output_folder(name, folder, kind=kind):
                 return func(*args, **kwargs)
 
         return run

@@ -340,6 +340,9 @@ def test_export_refuses_a_specimen_the_criterion_did_not_accept(
         for row in result["iterations"]:
             row["accepted"] = False
     (crit / "result.json").write_text(json.dumps(result))
+    err = _refused(["export", str(crit), "--to", "lammps", "--out", str(tmp_path / "lmp")], capsys)
+    assert "result.json" in err and "changed since poro2d wrote it" in err  # edited by hand: not trusted
+    (crit / ".digests.json").unlink()  # as an earlier version (no manifest) would have written it
     for specimen in (crit, crit / "specimen.npz"):
         err = _refused(["export", str(specimen), "--to", "lammps", "--out", str(tmp_path / "lmp")], capsys)
         assert "SPECIMEN" in err and ("converged = False" in err or "no accepted trial" in err)

@@ -80,6 +80,8 @@ def test_checkpoints_resume_the_saved_state(tmp_path):
     back, extra = ck.resume()
     assert extra == {"done": 200} and back.step_count == 200
     assert np.array_equal(back.particles.pos, sim.particles.pos)
+    meta, arrays = Store(tmp_path).read_state("stage.npz")  # the whole file read and checked
+    assert meta["extra"] == {"done": 200} and arrays
     ck.clear()
     assert ck.resume() is None
     ck.save(sim, extra={"done": 200})
@@ -152,3 +154,15 @@ def test_csv_rows_read_back_as_written(tmp_path):
     assert s.read_rows("t.csv") == [{"a": "1", "b": repr(x)}, {"a": "2", "b": "text, quoted"}]
     assert float(s.read_rows("t.csv")[0]["b"]) == x
     assert s.read_rows("missing.csv") is None
+
+
+def test_a_call_holds_the_folder_of_the_store_it_is_given(tmp_path):
+    """``holds_output`` holds a store by its folder; None holds nothing."""
+    from poro2d.locks import holds_output
+
+    @holds_output("store")
+    def run(store):
+        return None if store is None else store.root.is_dir()  # held: made for the call
+
+    assert run(None) is None and not list(tmp_path.iterdir())
+    assert run(Store(tmp_path / "out", parameter="--into"))

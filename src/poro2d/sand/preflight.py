@@ -154,11 +154,9 @@ def jamming_of(grading: GradingCurve, seeds: int = 3, *, use_cache: bool = True)
     """
     if not use_cache:
         return _compute_jamming(grading, seeds)
-    import json
-
     from poro2d import __version__
     from poro2d.identity import identity_digest
-    from poro2d.io_utils import write_json
+    from poro2d.store import Store
     from poro2d.sweep.density import cache_dir
 
     key = identity_digest(
@@ -171,16 +169,17 @@ def jamming_of(grading: GradingCurve, seeds: int = 3, *, use_cache: bool = True)
         },
         length=16,
     )
-    path = cache_dir() / "jamming" / f"{key}.json"
+    store, name = Store(cache_dir() / "jamming"), f"{key}.json"
+    data = store.read_json(name)
     try:
-        jam = _jamming_from(json.loads(path.read_text(encoding="utf-8")))
-    except (OSError, ValueError, TypeError, KeyError):
+        jam = _jamming_from(data) if isinstance(data, dict) else None
+    except (ValueError, TypeError, KeyError):
         jam = None
     if jam is not None:
         return jam
     jam = _compute_jamming(grading, seeds)
     try:
-        write_json(path, asdict(jam))
+        store.write_json(name, asdict(jam))
     except OSError:  # a read-only cache: the reference is simply computed again next time
         pass
     return jam
