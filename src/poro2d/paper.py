@@ -26,6 +26,9 @@ from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.typed_result import TypedResult
 
+#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+KIND = "paper"
+
 if TYPE_CHECKING:
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.criterion.result import CriterionOutputs
@@ -169,7 +172,7 @@ def conversion_files(store: Store) -> ConversionsRecord:
                              figures=[str(f.name) for f in figs], provenance=provenance())  # fmt: skip
 
 
-@holds_output("store")
+@holds_output("store", kind=KIND)
 def run_paper(
     store: Store,
     *,

@@ -33,6 +33,9 @@ from poro2d.shear.settings import MAX_FRICTION, ShearSettings
 from poro2d.store import Store
 from poro2d.typed_result import TypedResult
 
+#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+KIND = "calibrate"
+
 DEFAULT_FP_RANGE = (0.3, 3.0)
 DEFAULT_MU_R_RANGE = (0.0, 0.5)
 #: most design points of a round (each is replicates x stresses shear tests)
@@ -198,7 +201,7 @@ def _lab_targets(lab: LabData, base: dict) -> list[tuple[str, float, float]]:
     return targets
 
 
-@holds_output("store")
+@holds_output("store", kind=KIND)
 def run_calibration(
     lab: str | os.PathLike | LabData,
     specimens: list[str | os.PathLike] | None = None,

@@ -9,12 +9,15 @@ import typer
 from poro2d.console import OutputConsole, Table
 from poro2d.locks import holds_output
 
+#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+KIND = "export"
+
 console = OutputConsole()
 
 TARGETS = ("lammps", "yade", "pfc", "csv")
 
 
-@holds_output("out")
+@holds_output("out", kind=KIND)
 def export_cmd(
     specimen: str = typer.Argument(
         ...,

@@ -9,6 +9,9 @@ import typer
 from poro2d.console import OutputConsole, Table
 from poro2d.locks import holds_output
 
+#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+KIND = "import"
+
 console = OutputConsole()
 
 
@@ -25,7 +28,7 @@ IMPORT_OPTIONS = (
 MAX_STEPS_LIMIT = 100_000_000
 
 
-@holds_output("out")
+@holds_output("out", kind=KIND)
 def import_cmd(
     file: Path = typer.Argument(
         ..., help="disks.csv (walls.csv beside it), a LAMMPS data file or a checkpoint."

@@ -276,9 +276,7 @@ def _record(path: str | os.PathLike, folder: Store, name: str) -> dict | None:
     data = folder.read_json(name)
     if data is None:
         why = "it changed since poro2d wrote it" if not folder.intact(name) else "it is not valid JSON"
-        raise InputError(
-            "SPECIMEN", str(path), f"a specimen with a readable {name}", why
-        ) from None
+        raise InputError("SPECIMEN", str(path), f"a specimen with a readable {name}", why) from None
     return data if isinstance(data, dict) else None
 
 

@@ -38,6 +38,9 @@ from poro2d.sand.result import SandCalibration, SandResult, SeedSpecimen, write_
 from poro2d.store import Store, walk
 from poro2d.sweep import density as D
 
+#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+KIND = "sand"
+
 Announce = Callable[[str], None]
 
 #: the calibration's first trials are started looser by this times mu_prep: a frictional
@@ -285,7 +288,7 @@ def check_soil(
     return case, preflight(case, workers=workers or os.cpu_count() or 1, budget_minutes=budget_minutes)
 
 
-@holds_output("store")
+@holds_output("store", kind=KIND)
 def run_sand(
     config: ConfigLike,
     *,

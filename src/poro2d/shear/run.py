@@ -90,7 +90,7 @@ def run_shear(
     for name, flag in (("rate_check", rate_check), ("progress", progress)):
         if not isinstance(flag, bool):
             raise InputError(name, flag, "True or False")
-    with output_folder(store.parameter, store.root):
+    with output_folder(store.parameter, store.root, kind="shear"):
         series = ShearSeries(
             value, stresses, shear_settings, store=store, lab=lab_data, rate_check=rate_check,
             processes=processes, progress=progress, config=config,
