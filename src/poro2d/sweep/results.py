@@ -47,6 +47,29 @@ class SweepResult(TypedResult):
 
 
 @dataclass(eq=False)
+class CalibrationRun(TypedResult):
+    """Where a calibration's cases are and how many ran (``sweeps.calibration`` of a relation).
+
+    ``key``: the digest naming its cache entry; ``cases``: the folder of its sweep;
+    ``source``: "computed" when a case ran, else "cache"; ``interior``: the accepted
+    specimens' interior porosity per friction and seed (only for calibrations whose first
+    trials follow the grading, see :class:`~poro2d.sweep.density.CalibrationCase`);
+    ``summary`` and ``failed``: its sweep's summary and failed cases.
+    """
+
+    OPTIONAL = ("interior",)
+
+    key: str
+    cases: str
+    ran: int
+    reused: int
+    source: str
+    interior: list[list[float | None]] | None = None
+    summary: dict[str, Any] | None = None
+    failed: int | None = None
+
+
+@dataclass(eq=False)
 class DensityStateResult(TypedResult):
     """The density-controlled criterion for one laboratory state (``density.json``).
 
@@ -142,4 +165,4 @@ class SensitivityResult(TypedResult):
     provenance: dict[str, Any] | None = None
 
 
-__all__ = ["DensityStateResult", "RelationResult", "SensitivityResult", "SweepResult"]
+__all__ = ["CalibrationRun", "DensityStateResult", "RelationResult", "SensitivityResult", "SweepResult"]

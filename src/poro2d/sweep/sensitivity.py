@@ -20,7 +20,6 @@ accepts the paper's 0.15 within 0.005, or which comes closest and by how much.
 
 from __future__ import annotations
 
-import copy
 import math
 import time
 from dataclasses import dataclass
@@ -31,7 +30,11 @@ import numpy as np
 
 from poro2d.config import check_keys, check_number_list
 from poro2d.errors import InputError
-from poro2d.locks import holds_output
+from poro2d.io_utils import check_output_dir
+from poro2d.store import Store
+from poro2d.sweep.cases import SweepConfig
+from poro2d.sweep.criterion_base import CriterionBase
+from poro2d.sweep.output import held
 from poro2d.sweep.results import SensitivityResult
 
 #: grading widths of the full study (Cu = d60 / d10), and of ``--quick``: at the paper
@@ -95,19 +98,19 @@ def study_settings(table: dict | None, *, quick: bool, seeds: int | None) -> dic
 REFINE_DEFAULTS = {"refine_tolerance": 0.002, "max_iterations": 10}
 
 
-def study_base(base: dict, *, quick: bool) -> dict:
-    """The criterion config every case starts from: the given one, smaller in quick mode."""
+def study_base(base: CriterionBase, *, quick: bool) -> CriterionBase:
+    """The criterion base every case starts from: the given one, smaller in quick mode."""
     from poro2d.sweep.relation import QUICK_SPECIMEN
 
-    cfg = copy.deepcopy({k: v for k, v in base.items() if k not in ("sensitivity", "relation", "sweep")})
+    study = base.without("sensitivity", "relation", "sweep")
     # trials refined below the paper's 0.01 grid, so the study resolves differences of 0.005
-    cfg["criterion"] = dict(REFINE_DEFAULTS, **(cfg.get("criterion") or {}))
+    study = study.with_defaults({"criterion": REFINE_DEFAULTS})
     if quick:
-        cfg["specimen"] = dict(cfg.get("specimen") or {}, **QUICK_SPECIMEN)
+        study = study.with_tables(specimen=dict(study.table("specimen"), **QUICK_SPECIMEN))
         # in a box of a few hundred disks 1 % of G is about two disks' weight: the quick
         # look widens the window as `poro2d paper --quick` does (a config's own value wins)
-        cfg["criterion"] = dict(quick_criterion(), **(cfg.get("criterion") or {}))
-    return cfg
+        study = study.with_defaults({"criterion": quick_criterion()})
+    return study
 
 
 # ------------------------------------------------------------------------------ gradings
@@ -137,20 +140,20 @@ class GradingCase:
         }
 
 
-def _reference_params(base: dict, base_dir: Path | None) -> dict[str, Any]:
-    g = dict(base.get("grading") or {"preset": "paper"})
-    if isinstance(g.get("csv"), str) and base_dir is not None and not Path(g["csv"]).is_absolute():
-        g["csv"] = str((base_dir / g["csv"]).resolve())
+def _reference_params(base: CriterionBase) -> dict[str, Any]:
+    g = base.table("grading") or {"preset": "paper"}
+    if isinstance(g.get("csv"), str) and base.base_dir is not None and not Path(g["csv"]).is_absolute():
+        g["csv"] = str((base.base_dir / g["csv"]).resolve())
     return {f"grading.{k}": v for k, v in g.items()}
 
 
-def gradings(base: dict, base_dir: Path | None, cus: list[float]) -> list[GradingCase]:
+def gradings(base: CriterionBase, cus: list[float]) -> list[GradingCase]:
     """The config's grading, then the log-linear family at its mean disk area."""
     from poro2d.criterion.config import build
     from poro2d.specimen.grading import log_linear_grading
 
-    _, ref, _, _ = build(copy.deepcopy(base), base_dir)
-    out = [GradingCase(REFERENCE, None, _reference_params(base, base_dir), ref)]
+    _, ref, _, _ = build(base.as_config(), base.base_dir)
+    out = [GradingCase(REFERENCE, None, _reference_params(base), ref)]
     area = ref.mean_disk_area()
     for cu in cus:
         g = log_linear_grading(cu, area)
@@ -163,12 +166,12 @@ def gradings(base: dict, base_dir: Path | None, cus: list[float]) -> list[Gradin
     return out
 
 
-def check_gradings(base: dict, base_dir: Path | None, cases: list[GradingCase]) -> None:
+def check_gradings(base: CriterionBase, cases: list[GradingCase]) -> None:
     """Every grading must fit the box: one clear line naming the Cu, before anything runs."""
     from poro2d.criterion.config import build
     from poro2d.specimen.compaction import check_feasible
 
-    spec, _, settings, _ = build(copy.deepcopy(base), base_dir)
+    spec, _, settings, _ = build(base.as_config(), base.base_dir)
     band = spec.height / spec.layers
     for g in cases:
         d_max = g.curve.d_max_m
@@ -183,16 +186,11 @@ def check_gradings(base: dict, base_dir: Path | None, cases: list[GradingCase]) 
         check_feasible(spec, g.curve, settings.initial_trial())
 
 
-def grading_sweep(base: dict, cases: list[GradingCase], seeds: int) -> dict:
+def grading_sweep(base: CriterionBase, cases: list[GradingCase], seeds: int) -> SweepConfig:
     """One criterion case per grading and seed, everything else as in ``base``."""
-    cfg = copy.deepcopy(base)
-    cfg["grading"] = {}  # each case names its own grading
-    cfg["sweep"] = {
-        "kind": "criterion",
-        "title": "accepted n2D against grading width",
-        "cases": [dict(g.params, seed=s) for g in cases for s in range(seeds)],
-    }
-    return cfg
+    params = [dict(g.params, seed=s) for g in cases for s in range(seeds)]
+    table = {"kind": "criterion", "title": "accepted n2D against grading width", "cases": params}
+    return base.with_tables(grading={}).sweep(table, params)  # each case names its own grading
 
 
 # ------------------------------------------------------------------------------ analysis
@@ -383,7 +381,8 @@ def _protocol_lines(sens: dict, ref: dict | None) -> list[str]:
         return []
     # each trial is a fresh specimen seeded by the seed and the trial porosity: where the two
     # protocols reach the same trial porosity they prepare the same specimen
-    first = first_trial(with_density_defaults(sens.get("config") or {})["criterion"], mu0)
+    study = with_density_defaults(CriterionBase(sens.get("config") or {}))
+    first = first_trial(study.table("criterion"), mu0)
     return [
         f"At mu_prep = {mu0:g} the measured porosity n' of the accepted trial is {a:.4f} starting from "
         f"the first trial {ref['first_trial_porosity']:g} and {b:.4f} starting from {first:g} (the "
@@ -408,11 +407,9 @@ def _first_trial_lines(ref: dict | None, paper: dict) -> list[str]:
 
 
 # ----------------------------------------------------------------------------------- run
-@holds_output("out")
 def run_sensitivity(
-    base: dict,
-    base_dir: Path | None,
-    out: Path,
+    base: CriterionBase,
+    store: Store | None = None,
     *,
     quick: bool = False,
     seeds: int | None = None,
@@ -420,10 +417,11 @@ def run_sensitivity(
     announce=None,
     **sweep_kw,
 ) -> SensitivityResult:
-    """The whole study into ``out``; returns the :class:`SensitivityResult` of ``out/sensitivity.json``.
+    """The whole study into ``store``; returns the :class:`SensitivityResult` of its ``sensitivity.json``.
 
-    ``base``: a criterion config, optionally with a ``[sensitivity]`` table (``cu``,
-    ``mu_prep``, ``seeds``). Everything is checked before the first case runs; ``announce``
+    ``base``: a criterion config as read, optionally with a ``[sensitivity]`` table (``cu``,
+    ``mu_prep``, ``seeds``); ``store``: where the study is kept (None: nothing is kept but
+    the shared calibration cache). Everything is checked before the first case runs; ``announce``
     (no arguments) is called then, before any work.
     ``sweep_kw``: ``scheduler``, ``workers``, ``client``, ``progress`` of the sweep runner.
     """
@@ -431,37 +429,48 @@ def run_sensitivity(
     from poro2d.execute.cluster_options import check_cluster_options
     from poro2d.execute.dask_cluster import check_reachable
     from poro2d.sweep import density as D
-    from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.runner import run_sweep
 
+    if store is not None:
+        check_output_dir(store.parameter, store.root)
     if sweep_kw.get("client") is None:
         check_cluster_options(sweep_kw.get("scheduler"), sweep_kw.get("workers"))
-    settings = study_settings(base.get("sensitivity"), quick=quick, seeds=seeds)
-    cfg = study_base(base, quick=quick)
-    _, _, crit, _ = build(copy.deepcopy(cfg), base_dir)
-    cases = gradings(cfg, base_dir, settings["cus"])
-    check_gradings(cfg, base_dir, cases)
-    sweep = parse_sweep(grading_sweep(cfg, cases, settings["seeds"]), base_dir)
-    parse_sweep(D.calibration_sweep(cfg, settings["mus"], settings["seeds"]), base_dir)  # checked now
+    settings = study_settings(base.config.get("sensitivity"), quick=quick, seeds=seeds)
+    study = study_base(base, quick=quick)
+    _, _, crit, _ = build(study.as_config(), study.base_dir)
+    cases = gradings(study, settings["cus"])
+    check_gradings(study, cases)
+    sweep = grading_sweep(study, cases, settings["seeds"])
+    # the friction axis is the density calibration, with its settings (layers that settle):
+    # the same cases as the relation's, read back from the shared cache when it ran them
+    calibration = D.CalibrationCase(D.with_density_defaults(study), tuple(settings["mus"]), settings["seeds"])
+    calibration.sweep  # noqa: B018 (its cases are built, so checked, now)
     check_reachable(sweep_kw.get("scheduler"))
     if announce is not None:
         announce()
+    with held(store) as kept:
+        return _run_study(study, crit, cases, sweep, calibration, settings, kept, use_cache=use_cache,
+                          **sweep_kw)  # fmt: skip
+
+
+def _run_study(study: CriterionBase, crit, cases: list[GradingCase], sweep: SweepConfig, calibration,
+               settings: dict, store: Store, *, use_cache: bool,
+               **sweep_kw) -> SensitivityResult:  # fmt: skip
+    """The grading sweep, the calibration, and the study's record of both (checked inputs)."""
+    from poro2d.sweep import density as D
+    from poro2d.sweep.runner import run_sweep
 
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
-    res = run_sweep(sweep, out / "grading", **sweep_kw)
+    res = run_sweep(sweep, store.child("grading"), **sweep_kw)
     timings["grading_s"] = time.perf_counter() - t0
     t1 = time.perf_counter()
-    # the friction axis is the density calibration, with its settings (layers that settle):
-    # the same cases as the relation's, read back from the shared cache when it ran them
-    cal, cal_info = D.calibrate(D.with_density_defaults(cfg), base_dir, out / "mu_prep", mus=settings["mus"],
-                                seeds=settings["seeds"], use_cache=use_cache, **sweep_kw)  # fmt: skip
+    cal, cal_info = D.calibrate(calibration, store.child("mu_prep"), use_cache=use_cache, **sweep_kw)
     timings["mu_prep_s"] = time.perf_counter() - t1
 
     grads = [g.describe() for g in cases]
     labels = [(g, s) for g in grads for s in range(settings["seeds"])]
     records = [seed_record(r, g, s) for r, (g, s) in zip(res.rows, labels, strict=True)]
-    spec = cfg.get("specimen") or {}
+    spec = study.table("specimen")
     sens = {
         "title": "accepted n2D against grading width and preparation friction (paper protocol)",
         "settings": dict(
@@ -475,34 +484,33 @@ def run_sensitivity(
         "gradings": grads,
         "seeds": records,
         "points": {"grading": grading_points(records, grads), "mu_prep": mu_points(cal.to_dict())},
-        "calibration": dict(cal.to_dict(), **cal_info),
+        "calibration": dict(cal.to_dict(), **cal_info.to_dict()),
         "paper": paper_numbers(),
-        "config": cfg,
+        "config": study.as_config(),
         "sweeps": {"grading": res.summary, "failed_cases": len(res.failed)},
         "timings": timings,
     }
     sens["answer"] = answer(sens)
     timings["total_s"] = time.perf_counter() - t0
-    return write_sensitivity(sens, out)
+    return write_sensitivity(sens, store)
 
 
 def _first_from(crit) -> str:
     return "given" if crit.trial_porosity is not None else "Eq. 12"
 
 
-def write_sensitivity(sens: dict, out: Path) -> SensitivityResult:
+def write_sensitivity(sens: dict, store: Store) -> SensitivityResult:
     """sensitivity.json, sensitivity.csv (points), sensitivity_seeds.csv and the figure; the study typed."""
-    from poro2d.io_utils import provenance, write_csv, write_json
+    from poro2d.io_utils import provenance
     from poro2d.report.sensitivity_report import plot_sensitivity
 
-    out.mkdir(parents=True, exist_ok=True)
-    figs = plot_sensitivity(sens, out / "sensitivity")
+    figs = plot_sensitivity(sens, store.path("sensitivity"))
     sens = dict(sens, figure=str(figs[0]), provenance=provenance())
-    write_csv(out / "sensitivity_seeds.csv", sens["seeds"])
+    store.write_csv("sensitivity_seeds.csv", sens["seeds"])
     points = sens["points"]["grading"] + sens["points"]["mu_prep"]
-    write_csv(out / "sensitivity.csv", [_csv_row(p, sens) for p in points])
+    store.write_csv("sensitivity.csv", [_csv_row(p, sens) for p in points])
     result = SensitivityResult.from_dict(sens)
-    write_json(out / "sensitivity.json", result.to_dict())
+    store.write_result("sensitivity.json", result)
     return result
 
 
@@ -515,15 +523,12 @@ def _csv_row(p: dict, sens: dict) -> dict:
     return row
 
 
-def load_sensitivity(folder: Path) -> SensitivityResult:
-    """A finished study read back, its figure path pointing into ``folder``."""
-    import json
-
-    p = Path(folder) / "sensitivity.json"
-    if not p.is_file():
-        raise InputError("sensitivity", str(folder), "a folder holding sensitivity.json")
-    sens = SensitivityResult.from_dict(json.loads(p.read_text()))
-    sens.figure = str(Path(folder) / "sensitivity.png")
+def load_sensitivity(store: Store) -> SensitivityResult:
+    """A finished study read back, its figure path pointing into ``store``."""
+    sens = store.read_result("sensitivity.json", SensitivityResult.from_dict)
+    if sens is None:
+        raise InputError("sensitivity", str(store.root), "a folder holding sensitivity.json")
+    sens.figure = str(store.path("sensitivity.png"))
     return sens
 
 
