@@ -28,6 +28,7 @@ from poro2d.store import Store
 from poro2d.sweep.cases import SweepConfig
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.output import held
+from poro2d.sweep.records import DensitySweeps, QuadraticFit
 from poro2d.sweep.results import RelationResult
 
 RELATION_KEYS = {"n_max", "n_min", "points", "n_lab", "mode", "seeds", "mu_prep"}
@@ -53,7 +54,7 @@ def lab_porosities(n_max: float, n_min: float, points: int) -> list[float]:
     return [round(float(x), 4) for x in np.linspace(n_max, n_min, points)]
 
 
-def fit_quadratic_origin(n_lab, n2d) -> dict[str, Any]:
+def fit_quadratic_origin(n_lab, n2d) -> QuadraticFit:
     """Least-squares n2D = a nLab^2 + b nLab (no constant: the curve passes the origin).
 
     Returns a, b, the residuals (data - fit), their RMS and maximum, and R^2 about the
@@ -71,16 +72,16 @@ def fit_quadratic_origin(n_lab, n2d) -> dict[str, Any]:
     (a, b), *_ = np.linalg.lstsq(A, y, rcond=None)
     resid = y - (a * x * x + b * x)
     ss_tot = float(np.sum((y - y.mean()) ** 2))
-    return {
-        "a": float(a),
-        "b": float(b),
-        "points": int(x.size),
-        "residuals": resid.tolist(),
-        "rms_residual": float(np.sqrt(np.mean(resid**2))),
-        "max_abs_residual": float(np.max(np.abs(resid))),
-        "r2": float(1.0 - np.sum(resid**2) / ss_tot) if ss_tot > 0 else None,
-        "form": "n2D = a nLab^2 + b nLab",
-    }
+    return QuadraticFit(
+        a=float(a),
+        b=float(b),
+        points=int(x.size),
+        residuals=resid.tolist(),
+        rms_residual=float(np.sqrt(np.mean(resid**2))),
+        max_abs_residual=float(np.max(np.abs(resid))),
+        r2=float(1.0 - np.sum(resid**2) / ss_tot) if ss_tot > 0 else None,
+        form="n2D = a nLab^2 + b nLab",
+    )
 
 
 @dataclass(frozen=True)
@@ -149,7 +150,7 @@ def relation_sweep(base: CriterionBase, n_labs: tuple[float, ...]) -> SweepConfi
     return base.sweep(table, [{"criterion.n_lab": n} for n in n_labs])
 
 
-def analyse(rows: list[dict], n_max: float, n_min: float) -> dict:
+def analyse(rows: list[dict], n_max: float, n_min: float) -> RelationResult:
     """Relation points (one per case), the fit through the converged ones, comparisons."""
     pts = []
     for r in rows:
@@ -180,7 +181,7 @@ def analyse(rows: list[dict], n_max: float, n_min: float) -> dict:
             pt[f"n2d_{m}"] = conv.results[m].value
         pts.append(pt)
     pts.sort(key=lambda p: -p["n_lab"])  # loose to dense
-    return dict(_fit_points(pts, n_max, n_min), mode="paper")
+    return _relation(pts, n_max, n_min, "paper")
 
 
 def _stats(values: list[float]) -> tuple[float, float]:
@@ -195,7 +196,7 @@ def _why(row: dict) -> str:
     return str((row.get("results") or {}).get("message") or row.get("error"))
 
 
-def analyse_states(rows: list[dict], targets: list, cal, n_max: float, n_min: float) -> dict:
+def analyse_states(rows: list[dict], targets: list, cal, n_max: float, n_min: float) -> RelationResult:
     """Density-controlled relation: one point per laboratory state, mean and spread over seeds.
 
     ``n2d_dem`` is the mean accepted n2D of the seeds whose criterion converged (the
@@ -241,7 +242,6 @@ def analyse_states(rows: list[dict], targets: list, cal, n_max: float, n_min: fl
             pt[f"n2d_{m}"] = conv.results[m].value
         pts.append(pt)
     pts.sort(key=lambda p: -p["n_lab"])
-    rel = _fit_points(pts, n_max, n_min)
     good = [p for p in pts if p["converged"]]
     spread = None
     if len(good) >= 2:
@@ -259,15 +259,15 @@ def analyse_states(rows: list[dict], targets: list, cal, n_max: float, n_min: fl
                 a["n2d_interior"] >= b["n2d_interior"] for a, b in zip(good, good[1:], strict=False)
             ),
         }
-    rel.update(mode="density", calibration=cal.to_dict(), n2d_max=cal.n2d_max, n2d_min=cal.n2d_min,
-               spread=spread)  # fmt: skip
-    return rel
+    return _relation(pts, n_max, n_min, "density", calibration=cal.to_dict(), n2d_max=cal.n2d_max,
+                     n2d_min=cal.n2d_min, spread=spread)  # fmt: skip
 
 
-def _fit_points(pts: list[dict], n_max: float, n_min: float) -> dict:
-    """The Eq. 12-form fit through the converged points, residuals and comparisons."""
+def _relation(pts: list[dict], n_max: float, n_min: float, mode: str, **extra: Any) -> RelationResult:
+    """The relation of the points (loose to dense): the Eq. 12-form fit through the converged
+    ones, each point's residual and comparison, and ``extra`` keys after ``mode``."""
     good = [p for p in pts if p["converged"] and math.isfinite(p["n2d_dem"])]
-    fit: dict[str, Any] | None = None
+    fit: QuadraticFit | None = None
     note = ""
     try:
         fit = fit_quadratic_origin([p["n_lab"] for p in good], [p["n2d_dem"] for p in good])
@@ -275,13 +275,13 @@ def _fit_points(pts: list[dict], n_max: float, n_min: float) -> dict:
         note = f"no fit: {len(good)} converged point(s); at least two distinct nLab are needed"
     for p in pts:
         if fit is not None and math.isfinite(p["n2d_dem"]):
-            p["n2d_fit"] = fit["a"] * p["n_lab"] ** 2 + fit["b"] * p["n_lab"]
+            p["n2d_fit"] = fit.a * p["n_lab"] ** 2 + fit.b * p["n_lab"]
             p["residual"] = p["n2d_dem"] - p["n2d_fit"]
         else:
             p["n2d_fit"] = None
             p["residual"] = None
         p["dem_minus_parabola"] = p["n2d_dem"] - p["n2d_parabolic"] if math.isfinite(p["n2d_dem"]) else None
-    return {
+    return RelationResult.from_dict({
         "n_max": n_max,
         "n_min": n_min,
         "points": pts,
@@ -291,7 +291,9 @@ def _fit_points(pts: list[dict], n_max: float, n_min: float) -> dict:
         "eq12": {"a": 0.42, "b": 0.25},
         "converged_points": len(good),
         "flagged_points": len(pts) - len(good),
-    }
+        "mode": mode,
+        **extra,
+    })  # fmt: skip
 
 
 def write_relation(rel: dict, store: Store, title: str = "", extra: dict | None = None) -> list[Path]:
@@ -320,7 +322,7 @@ def density_relation(
     mus=None,
     use_cache: bool = True,
     **sweep_kw,
-) -> tuple[dict, dict]:
+) -> tuple[RelationResult, DensitySweeps]:
     """The density-controlled relation: calibrate, map every state, check it over seeds.
 
     ``base``: the criterion config as read; ``settings``: from :func:`relation_settings`;
@@ -349,9 +351,12 @@ def density_relation(
         rows, summary, failed = res.rows + rows, res.summary, res.failed
     summary = dict(summary, from_calibration=len(twins))
     rel = analyse_states(rows, list(targets), cal, settings.n_max, settings.n_min)
-    record = {"calibration": cal_info.to_dict(), "states_summary": summary,
-              "failed_cases": len(failed) + cal_info.failed}  # fmt: skip
-    return rel, record
+    record = {
+        "calibration": cal_info,
+        "states_summary": summary,
+        "failed_cases": len(failed) + cal_info.failed,
+    }
+    return rel, DensitySweeps.from_dict(record)
 
 
 def refuse_density_options(table: dict, seeds: int | None) -> None:

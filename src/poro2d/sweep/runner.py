@@ -36,6 +36,7 @@ from poro2d.locks import cache_entry, output_folder
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.sweep.cases import KINDS, Case, SweepConfig, config_tables
+from poro2d.sweep.records import SweepSummary
 from poro2d.sweep.results import SweepResult
 
 RESULT = "result.json"
@@ -307,7 +308,7 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Sto
     return cluster_info
 
 
-def _summary(ordered: list[dict], n_reused: int, wall: float, cluster_info: dict) -> dict:
+def _summary(ordered: list[dict], n_reused: int, wall: float, cluster_info: dict) -> SweepSummary:
     """Counts, wall and case time, the worker processes and the parallel efficiency of a sweep."""
     busy = sum(r.get("time_s") or 0.0 for r in ordered if not r["reused"])
     summary = {
@@ -324,7 +325,7 @@ def _summary(ordered: list[dict], n_reused: int, wall: float, cluster_info: dict
     }
     if cluster_info.get("threads"):
         summary["parallel_efficiency"] = busy / (wall * cluster_info["threads"]) if wall > 0 else None
-    return summary
+    return SweepSummary.from_dict(summary)
 
 
 def _submit_all(

@@ -36,6 +36,16 @@ from poro2d.sweep.cases import SweepConfig
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.output import held
 from poro2d.sweep.results import SensitivityResult
+from poro2d.sweep.sensitivity_records import (
+    Answer,
+    GradingDescription,
+    GradingPoint,
+    Match,
+    MeanSd,
+    MuPoint,
+    SeedRecord,
+    StudySettings,
+)
 
 #: grading widths of the full study (Cu = d60 / d10), and of ``--quick``: at the paper
 #: grading's mean disk area Cu = 4 has disks of about 26 mm, taller than the 20 mm layer
@@ -78,7 +88,7 @@ def check_cus(cus: Any) -> list[float]:
     return sorted(out)
 
 
-def study_settings(table: dict | None, *, quick: bool, seeds: int | None) -> dict:
+def study_settings(table: dict | None, *, quick: bool, seeds: int | None) -> StudySettings:
     """Cu list, mu_prep list and seeds from ``[sensitivity]`` and the command line."""
     from poro2d.criterion.density import DEFAULT_MUS
     from poro2d.sweep.density import check_mus, check_seeds
@@ -91,7 +101,7 @@ def study_settings(table: dict | None, *, quick: bool, seeds: int | None) -> dic
         n = check_seeds(seeds, "--seeds")
     else:
         n = check_seeds(t.get("seeds", QUICK_SEEDS if quick else DEFAULT_SEEDS), "sensitivity.seeds")
-    return {"cus": cus, "mus": mus, "seeds": n, "quick": bool(quick)}
+    return StudySettings(cus=cus, mus=mus, seeds=n, quick=bool(quick))
 
 
 #: the criterion settings of the study unless its config sets them
@@ -123,21 +133,22 @@ class GradingCase:
     params: dict[str, Any]
     curve: Any  # GradingCurve
 
-    def describe(self) -> dict:
+    def describe(self) -> GradingDescription:
+        """The grading as the study's file records it: widths, sizes, where it came from."""
         c = self.curve
-        return {
-            "label": self.label,
-            "cu_nominal": self.cu_nominal,
-            "cu": c.uniformity,
-            "d10_mm": 1e3 * c.size_at(10.0),
-            "d50_mm": 1e3 * c.size_at(50.0),
-            "d_min_mm": 1e3 * c.d_min_m,
-            "d_max_mm": 1e3 * c.d_max_m,
-            "mean_disk_area_m2": c.mean_disk_area(),
-            "sizes_m": list(c.sizes_m),
-            "percent_passing": list(c.percent_passing),
-            "source": c.source,
-        }
+        return GradingDescription(
+            label=self.label,
+            cu_nominal=self.cu_nominal,
+            cu=c.uniformity,
+            d10_mm=1e3 * c.size_at(10.0),
+            d50_mm=1e3 * c.size_at(50.0),
+            d_min_mm=1e3 * c.d_min_m,
+            d_max_mm=1e3 * c.d_max_m,
+            mean_disk_area_m2=c.mean_disk_area(),
+            sizes_m=list(c.sizes_m),
+            percent_passing=list(c.percent_passing),
+            source=c.source,
+        )
 
 
 def _reference_params(base: CriterionBase) -> dict[str, Any]:
@@ -194,12 +205,12 @@ def grading_sweep(base: CriterionBase, cases: list[GradingCase], seeds: int) -> 
 
 
 # ------------------------------------------------------------------------------ analysis
-def finite_mean_sd(values: list) -> dict:
+def finite_mean_sd(values: list) -> MeanSd:
     """Mean, sample sd (0 for one value) and n of the finite values; NaN when there are none."""
     a = np.array([float(v) for v in values if v is not None and math.isfinite(float(v))], dtype=float)
     if a.size == 0:
-        return {"mean": math.nan, "sd": math.nan, "n": 0}
-    return {"mean": float(a.mean()), "sd": float(a.std(ddof=1)) if a.size > 1 else 0.0, "n": int(a.size)}
+        return MeanSd(math.nan, math.nan, 0)
+    return MeanSd(float(a.mean()), float(a.std(ddof=1)) if a.size > 1 else 0.0, int(a.size))
 
 
 def _ratio(a, b) -> float | None:
@@ -208,11 +219,11 @@ def _ratio(a, b) -> float | None:
     return float(a) / float(b)
 
 
-def seed_record(row: dict, grading: dict, seed: int) -> dict:
+def seed_record(row: dict, grading: GradingDescription, seed: int) -> SeedRecord:
     """One criterion run of the grading study, flattened: accepted n2D, first and last trial."""
     res = row.get("results") or {}
     ok = row.get("status") == "done" and bool(res.get("converged"))
-    return {
+    return SeedRecord.from_dict({
         "grading": grading["label"],
         "cu": grading["cu"],
         "seed": seed,
@@ -234,16 +245,29 @@ def seed_record(row: dict, grading: dict, seed: int) -> dict:
         "accepted_self_weight_n_per_m": res.get("self_weight_n_per_m") if ok else None,
         "message": res.get("message") or row.get("error"),
         "time_s": row.get("time_s"),
-    }
+    })  # fmt: skip
 
 
-def grading_points(records: list[dict], grads: list[dict]) -> list[dict]:
+#: the per-seed quantities a grading point averages: its key prefix, the seed record's key
+AVERAGED = (
+    ("measured", "accepted_measured_n2d"),
+    ("interior", "accepted_interior_porosity"),
+    ("first_f_top", "first_f_top_n_per_m"),
+    ("first_g", "first_self_weight_n_per_m"),
+    ("first_f_top_over_g", "first_f_top_over_g"),
+    ("first_n_prime", "first_new_porosity"),
+    ("accepted_f_top", "accepted_f_top_n_per_m"),
+)
+
+
+def grading_points(records: list[SeedRecord], grads: list[GradingDescription]) -> list[GradingPoint]:
     """One point per grading: accepted n2D and first-trial forces over its seeds."""
     pts = []
     for g in grads:
         recs = [r for r in records if r["grading"] == g["label"]]
         acc = finite_mean_sd([r["accepted_n2d"] for r in recs])
-        pts.append({
+        means = {name: finite_mean_sd([r.get(key) for r in recs]) for name, key in AVERAGED}
+        pts.append(GradingPoint.from_dict({
             "axis": "grading",
             "label": g["label"],
             "cu": g["cu"],
@@ -256,37 +280,27 @@ def grading_points(records: list[dict], grads: list[dict]) -> list[dict]:
             "seeds": len(recs),
             "unconverged": len(recs) - acc["n"],
             "quantity": "accepted trial n2D",
-            **_prefixed("measured", finite_mean_sd([r["accepted_measured_n2d"] for r in recs])),
-            **_prefixed("interior", finite_mean_sd([r.get("accepted_interior_porosity") for r in recs])),
-            **_prefixed("first_f_top", finite_mean_sd([r["first_f_top_n_per_m"] for r in recs])),
-            **_prefixed("first_g", finite_mean_sd([r["first_self_weight_n_per_m"] for r in recs])),
-            **_prefixed("first_f_top_over_g", finite_mean_sd([r["first_f_top_over_g"] for r in recs])),
-            **_prefixed("first_n_prime", finite_mean_sd([r["first_new_porosity"] for r in recs])),
-            **_prefixed("accepted_f_top", finite_mean_sd([r["accepted_f_top_n_per_m"] for r in recs])),
+            **{f"{name}_{stat}": getattr(m, stat) for name, m in means.items() for stat in ("mean", "sd")},
             "first_trial_porosity": next((r["first_trial_porosity"] for r in recs), None),
-        })  # fmt: skip
+        }))  # fmt: skip
     return pts
 
 
-def _prefixed(name: str, s: dict) -> dict:
-    return {f"{name}_mean": s["mean"], f"{name}_sd": s["sd"]}
-
-
-def mu_points(cal: dict) -> list[dict]:
+def mu_points(cal: dict) -> list[MuPoint]:
     """One point per preparation friction, from a calibration's samples (n' per seed)."""
     pts = []
     for mu, samples in zip(cal["mus"], cal["samples"], strict=True):
         s = finite_mean_sd(samples)
-        pts.append({
-            "axis": "mu_prep", "label": f"mu_prep {mu:g}", "mu_prep": mu,
-            "n2d_mean": s["mean"], "n2d_sd": s["sd"], "n": s["n"], "seeds": len(samples),
-            "unconverged": len(samples) - s["n"], "quantity": "n' of the accepted trial (first trial 0.19)",
-        })  # fmt: skip
+        pts.append(MuPoint(
+            axis="mu_prep", label=f"mu_prep {mu:g}", mu_prep=mu,
+            n2d_mean=s.mean, n2d_sd=s.sd, n=s.n, seeds=len(samples),
+            unconverged=len(samples) - s.n, quantity="n' of the accepted trial (first trial 0.19)",
+        ))  # fmt: skip
     return pts
 
 
 # -------------------------------------------------------------------------------- answer
-def closest_match(points: list[dict], x: str, target: float, tol: float = MATCH_TOLERANCE) -> dict:
+def closest_match(points: list[dict], x: str, target: float, tol: float = MATCH_TOLERANCE) -> Match:
     """Points within ``tol`` of ``target``, the closest point, and where the means cross it.
 
     ``x`` names the swept quantity. The crossing is a linear interpolation between two
@@ -294,7 +308,7 @@ def closest_match(points: list[dict], x: str, target: float, tol: float = MATCH_
     """
     good = sorted((p for p in points if math.isfinite(p["n2d_mean"])), key=lambda p: p[x])
     if not good:
-        return {"matches": [], "closest": None, "distance": None, "crossing": None}
+        return Match.from_dict({"matches": [], "closest": None, "distance": None, "crossing": None})
     best = min(good, key=lambda p: abs(p["n2d_mean"] - target))
     crossing = None
     for a, b in zip(good, good[1:], strict=False):
@@ -302,7 +316,7 @@ def closest_match(points: list[dict], x: str, target: float, tol: float = MATCH_
         if ya * yb <= 0.0 and ya != yb:
             crossing = a[x] + (b[x] - a[x]) * ya / (ya - yb)
             break
-    return {
+    return Match.from_dict({
         "matches": [p[x] for p in good if abs(p["n2d_mean"] - target) <= tol + 1e-12],
         "closest": best[x],
         "closest_mean": best["n2d_mean"],
@@ -311,7 +325,7 @@ def closest_match(points: list[dict], x: str, target: float, tol: float = MATCH_
         "distance": best["n2d_mean"] - target,
         "crossing": crossing,
         "ends": [[good[0][x], good[0]["n2d_mean"]], [good[-1][x], good[-1]["n2d_mean"]]],
-    }
+    })  # fmt: skip
 
 
 def _pm(p_mean: float, sd: float, n: int) -> str:
@@ -338,7 +352,7 @@ def _axis_text(name: str, unit: str, m: dict, points: list[dict], x: str, target
     return text + "."
 
 
-def answer(sens: dict, tol: float = MATCH_TOLERANCE) -> dict:
+def answer(sens: dict, tol: float = MATCH_TOLERANCE) -> Answer:
     """Which grading width and which mu_prep accept the paper's n2D, from the measured points."""
     paper = sens["paper"]
     target = float(paper["accepted_porosity"])
@@ -365,7 +379,7 @@ def answer(sens: dict, tol: float = MATCH_TOLERANCE) -> dict:
     unconv = sum(p["unconverged"] for p in g_pts + sens["points"]["mu_prep"])
     if unconv:
         lines.append(f"{unconv} seed(s) did not converge; they are counted, not averaged.")
-    return {"target": target, "tolerance": tol, "grading": g, "mu_prep": mu, "lines": lines}
+    return Answer(target=target, tolerance=tol, grading=g, mu_prep=mu, lines=lines)
 
 
 def _protocol_lines(sens: dict, ref: dict | None) -> list[str]:
