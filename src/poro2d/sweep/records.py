@@ -59,6 +59,14 @@ class WithParts(TypedResult):
 
 
 @dataclass(eq=False)
+class CaseEntry(TypedResult):
+    """A case as ``sweep.json`` lists it: its id (its folder's name) and its parameters."""
+
+    id: str
+    params: dict[str, Any]
+
+
+@dataclass(eq=False)
 class SweepSummary(TypedResult):
     """A sweep's counts and times (``summary`` of ``sweep.json``).
 
@@ -221,6 +229,7 @@ def relation_points(items: list[Mapping[str, Any]]) -> list[PaperPoint | Density
 
 __all__ = [
     "CalibrationRun",
+    "CaseEntry",
     "DensityPoint",
     "DensitySweeps",
     "PaperPoint",

@@ -14,6 +14,7 @@ from typing import Any
 
 from poro2d.sweep.records import (
     CalibrationRun,
+    CaseEntry,
     DensityPoint,
     DensitySweeps,
     PaperPoint,
@@ -47,13 +48,13 @@ class SweepResult(WithParts):
     ``table``: the same as a pandas DataFrame (``results.csv``).
     """
 
-    PARTS = {"summary": part(SweepSummary)}
+    PARTS = {"cases": parts(CaseEntry), "summary": part(SweepSummary)}
 
     status: str
     title: str
     kind: str
     axes: list[str]
-    cases: list[dict[str, Any]]
+    cases: list[CaseEntry]
     config: dict[str, Any]
     base_dir: str | None
     retries: int
