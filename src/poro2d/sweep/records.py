@@ -59,6 +59,46 @@ class WithParts(TypedResult):
 
 
 @dataclass(eq=False)
+class CaseRow(TypedResult):
+    """A case's row (its ``result.json``, or its ``error.json`` when it raised on a worker).
+
+    Where and when it ran, ``status`` (done or failed), the error, and ``results``: the
+    case kind's scalars, the cells of the sweep's table. A row in memory may carry labels
+    that are not in the file (``reused``: read back, not run), kept as ``extra``.
+    """
+
+    case_id: str
+    kind: str
+    params: dict[str, Any]
+    host: str | None = None
+    pid: int | None = None
+    worker: str | None = None
+    started_utc: str | None = None
+    status: str | None = None
+    error: str | None = None
+    time_s: float | None = None
+    finished_utc: str | None = None
+    results: dict[str, Any] | None = None
+
+
+@dataclass(eq=False)
+class LostCaseRow(TypedResult):
+    """The row of a case whose task failed outside the case (its worker lost): its ``error.json``."""
+
+    case_id: str
+    kind: str
+    params: dict[str, Any]
+    status: str
+    error: str
+    time_s: float | None
+    results: dict[str, Any]
+    host: str | None
+    pid: int | None
+    worker: str | None
+    finished_utc: str
+
+
+@dataclass(eq=False)
 class CaseEntry(TypedResult):
     """A case as ``sweep.json`` lists it: its id (its folder's name) and its parameters."""
 
@@ -230,6 +270,8 @@ def relation_points(items: list[Mapping[str, Any]]) -> list[PaperPoint | Density
 __all__ = [
     "CalibrationRun",
     "CaseEntry",
+    "CaseRow",
+    "LostCaseRow",
     "DensityPoint",
     "DensitySweeps",
     "PaperPoint",

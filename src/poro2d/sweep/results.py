@@ -15,8 +15,10 @@ from typing import Any
 from poro2d.sweep.records import (
     CalibrationRun,
     CaseEntry,
+    CaseRow,
     DensityPoint,
     DensitySweeps,
+    LostCaseRow,
     PaperPoint,
     QuadraticFit,
     Spread,
@@ -62,11 +64,13 @@ class SweepResult(WithParts):
     cluster: dict[str, Any]
     summary: SweepSummary
     finished_utc: str
-    rows: list[dict[str, Any]] = field(default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE)
+    rows: list[CaseRow | LostCaseRow] = field(
+        default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
+    )
     table: Any = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     @property
-    def failed(self) -> list[dict[str, Any]]:
+    def failed(self) -> list[CaseRow | LostCaseRow]:
         """The rows of the cases that failed."""
         return [r for r in self.rows if r["status"] == "failed"]
 

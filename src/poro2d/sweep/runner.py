@@ -36,7 +36,7 @@ from poro2d.locks import cache_entry, output_folder
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.sweep.cases import KINDS, Case, SweepConfig, config_tables
-from poro2d.sweep.records import SweepSummary
+from poro2d.sweep.records import CaseRow, LostCaseRow, SweepSummary
 from poro2d.sweep.results import SweepResult
 
 RESULT = "result.json"
@@ -85,13 +85,14 @@ def _is_done(row: dict) -> bool:
     return row.get("status") == "done"
 
 
-def finished_row(case: dict, store: Store) -> dict | None:
+def finished_row(case: dict, store: Store) -> CaseRow | None:
     """The stored row of a finished case, or None (no marker, unreadable, or another case's)."""
-    return case_stage(case, store).stored(RESULT, accept=_is_done)
+    row = case_stage(case, store).stored(RESULT, accept=_is_done)
+    return None if row is None else CaseRow.from_dict(row)
 
 
 # ------------------------------------------------------------------------ worker side
-def compute_case(case: dict, store: Store, func) -> dict:
+def compute_case(case: dict, store: Store, func) -> CaseRow:
     """Run one case on a worker; never raises for errors of the case itself.
 
     ``func`` is the kind's callable, shipped with the task so that kinds registered
@@ -103,11 +104,11 @@ def compute_case(case: dict, store: Store, func) -> dict:
         return _run_case(case, store, func)
 
 
-def _run_case(case: dict, store: Store, func) -> dict:
+def _run_case(case: dict, store: Store, func) -> CaseRow:
     stage = case_stage(case, store)
     done = stage.stored(RESULT, accept=_is_done)
     if done is not None:  # a retry after the marker was written
-        return done
+        return CaseRow.from_dict(done)
     pin_numba_threads()
     row: dict[str, Any] = {
         "case_id": case["id"],
@@ -120,7 +121,8 @@ def _run_case(case: dict, store: Store, func) -> dict:
     }
     t0 = time.perf_counter()
     try:
-        return stage.run(lambda: _done_row(case, store, func, row, t0), RESULT, accept=_is_done)
+        return stage.run(lambda: _done_row(case, store, func, row, t0), RESULT, accept=_is_done,
+                         decode=CaseRow.from_dict)  # fmt: skip
     except Exception as exc:
         row.update(
             status="failed",
@@ -131,7 +133,7 @@ def _run_case(case: dict, store: Store, func) -> dict:
         )
         store.write_text(ERROR_TXT, traceback.format_exc())
         store.write_json(ERROR_JSON, row)
-        return row
+        return CaseRow.from_dict(row)
 
 
 def _done_row(case: dict, store: Store, func, row: dict, t0: float) -> dict:
@@ -157,8 +159,8 @@ def _worker_address() -> str:
 
 
 # ------------------------------------------------------------------------ driver side
-def _failed_row(case: Case, store: Store, err: BaseException, tb: str) -> dict:
-    row = {
+def _failed_row(case: Case, store: Store, err: BaseException, tb: str) -> LostCaseRow:
+    row = LostCaseRow(**{
         "case_id": case.id,
         "kind": case.kind,
         "params": case.params,
@@ -170,10 +172,10 @@ def _failed_row(case: Case, store: Store, err: BaseException, tb: str) -> dict:
         "pid": None,
         "worker": None,
         "finished_utc": _now(),
-    }
+    })  # fmt: skip
     case_stage(case.to_dict(), store).bind()
-    store.write_text(ERROR_TXT, tb or row["error"])
-    store.write_json(ERROR_JSON, row)
+    store.write_text(ERROR_TXT, tb or row.error)
+    store.write_result(ERROR_JSON, row)
     return row
 
 
@@ -261,12 +263,12 @@ def _run_sweep(sweep: SweepConfig, store: Store, *, client, scheduler, workers, 
     }
     store.write_json("sweep.json", record)
 
-    rows: dict[str, dict] = {}
+    rows: dict[str, CaseRow | LostCaseRow] = {}
     pending: list[Case] = []
     for c in sweep.cases:
         done = finished_row(c.to_dict(), cases.child(c.id))
         if done is not None:
-            rows[c.id] = dict(done, status="done", reused=True)
+            rows[c.id] = CaseRow.from_dict(dict(done, status="done", reused=True))
         else:
             pending.append(c)
     n_reused = len(rows)
@@ -275,7 +277,8 @@ def _run_sweep(sweep: SweepConfig, store: Store, *, client, scheduler, workers, 
         cluster_info = _run_pending(sweep, pending, rows, cases, n_reused, client=client,
                                     scheduler=scheduler, workers=workers, progress=progress,
                                     dashboard=dashboard)  # fmt: skip
-    ordered = [dict(rows[c.id], reused=bool(rows[c.id].get("reused", False))) for c in sweep.cases]
+    ordered = [type(rows[c.id]).from_dict(dict(rows[c.id], reused=bool(rows[c.id].get("reused", False))))
+               for c in sweep.cases]  # fmt: skip
     df = table_from_rows(ordered, sweep.axes)
     df["reused"] = [r["reused"] for r in ordered]
     write_tables(df, store)
@@ -336,7 +339,7 @@ def _submit_all(
     progress: bool,
     n_reused: int,
     n_total: int,
-) -> dict[str, dict]:
+) -> dict[str, CaseRow | LostCaseRow]:
     """Every pending case as a job; its row (a failed task's as an error row) as it ends."""
     from poro2d.progress import CountProgress
 
@@ -345,7 +348,7 @@ def _submit_all(
             retries=retries)
         for c in pending
     ]  # fmt: skip
-    rows: dict[str, dict] = {}
+    rows: dict[str, CaseRow | LostCaseRow] = {}
     label = f"sweep ({n_reused} of {n_total} already done)" if n_reused else "sweep"
     with CountProgress(label, len(pending), "cases", enabled=progress) as bar:
 
