@@ -211,11 +211,6 @@ FILE_HOMES = (
 NOT_YET_THROUGH_STORE = {
     "criterion/protocol.py",
     "criterion/result.py",
-    "sweep/density.py",
-    "sweep/density_criterion.py",
-    "sweep/relation.py",
-    "sweep/runner.py",
-    "sweep/sensitivity.py",
 }
 
 #: calls that read or write files: (owner or "" for a bare name, function)

@@ -26,6 +26,27 @@ def ignore_interrupts_in_dask_worker() -> bool:
     return True
 
 
+#: the argument multiprocessing gives a process it spawns (``python -c ... --multiprocessing-fork``)
+SPAWNED_CHILD_FLAG = "--multiprocessing-fork"
+
+
+def ignore_interrupts_in_spawned_child() -> bool:
+    """Ignore SIGINT if this process is a child the command spawned; True if it is one.
+
+    A spawned child imports the command's main module before anything else it runs (a Dask
+    worker then imports distributed for a second or more): a Ctrl-C in that time would kill
+    it with a traceback printed beside the command's one line. Called when the command line
+    package is imported, this makes every child of the command ignore SIGINT from its first
+    import; the command ends them itself.
+    """
+    import sys
+
+    if SPAWNED_CHILD_FLAG not in sys.argv:
+        return False
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    return True
+
+
 def hold_interrupts() -> set | None:
     """Block SIGINT in this thread while a local cluster or a process pool starts; returns what to restore.
 

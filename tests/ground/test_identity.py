@@ -22,6 +22,7 @@ from poro2d.specimen.grading import paper_grading
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint
 from poro2d.sweep.cases import Case, case_id
+from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.density import _run_key, calibration_key
 
 #: values for fields whose default (None, 0, a name) cannot simply be scaled
@@ -127,7 +128,7 @@ def test_calibration_key_and_fields(name):
     cfg = dict(base, **{table: {name: other_value(cls, name)}})
     # the calibration's own axis (friction_prep) and what only picks a first trial are not its identity
     same = name in (*outside_fields(SpecimenSpec), "friction_prep", "n_lab", "trial_porosity")
-    assert (calibration_key(cfg) == calibration_key(base)) == same
+    assert (calibration_key(CriterionBase(cfg)) == calibration_key(CriterionBase(base))) == same
 
 
 @pytest.mark.parametrize("name", each_field(ShearSettings))
@@ -165,7 +166,7 @@ def test_digests_keep_the_values_that_name_existing_folders():
     former = {"base": {"specimen": {"width": 0.1}, "grading": {"preset": "paper"}, "criterion": {}},
               "version": __version__}  # fmt: skip
     expected = hashlib.sha256(json.dumps(former, sort_keys=True, default=str).encode()).hexdigest()[:16]
-    assert calibration_key(base) == expected
+    assert calibration_key(CriterionBase(base)) == expected
 
 
 def test_specimen_records_keep_their_keys():

@@ -153,6 +153,7 @@ import json, sys, time
 from pathlib import Path
 from poro2d.io_utils import write_json
 from poro2d.locks import cache_entry
+from poro2d.store import Store
 from poro2d.sweep.runner import RESULT, case_stage
 
 folder, held = Path(sys.argv[1]), Path(sys.argv[2])
@@ -160,12 +161,13 @@ case = json.loads(sys.argv[3])
 with cache_entry(folder, parameter="case folder"):  # a worker of a killed sweep, still running the case
     held.touch()
     time.sleep(1.0)  # computing
-    case_stage(case, folder).bind()
+    case_stage(case, Store(folder)).bind()
     write_json(folder / RESULT, {"case_id": "c1", "status": "done", "results": {"by": "the first worker"}})
 """
 
 
 def test_a_case_still_running_elsewhere_is_waited_for_and_read_back(tmp_path):
+    from poro2d.store import Store
     from poro2d.sweep.runner import compute_case
 
     folder = tmp_path / "cases" / "c1"
@@ -173,7 +175,7 @@ def test_a_case_still_running_elsewhere_is_waited_for_and_read_back(tmp_path):
     proc = subprocess.Popen(cmd, env=_env())
     try:
         _wait_for(tmp_path / "held", proc)
-        row = compute_case(_CASE, str(folder), lambda config, out: {"by": "a second worker"})
+        row = compute_case(_CASE, Store(folder), lambda config, store: {"by": "a second worker"})
     finally:
         assert proc.wait(60) == 0
     assert row["results"] == {"by": "the first worker"}

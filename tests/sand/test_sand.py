@@ -2,6 +2,7 @@
 
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -37,11 +38,13 @@ def test_case_reads_the_laboratory_state_and_fills_density_defaults():
 
 def test_calibration_cases_run_the_loosest_first():
     """The most frictional cases take longest: the workers start them first."""
-    from poro2d.sweep.density import calibration_sweep
+    from poro2d.sweep.criterion_base import CriterionBase
+    from poro2d.sweep.density import CalibrationCase
 
     case = load_sand_case(_config())
-    listed = calibration_sweep(case.config, [0.0, 0.1, 1.0], 2)["sweep"]["cases"]
-    first = calibration_sweep(case.config, [0.0, 0.1, 1.0], 2, loosest_first=True)["sweep"]["cases"]
+    calibration = CalibrationCase(CriterionBase(case.config), (0.0, 0.1, 1.0), 2)
+    listed = [c.params for c in calibration.sweep.cases]
+    first = [c.params for c in replace(calibration, loosest_first=True).sweep.cases]
     assert [c["specimen.friction_prep"] for c in listed] == [0.0, 0.0, 0.1, 0.1, 1.0, 1.0]
     assert [c["specimen.friction_prep"] for c in first] == [1.0, 1.0, 0.1, 0.1, 0.0, 0.0]
     key = lambda c: (c["specimen.friction_prep"], c["seed"])  # noqa: E731
@@ -144,7 +147,7 @@ def test_jamming_cache_is_read_back_and_a_damaged_entry_recomputed(tmp_path, mon
     g = paper_grading()
     first = PF.jamming_of(g, seeds=1)
     assert first.porosity is not None and 0.1 < first.porosity < 0.2
-    (entry,) = (tmp_path / "jamming").glob("*.json")
+    (entry,) = (tmp_path / "jamming").glob("[!.]*.json")  # not the store's manifest
     assert PF.jamming_of(g, seeds=1) == first  # read back
     data = json.loads(entry.read_text())
     entry.write_text(json.dumps(dict(data, porosity=5.0)))

@@ -47,6 +47,8 @@ def test_tables_and_arrays(tmp_path):
     assert list(frame.columns) == ["a", "b", "c"] and frame["a"].tolist() == [1, 2]
     s.write_frame("f.csv", pd.DataFrame({"y": [0.5, 0.25]}))
     assert s.read_frame("f.csv")["y"].tolist() == [0.5, 0.25]
+    s.write_parquet("f.parquet", pd.DataFrame({"y": [0.5, 0.25]}))
+    assert pd.read_parquet(tmp_path / "f.parquet")["y"].tolist() == [0.5, 0.25]
     s.write_arrays("a.npz", x=np.arange(3.0), y=np.ones(2, dtype=np.int64))
     arrays = s.read_arrays("a.npz")
     assert arrays["x"].tolist() == [0.0, 1.0, 2.0] and arrays["y"].dtype == np.int64

@@ -2,8 +2,9 @@
 
 import pytest
 
+from poro2d.store import Store
 from poro2d.sweep import density as D
-from poro2d.sweep.cases import parse_sweep
+from poro2d.sweep.criterion_base import CriterionBase
 
 BASE = {"seed": 0, "specimen": {"width": 0.05, "height": 0.025, "layers": 2}}
 
@@ -12,8 +13,12 @@ def _fill(**criterion):
     return dict(BASE, criterion={"acceptance": "fill", "refine_tolerance": 0.002, **criterion})
 
 
+def _calibration(cfg, mus, seeds):
+    return D.CalibrationCase(CriterionBase(cfg), tuple(mus), seeds).sweep
+
+
 def _trials(cfg, mus, seeds):
-    sweep = parse_sweep(D.calibration_sweep(cfg, mus, seeds))
+    sweep = _calibration(cfg, mus, seeds)
     return {(c.params["specimen.friction_prep"], c.params["seed"]): c.config["criterion"]["trial_porosity"]
             for c in sweep.cases}  # fmt: skip
 
@@ -41,7 +46,7 @@ def test_the_first_trial_lies_on_the_grid_the_criterion_steps_on():
 
 
 def test_a_fill_calibration_reads_back_per_friction_and_seed():
-    sweep = parse_sweep(D.calibration_sweep(_fill(), [0.0, 1.0], 2))
+    sweep = _calibration(_fill(), [0.0, 1.0], 2)
     rows = [{"status": "done", "params": c.params,
              "results": {"converged": True, "last_new_porosity": c.config["criterion"]["trial_porosity"]}}
             for c in sweep.cases]  # fmt: skip
@@ -55,7 +60,7 @@ def test_under_the_fill_a_check_at_a_calibration_friction_is_its_calibration_cas
     from poro2d.io_utils import write_json
 
     cfg = _fill()
-    cal = parse_sweep(D.calibration_sweep(cfg, [0.0, 1.0], 2))
+    cal = _calibration(cfg, [0.0, 1.0], 2)
     folder = tmp_path / "cal"
     for c in cal.cases:
         row = {"id": c.id, "status": "done", "params": c.params,
@@ -66,8 +71,8 @@ def test_under_the_fill_a_check_at_a_calibration_friction_is_its_calibration_cas
     dense = StateTarget(0.3253, 1.0, 0.1632, 0.0)  # rounds to 0.163, the frictionless first trial
     loose = StateTarget(0.4571, 0.0, 0.2130, 1.0)  # 0.213: not the calibration's 0.216
     between = StateTarget(0.40, 0.5, 0.19, 0.5)
-    states = parse_sweep(D.state_sweep(cfg, [dense, loose, between], 2, 0.001))
-    twins = D.calibration_twins(cal, states, None, folder)
+    states = D.StateChecks(CriterionBase(cfg), (dense, loose, between), 2, 0.001).sweep
+    twins = D.calibration_twins(cal, states, None, Store(folder))
     assert len(twins) == 4
     got = {(r["params"]["criterion.n_lab"], r["params"]["seed"]): r for r in twins.values()}
     assert set(got) == {(0.3253, 0), (0.3253, 1), (0.4571, 0), (0.4571, 1)}
@@ -75,10 +80,10 @@ def test_under_the_fill_a_check_at_a_calibration_friction_is_its_calibration_cas
         assert r["results"]["n_lab"] == n_lab and r["results"]["final_porosity"] == seed + 0.1
     # under the paper's plate only the same first trial makes a twin (none here: 0.19 vs 0.213)
     plate = dict(BASE, criterion={"refine_tolerance": 0.002})
-    cal_p = parse_sweep(D.calibration_sweep(plate, [0.0, 1.0], 2))
+    cal_p = _calibration(plate, [0.0, 1.0], 2)
     for c in cal_p.cases:
         row = {"id": c.id, "status": "done", "params": c.params, "results": {"converged": True}}
         write_json(tmp_path / "p" / "cases" / c.id / "params.json", c.to_dict(), config=True)
         write_json(tmp_path / "p" / "cases" / c.id / "result.json", row)
-    states_p = parse_sweep(D.state_sweep(plate, [loose], 2, 0.001))
-    assert D.calibration_twins(cal_p, states_p, None, tmp_path / "p") == {}
+    states_p = D.StateChecks(CriterionBase(plate), (loose,), 2, 0.001).sweep
+    assert D.calibration_twins(cal_p, states_p, None, Store(tmp_path / "p")) == {}

@@ -34,10 +34,11 @@ def test_density_mode_of_the_criterion(tmp_path, monkeypatch):
     assert "provenance" in res and res["config"]["specimen"]["width"] == 0.05
     # the call of the command's density mode reads the same run back, typed
     from poro2d.io_utils import as_json
+    from poro2d.store import Store
     from poro2d.sweep.density_criterion import run_density_criterion
     from poro2d.sweep.results import DensityStateResult
 
-    again = run_density_criterion(cfg, out=out, n_lab=0.40, progress=False)
+    again = run_density_criterion(cfg, store=Store(out), n_lab=0.40, progress=False)
     assert isinstance(again, DensityStateResult) and again.n_lab == 0.40
     assert again.final_porosity_per_seed == res["final_porosity_per_seed"] and again.mu_prep == res["mu_prep"]
     assert as_json(again.to_dict()) == json.loads((out / "density.json").read_text())  # NaN: null

@@ -11,6 +11,7 @@ from poro2d import porosity as P
 from poro2d.cli import main
 from poro2d.errors import InputError
 from poro2d.report.relation_figure import plot_relation
+from poro2d.store import Store
 from poro2d.sweep import relation as R
 
 
@@ -42,11 +43,11 @@ def test_lab_porosities_loose_to_dense_and_settings():
     pts = R.lab_porosities(P.PAPER_N_MAX, P.PAPER_N_MIN, 5)
     assert pts[0] == 0.4571 and pts[-1] == 0.3253 and pts == sorted(pts, reverse=True)
     s = R.relation_settings(None, points=3, n_max=None, n_min=None, preset=True)
-    assert s["n_lab"] == [0.4571, 0.3912, 0.3253]
+    assert s == R.RelationSettings(0.4571, 0.3253, (0.4571, 0.3912, 0.3253))
     s = R.relation_settings(
         {"n_max": 0.5, "n_min": 0.3, "n_lab": [0.35, 0.45]}, points=None, n_max=None, n_min=None, preset=False
     )
-    assert s["n_lab"] == [0.45, 0.35]
+    assert s.n_lab == (0.45, 0.35)
     with pytest.raises(InputError):
         R.relation_settings({"nmax": 0.5}, points=None, n_max=None, n_min=None, preset=True)
     with pytest.raises(InputError):
@@ -99,7 +100,7 @@ def test_analysis_flags_points_and_writes_files(tmp_path):
     ] == pytest.approx(1.0)
     assert pts["c0"]["n2d_parabolic"] == pytest.approx(float(P.parabolic(0.4571)))
     assert pts["c0"]["n2d_lim_3d"] == pytest.approx(float(P.lim_3d(0.4571)))
-    files = R.write_relation(rel, tmp_path)
+    files = R.write_relation(rel, Store(tmp_path))
     for f in files:
         assert f.stat().st_size > 0
     df = pd.read_csv(tmp_path / "relation.csv")
@@ -238,10 +239,10 @@ def test_a_state_check_that_is_a_calibration_case_is_read_back(tmp_path):
     from poro2d.criterion.density import StateTarget
     from poro2d.io_utils import write_json
     from poro2d.sweep import density as D
-    from poro2d.sweep.cases import parse_sweep
+    from poro2d.sweep.criterion_base import CriterionBase
 
-    base = {"seed": 0, "specimen": {"width": 0.05, "height": 0.025, "layers": 2}}
-    cal = parse_sweep(D.calibration_sweep(base, [0.05, 0.5], 2))
+    base = CriterionBase({"seed": 0, "specimen": {"width": 0.05, "height": 0.025, "layers": 2}})
+    cal = D.CalibrationCase(base, (0.05, 0.5), 2).sweep
     folder = tmp_path / "cal"
     for c in cal.cases:
         mu = c.params["specimen.friction_prep"]
@@ -253,8 +254,8 @@ def test_a_state_check_that_is_a_calibration_case_is_read_back(tmp_path):
     dense = StateTarget(0.33, 1.0, 0.1883, 0.05)  # first trial rounds to 0.19, the calibration's
     other = StateTarget(0.40, 0.4, 0.2, 0.3)
     loose_trial = StateTarget(0.45, 0.0, 0.2095, 0.5)  # a calibration friction, another first trial
-    states = parse_sweep(D.state_sweep(base, [dense, other, loose_trial], 2, 0.01))
-    twins = D.calibration_twins(cal, states, None, folder)
+    states = D.StateChecks(base, (dense, other, loose_trial), 2, 0.01).sweep
+    twins = D.calibration_twins(cal, states, None, Store(folder))
     assert len(twins) == 2
     for row in twins.values():
         assert row["params"]["criterion.n_lab"] == 0.33 and row["results"]["n_lab"] == 0.33
@@ -264,4 +265,4 @@ def test_a_state_check_that_is_a_calibration_case_is_read_back(tmp_path):
     assert {r["params"]["seed"] for r in twins.values()} == {0, 1}
     # an unfinished calibration case is not a twin: the check then runs
     (folder / "cases" / cal.cases[0].id / "result.json").unlink()
-    assert len(D.calibration_twins(cal, states, None, folder)) == 1
+    assert len(D.calibration_twins(cal, states, None, Store(folder))) == 1

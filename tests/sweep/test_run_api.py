@@ -5,6 +5,7 @@ import pytest
 from poro2d.criterion import run_criterion
 from poro2d.criterion.result import CriterionResult
 from poro2d.errors import InputError
+from poro2d.store import Store
 from poro2d.sweep.density_criterion import run_criterion_modes, run_density_criterion
 from poro2d.sweep.relation import run_relation
 
@@ -28,8 +29,9 @@ SMALL = {
 def test_run_criterion_refuses_bad_input_before_writing(tmp_path, run, kw, name):
     out = tmp_path / "o"
     kw = {"config": SMALL, **kw}
+    where = {"out": out} if run is run_criterion else {"store": Store(out)}
     with pytest.raises(InputError) as e:
-        run(kw.pop("config"), out=out, progress=False, **kw)
+        run(kw.pop("config"), progress=False, **where, **kw)
     assert e.value.parameter == name
     assert not out.exists()
 
@@ -58,6 +60,6 @@ def test_run_criterion_matches_the_command(tmp_path):
 def test_run_relation_refuses_bad_input_before_writing(tmp_path, kw, name):
     out = tmp_path / "o"
     with pytest.raises(InputError) as e:
-        run_relation(None, out=out, quick=True, progress=False, **kw)
+        run_relation(None, store=Store(out), quick=True, progress=False, **kw)
     assert name in e.value.parameter
     assert not out.exists()

@@ -12,6 +12,7 @@ import pytest
 from poro2d.cli import main
 from poro2d.errors import InputError
 from poro2d.execute.dask_cluster import SINGLE_THREAD_ENV
+from poro2d.store import Store
 from poro2d.sweep import SweepResult, parse_sweep, register_kind, run_sweep
 
 TINY = {"width": 0.05, "height": 0.025, "layers": 2}
@@ -19,13 +20,11 @@ TINY = {"width": 0.05, "height": 0.025, "layers": 2}
 FAST = {"max_iterations": 1, "max_plate_steps": 5000}
 
 
-def probe(config: dict, out_dir: Path) -> dict:
+def probe(config: dict, store: Store) -> dict:
     """A cheap case kind: counts its runs, can fail, can kill its worker once."""
     p = config.get("probe", {})
-    out_dir.mkdir(parents=True, exist_ok=True)
-    counter = out_dir / "runs.txt"
-    runs = int(counter.read_text()) + 1 if counter.is_file() else 1
-    counter.write_text(str(runs))
+    runs = int(store.read_text("runs.txt") or 0) + 1
+    store.write_text("runs.txt", str(runs))
     marker = p.get("kill_marker")
     if marker and not Path(marker).exists():
         Path(marker).write_text(str(os.getpid()))
@@ -68,7 +67,7 @@ def test_criterion_sweep_uses_both_workers_and_rerun_skips(client, tmp_path):
     sweep = parse_sweep(cfg)
     assert len(sweep.cases) == 8 and sweep.axes == ["criterion.n_lab", "specimen.friction_particle"]
     t0 = time.perf_counter()
-    res = run_sweep(sweep, tmp_path, client=client, progress=False)
+    res = run_sweep(sweep, Store(tmp_path), client=client, progress=False)
     wall = time.perf_counter() - t0
     assert [r["status"] for r in res.rows] == ["done"] * 8, [r.get("error") for r in res.rows]
     # the result is sweep.json's content, typed, with the rows and the table beside the file
@@ -110,7 +109,7 @@ def test_criterion_sweep_uses_both_workers_and_rerun_skips(client, tmp_path):
     )
 
     stamps = {c.id: (tmp_path / "cases" / c.id / "result.json").stat().st_mtime_ns for c in sweep.cases}
-    again = run_sweep(parse_sweep(cfg), tmp_path, client=client, progress=False)
+    again = run_sweep(parse_sweep(cfg), Store(tmp_path), client=client, progress=False)
     assert again.summary["ran"] == 0 and again.summary["reused"] == 8
     assert all(r["reused"] for r in again.rows)
     for c in sweep.cases:
@@ -133,7 +132,7 @@ def test_killed_worker_does_not_lose_the_sweep(client, tmp_path):
             ],
         }
     }
-    res = run_sweep(parse_sweep(cfg), tmp_path / "out", client=client, progress=False)
+    res = run_sweep(parse_sweep(cfg), Store(tmp_path / "out"), client=client, progress=False)
     assert marker.is_file()  # the worker really died once
     assert [r["status"] for r in res.rows] == ["done"] * 4
     killed = res.rows[1]
@@ -144,11 +143,11 @@ def test_killed_worker_does_not_lose_the_sweep(client, tmp_path):
 
 def test_interrupted_sweep_rerun_skips_finished_cases(client, tmp_path):
     out = tmp_path / "out"
-    first = run_sweep(parse_sweep(probe_cfg([1, 2])), out, client=client, progress=False)
+    first = run_sweep(parse_sweep(probe_cfg([1, 2])), Store(out), client=client, progress=False)
     assert first.summary["ran"] == 2
     # the "interrupted" sweep finished two of four cases; the rerun runs only the rest
     full = parse_sweep(probe_cfg([1, 2, 3, 4]))
-    res = run_sweep(full, out, client=client, progress=False)
+    res = run_sweep(full, Store(out), client=client, progress=False)
     assert res.summary["reused"] == 2 and res.summary["ran"] == 2
     assert [r["reused"] for r in res.rows] == [True, True, False, False]
     for c in full.cases:  # every case ran exactly once
@@ -169,7 +168,7 @@ def test_failing_case_is_reported_and_others_finish(client, tmp_path):
         }
     }
     sweep = parse_sweep(cfg)
-    res = run_sweep(sweep, tmp_path, client=client, progress=False)
+    res = run_sweep(sweep, Store(tmp_path), client=client, progress=False)
     assert [r["status"] for r in res.rows] == ["done", "failed", "done"]
     bad = tmp_path / "cases" / sweep.cases[1].id
     assert "RuntimeError: probe failure x=2" in (bad / "error.txt").read_text()
@@ -179,7 +178,7 @@ def test_failing_case_is_reported_and_others_finish(client, tmp_path):
     assert df["status"].tolist() == ["done", "failed", "done"]
     assert df["error"].isna().tolist() == [True, False, True]
     assert "probe failure" in df["error"][1]
-    rerun = run_sweep(sweep, tmp_path, client=client, progress=False)
+    rerun = run_sweep(sweep, Store(tmp_path), client=client, progress=False)
     assert rerun.summary["reused"] == 2 and rerun.summary["ran"] == 1 and rerun.summary["failed"] == 1
 
 
@@ -284,15 +283,15 @@ def test_a_case_runs_in_this_process_once_and_its_folder_binds(tmp_path):
     case = parse_sweep(probe_cfg([3], seconds=0.0)).cases[0].to_dict()
     case["config"]["specimen"] = {"threads": 1}
     d = tmp_path / case["id"]
-    row = compute_case(case, str(d), probe)
+    row = compute_case(case, Store(d), probe)
     assert row["status"] == "done" and row["results"]["value"] == 6
-    assert compute_case(case, str(d), probe) == row == finished_row(case, d)  # read back: ran once
+    assert compute_case(case, Store(d), probe) == row == finished_row(case, Store(d))  # read back: ran once
     assert (d / "run" / "runs.txt").read_text() == "1"
     assert json.loads((d / "params.json").read_text()) == case
     threads = dict(case, config=dict(case["config"], specimen={"threads": 2}))
     relabelled = dict(threads, params={"x": 3}, id="same-config")
-    assert finished_row(relabelled, d) == row  # labels and threads are not what the case depends on
+    assert finished_row(relabelled, Store(d)) == row  # labels and threads are not what the case depends on
     other = dict(case, config={"probe": {"x": 4, "seconds": 0.0}})
-    assert finished_row(other, d) is None
-    failed = compute_case(other, str(d), probe)  # a case folder holding another case
+    assert finished_row(other, Store(d)) is None
+    failed = compute_case(other, Store(d), probe)  # a case folder holding another case
     assert failed["status"] == "failed" and "probe.x" in failed["error"]

@@ -5,6 +5,12 @@ and prints the answer; :mod:`poro2d.cli.app` registers them all and holds :func:
 console entry point.
 """
 
-from poro2d.cli.app import app, main
+from poro2d.worker_signals import ignore_interrupts_in_spawned_child
+
+# a worker process of the command (a local Dask cluster's, a process pool's) imports this
+# package first of all, before any signal handling of its own: Ctrl-C is the command's
+ignore_interrupts_in_spawned_child()
+
+from poro2d.cli.app import app, main  # noqa: E402
 
 __all__ = ["app", "main"]

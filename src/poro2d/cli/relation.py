@@ -41,15 +41,16 @@ def relation_cmd(
     accepted n2D, the grading's densest and loosest 2D states), every laboratory state is
     mapped between them by its relative density, and checked by the criterion over seeds.
     """
+    from poro2d.store import Store
     from poro2d.sweep.relation import run_relation
 
     def banner() -> None:  # once every input is checked: a refusal is the only line
         console.print(f"criterion relation{' (quick)' if quick else ''} -> {out}")
 
     rel = run_relation(
-        config, preset=preset, out=out, points=points, n_max=n_max, n_min=n_min, mode=mode, seeds=seeds,
-        quick=quick, scheduler=scheduler, workers=workers, progress=not quiet, dashboard=dashboard,
-        announce=banner,
+        config, preset=preset, store=Store(out), points=points, n_max=n_max, n_min=n_min, mode=mode,
+        seeds=seeds, quick=quick, scheduler=scheduler, workers=workers, progress=not quiet,
+        dashboard=dashboard, announce=banner,
     )  # fmt: skip
     print_relation(rel, out)
     if rel.failed_cases:

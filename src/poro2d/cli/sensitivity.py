@@ -41,6 +41,8 @@ def register(app: typer.Typer) -> None:
         from poro2d.errors import check_int
         from poro2d.execute.cluster_options import check_cluster_options, check_dashboard
         from poro2d.io_utils import check_output_dir
+        from poro2d.store import Store
+        from poro2d.sweep.criterion_base import CriterionBase
         from poro2d.sweep.sensitivity import run_sensitivity
 
         check_cluster_options(scheduler, workers)
@@ -48,12 +50,13 @@ def register(app: typer.Typer) -> None:
             check_int("--seeds", seeds, 1, 50)
         check_output_dir("--out", out)
         dashboard_address = check_dashboard(dashboard)
-        base, base_dir = load_config(config, preset, extra_tables=("sensitivity",))
+        cfg, base_dir = load_config(config, preset, extra_tables=("sensitivity",))
+        base = CriterionBase.from_config(cfg, base_dir)
 
         def banner() -> None:  # once every input is checked: a refusal is the only line
             console.print(f"sensitivity study{' (quick)' if quick else ''} -> {out}")
 
-        sens = run_sensitivity(base, base_dir, out, quick=quick, seeds=seeds, scheduler=scheduler,
+        sens = run_sensitivity(base, Store(out), quick=quick, seeds=seeds, scheduler=scheduler,
                                workers=workers, progress=not quiet, dashboard=dashboard_address,
                                announce=banner)  # fmt: skip
         print_sensitivity(sens, out)

@@ -28,6 +28,7 @@ def sweep_cmd(
     from poro2d.execute.cluster_options import check_cluster_options, check_dashboard
     from poro2d.execute.dask_cluster import check_reachable
     from poro2d.io_utils import check_output_dir
+    from poro2d.store import Store
     from poro2d.sweep.cases import parse_sweep
     from poro2d.sweep.runner import run_sweep
 
@@ -38,7 +39,7 @@ def sweep_cmd(
     sweep = parse_sweep(cfg, Path(config).resolve().parent)
     check_reachable(scheduler)  # before the first line: an unreachable scheduler is the only one
     console.print(f"{len(sweep.cases)} case(s) of kind {sweep.kind!r} -> {out}")
-    res = run_sweep(sweep, out, scheduler=scheduler, workers=workers, progress=not quiet,
+    res = run_sweep(sweep, Store(out), scheduler=scheduler, workers=workers, progress=not quiet,
                     dashboard=dashboard_address)  # fmt: skip
     print_summary(res, out)
     if res.failed:

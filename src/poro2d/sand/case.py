@@ -35,6 +35,7 @@ from poro2d.errors import InputError, check_int
 from poro2d.lab_state import LabState, lab_state_from_table
 from poro2d.specimen.compaction import SpecimenSpec, time_step
 from poro2d.specimen.grading import GradingCurve
+from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.density import DEFAULT_SEEDS, with_density_defaults
 from poro2d.typed_result import TypedResult
 
@@ -157,7 +158,7 @@ def _criterion_config(cfg: dict, lab: LabState) -> dict:
         raise InputError("criterion.n_lab", given, f"unset or the [lab] state's n = {lab.n_lab:.4f}")
     table["n_lab"] = round(lab.n_lab, 6)
     crit["criterion"] = table
-    return with_density_defaults(crit)
+    return with_density_defaults(CriterionBase(crit)).as_config()
 
 
 #: step budgets (setting: the paper's default) that bound a stage in simulated time; they were

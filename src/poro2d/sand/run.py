@@ -37,6 +37,7 @@ from poro2d.sand.profile import case_runs, stage_profile
 from poro2d.sand.result import SandCalibration, SandResult, SeedSpecimen, write_summary
 from poro2d.store import Store, walk
 from poro2d.sweep import density as D
+from poro2d.sweep.criterion_base import CriterionBase
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
 KIND = "sand"
@@ -151,27 +152,18 @@ def _first_trial_shifts(pf: Preflight) -> FirstTrialShifts:
 
 def calibration_cases(case: SandCase, pf: Preflight, mus: list[float]) -> list:
     """The calibration's cases at ``mus`` (their ids name their folders in the cache)."""
-    from poro2d.sweep.cases import parse_sweep
+    return _calibration_case(case, pf, mus).sweep.cases
 
-    cfg = calibration_config(case, pf)
-    sweep = D.calibration_sweep(cfg, mus, case.calibration_seeds, **asdict(_first_trial_shifts(pf)))
-    return parse_sweep(sweep, case.base_dir).cases
+
+def _calibration_case(case: SandCase, pf: Preflight, mus: list[float], loosest_first: bool = False):
+    base = CriterionBase(calibration_config(case, pf), case.base_dir)
+    return D.CalibrationCase(base, tuple(mus), case.calibration_seeds, **asdict(_first_trial_shifts(pf)),
+                             loosest_first=loosest_first)  # fmt: skip
 
 
 def _calibrate(case, pf, store: Store, mus, record, cal_kw) -> tuple[Calibration, dict]:
-    cfg = calibration_config(case, pf)
-    shifts = _first_trial_shifts(pf)
-    return D.calibrate(
-        cfg,
-        case.base_dir,
-        store.root,
-        mus=mus,
-        seeds=case.calibration_seeds,
-        **asdict(shifts),
-        loosest_first=True,
-        record=record,
-        **cal_kw,
-    )
+    calibration = _calibration_case(case, pf, mus, loosest_first=True)
+    return D.calibrate(calibration, store, record=record, **cal_kw)
 
 
 def calibration_stage(
@@ -233,13 +225,12 @@ def calibrate_ends(
 def specimen_stage(case: SandCase, trial: StateTarget, store: Store, sweep_kw: dict) -> list[dict]:
     """One criterion case per seed at full size, at the state's friction, from ``trial``."""
     from poro2d.criterion.protocol import trial_grid
-    from poro2d.sweep.cases import parse_sweep
     from poro2d.sweep.runner import run_sweep
 
     crit = case.config.get("criterion") or {}
     grid = trial_grid(float(crit.get("resolution", 0.01)), crit.get("refine_tolerance"))
-    sweep = parse_sweep(D.state_sweep(case.config, [trial], case.seeds, grid), case.base_dir)
-    res = run_sweep(sweep, store.child("states").root, **sweep_kw)
+    sweep = D.StateChecks(CriterionBase(case.config, case.base_dir), (trial,), case.seeds, grid).sweep
+    res = run_sweep(sweep, store.child("states"), **sweep_kw)
     return sorted(res.rows, key=lambda r: int((r.get("params") or {}).get("seed", 0)))
 
 

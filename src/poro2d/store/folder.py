@@ -161,6 +161,13 @@ class Store:
         self.check_intact(name)
         return pd.read_csv(self._root / name, **kw)
 
+    def write_parquet(self, name: str, frame: pd.DataFrame) -> Path:
+        """A pandas table as Parquet (no index), atomically: typed columns for the next reader."""
+        path = self._root / name
+        with atomic_path(path) as tmp:
+            frame.to_parquet(tmp, index=False)
+        return path
+
     def write_text(self, name: str, text: str) -> Path:
         """A text file (a report, a script), atomically."""
         path = self._root / name

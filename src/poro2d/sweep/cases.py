@@ -20,7 +20,13 @@ A parameter is a dotted path into the base config (``specimen.kn_particle``,
 ``criterion.n_lab``). Names are resolved once, so ``n_lab`` and
 ``criterion.n_lab`` give the same case and the same id.
 
-A case kind is a callable ``run(config, out_dir) -> dict of scalars``; it is
+The TOML is read once, at the edge (:func:`parse_sweep`); a study that builds its cases
+itself (the relation, the calibration) hands :func:`make_sweep` its base config and the
+parameters of every case. A :class:`Case` is a value: its id is the digest of its kind
+and merged config, fixed when it is made.
+
+A case kind is a callable ``run(config, store) -> dict of scalars`` (``store``: the case's
+:class:`~poro2d.store.Store`, where it keeps what it writes); it is
 registered in :data:`KINDS` (and optionally a ``validate(config, base_dir)`` in
 :data:`VALIDATORS`, run before anything is submitted, that raises
 :class:`InputError` on bad input). New kinds (direct shear, ...) only add an entry.
@@ -32,17 +38,20 @@ import copy
 import dataclasses
 import itertools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from poro2d.config import check_finite, check_keys
 from poro2d.errors import InputError
 from poro2d.identity import identity_digest
 
-#: kind -> run(config, out_dir) -> dict of scalar results
-KINDS: dict[str, Callable[[dict, Path], dict]] = {}
+if TYPE_CHECKING:
+    from poro2d.store import Store
+
+#: kind -> run(config, store) -> dict of scalar results
+KINDS: dict[str, Callable[[dict, Store], dict]] = {}
 #: kind -> validate(config, base_dir); raises InputError before any case runs
 VALIDATORS: dict[str, Callable[[dict, Path | None], None]] = {}
 #: tables whose dataclass field names may be used without the table prefix
@@ -58,7 +67,7 @@ CASE_TABLES = {"specimen", "grading", "criterion", "shear"}
 
 def register_kind(
     name: str,
-    run: Callable[[dict, Path], dict],
+    run: Callable[[dict, Store], dict],
     validate: Callable[[dict, Path | None], None] | None = None,
     tables: tuple[str, ...] = (),
 ) -> None:
@@ -88,10 +97,14 @@ def validate_criterion(config: dict, base_dir: Path | None = None) -> None:
     criterion_objects(config, base_dir)
 
 
-def criterion_case(config: dict, out_dir: Path) -> dict:
-    """The criterion of Fig. 3 for one case; scalars of its result, of its first and of its accepted trial."""
+def criterion_case(config: dict, store: Store) -> dict:
+    """The criterion of Fig. 3 for one case; scalars of its result, of its first and of its accepted trial.
+
+    The dict is the case's row of table cells (the kind's contract with the runner).
+    """
     from poro2d.criterion.protocol import PorosityCriterion
 
+    out_dir = store.root
     spec, grading, settings, seed = criterion_objects(config)
     figures = bool(config.get("sweep_options", {}).get("figures", False))
     crit = PorosityCriterion(
@@ -146,9 +159,13 @@ def _register_builtin() -> None:
 
 
 # --------------------------------------------------------------------------------- cases
-@dataclass
+@dataclass(frozen=True)
 class Case:
-    """One case: its kind, the parameters that differ from the base, the merged config."""
+    """One case, a value: its kind, the parameters that differ from the base, the merged config.
+
+    ``id`` is fixed when the case is made (:func:`case_id` of kind and config), so a case
+    built again from the same values names the same folder.
+    """
 
     kind: str
     params: dict[str, Any]
@@ -157,15 +174,16 @@ class Case:
 
     def __post_init__(self) -> None:
         if not self.id:
-            self.id = case_id(self.kind, self.config)
+            object.__setattr__(self, "id", case_id(self.kind, self.config))
 
     def to_dict(self) -> dict:
+        """The case as its ``params.json`` records it."""
         return {"id": self.id, "kind": self.kind, "params": self.params, "config": self.config}
 
 
-@dataclass
+@dataclass(frozen=True)
 class SweepConfig:
-    """A parsed sweep: its cases and options, plus the raw config for the record."""
+    """A sweep: its cases and options, plus its config as given (written to ``sweep.json``)."""
 
     kind: str
     cases: list[Case]
@@ -271,8 +289,22 @@ def _absolute_grading(cfg: dict, base_dir: Path | None) -> dict:
     return cfg
 
 
+def grid_cases(grid: Mapping[str, list]) -> list[dict[str, Any]]:
+    """Every combination of the grid's values, the first axis slowest (the base case for no axis)."""
+    names = list(grid)
+    return [dict(zip(names, vals, strict=True)) for vals in itertools.product(*grid.values())] or [{}]
+
+
+def axes_of(cases: list[dict[str, Any]]) -> list[str]:
+    """The parameters the cases set, in the order they first appear: the table's columns."""
+    axes: list[str] = []
+    for params in cases:
+        axes.extend(k for k in params if k not in axes)
+    return axes
+
+
 def parse_sweep(cfg: dict, base_dir: Path | None = None, *, validate: bool = True) -> SweepConfig:
-    """Cases of a sweep config dict; every problem is an :class:`InputError`."""
+    """Cases of a sweep config dict (a TOML file's, read at the edge); every problem is an InputError."""
     if not BARE_NAME_TABLES:
         _register_builtin()
     check_keys("config", cfg, TOP_KEYS)
@@ -293,17 +325,13 @@ def parse_sweep(cfg: dict, base_dir: Path | None = None, *, validate: bool = Tru
 
     axes_raw = _flatten("", {k: v for k, v in sw.items() if k not in SWEEP_OPTIONS})
     explicit = sw.get("cases")
-    combos: list[dict[str, Any]] = []
-    axes: list[str] = []
     if axes_raw and explicit is not None:
         raise InputError("sweep.cases", "cases and grid axes", "either grid axes or a list of cases")
     if explicit is not None:
         if not isinstance(explicit, list) or not explicit or not all(isinstance(c, dict) for c in explicit):
             raise InputError("sweep.cases", explicit, "a non-empty list of tables ([[sweep.cases]])")
-        for c in explicit:
-            flat = {resolve_name(k): _check_value(k, v) for k, v in _flatten("", c).items()}
-            combos.append(flat)
-            axes.extend(k for k in flat if k not in axes)
+        combos = [{resolve_name(k): _check_value(k, v) for k, v in _flatten("", c).items()} for c in explicit]
+        axes = axes_of(combos)
     else:
         grid: dict[str, list] = {}
         for name, values in axes_raw.items():
@@ -314,11 +342,35 @@ def parse_sweep(cfg: dict, base_dir: Path | None = None, *, validate: bool = Tru
                 raise InputError(f"sweep.{name}", values, "a non-empty list of values (a grid axis)")
             grid[full] = [_check_value(name, v) for v in values]
         axes = list(grid)
-        combos = [dict(zip(axes, vals, strict=True)) for vals in itertools.product(*grid.values())]
-        if not combos:
-            combos = [{}]
+        combos = grid_cases(grid)
 
-    base = _absolute_grading(copy.deepcopy(cfg), base_dir)
+    return make_sweep(kind, cfg, combos, axes, base_dir=base_dir, retries=retries, figures=figures,
+                      title=title, validate=validate)  # fmt: skip
+
+
+def make_sweep(
+    kind: str,
+    raw: Mapping[str, Any],
+    combos: list[dict[str, Any]],
+    axes: list[str],
+    *,
+    base_dir: Path | None = None,
+    retries: int = 2,
+    figures: bool = False,
+    title: str = "",
+    validate: bool = True,
+) -> SweepConfig:
+    """The sweep of ``kind`` whose cases set ``combos`` (resolved dotted names) on the base ``raw``.
+
+    ``raw``: the base config as it is recorded in ``sweep.json`` (its ``[sweep]`` table too,
+    which no case sees). Two cases with one id, or a case its kind refuses, are an
+    :class:`InputError` naming the case.
+    """
+    if not BARE_NAME_TABLES:
+        _register_builtin()
+    check_keys("config", raw, TOP_KEYS)
+    check_finite("config", raw)
+    base = _absolute_grading(copy.deepcopy(dict(raw)), base_dir)
     cases: list[Case] = []
     seen: dict[str, int] = {}
     for i, params in enumerate(combos):
@@ -338,7 +390,7 @@ def parse_sweep(cfg: dict, base_dir: Path | None = None, *, validate: bool = Tru
                 where = ", ".join(f"{k} = {v!r}" for k, v in params.items()) or "the base case"
                 raise InputError(exc.parameter, exc.value, exc.allowed, f"in the case {where}") from None
         cases.append(case)
-    return SweepConfig(kind, cases, cfg, base_dir, retries, figures, title, axes)
+    return SweepConfig(kind, cases, dict(raw), base_dir, retries, figures, title, list(axes))
 
 
 _register_builtin()

@@ -13,10 +13,10 @@ preparation friction that the calibration gives for the state's 2D target
 
 from __future__ import annotations
 
-import copy
 import math
 import os
-from dataclasses import replace
+from dataclasses import dataclass, replace
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -26,10 +26,13 @@ from poro2d import __version__
 from poro2d.criterion.density import DEFAULT_MUS, Calibration, StateTarget, check_mus
 from poro2d.errors import check_int
 from poro2d.identity import identity_digest, outside_fields
-from poro2d.io_utils import provenance, write_json
+from poro2d.io_utils import provenance
 from poro2d.locks import cache_entry
 from poro2d.specimen.compaction import SpecimenSpec
-from poro2d.sweep.cases import criterion_objects
+from poro2d.store import Store
+from poro2d.sweep.cases import Case, SweepConfig, criterion_objects, grid_cases
+from poro2d.sweep.criterion_base import CriterionBase
+from poro2d.sweep.results import CalibrationRun
 
 #: seeds per friction and per state unless the config says otherwise
 DEFAULT_SEEDS = 3
@@ -90,12 +93,9 @@ DENSITY_DEFAULTS = {
 }
 
 
-def with_density_defaults(base: dict) -> dict:
-    """A copy of a criterion config with ``DENSITY_DEFAULTS`` filled in where it is silent."""
-    cfg = copy.deepcopy(base)
-    for table, values in DENSITY_DEFAULTS.items():
-        cfg[table] = dict(values, **(cfg.get(table) or {}))
-    return cfg
+def with_density_defaults(base: CriterionBase) -> CriterionBase:
+    """``base`` with ``DENSITY_DEFAULTS`` filled in where its config is silent."""
+    return base.with_defaults(DENSITY_DEFAULTS)
 
 
 def cache_dir() -> Path:
@@ -112,22 +112,23 @@ def check_seeds(seeds: Any, parameter: str = "density.seeds") -> int:
     return check_int(parameter, seeds, 1, 50)
 
 
-def calibration_base(base: dict) -> dict:
-    """The parts of a criterion config that fix a calibration (no n_lab, no first trial)."""
+def calibration_base(base: CriterionBase) -> CriterionBase:
+    """The parts of a criterion base that fix a calibration (no n_lab, no first trial)."""
     # friction_prep is the calibration's own axis; the marked fields change no result
     left_out = ("friction_prep", *outside_fields(SpecimenSpec))
-    spec = {k: v for k, v in (base.get("specimen") or {}).items() if k not in left_out}
-    crit = {k: v for k, v in (base.get("criterion") or {}).items() if k not in _CRITERION_KEYS_IGNORED}
-    return {"specimen": spec, "grading": base.get("grading") or {"preset": "paper"}, "criterion": crit}
+    spec = {k: v for k, v in base.table("specimen").items() if k not in left_out}
+    crit = {k: v for k, v in base.table("criterion").items() if k not in _CRITERION_KEYS_IGNORED}
+    grading = base.config.get("grading") or {"preset": "paper"}
+    return CriterionBase({"specimen": spec, "grading": grading, "criterion": crit}, base.base_dir)
 
 
-def calibration_key(base: dict) -> str:
+def calibration_key(base: CriterionBase) -> str:
     """The run digest of the calibration's cases: grading, box, contact and criterion settings,
     and the poro2d version (another version may compute another criterion).
 
     Spaced as these keys were first written, so cached calibrations keep their folders.
     """
-    rec = {"base": calibration_base(base), "version": __version__}
+    rec = {"base": calibration_base(base).as_config(), "version": __version__}
     return identity_digest(rec, tables={"base.specimen": SpecimenSpec}, length=16, layout="spaced")
 
 
@@ -165,40 +166,66 @@ def first_trial(
     return round_to(n + loose_bias * mu, grid)
 
 
-def calibration_sweep(
-    base: dict,
-    mus: list[float],
-    seeds: int,
-    dense_end: float | None = None,
-    walls: float | None = None,
-    loose_bias: float = 0.0,
-    loosest_first: bool = False,
-) -> dict:
-    """The sweep of the calibration: every friction with every seed, from its first trial.
+@dataclass(frozen=True)
+class CalibrationCase:
+    """The calibration of one grading and box, as a value: every friction with every seed.
 
-    Under the paper's plate a grid sweep (one first trial for all); under the fill acceptance
-    a list of cases, each friction from its own first trial (:func:`first_trial`, moved to the
-    grading's ``dense_end`` and the box's ``walls`` when given). ``loosest_first`` lists the
-    most frictional cases first: they take longest (their lid waits for a creeping surface),
-    so the workers start them first and fill in with the quick dense ones.
+    ``base``: the criterion base the calibration is of (density mode's defaults filled in);
+    a study that wants other frictions or seeds of the same calibration varies it with
+    :func:`dataclasses.replace`, and finds the cases already run in the same cache entry
+    (:attr:`key`). ``dense_end`` (the grading's jamming porosity) and ``walls`` (the box's
+    :func:`wall_share`) move the first trials (:func:`first_trial`); ``loosest_first`` lists
+    the most frictional cases first: they take longest (their lid waits for a creeping
+    surface), so the workers start them first and fill in with the quick dense ones.
     """
-    cfg = copy.deepcopy(calibration_base(base))
-    threads = (base.get("specimen") or {}).get("threads")
-    if threads is not None:
-        cfg["specimen"]["threads"] = threads
-    cfg["sweep"] = {"kind": "criterion", "title": "mu_prep -> n2D calibration"}
-    if cfg["criterion"].get("acceptance", "plate") != "fill":
-        cfg["criterion"]["trial_porosity"] = CALIBRATION_FIRST_TRIAL
-        cfg["sweep"].update({"specimen.friction_prep": list(mus), "seed": list(range(seeds))})
-        return cfg
-    firsts = {mu: first_trial(cfg["criterion"], mu, dense_end, walls, loose_bias) for mu in mus}
-    order = sorted(mus, reverse=True) if loosest_first else mus
-    cfg["sweep"]["cases"] = [
-        {"specimen.friction_prep": mu, "criterion.trial_porosity": firsts[mu], "seed": s}
-        for mu in order
-        for s in range(seeds)
-    ]
-    return cfg
+
+    base: CriterionBase
+    mus: tuple[float, ...] = DEFAULT_MUS
+    seeds: int = DEFAULT_SEEDS
+    dense_end: float | None = None
+    walls: float | None = None
+    loose_bias: float = 0.0
+    loosest_first: bool = False
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "mus", tuple(check_mus(list(self.mus))))
+        object.__setattr__(self, "seeds", check_seeds(self.seeds))
+
+    @property
+    def key(self) -> str:
+        """The digest naming the calibration's cache entry (:func:`calibration_key`)."""
+        return calibration_key(self.base)
+
+    @property
+    def moves_first_trials(self) -> bool:
+        """Whether the grading's dense end or the box's walls move the first trials."""
+        return self.dense_end is not None or self.walls is not None
+
+    @cached_property
+    def sweep(self) -> SweepConfig:
+        """The calibration's criterion cases, each friction from its first trial.
+
+        Under the paper's plate a grid (one first trial for all); under the fill acceptance a
+        list of cases, each friction from its own first trial (:func:`first_trial`).
+        """
+        tables = calibration_base(self.base)
+        threads = self.base.table("specimen").get("threads")
+        if threads is not None:
+            tables = tables.with_tables(specimen=dict(tables.table("specimen"), threads=threads))
+        table: dict[str, Any] = {"kind": "criterion", "title": "mu_prep -> n2D calibration"}
+        crit = tables.table("criterion")
+        if crit.get("acceptance", "plate") != "fill":
+            grid = {"specimen.friction_prep": list(self.mus), "seed": list(range(self.seeds))}
+            tables = tables.with_tables(criterion=dict(crit, trial_porosity=CALIBRATION_FIRST_TRIAL))
+            return tables.sweep(dict(table, **grid), grid_cases(grid))
+        firsts = {mu: first_trial(crit, mu, self.dense_end, self.walls, self.loose_bias) for mu in self.mus}
+        order = sorted(self.mus, reverse=True) if self.loosest_first else self.mus
+        cases = [
+            {"specimen.friction_prep": mu, "criterion.trial_porosity": firsts[mu], "seed": s}
+            for mu in order
+            for s in range(self.seeds)
+        ]
+        return tables.sweep(dict(table, cases=cases), cases)
 
 
 def _sample(row: dict) -> float | None:
@@ -234,82 +261,98 @@ def calibration_from_rows(rows: list[dict], mus: list[float], seeds: int) -> Cal
     return Calibration(list(mus), samples, list(range(seeds)))
 
 
+def calibration_store(case: CalibrationCase, store: Store, *, use_cache: bool = True) -> Store:
+    """Where the calibration's cases live: the shared cache entry, else ``calibration`` in ``store``.
+
+    A cache that cannot be written (read-only) sends the cases to ``store`` too.
+    """
+    if not use_cache:
+        return store.child("calibration")
+    entry = Store(cache_dir() / "calibrations" / case.key)
+    try:
+        entry.root.mkdir(parents=True, exist_ok=True)
+    except OSError:
+        return store.child("calibration")
+    return entry
+
+
 def calibrate(
-    base: dict,
-    base_dir: Path | None,
-    out: Path,
+    case: CalibrationCase,
+    store: Store,
     *,
-    mus: tuple[float, ...] | list[float] = DEFAULT_MUS,
-    seeds: int = DEFAULT_SEEDS,
     use_cache: bool = True,
-    dense_end: float | None = None,
-    walls: float | None = None,
-    loose_bias: float = 0.0,
-    loosest_first: bool = False,
     record: str = "calibration.json",
     **sweep_kw,
-) -> tuple[Calibration, dict]:
+) -> tuple[Calibration, CalibrationRun]:
     """The grading's calibration, its cases run on the sweep runner (resumable).
 
     With ``use_cache`` the cases live in a folder shared by every run of the same grading and
     settings (:func:`cache_dir` / ``calibrations`` / key): a case done once, for any list of
     frictions or number of seeds, is read back, not run again. Without it they go to
-    ``out/calibration``. ``out/calibration.json`` records the calibration and where its
-    cases are; ``loosest_first``: see :func:`calibration_sweep`. Returns the calibration and
-    a record (key, folder, how many cases ran).
+    ``calibration`` in ``store``. ``record`` (in ``store``) records the calibration and where
+    its cases are. Returns the calibration and a record (key, folder, how many cases ran).
     """
-    from poro2d.sweep.cases import parse_sweep
     from poro2d.sweep.runner import run_sweep
 
-    mus, seeds = check_mus(mus), check_seeds(seeds)
-    key = calibration_key(base)
-    folder = cache_dir() / "calibrations" / key if use_cache else out / "calibration"
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError:  # a read-only cache: the cases go with the results
-        folder = out / "calibration"
-    cases = calibration_sweep(base, mus, seeds, dense_end, walls, loose_bias, loosest_first)
-    sweep = parse_sweep(cases, base_dir)
+    mus, seeds = list(case.mus), case.seeds
+    cases = calibration_store(case, store, use_cache=use_cache)
     # another run of the same grading may be computing this entry: wait, then reuse its cases
-    with cache_entry(folder):
-        res = run_sweep(sweep, folder, **sweep_kw)
+    with cache_entry(cases.root):
+        res = run_sweep(case.sweep, cases, **sweep_kw)
     cal = calibration_from_rows(res.rows, mus, seeds)
-    info = {"key": key, "cases": str(folder), "ran": res.summary["ran"], "reused": res.summary["reused"],
-            "source": "computed" if res.summary["ran"] else "cache"}  # fmt: skip
-    if dense_end is not None or walls is not None:  # new callers only: earlier records keep their keys
+    ran, reused = res.summary["ran"], res.summary["reused"]
+    info = {"key": case.key, "cases": str(cases.root), "ran": ran, "reused": reused,
+            "source": "computed" if ran else "cache"}  # fmt: skip
+    if case.moves_first_trials:  # new callers only: earlier records keep their keys
         info["interior"] = interior_by_friction(res.rows, mus, seeds)
     rec = {
         **info,
         "calibration": cal.to_dict(),
-        "settings": calibration_base(base),
+        "settings": calibration_base(case.base).as_config(),
         "sample": "n' of the accepted trial: box porosity, whole disk areas, plate just touching",
         "sweep_summary": res.summary,
         "provenance": provenance(),
     }
-    write_json(out / record, rec)
-    return cal, dict(info, summary=res.summary, failed=len(res.failed))
+    store.write_json(record, rec)
+    return cal, CalibrationRun.from_dict(dict(info, summary=res.summary, failed=len(res.failed)))
 
 
-def state_sweep(base: dict, targets: list[StateTarget], seeds: int, resolution: float) -> dict:
-    """One criterion case per state and seed, at the state's friction, from its target."""
-    from poro2d.criterion.protocol import round_to
+@dataclass(frozen=True)
+class StateChecks:
+    """The criterion once per laboratory state and seed, at the state's friction, from its target.
 
-    cfg = copy.deepcopy({k: v for k, v in base.items() if k not in ("relation", "sweep", "density")})
-    cfg.setdefault("criterion", {}).pop("trial_porosity", None)
-    cases = []
-    for t in targets:
-        for s in range(seeds):
-            cases.append({
+    ``base``: the criterion base of the states (density mode's defaults filled in);
+    ``resolution``: the grid the first trials are rounded to (the one the criterion steps on).
+    """
+
+    base: CriterionBase
+    targets: tuple[StateTarget, ...]
+    seeds: int
+    resolution: float
+
+    @cached_property
+    def sweep(self) -> SweepConfig:
+        """One case per state and seed; the base's own first trial is left out (each case has one)."""
+        from poro2d.criterion.protocol import round_to
+
+        base = self.base.without("relation", "sweep", "density")
+        crit = base.table("criterion")
+        crit.pop("trial_porosity", None)
+        cases = [
+            {
                 "criterion.n_lab": t.n_lab,
                 "specimen.friction_prep": round(t.mu_prep, 6),
-                "criterion.trial_porosity": round_to(t.n2d_target, resolution),
+                "criterion.trial_porosity": round_to(t.n2d_target, self.resolution),
                 "seed": s,
-            })  # fmt: skip
-    cfg["sweep"] = {"kind": "criterion", "title": "density-controlled states", "cases": cases}
-    return cfg
+            }
+            for t in self.targets
+            for s in range(self.seeds)
+        ]
+        table = {"kind": "criterion", "title": "density-controlled states", "cases": cases}
+        return base.with_tables(criterion=crit).sweep(table, cases)
 
 
-def _run_key(case, base_dir: Path | None) -> str:
+def _run_key(case: Case, base_dir: Path | None) -> str:
     """The run digest of what a criterion case computes: specimen, grading, settings, seed.
 
     The objects the case builds are compared, not its config's text, so defaults spelled
@@ -321,7 +364,7 @@ def _run_key(case, base_dir: Path | None) -> str:
     return identity_digest(run, ignore=("criterion.n_lab",))
 
 
-def _check_key(case, base_dir: Path | None) -> str:
+def _check_key(case: Case, base_dir: Path | None) -> str:
     """What makes a calibration case a state's check: the run (:func:`_run_key`), and under the
     fill acceptance the run whatever its first trial.
 
@@ -337,22 +380,24 @@ def _check_key(case, base_dir: Path | None) -> str:
     return _run_key(replace(case, config=config, id=case.id), base_dir)
 
 
-def calibration_twins(calibration, states, base_dir: Path | None, folder: Path) -> dict[str, dict]:
+def calibration_twins(
+    calibration: SweepConfig, states: SweepConfig, base_dir: Path | None, cases: Store
+) -> dict[str, dict]:
     """Finished calibration cases that are state checks too, as rows of those checks.
 
     The check of the densest state (Dr = 1) runs at the calibration's lowest usable friction,
     that of the loosest (Dr = 0) at its highest: at a calibration friction, seed for seed,
     the same criterion run as a calibration case (:func:`_check_key`: under the paper's plate
     only from the same first trial). Whether two cases are the same run is decided on the
-    specimen, grading and criterion settings they build, never assumed. Returns
-    ``{state case id: row}``, the calibration case's finished row relabelled with the check's
-    parameters.
+    specimen, grading and criterion settings they build, never assumed. ``cases``: the store
+    of the calibration's sweep. Returns ``{state case id: row}``, the calibration case's
+    finished row relabelled with the check's parameters.
     """
     from poro2d.sweep.runner import finished_row
 
     done = {}
     for c in calibration.cases:
-        row = finished_row(c.to_dict(), folder / "cases" / c.id)
+        row = finished_row(c.to_dict(), cases.child("cases", c.id))
         if row is not None:
             done[_check_key(c, base_dir)] = (c, row)
     twins = {}
@@ -371,16 +416,19 @@ __all__ = [
     "DEFAULT_SEEDS",
     "PAPER_JAMMING_POROSITY",
     "PAPER_WALL_SHARE",
+    "CalibrationCase",
+    "StateChecks",
     "cache_dir",
     "calibrate",
+    "calibration_base",
     "calibration_from_rows",
     "calibration_key",
-    "calibration_sweep",
+    "calibration_store",
     "calibration_twins",
     "check_mus",
     "check_seeds",
     "first_trial",
     "interior_by_friction",
-    "state_sweep",
     "wall_share",
+    "with_density_defaults",
 ]

@@ -12,27 +12,25 @@ the calibration (:mod:`poro2d.sweep.density`), so that neither imports the other
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
-
 from poro2d.criterion.density import lab_relative_density
 from poro2d.criterion.result import CriterionResult
 from poro2d.criterion.run import ConfigLike, CriterionInputs, criterion_inputs, run_paper_mode
 from poro2d.errors import InputError
-from poro2d.io_utils import check_output_dir, provenance, write_json
-from poro2d.locks import holds_output
+from poro2d.io_utils import check_output_dir, provenance
+from poro2d.store import Store
+from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.density import DEFAULT_SEEDS
-from poro2d.sweep.relation import density_relation
+from poro2d.sweep.output import held
+from poro2d.sweep.relation import RelationSettings, density_relation
 from poro2d.sweep.results import DensityStateResult
 
 
 def run_density_state(
-    base: dict,
-    base_dir: Path | None,
+    base: CriterionBase,
     n_lab: float,
     n_max: float,
     n_min: float,
-    out: Path,
+    store: Store,
     *,
     seeds: int = DEFAULT_SEEDS,
     mus=None,
@@ -43,13 +41,13 @@ def run_density_state(
 
     Calibrates (or reads the cached calibration), maps ``n_lab`` to its 2D target and
     preparation friction, runs the criterion with them for every seed and writes
-    ``out/density.json``: the accepted n2D (mean, sd, per seed), the target, mu_prep and Dr,
-    returned as a :class:`~poro2d.sweep.results.DensityStateResult`.
+    ``density.json`` to ``store``: the accepted n2D (mean, sd, per seed), the target, mu_prep
+    and Dr, returned as a :class:`~poro2d.sweep.results.DensityStateResult`.
     """
     lab_relative_density(n_lab, n_max, n_min)  # nLab outside [n_min, n_max]: refused before any run
-    settings = {"n_max": n_max, "n_min": n_min, "n_lab": [round(float(n_lab), 4)]}
-    rel, sweeps = density_relation(base, base_dir, settings, out, seeds=seeds, mus=mus,
-                                   use_cache=use_cache, **sweep_kw)  # fmt: skip
+    settings = RelationSettings(n_max, n_min, (round(float(n_lab), 4),))
+    rel, sweeps = density_relation(base, settings, store, seeds=seeds, mus=mus, use_cache=use_cache,
+                                   **sweep_kw)  # fmt: skip
     (point,) = rel["points"]
     record = {
         "mode": "density",
@@ -71,22 +69,23 @@ def run_density_state(
         "n2d_max": rel["n2d_max"],
         "calibration": rel["calibration"],
         "sweeps": sweeps,
-        "config": base,
+        "config": base.as_config(),
         "provenance": provenance(),
     }
     result = DensityStateResult.from_dict(record)
-    write_json(out / "density.json", result.to_dict())
+    store.write_result("density.json", result)
     return result
 
 
-def _run_density_mode(inputs: CriterionInputs, out: Path, *, threads: int | None,
+def _run_density_mode(inputs: CriterionInputs, store: Store, *, threads: int | None,
                       progress: bool) -> DensityStateResult:  # fmt: skip
     """Calibration (cached), the state's friction and first trial, the criterion over seeds."""
     rest = {k: v for k, v in inputs.config.items() if k != "density"}
     if threads is not None:  # the option's thread count, as the specimen was built with it
         rest["specimen"] = dict(rest.get("specimen") or {}, threads=inputs.spec.threads)
     dens = inputs.density
-    return run_density_state(rest, inputs.base, inputs.settings.n_lab, dens["n_max"], dens["n_min"], out,
+    base = CriterionBase(rest, inputs.base)
+    return run_density_state(base, inputs.settings.n_lab, dens["n_max"], dens["n_min"], store,
                              seeds=dens["seeds"], mus=dens["mu_prep"], progress=progress)  # fmt: skip
 
 
@@ -98,12 +97,11 @@ def _refuse_paper_options(seed: int | None, trial_porosity: float | None) -> Non
             raise InputError(option, value, "only in paper mode (density: --seeds and the 2D target)")
 
 
-@holds_output("out")
 def run_density_criterion(
     config: ConfigLike = None,
     *,
     preset: str | None = None,
-    out: str | os.PathLike = "criterion-out",
+    store: Store | None = None,
     n_lab: float | None = None,
     threads: int | None = None,
     n_max: float | None = None,
@@ -116,20 +114,20 @@ def run_density_criterion(
     Calibrates the grading (cached), sets the preparation friction from the laboratory
     relative density between ``n_max`` and ``n_min`` and runs the criterion over ``seeds``;
     returns the :class:`~poro2d.sweep.results.DensityStateResult` written to
-    ``out/density.json``. ``config`` as for :func:`poro2d.criterion.run_criterion`, whose
-    ``[density]`` table the options override. Bad input raises
-    :class:`~poro2d.errors.InputError` before anything is written.
+    ``density.json`` in ``store`` (None: nothing kept but the calibration cache). ``config`` as
+    for :func:`poro2d.criterion.run_criterion`, whose ``[density]`` table the options override.
+    Bad input raises :class:`~poro2d.errors.InputError` before anything is written.
     """
-    return run_criterion_modes(config, preset=preset, out=out, n_lab=n_lab, threads=threads, mode="density",
-                               n_max=n_max, n_min=n_min, seeds=seeds, progress=progress)  # fmt: skip
+    return run_criterion_modes(config, preset=preset, store=store, n_lab=n_lab, threads=threads,
+                               mode="density", n_max=n_max, n_min=n_min, seeds=seeds,
+                               progress=progress)  # fmt: skip
 
 
-@holds_output("out")
 def run_criterion_modes(
     config: ConfigLike = None,
     *,
     preset: str | None = None,
-    out: str | os.PathLike = "criterion-out",
+    store: Store | None = None,
     seed: int | None = None,
     n_lab: float | None = None,
     trial_porosity: float | None = None,
@@ -145,15 +143,19 @@ def run_criterion_modes(
     Paper mode returns the :class:`~poro2d.criterion.result.CriterionResult` of
     :func:`poro2d.criterion.run_criterion`, density mode the
     :class:`~poro2d.sweep.results.DensityStateResult` of :func:`run_density_criterion`.
+    ``store``: where the run is kept (None: nothing is kept).
     """
-    out = Path(out)
-    check_output_dir("--out", out)
-    inputs = criterion_inputs(config, preset=preset, seed=seed, n_lab=n_lab, trial_porosity=trial_porosity,
-                              threads=threads, mode=mode, n_max=n_max, n_min=n_min, seeds=seeds)  # fmt: skip
-    if inputs.mode == "paper":
-        return run_paper_mode(inputs, out, progress=progress)
-    _refuse_paper_options(seed, trial_porosity)
-    return _run_density_mode(inputs, out, threads=threads, progress=progress)
+    if store is not None:
+        check_output_dir(store.parameter, store.root)
+    with held(store, kind="criterion") as kept:
+        inputs = criterion_inputs(config, preset=preset, seed=seed, n_lab=n_lab,
+                                  trial_porosity=trial_porosity, threads=threads, mode=mode, n_max=n_max,
+                                  n_min=n_min, seeds=seeds)  # fmt: skip
+        if inputs.mode == "paper":
+            out = kept.root  # paper mode's criterion keeps its own files in the folder
+            return run_paper_mode(inputs, out, progress=progress)
+        _refuse_paper_options(seed, trial_porosity)
+        return _run_density_mode(inputs, kept, threads=threads, progress=progress)
 
 
 __all__ = ["run_criterion_modes", "run_density_criterion", "run_density_state"]

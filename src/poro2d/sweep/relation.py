@@ -12,10 +12,8 @@ moved), flagged in the table and left out of the fit.
 
 from __future__ import annotations
 
-import copy
 import math
-import os
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -24,9 +22,13 @@ import numpy as np
 from poro2d import porosity as P
 from poro2d.config import check_keys, check_number_list
 from poro2d.errors import InputError, check_range
-from poro2d.io_utils import float_or_nan, provenance
-from poro2d.locks import holds_output
+from poro2d.io_utils import check_output_dir, float_or_nan, provenance
 from poro2d.paper_data import QUICK_SPECIMEN as PAPER_QUICK_SPECIMEN
+from poro2d.store import Store
+from poro2d.sweep.cases import SweepConfig
+from poro2d.sweep.criterion_base import CriterionBase
+from poro2d.sweep.output import held
+from poro2d.sweep.records import DensitySweeps, QuadraticFit
 from poro2d.sweep.results import RelationResult
 
 RELATION_KEYS = {"n_max", "n_min", "points", "n_lab", "mode", "seeds", "mu_prep"}
@@ -52,7 +54,7 @@ def lab_porosities(n_max: float, n_min: float, points: int) -> list[float]:
     return [round(float(x), 4) for x in np.linspace(n_max, n_min, points)]
 
 
-def fit_quadratic_origin(n_lab, n2d) -> dict[str, Any]:
+def fit_quadratic_origin(n_lab, n2d) -> QuadraticFit:
     """Least-squares n2D = a nLab^2 + b nLab (no constant: the curve passes the origin).
 
     Returns a, b, the residuals (data - fit), their RMS and maximum, and R^2 about the
@@ -70,21 +72,30 @@ def fit_quadratic_origin(n_lab, n2d) -> dict[str, Any]:
     (a, b), *_ = np.linalg.lstsq(A, y, rcond=None)
     resid = y - (a * x * x + b * x)
     ss_tot = float(np.sum((y - y.mean()) ** 2))
-    return {
-        "a": float(a),
-        "b": float(b),
-        "points": int(x.size),
-        "residuals": resid.tolist(),
-        "rms_residual": float(np.sqrt(np.mean(resid**2))),
-        "max_abs_residual": float(np.max(np.abs(resid))),
-        "r2": float(1.0 - np.sum(resid**2) / ss_tot) if ss_tot > 0 else None,
-        "form": "n2D = a nLab^2 + b nLab",
-    }
+    return QuadraticFit(
+        a=float(a),
+        b=float(b),
+        points=int(x.size),
+        residuals=resid.tolist(),
+        rms_residual=float(np.sqrt(np.mean(resid**2))),
+        max_abs_residual=float(np.max(np.abs(resid))),
+        r2=float(1.0 - np.sum(resid**2) / ss_tot) if ss_tot > 0 else None,
+        form="n2D = a nLab^2 + b nLab",
+    )
+
+
+@dataclass(frozen=True)
+class RelationSettings:
+    """The laboratory extremes and the states of a relation, loose to dense."""
+
+    n_max: float
+    n_min: float
+    n_lab: tuple[float, ...]
 
 
 def relation_settings(
     table: dict | None, *, points: int | None, n_max: float | None, n_min: float | None, preset: bool
-) -> dict:
+) -> RelationSettings:
     """n_max, n_min and the nLab list from ``[relation]`` and the command-line options."""
     check_keys("relation", table or {}, RELATION_KEYS)
     t = dict(table or {})
@@ -114,28 +125,32 @@ def relation_settings(
         n_labs = sorted(n_labs, reverse=True)
     else:
         n_labs = lab_porosities(hi, lo, points if points is not None else t.get("points", 5))
-    return {"n_max": hi, "n_min": lo, "n_lab": n_labs}
+    return RelationSettings(hi, lo, tuple(n_labs))
 
 
-def sweep_config(base: dict, n_labs: list[float], *, quick: bool) -> dict:
-    """The criterion sweep over nLab for one grading (``base``: a criterion config)."""
-    cfg = copy.deepcopy({k: v for k, v in base.items() if k not in ("relation", "sweep")})
-    crit = dict(cfg.get("criterion") or {})
+def relation_base(base: CriterionBase, *, quick: bool) -> CriterionBase:
+    """The criterion base every state of the relation starts from (``quick``: the small box)."""
+    tables: dict[str, dict] = {}
+    crit = base.table("criterion")
     if quick:
-        spec = dict(cfg.get("specimen") or {})
-        spec.update(QUICK_SPECIMEN)
-        cfg["specimen"] = spec
+        tables["specimen"] = dict(base.table("specimen"), **QUICK_SPECIMEN)
         # the small box's window is the weight of a few grains: too coarse for the lid's
         # dozens of segments to rest at (docs/porosity.md), so the quick look keeps the plate
         crit.setdefault("acceptance", "plate")
     crit.pop("n_lab", None)
     crit.pop("trial_porosity", None)  # every point starts from Eq. 12 at its own nLab
-    cfg["criterion"] = crit
-    cfg["sweep"] = {"kind": "criterion", "title": "n2D(nLab) relation", "criterion.n_lab": list(n_labs)}
-    return cfg
+    tables["criterion"] = crit
+    return base.without("relation", "sweep").with_tables(**tables)
 
 
-def analyse(rows: list[dict], n_max: float, n_min: float) -> dict:
+def relation_sweep(base: CriterionBase, n_labs: tuple[float, ...]) -> SweepConfig:
+    """The criterion at every laboratory porosity, from :func:`relation_base` (paper mode's sweep)."""
+    grid = {"criterion.n_lab": list(n_labs)}
+    table = {"kind": "criterion", "title": "n2D(nLab) relation", **grid}
+    return base.sweep(table, [{"criterion.n_lab": n} for n in n_labs])
+
+
+def analyse(rows: list[dict], n_max: float, n_min: float) -> RelationResult:
     """Relation points (one per case), the fit through the converged ones, comparisons."""
     pts = []
     for r in rows:
@@ -166,7 +181,7 @@ def analyse(rows: list[dict], n_max: float, n_min: float) -> dict:
             pt[f"n2d_{m}"] = conv.results[m].value
         pts.append(pt)
     pts.sort(key=lambda p: -p["n_lab"])  # loose to dense
-    return dict(_fit_points(pts, n_max, n_min), mode="paper")
+    return _relation(pts, n_max, n_min, "paper")
 
 
 def _stats(values: list[float]) -> tuple[float, float]:
@@ -181,7 +196,7 @@ def _why(row: dict) -> str:
     return str((row.get("results") or {}).get("message") or row.get("error"))
 
 
-def analyse_states(rows: list[dict], targets: list, cal, n_max: float, n_min: float) -> dict:
+def analyse_states(rows: list[dict], targets: list, cal, n_max: float, n_min: float) -> RelationResult:
     """Density-controlled relation: one point per laboratory state, mean and spread over seeds.
 
     ``n2d_dem`` is the mean accepted n2D of the seeds whose criterion converged (the
@@ -227,7 +242,6 @@ def analyse_states(rows: list[dict], targets: list, cal, n_max: float, n_min: fl
             pt[f"n2d_{m}"] = conv.results[m].value
         pts.append(pt)
     pts.sort(key=lambda p: -p["n_lab"])
-    rel = _fit_points(pts, n_max, n_min)
     good = [p for p in pts if p["converged"]]
     spread = None
     if len(good) >= 2:
@@ -245,15 +259,15 @@ def analyse_states(rows: list[dict], targets: list, cal, n_max: float, n_min: fl
                 a["n2d_interior"] >= b["n2d_interior"] for a, b in zip(good, good[1:], strict=False)
             ),
         }
-    rel.update(mode="density", calibration=cal.to_dict(), n2d_max=cal.n2d_max, n2d_min=cal.n2d_min,
-               spread=spread)  # fmt: skip
-    return rel
+    return _relation(pts, n_max, n_min, "density", calibration=cal.to_dict(), n2d_max=cal.n2d_max,
+                     n2d_min=cal.n2d_min, spread=spread)  # fmt: skip
 
 
-def _fit_points(pts: list[dict], n_max: float, n_min: float) -> dict:
-    """The Eq. 12-form fit through the converged points, residuals and comparisons."""
+def _relation(pts: list[dict], n_max: float, n_min: float, mode: str, **extra: Any) -> RelationResult:
+    """The relation of the points (loose to dense): the Eq. 12-form fit through the converged
+    ones, each point's residual and comparison, and ``extra`` keys after ``mode``."""
     good = [p for p in pts if p["converged"] and math.isfinite(p["n2d_dem"])]
-    fit: dict[str, Any] | None = None
+    fit: QuadraticFit | None = None
     note = ""
     try:
         fit = fit_quadratic_origin([p["n_lab"] for p in good], [p["n2d_dem"] for p in good])
@@ -261,13 +275,13 @@ def _fit_points(pts: list[dict], n_max: float, n_min: float) -> dict:
         note = f"no fit: {len(good)} converged point(s); at least two distinct nLab are needed"
     for p in pts:
         if fit is not None and math.isfinite(p["n2d_dem"]):
-            p["n2d_fit"] = fit["a"] * p["n_lab"] ** 2 + fit["b"] * p["n_lab"]
+            p["n2d_fit"] = fit.a * p["n_lab"] ** 2 + fit.b * p["n_lab"]
             p["residual"] = p["n2d_dem"] - p["n2d_fit"]
         else:
             p["n2d_fit"] = None
             p["residual"] = None
         p["dem_minus_parabola"] = p["n2d_dem"] - p["n2d_parabolic"] if math.isfinite(p["n2d_dem"]) else None
-    return {
+    return RelationResult.from_dict({
         "n_max": n_max,
         "n_min": n_min,
         "points": pts,
@@ -277,72 +291,72 @@ def _fit_points(pts: list[dict], n_max: float, n_min: float) -> dict:
         "eq12": {"a": 0.42, "b": 0.25},
         "converged_points": len(good),
         "flagged_points": len(pts) - len(good),
-    }
+        "mode": mode,
+        **extra,
+    })  # fmt: skip
 
 
-def write_relation(rel: dict, out: Path, title: str = "", extra: dict | None = None) -> list[Path]:
-    """relation.csv, relation.json, relation.png and relation.svg in ``out``.
+def write_relation(rel: dict, store: Store, title: str = "", extra: dict | None = None) -> list[Path]:
+    """relation.csv, relation.json, relation.png and relation.svg in ``store``.
 
     ``rel``: an analysed relation (with ``extra`` keys for the file) or a :class:`RelationResult`.
     """
-    from poro2d.io_utils import write_csv, write_json
     from poro2d.report.relation_figure import write_relation_figure
 
-    out.mkdir(parents=True, exist_ok=True)
     flat = [{k: " ".join(f"{x:.4f}" for x in v) if isinstance(v, list) else v for k, v in p.items()}
             for p in rel["points"]]  # fmt: skip
-    write_csv(out / "relation.csv", flat)
+    table = store.write_csv("relation.csv", flat)
     record = dict(rel, **(extra or {}))
     record.setdefault("provenance", provenance())  # a RelationResult carries its own
-    write_json(out / "relation.json", record)
-    paths = write_relation_figure(rel, out, title)
-    return [out / "relation.csv", out / "relation.json", *paths]
+    file = store.write_json("relation.json", record)
+    return [table, file, *write_relation_figure(rel, store.root, title)]
 
 
 def density_relation(
-    base: dict,
-    base_dir: Path | None,
-    settings: dict,
-    out: Path,
+    base: CriterionBase,
+    settings: RelationSettings,
+    store: Store,
     *,
     quick: bool = False,
     seeds: int = 3,
     mus=None,
     use_cache: bool = True,
     **sweep_kw,
-) -> tuple[dict, dict]:
+) -> tuple[RelationResult, DensitySweeps]:
     """The density-controlled relation: calibrate, map every state, check it over seeds.
 
-    ``settings``: from :func:`relation_settings`. Returns the analysed relation and a
-    record of the two sweeps (calibration source, summaries).
+    ``base``: the criterion config as read; ``settings``: from :func:`relation_settings`;
+    ``store``: where the calibration's record and the states' sweep are kept (the
+    calibration's cases in the shared cache with ``use_cache``). Returns the analysed
+    relation and a record of the two sweeps (calibration source, summaries).
     """
     from poro2d.criterion.density import DEFAULT_MUS, state_target
     from poro2d.criterion.protocol import trial_grid
     from poro2d.sweep import density as D
-    from poro2d.sweep.cases import parse_sweep
     from poro2d.sweep.runner import run_sweep
 
-    cfg = D.with_density_defaults(sweep_config(base, settings["n_lab"], quick=quick))
-    cfg.pop("sweep")
-    cal, cal_info = D.calibrate(cfg, base_dir, out, mus=mus or DEFAULT_MUS, seeds=seeds,
-                                use_cache=use_cache, **sweep_kw)  # fmt: skip
-    targets = [state_target(n, settings["n_max"], settings["n_min"], cal) for n in settings["n_lab"]]
-    crit = cfg.get("criterion") or {}
+    states_base = D.with_density_defaults(relation_base(base, quick=quick))
+    calibration = D.CalibrationCase(states_base, tuple(mus or DEFAULT_MUS), seeds)
+    cal, cal_info = D.calibrate(calibration, store, use_cache=use_cache, **sweep_kw)
+    targets = tuple(state_target(n, settings.n_max, settings.n_min, cal) for n in settings.n_lab)
+    crit = states_base.table("criterion")
     # the first trial on the grid the criterion steps on: half the refined tolerance, else the resolution
     resolution = trial_grid(float(crit.get("resolution", 0.01)), crit.get("refine_tolerance"))
-    sweep = parse_sweep(D.state_sweep(cfg, targets, seeds, resolution), base_dir)
-    cal_sweep = parse_sweep(D.calibration_sweep(cfg, list(mus or DEFAULT_MUS), seeds), base_dir)
-    twins = D.calibration_twins(cal_sweep, sweep, base_dir, Path(cal_info["cases"]))
+    sweep = D.StateChecks(states_base, targets, seeds, resolution).sweep
+    twins = D.calibration_twins(calibration.sweep, sweep, base.base_dir, Store(cal_info.cases))
     rows, summary, failed = list(twins.values()), {"ran": 0, "reused": 0}, []
     if len(twins) < len(sweep.cases):
-        res = run_sweep(replace(sweep, cases=[c for c in sweep.cases if c.id not in twins]), out / "states",
-                        **sweep_kw)  # fmt: skip
+        left = replace(sweep, cases=[c for c in sweep.cases if c.id not in twins])
+        res = run_sweep(left, store.child("states"), **sweep_kw)
         rows, summary, failed = res.rows + rows, res.summary, res.failed
     summary = dict(summary, from_calibration=len(twins))
-    rel = analyse_states(rows, targets, cal, settings["n_max"], settings["n_min"])
-    record = {"calibration": cal_info, "states_summary": summary,
-              "failed_cases": len(failed) + cal_info["failed"]}  # fmt: skip
-    return rel, record
+    rel = analyse_states(rows, list(targets), cal, settings.n_max, settings.n_min)
+    record = {
+        "calibration": cal_info,
+        "states_summary": summary,
+        "failed_cases": len(failed) + cal_info.failed,
+    }
+    return rel, DensitySweeps.from_dict(record)
 
 
 def refuse_density_options(table: dict, seeds: int | None) -> None:
@@ -354,20 +368,11 @@ def refuse_density_options(table: dict, seeds: int | None) -> None:
             raise InputError(f"relation.{key}", table[key], "only in density mode (paper mode: leave it out)")
 
 
-def check_cases(base: dict, base_dir: Path | None, settings: dict, *, quick: bool) -> None:
-    """Every criterion case of the relation built once, without running: a bad specimen, grading
-    or criterion setting is refused before the calibration starts, not when its case comes up."""
-    from poro2d.sweep.cases import parse_sweep
-
-    parse_sweep(sweep_config(base, settings["n_lab"], quick=quick), base_dir)
-
-
-@holds_output("out")
 def run_relation(
     config=None,
     *,
     preset: str | None = None,
-    out: str | os.PathLike = "relation-out",
+    store: Store | None = None,
     points: int | None = None,
     n_max: float | None = None,
     n_min: float | None = None,
@@ -380,14 +385,15 @@ def run_relation(
     dashboard: str | None = None,
     announce=None,
 ) -> RelationResult:
-    """``poro2d relation`` as one call: the grading's n2D(nLab) relation, written to ``out``.
+    """``poro2d relation`` as one call: the grading's n2D(nLab) relation, written to ``store``.
 
     ``config``: a criterion config (a dict, a TOML file, or the paper preset when None) with
     an optional ``[relation]`` table, which the keyword options override. Density mode (the
     default) calibrates the grading, maps every laboratory state by its relative density and
     checks it over ``seeds``; paper mode runs the criterion once per state at the fixed
-    preparation friction. Returns the :class:`RelationResult` written to ``out/relation.json``;
-    its ``failed_cases`` counts the cases that raised (their tracebacks are in ``out``). Every input is
+    preparation friction. Returns the :class:`RelationResult` written to ``relation.json``;
+    its ``failed_cases`` counts the cases that raised (their tracebacks are in ``store``; None:
+    nothing is kept but the shared calibration cache). Every input is
     checked before the first case runs; ``announce`` (no arguments) is called then, before
     any work (the command prints its banner there, so a refusal stays one line). ``dashboard``: where a
     LocalCluster serves its dashboard (default 127.0.0.1:0, this machine; ``"none"``: none).
@@ -396,17 +402,16 @@ def run_relation(
     from poro2d.criterion.run import load
     from poro2d.execute.cluster_options import check_cluster_options, check_dashboard
     from poro2d.execute.dask_cluster import check_reachable
-    from poro2d.io_utils import check_output_dir
-    from poro2d.sweep.cases import parse_sweep
     from poro2d.sweep.density import check_seeds
     from poro2d.sweep.runner import run_sweep
 
-    out = Path(out)
-    check_output_dir("--out", out)
+    if store is not None:
+        check_output_dir(store.parameter, store.root)
     check_cluster_options(scheduler, workers)
     dashboard_address = check_dashboard(dashboard)
-    base, base_dir = load(config, preset, extra_tables=("relation",))
-    table = base.get("relation") or {}
+    cfg, base_dir = load(config, preset, extra_tables=("relation",))
+    base = CriterionBase.from_config(cfg, base_dir)
+    table = cfg.get("relation") or {}
     settings = relation_settings(
         table or None, points=points, n_max=n_max, n_min=n_min, preset=config is None
     )
@@ -416,7 +421,9 @@ def run_relation(
         mus = check_mus(table["mu_prep"], "relation.mu_prep") if "mu_prep" in table else None
     else:
         refuse_density_options(table, seeds)
-    check_cases(base, base_dir, settings, quick=quick)
+    # every criterion case of the relation built once, without running: a bad specimen, grading
+    # or criterion setting is refused before the calibration starts, not when its case comes up
+    states = relation_sweep(relation_base(base, quick=quick), settings.n_lab)
     check_reachable(scheduler)
     if announce is not None:
         announce()
@@ -425,16 +432,15 @@ def run_relation(
     title = "2D porosity from the criterion vs laboratory porosity" + (
         " (quick: 0.08 m x 0.04 m box)" if quick else ""
     )
-    if mode == "density":
-        rel, record = density_relation(base, base_dir, settings, out, quick=quick, seeds=n_seeds, mus=mus,
-                                       **sweep_kw)  # fmt: skip
-        extra = {"quick": quick, "config": base, "sweeps": record}
-    else:
-        res = run_sweep(
-            parse_sweep(sweep_config(base, settings["n_lab"], quick=quick), base_dir), out, **sweep_kw
-        )
-        rel = analyse(res.rows, settings["n_max"], settings["n_min"])
-        extra = {"quick": quick, "sweep_summary": res.summary, "config": base}
-    result = RelationResult.from_dict(dict(rel, **extra, provenance=provenance()))
-    write_relation(result, out, title=title)
+    with held(store, kind="relation") as kept:
+        if mode == "density":
+            rel, record = density_relation(base, settings, kept, quick=quick, seeds=n_seeds, mus=mus,
+                                           **sweep_kw)  # fmt: skip
+            extra = {"quick": quick, "config": cfg, "sweeps": record}
+        else:
+            res = run_sweep(states, kept, **sweep_kw)
+            rel = analyse(res.rows, settings.n_max, settings.n_min)
+            extra = {"quick": quick, "sweep_summary": res.summary, "config": cfg}
+        result = RelationResult.from_dict(dict(rel, **extra, provenance=provenance()))
+        write_relation(result, kept, title=title)
     return result

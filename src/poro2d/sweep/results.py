@@ -3,7 +3,8 @@
 Each class lists its file's keys as fields, in the file's order (see
 :mod:`poro2d.typed_result`); the runs build the dict they wrote before and return it as
 ``Class.from_dict(...)``, so the files stay what they were and a key a mode does not write
-stays out of the file.
+stays out of the file. Their nested records (a sweep's summary, a relation's fit and
+points) are typed parts (:mod:`poro2d.sweep.records`).
 """
 
 from __future__ import annotations
@@ -11,11 +12,35 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from poro2d.typed_result import NOT_IN_FILE, TypedResult
+from poro2d.sweep.records import (
+    CalibrationRun,
+    CaseEntry,
+    CaseRow,
+    DensityPoint,
+    DensitySweeps,
+    LostCaseRow,
+    PaperPoint,
+    QuadraticFit,
+    Spread,
+    SweepSummary,
+    WithParts,
+    part,
+    parts,
+    relation_points,
+)
+from poro2d.sweep.sensitivity_records import (
+    Answer,
+    GradingDescription,
+    GradingSweeps,
+    SeedRecord,
+    SensitivityPoints,
+    SensitivitySettings,
+)
+from poro2d.typed_result import NOT_IN_FILE
 
 
 @dataclass(eq=False)
-class SweepResult(TypedResult):
+class SweepResult(WithParts):
     """A finished sweep (its ``sweep.json``), with every case's row and the table of them.
 
     ``cases``: id and parameters of each case; ``config``: the sweep's config as given;
@@ -25,29 +50,33 @@ class SweepResult(TypedResult):
     ``table``: the same as a pandas DataFrame (``results.csv``).
     """
 
+    PARTS = {"cases": parts(CaseEntry), "summary": part(SweepSummary)}
+
     status: str
     title: str
     kind: str
     axes: list[str]
-    cases: list[dict[str, Any]]
+    cases: list[CaseEntry]
     config: dict[str, Any]
     base_dir: str | None
     retries: int
     provenance: dict[str, Any]
     cluster: dict[str, Any]
-    summary: dict[str, Any]
+    summary: SweepSummary
     finished_utc: str
-    rows: list[dict[str, Any]] = field(default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE)
+    rows: list[CaseRow | LostCaseRow] = field(
+        default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
+    )
     table: Any = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     @property
-    def failed(self) -> list[dict[str, Any]]:
+    def failed(self) -> list[CaseRow | LostCaseRow]:
         """The rows of the cases that failed."""
         return [r for r in self.rows if r["status"] == "failed"]
 
 
 @dataclass(eq=False)
-class DensityStateResult(TypedResult):
+class DensityStateResult(WithParts):
     """The density-controlled criterion for one laboratory state (``density.json``).
 
     The state (``n_lab``, ``relative_density``), its 2D target and preparation friction
@@ -56,6 +85,8 @@ class DensityStateResult(TypedResult):
     ``converged``: every seed accepted. ``sweeps``: where the calibration came from and
     the state sweep's summary.
     """
+
+    PARTS = {"sweeps": part(DensitySweeps)}
 
     mode: str
     n_lab: float
@@ -75,13 +106,13 @@ class DensityStateResult(TypedResult):
     n2d_min: float
     n2d_max: float
     calibration: dict[str, Any]
-    sweeps: dict[str, Any]
+    sweeps: DensitySweeps
     config: dict[str, Any]
     provenance: dict[str, Any]
 
 
 @dataclass(eq=False)
-class RelationResult(TypedResult):
+class RelationResult(WithParts):
     """The relation n2D(nLab) of one grading (``relation.json``).
 
     ``points``: one dict per laboratory state, loose to dense; ``fit``: the Eq. 12-form
@@ -90,10 +121,13 @@ class RelationResult(TypedResult):
     (calibration and state sweeps); paper mode the one sweep's ``sweep_summary``.
     """
 
+    PARTS = {"points": relation_points, "fit": part(QuadraticFit), "spread": part(Spread),
+             "sweep_summary": part(SweepSummary), "sweeps": part(DensitySweeps)}  # fmt: skip
+
     n_max: float
     n_min: float
-    points: list[dict[str, Any]]
-    fit: dict[str, Any] | None
+    points: list[PaperPoint | DensityPoint]
+    fit: QuadraticFit | None
     fit_note: str
     eq12: dict[str, float]
     converged_points: int
@@ -102,23 +136,23 @@ class RelationResult(TypedResult):
     calibration: dict[str, Any] | None = None
     n2d_max: float | None = None
     n2d_min: float | None = None
-    spread: dict[str, Any] | None = None
+    spread: Spread | None = None
     quick: bool | None = None
-    sweep_summary: dict[str, Any] | None = None
+    sweep_summary: SweepSummary | None = None
     config: dict[str, Any] | None = None
-    sweeps: dict[str, Any] | None = None
+    sweeps: DensitySweeps | None = None
     provenance: dict[str, Any] | None = None
 
     @property
     def failed_cases(self) -> int:
         """Cases that raised (their tracebacks are in the output folder), over every sweep."""
         if self.sweeps is not None:
-            return int(self.sweeps["failed_cases"])
+            return int(self.sweeps.failed_cases)
         return int((self.sweep_summary or {}).get("failed", 0))
 
 
 @dataclass(eq=False)
-class SensitivityResult(TypedResult):
+class SensitivityResult(WithParts):
     """The accepted n2D against grading width and preparation friction (``sensitivity.json``).
 
     ``points``: ``grading`` (one per Cu, the reference first) and ``mu_prep`` (one per
@@ -127,19 +161,23 @@ class SensitivityResult(TypedResult):
     ``figure``: the figure's path (a study read back points it into its folder).
     """
 
+    PARTS = {"settings": part(SensitivitySettings), "gradings": parts(GradingDescription),
+             "seeds": parts(SeedRecord), "points": part(SensitivityPoints), "sweeps": part(GradingSweeps),
+             "answer": part(Answer)}  # fmt: skip
+
     title: str
-    settings: dict[str, Any]
-    gradings: list[dict[str, Any]]
-    seeds: list[dict[str, Any]]
-    points: dict[str, list[dict[str, Any]]]
+    settings: SensitivitySettings
+    gradings: list[GradingDescription]
+    seeds: list[SeedRecord]
+    points: SensitivityPoints
     calibration: dict[str, Any]
     paper: dict[str, Any]
     config: dict[str, Any]
-    sweeps: dict[str, Any]
+    sweeps: GradingSweeps
     timings: dict[str, float]
-    answer: dict[str, Any]
+    answer: Answer
     figure: str | None = None
     provenance: dict[str, Any] | None = None
 
 
-__all__ = ["DensityStateResult", "RelationResult", "SensitivityResult", "SweepResult"]
+__all__ = ["CalibrationRun", "DensityStateResult", "RelationResult", "SensitivityResult", "SweepResult"]

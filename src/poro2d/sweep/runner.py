@@ -1,6 +1,6 @@
 """Run the cases of a sweep as Dask tasks; gather one tidy table.
 
-Layout of the output folder ``DIR``::
+Layout of the sweep's store ``DIR`` (every file through :class:`~poro2d.store.Store`)::
 
     DIR/sweep.json                 config, cases, cluster, counts, provenance
     DIR/results.csv                one row per case (also results.parquet)
@@ -26,16 +26,17 @@ import socket
 import time
 import traceback
 from datetime import UTC, datetime
-from pathlib import Path
 from typing import Any
 
 from poro2d.execute import Backend, Executor, Failed, Job
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
 from poro2d.execute.dask_cluster import pin_numba_threads
-from poro2d.io_utils import atomic_path, provenance, write_json
-from poro2d.locks import cache_entry, holds_output
+from poro2d.io_utils import provenance
+from poro2d.locks import cache_entry, output_folder
+from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.sweep.cases import KINDS, Case, SweepConfig, config_tables
+from poro2d.sweep.records import CaseRow, LostCaseRow, SweepSummary
 from poro2d.sweep.results import SweepResult
 
 RESULT = "result.json"
@@ -62,7 +63,7 @@ def _scalar(v: Any) -> Any:
     return json.dumps(v, default=str)
 
 
-def case_stage(case: dict, case_dir: Path) -> ResumableStage:
+def case_stage(case: dict, store: Store) -> ResumableStage:
     """A case's folder as a resumable stage: ``params.json`` binds it, ``result.json`` marks it done.
 
     The binding is the case's kind and merged config, as its id (which names the folder)
@@ -70,12 +71,10 @@ def case_stage(case: dict, case_dir: Path) -> ResumableStage:
     change no result (:mod:`poro2d.identity`) are recorded, not compared, so a rerun with
     another thread count finds it.
     """
-    return ResumableStage(
-        case_dir,
+    return store.stage(
         Fingerprint(case, ignore=("id", "params"), tables=config_tables("config.")),
         record=PARAMS,
         key=None,
-        parameter="--out",
         allowed="a sweep folder whose case folders hold the cases their ids name",
         unrecorded="adopt",
     )
@@ -86,13 +85,14 @@ def _is_done(row: dict) -> bool:
     return row.get("status") == "done"
 
 
-def finished_row(case: dict, case_dir: Path) -> dict | None:
+def finished_row(case: dict, store: Store) -> CaseRow | None:
     """The stored row of a finished case, or None (no marker, unreadable, or another case's)."""
-    return case_stage(case, case_dir).stored(RESULT, accept=_is_done)
+    row = case_stage(case, store).stored(RESULT, accept=_is_done)
+    return None if row is None else CaseRow.from_dict(row)
 
 
 # ------------------------------------------------------------------------ worker side
-def compute_case(case: dict, case_dir: str, func) -> dict:
+def compute_case(case: dict, store: Store, func) -> CaseRow:
     """Run one case on a worker; never raises for errors of the case itself.
 
     ``func`` is the kind's callable, shipped with the task so that kinds registered
@@ -100,16 +100,15 @@ def compute_case(case: dict, case_dir: str, func) -> dict:
     case runs: a worker left running by a killed sweep may still compute it, and a rerun's
     worker then waits for it and reads its result back instead of writing beside it.
     """
-    with cache_entry(case_dir, parameter="case folder"):
-        return _run_case(case, case_dir, func)
+    with cache_entry(store.root, parameter="case folder"):
+        return _run_case(case, store, func)
 
 
-def _run_case(case: dict, case_dir: str, func) -> dict:
-    d = Path(case_dir)
-    stage = case_stage(case, d)
+def _run_case(case: dict, store: Store, func) -> CaseRow:
+    stage = case_stage(case, store)
     done = stage.stored(RESULT, accept=_is_done)
     if done is not None:  # a retry after the marker was written
-        return done
+        return CaseRow.from_dict(done)
     pin_numba_threads()
     row: dict[str, Any] = {
         "case_id": case["id"],
@@ -122,7 +121,8 @@ def _run_case(case: dict, case_dir: str, func) -> dict:
     }
     t0 = time.perf_counter()
     try:
-        return stage.run(lambda: _done_row(case, d, func, row, t0), RESULT, accept=_is_done)
+        return stage.run(lambda: _done_row(case, store, func, row, t0), RESULT, accept=_is_done,
+                         decode=CaseRow.from_dict)  # fmt: skip
     except Exception as exc:
         row.update(
             status="failed",
@@ -131,22 +131,21 @@ def _run_case(case: dict, case_dir: str, func) -> dict:
             finished_utc=_now(),
             results={},
         )
-        with atomic_path(d / ERROR_TXT) as tmp:
-            tmp.write_text(traceback.format_exc())
-        write_json(d / ERROR_JSON, row)
-        return row
+        store.write_text(ERROR_TXT, traceback.format_exc())
+        store.write_json(ERROR_JSON, row)
+        return CaseRow.from_dict(row)
 
 
-def _done_row(case: dict, d: Path, func, row: dict, t0: float) -> dict:
-    """Run the case's kind into ``d/run``; its row (``status`` done, the results as table cells)."""
-    results = func(case["config"], d / "run")
+def _done_row(case: dict, store: Store, func, row: dict, t0: float) -> dict:
+    """Run the case's kind into its sub-store ``run``; its row (``status`` done, results as table cells)."""
+    results = func(case["config"], store.child("run"))
     if not isinstance(results, dict):
         raise TypeError(f"case kind {case['kind']!r} returned {type(results).__name__}, not a dict")
     results = {str(k): _scalar(v) for k, v in results.items()}
     row.update(status="done", error=None, time_s=time.perf_counter() - t0, finished_utc=_now())
     row["results"] = results
     for stale in (ERROR_TXT, ERROR_JSON):
-        (d / stale).unlink(missing_ok=True)
+        store.remove(stale)
     return row  # written as result.json, the done marker, last
 
 
@@ -160,8 +159,8 @@ def _worker_address() -> str:
 
 
 # ------------------------------------------------------------------------ driver side
-def _failed_row(case: Case, d: Path, err: BaseException, tb: str) -> dict:
-    row = {
+def _failed_row(case: Case, store: Store, err: BaseException, tb: str) -> LostCaseRow:
+    row = LostCaseRow(**{
         "case_id": case.id,
         "kind": case.kind,
         "params": case.params,
@@ -173,11 +172,10 @@ def _failed_row(case: Case, d: Path, err: BaseException, tb: str) -> dict:
         "pid": None,
         "worker": None,
         "finished_utc": _now(),
-    }
-    case_stage(case.to_dict(), d).bind()
-    with atomic_path(d / ERROR_TXT) as tmp:
-        tmp.write_text(tb or row["error"])
-    write_json(d / ERROR_JSON, row)
+    })  # fmt: skip
+    case_stage(case.to_dict(), store).bind()
+    store.write_text(ERROR_TXT, tb or row.error)
+    store.write_result(ERROR_JSON, row)
     return row
 
 
@@ -217,17 +215,15 @@ def table_from_rows(rows: list[dict], axes: list[str]):
     return df
 
 
-def write_tables(df, out: Path) -> None:
-    with atomic_path(out / "results.csv") as tmp:
-        df.to_csv(tmp, index=False)
-    with atomic_path(out / "results.parquet") as tmp:
-        df.to_parquet(tmp, index=False)
+def write_tables(df, store: Store) -> None:
+    """The table of a sweep's cases, ``results.csv`` and ``results.parquet``."""
+    store.write_frame("results.csv", df)
+    store.write_parquet("results.parquet", df)
 
 
-@holds_output("out")
 def run_sweep(
     sweep: SweepConfig,
-    out: str | os.PathLike,
+    store: Store,
     *,
     scheduler: str | None = None,
     workers: int | None = None,
@@ -235,18 +231,24 @@ def run_sweep(
     progress: bool = True,
     dashboard: str | None = DEFAULT_DASHBOARD,
 ) -> SweepResult:
-    """Run every unfinished case of ``sweep`` into ``out``; returns its ``sweep.json``, rows and table.
+    """Run every unfinished case of ``sweep`` into ``store``; returns its ``sweep.json``, rows and table.
 
+    The store's folder is held for the call (another run writing there is refused).
     ``client``: an existing ``distributed.Client`` (tests, notebooks); otherwise one is
     made for ``scheduler`` (an address such as ``tcp://host:8786``) or for a new
     LocalCluster with ``workers`` processes (default: one per core) of one thread each,
     its dashboard on ``dashboard`` (this machine only by default; None: none).
     """
-    out = Path(out)
     if client is None:
         check_cluster_options(scheduler, workers)
-    cases_dir = out / "cases"
-    cases_dir.mkdir(parents=True, exist_ok=True)
+    with output_folder(store.parameter, store.root, kind="sweep"):
+        return _run_sweep(sweep, store, client=client, scheduler=scheduler, workers=workers,
+                          progress=progress, dashboard=dashboard)  # fmt: skip
+
+
+def _run_sweep(sweep: SweepConfig, store: Store, *, client, scheduler, workers, progress: bool,
+               dashboard: str | None) -> SweepResult:  # fmt: skip
+    cases = store.child("cases")
     t_start = time.perf_counter()
     record = {
         "status": "running",
@@ -259,35 +261,36 @@ def run_sweep(
         "retries": sweep.retries,
         "provenance": provenance(),
     }
-    write_json(out / "sweep.json", record)
+    store.write_json("sweep.json", record)
 
-    rows: dict[str, dict] = {}
+    rows: dict[str, CaseRow | LostCaseRow] = {}
     pending: list[Case] = []
     for c in sweep.cases:
-        done = finished_row(c.to_dict(), cases_dir / c.id)
+        done = finished_row(c.to_dict(), cases.child(c.id))
         if done is not None:
-            rows[c.id] = dict(done, status="done", reused=True)
+            rows[c.id] = CaseRow.from_dict(dict(done, status="done", reused=True))
         else:
             pending.append(c)
     n_reused = len(rows)
     cluster_info: dict[str, Any] = {}
     if pending:
-        cluster_info = _run_pending(sweep, pending, rows, cases_dir, n_reused, client=client,
+        cluster_info = _run_pending(sweep, pending, rows, cases, n_reused, client=client,
                                     scheduler=scheduler, workers=workers, progress=progress,
                                     dashboard=dashboard)  # fmt: skip
-    ordered = [dict(rows[c.id], reused=bool(rows[c.id].get("reused", False))) for c in sweep.cases]
+    ordered = [type(rows[c.id]).from_dict(dict(rows[c.id], reused=bool(rows[c.id].get("reused", False))))
+               for c in sweep.cases]  # fmt: skip
     df = table_from_rows(ordered, sweep.axes)
     df["reused"] = [r["reused"] for r in ordered]
-    write_tables(df, out)
+    write_tables(df, store)
     summary = _summary(ordered, n_reused, time.perf_counter() - t_start, cluster_info)
     record.update(status="finished", cluster=cluster_info, summary=summary, finished_utc=_now())
-    write_json(out / "sweep.json", record)
+    store.write_json("sweep.json", record)
     result = SweepResult.from_dict(record)
     result.rows, result.table = ordered, df
     return result
 
 
-def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases_dir: Path, n_reused: int, *,
+def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Store, n_reused: int, *,
                  client, scheduler, workers, progress: bool, dashboard: str | None) -> dict:  # fmt: skip
     """Run the unfinished cases on ``client`` (or a cluster made for them) into ``rows``.
 
@@ -304,11 +307,11 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases_dir:
             err = OutputConsole(stderr=True)
             err.print(f"Dask dashboard: {cluster_info['dashboard']}", highlight=False)
         n_total = len(sweep.cases)
-        rows.update(_submit_all(executor, pending, cases_dir, sweep.retries, progress, n_reused, n_total))
+        rows.update(_submit_all(executor, pending, cases, sweep.retries, progress, n_reused, n_total))
     return cluster_info
 
 
-def _summary(ordered: list[dict], n_reused: int, wall: float, cluster_info: dict) -> dict:
+def _summary(ordered: list[dict], n_reused: int, wall: float, cluster_info: dict) -> SweepSummary:
     """Counts, wall and case time, the worker processes and the parallel efficiency of a sweep."""
     busy = sum(r.get("time_s") or 0.0 for r in ordered if not r["reused"])
     summary = {
@@ -325,27 +328,27 @@ def _summary(ordered: list[dict], n_reused: int, wall: float, cluster_info: dict
     }
     if cluster_info.get("threads"):
         summary["parallel_efficiency"] = busy / (wall * cluster_info["threads"]) if wall > 0 else None
-    return summary
+    return SweepSummary.from_dict(summary)
 
 
 def _submit_all(
     executor: Executor,
     pending: list[Case],
-    cases_dir: Path,
+    cases: Store,
     retries: int,
     progress: bool,
     n_reused: int,
     n_total: int,
-) -> dict[str, dict]:
+) -> dict[str, CaseRow | LostCaseRow]:
     """Every pending case as a job; its row (a failed task's as an error row) as it ends."""
     from poro2d.progress import CountProgress
 
     jobs = [
-        Job(compute_case, (c.to_dict(), str(cases_dir / c.id), KINDS[c.kind]), c.id, key=f"{c.kind}-{c.id}",
+        Job(compute_case, (c.to_dict(), cases.child(c.id), KINDS[c.kind]), c.id, key=f"{c.kind}-{c.id}",
             retries=retries)
         for c in pending
     ]  # fmt: skip
-    rows: dict[str, dict] = {}
+    rows: dict[str, CaseRow | LostCaseRow] = {}
     label = f"sweep ({n_reused} of {n_total} already done)" if n_reused else "sweep"
     with CountProgress(label, len(pending), "cases", enabled=progress) as bar:
 
@@ -354,7 +357,7 @@ def _submit_all(
             if isinstance(outcome, Failed):  # the task itself failed: e.g. KilledWorker after worker deaths
                 exc = outcome.error
                 outcome = _failed_row(
-                    c, cases_dir / c.id, exc, f"{outcome.traceback}{type(exc).__name__}: {exc}\n"
+                    c, cases.child(c.id), exc, f"{outcome.traceback}{type(exc).__name__}: {exc}\n"
                 )
             rows[c.id] = outcome
             n_failed = sum(r["status"] == "failed" for r in rows.values())

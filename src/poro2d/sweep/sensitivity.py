@@ -20,7 +20,6 @@ accepts the paper's 0.15 within 0.005, or which comes closest and by how much.
 
 from __future__ import annotations
 
-import copy
 import math
 import time
 from dataclasses import dataclass
@@ -31,8 +30,22 @@ import numpy as np
 
 from poro2d.config import check_keys, check_number_list
 from poro2d.errors import InputError
-from poro2d.locks import holds_output
+from poro2d.io_utils import check_output_dir
+from poro2d.store import Store
+from poro2d.sweep.cases import SweepConfig
+from poro2d.sweep.criterion_base import CriterionBase
+from poro2d.sweep.output import held
 from poro2d.sweep.results import SensitivityResult
+from poro2d.sweep.sensitivity_records import (
+    Answer,
+    GradingDescription,
+    GradingPoint,
+    Match,
+    MeanSd,
+    MuPoint,
+    SeedRecord,
+    StudySettings,
+)
 
 #: grading widths of the full study (Cu = d60 / d10), and of ``--quick``: at the paper
 #: grading's mean disk area Cu = 4 has disks of about 26 mm, taller than the 20 mm layer
@@ -75,7 +88,7 @@ def check_cus(cus: Any) -> list[float]:
     return sorted(out)
 
 
-def study_settings(table: dict | None, *, quick: bool, seeds: int | None) -> dict:
+def study_settings(table: dict | None, *, quick: bool, seeds: int | None) -> StudySettings:
     """Cu list, mu_prep list and seeds from ``[sensitivity]`` and the command line."""
     from poro2d.criterion.density import DEFAULT_MUS
     from poro2d.sweep.density import check_mus, check_seeds
@@ -88,26 +101,26 @@ def study_settings(table: dict | None, *, quick: bool, seeds: int | None) -> dic
         n = check_seeds(seeds, "--seeds")
     else:
         n = check_seeds(t.get("seeds", QUICK_SEEDS if quick else DEFAULT_SEEDS), "sensitivity.seeds")
-    return {"cus": cus, "mus": mus, "seeds": n, "quick": bool(quick)}
+    return StudySettings(cus=cus, mus=mus, seeds=n, quick=bool(quick))
 
 
 #: the criterion settings of the study unless its config sets them
 REFINE_DEFAULTS = {"refine_tolerance": 0.002, "max_iterations": 10}
 
 
-def study_base(base: dict, *, quick: bool) -> dict:
-    """The criterion config every case starts from: the given one, smaller in quick mode."""
+def study_base(base: CriterionBase, *, quick: bool) -> CriterionBase:
+    """The criterion base every case starts from: the given one, smaller in quick mode."""
     from poro2d.sweep.relation import QUICK_SPECIMEN
 
-    cfg = copy.deepcopy({k: v for k, v in base.items() if k not in ("sensitivity", "relation", "sweep")})
+    study = base.without("sensitivity", "relation", "sweep")
     # trials refined below the paper's 0.01 grid, so the study resolves differences of 0.005
-    cfg["criterion"] = dict(REFINE_DEFAULTS, **(cfg.get("criterion") or {}))
+    study = study.with_defaults({"criterion": REFINE_DEFAULTS})
     if quick:
-        cfg["specimen"] = dict(cfg.get("specimen") or {}, **QUICK_SPECIMEN)
+        study = study.with_tables(specimen=dict(study.table("specimen"), **QUICK_SPECIMEN))
         # in a box of a few hundred disks 1 % of G is about two disks' weight: the quick
         # look widens the window as `poro2d paper --quick` does (a config's own value wins)
-        cfg["criterion"] = dict(quick_criterion(), **(cfg.get("criterion") or {}))
-    return cfg
+        study = study.with_defaults({"criterion": quick_criterion()})
+    return study
 
 
 # ------------------------------------------------------------------------------ gradings
@@ -120,37 +133,38 @@ class GradingCase:
     params: dict[str, Any]
     curve: Any  # GradingCurve
 
-    def describe(self) -> dict:
+    def describe(self) -> GradingDescription:
+        """The grading as the study's file records it: widths, sizes, where it came from."""
         c = self.curve
-        return {
-            "label": self.label,
-            "cu_nominal": self.cu_nominal,
-            "cu": c.uniformity,
-            "d10_mm": 1e3 * c.size_at(10.0),
-            "d50_mm": 1e3 * c.size_at(50.0),
-            "d_min_mm": 1e3 * c.d_min_m,
-            "d_max_mm": 1e3 * c.d_max_m,
-            "mean_disk_area_m2": c.mean_disk_area(),
-            "sizes_m": list(c.sizes_m),
-            "percent_passing": list(c.percent_passing),
-            "source": c.source,
-        }
+        return GradingDescription(
+            label=self.label,
+            cu_nominal=self.cu_nominal,
+            cu=c.uniformity,
+            d10_mm=1e3 * c.size_at(10.0),
+            d50_mm=1e3 * c.size_at(50.0),
+            d_min_mm=1e3 * c.d_min_m,
+            d_max_mm=1e3 * c.d_max_m,
+            mean_disk_area_m2=c.mean_disk_area(),
+            sizes_m=list(c.sizes_m),
+            percent_passing=list(c.percent_passing),
+            source=c.source,
+        )
 
 
-def _reference_params(base: dict, base_dir: Path | None) -> dict[str, Any]:
-    g = dict(base.get("grading") or {"preset": "paper"})
-    if isinstance(g.get("csv"), str) and base_dir is not None and not Path(g["csv"]).is_absolute():
-        g["csv"] = str((base_dir / g["csv"]).resolve())
+def _reference_params(base: CriterionBase) -> dict[str, Any]:
+    g = base.table("grading") or {"preset": "paper"}
+    if isinstance(g.get("csv"), str) and base.base_dir is not None and not Path(g["csv"]).is_absolute():
+        g["csv"] = str((base.base_dir / g["csv"]).resolve())
     return {f"grading.{k}": v for k, v in g.items()}
 
 
-def gradings(base: dict, base_dir: Path | None, cus: list[float]) -> list[GradingCase]:
+def gradings(base: CriterionBase, cus: list[float]) -> list[GradingCase]:
     """The config's grading, then the log-linear family at its mean disk area."""
     from poro2d.criterion.config import build
     from poro2d.specimen.grading import log_linear_grading
 
-    _, ref, _, _ = build(copy.deepcopy(base), base_dir)
-    out = [GradingCase(REFERENCE, None, _reference_params(base, base_dir), ref)]
+    _, ref, _, _ = build(base.as_config(), base.base_dir)
+    out = [GradingCase(REFERENCE, None, _reference_params(base), ref)]
     area = ref.mean_disk_area()
     for cu in cus:
         g = log_linear_grading(cu, area)
@@ -163,12 +177,12 @@ def gradings(base: dict, base_dir: Path | None, cus: list[float]) -> list[Gradin
     return out
 
 
-def check_gradings(base: dict, base_dir: Path | None, cases: list[GradingCase]) -> None:
+def check_gradings(base: CriterionBase, cases: list[GradingCase]) -> None:
     """Every grading must fit the box: one clear line naming the Cu, before anything runs."""
     from poro2d.criterion.config import build
     from poro2d.specimen.compaction import check_feasible
 
-    spec, _, settings, _ = build(copy.deepcopy(base), base_dir)
+    spec, _, settings, _ = build(base.as_config(), base.base_dir)
     band = spec.height / spec.layers
     for g in cases:
         d_max = g.curve.d_max_m
@@ -183,25 +197,20 @@ def check_gradings(base: dict, base_dir: Path | None, cases: list[GradingCase]) 
         check_feasible(spec, g.curve, settings.initial_trial())
 
 
-def grading_sweep(base: dict, cases: list[GradingCase], seeds: int) -> dict:
+def grading_sweep(base: CriterionBase, cases: list[GradingCase], seeds: int) -> SweepConfig:
     """One criterion case per grading and seed, everything else as in ``base``."""
-    cfg = copy.deepcopy(base)
-    cfg["grading"] = {}  # each case names its own grading
-    cfg["sweep"] = {
-        "kind": "criterion",
-        "title": "accepted n2D against grading width",
-        "cases": [dict(g.params, seed=s) for g in cases for s in range(seeds)],
-    }
-    return cfg
+    params = [dict(g.params, seed=s) for g in cases for s in range(seeds)]
+    table = {"kind": "criterion", "title": "accepted n2D against grading width", "cases": params}
+    return base.with_tables(grading={}).sweep(table, params)  # each case names its own grading
 
 
 # ------------------------------------------------------------------------------ analysis
-def finite_mean_sd(values: list) -> dict:
+def finite_mean_sd(values: list) -> MeanSd:
     """Mean, sample sd (0 for one value) and n of the finite values; NaN when there are none."""
     a = np.array([float(v) for v in values if v is not None and math.isfinite(float(v))], dtype=float)
     if a.size == 0:
-        return {"mean": math.nan, "sd": math.nan, "n": 0}
-    return {"mean": float(a.mean()), "sd": float(a.std(ddof=1)) if a.size > 1 else 0.0, "n": int(a.size)}
+        return MeanSd(math.nan, math.nan, 0)
+    return MeanSd(float(a.mean()), float(a.std(ddof=1)) if a.size > 1 else 0.0, int(a.size))
 
 
 def _ratio(a, b) -> float | None:
@@ -210,11 +219,11 @@ def _ratio(a, b) -> float | None:
     return float(a) / float(b)
 
 
-def seed_record(row: dict, grading: dict, seed: int) -> dict:
+def seed_record(row: dict, grading: GradingDescription, seed: int) -> SeedRecord:
     """One criterion run of the grading study, flattened: accepted n2D, first and last trial."""
     res = row.get("results") or {}
     ok = row.get("status") == "done" and bool(res.get("converged"))
-    return {
+    return SeedRecord.from_dict({
         "grading": grading["label"],
         "cu": grading["cu"],
         "seed": seed,
@@ -236,16 +245,29 @@ def seed_record(row: dict, grading: dict, seed: int) -> dict:
         "accepted_self_weight_n_per_m": res.get("self_weight_n_per_m") if ok else None,
         "message": res.get("message") or row.get("error"),
         "time_s": row.get("time_s"),
-    }
+    })  # fmt: skip
 
 
-def grading_points(records: list[dict], grads: list[dict]) -> list[dict]:
+#: the per-seed quantities a grading point averages: its key prefix, the seed record's key
+AVERAGED = (
+    ("measured", "accepted_measured_n2d"),
+    ("interior", "accepted_interior_porosity"),
+    ("first_f_top", "first_f_top_n_per_m"),
+    ("first_g", "first_self_weight_n_per_m"),
+    ("first_f_top_over_g", "first_f_top_over_g"),
+    ("first_n_prime", "first_new_porosity"),
+    ("accepted_f_top", "accepted_f_top_n_per_m"),
+)
+
+
+def grading_points(records: list[SeedRecord], grads: list[GradingDescription]) -> list[GradingPoint]:
     """One point per grading: accepted n2D and first-trial forces over its seeds."""
     pts = []
     for g in grads:
         recs = [r for r in records if r["grading"] == g["label"]]
         acc = finite_mean_sd([r["accepted_n2d"] for r in recs])
-        pts.append({
+        means = {name: finite_mean_sd([r.get(key) for r in recs]) for name, key in AVERAGED}
+        pts.append(GradingPoint.from_dict({
             "axis": "grading",
             "label": g["label"],
             "cu": g["cu"],
@@ -258,37 +280,27 @@ def grading_points(records: list[dict], grads: list[dict]) -> list[dict]:
             "seeds": len(recs),
             "unconverged": len(recs) - acc["n"],
             "quantity": "accepted trial n2D",
-            **_prefixed("measured", finite_mean_sd([r["accepted_measured_n2d"] for r in recs])),
-            **_prefixed("interior", finite_mean_sd([r.get("accepted_interior_porosity") for r in recs])),
-            **_prefixed("first_f_top", finite_mean_sd([r["first_f_top_n_per_m"] for r in recs])),
-            **_prefixed("first_g", finite_mean_sd([r["first_self_weight_n_per_m"] for r in recs])),
-            **_prefixed("first_f_top_over_g", finite_mean_sd([r["first_f_top_over_g"] for r in recs])),
-            **_prefixed("first_n_prime", finite_mean_sd([r["first_new_porosity"] for r in recs])),
-            **_prefixed("accepted_f_top", finite_mean_sd([r["accepted_f_top_n_per_m"] for r in recs])),
+            **{f"{name}_{stat}": getattr(m, stat) for name, m in means.items() for stat in ("mean", "sd")},
             "first_trial_porosity": next((r["first_trial_porosity"] for r in recs), None),
-        })  # fmt: skip
+        }))  # fmt: skip
     return pts
 
 
-def _prefixed(name: str, s: dict) -> dict:
-    return {f"{name}_mean": s["mean"], f"{name}_sd": s["sd"]}
-
-
-def mu_points(cal: dict) -> list[dict]:
+def mu_points(cal: dict) -> list[MuPoint]:
     """One point per preparation friction, from a calibration's samples (n' per seed)."""
     pts = []
     for mu, samples in zip(cal["mus"], cal["samples"], strict=True):
         s = finite_mean_sd(samples)
-        pts.append({
-            "axis": "mu_prep", "label": f"mu_prep {mu:g}", "mu_prep": mu,
-            "n2d_mean": s["mean"], "n2d_sd": s["sd"], "n": s["n"], "seeds": len(samples),
-            "unconverged": len(samples) - s["n"], "quantity": "n' of the accepted trial (first trial 0.19)",
-        })  # fmt: skip
+        pts.append(MuPoint(
+            axis="mu_prep", label=f"mu_prep {mu:g}", mu_prep=mu,
+            n2d_mean=s.mean, n2d_sd=s.sd, n=s.n, seeds=len(samples),
+            unconverged=len(samples) - s.n, quantity="n' of the accepted trial (first trial 0.19)",
+        ))  # fmt: skip
     return pts
 
 
 # -------------------------------------------------------------------------------- answer
-def closest_match(points: list[dict], x: str, target: float, tol: float = MATCH_TOLERANCE) -> dict:
+def closest_match(points: list[dict], x: str, target: float, tol: float = MATCH_TOLERANCE) -> Match:
     """Points within ``tol`` of ``target``, the closest point, and where the means cross it.
 
     ``x`` names the swept quantity. The crossing is a linear interpolation between two
@@ -296,7 +308,7 @@ def closest_match(points: list[dict], x: str, target: float, tol: float = MATCH_
     """
     good = sorted((p for p in points if math.isfinite(p["n2d_mean"])), key=lambda p: p[x])
     if not good:
-        return {"matches": [], "closest": None, "distance": None, "crossing": None}
+        return Match.from_dict({"matches": [], "closest": None, "distance": None, "crossing": None})
     best = min(good, key=lambda p: abs(p["n2d_mean"] - target))
     crossing = None
     for a, b in zip(good, good[1:], strict=False):
@@ -304,7 +316,7 @@ def closest_match(points: list[dict], x: str, target: float, tol: float = MATCH_
         if ya * yb <= 0.0 and ya != yb:
             crossing = a[x] + (b[x] - a[x]) * ya / (ya - yb)
             break
-    return {
+    return Match.from_dict({
         "matches": [p[x] for p in good if abs(p["n2d_mean"] - target) <= tol + 1e-12],
         "closest": best[x],
         "closest_mean": best["n2d_mean"],
@@ -313,7 +325,7 @@ def closest_match(points: list[dict], x: str, target: float, tol: float = MATCH_
         "distance": best["n2d_mean"] - target,
         "crossing": crossing,
         "ends": [[good[0][x], good[0]["n2d_mean"]], [good[-1][x], good[-1]["n2d_mean"]]],
-    }
+    })  # fmt: skip
 
 
 def _pm(p_mean: float, sd: float, n: int) -> str:
@@ -340,7 +352,7 @@ def _axis_text(name: str, unit: str, m: dict, points: list[dict], x: str, target
     return text + "."
 
 
-def answer(sens: dict, tol: float = MATCH_TOLERANCE) -> dict:
+def answer(sens: dict, tol: float = MATCH_TOLERANCE) -> Answer:
     """Which grading width and which mu_prep accept the paper's n2D, from the measured points."""
     paper = sens["paper"]
     target = float(paper["accepted_porosity"])
@@ -367,7 +379,7 @@ def answer(sens: dict, tol: float = MATCH_TOLERANCE) -> dict:
     unconv = sum(p["unconverged"] for p in g_pts + sens["points"]["mu_prep"])
     if unconv:
         lines.append(f"{unconv} seed(s) did not converge; they are counted, not averaged.")
-    return {"target": target, "tolerance": tol, "grading": g, "mu_prep": mu, "lines": lines}
+    return Answer(target=target, tolerance=tol, grading=g, mu_prep=mu, lines=lines)
 
 
 def _protocol_lines(sens: dict, ref: dict | None) -> list[str]:
@@ -383,7 +395,8 @@ def _protocol_lines(sens: dict, ref: dict | None) -> list[str]:
         return []
     # each trial is a fresh specimen seeded by the seed and the trial porosity: where the two
     # protocols reach the same trial porosity they prepare the same specimen
-    first = first_trial(with_density_defaults(sens.get("config") or {})["criterion"], mu0)
+    study = with_density_defaults(CriterionBase(sens.get("config") or {}))
+    first = first_trial(study.table("criterion"), mu0)
     return [
         f"At mu_prep = {mu0:g} the measured porosity n' of the accepted trial is {a:.4f} starting from "
         f"the first trial {ref['first_trial_porosity']:g} and {b:.4f} starting from {first:g} (the "
@@ -408,11 +421,9 @@ def _first_trial_lines(ref: dict | None, paper: dict) -> list[str]:
 
 
 # ----------------------------------------------------------------------------------- run
-@holds_output("out")
 def run_sensitivity(
-    base: dict,
-    base_dir: Path | None,
-    out: Path,
+    base: CriterionBase,
+    store: Store | None = None,
     *,
     quick: bool = False,
     seeds: int | None = None,
@@ -420,10 +431,11 @@ def run_sensitivity(
     announce=None,
     **sweep_kw,
 ) -> SensitivityResult:
-    """The whole study into ``out``; returns the :class:`SensitivityResult` of ``out/sensitivity.json``.
+    """The whole study into ``store``; returns the :class:`SensitivityResult` of its ``sensitivity.json``.
 
-    ``base``: a criterion config, optionally with a ``[sensitivity]`` table (``cu``,
-    ``mu_prep``, ``seeds``). Everything is checked before the first case runs; ``announce``
+    ``base``: a criterion config as read, optionally with a ``[sensitivity]`` table (``cu``,
+    ``mu_prep``, ``seeds``); ``store``: where the study is kept (None: nothing is kept but
+    the shared calibration cache). Everything is checked before the first case runs; ``announce``
     (no arguments) is called then, before any work.
     ``sweep_kw``: ``scheduler``, ``workers``, ``client``, ``progress`` of the sweep runner.
     """
@@ -431,37 +443,48 @@ def run_sensitivity(
     from poro2d.execute.cluster_options import check_cluster_options
     from poro2d.execute.dask_cluster import check_reachable
     from poro2d.sweep import density as D
-    from poro2d.sweep.cases import parse_sweep
-    from poro2d.sweep.runner import run_sweep
 
+    if store is not None:
+        check_output_dir(store.parameter, store.root)
     if sweep_kw.get("client") is None:
         check_cluster_options(sweep_kw.get("scheduler"), sweep_kw.get("workers"))
-    settings = study_settings(base.get("sensitivity"), quick=quick, seeds=seeds)
-    cfg = study_base(base, quick=quick)
-    _, _, crit, _ = build(copy.deepcopy(cfg), base_dir)
-    cases = gradings(cfg, base_dir, settings["cus"])
-    check_gradings(cfg, base_dir, cases)
-    sweep = parse_sweep(grading_sweep(cfg, cases, settings["seeds"]), base_dir)
-    parse_sweep(D.calibration_sweep(cfg, settings["mus"], settings["seeds"]), base_dir)  # checked now
+    settings = study_settings(base.config.get("sensitivity"), quick=quick, seeds=seeds)
+    study = study_base(base, quick=quick)
+    _, _, crit, _ = build(study.as_config(), study.base_dir)
+    cases = gradings(study, settings["cus"])
+    check_gradings(study, cases)
+    sweep = grading_sweep(study, cases, settings["seeds"])
+    # the friction axis is the density calibration, with its settings (layers that settle):
+    # the same cases as the relation's, read back from the shared cache when it ran them
+    calibration = D.CalibrationCase(D.with_density_defaults(study), tuple(settings["mus"]), settings["seeds"])
+    calibration.sweep  # noqa: B018 (its cases are built, so checked, now)
     check_reachable(sweep_kw.get("scheduler"))
     if announce is not None:
         announce()
+    with held(store, kind="sensitivity") as kept:
+        return _run_study(study, crit, cases, sweep, calibration, settings, kept, use_cache=use_cache,
+                          **sweep_kw)  # fmt: skip
+
+
+def _run_study(study: CriterionBase, crit, cases: list[GradingCase], sweep: SweepConfig, calibration,
+               settings: dict, store: Store, *, use_cache: bool,
+               **sweep_kw) -> SensitivityResult:  # fmt: skip
+    """The grading sweep, the calibration, and the study's record of both (checked inputs)."""
+    from poro2d.sweep import density as D
+    from poro2d.sweep.runner import run_sweep
 
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
-    res = run_sweep(sweep, out / "grading", **sweep_kw)
+    res = run_sweep(sweep, store.child("grading"), **sweep_kw)
     timings["grading_s"] = time.perf_counter() - t0
     t1 = time.perf_counter()
-    # the friction axis is the density calibration, with its settings (layers that settle):
-    # the same cases as the relation's, read back from the shared cache when it ran them
-    cal, cal_info = D.calibrate(D.with_density_defaults(cfg), base_dir, out / "mu_prep", mus=settings["mus"],
-                                seeds=settings["seeds"], use_cache=use_cache, **sweep_kw)  # fmt: skip
+    cal, cal_info = D.calibrate(calibration, store.child("mu_prep"), use_cache=use_cache, **sweep_kw)
     timings["mu_prep_s"] = time.perf_counter() - t1
 
     grads = [g.describe() for g in cases]
     labels = [(g, s) for g in grads for s in range(settings["seeds"])]
     records = [seed_record(r, g, s) for r, (g, s) in zip(res.rows, labels, strict=True)]
-    spec = cfg.get("specimen") or {}
+    spec = study.table("specimen")
     sens = {
         "title": "accepted n2D against grading width and preparation friction (paper protocol)",
         "settings": dict(
@@ -475,34 +498,33 @@ def run_sensitivity(
         "gradings": grads,
         "seeds": records,
         "points": {"grading": grading_points(records, grads), "mu_prep": mu_points(cal.to_dict())},
-        "calibration": dict(cal.to_dict(), **cal_info),
+        "calibration": dict(cal.to_dict(), **cal_info.to_dict()),
         "paper": paper_numbers(),
-        "config": cfg,
+        "config": study.as_config(),
         "sweeps": {"grading": res.summary, "failed_cases": len(res.failed)},
         "timings": timings,
     }
     sens["answer"] = answer(sens)
     timings["total_s"] = time.perf_counter() - t0
-    return write_sensitivity(sens, out)
+    return write_sensitivity(sens, store)
 
 
 def _first_from(crit) -> str:
     return "given" if crit.trial_porosity is not None else "Eq. 12"
 
 
-def write_sensitivity(sens: dict, out: Path) -> SensitivityResult:
+def write_sensitivity(sens: dict, store: Store) -> SensitivityResult:
     """sensitivity.json, sensitivity.csv (points), sensitivity_seeds.csv and the figure; the study typed."""
-    from poro2d.io_utils import provenance, write_csv, write_json
+    from poro2d.io_utils import provenance
     from poro2d.report.sensitivity_report import plot_sensitivity
 
-    out.mkdir(parents=True, exist_ok=True)
-    figs = plot_sensitivity(sens, out / "sensitivity")
+    figs = plot_sensitivity(sens, store.path("sensitivity"))
     sens = dict(sens, figure=str(figs[0]), provenance=provenance())
-    write_csv(out / "sensitivity_seeds.csv", sens["seeds"])
+    store.write_csv("sensitivity_seeds.csv", sens["seeds"])
     points = sens["points"]["grading"] + sens["points"]["mu_prep"]
-    write_csv(out / "sensitivity.csv", [_csv_row(p, sens) for p in points])
+    store.write_csv("sensitivity.csv", [_csv_row(p, sens) for p in points])
     result = SensitivityResult.from_dict(sens)
-    write_json(out / "sensitivity.json", result.to_dict())
+    store.write_result("sensitivity.json", result)
     return result
 
 
@@ -515,15 +537,12 @@ def _csv_row(p: dict, sens: dict) -> dict:
     return row
 
 
-def load_sensitivity(folder: Path) -> SensitivityResult:
-    """A finished study read back, its figure path pointing into ``folder``."""
-    import json
-
-    p = Path(folder) / "sensitivity.json"
-    if not p.is_file():
-        raise InputError("sensitivity", str(folder), "a folder holding sensitivity.json")
-    sens = SensitivityResult.from_dict(json.loads(p.read_text()))
-    sens.figure = str(Path(folder) / "sensitivity.png")
+def load_sensitivity(store: Store) -> SensitivityResult:
+    """A finished study read back, its figure path pointing into ``store``."""
+    sens = store.read_result("sensitivity.json", SensitivityResult.from_dict)
+    if sens is None:
+        raise InputError("sensitivity", str(store.root), "a folder holding sensitivity.json")
+    sens.figure = str(store.path("sensitivity.png"))
     return sens
 
 

@@ -1,0 +1,286 @@
+"""The typed parts of the sweeps' result files: summaries, fits, points, answers.
+
+A result file of the sweeps (``sweep.json``, ``relation.json``, ``density.json``,
+``sensitivity.json``) nests records of a known shape: a sweep's summary, the parabola
+fitted to a relation, one point per laboratory state, the answer of the sensitivity study.
+Each is a :class:`~poro2d.typed_result.TypedResult` here, its fields the record's keys in
+the file's order, so it is written and read back with exactly the keys it had, and still
+reads as the dict it was (``fit["a"]``). A result holding parts is a :class:`WithParts`:
+``PARTS`` names the fields that are parts and how each is read from its file.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any, ClassVar, Self
+
+from poro2d.typed_result import TypedResult
+
+Decode = Callable[[Any], Any]
+
+
+def part(cls: type[TypedResult]) -> Decode:
+    """How a field holding one ``cls`` record is read from its file."""
+    return cls.from_dict
+
+
+def parts(cls: type[TypedResult]) -> Decode:
+    """How a field holding a list of ``cls`` records is read from its file."""
+    return lambda items: [cls.from_dict(x) for x in items]
+
+
+def plain(value: Any) -> Any:
+    """``value`` as its file holds it: typed parts as dicts (also inside lists and dicts)."""
+    if isinstance(value, TypedResult):
+        return value.to_dict()
+    if isinstance(value, list):
+        return [plain(v) for v in value]
+    if isinstance(value, dict):
+        return {k: plain(v) for k, v in value.items()}
+    return value
+
+
+@dataclass(eq=False)
+class WithParts(TypedResult):
+    """A typed result some of whose fields are typed parts (``PARTS``: field -> decoder)."""
+
+    PARTS: ClassVar[Mapping[str, Decode]] = {}
+
+    def to_dict(self) -> dict[str, Any]:
+        """The file's keys and values, every part as the dict its file holds."""
+        return {k: plain(v) if k in self.PARTS else v for k, v in super().to_dict().items()}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Self:
+        """The result of a file's dict (or of a result's), every part read as its record."""
+        decoded = {k: cls.PARTS[k](v) if k in cls.PARTS and v is not None else v for k, v in data.items()}
+        return super().from_dict(decoded)
+
+
+@dataclass(eq=False)
+class CaseRow(TypedResult):
+    """A case's row (its ``result.json``, or its ``error.json`` when it raised on a worker).
+
+    Where and when it ran, ``status`` (done or failed), the error, and ``results``: the
+    case kind's scalars, the cells of the sweep's table. A row in memory may carry labels
+    that are not in the file (``reused``: read back, not run), kept as ``extra``.
+    """
+
+    case_id: str
+    kind: str
+    params: dict[str, Any]
+    host: str | None = None
+    pid: int | None = None
+    worker: str | None = None
+    started_utc: str | None = None
+    status: str | None = None
+    error: str | None = None
+    time_s: float | None = None
+    finished_utc: str | None = None
+    results: dict[str, Any] | None = None
+
+
+@dataclass(eq=False)
+class LostCaseRow(TypedResult):
+    """The row of a case whose task failed outside the case (its worker lost): its ``error.json``."""
+
+    case_id: str
+    kind: str
+    params: dict[str, Any]
+    status: str
+    error: str
+    time_s: float | None
+    results: dict[str, Any]
+    host: str | None
+    pid: int | None
+    worker: str | None
+    finished_utc: str
+
+
+@dataclass(eq=False)
+class CaseEntry(TypedResult):
+    """A case as ``sweep.json`` lists it: its id (its folder's name) and its parameters."""
+
+    id: str
+    params: dict[str, Any]
+
+
+@dataclass(eq=False)
+class SweepSummary(TypedResult):
+    """A sweep's counts and times (``summary`` of ``sweep.json``).
+
+    ``parallel_efficiency``: busy case time over wall time and worker threads (when a
+    cluster ran cases); ``from_calibration``: the state checks read back from the
+    calibration's cases (a relation's ``states_summary``).
+    """
+
+    cases: int | None = None
+    ran: int | None = None
+    reused: int | None = None
+    done: int | None = None
+    failed: int | None = None
+    wall_time_s: float | None = None
+    case_time_sum_s: float | None = None
+    worker_processes: list[str] | None = None
+    parallel_efficiency: float | None = None
+    from_calibration: int | None = None
+
+
+@dataclass(eq=False)
+class CalibrationRun(WithParts):
+    """Where a calibration's cases are and how many ran (``sweeps.calibration`` of a relation).
+
+    ``key``: the digest naming its cache entry; ``cases``: the folder of its sweep;
+    ``source``: "computed" when a case ran, else "cache"; ``interior``: the accepted
+    specimens' interior porosity per friction and seed (only for calibrations whose first
+    trials follow the grading, see :class:`~poro2d.sweep.density.CalibrationCase`);
+    ``summary`` and ``failed``: its sweep's summary and failed cases.
+    """
+
+    OPTIONAL = ("interior",)
+    PARTS = {"summary": part(SweepSummary)}
+
+    key: str
+    cases: str
+    ran: int
+    reused: int
+    source: str
+    interior: list[list[float | None]] | None = None
+    summary: SweepSummary | None = None
+    failed: int | None = None
+
+
+@dataclass(eq=False)
+class DensitySweeps(WithParts):
+    """The two sweeps of density mode: the calibration's, the state checks' and their failures."""
+
+    PARTS = {"calibration": part(CalibrationRun), "states_summary": part(SweepSummary)}
+
+    calibration: CalibrationRun
+    states_summary: SweepSummary
+    failed_cases: int
+
+
+@dataclass(eq=False)
+class QuadraticFit(TypedResult):
+    """n2D = a nLab^2 + b nLab fitted by least squares (no constant: through the origin).
+
+    ``residuals``: data minus fit per point; ``r2``: about the mean (None for equal values).
+    """
+
+    a: float
+    b: float
+    points: int
+    residuals: list[float]
+    rms_residual: float
+    max_abs_residual: float
+    r2: float | None
+    form: str
+
+
+@dataclass(eq=False)
+class Spread(TypedResult):
+    """The loosest minus the densest converged state of a relation, measured (not a fit).
+
+    The same for the interior porosity (the packing's own, no gap under the plate);
+    ``monotone``: n2D never rises from loose to dense.
+    """
+
+    loose_n_lab: float
+    dense_n_lab: float
+    n2d_loose_minus_dense: float
+    sd: float
+    monotone: bool
+    interior_loose_minus_dense: float | None = None
+    interior_sd: float | None = None
+    interior_monotone: bool | None = None
+
+
+@dataclass(eq=False)
+class PaperPoint(TypedResult):
+    """One laboratory state of a paper-mode relation: its case, the criterion's n2D, the methods.
+
+    ``n2d_dem``: the accepted n2D, else the last estimate n' (``flag`` says which) or NaN for
+    a failed case; ``n2d_<method>``: the conversions compared; ``n2d_fit``, ``residual``:
+    the fitted parabola there and the point's distance from it.
+    """
+
+    case_id: str
+    n_lab: float
+    relative_density: float
+    degree_of_density: float
+    n2d_dem: float
+    converged: bool
+    flag: str
+    iterations: int | None
+    initial_trial_porosity: float | None
+    particle_count: int | None
+    message: str | None
+    n2d_parabolic: float
+    n2d_lim_3d: float
+    n2d_lim_lab: float
+    n2d_densest_state: float
+    n2d_fit: float | None = None
+    residual: float | None = None
+    dem_minus_parabola: float | None = None
+
+
+@dataclass(eq=False)
+class DensityPoint(TypedResult):
+    """One laboratory state of a density-mode relation: its target, friction and n2D over seeds.
+
+    ``n2d_dem``: the mean accepted n2D of the converged seeds (``n2d_seeds`` each);
+    ``n2d_measured``: the mean measured n' of those trials; ``n2d_interior``: the mean
+    interior porosity of their specimens.
+    """
+
+    n_lab: float
+    relative_density: float
+    degree_of_density: float
+    n2d_target: float
+    mu_prep: float
+    n2d_dem: float
+    n2d_sd: float
+    n2d_seeds: list[float]
+    n2d_measured: float
+    n2d_measured_sd: float
+    n2d_interior: float | None
+    n2d_interior_sd: float | None
+    n2d_interior_seeds: list[float] | None
+    seeds: int
+    seeds_converged: int
+    converged: bool
+    flag: str
+    message: str
+    n2d_parabolic: float
+    n2d_lim_3d: float
+    n2d_lim_lab: float
+    n2d_densest_state: float
+    n2d_fit: float | None = None
+    residual: float | None = None
+    dem_minus_parabola: float | None = None
+
+
+def relation_points(items: list[Mapping[str, Any]]) -> list[PaperPoint | DensityPoint]:
+    """A relation's points read from its file: a paper-mode point names its case, a density one not."""
+    return [(PaperPoint if "case_id" in p else DensityPoint).from_dict(p) for p in items]
+
+
+__all__ = [
+    "CalibrationRun",
+    "CaseEntry",
+    "CaseRow",
+    "LostCaseRow",
+    "DensityPoint",
+    "DensitySweeps",
+    "PaperPoint",
+    "QuadraticFit",
+    "Spread",
+    "SweepSummary",
+    "WithParts",
+    "part",
+    "parts",
+    "plain",
+    "relation_points",
+]
