@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 import poro2d
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "api.md"
@@ -22,6 +24,7 @@ def test_the_block_pattern_finds_python_only():
     assert python_blocks(text) == ["a = 1\n", "b = 2\n"]
 
 
+@pytest.mark.scenario  # the examples run a quick paper case and a quick relation
 def test_every_example_runs(tmp_path):
     blocks = python_blocks(DOC.read_text())
     assert len(blocks) >= 5

@@ -301,12 +301,12 @@ def test_a_bad_dashboard_address_is_refused_before_any_work(tmp_path, capsys):
 # ------------------------------------------------------- criteria: one folder, export of a refusal
 @pytest.fixture(scope="module")
 def criterion_reference(tmp_path_factory):
-    """One undisturbed criterion run of the tiny specimen."""
+    """One undisturbed criterion run of the tiny specimen, in this process: only the run it is
+    compared with needs a process of its own (its lock is what the second run meets)."""
     tmp = tmp_path_factory.mktemp("reference")
     cfg = tmp / "tiny.toml"
     cfg.write_text(TINY_SPECIMEN)
-    rc, err = _finish(_poro2d("criterion", "--config", cfg, "--out", tmp / "crit", "--quiet", env=_env()))
-    assert rc == 0, err
+    main(["criterion", "--config", str(cfg), "--out", str(tmp / "crit"), "--quiet"])  # raises on failure
     return cfg, tmp / "crit"
 
 

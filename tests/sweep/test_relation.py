@@ -188,6 +188,7 @@ def test_density_states_are_averaged_over_seeds_and_the_spread_is_measured():
     assert rel["mode"] == "density" and rel["n2d_min"] == pytest.approx(0.171)
 
 
+@pytest.mark.scenario  # three relations end to end, each with its calibration and Dask cluster
 def test_density_relation_command_on_tiny_specimens(tmp_path, monkeypatch):
     """Calibration, mapping and checks end to end; the calibration is reused from the cache."""
     monkeypatch.setenv("PORO2D_CACHE", str(tmp_path / "cache"))

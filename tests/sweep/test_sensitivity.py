@@ -189,6 +189,7 @@ def test_command_refuses_bad_input_before_anything_runs(tmp_path, capsys):
     assert ei.value.code == 2 and not (tmp_path / "o").exists()
 
 
+@pytest.mark.scenario  # 10 criterion runs and a calibration on a Dask cluster, then the rerun
 def test_command_end_to_end_on_tiny_specimens(tmp_path, monkeypatch):
     monkeypatch.setenv("PORO2D_CACHE", str(tmp_path / "cache"))
     cfg = tmp_path / "s.toml"
