@@ -40,7 +40,9 @@ def test_a_design_that_fits_the_surrogate_exactly_is_refused_before_any_test(spe
     shutil.copyfile(specimen, other)
     out = tmp_path / "out"
     with pytest.raises(InputError, match="--points"):
-        run_calibration(lab, [specimen, other], store=Store(out), points=points, settings=SHORT, progress=False)
+        run_calibration(
+            lab, [specimen, other], store=Store(out), points=points, settings=SHORT, progress=False
+        )
     assert not (out / "cache").exists()
 
 

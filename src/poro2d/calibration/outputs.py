@@ -73,7 +73,9 @@ def _config(result, lab) -> str:
     if result.unidentified is None:
         fp_lo, fp_hi = result.intervals["particle_friction"]
         mr_lo, mr_hi = result.intervals["rolling_friction"]
-        known = f"{result.level:.0%} intervals: f_p {fp_lo:.3g} to {fp_hi:.3g}, mu_r {mr_lo:.3g} to {mr_hi:.3g}"
+        known = (
+            f"{result.level:.0%} intervals: f_p {fp_lo:.3g} to {fp_hi:.3g}, mu_r {mr_lo:.3g} to {mr_hi:.3g}"
+        )
     else:
         known = f"NOT IDENTIFIED, intervals unknown: {result.unidentified}"
     lines = [

@@ -140,5 +140,11 @@ def preset_specimens(
     return specimens
 
 
-__all__ = ["GRADING_P_VALUE", "MAX_REPLICATES", "check_preset", "check_replicates", "given_specimens",
-           "preset_specimens"]
+__all__ = [
+    "GRADING_P_VALUE",
+    "MAX_REPLICATES",
+    "check_preset",
+    "check_replicates",
+    "given_specimens",
+    "preset_specimens",
+]
