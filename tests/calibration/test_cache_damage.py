@@ -38,6 +38,13 @@ def test_a_file_where_the_tests_folder_belongs_is_refused_naming_it(tmp_path):
     assert unit.key in str(exc.value) and len(str(exc.value).splitlines()) == 1
 
 
+def test_a_file_where_the_cache_belongs_is_refused_naming_it(tmp_path):
+    (tmp_path / "cache").write_text("junk")
+    with pytest.raises(InputError, match="a file") as exc:
+        check_entry(_unit(), Store(tmp_path / "cache"))
+    assert str(tmp_path / "cache") in str(exc.value)
+
+
 @pytest.mark.parametrize("damage", ["edit", "truncate"])
 def test_a_changed_file_of_the_entry_is_refused_naming_it(tmp_path, damage):
     cache = Store(tmp_path / "cache")

@@ -261,7 +261,14 @@ def run_calibration(
         check_range_pair("--fp-range", fp_range, 0.0, MAX_FRICTION, lo_open=True),
         check_range_pair("--mu-r-range", mu_r_range, 0.0, 1.0),
     )
-    points = check_int("--points", points, MIN_POINTS, MAX_POINTS)
+    try:
+        points = check_int("--points", points, MIN_POINTS, MAX_POINTS)
+    except InputError:
+        raise InputError(
+            "--points", points, f"an integer in [{MIN_POINTS}, {MAX_POINTS}]",
+            f"the surrogate's {model.N_COEFFICIENTS} coefficients and {RESIDUAL_DOF} degrees of freedom"
+            " to estimate its residual",
+        ) from None  # fmt: skip
     refine = check_int("--refine", refine, 0, MAX_POINTS)
     design_seed = check_int("--design-seed", design_seed, 0)
     check_range("--lab-error", lab_error, 0.0, 1.0)

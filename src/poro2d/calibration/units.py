@@ -132,13 +132,18 @@ def check_entry(unit: CalibrationUnit, cache: Store | None) -> None:
     would fail the test on its worker, and a calibration must not answer without it.
     """
     store = unit.store(cache)
-    if store is None or not store.root.exists():
+    if store is None:
         return
-    if not store.root.is_dir():
-        raise InputError(
-            str(store.root), "a file", "a folder of the calibration's cache (one shear test)",
-            "delete it to have the test computed again",
-        )  # fmt: skip
+    for folder, what in (
+        (cache.root, "the calibration's cache"),
+        (store.root, "one shear test of the cache"),
+    ):
+        if folder.exists() and not folder.is_dir():
+            raise InputError(
+                str(folder), "a file", f"a folder ({what})", "delete it to have the tests computed again"
+            )
+    if not store.root.exists():
+        return
     for name in store.names():
         if store.has(name):
             store.check_intact(name)
