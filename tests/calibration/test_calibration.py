@@ -113,14 +113,14 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     paths, lab = tiny
     assert lab.read_text().startswith("# SYNTHETIC")
     out = tmp_path / "cal"
-    res = run_calibration(lab, [paths[0], paths[1]], store=Store(out), points=8, refine=2, settings=SHORT,
+    res = run_calibration(lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2, settings=SHORT,
                           workers=1, dashboard=None, progress=False)  # fmt: skip
     for name, value in TRUTH.items():
         lo, hi = res.intervals[name]
         assert lo <= value <= hi, (name, value, lo, hi)
         assert lo <= res.posterior["median"][name] <= hi
     assert res == json.loads((out / "result.json").read_text())
-    assert len(res.evaluations) == 10 and res.cluster.tests_run == 10 * 2 * 2
+    assert len(res.evaluations) == 11 and res.cluster.tests_run == 11 * 2 * 2
     assert {o["observable"] for o in res.posterior["observables"]} == {"peak", "end"}
     for f in ("calibration_fit.png", "calibration_posterior.png", "calibration.md", "calibration.html"):
         assert (out / f).stat().st_size > 0, f
@@ -140,14 +140,14 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     table, _ = load_shear_config(out / "calibrated.toml")
     assert table["particle_friction"] == res.best["particle_friction"]
     assert table["rolling_friction"] == res.best["rolling_friction"]
-    again = run_calibration(lab, [paths[0], paths[1]], store=Store(out), points=8, refine=2, settings=SHORT,
+    again = run_calibration(lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2, settings=SHORT,
                             workers=1, dashboard=None, progress=False)  # fmt: skip
-    assert again.cluster.tests_run == 0 and again.cluster.tests_reused == 40
+    assert again.cluster.tests_run == 0 and again.cluster.tests_reused == 44
     assert again.best == res.best
     # a weaker 'laboratory' (the same specimen at lower frictions) moves the answer to weaker
     # parameters: the calibration follows its data (round 1 comes from the cache)
     weak_lab = synthetic_lab(paths[2], [50, 100], 0.3, 0.0, tmp_path / "weak.csv", settings=SHORT)
-    weak = run_calibration(weak_lab, [paths[0], paths[1]], store=Store(out), points=8, refine=2,
+    weak = run_calibration(weak_lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2,
                            settings=SHORT, workers=1, dashboard=None, progress=False)  # fmt: skip
     peaks = {
         o["normal_stress_kpa"]: o["model_kpa"]

@@ -43,6 +43,10 @@ FILES: dict[str, str | bytes] = {
     "lab_binary.csv": b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR",
     "lab_latin1.csv": b"normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,\xe9\n",
     "lab_wide.csv": "normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,75,3\n",
+    "lab_ok.csv": "normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,75\n",
+    # beside the specimens that were not accepted (written by _write_files)
+    "refused/trial.json": '{"accepted": false}',
+    "unconverged/result.json": '{"converged": false, "iterations": []}',
     "shear_empty_item.toml": "[shear]\nnormal_stress_kpa = [50, 1e9]\n",
     "relation_number.toml": "relation = 5\n",
     "density_list.toml": "density = [1, 2]\n",
@@ -167,6 +171,13 @@ CASES = [
     (["shear", "-s", "{d}/sp.npz", "-c", "{d}/gap.toml"], ["gap = 0.05", "0.025]"]),
     (["shear", "-s", "{d}/sp.npz", "-c", "{d}/friction.toml"], ["friction_wall = 1e+300", "10.0]"]),
     (["shear", "-s", "{d}/sp.npz", "--normal-stress", "1e9"], ["--normal-stress = '1e9'"]),
+    # only specimens the criterion accepted are sheared: a refused trial's, an unconverged criterion's
+    (["shear", "-s", "{d}/refused/after_plate.npz"], ["trial.json says accepted = False"]),
+    (["shear", "-s", "{d}/unconverged"], ["result.json says converged = False"]),
+    (["strength", "{d}/sp.npz", "{d}/refused/after_plate.npz"], ["refused/after_plate.npz", "accepted"]),
+    (["strength", "{d}/unconverged"], ["converged = False"]),
+    (["calibrate", "--lab", "{d}/lab_ok.csv", "-s", "{d}/refused/after_plate.npz"], ["accepted = False"]),
+    (["calibrate", "--lab", "{d}/lab_ok.csv", "-s", "{d}/sp.npz", "-s", "{d}/unconverged"], ["converged"]),
     (["convert", "--dry-density", "1600", "--solid-density", "1e300"], ["--solid-density = 1e+300", "23000"]),
     # usage errors of the option parser: one line too
     (["shear", "--stop-after-peak", "abc"], ["--stop-after-peak = 'abc'", "a valid number"]),
@@ -213,6 +224,8 @@ def _write_files(folder) -> None:
             path.write_bytes(content)
         else:
             path.write_text(content, encoding="utf-8")
+    _specimen(folder / "refused" / "after_plate.npz")
+    _specimen(folder / "unconverged" / "specimen.npz")
 
 
 def _specimen(path) -> None:

@@ -10,7 +10,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-from poro2d.calibration.units import CalibrationUnit, UnitRow, compute_unit, stored_row
+from poro2d.calibration.units import CalibrationUnit, UnitRow, check_entry, compute_unit, stored_row
 from poro2d.execute import Backend, Executor, Failed, Job
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD
 from poro2d.store import Store
@@ -58,6 +58,7 @@ class UnitRunner:
         self.scheduler, self.workers, self.progress, self.dashboard = scheduler, workers, progress, dashboard
         self.executor = Executor(Backend.dask(scheduler, workers, dashboard=dashboard))
         self.failures: list[UnitFailure] = []
+        self.broken: set[str] = set()  # keys of units that failed for another reason than their test
         self.ran = self.reused = 0
         self.busy_s = 0.0
         self.wall_s = 0.0
@@ -71,6 +72,7 @@ class UnitRunner:
         for unit in units:
             row = stored_row(unit, cache)
             if row is None:
+                check_entry(unit, cache)  # a damaged entry is refused here, before any test runs
                 todo.append(unit)
             else:
                 rows[unit.key] = row
@@ -93,7 +95,24 @@ class UnitRunner:
             raise
         finally:
             self.wall_s += time.perf_counter() - t0
+        self._refuse_broken()
         return rows
+
+    def _refuse_broken(self) -> None:
+        """Refuse to go on when a unit failed for another reason than its test's outcome.
+
+        A test that finds no equilibrium fails alike in every run (a RuntimeError, left out of
+        the fit and said in ``failures``); any other error (a damaged cache entry, a lost
+        worker, a full disk) would leave the fit without a value an undamaged run has.
+        """
+        broken = [f for f in self.failures if f.key in self.broken]
+        if broken:
+            f = broken[0]
+            more = f" (and {len(broken) - 1} more)" if len(broken) > 1 else ""
+            raise RuntimeError(
+                f"the shear test {f.key} ({f.specimen} at {f.sigma:g} kPa, f_p {f.fp:g}, mu_r {f.mu_r:g})"
+                f" failed on a worker{more}: {f.error}; no answer is computed without it"
+            )
 
     def _take(self, unit: CalibrationUnit, outcome, rows: dict[str, UnitRow]) -> None:
         """A unit's row into ``rows``; a test that fails (no equilibrium) is left out of the fit, and said."""
@@ -103,6 +122,8 @@ class UnitRunner:
             self.ran += 1
             return
         exc = outcome.error
+        if type(exc) is not RuntimeError:  # not the test's own outcome (no equilibrium)
+            self.broken.add(unit.key)
         self.failures.append(
             UnitFailure(
                 key=unit.key,

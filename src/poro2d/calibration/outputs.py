@@ -70,12 +70,17 @@ def _config(result, lab) -> str:
         rolling_friction=b["rolling_friction"],
         normal_stress_kpa=lab.normal_stresses(),
     )
-    fp_lo, fp_hi = result.intervals["particle_friction"]
-    mr_lo, mr_hi = result.intervals["rolling_friction"]
+    if result.unidentified is None:
+        fp_lo, fp_hi = result.intervals["particle_friction"]
+        mr_lo, mr_hi = result.intervals["rolling_friction"]
+        known = (
+            f"{result.level:.0%} intervals: f_p {fp_lo:.3g} to {fp_hi:.3g}, mu_r {mr_lo:.3g} to {mr_hi:.3g}"
+        )
+    else:
+        known = f"NOT IDENTIFIED, intervals unknown: {result.unidentified}"
     lines = [
         "# poro2d calibrate: the posterior maximum of particle and rolling friction",
-        f"# ({result.level:.0%} intervals: f_p {fp_lo:.3g} to {fp_hi:.3g}, mu_r {mr_lo:.3g} to {mr_hi:.3g});"
-        " see result.json and calibration.md before using them",
+        f"# ({known}); see result.json and calibration.md before using them",
         "",
         "[specimen]",
         f"friction_particle = {_toml_value(b['particle_friction'])}",

@@ -13,13 +13,13 @@ from __future__ import annotations
 import os
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from poro2d.calibration import model
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
-from poro2d.calibration.specimens import check_preset, given_specimens, preset_specimens
+from poro2d.calibration.specimens import check_preset, check_replicates, given_specimens, preset_specimens
 from poro2d.calibration.units import CACHE, CalibrationUnit, UnitRow
 from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
@@ -40,8 +40,12 @@ DEFAULT_FP_RANGE = (0.3, 3.0)
 DEFAULT_MU_R_RANGE = (0.0, 0.5)
 #: most design points of a round (each is replicates x stresses shear tests)
 MAX_POINTS = 500
-#: the quadratic surrogate has 6 coefficients: fewer points leave it undetermined
-MIN_POINTS = model.N_COEFFICIENTS
+#: the degrees of freedom left to the surrogate's residual beyond its coefficients: with fewer,
+#: the quadratic passes (nearly) through every replicate mean and its misfit, one of the noise
+#: terms, cannot be estimated (six points fit its six coefficients exactly: a residual of zero)
+RESIDUAL_DOF = 3
+#: the fewest design points of the first round (the quadratic surrogate has 6 coefficients)
+MIN_POINTS = model.N_COEFFICIENTS + RESIDUAL_DOF
 #: the settings calibrated here: given ones would be overridden, so they are refused
 CALIBRATED = ("particle_friction", "rolling_friction")
 
@@ -121,6 +125,11 @@ class CalibrationResult(TypedResult):
     timings: dict[str, float]
     config: dict[str, Any]
     provenance: dict[str, Any]
+    #: why the intervals are unknown (then ``intervals`` and ``posterior["wide"]`` hold None);
+    #: absent from the file of a calibration whose design estimates its own noise
+    unidentified: str | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("unidentified",)
 
     def to_dict(self) -> dict[str, Any]:
         """The file's keys; the cluster and the failures as the dicts they are written as."""
@@ -252,7 +261,14 @@ def run_calibration(
         check_range_pair("--fp-range", fp_range, 0.0, MAX_FRICTION, lo_open=True),
         check_range_pair("--mu-r-range", mu_r_range, 0.0, 1.0),
     )
-    points = check_int("--points", points, MIN_POINTS, MAX_POINTS)
+    try:
+        points = check_int("--points", points, MIN_POINTS, MAX_POINTS)
+    except InputError:
+        raise InputError(
+            "--points", points, f"an integer in [{MIN_POINTS}, {MAX_POINTS}]",
+            f"the surrogate's {model.N_COEFFICIENTS} coefficients and {RESIDUAL_DOF} degrees of freedom"
+            " to estimate its residual",
+        ) from None  # fmt: skip
     refine = check_int("--refine", refine, 0, MAX_POINTS)
     design_seed = check_int("--design-seed", design_seed, 0)
     check_range("--lab-error", lab_error, 0.0, 1.0)
@@ -274,6 +290,7 @@ def run_calibration(
     from poro2d.dem.checkpoint import state_digest
 
     digests = {label: state_digest(path) for label, path in found.items()}
+    check_replicates(found, digests)
     runner = UnitRunner(scheduler, workers, progress=progress, dashboard=dashboard)
     stresses = lab_data.normal_stresses()
     cache = _child(store, CACHE)
@@ -350,11 +367,35 @@ def _infer(ranges, design, found, digests, base, rows: dict[str, UnitRow], targe
             )
         surrogates.append(model.fit_surrogate(unit[ok], values[ok, k]))
     lab_values = [y for *_, y in targets]
-    cov = model.noise_covariance(surrogates, model.seed_covariance(values), lab_values, lab_error)
-    post = model.posterior(ranges, surrogates, lab_values, cov)
-    post.noise_sd = np.sqrt(np.diag(cov)).tolist()
-    post.noise_correlation = (cov / np.sqrt(np.outer(np.diag(cov), np.diag(cov)))).round(3).tolist()
+    try:  # an overflow or a 0/0 here would end in a posterior of NaN read as an answer
+        with np.errstate(divide="raise", over="raise", invalid="raise"):
+            cov = model.noise_covariance(surrogates, model.seed_covariance(values), lab_values, lab_error)
+            post = model.posterior(ranges, surrogates, lab_values, cov)
+            post.noise_sd = np.sqrt(np.diag(cov)).tolist()
+            post.noise_correlation = (cov / np.sqrt(np.outer(np.diag(cov), np.diag(cov)))).round(3).tolist()
+    except (FloatingPointError, np.linalg.LinAlgError) as exc:
+        raise RuntimeError(f"the posterior cannot be computed ({exc}): no answer is reported") from None
+    if not np.isfinite(post.density).all():
+        raise RuntimeError("the posterior is not finite: no answer is reported")
     return post, surrogates, table
+
+
+def unidentified_reason(specimens: int, intervals: dict) -> str | None:
+    """Why the intervals of a calibration are unknown, or None when its design estimates its noise.
+
+    One specimen has no seed scatter: the noise would be the surrogate's residual alone and
+    the intervals would look narrow for want of a scatter, not for the data. An interval of
+    zero width on the grid (one grid cell) says the same of the noise from the model's side.
+    """
+    if specimens < 2:
+        return "one specimen: the seed scatter cannot be estimated, so the intervals are unknown"
+    for name, (lo, hi) in intervals.items():
+        if not lo < hi:
+            return (
+                f"the {name} interval has zero width ({lo:.3g} to {hi:.3g}): the noise is not"
+                " estimated, so the intervals are unknown"
+            )
+    return None
 
 
 def _result(
@@ -381,13 +422,17 @@ def _result(
         "rolling_friction": list(post.interval("mu_r", level)),
     }
     spans = {"particle_friction": ranges.fp, "rolling_friction": ranges.mu_r}
-    wide = {}
+    wide: dict[str, bool | None] = {}
+    unknown = unidentified_reason(len(found), intervals)
     for name, (lo, hi) in intervals.items():
         r_lo, r_hi = spans[name]
         if name == "particle_friction":  # the fraction of the range in the coordinate searched: log f_p
             wide[name] = bool(np.log(hi / lo) > model.WIDE_FRACTION * np.log(r_hi / r_lo))
         else:
             wide[name] = bool(hi - lo > model.WIDE_FRACTION * (r_hi - r_lo))
+    if unknown is not None:
+        intervals = dict.fromkeys(intervals)
+        wide = dict.fromkeys(wide)
     best_unit = ranges.to_unit([fp], [mu_r])
     fitted = [
         FittedObservable(
@@ -423,6 +468,7 @@ def _result(
         timings={"wall_time_s": time.perf_counter() - t0},
         config=dict(config, points=points, refine=refine, design_seed=design_seed, lab_error=lab_error),
         provenance=provenance(),
+        unidentified=unknown,
     )
 
 
@@ -433,4 +479,5 @@ __all__ = [
     "FittedObservable",
     "PosteriorSummary",
     "run_calibration",
+    "unidentified_reason",
 ]

@@ -10,8 +10,10 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import numpy as np
+
 from poro2d.errors import InputError, check_int
-from poro2d.shear.specimen_file import resolve_specimen
+from poro2d.shear.specimen_file import Specimen, resolve_specimen
 from poro2d.store import Store
 
 #: the most replicate specimens of the preset (each is a criterion run)
@@ -34,6 +36,59 @@ def given_specimens(paths: list[str | os.PathLike]) -> dict[str, Path]:
             unique = f"{label}-{k}"
         found[unique] = path
     return found
+
+
+#: a two-sample Kolmogorov-Smirnov test of two specimens' radii below this p-value says they were
+#: drawn from different gradings (replicates of one grading pass it but once in a thousand)
+GRADING_P_VALUE = 1e-3
+
+
+def check_replicates(found: dict[str, Path], digests: dict[str, str]) -> None:
+    """Refuse replicates whose differences are not seed scatter, on one line naming the specimen.
+
+    The calibration counts the spread of the replicates at each design point as the seed
+    scatter of the laboratory specimen: the same specimen given twice (twins, by content)
+    has none, and specimens of other box widths, disk thicknesses or gradings differ by more
+    than their seeds, which would be counted as scatter and widen the intervals unseen.
+    """
+    seen: dict[str, str] = {}
+    for label, digest in digests.items():
+        if digest in seen:
+            raise InputError(
+                "--specimen", str(found[label]), "distinct replicate specimens",
+                f"it holds the same state as {found[seen[digest]]} (a twin has no seed scatter)",
+            )  # fmt: skip
+        seen[digest] = label
+    first, *others = list(found)
+    ref = _replicate_traits(found[first], digests[first])
+    for label in others:
+        traits = _replicate_traits(found[label], digests[label])
+        why = _mixed(ref, traits)
+        if why:
+            raise InputError(
+                "--specimen", str(found[label]), f"a replicate of {found[first]}",
+                f"{why}: their difference is not seed scatter",
+            )  # fmt: skip
+
+
+def _replicate_traits(path: Path, digest: str) -> tuple[float, float, np.ndarray]:
+    """(box width, disk thickness, radii) of a specimen: what replicates of one soil share."""
+    specimen = Specimen.read(path, digest)
+    width = specimen.box()[0]
+    return width, float(specimen.meta.get("thickness", 0.0)), specimen.arrays["particles.radius"]
+
+
+def _mixed(a: tuple[float, float, np.ndarray], b: tuple[float, float, np.ndarray]) -> str | None:
+    """Why two specimens are not replicates of one soil in one box, or None."""
+    from scipy.stats import ks_2samp
+
+    if not np.isclose(a[0], b[0], rtol=1e-6, atol=0.0):
+        return f"its box is {b[0]:g} m wide, not {a[0]:g} m"
+    if not np.isclose(a[1], b[1], rtol=1e-6, atol=0.0):
+        return f"its disks are {b[1]:g} m thick, not {a[1]:g} m"
+    if ks_2samp(a[2], b[2]).pvalue < GRADING_P_VALUE:
+        return "its radii are drawn from another grading"
+    return None
 
 
 def check_preset(preset: str | None, quick: bool, replicates: int) -> None:
@@ -85,4 +140,11 @@ def preset_specimens(
     return specimens
 
 
-__all__ = ["MAX_REPLICATES", "check_preset", "given_specimens", "preset_specimens"]
+__all__ = [
+    "GRADING_P_VALUE",
+    "MAX_REPLICATES",
+    "check_preset",
+    "check_replicates",
+    "given_specimens",
+    "preset_specimens",
+]

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from poro2d.errors import InputError
 from poro2d.execute.dask_cluster import pin_numba_threads
 from poro2d.identity import identity_digest
 from poro2d.shear.case import ShearCase
@@ -123,6 +124,31 @@ def stored_row(unit: CalibrationUnit, cache: Store | None) -> UnitRow | None:
     return None if res is None else _row(unit, res)
 
 
+def check_entry(unit: CalibrationUnit, cache: Store | None) -> None:
+    """Refuse, on one line naming it, a unit's cache entry that is damaged: what a test resumes from.
+
+    A file where the unit's folder belongs, or a file of the folder that differs from what
+    the store wrote (edited, truncated, replaced: :meth:`poro2d.store.Store.check_intact`),
+    would fail the test on its worker, and a calibration must not answer without it.
+    """
+    store = unit.store(cache)
+    if store is None:
+        return
+    for folder, what in (
+        (cache.root, "the calibration's cache"),
+        (store.root, "one shear test of the cache"),
+    ):
+        if folder.exists() and not folder.is_dir():
+            raise InputError(
+                str(folder), "a file", f"a folder ({what})", "delete it to have the tests computed again"
+            )
+    if not store.root.exists():
+        return
+    for name in store.names():
+        if store.has(name):
+            store.check_intact(name)
+
+
 def compute_unit(unit: CalibrationUnit, cache: Store | None) -> UnitRow:
     """Run (or finish) one unit, on one numba thread: the task a Dask worker runs."""
     pin_numba_threads()
@@ -143,6 +169,7 @@ __all__ = [
     "OBSERVABLES",
     "CalibrationUnit",
     "UnitRow",
+    "check_entry",
     "compute_unit",
     "stored_row",
     "unit_curve",

@@ -44,7 +44,7 @@ def register(app: typer.Typer) -> None:
         seed: int = typer.Option(0, "--seed", help="First seed of the preset's specimens."),
         fp_range: str = typer.Option(None, "--fp-range", help="Particle friction range LOW,HIGH (0.3,3)."),
         mu_r_range: str = typer.Option(None, "--mu-r-range", help="Rolling friction range LOW,HIGH (0,0.5)."),
-        points: int = typer.Option(12, "--points", help="Design points of round 1 (6-500)."),
+        points: int = typer.Option(12, "--points", help="Design points of round 1 (9-500)."),
         refine: int = typer.Option(
             6, "--refine", help="Points of round 2, drawn from the posterior (0: none)."
         ),

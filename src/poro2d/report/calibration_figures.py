@@ -97,10 +97,11 @@ def plot_calibration_posterior(result, post, path: str | os.PathLike) -> Path:
     )
     b = result.best
     ax.plot(b["particle_friction"], b["rolling_friction"], "r*", ms=13, label="posterior maximum")
-    lo, hi = result.intervals["particle_friction"]
-    ax.axvspan(lo, hi, color="w", alpha=0.12)
-    lo, hi = result.intervals["rolling_friction"]
-    ax.axhspan(lo, hi, color="w", alpha=0.12)
+    if result.intervals["particle_friction"] is not None:  # None: unknown (``unidentified``)
+        lo, hi = result.intervals["particle_friction"]
+        ax.axvspan(lo, hi, color="w", alpha=0.12)
+        lo, hi = result.intervals["rolling_friction"]
+        ax.axhspan(lo, hi, color="w", alpha=0.12)
     ax.set_xscale("log")
     ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
     ax.xaxis.set_minor_formatter(FormatStrFormatter("%g"))
@@ -109,7 +110,7 @@ def plot_calibration_posterior(result, post, path: str | os.PathLike) -> Path:
     ax.set_ylabel("rolling friction mu_r")
     ax.set_title(
         f"posterior (correlation {result.posterior['correlation']:+.2f}); shaded: "
-        f"{result.level:.0%} intervals",
+        f"{result.level:.0%} intervals" + (" (unknown: not shaded)" if result.get("unidentified") else ""),
         fontsize=9,
     )
     ax.legend(fontsize=7, loc="upper right")

@@ -8,6 +8,8 @@ from poro2d.report.document import write_report
 
 
 def interval_text(result, name: str) -> str:
+    if result.intervals[name] is None:  # a design that cannot estimate its noise (``unidentified``)
+        return f"{result.best[name]:.3g} at the posterior maximum; {result.level:.0%} interval unknown"
     lo, hi = result.intervals[name]
     median = result.posterior["median"][name]
     return (
@@ -18,6 +20,8 @@ def interval_text(result, name: str) -> str:
 
 def identifiability_note(result) -> str:
     """What the posterior says about identifiability, in words."""
+    if result.get("unidentified"):
+        return f"Not identified: {result['unidentified']}."
     wide = [n for n, w in result.posterior["wide"].items() if w]
     corr = result.posterior["correlation"]
     text = f"The posterior correlation of log(f_p) and mu_r is {corr:+.2f}."

@@ -15,13 +15,20 @@ import numpy as np
 
 from poro2d.dem import Simulation, checkpoint
 from poro2d.errors import InputError
+from poro2d.interop.specimen_data import check_accepted
 from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
 from poro2d.specimen.box import box_faces
 from poro2d.store import Store
 
 
 def resolve_specimen(path: str | Path) -> Path:
-    """A checkpoint file, or a criterion output folder holding ``specimen.npz``."""
+    """A checkpoint file, or a criterion output folder holding ``specimen.npz``, that was accepted.
+
+    A refused trial's checkpoint (``trial.json`` beside it says not accepted) or the specimen
+    of a criterion that did not converge (its ``result.json``) is refused on one line, the
+    check ``poro2d export`` makes (:func:`poro2d.interop.specimen_data.check_accepted`): a
+    shear test, a strength study and a calibration take only accepted specimens.
+    """
     p = Path(path)
     if p.is_dir():
         p = p / "specimen.npz"
@@ -31,7 +38,9 @@ def resolve_specimen(path: str | Path) -> Path:
             str(path),
             "a specimen checkpoint (.npz) or a criterion output folder with specimen.npz",
         )
-    return check_input_file("specimen", p, CHECKPOINT_FILE_LIMIT)
+    checked = check_input_file("specimen", p, CHECKPOINT_FILE_LIMIT)
+    check_accepted(checked)
+    return checked
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,0 +1,121 @@
+"""A calibration whose design cannot estimate its own noise never answers as if identified.
+
+Too few design points, twin specimens and replicates of other boxes or gradings are refused
+on one line before any test; one specimen runs, its intervals reported as unknown; a
+posterior that is not finite is no answer at all.
+"""
+
+import shutil
+
+import pytest
+
+from poro2d.calibration import model, run_calibration
+from poro2d.calibration.run import MIN_POINTS, _base_settings, _infer, unidentified_reason
+from poro2d.calibration.specimens import check_replicates
+from poro2d.calibration.units import CalibrationUnit, UnitRow
+from poro2d.cli.calibrate import print_result
+from poro2d.dem import checkpoint
+from poro2d.dem.checkpoint import state_digest
+from poro2d.errors import InputError
+from poro2d.store import Store
+
+SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4, "record_interval": 5e-5}
+LAB = "normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,75\n"
+
+
+@pytest.fixture
+def lab(tmp_path):
+    path = tmp_path / "lab.csv"
+    path.write_text(LAB)
+    return path
+
+
+def test_the_design_keeps_degrees_of_freedom_for_the_surrogates_residual():
+    assert MIN_POINTS == model.N_COEFFICIENTS + 3
+
+
+@pytest.mark.parametrize("points", [6, MIN_POINTS - 1])
+def test_a_design_that_fits_the_surrogate_exactly_is_refused_before_any_test(specimen, lab, tmp_path, points):
+    other = tmp_path / "other.npz"
+    shutil.copyfile(specimen, other)
+    out = tmp_path / "out"
+    with pytest.raises(InputError, match="--points"):
+        run_calibration(
+            lab, [specimen, other], store=Store(out), points=points, settings=SHORT, progress=False
+        )
+    assert not (out / "cache").exists()
+
+
+def test_twin_specimens_are_refused_naming_the_twin(specimen, lab, tmp_path):
+    twin = tmp_path / "twin.npz"
+    shutil.copyfile(specimen, twin)  # another file, the same content
+    out = tmp_path / "out"
+    with pytest.raises(InputError, match="twin") as exc:
+        run_calibration(lab, [specimen, twin], store=Store(out), settings=SHORT, progress=False)
+    assert "twin.npz" in str(exc.value) and len(str(exc.value).splitlines()) == 1
+    assert not (out / "cache").exists()
+
+
+def test_replicates_of_another_grading_are_refused(specimen, lab, tmp_path):
+    sim = checkpoint.load(specimen)
+    sim.particles.radius[:] *= 1.5  # the same box, disks of another grading
+    coarse = tmp_path / "coarse.npz"
+    checkpoint.save(sim, coarse)
+    out = tmp_path / "out"
+    with pytest.raises(InputError, match="another grading") as exc:
+        run_calibration(lab, [specimen, coarse], store=Store(out), settings=SHORT, progress=False)
+    assert "coarse.npz" in str(exc.value)
+    assert not (out / "cache").exists()
+
+
+def test_replicates_of_another_box_are_refused(specimen, tmp_path):
+    sim = checkpoint.load(specimen)
+    walls = sim.walls
+    right = list(walls.names).index("right")
+    walls.p0[right, 0] += 0.01
+    walls.p1[right, 0] += 0.01
+    wider = tmp_path / "wider.npz"
+    checkpoint.save(sim, wider)
+    found = {"a": specimen, "b": wider}
+    with pytest.raises(InputError, match="wide"):
+        check_replicates(found, {k: state_digest(p) for k, p in found.items()})
+
+
+def test_zero_width_intervals_are_unknown_and_wide_ones_are_not():
+    zero = {"particle_friction": [0.754, 0.754], "rolling_friction": [0.1, 0.2]}
+    assert "zero width" in unidentified_reason(2, zero)
+    assert "one specimen" in unidentified_reason(1, {"particle_friction": [0.3, 3.0]})
+    assert unidentified_reason(2, {"particle_friction": [0.5, 0.9], "rolling_friction": [0.1, 0.2]}) is None
+
+
+def test_a_posterior_that_is_not_finite_is_no_answer():
+    ranges = model.Ranges((0.3, 3.0), (0.0, 0.5))
+    design = model.space_filling(ranges, MIN_POINTS, 0)
+    base = _base_settings({"max_displacement": 0.002})
+    found, digests = {"a": "a.npz", "b": "b.npz"}, {"a": "a" * 64, "b": "b" * 64}
+    rows = {}
+    for k, (fp, mu_r) in enumerate(design):
+        for label in found:
+            unit = CalibrationUnit.at(found[label], digests[label], 50.0, base, fp, mu_r)
+            peak = 30.0 + 10.0 * fp + k + (label == "b")
+            rows[unit.key] = UnitRow(unit.key, 50.0, fp, mu_r, found[label], peak, peak, 1.0)
+    targets = [("peak", 50.0, 1e300)]  # an absurd laboratory value: the misfit overflows
+    with pytest.raises(RuntimeError, match="posterior"):
+        _infer(ranges, design, found, digests, base, rows, targets, 0.0)
+
+
+def test_one_specimen_reports_its_intervals_as_unknown(specimen, lab, tmp_path, capsys):
+    out = tmp_path / "out"
+    res = run_calibration(lab, [specimen], store=Store(out), points=MIN_POINTS, refine=0, settings=SHORT,
+                          workers=1, dashboard=None, progress=False)  # fmt: skip
+    assert "one specimen" in res.unidentified
+    assert res.intervals == {"particle_friction": None, "rolling_friction": None}
+    assert res.posterior["wide"] == {"particle_friction": None, "rolling_friction": None}
+    kept = Store(out).read_json("result.json")
+    assert kept["unidentified"] == res.unidentified and kept["intervals"]["particle_friction"] is None
+    assert "Not identified" in (out / "calibration.md").read_text()
+    assert "NOT IDENTIFIED" in (out / "calibrated.toml").read_text()
+    print_result(res, out)
+    printed = capsys.readouterr().out
+    assert "interval unknown" in printed and "Not identified" in printed
+    assert "narrower than half" not in printed
