@@ -215,8 +215,6 @@ NOT_YET_THROUGH_STORE = {
     "calibration/synthetic.py",
     "calibration/units.py",
     "cli/import_specimen.py",
-    "criterion/protocol.py",
-    "criterion/result.py",
     "interop/origin.py",
     "interop/specimen_data.py",
     "interop/state_specimen.py",

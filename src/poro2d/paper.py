@@ -124,6 +124,7 @@ def run_paper(
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.errors import check_int
     from poro2d.io_utils import check_output_dir
+    from poro2d.store import Store
 
     out = Path(out)
     seed = check_int("--seed", seed, 0)
@@ -137,7 +138,7 @@ def run_paper(
         lab_data = read_lab_csv(lab)  # bad lab files fail here, before any simulation
     nthreads = threads if threads is not None else min(os.cpu_count() or 1, 2)
     spec, grading, settings, sd = build(cfg, None, threads=nthreads)
-    crit = PorosityCriterion(spec, grading, settings, seed=sd, out=out / "criterion",
+    crit = PorosityCriterion(spec, grading, settings, seed=sd, store=Store(out / "criterion"),
                              progress=progress, config=cfg)  # fmt: skip
     crit.validate()  # every option is checked before the first file is written
     stage = paper_stage(out, quick, seed)
@@ -164,6 +165,7 @@ def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, qu
     """
     from poro2d.criterion.result import CriterionOutputs
     from poro2d.criterion.table import print_result
+    from poro2d.store import Store
 
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
@@ -174,14 +176,14 @@ def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, qu
     t1 = time.perf_counter()
     result = crit.run()
     timings["criterion_s"] = time.perf_counter() - t1
-    print_result(result, out / "criterion")
+    print_result(result, Store(out / "criterion"))
     shear = reps = None
     shear_figures: dict[str, Path] = {}
     if result.converged:
         t2 = time.perf_counter()
         n2d = result.final_porosity
         specimens, reps = accepted_and_replicates(crit.spec, crit.grading, crit.settings, n2d, crit.seed,
-                                                  replicates, out, progress=progress)  # fmt: skip
+                                                  replicates, Store(out), progress=progress)  # fmt: skip
         timings["replicates_s"] = time.perf_counter() - t2
         shear, shear_figures = _shear_stage(specimens, out / "shear", quick, lab_data, progress)
         timings["shear_s"] = time.perf_counter() - t2 - timings["replicates_s"]
@@ -204,7 +206,7 @@ def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, qu
         provenance=provenance(),
         lab=lab_data.to_dict() if lab_data is not None else None,
     )
-    return summary, CriterionOutputs.read(out / "criterion", result), shear_figures
+    return summary, CriterionOutputs.read(Store(out / "criterion"), result), shear_figures
 
 
 def _conversions_stage(out: Path, stage: ResumableStage) -> dict:

@@ -5,6 +5,7 @@ import pytest
 from poro2d.criterion import run_criterion
 from poro2d.criterion.result import CriterionResult
 from poro2d.errors import InputError
+from poro2d.store import Store
 from poro2d.sweep.density_criterion import run_criterion_modes, run_density_criterion
 from poro2d.sweep.relation import run_relation
 
@@ -28,8 +29,9 @@ SMALL = {
 def test_run_criterion_refuses_bad_input_before_writing(tmp_path, run, kw, name):
     out = tmp_path / "o"
     kw = {"config": SMALL, **kw}
+    where = {"store": Store(out)} if run is run_criterion else {"out": out}
     with pytest.raises(InputError) as e:
-        run(kw.pop("config"), out=out, progress=False, **kw)
+        run(kw.pop("config"), progress=False, **where, **kw)
     assert e.value.parameter == name
     assert not out.exists()
 
@@ -40,7 +42,7 @@ def test_run_criterion_matches_the_command(tmp_path):
 
     from poro2d.cli import main
 
-    res = run_criterion(SMALL, out=tmp_path / "api", progress=False)
+    res = run_criterion(SMALL, store=Store(tmp_path / "api"), progress=False)
     assert isinstance(res, CriterionResult)
     cfg = tmp_path / "c.toml"
     cfg.write_text(

@@ -56,12 +56,13 @@ def preset_specimens(
     from poro2d.criterion.config import build, paper_config
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.criterion.replicates import run_replicates
+    from poro2d.store import Store
 
     seed = check_int("--seed", seed, 0)
     cfg = paper_config(quick, seed)
     spec, grading, settings, sd = build(cfg, None, threads=min(os.cpu_count() or 1, 2))
     crit = PorosityCriterion(
-        spec, grading, settings, seed=sd, out=out / "criterion", progress=progress, config=cfg
+        spec, grading, settings, seed=sd, store=Store(out / "criterion"), progress=progress, config=cfg
     )
     crit.validate()
     result = crit.run()
@@ -76,7 +77,7 @@ def preset_specimens(
             settings,
             result.final_porosity,
             extra,
-            out / "replicates",
+            Store(out / "replicates"),
             processes=spec.threads,
             progress=progress,
         )

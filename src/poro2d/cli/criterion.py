@@ -13,6 +13,7 @@ import typer
 
 from poro2d.console import OutputConsole, Table
 from poro2d.criterion.table import print_result
+from poro2d.store import Store
 from poro2d.sweep.results import DensityStateResult
 
 console = OutputConsole()
@@ -63,7 +64,7 @@ def register(app: typer.Typer) -> None:
         if isinstance(result, DensityStateResult):
             print_density(result, out)
             return
-        print_result(result, out)
+        print_result(result, Store(out))
         console.print(PAPER_MODE_NOTE, soft_wrap=True)
         if not result.converged:
             # one line, whole: the reason names the trial, the stage or check, the ratio

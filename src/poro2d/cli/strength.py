@@ -38,16 +38,17 @@ def quick_specimens(out: Path, seeds: int, progress: bool) -> dict[str, Path]:
     from poro2d.criterion.config import build, paper_config
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.criterion.replicates import accepted_and_replicates
+    from poro2d.store import Store
 
     cfg = paper_config(True, 0)
     spec, grading, settings, seed = build(cfg, None, threads=1)
-    crit = PorosityCriterion(spec, grading, settings, seed=seed, out=out / "criterion", progress=progress,
-                             config=cfg)  # fmt: skip
+    crit = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(out / "criterion"),
+                             progress=progress, config=cfg)  # fmt: skip
     result = crit.run()
     if not result.converged:
         raise RuntimeError(f"the quick specimen was not accepted: {result.message}")
     specimens, _ = accepted_and_replicates(crit.spec, crit.grading, crit.settings, result.final_porosity,
-                                           crit.seed, seeds, out, progress=progress)  # fmt: skip
+                                           crit.seed, seeds, Store(out), progress=progress)  # fmt: skip
     return specimens
 
 

@@ -91,15 +91,15 @@ def validate_criterion(config: dict, base_dir: Path | None = None) -> None:
 def criterion_case(config: dict, out_dir: Path) -> dict:
     """The criterion of Fig. 3 for one case; scalars of its result, of its first and of its accepted trial."""
     from poro2d.criterion.protocol import PorosityCriterion
+    from poro2d.store import Store
 
     spec, grading, settings, seed = criterion_objects(config)
     figures = bool(config.get("sweep_options", {}).get("figures", False))
-    crit = PorosityCriterion(
-        spec, grading, settings, seed=seed, out=out_dir, progress=False, config=config, figures=figures
-    )
+    crit = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(out_dir), progress=False,
+                             config=config, figures=figures)  # fmt: skip
     res = crit.run()
     first = res["iterations"][0] if res["iterations"] else {}
-    # the accepted trial (not always the last: see PorosityCriterion._closed_bracket), else the last
+    # the accepted trial (not always the last: see poro2d.criterion.protocol.closed_bracket), else the last
     its = res["iterations"]
     last = next((r for r in its if r.get("accepted")), its[-1] if its else {})
     return {

@@ -86,8 +86,8 @@ def _run_density_mode(inputs: CriterionInputs, out: Path, *, threads: int | None
     if threads is not None:  # the option's thread count, as the specimen was built with it
         rest["specimen"] = dict(rest.get("specimen") or {}, threads=inputs.spec.threads)
     dens = inputs.density
-    return run_density_state(rest, inputs.base, inputs.settings.n_lab, dens["n_max"], dens["n_min"], out,
-                             seeds=dens["seeds"], mus=dens["mu_prep"], progress=progress)  # fmt: skip
+    return run_density_state(rest, inputs.base, inputs.settings.n_lab, dens.n_max, dens.n_min, out,
+                             seeds=dens.seeds, mus=dens.mu_prep, progress=progress)  # fmt: skip
 
 
 def _refuse_paper_options(seed: int | None, trial_porosity: float | None) -> None:
@@ -151,7 +151,9 @@ def run_criterion_modes(
     inputs = criterion_inputs(config, preset=preset, seed=seed, n_lab=n_lab, trial_porosity=trial_porosity,
                               threads=threads, mode=mode, n_max=n_max, n_min=n_min, seeds=seeds)  # fmt: skip
     if inputs.mode == "paper":
-        return run_paper_mode(inputs, out, progress=progress)
+        from poro2d.store import Store
+
+        return run_paper_mode(inputs, Store(out), progress=progress)
     _refuse_paper_options(seed, trial_porosity)
     return _run_density_mode(inputs, out, threads=threads, progress=progress)
 
