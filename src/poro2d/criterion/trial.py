@@ -260,8 +260,11 @@ class Trial(Mapping):
     def to_dict(self) -> dict[str, Any]:
         """The trial's row as its file holds it (``trial.json``; a trial of ``result.json``)."""
         row = {**self.modelled_row(), **self.extra}
-        if self.order is not None:  # a row read back keeps its file's order; keys set since go last
-            row = {**{k: row[k] for k in self.order if k in row}, **row}
+        if self.order is not None:
+            # a row read back keeps its file's keys in their order; of the keys its file lacks,
+            # only what a decision taken since added (a closed bracket's acceptance) comes last
+            gained = {k: row[k] for k in ("accepted_at",) if k not in self.order and k in row}
+            row = {**{k: row[k] for k in self.order if k in row}, **gained}
         return as_json(row)
 
     def flat(self) -> dict[str, Any]:
