@@ -181,6 +181,10 @@ class Decision:
                    row.get("reason"), row.get("accepted_at"))  # fmt: skip
 
 
+#: the keys of a row that the decision sets
+DECISION_KEYS = ("condition_met", "failed_check", "accepted", "refused", "reason", "accepted_at")
+
+
 @dataclass(eq=False)
 class Trial(Mapping):
     """One trial of Fig. 3, made of its parts; read as the dict of its row (``trial["new_porosity"]``).
@@ -262,8 +266,8 @@ class Trial(Mapping):
         row = {**self.modelled_row(), **self.extra}
         if self.order is not None:
             # a row read back keeps its file's keys in their order; of the keys its file lacks,
-            # only what a decision taken since added (a closed bracket's acceptance) comes last
-            gained = {k: row[k] for k in ("accepted_at",) if k not in self.order and k in row}
+            # only what a decision taken since set (a closed bracket's acceptance) comes last
+            gained = {k: row[k] for k in DECISION_KEYS if k not in self.order and row.get(k) is not None}
             row = {**{k: row[k] for k in self.order if k in row}, **gained}
         return as_json(row)
 
