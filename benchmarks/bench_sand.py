@@ -62,6 +62,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     from poro2d.sand import run_sand
+    from poro2d.store import Store
 
     scratch = tempfile.mkdtemp(prefix="bench-sand-")
     os.environ["PORO2D_CACHE"] = str(Path(scratch) / "cache")  # an empty cache: nothing reused
@@ -70,7 +71,7 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.perf_counter()
     res = run_sand(
         _config(args.config, args.calibration_seeds),
-        out=out,
+        store=Store(out),
         workers=args.workers,
         progress=False,
         announce=lambda line: stages.append((time.perf_counter() - t0, line)),

@@ -191,6 +191,12 @@ def test_config_values_of_the_wrong_type(tmp_path, capsys, toml, words):
     criterion_with(tmp_path, capsys, toml, *words)
 
 
+@pytest.mark.parametrize("value", ["2.0", "1e6", "-0.1"])
+def test_rolling_friction_of_a_specimen_is_held_to_the_range_shear_prints(tmp_path, capsys, value):
+    """[specimen] rolling_friction takes the range --rolling-friction prints: [0, 1]."""
+    criterion_with(tmp_path, capsys, f"[specimen]\nrolling_friction = {value}\n", "rolling_friction", "1.0]")
+
+
 def test_integers_are_accepted_for_floats(tmp_path):
     from poro2d.config import dataclass_from_table
 

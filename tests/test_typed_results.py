@@ -7,7 +7,9 @@ part of their paths was shortened. Written before the sweeps' results were typed
 density mode of ``poro2d criterion`` (density_state.json), ``poro2d sensitivity`` and
 ``poro2d relation --mode paper`` on that box, ``poro2d relation --preset paper --quick``
 (relation_density_mode.json), and from ``poro2d paper --quick`` the replicate specimens'
-shear summary and the accepted specimen's state and porosity files.
+shear summary and the accepted specimen's state and porosity files. Written before the
+calibration's and the sand's results had typed parts: ``poro2d calibrate --preset paper --quick``
+(calibration_result.json) and ``poro2d sand`` on a small toy soil (sand_result.json).
 """
 
 import json
@@ -17,13 +19,15 @@ from pathlib import Path
 
 import pytest
 
+from poro2d.calibration.run import CalibrationResult
 from poro2d.criterion.result import (
     CriterionResult,
     ReplicatesResult,
-    SpecimenPorosityResult,
     SpecimenStateResult,
 )
+from poro2d.measure.specimen_porosity import SpecimenPorosity
 from poro2d.paper import PaperSummary
+from poro2d.sand.result import SandResult
 from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult, ShearTestResult
 from poro2d.sweep.results import DensityStateResult, RelationResult, SensitivityResult
 from poro2d.typed_result import TypedResult
@@ -40,7 +44,9 @@ FILES = [
     (SensitivityResult, "sensitivity.json"),
     (ReplicateShearResult, "shear_replicates.json"),
     (SpecimenStateResult, "specimen_state.json"),
-    (SpecimenPorosityResult, "specimen_porosity.json"),
+    (SpecimenPorosity, "specimen_porosity.json"),
+    (CalibrationResult, "calibration_result.json"),
+    (SandResult, "sand_result.json"),
 ]
 
 
@@ -139,15 +145,16 @@ def test_a_criterion_folder_written_before_is_read_back_and_still_binds(tmp_path
 def test_a_shear_test_folder_written_before_is_read_back_and_still_binds(tmp_path):
     from poro2d.errors import InputError
     from poro2d.shear import record
+    from poro2d.store import Store
 
     out = _folder(tmp_path, {"test.json": "shear_test_record.json", "result.json": "shear_test_result.json"})
     old = json.loads((out / "test.json").read_text())
-    stage = record.folder_stage(out, old["run"], Path("moved") / "specimen.npz")
+    stage = record.folder_stage(Store(out), old["run"], str(Path("moved") / "specimen.npz"))
     assert ShearTestResult.from_dict(stage.stored()) == json.loads(
         (DATA / "shear_test_result.json").read_text()
     )
-    assert record.folder_stage(out, old["run"], Path("x")).fingerprint.digest == old["key"]
-    other = record.folder_stage(out, dict(old["run"], normal_stress_kpa=100.0), Path("x"))
+    assert record.folder_stage(Store(out), old["run"], "x").fingerprint.digest == old["key"]
+    other = record.folder_stage(Store(out), dict(old["run"], normal_stress_kpa=100.0), "x")
     with pytest.raises(InputError, match=r"another normal stress \(50.0 kPa\); use a new --out"):
         other.check()
     older = dict(old, run={k: v for k, v in old["run"].items() if k != "specimen_digest"})
@@ -279,3 +286,29 @@ def test_a_settled_run_writes_the_keys_each_engine_reported():
     assert list(ours) == [*forces, "mean_contact_force_n", "coordination_number", "contacts", "steps",
                           "converged", "max_ratio", "seconds"]  # fmt: skip
     assert ours["contacts"] == 7 and "yade_version" not in ours and pickle.loads(pickle.dumps(ours)) == ours
+
+
+def test_parts_of_a_result_are_typed_and_written_as_before():
+    """Known structures inside a result (the paper summary's criterion, a calibration's posterior
+    and cluster, the sand's calibration, time profiles and soil) are typed parts; the file is the same."""
+    from poro2d.calibration.cluster import ClusterRecord
+    from poro2d.calibration.run import PosteriorSummary
+    from poro2d.sand.case import SoilRecord
+    from poro2d.sand.profile import StageProfile
+    from poro2d.sand.result import SandCalibration
+
+    paper = PaperSummary.from_dict(json.loads((DATA / "paper_results.json").read_text()))
+    assert isinstance(paper.criterion, CriterionResult) and paper.criterion.converged
+    cal = CalibrationResult.from_dict(json.loads((DATA / "calibration_result.json").read_text()))
+    assert isinstance(cal.posterior, PosteriorSummary) and isinstance(cal.cluster, ClusterRecord)
+    assert cal.posterior.observables[0].observable == "peak" and cal.cluster.tests_run > 0
+    sand = SandResult.from_dict(json.loads((DATA / "sand_result.json").read_text()))
+    assert isinstance(sand.calibration, SandCalibration) and isinstance(sand.soil, SoilRecord)
+    assert isinstance(sand.calibration.time_profile, StageProfile)
+    assert sand.calibration.time_profile.plate.steps == sand.calibration["time_profile"]["plate"]["steps"]
+    for result, name in (
+        (paper, "paper_results.json"),
+        (cal, "calibration_result.json"),
+        (sand, "sand_result.json"),
+    ):
+        assert json.dumps(result.to_dict(), indent=2) + "\n" == (DATA / name).read_text()

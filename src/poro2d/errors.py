@@ -1,8 +1,10 @@
-"""One error type for bad input, so the CLI can print it as a single line."""
+"""One error type for bad input, so the CLI can print it as a single line, and the checks that raise it."""
 
 from __future__ import annotations
 
 import numbers
+from collections.abc import Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -96,6 +98,68 @@ def check_int(parameter: str, value: Any, lo: int | None = None, hi: int | None 
     if (lo is not None and v < lo) or (hi is not None and v > hi):
         raise InputError(parameter, value, allowed)
     return v
+
+
+@dataclass(frozen=True)
+class Real:
+    """The interval a real setting must lie in: ``Real(0, None, lo_open=True)`` is (0, inf).
+
+    ``or_none``: None is allowed too, for a setting that falls back on another when not given
+    (a shear test's ``particle_friction`` takes the specimen's). The bounds are printed as
+    written (``0`` or ``0.0``), as :func:`check_range` prints them.
+    """
+
+    lo: float | None = None
+    hi: float | None = None
+    lo_open: bool = False
+    hi_open: bool = False
+    or_none: bool = False
+
+    def check(self, parameter: str, value: Any) -> None:
+        if value is None and self.or_none:
+            return
+        check_range(parameter, value, self.lo, self.hi, lo_open=self.lo_open, hi_open=self.hi_open)
+
+
+@dataclass(frozen=True)
+class Integer:
+    """The closed range ``[lo, hi]`` an integer setting must lie in (None: no bound)."""
+
+    lo: int | None = None
+    hi: int | None = None
+
+    def check(self, parameter: str, value: Any) -> None:
+        check_int(parameter, value, self.lo, self.hi)
+
+
+@dataclass(frozen=True)
+class OneOf:
+    """One of a few names (``quoted``: the allowed names printed as strings, ``'max'``)."""
+
+    choices: tuple[str, ...]
+    quoted: bool = False
+
+    def check(self, parameter: str, value: Any) -> None:
+        if value not in self.choices:
+            names = [repr(c) for c in self.choices] if self.quoted else list(self.choices)
+            raise InputError(parameter, value, "one of " + ", ".join(names))
+
+
+#: a settings class's table of ranges: field name -> the rule its value keeps
+Ranges = Mapping[str, Real | Integer | OneOf]
+
+
+def check_fields(settings: Any, ranges: Ranges) -> None:
+    """Check each field of ``settings`` named in ``ranges`` against its rule, in the table's order.
+
+    A settings dataclass calls it first thing in ``__post_init__``, so that a value is checked
+    however the settings were made (a config file, the Python API, ``dataclasses.replace``),
+    and its table is the one place that says what each setting may be. The first field out of
+    its range is reported, named as the field (``layers = 0 is invalid; ...``); checks that
+    relate two fields stay in ``__post_init__`` after the table's.
+    """
+    for name, rule in ranges.items():
+        rule.check(name, getattr(settings, name))
 
 
 def as_float_array(parameter: str, values: Any) -> np.ndarray:

@@ -13,8 +13,12 @@ dies, so a killed run never leaves a folder locked. The lock files are removed o
   computed: both asked for the same content, so waiting is never wasted.
 
 Both check the folder first for symbolic links leading out of it (:func:`check_no_escape`),
-so nothing poro2d writes there ends up elsewhere. Locks are re-entrant within a process:
-a run that calls another run on the same folder does not refuse itself.
+so nothing poro2d writes there ends up elsewhere. An output folder also belongs to the kind
+of run that made it (``criterion``, ``shear``, ``calibrate``...): a marker (``.poro2d-kind``)
+written before any result says which, and a run of another kind refuses the folder on one
+line before any work, rather than mixing its files with another command's. Locks are
+re-entrant within a process: a run that calls another run on the same folder does not
+refuse itself.
 """
 
 from __future__ import annotations
@@ -37,6 +41,9 @@ LOCK_NAME = ".poro2d.lock"
 #: who holds the lock (pid and host), for the refusal message; written once the lock is held
 OWNER_NAME = ".poro2d.lock.owner"
 
+#: the kind of run an output folder belongs to; written first, kept with the results
+KIND_NAME = ".poro2d-kind"
+
 #: folders this process holds: resolved path -> [lock, holders still inside]
 _held: dict[Path, list] = {}
 _guard = threading.Lock()
@@ -44,7 +51,11 @@ _guard = threading.Lock()
 
 def is_lock_file(name: str) -> bool:
     """True for the lock's own files (and the temporaries of its owner file): never a result."""
-    return name == LOCK_NAME or name.startswith(OWNER_NAME) or name.startswith(f".{OWNER_NAME}.")
+    return (
+        name in (LOCK_NAME, KIND_NAME)
+        or name.startswith(OWNER_NAME)
+        or name.startswith((f".{OWNER_NAME}.", f".{KIND_NAME}."))
+    )
 
 
 def owner_text(folder: Path) -> str:
@@ -87,14 +98,38 @@ def check_no_escape(parameter: str, folder: str | os.PathLike) -> None:
                 )  # fmt: skip
 
 
+def folder_kind(folder: str | os.PathLike) -> str | None:
+    """The kind of run ``folder`` belongs to (its marker), None without one."""
+    try:
+        return (Path(folder) / KIND_NAME).read_text().strip() or None
+    except (OSError, UnicodeDecodeError):
+        return None
+
+
+def claim_kind(parameter: str, folder: Path, kind: str) -> None:
+    """Mark ``folder`` as ``kind``'s, or refuse it if it belongs to another kind of run."""
+    from poro2d.io_utils import atomic_path
+
+    owner = folder_kind(folder)
+    if owner is None:
+        with atomic_path(folder / KIND_NAME, suffix="") as tmp:
+            tmp.write_text(kind + "\n")
+    elif owner != kind:
+        raise InputError(
+            parameter, str(folder), f"an empty folder or one of a {kind} run",
+            f"it holds the results of a {owner} run; choose another folder",
+        )  # fmt: skip
+
+
 @contextmanager
-def output_folder(parameter: str, folder: str | os.PathLike) -> Iterator[Path]:
-    """Hold the output folder ``folder`` for the block; refuse it if another run holds it.
+def output_folder(parameter: str, folder: str | os.PathLike, kind: str | None = None) -> Iterator[Path]:
+    """Hold the output folder ``folder`` for the block; refuse it if another run holds it,
+    or, given the run's ``kind``, if it belongs to another kind of run.
 
     The folder is created if needed and removed again if the block leaves nothing in it
     but the lock (a run refused for its inputs leaves no folder behind).
     """
-    with _hold(parameter, Path(folder), wait=False) as path:
+    with _hold(parameter, Path(folder), wait=False, kind=kind) as path:
         yield path
 
 
@@ -105,8 +140,12 @@ def cache_entry(folder: str | os.PathLike, parameter: str = "PORO2D_CACHE") -> I
         yield path
 
 
-def holds_output(argument: str = "out", parameter: str = "--out"):
-    """Decorator: the call holds its ``argument`` folder (see :func:`output_folder`) throughout."""
+def holds_output(argument: str = "out", parameter: str = "--out", kind: str | None = None):
+    """Decorator: the call holds its ``argument`` folder (see :func:`output_folder`) throughout.
+
+    ``argument`` may be a folder or a store (held by its folder); None holds nothing.
+    ``kind`` marks the folder as that kind of run's (see :func:`claim_kind`).
+    """
 
     def decorate(func):
         signature = inspect.signature(func)
@@ -115,7 +154,14 @@ def holds_output(argument: str = "out", parameter: str = "--out"):
         def run(*args, **kwargs):
             bound = signature.bind(*args, **kwargs)
             bound.apply_defaults()
-            with output_folder(parameter, bound.arguments[argument]):
+            target = bound.arguments[argument]
+            if target is None:  # a store of None keeps nothing: there is no folder to hold
+                return func(*args, **kwargs)
+            # a store (poro2d.store.Store: a root and the option it came from) is held by its folder
+            folder, name = (
+                (target.root, target.parameter) if hasattr(target, "parameter") else (target, parameter)
+            )
+            with output_folder(name, folder, kind=kind):
                 return func(*args, **kwargs)
 
         return run
@@ -124,7 +170,7 @@ def holds_output(argument: str = "out", parameter: str = "--out"):
 
 
 @contextmanager
-def _hold(parameter: str, folder: Path, *, wait: bool) -> Iterator[Path]:
+def _hold(parameter: str, folder: Path, *, wait: bool, kind: str | None = None) -> Iterator[Path]:
     from poro2d.io_utils import check_output_dir
 
     check_output_dir(parameter, folder)
@@ -139,6 +185,8 @@ def _hold(parameter: str, folder: Path, *, wait: bool) -> Iterator[Path]:
         lock = _acquire(parameter, folder, wait=wait, created=created)
         try:
             check_no_escape(parameter, folder)
+            if kind is not None:
+                claim_kind(parameter, folder, kind)
             _write_owner(folder)
         except BaseException:
             _release(lock, folder, created)
@@ -200,9 +248,19 @@ def _release(lock: FileLock, folder: Path, created: bool) -> None:
             (folder / name).unlink(missing_ok=True)
         except OSError:
             pass
+    _drop_lone_kind(folder)
     lock.release()
     if created:  # a run refused for its inputs leaves no empty folder behind
         _remove_if_empty(folder)
+
+
+def _drop_lone_kind(folder: Path) -> None:
+    """A folder left with its kind marker alone holds no work of that kind: no marker either."""
+    try:
+        if [p.name for p in folder.iterdir()] == [KIND_NAME]:
+            (folder / KIND_NAME).unlink()
+    except OSError:
+        pass
 
 
 def _remove_if_empty(folder: Path) -> None:
@@ -213,7 +271,10 @@ def _remove_if_empty(folder: Path) -> None:
 
 
 __all__ = [
+    "KIND_NAME",
     "LOCK_NAME",
+    "claim_kind",
+    "folder_kind",
     "cache_entry",
     "check_no_escape",
     "holds_output",

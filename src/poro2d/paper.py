@@ -2,8 +2,8 @@
 
 Stages: the conversion table for the paper's sand (nLab = 0.3434, n_max = 0.4571,
 n_min = 0.3253) with Figs. 1-2, the criterion of Fig. 3 with Figs. 5-7, replicate
-specimens, direct shear (Fig. 8) and the report. Each stage writes into its own
-sub-folder; a rerun skips the stages already finished (see :func:`paper_stage`).
+specimens, direct shear (Fig. 8) and the report. Each stage keeps its files in its own
+sub-store; a rerun skips the stages already finished (see :func:`paper_stage`).
 ``quick`` (``--quick``) runs a reduced specimen (a smaller box, two layers) for a first look.
 """
 
@@ -12,16 +12,22 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from poro2d.console import OutputConsole
 from poro2d.criterion.config import paper_config
 from poro2d.criterion.replicates import accepted_and_replicates
-from poro2d.io_utils import provenance, write_csv, write_json
+from poro2d.criterion.result import CriterionResult
+from poro2d.io_utils import provenance
 from poro2d.locks import holds_output
 from poro2d.paper_data import PAPER, QUICK_SHEAR
+from poro2d.shear.results import ReplicateShearResult
+from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.typed_result import TypedResult
+
+#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+KIND = "paper"
 
 if TYPE_CHECKING:
     from poro2d.criterion.protocol import PorosityCriterion
@@ -30,14 +36,56 @@ if TYPE_CHECKING:
 console = OutputConsole()
 
 NORMAL_STRESSES_KPA = (50.0, 100.0, 200.0)
+#: what the summary keeps of the criterion's result (the whole result is ``criterion/result.json``)
+CRITERION_KEYS = ("final_porosity", "converged", "message", "iterations")
+
+
+@dataclass(eq=False)
+class ConversionsRecord(TypedResult):
+    """The conversions stage (``conversions/conversions.json``): the paper's sand, each method's
+    row of ``conversions.csv`` and the figures written (Figs. 1-2)."""
+
+    n_lab: float
+    n_max: float
+    n_min: float
+    methods: list[dict[str, Any]]
+    figures: list[str]
+    provenance: dict[str, Any]
+
+
+@dataclass(eq=False)
+class PaperShear(TypedResult):
+    """The direct shear stage's summary: the pooled fit over every specimen's peaks; ``tests``
+    and ``quasi_static`` of the first specimen; ``replicates``: the replicate specimens' summary."""
+
+    tests: list[dict[str, Any]]
+    friction_angle_deg: float | None
+    cohesion_kpa: float | None
+    r2: float | None
+    quasi_static: Any
+    replicates: ReplicateShearResult
+
+    def to_dict(self) -> dict[str, Any]:
+        out = super().to_dict()
+        if isinstance(self.replicates, TypedResult):
+            out["replicates"] = self.replicates.to_dict()
+        return out
+
+    @classmethod
+    def from_dict(cls, data) -> PaperShear:
+        obj = super().from_dict(data)
+        if isinstance(obj.replicates, dict):
+            obj.replicates = ReplicateShearResult.from_dict(obj.replicates)
+        return obj
 
 
 @dataclass(eq=False)
 class PaperSummary(TypedResult):
     """The case study's summary (``results.json``), as :func:`run_paper` returns it.
 
-    ``criterion``: the accepted porosity, ``converged``, ``message`` and the trials (the
-    whole result is ``criterion/result.json``); ``replicate_specimens``: one row per extra
+    ``criterion``: the criterion's result with only the accepted porosity, ``converged``,
+    ``message`` and the trials (:data:`CRITERION_KEYS`; the whole result is
+    ``criterion/result.json``); ``replicate_specimens``: one row per extra
     seed (None with one specimen); ``shear``: the pooled fit over the specimens, the first
     specimen's ``tests`` and ``quasi_static``, and ``replicates`` (None when the criterion
     did not converge); ``paper``: what the paper states, for the comparison; ``lab``: the
@@ -48,18 +96,43 @@ class PaperSummary(TypedResult):
 
     quick: bool
     seed: int
-    conversions: dict[str, Any]
-    criterion: dict[str, Any]
+    conversions: ConversionsRecord
+    criterion: CriterionResult
     replicate_specimens: list[dict[str, Any]] | None
-    shear: dict[str, Any] | None
+    shear: PaperShear | None
     paper: dict[str, Any]
     timings: dict[str, float]
     provenance: dict[str, Any]
     lab: dict[str, Any] | None = None
 
+    #: the typed parts, as their classes read them
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "conversions": ConversionsRecord,
+        "criterion": CriterionResult,
+        "shear": PaperShear,
+    }
 
-def paper_stage(out: Path, quick: bool, seed: int) -> ResumableStage:
-    """The case study's folder, bound by ``paper.json`` to ``--quick`` and ``--seed``.
+    def to_dict(self) -> dict[str, Any]:
+        """The file's keys; the typed parts as the dicts they are written as."""
+        out = super().to_dict()
+        for key in self.PARTS:
+            if isinstance(out.get(key), TypedResult):
+                out[key] = out[key].to_dict()
+        return out
+
+    @classmethod
+    def from_dict(cls, data) -> PaperSummary:
+        """A summary from its file's dict, each part read by its class."""
+        obj = super().from_dict(data)
+        for key, part in cls.PARTS.items():
+            value = getattr(obj, key)
+            if isinstance(value, dict):
+                setattr(obj, key, part.from_dict(value))
+        return obj
+
+
+def paper_stage(store: Store, quick: bool, seed: int) -> ResumableStage:
+    """The case study's store, bound by ``paper.json`` to ``--quick`` and ``--seed``.
 
     Its parts bind their own folders too (the criterion's ``config.json``, each test's
     ``test.json``) and are read back when finished; the summary and the report are made
@@ -67,12 +140,10 @@ def paper_stage(out: Path, quick: bool, seed: int) -> ResumableStage:
     specimens and tests already done are reused). A folder written before ``paper.json``
     existed is adopted.
     """
-    return ResumableStage(
-        out,
+    return store.stage(
         Fingerprint({"quick": quick, "seed": seed}),
         record="paper.json",
         extra={"provenance": provenance()},
-        parameter="--out",
         allowed="an empty folder or one holding a paper run of the same --quick and --seed",
         explain=lambda keys, _: (
             f"it holds a paper run with other {', '.join(f'--{k}' for k in keys or [])}; choose another --out"
@@ -81,29 +152,29 @@ def paper_stage(out: Path, quick: bool, seed: int) -> ResumableStage:
     )
 
 
-def conversion_files(out: Path) -> dict:
-    """The conversion table (``conversions.csv``) and Figs. 1-2 in ``out``; the summary of both.
+def conversion_files(store: Store) -> ConversionsRecord:
+    """The conversion table (``conversions.csv``) and Figs. 1-2 in ``store``; the summary of both.
 
     The summary is the stage's ``conversions.json``, written after the files by the stage.
     """
     from poro2d.porosity import convert_all
     from poro2d.report.conversion_figures import write_relation_figures
 
-    out.mkdir(parents=True, exist_ok=True)
     res = convert_all(PAPER["n_lab"], n_max=PAPER["n_max"], n_min=PAPER["n_min"])
     rows = [
         {"method": r.id, "name": r.name, "equation": r.equation, "n2d": r.value, "flags": ";".join(r.flags)}
         for r in res.results.values()
     ]
-    write_csv(out / "conversions.csv", rows)
-    figs = write_relation_figures(out, n_max=PAPER["n_max"], n_min=PAPER["n_min"], mark_n_lab=PAPER["n_lab"])
-    return {"n_lab": PAPER["n_lab"], "n_max": PAPER["n_max"], "n_min": PAPER["n_min"], "methods": rows,
-            "figures": [str(f.name) for f in figs], "provenance": provenance()}  # fmt: skip
+    store.write_csv("conversions.csv", rows)
+    figs = write_relation_figures(store.root, n_max=PAPER["n_max"], n_min=PAPER["n_min"],
+                                  mark_n_lab=PAPER["n_lab"])  # fmt: skip
+    return ConversionsRecord(n_lab=PAPER["n_lab"], n_max=PAPER["n_max"], n_min=PAPER["n_min"], methods=rows,
+                             figures=[str(f.name) for f in figs], provenance=provenance())  # fmt: skip
 
 
-@holds_output("out")
+@holds_output("store", kind=KIND)
 def run_paper(
-    out: str | Path = "paper-out",
+    store: Store,
     *,
     quick: bool = False,
     lab: str | Path | None = None,
@@ -115,7 +186,7 @@ def run_paper(
     """The paper's case study: conversions, the criterion (Fig. 3), direct shear on replicate
     specimens (Fig. 8), the report. Resumable: finished stages are read back.
 
-    Returns the summary written to ``out/results.json``; ``summary.criterion["converged"]``
+    Returns the summary kept as the store's ``results.json``; ``summary.criterion.converged``
     says whether the criterion found its porosity (no shear tests otherwise).
     """
     import os
@@ -124,12 +195,11 @@ def run_paper(
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.errors import check_int
     from poro2d.io_utils import check_output_dir
-    from poro2d.store import Store
 
-    out = Path(out)
+    out = store.root
     seed = check_int("--seed", seed, 0)
     replicates = check_int("--replicates", replicates, 1, 20)
-    check_output_dir("--out", out)
+    check_output_dir(store.parameter, out)
     cfg = paper_config(quick, seed)
     lab_data = None
     if lab is not None:
@@ -138,25 +208,27 @@ def run_paper(
         lab_data = read_lab_csv(lab)  # bad lab files fail here, before any simulation
     nthreads = threads if threads is not None else min(os.cpu_count() or 1, 2)
     spec, grading, settings, sd = build(cfg, None, threads=nthreads)
-    crit = PorosityCriterion(spec, grading, settings, seed=sd, store=Store(out / "criterion"),
+    crit = PorosityCriterion(spec, grading, settings, seed=sd, store=store.child("criterion"),
                              progress=progress, config=cfg)  # fmt: skip
     crit.validate()  # every option is checked before the first file is written
-    stage = paper_stage(out, quick, seed)
+    stage = paper_stage(store, quick, seed)
     stage.check()  # and the folder: one of another paper run is refused before anything is written
-    summary, criterion, shear_figures = _run_stages(out, stage, crit, quick=quick, replicates=replicates,
+    summary, criterion, shear_figures = _run_stages(store, stage, crit, quick=quick, replicates=replicates,
                                                     lab_data=lab_data, progress=progress)  # fmt: skip
-    write_json(out / "results.json", summary.to_dict())
+    store.write_result("results.json", summary)
     from poro2d.calibration.run import CalibrationResult
     from poro2d.report.paper_report import CALIBRATION_FOLDER, write_paper_report
 
     # the report takes objects and opens no file: a calibration kept beside the run is read here
-    md, html = write_paper_report(out, summary, criterion, shear_figures=shear_figures,
-                                  calibration=CalibrationResult.read(out / CALIBRATION_FOLDER))  # fmt: skip
+    calibration = CalibrationResult.read(store.child(CALIBRATION_FOLDER))
+    md, html = write_paper_report(
+        out, summary, criterion, shear_figures=shear_figures, calibration=calibration
+    )
     console.print(f"results in {out}/results.json; report: {html} and {md}")
     return summary
 
 
-def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, quick: bool, replicates: int,
+def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, *, quick: bool, replicates: int,
                 lab_data, progress: bool) -> tuple[PaperSummary, CriterionOutputs, dict]:  # fmt: skip
     """Conversions, criterion, replicate specimens and direct shear (each read back when done).
 
@@ -165,27 +237,26 @@ def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, qu
     """
     from poro2d.criterion.result import CriterionOutputs
     from poro2d.criterion.table import print_result
-    from poro2d.store import Store
 
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
-    conv = _conversions_stage(out, stage)
+    conv = _conversions_stage(store, stage)
     timings["conversions_s"] = time.perf_counter() - t0
     console.print(f"[bold]2/3 criterion[/] (Fig. 3) for nLab = {crit.settings.n_lab}"
                   f"{' [quick specimen]' if quick else ''}")  # fmt: skip
     t1 = time.perf_counter()
     result = crit.run()
     timings["criterion_s"] = time.perf_counter() - t1
-    print_result(result, Store(out / "criterion"))
+    print_result(result, store.child("criterion"))
     shear = reps = None
     shear_figures: dict[str, Path] = {}
     if result.converged:
         t2 = time.perf_counter()
         n2d = result.final_porosity
         specimens, reps = accepted_and_replicates(crit.spec, crit.grading, crit.settings, n2d, crit.seed,
-                                                  replicates, Store(out), progress=progress)  # fmt: skip
+                                                  replicates, store, progress=progress)  # fmt: skip
         timings["replicates_s"] = time.perf_counter() - t2
-        shear, shear_figures = _shear_stage(specimens, out / "shear", quick, lab_data, progress)
+        shear, shear_figures = _shear_stage(specimens, store.child("shear"), quick, lab_data, progress)
         timings["shear_s"] = time.perf_counter() - t2 - timings["replicates_s"]
     else:
         console.print("[yellow]criterion not converged: direct shear skipped[/]")
@@ -193,12 +264,7 @@ def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, qu
         quick=quick,
         seed=crit.seed,
         conversions=conv,
-        criterion={
-            "final_porosity": result.final_porosity,
-            "converged": result.converged,
-            "message": result.message,
-            "iterations": result.iterations,
-        },  # fmt: skip
+        criterion=CriterionResult.from_dict({k: result[k] for k in CRITERION_KEYS}),
         replicate_specimens=reps,
         shear=shear,
         paper=PAPER,
@@ -206,21 +272,22 @@ def _run_stages(out: Path, stage: ResumableStage, crit: PorosityCriterion, *, qu
         provenance=provenance(),
         lab=lab_data.to_dict() if lab_data is not None else None,
     )
-    return summary, CriterionOutputs.read(Store(out / "criterion"), result), shear_figures
+    return summary, CriterionOutputs.read(store.child("criterion"), result), shear_figures
 
 
-def _conversions_stage(out: Path, stage: ResumableStage) -> dict:
+def _conversions_stage(store: Store, stage: ResumableStage) -> ConversionsRecord:
     """Stage 1: every conversion of the paper's sand, printed as a table and written with Figs. 1-2."""
     console.print("[bold]1/3 conversions[/] (Eqs. 1-12, Figs. 1-2)")
-    conv = stage.run(lambda: conversion_files(out / "conversions"), "conversions/conversions.json")
-    for m in conv["methods"]:
+    conv = stage.run(lambda: conversion_files(store.child("conversions")), "conversions/conversions.json",
+                     decode=ConversionsRecord.from_dict)  # fmt: skip
+    for m in conv.methods:
         v = "skipped" if m["n2d"] is None else f"{m['n2d']:.4f}"
         console.print(f"  {m['method']:<24} {m['equation']:<10} {v:>8} {m['flags']}")
     return conv
 
 
-def _shear_stage(specimens: dict[str, Path], out: Path, quick: bool, lab_data,
-                 progress: bool) -> tuple[dict, dict[str, Path]]:  # fmt: skip
+def _shear_stage(specimens: dict[str, Path], store: Store, quick: bool, lab_data,
+                 progress: bool) -> tuple[PaperShear, dict[str, Path]]:  # fmt: skip
     """Direct shear at the paper's normal stresses on every specimen; the summary over them and
     the figures written (Fig. 8 over the specimens, the first specimen's curves)."""
     from poro2d.shear.replicates import ReplicateShear
@@ -231,7 +298,8 @@ def _shear_stage(specimens: dict[str, Path], out: Path, quick: bool, lab_data,
         f"on {len(specimens)} specimen(s)"
     )
     sset = ShearSettings(**(QUICK_SHEAR if quick else {}))
-    rep = ReplicateShear(specimens, NORMAL_STRESSES_KPA, sset, out=out, lab=lab_data, progress=progress).run()
+    rep = ReplicateShear(specimens, NORMAL_STRESSES_KPA, sset, store=store, lab=lab_data,
+                         progress=progress).run()  # fmt: skip
     first_label, first = next(iter(rep.series.items()))
     fit = rep.fit or {}
     ci = fit.get("friction_angle_ci_deg")
@@ -243,18 +311,18 @@ def _shear_stage(specimens: dict[str, Path], out: Path, quick: bool, lab_data,
         + ", ".join(f"{v:.1f}" for v in rep.friction_angle_per_specimen_deg)
         + " deg"
     )
-    summary = {
+    summary = PaperShear(
         # the pooled fit over every specimen's peaks; "tests" and quasi_static of the first specimen
-        "tests": first.tests,
-        "friction_angle_deg": fit.get("friction_angle_deg"),
-        "cohesion_kpa": fit.get("cohesion_kpa"),
-        "r2": fit.get("r2"),
-        "quasi_static": first.quasi_static,
-        "replicates": rep.to_dict(),
-    }
+        tests=first.tests,
+        friction_angle_deg=fit.get("friction_angle_deg"),
+        cohesion_kpa=fit.get("cohesion_kpa"),
+        r2=fit.get("r2"),
+        quasi_static=first.quasi_static,
+        replicates=ReplicateShearResult.from_dict(rep.to_dict()),
+    )
     figures = {
-        "curves_replicates": out / "fig8a_shear_curves_replicates.png",
-        "peaks_replicates": out / "fig8b_peak_strength_replicates.png",
-        "curves_first": out / first_label / "fig8a_shear_curves.png",
+        "curves_replicates": store.path("fig8a_shear_curves_replicates.png"),
+        "peaks_replicates": store.path("fig8b_peak_strength_replicates.png"),
+        "curves_first": store.child(first_label).path("fig8a_shear_curves.png"),
     }
     return summary, figures

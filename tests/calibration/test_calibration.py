@@ -16,6 +16,7 @@ from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
+from poro2d.store import Store
 
 RANGES = model.Ranges((0.3, 3.0), (0.0, 0.5))
 
@@ -112,14 +113,14 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     paths, lab = tiny
     assert lab.read_text().startswith("# SYNTHETIC")
     out = tmp_path / "cal"
-    res = run_calibration(lab, [paths[0], paths[1]], out=out, points=8, refine=2, settings=SHORT, workers=1,
-                          dashboard=None, progress=False)  # fmt: skip
+    res = run_calibration(lab, [paths[0], paths[1]], store=Store(out), points=8, refine=2, settings=SHORT,
+                          workers=1, dashboard=None, progress=False)  # fmt: skip
     for name, value in TRUTH.items():
         lo, hi = res.intervals[name]
         assert lo <= value <= hi, (name, value, lo, hi)
         assert lo <= res.posterior["median"][name] <= hi
     assert res == json.loads((out / "result.json").read_text())
-    assert len(res.evaluations) == 10 and res.cluster["tests_run"] == 10 * 2 * 2
+    assert len(res.evaluations) == 10 and res.cluster.tests_run == 10 * 2 * 2
     assert {o["observable"] for o in res.posterior["observables"]} == {"peak", "end"}
     for f in ("calibration_fit.png", "calibration_posterior.png", "calibration.md", "calibration.html"):
         assert (out / f).stat().st_size > 0, f
@@ -127,24 +128,27 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     from poro2d.calibration.run import CalibrationResult
     from poro2d.report.paper_report import _calibration_blocks
 
-    kept = CalibrationResult.read(out)
+    kept = CalibrationResult.read(Store(out))
     assert isinstance(kept, CalibrationResult) and kept == res
     blocks = _calibration_blocks(kept, out)
     assert blocks[0] == ("h2", "Calibration of particle and rolling friction")
     assert any(b[0] == "img" and str(b[1]).endswith("calibration_posterior.png") for b in blocks)
-    assert CalibrationResult.read(tmp_path / "nothing") is None and _calibration_blocks(None, tmp_path) == []
+    assert (
+        CalibrationResult.read(Store(tmp_path / "nothing")) is None
+        and _calibration_blocks(None, tmp_path) == []
+    )
     table, _ = load_shear_config(out / "calibrated.toml")
     assert table["particle_friction"] == res.best["particle_friction"]
     assert table["rolling_friction"] == res.best["rolling_friction"]
-    again = run_calibration(lab, [paths[0], paths[1]], out=out, points=8, refine=2, settings=SHORT, workers=1,
-                            dashboard=None, progress=False)  # fmt: skip
-    assert again.cluster["tests_run"] == 0 and again.cluster["tests_reused"] == 40
+    again = run_calibration(lab, [paths[0], paths[1]], store=Store(out), points=8, refine=2, settings=SHORT,
+                            workers=1, dashboard=None, progress=False)  # fmt: skip
+    assert again.cluster.tests_run == 0 and again.cluster.tests_reused == 40
     assert again.best == res.best
     # a weaker 'laboratory' (the same specimen at lower frictions) moves the answer to weaker
     # parameters: the calibration follows its data (round 1 comes from the cache)
     weak_lab = synthetic_lab(paths[2], [50, 100], 0.3, 0.0, tmp_path / "weak.csv", settings=SHORT)
-    weak = run_calibration(weak_lab, [paths[0], paths[1]], out=out, points=8, refine=2, settings=SHORT,
-                           workers=1, dashboard=None, progress=False)  # fmt: skip
+    weak = run_calibration(weak_lab, [paths[0], paths[1]], store=Store(out), points=8, refine=2,
+                           settings=SHORT, workers=1, dashboard=None, progress=False)  # fmt: skip
     peaks = {
         o["normal_stress_kpa"]: o["model_kpa"]
         for o in res.posterior["observables"]
@@ -178,7 +182,7 @@ def test_bad_input_is_refused_before_any_test(tiny, tmp_path, kw, name):
     out = tmp_path / "out"
     args = {"settings": SHORT, "progress": False} | kw
     with pytest.raises(InputError, match=name):
-        run_calibration(lab, [paths[0]], out=out, **args)
+        run_calibration(lab, [paths[0]], store=Store(out), **args)
     assert not (out / "result.json").exists() and not (out / "cache").exists()
 
 
@@ -236,9 +240,10 @@ def test_lab_curves_shorter_than_the_tests_are_refused_and_their_end_is_the_last
 
     paths, _ = tiny
     short = tmp_path / "short.csv"
-    short.write_text("normal_stress_kpa,shear_displacement_mm,shear_stress_kpa\n50,0.5,20\n50,1.0,30\n")
+    short.write_text("normal_stress_kpa,shear_displacement_mm,shear_stress_kpa\n"
+                     "50,0.2,10\n50,0.4,20\n50,0.6,25\n50,0.8,28\n50,1.0,30\n")  # fmt: skip
     with pytest.raises(InputError, match="settings.max_displacement"):
-        run_calibration(short, [paths[0]], out=tmp_path / "o", settings=SHORT, progress=False)
+        run_calibration(short, [paths[0]], store=Store(tmp_path / "o"), settings=SHORT, progress=False)
     assert not (tmp_path / "o" / "cache").exists()
     curves = tmp_path / "curves.csv"
     curves.write_text("normal_stress_kpa,shear_displacement_mm,shear_stress_kpa\n"
@@ -246,3 +251,28 @@ def test_lab_curves_shorter_than_the_tests_are_refused_and_their_end_is_the_last
     targets = _lab_targets(read_lab_csv(curves), {"max_displacement": 0.002, "peak_window": 5e-4})
     # the peak, and the mean of the readings within the last window before 2 mm (1.5 to 2 mm)
     assert targets == [("peak", 50.0, 40.0), ("end", 50.0, 20.0)]
+
+
+def test_a_units_identity_is_the_digest_its_cache_folder_was_named_by():
+    """A unit is a value; its key (its cache folder's name) hashes what it did when units were
+    dicts, so the shear tests of earlier calibrations are found again."""
+    import dataclasses
+    import pickle
+
+    from poro2d.calibration.run import _base_settings
+    from poro2d.calibration.units import CalibrationUnit
+
+    unit = CalibrationUnit.at(
+        "s.npz", "ab" * 32, 100.0, _base_settings({"max_displacement": 0.002}), 0.8, 0.15
+    )
+    assert unit.key == "47911f67c9214a97b5a2"
+    assert (unit.fp, unit.mu_r) == (0.8, 0.15) and pickle.loads(pickle.dumps(unit)) == unit
+    assert dataclasses.replace(unit, sigma=50.0).key != unit.key
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        unit.sigma = 1.0  # type: ignore[misc]
+
+
+def test_the_preset_needs_a_store_to_keep_its_specimens(tiny):
+    _, lab = tiny
+    with pytest.raises(InputError, match="store"):
+        run_calibration(lab, preset="paper", quick=True, store=None, progress=False)

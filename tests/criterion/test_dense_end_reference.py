@@ -3,7 +3,7 @@
 The dense end is the criterion run with frictionless preparation (mu_prep = 0, layers that
 end once settled, trials refined to 0.002), its interior porosity measured 2 d50 clear of the
 walls and of the surface. The reference is the jamming porosity of the same grading in a
-periodic cell (:mod:`poro2d.specimen.jamming`), which shares no code with the engine or the
+periodic cell (:mod:`poro2d.oracles.jamming`), which shares no code with the engine or the
 compaction. A 0.12 m x 0.06 m box of two layers keeps the suite short; on the paper's box the
 paper grading gives 0.152-0.154 against 0.153 (docs/jamming.md).
 """
@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
+from poro2d.oracles.jamming import jamming_reference
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.grading import log_linear_grading, paper_grading, preset_grading
-from poro2d.specimen.jamming import jamming_reference
 
 pytestmark = pytest.mark.scenario
 

@@ -15,12 +15,13 @@ from poro2d.criterion.density import Calibration
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion, wall_forces
 from poro2d.criterion.servo import PlateServo, in_window
 from poro2d.dem import checkpoint
-from poro2d.shear import DirectShearTest, ShearSettings
+from poro2d.measure.porosity import box_porosity
+from poro2d.shear import DirectShearTest, ShearCase, ShearSettings
 from poro2d.shear.controllers import Consolidation, ShearDrive
 from poro2d.shear.curve import curve_summary
 from poro2d.shear.shear_stage import ShearStage
 from poro2d.specimen import paper_grading
-from poro2d.specimen.compaction import SpecimenSpec, box_porosity
+from poro2d.specimen.compaction import SpecimenSpec
 
 SRC = Path(poro2d.__file__).parent
 SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4}
@@ -44,7 +45,9 @@ def test_the_plate_servo_brings_a_raised_plate_into_the_window(specimen):
     width, height = 0.06, 0.03
     sim.translate_wall("top", 0.0, 0.002)  # off the specimen: F_top = 0, out of the window
     settings = CriterionSettings()
-    weight = SpecimenSpec(width=width, height=height).self_weight(box_porosity(sim, width, height))
+    weight = SpecimenSpec(width=width, height=height).self_weight(
+        box_porosity(sim.particles.area(), width, height)
+    )
     plate = PlateServo(settings, 1e-3, "max", height).settle(sim, weight)
     assert plate.settled and plate.displacement_m < 0.0
     assert plate.height_m == float(sim.walls.p0[sim.walls.index("top"), 1])
@@ -54,9 +57,9 @@ def test_the_plate_servo_brings_a_raised_plate_into_the_window(specimen):
 def test_the_shear_test_is_its_controllers(specimen):
     """Consolidation, then the shear stage driven by ShearDrive: the test's own curve, number for number."""
     settings = ShearSettings(**SHORT)
-    whole = DirectShearTest(specimen, 50.0, settings, figures=False).run()
+    whole = DirectShearTest(ShearCase.of(specimen, 50.0, settings), figures=False).run()
 
-    test = DirectShearTest(specimen, 50.0, settings, figures=False)
+    test = DirectShearTest(ShearCase.of(specimen, 50.0, settings), figures=False)
     sim, info = test.consolidate()
     phases = []
     stage = ShearStage(
@@ -65,7 +68,7 @@ def test_the_shear_test_is_its_controllers(specimen):
     stage.run()
     assert len(stage.rows) == whole["records"] and set(phases) == {"shearing"}
     summary = curve_summary(stage.rows, 50.0, settings)
-    assert summary["peak_shear_stress_kpa"] == whole["peak_shear_stress_kpa"]
+    assert summary.peak_shear_stress_kpa == whole["peak_shear_stress_kpa"]
     lower = [stage.sim.walls.vel[stage.sim.walls.index(n), 0] for n in ("bottom", "lower_left")]
     assert lower == [settings.velocity] * 2  # ShearDrive set the lower half moving
 
@@ -76,7 +79,7 @@ def test_consolidation_reports_a_specimen_it_could_not_settle(specimen):
     sim, box = build_split_box(checkpoint.load(specimen), 0.002)
     settings = ShearSettings(consolidation_max_steps=1000, **SHORT)
     done = Consolidation(settings).settle(sim, 50e3 * box.width * box.thickness)
-    assert not done["settled"] and done["steps"] == 1000
-    assert done["plate_height_before_m"] == pytest.approx(box.height)
+    assert not done.settled and done.steps == 1000
+    assert done.plate_height_before_m == pytest.approx(box.height)
     ShearDrive(0.01).start(sim)
     assert np.all(sim.walls.vel[[sim.walls.index(n) for n in ("bottom", "lower_lip")], 0] == 0.01)

@@ -23,8 +23,8 @@ import numpy as np
 import pytest
 
 from poro2d.dem import Particles, Simulation, Walls
-from poro2d.dem.measure import kinetic_energy
 from poro2d.dem.model import ContactModel
+from poro2d.measure.energy import kinetic_energy
 
 R = 0.01
 

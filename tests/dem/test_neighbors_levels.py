@@ -26,7 +26,7 @@ from poro2d.dem.neighbors import (
     build_pairs,
     level_scratch,
 )
-from poro2d.dem.reference import ReferenceDEM, engine_pair_order, engine_partitions
+from poro2d.oracles.engine_step import ReferenceDEM, engine_pair_order, engine_partitions
 
 RF = 1e-5  # radius of the fines (m)
 

@@ -8,7 +8,7 @@ import pytest
 from poro2d.dem import Particles, Simulation, Walls
 from poro2d.dem.ordering import is_permutation, strip_order
 from poro2d.errors import InputError
-from tests.dem.test_reference import _lockstep, jammed_packing
+from tests.oracles.test_engine_step import _lockstep, jammed_packing
 
 R = 1e-3
 

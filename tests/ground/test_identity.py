@@ -15,11 +15,12 @@ from poro2d import __version__
 from poro2d.calibration.units import unit_key
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.identity import identity_digest, outside_fields, outside_identity
-from poro2d.store.stage import Fingerprint
 from poro2d.shear.record import content_record, folder_stage
 from poro2d.shear.settings import ShearSettings
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.grading import paper_grading
+from poro2d.store import Store
+from poro2d.store.stage import Fingerprint
 from poro2d.sweep.cases import Case, case_id
 from poro2d.sweep.density import _run_key, calibration_key
 
@@ -135,7 +136,7 @@ def test_calibration_key_and_fields(name):
 def test_calibration_unit_and_shear_test_record_and_shear_fields(tmp_path, name):
     base, other = ShearSettings().to_dict(), changed(ShearSettings, name).to_dict()
     assert unit_key("abc", 50.0, other) != unit_key("abc", 50.0, base)
-    record = folder_stage(tmp_path, content_record("abc", 50.0, base), tmp_path / "s.npz").fingerprint
+    record = folder_stage(Store(tmp_path), content_record("abc", 50.0, base), "s.npz").fingerprint
     assert record.differences(content_record("abc", 50.0, other)) == [f"settings.{name}"]
 
 

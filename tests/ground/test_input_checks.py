@@ -1,17 +1,22 @@
 """The checks behind the one-line refusals: lists of numbers, scheduler addresses, UTF-8
-files, normal stresses; and the paper report's word on laboratory data."""
+files, normal stresses; the settings classes' tables of ranges; and the paper report's word
+on laboratory data."""
 
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass, fields
 
 import pytest
 
 from poro2d.cli.shear import parse_stresses
 from poro2d.config import check_number_list
-from poro2d.errors import InputError
+from poro2d.criterion.protocol import CRITERION_RANGES, CriterionSettings
+from poro2d.errors import InputError, Integer, OneOf, Real, check_fields
 from poro2d.execute import cluster_options, dask_cluster
 from poro2d.io_utils import read_utf8, text_position
+from poro2d.shear.settings import SHEAR_RANGES, ShearSettings
+from poro2d.specimen.compaction import SPECIMEN_RANGES, SpecimenSpec
 from poro2d.sweep.density import check_mus
 
 
@@ -140,3 +145,50 @@ def test_paper_summary_keeps_lab_only_when_given():
     assert "lab" not in PaperSummary(**keys).to_dict()
     lab = {"source": "a.csv", "kind": "peaks", "peaks": []}
     assert PaperSummary(**keys, lab=lab).to_dict()["lab"] == lab
+
+
+@dataclass
+class _Knob:
+    gain: float = 0.5
+    steps: int = 10
+    mode: str = "a"
+    cap: float | None = None
+
+    def __post_init__(self) -> None:
+        check_fields(self, _KNOB_RANGES)
+
+
+_KNOB_RANGES = {
+    "gain": Real(0.0, 1.0, lo_open=True),
+    "steps": Integer(1, 100),
+    "mode": OneOf(("a", "b"), quoted=True),
+    "cap": Real(0, None, or_none=True),
+}
+
+
+@pytest.mark.parametrize(
+    ("kw", "message"),
+    [
+        ({"gain": 0.0}, "gain = 0.0 is invalid; allowed: (0.0, 1.0]"),
+        ({"gain": "0.3"}, "gain = '0.3' is invalid; allowed: a number"),
+        ({"steps": True}, "steps = True is invalid; allowed: an integer in [1, 100]"),
+        ({"steps": 4.0}, "steps = 4.0 is invalid; allowed: an integer in [1, 100]"),
+        ({"mode": "c"}, "mode = 'c' is invalid; allowed: one of 'a', 'b'"),
+        ({"cap": -1}, "cap = -1 is invalid; allowed: [0, inf]"),
+        ({"gain": 2.0, "steps": 0}, "gain = 2.0 is invalid"),  # the table's first bad field
+    ],
+)
+def test_a_table_of_ranges_words_its_refusals_as_check_range_does(kw, message):
+    with pytest.raises(InputError) as e:
+        _Knob(**kw)
+    assert str(e.value).startswith(message)
+    assert _Knob(cap=None).cap is None  # or_none: None means "not given"
+
+
+@pytest.mark.parametrize(
+    ("cls", "ranges"),
+    [(SpecimenSpec, SPECIMEN_RANGES), (CriterionSettings, CRITERION_RANGES), (ShearSettings, SHEAR_RANGES)],
+)
+def test_every_range_names_a_field_of_its_settings(cls, ranges):
+    assert set(ranges) <= {f.name for f in fields(cls)}
+    cls()  # the defaults keep every range

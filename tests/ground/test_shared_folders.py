@@ -273,11 +273,21 @@ def test_the_local_dashboard_listens_on_this_machine_only(monkeypatch):
     dask_cluster.start_client(None, 1, 1, dashboard=None)  # no dashboard: its web server stays local
     assert seen["dashboard_address"] == "127.0.0.1:0" and seen["scheduler_kwargs"] == {"dashboard": False}
     assert cluster_options.check_dashboard(None) == "127.0.0.1:0"
-    assert cluster_options.check_dashboard("0.0.0.0:8787") == "0.0.0.0:8787"
+    free = _free_port()
+    assert cluster_options.check_dashboard(f"0.0.0.0:{free}") == f"0.0.0.0:{free}"
     assert cluster_options.check_dashboard("none") is None
     for bad in ("8787", "host:port", "a b:1", "h:70000"):
         with pytest.raises(InputError, match="--dashboard"):
             cluster_options.check_dashboard(bad)
+
+
+def _free_port() -> int:
+    """A port no one listens on now (the system's pick, released)."""
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("0.0.0.0", 0))
+        return s.getsockname()[1]
 
 
 def test_a_bad_dashboard_address_is_refused_before_any_work(tmp_path, capsys):
@@ -330,6 +340,9 @@ def test_export_refuses_a_specimen_the_criterion_did_not_accept(
         for row in result["iterations"]:
             row["accepted"] = False
     (crit / "result.json").write_text(json.dumps(result))
+    err = _refused(["export", str(crit), "--to", "lammps", "--out", str(tmp_path / "lmp")], capsys)
+    assert "result.json" in err and "changed since poro2d wrote it" in err  # edited by hand: not trusted
+    (crit / ".digests.json").unlink()  # as an earlier version (no manifest) would have written it
     for specimen in (crit, crit / "specimen.npz"):
         err = _refused(["export", str(specimen), "--to", "lammps", "--out", str(tmp_path / "lmp")], capsys)
         assert "SPECIMEN" in err and ("converged = False" in err or "no accepted trial" in err)
@@ -430,3 +443,33 @@ def test_a_relation_killed_at_random_moments_resumes_to_the_same_result(two_rela
     assert _lock_files(out, tmp_path / "cache") == []
     cases = list((tmp_path / "cache").rglob("params.json"))
     assert cases and all((c.parent / "result.json").is_file() for c in cases)  # every case finished
+
+
+# ------------------------------------------------------- a folder belongs to one kind of run
+def test_a_folder_of_another_kind_of_run_is_refused_before_any_work(tmp_path):
+    from poro2d.locks import KIND_NAME, folder_kind, output_folder
+
+    out = tmp_path / "out"
+    with output_folder("--out", out, kind="criterion"):
+        (out / "result.json").write_text("{}")
+    assert folder_kind(out) == "criterion"
+    with output_folder("--out", out, kind="criterion"):  # the same kind: resumes
+        pass
+    with pytest.raises(InputError, match="holds the results of a criterion run") as e:
+        with output_folder("--out", out, kind="calibrate"):
+            raise AssertionError("no work may start")
+    assert e.value.parameter == "--out"
+    assert sorted(p.name for p in out.iterdir()) == sorted([KIND_NAME, "result.json"])
+
+
+def test_a_run_that_wrote_nothing_leaves_no_kind_behind(tmp_path):
+    from poro2d.locks import output_folder
+
+    empty = tmp_path / "given"
+    empty.mkdir()
+    with output_folder("--out", empty, kind="shear"):
+        pass
+    assert list(empty.iterdir()) == []  # a later run of any kind may use it
+    with output_folder("--out", tmp_path / "new", kind="shear"):
+        pass
+    assert not (tmp_path / "new").exists()

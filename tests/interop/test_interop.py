@@ -15,6 +15,7 @@ from poro2d.interop import csv_table, pfc, yade
 from poro2d.interop import lammps as lmp
 from poro2d.interop.check import DEFAULTS, check_specimen, read_specimen
 from poro2d.interop.specimen_data import from_checkpoint, from_simulation, series
+from poro2d.locks import KIND_NAME
 
 
 @pytest.fixture(scope="module")
@@ -147,7 +148,9 @@ def test_export_refuses_what_a_target_cannot_hold(spec, tmp_path):
 def test_export_cli_writes_each_target_and_refuses_bad_input(saved, tmp_path, capsys):
     for target, names in (("lammps", {"specimen.data", "in.specimen"}), ("csv", {"disks.csv", "walls.csv"})):
         main(["export", str(saved.parent), "--to", target, "--out", str(tmp_path / target)])
-        assert {p.name for p in (tmp_path / target).iterdir()} == names
+        files = {p.name for p in (tmp_path / target).iterdir()}
+        assert files == names | {KIND_NAME}  # the folder is marked as an export's
+
     for argv, word in (
         (["export", str(saved), "--to", "gromacs", "--out", str(tmp_path / "x")], "--to"),
         (["export", str(tmp_path / "none.npz"), "--to", "csv", "--out", str(tmp_path / "x")], "SPECIMEN"),

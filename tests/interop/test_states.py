@@ -16,6 +16,7 @@ from poro2d.interop import csv_table, lammps, pfc, yade
 from poro2d.interop.check import DEFAULTS
 from poro2d.interop.specimen_data import from_checkpoint
 from poro2d.interop.state_specimen import find_state_specimen, state_specimen
+from poro2d.store import Store
 
 PROV = {"poro2d_version": "0.0.9", "created_utc": "2026-01-02T03:04:05+00:00"}
 
@@ -92,6 +93,7 @@ def relation(tmp_path_factory, specimen):
 def test_a_relation_gives_the_specimen_of_a_state_and_seed(relation):
     cases = relation / "states" / "cases"
     assert find_state_specimen(relation, n_lab=0.4571) == cases / "x1" / "run"
+    assert find_state_specimen(Store(relation), n_lab=0.4571) == cases / "x1" / "run"  # a store reads alike
     assert find_state_specimen(relation, dr=1.0, seed=0) == cases / "zz" / "run"
     assert find_state_specimen(relation, n_lab=0.32531) == cases / "zz" / "run"  # 4 decimals
     # the dense state's seed 1 was not run again: the calibration's case of its friction and seed

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from poro2d.dem import Particles, Simulation, Walls
-from poro2d.dem.measure import ContactSet
+from poro2d.dem.contacts import ContactSet
 from poro2d.errors import InputError
 from poro2d.report.force_chains import plot_force_chains, plot_simulation_force_chains, wall_segments
 

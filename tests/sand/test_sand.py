@@ -180,6 +180,7 @@ TINY = {
 def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
     from poro2d.sand import SandResult, run_sand
     from poro2d.sand.run import StageClock
+    from poro2d.store import Store
 
     monkeypatch.setenv("PORO2D_CACHE", str(tmp_path / "cache"))
     monkeypatch.setattr(PF, "JAMMING_DISKS", 200)
@@ -187,7 +188,11 @@ def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
     seen = []
     out = tmp_path / "sand"
     res = run_sand(
-        TINY, out=out, progress=False, announce=lines.append, on_preflight=lambda c, p: seen.append(p)
+        TINY,
+        store=Store(out),
+        progress=False,
+        announce=lines.append,
+        on_preflight=lambda c, p: seen.append(p),
     )
     assert isinstance(res, SandResult) and seen and len(lines) == 2 and "left (estimate)" in lines[0]
     assert isinstance(StageClock, type)
@@ -222,7 +227,7 @@ def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
         .startswith("soil,upscale,disks,n_lab,e,Dr,mu_prep,interior_porosity")
     )
     # a rerun reads every finished case back: the same numbers
-    again = run_sand(TINY, out=out, progress=False)
+    again = run_sand(TINY, store=Store(out), progress=False)
     assert again.box_porosity_mean == res.box_porosity_mean
     assert [k.box_porosity for k in again.specimens] == [k.box_porosity for k in res.specimens]
     assert again.mu_prep == res.mu_prep

@@ -11,6 +11,7 @@ from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.shear import ShearSeries, ShearSettings, build_split_box, run_shear
 from poro2d.shear.peak_frame import PeakFrame, PeakTracker
+from poro2d.store import Store
 
 SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4}
 # the keys of peak_frame.npz as earlier versions of poro2d wrote them: a test they left
@@ -24,7 +25,7 @@ def test_run_shear_is_the_series_with_its_files(specimen, tmp_path):
     lab = tmp_path / "lab.csv"
     lab.write_text("normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,75\n")
     out = tmp_path / "api"
-    res = run_shear(specimen.parent, [50, 100], SHORT, out=out, lab=lab, processes=1, progress=False,
+    res = run_shear(specimen.parent, [50, 100], SHORT, store=Store(out), lab=lab, processes=1, progress=False,
                     config={"note": "kept"})  # fmt: skip
     assert res == json.loads((out / "result.json").read_text())
     assert res["config"] == {"note": "kept"} and res["settings"]["max_displacement"] == 0.002
@@ -33,12 +34,13 @@ def test_run_shear_is_the_series_with_its_files(specimen, tmp_path):
               "sn50kPa/forces_peak.png", "sn100kPa/curve.csv"):  # fmt: skip
         assert (out / f).stat().st_size > 0, f
     assert not (out / "sn50kPa" / "peak_frame.npz").exists()  # removed with the checkpoint
-    ref = ShearSeries(specimen, [50, 100], ShearSettings(**SHORT), out=tmp_path / "series", processes=1,
-                      progress=False, figures=False).run()  # fmt: skip
+    ref = ShearSeries(specimen, [50, 100], ShearSettings(**SHORT), store=Store(tmp_path / "series"),
+                      processes=1, progress=False, figures=False).run()  # fmt: skip
     assert [t["peak_shear_stress_kpa"] for t in res["tests"]] == [
         t["peak_shear_stress_kpa"] for t in ref["tests"]
     ]
-    again = run_shear(specimen, 100, ShearSettings(**SHORT), out=out / "one", processes=1, progress=False)
+    again = run_shear(specimen, 100, ShearSettings(**SHORT), store=Store(out / "one"), processes=1,
+                      progress=False)  # fmt: skip
     assert again["tests"][0]["peak_shear_stress_kpa"] == ref["tests"][1]["peak_shear_stress_kpa"]
 
 
@@ -64,7 +66,8 @@ def test_run_shear_refuses_bad_input_before_any_test(specimen, tmp_path, kw, nam
     args = {"specimen": specimen, "normal_stresses_kpa": [50], "settings": SHORT, "progress": False} | kw
     out = tmp_path / "out"
     with pytest.raises(InputError, match=name):
-        run_shear(args.pop("specimen"), args.pop("normal_stresses_kpa"), args.pop("settings"), out=out,
+        run_shear(args.pop("specimen"), args.pop("normal_stresses_kpa"), args.pop("settings"),
+                  store=Store(out),
                   **args)  # fmt: skip
     assert not out.exists()
 
@@ -73,11 +76,13 @@ def test_run_shear_refuses_a_file_as_out_and_a_damaged_specimen(specimen, tmp_pa
     taken = tmp_path / "taken"
     taken.write_text("x")
     with pytest.raises(InputError, match="out"):
-        run_shear(specimen, [50], out=taken)
+        run_shear(specimen, [50], store=Store(taken))
+    with pytest.raises(InputError, match="store"):
+        run_shear(specimen, [50], store=taken)  # a path is not a store
     bad = tmp_path / "bad.npz"
     bad.write_bytes(specimen.read_bytes()[:100])
     with pytest.raises(InputError, match="checkpoint"):
-        run_shear(bad, [50], out=tmp_path / "o")
+        run_shear(bad, [50], store=Store(tmp_path / "o"))
     assert not (tmp_path / "o").exists()
 
 
@@ -85,10 +90,10 @@ def test_peak_frame_round_trip_and_figure(specimen, tmp_path):
     sim, box = build_split_box(checkpoint.load(specimen), 0.002)
     sim.run(20)
     frame = PeakFrame.capture(sim, sim.contacts(), record=7, displacement_mm=0.35)
-    frame.save(tmp_path / "peak_frame.npz")
+    frame.save(Store(tmp_path), "peak_frame.npz")
     with np.load(tmp_path / "peak_frame.npz") as z:
         assert set(z.files) == FRAME_KEYS
-    back = PeakFrame.load(tmp_path / "peak_frame.npz")
+    back = PeakFrame.load(Store(tmp_path), "peak_frame.npz")
     assert back.record == 7 and back.displacement_mm == 0.35 and back.thickness == sim.particles.thickness
     np.testing.assert_array_equal(back.pos, sim.particles.pos)
     np.testing.assert_array_equal(back.walls[:, 1], sim.walls.p1)
@@ -102,7 +107,7 @@ def test_peak_frame_round_trip_and_figure(specimen, tmp_path):
 
 def _frame(k: int) -> PeakFrame:
     empty = np.zeros((0, 2))
-    from poro2d.dem.measure import ContactSet
+    from poro2d.dem.contacts import ContactSet
 
     c = ContactSet(np.zeros(0, int), np.zeros(0, int), np.zeros(0, int), empty, empty, np.zeros(0),
                    np.zeros(0), empty, empty)  # fmt: skip
@@ -122,9 +127,9 @@ def test_peak_tracker_keeps_the_frame_of_the_smoothed_maximum(tmp_path):
         assert set(range(max(0, k - 1), k + 1)) <= waiting and min(waiting) >= k - 2
     tracker.settle(rows, None)
     assert tracker.frame.record == 8 and tracker.value == pytest.approx(np.mean(tau[6:11]))
-    tracker.save(tmp_path / "f.npz")
+    tracker.save(Store(tmp_path), "f.npz")
     resumed = PeakTracker(window=4e-3)
-    resumed.restore(tmp_path / "f.npz", rows)
+    resumed.restore(Store(tmp_path), "f.npz", rows)
     assert resumed.frame.record == 8 and resumed.value == pytest.approx(tracker.value)
-    resumed.save(tmp_path / "g.npz")  # nothing new since the restore: nothing written
+    resumed.save(Store(tmp_path), "g.npz")  # nothing new since the restore: nothing written
     assert not (tmp_path / "g.npz").exists()

@@ -52,13 +52,56 @@ def test_lab_curves(tmp_path):
     p = tmp_path / "lab.csv"
     p.write_text(
         "# comment\nnormal_stress_kpa,shear_displacement_mm,shear_stress_kpa,note\n"
-        "50,0,0,a\n50,2,30,b\n50,1,35,c\n100,0,0,d\n100,3,70,e\n"
+        "50,0,0,a\n50,1,35,b\n50,2,30,c\n50,3,29,d\n50,4,28,e\n"
+        "100,0,0,f\n100,1,40,g\n100,2,60,h\n100,3,70,i\n100,4,66,j\n"
     )
     lab = read_lab_csv(p)
     assert lab.kind == "curves" and lab.normal_stresses() == [50.0, 100.0]
     assert lab.peaks == {50.0: 35.0, 100.0: 70.0}
     d, t = lab.curves[50.0]
-    assert np.allclose(d, [0.0, 0.001, 0.002]) and np.allclose(t, [0, 35, 30])  # sorted, in m
+    assert np.allclose(d, [0.0, 0.001, 0.002, 0.003, 0.004]) and np.allclose(t, [0, 35, 30, 29, 28])  # in m
+
+
+LAB_CURVES = "normal_stress_kpa,shear_displacement_mm,shear_stress_kpa\n"
+
+
+@pytest.mark.parametrize(
+    ("body", "words"),
+    [
+        ("50,0,0\n50,2,30\n50,1,35\n50,3,30\n50,4,30\n", ["line 4", "shear_displacement_mm", "rises"]),
+        ("50,0,0\n50,1,30\n50,1,30\n50,2,30\n50,3,30\n", ["line 4", "rises"]),  # a repeated row
+        ("50,0,0\n50,1,30\n", ["curve at 50 kPa", "at least 5 readings"]),
+        ("50,0,0\n50,1,0\n50,2,0\n50,3,0\n50,4,0\n", ["the curve's peak", "(0, 2.5]"]),
+        ("50,0,0\n50,1,300\n50,2,0\n50,3,0\n50,4,0\n", ["line 3", "(0, 2.5]", "strong"]),
+        ("50000,0,0\n50000,1,3\n50000,2,3\n50000,3,3\n50000,4,3\n", ["normal_stress_kpa", "in kPa"]),
+        ("50,0,0\n50,1,1_000\n50,2,3\n50,3,3\n50,4,3\n", ["line 3", "1_000", "a number"]),
+    ],
+)
+def test_lab_curves_that_cannot_be_right_are_refused(tmp_path, body, words):
+    p = tmp_path / "lab.csv"
+    p.write_text(LAB_CURVES + body)
+    with pytest.raises(InputError) as e:
+        read_lab_csv(p)
+    for w in words:
+        assert w in str(e.value), (w, str(e.value))
+
+
+@pytest.mark.parametrize(
+    ("body", "words"),
+    [
+        ("50,0\n100,70\n", ["line 2", "peak_shear_stress_kpa", "weak"]),
+        ("50,500\n100,70\n", ["line 2", "(0, 2.5]", "strong"]),
+        ("50,1e300\n100,70\n", ["line 2", "strong"]),
+        ("0,10\n100,70\n", ["normal_stress_kpa", "[1, 1000] kPa"]),
+    ],
+)
+def test_lab_peaks_that_cannot_be_right_are_refused(tmp_path, body, words):
+    p = tmp_path / "lab.csv"
+    p.write_text("normal_stress_kpa,peak_shear_stress_kpa\n" + body)
+    with pytest.raises(InputError) as e:
+        read_lab_csv(p)
+    for w in words:
+        assert w in str(e.value), (w, str(e.value))
 
 
 def test_lab_peaks(tmp_path):

@@ -16,9 +16,9 @@ from poro2d.interop import lammps as lmp
 from poro2d.interop.check import box_spec, build_simulation
 from poro2d.interop.check import read_specimen as import_specimen
 from poro2d.interop.specimen_data import from_checkpoint
-from poro2d.store.stage import Fingerprint
-from poro2d.shear import DirectShearTest, ShearSettings, build_split_box
+from poro2d.shear import DirectShearTest, ShearCase, ShearSettings, build_split_box
 from poro2d.shear.record import content_record
+from poro2d.store.stage import Fingerprint
 
 
 @pytest.fixture(scope="module")
@@ -47,7 +47,7 @@ def test_split_box_rolling_friction_replaces_the_specimens(rolling_specimen, spe
 
 def test_a_shear_test_runs_with_the_rolling_friction_of_its_settings(specimen):
     settings = ShearSettings(max_displacement=0.002, rolling_friction=0.3, particle_friction=0.8)
-    sim, _ = DirectShearTest(specimen, 50, settings).consolidate()
+    sim, _ = DirectShearTest(ShearCase.of(specimen, 50, settings)).consolidate()
     assert np.all(sim.particles.mu_r == 0.3) and np.all(sim.particles.mu == 0.8)
     disk_disk, disk_wall = sim.rolling_moments()
     assert np.abs(disk_disk).max() > 0.0 and np.abs(disk_wall).max() > 0.0

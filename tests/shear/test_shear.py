@@ -11,6 +11,8 @@ from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.shear import DirectShearTest, ShearSeries, ShearSettings, build_split_box, smooth
 from poro2d.shear.box import LOWER, UPPER
+from poro2d.shear.case import ShearCase
+from poro2d.store import Store
 
 # 2 mm of shear in the 60 mm box: the peak of this small specimen lies near the end
 SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4}
@@ -20,8 +22,9 @@ SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 
 def series(specimen, tmp_path_factory):
     out = tmp_path_factory.mktemp("series")
     s = ShearSeries(
-        specimen, [50, 100, 200], ShearSettings(**SHORT), out=out, processes=1, progress=False, figures=False
-    )
+        specimen, [50, 100, 200], ShearSettings(**SHORT), store=Store(out), processes=1, progress=False,
+        figures=False,
+    )  # fmt: skip
     return out, s.run()
 
 
@@ -90,13 +93,14 @@ def test_each_curve_travels_in_the_result_as_its_file_holds_it(specimen, series)
         assert list(curve) == list(on_file)
         for k in curve:
             np.testing.assert_array_equal(curve[k], on_file[k])
-        read = ShearTestResult.read(out / f"sn{sigma:g}kPa")
+        read = ShearTestResult.read(Store(out / f"sn{sigma:g}kPa"))
         assert read.normal_stress_kpa == sigma and read.curve["step"].size == read.records
         back = pickle.loads(pickle.dumps(read))
         np.testing.assert_array_equal(back.curve["shear_stress_kpa"], curve["shear_stress_kpa"])
     again = ShearSeries(
-        specimen, [50, 100, 200], ShearSettings(**SHORT), out=out, processes=1, progress=False, figures=False
-    ).run()  # every test finished: read back, nothing run
+        specimen, [50, 100, 200], ShearSettings(**SHORT), store=Store(out), processes=1, progress=False,
+        figures=False,
+    ).run()  # fmt: skip  # every test finished: read back, nothing run
     for sigma, curve in r.curves.items():
         for k in curve:
             np.testing.assert_array_equal(again.curves[sigma][k], curve[k])
@@ -137,7 +141,7 @@ def test_servo_holds_the_normal_stress(series):
 def test_frictionless_disks_are_far_weaker(specimen, series, tmp_path):
     _, r = series
     s = ShearSettings(particle_friction=0.0, **SHORT)
-    r0 = DirectShearTest(specimen, 100, s, out=tmp_path, figures=False).run()
+    r0 = DirectShearTest(ShearCase.of(specimen, 100, s), Store(tmp_path), figures=False).run()
     tau3 = next(t["peak_shear_stress_kpa"] for t in r["tests"] if t["normal_stress_kpa"] == 100)
     assert r0["peak_shear_stress_kpa"] < 0.5 * tau3
 
@@ -155,9 +159,11 @@ def test_killed_test_resumes_from_its_checkpoint(specimen, series, tmp_path):
             raise _Stop
 
     with pytest.raises(_Stop):
-        DirectShearTest(specimen, 100, ShearSettings(**SHORT), out=tmp_path, progress=stop).run()
+        DirectShearTest(
+            ShearCase.of(specimen, 100, ShearSettings(**SHORT)), Store(tmp_path), progress=stop
+        ).run()
     assert (tmp_path / "shear_checkpoint.npz").is_file() and not (tmp_path / "result.json").exists()
-    r = DirectShearTest(specimen, 100, ShearSettings(**SHORT), out=tmp_path).run()
+    r = DirectShearTest(ShearCase.of(specimen, 100, ShearSettings(**SHORT)), Store(tmp_path)).run()
     a = _curve(tmp_path / "curve.csv")
     b = _curve(out / "sn100kPa" / "curve.csv")
     np.testing.assert_array_equal(a["shear_stress_kpa"], b["shear_stress_kpa"])
@@ -247,21 +253,23 @@ def test_cli_missing_specimen_and_bad_lab(specimen, tmp_path, capsys):
 
 def test_api_bad_input(specimen, tmp_path):
     with pytest.raises(InputError, match="normal stress"):
-        DirectShearTest(specimen, -50)
+        ShearCase.of(specimen, -50)
     with pytest.raises(InputError, match="max_displacement"):
-        DirectShearTest(specimen, 50, ShearSettings(max_displacement=0.05))
+        ShearCase.of(specimen, 50, ShearSettings(max_displacement=0.05))
     with pytest.raises(InputError, match="specimen"):
         ShearSeries(tmp_path / "missing.npz", [50])
     with pytest.raises(InputError, match="normal stress"):
-        ShearSeries(specimen, [50, 50], out=tmp_path)
+        ShearSeries(specimen, [50, 50], store=Store(tmp_path))
 
 
 def test_a_folder_holding_another_test_is_not_overwritten(specimen, series):
     out, _ = series
     with pytest.raises(InputError, match="another normal stress"):
-        DirectShearTest(specimen, 100, ShearSettings(**SHORT), out=out / "sn50kPa").run()
+        DirectShearTest(ShearCase.of(specimen, 100, ShearSettings(**SHORT)), Store(out / "sn50kPa")).run()
     with pytest.raises(InputError, match=r"other settings \(velocity\)"):
-        DirectShearTest(specimen, 50, ShearSettings(**dict(SHORT, velocity=0.02)), out=out / "sn50kPa").run()
+        DirectShearTest(
+            ShearCase.of(specimen, 50, ShearSettings(**dict(SHORT, velocity=0.02))), Store(out / "sn50kPa")
+        ).run()
 
 
 def test_rate_check_reruns_at_half_velocity(specimen, series, tmp_path):
@@ -270,8 +278,8 @@ def test_rate_check_reruns_at_half_velocity(specimen, series, tmp_path):
     out, r = series
     shutil.copytree(out / "sn100kPa", tmp_path / "sn100kPa")  # done: only the v/2 rerun runs
     s = ShearSeries(
-        specimen, [100], ShearSettings(**SHORT), out=tmp_path, rate_check=True, processes=1, progress=False,
-        figures=False,
+        specimen, [100], ShearSettings(**SHORT), store=Store(tmp_path), rate_check=True, processes=1,
+        progress=False, figures=False,
     )  # fmt: skip
     res = s.run()
     rc = res["rate_check"]
@@ -338,8 +346,9 @@ def test_moved_folders_resume_without_recomputing(specimen, series, tmp_path):
     done = sorted(dest.glob("sn*/result.json"))
     stamps = [f.stat().st_mtime_ns for f in done]
     again = ShearSeries(
-        spec_dir, [50, 100, 200], ShearSettings(**SHORT), out=dest, processes=1, progress=False, figures=False
-    ).run()
+        spec_dir, [50, 100, 200], ShearSettings(**SHORT), store=Store(dest), processes=1, progress=False,
+        figures=False,
+    ).run()  # fmt: skip
     assert [f.stat().st_mtime_ns for f in done] == stamps
     assert [t["peak_shear_stress_kpa"] for t in again["tests"]] == [
         t["peak_shear_stress_kpa"] for t in r["tests"]
@@ -349,9 +358,13 @@ def test_moved_folders_resume_without_recomputing(specimen, series, tmp_path):
 def test_settings_bind_only_once_a_test_started(specimen, tmp_path):
     # a series stopped before any stage began (only the records written) does not hold its folder
     ShearSeries(
-        specimen, [50, 100], ShearSettings(**dict(SHORT, velocity=0.03)), out=tmp_path, progress=False
+        specimen,
+        [50, 100],
+        ShearSettings(**dict(SHORT, velocity=0.03)),
+        store=Store(tmp_path),
+        progress=False,
     )
-    s = ShearSeries(specimen, [50, 100], ShearSettings(**SHORT), out=tmp_path, progress=False)
+    s = ShearSeries(specimen, [50, 100], ShearSettings(**SHORT), store=Store(tmp_path), progress=False)
     stored = json.loads((tmp_path / "sn50kPa" / "test.json").read_text())
     assert stored["run"]["settings"]["velocity"] == s.settings.velocity
     assert str(tmp_path) not in json.dumps(stored["run"])  # no paths in what is compared
@@ -359,7 +372,9 @@ def test_settings_bind_only_once_a_test_started(specimen, tmp_path):
 
 def test_non_finite_shear_settings_are_refused(specimen, tmp_path):
     with pytest.raises(InputError, match="peak_window"):
-        ShearSeries(specimen, [50], ShearSettings(**dict(SHORT, peak_window=float("inf"))), out=tmp_path)
+        ShearSeries(
+            specimen, [50], ShearSettings(**dict(SHORT, peak_window=float("inf"))), store=Store(tmp_path)
+        )
     assert not any(tmp_path.iterdir())
 
 
@@ -367,8 +382,8 @@ def test_stop_after_peak_ends_the_test_with_the_same_peak(specimen):
     """Stopping once the peak is passed changes nothing before the stop: the curve is a prefix
     of the full one, the peak is the same, and the result says why it ended."""
     base = {"max_displacement": 0.004, "peak_window": 5e-4}
-    full = DirectShearTest(specimen, 100, ShearSettings(**base, stop_after_peak=0.0)).run()
-    short = DirectShearTest(specimen, 100, ShearSettings(**base, stop_after_peak=5e-4)).run()
+    full = DirectShearTest(ShearCase.of(specimen, 100, ShearSettings(**base, stop_after_peak=0.0))).run()
+    short = DirectShearTest(ShearCase.of(specimen, 100, ShearSettings(**base, stop_after_peak=5e-4))).run()
     assert full["ended_by"] == "max_displacement"
     assert short["ended_by"].startswith("peak passed by 0.5 mm")
     assert short["records"] < full["records"]

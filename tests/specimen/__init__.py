@@ -1,1 +1,1 @@
-"""Tests of ``poro2d.specimen``: gradings, placement, compaction, porosity regions, jamming."""
+"""Tests of ``poro2d.specimen``: gradings, placement, compaction, the box read back."""

@@ -7,7 +7,7 @@ import pytest
 
 from poro2d.criterion.protocol import wall_forces
 from poro2d.dem import Simulation
-from poro2d.dem.measure import contact_set
+from poro2d.dem.contacts import contact_set
 from poro2d.errors import InputError
 from poro2d.specimen.compaction import SettledTest, SpecimenSpec, prepare_specimen
 from poro2d.specimen.grading import preset_grading

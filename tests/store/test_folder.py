@@ -7,9 +7,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from poro2d.dem import Particles, Simulation, Walls
-from poro2d.store import Store, walk
+from poro2d.errors import InputError
+from poro2d.store import Store, digests, walk
+from poro2d.store.stage import Fingerprint
 from poro2d.typed_result import TypedResult
 
 
@@ -47,7 +50,8 @@ def test_tables_and_arrays(tmp_path):
     s.write_arrays("a.npz", x=np.arange(3.0), y=np.ones(2, dtype=np.int64))
     arrays = s.read_arrays("a.npz")
     assert arrays["x"].tolist() == [0.0, 1.0, 2.0] and arrays["y"].dtype == np.int64
-    assert not [p.name for p in tmp_path.iterdir() if p.name.startswith(".")], "no temporaries left"
+    hidden = [p.name for p in tmp_path.iterdir() if p.name.startswith(".")]
+    assert hidden == [digests.MANIFEST], "no temporaries left"
 
 
 def test_children_copy_remove_and_walk(tmp_path):
@@ -76,5 +80,89 @@ def test_checkpoints_resume_the_saved_state(tmp_path):
     back, extra = ck.resume()
     assert extra == {"done": 200} and back.step_count == 200
     assert np.array_equal(back.particles.pos, sim.particles.pos)
+    meta, arrays = Store(tmp_path).read_state("stage.npz")  # the whole file read and checked
+    assert meta["extra"] == {"done": 200} and arrays
     ck.clear()
     assert ck.resume() is None
+    ck.save(sim, extra={"done": 200})
+    (tmp_path / "stage.npz").write_bytes((tmp_path / "stage.npz").read_bytes()[:-10])
+    assert ck.resume() is None and not (tmp_path / "stage.npz").exists()  # damaged: start again
+
+
+def test_a_file_changed_since_it_was_written_is_not_used(tmp_path):
+    """Edited by hand, truncated or replaced: read as missing, refused where it cannot be recomputed."""
+    s = Store(tmp_path)
+    s.write_result("result.json", _Answer(0.17, True))
+    (tmp_path / "result.json").write_text((tmp_path / "result.json").read_text().replace("0.17", "0.5"))
+    assert s.read_json("result.json") is None and not s.intact("result.json")
+    s.write_arrays("a.npz", x=np.arange(1000.0))
+    data = (tmp_path / "a.npz").read_bytes()
+    (tmp_path / "a.npz").write_bytes(data[: len(data) // 2])
+    assert s.read_arrays("a.npz") is None
+    s.write_csv("c.csv", [{"a": 1}])
+    (tmp_path / "c.csv").write_text("a\n2\n")
+    with pytest.raises(InputError, match="changed since it was written"):
+        s.read_frame("c.csv")
+    s.write_csv("c.csv", [{"a": 3}])  # written again: trusted again
+    assert s.read_frame("c.csv")["a"].tolist() == [3]
+
+
+def test_files_the_store_did_not_write_are_read_unchecked(tmp_path):
+    (tmp_path / "old.json").write_text('{"porosity": 0.2}')
+    assert Store(tmp_path).read_json("old.json") == {"porosity": 0.2}
+
+
+def test_a_stage_whose_marker_was_edited_runs_again(tmp_path):
+    calls = []
+
+    def compute():
+        calls.append(1)
+        return {"peak_kpa": 42.0}
+
+    stage = Store(tmp_path).stage(Fingerprint({"case": 1}))
+    assert stage.run(compute) == {"peak_kpa": 42.0}
+    assert stage.run(compute) == {"peak_kpa": 42.0} and len(calls) == 1  # resumed
+    (tmp_path / "result.json").write_text('{"peak_kpa": 4200.0}')
+    assert stage.run(compute) == {"peak_kpa": 42.0} and len(calls) == 2  # recomputed, not used
+
+
+def test_a_state_read_once_starts_runs_as_its_file_does(tmp_path):
+    from poro2d.dem import checkpoint
+
+    p = Particles(
+        np.array([[0.01, 0.01], [0.0141, 0.01]]), np.array([0.002, 0.002]), 2650.0, 0.008, 4e5, 4e5, 0.5
+    )
+    sim = Simulation(p, Walls.box(0, 0, 0.05, 0.05, 1e7, 1e7, 0.5))
+    sim.run(100)
+    s = Store(tmp_path)
+    s.save_state("state.npz", sim)
+    meta, arrays = s.read_state("state.npz")
+    assert checkpoint.content_digest(meta, arrays) == checkpoint.state_digest(tmp_path / "state.npz")
+    a = checkpoint.from_content(meta, arrays)
+    a.run(100)
+    b = s.load_state("state.npz")
+    b.run(100)
+    assert np.array_equal(a.particles.pos, b.particles.pos)
+    again = checkpoint.from_content(meta, arrays)  # the content is unchanged by the first run
+    assert np.array_equal(again.particles.pos, s.load_state("state.npz").particles.pos)
+
+
+def test_csv_rows_read_back_as_written(tmp_path):
+    s = Store(tmp_path)
+    x = 0.1 + 0.2  # a float whose shortest repr has 17 digits
+    s.write_csv("t.csv", [{"a": 1, "b": x}, {"a": 2, "b": "text, quoted"}])
+    assert s.read_rows("t.csv") == [{"a": "1", "b": repr(x)}, {"a": "2", "b": "text, quoted"}]
+    assert float(s.read_rows("t.csv")[0]["b"]) == x
+    assert s.read_rows("missing.csv") is None
+
+
+def test_a_call_holds_the_folder_of_the_store_it_is_given(tmp_path):
+    """``holds_output`` holds a store by its folder; None holds nothing."""
+    from poro2d.locks import holds_output
+
+    @holds_output("store")
+    def run(store):
+        return None if store is None else store.root.is_dir()  # held: made for the call
+
+    assert run(None) is None and not list(tmp_path.iterdir())
+    assert run(Store(tmp_path / "out", parameter="--into"))

@@ -8,10 +8,40 @@ not cached and serves both rounds.
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
-from poro2d.calibration.units import compute_unit, stored_row
+from poro2d.calibration.units import CalibrationUnit, UnitRow, compute_unit, stored_row
 from poro2d.execute import Backend, Executor, Failed, Job
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD
+from poro2d.store import Store
+from poro2d.typed_result import TypedResult
+
+
+@dataclass(eq=False)
+class UnitFailure(TypedResult):
+    """A unit whose test failed (no equilibrium): left out of the fit, and said in ``failures``."""
+
+    key: str
+    sigma: float
+    fp: float
+    mu_r: float
+    specimen: str
+    error: str
+    traceback: str | None
+
+
+@dataclass(eq=False)
+class ClusterRecord(TypedResult):
+    """What is recorded of the cluster and the work (``cluster`` in ``result.json``)."""
+
+    scheduler: str | None
+    workers: int | None
+    local_cluster: bool
+    tests_run: int
+    tests_reused: int
+    tests_failed: int
+    test_time_sum_s: float
+    wall_time_tests_s: float
 
 
 class UnitRunner:
@@ -27,28 +57,28 @@ class UnitRunner:
     ) -> None:
         self.scheduler, self.workers, self.progress, self.dashboard = scheduler, workers, progress, dashboard
         self.executor = Executor(Backend.dask(scheduler, workers, dashboard=dashboard))
-        self.failures: list[dict] = []
+        self.failures: list[UnitFailure] = []
         self.ran = self.reused = 0
         self.busy_s = 0.0
         self.wall_s = 0.0
 
-    def run(self, jobs: list[dict], label: str) -> dict[str, dict]:
-        """Rows by unit key for ``jobs``: read back when cached, else run as Dask tasks."""
+    def run(self, units: list[CalibrationUnit], cache: Store | None, label: str) -> dict[str, UnitRow]:
+        """Rows by unit key for ``units``: read back when ``cache`` holds them, else run as Dask tasks."""
         from poro2d.progress import CountProgress
 
-        rows: dict[str, dict] = {}
+        rows: dict[str, UnitRow] = {}
         todo = []
-        for job in jobs:
-            row = stored_row(job)
+        for unit in units:
+            row = stored_row(unit, cache)
             if row is None:
-                todo.append(job)
+                todo.append(unit)
             else:
-                rows[job["key"]] = row
+                rows[unit.key] = row
         self.reused += len(rows)
         if not todo:
             return rows
         t0 = time.perf_counter()
-        done_before = f" ({len(rows)} of {len(jobs)} cached)" if rows else ""
+        done_before = f" ({len(rows)} of {len(units)} cached)" if rows else ""
         try:
             with CountProgress(label + done_before, len(todo), "shear tests", enabled=self.progress) as bar:
 
@@ -56,8 +86,8 @@ class UnitRunner:
                     self._take(todo[index], outcome, rows)
                     bar.advance(f"{len(self.failures)} failed" if self.failures else "")
 
-                units = [Job(compute_unit, (job,), job["key"], key=f"calibrate-{job['key']}") for job in todo]
-                self.executor.map(units, on_done=ended)
+                jobs = [Job(compute_unit, (u, cache), u.key, key=f"calibrate-{u.key}") for u in todo]
+                self.executor.map(jobs, on_done=ended)
         except KeyboardInterrupt:
             self.executor.quiet()
             raise
@@ -65,42 +95,42 @@ class UnitRunner:
             self.wall_s += time.perf_counter() - t0
         return rows
 
-    def _take(self, job: dict, outcome, rows: dict[str, dict]) -> None:
+    def _take(self, unit: CalibrationUnit, outcome, rows: dict[str, UnitRow]) -> None:
         """A unit's row into ``rows``; a test that fails (no equilibrium) is left out of the fit, and said."""
         if not isinstance(outcome, Failed):
-            rows[job["key"]] = outcome
-            self.busy_s += outcome["wall_time_s"]
+            rows[unit.key] = outcome
+            self.busy_s += outcome.wall_time_s
             self.ran += 1
             return
         exc = outcome.error
         self.failures.append(
-            {
-                "key": job["key"],
-                "sigma": job["sigma"],
-                "fp": job["fp"],
-                "mu_r": job["mu_r"],
-                "specimen": job["specimen"],
-                "error": f"{type(exc).__name__}: {exc}".splitlines()[0],
-                "traceback": outcome.traceback,
-            }
+            UnitFailure(
+                key=unit.key,
+                sigma=unit.sigma,
+                fp=unit.fp,
+                mu_r=unit.mu_r,
+                specimen=unit.specimen,
+                error=f"{type(exc).__name__}: {exc}".splitlines()[0],
+                traceback=outcome.traceback,
+            )
         )
 
-    def info(self) -> dict:
+    def info(self) -> ClusterRecord:
         """What is recorded of the cluster and the work: workers, tests run and reused, times."""
-        cluster = self.executor.cluster_info()
-        return {
-            "scheduler": self.scheduler,
-            "workers": cluster.get("workers"),
-            "local_cluster": cluster.get("local_cluster", False),
-            "tests_run": self.ran,
-            "tests_reused": self.reused,
-            "tests_failed": len(self.failures),
-            "test_time_sum_s": self.busy_s,
-            "wall_time_tests_s": self.wall_s,
-        }
+        cluster = self.executor.cluster_info()  # None: not a Dask cluster (inline, one worker)
+        return ClusterRecord(
+            scheduler=self.scheduler,
+            workers=None if cluster is None else cluster.workers,
+            local_cluster=False if cluster is None else cluster.local_cluster,
+            tests_run=self.ran,
+            tests_reused=self.reused,
+            tests_failed=len(self.failures),
+            test_time_sum_s=self.busy_s,
+            wall_time_tests_s=self.wall_s,
+        )
 
     def close(self) -> None:
         self.executor.close()
 
 
-__all__ = ["UnitRunner"]
+__all__ = ["ClusterRecord", "UnitFailure", "UnitRunner"]

@@ -3,34 +3,32 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
-from poro2d.io_utils import atomic_path, write_json
+from poro2d.calibration.units import CACHE, CalibrationUnit, unit_curve
+from poro2d.store import Store
 
 FIT_PNG = "calibration_fit.png"
 POSTERIOR_PNG = "calibration_posterior.png"
 CONFIG_TOML = "calibrated.toml"
 
 
-def write_outputs(out: Path, result, post, surrogates, lab, found, digests, base) -> None:
+def write_outputs(store: Store, result, post, surrogates, lab, found, digests, base) -> None:
     """Figures, config and report first; ``result.json`` last (its presence says: finished)."""
     from poro2d.report.calibration_figures import plot_calibration_fit, plot_calibration_posterior
 
-    curves, nearest = _best_curves(result, lab, found, digests, base, out)
-    plot_calibration_fit(result, lab, curves, nearest, out / FIT_PNG)
-    plot_calibration_posterior(result, post, out / POSTERIOR_PNG)
-    _config(out / CONFIG_TOML, result, lab)
+    curves, nearest = _best_curves(result, lab, found, digests, base, store.child(CACHE))
+    plot_calibration_fit(result, lab, curves, nearest, store.path(FIT_PNG))
+    plot_calibration_posterior(result, post, store.path(POSTERIOR_PNG))
+    store.write_text(CONFIG_TOML, _config(result, lab))
     from poro2d.report.calibration_report import write_calibration_report
 
-    write_calibration_report(out, result)
-    write_json(out / "result.json", result)
+    write_calibration_report(store.root, result)
+    store.write_result("result.json", result)
 
 
-def _best_curves(result, lab, found, digests, base, out: Path) -> tuple[dict[float, list], dict]:
+def _best_curves(result, lab, found, digests, base, cache: Store) -> tuple[dict[float, list], dict]:
     """The curves of the design point nearest the best parameters, per normal stress (all
     specimens), and that design point: what the fit figure draws."""
-    from poro2d.calibration.units import unit_curve, unit_job
-
     best = result.best
     nearest = min(
         result.evaluations,
@@ -42,16 +40,10 @@ def _best_curves(result, lab, found, digests, base, out: Path) -> tuple[dict[flo
     curves: dict[float, list] = {}
     for s in lab.normal_stresses():
         for label, path in found.items():
-            job = unit_job(
-                path,
-                digests[label],
-                s,
-                base,
-                nearest["particle_friction"],
-                nearest["rolling_friction"],
-                out / "cache",
+            unit = CalibrationUnit.at(
+                path, digests[label], s, base, nearest["particle_friction"], nearest["rolling_friction"]
             )
-            curve = unit_curve(job)
+            curve = unit_curve(unit, cache)
             if curve is not None:
                 curves.setdefault(s, []).append(curve)
     return curves, nearest
@@ -67,8 +59,9 @@ def _toml_value(v) -> str:
     return '"' + str(v).replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
-def _config(path: Path, result, lab) -> None:
-    """A config with the calibrated values: ``[shear]`` for ``poro2d shear --config``, ``[specimen]``
+def _config(result, lab) -> str:
+    """The text of a config with the calibrated values: ``[shear]`` for ``poro2d shear --config``,
+    ``[specimen]``
     for a new specimen (``poro2d criterion``) to export with ``poro2d export``."""
     b = result.best
     shear = {k: v for k, v in result.settings.items() if v is not None}
@@ -90,8 +83,7 @@ def _config(path: Path, result, lab) -> None:
         "",
         "[shear]",
     ] + [f"{k} = {_toml_value(v)}" for k, v in shear.items()]
-    with atomic_path(path) as tmp:
-        tmp.write_text("\n".join(lines) + "\n")
+    return "\n".join(lines) + "\n"
 
 
 __all__ = ["CONFIG_TOML", "FIT_PNG", "POSTERIOR_PNG", "write_outputs"]

@@ -10,19 +10,17 @@ Everything is checked before the first test starts.
 
 from __future__ import annotations
 
-import json
 import os
 import time
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from poro2d.calibration import model
-from poro2d.calibration.cluster import UnitRunner
+from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
 from poro2d.calibration.specimens import check_preset, given_specimens, preset_specimens
-from poro2d.calibration.units import unit_job
+from poro2d.calibration.units import CACHE, CalibrationUnit, UnitRow
 from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
 from poro2d.execute.dask_cluster import check_reachable
@@ -32,7 +30,11 @@ from poro2d.paper_data import QUICK_SHEAR
 from poro2d.shear.lab import LabData, read_lab_csv
 from poro2d.shear.series import check_stresses
 from poro2d.shear.settings import MAX_FRICTION, ShearSettings
+from poro2d.store import Store
 from poro2d.typed_result import TypedResult
+
+#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+KIND = "calibrate"
 
 DEFAULT_FP_RANGE = (0.3, 3.0)
 DEFAULT_MU_R_RANGE = (0.0, 0.5)
@@ -42,6 +44,53 @@ MAX_POINTS = 500
 MIN_POINTS = model.N_COEFFICIENTS
 #: the settings calibrated here: given ones would be overridden, so they are refused
 CALIBRATED = ("particle_friction", "rolling_friction")
+
+
+@dataclass(eq=False)
+class FittedObservable(TypedResult):
+    """One laboratory value fitted: the observable (``peak`` or ``end``) at a normal stress, the
+    laboratory's value, the surrogate's at the best parameters and the noise it was given (kPa)."""
+
+    observable: str
+    normal_stress_kpa: float
+    lab_kpa: float
+    model_kpa: float
+    noise_sd_kpa: float
+
+
+@dataclass(eq=False)
+class PosteriorSummary(TypedResult):
+    """What ``result.json`` keeps of the posterior (``posterior``).
+
+    ``median``: per parameter (inside its interval, unlike the maximum on a ridge);
+    ``correlation``: of the two parameters (near +-1: a ridge); ``wide``: per parameter,
+    whether its interval spans more than :data:`~poro2d.calibration.model.WIDE_FRACTION` of
+    its range; ``grid``: points per axis; ``prior``: in words; ``observables``: the values
+    fitted; ``noise_correlation``: of the observables' noise.
+    """
+
+    median: dict[str, float]
+    correlation: float
+    wide: dict[str, bool]
+    grid: int
+    prior: str
+    observables: list[FittedObservable]
+    noise_correlation: list[list[float]]
+
+    def to_dict(self) -> dict[str, Any]:
+        out = super().to_dict()
+        if self.observables is not None:
+            out["observables"] = [o.to_dict() if isinstance(o, TypedResult) else o for o in self.observables]
+        return out
+
+    @classmethod
+    def from_dict(cls, data) -> PosteriorSummary:
+        obj = super().from_dict(data)
+        if isinstance(obj.observables, list):
+            obj.observables = [
+                FittedObservable.from_dict(o) if isinstance(o, dict) else o for o in obj.observables
+            ]
+        return obj
 
 
 @dataclass(eq=False)
@@ -60,24 +109,45 @@ class CalibrationResult(TypedResult):
     best: dict[str, float]
     intervals: dict[str, list[float]]
     level: float
-    posterior: dict[str, Any]
+    posterior: PosteriorSummary
     evaluations: list[dict[str, Any]]
     fit: dict[str, Any]
     lab: dict[str, Any]
     specimens: dict[str, str]
     ranges: dict[str, list[float]]
     settings: dict[str, Any]
-    cluster: dict[str, Any]
-    failures: list[dict[str, Any]]
+    cluster: ClusterRecord
+    failures: list[UnitFailure]
     timings: dict[str, float]
     config: dict[str, Any]
     provenance: dict[str, Any]
 
+    def to_dict(self) -> dict[str, Any]:
+        """The file's keys; the cluster and the failures as the dicts they are written as."""
+        out = super().to_dict()
+        for key in ("posterior", "cluster"):
+            if isinstance(out.get(key), TypedResult):
+                out[key] = out[key].to_dict()
+        if self.failures is not None:
+            out["failures"] = [f.to_dict() if isinstance(f, UnitFailure) else f for f in self.failures]
+        return out
+
     @classmethod
-    def read(cls, folder: str | os.PathLike) -> CalibrationResult | None:
-        """The calibration finished in ``folder`` (its ``result.json``), or None when there is none."""
-        path = Path(folder) / "result.json"
-        return cls.from_dict(json.loads(path.read_text())) if path.is_file() else None
+    def from_dict(cls, data) -> CalibrationResult:
+        """A result from its file's dict; the cluster and the failures read as their records."""
+        obj = super().from_dict(data)
+        if isinstance(obj.posterior, dict):
+            obj.posterior = PosteriorSummary.from_dict(obj.posterior)
+        if isinstance(obj.cluster, dict):
+            obj.cluster = ClusterRecord.from_dict(obj.cluster)
+        if isinstance(obj.failures, list):
+            obj.failures = [UnitFailure.from_dict(f) if isinstance(f, dict) else f for f in obj.failures]
+        return obj
+
+    @classmethod
+    def read(cls, store: Store) -> CalibrationResult | None:
+        """The calibration finished in ``store`` (its ``result.json``), or None when there is none."""
+        return store.read_result("result.json", cls.from_dict)
 
 
 def check_range_pair(name: str, value, lo: float, hi: float, lo_open: bool = False) -> tuple[float, float]:
@@ -131,12 +201,12 @@ def _lab_targets(lab: LabData, base: dict) -> list[tuple[str, float, float]]:
     return targets
 
 
-@holds_output("out")
+@holds_output("store", kind=KIND)
 def run_calibration(
     lab: str | os.PathLike | LabData,
     specimens: list[str | os.PathLike] | None = None,
     *,
-    out: str | os.PathLike,
+    store: Store | None = None,
     preset: str | None = None,
     quick: bool = False,
     replicates: int = 3,
@@ -155,7 +225,7 @@ def run_calibration(
     progress: bool = True,
     config: dict | None = None,
 ) -> CalibrationResult:
-    """Calibrate f_p and mu_r against ``lab`` on replicate specimens; writes ``out/result.json``.
+    """Calibrate f_p and mu_r against ``lab`` on replicate specimens; keeps ``result.json`` in ``store``.
 
     ``specimens``: checkpoints or criterion folders, or ``preset="paper"`` (``quick``: the
     small box) with ``replicates`` seeds from ``seed``. ``fp_range``, ``mu_r_range``: the
@@ -164,15 +234,19 @@ def run_calibration(
     error as a fraction of each value, added to the seed scatter. ``level``: of the
     credible intervals. ``settings``: shear settings of every test (the quick preset's
     ``max_displacement`` 4 mm by default). ``scheduler``/``workers``/``dashboard``: as the sweeps.
-    A rerun reuses every finished shear test (cached by content under ``out/cache``).
+    A rerun reuses every finished shear test (cached by content in the store's ``cache``);
+    ``store=None`` keeps nothing (every test runs, no figure or report is made).
     """
     t0 = time.perf_counter()
-    out = check_output_dir("--out", out)
+    if store is not None:
+        check_output_dir(store.parameter, store.root)
     lab_data = lab if isinstance(lab, LabData) else read_lab_csv(lab)
     check_stresses(lab_data.normal_stresses())
     check_preset(preset, quick, replicates)
     if preset is not None and specimens:
         raise InputError("--specimen", ", ".join(map(str, specimens)), "nothing with --preset")
+    if preset is not None and store is None:
+        raise InputError("store", None, "a store to keep the preset's specimens in")
     given = given_specimens(list(specimens or [])) if preset is None else None
     ranges = model.Ranges(
         check_range_pair("--fp-range", fp_range, 0.0, MAX_FRICTION, lo_open=True),
@@ -194,7 +268,7 @@ def run_calibration(
         given
         if given is not None
         else preset_specimens(
-            out / "specimens", quick=quick, seed=seed, replicates=replicates, progress=progress
+            store.child("specimens"), quick=quick, seed=seed, replicates=replicates, progress=progress
         )
     )
     from poro2d.dem.checkpoint import state_digest
@@ -202,19 +276,16 @@ def run_calibration(
     digests = {label: state_digest(path) for label, path in found.items()}
     runner = UnitRunner(scheduler, workers, progress=progress, dashboard=dashboard)
     stresses = lab_data.normal_stresses()
+    cache = _child(store, CACHE)
     try:
         design = model.space_filling(ranges, points, design_seed)
-        rows = runner.run(_jobs(design, found, digests, stresses, base, out), "round 1")
-        post, surrogates, table = _infer(
-            ranges, design, found, digests, stresses, base, out, rows, targets, lab_error
-        )
+        rows = runner.run(_units(design, found, digests, stresses, base), cache, "round 1")
+        post, surrogates, table = _infer(ranges, design, found, digests, base, rows, targets, lab_error)
         if refine:
             extra = [p for p in post.draw(refine, design_seed + 1) if p not in design]
             design = design + extra
-            rows.update(runner.run(_jobs(extra, found, digests, stresses, base, out), "round 2"))
-            post, surrogates, table = _infer(
-                ranges, design, found, digests, stresses, base, out, rows, targets, lab_error
-            )
+            rows.update(runner.run(_units(extra, found, digests, stresses, base), cache, "round 2"))
+            post, surrogates, table = _infer(ranges, design, found, digests, base, rows, targets, lab_error)
     finally:
         runner.close()
     result = _result(
@@ -235,23 +306,27 @@ def run_calibration(
         points,
         refine,
     )
-    from poro2d.calibration.outputs import write_outputs
+    if store is not None:
+        from poro2d.calibration.outputs import write_outputs
 
-    write_outputs(out, result, post, surrogates, lab_data, found, digests, base)
+        write_outputs(store, result, post, surrogates, lab_data, found, digests, base)
     return result
 
 
-def _jobs(design, found, digests, stresses, base, out: Path) -> list[dict]:
-    cache = out / "cache"
+def _child(store: Store | None, name: str) -> Store | None:
+    return None if store is None else store.child(name)
+
+
+def _units(design, found, digests, stresses, base) -> list[CalibrationUnit]:
     return [
-        unit_job(path, digests[label], s, base, fp, mu_r, cache)
+        CalibrationUnit.at(path, digests[label], s, base, fp, mu_r)
         for fp, mu_r in design
         for label, path in found.items()
         for s in stresses
     ]
 
 
-def _infer(ranges, design, found, digests, stresses, base, out, rows, targets, lab_error):
+def _infer(ranges, design, found, digests, base, rows: dict[str, UnitRow], targets, lab_error):
     """The surrogates (one per target), the posterior and the table of replicate values per design point."""
     table = []
     for fp, mu_r in design:
@@ -259,9 +334,8 @@ def _infer(ranges, design, found, digests, stresses, base, out, rows, targets, l
         for obs, s, _ in targets:
             values = []
             for label, path in found.items():
-                job = unit_job(path, digests[label], s, base, fp, mu_r, out / "cache")
-                row = rows.get(job["key"])
-                values.append(row[obs] if row is not None else float("nan"))
+                row = rows.get(CalibrationUnit.at(path, digests[label], s, base, fp, mu_r).key)
+                values.append(row.observable(obs) if row is not None else float("nan"))
             entry[f"{obs}_{s:g}kPa"] = values
         table.append(entry)
     unit = ranges.to_unit([e["particle_friction"] for e in table], [e["rolling_friction"] for e in table])
@@ -316,28 +390,28 @@ def _result(
             wide[name] = bool(hi - lo > model.WIDE_FRACTION * (r_hi - r_lo))
     best_unit = ranges.to_unit([fp], [mu_r])
     fitted = [
-        {
-            "observable": obs,
-            "normal_stress_kpa": s,
-            "lab_kpa": y,
-            "model_kpa": float(sg.mean(best_unit)[0]),
-            "noise_sd_kpa": sd,
-        }
+        FittedObservable(
+            observable=obs,
+            normal_stress_kpa=s,
+            lab_kpa=y,
+            model_kpa=float(sg.mean(best_unit)[0]),
+            noise_sd_kpa=sd,
+        )
         for (obs, s, y), sg, sd in zip(targets, surrogates, post.noise_sd, strict=True)
     ]
     return CalibrationResult(
         best={"particle_friction": fp, "rolling_friction": mu_r},
         intervals=intervals,
         level=level,
-        posterior={
-            "median": {"particle_friction": post.median("fp"), "rolling_friction": post.median("mu_r")},
-            "correlation": post.correlation(),
-            "wide": wide,
-            "grid": model.GRID,
-            "prior": "uniform in log(f_p) and mu_r over the ranges",
-            "observables": fitted,
-            "noise_correlation": post.noise_correlation,
-        },
+        posterior=PosteriorSummary(
+            median={"particle_friction": post.median("fp"), "rolling_friction": post.median("mu_r")},
+            correlation=post.correlation(),
+            wide=wide,
+            grid=model.GRID,
+            prior="uniform in log(f_p) and mu_r over the ranges",
+            observables=fitted,
+            noise_correlation=post.noise_correlation,
+        ),
         evaluations=table,
         fit={f"{obs}_{s:g}kPa": sg.to_dict() for (obs, s, _), sg in zip(targets, surrogates, strict=True)},
         lab=lab_data.to_dict(),
@@ -352,4 +426,11 @@ def _result(
     )
 
 
-__all__ = ["DEFAULT_FP_RANGE", "DEFAULT_MU_R_RANGE", "CalibrationResult", "run_calibration"]
+__all__ = [
+    "DEFAULT_FP_RANGE",
+    "DEFAULT_MU_R_RANGE",
+    "CalibrationResult",
+    "FittedObservable",
+    "PosteriorSummary",
+    "run_calibration",
+]

@@ -10,9 +10,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from poro2d.dem import checkpoint
 from poro2d.errors import InputError, check_int
 from poro2d.shear.specimen_file import resolve_specimen
+from poro2d.store import Store
 
 #: the most replicate specimens of the preset (each is a criterion run)
 MAX_REPLICATES = 20
@@ -25,7 +25,7 @@ def given_specimens(paths: list[str | os.PathLike]) -> dict[str, Path]:
     found: dict[str, Path] = {}
     for given in paths:
         path = resolve_specimen(given)
-        checkpoint.read(path)  # a damaged file is refused here, in one line
+        Store(path.parent).read_state(path.name)  # a damaged file is refused here, in one line
         label = path.parent.name if path.name == "specimen.npz" else path.stem
         label = label or "specimen"
         unique, k = label, 1
@@ -46,23 +46,23 @@ def check_preset(preset: str | None, quick: bool, replicates: int) -> None:
 
 
 def preset_specimens(
-    out: Path, *, quick: bool, seed: int, replicates: int, progress: bool
+    store: Store, *, quick: bool, seed: int, replicates: int, progress: bool
 ) -> dict[str, Path]:
-    """The paper preset's accepted specimens for ``replicates`` seeds from ``seed``, under ``out``.
+    """The paper preset's accepted specimens for ``replicates`` seeds from ``seed``, kept in ``store``.
 
-    The criterion runs once on ``seed`` (``out/criterion``), then on the next seeds from its
-    accepted porosity (``out/replicates``); seeds whose criterion does not converge are left out.
+    The criterion runs once on ``seed`` (its ``criterion``), then on the next seeds from its
+    accepted porosity (its ``replicates``); seeds whose criterion does not converge are left out.
     """
     from poro2d.criterion.config import build, paper_config
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.criterion.replicates import run_replicates
-    from poro2d.store import Store
 
     seed = check_int("--seed", seed, 0)
     cfg = paper_config(quick, seed)
     spec, grading, settings, sd = build(cfg, None, threads=min(os.cpu_count() or 1, 2))
+    out = store.root
     crit = PorosityCriterion(
-        spec, grading, settings, seed=sd, store=Store(out / "criterion"), progress=progress, config=cfg
+        spec, grading, settings, seed=sd, store=store.child("criterion"), progress=progress, config=cfg
     )
     crit.validate()
     result = crit.run()
@@ -77,7 +77,7 @@ def preset_specimens(
             settings,
             result.final_porosity,
             extra,
-            Store(out / "replicates"),
+            store.child("replicates"),
             processes=spec.threads,
             progress=progress,
         )

@@ -9,9 +9,11 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from poro2d.io_utils import atomic_path
+from poro2d.shear.case import ShearCase
 from poro2d.shear.settings import ShearSettings
 from poro2d.shear.single import DirectShearTest
+from poro2d.shear.specimen_file import Specimen
+from poro2d.store import Store
 
 
 def synthetic_lab(
@@ -22,19 +24,20 @@ def synthetic_lab(
     path: str | os.PathLike,
     *,
     settings: dict | None = None,
-    work: str | os.PathLike | None = None,
+    work: Store | None = None,
     curves: bool = True,
 ) -> Path:
     """Shear ``specimen`` at each stress with the given frictions; write the lab CSV at ``path``.
 
     ``curves``: the whole curves (the lab curve layout), else one peak per stress.
-    ``work``: where the tests run (default: beside ``path``).
+    ``work``: the store the tests keep their files in (default: a folder beside ``path``).
+    The curves are the tests' own (:attr:`poro2d.shear.results.ShearTestResult.curve`).
     """
     base = dict(settings or {}, particle_friction=particle_friction, rolling_friction=rolling_friction)
     base.setdefault("stop_after_peak", 0.0)
     sset = ShearSettings(**base)
     path = Path(path)
-    work = Path(work) if work is not None else path.with_name(path.stem + "-tests")
+    work = work if work is not None else Store(path.with_name(path.stem + "-tests"))
     header = [
         "# SYNTHETIC laboratory data, not measured: made by poro2d's own direct shear",
         f"# at particle_friction = {particle_friction}, rolling_friction = {rolling_friction}",
@@ -46,21 +49,17 @@ def synthetic_lab(
         if curves
         else "normal_stress_kpa,peak_shear_stress_kpa"
     ]
+    value = Specimen.read(specimen)  # read once for every test
     for sigma in sorted(float(s) for s in normal_stresses_kpa):
         res = DirectShearTest(
-            specimen, sigma, sset, out=work / f"sn{sigma:g}kPa", figures=False, threads=1
+            ShearCase(value, sigma, sset), work.child(f"sn{sigma:g}kPa"), figures=False, threads=1
         ).run()
         if not curves:
             lines.append(f"{sigma:g},{res['peak_shear_stress_kpa']:.4f}")
             continue
-        import pandas as pd
-
-        table = pd.read_csv(work / f"sn{sigma:g}kPa" / "curve.csv")
-        for d, t in zip(table["shear_displacement_mm"], table["shear_stress_kpa"], strict=True):
+        for d, t in zip(res.curve["shear_displacement_mm"], res.curve["shear_stress_kpa"], strict=True):
             lines.append(f"{sigma:g},{d:.5f},{t:.4f}")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        tmp.write_text("\n".join(header + lines) + "\n")
+    Store(path.parent).write_text(path.name, "\n".join(header + lines) + "\n")
     return path
 
 

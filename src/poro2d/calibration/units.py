@@ -1,24 +1,32 @@
 """One shear test of a calibration: (specimen, normal stress, f_p, mu_r), cached by content.
 
-A unit's folder under ``cache/`` is named by a hash of what decides its result (the
-specimen's content, the normal stress, every shear setting with the two frictions), so
-a rerun, a second round or another calibration on the same specimens reuses it; inside,
-:class:`poro2d.shear.single.DirectShearTest` resumes a test that was killed.
+A unit is a value (:class:`CalibrationUnit`); its store under ``cache/`` is named by a hash
+of what decides its result (the specimen's content, the normal stress, every shear setting
+with the two frictions), so a rerun, a second round or another calibration on the same
+specimens reuses it; inside, :class:`poro2d.shear.single.DirectShearTest` resumes a test
+that was killed.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Any
 
 import numpy as np
 
 from poro2d.execute.dask_cluster import pin_numba_threads
 from poro2d.identity import identity_digest
+from poro2d.shear.case import ShearCase
 from poro2d.shear.settings import ShearSettings
 from poro2d.shear.single import DirectShearTest
+from poro2d.shear.specimen_file import Specimen
+from poro2d.store import Store
 
 #: what a unit returns besides its identity: the observables a calibration may fit
 OBSERVABLES = ("peak", "end")
+#: the sub-store of a calibration's store that holds its units, each under its key
+CACHE = "cache"
 
 
 def unit_key(specimen_digest: str, sigma: float, settings: dict) -> str:
@@ -31,71 +39,112 @@ def unit_key(specimen_digest: str, sigma: float, settings: dict) -> str:
     return identity_digest(unit, tables={"settings": ShearSettings}, length=20, layout="spaced")
 
 
-def unit_job(
-    specimen: Path, digest: str, sigma: float, base: dict, fp: float, mu_r: float, cache: Path
-) -> dict:
-    """The job of one unit (a plain dict: it travels to a Dask worker)."""
-    settings = dict(base, particle_friction=fp, rolling_friction=mu_r)
-    ShearSettings(**settings)  # refused here, on the driver, before any work
-    key = unit_key(digest, sigma, settings)
-    return {
-        "key": key,
-        "specimen": str(specimen),
-        "digest": digest,
-        "sigma": float(sigma),
-        "fp": fp,
-        "mu_r": mu_r,
-        "settings": settings,
-        "out": str(cache / key),
-    }
+@dataclass(frozen=True)
+class CalibrationUnit:
+    """One shear test of a calibration, as a value that travels to a Dask worker.
+
+    ``specimen``: the specimen's file; ``digest``: its content (what the cache key hashes,
+    not the path); ``settings``: every shear setting, the two frictions included.
+    """
+
+    specimen: str
+    digest: str
+    sigma: float
+    settings: dict[str, Any]
+
+    @classmethod
+    def at(cls, specimen, digest: str, sigma: float, base: dict, fp: float, mu_r: float) -> CalibrationUnit:
+        """The unit of ``specimen`` at ``sigma`` with the frictions (f_p, mu_r) on the ``base`` settings.
+
+        The settings are checked here, on the driver, before any work.
+        """
+        settings = dict(base, particle_friction=fp, rolling_friction=mu_r)
+        ShearSettings(**settings)
+        return cls(str(specimen), digest, float(sigma), settings)
+
+    @property
+    def fp(self) -> float:
+        return self.settings["particle_friction"]
+
+    @property
+    def mu_r(self) -> float:
+        return self.settings["rolling_friction"]
+
+    @cached_property
+    def key(self) -> str:
+        """The unit's identity: the name of its store in the cache (:func:`unit_key`)."""
+        return unit_key(self.digest, self.sigma, self.settings)
+
+    def store(self, cache: Store | None) -> Store | None:
+        """The unit's store in ``cache`` (None: nothing kept)."""
+        return None if cache is None else cache.child(self.key)
 
 
-def _test(job: dict, threads: int = 1) -> DirectShearTest:
-    return DirectShearTest(
-        job["specimen"],
-        job["sigma"],
-        ShearSettings(**job["settings"]),
-        out=job["out"],
-        figures=False,
-        threads=threads,
-        specimen_digest=job["digest"],
+@dataclass(frozen=True)
+class UnitRow:
+    """What a finished unit gives the fit: its observables (kPa) and its cost."""
+
+    key: str
+    sigma: float
+    fp: float
+    mu_r: float
+    specimen: str
+    peak: float
+    end: float
+    wall_time_s: float
+
+    def observable(self, name: str) -> float:
+        """The value of the observable ``name`` (:data:`OBSERVABLES`)."""
+        return {"peak": self.peak, "end": self.end}[name]
+
+
+def _test(unit: CalibrationUnit, store: Store | None, threads: int = 1) -> DirectShearTest:
+    case = ShearCase(Specimen.read(unit.specimen, unit.digest), unit.sigma, ShearSettings(**unit.settings))
+    return DirectShearTest(case, store, figures=False, threads=threads)
+
+
+def _row(unit: CalibrationUnit, res) -> UnitRow:
+    return UnitRow(
+        key=unit.key,
+        sigma=unit.sigma,
+        fp=unit.fp,
+        mu_r=unit.mu_r,
+        specimen=unit.specimen,
+        peak=float(res["peak_shear_stress_kpa"]),
+        end=float(res["end"]["shear_stress_kpa"]),
+        wall_time_s=float(res["wall_time_s"]),
     )
 
 
-def _row(job: dict, res) -> dict:
-    return {
-        "key": job["key"],
-        "sigma": job["sigma"],
-        "fp": job["fp"],
-        "mu_r": job["mu_r"],
-        "specimen": job["specimen"],
-        "peak": float(res["peak_shear_stress_kpa"]),
-        "end": float(res["end"]["shear_stress_kpa"]),
-        "wall_time_s": float(res["wall_time_s"]),
-    }
+def stored_row(unit: CalibrationUnit, cache: Store | None) -> UnitRow | None:
+    """The unit's row when its store in ``cache`` holds the finished test, else None."""
+    store = unit.store(cache)
+    res = None if store is None else _test(unit, store).stored()
+    return None if res is None else _row(unit, res)
 
 
-def stored_row(job: dict) -> dict | None:
-    """The unit's row when its folder holds the finished test, else None."""
-    res = _test(job).stored()
-    return None if res is None else _row(job, res)
-
-
-def compute_unit(job: dict) -> dict:
+def compute_unit(unit: CalibrationUnit, cache: Store | None) -> UnitRow:
     """Run (or finish) one unit, on one numba thread: the task a Dask worker runs."""
     pin_numba_threads()
-    return _row(job, _test(job).run())
+    return _row(unit, _test(unit, unit.store(cache)).run())
 
 
-def unit_curve(job: dict) -> tuple[np.ndarray, np.ndarray] | None:
-    """The unit's curve (shear displacement m, shear stress kPa), or None when it has none."""
-    path = Path(job["out"]) / "curve.csv"
-    if not path.is_file():
+def unit_curve(unit: CalibrationUnit, cache: Store | None) -> tuple[np.ndarray, np.ndarray] | None:
+    """The finished unit's curve (shear displacement m, shear stress kPa), or None when it has none."""
+    store = unit.store(cache)
+    res = None if store is None else _test(unit, store).stored()
+    if res is None or not res.curve:
         return None
-    import pandas as pd
-
-    table = pd.read_csv(path)
-    return table["shear_displacement_mm"].to_numpy() * 1e-3, table["shear_stress_kpa"].to_numpy()
+    return res.curve["shear_displacement_mm"] * 1e-3, res.curve["shear_stress_kpa"]
 
 
-__all__ = ["OBSERVABLES", "compute_unit", "stored_row", "unit_curve", "unit_job", "unit_key"]
+__all__ = [
+    "CACHE",
+    "OBSERVABLES",
+    "CalibrationUnit",
+    "UnitRow",
+    "compute_unit",
+    "stored_row",
+    "unit_curve",
+    "unit_key",
+]

@@ -63,6 +63,7 @@ def register(app: typer.Typer) -> None:
         """Calibrate particle friction f_p and rolling friction mu_r against laboratory direct shear."""
         from poro2d.calibration.run import DEFAULT_FP_RANGE, DEFAULT_MU_R_RANGE, run_calibration
         from poro2d.execute.cluster_options import check_dashboard
+        from poro2d.store import Store
 
         settings = None if max_displacement is None else {"max_displacement": max_displacement}
         options = {
@@ -80,7 +81,7 @@ def register(app: typer.Typer) -> None:
             result = run_calibration(
                 lab,
                 list(specimen or []),
-                out=out,
+                store=Store(out),
                 preset=preset,
                 quick=quick,
                 replicates=replicates,

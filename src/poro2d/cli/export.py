@@ -9,12 +9,15 @@ import typer
 from poro2d.console import OutputConsole, Table
 from poro2d.locks import holds_output
 
+#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+KIND = "export"
+
 console = OutputConsole()
 
 TARGETS = ("lammps", "yade", "pfc", "csv")
 
 
-@holds_output("out")
+@holds_output("out", kind=KIND)
 def export_cmd(
     specimen: str = typer.Argument(
         ...,
@@ -55,6 +58,8 @@ def export_cmd(
     for p in paths:
         t.add_row(str(p), f"{p.stat().st_size:,}")
     console.print(t)
+    if to == "pfc" and pfc.pfc4_refusal(spec):
+        console.print(pfc.pfc4_refusal(spec))
     if state is not None:
         dr_text = "unknown" if state.relative_density is None else f"{state.relative_density:.4f}"
         console.print(
@@ -96,7 +101,7 @@ def export_specimen(specimen, out: Path, *, n_lab=None, dr=None, seed=None):
     check_output_dir("--out", out)
     check_accepted(state.folder)
     spec = from_checkpoint(state.folder)
-    spec.origin = origin_lines(resolve_specimen(state.folder), state.as_dict())
+    spec.origin = origin_lines(resolve_specimen(state.folder), state.known())
     return spec, state
 
 

@@ -9,6 +9,9 @@ import typer
 from poro2d.console import OutputConsole, Table
 from poro2d.locks import holds_output
 
+#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+KIND = "import"
+
 console = OutputConsole()
 
 
@@ -25,7 +28,7 @@ IMPORT_OPTIONS = (
 MAX_STEPS_LIMIT = 100_000_000
 
 
-@holds_output("out")
+@holds_output("out", kind=KIND)
 def import_cmd(
     file: Path = typer.Argument(
         ..., help="disks.csv (walls.csv beside it), a LAMMPS data file or a checkpoint."
@@ -55,11 +58,11 @@ def import_cmd(
     import numba
 
     from poro2d.criterion.protocol import CriterionSettings
-    from poro2d.dem import checkpoint
     from poro2d.errors import check_int, check_range
     from poro2d.interop.check import check_specimen, read_specimen
     from poro2d.interop.validate import LIMITS, check_value
-    from poro2d.io_utils import check_output_dir, provenance, write_json
+    from poro2d.io_utils import check_output_dir, provenance
+    from poro2d.store import Store
 
     check_range("--ratio", ratio, 0.0, 1.0, lo_open=True)
     check_int("--max-steps", max_steps, 1000, MAX_STEPS_LIMIT)
@@ -78,9 +81,10 @@ def import_cmd(
     fraction = window if window is not None else (spec.force_fraction or CriterionSettings.force_fraction)
     window_from = "--window" if window is not None else ("the file" if spec.force_fraction else "the paper's")
 
+    store = Store(out)
+
     def save_state(sim, report) -> None:
-        out.mkdir(parents=True, exist_ok=True)
-        checkpoint.save(sim, out / "specimen.npz", extra={"stage": "imported", "source": str(file)})
+        store.save_state("specimen.npz", sim, extra={"stage": "imported", "source": str(file)})
 
     sim, report = check_specimen(
         spec, settings=CriterionSettings(force_fraction=fraction), ratio=ratio, max_steps=max_steps,
@@ -88,9 +92,9 @@ def import_cmd(
     )  # fmt: skip
     report["window_from"] = window_from
     if "plate" in report:
-        checkpoint.save(sim, out / "after_plate.npz", extra={"stage": "after_plate", "source": str(file)})
+        store.save_state("after_plate.npz", sim, extra={"stage": "after_plate", "source": str(file)})
     report["provenance"] = provenance()
-    write_json(out / "check.json", report)
+    store.write_json("check.json", report)
     print_check(report, out)
     if not report["passes"]:
         raise typer.Exit(1)

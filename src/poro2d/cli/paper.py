@@ -7,6 +7,7 @@ from pathlib import Path
 import typer
 
 from poro2d.paper import run_paper
+from poro2d.store import Store
 
 
 def register(app: typer.Typer) -> None:
@@ -27,7 +28,7 @@ def register(app: typer.Typer) -> None:
         quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
     ) -> None:
         """Run the paper's case study: conversions, criterion (Fig. 3), direct shear (Fig. 8), report."""
-        summary = run_paper(out, quick=quick, lab=lab, seed=seed, threads=threads, replicates=replicates,
-                            progress=not quiet)  # fmt: skip
-        if not summary.criterion["converged"]:
+        summary = run_paper(Store(out), quick=quick, lab=lab, seed=seed, threads=threads,
+                            replicates=replicates, progress=not quiet)  # fmt: skip
+        if not summary.criterion.converged:
             raise typer.Exit(1)

@@ -143,6 +143,7 @@ def sand_cmd(
     small box, specimens at full size, and the interior porosity to use in other codes.
     """
     from poro2d.sand.run import check_soil, run_sand
+    from poro2d.store import Store
 
     if preflight_only:
         case, pf = check_soil(config, seeds=seeds, workers=workers, budget_minutes=budget)
@@ -150,7 +151,7 @@ def sand_cmd(
         return
     res = run_sand(
         config,
-        out=out,
+        store=Store(out),
         seeds=seeds,
         budget_minutes=budget,
         workers=workers,

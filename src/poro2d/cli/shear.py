@@ -107,6 +107,7 @@ def register(app: typer.Typer) -> None:
         """Direct shear tests (the paper's Fig. 8): peak strengths, friction angle, figures."""
         from poro2d.io_utils import check_output_dir
         from poro2d.shear.run import run_shear
+        from poro2d.store import Store
 
         check_output_dir("--out", out)
         check_friction_options(particle_friction, rolling_friction)
@@ -133,7 +134,7 @@ def register(app: typer.Typer) -> None:
                     particle_friction=particle_friction,
                     rolling_friction=rolling_friction,
                 ),  # fmt: skip
-                out=out,
+                store=Store(out),
                 lab=resolve_path("--lab", lab, extra.get("lab"), base),
                 rate_check=rate_check or bool(extra.get("rate_check", False)),
                 processes=processes if processes is not None else extra.get("processes"),

@@ -76,6 +76,7 @@ def register(app: typer.Typer) -> None:
         from poro2d.io_utils import check_output_dir
         from poro2d.shear import strength as st
         from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
+        from poro2d.store import Store
 
         # everything is checked before the first specimen or test is made
         check_output_dir("--out", out)
@@ -105,7 +106,7 @@ def register(app: typer.Typer) -> None:
             specimens = quick_specimens(out / "specimens", n_seeds, not quiet)
         else:
             specimens = {f"specimen{k + 1}": Path(p) for k, p in enumerate(specimen)}
-        study = st.StrengthStudy(specimens, mu_values, fp_values, stresses, settings, out=out,
+        study = st.StrengthStudy(specimens, mu_values, fp_values, stresses, settings, store=Store(out),
                                  processes=processes, progress=not quiet, config=config)  # fmt: skip
         console.print(
             f"[bold]direct shear[/] over {len(study.cases)} (mu_r, f_p) cases x {len(specimens)} specimen(s) "

@@ -24,7 +24,7 @@ import numpy as np
 from poro2d.dem import Simulation
 from poro2d.dem.state import Particles, Walls
 from poro2d.errors import InputError
-from poro2d.specimen.porosity_regions import lid_height_at
+from poro2d.measure.surface import lid_height_at
 
 #: wall names of the lid's segments: ``lid0``, ``lid1``, ... from left to right
 LID_PREFIX = "lid"

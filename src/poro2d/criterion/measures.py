@@ -260,7 +260,7 @@ class PorosityNumbers:
 def porosity_numbers(
     sim: Simulation, width: float, plate_y: float, lid: tuple[np.ndarray, np.ndarray] | None = None
 ) -> PorosityNumbers:
-    """The specimen's porosities beside the paper's n' (:mod:`poro2d.specimen.porosity_regions`).
+    """The specimen's porosities beside the paper's n' (:mod:`poro2d.measure.specimen_porosity`).
 
     ``box_porosity`` is the paper's: W x plate height, the gap under the plate included;
     ``interior_porosity`` (mean over measurement circles 2 d50 clear of every wall and of the
@@ -268,13 +268,16 @@ def porosity_numbers(
     gets ``interior_porosity = None`` and the reason in ``interior_porosity_note``. With a
     ``lid`` (edges, heights), the box porosity and the gap are those under the lid.
     """
-    from poro2d.specimen.porosity_regions import measure_specimen
+    from poro2d.measure.porosity import box_porosity
+    from poro2d.measure.specimen_porosity import measure_specimen
 
     p = sim.particles
     try:
         m = measure_specimen(p.pos, p.radius, width, plate_y, lid=lid).to_dict()
     except (InputError, RuntimeError) as e:  # too small to measure; a degenerate tessellation
-        return PorosityNumbers(box_porosity=1.0 - p.area() / (width * plate_y), interior_porosity_note=str(e))
+        return PorosityNumbers(
+            box_porosity=box_porosity(p.area(), width, plate_y), interior_porosity_note=str(e)
+        )
     return PorosityNumbers(**{k: m[k] for k in POROSITY_KEYS})
 
 

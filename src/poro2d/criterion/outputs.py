@@ -86,8 +86,8 @@ def _trial_store(store: Store, trial) -> Store:
 
 def write_specimen_state(store: Store, sim: Simulation, width: float, n2d: float, *, figures: bool) -> None:
     """Homogeneity and stress state of the accepted specimen: ``specimen_state.json`` and its figure."""
+    from poro2d.measure.specimen_state import specimen_state
     from poro2d.report.specimen_figures import plot_specimen_state
-    from poro2d.specimen.state import specimen_state
 
     state = specimen_state(sim, width, top_height(sim, width))
     store.write_json("specimen_state.json", dict(state, trial_porosity=n2d))
@@ -100,8 +100,8 @@ def write_specimen_porosity(
     store: Store, sim: Simulation, width: float, n2d: float, *, figures: bool
 ) -> None:
     """The accepted specimen's porosities: ``specimen_porosity.json`` and the local porosity map."""
+    from poro2d.measure.specimen_porosity import measure_specimen
     from poro2d.report.specimen_figures import plot_local_porosity
-    from poro2d.specimen.porosity_regions import measure_specimen
 
     p = sim.particles
     top = top_height(sim, width)

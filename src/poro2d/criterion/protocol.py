@@ -57,12 +57,14 @@ from poro2d.criterion.result import CriterionResult
 from poro2d.criterion.servo import PlateServo, in_window
 from poro2d.criterion.trial import Decision, PlateStage, Preparation, StageFailure, Trial, trial_name
 from poro2d.dem import Simulation
-from poro2d.errors import InputError, check_range
+from poro2d.errors import Integer, OneOf, Ranges, Real, check_fields, check_range
 from poro2d.io_utils import provenance
+from poro2d.measure.disks import mass_d50
+from poro2d.measure.porosity import box_porosity
+from poro2d.measure.surface import lid_height_at
 from poro2d.porosity import PAPER_N_LAB, parabolic
-from poro2d.specimen.compaction import SpecimenSpec, box_porosity, preparation_note, prepare_specimen
+from poro2d.specimen.compaction import SpecimenSpec, preparation_note, prepare_specimen
 from poro2d.specimen.grading import GradingCurve
-from poro2d.specimen.porosity_regions import lid_height_at, mass_d50
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
 
@@ -72,6 +74,31 @@ from poro2d.store.stage import Fingerprint, ResumableStage
 ACCEPTANCE_MODES = ("plate", "fill")
 
 _log = logging.getLogger(__name__)
+
+
+#: what each setting of :class:`CriterionSettings` may be (checked in this order);
+#: ``refine_tolerance`` is checked against ``porosity_tolerance`` after these
+CRITERION_RANGES: Ranges = {
+    "n_lab": Real(0.0, 1.0, hi_open=True),
+    "trial_porosity": Real(0.0, 1.0, lo_open=True, hi_open=True, or_none=True),
+    "force_fraction": Real(0.0, 1.0, lo_open=True),
+    "porosity_tolerance": Real(0.0, 0.1, lo_open=True),
+    "resolution": Real(0.0, 0.1, lo_open=True),
+    "max_iterations": Integer(1, 50),
+    "servo_target_fraction": Real(0.0, 1.0, lo_open=True, hi_open=True),
+    "servo_max_speed": Real(0.0, 10.0, lo_open=True),
+    "servo_gain": Real(0.0, 1.0, lo_open=True),
+    "settle_gain": Real(0.0, 1.0, lo_open=True),
+    "settle_max_speed": Real(0.0, 10.0, lo_open=True),
+    "plate_drift": Real(0.0, 0.1, lo_open=True),
+    "settle_checks": Integer(2),
+    "max_plate_steps": Integer(1000),
+    "check_every": Integer(1),
+    "window_checks": Integer(1),
+    "generation_tolerance": Real(0.0, 0.05, lo_open=True),
+    "balance_tolerance": Real(0.0, 0.5, lo_open=True),
+    "acceptance": OneOf(ACCEPTANCE_MODES),
+}
 
 
 @dataclass
@@ -100,34 +127,9 @@ class CriterionSettings:
     acceptance: str = "plate"
 
     def __post_init__(self) -> None:
-        check_range("n_lab", self.n_lab, 0.0, 1.0, hi_open=True)
-        if self.trial_porosity is not None:
-            check_range("trial_porosity", self.trial_porosity, 0.0, 1.0, lo_open=True, hi_open=True)
-        check_range("force_fraction", self.force_fraction, 0.0, 1.0, lo_open=True)
-        check_range("porosity_tolerance", self.porosity_tolerance, 0.0, 0.1, lo_open=True)
-        check_range("resolution", self.resolution, 0.0, 0.1, lo_open=True)
-        if not (isinstance(self.max_iterations, int) and 1 <= self.max_iterations <= 50):
-            raise InputError("max_iterations", self.max_iterations, "an integer in [1, 50]")
-        check_range("servo_target_fraction", self.servo_target_fraction, 0.0, 1.0, lo_open=True, hi_open=True)
-        check_range("servo_max_speed", self.servo_max_speed, 0.0, 10.0, lo_open=True)
-        check_range("servo_gain", self.servo_gain, 0.0, 1.0, lo_open=True)
-        check_range("settle_gain", self.settle_gain, 0.0, 1.0, lo_open=True)
-        check_range("settle_max_speed", self.settle_max_speed, 0.0, 10.0, lo_open=True)
-        check_range("plate_drift", self.plate_drift, 0.0, 0.1, lo_open=True)
-        if not (isinstance(self.settle_checks, int) and self.settle_checks >= 2):
-            raise InputError("settle_checks", self.settle_checks, "an integer >= 2")
-        if not (isinstance(self.max_plate_steps, int) and self.max_plate_steps >= 1000):
-            raise InputError("max_plate_steps", self.max_plate_steps, "an integer >= 1000")
-        if not (isinstance(self.check_every, int) and self.check_every >= 1):
-            raise InputError("check_every", self.check_every, "an integer >= 1")
-        if not (isinstance(self.window_checks, int) and self.window_checks >= 1):
-            raise InputError("window_checks", self.window_checks, "an integer >= 1")
-        check_range("generation_tolerance", self.generation_tolerance, 0.0, 0.05, lo_open=True)
-        check_range("balance_tolerance", self.balance_tolerance, 0.0, 0.5, lo_open=True)
+        check_fields(self, CRITERION_RANGES)
         if self.refine_tolerance is not None:
             check_range("refine_tolerance", self.refine_tolerance, 1e-4, self.porosity_tolerance)
-        if self.acceptance not in ACCEPTANCE_MODES:
-            raise InputError("acceptance", self.acceptance, f"one of {', '.join(ACCEPTANCE_MODES)}")
 
     @property
     def tolerance(self) -> float:
@@ -483,7 +485,9 @@ class PorosityCriterion:
                 # and swells for long): the lid then only has the surface left to follow
                 first = servo.settle(sim, weight)
                 if not first.settled:
-                    stage = PlateStage("lid", box_porosity(sim, width, first.height_m), first)
+                    stage = PlateStage(
+                        "lid", box_porosity(sim.particles.area(), width, first.height_m), first
+                    )
                     return stage, self._after_top(sim, k, n, weight, stage)
             lid = SegmentedLid(sim, width, mass_d50(sim.particles.radius))
             settle = servo.settle(sim, weight, lid)
@@ -496,7 +500,7 @@ class PorosityCriterion:
         else:
             moved = "down" if f_top <= 0.0 else "up"
             settle = servo.settle(sim, weight)
-            stage = PlateStage(moved, box_porosity(sim, width, settle.height_m), settle)
+            stage = PlateStage(moved, box_porosity(sim.particles.area(), width, settle.height_m), settle)
         return stage, self._after_top(sim, k, n, weight, stage)
 
     def _after_top(self, sim: Simulation, k: int, n: float, weight: float, stage: PlateStage) -> WallForces:

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Any, Self
 
 from poro2d.criterion.trial import Trial
+from poro2d.measure.specimen_porosity import SpecimenPorosity
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
@@ -136,33 +137,6 @@ class SpecimenStateResult(TypedResult):
     trial_porosity: float
 
 
-@dataclass(eq=False)
-class SpecimenPorosityResult(TypedResult):
-    """The accepted specimen's box and interior porosity, its surface under the plate
-    (``specimen_porosity.json``); a specimen too small to measure has only ``note``."""
-
-    box_porosity: float | None = None
-    interior_porosity: float | None = None
-    interior_porosity_std: float | None = None
-    interior_porosity_min: float | None = None
-    interior_porosity_max: float | None = None
-    interior_regions: int | None = None
-    interior_rect_porosity: float | None = None
-    laguerre_interior_porosity: float | None = None
-    margin_d50: float | None = None
-    circle_radius_m: float | None = None
-    surface_gap_mean_m: float | None = None
-    surface_gap_mean_d50: float | None = None
-    surface_gap_max_m: float | None = None
-    plate_contact_fraction: float | None = None
-    plate_touching_disks: int | None = None
-    d50_m: float | None = None
-    surface_level_m: float | None = None
-    trial_porosity: float | None = None
-    note: str | None = None
-    provenance: dict[str, Any] | None = None
-
-
 #: the figures a criterion run may leave at the top of its folder, by name
 CRITERION_FIGURES = (
     "fig5_forces_initial_trial.png", "fig6_forces_after_plate.png", "fig7_forces_accepted.png",
@@ -181,7 +155,7 @@ class CriterionOutputs:
 
     result: CriterionResult
     state: SpecimenStateResult | None = None
-    porosity: SpecimenPorosityResult | None = None
+    porosity: SpecimenPorosity | None = None
     figures: dict[str, Path] = field(default_factory=dict)
 
     @classmethod
@@ -192,7 +166,7 @@ class CriterionOutputs:
         return cls(
             result,
             store.read_result("specimen_state.json", SpecimenStateResult.from_dict),
-            store.read_result("specimen_porosity.json", SpecimenPorosityResult.from_dict),
+            store.read_result("specimen_porosity.json", SpecimenPorosity.from_dict),
             {name: store.path(name) for name in CRITERION_FIGURES if store.has(name)},
         )
 
@@ -203,6 +177,5 @@ __all__ = [
     "CriterionResult",
     "ReplicateRow",
     "ReplicatesResult",
-    "SpecimenPorosityResult",
     "SpecimenStateResult",
 ]

@@ -12,10 +12,12 @@ resistance keeps its file contents and its :func:`state_digest`.
 
 from __future__ import annotations
 
+import copy
 import hashlib
 import json
 import os
 import zipfile
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -125,16 +127,21 @@ def state_digest(path: str | os.PathLike) -> str:
     whichever run wrote it, since a shear test depends on the state it starts from, not on
     how that state was made. It enters run descriptions as a value.
     """
-    h = hashlib.sha256()
     with np.load(_existing(path)) as z:
-        meta = json.loads(bytes(z["meta"]).decode())
-        for name in sorted(k for k in z.files if k != "meta"):
-            a = np.ascontiguousarray(z[name])
-            if name == _key("_iprm"):
-                a = a.copy()
-                a[[i for i in (K.NSTEPS, K.CHECK_EVERY, K.THREADS) if i < a.size]] = 0
-            h.update(f"{name}:{a.dtype.str}:{a.shape}\n".encode())
-            h.update(a.tobytes())
+        return content_digest(json.loads(bytes(z["meta"]).decode()), z)
+
+
+def content_digest(meta: dict, arrays: Mapping[str, np.ndarray]) -> str:
+    """:func:`state_digest` of a checkpoint's content already read (:func:`read`); ``meta`` is not changed."""
+    h = hashlib.sha256()
+    for name in sorted(k for k in arrays if k != "meta"):
+        a = np.ascontiguousarray(arrays[name])
+        if name == _key("_iprm"):
+            a = a.copy()
+            a[[i for i in (K.NSTEPS, K.CHECK_EVERY, K.THREADS) if i < a.size]] = 0
+        h.update(f"{name}:{a.dtype.str}:{a.shape}\n".encode())
+        h.update(a.tobytes())
+    meta = copy.deepcopy(meta)
     meta.pop("provenance", None)
     meta.get("settings", {}).pop("threads", None)
     h.update(json.dumps(meta, sort_keys=True, separators=(",", ":")).encode())
@@ -195,6 +202,14 @@ def load(path: str | os.PathLike, threads: int | None = None) -> Simulation:
         if isinstance(exc, InputError):
             raise
         raise _damaged(Path(path), exc) from None
+
+
+def from_content(meta: dict, arrays: Mapping[str, np.ndarray], threads: int | None = None) -> Simulation:
+    """The :class:`Simulation` of a checkpoint's content already read (:func:`read`).
+
+    The arrays are copied: the content stays as read, so it can start several runs.
+    """
+    return _build(meta, {k: np.array(v, copy=True) for k, v in arrays.items()}, threads)
 
 
 def _build(meta: dict, a: dict[str, np.ndarray], threads: int | None) -> Simulation:

@@ -35,6 +35,12 @@ from numba import njit
 PER_BODY = 0  # PFC 4.0: kn = kA kB / (kA + kB), mu = min(muA, muB)
 PER_PAIR_TYPE = 1  # PFC 5 style: one (kn, ks, mu) for disk-disk, one for disk-wall
 
+#: rolling frictions beyond 1 hold a disk against any tilt it meets in a shear band (a disk
+#: rolls when the moment arm of its contact force exceeds mu_r R: at 1 the force would have to
+#: lean past 45 degrees); larger ones are typos. Every input of a rolling friction (a specimen,
+#: a shear test, a strength grid) is held to [0, MAX_ROLLING_FRICTION].
+MAX_ROLLING_FRICTION = 1.0
+
 
 @njit(inline="always", cache=True)
 def series(ka, kb):

@@ -826,8 +826,8 @@ class Simulation:
         return self.wall_force(wall) / self.particles.thickness
 
     def contacts(self):
-        """Touching contacts as a :class:`poro2d.dem.measure.ContactSet`."""
-        from poro2d.dem.measure import contact_set
+        """Touching contacts as a :class:`poro2d.dem.contacts.ContactSet`."""
+        from poro2d.dem.contacts import contact_set
 
         return contact_set(self)
 

@@ -7,7 +7,9 @@ answers is :func:`poro2d.execute.dask_cluster.check_reachable`'s question).
 
 from __future__ import annotations
 
+import errno
 import os
+import socket
 from urllib.parse import urlsplit
 
 from poro2d.errors import InputError, check_int
@@ -29,7 +31,38 @@ def check_dashboard(value: str | None, parameter: str = "--dashboard") -> str | 
     host, sep, port = text.rpartition(":")
     if not sep or not port.isdigit() or int(port) > 65535 or any(c.isspace() or c == "/" for c in host):
         raise InputError(parameter, value, "HOST:PORT (port 0 to 65535, 0: any free one), :PORT, or none")
+    problem = bind_problem(host.strip("[]"), int(port))
+    if problem:
+        raise InputError(
+            parameter, value, "an address of this machine and a free port (0: any free one)", problem
+        )
     return text
+
+
+def bind_problem(host: str, port: int) -> str | None:
+    """Why a server could not listen on ``host:port`` here (unknown host, not this machine's,
+    port taken), tried now with a socket of our own; None when it can.
+
+    Dask would otherwise find out only once the cluster starts, after the command's first
+    stage of work, and answer an unknown host with a failure and a taken port with a
+    warning of several lines and another port.
+    """
+    try:
+        infos = socket.getaddrinfo(host or None, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
+    except (socket.gaierror, UnicodeError) as exc:
+        return f"the host {host!r} is not known ({exc})"
+    family, kind, proto, _, address = infos[0]
+    with socket.socket(family, kind, proto) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as the dashboard's server does
+        try:
+            probe.bind(address)
+        except OSError as exc:
+            if exc.errno == errno.EADDRINUSE:
+                return f"port {port} is in use on {host or 'this machine'}"
+            if exc.errno == errno.EADDRNOTAVAIL:
+                return f"{host} is not an address of this machine"
+            return f"cannot listen there: {exc.strerror or exc}"
+    return None
 
 
 #: seconds to wait for a running scheduler to answer (distributed's own default is 30)
@@ -81,6 +114,7 @@ __all__ = [
     "SCHEDULER_FORM",
     "check_cluster_options",
     "check_dashboard",
+    "bind_problem",
     "check_scheduler_address",
     "max_workers",
 ]

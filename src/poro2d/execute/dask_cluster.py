@@ -12,13 +12,18 @@ from __future__ import annotations
 
 import logging
 import os
+import socket
+import struct
 import traceback
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
+from urllib.parse import urlsplit
 
 from poro2d.errors import InputError
 from poro2d.execute.cluster_options import CONNECT_TIMEOUT_S, DEFAULT_DASHBOARD, check_scheduler_address
 from poro2d.execute.jobs import Failed, Job
+from poro2d.typed_result import TypedResult
 from poro2d.worker_signals import hold_interrupts, ignore_interrupts_in_dask_worker, release_interrupts
 
 ignore_interrupts_in_dask_worker()  # a worker imports this module to run its first task
@@ -80,6 +85,14 @@ def connect(scheduler: str):
     from distributed import Client
 
     address = check_scheduler_address(scheduler)
+    silent = not_a_scheduler(address)
+    if silent:
+        raise InputError(
+            "--scheduler",
+            scheduler,
+            f"a running Dask scheduler that answers within {CONNECT_TIMEOUT_S} s",
+            silent,
+        )
     try:
         return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
     except (OSError, TimeoutError) as exc:  # refused, unreachable, or no answer in time
@@ -89,6 +102,46 @@ def connect(scheduler: str):
             f"a running Dask scheduler that answers within {CONNECT_TIMEOUT_S} s",
             f"{type(exc).__name__}: {exc}".splitlines()[0],
         ) from None
+
+
+def not_a_scheduler(address: str, timeout: float = CONNECT_TIMEOUT_S) -> str | None:
+    """Why the server at a ``tcp://`` ``address`` is not a Dask scheduler; None when it may be.
+
+    A Dask server speaks first: on a new connection it sends its handshake, a message whose
+    first two 8-byte words are its length and its count of frames. A server of another kind
+    (a web server waiting for a request) sends nothing, and the Dask client would wait on it
+    for ever; one that sends something else is not Dask either. Other schemes (tls, ws, ucx)
+    start with their own handshake and are left to the client's timeout.
+    """
+    parts = urlsplit(address)
+    if parts.scheme != "tcp":
+        return None
+    try:
+        with socket.create_connection((parts.hostname, parts.port), timeout=timeout) as sock:
+            greeting = _receive(sock, 16, timeout)
+    except OSError as exc:  # refused or unreachable: the client says so in its own words
+        return None if not isinstance(exc, TimeoutError) else f"no connection in {timeout:g} s"
+    if len(greeting) < 16:
+        return f"the server at {parts.hostname}:{parts.port} sent no Dask handshake in {timeout:g} s"
+    length, frames = struct.unpack("<QQ", greeting)
+    if not (16 <= length < 1 << 30 and 1 <= frames < 1 << 16):
+        return f"the server at {parts.hostname}:{parts.port} does not speak Dask's protocol"
+    return None
+
+
+def _receive(sock: socket.socket, count: int, timeout: float) -> bytes:
+    """Up to ``count`` bytes, as many as arrive before ``timeout`` or the end of the stream."""
+    sock.settimeout(timeout)
+    data = b""
+    try:
+        while len(data) < count:
+            chunk = sock.recv(count - len(data))
+            if not chunk:
+                break
+            data += chunk
+    except TimeoutError:
+        pass
+    return data
 
 
 def quiet_shutdown_logs(client) -> None:
@@ -127,6 +180,17 @@ def _dashboard(client) -> str | None:
         return None
 
 
+@dataclass(eq=False)
+class ClusterInfo(TypedResult):
+    """What a sweep records of the Dask cluster it ran on (the ``cluster`` key of its record)."""
+
+    scheduler: str | None
+    workers: int
+    threads: int
+    local_cluster: bool
+    dashboard: str | None
+
+
 class DaskCluster:
     """A Dask client for the executor: ``client`` as given, or one started at the first job.
 
@@ -163,23 +227,23 @@ class DaskCluster:
         self.scheduler_info = self.client.scheduler_info()
         return self.client
 
-    def info(self) -> dict:
-        """Scheduler, workers, threads, whether it is a local cluster, the dashboard; {} before the start.
+    def info(self) -> ClusterInfo | None:
+        """Scheduler, workers, threads, whether it is a local cluster, the dashboard; None before the start.
 
         The dashboard is asked of the client, so before it is closed.
         """
         if self.scheduler_info is None:
-            return {}
+            return None
         workers = self.scheduler_info.get("workers", {})
-        return {
-            "scheduler": self.scheduler or self.scheduler_info.get("address"),
-            "workers": len(workers),
-            "threads": sum(w.get("nthreads", 0) for w in workers.values()),
-            "local_cluster": self.local_cluster,
-            "dashboard": _dashboard(self.client)
+        return ClusterInfo(
+            scheduler=self.scheduler or self.scheduler_info.get("address"),
+            workers=len(workers),
+            threads=sum(w.get("nthreads", 0) for w in workers.values()),
+            local_cluster=self.local_cluster,
+            dashboard=_dashboard(self.client)
             if self.client is not None and (self.dashboard is not None or self.scheduler)
             else None,
-        }
+        )
 
     def map(self, jobs: Sequence[Job], on_done: Callable[[int, Any], None] | None) -> list:
         """Every job as a task; ``on_done(index, outcome)`` as each ends; outcomes in job order."""
@@ -227,9 +291,11 @@ def _run_task(job: Job):
 
 __all__ = [
     "SINGLE_THREAD_ENV",
+    "ClusterInfo",
     "DaskCluster",
     "check_reachable",
     "connect",
+    "not_a_scheduler",
     "pin_numba_threads",
     "quiet_shutdown_logs",
     "start_client",

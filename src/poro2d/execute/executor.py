@@ -13,11 +13,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD
 from poro2d.execute.jobs import Job
 from poro2d.execute.local import map_in_processes, map_inline
+
+if TYPE_CHECKING:
+    from poro2d.execute.dask_cluster import ClusterInfo
 
 #: the backends: this process, spawned processes on this machine, a Dask cluster
 KINDS = ("inline", "processes", "dask")
@@ -104,11 +107,11 @@ class Executor:
         if self._dask is not None:
             self._dask.start()
 
-    def cluster_info(self) -> dict:
+    def cluster_info(self) -> ClusterInfo | None:
         """What is recorded of a started Dask cluster (scheduler, workers, threads, local_cluster,
-        dashboard); {} for the local backends and before the start.
+        dashboard); None for the local backends and before the start.
         """
-        return self._dask.info() if self._dask is not None else {}
+        return self._dask.info() if self._dask is not None else None
 
     def quiet(self) -> None:
         """Silence the shutdown of a cluster this executor started (an interrupted run)."""

@@ -26,7 +26,6 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.criterion.protocol import wall_forces
-from poro2d.dem.measure import coordination_number
 from poro2d.dem.state import BOX_WALLS
 from poro2d.interop import lammps as lmp
 from poro2d.interop.lammps_run import (
@@ -38,6 +37,7 @@ from poro2d.interop.lammps_run import (
 )
 from poro2d.interop.settled import SettledRun
 from poro2d.interop.specimen_data import SpecimenData
+from poro2d.measure.coordination import coordination_number
 
 #: quantities compared, as (key, label) pairs
 QUANTITIES = (

@@ -28,8 +28,9 @@ from poro2d.interop import csv_table
 from poro2d.interop import lammps as lmp
 from poro2d.interop.specimen_data import SpecimenData, from_checkpoint
 from poro2d.interop.validate import check_imported
+from poro2d.measure.porosity import box_porosity
 from poro2d.paper_data import TABLE_1
-from poro2d.specimen.compaction import SpecimenSpec, box_porosity, make_walls
+from poro2d.specimen.compaction import SpecimenSpec, make_walls
 
 #: values for what a file does not say (a LAMMPS data file of another origin): Table 1, and
 #: the specimen's defaults for the rest
@@ -149,7 +150,7 @@ def check_specimen(
     sim = build_simulation(spec, box, threads)
     t0 = time.perf_counter()
     res = sim.solve(ratio, max_steps, progress="equilibrium" if progress else False)
-    n_box = box_porosity(sim, box.width, box.height)
+    n_box = box_porosity(sim.particles.area(), box.width, box.height)
     weight = box.self_weight(n_box)
     forces = wall_forces(sim).to_dict()
     passes = bool(res.converged and in_window(forces["f_top_n_per_m"], weight, settings.force_fraction))
@@ -178,7 +179,7 @@ def check_specimen(
     report["plate"] = {
         **plate.to_dict(),
         "moved": "down" if forces["f_top_n_per_m"] <= 0.0 else "up",
-        "new_porosity": box_porosity(sim, box.width, plate.height_m),
+        "new_porosity": box_porosity(sim.particles.area(), box.width, plate.height_m),
         "f_top_after_n_per_m": after.f_top_n_per_m,
         "f_bottom_after_n_per_m": after.f_bottom_n_per_m,
     }

@@ -3,10 +3,11 @@
 ``disks.csv`` columns: ``id`` (1-based), ``x_m``, ``y_m``, ``radius_m``,
 ``density_kg_m3``, ``kn_n_per_m``, ``ks_n_per_m``, ``mu`` (per-body values, PFC 4.0).
 ``walls.csv`` columns: ``name``, ``x0_m``, ``y0_m``, ``x1_m``, ``y1_m``, ``kn_n_per_m``,
-``ks_n_per_m``, ``mu``. Both start with ``#`` comment lines (units, the thickness
-convention, poro2d's version); ``# poro2d thickness T`` and ``# poro2d settings GX GY
-DAMPING DT`` are read back. Numbers are written with ``repr``: they read back to the
-same float. ``pandas.read_csv(path, comment="#")`` reads either table.
+``ks_n_per_m``, ``mu``. A specimen with rolling friction has one more column in each,
+``mu_r`` (per-body rolling friction), so it reads back whole. Both start with ``#``
+comment lines (units, the thickness convention, poro2d's version); ``# poro2d thickness
+T`` and ``# poro2d settings GX GY DAMPING DT`` are read back. Numbers are written with
+``repr``: they read back to the same float. ``pandas.read_csv(path, comment="#")`` reads either table.
 """
 
 from __future__ import annotations
@@ -27,6 +28,8 @@ DISKS_FILE = "disks.csv"
 WALLS_FILE = "walls.csv"
 DISK_COLUMNS = ("id", "x_m", "y_m", "radius_m", "density_kg_m3", "kn_n_per_m", "ks_n_per_m", "mu")
 WALL_COLUMNS = ("name", "x0_m", "y0_m", "x1_m", "y1_m", "kn_n_per_m", "ks_n_per_m", "mu")
+#: the column a specimen with rolling friction adds to both tables
+ROLLING_COLUMN = "mu_r"
 
 
 def _notes(spec: SpecimenData) -> list[str]:
@@ -42,13 +45,19 @@ def _notes(spec: SpecimenData) -> list[str]:
 def write_specimen(spec: SpecimenData, out: str | os.PathLike) -> list[Path]:
     """Write ``disks.csv`` and ``walls.csv`` into ``out`` (atomically); returns their paths."""
     out = Path(out)
-    disks = (spec.x, spec.y, spec.radius, spec.density, spec.kn, spec.ks, spec.mu)
+    rolled = spec.rolled
+    disks = [spec.x, spec.y, spec.radius, spec.density, spec.kn, spec.ks, spec.mu]
+    if rolled:
+        disks.append(np.zeros(spec.n) if spec.mu_r is None else np.asarray(spec.mu_r, dtype=float))
     rows = [[str(i + 1), *(repr(float(a[i])) for a in disks)] for i in range(spec.n)]
     wrows = [
-        [w.name, *(repr(float(v)) for v in (w.x0, w.y0, w.x1, w.y1, w.kn, w.ks, w.mu))] for w in spec.walls
+        [w.name, *(repr(float(v)) for v in (w.x0, w.y0, w.x1, w.y1, w.kn, w.ks, w.mu, w.mu_r)[: 7 + rolled])]
+        for w in spec.walls
     ]
+    extra = (ROLLING_COLUMN,) if rolled else ()
     paths = []
-    for name, columns, body in ((DISKS_FILE, DISK_COLUMNS, rows), (WALLS_FILE, WALL_COLUMNS, wrows)):
+    tables = ((DISKS_FILE, DISK_COLUMNS + extra, rows), (WALLS_FILE, WALL_COLUMNS + extra, wrows))
+    for name, columns, body in tables:
         with atomic_path(out / name) as tmp, open(tmp, "w", newline="") as fh:
             fh.write("\n".join(_notes(spec)) + "\n")
             w = csv.writer(fh, lineterminator="\n")
@@ -76,6 +85,7 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
             )
     notes, drows = _read_table(disks_path, DISK_COLUMNS)
     wnotes, wrows = _read_table(walls_path, WALL_COLUMNS)
+    rolled = len(drows[0][1]) > len(DISK_COLUMNS) if drows else False
     notes.update({k: v for k, v in wnotes.items() if k not in notes})
     if not drows:
         raise InputError(str(disks_path), "no disks", "at least one disk row below the header")
@@ -84,6 +94,8 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
     walls = []
     for k, r in wrows:
         walls.append(WallData(r[0], *(_number(walls_path, k, c, v) for c, v in enumerate(r[1:], start=2))))
+    if rolled:
+        _check_rolling(disks_path, drows, a[:, 7], walls_path, wrows, [w.mu_r for w in walls])
     t = _setting(notes, "thickness", 1)
     settings = _setting(notes, "settings", 4)
     window = _setting(notes, "window", 1)
@@ -95,6 +107,7 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
         local_damping=settings[2] if settings else float(defaults["local_damping"]),
         dt=dt if dt != 0.0 else None,  # 0: the automatic step (written when the specimen had none)
         source=str(disks_path), force_fraction=window[0] if window else None,
+        mu_r=a[:, 7].copy() if rolled else None,
         locate=_locator(disks_path, walls_path, drows, wrows, notes),
     )  # fmt: skip
 
@@ -156,9 +169,22 @@ def _check_ids(path: Path, rows: list[tuple[int, list[str]]]) -> None:
         seen[ident] = k
 
 
+def _check_rolling(disks_path: Path, drows, disk_mu_r, walls_path: Path, wrows, wall_mu_r) -> None:
+    """Rolling friction is >= 0, and given in both tables or in neither."""
+    if wrows and len(wrows[0][1]) != len(WALL_COLUMNS) + 1:
+        raise InputError(str(walls_path), "no mu_r column", f"a mu_r column, as {disks_path.name} has")
+    column = len(DISK_COLUMNS) + 1
+    for (k, _), v in zip(drows, disk_mu_r, strict=True):
+        if v < 0.0:
+            raise InputError(f"{disks_path} line {k} column {column} (mu_r)", float(v), "[0, inf)")
+    for (k, _), v in zip(wrows, wall_mu_r, strict=True):
+        if v < 0.0:
+            raise InputError(f"{walls_path} line {k} column {column} (mu_r)", float(v), "[0, inf)")
+
+
 def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[dict, list[tuple[int, list[str]]]]:
     """(``# poro2d`` notes as key: (file, line, values), numbered rows) of a table whose
-    header must be ``columns``."""
+    header must be ``columns``, or ``columns`` and ``mu_r`` (a specimen with rolling friction)."""
     notes: dict = {}
     rows: list[tuple[int, list[str]]] = []
     header_seen = False
@@ -177,9 +203,12 @@ def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[dict, list[tuple[
             continue
         cells = next(csv.reader([line]))
         if not header_seen:
-            if tuple(c.strip() for c in cells) != columns:
-                raise InputError(f"{path} line {k}", line, "the header " + ",".join(columns))
-            header_seen = True
+            header = tuple(c.strip() for c in cells)
+            if header not in (columns, columns + (ROLLING_COLUMN,)):
+                raise InputError(
+                    f"{path} line {k}", line, "the header " + ",".join(columns) + f" (and {ROLLING_COLUMN})"
+                )
+            columns, header_seen = header, True
             continue
         if len(cells) != len(columns):
             column = min(len(cells), len(columns)) + 1

@@ -14,10 +14,12 @@ saying its provenance is unknown: nothing is made up.
 
 from __future__ import annotations
 
-import json
 import math
+from dataclasses import replace
 from pathlib import Path
-from typing import Any
+
+from poro2d.interop.state_specimen import KnownState, read_state_index, state_record
+from poro2d.store import Store
 
 #: every provenance line starts with this (after the target's comment sign)
 PREFIX = "provenance:"
@@ -25,17 +27,18 @@ PREFIX = "provenance:"
 SOIL_FILE = "soil.json"
 
 
-def origin_lines(checkpoint: str | Path, state: dict[str, Any] | None = None) -> list[str]:
+def origin_lines(checkpoint: str | Path, state: KnownState | None = None) -> list[str]:
     """The provenance lines of the specimen saved at ``checkpoint`` (without comment signs).
 
-    ``state``: the state the specimen was found by (``StateSpecimen.as_dict()``: record,
-    mode, n_lab, relative_density, seed), None to look it up from the folder.
+    ``state``: the state the specimen was found by
+    (:meth:`~poro2d.interop.state_specimen.StateSpecimen.known`), None to look it up from the folder.
     """
     p = Path(checkpoint)
     folder = p.parent
-    result = _criterion_record(folder / "result.json", ("iterations", "specimen"))
-    config = _criterion_record(folder / "config.json", ("run",))
-    soil = _criterion_record(folder / SOIL_FILE, ("soil", "state"))
+    records = Store(folder)
+    result = _criterion_record(records, "result.json", ("iterations", "specimen"))
+    config = _criterion_record(records, "config.json", ("run",))
+    soil = _criterion_record(records, SOIL_FILE, ("soil", "state"))
     if result is None and config is None and soil is None:
         return [
             f"{PREFIX} unknown (no criterion record, result.json or config.json, beside {_text(p.name)}: "
@@ -43,12 +46,12 @@ def origin_lines(checkpoint: str | Path, state: dict[str, Any] | None = None) ->
         ]
     if state is None and soil is not None:  # a specimen folder that poro2d sand named
         lab = soil["state"] if isinstance(soil["state"], dict) else {}
-        state = {"mode": soil.get("mode"), "n_lab": lab.get("n_lab"),
-                 "relative_density": lab.get("relative_density"), "seed": soil.get("seed")}  # fmt: skip
+        state = KnownState(soil.get("mode"), lab.get("n_lab"), lab.get("relative_density"), soil.get("seed"))
     if state is None:
         state = _state_of_case(folder)
-    elif not state.get("mode"):  # a sand folder that does not say: the state folder of the case
-        state = dict(state, mode=(_state_of_case(folder) or {}).get("mode"))
+    elif not state.mode:  # a sand folder that does not say: the state folder of the case
+        case = _state_of_case(folder)
+        state = replace(state, mode=case.mode if case is not None else None)
     result, config = result or {}, config or {}
     lines = [f"{PREFIX} grading {_grading(config)}"]
     if soil is not None and isinstance(soil["soil"], dict):
@@ -61,19 +64,16 @@ def origin_lines(checkpoint: str | Path, state: dict[str, Any] | None = None) ->
     lines.append(f"{PREFIX} preparation friction mu_prep (specimen.friction_prep) = {_value(mu)}")
     lines.append(f"{PREFIX} {_porosities(result)}")
     lines.append(f"{PREFIX} {_run(result, config, state)}")
-    if state is not None and state.get("record"):
-        lines.append(f"{PREFIX} state read from {_text(state['record'])}")
+    if state is not None and state.record:
+        lines.append(f"{PREFIX} state read from {_text(state.record)}")
     return lines
 
 
-def _criterion_record(path: Path, keys: tuple[str, ...]) -> dict | None:
+def _criterion_record(records: Store, name: str, keys: tuple[str, ...]) -> dict | None:
     """The JSON object of a criterion's record file, None if missing, unreadable or of another kind."""
-    if not path.is_file() or path.stat().st_size > 50_000_000:
+    if not records.has(name) or (records.root / name).stat().st_size > 50_000_000:
         return None
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None
+    data = records.read_json(name)
     return data if isinstance(data, dict) and all(k in data for k in keys) else None
 
 
@@ -107,12 +107,12 @@ def _grading(config: dict) -> str:
     )
 
 
-def _state(result: dict, config: dict, state: dict | None, folder: Path) -> str:
+def _state(result: dict, config: dict, state: KnownState | None, folder: Path) -> str:
     """n_lab, Dr and the mode."""
-    n_lab = state.get("n_lab") if state else _num(result.get("n_lab"))
-    dr = state.get("relative_density") if state else _config_dr(n_lab, config)
+    n_lab = state.n_lab if state is not None else _num(result.get("n_lab"))
+    dr = state.relative_density if state is not None else _config_dr(n_lab, config)
     if state is not None:
-        mode = state.get("mode") or "unknown"
+        mode = state.mode or "unknown"
     elif (folder.parent / "params.json").is_file():  # a sweep case not found in a state folder above it
         mode = "unknown (a sweep case: export it by its state folder)"
     else:
@@ -149,8 +149,8 @@ def _porosities(result: dict) -> str:
     return text + f"; interior porosity = {inner:.6g}" + (f" +- {sd:.4g}" if sd is not None else "")
 
 
-def _run(result: dict, config: dict, state: dict | None) -> str:
-    seed = state.get("seed") if state else result.get("seed", (config.get("run") or {}).get("seed"))
+def _run(result: dict, config: dict, state: KnownState | None) -> str:
+    seed = state.seed if state is not None else result.get("seed", (config.get("run") or {}).get("seed"))
     prov = result.get("provenance") or config.get("provenance") or {}
     version = prov.get("poro2d_version") if isinstance(prov, dict) else None
     when = prov.get("created_utc") if isinstance(prov, dict) else None
@@ -159,11 +159,10 @@ def _run(result: dict, config: dict, state: dict | None) -> str:
     return text + (f" ({_text(when)})" if when else "")
 
 
-def _state_of_case(folder: Path) -> dict | None:
+def _state_of_case(folder: Path) -> KnownState | None:
     """The state of a sweep case's criterion folder (``<sweep>/cases/<id>/run``), from the state
     folder whose sweep it is (the sweep folder itself, or the folder above ``states/``)."""
     from poro2d.errors import InputError
-    from poro2d.interop.state_specimen import read_state_index, state_record
 
     if not (folder.parent / "params.json").is_file():
         return None
@@ -179,13 +178,7 @@ def _state_of_case(folder: Path) -> dict | None:
         for case in index.cases:
             if case.folder is not None and case.folder.resolve() == folder.resolve():
                 dr = next((d for n, d in index.states if abs(n - case.n_lab) <= 1e-9), None)
-                return {
-                    "record": str(record),
-                    "mode": index.mode,
-                    "n_lab": case.n_lab,
-                    "relative_density": dr,
-                    "seed": case.seed,
-                }
+                return KnownState(index.mode, case.n_lab, dr, case.seed, record=str(record))
     return None
 
 

@@ -9,12 +9,18 @@ N, and divided by ``t`` they give N/m, the paper's unit.
   ``ball attribute density ... damp ... range id i``, ``wall create vertices ... id k
   name '...'`` and the linear contact model with contact-level properties (PFC 5+
   does not combine per-body values): springs in series, the smaller friction, as PFC
-  4.0 did, one set for ball-ball and one for ball-facet contacts.
+  4.0 did, one set for ball-ball and one for ball-facet contacts. A specimen with
+  rolling friction gets PFC's rolling-resistance linear model (``rrlinear``, property
+  ``rr_fric``): its rolling stiffness ``ks R^2`` and limit ``rr_fric R Fn``, with ``R``
+  the contact's effective radius, are poro2d's rolling spring
+  (:mod:`poro2d.dem.contact_law`).
 * ``specimen_pfc4.dat`` (PFC 4.0, the paper's code): ``ball id=i x=... y=... rad=...``
   with ``property`` lines of the per-body values (density, kn, ks, friction) of Table 1
   and ``wall id=k kn=... ks=... friction=... nodes (x0,y0) (x1,y1)``. The nodes of each
   wall are as poro2d stores them: the specimen lies to the left when going from the
-  first node to the second.
+  first node to the second. PFC 4.0 has no rolling-resistance model: a specimen with
+  rolling friction gets no 4.0 file (:func:`pfc4_refusal` says why), never one that
+  silently drops it.
 """
 
 from __future__ import annotations
@@ -39,7 +45,8 @@ def _r(v) -> str:
 def current_commands(spec: SpecimenData, ratio: float = 1e-3) -> str:
     """The PFC 5+ command file (``;`` comments)."""
     params = spec.contact_parameters()  # refuses disks of differing properties
-    wall_sets = {params[w.name] for w in spec.walls}
+    rolling = spec.rolling_parameters()
+    wall_sets = {(*params[w.name], rolling[w.name]) for w in spec.walls}
     if len(wall_sets) > 1:
         raise InputError(
             "walls", [w.name for w in spec.walls],
@@ -66,16 +73,10 @@ def current_commands(spec: SpecimenData, ratio: float = 1e-3) -> str:
         lines.append(
             f"wall create vertices {_r(w.x0)} {_r(w.y0)} {_r(w.x1)} {_r(w.y1)} id {k} name '{w.name}'"
         )
-    kn, ks, mu = params["pp"]
-    lines.append(
-        f"contact cmat default type 'ball-ball' model 'linear' property kn {_r(kn)} ks {_r(ks)} fric {_r(mu)}"
-    )
+    lines.append(_cmat("ball-ball", *params["pp"], rolling["pp"], rolled=spec.rolled))
     if spec.walls:
-        kn, ks, mu = params[spec.walls[0].name]
-        lines.append(
-            f"contact cmat default type 'ball-facet' model 'linear' property kn {_r(kn)} ks {_r(ks)} "
-            f"fric {_r(mu)}"
-        )
+        name = spec.walls[0].name
+        lines.append(_cmat("ball-facet", *params[name], rolling[name], rolled=spec.rolled))
     if spec.dt:
         lines.append(f"model mechanical timestep fix {_r(spec.dt)}")
     lines += [
@@ -85,8 +86,28 @@ def current_commands(spec: SpecimenData, ratio: float = 1e-3) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _cmat(kind: str, kn: float, ks: float, mu: float, mu_r: float, *, rolled: bool) -> str:
+    """One default contact model: ``linear``, or ``rrlinear`` with ``rr_fric`` for a rolled specimen."""
+    text = f"contact cmat default type '{kind}' model '{'rrlinear' if rolled else 'linear'}' property "
+    text += f"kn {_r(kn)} ks {_r(ks)} fric {_r(mu)}"
+    return text + (f" rr_fric {_r(mu_r)}" if rolled else "")
+
+
+def pfc4_refusal(spec: SpecimenData) -> str | None:
+    """Why ``spec`` gets no PFC 4.0 file (rolling friction: PFC 4.0 cannot express it); None: it gets one."""
+    if not spec.rolled:
+        return None
+    return (
+        f"{PFC4_FILE} not written: PFC 4.0 has no rolling-resistance model and the specimen has "
+        f"rolling friction (disks {spec.rolling_parameters()['pp']:g}); {CURRENT_FILE} carries it (rrlinear)"
+    )
+
+
 def pfc4_commands(spec: SpecimenData) -> str:
     """The PFC 4.0 command file: per-body properties, as in the paper's Table 1."""
+    reason = pfc4_refusal(spec)
+    if reason is not None:
+        raise InputError("rolling friction", spec.rolling_parameters()["pp"], "0 for PFC 4.0", reason)
     t = spec.thickness
     lines = [
         *spec.header(";"),
@@ -123,10 +144,16 @@ def _extent(spec: SpecimenData) -> tuple[float, float, float, float]:
 
 
 def write_specimen(spec: SpecimenData, out: str | os.PathLike) -> list[Path]:
-    """Write ``specimen.p2dat`` and ``specimen_pfc4.dat`` into ``out`` (atomically)."""
+    """Write ``specimen.p2dat`` and ``specimen_pfc4.dat`` into ``out`` (atomically).
+
+    A specimen with rolling friction gets the PFC 5+ file only (see :func:`pfc4_refusal`).
+    """
     out = Path(out)
     paths = []
-    for name, text in ((CURRENT_FILE, current_commands(spec)), (PFC4_FILE, pfc4_commands(spec))):
+    files = [(CURRENT_FILE, current_commands(spec))]
+    if pfc4_refusal(spec) is None:
+        files.append((PFC4_FILE, pfc4_commands(spec)))
+    for name, text in files:
         with atomic_path(out / name) as tmp:
             tmp.write_text(text)
         paths.append(out / name)

@@ -19,7 +19,6 @@ turned into them in one (:meth:`SpecimenData.to_simulation`), and reads its box 
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from collections.abc import Callable
@@ -29,12 +28,13 @@ from pathlib import Path
 import numpy as np
 
 from poro2d import __version__
-from poro2d.dem import ContactModel, Particles, Simulation, Walls, checkpoint
+from poro2d.dem import ContactModel, Particles, Simulation, Walls
 from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
 from poro2d.interop.origin import origin_lines
 from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
 from poro2d.specimen.box import box_faces
+from poro2d.store import Store
 
 
 @dataclass
@@ -90,6 +90,12 @@ class SpecimenData:
     @property
     def n(self) -> int:
         return int(self.x.shape[0])
+
+    @property
+    def rolled(self) -> bool:
+        """True when any disk or wall has rolling friction (a target must carry it or refuse)."""
+        disks = self.mu_r is not None and bool(np.any(np.asarray(self.mu_r) > 0.0))
+        return disks or any(w.mu_r > 0.0 for w in self.walls)
 
     @property
     def mass(self) -> np.ndarray:
@@ -186,10 +192,10 @@ class SpecimenData:
 
         The box porosity is the paper's n' (box W x plate height, the gap under the plate
         included); the interior porosity is the packing's own, 2 d50 clear of every wall and
-        of the free surface (:mod:`poro2d.specimen.porosity_regions`). None for a specimen
+        of the free surface (:mod:`poro2d.measure.specimen_porosity`). None for a specimen
         without a box or too small to measure.
         """
-        from poro2d.specimen.porosity_regions import measure_specimen
+        from poro2d.measure.specimen_porosity import measure_specimen
 
         try:
             xlo, xhi, ylo, yhi = self.box()
@@ -247,8 +253,8 @@ def check_accepted(path: str | os.PathLike) -> None:
     one) is taken as it is.
     """
     p = Path(path)
-    folder = p if p.is_dir() else p.parent
-    result = _record(path, folder / "result.json")
+    folder = Store(p if p.is_dir() else p.parent, parameter="SPECIMEN")
+    result = _record(path, folder, "result.json")
     if result is not None and "converged" in result:
         trials = result.get("iterations") if isinstance(result.get("iterations"), list) else []
         accepted = any(isinstance(row, dict) and row.get("accepted") is True for row in trials)
@@ -256,22 +262,21 @@ def check_accepted(path: str | os.PathLike) -> None:
             state = (
                 "no accepted trial" if result["converged"] is True else f"converged = {result['converged']}"
             )
-            _refuse_unaccepted(path, folder / "result.json", state)
-    trial = _record(path, folder / "trial.json")
+            _refuse_unaccepted(path, folder.root / "result.json", state)
+    trial = _record(path, folder, "trial.json")
     if trial is not None and "accepted" in trial and trial["accepted"] is not True:
-        _refuse_unaccepted(path, folder / "trial.json", f"accepted = {trial['accepted']}")
+        _refuse_unaccepted(path, folder.root / "trial.json", f"accepted = {trial['accepted']}")
 
 
-def _record(path: str | os.PathLike, record: Path) -> dict | None:
-    """The JSON object in ``record``, None if there is none (or it holds something else)."""
-    if not record.is_file():
+def _record(path: str | os.PathLike, folder: Store, name: str) -> dict | None:
+    """The JSON object ``name`` beside the specimen, None if there is none (or it holds something else)."""
+    if not folder.has(name):
         return None
-    try:
-        data = json.loads(check_input_file("SPECIMEN", record).read_text())
-    except (OSError, ValueError) as exc:
-        raise InputError(
-            "SPECIMEN", str(path), f"a specimen with a readable {record.name}", str(exc)
-        ) from None
+    check_input_file("SPECIMEN", folder.root / name)
+    data = folder.read_json(name)
+    if data is None:
+        why = "it changed since poro2d wrote it" if not folder.intact(name) else "it is not valid JSON"
+        raise InputError("SPECIMEN", str(path), f"a specimen with a readable {name}", why) from None
     return data if isinstance(data, dict) else None
 
 
@@ -298,11 +303,11 @@ def from_simulation(sim: Simulation, source: str = "") -> SpecimenData:
 def from_checkpoint(path: str | os.PathLike) -> SpecimenData:
     """The specimen saved at ``path`` (a checkpoint or a folder holding ``specimen.npz``).
 
-    Read with :func:`poro2d.dem.checkpoint.read`, which checks the whole file first: a
+    Read with :meth:`poro2d.store.Store.read_state`, which checks the whole file first: a
     damaged checkpoint is one InputError naming it.
     """
     p = resolve_specimen(path)
-    meta, a = checkpoint.read(p)
+    meta, a = Store(p.parent).read_state(p.name)
     s = meta["settings"]
     convention = s["contact"]["convention"]
     _check_per_body(convention, "'per_body' (the PFC 4.0 properties that travel with the bodies)")
@@ -358,12 +363,10 @@ def accepted_window(checkpoint_path: Path) -> float | None:
     ``settings.force_fraction`` is the window the specimen was accepted with (1 % in the
     paper, 5 % for ``paper --quick``). None for a checkpoint without one.
     """
-    import json
-
-    result = Path(checkpoint_path).parent / "result.json"
+    result = Store(Path(checkpoint_path).parent).read_json("result.json")
     try:
-        value = json.loads(result.read_text())["settings"]["force_fraction"]
-    except (OSError, ValueError, KeyError, TypeError):
+        value = result["settings"]["force_fraction"]
+    except (KeyError, TypeError):
         return None
     ok = isinstance(value, int | float) and not isinstance(value, bool) and 0.0 < value <= 1.0
     return float(value) if ok else None

@@ -26,15 +26,14 @@ and the states and seeds there are.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from poro2d.errors import InputError, check_int, check_range
 from poro2d.io_utils import check_input_file
+from poro2d.store import Store
 
 #: the record files of a folder of specimens by state, in the order they are looked for
 STATE_RECORDS = ("sand.json", "relation.json", "density.json")
@@ -44,6 +43,21 @@ N_LAB_TOLERANCE = 5e-5
 DR_TOLERANCE = 5e-4
 #: the folder holding a sweep case's criterion outputs (:mod:`poro2d.sweep.runner`)
 CASE_RUN = "run"
+
+
+@dataclass(frozen=True)
+class KnownState:
+    """The laboratory state a specimen belongs to, as far as its records say (None: not said).
+
+    ``record``: the state folder's record it was read from (``sand.json``, ``relation.json``,
+    ``density.json``), None when the specimen's own ``soil.json`` says it.
+    """
+
+    mode: str | None
+    n_lab: float | None
+    relative_density: float | None
+    seed: int | None
+    record: str | None = None
 
 
 @dataclass(frozen=True)
@@ -76,14 +90,9 @@ class StateSpecimen:
     relative_density: float | None
     seed: int
 
-    def as_dict(self) -> dict[str, Any]:
-        return {
-            "record": str(self.record),
-            "mode": self.mode,
-            "n_lab": self.n_lab,
-            "relative_density": self.relative_density,
-            "seed": self.seed,
-        }
+    def known(self) -> KnownState:
+        """The state as the export's provenance lines name it (:func:`poro2d.interop.origin.origin_lines`)."""
+        return KnownState(self.mode, self.n_lab, self.relative_density, self.seed, record=str(self.record))
 
 
 @dataclass
@@ -115,20 +124,25 @@ class StateIndex:
         return "; ".join(parts) if parts else "none"
 
 
-def state_record(folder: str | os.PathLike) -> Path | None:
+def _store(folder: str | os.PathLike | Store) -> Store:
+    """The finished run a state is read from: a store, or the folder the user named."""
+    return folder if isinstance(folder, Store) else Store(folder, parameter="SPECIMEN")
+
+
+def state_record(folder: str | os.PathLike | Store) -> Path | None:
     """The record file of a folder of specimens by state, None for any other folder or a file."""
-    p = Path(folder)
-    if not p.is_dir():
+    store = _store(folder)
+    if not store.exists():
         return None
-    return next((p / name for name in STATE_RECORDS if (p / name).is_file()), None)
+    return next((store.root / name for name in STATE_RECORDS if store.has(name)), None)
 
 
 def find_state_specimen(
-    folder: str | os.PathLike, n_lab: float | None = None, dr: float | None = None, seed: int = 0
+    folder: str | os.PathLike | Store, n_lab: float | None = None, dr: float | None = None, seed: int = 0
 ) -> Path:
     """The criterion folder holding the accepted ``specimen.npz`` of one state and seed.
 
-    ``folder``: a relation folder, a density-mode criterion folder or a sand folder; the
+    ``folder``: a relation, a density-mode criterion or a sand run (its store or folder); the
     state by its laboratory porosity ``n_lab`` or its relative density ``dr`` (one of the
     two), ``seed`` the specimen among the state's. Refused (InputError naming ``--n-lab``,
     ``--dr`` or ``--seed``, with the states and accepted seeds there are) when the state or
@@ -138,13 +152,16 @@ def find_state_specimen(
 
 
 def state_specimen(
-    folder: str | os.PathLike, n_lab: float | None = None, dr: float | None = None, seed: int = 0
+    folder: str | os.PathLike | Store, n_lab: float | None = None, dr: float | None = None, seed: int = 0
 ) -> StateSpecimen:
     """:func:`find_state_specimen` with the state it belongs to (mode, n_lab, Dr, seed)."""
-    record = state_record(folder)
+    store = _store(folder)
+    record = state_record(store)
     if record is None:
         raise InputError(
-            "SPECIMEN", str(folder), "a folder holding " + ", ".join(STATE_RECORDS) + " (a folder of states)"
+            "SPECIMEN",
+            str(store.root),
+            "a folder holding " + ", ".join(STATE_RECORDS) + " (a folder of states)",
         )
     if n_lab is not None and dr is not None:
         raise InputError("--n-lab/--dr", (n_lab, dr), "one of the two, not both")
@@ -367,12 +384,11 @@ def _config_seed(data: dict) -> int | None:
 
 
 def _json(path: Path, parameter: str) -> dict:
-    try:
-        data = json.loads(check_input_file(parameter, path).read_text())
-    except (OSError, ValueError) as exc:
-        if isinstance(exc, InputError):
-            raise
-        raise InputError(parameter, str(path), "a readable JSON file", str(exc).splitlines()[0]) from None
+    """The JSON object of a record the user pointed at (checked as every input file is)."""
+    check_input_file(parameter, path)
+    data = Store(path.parent, parameter=parameter).read_json(path.name)
+    if data is None:
+        raise InputError(parameter, str(path), "a readable JSON file", "it cannot be read or parsed")
     if not isinstance(data, dict):
         raise InputError(parameter, str(path), "a JSON file holding an object")
     return data
@@ -399,6 +415,7 @@ def _dr_text(dr: float | None) -> str:
 
 __all__ = [
     "STATE_RECORDS",
+    "KnownState",
     "StateSpecimen",
     "find_state_specimen",
     "read_state_index",

@@ -17,7 +17,10 @@ YADE is 3D. The choices made here:
   ``PyRunner`` after the interaction loop sets kn, ks and the friction of every
   disk-wall contact to the PFC 4.0 values (from the step after the contact forms);
 * Cundall's local damping is ``NewtonIntegrator(damping=...)``, gravity its
-  ``gravity``; the time step is poro2d's.
+  ``gravity``; the time step is poro2d's;
+* rolling friction is not written: YADE's rolling law (``CohFrictPhys``) sets its
+  rolling stiffness from the two radii and materials, not as ``ks R^2`` per contact, so
+  a specimen with rolling friction is refused (the LAMMPS and PFC 5+ exports carry it).
 
 The numbers are in three literals at the top of the script (``SETTINGS``, ``DISKS``,
 ``WALLS``), written with ``repr``, so that they can be read back exactly.
@@ -194,6 +197,12 @@ def write_specimen(
     """Write ``specimen_yade.py`` into ``out`` (atomically), stopping at ``ratio`` (YADE's mean ratio)."""
     if not spec.dt:
         raise InputError("time step", spec.dt, "the time step of the specimen (a poro2d checkpoint has one)")
+    if spec.rolled:
+        raise InputError(
+            "rolling friction", spec.rolling_parameters()["pp"], "0 for a YADE export",
+            "YADE's rolling law cannot be given poro2d's rolling stiffness ks R^2 per contact; "
+            "export with --to lammps or --to pfc, which carry it",
+        )  # fmt: skip
     slanted = [w.name for w in spec.walls if not (w.horizontal or w.vertical)]
     if slanted:
         raise InputError("walls", slanted, "horizontal or vertical walls (written as YADE boxes)")

@@ -1,6 +1,6 @@
 """Contact force chains like the paper's Figs. 5-7: line width proportional to force.
 
-:func:`plot_force_chains` draws from plain data: a :class:`poro2d.dem.measure.ContactSet`,
+:func:`plot_force_chains` draws from plain data: a :class:`poro2d.dem.contacts.ContactSet`,
 the disks' positions and radii and the wall segments, so a stored state (a frame saved
 during a direct shear test, say) is drawn without a simulation.
 :func:`plot_simulation_force_chains` takes those from a live :class:`poro2d.dem.Simulation`.
@@ -20,7 +20,7 @@ from matplotlib.collections import LineCollection, PatchCollection  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Circle  # noqa: E402
 
-from poro2d.dem.measure import ContactSet  # noqa: E402
+from poro2d.dem.contacts import ContactSet  # noqa: E402
 from poro2d.errors import InputError, check_range  # noqa: E402
 from poro2d.report.figure_file import save_figure  # noqa: E402
 
@@ -42,7 +42,7 @@ def _check_inputs(contacts, pos, radius, walls) -> tuple[np.ndarray, np.ndarray,
     """The arrays as float arrays of the expected shapes; an InputError names the first bad one."""
     if not isinstance(contacts, ContactSet):
         raise InputError(
-            "contacts", type(contacts).__name__, "a poro2d.dem.measure.ContactSet",
+            "contacts", type(contacts).__name__, "a poro2d.dem.contacts.ContactSet",
             "for a Simulation use plot_simulation_force_chains",
         )  # fmt: skip
     pos = np.asarray(pos, dtype=float)

@@ -1,7 +1,7 @@
 """Figures of a prepared specimen: its state by bands of equal height, its local porosity.
 
-Both are drawn from what the measurements return (:func:`poro2d.specimen.state.specimen_state`,
-:func:`poro2d.specimen.porosity_regions.measure_specimen`), so the criterion saves them
+Both are drawn from what the measurements return (:func:`poro2d.measure.specimen_state.specimen_state`,
+:func:`poro2d.measure.specimen_porosity.measure_specimen`), so the criterion saves them
 beside the numbers they show.
 """
 
@@ -19,8 +19,9 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Circle, Rectangle
 
 from poro2d.errors import InputError
+from poro2d.measure.laguerre import LaguerreCells
+from poro2d.measure.specimen_porosity import PorosityDetails, SpecimenPorosity
 from poro2d.report.figure_file import save_figure
-from poro2d.specimen.porosity_regions import LaguerreCells, PorosityDetails, SpecimenPorosity
 
 #: the local porosity figure writes each circle's value when there are at most this many circles
 MAX_LABELLED_CIRCLES = 60
@@ -29,7 +30,7 @@ MAX_LABELLED_CIRCLES = 60
 def plot_specimen_state(state: dict, path: str | os.PathLike, title: str = "") -> Path:
     """Porosity per band and sigma_v, sigma_h, geostatic sigma_v against height; K0 in the legend.
 
-    ``state``: the dict of :func:`poro2d.specimen.state.specimen_state`.
+    ``state``: the dict of :func:`poro2d.measure.specimen_state.specimen_state`.
     """
     rows = state["bands"]
     z = np.array([r["z_mid_m"] for r in rows]) * 1e3
@@ -75,7 +76,7 @@ def plot_local_porosity(
     Drawn in mm: cells (colour range 0-0.5, values outside it clipped in the drawing only),
     disk outlines, the free surface, the plate, the interior rectangle and its circles with
     their porosity, and a box with the summary numbers. ``measures`` is what
-    :func:`poro2d.specimen.porosity_regions.measure_specimen` returned for these disks and
+    :func:`poro2d.measure.specimen_porosity.measure_specimen` returned for these disks and
     this box (it checked them). PNG (or the suffix's format).
     """
     pos, radius = np.asarray(pos, dtype=float), np.asarray(radius, dtype=float)

@@ -27,6 +27,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from poro2d.config import check_keys
 from poro2d.criterion.density import DEFAULT_MUS, check_mus
@@ -35,6 +36,7 @@ from poro2d.lab_state import LabState, lab_state_from_table
 from poro2d.specimen.compaction import SpecimenSpec, time_step
 from poro2d.specimen.grading import GradingCurve
 from poro2d.sweep.density import DEFAULT_SEEDS, with_density_defaults
+from poro2d.typed_result import TypedResult
 
 #: the tables a sand config adds to a criterion config
 SAND_TABLES = ("soil", "lab", "sand")
@@ -50,6 +52,20 @@ CALIBRATION_DISKS = 1500
 CALIBRATION_SEEDS = 2
 
 ConfigLike = dict | str | os.PathLike
+
+
+@dataclass(eq=False)
+class SoilRecord(TypedResult):
+    """The soil as every result file names it (``soil`` in ``preflight.json``, ``sand.json`` and
+    each kept specimen's ``soil.json``): who it is, its ``[grading]`` table, the grading's source
+    and up-scaling, and its laboratory description (:meth:`poro2d.lab_state.LabState.to_dict`)."""
+
+    name: str
+    reference: str
+    grading: dict[str, Any]
+    grading_source: str
+    upscale: float
+    lab: dict[str, Any]
 
 
 @dataclass(frozen=True)
@@ -83,16 +99,16 @@ class SandCase:
         assert self.lab.n_min is not None
         return self.lab.n_min
 
-    def soil_record(self) -> dict:
+    def soil_record(self) -> SoilRecord:
         """The soil as every result file names it."""
-        return {
-            "name": self.name,
-            "reference": self.reference,
-            "grading": dict(self.config.get("grading") or {}),
-            "grading_source": self.grading.source,
-            "upscale": self.grading.upscale,
-            "lab": self.lab.to_dict(),
-        }
+        return SoilRecord(
+            name=self.name,
+            reference=self.reference,
+            grading=dict(self.config.get("grading") or {}),
+            grading_source=self.grading.source,
+            upscale=self.grading.upscale,
+            lab=self.lab.to_dict(),
+        )
 
 
 def _soil(table: dict) -> tuple[str, str]:
@@ -217,4 +233,4 @@ def load_sand_case(config: ConfigLike, *, seeds: int | None = None) -> SandCase:
     return SandCase(name, reference, lab, crit, base_dir, spec, grading, n_seeds, cal_disks, mus, cal_seeds)
 
 
-__all__ = ["CALIBRATION_DISKS", "CALIBRATION_SEEDS", "SandCase", "load_sand_case"]
+__all__ = ["CALIBRATION_DISKS", "CALIBRATION_SEEDS", "SandCase", "SoilRecord", "load_sand_case"]

@@ -3,7 +3,7 @@
 The pre-flight reads only the grading and the box (no disk is simulated): the disk count
 is the box's solid area over the grading's mean disk area, the time step is the engine's
 critical step for the lightest disk (:func:`poro2d.specimen.compaction.time_step`), and the
-grading's frictionless jamming porosity (:mod:`poro2d.specimen.jamming`, an energy
+grading's frictionless jamming porosity (:mod:`poro2d.oracles.jamming`, an energy
 minimisation, not a DEM run) places the first trials. The run time is a model:
 
     particle-steps = disks x steps per trial x trials per case
@@ -154,11 +154,9 @@ def jamming_of(grading: GradingCurve, seeds: int = 3, *, use_cache: bool = True)
     """
     if not use_cache:
         return _compute_jamming(grading, seeds)
-    import json
-
     from poro2d import __version__
     from poro2d.identity import identity_digest
-    from poro2d.io_utils import write_json
+    from poro2d.store import Store
     from poro2d.sweep.density import cache_dir
 
     key = identity_digest(
@@ -171,16 +169,17 @@ def jamming_of(grading: GradingCurve, seeds: int = 3, *, use_cache: bool = True)
         },
         length=16,
     )
-    path = cache_dir() / "jamming" / f"{key}.json"
+    store, name = Store(cache_dir() / "jamming"), f"{key}.json"
+    data = store.read_json(name)
     try:
-        jam = _jamming_from(json.loads(path.read_text(encoding="utf-8")))
-    except (OSError, ValueError, TypeError, KeyError):
+        jam = _jamming_from(data) if isinstance(data, dict) else None
+    except (ValueError, TypeError, KeyError):
         jam = None
     if jam is not None:
         return jam
     jam = _compute_jamming(grading, seeds)
     try:
-        write_json(path, asdict(jam))
+        store.write_json(name, asdict(jam))
     except OSError:  # a read-only cache: the reference is simply computed again next time
         pass
     return jam
@@ -203,7 +202,7 @@ def _jamming_from(d: dict) -> Jamming | None:
 def _compute_jamming(grading: GradingCurve, seeds: int) -> Jamming:
     import time
 
-    from poro2d.specimen.jamming import jamming_reference
+    from poro2d.oracles.jamming import jamming_reference
 
     # the periodic cell must be wider than four of the largest radii: N mean disks at phi 0.85
     need = (4.0 * grading.d_max_m / 2.0) ** 2 * 4.0 * 0.85 / grading.mean_disk_area()

@@ -1,6 +1,6 @@
 """Where a sand run's time went: steps and particle-steps per second, stage by stage.
 
-Read from the criterion folders of its cases (each trial's ``prepared.json``, the layers'
+Read from the criterion stores of its cases (each trial's ``prepared.json``, the layers'
 and the working-friction stage's steps, and the trial's ``time_prepare_s``, ``plate_steps``
 and ``time_plate_s`` in ``result.json``), so a resumed run reports the work of every case,
 whenever it ran.
@@ -8,43 +8,78 @@ whenever it ran.
 
 from __future__ import annotations
 
-import json
 import math
-from pathlib import Path
+from dataclasses import dataclass
+from typing import Any
+
+from poro2d.store import Store, walk
+from poro2d.typed_result import TypedResult
 
 
-def _read(path: Path) -> dict | None:
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
+@dataclass(eq=False)
+class PhaseProfile(TypedResult):
+    """One phase's work (the preparation, or the plate/lid stage): steps, seconds, particle-steps."""
+
+    steps: int
+    seconds: float
+    particle_steps: float
+    particle_steps_per_s: float
+
+
+@dataclass(eq=False)
+class StageProfile(TypedResult):
+    """Where a stage's time went (``time_profile``, ``specimens_time_profile`` in ``sand.json``):
+    its trials, and the work of its preparation and plate phases."""
+
+    trials: int
+    prepare: PhaseProfile
+    plate: PhaseProfile
+
+    def to_dict(self) -> dict[str, Any]:
+        out = super().to_dict()
+        for key in ("prepare", "plate"):
+            if isinstance(out.get(key), PhaseProfile):
+                out[key] = out[key].to_dict()
+        return out
+
+    @classmethod
+    def from_dict(cls, data) -> StageProfile:
+        obj = super().from_dict(data)
+        for key in ("prepare", "plate"):
+            if isinstance(getattr(obj, key), dict):
+                setattr(obj, key, PhaseProfile.from_dict(getattr(obj, key)))
+        return obj
+
+
+def _read(store: Store, name: str) -> dict | None:
+    data = store.read_json(name)
     return data if isinstance(data, dict) else None
 
 
-def _preparation_steps(trial_folder: Path) -> int:
-    prep = _read(trial_folder / "prepared.json") or {}
+def _preparation_steps(trial: Store) -> int:
+    prep = _read(trial, "prepared.json") or {}
     steps = sum(int(layer.get("steps") or 0) for layer in prep.get("layers") or [])
     return steps + int((prep.get("final_stage") or {}).get("steps") or 0)
 
 
-def _trial_folders(run: Path) -> dict[int, Path]:
+def _trial_stores(run: Store) -> dict[int, Store]:
     out = {}
-    for f in sorted((run / "trials").glob("*_n*")):
-        head = f.name.split("_", 1)[0]
+    for trial in walk(run.child("trials"), "*_n*"):
+        head = trial.root.name.split("_", 1)[0]
         if head.isdigit():
-            out[int(head)] = f
+            out[int(head)] = trial
     return out
 
 
-def stage_profile(runs: list[Path]) -> dict:
+def stage_profile(runs: list[Store]) -> StageProfile:
     """Trials, steps, seconds and particle-steps per second of the preparation and the plate/lid
-    stage, summed over the criterion folders ``runs`` (one per case)."""
+    stage, summed over the criterion stores ``runs`` (one per case)."""
     tally = {"trials": 0, "prepare": [0.0, 0.0, 0.0], "plate": [0.0, 0.0, 0.0]}  # steps, seconds, disk-steps
     for run in runs:
-        res = _read(run / "result.json")
+        res = _read(run, "result.json")
         if res is None:
             continue
-        folders = _trial_folders(run)
+        folders = _trial_stores(run)
         for it in res.get("iterations") or []:
             n = float(it.get("particle_count") or 0)
             tally["trials"] += 1
@@ -55,22 +90,17 @@ def stage_profile(runs: list[Path]) -> dict:
                 tally[key][0] += steps
                 tally[key][1] += float(secs or 0.0)
                 tally[key][2] += steps * n
-    out: dict = {"trials": tally["trials"]}
+    phases = {}
     for key in ("prepare", "plate"):
         steps, secs, work = tally[key]
-        out[key] = {
-            "steps": int(steps),
-            "seconds": secs,
-            "particle_steps": work,
-            "particle_steps_per_s": work / secs if secs > 0 else math.nan,
-        }
-    return out
+        phases[key] = PhaseProfile(int(steps), secs, work, work / secs if secs > 0 else math.nan)
+    return StageProfile(int(tally["trials"]), phases["prepare"], phases["plate"])
 
 
-def case_runs(folder: Path, case_ids: list[str]) -> list[Path]:
-    """The criterion folders of the cases ``case_ids`` of a sweep folder (a shared calibration
+def case_runs(sweep: Store, case_ids: list[str]) -> list[Store]:
+    """The criterion stores of the cases ``case_ids`` of a sweep's store (a shared calibration
     cache may hold other cases of the same grading and box: other frictions, seeds or first trials)."""
-    return [Path(folder) / "cases" / cid / "run" for cid in case_ids]
+    return [sweep.child("cases", cid, "run") for cid in case_ids]
 
 
-__all__ = ["case_runs", "stage_profile"]
+__all__ = ["PhaseProfile", "StageProfile", "case_runs", "stage_profile"]

@@ -11,12 +11,14 @@ import csv
 import io
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
-from poro2d.io_utils import atomic_path, provenance, write_json
+from poro2d.io_utils import provenance
+from poro2d.sand.case import SoilRecord
+from poro2d.sand.profile import StageProfile
+from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
@@ -66,11 +68,55 @@ class SeedSpecimen:
 
 
 @dataclass(eq=False)
+class SandCalibration(TypedResult):
+    """The calibration in the small box (``calibration`` in ``sand.json``).
+
+    ``mus``: the preparation frictions of the final calibration; ``calibration``: its record
+    (:meth:`poro2d.criterion.density.Calibration.to_dict`); ``n2d_min``/``n2d_max``: the 2D
+    extremes; ``dropped_ends``: frictions no seed could prepare; ``cases``: the sweep's folder;
+    ``interior_by_friction``: interior porosities per friction and seed; the densest
+    preparation's own porosity (to hold against the jamming porosity); where the time went
+    in the calibration and in the specimens at full size.
+    """
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("time_profile", "specimens_time_profile")
+
+    mus: list[float]
+    calibration: dict[str, Any]
+    n2d_min: float
+    n2d_max: float
+    dropped_ends: list[float]
+    cases: str
+    interior_by_friction: list[list[float | None]]
+    dense_end_interior: float | None
+    dense_end_interior_sd: float | None
+    time_profile: StageProfile | None = None
+    specimens_time_profile: StageProfile | None = None
+
+    PROFILES: ClassVar[tuple[str, ...]] = ("time_profile", "specimens_time_profile")
+
+    def to_dict(self) -> dict[str, Any]:
+        out = super().to_dict()
+        for key in self.PROFILES:
+            if isinstance(out.get(key), StageProfile):
+                out[key] = out[key].to_dict()
+        return out
+
+    @classmethod
+    def from_dict(cls, data) -> SandCalibration:
+        obj = super().from_dict(data)
+        for key in cls.PROFILES:
+            if isinstance(getattr(obj, key), dict):
+                setattr(obj, key, StageProfile.from_dict(getattr(obj, key)))
+        return obj
+
+
+@dataclass(eq=False)
 class SandResult(TypedResult):
     """``sand.json``: the soil, its state, the answer over seeds and where every part is."""
 
     mode: str
-    soil: dict[str, Any]
+    soil: SoilRecord
     state: dict[str, Any]
     interior_porosity_mean: float
     interior_porosity_sd: float
@@ -87,7 +133,7 @@ class SandResult(TypedResult):
     n2d_max: float
     jamming_porosity: float | None
     jamming_porosity_sd: float | None
-    calibration: dict[str, Any]
+    calibration: SandCalibration
     states: list[dict[str, Any]]
     seed_results: list[dict[str, Any]]
     preflight: dict[str, Any]
@@ -96,9 +142,34 @@ class SandResult(TypedResult):
     provenance: dict[str, Any]
     specimens: list[SeedSpecimen] = field(default_factory=list, metadata=NOT_IN_FILE)
 
+    #: the typed parts, as their classes read them
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"soil": SoilRecord, "calibration": SandCalibration}
+
+    def to_dict(self) -> dict[str, Any]:
+        out = super().to_dict()
+        for key in self.PARTS:
+            if isinstance(out.get(key), TypedResult):
+                out[key] = out[key].to_dict()
+        return out
+
+    @classmethod
+    def from_dict(cls, data) -> SandResult:
+        obj = super().from_dict(data)
+        for key, part in cls.PARTS.items():
+            if isinstance(getattr(obj, key), dict):
+                setattr(obj, key, part.from_dict(getattr(obj, key)))
+        return obj
+
     @classmethod
     def build(
-        cls, case, pf, target, trial: float, cal_record: dict, kept: list[SeedSpecimen], seconds: float
+        cls,
+        case,
+        pf,
+        target,
+        trial: float,
+        cal_record: SandCalibration,
+        kept: list[SeedSpecimen],
+        seconds: float,
     ) -> SandResult:
         inner_m, inner_sd = _stats([k.interior_porosity for k in kept if k.accepted])
         box_m, box_sd = _stats([k.box_porosity for k in kept if k.accepted])
@@ -131,8 +202,8 @@ class SandResult(TypedResult):
             mu_prep=target.mu_prep,
             n2d_target=target.n2d_target,
             first_trial_full_box=trial,
-            n2d_min=cal_record["n2d_min"],
-            n2d_max=cal_record["n2d_max"],
+            n2d_min=cal_record.n2d_min,
+            n2d_max=cal_record.n2d_max,
             jamming_porosity=pf.jamming.porosity,
             jamming_porosity_sd=pf.jamming.sd,
             calibration=cal_record,
@@ -191,8 +262,10 @@ def summary_row(res: SandResult) -> dict:
     }
 
 
-def summary_markdown(res: SandResult, out: Path) -> str:
-    """The paste-ready summary: the answer first, then the soil, the run and the specimens."""
+def summary_markdown(res: SandResult, store: Store) -> str:
+    """The paste-ready summary: the answer first, then the soil, the run and the specimens
+    (the export commands name the store's folder)."""
+    out = store.root
     st, soil = res.state, res.soil
     dr = st.get("relative_density")
     jam = res.jamming_porosity
@@ -287,16 +360,23 @@ def _fmt(v: float | None) -> str:
     return "n/a" if v is None or not math.isfinite(v) else f"{v:.4f}"
 
 
-def write_summary(res: SandResult, out: Path) -> None:
+def write_summary(res: SandResult, store: Store) -> None:
     """``summary.md``, ``summary.csv`` and, last (it marks the run done), ``sand.json``."""
     buf = io.StringIO()
     w = csv.DictWriter(buf, fieldnames=SUMMARY_COLUMNS, lineterminator="\n")
     w.writeheader()
     w.writerow(summary_row(res))
-    for name, text in (("summary.md", summary_markdown(res, out)), ("summary.csv", buf.getvalue())):
-        with atomic_path(out / name) as tmp:
-            tmp.write_text(text, encoding="utf-8")
-    write_json(out / "sand.json", res.to_dict())
+    for name, text in (("summary.md", summary_markdown(res, store)), ("summary.csv", buf.getvalue())):
+        store.write_text(name, text)
+    store.write_result("sand.json", res)
 
 
-__all__ = ["SandResult", "SeedSpecimen", "summary_markdown", "summary_row", "warnings", "write_summary"]
+__all__ = [
+    "SandCalibration",
+    "SandResult",
+    "SeedSpecimen",
+    "summary_markdown",
+    "summary_row",
+    "warnings",
+    "write_summary",
+]

@@ -20,23 +20,26 @@ Stages (each resumable: rerun the same command to go on):
 from __future__ import annotations
 
 import os
-import shutil
 import time
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from poro2d.criterion.density import Calibration, StateTarget, state_target
 from poro2d.interop.origin import SOIL_FILE
-from poro2d.io_utils import check_output_dir, provenance, write_json
+from poro2d.io_utils import check_output_dir, provenance
 from poro2d.locks import holds_output
 from poro2d.sand.case import ConfigLike, SandCase, load_sand_case
 from poro2d.sand.preflight import Preflight, preflight
 from poro2d.sand.profile import case_runs, stage_profile
-from poro2d.sand.result import SandResult, SeedSpecimen, write_summary
+from poro2d.sand.result import SandCalibration, SandResult, SeedSpecimen, write_summary
+from poro2d.store import Store, walk
 from poro2d.sweep import density as D
+
+#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+KIND = "sand"
 
 Announce = Callable[[str], None]
 
@@ -131,11 +134,19 @@ def full_box_trial(target: float, dense_end: float | None, cal_dense: float, pf:
     return target - excess * (1.0 - ratio)
 
 
-def _first_trial_shifts(pf: Preflight) -> dict:
-    """What moves the calibration's first trials: the grading's jamming porosity, the box's walls."""
+@dataclass(frozen=True)
+class FirstTrialShifts:
+    """What moves the calibration's first trials: the grading's jamming porosity (the dense
+    end), the box's walls' share and the loose bias (:func:`poro2d.sweep.density.calibrate`)."""
+
+    dense_end: float | None
+    walls: float
+    loose_bias: float
+
+
+def _first_trial_shifts(pf: Preflight) -> FirstTrialShifts:
     box = pf.calibration_box
-    return {"dense_end": pf.jamming.porosity, "walls": D.wall_share(box.width, box.height, pf.d50_m),
-            "loose_bias": LOOSE_BIAS}  # fmt: skip
+    return FirstTrialShifts(pf.jamming.porosity, D.wall_share(box.width, box.height, pf.d50_m), LOOSE_BIAS)
 
 
 def calibration_cases(case: SandCase, pf: Preflight, mus: list[float]) -> list:
@@ -143,60 +154,64 @@ def calibration_cases(case: SandCase, pf: Preflight, mus: list[float]) -> list:
     from poro2d.sweep.cases import parse_sweep
 
     cfg = calibration_config(case, pf)
-    sweep = D.calibration_sweep(cfg, mus, case.calibration_seeds, **_first_trial_shifts(pf))
+    sweep = D.calibration_sweep(cfg, mus, case.calibration_seeds, **asdict(_first_trial_shifts(pf)))
     return parse_sweep(sweep, case.base_dir).cases
 
 
-def _calibrate(case, pf, out, mus, record, cal_kw) -> tuple[Calibration, dict]:
+def _calibrate(case, pf, store: Store, mus, record, cal_kw) -> tuple[Calibration, dict]:
     cfg = calibration_config(case, pf)
     shifts = _first_trial_shifts(pf)
     return D.calibrate(
         cfg,
         case.base_dir,
-        out,
+        store.root,
         mus=mus,
         seeds=case.calibration_seeds,
-        **shifts,
+        **asdict(shifts),
         loosest_first=True,
         record=record,
         **cal_kw,
     )
 
 
-def calibration_stage(case: SandCase, pf: Preflight, out: Path, cal_kw: dict) -> tuple[StateTarget, dict]:
+def calibration_stage(
+    case: SandCase, pf: Preflight, store: Store, cal_kw: dict
+) -> tuple[StateTarget, SandCalibration]:
     """The ends, then the two frictions around the state: its target and friction.
 
     ``cal_kw``: the sweep's options and ``use_cache`` (:func:`poro2d.sweep.density.calibrate`).
     """
-    cal_ends, usable, ends_info = calibrate_ends(case, pf, out, cal_kw)
+    cal_ends, usable, ends_info = calibrate_ends(case, pf, store, cal_kw)
     ends = [usable[0], usable[-1]]
     first = state_target(case.lab.n_lab, case.n_max, case.n_min, cal_ends)
     mus = bracket(usable, predicted_mu(cal_ends, first.n2d_target))
     cal, info = (
-        (cal_ends, ends_info) if mus == ends else _calibrate(case, pf, out, mus, "calibration.json", cal_kw)
+        (cal_ends, ends_info) if mus == ends else _calibrate(case, pf, store, mus, "calibration.json", cal_kw)
     )
     if mus == ends:
-        write_json(
-            out / "calibration.json", {"calibration": cal.to_dict(), "mus": mus, "note": "the ends only"}
+        store.write_json(
+            "calibration.json", {"calibration": cal.to_dict(), "mus": mus, "note": "the ends only"}
         )
     target = state_target(case.lab.n_lab, case.n_max, case.n_min, cal)
     dropped = [mu for mu in case.mus if mu < ends[0] or mu > ends[1]]
     dense = [v for v in info["interior"][0] if v is not None]
-    return target, {
-        "mus": mus,
-        "calibration": cal.to_dict(),
-        "n2d_min": cal.n2d_min,
-        "n2d_max": cal.n2d_max,
-        "dropped_ends": dropped,
-        "cases": info["cases"],
-        "interior_by_friction": info["interior"],
+    return target, SandCalibration(
+        mus=mus,
+        calibration=cal.to_dict(),
+        n2d_min=cal.n2d_min,
+        n2d_max=cal.n2d_max,
+        dropped_ends=dropped,
+        cases=info["cases"],
+        interior_by_friction=info["interior"],
         # the densest preparation's own porosity: to hold against the jamming porosity
-        "dense_end_interior": float(np.mean(dense)) if dense else None,
-        "dense_end_interior_sd": float(np.std(dense, ddof=1)) if len(dense) > 1 else None,
-    }
+        dense_end_interior=float(np.mean(dense)) if dense else None,
+        dense_end_interior_sd=float(np.std(dense, ddof=1)) if len(dense) > 1 else None,
+    )
 
 
-def calibrate_ends(case: SandCase, pf: Preflight, out: Path, cal_kw: dict) -> tuple[Calibration, tuple, dict]:
+def calibrate_ends(
+    case: SandCase, pf: Preflight, store: Store, cal_kw: dict
+) -> tuple[Calibration, tuple, dict]:
     """The densest and loosest preparations that at least one seed could prepare.
 
     An end whose every seed was refused (e.g. a lid that does not settle on a very frictional
@@ -205,7 +220,7 @@ def calibrate_ends(case: SandCase, pf: Preflight, out: Path, cal_kw: dict) -> tu
     """
     lo, hi = 0, len(case.mus) - 1
     while True:
-        cal, info = _calibrate(case, pf, out, [case.mus[lo], case.mus[hi]], "calibration_ends.json", cal_kw)
+        cal, info = _calibrate(case, pf, store, [case.mus[lo], case.mus[hi]], "calibration_ends.json", cal_kw)
         ok_lo, ok_hi = cal.accepted(0).size > 0, cal.accepted(1).size > 0
         if ok_lo and ok_hi:
             return cal, case.mus[lo : hi + 1], info
@@ -215,7 +230,7 @@ def calibrate_ends(case: SandCase, pf: Preflight, out: Path, cal_kw: dict) -> tu
             raise AssertionError("unreachable: usable() refuses fewer than two frictions")
 
 
-def specimen_stage(case: SandCase, trial: StateTarget, out: Path, sweep_kw: dict) -> list[dict]:
+def specimen_stage(case: SandCase, trial: StateTarget, store: Store, sweep_kw: dict) -> list[dict]:
     """One criterion case per seed at full size, at the state's friction, from ``trial``."""
     from poro2d.criterion.protocol import trial_grid
     from poro2d.sweep.cases import parse_sweep
@@ -224,29 +239,30 @@ def specimen_stage(case: SandCase, trial: StateTarget, out: Path, sweep_kw: dict
     crit = case.config.get("criterion") or {}
     grid = trial_grid(float(crit.get("resolution", 0.01)), crit.get("refine_tolerance"))
     sweep = parse_sweep(D.state_sweep(case.config, [trial], case.seeds, grid), case.base_dir)
-    res = run_sweep(sweep, out / "states", **sweep_kw)
+    res = run_sweep(sweep, store.child("states").root, **sweep_kw)
     return sorted(res.rows, key=lambda r: int((r.get("params") or {}).get("seed", 0)))
 
 
-def keep_specimens(rows: list[dict], out: Path, label: str, soil: dict, state: dict) -> list[SeedSpecimen]:
-    """Each seed's accepted specimen in a named folder (``specimens/<label>-seed<k>``), with a
+def keep_specimens(rows: list[dict], store: Store, label: str, soil: dict, state: dict) -> list[SeedSpecimen]:
+    """Each seed's accepted specimen in a named store (``specimens/<label>-seed<k>``), with a
     ``soil.json`` naming the soil and its laboratory state."""
     kept = []
     for r in rows:
         seed = int((r.get("params") or {}).get("seed", 0))
         res = r.get("results") or {}
         ok = r.get("status") == "done" and bool(res.get("converged"))
-        src = out / "states" / "cases" / str(r.get("case_id")) / "run"  # the criterion's folder of the case
+        # the criterion's store of the case
+        src = store.child("states", "cases", str(r.get("case_id")), "run")
         folder = None
-        if ok and (src / "specimen.npz").is_file():
-            dest = out / "specimens" / f"{label}-seed{seed}"
-            dest.mkdir(parents=True, exist_ok=True)
-            for f in src.iterdir():
-                if f.is_file() and not f.name.startswith("."):
-                    shutil.copy2(f, dest / f.name)
+        if ok and src.has("specimen.npz"):
+            name = f"{label}-seed{seed}"
+            dest = store.child("specimens", name)
+            for f in src.names():
+                if src.has(f) and not f.startswith("."):
+                    src.copy(f, dest)
             # who the specimen is, for the export headers (poro2d.interop.origin)
-            write_json(dest / SOIL_FILE, {"soil": soil, "state": state, "mode": "density", "seed": seed})
-            folder = str(dest.relative_to(out))
+            dest.write_json(SOIL_FILE, {"soil": soil, "state": state, "mode": "density", "seed": seed})
+            folder = str(Path("specimens", name))
         kept.append(SeedSpecimen.from_row(seed, r, folder))
     return kept
 
@@ -272,11 +288,11 @@ def check_soil(
     return case, preflight(case, workers=workers or os.cpu_count() or 1, budget_minutes=budget_minutes)
 
 
-@holds_output("out")
+@holds_output("store", kind=KIND)
 def run_sand(
     config: ConfigLike,
     *,
-    out: str | os.PathLike = "sand-out",
+    store: Store,
     seeds: int | None = None,
     budget_minutes: float | None = None,
     workers: int | None = None,
@@ -288,7 +304,7 @@ def run_sand(
 ) -> SandResult:
     """The density-aware 2D porosity of a soil at its laboratory state, over seeds.
 
-    ``config``: a sand config (:mod:`poro2d.sand.case`), a TOML file or a dict. Writes
+    ``config``: a sand config (:mod:`poro2d.sand.case`), a TOML file or a dict. Keeps in ``store``
     ``preflight.json`` before any DEM work, then the calibration, the specimens
     (``specimens/<state>-seed<k>``), ``fig_grading.png``, ``summary.md``, ``summary.csv`` and
     ``sand.json`` (returned as a :class:`~poro2d.sand.result.SandResult`). ``on_preflight``
@@ -298,13 +314,11 @@ def run_sand(
     """
     from poro2d.execute.cluster_options import check_cluster_options
 
-    out = Path(out)
-    check_output_dir("--out", out)
+    check_output_dir(store.parameter, store.root)
     check_cluster_options(scheduler, workers)
     case, pf = check_soil(config, seeds=seeds, workers=workers, budget_minutes=budget_minutes)
-    out.mkdir(parents=True, exist_ok=True)
-    write_json(
-        out / "preflight.json",
+    store.write_json(
+        "preflight.json",
         {"preflight": pf.to_dict(), "soil": case.soil_record(), "provenance": provenance()},
     )
     if on_preflight is not None:
@@ -314,36 +328,38 @@ def run_sand(
     t = clock.begin(
         f"calibration: {pf.cases_calibration} cases at most, {pf.calibration_box.disks:.0f} disks each",
     )
-    target, cal_record = calibration_stage(case, pf, out, dict(sweep_kw, use_cache=use_cache))
+    target, cal_record = calibration_stage(case, pf, store, dict(sweep_kw, use_cache=use_cache))
     clock.end("calibration", t)
-    trial = full_box_trial(target.n2d_target, pf.jamming.porosity, cal_record["n2d_min"], pf)
+    trial = full_box_trial(target.n2d_target, pf.jamming.porosity, cal_record.n2d_min, pf)
     t = clock.begin(
         f"specimens: {case.seeds} at full size ({pf.box.disks:.0f} disks), "
         f"mu_prep {target.mu_prep:.3f}, first trial {trial:.4f}",
     )
-    rows = specimen_stage(case, replace(target, n2d_target=trial), out, sweep_kw)
+    rows = specimen_stage(case, replace(target, n2d_target=trial), store, sweep_kw)
     clock.end("specimens", t)
-    kept = keep_specimens(rows, out, _state_label(case), case.soil_record(), case.lab.to_dict())
-    cal_ids = [c.id for c in calibration_cases(case, pf, [float(m) for m in cal_record["mus"]])]
-    cal_record["time_profile"] = stage_profile(case_runs(Path(cal_record["cases"]), cal_ids))
-    cal_record["specimens_time_profile"] = stage_profile(sorted((out / "states" / "cases").glob("*/run")))
-    radii = _drawn_radii(out, kept)
-    _grading_figure(case, radii, out)
+    kept = keep_specimens(rows, store, _state_label(case), case.soil_record(), case.lab.to_dict())
+    cal_ids = [c.id for c in calibration_cases(case, pf, [float(m) for m in cal_record.mus])]
+    runs = [c.child("run") for c in walk(store.child("states", "cases"), "*")]
+    cal_record = replace(
+        cal_record,
+        time_profile=stage_profile(case_runs(Store(cal_record.cases), cal_ids)),
+        specimens_time_profile=stage_profile(runs),
+    )
+    radii = _drawn_radii(store, kept)
+    _grading_figure(case, radii, store)
     result = SandResult.build(case, pf, target, trial, cal_record, kept, clock.elapsed())
-    write_summary(result, out)
+    write_summary(result, store)
     return result
 
 
-def _drawn_radii(out: Path, kept: list[SeedSpecimen]) -> np.ndarray | None:
-    from poro2d.dem import checkpoint
-
+def _drawn_radii(store: Store, kept: list[SeedSpecimen]) -> np.ndarray | None:
     for k in kept:
         if k.folder:
-            return checkpoint.load(out / k.folder / "specimen.npz").particles.radius.copy()
+            return store.child(k.folder).load_state("specimen.npz").particles.radius.copy()
     return None
 
 
-def _grading_figure(case: SandCase, radii, out: Path) -> None:
+def _grading_figure(case: SandCase, radii, store: Store) -> None:
     from poro2d.report.grading_figure import grading_figure
 
     grading_figure(
@@ -351,7 +367,7 @@ def _grading_figure(case: SandCase, radii, out: Path) -> None:
         case.base_dir,
         case.grading,
         radii,
-        out / "fig_grading.png",
+        store.path("fig_grading.png"),
         title=case.name,
     )
 

@@ -25,10 +25,12 @@ displacement plus one largest disk diameter.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
+from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
 from poro2d.dem.ordering import strip_order
 from poro2d.errors import InputError, check_range
 from poro2d.paper_data import TABLE_1
@@ -36,6 +38,14 @@ from poro2d.specimen.box import box_faces
 
 LOWER = ("bottom", "lower_left", "lower_right", "lower_lip")
 UPPER = ("upper_left", "upper_right", "upper_lip", "top")
+
+
+class PlaneForce(NamedTuple):
+    """What crosses the shear plane (:meth:`SplitBox.plane_force`): forces (N, x and y) and contacts."""
+
+    across: np.ndarray
+    unbalanced: np.ndarray
+    contacts_across: int
 
 
 @dataclass(frozen=True)
@@ -86,7 +96,7 @@ class SplitBox:
         """Upward push of the disks on the top plate (N)."""
         return float(sim.wall_force("top")[1])
 
-    def plane_force(self, sim: Simulation, contacts=None) -> dict:
+    def plane_force(self, sim: Simulation, contacts=None) -> PlaneForce:
         """Forces carried across the shear plane ``y = split_y`` (N).
 
         The disks are split by their centres into an upper set (``y >= split_y``)
@@ -122,7 +132,7 @@ class SplitBox:
         across -= c.force[wu & ~ui].sum(axis=0)
         unbalanced = sim.force[up].sum(axis=0) - sim.particles.mass[up].sum() * np.asarray(sim.gravity)
         n_cross = int(np.count_nonzero(m1 | m2))
-        return {"across": across, "unbalanced": unbalanced, "contacts_across": n_cross}
+        return PlaneForce(across, unbalanced, n_cross)
 
 
 def _specimen_box(sim: Simulation) -> tuple[float, float]:
@@ -167,7 +177,7 @@ def build_split_box(
     if particle_friction is not None:
         check_range("particle_friction", particle_friction, 0.0, None)
     if rolling_friction is not None:
-        check_range("rolling_friction", rolling_friction, 0.0, None)
+        check_range("rolling_friction", rolling_friction, 0.0, MAX_ROLLING_FRICTION)
     p0 = specimen.particles
     if p0.n == 0:
         raise InputError("specimen", "no disks", "a specimen with disks")
@@ -213,4 +223,4 @@ def build_split_box(
     return sim, box
 
 
-__all__ = ["LOWER", "UPPER", "SplitBox", "build_split_box"]
+__all__ = ["LOWER", "UPPER", "PlaneForce", "SplitBox", "build_split_box"]

@@ -26,6 +26,18 @@ CONSOLIDATION_CHECK = 500
 
 
 @dataclass(frozen=True)
+class Settling:
+    """How a consolidation ended: ``settled`` (equilibrium and stress on target), its ``steps``, the
+    maximum unbalanced-force ratio and |F / target - 1| at the last check, the plate's height before."""
+
+    settled: bool
+    steps: int
+    max_unbalanced_ratio: float
+    normal_stress_error: float
+    plate_height_before_m: float
+
+
+@dataclass(frozen=True)
 class Consolidation:
     """Servo the top plate to a normal force until the specimen is at equilibrium under it.
 
@@ -37,12 +49,10 @@ class Consolidation:
     settings: ShearSettings
     progress: ProgressFn | None = None
 
-    def settle(self, sim: Simulation, target: float) -> dict:
+    def settle(self, sim: Simulation, target: float) -> Settling:
         """Consolidate ``sim`` under ``target`` newtons on its top plate; the servo stays on after.
 
-        Returns ``settled``, ``steps``, ``max_unbalanced_ratio`` (at the last check),
-        ``normal_stress_error`` (|F / target - 1| at the last check) and
-        ``plate_height_before_m``. The engine's clock starts again at 0.
+        The engine's clock starts again at 0.
         """
         s = self.settings
         plate = FlatPlate(sim)
@@ -60,13 +70,13 @@ class Consolidation:
 
         sim.reset_clock()
         res = sim.run(s.consolidation_max_steps, every=CONSOLIDATION_CHECK, callback=settled)
-        return {
-            "settled": state["ratio"] < s.consolidation_ratio and state["err"] < s.stress_tolerance,
-            "steps": res.steps,
-            "max_unbalanced_ratio": state["ratio"],
-            "normal_stress_error": state["err"],
-            "plate_height_before_m": y0,
-        }
+        return Settling(
+            settled=state["ratio"] < s.consolidation_ratio and state["err"] < s.stress_tolerance,
+            steps=res.steps,
+            max_unbalanced_ratio=state["ratio"],
+            normal_stress_error=state["err"],
+            plate_height_before_m=y0,
+        )
 
 
 @dataclass(frozen=True)
@@ -81,4 +91,4 @@ class ShearDrive:
             sim.set_wall_velocity(name, (self.velocity, 0.0))
 
 
-__all__ = ["CONSOLIDATION_CHECK", "Consolidation", "ProgressFn", "ShearDrive"]
+__all__ = ["CONSOLIDATION_CHECK", "Consolidation", "ProgressFn", "Settling", "ShearDrive"]

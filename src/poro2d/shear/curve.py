@@ -9,14 +9,18 @@ shear displacement.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
 
 import numpy as np
 
 from poro2d.dem import Simulation
-from poro2d.dem.measure import ContactSet
+from poro2d.dem.contacts import ContactSet
 from poro2d.shear.box import SplitBox
 from poro2d.shear.fit import peak, smooth
+from poro2d.shear.parts import EndValues, ForceBalance
 from poro2d.shear.settings import ShearSettings, inertial_number
+from poro2d.store import Store
 
 CURVE_COLUMNS = [
     "step", "shear_displacement_mm", "shear_stress_kpa", "normal_stress_kpa", "plate_displacement_mm",
@@ -25,18 +29,52 @@ CURVE_COLUMNS = [
 ]  # fmt: skip
 
 
-def curve_columns(rows: list[dict]) -> dict[str, np.ndarray]:
-    """A curve's records as one float array per column of :data:`CURVE_COLUMNS` (none without rows).
+@dataclass(frozen=True, eq=False)
+class ShearCurve(Mapping):
+    """A test's recorded curve: one float array per column of ``curve.csv`` (:data:`CURVE_COLUMNS`).
+
+    Also a read-only mapping of the column names to the arrays, in the file's order (the
+    figures take a curve as such).
+    """
+
+    step: np.ndarray
+    shear_displacement_mm: np.ndarray
+    shear_stress_kpa: np.ndarray
+    normal_stress_kpa: np.ndarray
+    plate_displacement_mm: np.ndarray
+    coordination_number: np.ndarray
+    lower_half_stress_kpa: np.ndarray
+    plane_stress_kpa: np.ndarray
+    upper_unbalanced_kpa: np.ndarray
+    plate_friction_kpa: np.ndarray
+    contacts_across_plane: np.ndarray
+    max_unbalanced_ratio: np.ndarray
+    inertial_number: np.ndarray
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in CURVE_COLUMNS:
+            raise KeyError(name)
+        return getattr(self, name)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(CURVE_COLUMNS)
+
+    def __len__(self) -> int:
+        return len(CURVE_COLUMNS)
+
+
+def curve_columns(rows: list[Mapping]) -> ShearCurve | None:
+    """A curve's records as one float array per column of :data:`CURVE_COLUMNS` (None without rows).
 
     Every value goes through ``float`` as ``curve.csv`` stores it (an integer column reads
     back as floats), so a curve in memory and one read from its file are the same arrays.
     """
     if not rows:
-        return {}
-    return {k: np.array([float(r[k]) for r in rows]) for k in CURVE_COLUMNS}
+        return None
+    return ShearCurve(**{k: np.array([float(r[k]) for r in rows]) for k in CURVE_COLUMNS})
 
 
-def curve_rows(curve: dict[str, np.ndarray]) -> list[dict]:
+def curve_rows(curve: Mapping[str, np.ndarray]) -> list[dict]:
     """The records of a curve held as columns (:func:`curve_columns`), as rows of Python floats."""
     names = list(curve)
     return [
@@ -45,12 +83,10 @@ def curve_rows(curve: dict[str, np.ndarray]) -> list[dict]:
     ]
 
 
-def read_curve(path) -> dict[str, np.ndarray]:
-    """The columns of a test's ``curve.csv`` (as :func:`curve_columns`)."""
-    import csv
-
-    with open(path, newline="") as fh:
-        return curve_columns(list(csv.DictReader(fh)))
+def read_curve(store: Store, name: str = "curve.csv") -> ShearCurve | None:
+    """The curve in a test's ``curve.csv`` in ``store`` (as :func:`curve_columns`; None without it)."""
+    rows = store.read_rows(name)
+    return None if rows is None else curve_columns(rows)
 
 
 def curve_row(
@@ -77,10 +113,10 @@ def curve_row(
         "coordination_number": float(2 * np.count_nonzero(c.kind == 0) + np.count_nonzero(c.kind == 1))
         / sim.particles.n,
         "lower_half_stress_kpa": -fl[0] / area / 1e3,
-        "plane_stress_kpa": pl["across"][0] / area / 1e3,
-        "upper_unbalanced_kpa": pl["unbalanced"][0] / area / 1e3,
+        "plane_stress_kpa": pl.across[0] / area / 1e3,
+        "upper_unbalanced_kpa": pl.unbalanced[0] / area / 1e3,
         "plate_friction_kpa": sim.wall_force("top")[0] / area / 1e3,
-        "contacts_across_plane": pl["contacts_across"],
+        "contacts_across_plane": pl.contacts_across,
         "max_unbalanced_ratio": sim.unbalanced_ratios()[0],
         "inertial_number": inertial_number(settings.velocity, sigma, rho, settings.shear_zone_factor),
     }
@@ -90,7 +126,7 @@ def _rel(a: np.ndarray, b: np.ndarray, mask: np.ndarray, ref: float) -> float:
     return float(np.mean(np.abs(a - b)[mask]) / ref) if ref > 0 else math.nan
 
 
-def force_balance(x: np.ndarray, col: dict[str, np.ndarray], window: float) -> dict:
+def force_balance(x: np.ndarray, col: dict[str, np.ndarray], window: float) -> ForceBalance:
     """How far the upper half, the shear plane and the lower half agree, over the test.
 
     The first moments of shearing (one ``window``, at most half the test) are left out.
@@ -98,16 +134,16 @@ def force_balance(x: np.ndarray, col: dict[str, np.ndarray], window: float) -> d
     tau = col["shear_stress_kpa"]
     late = x >= min(window, 0.5 * x[-1])
     ref = float(np.mean(np.abs(tau[late])))
-    return {
-        "mean_abs_upper_minus_plane_rel": _rel(tau, col["plane_stress_kpa"], late, ref),
-        "mean_abs_upper_minus_lower_rel": _rel(tau, col["lower_half_stress_kpa"], late, ref),
-        "mean_upper_kpa": float(np.mean(tau[late])),
-        "mean_plane_kpa": float(np.mean(col["plane_stress_kpa"][late])),
-        "mean_lower_kpa": float(np.mean(col["lower_half_stress_kpa"][late])),
-        "note": "upper = force on the upper half walls; plane = contact forces across y = H/2; "
+    return ForceBalance(
+        mean_abs_upper_minus_plane_rel=_rel(tau, col["plane_stress_kpa"], late, ref),
+        mean_abs_upper_minus_lower_rel=_rel(tau, col["lower_half_stress_kpa"], late, ref),
+        mean_upper_kpa=float(np.mean(tau[late])),
+        mean_plane_kpa=float(np.mean(col["plane_stress_kpa"][late])),
+        mean_lower_kpa=float(np.mean(col["lower_half_stress_kpa"][late])),
+        note="upper = force on the upper half walls; plane = contact forces across y = H/2; "
         "lower = force on the lower half walls; all over W t, means over the test after the "
         "first peak_window of displacement",
-    }  # fmt: skip
+    )  # fmt: skip
 
 
 def peak_passed(x: np.ndarray, x_peak: float, s: ShearSettings) -> bool:
@@ -122,7 +158,29 @@ def ended_by(x: np.ndarray, x_peak: float, s: ShearSettings) -> str:
     return "max_displacement"
 
 
-def curve_summary(rows: list[dict], sigma_kpa: float, settings: ShearSettings) -> dict:
+@dataclass(frozen=True)
+class CurveSummary:
+    """What a test's curve says (the first keys of its ``result.json``, in their order)."""
+
+    normal_stress_kpa: float
+    peak_shear_stress_kpa: float
+    shear_displacement_at_peak_m: float
+    peak_stress_ratio: float
+    peak_shear_stress_raw_kpa: float
+    peak_window_m: float
+    normal_stress_at_peak_kpa: float
+    plate_displacement_at_peak_mm: float
+    end: EndValues
+    end_shear_displacement_m: float
+    ended_by: str
+    max_inertial_number: float
+    inertial_number_ok: bool
+    normal_stress_max_error_after_consolidation: float
+    normal_stress_mean_error: float
+    force_balance: ForceBalance
+
+
+def curve_summary(rows: list[dict], sigma_kpa: float, settings: ShearSettings) -> CurveSummary:
     """Peak, end values, servo error, inertial number and force balance read off the curve."""
     s = settings
     x = np.array([r["shear_displacement_mm"] for r in rows]) * 1e-3
@@ -133,24 +191,33 @@ def curve_summary(rows: list[dict], sigma_kpa: float, settings: ShearSettings) -
         end[name] = float(smooth(x, col[name], s.peak_window)[-1])
     sig_err = np.abs(col["normal_stress_kpa"] / sigma_kpa - 1.0)
     inertial = col["inertial_number"]
-    return {
-        "normal_stress_kpa": sigma_kpa,
-        "peak_shear_stress_kpa": tp,
-        "shear_displacement_at_peak_m": xp,
-        "peak_stress_ratio": tp / sigma_kpa,
-        "peak_shear_stress_raw_kpa": float(np.max(col["shear_stress_kpa"])),
-        "peak_window_m": s.peak_window,
-        "normal_stress_at_peak_kpa": float(smooth(x, col["normal_stress_kpa"], s.peak_window)[k]),
-        "plate_displacement_at_peak_mm": float(col["plate_displacement_mm"][k]),
-        "end": end,
-        "end_shear_displacement_m": float(x[-1]),
-        "ended_by": ended_by(x, xp, s),
-        "max_inertial_number": float(np.max(inertial)),
-        "inertial_number_ok": bool(np.max(inertial) < s.inertial_limit),
-        "normal_stress_max_error_after_consolidation": float(np.max(sig_err)),
-        "normal_stress_mean_error": float(np.mean(sig_err)),
-        "force_balance": force_balance(x, col, s.peak_window),
-    }
+    return CurveSummary(
+        normal_stress_kpa=sigma_kpa,
+        peak_shear_stress_kpa=tp,
+        shear_displacement_at_peak_m=xp,
+        peak_stress_ratio=tp / sigma_kpa,
+        peak_shear_stress_raw_kpa=float(np.max(col["shear_stress_kpa"])),
+        peak_window_m=s.peak_window,
+        normal_stress_at_peak_kpa=float(smooth(x, col["normal_stress_kpa"], s.peak_window)[k]),
+        plate_displacement_at_peak_mm=float(col["plate_displacement_mm"][k]),
+        end=EndValues(**end),
+        end_shear_displacement_m=float(x[-1]),
+        ended_by=ended_by(x, xp, s),
+        max_inertial_number=float(np.max(inertial)),
+        inertial_number_ok=bool(np.max(inertial) < s.inertial_limit),
+        normal_stress_max_error_after_consolidation=float(np.max(sig_err)),
+        normal_stress_mean_error=float(np.mean(sig_err)),
+        force_balance=force_balance(x, col, s.peak_window),
+    )
 
 
-__all__ = ["CURVE_COLUMNS", "curve_row", "curve_summary", "ended_by", "force_balance", "peak_passed"]
+__all__ = [
+    "CURVE_COLUMNS",
+    "ShearCurve",
+    "CurveSummary",
+    "curve_row",
+    "curve_summary",
+    "ended_by",
+    "force_balance",
+    "peak_passed",
+]

@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from poro2d.errors import InputError
+from poro2d.shear.parts import FitRecord
 
 
 @dataclass(frozen=True)
@@ -37,6 +39,13 @@ class MohrCoulombFit:
         d = asdict(self)
         d["tan_phi"] = self.tan_phi
         return d
+
+    def record(self) -> FitRecord:
+        """The fit as a result file keeps it (its fields and ``tan_phi``)."""
+        return FitRecord(
+            friction_angle_deg=self.friction_angle_deg, cohesion_kpa=self.cohesion_kpa, r2=self.r2,
+            n_points=self.n_points, through_origin=self.through_origin, tan_phi=self.tan_phi,
+        )  # fmt: skip
 
 
 def mohr_coulomb(sigma_kpa, tau_kpa, through_origin: bool = False) -> MohrCoulombFit:
@@ -82,13 +91,21 @@ def smooth(x, y, window: float) -> np.ndarray:
     return (c[hi] - c[lo]) / (hi - lo)
 
 
-def peak(x, y, window: float) -> tuple[int, float, float]:
-    """(index, x, smoothed y) of the maximum of ``y`` smoothed over ``window`` (see :func:`smooth`)."""
+class Peak(NamedTuple):
+    """The maximum of a smoothed curve: its record's ``index``, where it lies (``x``) and its ``value``."""
+
+    index: int
+    x: float
+    value: float
+
+
+def peak(x, y, window: float) -> Peak:
+    """The maximum of ``y`` smoothed over ``window`` (see :func:`smooth`)."""
     ys = smooth(x, y, window)
     if ys.size == 0:
         raise InputError("curve", "empty", "at least one point")
     k = int(np.argmax(ys))
-    return k, float(np.asarray(x, float)[k]), float(ys[k])
+    return Peak(k, float(np.asarray(x, float)[k]), float(ys[k]))
 
 
-__all__ = ["MohrCoulombFit", "mohr_coulomb", "peak", "smooth"]
+__all__ = ["MohrCoulombFit", "Peak", "mohr_coulomb", "peak", "smooth"]

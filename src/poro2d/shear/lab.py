@@ -9,7 +9,9 @@ comments; the file is UTF-8 text):
 * peaks: ``normal_stress_kpa, peak_shear_stress_kpa``, one row per test.
 
 The peak of a curve is its largest shear stress as measured (laboratory curves
-are smooth enough; no smoothing is applied).
+are smooth enough; no smoothing is applied). Data that cannot be right (a peak of 0 or
+ten times its normal stress, a curve whose displacement steps back, a one-point curve)
+are refused before any work (:mod:`poro2d.shear.lab_checks`).
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ import numpy as np
 
 from poro2d.errors import InputError
 from poro2d.io_utils import check_input_file, read_utf8
+from poro2d.shear.lab_checks import check_curve, check_normal_stress, check_peak
 
 CURVE_COLUMNS = ("normal_stress_kpa", "shear_displacement_mm", "shear_stress_kpa")
 PEAK_COLUMNS = ("normal_stress_kpa", "peak_shear_stress_kpa")
@@ -44,17 +47,19 @@ class LabData:
     def normal_stresses(self) -> list[float]:
         return sorted(self.peaks)
 
+    def peak_rows(self) -> list[dict[str, float]]:
+        """The peaks as rows (``normal_stress_kpa``, ``peak_shear_stress_kpa``), by normal stress."""
+        return [{"normal_stress_kpa": s, "peak_shear_stress_kpa": self.peaks[s]} for s in sorted(self.peaks)]
+
     def to_dict(self) -> dict:
-        return {
-            "source": self.source,
-            "kind": self.kind,
-            "peaks": [
-                {"normal_stress_kpa": s, "peak_shear_stress_kpa": self.peaks[s]} for s in sorted(self.peaks)
-            ],
-        }
+        return {"source": self.source, "kind": self.kind, "peaks": self.peak_rows()}
 
 
 def _number(path: str, line: int, col: str, text: str) -> float:
+    if "_" in text:  # Python's float() reads 1_000; a spreadsheet never writes it
+        raise InputError(
+            f"lab {col} (line {line} of {path})", text, "a number (digits, sign, point, exponent)"
+        )
     try:
         v = float(text)
     except (TypeError, ValueError):
@@ -92,7 +97,7 @@ def read_lab_csv(path: str | os.PathLike) -> LabData:
             f"the columns {','.join(CURVE_COLUMNS)} (curves) or {','.join(PEAK_COLUMNS)} (peaks)",
         )  # fmt: skip
     idx = [header.index(c) for c in cols]
-    data = []
+    data, numbers = [], []
     for (line, _), row in zip(lines[1:], rows[1:], strict=True):
         if len(row) != len(header):  # a cell too many is as unclear as one too few: which column moved?
             where = f"line {line}, column {min(len(row), len(header)) + 1} of {p}"
@@ -101,23 +106,28 @@ def read_lab_csv(path: str | os.PathLike) -> LabData:
         for c, v in zip(cols, vals, strict=True):
             if v < 0:
                 raise InputError(f"lab {c} (line {line} of {p})", v, "[0, inf)")
+        check_normal_stress(str(p), line, vals[0])
         data.append(vals)
+        numbers.append(line)
     if not data:
         raise InputError("lab", str(p), "at least one data row")
-    a = np.array(data)
+    a, at = np.array(data), np.array(numbers)
     if kind == "peaks":
         peaks: dict[float, float] = {}
-        for s, t in a:
+        for (s, t), line in zip(a, at, strict=True):
             if float(s) in peaks:
                 raise InputError("lab normal_stress_kpa", float(s), "each normal stress once in a peaks CSV")
+            check_peak(str(p), int(line), "peak_shear_stress_kpa", float(s), float(t))
             peaks[float(s)] = float(t)
         return LabData(str(p), peaks)
     curves: dict[float, tuple[np.ndarray, np.ndarray]] = {}
     for s in np.unique(a[:, 0]):
         m = a[:, 0] == s
         d, t = a[m, 1], a[m, 2]
-        order = np.argsort(d, kind="stable")
-        curves[float(s)] = (d[order] * 1e-3, t[order])  # displacement in m
+        check_curve(str(p), float(s), at[m], d)  # rows in file order, displacement rising
+        k = int(np.argmax(t))
+        check_peak(str(p), int(at[m][k]), "shear_stress_kpa (the curve's peak)", float(s), float(t[k]))
+        curves[float(s)] = (d * 1e-3, t)  # displacement in m
     peaks = {s: float(np.max(t)) for s, (_, t) in curves.items()}
     return LabData(str(p), peaks, curves)
 

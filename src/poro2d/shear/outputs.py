@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-from pathlib import Path
+from collections.abc import Mapping
 
-import numpy as np
-
-from poro2d.io_utils import write_csv
-from poro2d.shear.curve import CURVE_COLUMNS, curve_rows
+from poro2d.shear.curve import CURVE_COLUMNS, ShearCurve, curve_rows
 from poro2d.shear.fit import MohrCoulombFit, mohr_coulomb
 from poro2d.shear.lab import LabData
+from poro2d.shear.parts import TestSummary
+from poro2d.store import Store
 
 
 def folder_name(sigma_kpa: float) -> str:
@@ -25,7 +24,7 @@ def lab_fit(lab: LabData | None) -> MohrCoulombFit | None:
     return mohr_coulomb(ls, [lab.peaks[v] for v in ls])
 
 
-def write_tables(out: Path, curves: dict[float, dict[str, np.ndarray]], summary: list[dict]) -> None:
+def write_tables(store: Store, curves: dict[float, ShearCurve], summary: list[TestSummary]) -> None:
     """``curves.csv`` (every curve, long format) and ``peaks.csv`` (one row per test).
 
     ``curves``: each test's curve (:attr:`ShearTestResult.curve`) by normal stress.
@@ -33,12 +32,15 @@ def write_tables(out: Path, curves: dict[float, dict[str, np.ndarray]], summary:
     long_rows = [
         {"normal_stress_kpa": sigma, **row} for sigma, curve in curves.items() for row in curve_rows(curve)
     ]
-    write_csv(out / "curves.csv", long_rows, header=["normal_stress_kpa"] + CURVE_COLUMNS)
-    write_csv(out / "peaks.csv", [{k: v for k, v in r.items() if not isinstance(v, dict)} for r in summary])
+    store.write_csv("curves.csv", long_rows, header=["normal_stress_kpa"] + CURVE_COLUMNS)
+    # the nested parts of a test's summary (end values, force balance) are in result.json only
+    store.write_csv(
+        "peaks.csv", [{k: v for k, v in r.items() if not isinstance(v, Mapping)} for r in summary]
+    )
 
 
 def write_figures(
-    out: Path, tests: list[dict], curves: dict[float, dict[str, np.ndarray]], fit, fit0, settings,
+    store: Store, tests: list[dict], curves: dict[float, ShearCurve], fit, fit0, settings,
     lab: LabData | None,
 ) -> None:  # fmt: skip
     """``fig8a_shear_curves.png`` (curves, peaks marked) and ``fig8b_peak_strength.png`` (the fits)."""
@@ -48,13 +50,13 @@ def write_figures(
         t["normal_stress_kpa"]: (t["shear_displacement_at_peak_m"], t["peak_shear_stress_kpa"]) for t in tests
     }
     plot_shear_curves(
-        curves, out / "fig8a_shear_curves.png", lab=lab, peaks=peaks,
+        curves, store.path("fig8a_shear_curves.png"), lab=lab, peaks=peaks,
         smoothing_note=f"v = {1e3 * settings.velocity:g} mm/s; peaks (dots) smoothed over "
         f"{1e3 * settings.peak_window:g} mm",
     )  # fmt: skip
     plot_peak_strength(
         [t["normal_stress_kpa"] for t in tests], [t["peak_shear_stress_kpa"] for t in tests], fit,
-        out / "fig8b_peak_strength.png", fit_origin=fit0, lab=lab, lab_fit=lab_fit(lab),
+        store.path("fig8b_peak_strength.png"), fit_origin=fit0, lab=lab, lab_fit=lab_fit(lab),
     )  # fmt: skip
 
 

@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.dem import Simulation
-from poro2d.dem.measure import ContactSet
-from poro2d.io_utils import atomic_path
+from poro2d.dem.contacts import ContactSet
 from poro2d.shear.fit import smooth
+from poro2d.store import Store
 
 _CONTACT_FIELDS = ("i", "j", "kind", "point", "normal", "fn", "fs", "force", "branch")
 
@@ -67,14 +67,14 @@ class PeakFrame:
             record=int(data["record"]), displacement_mm=float(data["displacement_mm"]),
         )  # fmt: skip
 
-    def save(self, path: Path) -> None:
-        with atomic_path(path, suffix=".npz") as tmp, open(tmp, "wb") as fh:
-            np.savez(fh, **self.to_arrays())
+    def save(self, store: Store, name: str) -> None:
+        store.write_arrays(name, **self.to_arrays())
 
     @classmethod
-    def load(cls, path: Path) -> PeakFrame:
-        with np.load(path) as z:
-            return cls.from_arrays({k: z[k].copy() for k in z.files})
+    def load(cls, store: Store, name: str) -> PeakFrame | None:
+        """The frame kept in ``store`` as ``name``; None when it is missing or damaged."""
+        data = store.read_arrays(name)
+        return None if data is None else cls.from_arrays(data)
 
     def draw(self, path: Path, **kw) -> Path:
         """The force chains of this frame (keywords as :func:`plot_force_chains`), in N/m."""
@@ -100,11 +100,12 @@ class PeakTracker:
         self.frame: PeakFrame | None = None
         self.saved = True  # nothing new to save
 
-    def restore(self, path: Path | None, rows: list[dict]) -> None:
+    def restore(self, store: Store | None, name: str, rows: list[dict]) -> None:
         """Continue from the frame saved with a shear checkpoint (if any)."""
-        if path is None or not path.is_file() or not rows:
+        frame = PeakFrame.load(store, name) if store is not None and rows else None
+        if frame is None:
             return
-        self.frame = PeakFrame.load(path)
+        self.frame = frame
         xs, ys = _curve(rows)
         self.value = float(smooth(xs, ys, self.window)[self.frame.record])
 
@@ -123,10 +124,10 @@ class PeakTracker:
             if v > self.value:
                 self.value, self.frame, self.saved = v, fr, False
 
-    def save(self, path: Path | None) -> None:
+    def save(self, store: Store | None, name: str) -> None:
         """Save a frame found since the last save (a resumed test still draws it)."""
-        if path is not None and self.frame is not None and not self.saved:
-            self.frame.save(path)
+        if store is not None and self.frame is not None and not self.saved:
+            self.frame.save(store, name)
             self.saved = True
 
 

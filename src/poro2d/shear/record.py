@@ -10,11 +10,11 @@ without recomputing; a folder whose work belongs to another test is refused. The
 from __future__ import annotations
 
 from collections.abc import Mapping
-from pathlib import Path
 
 from poro2d.io_utils import provenance
-from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.shear.settings import ShearSettings
+from poro2d.store import Store
+from poro2d.store.stage import Fingerprint, ResumableStage
 
 RECORD = "test.json"
 
@@ -50,15 +50,14 @@ def _explain(keys: list[str] | None, old: Mapping | None) -> str:
     return f"it holds a test of {stale_reason(keys, old)}; use a new --out"
 
 
-def folder_stage(out: Path, record: dict, specimen: Path) -> ResumableStage:
-    """The stages of one test in ``out`` (consolidation, shearing), bound by ``test.json``.
+def folder_stage(store: Store, record: dict, specimen: str) -> ResumableStage:
+    """The stages of one test in ``store`` (consolidation, shearing), bound by ``test.json``.
 
     ``record``: :func:`content_record`; the record file keeps its digest (``key``) and the
     specimen's path (for information: not compared) beside it.
     """
     fingerprint = Fingerprint(record, tables={"settings": ShearSettings})
-    return ResumableStage(
-        out,
+    return store.stage(
         fingerprint,
         record=RECORD,
         key="run",

@@ -13,17 +13,22 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from poro2d.errors import InputError, check_range
-from poro2d.io_utils import provenance, write_csv, write_json
+from poro2d.io_utils import provenance
 from poro2d.shear.fit import mohr_coulomb
-from poro2d.shear.results import ReplicateShearResult
+from poro2d.shear.parts import FitInterval, StressPeaks
+from poro2d.shear.pool import ShearJob
+from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult
+from poro2d.shear.specimen_file import Specimen
+from poro2d.store import Store
 
 
-def mohr_coulomb_ci(sigma_kpa, tau_kpa, through_origin: bool = False, level: float = 0.95) -> dict:
+def mohr_coulomb_ci(sigma_kpa, tau_kpa, through_origin: bool = False, level: float = 0.95) -> FitInterval:
     """The least-squares Mohr-Coulomb line with ``level`` confidence intervals of phi and c.
 
     Intervals from the slope's and intercept's standard errors and Student's t with
@@ -36,9 +41,8 @@ def mohr_coulomb_ci(sigma_kpa, tau_kpa, through_origin: bool = False, level: flo
     s = np.asarray(sigma_kpa, float).ravel()
     t = np.asarray(tau_kpa, float).ravel()
     fit = mohr_coulomb(s, t, through_origin=through_origin)
-    out = fit.to_dict()
     df = s.size - (1 if through_origin else 2)
-    out.update(level=level, dof=df, friction_angle_ci_deg=None, cohesion_ci_kpa=None)
+    out = FitInterval(**fit.record(), level=level, dof=df)
     if df < 1:
         return out
     resid = t - fit.predict(s)
@@ -50,16 +54,19 @@ def mohr_coulomb_ci(sigma_kpa, tau_kpa, through_origin: bool = False, level: flo
         sxx = float(np.sum((s - s.mean()) ** 2))
         se_slope = math.sqrt(s2 / sxx)
         se_c = math.sqrt(s2 * (1.0 / s.size + s.mean() ** 2 / sxx))
-        out["cohesion_ci_kpa"] = [fit.cohesion_kpa - q * se_c, fit.cohesion_kpa + q * se_c]
+        out.cohesion_ci_kpa = [fit.cohesion_kpa - q * se_c, fit.cohesion_kpa + q * se_c]
     lo, hi = fit.tan_phi - q * se_slope, fit.tan_phi + q * se_slope
-    out["friction_angle_ci_deg"] = [math.degrees(math.atan(lo)), math.degrees(math.atan(hi))]
+    out.friction_angle_ci_deg = [math.degrees(math.atan(lo)), math.degrees(math.atan(hi))]
     return out
 
 
-def summarize_replicate_peaks(series: dict[str, dict], level: float = 0.95) -> dict:
+def summarize_replicate_peaks(
+    series: dict[str, ShearSeriesResult], level: float = 0.95
+) -> ReplicateShearResult:
     """Per normal stress mean +- sd of the peaks over specimens, pooled fits with intervals.
 
-    ``series``: label -> the result of one :class:`ShearSeries` (its ``tests`` list).
+    ``series``: label -> the result of one :class:`ShearSeries` (its ``tests`` list). The
+    summary's run fields (wall time, processes, config, provenance) are left for the caller.
     """
     if not series:
         raise InputError("replicates", 0, "at least one specimen's tests")
@@ -70,38 +77,39 @@ def summarize_replicate_peaks(series: dict[str, dict], level: float = 0.95) -> d
     rows = []
     for sig in sorted(by_sigma):
         v = np.array(by_sigma[sig])
-        rows.append({
-            "normal_stress_kpa": sig,
-            "peak_mean_kpa": float(v.mean()),
-            "peak_sd_kpa": float(v.std(ddof=1)) if v.size > 1 else 0.0,
-            "n": int(v.size),
-            "peaks_kpa": v.tolist(),
-        })  # fmt: skip
-    sig = np.concatenate([[r["normal_stress_kpa"]] * r["n"] for r in rows])
-    tau = np.concatenate([r["peaks_kpa"] for r in rows])
+        rows.append(StressPeaks(
+            normal_stress_kpa=sig,
+            peak_mean_kpa=float(v.mean()),
+            peak_sd_kpa=float(v.std(ddof=1)) if v.size > 1 else 0.0,
+            n=int(v.size),
+            peaks_kpa=v.tolist(),
+        ))  # fmt: skip
+    sig = np.concatenate([[r.normal_stress_kpa] * r.n for r in rows])
+    tau = np.concatenate([r.peaks_kpa for r in rows])
     phis = [r["friction_angle_deg"] for r in series.values() if r.get("friction_angle_deg") is not None]
-    return {
-        "specimens": list(series),
-        "per_normal_stress": rows,
-        "fit": mohr_coulomb_ci(sig, tau, level=level) if np.unique(sig).size >= 2 else None,
-        "fit_through_origin": mohr_coulomb_ci(sig, tau, through_origin=True, level=level),
-        "friction_angle_per_specimen_deg": phis,
-        "friction_angle_mean_deg": float(np.mean(phis)) if phis else None,
-        "friction_angle_sd_deg": float(np.std(phis, ddof=1)) if len(phis) > 1 else None,
-        "method": "peaks of every specimen pooled; Student-t intervals of the least-squares line",
-    }
+    return ReplicateShearResult(
+        specimens=list(series),
+        per_normal_stress=rows,
+        fit=mohr_coulomb_ci(sig, tau, level=level) if np.unique(sig).size >= 2 else None,
+        fit_through_origin=mohr_coulomb_ci(sig, tau, through_origin=True, level=level),
+        friction_angle_per_specimen_deg=phis,
+        friction_angle_mean_deg=float(np.mean(phis)) if phis else None,
+        friction_angle_sd_deg=float(np.std(phis, ddof=1)) if len(phis) > 1 else None,
+        method="peaks of every specimen pooled; Student-t intervals of the least-squares line",
+    )
 
 
 class ReplicateShear:
     """The same direct shear tests on several specimens, in one process pool, then the summary.
 
-    ``specimens``: label -> specimen (checkpoint or folder holding ``specimen.npz``); each
-    specimen's tests go to ``out/<label>/`` as a :class:`ShearSeries` would write them, and
-    the summary to ``out/replicates.json`` and ``out/replicates.csv``.
+    ``specimens``: label -> specimen (a :class:`~poro2d.shear.specimen_file.Specimen`, or a
+    checkpoint or folder holding ``specimen.npz``, read once); with ``store`` each
+    specimen's tests are kept in ``<label>/`` as a :class:`ShearSeries` keeps them, and the
+    summary in ``replicates.json`` and ``replicates.csv`` (``store=None``: nothing is kept).
     """
 
-    def __init__(self, specimens: dict[str, str | Path], normal_stresses_kpa, settings=None, *,
-                 out: str | Path = "shear-out", lab=None, processes: int | None = None, progress: bool = True,
+    def __init__(self, specimens: dict[str, Specimen | str | Path], normal_stresses_kpa, settings=None, *,
+                 store: Store | None = None, lab=None, processes: int | None = None, progress: bool = True,
                  config: dict | None = None, figures: bool = True) -> None:  # fmt: skip
         import os
 
@@ -109,7 +117,7 @@ class ReplicateShear:
 
         if not specimens:
             raise InputError("specimens", {}, "at least one specimen")
-        self.out = Path(out)
+        self.store = store
         self.progress = progress
         self.config = config or {}
         self.figures = figures
@@ -118,7 +126,7 @@ class ReplicateShear:
                 path,
                 normal_stresses_kpa,
                 settings,
-                out=self.out / label,
+                store=store.child(label) if store is not None else None,
                 lab=lab,
                 progress=False,
                 processes=1,
@@ -130,9 +138,9 @@ class ReplicateShear:
         njobs = sum(len(s.jobs) for s in self.series.values())
         self.processes = processes if processes is not None else min(njobs, 2 * (os.cpu_count() or 1))
 
-    def jobs(self) -> list[dict]:
+    def jobs(self) -> list[ShearJob]:
         """Every specimen's tests as pool jobs, keyed ``(label, *key)`` (a caller may pool several)."""
-        return [dict(j, key=(label, *j["key"]), series=label)
+        return [replace(j, key=(label, *j.key), series=label)
                 for label, s in self.series.items() for j in s.jobs]  # fmt: skip
 
     def run(self) -> ReplicateShearResult:
@@ -147,19 +155,22 @@ class ReplicateShear:
             label: s.finish({k[1:]: v for k, v in results.items() if k[0] == label}, t0)
             for label, s in self.series.items()
         }
-        timing = {"wall_time_s": time.perf_counter() - t0, "processes": self.processes}
-        summary = ReplicateShearResult.from_dict(
-            dict(summarize_replicate_peaks(per), **timing, config=self.config, provenance=provenance())
-        )
-        write_csv(self.out / "replicates.csv", [{k: v for k, v in r.items() if k != "peaks_kpa"}
-                                                 for r in summary.per_normal_stress])  # fmt: skip
-        write_json(self.out / "replicates.json", summary.to_dict())
+        summary = summarize_replicate_peaks(per)
+        summary.wall_time_s = time.perf_counter() - t0
+        summary.processes = self.processes
+        summary.config = self.config
+        summary.provenance = provenance()
         summary.series = per
+        if self.store is None:
+            return summary
+        self.store.write_csv("replicates.csv", [{k: v for k, v in r.items() if k != "peaks_kpa"}
+                                                for r in summary.per_normal_stress])  # fmt: skip
+        self.store.write_json("replicates.json", summary.to_dict())
         if self.figures:
-            self._figures(summary)
+            self._figures(summary, self.store)
         return summary
 
-    def _figures(self, summary: ReplicateShearResult) -> None:
+    def _figures(self, summary: ReplicateShearResult, store: Store) -> None:
         """fig8a/fig8b over specimens: mean curves with +- sd bands, peaks with the pooled fit."""
         from poro2d.report.shear_figures import curve_band, plot_replicate_curves, plot_replicate_peaks
         from poro2d.shear.outputs import lab_fit
@@ -170,8 +181,8 @@ class ReplicateShear:
             bands[sigma] = curve_band([res.curves[sigma] for res in summary.series.values()])
         n = len(self.series)
         lab = next(iter(self.series.values())).lab
-        plot_replicate_curves(bands, self.out / "fig8a_shear_curves_replicates.png", n, lab=lab)
-        peaks_png = self.out / "fig8b_peak_strength_replicates.png"
+        plot_replicate_curves(bands, store.path("fig8a_shear_curves_replicates.png"), n, lab=lab)
+        peaks_png = store.path("fig8b_peak_strength_replicates.png")
         plot_replicate_peaks(summary, peaks_png, lab=lab, lab_fit=lab_fit(lab))
 
 

@@ -1,27 +1,42 @@
 """Typed results of direct shear: one test's ``result.json``, a series' ``result.json`` and the
-replicate specimens' ``replicates.json``."""
+replicate specimens' ``replicates.json`` and a strength study's ``strength.json``."""
 
 from __future__ import annotations
 
-import json
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, ClassVar
 
-import numpy as np
-
-from poro2d.typed_result import NOT_IN_FILE, TypedResult
+from poro2d.shear.curve import ShearCurve, read_curve
+from poro2d.shear.parts import (
+    ConsolidationRecord,
+    EndValues,
+    FitInterval,
+    FitRecord,
+    ForceBalance,
+    LabComparison,
+    Nested,
+    QuasiStatic,
+    RateCheck,
+    StrengthCase,
+    StressPeaks,
+    TestSummary,
+    part,
+    parts,
+)
+from poro2d.store import Store
+from poro2d.typed_result import NOT_IN_FILE
 
 
 @dataclass(eq=False)
-class ShearTestResult(TypedResult):
+class ShearTestResult(Nested):
     """One test (a test folder's ``result.json``): what its curve says, and how it was obtained.
 
     The first fields are read off the curve (:func:`poro2d.shear.curve.curve_summary`):
     the smoothed peak and where it lies, the end values (``end``: smoothed over one peak
     window), the servo's stress error, the inertial number and the force balance. Stresses
     in kPa, lengths in m unless the name says mm. ``curve`` (not in the file): the recorded
-    curve, one float array per column of ``curve.csv`` (empty when the test is not at hand).
+    curve (:class:`~poro2d.shear.curve.ShearCurve`; None when the test is not at hand).
     """
 
     normal_stress_kpa: float
@@ -32,16 +47,16 @@ class ShearTestResult(TypedResult):
     peak_window_m: float
     normal_stress_at_peak_kpa: float
     plate_displacement_at_peak_mm: float
-    end: dict[str, float]
+    end: EndValues
     end_shear_displacement_m: float
     ended_by: str | None
     max_inertial_number: float | None
     inertial_number_ok: bool
     normal_stress_max_error_after_consolidation: float
     normal_stress_mean_error: float
-    force_balance: dict[str, Any]
+    force_balance: ForceBalance
     inertial_number_at_target_stress: float
-    consolidation: dict[str, Any]
+    consolidation: ConsolidationRecord
     velocity_m_per_s: float
     density_scale: float
     local_damping: float
@@ -55,28 +70,36 @@ class ShearTestResult(TypedResult):
     specimen: str
     engine: dict[str, Any]
     provenance: dict[str, Any]
-    curve: dict[str, np.ndarray] = field(default_factory=dict, kw_only=True, repr=False, metadata=NOT_IN_FILE)
+    curve: ShearCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     @classmethod
-    def read(cls, folder: str | Path, data: dict[str, Any] | None = None) -> ShearTestResult:
-        """A finished test read back from ``folder``: its ``result.json`` and its ``curve.csv``.
+    def from_dict(cls, data: Mapping[str, Any]) -> ShearTestResult:
+        obj = super().from_dict(data)
+        obj.end = part(EndValues, obj.end)
+        obj.force_balance = part(ForceBalance, obj.force_balance)
+        obj.consolidation = part(ConsolidationRecord, obj.consolidation)
+        return obj
+
+    @classmethod
+    def read(cls, store: Store, data: dict[str, Any] | None = None) -> ShearTestResult:
+        """A finished test read back from ``store``: its ``result.json`` and its ``curve.csv``.
 
         ``data``: the content of ``result.json`` when the caller has read it already.
         """
-        from poro2d.shear.curve import read_curve
-
-        folder = Path(folder)
-        result = cls.from_dict(data if data is not None else json.loads((folder / "result.json").read_text()))
-        result.curve = read_curve(folder / "curve.csv")
+        if data is None:
+            data = store.read_json("result.json")
+        if not isinstance(data, dict):
+            raise FileNotFoundError(f"no finished direct shear test in {store.root} (result.json)")
+        result = cls.from_dict(data)
+        result.curve = read_curve(store)
         return result
 
 
 @dataclass(eq=False)
-class ShearSeriesResult(TypedResult):
+class ShearSeriesResult(Nested):
     """Tests at several normal stresses on one specimen (a series' ``result.json``), with the fit.
 
-    ``tests``: one summary dict per test (:data:`poro2d.shear.series.SUMMARY_KEYS`, the
-    consolidation's stress error, the test's folder). The Mohr-Coulomb fit (``fit``, and
+    ``tests``: one :class:`~poro2d.shear.parts.TestSummary` per test. The Mohr-Coulomb fit (``fit``, and
     its ``friction_angle_deg``, ``cohesion_kpa``, ``r2``) needs two stresses or more, else
     they are None. ``rate_check`` and ``lab`` are in the file only when the series ran with
     them. ``curves`` (not in the file): each test's curve (:attr:`ShearTestResult.curve`)
@@ -86,14 +109,14 @@ class ShearSeriesResult(TypedResult):
     OPTIONAL: ClassVar[tuple[str, ...]] = ("rate_check", "lab")
 
     normal_stresses_kpa: list[float]
-    tests: list[dict[str, Any]]
+    tests: list[TestSummary]
     friction_angle_deg: float | None
     cohesion_kpa: float | None
     r2: float | None
-    fit: dict[str, Any] | None
+    fit: FitRecord | None
     friction_angle_through_origin_deg: float
-    fit_through_origin: dict[str, Any]
-    quasi_static: dict[str, Any]
+    fit_through_origin: FitRecord
+    quasi_static: QuasiStatic
     peak_definition: str
     shear_stress_definition: str
     settings: dict[str, Any]
@@ -104,17 +127,28 @@ class ShearSeriesResult(TypedResult):
     specimen_meta: dict[str, Any]
     processes: int
     config: dict[str, Any]
-    rate_check: dict[str, Any] | None = None
-    lab: dict[str, Any] | None = None
+    rate_check: RateCheck | None = None
+    lab: LabComparison | None = None
     wall_time_s: float | None = None
     provenance: dict[str, Any] | None = None
-    curves: dict[float, dict[str, np.ndarray]] = field(
+    curves: dict[float, ShearCurve] = field(
         default_factory=dict, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
 
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ShearSeriesResult:
+        obj = super().from_dict(data)
+        obj.tests = parts(TestSummary, obj.tests)
+        obj.fit = part(FitRecord, obj.fit)
+        obj.fit_through_origin = part(FitRecord, obj.fit_through_origin)
+        obj.quasi_static = part(QuasiStatic, obj.quasi_static)
+        obj.rate_check = part(RateCheck, obj.rate_check)
+        obj.lab = part(LabComparison, obj.lab)
+        return obj
+
 
 @dataclass(eq=False)
-class ReplicateShearResult(TypedResult):
+class ReplicateShearResult(Nested):
     """The same tests on several specimens (``replicates.json``): peaks over specimens, pooled fits.
 
     ``per_normal_stress``: per stress the peaks' mean, sd, count and values; ``fit`` (None
@@ -125,9 +159,9 @@ class ReplicateShearResult(TypedResult):
     """
 
     specimens: list[str]
-    per_normal_stress: list[dict[str, Any]]
-    fit: dict[str, Any] | None
-    fit_through_origin: dict[str, Any]
+    per_normal_stress: list[StressPeaks]
+    fit: FitInterval | None
+    fit_through_origin: FitInterval
     friction_angle_per_specimen_deg: list[float]
     friction_angle_mean_deg: float | None
     friction_angle_sd_deg: float | None
@@ -138,5 +172,40 @@ class ReplicateShearResult(TypedResult):
     provenance: dict[str, Any] | None = None
     series: dict[str, ShearSeriesResult] = field(default_factory=dict, kw_only=True, metadata=NOT_IN_FILE)
 
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ReplicateShearResult:
+        obj = super().from_dict(data)
+        obj.per_normal_stress = parts(StressPeaks, obj.per_normal_stress)
+        obj.fit = part(FitInterval, obj.fit)
+        obj.fit_through_origin = part(FitInterval, obj.fit_through_origin)
+        return obj
 
-__all__ = ["ReplicateShearResult", "ShearSeriesResult", "ShearTestResult"]
+
+@dataclass(eq=False)
+class StrengthResult(Nested):
+    """Strength against rolling and particle friction (a strength study's ``strength.json``).
+
+    ``cases``: one row per (mu_r, f_p) (the rows of ``strength.csv`` with the pooled fits'
+    intervals): peak and residual friction angles and the dilation angle, mean and sd over
+    the specimens; ``definitions``: how each is measured.
+    """
+
+    cases: list[StrengthCase]
+    mu_r: list[float]
+    particle_friction: list[float]
+    specimens: list[str]
+    settings: dict[str, Any]
+    definitions: dict[str, str]
+    wall_time_s: float | None = None
+    processes: int | None = None
+    config: dict[str, Any] | None = None
+    provenance: dict[str, Any] | None = None
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> StrengthResult:
+        obj = super().from_dict(data)
+        obj.cases = parts(StrengthCase, obj.cases)
+        return obj
+
+
+__all__ = ["ReplicateShearResult", "ShearSeriesResult", "ShearTestResult", "StrengthResult"]

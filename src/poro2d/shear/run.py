@@ -8,18 +8,17 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterable
-from pathlib import Path
 
 from poro2d.config import dataclass_from_table
-from poro2d.dem import checkpoint
 from poro2d.errors import InputError, is_number
 from poro2d.io_utils import check_output_dir
-from poro2d.locks import holds_output
+from poro2d.locks import output_folder
 from poro2d.shear.lab import LabData, read_lab_csv
 from poro2d.shear.results import ShearSeriesResult
 from poro2d.shear.series import ShearSeries, check_stresses
 from poro2d.shear.settings import ShearSettings
-from poro2d.shear.specimen_file import resolve_specimen
+from poro2d.shear.specimen_file import Specimen
+from poro2d.store import Store
 
 
 def _stresses(value) -> list[float]:
@@ -51,13 +50,12 @@ def _lab(value) -> LabData | None:
     raise InputError("lab", type(value).__name__, "a laboratory CSV path, a LabData or None")
 
 
-@holds_output("out")
 def run_shear(
     specimen: str | os.PathLike,
     normal_stresses_kpa,
     settings: ShearSettings | dict | None = None,
     *,
-    out: str | os.PathLike,
+    store: Store,
     lab: str | os.PathLike | LabData | None = None,
     rate_check: bool = False,
     processes: int | None = None,
@@ -66,35 +64,38 @@ def run_shear(
 ) -> ShearSeriesResult:
     """Direct shear tests on ``specimen`` at ``normal_stresses_kpa``, the fit and Fig. 8.
 
-    ``specimen``: a checkpoint (.npz) or a criterion output folder holding ``specimen.npz``.
-    ``normal_stresses_kpa``: a number or a list (kPa). ``settings``: a :class:`ShearSettings`,
-    a dict of its fields, or None for the defaults. ``out``: the output folder; a rerun
+    ``specimen``: a checkpoint (.npz) or a criterion output folder holding ``specimen.npz``
+    (read once: every test starts from that content). ``normal_stresses_kpa``: a number or
+    a list (kPa). ``settings``: a :class:`ShearSettings`, a dict of its fields, or None for
+    the defaults. ``store``: where the results are kept (``Store("shear-out")``); a rerun
     with the same inputs skips finished tests and resumes a killed one. ``lab``: a
     laboratory CSV (or :class:`LabData`) to compare with. ``rate_check``: repeat every
     test at half the velocity. ``processes``: worker processes (default one per test, at
     most twice the CPU count). ``progress``: bars on a terminal, periodic lines in a log.
     ``config``: recorded in ``result.json`` as it is.
 
-    Returns the :class:`ShearSeriesResult` written to ``out/result.json`` (per test ``tests``, the fit
+    Returns the :class:`ShearSeriesResult` kept as ``result.json`` (per test ``tests``, the fit
     ``friction_angle_deg``, ``cohesion_kpa``, ``r2``, ...; see docs/shear.md). Tests run in
     spawned processes, which import the calling script: call this under
     ``if __name__ == "__main__":`` in a script. A test that fails to run (consolidation
     without equilibrium) raises RuntimeError once the others have finished.
     """
-    out = check_output_dir("out", out)
-    path = resolve_specimen(specimen)
-    checkpoint.read(path)  # a damaged file is refused here, in one line
+    if not isinstance(store, Store):
+        raise InputError("store", type(store).__name__, "a poro2d.store.Store (Store('shear-out'))")
+    check_output_dir(store.parameter, store.root)
+    value = Specimen.read(specimen)  # a damaged file is refused here, in one line
     stresses = _stresses(normal_stresses_kpa)
     lab_data = _lab(lab)
     shear_settings = _settings(settings)
     for name, flag in (("rate_check", rate_check), ("progress", progress)):
         if not isinstance(flag, bool):
             raise InputError(name, flag, "True or False")
-    series = ShearSeries(
-        path, stresses, shear_settings, out=Path(out), lab=lab_data, rate_check=rate_check,
-        processes=processes, progress=progress, config=config,
-    )  # fmt: skip
-    return series.run()
+    with output_folder(store.parameter, store.root, kind="shear"):
+        series = ShearSeries(
+            value, stresses, shear_settings, store=store, lab=lab_data, rate_check=rate_check,
+            processes=processes, progress=progress, config=config,
+        )  # fmt: skip
+        return series.run()
 
 
 __all__ = ["run_shear"]

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import numpy as np
 
-from poro2d.dem import checkpoint
 from poro2d.errors import InputError, check_range
-from poro2d.io_utils import provenance, write_json
+from poro2d.io_utils import provenance
+from poro2d.shear.case import ShearCase
 from poro2d.shear.fit import mohr_coulomb, smooth
 from poro2d.shear.outputs import (
     folder_name,
@@ -19,10 +19,12 @@ from poro2d.shear.outputs import (
     write_figures,
     write_tables,
 )
-from poro2d.shear.pool import execute_jobs, job_test
+from poro2d.shear.parts import LabComparison, QuasiStatic, RateCheck, RateCheckRow, TestSummary
+from poro2d.shear.pool import ShearJob, execute_jobs
 from poro2d.shear.results import ShearSeriesResult, ShearTestResult
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings
-from poro2d.shear.specimen_file import resolve_specimen
+from poro2d.shear.specimen_file import Specimen
+from poro2d.store import Store
 
 #: what a series' ``result.json`` keeps of each test
 SUMMARY_KEYS = (
@@ -54,19 +56,21 @@ def check_stresses(normal_stresses_kpa) -> list[float]:
 class ShearSeries:
     """Direct shear tests at several normal stresses, in parallel processes, with the fit.
 
-    Writes ``out/result.json`` (per test and overall), ``peaks.csv``, ``curves.csv``,
-    ``fig8a_shear_curves.png``, ``fig8b_peak_strength.png`` and one folder per test
-    (see :class:`DirectShearTest`); with ``rate_check`` every test is repeated at half
-    the velocity under ``out/rate_check/`` and the change of the peak is reported.
-    Finished tests are skipped on a rerun; a killed test resumes from its checkpoint.
+    ``specimen``: a :class:`~poro2d.shear.specimen_file.Specimen`, or its path (read once,
+    here). With ``store`` it keeps ``result.json`` (per test and overall), ``peaks.csv``,
+    ``curves.csv``, ``fig8a_shear_curves.png``, ``fig8b_peak_strength.png`` and one sub-store
+    per test (see :class:`DirectShearTest`); with ``rate_check`` every test is repeated at
+    half the velocity under ``rate_check/`` and the change of the peak is reported. Finished
+    tests are skipped on a rerun; a killed test resumes from its checkpoint. ``store=None``:
+    nothing is kept.
     """
 
     def __init__(
         self,
-        specimen: str | Path,
+        specimen: Specimen | str | Path,
         normal_stresses_kpa,
         settings: ShearSettings | None = None,
-        out: str | Path = "shear-out",
+        store: Store | None = None,
         lab=None,
         rate_check: bool = False,
         rate_tolerance: float = 0.02,
@@ -75,10 +79,10 @@ class ShearSeries:
         config: dict | None = None,
         figures: bool = True,
     ) -> None:
-        self.specimen = resolve_specimen(specimen)
+        self.specimen = Specimen.of(specimen)
         self.stresses = check_stresses(normal_stresses_kpa)
         self.settings = settings if settings is not None else ShearSettings()
-        self.out = Path(out)
+        self.store = store
         self.lab = lab
         self.rate_check = bool(rate_check)
         self.rate_tolerance = check_range("rate_tolerance", rate_tolerance, 0.0, 1.0, lo_open=True)
@@ -94,42 +98,46 @@ class ShearSeries:
         self.processes = processes if processes is not None else min(len(self.jobs), 2 * ncpu)
         self._bind_tests()
 
+    @property
+    def specimen_digest(self) -> str:
+        """Digest of the specimen's state (:func:`poro2d.dem.checkpoint.state_digest`)."""
+        return self.specimen.digest
+
     def _bind_tests(self) -> None:
         """Validate every test (box size, then what each folder holds) before anything is written."""
-        self.specimen_digest = checkpoint.state_digest(self.specimen)  # one specimen: hashed once
-        stages = [job_test(job, self.specimen_digest).stage() for job in self.jobs]
+        if self.store is None:
+            return
+        stages = [job.test().stage() for job in self.jobs]
         for stage in stages:
             stage.check()
         for stage in stages:
             stage.bind()
 
-    def _jobs(self) -> list[dict]:
-        base = self.settings.to_dict()
-        half = dict(base, velocity=0.5 * base["velocity"])
-        common = {"specimen": str(self.specimen)}
+    def _folder(self, *parts: str) -> str | None:
+        """The folder of a test's store, as a string a worker makes its store from."""
+        return None if self.store is None else str(self.store.child(*parts).root)
+
+    def _jobs(self) -> list[ShearJob]:
+        base = ShearCase(self.specimen, self.stresses[0], self.settings)
+        half = base.with_settings(velocity=0.5 * self.settings.velocity)
         jobs = [
-            {"key": ("test", sig), "sigma": sig, "settings": base, "figures": self.figures,
-             "out": str(self.out / folder_name(sig)), **common}
+            ShearJob(("test", sig), base.at(sig), self._folder(folder_name(sig)), self.figures)
             for sig in self.stresses
-        ]  # fmt: skip
+        ]
         if self.rate_check:
             jobs += [
-                {"key": ("rate", sig), "sigma": sig, "settings": half, "figures": False,
-                 "out": str(self.out / "rate_check" / folder_name(sig)), **common}
+                ShearJob(("rate", sig), half.at(sig), self._folder("rate_check", folder_name(sig)), False)
                 for sig in self.stresses
-            ]  # fmt: skip
+            ]
         return jobs
-
-    def _execute(self) -> dict:
-        return execute_jobs(self.jobs, self.processes, self.progress)
 
     def run(self) -> ShearSeriesResult:
         """Run the tests (finished ones are read back), then the fit, figures and ``result.json``."""
         t0 = time.perf_counter()
-        return self.finish(self._execute(), t0)
+        return self.finish(execute_jobs(self.jobs, self.processes, self.progress), t0)
 
     # ------------------------------------------------------------------ results
-    def finish(self, results: dict, t0: float) -> ShearSeriesResult:
+    def finish(self, results: dict[tuple, ShearTestResult], t0: float) -> ShearSeriesResult:
         """Fit, figures and ``result.json`` from the tests' results (keyed as in :meth:`_jobs`)."""
         tests = [results[("test", s)] for s in self.stresses]
         sig = np.array([t["normal_stress_kpa"] for t in tests])
@@ -144,9 +152,9 @@ class ShearSeries:
             friction_angle_deg=fit.friction_angle_deg if fit else None,
             cohesion_kpa=fit.cohesion_kpa if fit else None,
             r2=fit.r2 if fit else None,
-            fit=fit.to_dict() if fit else None,
+            fit=fit.record() if fit else None,
             friction_angle_through_origin_deg=fit0.friction_angle_deg,
-            fit_through_origin=fit0.to_dict(),
+            fit_through_origin=fit0.record(),
             quasi_static=self._quasi_static(tests),
             peak_definition=f"maximum of the shear stress curve smoothed by a centred moving average over "
             f"{1e3 * s.peak_window:g} mm of shear displacement",
@@ -155,9 +163,9 @@ class ShearSeries:
             settings=s.to_dict(),
             velocity_m_per_s=s.velocity,
             density_scale=s.density_scale,
-            specimen=str(self.specimen),
-            specimen_digest=self.specimen_digest,
-            specimen_meta=checkpoint.read_meta(self.specimen).get("extra", {}),
+            specimen=self.specimen.source,
+            specimen_digest=self.specimen.digest,
+            specimen_meta=self.specimen.extra,
             processes=self.processes,
             config=self.config,
         )
@@ -168,67 +176,71 @@ class ShearSeries:
         result.wall_time_s = time.perf_counter() - t0
         result.provenance = provenance()
         curves = {t["normal_stress_kpa"]: t.curve for t in tests}
-        write_tables(self.out, curves, summary)
-        if self.figures:
-            write_figures(self.out, tests, curves, fit, fit0, self.settings, self.lab)
-        write_json(self.out / "result.json", result)
+        if self.store is not None:
+            write_tables(self.store, curves, summary)
+            if self.figures:
+                write_figures(self.store, tests, curves, fit, fit0, self.settings, self.lab)
+            self.store.write_json("result.json", result)
         result.curves = curves
         return result
 
     @staticmethod
-    def _test_summary(t: dict) -> dict:
+    def _test_summary(t: ShearTestResult) -> TestSummary:
         """One test's line of the series' result."""
         # tests written before a test said why it ended lack ``ended_by``
-        return {k: t.get(k) if k == "ended_by" else t[k] for k in SUMMARY_KEYS} | {
-            "consolidation_normal_stress_error": t["consolidation"]["normal_stress_error"],
-            "folder": folder_name(t["normal_stress_kpa"]),
-        }
+        return TestSummary(
+            **{k: t.get(k) if k == "ended_by" else t[k] for k in SUMMARY_KEYS},
+            consolidation_normal_stress_error=t.consolidation["normal_stress_error"],
+            folder=folder_name(t.normal_stress_kpa),
+        )
 
-    def _quasi_static(self, tests: list[dict]) -> dict:
+    def _quasi_static(self, tests: list[ShearTestResult]) -> QuasiStatic:
         s = self.settings
         # a stored infinity reads back as null (JSON has no infinity): the check failed
         max_i = max(math.inf if t["max_inertial_number"] is None else t["max_inertial_number"] for t in tests)
-        return {
-            "max_inertial_number": max_i,
-            "inertial_limit": s.inertial_limit,
-            "inertial_number_ok": max_i < s.inertial_limit,
-            "inertial_number_definition": "I = gamma_dot d_mean sqrt(rho_s density_scale / sigma_n), "
+        return QuasiStatic(
+            max_inertial_number=max_i,
+            inertial_limit=s.inertial_limit,
+            inertial_number_ok=max_i < s.inertial_limit,
+            inertial_number_definition="I = gamma_dot d_mean sqrt(rho_s density_scale / sigma_n), "
             f"gamma_dot = v / ({s.shear_zone_factor:g} d_mean) (a thin shear zone: conservative), "
             "sigma_n the measured plate stress at each record",
-        }
+        )
 
-    def _rate_check(self, tests: list[ShearTestResult], results: dict, sig: np.ndarray, fit) -> dict:
+    def _rate_check(
+        self, tests: list[ShearTestResult], results: dict[tuple, ShearTestResult], sig: np.ndarray, fit
+    ) -> RateCheck:
         """How the peaks change at half the velocity (the reruns under ``rate_check/``)."""
         rows = []
         for t in tests:
             h = results[("rate", t["normal_stress_kpa"])]
-            rows.append({
-                "normal_stress_kpa": t["normal_stress_kpa"],
-                "peak_kpa": t["peak_shear_stress_kpa"],
-                "peak_half_velocity_kpa": h["peak_shear_stress_kpa"],
-                "relative_change": h["peak_shear_stress_kpa"] / t["peak_shear_stress_kpa"] - 1.0,
-                "shear_displacement_at_peak_m": t["shear_displacement_at_peak_m"],
-                "shear_displacement_at_peak_half_velocity_m": h["shear_displacement_at_peak_m"],
-                "max_inertial_number_half_velocity": h["max_inertial_number"],
-                "mean_abs_change_before_peak": self._pre_peak_change(t, h),
-                "wall_time_s": h["wall_time_s"],
-            })  # fmt: skip
-        worst = max(abs(r["relative_change"]) for r in rows)
-        fit_h = mohr_coulomb(sig, [r["peak_half_velocity_kpa"] for r in rows]) if len(sig) >= 2 else None
-        return {
-            "velocity_m_per_s": self.settings.velocity,
-            "half_velocity_m_per_s": 0.5 * self.settings.velocity,
-            "tests": rows,
-            "max_abs_relative_change": worst,
-            "tolerance": self.rate_tolerance,
-            "passed": worst < self.rate_tolerance,
-            "friction_angle_half_velocity_deg": fit_h.friction_angle_deg if fit_h else None,
-            "friction_angle_change_deg": (fit_h.friction_angle_deg - fit.friction_angle_deg)
+            rows.append(RateCheckRow(
+                normal_stress_kpa=t.normal_stress_kpa,
+                peak_kpa=t.peak_shear_stress_kpa,
+                peak_half_velocity_kpa=h.peak_shear_stress_kpa,
+                relative_change=h.peak_shear_stress_kpa / t.peak_shear_stress_kpa - 1.0,
+                shear_displacement_at_peak_m=t.shear_displacement_at_peak_m,
+                shear_displacement_at_peak_half_velocity_m=h.shear_displacement_at_peak_m,
+                max_inertial_number_half_velocity=h.max_inertial_number,
+                mean_abs_change_before_peak=self._pre_peak_change(t, h),
+                wall_time_s=h.wall_time_s,
+            ))  # fmt: skip
+        worst = max(abs(r.relative_change) for r in rows)
+        fit_h = mohr_coulomb(sig, [r.peak_half_velocity_kpa for r in rows]) if len(sig) >= 2 else None
+        return RateCheck(
+            velocity_m_per_s=self.settings.velocity,
+            half_velocity_m_per_s=0.5 * self.settings.velocity,
+            tests=rows,
+            max_abs_relative_change=worst,
+            tolerance=self.rate_tolerance,
+            passed=worst < self.rate_tolerance,
+            friction_angle_half_velocity_deg=fit_h.friction_angle_deg if fit_h else None,
+            friction_angle_change_deg=(fit_h.friction_angle_deg - fit.friction_angle_deg)
             if (fit_h and fit)
             else None,
-            "max_mean_abs_change_before_peak": max(r["mean_abs_change_before_peak"] for r in rows),
-            "note": RATE_CHECK_NOTE,
-        }
+            max_mean_abs_change_before_peak=max(r.mean_abs_change_before_peak for r in rows),
+            note=RATE_CHECK_NOTE,
+        )
 
     def _pre_peak_change(self, t: ShearTestResult, h: ShearTestResult) -> float:
         """Mean |tau_half - tau| / tau_peak of the smoothed curves up to the earlier peak."""
@@ -244,22 +256,23 @@ class ShearSeries:
             return math.nan
         return float(np.mean(np.abs(yb[m] - ya[m])) / t["peak_shear_stress_kpa"])
 
-    def _lab_part(self, fit) -> dict:
+    def _lab_part(self, fit) -> LabComparison:
         """The laboratory data, their fit and the difference of the friction angles."""
         lab = self.lab
-        part = lab.to_dict()
         ls = lab.normal_stresses()
         lf = lab_fit(lab)
-        part["fit"] = lf.to_dict() if lf else None
-        part["friction_angle_deg"] = lf.friction_angle_deg if lf else None
-        part["cohesion_kpa"] = lf.cohesion_kpa if lf else None
-        part["friction_angle_difference_deg"] = (
-            fit.friction_angle_deg - lf.friction_angle_deg if (fit and lf) else None
+        return LabComparison(
+            source=lab.source,
+            kind=lab.kind,
+            peaks=lab.peak_rows(),
+            fit=lf.record() if lf else None,
+            friction_angle_deg=lf.friction_angle_deg if lf else None,
+            cohesion_kpa=lf.cohesion_kpa if lf else None,
+            friction_angle_difference_deg=fit.friction_angle_deg - lf.friction_angle_deg
+            if (fit and lf)
+            else None,
+            fit_through_origin=mohr_coulomb(ls, [lab.peaks[v] for v in ls], through_origin=True).record(),
         )
-        part["fit_through_origin"] = mohr_coulomb(
-            ls, [lab.peaks[v] for v in ls], through_origin=True
-        ).to_dict()
-        return part
 
 
 __all__ = ["ShearSeries", "check_stresses"]

@@ -5,7 +5,8 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
-from poro2d.errors import InputError, check_int, check_range
+from poro2d.dem.contact_law import MAX_ROLLING_FRICTION as ENGINE_MAX_ROLLING_FRICTION
+from poro2d.errors import InputError, Integer, Ranges, Real, check_fields
 from poro2d.paper_data import TABLE_1
 
 #: the normal stresses (kPa) a test may be run at. A contact carries about sigma d t, so two
@@ -26,12 +27,42 @@ MAX_CONSOLIDATION_STEPS = 10_000_000
 MAX_WALL_STIFFNESS = 1e10
 #: friction coefficients beyond 10 hold as a rough wall does; larger ones are typos
 MAX_FRICTION = 10.0
-#: rolling frictions beyond 1 hold a disk against any tilt it meets in a shear band (a disk
-#: rolls when the moment arm of its contact force exceeds mu_r R: at 1 the force would have to
-#: lean past 45 degrees); larger ones are typos
-MAX_ROLLING_FRICTION = 1.0
+#: the largest rolling friction (the engine's bound, see poro2d.dem.contact_law)
+MAX_ROLLING_FRICTION = ENGINE_MAX_ROLLING_FRICTION
 #: inertial masses up to 1000 times the real ones: the inertial number grows with its root
 MAX_DENSITY_SCALE = 1000.0
+
+
+#: what each setting of :class:`ShearSettings` may be (checked in this order); the intervals
+#: are checked against ``max_displacement`` and ``stop_after_peak`` against ``peak_window``
+#: after these
+SHEAR_RANGES: Ranges = {
+    "velocity": Real(0.0, 10.0, lo_open=True),
+    # half the width of a 2 m box; a test checks it against its own specimen's half width too
+    "max_displacement": Real(0.0, MAX_DISPLACEMENT, lo_open=True),
+    "record_interval": Real(0.0, None, lo_open=True),
+    # beyond max_displacement it never ends a test (as a short quick test with the default)
+    "stop_after_peak": Real(0.0, MAX_DISPLACEMENT),
+    "checkpoint_interval": Real(0.0, None, lo_open=True),
+    "consolidation_ratio": Real(0.0, 1.0, lo_open=True),
+    "consolidation_max_steps": Integer(1000, MAX_CONSOLIDATION_STEPS),
+    "servo_gain": Real(0.0, 1.0, lo_open=True),
+    "servo_integral": Real(0.0, 0.1),
+    "servo_max_speed": Real(0.0, 10.0, lo_open=True),
+    "kn_wall": Real(0.0, MAX_WALL_STIFFNESS, lo_open=True),
+    "ks_wall": Real(0.0, MAX_WALL_STIFFNESS),
+    "friction_wall": Real(0.0, MAX_FRICTION),
+    "gap": Real(0.0, None),
+    "particle_friction": Real(0.0, MAX_FRICTION, or_none=True),
+    "rolling_friction": Real(0.0, MAX_ROLLING_FRICTION, or_none=True),
+    "local_damping": Real(0.0, 1.0, hi_open=True, or_none=True),
+    "density_scale": Real(1.0, MAX_DENSITY_SCALE),
+    "dt_safety": Real(0.0, 1.0, lo_open=True),
+    "peak_window": Real(0.0, None),
+    "shear_zone_factor": Real(0.0, None, lo_open=True),
+    "inertial_limit": Real(0.0, None, lo_open=True),
+    "stress_tolerance": Real(0.0, 1.0, lo_open=True),
+}
 
 
 @dataclass
@@ -79,36 +110,11 @@ class ShearSettings:
     stress_tolerance: float = 0.02
 
     def __post_init__(self) -> None:
-        check_range("velocity", self.velocity, 0.0, 10.0, lo_open=True)
-        # half the width of a 2 m box; a test checks it against its own specimen's half width too
-        check_range("max_displacement", self.max_displacement, 0.0, MAX_DISPLACEMENT, lo_open=True)
+        check_fields(self, SHEAR_RANGES)
         # at most MAX_RECORDS rows and MAX_CHECKPOINTS checkpoints a test: a finer interval
         # (1e-300 m) asks for more rows than memory holds, or a checkpoint every step
         self._check_interval("record_interval", self.record_interval, MAX_RECORDS)
-        # beyond max_displacement it never ends a test (as a short quick test with the default)
-        check_range("stop_after_peak", self.stop_after_peak, 0.0, MAX_DISPLACEMENT)
         self._check_interval("checkpoint_interval", self.checkpoint_interval, MAX_CHECKPOINTS)
-        check_range("consolidation_ratio", self.consolidation_ratio, 0.0, 1.0, lo_open=True)
-        check_int("consolidation_max_steps", self.consolidation_max_steps, 1000, MAX_CONSOLIDATION_STEPS)
-        check_range("servo_gain", self.servo_gain, 0.0, 1.0, lo_open=True)
-        check_range("servo_integral", self.servo_integral, 0.0, 0.1)
-        check_range("servo_max_speed", self.servo_max_speed, 0.0, 10.0, lo_open=True)
-        check_range("kn_wall", self.kn_wall, 0.0, MAX_WALL_STIFFNESS, lo_open=True)
-        check_range("ks_wall", self.ks_wall, 0.0, MAX_WALL_STIFFNESS)
-        check_range("friction_wall", self.friction_wall, 0.0, MAX_FRICTION)
-        check_range("gap", self.gap, 0.0, None)
-        if self.particle_friction is not None:
-            check_range("particle_friction", self.particle_friction, 0.0, MAX_FRICTION)
-        if self.rolling_friction is not None:
-            check_range("rolling_friction", self.rolling_friction, 0.0, MAX_ROLLING_FRICTION)
-        if self.local_damping is not None:
-            check_range("local_damping", self.local_damping, 0.0, 1.0, hi_open=True)
-        check_range("density_scale", self.density_scale, 1.0, MAX_DENSITY_SCALE)
-        check_range("dt_safety", self.dt_safety, 0.0, 1.0, lo_open=True)
-        check_range("peak_window", self.peak_window, 0.0, None)
-        check_range("shear_zone_factor", self.shear_zone_factor, 0.0, None, lo_open=True)
-        check_range("inertial_limit", self.inertial_limit, 0.0, None, lo_open=True)
-        check_range("stress_tolerance", self.stress_tolerance, 0.0, 1.0, lo_open=True)
         if 0.0 < self.stop_after_peak < self.peak_window:
             # the smoothed value at a peak needs half a window of curve after it to be final
             allowed = f"0 (off) or >= peak_window = {self.peak_window} m"
@@ -118,7 +124,6 @@ class ShearSettings:
 
     def _check_interval(self, name: str, interval: float, most: int) -> None:
         """An interval of shear displacement (m) that comes at most ``most`` times a test."""
-        check_range(name, interval, 0.0, None, lo_open=True)
         shortest = self.max_displacement / most
         if interval < shortest:
             raise InputError(name, interval, f"[max_displacement / {most} = {shortest:.3g}, inf) m")

@@ -10,17 +10,17 @@ from __future__ import annotations
 
 import math
 import time
-from pathlib import Path
 
 import numpy as np
 
-from poro2d.dem import Simulation, checkpoint
+from poro2d.dem import Simulation
 from poro2d.shear.box import SplitBox
 from poro2d.shear.controllers import ProgressFn, ShearDrive
 from poro2d.shear.curve import curve_row, peak_passed
 from poro2d.shear.fit import peak
 from poro2d.shear.peak_frame import PeakFrame, PeakTracker
 from poro2d.shear.settings import ShearSettings
+from poro2d.store import Store
 
 #: the files that let a killed shear stage continue: the engine state and the peak's frame
 CHECKPOINT = "shear_checkpoint.npz"
@@ -28,13 +28,14 @@ PEAK_FRAME = "peak_frame.npz"
 
 
 class ShearStage:
-    """Shear ``sim`` (consolidated, or from the checkpoint in ``folder``) to ``max_displacement``,
+    """Shear ``sim`` (consolidated, or from the checkpoint in ``store``) to ``max_displacement``,
     or until the peak is passed by ``stop_after_peak``: past it the curve only serves the
     residual part of Fig. 8, and it is a third or more of a test's cost.
 
     ``box``: the split box ``sim`` stands in; ``y_plate0``: the plate's height after
-    consolidation (the dilation's zero); ``folder``: where the checkpoint and the peak's
-    frame are kept (None: nowhere); ``threads``: for a state read back from the checkpoint;
+    consolidation (the dilation's zero); ``store``: where the checkpoint (through its
+    :class:`~poro2d.store.Checkpoints`) and the peak's frame are kept (None: nowhere);
+    ``threads``: for a state read back from the checkpoint;
     ``figures``: keep the state at the peak for its force chains; ``progress(phase,
     fraction)``: called at every record.
 
@@ -48,7 +49,7 @@ class ShearStage:
         box: SplitBox,
         settings: ShearSettings,
         y_plate0: float,
-        folder: Path | None = None,
+        store: Store | None = None,
         threads: int = 1,
         figures: bool = True,
         progress: ProgressFn | None = None,
@@ -57,8 +58,8 @@ class ShearStage:
         self.box, self.settings = box, s
         self.threads, self.figures, self.progress = threads, figures, progress
         self.t0 = time.perf_counter()
-        self.ck = None if folder is None else folder / CHECKPOINT
-        self.fpath = None if folder is None else folder / PEAK_FRAME
+        self.store = store
+        self.checkpoints = None if store is None else store.checkpoints(CHECKPOINT)
         self.y_plate0 = y_plate0
         self.sim, self.rows, self.step0, self.wall_before = self._start(sim)
         dx_step = s.velocity * self.sim.dt
@@ -67,13 +68,13 @@ class ShearStage:
         self.ck_every = max(1, int(round(s.checkpoint_interval / (self.every * dx_step))))
         self.rho = float(np.mean(self.sim.particles.density)) * self.sim.density_scale
         self.peak = PeakTracker(s.peak_window)
-        self.peak.restore(self.fpath, self.rows)
+        self.peak.restore(store, PEAK_FRAME, self.rows)
 
     def _start(self, sim: Simulation) -> tuple[Simulation, list[dict], int, float]:
         """(simulation, rows, step shearing began at, wall time so far): resumed or new."""
-        if self.ck is not None and self.ck.is_file():
-            meta = checkpoint.read_meta(self.ck)["extra"]
-            resumed = checkpoint.load(self.ck, threads=self.threads)
+        saved = None if self.checkpoints is None else self.checkpoints.resume(threads=self.threads)
+        if saved is not None:
+            resumed, meta = saved
             return resumed, meta["rows"], meta["step0"], meta.get("wall_time_s", 0.0)
         ShearDrive(self.settings.velocity).start(sim)
         return sim, [], sim.step_count, 0.0
@@ -90,11 +91,11 @@ class ShearStage:
         done = sim.step_count - self.step0
         if self.progress is not None:
             self.progress("shearing", done / self.total)
-        if self.ck is not None and len(rows) % self.ck_every == 0 and done < self.total:
-            self.peak.save(self.fpath)  # a resumed run still draws the peak's forces
+        if self.checkpoints is not None and len(rows) % self.ck_every == 0 and done < self.total:
+            self.peak.save(self.store, PEAK_FRAME)  # a resumed run still draws the peak's forces
             wall = self.wall_before + time.perf_counter() - self.t0
             extra = {"stage": "shear", "rows": rows, "step0": self.step0, "wall_time_s": wall}
-            checkpoint.save(sim, self.ck, extra=extra)
+            self.checkpoints.save(sim, extra=extra)
         return self.peak_passed()
 
     def peak_passed(self) -> bool:
@@ -107,7 +108,7 @@ class ShearStage:
             return False
         x = np.array([r["shear_displacement_mm"] for r in self.rows]) * 1e-3
         tau = np.array([r["shear_stress_kpa"] for r in self.rows])
-        return peak_passed(x, peak(x, tau, s.peak_window)[1], s)
+        return peak_passed(x, peak(x, tau, s.peak_window).x, s)
 
     def run(self) -> float:
         """Shear to the end; returns the stage's wall time (s), resumed parts included."""
@@ -118,10 +119,10 @@ class ShearStage:
         return self.wall_before + time.perf_counter() - self.t0
 
 
-def remove_stage_files(out: Path) -> None:
-    """The checkpoint and the stored frame of a test in ``out``, once its results are written."""
-    for name in (CHECKPOINT, PEAK_FRAME):
-        (out / name).unlink(missing_ok=True)
+def remove_stage_files(store: Store) -> None:
+    """The checkpoint and the stored frame of a test in ``store``, once its results are written."""
+    store.checkpoints(CHECKPOINT).clear()
+    store.remove(PEAK_FRAME)
 
 
 __all__ = ["CHECKPOINT", "PEAK_FRAME", "ShearStage", "remove_stage_files"]

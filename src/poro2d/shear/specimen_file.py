@@ -1,15 +1,23 @@
-"""The specimen a direct shear test starts from: where its file is and the size of its box."""
+"""The specimen a direct shear test starts from: read once, then passed down as a value.
+
+A series runs several tests on one specimen, in other processes: the file is read (and
+checked, and hashed) once into a :class:`Specimen`, and every test builds its simulation
+from that value instead of opening the file again.
+"""
 
 from __future__ import annotations
 
-import json
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from poro2d.dem import Simulation, checkpoint
 from poro2d.errors import InputError
 from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
 from poro2d.specimen.box import box_faces
+from poro2d.store import Store
 
 
 def resolve_specimen(path: str | Path) -> Path:
@@ -26,14 +34,48 @@ def resolve_specimen(path: str | Path) -> Path:
     return check_input_file("specimen", p, CHECKPOINT_FILE_LIMIT)
 
 
-def specimen_box(path: str | Path) -> tuple[float, float]:
-    """(W, H) of a specimen checkpoint, from its right wall and top plate, without loading it."""
-    with np.load(resolve_specimen(path)) as z:
-        meta = json.loads(bytes(z["meta"]).decode())
-        names = meta.get("wall_names", [])
-        p0 = z["walls.p0"]
-    _, right, _, top = box_faces(names, p0, "specimen walls", "a poro2d specimen")
-    return right, top
+@dataclass(frozen=True, eq=False)
+class Specimen:
+    """A specimen checkpoint's content: its metadata, its arrays and the digest of its state.
+
+    ``source``: the file it was read from (recorded in results, for information only: a
+    test's identity is ``digest``, :func:`poro2d.dem.checkpoint.state_digest`).
+    """
+
+    source: str
+    meta: dict[str, Any]
+    arrays: dict[str, np.ndarray]
+    digest: str
+
+    @classmethod
+    def read(cls, path: str | Path, digest: str | None = None) -> Specimen:
+        """The specimen at ``path`` (a checkpoint or a folder holding ``specimen.npz``), checked.
+
+        ``digest``: the state's digest when the caller knows it already (it is not computed again).
+        """
+        p = resolve_specimen(path)
+        meta, arrays = Store(p.parent, parameter="specimen").read_state(p.name)
+        return cls(str(p), meta, arrays, digest or checkpoint.content_digest(meta, arrays))
+
+    @classmethod
+    def of(cls, specimen: Specimen | str | Path) -> Specimen:
+        """``specimen`` as it is when a value, else read from its path."""
+        return specimen if isinstance(specimen, Specimen) else cls.read(specimen)
+
+    @property
+    def extra(self) -> dict[str, Any]:
+        """What the specimen's maker recorded with it (the checkpoint's ``extra``)."""
+        return self.meta.get("extra", {})
+
+    def box(self) -> tuple[float, float]:
+        """(W, H): the specimen box's right wall and top plate."""
+        names = self.meta.get("wall_names", [])
+        _, right, _, top = box_faces(names, self.arrays["walls.p0"], "specimen walls", "a poro2d specimen")
+        return right, top
+
+    def simulation(self, threads: int | None = None) -> Simulation:
+        """A new simulation of the specimen's state (the value itself is left as read)."""
+        return checkpoint.from_content(self.meta, self.arrays, threads=threads)
 
 
-__all__ = ["resolve_specimen", "specimen_box"]
+__all__ = ["Specimen", "resolve_specimen"]

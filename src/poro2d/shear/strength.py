@@ -22,17 +22,22 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from poro2d.errors import InputError, check_range
-from poro2d.io_utils import provenance, write_csv, write_json
+from poro2d.io_utils import provenance
+from poro2d.shear.case import ShearCase
 from poro2d.shear.fit import mohr_coulomb
+from poro2d.shear.parts import StrengthCase
 from poro2d.shear.replicates import ReplicateShear, mohr_coulomb_ci
-from poro2d.shear.results import ReplicateShearResult
+from poro2d.shear.results import ReplicateShearResult, StrengthResult
 from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
+from poro2d.shear.specimen_file import Specimen
+from poro2d.store import Store
 
 #: the part of each test's shear displacement, at its end, that the residual strength averages
 RESIDUAL_FRACTION = 0.2
@@ -61,14 +66,14 @@ def check_grid(name: str, values, hi: float) -> list[float]:
 
 
 # ---------------------------------------------------------------------- per test
-def residual_point(curve: dict[str, np.ndarray]) -> tuple[float, float]:
+def residual_point(curve: Mapping[str, np.ndarray]) -> tuple[float, float]:
     """(mean normal stress, mean shear stress) in kPa over the last RESIDUAL_FRACTION of the curve."""
     x = curve["shear_displacement_mm"]
     tail = x >= (1.0 - RESIDUAL_FRACTION) * x[-1]
     return float(curve["normal_stress_kpa"][tail].mean()), float(curve["shear_stress_kpa"][tail].mean())
 
 
-def max_dilation_angle(curve: dict[str, np.ndarray], window_m: float) -> float:
+def max_dilation_angle(curve: Mapping[str, np.ndarray], window_m: float) -> float:
     """atan of the largest mean slope of the plate rise over ``window_m`` of shear displacement (deg).
 
     The slope is the secant (dy(x + w/2) - dy(x - w/2)) / w, for every recorded x at least half
@@ -92,8 +97,8 @@ def _mean_sd(values: list[float]) -> tuple[float, float | None]:
 
 
 def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float, friction: float,
-                 window_m: float) -> tuple:  # fmt: skip
-    """One case's row (means and spreads over the specimens) and its per-test rows."""
+                 window_m: float) -> tuple[StrengthCase, list[dict]]:  # fmt: skip
+    """One case's row (means and spreads over the specimens) and its rows of ``strength_tests.csv``."""
     tests = []
     per_specimen = []
     for label, res in summary.series.items():
@@ -120,39 +125,49 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
             "residual": mohr_coulomb(s, tau, through_origin=True).friction_angle_deg,
             "dilation": float(np.mean(psis)),
         })  # fmt: skip
-    row = {"mu_r": mu_r, "particle_friction": friction, "specimens": len(per_specimen)}
+    spread = {}
     for key in ("peak", "residual", "dilation"):
-        name = "max_dilation_angle" if key == "dilation" else f"{key}_friction_angle"
         values = [p[key] for p in per_specimen if p[key] is not None]
-        row[f"{name}_mean_deg"], row[f"{name}_sd_deg"] = _mean_sd(values) if values else (None, None)
-    pooled = summary.fit or {}
-    row["peak_friction_angle_pooled_deg"] = pooled.get("friction_angle_deg")
-    row["peak_friction_angle_pooled_ci_deg"] = pooled.get("friction_angle_ci_deg")
-    row["cohesion_pooled_kpa"] = pooled.get("cohesion_kpa")
+        spread[key] = _mean_sd(values) if values else (None, None)
+    pooled = summary.fit
     res_fit = mohr_coulomb_ci(
         [r["residual_normal_stress_kpa"] for r in tests], [r["residual_shear_stress_kpa"] for r in tests],
         through_origin=True,
     )  # fmt: skip
-    row["residual_friction_angle_pooled_deg"] = res_fit["friction_angle_deg"]
-    row["residual_friction_angle_pooled_ci_deg"] = res_fit["friction_angle_ci_deg"]
-    row["residual_stress_ratio_mean"] = float(np.mean([r["residual_stress_ratio"] for r in tests]))
+    row = StrengthCase(
+        mu_r=mu_r,
+        particle_friction=friction,
+        specimens=len(per_specimen),
+        peak_friction_angle_mean_deg=spread["peak"][0],
+        peak_friction_angle_sd_deg=spread["peak"][1],
+        residual_friction_angle_mean_deg=spread["residual"][0],
+        residual_friction_angle_sd_deg=spread["residual"][1],
+        max_dilation_angle_mean_deg=spread["dilation"][0],
+        max_dilation_angle_sd_deg=spread["dilation"][1],
+        peak_friction_angle_pooled_deg=pooled.friction_angle_deg if pooled else None,
+        peak_friction_angle_pooled_ci_deg=pooled.friction_angle_ci_deg if pooled else None,
+        cohesion_pooled_kpa=pooled.cohesion_kpa if pooled else None,
+        residual_friction_angle_pooled_deg=res_fit.friction_angle_deg,
+        residual_friction_angle_pooled_ci_deg=res_fit.friction_angle_ci_deg,
+        residual_stress_ratio_mean=float(np.mean([r["residual_stress_ratio"] for r in tests])),
+    )
     return row, tests
 
 
 # ---------------------------------------------------------------------- the study
-def check_specimens(specimens: dict, normal_stresses_kpa, settings: ShearSettings) -> None:
-    """Every specimen and stress as a test would take them, before any case binds a folder.
+def check_specimens(specimens: dict, normal_stresses_kpa, settings: ShearSettings) -> dict[str, Specimen]:
+    """Every specimen (read once) and stress as a test would take them, before any case binds a folder.
 
     A case's series writes its tests' records as it is built, so a bad second specimen found
     while building the cases would leave the first one's folders behind.
     """
-    from poro2d.shear.single import DirectShearTest
-
     if not specimens:
         raise InputError("specimens", {}, "at least one specimen")
-    for path in specimens.values():
+    values = {label: Specimen.of(path) for label, path in specimens.items()}
+    for value in values.values():
         for sigma in normal_stresses_kpa:
-            DirectShearTest(path, sigma, settings)  # no folder: checks only
+            ShearCase(value, sigma, settings)  # checks only
+    return values
 
 
 class StrengthStudy:
@@ -160,30 +175,31 @@ class StrengthStudy:
 
     ``specimens``: label -> specimen (checkpoint or criterion folder); ``settings``: the shear
     settings every case starts from (its ``particle_friction`` and ``rolling_friction`` are
-    the case's). Writes ``out/<case>/`` (a :class:`ReplicateShear` each), ``strength.csv``
-    (one row per case), ``strength_tests.csv`` (one per test), ``strength.json`` and
-    ``fig_strength.png``.
+    the case's). With ``store`` it keeps ``<case>/`` (a :class:`ReplicateShear` each),
+    ``strength.csv`` (one row per case), ``strength_tests.csv`` (one per test),
+    ``strength.json`` and ``fig_strength.png`` (``store=None``: nothing is kept).
     """
 
-    def __init__(self, specimens: dict[str, str | Path], mu_r, friction, normal_stresses_kpa,
-                 settings: ShearSettings | None = None, *, out: str | Path, processes: int | None = None,
-                 progress: bool = True, config: dict | None = None) -> None:  # fmt: skip
+    def __init__(self, specimens: dict[str, Specimen | str | Path], mu_r, friction, normal_stresses_kpa,
+                 settings: ShearSettings | None = None, *, store: Store | None = None,
+                 processes: int | None = None, progress: bool = True,
+                 config: dict | None = None) -> None:  # fmt: skip
         import os
 
         self.mu_r = check_grid("mu_r", mu_r, MAX_ROLLING_FRICTION)
         self.friction = check_grid("particle friction", friction, MAX_FRICTION)
         base = settings if settings is not None else ShearSettings()
         self.settings = base
-        check_specimens(specimens, normal_stresses_kpa, base)
-        self.out = Path(out)
+        values = check_specimens(specimens, normal_stresses_kpa, base)
+        self.store = store
         self.progress = progress
         self.config = config or {}
         self.cases = {
             (m, f): ReplicateShear(
-                specimens,
+                values,
                 normal_stresses_kpa,
                 replace(base, rolling_friction=m, particle_friction=f),
-                out=self.out / case_label(m, f),
+                store=store.child(case_label(m, f)) if store is not None else None,
                 progress=False,
                 config=self.config,
                 figures=False,
@@ -194,11 +210,11 @@ class StrengthStudy:
         njobs = sum(len(rep.jobs()) for rep in self.cases.values())
         self.processes = processes if processes is not None else min(njobs, 2 * (os.cpu_count() or 1))
 
-    def run(self) -> dict:
+    def run(self) -> StrengthResult:
         from poro2d.shear.pool import execute_jobs
 
         t0 = time.perf_counter()
-        jobs = [dict(j, key=(case, *j["key"]), series=f"{case_label(*case)} {j['series']}")
+        jobs = [replace(j, key=(case, *j.key), series=f"{case_label(*case)} {j.series}")
                 for case, rep in self.cases.items() for j in rep.jobs()]  # fmt: skip
         results = execute_jobs(jobs, self.processes, self.progress)
         rows, tests = [], []
@@ -207,26 +223,33 @@ class StrengthStudy:
             row, case_tests = case_summary(rep, summary, *case, self.settings.peak_window)
             rows.append(row)
             tests += case_tests
-        result = {
-            "cases": rows,
-            "mu_r": self.mu_r,
-            "particle_friction": self.friction,
-            "specimens": list(next(iter(self.cases.values())).series),
-            "settings": self.settings.to_dict(),
-            "definitions": DEFINITIONS,
-            "wall_time_s": time.perf_counter() - t0,
-            "processes": self.processes,
-            "config": self.config,
-            "provenance": provenance(),
-        }
-        write_csv(self.out / "strength_tests.csv", tests)
-        write_csv(self.out / "strength.csv", [{k: v for k, v in r.items() if not k.endswith("_ci_deg")}
-                                              for r in rows])  # fmt: skip
-        write_json(self.out / "strength.json", result)
+        result = StrengthResult(
+            cases=rows,
+            mu_r=self.mu_r,
+            particle_friction=self.friction,
+            specimens=list(next(iter(self.cases.values())).series),
+            settings=self.settings.to_dict(),
+            definitions=DEFINITIONS,
+            wall_time_s=time.perf_counter() - t0,
+            processes=self.processes,
+            config=self.config,
+            provenance=provenance(),
+        )
+        if self.store is not None:
+            self._write(self.store, result, tests)
+        return result
+
+    @staticmethod
+    def _write(store: Store, result: StrengthResult, tests: list[dict]) -> None:
+        """The study's tables, ``strength.json`` and its figure."""
         from poro2d.report.strength_figure import plot_strength
 
-        plot_strength(rows, self.out / "fig_strength.png")
-        return result
+        rows = result.cases
+        store.write_csv("strength_tests.csv", tests)
+        store.write_csv("strength.csv", [{k: v for k, v in r.items() if not k.endswith("_ci_deg")}
+                                         for r in rows])  # fmt: skip
+        store.write_result("strength.json", result)
+        plot_strength(rows, store.path("fig_strength.png"))
 
 
 DEFINITIONS = {

@@ -31,11 +31,12 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
-from poro2d.dem.measure import porosity_rect
+from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
 from poro2d.dem.ordering import strip_order
 from poro2d.dem.simulation import MEASURES
-from poro2d.errors import InputError, check_int, check_range
+from poro2d.errors import InputError, Integer, OneOf, Ranges, Real, check_fields, check_range
 from poro2d.identity import outside_identity
+from poro2d.measure.porosity import box_porosity, porosity_rect
 from poro2d.paper_data import TABLE_1
 from poro2d.specimen.grading import MAX_DRAW, GradingCurve, draw_disks
 from poro2d.specimen.placement import Band, place_disks
@@ -69,6 +70,35 @@ OMITTED_AT_DEFAULT = {
     "equilibrium": "max", "settle_drift": None, "settle_window": 10_000, "settle_checks": 3,
     "rolling_friction": 0.0,
 }  # fmt: skip
+
+
+#: what each setting of a :class:`SpecimenSpec` may be (checked in this order)
+SPECIMEN_RANGES: Ranges = {
+    **{k: Real(0, None, lo_open=True) for k in ("width", "height", "thickness", "solid_density")},
+    **{k: Real(0, None, lo_open=True) for k in ("kn_particle", "kn_wall")},
+    **{
+        k: Real(0, None)
+        for k in ("ks_particle", "ks_wall", "friction_prep", "friction_particle", "friction_wall")
+    },
+    "rolling_friction": Real(0, MAX_ROLLING_FRICTION),
+    "layers": Integer(1, 50),
+    "undercompaction": Real(0.0, 0.5),
+    "ratio": Real(0.0, 1.0, lo_open=True),
+    "equilibrium": OneOf(tuple(MEASURES), quoted=True),
+    "settle_drift": Real(0.0, 0.1, lo_open=True, or_none=True),
+    "settle_window": Integer(100),
+    "settle_checks": Integer(1, 100),
+    "local_damping": Real(0.0, 1.0, hi_open=True),
+    "gravity": Real(0.0, None),
+    **{
+        k: Integer(1)
+        for k in ("growth_increments", "growth_steps", "max_steps_per_stage", "fallback_steps", "calm_steps")
+    },
+    "calm_damping": Real(0.0, 1.0, hi_open=True),
+    "dt_safety": Real(0.0, 1.0, lo_open=True),
+    "threads": Integer(1),
+    "max_disks": Integer(1, MAX_DRAW),
+}
 
 
 @dataclass
@@ -112,35 +142,7 @@ class SpecimenSpec:
     max_disks: int = DEFAULT_MAX_DISKS
 
     def __post_init__(self) -> None:
-        check_range("width", self.width, 0, None, lo_open=True)
-        check_range("height", self.height, 0, None, lo_open=True)
-        check_range("thickness", self.thickness, 0, None, lo_open=True)
-        check_range("solid_density", self.solid_density, 0, None, lo_open=True)
-        for k in ("kn_particle", "kn_wall"):
-            check_range(k, getattr(self, k), 0, None, lo_open=True)
-        for k in ("ks_particle", "ks_wall", "friction_prep", "friction_particle", "friction_wall"):
-            check_range(k, getattr(self, k), 0, None)
-        check_range("rolling_friction", self.rolling_friction, 0, None)
-        check_int("layers", self.layers, 1, 50)
-        check_range("undercompaction", self.undercompaction, 0.0, 0.5)
-        check_range("ratio", self.ratio, 0.0, 1.0, lo_open=True)
-        if self.equilibrium not in MEASURES:
-            allowed = "one of " + ", ".join(repr(m) for m in MEASURES)
-            raise InputError("equilibrium", self.equilibrium, allowed)
-        if self.settle_drift is not None:
-            check_range("settle_drift", self.settle_drift, 0.0, 0.1, lo_open=True)
-        check_int("settle_window", self.settle_window, 100)
-        check_int("settle_checks", self.settle_checks, 1, 100)
-        check_range("local_damping", self.local_damping, 0.0, 1.0, hi_open=True)
-        check_range("gravity", self.gravity, 0.0, None)
-        check_int("growth_increments", self.growth_increments, 1)
-        check_int("growth_steps", self.growth_steps, 1)
-        for k in ("max_steps_per_stage", "fallback_steps", "calm_steps"):
-            check_int(k, getattr(self, k), 1)
-        check_range("calm_damping", self.calm_damping, 0.0, 1.0, hi_open=True)
-        check_range("dt_safety", self.dt_safety, 0.0, 1.0, lo_open=True)
-        check_int("threads", self.threads, 1)
-        check_int("max_disks", self.max_disks, 1, MAX_DRAW)
+        check_fields(self, SPECIMEN_RANGES)
 
     def to_dict(self) -> dict:
         """The specimen's settings as recorded with results.
@@ -293,11 +295,11 @@ _DENSEST: dict[tuple, float | None] = {}
 def densest_porosity(grading: GradingCurve) -> float | None:
     """A quick estimate of the grading's frictionless jamming porosity n_J (None if it cannot be made).
 
-    One seed of :func:`poro2d.specimen.jamming.jamming_reference` on ``PREFLIGHT_JAMMING``
+    One seed of :func:`poro2d.oracles.jamming.jamming_reference` on ``PREFLIGHT_JAMMING``
     disks, cached per grading. None when the grading is too wide for that many disks in the
     periodic cell (the largest disks would span it).
     """
-    from poro2d.specimen.jamming import jamming_reference
+    from poro2d.oracles.jamming import jamming_reference
 
     key = (tuple(grading.sizes.tolist()), tuple(grading.percent.tolist()))
     if key not in _DENSEST:
@@ -555,7 +557,7 @@ class SettledTest:
     """
 
     def __init__(self, sim: Simulation, drift_d50: float, checks: int) -> None:
-        from poro2d.specimen.porosity_regions import mass_d50
+        from poro2d.measure.disks import mass_d50
 
         self.tol = drift_d50 * mass_d50(sim.particles.radius)
         self.checks = checks
@@ -627,7 +629,7 @@ def prepare_specimen(
         "planned_count": int(len(radii)),
         "particle_count": p.n,
         "solid_area_m2": p.area(),
-        "box_porosity": 1.0 - p.area() / (W * H),
+        "box_porosity": box_porosity(p.area(), W, H),
         "measured_porosity": porosity_rect(p.pos, p.radius, 0.0, 0.0, W, H),
         "layers": layers,
         "final_stage": final,
@@ -763,19 +765,10 @@ def _grow(sim: Simulation, idx: np.ndarray, full: np.ndarray, scale: float, spec
     return steps
 
 
-def box_porosity(sim: Simulation, width: float, top: float, bottom: float = 0.0) -> float:
-    """Porosity of the box between the bottom wall and the top plate (disk area / box area)."""
-    h = top - bottom
-    if not h > 0:
-        raise InputError("box height", h, "(0, inf) m")
-    return 1.0 - sim.particles.area() / (width * h)
-
-
 __all__ = [
     "SettledTest",
     "SizeEstimate",
     "SpecimenSpec",
-    "box_porosity",
     "check_feasible",
     "is_wide",
     "preparation_note",

@@ -22,6 +22,7 @@ the names a protocol uses are relative, so a moved or copied folder resumes.
 
 from __future__ import annotations
 
+import csv
 import json
 import os
 import shutil
@@ -33,7 +34,9 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import numpy as np
 
 from poro2d.dem import checkpoint
+from poro2d.errors import InputError
 from poro2d.io_utils import atomic_path, write_csv, write_json
+from poro2d.store import digests
 from poro2d.store.stage import Fingerprint, ResumableStage
 
 if TYPE_CHECKING:
@@ -53,6 +56,9 @@ class Store:
     def __init__(self, root: str | os.PathLike, *, parameter: str = "--out") -> None:
         self._root = Path(root)
         self.parameter = parameter
+
+    def __fspath__(self) -> str:
+        return str(self._root)
 
     def __repr__(self) -> str:
         return f"Store({str(self._root)!r})"
@@ -90,7 +96,7 @@ class Store:
         """The store's entries matching ``pattern``, sorted (sub-stores included)."""
         if not self._root.is_dir():
             return []
-        return sorted(p.name for p in self._root.glob(pattern))
+        return sorted(p.name for p in self._root.glob(pattern) if p.name != digests.MANIFEST)
 
     # -- JSON and typed results -------------------------------------------------------
 
@@ -98,10 +104,12 @@ class Store:
         """``data`` as strict JSON in ``name``, atomically (see :func:`poro2d.io_utils.write_json`)."""
         path = self._root / name
         write_json(path, data, config=config)
-        return path
+        return self._written(name)
 
     def read_json(self, name: str) -> Any:
-        """The JSON in ``name``; None when it is missing or cannot be parsed."""
+        """The JSON in ``name``; None when it is missing, damaged or cannot be parsed."""
+        if not self.intact(name):
+            return None
         try:
             return json.loads((self._root / name).read_text())
         except (OSError, ValueError):
@@ -120,9 +128,23 @@ class Store:
 
     def write_csv(self, name: str, rows: Iterable[Mapping], header: list[str] | None = None) -> Path:
         """Rows of dicts as CSV, atomically (columns in first-seen order unless ``header``)."""
-        path = self._root / name
-        write_csv(path, rows, header)
-        return path
+        write_csv(self._root / name, rows, header)
+        return self._written(name)
+
+    def read_rows(self, name: str) -> list[dict[str, str]] | None:
+        """The rows of the CSV ``name`` as dicts of strings, as :meth:`write_csv` wrote them; None if missing.
+
+        The text is left to the caller to convert: ``float()`` of it gives back the very
+        numbers written (a table parser may round the last digit). A table changed since
+        it was written reads as missing.
+        """
+        if not self.intact(name):
+            return None
+        try:
+            with open(self._root / name, newline="") as fh:
+                return list(csv.DictReader(fh))
+        except (OSError, UnicodeDecodeError):
+            return None
 
     def write_frame(self, name: str, frame: pd.DataFrame, **kw: Any) -> Path:
         """A pandas table as CSV, atomically (``kw`` go to ``DataFrame.to_csv``; no index by default)."""
@@ -130,12 +152,13 @@ class Store:
         kw.setdefault("index", False)
         with atomic_path(path) as tmp:
             frame.to_csv(tmp, **kw)
-        return path
+        return self._written(name)
 
     def read_frame(self, name: str, **kw: Any) -> pd.DataFrame:
         """The CSV ``name`` as a pandas table (``kw`` go to ``pandas.read_csv``)."""
         import pandas as pd
 
+        self.check_intact(name)
         return pd.read_csv(self._root / name, **kw)
 
     def write_text(self, name: str, text: str) -> Path:
@@ -143,10 +166,12 @@ class Store:
         path = self._root / name
         with atomic_path(path) as tmp:
             tmp.write_text(text)
-        return path
+        return self._written(name)
 
     def read_text(self, name: str) -> str | None:
-        """The text in ``name``; None when it is missing or unreadable."""
+        """The text in ``name``; None when it is missing, damaged or unreadable."""
+        if not self.intact(name):
+            return None
         try:
             return (self._root / name).read_text()
         except (OSError, UnicodeDecodeError):
@@ -159,10 +184,12 @@ class Store:
         path = self._root / name
         with atomic_path(path, suffix=".npz") as tmp:
             np.savez(tmp, **arrays)
-        return path
+        return self._written(name)
 
     def read_arrays(self, name: str) -> dict[str, np.ndarray] | None:
         """The arrays of ``name`` (all read now, so the file is closed); None when missing or damaged."""
+        if not self.intact(name):
+            return None
         try:
             with np.load(self._root / name, allow_pickle=False) as z:
                 return {k: z[k] for k in z.files}
@@ -171,14 +198,26 @@ class Store:
 
     def save_state(self, name: str, sim: Simulation, extra: dict | None = None) -> Path:
         """A simulation's whole state (:func:`poro2d.dem.checkpoint.save`)."""
-        return checkpoint.save(sim, self._root / name, extra=extra)
+        checkpoint.save(sim, self._root / name, extra=extra)
+        return self._written(name)
 
     def load_state(self, name: str, threads: int | None = None) -> Simulation:
         """A saved state as a simulation (:func:`poro2d.dem.checkpoint.load`; a damaged file is refused)."""
+        self.check_intact(name)
         return checkpoint.load(self._root / name, threads=threads)
+
+    def read_state(self, name: str) -> tuple[dict, dict[str, np.ndarray]]:
+        """(metadata, arrays) of a saved state, read once in full (:func:`poro2d.dem.checkpoint.read`).
+
+        For a state that starts several runs: build each with
+        :func:`poro2d.dem.checkpoint.from_content` instead of reading the file again.
+        """
+        self.check_intact(name)
+        return checkpoint.read(self._root / name)
 
     def state_meta(self, name: str) -> dict:
         """The metadata of a saved state (:func:`poro2d.dem.checkpoint.read_meta`)."""
+        self.check_intact(name)
         return checkpoint.read_meta(self._root / name)
 
     def copy(self, name: str, to: str | Store, as_name: str | None = None) -> Path:
@@ -187,6 +226,7 @@ class Store:
         target = dest_store.root / dest
         with atomic_path(target) as tmp:
             shutil.copyfile(self._root / name, tmp)
+        digests.record(target.parent, target.name)
         return target
 
     def remove(self, name: str) -> None:
@@ -194,7 +234,26 @@ class Store:
         try:
             (self._root / name).unlink()
         except FileNotFoundError:
-            pass
+            return
+        digests.forget(self._root, name)
+
+    # -- integrity ------------------------------------------------------------------------
+
+    def _written(self, name: str) -> Path:
+        digests.record(self._root, name)
+        return self._root / name
+
+    def intact(self, name: str) -> bool:
+        """False when ``name`` differs from what this store wrote (edited, truncated, replaced)."""
+        return digests.intact(self._root, name)
+
+    def check_intact(self, name: str) -> None:
+        """Refuse, on one line naming it, a file that differs from what this store wrote."""
+        if not self.intact(name):
+            raise InputError(
+                str(self._root / name), "changed since it was written", "the file as poro2d wrote it",
+                "delete it (or its folder) to have it computed again",
+            )  # fmt: skip
 
     # -- stages ---------------------------------------------------------------------------
 
@@ -222,8 +281,14 @@ class Checkpoints:
         self.name = name
 
     def resume(self, threads: int | None = None) -> tuple[Simulation, dict] | None:
-        """The saved state and the ``extra`` it was saved with; None when there is none."""
+        """The saved state and the ``extra`` it was saved with; None when there is none.
+
+        A checkpoint that differs from what was saved is dropped: the stage starts again.
+        """
         if not self.store.has(self.name):
+            return None
+        if not self.store.intact(self.name):
+            self.store.remove(self.name)
             return None
         extra = self.store.state_meta(self.name).get("extra", {})
         return self.store.load_state(self.name, threads=threads), extra

@@ -36,6 +36,7 @@ from poro2d.errors import InputError
 from poro2d.identity import identity_digest, identity_view
 from poro2d.io_utils import as_json, write_json
 from poro2d.locks import is_lock_file
+from poro2d.store import digests
 
 #: ``explain(keys, stored)``: the InputError's hint for a refused folder; ``keys`` are the
 #: fingerprint's differing keys, None when the folder's work has no record at all
@@ -139,7 +140,9 @@ class ResumableStage:
             return False
         temporary = f".{self.record}."  # see poro2d.io_utils.atomic_path
         return any(
-            p.name != self.record and not p.name.startswith(temporary) and not is_lock_file(p.name)
+            p.name not in (self.record, digests.MANIFEST)
+            and not p.name.startswith(temporary)
+            and not is_lock_file(p.name)
             for p in self.folder.iterdir()
         )
 
@@ -189,8 +192,8 @@ class ResumableStage:
         when the stage has to run.
         """
         path = self.folder / marker
-        if not path.is_file():
-            return None
+        if not path.is_file() or not digests.intact(self.folder, marker):
+            return None  # a marker changed since it was written is not trusted: the stage runs again
         stored = self.recorded()
         if stored is None or self.fingerprint.differences(stored):
             return None
@@ -221,6 +224,7 @@ class ResumableStage:
             self.bind()
             data = as_json(compute())
             write_json(self.folder / marker, data)
+            digests.record(self.folder, marker)
         return data if decode is None else decode(data)
 
 

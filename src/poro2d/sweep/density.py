@@ -143,7 +143,7 @@ def first_trial(
     Under the paper's plate every case starts at ``CALIBRATION_FIRST_TRIAL``; under the fill
     acceptance at the porosity ``FILL_FIRST_TRIALS`` gives for ``mu``, rounded to the grid the
     criterion steps on (``criterion``: the calibration's criterion table). ``dense_end``: the
-    grading's own frictionless jamming porosity (:mod:`poro2d.specimen.jamming`); the table is
+    grading's own frictionless jamming porosity (:mod:`poro2d.oracles.jamming`); the table is
     then moved by its difference from the paper grading's (``PAPER_JAMMING_POROSITY``), and
     ``walls`` (the box's :func:`wall_share`) by its difference from the paper box's.
     ``loose_bias`` x ``mu`` is added on top: a frictional preparation prepared denser than it

@@ -9,17 +9,13 @@ import pytest
 from scipy.spatial import Voronoi
 
 from poro2d.errors import InputError
+from poro2d.measure import surface
+from poro2d.measure.disks import mass_d50
+from poro2d.measure.interior import interior_regions
+from poro2d.measure.laguerre import laguerre_cells
+from poro2d.measure.specimen_porosity import MEASURES, SpecimenPorosity, measure_specimen
+from poro2d.measure.surface import plate_surface, surface_profile
 from poro2d.report.specimen_figures import plot_local_porosity
-from poro2d.specimen import porosity_regions as pr
-from poro2d.specimen.porosity_regions import (
-    SpecimenPorosity,
-    interior_regions,
-    laguerre_cells,
-    mass_d50,
-    measure_specimen,
-    plate_surface,
-    surface_profile,
-)
 
 HEX_POROSITY = 1.0 - math.pi / (2.0 * math.sqrt(3.0))
 SQUARE_POROSITY = 1.0 - math.pi / 4.0
@@ -211,7 +207,7 @@ def test_surface_profile_matches_a_loop_and_does_not_depend_on_chunks(monkeypatc
         inside = np.abs(x - cx) <= ri
         expected[inside] = np.maximum(expected[inside], cy + np.sqrt(ri**2 - (x[inside] - cx) ** 2))
     assert np.allclose(h, expected, rtol=0, atol=1e-12)
-    monkeypatch.setattr(pr, "_PAIRS_PER_CHUNK", 37)
+    monkeypatch.setattr(surface, "_PAIRS_PER_CHUNK", 37)
     assert np.array_equal(surface_profile(pos, r, W, 500)[1], h)
 
 
@@ -265,6 +261,20 @@ def test_measure_specimen_box_porosity_and_dict_round_trip(tmp_path):
     assert type(numpy_typed.to_dict()["interior_regions"]) is int
     path = plot_local_porosity(pos, r, W, plate, m, tmp_path / "local.png", title="random")
     assert path.stat().st_size > 20_000
+
+
+def test_one_record_is_the_measures_and_the_criterions_file():
+    """measure_specimen's record holds the measures alone; the criterion's specimen_porosity.json
+    adds the trial porosity and provenance, or only a note for a specimen too small to measure."""
+    pos, r, W, H = random_packing(36, 24, seed=9)
+    m = measure_specimen(pos, r, W, H + 3.0)
+    assert list(m.to_dict()) == list(MEASURES) and m.details is not None and "details" not in m
+    m.trial_porosity, m.provenance = 0.2, {"poro2d_version": "x"}
+    assert list(m.to_dict()) == [*MEASURES, "trial_porosity", "provenance"]
+    small = {"trial_porosity": 0.2, "note": "specimen too small for the margin", "provenance": {}}
+    assert SpecimenPorosity(**small).to_dict() == small
+    back = SpecimenPorosity.from_dict(small)
+    assert back.to_dict() == small and back.box_porosity is None and "box_porosity" not in back
 
 
 def test_mass_d50_is_the_median_by_area():

@@ -8,14 +8,14 @@ import numpy as np
 import pytest
 
 from poro2d.errors import InputError
-from poro2d.specimen.grading import paper_grading
-from poro2d.specimen.jamming import (
+from poro2d.oracles.jamming import (
     E_ZERO,
     energy_and_forces,
     fire_minimise,
     jamming_fraction,
     jamming_reference,
 )
+from poro2d.specimen.grading import paper_grading
 
 
 def bidisperse(n: int) -> np.ndarray:

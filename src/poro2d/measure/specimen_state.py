@@ -20,8 +20,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from poro2d.dem.measure import average_stress, porosity_rect
 from poro2d.errors import check_int
+from poro2d.measure.porosity import porosity_rect
+from poro2d.measure.stress import average_stress
 
 
 def band_edges(top: float, bands: int) -> np.ndarray:

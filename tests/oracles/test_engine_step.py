@@ -1,4 +1,4 @@
-"""The compiled engine against the direct NumPy reference step (dem/reference.py).
+"""The compiled engine against the direct NumPy reference step (oracles/engine_step.py).
 
 Random packings (initial overlaps, random velocities and spins, gravity, local
 damping 0.7, friction low enough that contacts slide, a moving wall, a disk with
@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
-from poro2d.dem.reference import ReferenceDEM, engine_pair_order, engine_partitions
+from poro2d.oracles.engine_step import ReferenceDEM, engine_pair_order, engine_partitions
 
 R = 1e-3  # mean radius (m)
 

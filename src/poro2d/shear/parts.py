@@ -1,0 +1,260 @@
+"""The typed parts of the direct shear results: what the nested objects of their files hold.
+
+Each part is a :class:`~poro2d.typed_result.TypedResult` (so a read-only mapping that
+equals the dict of its file, and is written as that dict) with one field per key, in the
+file's order: a test's force balance, end values and consolidation; a series' summary of
+each test, its quasi-static check, its rate check and laboratory comparison; a
+Mohr-Coulomb fit as kept in a file, with or without its confidence intervals; a
+replicate study's peaks at one normal stress.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any, ClassVar, TypeVar
+
+from poro2d.typed_result import TypedResult
+
+P = TypeVar("P", bound=TypedResult)
+
+
+def _plain(value: Any) -> Any:
+    """A part as the dict of its file; a list of parts as a list of dicts; anything else as it is."""
+    if isinstance(value, TypedResult):
+        return value.to_dict()
+    if isinstance(value, list) and any(isinstance(v, TypedResult) for v in value):
+        return [_plain(v) for v in value]
+    return value
+
+
+@dataclass(eq=False)
+class Nested(TypedResult):
+    """A typed result made of typed parts: its ``to_dict()`` is the file's plain dict, parts included."""
+
+    def to_dict(self) -> dict[str, Any]:
+        return {k: _plain(v) for k, v in super().to_dict().items()}
+
+
+def part(cls: type[P], value: Any) -> Any:
+    """``value`` as the part ``cls`` when it is the dict of one (as read from a file), else as it is."""
+    if isinstance(value, Mapping) and not isinstance(value, cls):
+        return cls.from_dict(value)
+    return value
+
+
+def parts(cls: type[P], values: Any) -> Any:
+    """Each item of the list ``values`` as the part ``cls`` (see :func:`part`); None stays None."""
+    return None if values is None else [part(cls, v) for v in values]
+
+
+@dataclass(eq=False)
+class ForceBalance(Nested):
+    """How far the upper half, the shear plane and the lower half agree over a test (kPa, relative)."""
+
+    mean_abs_upper_minus_plane_rel: float
+    mean_abs_upper_minus_lower_rel: float
+    mean_upper_kpa: float
+    mean_plane_kpa: float
+    mean_lower_kpa: float
+    note: str
+
+
+@dataclass(eq=False)
+class EndValues(Nested):
+    """The end of a test's curve, smoothed over one peak window."""
+
+    shear_stress_kpa: float
+    normal_stress_kpa: float
+    plate_displacement_mm: float
+    coordination_number: float
+
+
+@dataclass(eq=False)
+class ConsolidationRecord(Nested):
+    """A test's consolidation (``consolidation.json``; in ``result.json`` without ``engine``).
+
+    ``box``: the split box's geometry (:meth:`poro2d.shear.box.SplitBox.to_dict`); ``engine``:
+    the simulation's summary after consolidating.
+    """
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("engine",)
+
+    normal_stress_kpa: float
+    target_force_n: float
+    steps: int
+    max_unbalanced_ratio: float
+    normal_stress_measured_kpa: float
+    normal_stress_error: float
+    plate_height_before_m: float
+    plate_height_m: float
+    plate_settlement_m: float
+    coordination_number: float
+    wall_time_s: float
+    box: dict[str, float]
+    engine: dict[str, Any] | None = None
+
+
+@dataclass(eq=False)
+class FitRecord(Nested):
+    """A Mohr-Coulomb line as a file keeps it (:meth:`poro2d.shear.fit.MohrCoulombFit.to_dict`)."""
+
+    friction_angle_deg: float
+    cohesion_kpa: float
+    r2: float
+    n_points: int
+    through_origin: bool
+    tan_phi: float
+
+
+@dataclass(eq=False)
+class FitInterval(FitRecord):
+    """A Mohr-Coulomb line with ``level`` Student-t intervals of phi and c (None without dof)."""
+
+    level: float | None = None
+    dof: int | None = None
+    friction_angle_ci_deg: list[float] | None = None
+    cohesion_ci_kpa: list[float] | None = None
+
+
+@dataclass(eq=False)
+class TestSummary(Nested):
+    """One test's line of a series' ``result.json`` (and ``peaks.csv``, without its nested parts)."""
+
+    __test__ = False  # not a test class, whatever its name
+
+    normal_stress_kpa: float
+    peak_shear_stress_kpa: float
+    shear_displacement_at_peak_m: float
+    peak_stress_ratio: float
+    peak_shear_stress_raw_kpa: float
+    normal_stress_at_peak_kpa: float
+    plate_displacement_at_peak_mm: float
+    end: EndValues
+    end_shear_displacement_m: float
+    ended_by: str | None
+    max_inertial_number: float | None
+    inertial_number_ok: bool
+    normal_stress_max_error_after_consolidation: float
+    force_balance: ForceBalance
+    wall_time_s: float
+    consolidation_normal_stress_error: float
+    folder: str
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> TestSummary:
+        obj = super().from_dict(data)
+        obj.end = part(EndValues, obj.end)
+        obj.force_balance = part(ForceBalance, obj.force_balance)
+        return obj
+
+
+@dataclass(eq=False)
+class QuasiStatic(Nested):
+    """A series' check of the inertial number over all its tests."""
+
+    max_inertial_number: float | None
+    inertial_limit: float
+    inertial_number_ok: bool
+    inertial_number_definition: str
+
+
+@dataclass(eq=False)
+class RateCheckRow(Nested):
+    """One test against its rerun at half the velocity."""
+
+    normal_stress_kpa: float
+    peak_kpa: float
+    peak_half_velocity_kpa: float
+    relative_change: float
+    shear_displacement_at_peak_m: float
+    shear_displacement_at_peak_half_velocity_m: float
+    max_inertial_number_half_velocity: float | None
+    mean_abs_change_before_peak: float | None
+    wall_time_s: float
+
+
+@dataclass(eq=False)
+class RateCheck(Nested):
+    """How the peaks change at half the velocity (a series run with ``rate_check``)."""
+
+    velocity_m_per_s: float
+    half_velocity_m_per_s: float
+    tests: list[RateCheckRow]
+    max_abs_relative_change: float
+    tolerance: float
+    passed: bool
+    friction_angle_half_velocity_deg: float | None
+    friction_angle_change_deg: float | None
+    max_mean_abs_change_before_peak: float | None
+    note: str
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> RateCheck:
+        obj = super().from_dict(data)
+        obj.tests = parts(RateCheckRow, obj.tests)
+        return obj
+
+
+@dataclass(eq=False)
+class LabComparison(Nested):
+    """The laboratory data a series is compared with, their fits and the difference of the angles."""
+
+    source: str
+    kind: str
+    peaks: list[dict[str, float]]
+    fit: FitRecord | None
+    friction_angle_deg: float | None
+    cohesion_kpa: float | None
+    friction_angle_difference_deg: float | None
+    fit_through_origin: FitRecord
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> LabComparison:
+        obj = super().from_dict(data)
+        obj.fit = part(FitRecord, obj.fit)
+        obj.fit_through_origin = part(FitRecord, obj.fit_through_origin)
+        return obj
+
+
+@dataclass(eq=False)
+class StressPeaks(Nested):
+    """The peaks of every specimen at one normal stress: mean, sd (0 with one), count and values."""
+
+    normal_stress_kpa: float
+    peak_mean_kpa: float
+    peak_sd_kpa: float
+    n: int
+    peaks_kpa: list[float]
+
+
+@dataclass(eq=False)
+class StrengthCase(Nested):
+    """One (mu_r, f_p) case of a strength study (a row of ``strength.csv``, with the pooled intervals).
+
+    Peak and residual friction angles and the dilation angle, mean and sd over the specimens
+    (None when no specimen gave one; the sd None with one specimen); the pooled fits over
+    every specimen's points with their intervals; the mean residual stress ratio.
+    """
+
+    mu_r: float
+    particle_friction: float
+    specimens: int
+    peak_friction_angle_mean_deg: float | None
+    peak_friction_angle_sd_deg: float | None
+    residual_friction_angle_mean_deg: float | None
+    residual_friction_angle_sd_deg: float | None
+    max_dilation_angle_mean_deg: float | None
+    max_dilation_angle_sd_deg: float | None
+    peak_friction_angle_pooled_deg: float | None
+    peak_friction_angle_pooled_ci_deg: list[float] | None
+    cohesion_pooled_kpa: float | None
+    residual_friction_angle_pooled_deg: float
+    residual_friction_angle_pooled_ci_deg: list[float] | None
+    residual_stress_ratio_mean: float
+
+
+__all__ = [
+    "ConsolidationRecord", "EndValues", "FitInterval", "FitRecord", "ForceBalance", "LabComparison", "Nested",
+    "QuasiStatic", "RateCheck", "RateCheckRow", "StrengthCase", "StressPeaks", "TestSummary", "part", "parts",
+]  # fmt: skip

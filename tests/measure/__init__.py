@@ -1,0 +1,1 @@
+"""Tests of ``poro2d.measure``: porosities, the specimen's porosity and state, stress, coordination."""

@@ -1,0 +1,1 @@
+"""Tests of ``poro2d.oracles``: the engine's NumPy reference step and the jamming reference."""

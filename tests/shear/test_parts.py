@@ -1,0 +1,84 @@
+"""The typed parts of the direct shear results read from files of earlier versions, written back the same."""
+
+import json
+import pickle
+from pathlib import Path
+
+import numpy as np
+
+from poro2d.shear.curve import CURVE_COLUMNS, ShearCurve, curve_columns, curve_rows
+from poro2d.shear.fit import mohr_coulomb, peak
+from poro2d.shear.parts import (
+    ConsolidationRecord,
+    EndValues,
+    FitInterval,
+    FitRecord,
+    ForceBalance,
+    LabComparison,
+    QuasiStatic,
+    RateCheck,
+    RateCheckRow,
+    StressPeaks,
+    TestSummary,
+)
+from poro2d.shear.replicates import mohr_coulomb_ci
+from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult, ShearTestResult
+
+DATA = Path(__file__).parents[1] / "data" / "before_typed_results"
+
+
+def _stored(name: str) -> dict:
+    return json.loads((DATA / name).read_text())
+
+
+def test_a_test_result_reads_into_its_parts():
+    stored = _stored("shear_test_result.json")
+    r = ShearTestResult.from_dict(stored)
+    assert isinstance(r.end, EndValues) and isinstance(r.force_balance, ForceBalance)
+    assert isinstance(r.consolidation, ConsolidationRecord) and "engine" not in r.consolidation.to_dict()
+    assert r.end.shear_stress_kpa == stored["end"]["shear_stress_kpa"]
+    assert r.to_dict() == stored and json.loads(json.dumps(r.to_dict())) == stored
+    assert list(r.to_dict()["consolidation"]) == list(stored["consolidation"])  # the file's order
+
+
+def test_a_series_result_reads_into_its_parts():
+    stored = _stored("shear_series_result.json")
+    s = ShearSeriesResult.from_dict(stored)
+    assert all(isinstance(t, TestSummary) and isinstance(t.end, EndValues) for t in s.tests)
+    assert isinstance(s.fit, FitRecord) and isinstance(s.fit_through_origin, FitRecord)
+    assert isinstance(s.quasi_static, QuasiStatic) and isinstance(s.lab, LabComparison)
+    assert isinstance(s.rate_check, RateCheck) and all(
+        isinstance(t, RateCheckRow) for t in s.rate_check.tests
+    )
+    assert s.tests[0]["end"] == stored["tests"][0]["end"]  # parts still read as the dicts they were
+    assert json.loads(json.dumps(s.to_dict())) == stored
+    assert pickle.loads(pickle.dumps(s)) == stored
+
+
+def test_a_replicate_result_reads_into_its_parts():
+    stored = _stored("shear_replicates.json")
+    r = ReplicateShearResult.from_dict(stored)
+    assert all(isinstance(p, StressPeaks) for p in r.per_normal_stress)
+    assert isinstance(r.fit, FitInterval) and isinstance(r.fit_through_origin, FitInterval)
+    assert r.fit_through_origin.cohesion_ci_kpa is None
+    assert json.loads(json.dumps(r.to_dict())) == stored
+
+
+def test_fits_are_kept_as_their_dicts_were():
+    s, t = [50.0, 100.0, 200.0], [40.0, 76.0, 139.0]
+    fit = mohr_coulomb(s, t)
+    assert fit.record().to_dict() == fit.to_dict()
+    ci = mohr_coulomb_ci(s, t)
+    assert list(ci.to_dict()) == [*fit.to_dict(), "level", "dof", "friction_angle_ci_deg", "cohesion_ci_kpa"]
+    lo, hi = ci.friction_angle_ci_deg
+    assert lo < ci.friction_angle_deg < hi and ci.dof == 1
+
+
+def test_a_curve_is_its_columns():
+    rows = [{k: float(i + j) for j, k in enumerate(CURVE_COLUMNS)} for i in range(4)]
+    curve = curve_columns(rows)
+    assert isinstance(curve, ShearCurve) and list(curve) == CURVE_COLUMNS and len(curve) == len(CURVE_COLUMNS)
+    np.testing.assert_array_equal(curve.shear_stress_kpa, curve["shear_stress_kpa"])
+    assert curve_rows(curve) == rows and curve_columns([]) is None
+    k, x, value = peak(curve.shear_displacement_mm, curve.shear_stress_kpa, 0.0)
+    assert peak(curve.shear_displacement_mm, curve.shear_stress_kpa, 0.0).index == k == 3 and value == x + 1
