@@ -28,6 +28,7 @@ def main() -> None:
     from poro2d.criterion.config import build, paper_preset
     from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
     from poro2d.specimen.grading import paper_grading
+    from poro2d.store import Store
 
     # warm-up: compile or load every kernel outside the timed run
     prepare_specimen(SpecimenSpec(width=0.03, height=0.02, layers=1), paper_grading(), 0.2, seed=1)
@@ -40,7 +41,7 @@ def main() -> None:
         raise SystemExit(f"{out} is not empty: the benchmark needs a fresh folder")
     load0 = os.getloadavg()
     t0 = time.perf_counter()
-    result = PorosityCriterion(spec, grading, settings, seed=seed, out=out).run()
+    result = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(out)).run()
     total = time.perf_counter() - t0
     load1 = os.getloadavg()
     print(f"{'trial':>6} {'n2D':>6} {'disks':>6} {'prepare s':>10} {'plate s':>8} {'n_prime':>8} accepted")

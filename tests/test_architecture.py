@@ -208,10 +208,7 @@ FILE_HOMES = (
 
 #: modules that still read or write result files themselves, on their way to the store;
 #: this list only shrinks
-NOT_YET_THROUGH_STORE = {
-    "criterion/protocol.py",
-    "criterion/result.py",
-}
+NOT_YET_THROUGH_STORE = {}
 
 #: calls that read or write files: (owner or "" for a bare name, function)
 _FILE_CALLS = {

@@ -125,6 +125,7 @@ def test_a_criterion_folder_written_before_is_read_back_and_still_binds(tmp_path
     from poro2d.errors import InputError
     from poro2d.specimen import paper_grading
     from poro2d.specimen.compaction import SpecimenSpec
+    from poro2d.store import Store
 
     out = _folder(tmp_path, {"config.json": "criterion_config.json", "result.json": "criterion_result.json"})
     run = json.loads((out / "config.json").read_text())["run"]
@@ -132,7 +133,7 @@ def test_a_criterion_folder_written_before_is_read_back_and_still_binds(tmp_path
     def crit(threads=1, **changes):
         spec = SpecimenSpec.from_record(dict(run["specimen"], threads=threads))
         settings = CriterionSettings(**dict(run["criterion"], **changes))
-        return PorosityCriterion(spec, paper_grading(), settings, seed=run["seed"], out=out)
+        return PorosityCriterion(spec, paper_grading(), settings, seed=run["seed"], store=Store(out))
 
     stored = json.loads((DATA / "criterion_result.json").read_text())
     assert crit().run() == stored  # read back, nothing computed
@@ -182,7 +183,9 @@ def test_a_density_relation_without_a_spread_still_writes_the_key():
     assert RelationResult.from_dict(stored).to_dict() == stored
 
 
-def test_fields_not_in_the_file_stay_out_of_it():
+def test_fields_not_in_the_file_stay_out_of_it(tmp_path):
+    from poro2d.store import Store
+
     stored = _stored("shear_replicates.json")
     rep = ReplicateShearResult.from_dict(stored)
     assert rep.series == {}
@@ -192,9 +195,10 @@ def test_fields_not_in_the_file_stay_out_of_it():
     row = {"seed": 1, "final_porosity": 0.2, "converged": True, "trials": 2, "message": "", "folder": "seed1",
            "time_s": 1.0}  # fmt: skip
     rows = [row, dict(row, seed=2, final_porosity=None, converged=False, folder="seed2")]
-    reps = ReplicatesResult(rows, out=Path("reps"))
-    assert reps.to_dict() == {"rows": rows}
-    assert reps.specimens == {"seed1": Path("reps") / "seed1" / "specimen.npz"}
+    reps = ReplicatesResult.from_dict({"rows": rows})
+    reps.store = Store(tmp_path / "reps")
+    assert reps.to_dict() == {"rows": rows} and reps.rows[1].converged is False
+    assert reps.specimens == {"seed1": tmp_path / "reps" / "seed1" / "specimen.npz"}
 
 
 def _public_runs():

@@ -208,7 +208,7 @@ def run_paper(
         lab_data = read_lab_csv(lab)  # bad lab files fail here, before any simulation
     nthreads = threads if threads is not None else min(os.cpu_count() or 1, 2)
     spec, grading, settings, sd = build(cfg, None, threads=nthreads)
-    crit = PorosityCriterion(spec, grading, settings, seed=sd, out=out / "criterion",
+    crit = PorosityCriterion(spec, grading, settings, seed=sd, store=store.child("criterion"),
                              progress=progress, config=cfg)  # fmt: skip
     crit.validate()  # every option is checked before the first file is written
     stage = paper_stage(store, quick, seed)
@@ -238,7 +238,6 @@ def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, *,
     from poro2d.criterion.result import CriterionOutputs
     from poro2d.criterion.table import print_result
 
-    out = store.root
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
     conv = _conversions_stage(store, stage)
@@ -248,14 +247,14 @@ def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, *,
     t1 = time.perf_counter()
     result = crit.run()
     timings["criterion_s"] = time.perf_counter() - t1
-    print_result(result, out / "criterion")
+    print_result(result, store.child("criterion"))
     shear = reps = None
     shear_figures: dict[str, Path] = {}
     if result.converged:
         t2 = time.perf_counter()
         n2d = result.final_porosity
         specimens, reps = accepted_and_replicates(crit.spec, crit.grading, crit.settings, n2d, crit.seed,
-                                                  replicates, out, progress=progress)  # fmt: skip
+                                                  replicates, store, progress=progress)  # fmt: skip
         timings["replicates_s"] = time.perf_counter() - t2
         shear, shear_figures = _shear_stage(specimens, store.child("shear"), quick, lab_data, progress)
         timings["shear_s"] = time.perf_counter() - t2 - timings["replicates_s"]
@@ -273,7 +272,7 @@ def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, *,
         provenance=provenance(),
         lab=lab_data.to_dict() if lab_data is not None else None,
     )
-    return summary, CriterionOutputs.read(out / "criterion", result), shear_figures
+    return summary, CriterionOutputs.read(store.child("criterion"), result), shear_figures
 
 
 def _conversions_stage(store: Store, stage: ResumableStage) -> ConversionsRecord:

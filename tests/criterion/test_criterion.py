@@ -11,6 +11,7 @@ from poro2d.criterion.protocol import round_to
 from poro2d.errors import InputError
 from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec
+from poro2d.store import Store
 
 SMALL = SpecimenSpec(width=0.06, height=0.03, layers=2)
 REQUIRED = {
@@ -21,7 +22,7 @@ REQUIRED = {
 
 def _run(out, trial, **kw):
     settings = CriterionSettings(trial_porosity=trial, **kw)
-    return PorosityCriterion(SMALL, paper_grading(), settings, seed=0, out=out).run()
+    return PorosityCriterion(SMALL, paper_grading(), settings, seed=0, store=Store(out)).run()
 
 
 @pytest.fixture(scope="module")
@@ -136,7 +137,7 @@ def test_rerun_with_other_threads_resumes(down):
     stamp = (trial_dir / "trial.json").stat().st_mtime_ns
     spec = replace(SMALL, threads=2)
     settings = CriterionSettings(trial_porosity=0.30, max_iterations=1)
-    again = PorosityCriterion(spec, paper_grading(), settings, seed=0, out=out).run()
+    again = PorosityCriterion(spec, paper_grading(), settings, seed=0, store=Store(out)).run()
     assert again["iterations"] == r["iterations"]
     assert (trial_dir / "trial.json").stat().st_mtime_ns == stamp
 
@@ -194,7 +195,7 @@ def test_corrected_rerun_after_a_refused_one(tmp_path, capsys):
 def test_config_of_a_run_that_never_started_does_not_bind(tmp_path):
     # a run stopped before its first trial leaves only config.json: another config may use the folder
     PorosityCriterion(
-        SMALL, paper_grading(), CriterionSettings(trial_porosity=0.25), out=tmp_path
+        SMALL, paper_grading(), CriterionSettings(trial_porosity=0.25), store=Store(tmp_path)
     ).stage().bind()
     r = _run(tmp_path, 0.30, max_iterations=1)
     assert r["iterations"][0]["trial_porosity"] == 0.30
@@ -256,7 +257,7 @@ def test_half_built_frictionless_specimen_is_refused(tmp_path):
     # disks (here 2 layers of 3), and that specimen went on to be accepted (before: 0.23, 75 disks)
     settings = CriterionSettings(trial_porosity=0.20, force_fraction=0.05)
     r = PorosityCriterion(
-        _frictionless(), paper_grading(), settings, seed=0, out=tmp_path, figures=False
+        _frictionless(), paper_grading(), settings, seed=0, store=Store(tmp_path), figures=False
     ).run()
     assert not r["converged"] and r["final_porosity"] is None and r["failed_trial"] == 1
     (it,) = r["iterations"]
@@ -272,7 +273,9 @@ def test_half_built_frictionless_specimen_is_refused(tmp_path):
     assert (trial / "prepared.npz").is_file() and (trial / "trial.json").is_file()
     assert not (tmp_path / "specimen.npz").exists()
     # the refusal is read back on resume, not recomputed into an acceptance
-    again = PorosityCriterion(_frictionless(), paper_grading(), settings, seed=0, out=tmp_path, figures=False)
+    again = PorosityCriterion(
+        _frictionless(), paper_grading(), settings, seed=0, store=Store(tmp_path), figures=False
+    )
     assert again.run()["iterations"] == r["iterations"]
 
 

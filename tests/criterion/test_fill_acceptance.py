@@ -71,7 +71,7 @@ def test_the_lid_replaces_the_plate_and_its_force_is_the_top_force(prepared, tmp
         install_lid(sim, spec.width, 0.003)
     sim.run(2000)
     t = sim.particles.thickness
-    assert wall_forces(sim)["f_top_n_per_m"] == pytest.approx(
+    assert wall_forces(sim).f_top_n_per_m == pytest.approx(
         float(sim.wall_force("top")[1]) / t + lid_force(sim) / t
     )
     assert lid_indices(sim) == idx

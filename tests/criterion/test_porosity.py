@@ -17,7 +17,7 @@ def quick():
 
 def test_a_trial_carries_both_porosities(quick):
     spec, sim = quick
-    row = porosity_numbers(sim, spec.width, spec.height)
+    row = porosity_numbers(sim, spec.width, spec.height).to_dict()
     assert set(row) == set(POROSITY_KEYS)
     assert row["box_porosity"] == pytest.approx(0.2, abs=1e-12)  # the trial's own disks, plate at H
     # the interior leaves out the loose wall layers and the gap under the plate
@@ -29,7 +29,7 @@ def test_a_trial_carries_both_porosities(quick):
 def test_a_specimen_too_small_to_measure_says_why_instead_of_failing():
     spec = SpecimenSpec(width=0.04, height=0.02, layers=1)
     sim, rep = prepare_specimen(spec, paper_grading(), 0.2, seed=1)
-    row = porosity_numbers(sim, spec.width, spec.height)
+    row = porosity_numbers(sim, spec.width, spec.height).to_dict()
     assert row["interior_porosity"] is None
     assert "margin_d50" in row["interior_porosity_note"]
     assert row["box_porosity"] == pytest.approx(0.2, abs=1e-12)

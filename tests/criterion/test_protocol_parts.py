@@ -49,9 +49,9 @@ def test_the_plate_servo_brings_a_raised_plate_into_the_window(specimen):
         box_porosity(sim.particles.area(), width, height)
     )
     plate = PlateServo(settings, 1e-3, "max", height).settle(sim, weight)
-    assert plate["plate_settled"] and plate["plate_displacement_m"] < 0.0
-    assert plate["plate_height_m"] == float(sim.walls.p0[sim.walls.index("top"), 1])
-    assert in_window(wall_forces(sim)["f_top_n_per_m"], weight, settings.force_fraction)
+    assert plate.settled and plate.displacement_m < 0.0
+    assert plate.height_m == float(sim.walls.p0[sim.walls.index("top"), 1])
+    assert in_window(wall_forces(sim).f_top_n_per_m, weight, settings.force_fraction)
 
 
 def test_the_shear_test_is_its_controllers(specimen):

@@ -2,7 +2,8 @@
 
 import pytest
 
-from poro2d.criterion.protocol import CriterionSettings, next_trial
+from poro2d.criterion.protocol import CriterionSettings, closed_bracket, next_trial
+from poro2d.criterion.trial import Trial
 from poro2d.errors import InputError
 
 
@@ -61,36 +62,27 @@ def test_refine_tolerance_is_checked_and_recorded_only_when_set():
 
 
 def _row(n, new, *, failed=""):
-    return {
+    return Trial.from_dict({
         "trial_porosity": n, "new_porosity": new, "porosity_change": abs(new - n), "converged": True,
         "plate_settled": True, "failed_check": failed, "accepted": False, "condition_met": False,
-    }  # fmt: skip
+    })  # fmt: skip
 
 
 def test_a_closed_bracket_accepts_the_closest_trial_within_the_papers_tolerance():
-    from poro2d.criterion.protocol import PorosityCriterion
-    from poro2d.specimen.compaction import SpecimenSpec
-    from poro2d.specimen.grading import paper_grading
-
     s = CriterionSettings(refine_tolerance=0.002, max_iterations=10)
-    crit = PorosityCriterion(SpecimenSpec(), paper_grading(), s)
     # the relation's seed that cycled: n' scatters by about 0.003 from specimen to specimen
     rows = [_row(0.19, 0.1753), _row(0.175, 0.1719), _row(0.172, 0.1753), _row(0.1735, 0.1702),
             _row(0.1725, 0.1683)]  # fmt: skip
     assert next_trial(rows, s) in {r["trial_porosity"] for r in rows}
-    best = crit._closed_bracket(rows)
+    best = closed_bracket(rows, s)
     assert best is rows[1] and best["accepted"] and best["accepted_at"] == "closed bracket"
     assert "0.0031" in best["reason"]
+    assert list(best)[-1] == "accepted_at"  # the key a closed bracket adds comes last in the row
 
 
 def test_a_closed_bracket_accepts_nothing_outside_the_papers_tolerance_or_a_failed_check():
-    from poro2d.criterion.protocol import PorosityCriterion
-    from poro2d.specimen.compaction import SpecimenSpec
-    from poro2d.specimen.grading import paper_grading
-
     refine = CriterionSettings(refine_tolerance=0.002)
-    crit = PorosityCriterion(SpecimenSpec(), paper_grading(), refine)
-    assert crit._closed_bracket([_row(0.17, 0.176), _row(0.172, 0.166)]) is None
-    assert crit._closed_bracket([_row(0.17, 0.173, failed="force_balance")]) is None
-    paper = PorosityCriterion(SpecimenSpec(), paper_grading(), CriterionSettings())
-    assert paper._closed_bracket([_row(0.17, 0.173)]) is None  # the paper's rule never does this
+    assert closed_bracket([_row(0.17, 0.176), _row(0.172, 0.166)], refine) is None
+    assert closed_bracket([_row(0.17, 0.173, failed="force_balance")], refine) is None
+    # the paper's rule never does this
+    assert closed_bracket([_row(0.17, 0.173)], CriterionSettings()) is None

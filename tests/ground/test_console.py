@@ -66,6 +66,7 @@ def test_narrow_terminal_folds_numbers_instead_of_cutting_them():
 def test_criterion_table_numbers_in_full(capsys):
     from poro2d.criterion.result import CriterionResult
     from poro2d.criterion.table import print_result
+    from poro2d.store import Store
 
     it = {
         "trial_porosity": 0.21, "particle_count": 2591, "f_top_n_per_m": 3854.123456,
@@ -76,7 +77,7 @@ def test_criterion_table_numbers_in_full(capsys):
     result = CriterionResult.from_dict(
         {"n_lab": 0.3434, "iterations": [it], "message": "accepted n2D = 0.15"}
     )
-    print_result(result, "out")
+    print_result(result, Store("out"))
     out = capsys.readouterr().out
     assert ELLIPSIS not in out
     row = next(line for line in out.splitlines() if "2591" in line)

@@ -96,7 +96,9 @@ def test_a_marked_field_is_recorded_but_not_compared():
 
 def criterion_digest(tmp_path, spec=SpecimenSpec(), settings=CriterionSettings()) -> str:
     """The digest of the record that binds a criterion folder (config.json)."""
-    crit = PorosityCriterion(spec, paper_grading(), settings, seed=0, out=tmp_path)
+    from poro2d.store import Store
+
+    crit = PorosityCriterion(spec, paper_grading(), settings, seed=0, store=Store(tmp_path))
     return crit.stage().fingerprint.digest
 
 

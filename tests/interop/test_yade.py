@@ -15,6 +15,7 @@ from poro2d.criterion.protocol import PorosityCriterion
 from poro2d.interop.agreement import run_poro2d
 from poro2d.interop.specimen_data import from_checkpoint
 from poro2d.interop.yade_run import run_yade
+from poro2d.store import Store
 
 pytestmark = pytest.mark.scenario
 
@@ -36,7 +37,7 @@ def paper_specimen(tmp_path_factory):
     cfg["criterion"]["trial_porosity"] = ACCEPTED_N2D
     spec, grading, settings, seed = build(cfg)
     out = tmp_path_factory.mktemp("paper_criterion")
-    result = PorosityCriterion(spec, grading, settings, seed=seed, out=out, figures=False).run()
+    result = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(out), figures=False).run()
     assert result.converged
     return from_checkpoint(out)
 

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from poro2d.criterion.protocol import CriterionSettings, specimen_checks, wall_forces
+from poro2d.criterion.trial import Preparation
 from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.specimen import GradingCurve, paper_grading
@@ -34,9 +35,9 @@ def test_vertical_force_balance_with_side_friction(loose):
     f = wall_forces(sim)
     weight = float(np.sum(sim.particles.mass)) * spec.gravity / spec.thickness
     assert weight == pytest.approx(spec.self_weight(0.22), rel=1e-12)
-    lhs = f["f_bottom_n_per_m"] + f["side_friction_up_n_per_m"]
-    assert lhs == pytest.approx(weight + f["f_top_n_per_m"], rel=0.01)
-    assert abs(f["side_friction_up_n_per_m"]) > 0.0  # frictional side walls take vertical load
+    lhs = f.f_bottom_n_per_m + f.side_friction_up_n_per_m
+    assert lhs == pytest.approx(weight + f.f_top_n_per_m, rel=0.01)
+    assert abs(f.side_friction_up_n_per_m) > 0.0  # frictional side walls take vertical load
     assert sim.unbalanced_ratios()[0] < spec.ratio
 
 
@@ -44,30 +45,32 @@ def test_frictionless_side_walls_put_the_weight_on_the_bottom():
     spec = SpecimenSpec(**SMALL, friction_wall=0.0)
     sim, rep = prepare_specimen(spec, paper_grading(), 0.22, seed=4)
     f = wall_forces(sim)
-    assert abs(f["side_friction_up_n_per_m"]) < 1e-9
-    assert f["f_bottom_n_per_m"] == pytest.approx(spec.self_weight(0.22) + f["f_top_n_per_m"], rel=0.01)
+    assert abs(f.side_friction_up_n_per_m) < 1e-9
+    assert f.f_bottom_n_per_m == pytest.approx(spec.self_weight(0.22) + f.f_top_n_per_m, rel=0.01)
 
 
 def test_dense_trial_loads_the_top_plate():
     spec = SpecimenSpec(**SMALL)
     sim, rep = prepare_specimen(spec, paper_grading(), 0.14, seed=3)
     f = wall_forces(sim)
-    assert f["f_top_n_per_m"] > 10 * spec.self_weight(0.14)
+    assert f.f_top_n_per_m > 10 * spec.self_weight(0.14)
     # balance: bottom + side friction = weight + top, relative to the forces involved
-    lhs = f["f_bottom_n_per_m"] + f["side_friction_up_n_per_m"]
-    assert lhs == pytest.approx(spec.self_weight(0.14) + f["f_top_n_per_m"], rel=1e-3)
+    lhs = f.f_bottom_n_per_m + f.side_friction_up_n_per_m
+    assert lhs == pytest.approx(spec.self_weight(0.14) + f.f_top_n_per_m, rel=1e-3)
 
 
 def test_checks_hold_on_a_specimen_at_rest(loose):
     spec, sim, rep = loose
-    checks, nums = specimen_checks(sim, spec, rep, 0.22, spec.height, wall_forces(sim), CriterionSettings())
-    assert checks == dict.fromkeys(checks, True) and len(checks) == 5
+    checks, nums = specimen_checks(
+        sim, spec, Preparation(rep), 0.22, spec.height, wall_forces(sim), CriterionSettings()
+    )
+    assert checks.to_dict() == dict.fromkeys(checks.to_dict(), True) and len(checks.to_dict()) == 5
     # the weight the balance uses, against rho_s g pi r^2 summed over the radii (per metre of thickness)
     weight = spec.solid_density * spec.gravity * np.pi * float(np.sum(sim.particles.radius**2))
-    assert nums["weight_from_masses_n_per_m"] == pytest.approx(weight, rel=1e-12)
-    assert nums["force_balance_error"] < 0.01
-    assert nums["planned_particle_count"] == sim.particles.n and nums["disks_outside_box"] == 0
-    assert nums["generation_porosity_error"] < 1e-3
+    assert nums.weight_from_masses_n_per_m == pytest.approx(weight, rel=1e-12)
+    assert nums.force_balance_error < 0.01
+    assert nums.planned_particle_count == sim.particles.n and nums.disks_outside_box == 0
+    assert nums.generation_porosity_error < 1e-3
 
 
 def test_checks_catch_a_falling_or_broken_specimen(loose, tmp_path):
@@ -80,18 +83,18 @@ def test_checks_catch_a_falling_or_broken_specimen(loose, tmp_path):
     falling.run(10)
     lifted = spec.height + 0.01
     checks, nums = specimen_checks(
-        falling, spec, rep, 0.22, lifted, wall_forces(falling), CriterionSettings()
+        falling, spec, Preparation(rep), 0.22, lifted, wall_forces(falling), CriterionSettings()
     )
-    assert not checks["force_balance"] and nums["force_balance_error"] > 0.5
-    assert checks["disks_inside_box"] and checks["all_disks_present"]
+    assert not checks.force_balance and nums.force_balance_error > 0.5
+    assert checks.disks_inside_box and checks.all_disks_present
     # a disk missing from the plan, a specimen built for another porosity, a disk through the plate
-    broken = dict(rep, planned_count=rep["particle_count"] + 3)
+    broken = Preparation(dict(rep, planned_count=rep["particle_count"] + 3))
     checks, nums = specimen_checks(
         sim, spec, broken, 0.22 + 2e-3, 0.8 * spec.height, wall_forces(sim), CriterionSettings()
     )
-    assert nums["porosity_after_generation"] == pytest.approx(0.22, abs=1e-12)  # whole disks, as drawn
-    assert not checks["all_disks_present"] and not checks["porosity_after_generation"]
-    assert not checks["disks_inside_box"] and nums["disks_outside_box"] > 0
+    assert nums.porosity_after_generation == pytest.approx(0.22, abs=1e-12)  # whole disks, as drawn
+    assert not checks.all_disks_present and not checks.porosity_after_generation
+    assert not checks.disks_inside_box and nums.disks_outside_box > 0
 
 
 def test_a_layer_short_of_steps_gets_the_fallback():

@@ -110,5 +110,5 @@ def test_a_frictionless_wide_grading_settles_then_comes_to_equilibrium():
     assert sim.unbalanced_ratios()[0] < spec.ratio
     f = wall_forces(sim)
     weight = float(np.sum(sim.particles.mass)) * spec.gravity / spec.thickness
-    lhs = f["f_bottom_n_per_m"] + f["side_friction_up_n_per_m"]
-    assert math.isclose(lhs, weight + f["f_top_n_per_m"], rel_tol=0.01)
+    lhs = f.f_bottom_n_per_m + f.side_friction_up_n_per_m
+    assert math.isclose(lhs, weight + f.f_top_n_per_m, rel_tol=0.01)

@@ -162,6 +162,7 @@ def test_an_overfull_first_trial_ends_in_a_looser_accepted_trial(tmp_path):
     H, the plate moves up, the next trial is looser and is accepted (measured: 0.07 -> n' 0.197,
     0.20 -> 0.194, 0.19 accepted; 40 s). The old preparation had no over-full box."""
     from poro2d.criterion.protocol import PorosityCriterion
+    from poro2d.store import Store
 
     cfg = {
         "grading": {"preset": "wide_cu4"},
@@ -169,7 +170,9 @@ def test_an_overfull_first_trial_ends_in_a_looser_accepted_trial(tmp_path):
         "criterion": {"trial_porosity": 0.07, "force_fraction": 0.05, "max_iterations": 4},
     }
     spec, grading, settings, seed = build(cfg)
-    res = PorosityCriterion(spec, grading, settings, seed=seed, out=tmp_path / "c", figures=False).run()
+    res = PorosityCriterion(
+        spec, grading, settings, seed=seed, store=Store(tmp_path / "c"), figures=False
+    ).run()
     first = res.iterations[0]
     assert first["overfull_m"] > 0.0 and first["plate_moved"] == "up"
     assert "over-full box" in first["reason"] and not first["refused"]
@@ -186,6 +189,7 @@ def test_an_overfull_first_trial_under_the_lid_leads_to_a_looser_trial(tmp_path)
     window, the lid rests on it, n' is measured under the lid and the next trial is looser
     (measured: 0.07 -> n' 0.178, then 0.18; 10 s for the first trial)."""
     from poro2d.criterion.protocol import PorosityCriterion
+    from poro2d.store import Store
 
     cfg = {
         "grading": {"preset": "wide_cu4"},
@@ -198,7 +202,9 @@ def test_an_overfull_first_trial_under_the_lid_leads_to_a_looser_trial(tmp_path)
         },  # fmt: skip
     }
     spec, grading, settings, seed = build(cfg)
-    res = PorosityCriterion(spec, grading, settings, seed=seed, out=tmp_path / "c", figures=False).run()
+    res = PorosityCriterion(
+        spec, grading, settings, seed=seed, store=Store(tmp_path / "c"), figures=False
+    ).run()
     first = res.iterations[0]
     assert first["overfull_m"] > 0.0 and first["plate_moved"] == "lid"
     assert not first["refused"] and first["checks"]["disks_inside_box"] and first["disks_outside_box"] == 0

@@ -29,7 +29,7 @@ SMALL = {
 def test_run_criterion_refuses_bad_input_before_writing(tmp_path, run, kw, name):
     out = tmp_path / "o"
     kw = {"config": SMALL, **kw}
-    where = {"out": out} if run is run_criterion else {"store": Store(out)}
+    where = {"store": Store(out)}
     with pytest.raises(InputError) as e:
         run(kw.pop("config"), progress=False, **where, **kw)
     assert e.value.parameter == name
@@ -42,7 +42,7 @@ def test_run_criterion_matches_the_command(tmp_path):
 
     from poro2d.cli import main
 
-    res = run_criterion(SMALL, out=tmp_path / "api", progress=False)
+    res = run_criterion(SMALL, store=Store(tmp_path / "api"), progress=False)
     assert isinstance(res, CriterionResult)
     cfg = tmp_path / "c.toml"
     cfg.write_text(

@@ -117,7 +117,7 @@ def preset_specimens(
     spec, grading, settings, sd = build(cfg, None, threads=min(os.cpu_count() or 1, 2))
     out = store.root
     crit = PorosityCriterion(
-        spec, grading, settings, seed=sd, out=out / "criterion", progress=progress, config=cfg
+        spec, grading, settings, seed=sd, store=store.child("criterion"), progress=progress, config=cfg
     )
     crit.validate()
     result = crit.run()
@@ -132,7 +132,7 @@ def preset_specimens(
             settings,
             result.final_porosity,
             extra,
-            out / "replicates",
+            store.child("replicates"),
             processes=spec.threads,
             progress=progress,
         )

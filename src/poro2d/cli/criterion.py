@@ -13,6 +13,7 @@ import typer
 
 from poro2d.console import OutputConsole, Table
 from poro2d.criterion.table import print_result
+from poro2d.store import Store
 from poro2d.sweep.results import DensityStateResult
 
 console = OutputConsole()
@@ -54,7 +55,6 @@ def register(app: typer.Typer) -> None:
         grading (preparation friction -> accepted n2D, cached), sets the preparation friction
         from the laboratory relative density and runs the criterion over seeds.
         """
-        from poro2d.store import Store
         from poro2d.sweep.density_criterion import run_criterion_modes
 
         result = run_criterion_modes(
@@ -64,7 +64,7 @@ def register(app: typer.Typer) -> None:
         if isinstance(result, DensityStateResult):
             print_density(result, out)
             return
-        print_result(result, out)
+        print_result(result, Store(out))
         console.print(PAPER_MODE_NOTE, soft_wrap=True)
         if not result.converged:
             # one line, whole: the reason names the trial, the stage or check, the ratio

@@ -38,17 +38,24 @@ def quick_specimens(out: Path, seeds: int, progress: bool) -> dict[str, Path]:
     from poro2d.criterion.config import build, paper_config
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.criterion.replicates import accepted_and_replicates
+    from poro2d.store import Store
 
     cfg = paper_config(True, 0)
     spec, grading, settings, seed = build(cfg, None, threads=1)
-    crit = PorosityCriterion(spec, grading, settings, seed=seed, out=out / "criterion", progress=progress,
-                             config=cfg)  # fmt: skip
+    crit = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(out / "criterion"),
+                             progress=progress, config=cfg)  # fmt: skip
     result = crit.run()
     if not result.converged:
         raise RuntimeError(f"the quick specimen was not accepted: {result.message}")
     specimens, _ = accepted_and_replicates(crit.spec, crit.grading, crit.settings, result.final_porosity,
-                                           crit.seed, seeds, out, progress=progress)  # fmt: skip
+                                           crit.seed, seeds, Store(out), progress=progress)  # fmt: skip
     return specimens
+
+
+#: the most tests a strength grid starts unless asked for more: the quick grid is 72 (8 cases,
+#: 3 specimens, 3 stresses, minutes); a grid of hundreds of cases is hours of work, which a
+#: typo in --mu-r or --friction should not start unannounced
+MAX_TESTS = 300
 
 
 def register(app: typer.Typer) -> None:
@@ -67,12 +74,18 @@ def register(app: typer.Typer) -> None:
         max_displacement: float = typer.Option(None, "--max-displacement", help="Shear displacement (m)."),
         out: Path = typer.Option(Path("strength-out"), "--out", "-o", help="Output folder (resumable)."),
         processes: int = typer.Option(None, "--processes", "-p", help="Worker processes (default 2 x CPUs)."),
+        max_tests: int = typer.Option(
+            MAX_TESTS,
+            "--max-tests",
+            help="Most direct shear tests the grid may start (cases x specimens x stresses).",
+        ),
         quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
     ) -> None:
         """Peak and residual friction angles and dilation against rolling and particle friction."""
         from poro2d.cli.shear import parse_stresses
         from poro2d.errors import InputError, check_int
         from poro2d.io_utils import check_output_dir
+        from poro2d.locks import output_folder
         from poro2d.shear import strength as st
         from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
         from poro2d.store import Store
@@ -93,6 +106,14 @@ def register(app: typer.Typer) -> None:
         stresses = parse_stresses(normal_stress) if normal_stress else list(st.QUICK_NORMAL_STRESSES)
         if processes is not None:
             check_int("--processes", processes, 1, 64)
+        check_int("--max-tests", max_tests, 1, 1_000_000)
+        n_tests = len(mu_values) * len(fp_values) * (n_seeds if quick else len(specimen)) * len(stresses)
+        if n_tests > max_tests:
+            raise InputError(
+                "--max-tests", max_tests, f"at least the grid's {n_tests} tests",
+                f"{len(mu_values)} mu_r x {len(fp_values)} f_p x {n_seeds if quick else len(specimen)} "
+                f"specimen(s) x {len(stresses)} stresses; raise --max-tests to run them all",
+            )  # fmt: skip
         shear = dict(st.QUICK_STRENGTH_SHEAR) if quick else {"stop_after_peak": 0.0}
         if max_displacement is not None:
             shear["max_displacement"] = max_displacement
@@ -100,22 +121,23 @@ def register(app: typer.Typer) -> None:
         config = {"quick": quick, "seeds": n_seeds if quick else None, "specimens": specimen or None,
                   "mu_r": mu_values, "particle_friction": fp_values, "normal_stress_kpa": stresses,
                   "shear": shear}  # fmt: skip
-        if quick:
-            console.print(f"[bold]quick specimens[/] (the paper's quick preset), {n_seeds} seed(s)")
-            specimens = quick_specimens(out / "specimens", n_seeds, not quiet)
-        else:
-            specimens = {f"specimen{k + 1}": Path(p) for k, p in enumerate(specimen)}
-        study = st.StrengthStudy(specimens, mu_values, fp_values, stresses, settings, store=Store(out),
-                                 processes=processes, progress=not quiet, config=config)  # fmt: skip
-        console.print(
-            f"[bold]direct shear[/] over {len(study.cases)} (mu_r, f_p) cases x {len(specimens)} specimen(s) "
-            f"x {len(stresses)} normal stresses on {study.processes} processes"
-        )
-        try:
-            result = study.run()
-        except RuntimeError as exc:
-            console.print(f"[bold red]failed:[/] {exc}")
-            raise typer.Exit(1) from None
+        with output_folder("--out", out, kind="strength"):
+            if quick:
+                console.print(f"[bold]quick specimens[/] (the paper's quick preset), {n_seeds} seed(s)")
+                specimens = quick_specimens(out / "specimens", n_seeds, not quiet)
+            else:
+                specimens = {f"specimen{k + 1}": Path(p) for k, p in enumerate(specimen)}
+            study = st.StrengthStudy(specimens, mu_values, fp_values, stresses, settings, store=Store(out),
+                                     processes=processes, progress=not quiet, config=config)  # fmt: skip
+            console.print(
+                f"[bold]direct shear[/] over {len(study.cases)} (mu_r, f_p) cases x {len(specimens)} "
+                f"specimen(s) x {len(stresses)} normal stresses on {study.processes} processes"
+            )
+            try:
+                result = study.run()
+            except RuntimeError as exc:
+                console.print(f"[bold red]failed:[/] {exc}")
+                raise typer.Exit(1) from None
         print_strength(result, out)
 
 

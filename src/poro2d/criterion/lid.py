@@ -217,14 +217,54 @@ class SegmentedLid:
         return touching_share(sim, total, self.width) >= self.min_share
 
 
-def lid_numbers(sim: Simulation, profile: LidProfile, total: float) -> dict:
-    """What a trial's row records of its lid: segments, heights, and the width it rests on."""
-    return {
-        "lid_segments": int(profile.heights.size),
-        "lid_height_min_m": float(profile.heights.min()),
-        "lid_height_max_m": float(profile.heights.max()),
-        "lid_contact_share": touching_share(sim, total, float(profile.edges[-1])),
-    }
+def lid_shape(sim: Simulation, width: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """The lid's (edges, heights) when ``sim`` has one, else None (a flat top plate)."""
+    if not lid_indices(sim):
+        return None
+    profile = lid_profile(sim, width)
+    return profile.edges, profile.heights
+
+
+def top_height(sim: Simulation, width: float) -> float:
+    """The height of the top: the plate's, or the highest lid segment's."""
+    lid = lid_shape(sim, width)
+    return float(sim.walls.p0[sim.walls.index("top"), 1]) if lid is None else float(lid[1].max())
+
+
+@dataclass(frozen=True)
+class LidNumbers:
+    """What a trial's row records of its lid: segments, heights, and the share of the width it rests on."""
+
+    segments: int
+    height_min_m: float
+    height_max_m: float
+    contact_share: float
+
+    def to_dict(self) -> dict:
+        return {
+            "lid_segments": self.segments,
+            "lid_height_min_m": self.height_min_m,
+            "lid_height_max_m": self.height_max_m,
+            "lid_contact_share": self.contact_share,
+        }
+
+    @classmethod
+    def from_row(cls, row: dict) -> LidNumbers | None:
+        """The lid numbers of a trial's row; None for a trial without a lid."""
+        if "lid_segments" not in row:
+            return None
+        return cls(row["lid_segments"], row.get("lid_height_min_m"), row.get("lid_height_max_m"),
+                   row.get("lid_contact_share"))  # fmt: skip
+
+
+def lid_numbers(sim: Simulation, profile: LidProfile, total: float) -> LidNumbers:
+    """What a trial's row records of its lid (:class:`LidNumbers`)."""
+    return LidNumbers(
+        int(profile.heights.size),
+        float(profile.heights.min()),
+        float(profile.heights.max()),
+        touching_share(sim, total, float(profile.edges[-1])),
+    )
 
 
 #: the lid's segments rest on single grains: a window narrower than this many grain weights

@@ -10,9 +10,12 @@ For a trial 2D porosity n2D (Eq. 12 of the paper unless given):
    and compute the porosity n' of the new box; accept n2D when |n' - n2D| < 0.005;
 4. else start again from 1 with n' rounded to the porosity resolution (0.01).
 
-Every trial is written to its own folder as it finishes, so an interrupted run
-resumes where it stopped; a run that does not converge stops with a clear
-message and keeps every trial's results.
+With a :class:`~poro2d.store.Store`, every trial is kept in its own sub-store as it
+finishes, so an interrupted run resumes where it stopped; a run that does not converge
+stops with a clear message and keeps every trial's results. A trial is a typed record
+made of its parts (:mod:`poro2d.criterion.trial`), its measures are those of
+:mod:`poro2d.criterion.measures`, and the figures and accepted specimen's files are
+written by :mod:`poro2d.criterion.outputs`, outside the loop.
 
 A trial is only accepted when, besides the paper's condition, its specimen passes
 the checks of :func:`specimen_checks` (every planned disk built and inside the box,
@@ -26,8 +29,9 @@ from __future__ import annotations
 import logging
 import math
 import time
-from dataclasses import asdict, dataclass
-from pathlib import Path
+from collections.abc import Mapping, Sequence
+from dataclasses import asdict, dataclass, replace
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -35,24 +39,33 @@ from poro2d.config import check_finite
 from poro2d.criterion.lid import (
     SegmentedLid,
     fill_porosity,
-    flat_top,
-    lid_force,
-    lid_indices,
     lid_numbers,
     lid_profile,
+    lid_shape,
     lid_window_note,
 )
+from poro2d.criterion.measures import (
+    INTEGRITY_CHECKS,
+    POROSITY_KEYS,
+    WallForces,
+    porosity_numbers,
+    specimen_checks,
+    wall_forces,
+)
+from poro2d.criterion.outputs import force_figure, write_accepted
 from poro2d.criterion.result import CriterionResult
 from poro2d.criterion.servo import PlateServo, in_window
-from poro2d.dem import Simulation, checkpoint
-from poro2d.errors import InputError, Integer, OneOf, Ranges, Real, check_fields, check_range
-from poro2d.io_utils import as_json, provenance, write_csv, write_json
+from poro2d.criterion.trial import Decision, PlateStage, Preparation, StageFailure, Trial, trial_name
+from poro2d.dem import Simulation
+from poro2d.errors import Integer, OneOf, Ranges, Real, check_fields, check_range
+from poro2d.io_utils import provenance
 from poro2d.measure.disks import mass_d50
 from poro2d.measure.porosity import box_porosity
 from poro2d.measure.surface import lid_height_at
 from poro2d.porosity import PAPER_N_LAB, parabolic
 from poro2d.specimen.compaction import SpecimenSpec, preparation_note, prepare_specimen
 from poro2d.specimen.grading import GradingCurve
+from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
 
 #: how a trial's specimen is judged full: "plate", the paper's rigid top plate (its n' includes
@@ -152,7 +165,7 @@ def trial_grid(resolution: float, refine_tolerance: float | None) -> float:
     return resolution if refine_tolerance is None else refine_tolerance / 2.0
 
 
-def next_trial(rows: list[dict], s: CriterionSettings) -> float:
+def next_trial(rows: Sequence[Mapping], s: CriterionSettings) -> float:
     """The next trial porosity after the trials ``rows`` (none accepted).
 
     The paper's rule: n' rounded to the resolution (0.01), one resolution towards n' when
@@ -181,155 +194,28 @@ def next_trial(rows: list[dict], s: CriterionSettings) -> float:
     return nxt
 
 
-def wall_forces(sim: Simulation) -> dict:
-    """Top, bottom and side wall forces per metre of thickness (N/m).
-
-    ``f_top`` is the upward push of the disks on the top plate (and lid), ``f_bottom`` the
-    downward push on the bottom wall, ``side_friction_up`` the upward friction of
-    the side walls on the disks (what the side walls carry of the weight).
-    """
-    t = sim.particles.thickness
-    top = sim.wall_force("top") / t
-    if lid_indices(sim):  # the fill acceptance's lid carries what the parked plate does not
-        top = top + np.array([0.0, lid_force(sim) / t])
-    bottom = sim.wall_force("bottom") / t
-    left = sim.wall_force("left") / t
-    right = sim.wall_force("right") / t
-    return {
-        "f_top_n_per_m": float(top[1]),
-        "f_bottom_n_per_m": float(-bottom[1]),
-        "side_friction_up_n_per_m": float(-(left[1] + right[1])),
-        "f_left_n_per_m": float(-left[0]),
-        "f_right_n_per_m": float(right[0]),
-    }
-
-
-# A disk counts as inside the box while it presses into a wall by less than this
-# fraction of its radius: contact overlaps under the self-weight and plate forces
-# of the paper's stiffnesses are well below 1 % of a radius.
-WALL_OVERLAP_FRACTION = 0.05
-
-# checks that say the specimen itself is broken: a trial failing one is refused
-# (no n' can be trusted from it) and the run stops
-INTEGRITY_CHECKS = (
-    "preparation_converged",
-    "all_disks_present",
-    "disks_inside_box",
-    "porosity_after_generation",
-)
-
-
-def specimen_checks(
-    sim: Simulation,
-    spec: SpecimenSpec,
-    prep: dict,
-    trial: float,
-    plate_height: float,
-    forces: dict,
-    settings: CriterionSettings,
-) -> tuple[dict, dict]:
-    """The checks a trial must pass to be accepted: (booleans, the numbers behind them).
-
-    * ``preparation_converged``: every layer and the working-friction stage reached
-      equilibrium (with the fallback of :func:`poro2d.specimen.compaction.equilibrate`);
-    * ``all_disks_present``: as many disks as drawn for the trial porosity;
-    * ``disks_inside_box``: every disk between the side walls, above the bottom and
-      below the top plate (at ``plate_height``), pressing into a wall by less than
-      ``WALL_OVERLAP_FRACTION`` of its radius;
-    * ``porosity_after_generation``: the porosity of the built specimen, 1 - (area of
-      its disks) / (W H) with whole disks and overlaps not subtracted (as PFC measures),
-      is the trial porosity within ``generation_tolerance``: every disk drawn for the
-      trial is in, at its drawn size. The porosity with disks clipped by the box
-      (``porosity_after_generation_clipped``) is recorded beside it: it is higher by the
-      area the disks press into the walls, which grows with the plate force (a dense
-      trial of a frictional preparation pushes hard) and with the box's perimeter over
-      its area; ``disks_inside_box`` bounds that penetration instead;
-    * ``force_balance``: on the state the decision is taken on, F_bottom + side
-      friction = weight + F_top within ``balance_tolerance`` of the right-hand side.
-      Signs: F_bottom > 0 when the disks push the bottom wall down, side friction > 0
-      when the side walls hold the disks up, F_top > 0 when the disks push the top
-      plate up; the weight is sum(m) g / t from the disks' masses. With local damping,
-      a specimen that still moves does not balance: damping forces carry the rest.
-    """
-    p = sim.particles
-    x, y, r = p.pos[:, 0], p.pos[:, 1], p.radius
-    slack = WALL_OVERLAP_FRACTION * r
-    outside = (
-        (x - r < -slack) | (x + r > spec.width + slack) | (y - r < -slack) | (y + r > plate_height + slack)
-    )
-    weight = float(np.sum(p.mass)) * spec.gravity / p.thickness
-    rhs = weight + forces["f_top_n_per_m"]
-    lhs = forces["f_bottom_n_per_m"] + forces["side_friction_up_n_per_m"]
-    balance_error = abs(lhs - rhs) / rhs if rhs > 0.0 else math.inf
-    built = 1.0 - float(np.sum(np.pi * r * r)) / (spec.width * spec.height)
-    generation_error = abs(built - trial)
-    numbers = {
-        "planned_particle_count": int(prep["planned_count"]),
-        "disks_outside_box": int(np.count_nonzero(outside)),
-        "porosity_after_generation": built,
-        "porosity_after_generation_clipped": float(prep["measured_porosity"]),
-        "generation_porosity_error": float(generation_error),
-        "weight_from_masses_n_per_m": weight,
-        "force_balance_error": float(balance_error),
-    }
-    checks = {
-        "preparation_converged": bool(prep["converged"]),
-        "all_disks_present": bool(p.n == prep["planned_count"]),
-        "disks_inside_box": bool(not outside.any()),
-        "porosity_after_generation": bool(generation_error <= settings.generation_tolerance),
-        "force_balance": bool(balance_error <= settings.balance_tolerance),
-    }
-    return checks, numbers
-
-
-#: the measures of a trial's decision state that its row carries (see :func:`porosity_numbers`)
-POROSITY_KEYS = (
-    "box_porosity", "interior_porosity", "interior_porosity_std", "interior_regions",
-    "laguerre_interior_porosity", "surface_gap_mean_d50", "plate_contact_fraction",
-)  # fmt: skip
-
-
-def porosity_numbers(
-    sim: Simulation, width: float, plate_y: float, lid: tuple[np.ndarray, np.ndarray] | None = None
-) -> dict:
-    """The specimen's porosities beside the paper's n' (:mod:`poro2d.measure.specimen_porosity`).
-
-    ``box_porosity`` is the paper's: W x plate height, the gap under the plate included;
-    ``interior_porosity`` (mean over measurement circles 2 d50 clear of every wall and of the
-    free surface, with its spread) is the packing's own. A specimen too small to measure
-    gets ``interior_porosity = None`` and the reason in ``interior_porosity_note``. With a
-    ``lid`` (edges, heights), the box porosity and the gap are those under the lid.
-    """
-    from poro2d.measure.specimen_porosity import measure_specimen
-
-    p = sim.particles
-    try:
-        m = measure_specimen(p.pos, p.radius, width, plate_y, lid=lid).to_dict()
-    except (InputError, RuntimeError) as e:  # too small to measure; a degenerate tessellation
-        return {"box_porosity": box_porosity(p.area(), width, plate_y), "interior_porosity": None,
-                "interior_porosity_note": str(e)}  # fmt: skip
-    return {k: m[k] for k in POROSITY_KEYS}
-
-
-def _check_reason(name: str, row: dict, settings: CriterionSettings) -> str:
+def _check_reason(name: str, trial: Trial, settings: CriterionSettings) -> str:
     """One line on why check ``name`` failed, with its numbers."""
+    nums = trial.check_numbers
     if name == "preparation_converged":
+        f = trial.failure
+        assert f is not None
+        ratio = f.ratio if f.equilibrium is not None else f.max_ratio
         return (
-            f"{row['failed_stage']} did not reach equilibrium: {row.get('equilibrium', 'max')} "
-            f"unbalanced-force ratio {row.get('failed_ratio', row['failed_max_ratio']):.3g} "
-            f"after {row['failed_steps']} steps (fallback included)"
+            f"{f.stage} did not reach equilibrium: {f.equilibrium or 'max'} "
+            f"unbalanced-force ratio {ratio:.3g} after {f.steps} steps (fallback included)"
         )
     if name == "all_disks_present":
-        return f"{row['particle_count']} disks built of {row['planned_particle_count']} planned"
+        return f"{trial.particle_count} disks built of {nums.planned_particle_count} planned"
     if name == "disks_inside_box":
-        return f"{row['disks_outside_box']} disk(s) outside the box"
+        return f"{nums.disks_outside_box} disk(s) outside the box"
     if name == "porosity_after_generation":
         return (
-            f"porosity after generation {row['porosity_after_generation']:.4f} differs from the trial "
-            f"by {row['generation_porosity_error']:.2g} > {settings.generation_tolerance:g}"
+            f"porosity after generation {nums.porosity_after_generation:.4f} differs from the trial "
+            f"by {nums.generation_porosity_error:.2g} > {settings.generation_tolerance:g}"
         )
     return (
-        f"vertical forces out of balance by {100 * row['force_balance_error']:.2f} % "
+        f"vertical forces out of balance by {100 * nums.force_balance_error:.2f} % "
         f"> {100 * settings.balance_tolerance:g} % (F_bottom + side friction vs weight + F_top)"
     )
 
@@ -342,10 +228,90 @@ def overfull_note(overfull_m: float) -> str:
     )
 
 
-class PorosityCriterion:
-    """Run Fig. 3 for one grading and laboratory porosity, writing results to ``out``.
+def decide(trial: Trial, settings: CriterionSettings) -> Decision:
+    """Accept, reject or refuse a trial.
 
-    ``on_stage(name)`` (optional) is called as each stage starts, for progress display.
+    Accepted: the paper's condition (the plate settled with 0 < F_top < 1 % G and
+    |n' - n2D| below the tolerance) and every check passed. Refused (the run stops):
+    a stage that did not reach equilibrium, a broken specimen (an integrity check
+    failed), or the paper's condition met while a check failed.
+    """
+    s = settings
+    failed = trial.checks.failed
+    condition = bool(trial.converged and trial.plate.is_settled and trial.porosity_change < s.tolerance)
+    if not trial.converged:
+        failure = trial.failure
+        assert failure is not None
+        if failure.stage == "top plate":
+            what = "lid" if trial.plate.moved == "lid" else "top plate"
+            reason = (
+                f"the {what} did not settle within {s.max_plate_steps} steps: F_top "
+                f"{trial.forces_after.f_top_n_per_m:.4g} N/m, window (0, {trial.force_limit_n_per_m:.4g}), "
+                f"max unbalanced-force ratio {failure.max_ratio:.3g} when held"
+            ) + (trial.plate.lid_note or "")
+        else:
+            reason = _check_reason("preparation_converged", trial, s)
+        refused = True
+    elif failed:
+        reason = f"check {failed} failed: {_check_reason(failed, trial, s)}"
+        refused = condition or failed in INTEGRITY_CHECKS
+    else:
+        refused = False
+        reason = (
+            "0 < F_top < limit with the plate settled, |n' - n2D| below the tolerance, all checks passed"
+            if condition
+            else f"|n' - n2D| = {trial.porosity_change:.4f} >= {s.tolerance:g}"
+        )
+    if trial.overfull_m > 0.0:
+        reason += "; " + overfull_note(trial.overfull_m)
+    return Decision(condition, failed, condition and not failed, refused, reason)
+
+
+def closed_bracket(trials: list[Trial], s: CriterionSettings) -> Trial | None:
+    """The trial accepted when refinement can go no finer, or None; its decision says so.
+
+    With ``refine_tolerance``, bisection proposes a trial already tried once two trials
+    a grid step apart bracket the fixed point: one settled looser than its trial, the
+    other denser. Each trial is a new random specimen, so n' scatters from specimen to
+    specimen (about 0.003 on the paper's box); a tolerance below that scatter cannot be
+    met by refining further. The trial then accepted is the one closest to its own n',
+    if it meets the paper's tolerance (``porosity_tolerance``) and passed every check;
+    its row says so (``accepted_at = "closed bracket"``).
+    """
+    if s.refine_tolerance is None:
+        return None
+    fit = [
+        t for t in trials
+        if t["converged"] and t.get("plate_settled") and not t["failed_check"]
+        and t["porosity_change"] is not None and t["porosity_change"] < s.porosity_tolerance
+    ]  # fmt: skip
+    if not fit:
+        return None
+    best = min(fit, key=lambda t: t["porosity_change"])
+    best.decision = replace(
+        best.decision, accepted=True, condition_met=True, accepted_at="closed bracket",
+        reason=(
+            f"the trials bracket the fixed point a grid step apart: |n' - n2D| = "
+            f"{best['porosity_change']:.4f}, below the paper's {s.porosity_tolerance:g} (refining to "
+            f"{s.refine_tolerance:g} cannot go finer than the specimens' scatter), all checks passed"
+        ),
+    )  # fmt: skip
+    return best
+
+
+class ConfigRecord(NamedTuple):
+    """What binds a criterion's store (``config.json``): the run's identity, the config, the provenance."""
+
+    run: dict[str, Any]
+    config: dict[str, Any]
+    provenance: dict[str, Any]
+
+
+class PorosityCriterion:
+    """Run Fig. 3 for one grading and laboratory porosity, keeping its results in ``store``.
+
+    ``store``: where the trials, the table and the result are kept, and from which a rerun
+    resumes; None keeps nothing (compute only). ``figures``: draw the force-chain figures.
     """
 
     def __init__(
@@ -354,7 +320,7 @@ class PorosityCriterion:
         grading: GradingCurve,
         settings: CriterionSettings,
         seed: int = 0,
-        out: str | Path | None = None,
+        store: Store | None = None,
         progress: bool = False,
         config: dict | None = None,
         figures: bool = True,
@@ -363,29 +329,27 @@ class PorosityCriterion:
         self.grading = grading
         self.settings = settings
         self.seed = int(seed)
-        self.out = Path(out) if out is not None else None
+        self.store = store
         self.progress = progress
         self.config = config or {}
         self.figures = figures
-        self.timings: dict[str, float] = {}
         self._stage: ResumableStage | None = None
 
     # ------------------------------------------------------------------ stages
     def stage(self) -> ResumableStage:
-        """The run's stages in ``out``: ``config.json`` binds it to the config and seed.
+        """The run's stages in the store: ``config.json`` binds it to the config and seed.
 
         The binding leaves out the specimen's fields marked as not changing results
         (:mod:`poro2d.identity`: a rerun on another thread count resumes). A folder whose
         trials lack that record (it was deleted) is adopted: its finished trials are read back, the rest run.
         """
-        assert self.out is not None
+        assert self.store is not None
         if self._stage is None:
             record = self._config_record()
-            self._stage = ResumableStage(
-                self.out,
-                Fingerprint(record["run"], tables={"specimen": SpecimenSpec}),
+            self._stage = self.store.stage(
+                Fingerprint(record.run, tables={"specimen": SpecimenSpec}),
                 record="config.json",
-                extra={"config": record["config"], "provenance": record["provenance"]},
+                extra={"config": record.config, "provenance": record.provenance},
                 parameter="out",
                 allowed="an empty folder or one holding a run of the same config and seed",
                 explain=_other_config,
@@ -393,37 +357,32 @@ class PorosityCriterion:
             )
         return self._stage
 
-    def _trial_name(self, k: int, n: float) -> str:
-        """Trial ``k``'s folder, relative to ``out`` (``trials/02_n0.2300``)."""
-        return f"trials/{k:02d}_n{n:.4f}"
+    def _trial_store(self, k: int, n: float) -> Store | None:
+        return None if self.store is None else self.store.child(trial_name(k, n))
 
-    def _trial_dir(self, k: int, n: float) -> Path | None:
-        if self.out is None:
-            return None
-        return self.out / self._trial_name(k, n)
-
-    def _prepare(self, k: int, n: float) -> tuple[Simulation, dict]:
-        """Trial ``k``'s specimen and its preparation report: built, or read back once saved."""
-        d = self._trial_dir(k, n)
-        if d is None:
+    def _prepare(self, k: int, n: float) -> tuple[Simulation, Preparation]:
+        """Trial ``k``'s specimen and its preparation: built, or read back once saved."""
+        folder = self._trial_store(k, n)
+        if folder is None:
             return self._build(n)
-        npz = d / "prepared.npz"
         built: list[Simulation] = []
 
         def compute() -> dict:
-            sim, rep = self._build(n)
-            d.mkdir(parents=True, exist_ok=True)
-            checkpoint.save(sim, npz, extra={"stage": "prepared", "trial_porosity": n})
+            sim, prep = self._build(n)
+            folder.save_state("prepared.npz", sim, extra={"stage": "prepared", "trial_porosity": n})
             if self.figures:
-                self._figure(sim, d / "forces_trial.png", f"trial n2D = {n:.3f}, top plate at H", rep)
+                title = f"trial n2D = {n:.3f}, top plate at H"
+                force_figure(folder, "forces_trial.png", sim, self.spec.width, title, wall_forces(sim),
+                             self.spec.self_weight(n))  # fmt: skip
             built.append(sim)
-            return rep
+            return prep.report
 
-        marker = f"{self._trial_name(k, n)}/prepared.json"
-        rep = self.stage().run(compute, marker, accept=lambda _: npz.is_file())
-        return (built[0] if built else checkpoint.load(npz, threads=self.spec.threads)), rep
+        report = self.stage().run(compute, f"{trial_name(k, n)}/prepared.json",
+                                  accept=lambda _: folder.has("prepared.npz"))  # fmt: skip
+        sim = built[0] if built else folder.load_state("prepared.npz", threads=self.spec.threads)
+        return sim, Preparation(report)
 
-    def _build(self, n: float) -> tuple[Simulation, dict]:
+    def _build(self, n: float) -> tuple[Simulation, Preparation]:
         """A specimen at trial porosity ``n``, with its report (seed, time, weight, wall forces)."""
         t0 = time.perf_counter()
         # the same seed per trial porosity: a rerun of a trial rebuilds the same specimen
@@ -432,221 +391,157 @@ class PorosityCriterion:
         rep["seed"] = seed
         rep["time_s"] = time.perf_counter() - t0
         rep["weight_n_per_m"] = self.spec.self_weight(n)
-        rep.update(wall_forces(sim))
-        return sim, rep
-
-    def _figure(self, sim: Simulation, path: Path, title: str, forces: dict) -> None:
-        from poro2d.report.force_chains import plot_simulation_force_chains
-
-        lid = self._lid(sim)
-        plate = float(sim.walls.p0[sim.walls.index("top"), 1]) if lid is None else float(lid[1].max())
-        plot_simulation_force_chains(
-            sim, path, title=title, box=(0.0, 0.0, self.spec.width, plate),
-            notes=[
-                f"F_top = {forces['f_top_n_per_m']:.4g} N/m",
-                f"F_bottom = {forces['f_bottom_n_per_m']:.4g} N/m",
-                f"G = {forces.get('weight_n_per_m', float('nan')):.4g} N/m",
-            ],
-        )  # fmt: skip
+        rep.update(wall_forces(sim).to_dict())
+        return sim, Preparation(rep)
 
     def plate_servo(self) -> PlateServo:
         """The plate (and lid) servo of step 3, with this run's settings and equilibrium."""
         sp = self.spec
         return PlateServo(self.settings, sp.ratio, sp.equilibrium, sp.height, progress=self.progress)
 
-    def _trial(self, k: int, n: float) -> dict:
-        """Trial ``k`` at porosity ``n``: its row, read back from its ``trial.json`` once written."""
-        if self.out is None:
-            return as_json(self._run_trial(k, n))
-        return self.stage().run(lambda: self._run_trial(k, n), f"{self._trial_name(k, n)}/trial.json")
+    def _trial(self, k: int, n: float) -> Trial:
+        """Trial ``k`` at porosity ``n``: run, or read back from its ``trial.json`` once written."""
+        if self.store is None:
+            return self._run_trial(k, n)
+        return self.stage().run(lambda: self._run_trial(k, n).to_dict(), f"{trial_name(k, n)}/trial.json",
+                                decode=Trial.from_dict)  # fmt: skip
 
-    def _run_trial(self, k: int, n: float) -> dict:
+    def _run_trial(self, k: int, n: float) -> Trial:
         """Prepare the specimen, move the plate when F_top is out of the window, check, decide."""
-        d = self._trial_dir(k, n)
         s = self.settings
         t0 = time.perf_counter()
         sim, prep = self._prepare(k, n)
-        t_prep = prep.get("time_s", time.perf_counter() - t0)
+        t_prep = prep.report.get("time_s", time.perf_counter() - t0)
         weight = self.spec.self_weight(n)
         forces0 = wall_forces(sim)
-        f_top = forces0["f_top_n_per_m"]
-        row: dict = {
-            "iteration": k,
-            "trial_porosity": n,
-            "particle_count": prep["particle_count"],
-            "planned_particle_count": prep["planned_count"],
-            "measured_porosity_after_generation": prep["measured_porosity"],
-            "f_top_n_per_m": f_top,
-            "f_bottom_n_per_m": forces0["f_bottom_n_per_m"],
-            "side_friction_up_n_per_m": forces0["side_friction_up_n_per_m"],
-            "self_weight_n_per_m": weight,
-            "force_limit_n_per_m": s.force_fraction * weight,
-            "preparation_converged": prep["converged"],
-            "converged": True,
-        }
-        overfull = float(prep.get("overfull_m") or 0.0)
-        if overfull > 0.0:  # recorded only when it happens: ordinary rows keep their keys
-            row["overfull_m"] = overfull
         t1 = time.perf_counter()
-        top = sim.walls.index("top")
-        if not prep["converged"]:
+        failure: StageFailure | None = None
+        if not prep.converged:
             # a half-built specimen: no plate stage, no n'; refused below
-            row.update(plate_moved="not run", plate_displacement_m=0.0, new_porosity=None)
-            row.update(
-                converged=False, failed_stage=prep["failed_stage"],
-                failed_max_ratio=prep["failed_max_ratio"], failed_steps=prep["failed_steps"],
-                failed_ratio=prep.get("failed_ratio", prep["failed_max_ratio"]),
-                equilibrium=self.spec.equilibrium,
-            )  # fmt: skip
+            plate = PlateStage("not run", None, displacement_m=0.0)
+            failure = prep.failure(self.spec.equilibrium)
             after = forces0
-        elif s.acceptance == "plate" and overfull == 0.0 and in_window(f_top, weight, s.force_fraction):
+        elif (
+            s.acceptance == "plate"
+            and prep.overfull_m == 0.0
+            and in_window(forces0.f_top_n_per_m, weight, s.force_fraction)
+        ):
             # an over-full box has its plate above H: n' is measured where the plate settles
-            row.update(plate_moved="no", plate_displacement_m=0.0, new_porosity=n, plate_settled=True)
+            plate = PlateStage("no", n, settled=True, displacement_m=0.0)
             after = forces0
         else:
-            after = self._top_stage(sim, n, weight, row, d)
-        row["f_top_after_n_per_m"] = after["f_top_n_per_m"]
-        row["f_bottom_after_n_per_m"] = after["f_bottom_n_per_m"]
-        row["side_friction_up_after_n_per_m"] = after["side_friction_up_n_per_m"]
-        row["porosity_change"] = None if row["new_porosity"] is None else abs(row["new_porosity"] - n)
+            plate, after = self._top_stage(sim, k, n, weight, forces0.f_top_n_per_m)
+            if not plate.is_settled:
+                assert plate.servo is not None
+                failure = StageFailure("top plate", plate.servo.final_max_ratio, plate.servo.steps)
+        converged = failure is None
         checks, numbers = specimen_checks(sim, self.spec, prep, n, self._top_at_disks(sim), after, s)
-        row.update(numbers)
-        if row["converged"]:
-            row.update(porosity_numbers(sim, self.spec.width, float(sim.walls.p0[top, 1]), self._lid(sim)))
-        # the plate stage is part of the record: False when it did not settle or never ran
-        checks = {"preparation_converged": checks.pop("preparation_converged"),
-                  "plate_settled": bool(row.get("plate_settled", False)), **checks}  # fmt: skip
-        row["checks"] = checks
-        self._decide(row)
-        row["time_prepare_s"] = t_prep
-        row["time_plate_s"] = time.perf_counter() - t1
-        return row
+        porosity = None
+        if converged:
+            top = float(sim.walls.p0[sim.walls.index("top"), 1])
+            porosity = porosity_numbers(sim, self.spec.width, top, lid_shape(sim, self.spec.width))
+        trial = Trial(
+            iteration=k,
+            trial_porosity=n,
+            particle_count=prep.particle_count,
+            planned_particle_count=numbers.planned_particle_count,
+            measured_porosity_after_generation=prep.measured_porosity,
+            forces=forces0,
+            self_weight_n_per_m=weight,
+            force_limit_n_per_m=s.force_fraction * weight,
+            preparation_converged=prep.converged,
+            converged=converged,
+            plate=plate,
+            forces_after=after,
+            porosity_change=None if plate.new_porosity is None else abs(plate.new_porosity - n),
+            check_numbers=numbers,
+            # the plate stage is part of the record: False when it did not settle or never ran
+            checks=replace(checks, plate_settled=plate.is_settled),
+            decision=Decision(False, "", False, False, ""),
+            overfull_m=prep.overfull_m,
+            failure=failure,
+            porosity=porosity,
+            time_prepare_s=t_prep,
+            preparation=prep,
+        )
+        trial.decision = decide(trial, s)
+        trial.time_plate_s = time.perf_counter() - t1
+        return trial
 
-    def _top_stage(self, sim: Simulation, n: float, weight: float, row: dict, d: Path | None) -> dict:
-        """Move the plate (or rest the lid) until the force window holds; returns the wall forces.
+    def _top_stage(
+        self, sim: Simulation, k: int, n: float, weight: float, f_top: float
+    ) -> tuple[PlateStage, WallForces]:
+        """Move the plate (or rest the lid) until the force window holds; the stage, the wall forces after.
 
         Paper acceptance: the plate moves down when F_top = 0 and up when it is too large,
         and n' is the box porosity under it. Fill acceptance: the lid replaces the plate
         and n' is the porosity of the area under it (:func:`~poro2d.criterion.lid.fill_porosity`).
         """
-        f_top = row["f_top_n_per_m"]
+        width = self.spec.width
         servo = self.plate_servo()
         if self.settings.acceptance == "fill":
-            row["plate_moved"] = "lid"
             if not in_window(f_top, weight, self.settings.force_fraction):
                 # the plate first takes the specimen to the window (a dense trial pushes hard
                 # and swells for long): the lid then only has the surface left to follow
-                plate = servo.settle(sim, weight)
-                if not plate["plate_settled"]:
-                    row.update(plate)
-                    row["new_porosity"] = box_porosity(
-                        sim.particles.area(), self.spec.width, row["plate_height_m"]
+                first = servo.settle(sim, weight)
+                if not first.settled:
+                    stage = PlateStage(
+                        "lid", box_porosity(sim.particles.area(), width, first.height_m), first
                     )
-                    return self._after_top(sim, weight, row, d)
-            lid = SegmentedLid(sim, self.spec.width, mass_d50(sim.particles.radius))
-            row.update(servo.settle(sim, weight, lid))
-            profile = lid_profile(sim, self.spec.width)
-            row["new_porosity"] = fill_porosity(sim.particles.radius, profile)
-            row.update(lid_numbers(sim, profile, servo.target(sim, weight)))
-            row["lid_note"] = lid_window_note(sim, profile, row["force_limit_n_per_m"])
-        else:
-            row["plate_moved"] = "down" if f_top <= 0.0 else "up"
-            row.update(servo.settle(sim, weight))
-            row["new_porosity"] = box_porosity(sim.particles.area(), self.spec.width, row["plate_height_m"])
-        return self._after_top(sim, weight, row, d)
-
-    def _after_top(self, sim: Simulation, weight: float, row: dict, d: Path | None) -> dict:
-        """Save the state after the plate or lid stage, and mark a stage that did not settle."""
-        after = wall_forces(sim)
-        if d is not None:
-            checkpoint.save(sim, d / "after_plate.npz", extra={"stage": "after_plate"})
-            if self.figures:
-                after_fig = dict(after, weight_n_per_m=weight)
-                what = (
-                    "resting the lid"
-                    if row["plate_moved"] == "lid"
-                    else f"moving the top plate {row['plate_moved']}"
-                )
-                self._figure(
-                    sim,
-                    d / "forces_after_plate.png",
-                    f"after {what}: n' = {row['new_porosity']:.4f}",
-                    after_fig,
-                )
-        if not row["plate_settled"]:
-            row.update(
-                converged=False, failed_stage="top plate",
-                failed_max_ratio=row["plate_final_max_ratio"], failed_steps=row["plate_steps"],
+                    return stage, self._after_top(sim, k, n, weight, stage)
+            lid = SegmentedLid(sim, width, mass_d50(sim.particles.radius))
+            settle = servo.settle(sim, weight, lid)
+            profile = lid_profile(sim, width)
+            stage = PlateStage(
+                "lid", fill_porosity(sim.particles.radius, profile), settle,
+                lid=lid_numbers(sim, profile, servo.target(sim, weight)),
+                lid_note=lid_window_note(sim, profile, self.settings.force_fraction * weight),
             )  # fmt: skip
-        return after
+        else:
+            moved = "down" if f_top <= 0.0 else "up"
+            settle = servo.settle(sim, weight)
+            stage = PlateStage(moved, box_porosity(sim.particles.area(), width, settle.height_m), settle)
+        return stage, self._after_top(sim, k, n, weight, stage)
 
-    def _lid(self, sim: Simulation) -> tuple[np.ndarray, np.ndarray] | None:
-        """The lid's (edges, heights) when the trial rested one, else None."""
-        if not lid_indices(sim):
-            return None
-        profile = lid_profile(sim, self.spec.width)
-        return profile.edges, profile.heights
+    def _after_top(self, sim: Simulation, k: int, n: float, weight: float, stage: PlateStage) -> WallForces:
+        """Keep the state after the plate or lid stage (and its figure); the wall forces then."""
+        after = wall_forces(sim)
+        folder = self._trial_store(k, n)
+        if folder is not None:
+            folder.save_state("after_plate.npz", sim, extra={"stage": "after_plate"})
+            if self.figures:
+                what = "resting the lid" if stage.moved == "lid" else f"moving the top plate {stage.moved}"
+                force_figure(folder, "forces_after_plate.png", sim, self.spec.width,
+                             f"after {what}: n' = {stage.new_porosity:.4f}", after, weight)  # fmt: skip
+        return after
 
     def _top_at_disks(self, sim: Simulation) -> float | np.ndarray:
         """The height of the plate, or of the lid above each disk, for the in-box check."""
-        lid = self._lid(sim)
+        lid = lid_shape(sim, self.spec.width)
         if lid is None:
             return float(sim.walls.p0[sim.walls.index("top"), 1])
         return lid_height_at(lid[0], lid[1], sim.particles.pos[:, 0])
 
-    def _decide(self, row: dict) -> None:
-        """Accept, reject or refuse a trial; records ``accepted``, ``refused``, ``failed_check``, ``reason``.
-
-        Accepted: the paper's condition (the plate settled with 0 < F_top < 1 % G and
-        |n' - n2D| below the tolerance) and every check passed. Refused (the run stops):
-        a stage that did not reach equilibrium, a broken specimen (an integrity check
-        failed), or the paper's condition met while a check failed.
-        """
-        s = self.settings
-        checks = row["checks"]
-        failed = next((c for c, ok in checks.items() if not ok), "")
-        condition = bool(
-            row["converged"] and bool(row.get("plate_settled", False))
-            and row["porosity_change"] < s.tolerance
-        )  # fmt: skip
-        row["condition_met"] = condition
-        row["failed_check"] = failed
-        row["accepted"] = condition and not failed
-        if not row["converged"]:
-            if row["failed_stage"] == "top plate":
-                what = "lid" if row.get("plate_moved") == "lid" else "top plate"
-                row["reason"] = (
-                    f"the {what} did not settle within {s.max_plate_steps} steps: F_top "
-                    f"{row['f_top_after_n_per_m']:.4g} N/m, window (0, {row['force_limit_n_per_m']:.4g}), "
-                    f"max unbalanced-force ratio {row['failed_max_ratio']:.3g} when held"
-                ) + row.get("lid_note", "")
-            else:
-                row["reason"] = _check_reason("preparation_converged", row, s)
-            row["refused"] = True
-        elif failed:
-            row["reason"] = f"check {failed} failed: {_check_reason(failed, row, s)}"
-            row["refused"] = condition or failed in INTEGRITY_CHECKS
-        else:
-            row["refused"] = False
-            row["reason"] = (
-                "0 < F_top < limit with the plate settled, |n' - n2D| below the tolerance, all checks passed"
-                if condition
-                else f"|n' - n2D| = {row['porosity_change']:.4f} >= {s.tolerance:g}"
-            )
-        if row.get("overfull_m"):
-            row["reason"] += "; " + overfull_note(row["overfull_m"])
-
     # -------------------------------------------------------------------- loop
     def run(self) -> CriterionResult:
-        """Run Fig. 3, or read a finished run back from ``out/result.json``.
+        """Run Fig. 3, or read a finished run back from the store's ``result.json``.
 
-        Every input is checked first (:meth:`validate`), then ``out`` (:meth:`stage`): a
+        Every input is checked first (:meth:`validate`), then the store (:meth:`stage`): a
         folder holding a run of another config is refused before anything is written.
+        Once the run ends, the side outputs (figures, the accepted specimen and its files)
+        are written by :func:`poro2d.criterion.outputs.write_accepted`, before the result.
         """
         self.validate()
-        if self.out is None:
-            return CriterionResult.from_dict(as_json(self._search()))
-        return self.stage().run(self._search, decode=CriterionResult.from_dict)
+        if self.store is None:
+            return self._search()
+        store = self.store
+
+        def compute() -> CriterionResult:
+            result = self._search()
+            write_accepted(result, store, self.spec.width, figures=self.figures)
+            return result
+
+        return self.stage().run(compute, decode=CriterionResult.from_dict)
 
     def _search(self) -> CriterionResult:
         """The loop of Fig. 3: trials until one is accepted or refused, or the trials run out."""
@@ -656,30 +551,29 @@ class PorosityCriterion:
         note = preparation_note(self.spec, self.grading)
         if note:
             _log.warning("preparation: %s", note)
-        rows: list[dict] = []
+        trials: list[Trial] = []
         tried: list[float] = []
-        accepted: dict | None = None
+        accepted: Trial | None = None
         failed_trial = None
         message = ""
         for k in range(1, s.max_iterations + 1):
             tried.append(n)
-            # as a resumed run reads it back from trial.json: plain booleans and numbers
-            row = as_json(self._trial(k, n))
-            rows.append(row)
-            self._write_table(rows)
-            if row["accepted"]:
-                accepted = row
+            trial = self._trial(k, n)
+            trials.append(trial)
+            self._write_table(trials)
+            if trial.decision.accepted:
+                accepted = trial
                 message = f"accepted n2D = {n:.4f} after {k} trial(s)"
                 break
-            if row["refused"]:
+            if trial.decision.refused:
                 failed_trial = k
-                message = f"trial {k} (n2D = {n:.4f}) refused: {row['reason']}"
+                message = f"trial {k} (n2D = {n:.4f}) refused: {trial['reason']}"
                 break
-            nxt = next_trial(rows, s)
+            nxt = next_trial(trials, s)
             if nxt in tried:
-                accepted = self._closed_bracket(rows)
+                accepted = closed_bracket(trials, s)
                 if accepted is not None:
-                    self._write_table(rows)
+                    self._write_table(trials)
                     message = (
                         f"accepted n2D = {accepted['trial_porosity']:.4f} after {k} trial(s), "
                         "when the bracket closed (docs/criterion.md)"
@@ -694,46 +588,14 @@ class PorosityCriterion:
         else:
             message = f"no convergence within max_iterations = {s.max_iterations} (trials {tried})"
         final = None if accepted is None else accepted["trial_porosity"]
-        result = self._result(rows, final=final, converged=accepted is not None, message=message)
+        result = self._result(trials, final=final, converged=accepted is not None, message=message)
         result.failed_trial = failed_trial
         if accepted is not None:
             for key in CriterionResult.OPTIONAL:
                 setattr(result, key, accepted.get(key))
         result.preparation_note = preparation_note(self.spec, self.grading)
         result.time_total_s = time.perf_counter() - t_start
-        if self.out is not None:
-            self._final_outputs(rows, accepted)
         return result
-
-    def _closed_bracket(self, rows: list[dict]) -> dict | None:
-        """The trial accepted when refinement can go no finer, or None.
-
-        With ``refine_tolerance``, bisection proposes a trial already tried once two trials
-        a grid step apart bracket the fixed point: one settled looser than its trial, the
-        other denser. Each trial is a new random specimen, so n' scatters from specimen to
-        specimen (about 0.003 on the paper's box); a tolerance below that scatter cannot be
-        met by refining further. The trial then accepted is the one closest to its own n',
-        if it meets the paper's tolerance (``porosity_tolerance``) and passed every check;
-        its row says so (``accepted_at = "closed bracket"``).
-        """
-        s = self.settings
-        if s.refine_tolerance is None:
-            return None
-        fit = [
-            r for r in rows
-            if r["converged"] and r.get("plate_settled") and not r["failed_check"]
-            and r["porosity_change"] is not None and r["porosity_change"] < s.porosity_tolerance
-        ]  # fmt: skip
-        if not fit:
-            return None
-        best = min(fit, key=lambda r: r["porosity_change"])
-        best.update(accepted=True, condition_met=True, accepted_at="closed bracket")
-        best["reason"] = (
-            f"the trials bracket the fixed point a grid step apart: |n' - n2D| = "
-            f"{best['porosity_change']:.4f}, below the paper's {s.porosity_tolerance:g} (refining to "
-            f"{s.refine_tolerance:g} cannot go finer than the specimens' scatter), all checks passed"
-        )
-        return best
 
     def validate(self) -> None:
         """Reject bad input before anything is written: a corrected rerun then starts clean.
@@ -747,12 +609,12 @@ class PorosityCriterion:
         Simulation.check_threads(self.spec.threads)
         check_feasible(self.spec, self.grading, self.settings.initial_trial())
         record = self._config_record()
-        check_finite("config", record["config"])
-        check_finite("run", record["run"])
+        check_finite("config", record.config)
+        check_finite("run", record.run)
 
-    def _config_record(self) -> dict:
-        return {
-            "run": {
+    def _config_record(self) -> ConfigRecord:
+        return ConfigRecord(
+            run={
                 "specimen": self.spec.to_dict(),
                 "grading": {
                     "sizes_m": self.grading.sizes.tolist(),
@@ -762,11 +624,11 @@ class PorosityCriterion:
                 "criterion": self.settings.to_record(),
                 "seed": self.seed,
             },
-            "config": self.config,
-            "provenance": provenance(),
-        }
+            config=self.config,
+            provenance=provenance(),
+        )
 
-    def _result(self, rows: list[dict], final, converged: bool, message: str) -> CriterionResult:
+    def _result(self, trials: list[Trial], final, converged: bool, message: str) -> CriterionResult:
         return CriterionResult(
             final_porosity=final,
             converged=converged,
@@ -774,7 +636,7 @@ class PorosityCriterion:
             n_lab=self.settings.n_lab,
             initial_trial_porosity=self.settings.initial_trial(),
             initial_from="given" if self.settings.trial_porosity is not None else "Eq. 12 (parabola)",
-            iterations=rows,
+            iterations=trials,
             seed=self.seed,
             settings=self.settings.to_record(),
             specimen=self.spec.to_dict(),
@@ -783,84 +645,10 @@ class PorosityCriterion:
             provenance=provenance(),
         )
 
-    def _write_table(self, rows: list[dict]) -> None:
+    def _write_table(self, trials: list[Trial]) -> None:
         """``iterations.csv``: the trials so far, rewritten as each one finishes."""
-        if self.out is not None:
-            write_csv(self.out / "iterations.csv", [_flat(r) for r in rows])
-
-    def _final_outputs(self, rows: list[dict], accepted: dict | None) -> None:
-        """Copy the paper-style figures and the accepted specimen to the top of ``out``."""
-        import shutil
-
-        from poro2d.dem.export import write_vtu
-
-        assert self.out is not None
-        first = rows[0]
-        d0 = self._trial_dir(first["iteration"], first["trial_porosity"])
-        pairs = [(d0 / "forces_trial.png", "fig5_forces_initial_trial.png")]
-        moved = next((r for r in rows if r.get("plate_moved") in ("up", "down", "lid")), None)
-        if moved is not None:
-            dm = self._trial_dir(moved["iteration"], moved["trial_porosity"])
-            pairs.append((dm / "forces_after_plate.png", "fig6_forces_after_plate.png"))
-        if accepted is not None:
-            last = accepted
-            dl = self._trial_dir(last["iteration"], last["trial_porosity"])
-            # the accepted specimen is the state the decision was taken on: after the plate
-            # moved to touch (when it moved), else as prepared with the plate at H
-            moved_last = (
-                last.get("plate_moved") in ("up", "down", "lid") and (dl / "after_plate.npz").is_file()
-            )
-            state = "after_plate" if moved_last else "prepared"
-            figure = "forces_after_plate.png" if moved_last else "forces_trial.png"
-            pairs.append((dl / figure, "fig7_forces_accepted.png"))
-            sim = checkpoint.load(dl / f"{state}.npz")
-            lid = self._lid(sim)
-            if lid is None:
-                shutil.copyfile(dl / f"{state}.npz", self.out / ".specimen.npz.tmp")
-                (self.out / ".specimen.npz.tmp").replace(self.out / "specimen.npz")
-            else:  # what leaves is a box of four walls (lid.flat_top); the lid is measured here
-                checkpoint.save(flat_top(sim, self.spec.width), self.out / "specimen.npz",
-                                extra={"stage": "accepted", "lid_heights_m": lid[1].tolist()})  # fmt: skip
-            write_vtu(sim, self.out / "vtu", "accepted_specimen")
-            self._specimen_state(sim, last["trial_porosity"])
-        for src, dst in pairs:
-            if src.is_file():
-                shutil.copyfile(src, self.out / dst)
-
-    def _specimen_state(self, sim: Simulation, n2d: float) -> None:
-        """Homogeneity and stress state of the accepted specimen: specimen_state.json and .png."""
-        from poro2d.measure.specimen_state import specimen_state
-        from poro2d.report.specimen_figures import plot_specimen_state
-
-        assert self.out is not None
-        lid = self._lid(sim)
-        top = float(sim.walls.p0[sim.walls.index("top"), 1]) if lid is None else float(lid[1].max())
-        state = specimen_state(sim, self.spec.width, top)
-        write_json(self.out / "specimen_state.json", dict(state, trial_porosity=n2d))
-        if self.figures:
-            title = f"accepted specimen, n2D = {n2d:.3f}: bands of equal height"
-            plot_specimen_state(state, self.out / "specimen_state.png", title=title)
-        self._specimen_porosity(sim, n2d, top)
-
-    def _specimen_porosity(self, sim: Simulation, n2d: float, top: float) -> None:
-        """The accepted specimen's porosities: specimen_porosity.json and the local porosity map."""
-        from poro2d.measure.specimen_porosity import measure_specimen
-        from poro2d.report.specimen_figures import plot_local_porosity
-
-        assert self.out is not None
-        p = sim.particles
-        try:
-            m = measure_specimen(p.pos, p.radius, self.spec.width, top, lid=self._lid(sim))
-        except (InputError, RuntimeError) as e:
-            write_json(self.out / "specimen_porosity.json", {"trial_porosity": n2d, "note": str(e),
-                                                              "provenance": provenance()})  # fmt: skip
-            return
-        write_json(self.out / "specimen_porosity.json", dict(m.to_dict(), trial_porosity=n2d,
-                                                            provenance=provenance()))  # fmt: skip
-        if self.figures:
-            title = f"accepted specimen, n2D = {n2d:.3f}: local porosity (Laguerre cells)"
-            plot_local_porosity(p.pos, p.radius, self.spec.width, top, m, self.out / "local_porosity.png",
-                                title=title)  # fmt: skip
+        if self.store is not None:
+            self.store.write_csv("iterations.csv", [t.flat() for t in trials])
 
 
 def _other_config(keys: list[str] | None, stored) -> str:
@@ -868,14 +656,7 @@ def _other_config(keys: list[str] | None, stored) -> str:
     return f"it holds results of a different config ({', '.join(keys or [])}); choose another --out"
 
 
-def _flat(row: dict) -> dict:
-    """A trial row for the CSV table: the ``checks`` dict as ``check_<name>`` columns."""
-    out = {k: v for k, v in row.items() if k != "checks"}
-    out.update({f"check_{k}": v for k, v in row.get("checks", {}).items()})
-    return out
-
-
 __all__ = [
-    "CriterionResult", "CriterionSettings", "PorosityCriterion", "in_window", "round_to", "specimen_checks",
-    "wall_forces",
+    "POROSITY_KEYS", "CriterionResult", "CriterionSettings", "PorosityCriterion", "closed_bracket", "decide",
+    "in_window", "next_trial", "porosity_numbers", "round_to", "specimen_checks", "wall_forces",
 ]  # fmt: skip

@@ -2,7 +2,7 @@
 
 A strength from one specimen is one sample of a chaotic packing, so the case study shears
 several specimens of the same accepted porosity. Each replicate is a criterion run of its
-own seed, first trial the porosity the main seed accepted, in ``out/seed<N>``; it must
+own seed, first trial the porosity the main seed accepted, in the sub-store ``seed<N>``; it must
 pass the criterion itself (a seed may settle on a neighbouring trial porosity: that is
 part of the spread). The runs are jobs of the executor's local processes
 (:mod:`poro2d.execute`) with one numba thread each: two threads on one specimen of a few
@@ -18,24 +18,24 @@ from pathlib import Path
 
 from poro2d.console import OutputConsole
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
-from poro2d.criterion.result import ReplicatesResult
+from poro2d.criterion.result import ReplicateRow, ReplicatesResult
 from poro2d.execute import Backend, Executor, Failed, Job, results_or_raise
 from poro2d.progress import JobsProgress
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.grading import GradingCurve
+from poro2d.store import Store
 
 console = OutputConsole()
 
 
-def _run_one(spec: SpecimenSpec, grading: GradingCurve, settings: CriterionSettings, seed: int, out: Path,
-             report) -> dict:  # fmt: skip
+def _run_one(spec: SpecimenSpec, grading: GradingCurve, settings: CriterionSettings, seed: int, store: Store,
+             report) -> ReplicateRow:  # fmt: skip
     """One replicate's criterion run (in a worker process); its summary row."""
     report("running")
     t0 = time.perf_counter()
-    res = PorosityCriterion(spec, grading, settings, seed=seed, out=out, progress=False).run()
-    return {"seed": seed, "final_porosity": res["final_porosity"], "converged": bool(res["converged"]),
-            "trials": len(res["iterations"]), "message": res["message"], "folder": out.name,
-            "time_s": time.perf_counter() - t0}  # fmt: skip
+    res = PorosityCriterion(spec, grading, settings, seed=seed, store=store, progress=False).run()
+    return ReplicateRow(seed, res.final_porosity, bool(res.converged), len(res.iterations), res.message,
+                        store.root.name, time.perf_counter() - t0)  # fmt: skip
 
 
 def run_replicates(
@@ -44,20 +44,20 @@ def run_replicates(
     settings: CriterionSettings,
     n2d: float,
     seeds: list[int],
-    out: Path,
+    store: Store,
     *,
     processes: int = 2,
     progress: bool = True,
 ) -> ReplicatesResult:
     """Criterion runs of ``seeds`` from the first trial ``n2d``, ``processes`` at a time.
 
-    Returns one summary row per seed (accepted or not, the criterion's message, its folder
-    under ``out``), in seed order, and the accepted specimens by label (``seed1``, ...) as
+    Returns one summary row per seed (accepted or not, the criterion's message, its sub-store
+    of ``store``), in seed order, and the accepted specimens by label (``seed1``, ...) as
     the result's ``specimens``.
     """
     spec1 = replace(spec, threads=1)
     first = replace(settings, trial_porosity=n2d)
-    jobs = [Job(_run_one, (spec1, grading, first, sd, Path(out) / f"seed{sd}"), f"seed {sd}", reports=True)
+    jobs = [Job(_run_one, (spec1, grading, first, sd, store.child(f"seed{sd}")), f"seed {sd}", reports=True)
             for sd in seeds]  # fmt: skip
     names = [job.label for job in jobs]
 
@@ -68,7 +68,7 @@ def run_replicates(
     with JobsProgress("replicate criterion", names, enabled=progress) as display:
         outcomes = Executor(Backend.local(processes)).map(jobs, on_report=display.update, on_done=ended)
         rows = results_or_raise(outcomes, "replicate criterion run(s)")
-    return ReplicatesResult(rows, out=Path(out))
+    return ReplicatesResult(rows, store=store)
 
 
 def accepted_and_replicates(
@@ -78,33 +78,30 @@ def accepted_and_replicates(
     n2d: float,
     seed: int,
     replicates: int,
-    out: Path,
+    store: Store,
     *,
     progress: bool,
 ) -> tuple[dict[str, Path], list[dict] | None]:
-    """The specimen ``seed`` accepted in ``out/criterion`` and, with replicates, those of the next seeds.
+    """The specimen ``seed`` accepted in ``store``'s ``criterion`` and, with replicates, the next seeds'.
 
-    The replicates are criterion runs from the accepted ``n2d`` in ``out/replicates``, one
-    process per thread of ``spec`` (:func:`run_replicates`); their rows are None without any.
+    The replicates are criterion runs from the accepted ``n2d`` in its ``replicates``, one
+    process per thread of ``spec`` (:func:`run_replicates`); their rows (as ``results.json``
+    holds them) are None without any.
     """
-    specimens = {f"seed{seed}": out / "criterion" / "specimen.npz"}
+    specimens = {f"seed{seed}": store.child("criterion").path("specimen.npz")}
     if replicates == 1:
         return specimens, None
     more_seeds = list(range(seed + 1, seed + replicates))
     console.print(f"  replicate specimens: seeds {', '.join(map(str, more_seeds))} from n2D = {n2d:.2f}")
-    more = run_replicates(spec, grading, settings, n2d, more_seeds, out / "replicates",
+    more = run_replicates(spec, grading, settings, n2d, more_seeds, store.child("replicates"),
                           processes=spec.threads, progress=progress)  # fmt: skip
-    return {**specimens, **more.specimens}, more.rows
+    return {**specimens, **more.specimens}, [row.to_dict() for row in more.rows]
 
 
-def _outcome(row: dict) -> str:
+def _outcome(row: ReplicateRow) -> str:
     """How a replicate ended, as its progress shows it."""
-    what = (
-        f"accepted n2D = {row['final_porosity']:.4f}"
-        if row["converged"]
-        else f"not accepted: {row['message']}"
-    )
-    return f"{what} ({row['trials']} trial(s) in {row['time_s']:.0f} s)"
+    what = f"accepted n2D = {row.final_porosity:.4f}" if row.converged else f"not accepted: {row.message}"
+    return f"{what} ({row.trials} trial(s) in {row.time_s:.0f} s)"
 
 
 __all__ = ["accepted_and_replicates", "run_replicates"]

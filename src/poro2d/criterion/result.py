@@ -2,18 +2,19 @@
 
 from __future__ import annotations
 
-import json
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Self
 
+from poro2d.criterion.trial import Trial
 from poro2d.measure.specimen_porosity import SpecimenPorosity
+from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
 @dataclass(eq=False)
 class CriterionResult(TypedResult):
-    """What a run of Fig. 3 found, with every trial (``iterations``: one dict per trial row).
+    """What a run of Fig. 3 found, with every trial (``iterations``: one ``Trial`` each).
 
     ``final_porosity`` is the accepted n2D, None when the run did not converge (``message``
     says why; ``failed_trial`` is the trial that was refused, if one was). Beside it, for an
@@ -34,7 +35,7 @@ class CriterionResult(TypedResult):
     n_lab: float
     initial_trial_porosity: float
     initial_from: str
-    iterations: list[dict[str, Any]]
+    iterations: list[Trial]
     seed: int
     settings: dict[str, Any]
     specimen: dict[str, Any]
@@ -50,25 +51,74 @@ class CriterionResult(TypedResult):
     # a wide grading's equilibrium test and why (poro2d.specimen.compaction.preparation_note)
     preparation_note: str | None = None
 
+    def to_dict(self) -> dict[str, Any]:
+        """The keys of ``result.json``; every trial as its row."""
+        d = super().to_dict()
+        if d.get("iterations") is not None:
+            d["iterations"] = [t.to_dict() if isinstance(t, Trial) else t for t in d["iterations"]]
+        return d
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Self:
+        """A result from ``result.json``; its trials' rows read as :class:`~poro2d.criterion.trial.Trial`."""
+        result = super().from_dict(data)
+        if result.iterations is not None:
+            result.iterations = [Trial.from_dict(row) for row in result.iterations]
+        return result
+
+
+@dataclass(frozen=True)
+class ReplicateRow:
+    """One seed's criterion run among replicates: whether it accepted a porosity, in how many trials.
+
+    ``folder``: the seed's sub-store (``seed<N>``); ``time_s``: the run's wall time.
+    """
+
+    seed: int
+    final_porosity: float | None
+    converged: bool
+    trials: int
+    message: str
+    folder: str
+    time_s: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
 
 @dataclass(eq=False)
 class ReplicatesResult(TypedResult):
-    """Replicate seeds' criterion runs: one row per seed, in seed order (``rows``).
+    """Replicate seeds' criterion runs: one :class:`ReplicateRow` per seed, in seed order (``rows``).
 
-    A row says whether the seed's criterion accepted a porosity (``seed``, ``final_porosity``,
-    ``converged``, ``trials``, ``message``, ``folder`` under ``out``, ``time_s``); the rows
-    are what ``poro2d paper`` writes as ``replicate_specimens`` in ``results.json``.
-    ``out`` (not a key) is the folder holding the seeds' folders.
+    The rows are what ``poro2d paper`` writes as ``replicate_specimens`` in ``results.json``.
+    ``store`` (not a key) is the store holding the seeds' sub-stores.
     """
 
-    rows: list[dict[str, Any]]
-    out: Path | None = field(default=None, kw_only=True, metadata=NOT_IN_FILE)
+    rows: list[ReplicateRow]
+    store: Store | None = field(default=None, kw_only=True, metadata=NOT_IN_FILE)
+
+    def to_dict(self) -> dict[str, Any]:
+        d = super().to_dict()
+        if d.get("rows") is not None:
+            d["rows"] = [r.to_dict() if isinstance(r, ReplicateRow) else r for r in d["rows"]]
+        return d
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Self:
+        result = super().from_dict(data)
+        if result.rows is not None:
+            result.rows = [ReplicateRow(**row) for row in result.rows]
+        return result
+
+    def __getitem__(self, key: str) -> Any:
+        return self.to_dict()[key]
 
     @property
     def specimens(self) -> dict[str, Path]:
         """The accepted specimens by label (``seed1``, ...): each seed's ``specimen.npz``."""
-        return {f"seed{r['seed']}": Path(self.out) / r["folder"] / "specimen.npz" for r in self.rows
-                if r["converged"]}  # fmt: skip
+        assert self.store is not None
+        return {f"seed{r.seed}": self.store.child(r.folder).path("specimen.npz") for r in self.rows
+                if r.converged}  # fmt: skip
 
 
 @dataclass(eq=False)
@@ -109,29 +159,23 @@ class CriterionOutputs:
     figures: dict[str, Path] = field(default_factory=dict)
 
     @classmethod
-    def read(cls, folder: str | Path, result: CriterionResult | None = None) -> CriterionOutputs:
-        """A finished criterion folder read back (``result``: the run's result, when in hand)."""
-        folder = Path(folder)
+    def read(cls, store: Store, result: CriterionResult | None = None) -> CriterionOutputs:
+        """A finished criterion run read back from its store (``result``: the run's result, when in hand)."""
         if result is None:
-            result = CriterionResult.from_dict(_json(folder / "result.json"))
-        state = _json(folder / "specimen_state.json")
-        porosity = _json(folder / "specimen_porosity.json")
+            result = store.read_result("result.json", CriterionResult.from_dict)
         return cls(
             result,
-            None if state is None else SpecimenStateResult.from_dict(state),
-            None if porosity is None else SpecimenPorosity.from_dict(porosity),
-            {name: folder / name for name in CRITERION_FIGURES if (folder / name).is_file()},
+            store.read_result("specimen_state.json", SpecimenStateResult.from_dict),
+            store.read_result("specimen_porosity.json", SpecimenPorosity.from_dict),
+            {name: store.path(name) for name in CRITERION_FIGURES if store.has(name)},
         )
-
-
-def _json(path: Path) -> dict | None:
-    return json.loads(path.read_text()) if path.is_file() else None
 
 
 __all__ = [
     "CRITERION_FIGURES",
     "CriterionOutputs",
     "CriterionResult",
+    "ReplicateRow",
     "ReplicatesResult",
     "SpecimenStateResult",
 ]

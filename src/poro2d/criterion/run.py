@@ -15,9 +15,10 @@ from pathlib import Path
 
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.criterion.result import CriterionResult
-from poro2d.locks import holds_output
+from poro2d.locks import output_folder
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.grading import GradingCurve
+from poro2d.store import Store
 
 ConfigLike = dict | str | os.PathLike | None
 
@@ -46,7 +47,22 @@ def load(
 DENSITY_KEYS = {"mode", "n_max", "n_min", "mu_prep", "seeds"}
 
 
-def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> dict:
+@dataclass(frozen=True)
+class DensitySettings:
+    """The mode of ``poro2d criterion`` and, in density mode, its settings.
+
+    ``mu_prep``: the calibration's preparation frictions (None: the defaults); ``n_max``,
+    ``n_min``: the laboratory extremes; ``seeds``: specimens per state (density mode only).
+    """
+
+    mode: str
+    mu_prep: list[float] | None = None
+    n_max: float | None = None
+    n_min: float | None = None
+    seeds: int | None = None
+
+
+def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> DensitySettings:
     """Mode and density-mode settings from ``[density]`` and the options (options win).
 
     With no mode given, density mode when both laboratory extremes are (``[density]`` or the
@@ -74,18 +90,21 @@ def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> d
         for option, value in (("--n-max", n_max), ("--n-min", n_min), ("--seeds", seeds)):
             if value is not None:
                 raise InputError(option, value, "only with --mode density (paper mode: the paper's protocol)")
-        return {"mode": mode, "mu_prep": None}
+        return DensitySettings(mode)
     mus = t.get("mu_prep")
-    out = {"mode": mode, "mu_prep": None if mus is None else check_mus(mus, "density.mu_prep")}
+    mu_prep = None if mus is None else check_mus(mus, "density.mu_prep")
     hi = n_max if n_max is not None else t.get("n_max", P.PAPER_N_MAX if preset else None)
     lo = n_min if n_min is not None else t.get("n_min", P.PAPER_N_MIN if preset else None)
     if hi is None or lo is None:
         raise InputError("density.n_max/n_min", (hi, lo), "both laboratory extremes",
                          "set them in [density] or with --n-max/--n-min")  # fmt: skip
-    out["n_max"] = check_range("n_max", hi, 0.0, 1.0, lo_open=True, hi_open=True)
-    out["n_min"] = check_range("n_min", lo, 0.0, 1.0, lo_open=True, hi_open=True)
-    out["seeds"] = check_int("seeds", seeds if seeds is not None else t.get("seeds", 3), 1, 50)
-    return out
+    return DensitySettings(
+        mode,
+        mu_prep,
+        n_max=check_range("n_max", hi, 0.0, 1.0, lo_open=True, hi_open=True),
+        n_min=check_range("n_min", lo, 0.0, 1.0, lo_open=True, hi_open=True),
+        seeds=check_int("seeds", seeds if seeds is not None else t.get("seeds", 3), 1, 50),
+    )
 
 
 @dataclass(frozen=True)
@@ -100,7 +119,7 @@ class CriterionInputs:
 
     config: dict
     base: Path | None
-    density: dict
+    density: DensitySettings
     spec: SpecimenSpec
     grading: GradingCurve
     settings: CriterionSettings
@@ -108,7 +127,7 @@ class CriterionInputs:
 
     @property
     def mode(self) -> str:
-        return self.density["mode"]
+        return self.density.mode
 
 
 def criterion_inputs(
@@ -141,18 +160,17 @@ def criterion_inputs(
     return CriterionInputs(cfg, base, dens, spec, grading, settings, sd)
 
 
-def run_paper_mode(inputs: CriterionInputs, out: Path, *, progress: bool = True) -> CriterionResult:
-    """The criterion of Fig. 3 once, on checked inputs, into ``out`` (resumable)."""
-    return PorosityCriterion(inputs.spec, inputs.grading, inputs.settings, seed=inputs.seed, out=out,
+def run_paper_mode(inputs: CriterionInputs, store: Store | None, *, progress: bool = True) -> CriterionResult:
+    """The criterion of Fig. 3 once, on checked inputs, kept in ``store`` (resumable; None: kept nowhere)."""
+    return PorosityCriterion(inputs.spec, inputs.grading, inputs.settings, seed=inputs.seed, store=store,
                              progress=progress, config=inputs.config).run()  # fmt: skip
 
 
-@holds_output("out")
 def run_criterion(
     config: ConfigLike = None,
     *,
     preset: str | None = None,
-    out: str | os.PathLike = "criterion-out",
+    store: Store | None = None,
     seed: int | None = None,
     n_lab: float | None = None,
     trial_porosity: float | None = None,
@@ -162,24 +180,28 @@ def run_criterion(
     """The criterion of Fig. 3 for a config (a dict, a TOML file, or the paper preset when None).
 
     Runs it once, as the paper does, and returns the
-    :class:`~poro2d.criterion.result.CriterionResult` written to ``out/result.json``. The
-    keyword options override the config as the command's options do. Density mode (a
+    :class:`~poro2d.criterion.result.CriterionResult` kept as ``result.json`` in ``store``
+    (held for the call, resumable; None: nothing is kept). The keyword options override the
+    config as the command's options do. Density mode (a
     config whose ``[density]`` table says ``mode = "density"``) runs on the sweep layer:
     :func:`poro2d.sweep.density_criterion.run_density_criterion` is its call, and it is
     refused here. Bad input raises :class:`~poro2d.errors.InputError` before anything is
     written.
     """
     from poro2d.errors import InputError
-    from poro2d.io_utils import check_output_dir
 
-    out = Path(out)
-    check_output_dir("--out", out)
-    inputs = criterion_inputs(config, preset=preset, seed=seed, n_lab=n_lab, trial_porosity=trial_porosity,
-                              threads=threads)  # fmt: skip
-    if inputs.mode == "density":
-        raise InputError("density.mode", "density", "paper here (density mode: "
-                         "poro2d.sweep.density_criterion.run_density_criterion)")  # fmt: skip
-    return run_paper_mode(inputs, out, progress=progress)
+    def run() -> CriterionResult:
+        inputs = criterion_inputs(config, preset=preset, seed=seed, n_lab=n_lab,
+                                  trial_porosity=trial_porosity, threads=threads)  # fmt: skip
+        if inputs.mode == "density":
+            raise InputError("density.mode", "density", "paper here (density mode: "
+                             "poro2d.sweep.density_criterion.run_density_criterion)")  # fmt: skip
+        return run_paper_mode(inputs, store, progress=progress)
+
+    if store is None:
+        return run()
+    with output_folder(store.parameter, store.root, kind="criterion"):
+        return run()
 
 
-__all__ = ["CriterionInputs", "criterion_inputs", "run_criterion", "run_paper_mode"]
+__all__ = ["CriterionInputs", "DensitySettings", "criterion_inputs", "run_criterion", "run_paper_mode"]

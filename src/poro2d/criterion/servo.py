@@ -14,12 +14,41 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 from poro2d.criterion.lid import FlatPlate, SegmentedLid
 from poro2d.dem import Simulation
 
 _log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class PlateSettle:
+    """What the plate stage of :meth:`PlateServo.settle` did: the ``plate_*`` keys of a trial's row."""
+
+    settled: bool
+    steps: int
+    rounds: int
+    final_max_ratio: float
+    displacement_m: float
+    height_m: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "plate_settled": self.settled,
+            "plate_steps": self.steps,
+            "plate_rounds": self.rounds,
+            "plate_final_max_ratio": self.final_max_ratio,
+            "plate_displacement_m": self.displacement_m,
+            "plate_height_m": self.height_m,
+        }
+
+    @classmethod
+    def from_row(cls, row: dict) -> PlateSettle:
+        return cls(
+            row.get("plate_settled"), row.get("plate_steps"), row.get("plate_rounds"),
+            row.get("plate_final_max_ratio"), row.get("plate_displacement_m"), row.get("plate_height_m"),
+        )  # fmt: skip
 
 
 def in_window(f_top: float, weight: float, fraction: float) -> bool:
@@ -65,7 +94,9 @@ class PlateServo:
         s = self.settings
         return s.servo_target_fraction * (s.force_fraction * weight) * sim.particles.thickness
 
-    def settle(self, sim: Simulation, weight: float, top: FlatPlate | SegmentedLid | None = None) -> dict:
+    def settle(
+        self, sim: Simulation, weight: float, top: FlatPlate | SegmentedLid | None = None
+    ) -> PlateSettle:
         """Servo ``top`` (the flat plate by default) until the window holds at equilibrium.
 
         Each round (:meth:`round`) has two phases. The approach servos the plate briskly
@@ -80,9 +111,8 @@ class PlateServo:
         the force, and counts as in the window only while it rests on the specimen over
         most of the width. ``weight``: the self weight G (N/m).
 
-        Returns the plate stage's record: ``plate_settled``, ``plate_steps``,
-        ``plate_rounds``, ``plate_final_max_ratio``, ``plate_displacement_m``,
-        ``plate_height_m``.
+        Returns the plate stage's record (:class:`PlateSettle`): whether it settled, the
+        steps and rounds, the final unbalanced-force ratio, the displacement and height.
         """
         s = self.settings
         top = FlatPlate(sim) if top is None else top
@@ -95,14 +125,7 @@ class PlateServo:
             rounds += 1
             steps, ok, final_ratio = self.round(sim, weight, rounds, steps, top)
         y_end = top.height(sim)
-        return {
-            "plate_settled": ok,
-            "plate_steps": steps,
-            "plate_rounds": rounds,
-            "plate_final_max_ratio": final_ratio,
-            "plate_displacement_m": y_end - y_start,
-            "plate_height_m": y_end,
-        }
+        return PlateSettle(ok, steps, rounds, final_ratio, y_end - y_start, y_end)
 
     def round(
         self, sim: Simulation, weight: float, rounds: int, steps: int, top: FlatPlate | SegmentedLid
@@ -182,4 +205,4 @@ class PlateServo:
         return settled
 
 
-__all__ = ["PlateServo", "ServoSettings", "in_window"]
+__all__ = ["PlateServo", "PlateSettle", "ServoSettings", "in_window"]

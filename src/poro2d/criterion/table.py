@@ -6,15 +6,15 @@ command itself (its two modes) is :mod:`poro2d.cli.criterion`.
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from poro2d.console import OutputConsole, Table
 from poro2d.criterion.result import CriterionResult
+from poro2d.store import Store
 
 console = OutputConsole()
 
 
-def print_result(result: CriterionResult, out: Path) -> None:
+def print_result(result: CriterionResult, store: Store) -> None:
+    """The trials of ``result`` as a table, its message and where ``store`` keeps it."""
     t = Table(title=f"criterion (Fig. 3): nLab = {result.n_lab}")
     for col in ("trial n2D", "disks", "F_top N/m", "F_bottom N/m", "G N/m", "plate", "dz (mm)", "n' (box)",
                 "|n'-n2D|", "interior n", "gap/d50", "accepted"):  # fmt: skip
@@ -37,7 +37,7 @@ def print_result(result: CriterionResult, out: Path) -> None:
             )
     if result.preparation_note:
         console.print(f"preparation: {result.preparation_note}", soft_wrap=True)
-    console.print(f"{result.message}; results in {out}/result.json")
+    console.print(f"{result.message}; results in {store.root}/result.json")
     if result.interior_porosity is not None:
         under_lid = result.settings.get("acceptance") == "fill"
         what = (

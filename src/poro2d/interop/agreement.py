@@ -56,7 +56,7 @@ def run_poro2d(spec: SpecimenData, ratio: float, max_steps: int) -> SettledRun:
     res = sim.solve(ratio, max_steps)
     mags = sim.contacts().magnitude
     return SettledRun(
-        **_named_forces(wall_forces(sim)),
+        **_named_forces(wall_forces(sim).to_dict()),
         mean_contact_force_n=float(mags.mean()) if mags.size else 0.0,
         coordination_number=coordination_number(sim),
         contacts=int(mags.size),

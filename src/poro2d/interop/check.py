@@ -152,7 +152,7 @@ def check_specimen(
     res = sim.solve(ratio, max_steps, progress="equilibrium" if progress else False)
     n_box = box_porosity(sim.particles.area(), box.width, box.height)
     weight = box.self_weight(n_box)
-    forces = wall_forces(sim)
+    forces = wall_forces(sim).to_dict()
     passes = bool(res.converged and in_window(forces["f_top_n_per_m"], weight, settings.force_fraction))
     report = {
         "source": spec.source,
@@ -177,10 +177,10 @@ def check_specimen(
     plate = servo.settle(sim, weight)
     after = wall_forces(sim)
     report["plate"] = {
-        **plate,
+        **plate.to_dict(),
         "moved": "down" if forces["f_top_n_per_m"] <= 0.0 else "up",
-        "new_porosity": box_porosity(sim.particles.area(), box.width, plate["plate_height_m"]),
-        "f_top_after_n_per_m": after["f_top_n_per_m"],
-        "f_bottom_after_n_per_m": after["f_bottom_n_per_m"],
+        "new_porosity": box_porosity(sim.particles.area(), box.width, plate.height_m),
+        "f_top_after_n_per_m": after.f_top_n_per_m,
+        "f_bottom_after_n_per_m": after.f_bottom_n_per_m,
     }
     return sim, report

@@ -103,16 +103,16 @@ def criterion_case(config: dict, store: Store) -> dict:
     The dict is the case's row of table cells (the kind's contract with the runner).
     """
     from poro2d.criterion.protocol import PorosityCriterion
+    from poro2d.store import Store
 
     out_dir = store.root
     spec, grading, settings, seed = criterion_objects(config)
     figures = bool(config.get("sweep_options", {}).get("figures", False))
-    crit = PorosityCriterion(
-        spec, grading, settings, seed=seed, out=out_dir, progress=False, config=config, figures=figures
-    )
+    crit = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(out_dir), progress=False,
+                             config=config, figures=figures)  # fmt: skip
     res = crit.run()
     first = res["iterations"][0] if res["iterations"] else {}
-    # the accepted trial (not always the last: see PorosityCriterion._closed_bracket), else the last
+    # the accepted trial (not always the last: see poro2d.criterion.protocol.closed_bracket), else the last
     its = res["iterations"]
     last = next((r for r in its if r.get("accepted")), its[-1] if its else {})
     return {

@@ -85,8 +85,8 @@ def _run_density_mode(inputs: CriterionInputs, store: Store, *, threads: int | N
         rest["specimen"] = dict(rest.get("specimen") or {}, threads=inputs.spec.threads)
     dens = inputs.density
     base = CriterionBase(rest, inputs.base)
-    return run_density_state(base, inputs.settings.n_lab, dens["n_max"], dens["n_min"], store,
-                             seeds=dens["seeds"], mus=dens["mu_prep"], progress=progress)  # fmt: skip
+    return run_density_state(base, inputs.settings.n_lab, dens.n_max, dens.n_min, store,
+                             seeds=dens.seeds, mus=dens.mu_prep, progress=progress)  # fmt: skip
 
 
 def _refuse_paper_options(seed: int | None, trial_porosity: float | None) -> None:
@@ -152,8 +152,7 @@ def run_criterion_modes(
                                   trial_porosity=trial_porosity, threads=threads, mode=mode, n_max=n_max,
                                   n_min=n_min, seeds=seeds)  # fmt: skip
         if inputs.mode == "paper":
-            out = kept.root  # paper mode's criterion keeps its own files in the folder
-            return run_paper_mode(inputs, out, progress=progress)
+            return run_paper_mode(inputs, kept, progress=progress)
         _refuse_paper_options(seed, trial_porosity)
         return _run_density_mode(inputs, kept, threads=threads, progress=progress)
 

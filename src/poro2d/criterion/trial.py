@@ -1,0 +1,326 @@
+"""One trial of Fig. 3 as a typed record made of its parts.
+
+A trial is its preparation (:class:`Preparation`, what ``prepared.json`` holds), the wall
+forces as prepared, its plate (or lid) stage (:class:`PlateStage`), the stage that did not
+reach equilibrium if one did not (:class:`StageFailure`), the wall forces after the plate
+stage, the checks and the numbers behind them, the porosities of its decision state and
+the decision itself (:class:`Decision`).
+
+The files keep the row a trial always had: :meth:`Trial.to_dict` gives the keys of
+``trial.json`` (and of a trial of ``result.json``) in their order, with the values as they
+are read back (plain booleans and numbers, ``None`` for NaN); :meth:`Trial.flat` is its row
+of ``iterations.csv``. :meth:`Trial.from_dict` reads any such row back, in the order its
+file has it, keeping keys it does not model.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+from poro2d.criterion.lid import LidNumbers
+from poro2d.criterion.measures import CheckNumbers, Checks, PorosityNumbers, WallForces
+from poro2d.criterion.servo import PlateSettle
+from poro2d.io_utils import as_json
+
+
+def trial_name(k: int, n: float) -> str:
+    """Trial ``k``'s folder in a criterion's store (``trials/02_n0.2300``)."""
+    return f"trials/{k:02d}_n{n:.4f}"
+
+
+@dataclass(frozen=True)
+class Preparation:
+    """A trial's specimen as prepared: its preparation's report (``prepared.json``), read by name.
+
+    ``report`` is the report of :func:`poro2d.specimen.compaction.prepare_specimen` with the
+    trial's seed, time, self weight and wall forces: the file's content, kept whole.
+    """
+
+    report: dict[str, Any]
+
+    @property
+    def particle_count(self) -> int:
+        return self.report["particle_count"]
+
+    @property
+    def planned_count(self) -> int:
+        return self.report["planned_count"]
+
+    @property
+    def measured_porosity(self) -> float:
+        return self.report["measured_porosity"]
+
+    @property
+    def converged(self) -> bool:
+        return self.report["converged"]
+
+    @property
+    def overfull_m(self) -> float:
+        """How far the specimen stood above H (0 unless the layers did not fit below it)."""
+        return float(self.report.get("overfull_m") or 0.0)
+
+    @property
+    def time_s(self) -> float | None:
+        return self.report.get("time_s")
+
+    def failure(self, equilibrium: str) -> StageFailure:
+        """The stage of a preparation that did not reach equilibrium (``equilibrium``: its measure)."""
+        r = self.report
+        return StageFailure(r["failed_stage"], r["failed_max_ratio"], r["failed_steps"],
+                            r.get("failed_ratio", r["failed_max_ratio"]), equilibrium)  # fmt: skip
+
+    def to_dict(self) -> dict[str, Any]:
+        return self.report
+
+
+@dataclass(frozen=True)
+class StageFailure:
+    """A stage that did not reach equilibrium: the preparation's or the top plate's.
+
+    ``ratio`` and ``equilibrium`` (the ratio measured and its measure) only for the preparation.
+    """
+
+    stage: Any
+    max_ratio: Any
+    steps: Any
+    ratio: Any = None
+    equilibrium: Any = None
+
+    def to_dict(self) -> dict[str, Any]:
+        d = {"failed_stage": self.stage, "failed_max_ratio": self.max_ratio, "failed_steps": self.steps}
+        if self.equilibrium is not None:
+            d.update(failed_ratio=self.ratio, equilibrium=self.equilibrium)
+        return d
+
+    @classmethod
+    def from_row(cls, row: Mapping[str, Any]) -> StageFailure | None:
+        if "failed_stage" not in row:
+            return None
+        return cls(row["failed_stage"], row.get("failed_max_ratio"), row.get("failed_steps"),
+                   row.get("failed_ratio"), row.get("equilibrium"))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class PlateStage:
+    """Step 3 of Fig. 3: how the top moved (``moved``: "no", "up", "down", "lid", "not run") and n'.
+
+    ``servo``: the servo's record when the plate (or lid) moved; ``settled`` and
+    ``displacement_m`` otherwise (a plate already in the window, or a stage not run);
+    ``lid`` and ``lid_note``: the lid's numbers and a note on its window, under the fill
+    acceptance.
+    """
+
+    moved: Any
+    new_porosity: Any
+    servo: PlateSettle | None = None
+    settled: bool | None = None
+    displacement_m: Any = 0.0
+    lid: LidNumbers | None = None
+    lid_note: str | None = None
+
+    @property
+    def is_settled(self) -> bool:
+        """Whether the stage ended with the plate settled in the window (False when it never ran)."""
+        return bool(self.servo.settled if self.servo is not None else self.settled)
+
+    def to_dict(self) -> dict[str, Any]:
+        d: dict[str, Any] = {"plate_moved": self.moved}
+        if self.servo is None:
+            d.update(plate_displacement_m=self.displacement_m, new_porosity=self.new_porosity)
+            if self.settled is not None:
+                d["plate_settled"] = self.settled
+            return d
+        d.update(self.servo.to_dict())
+        d["new_porosity"] = self.new_porosity
+        if self.lid is not None:
+            d.update(self.lid.to_dict())
+        if self.lid_note is not None:
+            d["lid_note"] = self.lid_note
+        return d
+
+    @classmethod
+    def from_row(cls, row: Mapping[str, Any]) -> PlateStage:
+        servo = PlateSettle.from_row(row) if "plate_steps" in row else None
+        return cls(
+            row.get("plate_moved"), row.get("new_porosity"), servo,
+            settled=None if servo is not None else row.get("plate_settled"),
+            displacement_m=row.get("plate_displacement_m"), lid=LidNumbers.from_row(row),
+            lid_note=row.get("lid_note"),
+        )  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Decision:
+    """Accepted, rejected or refused: the paper's condition, the first failed check and why.
+
+    ``accepted_at`` is "closed bracket" for a trial accepted when refinement could go no finer.
+    """
+
+    condition_met: bool
+    failed_check: str
+    accepted: bool
+    refused: bool
+    reason: str
+    accepted_at: str | None = None
+
+    def to_dict(self, refused_first: bool) -> dict[str, Any]:
+        """The decision's keys; ``refused`` before ``reason`` for a trial that failed no stage or check."""
+        d: dict[str, Any] = {"condition_met": self.condition_met, "failed_check": self.failed_check,
+                             "accepted": self.accepted}  # fmt: skip
+        if refused_first:
+            d.update(refused=self.refused, reason=self.reason)
+        else:
+            d.update(reason=self.reason, refused=self.refused)
+        return d
+
+    @classmethod
+    def from_row(cls, row: Mapping[str, Any]) -> Decision:
+        return cls(row.get("condition_met"), row.get("failed_check"), row.get("accepted"), row.get("refused"),
+                   row.get("reason"), row.get("accepted_at"))  # fmt: skip
+
+
+#: the keys of a row that the decision sets
+DECISION_KEYS = ("condition_met", "failed_check", "accepted", "refused", "reason", "accepted_at")
+
+
+@dataclass(eq=False)
+class Trial(Mapping):
+    """One trial of Fig. 3, made of its parts; read as the dict of its row (``trial["new_porosity"]``).
+
+    ``preparation`` is the prepared specimen's report for a trial run now, None for a trial
+    read back from its row (the row keeps what the trial uses of it: counts, porosity,
+    whether it converged and how far the box was over-full).
+    """
+
+    iteration: int
+    trial_porosity: float
+    particle_count: int
+    planned_particle_count: int
+    measured_porosity_after_generation: float
+    forces: WallForces
+    self_weight_n_per_m: float
+    force_limit_n_per_m: float
+    preparation_converged: bool
+    converged: bool
+    plate: PlateStage
+    forces_after: WallForces
+    porosity_change: float | None
+    check_numbers: CheckNumbers
+    checks: Checks
+    decision: Decision
+    overfull_m: float = 0.0
+    failure: StageFailure | None = None
+    porosity: PorosityNumbers | None = None
+    time_prepare_s: float | None = None
+    time_plate_s: float | None = None
+    preparation: Preparation | None = field(default=None, repr=False)
+    #: keys of a row read back that the record does not model, and the row's key order
+    extra: dict[str, Any] = field(default_factory=dict, repr=False)
+    order: tuple[str, ...] | None = field(default=None, repr=False)
+
+    @property
+    def new_porosity(self) -> float | None:
+        """n': the porosity of the box after the plate stage (None when it never ran)."""
+        return self.plate.new_porosity
+
+    def modelled_row(self) -> dict[str, Any]:
+        """The row's keys in the order the trial records them."""
+        d: dict[str, Any] = {
+            "iteration": self.iteration,
+            "trial_porosity": self.trial_porosity,
+            "particle_count": self.particle_count,
+            "planned_particle_count": self.planned_particle_count,
+            "measured_porosity_after_generation": self.measured_porosity_after_generation,
+            "f_top_n_per_m": self.forces.f_top_n_per_m,
+            "f_bottom_n_per_m": self.forces.f_bottom_n_per_m,
+            "side_friction_up_n_per_m": self.forces.side_friction_up_n_per_m,
+            "self_weight_n_per_m": self.self_weight_n_per_m,
+            "force_limit_n_per_m": self.force_limit_n_per_m,
+            "preparation_converged": self.preparation_converged,
+            "converged": self.converged,
+        }
+        if self.overfull_m > 0.0:  # recorded only when it happens: ordinary rows keep their keys
+            d["overfull_m"] = self.overfull_m
+        d.update(self.plate.to_dict())
+        if self.failure is not None:
+            d.update(self.failure.to_dict())
+        d["f_top_after_n_per_m"] = self.forces_after.f_top_n_per_m
+        d["f_bottom_after_n_per_m"] = self.forces_after.f_bottom_n_per_m
+        d["side_friction_up_after_n_per_m"] = self.forces_after.side_friction_up_n_per_m
+        d["porosity_change"] = self.porosity_change
+        d.update(self.check_numbers.to_dict())
+        if self.porosity is not None:
+            d.update(self.porosity.to_dict())
+        d["checks"] = self.checks.to_dict()
+        d.update(self.decision.to_dict(refused_first=bool(self.converged and not self.decision.failed_check)))
+        d["time_prepare_s"] = self.time_prepare_s
+        d["time_plate_s"] = self.time_plate_s
+        if self.decision.accepted_at is not None:
+            d["accepted_at"] = self.decision.accepted_at
+        return d
+
+    def to_dict(self) -> dict[str, Any]:
+        """The trial's row as its file holds it (``trial.json``; a trial of ``result.json``)."""
+        row = {**self.modelled_row(), **self.extra}
+        if self.order is not None:
+            # a row read back keeps its file's keys in their order; of the keys its file lacks,
+            # only what a decision taken since set (a closed bracket's acceptance) comes last
+            gained = {k: row[k] for k in DECISION_KEYS if k not in self.order and row.get(k) is not None}
+            row = {**{k: row[k] for k in self.order if k in row}, **gained}
+        return as_json(row)
+
+    def flat(self) -> dict[str, Any]:
+        """The trial's row of ``iterations.csv``: the checks as ``check_<name>`` columns."""
+        row = self.to_dict()
+        checks = row.pop("checks", {})
+        row.update({f"check_{k}": v for k, v in checks.items()})
+        return row
+
+    @classmethod
+    def from_dict(cls, row: Mapping[str, Any]) -> Trial:
+        """A trial from its row (``trial.json``, a trial of ``result.json``, or :meth:`to_dict`)."""
+        trial = cls(
+            iteration=row.get("iteration"),
+            trial_porosity=row.get("trial_porosity"),
+            particle_count=row.get("particle_count"),
+            planned_particle_count=row.get("planned_particle_count"),
+            measured_porosity_after_generation=row.get("measured_porosity_after_generation"),
+            forces=WallForces.from_row(dict(row)),
+            self_weight_n_per_m=row.get("self_weight_n_per_m"),
+            force_limit_n_per_m=row.get("force_limit_n_per_m"),
+            preparation_converged=row.get("preparation_converged"),
+            converged=row.get("converged"),
+            plate=PlateStage.from_row(row),
+            forces_after=WallForces.from_row(dict(row), "_after"),
+            porosity_change=row.get("porosity_change"),
+            check_numbers=CheckNumbers.from_row(dict(row)),
+            checks=Checks(**{f.name: (row.get("checks") or {}).get(f.name) for f in fields(Checks)}),
+            decision=Decision.from_row(row),
+            overfull_m=row.get("overfull_m") or 0.0,
+            failure=StageFailure.from_row(row),
+            porosity=PorosityNumbers.from_row(dict(row)),
+            time_prepare_s=row.get("time_prepare_s"),
+            time_plate_s=row.get("time_plate_s"),
+        )
+        modelled = trial.modelled_row()
+        trial.extra = {k: v for k, v in row.items() if k not in modelled}
+        checks = row.get("checks")
+        if isinstance(checks, Mapping) and list(checks) != list(trial.checks.to_dict()):
+            trial.extra["checks"] = checks  # checks this version does not know: kept as they were
+        trial.order = tuple(row)
+        return trial
+
+    # read-only mapping access: the trial reads as the dict of its row
+    def __getitem__(self, key: str) -> Any:
+        return self.to_dict()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.to_dict())
+
+    def __len__(self) -> int:
+        return len(self.to_dict())
+
+
+__all__ = ["Decision", "PlateStage", "Preparation", "StageFailure", "Trial", "trial_name"]
