@@ -206,10 +206,6 @@ FILE_HOMES = (
     "specimen/grading.py",
 )
 
-#: modules that still read or write result files themselves, on their way to the store;
-#: this list only shrinks
-NOT_YET_THROUGH_STORE = {}
-
 #: calls that read or write files: (owner or "" for a bare name, function)
 _FILE_CALLS = {
     ("", "write_json"), ("", "write_csv"), ("", "atomic_path"), ("", "open"),
@@ -246,7 +242,7 @@ def test_result_files_are_read_and_written_by_the_store_only():
     found = {}
     for p in sorted(PACKAGE.rglob("*.py")):
         rel = p.relative_to(PACKAGE).as_posix()
-        if rel.startswith(FILE_HOMES) or rel in NOT_YET_THROUGH_STORE:
+        if rel.startswith(FILE_HOMES):
             continue
         calls = _file_calls(p)
         if calls:
@@ -254,11 +250,3 @@ def test_result_files_are_read_and_written_by_the_store_only():
     assert not found, "file reads and writes outside the store:\n" + "\n".join(
         f"{k}: {v}" for k, v in found.items()
     )
-
-
-def test_the_list_of_modules_not_yet_through_the_store_is_current():
-    """A module that now goes through the store leaves NOT_YET_THROUGH_STORE (the list only shrinks)."""
-    stale = sorted(
-        m for m in NOT_YET_THROUGH_STORE if not (PACKAGE / m).is_file() or not _file_calls(PACKAGE / m)
-    )
-    assert not stale, f"remove from NOT_YET_THROUGH_STORE: {stale}"
