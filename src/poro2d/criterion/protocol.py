@@ -37,6 +37,7 @@ import numpy as np
 
 from poro2d.config import check_finite
 from poro2d.criterion.lid import (
+    FlatPlate,
     SegmentedLid,
     fill_porosity,
     lid_numbers,
@@ -430,7 +431,7 @@ class PorosityCriterion:
             plate = PlateStage("no", n, settled=True, displacement_m=0.0)
             after = forces0
         else:
-            plate, after = self._top_stage(sim, k, n, weight, forces0.f_top_n_per_m)
+            plate, after = self._top_stage(sim, k, n, weight, forces0.f_top_n_per_m, prep.overfull_m > 0.0)
             if not plate.is_settled:
                 assert plate.servo is not None
                 failure = StageFailure("top plate", plate.servo.final_max_ratio, plate.servo.steps)
@@ -469,16 +470,23 @@ class PorosityCriterion:
         return trial
 
     def _top_stage(
-        self, sim: Simulation, k: int, n: float, weight: float, f_top: float
+        self, sim: Simulation, k: int, n: float, weight: float, f_top: float, overfull: bool = False
     ) -> tuple[PlateStage, WallForces]:
         """Move the plate (or rest the lid) until the force window holds; the stage, the wall forces after.
 
         Paper acceptance: the plate moves down when F_top = 0 and up when it is too large,
         and n' is the box porosity under it. Fill acceptance: the lid replaces the plate
         and n' is the porosity of the area under it (:func:`~poro2d.criterion.lid.fill_porosity`).
+        An over-full box with rolling friction first rises free to roll
+        (:meth:`~poro2d.criterion.servo.PlateServo.relax_rolling`).
         """
         width = self.spec.width
         servo = self.plate_servo()
+        free = None
+        mu_r = self.spec.rolling_friction
+        if overfull and mu_r > 0.0:
+            free = servo.relax_rolling(sim, weight, mu_r)
+            f_top = FlatPlate(sim).force(sim) / sim.particles.thickness
         if self.settings.acceptance == "fill":
             if not in_window(f_top, weight, self.settings.force_fraction):
                 # the plate first takes the specimen to the window (a dense trial pushes hard
@@ -500,6 +508,8 @@ class PorosityCriterion:
         else:
             moved = "down" if f_top <= 0.0 else "up"
             settle = servo.settle(sim, weight)
+            if free is not None:
+                moved, settle = "up", free.then(settle)
             stage = PlateStage(moved, box_porosity(sim.particles.area(), width, settle.height_m), settle)
         return stage, self._after_top(sim, k, n, weight, stage)
 

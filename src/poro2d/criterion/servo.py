@@ -43,6 +43,13 @@ class PlateSettle:
             "plate_height_m": self.height_m,
         }
 
+    def then(self, later: PlateSettle) -> PlateSettle:
+        """This stage followed by ``later``: one record of both (steps, rounds and moves add up)."""
+        return PlateSettle(
+            later.settled, self.steps + later.steps, self.rounds + later.rounds,
+            later.final_max_ratio, self.displacement_m + later.displacement_m, later.height_m,
+        )  # fmt: skip
+
     @classmethod
     def from_row(cls, row: dict) -> PlateSettle:
         return cls(
@@ -126,6 +133,24 @@ class PlateServo:
             steps, ok, final_ratio = self.round(sim, weight, rounds, steps, top)
         y_end = top.height(sim)
         return PlateSettle(ok, steps, rounds, final_ratio, y_end - y_start, y_end)
+
+    def relax_rolling(self, sim: Simulation, weight: float, rolling_friction: float) -> PlateSettle:
+        """Let an over-full specimen with rolling friction rise to the window free to roll.
+
+        An over-full box (a trial denser than its grading packs) starts the plate stage
+        squeezed hundreds of times its weight. Without rolling friction its disks roll apart
+        as the plate rises, sideways as well as up. Rolling friction locks them: the packing
+        rises as a plug wedged between the side walls (their friction holding it down by
+        about the force it had pressed up with), and disks stay pressed into the walls by
+        more than the in-box check allows: the trial was refused. The plate therefore first
+        rises with rolling friction off (disks and walls), which frees the locked stress;
+        the rolling friction ``rolling_friction`` is then set again and the caller settles
+        the plate with it. Returns the plate stage of the free rise.
+        """
+        sim.set_rolling_friction(0.0, walls=0.0)
+        free = self.settle(sim, weight)
+        sim.set_rolling_friction(rolling_friction, walls=rolling_friction)
+        return free
 
     def round(
         self, sim: Simulation, weight: float, rounds: int, steps: int, top: FlatPlate | SegmentedLid
