@@ -20,7 +20,7 @@ def test_a_free_rise_and_the_settling_after_it_are_one_plate_record():
     assert not free.then(PlateSettle(False, 5, 1, 0.1, 0.0, 0.045)).settled
 
 
-@pytest.mark.slow
+@pytest.mark.scenario  # two whole criterion runs of an over-full box (a minute each)
 @pytest.mark.parametrize("rolling", [0.4, 1.0])
 def test_an_overfull_first_trial_with_rolling_friction_keeps_every_disk_in_the_box(tmp_path, rolling):
     """Trial 0.07 of the wide grading in a small box (over-full by 1.5 mm), rolling friction 0.4
