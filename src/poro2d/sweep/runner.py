@@ -136,7 +136,7 @@ def _run_case(case: dict, store: Store, func) -> CaseRow:
         return CaseRow.from_dict(row)
 
 
-def _done_row(case: dict, store: Store, func, row: dict, t0: float) -> dict:
+def _done_row(case: dict, store: Store, func, row: dict, t0: float) -> CaseRow:
     """Run the case's kind into its sub-store ``run``; its row (``status`` done, results as table cells)."""
     results = func(case["config"], store.child("run"))
     if not isinstance(results, dict):
@@ -146,7 +146,7 @@ def _done_row(case: dict, store: Store, func, row: dict, t0: float) -> dict:
     row["results"] = results
     for stale in (ERROR_TXT, ERROR_JSON):
         store.remove(stale)
-    return row  # written as result.json, the done marker, last
+    return CaseRow.from_dict(row)  # written as result.json, the done marker, last
 
 
 def _worker_address() -> str:
