@@ -31,23 +31,23 @@ def main(argv=None) -> int:
 
     spec = from_checkpoint(args.specimen)
     r = compare(spec, ratio=args.ratio, max_steps=args.max_steps, workdir=args.workdir)
-    ours, theirs = r["poro2d"], r["lammps"]
-    t = Table(title=f"{spec.n} disks, G = {r['weight_n_per_m']:.4g} N/m, stop ratio {args.ratio:g}")
+    ours, theirs = r.poro2d, r.lammps
+    t = Table(title=f"{spec.n} disks, G = {r.weight_n_per_m:.4g} N/m, stop ratio {args.ratio:g}")
     for col in ("quantity", "poro2d", "LAMMPS", "|diff| / poro2d", "|diff| / G"):
         t.add_column(col, justify="right")
     for key, label in QUANTITIES:
-        relg = r["rel_to_weight"].get(key)
+        relg = r.rel_to_weight.get(key)
         t.add_row(
-            label, f"{ours[key]:.6g}", f"{theirs[key]:.6g}", f"{r['rel_diff'][key]:.2e}",
+            label, f"{getattr(ours, key):.6g}", f"{getattr(theirs, key):.6g}", f"{r.rel_diff[key]:.2e}",
             "" if relg is None else f"{relg:.2e}",
         )  # fmt: skip
-    t.add_row("steps to rest", str(ours["steps"]), str(theirs["steps"]), "", "")
-    t.add_row("seconds", f"{ours['seconds']:.1f}", f"{theirs['seconds']:.1f}", "", "")
+    t.add_row("steps to rest", str(ours.steps), str(theirs.steps), "", "")
+    t.add_row("seconds", f"{ours.seconds:.1f}", f"{theirs.seconds:.1f}", "", "")
     console = OutputConsole()
     console.print(t)
-    console.print(f"LAMMPS {theirs['lammps_version']}")
+    console.print(f"LAMMPS {theirs.lammps_version}")
     if args.json:
-        write_json(args.json, dict(r, specimen=spec.source, provenance=provenance()))
+        write_json(args.json, dict(r.to_dict(), specimen=spec.source, provenance=provenance()))
     return 0
 
 

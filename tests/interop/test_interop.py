@@ -33,7 +33,7 @@ def test_checkpoint_reads_as_the_simulation_holds_it(saved, spec):
     assert np.array_equal(np.column_stack([spec.x, spec.y]), sim.particles.pos)
     assert spec.thickness == 0.008 and spec.dt == sim.dt and spec.gravity == (0.0, -9.81)
     assert spec.box() == (0.0, 0.06, 0.0, 0.03)
-    assert spec.contact_parameters()["top"] == (series(4e5, 1e7), series(4e5, 1e7), 1.5)
+    assert spec.contact_parameters().walls["top"] == (series(4e5, 1e7), series(4e5, 1e7), 1.5)
     live = from_simulation(sim)  # a running Simulation gives the same numbers
     _same_disks(spec, live)
     assert live.walls == spec.walls and live.dt == spec.dt
@@ -218,3 +218,19 @@ def test_import_of_a_loose_box_moves_the_plate_down(spec, tmp_path, capsys):
     assert math.isfinite(rep["plate"]["plate_height_m"]) and "poro2d_version" in rep["provenance"]
     assert (tmp_path / "out" / "specimen.npz").is_file() and (tmp_path / "out" / "after_plate.npz").is_file()
     assert "moving down" in capsys.readouterr().out
+
+
+def test_result_lines_read_as_typed_records():
+    """The last ``poro2d-result`` line a LAMMPS or YADE script prints, one field per key."""
+    from poro2d.interop.lammps_run import read_result_line
+    from poro2d.interop.yade_run import read_result
+
+    log = "poro2d-result ratio 9 f_top 9 f_bottom 9 side_friction_up 9 f_left 9 f_right 9 coordination 9\n"
+    log += "poro2d-result ratio 1e-4 f_top 1.5 f_bottom 800 side_friction_up 2 f_left 3 f_right 4 "
+    log += "coordination 3.5"
+    line = read_result_line(log)
+    assert (line.ratio, line.f_top, line.f_bottom, line.coordination) == (1e-4, 1.5, 800.0, 3.5)
+    out = "poro2d-result f_top_n_per_m 1.0 f_bottom_n_per_m 2.0 side_friction_up_n_per_m 0.5 "
+    out += "unbalanced_force 1e-05 steps 1200"
+    res = read_result(out)
+    assert (res.f_bottom_n_per_m, res.unbalanced_force, int(res.steps)) == (2.0, 1e-5, 1200)

@@ -32,12 +32,12 @@ def test_the_record_digest_of_a_fixed_case_is_pinned(specimen):
     value = replace(Specimen.read(specimen), digest="abc")
     case = ShearCase(value, 100.0, ShearSettings(max_displacement=0.002, particle_friction=0.5))
     pinned = "eed86443ff03ed15dce5838cd0ab6fac659036a3698cd8c1bdb00200ca988b0f"
-    assert stage.Fingerprint(case.record(), tables={"settings": ShearSettings}).digest == pinned
+    assert stage.Fingerprint(case.record().to_dict(), tables={"settings": ShearSettings}).digest == pinned
     half = case.with_settings(
         velocity=0.5 * case.settings.velocity, rolling_friction=0.1, particle_friction=None
     )
     pinned = "a92c202b3337b524fdff86231bd65dd93bb032d56d259c13674b7475a27f9c6a"
-    assert stage.Fingerprint(half.record(), tables={"settings": ShearSettings}).digest == pinned
+    assert stage.Fingerprint(half.record().to_dict(), tables={"settings": ShearSettings}).digest == pinned
     assert case.at(50.0).normal_stress_kpa == 50.0 and case.normal_stress_kpa == 100.0
 
 

@@ -89,8 +89,8 @@ def write_specimen_state(store: Store, sim: Simulation, width: float, n2d: float
     from poro2d.measure.specimen_state import specimen_state
     from poro2d.report.specimen_figures import plot_specimen_state
 
-    state = specimen_state(sim, width, top_height(sim, width))
-    store.write_json("specimen_state.json", dict(state, trial_porosity=n2d))
+    state = specimen_state(sim, width, top_height(sim, width), trial_porosity=n2d)
+    store.write_result("specimen_state.json", state)
     if figures:
         title = f"accepted specimen, n2D = {n2d:.3f}: bands of equal height"
         plot_specimen_state(state, store.path("specimen_state.png"), title=title)

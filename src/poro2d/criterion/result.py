@@ -8,6 +8,7 @@ from typing import Any, Self
 
 from poro2d.criterion.trial import Trial
 from poro2d.measure.specimen_porosity import SpecimenPorosity
+from poro2d.measure.specimen_state import SpecimenStateResult
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
@@ -119,22 +120,6 @@ class ReplicatesResult(TypedResult):
         assert self.store is not None
         return {f"seed{r.seed}": self.store.child(r.folder).path("specimen.npz") for r in self.rows
                 if r.converged}  # fmt: skip
-
-
-@dataclass(eq=False)
-class SpecimenStateResult(TypedResult):
-    """The accepted specimen's homogeneity and stress state by band (``specimen_state.json``)."""
-
-    bands: list[dict[str, Any]]
-    porosity_definition: str
-    porosity_mean: float
-    porosity_sd: float
-    porosity_range: float
-    k0_mean: float | None
-    k0_sd: float | None
-    sigma_v_bottom_over_geostatic: float | None
-    stress_sign: str
-    trial_porosity: float
 
 
 #: the figures a criterion run may leave at the top of its folder, by name

@@ -21,6 +21,7 @@ from __future__ import annotations
 import os
 import tempfile
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -38,6 +39,7 @@ from poro2d.interop.lammps_run import (
 from poro2d.interop.settled import SettledRun
 from poro2d.interop.specimen_data import SpecimenData
 from poro2d.measure.coordination import coordination_number
+from poro2d.typed_result import TypedResult
 
 #: quantities compared, as (key, label) pairs
 QUANTITIES = (
@@ -49,14 +51,35 @@ QUANTITIES = (
 )
 
 
+@dataclass(eq=False, kw_only=True)
+class Agreement(TypedResult):
+    """Both engines' runs of one specimen to rest and how far apart they are (``--json`` of the benchmark).
+
+    ``disks`` and the self weight ``weight_n_per_m`` (G) of the specimen, the stop ``ratio``
+    of both; ``poro2d`` and ``lammps``: each engine's :class:`SettledRun`; ``rel_diff`` and
+    ``rel_to_weight``: the differences by quantity key (see :func:`compare`).
+    """
+
+    disks: int
+    weight_n_per_m: float
+    ratio: float
+    poro2d: SettledRun
+    lammps: SettledRun
+    rel_diff: dict[str, float]
+    rel_to_weight: dict[str, float]
+
+
 def run_poro2d(spec: SpecimenData, ratio: float, max_steps: int) -> SettledRun:
     """poro2d from the exported state: disks at rest, no history; cycled until ``ratio``."""
     sim = spec.to_simulation(dt=spec.dt)
     t0 = time.perf_counter()
     res = sim.solve(ratio, max_steps)
     mags = sim.contacts().magnitude
+    forces = wall_forces(sim)
     return SettledRun(
-        **_named_forces(wall_forces(sim).to_dict()),
+        f_top_n_per_m=float(forces.f_top_n_per_m),
+        f_bottom_n_per_m=float(forces.f_bottom_n_per_m),
+        side_friction_up_n_per_m=float(forces.side_friction_up_n_per_m),
         mean_contact_force_n=float(mags.mean()) if mags.size else 0.0,
         coordination_number=coordination_number(sim),
         contacts=int(mags.size),
@@ -65,11 +88,6 @@ def run_poro2d(spec: SpecimenData, ratio: float, max_steps: int) -> SettledRun:
         max_ratio=res.max_ratio,
         seconds=time.perf_counter() - t0,
     )
-
-
-def _named_forces(forces: dict) -> dict:
-    keys = ("f_top_n_per_m", "f_bottom_n_per_m", "side_friction_up_n_per_m")
-    return {k: float(forces[k]) for k in keys}
 
 
 def run_lammps(spec: SpecimenData, workdir: str | os.PathLike, ratio: float, max_steps: int) -> SettledRun:
@@ -91,22 +109,22 @@ def run_lammps(spec: SpecimenData, workdir: str | os.PathLike, ratio: float, max
     allm = np.concatenate(mags)
     head, rows = parse_thermo(log)[-1]
     return SettledRun(
-        f_top_n_per_m=res["f_top"],
-        f_bottom_n_per_m=res["f_bottom"],
-        side_friction_up_n_per_m=res["side_friction_up"],
+        f_top_n_per_m=res.f_top,
+        f_bottom_n_per_m=res.f_bottom,
+        side_friction_up_n_per_m=res.side_friction_up,
         mean_contact_force_n=float(allm.mean()) if allm.size else 0.0,
-        coordination_number=res["coordination"],
+        coordination_number=res.coordination,
         contacts=int(allm.size),
         steps=int(rows[-1][head.index("Step")]),
-        converged=res["ratio"] < ratio,
-        max_ratio=res["ratio"],
+        converged=res.ratio < ratio,
+        max_ratio=res.ratio,
         seconds=seconds,
         lammps_version=version_from_log(log),
     )
 
 
 def compare(spec: SpecimenData, ratio: float = 1e-5, max_steps: int = 2_000_000,
-            workdir: str | os.PathLike | None = None) -> dict:  # fmt: skip
+            workdir: str | os.PathLike | None = None) -> Agreement:  # fmt: skip
     """Run both engines from the same state; their results and relative differences.
 
     ``rel_diff[key]`` is |LAMMPS - poro2d| / |poro2d|; for the wall forces also
@@ -122,16 +140,11 @@ def compare(spec: SpecimenData, ratio: float = 1e-5, max_steps: int = 2_000_000,
     weight = spec.weight_per_thickness()
     rel, relg = {}, {}
     for key, _ in QUANTITIES:
-        a, b = theirs[key], ours[key]
+        a, b = getattr(theirs, key), getattr(ours, key)
         rel[key] = abs(a - b) / abs(b) if b != 0.0 else (0.0 if a == 0.0 else float("inf"))
         if key.endswith("_n_per_m"):
             relg[key] = abs(a - b) / weight
-    return {
-        "disks": spec.n,
-        "weight_n_per_m": weight,
-        "ratio": ratio,
-        "poro2d": ours,
-        "lammps": theirs,
-        "rel_diff": rel,
-        "rel_to_weight": relg,
-    }
+    return Agreement(
+        disks=spec.n, weight_n_per_m=weight, ratio=ratio, poro2d=ours, lammps=theirs,
+        rel_diff=rel, rel_to_weight=relg,
+    )  # fmt: skip

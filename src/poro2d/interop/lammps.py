@@ -394,8 +394,8 @@ def box_wall_fixes(spec: SpecimenData) -> list[WallFix]:
     for name in BOX_WALLS:
         style, side = _PLANES[name]
         lo, hi = (faces[name], None) if side == 0 else (None, faces[name])
-        kn, kt, mu = params[name]
-        fixes.append(WallFix(f"w_{name}", style, lo, hi, kn, kt, mu, mu_r=rolling[name]))
+        kn, kt, mu = params.walls[name]
+        fixes.append(WallFix(f"w_{name}", style, lo, hi, kn, kt, mu, mu_r=rolling.walls[name]))
     return fixes
 
 
@@ -411,9 +411,9 @@ def input_script(
         raise InputError("time step", None, "the time step of the specimen (a poro2d checkpoint has one)")
     t = spec.thickness
     model = model_commands(
-        DATA_FILE, spec.contact_parameters()["pp"], box_wall_fixes(spec), spec.dt,
+        DATA_FILE, spec.contact_parameters().disks, box_wall_fixes(spec), spec.dt,
         0.5 * float(spec.radius.min()), spec.gravity, spec.local_damping, store_force=True,
-        pp_mu_r=spec.rolling_parameters()["pp"],
+        pp_mu_r=spec.rolling_parameters().disks,
     )  # fmt: skip
     head = "\n".join(spec.header("#")) + "\n"
     head += f"""# written by poro2d export --to lammps; run: lmp -in {INPUT_FILE}
@@ -513,10 +513,10 @@ def write_specimen(spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e
         f"# poro2d settings {spec.gravity[0]!r} {spec.gravity[1]!r} {spec.local_damping!r} {spec.dt!r}",
         *(_wall_note(w) for w in spec.walls),
         *([f"# poro2d window {spec.force_fraction!r}"] if spec.force_fraction is not None else []),
-        f"# pair contact kn ks mu: {params['pp'][0]!r} {params['pp'][1]!r} {params['pp'][2]!r}",
+        f"# pair contact kn ks mu: {params.disks.kn!r} {params.disks.ks!r} {params.disks.mu!r}",
     ]
-    if spec.rolling_parameters()["pp"] > 0.0:  # the disks', then each wall's, in wall-line order
-        values = [spec.rolling_parameters()["pp"], *(w.mu_r for w in spec.walls)]
+    if spec.rolling_parameters().disks > 0.0:  # the disks', then each wall's, in wall-line order
+        values = [spec.rolling_parameters().disks, *(w.mu_r for w in spec.walls)]
         notes.append("# poro2d rolling_friction " + " ".join(repr(float(v)) for v in values))
     paths = []
     with atomic_path(out / DATA_FILE) as tmp:

@@ -24,6 +24,7 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Generic, NamedTuple, TypeVar
 
 import numpy as np
 
@@ -35,6 +36,25 @@ from poro2d.interop.origin import origin_lines
 from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
 from poro2d.specimen.box import box_faces
 from poro2d.store import Store
+
+
+class ContactLaw(NamedTuple):
+    """The contact-level springs and friction of one pair type (N/m, N/m, -)."""
+
+    kn: float
+    ks: float
+    mu: float
+
+
+T = TypeVar("T")
+
+
+@dataclass(frozen=True)
+class ByPairType(Generic[T]):
+    """One value per contact pair type: the disk-disk pair's (``disks``) and each wall's, by wall name."""
+
+    disks: T
+    walls: dict[str, T]
 
 
 @dataclass
@@ -128,7 +148,7 @@ class SpecimenData:
         g = math.hypot(*self.gravity)
         return float(np.sum(self.mass)) * g / self.thickness
 
-    def contact_parameters(self) -> dict:
+    def contact_parameters(self) -> ByPairType[ContactLaw]:
         """The contact-level (kn, ks, mu) of disk-disk contacts and of each wall's contacts.
 
         PFC 4.0 (``per_body``): springs in series, kn = kA kB / (kA + kB), the smaller
@@ -143,13 +163,11 @@ class SpecimenData:
                     "one value for every disk (the target takes one set of contact properties)",
                 )  # fmt: skip
         kn, ks, mu = float(self.kn[0]), float(self.ks[0]), float(self.mu[0])
-        out = {"pp": (series(kn, kn), series(ks, ks), mu)}
-        for w in self.walls:
-            out[w.name] = (series(kn, w.kn), series(ks, w.ks), min(mu, w.mu))
-        return out
+        walls = {w.name: ContactLaw(series(kn, w.kn), series(ks, w.ks), min(mu, w.mu)) for w in self.walls}
+        return ByPairType(ContactLaw(series(kn, kn), series(ks, ks), mu), walls)
 
-    def rolling_parameters(self) -> dict:
-        """The contact-level rolling friction of disk-disk contacts (``pp``) and of each wall's.
+    def rolling_parameters(self) -> ByPairType[float]:
+        """The contact-level rolling friction of disk-disk contacts and of each wall's.
 
         The smaller of the two bodies' values, as for ``mu``; every disk alike, as in
         :meth:`contact_parameters`.
@@ -161,7 +179,7 @@ class SpecimenData:
                 "one value for every disk (the target takes one set of contact properties)",
             )  # fmt: skip
         disk = float(mu_r[0]) if self.n else 0.0
-        return {"pp": disk, **{w.name: min(disk, w.mu_r) for w in self.walls}}
+        return ByPairType(disk, {w.name: min(disk, w.mu_r) for w in self.walls})
 
     def header(self, comment: str) -> list[str]:
         """Lines that every exported file starts with: units, thickness convention, version."""

@@ -199,7 +199,7 @@ def write_specimen(
         raise InputError("time step", spec.dt, "the time step of the specimen (a poro2d checkpoint has one)")
     if spec.rolled:
         raise InputError(
-            "rolling friction", spec.rolling_parameters()["pp"], "0 for a YADE export",
+            "rolling friction", spec.rolling_parameters().disks, "0 for a YADE export",
             "YADE's rolling law cannot be given poro2d's rolling stiffness ks R^2 per contact; "
             "export with --to lammps or --to pfc, which carry it",
         )  # fmt: skip

@@ -13,6 +13,7 @@ import re
 import shutil
 import subprocess
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 from poro2d.interop import yade
@@ -62,13 +63,28 @@ def execute_script(workdir: str | os.PathLike, settings: dict | None = None, tim
     return proc.stdout
 
 
-def read_result(output: str) -> dict[str, float]:
+@dataclass(frozen=True)
+class ResultLine:
+    """What the exported script reports last (``poro2d-result key value ...``, its ``report()``).
+
+    The wall forces per metre of thickness (N/m) as poro2d reports them, YADE's mean
+    ``unbalanced_force`` and the ``steps`` cycled (printed as a number).
+    """
+
+    f_top_n_per_m: float
+    f_bottom_n_per_m: float
+    side_friction_up_n_per_m: float
+    unbalanced_force: float
+    steps: float
+
+
+def read_result(output: str) -> ResultLine:
     """The numbers of the script's last ``poro2d-result key value ...`` line."""
     lines = [ln for ln in output.splitlines() if ln.startswith(RESULT_TAG + " ")]
     if not lines:
         raise YadeError(f"no '{RESULT_TAG}' line in YADE's output")
     words = lines[-1].split()[1:]
-    return {words[i]: float(words[i + 1]) for i in range(0, len(words) - 1, 2)}
+    return ResultLine(**{words[i]: float(words[i + 1]) for i in range(0, len(words) - 1, 2)})
 
 
 def version_from_output(output: str) -> str:
@@ -88,12 +104,12 @@ def run_yade(spec: SpecimenData, workdir: str | os.PathLike, ratio: float, max_s
     output = execute_script(workdir)
     res = read_result(output)
     return SettledRun(
-        f_top_n_per_m=res["f_top_n_per_m"],
-        f_bottom_n_per_m=res["f_bottom_n_per_m"],
-        side_friction_up_n_per_m=res["side_friction_up_n_per_m"],
-        unbalanced_force=res["unbalanced_force"],
-        steps=int(res["steps"]),
-        converged=res["unbalanced_force"] < ratio,
+        f_top_n_per_m=res.f_top_n_per_m,
+        f_bottom_n_per_m=res.f_bottom_n_per_m,
+        side_friction_up_n_per_m=res.side_friction_up_n_per_m,
+        unbalanced_force=res.unbalanced_force,
+        steps=int(res.steps),
+        converged=res.unbalanced_force < ratio,
         seconds=time.perf_counter() - t0,
         yade_version=version_from_output(output),
         workdir=str(Path(workdir)),

@@ -18,22 +18,50 @@ stress that does not grow with depth.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Any
+
 import numpy as np
 
 from poro2d.errors import check_int
 from poro2d.measure.porosity import porosity_rect
 from poro2d.measure.stress import average_stress
+from poro2d.typed_result import TypedResult
+
+
+@dataclass(eq=False)
+class SpecimenStateResult(TypedResult):
+    """A specimen's homogeneity and stress state by band; the accepted one's is ``specimen_state.json``.
+
+    ``bands``: one row per band, bottom to top (heights, porosity, sigma_v, sigma_h, K0 and
+    the geostatic sigma_v); the summary over them; ``trial_porosity``: the criterion's n2D
+    of the accepted specimen (None for a state measured outside a criterion run).
+    """
+
+    bands: list[dict[str, Any]]
+    porosity_definition: str
+    porosity_mean: float
+    porosity_sd: float
+    porosity_range: float
+    k0_mean: float | None
+    k0_sd: float | None
+    sigma_v_bottom_over_geostatic: float | None
+    stress_sign: str
+    trial_porosity: float | None = None
 
 
 def band_edges(top: float, bands: int) -> np.ndarray:
     return np.linspace(0.0, top, bands + 1)
 
 
-def specimen_state(sim, width: float, top: float, bands: int = 8) -> dict:
+def specimen_state(
+    sim, width: float, top: float, bands: int = 8, trial_porosity: float | None = None
+) -> SpecimenStateResult:
     """Porosity, sigma_v, sigma_h, K0 and the geostatic sigma_v per band, bottom to top.
 
     ``top``: the height of the top plate. Returns the bands and a summary (porosity
-    spread, mean K0, the ratio of measured to geostatic sigma_v at the bottom band).
+    spread, mean K0, the ratio of measured to geostatic sigma_v at the bottom band), with
+    ``trial_porosity`` (the criterion's n2D of the specimen) as given.
     """
     check_int("bands", bands, 2, 200)
     p = sim.particles
@@ -63,17 +91,18 @@ def specimen_state(sim, width: float, top: float, bands: int = 8) -> dict:
     k0 = np.array([r["k0"] for r in rows if r["k0"] is not None])
     bottom = rows[0]
     geo0 = bottom["sigma_v_geostatic_pa"]
-    return {
-        "bands": rows,
-        "porosity_definition": "disk area clipped to the band / band area",
-        "porosity_mean": float(por.mean()),
-        "porosity_sd": float(por.std(ddof=1)),
-        "porosity_range": float(por.max() - por.min()),
-        "k0_mean": float(k0.mean()) if k0.size else None,
-        "k0_sd": float(k0.std(ddof=1)) if k0.size > 1 else None,
-        "sigma_v_bottom_over_geostatic": bottom["sigma_v_pa"] / geo0 if geo0 > 0 else None,
-        "stress_sign": "compression positive; per metre of thickness and of width (Pa)",
-    }
+    return SpecimenStateResult(
+        bands=rows,
+        porosity_definition="disk area clipped to the band / band area",
+        porosity_mean=float(por.mean()),
+        porosity_sd=float(por.std(ddof=1)),
+        porosity_range=float(por.max() - por.min()),
+        k0_mean=float(k0.mean()) if k0.size else None,
+        k0_sd=float(k0.std(ddof=1)) if k0.size > 1 else None,
+        sigma_v_bottom_over_geostatic=bottom["sigma_v_pa"] / geo0 if geo0 > 0 else None,
+        stress_sign="compression positive; per metre of thickness and of width (Pa)",
+        trial_porosity=trial_porosity,
+    )
 
 
-__all__ = ["band_edges", "specimen_state"]
+__all__ = ["SpecimenStateResult", "band_edges", "specimen_state"]

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 import matplotlib
@@ -128,27 +129,34 @@ def _finish_peaks(fig, ax, xs, smax: float, lab, lab_fit, title: str, path) -> P
     return save_figure(fig, path)
 
 
-def curve_band(curves: list[dict[str, np.ndarray]], points: int = 200) -> dict[str, np.ndarray]:
+@dataclass(frozen=True)
+class CurveBand:
+    """The mean shear stress curve over specimens with its sd, on a common displacement grid."""
+
+    shear_displacement_mm: np.ndarray
+    mean_kpa: np.ndarray
+    sd_kpa: np.ndarray
+
+
+def curve_band(curves: list[dict[str, np.ndarray]], points: int = 200) -> CurveBand:
     """Mean and sd over specimens of shear stress curves, on their common displacement range."""
     end = min(float(c["shear_displacement_mm"][-1]) for c in curves)
     x = np.linspace(0.0, end, points)
     ys = np.array([np.interp(x, c["shear_displacement_mm"], c["shear_stress_kpa"]) for c in curves])
     sd = ys.std(axis=0, ddof=1) if len(curves) > 1 else np.zeros_like(x)
-    return {"shear_displacement_mm": x, "mean_kpa": ys.mean(axis=0), "sd_kpa": sd}
+    return CurveBand(x, ys.mean(axis=0), sd)
 
 
 def plot_replicate_curves(
-    bands: dict[float, dict[str, np.ndarray]], path: str | os.PathLike, n_specimens: int, lab=None
+    bands: dict[float, CurveBand], path: str | os.PathLike, n_specimens: int, lab=None
 ) -> Path:
     """Fig. 8(a) over specimens: the mean curve per normal stress with a +- sd band."""
     fig, ax = plt.subplots(figsize=(7.5, 4.8))
     for k, sigma in enumerate(sorted(bands)):
         b, col = bands[sigma], COLORS[k % len(COLORS)]
-        x = b["shear_displacement_mm"]
-        ax.plot(x, b["mean_kpa"], color=col, lw=1.4, label=f"DEM, {sigma:g} kPa (mean)")
-        ax.fill_between(
-            x, b["mean_kpa"] - b["sd_kpa"], b["mean_kpa"] + b["sd_kpa"], color=col, alpha=0.2, lw=0
-        )
+        x = b.shear_displacement_mm
+        ax.plot(x, b.mean_kpa, color=col, lw=1.4, label=f"DEM, {sigma:g} kPa (mean)")
+        ax.fill_between(x, b.mean_kpa - b.sd_kpa, b.mean_kpa + b.sd_kpa, color=col, alpha=0.2, lw=0)
     if lab is not None and lab.curves:
         for k, sigma in enumerate(sorted(lab.curves)):
             d, t = lab.curves[sigma]
@@ -192,6 +200,7 @@ def plot_replicate_peaks(summary: dict, path: str | os.PathLike, lab=None, lab_f
 
 __all__ = [
     "COLORS",
+    "CurveBand",
     "curve_band",
     "plot_peak_strength",
     "plot_replicate_curves",

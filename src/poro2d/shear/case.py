@@ -13,7 +13,7 @@ from pathlib import Path
 
 from poro2d.config import check_finite
 from poro2d.errors import InputError, check_range
-from poro2d.shear.record import content_record
+from poro2d.shear.record import TestContent, content_record
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings
 from poro2d.shear.specimen_file import Specimen
 
@@ -60,7 +60,7 @@ class ShearCase:
         """The same test with some settings changed (``velocity=...``)."""
         return replace(self, settings=replace(self.settings, **changes))
 
-    def record(self) -> dict:
+    def record(self) -> TestContent:
         """The content a stored test must share with this one (:func:`poro2d.shear.record.content_record`)."""
         return content_record(self.specimen.digest, self.normal_stress_kpa, self.settings.to_dict())
 

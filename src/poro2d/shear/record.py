@@ -10,6 +10,8 @@ without recomputing; a folder whose work belongs to another test is refused. The
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
 
 from poro2d.io_utils import provenance
 from poro2d.shear.settings import ShearSettings
@@ -25,10 +27,31 @@ RECORD = "test.json"
 LATER_SETTINGS = ("rolling_friction",)
 
 
-def content_record(specimen_digest: str, sigma_kpa: float, settings: dict) -> dict:
+@dataclass(frozen=True)
+class TestContent:
+    """What a stored test must share with this one to be reused: content, never paths.
+
+    The digest of the specimen's state, the normal stress (kPa) and the settings as recorded
+    (``ShearSettings.to_dict()`` less the later settings at their default); :meth:`to_dict` is
+    the ``run`` of ``test.json``, the content its digest is taken of.
+    """
+
+    __test__ = False  # not a test class, for all its name
+
+    specimen_digest: str
+    normal_stress_kpa: float
+    settings: dict[str, Any]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The record's keys, as ``test.json`` holds them under ``run``."""
+        return {"specimen_digest": self.specimen_digest, "normal_stress_kpa": self.normal_stress_kpa,
+                "settings": self.settings}  # fmt: skip
+
+
+def content_record(specimen_digest: str, sigma_kpa: float, settings: dict) -> TestContent:
     """What a stored test must share with this one to be reused: content, never paths."""
     kept = {k: v for k, v in settings.items() if not (k in LATER_SETTINGS and v is None)}
-    return {"specimen_digest": specimen_digest, "normal_stress_kpa": sigma_kpa, "settings": kept}
+    return TestContent(specimen_digest, sigma_kpa, kept)
 
 
 def stale_reason(keys: list[str] | None, old: Mapping | None) -> str:
@@ -50,13 +73,15 @@ def _explain(keys: list[str] | None, old: Mapping | None) -> str:
     return f"it holds a test of {stale_reason(keys, old)}; use a new --out"
 
 
-def folder_stage(store: Store, record: dict, specimen: str) -> ResumableStage:
+def folder_stage(store: Store, record: TestContent | Mapping, specimen: str) -> ResumableStage:
     """The stages of one test in ``store`` (consolidation, shearing), bound by ``test.json``.
 
-    ``record``: :func:`content_record`; the record file keeps its digest (``key``) and the
-    specimen's path (for information: not compared) beside it.
+    ``record``: :func:`content_record` (or its dict, as a ``test.json`` holds it under ``run``);
+    the record file keeps its digest (``key``) and the specimen's path (for information: not
+    compared) beside it.
     """
-    fingerprint = Fingerprint(record, tables={"settings": ShearSettings})
+    content = record.to_dict() if isinstance(record, TestContent) else record
+    fingerprint = Fingerprint(content, tables={"settings": ShearSettings})
     return store.stage(
         fingerprint,
         record=RECORD,
@@ -69,4 +94,4 @@ def folder_stage(store: Store, record: dict, specimen: str) -> ResumableStage:
     )
 
 
-__all__ = ["content_record", "folder_stage", "stale_reason"]
+__all__ = ["TestContent", "content_record", "folder_stage", "stale_reason"]

@@ -40,6 +40,7 @@ from poro2d.measure.porosity import box_porosity, porosity_rect
 from poro2d.paper_data import TABLE_1
 from poro2d.specimen.grading import MAX_DRAW, GradingCurve, draw_disks
 from poro2d.specimen.placement import Band, place_disks
+from poro2d.typed_result import TypedResult
 
 _log = logging.getLogger(__name__)
 
@@ -470,9 +471,28 @@ class LayerReport:
     attempts: list
 
 
+@dataclass(eq=False, kw_only=True)
+class Equilibration(TypedResult):
+    """How a stage came to equilibrium (:func:`equilibrate`); a preparation's ``final_stage``.
+
+    Whether it ``converged``, the total ``steps``, the last attempt's ``max_ratio``, the
+    ratio that decides (``measure``) and its ``measured_ratio``, the rattler fraction, what
+    ended it (``ended_by``: ``ratio``, ``settled`` or ``budget``) and every attempt made.
+    """
+
+    converged: bool
+    steps: int
+    max_ratio: float
+    measure: str
+    measured_ratio: float
+    rattler_fraction: float
+    ended_by: str
+    attempts: list[dict]
+
+
 def equilibrate(
     sim: Simulation, spec: SpecimenSpec, label: str, progress: bool = False, settle: bool = False
-) -> dict:
+) -> Equilibration:
     """Cycle to equilibrium (the ratio ``spec.equilibrium`` below ``spec.ratio``), with a fallback.
 
     The measure is the maximum unbalanced-force ratio by default (the paper's); ``mean``
@@ -536,16 +556,16 @@ def equilibrate(
             sim.set_local_damping(damping)
         ok = attempt("normal again", spec.calm_steps)
     last = attempts[-1]
-    return {
-        "converged": ok,
-        "steps": sum(a["steps"] for a in attempts),
-        "max_ratio": last["max_ratio"],
-        "measure": spec.equilibrium,
-        "measured_ratio": last["measured_ratio"],
-        "rattler_fraction": last["rattler_fraction"],
-        "ended_by": last["ended_by"],
-        "attempts": attempts,
-    }
+    return Equilibration(
+        converged=ok,
+        steps=sum(a["steps"] for a in attempts),
+        max_ratio=last["max_ratio"],
+        measure=spec.equilibrium,
+        measured_ratio=last["measured_ratio"],
+        rattler_fraction=last["rattler_fraction"],
+        ended_by=last["ended_by"],
+        attempts=attempts,
+    )
 
 
 class SettledTest:
@@ -611,7 +631,7 @@ def prepare_specimen(
     for k, idx in enumerate(_layer_groups(radii, spec.layers)):
         sim, layer, eq = _build_layer(sim, spec, k, idx, radii, tops, rng, progress)
         layers.append(layer)
-        if not eq["converged"]:
+        if not eq.converged:
             failed = (f"layer {k + 1}", eq)
             break
     assert sim is not None
@@ -621,7 +641,7 @@ def prepare_specimen(
         if spec.rolling_friction > 0.0:
             sim.set_rolling_friction(spec.rolling_friction, walls=spec.rolling_friction)
         final = equilibrate(sim, spec, "working friction", progress)
-        if not final["converged"]:
+        if not final.converged:
             failed = ("working friction", final)
     p = sim.particles
     report = {
@@ -632,12 +652,12 @@ def prepare_specimen(
         "box_porosity": box_porosity(p.area(), W, H),
         "measured_porosity": porosity_rect(p.pos, p.radius, 0.0, 0.0, W, H),
         "layers": layers,
-        "final_stage": final,
+        "final_stage": None if final is None else final.to_dict(),
         "converged": failed is None,
         "failed_stage": None if failed is None else failed[0],
-        "failed_max_ratio": None if failed is None else failed[1]["max_ratio"],
-        "failed_steps": None if failed is None else failed[1]["steps"],
-        "failed_ratio": None if failed is None else failed[1]["measured_ratio"],
+        "failed_max_ratio": None if failed is None else failed[1].max_ratio,
+        "failed_steps": None if failed is None else failed[1].steps,
+        "failed_ratio": None if failed is None else failed[1].measured_ratio,
         "equilibrium": spec.equilibrium,
     }
     lid_y = float(sim.walls.p0[sim.walls.index("top"), 1])
@@ -658,7 +678,8 @@ def _layer_groups(radii: np.ndarray, layers: int) -> list[np.ndarray]:
 
 
 def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.ndarray, tops: np.ndarray,
-                 rng: np.random.Generator, progress: bool) -> tuple[Simulation, dict, dict]:  # fmt: skip
+                 rng: np.random.Generator,
+                 progress: bool) -> tuple[Simulation, dict, Equilibration]:  # fmt: skip
     """Place layer ``k`` in its band under the lid, grow it to size, bring it to equilibrium.
 
     Returns the simulation (made with the first layer), the layer's report and the result of
@@ -693,9 +714,9 @@ def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.nda
     # appended on top): threads then split it along a short cut (dem.ordering)
     sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
     eq = equilibrate(sim, spec, f"layer {k + 1}", progress, settle=True)
-    steps += eq["steps"]
-    report = LayerReport(k + 1, len(idx), y_top, plc.scale, steps, eq["max_ratio"], eq["converged"],
-                         eq["attempts"])  # fmt: skip
+    steps += eq.steps
+    report = LayerReport(k + 1, len(idx), y_top, plc.scale, steps, eq.max_ratio, eq.converged,
+                         eq.attempts)  # fmt: skip
     layer = asdict(report)
     if raised > 0.0:  # recorded only when it happens: the reports of ordinary layers keep their keys
         layer["band_raised_m"] = raised

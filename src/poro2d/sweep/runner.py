@@ -30,7 +30,7 @@ from typing import Any
 
 from poro2d.execute import Backend, Executor, Failed, Job
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
-from poro2d.execute.dask_cluster import pin_numba_threads
+from poro2d.execute.dask_cluster import ClusterInfo, pin_numba_threads
 from poro2d.io_utils import provenance
 from poro2d.locks import cache_entry, output_folder
 from poro2d.store import Store
@@ -136,7 +136,7 @@ def _run_case(case: dict, store: Store, func) -> CaseRow:
         return CaseRow.from_dict(row)
 
 
-def _done_row(case: dict, store: Store, func, row: dict, t0: float) -> dict:
+def _done_row(case: dict, store: Store, func, row: dict, t0: float) -> CaseRow:
     """Run the case's kind into its sub-store ``run``; its row (``status`` done, results as table cells)."""
     results = func(case["config"], store.child("run"))
     if not isinstance(results, dict):
@@ -146,7 +146,7 @@ def _done_row(case: dict, store: Store, func, row: dict, t0: float) -> dict:
     row["results"] = results
     for stale in (ERROR_TXT, ERROR_JSON):
         store.remove(stale)
-    return row  # written as result.json, the done marker, last
+    return CaseRow.from_dict(row)  # written as result.json, the done marker, last
 
 
 def _worker_address() -> str:
@@ -272,7 +272,7 @@ def _run_sweep(sweep: SweepConfig, store: Store, *, client, scheduler, workers, 
         else:
             pending.append(c)
     n_reused = len(rows)
-    cluster_info: dict[str, Any] = {}
+    cluster_info: ClusterInfo | None = None
     if pending:
         cluster_info = _run_pending(sweep, pending, rows, cases, n_reused, client=client,
                                     scheduler=scheduler, workers=workers, progress=progress,
@@ -283,7 +283,7 @@ def _run_sweep(sweep: SweepConfig, store: Store, *, client, scheduler, workers, 
     df["reused"] = [r["reused"] for r in ordered]
     write_tables(df, store)
     summary = _summary(ordered, n_reused, time.perf_counter() - t_start, cluster_info)
-    record.update(status="finished", cluster=cluster_info, summary=summary, finished_utc=_now())
+    record.update(status="finished", cluster=cluster_info or {}, summary=summary, finished_utc=_now())
     store.write_json("sweep.json", record)
     result = SweepResult.from_dict(record)
     result.rows, result.table = ordered, df
@@ -291,7 +291,8 @@ def _run_sweep(sweep: SweepConfig, store: Store, *, client, scheduler, workers, 
 
 
 def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Store, n_reused: int, *,
-                 client, scheduler, workers, progress: bool, dashboard: str | None) -> dict:  # fmt: skip
+                 client, scheduler, workers, progress: bool,
+                 dashboard: str | None) -> ClusterInfo | None:  # fmt: skip
     """Run the unfinished cases on ``client`` (or a cluster made for them) into ``rows``.
 
     Returns what is recorded of the cluster (scheduler, workers, threads, dashboard).
@@ -301,17 +302,19 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Sto
     with Executor(backend, client=client) as executor:
         executor.start()
         cluster_info = executor.cluster_info()
-        if progress and cluster_info["dashboard"]:
+        if progress and cluster_info is not None and cluster_info.dashboard:
             from poro2d.console import OutputConsole
 
             err = OutputConsole(stderr=True)
-            err.print(f"Dask dashboard: {cluster_info['dashboard']}", highlight=False)
+            err.print(f"Dask dashboard: {cluster_info.dashboard}", highlight=False)
         n_total = len(sweep.cases)
         rows.update(_submit_all(executor, pending, cases, sweep.retries, progress, n_reused, n_total))
     return cluster_info
 
 
-def _summary(ordered: list[dict], n_reused: int, wall: float, cluster_info: dict) -> SweepSummary:
+def _summary(
+    ordered: list[dict], n_reused: int, wall: float, cluster_info: ClusterInfo | None
+) -> SweepSummary:
     """Counts, wall and case time, the worker processes and the parallel efficiency of a sweep."""
     busy = sum(r.get("time_s") or 0.0 for r in ordered if not r["reused"])
     summary = {
@@ -326,8 +329,8 @@ def _summary(ordered: list[dict], n_reused: int, wall: float, cluster_info: dict
             {f"{r.get('host')}:{r.get('pid')}" for r in ordered if not r["reused"] and r.get("pid")}
         ),
     }
-    if cluster_info.get("threads"):
-        summary["parallel_efficiency"] = busy / (wall * cluster_info["threads"]) if wall > 0 else None
+    if cluster_info is not None and cluster_info.threads:
+        summary["parallel_efficiency"] = busy / (wall * cluster_info.threads) if wall > 0 else None
     return SweepSummary.from_dict(summary)
 
 

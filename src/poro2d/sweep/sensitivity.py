@@ -43,6 +43,7 @@ from poro2d.sweep.sensitivity_records import (
     Match,
     MeanSd,
     MuPoint,
+    PaperNumbers,
     SeedRecord,
     StudySettings,
 )
@@ -63,11 +64,11 @@ MATCH_TOLERANCE = 0.005
 REFERENCE = "reference"
 
 
-def paper_numbers() -> dict:
+def paper_numbers() -> PaperNumbers:
     """The numbers the paper reports for its criterion run (held by ``poro2d.paper_data``)."""
     from poro2d.paper_data import PAPER
 
-    return {"n_lab": PAPER["n_lab"], **PAPER["criterion"]}
+    return PaperNumbers(n_lab=PAPER["n_lab"], **PAPER["criterion"])
 
 
 def quick_criterion() -> dict:

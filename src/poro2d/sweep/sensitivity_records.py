@@ -23,6 +23,26 @@ class MeanSd(TypedResult):
 
 
 @dataclass(eq=False)
+class PaperNumbers(TypedResult):
+    """The numbers the paper reports for its criterion run (``paper`` of the file): n_lab, the
+    trials and their particle counts, the wall forces and self weights of the first and the
+    accepted trial, the accepted porosity.
+    """
+
+    n_lab: float
+    trials: list[float]
+    particle_counts: list[int]
+    porosity_change_first_trial: float
+    f_top_first_trial_kn_per_m: float
+    f_bottom_first_trial_kn_per_m: float
+    self_weight_first_trial_n_per_m: float
+    f_top_accepted_n_per_m: float
+    f_bottom_accepted_n_per_m: float
+    self_weight_accepted_n_per_m: float
+    accepted_porosity: float
+
+
+@dataclass(eq=False)
 class StudySettings(TypedResult):
     """What the study varies: the grading widths, the frictions, seeds per point, quick or full."""
 
@@ -192,6 +212,7 @@ __all__ = [
     "Match",
     "MeanSd",
     "MuPoint",
+    "PaperNumbers",
     "SeedRecord",
     "SensitivityPoints",
     "SensitivitySettings",
