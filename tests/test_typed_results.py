@@ -312,3 +312,22 @@ def test_parts_of_a_result_are_typed_and_written_as_before():
         (sand, "sand_result.json"),
     ):
         assert json.dumps(result.to_dict(), indent=2) + "\n" == (DATA / name).read_text()
+
+
+@pytest.mark.parametrize(
+    ("cls", "name"),
+    [(cls, name) for cls, name in FILES if "provenance" in json.loads((DATA / name).read_text())],
+)
+def test_provenance_is_a_record_written_as_before(cls, name):
+    """Every result's ``provenance`` reads as a :class:`~poro2d.io_utils.Provenance` record that
+    writes the file's keys back; a key of another version is kept, a missing one stays missing."""
+    from poro2d.io_utils import Provenance, provenance
+
+    stored = json.loads((DATA / name).read_text())
+    result = cls.from_dict(stored)
+    assert isinstance(result.provenance, Provenance) and result.provenance.poro2d_version
+    assert result.provenance["python"] == stored["provenance"]["python"]
+    assert json.dumps(result.to_dict(), indent=2) == json.dumps(stored, indent=2)
+    assert Provenance.now().to_dict().keys() == provenance().keys()
+    older = Provenance.from_dict({"poro2d_version": "0.0.1", "host": "h"})
+    assert older.to_dict() == {"poro2d_version": "0.0.1", "host": "h"}

@@ -18,13 +18,14 @@ from poro2d.console import OutputConsole
 from poro2d.criterion.config import paper_config
 from poro2d.criterion.replicates import accepted_and_replicates
 from poro2d.criterion.result import CriterionResult
-from poro2d.io_utils import provenance
+from poro2d.io_utils import Provenance, provenance
 from poro2d.locks import holds_output
 from poro2d.paper_data import PAPER, QUICK_SHEAR
 from poro2d.shear.results import ReplicateShearResult
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.typed_result import TypedResult
+from poro2d.typed_result import part as as_part
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
 KIND = "paper"
@@ -50,7 +51,13 @@ class ConversionsRecord(TypedResult):
     n_min: float
     methods: list[dict[str, Any]]
     figures: list[str]
-    provenance: dict[str, Any]
+    provenance: Provenance
+
+    @classmethod
+    def from_dict(cls, data) -> ConversionsRecord:
+        obj = super().from_dict(data)
+        obj.provenance = as_part(Provenance, obj.provenance)
+        return obj
 
 
 @dataclass(eq=False)
@@ -102,7 +109,7 @@ class PaperSummary(TypedResult):
     shear: PaperShear | None
     paper: dict[str, Any]
     timings: dict[str, float]
-    provenance: dict[str, Any]
+    provenance: Provenance
     lab: dict[str, Any] | None = None
 
     #: the typed parts, as their classes read them
@@ -128,6 +135,7 @@ class PaperSummary(TypedResult):
             value = getattr(obj, key)
             if isinstance(value, dict):
                 setattr(obj, key, part.from_dict(value))
+        obj.provenance = as_part(Provenance, obj.provenance)
         return obj
 
 
@@ -169,7 +177,7 @@ def conversion_files(store: Store) -> ConversionsRecord:
     figs = write_relation_figures(store.root, n_max=PAPER["n_max"], n_min=PAPER["n_min"],
                                   mark_n_lab=PAPER["n_lab"])  # fmt: skip
     return ConversionsRecord(n_lab=PAPER["n_lab"], n_max=PAPER["n_max"], n_min=PAPER["n_min"], methods=rows,
-                             figures=[str(f.name) for f in figs], provenance=provenance())  # fmt: skip
+                             figures=[str(f.name) for f in figs], provenance=Provenance.now())  # fmt: skip
 
 
 @holds_output("store", kind=KIND)
@@ -269,7 +277,7 @@ def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, *,
         shear=shear,
         paper=PAPER,
         timings=timings,
-        provenance=provenance(),
+        provenance=Provenance.now(),
         lab=lab_data.to_dict() if lab_data is not None else None,
     )
     return summary, CriterionOutputs.read(store.child("criterion"), result), shear_figures

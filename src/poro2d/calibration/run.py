@@ -24,14 +24,14 @@ from poro2d.calibration.units import CACHE, CalibrationUnit, UnitRow
 from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
 from poro2d.execute.dask_cluster import check_reachable
-from poro2d.io_utils import check_output_dir, provenance
+from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import holds_output
 from poro2d.paper_data import QUICK_SHEAR
 from poro2d.shear.lab import LabData, read_lab_csv
 from poro2d.shear.series import check_stresses
 from poro2d.shear.settings import MAX_FRICTION, ShearSettings
 from poro2d.store import Store
-from poro2d.typed_result import TypedResult
+from poro2d.typed_result import TypedResult, part
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
 KIND = "calibrate"
@@ -124,7 +124,7 @@ class CalibrationResult(TypedResult):
     failures: list[UnitFailure]
     timings: dict[str, float]
     config: dict[str, Any]
-    provenance: dict[str, Any]
+    provenance: Provenance
     #: why the intervals are unknown (then ``intervals`` and ``posterior["wide"]`` hold None);
     #: absent from the file of a calibration whose design estimates its own noise
     unidentified: str | None = None
@@ -151,6 +151,7 @@ class CalibrationResult(TypedResult):
             obj.cluster = ClusterRecord.from_dict(obj.cluster)
         if isinstance(obj.failures, list):
             obj.failures = [UnitFailure.from_dict(f) if isinstance(f, dict) else f for f in obj.failures]
+        obj.provenance = part(Provenance, obj.provenance)
         return obj
 
     @classmethod
@@ -467,7 +468,7 @@ def _result(
         failures=runner.failures,
         timings={"wall_time_s": time.perf_counter() - t0},
         config=dict(config, points=points, refine=refine, design_seed=design_seed, lab_error=lab_error),
-        provenance=provenance(),
+        provenance=Provenance.now(),
         unidentified=unknown,
     )
 

@@ -58,7 +58,7 @@ from poro2d.criterion.servo import PlateServo, in_window
 from poro2d.criterion.trial import Decision, PlateStage, Preparation, StageFailure, Trial, trial_name
 from poro2d.dem import Simulation
 from poro2d.errors import Integer, OneOf, Ranges, Real, check_fields, check_range
-from poro2d.io_utils import provenance
+from poro2d.io_utils import Provenance, provenance
 from poro2d.measure.disks import mass_d50
 from poro2d.measure.porosity import box_porosity
 from poro2d.measure.surface import lid_height_at
@@ -642,7 +642,7 @@ class PorosityCriterion:
             specimen=self.spec.to_dict(),
             local_damping_note=f"local damping {self.spec.local_damping} (PFC 4.0 default; "
             "the paper does not state it)",
-            provenance=provenance(),
+            provenance=Provenance.now(),
         )
 
     def _write_table(self, trials: list[Trial]) -> None:

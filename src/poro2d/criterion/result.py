@@ -7,9 +7,10 @@ from pathlib import Path
 from typing import Any, Self
 
 from poro2d.criterion.trial import Trial
+from poro2d.io_utils import Provenance
 from poro2d.measure.specimen_porosity import SpecimenPorosity
 from poro2d.store import Store
-from poro2d.typed_result import NOT_IN_FILE, TypedResult
+from poro2d.typed_result import NOT_IN_FILE, TypedResult, part
 
 
 @dataclass(eq=False)
@@ -40,7 +41,7 @@ class CriterionResult(TypedResult):
     settings: dict[str, Any]
     specimen: dict[str, Any]
     local_damping_note: str
-    provenance: dict[str, Any]
+    provenance: Provenance
     failed_trial: int | None = None
     time_total_s: float | None = None
     box_porosity: float | None = None
@@ -64,6 +65,7 @@ class CriterionResult(TypedResult):
         result = super().from_dict(data)
         if result.iterations is not None:
             result.iterations = [Trial.from_dict(row) for row in result.iterations]
+        result.provenance = part(Provenance, result.provenance)
         return result
 
 

@@ -15,11 +15,12 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from poro2d.io_utils import provenance
+from poro2d.io_utils import Provenance
 from poro2d.sand.case import SoilRecord
 from poro2d.sand.profile import StageProfile
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
+from poro2d.typed_result import part as as_part
 
 
 def _stats(values: list[float | None]) -> tuple[float, float]:
@@ -139,7 +140,7 @@ class SandResult(TypedResult):
     preflight: dict[str, Any]
     wall_seconds: float
     config: dict[str, Any]
-    provenance: dict[str, Any]
+    provenance: Provenance
     specimens: list[SeedSpecimen] = field(default_factory=list, metadata=NOT_IN_FILE)
 
     #: the typed parts, as their classes read them
@@ -158,6 +159,7 @@ class SandResult(TypedResult):
         for key, part in cls.PARTS.items():
             if isinstance(getattr(obj, key), dict):
                 setattr(obj, key, part.from_dict(getattr(obj, key)))
+        obj.provenance = as_part(Provenance, obj.provenance)
         return obj
 
     @classmethod
@@ -212,7 +214,7 @@ class SandResult(TypedResult):
             preflight=pf.to_dict(),
             wall_seconds=seconds,
             config=case.config,
-            provenance=provenance(),
+            provenance=Provenance.now(),
             specimens=list(kept),
         )
 

@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar, TypeVar
 
-from poro2d.typed_result import TypedResult
+from poro2d.typed_result import TypedResult, part
 
 P = TypeVar("P", bound=TypedResult)
 
@@ -34,13 +34,6 @@ class Nested(TypedResult):
 
     def to_dict(self) -> dict[str, Any]:
         return {k: _plain(v) for k, v in super().to_dict().items()}
-
-
-def part(cls: type[P], value: Any) -> Any:
-    """``value`` as the part ``cls`` when it is the dict of one (as read from a file), else as it is."""
-    if isinstance(value, Mapping) and not isinstance(value, cls):
-        return cls.from_dict(value)
-    return value
 
 
 def parts(cls: type[P], values: Any) -> Any:

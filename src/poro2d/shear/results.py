@@ -7,6 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
+from poro2d.io_utils import Provenance
 from poro2d.shear.curve import ShearCurve, read_curve
 from poro2d.shear.parts import (
     ConsolidationRecord,
@@ -69,7 +70,7 @@ class ShearTestResult(Nested):
     settings: dict[str, Any]
     specimen: str
     engine: dict[str, Any]
-    provenance: dict[str, Any]
+    provenance: Provenance
     curve: ShearCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     @classmethod
@@ -78,6 +79,7 @@ class ShearTestResult(Nested):
         obj.end = part(EndValues, obj.end)
         obj.force_balance = part(ForceBalance, obj.force_balance)
         obj.consolidation = part(ConsolidationRecord, obj.consolidation)
+        obj.provenance = part(Provenance, obj.provenance)
         return obj
 
     @classmethod
@@ -130,7 +132,7 @@ class ShearSeriesResult(Nested):
     rate_check: RateCheck | None = None
     lab: LabComparison | None = None
     wall_time_s: float | None = None
-    provenance: dict[str, Any] | None = None
+    provenance: Provenance | None = None
     curves: dict[float, ShearCurve] = field(
         default_factory=dict, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
@@ -144,6 +146,7 @@ class ShearSeriesResult(Nested):
         obj.quasi_static = part(QuasiStatic, obj.quasi_static)
         obj.rate_check = part(RateCheck, obj.rate_check)
         obj.lab = part(LabComparison, obj.lab)
+        obj.provenance = part(Provenance, obj.provenance)
         return obj
 
 
@@ -169,7 +172,7 @@ class ReplicateShearResult(Nested):
     wall_time_s: float | None = None
     processes: int | None = None
     config: dict[str, Any] | None = None
-    provenance: dict[str, Any] | None = None
+    provenance: Provenance | None = None
     series: dict[str, ShearSeriesResult] = field(default_factory=dict, kw_only=True, metadata=NOT_IN_FILE)
 
     @classmethod
@@ -178,6 +181,7 @@ class ReplicateShearResult(Nested):
         obj.per_normal_stress = parts(StressPeaks, obj.per_normal_stress)
         obj.fit = part(FitInterval, obj.fit)
         obj.fit_through_origin = part(FitInterval, obj.fit_through_origin)
+        obj.provenance = part(Provenance, obj.provenance)
         return obj
 
 
@@ -199,12 +203,13 @@ class StrengthResult(Nested):
     wall_time_s: float | None = None
     processes: int | None = None
     config: dict[str, Any] | None = None
-    provenance: dict[str, Any] | None = None
+    provenance: Provenance | None = None
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> StrengthResult:
         obj = super().from_dict(data)
         obj.cases = parts(StrengthCase, obj.cases)
+        obj.provenance = part(Provenance, obj.provenance)
         return obj
 
 

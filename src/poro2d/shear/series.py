@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.errors import InputError, check_range
-from poro2d.io_utils import provenance
+from poro2d.io_utils import Provenance
 from poro2d.shear.case import ShearCase
 from poro2d.shear.fit import mohr_coulomb, smooth
 from poro2d.shear.outputs import (
@@ -174,7 +174,7 @@ class ShearSeries:
         if self.lab is not None:
             result.lab = self._lab_part(fit)
         result.wall_time_s = time.perf_counter() - t0
-        result.provenance = provenance()
+        result.provenance = Provenance.now()
         curves = {t["normal_stress_kpa"]: t.curve for t in tests}
         if self.store is not None:
             write_tables(self.store, curves, summary)

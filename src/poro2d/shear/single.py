@@ -21,7 +21,7 @@ from dataclasses import replace
 import numpy as np
 
 from poro2d.dem import Simulation
-from poro2d.io_utils import as_json, provenance
+from poro2d.io_utils import Provenance, as_json
 from poro2d.measure.coordination import coordination_number
 from poro2d.shear import record
 from poro2d.shear.box import SplitBox, build_split_box
@@ -213,7 +213,7 @@ class DirectShearTest:
             settings=s.to_dict(),
             specimen=self.case.specimen.source,
             engine=sim.summary(),
-            provenance=provenance(),
+            provenance=Provenance.now(),
         )
 
     def run(self) -> ShearTestResult:

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.errors import InputError, check_range
-from poro2d.io_utils import provenance
+from poro2d.io_utils import Provenance
 from poro2d.shear.case import ShearCase
 from poro2d.shear.fit import mohr_coulomb
 from poro2d.shear.parts import StrengthCase
@@ -233,7 +233,7 @@ class StrengthStudy:
             wall_time_s=time.perf_counter() - t0,
             processes=self.processes,
             config=self.config,
-            provenance=provenance(),
+            provenance=Provenance.now(),
         )
         if self.store is not None:
             self._write(self.store, result, tests)
