@@ -331,3 +331,39 @@ def test_provenance_is_a_record_written_as_before(cls, name):
     assert Provenance.now().to_dict().keys() == provenance().keys()
     older = Provenance.from_dict({"poro2d_version": "0.0.1", "host": "h"})
     assert older.to_dict() == {"poro2d_version": "0.0.1", "host": "h"}
+
+
+def test_known_structures_of_shear_and_paper_files_are_typed_parts():
+    """The split box, laboratory peaks, a strength study's definitions and the case study's
+    facts, timings, conversion rows and shear summary are typed parts; the files are the same."""
+    from poro2d.paper import ConversionRow, PaperFacts, PaperTimings
+    from poro2d.shear.parts import BoxRecord, LabPeak, QuasiStatic, StrengthDefinitions, TestSummary
+    from poro2d.shear.results import StrengthResult
+
+    test = ShearTestResult.from_dict(json.loads((DATA / "shear_test_result.json").read_text()))
+    assert isinstance(test.consolidation.box, BoxRecord) and test.consolidation.box.width == 0.05
+    series = ShearSeriesResult.from_dict(json.loads((DATA / "shear_series_result.json").read_text()))
+    assert all(isinstance(p, LabPeak) for p in series.lab.peaks)
+    assert series.lab.peaks[0].normal_stress_kpa == 50
+    paper = PaperSummary.from_dict(json.loads((DATA / "paper_results.json").read_text()))
+    assert isinstance(paper.paper, PaperFacts) and paper.paper.criterion.accepted_porosity == 0.15
+    assert isinstance(paper.timings, PaperTimings) and paper.timings.shear_s > 0
+    assert isinstance(paper.conversions.methods[0], ConversionRow)
+    assert isinstance(paper.shear.tests[0], TestSummary) and isinstance(paper.shear.quasi_static, QuasiStatic)
+    for result, name in (
+        (test, "shear_test_result.json"),
+        (series, "shear_series_result.json"),
+        (paper, "paper_results.json"),
+    ):
+        stored = json.loads((DATA / name).read_text())
+        assert json.dumps(result.to_dict(), indent=2) == json.dumps(stored, indent=2)
+    # a study without a converged criterion has no shear timings: they stay out of the file
+    assert PaperTimings.from_dict({"conversions_s": 1.0, "criterion_s": 2.0}).to_dict() == {
+        "conversions_s": 1.0,
+        "criterion_s": 2.0,
+    }
+    strength = {"cases": [], "mu_r": [0.1], "particle_friction": [0.5], "specimens": ["s1"], "settings": {},
+                "definitions": {"peak_friction_angle": "a", "residual_friction_angle": "b",
+                                "max_dilation_angle": "c"}}  # fmt: skip
+    read = StrengthResult.from_dict(strength)
+    assert isinstance(read.definitions, StrengthDefinitions) and read.to_dict() == strength

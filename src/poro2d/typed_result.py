@@ -38,8 +38,12 @@ def _keys(cls: type) -> tuple[str, ...]:
 
 
 def _plain(value: Any) -> Any:
-    """A typed part as the dict of its file; anything else as it is."""
-    return value.to_dict() if isinstance(value, TypedResult) else value
+    """A typed part as the dict of its file, a list of them as a list of dicts; anything else as it is."""
+    if isinstance(value, TypedResult):
+        return value.to_dict()
+    if isinstance(value, list) and any(isinstance(v, TypedResult) for v in value):
+        return [_plain(v) for v in value]
+    return value
 
 
 def part(cls: type[R], value: Any) -> Any:
@@ -70,7 +74,8 @@ class TypedResult(Mapping):
     def to_dict(self) -> dict[str, Any]:
         """The keys and values of the file, in its order (a shallow copy: nested values are shared).
 
-        A field holding a typed part (a record such as a file's provenance) is written as its dict.
+        A field holding a typed part (a record such as a file's provenance), or a list of them, is
+        written as its dict(s).
         """
         out = {k: _plain(getattr(self, k)) for k in _keys(type(self)) if self._present(k)}
         out.update(self.extra)

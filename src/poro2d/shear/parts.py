@@ -64,6 +64,19 @@ class EndValues(Nested):
 
 
 @dataclass(eq=False)
+class BoxRecord(Nested):
+    """The split box's geometry as a file keeps it (:meth:`poro2d.shear.box.SplitBox.to_dict`), in m."""
+
+    width: float
+    height: float
+    split_y: float
+    gap: float
+    max_displacement: float
+    thickness: float
+    x0_lower: float
+
+
+@dataclass(eq=False)
 class ConsolidationRecord(Nested):
     """A test's consolidation (``consolidation.json``; in ``result.json`` without ``engine``).
 
@@ -84,8 +97,14 @@ class ConsolidationRecord(Nested):
     plate_settlement_m: float
     coordination_number: float
     wall_time_s: float
-    box: dict[str, float]
+    box: BoxRecord
     engine: dict[str, Any] | None = None
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ConsolidationRecord:
+        obj = super().from_dict(data)
+        obj.box = part(BoxRecord, obj.box)
+        return obj
 
 
 @dataclass(eq=False)
@@ -190,12 +209,35 @@ class RateCheck(Nested):
 
 
 @dataclass(eq=False)
+class LabPeak(Nested):
+    """One laboratory peak: the peak shear stress at a normal stress (kPa)."""
+
+    normal_stress_kpa: float
+    peak_shear_stress_kpa: float
+
+
+@dataclass(eq=False)
+class LabRecord(Nested):
+    """Laboratory data as a file keeps them (:meth:`poro2d.shear.lab.LabData.to_dict`)."""
+
+    source: str
+    kind: str
+    peaks: list[LabPeak]
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> LabRecord:
+        obj = super().from_dict(data)
+        obj.peaks = parts(LabPeak, obj.peaks)
+        return obj
+
+
+@dataclass(eq=False)
 class LabComparison(Nested):
     """The laboratory data a series is compared with, their fits and the difference of the angles."""
 
     source: str
     kind: str
-    peaks: list[dict[str, float]]
+    peaks: list[LabPeak]
     fit: FitRecord | None
     friction_angle_deg: float | None
     cohesion_kpa: float | None
@@ -205,6 +247,7 @@ class LabComparison(Nested):
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> LabComparison:
         obj = super().from_dict(data)
+        obj.peaks = parts(LabPeak, obj.peaks)
         obj.fit = part(FitRecord, obj.fit)
         obj.fit_through_origin = part(FitRecord, obj.fit_through_origin)
         return obj
@@ -219,6 +262,15 @@ class StressPeaks(Nested):
     peak_sd_kpa: float
     n: int
     peaks_kpa: list[float]
+
+
+@dataclass(eq=False)
+class StrengthDefinitions(Nested):
+    """How a strength study measures each of its angles, in words (a study's ``definitions``)."""
+
+    peak_friction_angle: str
+    residual_friction_angle: str
+    max_dilation_angle: str
 
 
 @dataclass(eq=False)
@@ -248,6 +300,7 @@ class StrengthCase(Nested):
 
 
 __all__ = [
-    "ConsolidationRecord", "EndValues", "FitInterval", "FitRecord", "ForceBalance", "LabComparison", "Nested",
-    "QuasiStatic", "RateCheck", "RateCheckRow", "StrengthCase", "StressPeaks", "TestSummary", "part", "parts",
+    "BoxRecord", "ConsolidationRecord", "EndValues", "FitInterval", "FitRecord", "ForceBalance",
+    "LabComparison", "LabPeak", "LabRecord", "Nested", "QuasiStatic", "RateCheck", "RateCheckRow",
+    "StrengthCase", "StrengthDefinitions", "StressPeaks", "TestSummary", "part", "parts",
 ]  # fmt: skip

@@ -20,6 +20,7 @@ from poro2d.shear.parts import (
     QuasiStatic,
     RateCheck,
     StrengthCase,
+    StrengthDefinitions,
     StressPeaks,
     TestSummary,
     part,
@@ -199,7 +200,7 @@ class StrengthResult(Nested):
     particle_friction: list[float]
     specimens: list[str]
     settings: dict[str, Any]
-    definitions: dict[str, str]
+    definitions: StrengthDefinitions
     wall_time_s: float | None = None
     processes: int | None = None
     config: dict[str, Any] | None = None
@@ -209,6 +210,7 @@ class StrengthResult(Nested):
     def from_dict(cls, data: Mapping[str, Any]) -> StrengthResult:
         obj = super().from_dict(data)
         obj.cases = parts(StrengthCase, obj.cases)
+        obj.definitions = part(StrengthDefinitions, obj.definitions)
         obj.provenance = part(Provenance, obj.provenance)
         return obj
 

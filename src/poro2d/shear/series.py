@@ -19,7 +19,15 @@ from poro2d.shear.outputs import (
     write_figures,
     write_tables,
 )
-from poro2d.shear.parts import LabComparison, QuasiStatic, RateCheck, RateCheckRow, TestSummary
+from poro2d.shear.parts import (
+    LabComparison,
+    LabPeak,
+    QuasiStatic,
+    RateCheck,
+    RateCheckRow,
+    TestSummary,
+    parts,
+)
 from poro2d.shear.pool import ShearJob, execute_jobs
 from poro2d.shear.results import ShearSeriesResult, ShearTestResult
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings
@@ -264,7 +272,7 @@ class ShearSeries:
         return LabComparison(
             source=lab.source,
             kind=lab.kind,
-            peaks=lab.peak_rows(),
+            peaks=parts(LabPeak, lab.peak_rows()),
             fit=lf.record() if lf else None,
             friction_angle_deg=lf.friction_angle_deg if lf else None,
             cohesion_kpa=lf.cohesion_kpa if lf else None,
