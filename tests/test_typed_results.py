@@ -387,3 +387,16 @@ def test_a_calibrations_per_parameter_values_are_typed_parts():
     unknown = FrictionBounds.from_dict({"particle_friction": None, "rolling_friction": None})
     assert unknown == {"particle_friction": None, "rolling_friction": None}
     assert unknown["rolling_friction"] is None
+
+
+def test_a_sands_laboratory_state_and_accepted_states_are_typed_parts():
+    """``sand.json``'s state (and the soil's), and each accepted specimen's row, are typed parts."""
+    from poro2d.sand.case import LabStateRecord
+    from poro2d.sand.result import AcceptedState
+
+    stored = json.loads((DATA / "sand_result.json").read_text())
+    sand = SandResult.from_dict(stored)
+    assert isinstance(sand.state, LabStateRecord) and sand.state.given == "Dr"
+    assert isinstance(sand.soil.lab, LabStateRecord) and sand.soil.lab.n_lab == sand.state.n_lab
+    assert all(isinstance(s, AcceptedState) for s in sand.states) and sand.states[1].seed == 1
+    assert json.dumps(sand.to_dict(), indent=2) == json.dumps(stored, indent=2)

@@ -16,7 +16,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from poro2d.io_utils import Provenance
-from poro2d.sand.case import SoilRecord
+from poro2d.sand.case import LabStateRecord, SoilRecord
 from poro2d.sand.profile import StageProfile
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
@@ -113,12 +113,24 @@ class SandCalibration(TypedResult):
 
 
 @dataclass(eq=False)
+class AcceptedState(TypedResult):
+    """One accepted specimen of ``sand.json``'s ``states``: its state, seed, folder and porosities."""
+
+    n_lab: float
+    relative_density: float | None
+    seed: int
+    specimen: str | None
+    box_porosity: float | None
+    interior_porosity: float | None
+
+
+@dataclass(eq=False)
 class SandResult(TypedResult):
     """``sand.json``: the soil, its state, the answer over seeds and where every part is."""
 
     mode: str
     soil: SoilRecord
-    state: dict[str, Any]
+    state: LabStateRecord
     interior_porosity_mean: float
     interior_porosity_sd: float
     box_porosity_mean: float
@@ -135,7 +147,7 @@ class SandResult(TypedResult):
     jamming_porosity: float | None
     jamming_porosity_sd: float | None
     calibration: SandCalibration
-    states: list[dict[str, Any]]
+    states: list[AcceptedState]
     seed_results: list[dict[str, Any]]
     preflight: dict[str, Any]
     wall_seconds: float
@@ -159,6 +171,8 @@ class SandResult(TypedResult):
         for key, part in cls.PARTS.items():
             if isinstance(getattr(obj, key), dict):
                 setattr(obj, key, part.from_dict(getattr(obj, key)))
+        obj.state = as_part(LabStateRecord, obj.state)
+        obj.states = None if obj.states is None else [as_part(AcceptedState, s) for s in obj.states]
         obj.provenance = as_part(Provenance, obj.provenance)
         return obj
 
@@ -177,14 +191,14 @@ class SandResult(TypedResult):
         box_m, box_sd = _stats([k.box_porosity for k in kept if k.accepted])
         lab = case.lab
         states = [
-            {
-                "n_lab": lab.n_lab,
-                "relative_density": lab.relative_density,
-                "seed": k.seed,
-                "specimen": k.folder,
-                "box_porosity": k.box_porosity,
-                "interior_porosity": k.interior_porosity,
-            }
+            AcceptedState(
+                n_lab=lab.n_lab,
+                relative_density=lab.relative_density,
+                seed=k.seed,
+                specimen=k.folder,
+                box_porosity=k.box_porosity,
+                interior_porosity=k.interior_porosity,
+            )
             for k in kept
             if k.accepted
         ]
@@ -192,7 +206,7 @@ class SandResult(TypedResult):
         return cls(
             mode="density",
             soil=case.soil_record(),
-            state=lab.to_dict(),
+            state=LabStateRecord.from_dict(lab.to_dict()),
             interior_porosity_mean=inner_m,
             interior_porosity_sd=inner_sd,
             box_porosity_mean=box_m,
