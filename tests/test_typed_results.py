@@ -400,3 +400,23 @@ def test_a_sands_laboratory_state_and_accepted_states_are_typed_parts():
     assert isinstance(sand.soil.lab, LabStateRecord) and sand.soil.lab.n_lab == sand.state.n_lab
     assert all(isinstance(s, AcceptedState) for s in sand.states) and sand.states[1].seed == 1
     assert json.dumps(sand.to_dict(), indent=2) == json.dumps(stored, indent=2)
+
+
+def test_shear_settings_are_a_record_that_keeps_the_keys_a_file_had():
+    """A result's shear settings read as a :class:`~poro2d.shear.parts.ShearSettingsRecord`; a file
+    written before ``stop_after_peak`` and ``rolling_friction`` existed is written back without them."""
+    from poro2d.shear.parts import ShearSettingsRecord
+    from poro2d.shear.settings import ShearSettings
+
+    stored = json.loads((DATA / "shear_test_result.json").read_text())
+    test = ShearTestResult.from_dict(stored)
+    assert (
+        isinstance(test.settings, ShearSettingsRecord)
+        and test.settings.velocity == stored["settings"]["velocity"]
+    )
+    assert "stop_after_peak" not in test.to_dict()["settings"] and test.to_dict() == stored
+    cal = CalibrationResult.from_dict(json.loads((DATA / "calibration_result.json").read_text()))
+    assert isinstance(cal.settings, ShearSettingsRecord) and cal.settings.stop_after_peak == 0.0
+    fresh = ShearSettings(velocity=0.01)
+    assert ShearSettingsRecord.from_dict(fresh.to_dict()).to_dict() == fresh.to_dict()
+    assert list(ShearSettingsRecord.from_dict(fresh.to_dict()).to_dict()) == list(fresh.to_dict())

@@ -28,7 +28,7 @@ from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import holds_output
 from poro2d.paper_data import QUICK_SHEAR
 from poro2d.shear.lab import LabData, read_lab_csv
-from poro2d.shear.parts import LabRecord
+from poro2d.shear.parts import LabRecord, ShearSettingsRecord
 from poro2d.shear.series import check_stresses
 from poro2d.shear.settings import MAX_FRICTION, ShearSettings
 from poro2d.store import Store
@@ -153,7 +153,7 @@ class CalibrationResult(TypedResult):
     lab: LabRecord
     specimens: dict[str, str]
     ranges: FrictionBounds
-    settings: dict[str, Any]
+    settings: ShearSettingsRecord
     cluster: ClusterRecord
     failures: list[UnitFailure]
     timings: CalibrationTimings
@@ -170,6 +170,7 @@ class CalibrationResult(TypedResult):
         "intervals": FrictionBounds,
         "lab": LabRecord,
         "ranges": FrictionBounds,
+        "settings": ShearSettingsRecord,
         "timings": CalibrationTimings,
         "provenance": Provenance,
     }
@@ -507,7 +508,7 @@ def _result(
         lab=LabRecord.from_dict(lab_data.to_dict()),
         specimens={k: str(v) for k, v in found.items()},
         ranges=FrictionBounds.from_dict(ranges.to_dict()),
-        settings=base,
+        settings=ShearSettingsRecord.from_dict(base),
         cluster=runner.info(),
         failures=runner.failures,
         timings=CalibrationTimings(wall_time_s=time.perf_counter() - t0),

@@ -64,6 +64,39 @@ class EndValues(Nested):
 
 
 @dataclass(eq=False)
+class ShearSettingsRecord(Nested):
+    """The shear settings as a result file keeps them (:meth:`poro2d.shear.settings.ShearSettings.to_dict`).
+
+    A file written before a setting existed lacks its key, and keeps lacking it when written
+    again (``stop_after_peak`` and ``rolling_friction`` are newer than the first files).
+    """
+
+    velocity: float
+    max_displacement: float
+    stop_after_peak: float
+    record_interval: float
+    checkpoint_interval: float
+    consolidation_ratio: float
+    consolidation_max_steps: int
+    servo_gain: float
+    servo_integral: float
+    servo_max_speed: float
+    kn_wall: float
+    ks_wall: float
+    friction_wall: float
+    gap: float
+    particle_friction: float | None
+    rolling_friction: float | None
+    local_damping: float | None
+    density_scale: float
+    dt_safety: float
+    peak_window: float
+    shear_zone_factor: float
+    inertial_limit: float
+    stress_tolerance: float
+
+
+@dataclass(eq=False)
 class BoxRecord(Nested):
     """The split box's geometry as a file keeps it (:meth:`poro2d.shear.box.SplitBox.to_dict`), in m."""
 
@@ -302,5 +335,6 @@ class StrengthCase(Nested):
 __all__ = [
     "BoxRecord", "ConsolidationRecord", "EndValues", "FitInterval", "FitRecord", "ForceBalance",
     "LabComparison", "LabPeak", "LabRecord", "Nested", "QuasiStatic", "RateCheck", "RateCheckRow",
-    "StrengthCase", "StrengthDefinitions", "StressPeaks", "TestSummary", "part", "parts",
+    "ShearSettingsRecord", "StrengthCase", "StrengthDefinitions", "StressPeaks", "TestSummary",
+    "part", "parts",
 ]  # fmt: skip

@@ -19,6 +19,7 @@ from poro2d.shear.parts import (
     Nested,
     QuasiStatic,
     RateCheck,
+    ShearSettingsRecord,
     StrengthCase,
     StrengthDefinitions,
     StressPeaks,
@@ -68,7 +69,7 @@ class ShearTestResult(Nested):
     records: int
     wall_time_shear_s: float
     wall_time_s: float
-    settings: dict[str, Any]
+    settings: ShearSettingsRecord
     specimen: str
     engine: dict[str, Any]
     provenance: Provenance
@@ -80,6 +81,7 @@ class ShearTestResult(Nested):
         obj.end = part(EndValues, obj.end)
         obj.force_balance = part(ForceBalance, obj.force_balance)
         obj.consolidation = part(ConsolidationRecord, obj.consolidation)
+        obj.settings = part(ShearSettingsRecord, obj.settings)
         obj.provenance = part(Provenance, obj.provenance)
         return obj
 
@@ -122,7 +124,7 @@ class ShearSeriesResult(Nested):
     quasi_static: QuasiStatic
     peak_definition: str
     shear_stress_definition: str
-    settings: dict[str, Any]
+    settings: ShearSettingsRecord
     velocity_m_per_s: float
     density_scale: float
     specimen: str
@@ -147,6 +149,7 @@ class ShearSeriesResult(Nested):
         obj.quasi_static = part(QuasiStatic, obj.quasi_static)
         obj.rate_check = part(RateCheck, obj.rate_check)
         obj.lab = part(LabComparison, obj.lab)
+        obj.settings = part(ShearSettingsRecord, obj.settings)
         obj.provenance = part(Provenance, obj.provenance)
         return obj
 
@@ -199,7 +202,7 @@ class StrengthResult(Nested):
     mu_r: list[float]
     particle_friction: list[float]
     specimens: list[str]
-    settings: dict[str, Any]
+    settings: ShearSettingsRecord
     definitions: StrengthDefinitions
     wall_time_s: float | None = None
     processes: int | None = None
@@ -211,6 +214,7 @@ class StrengthResult(Nested):
         obj = super().from_dict(data)
         obj.cases = parts(StrengthCase, obj.cases)
         obj.definitions = part(StrengthDefinitions, obj.definitions)
+        obj.settings = part(ShearSettingsRecord, obj.settings)
         obj.provenance = part(Provenance, obj.provenance)
         return obj
 
