@@ -420,3 +420,24 @@ def test_shear_settings_are_a_record_that_keeps_the_keys_a_file_had():
     fresh = ShearSettings(velocity=0.01)
     assert ShearSettingsRecord.from_dict(fresh.to_dict()).to_dict() == fresh.to_dict()
     assert list(ShearSettingsRecord.from_dict(fresh.to_dict()).to_dict()) == list(fresh.to_dict())
+
+
+def test_a_criterion_keeps_its_settings_and_specimen_as_records():
+    """A criterion result's settings and specimen are records that write the keys the file had:
+    options left out at their default stay out, the specimen's former ``extra`` key stays in."""
+    from poro2d.criterion.protocol import CriterionSettings
+    from poro2d.criterion.result import CriterionSettingsRecord, SpecimenRecord
+    from poro2d.specimen.compaction import SpecimenSpec
+
+    stored = json.loads((DATA / "criterion_result.json").read_text())
+    crit = CriterionResult.from_dict(stored)
+    assert isinstance(crit.settings, CriterionSettingsRecord) and crit.settings.max_iterations == 6
+    assert isinstance(crit.specimen, SpecimenRecord) and crit.specimen.width == 0.05
+    assert crit.specimen.extra == {"extra": {}} and json.dumps(crit.to_dict()) == json.dumps(stored)
+    for record, made in (
+        (CriterionSettingsRecord, CriterionSettings(refine_tolerance=0.002).to_record()),
+        (CriterionSettingsRecord, CriterionSettings(acceptance="fill").to_record()),
+        (SpecimenRecord, SpecimenSpec(width=0.05, height=0.025, rolling_friction=0.1).to_dict()),
+        (SpecimenRecord, SpecimenSpec().to_dict()),
+    ):
+        assert list(record.from_dict(made).to_dict().items()) == list(made.items())
