@@ -69,6 +69,39 @@ class SeedSpecimen:
 
 
 @dataclass(eq=False)
+class SeedResult(TypedResult):
+    """One seed's specimen as ``sand.json`` keeps it (``seed_results``: a :class:`SeedSpecimen`'s fields)."""
+
+    seed: int
+    accepted: bool
+    box_porosity: float | None
+    interior_porosity: float | None
+    particle_count: int | None
+    trials: int | None
+    folder: str | None
+    message: str
+
+
+@dataclass(eq=False)
+class DensityCalibrationRecord(TypedResult):
+    """mu_prep -> accepted n2D over seeds as a file keeps it (``Calibration.to_dict()``).
+
+    ``samples``: per friction, each seed's accepted n2D (None: not accepted); ``mean``, ``sd``
+    and ``fitted``: per friction, over the accepted seeds; ``failed``: per friction, the seeds
+    not accepted; ``dropped``: frictions left out of the fit.
+    """
+
+    mus: list[float]
+    samples: list[list[float | None]]
+    seeds: list[int]
+    mean: list[float | None]
+    sd: list[float | None]
+    fitted: list[float | None]
+    failed: list[int]
+    dropped: list[float]
+
+
+@dataclass(eq=False)
 class SandCalibration(TypedResult):
     """The calibration in the small box (``calibration`` in ``sand.json``).
 
@@ -83,7 +116,7 @@ class SandCalibration(TypedResult):
     OPTIONAL: ClassVar[tuple[str, ...]] = ("time_profile", "specimens_time_profile")
 
     mus: list[float]
-    calibration: dict[str, Any]
+    calibration: DensityCalibrationRecord
     n2d_min: float
     n2d_max: float
     dropped_ends: list[float]
@@ -109,6 +142,7 @@ class SandCalibration(TypedResult):
         for key in cls.PROFILES:
             if isinstance(getattr(obj, key), dict):
                 setattr(obj, key, StageProfile.from_dict(getattr(obj, key)))
+        obj.calibration = as_part(DensityCalibrationRecord, obj.calibration)
         return obj
 
 
@@ -148,7 +182,7 @@ class SandResult(TypedResult):
     jamming_porosity_sd: float | None
     calibration: SandCalibration
     states: list[AcceptedState]
-    seed_results: list[dict[str, Any]]
+    seed_results: list[SeedResult]
     preflight: dict[str, Any]
     wall_seconds: float
     config: dict[str, Any]
@@ -172,7 +206,8 @@ class SandResult(TypedResult):
             if isinstance(getattr(obj, key), dict):
                 setattr(obj, key, part.from_dict(getattr(obj, key)))
         obj.state = as_part(LabStateRecord, obj.state)
-        obj.states = None if obj.states is None else [as_part(AcceptedState, s) for s in obj.states]
+        obj.states = _rows(AcceptedState, obj.states)
+        obj.seed_results = _rows(SeedResult, obj.seed_results)
         obj.provenance = as_part(Provenance, obj.provenance)
         return obj
 
@@ -224,13 +259,18 @@ class SandResult(TypedResult):
             jamming_porosity_sd=pf.jamming.sd,
             calibration=cal_record,
             states=states,
-            seed_results=[k.to_dict() for k in kept],
+            seed_results=[SeedResult.from_dict(k.to_dict()) for k in kept],
             preflight=pf.to_dict(),
             wall_seconds=seconds,
             config=case.config,
             provenance=Provenance.now(),
             specimens=list(kept),
         )
+
+
+def _rows(cls: type[TypedResult], rows: list | None) -> list | None:
+    """Each row of a file's list as the record ``cls``; None (a file without the key) stays None."""
+    return None if rows is None else [as_part(cls, row) for row in rows]
 
 
 def _pm(mean: float, sd: float) -> str:
