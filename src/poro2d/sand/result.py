@@ -69,6 +69,84 @@ class SeedSpecimen:
 
 
 @dataclass(eq=False)
+class BoxPlanRecord(TypedResult):
+    """A box of the pre-flight as a file keeps it (:class:`~poro2d.sand.preflight.BoxPlan`): m, disks."""
+
+    width: float
+    height: float
+    layers: int
+    disks: float
+
+
+@dataclass(eq=False)
+class JammingRecord(TypedResult):
+    """The pre-flight's jamming porosity as a file keeps it (:class:`~poro2d.sand.preflight.Jamming`)."""
+
+    porosity: float | None
+    sd: float | None
+    disks: int
+    seeds: int
+    seconds: float
+    note: str
+
+
+@dataclass(eq=False)
+class StageEstimate(TypedResult):
+    """The pre-flight's estimate for the calibration and the specimens (particle steps or s)."""
+
+    calibration: float
+    specimens: float
+    total: float | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("total",)
+
+
+@dataclass(eq=False)
+class PreflightRecord(TypedResult):
+    """The pre-flight as ``sand.json`` keeps it (:meth:`poro2d.sand.preflight.Preflight.to_dict`)."""
+
+    soil: str
+    d_min_m: float
+    d50_m: float
+    d_max_m: float
+    cu: float
+    size_ratio: float
+    upscale: float
+    box: BoxPlanRecord
+    calibration_box: BoxPlanRecord
+    band_over_d_max: float
+    time_step_s: float
+    time_step_paper_s: float
+    jamming: JammingRecord
+    first_trial: float
+    eq12_trial: float
+    cases_calibration: int
+    cases_specimens: int
+    particle_steps: StageEstimate
+    seconds: StageEstimate
+    workers: int
+    budget_minutes: float | None
+    suggestion: str
+    notes: list[str]
+
+    #: the typed parts, as their classes read them
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "box": BoxPlanRecord,
+        "calibration_box": BoxPlanRecord,
+        "jamming": JammingRecord,
+        "particle_steps": StageEstimate,
+        "seconds": StageEstimate,
+    }
+
+    @classmethod
+    def from_dict(cls, data) -> PreflightRecord:
+        obj = super().from_dict(data)
+        for key, part_cls in cls.PARTS.items():
+            setattr(obj, key, as_part(part_cls, getattr(obj, key)))
+        return obj
+
+
+@dataclass(eq=False)
 class SeedResult(TypedResult):
     """One seed's specimen as ``sand.json`` keeps it (``seed_results``: a :class:`SeedSpecimen`'s fields)."""
 
@@ -183,7 +261,7 @@ class SandResult(TypedResult):
     calibration: SandCalibration
     states: list[AcceptedState]
     seed_results: list[SeedResult]
-    preflight: dict[str, Any]
+    preflight: PreflightRecord
     wall_seconds: float
     config: dict[str, Any]
     provenance: Provenance
@@ -208,6 +286,7 @@ class SandResult(TypedResult):
         obj.state = as_part(LabStateRecord, obj.state)
         obj.states = _rows(AcceptedState, obj.states)
         obj.seed_results = _rows(SeedResult, obj.seed_results)
+        obj.preflight = as_part(PreflightRecord, obj.preflight)
         obj.provenance = as_part(Provenance, obj.provenance)
         return obj
 
@@ -260,7 +339,7 @@ class SandResult(TypedResult):
             calibration=cal_record,
             states=states,
             seed_results=[SeedResult.from_dict(k.to_dict()) for k in kept],
-            preflight=pf.to_dict(),
+            preflight=PreflightRecord.from_dict(pf.to_dict()),
             wall_seconds=seconds,
             config=case.config,
             provenance=Provenance.now(),
