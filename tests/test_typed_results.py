@@ -372,7 +372,13 @@ def test_known_structures_of_shear_and_paper_files_are_typed_parts():
 def test_a_calibrations_per_parameter_values_are_typed_parts():
     """A calibration's best pair, intervals, ranges, posterior median and wide flags, its
     laboratory data and timings are typed parts; the file is the same."""
-    from poro2d.calibration.run import CalibrationTimings, FrictionBounds, FrictionFlags, FrictionValues
+    from poro2d.calibration.run import (
+        CalibrationTimings,
+        FrictionBounds,
+        FrictionFlags,
+        FrictionValues,
+        SurrogateRecord,
+    )
     from poro2d.shear.parts import LabRecord
 
     stored = json.loads((DATA / "calibration_result.json").read_text())
@@ -383,6 +389,7 @@ def test_a_calibrations_per_parameter_values_are_typed_parts():
     assert cal.ranges.rolling_friction == [0.0, 0.5] and isinstance(cal.posterior.wide, FrictionFlags)
     assert isinstance(cal.posterior.median, FrictionValues) and isinstance(cal.lab, LabRecord)
     assert isinstance(cal.timings, CalibrationTimings) and cal.timings.wall_time_s > 0
+    assert isinstance(cal.fit["peak_50kPa"], SurrogateRecord) and cal.fit["peak_50kPa"].replicates == 2
     assert json.dumps(cal.to_dict(), indent=2) == json.dumps(stored, indent=2)
     unknown = FrictionBounds.from_dict({"particle_friction": None, "rolling_friction": None})
     assert unknown == {"particle_friction": None, "rolling_friction": None}

@@ -76,6 +76,16 @@ class FrictionFlags(TypedResult):
 
 
 @dataclass(eq=False)
+class SurrogateRecord(TypedResult):
+    """One observable's quadratic surrogate as a file keeps it (``Surrogate.to_dict()``)."""
+
+    coefficients: list[float]
+    seed_scatter_kpa: float
+    surrogate_residual_kpa: float
+    replicates: int
+
+
+@dataclass(eq=False)
 class CalibrationTimings(TypedResult):
     """Where a calibration's time went (s)."""
 
@@ -149,7 +159,7 @@ class CalibrationResult(TypedResult):
     level: float
     posterior: PosteriorSummary
     evaluations: list[dict[str, Any]]
-    fit: dict[str, Any]
+    fit: dict[str, SurrogateRecord]
     lab: LabRecord
     specimens: dict[str, str]
     ranges: FrictionBounds
@@ -181,6 +191,8 @@ class CalibrationResult(TypedResult):
         for key in ("posterior", "cluster"):
             if isinstance(out.get(key), TypedResult):
                 out[key] = out[key].to_dict()
+        if self.fit is not None:
+            out["fit"] = {k: v.to_dict() if isinstance(v, TypedResult) else v for k, v in self.fit.items()}
         if self.failures is not None:
             out["failures"] = [f.to_dict() if isinstance(f, UnitFailure) else f for f in self.failures]
         return out
@@ -197,6 +209,8 @@ class CalibrationResult(TypedResult):
             obj.failures = [UnitFailure.from_dict(f) if isinstance(f, dict) else f for f in obj.failures]
         for key, cls_part in CalibrationResult.PARTS.items():
             setattr(obj, key, part(cls_part, getattr(obj, key)))
+        if isinstance(obj.fit, dict):
+            obj.fit = {k: part(SurrogateRecord, v) for k, v in obj.fit.items()}
         return obj
 
     @classmethod
@@ -504,7 +518,10 @@ def _result(
             noise_correlation=post.noise_correlation,
         ),
         evaluations=table,
-        fit={f"{obs}_{s:g}kPa": sg.to_dict() for (obs, s, _), sg in zip(targets, surrogates, strict=True)},
+        fit={
+            f"{obs}_{s:g}kPa": SurrogateRecord.from_dict(sg.to_dict())
+            for (obs, s, _), sg in zip(targets, surrogates, strict=True)
+        },
         lab=LabRecord.from_dict(lab_data.to_dict()),
         specimens={k: str(v) for k, v in found.items()},
         ranges=FrictionBounds.from_dict(ranges.to_dict()),
