@@ -312,3 +312,168 @@ def test_parts_of_a_result_are_typed_and_written_as_before():
         (sand, "sand_result.json"),
     ):
         assert json.dumps(result.to_dict(), indent=2) + "\n" == (DATA / name).read_text()
+
+
+@pytest.mark.parametrize(
+    ("cls", "name"),
+    [(cls, name) for cls, name in FILES if "provenance" in json.loads((DATA / name).read_text())],
+)
+def test_provenance_is_a_record_written_as_before(cls, name):
+    """Every result's ``provenance`` reads as a :class:`~poro2d.io_utils.Provenance` record that
+    writes the file's keys back; a key of another version is kept, a missing one stays missing."""
+    from poro2d.io_utils import Provenance, provenance
+
+    stored = json.loads((DATA / name).read_text())
+    result = cls.from_dict(stored)
+    assert isinstance(result.provenance, Provenance) and result.provenance.poro2d_version
+    assert result.provenance["python"] == stored["provenance"]["python"]
+    assert json.dumps(result.to_dict(), indent=2) == json.dumps(stored, indent=2)
+    assert Provenance.now().to_dict().keys() == provenance().keys()
+    older = Provenance.from_dict({"poro2d_version": "0.0.1", "host": "h"})
+    assert older.to_dict() == {"poro2d_version": "0.0.1", "host": "h"}
+
+
+def test_known_structures_of_shear_and_paper_files_are_typed_parts():
+    """The split box, laboratory peaks, a strength study's definitions and the case study's
+    facts, timings, conversion rows and shear summary are typed parts; the files are the same."""
+    from poro2d.paper import ConversionRow, PaperFacts, PaperTimings
+    from poro2d.shear.parts import BoxRecord, LabPeak, QuasiStatic, StrengthDefinitions, TestSummary
+    from poro2d.shear.results import StrengthResult
+
+    test = ShearTestResult.from_dict(json.loads((DATA / "shear_test_result.json").read_text()))
+    assert isinstance(test.consolidation.box, BoxRecord) and test.consolidation.box.width == 0.05
+    series = ShearSeriesResult.from_dict(json.loads((DATA / "shear_series_result.json").read_text()))
+    assert all(isinstance(p, LabPeak) for p in series.lab.peaks)
+    assert series.lab.peaks[0].normal_stress_kpa == 50
+    paper = PaperSummary.from_dict(json.loads((DATA / "paper_results.json").read_text()))
+    assert isinstance(paper.paper, PaperFacts) and paper.paper.criterion.accepted_porosity == 0.15
+    assert isinstance(paper.timings, PaperTimings) and paper.timings.shear_s > 0
+    assert isinstance(paper.conversions.methods[0], ConversionRow)
+    assert isinstance(paper.shear.tests[0], TestSummary) and isinstance(paper.shear.quasi_static, QuasiStatic)
+    for result, name in (
+        (test, "shear_test_result.json"),
+        (series, "shear_series_result.json"),
+        (paper, "paper_results.json"),
+    ):
+        stored = json.loads((DATA / name).read_text())
+        assert json.dumps(result.to_dict(), indent=2) == json.dumps(stored, indent=2)
+    # a study without a converged criterion has no shear timings: they stay out of the file
+    assert PaperTimings.from_dict({"conversions_s": 1.0, "criterion_s": 2.0}).to_dict() == {
+        "conversions_s": 1.0,
+        "criterion_s": 2.0,
+    }
+    strength = {"cases": [], "mu_r": [0.1], "particle_friction": [0.5], "specimens": ["s1"], "settings": {},
+                "definitions": {"peak_friction_angle": "a", "residual_friction_angle": "b",
+                                "max_dilation_angle": "c"}}  # fmt: skip
+    read = StrengthResult.from_dict(strength)
+    assert isinstance(read.definitions, StrengthDefinitions) and read.to_dict() == strength
+
+
+def test_a_calibrations_per_parameter_values_are_typed_parts():
+    """A calibration's best pair, intervals, ranges, posterior median and wide flags, its
+    laboratory data and timings are typed parts; the file is the same."""
+    from poro2d.calibration.run import (
+        CalibrationTimings,
+        FrictionBounds,
+        FrictionFlags,
+        FrictionValues,
+        SurrogateRecord,
+    )
+    from poro2d.shear.parts import LabRecord
+
+    stored = json.loads((DATA / "calibration_result.json").read_text())
+    cal = CalibrationResult.from_dict(stored)
+    assert isinstance(cal.best, FrictionValues)
+    assert cal.best.particle_friction == stored["best"]["particle_friction"]
+    assert isinstance(cal.intervals, FrictionBounds) and isinstance(cal.ranges, FrictionBounds)
+    assert cal.ranges.rolling_friction == [0.0, 0.5] and isinstance(cal.posterior.wide, FrictionFlags)
+    assert isinstance(cal.posterior.median, FrictionValues) and isinstance(cal.lab, LabRecord)
+    assert isinstance(cal.timings, CalibrationTimings) and cal.timings.wall_time_s > 0
+    assert isinstance(cal.fit["peak_50kPa"], SurrogateRecord) and cal.fit["peak_50kPa"].replicates == 2
+    assert json.dumps(cal.to_dict(), indent=2) == json.dumps(stored, indent=2)
+    unknown = FrictionBounds.from_dict({"particle_friction": None, "rolling_friction": None})
+    assert unknown == {"particle_friction": None, "rolling_friction": None}
+    assert unknown["rolling_friction"] is None
+
+
+def test_a_sands_laboratory_state_and_accepted_states_are_typed_parts():
+    """``sand.json``'s state (and the soil's), and each accepted specimen's row, are typed parts."""
+    from poro2d.sand.case import LabStateRecord
+    from poro2d.sand.result import AcceptedState
+
+    stored = json.loads((DATA / "sand_result.json").read_text())
+    sand = SandResult.from_dict(stored)
+    assert isinstance(sand.state, LabStateRecord) and sand.state.given == "Dr"
+    assert isinstance(sand.soil.lab, LabStateRecord) and sand.soil.lab.n_lab == sand.state.n_lab
+    assert all(isinstance(s, AcceptedState) for s in sand.states) and sand.states[1].seed == 1
+    assert json.dumps(sand.to_dict(), indent=2) == json.dumps(stored, indent=2)
+
+
+def test_shear_settings_are_a_record_that_keeps_the_keys_a_file_had():
+    """A result's shear settings read as a :class:`~poro2d.shear.parts.ShearSettingsRecord`; a file
+    written before ``stop_after_peak`` and ``rolling_friction`` existed is written back without them."""
+    from poro2d.shear.parts import ShearSettingsRecord
+    from poro2d.shear.settings import ShearSettings
+
+    stored = json.loads((DATA / "shear_test_result.json").read_text())
+    test = ShearTestResult.from_dict(stored)
+    assert (
+        isinstance(test.settings, ShearSettingsRecord)
+        and test.settings.velocity == stored["settings"]["velocity"]
+    )
+    assert "stop_after_peak" not in test.to_dict()["settings"] and test.to_dict() == stored
+    cal = CalibrationResult.from_dict(json.loads((DATA / "calibration_result.json").read_text()))
+    assert isinstance(cal.settings, ShearSettingsRecord) and cal.settings.stop_after_peak == 0.0
+    fresh = ShearSettings(velocity=0.01)
+    assert ShearSettingsRecord.from_dict(fresh.to_dict()).to_dict() == fresh.to_dict()
+    assert list(ShearSettingsRecord.from_dict(fresh.to_dict()).to_dict()) == list(fresh.to_dict())
+
+
+def test_a_criterion_keeps_its_settings_and_specimen_as_records():
+    """A criterion result's settings and specimen are records that write the keys the file had:
+    options left out at their default stay out, the specimen's former ``extra`` key stays in."""
+    from poro2d.criterion.protocol import CriterionSettings
+    from poro2d.criterion.result import CriterionSettingsRecord, SpecimenRecord
+    from poro2d.specimen.compaction import SpecimenSpec
+
+    stored = json.loads((DATA / "criterion_result.json").read_text())
+    crit = CriterionResult.from_dict(stored)
+    assert isinstance(crit.settings, CriterionSettingsRecord) and crit.settings.max_iterations == 6
+    assert isinstance(crit.specimen, SpecimenRecord) and crit.specimen.width == 0.05
+    assert crit.specimen.extra == {"extra": {}} and json.dumps(crit.to_dict()) == json.dumps(stored)
+    for record, made in (
+        (CriterionSettingsRecord, CriterionSettings(refine_tolerance=0.002).to_record()),
+        (CriterionSettingsRecord, CriterionSettings(acceptance="fill").to_record()),
+        (SpecimenRecord, SpecimenSpec(width=0.05, height=0.025, rolling_friction=0.1).to_dict()),
+        (SpecimenRecord, SpecimenSpec().to_dict()),
+    ):
+        assert list(record.from_dict(made).to_dict().items()) == list(made.items())
+
+
+def test_a_sands_calibration_record_and_seed_results_are_typed_parts():
+    """The small box's calibration record and each seed's row are typed parts, written as before."""
+    from poro2d.sand.result import DensityCalibrationRecord, SeedResult, SeedSpecimen
+
+    stored = json.loads((DATA / "sand_result.json").read_text())
+    sand = SandResult.from_dict(stored)
+    assert isinstance(sand.calibration.calibration, DensityCalibrationRecord)
+    assert sand.calibration.calibration.mus == stored["calibration"]["calibration"]["mus"]
+    assert "seed_results" not in sand.to_dict()  # a file written before the key stays without it
+    seed = SeedSpecimen(1, True, 0.17, 0.16, 900, 2, "specimens/seed1")
+    row = SeedResult.from_dict(seed.to_dict())
+    sand.seed_results = [row]
+    assert sand.to_dict()["seed_results"] == [seed.to_dict()] and row.folder == "specimens/seed1"
+    assert SandResult.from_dict(sand.to_dict()).seed_results[0].trials == 2
+
+
+def test_a_sands_preflight_is_a_typed_part():
+    """``sand.json``'s pre-flight (its boxes, jamming porosity and estimates) is a typed part."""
+    from poro2d.sand.result import BoxPlanRecord, JammingRecord, PreflightRecord, StageEstimate
+
+    stored = json.loads((DATA / "sand_result.json").read_text())
+    pf = SandResult.from_dict(stored).preflight
+    assert isinstance(pf, PreflightRecord) and isinstance(pf.box, BoxPlanRecord) and pf.box.layers == 4
+    assert isinstance(pf.jamming, JammingRecord) and pf.jamming.seeds == 3
+    assert isinstance(pf.seconds, StageEstimate)
+    assert pf.seconds.total == stored["preflight"]["seconds"]["total"]
+    assert "total" not in pf.particle_steps.to_dict() and pf.to_dict() == stored["preflight"]

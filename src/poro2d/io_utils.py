@@ -13,11 +13,13 @@ import tempfile
 import time
 from collections.abc import Iterable, Mapping
 from contextlib import contextmanager
+from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
 from poro2d import __version__
+from poro2d.typed_result import TypedResult
 
 
 @contextmanager
@@ -148,6 +150,27 @@ def provenance() -> dict:
         "cpu_count": os.cpu_count(),
         "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
     }
+
+
+@dataclass(eq=False)
+class Provenance(TypedResult):
+    """The ``provenance`` record of a result file: which poro2d, Python and machine wrote it, and when.
+
+    The keys are those :func:`provenance` writes; a file of another version keeps its other
+    keys (``extra``) and lacks none it did not have.
+    """
+
+    poro2d_version: str
+    python: str
+    machine: str
+    platform: str
+    cpu_count: int | None
+    created_utc: str
+
+    @classmethod
+    def now(cls) -> Provenance:
+        """The record of the run at hand (:func:`provenance`)."""
+        return cls.from_dict(provenance())
 
 
 def _default(o):

@@ -18,13 +18,15 @@ from poro2d.console import OutputConsole
 from poro2d.criterion.config import paper_config
 from poro2d.criterion.replicates import accepted_and_replicates
 from poro2d.criterion.result import CriterionResult
-from poro2d.io_utils import provenance
+from poro2d.io_utils import Provenance, provenance
 from poro2d.locks import holds_output
 from poro2d.paper_data import PAPER, QUICK_SHEAR
+from poro2d.shear.parts import LabRecord, QuasiStatic, TestSummary, parts
 from poro2d.shear.results import ReplicateShearResult
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.typed_result import TypedResult
+from poro2d.typed_result import part as as_part
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
 KIND = "paper"
@@ -41,6 +43,17 @@ CRITERION_KEYS = ("final_porosity", "converged", "message", "iterations")
 
 
 @dataclass(eq=False)
+class ConversionRow(TypedResult):
+    """One conversion method's row of ``conversions.csv``: its id, name, equation, n2D and flags."""
+
+    method: str
+    name: str
+    equation: str
+    n2d: float
+    flags: str
+
+
+@dataclass(eq=False)
 class ConversionsRecord(TypedResult):
     """The conversions stage (``conversions/conversions.json``): the paper's sand, each method's
     row of ``conversions.csv`` and the figures written (Figs. 1-2)."""
@@ -48,9 +61,16 @@ class ConversionsRecord(TypedResult):
     n_lab: float
     n_max: float
     n_min: float
-    methods: list[dict[str, Any]]
+    methods: list[ConversionRow]
     figures: list[str]
-    provenance: dict[str, Any]
+    provenance: Provenance
+
+    @classmethod
+    def from_dict(cls, data) -> ConversionsRecord:
+        obj = super().from_dict(data)
+        obj.methods = [as_part(ConversionRow, m) for m in obj.methods] if obj.methods is not None else None
+        obj.provenance = as_part(Provenance, obj.provenance)
+        return obj
 
 
 @dataclass(eq=False)
@@ -58,11 +78,11 @@ class PaperShear(TypedResult):
     """The direct shear stage's summary: the pooled fit over every specimen's peaks; ``tests``
     and ``quasi_static`` of the first specimen; ``replicates``: the replicate specimens' summary."""
 
-    tests: list[dict[str, Any]]
+    tests: list[TestSummary]
     friction_angle_deg: float | None
     cohesion_kpa: float | None
     r2: float | None
-    quasi_static: Any
+    quasi_static: QuasiStatic
     replicates: ReplicateShearResult
 
     def to_dict(self) -> dict[str, Any]:
@@ -76,7 +96,53 @@ class PaperShear(TypedResult):
         obj = super().from_dict(data)
         if isinstance(obj.replicates, dict):
             obj.replicates = ReplicateShearResult.from_dict(obj.replicates)
+        obj.tests = parts(TestSummary, obj.tests)
+        obj.quasi_static = as_part(QuasiStatic, obj.quasi_static)
         return obj
+
+
+@dataclass(eq=False)
+class PaperCriterionFacts(TypedResult):
+    """What the paper reports of its criterion run (section 3): trials, disks, forces (per m of depth)."""
+
+    trials: list[float]
+    particle_counts: list[int]
+    porosity_change_first_trial: float
+    f_top_first_trial_kn_per_m: float
+    f_bottom_first_trial_kn_per_m: float
+    self_weight_first_trial_n_per_m: float
+    f_top_accepted_n_per_m: float
+    f_bottom_accepted_n_per_m: float
+    self_weight_accepted_n_per_m: float
+    accepted_porosity: float
+
+
+@dataclass(eq=False)
+class PaperFacts(TypedResult):
+    """What the paper states (:data:`poro2d.paper_data.PAPER`), kept in the summary for the comparison."""
+
+    n_lab: float
+    n_max: float
+    n_min: float
+    dry_density_kg_m3: float
+    solid_density_kg_m3: float
+    criterion: PaperCriterionFacts
+
+    @classmethod
+    def from_dict(cls, data) -> PaperFacts:
+        obj = super().from_dict(data)
+        obj.criterion = as_part(PaperCriterionFacts, obj.criterion)
+        return obj
+
+
+@dataclass(eq=False)
+class PaperTimings(TypedResult):
+    """Where the case study's time went (s); the last two only when the criterion converged."""
+
+    conversions_s: float
+    criterion_s: float
+    replicates_s: float | None = None
+    shear_s: float | None = None
 
 
 @dataclass(eq=False)
@@ -100,10 +166,10 @@ class PaperSummary(TypedResult):
     criterion: CriterionResult
     replicate_specimens: list[dict[str, Any]] | None
     shear: PaperShear | None
-    paper: dict[str, Any]
-    timings: dict[str, float]
-    provenance: dict[str, Any]
-    lab: dict[str, Any] | None = None
+    paper: PaperFacts
+    timings: PaperTimings
+    provenance: Provenance
+    lab: LabRecord | None = None
 
     #: the typed parts, as their classes read them
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
@@ -128,6 +194,10 @@ class PaperSummary(TypedResult):
             value = getattr(obj, key)
             if isinstance(value, dict):
                 setattr(obj, key, part.from_dict(value))
+        obj.paper = as_part(PaperFacts, obj.paper)
+        obj.timings = as_part(PaperTimings, obj.timings)
+        obj.provenance = as_part(Provenance, obj.provenance)
+        obj.lab = as_part(LabRecord, obj.lab)
         return obj
 
 
@@ -168,8 +238,9 @@ def conversion_files(store: Store) -> ConversionsRecord:
     store.write_csv("conversions.csv", rows)
     figs = write_relation_figures(store.root, n_max=PAPER["n_max"], n_min=PAPER["n_min"],
                                   mark_n_lab=PAPER["n_lab"])  # fmt: skip
-    return ConversionsRecord(n_lab=PAPER["n_lab"], n_max=PAPER["n_max"], n_min=PAPER["n_min"], methods=rows,
-                             figures=[str(f.name) for f in figs], provenance=provenance())  # fmt: skip
+    return ConversionsRecord(n_lab=PAPER["n_lab"], n_max=PAPER["n_max"], n_min=PAPER["n_min"],
+                             methods=[ConversionRow.from_dict(r) for r in rows],
+                             figures=[str(f.name) for f in figs], provenance=Provenance.now())  # fmt: skip
 
 
 @holds_output("store", kind=KIND)
@@ -267,10 +338,10 @@ def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, *,
         criterion=CriterionResult.from_dict({k: result[k] for k in CRITERION_KEYS}),
         replicate_specimens=reps,
         shear=shear,
-        paper=PAPER,
-        timings=timings,
-        provenance=provenance(),
-        lab=lab_data.to_dict() if lab_data is not None else None,
+        paper=PaperFacts.from_dict(PAPER),
+        timings=PaperTimings.from_dict(timings),
+        provenance=Provenance.now(),
+        lab=LabRecord.from_dict(lab_data.to_dict()) if lab_data is not None else None,
     )
     return summary, CriterionOutputs.read(store.child("criterion"), result), shear_figures
 

@@ -23,16 +23,34 @@ from __future__ import annotations
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, fields
 from functools import cache
-from typing import Any, ClassVar, Self
+from typing import Any, ClassVar, Self, TypeVar
 
 #: the metadata of a field that is not a key of the result's file
 NOT_IN_FILE = {"in_file": False}
+
+R = TypeVar("R", bound="TypedResult")
 
 
 @cache
 def _keys(cls: type) -> tuple[str, ...]:
     """The file keys a result class models: its fields but ``extra`` and those not in the file."""
     return tuple(f.name for f in fields(cls) if f.name != "extra" and f.metadata.get("in_file", True))
+
+
+def _plain(value: Any) -> Any:
+    """A typed part as the dict of its file, a list of them as a list of dicts; anything else as it is."""
+    if isinstance(value, TypedResult):
+        return value.to_dict()
+    if isinstance(value, list) and any(isinstance(v, TypedResult) for v in value):
+        return [_plain(v) for v in value]
+    return value
+
+
+def part(cls: type[R], value: Any) -> Any:
+    """``value`` as the part ``cls`` when it is the dict of one (as read from a file), else as it is."""
+    if isinstance(value, Mapping) and not isinstance(value, cls):
+        return cls.from_dict(value)
+    return value
 
 
 @dataclass(eq=False)
@@ -54,8 +72,12 @@ class TypedResult(Mapping):
         return getattr(self, key) is not None or (key not in self._absent and key not in self.OPTIONAL)
 
     def to_dict(self) -> dict[str, Any]:
-        """The keys and values of the file, in its order (a shallow copy: nested values are shared)."""
-        out = {k: getattr(self, k) for k in _keys(type(self)) if self._present(k)}
+        """The keys and values of the file, in its order (a shallow copy: nested values are shared).
+
+        A field holding a typed part (a record such as a file's provenance), or a list of them, is
+        written as its dict(s).
+        """
+        out = {k: _plain(getattr(self, k)) for k in _keys(type(self)) if self._present(k)}
         out.update(self.extra)
         return out
 
@@ -83,4 +105,4 @@ class TypedResult(Mapping):
         return len(self.to_dict())
 
 
-__all__ = ["NOT_IN_FILE", "TypedResult"]
+__all__ = ["NOT_IN_FILE", "TypedResult", "part"]

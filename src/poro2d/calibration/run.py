@@ -24,14 +24,15 @@ from poro2d.calibration.units import CACHE, CalibrationUnit, UnitRow
 from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
 from poro2d.execute.dask_cluster import check_reachable
-from poro2d.io_utils import check_output_dir, provenance
+from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import holds_output
 from poro2d.paper_data import QUICK_SHEAR
 from poro2d.shear.lab import LabData, read_lab_csv
+from poro2d.shear.parts import LabRecord, ShearSettingsRecord
 from poro2d.shear.series import check_stresses
 from poro2d.shear.settings import MAX_FRICTION, ShearSettings
 from poro2d.store import Store
-from poro2d.typed_result import TypedResult
+from poro2d.typed_result import TypedResult, part
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
 KIND = "calibrate"
@@ -48,6 +49,47 @@ RESIDUAL_DOF = 3
 MIN_POINTS = model.N_COEFFICIENTS + RESIDUAL_DOF
 #: the settings calibrated here: given ones would be overridden, so they are refused
 CALIBRATED = ("particle_friction", "rolling_friction")
+
+
+@dataclass(eq=False)
+class FrictionValues(TypedResult):
+    """A value per calibrated parameter: the posterior maximum or median of f_p and mu_r."""
+
+    particle_friction: float
+    rolling_friction: float
+
+
+@dataclass(eq=False)
+class FrictionBounds(TypedResult):
+    """A [low, high] pair per calibrated parameter: its range, or its interval (None: unknown)."""
+
+    particle_friction: list[float] | None
+    rolling_friction: list[float] | None
+
+
+@dataclass(eq=False)
+class FrictionFlags(TypedResult):
+    """A yes/no per calibrated parameter: whether its interval is wide (None: unknown)."""
+
+    particle_friction: bool | None
+    rolling_friction: bool | None
+
+
+@dataclass(eq=False)
+class SurrogateRecord(TypedResult):
+    """One observable's quadratic surrogate as a file keeps it (``Surrogate.to_dict()``)."""
+
+    coefficients: list[float]
+    seed_scatter_kpa: float
+    surrogate_residual_kpa: float
+    replicates: int
+
+
+@dataclass(eq=False)
+class CalibrationTimings(TypedResult):
+    """Where a calibration's time went (s)."""
+
+    wall_time_s: float
 
 
 @dataclass(eq=False)
@@ -73,9 +115,9 @@ class PosteriorSummary(TypedResult):
     fitted; ``noise_correlation``: of the observables' noise.
     """
 
-    median: dict[str, float]
+    median: FrictionValues
     correlation: float
-    wide: dict[str, bool]
+    wide: FrictionFlags
     grid: int
     prior: str
     observables: list[FittedObservable]
@@ -94,6 +136,8 @@ class PosteriorSummary(TypedResult):
             obj.observables = [
                 FittedObservable.from_dict(o) if isinstance(o, dict) else o for o in obj.observables
             ]
+        obj.median = part(FrictionValues, obj.median)
+        obj.wide = part(FrictionFlags, obj.wide)
         return obj
 
 
@@ -110,26 +154,36 @@ class CalibrationResult(TypedResult):
     ``fit``: the surrogate per observable; ``lab``: the laboratory values fitted.
     """
 
-    best: dict[str, float]
-    intervals: dict[str, list[float]]
+    best: FrictionValues
+    intervals: FrictionBounds
     level: float
     posterior: PosteriorSummary
     evaluations: list[dict[str, Any]]
-    fit: dict[str, Any]
-    lab: dict[str, Any]
+    fit: dict[str, SurrogateRecord]
+    lab: LabRecord
     specimens: dict[str, str]
-    ranges: dict[str, list[float]]
-    settings: dict[str, Any]
+    ranges: FrictionBounds
+    settings: ShearSettingsRecord
     cluster: ClusterRecord
     failures: list[UnitFailure]
-    timings: dict[str, float]
+    timings: CalibrationTimings
     config: dict[str, Any]
-    provenance: dict[str, Any]
+    provenance: Provenance
     #: why the intervals are unknown (then ``intervals`` and ``posterior["wide"]`` hold None);
     #: absent from the file of a calibration whose design estimates its own noise
     unidentified: str | None = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = ("unidentified",)
+    #: the fields read as their records from a file's dict
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "best": FrictionValues,
+        "intervals": FrictionBounds,
+        "lab": LabRecord,
+        "ranges": FrictionBounds,
+        "settings": ShearSettingsRecord,
+        "timings": CalibrationTimings,
+        "provenance": Provenance,
+    }
 
     def to_dict(self) -> dict[str, Any]:
         """The file's keys; the cluster and the failures as the dicts they are written as."""
@@ -137,6 +191,8 @@ class CalibrationResult(TypedResult):
         for key in ("posterior", "cluster"):
             if isinstance(out.get(key), TypedResult):
                 out[key] = out[key].to_dict()
+        if self.fit is not None:
+            out["fit"] = {k: v.to_dict() if isinstance(v, TypedResult) else v for k, v in self.fit.items()}
         if self.failures is not None:
             out["failures"] = [f.to_dict() if isinstance(f, UnitFailure) else f for f in self.failures]
         return out
@@ -151,6 +207,10 @@ class CalibrationResult(TypedResult):
             obj.cluster = ClusterRecord.from_dict(obj.cluster)
         if isinstance(obj.failures, list):
             obj.failures = [UnitFailure.from_dict(f) if isinstance(f, dict) else f for f in obj.failures]
+        for key, cls_part in CalibrationResult.PARTS.items():
+            setattr(obj, key, part(cls_part, getattr(obj, key)))
+        if isinstance(obj.fit, dict):
+            obj.fit = {k: part(SurrogateRecord, v) for k, v in obj.fit.items()}
         return obj
 
     @classmethod
@@ -445,29 +505,32 @@ def _result(
         for (obs, s, y), sg, sd in zip(targets, surrogates, post.noise_sd, strict=True)
     ]
     return CalibrationResult(
-        best={"particle_friction": fp, "rolling_friction": mu_r},
-        intervals=intervals,
+        best=FrictionValues(particle_friction=fp, rolling_friction=mu_r),
+        intervals=FrictionBounds.from_dict(intervals),
         level=level,
         posterior=PosteriorSummary(
-            median={"particle_friction": post.median("fp"), "rolling_friction": post.median("mu_r")},
+            median=FrictionValues(particle_friction=post.median("fp"), rolling_friction=post.median("mu_r")),
             correlation=post.correlation(),
-            wide=wide,
+            wide=FrictionFlags.from_dict(wide),
             grid=model.GRID,
             prior="uniform in log(f_p) and mu_r over the ranges",
             observables=fitted,
             noise_correlation=post.noise_correlation,
         ),
         evaluations=table,
-        fit={f"{obs}_{s:g}kPa": sg.to_dict() for (obs, s, _), sg in zip(targets, surrogates, strict=True)},
-        lab=lab_data.to_dict(),
+        fit={
+            f"{obs}_{s:g}kPa": SurrogateRecord.from_dict(sg.to_dict())
+            for (obs, s, _), sg in zip(targets, surrogates, strict=True)
+        },
+        lab=LabRecord.from_dict(lab_data.to_dict()),
         specimens={k: str(v) for k, v in found.items()},
-        ranges=ranges.to_dict(),
-        settings=base,
+        ranges=FrictionBounds.from_dict(ranges.to_dict()),
+        settings=ShearSettingsRecord.from_dict(base),
         cluster=runner.info(),
         failures=runner.failures,
-        timings={"wall_time_s": time.perf_counter() - t0},
+        timings=CalibrationTimings(wall_time_s=time.perf_counter() - t0),
         config=dict(config, points=points, refine=refine, design_seed=design_seed, lab_error=lab_error),
-        provenance=provenance(),
+        provenance=Provenance.now(),
         unidentified=unknown,
     )
 

@@ -54,12 +54,12 @@ from poro2d.criterion.measures import (
     wall_forces,
 )
 from poro2d.criterion.outputs import force_figure, write_accepted
-from poro2d.criterion.result import CriterionResult
+from poro2d.criterion.result import CriterionResult, CriterionSettingsRecord, SpecimenRecord
 from poro2d.criterion.servo import PlateServo, in_window
 from poro2d.criterion.trial import Decision, PlateStage, Preparation, StageFailure, Trial, trial_name
 from poro2d.dem import Simulation
 from poro2d.errors import Integer, OneOf, Ranges, Real, check_fields, check_range
-from poro2d.io_utils import provenance
+from poro2d.io_utils import Provenance, provenance
 from poro2d.measure.disks import mass_d50
 from poro2d.measure.porosity import box_porosity
 from poro2d.measure.surface import lid_height_at
@@ -648,11 +648,11 @@ class PorosityCriterion:
             initial_from="given" if self.settings.trial_porosity is not None else "Eq. 12 (parabola)",
             iterations=trials,
             seed=self.seed,
-            settings=self.settings.to_record(),
-            specimen=self.spec.to_dict(),
+            settings=CriterionSettingsRecord.from_dict(self.settings.to_record()),
+            specimen=SpecimenRecord.from_dict(self.spec.to_dict()),
             local_damping_note=f"local damping {self.spec.local_damping} (PFC 4.0 default; "
             "the paper does not state it)",
-            provenance=provenance(),
+            provenance=Provenance.now(),
         )
 
     def _write_table(self, trials: list[Trial]) -> None:

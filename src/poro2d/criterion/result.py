@@ -7,10 +7,82 @@ from pathlib import Path
 from typing import Any, Self
 
 from poro2d.criterion.trial import Trial
+from poro2d.io_utils import Provenance
 from poro2d.measure.specimen_porosity import SpecimenPorosity
 from poro2d.measure.specimen_state import SpecimenStateResult
 from poro2d.store import Store
-from poro2d.typed_result import NOT_IN_FILE, TypedResult
+from poro2d.typed_result import NOT_IN_FILE, TypedResult, part
+
+
+@dataclass(eq=False)
+class CriterionSettingsRecord(TypedResult):
+    """The criterion's settings as a result keeps them (``CriterionSettings.to_record()``).
+
+    ``refine_tolerance`` and ``acceptance`` are keys only when set (the plate acceptance is
+    left out), as in every file written before they existed: a record is read from that dict
+    (``from_dict``), so the keys it lacks stay out of the file.
+    """
+
+    n_lab: float
+    trial_porosity: float | None
+    force_fraction: float
+    porosity_tolerance: float
+    resolution: float
+    max_iterations: int
+    servo_target_fraction: float
+    servo_max_speed: float
+    servo_gain: float
+    settle_gain: float
+    settle_max_speed: float
+    settle_checks: int
+    plate_drift: float
+    max_plate_steps: int
+    check_every: int
+    window_checks: int
+    generation_tolerance: float
+    balance_tolerance: float
+    refine_tolerance: float | None
+    acceptance: str | None
+
+
+@dataclass(eq=False)
+class SpecimenRecord(TypedResult):
+    """The specimen's settings as a result keeps them (``SpecimenSpec.to_dict()``).
+
+    Settings newer than the first files are keys only when they leave their default, and a
+    file's former ``extra`` key (always empty) is kept, like any key not modelled, in
+    :attr:`~poro2d.typed_result.TypedResult.extra`.
+    """
+
+    width: float
+    height: float
+    thickness: float
+    solid_density: float
+    kn_particle: float
+    ks_particle: float
+    kn_wall: float
+    ks_wall: float
+    friction_prep: float
+    friction_particle: float
+    friction_wall: float
+    rolling_friction: float | None
+    layers: int | None
+    undercompaction: float | None
+    ratio: float | None
+    equilibrium: str | None
+    settle_drift: float | None
+    settle_window: int | None
+    settle_checks: int | None
+    local_damping: float | None
+    gravity: float | None
+    growth_increments: int | None
+    growth_steps: int | None
+    max_steps_per_stage: int | None
+    fallback_steps: int | None
+    calm_steps: int | None
+    calm_damping: float | None
+    dt_safety: float | None
+    threads: int | None
 
 
 @dataclass(eq=False)
@@ -38,10 +110,10 @@ class CriterionResult(TypedResult):
     initial_from: str
     iterations: list[Trial]
     seed: int
-    settings: dict[str, Any]
-    specimen: dict[str, Any]
+    settings: CriterionSettingsRecord
+    specimen: SpecimenRecord
     local_damping_note: str
-    provenance: dict[str, Any]
+    provenance: Provenance
     failed_trial: int | None = None
     time_total_s: float | None = None
     box_porosity: float | None = None
@@ -65,6 +137,9 @@ class CriterionResult(TypedResult):
         result = super().from_dict(data)
         if result.iterations is not None:
             result.iterations = [Trial.from_dict(row) for row in result.iterations]
+        result.settings = part(CriterionSettingsRecord, result.settings)
+        result.specimen = part(SpecimenRecord, result.specimen)
+        result.provenance = part(Provenance, result.provenance)
         return result
 
 

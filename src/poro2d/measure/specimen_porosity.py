@@ -31,12 +31,13 @@ from typing import Any
 import numpy as np
 
 from poro2d.errors import InputError, as_float_array, check_range
+from poro2d.io_utils import Provenance
 from poro2d.measure.disks import check_box, check_d50, check_disks
 from poro2d.measure.interior import DEFAULT_CIRCLE_D50, DEFAULT_MARGIN_D50, InteriorRegions, interior_regions
 from poro2d.measure.laguerre import LaguerreCells, laguerre_cells, laguerre_porosity
 from poro2d.measure.porosity import box_porosity, disk_area
 from poro2d.measure.surface import lid_height_at, plate_from_profile, profile_bins, surface_profile
-from poro2d.typed_result import NOT_IN_FILE, TypedResult
+from poro2d.typed_result import NOT_IN_FILE, TypedResult, part
 
 
 @dataclass(frozen=True)
@@ -110,11 +111,13 @@ class SpecimenPorosity(TypedResult):
     surface_level_m: float | None = None
     trial_porosity: float | None = None
     note: str | None = None
-    provenance: dict[str, Any] | None = None
+    provenance: Provenance | None = None
     details: PorosityDetails | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     def __post_init__(self) -> None:
         super().__post_init__()
+        # a file's provenance read as its record
+        self.provenance = part(Provenance, self.provenance)
         # NumPy scalars in, plain numbers out: the record is written as JSON
         for name in MEASURES:
             value = getattr(self, name)

@@ -238,7 +238,8 @@ def _provenance_blocks(summary, crit) -> list[Block]:
         ("table", ["item", "value"], [[k, str(v)] for k, v in (summary.provenance or {}).items()]
          + [["seed", summary.seed]]
          + [[f"time: {k}", v] for k, v in (summary.timings or {}).items()]),
-        ("code", json.dumps({"specimen": crit.specimen or {}, "criterion": crit.settings or {}}, indent=1)),
+        ("code", json.dumps({"specimen": dict(crit.specimen or {}), "criterion": dict(crit.settings or {})},
+                            indent=1)),
     ]  # fmt: skip
 
 

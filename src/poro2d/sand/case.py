@@ -37,7 +37,7 @@ from poro2d.specimen.compaction import SpecimenSpec, time_step
 from poro2d.specimen.grading import GradingCurve
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.density import DEFAULT_SEEDS, with_density_defaults
-from poro2d.typed_result import TypedResult
+from poro2d.typed_result import TypedResult, part
 
 #: the tables a sand config adds to a criterion config
 SAND_TABLES = ("soil", "lab", "sand")
@@ -56,6 +56,18 @@ ConfigLike = dict | str | os.PathLike
 
 
 @dataclass(eq=False)
+class LabStateRecord(TypedResult):
+    """A laboratory state as a file keeps it (:meth:`poro2d.lab_state.LabState.to_dict`)."""
+
+    n_lab: float
+    e: float
+    n_max: float | None
+    n_min: float | None
+    relative_density: float | None
+    given: str
+
+
+@dataclass(eq=False)
 class SoilRecord(TypedResult):
     """The soil as every result file names it (``soil`` in ``preflight.json``, ``sand.json`` and
     each kept specimen's ``soil.json``): who it is, its ``[grading]`` table, the grading's source
@@ -66,7 +78,13 @@ class SoilRecord(TypedResult):
     grading: dict[str, Any]
     grading_source: str
     upscale: float
-    lab: dict[str, Any]
+    lab: LabStateRecord
+
+    @classmethod
+    def from_dict(cls, data) -> SoilRecord:
+        obj = super().from_dict(data)
+        obj.lab = part(LabStateRecord, obj.lab)
+        return obj
 
 
 @dataclass(frozen=True)
@@ -108,7 +126,7 @@ class SandCase:
             grading=dict(self.config.get("grading") or {}),
             grading_source=self.grading.source,
             upscale=self.grading.upscale,
-            lab=self.lab.to_dict(),
+            lab=LabStateRecord.from_dict(self.lab.to_dict()),
         )
 
 

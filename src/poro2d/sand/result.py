@@ -15,11 +15,12 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from poro2d.io_utils import provenance
-from poro2d.sand.case import SoilRecord
+from poro2d.io_utils import Provenance
+from poro2d.sand.case import LabStateRecord, SoilRecord
 from poro2d.sand.profile import StageProfile
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
+from poro2d.typed_result import part as as_part
 
 
 def _stats(values: list[float | None]) -> tuple[float, float]:
@@ -68,6 +69,117 @@ class SeedSpecimen:
 
 
 @dataclass(eq=False)
+class BoxPlanRecord(TypedResult):
+    """A box of the pre-flight as a file keeps it (:class:`~poro2d.sand.preflight.BoxPlan`): m, disks."""
+
+    width: float
+    height: float
+    layers: int
+    disks: float
+
+
+@dataclass(eq=False)
+class JammingRecord(TypedResult):
+    """The pre-flight's jamming porosity as a file keeps it (:class:`~poro2d.sand.preflight.Jamming`)."""
+
+    porosity: float | None
+    sd: float | None
+    disks: int
+    seeds: int
+    seconds: float
+    note: str
+
+
+@dataclass(eq=False)
+class StageEstimate(TypedResult):
+    """The pre-flight's estimate for the calibration and the specimens (particle steps or s)."""
+
+    calibration: float
+    specimens: float
+    total: float | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("total",)
+
+
+@dataclass(eq=False)
+class PreflightRecord(TypedResult):
+    """The pre-flight as ``sand.json`` keeps it (:meth:`poro2d.sand.preflight.Preflight.to_dict`)."""
+
+    soil: str
+    d_min_m: float
+    d50_m: float
+    d_max_m: float
+    cu: float
+    size_ratio: float
+    upscale: float
+    box: BoxPlanRecord
+    calibration_box: BoxPlanRecord
+    band_over_d_max: float
+    time_step_s: float
+    time_step_paper_s: float
+    jamming: JammingRecord
+    first_trial: float
+    eq12_trial: float
+    cases_calibration: int
+    cases_specimens: int
+    particle_steps: StageEstimate
+    seconds: StageEstimate
+    workers: int
+    budget_minutes: float | None
+    suggestion: str
+    notes: list[str]
+
+    #: the typed parts, as their classes read them
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "box": BoxPlanRecord,
+        "calibration_box": BoxPlanRecord,
+        "jamming": JammingRecord,
+        "particle_steps": StageEstimate,
+        "seconds": StageEstimate,
+    }
+
+    @classmethod
+    def from_dict(cls, data) -> PreflightRecord:
+        obj = super().from_dict(data)
+        for key, part_cls in cls.PARTS.items():
+            setattr(obj, key, as_part(part_cls, getattr(obj, key)))
+        return obj
+
+
+@dataclass(eq=False)
+class SeedResult(TypedResult):
+    """One seed's specimen as ``sand.json`` keeps it (``seed_results``: a :class:`SeedSpecimen`'s fields)."""
+
+    seed: int
+    accepted: bool
+    box_porosity: float | None
+    interior_porosity: float | None
+    particle_count: int | None
+    trials: int | None
+    folder: str | None
+    message: str
+
+
+@dataclass(eq=False)
+class DensityCalibrationRecord(TypedResult):
+    """mu_prep -> accepted n2D over seeds as a file keeps it (``Calibration.to_dict()``).
+
+    ``samples``: per friction, each seed's accepted n2D (None: not accepted); ``mean``, ``sd``
+    and ``fitted``: per friction, over the accepted seeds; ``failed``: per friction, the seeds
+    not accepted; ``dropped``: frictions left out of the fit.
+    """
+
+    mus: list[float]
+    samples: list[list[float | None]]
+    seeds: list[int]
+    mean: list[float | None]
+    sd: list[float | None]
+    fitted: list[float | None]
+    failed: list[int]
+    dropped: list[float]
+
+
+@dataclass(eq=False)
 class SandCalibration(TypedResult):
     """The calibration in the small box (``calibration`` in ``sand.json``).
 
@@ -82,7 +194,7 @@ class SandCalibration(TypedResult):
     OPTIONAL: ClassVar[tuple[str, ...]] = ("time_profile", "specimens_time_profile")
 
     mus: list[float]
-    calibration: dict[str, Any]
+    calibration: DensityCalibrationRecord
     n2d_min: float
     n2d_max: float
     dropped_ends: list[float]
@@ -108,7 +220,20 @@ class SandCalibration(TypedResult):
         for key in cls.PROFILES:
             if isinstance(getattr(obj, key), dict):
                 setattr(obj, key, StageProfile.from_dict(getattr(obj, key)))
+        obj.calibration = as_part(DensityCalibrationRecord, obj.calibration)
         return obj
+
+
+@dataclass(eq=False)
+class AcceptedState(TypedResult):
+    """One accepted specimen of ``sand.json``'s ``states``: its state, seed, folder and porosities."""
+
+    n_lab: float
+    relative_density: float | None
+    seed: int
+    specimen: str | None
+    box_porosity: float | None
+    interior_porosity: float | None
 
 
 @dataclass(eq=False)
@@ -117,7 +242,7 @@ class SandResult(TypedResult):
 
     mode: str
     soil: SoilRecord
-    state: dict[str, Any]
+    state: LabStateRecord
     interior_porosity_mean: float
     interior_porosity_sd: float
     box_porosity_mean: float
@@ -134,12 +259,12 @@ class SandResult(TypedResult):
     jamming_porosity: float | None
     jamming_porosity_sd: float | None
     calibration: SandCalibration
-    states: list[dict[str, Any]]
-    seed_results: list[dict[str, Any]]
-    preflight: dict[str, Any]
+    states: list[AcceptedState]
+    seed_results: list[SeedResult]
+    preflight: PreflightRecord
     wall_seconds: float
     config: dict[str, Any]
-    provenance: dict[str, Any]
+    provenance: Provenance
     specimens: list[SeedSpecimen] = field(default_factory=list, metadata=NOT_IN_FILE)
 
     #: the typed parts, as their classes read them
@@ -158,6 +283,11 @@ class SandResult(TypedResult):
         for key, part in cls.PARTS.items():
             if isinstance(getattr(obj, key), dict):
                 setattr(obj, key, part.from_dict(getattr(obj, key)))
+        obj.state = as_part(LabStateRecord, obj.state)
+        obj.states = _rows(AcceptedState, obj.states)
+        obj.seed_results = _rows(SeedResult, obj.seed_results)
+        obj.preflight = as_part(PreflightRecord, obj.preflight)
+        obj.provenance = as_part(Provenance, obj.provenance)
         return obj
 
     @classmethod
@@ -175,14 +305,14 @@ class SandResult(TypedResult):
         box_m, box_sd = _stats([k.box_porosity for k in kept if k.accepted])
         lab = case.lab
         states = [
-            {
-                "n_lab": lab.n_lab,
-                "relative_density": lab.relative_density,
-                "seed": k.seed,
-                "specimen": k.folder,
-                "box_porosity": k.box_porosity,
-                "interior_porosity": k.interior_porosity,
-            }
+            AcceptedState(
+                n_lab=lab.n_lab,
+                relative_density=lab.relative_density,
+                seed=k.seed,
+                specimen=k.folder,
+                box_porosity=k.box_porosity,
+                interior_porosity=k.interior_porosity,
+            )
             for k in kept
             if k.accepted
         ]
@@ -190,7 +320,7 @@ class SandResult(TypedResult):
         return cls(
             mode="density",
             soil=case.soil_record(),
-            state=lab.to_dict(),
+            state=LabStateRecord.from_dict(lab.to_dict()),
             interior_porosity_mean=inner_m,
             interior_porosity_sd=inner_sd,
             box_porosity_mean=box_m,
@@ -208,13 +338,18 @@ class SandResult(TypedResult):
             jamming_porosity_sd=pf.jamming.sd,
             calibration=cal_record,
             states=states,
-            seed_results=[k.to_dict() for k in kept],
-            preflight=pf.to_dict(),
+            seed_results=[SeedResult.from_dict(k.to_dict()) for k in kept],
+            preflight=PreflightRecord.from_dict(pf.to_dict()),
             wall_seconds=seconds,
             config=case.config,
-            provenance=provenance(),
+            provenance=Provenance.now(),
             specimens=list(kept),
         )
+
+
+def _rows(cls: type[TypedResult], rows: list | None) -> list | None:
+    """Each row of a file's list as the record ``cls``; None (a file without the key) stays None."""
+    return None if rows is None else [as_part(cls, row) for row in rows]
 
 
 def _pm(mean: float, sd: float) -> str:

@@ -34,7 +34,13 @@ from poro2d.locks import holds_output
 from poro2d.sand.case import ConfigLike, SandCase, load_sand_case
 from poro2d.sand.preflight import Preflight, preflight
 from poro2d.sand.profile import case_runs, stage_profile
-from poro2d.sand.result import SandCalibration, SandResult, SeedSpecimen, write_summary
+from poro2d.sand.result import (
+    DensityCalibrationRecord,
+    SandCalibration,
+    SandResult,
+    SeedSpecimen,
+    write_summary,
+)
 from poro2d.store import Store, walk
 from poro2d.sweep import density as D
 from poro2d.sweep.criterion_base import CriterionBase
@@ -189,7 +195,7 @@ def calibration_stage(
     dense = [v for v in info["interior"][0] if v is not None]
     return target, SandCalibration(
         mus=mus,
-        calibration=cal.to_dict(),
+        calibration=DensityCalibrationRecord.from_dict(cal.to_dict()),
         n2d_min=cal.n2d_min,
         n2d_max=cal.n2d_max,
         dropped_ends=dropped,

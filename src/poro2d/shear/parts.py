@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar, TypeVar
 
-from poro2d.typed_result import TypedResult
+from poro2d.typed_result import TypedResult, part
 
 P = TypeVar("P", bound=TypedResult)
 
@@ -34,13 +34,6 @@ class Nested(TypedResult):
 
     def to_dict(self) -> dict[str, Any]:
         return {k: _plain(v) for k, v in super().to_dict().items()}
-
-
-def part(cls: type[P], value: Any) -> Any:
-    """``value`` as the part ``cls`` when it is the dict of one (as read from a file), else as it is."""
-    if isinstance(value, Mapping) and not isinstance(value, cls):
-        return cls.from_dict(value)
-    return value
 
 
 def parts(cls: type[P], values: Any) -> Any:
@@ -71,6 +64,52 @@ class EndValues(Nested):
 
 
 @dataclass(eq=False)
+class ShearSettingsRecord(Nested):
+    """The shear settings as a result file keeps them (:meth:`poro2d.shear.settings.ShearSettings.to_dict`).
+
+    A file written before a setting existed lacks its key, and keeps lacking it when written
+    again (``stop_after_peak`` and ``rolling_friction`` are newer than the first files).
+    """
+
+    velocity: float
+    max_displacement: float
+    stop_after_peak: float
+    record_interval: float
+    checkpoint_interval: float
+    consolidation_ratio: float
+    consolidation_max_steps: int
+    servo_gain: float
+    servo_integral: float
+    servo_max_speed: float
+    kn_wall: float
+    ks_wall: float
+    friction_wall: float
+    gap: float
+    particle_friction: float | None
+    rolling_friction: float | None
+    local_damping: float | None
+    density_scale: float
+    dt_safety: float
+    peak_window: float
+    shear_zone_factor: float
+    inertial_limit: float
+    stress_tolerance: float
+
+
+@dataclass(eq=False)
+class BoxRecord(Nested):
+    """The split box's geometry as a file keeps it (:meth:`poro2d.shear.box.SplitBox.to_dict`), in m."""
+
+    width: float
+    height: float
+    split_y: float
+    gap: float
+    max_displacement: float
+    thickness: float
+    x0_lower: float
+
+
+@dataclass(eq=False)
 class ConsolidationRecord(Nested):
     """A test's consolidation (``consolidation.json``; in ``result.json`` without ``engine``).
 
@@ -91,8 +130,14 @@ class ConsolidationRecord(Nested):
     plate_settlement_m: float
     coordination_number: float
     wall_time_s: float
-    box: dict[str, float]
+    box: BoxRecord
     engine: dict[str, Any] | None = None
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ConsolidationRecord:
+        obj = super().from_dict(data)
+        obj.box = part(BoxRecord, obj.box)
+        return obj
 
 
 @dataclass(eq=False)
@@ -197,12 +242,35 @@ class RateCheck(Nested):
 
 
 @dataclass(eq=False)
+class LabPeak(Nested):
+    """One laboratory peak: the peak shear stress at a normal stress (kPa)."""
+
+    normal_stress_kpa: float
+    peak_shear_stress_kpa: float
+
+
+@dataclass(eq=False)
+class LabRecord(Nested):
+    """Laboratory data as a file keeps them (:meth:`poro2d.shear.lab.LabData.to_dict`)."""
+
+    source: str
+    kind: str
+    peaks: list[LabPeak]
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> LabRecord:
+        obj = super().from_dict(data)
+        obj.peaks = parts(LabPeak, obj.peaks)
+        return obj
+
+
+@dataclass(eq=False)
 class LabComparison(Nested):
     """The laboratory data a series is compared with, their fits and the difference of the angles."""
 
     source: str
     kind: str
-    peaks: list[dict[str, float]]
+    peaks: list[LabPeak]
     fit: FitRecord | None
     friction_angle_deg: float | None
     cohesion_kpa: float | None
@@ -212,6 +280,7 @@ class LabComparison(Nested):
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> LabComparison:
         obj = super().from_dict(data)
+        obj.peaks = parts(LabPeak, obj.peaks)
         obj.fit = part(FitRecord, obj.fit)
         obj.fit_through_origin = part(FitRecord, obj.fit_through_origin)
         return obj
@@ -226,6 +295,15 @@ class StressPeaks(Nested):
     peak_sd_kpa: float
     n: int
     peaks_kpa: list[float]
+
+
+@dataclass(eq=False)
+class StrengthDefinitions(Nested):
+    """How a strength study measures each of its angles, in words (a study's ``definitions``)."""
+
+    peak_friction_angle: str
+    residual_friction_angle: str
+    max_dilation_angle: str
 
 
 @dataclass(eq=False)
@@ -255,6 +333,8 @@ class StrengthCase(Nested):
 
 
 __all__ = [
-    "ConsolidationRecord", "EndValues", "FitInterval", "FitRecord", "ForceBalance", "LabComparison", "Nested",
-    "QuasiStatic", "RateCheck", "RateCheckRow", "StrengthCase", "StressPeaks", "TestSummary", "part", "parts",
+    "BoxRecord", "ConsolidationRecord", "EndValues", "FitInterval", "FitRecord", "ForceBalance",
+    "LabComparison", "LabPeak", "LabRecord", "Nested", "QuasiStatic", "RateCheck", "RateCheckRow",
+    "ShearSettingsRecord", "StrengthCase", "StrengthDefinitions", "StressPeaks", "TestSummary",
+    "part", "parts",
 ]  # fmt: skip

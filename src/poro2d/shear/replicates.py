@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.errors import InputError, check_range
-from poro2d.io_utils import provenance
+from poro2d.io_utils import Provenance
 from poro2d.shear.fit import mohr_coulomb
 from poro2d.shear.parts import FitInterval, StressPeaks
 from poro2d.shear.pool import ShearJob
@@ -159,7 +159,7 @@ class ReplicateShear:
         summary.wall_time_s = time.perf_counter() - t0
         summary.processes = self.processes
         summary.config = self.config
-        summary.provenance = provenance()
+        summary.provenance = Provenance.now()
         summary.series = per
         if self.store is None:
             return summary

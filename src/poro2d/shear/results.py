@@ -7,6 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
+from poro2d.io_utils import Provenance
 from poro2d.shear.curve import ShearCurve, read_curve
 from poro2d.shear.parts import (
     ConsolidationRecord,
@@ -18,7 +19,9 @@ from poro2d.shear.parts import (
     Nested,
     QuasiStatic,
     RateCheck,
+    ShearSettingsRecord,
     StrengthCase,
+    StrengthDefinitions,
     StressPeaks,
     TestSummary,
     part,
@@ -66,10 +69,10 @@ class ShearTestResult(Nested):
     records: int
     wall_time_shear_s: float
     wall_time_s: float
-    settings: dict[str, Any]
+    settings: ShearSettingsRecord
     specimen: str
     engine: dict[str, Any]
-    provenance: dict[str, Any]
+    provenance: Provenance
     curve: ShearCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     @classmethod
@@ -78,6 +81,8 @@ class ShearTestResult(Nested):
         obj.end = part(EndValues, obj.end)
         obj.force_balance = part(ForceBalance, obj.force_balance)
         obj.consolidation = part(ConsolidationRecord, obj.consolidation)
+        obj.settings = part(ShearSettingsRecord, obj.settings)
+        obj.provenance = part(Provenance, obj.provenance)
         return obj
 
     @classmethod
@@ -119,7 +124,7 @@ class ShearSeriesResult(Nested):
     quasi_static: QuasiStatic
     peak_definition: str
     shear_stress_definition: str
-    settings: dict[str, Any]
+    settings: ShearSettingsRecord
     velocity_m_per_s: float
     density_scale: float
     specimen: str
@@ -130,7 +135,7 @@ class ShearSeriesResult(Nested):
     rate_check: RateCheck | None = None
     lab: LabComparison | None = None
     wall_time_s: float | None = None
-    provenance: dict[str, Any] | None = None
+    provenance: Provenance | None = None
     curves: dict[float, ShearCurve] = field(
         default_factory=dict, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
@@ -144,6 +149,8 @@ class ShearSeriesResult(Nested):
         obj.quasi_static = part(QuasiStatic, obj.quasi_static)
         obj.rate_check = part(RateCheck, obj.rate_check)
         obj.lab = part(LabComparison, obj.lab)
+        obj.settings = part(ShearSettingsRecord, obj.settings)
+        obj.provenance = part(Provenance, obj.provenance)
         return obj
 
 
@@ -169,7 +176,7 @@ class ReplicateShearResult(Nested):
     wall_time_s: float | None = None
     processes: int | None = None
     config: dict[str, Any] | None = None
-    provenance: dict[str, Any] | None = None
+    provenance: Provenance | None = None
     series: dict[str, ShearSeriesResult] = field(default_factory=dict, kw_only=True, metadata=NOT_IN_FILE)
 
     @classmethod
@@ -178,6 +185,7 @@ class ReplicateShearResult(Nested):
         obj.per_normal_stress = parts(StressPeaks, obj.per_normal_stress)
         obj.fit = part(FitInterval, obj.fit)
         obj.fit_through_origin = part(FitInterval, obj.fit_through_origin)
+        obj.provenance = part(Provenance, obj.provenance)
         return obj
 
 
@@ -194,17 +202,20 @@ class StrengthResult(Nested):
     mu_r: list[float]
     particle_friction: list[float]
     specimens: list[str]
-    settings: dict[str, Any]
-    definitions: dict[str, str]
+    settings: ShearSettingsRecord
+    definitions: StrengthDefinitions
     wall_time_s: float | None = None
     processes: int | None = None
     config: dict[str, Any] | None = None
-    provenance: dict[str, Any] | None = None
+    provenance: Provenance | None = None
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> StrengthResult:
         obj = super().from_dict(data)
         obj.cases = parts(StrengthCase, obj.cases)
+        obj.definitions = part(StrengthDefinitions, obj.definitions)
+        obj.settings = part(ShearSettingsRecord, obj.settings)
+        obj.provenance = part(Provenance, obj.provenance)
         return obj
 
 

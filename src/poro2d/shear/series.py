@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.errors import InputError, check_range
-from poro2d.io_utils import provenance
+from poro2d.io_utils import Provenance
 from poro2d.shear.case import ShearCase
 from poro2d.shear.fit import mohr_coulomb, smooth
 from poro2d.shear.outputs import (
@@ -19,7 +19,16 @@ from poro2d.shear.outputs import (
     write_figures,
     write_tables,
 )
-from poro2d.shear.parts import LabComparison, QuasiStatic, RateCheck, RateCheckRow, TestSummary
+from poro2d.shear.parts import (
+    LabComparison,
+    LabPeak,
+    QuasiStatic,
+    RateCheck,
+    RateCheckRow,
+    ShearSettingsRecord,
+    TestSummary,
+    parts,
+)
 from poro2d.shear.pool import ShearJob, execute_jobs
 from poro2d.shear.results import ShearSeriesResult, ShearTestResult
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings
@@ -160,7 +169,7 @@ class ShearSeries:
             f"{1e3 * s.peak_window:g} mm of shear displacement",
             shear_stress_definition="horizontal force of the disks on the upper half (upper walls, upper "
             "lip, top plate friction) / (W t), W the box width (no area correction)",
-            settings=s.to_dict(),
+            settings=ShearSettingsRecord.from_dict(s.to_dict()),
             velocity_m_per_s=s.velocity,
             density_scale=s.density_scale,
             specimen=self.specimen.source,
@@ -174,7 +183,7 @@ class ShearSeries:
         if self.lab is not None:
             result.lab = self._lab_part(fit)
         result.wall_time_s = time.perf_counter() - t0
-        result.provenance = provenance()
+        result.provenance = Provenance.now()
         curves = {t["normal_stress_kpa"]: t.curve for t in tests}
         if self.store is not None:
             write_tables(self.store, curves, summary)
@@ -264,7 +273,7 @@ class ShearSeries:
         return LabComparison(
             source=lab.source,
             kind=lab.kind,
-            peaks=lab.peak_rows(),
+            peaks=parts(LabPeak, lab.peak_rows()),
             fit=lf.record() if lf else None,
             friction_angle_deg=lf.friction_angle_deg if lf else None,
             cohesion_kpa=lf.cohesion_kpa if lf else None,

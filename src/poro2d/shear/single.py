@@ -21,14 +21,14 @@ from dataclasses import replace
 import numpy as np
 
 from poro2d.dem import Simulation
-from poro2d.io_utils import as_json, provenance
+from poro2d.io_utils import Provenance, as_json
 from poro2d.measure.coordination import coordination_number
 from poro2d.shear import record
 from poro2d.shear.box import SplitBox, build_split_box
 from poro2d.shear.case import ShearCase
 from poro2d.shear.controllers import Consolidation, ProgressFn
 from poro2d.shear.curve import CURVE_COLUMNS, curve_columns, curve_summary
-from poro2d.shear.parts import ConsolidationRecord
+from poro2d.shear.parts import BoxRecord, ConsolidationRecord, ShearSettingsRecord
 from poro2d.shear.peak_frame import PeakFrame
 from poro2d.shear.results import ShearTestResult
 from poro2d.shear.settings import inertial_number
@@ -153,7 +153,7 @@ class DirectShearTest:
             normal_stress_error=done.normal_stress_error, plate_height_before_m=y0,
             plate_height_m=box.plate_height(sim), plate_settlement_m=y0 - box.plate_height(sim),
             coordination_number=coordination_number(sim), wall_time_s=time.perf_counter() - t0,
-            box=box.to_dict(), engine=sim.summary(),
+            box=BoxRecord.from_dict(box.to_dict()), engine=sim.summary(),
         )  # fmt: skip
         return sim, info
 
@@ -210,10 +210,10 @@ class DirectShearTest:
             records=len(rows),
             wall_time_shear_s=wall,
             wall_time_s=wall + float(info.wall_time_s or 0.0),
-            settings=s.to_dict(),
+            settings=ShearSettingsRecord.from_dict(s.to_dict()),
             specimen=self.case.specimen.source,
             engine=sim.summary(),
-            provenance=provenance(),
+            provenance=Provenance.now(),
         )
 
     def run(self) -> ShearTestResult:

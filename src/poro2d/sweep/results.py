@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from poro2d.io_utils import Provenance
 from poro2d.sweep.records import (
     CalibrationRun,
     CaseEntry,
@@ -50,7 +51,7 @@ class SweepResult(WithParts):
     ``table``: the same as a pandas DataFrame (``results.csv``).
     """
 
-    PARTS = {"cases": parts(CaseEntry), "summary": part(SweepSummary)}
+    PARTS = {"cases": parts(CaseEntry), "summary": part(SweepSummary), "provenance": part(Provenance)}
 
     status: str
     title: str
@@ -60,7 +61,7 @@ class SweepResult(WithParts):
     config: dict[str, Any]
     base_dir: str | None
     retries: int
-    provenance: dict[str, Any]
+    provenance: Provenance
     cluster: dict[str, Any]
     summary: SweepSummary
     finished_utc: str
@@ -86,7 +87,7 @@ class DensityStateResult(WithParts):
     the state sweep's summary.
     """
 
-    PARTS = {"sweeps": part(DensitySweeps)}
+    PARTS = {"sweeps": part(DensitySweeps), "provenance": part(Provenance)}
 
     mode: str
     n_lab: float
@@ -108,7 +109,7 @@ class DensityStateResult(WithParts):
     calibration: dict[str, Any]
     sweeps: DensitySweeps
     config: dict[str, Any]
-    provenance: dict[str, Any]
+    provenance: Provenance
 
 
 @dataclass(eq=False)
@@ -122,7 +123,8 @@ class RelationResult(WithParts):
     """
 
     PARTS = {"points": relation_points, "fit": part(QuadraticFit), "spread": part(Spread),
-             "sweep_summary": part(SweepSummary), "sweeps": part(DensitySweeps)}  # fmt: skip
+             "sweep_summary": part(SweepSummary), "sweeps": part(DensitySweeps),
+             "provenance": part(Provenance)}  # fmt: skip
 
     n_max: float
     n_min: float
@@ -141,7 +143,7 @@ class RelationResult(WithParts):
     sweep_summary: SweepSummary | None = None
     config: dict[str, Any] | None = None
     sweeps: DensitySweeps | None = None
-    provenance: dict[str, Any] | None = None
+    provenance: Provenance | None = None
 
     @property
     def failed_cases(self) -> int:
@@ -163,7 +165,7 @@ class SensitivityResult(WithParts):
 
     PARTS = {"settings": part(SensitivitySettings), "gradings": parts(GradingDescription),
              "seeds": parts(SeedRecord), "points": part(SensitivityPoints), "sweeps": part(GradingSweeps),
-             "answer": part(Answer)}  # fmt: skip
+             "answer": part(Answer), "provenance": part(Provenance)}  # fmt: skip
 
     title: str
     settings: SensitivitySettings
@@ -177,7 +179,7 @@ class SensitivityResult(WithParts):
     timings: dict[str, float]
     answer: Answer
     figure: str | None = None
-    provenance: dict[str, Any] | None = None
+    provenance: Provenance | None = None
 
 
 __all__ = ["CalibrationRun", "DensityStateResult", "RelationResult", "SensitivityResult", "SweepResult"]
