@@ -26,8 +26,8 @@ def main() -> None:
 
     from poro2d.criterion import PorosityCriterion
     from poro2d.criterion.config import build, paper_preset
+    from poro2d.grading import paper_grading
     from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
-    from poro2d.specimen.grading import paper_grading
     from poro2d.store import Store
 
     # warm-up: compile or load every kernel outside the timed run

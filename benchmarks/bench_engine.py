@@ -106,8 +106,8 @@ def paper_simulation(out: Path, rebuild: bool, threads: int = 2):
     ck = out / "paper_settled.npz"
     from poro2d.dem import Simulation
     from poro2d.dem.ordering import strip_order
+    from poro2d.grading import paper_grading
     from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
-    from poro2d.specimen.grading import paper_grading
 
     if ck.is_file() and not rebuild:
         sim = checkpoint.load(ck, threads=threads)

@@ -38,9 +38,9 @@ def main() -> None:
     )
     args = ap.parse_args()
 
+    from poro2d.grading import paper_grading, preset_grading
     from poro2d.measure.specimen_porosity import measure_specimen
     from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
-    from poro2d.specimen.grading import paper_grading, preset_grading
 
     prepare_specimen(SpecimenSpec(width=0.03, height=0.02, layers=1), paper_grading(), 0.2, seed=1)
     grading = preset_grading(args.grading)

@@ -50,7 +50,7 @@ FALL_FRACTIONS = (0.5, 0.15, 0.05)
 
 
 def grading(name: str):
-    from poro2d.specimen.grading import GradingCurve, paper_grading
+    from poro2d.grading import GradingCurve, paper_grading
 
     if name == "narrow":
         return paper_grading()
@@ -69,8 +69,8 @@ def build(name: str, disks: int, seed: int, settle_steps: int):
     from poro2d.dem import Particles, Simulation, Walls
     from poro2d.dem.ordering import strip_order
     from poro2d.errors import InputError
+    from poro2d.grading import draw_disks
     from poro2d.paper_data import TABLE_1
-    from poro2d.specimen.grading import draw_disks
     from poro2d.specimen.placement import place_disks
 
     curve = grading(name)

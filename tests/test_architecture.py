@@ -203,7 +203,7 @@ FILE_HOMES = (
     "interop/pfc.py",
     "interop/csv_table.py",
     "interop/validate.py",
-    "specimen/grading.py",
+    "grading.py",
 )
 
 #: calls that read or write files: (owner or "" for a bare name, function)

@@ -15,8 +15,8 @@ from poro2d.criterion.protocol import CriterionSettings
 from poro2d.dem import Particles, Simulation, Walls, checkpoint
 from poro2d.dem.layout import COINCIDENT, coincident_pair
 from poro2d.errors import InputError, check_int, check_range
+from poro2d.grading import GradingCurve, draw_disks, paper_grading
 from poro2d.specimen.compaction import DEFAULT_MAX_DISKS, SpecimenSpec, check_feasible, estimate_size
-from poro2d.specimen.grading import GradingCurve, draw_disks, paper_grading
 
 R = 1e-3
 # the probe's grading: fines of 0.1 um up-scaled by 10 mean about 1.5e8 disks in the paper's box

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
+from poro2d.grading import log_linear_grading, paper_grading, preset_grading
 from poro2d.oracles.jamming import jamming_reference
 from poro2d.specimen.compaction import SpecimenSpec
-from poro2d.specimen.grading import log_linear_grading, paper_grading, preset_grading
 
 pytestmark = pytest.mark.scenario
 

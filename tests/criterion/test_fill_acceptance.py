@@ -21,10 +21,10 @@ from poro2d.criterion.lid import (
 )
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion, wall_forces
 from poro2d.errors import InputError
+from poro2d.grading import paper_grading
 from poro2d.measure.disks import mass_d50
 from poro2d.measure.specimen_porosity import measure_specimen
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
-from poro2d.specimen.grading import paper_grading
 
 
 def test_the_porosity_under_a_stepped_lid_is_disk_area_over_the_area_under_it():

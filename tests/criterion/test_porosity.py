@@ -3,8 +3,8 @@
 import pytest
 
 from poro2d.criterion.protocol import POROSITY_KEYS, porosity_numbers
+from poro2d.grading import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
-from poro2d.specimen.grading import paper_grading
 
 
 @pytest.fixture(scope="module")

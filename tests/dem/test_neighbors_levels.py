@@ -154,7 +154,7 @@ def test_level_rebuild_carries_history(shuffled):
 
 def test_search_follows_the_size_ratio():
     """Narrow and the built-in gradings keep the one cell grid; wide ones get the levels."""
-    from poro2d.specimen.grading import draw_disks, paper_grading, preset_grading
+    from poro2d.grading import draw_disks, paper_grading, preset_grading
 
     for curve in (paper_grading(), preset_grading("wide_cu4"), preset_grading("wide_cu6")):
         r = draw_disks(curve, 2e-3, 0)

@@ -14,11 +14,11 @@ import pytest
 from poro2d import __version__
 from poro2d.calibration.units import unit_key
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
+from poro2d.grading import paper_grading
 from poro2d.identity import identity_digest, outside_fields, outside_identity
 from poro2d.shear.record import content_record, folder_stage
 from poro2d.shear.settings import ShearSettings
 from poro2d.specimen.compaction import SpecimenSpec
-from poro2d.specimen.grading import paper_grading
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint
 from poro2d.sweep.cases import Case, case_id

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 from poro2d.errors import InputError
+from poro2d.grading import paper_grading
 from poro2d.measure.specimen_state import specimen_state
 from poro2d.report.specimen_figures import plot_specimen_state
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
-from poro2d.specimen.grading import paper_grading
 
 
 @pytest.fixture(scope="module")

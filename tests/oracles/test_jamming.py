@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from poro2d.errors import InputError
+from poro2d.grading import paper_grading
 from poro2d.oracles.jamming import (
     E_ZERO,
     energy_and_forces,
@@ -15,7 +16,6 @@ from poro2d.oracles.jamming import (
     jamming_fraction,
     jamming_reference,
 )
-from poro2d.specimen.grading import paper_grading
 
 
 def bidisperse(n: int) -> np.ndarray:

@@ -9,11 +9,11 @@ import pytest
 
 from poro2d.criterion.density import Calibration
 from poro2d.errors import InputError
+from poro2d.grading import paper_grading
 from poro2d.sand import load_sand_case
 from poro2d.sand import preflight as PF
 from poro2d.sand.run import bracket, full_box_trial, predicted_mu
 from poro2d.specimen.compaction import SpecimenSpec, estimate_size
-from poro2d.specimen.grading import paper_grading
 
 LAB = {"e_max": 0.977, "e_min": 0.597, "dr": 0.5}
 
@@ -248,8 +248,8 @@ def test_preflight_says_what_a_cut_of_fines_does(tmp_path, monkeypatch):
 
 
 def test_step_budgets_follow_the_time_step():
+    from poro2d.grading import GradingCurve
     from poro2d.sand.case import STEP_BUDGETS, with_step_budgets
-    from poro2d.specimen.grading import GradingCurve
 
     spec = SpecimenSpec()
     paper = {"criterion": {}, "specimen": {}}

@@ -9,8 +9,8 @@ from poro2d.criterion.protocol import wall_forces
 from poro2d.dem import Simulation
 from poro2d.dem.contacts import contact_set
 from poro2d.errors import InputError
+from poro2d.grading import preset_grading
 from poro2d.specimen.compaction import SettledTest, SpecimenSpec, prepare_specimen
-from poro2d.specimen.grading import preset_grading
 
 
 def _column(seed: int = 0) -> Simulation:

@@ -13,6 +13,7 @@ import pytest
 from poro2d.criterion.config import build
 from poro2d.dem import ContactModel, Particles, Simulation
 from poro2d.errors import InputError
+from poro2d.grading import GradingCurve, paper_grading, preset_grading
 from poro2d.specimen.compaction import (
     BAND_FRACTION_MAX,
     EQUILIBRIUM_STEPS,
@@ -26,7 +27,6 @@ from poro2d.specimen.compaction import (
     prepare_specimen,
     time_step,
 )
-from poro2d.specimen.grading import GradingCurve, paper_grading, preset_grading
 
 # the gravel of the report (0.1-18.9 mm, fines to 0.75 mm after up-scaling 1.5): the old
 # preparation raised "radii = 'solid fraction 1.0480' is invalid" in layer 2 after 14 s

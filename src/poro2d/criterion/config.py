@@ -21,10 +21,10 @@ from pathlib import Path
 from poro2d.config import check_keys, dataclass_from_table, load_toml
 from poro2d.criterion.protocol import CriterionSettings
 from poro2d.errors import InputError, check_int
+from poro2d.grading import GradingCurve, paper_grading
 from poro2d.paper_data import QUICK_CRITERION, QUICK_SPECIMEN
 from poro2d.porosity import PAPER_N_LAB
 from poro2d.specimen.compaction import SpecimenSpec, wide_grading_spec
-from poro2d.specimen.grading import GradingCurve, paper_grading
 
 TOP_KEYS = {"seed", "specimen", "grading", "criterion", "shear", "title", "density"}
 

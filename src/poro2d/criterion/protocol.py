@@ -59,13 +59,13 @@ from poro2d.criterion.servo import PlateServo, in_window
 from poro2d.criterion.trial import Decision, PlateStage, Preparation, StageFailure, Trial, trial_name
 from poro2d.dem import Simulation
 from poro2d.errors import Integer, OneOf, Ranges, Real, check_fields, check_range
+from poro2d.grading import GradingCurve
 from poro2d.io_utils import Provenance, provenance
 from poro2d.measure.disks import mass_d50
 from poro2d.measure.porosity import box_porosity
 from poro2d.measure.surface import lid_height_at
 from poro2d.porosity import PAPER_N_LAB, parabolic
 from poro2d.specimen.compaction import SpecimenSpec, preparation_note, prepare_specimen
-from poro2d.specimen.grading import GradingCurve
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
 

@@ -20,9 +20,9 @@ from poro2d.console import OutputConsole
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.criterion.result import ReplicateRow, ReplicatesResult
 from poro2d.execute import Backend, Executor, Failed, Job, results_or_raise
+from poro2d.grading import GradingCurve
 from poro2d.progress import JobsProgress
 from poro2d.specimen.compaction import SpecimenSpec
-from poro2d.specimen.grading import GradingCurve
 from poro2d.store import Store
 
 console = OutputConsole()

@@ -15,9 +15,9 @@ from pathlib import Path
 
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.criterion.result import CriterionResult
+from poro2d.grading import GradingCurve
 from poro2d.locks import output_folder
 from poro2d.specimen.compaction import SpecimenSpec
-from poro2d.specimen.grading import GradingCurve
 from poro2d.store import Store
 
 ConfigLike = dict | str | os.PathLike | None

@@ -79,7 +79,7 @@ def _criterion_record(records: Store, name: str, keys: tuple[str, ...]) -> dict 
 
 def _grading(config: dict) -> str:
     """Preset name or CSV file, up-scaling factor and cuts, from the config's ``[grading]``."""
-    from poro2d.specimen.grading import PAPER_UPSCALE
+    from poro2d.grading import PAPER_UPSCALE
 
     if "config" not in config:
         return "unknown (no config.json beside the specimen)"

@@ -6,7 +6,7 @@ Multilayer compaction with frictionless preparation should reach, near its dense
 the solid fraction at which frictionless disks of the same grading jam. This module finds
 that fraction by a different method, in different code: it imports nothing from the DEM
 engine (:mod:`poro2d.dem`) or the compaction (:mod:`poro2d.specimen.compaction`); only the
-drawing of radii from a grading curve (:mod:`poro2d.specimen.grading`) may be shared.
+drawing of radii from a grading curve (:mod:`poro2d.grading`) may be shared.
 
 Model
 -----
@@ -84,7 +84,7 @@ import numpy as np
 from numba import njit
 
 from poro2d.errors import InputError, as_float_array, check_int, check_range
-from poro2d.specimen.grading import GradingCurve, draw_disks
+from poro2d.grading import GradingCurve, draw_disks
 
 __all__ = [
     "E_ZERO",
@@ -735,7 +735,7 @@ def jamming_reference(
 ) -> JammingReference:
     """phi_J of ``grading`` for each seed, with about ``n_disks`` disks; mean and spread.
 
-    Radii come from :func:`poro2d.specimen.grading.draw_disks` with a solid area of
+    Radii come from :func:`poro2d.grading.draw_disks` with a solid area of
     ``n_disks`` mean disk areas; each seed is split into two independent streams, one for the
     radii and one for the start positions. ``options`` go to :func:`jamming_fraction`.
     """

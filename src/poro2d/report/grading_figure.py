@@ -6,7 +6,7 @@ specimen is made of), the cuts as vertical lines, and the drawn disks of one spe
 (percent passing by area, the 2D counterpart of mass).
 
 :func:`plot_realised`: a curve against the disks drawn from it, at the curve's own sieve
-sizes in the model (the check of :func:`poro2d.specimen.grading.realised_curve`).
+sizes in the model (the check of :func:`poro2d.grading.realised_curve`).
 """
 
 from __future__ import annotations
@@ -23,8 +23,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.ticker import FuncFormatter  # noqa: E402
 
+from poro2d.grading import GradingCurve, realised_curve  # noqa: E402
 from poro2d.report.figure_file import DPI, save_figure  # noqa: E402
-from poro2d.specimen.grading import GradingCurve, realised_curve  # noqa: E402
 
 
 def uncut_curve(table: dict, base_dir: str | os.PathLike | None, used: GradingCurve) -> GradingCurve:

@@ -32,9 +32,9 @@ from typing import Any
 from poro2d.config import check_keys
 from poro2d.criterion.density import DEFAULT_MUS, check_mus
 from poro2d.errors import InputError, check_int
+from poro2d.grading import GradingCurve
 from poro2d.lab_state import LabState, lab_state_from_table
 from poro2d.specimen.compaction import SpecimenSpec, time_step
-from poro2d.specimen.grading import GradingCurve
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.density import DEFAULT_SEEDS, with_density_defaults
 from poro2d.typed_result import TypedResult, part
@@ -198,7 +198,7 @@ def with_step_budgets(config: dict, spec: SpecimenSpec, grading: GradingCurve) -
     time for the lid to settle and the layers to come to rest. The paper's grading keeps the
     defaults exactly.
     """
-    from poro2d.specimen.grading import paper_grading
+    from poro2d.grading import paper_grading
 
     slow = time_step(spec, paper_grading().d_min_m) / time_step(spec, grading.d_min_m)
     if slow <= 1.0 + 1e-9:

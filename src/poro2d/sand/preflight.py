@@ -22,10 +22,10 @@ from dataclasses import asdict, dataclass, field, replace
 import numpy as np
 
 from poro2d.errors import InputError
+from poro2d.grading import GradingCurve, paper_grading
 from poro2d.porosity import parabolic
 from poro2d.sand.case import SandCase
 from poro2d.specimen.compaction import SpecimenSpec, check_feasible, estimate_size, time_step
-from poro2d.specimen.grading import GradingCurve, paper_grading
 
 #: particle-steps per second per core assumed by the estimate: measured 2.0e7 (lid) to 2.7e7
 #: (preparation) per core with both cores running cases (Toyoura sand, 4 100 and 10 800 disks,

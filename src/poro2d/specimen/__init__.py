@@ -5,7 +5,7 @@
 of radii into a rectangular band without overlap (at reduced radius when the band is dense).
 """
 
-from poro2d.specimen.grading import (
+from poro2d.grading import (
     PAPER_UPSCALE,
     GradingCurve,
     draw_disks,

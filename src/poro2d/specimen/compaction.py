@@ -35,10 +35,10 @@ from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
 from poro2d.dem.ordering import strip_order
 from poro2d.dem.simulation import MEASURES
 from poro2d.errors import InputError, Integer, OneOf, Ranges, Real, check_fields, check_range
+from poro2d.grading import MAX_DRAW, GradingCurve, draw_disks
 from poro2d.identity import outside_identity
 from poro2d.measure.porosity import box_porosity, porosity_rect
 from poro2d.paper_data import TABLE_1
-from poro2d.specimen.grading import MAX_DRAW, GradingCurve, draw_disks
 from poro2d.specimen.placement import Band, place_disks
 from poro2d.typed_result import TypedResult
 

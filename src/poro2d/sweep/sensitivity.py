@@ -162,7 +162,7 @@ def _reference_params(base: CriterionBase) -> dict[str, Any]:
 def gradings(base: CriterionBase, cus: list[float]) -> list[GradingCase]:
     """The config's grading, then the log-linear family at its mean disk area."""
     from poro2d.criterion.config import build
-    from poro2d.specimen.grading import log_linear_grading
+    from poro2d.grading import log_linear_grading
 
     _, ref, _, _ = build(base.as_config(), base.base_dir)
     out = [GradingCase(REFERENCE, None, _reference_params(base), ref)]

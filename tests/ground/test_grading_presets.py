@@ -3,7 +3,7 @@
 import pytest
 
 from poro2d.errors import InputError
-from poro2d.specimen.grading import GRADING_PRESETS, GradingCurve, paper_grading, preset_grading
+from poro2d.grading import GRADING_PRESETS, GradingCurve, paper_grading, preset_grading
 
 
 @pytest.mark.parametrize(

@@ -10,14 +10,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from poro2d.errors import InputError
-from poro2d.report.grading_figure import plot_realised
-from poro2d.specimen.grading import (
+from poro2d.grading import (
     GradingCurve,
     draw_disks,
     max_deviation,
     paper_grading,
     realised_curve,
 )
+from poro2d.report.grading_figure import plot_realised
 
 W, H = 0.305, 0.124  # paper box, Table 1
 
@@ -254,7 +254,7 @@ def test_paper_grading_particle_counts(n2d, paper_count):
 
 
 def test_log_linear_family_has_its_uniformity_and_mean_area():
-    from poro2d.specimen.grading import draw_disks, log_linear_grading, paper_grading
+    from poro2d.grading import draw_disks, log_linear_grading, paper_grading
 
     target = paper_grading().mean_disk_area()
     for cu in (1.5, 2.5, 4.0):
