@@ -1,0 +1,54 @@
+"""Cases of the outside probe of the calibrate/strength/export surface, kept as a regression suite:
+each is refused on one line (exit 2, no traceback) before any work, or handled with nothing lost.
+
+The other groups of that probe have their tests beside the code they check: damaged caches
+(tests/store/test_folder.py, tests/calibration/test_cache_damage.py), folders of another kind
+(tests/cli/test_folder_kinds.py), rolling friction on export (tests/interop/test_rolling_export.py),
+laboratory files (tests/shear/test_fit_lab.py), identifiability (tests/calibration/test_identifiability.py),
+unaccepted specimens (tests/shear/test_accepted_specimens.py), the over-full box with rolling friction
+(tests/criterion/test_overfull_rolling.py), dashboards and schedulers (tests/ground/test_cluster_checks.py).
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from poro2d.cli import main
+
+
+def _refused(argv, capsys) -> str:
+    with pytest.raises(SystemExit) as e:
+        main([str(a) for a in argv])
+    err = capsys.readouterr().err.strip()
+    assert e.value.code == 2, err
+    assert len(err.splitlines()) == 1 and err.startswith("error:"), err
+    return err
+
+
+@pytest.mark.parametrize("command", ["strength", "shear"])
+def test_a_garbage_specimen_is_one_line(tmp_path, capsys, command):
+    garbage = tmp_path / "specimen.npz"
+    garbage.write_bytes(b"PK\x03\x04" + bytes(range(256)) * 8)
+    extra = ["-n", "50"] if command == "shear" else []
+    err = _refused([command, garbage, *extra, "--out", tmp_path / "o"], capsys)
+    assert "specimen.npz" in err and not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize(
+    ("rows", "words"),
+    [
+        ("50,1e300\n100,70\n200,140\n", ["strong"]),
+        ("50,0\n100,70\n200,140\n", ["weak"]),
+        ("50,500\n100,70\n200,140\n", ["(0, 2.5]"]),
+        ("50,4_0\n100,70\n200,140\n", ["a number"]),
+    ],
+)
+def test_a_laboratory_file_that_cannot_be_right_stops_calibrate_before_work(tmp_path, capsys, rows, words):
+    lab = tmp_path / "lab.csv"
+    lab.write_text("normal_stress_kpa,peak_shear_stress_kpa\n" + rows)
+    err = _refused(
+        ["calibrate", "--lab", lab, "--preset", "paper", "--quick", "--out", tmp_path / "o"], capsys
+    )
+    for w in words:
+        assert w in err, (w, err)
+    assert "line 2" in err and not (tmp_path / "o").exists()
