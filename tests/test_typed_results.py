@@ -477,3 +477,27 @@ def test_a_sands_preflight_is_a_typed_part():
     assert isinstance(pf.seconds, StageEstimate)
     assert pf.seconds.total == stored["preflight"]["seconds"]["total"]
     assert "total" not in pf.particle_steps.to_dict() and pf.to_dict() == stored["preflight"]
+
+
+def test_parts_are_read_by_the_base_class_singly_or_as_lists():
+    """``PARTS`` names the fields whose file dicts (or lists of them) ``from_dict`` reads as records."""
+    from dataclasses import dataclass as _dataclass
+
+    from poro2d.typed_result import TypedResult as _TR
+
+    @_dataclass(eq=False)
+    class Row(_TR):
+        x: float
+
+    @_dataclass(eq=False)
+    class Holder(_TR):
+        one: Row | None
+        many: list[Row] | None
+        PARTS = {"one": Row, "many": Row}
+
+    data = {"one": {"x": 1.0}, "many": [{"x": 2.0}, {"x": 3.0}]}
+    held = Holder.from_dict(data)
+    assert isinstance(held.one, Row) and [type(r) for r in held.many] == [Row, Row]
+    assert held.to_dict() == data  # written back as the same dicts
+    empty = Holder.from_dict({"one": None, "many": None})
+    assert empty.one is None and empty.many is None

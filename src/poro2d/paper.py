@@ -21,12 +21,11 @@ from poro2d.criterion.result import CriterionResult
 from poro2d.io_utils import Provenance, provenance
 from poro2d.locks import holds_output
 from poro2d.paper_data import PAPER, QUICK_SHEAR
-from poro2d.shear.parts import LabRecord, QuasiStatic, TestSummary, parts
+from poro2d.shear.parts import LabRecord, QuasiStatic, TestSummary
 from poro2d.shear.results import ReplicateShearResult
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.typed_result import TypedResult
-from poro2d.typed_result import part as as_part
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
 KIND = "paper"
@@ -65,12 +64,7 @@ class ConversionsRecord(TypedResult):
     figures: list[str]
     provenance: Provenance
 
-    @classmethod
-    def from_dict(cls, data) -> ConversionsRecord:
-        obj = super().from_dict(data)
-        obj.methods = [as_part(ConversionRow, m) for m in obj.methods] if obj.methods is not None else None
-        obj.provenance = as_part(Provenance, obj.provenance)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"methods": ConversionRow, "provenance": Provenance}
 
 
 @dataclass(eq=False)
@@ -85,20 +79,11 @@ class PaperShear(TypedResult):
     quasi_static: QuasiStatic
     replicates: ReplicateShearResult
 
-    def to_dict(self) -> dict[str, Any]:
-        out = super().to_dict()
-        if isinstance(self.replicates, TypedResult):
-            out["replicates"] = self.replicates.to_dict()
-        return out
-
-    @classmethod
-    def from_dict(cls, data) -> PaperShear:
-        obj = super().from_dict(data)
-        if isinstance(obj.replicates, dict):
-            obj.replicates = ReplicateShearResult.from_dict(obj.replicates)
-        obj.tests = parts(TestSummary, obj.tests)
-        obj.quasi_static = as_part(QuasiStatic, obj.quasi_static)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "replicates": ReplicateShearResult,
+        "tests": TestSummary,
+        "quasi_static": QuasiStatic,
+    }
 
 
 @dataclass(eq=False)
@@ -128,11 +113,7 @@ class PaperFacts(TypedResult):
     solid_density_kg_m3: float
     criterion: PaperCriterionFacts
 
-    @classmethod
-    def from_dict(cls, data) -> PaperFacts:
-        obj = super().from_dict(data)
-        obj.criterion = as_part(PaperCriterionFacts, obj.criterion)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"criterion": PaperCriterionFacts}
 
 
 @dataclass(eq=False)
@@ -171,34 +152,15 @@ class PaperSummary(TypedResult):
     provenance: Provenance
     lab: LabRecord | None = None
 
-    #: the typed parts, as their classes read them
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "conversions": ConversionsRecord,
         "criterion": CriterionResult,
         "shear": PaperShear,
+        "paper": PaperFacts,
+        "timings": PaperTimings,
+        "provenance": Provenance,
+        "lab": LabRecord,
     }
-
-    def to_dict(self) -> dict[str, Any]:
-        """The file's keys; the typed parts as the dicts they are written as."""
-        out = super().to_dict()
-        for key in self.PARTS:
-            if isinstance(out.get(key), TypedResult):
-                out[key] = out[key].to_dict()
-        return out
-
-    @classmethod
-    def from_dict(cls, data) -> PaperSummary:
-        """A summary from its file's dict, each part read by its class."""
-        obj = super().from_dict(data)
-        for key, part in cls.PARTS.items():
-            value = getattr(obj, key)
-            if isinstance(value, dict):
-                setattr(obj, key, part.from_dict(value))
-        obj.paper = as_part(PaperFacts, obj.paper)
-        obj.timings = as_part(PaperTimings, obj.timings)
-        obj.provenance = as_part(Provenance, obj.provenance)
-        obj.lab = as_part(LabRecord, obj.lab)
-        return obj
 
 
 def paper_stage(store: Store, quick: bool, seed: int) -> ResumableStage:

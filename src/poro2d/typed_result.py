@@ -60,6 +60,10 @@ class TypedResult(Mapping):
     #: keys written only when their value is not None
     OPTIONAL: ClassVar[tuple[str, ...]] = ()
 
+    #: fields that are typed parts: field -> the TypedResult class its file's dict (or each dict
+    #: of its file's list) is read as by :meth:`from_dict`; :meth:`to_dict` writes them back as dicts
+    PARTS: ClassVar[Mapping[str, Any]] = {}
+
     #: keys of the file that the class does not model, written back after the modelled ones
     extra: dict[str, Any] = field(default_factory=dict, kw_only=True, repr=False)
 
@@ -87,6 +91,11 @@ class TypedResult(Mapping):
         keys = _keys(cls)
         obj = cls(**{k: data.get(k) for k in keys}, extra={k: v for k, v in data.items() if k not in keys})
         obj._absent = frozenset(k for k in keys if k not in data)
+        for key, kind in cls.PARTS.items():
+            if isinstance(kind, type) and issubclass(kind, TypedResult):  # not a decoder of its own
+                value = getattr(obj, key)
+                rows = isinstance(value, list)
+                setattr(obj, key, [part(kind, v) for v in value] if rows else part(kind, value))
         return obj
 
     # read-only mapping access, for code that reads results as dicts

@@ -183,32 +183,22 @@ class CalibrationResult(TypedResult):
         "settings": ShearSettingsRecord,
         "timings": CalibrationTimings,
         "provenance": Provenance,
+        "posterior": PosteriorSummary,
+        "cluster": ClusterRecord,
+        "failures": UnitFailure,
     }
 
     def to_dict(self) -> dict[str, Any]:
-        """The file's keys; the cluster and the failures as the dicts they are written as."""
+        """The file's keys; the surrogates of ``fit`` (a map of parts) as the dicts they are written as."""
         out = super().to_dict()
-        for key in ("posterior", "cluster"):
-            if isinstance(out.get(key), TypedResult):
-                out[key] = out[key].to_dict()
         if self.fit is not None:
             out["fit"] = {k: v.to_dict() if isinstance(v, TypedResult) else v for k, v in self.fit.items()}
-        if self.failures is not None:
-            out["failures"] = [f.to_dict() if isinstance(f, UnitFailure) else f for f in self.failures]
         return out
 
     @classmethod
     def from_dict(cls, data) -> CalibrationResult:
-        """A result from its file's dict; the cluster and the failures read as their records."""
+        """A result from its file's dict; the surrogates of ``fit`` read as their records."""
         obj = super().from_dict(data)
-        if isinstance(obj.posterior, dict):
-            obj.posterior = PosteriorSummary.from_dict(obj.posterior)
-        if isinstance(obj.cluster, dict):
-            obj.cluster = ClusterRecord.from_dict(obj.cluster)
-        if isinstance(obj.failures, list):
-            obj.failures = [UnitFailure.from_dict(f) if isinstance(f, dict) else f for f in obj.failures]
-        for key, cls_part in CalibrationResult.PARTS.items():
-            setattr(obj, key, part(cls_part, getattr(obj, key)))
         if isinstance(obj.fit, dict):
             obj.fit = {k: part(SurrogateRecord, v) for k, v in obj.fit.items()}
         return obj

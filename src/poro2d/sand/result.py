@@ -20,7 +20,6 @@ from poro2d.sand.case import LabStateRecord, SoilRecord
 from poro2d.sand.profile import StageProfile
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
-from poro2d.typed_result import part as as_part
 
 
 def _stats(values: list[float | None]) -> tuple[float, float]:
@@ -138,13 +137,6 @@ class PreflightRecord(TypedResult):
         "seconds": StageEstimate,
     }
 
-    @classmethod
-    def from_dict(cls, data) -> PreflightRecord:
-        obj = super().from_dict(data)
-        for key, part_cls in cls.PARTS.items():
-            setattr(obj, key, as_part(part_cls, getattr(obj, key)))
-        return obj
-
 
 @dataclass(eq=False)
 class SeedResult(TypedResult):
@@ -205,23 +197,11 @@ class SandCalibration(TypedResult):
     time_profile: StageProfile | None = None
     specimens_time_profile: StageProfile | None = None
 
-    PROFILES: ClassVar[tuple[str, ...]] = ("time_profile", "specimens_time_profile")
-
-    def to_dict(self) -> dict[str, Any]:
-        out = super().to_dict()
-        for key in self.PROFILES:
-            if isinstance(out.get(key), StageProfile):
-                out[key] = out[key].to_dict()
-        return out
-
-    @classmethod
-    def from_dict(cls, data) -> SandCalibration:
-        obj = super().from_dict(data)
-        for key in cls.PROFILES:
-            if isinstance(getattr(obj, key), dict):
-                setattr(obj, key, StageProfile.from_dict(getattr(obj, key)))
-        obj.calibration = as_part(DensityCalibrationRecord, obj.calibration)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "calibration": DensityCalibrationRecord,
+        "time_profile": StageProfile,
+        "specimens_time_profile": StageProfile,
+    }
 
 
 @dataclass(eq=False)
@@ -268,27 +248,15 @@ class SandResult(TypedResult):
     specimens: list[SeedSpecimen] = field(default_factory=list, metadata=NOT_IN_FILE)
 
     #: the typed parts, as their classes read them
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"soil": SoilRecord, "calibration": SandCalibration}
-
-    def to_dict(self) -> dict[str, Any]:
-        out = super().to_dict()
-        for key in self.PARTS:
-            if isinstance(out.get(key), TypedResult):
-                out[key] = out[key].to_dict()
-        return out
-
-    @classmethod
-    def from_dict(cls, data) -> SandResult:
-        obj = super().from_dict(data)
-        for key, part in cls.PARTS.items():
-            if isinstance(getattr(obj, key), dict):
-                setattr(obj, key, part.from_dict(getattr(obj, key)))
-        obj.state = as_part(LabStateRecord, obj.state)
-        obj.states = _rows(AcceptedState, obj.states)
-        obj.seed_results = _rows(SeedResult, obj.seed_results)
-        obj.preflight = as_part(PreflightRecord, obj.preflight)
-        obj.provenance = as_part(Provenance, obj.provenance)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "soil": SoilRecord,
+        "calibration": SandCalibration,
+        "state": LabStateRecord,
+        "states": AcceptedState,
+        "seed_results": SeedResult,
+        "preflight": PreflightRecord,
+        "provenance": Provenance,
+    }
 
     @classmethod
     def build(
@@ -345,11 +313,6 @@ class SandResult(TypedResult):
             provenance=Provenance.now(),
             specimens=list(kept),
         )
-
-
-def _rows(cls: type[TypedResult], rows: list | None) -> list | None:
-    """Each row of a file's list as the record ``cls``; None (a file without the key) stays None."""
-    return None if rows is None else [as_part(cls, row) for row in rows]
 
 
 def _pm(mean: float, sd: float) -> str:
