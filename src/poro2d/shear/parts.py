@@ -10,7 +10,6 @@ replicate study's peaks at one normal stress.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar, TypeVar
 
@@ -133,11 +132,9 @@ class ConsolidationRecord(Nested):
     box: BoxRecord
     engine: dict[str, Any] | None = None
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> ConsolidationRecord:
-        obj = super().from_dict(data)
-        obj.box = part(BoxRecord, obj.box)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "box": BoxRecord,
+    }
 
 
 @dataclass(eq=False)
@@ -186,12 +183,10 @@ class TestSummary(Nested):
     consolidation_normal_stress_error: float
     folder: str
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> TestSummary:
-        obj = super().from_dict(data)
-        obj.end = part(EndValues, obj.end)
-        obj.force_balance = part(ForceBalance, obj.force_balance)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "end": EndValues,
+        "force_balance": ForceBalance,
+    }
 
 
 @dataclass(eq=False)
@@ -234,11 +229,9 @@ class RateCheck(Nested):
     max_mean_abs_change_before_peak: float | None
     note: str
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> RateCheck:
-        obj = super().from_dict(data)
-        obj.tests = parts(RateCheckRow, obj.tests)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "tests": RateCheckRow,
+    }
 
 
 @dataclass(eq=False)
@@ -257,11 +250,9 @@ class LabRecord(Nested):
     kind: str
     peaks: list[LabPeak]
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> LabRecord:
-        obj = super().from_dict(data)
-        obj.peaks = parts(LabPeak, obj.peaks)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "peaks": LabPeak,
+    }
 
 
 @dataclass(eq=False)
@@ -277,13 +268,11 @@ class LabComparison(Nested):
     friction_angle_difference_deg: float | None
     fit_through_origin: FitRecord
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> LabComparison:
-        obj = super().from_dict(data)
-        obj.peaks = parts(LabPeak, obj.peaks)
-        obj.fit = part(FitRecord, obj.fit)
-        obj.fit_through_origin = part(FitRecord, obj.fit_through_origin)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "peaks": LabPeak,
+        "fit": FitRecord,
+        "fit_through_origin": FitRecord,
+    }
 
 
 @dataclass(eq=False)

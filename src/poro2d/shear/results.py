@@ -3,7 +3,6 @@ replicate specimens' ``replicates.json`` and a strength study's ``strength.json`
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -24,11 +23,9 @@ from poro2d.shear.parts import (
     StrengthDefinitions,
     StressPeaks,
     TestSummary,
-    part,
-    parts,
 )
 from poro2d.store import Store
-from poro2d.typed_result import NOT_IN_FILE
+from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
 @dataclass(eq=False)
@@ -75,15 +72,13 @@ class ShearTestResult(Nested):
     provenance: Provenance
     curve: ShearCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> ShearTestResult:
-        obj = super().from_dict(data)
-        obj.end = part(EndValues, obj.end)
-        obj.force_balance = part(ForceBalance, obj.force_balance)
-        obj.consolidation = part(ConsolidationRecord, obj.consolidation)
-        obj.settings = part(ShearSettingsRecord, obj.settings)
-        obj.provenance = part(Provenance, obj.provenance)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "end": EndValues,
+        "force_balance": ForceBalance,
+        "consolidation": ConsolidationRecord,
+        "settings": ShearSettingsRecord,
+        "provenance": Provenance,
+    }
 
     @classmethod
     def read(cls, store: Store, data: dict[str, Any] | None = None) -> ShearTestResult:
@@ -140,18 +135,16 @@ class ShearSeriesResult(Nested):
         default_factory=dict, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> ShearSeriesResult:
-        obj = super().from_dict(data)
-        obj.tests = parts(TestSummary, obj.tests)
-        obj.fit = part(FitRecord, obj.fit)
-        obj.fit_through_origin = part(FitRecord, obj.fit_through_origin)
-        obj.quasi_static = part(QuasiStatic, obj.quasi_static)
-        obj.rate_check = part(RateCheck, obj.rate_check)
-        obj.lab = part(LabComparison, obj.lab)
-        obj.settings = part(ShearSettingsRecord, obj.settings)
-        obj.provenance = part(Provenance, obj.provenance)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "tests": TestSummary,
+        "fit": FitRecord,
+        "fit_through_origin": FitRecord,
+        "quasi_static": QuasiStatic,
+        "rate_check": RateCheck,
+        "lab": LabComparison,
+        "settings": ShearSettingsRecord,
+        "provenance": Provenance,
+    }
 
 
 @dataclass(eq=False)
@@ -179,14 +172,12 @@ class ReplicateShearResult(Nested):
     provenance: Provenance | None = None
     series: dict[str, ShearSeriesResult] = field(default_factory=dict, kw_only=True, metadata=NOT_IN_FILE)
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> ReplicateShearResult:
-        obj = super().from_dict(data)
-        obj.per_normal_stress = parts(StressPeaks, obj.per_normal_stress)
-        obj.fit = part(FitInterval, obj.fit)
-        obj.fit_through_origin = part(FitInterval, obj.fit_through_origin)
-        obj.provenance = part(Provenance, obj.provenance)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "per_normal_stress": StressPeaks,
+        "fit": FitInterval,
+        "fit_through_origin": FitInterval,
+        "provenance": Provenance,
+    }
 
 
 @dataclass(eq=False)
@@ -209,14 +200,12 @@ class StrengthResult(Nested):
     config: dict[str, Any] | None = None
     provenance: Provenance | None = None
 
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> StrengthResult:
-        obj = super().from_dict(data)
-        obj.cases = parts(StrengthCase, obj.cases)
-        obj.definitions = part(StrengthDefinitions, obj.definitions)
-        obj.settings = part(ShearSettingsRecord, obj.settings)
-        obj.provenance = part(Provenance, obj.provenance)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "cases": StrengthCase,
+        "definitions": StrengthDefinitions,
+        "settings": ShearSettingsRecord,
+        "provenance": Provenance,
+    }
 
 
 __all__ = ["ReplicateShearResult", "ShearSeriesResult", "ShearTestResult", "StrengthResult"]
