@@ -41,27 +41,45 @@ def ignore_interrupts_in_spawned_child() -> bool:
     """
     import sys
 
-    if SPAWNED_CHILD_FLAG not in sys.argv:
+    # sys.orig_argv: multiprocessing gives the child the parent's sys.argv before it imports
+    # the main module, so only the interpreter's own command line still shows the flag
+    if SPAWNED_CHILD_FLAG not in sys.orig_argv:
         return False
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     return True
 
 
-def hold_interrupts() -> set | None:
-    """Block SIGINT in this thread while a local cluster or a process pool starts; returns what to restore.
+class _HeldInterrupt:
+    """The SIGINT handler while interrupts are held: it notes a Ctrl-C for the release."""
+
+    def __init__(self, previous) -> None:
+        self.previous = previous
+        self.came = False
+
+    def __call__(self, signum, frame) -> None:
+        self.came = True
+
+
+def hold_interrupts() -> _HeldInterrupt | None:
+    """Hold Ctrl-C while a local cluster or a process pool starts; returns what to release.
 
     A Ctrl-C in the middle of the cluster's start-up left it half built, to be closed at
-    exit with a traceback. Blocked here, the signal waits until :func:`release_interrupts`,
-    when the cluster is whole and the command can close it. (Dask's worker processes start
-    with no signal blocked and ignore SIGINT themselves; a process pool's start from this
-    thread, with it blocked.)
+    exit with a traceback. Held here, it is noted and raised by :func:`release_interrupts`,
+    when the cluster is whole and the command can close it. (Blocking the signal in this
+    thread would not hold it: any other thread of the command, numba's or the display's,
+    takes it and Python still runs its handler in the main thread.)
     """
-    if threading.current_thread() is not threading.main_thread() or not hasattr(signal, "pthread_sigmask"):
+    if threading.current_thread() is not threading.main_thread():
         return None
-    return signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    held = _HeldInterrupt(signal.getsignal(signal.SIGINT))
+    signal.signal(signal.SIGINT, held)
+    return held
 
 
-def release_interrupts(previous: set | None) -> None:
+def release_interrupts(held: _HeldInterrupt | None) -> None:
     """Undo :func:`hold_interrupts`; a Ctrl-C that came meanwhile is raised now."""
-    if previous is not None and signal.SIGINT not in previous:
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    if held is None or signal.getsignal(signal.SIGINT) is not held:
+        return  # nothing held, or released already
+    signal.signal(signal.SIGINT, held.previous if held.previous is not None else signal.SIG_DFL)
+    if held.came:
+        raise KeyboardInterrupt

@@ -55,8 +55,8 @@ def map_in_processes(jobs: Sequence[Job], order: list[int], n: int, on_report, o
     queue = ctx.Queue()
     before = {child.pid for child in ctx.active_children()}  # processes started before this pool
     pool = ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_start_worker, initargs=(queue,))
-    # the workers start as the jobs are submitted; with SIGINT blocked meanwhile they start with it
-    # blocked (a Ctrl-C then reaches the command alone, which ends them)
+    # the workers start as the jobs are submitted; a Ctrl-C meanwhile is raised when all are
+    # started (the workers ignore it: it is the command's, which ends them)
     held = hold_interrupts()
     try:
         futures = {pool.submit(_run_reporting, jobs[i], i): i for i in order}
