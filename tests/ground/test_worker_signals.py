@@ -41,7 +41,8 @@ def test_interrupt_during_the_hold_is_raised_at_the_release(tmp_path):
     script.write_text(SCRIPT)
     done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
-    assert done.stdout.splitlines() == ["held", "raised at release", "handler True", "quiet release"], done.stdout
+    expected = ["held", "raised at release", "handler True", "quiet release"]
+    assert done.stdout.splitlines() == expected, done.stdout
 
 
 def test_release_of_nothing_held_is_harmless():
