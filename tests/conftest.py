@@ -1,6 +1,15 @@
 """Fixtures shared by several test modules: each is built once per session, then only read."""
 
+import os
+
 import pytest
+
+# pytest-xdist starts its workers with COLUMNS=80: the commands' tables would then wrap as in an
+# 80-column terminal, where a plain run writes them whole (poro2d.console); a worker sees what a
+# plain run sees
+if os.environ.get("PYTEST_XDIST_WORKER"):
+    os.environ.pop("COLUMNS", None)
+    os.environ.pop("LINES", None)
 
 from poro2d.dem import checkpoint
 from poro2d.specimen import paper_grading

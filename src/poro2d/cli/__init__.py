@@ -11,6 +11,12 @@ from poro2d.worker_signals import ignore_interrupts_in_spawned_child
 # package first of all, before any signal handling of its own: Ctrl-C is the command's
 ignore_interrupts_in_spawned_child()
 
-from poro2d.cli.app import app, main  # noqa: E402
+try:
+    from poro2d.cli.app import app, main
+except KeyboardInterrupt:  # a Ctrl-C while the command still imports (a second or so): its one line
+    import sys
+
+    print("interrupted", file=sys.stderr)
+    raise SystemExit(130) from None
 
 __all__ = ["app", "main"]
