@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, ClassVar, TypeVar
 
+from poro2d.dem.summary import EngineSummary
 from poro2d.typed_result import TypedResult, part
 
 P = TypeVar("P", bound=TypedResult)
@@ -112,7 +113,7 @@ class BoxRecord(Nested):
 class ConsolidationRecord(Nested):
     """A test's consolidation (``consolidation.json``; in ``result.json`` without ``engine``).
 
-    ``box``: the split box's geometry (:meth:`poro2d.shear.box.SplitBox.to_dict`); ``engine``:
+    ``box``: the split box's geometry (:meth:`poro2d.shear.box.SplitBox.record`); ``engine``:
     the simulation's summary after consolidating.
     """
 
@@ -130,10 +131,11 @@ class ConsolidationRecord(Nested):
     coordination_number: float
     wall_time_s: float
     box: BoxRecord
-    engine: dict[str, Any] | None = None
+    engine: EngineSummary | None = None
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "box": BoxRecord,
+        "engine": EngineSummary,
     }
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
+from poro2d.dem.summary import EngineSummary
 from poro2d.io_utils import Provenance
 from poro2d.shear.curve import ShearCurve, read_curve
 from poro2d.shear.parts import (
@@ -68,7 +69,7 @@ class ShearTestResult(Nested):
     wall_time_s: float
     settings: ShearSettingsRecord
     specimen: str
-    engine: dict[str, Any]
+    engine: EngineSummary
     provenance: Provenance
     curve: ShearCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
@@ -77,6 +78,7 @@ class ShearTestResult(Nested):
         "force_balance": ForceBalance,
         "consolidation": ConsolidationRecord,
         "settings": ShearSettingsRecord,
+        "engine": EngineSummary,
         "provenance": Provenance,
     }
 
