@@ -81,7 +81,7 @@ class ShearSettingsRecord(TypedResult):
 
 @dataclass(eq=False)
 class BoxRecord(TypedResult):
-    """The split box's geometry as a file keeps it (:meth:`poro2d.shear.box.SplitBox.to_dict`), in m."""
+    """The split box's geometry as a file keeps it (:meth:`poro2d.shear.box.SplitBox.record`), in m."""
 
     width: float
     height: float
@@ -124,7 +124,7 @@ class ConsolidationRecord(TypedResult):
 
 @dataclass(eq=False)
 class FitRecord(TypedResult):
-    """A Mohr-Coulomb line as a file keeps it (:meth:`poro2d.shear.fit.MohrCoulombFit.to_dict`)."""
+    """A Mohr-Coulomb line as a file keeps it (:meth:`poro2d.shear.fit.MohrCoulombFit.record`)."""
 
     friction_angle_deg: float
     cohesion_kpa: float

@@ -28,7 +28,7 @@ from poro2d.shear.box import SplitBox, build_split_box
 from poro2d.shear.case import ShearCase
 from poro2d.shear.controllers import Consolidation, ProgressFn
 from poro2d.shear.curve import CURVE_COLUMNS, curve_columns, curve_summary
-from poro2d.shear.parts import BoxRecord, ConsolidationRecord, ShearSettingsRecord
+from poro2d.shear.parts import ConsolidationRecord, ShearSettingsRecord
 from poro2d.shear.peak_frame import PeakFrame
 from poro2d.shear.results import ShearTestResult
 from poro2d.shear.settings import inertial_number
@@ -153,7 +153,7 @@ class DirectShearTest:
             normal_stress_error=done.normal_stress_error, plate_height_before_m=y0,
             plate_height_m=box.plate_height(sim), plate_settlement_m=y0 - box.plate_height(sim),
             coordination_number=coordination_number(sim), wall_time_s=time.perf_counter() - t0,
-            box=BoxRecord.from_dict(box.to_dict()), engine=sim.summary(),
+            box=box.record(), engine=sim.summary(),
         )  # fmt: skip
         return sim, info
 
