@@ -303,7 +303,7 @@ def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, *,
         paper=PaperFacts.from_dict(PAPER),
         timings=PaperTimings.from_dict(timings),
         provenance=Provenance.now(),
-        lab=LabRecord.from_dict(lab_data.to_dict()) if lab_data is not None else None,
+        lab=lab_data.record() if lab_data is not None else None,
     )
     return summary, CriterionOutputs.read(store.child("criterion"), result), shear_figures
 

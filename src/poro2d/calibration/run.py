@@ -512,7 +512,7 @@ def _result(
             f"{obs}_{s:g}kPa": SurrogateRecord.from_dict(sg.to_dict())
             for (obs, s, _), sg in zip(targets, surrogates, strict=True)
         },
-        lab=LabRecord.from_dict(lab_data.to_dict()),
+        lab=lab_data.record(),
         specimens={k: str(v) for k, v in found.items()},
         ranges=FrictionBounds.from_dict(ranges.to_dict()),
         settings=ShearSettingsRecord.from_dict(base),

@@ -229,7 +229,7 @@ class LabPeak(TypedResult):
 
 @dataclass(eq=False)
 class LabRecord(TypedResult):
-    """Laboratory data as a file keeps them (:meth:`poro2d.shear.lab.LabData.to_dict`)."""
+    """Laboratory data as a file keeps them (:meth:`poro2d.shear.lab.LabData.record`)."""
 
     source: str
     kind: str

@@ -21,13 +21,11 @@ from poro2d.shear.outputs import (
 )
 from poro2d.shear.parts import (
     LabComparison,
-    LabPeak,
     QuasiStatic,
     RateCheck,
     RateCheckRow,
     ShearSettingsRecord,
     TestSummary,
-    parts,
 )
 from poro2d.shear.pool import ShearJob, execute_jobs
 from poro2d.shear.results import ShearSeriesResult, ShearTestResult
@@ -273,7 +271,7 @@ class ShearSeries:
         return LabComparison(
             source=lab.source,
             kind=lab.kind,
-            peaks=parts(LabPeak, lab.peak_rows()),
+            peaks=lab.peak_rows(),
             fit=lf.record() if lf else None,
             friction_angle_deg=lf.friction_angle_deg if lf else None,
             cohesion_kpa=lf.cohesion_kpa if lf else None,
