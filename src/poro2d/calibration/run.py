@@ -235,7 +235,7 @@ def _base_settings(settings: dict | None) -> dict:
     given.setdefault("stop_after_peak", 0.0)
     from poro2d.config import dataclass_from_table
 
-    return dataclass_from_table(ShearSettings, "settings", given).to_dict()
+    return dataclass_from_table(ShearSettings, "settings", given).record().to_dict()
 
 
 def _lab_targets(lab: LabData, base: dict) -> list[tuple[str, float, float]]:

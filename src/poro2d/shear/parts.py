@@ -48,7 +48,7 @@ class EndValues(TypedResult):
 
 @dataclass(eq=False)
 class ShearSettingsRecord(TypedResult):
-    """The shear settings as a result file keeps them (:meth:`poro2d.shear.settings.ShearSettings.to_dict`).
+    """The shear settings as a result file keeps them (:meth:`poro2d.shear.settings.ShearSettings.record`).
 
     A file written before a setting existed lacks its key, and keeps lacking it when written
     again (``stop_after_peak`` and ``rolling_friction`` are newer than the first files).

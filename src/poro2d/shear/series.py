@@ -24,7 +24,6 @@ from poro2d.shear.parts import (
     QuasiStatic,
     RateCheck,
     RateCheckRow,
-    ShearSettingsRecord,
     TestSummary,
 )
 from poro2d.shear.pool import ShearJob, execute_jobs
@@ -167,7 +166,7 @@ class ShearSeries:
             f"{1e3 * s.peak_window:g} mm of shear displacement",
             shear_stress_definition="horizontal force of the disks on the upper half (upper walls, upper "
             "lip, top plate friction) / (W t), W the box width (no area correction)",
-            settings=ShearSettingsRecord.from_dict(s.to_dict()),
+            settings=s.record(),
             velocity_m_per_s=s.velocity,
             density_scale=s.density_scale,
             specimen=self.specimen.source,

@@ -28,7 +28,7 @@ from poro2d.shear.box import SplitBox, build_split_box
 from poro2d.shear.case import ShearCase
 from poro2d.shear.controllers import Consolidation, ProgressFn
 from poro2d.shear.curve import CURVE_COLUMNS, curve_columns, curve_summary
-from poro2d.shear.parts import ConsolidationRecord, ShearSettingsRecord
+from poro2d.shear.parts import ConsolidationRecord
 from poro2d.shear.peak_frame import PeakFrame
 from poro2d.shear.results import ShearTestResult
 from poro2d.shear.settings import inertial_number
@@ -210,7 +210,7 @@ class DirectShearTest:
             records=len(rows),
             wall_time_shear_s=wall,
             wall_time_s=wall + float(info.wall_time_s or 0.0),
-            settings=ShearSettingsRecord.from_dict(s.to_dict()),
+            settings=s.record(),
             specimen=self.case.specimen.source,
             engine=sim.summary(),
             provenance=Provenance.now(),

@@ -32,7 +32,7 @@ from poro2d.errors import InputError, check_range
 from poro2d.io_utils import Provenance
 from poro2d.shear.case import ShearCase
 from poro2d.shear.fit import mohr_coulomb
-from poro2d.shear.parts import ShearSettingsRecord, StrengthCase, StrengthDefinitions
+from poro2d.shear.parts import StrengthCase, StrengthDefinitions
 from poro2d.shear.replicates import ReplicateShear, mohr_coulomb_ci
 from poro2d.shear.results import ReplicateShearResult, StrengthResult
 from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
@@ -228,7 +228,7 @@ class StrengthStudy:
             mu_r=self.mu_r,
             particle_friction=self.friction,
             specimens=list(next(iter(self.cases.values())).series),
-            settings=ShearSettingsRecord.from_dict(self.settings.to_dict()),
+            settings=self.settings.record(),
             definitions=StrengthDefinitions.from_dict(DEFINITIONS),
             wall_time_s=time.perf_counter() - t0,
             processes=self.processes,
