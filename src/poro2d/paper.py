@@ -18,7 +18,7 @@ from poro2d.console import OutputConsole
 from poro2d.criterion.config import paper_config
 from poro2d.criterion.replicates import accepted_and_replicates
 from poro2d.criterion.result import CriterionResult
-from poro2d.io_utils import Provenance, provenance
+from poro2d.io_utils import Provenance
 from poro2d.locks import holds_output
 from poro2d.paper_data import PAPER, QUICK_SHEAR
 from poro2d.shear.parts import LabRecord, QuasiStatic, TestSummary
@@ -175,7 +175,7 @@ def paper_stage(store: Store, quick: bool, seed: int) -> ResumableStage:
     return store.stage(
         Fingerprint({"quick": quick, "seed": seed}),
         record="paper.json",
-        extra={"provenance": provenance()},
+        extra={"provenance": Provenance.now().to_dict()},
         allowed="an empty folder or one holding a paper run of the same --quick and --seed",
         explain=lambda keys, _: (
             f"it holds a paper run with other {', '.join(f'--{k}' for k in keys or [])}; choose another --out"

@@ -13,7 +13,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from poro2d.io_utils import provenance
+from poro2d.io_utils import Provenance
 from poro2d.shear.parts import ShearSettingsRecord
 from poro2d.shear.settings import ShearSettings
 from poro2d.store import Store
@@ -88,7 +88,11 @@ def folder_stage(store: Store, record: TestContent | Mapping, specimen: str) -> 
         fingerprint,
         record=RECORD,
         key="run",
-        extra={"key": fingerprint.digest, "specimen": str(specimen), "provenance": provenance()},
+        extra={
+            "key": fingerprint.digest,
+            "specimen": str(specimen),
+            "provenance": Provenance.now().to_dict(),
+        },
         parameter="out",
         allowed="an empty folder or one holding the same test",
         explain=_explain,
