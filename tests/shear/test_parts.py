@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from poro2d.shear.curve import CURVE_COLUMNS, ShearCurve, curve_columns, curve_rows
+from poro2d.shear.curve import CURVE_COLUMNS, CurveRow, ShearCurve, curve_columns, curve_rows
 from poro2d.shear.fit import mohr_coulomb, peak
 from poro2d.shear.parts import (
     ConsolidationRecord,
@@ -79,6 +79,13 @@ def test_fits_are_kept_as_their_dicts_were():
     ]
     lo, hi = ci.friction_angle_ci_deg
     assert lo < ci.friction_angle_deg < hi and ci.dof == 1
+
+
+def test_a_curve_row_is_a_record_of_the_files_columns():
+    assert [f.name for f in dataclasses.fields(CurveRow) if f.name != "extra"] == CURVE_COLUMNS
+    row = CurveRow(*range(len(CURVE_COLUMNS)))
+    assert list(row.to_dict()) == CURVE_COLUMNS and dict(row) == row.to_dict()
+    assert CurveRow.from_dict(json.loads(json.dumps(row.to_dict()))).to_dict() == row.to_dict()
 
 
 def test_a_curve_is_its_columns():
