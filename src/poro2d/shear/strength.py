@@ -156,7 +156,8 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
 
 # ---------------------------------------------------------------------- the study
 def check_specimens(specimens: dict, normal_stresses_kpa, settings: ShearSettings) -> dict[str, Specimen]:
-    """Every specimen (read once) and stress as a test would take them, before any case binds a folder.
+    """Every specimen (read once, by its label) and stress as a test would take them, before any case
+    binds a folder.
 
     A case's series writes its tests' records as it is built, so a bad second specimen found
     while building the cases would leave the first one's folders behind.
