@@ -17,7 +17,7 @@ import sys
 from poro2d.console import OutputConsole, Table
 from poro2d.interop.agreement import QUANTITIES, compare
 from poro2d.interop.specimen_data import from_checkpoint
-from poro2d.io_utils import provenance, write_json
+from poro2d.io_utils import Provenance, write_json
 
 
 def main(argv=None) -> int:
@@ -47,7 +47,7 @@ def main(argv=None) -> int:
     console.print(t)
     console.print(f"LAMMPS {theirs.lammps_version}")
     if args.json:
-        write_json(args.json, dict(r.to_dict(), specimen=spec.source, provenance=provenance()))
+        write_json(args.json, dict(r.to_dict(), specimen=spec.source, provenance=Provenance.now().to_dict()))
     return 0
 
 

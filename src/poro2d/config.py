@@ -18,6 +18,8 @@ from poro2d.io_utils import check_input_file, read_utf8
 
 
 def load_toml(path: str | os.PathLike) -> dict:
+    """The raw tables of the TOML file at ``path``: read at the edge, where each command turns them
+    into its settings and cases once."""
     p = Path(path)
     if p.exists():  # a device, a FIFO or a folder is named as such
         check_input_file("config", p)

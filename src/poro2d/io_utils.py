@@ -140,24 +140,12 @@ def current_umask() -> int:
     return mask
 
 
-def provenance() -> dict:
-    """Version, machine and time stamp recorded in every result file."""
-    return {
-        "poro2d_version": __version__,
-        "python": platform.python_version(),
-        "machine": platform.machine(),
-        "platform": platform.platform(),
-        "cpu_count": os.cpu_count(),
-        "created_utc": datetime.now(UTC).isoformat(timespec="seconds"),
-    }
-
-
 @dataclass(eq=False)
 class Provenance(TypedResult):
     """The ``provenance`` record of a result file: which poro2d, Python and machine wrote it, and when.
 
-    The keys are those :func:`provenance` writes; a file of another version keeps its other
-    keys (``extra``) and lacks none it did not have.
+    :meth:`now` gives the run at hand's; a file of another version keeps its other keys
+    (``extra``) and lacks none it did not have.
     """
 
     poro2d_version: str
@@ -169,8 +157,15 @@ class Provenance(TypedResult):
 
     @classmethod
     def now(cls) -> Provenance:
-        """The record of the run at hand (:func:`provenance`)."""
-        return cls.from_dict(provenance())
+        """The record of the run at hand: this poro2d, Python and machine, the time in UTC."""
+        return cls(
+            poro2d_version=__version__,
+            python=platform.python_version(),
+            machine=platform.machine(),
+            platform=platform.platform(),
+            cpu_count=os.cpu_count(),
+            created_utc=datetime.now(UTC).isoformat(timespec="seconds"),
+        )
 
 
 def _default(o):

@@ -18,7 +18,7 @@ from poro2d.console import OutputConsole
 from poro2d.criterion.config import paper_config
 from poro2d.criterion.replicates import accepted_and_replicates
 from poro2d.criterion.result import CriterionResult
-from poro2d.io_utils import Provenance, provenance
+from poro2d.io_utils import Provenance
 from poro2d.locks import holds_output
 from poro2d.paper_data import PAPER, QUICK_SHEAR
 from poro2d.shear.parts import LabRecord, QuasiStatic, TestSummary
@@ -175,7 +175,7 @@ def paper_stage(store: Store, quick: bool, seed: int) -> ResumableStage:
     return store.stage(
         Fingerprint({"quick": quick, "seed": seed}),
         record="paper.json",
-        extra={"provenance": provenance()},
+        extra={"provenance": Provenance.now().to_dict()},
         allowed="an empty folder or one holding a paper run of the same --quick and --seed",
         explain=lambda keys, _: (
             f"it holds a paper run with other {', '.join(f'--{k}' for k in keys or [])}; choose another --out"
@@ -303,7 +303,7 @@ def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, *,
         paper=PaperFacts.from_dict(PAPER),
         timings=PaperTimings.from_dict(timings),
         provenance=Provenance.now(),
-        lab=LabRecord.from_dict(lab_data.to_dict()) if lab_data is not None else None,
+        lab=lab_data.record() if lab_data is not None else None,
     )
     return summary, CriterionOutputs.read(store.child("criterion"), result), shear_figures
 

@@ -8,6 +8,7 @@ their input. Plus the layout of the records the kernels read.
 
 from __future__ import annotations
 
+import json
 import math
 
 import numba
@@ -16,6 +17,7 @@ import pytest
 
 from poro2d.dem import Particles, Simulation, Walls, checkpoint
 from poro2d.dem import kernels as K
+from poro2d.dem.summary import EngineSummary
 from poro2d.errors import InputError
 
 R = 1e-3
@@ -131,6 +133,31 @@ def test_summary_reports_the_threads_used():
     sim.run(10)
     s = sim.summary()
     assert s["threads_used"] == sim.threads_used == 1 and s["threads_intended"] == 1
+
+
+#: the keys of a file's ``engine``, in their order (the rolling frictions only when a disk has one)
+ENGINE_KEYS = [
+    "n_particles", "n_walls", "wall_names", "thickness_m", "contact", "gravity", "local_damping",
+    "restitution", "dt_s", "dt_critical_s", "dt_mode", "density_scale", "density_scaling", "skin_m",
+    "threads", "threads_intended", "threads_used", "partitions", "step", "time_s",
+]  # fmt: skip
+
+
+def test_summary_is_a_record_that_writes_the_files_keys():
+    sim = _grid_box()
+    s = sim.summary()
+    assert isinstance(s, EngineSummary) and s.contact.convention == "per_body"
+    assert list(s.to_dict()) == ENGINE_KEYS and s.rolling_friction is None
+    assert list(s.to_dict()["contact"]) == ["convention", "pp", "pw"]
+    sim.particles.mu_r[:] = 0.2
+    rolled = sim.summary().to_dict()
+    assert list(rolled) == ENGINE_KEYS[:8] + ["rolling_friction"] + ENGINE_KEYS[8:]
+    assert (
+        rolled["rolling_friction"]["disks"] == [0.2, 0.2]
+        and rolled["rolling_friction"]["combination"] == "min"
+    )
+    read = EngineSummary.from_dict(json.loads(json.dumps(rolled)))
+    assert json.dumps(read.to_dict()) == json.dumps(rolled)
 
 
 @pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="needs 2 numba threads")

@@ -1,12 +1,13 @@
 """The typed parts of the direct shear results read from files of earlier versions, written back the same."""
 
+import dataclasses
 import json
 import pickle
 from pathlib import Path
 
 import numpy as np
 
-from poro2d.shear.curve import CURVE_COLUMNS, ShearCurve, curve_columns, curve_rows
+from poro2d.shear.curve import CURVE_COLUMNS, CurveRow, ShearCurve, curve_columns, curve_rows
 from poro2d.shear.fit import mohr_coulomb, peak
 from poro2d.shear.parts import (
     ConsolidationRecord,
@@ -67,11 +68,24 @@ def test_a_replicate_result_reads_into_its_parts():
 def test_fits_are_kept_as_their_dicts_were():
     s, t = [50.0, 100.0, 200.0], [40.0, 76.0, 139.0]
     fit = mohr_coulomb(s, t)
-    assert fit.record().to_dict() == fit.to_dict()
+    assert fit.record().to_dict() == {**dataclasses.asdict(fit), "tan_phi": fit.tan_phi}
     ci = mohr_coulomb_ci(s, t)
-    assert list(ci.to_dict()) == [*fit.to_dict(), "level", "dof", "friction_angle_ci_deg", "cohesion_ci_kpa"]
+    assert list(ci.to_dict()) == [
+        *fit.record().to_dict(),
+        "level",
+        "dof",
+        "friction_angle_ci_deg",
+        "cohesion_ci_kpa",
+    ]
     lo, hi = ci.friction_angle_ci_deg
     assert lo < ci.friction_angle_deg < hi and ci.dof == 1
+
+
+def test_a_curve_row_is_a_record_of_the_files_columns():
+    assert [f.name for f in dataclasses.fields(CurveRow) if f.name != "extra"] == CURVE_COLUMNS
+    row = CurveRow(*range(len(CURVE_COLUMNS)))
+    assert list(row.to_dict()) == CURVE_COLUMNS and dict(row) == row.to_dict()
+    assert CurveRow.from_dict(json.loads(json.dumps(row.to_dict()))).to_dict() == row.to_dict()
 
 
 def test_a_curve_is_its_columns():

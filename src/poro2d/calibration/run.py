@@ -235,7 +235,7 @@ def _base_settings(settings: dict | None) -> dict:
     given.setdefault("stop_after_peak", 0.0)
     from poro2d.config import dataclass_from_table
 
-    return dataclass_from_table(ShearSettings, "settings", given).to_dict()
+    return dataclass_from_table(ShearSettings, "settings", given).record().to_dict()
 
 
 def _lab_targets(lab: LabData, base: dict) -> list[tuple[str, float, float]]:
@@ -512,7 +512,7 @@ def _result(
             f"{obs}_{s:g}kPa": SurrogateRecord.from_dict(sg.to_dict())
             for (obs, s, _), sg in zip(targets, surrogates, strict=True)
         },
-        lab=LabRecord.from_dict(lab_data.to_dict()),
+        lab=lab_data.record(),
         specimens={k: str(v) for k, v in found.items()},
         ranges=FrictionBounds.from_dict(ranges.to_dict()),
         settings=ShearSettingsRecord.from_dict(base),

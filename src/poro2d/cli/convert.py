@@ -215,6 +215,8 @@ def conversion_to_json(
 ) -> dict:
     """The JSON object of one laboratory porosity (method ids as keys, see module doc).
 
+    A dict as the file holds it: its first keys are the methods a conversion ran, which vary.
+
     With ``state`` (the :class:`~poro2d.lab_state.LabState` that ``conv`` converted) the
     object also holds ``e`` and ``lab_state``, and its ``relative_density`` is the state's.
     """

@@ -61,7 +61,7 @@ def import_cmd(
     from poro2d.errors import check_int, check_range
     from poro2d.interop.check import check_specimen, read_specimen
     from poro2d.interop.validate import LIMITS, check_value
-    from poro2d.io_utils import check_output_dir, provenance
+    from poro2d.io_utils import Provenance, check_output_dir
     from poro2d.store import Store
 
     check_range("--ratio", ratio, 0.0, 1.0, lo_open=True)
@@ -93,7 +93,7 @@ def import_cmd(
     report["window_from"] = window_from
     if "plate" in report:
         store.save_state("after_plate.npz", sim, extra={"stage": "after_plate", "source": str(file)})
-    report["provenance"] = provenance()
+    report["provenance"] = Provenance.now().to_dict()
     store.write_json("check.json", report)
     print_check(report, out)
     if not report["passes"]:

@@ -31,7 +31,8 @@ def parse_values(text: str, option: str, hi: float) -> list[float]:
 
 
 def quick_specimens(out: Path, seeds: int, progress: bool) -> dict[str, Path]:
-    """The paper's quick specimen (``poro2d paper --quick``) of seed 0 and those of the next seeds.
+    """The paper's quick specimen (``poro2d paper --quick``) of seed 0 and those of the next seeds,
+    by their labels.
 
     The criterion and its replicate runs are the paper's own stages, resumable in ``out``.
     """

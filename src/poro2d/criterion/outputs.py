@@ -17,7 +17,7 @@ from poro2d.criterion.result import CriterionResult
 from poro2d.criterion.trial import trial_name
 from poro2d.dem import Simulation
 from poro2d.errors import InputError
-from poro2d.io_utils import provenance
+from poro2d.io_utils import Provenance
 from poro2d.store import Store
 
 #: how the top moved in a trial whose state after the plate stage was kept
@@ -109,9 +109,11 @@ def write_specimen_porosity(
         m = measure_specimen(p.pos, p.radius, width, top, lid=lid_shape(sim, width))
     except (InputError, RuntimeError) as e:
         store.write_json("specimen_porosity.json", {"trial_porosity": n2d, "note": str(e),
-                                                    "provenance": provenance()})  # fmt: skip
+                                                    "provenance": Provenance.now().to_dict()})  # fmt: skip
         return
-    store.write_json("specimen_porosity.json", dict(m.to_dict(), trial_porosity=n2d, provenance=provenance()))
+    store.write_json(
+        "specimen_porosity.json", dict(m.to_dict(), trial_porosity=n2d, provenance=Provenance.now().to_dict())
+    )
     if figures:
         title = f"accepted specimen, n2D = {n2d:.3f}: local porosity (Laguerre cells)"
         plot_local_porosity(p.pos, p.radius, width, top, m, store.path("local_porosity.png"), title=title)

@@ -60,7 +60,7 @@ from poro2d.criterion.trial import Decision, PlateStage, Preparation, StageFailu
 from poro2d.dem import Simulation
 from poro2d.errors import Integer, OneOf, Ranges, Real, check_fields, check_range
 from poro2d.grading import GradingCurve
-from poro2d.io_utils import Provenance, provenance
+from poro2d.io_utils import Provenance
 from poro2d.measure.disks import mass_d50
 from poro2d.measure.porosity import box_porosity
 from poro2d.measure.surface import lid_height_at
@@ -635,7 +635,7 @@ class PorosityCriterion:
                 "seed": self.seed,
             },
             config=self.config,
-            provenance=provenance(),
+            provenance=Provenance.now().to_dict(),
         )
 
     def _result(self, trials: list[Trial], final, converged: bool, message: str) -> CriterionResult:

@@ -27,7 +27,7 @@ from poro2d.dem.model import ContactModel
 from poro2d.dem.simulation import Simulation
 from poro2d.dem.state import PARTICLE_FIELDS, SERVO_COLUMNS, Particles, Walls
 from poro2d.errors import InputError
-from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, atomic_path, check_input_file, provenance
+from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, Provenance, atomic_path, check_input_file
 
 FORMAT = "poro2d-checkpoint-1"
 
@@ -78,7 +78,7 @@ def save(sim: Simulation, path: str | os.PathLike, extra: dict | None = None) ->
             arrays[_key(name)] = getattr(sim, store).mr
     meta = {
         "format": FORMAT,
-        "provenance": provenance(),
+        "provenance": Provenance.now().to_dict(),
         "thickness": sim.particles.thickness,
         "wall_names": sim.walls.names,
         "settings": {

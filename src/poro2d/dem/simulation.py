@@ -46,6 +46,7 @@ from poro2d.dem.state import (
     Walls,
 )
 from poro2d.dem.stores import ContactStore, DiskMasses, KernelParams, KernelWork
+from poro2d.dem.summary import ContactRecord, EngineSummary, RollingFrictionRecord
 from poro2d.errors import InputError, is_number
 
 _THREADING_SET = False
@@ -831,42 +832,41 @@ class Simulation:
 
         return contact_set(self)
 
-    def _rolling_summary(self) -> dict:
+    def _rolling_summary(self) -> RollingFrictionRecord | None:
         """The rolling frictions, only when some disk has one (outputs without it stay as they were)."""
         if not K.rolling_active(self.particles.mu_r):
-            return {}
+            return None
         p, w = self.particles, self.walls
-        return {
-            "rolling_friction": {
-                "disks": [float(p.mu_r.min()), float(p.mu_r.max())],
-                "walls": [float(v) for v in w.rolling_friction()],
-                "combination": "min",
-                "stiffness": "ks R^2",
-            }
-        }
+        return RollingFrictionRecord(
+            disks=[float(p.mu_r.min()), float(p.mu_r.max())],
+            walls=[float(v) for v in w.rolling_friction()],
+            combination="min",
+            stiffness="ks R^2",
+        )
 
-    def summary(self) -> dict:
-        """Settings that every output file should record."""
-        return {
-            "n_particles": self.particles.n,
-            "n_walls": self.walls.n,
-            "wall_names": list(self.walls.names),
-            "thickness_m": self.particles.thickness,
-            "contact": self.contact.to_dict(),
-            "gravity": list(self.gravity),
-            "local_damping": self.local_damping,
-            "restitution": self.restitution,
-            **self._rolling_summary(),
-            "dt_s": self.dt,
-            "dt_critical_s": self.dt_critical,
-            "dt_mode": "fixed" if self._fixed_dt is not None else f"auto (safety {self.dt_safety})",
-            "density_scale": self.density_scale,
-            "density_scaling": self.density_scale != 1.0,
-            "skin_m": self.skin,
-            "threads": self.threads,
-            "threads_intended": self.effective_threads,
-            "threads_used": self.threads_used,  # by the kernel's last call (0: none yet)
-            "partitions": self.partitions,
-            "step": self.step_count,
-            "time_s": self.time,
-        }
+    def summary(self) -> EngineSummary:
+        """Settings that every output file should record (a file's ``engine``)."""
+        c = self.contact
+        return EngineSummary(
+            n_particles=self.particles.n,
+            n_walls=self.walls.n,
+            wall_names=list(self.walls.names),
+            thickness_m=self.particles.thickness,
+            contact=ContactRecord(convention=c.convention, pp=c.pp, pw=c.pw),
+            gravity=list(self.gravity),
+            local_damping=self.local_damping,
+            restitution=self.restitution,
+            rolling_friction=self._rolling_summary(),
+            dt_s=self.dt,
+            dt_critical_s=self.dt_critical,
+            dt_mode="fixed" if self._fixed_dt is not None else f"auto (safety {self.dt_safety})",
+            density_scale=self.density_scale,
+            density_scaling=self.density_scale != 1.0,
+            skin_m=self.skin,
+            threads=self.threads,
+            threads_intended=self.effective_threads,
+            threads_used=self.threads_used,  # by the kernel's last call (0: none yet)
+            partitions=self.partitions,
+            step=self.step_count,
+            time_s=self.time,
+        )

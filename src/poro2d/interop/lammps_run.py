@@ -62,7 +62,7 @@ def find_mpirun() -> str:
     return w
 
 
-def lammps_env(threads: int = 1) -> dict:
+def lammps_env(threads: int = 1) -> dict[str, str]:
     """Environment for the subprocess: the Python prefix's lib/ (MPI) on LD_LIBRARY_PATH."""
     env = dict(os.environ)
     libs = [str(Path(sys.prefix) / "lib"), str(Path(find_lammps()).resolve().parent)]

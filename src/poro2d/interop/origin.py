@@ -70,7 +70,8 @@ def origin_lines(checkpoint: str | Path, state: KnownState | None = None) -> lis
 
 
 def _criterion_record(records: Store, name: str, keys: tuple[str, ...]) -> dict | None:
-    """The JSON object of a criterion's record file, None if missing, unreadable or of another kind."""
+    """The JSON object of a criterion's record file as it is (its keys are checked where read), None
+    if missing, unreadable or of another kind."""
     if not records.has(name) or (records.root / name).stat().st_size > 50_000_000:
         return None
     data = records.read_json(name)

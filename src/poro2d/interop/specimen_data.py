@@ -287,7 +287,8 @@ def check_accepted(path: str | os.PathLike) -> None:
 
 
 def _record(path: str | os.PathLike, folder: Store, name: str) -> dict | None:
-    """The JSON object ``name`` beside the specimen, None if there is none (or it holds something else)."""
+    """The JSON object ``name`` beside the specimen as it is (a file of any poro2d: its keys are checked
+    where read), None if there is none (or it holds something else)."""
     if not folder.has(name):
         return None
     check_input_file("SPECIMEN", folder.root / name)

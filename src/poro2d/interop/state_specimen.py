@@ -384,7 +384,8 @@ def _config_seed(data: dict) -> int | None:
 
 
 def _json(path: Path, parameter: str) -> dict:
-    """The JSON object of a record the user pointed at (checked as every input file is)."""
+    """The JSON object of a record the user pointed at, as it is (checked as every input file is; its
+    keys are checked where read)."""
     check_input_file(parameter, path)
     data = Store(path.parent, parameter=parameter).read_json(path.name)
     if data is None:

@@ -40,7 +40,7 @@ def find_yade() -> str:
     return exe
 
 
-def yade_env(threads: int = 1) -> dict:
+def yade_env(threads: int = 1) -> dict[str, str]:
     """Environment of the child process: YADE runs on the system's Python, so this
     process's module paths (a virtual environment, a source tree) are kept away from it."""
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}

@@ -29,7 +29,7 @@ import numpy as np
 
 from poro2d.criterion.density import Calibration, StateTarget, state_target
 from poro2d.interop.origin import SOIL_FILE
-from poro2d.io_utils import check_output_dir, provenance
+from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import holds_output
 from poro2d.sand.case import ConfigLike, SandCase, load_sand_case
 from poro2d.sand.preflight import Preflight, preflight
@@ -316,7 +316,7 @@ def run_sand(
     case, pf = check_soil(config, seeds=seeds, workers=workers, budget_minutes=budget_minutes)
     store.write_json(
         "preflight.json",
-        {"preflight": pf.to_dict(), "soil": case.soil_record(), "provenance": provenance()},
+        {"preflight": pf.to_dict(), "soil": case.soil_record(), "provenance": Provenance.now().to_dict()},
     )
     if on_preflight is not None:
         on_preflight(case, pf)

@@ -24,7 +24,7 @@ displacement plus one largest disk diameter.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -34,6 +34,7 @@ from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
 from poro2d.dem.ordering import strip_order
 from poro2d.errors import InputError, check_range
 from poro2d.paper_data import TABLE_1
+from poro2d.shear.parts import BoxRecord
 from poro2d.specimen.box import box_faces
 
 LOWER = ("bottom", "lower_left", "lower_right", "lower_lip")
@@ -65,8 +66,12 @@ class SplitBox:
     thickness: float
     x0_lower: float = 0.0
 
-    def to_dict(self) -> dict:
-        return asdict(self)
+    def record(self) -> BoxRecord:
+        """The geometry as a file keeps it (a consolidation's ``box``)."""
+        return BoxRecord(
+            width=self.width, height=self.height, split_y=self.split_y, gap=self.gap,
+            max_displacement=self.max_displacement, thickness=self.thickness, x0_lower=self.x0_lower,
+        )  # fmt: skip
 
     # ------------------------------------------------------------ kinematics
     def shear_displacement(self, sim: Simulation) -> float:

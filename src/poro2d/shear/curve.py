@@ -21,6 +21,7 @@ from poro2d.shear.fit import peak, smooth
 from poro2d.shear.parts import EndValues, ForceBalance
 from poro2d.shear.settings import ShearSettings, inertial_number
 from poro2d.store import Store
+from poro2d.typed_result import TypedResult
 
 CURVE_COLUMNS = [
     "step", "shear_displacement_mm", "shear_stress_kpa", "normal_stress_kpa", "plate_displacement_mm",
@@ -63,6 +64,30 @@ class ShearCurve(Mapping):
         return len(CURVE_COLUMNS)
 
 
+@dataclass(eq=False)
+class CurveRow(TypedResult):
+    """One record of a test's curve: a row of ``curve.csv``, its fields the columns in order.
+
+    The stresses are over the nominal area ``W t``: the force on the upper half (``shear_stress_kpa``),
+    on the lower half, across the shear plane and the upper disks' unbalanced part, the plate's
+    push and its friction; displacements in mm, ``step`` counted from the start of shearing.
+    """
+
+    step: int
+    shear_displacement_mm: float
+    shear_stress_kpa: float
+    normal_stress_kpa: float
+    plate_displacement_mm: float
+    coordination_number: float
+    lower_half_stress_kpa: float
+    plane_stress_kpa: float
+    upper_unbalanced_kpa: float
+    plate_friction_kpa: float
+    contacts_across_plane: int
+    max_unbalanced_ratio: float
+    inertial_number: float
+
+
 def curve_columns(rows: list[Mapping]) -> ShearCurve | None:
     """A curve's records as one float array per column of :data:`CURVE_COLUMNS` (None without rows).
 
@@ -92,8 +117,8 @@ def read_curve(store: Store, name: str = "curve.csv") -> ShearCurve | None:
 def curve_row(
     sim: Simulation, box: SplitBox, settings: ShearSettings, contacts: ContactSet,
     y_plate0: float, step0: int, rho: float,
-) -> dict:  # fmt: skip
-    """One record of the curve (:data:`CURVE_COLUMNS`) from the simulation's current state.
+) -> CurveRow:  # fmt: skip
+    """One record of the curve from the simulation's current state.
 
     ``contacts`` are the simulation's current contacts, ``y_plate0`` the plate height after
     consolidation, ``step0`` the step shearing began at, ``rho`` the inertial density.
@@ -104,22 +129,22 @@ def curve_row(
     pl = box.plane_force(sim, contacts)
     sigma = box.plate_force(sim) / area
     c = contacts
-    return {
-        "step": sim.step_count - step0,
-        "shear_displacement_mm": 1e3 * box.shear_displacement(sim),
-        "shear_stress_kpa": fu[0] / area / 1e3,
-        "normal_stress_kpa": sigma / 1e3,
-        "plate_displacement_mm": 1e3 * (box.plate_height(sim) - y_plate0),
-        "coordination_number": float(2 * np.count_nonzero(c.kind == 0) + np.count_nonzero(c.kind == 1))
+    return CurveRow(
+        step=sim.step_count - step0,
+        shear_displacement_mm=1e3 * box.shear_displacement(sim),
+        shear_stress_kpa=fu[0] / area / 1e3,
+        normal_stress_kpa=sigma / 1e3,
+        plate_displacement_mm=1e3 * (box.plate_height(sim) - y_plate0),
+        coordination_number=float(2 * np.count_nonzero(c.kind == 0) + np.count_nonzero(c.kind == 1))
         / sim.particles.n,
-        "lower_half_stress_kpa": -fl[0] / area / 1e3,
-        "plane_stress_kpa": pl.across[0] / area / 1e3,
-        "upper_unbalanced_kpa": pl.unbalanced[0] / area / 1e3,
-        "plate_friction_kpa": sim.wall_force("top")[0] / area / 1e3,
-        "contacts_across_plane": pl.contacts_across,
-        "max_unbalanced_ratio": sim.unbalanced_ratios()[0],
-        "inertial_number": inertial_number(settings.velocity, sigma, rho, settings.shear_zone_factor),
-    }
+        lower_half_stress_kpa=-fl[0] / area / 1e3,
+        plane_stress_kpa=pl.across[0] / area / 1e3,
+        upper_unbalanced_kpa=pl.unbalanced[0] / area / 1e3,
+        plate_friction_kpa=sim.wall_force("top")[0] / area / 1e3,
+        contacts_across_plane=pl.contacts_across,
+        max_unbalanced_ratio=sim.unbalanced_ratios()[0],
+        inertial_number=inertial_number(settings.velocity, sigma, rho, settings.shear_zone_factor),
+    )
 
 
 def _rel(a: np.ndarray, b: np.ndarray, mask: np.ndarray, ref: float) -> float:
@@ -180,7 +205,7 @@ class CurveSummary:
     force_balance: ForceBalance
 
 
-def curve_summary(rows: list[dict], sigma_kpa: float, settings: ShearSettings) -> CurveSummary:
+def curve_summary(rows: list[CurveRow], sigma_kpa: float, settings: ShearSettings) -> CurveSummary:
     """Peak, end values, servo error, inertial number and force balance read off the curve."""
     s = settings
     x = np.array([r["shear_displacement_mm"] for r in rows]) * 1e-3
@@ -213,6 +238,7 @@ def curve_summary(rows: list[dict], sigma_kpa: float, settings: ShearSettings) -
 
 __all__ = [
     "CURVE_COLUMNS",
+    "CurveRow",
     "ShearCurve",
     "CurveSummary",
     "curve_row",

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -34,11 +34,6 @@ class MohrCoulombFit:
 
     def predict(self, sigma_kpa) -> np.ndarray:
         return self.cohesion_kpa + self.tan_phi * np.asarray(sigma_kpa, float)
-
-    def to_dict(self) -> dict:
-        d = asdict(self)
-        d["tan_phi"] = self.tan_phi
-        return d
 
     def record(self) -> FitRecord:
         """The fit as a result file keeps it (its fields and ``tan_phi``)."""

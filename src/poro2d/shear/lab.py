@@ -27,6 +27,7 @@ import numpy as np
 from poro2d.errors import InputError
 from poro2d.io_utils import check_input_file, read_utf8
 from poro2d.shear.lab_checks import check_curve, check_normal_stress, check_peak
+from poro2d.shear.parts import LabPeak, LabRecord
 
 CURVE_COLUMNS = ("normal_stress_kpa", "shear_displacement_mm", "shear_stress_kpa")
 PEAK_COLUMNS = ("normal_stress_kpa", "peak_shear_stress_kpa")
@@ -47,12 +48,13 @@ class LabData:
     def normal_stresses(self) -> list[float]:
         return sorted(self.peaks)
 
-    def peak_rows(self) -> list[dict[str, float]]:
-        """The peaks as rows (``normal_stress_kpa``, ``peak_shear_stress_kpa``), by normal stress."""
-        return [{"normal_stress_kpa": s, "peak_shear_stress_kpa": self.peaks[s]} for s in sorted(self.peaks)]
+    def peak_rows(self) -> list[LabPeak]:
+        """The peaks as records (normal stress, peak shear stress), by normal stress."""
+        return [LabPeak(normal_stress_kpa=s, peak_shear_stress_kpa=self.peaks[s]) for s in sorted(self.peaks)]
 
-    def to_dict(self) -> dict:
-        return {"source": self.source, "kind": self.kind, "peaks": self.peak_rows()}
+    def record(self) -> LabRecord:
+        """The data as a result file keeps them: the source, the kind of CSV and the peaks."""
+        return LabRecord(source=self.source, kind=self.kind, peaks=self.peak_rows())
 
 
 def _number(path: str, line: int, col: str, text: str) -> float:

@@ -13,26 +13,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, ClassVar, TypeVar
 
+from poro2d.dem.summary import EngineSummary
 from poro2d.typed_result import TypedResult, part
 
 P = TypeVar("P", bound=TypedResult)
-
-
-def _plain(value: Any) -> Any:
-    """A part as the dict of its file; a list of parts as a list of dicts; anything else as it is."""
-    if isinstance(value, TypedResult):
-        return value.to_dict()
-    if isinstance(value, list) and any(isinstance(v, TypedResult) for v in value):
-        return [_plain(v) for v in value]
-    return value
-
-
-@dataclass(eq=False)
-class Nested(TypedResult):
-    """A typed result made of typed parts: its ``to_dict()`` is the file's plain dict, parts included."""
-
-    def to_dict(self) -> dict[str, Any]:
-        return {k: _plain(v) for k, v in super().to_dict().items()}
 
 
 def parts(cls: type[P], values: Any) -> Any:
@@ -41,7 +25,7 @@ def parts(cls: type[P], values: Any) -> Any:
 
 
 @dataclass(eq=False)
-class ForceBalance(Nested):
+class ForceBalance(TypedResult):
     """How far the upper half, the shear plane and the lower half agree over a test (kPa, relative)."""
 
     mean_abs_upper_minus_plane_rel: float
@@ -53,7 +37,7 @@ class ForceBalance(Nested):
 
 
 @dataclass(eq=False)
-class EndValues(Nested):
+class EndValues(TypedResult):
     """The end of a test's curve, smoothed over one peak window."""
 
     shear_stress_kpa: float
@@ -63,8 +47,8 @@ class EndValues(Nested):
 
 
 @dataclass(eq=False)
-class ShearSettingsRecord(Nested):
-    """The shear settings as a result file keeps them (:meth:`poro2d.shear.settings.ShearSettings.to_dict`).
+class ShearSettingsRecord(TypedResult):
+    """The shear settings as a result file keeps them (:meth:`poro2d.shear.settings.ShearSettings.record`).
 
     A file written before a setting existed lacks its key, and keeps lacking it when written
     again (``stop_after_peak`` and ``rolling_friction`` are newer than the first files).
@@ -96,8 +80,8 @@ class ShearSettingsRecord(Nested):
 
 
 @dataclass(eq=False)
-class BoxRecord(Nested):
-    """The split box's geometry as a file keeps it (:meth:`poro2d.shear.box.SplitBox.to_dict`), in m."""
+class BoxRecord(TypedResult):
+    """The split box's geometry as a file keeps it (:meth:`poro2d.shear.box.SplitBox.record`), in m."""
 
     width: float
     height: float
@@ -109,10 +93,10 @@ class BoxRecord(Nested):
 
 
 @dataclass(eq=False)
-class ConsolidationRecord(Nested):
+class ConsolidationRecord(TypedResult):
     """A test's consolidation (``consolidation.json``; in ``result.json`` without ``engine``).
 
-    ``box``: the split box's geometry (:meth:`poro2d.shear.box.SplitBox.to_dict`); ``engine``:
+    ``box``: the split box's geometry (:meth:`poro2d.shear.box.SplitBox.record`); ``engine``:
     the simulation's summary after consolidating.
     """
 
@@ -130,16 +114,17 @@ class ConsolidationRecord(Nested):
     coordination_number: float
     wall_time_s: float
     box: BoxRecord
-    engine: dict[str, Any] | None = None
+    engine: EngineSummary | None = None
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "box": BoxRecord,
+        "engine": EngineSummary,
     }
 
 
 @dataclass(eq=False)
-class FitRecord(Nested):
-    """A Mohr-Coulomb line as a file keeps it (:meth:`poro2d.shear.fit.MohrCoulombFit.to_dict`)."""
+class FitRecord(TypedResult):
+    """A Mohr-Coulomb line as a file keeps it (:meth:`poro2d.shear.fit.MohrCoulombFit.record`)."""
 
     friction_angle_deg: float
     cohesion_kpa: float
@@ -160,7 +145,7 @@ class FitInterval(FitRecord):
 
 
 @dataclass(eq=False)
-class TestSummary(Nested):
+class TestSummary(TypedResult):
     """One test's line of a series' ``result.json`` (and ``peaks.csv``, without its nested parts)."""
 
     __test__ = False  # not a test class, whatever its name
@@ -190,7 +175,7 @@ class TestSummary(Nested):
 
 
 @dataclass(eq=False)
-class QuasiStatic(Nested):
+class QuasiStatic(TypedResult):
     """A series' check of the inertial number over all its tests."""
 
     max_inertial_number: float | None
@@ -200,7 +185,7 @@ class QuasiStatic(Nested):
 
 
 @dataclass(eq=False)
-class RateCheckRow(Nested):
+class RateCheckRow(TypedResult):
     """One test against its rerun at half the velocity."""
 
     normal_stress_kpa: float
@@ -215,7 +200,7 @@ class RateCheckRow(Nested):
 
 
 @dataclass(eq=False)
-class RateCheck(Nested):
+class RateCheck(TypedResult):
     """How the peaks change at half the velocity (a series run with ``rate_check``)."""
 
     velocity_m_per_s: float
@@ -235,7 +220,7 @@ class RateCheck(Nested):
 
 
 @dataclass(eq=False)
-class LabPeak(Nested):
+class LabPeak(TypedResult):
     """One laboratory peak: the peak shear stress at a normal stress (kPa)."""
 
     normal_stress_kpa: float
@@ -243,8 +228,8 @@ class LabPeak(Nested):
 
 
 @dataclass(eq=False)
-class LabRecord(Nested):
-    """Laboratory data as a file keeps them (:meth:`poro2d.shear.lab.LabData.to_dict`)."""
+class LabRecord(TypedResult):
+    """Laboratory data as a file keeps them (:meth:`poro2d.shear.lab.LabData.record`)."""
 
     source: str
     kind: str
@@ -256,7 +241,7 @@ class LabRecord(Nested):
 
 
 @dataclass(eq=False)
-class LabComparison(Nested):
+class LabComparison(TypedResult):
     """The laboratory data a series is compared with, their fits and the difference of the angles."""
 
     source: str
@@ -276,7 +261,7 @@ class LabComparison(Nested):
 
 
 @dataclass(eq=False)
-class StressPeaks(Nested):
+class StressPeaks(TypedResult):
     """The peaks of every specimen at one normal stress: mean, sd (0 with one), count and values."""
 
     normal_stress_kpa: float
@@ -287,7 +272,7 @@ class StressPeaks(Nested):
 
 
 @dataclass(eq=False)
-class StrengthDefinitions(Nested):
+class StrengthDefinitions(TypedResult):
     """How a strength study measures each of its angles, in words (a study's ``definitions``)."""
 
     peak_friction_angle: str
@@ -296,7 +281,7 @@ class StrengthDefinitions(Nested):
 
 
 @dataclass(eq=False)
-class StrengthCase(Nested):
+class StrengthCase(TypedResult):
     """One (mu_r, f_p) case of a strength study (a row of ``strength.csv``, with the pooled intervals).
 
     Peak and residual friction angles and the dilation angle, mean and sd over the specimens
@@ -323,7 +308,7 @@ class StrengthCase(Nested):
 
 __all__ = [
     "BoxRecord", "ConsolidationRecord", "EndValues", "FitInterval", "FitRecord", "ForceBalance",
-    "LabComparison", "LabPeak", "LabRecord", "Nested", "QuasiStatic", "RateCheck", "RateCheckRow",
+    "LabComparison", "LabPeak", "LabRecord", "QuasiStatic", "RateCheck", "RateCheckRow",
     "ShearSettingsRecord", "StrengthCase", "StrengthDefinitions", "StressPeaks", "TestSummary",
     "part", "parts",
 ]  # fmt: skip

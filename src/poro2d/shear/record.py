@@ -11,12 +11,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
-from poro2d.io_utils import provenance
+from poro2d.io_utils import Provenance
+from poro2d.shear.parts import ShearSettingsRecord
 from poro2d.shear.settings import ShearSettings
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
+from poro2d.typed_result import TypedResult
 
 RECORD = "test.json"
 
@@ -27,31 +29,31 @@ RECORD = "test.json"
 LATER_SETTINGS = ("rolling_friction",)
 
 
-@dataclass(frozen=True)
-class TestContent:
+@dataclass(eq=False)
+class TestContent(TypedResult):
     """What a stored test must share with this one to be reused: content, never paths.
 
     The digest of the specimen's state, the normal stress (kPa) and the settings as recorded
-    (``ShearSettings.to_dict()`` less the later settings at their default); :meth:`to_dict` is
-    the ``run`` of ``test.json``, the content its digest is taken of.
+    (the settings' record less the later settings at their default); ``to_dict()`` is the
+    ``run`` of ``test.json``, the content its digest is taken of.
     """
 
     __test__ = False  # not a test class, for all its name
 
     specimen_digest: str
     normal_stress_kpa: float
-    settings: dict[str, Any]
+    settings: ShearSettingsRecord
 
-    def to_dict(self) -> dict[str, Any]:
-        """The record's keys, as ``test.json`` holds them under ``run``."""
-        return {"specimen_digest": self.specimen_digest, "normal_stress_kpa": self.normal_stress_kpa,
-                "settings": self.settings}  # fmt: skip
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"settings": ShearSettingsRecord}
 
 
-def content_record(specimen_digest: str, sigma_kpa: float, settings: dict) -> TestContent:
-    """What a stored test must share with this one to be reused: content, never paths."""
+def content_record(specimen_digest: str, sigma_kpa: float, settings: Mapping[str, Any]) -> TestContent:
+    """What a stored test must share with this one to be reused: content, never paths.
+
+    ``settings``: :meth:`ShearSettings.record` (or its dict, as a ``test.json`` holds it).
+    """
     kept = {k: v for k, v in settings.items() if not (k in LATER_SETTINGS and v is None)}
-    return TestContent(specimen_digest, sigma_kpa, kept)
+    return TestContent(specimen_digest, sigma_kpa, ShearSettingsRecord.from_dict(kept))
 
 
 def stale_reason(keys: list[str] | None, old: Mapping | None) -> str:
@@ -86,7 +88,11 @@ def folder_stage(store: Store, record: TestContent | Mapping, specimen: str) -> 
         fingerprint,
         record=RECORD,
         key="run",
-        extra={"key": fingerprint.digest, "specimen": str(specimen), "provenance": provenance()},
+        extra={
+            "key": fingerprint.digest,
+            "specimen": str(specimen),
+            "provenance": Provenance.now().to_dict(),
+        },
         parameter="out",
         allowed="an empty folder or one holding the same test",
         explain=_explain,

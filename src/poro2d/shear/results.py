@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
+from poro2d.dem.summary import EngineSummary
 from poro2d.io_utils import Provenance
 from poro2d.shear.curve import ShearCurve, read_curve
 from poro2d.shear.parts import (
@@ -15,7 +16,6 @@ from poro2d.shear.parts import (
     FitRecord,
     ForceBalance,
     LabComparison,
-    Nested,
     QuasiStatic,
     RateCheck,
     ShearSettingsRecord,
@@ -29,7 +29,7 @@ from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
 @dataclass(eq=False)
-class ShearTestResult(Nested):
+class ShearTestResult(TypedResult):
     """One test (a test folder's ``result.json``): what its curve says, and how it was obtained.
 
     The first fields are read off the curve (:func:`poro2d.shear.curve.curve_summary`):
@@ -68,7 +68,7 @@ class ShearTestResult(Nested):
     wall_time_s: float
     settings: ShearSettingsRecord
     specimen: str
-    engine: dict[str, Any]
+    engine: EngineSummary
     provenance: Provenance
     curve: ShearCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
@@ -77,6 +77,7 @@ class ShearTestResult(Nested):
         "force_balance": ForceBalance,
         "consolidation": ConsolidationRecord,
         "settings": ShearSettingsRecord,
+        "engine": EngineSummary,
         "provenance": Provenance,
     }
 
@@ -96,7 +97,7 @@ class ShearTestResult(Nested):
 
 
 @dataclass(eq=False)
-class ShearSeriesResult(Nested):
+class ShearSeriesResult(TypedResult):
     """Tests at several normal stresses on one specimen (a series' ``result.json``), with the fit.
 
     ``tests``: one :class:`~poro2d.shear.parts.TestSummary` per test. The Mohr-Coulomb fit (``fit``, and
@@ -148,7 +149,7 @@ class ShearSeriesResult(Nested):
 
 
 @dataclass(eq=False)
-class ReplicateShearResult(Nested):
+class ReplicateShearResult(TypedResult):
     """The same tests on several specimens (``replicates.json``): peaks over specimens, pooled fits.
 
     ``per_normal_stress``: per stress the peaks' mean, sd, count and values; ``fit`` (None
@@ -181,7 +182,7 @@ class ReplicateShearResult(Nested):
 
 
 @dataclass(eq=False)
-class StrengthResult(Nested):
+class StrengthResult(TypedResult):
     """Strength against rolling and particle friction (a strength study's ``strength.json``).
 
     ``cases``: one row per (mu_r, f_p) (the rows of ``strength.csv`` with the pooled fits'

@@ -21,13 +21,10 @@ from poro2d.shear.outputs import (
 )
 from poro2d.shear.parts import (
     LabComparison,
-    LabPeak,
     QuasiStatic,
     RateCheck,
     RateCheckRow,
-    ShearSettingsRecord,
     TestSummary,
-    parts,
 )
 from poro2d.shear.pool import ShearJob, execute_jobs
 from poro2d.shear.results import ShearSeriesResult, ShearTestResult
@@ -169,7 +166,7 @@ class ShearSeries:
             f"{1e3 * s.peak_window:g} mm of shear displacement",
             shear_stress_definition="horizontal force of the disks on the upper half (upper walls, upper "
             "lip, top plate friction) / (W t), W the box width (no area correction)",
-            settings=ShearSettingsRecord.from_dict(s.to_dict()),
+            settings=s.record(),
             velocity_m_per_s=s.velocity,
             density_scale=s.density_scale,
             specimen=self.specimen.source,
@@ -273,7 +270,7 @@ class ShearSeries:
         return LabComparison(
             source=lab.source,
             kind=lab.kind,
-            peaks=parts(LabPeak, lab.peak_rows()),
+            peaks=lab.peak_rows(),
             fit=lf.record() if lf else None,
             friction_angle_deg=lf.friction_angle_deg if lf else None,
             cohesion_kpa=lf.cohesion_kpa if lf else None,

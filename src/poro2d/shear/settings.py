@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, fields
 
 from poro2d.dem.contact_law import MAX_ROLLING_FRICTION as ENGINE_MAX_ROLLING_FRICTION
 from poro2d.errors import InputError, Integer, Ranges, Real, check_fields
 from poro2d.paper_data import TABLE_1
+from poro2d.shear.parts import ShearSettingsRecord
 
 #: the normal stresses (kPa) a test may be run at. A contact carries about sigma d t, so two
 #: disks of the paper's stiffness (kn = 4e5 N/m each, in series 2e5; 8 mm thick) overlap by
@@ -128,8 +129,9 @@ class ShearSettings:
         if interval < shortest:
             raise InputError(name, interval, f"[max_displacement / {most} = {shortest:.3g}, inf) m")
 
-    def to_dict(self) -> dict:
-        return asdict(self)
+    def record(self) -> ShearSettingsRecord:
+        """The settings as a result file keeps them (every setting, in this class's order)."""
+        return ShearSettingsRecord(**{f.name: getattr(self, f.name) for f in fields(self)})
 
 
 def inertial_number(velocity: float, sigma_pa: float, rho_inertial: float, shear_zone_factor: float) -> float:

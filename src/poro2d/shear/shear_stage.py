@@ -16,7 +16,7 @@ import numpy as np
 from poro2d.dem import Simulation
 from poro2d.shear.box import SplitBox
 from poro2d.shear.controllers import ProgressFn, ShearDrive
-from poro2d.shear.curve import curve_row, peak_passed
+from poro2d.shear.curve import CurveRow, curve_row, peak_passed
 from poro2d.shear.fit import peak
 from poro2d.shear.peak_frame import PeakFrame, PeakTracker
 from poro2d.shear.settings import ShearSettings
@@ -70,12 +70,13 @@ class ShearStage:
         self.peak = PeakTracker(s.peak_window)
         self.peak.restore(store, PEAK_FRAME, self.rows)
 
-    def _start(self, sim: Simulation) -> tuple[Simulation, list[dict], int, float]:
+    def _start(self, sim: Simulation) -> tuple[Simulation, list[CurveRow], int, float]:
         """(simulation, rows, step shearing began at, wall time so far): resumed or new."""
         saved = None if self.checkpoints is None else self.checkpoints.resume(threads=self.threads)
         if saved is not None:
             resumed, meta = saved
-            return resumed, meta["rows"], meta["step0"], meta.get("wall_time_s", 0.0)
+            rows = [CurveRow.from_dict(row) for row in meta["rows"]]
+            return resumed, rows, meta["step0"], meta.get("wall_time_s", 0.0)
         ShearDrive(self.settings.velocity).start(sim)
         return sim, [], sim.step_count, 0.0
 
@@ -84,7 +85,7 @@ class ShearStage:
         rows = self.rows
         contacts = sim.contacts()
         rows.append(curve_row(sim, self.box, self.settings, contacts, self.y_plate0, self.step0, self.rho))
-        x_mm = rows[-1]["shear_displacement_mm"]
+        x_mm = rows[-1].shear_displacement_mm
         if self.figures:
             self.peak.add(PeakFrame.capture(sim, contacts, len(rows) - 1, x_mm))
         self.peak.settle(rows, x_mm * 1e-3)
@@ -94,7 +95,8 @@ class ShearStage:
         if self.checkpoints is not None and len(rows) % self.ck_every == 0 and done < self.total:
             self.peak.save(self.store, PEAK_FRAME)  # a resumed run still draws the peak's forces
             wall = self.wall_before + time.perf_counter() - self.t0
-            extra = {"stage": "shear", "rows": rows, "step0": self.step0, "wall_time_s": wall}
+            kept = [row.to_dict() for row in rows]
+            extra = {"stage": "shear", "rows": kept, "step0": self.step0, "wall_time_s": wall}
             self.checkpoints.save(sim, extra=extra)
         return self.peak_passed()
 
@@ -106,8 +108,8 @@ class ShearStage:
         s = self.settings
         if s.stop_after_peak <= 0.0:
             return False
-        x = np.array([r["shear_displacement_mm"] for r in self.rows]) * 1e-3
-        tau = np.array([r["shear_stress_kpa"] for r in self.rows])
+        x = np.array([r.shear_displacement_mm for r in self.rows]) * 1e-3
+        tau = np.array([r.shear_stress_kpa for r in self.rows])
         return peak_passed(x, peak(x, tau, s.peak_window).x, s)
 
     def run(self) -> float:

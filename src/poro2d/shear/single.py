@@ -27,8 +27,8 @@ from poro2d.shear import record
 from poro2d.shear.box import SplitBox, build_split_box
 from poro2d.shear.case import ShearCase
 from poro2d.shear.controllers import Consolidation, ProgressFn
-from poro2d.shear.curve import CURVE_COLUMNS, curve_columns, curve_summary
-from poro2d.shear.parts import BoxRecord, ConsolidationRecord, ShearSettingsRecord
+from poro2d.shear.curve import CURVE_COLUMNS, CurveRow, curve_columns, curve_summary
+from poro2d.shear.parts import ConsolidationRecord
 from poro2d.shear.peak_frame import PeakFrame
 from poro2d.shear.results import ShearTestResult
 from poro2d.shear.settings import inertial_number
@@ -153,7 +153,7 @@ class DirectShearTest:
             normal_stress_error=done.normal_stress_error, plate_height_before_m=y0,
             plate_height_m=box.plate_height(sim), plate_settlement_m=y0 - box.plate_height(sim),
             coordination_number=coordination_number(sim), wall_time_s=time.perf_counter() - t0,
-            box=BoxRecord.from_dict(box.to_dict()), engine=sim.summary(),
+            box=box.record(), engine=sim.summary(),
         )  # fmt: skip
         return sim, info
 
@@ -190,7 +190,7 @@ class DirectShearTest:
         )  # fmt: skip
 
     def _result(
-        self, rows: list[dict], info: ConsolidationRecord, sim: Simulation, wall: float
+        self, rows: list[CurveRow], info: ConsolidationRecord, sim: Simulation, wall: float
     ) -> ShearTestResult:
         """The test's ``result.json``: what the curve says, and how it was obtained."""
         s = self.settings
@@ -206,11 +206,11 @@ class DirectShearTest:
             local_damping=sim.local_damping,
             dt_s=sim.dt,
             d_mean_m=float(2.0 * np.mean(sim.particles.radius)),
-            shear_steps=int(rows[-1]["step"]) if rows else 0,
+            shear_steps=int(rows[-1].step) if rows else 0,
             records=len(rows),
             wall_time_shear_s=wall,
             wall_time_s=wall + float(info.wall_time_s or 0.0),
-            settings=ShearSettingsRecord.from_dict(s.to_dict()),
+            settings=s.record(),
             specimen=self.case.specimen.source,
             engine=sim.summary(),
             provenance=Provenance.now(),

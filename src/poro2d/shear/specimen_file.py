@@ -73,7 +73,7 @@ class Specimen:
 
     @property
     def extra(self) -> dict[str, Any]:
-        """What the specimen's maker recorded with it (the checkpoint's ``extra``)."""
+        """What the specimen's maker recorded with it (the checkpoint's ``extra``: each maker its keys)."""
         return self.meta.get("extra", {})
 
     def box(self) -> tuple[float, float]:

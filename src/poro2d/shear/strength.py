@@ -32,7 +32,7 @@ from poro2d.errors import InputError, check_range
 from poro2d.io_utils import Provenance
 from poro2d.shear.case import ShearCase
 from poro2d.shear.fit import mohr_coulomb
-from poro2d.shear.parts import ShearSettingsRecord, StrengthCase, StrengthDefinitions
+from poro2d.shear.parts import StrengthCase, StrengthDefinitions
 from poro2d.shear.replicates import ReplicateShear, mohr_coulomb_ci
 from poro2d.shear.results import ReplicateShearResult, StrengthResult
 from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
@@ -156,7 +156,8 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
 
 # ---------------------------------------------------------------------- the study
 def check_specimens(specimens: dict, normal_stresses_kpa, settings: ShearSettings) -> dict[str, Specimen]:
-    """Every specimen (read once) and stress as a test would take them, before any case binds a folder.
+    """Every specimen (read once, by its label) and stress as a test would take them, before any case
+    binds a folder.
 
     A case's series writes its tests' records as it is built, so a bad second specimen found
     while building the cases would leave the first one's folders behind.
@@ -228,7 +229,7 @@ class StrengthStudy:
             mu_r=self.mu_r,
             particle_friction=self.friction,
             specimens=list(next(iter(self.cases.values())).series),
-            settings=ShearSettingsRecord.from_dict(self.settings.to_dict()),
+            settings=self.settings.record(),
             definitions=StrengthDefinitions.from_dict(DEFINITIONS),
             wall_time_s=time.perf_counter() - t0,
             processes=self.processes,

@@ -37,6 +37,7 @@ def file_digest(path: str | os.PathLike) -> str:
 
 
 def _manifest(folder: Path) -> dict[str, str]:
+    """The folder's manifest as it is on disk: file name -> SHA-256 (empty when missing or unreadable)."""
     try:
         data = json.loads((folder / MANIFEST).read_text())
     except (OSError, ValueError):

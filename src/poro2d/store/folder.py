@@ -194,7 +194,7 @@ class Store:
         return self._written(name)
 
     def read_arrays(self, name: str) -> dict[str, np.ndarray] | None:
-        """The arrays of ``name`` (all read now, so the file is closed); None when missing or damaged."""
+        """The arrays of ``name`` by name (all read now, so the file is closed); None if missing or broken."""
         if not self.intact(name):
             return None
         try:
@@ -223,7 +223,7 @@ class Store:
         return checkpoint.read(self._root / name)
 
     def state_meta(self, name: str) -> dict:
-        """The metadata of a saved state (:func:`poro2d.dem.checkpoint.read_meta`)."""
+        """The metadata of a saved state as its JSON holds it (:func:`poro2d.dem.checkpoint.read_meta`)."""
         self.check_intact(name)
         return checkpoint.read_meta(self._root / name)
 

@@ -185,7 +185,10 @@ class ResumableStage:
     def stored(
         self, marker: str = "result.json", accept: Callable[[dict], bool] | None = None
     ) -> dict | None:
-        """The result of a finished stage: its marker's content, if the record holds this fingerprint.
+        """The result of a finished stage: its marker's raw JSON, if the record holds this fingerprint.
+
+        The stage does not know the result's class: the caller reads the content with its own
+        (:meth:`poro2d.shear.results.ShearTestResult.read`, say).
 
         ``marker`` is relative to the folder; ``accept(result)`` may refuse a marker of an
         unfinished shape (a failure written under the same name, a missing side file). None

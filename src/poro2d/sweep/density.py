@@ -26,7 +26,7 @@ from poro2d import __version__
 from poro2d.criterion.density import DEFAULT_MUS, Calibration, StateTarget, check_mus
 from poro2d.errors import check_int
 from poro2d.identity import identity_digest, outside_fields
-from poro2d.io_utils import provenance
+from poro2d.io_utils import Provenance
 from poro2d.locks import cache_entry
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.store import Store
@@ -311,7 +311,7 @@ def calibrate(
         "settings": calibration_base(case.base).as_config(),
         "sample": "n' of the accepted trial: box porosity, whole disk areas, plate just touching",
         "sweep_summary": res.summary,
-        "provenance": provenance(),
+        "provenance": Provenance.now().to_dict(),
     }
     store.write_json(record, rec)
     return cal, CalibrationRun.from_dict(dict(info, summary=res.summary, failed=len(res.failed)))

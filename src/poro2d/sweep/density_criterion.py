@@ -16,7 +16,7 @@ from poro2d.criterion.density import lab_relative_density
 from poro2d.criterion.result import CriterionResult
 from poro2d.criterion.run import ConfigLike, CriterionInputs, criterion_inputs, run_paper_mode
 from poro2d.errors import InputError
-from poro2d.io_utils import check_output_dir, provenance
+from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.store import Store
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.density import DEFAULT_SEEDS
@@ -70,7 +70,7 @@ def run_density_state(
         "calibration": rel["calibration"],
         "sweeps": sweeps,
         "config": base.as_config(),
-        "provenance": provenance(),
+        "provenance": Provenance.now().to_dict(),
     }
     result = DensityStateResult.from_dict(record)
     store.write_result("density.json", result)

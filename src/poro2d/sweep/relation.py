@@ -22,7 +22,7 @@ import numpy as np
 from poro2d import porosity as P
 from poro2d.config import check_keys, check_number_list
 from poro2d.errors import InputError, check_range
-from poro2d.io_utils import check_output_dir, float_or_nan, provenance
+from poro2d.io_utils import Provenance, check_output_dir, float_or_nan
 from poro2d.paper_data import QUICK_SPECIMEN as PAPER_QUICK_SPECIMEN
 from poro2d.store import Store
 from poro2d.sweep.cases import SweepConfig
@@ -307,7 +307,7 @@ def write_relation(rel: dict, store: Store, title: str = "", extra: dict | None 
             for p in rel["points"]]  # fmt: skip
     table = store.write_csv("relation.csv", flat)
     record = dict(rel, **(extra or {}))
-    record.setdefault("provenance", provenance())  # a RelationResult carries its own
+    record.setdefault("provenance", Provenance.now().to_dict())  # a RelationResult carries its own
     file = store.write_json("relation.json", record)
     return [table, file, *write_relation_figure(rel, store.root, title)]
 
@@ -441,6 +441,6 @@ def run_relation(
             res = run_sweep(states, kept, **sweep_kw)
             rel = analyse(res.rows, settings.n_max, settings.n_min)
             extra = {"quick": quick, "sweep_summary": res.summary, "config": cfg}
-        result = RelationResult.from_dict(dict(rel, **extra, provenance=provenance()))
+        result = RelationResult.from_dict(dict(rel, **extra, provenance=Provenance.now().to_dict()))
         write_relation(result, kept, title=title)
     return result

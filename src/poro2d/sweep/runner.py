@@ -31,7 +31,7 @@ from typing import Any
 from poro2d.execute import Backend, Executor, Failed, Job
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
 from poro2d.execute.dask_cluster import ClusterInfo, pin_numba_threads
-from poro2d.io_utils import provenance
+from poro2d.io_utils import Provenance
 from poro2d.locks import cache_entry, output_folder
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
@@ -259,7 +259,7 @@ def _run_sweep(sweep: SweepConfig, store: Store, *, client, scheduler, workers, 
         "config": sweep.raw,
         "base_dir": str(sweep.base_dir) if sweep.base_dir else None,
         "retries": sweep.retries,
-        "provenance": provenance(),
+        "provenance": Provenance.now().to_dict(),
     }
     store.write_json("sweep.json", record)
 

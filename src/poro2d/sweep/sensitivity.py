@@ -516,11 +516,11 @@ def _first_from(crit) -> str:
 
 def write_sensitivity(sens: dict, store: Store) -> SensitivityResult:
     """sensitivity.json, sensitivity.csv (points), sensitivity_seeds.csv and the figure; the study typed."""
-    from poro2d.io_utils import provenance
+    from poro2d.io_utils import Provenance
     from poro2d.report.sensitivity_report import plot_sensitivity
 
     figs = plot_sensitivity(sens, store.path("sensitivity"))
-    sens = dict(sens, figure=str(figs[0]), provenance=provenance())
+    sens = dict(sens, figure=str(figs[0]), provenance=Provenance.now().to_dict())
     store.write_csv("sensitivity_seeds.csv", sens["seeds"])
     points = sens["points"]["grading"] + sens["points"]["mu_prep"]
     store.write_csv("sensitivity.csv", [_csv_row(p, sens) for p in points])

@@ -1,0 +1,79 @@
+"""The engine's summary: the settings of a simulation that every output file records.
+
+:meth:`poro2d.dem.simulation.Simulation.summary` gives it as an :class:`EngineSummary`, a
+typed record whose ``to_dict()`` holds the keys files have always kept under ``engine``, in
+their order; ``from_dict()`` reads those of earlier files back. The rolling frictions are
+written only when some disk has one, so files of runs without it keep the keys they had.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import ClassVar
+
+from poro2d.typed_result import TypedResult
+
+
+@dataclass(eq=False)
+class ContactRecord(TypedResult):
+    """The contact convention (:class:`poro2d.dem.model.ContactModel`) as a file keeps it.
+
+    ``pp`` and ``pw``: (kn, ks, mu) of disk-disk and disk-wall contacts under
+    ``per_pair_type``, None under ``per_body``.
+    """
+
+    convention: str
+    pp: tuple[float, float, float] | list[float] | None
+    pw: tuple[float, float, float] | list[float] | None
+
+
+@dataclass(eq=False)
+class RollingFrictionRecord(TypedResult):
+    """The rolling frictions of a simulation: the disks' range, each wall's value, and the rule."""
+
+    disks: list[float]
+    walls: list[float]
+    combination: str
+    stiffness: str
+
+
+@dataclass(eq=False)
+class EngineSummary(TypedResult):
+    """What a simulation ran with: disks, walls, contact law, damping, time step, threads, clock.
+
+    ``dt_mode`` says whether the step was fixed or automatic (with its safety factor);
+    ``threads_used`` is what the kernel's last call used (0: none yet); ``step`` and
+    ``time_s`` are the simulation's clock when the summary was taken.
+    """
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("rolling_friction",)
+
+    n_particles: int
+    n_walls: int
+    wall_names: list[str]
+    thickness_m: float
+    contact: ContactRecord
+    gravity: list[float]
+    local_damping: float
+    restitution: float | None
+    rolling_friction: RollingFrictionRecord | None
+    dt_s: float
+    dt_critical_s: float
+    dt_mode: str
+    density_scale: float
+    density_scaling: bool
+    skin_m: float
+    threads: int
+    threads_intended: int
+    threads_used: int
+    partitions: int
+    step: int
+    time_s: float
+
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "contact": ContactRecord,
+        "rolling_friction": RollingFrictionRecord,
+    }
+
+
+__all__ = ["ContactRecord", "EngineSummary", "RollingFrictionRecord"]
