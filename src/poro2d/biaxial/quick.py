@@ -3,7 +3,7 @@
 The paper's grading and Table 1's disks (kn = ks = 4e5 N/m, 8 mm thick) with a particle
 friction of 0.5, the frictional disks of the 2D literature (docs/biaxial.md), placed by the
 multilayer compaction of :mod:`poro2d.specimen.compaction` in a box twice as tall as wide
-(0.05 m x 0.10 m, about 320 disks, 14 d50 wide) at a box porosity of 0.18: dense for these
+(0.05 m x 0.10 m, about 320 disks, 11 d50 wide) at a box porosity of 0.18: dense for these
 disks, so it dilates in shear. A value that pickles: a worker process builds the specimen
 from it, and the same seed builds the same disks, bit for bit.
 """
