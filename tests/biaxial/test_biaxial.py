@@ -195,3 +195,17 @@ def test_bad_input_is_refused_on_one_line(argv, words, specimen, tmp_path, capsy
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and words in err, err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_folder_of_another_kind_is_refused_before_any_work(tmp_path, capsys):
+    from poro2d.locks import output_folder
+
+    out = tmp_path / "shear-out"
+    with output_folder("--out", out, kind="shear"):
+        (out / "result.json").write_text("{}")
+    with pytest.raises(SystemExit) as exc:
+        main(["biaxial", "--quick", "--out", str(out), "--quiet"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "shear" in err and "biaxial" in err, err
+    assert (out / "result.json").read_text() == "{}"
