@@ -67,6 +67,7 @@ def test_a_dense_specimen_dilates_and_peaks_above_its_end(full):
     t = r.tests[0]
     assert t.end_volumetric_strain < -0.01  # the area has grown by more than 1 %
     assert t.max_dilatancy_angle_deg > 5.0
+    assert t.max_dilatancy_angle_deg > abs(t.end_dilatancy_angle_deg) + 5.0  # dilation slows down at the end
     assert t.peak_friction_angle_deg > t.critical_state_friction_angle_deg + 3.0
     assert 20.0 < t.peak_friction_angle_deg < 35.0  # dense disks at mu 0.5: 25-35 deg (docs/biaxial.md)
 

@@ -9,7 +9,8 @@ Definitions (docs/biaxial.md):
 * critical state: the mean sin(phi) over the last ``critical_window`` of the test's axial
   strain, counted as critical only if the volumetric strain has nearly stopped changing
   there: the least-squares slope d eps_v / d eps_1 over that window within
-  ``critical_rate_limit`` of 0. Otherwise the test says "not yet at critical state" and
+  ``critical_rate_limit`` of 0 (the dilatancy angle over the window, from the slopes of eps_v
+  and eps_s, is reported beside it). Otherwise the test says "not yet at critical state" and
   the angle is the end value, not a critical-state one;
 * dilatancy: sin(psi) = -d eps_v / d eps_s with eps_s = eps_1 - eps_3 (positive: the
   specimen dilates), each increment a secant over ``smoothing_strain`` of axial strain;
@@ -52,6 +53,7 @@ class Angles:
     critical_state_mean_stress_kpa: float
     critical_window: list[float]
     end_dilatancy_rate: float
+    end_dilatancy_angle_deg: float
     critical_state_reached: bool
     critical_state_note: str
     max_dilatancy_angle_deg: float
@@ -75,6 +77,7 @@ def read_angles(
         tail = np.zeros(e1.size, bool)
         tail[-3:] = True
     rate = float(np.polyfit(e1[tail], ev[tail], 1)[0])
+    shear_rate = float(np.polyfit(e1[tail], es[tail], 1)[0])
     s_cs = float(np.mean(curve.sin_phi[tail]))
     reached = abs(rate) <= rate_limit
     note = (
@@ -93,6 +96,7 @@ def read_angles(
         critical_state_mean_stress_kpa=float(np.mean(curve.mean_stress_kpa[tail])),
         critical_window=[float(e1[tail][0]), end],
         end_dilatancy_rate=rate,
+        end_dilatancy_angle_deg=_asin_deg(-rate / shear_rate) if shear_rate > 0 else math.nan,
         critical_state_reached=bool(reached),
         critical_state_note=note,
         max_dilatancy_angle_deg=psi,

@@ -38,6 +38,7 @@ class BiaxialTestResult(Nested):
     critical_state_mean_stress_kpa: float
     critical_window: list[float]
     end_dilatancy_rate: float
+    end_dilatancy_angle_deg: float
     critical_state_reached: bool
     critical_state_note: str
     max_dilatancy_angle_deg: float
