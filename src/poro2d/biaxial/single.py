@@ -14,13 +14,14 @@ With a store the test keeps ``curve.csv`` and then ``result.json`` there (each a
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import asdict
 
 import numpy as np
 
 from poro2d.biaxial.angles import read_angles
-from poro2d.biaxial.box import build_biaxial_box
+from poro2d.biaxial.box import BiaxialBox, build_biaxial_box
 from poro2d.biaxial.case import BiaxialCase
 from poro2d.biaxial.curve import CURVE_COLUMNS, BiaxialCurve
 from poro2d.biaxial.parts import ShearChecks
@@ -51,6 +52,11 @@ class BiaxialTest:
         self.store = store
         self.progress = progress
         self.threads = threads
+        # known once the box is built (:meth:`build`)
+        self.box: BiaxialBox | None = None
+        self.d50 = math.nan
+        self.rho = math.nan
+        self.i0 = math.nan
 
     def build(self) -> Simulation:
         """The specimen in its box, with the test's damping; the inertial number checked."""
@@ -80,6 +86,7 @@ class BiaxialTest:
         t0 = time.perf_counter()
         s = self.case.settings
         sim = self.build()
+        assert self.box is not None
         info = consolidate(sim, self.box, self.case.confining_kpa, s, self.progress)
         rows, velocity = Shearing(sim, self.case.confining_kpa, s, self.d50, self.rho, self.progress).run()
         curve = BiaxialCurve.of_rows(rows)
