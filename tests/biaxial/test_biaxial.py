@@ -210,3 +210,28 @@ def test_a_folder_of_another_kind_is_refused_before_any_work(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "shear" in err and "biaxial" in err, err
     assert (out / "result.json").read_text() == "{}"
+
+
+@pytest.mark.parametrize(
+    ("make", "name"),
+    [
+        (lambda: run_biaxial("crit"), "case"),
+        (lambda: run_biaxial(BiaxialCase.quick(100.0), replicates=0), "replicates"),
+        (lambda: run_biaxial(BiaxialCase.quick(100.0), replicates="2"), "replicates"),
+        (lambda: run_biaxial(BiaxialCase.quick(100.0), lab=5), "lab"),
+        (lambda: run_biaxial(BiaxialCase.quick(100.0), store="out"), "store"),
+        (lambda: run_biaxial(BiaxialCase.quick(100.0), progress=None), "progress"),
+        (lambda: run_biaxial([BiaxialCase.quick(100.0), BiaxialCase.quick(50.0, seed=1)]), "case"),
+        (lambda: BiaxialSettings(max_strain=0.9), "max_strain"),
+        (lambda: BiaxialSettings(record_strain=0.2, max_strain=0.1), "record_strain"),
+        (lambda: BiaxialSettings(strain_rate=float("nan")), "strain_rate"),
+        (lambda: BiaxialSettings(critical_window=0.01), "critical_window"),
+        (lambda: BiaxialCase.quick(5000.0), "confining stress"),
+        (lambda: BiaxialCase.quick(100.0, seed=-1), "seed"),
+        (lambda: BiaxialCase("crit", 100.0, BiaxialSettings()), "specimen"),
+    ],
+)
+def test_bad_api_input_names_its_parameter(make, name):
+    with pytest.raises(InputError) as exc:
+        make()
+    assert exc.value.parameter.startswith(name), exc.value
