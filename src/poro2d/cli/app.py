@@ -51,6 +51,7 @@ def _register() -> None:
     # Imported here so that `poro2d --help` stays cheap and a broken optional
     # layer cannot take the whole CLI down at import time.
     from poro2d.cli import (
+        biaxial,
         calibrate,
         convert,
         criterion,
@@ -70,6 +71,7 @@ def _register() -> None:
     plot.register(app)
     criterion.register(app)
     shear.register(app)
+    biaxial.register(app)
     strength.register(app)
     paper.register(app)
     sweep.register(app)

@@ -1,0 +1,119 @@
+"""A biaxial test's curve: one row per ``record_strain`` of axial strain, held as arrays.
+
+Strains are logarithmic (true) strains from the walls' positions, compression positive:
+eps_1 = ln(H0 / H), eps_3 = ln(W0 / W), so that the area change is exactly
+eps_v = ln(A0 / A) = eps_1 + eps_3 (positive: the specimen contracts; negative: it dilates),
+and eps_s = eps_1 - eps_3 is the 2D shear strain. H0 and W0 are the box's after
+consolidation. sigma_1 (the plate) and sigma_3 (the side walls) as
+:class:`poro2d.biaxial.box.BiaxialBox` measures them; q = sigma_1 - sigma_3,
+p = (sigma_1 + sigma_3) / 2 and the mobilized friction sin(phi) = q / (sigma_1 + sigma_3).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from poro2d.biaxial.box import BiaxialBox, BoxSize
+from poro2d.dem import Simulation
+from poro2d.store import Store
+
+#: the columns of ``curve.csv``, in order
+CURVE_COLUMNS = (
+    "step",
+    "axial_strain",
+    "lateral_strain",
+    "volumetric_strain",
+    "shear_strain",
+    "sigma_1_kpa",
+    "sigma_3_kpa",
+    "sigma_3_left_kpa",
+    "sigma_3_right_kpa",
+    "deviator_kpa",
+    "mean_stress_kpa",
+    "sin_phi",
+    "max_unbalanced_ratio",
+    "inertial_number",
+)
+
+
+@dataclass(frozen=True, eq=False)
+class BiaxialCurve(Mapping):
+    """A test's recorded curve: one float array per column of :data:`CURVE_COLUMNS`.
+
+    Also a read-only mapping of the column names to the arrays, in the file's order.
+    """
+
+    step: np.ndarray
+    axial_strain: np.ndarray
+    lateral_strain: np.ndarray
+    volumetric_strain: np.ndarray
+    shear_strain: np.ndarray
+    sigma_1_kpa: np.ndarray
+    sigma_3_kpa: np.ndarray
+    sigma_3_left_kpa: np.ndarray
+    sigma_3_right_kpa: np.ndarray
+    deviator_kpa: np.ndarray
+    mean_stress_kpa: np.ndarray
+    sin_phi: np.ndarray
+    max_unbalanced_ratio: np.ndarray
+    inertial_number: np.ndarray
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        if name not in CURVE_COLUMNS:
+            raise KeyError(name)
+        return getattr(self, name)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(CURVE_COLUMNS)
+
+    def __len__(self) -> int:
+        return len(CURVE_COLUMNS)
+
+    @classmethod
+    def of_rows(cls, rows: list[Mapping]) -> BiaxialCurve:
+        """The rows as columns, every value through ``float`` as ``curve.csv`` stores it."""
+        return cls(**{k: np.array([float(r[k]) for r in rows]) for k in CURVE_COLUMNS})
+
+    def rows(self) -> list[dict]:
+        """The curve as rows of Python floats (for ``curve.csv``)."""
+        cols = [self[k].tolist() for k in CURVE_COLUMNS]
+        return [dict(zip(CURVE_COLUMNS, values, strict=True)) for values in zip(*cols, strict=True)]
+
+
+def read_curve(store: Store, name: str = "curve.csv") -> BiaxialCurve | None:
+    """The curve kept in ``store`` (None without it)."""
+    rows = store.read_rows(name)
+    return None if rows is None else BiaxialCurve.of_rows(rows)
+
+
+def curve_row(sim: Simulation, start: BoxSize, step: int, d50: float, rho: float, strain_rate: float) -> dict:
+    """One row of the curve: the box's strains and stresses now (see the module's conventions)."""
+    now = BiaxialBox.size(sim)
+    s1, s3, left, right = BiaxialBox.stresses(sim)
+    e1 = math.log(start.height / now.height)
+    e3 = math.log(start.width / now.width)
+    p = 0.5 * (s1 + s3)
+    ratio, _ = sim.unbalanced_ratios()
+    return {
+        "step": step,
+        "axial_strain": e1,
+        "lateral_strain": e3,
+        "volumetric_strain": e1 + e3,
+        "shear_strain": e1 - e3,
+        "sigma_1_kpa": s1 / 1e3,
+        "sigma_3_kpa": s3 / 1e3,
+        "sigma_3_left_kpa": left / 1e3,
+        "sigma_3_right_kpa": right / 1e3,
+        "deviator_kpa": (s1 - s3) / 1e3,
+        "mean_stress_kpa": p / 1e3,
+        "sin_phi": (s1 - s3) / (s1 + s3) if s1 + s3 > 0 else math.nan,
+        "max_unbalanced_ratio": ratio,
+        "inertial_number": strain_rate * d50 * math.sqrt(rho / p) if p > 0 else math.inf,
+    }
+
+
+__all__ = ["CURVE_COLUMNS", "BiaxialCurve", "curve_row", "read_curve"]

@@ -1,0 +1,137 @@
+"""Typed results of the biaxial test: one test's ``result.json`` and a study's ``result.json``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+from poro2d.biaxial.curve import BiaxialCurve, read_curve
+from poro2d.biaxial.parts import (
+    AngleSpread,
+    ConsolidationRecord,
+    Definitions,
+    LabCurveRecord,
+    ShearChecks,
+    TestSummary,
+)
+from poro2d.io_utils import Provenance
+from poro2d.shear.parts import Nested
+from poro2d.store import Store
+from poro2d.typed_result import NOT_IN_FILE, TypedResult
+
+
+@dataclass(eq=False)
+class BiaxialTestResult(Nested):
+    """One biaxial test (a replicate folder's ``result.json``): its angles and how they were obtained.
+
+    Angles in degrees, strains as fractions (compression positive), stresses in kPa; the
+    definitions are :mod:`poro2d.biaxial.angles`'. ``curve`` (not in the file): the recorded
+    curve (:class:`~poro2d.biaxial.curve.BiaxialCurve`).
+    """
+
+    confining_stress_kpa: float
+    peak_friction_angle_deg: float
+    peak_sin_phi: float
+    axial_strain_at_peak: float
+    critical_state_friction_angle_deg: float
+    critical_state_sin_phi: float
+    critical_state_mean_stress_kpa: float
+    critical_window: list[float]
+    end_dilatancy_rate: float
+    end_dilatancy_angle_deg: float
+    critical_state_reached: bool
+    critical_state_note: str
+    max_dilatancy_angle_deg: float
+    axial_strain_at_max_dilatancy: float
+    end_volumetric_strain: float
+    min_volumetric_strain: float
+    checks: ShearChecks
+    consolidation: ConsolidationRecord
+    strain_rate_per_s: float
+    plate_velocity_m_per_s: float
+    d50_m: float
+    dt_s: float
+    local_damping: float
+    density_scale: float
+    shear_steps: int
+    records: int
+    wall_time_s: float
+    settings: dict[str, Any]
+    specimen: str
+    specimen_digest: str
+    provenance: Provenance
+    curve: BiaxialCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
+
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "checks": ShearChecks,
+        "consolidation": ConsolidationRecord,
+        "provenance": Provenance,
+    }
+
+    @classmethod
+    def read(cls, store: Store) -> BiaxialTestResult | None:
+        """A finished test read back from ``store`` with its curve (None if it holds none)."""
+        data = store.read_json("result.json")
+        if not isinstance(data, dict):
+            return None
+        result = cls.from_dict(data)
+        result.curve = read_curve(store)
+        return result
+
+
+@dataclass(eq=False)
+class BiaxialResult(Nested):
+    """Biaxial tests at one confining stress on replicate specimens (the study's ``result.json``).
+
+    ``peak_friction_angle``, ``critical_state_friction_angle`` and ``max_dilatancy_angle``:
+    each angle's spread over the replicates; ``critical_state_reached`` only if every
+    replicate reached it (``critical_state_note`` says which did not); ``lab`` only with
+    laboratory curves. ``tests`` (not in the file): each replicate's full result.
+    """
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("lab",)
+
+    confining_stress_kpa: float
+    replicates: int
+    peak_friction_angle: AngleSpread
+    critical_state_friction_angle: AngleSpread
+    max_dilatancy_angle: AngleSpread
+    axial_strain_at_peak: AngleSpread
+    critical_state_reached: bool
+    critical_state_note: str
+    summaries: list[TestSummary]
+    definitions: Definitions
+    settings: dict[str, Any]
+    specimens: list[str]
+    processes: int
+    wall_time_s: float
+    config: dict[str, Any]
+    provenance: Provenance
+    lab: LabCurveRecord | None = None
+    tests: list[BiaxialTestResult] = field(
+        default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
+    )
+
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "peak_friction_angle": AngleSpread,
+        "critical_state_friction_angle": AngleSpread,
+        "max_dilatancy_angle": AngleSpread,
+        "axial_strain_at_peak": AngleSpread,
+        "summaries": TestSummary,
+        "definitions": Definitions,
+        "provenance": Provenance,
+        "lab": LabCurveRecord,
+    }
+
+    def headline(self) -> str:
+        """The number to take away, one line: peak and critical-state angles with their spread."""
+        n = self.replicates
+        cs = "phi_cs" if self.critical_state_reached else "phi_end (not yet at critical state)"
+        return (
+            f"biaxial at sigma_3 = {self.confining_stress_kpa:g} kPa, {n} replicate{'s' if n > 1 else ''}: "
+            f"phi_peak = {self.peak_friction_angle.text()}, "
+            f"{cs} = {self.critical_state_friction_angle.text()}"
+        )
+
+
+__all__ = ["BiaxialResult", "BiaxialTestResult"]

@@ -1,0 +1,213 @@
+"""``run_biaxial``: biaxial tests on replicate specimens, the spread of their angles and a figure.
+
+Everything is checked before the first test starts; bad input raises
+:class:`poro2d.errors.InputError` naming the parameter. The replicates run as jobs of the
+executor (:mod:`poro2d.execute`), one per specimen, on local processes.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from poro2d.biaxial.case import BiaxialCase
+from poro2d.biaxial.curve import CURVE_COLUMNS
+from poro2d.biaxial.lab import LabCurve, read_lab_curve
+from poro2d.biaxial.parts import DEFINITIONS, AngleSpread, Definitions, LabCurveRecord, TestSummary
+from poro2d.biaxial.results import BiaxialResult, BiaxialTestResult
+from poro2d.biaxial.single import BiaxialTest
+from poro2d.errors import InputError, check_int
+from poro2d.execute import Backend, Executor, Failed, Job, results_or_raise
+from poro2d.io_utils import Provenance, as_json, check_output_dir
+from poro2d.locks import output_folder
+from poro2d.progress import JobsProgress
+from poro2d.report.biaxial_figures import plot_biaxial
+from poro2d.store import Store
+
+#: the most replicates one call runs
+MAX_REPLICATES = 50
+#: the figure of a study
+FIGURE = "biaxial.png"
+
+
+@dataclass(frozen=True)
+class BiaxialJob:
+    """One replicate: its case, and the folder its files go to (a path string; None: nothing kept)."""
+
+    case: BiaxialCase
+    folder: str | None
+    label: str
+
+    def run(self, report) -> BiaxialTestResult:
+        store = Store(self.folder) if self.folder is not None else None
+        return BiaxialTest(self.case, store, progress=report).run()
+
+
+def _run_job(job: BiaxialJob, report) -> BiaxialTestResult:
+    """Run one replicate (in a worker process); its phase and fraction go to ``report``."""
+    return job.run(report)
+
+
+def _cases(case, replicates: int) -> list[BiaxialCase]:
+    """One case per replicate: ``case`` and its quick specimen's next seeds, or the given cases."""
+    if isinstance(case, BiaxialCase):
+        return [case.replicate(k) for k in range(replicates)]
+    if isinstance(case, Sequence) and not isinstance(case, str | bytes) and case:
+        cases = list(case)
+        if not all(isinstance(c, BiaxialCase) for c in cases):
+            raise InputError("case", [type(c).__name__ for c in cases], "BiaxialCase values")
+        if replicates != 1:
+            raise InputError("replicates", replicates, "1 with a list of cases (each case is a replicate)")
+        if len({c.confining_kpa for c in cases}) != 1:
+            raise InputError("case", [c.confining_kpa for c in cases], "cases at one confining stress")
+        return cases
+    raise InputError("case", type(case).__name__, "a BiaxialCase or a list of them (one per replicate)")
+
+
+def _lab(value) -> LabCurve | None:
+    if value is None or isinstance(value, LabCurve):
+        return value
+    if isinstance(value, str | os.PathLike):
+        return read_lab_curve(value)
+    raise InputError("lab", type(value).__name__, "a laboratory CSV path, a LabCurve or None")
+
+
+def run_biaxial(
+    case: BiaxialCase | Sequence[BiaxialCase],
+    store: Store | None = None,
+    *,
+    replicates: int = 1,
+    lab: str | os.PathLike | LabCurve | None = None,
+    processes: int | None = None,
+    progress: bool = False,
+    config: dict | None = None,
+) -> BiaxialResult:
+    """Biaxial tests of ``case`` on ``replicates`` specimens (quick specimens of seed, seed + 1, ...).
+
+    ``case``: a :class:`BiaxialCase`, or a list of them, one per replicate specimen (then
+    ``replicates`` stays 1). ``store``: where the files go (``result.json``, ``curves.csv``,
+    ``biaxial.png``, and per replicate ``replicate<k>/result.json`` and ``curve.csv``); None:
+    nothing is kept. ``lab``: a laboratory CSV of the user's (:mod:`poro2d.biaxial.lab`),
+    overlaid on the figure. ``processes``: worker processes (default one per replicate, at
+    most the CPU count). ``config``: recorded as it is.
+
+    Returns the :class:`BiaxialResult`: the spread of each angle over the replicates, and each
+    replicate's result with its curve (``tests``). A test whose consolidation does not reach
+    equilibrium raises RuntimeError once the others have ended. Replicates on several
+    processes spawn them, which import the calling script: call this under
+    ``if __name__ == "__main__":`` in a script.
+    """
+    n = check_int("replicates", replicates, 1, MAX_REPLICATES)
+    cases = _cases(case, n)
+    lab_curve = _lab(lab)
+    if store is not None and not isinstance(store, Store):
+        raise InputError("store", type(store).__name__, "a poro2d.store.Store or None")
+    if not isinstance(progress, bool):
+        raise InputError("progress", progress, "True or False")
+    workers = (
+        check_int("processes", processes, 1, 64)
+        if processes is not None
+        else min(len(cases), os.cpu_count() or 1)
+    )
+    if store is None:
+        return _run(cases, None, lab_curve, workers, progress, config)
+    check_output_dir(store.parameter, store.root)
+    with output_folder(store.parameter, store.root, kind="biaxial"):
+        return _run(cases, store, lab_curve, workers, progress, config)
+
+
+def _run(cases, store, lab, workers, progress, config) -> BiaxialResult:
+    t0 = time.perf_counter()
+    jobs = [
+        BiaxialJob(
+            c, None if store is None else str(store.child(f"replicate{k + 1}").root), f"replicate {k + 1}"
+        )
+        for k, c in enumerate(cases)
+    ]
+    with JobsProgress("biaxial", [j.label for j in jobs], enabled=progress) as bars:
+
+        def show(index: int, phase: str, fraction: float) -> None:
+            bars.update(index, phase, fraction)
+
+        def ended(index: int, outcome) -> None:
+            if not isinstance(outcome, Failed):
+                bars.done(index)
+
+        outcomes = Executor(Backend.local(workers)).map(
+            [Job(_run_job, (job,), job.label, reports=True) for job in jobs], on_report=show, on_done=ended
+        )
+        tests: list[BiaxialTestResult] = results_or_raise(outcomes, "biaxial test(s)")
+    result = summarize(cases, tests, lab, workers, time.perf_counter() - t0, config)
+    if store is not None:
+        _write(store, result, lab)
+    return result
+
+
+def summarize(cases, tests, lab, workers, wall, config) -> BiaxialResult:
+    """The study's result from its replicates' results."""
+    missed = [k + 1 for k, t in enumerate(tests) if not t.critical_state_reached]
+    note = (
+        "every replicate reached the critical state"
+        if not missed
+        else f"not yet at critical state in replicate(s) {', '.join(map(str, missed))}: their end angles are "
+        "not critical-state angles (a longer --strain, or a larger specimen)"
+    )
+    summaries = [
+        TestSummary(
+            replicate=k + 1,
+            specimen=t.specimen,
+            peak_friction_angle_deg=t.peak_friction_angle_deg,
+            axial_strain_at_peak=t.axial_strain_at_peak,
+            critical_state_friction_angle_deg=t.critical_state_friction_angle_deg,
+            critical_state_reached=t.critical_state_reached,
+            max_dilatancy_angle_deg=t.max_dilatancy_angle_deg,
+            end_volumetric_strain=t.end_volumetric_strain,
+            sigma_3_max_error=t.checks.sigma_3_max_error,
+            wall_time_s=t.wall_time_s,
+        )  # fmt: skip
+        for k, t in enumerate(tests)
+    ]
+    lab_record = None
+    if lab is not None:
+        lab_record = LabCurveRecord(lab.source, int(lab.axial_strain.size), lab.peak_friction_angle_deg(),
+                                    lab.end_friction_angle_deg())  # fmt: skip
+    result = BiaxialResult(
+        confining_stress_kpa=cases[0].confining_kpa, replicates=len(tests),
+        peak_friction_angle=AngleSpread.of([t.peak_friction_angle_deg for t in tests]),
+        critical_state_friction_angle=AngleSpread.of([t.critical_state_friction_angle_deg for t in tests]),
+        max_dilatancy_angle=AngleSpread.of([t.max_dilatancy_angle_deg for t in tests]),
+        axial_strain_at_peak=AngleSpread.of([t.axial_strain_at_peak for t in tests]),
+        critical_state_reached=not missed, critical_state_note=note, summaries=summaries,
+        definitions=Definitions(**DEFINITIONS), settings=cases[0].settings.to_dict(),
+        specimens=[c.specimen.source for c in cases], processes=workers, wall_time_s=wall,
+        config=config or {}, provenance=Provenance.now(), lab=lab_record,
+    )  # fmt: skip
+    stored = BiaxialResult.from_dict(as_json(result))
+    stored.tests = list(tests)
+    return stored
+
+
+def _write(store: Store, result: BiaxialResult, lab: LabCurve | None) -> None:
+    """``curves.csv`` (every replicate's rows), the figure, then ``result.json``."""
+    rows = []
+    for k, t in enumerate(result.tests):
+        rows += [{"replicate": k + 1, **r} for r in t.curve.rows()]
+    store.write_csv("curves.csv", rows, header=["replicate", *CURVE_COLUMNS])
+    starts = [t.critical_window[0] for t in result.tests]
+    end_mean = sum(t.critical_state_sin_phi for t in result.tests) / len(result.tests)
+    lab_arrays = None
+    if lab is not None:
+        lab_arrays = {"axial_strain": lab.axial_strain, "stress_ratio": lab.stress_ratio,
+                      "volumetric_strain": lab.volumetric_strain}  # fmt: skip
+    plot_biaxial(
+        [(f"replicate {k + 1}", t.curve) for k, t in enumerate(result.tests)], store.path(FIGURE),
+        title=f"biaxial test, sigma_3 = {result.confining_stress_kpa:g} kPa, replicates: {result.replicates}",
+        critical=(end_mean, min(starts)), lab=lab_arrays,
+        lab_label=f"laboratory ({os.path.basename(lab.source)})" if lab is not None else "laboratory",
+    )  # fmt: skip
+    store.write_result("result.json", result)
+
+
+__all__ = ["BiaxialJob", "MAX_REPLICATES", "run_biaxial"]

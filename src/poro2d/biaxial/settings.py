@@ -1,0 +1,124 @@
+"""Settings of a biaxial test, and the inertial number that says whether it is quasi-static."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+from poro2d.errors import InputError, Integer, Ranges, Real, check_fields
+from poro2d.paper_data import TABLE_1
+from poro2d.shear.settings import (
+    MAX_CONSOLIDATION_STEPS,
+    MAX_DENSITY_SCALE,
+    MAX_FRICTION,
+    MAX_ROLLING_FRICTION,
+    MAX_WALL_STIFFNESS,
+    NORMAL_STRESS_RANGE_KPA,
+)
+
+#: the confining stresses (kPa) a test may be run at: the direct shear test's normal stresses,
+#: for the same reasons (a soft contact's overlap above, the specimen's weight below)
+CONFINING_RANGE_KPA = NORMAL_STRESS_RANGE_KPA
+#: the largest axial strain a test may reach: past a half the specimen is a flat layer
+MAX_AXIAL_STRAIN = 0.5
+#: most rows a curve may hold
+MAX_RECORDS = 100_000
+
+#: what each setting of :class:`BiaxialSettings` may be (checked in this order)
+BIAXIAL_RANGES: Ranges = {
+    "strain_rate": Real(0.0, 100.0, lo_open=True),
+    "max_strain": Real(0.0, MAX_AXIAL_STRAIN, lo_open=True),
+    "record_strain": Real(0.0, 0.05, lo_open=True),
+    "consolidation_ratio": Real(0.0, 1.0, lo_open=True),
+    "consolidation_max_steps": Integer(1000, MAX_CONSOLIDATION_STEPS),
+    "stress_tolerance": Real(0.0, 1.0, lo_open=True),
+    "servo_gain": Real(0.0, 1.0, lo_open=True),
+    "servo_integral": Real(0.0, 0.1),
+    "servo_max_speed": Real(0.0, 10.0, lo_open=True),
+    "kn_wall": Real(0.0, MAX_WALL_STIFFNESS, lo_open=True),
+    "ks_wall": Real(0.0, MAX_WALL_STIFFNESS),
+    "friction_wall": Real(0.0, MAX_FRICTION),
+    "particle_friction": Real(0.0, MAX_FRICTION, or_none=True),
+    "rolling_friction": Real(0.0, MAX_ROLLING_FRICTION, or_none=True),
+    "local_damping": Real(0.0, 1.0, hi_open=True, or_none=True),
+    "density_scale": Real(1.0, MAX_DENSITY_SCALE),
+    "dt_safety": Real(0.0, 1.0, lo_open=True),
+    "inertial_limit": Real(0.0, 0.1, lo_open=True),
+    "smoothing_strain": Real(0.0, 0.1),
+    "critical_window": Real(0.0, 0.5, lo_open=True),
+    "critical_rate_limit": Real(0.0, 1.0, lo_open=True),
+}
+
+
+@dataclass
+class BiaxialSettings:
+    """Settings of a biaxial test (SI units; strains are fractions, compression positive).
+
+    strain_rate (1/s): the top plate moves down at ``strain_rate * H0`` (H0 the specimen's
+    height after consolidation); max_strain: the axial strain where the test ends;
+    record_strain: axial strain between two rows of the curve; consolidation_ratio,
+    consolidation_max_steps and stress_tolerance: when consolidation has ended (the maximum
+    unbalanced-force ratio below the first, every wall's stress within the last of sigma_3);
+    servo_gain, servo_integral, servo_max_speed (m/s): the walls' servo; kn_wall, ks_wall
+    (N/m) and friction_wall of the box (default: Table 1's stiffness and smooth walls, so
+    that the walls carry normal stress only); particle_friction, rolling_friction and
+    local_damping replace the specimen's when given; density_scale >= 1 scales the inertial
+    masses; dt_safety the automatic time step; inertial_limit the largest inertial number
+    a test may run at; smoothing_strain the window (axial strain) over which the stress ratio
+    is averaged before its peak is read; critical_window the last part of the axial strain
+    (a fraction of max_strain) where the critical state is read; critical_rate_limit the
+    largest |d eps_v / d eps_1| over that window for it to count as critical.
+    """
+
+    strain_rate: float = 0.2
+    max_strain: float = 0.20
+    record_strain: float = 0.001
+    consolidation_ratio: float = 1e-3
+    consolidation_max_steps: int = 300_000
+    stress_tolerance: float = 0.02
+    servo_gain: float = 0.3
+    servo_integral: float = 1e-3
+    servo_max_speed: float = 0.05
+    kn_wall: float = TABLE_1.kn_wall
+    ks_wall: float = TABLE_1.ks_wall
+    friction_wall: float = 0.0
+    particle_friction: float | None = None
+    rolling_friction: float | None = None
+    local_damping: float | None = None
+    density_scale: float = 1.0
+    dt_safety: float = 0.8
+    inertial_limit: float = 1e-3
+    smoothing_strain: float = 0.01
+    critical_window: float = 0.25
+    critical_rate_limit: float = 0.1
+
+    def __post_init__(self) -> None:
+        check_fields(self, BIAXIAL_RANGES)
+        if self.record_strain > self.max_strain:
+            raise InputError("record_strain", self.record_strain, f"(0, max_strain = {self.max_strain:g}]")
+        if self.max_strain / self.record_strain > MAX_RECORDS:
+            shortest = self.max_strain / MAX_RECORDS
+            raise InputError(
+                "record_strain", self.record_strain, f"[max_strain / {MAX_RECORDS} = {shortest:.3g}, 0.05]"
+            )
+        if self.critical_window * self.max_strain < 3 * self.record_strain:
+            raise InputError(
+                "critical_window", self.critical_window,
+                f"at least 3 rows of the curve: >= {3 * self.record_strain / self.max_strain:.3g}",
+            )  # fmt: skip
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def inertial_number(strain_rate: float, d50: float, rho: float, pressure_pa: float) -> float:
+    """I = strain_rate * d50 * sqrt(rho / p): how far from quasi-static a test is (below 1e-3: it is).
+
+    ``rho`` the disks' (inertial) density in kg/m3, ``p`` the mean stress in Pa.
+    """
+    if not pressure_pa > 0:
+        return math.inf
+    return strain_rate * d50 * math.sqrt(rho / pressure_pa)
+
+
+__all__ = ["BIAXIAL_RANGES", "CONFINING_RANGE_KPA", "BiaxialSettings", "inertial_number"]

@@ -1,0 +1,127 @@
+"""One biaxial test: the protocol of a :class:`~poro2d.biaxial.case.BiaxialCase`.
+
+1. the specimen in the biaxial box (:func:`poro2d.biaxial.box.build_biaxial_box`): every disk
+   inside, gravity off;
+2. the inertial number of the asked strain rate at sigma_3 checked against ``inertial_limit``
+   (refused above it, before any step);
+3. consolidation (:func:`poro2d.biaxial.stages.consolidate`): plate and side walls servoed to
+   sigma_3 until equilibrium, refused loudly if not reached;
+4. shearing (:class:`poro2d.biaxial.stages.Shearing`) to ``max_strain``;
+5. the angles read off the curve (:func:`poro2d.biaxial.angles.read_angles`).
+
+With a store the test keeps ``curve.csv`` and then ``result.json`` there (each atomic).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict
+
+import numpy as np
+
+from poro2d.biaxial.angles import read_angles
+from poro2d.biaxial.box import BiaxialBox, build_biaxial_box
+from poro2d.biaxial.case import BiaxialCase
+from poro2d.biaxial.curve import CURVE_COLUMNS, BiaxialCurve
+from poro2d.biaxial.parts import ShearChecks
+from poro2d.biaxial.results import BiaxialTestResult
+from poro2d.biaxial.settings import inertial_number
+from poro2d.biaxial.stages import SIDE_START_STRAIN, ProgressFn, Shearing, consolidate
+from poro2d.dem import Simulation
+from poro2d.errors import InputError
+from poro2d.io_utils import Provenance, as_json
+from poro2d.store import Store
+
+
+def median_diameter(radius: np.ndarray) -> float:
+    """d50 (m): the diameter that half the disks' area lies below (the 2D sieve curve's median)."""
+    d = np.sort(2.0 * radius)
+    area = np.cumsum(d**2)
+    return float(np.interp(0.5, area / area[-1], d))
+
+
+class BiaxialTest:
+    """One biaxial test; ``store`` (or None: nothing kept) holds its ``curve.csv`` and ``result.json``."""
+
+    def __init__(
+        self, case: BiaxialCase, store: Store | None = None, *, progress: ProgressFn | None = None,
+        threads: int = 1,
+    ) -> None:  # fmt: skip
+        self.case = case
+        self.store = store
+        self.progress = progress
+        self.threads = threads
+        # known once the box is built (:meth:`build`)
+        self.box: BiaxialBox | None = None
+        self.d50 = math.nan
+        self.rho = math.nan
+        self.i0 = math.nan
+
+    def build(self) -> Simulation:
+        """The specimen in its box, with the test's damping; the inertial number checked."""
+        s = self.case.settings
+        spec = self.case.specimen.simulation(threads=self.threads)
+        sim, self.box = build_biaxial_box(
+            spec, s.kn_wall, s.ks_wall, s.friction_wall, s.particle_friction, s.rolling_friction,
+            s.density_scale, s.dt_safety, self.threads,
+        )  # fmt: skip
+        if s.local_damping is not None:
+            sim.set_local_damping(float(s.local_damping))
+        self.d50 = median_diameter(sim.particles.radius)
+        self.rho = float(np.mean(sim.particles.density)) * sim.density_scale
+        i0 = inertial_number(s.strain_rate, self.d50, self.rho, self.case.confining_kpa * 1e3)
+        if i0 > s.inertial_limit:
+            fastest = s.strain_rate * s.inertial_limit / i0
+            raise InputError(
+                "strain_rate", s.strain_rate, f"(0, {fastest:.3g}] 1/s",
+                f"I = rate d50 sqrt(rho / sigma_3) = {i0:.2e} at {self.case.confining_kpa:g} kPa, above the "
+                f"quasi-static limit {s.inertial_limit:g}",
+            )  # fmt: skip
+        self.i0 = i0
+        return sim
+
+    def run(self) -> BiaxialTestResult:
+        """Consolidate, shear, read the angles; with a store write ``curve.csv``, then ``result.json``."""
+        t0 = time.perf_counter()
+        s = self.case.settings
+        sim = self.build()
+        assert self.box is not None
+        info = consolidate(sim, self.box, self.case.confining_kpa, s, self.progress)
+        rows, velocity = Shearing(sim, self.case.confining_kpa, s, self.d50, self.rho, self.progress).run()
+        curve = BiaxialCurve.of_rows(rows)
+        angles = read_angles(curve, s.smoothing_strain, s.critical_window, s.critical_rate_limit)
+        result = BiaxialTestResult(
+            confining_stress_kpa=self.case.confining_kpa, **asdict(angles),
+            checks=self.checks(curve), consolidation=info, strain_rate_per_s=s.strain_rate,
+            plate_velocity_m_per_s=velocity, d50_m=self.d50, dt_s=sim.dt, local_damping=sim.local_damping,
+            density_scale=sim.density_scale, shear_steps=int(rows[-1]["step"]), records=len(rows),
+            wall_time_s=time.perf_counter() - t0, settings=s.to_dict(), specimen=self.case.specimen.source,
+            specimen_digest=self.case.specimen.digest, provenance=Provenance.now(),
+        )  # fmt: skip
+        stored = BiaxialTestResult.from_dict(as_json(result))
+        stored.curve = curve
+        if self.store is not None:
+            self.store.write_csv("curve.csv", curve.rows(), header=list(CURVE_COLUMNS))
+            self.store.write_result("result.json", stored)
+        return stored
+
+    def checks(self, curve: BiaxialCurve) -> ShearChecks:
+        """sigma_3 held, equilibrium and the inertial number over the shearing stage."""
+        s = self.case.settings
+        later = curve.axial_strain >= SIDE_START_STRAIN
+        err = np.abs(curve.sigma_3_kpa[later] / self.case.confining_kpa - 1.0)
+        max_err = float(err.max()) if err.size else float("nan")
+        mean_err = float(err.mean()) if err.size else float("nan")
+        max_i = float(np.max(curve.inertial_number))
+        return ShearChecks(
+            sigma_3_max_error=max_err, sigma_3_mean_error=mean_err, stress_tolerance=s.stress_tolerance,
+            sigma_3_held=bool(mean_err <= s.stress_tolerance),
+            mean_unbalanced_ratio=float(np.mean(curve.max_unbalanced_ratio)),
+            max_unbalanced_ratio=float(np.max(curve.max_unbalanced_ratio)),
+            inertial_number_at_confining=self.i0, max_inertial_number=max_i, inertial_limit=s.inertial_limit,
+            quasi_static=bool(self.i0 <= s.inertial_limit),
+        )  # fmt: skip
+
+
+__all__ = ["BiaxialTest", "median_diameter"]

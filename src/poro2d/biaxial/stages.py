@@ -1,0 +1,138 @@
+"""The biaxial test's two stages: consolidation to sigma_3 and shearing at constant sigma_3.
+
+Both drive the engine in blocks of steps (:meth:`poro2d.dem.Simulation.run`); between the
+blocks, in Python, only the walls' targets are renewed (a stress times the current contact
+length) and a row is read.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from poro2d.biaxial.box import BiaxialBox, BoxSize
+from poro2d.biaxial.curve import curve_row
+from poro2d.biaxial.parts import BoxRecord, ConsolidationRecord
+from poro2d.biaxial.settings import BiaxialSettings
+from poro2d.dem import Simulation
+from poro2d.measure.coordination import coordination_number
+
+#: ``progress(phase, fraction)``: called between blocks of steps
+ProgressFn = Callable[[str, float], None]
+#: how often (steps) consolidation renews the walls' targets and checks for equilibrium
+CONSOLIDATION_CHECK = 500
+#: the first part of the axial strain, where the side walls only start to follow, left out of
+#: the sigma_3 check
+SIDE_START_STRAIN = 0.01
+
+
+def servo_targets(sim: Simulation, sigma_pa: float, settings: BiaxialSettings, *, top: bool) -> None:
+    """Servo the side walls (and the plate when ``top``) to ``sigma_pa`` over their current contact length."""
+    s = BiaxialBox.size(sim)
+    side = sigma_pa * s.height * s.thickness
+    BiaxialBox.servo(sim, "left", side, settings)
+    BiaxialBox.servo(sim, "right", side, settings)
+    if top:
+        BiaxialBox.servo(sim, "top", sigma_pa * s.width * s.thickness, settings)
+
+
+def stress_errors(sim: Simulation, sigma_pa: float) -> list[float]:
+    """|stress / sigma - 1| of the plate, the left and the right wall."""
+    s1, _, left, right = BiaxialBox.stresses(sim)
+    return [abs(v / sigma_pa - 1.0) for v in (s1, left, right)]
+
+
+def porosity(sim: Simulation) -> float:
+    """The box's porosity: 1 - disk area / box area."""
+    s = BiaxialBox.size(sim)
+    return 1.0 - float(np.sum(np.pi * sim.particles.radius**2)) / (s.width * s.height)
+
+
+def consolidate(
+    sim: Simulation, box: BiaxialBox, confining_kpa: float, settings: BiaxialSettings,
+    progress: ProgressFn | None = None,
+) -> ConsolidationRecord:  # fmt: skip
+    """Servo the plate and the side walls to sigma_3 until equilibrium; refuse loudly if not reached.
+
+    Reached: the maximum unbalanced-force ratio below ``consolidation_ratio`` and every wall's
+    stress within ``stress_tolerance`` of sigma_3, within ``consolidation_max_steps`` steps.
+    """
+    t0 = time.perf_counter()
+    sigma = confining_kpa * 1e3
+    state = {"ratio": math.inf, "err": math.inf}
+
+    def check(sm: Simulation) -> bool:
+        rmax, _ = sm.unbalanced_ratios()
+        err = max(stress_errors(sm, sigma))
+        state.update(ratio=rmax, err=err)
+        if progress is not None:
+            progress("consolidating", min(sm.step_count / settings.consolidation_max_steps, 1.0))
+        if rmax < settings.consolidation_ratio and err < settings.stress_tolerance:
+            return True
+        servo_targets(sm, sigma, settings, top=True)
+        return False
+
+    servo_targets(sim, sigma, settings, top=True)
+    sim.reset_clock()
+    res = sim.run(settings.consolidation_max_steps, every=CONSOLIDATION_CHECK, callback=check)
+    if not (state["ratio"] < settings.consolidation_ratio and state["err"] < settings.stress_tolerance):
+        raise RuntimeError(
+            f"consolidation to sigma_3 = {confining_kpa:g} kPa did not reach equilibrium within "
+            f"{settings.consolidation_max_steps} steps (unbalanced ratio {state['ratio']:.2e}, limit "
+            f"{settings.consolidation_ratio:g}; stress error {state['err']:.2%}, "
+            f"limit {settings.stress_tolerance:.0%})"
+        )
+    s1, _, left, right = BiaxialBox.stresses(sim)
+    size = BiaxialBox.size(sim)
+    return ConsolidationRecord(
+        confining_stress_kpa=confining_kpa, steps=res.steps, max_unbalanced_ratio=state["ratio"],
+        sigma_1_kpa=s1 / 1e3, sigma_3_left_kpa=left / 1e3, sigma_3_right_kpa=right / 1e3,
+        max_stress_error=state["err"], width_m=size.width, height_m=size.height, porosity=porosity(sim),
+        coordination_number=coordination_number(sim), wall_time_s=time.perf_counter() - t0,
+        box=BoxRecord.from_dict(box.to_dict()),
+    )  # fmt: skip
+
+
+@dataclass
+class Shearing:
+    """The plate moves down at ``strain_rate * H0``; the side walls stay servoed at sigma_3.
+
+    One row per ``record_strain`` of axial strain (:func:`poro2d.biaxial.curve.curve_row`)
+    until the axial strain reaches ``max_strain``; the side walls' targets are renewed at
+    every row (sigma_3 over the current height).
+    """
+
+    sim: Simulation
+    confining_kpa: float
+    settings: BiaxialSettings
+    d50: float
+    rho: float
+    progress: ProgressFn | None = None
+
+    def run(self) -> tuple[list[dict], float]:
+        """The curve's rows and the plate's velocity (m/s)."""
+        sim, s = self.sim, self.settings
+        sigma = self.confining_kpa * 1e3
+        start: BoxSize = BiaxialBox.size(sim)
+        velocity = s.strain_rate * start.height
+        sim.set_wall_velocity("top", (0.0, -velocity))
+        servo_targets(sim, sigma, s, top=False)
+        steps_per_row = max(1, round(s.record_strain * start.height / (velocity * sim.dt)))
+        sim.reset_clock()
+        rows = [curve_row(sim, start, 0, self.d50, self.rho, s.strain_rate)]
+        step = 0
+        while rows[-1]["axial_strain"] < s.max_strain:
+            sim.run(steps_per_row)
+            step += steps_per_row
+            servo_targets(sim, sigma, s, top=False)
+            rows.append(curve_row(sim, start, step, self.d50, self.rho, s.strain_rate))
+            if self.progress is not None:
+                self.progress("shearing", min(rows[-1]["axial_strain"] / s.max_strain, 1.0))
+        return rows, velocity
+
+
+__all__ = ["CONSOLIDATION_CHECK", "ProgressFn", "Shearing", "consolidate", "porosity", "servo_targets"]
