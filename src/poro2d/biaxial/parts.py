@@ -8,12 +8,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from poro2d.shear.parts import Nested
 from poro2d.typed_result import TypedResult
 
 
 @dataclass(eq=False)
-class BoxRecord(Nested):
+class BoxRecord(TypedResult):
     """The box as built (m): the specimen's width and height, the disks' thickness."""
 
     width: float
@@ -22,7 +21,7 @@ class BoxRecord(Nested):
 
 
 @dataclass(eq=False)
-class ConsolidationRecord(Nested):
+class ConsolidationRecord(TypedResult):
     """How consolidation to sigma_3 ended: steps, the unbalanced-force ratio and each wall's stress."""
 
     confining_stress_kpa: float
@@ -43,7 +42,7 @@ class ConsolidationRecord(Nested):
 
 
 @dataclass(eq=False)
-class ShearChecks(Nested):
+class ShearChecks(TypedResult):
     """What the shearing stage kept: sigma_3 on target, equilibrium, the inertial number.
 
     ``sigma_3_max_error`` and ``sigma_3_mean_error``: |sigma_3 / target - 1| over the rows
@@ -65,7 +64,7 @@ class ShearChecks(Nested):
 
 
 @dataclass(eq=False)
-class AngleSpread(Nested):
+class AngleSpread(TypedResult):
     """One angle over the replicates (degrees): mean, sd (None for one), min, max and each value."""
 
     mean: float
@@ -88,7 +87,7 @@ class AngleSpread(Nested):
 
 
 @dataclass(eq=False)
-class TestSummary(Nested):
+class TestSummary(TypedResult):
     """One replicate's row of a study's ``result.json``."""
 
     replicate: int
@@ -104,7 +103,7 @@ class TestSummary(Nested):
 
 
 @dataclass(eq=False)
-class LabCurveRecord(Nested):
+class LabCurveRecord(TypedResult):
     """Laboratory curves given with the test (the user's own data): where they came from and what they say."""
 
     source: str
@@ -114,7 +113,7 @@ class LabCurveRecord(Nested):
 
 
 @dataclass(eq=False)
-class Definitions(Nested):
+class Definitions(TypedResult):
     """How each number is read (the text of docs/biaxial.md, kept with the numbers)."""
 
     strains: str

@@ -15,13 +15,12 @@ from poro2d.biaxial.parts import (
     TestSummary,
 )
 from poro2d.io_utils import Provenance
-from poro2d.shear.parts import Nested
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
 @dataclass(eq=False)
-class BiaxialTestResult(Nested):
+class BiaxialTestResult(TypedResult):
     """One biaxial test (a replicate folder's ``result.json``): its angles and how they were obtained.
 
     Angles in degrees, strains as fractions (compression positive), stresses in kPa; the
@@ -80,7 +79,7 @@ class BiaxialTestResult(Nested):
 
 
 @dataclass(eq=False)
-class BiaxialResult(Nested):
+class BiaxialResult(TypedResult):
     """Biaxial tests at one confining stress on replicate specimens (the study's ``result.json``).
 
     ``peak_friction_angle``, ``critical_state_friction_angle`` and ``max_dilatancy_angle``:
