@@ -19,7 +19,7 @@ over the current height.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -48,9 +48,6 @@ class BiaxialBox:
     width: float
     height: float
     thickness: float
-
-    def to_dict(self) -> dict:
-        return asdict(self)
 
     @staticmethod
     def size(sim: Simulation) -> BoxSize:

@@ -20,6 +20,7 @@ import numpy as np
 from poro2d.biaxial.box import BiaxialBox, BoxSize
 from poro2d.dem import Simulation
 from poro2d.store import Store
+from poro2d.typed_result import TypedResult
 
 #: the columns of ``curve.csv``, in order
 CURVE_COLUMNS = (
@@ -84,13 +85,35 @@ class BiaxialCurve(Mapping):
         return [dict(zip(CURVE_COLUMNS, values, strict=True)) for values in zip(*cols, strict=True)]
 
 
+@dataclass(eq=False)
+class CurveRow(TypedResult):
+    """One row of ``curve.csv``, its fields the columns in order (see the module's conventions)."""
+
+    step: int
+    axial_strain: float
+    lateral_strain: float
+    volumetric_strain: float
+    shear_strain: float
+    sigma_1_kpa: float
+    sigma_3_kpa: float
+    sigma_3_left_kpa: float
+    sigma_3_right_kpa: float
+    deviator_kpa: float
+    mean_stress_kpa: float
+    sin_phi: float
+    max_unbalanced_ratio: float
+    inertial_number: float
+
+
 def read_curve(store: Store, name: str = "curve.csv") -> BiaxialCurve | None:
     """The curve kept in ``store`` (None without it)."""
     rows = store.read_rows(name)
     return None if rows is None else BiaxialCurve.of_rows(rows)
 
 
-def curve_row(sim: Simulation, start: BoxSize, step: int, d50: float, rho: float, strain_rate: float) -> dict:
+def curve_row(
+    sim: Simulation, start: BoxSize, step: int, d50: float, rho: float, strain_rate: float
+) -> CurveRow:
     """One row of the curve: the box's strains and stresses now (see the module's conventions)."""
     now = BiaxialBox.size(sim)
     s1, s3, left, right = BiaxialBox.stresses(sim)
@@ -98,22 +121,22 @@ def curve_row(sim: Simulation, start: BoxSize, step: int, d50: float, rho: float
     e3 = math.log(start.width / now.width)
     p = 0.5 * (s1 + s3)
     ratio, _ = sim.unbalanced_ratios()
-    return {
-        "step": step,
-        "axial_strain": e1,
-        "lateral_strain": e3,
-        "volumetric_strain": e1 + e3,
-        "shear_strain": e1 - e3,
-        "sigma_1_kpa": s1 / 1e3,
-        "sigma_3_kpa": s3 / 1e3,
-        "sigma_3_left_kpa": left / 1e3,
-        "sigma_3_right_kpa": right / 1e3,
-        "deviator_kpa": (s1 - s3) / 1e3,
-        "mean_stress_kpa": p / 1e3,
-        "sin_phi": (s1 - s3) / (s1 + s3) if s1 + s3 > 0 else math.nan,
-        "max_unbalanced_ratio": ratio,
-        "inertial_number": strain_rate * d50 * math.sqrt(rho / p) if p > 0 else math.inf,
-    }
+    return CurveRow(
+        step=step,
+        axial_strain=e1,
+        lateral_strain=e3,
+        volumetric_strain=e1 + e3,
+        shear_strain=e1 - e3,
+        sigma_1_kpa=s1 / 1e3,
+        sigma_3_kpa=s3 / 1e3,
+        sigma_3_left_kpa=left / 1e3,
+        sigma_3_right_kpa=right / 1e3,
+        deviator_kpa=(s1 - s3) / 1e3,
+        mean_stress_kpa=p / 1e3,
+        sin_phi=(s1 - s3) / (s1 + s3) if s1 + s3 > 0 else math.nan,
+        max_unbalanced_ratio=ratio,
+        inertial_number=strain_rate * d50 * math.sqrt(rho / p) if p > 0 else math.inf,
+    )
 
 
-__all__ = ["CURVE_COLUMNS", "BiaxialCurve", "curve_row", "read_curve"]
+__all__ = ["CURVE_COLUMNS", "BiaxialCurve", "CurveRow", "curve_row", "read_curve"]

@@ -14,6 +14,7 @@ from poro2d.biaxial.parts import (
     ShearChecks,
     TestSummary,
 )
+from poro2d.biaxial.settings import BiaxialSettingsRecord
 from poro2d.io_utils import Provenance
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
@@ -55,7 +56,7 @@ class BiaxialTestResult(TypedResult):
     shear_steps: int
     records: int
     wall_time_s: float
-    settings: dict[str, Any]
+    settings: BiaxialSettingsRecord
     specimen: str
     specimen_digest: str
     provenance: Provenance
@@ -65,6 +66,7 @@ class BiaxialTestResult(TypedResult):
         "checks": ShearChecks,
         "consolidation": ConsolidationRecord,
         "provenance": Provenance,
+        "settings": BiaxialSettingsRecord,
     }
 
     @classmethod
@@ -100,7 +102,7 @@ class BiaxialResult(TypedResult):
     critical_state_note: str
     summaries: list[TestSummary]
     definitions: Definitions
-    settings: dict[str, Any]
+    settings: BiaxialSettingsRecord
     specimens: list[str]
     processes: int
     wall_time_s: float

@@ -15,6 +15,7 @@ from poro2d.shear.settings import (
     MAX_WALL_STIFFNESS,
     NORMAL_STRESS_RANGE_KPA,
 )
+from poro2d.typed_result import TypedResult
 
 #: the confining stresses (kPa) a test may be run at: the direct shear test's normal stresses,
 #: for the same reasons (a soft contact's overlap above, the specimen's weight below)
@@ -107,8 +108,36 @@ class BiaxialSettings:
                 f"at least 3 rows of the curve: >= {3 * self.record_strain / self.max_strain:.3g}",
             )  # fmt: skip
 
-    def to_dict(self) -> dict:
-        return asdict(self)
+    def record(self) -> BiaxialSettingsRecord:
+        """The settings as a result file keeps them (every setting, in this class's order)."""
+        return BiaxialSettingsRecord(**asdict(self))
+
+
+@dataclass(eq=False)
+class BiaxialSettingsRecord(TypedResult):
+    """:class:`BiaxialSettings` as a result file keeps them (its ``settings``)."""
+
+    strain_rate: float
+    max_strain: float
+    record_strain: float
+    consolidation_ratio: float
+    consolidation_max_steps: int
+    stress_tolerance: float
+    servo_gain: float
+    servo_integral: float
+    servo_max_speed: float
+    kn_wall: float
+    ks_wall: float
+    friction_wall: float
+    particle_friction: float | None
+    rolling_friction: float | None
+    local_damping: float | None
+    density_scale: float
+    dt_safety: float
+    inertial_limit: float
+    smoothing_strain: float
+    critical_window: float
+    critical_rate_limit: float
 
 
 def inertial_number(strain_rate: float, d50: float, rho: float, pressure_pa: float) -> float:
@@ -121,4 +150,10 @@ def inertial_number(strain_rate: float, d50: float, rho: float, pressure_pa: flo
     return strain_rate * d50 * math.sqrt(rho / pressure_pa)
 
 
-__all__ = ["BIAXIAL_RANGES", "CONFINING_RANGE_KPA", "BiaxialSettings", "inertial_number"]
+__all__ = [
+    "BIAXIAL_RANGES",
+    "CONFINING_RANGE_KPA",
+    "BiaxialSettings",
+    "BiaxialSettingsRecord",
+    "inertial_number",
+]

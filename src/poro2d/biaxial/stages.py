@@ -93,7 +93,7 @@ def consolidate(
         sigma_1_kpa=s1 / 1e3, sigma_3_left_kpa=left / 1e3, sigma_3_right_kpa=right / 1e3,
         max_stress_error=state["err"], width_m=size.width, height_m=size.height, porosity=porosity(sim),
         coordination_number=coordination_number(sim), wall_time_s=time.perf_counter() - t0,
-        box=BoxRecord.from_dict(box.to_dict()),
+        box=BoxRecord(box.width, box.height, box.thickness),
     )  # fmt: skip
 
 
