@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from poro2d.console import OutputConsole, Table
+
+if TYPE_CHECKING:
+    from poro2d.shear.results import ShearSeriesResult
 
 console = OutputConsole()
 
@@ -207,7 +211,7 @@ def _sci(v) -> str:
     return "inf" if v is None else f"{v:.2e}"
 
 
-def print_result(result: dict, out: Path) -> None:
+def print_result(result: ShearSeriesResult, out: Path) -> None:
     t = Table(title="direct shear")
     for col in (
         "sigma_n kPa",
@@ -228,12 +232,18 @@ def print_result(result: dict, out: Path) -> None:
             _sci(r["max_inertial_number"]), f"{r['wall_time_s']:.0f}",
         )  # fmt: skip
     console.print(t)
+    scale = result.box_scale
+    label = f"{scale.label()} " if scale is not None and scale.label() else ""
     if result.get("friction_angle_deg") is not None:
         console.print(
-            f"Mohr-Coulomb: phi = {result['friction_angle_deg']:.2f} deg, "
+            f"Mohr-Coulomb: {label}phi = {result['friction_angle_deg']:.2f} deg, "
             f"c = {result['cohesion_kpa']:.2f} kPa, R2 = {result['r2']:.4f}; "
             f"through the origin phi = {result['friction_angle_through_origin_deg']:.2f} deg"
         )
+    if scale is not None:
+        console.print(scale.note())
+        if scale.warning():
+            console.print(f"warning: {scale.warning()}")
     qs = result["quasi_static"]
     console.print(f"max inertial number {qs['max_inertial_number']:.2e} (limit {qs['inertial_limit']:g})")
     rc = result.get("rate_check")

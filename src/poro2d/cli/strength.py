@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from poro2d.console import OutputConsole, Table
+
+if TYPE_CHECKING:
+    from poro2d.shear.results import StrengthResult
 
 console = OutputConsole()
 
@@ -148,8 +152,10 @@ def _deg(mean, sd) -> str:
     return f"{mean:.1f}" + ("" if sd is None else f" +- {sd:.1f}")
 
 
-def print_strength(result: dict, out: Path) -> None:
-    t = Table(title="strength against rolling and particle friction (mean +- sd over specimens)")
+def print_strength(result: StrengthResult, out: Path) -> None:
+    scale = result.box_scale
+    label = f"{scale.label()} " if scale is not None and scale.label() else ""
+    t = Table(title=f"{label}strength against rolling and particle friction (mean +- sd over specimens)")
     for col in ("mu_r", "f_p", "phi peak deg", "phi residual deg", "psi max deg", "tau/sigma residual"):
         t.add_column(col, justify="right")
     for r in result["cases"]:
@@ -161,6 +167,10 @@ def print_strength(result: dict, out: Path) -> None:
             f"{r['residual_stress_ratio_mean']:.3f}",
         )  # fmt: skip
     console.print(t)
+    if scale is not None:
+        console.print(scale.note())
+        if scale.warning():
+            console.print(f"warning: {scale.warning()}")
     console.print(
         f"results in {out}/strength.json, strength.csv, strength_tests.csv; figure fig_strength.png"
     )

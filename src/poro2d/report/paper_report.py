@@ -112,7 +112,9 @@ def _intro_blocks(summary, crit) -> list[Block]:
         phi = shear.get("friction_angle_deg")
         if phi is not None and ci:
             phi = f"{phi:.1f} ({fit['level']:.0%} interval {ci[0]:.1f} to {ci[1]:.1f})"
-        rows.append(["friction angle from peak strengths (deg)", phi, "not stated"])
+        scale = shear.get("box_scale")  # the shear package's BoxScale: box-scale angles are labelled
+        label = f" ({scale.label()})" if scale is not None and scale.label() else ""
+        rows.append([f"friction angle from peak strengths{label} (deg)", phi, "not stated"])
     b.append(("table", ["quantity", "poro2d", "paper"], rows))
     b.append(("note", crit.message if crit.message is not None else "criterion not run"))
     return b
@@ -373,6 +375,9 @@ def _shear_blocks(shear: dict, figures: dict[str, Path]) -> list[Block]:
         b.append(
             ("p", f"Mohr-Coulomb fit of the peaks: friction angle {shear['friction_angle_deg']:.3g} deg.")
         )
+    scale = shear.get("box_scale")
+    if scale is not None:
+        b.append(("note", scale.note() + ("" if scale.warning() is None else f"; {scale.warning()}")))
     for name, cap in SHEAR_FIGURES.items():
         if name in figures:
             b.append(("img", figures[name], cap))

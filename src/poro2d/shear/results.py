@@ -8,6 +8,7 @@ from typing import Any, ClassVar
 
 from poro2d.dem.summary import EngineSummary
 from poro2d.io_utils import Provenance
+from poro2d.shear.box_scale import BoxScale
 from poro2d.shear.curve import ShearCurve, read_curve
 from poro2d.shear.parts import (
     ConsolidationRecord,
@@ -107,7 +108,7 @@ class ShearSeriesResult(TypedResult):
     by normal stress, for figures and summaries made from the result.
     """
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("rate_check", "lab")
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("rate_check", "lab", "box_scale")
 
     normal_stresses_kpa: list[float]
     tests: list[TestSummary]
@@ -130,6 +131,7 @@ class ShearSeriesResult(TypedResult):
     config: dict[str, Any]
     rate_check: RateCheck | None = None
     lab: LabComparison | None = None
+    box_scale: BoxScale | None = None
     wall_time_s: float | None = None
     provenance: Provenance | None = None
     curves: dict[float, ShearCurve] = field(
@@ -143,6 +145,7 @@ class ShearSeriesResult(TypedResult):
         "quasi_static": QuasiStatic,
         "rate_check": RateCheck,
         "lab": LabComparison,
+        "box_scale": BoxScale,
         "settings": ShearSettingsRecord,
         "provenance": Provenance,
     }
@@ -187,7 +190,8 @@ class StrengthResult(TypedResult):
 
     ``cases``: one row per (mu_r, f_p) (the rows of ``strength.csv`` with the pooled fits'
     intervals): peak and residual friction angles and the dilation angle, mean and sd over
-    the specimens; ``definitions``: how each is measured.
+    the specimens; ``definitions``: how each is measured; ``box_scale``: the smallest box of
+    the specimens against ASTM D3080 and the size-insensitive 2D box (its angles are box-scale).
     """
 
     cases: list[StrengthCase]
@@ -200,8 +204,11 @@ class StrengthResult(TypedResult):
     processes: int | None = None
     config: dict[str, Any] | None = None
     provenance: Provenance | None = None
+    box_scale: BoxScale | None = None
 
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("box_scale",)
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "box_scale": BoxScale,
         "cases": StrengthCase,
         "definitions": StrengthDefinitions,
         "settings": ShearSettingsRecord,

@@ -11,6 +11,7 @@ import numpy as np
 
 from poro2d.errors import InputError, check_range
 from poro2d.io_utils import Provenance
+from poro2d.shear.box_scale import box_scale
 from poro2d.shear.case import ShearCase
 from poro2d.shear.fit import mohr_coulomb, smooth
 from poro2d.shear.outputs import (
@@ -175,6 +176,8 @@ class ShearSeries:
             processes=self.processes,
             config=self.config,
         )
+        width, height = self.specimen.box()
+        result.box_scale = box_scale(width, height, self.specimen.arrays["particles.radius"])
         if self.rate_check:
             result.rate_check = self._rate_check(tests, results, sig, fit)
         if self.lab is not None:

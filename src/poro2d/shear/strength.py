@@ -30,6 +30,7 @@ import numpy as np
 
 from poro2d.errors import InputError, check_range
 from poro2d.io_utils import Provenance
+from poro2d.shear.box_scale import box_scale
 from poro2d.shear.case import ShearCase
 from poro2d.shear.fit import mohr_coulomb
 from poro2d.shear.parts import StrengthCase, StrengthDefinitions
@@ -192,6 +193,8 @@ class StrengthStudy:
         base = settings if settings is not None else ShearSettings()
         self.settings = base
         values = check_specimens(specimens, normal_stresses_kpa, base)
+        scales = [box_scale(*v.box(), v.arrays["particles.radius"]) for v in values.values()]
+        self.box_scale = min(scales, key=lambda b: b.width_over_d_max)
         self.store = store
         self.progress = progress
         self.config = config or {}
@@ -235,6 +238,7 @@ class StrengthStudy:
             processes=self.processes,
             config=self.config,
             provenance=Provenance.now(),
+            box_scale=self.box_scale,
         )
         if self.store is not None:
             self._write(self.store, result, tests)
