@@ -24,6 +24,7 @@ from poro2d.criterion.measures import CheckNumbers, Checks, PorosityNumbers, Wal
 from poro2d.criterion.servo import PlateSettle
 from poro2d.io_utils import as_json
 from poro2d.record import Record, Spliced
+from poro2d.typed_result import TypedResult
 
 
 def trial_name(k: int, n: float) -> str:
@@ -178,7 +179,7 @@ DECISION_KEYS = ("condition_met", "failed_check", "accepted", "refused", "reason
 
 
 @dataclass(eq=False)
-class Trial(Record, Mapping):
+class Trial(Record, TypedResult):
     """One trial of Fig. 3, made of its parts; read as the dict of its row (``trial["new_porosity"]``).
 
     ``preparation`` is the prepared specimen's report for a trial run now, None for a trial
@@ -187,7 +188,9 @@ class Trial(Record, Mapping):
 
     ``ROW`` is the row a trial records, its parts in place: the wall forces as prepared and
     after the plate stage under their own keys, ``overfull_m`` only when the box was
-    over-full, ``accepted_at`` only for a trial accepted when the bracket closed.
+    over-full, ``accepted_at`` only for a trial accepted when the bracket closed. A trial is the
+    typed result of its file (``trial.json``), and so a part of the criterion's result; keys of
+    a row read back that it does not model are kept in ``extra``.
     """
 
     ROW = (
@@ -227,8 +230,7 @@ class Trial(Record, Mapping):
     time_prepare_s: float | None = None
     time_plate_s: float | None = None
     preparation: Preparation | None = field(default=None, repr=False)
-    #: keys of a row read back that the record does not model, and the row's key order
-    extra: dict[str, Any] = field(default_factory=dict, repr=False)
+    #: the key order of a row read back
     order: tuple[str, ...] | None = field(default=None, repr=False)
 
     @property
