@@ -27,6 +27,7 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import asdict, dataclass, replace
+from typing import ClassVar
 
 import numpy as np
 
@@ -459,16 +460,22 @@ def _duration(seconds: float) -> str:
     return f"{seconds / 86400:.1f} days"
 
 
-@dataclass
-class LayerReport:
-    layer: int
-    n_particles: int
-    lid_height_m: float
-    placement_scale: float
+@dataclass(eq=False, kw_only=True)
+class Attempt(TypedResult):
+    """One attempt of :func:`equilibrate` (``attempt``: "normal", "second budget", "calm", "normal again").
+
+    Its steps, the three unbalanced-force ratios at its end and the one that decides
+    (``measured_ratio``), the rattler fraction and what ended it (``ended_by``).
+    """
+
+    attempt: str
     steps: int
     max_ratio: float
-    converged: bool
-    attempts: list
+    mean_ratio: float
+    loaded_max_ratio: float
+    measured_ratio: float
+    rattler_fraction: float
+    ended_by: str
 
 
 @dataclass(eq=False, kw_only=True)
@@ -480,6 +487,8 @@ class Equilibration(TypedResult):
     ended it (``ended_by``: ``ratio``, ``settled`` or ``budget``) and every attempt made.
     """
 
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"attempts": Attempt}
+
     converged: bool
     steps: int
     max_ratio: float
@@ -487,7 +496,28 @@ class Equilibration(TypedResult):
     measured_ratio: float
     rattler_fraction: float
     ended_by: str
-    attempts: list[dict]
+    attempts: list[Attempt]
+
+
+@dataclass(eq=False)
+class LayerReport(TypedResult):
+    """One layer of a preparation (a row of its report's ``layers``): its disks, lid, steps and attempts.
+
+    ``band_raised_m``: how far its band was raised above its share of H, only when it was.
+    """
+
+    OPTIONAL = ("band_raised_m",)
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"attempts": Attempt}
+
+    layer: int
+    n_particles: int
+    lid_height_m: float
+    placement_scale: float
+    steps: int
+    max_ratio: float
+    converged: bool
+    attempts: list[Attempt]
+    band_raised_m: float | None = None
 
 
 def equilibrate(
@@ -521,7 +551,7 @@ def equilibrate(
     the total ``steps``, the last ``max_ratio``, ``ended_by`` (``ratio``, ``settled`` or
     ``budget``) and every attempt made (name, steps, ratios, rattler fraction, how it ended).
     """
-    attempts: list[dict] = []
+    attempts: list[Attempt] = []
     drift = spec.settle_drift if settle else None
 
     def attempt(name: str, budget: int) -> bool:
@@ -535,11 +565,11 @@ def equilibrate(
                           callback=test, progress=bar)  # fmt: skip
             calm = test.settled
         ended = "ratio" if res.converged else ("settled" if calm else "budget")
-        attempts.append({
-            "attempt": name, "steps": res.steps, "max_ratio": res.max_ratio, "mean_ratio": res.mean_ratio,
-            "loaded_max_ratio": res.loaded_ratio, "measured_ratio": res.measured_ratio,
-            "rattler_fraction": res.rattler_fraction, "ended_by": ended,
-        })  # fmt: skip
+        attempts.append(Attempt(
+            attempt=name, steps=res.steps, max_ratio=res.max_ratio, mean_ratio=res.mean_ratio,
+            loaded_max_ratio=res.loaded_ratio, measured_ratio=res.measured_ratio,
+            rattler_fraction=res.rattler_fraction, ended_by=ended,
+        ))  # fmt: skip
         return res.converged or calm
 
     ok = attempt("normal", spec.max_steps_per_stage)
@@ -558,12 +588,12 @@ def equilibrate(
     last = attempts[-1]
     return Equilibration(
         converged=ok,
-        steps=sum(a["steps"] for a in attempts),
-        max_ratio=last["max_ratio"],
+        steps=sum(a.steps for a in attempts),
+        max_ratio=last.max_ratio,
         measure=spec.equilibrium,
-        measured_ratio=last["measured_ratio"],
-        rattler_fraction=last["rattler_fraction"],
-        ended_by=last["ended_by"],
+        measured_ratio=last.measured_ratio,
+        rattler_fraction=last.rattler_fraction,
+        ended_by=last.ended_by,
         attempts=attempts,
     )
 
@@ -630,7 +660,7 @@ def prepare_specimen(
     failed = None
     for k, idx in enumerate(_layer_groups(radii, spec.layers)):
         sim, layer, eq = _build_layer(sim, spec, k, idx, radii, tops, rng, progress)
-        layers.append(layer)
+        layers.append(layer.to_dict())
         if not eq.converged:
             failed = (f"layer {k + 1}", eq)
             break
@@ -679,7 +709,7 @@ def _layer_groups(radii: np.ndarray, layers: int) -> list[np.ndarray]:
 
 def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.ndarray, tops: np.ndarray,
                  rng: np.random.Generator,
-                 progress: bool) -> tuple[Simulation, dict, Equilibration]:  # fmt: skip
+                 progress: bool) -> tuple[Simulation, LayerReport, Equilibration]:  # fmt: skip
     """Place layer ``k`` in its band under the lid, grow it to size, bring it to equilibrium.
 
     Returns the simulation (made with the first layer), the layer's report and the result of
@@ -715,11 +745,9 @@ def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.nda
     sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
     eq = equilibrate(sim, spec, f"layer {k + 1}", progress, settle=True)
     steps += eq.steps
-    report = LayerReport(k + 1, len(idx), y_top, plc.scale, steps, eq.max_ratio, eq.converged,
-                         eq.attempts)  # fmt: skip
-    layer = asdict(report)
-    if raised > 0.0:  # recorded only when it happens: the reports of ordinary layers keep their keys
-        layer["band_raised_m"] = raised
+    # band_raised_m recorded only when it happens: the reports of ordinary layers keep their keys
+    layer = LayerReport(k + 1, len(idx), y_top, plc.scale, steps, eq.max_ratio, eq.converged, eq.attempts,
+                        raised if raised > 0.0 else None)  # fmt: skip
     return sim, layer, eq
 
 
