@@ -31,6 +31,7 @@ import numpy as np
 from poro2d import porosity as P
 from poro2d.config import check_number_list
 from poro2d.errors import InputError, check_range
+from poro2d.record import Record
 
 #: the preparation frictions of a calibration, densest first: frictionless preparation gives
 #: the grading's densest state (its layers settle: ``settle_drift`` of density mode), 1.0 the
@@ -237,16 +238,13 @@ class Calibration:
 
 
 @dataclass
-class StateTarget:
-    """The density-controlled target of one laboratory state."""
+class StateTarget(Record):
+    """The density-controlled target of one laboratory state; its row is every field."""
 
     n_lab: float
     relative_density: float
     n2d_target: float
     mu_prep: float
-
-    def to_dict(self) -> dict:
-        return asdict(self)
 
 
 def state_target(n_lab: float, n_max: float, n_min: float, cal: Calibration) -> StateTarget:
