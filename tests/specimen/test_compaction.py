@@ -1,5 +1,7 @@
 """Multilayer compaction: porosity after generation, force balance, bad configs."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -88,7 +90,7 @@ def test_checks_catch_a_falling_or_broken_specimen(loose, tmp_path):
     assert not checks.force_balance and nums.force_balance_error > 0.5
     assert checks.disks_inside_box and checks.all_disks_present
     # a disk missing from the plan, a specimen built for another porosity, a disk through the plate
-    broken = Preparation(dict(rep, planned_count=rep["particle_count"] + 3))
+    broken = Preparation(replace(rep, planned_count=rep.particle_count + 3))
     checks, nums = specimen_checks(
         sim, spec, broken, 0.22 + 2e-3, 0.8 * spec.height, wall_forces(sim), CriterionSettings()
     )

@@ -16,7 +16,7 @@ from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 @dataclass(eq=False)
 class CriterionSettingsRecord(TypedResult):
-    """The criterion's settings as a result keeps them (``CriterionSettings.to_record()``).
+    """The criterion's settings as a result keeps them (``CriterionSettings.to_dict()``).
 
     ``refine_tolerance`` and ``acceptance`` are keys only when set (the plate acceptance is
     left out), as in every file written before they existed: a record is read from that dict

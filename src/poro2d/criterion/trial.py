@@ -24,6 +24,7 @@ from poro2d.criterion.measures import CheckNumbers, Checks, PorosityNumbers, Wal
 from poro2d.criterion.servo import PlateSettle
 from poro2d.io_utils import as_json
 from poro2d.record import Record, Spliced
+from poro2d.specimen.compaction import PreparationReport
 from poro2d.typed_result import TypedResult
 
 
@@ -34,44 +35,44 @@ def trial_name(k: int, n: float) -> str:
 
 @dataclass(frozen=True)
 class Preparation:
-    """A trial's specimen as prepared: its preparation's report (``prepared.json``), read by name.
+    """A trial's specimen as prepared: its preparation's report (``prepared.json``).
 
     ``report`` is the report of :func:`poro2d.specimen.compaction.prepare_specimen` with the
-    trial's seed, time, self weight and wall forces: the file's content, kept whole.
+    trial's seed, time, self weight and wall forces: the file's content, typed.
     """
 
-    report: dict[str, Any]
+    report: PreparationReport
 
     @property
     def particle_count(self) -> int:
-        return self.report["particle_count"]
+        return self.report.particle_count
 
     @property
     def planned_count(self) -> int:
-        return self.report["planned_count"]
+        return self.report.planned_count
 
     @property
     def measured_porosity(self) -> float:
-        return self.report["measured_porosity"]
+        return self.report.measured_porosity
 
     @property
     def converged(self) -> bool:
-        return self.report["converged"]
+        return self.report.converged
 
     @property
     def overfull_m(self) -> float:
         """How far the specimen stood above H (0 unless the layers did not fit below it)."""
-        return float(self.report.get("overfull_m") or 0.0)
+        return float(self.report.overfull_m or 0.0)
 
     @property
     def time_s(self) -> float | None:
-        return self.report.get("time_s")
+        return self.report.time_s
 
     def failure(self, equilibrium: str) -> StageFailure:
         """The stage of a preparation that did not reach equilibrium (``equilibrium``: its measure)."""
         r = self.report
-        return StageFailure(r["failed_stage"], r["failed_max_ratio"], r["failed_steps"],
-                            r.get("failed_ratio", r["failed_max_ratio"]), equilibrium)  # fmt: skip
+        ratio = r.failed_max_ratio if "failed_ratio" not in r else r.failed_ratio
+        return StageFailure(r.failed_stage, r.failed_max_ratio, r.failed_steps, ratio, equilibrium)
 
 
 @dataclass(frozen=True)

@@ -520,6 +520,49 @@ class LayerReport(TypedResult):
     band_raised_m: float | None = None
 
 
+@dataclass(eq=False)
+class PreparationReport(TypedResult):
+    """What a preparation did (:func:`prepare_specimen`), and a criterion trial's ``prepared.json``.
+
+    The counts and porosities of the specimen built, every layer (:class:`LayerReport`), the
+    working-friction stage (``final_stage``, None when a layer failed first), whether it
+    converged and, if not, the stage that failed with its ratios. ``overfull_m`` and
+    ``top_height_m`` only for an over-full box; the trial's seed, time, self weight and wall
+    forces only once the criterion added them (``prepared.json``).
+    """
+
+    OPTIONAL = (
+        "overfull_m", "top_height_m", "seed", "time_s", "weight_n_per_m", "f_top_n_per_m",
+        "f_bottom_n_per_m", "side_friction_up_n_per_m", "f_left_n_per_m", "f_right_n_per_m",
+    )  # fmt: skip
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"layers": LayerReport, "final_stage": Equilibration}
+
+    trial_porosity: float
+    planned_count: int
+    particle_count: int
+    solid_area_m2: float
+    box_porosity: float
+    measured_porosity: float
+    layers: list[LayerReport]
+    final_stage: Equilibration | None
+    converged: bool
+    failed_stage: str | None
+    failed_max_ratio: float | None
+    failed_steps: int | None
+    failed_ratio: float | None
+    equilibrium: str
+    overfull_m: float | None = None
+    top_height_m: float | None = None
+    seed: int | None = None
+    time_s: float | None = None
+    weight_n_per_m: float | None = None
+    f_top_n_per_m: float | None = None
+    f_bottom_n_per_m: float | None = None
+    side_friction_up_n_per_m: float | None = None
+    f_left_n_per_m: float | None = None
+    f_right_n_per_m: float | None = None
+
+
 def equilibrate(
     sim: Simulation, spec: SpecimenSpec, label: str, progress: bool = False, settle: bool = False
 ) -> Equilibration:
@@ -637,7 +680,7 @@ def prepare_specimen(
     porosity: float,
     seed: int,
     progress: bool = False,
-) -> tuple[Simulation, dict]:
+) -> tuple[Simulation, PreparationReport]:
     """Build a specimen at trial ``porosity`` by multilayer compaction.
 
     Returns the simulation (top plate = wall "top" at H) and a report with the
@@ -656,11 +699,11 @@ def prepare_specimen(
     radii = radii[rng.permutation(len(radii))]
     tops = spec.layer_tops()
     sim: Simulation | None = None
-    layers: list[dict] = []
+    layers: list[LayerReport] = []
     failed = None
     for k, idx in enumerate(_layer_groups(radii, spec.layers)):
         sim, layer, eq = _build_layer(sim, spec, k, idx, radii, tops, rng, progress)
-        layers.append(layer.to_dict())
+        layers.append(layer)
         if not eq.converged:
             failed = (f"layer {k + 1}", eq)
             break
@@ -674,28 +717,28 @@ def prepare_specimen(
         if not final.converged:
             failed = ("working friction", final)
     p = sim.particles
-    report = {
-        "trial_porosity": porosity,
-        "planned_count": int(len(radii)),
-        "particle_count": p.n,
-        "solid_area_m2": p.area(),
-        "box_porosity": box_porosity(p.area(), W, H),
-        "measured_porosity": porosity_rect(p.pos, p.radius, 0.0, 0.0, W, H),
-        "layers": layers,
-        "final_stage": None if final is None else final.to_dict(),
-        "converged": failed is None,
-        "failed_stage": None if failed is None else failed[0],
-        "failed_max_ratio": None if failed is None else failed[1].max_ratio,
-        "failed_steps": None if failed is None else failed[1].steps,
-        "failed_ratio": None if failed is None else failed[1].measured_ratio,
-        "equilibrium": spec.equilibrium,
-    }
+    report = PreparationReport(
+        trial_porosity=porosity,
+        planned_count=int(len(radii)),
+        particle_count=p.n,
+        solid_area_m2=p.area(),
+        box_porosity=box_porosity(p.area(), W, H),
+        measured_porosity=porosity_rect(p.pos, p.radius, 0.0, 0.0, W, H),
+        layers=layers,
+        final_stage=final,
+        converged=failed is None,
+        failed_stage=None if failed is None else failed[0],
+        failed_max_ratio=None if failed is None else failed[1].max_ratio,
+        failed_steps=None if failed is None else failed[1].steps,
+        failed_ratio=None if failed is None else failed[1].measured_ratio,
+        equilibrium=spec.equilibrium,
+    )
     lid_y = float(sim.walls.p0[sim.walls.index("top"), 1])
-    if any("band_raised_m" in layer for layer in layers) and lid_y > H:
+    if any(layer.band_raised_m is not None for layer in layers) and lid_y > H:
         # an over-full box: the trial is denser than its layers could be built in H; the top
         # plate stands at lid_y, and the criterion's plate stage measures where it settles
-        report["overfull_m"] = lid_y - H
-        report["top_height_m"] = lid_y
+        report.overfull_m = lid_y - H
+        report.top_height_m = lid_y
     return sim, report
 
 
@@ -815,6 +858,7 @@ def _grow(sim: Simulation, idx: np.ndarray, full: np.ndarray, scale: float, spec
 
 
 __all__ = [
+    "PreparationReport",
     "SettledTest",
     "SizeEstimate",
     "SpecimenSpec",
