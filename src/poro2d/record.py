@@ -15,13 +15,16 @@ hand, a :class:`Record` declares its row in ``ROW`` and one function,
 ``OMITTED`` names the keys left out while their value is the one given (a key recorded only
 when it happens, such as an over-full box's ``overfull_m``). A record whose row has two
 shapes declares both and says which one applies in :meth:`Record.layout`. A value that is a
-record is written as its dict (a nested table, such as a trial's ``checks``).
+record is written as its dict (a nested table, such as a trial's ``checks``), an array as a
+list (a row is written as JSON).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar
+
+import numpy as np
 
 
 @dataclass(frozen=True)
@@ -38,6 +41,13 @@ def _at(obj: Any, path: str) -> Any:
             return None
         obj = getattr(obj, name)
     return obj
+
+
+def _plain(value: Any) -> Any:
+    """A record as its row, an array as a list; anything else as it is."""
+    if isinstance(value, Record):
+        return value.to_dict()
+    return value.tolist() if isinstance(value, np.ndarray) else value
 
 
 def _omitted(value: Any, when: Any) -> bool:
@@ -69,7 +79,7 @@ class Record:
             value = _at(self, path)
             if key in self.OMITTED and _omitted(value, self.OMITTED[key]):
                 continue
-            row[key] = value.to_dict() if isinstance(value, Record) else value
+            row[key] = _plain(value)
         return row
 
 

@@ -24,7 +24,7 @@ the check is the sweep layer's job (:mod:`poro2d.sweep.density`).
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -96,12 +96,16 @@ def isotonic_increasing(y, w=None) -> np.ndarray:
 
 
 @dataclass
-class Calibration:
+class Calibration(Record):
     """mu_prep -> accepted n2D of one grading and box, over seeds.
 
     ``samples[k]`` holds the accepted n2D of every seed at ``mus[k]`` (None where the
-    criterion did not converge; such seeds are left out of the mean and counted).
+    criterion did not converge; such seeds are left out of the mean and counted). Its row
+    has the statistics beside the samples: the means, their spread and fit, the failed
+    seeds and the frictions dropped.
     """
+
+    ROW = ("mus", "samples", "seeds", "mean", "sd", "fitted", "failed", "dropped")
 
     mus: list[float]
     samples: list[list[float | None]]
@@ -226,12 +230,6 @@ class Calibration:
         return float(np.interp(n2d, ys, xs))
 
     # ------------------------------------------------------------------ io
-    def to_dict(self) -> dict:
-        d = asdict(self)
-        d.update(mean=self.mean.tolist(), sd=self.sd.tolist(), fitted=self.fitted.tolist(),
-                 failed=self.failed, dropped=self.dropped)  # fmt: skip
-        return d
-
     @classmethod
     def from_dict(cls, d: dict) -> Calibration:
         return cls(list(d["mus"]), [list(s) for s in d["samples"]], list(d.get("seeds", [])))
