@@ -10,7 +10,9 @@ hand, a :class:`Record` declares its row in ``ROW`` and one function,
 * ``"name"``: the field ``name`` under its own key;
 * ``("key", "path")``: the value at ``path`` (a field, or a part's field: ``"forces.f_top_n_per_m"``)
   under ``key``;
-* ``Spliced("part")``: the part's own row, in place (nothing when the part is None).
+* ``Spliced("part")``: the part's own row, in place (nothing when the part is None);
+* ``Fixed("key", value)``: ``key`` with the same value in every row (a former field's key,
+  still written so that files keep their keys).
 
 ``OMITTED`` names the keys left out while their value is the one given (a key recorded only
 when it happens, such as an over-full box's ``overfull_m``). A record whose row has two
@@ -21,6 +23,7 @@ list (a row is written as JSON).
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, fields
 from typing import Any, ClassVar
 
@@ -32,6 +35,14 @@ class Spliced:
     """A row entry: the part in field ``name`` writes its own keys here (none when it is None)."""
 
     name: str
+
+
+@dataclass(frozen=True)
+class Fixed:
+    """A row entry: ``key`` with ``value`` in every row (each row gets its own copy)."""
+
+    key: str
+    value: Any
 
 
 def _at(obj: Any, path: str) -> Any:
@@ -75,6 +86,9 @@ class Record:
                 if part is not None:
                     row.update(part.to_dict())
                 continue
+            if isinstance(entry, Fixed):
+                row[entry.key] = copy.copy(entry.value)
+                continue
             key, path = (entry, entry) if isinstance(entry, str) else entry
             value = _at(self, path)
             if key in self.OMITTED and _omitted(value, self.OMITTED[key]):
@@ -83,4 +97,4 @@ class Record:
         return row
 
 
-__all__ = ["Record", "Spliced"]
+__all__ = ["Fixed", "Record", "Spliced"]

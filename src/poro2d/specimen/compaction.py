@@ -26,8 +26,8 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import asdict, dataclass, replace
-from typing import ClassVar
+from dataclasses import dataclass, fields, replace
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -40,6 +40,7 @@ from poro2d.grading import MAX_DRAW, GradingCurve, draw_disks
 from poro2d.identity import outside_identity
 from poro2d.measure.porosity import box_porosity, porosity_rect
 from poro2d.paper_data import TABLE_1
+from poro2d.record import Fixed, Record
 from poro2d.specimen.placement import Band, place_disks
 from poro2d.typed_result import TypedResult
 
@@ -104,9 +105,11 @@ SPECIMEN_RANGES: Ranges = {
 
 
 @dataclass
-class SpecimenSpec:
+class SpecimenSpec(Record):
     """Box, material and preparation settings; the disks' and walls' defaults are the paper's
     Table 1 (:data:`poro2d.paper_data.TABLE_1`)."""
+
+    OMITTED: ClassVar[dict[str, Any]] = OMITTED_AT_DEFAULT
 
     width: float = 0.305
     height: float = 0.124
@@ -146,23 +149,17 @@ class SpecimenSpec:
     def __post_init__(self) -> None:
         check_fields(self, SPECIMEN_RANGES)
 
-    def to_dict(self) -> dict:
-        """The specimen's settings as recorded with results.
+    def layout(self) -> tuple:
+        """The specimen's settings as recorded with results (its row, :meth:`~poro2d.record.Record.to_dict`).
 
         ``max_disks`` is left out: it is a guard, not a property of the specimen, so raising
         it does not make a resumable output folder look like another config's. Settings added
         after results were first written (``OMITTED_AT_DEFAULT``) are left out while they hold
-        their default: folders written before them still resume.
+        their default: folders written before them still resume. ``extra`` is the key of a
+        former field that could not be set: always empty, still written so that records and
+        result files keep their keys and earlier folders resume.
         """
-        d = asdict(self)
-        del d["max_disks"]
-        for key, default in OMITTED_AT_DEFAULT.items():
-            if d[key] == default:
-                del d[key]
-        # the key of a former field that could not be set: always empty, still written so
-        # that records and result files keep their keys and earlier folders resume
-        d["extra"] = {}
-        return d
+        return (*(f.name for f in fields(self) if f.name != "max_disks"), Fixed("extra", {}))
 
     @classmethod
     def from_record(cls, record: dict) -> SpecimenSpec:
