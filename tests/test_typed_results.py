@@ -445,8 +445,8 @@ def test_a_criterion_keeps_its_settings_and_specimen_as_records():
     assert isinstance(crit.specimen, SpecimenRecord) and crit.specimen.width == 0.05
     assert crit.specimen.extra == {"extra": {}} and json.dumps(crit.to_dict()) == json.dumps(stored)
     for record, made in (
-        (CriterionSettingsRecord, CriterionSettings(refine_tolerance=0.002).to_record()),
-        (CriterionSettingsRecord, CriterionSettings(acceptance="fill").to_record()),
+        (CriterionSettingsRecord, CriterionSettings(refine_tolerance=0.002).to_dict()),
+        (CriterionSettingsRecord, CriterionSettings(acceptance="fill").to_dict()),
         (SpecimenRecord, SpecimenSpec(width=0.05, height=0.025, rolling_friction=0.1).to_dict()),
         (SpecimenRecord, SpecimenSpec().to_dict()),
     ):

@@ -24,12 +24,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import Any
 
 from poro2d import porosity as P
 from poro2d.config import check_keys
 from poro2d.errors import InputError, check_range, is_number
+from poro2d.record import Record
 
 #: kg/m3, the densities of solids accepted: from light volcanic grains to the densest metal
 #: (osmium, 22 590 kg/m3); 1e300 would give a porosity of 1 and an answer about nothing
@@ -62,13 +63,14 @@ _STATE_ALLOWED = "exactly one of e, n, dr, or dry_density with solid_density"
 
 
 @dataclass(frozen=True)
-class LabState:
+class LabState(Record):
     """One laboratory state: its porosity, void ratio and, with the extremes, Dr.
 
     ``n_max``/``n_min`` are the loosest and densest laboratory porosities (None when no
     extremes were given), ``relative_density`` Dr = (e_max - e) / (e_max - e_min) (None
     without extremes) and ``given`` what the description gave: "e", "n", "Dr" or
-    "dry_density".
+    "dry_density". Its row (:meth:`~poro2d.record.Record.to_dict`) is every field, as JSON takes
+    it (floats, None, one string).
     """
 
     n_lab: float
@@ -77,10 +79,6 @@ class LabState:
     n_min: float | None
     relative_density: float | None
     given: str
-
-    def to_dict(self) -> dict:
-        """Every field, as JSON takes it (floats, None, one string)."""
-        return asdict(self)
 
 
 # ---------------------------------------------------------------------------------------

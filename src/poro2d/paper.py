@@ -12,12 +12,12 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 from poro2d.console import OutputConsole
 from poro2d.criterion.config import paper_config
 from poro2d.criterion.replicates import accepted_and_replicates
-from poro2d.criterion.result import CriterionResult
+from poro2d.criterion.result import CriterionResult, ReplicateRow
 from poro2d.io_utils import Provenance
 from poro2d.locks import holds_output
 from poro2d.paper_data import PAPER, QUICK_SHEAR
@@ -145,7 +145,7 @@ class PaperSummary(TypedResult):
     seed: int
     conversions: ConversionsRecord
     criterion: CriterionResult
-    replicate_specimens: list[dict[str, Any]] | None
+    replicate_specimens: list[ReplicateRow] | None
     shear: PaperShear | None
     paper: PaperFacts
     timings: PaperTimings
@@ -155,6 +155,7 @@ class PaperSummary(TypedResult):
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "conversions": ConversionsRecord,
         "criterion": CriterionResult,
+        "replicate_specimens": ReplicateRow,
         "shear": PaperShear,
         "paper": PaperFacts,
         "timings": PaperTimings,

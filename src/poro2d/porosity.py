@@ -524,19 +524,6 @@ class MethodResult:
     warnings: list[str] = field(default_factory=list)
     details: dict[str, Any] = field(default_factory=dict)
 
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "id": self.id,
-            "name": self.name,
-            "equation": self.equation,
-            "source": self.source,
-            "n2d": self.value,
-            "skipped": self.skipped,
-            "flags": list(self.flags),
-            "warnings": list(self.warnings),
-            "details": dict(self.details),
-        }
-
 
 @dataclass
 class Conversion:
@@ -552,9 +539,6 @@ class Conversion:
     @property
     def warnings(self) -> list[str]:
         return [w for r in self.results.values() for w in r.warnings]
-
-    def values(self) -> dict[str, float | None]:
-        return {k: r.value for k, r in self.results.items()}
 
 
 def _conversion_options(options: dict) -> tuple[str, bool]:

@@ -121,8 +121,8 @@ def test_under_the_lid_the_box_porosity_loses_the_surface_gap(both):
 def test_the_acceptance_mode_is_checked_and_left_out_of_old_records():
     with pytest.raises(InputError, match="acceptance"):
         CriterionSettings(acceptance="flat")
-    assert "acceptance" not in CriterionSettings().to_record()
-    assert CriterionSettings(acceptance="fill").to_record()["acceptance"] == "fill"
+    assert "acceptance" not in CriterionSettings().to_dict()
+    assert CriterionSettings(acceptance="fill").to_dict()["acceptance"] == "fill"
 
 
 def test_a_lid_counts_as_resting_only_while_it_bears_on_most_of_the_width(prepared, tmp_path):

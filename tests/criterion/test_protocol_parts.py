@@ -83,3 +83,15 @@ def test_consolidation_reports_a_specimen_it_could_not_settle(specimen):
     assert done.plate_height_before_m == pytest.approx(box.height)
     ShearDrive(0.01).start(sim)
     assert np.all(sim.walls.vel[[sim.walls.index(n) for n in ("bottom", "lower_lip")], 0] == 0.01)
+
+
+def test_the_settings_row_keeps_the_run_identity():
+    """The settings' row binds a criterion's store (config.json): its digest is the one of earlier folders."""
+    from poro2d.identity import identity_digest
+
+    assert identity_digest(CriterionSettings().to_dict()) == (
+        "37c6ebfbebe4e84a6c301474fc6f0c1e34ebb678bd3ae5afc66bc6b664a32d6d"
+    )
+    assert identity_digest(CriterionSettings(refine_tolerance=0.002, acceptance="fill").to_dict()) == (
+        "56a7bb2a4156296b2f712b22bb3fc7feecc426db64c9ceaa0c3ad5384214de51"
+    )

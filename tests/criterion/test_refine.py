@@ -55,8 +55,8 @@ def test_refine_tolerance_is_checked_and_recorded_only_when_set():
         CriterionSettings(refine_tolerance=0.01)  # above the paper's tolerance 0.005
     with pytest.raises(InputError, match="refine_tolerance"):
         CriterionSettings(refine_tolerance=0.0)
-    assert "refine_tolerance" not in CriterionSettings().to_record()
-    assert CriterionSettings(refine_tolerance=0.002).to_record()["refine_tolerance"] == 0.002
+    assert "refine_tolerance" not in CriterionSettings().to_dict()
+    assert CriterionSettings(refine_tolerance=0.002).to_dict()["refine_tolerance"] == 0.002
     assert CriterionSettings(refine_tolerance=0.002).tolerance == 0.002
     assert CriterionSettings().tolerance == 0.005
 

@@ -1,5 +1,7 @@
 """Multilayer compaction: porosity after generation, force balance, bad configs."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -88,7 +90,7 @@ def test_checks_catch_a_falling_or_broken_specimen(loose, tmp_path):
     assert not checks.force_balance and nums.force_balance_error > 0.5
     assert checks.disks_inside_box and checks.all_disks_present
     # a disk missing from the plan, a specimen built for another porosity, a disk through the plate
-    broken = Preparation(dict(rep, planned_count=rep["particle_count"] + 3))
+    broken = Preparation(replace(rep, planned_count=rep.particle_count + 3))
     checks, nums = specimen_checks(
         sim, spec, broken, 0.22 + 2e-3, 0.8 * spec.height, wall_forces(sim), CriterionSettings()
     )
@@ -179,3 +181,19 @@ def test_bad_configs_fail_before_simulating():
     big = GradingCurve.from_lists([40.0, 80.0], [0, 100])
     with pytest.raises(InputError, match="largest disk"):
         check_feasible(SpecimenSpec(), big, 0.15)
+
+
+def test_the_specimen_row_keeps_the_run_identity():
+    """The specimen's row binds stores and names cases: its digest is the one of earlier folders."""
+    from poro2d.identity import identity_digest
+
+    assert identity_digest(SpecimenSpec().to_dict()) == (
+        "8b4c268a0eb4fc927eec732a9c31e4bbf427a8b286b1e18c59ed3beb98e50959"
+    )
+    changed = SpecimenSpec(equilibrium="mean", settle_drift=0.01, settle_window=5000, settle_checks=4,
+                           rolling_friction=0.1)  # fmt: skip
+    assert identity_digest(changed.to_dict()) == (
+        "f385d7803ab25692d7becd84e32135ea94a9b8a4238cacc3718d46fefa6d8e30"
+    )
+    row, other = SpecimenSpec(max_disks=10**6).to_dict(), SpecimenSpec().to_dict()
+    assert "max_disks" not in row and row["extra"] == {} and row["extra"] is not other["extra"]

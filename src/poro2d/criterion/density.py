@@ -24,13 +24,14 @@ the check is the sweep layer's job (:mod:`poro2d.sweep.density`).
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from poro2d import porosity as P
 from poro2d.config import check_number_list
 from poro2d.errors import InputError, check_range
+from poro2d.record import Record
 
 #: the preparation frictions of a calibration, densest first: frictionless preparation gives
 #: the grading's densest state (its layers settle: ``settle_drift`` of density mode), 1.0 the
@@ -95,12 +96,16 @@ def isotonic_increasing(y, w=None) -> np.ndarray:
 
 
 @dataclass
-class Calibration:
+class Calibration(Record):
     """mu_prep -> accepted n2D of one grading and box, over seeds.
 
     ``samples[k]`` holds the accepted n2D of every seed at ``mus[k]`` (None where the
-    criterion did not converge; such seeds are left out of the mean and counted).
+    criterion did not converge; such seeds are left out of the mean and counted). Its row
+    has the statistics beside the samples: the means, their spread and fit, the failed
+    seeds and the frictions dropped.
     """
+
+    ROW = ("mus", "samples", "seeds", "mean", "sd", "fitted", "failed", "dropped")
 
     mus: list[float]
     samples: list[list[float | None]]
@@ -225,28 +230,19 @@ class Calibration:
         return float(np.interp(n2d, ys, xs))
 
     # ------------------------------------------------------------------ io
-    def to_dict(self) -> dict:
-        d = asdict(self)
-        d.update(mean=self.mean.tolist(), sd=self.sd.tolist(), fitted=self.fitted.tolist(),
-                 failed=self.failed, dropped=self.dropped)  # fmt: skip
-        return d
-
     @classmethod
     def from_dict(cls, d: dict) -> Calibration:
         return cls(list(d["mus"]), [list(s) for s in d["samples"]], list(d.get("seeds", [])))
 
 
 @dataclass
-class StateTarget:
-    """The density-controlled target of one laboratory state."""
+class StateTarget(Record):
+    """The density-controlled target of one laboratory state; its row is every field."""
 
     n_lab: float
     relative_density: float
     n2d_target: float
     mu_prep: float
-
-    def to_dict(self) -> dict:
-        return asdict(self)
 
 
 def state_target(n_lab: float, n_max: float, n_min: float, cal: Calibration) -> StateTarget:

@@ -25,6 +25,7 @@ from poro2d.dem import Simulation
 from poro2d.dem.state import Particles, Walls
 from poro2d.errors import InputError
 from poro2d.measure.surface import lid_height_at
+from poro2d.record import Record
 
 #: wall names of the lid's segments: ``lid0``, ``lid1``, ... from left to right
 LID_PREFIX = "lid"
@@ -232,21 +233,18 @@ def top_height(sim: Simulation, width: float) -> float:
 
 
 @dataclass(frozen=True)
-class LidNumbers:
+class LidNumbers(Record):
     """What a trial's row records of its lid: segments, heights, and the share of the width it rests on."""
+
+    ROW = (
+        ("lid_segments", "segments"), ("lid_height_min_m", "height_min_m"),
+        ("lid_height_max_m", "height_max_m"), ("lid_contact_share", "contact_share"),
+    )  # fmt: skip
 
     segments: int
     height_min_m: float
     height_max_m: float
     contact_share: float
-
-    def to_dict(self) -> dict:
-        return {
-            "lid_segments": self.segments,
-            "lid_height_min_m": self.height_min_m,
-            "lid_height_max_m": self.height_max_m,
-            "lid_contact_share": self.contact_share,
-        }
 
     @classmethod
     def from_row(cls, row: dict) -> LidNumbers | None:

@@ -8,7 +8,7 @@ names; the trial (:mod:`poro2d.criterion.trial`) is made of them.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, fields
+from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING, Any, NamedTuple, Protocol
 
 import numpy as np
@@ -16,6 +16,7 @@ import numpy as np
 from poro2d.criterion.lid import lid_force, lid_indices
 from poro2d.dem import Simulation
 from poro2d.errors import InputError
+from poro2d.record import Record
 
 if TYPE_CHECKING:
     from poro2d.specimen.compaction import SpecimenSpec
@@ -40,14 +41,15 @@ class CheckTolerances(Protocol):
 
 
 @dataclass(frozen=True)
-class WallForces:
+class WallForces(Record):
     """Top, bottom and side wall forces per metre of thickness (N/m).
 
     ``f_top_n_per_m`` is the upward push of the disks on the top plate (and lid),
     ``f_bottom_n_per_m`` the downward push on the bottom wall, ``side_friction_up_n_per_m``
     the upward friction of the side walls on the disks (what the side walls carry of the
     weight); the horizontal pushes on the side walls are None for forces read back from a
-    trial's row, which keeps only the three vertical ones.
+    trial's row, which keeps only the three vertical ones. Its row (:meth:`~poro2d.record.Record.to_dict`)
+    has the five forces under their names: a reader of a specimen's check writes them all.
     """
 
     f_top_n_per_m: Any
@@ -55,10 +57,6 @@ class WallForces:
     side_friction_up_n_per_m: Any
     f_left_n_per_m: Any = None
     f_right_n_per_m: Any = None
-
-    def to_dict(self) -> dict[str, Any]:
-        """The five forces under their keys (a reader of a specimen's check writes them all)."""
-        return asdict(self)
 
     @classmethod
     def from_row(cls, row: dict, suffix: str = "") -> WallForces:
@@ -104,12 +102,17 @@ INTEGRITY_CHECKS = (
 
 
 @dataclass(frozen=True)
-class Checks:
+class Checks(Record):
     """The checks of a trial, passed (True) or failed, in the order of its ``checks`` table.
 
     ``plate_settled`` is the plate stage's (False when it did not settle or never ran); a
-    check a row read back from an older file lacks is None and left out of :meth:`to_dict`.
+    check a row read back from an older file lacks is None and left out of its row.
     """
+
+    OMITTED = dict.fromkeys(
+        ("preparation_converged", "plate_settled", "all_disks_present", "disks_inside_box",
+         "porosity_after_generation", "force_balance")
+    )  # fmt: skip
 
     preparation_converged: bool | None = None
     plate_settled: bool | None = None
@@ -118,9 +121,6 @@ class Checks:
     porosity_after_generation: bool | None = None
     force_balance: bool | None = None
 
-    def to_dict(self) -> dict[str, bool]:
-        return {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) is not None}
-
     @property
     def failed(self) -> str:
         """The first check that failed, or "" when every one passed."""
@@ -128,7 +128,7 @@ class Checks:
 
 
 @dataclass(frozen=True)
-class CheckNumbers:
+class CheckNumbers(Record):
     """The numbers behind the checks (see :func:`specimen_checks`)."""
 
     planned_particle_count: int | None = None
@@ -138,9 +138,6 @@ class CheckNumbers:
     generation_porosity_error: float | None = None
     weight_from_masses_n_per_m: float | None = None
     force_balance_error: float | None = None
-
-    def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
 
     @classmethod
     def from_row(cls, row: dict) -> CheckNumbers:
@@ -227,7 +224,7 @@ POROSITY_KEYS = (
 
 
 @dataclass(frozen=True)
-class PorosityNumbers:
+class PorosityNumbers(Record):
     """A trial's porosities beside the paper's n' (keys :data:`POROSITY_KEYS`).
 
     A specimen too small to measure has only ``box_porosity``, ``interior_porosity = None``
@@ -243,11 +240,11 @@ class PorosityNumbers:
     plate_contact_fraction: Any = None
     interior_porosity_note: str | None = None
 
-    def to_dict(self) -> dict[str, Any]:
-        if self.interior_porosity_note is not None:
-            return {"box_porosity": self.box_porosity, "interior_porosity": self.interior_porosity,
-                    "interior_porosity_note": self.interior_porosity_note}  # fmt: skip
-        return {k: getattr(self, k) for k in POROSITY_KEYS}
+    #: the row of a specimen too small to measure
+    UNMEASURED = ("box_porosity", "interior_porosity", "interior_porosity_note")
+
+    def layout(self) -> tuple:
+        return POROSITY_KEYS if self.interior_porosity_note is None else self.UNMEASURED
 
     @classmethod
     def from_row(cls, row: dict) -> PorosityNumbers | None:

@@ -30,8 +30,8 @@ import logging
 import math
 import time
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass, replace
-from typing import Any, NamedTuple
+from dataclasses import dataclass, replace
+from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 
@@ -65,7 +65,8 @@ from poro2d.measure.disks import mass_d50
 from poro2d.measure.porosity import box_porosity
 from poro2d.measure.surface import lid_height_at
 from poro2d.porosity import PAPER_N_LAB, parabolic
-from poro2d.specimen.compaction import SpecimenSpec, preparation_note, prepare_specimen
+from poro2d.record import Record
+from poro2d.specimen.compaction import PreparationReport, SpecimenSpec, preparation_note, prepare_specimen
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
 
@@ -103,8 +104,15 @@ CRITERION_RANGES: Ranges = {
 
 
 @dataclass
-class CriterionSettings:
-    """Thresholds of Fig. 3 (the paper's values by default) and the plate servo."""
+class CriterionSettings(Record):
+    """Thresholds of Fig. 3 (the paper's values by default) and the plate servo.
+
+    Its row (:meth:`~poro2d.record.Record.to_dict`) is the settings as recorded with results:
+    ``refine_tolerance`` only when set and ``acceptance`` only when not "plate", so folders
+    written before the options existed still resume.
+    """
+
+    OMITTED: ClassVar[dict[str, Any]] = {"refine_tolerance": None, "acceptance": "plate"}
 
     n_lab: float = PAPER_N_LAB
     trial_porosity: float | None = None
@@ -136,19 +144,6 @@ class CriterionSettings:
     def tolerance(self) -> float:
         """|n' - n2D| below this accepts a trial: the paper's 0.005, or ``refine_tolerance``."""
         return self.porosity_tolerance if self.refine_tolerance is None else self.refine_tolerance
-
-    def to_record(self) -> dict:
-        """The settings as recorded with results; ``refine_tolerance`` only when set.
-
-        Left out while unset (and ``acceptance`` while "plate"), so folders written before
-        the options existed still resume.
-        """
-        d = asdict(self)
-        if d["refine_tolerance"] is None:
-            del d["refine_tolerance"]
-        if d["acceptance"] == "plate":
-            del d["acceptance"]
-        return d
 
     def initial_trial(self) -> float:
         """Eq. 12 (n2D = 0.42 nLab^2 + 0.25 nLab), rounded to the resolution, unless given."""
@@ -368,7 +363,7 @@ class PorosityCriterion:
             return self._build(n)
         built: list[Simulation] = []
 
-        def compute() -> dict:
+        def compute() -> PreparationReport:
             sim, prep = self._build(n)
             folder.save_state("prepared.npz", sim, extra={"stage": "prepared", "trial_porosity": n})
             if self.figures:
@@ -379,7 +374,8 @@ class PorosityCriterion:
             return prep.report
 
         report = self.stage().run(compute, f"{trial_name(k, n)}/prepared.json",
-                                  accept=lambda _: folder.has("prepared.npz"))  # fmt: skip
+                                  accept=lambda _: folder.has("prepared.npz"),
+                                  decode=PreparationReport.from_dict)  # fmt: skip
         sim = built[0] if built else folder.load_state("prepared.npz", threads=self.spec.threads)
         return sim, Preparation(report)
 
@@ -389,10 +385,9 @@ class PorosityCriterion:
         # the same seed per trial porosity: a rerun of a trial rebuilds the same specimen
         seed = self.seed * 1_000_003 + int(round(n * 1e6))
         sim, rep = prepare_specimen(self.spec, self.grading, n, seed, progress=self.progress)
-        rep["seed"] = seed
-        rep["time_s"] = time.perf_counter() - t0
-        rep["weight_n_per_m"] = self.spec.self_weight(n)
-        rep.update(wall_forces(sim).to_dict())
+        weight = self.spec.self_weight(n)
+        rep = replace(rep, seed=seed, time_s=time.perf_counter() - t0, weight_n_per_m=weight,
+                      **wall_forces(sim).to_dict())  # fmt: skip
         return sim, Preparation(rep)
 
     def plate_servo(self) -> PlateServo:
@@ -631,7 +626,7 @@ class PorosityCriterion:
                     "percent_passing": self.grading.percent.tolist(),
                     "source": getattr(self.grading, "source", ""),
                 },
-                "criterion": self.settings.to_record(),
+                "criterion": self.settings.to_dict(),
                 "seed": self.seed,
             },
             config=self.config,
@@ -648,7 +643,7 @@ class PorosityCriterion:
             initial_from="given" if self.settings.trial_porosity is not None else "Eq. 12 (parabola)",
             iterations=trials,
             seed=self.seed,
-            settings=CriterionSettingsRecord.from_dict(self.settings.to_record()),
+            settings=CriterionSettingsRecord.from_dict(self.settings.to_dict()),
             specimen=SpecimenRecord.from_dict(self.spec.to_dict()),
             local_damping_note=f"local damping {self.spec.local_damping} (PFC 4.0 default; "
             "the paper does not state it)",

@@ -81,7 +81,7 @@ def accepted_and_replicates(
     store: Store,
     *,
     progress: bool,
-) -> tuple[dict[str, Path], list[dict] | None]:
+) -> tuple[dict[str, Path], list[ReplicateRow] | None]:
     """The specimen ``seed`` accepted in ``store``'s ``criterion`` and, with replicates, the next seeds'.
 
     The replicates are criterion runs from the accepted ``n2d`` in its ``replicates``, one
@@ -95,7 +95,7 @@ def accepted_and_replicates(
     console.print(f"  replicate specimens: seeds {', '.join(map(str, more_seeds))} from n2D = {n2d:.2f}")
     more = run_replicates(spec, grading, settings, n2d, more_seeds, store.child("replicates"),
                           processes=spec.threads, progress=progress)  # fmt: skip
-    return {**specimens, **more.specimens}, [row.to_dict() for row in more.rows]
+    return {**specimens, **more.specimens}, more.rows
 
 
 def _outcome(row: ReplicateRow) -> str:

@@ -2,21 +2,21 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Self
+from typing import Any, ClassVar
 
 from poro2d.criterion.trial import Trial
 from poro2d.io_utils import Provenance
 from poro2d.measure.specimen_porosity import SpecimenPorosity
 from poro2d.measure.specimen_state import SpecimenStateResult
 from poro2d.store import Store
-from poro2d.typed_result import NOT_IN_FILE, TypedResult, part
+from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
 @dataclass(eq=False)
 class CriterionSettingsRecord(TypedResult):
-    """The criterion's settings as a result keeps them (``CriterionSettings.to_record()``).
+    """The criterion's settings as a result keeps them (``CriterionSettings.to_dict()``).
 
     ``refine_tolerance`` and ``acceptance`` are keys only when set (the plate acceptance is
     left out), as in every file written before they existed: a record is read from that dict
@@ -101,6 +101,11 @@ class CriterionResult(TypedResult):
         "box_porosity", "interior_porosity", "interior_porosity_std", "surface_gap_mean_d50",
         "plate_contact_fraction", "preparation_note",
     )  # fmt: skip
+    #: every trial as its row (:class:`~poro2d.criterion.trial.Trial`), the settings and specimen as records
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "iterations": Trial, "settings": CriterionSettingsRecord, "specimen": SpecimenRecord,
+        "provenance": Provenance,
+    }  # fmt: skip
 
     final_porosity: float | None
     converged: bool
@@ -124,30 +129,13 @@ class CriterionResult(TypedResult):
     # a wide grading's equilibrium test and why (poro2d.specimen.compaction.preparation_note)
     preparation_note: str | None = None
 
-    def to_dict(self) -> dict[str, Any]:
-        """The keys of ``result.json``; every trial as its row."""
-        d = super().to_dict()
-        if d.get("iterations") is not None:
-            d["iterations"] = [t.to_dict() if isinstance(t, Trial) else t for t in d["iterations"]]
-        return d
 
-    @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> Self:
-        """A result from ``result.json``; its trials' rows read as :class:`~poro2d.criterion.trial.Trial`."""
-        result = super().from_dict(data)
-        if result.iterations is not None:
-            result.iterations = [Trial.from_dict(row) for row in result.iterations]
-        result.settings = part(CriterionSettingsRecord, result.settings)
-        result.specimen = part(SpecimenRecord, result.specimen)
-        result.provenance = part(Provenance, result.provenance)
-        return result
-
-
-@dataclass(frozen=True)
-class ReplicateRow:
+@dataclass(eq=False)
+class ReplicateRow(TypedResult):
     """One seed's criterion run among replicates: whether it accepted a porosity, in how many trials.
 
-    ``folder``: the seed's sub-store (``seed<N>``); ``time_s``: the run's wall time.
+    ``folder``: the seed's sub-store (``seed<N>``); ``time_s``: the run's wall time. A row of
+    :class:`ReplicatesResult` and of the paper summary's ``replicate_specimens``.
     """
 
     seed: int
@@ -158,9 +146,6 @@ class ReplicateRow:
     folder: str
     time_s: float
 
-    def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
-
 
 @dataclass(eq=False)
 class ReplicatesResult(TypedResult):
@@ -170,28 +155,17 @@ class ReplicatesResult(TypedResult):
     ``store`` (not a key) is the store holding the seeds' sub-stores.
     """
 
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"rows": ReplicateRow}
+
     rows: list[ReplicateRow]
     store: Store | None = field(default=None, kw_only=True, metadata=NOT_IN_FILE)
-
-    def to_dict(self) -> dict[str, Any]:
-        d = super().to_dict()
-        if d.get("rows") is not None:
-            d["rows"] = [r.to_dict() if isinstance(r, ReplicateRow) else r for r in d["rows"]]
-        return d
-
-    @classmethod
-    def from_dict(cls, data: dict[str, Any]) -> Self:
-        result = super().from_dict(data)
-        if result.rows is not None:
-            result.rows = [ReplicateRow(**row) for row in result.rows]
-        return result
 
     def __getitem__(self, key: str) -> Any:
         return self.to_dict()[key]
 
     @property
     def specimens(self) -> dict[str, Path]:
-        """The accepted specimens by label (``seed1``, ...): each seed's ``specimen.npz``."""
+        """The accepted specimens by label (``seed1``, ...), each seed's ``specimen.npz``: keyed paths."""
         assert self.store is not None
         return {f"seed{r.seed}": self.store.child(r.folder).path("specimen.npz") for r in self.rows
                 if r.converged}  # fmt: skip

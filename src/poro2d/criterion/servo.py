@@ -14,17 +14,24 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Protocol
 
 from poro2d.criterion.lid import FlatPlate, SegmentedLid
 from poro2d.dem import Simulation
+from poro2d.record import Record
 
 _log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
-class PlateSettle:
+class PlateSettle(Record):
     """What the plate stage of :meth:`PlateServo.settle` did: the ``plate_*`` keys of a trial's row."""
+
+    ROW = (
+        ("plate_settled", "settled"), ("plate_steps", "steps"), ("plate_rounds", "rounds"),
+        ("plate_final_max_ratio", "final_max_ratio"), ("plate_displacement_m", "displacement_m"),
+        ("plate_height_m", "height_m"),
+    )  # fmt: skip
 
     settled: bool
     steps: int
@@ -32,16 +39,6 @@ class PlateSettle:
     final_max_ratio: float
     displacement_m: float
     height_m: float
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "plate_settled": self.settled,
-            "plate_steps": self.steps,
-            "plate_rounds": self.rounds,
-            "plate_final_max_ratio": self.final_max_ratio,
-            "plate_displacement_m": self.displacement_m,
-            "plate_height_m": self.height_m,
-        }
 
     def then(self, later: PlateSettle) -> PlateSettle:
         """This stage followed by ``later``: one record of both (steps, rounds and moves add up)."""

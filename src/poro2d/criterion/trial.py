@@ -23,6 +23,9 @@ from poro2d.criterion.lid import LidNumbers
 from poro2d.criterion.measures import CheckNumbers, Checks, PorosityNumbers, WallForces
 from poro2d.criterion.servo import PlateSettle
 from poro2d.io_utils import as_json
+from poro2d.record import Record, Spliced
+from poro2d.specimen.compaction import PreparationReport
+from poro2d.typed_result import TypedResult
 
 
 def trial_name(k: int, n: float) -> str:
@@ -32,55 +35,56 @@ def trial_name(k: int, n: float) -> str:
 
 @dataclass(frozen=True)
 class Preparation:
-    """A trial's specimen as prepared: its preparation's report (``prepared.json``), read by name.
+    """A trial's specimen as prepared: its preparation's report (``prepared.json``).
 
     ``report`` is the report of :func:`poro2d.specimen.compaction.prepare_specimen` with the
-    trial's seed, time, self weight and wall forces: the file's content, kept whole.
+    trial's seed, time, self weight and wall forces: the file's content, typed.
     """
 
-    report: dict[str, Any]
+    report: PreparationReport
 
     @property
     def particle_count(self) -> int:
-        return self.report["particle_count"]
+        return self.report.particle_count
 
     @property
     def planned_count(self) -> int:
-        return self.report["planned_count"]
+        return self.report.planned_count
 
     @property
     def measured_porosity(self) -> float:
-        return self.report["measured_porosity"]
+        return self.report.measured_porosity
 
     @property
     def converged(self) -> bool:
-        return self.report["converged"]
+        return self.report.converged
 
     @property
     def overfull_m(self) -> float:
         """How far the specimen stood above H (0 unless the layers did not fit below it)."""
-        return float(self.report.get("overfull_m") or 0.0)
+        return float(self.report.overfull_m or 0.0)
 
     @property
     def time_s(self) -> float | None:
-        return self.report.get("time_s")
+        return self.report.time_s
 
     def failure(self, equilibrium: str) -> StageFailure:
         """The stage of a preparation that did not reach equilibrium (``equilibrium``: its measure)."""
         r = self.report
-        return StageFailure(r["failed_stage"], r["failed_max_ratio"], r["failed_steps"],
-                            r.get("failed_ratio", r["failed_max_ratio"]), equilibrium)  # fmt: skip
-
-    def to_dict(self) -> dict[str, Any]:
-        return self.report
+        ratio = r.failed_max_ratio if "failed_ratio" not in r else r.failed_ratio
+        return StageFailure(r.failed_stage, r.failed_max_ratio, r.failed_steps, ratio, equilibrium)
 
 
 @dataclass(frozen=True)
-class StageFailure:
+class StageFailure(Record):
     """A stage that did not reach equilibrium: the preparation's or the top plate's.
 
-    ``ratio`` and ``equilibrium`` (the ratio measured and its measure) only for the preparation.
+    ``ratio`` and ``equilibrium`` (the ratio measured and its measure) only for the preparation:
+    the top plate's row stops after ``failed_steps``.
     """
+
+    ROW = (("failed_stage", "stage"), ("failed_max_ratio", "max_ratio"), ("failed_steps", "steps"),
+           ("failed_ratio", "ratio"), "equilibrium")  # fmt: skip
 
     stage: Any
     max_ratio: Any
@@ -88,11 +92,8 @@ class StageFailure:
     ratio: Any = None
     equilibrium: Any = None
 
-    def to_dict(self) -> dict[str, Any]:
-        d = {"failed_stage": self.stage, "failed_max_ratio": self.max_ratio, "failed_steps": self.steps}
-        if self.equilibrium is not None:
-            d.update(failed_ratio=self.ratio, equilibrium=self.equilibrium)
-        return d
+    def layout(self) -> tuple:
+        return self.ROW if self.equilibrium is not None else self.ROW[:3]
 
     @classmethod
     def from_row(cls, row: Mapping[str, Any]) -> StageFailure | None:
@@ -103,14 +104,20 @@ class StageFailure:
 
 
 @dataclass(frozen=True)
-class PlateStage:
+class PlateStage(Record):
     """Step 3 of Fig. 3: how the top moved (``moved``: "no", "up", "down", "lid", "not run") and n'.
 
     ``servo``: the servo's record when the plate (or lid) moved; ``settled`` and
     ``displacement_m`` otherwise (a plate already in the window, or a stage not run);
     ``lid`` and ``lid_note``: the lid's numbers and a note on its window, under the fill
-    acceptance.
+    acceptance. The row has two shapes: the servo's keys (``MOVED``), or the plate's
+    displacement and whether it settled (``KEPT``).
     """
+
+    MOVED = (("plate_moved", "moved"), Spliced("servo"), "new_porosity", Spliced("lid"), "lid_note")
+    KEPT = (("plate_moved", "moved"), ("plate_displacement_m", "displacement_m"), "new_porosity",
+            ("plate_settled", "settled"))  # fmt: skip
+    OMITTED = {"plate_settled": None, "lid_note": None}
 
     moved: Any
     new_porosity: Any
@@ -125,20 +132,8 @@ class PlateStage:
         """Whether the stage ended with the plate settled in the window (False when it never ran)."""
         return bool(self.servo.settled if self.servo is not None else self.settled)
 
-    def to_dict(self) -> dict[str, Any]:
-        d: dict[str, Any] = {"plate_moved": self.moved}
-        if self.servo is None:
-            d.update(plate_displacement_m=self.displacement_m, new_porosity=self.new_porosity)
-            if self.settled is not None:
-                d["plate_settled"] = self.settled
-            return d
-        d.update(self.servo.to_dict())
-        d["new_porosity"] = self.new_porosity
-        if self.lid is not None:
-            d.update(self.lid.to_dict())
-        if self.lid_note is not None:
-            d["lid_note"] = self.lid_note
-        return d
+    def layout(self) -> tuple:
+        return self.KEPT if self.servo is None else self.MOVED
 
     @classmethod
     def from_row(cls, row: Mapping[str, Any]) -> PlateStage:
@@ -152,11 +147,17 @@ class PlateStage:
 
 
 @dataclass(frozen=True)
-class Decision:
+class Decision(Record):
     """Accepted, rejected or refused: the paper's condition, the first failed check and why.
 
-    ``accepted_at`` is "closed bracket" for a trial accepted when refinement could go no finer.
+    ``accepted_at`` is "closed bracket" for a trial accepted when refinement could go no finer
+    (the trial writes it last). ``refused`` comes before ``reason`` for a trial that failed no
+    check, after it otherwise (a trial whose stage did not reach equilibrium fails a check:
+    ``preparation_converged`` or ``plate_settled``).
     """
+
+    PASSED = ("condition_met", "failed_check", "accepted", "refused", "reason")
+    FAILED = ("condition_met", "failed_check", "accepted", "reason", "refused")
 
     condition_met: bool
     failed_check: str
@@ -165,15 +166,8 @@ class Decision:
     reason: str
     accepted_at: str | None = None
 
-    def to_dict(self, refused_first: bool) -> dict[str, Any]:
-        """The decision's keys; ``refused`` before ``reason`` for a trial that failed no stage or check."""
-        d: dict[str, Any] = {"condition_met": self.condition_met, "failed_check": self.failed_check,
-                             "accepted": self.accepted}  # fmt: skip
-        if refused_first:
-            d.update(refused=self.refused, reason=self.reason)
-        else:
-            d.update(reason=self.reason, refused=self.refused)
-        return d
+    def layout(self) -> tuple:
+        return self.FAILED if self.failed_check else self.PASSED
 
     @classmethod
     def from_row(cls, row: Mapping[str, Any]) -> Decision:
@@ -186,13 +180,34 @@ DECISION_KEYS = ("condition_met", "failed_check", "accepted", "refused", "reason
 
 
 @dataclass(eq=False)
-class Trial(Mapping):
+class Trial(Record, TypedResult):
     """One trial of Fig. 3, made of its parts; read as the dict of its row (``trial["new_porosity"]``).
 
     ``preparation`` is the prepared specimen's report for a trial run now, None for a trial
     read back from its row (the row keeps what the trial uses of it: counts, porosity,
     whether it converged and how far the box was over-full).
+
+    ``ROW`` is the row a trial records, its parts in place: the wall forces as prepared and
+    after the plate stage under their own keys, ``overfull_m`` only when the box was
+    over-full, ``accepted_at`` only for a trial accepted when the bracket closed. A trial is the
+    typed result of its file (``trial.json``), and so a part of the criterion's result; keys of
+    a row read back that it does not model are kept in ``extra``.
     """
+
+    ROW = (
+        "iteration", "trial_porosity", "particle_count", "planned_particle_count",
+        "measured_porosity_after_generation",
+        ("f_top_n_per_m", "forces.f_top_n_per_m"), ("f_bottom_n_per_m", "forces.f_bottom_n_per_m"),
+        ("side_friction_up_n_per_m", "forces.side_friction_up_n_per_m"),
+        "self_weight_n_per_m", "force_limit_n_per_m", "preparation_converged", "converged", "overfull_m",
+        Spliced("plate"), Spliced("failure"),
+        ("f_top_after_n_per_m", "forces_after.f_top_n_per_m"),
+        ("f_bottom_after_n_per_m", "forces_after.f_bottom_n_per_m"),
+        ("side_friction_up_after_n_per_m", "forces_after.side_friction_up_n_per_m"),
+        "porosity_change", Spliced("check_numbers"), Spliced("porosity"), "checks", Spliced("decision"),
+        "time_prepare_s", "time_plate_s", ("accepted_at", "decision.accepted_at"),
+    )  # fmt: skip
+    OMITTED = {"overfull_m": 0.0, "accepted_at": None}
 
     iteration: int
     trial_porosity: float
@@ -216,8 +231,7 @@ class Trial(Mapping):
     time_prepare_s: float | None = None
     time_plate_s: float | None = None
     preparation: Preparation | None = field(default=None, repr=False)
-    #: keys of a row read back that the record does not model, and the row's key order
-    extra: dict[str, Any] = field(default_factory=dict, repr=False)
+    #: the key order of a row read back
     order: tuple[str, ...] | None = field(default=None, repr=False)
 
     @property
@@ -225,45 +239,9 @@ class Trial(Mapping):
         """n': the porosity of the box after the plate stage (None when it never ran)."""
         return self.plate.new_porosity
 
-    def modelled_row(self) -> dict[str, Any]:
-        """The row's keys in the order the trial records them."""
-        d: dict[str, Any] = {
-            "iteration": self.iteration,
-            "trial_porosity": self.trial_porosity,
-            "particle_count": self.particle_count,
-            "planned_particle_count": self.planned_particle_count,
-            "measured_porosity_after_generation": self.measured_porosity_after_generation,
-            "f_top_n_per_m": self.forces.f_top_n_per_m,
-            "f_bottom_n_per_m": self.forces.f_bottom_n_per_m,
-            "side_friction_up_n_per_m": self.forces.side_friction_up_n_per_m,
-            "self_weight_n_per_m": self.self_weight_n_per_m,
-            "force_limit_n_per_m": self.force_limit_n_per_m,
-            "preparation_converged": self.preparation_converged,
-            "converged": self.converged,
-        }
-        if self.overfull_m > 0.0:  # recorded only when it happens: ordinary rows keep their keys
-            d["overfull_m"] = self.overfull_m
-        d.update(self.plate.to_dict())
-        if self.failure is not None:
-            d.update(self.failure.to_dict())
-        d["f_top_after_n_per_m"] = self.forces_after.f_top_n_per_m
-        d["f_bottom_after_n_per_m"] = self.forces_after.f_bottom_n_per_m
-        d["side_friction_up_after_n_per_m"] = self.forces_after.side_friction_up_n_per_m
-        d["porosity_change"] = self.porosity_change
-        d.update(self.check_numbers.to_dict())
-        if self.porosity is not None:
-            d.update(self.porosity.to_dict())
-        d["checks"] = self.checks.to_dict()
-        d.update(self.decision.to_dict(refused_first=bool(self.converged and not self.decision.failed_check)))
-        d["time_prepare_s"] = self.time_prepare_s
-        d["time_plate_s"] = self.time_plate_s
-        if self.decision.accepted_at is not None:
-            d["accepted_at"] = self.decision.accepted_at
-        return d
-
     def to_dict(self) -> dict[str, Any]:
         """The trial's row as its file holds it (``trial.json``; a trial of ``result.json``)."""
-        row = {**self.modelled_row(), **self.extra}
+        row = {**super().to_dict(), **self.extra}
         if self.order is not None:
             # a row read back keeps its file's keys in their order; of the keys its file lacks,
             # only what a decision taken since set (a closed bracket's acceptance) comes last
@@ -304,7 +282,7 @@ class Trial(Mapping):
             time_prepare_s=row.get("time_prepare_s"),
             time_plate_s=row.get("time_plate_s"),
         )
-        modelled = trial.modelled_row()
+        modelled = Record.to_dict(trial)
         trial.extra = {k: v for k, v in row.items() if k not in modelled}
         checks = row.get("checks")
         if isinstance(checks, Mapping) and list(checks) != list(trial.checks.to_dict()):

@@ -19,7 +19,7 @@ stress that does not grow with depth.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import ClassVar
 
 import numpy as np
 
@@ -27,6 +27,23 @@ from poro2d.errors import check_int
 from poro2d.measure.porosity import porosity_rect
 from poro2d.measure.stress import average_stress
 from poro2d.typed_result import TypedResult
+
+
+@dataclass(eq=False)
+class StateBand(TypedResult):
+    """One horizontal band of a specimen: its heights, porosity, stresses, K0 and the geostatic sigma_v.
+
+    ``k0`` is None where sigma_v is not compressive.
+    """
+
+    z_bottom_m: float
+    z_top_m: float
+    z_mid_m: float
+    porosity: float
+    sigma_v_pa: float
+    sigma_h_pa: float
+    k0: float | None
+    sigma_v_geostatic_pa: float
 
 
 @dataclass(eq=False)
@@ -38,7 +55,9 @@ class SpecimenStateResult(TypedResult):
     of the accepted specimen (None for a state measured outside a criterion run).
     """
 
-    bands: list[dict[str, Any]]
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"bands": StateBand}
+
+    bands: list[StateBand]
     porosity_definition: str
     porosity_mean: float
     porosity_sd: float
@@ -69,7 +88,7 @@ def specimen_state(
     g = -sim.gravity[1]
     rho_s = float(np.mean(p.density)) if p.n else 0.0
     f_top = float(sim.wall_force("top")[1]) / p.thickness  # N/m, upward push on the plate
-    rows = []
+    rows: list[StateBand] = []
     for k in range(bands):
         y0, y1 = edges[k], edges[k + 1]
         s = average_stress(sim, 0.0, y0, width, y1)  # tension positive
@@ -77,20 +96,15 @@ def specimen_state(
         n_above = porosity_rect(p.pos, p.radius, 0.0, zc, width, top)
         geo = f_top / width + rho_s * g * (1.0 - n_above) * (top - zc)
         sv, sh = -float(s[1, 1]), -float(s[0, 0])
-        rows.append({
-            "z_bottom_m": float(y0),
-            "z_top_m": float(y1),
-            "z_mid_m": float(zc),
-            "porosity": porosity_rect(p.pos, p.radius, 0.0, y0, width, y1),
-            "sigma_v_pa": sv,
-            "sigma_h_pa": sh,
-            "k0": sh / sv if sv > 0 else None,
-            "sigma_v_geostatic_pa": geo,
-        })  # fmt: skip
-    por = np.array([r["porosity"] for r in rows])
-    k0 = np.array([r["k0"] for r in rows if r["k0"] is not None])
+        rows.append(StateBand(
+            z_bottom_m=float(y0), z_top_m=float(y1), z_mid_m=float(zc),
+            porosity=porosity_rect(p.pos, p.radius, 0.0, y0, width, y1),
+            sigma_v_pa=sv, sigma_h_pa=sh, k0=sh / sv if sv > 0 else None, sigma_v_geostatic_pa=geo,
+        ))  # fmt: skip
+    por = np.array([r.porosity for r in rows])
+    k0 = np.array([r.k0 for r in rows if r.k0 is not None])
     bottom = rows[0]
-    geo0 = bottom["sigma_v_geostatic_pa"]
+    geo0 = bottom.sigma_v_geostatic_pa
     return SpecimenStateResult(
         bands=rows,
         porosity_definition="disk area clipped to the band / band area",
@@ -99,10 +113,10 @@ def specimen_state(
         porosity_range=float(por.max() - por.min()),
         k0_mean=float(k0.mean()) if k0.size else None,
         k0_sd=float(k0.std(ddof=1)) if k0.size > 1 else None,
-        sigma_v_bottom_over_geostatic=bottom["sigma_v_pa"] / geo0 if geo0 > 0 else None,
+        sigma_v_bottom_over_geostatic=bottom.sigma_v_pa / geo0 if geo0 > 0 else None,
         stress_sign="compression positive; per metre of thickness and of width (Pa)",
         trial_porosity=trial_porosity,
     )
 
 
-__all__ = ["SpecimenStateResult", "band_edges", "specimen_state"]
+__all__ = ["SpecimenStateResult", "StateBand", "band_edges", "specimen_state"]

@@ -402,7 +402,7 @@ def engine_partitions(sim) -> np.ndarray:
 
 
 def engine_pair_order(sim) -> dict[tuple[int, int], int]:
-    """Slot of every disk pair in a simulation's current neighbour list (its sum order)."""
+    """Slot of every disk pair in a simulation's current neighbour list (its sum order), keyed by pair."""
     nb = sim.pairs
     return {(int(a), int(b)): k for k, (a, b) in enumerate(zip(nb.rows(), nb.other[: nb.used], strict=True))}
 

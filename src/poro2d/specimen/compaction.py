@@ -26,7 +26,8 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import asdict, dataclass, replace
+from dataclasses import dataclass, fields, replace
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -39,6 +40,7 @@ from poro2d.grading import MAX_DRAW, GradingCurve, draw_disks
 from poro2d.identity import outside_identity
 from poro2d.measure.porosity import box_porosity, porosity_rect
 from poro2d.paper_data import TABLE_1
+from poro2d.record import Fixed, Record
 from poro2d.specimen.placement import Band, place_disks
 from poro2d.typed_result import TypedResult
 
@@ -103,9 +105,11 @@ SPECIMEN_RANGES: Ranges = {
 
 
 @dataclass
-class SpecimenSpec:
+class SpecimenSpec(Record):
     """Box, material and preparation settings; the disks' and walls' defaults are the paper's
     Table 1 (:data:`poro2d.paper_data.TABLE_1`)."""
+
+    OMITTED: ClassVar[dict[str, Any]] = OMITTED_AT_DEFAULT
 
     width: float = 0.305
     height: float = 0.124
@@ -145,23 +149,17 @@ class SpecimenSpec:
     def __post_init__(self) -> None:
         check_fields(self, SPECIMEN_RANGES)
 
-    def to_dict(self) -> dict:
-        """The specimen's settings as recorded with results.
+    def layout(self) -> tuple:
+        """The specimen's settings as recorded with results (its row, :meth:`~poro2d.record.Record.to_dict`).
 
         ``max_disks`` is left out: it is a guard, not a property of the specimen, so raising
         it does not make a resumable output folder look like another config's. Settings added
         after results were first written (``OMITTED_AT_DEFAULT``) are left out while they hold
-        their default: folders written before them still resume.
+        their default: folders written before them still resume. ``extra`` is the key of a
+        former field that could not be set: always empty, still written so that records and
+        result files keep their keys and earlier folders resume.
         """
-        d = asdict(self)
-        del d["max_disks"]
-        for key, default in OMITTED_AT_DEFAULT.items():
-            if d[key] == default:
-                del d[key]
-        # the key of a former field that could not be set: always empty, still written so
-        # that records and result files keep their keys and earlier folders resume
-        d["extra"] = {}
-        return d
+        return (*(f.name for f in fields(self) if f.name != "max_disks"), Fixed("extra", {}))
 
     @classmethod
     def from_record(cls, record: dict) -> SpecimenSpec:
@@ -459,16 +457,22 @@ def _duration(seconds: float) -> str:
     return f"{seconds / 86400:.1f} days"
 
 
-@dataclass
-class LayerReport:
-    layer: int
-    n_particles: int
-    lid_height_m: float
-    placement_scale: float
+@dataclass(eq=False, kw_only=True)
+class Attempt(TypedResult):
+    """One attempt of :func:`equilibrate` (``attempt``: "normal", "second budget", "calm", "normal again").
+
+    Its steps, the three unbalanced-force ratios at its end and the one that decides
+    (``measured_ratio``), the rattler fraction and what ended it (``ended_by``).
+    """
+
+    attempt: str
     steps: int
     max_ratio: float
-    converged: bool
-    attempts: list
+    mean_ratio: float
+    loaded_max_ratio: float
+    measured_ratio: float
+    rattler_fraction: float
+    ended_by: str
 
 
 @dataclass(eq=False, kw_only=True)
@@ -480,6 +484,8 @@ class Equilibration(TypedResult):
     ended it (``ended_by``: ``ratio``, ``settled`` or ``budget``) and every attempt made.
     """
 
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"attempts": Attempt}
+
     converged: bool
     steps: int
     max_ratio: float
@@ -487,7 +493,71 @@ class Equilibration(TypedResult):
     measured_ratio: float
     rattler_fraction: float
     ended_by: str
-    attempts: list[dict]
+    attempts: list[Attempt]
+
+
+@dataclass(eq=False)
+class LayerReport(TypedResult):
+    """One layer of a preparation (a row of its report's ``layers``): its disks, lid, steps and attempts.
+
+    ``band_raised_m``: how far its band was raised above its share of H, only when it was.
+    """
+
+    OPTIONAL = ("band_raised_m",)
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"attempts": Attempt}
+
+    layer: int
+    n_particles: int
+    lid_height_m: float
+    placement_scale: float
+    steps: int
+    max_ratio: float
+    converged: bool
+    attempts: list[Attempt]
+    band_raised_m: float | None = None
+
+
+@dataclass(eq=False)
+class PreparationReport(TypedResult):
+    """What a preparation did (:func:`prepare_specimen`), and a criterion trial's ``prepared.json``.
+
+    The counts and porosities of the specimen built, every layer (:class:`LayerReport`), the
+    working-friction stage (``final_stage``, None when a layer failed first), whether it
+    converged and, if not, the stage that failed with its ratios. ``overfull_m`` and
+    ``top_height_m`` only for an over-full box; the trial's seed, time, self weight and wall
+    forces only once the criterion added them (``prepared.json``).
+    """
+
+    OPTIONAL = (
+        "overfull_m", "top_height_m", "seed", "time_s", "weight_n_per_m", "f_top_n_per_m",
+        "f_bottom_n_per_m", "side_friction_up_n_per_m", "f_left_n_per_m", "f_right_n_per_m",
+    )  # fmt: skip
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"layers": LayerReport, "final_stage": Equilibration}
+
+    trial_porosity: float
+    planned_count: int
+    particle_count: int
+    solid_area_m2: float
+    box_porosity: float
+    measured_porosity: float
+    layers: list[LayerReport]
+    final_stage: Equilibration | None
+    converged: bool
+    failed_stage: str | None
+    failed_max_ratio: float | None
+    failed_steps: int | None
+    failed_ratio: float | None
+    equilibrium: str
+    overfull_m: float | None = None
+    top_height_m: float | None = None
+    seed: int | None = None
+    time_s: float | None = None
+    weight_n_per_m: float | None = None
+    f_top_n_per_m: float | None = None
+    f_bottom_n_per_m: float | None = None
+    side_friction_up_n_per_m: float | None = None
+    f_left_n_per_m: float | None = None
+    f_right_n_per_m: float | None = None
 
 
 def equilibrate(
@@ -521,7 +591,7 @@ def equilibrate(
     the total ``steps``, the last ``max_ratio``, ``ended_by`` (``ratio``, ``settled`` or
     ``budget``) and every attempt made (name, steps, ratios, rattler fraction, how it ended).
     """
-    attempts: list[dict] = []
+    attempts: list[Attempt] = []
     drift = spec.settle_drift if settle else None
 
     def attempt(name: str, budget: int) -> bool:
@@ -535,11 +605,11 @@ def equilibrate(
                           callback=test, progress=bar)  # fmt: skip
             calm = test.settled
         ended = "ratio" if res.converged else ("settled" if calm else "budget")
-        attempts.append({
-            "attempt": name, "steps": res.steps, "max_ratio": res.max_ratio, "mean_ratio": res.mean_ratio,
-            "loaded_max_ratio": res.loaded_ratio, "measured_ratio": res.measured_ratio,
-            "rattler_fraction": res.rattler_fraction, "ended_by": ended,
-        })  # fmt: skip
+        attempts.append(Attempt(
+            attempt=name, steps=res.steps, max_ratio=res.max_ratio, mean_ratio=res.mean_ratio,
+            loaded_max_ratio=res.loaded_ratio, measured_ratio=res.measured_ratio,
+            rattler_fraction=res.rattler_fraction, ended_by=ended,
+        ))  # fmt: skip
         return res.converged or calm
 
     ok = attempt("normal", spec.max_steps_per_stage)
@@ -558,12 +628,12 @@ def equilibrate(
     last = attempts[-1]
     return Equilibration(
         converged=ok,
-        steps=sum(a["steps"] for a in attempts),
-        max_ratio=last["max_ratio"],
+        steps=sum(a.steps for a in attempts),
+        max_ratio=last.max_ratio,
         measure=spec.equilibrium,
-        measured_ratio=last["measured_ratio"],
-        rattler_fraction=last["rattler_fraction"],
-        ended_by=last["ended_by"],
+        measured_ratio=last.measured_ratio,
+        rattler_fraction=last.rattler_fraction,
+        ended_by=last.ended_by,
         attempts=attempts,
     )
 
@@ -607,7 +677,7 @@ def prepare_specimen(
     porosity: float,
     seed: int,
     progress: bool = False,
-) -> tuple[Simulation, dict]:
+) -> tuple[Simulation, PreparationReport]:
     """Build a specimen at trial ``porosity`` by multilayer compaction.
 
     Returns the simulation (top plate = wall "top" at H) and a report with the
@@ -626,7 +696,7 @@ def prepare_specimen(
     radii = radii[rng.permutation(len(radii))]
     tops = spec.layer_tops()
     sim: Simulation | None = None
-    layers: list[dict] = []
+    layers: list[LayerReport] = []
     failed = None
     for k, idx in enumerate(_layer_groups(radii, spec.layers)):
         sim, layer, eq = _build_layer(sim, spec, k, idx, radii, tops, rng, progress)
@@ -644,28 +714,28 @@ def prepare_specimen(
         if not final.converged:
             failed = ("working friction", final)
     p = sim.particles
-    report = {
-        "trial_porosity": porosity,
-        "planned_count": int(len(radii)),
-        "particle_count": p.n,
-        "solid_area_m2": p.area(),
-        "box_porosity": box_porosity(p.area(), W, H),
-        "measured_porosity": porosity_rect(p.pos, p.radius, 0.0, 0.0, W, H),
-        "layers": layers,
-        "final_stage": None if final is None else final.to_dict(),
-        "converged": failed is None,
-        "failed_stage": None if failed is None else failed[0],
-        "failed_max_ratio": None if failed is None else failed[1].max_ratio,
-        "failed_steps": None if failed is None else failed[1].steps,
-        "failed_ratio": None if failed is None else failed[1].measured_ratio,
-        "equilibrium": spec.equilibrium,
-    }
+    report = PreparationReport(
+        trial_porosity=porosity,
+        planned_count=int(len(radii)),
+        particle_count=p.n,
+        solid_area_m2=p.area(),
+        box_porosity=box_porosity(p.area(), W, H),
+        measured_porosity=porosity_rect(p.pos, p.radius, 0.0, 0.0, W, H),
+        layers=layers,
+        final_stage=final,
+        converged=failed is None,
+        failed_stage=None if failed is None else failed[0],
+        failed_max_ratio=None if failed is None else failed[1].max_ratio,
+        failed_steps=None if failed is None else failed[1].steps,
+        failed_ratio=None if failed is None else failed[1].measured_ratio,
+        equilibrium=spec.equilibrium,
+    )
     lid_y = float(sim.walls.p0[sim.walls.index("top"), 1])
-    if any("band_raised_m" in layer for layer in layers) and lid_y > H:
+    if any(layer.band_raised_m is not None for layer in layers) and lid_y > H:
         # an over-full box: the trial is denser than its layers could be built in H; the top
         # plate stands at lid_y, and the criterion's plate stage measures where it settles
-        report["overfull_m"] = lid_y - H
-        report["top_height_m"] = lid_y
+        report.overfull_m = lid_y - H
+        report.top_height_m = lid_y
     return sim, report
 
 
@@ -679,7 +749,7 @@ def _layer_groups(radii: np.ndarray, layers: int) -> list[np.ndarray]:
 
 def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.ndarray, tops: np.ndarray,
                  rng: np.random.Generator,
-                 progress: bool) -> tuple[Simulation, dict, Equilibration]:  # fmt: skip
+                 progress: bool) -> tuple[Simulation, LayerReport, Equilibration]:  # fmt: skip
     """Place layer ``k`` in its band under the lid, grow it to size, bring it to equilibrium.
 
     Returns the simulation (made with the first layer), the layer's report and the result of
@@ -715,11 +785,9 @@ def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.nda
     sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
     eq = equilibrate(sim, spec, f"layer {k + 1}", progress, settle=True)
     steps += eq.steps
-    report = LayerReport(k + 1, len(idx), y_top, plc.scale, steps, eq.max_ratio, eq.converged,
-                         eq.attempts)  # fmt: skip
-    layer = asdict(report)
-    if raised > 0.0:  # recorded only when it happens: the reports of ordinary layers keep their keys
-        layer["band_raised_m"] = raised
+    # band_raised_m recorded only when it happens: the reports of ordinary layers keep their keys
+    layer = LayerReport(k + 1, len(idx), y_top, plc.scale, steps, eq.max_ratio, eq.converged, eq.attempts,
+                        raised if raised > 0.0 else None)  # fmt: skip
     return sim, layer, eq
 
 
@@ -787,6 +855,7 @@ def _grow(sim: Simulation, idx: np.ndarray, full: np.ndarray, scale: float, spec
 
 
 __all__ = [
+    "PreparationReport",
     "SettledTest",
     "SizeEstimate",
     "SpecimenSpec",
