@@ -1,4 +1,4 @@
-"""The shear box against ASTM D3080's least size and the size-insensitive 2D box: ratios, shortfalls, labels."""
+"""The shear box against ASTM D3080 and the size-insensitive 2D box: ratios, shortfalls, labels."""
 
 import numpy as np
 import pytest

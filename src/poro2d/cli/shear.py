@@ -240,6 +240,16 @@ def print_result(result: ShearSeriesResult, out: Path) -> None:
             f"c = {result['cohesion_kpa']:.2f} kPa, R2 = {result['r2']:.4f}; "
             f"through the origin phi = {result['friction_angle_through_origin_deg']:.2f} deg"
         )
+    on_plane = [t for t in result.tests if t.plane_load_fraction_at_peak is not None]
+    if on_plane:
+        fractions = [t.plane_load_fraction_at_peak for t in on_plane]
+        ratios = [t.peak_stress_ratio / t.plane_load_fraction_at_peak for t in on_plane]
+        console.print(
+            f"the shear plane carries {100 * min(fractions):.0f}-{100 * max(fractions):.0f} % of the plate's "
+            f"normal stress at the peaks (side wall friction: below 100 % it holds load up, above it drags "
+            f"a dilating upper half down; lab boxes 65-85 %): peak tau/sigma on the plane "
+            f"{min(ratios):.3f}-{max(ratios):.3f}"
+        )
     if scale is not None:
         console.print(scale.note())
         if scale.warning():

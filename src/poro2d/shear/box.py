@@ -39,6 +39,8 @@ from poro2d.specimen.box import box_faces
 
 LOWER = ("bottom", "lower_left", "lower_right", "lower_lip")
 UPPER = ("upper_left", "upper_right", "upper_lip", "top")
+#: the upper half's side walls: their friction holds up part of the plate's load
+UPPER_SIDE_WALLS = ("upper_left", "upper_right")
 
 
 class PlaneForce(NamedTuple):

@@ -16,7 +16,7 @@ import numpy as np
 
 from poro2d.dem import Simulation
 from poro2d.dem.contacts import ContactSet
-from poro2d.shear.box import SplitBox
+from poro2d.shear.box import UPPER_SIDE_WALLS, SplitBox
 from poro2d.shear.fit import peak, smooth
 from poro2d.shear.parts import EndValues, ForceBalance
 from poro2d.shear.settings import ShearSettings, inertial_number
@@ -27,7 +27,10 @@ CURVE_COLUMNS = [
     "step", "shear_displacement_mm", "shear_stress_kpa", "normal_stress_kpa", "plate_displacement_mm",
     "coordination_number", "lower_half_stress_kpa", "plane_stress_kpa", "upper_unbalanced_kpa",
     "plate_friction_kpa", "contacts_across_plane", "max_unbalanced_ratio", "inertial_number",
+    "plane_normal_stress_kpa", "upper_wall_friction_kpa",
 ]  # fmt: skip
+#: columns a curve of an earlier poro2d lacks: read back as NaN
+LATER_COLUMNS = ("plane_normal_stress_kpa", "upper_wall_friction_kpa")
 
 
 @dataclass(frozen=True, eq=False)
@@ -51,6 +54,8 @@ class ShearCurve(Mapping):
     contacts_across_plane: np.ndarray
     max_unbalanced_ratio: np.ndarray
     inertial_number: np.ndarray
+    plane_normal_stress_kpa: np.ndarray
+    upper_wall_friction_kpa: np.ndarray
 
     def __getitem__(self, name: str) -> np.ndarray:
         if name not in CURVE_COLUMNS:
@@ -71,6 +76,10 @@ class CurveRow(TypedResult):
     The stresses are over the nominal area ``W t``: the force on the upper half (``shear_stress_kpa``),
     on the lower half, across the shear plane and the upper disks' unbalanced part, the plate's
     push and its friction; displacements in mm, ``step`` counted from the start of shearing.
+    ``plane_normal_stress_kpa`` is the vertical force the lower body exerts on the upper one
+    across the shear plane (the normal stress the plane carries; compression positive), and
+    ``upper_wall_friction_kpa`` the upward friction of the upper side walls on the disks:
+    part of the plate's load that never reaches the plane (NaN in a curve of an earlier poro2d).
     """
 
     step: int
@@ -86,6 +95,8 @@ class CurveRow(TypedResult):
     contacts_across_plane: int
     max_unbalanced_ratio: float
     inertial_number: float
+    plane_normal_stress_kpa: float = math.nan
+    upper_wall_friction_kpa: float = math.nan
 
 
 def curve_columns(rows: list[Mapping]) -> ShearCurve | None:
@@ -96,7 +107,11 @@ def curve_columns(rows: list[Mapping]) -> ShearCurve | None:
     """
     if not rows:
         return None
-    return ShearCurve(**{k: np.array([float(r[k]) for r in rows]) for k in CURVE_COLUMNS})
+
+    def value(row: Mapping, k: str) -> float:
+        return float(row.get(k, math.nan)) if k in LATER_COLUMNS else float(row[k])
+
+    return ShearCurve(**{k: np.array([value(r, k) for r in rows]) for k in CURVE_COLUMNS})
 
 
 def curve_rows(curve: Mapping[str, np.ndarray]) -> list[dict]:
@@ -144,6 +159,8 @@ def curve_row(
         contacts_across_plane=pl.contacts_across,
         max_unbalanced_ratio=sim.unbalanced_ratios()[0],
         inertial_number=inertial_number(settings.velocity, sigma, rho, settings.shear_zone_factor),
+        plane_normal_stress_kpa=pl.across[1] / area / 1e3,
+        upper_wall_friction_kpa=-sum(sim.wall_force(w)[1] for w in UPPER_SIDE_WALLS) / area / 1e3,
     )
 
 
@@ -203,6 +220,7 @@ class CurveSummary:
     normal_stress_max_error_after_consolidation: float
     normal_stress_mean_error: float
     force_balance: ForceBalance
+    plane_load_fraction_at_peak: float
 
 
 def curve_summary(rows: list[CurveRow], sigma_kpa: float, settings: ShearSettings) -> CurveSummary:
@@ -233,7 +251,20 @@ def curve_summary(rows: list[CurveRow], sigma_kpa: float, settings: ShearSetting
         normal_stress_max_error_after_consolidation=float(np.max(sig_err)),
         normal_stress_mean_error=float(np.mean(sig_err)),
         force_balance=force_balance(x, col, s.peak_window),
+        plane_load_fraction_at_peak=plane_load_fraction(x, col, k, s.peak_window),
     )
+
+
+def plane_load_fraction(x: np.ndarray, col: Mapping[str, np.ndarray], k: int, window: float) -> float:
+    """The part of the plate's normal stress the shear plane carries at the peak (record ``k``), smoothed.
+
+    Below 1 when the upper side walls hold part of the load up by friction (laboratory boxes:
+    0.65-0.85, Amsiejus et al. 2014); above 1 by the weight of the upper disks. NaN for a curve
+    of an earlier poro2d, which did not record the plane's normal force.
+    """
+    plane = smooth(x, col["plane_normal_stress_kpa"], window)[k]
+    plate = smooth(x, col["normal_stress_kpa"], window)[k]
+    return float(plane / plate) if plate > 0 and math.isfinite(plane) else math.nan
 
 
 __all__ = [

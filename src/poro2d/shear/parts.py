@@ -167,7 +167,9 @@ class TestSummary(TypedResult):
     wall_time_s: float
     consolidation_normal_stress_error: float
     folder: str
+    plane_load_fraction_at_peak: float | None = None
 
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("plane_load_fraction_at_peak",)
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "end": EndValues,
         "force_balance": ForceBalance,

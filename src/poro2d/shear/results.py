@@ -71,8 +71,12 @@ class ShearTestResult(TypedResult):
     specimen: str
     engine: EngineSummary
     provenance: Provenance
+    # the part of the plate's load the shear plane carries at the peak (absent in a test of an
+    # earlier poro2d): see poro2d.shear.curve.plane_load_fraction
+    plane_load_fraction_at_peak: float | None = None
     curve: ShearCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("plane_load_fraction_at_peak",)
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "end": EndValues,
         "force_balance": ForceBalance,

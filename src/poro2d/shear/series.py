@@ -201,6 +201,7 @@ class ShearSeries:
             **{k: t.get(k) if k == "ended_by" else t[k] for k in SUMMARY_KEYS},
             consolidation_normal_stress_error=t.consolidation["normal_stress_error"],
             folder=folder_name(t.normal_stress_kpa),
+            plane_load_fraction_at_peak=t.plane_load_fraction_at_peak,
         )
 
     def _quasi_static(self, tests: list[ShearTestResult]) -> QuasiStatic:
