@@ -77,12 +77,19 @@ class FrictionFlags(TypedResult):
 
 @dataclass(eq=False)
 class SurrogateRecord(TypedResult):
-    """One observable's quadratic surrogate as a file keeps it (``Surrogate.to_dict()``)."""
+    """One observable's quadratic surrogate as a file keeps it."""
 
     coefficients: list[float]
     seed_scatter_kpa: float
     surrogate_residual_kpa: float
     replicates: int
+
+    @classmethod
+    def of(cls, surrogate: model.Surrogate) -> SurrogateRecord:
+        """The record of a fitted surrogate (its coefficients as a list)."""
+        return cls(
+            surrogate.coefficients.tolist(), surrogate.scatter, surrogate.residual, surrogate.replicates
+        )
 
 
 @dataclass(eq=False)
@@ -123,22 +130,11 @@ class PosteriorSummary(TypedResult):
     observables: list[FittedObservable]
     noise_correlation: list[list[float]]
 
-    def to_dict(self) -> dict[str, Any]:
-        out = super().to_dict()
-        if self.observables is not None:
-            out["observables"] = [o.to_dict() if isinstance(o, TypedResult) else o for o in self.observables]
-        return out
-
-    @classmethod
-    def from_dict(cls, data) -> PosteriorSummary:
-        obj = super().from_dict(data)
-        if isinstance(obj.observables, list):
-            obj.observables = [
-                FittedObservable.from_dict(o) if isinstance(o, dict) else o for o in obj.observables
-            ]
-        obj.median = part(FrictionValues, obj.median)
-        obj.wide = part(FrictionFlags, obj.wide)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "median": FrictionValues,
+        "wide": FrictionFlags,
+        "observables": FittedObservable,
+    }
 
 
 @dataclass(eq=False)
@@ -223,9 +219,11 @@ def check_range_pair(name: str, value, lo: float, hi: float, lo_open: bool = Fal
     return float(a), float(b)
 
 
-def _base_settings(settings: dict | None) -> dict:
+def _base_settings(settings: dict | None) -> ShearSettings:
     """The shear settings of every test (frictions apart); ``stop_after_peak`` 0 by default so
-    that every test ends at ``max_displacement``, where the end stress is compared."""
+    that every test ends at ``max_displacement``, where the end stress is compared.
+
+    ``settings``: the caller's table of shear settings (a command's options), read once here."""
     given = dict(settings or {})
     if not isinstance(settings, dict | None):
         raise InputError("settings", type(settings).__name__, "a dict of shear settings or None")
@@ -235,17 +233,17 @@ def _base_settings(settings: dict | None) -> dict:
     given.setdefault("stop_after_peak", 0.0)
     from poro2d.config import dataclass_from_table
 
-    return dataclass_from_table(ShearSettings, "settings", given).to_dict()
+    return dataclass_from_table(ShearSettings, "settings", given)
 
 
-def _lab_targets(lab: LabData, base: dict) -> list[tuple[str, float, float]]:
+def _lab_targets(lab: LabData, base: ShearSettings) -> list[tuple[str, float, float]]:
     """(observable, normal stress, laboratory value) fitted: every peak, and with curves the end stress.
 
     The end stress of a laboratory curve is its mean over the last peak window before the
     tests' ``max_displacement`` (the simulated end value is smoothed over the same window).
     """
     targets = [("peak", s, lab.peaks[s]) for s in lab.normal_stresses()]
-    end, window = base["max_displacement"], base["peak_window"]
+    end, window = base.max_displacement, base.peak_window
     for s in lab.normal_stresses() if lab.curves else []:
         d, t = lab.curves[s]
         if d[-1] < end:
@@ -509,13 +507,15 @@ def _result(
         ),
         evaluations=table,
         fit={
-            f"{obs}_{s:g}kPa": SurrogateRecord.from_dict(sg.to_dict())
+            f"{obs}_{s:g}kPa": SurrogateRecord(
+                sg.coefficients.tolist(), sg.scatter, sg.residual, sg.replicates
+            )
             for (obs, s, _), sg in zip(targets, surrogates, strict=True)
         },
         lab=LabRecord.from_dict(lab_data.to_dict()),
         specimens={k: str(v) for k, v in found.items()},
-        ranges=FrictionBounds.from_dict(ranges.to_dict()),
-        settings=ShearSettingsRecord.from_dict(base),
+        ranges=FrictionBounds(list(ranges.fp), list(ranges.mu_r)),
+        settings=ShearSettingsRecord.from_dict(base.to_dict()),
         cluster=runner.info(),
         failures=runner.failures,
         timings=CalibrationTimings(wall_time_s=time.perf_counter() - t0),
