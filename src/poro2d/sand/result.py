@@ -295,7 +295,7 @@ class SandResult(TypedResult):
             seed_results=list(kept),
             preflight=PreflightRecord.from_dict(pf.to_dict()),
             wall_seconds=seconds,
-            config=case.config,
+            config=case.config.as_config(),
             provenance=Provenance.now(),
             specimens=list(kept),
         )

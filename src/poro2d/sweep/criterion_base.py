@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from poro2d.criterion.config import build
 from poro2d.sweep.cases import SweepConfig, axes_of, make_sweep
 
 #: tables of a config that describe a study, not the criterion cases it runs
@@ -59,8 +60,12 @@ class CriterionBase:
         return replace(self, config={k: v for k, v in self.config.items() if k not in names})
 
     def as_config(self) -> dict[str, Any]:
-        """The config as a plain dict (a deep copy: a record or a case may keep it)."""
+        """The config as the files record it, its tables as given (a deep copy: a record may keep it)."""
         return copy.deepcopy(dict(self.config))
+
+    def build(self, **overrides):
+        """(SpecimenSpec, GradingCurve, CriterionSettings, seed) of this config, every value checked."""
+        return build(self.as_config(), self.base_dir, **overrides)
 
     def sweep(self, table: Mapping[str, Any], cases: list[dict[str, Any]]) -> SweepConfig:
         """The sweep of criterion ``cases`` (dotted parameters) on this base.
