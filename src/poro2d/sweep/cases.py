@@ -25,7 +25,8 @@ itself (the relation, the calibration) hands :func:`make_sweep` its base config 
 parameters of every case. A :class:`Case` is a value: its id is the digest of its kind
 and merged config, fixed when it is made.
 
-A case kind is a callable ``run(config, store) -> dict of scalars`` (``store``: the case's
+A case kind is a callable ``run(config, store)`` that returns the case's table cells, a
+dict of scalars or a typed record of them (``store``: the case's
 :class:`~poro2d.store.Store`, where it keeps what it writes); it is
 registered in :data:`KINDS` (and optionally a ``validate(config, base_dir)`` in
 :data:`VALIDATORS`, run before anything is submitted, that raises
@@ -46,12 +47,13 @@ from typing import TYPE_CHECKING, Any
 from poro2d.config import check_finite, check_keys
 from poro2d.errors import InputError
 from poro2d.identity import identity_digest
+from poro2d.sweep.records import CriterionCaseResults
 
 if TYPE_CHECKING:
     from poro2d.store import Store
 
-#: kind -> run(config, store) -> dict of scalar results
-KINDS: dict[str, Callable[[dict, Store], dict]] = {}
+#: kind -> run(config, store) -> the case's scalar results (a dict or a typed record)
+KINDS: dict[str, Callable[[dict, Store], Mapping[str, Any]]] = {}
 #: kind -> validate(config, base_dir); raises InputError before any case runs
 VALIDATORS: dict[str, Callable[[dict, Path | None], None]] = {}
 #: tables whose dataclass field names may be used without the table prefix
@@ -67,7 +69,7 @@ CASE_TABLES = {"specimen", "grading", "criterion", "shear"}
 
 def register_kind(
     name: str,
-    run: Callable[[dict, Store], dict],
+    run: Callable[[dict, Store], Mapping[str, Any]],
     validate: Callable[[dict, Path | None], None] | None = None,
     tables: tuple[str, ...] = (),
 ) -> None:
@@ -97,10 +99,10 @@ def validate_criterion(config: dict, base_dir: Path | None = None) -> None:
     criterion_objects(config, base_dir)
 
 
-def criterion_case(config: dict, store: Store) -> dict:
+def criterion_case(config: dict, store: Store) -> CriterionCaseResults:
     """The criterion of Fig. 3 for one case; scalars of its result, of its first and of its accepted trial.
 
-    The dict is the case's row of table cells (the kind's contract with the runner).
+    ``config``: the case's merged config as its ``params.json`` records it.
     """
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.store import Store
@@ -110,43 +112,7 @@ def criterion_case(config: dict, store: Store) -> dict:
     figures = bool(config.get("sweep_options", {}).get("figures", False))
     crit = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(out_dir), progress=False,
                              config=config, figures=figures)  # fmt: skip
-    res = crit.run()
-    first = res["iterations"][0] if res["iterations"] else {}
-    # the accepted trial (not always the last: see poro2d.criterion.protocol.closed_bracket), else the last
-    its = res["iterations"]
-    last = next((r for r in its if r.get("accepted")), its[-1] if its else {})
-    return {
-        "n_lab": res["n_lab"],
-        "final_porosity": res["final_porosity"],
-        "converged": bool(res["converged"]),
-        "iterations": len(res["iterations"]),
-        "message": res["message"],
-        "initial_trial_porosity": res["initial_trial_porosity"],
-        "last_trial_porosity": last.get("trial_porosity"),
-        "last_new_porosity": last.get("new_porosity"),
-        "particle_count": last.get("particle_count"),
-        "plate_moved": last.get("plate_moved"),
-        "f_top_n_per_m": last.get("f_top_n_per_m"),
-        "f_bottom_n_per_m": last.get("f_bottom_n_per_m"),
-        "f_top_after_n_per_m": last.get("f_top_after_n_per_m"),
-        "f_bottom_after_n_per_m": last.get("f_bottom_after_n_per_m"),
-        "self_weight_n_per_m": last.get("self_weight_n_per_m"),
-        # the first trial (Eq. 12 unless given): the paper reports its forces too (its Fig. 5)
-        "first_trial_porosity": first.get("trial_porosity"),
-        "first_particle_count": first.get("particle_count"),
-        "first_f_top_n_per_m": first.get("f_top_n_per_m"),
-        "first_f_bottom_n_per_m": first.get("f_bottom_n_per_m"),
-        "first_self_weight_n_per_m": first.get("self_weight_n_per_m"),
-        "first_plate_moved": first.get("plate_moved"),
-        "first_new_porosity": first.get("new_porosity"),
-        "criterion_time_s": res.get("time_total_s"),
-        # the accepted specimen's own porosity beside the paper's box porosity n'
-        "box_porosity": res.get("box_porosity"),
-        "interior_porosity": res.get("interior_porosity"),
-        "interior_porosity_std": res.get("interior_porosity_std"),
-        "surface_gap_mean_d50": res.get("surface_gap_mean_d50"),
-        "plate_contact_fraction": res.get("plate_contact_fraction"),
-    }
+    return CriterionCaseResults.of(crit.run())
 
 
 def _register_builtin() -> None:

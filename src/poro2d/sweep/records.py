@@ -42,6 +42,82 @@ class CaseRow(TypedResult):
 
 
 @dataclass(eq=False)
+class CriterionCaseResults(TypedResult):
+    """The table cells of a criterion case (``results`` of its row): the run's answer, then the
+    accepted trial (else the last), then the first trial (the paper reports its forces too, its
+    Fig. 5), then the accepted specimen's own porosity beside the paper's box porosity n'."""
+
+    n_lab: float
+    final_porosity: float
+    converged: bool
+    iterations: int
+    message: str
+    initial_trial_porosity: float | None
+    last_trial_porosity: float | None
+    last_new_porosity: float | None
+    particle_count: int | None
+    plate_moved: bool | None
+    f_top_n_per_m: float | None
+    f_bottom_n_per_m: float | None
+    f_top_after_n_per_m: float | None
+    f_bottom_after_n_per_m: float | None
+    self_weight_n_per_m: float | None
+    first_trial_porosity: float | None
+    first_particle_count: int | None
+    first_f_top_n_per_m: float | None
+    first_f_bottom_n_per_m: float | None
+    first_self_weight_n_per_m: float | None
+    first_plate_moved: bool | None
+    first_new_porosity: float | None
+    criterion_time_s: float | None
+    box_porosity: float | None
+    interior_porosity: float | None
+    interior_porosity_std: float | None
+    surface_gap_mean_d50: float | None
+    plate_contact_fraction: float | None
+
+    @classmethod
+    def of(cls, res: Mapping[str, Any]) -> CriterionCaseResults:
+        """The cells of a criterion result (a ``CriterionResult``: its trials as the dicts of its file).
+
+        The accepted trial is not always the last (see ``poro2d.criterion.protocol.closed_bracket``).
+        """
+        its = res["iterations"]
+        first = its[0] if its else {}
+        last = next((r for r in its if r.get("accepted")), its[-1] if its else {})
+        return cls(
+            n_lab=res["n_lab"],
+            final_porosity=res["final_porosity"],
+            converged=bool(res["converged"]),
+            iterations=len(its),
+            message=res["message"],
+            initial_trial_porosity=res["initial_trial_porosity"],
+            last_trial_porosity=last.get("trial_porosity"),
+            last_new_porosity=last.get("new_porosity"),
+            particle_count=last.get("particle_count"),
+            plate_moved=last.get("plate_moved"),
+            f_top_n_per_m=last.get("f_top_n_per_m"),
+            f_bottom_n_per_m=last.get("f_bottom_n_per_m"),
+            f_top_after_n_per_m=last.get("f_top_after_n_per_m"),
+            f_bottom_after_n_per_m=last.get("f_bottom_after_n_per_m"),
+            self_weight_n_per_m=last.get("self_weight_n_per_m"),
+            first_trial_porosity=first.get("trial_porosity"),
+            first_particle_count=first.get("particle_count"),
+            first_f_top_n_per_m=first.get("f_top_n_per_m"),
+            first_f_bottom_n_per_m=first.get("f_bottom_n_per_m"),
+            first_self_weight_n_per_m=first.get("self_weight_n_per_m"),
+            first_plate_moved=first.get("plate_moved"),
+            first_new_porosity=first.get("new_porosity"),
+            criterion_time_s=res.get("time_total_s"),
+            box_porosity=res.get("box_porosity"),
+            interior_porosity=res.get("interior_porosity"),
+            interior_porosity_std=res.get("interior_porosity_std"),
+            surface_gap_mean_d50=res.get("surface_gap_mean_d50"),
+            plate_contact_fraction=res.get("plate_contact_fraction"),
+        )
+
+
+@dataclass(eq=False)
 class LostCaseRow(TypedResult):
     """The row of a case whose task failed outside the case (its worker lost): its ``error.json``."""
 
@@ -241,6 +317,7 @@ __all__ = [
     "CalibrationRun",
     "CaseEntry",
     "CaseRow",
+    "CriterionCaseResults",
     "LostCaseRow",
     "DensityPoint",
     "DensitySweeps",

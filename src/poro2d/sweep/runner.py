@@ -38,6 +38,7 @@ from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.sweep.cases import KINDS, Case, SweepConfig, config_tables
 from poro2d.sweep.records import CaseRow, LostCaseRow, SweepSummary
 from poro2d.sweep.results import SweepResult
+from poro2d.typed_result import TypedResult
 
 RESULT = "result.json"
 PARAMS = "params.json"
@@ -139,8 +140,12 @@ def _run_case(case: dict, store: Store, func) -> CaseRow:
 def _done_row(case: dict, store: Store, func, row: dict, t0: float) -> CaseRow:
     """Run the case's kind into its sub-store ``run``; its row (``status`` done, results as table cells)."""
     results = func(case["config"], store.child("run"))
+    if isinstance(results, TypedResult):  # a kind's typed record of its cells
+        results = results.to_dict()
     if not isinstance(results, dict):
-        raise TypeError(f"case kind {case['kind']!r} returned {type(results).__name__}, not a dict")
+        raise TypeError(
+            f"case kind {case['kind']!r} returned {type(results).__name__}, not a dict or a record"
+        )
     results = {str(k): _scalar(v) for k, v in results.items()}
     row.update(status="done", error=None, time_s=time.perf_counter() - t0, finished_utc=_now())
     row["results"] = results
