@@ -130,21 +130,18 @@ class Case:
     """One case, a value: its kind, the parameters that differ from the base, the merged config.
 
     ``id`` is fixed when the case is made (:func:`case_id` of kind and config), so a case
-    built again from the same values names the same folder.
+    built again from the same values names the same folder. Its fields, in their order, are
+    what its ``params.json`` records (``dataclasses.asdict``).
     """
 
+    id: str = field(default="", kw_only=True)
     kind: str
     params: dict[str, Any]
     config: dict
-    id: str = ""
 
     def __post_init__(self) -> None:
         if not self.id:
             object.__setattr__(self, "id", case_id(self.kind, self.config))
-
-    def to_dict(self) -> dict:
-        """The case as its ``params.json`` records it."""
-        return {"id": self.id, "kind": self.kind, "params": self.params, "config": self.config}
 
 
 @dataclass(frozen=True)

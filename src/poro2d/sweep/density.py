@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass, replace
+from dataclasses import asdict, dataclass, replace
 from functools import cached_property
 from pathlib import Path
 from typing import Any
@@ -398,7 +398,7 @@ def calibration_twins(
 
     done = {}
     for c in calibration.cases:
-        row = finished_row(c.to_dict(), cases.child("cases", c.id))
+        row = finished_row(asdict(c), cases.child("cases", c.id))
         if row is not None:
             done[_check_key(c, base_dir)] = (c, row)
     twins = {}

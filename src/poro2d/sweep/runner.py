@@ -25,6 +25,7 @@ import os
 import socket
 import time
 import traceback
+from dataclasses import asdict
 from datetime import UTC, datetime
 from typing import Any
 
@@ -178,7 +179,7 @@ def _failed_row(case: Case, store: Store, err: BaseException, tb: str) -> LostCa
         "worker": None,
         "finished_utc": _now(),
     })  # fmt: skip
-    case_stage(case.to_dict(), store).bind()
+    case_stage(asdict(case), store).bind()
     store.write_text(ERROR_TXT, tb or row.error)
     store.write_result(ERROR_JSON, row)
     return row
@@ -271,7 +272,7 @@ def _run_sweep(sweep: SweepConfig, store: Store, *, client, scheduler, workers, 
     rows: dict[str, CaseRow | LostCaseRow] = {}
     pending: list[Case] = []
     for c in sweep.cases:
-        done = finished_row(c.to_dict(), cases.child(c.id))
+        done = finished_row(asdict(c), cases.child(c.id))
         if done is not None:
             rows[c.id] = CaseRow.from_dict(dict(done, status="done", reused=True))
         else:
@@ -352,7 +353,7 @@ def _submit_all(
     from poro2d.progress import CountProgress
 
     jobs = [
-        Job(compute_case, (c.to_dict(), cases.child(c.id), KINDS[c.kind]), c.id, key=f"{c.kind}-{c.id}",
+        Job(compute_case, (asdict(c), cases.child(c.id), KINDS[c.kind]), c.id, key=f"{c.kind}-{c.id}",
             retries=retries)
         for c in pending
     ]  # fmt: skip
