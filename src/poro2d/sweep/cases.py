@@ -159,7 +159,8 @@ class SweepConfig:
 
 
 def config_tables(prefix: str = "") -> dict[str, type]:
-    """The dataclass each table of a case's config stands for, keyed ``prefix`` + table name.
+    """The dataclass each table of a case's config stands for, keyed ``prefix`` + table name (a
+    registry: which tables there are depends on the kinds registered).
 
     Their fields marked as not changing results (:mod:`poro2d.identity`: the thread count)
     are left out of a case's identity.
@@ -212,7 +213,8 @@ def resolve_name(name: str) -> str:
 
 
 def _flatten(prefix: str, table: dict) -> dict[str, Any]:
-    """Nested TOML tables (``specimen.kn = ...`` inside ``[sweep]``) to dotted keys."""
+    """Nested TOML tables (``specimen.kn = ...`` inside ``[sweep]``) to dotted keys: a table as
+    read, at the edge, before its names are resolved."""
     out: dict[str, Any] = {}
     for k, v in table.items():
         name = f"{prefix}.{k}" if prefix else str(k)

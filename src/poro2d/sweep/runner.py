@@ -349,7 +349,7 @@ def _submit_all(
     n_reused: int,
     n_total: int,
 ) -> dict[str, CaseRow | LostCaseRow]:
-    """Every pending case as a job; its row (a failed task's as an error row) as it ends."""
+    """Every pending case as a job; the rows by case id (a failed task's as an error row) as they end."""
     from poro2d.progress import CountProgress
 
     jobs = [
