@@ -99,9 +99,6 @@ class Preflight:
     suggestion: str
     notes: list[str] = field(default_factory=list)
 
-    def to_dict(self) -> dict:
-        return asdict(self)
-
 
 #: a lid must rest in the calibration box: its force window at least this many times the
 #: grain weights its segments need (:data:`poro2d.criterion.lid.GRAINS_PER_SEGMENT` per segment).

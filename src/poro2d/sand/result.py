@@ -10,13 +10,14 @@ from __future__ import annotations
 import csv
 import io
 import math
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
 
 from poro2d.io_utils import Provenance
 from poro2d.sand.case import LabStateRecord, SoilRecord
+from poro2d.sand.preflight import Preflight
 from poro2d.sand.profile import StageProfile
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
@@ -102,7 +103,7 @@ class StageEstimate(TypedResult):
 
 @dataclass(eq=False)
 class PreflightRecord(TypedResult):
-    """The pre-flight as ``sand.json`` keeps it (:meth:`poro2d.sand.preflight.Preflight.to_dict`)."""
+    """A :class:`~poro2d.sand.preflight.Preflight` as ``preflight.json`` and ``sand.json`` keep it."""
 
     soil: str
     d_min_m: float
@@ -136,6 +137,12 @@ class PreflightRecord(TypedResult):
         "particle_steps": StageEstimate,
         "seconds": StageEstimate,
     }
+
+    @classmethod
+    def of(cls, pf: Preflight) -> PreflightRecord:
+        """The record of a pre-flight (``preflight.json``'s and ``sand.json``'s): its fields, in
+        their order, the boxes, the jamming porosity and the estimates as their records."""
+        return cls.from_dict(asdict(pf))
 
 
 @dataclass(eq=False)
@@ -293,7 +300,7 @@ class SandResult(TypedResult):
             calibration=cal_record,
             states=states,
             seed_results=list(kept),
-            preflight=PreflightRecord.from_dict(pf.to_dict()),
+            preflight=PreflightRecord.of(pf),
             wall_seconds=seconds,
             config=case.config.as_config(),
             provenance=Provenance.now(),

@@ -36,6 +36,7 @@ from poro2d.sand.preflight import Preflight, preflight
 from poro2d.sand.profile import case_runs, stage_profile
 from poro2d.sand.result import (
     DensityCalibrationRecord,
+    PreflightRecord,
     SandCalibration,
     SandResult,
     SeedSpecimen,
@@ -312,7 +313,11 @@ def run_sand(
     case, pf = check_soil(config, seeds=seeds, workers=workers, budget_minutes=budget_minutes)
     store.write_json(
         "preflight.json",
-        {"preflight": pf.to_dict(), "soil": case.soil_record(), "provenance": provenance()},
+        {
+            "preflight": PreflightRecord.of(pf).to_dict(),
+            "soil": case.soil_record(),
+            "provenance": provenance(),
+        },
     )
     if on_preflight is not None:
         on_preflight(case, pf)
