@@ -24,7 +24,9 @@ QUICK_CALIBRATION_CASES = [
 
 
 def _quick_states_base() -> CriterionBase:
-    return with_density_defaults(relation_base(CriterionBase.from_config(paper_preset()), quick=True))
+    return with_density_defaults(
+        relation_base(CriterionBase.from_config(paper_preset().as_config()), quick=True)
+    )
 
 
 def test_the_quick_relations_cases_keep_the_ids_naming_their_folders():
@@ -38,7 +40,7 @@ def test_the_quick_relations_cases_keep_the_ids_naming_their_folders():
 
 
 def test_a_base_is_varied_never_changed():
-    given = paper_preset()
+    given = paper_preset().as_config()
     base = CriterionBase.from_config(dict(given, relation={"n_max": 0.45}))
     quick = relation_base(base, quick=True)
     assert base.config == given and "relation" not in base.config

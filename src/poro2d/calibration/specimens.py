@@ -108,16 +108,22 @@ def preset_specimens(
     The criterion runs once on ``seed`` (its ``criterion``), then on the next seeds from its
     accepted porosity (its ``replicates``); seeds whose criterion does not converge are left out.
     """
-    from poro2d.criterion.config import build, paper_config
+    from poro2d.criterion.config import paper_config
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.criterion.replicates import run_replicates
 
     seed = check_int("--seed", seed, 0)
     cfg = paper_config(quick, seed)
-    spec, grading, settings, sd = build(cfg, None, threads=min(os.cpu_count() or 1, 2))
+    spec, grading, settings, sd = cfg.build(threads=min(os.cpu_count() or 1, 2))
     out = store.root
     crit = PorosityCriterion(
-        spec, grading, settings, seed=sd, store=store.child("criterion"), progress=progress, config=cfg
+        spec,
+        grading,
+        settings,
+        seed=sd,
+        store=store.child("criterion"),
+        progress=progress,
+        config=cfg.as_config(),
     )
     crit.validate()
     result = crit.run()
