@@ -67,6 +67,29 @@ class CriterionConfig:
         """This config without the top-level keys ``names``."""
         return replace(self, config={k: v for k, v in self.config.items() if k not in names})
 
+    def with_params(self, params: Mapping[str, Any]) -> Self:
+        """This config with a case's parameters set, in their order: a dotted name
+        (``specimen.kn_particle``) sets a key of its table, a bare one (``seed``) a top-level key."""
+        config = dict(self.config)
+        for name, value in params.items():
+            if "." in name:
+                table, key = name.split(".", 1)
+                config[table] = {**(config.get(table) or {}), key: value}
+            else:
+                config[name] = value
+        return replace(self, config=config)
+
+    def with_grading_file_absolute(self) -> Self:
+        """This config with its grading file's path made absolute (from ``base_dir``): a case
+        run in another folder, or recorded, names the same file."""
+        g = self.config.get("grading")
+        if not (isinstance(g, Mapping) and isinstance(g.get("csv"), str) and self.base_dir is not None):
+            return self
+        path = Path(g["csv"])
+        if path.is_absolute():
+            return self
+        return self.with_tables(grading=dict(g, csv=str((self.base_dir / path).resolve())))
+
     def as_config(self) -> dict[str, Any]:
         """The tables as the files record them (a deep copy: a record may keep it)."""
         return copy.deepcopy(dict(self.config))

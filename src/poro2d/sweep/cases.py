@@ -45,6 +45,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from poro2d.config import check_finite, check_keys
+from poro2d.criterion.config import CriterionConfig
 from poro2d.errors import InputError
 from poro2d.identity import identity_digest
 from poro2d.sweep.records import CriterionCaseResults
@@ -225,33 +226,12 @@ def _flatten(prefix: str, table: dict) -> dict[str, Any]:
     return out
 
 
-def apply_params(base: dict, params: dict[str, Any]) -> dict:
-    """The base config with the case's parameters set (dotted names already resolved)."""
-    cfg = copy.deepcopy({k: v for k, v in base.items() if k not in ("sweep", "relation", "title")})
-    for name, value in params.items():
-        if "." not in name:
-            cfg[name] = value
-            continue
-        table, key = name.split(".", 1)
-        cfg.setdefault(table, {})[key] = value
-    return cfg
-
-
 def _check_value(name: str, value: Any) -> Any:
     if isinstance(value, float) and not math.isfinite(value):
         raise InputError(f"sweep.{name}", value, "a finite number")
     if isinstance(value, dict):
         raise InputError(f"sweep.{name}", value, "a value (number, string, bool or list)")
     return value
-
-
-def _absolute_grading(cfg: dict, base_dir: Path | None) -> dict:
-    g = cfg.get("grading")
-    if isinstance(g, dict) and isinstance(g.get("csv"), str) and base_dir is not None:
-        p = Path(g["csv"])
-        if not p.is_absolute():
-            g["csv"] = str((base_dir / p).resolve())
-    return cfg
 
 
 def grid_cases(grid: Mapping[str, list]) -> list[dict[str, Any]]:
@@ -335,11 +315,12 @@ def make_sweep(
         _register_builtin()
     check_keys("config", raw, TOP_KEYS)
     check_finite("config", raw)
-    base = _absolute_grading(copy.deepcopy(dict(raw)), base_dir)
+    # the tables every case starts from: a study's own tables are recorded in sweep.json, not by a case
+    base = CriterionConfig(raw, base_dir).without("sweep", "relation", "title").with_grading_file_absolute()
     cases: list[Case] = []
     seen: dict[str, int] = {}
     for i, params in enumerate(combos):
-        merged = apply_params(base, params)
+        merged = base.with_params(params).as_config()
         if figures:
             merged["sweep_options"] = {"figures": True}
         case = Case(kind, params, merged)

@@ -23,7 +23,6 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -149,9 +148,7 @@ class GradingCase:
 def _reference_params(base: CriterionBase) -> dict[str, Any]:
     """The config's own grading as a case's parameters (dotted names, a grading file's path made
     absolute): the reference case names its grading as the family's cases name theirs."""
-    g = base.table("grading") or {"preset": "paper"}
-    if isinstance(g.get("csv"), str) and base.base_dir is not None and not Path(g["csv"]).is_absolute():
-        g["csv"] = str((base.base_dir / g["csv"]).resolve())
+    g = base.with_grading_file_absolute().table("grading") or {"preset": "paper"}
     return {f"grading.{k}": v for k, v in g.items()}
 
 
