@@ -523,6 +523,8 @@ def write_sensitivity(sens: dict, store: Store) -> SensitivityResult:
 
 
 def _csv_row(p: dict, sens: dict) -> dict:
+    """A row of ``sensitivity.csv``: the point's own columns (a grading's or a friction's, which
+    differ), then whether it reproduces the paper's n2D, the seeds and the version."""
     target, tol = sens["answer"]["target"], sens["answer"]["tolerance"]
     row = {k: v for k, v in p.items()}
     row["reproduces_paper"] = math.isfinite(p["n2d_mean"]) and abs(p["n2d_mean"] - target) <= tol + 1e-12
