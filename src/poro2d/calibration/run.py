@@ -19,7 +19,13 @@ import numpy as np
 
 from poro2d.calibration import model
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
-from poro2d.calibration.specimens import check_preset, check_replicates, given_specimens, preset_specimens
+from poro2d.calibration.specimens import (
+    Replicates,
+    check_preset,
+    check_replicates,
+    given_specimens,
+    preset_specimens,
+)
 from poro2d.calibration.units import CACHE, CalibrationUnit, UnitRow
 from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
@@ -328,29 +334,26 @@ def run_calibration(
     check_cluster_options(scheduler, workers)
     check_reachable(scheduler)
 
-    found = (
+    found = Replicates.read(
         given
         if given is not None
         else preset_specimens(
             store.child("specimens"), quick=quick, seed=seed, replicates=replicates, progress=progress
         )
     )
-    from poro2d.dem.checkpoint import state_digest
-
-    digests = {label: state_digest(path) for label, path in found.items()}
-    check_replicates(found, digests)
+    check_replicates(found)
     runner = UnitRunner(scheduler, workers, progress=progress, dashboard=dashboard)
     stresses = lab_data.normal_stresses()
     cache = _child(store, CACHE)
     try:
         design = model.space_filling(ranges, points, design_seed)
-        rows = runner.run(_units(design, found, digests, stresses, base), cache, "round 1")
-        post, surrogates, table = _infer(ranges, design, found, digests, base, rows, targets, lab_error)
+        rows = runner.run(_units(design, found, stresses, base), cache, "round 1")
+        post, surrogates, table = _infer(ranges, design, found, base, rows, targets, lab_error)
         if refine:
             extra = [p for p in post.draw(refine, design_seed + 1) if p not in design]
             design = design + extra
-            rows.update(runner.run(_units(extra, found, digests, stresses, base), cache, "round 2"))
-            post, surrogates, table = _infer(ranges, design, found, digests, base, rows, targets, lab_error)
+            rows.update(runner.run(_units(extra, found, stresses, base), cache, "round 2"))
+            post, surrogates, table = _infer(ranges, design, found, base, rows, targets, lab_error)
     finally:
         runner.close()
     result = _result(
@@ -374,7 +377,7 @@ def run_calibration(
     if store is not None:
         from poro2d.calibration.outputs import write_outputs
 
-        write_outputs(store, result, post, surrogates, lab_data, found, digests, base)
+        write_outputs(store, result, post, surrogates, lab_data, found, base)
     return result
 
 
@@ -382,24 +385,24 @@ def _child(store: Store | None, name: str) -> Store | None:
     return None if store is None else store.child(name)
 
 
-def _units(design, found, digests, stresses, base) -> list[CalibrationUnit]:
+def _units(design, specimens: Replicates, stresses, base) -> list[CalibrationUnit]:
     return [
-        CalibrationUnit.at(path, digests[label], s, base, fp, mu_r)
+        specimens.unit(label, s, base, fp, mu_r)
         for fp, mu_r in design
-        for label, path in found.items()
+        for label in specimens.paths
         for s in stresses
     ]
 
 
-def _infer(ranges, design, found, digests, base, rows: dict[str, UnitRow], targets, lab_error):
+def _infer(ranges, design, specimens: Replicates, base, rows: dict[str, UnitRow], targets, lab_error):
     """The surrogates (one per target), the posterior and the table of replicate values per design point."""
     table = []
     for fp, mu_r in design:
         entry: dict[str, Any] = {"particle_friction": fp, "rolling_friction": mu_r}
         for obs, s, _ in targets:
             values = []
-            for label, path in found.items():
-                row = rows.get(CalibrationUnit.at(path, digests[label], s, base, fp, mu_r).key)
+            for label in specimens.paths:
+                row = rows.get(specimens.unit(label, s, base, fp, mu_r).key)
                 values.append(row.observable(obs) if row is not None else float("nan"))
             entry[f"{obs}_{s:g}kPa"] = values
         table.append(entry)
@@ -453,7 +456,7 @@ def _result(
     targets,
     level,
     lab_data,
-    found,
+    found: Replicates,
     ranges,
     base,
     runner,
@@ -513,7 +516,7 @@ def _result(
             for (obs, s, _), sg in zip(targets, surrogates, strict=True)
         },
         lab=LabRecord.from_dict(lab_data.to_dict()),
-        specimens={k: str(v) for k, v in found.items()},
+        specimens={k: str(v) for k, v in found.paths.items()},
         ranges=FrictionBounds(list(ranges.fp), list(ranges.mu_r)),
         settings=ShearSettingsRecord.from_dict(base.to_dict()),
         cluster=runner.info(),
