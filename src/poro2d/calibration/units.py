@@ -63,7 +63,7 @@ class CalibrationUnit:
         the table its key hashes (and its worker reads back).
         """
         settings = replace(base, particle_friction=fp, rolling_friction=mu_r)
-        return cls(str(specimen), digest, float(sigma), settings.to_dict())
+        return cls(str(specimen), digest, float(sigma), settings.record().to_dict())
 
     @property
     def fp(self) -> float:
