@@ -25,7 +25,7 @@ def main() -> None:
     args = ap.parse_args()
 
     from poro2d.criterion import PorosityCriterion
-    from poro2d.criterion.config import build, paper_preset
+    from poro2d.criterion.config import paper_preset
     from poro2d.grading import paper_grading
     from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
     from poro2d.store import Store
@@ -33,9 +33,7 @@ def main() -> None:
     # warm-up: compile or load every kernel outside the timed run
     prepare_specimen(SpecimenSpec(width=0.03, height=0.02, layers=1), paper_grading(), 0.2, seed=1)
 
-    cfg = paper_preset()
-    cfg["seed"] = args.seed
-    spec, grading, settings, seed = build(cfg, None, threads=args.threads)
+    spec, grading, settings, seed = paper_preset().with_seed(args.seed).build(threads=args.threads)
     out = args.keep or Path(tempfile.mkdtemp(prefix="poro2d-bench-"))
     if out.exists() and any(out.iterdir()):
         raise SystemExit(f"{out} is not empty: the benchmark needs a fresh folder")

@@ -455,7 +455,7 @@ def test_a_criterion_keeps_its_settings_and_specimen_as_records():
 
 def test_a_sands_calibration_record_and_seed_results_are_typed_parts():
     """The small box's calibration record and each seed's row are typed parts, written as before."""
-    from poro2d.sand.result import DensityCalibrationRecord, SeedResult, SeedSpecimen
+    from poro2d.sand.result import DensityCalibrationRecord, SeedSpecimen
 
     stored = json.loads((DATA / "sand_result.json").read_text())
     sand = SandResult.from_dict(stored)
@@ -463,7 +463,7 @@ def test_a_sands_calibration_record_and_seed_results_are_typed_parts():
     assert sand.calibration.calibration.mus == stored["calibration"]["calibration"]["mus"]
     assert "seed_results" not in sand.to_dict()  # a file written before the key stays without it
     seed = SeedSpecimen(1, True, 0.17, 0.16, 900, 2, "specimens/seed1")
-    row = SeedResult.from_dict(seed.to_dict())
+    row = SeedSpecimen.from_dict(seed.to_dict())
     sand.seed_results = [row]
     assert sand.to_dict()["seed_results"] == [seed.to_dict()] and row.folder == "specimens/seed1"
     assert SandResult.from_dict(sand.to_dict()).seed_results[0].trials == 2

@@ -225,7 +225,6 @@ def run_paper(
     """
     import os
 
-    from poro2d.criterion.config import build
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.errors import check_int
     from poro2d.io_utils import check_output_dir
@@ -241,9 +240,9 @@ def run_paper(
 
         lab_data = read_lab_csv(lab)  # bad lab files fail here, before any simulation
     nthreads = threads if threads is not None else min(os.cpu_count() or 1, 2)
-    spec, grading, settings, sd = build(cfg, None, threads=nthreads)
+    spec, grading, settings, sd = cfg.build(threads=nthreads)
     crit = PorosityCriterion(spec, grading, settings, seed=sd, store=store.child("criterion"),
-                             progress=progress, config=cfg)  # fmt: skip
+                             progress=progress, config=cfg.as_config())  # fmt: skip
     crit.validate()  # every option is checked before the first file is written
     stage = paper_stage(store, quick, seed)
     stage.check()  # and the folder: one of another paper run is refused before anything is written

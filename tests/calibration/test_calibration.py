@@ -235,7 +235,7 @@ def test_shear_settings_take_a_rolling_friction_for_every_disk(tiny):
 
 
 def test_lab_curves_shorter_than_the_tests_are_refused_and_their_end_is_the_last_window(tiny, tmp_path):
-    from poro2d.calibration.run import _lab_targets
+    from poro2d.calibration.run import _base_settings, _lab_targets
     from poro2d.shear.lab import read_lab_csv
 
     paths, _ = tiny
@@ -248,7 +248,8 @@ def test_lab_curves_shorter_than_the_tests_are_refused_and_their_end_is_the_last
     curves = tmp_path / "curves.csv"
     curves.write_text("normal_stress_kpa,shear_displacement_mm,shear_stress_kpa\n"
                       "50,0.5,40\n50,1.0,30\n50,1.7,22\n50,2.0,18\n50,2.5,5\n")  # fmt: skip
-    targets = _lab_targets(read_lab_csv(curves), {"max_displacement": 0.002, "peak_window": 5e-4})
+    base = _base_settings({"max_displacement": 0.002, "peak_window": 5e-4})
+    targets = _lab_targets(read_lab_csv(curves), base)
     # the peak, and the mean of the readings within the last window before 2 mm (1.5 to 2 mm)
     assert targets == [("peak", 50.0, 40.0), ("end", 50.0, 20.0)]
 

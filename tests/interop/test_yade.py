@@ -10,7 +10,7 @@ import shutil
 
 import pytest
 
-from poro2d.criterion.config import build, paper_preset
+from poro2d.criterion.config import paper_preset
 from poro2d.criterion.protocol import PorosityCriterion
 from poro2d.interop.agreement import run_poro2d
 from poro2d.interop.specimen_data import from_checkpoint
@@ -34,8 +34,8 @@ def _yade() -> None:
 def paper_specimen(tmp_path_factory):
     _yade()
     cfg = paper_preset()
-    cfg["criterion"]["trial_porosity"] = ACCEPTED_N2D
-    spec, grading, settings, seed = build(cfg)
+    cfg = cfg.with_tables(criterion=dict(cfg.table("criterion"), trial_porosity=ACCEPTED_N2D))
+    spec, grading, settings, seed = cfg.build()
     out = tmp_path_factory.mktemp("paper_criterion")
     result = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(out), figures=False).run()
     assert result.converged

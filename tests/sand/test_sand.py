@@ -29,8 +29,8 @@ def test_case_reads_the_laboratory_state_and_fills_density_defaults():
     assert case.lab.relative_density == pytest.approx(0.5)
     # e = 0.977 - 0.5 (0.977 - 0.597) = 0.787, n = e / (1 + e)
     assert case.lab.n_lab == pytest.approx(0.787 / 1.787)
-    assert case.config["criterion"]["n_lab"] == pytest.approx(0.787 / 1.787, abs=1e-6)
-    assert case.config["criterion"]["acceptance"] == "fill"  # density mode's defaults
+    assert case.config.table("criterion")["n_lab"] == pytest.approx(0.787 / 1.787, abs=1e-6)
+    assert case.config.table("criterion")["acceptance"] == "fill"  # density mode's defaults
     assert case.seeds == 3 and case.mus[0] == 0.0 and case.mus[-1] == 1.0
     assert case.calibration_seeds == 2
     assert load_sand_case(_config(sand={"calibration_seeds": 3})).calibration_seeds == 3
@@ -38,11 +38,10 @@ def test_case_reads_the_laboratory_state_and_fills_density_defaults():
 
 def test_calibration_cases_run_the_loosest_first():
     """The most frictional cases take longest: the workers start them first."""
-    from poro2d.sweep.criterion_base import CriterionBase
     from poro2d.sweep.density import CalibrationCase
 
     case = load_sand_case(_config())
-    calibration = CalibrationCase(CriterionBase(case.config), (0.0, 0.1, 1.0), 2)
+    calibration = CalibrationCase(case.config, (0.0, 0.1, 1.0), 2)
     listed = [c.params for c in calibration.sweep.cases]
     first = [c.params for c in replace(calibration, loosest_first=True).sweep.cases]
     assert [c["specimen.friction_prep"] for c in listed] == [0.0, 0.0, 0.1, 0.1, 1.0, 1.0]
@@ -250,18 +249,19 @@ def test_preflight_says_what_a_cut_of_fines_does(tmp_path, monkeypatch):
 def test_step_budgets_follow_the_time_step():
     from poro2d.grading import GradingCurve
     from poro2d.sand.case import STEP_BUDGETS, with_step_budgets
+    from poro2d.sweep.criterion_base import CriterionBase
 
     spec = SpecimenSpec()
-    paper = {"criterion": {}, "specimen": {}}
+    paper = CriterionBase({"criterion": {}, "specimen": {}})
     assert with_step_budgets(paper, spec, paper_grading()) is paper  # the paper grading: the defaults
     fine = GradingCurve.from_lists([0.1, 0.2, 0.4], [0, 50, 100], upscale=10)  # d_min 1 mm: half the step
     slow = PF.time_step(spec, 0.002) / PF.time_step(spec, 0.001)
     assert slow == pytest.approx(2.0)
-    cfg = with_step_budgets({"criterion": {"max_plate_steps": 1234}}, spec, fine)
-    assert cfg["criterion"]["max_plate_steps"] == 1234  # what the user set stays
+    cfg = with_step_budgets(CriterionBase({"criterion": {"max_plate_steps": 1234}}), spec, fine)
+    assert cfg.table("criterion")["max_plate_steps"] == 1234  # what the user set stays
     for (table, key), default in STEP_BUDGETS.items():
         if (table, key) != ("criterion", "max_plate_steps"):
-            assert cfg[table][key] == pytest.approx(default * 2.0, rel=0.01)
+            assert cfg.table(table)[key] == pytest.approx(default * 2.0, rel=0.01)
 
 
 def test_budget_suggestion_offers_only_what_fits_the_box():
@@ -301,3 +301,28 @@ def test_frictional_first_trials_start_on_the_loose_side():
     assert first_trial(crit, 1.0, 0.15, 0.01, LOOSE_BIAS) == pytest.approx(
         first_trial(crit, 1.0, 0.15, 0.01) + LOOSE_BIAS, abs=0.0011
     )
+
+
+def test_a_sand_cases_config_and_case_ids_are_pinned():
+    """The specimens' config (step budgets scaled for a fine grading) and the calibration's and
+    states' case ids, which name cache folders, stay what they were when configs were dicts."""
+    from types import SimpleNamespace
+
+    from poro2d.criterion.density import StateTarget
+    from poro2d.sand.run import calibration_config
+    from poro2d.sweep.density import CalibrationCase, StateChecks
+
+    fine = {"sizes_mm": [0.5, 1.0, 2.0], "percent_passing": [0, 50, 100]}
+    case = load_sand_case(_config(grading=fine, specimen={"layers": 3}))
+    assert json.dumps(case.config.as_config()) == (
+        '{"grading": {"sizes_mm": [0.5, 1.0, 2.0], "percent_passing": [0, 50, 100]}, "specimen": '
+        '{"settle_drift": 0.001, "layers": 3, "max_steps_per_stage": 1600000, "fallback_steps": 800000, '
+        '"calm_steps": 200000}, "criterion": {"refine_tolerance": 0.002, "max_iterations": 10, '
+        '"acceptance": "fill", "force_fraction": 0.02, "n_lab": 0.440403, "max_plate_steps": 2400000}}'
+    )
+    box = SimpleNamespace(calibration_box=SimpleNamespace(width=0.1, height=0.05, layers=2))
+    calibration = CalibrationCase(calibration_config(case, box), (0.0, 1.0), 2).sweep
+    ids = ["afc5b7896b1f", "a9325bb0389e", "511d1f4f81e3", "ce24f5fc7eec"]
+    assert [c.id for c in calibration.cases] == ids
+    states = StateChecks(case.config, (StateTarget(0.3, 0.5, 0.17, 0.3),), 2, 0.001).sweep
+    assert [c.id for c in states.cases] == ["aed9d8864d02", "863f868d6f95"]

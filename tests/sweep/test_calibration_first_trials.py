@@ -1,5 +1,7 @@
 """The calibration's first trials: one for all under the paper's plate, per friction under the fill."""
 
+from dataclasses import asdict
+
 import pytest
 
 from poro2d.store import Store
@@ -66,7 +68,7 @@ def test_under_the_fill_a_check_at_a_calibration_friction_is_its_calibration_cas
         row = {"id": c.id, "status": "done", "params": c.params,
                "results": {"n_lab": 0.3434, "converged": True, "final_porosity": c.params["seed"] + 0.1,
                            "last_new_porosity": 0.1631}}  # fmt: skip
-        write_json(folder / "cases" / c.id / "params.json", c.to_dict(), config=True)
+        write_json(folder / "cases" / c.id / "params.json", asdict(c), config=True)
         write_json(folder / "cases" / c.id / "result.json", row)
     dense = StateTarget(0.3253, 1.0, 0.1632, 0.0)  # rounds to 0.163, the frictionless first trial
     loose = StateTarget(0.4571, 0.0, 0.2130, 1.0)  # 0.213: not the calibration's 0.216
@@ -83,7 +85,7 @@ def test_under_the_fill_a_check_at_a_calibration_friction_is_its_calibration_cas
     cal_p = _calibration(plate, [0.0, 1.0], 2)
     for c in cal_p.cases:
         row = {"id": c.id, "status": "done", "params": c.params, "results": {"converged": True}}
-        write_json(tmp_path / "p" / "cases" / c.id / "params.json", c.to_dict(), config=True)
+        write_json(tmp_path / "p" / "cases" / c.id / "params.json", asdict(c), config=True)
         write_json(tmp_path / "p" / "cases" / c.id / "result.json", row)
     states_p = D.StateChecks(CriterionBase(plate), (loose,), 2, 0.001).sweep
     assert D.calibration_twins(cal_p, states_p, None, Store(tmp_path / "p")) == {}

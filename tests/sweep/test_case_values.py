@@ -5,6 +5,7 @@ before its cases were values (the calibration's cases in ``$PORO2D_CACHE`` and t
 checks in ``states/cases``): a changed id would lose every user's cached cases.
 """
 
+import json
 from dataclasses import FrozenInstanceError, replace
 
 import pytest
@@ -24,7 +25,9 @@ QUICK_CALIBRATION_CASES = [
 
 
 def _quick_states_base() -> CriterionBase:
-    return with_density_defaults(relation_base(CriterionBase.from_config(paper_preset()), quick=True))
+    return with_density_defaults(
+        relation_base(CriterionBase.from_config(paper_preset().as_config()), quick=True)
+    )
 
 
 def test_the_quick_relations_cases_keep_the_ids_naming_their_folders():
@@ -38,7 +41,7 @@ def test_the_quick_relations_cases_keep_the_ids_naming_their_folders():
 
 
 def test_a_base_is_varied_never_changed():
-    given = paper_preset()
+    given = paper_preset().as_config()
     base = CriterionBase.from_config(dict(given, relation={"n_max": 0.45}))
     quick = relation_base(base, quick=True)
     assert base.config == given and "relation" not in base.config
@@ -53,3 +56,26 @@ def test_fewer_frictions_are_the_same_calibrations_cases():
     ends = replace(calibration, mus=(0.0, 1.0), seeds=2)
     assert ends.key == calibration.key  # one cache entry: its finished cases are read back
     assert {c.id for c in ends.sweep.cases} < {c.id for c in calibration.sweep.cases}
+
+
+def test_a_cases_merged_config_and_id_are_pinned():
+    """A case's parameters set on the base in their order (new tables and keys after the given
+    ones): its config as ``params.json`` records it and its id (its folder's name) are pinned."""
+    from poro2d.sweep.cases import parse_sweep
+
+    axes = {"n_lab": [0.33, 0.36], "specimen": {"friction_particle": [1.0, 3.0]}, "seed": [0, 4]}
+    grid = {"seed": 1, "specimen": {"width": 0.1}, "criterion": {"n_lab": 0.35}, "sweep": axes}
+    ids = [c.id for c in parse_sweep(grid, validate=False).cases]
+    assert ids[:4] == ["c99f95fb9d5a", "25d70fb850e2", "b8df56b1f5d7", "922fa686999d"]
+    cases = [{"n_lab": 0.33, "specimen.kn_particle": 2e5}, {"seed": 3, "grading.upscale": 2.0}]
+    listed = {"title": "t", "criterion": {"resolution": 0.01}, "sweep": {"cases": cases, "figures": True}}
+    first, second = parse_sweep(listed, validate=False).cases
+    assert (first.id, second.id) == ("50a322f82efc", "0b07a550582f")
+    assert json.dumps(first.config) == (
+        '{"criterion": {"resolution": 0.01, "n_lab": 0.33}, "specimen": {"kn_particle": 200000.0}, '
+        '"sweep_options": {"figures": true}}'
+    )
+    assert json.dumps(second.config) == (
+        '{"criterion": {"resolution": 0.01}, "seed": 3, "grading": {"upscale": 2.0}, '
+        '"sweep_options": {"figures": true}}'
+    )

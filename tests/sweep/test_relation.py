@@ -2,6 +2,7 @@
 
 import json
 import math
+from dataclasses import asdict
 
 import numpy as np
 import pandas as pd
@@ -250,7 +251,7 @@ def test_a_state_check_that_is_a_calibration_case_is_read_back(tmp_path):
         row = {"id": c.id, "status": "done", "params": c.params,
                "results": {"n_lab": 0.3434, "converged": True, "final_porosity": 0.19 + mu / 10,
                            "last_new_porosity": 0.188 + mu / 10}}  # fmt: skip
-        write_json(folder / "cases" / c.id / "params.json", c.to_dict(), config=True)  # the runner binds so
+        write_json(folder / "cases" / c.id / "params.json", asdict(c), config=True)  # the runner binds so
         write_json(folder / "cases" / c.id / "result.json", row)
     dense = StateTarget(0.33, 1.0, 0.1883, 0.05)  # first trial rounds to 0.19, the calibration's
     other = StateTarget(0.40, 0.4, 0.2, 0.3)

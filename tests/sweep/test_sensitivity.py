@@ -146,20 +146,20 @@ def test_settings_defaults_and_seeds():
 def test_quick_widths_fit_the_quick_box_and_cu_4_does_not():
     from poro2d.criterion.config import paper_preset
 
-    study = S.study_base(CriterionBase(paper_preset()), quick=True)
+    study = S.study_base(CriterionBase(paper_preset().config), quick=True)
     S.check_gradings(study, S.gradings(study, list(S.QUICK_CUS)))
     with pytest.raises(InputError) as ei:
         S.check_gradings(study, S.gradings(study, [4.0]))
     assert ei.value.parameter == "sensitivity.cu" and ei.value.value == 4.0
     # the full box takes Cu = 4 (its bands are 31 mm)
-    full = S.study_base(CriterionBase(paper_preset()), quick=False)
+    full = S.study_base(CriterionBase(paper_preset().config), quick=False)
     S.check_gradings(full, S.gradings(full, [4.0]))
 
 
 def test_family_keeps_the_reference_mean_disk_area():
     from poro2d.criterion.config import paper_preset
 
-    g = S.gradings(S.study_base(CriterionBase(paper_preset()), quick=False), [1.5, 3.0])
+    g = S.gradings(S.study_base(CriterionBase(paper_preset().config), quick=False), [1.5, 3.0])
     areas = [x.curve.mean_disk_area() for x in g]
     assert areas == pytest.approx([areas[0]] * 3, rel=1e-9)
     assert [x.describe()["cu"] for x in g[1:]] == pytest.approx([1.5, 3.0])

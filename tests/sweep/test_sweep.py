@@ -278,9 +278,11 @@ def test_worker_pins_numba_threads_so_a_compile_does_not_fail(monkeypatch):
 
 
 def test_a_case_runs_in_this_process_once_and_its_folder_binds(tmp_path):
+    from dataclasses import asdict
+
     from poro2d.sweep.runner import compute_case, finished_row
 
-    case = parse_sweep(probe_cfg([3], seconds=0.0)).cases[0].to_dict()
+    case = asdict(parse_sweep(probe_cfg([3], seconds=0.0)).cases[0])
     case["config"]["specimen"] = {"threads": 1}
     d = tmp_path / case["id"]
     row = compute_case(case, Store(d), probe)

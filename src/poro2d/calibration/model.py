@@ -48,9 +48,6 @@ class Ranges:
         mu_r = self.mu_r[0] + unit[:, 1] * (self.mu_r[1] - self.mu_r[0])
         return fp, mu_r
 
-    def to_dict(self) -> dict:
-        return {"particle_friction": list(self.fp), "rolling_friction": list(self.mu_r)}
-
 
 def rounded(fp: np.ndarray, mu_r: np.ndarray) -> list[tuple[float, float]]:
     """Parameter pairs rounded to 4 significant digits: the identity of a shear test in the cache."""
@@ -89,14 +86,6 @@ class Surrogate:
 
     def mean(self, unit: np.ndarray) -> np.ndarray:
         return _features(np.atleast_2d(unit)) @ self.coefficients
-
-    def to_dict(self) -> dict:
-        return {
-            "coefficients": self.coefficients.tolist(),
-            "seed_scatter_kpa": self.scatter,
-            "surrogate_residual_kpa": self.residual,
-            "replicates": self.replicates,
-        }
 
 
 def fit_surrogate(unit: np.ndarray, values: np.ndarray) -> Surrogate:

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import math
 
-from poro2d.calibration.units import CACHE, CalibrationUnit, unit_curve
+from poro2d.calibration.specimens import Replicates
+from poro2d.calibration.units import CACHE, unit_curve
 from poro2d.store import Store
 
 FIT_PNG = "calibration_fit.png"
@@ -12,11 +13,11 @@ POSTERIOR_PNG = "calibration_posterior.png"
 CONFIG_TOML = "calibrated.toml"
 
 
-def write_outputs(store: Store, result, post, surrogates, lab, found, digests, base) -> None:
+def write_outputs(store: Store, result, post, surrogates, lab, specimens: Replicates, base) -> None:
     """Figures, config and report first; ``result.json`` last (its presence says: finished)."""
     from poro2d.report.calibration_figures import plot_calibration_fit, plot_calibration_posterior
 
-    curves, nearest = _best_curves(result, lab, found, digests, base, store.child(CACHE))
+    curves, nearest = _best_curves(result, lab, specimens, base, store.child(CACHE))
     plot_calibration_fit(result, lab, curves, nearest, store.path(FIT_PNG))
     plot_calibration_posterior(result, post, store.path(POSTERIOR_PNG))
     store.write_text(CONFIG_TOML, _config(result, lab))
@@ -26,7 +27,7 @@ def write_outputs(store: Store, result, post, surrogates, lab, found, digests, b
     store.write_result("result.json", result)
 
 
-def _best_curves(result, lab, found, digests, base, cache: Store) -> tuple[dict[float, list], dict]:
+def _best_curves(result, lab, specimens: Replicates, base, cache: Store) -> tuple[dict[float, list], dict]:
     """The curves of the design point nearest the best parameters, per normal stress (all
     specimens), and that design point: what the fit figure draws."""
     best = result.best
@@ -39,10 +40,8 @@ def _best_curves(result, lab, found, digests, base, cache: Store) -> tuple[dict[
     )
     curves: dict[float, list] = {}
     for s in lab.normal_stresses():
-        for label, path in found.items():
-            unit = CalibrationUnit.at(
-                path, digests[label], s, base, nearest["particle_friction"], nearest["rolling_friction"]
-            )
+        for label in specimens.paths:
+            unit = specimens.unit(label, s, base, nearest["particle_friction"], nearest["rolling_friction"])
             curve = unit_curve(unit, cache)
             if curve is not None:
                 curves.setdefault(s, []).append(curve)

@@ -19,7 +19,13 @@ import numpy as np
 
 from poro2d.calibration import model
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
-from poro2d.calibration.specimens import check_preset, check_replicates, given_specimens, preset_specimens
+from poro2d.calibration.specimens import (
+    Replicates,
+    check_preset,
+    check_replicates,
+    given_specimens,
+    preset_specimens,
+)
 from poro2d.calibration.units import CACHE, CalibrationUnit, UnitRow
 from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
@@ -77,12 +83,19 @@ class FrictionFlags(TypedResult):
 
 @dataclass(eq=False)
 class SurrogateRecord(TypedResult):
-    """One observable's quadratic surrogate as a file keeps it (``Surrogate.to_dict()``)."""
+    """One observable's quadratic surrogate as a file keeps it."""
 
     coefficients: list[float]
     seed_scatter_kpa: float
     surrogate_residual_kpa: float
     replicates: int
+
+    @classmethod
+    def of(cls, surrogate: model.Surrogate) -> SurrogateRecord:
+        """The record of a fitted surrogate (its coefficients as a list)."""
+        return cls(
+            surrogate.coefficients.tolist(), surrogate.scatter, surrogate.residual, surrogate.replicates
+        )
 
 
 @dataclass(eq=False)
@@ -123,22 +136,11 @@ class PosteriorSummary(TypedResult):
     observables: list[FittedObservable]
     noise_correlation: list[list[float]]
 
-    def to_dict(self) -> dict[str, Any]:
-        out = super().to_dict()
-        if self.observables is not None:
-            out["observables"] = [o.to_dict() if isinstance(o, TypedResult) else o for o in self.observables]
-        return out
-
-    @classmethod
-    def from_dict(cls, data) -> PosteriorSummary:
-        obj = super().from_dict(data)
-        if isinstance(obj.observables, list):
-            obj.observables = [
-                FittedObservable.from_dict(o) if isinstance(o, dict) else o for o in obj.observables
-            ]
-        obj.median = part(FrictionValues, obj.median)
-        obj.wide = part(FrictionFlags, obj.wide)
-        return obj
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "median": FrictionValues,
+        "wide": FrictionFlags,
+        "observables": FittedObservable,
+    }
 
 
 @dataclass(eq=False)
@@ -223,9 +225,11 @@ def check_range_pair(name: str, value, lo: float, hi: float, lo_open: bool = Fal
     return float(a), float(b)
 
 
-def _base_settings(settings: dict | None) -> dict:
+def _base_settings(settings: dict | None) -> ShearSettings:
     """The shear settings of every test (frictions apart); ``stop_after_peak`` 0 by default so
-    that every test ends at ``max_displacement``, where the end stress is compared."""
+    that every test ends at ``max_displacement``, where the end stress is compared.
+
+    ``settings``: the caller's table of shear settings (a command's options), read once here."""
     given = dict(settings or {})
     if not isinstance(settings, dict | None):
         raise InputError("settings", type(settings).__name__, "a dict of shear settings or None")
@@ -235,17 +239,17 @@ def _base_settings(settings: dict | None) -> dict:
     given.setdefault("stop_after_peak", 0.0)
     from poro2d.config import dataclass_from_table
 
-    return dataclass_from_table(ShearSettings, "settings", given).record().to_dict()
+    return dataclass_from_table(ShearSettings, "settings", given)
 
 
-def _lab_targets(lab: LabData, base: dict) -> list[tuple[str, float, float]]:
+def _lab_targets(lab: LabData, base: ShearSettings) -> list[tuple[str, float, float]]:
     """(observable, normal stress, laboratory value) fitted: every peak, and with curves the end stress.
 
     The end stress of a laboratory curve is its mean over the last peak window before the
     tests' ``max_displacement`` (the simulated end value is smoothed over the same window).
     """
     targets = [("peak", s, lab.peaks[s]) for s in lab.normal_stresses()]
-    end, window = base["max_displacement"], base["peak_window"]
+    end, window = base.max_displacement, base.peak_window
     for s in lab.normal_stresses() if lab.curves else []:
         d, t = lab.curves[s]
         if d[-1] < end:
@@ -330,29 +334,26 @@ def run_calibration(
     check_cluster_options(scheduler, workers)
     check_reachable(scheduler)
 
-    found = (
+    found = Replicates.read(
         given
         if given is not None
         else preset_specimens(
             store.child("specimens"), quick=quick, seed=seed, replicates=replicates, progress=progress
         )
     )
-    from poro2d.dem.checkpoint import state_digest
-
-    digests = {label: state_digest(path) for label, path in found.items()}
-    check_replicates(found, digests)
+    check_replicates(found)
     runner = UnitRunner(scheduler, workers, progress=progress, dashboard=dashboard)
     stresses = lab_data.normal_stresses()
     cache = _child(store, CACHE)
     try:
         design = model.space_filling(ranges, points, design_seed)
-        rows = runner.run(_units(design, found, digests, stresses, base), cache, "round 1")
-        post, surrogates, table = _infer(ranges, design, found, digests, base, rows, targets, lab_error)
+        rows = runner.run(_units(design, found, stresses, base), cache, "round 1")
+        post, surrogates, table = _infer(ranges, design, found, base, rows, targets, lab_error)
         if refine:
             extra = [p for p in post.draw(refine, design_seed + 1) if p not in design]
             design = design + extra
-            rows.update(runner.run(_units(extra, found, digests, stresses, base), cache, "round 2"))
-            post, surrogates, table = _infer(ranges, design, found, digests, base, rows, targets, lab_error)
+            rows.update(runner.run(_units(extra, found, stresses, base), cache, "round 2"))
+            post, surrogates, table = _infer(ranges, design, found, base, rows, targets, lab_error)
     finally:
         runner.close()
     result = _result(
@@ -376,7 +377,7 @@ def run_calibration(
     if store is not None:
         from poro2d.calibration.outputs import write_outputs
 
-        write_outputs(store, result, post, surrogates, lab_data, found, digests, base)
+        write_outputs(store, result, post, surrogates, lab_data, found, base)
     return result
 
 
@@ -384,24 +385,24 @@ def _child(store: Store | None, name: str) -> Store | None:
     return None if store is None else store.child(name)
 
 
-def _units(design, found, digests, stresses, base) -> list[CalibrationUnit]:
+def _units(design, specimens: Replicates, stresses, base) -> list[CalibrationUnit]:
     return [
-        CalibrationUnit.at(path, digests[label], s, base, fp, mu_r)
+        specimens.unit(label, s, base, fp, mu_r)
         for fp, mu_r in design
-        for label, path in found.items()
+        for label in specimens.paths
         for s in stresses
     ]
 
 
-def _infer(ranges, design, found, digests, base, rows: dict[str, UnitRow], targets, lab_error):
+def _infer(ranges, design, specimens: Replicates, base, rows: dict[str, UnitRow], targets, lab_error):
     """The surrogates (one per target), the posterior and the table of replicate values per design point."""
     table = []
     for fp, mu_r in design:
         entry: dict[str, Any] = {"particle_friction": fp, "rolling_friction": mu_r}
         for obs, s, _ in targets:
             values = []
-            for label, path in found.items():
-                row = rows.get(CalibrationUnit.at(path, digests[label], s, base, fp, mu_r).key)
+            for label in specimens.paths:
+                row = rows.get(specimens.unit(label, s, base, fp, mu_r).key)
                 values.append(row.observable(obs) if row is not None else float("nan"))
             entry[f"{obs}_{s:g}kPa"] = values
         table.append(entry)
@@ -455,7 +456,7 @@ def _result(
     targets,
     level,
     lab_data,
-    found,
+    found: Replicates,
     ranges,
     base,
     runner,
@@ -509,13 +510,15 @@ def _result(
         ),
         evaluations=table,
         fit={
-            f"{obs}_{s:g}kPa": SurrogateRecord.from_dict(sg.to_dict())
+            f"{obs}_{s:g}kPa": SurrogateRecord(
+                sg.coefficients.tolist(), sg.scatter, sg.residual, sg.replicates
+            )
             for (obs, s, _), sg in zip(targets, surrogates, strict=True)
         },
         lab=lab_data.record(),
-        specimens={k: str(v) for k, v in found.items()},
-        ranges=FrictionBounds.from_dict(ranges.to_dict()),
-        settings=ShearSettingsRecord.from_dict(base),
+        specimens={k: str(v) for k, v in found.paths.items()},
+        ranges=FrictionBounds(list(ranges.fp), list(ranges.mu_r)),
+        settings=base.record(),
         cluster=runner.info(),
         failures=runner.failures,
         timings=CalibrationTimings(wall_time_s=time.perf_counter() - t0),

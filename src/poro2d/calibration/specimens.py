@@ -8,10 +8,12 @@ as ``poro2d paper`` does; both are resumable, so a rerun reads the specimens bac
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from poro2d.calibration.units import CalibrationUnit
 from poro2d.errors import InputError, check_int
 from poro2d.shear.specimen_file import Specimen, resolve_specimen
 from poro2d.store import Store
@@ -38,12 +40,35 @@ def given_specimens(paths: list[str | os.PathLike]) -> dict[str, Path]:
     return found
 
 
+@dataclass(frozen=True)
+class Replicates:
+    """The replicate specimens a calibration shears: each one's file by label, and the digest of
+    its content (what a unit's key hashes: a specimen moved to another folder is the same one)."""
+
+    paths: dict[str, Path]
+    digests: dict[str, str]
+
+    @classmethod
+    def read(cls, paths: dict[str, Path]) -> Replicates:
+        """The replicates of the files ``paths`` (by label), each file's content hashed once."""
+        from poro2d.dem.checkpoint import state_digest
+
+        return cls(dict(paths), {label: state_digest(path) for label, path in paths.items()})
+
+    def __len__(self) -> int:
+        return len(self.paths)
+
+    def unit(self, label: str, sigma: float, base, fp: float, mu_r: float) -> CalibrationUnit:
+        """The shear test of specimen ``label`` at ``sigma`` with the frictions (f_p, mu_r) on ``base``."""
+        return CalibrationUnit.at(self.paths[label], self.digests[label], sigma, base, fp, mu_r)
+
+
 #: a two-sample Kolmogorov-Smirnov test of two specimens' radii below this p-value says they were
 #: drawn from different gradings (replicates of one grading pass it but once in a thousand)
 GRADING_P_VALUE = 1e-3
 
 
-def check_replicates(found: dict[str, Path], digests: dict[str, str]) -> None:
+def check_replicates(replicates: Replicates) -> None:
     """Refuse replicates whose differences are not seed scatter, on one line naming the specimen.
 
     The calibration counts the spread of the replicates at each design point as the seed
@@ -51,6 +76,7 @@ def check_replicates(found: dict[str, Path], digests: dict[str, str]) -> None:
     has none, and specimens of other box widths, disk thicknesses or gradings differ by more
     than their seeds, which would be counted as scatter and widen the intervals unseen.
     """
+    found, digests = replicates.paths, replicates.digests
     seen: dict[str, str] = {}
     for label, digest in digests.items():
         if digest in seen:
@@ -108,16 +134,22 @@ def preset_specimens(
     The criterion runs once on ``seed`` (its ``criterion``), then on the next seeds from its
     accepted porosity (its ``replicates``); seeds whose criterion does not converge are left out.
     """
-    from poro2d.criterion.config import build, paper_config
+    from poro2d.criterion.config import paper_config
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.criterion.replicates import run_replicates
 
     seed = check_int("--seed", seed, 0)
     cfg = paper_config(quick, seed)
-    spec, grading, settings, sd = build(cfg, None, threads=min(os.cpu_count() or 1, 2))
+    spec, grading, settings, sd = cfg.build(threads=min(os.cpu_count() or 1, 2))
     out = store.root
     crit = PorosityCriterion(
-        spec, grading, settings, seed=sd, store=store.child("criterion"), progress=progress, config=cfg
+        spec,
+        grading,
+        settings,
+        seed=sd,
+        store=store.child("criterion"),
+        progress=progress,
+        config=cfg.as_config(),
     )
     crit.validate()
     result = crit.run()
@@ -143,6 +175,7 @@ def preset_specimens(
 __all__ = [
     "GRADING_P_VALUE",
     "MAX_REPLICATES",
+    "Replicates",
     "check_preset",
     "check_replicates",
     "given_specimens",

@@ -9,7 +9,7 @@ that was killed.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import Any
 
@@ -54,14 +54,16 @@ class CalibrationUnit:
     settings: dict[str, Any]
 
     @classmethod
-    def at(cls, specimen, digest: str, sigma: float, base: dict, fp: float, mu_r: float) -> CalibrationUnit:
+    def at(
+        cls, specimen, digest: str, sigma: float, base: ShearSettings, fp: float, mu_r: float
+    ) -> CalibrationUnit:
         """The unit of ``specimen`` at ``sigma`` with the frictions (f_p, mu_r) on the ``base`` settings.
 
-        The settings are checked here, on the driver, before any work.
+        The settings are checked here, on the driver, before any work; the unit keeps them as
+        the table its key hashes (and its worker reads back).
         """
-        settings = dict(base, particle_friction=fp, rolling_friction=mu_r)
-        ShearSettings(**settings)
-        return cls(str(specimen), digest, float(sigma), settings)
+        settings = replace(base, particle_friction=fp, rolling_friction=mu_r)
+        return cls(str(specimen), digest, float(sigma), settings.record().to_dict())
 
     @property
     def fp(self) -> float:

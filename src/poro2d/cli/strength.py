@@ -40,15 +40,15 @@ def quick_specimens(out: Path, seeds: int, progress: bool) -> dict[str, Path]:
 
     The criterion and its replicate runs are the paper's own stages, resumable in ``out``.
     """
-    from poro2d.criterion.config import build, paper_config
+    from poro2d.criterion.config import paper_config
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.criterion.replicates import accepted_and_replicates
     from poro2d.store import Store
 
     cfg = paper_config(True, 0)
-    spec, grading, settings, seed = build(cfg, None, threads=1)
+    spec, grading, settings, seed = cfg.build(threads=1)
     crit = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(out / "criterion"),
-                             progress=progress, config=cfg)  # fmt: skip
+                             progress=progress, config=cfg.as_config())  # fmt: skip
     result = crit.run()
     if not result.converged:
         raise RuntimeError(f"the quick specimen was not accepted: {result.message}")

@@ -14,9 +14,13 @@ Example (every key optional; the defaults are the paper preset)::
 
 from __future__ import annotations
 
+import copy
 import math
 import os
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any, Self
 
 from poro2d.config import check_keys, dataclass_from_table, load_toml
 from poro2d.criterion.protocol import CriterionSettings
@@ -29,18 +33,84 @@ from poro2d.specimen.compaction import SpecimenSpec, wide_grading_spec
 TOP_KEYS = {"seed", "specimen", "grading", "criterion", "shear", "title", "density"}
 
 
-def paper_preset() -> dict:
-    """The paper's case as a config dict (Table 1, nLab = 0.3434, reconstructed grading)."""
-    return {"seed": 0, "specimen": {}, "grading": {"preset": "paper"}, "criterion": {"n_lab": PAPER_N_LAB}}
+@dataclass(frozen=True)
+class CriterionConfig:
+    """A criterion config's tables (``seed``, ``specimen``, ``grading``, ``criterion``, ...) as a value.
+
+    Read once, at the edge (a command, a preset, the one call of a study); every variation
+    (another seed, a smaller box, a friction) is a new value, so nothing below re-reads the
+    file or edits another's dict. ``config``: the tables in the order given, never changed in
+    place: result files record them as given, and case ids hash them; ``base_dir``: the folder
+    a grading file's relative path starts from.
+    """
+
+    config: Mapping[str, Any]
+    base_dir: Path | None = None
+
+    def table(self, name: str) -> dict[str, Any]:
+        """A copy of the table ``name`` as given (empty when the config has none)."""
+        return copy.deepcopy(dict(self.config.get(name) or {}))
+
+    def with_tables(self, **tables: Mapping[str, Any]) -> Self:
+        """This config with ``tables`` in place of its own (where they stood; new ones at the end)."""
+        return replace(self, config={**self.config, **{k: dict(v) for k, v in tables.items()}})
+
+    def with_defaults(self, defaults: Mapping[str, Mapping[str, Any]]) -> Self:
+        """This config with ``defaults`` filled in where its tables are silent (its own values win)."""
+        return self.with_tables(**{name: {**values, **self.table(name)} for name, values in defaults.items()})
+
+    def with_seed(self, seed: int) -> Self:
+        """This config with another seed (where ``seed`` stood; at the end when it had none)."""
+        return replace(self, config={**self.config, "seed": seed})
+
+    def without(self, *names: str) -> Self:
+        """This config without the top-level keys ``names``."""
+        return replace(self, config={k: v for k, v in self.config.items() if k not in names})
+
+    def with_params(self, params: Mapping[str, Any]) -> Self:
+        """This config with a case's parameters set, in their order: a dotted name
+        (``specimen.kn_particle``) sets a key of its table, a bare one (``seed``) a top-level key."""
+        config = dict(self.config)
+        for name, value in params.items():
+            if "." in name:
+                table, key = name.split(".", 1)
+                config[table] = {**(config.get(table) or {}), key: value}
+            else:
+                config[name] = value
+        return replace(self, config=config)
+
+    def with_grading_file_absolute(self) -> Self:
+        """This config with its grading file's path made absolute (from ``base_dir``): a case
+        run in another folder, or recorded, names the same file."""
+        g = self.config.get("grading")
+        if not (isinstance(g, Mapping) and isinstance(g.get("csv"), str) and self.base_dir is not None):
+            return self
+        path = Path(g["csv"])
+        if path.is_absolute():
+            return self
+        return self.with_tables(grading=dict(g, csv=str((self.base_dir / path).resolve())))
+
+    def as_config(self) -> dict[str, Any]:
+        """The tables as the files record them (a deep copy: a record may keep it)."""
+        return copy.deepcopy(dict(self.config))
+
+    def build(self, **overrides):
+        """(SpecimenSpec, GradingCurve, CriterionSettings, seed) of this config, every value checked."""
+        return build(self.as_config(), self.base_dir, **overrides)
 
 
-def paper_config(quick: bool, seed: int) -> dict:
-    """The paper preset as a config of ``seed`` (``quick``: the small box and the widened force window)."""
-    cfg = paper_preset()
-    cfg["seed"] = seed
+def paper_preset() -> CriterionConfig:
+    """The paper's case (Table 1, nLab = 0.3434, reconstructed grading)."""
+    tables = {"seed": 0, "specimen": {}, "grading": {"preset": "paper"}, "criterion": {"n_lab": PAPER_N_LAB}}
+    return CriterionConfig(tables)
+
+
+def paper_config(quick: bool, seed: int) -> CriterionConfig:
+    """The paper's case with ``seed`` (``quick``: the small box and the widened force window)."""
+    cfg = paper_preset().with_seed(seed)
     if quick:
-        cfg["specimen"] = dict(QUICK_SPECIMEN)
-        cfg["criterion"].update(QUICK_CRITERION)
+        quick_criterion = {**cfg.table("criterion"), **QUICK_CRITERION}
+        cfg = cfg.with_tables(specimen=QUICK_SPECIMEN, criterion=quick_criterion)
     return cfg
 
 
@@ -57,7 +127,7 @@ def load_config(
     if path is None:
         if preset not in (None, "paper"):
             raise InputError("preset", preset, "'paper'")
-        return paper_preset(), None
+        return paper_preset().as_config(), None
     cfg = load_toml(path)
     check_keys("config", cfg, TOP_KEYS | set(extra_tables))
     check_tables(cfg)

@@ -91,15 +91,16 @@ class SoilRecord(TypedResult):
 class SandCase:
     """Everything ``poro2d sand`` needs, checked: the soil, its state, the specimens' config.
 
-    ``config`` is the criterion config of the full-size specimens (density mode's defaults
-    filled in, ``criterion.n_lab`` the laboratory state), ``base_dir`` the folder its relative
-    paths start from; ``spec`` and ``grading`` are built from it.
+    ``config`` is the criterion config of the full-size specimens as a value (density mode's
+    defaults filled in, ``criterion.n_lab`` the laboratory state), which the calibration and
+    the specimens vary; ``base_dir`` the folder its relative paths start from; ``spec`` and
+    ``grading`` are built from it.
     """
 
     name: str
     reference: str
     lab: LabState
-    config: dict = field(repr=False)
+    config: CriterionBase = field(repr=False)
     base_dir: Path | None
     spec: SpecimenSpec
     grading: GradingCurve
@@ -123,7 +124,7 @@ class SandCase:
         return SoilRecord(
             name=self.name,
             reference=self.reference,
-            grading=dict(self.config.get("grading") or {}),
+            grading=self.config.table("grading"),
             grading_source=self.grading.source,
             upscale=self.grading.upscale,
             lab=LabStateRecord.from_dict(self.lab.to_dict()),
@@ -160,8 +161,11 @@ def _lab(table) -> LabState:
     return lab
 
 
-def _criterion_config(cfg: dict, lab: LabState) -> dict:
-    """The criterion config of the full-size specimens: the state's nLab, density mode's defaults."""
+def _criterion_config(cfg: dict, lab: LabState, base_dir: Path | None) -> CriterionBase:
+    """The criterion config of the full-size specimens: the state's nLab, density mode's defaults.
+
+    ``cfg``: the sand config as read (its criterion tables beside ``[soil]``, ``[lab]``, ``[sand]``).
+    """
     if "density" in cfg:
         raise InputError(
             "density",
@@ -176,7 +180,7 @@ def _criterion_config(cfg: dict, lab: LabState) -> dict:
         raise InputError("criterion.n_lab", given, f"unset or the [lab] state's n = {lab.n_lab:.4f}")
     table["n_lab"] = round(lab.n_lab, 6)
     crit["criterion"] = table
-    return with_density_defaults(CriterionBase(crit)).as_config()
+    return with_density_defaults(CriterionBase(crit, base_dir))
 
 
 #: step budgets (setting: the paper's default) that bound a stage in simulated time; they were
@@ -191,7 +195,7 @@ STEP_BUDGETS = {
 }
 
 
-def with_step_budgets(config: dict, spec: SpecimenSpec, grading: GradingCurve) -> dict:
+def with_step_budgets(config: CriterionBase, spec: SpecimenSpec, grading: GradingCurve) -> CriterionBase:
     """``config`` with every step budget it leaves unset scaled to the grading's time step.
 
     The factor is the paper grading's step over this one's (at least 1): the same simulated
@@ -203,12 +207,10 @@ def with_step_budgets(config: dict, spec: SpecimenSpec, grading: GradingCurve) -
     slow = time_step(spec, paper_grading().d_min_m) / time_step(spec, grading.d_min_m)
     if slow <= 1.0 + 1e-9:
         return config
-    out = copy.deepcopy(config)
+    tables = {name: config.table(name) for name in dict.fromkeys(table for table, _ in STEP_BUDGETS)}
     for (table, key), default in STEP_BUDGETS.items():
-        section = out.setdefault(table, {})
-        if key not in section:
-            section[key] = int(math.ceil(default * slow / 1000.0) * 1000)
-    return out
+        tables[table].setdefault(key, int(math.ceil(default * slow / 1000.0) * 1000))
+    return config.with_tables(**tables)
 
 
 def load_sand_case(config: ConfigLike, *, seeds: int | None = None) -> SandCase:
@@ -217,7 +219,7 @@ def load_sand_case(config: ConfigLike, *, seeds: int | None = None) -> SandCase:
     ``seeds`` overrides ``[sand] seeds``. Raises :class:`~poro2d.errors.InputError` naming
     the key, its value and what is allowed.
     """
-    from poro2d.criterion.config import build, check_tables, load_config
+    from poro2d.criterion.config import check_tables, load_config
 
     if isinstance(config, dict):
         check_keys("config", config, {"seed", "specimen", "grading", "criterion", "title", *SAND_TABLES})
@@ -245,10 +247,10 @@ def load_sand_case(config: ConfigLike, *, seeds: int | None = None) -> SandCase:
     mus = tuple(check_mus(sand["mu_prep"], "sand.mu_prep")) if "mu_prep" in sand else DEFAULT_MUS
     if "grading" not in cfg:
         raise InputError("grading", None, "a [grading] table: csv, sizes_mm with percent_passing, or preset")
-    crit = _criterion_config(cfg, lab)
-    spec, grading, _settings, _seed = build(crit, base_dir)
+    crit = _criterion_config(cfg, lab, base_dir)
+    spec, grading, _settings, _seed = crit.build()
     crit = with_step_budgets(crit, spec, grading)
-    spec, grading, _settings, _seed = build(crit, base_dir)
+    spec, grading, _settings, _seed = crit.build()
     return SandCase(name, reference, lab, crit, base_dir, spec, grading, n_seeds, cal_disks, mus, cal_seeds)
 
 

@@ -99,9 +99,6 @@ class Preflight:
     suggestion: str
     notes: list[str] = field(default_factory=list)
 
-    def to_dict(self) -> dict:
-        return asdict(self)
-
 
 #: a lid must rest in the calibration box: its force window at least this many times the
 #: grain weights its segments need (:data:`poro2d.criterion.lid.GRAINS_PER_SEGMENT` per segment).
@@ -292,7 +289,7 @@ def budget_suggestion(
 def _fines_cut_for(case: SandCase, budget: float, first: float, workers: int) -> tuple[float, float] | None:
     """(d_min_mm, % of the mass removed) of the smallest cut of fines whose estimate fits ``budget``."""
     g = case.grading
-    table = dict(case.config.get("grading") or {})
+    table = case.config.table("grading")
     for d in np.geomspace(g.d_min_m, g.size_at(50.0), 25)[1:]:
         d_mm = float(f"{d * 1e3:.3g}")
         try:
@@ -320,7 +317,7 @@ class Workload:
 
 def workload(case: SandCase, spec: SpecimenSpec, g: GradingCurve, first: float, workers: int) -> Workload:
     """What ``case`` costs with ``spec`` and grading ``g`` from first trial ``first`` (the model above)."""
-    crit = case.config.get("criterion") or {}
+    crit = case.config.table("criterion")
     full = BoxPlan(spec.width, spec.height, spec.layers, estimate_size(spec, g, first).disks)
     fill = crit.get("acceptance", "plate") == "fill"
     window = float(crit.get("force_fraction", 0.01)) if fill else None
@@ -350,7 +347,7 @@ def preflight(case: SandCase, *, workers: int = 2, budget_minutes: float | None 
     jam = jamming_of(g)
     from poro2d.sweep.density import first_trial, wall_share
 
-    crit = case.config.get("criterion") or {}
+    crit = case.config.table("criterion")
     first = first_trial(crit, case.mus[0], jam.porosity, wall_share(spec.width, spec.height, g.size_at(50.0)))
     check_feasible(spec, g, first)
     work = workload(case, spec, g, first, workers)
@@ -401,7 +398,7 @@ def _notes(case: SandCase, jam: Jamming, eq12: float, dt: float, dt_paper: float
             "cutting fines (d_min_mm) or up-scaling more shortens every stage"
         )
     notes += _cut_notes(case)
-    crit = case.config.get("criterion") or {}
+    crit = case.config.table("criterion")
     if crit.get("acceptance", "plate") == "fill":
         from poro2d.criterion.lid import GRAINS_PER_SEGMENT, SEGMENT_D50
 
@@ -425,7 +422,7 @@ def _notes(case: SandCase, jam: Jamming, eq12: float, dt: float, dt_paper: float
 
 def _cut_notes(case: SandCase) -> list[str]:
     """What a d_min_mm / d_max_mm cut does to the soil, and how the laboratory state is read then."""
-    table = case.config.get("grading") or {}
+    table = case.config.table("grading")
     cuts = {k: table[k] for k in ("d_min_mm", "d_max_mm") if k in table}
     if not cuts:
         return []

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import ClassVar
 
 from poro2d.store import Store, walk
 from poro2d.typed_result import TypedResult
@@ -31,27 +31,16 @@ class StageProfile(TypedResult):
     """Where a stage's time went (``time_profile``, ``specimens_time_profile`` in ``sand.json``):
     its trials, and the work of its preparation and plate phases."""
 
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"prepare": PhaseProfile, "plate": PhaseProfile}
+
     trials: int
     prepare: PhaseProfile
     plate: PhaseProfile
 
-    def to_dict(self) -> dict[str, Any]:
-        out = super().to_dict()
-        for key in ("prepare", "plate"):
-            if isinstance(out.get(key), PhaseProfile):
-                out[key] = out[key].to_dict()
-        return out
-
-    @classmethod
-    def from_dict(cls, data) -> StageProfile:
-        obj = super().from_dict(data)
-        for key in ("prepare", "plate"):
-            if isinstance(getattr(obj, key), dict):
-                setattr(obj, key, PhaseProfile.from_dict(getattr(obj, key)))
-        return obj
-
 
 def _read(store: Store, name: str) -> dict | None:
+    """A criterion file's raw content (None when it is missing or not a JSON object): only a few
+    step counts and times are read from it, whichever version of the criterion wrote it."""
     data = store.read_json(name)
     return data if isinstance(data, dict) else None
 
@@ -63,6 +52,7 @@ def _preparation_steps(trial: Store) -> int:
 
 
 def _trial_stores(run: Store) -> dict[int, Store]:
+    """The trial folders of a criterion store by trial number."""
     out = {}
     for trial in walk(run.child("trials"), "*_n*"):
         head = trial.root.name.split("_", 1)[0]

@@ -10,13 +10,14 @@ from __future__ import annotations
 import csv
 import io
 import math
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
 
 from poro2d.io_utils import Provenance
 from poro2d.sand.case import LabStateRecord, SoilRecord
+from poro2d.sand.preflight import Preflight
 from poro2d.sand.profile import StageProfile
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
@@ -29,9 +30,12 @@ def _stats(values: list[float | None]) -> tuple[float, float]:
     return float(v.mean()), float(v.std(ddof=1)) if v.size > 1 else 0.0
 
 
-@dataclass(frozen=True)
-class SeedSpecimen:
-    """One seed's specimen at full size: accepted or why not, its porosities, its folder."""
+@dataclass(eq=False)
+class SeedSpecimen(TypedResult):
+    """One seed's specimen at full size: accepted or why not, its porosities, its folder.
+
+    It is also the record ``sand.json`` keeps of each seed (``seed_results``).
+    """
 
     seed: int
     accepted: bool
@@ -62,9 +66,6 @@ class SeedSpecimen:
             folder,
             "" if ok else str(why),
         )
-
-    def to_dict(self) -> dict:
-        return dict(self.__dict__)
 
 
 @dataclass(eq=False)
@@ -102,7 +103,7 @@ class StageEstimate(TypedResult):
 
 @dataclass(eq=False)
 class PreflightRecord(TypedResult):
-    """The pre-flight as ``sand.json`` keeps it (:meth:`poro2d.sand.preflight.Preflight.to_dict`)."""
+    """A :class:`~poro2d.sand.preflight.Preflight` as ``preflight.json`` and ``sand.json`` keep it."""
 
     soil: str
     d_min_m: float
@@ -137,19 +138,11 @@ class PreflightRecord(TypedResult):
         "seconds": StageEstimate,
     }
 
-
-@dataclass(eq=False)
-class SeedResult(TypedResult):
-    """One seed's specimen as ``sand.json`` keeps it (``seed_results``: a :class:`SeedSpecimen`'s fields)."""
-
-    seed: int
-    accepted: bool
-    box_porosity: float | None
-    interior_porosity: float | None
-    particle_count: int | None
-    trials: int | None
-    folder: str | None
-    message: str
+    @classmethod
+    def of(cls, pf: Preflight) -> PreflightRecord:
+        """The record of a pre-flight (``preflight.json``'s and ``sand.json``'s): its fields, in
+        their order, the boxes, the jamming porosity and the estimates as their records."""
+        return cls.from_dict(asdict(pf))
 
 
 @dataclass(eq=False)
@@ -240,7 +233,7 @@ class SandResult(TypedResult):
     jamming_porosity_sd: float | None
     calibration: SandCalibration
     states: list[AcceptedState]
-    seed_results: list[SeedResult]
+    seed_results: list[SeedSpecimen]
     preflight: PreflightRecord
     wall_seconds: float
     config: dict[str, Any]
@@ -253,7 +246,7 @@ class SandResult(TypedResult):
         "calibration": SandCalibration,
         "state": LabStateRecord,
         "states": AcceptedState,
-        "seed_results": SeedResult,
+        "seed_results": SeedSpecimen,
         "preflight": PreflightRecord,
         "provenance": Provenance,
     }
@@ -306,10 +299,10 @@ class SandResult(TypedResult):
             jamming_porosity_sd=pf.jamming.sd,
             calibration=cal_record,
             states=states,
-            seed_results=[SeedResult.from_dict(k.to_dict()) for k in kept],
-            preflight=PreflightRecord.from_dict(pf.to_dict()),
+            seed_results=list(kept),
+            preflight=PreflightRecord.of(pf),
             wall_seconds=seconds,
-            config=case.config,
+            config=case.config.as_config(),
             provenance=Provenance.now(),
             specimens=list(kept),
         )
@@ -319,45 +312,47 @@ def _pm(mean: float, sd: float) -> str:
     return "n/a" if not math.isfinite(mean) else f"{mean:.4f} +- {sd:.4f}"
 
 
-SUMMARY_COLUMNS = (
-    "soil",
-    "upscale",
-    "disks",
-    "n_lab",
-    "e",
-    "Dr",
-    "mu_prep",
-    "interior_porosity",
-    "interior_sd",
-    "box_porosity",
-    "box_sd",
-    "solid_fraction",
-    "jamming_porosity",
-    "seeds",
-    "seeds_accepted",
-)
+@dataclass(eq=False)
+class SummaryRow(TypedResult):
+    """The row of ``summary.csv``: the soil, its state, the answer over seeds (fields in column order)."""
 
+    soil: str | None
+    upscale: float | None
+    disks: int
+    n_lab: float
+    e: float
+    Dr: float | None
+    mu_prep: float
+    interior_porosity: float
+    interior_sd: float
+    box_porosity: float
+    box_sd: float
+    solid_fraction: float
+    jamming_porosity: float
+    seeds: int
+    seeds_accepted: int
 
-def summary_row(res: SandResult) -> dict:
-    """One row of the summary table (the CSV's, the markdown's)."""
-    st, pf = res.state, res.preflight
-    return {
-        "soil": res.soil.get("name"),
-        "upscale": res.soil.get("upscale"),
-        "disks": round(pf["box"]["disks"]),
-        "n_lab": st["n_lab"],
-        "e": st["e"],
-        "Dr": st.get("relative_density"),
-        "mu_prep": res.mu_prep,
-        "interior_porosity": res.interior_porosity_mean,
-        "interior_sd": res.interior_porosity_sd,
-        "box_porosity": res.box_porosity_mean,
-        "box_sd": res.box_porosity_sd,
-        "solid_fraction": res.solid_fraction_mean,
-        "jamming_porosity": res.jamming_porosity,
-        "seeds": res.seeds,
-        "seeds_accepted": res.seeds_accepted,
-    }
+    @classmethod
+    def of(cls, res: SandResult) -> SummaryRow:
+        """The row of a finished run."""
+        st, pf = res.state, res.preflight
+        return cls(
+            res.soil.get("name"),
+            res.soil.get("upscale"),
+            round(pf["box"]["disks"]),
+            st["n_lab"],
+            st["e"],
+            st.get("relative_density"),
+            res.mu_prep,
+            res.interior_porosity_mean,
+            res.interior_porosity_sd,
+            res.box_porosity_mean,
+            res.box_porosity_sd,
+            res.solid_fraction_mean,
+            res.jamming_porosity,
+            res.seeds,
+            res.seeds_accepted,
+        )
 
 
 def summary_markdown(res: SandResult, store: Store) -> str:
@@ -461,9 +456,10 @@ def _fmt(v: float | None) -> str:
 def write_summary(res: SandResult, store: Store) -> None:
     """``summary.md``, ``summary.csv`` and, last (it marks the run done), ``sand.json``."""
     buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=SUMMARY_COLUMNS, lineterminator="\n")
+    row = SummaryRow.of(res).to_dict()
+    w = csv.DictWriter(buf, fieldnames=list(row), lineterminator="\n")
     w.writeheader()
-    w.writerow(summary_row(res))
+    w.writerow(row)
     for name, text in (("summary.md", summary_markdown(res, store)), ("summary.csv", buf.getvalue())):
         store.write_text(name, text)
     store.write_result("sand.json", res)
@@ -474,7 +470,7 @@ __all__ = [
     "SandResult",
     "SeedSpecimen",
     "summary_markdown",
-    "summary_row",
+    "SummaryRow",
     "warnings",
     "write_summary",
 ]

@@ -36,6 +36,7 @@ from poro2d.sand.preflight import Preflight, preflight
 from poro2d.sand.profile import case_runs, stage_profile
 from poro2d.sand.result import (
     DensityCalibrationRecord,
+    PreflightRecord,
     SandCalibration,
     SandResult,
     SeedSpecimen,
@@ -92,14 +93,11 @@ def _clock(seconds: float) -> str:
     return f"{s // 3600:d}:{s % 3600 // 60:02d}:{s % 60:02d}"
 
 
-def calibration_config(case: SandCase, pf: Preflight) -> dict:
+def calibration_config(case: SandCase, pf: Preflight) -> CriterionBase:
     """The criterion config of the calibration's cases: the sand's, in the calibration box."""
-    import copy
-
-    cfg = copy.deepcopy(case.config)
     box = pf.calibration_box
-    cfg["specimen"] = dict(cfg.get("specimen") or {}, width=box.width, height=box.height, layers=box.layers)
-    return cfg
+    specimen = dict(case.config.table("specimen"), width=box.width, height=box.height, layers=box.layers)
+    return case.config.with_tables(specimen=specimen)
 
 
 def predicted_mu(cal_ends: Calibration, n2d_target: float) -> float:
@@ -162,9 +160,8 @@ def calibration_cases(case: SandCase, pf: Preflight, mus: list[float]) -> list:
 
 
 def _calibration_case(case: SandCase, pf: Preflight, mus: list[float], loosest_first: bool = False):
-    base = CriterionBase(calibration_config(case, pf), case.base_dir)
-    return D.CalibrationCase(base, tuple(mus), case.calibration_seeds, **asdict(_first_trial_shifts(pf)),
-                             loosest_first=loosest_first)  # fmt: skip
+    base, shifts = calibration_config(case, pf), asdict(_first_trial_shifts(pf))
+    return D.CalibrationCase(base, tuple(mus), case.calibration_seeds, **shifts, loosest_first=loosest_first)
 
 
 def _calibrate(case, pf, store: Store, mus, record, cal_kw) -> tuple[Calibration, dict]:
@@ -233,9 +230,9 @@ def specimen_stage(case: SandCase, trial: StateTarget, store: Store, sweep_kw: d
     from poro2d.criterion.protocol import trial_grid
     from poro2d.sweep.runner import run_sweep
 
-    crit = case.config.get("criterion") or {}
+    crit = case.config.table("criterion")
     grid = trial_grid(float(crit.get("resolution", 0.01)), crit.get("refine_tolerance"))
-    sweep = D.StateChecks(CriterionBase(case.config, case.base_dir), (trial,), case.seeds, grid).sweep
+    sweep = D.StateChecks(case.config, (trial,), case.seeds, grid).sweep
     res = run_sweep(sweep, store.child("states"), **sweep_kw)
     return sorted(res.rows, key=lambda r: int((r.get("params") or {}).get("seed", 0)))
 
@@ -316,7 +313,11 @@ def run_sand(
     case, pf = check_soil(config, seeds=seeds, workers=workers, budget_minutes=budget_minutes)
     store.write_json(
         "preflight.json",
-        {"preflight": pf.to_dict(), "soil": case.soil_record(), "provenance": Provenance.now().to_dict()},
+        {
+            "preflight": PreflightRecord.of(pf).to_dict(),
+            "soil": case.soil_record(),
+            "provenance": Provenance.now().to_dict(),
+        },
     )
     if on_preflight is not None:
         on_preflight(case, pf)
@@ -360,7 +361,7 @@ def _grading_figure(case: SandCase, radii, store: Store) -> None:
     from poro2d.report.grading_figure import grading_figure
 
     grading_figure(
-        case.config.get("grading") or {},
+        case.config.table("grading"),
         case.base_dir,
         case.grading,
         radii,

@@ -25,7 +25,8 @@ itself (the relation, the calibration) hands :func:`make_sweep` its base config 
 parameters of every case. A :class:`Case` is a value: its id is the digest of its kind
 and merged config, fixed when it is made.
 
-A case kind is a callable ``run(config, store) -> dict of scalars`` (``store``: the case's
+A case kind is a callable ``run(config, store)`` that returns the case's table cells, a
+dict of scalars or a typed record of them (``store``: the case's
 :class:`~poro2d.store.Store`, where it keeps what it writes); it is
 registered in :data:`KINDS` (and optionally a ``validate(config, base_dir)`` in
 :data:`VALIDATORS`, run before anything is submitted, that raises
@@ -44,14 +45,16 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from poro2d.config import check_finite, check_keys
+from poro2d.criterion.config import CriterionConfig
 from poro2d.errors import InputError
 from poro2d.identity import identity_digest
+from poro2d.sweep.records import CriterionCaseResults
 
 if TYPE_CHECKING:
     from poro2d.store import Store
 
-#: kind -> run(config, store) -> dict of scalar results
-KINDS: dict[str, Callable[[dict, Store], dict]] = {}
+#: kind -> run(config, store) -> the case's scalar results (a dict or a typed record)
+KINDS: dict[str, Callable[[dict, Store], Mapping[str, Any]]] = {}
 #: kind -> validate(config, base_dir); raises InputError before any case runs
 VALIDATORS: dict[str, Callable[[dict, Path | None], None]] = {}
 #: tables whose dataclass field names may be used without the table prefix
@@ -67,7 +70,7 @@ CASE_TABLES = {"specimen", "grading", "criterion", "shear"}
 
 def register_kind(
     name: str,
-    run: Callable[[dict, Store], dict],
+    run: Callable[[dict, Store], Mapping[str, Any]],
     validate: Callable[[dict, Path | None], None] | None = None,
     tables: tuple[str, ...] = (),
 ) -> None:
@@ -97,10 +100,10 @@ def validate_criterion(config: dict, base_dir: Path | None = None) -> None:
     criterion_objects(config, base_dir)
 
 
-def criterion_case(config: dict, store: Store) -> dict:
+def criterion_case(config: dict, store: Store) -> CriterionCaseResults:
     """The criterion of Fig. 3 for one case; scalars of its result, of its first and of its accepted trial.
 
-    The dict is the case's row of table cells (the kind's contract with the runner).
+    ``config``: the case's merged config as its ``params.json`` records it.
     """
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.store import Store
@@ -110,43 +113,7 @@ def criterion_case(config: dict, store: Store) -> dict:
     figures = bool(config.get("sweep_options", {}).get("figures", False))
     crit = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(out_dir), progress=False,
                              config=config, figures=figures)  # fmt: skip
-    res = crit.run()
-    first = res["iterations"][0] if res["iterations"] else {}
-    # the accepted trial (not always the last: see poro2d.criterion.protocol.closed_bracket), else the last
-    its = res["iterations"]
-    last = next((r for r in its if r.get("accepted")), its[-1] if its else {})
-    return {
-        "n_lab": res["n_lab"],
-        "final_porosity": res["final_porosity"],
-        "converged": bool(res["converged"]),
-        "iterations": len(res["iterations"]),
-        "message": res["message"],
-        "initial_trial_porosity": res["initial_trial_porosity"],
-        "last_trial_porosity": last.get("trial_porosity"),
-        "last_new_porosity": last.get("new_porosity"),
-        "particle_count": last.get("particle_count"),
-        "plate_moved": last.get("plate_moved"),
-        "f_top_n_per_m": last.get("f_top_n_per_m"),
-        "f_bottom_n_per_m": last.get("f_bottom_n_per_m"),
-        "f_top_after_n_per_m": last.get("f_top_after_n_per_m"),
-        "f_bottom_after_n_per_m": last.get("f_bottom_after_n_per_m"),
-        "self_weight_n_per_m": last.get("self_weight_n_per_m"),
-        # the first trial (Eq. 12 unless given): the paper reports its forces too (its Fig. 5)
-        "first_trial_porosity": first.get("trial_porosity"),
-        "first_particle_count": first.get("particle_count"),
-        "first_f_top_n_per_m": first.get("f_top_n_per_m"),
-        "first_f_bottom_n_per_m": first.get("f_bottom_n_per_m"),
-        "first_self_weight_n_per_m": first.get("self_weight_n_per_m"),
-        "first_plate_moved": first.get("plate_moved"),
-        "first_new_porosity": first.get("new_porosity"),
-        "criterion_time_s": res.get("time_total_s"),
-        # the accepted specimen's own porosity beside the paper's box porosity n'
-        "box_porosity": res.get("box_porosity"),
-        "interior_porosity": res.get("interior_porosity"),
-        "interior_porosity_std": res.get("interior_porosity_std"),
-        "surface_gap_mean_d50": res.get("surface_gap_mean_d50"),
-        "plate_contact_fraction": res.get("plate_contact_fraction"),
-    }
+    return CriterionCaseResults.of(crit.run())
 
 
 def _register_builtin() -> None:
@@ -164,21 +131,18 @@ class Case:
     """One case, a value: its kind, the parameters that differ from the base, the merged config.
 
     ``id`` is fixed when the case is made (:func:`case_id` of kind and config), so a case
-    built again from the same values names the same folder.
+    built again from the same values names the same folder. Its fields, in their order, are
+    what its ``params.json`` records (``dataclasses.asdict``).
     """
 
+    id: str = field(default="", kw_only=True)
     kind: str
     params: dict[str, Any]
     config: dict
-    id: str = ""
 
     def __post_init__(self) -> None:
         if not self.id:
             object.__setattr__(self, "id", case_id(self.kind, self.config))
-
-    def to_dict(self) -> dict:
-        """The case as its ``params.json`` records it."""
-        return {"id": self.id, "kind": self.kind, "params": self.params, "config": self.config}
 
 
 @dataclass(frozen=True)
@@ -196,7 +160,8 @@ class SweepConfig:
 
 
 def config_tables(prefix: str = "") -> dict[str, type]:
-    """The dataclass each table of a case's config stands for, keyed ``prefix`` + table name.
+    """The dataclass each table of a case's config stands for, keyed ``prefix`` + table name (a
+    registry: which tables there are depends on the kinds registered).
 
     Their fields marked as not changing results (:mod:`poro2d.identity`: the thread count)
     are left out of a case's identity.
@@ -249,7 +214,8 @@ def resolve_name(name: str) -> str:
 
 
 def _flatten(prefix: str, table: dict) -> dict[str, Any]:
-    """Nested TOML tables (``specimen.kn = ...`` inside ``[sweep]``) to dotted keys."""
+    """Nested TOML tables (``specimen.kn = ...`` inside ``[sweep]``) to dotted keys: a table as
+    read, at the edge, before its names are resolved."""
     out: dict[str, Any] = {}
     for k, v in table.items():
         name = f"{prefix}.{k}" if prefix else str(k)
@@ -260,33 +226,12 @@ def _flatten(prefix: str, table: dict) -> dict[str, Any]:
     return out
 
 
-def apply_params(base: dict, params: dict[str, Any]) -> dict:
-    """The base config with the case's parameters set (dotted names already resolved)."""
-    cfg = copy.deepcopy({k: v for k, v in base.items() if k not in ("sweep", "relation", "title")})
-    for name, value in params.items():
-        if "." not in name:
-            cfg[name] = value
-            continue
-        table, key = name.split(".", 1)
-        cfg.setdefault(table, {})[key] = value
-    return cfg
-
-
 def _check_value(name: str, value: Any) -> Any:
     if isinstance(value, float) and not math.isfinite(value):
         raise InputError(f"sweep.{name}", value, "a finite number")
     if isinstance(value, dict):
         raise InputError(f"sweep.{name}", value, "a value (number, string, bool or list)")
     return value
-
-
-def _absolute_grading(cfg: dict, base_dir: Path | None) -> dict:
-    g = cfg.get("grading")
-    if isinstance(g, dict) and isinstance(g.get("csv"), str) and base_dir is not None:
-        p = Path(g["csv"])
-        if not p.is_absolute():
-            g["csv"] = str((base_dir / p).resolve())
-    return cfg
 
 
 def grid_cases(grid: Mapping[str, list]) -> list[dict[str, Any]]:
@@ -370,11 +315,12 @@ def make_sweep(
         _register_builtin()
     check_keys("config", raw, TOP_KEYS)
     check_finite("config", raw)
-    base = _absolute_grading(copy.deepcopy(dict(raw)), base_dir)
+    # the tables every case starts from: a study's own tables are recorded in sweep.json, not by a case
+    base = CriterionConfig(raw, base_dir).without("sweep", "relation", "title").with_grading_file_absolute()
     cases: list[Case] = []
     seen: dict[str, int] = {}
     for i, params in enumerate(combos):
-        merged = apply_params(base, params)
+        merged = base.with_params(params).as_config()
         if figures:
             merged["sweep_options"] = {"figures": True}
         case = Case(kind, params, merged)

@@ -4,7 +4,8 @@ The relation, the density calibration, the state checks and the sensitivity stud
 the criterion on variations of one config: a smaller box for a quick look, density mode's
 defaults, a friction, a first trial or a grading per case. The config is read once, at the
 edge (a command, or the one call of a study), into a :class:`CriterionBase`; each study
-derives the base it runs from with :func:`dataclasses.replace` (through the methods here)
+derives the base it runs from with :func:`dataclasses.replace` (through the methods of
+:class:`~poro2d.criterion.config.CriterionConfig`, the criterion's config as a value)
 and hands it the parameters of its cases, so no study re-reads the file or edits another's
 dict. The tables keep the order they were given in: a case's merged config, recorded in its
 ``params.json`` and named by its id, is the same whichever way the base was reached.
@@ -14,10 +15,11 @@ from __future__ import annotations
 
 import copy
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from poro2d.criterion.config import CriterionConfig
 from poro2d.sweep.cases import SweepConfig, axes_of, make_sweep
 
 #: tables of a config that describe a study, not the criterion cases it runs
@@ -25,15 +27,9 @@ STUDY_TABLES = ("relation", "sweep")
 
 
 @dataclass(frozen=True)
-class CriterionBase:
-    """A criterion config's tables (``seed``, ``specimen``, ``grading``, ``criterion``, ...) as a value.
-
-    ``config``: the tables in the order given, never changed in place (every variation is
-    a new base); ``base_dir``: the folder a grading file's relative path starts from.
-    """
-
-    config: Mapping[str, Any]
-    base_dir: Path | None = None
+class CriterionBase(CriterionConfig):
+    """The base config of a criterion study (:class:`~poro2d.criterion.config.CriterionConfig`),
+    which makes the sweeps of its cases."""
 
     @classmethod
     def from_config(
@@ -41,26 +37,6 @@ class CriterionBase:
     ) -> CriterionBase:
         """The base of a config as read (a copy: the caller's dict stays its own), without ``drop``."""
         return cls(copy.deepcopy({k: v for k, v in cfg.items() if k not in drop}), base_dir)
-
-    def table(self, name: str) -> dict[str, Any]:
-        """A copy of the table ``name`` (empty when the config has none)."""
-        return copy.deepcopy(dict(self.config.get(name) or {}))
-
-    def with_tables(self, **tables: Mapping[str, Any]) -> CriterionBase:
-        """This base with ``tables`` in place of its own (where they stood; new ones at the end)."""
-        return replace(self, config={**self.config, **{k: dict(v) for k, v in tables.items()}})
-
-    def with_defaults(self, defaults: Mapping[str, Mapping[str, Any]]) -> CriterionBase:
-        """This base with ``defaults`` filled in where its tables are silent (its own values win)."""
-        return self.with_tables(**{name: {**values, **self.table(name)} for name, values in defaults.items()})
-
-    def without(self, *names: str) -> CriterionBase:
-        """This base without the top-level keys ``names``."""
-        return replace(self, config={k: v for k, v in self.config.items() if k not in names})
-
-    def as_config(self) -> dict[str, Any]:
-        """The config as a plain dict (a deep copy: a record or a case may keep it)."""
-        return copy.deepcopy(dict(self.config))
 
     def sweep(self, table: Mapping[str, Any], cases: list[dict[str, Any]]) -> SweepConfig:
         """The sweep of criterion ``cases`` (dotted parameters) on this base.

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass, replace
+from dataclasses import asdict, dataclass, replace
 from functools import cached_property
 from pathlib import Path
 from typing import Any
@@ -32,6 +32,7 @@ from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.store import Store
 from poro2d.sweep.cases import Case, SweepConfig, criterion_objects, grid_cases
 from poro2d.sweep.criterion_base import CriterionBase
+from poro2d.sweep.records import CaseRow
 from poro2d.sweep.results import CalibrationRun
 
 #: seeds per friction and per state unless the config says otherwise
@@ -382,7 +383,7 @@ def _check_key(case: Case, base_dir: Path | None) -> str:
 
 def calibration_twins(
     calibration: SweepConfig, states: SweepConfig, base_dir: Path | None, cases: Store
-) -> dict[str, dict]:
+) -> dict[str, CaseRow]:
     """Finished calibration cases that are state checks too, as rows of those checks.
 
     The check of the densest state (Dr = 1) runs at the calibration's lowest usable friction,
@@ -397,7 +398,7 @@ def calibration_twins(
 
     done = {}
     for c in calibration.cases:
-        row = finished_row(c.to_dict(), cases.child("cases", c.id))
+        row = finished_row(asdict(c), cases.child("cases", c.id))
         if row is not None:
             done[_check_key(c, base_dir)] = (c, row)
     twins = {}
@@ -407,8 +408,9 @@ def calibration_twins(
             continue
         cal_case, row = hit
         results = dict(row.get("results") or {}, n_lab=c.config["criterion"]["n_lab"])
-        twins[c.id] = dict(row, case_id=c.id, params=dict(c.params), results=results, reused=True,
-                           reused_calibration_case=cal_case.id)  # fmt: skip
+        relabelled = dict(row, case_id=c.id, params=dict(c.params), results=results, reused=True,
+                          reused_calibration_case=cal_case.id)  # fmt: skip
+        twins[c.id] = CaseRow.from_dict(relabelled)
     return twins
 
 

@@ -5,57 +5,17 @@ A result file of the sweeps (``sweep.json``, ``relation.json``, ``density.json``
 fitted to a relation, one point per laboratory state, the answer of the sensitivity study.
 Each is a :class:`~poro2d.typed_result.TypedResult` here, its fields the record's keys in
 the file's order, so it is written and read back with exactly the keys it had, and still
-reads as the dict it was (``fit["a"]``). A result holding parts is a :class:`WithParts`:
-``PARTS`` names the fields that are parts and how each is read from its file.
+reads as the dict it was (``fit["a"]``). A result holding parts names them in ``PARTS``
+(field -> record class), which the base class reads and writes.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, ClassVar, Self
+from typing import Any, Self
 
 from poro2d.typed_result import TypedResult
-
-Decode = Callable[[Any], Any]
-
-
-def part(cls: type[TypedResult]) -> Decode:
-    """How a field holding one ``cls`` record is read from its file."""
-    return cls.from_dict
-
-
-def parts(cls: type[TypedResult]) -> Decode:
-    """How a field holding a list of ``cls`` records is read from its file."""
-    return lambda items: [cls.from_dict(x) for x in items]
-
-
-def plain(value: Any) -> Any:
-    """``value`` as its file holds it: typed parts as dicts (also inside lists and dicts)."""
-    if isinstance(value, TypedResult):
-        return value.to_dict()
-    if isinstance(value, list):
-        return [plain(v) for v in value]
-    if isinstance(value, dict):
-        return {k: plain(v) for k, v in value.items()}
-    return value
-
-
-@dataclass(eq=False)
-class WithParts(TypedResult):
-    """A typed result some of whose fields are typed parts (``PARTS``: field -> decoder)."""
-
-    PARTS: ClassVar[Mapping[str, Decode]] = {}
-
-    def to_dict(self) -> dict[str, Any]:
-        """The file's keys and values, every part as the dict its file holds."""
-        return {k: plain(v) if k in self.PARTS else v for k, v in super().to_dict().items()}
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> Self:
-        """The result of a file's dict (or of a result's), every part read as its record."""
-        decoded = {k: cls.PARTS[k](v) if k in cls.PARTS and v is not None else v for k, v in data.items()}
-        return super().from_dict(decoded)
 
 
 @dataclass(eq=False)
@@ -79,6 +39,82 @@ class CaseRow(TypedResult):
     time_s: float | None = None
     finished_utc: str | None = None
     results: dict[str, Any] | None = None
+
+
+@dataclass(eq=False)
+class CriterionCaseResults(TypedResult):
+    """The table cells of a criterion case (``results`` of its row): the run's answer, then the
+    accepted trial (else the last), then the first trial (the paper reports its forces too, its
+    Fig. 5), then the accepted specimen's own porosity beside the paper's box porosity n'."""
+
+    n_lab: float
+    final_porosity: float
+    converged: bool
+    iterations: int
+    message: str
+    initial_trial_porosity: float | None
+    last_trial_porosity: float | None
+    last_new_porosity: float | None
+    particle_count: int | None
+    plate_moved: bool | None
+    f_top_n_per_m: float | None
+    f_bottom_n_per_m: float | None
+    f_top_after_n_per_m: float | None
+    f_bottom_after_n_per_m: float | None
+    self_weight_n_per_m: float | None
+    first_trial_porosity: float | None
+    first_particle_count: int | None
+    first_f_top_n_per_m: float | None
+    first_f_bottom_n_per_m: float | None
+    first_self_weight_n_per_m: float | None
+    first_plate_moved: bool | None
+    first_new_porosity: float | None
+    criterion_time_s: float | None
+    box_porosity: float | None
+    interior_porosity: float | None
+    interior_porosity_std: float | None
+    surface_gap_mean_d50: float | None
+    plate_contact_fraction: float | None
+
+    @classmethod
+    def of(cls, res: Mapping[str, Any]) -> CriterionCaseResults:
+        """The cells of a criterion result (a ``CriterionResult``: its trials as the dicts of its file).
+
+        The accepted trial is not always the last (see ``poro2d.criterion.protocol.closed_bracket``).
+        """
+        its = res["iterations"]
+        first = its[0] if its else {}
+        last = next((r for r in its if r.get("accepted")), its[-1] if its else {})
+        return cls(
+            n_lab=res["n_lab"],
+            final_porosity=res["final_porosity"],
+            converged=bool(res["converged"]),
+            iterations=len(its),
+            message=res["message"],
+            initial_trial_porosity=res["initial_trial_porosity"],
+            last_trial_porosity=last.get("trial_porosity"),
+            last_new_porosity=last.get("new_porosity"),
+            particle_count=last.get("particle_count"),
+            plate_moved=last.get("plate_moved"),
+            f_top_n_per_m=last.get("f_top_n_per_m"),
+            f_bottom_n_per_m=last.get("f_bottom_n_per_m"),
+            f_top_after_n_per_m=last.get("f_top_after_n_per_m"),
+            f_bottom_after_n_per_m=last.get("f_bottom_after_n_per_m"),
+            self_weight_n_per_m=last.get("self_weight_n_per_m"),
+            first_trial_porosity=first.get("trial_porosity"),
+            first_particle_count=first.get("particle_count"),
+            first_f_top_n_per_m=first.get("f_top_n_per_m"),
+            first_f_bottom_n_per_m=first.get("f_bottom_n_per_m"),
+            first_self_weight_n_per_m=first.get("self_weight_n_per_m"),
+            first_plate_moved=first.get("plate_moved"),
+            first_new_porosity=first.get("new_porosity"),
+            criterion_time_s=res.get("time_total_s"),
+            box_porosity=res.get("box_porosity"),
+            interior_porosity=res.get("interior_porosity"),
+            interior_porosity_std=res.get("interior_porosity_std"),
+            surface_gap_mean_d50=res.get("surface_gap_mean_d50"),
+            plate_contact_fraction=res.get("plate_contact_fraction"),
+        )
 
 
 @dataclass(eq=False)
@@ -128,7 +164,7 @@ class SweepSummary(TypedResult):
 
 
 @dataclass(eq=False)
-class CalibrationRun(WithParts):
+class CalibrationRun(TypedResult):
     """Where a calibration's cases are and how many ran (``sweeps.calibration`` of a relation).
 
     ``key``: the digest naming its cache entry; ``cases``: the folder of its sweep;
@@ -139,7 +175,7 @@ class CalibrationRun(WithParts):
     """
 
     OPTIONAL = ("interior",)
-    PARTS = {"summary": part(SweepSummary)}
+    PARTS = {"summary": SweepSummary}
 
     key: str
     cases: str
@@ -152,10 +188,10 @@ class CalibrationRun(WithParts):
 
 
 @dataclass(eq=False)
-class DensitySweeps(WithParts):
+class DensitySweeps(TypedResult):
     """The two sweeps of density mode: the calibration's, the state checks' and their failures."""
 
-    PARTS = {"calibration": part(CalibrationRun), "states_summary": part(SweepSummary)}
+    PARTS = {"calibration": CalibrationRun, "states_summary": SweepSummary}
 
     calibration: CalibrationRun
     states_summary: SweepSummary
@@ -198,7 +234,22 @@ class Spread(TypedResult):
 
 
 @dataclass(eq=False)
-class PaperPoint(TypedResult):
+class RelationPoint(TypedResult):
+    """One laboratory state of a relation: a paper-mode point (it names its case) or a density-mode one.
+
+    A relation's file holds either kind in its ``points``; reading a point as a
+    ``RelationPoint`` gives the kind its keys say.
+    """
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Self:
+        if cls is RelationPoint:
+            return (PaperPoint if "case_id" in data else DensityPoint).from_dict(data)
+        return super().from_dict(data)
+
+
+@dataclass(eq=False)
+class PaperPoint(RelationPoint):
     """One laboratory state of a paper-mode relation: its case, the criterion's n2D, the methods.
 
     ``n2d_dem``: the accepted n2D, else the last estimate n' (``flag`` says which) or NaN for
@@ -227,7 +278,7 @@ class PaperPoint(TypedResult):
 
 
 @dataclass(eq=False)
-class DensityPoint(TypedResult):
+class DensityPoint(RelationPoint):
     """One laboratory state of a density-mode relation: its target, friction and n2D over seeds.
 
     ``n2d_dem``: the mean accepted n2D of the converged seeds (``n2d_seeds`` each);
@@ -262,25 +313,17 @@ class DensityPoint(TypedResult):
     dem_minus_parabola: float | None = None
 
 
-def relation_points(items: list[Mapping[str, Any]]) -> list[PaperPoint | DensityPoint]:
-    """A relation's points read from its file: a paper-mode point names its case, a density one not."""
-    return [(PaperPoint if "case_id" in p else DensityPoint).from_dict(p) for p in items]
-
-
 __all__ = [
     "CalibrationRun",
     "CaseEntry",
     "CaseRow",
+    "CriterionCaseResults",
     "LostCaseRow",
     "DensityPoint",
     "DensitySweeps",
     "PaperPoint",
     "QuadraticFit",
+    "RelationPoint",
     "Spread",
     "SweepSummary",
-    "WithParts",
-    "part",
-    "parts",
-    "plain",
-    "relation_points",
 ]

@@ -22,12 +22,9 @@ from poro2d.sweep.records import (
     LostCaseRow,
     PaperPoint,
     QuadraticFit,
+    RelationPoint,
     Spread,
     SweepSummary,
-    WithParts,
-    part,
-    parts,
-    relation_points,
 )
 from poro2d.sweep.sensitivity_records import (
     Answer,
@@ -37,11 +34,11 @@ from poro2d.sweep.sensitivity_records import (
     SensitivityPoints,
     SensitivitySettings,
 )
-from poro2d.typed_result import NOT_IN_FILE
+from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
 @dataclass(eq=False)
-class SweepResult(WithParts):
+class SweepResult(TypedResult):
     """A finished sweep (its ``sweep.json``), with every case's row and the table of them.
 
     ``cases``: id and parameters of each case; ``config``: the sweep's config as given;
@@ -51,7 +48,7 @@ class SweepResult(WithParts):
     ``table``: the same as a pandas DataFrame (``results.csv``).
     """
 
-    PARTS = {"cases": parts(CaseEntry), "summary": part(SweepSummary), "provenance": part(Provenance)}
+    PARTS = {"cases": CaseEntry, "summary": SweepSummary, "provenance": Provenance}
 
     status: str
     title: str
@@ -77,7 +74,7 @@ class SweepResult(WithParts):
 
 
 @dataclass(eq=False)
-class DensityStateResult(WithParts):
+class DensityStateResult(TypedResult):
     """The density-controlled criterion for one laboratory state (``density.json``).
 
     The state (``n_lab``, ``relative_density``), its 2D target and preparation friction
@@ -87,7 +84,7 @@ class DensityStateResult(WithParts):
     the state sweep's summary.
     """
 
-    PARTS = {"sweeps": part(DensitySweeps), "provenance": part(Provenance)}
+    PARTS = {"sweeps": DensitySweeps, "provenance": Provenance}
 
     mode: str
     n_lab: float
@@ -113,7 +110,7 @@ class DensityStateResult(WithParts):
 
 
 @dataclass(eq=False)
-class RelationResult(WithParts):
+class RelationResult(TypedResult):
     """The relation n2D(nLab) of one grading (``relation.json``).
 
     ``points``: one dict per laboratory state, loose to dense; ``fit``: the Eq. 12-form
@@ -122,9 +119,9 @@ class RelationResult(WithParts):
     (calibration and state sweeps); paper mode the one sweep's ``sweep_summary``.
     """
 
-    PARTS = {"points": relation_points, "fit": part(QuadraticFit), "spread": part(Spread),
-             "sweep_summary": part(SweepSummary), "sweeps": part(DensitySweeps),
-             "provenance": part(Provenance)}  # fmt: skip
+    PARTS = {"points": RelationPoint, "fit": QuadraticFit, "spread": Spread,
+             "sweep_summary": SweepSummary, "sweeps": DensitySweeps,
+             "provenance": Provenance}  # fmt: skip
 
     n_max: float
     n_min: float
@@ -154,7 +151,7 @@ class RelationResult(WithParts):
 
 
 @dataclass(eq=False)
-class SensitivityResult(WithParts):
+class SensitivityResult(TypedResult):
     """The accepted n2D against grading width and preparation friction (``sensitivity.json``).
 
     ``points``: ``grading`` (one per Cu, the reference first) and ``mu_prep`` (one per
@@ -163,9 +160,9 @@ class SensitivityResult(WithParts):
     ``figure``: the figure's path (a study read back points it into its folder).
     """
 
-    PARTS = {"settings": part(SensitivitySettings), "gradings": parts(GradingDescription),
-             "seeds": parts(SeedRecord), "points": part(SensitivityPoints), "sweeps": part(GradingSweeps),
-             "answer": part(Answer), "provenance": part(Provenance)}  # fmt: skip
+    PARTS = {"settings": SensitivitySettings, "gradings": GradingDescription,
+             "seeds": SeedRecord, "points": SensitivityPoints, "sweeps": GradingSweeps,
+             "answer": Answer, "provenance": Provenance}  # fmt: skip
 
     title: str
     settings: SensitivitySettings

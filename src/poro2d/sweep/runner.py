@@ -25,6 +25,7 @@ import os
 import socket
 import time
 import traceback
+from dataclasses import asdict
 from datetime import UTC, datetime
 from typing import Any
 
@@ -38,6 +39,7 @@ from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.sweep.cases import KINDS, Case, SweepConfig, config_tables
 from poro2d.sweep.records import CaseRow, LostCaseRow, SweepSummary
 from poro2d.sweep.results import SweepResult
+from poro2d.typed_result import TypedResult
 
 RESULT = "result.json"
 PARAMS = "params.json"
@@ -139,8 +141,12 @@ def _run_case(case: dict, store: Store, func) -> CaseRow:
 def _done_row(case: dict, store: Store, func, row: dict, t0: float) -> CaseRow:
     """Run the case's kind into its sub-store ``run``; its row (``status`` done, results as table cells)."""
     results = func(case["config"], store.child("run"))
+    if isinstance(results, TypedResult):  # a kind's typed record of its cells
+        results = results.to_dict()
     if not isinstance(results, dict):
-        raise TypeError(f"case kind {case['kind']!r} returned {type(results).__name__}, not a dict")
+        raise TypeError(
+            f"case kind {case['kind']!r} returned {type(results).__name__}, not a dict or a record"
+        )
     results = {str(k): _scalar(v) for k, v in results.items()}
     row.update(status="done", error=None, time_s=time.perf_counter() - t0, finished_utc=_now())
     row["results"] = results
@@ -173,7 +179,7 @@ def _failed_row(case: Case, store: Store, err: BaseException, tb: str) -> LostCa
         "worker": None,
         "finished_utc": _now(),
     })  # fmt: skip
-    case_stage(case.to_dict(), store).bind()
+    case_stage(asdict(case), store).bind()
     store.write_text(ERROR_TXT, tb or row.error)
     store.write_result(ERROR_JSON, row)
     return row
@@ -266,7 +272,7 @@ def _run_sweep(sweep: SweepConfig, store: Store, *, client, scheduler, workers, 
     rows: dict[str, CaseRow | LostCaseRow] = {}
     pending: list[Case] = []
     for c in sweep.cases:
-        done = finished_row(c.to_dict(), cases.child(c.id))
+        done = finished_row(asdict(c), cases.child(c.id))
         if done is not None:
             rows[c.id] = CaseRow.from_dict(dict(done, status="done", reused=True))
         else:
@@ -343,11 +349,11 @@ def _submit_all(
     n_reused: int,
     n_total: int,
 ) -> dict[str, CaseRow | LostCaseRow]:
-    """Every pending case as a job; its row (a failed task's as an error row) as it ends."""
+    """Every pending case as a job; the rows by case id (a failed task's as an error row) as they end."""
     from poro2d.progress import CountProgress
 
     jobs = [
-        Job(compute_case, (c.to_dict(), cases.child(c.id), KINDS[c.kind]), c.id, key=f"{c.kind}-{c.id}",
+        Job(compute_case, (asdict(c), cases.child(c.id), KINDS[c.kind]), c.id, key=f"{c.kind}-{c.id}",
             retries=retries)
         for c in pending
     ]  # fmt: skip

@@ -23,7 +23,6 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -31,6 +30,7 @@ import numpy as np
 from poro2d.config import check_keys, check_number_list
 from poro2d.errors import InputError
 from poro2d.io_utils import check_output_dir
+from poro2d.paper_data import QUICK_CRITERION
 from poro2d.store import Store
 from poro2d.sweep.cases import SweepConfig
 from poro2d.sweep.criterion_base import CriterionBase
@@ -69,13 +69,6 @@ def paper_numbers() -> PaperNumbers:
     from poro2d.paper_data import PAPER
 
     return PaperNumbers(n_lab=PAPER["n_lab"], **PAPER["criterion"])
-
-
-def quick_criterion() -> dict:
-    """The criterion settings of a quick run: those of ``poro2d paper --quick``."""
-    from poro2d.paper_data import QUICK_CRITERION
-
-    return dict(QUICK_CRITERION)
 
 
 # ------------------------------------------------------------------------------ settings
@@ -120,7 +113,7 @@ def study_base(base: CriterionBase, *, quick: bool) -> CriterionBase:
         study = study.with_tables(specimen=dict(study.table("specimen"), **QUICK_SPECIMEN))
         # in a box of a few hundred disks 1 % of G is about two disks' weight: the quick
         # look widens the window as `poro2d paper --quick` does (a config's own value wins)
-        study = study.with_defaults({"criterion": quick_criterion()})
+        study = study.with_defaults({"criterion": QUICK_CRITERION})
     return study
 
 
@@ -153,9 +146,9 @@ class GradingCase:
 
 
 def _reference_params(base: CriterionBase) -> dict[str, Any]:
-    g = base.table("grading") or {"preset": "paper"}
-    if isinstance(g.get("csv"), str) and base.base_dir is not None and not Path(g["csv"]).is_absolute():
-        g["csv"] = str((base.base_dir / g["csv"]).resolve())
+    """The config's own grading as a case's parameters (dotted names, a grading file's path made
+    absolute): the reference case names its grading as the family's cases name theirs."""
+    g = base.with_grading_file_absolute().table("grading") or {"preset": "paper"}
     return {f"grading.{k}": v for k, v in g.items()}
 
 
@@ -530,6 +523,8 @@ def write_sensitivity(sens: dict, store: Store) -> SensitivityResult:
 
 
 def _csv_row(p: dict, sens: dict) -> dict:
+    """A row of ``sensitivity.csv``: the point's own columns (a grading's or a friction's, which
+    differ), then whether it reproduces the paper's n2D, the seeds and the version."""
     target, tol = sens["answer"]["target"], sens["answer"]["tolerance"]
     row = {k: v for k, v in p.items()}
     row["reproduces_paper"] = math.isfinite(p["n2d_mean"]) and abs(p["n2d_mean"] - target) <= tol + 1e-12

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from poro2d.sweep.records import SweepSummary, WithParts, part, parts
+from poro2d.sweep.records import SweepSummary
 from poro2d.typed_result import TypedResult
 
 
@@ -157,10 +157,10 @@ class MuPoint(TypedResult):
 
 
 @dataclass(eq=False)
-class SensitivityPoints(WithParts):
+class SensitivityPoints(TypedResult):
     """The study's two axes: one point per grading (the reference first), one per friction."""
 
-    PARTS = {"grading": parts(GradingPoint), "mu_prep": parts(MuPoint)}
+    PARTS = {"grading": GradingPoint, "mu_prep": MuPoint}
 
     grading: list[GradingPoint]
     mu_prep: list[MuPoint]
@@ -182,10 +182,10 @@ class Match(TypedResult):
 
 
 @dataclass(eq=False)
-class Answer(WithParts):
+class Answer(TypedResult):
     """Which grading width and which friction accept the paper's n2D, and the lines saying so."""
 
-    PARTS = {"grading": part(Match), "mu_prep": part(Match)}
+    PARTS = {"grading": Match, "mu_prep": Match}
 
     target: float
     tolerance: float
@@ -195,10 +195,10 @@ class Answer(WithParts):
 
 
 @dataclass(eq=False)
-class GradingSweeps(WithParts):
+class GradingSweeps(TypedResult):
     """The grading axis's sweep: its summary and the cases that failed."""
 
-    PARTS = {"grading": part(SweepSummary)}
+    PARTS = {"grading": SweepSummary}
 
     grading: SweepSummary
     failed_cases: int
