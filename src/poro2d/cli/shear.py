@@ -232,7 +232,9 @@ def print_result(result: ShearSeriesResult, out: Path) -> None:
             _sci(r["max_inertial_number"]), f"{r['wall_time_s']:.0f}",
         )  # fmt: skip
     console.print(t)
-    scale = result.box_scale
+    from poro2d.shear.box_scale import box_scale_of
+
+    scale = box_scale_of(result)
     label = f"{scale.label()} " if scale is not None and scale.label() else ""
     if result.get("friction_angle_deg") is not None:
         console.print(
@@ -240,10 +242,10 @@ def print_result(result: ShearSeriesResult, out: Path) -> None:
             f"c = {result['cohesion_kpa']:.2f} kPa, R2 = {result['r2']:.4f}; "
             f"through the origin phi = {result['friction_angle_through_origin_deg']:.2f} deg"
         )
-    on_plane = [t for t in result.tests if t.plane_load_fraction_at_peak is not None]
+    on_plane = [t for t in result["tests"] if t.get("plane_load_fraction_at_peak") is not None]
     if on_plane:
-        fractions = [t.plane_load_fraction_at_peak for t in on_plane]
-        ratios = [t.peak_stress_ratio / t.plane_load_fraction_at_peak for t in on_plane]
+        fractions = [t["plane_load_fraction_at_peak"] for t in on_plane]
+        ratios = [t["peak_stress_ratio"] / t["plane_load_fraction_at_peak"] for t in on_plane]
         console.print(
             f"the shear plane carries {100 * min(fractions):.0f}-{100 * max(fractions):.0f} % of the plate's "
             f"normal stress at the peaks (side wall friction: below 100 % it holds load up, above it drags "

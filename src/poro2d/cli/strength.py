@@ -153,7 +153,9 @@ def _deg(mean, sd) -> str:
 
 
 def print_strength(result: StrengthResult, out: Path) -> None:
-    scale = result.box_scale
+    from poro2d.shear.box_scale import box_scale_of
+
+    scale = box_scale_of(result)
     label = f"{scale.label()} " if scale is not None and scale.label() else ""
     t = Table(title=f"{label}strength against rolling and particle friction (mean +- sd over specimens)")
     for col in ("mu_r", "f_p", "phi peak deg", "phi residual deg", "psi max deg", "tau/sigma residual"):

@@ -16,6 +16,7 @@ The record is written with every series (its ``box_scale``) and printed wherever
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -81,6 +82,17 @@ class BoxScale(TypedResult):
         )
 
 
+def box_scale_of(result: Mapping) -> BoxScale | None:
+    """The ``box_scale`` of a series or strength result as its record (None when it has none).
+
+    A result read back as a plain dict (``json.loads`` of its file) holds the record's dict.
+    """
+    scale = result.get("box_scale")
+    if isinstance(scale, Mapping) and not isinstance(scale, BoxScale):
+        return BoxScale.from_dict(scale)
+    return scale
+
+
 def box_scale(width: float, height: float, radii: np.ndarray) -> BoxScale:
     """The :class:`BoxScale` of a box ``width`` x ``height`` (m) holding disks of ``radii`` (m)."""
     d_max = 2.0 * float(np.max(radii))
@@ -108,5 +120,5 @@ def box_scale(width: float, height: float, radii: np.ndarray) -> BoxScale:
 
 __all__ = [
     "ASTM_MIN_ASPECT", "ASTM_MIN_HEIGHT_DMAX", "ASTM_MIN_WIDTH_DMAX", "BoxScale",
-    "SIZE_INSENSITIVE_DISKS", "SIZE_INSENSITIVE_WIDTH_DMAX", "box_scale",
+    "SIZE_INSENSITIVE_DISKS", "SIZE_INSENSITIVE_WIDTH_DMAX", "box_scale", "box_scale_of",
 ]  # fmt: skip
