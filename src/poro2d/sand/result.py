@@ -20,6 +20,7 @@ from poro2d.sand.case import LabStateRecord, SoilRecord
 from poro2d.sand.preflight import Preflight
 from poro2d.sand.profile import StageProfile
 from poro2d.store import Store
+from poro2d.sweep.records import DensityCalibrationRecord
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
@@ -143,25 +144,6 @@ class PreflightRecord(TypedResult):
         """The record of a pre-flight (``preflight.json``'s and ``sand.json``'s): its fields, in
         their order, the boxes, the jamming porosity and the estimates as their records."""
         return cls.from_dict(asdict(pf))
-
-
-@dataclass(eq=False)
-class DensityCalibrationRecord(TypedResult):
-    """mu_prep -> accepted n2D over seeds as a file keeps it (``Calibration.to_dict()``).
-
-    ``samples``: per friction, each seed's accepted n2D (None: not accepted); ``mean``, ``sd``
-    and ``fitted``: per friction, over the accepted seeds; ``failed``: per friction, the seeds
-    not accepted; ``dropped``: frictions left out of the fit.
-    """
-
-    mus: list[float]
-    samples: list[list[float | None]]
-    seeds: list[int]
-    mean: list[float | None]
-    sd: list[float | None]
-    fitted: list[float | None]
-    failed: list[int]
-    dropped: list[float]
 
 
 @dataclass(eq=False)

@@ -35,7 +35,6 @@ from poro2d.sand.case import ConfigLike, SandCase, load_sand_case
 from poro2d.sand.preflight import Preflight, preflight
 from poro2d.sand.profile import case_runs, stage_profile
 from poro2d.sand.result import (
-    DensityCalibrationRecord,
     PreflightRecord,
     SandCalibration,
     SandResult,
@@ -45,6 +44,7 @@ from poro2d.sand.result import (
 from poro2d.store import Store, walk
 from poro2d.sweep import density as D
 from poro2d.sweep.criterion_base import CriterionBase
+from poro2d.sweep.records import DensityCalibrationRecord
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
 KIND = "sand"

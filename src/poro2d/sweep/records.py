@@ -313,7 +313,36 @@ class DensityPoint(RelationPoint):
     dem_minus_parabola: float | None = None
 
 
+@dataclass(eq=False)
+class Eq12Coefficients(TypedResult):
+    """The coefficients of the paper's Eq. 12, n2D = a nLab^2 + b nLab, a relation is set beside."""
+
+    a: float
+    b: float
+
+
+@dataclass(eq=False)
+class DensityCalibrationRecord(TypedResult):
+    """mu_prep -> accepted n2D over seeds as a file keeps it (``Calibration.to_dict()``).
+
+    ``samples``: per friction, each seed's accepted n2D (None: not accepted); ``mean``, ``sd``
+    and ``fitted``: per friction, over the accepted seeds; ``failed``: per friction, the seeds
+    not accepted; ``dropped``: frictions left out of the fit.
+    """
+
+    mus: list[float]
+    samples: list[list[float | None]]
+    seeds: list[int]
+    mean: list[float | None]
+    sd: list[float | None]
+    fitted: list[float | None]
+    failed: list[int]
+    dropped: list[float]
+
+
 __all__ = [
+    "Eq12Coefficients",
+    "DensityCalibrationRecord",
     "CalibrationRun",
     "CaseEntry",
     "CaseRow",

@@ -28,7 +28,7 @@ from poro2d.store import Store
 from poro2d.sweep.cases import SweepConfig
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.output import held
-from poro2d.sweep.records import DensitySweeps, QuadraticFit
+from poro2d.sweep.records import DensitySweeps, Eq12Coefficients, QuadraticFit
 from poro2d.sweep.results import RelationResult
 
 RELATION_KEYS = {"n_max", "n_min", "points", "n_lab", "mode", "seeds", "mu_prep"}
@@ -288,7 +288,7 @@ def _relation(pts: list[dict], n_max: float, n_min: float, mode: str, **extra: A
         "fit": fit,
         "fit_note": note
         or f"fitted to the {len(good)} converged point(s); non-converged points are shown only",
-        "eq12": {"a": 0.42, "b": 0.25},
+        "eq12": Eq12Coefficients(a=0.42, b=0.25),
         "converged_points": len(good),
         "flagged_points": len(pts) - len(good),
         "mode": mode,

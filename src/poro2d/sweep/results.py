@@ -12,13 +12,16 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from poro2d.execute.dask_cluster import ClusterInfo
 from poro2d.io_utils import Provenance
 from poro2d.sweep.records import (
     CalibrationRun,
     CaseEntry,
     CaseRow,
+    DensityCalibrationRecord,
     DensityPoint,
     DensitySweeps,
+    Eq12Coefficients,
     LostCaseRow,
     PaperPoint,
     QuadraticFit,
@@ -30,6 +33,7 @@ from poro2d.sweep.sensitivity_records import (
     Answer,
     GradingDescription,
     GradingSweeps,
+    PaperNumbers,
     SeedRecord,
     SensitivityPoints,
     SensitivitySettings,
@@ -48,7 +52,7 @@ class SweepResult(TypedResult):
     ``table``: the same as a pandas DataFrame (``results.csv``).
     """
 
-    PARTS = {"cases": CaseEntry, "summary": SweepSummary, "provenance": Provenance}
+    PARTS = {"cases": CaseEntry, "summary": SweepSummary, "cluster": ClusterInfo, "provenance": Provenance}
 
     status: str
     title: str
@@ -59,7 +63,7 @@ class SweepResult(TypedResult):
     base_dir: str | None
     retries: int
     provenance: Provenance
-    cluster: dict[str, Any]
+    cluster: ClusterInfo
     summary: SweepSummary
     finished_utc: str
     rows: list[CaseRow | LostCaseRow] = field(
@@ -84,7 +88,7 @@ class DensityStateResult(TypedResult):
     the state sweep's summary.
     """
 
-    PARTS = {"sweeps": DensitySweeps, "provenance": Provenance}
+    PARTS = {"sweeps": DensitySweeps, "calibration": DensityCalibrationRecord, "provenance": Provenance}
 
     mode: str
     n_lab: float
@@ -103,7 +107,7 @@ class DensityStateResult(TypedResult):
     converged: bool
     n2d_min: float
     n2d_max: float
-    calibration: dict[str, Any]
+    calibration: DensityCalibrationRecord
     sweeps: DensitySweeps
     config: dict[str, Any]
     provenance: Provenance
@@ -120,19 +124,19 @@ class RelationResult(TypedResult):
     """
 
     PARTS = {"points": RelationPoint, "fit": QuadraticFit, "spread": Spread,
-             "sweep_summary": SweepSummary, "sweeps": DensitySweeps,
-             "provenance": Provenance}  # fmt: skip
+             "sweep_summary": SweepSummary, "sweeps": DensitySweeps, "eq12": Eq12Coefficients,
+             "calibration": DensityCalibrationRecord, "provenance": Provenance}  # fmt: skip
 
     n_max: float
     n_min: float
     points: list[PaperPoint | DensityPoint]
     fit: QuadraticFit | None
     fit_note: str
-    eq12: dict[str, float]
+    eq12: Eq12Coefficients
     converged_points: int
     flagged_points: int
     mode: str
-    calibration: dict[str, Any] | None = None
+    calibration: DensityCalibrationRecord | None = None
     n2d_max: float | None = None
     n2d_min: float | None = None
     spread: Spread | None = None
@@ -162,7 +166,7 @@ class SensitivityResult(TypedResult):
 
     PARTS = {"settings": SensitivitySettings, "gradings": GradingDescription,
              "seeds": SeedRecord, "points": SensitivityPoints, "sweeps": GradingSweeps,
-             "answer": Answer, "provenance": Provenance}  # fmt: skip
+             "answer": Answer, "paper": PaperNumbers, "provenance": Provenance}  # fmt: skip
 
     title: str
     settings: SensitivitySettings
@@ -170,7 +174,7 @@ class SensitivityResult(TypedResult):
     seeds: list[SeedRecord]
     points: SensitivityPoints
     calibration: dict[str, Any]
-    paper: dict[str, Any]
+    paper: PaperNumbers
     config: dict[str, Any]
     sweeps: GradingSweeps
     timings: dict[str, float]
