@@ -37,6 +37,8 @@ from poro2d.sweep.sensitivity_records import (
     SeedRecord,
     SensitivityPoints,
     SensitivitySettings,
+    StudyCalibration,
+    StudyTimings,
 )
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
@@ -166,18 +168,19 @@ class SensitivityResult(TypedResult):
 
     PARTS = {"settings": SensitivitySettings, "gradings": GradingDescription,
              "seeds": SeedRecord, "points": SensitivityPoints, "sweeps": GradingSweeps,
-             "answer": Answer, "paper": PaperNumbers, "provenance": Provenance}  # fmt: skip
+             "answer": Answer, "paper": PaperNumbers, "calibration": StudyCalibration,
+             "timings": StudyTimings, "provenance": Provenance}  # fmt: skip
 
     title: str
     settings: SensitivitySettings
     gradings: list[GradingDescription]
     seeds: list[SeedRecord]
     points: SensitivityPoints
-    calibration: dict[str, Any]
+    calibration: StudyCalibration
     paper: PaperNumbers
     config: dict[str, Any]
     sweeps: GradingSweeps
-    timings: dict[str, float]
+    timings: StudyTimings
     answer: Answer
     figure: str | None = None
     provenance: Provenance | None = None

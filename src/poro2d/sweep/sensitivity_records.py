@@ -204,7 +204,45 @@ class GradingSweeps(TypedResult):
     failed_cases: int
 
 
+@dataclass(eq=False)
+class StudyCalibration(TypedResult):
+    """The density calibration of a sensitivity study (its ``calibration``): mu_prep -> n2D over
+    seeds (the fields of :class:`~poro2d.sweep.records.DensityCalibrationRecord`) merged with
+    where it ran (those of :class:`~poro2d.sweep.records.CalibrationRun`); ``failed`` is the
+    run's count of failed cases, which takes the place of the per-friction seeds not accepted.
+    """
+
+    PARTS = {"summary": SweepSummary}
+
+    mus: list[float]
+    samples: list[list[float | None]]
+    seeds: list[int]
+    mean: list[float | None]
+    sd: list[float | None]
+    fitted: list[float | None]
+    failed: int | list[int] | None
+    dropped: list[float]
+    key: str
+    cases: str
+    ran: int
+    reused: int
+    source: str
+    interior: list[list[float | None]] | None = None
+    summary: SweepSummary | None = None
+
+
+@dataclass(eq=False)
+class StudyTimings(TypedResult):
+    """Where a sensitivity study's time went (s): the grading sweep, the friction calibration, all."""
+
+    grading_s: float
+    mu_prep_s: float
+    total_s: float | None = None
+
+
 __all__ = [
+    "StudyCalibration",
+    "StudyTimings",
     "Answer",
     "GradingDescription",
     "GradingPoint",
