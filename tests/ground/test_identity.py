@@ -34,6 +34,7 @@ OTHER = {
     "acceptance": "fill",
     "particle_friction": 0.5,
     "rolling_friction": 0.1,
+    "rolling_friction_prep": 0.1,
     "local_damping": 0.5,
     "undercompaction": 0.05,
     "gap": 1e-4,

@@ -197,3 +197,19 @@ def test_the_specimen_row_keeps_the_run_identity():
     )
     row, other = SpecimenSpec(max_disks=10**6).to_dict(), SpecimenSpec().to_dict()
     assert "max_disks" not in row and row["extra"] == {} and row["extra"] is not other["extra"]
+
+
+def test_rolling_resistance_of_the_preparation_acts_while_layers_are_built_then_gives_way():
+    from poro2d.specimen import paper_grading as grading
+
+    spec = SpecimenSpec(width=0.05, height=0.025, layers=2, friction_prep=1.0, rolling_friction_prep=0.3)
+    sim, rep = prepare_specimen(spec, grading(), 0.2, seed=0)
+    assert rep.converged
+    assert float(sim.particles.mu_r.max()) == 0.0  # the working material has none
+    without = SpecimenSpec(width=0.05, height=0.025, layers=2, friction_prep=1.0)
+    plain, _ = prepare_specimen(without, grading(), 0.2, seed=0)
+    # the layers were built with it: the packing differs from one built without
+    assert not np.array_equal(sim.particles.pos, plain.particles.pos)
+    # recorded only when set, so the records (and digests) of every earlier specimen stay as they were
+    assert spec.to_dict()["rolling_friction_prep"] == 0.3
+    assert "rolling_friction_prep" not in SpecimenSpec().to_dict()

@@ -71,7 +71,7 @@ REFUSE_SECONDS = 6 * 3600.0
 #: settings recorded with results only when they differ from these defaults (see ``to_dict``)
 OMITTED_AT_DEFAULT = {
     "equilibrium": "max", "settle_drift": None, "settle_window": 10_000, "settle_checks": 3,
-    "rolling_friction": 0.0,
+    "rolling_friction": 0.0, "rolling_friction_prep": 0.0,
 }  # fmt: skip
 
 
@@ -84,6 +84,7 @@ SPECIMEN_RANGES: Ranges = {
         for k in ("ks_particle", "ks_wall", "friction_prep", "friction_particle", "friction_wall")
     },
     "rolling_friction": Real(0, MAX_ROLLING_FRICTION),
+    "rolling_friction_prep": Real(0, MAX_ROLLING_FRICTION),
     "layers": Integer(1, 50),
     "undercompaction": Real(0.0, 0.5),
     "ratio": Real(0.0, 1.0, lo_open=True),
@@ -125,6 +126,9 @@ class SpecimenSpec(Record):
     # rolling resistance of the working material (docs/engine.md), set with friction_particle
     # on disks and walls; 0: none, the paper's round disks
     rolling_friction: float = 0.0
+    # rolling resistance while the layers are built (with friction_prep): it lets a packing
+    # hold looser arrangements than sliding friction alone; the working value replaces it
+    rolling_friction_prep: float = 0.0
     layers: int = 4
     undercompaction: float = 0.0
     ratio: float = 1e-3
@@ -708,7 +712,7 @@ def prepare_specimen(
     final = None
     if failed is None:
         sim.set_particle_friction(spec.friction_particle)
-        if spec.rolling_friction > 0.0:
+        if spec.rolling_friction > 0.0 or spec.rolling_friction_prep > 0.0:
             sim.set_rolling_friction(spec.rolling_friction, walls=spec.rolling_friction)
         final = equilibrate(sim, spec, "working friction", progress)
         if not final.converged:
@@ -779,6 +783,8 @@ def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.nda
     # the fill acceptance's lid to park it higher (criterion.lid): needed above an over-full
     # band and in boxes taller than wide; the paper's box is closed far above that already
     side_walls_reach(sim, SIDE_WALL_REACH * y_top + 4.0 * float(radii.max()))
+    if spec.rolling_friction_prep > 0.0:  # the new disks take it too (they are added with none)
+        sim.set_rolling_friction(spec.rolling_friction_prep, walls=spec.rolling_friction_prep)
     steps = _grow(sim, new, radii[idx], plc.scale, spec)
     # renumber the whole packing in strips across its short side (the new layer was
     # appended on top): threads then split it along a short cut (dem.ordering)
