@@ -1,6 +1,7 @@
 """Direct shear tests on the executor's local processes, with their progress.
 
-A job (:class:`ShearJob`) is a value that pickles: its key (how its result is returned),
+A job (:class:`ShearJob`) is a value that pickles: its key (what the test is: a test or a
+rate check's rerun, at which stress; results come back in job order),
 its case (the specimen's content travels with it: the worker reads no specimen file), the
 folder its test keeps its files in (a path string: the worker makes the store from it),
 whether it draws its figure and a label for progress lines. Each test is a job of the
@@ -23,7 +24,8 @@ from poro2d.store import Store
 
 @dataclass(frozen=True)
 class ShearJob:
-    """One test of a pool: ``key`` names its result, ``folder`` its store (None: nothing kept)."""
+    """One test of a pool: ``key`` says which (``("test", sigma)``, a rate check's ``("rate", sigma)``),
+    ``folder`` names its store (None: nothing kept)."""
 
     key: tuple
     case: ShearCase
@@ -53,17 +55,10 @@ def _run_job(job: ShearJob, report) -> ShearTestResult:
     return job.test(progress=report).run()
 
 
-def _finished(jobs: list[ShearJob]) -> tuple[dict[tuple, ShearTestResult], list[ShearJob]]:
-    """Results of the finished tests (read back, no process started) and the jobs still to run."""
-    results: dict[tuple, ShearTestResult] = {}
-    todo = []
-    for job in jobs:
-        done = job.test().stored()
-        if done is not None:
-            results[job.key] = done
-        else:
-            todo.append(job)
-    return results, todo
+def _finished(jobs: list[ShearJob]) -> list[ShearTestResult | None]:
+    """The results of the finished tests, read back (no process started), in job order; None for a
+    test still to run."""
+    return [job.test().stored() for job in jobs]
 
 
 def _slowest_first(job: ShearJob) -> tuple:
@@ -71,17 +66,18 @@ def _slowest_first(job: ShearJob) -> tuple:
     return (not job.rate, -job.case.normal_stress_kpa)
 
 
-def execute_jobs(jobs: list[ShearJob], processes: int, progress: bool) -> dict[tuple, ShearTestResult]:
+def execute_jobs(jobs: list[ShearJob], processes: int, progress: bool) -> list[ShearTestResult]:
     """Run the tests of ``jobs`` (finished ones are read back) in up to ``processes`` processes.
 
-    Returns ``{job.key: result}`` in job order. Every test runs even when one fails;
-    then an input error of a test is raised as it is, other failures together
+    Returns their results in job order. Every test runs even when one fails; then an input
+    error of a test is raised as it is, other failures together
     (:class:`poro2d.execute.JobsFailed`, each test named).
     """
-    results, todo = _finished(jobs)
+    results = _finished(jobs)
+    todo = [k for k, res in enumerate(results) if res is None]
     if not todo:
         return results
-    names = [j.label for j in todo]
+    names = [jobs[k].label for k in todo]
     with JobsProgress("direct shear", names, enabled=progress) as bars:
 
         def show(index: int, phase: str, fraction: float) -> None:
@@ -92,12 +88,13 @@ def execute_jobs(jobs: list[ShearJob], processes: int, progress: bool) -> dict[t
                 bars.done(index)
 
         outcomes = Executor(Backend.local(processes)).map(
-            [Job(_run_job, (job,), name, reports=True) for job, name in zip(todo, names, strict=True)],
+            [Job(_run_job, (jobs[k],), name, reports=True) for k, name in zip(todo, names, strict=True)],
             on_report=show, on_done=ended, start_first=lambda j: _slowest_first(j.args[0]),
         )  # fmt: skip
         done = results_or_raise(outcomes, "direct shear test(s)")
-    results.update((job.key, res) for job, res in zip(todo, done, strict=True))
-    return {j.key: results[j.key] for j in jobs}
+    for k, res in zip(todo, done, strict=True):
+        results[k] = res
+    return results
 
 
 __all__ = ["ShearJob", "execute_jobs"]

@@ -23,7 +23,7 @@ from poro2d.io_utils import Provenance
 from poro2d.shear.fit import mohr_coulomb
 from poro2d.shear.parts import FitInterval, StressPeaks
 from poro2d.shear.pool import ShearJob
-from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult
+from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult, ShearTestResult
 from poro2d.shear.specimen_file import Specimen
 from poro2d.store import Store
 
@@ -139,9 +139,8 @@ class ReplicateShear:
         self.processes = processes if processes is not None else min(njobs, 2 * (os.cpu_count() or 1))
 
     def jobs(self) -> list[ShearJob]:
-        """Every specimen's tests as pool jobs, keyed ``(label, *key)`` (a caller may pool several)."""
-        return [replace(j, key=(label, *j.key), series=label)
-                for label, s in self.series.items() for j in s.jobs]  # fmt: skip
+        """Every specimen's tests as pool jobs, a specimen after the other (a caller may pool several)."""
+        return [replace(j, series=label) for label, s in self.series.items() for j in s.jobs]
 
     def run(self) -> ReplicateShearResult:
         from poro2d.shear.pool import execute_jobs
@@ -149,12 +148,12 @@ class ReplicateShear:
         t0 = time.perf_counter()
         return self.finish(execute_jobs(self.jobs(), self.processes, self.progress), t0)
 
-    def finish(self, results: dict, t0: float) -> ReplicateShearResult:
-        """Each specimen's fit and files, then the summary, from the results keyed as by :meth:`jobs`."""
-        per = {
-            label: s.finish({k[1:]: v for k, v in results.items() if k[0] == label}, t0)
-            for label, s in self.series.items()
-        }
+    def finish(self, results: list[ShearTestResult], t0: float) -> ReplicateShearResult:
+        """Each specimen's fit and files, then the summary, from the results in the order of :meth:`jobs`."""
+        per, start = {}, 0
+        for label, s in self.series.items():
+            per[label] = s.finish(results[start : start + len(s.jobs)], t0)
+            start += len(s.jobs)
         summary = summarize_replicate_peaks(per)
         summary.wall_time_s = time.perf_counter() - t0
         summary.processes = self.processes

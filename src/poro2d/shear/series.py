@@ -144,9 +144,11 @@ class ShearSeries:
         return self.finish(execute_jobs(self.jobs, self.processes, self.progress), t0)
 
     # ------------------------------------------------------------------ results
-    def finish(self, results: dict[tuple, ShearTestResult], t0: float) -> ShearSeriesResult:
-        """Fit, figures and ``result.json`` from the tests' results (keyed as in :meth:`_jobs`)."""
-        tests = [results[("test", s)] for s in self.stresses]
+    def finish(self, results: list[ShearTestResult], t0: float) -> ShearSeriesResult:
+        """Fit, figures and ``result.json`` from the tests' results, in the order of :attr:`jobs`
+        (a test per stress, then the rate check's reruns)."""
+        n = len(self.stresses)
+        tests = results[:n]
         sig = np.array([t["normal_stress_kpa"] for t in tests])
         tau = np.array([t["peak_shear_stress_kpa"] for t in tests])
         fit = mohr_coulomb(sig, tau) if len(sig) >= 2 else None
@@ -179,7 +181,7 @@ class ShearSeries:
         width, height = self.specimen.box()
         result.box_scale = box_scale(width, height, self.specimen.arrays["particles.radius"])
         if self.rate_check:
-            result.rate_check = self._rate_check(tests, results, sig, fit)
+            result.rate_check = self._rate_check(tests, results[n:], sig, fit)
         if self.lab is not None:
             result.lab = self._lab_part(fit)
         result.wall_time_s = time.perf_counter() - t0
@@ -218,12 +220,11 @@ class ShearSeries:
         )
 
     def _rate_check(
-        self, tests: list[ShearTestResult], results: dict[tuple, ShearTestResult], sig: np.ndarray, fit
+        self, tests: list[ShearTestResult], halves: list[ShearTestResult], sig: np.ndarray, fit
     ) -> RateCheck:
-        """How the peaks change at half the velocity (the reruns under ``rate_check/``)."""
+        """How the peaks change at half the velocity (the reruns under ``rate_check/``, one per test)."""
         rows = []
-        for t in tests:
-            h = results[("rate", t["normal_stress_kpa"])]
+        for t, h in zip(tests, halves, strict=True):
             rows.append(RateCheckRow(
                 normal_stress_kpa=t.normal_stress_kpa,
                 peak_kpa=t.peak_shear_stress_kpa,

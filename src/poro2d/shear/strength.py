@@ -218,12 +218,14 @@ class StrengthStudy:
         from poro2d.shear.pool import execute_jobs
 
         t0 = time.perf_counter()
-        jobs = [replace(j, key=(case, *j.key), series=f"{case_label(*case)} {j.series}")
+        jobs = [replace(j, series=f"{case_label(*case)} {j.series}")
                 for case, rep in self.cases.items() for j in rep.jobs()]  # fmt: skip
-        results = execute_jobs(jobs, self.processes, self.progress)
-        rows, tests = [], []
+        results = execute_jobs(jobs, self.processes, self.progress)  # in job order: a case after the other
+        rows, tests, start = [], [], 0
         for case, rep in self.cases.items():
-            summary = rep.finish({k[1:]: v for k, v in results.items() if k[0] == case}, t0)
+            count = len(rep.jobs())
+            summary = rep.finish(results[start : start + count], t0)
+            start += count
             row, case_tests = case_summary(rep, summary, *case, self.settings.peak_window)
             rows.append(row)
             tests += case_tests
