@@ -97,6 +97,33 @@ def test_other_config_in_the_same_folder_is_refused(down):
         _run(out, 0.30, max_iterations=2)
 
 
+def test_a_sand_profile_counts_the_steps_and_times_the_files_record(down):
+    """A sand run's time profile of a criterion store adds up what its files say: the layers'
+    and working stage's steps of each ``prepared.json``, the plate's steps and the times in
+    ``result.json``, and the particle-steps per second that follow."""
+    from poro2d.sand.profile import stage_profile
+
+    out, _ = down
+    saved = json.loads((out / "result.json").read_text())
+    trials = saved["iterations"]
+    prep_steps = 0
+    for it in trials:
+        (folder,) = (out / "trials").glob(f"{it['iteration']:02d}_n*")
+        prep = json.loads((folder / "prepared.json").read_text())
+        prep_steps += sum(layer["steps"] for layer in prep["layers"]) + prep["final_stage"]["steps"]
+    plate_steps = sum(it.get("plate_steps", 0) for it in trials)
+    prof = stage_profile([Store(out)])
+    assert prof.trials == len(trials) and prof.prepare.steps == prep_steps > 0
+    assert prof.plate.steps == plate_steps > 0
+    secs = sum(it["time_plate_s"] for it in trials)
+    work = sum(it.get("plate_steps", 0) * it["particle_count"] for it in trials)
+    assert prof.plate.seconds == pytest.approx(secs) and prof.plate.particle_steps_per_s == pytest.approx(
+        work / secs
+    )
+    # a store without a result (a case not yet run) adds nothing
+    assert stage_profile([Store(out), Store(out / "missing")]).to_dict() == prof.to_dict()
+
+
 def test_next_trial_rounding():
     assert round_to(0.148, 0.01) == 0.15
     assert round_to(0.1851, 0.01) == 0.19

@@ -1,9 +1,9 @@
 """Where a sand run's time went: steps and particle-steps per second, stage by stage.
 
-Read from the criterion stores of its cases (each trial's ``prepared.json``, the layers'
-and the working-friction stage's steps, and the trial's ``time_prepare_s``, ``plate_steps``
-and ``time_plate_s`` in ``result.json``), so a resumed run reports the work of every case,
-whenever it ran.
+Read from the criterion stores of its cases through the criterion's own readers (each
+trial's ``prepared.json``, the layers' and the working-friction stage's steps, and the
+trial's ``time_prepare_s``, ``plate_steps`` and ``time_plate_s`` in ``result.json``, files of
+earlier versions included), so a resumed run reports the work of every case, whenever it ran.
 """
 
 from __future__ import annotations
@@ -12,7 +12,10 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar
 
-from poro2d.store import Store, walk
+from poro2d.criterion.result import CriterionResult
+from poro2d.criterion.trial import Trial, trial_name
+from poro2d.specimen.compaction import PreparationReport
+from poro2d.store import Store
 from poro2d.typed_result import TypedResult
 
 
@@ -38,27 +41,19 @@ class StageProfile(TypedResult):
     plate: PhaseProfile
 
 
-def _read(store: Store, name: str) -> dict | None:
-    """A criterion file's raw content (None when it is missing or not a JSON object): only a few
-    step counts and times are read from it, whichever version of the criterion wrote it."""
-    data = store.read_json(name)
-    return data if isinstance(data, dict) else None
-
-
 def _preparation_steps(trial: Store) -> int:
-    prep = _read(trial, "prepared.json") or {}
-    steps = sum(int(layer.get("steps") or 0) for layer in prep.get("layers") or [])
-    return steps + int((prep.get("final_stage") or {}).get("steps") or 0)
+    """The steps of a trial's layers and working-friction stage (its ``prepared.json``; 0 without one)."""
+    prep = trial.read_result("prepared.json", PreparationReport.from_dict)
+    if prep is None:
+        return 0
+    steps = sum(int(layer.steps or 0) for layer in prep.layers or [])
+    return steps + int((prep.final_stage.steps if prep.final_stage is not None else 0) or 0)
 
 
-def _trial_stores(run: Store) -> dict[int, Store]:
-    """The trial folders of a criterion store by trial number."""
-    out = {}
-    for trial in walk(run.child("trials"), "*_n*"):
-        head = trial.root.name.split("_", 1)[0]
-        if head.isdigit():
-            out[int(head)] = trial
-    return out
+def _plate_steps(trial: Trial) -> int:
+    """The steps of a trial's plate (or lid) stage: the servo's, none when the plate did not move."""
+    servo = trial.plate.servo
+    return int(servo.steps or 0) if servo is not None else 0
 
 
 def stage_profile(runs: list[Store]) -> StageProfile:
@@ -66,16 +61,15 @@ def stage_profile(runs: list[Store]) -> StageProfile:
     stage, summed over the criterion stores ``runs`` (one per case)."""
     tally = {"trials": 0, "prepare": [0.0, 0.0, 0.0], "plate": [0.0, 0.0, 0.0]}  # steps, seconds, disk-steps
     for run in runs:
-        res = _read(run, "result.json")
+        res = run.read_result("result.json", CriterionResult.from_dict)
         if res is None:
             continue
-        folders = _trial_stores(run)
-        for it in res.get("iterations") or []:
-            n = float(it.get("particle_count") or 0)
+        for trial in res.iterations or []:
+            n = float(trial.particle_count or 0)
             tally["trials"] += 1
-            prep = _preparation_steps(folders[it["iteration"]]) if it.get("iteration") in folders else 0
-            for key, steps, secs in (("prepare", prep, it.get("time_prepare_s")),
-                                     ("plate", it.get("plate_steps"), it.get("time_plate_s"))):  # fmt: skip
+            prep = _preparation_steps(run.child(trial_name(trial.iteration, trial.trial_porosity)))
+            for key, steps, secs in (("prepare", prep, trial.time_prepare_s),
+                                     ("plate", _plate_steps(trial), trial.time_plate_s)):  # fmt: skip
                 steps = float(steps or 0)
                 tally[key][0] += steps
                 tally[key][1] += float(secs or 0.0)
