@@ -82,6 +82,23 @@ def test_points_are_mean_sd_and_n_over_converged_seeds():
     assert mu[1]["n2d_sd"] == pytest.approx(np.std([0.19, 0.185], ddof=1))
 
 
+def test_a_csv_row_is_the_points_columns_then_the_answer_seeds_and_version():
+    from poro2d.sweep.sensitivity_records import PointRow
+
+    sens, _ = _synthetic_sens()
+    ref, _, cu3 = sens["points"]["grading"]
+    rows = [
+        PointRow.of(p, 0.15, 0.005, [0, 1, 2], "9.9").to_dict()
+        for p in (ref, cu3, sens["points"]["mu_prep"][0])
+    ]
+    for row, point in zip(rows, (ref, cu3, sens["points"]["mu_prep"][0]), strict=True):
+        assert list(row) == [*point.to_dict(), "reproduces_paper", "seed_list", "poro2d_version"]
+        assert {k: row[k] for k in point.to_dict()} == point.to_dict()
+        assert row["seed_list"] == "0 1 2" and row["poro2d_version"] == "9.9"
+    # Cu 3 (0.1467) lies within 0.005 of 0.15, the reference (0.193) does not
+    assert [r["reproduces_paper"] for r in rows[:2]] == [False, True]
+
+
 def test_finite_mean_sd_edge_cases():
     assert S.finite_mean_sd([0.2]) == {"mean": 0.2, "sd": 0.0, "n": 1}
     s = S.finite_mean_sd([None, float("nan")])

@@ -44,6 +44,7 @@ from poro2d.sweep.sensitivity_records import (
     MeanSd,
     MuPoint,
     PaperNumbers,
+    PointRow,
     SeedRecord,
     StudySettings,
 )
@@ -514,23 +515,20 @@ def write_sensitivity(sens: dict, store: Store) -> SensitivityResult:
 
     figs = plot_sensitivity(sens, store.path("sensitivity"))
     sens = dict(sens, figure=str(figs[0]), provenance=Provenance.now().to_dict())
-    store.write_csv("sensitivity_seeds.csv", sens["seeds"])
-    points = sens["points"]["grading"] + sens["points"]["mu_prep"]
-    store.write_csv("sensitivity.csv", [_csv_row(p, sens) for p in points])
     result = SensitivityResult.from_dict(sens)
+    store.write_csv("sensitivity_seeds.csv", sens["seeds"])
+    store.write_csv("sensitivity.csv", [row.to_dict() for row in _csv_rows(result)])
     store.write_result("sensitivity.json", result)
     return result
 
 
-def _csv_row(p: dict, sens: dict) -> dict:
-    """A row of ``sensitivity.csv``: the point's own columns (a grading's or a friction's, which
-    differ), then whether it reproduces the paper's n2D, the seeds and the version."""
-    target, tol = sens["answer"]["target"], sens["answer"]["tolerance"]
-    row = {k: v for k, v in p.items()}
-    row["reproduces_paper"] = math.isfinite(p["n2d_mean"]) and abs(p["n2d_mean"] - target) <= tol + 1e-12
-    row["seed_list"] = " ".join(map(str, sens["settings"]["seed_list"]))
-    row["poro2d_version"] = sens["provenance"]["poro2d_version"]
-    return row
+def _csv_rows(result: SensitivityResult) -> list[PointRow]:
+    """The rows of ``sensitivity.csv``: the grading points, then the friction points."""
+    answer, version = result.answer, result.provenance.poro2d_version
+    return [
+        PointRow.of(p, answer.target, answer.tolerance, result.settings.seed_list, version)
+        for p in result.points.grading + result.points.mu_prep
+    ]
 
 
 def load_sensitivity(store: Store) -> SensitivityResult:

@@ -7,8 +7,10 @@ it was (``point["n2d_mean"]``), which the report's tables and figure use.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
+from poro2d.record import Record, Spliced
 from poro2d.sweep.records import DensityCalibrationRecord, SweepSummary
 from poro2d.typed_result import TypedResult
 
@@ -164,6 +166,29 @@ class SensitivityPoints(TypedResult):
 
     grading: list[GradingPoint]
     mu_prep: list[MuPoint]
+
+
+@dataclass(frozen=True)
+class PointRow(Record):
+    """A row of ``sensitivity.csv``: the point's own columns (a grading's or a friction's, which
+    differ), then whether it reproduces the paper's n2D, the seeds and the version."""
+
+    ROW = (Spliced("point"), "reproduces_paper", "seed_list", "poro2d_version")
+
+    point: GradingPoint | MuPoint
+    reproduces_paper: bool
+    seed_list: str
+    poro2d_version: str
+
+    @classmethod
+    def of(
+        cls, point: GradingPoint | MuPoint, target: float, tolerance: float, seeds: list[int], version: str
+    ):
+        """The row of ``point``: it reproduces the paper when its mean lies within ``tolerance``
+        of ``target``."""
+        mean = point.n2d_mean
+        close = math.isfinite(mean) and abs(mean - target) <= tolerance + 1e-12
+        return cls(point, close, " ".join(map(str, seeds)), version)
 
 
 @dataclass(eq=False)
