@@ -166,13 +166,13 @@ def check_raw_arguments(argv: list[str]) -> None:
     option given twice (``--n-lab 0.3 ... --n-lab 0.4``, ``-o a --out b``): the parser
     keeps the last; which one was meant is the user's to say.
     """
-    spelling = _option_spellings(argv)
+    params = _command_params(argv)
     seen: dict[object, list[str]] = {}
     for k, arg in enumerate(argv):
         if arg == "--":
             break
         name, eq, value = arg.partition("=")
-        param = spelling.get(name)
+        param = next((p for p in params if name in p.opts), None)
         if param is None:  # not an option of the command (its value, an argument, a typo)
             continue
         is_flag = bool(getattr(param, "is_flag", False))
@@ -186,8 +186,8 @@ def check_raw_arguments(argv: list[str]) -> None:
             raise InputError(max(param.opts, key=len), ", ".join(given), "the option once")
 
 
-def _option_spellings(argv: list[str]) -> dict[str, object]:
-    """``{"-o": param, "--out": param, ...}`` of the (sub)command that ``argv`` names."""
+def _command_params(argv: list[str]) -> list:
+    """The parameters of the (sub)command that ``argv`` names (each with its spellings, ``opts``)."""
     import typer.main
 
     command = typer.main.get_command(app)
@@ -196,7 +196,7 @@ def _option_spellings(argv: list[str]) -> dict[str, object]:
         if not commands or arg not in commands:
             break
         command = commands[arg]
-    return {o: p for p in getattr(command, "params", []) for o in p.opts}
+    return list(getattr(command, "params", []))
 
 
 def usage_line(exc, argv: list[str]) -> str:
