@@ -76,7 +76,7 @@ def test_under_the_fill_a_check_at_a_calibration_friction_is_its_calibration_cas
     states = D.StateChecks(CriterionBase(cfg), (dense, loose, between), 2, 0.001).sweep
     twins = D.calibration_twins(cal, states, None, Store(folder))
     assert len(twins) == 4
-    got = {(r["params"]["criterion.n_lab"], r["params"]["seed"]): r for r in twins.values()}
+    got = {(r["params"]["criterion.n_lab"], r["params"]["seed"]): r for r in twins}
     assert set(got) == {(0.3253, 0), (0.3253, 1), (0.4571, 0), (0.4571, 1)}
     for (n_lab, seed), r in got.items():
         assert r["results"]["n_lab"] == n_lab and r["results"]["final_porosity"] == seed + 0.1
@@ -88,4 +88,4 @@ def test_under_the_fill_a_check_at_a_calibration_friction_is_its_calibration_cas
         write_json(tmp_path / "p" / "cases" / c.id / "params.json", asdict(c), config=True)
         write_json(tmp_path / "p" / "cases" / c.id / "result.json", row)
     states_p = D.StateChecks(CriterionBase(plate), (loose,), 2, 0.001).sweep
-    assert D.calibration_twins(cal_p, states_p, None, Store(tmp_path / "p")) == {}
+    assert D.calibration_twins(cal_p, states_p, None, Store(tmp_path / "p")) == []

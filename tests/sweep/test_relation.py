@@ -259,12 +259,16 @@ def test_a_state_check_that_is_a_calibration_case_is_read_back(tmp_path):
     states = D.StateChecks(base, (dense, other, loose_trial), 2, 0.01).sweep
     twins = D.calibration_twins(cal, states, None, Store(folder))
     assert len(twins) == 2
-    for row in twins.values():
+    # in the order of the state checks, each relabelled with its check's id
+    assert [row.case_id for row in twins] == [
+        c.id for c in states.cases if c.id in {r.case_id for r in twins}
+    ]
+    for row in twins:
         assert row["params"]["criterion.n_lab"] == 0.33 and row["results"]["n_lab"] == 0.33
         assert row["params"]["specimen.friction_prep"] == 0.05
         assert row["results"]["final_porosity"] == pytest.approx(0.195)
         assert row["reused_calibration_case"] in {c.id for c in cal.cases}
-    assert {r["params"]["seed"] for r in twins.values()} == {0, 1}
+    assert {r["params"]["seed"] for r in twins} == {0, 1}
     # an unfinished calibration case is not a twin: the check then runs
     (folder / "cases" / cal.cases[0].id / "result.json").unlink()
     assert len(D.calibration_twins(cal, states, None, Store(folder))) == 1

@@ -383,7 +383,7 @@ def _check_key(case: Case, base_dir: Path | None) -> str:
 
 def calibration_twins(
     calibration: SweepConfig, states: SweepConfig, base_dir: Path | None, cases: Store
-) -> dict[str, CaseRow]:
+) -> list[CaseRow]:
     """Finished calibration cases that are state checks too, as rows of those checks.
 
     The check of the densest state (Dr = 1) runs at the calibration's lowest usable friction,
@@ -391,8 +391,8 @@ def calibration_twins(
     the same criterion run as a calibration case (:func:`_check_key`: under the paper's plate
     only from the same first trial). Whether two cases are the same run is decided on the
     specimen, grading and criterion settings they build, never assumed. ``cases``: the store
-    of the calibration's sweep. Returns ``{state case id: row}``, the calibration case's
-    finished row relabelled with the check's parameters.
+    of the calibration's sweep. Returns a row per state check that has a twin, in the order of
+    ``states``: the calibration case's finished row relabelled with the check's id and parameters.
     """
     from poro2d.sweep.runner import finished_row
 
@@ -401,7 +401,7 @@ def calibration_twins(
         row = finished_row(asdict(c), cases.child("cases", c.id))
         if row is not None:
             done[_check_key(c, base_dir)] = (c, row)
-    twins = {}
+    twins = []
     for c in states.cases:
         hit = done.get(_check_key(c, base_dir))
         if hit is None:
@@ -410,7 +410,7 @@ def calibration_twins(
         results = dict(row.get("results") or {}, n_lab=c.config["criterion"]["n_lab"])
         relabelled = dict(row, case_id=c.id, params=dict(c.params), results=results, reused=True,
                           reused_calibration_case=cal_case.id)  # fmt: skip
-        twins[c.id] = CaseRow.from_dict(relabelled)
+        twins.append(CaseRow.from_dict(relabelled))
     return twins
 
 

@@ -344,9 +344,10 @@ def density_relation(
     resolution = trial_grid(float(crit.get("resolution", 0.01)), crit.get("refine_tolerance"))
     sweep = D.StateChecks(states_base, targets, seeds, resolution).sweep
     twins = D.calibration_twins(calibration.sweep, sweep, base.base_dir, Store(cal_info.cases))
-    rows, summary, failed = list(twins.values()), {"ran": 0, "reused": 0}, []
+    rows, summary, failed = twins, {"ran": 0, "reused": 0}, []
     if len(twins) < len(sweep.cases):
-        left = replace(sweep, cases=[c for c in sweep.cases if c.id not in twins])
+        twin_ids = {row.case_id for row in twins}
+        left = replace(sweep, cases=[c for c in sweep.cases if c.id not in twin_ids])
         res = run_sweep(left, store.child("states"), **sweep_kw)
         rows, summary, failed = res.rows + rows, res.summary, res.failed
     summary = dict(summary, from_calibration=len(twins))

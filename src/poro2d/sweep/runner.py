@@ -314,7 +314,8 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Sto
             err = OutputConsole(stderr=True)
             err.print(f"Dask dashboard: {cluster_info.dashboard}", highlight=False)
         n_total = len(sweep.cases)
-        rows.update(_submit_all(executor, pending, cases, sweep.retries, progress, n_reused, n_total))
+        ended = _submit_all(executor, pending, cases, sweep.retries, progress, n_reused, n_total)
+        rows.update((c.id, row) for c, row in zip(pending, ended, strict=True))
     return cluster_info
 
 
@@ -348,8 +349,9 @@ def _submit_all(
     progress: bool,
     n_reused: int,
     n_total: int,
-) -> dict[str, CaseRow | LostCaseRow]:
-    """Every pending case as a job; the rows by case id (a failed task's as an error row) as they end."""
+) -> list[CaseRow | LostCaseRow]:
+    """Every pending case as a job; their rows in the order of ``pending`` (a failed task gives an
+    error row)."""
     from poro2d.progress import CountProgress
 
     jobs = [
@@ -357,7 +359,7 @@ def _submit_all(
             retries=retries)
         for c in pending
     ]  # fmt: skip
-    rows: dict[str, CaseRow | LostCaseRow] = {}
+    rows: list[CaseRow | LostCaseRow | None] = [None] * len(pending)
     label = f"sweep ({n_reused} of {n_total} already done)" if n_reused else "sweep"
     with CountProgress(label, len(pending), "cases", enabled=progress) as bar:
 
@@ -368,8 +370,8 @@ def _submit_all(
                 outcome = _failed_row(
                     c, cases.child(c.id), exc, f"{outcome.traceback}{type(exc).__name__}: {exc}\n"
                 )
-            rows[c.id] = outcome
-            n_failed = sum(r["status"] == "failed" for r in rows.values())
+            rows[index] = outcome
+            n_failed = sum(r is not None and r["status"] == "failed" for r in rows)
             bar.advance(f"{n_failed} failed" if n_failed else "")
 
         executor.map(jobs, on_done=ended)
