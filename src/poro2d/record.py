@@ -10,7 +10,8 @@ hand, a :class:`Record` declares its row in ``ROW`` and one function,
 * ``"name"``: the field ``name`` under its own key;
 * ``("key", "path")``: the value at ``path`` (a field, or a part's field: ``"forces.f_top_n_per_m"``)
   under ``key``;
-* ``Spliced("part")``: the part's own row, in place (nothing when the part is None);
+* ``Spliced("part")``: the part's own row, in place (nothing when the part is None; a tuple
+  of parts: each one's row in turn);
 * ``Fixed("key", value)``: ``key`` with the same value in every row (a former field's key,
   still written so that files keep their keys).
 
@@ -32,7 +33,8 @@ import numpy as np
 
 @dataclass(frozen=True)
 class Spliced:
-    """A row entry: the part in field ``name`` writes its own keys here (none when it is None)."""
+    """A row entry: the part in field ``name`` writes its own keys here (none when it is None; a
+    tuple of parts writes each one's keys in turn)."""
 
     name: str
 
@@ -83,8 +85,8 @@ class Record:
         for entry in self.layout():
             if isinstance(entry, Spliced):
                 part = getattr(self, entry.name)
-                if part is not None:
-                    row.update(part.to_dict())
+                for each in part if isinstance(part, tuple) else () if part is None else (part,):
+                    row.update(each.to_dict())
                 continue
             if isinstance(entry, Fixed):
                 row[entry.key] = copy.copy(entry.value)

@@ -25,6 +25,8 @@ from dataclasses import dataclass, field, fields
 from functools import cache
 from typing import Any, ClassVar, Self, TypeVar
 
+from poro2d.record import Record
+
 #: the metadata of a field that is not a key of the result's file
 NOT_IN_FILE = {"in_file": False}
 
@@ -38,11 +40,14 @@ def _keys(cls: type) -> tuple[str, ...]:
 
 
 def _plain(value: Any) -> Any:
-    """A typed part as the dict of its file, a list of them as a list of dicts; anything else as it is."""
-    if isinstance(value, TypedResult):
+    """A typed part (a result or a :class:`~poro2d.record.Record`) as the dict of its file, a list
+    of them as a list of dicts, a map of them as a map of dicts; anything else as it is."""
+    if isinstance(value, TypedResult | Record):
         return value.to_dict()
-    if isinstance(value, list) and any(isinstance(v, TypedResult) for v in value):
+    if isinstance(value, list) and any(isinstance(v, TypedResult | Record) for v in value):
         return [_plain(v) for v in value]
+    if isinstance(value, dict) and any(isinstance(v, TypedResult) for v in value.values()):
+        return {k: _plain(v) for k, v in value.items()}
     return value
 
 
@@ -53,6 +58,21 @@ def part(cls: type[R], value: Any) -> Any:
     return value
 
 
+@dataclass(frozen=True)
+class Keyed:
+    """A ``PARTS`` entry for a field that maps names to parts of one class (a file's object whose
+    values are the objects of ``kind``, such as a calibration's surrogate per observable): its
+    names are data (they vary from run to run), its values are typed."""
+
+    kind: type[TypedResult]
+
+    def read(self, value: Any) -> Any:
+        """``value`` with each of its values read as ``kind`` (as it is when not a map)."""
+        if not isinstance(value, Mapping):
+            return value
+        return {k: part(self.kind, v) for k, v in value.items()}
+
+
 @dataclass(eq=False)
 class TypedResult(Mapping):
     """Base of typed results; subclasses are ``@dataclass(eq=False)`` with one field per key."""
@@ -60,8 +80,10 @@ class TypedResult(Mapping):
     #: keys written only when their value is not None
     OPTIONAL: ClassVar[tuple[str, ...]] = ()
 
-    #: fields that are typed parts: field -> the TypedResult class its file's dict (or each dict
-    #: of its file's list) is read as by :meth:`from_dict`; :meth:`to_dict` writes them back as dicts
+    #: fields that are typed parts: field -> the TypedResult class (or a Record class with a
+    #: ``from_dict``) its file's dict (or each dict of its file's list) is read as by
+    #: :meth:`from_dict`, or :class:`Keyed` of it for a map of such parts; :meth:`to_dict` writes
+    #: them back as dicts
     PARTS: ClassVar[Mapping[str, Any]] = {}
 
     #: keys of the file that the class does not model, written back after the modelled ones
@@ -92,7 +114,11 @@ class TypedResult(Mapping):
         obj = cls(**{k: data.get(k) for k in keys}, extra={k: v for k, v in data.items() if k not in keys})
         obj._absent = frozenset(k for k in keys if k not in data)
         for key, kind in cls.PARTS.items():
-            if isinstance(kind, type) and issubclass(kind, TypedResult):  # not a decoder of its own
+            if isinstance(kind, Keyed):
+                setattr(obj, key, kind.read(getattr(obj, key)))
+            elif isinstance(kind, type) and issubclass(
+                kind, TypedResult | Record
+            ):  # not a decoder of its own
                 value = getattr(obj, key)
                 rows = isinstance(value, list)
                 setattr(obj, key, [part(kind, v) for v in value] if rows else part(kind, value))
@@ -114,4 +140,4 @@ class TypedResult(Mapping):
         return len(self.to_dict())
 
 
-__all__ = ["NOT_IN_FILE", "TypedResult", "part"]
+__all__ = ["NOT_IN_FILE", "Keyed", "TypedResult", "part"]
