@@ -504,3 +504,22 @@ def test_parts_are_read_by_the_base_class_singly_or_as_lists():
     assert held.to_dict() == data  # written back as the same dicts
     empty = Holder.from_dict({"one": None, "many": None})
     assert empty.one is None and empty.many is None
+
+
+def test_a_map_of_parts_and_a_list_of_records_are_read_typed_and_written_back():
+    """``Keyed`` reads a map of parts (names that vary, values of one class); a Record class
+    with ``from_dict`` reads a list of rows: a calibration's surrogates and design points."""
+    from poro2d.calibration.evaluations import DesignPoint, Observed
+    from poro2d.calibration.run import SurrogateRecord
+
+    stored = json.loads((DATA / "calibration_result.json").read_text())
+    cal = CalibrationResult.from_dict(stored)
+    assert list(cal.fit) == list(stored["fit"]) and all(
+        isinstance(v, SurrogateRecord) for v in cal.fit.values()
+    )
+    assert [type(e) for e in cal.evaluations] == [DesignPoint] * len(stored["evaluations"])
+    first = cal.evaluations[0]
+    assert first.observed[1] == Observed("peak", 100.0, stored["evaluations"][0]["peak_100kPa"])
+    assert cal.to_dict() == stored and json.dumps(cal.to_dict()) == json.dumps(stored)  # keys in order too
+    with pytest.raises(ValueError, match="not an observable"):
+        DesignPoint.from_dict({"particle_friction": 1.0, "rolling_friction": 0.1, "note": [1.0]})

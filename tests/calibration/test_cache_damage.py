@@ -90,10 +90,10 @@ def test_a_worker_failure_that_is_not_the_tests_outcome_stops_the_calibration(
 def test_a_test_without_equilibrium_is_left_out_and_said(specimen, tmp_path, monkeypatch):
     runner = _runner(monkeypatch, RuntimeError("consolidation at 50 kPa did not reach equilibrium"))
     rows = runner.run([_unit(50.0, specimen)], Store(tmp_path / "cache"), "round 1")
-    assert rows == {} and len(runner.failures) == 1 and "equilibrium" in runner.failures[0].error
+    assert rows == [None] and len(runner.failures) == 1 and "equilibrium" in runner.failures[0].error
 
 
 def test_units_that_run_give_their_rows(specimen, tmp_path, monkeypatch):
     runner = _runner(monkeypatch, None)
     rows = runner.run([_unit(50.0, specimen)], Store(tmp_path / "cache"), "round 1")
-    assert list(rows) == [_unit(50.0, specimen).key] and runner.failures == []
+    assert [r.key for r in rows] == [_unit(50.0, specimen).key] and runner.failures == []

@@ -10,7 +10,7 @@ import shutil
 import pytest
 
 from poro2d.calibration import model, run_calibration
-from poro2d.calibration.run import MIN_POINTS, _base_settings, _infer, unidentified_reason
+from poro2d.calibration.run import MIN_POINTS, _base_settings, _infer, _units, unidentified_reason
 from poro2d.calibration.specimens import Replicates, check_replicates
 from poro2d.calibration.units import CalibrationUnit, UnitRow
 from poro2d.cli.calibrate import print_result
@@ -92,15 +92,51 @@ def test_a_posterior_that_is_not_finite_is_no_answer():
     design = model.space_filling(ranges, MIN_POINTS, 0)
     base = _base_settings({"max_displacement": 0.002})
     found, digests = {"a": "a.npz", "b": "b.npz"}, {"a": "a" * 64, "b": "b" * 64}
-    rows = {}
+    rows = []  # in the units' order: per design point, per specimen, per stress
     for k, (fp, mu_r) in enumerate(design):
         for label in found:
             unit = CalibrationUnit.at(found[label], digests[label], 50.0, base, fp, mu_r)
             peak = 30.0 + 10.0 * fp + k + (label == "b")
-            rows[unit.key] = UnitRow(unit.key, 50.0, fp, mu_r, found[label], peak, peak, 1.0)
+            rows.append(UnitRow(unit.key, 50.0, fp, mu_r, found[label], peak, peak, 1.0))
     targets = [("peak", 50.0, 1e300)]  # an absurd laboratory value: the misfit overflows
     with pytest.raises(RuntimeError, match="posterior"):
-        _infer(ranges, design, Replicates(found, digests), base, rows, targets, 0.0)
+        _infer(ranges, design, Replicates(found, digests), [50.0], rows, targets, 0.0)
+
+
+def test_the_table_reads_each_units_row_in_the_units_order():
+    """Rows come back in the units' order: each design point's replicate values are its own
+    specimens' at its own stress, whatever the number of specimens and stresses."""
+    ranges = model.Ranges((0.3, 3.0), (0.0, 0.5))
+    design = model.space_filling(ranges, MIN_POINTS, 0)
+    base = _base_settings({"max_displacement": 0.002})
+    found = Replicates({"a": "a.npz", "b": "b.npz", "c": "c.npz"}, {k: k * 64 for k in "abc"})
+    stresses = [50.0, 100.0]
+    units = _units(design, found, stresses, base)
+
+    def peak(unit):  # linear in the stress, with a seed scatter: a posterior that can be computed
+        return (
+            unit.sigma * (0.4 + 0.2 * unit.fp)
+            + 2.0 * unit.mu_r
+            + {"a.npz": 0.0, "b.npz": 1.0, "c.npz": -1.0}[unit.specimen]
+        )
+
+    rows = [UnitRow(u.key, u.sigma, u.fp, u.mu_r, u.specimen, peak(u), 0.9 * peak(u), 1.0) for u in units]
+    rows[4] = None  # a failed test: NaN in its place only
+    by_key = {u.key: r for u, r in zip(units, rows, strict=True)}
+    targets = [("peak", 50.0, 40.0), ("peak", 100.0, 75.0)]
+    _, _, table = _infer(ranges, design, found, stresses, rows, targets, 0.0)
+    for (fp, mu_r), entry in zip(design, table, strict=True):
+        for s in stresses:
+            expected = []
+            for label in found.paths:
+                row = by_key[found.unit(label, s, base, fp, mu_r).key]
+                expected.append(row.peak if row is not None else None)
+            (obs,) = [o for o in entry.observed if o.normal_stress_kpa == s]
+            got = [None if v != v else v for v in obs.values]
+            assert got == expected
+    assert sum(v != v for e in table for o in e.observed for v in o.values) == 1
+    # the file's row: the pair, then a key per target in the targets' order
+    assert list(table[0].to_dict()) == ["particle_friction", "rolling_friction", "peak_50kPa", "peak_100kPa"]
 
 
 def test_one_specimen_reports_its_intervals_as_unknown(specimen, lab, tmp_path, capsys):

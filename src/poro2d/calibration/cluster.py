@@ -63,32 +63,32 @@ class UnitRunner:
         self.busy_s = 0.0
         self.wall_s = 0.0
 
-    def run(self, units: list[CalibrationUnit], cache: Store | None, label: str) -> dict[str, UnitRow]:
-        """Rows by unit key for ``units``: read back when ``cache`` holds them, else run as Dask tasks."""
+    def run(self, units: list[CalibrationUnit], cache: Store | None, label: str) -> list[UnitRow | None]:
+        """The rows of ``units`` in their order (None: the test failed, said in ``failures``): read
+        back when ``cache`` holds them, else run as Dask tasks."""
         from poro2d.progress import CountProgress
 
-        rows: dict[str, UnitRow] = {}
-        todo = []
-        for unit in units:
-            row = stored_row(unit, cache)
-            if row is None:
-                check_entry(unit, cache)  # a damaged entry is refused here, before any test runs
-                todo.append(unit)
-            else:
-                rows[unit.key] = row
-        self.reused += len(rows)
+        rows = [stored_row(unit, cache) for unit in units]
+        todo = [k for k, row in enumerate(rows) if row is None]
+        for k in todo:
+            check_entry(units[k], cache)  # a damaged entry is refused here, before any test runs
+        cached = len(units) - len(todo)
+        self.reused += cached
         if not todo:
             return rows
         t0 = time.perf_counter()
-        done_before = f" ({len(rows)} of {len(units)} cached)" if rows else ""
+        done_before = f" ({cached} of {len(units)} cached)" if cached else ""
         try:
             with CountProgress(label + done_before, len(todo), "shear tests", enabled=self.progress) as bar:
 
                 def ended(index: int, outcome) -> None:
-                    self._take(todo[index], outcome, rows)
+                    rows[todo[index]] = self._take(units[todo[index]], outcome)
                     bar.advance(f"{len(self.failures)} failed" if self.failures else "")
 
-                jobs = [Job(compute_unit, (u, cache), u.key, key=f"calibrate-{u.key}") for u in todo]
+                jobs = [
+                    Job(compute_unit, (units[k], cache), units[k].key, key=f"calibrate-{units[k].key}")
+                    for k in todo
+                ]
                 self.executor.map(jobs, on_done=ended)
         except KeyboardInterrupt:
             self.executor.quiet()
@@ -114,13 +114,12 @@ class UnitRunner:
                 f" failed on a worker{more}: {f.error}; no answer is computed without it"
             )
 
-    def _take(self, unit: CalibrationUnit, outcome, rows: dict[str, UnitRow]) -> None:
-        """A unit's row into ``rows``; a test that fails (no equilibrium) is left out of the fit, and said."""
+    def _take(self, unit: CalibrationUnit, outcome) -> UnitRow | None:
+        """A unit's row; a test that fails (no equilibrium) is left out of the fit (None), and said."""
         if not isinstance(outcome, Failed):
-            rows[unit.key] = outcome
             self.busy_s += outcome.wall_time_s
             self.ran += 1
-            return
+            return outcome
         exc = outcome.error
         if type(exc) is not RuntimeError:  # not the test's own outcome (no equilibrium)
             self.broken.add(unit.key)
@@ -135,6 +134,7 @@ class UnitRunner:
                 traceback=outcome.traceback,
             )
         )
+        return None
 
     def info(self) -> ClusterRecord:
         """What is recorded of the cluster and the work: workers, tests run and reused, times."""

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+from poro2d.calibration.evaluations import DesignPoint
 from poro2d.calibration.specimens import Replicates
 from poro2d.calibration.units import CACHE, unit_curve
 from poro2d.store import Store
@@ -27,21 +28,23 @@ def write_outputs(store: Store, result, post, surrogates, lab, specimens: Replic
     store.write_result("result.json", result)
 
 
-def _best_curves(result, lab, specimens: Replicates, base, cache: Store) -> tuple[dict[float, list], dict]:
+def _best_curves(
+    result, lab, specimens: Replicates, base, cache: Store
+) -> tuple[dict[float, list], DesignPoint]:
     """The curves of the design point nearest the best parameters, per normal stress (all
     specimens), and that design point: what the fit figure draws."""
     best = result.best
     nearest = min(
         result.evaluations,
         key=lambda e: (
-            (math.log(e["particle_friction"] / best["particle_friction"])) ** 2
-            + (e["rolling_friction"] - best["rolling_friction"]) ** 2
+            (math.log(e.particle_friction / best["particle_friction"])) ** 2
+            + (e.rolling_friction - best["rolling_friction"]) ** 2
         ),
     )
     curves: dict[float, list] = {}
     for s in lab.normal_stresses():
         for label in specimens.paths:
-            unit = specimens.unit(label, s, base, nearest["particle_friction"], nearest["rolling_friction"])
+            unit = specimens.unit(label, s, base, nearest.particle_friction, nearest.rolling_friction)
             curve = unit_curve(unit, cache)
             if curve is not None:
                 curves.setdefault(s, []).append(curve)

@@ -19,6 +19,7 @@ import numpy as np
 
 from poro2d.calibration import model
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
+from poro2d.calibration.evaluations import DesignPoint, Observed, target_key
 from poro2d.calibration.specimens import (
     Replicates,
     check_preset,
@@ -38,7 +39,7 @@ from poro2d.shear.parts import LabRecord, ShearSettingsRecord
 from poro2d.shear.series import check_stresses
 from poro2d.shear.settings import MAX_FRICTION, ShearSettings
 from poro2d.store import Store
-from poro2d.typed_result import TypedResult, part
+from poro2d.typed_result import Keyed, TypedResult
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
 KIND = "calibrate"
@@ -152,7 +153,7 @@ class CalibrationResult(TypedResult):
     the central intervals, which ``posterior["median"]`` never does;
     ``intervals``: central credible intervals at ``level``; ``posterior``: its correlation
     (near +-1: a ridge), whether each interval is wide, the observables fitted;
-    ``evaluations``: one row per design point (replicate means per observable);
+    ``evaluations``: one :class:`DesignPoint` per design point (each observable's replicate values);
     ``fit``: the surrogate per observable; ``lab``: the laboratory values fitted.
     """
 
@@ -160,7 +161,7 @@ class CalibrationResult(TypedResult):
     intervals: FrictionBounds
     level: float
     posterior: PosteriorSummary
-    evaluations: list[dict[str, Any]]
+    evaluations: list[DesignPoint]
     fit: dict[str, SurrogateRecord]
     lab: LabRecord
     specimens: dict[str, str]
@@ -176,8 +177,8 @@ class CalibrationResult(TypedResult):
     unidentified: str | None = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = ("unidentified",)
-    #: the fields read as their records from a file's dict
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+    #: the fields read as their records from a file's dict (``fit``: a surrogate per observable)
+    PARTS: ClassVar[dict[str, type[TypedResult] | Keyed]] = {
         "best": FrictionValues,
         "intervals": FrictionBounds,
         "lab": LabRecord,
@@ -188,22 +189,9 @@ class CalibrationResult(TypedResult):
         "posterior": PosteriorSummary,
         "cluster": ClusterRecord,
         "failures": UnitFailure,
+        "fit": Keyed(SurrogateRecord),
+        "evaluations": DesignPoint,
     }
-
-    def to_dict(self) -> dict[str, Any]:
-        """The file's keys; the surrogates of ``fit`` (a map of parts) as the dicts they are written as."""
-        out = super().to_dict()
-        if self.fit is not None:
-            out["fit"] = {k: v.to_dict() if isinstance(v, TypedResult) else v for k, v in self.fit.items()}
-        return out
-
-    @classmethod
-    def from_dict(cls, data) -> CalibrationResult:
-        """A result from its file's dict; the surrogates of ``fit`` read as their records."""
-        obj = super().from_dict(data)
-        if isinstance(obj.fit, dict):
-            obj.fit = {k: part(SurrogateRecord, v) for k, v in obj.fit.items()}
-        return obj
 
     @classmethod
     def read(cls, store: Store) -> CalibrationResult | None:
@@ -348,12 +336,12 @@ def run_calibration(
     try:
         design = model.space_filling(ranges, points, design_seed)
         rows = runner.run(_units(design, found, stresses, base), cache, "round 1")
-        post, surrogates, table = _infer(ranges, design, found, base, rows, targets, lab_error)
+        post, surrogates, table = _infer(ranges, design, found, stresses, rows, targets, lab_error)
         if refine:
             extra = [p for p in post.draw(refine, design_seed + 1) if p not in design]
             design = design + extra
-            rows.update(runner.run(_units(extra, found, stresses, base), cache, "round 2"))
-            post, surrogates, table = _infer(ranges, design, found, base, rows, targets, lab_error)
+            rows += runner.run(_units(extra, found, stresses, base), cache, "round 2")
+            post, surrogates, table = _infer(ranges, design, found, stresses, rows, targets, lab_error)
     finally:
         runner.close()
     result = _result(
@@ -386,6 +374,8 @@ def _child(store: Store | None, name: str) -> Store | None:
 
 
 def _units(design, specimens: Replicates, stresses, base) -> list[CalibrationUnit]:
+    """The units of ``design``: per design point, per specimen, per normal stress (the order of
+    the rows :func:`_infer` reads; the units of more points follow those of the first)."""
     return [
         specimens.unit(label, s, base, fp, mu_r)
         for fp, mu_r in design
@@ -394,20 +384,22 @@ def _units(design, specimens: Replicates, stresses, base) -> list[CalibrationUni
     ]
 
 
-def _infer(ranges, design, specimens: Replicates, base, rows: dict[str, UnitRow], targets, lab_error):
-    """The surrogates (one per target), the posterior and the table of replicate values per design point."""
+def _infer(ranges, design, specimens: Replicates, stresses, rows: list[UnitRow | None], targets, lab_error):
+    """The surrogates (one per target), the posterior and the table of replicate values per design point.
+
+    ``rows``: the units' rows in the order of :func:`_units` (None: the test failed)."""
+    per_point = len(specimens.paths) * len(stresses)
     table = []
-    for fp, mu_r in design:
-        entry: dict[str, Any] = {"particle_friction": fp, "rolling_friction": mu_r}
+    for k, (fp, mu_r) in enumerate(design):
+        point = rows[k * per_point : (k + 1) * per_point]
+        observed = []
         for obs, s, _ in targets:
-            values = []
-            for label in specimens.paths:
-                row = rows.get(specimens.unit(label, s, base, fp, mu_r).key)
-                values.append(row.observable(obs) if row is not None else float("nan"))
-            entry[f"{obs}_{s:g}kPa"] = values
-        table.append(entry)
-    unit = ranges.to_unit([e["particle_friction"] for e in table], [e["rolling_friction"] for e in table])
-    values = np.array([[e[f"{obs}_{s:g}kPa"] for obs, s, _ in targets] for e in table], float)
+            at_s = point[stresses.index(s) :: len(stresses)]  # one row per specimen
+            values = [row.observable(obs) if row is not None else float("nan") for row in at_s]
+            observed.append(Observed(obs, s, values))
+        table.append(DesignPoint(fp, mu_r, tuple(observed)))
+    unit = ranges.to_unit([e.particle_friction for e in table], [e.rolling_friction for e in table])
+    values = np.array([[o.values for o in e.observed] for e in table], float)
     surrogates = []
     for k, (obs, s, _) in enumerate(targets):
         ok = np.isfinite(values[:, k]).any(axis=1)
@@ -510,7 +502,7 @@ def _result(
         ),
         evaluations=table,
         fit={
-            f"{obs}_{s:g}kPa": SurrogateRecord(
+            target_key(obs, s): SurrogateRecord(
                 sg.coefficients.tolist(), sg.scatter, sg.residual, sg.replicates
             )
             for (obs, s, _), sg in zip(targets, surrogates, strict=True)

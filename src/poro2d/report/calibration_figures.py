@@ -20,9 +20,7 @@ from matplotlib.ticker import FormatStrFormatter  # noqa: E402
 from poro2d.report.figure_file import save_figure  # noqa: E402
 
 
-def plot_calibration_fit(
-    result, lab, curves: dict[float, list], nearest: dict, path: str | os.PathLike
-) -> Path:
+def plot_calibration_fit(result, lab, curves: dict[float, list], nearest, path: str | os.PathLike) -> Path:
     """Left: laboratory peaks (and ends) against the calibrated model's; right: the model's curves
     at the design point ``nearest`` the best parameters (``curves[sigma]``: (d, tau) per specimen)
     against the laboratory curves, or its peak as a dotted line where the laboratory gave no curve.
@@ -69,8 +67,8 @@ def plot_calibration_fit(
     ax_curve.set_xlabel("shear displacement (mm)")
     ax_curve.set_ylabel("shear stress (kPa)")
     ax_curve.set_title(
-        f"curves at the design point nearest the best (f_p = {nearest['particle_friction']:.3g}, "
-        f"mu_r = {nearest['rolling_friction']:.3g})",
+        f"curves at the design point nearest the best (f_p = {nearest.particle_friction:.3g}, "
+        f"mu_r = {nearest.rolling_friction:.3g})",
         fontsize=9,
     )
     ax_curve.legend(fontsize=7)
@@ -88,8 +86,8 @@ def plot_calibration_posterior(result, post, path: str | os.PathLike) -> Path:
     fig.colorbar(mesh, ax=ax, label="posterior density / its maximum")
     ev = result.evaluations
     ax.plot(
-        [e["particle_friction"] for e in ev],
-        [e["rolling_friction"] for e in ev],
+        [e.particle_friction for e in ev],
+        [e.rolling_friction for e in ev],
         "w.",
         ms=7,
         mec="k",

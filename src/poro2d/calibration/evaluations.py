@@ -1,0 +1,76 @@
+"""A calibration's evaluations: each design point with its observables' replicate values.
+
+``result.json`` keeps one row per design point (``evaluations``): the parameter pair, then a
+key per laboratory target (``peak_50kPa``, ``end_100kPa``) with the value of each replicate
+specimen. The targets vary with the laboratory data, so the keys are formed from them
+(:func:`target_key`) and read back into the observable and stress they name.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from poro2d.record import Record, Spliced
+
+
+def target_key(observable: str, normal_stress_kpa: float) -> str:
+    """How a file names an observable at a normal stress (``peak_50kPa``): in ``evaluations`` and ``fit``."""
+    return f"{observable}_{normal_stress_kpa:g}kPa"
+
+
+@dataclass(frozen=True)
+class Observed(Record):
+    """One observable of a design point at one normal stress: its value per replicate specimen
+    (kPa, in the specimens' order; NaN where the test failed), written under :func:`target_key`."""
+
+    observable: str
+    normal_stress_kpa: float
+    values: list[float]
+
+    def layout(self) -> tuple:
+        return ((target_key(self.observable, self.normal_stress_kpa), "values"),)
+
+    @classmethod
+    def from_key(cls, key: str, values: list[float]) -> Observed:
+        """The observable a file's key names (``peak_50kPa``), with its values."""
+        observable, _, stress = key.rpartition("_")
+        if not observable or not stress.endswith("kPa"):
+            raise ValueError(f"not an observable at a normal stress: {key!r}")
+        return cls(observable, float(stress.removesuffix("kPa")), values)
+
+
+@dataclass(frozen=True, eq=False)
+class DesignPoint(Record, Mapping):
+    """One evaluated design point (a row of ``evaluations``): the parameter pair, then each
+    observable's replicate values in the order of the laboratory targets.
+
+    It reads as the dict of its row (``point["peak_50kPa"]``, equal to the row read from a
+    file), as a result's other parts do.
+    """
+
+    ROW = ("particle_friction", "rolling_friction", Spliced("observed"))
+
+    particle_friction: float
+    rolling_friction: float
+    observed: tuple[Observed, ...]
+
+    @classmethod
+    def from_dict(cls, row: Mapping[str, Any]) -> DesignPoint:
+        """A design point from its row in a file: every key beside the pair is an observable."""
+        observed = tuple(Observed.from_key(k, v) for k, v in row.items() if k not in cls.ROW)
+        return cls(row["particle_friction"], row["rolling_friction"], observed)
+
+    # read-only mapping access: the point reads as the dict of its row
+    def __getitem__(self, key: str) -> Any:
+        return self.to_dict()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.to_dict())
+
+    def __len__(self) -> int:
+        return len(self.to_dict())
+
+
+__all__ = ["DesignPoint", "Observed", "target_key"]
