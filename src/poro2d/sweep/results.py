@@ -10,7 +10,7 @@ points) are typed parts (:mod:`poro2d.sweep.records`).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from poro2d.execute.dask_cluster import ClusterInfo
 from poro2d.io_utils import Provenance
@@ -42,6 +42,9 @@ from poro2d.sweep.sensitivity_records import (
 )
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
+if TYPE_CHECKING:  # pandas is imported where a table is made, not with the results
+    import pandas as pd
+
 
 @dataclass(eq=False)
 class SweepResult(TypedResult):
@@ -71,7 +74,7 @@ class SweepResult(TypedResult):
     rows: list[CaseRow | LostCaseRow] = field(
         default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
-    table: Any = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
+    table: pd.DataFrame | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     @property
     def failed(self) -> list[CaseRow | LostCaseRow]:
