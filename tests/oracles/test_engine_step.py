@@ -25,7 +25,7 @@ import numpy as np
 import pytest
 
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
-from poro2d.oracles.engine_step import ReferenceDEM, engine_pair_order, engine_partitions
+from poro2d.oracles.engine_step import ReferenceDEM, _ranks, engine_pair_order, engine_partitions
 
 R = 1e-3  # mean radius (m)
 
@@ -134,6 +134,15 @@ def _contact_keys(sim) -> set:
         (a, b) if kind == 0 else (a, "wall", b)
         for a, b, kind in zip(c.i.tolist(), c.j.tolist(), c.kind.tolist(), strict=True)
     }
+
+
+def test_a_pairs_rank_is_its_row_in_the_engines_list():
+    """The reference sums pairs in the engine's order: a pair's rank is its row in the list
+    (the last row when listed twice), a pair the list lacks comes after every listed one."""
+    pairs = np.array([[0, 1], [2, 5], [1, 3], [2, 5], [4, 0]])
+    i, j = np.array([1, 2, 9, 0, 4, 0]), np.array([3, 5, 9, 1, 0, 4])
+    assert _ranks(pairs, i, j).tolist() == [2, 3, 6, 0, 4, 6]
+    assert _ranks(pairs[:0], i, j).tolist() == [1] * 6 and _ranks(pairs, i[:0], j[:0]).tolist() == []
 
 
 @pytest.mark.parametrize(

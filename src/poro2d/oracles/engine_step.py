@@ -205,15 +205,15 @@ class ReferenceDEM:
 
     def step(
         self,
-        pair_order: dict[tuple[int, int], int] | None = None,
+        pair_order: np.ndarray | None = None,
         partitions: np.ndarray | None = None,
     ) -> None:
         """Advance the copy by one time step.
 
         The contributions to each disk's force are summed disk-pair by disk-pair in
-        ascending ``(i, j)`` order, unless ``pair_order`` maps pairs to ranks (e.g. the
-        slots of the engine's neighbour list, :func:`engine_pair_order`): then in
-        ascending rank, pairs without a rank last. With ``partitions`` (the engine's
+        ascending ``(i, j)`` order, unless ``pair_order`` lists pairs (``(m, 2)``) in the order
+        to sum them (e.g. the slots of the engine's neighbour list, :func:`engine_pair_order`):
+        then in that order, pairs it does not list last. With ``partitions`` (the engine's
         partition boundaries, :func:`engine_partitions`) the sums follow the engine's
         partitioned order: a pair whose disks lie in different partitions reaches its
         second disk last, and wall resultants are summed partition by partition. Only
@@ -232,11 +232,7 @@ class ReferenceDEM:
         # disk-disk
         i, j, dx, dy, d, ov = self._disk_pairs()
         if pair_order is not None and len(i):
-            big = len(pair_order) + 1
-            rank = np.array(
-                [pair_order.get((a, b), big) for a, b in zip(i.tolist(), j.tolist(), strict=True)]
-            )
-            o = np.argsort(rank, kind="stable")
+            o = np.argsort(_ranks(pair_order, i, j), kind="stable")
             i, j, dx, dy, d, ov = i[o], j[o], dx[o], dy[o], d[o], ov[o]
         with np.errstate(invalid="ignore", divide="ignore"):
             inv = 1.0 / d  # as the kernel: one division, two products
@@ -401,10 +397,26 @@ def engine_partitions(sim) -> np.ndarray:
     return sim.work.part.copy()
 
 
-def engine_pair_order(sim) -> dict[tuple[int, int], int]:
-    """Slot of every disk pair in a simulation's current neighbour list (its sum order), keyed by pair."""
+def engine_pair_order(sim) -> np.ndarray:
+    """The disk pairs of a simulation's current neighbour list, ``(m, 2)``, in their slots' order
+    (the engine's sum order)."""
     nb = sim.pairs
-    return {(int(a), int(b)): k for k, (a, b) in enumerate(zip(nb.rows(), nb.other[: nb.used], strict=True))}
+    return np.column_stack((nb.rows(), nb.other[: nb.used])).astype(np.int64)
+
+
+def _ranks(pairs: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    """The row of each pair ``(i[k], j[k])`` in ``pairs`` (the last one when a pair is listed
+    twice); ``len(pairs) + 1`` for a pair not listed."""
+    missing = len(pairs) + 1
+    if not len(pairs) or not len(i):
+        return np.full(len(i), missing)
+    span = int(max(pairs.max(), i.max(), j.max())) + 1  # a pair as one integer: i * span + j
+    keys = pairs[:, 0].astype(np.int64) * span + pairs[:, 1]
+    order = np.argsort(keys, kind="stable")
+    listed = keys[order]
+    asked = i.astype(np.int64) * span + j
+    at = np.maximum(np.searchsorted(listed, asked, side="right") - 1, 0)
+    return np.where(listed[at] == asked, order[at], missing)
 
 
 def max_rel_diff(a: np.ndarray, b: np.ndarray, scale: float) -> float:
