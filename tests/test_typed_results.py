@@ -30,6 +30,7 @@ from poro2d.measure.specimen_porosity import SpecimenPorosity
 from poro2d.paper import PaperSummary
 from poro2d.sand.result import SandResult
 from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult, ShearTestResult
+from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.sweep.results import DensityStateResult, RelationResult, SensitivityResult
 from poro2d.typed_result import TypedResult
 
@@ -199,7 +200,7 @@ def test_fields_not_in_the_file_stay_out_of_it(tmp_path):
     reps = ReplicatesResult.from_dict({"rows": rows})
     reps.store = Store(tmp_path / "reps")
     assert reps.to_dict() == {"rows": rows} and reps.rows[1].converged is False
-    assert reps.specimens == {"seed1": tmp_path / "reps" / "seed1" / "specimen.npz"}
+    assert reps.specimens == SpecimenSet.made([("seed1", tmp_path / "reps" / "seed1" / "specimen.npz")])
 
 
 def _public_runs():

@@ -23,6 +23,7 @@ from poro2d.locks import holds_output
 from poro2d.paper_data import PAPER, QUICK_SHEAR
 from poro2d.shear.parts import LabRecord, QuasiStatic, TestSummary
 from poro2d.shear.results import ReplicateShearResult
+from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.typed_result import TypedResult
@@ -319,7 +320,7 @@ def _conversions_stage(store: Store, stage: ResumableStage) -> ConversionsRecord
     return conv
 
 
-def _shear_stage(specimens: dict[str, Path], store: Store, quick: bool, lab_data,
+def _shear_stage(specimens: SpecimenSet, store: Store, quick: bool, lab_data,
                  progress: bool) -> tuple[PaperShear, dict[str, Path]]:  # fmt: skip
     """Direct shear at the paper's normal stresses on every specimen; the summary over them and
     the figures written (Fig. 8 over the specimens, the first specimen's curves)."""

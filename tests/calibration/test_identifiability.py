@@ -6,16 +6,18 @@ posterior that is not finite is no answer at all.
 """
 
 import shutil
+from pathlib import Path
 
 import pytest
 
 from poro2d.calibration import model, run_calibration
 from poro2d.calibration.run import MIN_POINTS, _base_settings, _infer, _units, unidentified_reason
-from poro2d.calibration.specimens import Replicates, check_replicates
+from poro2d.calibration.specimens import check_replicates, replicate_unit
 from poro2d.calibration.units import CalibrationUnit, UnitRow
 from poro2d.cli.calibrate import print_result
 from poro2d.dem import checkpoint
 from poro2d.errors import InputError
+from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 
 SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4, "record_interval": 5e-5}
@@ -75,9 +77,8 @@ def test_replicates_of_another_box_are_refused(specimen, tmp_path):
     walls.p1[right, 0] += 0.01
     wider = tmp_path / "wider.npz"
     checkpoint.save(sim, wider)
-    found = {"a": specimen, "b": wider}
     with pytest.raises(InputError, match="wide"):
-        check_replicates(Replicates.read(found))
+        check_replicates(SpecimenSet.accepted({"a": specimen, "b": wider}))
 
 
 def test_zero_width_intervals_are_unknown_and_wide_ones_are_not():
@@ -100,7 +101,8 @@ def test_a_posterior_that_is_not_finite_is_no_answer():
             rows.append(UnitRow(unit.key, 50.0, fp, mu_r, found[label], peak, peak, 1.0))
     targets = [("peak", 50.0, 1e300)]  # an absurd laboratory value: the misfit overflows
     with pytest.raises(RuntimeError, match="posterior"):
-        _infer(ranges, design, Replicates(found, digests), [50.0], rows, targets, 0.0)
+        known = SpecimenSet(("a", "b"), (Path("a.npz"), Path("b.npz")), ("a" * 64, "b" * 64))
+        _infer(ranges, design, known, [50.0], rows, targets, 0.0)
 
 
 def test_the_table_reads_each_units_row_in_the_units_order():
@@ -109,7 +111,7 @@ def test_the_table_reads_each_units_row_in_the_units_order():
     ranges = model.Ranges((0.3, 3.0), (0.0, 0.5))
     design = model.space_filling(ranges, MIN_POINTS, 0)
     base = _base_settings({"max_displacement": 0.002})
-    found = Replicates({"a": "a.npz", "b": "b.npz", "c": "c.npz"}, {k: k * 64 for k in "abc"})
+    found = SpecimenSet(tuple("abc"), tuple(Path(f"{k}.npz") for k in "abc"), tuple(k * 64 for k in "abc"))
     stresses = [50.0, 100.0]
     units = _units(design, found, stresses, base)
 
@@ -128,8 +130,8 @@ def test_the_table_reads_each_units_row_in_the_units_order():
     for (fp, mu_r), entry in zip(design, table, strict=True):
         for s in stresses:
             expected = []
-            for label in found.paths:
-                row = by_key[found.unit(label, s, base, fp, mu_r).key]
+            for label in found:
+                row = by_key[replicate_unit(found, label, s, base, fp, mu_r).key]
                 expected.append(row.peak if row is not None else None)
             (obs,) = [o for o in entry.observed if o.normal_stress_kpa == s]
             got = [None if v != v else v for v in obs.values]

@@ -5,15 +5,20 @@ The other groups of that probe have their tests beside the code they check: dama
 (tests/store/test_folder.py, tests/calibration/test_cache_damage.py), folders of another kind
 (tests/cli/test_folder_kinds.py), rolling friction on export (tests/interop/test_rolling_export.py),
 laboratory files (tests/shear/test_fit_lab.py), identifiability (tests/calibration/test_identifiability.py),
-unaccepted specimens (tests/shear/test_accepted_specimens.py), the over-full box with rolling friction
-(tests/criterion/test_overfull_rolling.py), dashboards and schedulers (tests/ground/test_cluster_checks.py).
+unaccepted specimens (tests/specimen/test_accepted.py, tests/specimen/test_specimen_set.py), the
+over-full box with rolling friction (tests/criterion/test_overfull_rolling.py), dashboards and
+schedulers (tests/ground/test_cluster_checks.py).
 """
 
 from __future__ import annotations
 
+import json
+import shutil
+
 import pytest
 
 from poro2d.cli import main
+from poro2d.store import Store
 
 
 def _refused(argv, capsys) -> str:
@@ -32,6 +37,35 @@ def test_a_garbage_specimen_is_one_line(tmp_path, capsys, command):
     extra = ["-n", "50"] if command == "shear" else []
     err = _refused([command, garbage, *extra, "--out", tmp_path / "o"], capsys)
     assert "specimen.npz" in err and not (tmp_path / "o").exists()
+
+
+def test_strength_refuses_a_refused_trial_and_shears_the_accepted_one(specimen, tmp_path, capsys):
+    trials = tmp_path / "crit" / "trials"
+    for name, accepted in (("01_n0.14", False), ("02_n0.22", True)):
+        (trials / name).mkdir(parents=True)
+        shutil.copyfile(specimen, trials / name / "after_plate.npz")
+        Store(trials / name).write_json("trial.json", {"accepted": accepted})
+    out = tmp_path / "o"
+    tiny = ["--mu-r", "0", "--friction", "0.5", "-n", "50", "--max-displacement", "0.002", "-p", "1"]
+    accepted, refused = trials / "02_n0.22" / "after_plate.npz", trials / "01_n0.14" / "after_plate.npz"
+    err = _refused(["strength", accepted, refused, *tiny, "--out", out], capsys)
+    assert "01_n0.14/trial.json says accepted = False" in err and not out.exists()
+    main(["strength", str(accepted), *tiny, "--out", str(out), "--quiet"])
+    result = json.loads((out / "strength.json").read_text())
+    assert result["specimens"] == ["specimen1"] and len(result["cases"]) == 1
+    assert 0.0 < result["cases"][0]["residual_friction_angle_mean_deg"] < 90.0  # one stress: no peak line
+
+
+def test_a_strength_grid_over_its_budget_is_refused_before_any_specimen_is_read(tmp_path, capsys):
+    garbage = tmp_path / "specimen.npz"
+    garbage.write_bytes(b"not a checkpoint")
+    mu = ",".join(f"{0.1 * k:.1f}" for k in range(10))
+    stresses = ",".join(str(25 * k) for k in range(1, 11))
+    err = _refused(["strength", garbage, "--mu-r", mu, "--friction", "0.5,1,2,3", "-n", stresses,
+                    "--out", tmp_path / "o"], capsys)  # fmt: skip
+    assert "--max-tests = 300" in err and "400 tests" in err and not (tmp_path / "o").exists()
+    err = _refused(["strength", garbage, "--max-tests", "2000000", "--out", tmp_path / "o"], capsys)
+    assert "--max-tests = 2000000" in err and "[1, 1000000]" in err
 
 
 @pytest.mark.parametrize(

@@ -78,6 +78,7 @@ def test_replicate_series_on_small_specimens(tmp_path):
     from poro2d.shear.results import ReplicateShearResult
     from poro2d.specimen import paper_grading
     from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
+    from poro2d.specimen.specimen_set import SpecimenSet
     from poro2d.store import Store
 
     specimens = {}
@@ -91,7 +92,12 @@ def test_replicate_series_on_small_specimens(tmp_path):
     short = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4}
     out = tmp_path / "rep"
     res = ReplicateShear(
-        specimens, [50, 100], ShearSettings(**short), store=Store(out), processes=2, progress=False
+        SpecimenSet.accepted(specimens),
+        [50, 100],
+        ShearSettings(**short),
+        store=Store(out),
+        processes=2,
+        progress=False,
     ).run()
     assert isinstance(res, ReplicateShearResult) and "series" not in res.to_dict()
     assert res.to_dict() == json.loads((out / "replicates.json").read_text())

@@ -14,6 +14,7 @@ from poro2d.cli import main
 from poro2d.errors import InputError
 from poro2d.shear import ShearSettings
 from poro2d.shear.strength import StrengthStudy, max_dilation_angle, residual_point
+from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 
 TINY = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4, "stop_after_peak": 0.0}
@@ -38,7 +39,8 @@ def test_max_dilation_angle_of_a_known_plate_path():
 @pytest.fixture(scope="module")
 def study(specimen, tmp_path_factory):
     out = tmp_path_factory.mktemp("strength")
-    s = StrengthStudy({"a": specimen, "b": specimen}, [0.0, 0.3], [0.5], [50, 100], ShearSettings(**TINY),
+    twice = SpecimenSet.accepted({"a": specimen, "b": specimen})
+    s = StrengthStudy(twice, [0.0, 0.3], [0.5], [50, 100], ShearSettings(**TINY),
                       store=Store(out), processes=2, progress=False)  # fmt: skip
     return out, s.run()
 
@@ -68,7 +70,8 @@ def test_a_rerun_reads_the_tests_back(specimen, study):
     out, result = study
     test_json = out / "mur0.3_fp0.5" / "b" / "sn100kPa" / "result.json"
     stamp = test_json.stat().st_mtime_ns
-    again = StrengthStudy({"a": specimen, "b": specimen}, [0.0, 0.3], [0.5], [50, 100], ShearSettings(**TINY),
+    twice = SpecimenSet.accepted({"a": specimen, "b": specimen})
+    again = StrengthStudy(twice, [0.0, 0.3], [0.5], [50, 100], ShearSettings(**TINY),
                           store=Store(out), processes=1, progress=False).run()  # fmt: skip
     assert test_json.stat().st_mtime_ns == stamp
     assert again["cases"] == result["cases"]
@@ -98,9 +101,9 @@ def test_cli_refuses_bad_input_before_any_work(tmp_path, capsys, args, words):
 
 def test_study_refuses_bad_grids(specimen, tmp_path):
     with pytest.raises(InputError, match="mu_r"):
-        StrengthStudy({"a": specimen}, [0.0, 1.5], [0.5], [50], store=Store(tmp_path))
+        StrengthStudy(SpecimenSet.accepted({"a": specimen}), [0.0, 1.5], [0.5], [50], store=Store(tmp_path))
     with pytest.raises(InputError, match="particle friction"):
-        StrengthStudy({"a": specimen}, [0.0], [], [50], store=Store(tmp_path))
+        StrengthStudy(SpecimenSet.accepted({"a": specimen}), [0.0], [], [50], store=Store(tmp_path))
 
 
 def test_cli_runs_a_tiny_study_and_records_its_grid(specimen, tmp_path, capsys):

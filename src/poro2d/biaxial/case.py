@@ -1,6 +1,6 @@
 """A biaxial case: what one test's results depend on, as one frozen value.
 
-The specimen (a :class:`~poro2d.shear.specimen_file.Specimen` read once from a file made by
+The specimen (a :class:`~poro2d.specimen.saved.Specimen` read once from a file made by
 ``poro2d criterion`` or ``poro2d sand``, or the recipe of a quick specimen,
 :class:`~poro2d.biaxial.quick.QuickSpecimen`), the confining stress and the settings. A
 replicate study makes its cases from one case with :meth:`BiaxialCase.replicate`; a case
@@ -16,7 +16,7 @@ from poro2d.biaxial.quick import QuickSpecimen
 from poro2d.biaxial.settings import CONFINING_RANGE_KPA, BiaxialSettings
 from poro2d.config import check_finite
 from poro2d.errors import InputError, check_range
-from poro2d.shear.specimen_file import Specimen
+from poro2d.specimen.saved import Specimen
 
 
 @dataclass(frozen=True, eq=False)

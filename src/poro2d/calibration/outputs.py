@@ -5,8 +5,9 @@ from __future__ import annotations
 import math
 
 from poro2d.calibration.evaluations import DesignPoint
-from poro2d.calibration.specimens import Replicates
+from poro2d.calibration.specimens import replicate_unit
 from poro2d.calibration.units import CACHE, unit_curve
+from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 
 FIT_PNG = "calibration_fit.png"
@@ -14,7 +15,7 @@ POSTERIOR_PNG = "calibration_posterior.png"
 CONFIG_TOML = "calibrated.toml"
 
 
-def write_outputs(store: Store, result, post, surrogates, lab, specimens: Replicates, base) -> None:
+def write_outputs(store: Store, result, post, surrogates, lab, specimens: SpecimenSet, base) -> None:
     """Figures, config and report first; ``result.json`` last (its presence says: finished)."""
     from poro2d.report.calibration_figures import plot_calibration_fit, plot_calibration_posterior
 
@@ -29,7 +30,7 @@ def write_outputs(store: Store, result, post, surrogates, lab, specimens: Replic
 
 
 def _best_curves(
-    result, lab, specimens: Replicates, base, cache: Store
+    result, lab, specimens: SpecimenSet, base, cache: Store
 ) -> tuple[dict[float, list], DesignPoint]:
     """The curves of the design point nearest the best parameters, per normal stress (all
     specimens), and that design point: what the fit figure draws."""
@@ -43,8 +44,10 @@ def _best_curves(
     )
     curves: dict[float, list] = {}
     for s in lab.normal_stresses():
-        for label in specimens.paths:
-            unit = specimens.unit(label, s, base, nearest.particle_friction, nearest.rolling_friction)
+        for label in specimens:
+            unit = replicate_unit(
+                specimens, label, s, base, nearest.particle_friction, nearest.rolling_friction
+            )
             curve = unit_curve(unit, cache)
             if curve is not None:
                 curves.setdefault(s, []).append(curve)

@@ -21,11 +21,10 @@ from poro2d.calibration import model
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
 from poro2d.calibration.evaluations import DesignPoint, Observed, target_key
 from poro2d.calibration.specimens import (
-    Replicates,
     check_preset,
     check_replicates,
-    given_specimens,
     preset_specimens,
+    replicate_unit,
 )
 from poro2d.calibration.units import CACHE, CalibrationUnit, UnitRow
 from poro2d.errors import InputError, check_int, check_range, is_number
@@ -38,6 +37,7 @@ from poro2d.shear.lab import LabData, read_lab_csv
 from poro2d.shear.parts import LabRecord, ShearSettingsRecord
 from poro2d.shear.series import check_stresses
 from poro2d.shear.settings import MAX_FRICTION, ShearSettings
+from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 from poro2d.typed_result import Keyed, TypedResult
 
@@ -298,7 +298,8 @@ def run_calibration(
         raise InputError("--specimen", ", ".join(map(str, specimens)), "nothing with --preset")
     if preset is not None and store is None:
         raise InputError("store", None, "a store to keep the preset's specimens in")
-    given = given_specimens(list(specimens or [])) if preset is None else None
+    # every given specimen accepted and read whole (a damaged file refused on one line) before any work
+    given = SpecimenSet.named(specimens or []).read() if preset is None else None
     ranges = model.Ranges(
         check_range_pair("--fp-range", fp_range, 0.0, MAX_FRICTION, lo_open=True),
         check_range_pair("--mu-r-range", mu_r_range, 0.0, 1.0),
@@ -322,12 +323,12 @@ def run_calibration(
     check_cluster_options(scheduler, workers)
     check_reachable(scheduler)
 
-    found = Replicates.read(
+    found = (
         given
         if given is not None
         else preset_specimens(
             store.child("specimens"), quick=quick, seed=seed, replicates=replicates, progress=progress
-        )
+        ).read()
     )
     check_replicates(found)
     runner = UnitRunner(scheduler, workers, progress=progress, dashboard=dashboard)
@@ -373,22 +374,22 @@ def _child(store: Store | None, name: str) -> Store | None:
     return None if store is None else store.child(name)
 
 
-def _units(design, specimens: Replicates, stresses, base) -> list[CalibrationUnit]:
+def _units(design, specimens: SpecimenSet, stresses, base) -> list[CalibrationUnit]:
     """The units of ``design``: per design point, per specimen, per normal stress (the order of
     the rows :func:`_infer` reads; the units of more points follow those of the first)."""
     return [
-        specimens.unit(label, s, base, fp, mu_r)
+        replicate_unit(specimens, label, s, base, fp, mu_r)
         for fp, mu_r in design
-        for label in specimens.paths
+        for label in specimens
         for s in stresses
     ]
 
 
-def _infer(ranges, design, specimens: Replicates, stresses, rows: list[UnitRow | None], targets, lab_error):
+def _infer(ranges, design, specimens: SpecimenSet, stresses, rows: list[UnitRow | None], targets, lab_error):
     """The surrogates (one per target), the posterior and the table of replicate values per design point.
 
     ``rows``: the units' rows in the order of :func:`_units` (None: the test failed)."""
-    per_point = len(specimens.paths) * len(stresses)
+    per_point = len(specimens) * len(stresses)
     table = []
     for k, (fp, mu_r) in enumerate(design):
         point = rows[k * per_point : (k + 1) * per_point]
@@ -448,7 +449,7 @@ def _result(
     targets,
     level,
     lab_data,
-    found: Replicates,
+    found: SpecimenSet,
     ranges,
     base,
     runner,
@@ -508,7 +509,7 @@ def _result(
             for (obs, s, _), sg in zip(targets, surrogates, strict=True)
         },
         lab=lab_data.record(),
-        specimens={k: str(v) for k, v in found.paths.items()},
+        specimens={label: str(found[label]) for label in found},
         ranges=FrictionBounds(list(ranges.fp), list(ranges.mu_r)),
         settings=base.record(),
         cluster=runner.info(),

@@ -8,59 +8,24 @@ as ``poro2d paper`` does; both are resumable, so a rerun reads the specimens bac
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from poro2d.calibration.units import CalibrationUnit
 from poro2d.errors import InputError, check_int
-from poro2d.shear.specimen_file import Specimen, resolve_specimen
+from poro2d.specimen.saved import Specimen
+from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 
 #: the most replicate specimens of the preset (each is a criterion run)
 MAX_REPLICATES = 20
 
 
-def given_specimens(paths: list[str | os.PathLike]) -> dict[str, Path]:
-    """Specimens by label (their folder or file name; made unique) from ``--specimen`` paths."""
-    if not paths:
-        raise InputError("--specimen", "none", "at least one specimen (or --preset paper)")
-    found: dict[str, Path] = {}
-    for given in paths:
-        path = resolve_specimen(given)
-        Store(path.parent).read_state(path.name)  # a damaged file is refused here, in one line
-        label = path.parent.name if path.name == "specimen.npz" else path.stem
-        label = label or "specimen"
-        unique, k = label, 1
-        while unique in found:
-            k += 1
-            unique = f"{label}-{k}"
-        found[unique] = path
-    return found
-
-
-@dataclass(frozen=True)
-class Replicates:
-    """The replicate specimens a calibration shears: each one's file by label, and the digest of
-    its content (what a unit's key hashes: a specimen moved to another folder is the same one)."""
-
-    paths: dict[str, Path]
-    digests: dict[str, str]
-
-    @classmethod
-    def read(cls, paths: dict[str, Path]) -> Replicates:
-        """The replicates of the files ``paths`` (by label), each file's content hashed once."""
-        from poro2d.dem.checkpoint import state_digest
-
-        return cls(dict(paths), {label: state_digest(path) for label, path in paths.items()})
-
-    def __len__(self) -> int:
-        return len(self.paths)
-
-    def unit(self, label: str, sigma: float, base, fp: float, mu_r: float) -> CalibrationUnit:
-        """The shear test of specimen ``label`` at ``sigma`` with the frictions (f_p, mu_r) on ``base``."""
-        return CalibrationUnit.at(self.paths[label], self.digests[label], sigma, base, fp, mu_r)
+def replicate_unit(specimens: SpecimenSet, label: str, sigma: float, base, fp: float, mu_r: float
+                   ) -> CalibrationUnit:  # fmt: skip
+    """The shear test of specimen ``label`` (of a read set) at ``sigma`` with the frictions (f_p, mu_r)
+    on ``base``: its key hashes the specimen's content, not where it lies."""
+    return CalibrationUnit.at(specimens[label], specimens.digest(label), sigma, base, fp, mu_r)
 
 
 #: a two-sample Kolmogorov-Smirnov test of two specimens' radii below this p-value says they were
@@ -68,7 +33,7 @@ class Replicates:
 GRADING_P_VALUE = 1e-3
 
 
-def check_replicates(replicates: Replicates) -> None:
+def check_replicates(replicates: SpecimenSet) -> None:
     """Refuse replicates whose differences are not seed scatter, on one line naming the specimen.
 
     The calibration counts the spread of the replicates at each design point as the seed
@@ -76,9 +41,10 @@ def check_replicates(replicates: Replicates) -> None:
     has none, and specimens of other box widths, disk thicknesses or gradings differ by more
     than their seeds, which would be counted as scatter and widen the intervals unseen.
     """
-    found, digests = replicates.paths, replicates.digests
+    found = replicates.read()
     seen: dict[str, str] = {}
-    for label, digest in digests.items():
+    for label in found:
+        digest = found.digest(label)
         if digest in seen:
             raise InputError(
                 "--specimen", str(found[label]), "distinct replicate specimens",
@@ -86,10 +52,9 @@ def check_replicates(replicates: Replicates) -> None:
             )  # fmt: skip
         seen[digest] = label
     first, *others = list(found)
-    ref = _replicate_traits(found[first], digests[first])
+    ref = _replicate_traits(found.specimen(first))
     for label in others:
-        traits = _replicate_traits(found[label], digests[label])
-        why = _mixed(ref, traits)
+        why = _mixed(ref, _replicate_traits(found.specimen(label)))
         if why:
             raise InputError(
                 "--specimen", str(found[label]), f"a replicate of {found[first]}",
@@ -97,9 +62,8 @@ def check_replicates(replicates: Replicates) -> None:
             )  # fmt: skip
 
 
-def _replicate_traits(path: Path, digest: str) -> tuple[float, float, np.ndarray]:
-    """(box width, disk thickness, radii) of a specimen: what replicates of one soil share."""
-    specimen = Specimen.read(path, digest)
+def _replicate_traits(specimen: Specimen) -> tuple[float, float, np.ndarray]:
+    """(box width, disk thickness, radii) of a specimen read: what replicates of one soil share."""
     width = specimen.box()[0]
     return width, float(specimen.meta.get("thickness", 0.0)), specimen.arrays["particles.radius"]
 
@@ -126,9 +90,7 @@ def check_preset(preset: str | None, quick: bool, replicates: int) -> None:
     check_int("--replicates", replicates, 1, MAX_REPLICATES)
 
 
-def preset_specimens(
-    store: Store, *, quick: bool, seed: int, replicates: int, progress: bool
-) -> dict[str, Path]:
+def preset_specimens(store: Store, *, quick: bool, seed: int, replicates: int, progress: bool) -> SpecimenSet:
     """The paper preset's accepted specimens for ``replicates`` seeds from ``seed``, kept in ``store``.
 
     The criterion runs once on ``seed`` (its ``criterion``), then on the next seeds from its
@@ -155,7 +117,7 @@ def preset_specimens(
     result = crit.run()
     if not result.converged:
         raise RuntimeError(f"the criterion of seed {seed} did not converge: {result.message}")
-    specimens = {f"seed{seed}": out / "criterion" / "specimen.npz"}
+    specimens = SpecimenSet.made([(f"seed{seed}", out / "criterion" / "specimen.npz")])
     if replicates > 1:
         extra = list(range(seed + 1, seed + replicates))
         more = run_replicates(
@@ -168,16 +130,15 @@ def preset_specimens(
             processes=spec.threads,
             progress=progress,
         )
-        specimens.update(more.specimens)
+        specimens += more.specimens
     return specimens
 
 
 __all__ = [
     "GRADING_P_VALUE",
     "MAX_REPLICATES",
-    "Replicates",
     "check_preset",
     "check_replicates",
-    "given_specimens",
     "preset_specimens",
+    "replicate_unit",
 ]

@@ -12,7 +12,7 @@ from pathlib import Path
 from poro2d.shear.case import ShearCase
 from poro2d.shear.settings import ShearSettings
 from poro2d.shear.single import DirectShearTest
-from poro2d.shear.specimen_file import Specimen
+from poro2d.specimen.saved import Specimen
 from poro2d.store import Store
 
 

@@ -21,7 +21,7 @@ from poro2d.identity import identity_digest
 from poro2d.shear.case import ShearCase
 from poro2d.shear.settings import ShearSettings
 from poro2d.shear.single import DirectShearTest
-from poro2d.shear.specimen_file import Specimen
+from poro2d.specimen.saved import Specimen
 from poro2d.store import Store
 
 #: what a unit returns besides its identity: the observables a calibration may fit

@@ -82,9 +82,10 @@ def export_specimen(specimen, out: Path, *, n_lab=None, dr=None, seed=None):
     """
     from poro2d.errors import InputError
     from poro2d.interop.origin import origin_lines
-    from poro2d.interop.specimen_data import check_accepted, from_checkpoint, resolve_specimen
+    from poro2d.interop.specimen_data import from_checkpoint, resolve_specimen
     from poro2d.interop.state_specimen import STATE_RECORDS, state_record, state_specimen
     from poro2d.io_utils import check_output_dir
+    from poro2d.specimen.accepted import check_accepted
 
     has_specimen = Path(specimen).is_file() or (Path(specimen) / "specimen.npz").is_file()
     record = None if has_specimen else state_record(specimen)

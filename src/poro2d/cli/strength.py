@@ -11,6 +11,7 @@ from poro2d.console import OutputConsole, Table
 
 if TYPE_CHECKING:
     from poro2d.shear.results import StrengthResult
+    from poro2d.specimen.specimen_set import SpecimenSet
 
 console = OutputConsole()
 
@@ -34,7 +35,7 @@ def parse_values(text: str, option: str, hi: float) -> list[float]:
     return values
 
 
-def quick_specimens(out: Path, seeds: int, progress: bool) -> dict[str, Path]:
+def quick_specimens(out: Path, seeds: int, progress: bool) -> SpecimenSet:
     """The paper's quick specimen (``poro2d paper --quick``) of seed 0 and those of the next seeds,
     by their labels.
 
@@ -82,7 +83,8 @@ def register(app: typer.Typer) -> None:
         max_tests: int = typer.Option(
             MAX_TESTS,
             "--max-tests",
-            help="Most direct shear tests the grid may start (cases x specimens x stresses).",
+            help="Most direct shear tests the grid may start (cases x specimens x stresses); "
+            "a larger grid is refused before any work.",
         ),
         quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
     ) -> None:
@@ -93,6 +95,7 @@ def register(app: typer.Typer) -> None:
         from poro2d.locks import output_folder
         from poro2d.shear import strength as st
         from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
+        from poro2d.specimen.specimen_set import SpecimenSet
         from poro2d.store import Store
 
         # everything is checked before the first specimen or test is made
@@ -123,6 +126,9 @@ def register(app: typer.Typer) -> None:
         if max_displacement is not None:
             shear["max_displacement"] = max_displacement
         settings = ShearSettings(**shear)
+        # the given specimens: each one the criterion accepted, read whole, before the folder is claimed
+        labelled = {f"specimen{k + 1}": p for k, p in enumerate(specimen or [])}
+        given = None if quick else SpecimenSet.accepted(labelled, "SPECIMEN").read()
         config = {"quick": quick, "seeds": n_seeds if quick else None, "specimens": specimen or None,
                   "mu_r": mu_values, "particle_friction": fp_values, "normal_stress_kpa": stresses,
                   "shear": shear}  # fmt: skip
@@ -131,7 +137,7 @@ def register(app: typer.Typer) -> None:
                 console.print(f"[bold]quick specimens[/] (the paper's quick preset), {n_seeds} seed(s)")
                 specimens = quick_specimens(out / "specimens", n_seeds, not quiet)
             else:
-                specimens = {f"specimen{k + 1}": Path(p) for k, p in enumerate(specimen)}
+                specimens = given
             study = st.StrengthStudy(specimens, mu_values, fp_values, stresses, settings, store=Store(out),
                                      processes=processes, progress=not quiet, config=config)  # fmt: skip
             console.print(

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
-from pathlib import Path
 
 from poro2d.console import OutputConsole
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
@@ -23,6 +22,7 @@ from poro2d.execute import Backend, Executor, Failed, Job, results_or_raise
 from poro2d.grading import GradingCurve
 from poro2d.progress import JobsProgress
 from poro2d.specimen.compaction import SpecimenSpec
+from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 
 console = OutputConsole()
@@ -81,21 +81,21 @@ def accepted_and_replicates(
     store: Store,
     *,
     progress: bool,
-) -> tuple[dict[str, Path], list[ReplicateRow] | None]:
+) -> tuple[SpecimenSet, list[ReplicateRow] | None]:
     """The specimen ``seed`` accepted in ``store``'s ``criterion`` and, with replicates, the next seeds'.
 
     The replicates are criterion runs from the accepted ``n2d`` in its ``replicates``, one
     process per thread of ``spec`` (:func:`run_replicates`); their rows (as ``results.json``
     holds them) are None without any.
     """
-    specimens = {f"seed{seed}": store.child("criterion").path("specimen.npz")}
+    specimens = SpecimenSet.made([(f"seed{seed}", store.child("criterion").path("specimen.npz"))])
     if replicates == 1:
         return specimens, None
     more_seeds = list(range(seed + 1, seed + replicates))
     console.print(f"  replicate specimens: seeds {', '.join(map(str, more_seeds))} from n2D = {n2d:.2f}")
     more = run_replicates(spec, grading, settings, n2d, more_seeds, store.child("replicates"),
                           processes=spec.threads, progress=progress)  # fmt: skip
-    return {**specimens, **more.specimens}, more.rows
+    return specimens + more.specimens, more.rows
 
 
 def _outcome(row: ReplicateRow) -> str:

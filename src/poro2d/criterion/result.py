@@ -10,6 +10,7 @@ from poro2d.criterion.trial import Trial
 from poro2d.io_utils import Provenance
 from poro2d.measure.specimen_porosity import SpecimenPorosity
 from poro2d.measure.specimen_state import SpecimenStateResult
+from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
@@ -164,11 +165,11 @@ class ReplicatesResult(TypedResult):
         return self.to_dict()[key]
 
     @property
-    def specimens(self) -> dict[str, Path]:
-        """The accepted specimens by label (``seed1``, ...), each seed's ``specimen.npz``: keyed paths."""
+    def specimens(self) -> SpecimenSet:
+        """The accepted specimens by label (``seed1``, ...), each seed's ``specimen.npz``, in seed order."""
         assert self.store is not None
-        return {f"seed{r.seed}": self.store.child(r.folder).path("specimen.npz") for r in self.rows
-                if r.converged}  # fmt: skip
+        return SpecimenSet.made((f"seed{r.seed}", self.store.child(r.folder).path("specimen.npz"))
+                                for r in self.rows if r.converged)  # fmt: skip
 
 
 #: the figures a criterion run may leave at the top of its folder, by name

@@ -261,50 +261,6 @@ def resolve_specimen(path: str | os.PathLike) -> Path:
     return check_input_file("SPECIMEN", p, CHECKPOINT_FILE_LIMIT)
 
 
-def check_accepted(path: str | os.PathLike) -> None:
-    """Refuse a specimen that the criterion beside it did not accept.
-
-    A criterion folder (or the folder of the checkpoint given) holds ``result.json``;
-    when it says ``converged = false`` or lists no accepted trial, the specimen must not
-    leave as if valid. A trial's checkpoint has ``trial.json`` beside it, which must say
-    ``accepted = true``. A checkpoint with neither beside it (a shear test's, an imported
-    one) is taken as it is.
-    """
-    p = Path(path)
-    folder = Store(p if p.is_dir() else p.parent, parameter="SPECIMEN")
-    result = _record(path, folder, "result.json")
-    if result is not None and "converged" in result:
-        trials = result.get("iterations") if isinstance(result.get("iterations"), list) else []
-        accepted = any(isinstance(row, dict) and row.get("accepted") is True for row in trials)
-        if result["converged"] is not True or not accepted:
-            state = (
-                "no accepted trial" if result["converged"] is True else f"converged = {result['converged']}"
-            )
-            _refuse_unaccepted(path, folder.root / "result.json", state)
-    trial = _record(path, folder, "trial.json")
-    if trial is not None and "accepted" in trial and trial["accepted"] is not True:
-        _refuse_unaccepted(path, folder.root / "trial.json", f"accepted = {trial['accepted']}")
-
-
-def _record(path: str | os.PathLike, folder: Store, name: str) -> dict | None:
-    """The JSON object ``name`` beside the specimen as it is (a file of any poro2d: its keys are checked
-    where read), None if there is none (or it holds something else)."""
-    if not folder.has(name):
-        return None
-    check_input_file("SPECIMEN", folder.root / name)
-    data = folder.read_json(name)
-    if data is None:
-        why = "it changed since poro2d wrote it" if not folder.intact(name) else "it is not valid JSON"
-        raise InputError("SPECIMEN", str(path), f"a specimen with a readable {name}", why) from None
-    return data if isinstance(data, dict) else None
-
-
-def _refuse_unaccepted(path: str | os.PathLike, record: Path, state: str) -> None:
-    raise InputError(
-        "SPECIMEN", str(path), "a specimen the criterion accepted", f"{record} says {state}; nothing written"
-    )
-
-
 def from_simulation(sim: Simulation, source: str = "") -> SpecimenData:
     """The disks and walls of ``sim`` (copies), with its gravity, damping and time step."""
     _check_per_body(sim.contact.convention, "'per_body' (the properties travel with the bodies)")

@@ -8,7 +8,7 @@ from poro2d.shear.run import run_shear
 from poro2d.shear.series import ShearSeries
 from poro2d.shear.settings import ShearSettings, inertial_number
 from poro2d.shear.single import DirectShearTest
-from poro2d.shear.specimen_file import Specimen
+from poro2d.specimen.saved import Specimen
 
 __all__ = [
     "DirectShearTest", "LabData", "MohrCoulombFit", "ShearCase", "ShearSeries", "ShearSettings", "Specimen",

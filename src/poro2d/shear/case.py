@@ -1,6 +1,6 @@
 """A direct shear case: what one test's results depend on, as one frozen value.
 
-The specimen (read once, :class:`~poro2d.shear.specimen_file.Specimen`), the normal stress
+The specimen (read once, :class:`~poro2d.specimen.saved.Specimen`), the normal stress
 and the settings. A series, its rate check, a replicate study and a strength study make
 their tests' cases from one case with :func:`dataclasses.replace`; a case travels to a
 worker process as it is (it pickles), and it names its test's record (``test.json``).
@@ -15,7 +15,7 @@ from poro2d.config import check_finite
 from poro2d.errors import InputError, check_range
 from poro2d.shear.record import TestContent, content_record
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings
-from poro2d.shear.specimen_file import Specimen
+from poro2d.specimen.saved import Specimen
 
 
 @dataclass(frozen=True, eq=False)

@@ -14,7 +14,6 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 
@@ -24,7 +23,7 @@ from poro2d.shear.fit import mohr_coulomb
 from poro2d.shear.parts import FitInterval, StressPeaks
 from poro2d.shear.pool import ShearJob
 from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult, ShearTestResult
-from poro2d.shear.specimen_file import Specimen
+from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 
 
@@ -102,13 +101,13 @@ def summarize_replicate_peaks(
 class ReplicateShear:
     """The same direct shear tests on several specimens, in one process pool, then the summary.
 
-    ``specimens``: label -> specimen (a :class:`~poro2d.shear.specimen_file.Specimen`, or a
-    checkpoint or folder holding ``specimen.npz``, read once); with ``store`` each
+    ``specimens``: the specimens by label (a :class:`~poro2d.specimen.specimen_set.SpecimenSet`;
+    each read once, here or in its series when the set is not read yet); with ``store`` each
     specimen's tests are kept in ``<label>/`` as a :class:`ShearSeries` keeps them, and the
     summary in ``replicates.json`` and ``replicates.csv`` (``store=None``: nothing is kept).
     """
 
-    def __init__(self, specimens: dict[str, Specimen | str | Path], normal_stresses_kpa, settings=None, *,
+    def __init__(self, specimens: SpecimenSet, normal_stresses_kpa, settings=None, *,
                  store: Store | None = None, lab=None, processes: int | None = None, progress: bool = True,
                  config: dict | None = None, figures: bool = True) -> None:  # fmt: skip
         import os
@@ -116,14 +115,14 @@ class ReplicateShear:
         from poro2d.shear.series import ShearSeries
 
         if not specimens:
-            raise InputError("specimens", {}, "at least one specimen")
+            raise InputError("specimens", "none", "at least one specimen")
         self.store = store
         self.progress = progress
         self.config = config or {}
         self.figures = figures
         self.series = {
             label: ShearSeries(
-                path,
+                specimens.specimen(label),
                 normal_stresses_kpa,
                 settings,
                 store=store.child(label) if store is not None else None,
@@ -133,7 +132,7 @@ class ReplicateShear:
                 config=self.config,
                 figures=figures,
             )  # fmt: skip
-            for label, path in specimens.items()
+            for label in specimens
         }
         njobs = sum(len(s.jobs) for s in self.series.values())
         self.processes = processes if processes is not None else min(njobs, 2 * (os.cpu_count() or 1))

@@ -17,7 +17,7 @@ from poro2d.shear.lab import LabData, read_lab_csv
 from poro2d.shear.results import ShearSeriesResult
 from poro2d.shear.series import ShearSeries, check_stresses
 from poro2d.shear.settings import ShearSettings
-from poro2d.shear.specimen_file import Specimen
+from poro2d.specimen.saved import Specimen
 from poro2d.store import Store
 
 

@@ -30,7 +30,7 @@ from poro2d.shear.parts import (
 from poro2d.shear.pool import ShearJob, execute_jobs
 from poro2d.shear.results import ShearSeriesResult, ShearTestResult
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings
-from poro2d.shear.specimen_file import Specimen
+from poro2d.specimen.saved import Specimen
 from poro2d.store import Store
 
 #: what a series' ``result.json`` keeps of each test
@@ -63,7 +63,7 @@ def check_stresses(normal_stresses_kpa) -> list[float]:
 class ShearSeries:
     """Direct shear tests at several normal stresses, in parallel processes, with the fit.
 
-    ``specimen``: a :class:`~poro2d.shear.specimen_file.Specimen`, or its path (read once,
+    ``specimen``: a :class:`~poro2d.specimen.saved.Specimen`, or its path (read once,
     here). With ``store`` it keeps ``result.json`` (per test and overall), ``peaks.csv``,
     ``curves.csv``, ``fig8a_shear_curves.png``, ``fig8b_peak_strength.png`` and one sub-store
     per test (see :class:`DirectShearTest`); with ``rate_check`` every test is repeated at

@@ -1,6 +1,6 @@
 """One direct shear test at one normal stress sigma_n, driving the engine.
 
-1. build the specimen (read once, :class:`poro2d.shear.specimen_file.Specimen`) in a split box
+1. build the specimen (read once, :class:`poro2d.specimen.saved.Specimen`) in a split box
    (:func:`poro2d.shear.box.build_split_box`);
 2. consolidate (:class:`poro2d.shear.controllers.Consolidation`): servo the top plate
    to ``sigma_n W t`` until the specimen is in equilibrium (maximum unbalanced-force

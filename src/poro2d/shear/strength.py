@@ -24,7 +24,6 @@ import math
 import time
 from collections.abc import Mapping
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 
@@ -37,7 +36,7 @@ from poro2d.shear.parts import StrengthCase, StrengthDefinitions
 from poro2d.shear.replicates import ReplicateShear, mohr_coulomb_ci
 from poro2d.shear.results import ReplicateShearResult, StrengthResult
 from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
-from poro2d.shear.specimen_file import Specimen
+from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 
 #: the part of each test's shear displacement, at its end, that the residual strength averages
@@ -156,33 +155,33 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
 
 
 # ---------------------------------------------------------------------- the study
-def check_specimens(specimens: dict, normal_stresses_kpa, settings: ShearSettings) -> dict[str, Specimen]:
-    """Every specimen (read once, by its label) and stress as a test would take them, before any case
-    binds a folder.
+def read_specimens(specimens: SpecimenSet, normal_stresses_kpa, settings: ShearSettings) -> SpecimenSet:
+    """The specimens read (each once, for every case) and checked with every stress as a test would
+    take them, before any case binds a folder.
 
     A case's series writes its tests' records as it is built, so a bad second specimen found
     while building the cases would leave the first one's folders behind.
     """
     if not specimens:
-        raise InputError("specimens", {}, "at least one specimen")
-    values = {label: Specimen.of(path) for label, path in specimens.items()}
-    for value in values.values():
+        raise InputError("specimens", "none", "at least one specimen")
+    found = specimens.read()
+    for value in found.contents():
         for sigma in normal_stresses_kpa:
             ShearCase(value, sigma, settings)  # checks only
-    return values
+    return found
 
 
 class StrengthStudy:
     """Direct shear over the grid ``mu_r`` x ``friction`` on every specimen, in one process pool.
 
-    ``specimens``: label -> specimen (checkpoint or criterion folder); ``settings``: the shear
+    ``specimens``: the replicate specimens by label (read once here); ``settings``: the shear
     settings every case starts from (its ``particle_friction`` and ``rolling_friction`` are
     the case's). With ``store`` it keeps ``<case>/`` (a :class:`ReplicateShear` each),
     ``strength.csv`` (one row per case), ``strength_tests.csv`` (one per test),
     ``strength.json`` and ``fig_strength.png`` (``store=None``: nothing is kept).
     """
 
-    def __init__(self, specimens: dict[str, Specimen | str | Path], mu_r, friction, normal_stresses_kpa,
+    def __init__(self, specimens: SpecimenSet, mu_r, friction, normal_stresses_kpa,
                  settings: ShearSettings | None = None, *, store: Store | None = None,
                  processes: int | None = None, progress: bool = True,
                  config: dict | None = None) -> None:  # fmt: skip
@@ -192,8 +191,8 @@ class StrengthStudy:
         self.friction = check_grid("particle friction", friction, MAX_FRICTION)
         base = settings if settings is not None else ShearSettings()
         self.settings = base
-        values = check_specimens(specimens, normal_stresses_kpa, base)
-        scales = [box_scale(*v.box(), v.arrays["particles.radius"]) for v in values.values()]
+        values = read_specimens(specimens, normal_stresses_kpa, base)
+        scales = [box_scale(*v.box(), v.arrays["particles.radius"]) for v in values.contents()]
         self.box_scale = min(scales, key=lambda b: b.width_over_d_max)
         self.store = store
         self.progress = progress

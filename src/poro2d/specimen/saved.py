@@ -1,8 +1,10 @@
-"""The specimen a direct shear test starts from: read once, then passed down as a value.
+"""A saved specimen read once, then passed down as a value.
 
-A series runs several tests on one specimen, in other processes: the file is read (and
-checked, and hashed) once into a :class:`Specimen`, and every test builds its simulation
-from that value instead of opening the file again.
+A shear series runs several tests on one specimen, in other processes, and a strength
+study or a biaxial run does the same: the file is read (and checked, and hashed) once into
+a :class:`Specimen`, and every test builds its simulation from that value instead of
+opening the file again. Only specimens the criterion accepted are read
+(:func:`poro2d.specimen.accepted.accepted_file`).
 """
 
 from __future__ import annotations
@@ -14,33 +16,9 @@ from typing import Any
 import numpy as np
 
 from poro2d.dem import Simulation, checkpoint
-from poro2d.errors import InputError
-from poro2d.interop.specimen_data import check_accepted
-from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
+from poro2d.specimen.accepted import accepted_file
 from poro2d.specimen.box import box_faces
 from poro2d.store import Store
-
-
-def resolve_specimen(path: str | Path) -> Path:
-    """A checkpoint file, or a criterion output folder holding ``specimen.npz``, that was accepted.
-
-    A refused trial's checkpoint (``trial.json`` beside it says not accepted) or the specimen
-    of a criterion that did not converge (its ``result.json``) is refused on one line, the
-    check ``poro2d export`` makes (:func:`poro2d.interop.specimen_data.check_accepted`): a
-    shear test, a strength study and a calibration take only accepted specimens.
-    """
-    p = Path(path)
-    if p.is_dir():
-        p = p / "specimen.npz"
-    if not p.is_file():
-        raise InputError(
-            "specimen",
-            str(path),
-            "a specimen checkpoint (.npz) or a criterion output folder with specimen.npz",
-        )
-    checked = check_input_file("specimen", p, CHECKPOINT_FILE_LIMIT)
-    check_accepted(checked)
-    return checked
 
 
 @dataclass(frozen=True, eq=False)
@@ -62,7 +40,7 @@ class Specimen:
 
         ``digest``: the state's digest when the caller knows it already (it is not computed again).
         """
-        p = resolve_specimen(path)
+        p = accepted_file(path)
         meta, arrays = Store(p.parent, parameter="specimen").read_state(p.name)
         return cls(str(p), meta, arrays, digest or checkpoint.content_digest(meta, arrays))
 
@@ -87,4 +65,4 @@ class Specimen:
         return checkpoint.from_content(self.meta, self.arrays, threads=threads)
 
 
-__all__ = ["Specimen", "resolve_specimen"]
+__all__ = ["Specimen"]

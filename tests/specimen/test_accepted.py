@@ -5,7 +5,8 @@ import shutil
 import pytest
 
 from poro2d.errors import InputError
-from poro2d.shear.specimen_file import Specimen, resolve_specimen
+from poro2d.specimen.accepted import accepted_file
+from poro2d.specimen.saved import Specimen
 from poro2d.store import Store
 
 
@@ -27,12 +28,12 @@ def test_the_specimen_of_a_criterion_that_did_not_converge_is_refused(specimen, 
         specimen, tmp_path / "crit", "specimen.npz", {"converged": False, "iterations": []}
     ).parent
     with pytest.raises(InputError, match="converged = False"):
-        resolve_specimen(folder)
+        accepted_file(folder)
 
 
 def test_accepted_specimens_and_bare_checkpoints_are_taken(specimen, tmp_path):
     accepted = _beside(specimen, tmp_path / "trial", "after_plate.npz", {"accepted": True})
-    assert resolve_specimen(accepted) == accepted
+    assert accepted_file(accepted) == accepted
     crit = _beside(specimen, tmp_path / "crit", "specimen.npz",
                    {"converged": True, "iterations": [{"accepted": True}]}).parent  # fmt: skip
     assert Specimen.read(crit).digest == Specimen.read(specimen).digest
