@@ -33,6 +33,7 @@ from poro2d.dem import ContactModel, Particles, Simulation, Walls
 from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
 from poro2d.interop.origin import origin_lines
+from poro2d.interop.run_records import CriterionOutcome, TrialVerdict
 from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
 from poro2d.specimen.box import box_faces
 from poro2d.store import Store
@@ -47,6 +48,7 @@ class ContactLaw(NamedTuple):
 
 
 T = TypeVar("T")
+R = TypeVar("R")  # a record read from a JSON file
 
 
 @dataclass(frozen=True)
@@ -272,23 +274,19 @@ def check_accepted(path: str | os.PathLike) -> None:
     """
     p = Path(path)
     folder = Store(p if p.is_dir() else p.parent, parameter="SPECIMEN")
-    result = _record(path, folder, "result.json")
-    if result is not None and "converged" in result:
-        trials = result.get("iterations") if isinstance(result.get("iterations"), list) else []
-        accepted = any(isinstance(row, dict) and row.get("accepted") is True for row in trials)
-        if result["converged"] is not True or not accepted:
-            state = (
-                "no accepted trial" if result["converged"] is True else f"converged = {result['converged']}"
-            )
+    result = _record(path, folder, "result.json", CriterionOutcome.from_json)
+    if result is not None and result.converged_said is not None:
+        if not result.converged or not result.accepted_trial:
+            state = "no accepted trial" if result.converged else f"converged = {result.converged_said}"
             _refuse_unaccepted(path, folder.root / "result.json", state)
-    trial = _record(path, folder, "trial.json")
-    if trial is not None and "accepted" in trial and trial["accepted"] is not True:
-        _refuse_unaccepted(path, folder.root / "trial.json", f"accepted = {trial['accepted']}")
+    trial = _record(path, folder, "trial.json", TrialVerdict.from_json)
+    if trial is not None and trial.accepted_said is not None and not trial.accepted:
+        _refuse_unaccepted(path, folder.root / "trial.json", f"accepted = {trial.accepted_said}")
 
 
-def _record(path: str | os.PathLike, folder: Store, name: str) -> dict | None:
-    """The JSON object ``name`` beside the specimen as it is (a file of any poro2d: its keys are checked
-    where read), None if there is none (or it holds something else)."""
+def _record(path: str | os.PathLike, folder: Store, name: str, parse: Callable[[dict], R]) -> R | None:
+    """The record ``name`` beside the specimen, read by ``parse`` from its JSON object (a file of any
+    poro2d: ``parse`` keeps what it needs), None if there is none (or it holds something else)."""
     if not folder.has(name):
         return None
     check_input_file("SPECIMEN", folder.root / name)
@@ -296,7 +294,7 @@ def _record(path: str | os.PathLike, folder: Store, name: str) -> dict | None:
     if data is None:
         why = "it changed since poro2d wrote it" if not folder.intact(name) else "it is not valid JSON"
         raise InputError("SPECIMEN", str(path), f"a specimen with a readable {name}", why) from None
-    return data if isinstance(data, dict) else None
+    return parse(data) if isinstance(data, dict) else None
 
 
 def _refuse_unaccepted(path: str | os.PathLike, record: Path, state: str) -> None:
