@@ -20,7 +20,11 @@ from poro2d.errors import InputError
 
 def number_at(data: dict, *keys: str) -> float | None:
     """The finite number at ``keys`` (nested objects), None when absent or of another kind."""
-    value = value_at(data, *keys)
+    return finite_number(value_at(data, *keys))
+
+
+def finite_number(value) -> float | None:
+    """``value`` as a float when it is a finite number (not a bool), else None."""
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
         return None
     return float(value)
