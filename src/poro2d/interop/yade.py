@@ -301,6 +301,7 @@ def write_specimen(
     """Write ``specimen_yade.py`` into ``out`` (atomically), stopping at ``ratio`` (YADE's mean ratio)."""
     if not spec.dt:
         raise InputError("time step", spec.dt, "the time step of the specimen (a poro2d checkpoint has one)")
+    spec.refuse_dashpot("YADE")
     slanted = [w.name for w in spec.walls if not (w.horizontal or w.vertical)]
     if slanted:
         raise InputError("walls", slanted, "horizontal or vertical walls (written as YADE boxes)")
