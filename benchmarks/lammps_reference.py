@@ -496,8 +496,8 @@ class LammpsSession:
 
 def _read_dump(path: Path) -> dict:
     d = read_dump(path)
-    order = np.argsort(d["id"], kind="stable")
-    return dict(x=d["x"][order], y=d["y"][order], radius=d["radius"][order])
+    order = np.argsort(d.column("id"), kind="stable")
+    return {name: d.column(name)[order] for name in ("x", "y", "radius")}
 
 
 # ------------------------------------------------------------------ script

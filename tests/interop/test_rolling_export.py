@@ -1,5 +1,6 @@
 """Rolling friction survives every export, or the target refuses the specimen saying why."""
 
+import hashlib
 from dataclasses import replace
 
 import numpy as np
@@ -66,10 +67,28 @@ def test_pfc5_carries_rolling_friction_and_pfc4_is_not_written(rolled, tmp_path)
         pfc.pfc4_commands(rolled)
 
 
-def test_yade_refuses_a_rolled_specimen(rolled, tmp_path):
-    with pytest.raises(InputError, match="rolling friction.*lammps"):
-        yade.write_specimen(rolled, tmp_path)
-    assert not any(tmp_path.iterdir())
+def test_yade_carries_rolling_friction_per_disk_and_wall(rolled, tmp_path):
+    (path,) = yade.write_specimen(rolled, tmp_path)
+    text = path.read_text()
+    values = {}
+    exec(text.split("\nimport math\n", 1)[0], values)  # the literals at the top, without YADE
+    assert values["DISK_ROLLING"] == [0.2] * rolled.n
+    assert values["WALL_ROLLING"] == {w.name: 0.1 for w in rolled.walls}
+    assert "Law2_ScGeom6D_CohFrictPhys_CohesionMoment(useIncrementalForm=True" in text
+    assert 'PyRunner(command="rolling_contacts()", iterPeriod=1, initRun=True)' in text
+
+
+#: SHA-256 of the script's text after its literals, as every export wrote it before rolling
+#: friction reached YADE: a specimen without rolling friction still gets exactly that script
+_UNROLLED_BODY = "90624d6244167fd1cf3f4efe29f7d9385a38f81cd6bf02c3c4e00b44c5efb721"
+
+
+def test_yade_script_without_rolling_friction_is_unchanged(saved, tmp_path):
+    (path,) = yade.write_specimen(from_checkpoint(saved), tmp_path)
+    text = path.read_text()
+    assert "ROLLING" not in text and "CohFrict" not in text
+    body = "\nimport math\n" + text.split("\nimport math\n", 1)[1]
+    assert hashlib.sha256(body.encode()).hexdigest() == _UNROLLED_BODY
 
 
 def test_export_cli_says_what_each_target_does_with_rolling_friction(saved, tmp_path, capsys):
@@ -82,9 +101,5 @@ def test_export_cli_says_what_each_target_does_with_rolling_friction(saved, tmp_
     assert "rr_fric 0.2" in (tmp_path / "pfc" / pfc.CURRENT_FILE).read_text()
     main(["export", str(path.parent), "--to", "csv", "--out", str(tmp_path / "csv")])
     assert np.all(csv_table.read_specimen(tmp_path / "csv", DEFAULTS).mu_r == 0.2)
-    with pytest.raises(SystemExit) as e:
-        main(["export", str(path.parent), "--to", "yade", "--out", str(tmp_path / "yade")])
-    assert e.value.code == 2
-    err = capsys.readouterr().err.strip()
-    assert "rolling friction" in err and len(err.splitlines()) == 1
-    assert not (tmp_path / "yade").exists()
+    main(["export", str(path.parent), "--to", "yade", "--out", str(tmp_path / "yade")])
+    assert "DISK_ROLLING = [\n    0.2," in (tmp_path / "yade" / yade.SCRIPT_FILE).read_text()

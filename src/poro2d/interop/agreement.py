@@ -99,13 +99,13 @@ def run_lammps(spec: SpecimenData, workdir: str | os.PathLike, ratio: float, max
     seconds = time.perf_counter() - t0
     res = read_result_line(log)
     pairs = read_dump(wd / lmp.FINAL_CONTACTS)
-    fn, ft = pairs["c_pl[1]"], pairs["c_pl[2]"]
+    fn, ft = pairs.column("c_pl[1]"), pairs.column("c_pl[2]")
     touching = fn > 0.0
     mags = [np.hypot(fn[touching], ft[touching])]
     disks = read_dump(wd / lmp.FINAL_DISKS)
     for w in BOX_WALLS:
-        on = disks[f"f_w_{w}[1]"] > 0.0
-        mags.append(np.hypot(disks[f"f_w_{w}[2]"][on], disks[f"f_w_{w}[3]"][on]))
+        on = disks.column(f"f_w_{w}[1]") > 0.0
+        mags.append(np.hypot(disks.column(f"f_w_{w}[2]")[on], disks.column(f"f_w_{w}[3]")[on]))
     allm = np.concatenate(mags)
     head, rows = parse_thermo(log)[-1]
     return SettledRun(

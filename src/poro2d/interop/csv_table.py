@@ -6,7 +6,8 @@
 ``ks_n_per_m``, ``mu``. A specimen with rolling friction has one more column in each,
 ``mu_r`` (per-body rolling friction), so it reads back whole. Both start with ``#``
 comment lines (units, the thickness convention, poro2d's version); ``# poro2d thickness
-T`` and ``# poro2d settings GX GY DAMPING DT`` are read back. Numbers are written with
+T``, ``# poro2d settings GX GY DAMPING DT``, the criterion's ``# poro2d window F`` and, for
+contacts with a normal dashpot, ``# poro2d restitution E`` are read back. Numbers are written with
 ``repr``: they read back to the same float. ``pandas.read_csv(path, comment="#")`` reads either table.
 """
 
@@ -39,6 +40,7 @@ def _notes(spec: SpecimenData) -> list[str]:
         f"# poro2d settings {spec.gravity[0]!r} {spec.gravity[1]!r} {spec.local_damping!r} "
         f"{spec.dt if spec.dt is not None else 0.0!r}",
         *([f"# poro2d window {spec.force_fraction!r}"] if spec.force_fraction is not None else []),
+        *([f"# poro2d restitution {spec.restitution!r}"] if spec.restitution is not None else []),
     ]
 
 
@@ -99,6 +101,7 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
     t = _setting(notes, "thickness", 1)
     settings = _setting(notes, "settings", 4)
     window = _setting(notes, "window", 1)
+    restitution = _setting(notes, "restitution", 1)
     gravity = (settings[0], settings[1]) if settings else (0.0, -float(defaults["gravity"]))
     dt = settings[3] if settings else None
     return SpecimenData(
@@ -107,7 +110,7 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
         local_damping=settings[2] if settings else float(defaults["local_damping"]),
         dt=dt if dt != 0.0 else None,  # 0: the automatic step (written when the specimen had none)
         source=str(disks_path), force_fraction=window[0] if window else None,
-        mu_r=a[:, 7].copy() if rolled else None,
+        mu_r=a[:, 7].copy() if rolled else None, restitution=restitution[0] if restitution else None,
         locate=_locator(disks_path, walls_path, drows, wrows, notes),
     )  # fmt: skip
 
@@ -118,6 +121,7 @@ _WALL_COLUMN = {name: c for c, name in enumerate(("name", "x0", "y0", "x1", "y1"
 _NOTE_COLUMN = {
     "thickness": ("thickness", 4), "gravity_x": ("settings", 4), "gravity_y": ("settings", 5),
     "local_damping": ("settings", 6), "dt": ("settings", 7), "window": ("window", 4),
+    "restitution": ("restitution", 4),
 }  # fmt: skip
 
 

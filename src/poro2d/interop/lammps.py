@@ -501,6 +501,7 @@ def write_specimen(spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e
     """
     from poro2d.io_utils import atomic_path
 
+    spec.refuse_dashpot("LAMMPS")
     out = Path(out)
     params = spec.contact_parameters()  # refuses disks of differing properties first
     box = spec.box()

@@ -138,14 +138,30 @@ def parse_thermo(log: str) -> list[tuple[list[str], list[list[float]]]]:
     return blocks
 
 
-def read_dump(path: str | os.PathLike) -> dict[str, np.ndarray]:
-    """Columns of the last snapshot of a LAMMPS text dump (atom or local), by column name."""
+@dataclass(frozen=True)
+class DumpFrame:
+    """The last snapshot of a LAMMPS text dump: its column names, as the dump's header gives them
+    (``id x y radius ...`` of atoms, ``c_pl[1] c_pl[2]`` of local entries), and one row per atom or
+    entry. A dump's columns are those its ``write_dump`` line asked for, so they are read by name."""
+
+    path: str
+    columns: tuple[str, ...]
+    values: np.ndarray  # (rows, len(columns))
+
+    def column(self, name: str) -> np.ndarray:
+        """Column ``name`` (a copy); a column the dump lacks is a LammpsError naming the columns it has."""
+        if name not in self.columns:
+            raise LammpsError(f"{self.path} has no column {name!r} (it has {' '.join(self.columns)})")
+        return self.values[:, self.columns.index(name)].copy()
+
+
+def read_dump(path: str | os.PathLike) -> DumpFrame:
+    """The last snapshot of a LAMMPS text dump (atom or local)."""
     lines = Path(path).read_text().splitlines()
     k = max(i for i, ln in enumerate(lines) if ln.startswith("ITEM: ATOMS") or ln.startswith("ITEM: ENTRIES"))
-    names = lines[k].split()[2:]
+    names = tuple(lines[k].split()[2:])
     rows = [ln.split() for ln in lines[k + 1 :] if ln.strip()]
-    arr = np.array(rows, dtype=float).reshape(len(rows), len(names))
-    return {name: arr[:, c].copy() for c, name in enumerate(names)}
+    return DumpFrame(str(path), names, np.array(rows, dtype=float).reshape(len(rows), len(names)))
 
 
 @dataclass(frozen=True)

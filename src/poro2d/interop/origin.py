@@ -15,9 +15,12 @@ saying its provenance is unknown: nothing is made up.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
+from typing import TypeVar
 
+from poro2d.interop.provenance_records import ConfigFacts, GradingFacts, ResultFacts, SoilFacts
 from poro2d.interop.state_specimen import KnownState, read_state_index, state_record
 from poro2d.store import Store
 
@@ -25,6 +28,8 @@ from poro2d.store import Store
 PREFIX = "provenance:"
 #: written by ``poro2d sand`` beside each specimen it names: the soil, its state, mode and seed
 SOIL_FILE = "soil.json"
+
+R = TypeVar("R")  # a record read from a JSON file
 
 
 def origin_lines(checkpoint: str | Path, state: KnownState | None = None) -> list[str]:
@@ -36,31 +41,34 @@ def origin_lines(checkpoint: str | Path, state: KnownState | None = None) -> lis
     p = Path(checkpoint)
     folder = p.parent
     records = Store(folder)
-    result = _criterion_record(records, "result.json", ("iterations", "specimen"))
-    config = _criterion_record(records, "config.json", ("run",))
-    soil = _criterion_record(records, SOIL_FILE, ("soil", "state"))
+    result = _criterion_record(records, "result.json", ("iterations", "specimen"), ResultFacts.from_json)
+    config = _criterion_record(records, "config.json", ("run",), ConfigFacts.from_json)
+    soil = _criterion_record(records, SOIL_FILE, ("soil", "state"), SoilFacts.from_json)
     if result is None and config is None and soil is None:
         return [
             f"{PREFIX} unknown (no criterion record, result.json or config.json, beside {_text(p.name)}: "
             "grading, laboratory state, mode and seed not recorded)"
         ]
     if state is None and soil is not None:  # a specimen folder that poro2d sand named
-        lab = soil["state"] if isinstance(soil["state"], dict) else {}
-        state = KnownState(soil.get("mode"), lab.get("n_lab"), lab.get("relative_density"), soil.get("seed"))
+        state = KnownState(soil.mode, soil.n_lab, soil.relative_density, soil.seed)
     if state is None:
         state = _state_of_case(folder)
     elif not state.mode:  # a sand folder that does not say: the state folder of the case
         case = _state_of_case(folder)
         state = replace(state, mode=case.mode if case is not None else None)
-    result, config = result or {}, config or {}
-    lines = [f"{PREFIX} grading {_grading(config)}"]
-    if soil is not None and isinstance(soil["soil"], dict):
-        who = soil["soil"]
-        ref = f" ({_text(who.get('reference'))})" if who.get("reference") else ""
-        lines.insert(0, f"{PREFIX} soil {_text(who.get('name'))}{ref}")
+    result, config = result or ResultFacts(), config or ConfigFacts()
+    lines = [f"{PREFIX} grading {_grading(config.grading)}"]
+    if soil is not None and soil.named:
+        ref = f" ({_text(soil.reference)})" if soil.reference else ""
+        lines.insert(0, f"{PREFIX} soil {_text(soil.name)}{ref}")
     lines.append(f"{PREFIX} laboratory state {_state(result, config, state, folder)}")
-    spec = result.get("specimen") or (config.get("run") or {}).get("specimen") or {}
-    mu = _num(spec.get("friction_prep")) if isinstance(spec, dict) else None
+    mu = (
+        result.friction_prep
+        if result.names_specimen
+        else config.friction_prep
+        if config.names_specimen
+        else None
+    )
     lines.append(f"{PREFIX} preparation friction mu_prep (specimen.friction_prep) = {_value(mu)}")
     lines.append(f"{PREFIX} {_porosities(result)}")
     lines.append(f"{PREFIX} {_run(result, config, state)}")
@@ -69,95 +77,81 @@ def origin_lines(checkpoint: str | Path, state: KnownState | None = None) -> lis
     return lines
 
 
-def _criterion_record(records: Store, name: str, keys: tuple[str, ...]) -> dict | None:
-    """The JSON object of a criterion's record file as it is (its keys are checked where read), None
-    if missing, unreadable or of another kind."""
+def _criterion_record(
+    records: Store, name: str, keys: tuple[str, ...], parse: Callable[[dict], R]
+) -> R | None:
+    """A criterion's record file read by ``parse`` from its JSON object (which keeps what the lines
+    name), None if missing, unreadable or of another kind (an object without ``keys``)."""
     if not records.has(name) or (records.root / name).stat().st_size > 50_000_000:
         return None
     data = records.read_json(name)
-    return data if isinstance(data, dict) and all(k in data for k in keys) else None
+    return parse(data) if isinstance(data, dict) and all(k in data for k in keys) else None
 
 
-def _grading(config: dict) -> str:
+def _grading(g: GradingFacts) -> str:
     """Preset name or CSV file, up-scaling factor and cuts, from the config's ``[grading]``."""
-    from poro2d.grading import PAPER_UPSCALE
-
-    if "config" not in config:
+    if g.kind == "unknown":
         return "unknown (no config.json beside the specimen)"
-    table = (config.get("config") or {}).get("grading")
-    table = table if isinstance(table, dict) and table else {"preset": "paper"}  # the criterion's default
-    run = (config.get("run") or {}).get("grading") or {}
-    source = run.get("source") if isinstance(run, dict) and run.get("source") else None
-    if "preset" in table:
-        text = f"preset {_text(table['preset'])!r}" + (f" ({_text(source)})" if source else "")
-        upscale = table.get("upscale", PAPER_UPSCALE)
-    elif "csv" in table:
-        text = f"CSV file {_text(source or table['csv'])}"
-        upscale = table.get("upscale", 1.0)
+    if g.kind == "preset":
+        text = f"preset {_text(g.name)!r}" + (f" ({_text(g.source)})" if g.source else "")
+    elif g.kind == "csv":
+        text = f"CSV file {_text(g.source or g.name)}"
     else:
-        sizes = table.get("sizes_mm")
-        count = f"{len(sizes)} " if isinstance(sizes, list) else ""
+        count = f"{g.sizes} " if g.sizes is not None else ""
         text = f"{count}sieve sizes given in the config (sizes_mm, percent_passing)"
-        upscale = table.get("upscale", 1.0)
-    text += f", up-scaling factor {_value(_num(upscale))}"
-    cuts = [
-        f"{k} = {_value(_num(table[k]))} mm" for k in ("d_min_mm", "d_max_mm") if table.get(k) is not None
-    ]
+    text += f", up-scaling factor {_value(g.upscale)}"
+    cuts = [f"{k} = {_value(v)} mm" for k, v in g.cuts]
     return text + (
         "; cut at " + ", ".join(cuts) + " (of the up-scaled curve)" if cuts else "; no d_min/d_max cut"
     )
 
 
-def _state(result: dict, config: dict, state: KnownState | None, folder: Path) -> str:
+def _state(result: ResultFacts, config: ConfigFacts, state: KnownState | None, folder: Path) -> str:
     """n_lab, Dr and the mode."""
-    n_lab = state.n_lab if state is not None else _num(result.get("n_lab"))
+    n_lab = state.n_lab if state is not None else result.n_lab
     dr = state.relative_density if state is not None else _config_dr(n_lab, config)
     if state is not None:
         mode = state.mode or "unknown"
     elif (folder.parent / "params.json").is_file():  # a sweep case not found in a state folder above it
         mode = "unknown (a sweep case: export it by its state folder)"
     else:
-        dens = (config.get("config") or {}).get("density")
-        mode = dens.get("mode", "paper") if isinstance(dens, dict) else "paper"
+        mode = "paper" if config.density_mode is None else config.density_mode
         mode = _text(mode) + " (a criterion folder of its own)"
     dr_text = "unknown" if dr is None else f"{dr:.4f}"
     return f"n_lab = {_value(_num(n_lab))}, relative density Dr = {dr_text}; mode {mode}"
 
 
-def _config_dr(n_lab: float | None, config: dict) -> float | None:
+def _config_dr(n_lab: float | None, config: ConfigFacts) -> float | None:
     """Dr of ``n_lab`` between the laboratory extremes the config's ``[density]`` gives, if it does."""
     from poro2d.errors import InputError
     from poro2d.porosity import relative_density
 
-    dens = (config.get("config") or {}).get("density")
-    hi, lo = (_num(dens.get(k)) for k in ("n_max", "n_min")) if isinstance(dens, dict) else (None, None)
-    if n_lab is None or hi is None or lo is None:
+    if n_lab is None or config.n_max is None or config.n_min is None:
         return None
     try:
-        return float(relative_density(n_lab, hi, lo))
+        return float(relative_density(n_lab, config.n_max, config.n_min))
     except InputError:
         return None
 
 
-def _porosities(result: dict) -> str:
-    n2d = _num(result.get("final_porosity"))
-    box = _num(result.get("box_porosity"))
-    inner = _num(result.get("interior_porosity"))
-    sd = _num(result.get("interior_porosity_std"))
+def _porosities(result: ResultFacts) -> str:
+    n2d, box = result.final_porosity, result.box_porosity
+    inner, sd = result.interior_porosity, result.interior_porosity_std
     text = f"accepted n2D = {_value(n2d)}, box porosity n' = {_value(box, '.6g')}"
     if inner is None:
         return text + "; interior porosity unknown (not measured)"
     return text + f"; interior porosity = {inner:.6g}" + (f" +- {sd:.4g}" if sd is not None else "")
 
 
-def _run(result: dict, config: dict, state: KnownState | None) -> str:
-    seed = state.seed if state is not None else result.get("seed", (config.get("run") or {}).get("seed"))
-    prov = result.get("provenance") or config.get("provenance") or {}
-    version = prov.get("poro2d_version") if isinstance(prov, dict) else None
-    when = prov.get("created_utc") if isinstance(prov, dict) else None
+def _run(result: ResultFacts, config: ConfigFacts, state: KnownState | None) -> str:
+    if state is not None:
+        seed = state.seed
+    else:
+        seed = result.seed if result.names_seed else config.seed
+    stamp = result.stamp if result.stamp.given else config.stamp
     text = f"seed {seed if isinstance(seed, int) and not isinstance(seed, bool) else 'unknown'}; "
-    text += f"criterion run by poro2d {_text(version) if version else 'unknown'}"
-    return text + (f" ({_text(when)})" if when else "")
+    text += f"criterion run by poro2d {_text(stamp.version) if stamp.version else 'unknown'}"
+    return text + (f" ({_text(stamp.created_utc)})" if stamp.created_utc else "")
 
 
 def _state_of_case(folder: Path) -> KnownState | None:

@@ -148,6 +148,7 @@ def write_specimen(spec: SpecimenData, out: str | os.PathLike) -> list[Path]:
 
     A specimen with rolling friction gets the PFC 5+ file only (see :func:`pfc4_refusal`).
     """
+    spec.refuse_dashpot("PFC2D")
     out = Path(out)
     paths = []
     files = [(CURRENT_FILE, current_commands(spec))]

@@ -47,6 +47,7 @@ class ContactLaw(NamedTuple):
 
 
 T = TypeVar("T")
+R = TypeVar("R")  # a record read from a JSON file
 
 
 @dataclass(frozen=True)
@@ -99,6 +100,8 @@ class SpecimenData:
     contact: str = "per_body"
     source: str = ""
     mu_r: np.ndarray | None = None  # rolling friction per disk; None: 0 for every disk
+    #: the normal dashpot's coefficient of restitution (``Simulation(restitution=)``); None: no dashpot
+    restitution: float | None = None
     #: the criterion's window the specimen was accepted with (F_top below this fraction of G)
     force_fraction: float | None = None
     #: where the specimen came from (grading, laboratory state, mode, mu_prep, n2D, seed, version):
@@ -116,6 +119,25 @@ class SpecimenData:
         """True when any disk or wall has rolling friction (a target must carry it or refuse)."""
         disks = self.mu_r is not None and bool(np.any(np.asarray(self.mu_r) > 0.0))
         return disks or any(w.mu_r > 0.0 for w in self.walls)
+
+    @property
+    def dashpot(self) -> bool:
+        """True when the contacts have a normal dashpot (a restitution below 1)."""
+        return self.restitution is not None and self.restitution < 1.0
+
+    def refuse_dashpot(self, target: str) -> None:
+        """Refuse (InputError) a specimen with a normal dashpot for ``target``, which cannot carry it.
+
+        poro2d's dashpot never pulls, and its damping ratio is the one whose rebound is the
+        restitution for such a dashpot (:func:`poro2d.dem.model.restitution_to_beta`): the
+        viscous terms of LAMMPS, YADE and PFC set their coefficients otherwise, so no target
+        but the CSV tables (a ``# poro2d restitution`` line) would give the same contacts.
+        """
+        if self.dashpot:
+            raise InputError(
+                "restitution", self.restitution, f"none (no normal dashpot) for {target}",
+                f"{target} cannot express poro2d's no-tension dashpot; --to csv carries it",
+            )  # fmt: skip
 
     @property
     def mass(self) -> np.ndarray:
@@ -240,7 +262,7 @@ class SpecimenData:
             walls.add((w.x0, w.y0), (w.x1, w.y1), w.kn, w.ks, w.mu, w.name, mu_r=w.mu_r)
         return Simulation(
             p, walls, ContactModel("per_body"), gravity=self.gravity, local_damping=self.local_damping,
-            dt=dt, threads=threads,
+            dt=dt, threads=threads, restitution=self.restitution,
         )  # fmt: skip
 
 
@@ -271,7 +293,7 @@ def from_simulation(sim: Simulation, source: str = "") -> SpecimenData:
     walls = {f: getattr(w, f) for f in _WALL_FIELDS} | {"mu_r": w.rolling_friction()}
     return _from_records(
         disks, walls, w.names, thickness=p.thickness, gravity=sim.gravity, local_damping=sim.local_damping,
-        dt=sim.dt, source=source,
+        dt=sim.dt, source=source, restitution=sim.restitution,
     )  # fmt: skip
 
 
@@ -293,6 +315,7 @@ def from_checkpoint(path: str | os.PathLike) -> SpecimenData:
         disks, walls, list(meta["wall_names"]), thickness=float(meta["thickness"]),
         gravity=tuple(float(g) for g in s["gravity"]), local_damping=float(s["local_damping"]),
         dt=float(s["dt"]), source=str(p), force_fraction=accepted_window(p), origin=origin_lines(p),
+        restitution=None if s.get("restitution") is None else float(s["restitution"]),
     )  # fmt: skip
 
 

@@ -28,11 +28,21 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
 from poro2d.errors import InputError, check_int, check_range
+from poro2d.interop.run_records import (
+    CaseParams,
+    CaseRow,
+    SandRecord,
+    StatesRecord,
+    SweepListing,
+)
 from poro2d.io_utils import check_input_file
+from poro2d.specimen.accepted import CriterionOutcome
 from poro2d.store import Store
 
 #: the record files of a folder of specimens by state, in the order they are looked for
@@ -43,6 +53,8 @@ N_LAB_TOLERANCE = 5e-5
 DR_TOLERANCE = 5e-4
 #: the folder holding a sweep case's criterion outputs (:mod:`poro2d.sweep.runner`)
 CASE_RUN = "run"
+
+R = TypeVar("R")  # a record read from a JSON file
 
 
 @dataclass(frozen=True)
@@ -212,93 +224,76 @@ def _pick_state(index: StateIndex, n_lab: float | None, dr: float | None) -> tup
 
 def read_state_index(record: Path) -> StateIndex:
     """The states of a state folder and their cases, read from its files."""
-    data = _json(record, "SPECIMEN")
     if record.name == "sand.json":
-        return _sand_index(record, data)
-    mode = data.get("mode") if isinstance(data.get("mode"), str) else None
-    if record.name == "density.json":
-        states = [data]
-    else:
-        states = [p for p in data.get("points") or [] if isinstance(p, dict)]
-    pairs = [(_number(p.get("n_lab")), _number(p.get("relative_density"))) for p in states]
-    pairs = [(n, d) for n, d in pairs if n is not None]
+        return _sand_index(record, _read(record, "SPECIMEN", lambda d: SandRecord.from_json(d, record)))
+    data = _read(
+        record, "SPECIMEN", lambda d: StatesRecord.from_json(d, one_state=record.name == "density.json")
+    )
+    pairs = [(p.n_lab, p.relative_density) for p in data.points if p.n_lab is not None]
     if not pairs:
         raise InputError(
             "SPECIMEN", str(record.parent), f"a folder whose {record.name} lists laboratory states"
         )
     folder = record.parent
     # paper mode runs its sweep in the folder itself (a relation of before "mode" was recorded too)
-    if mode == "paper" or (mode is None and (folder / "sweep.json").is_file()):
-        cases = _sweep_cases(folder, relation_seed=_config_seed(data))
+    if data.mode == "paper" or (data.mode is None and (folder / "sweep.json").is_file()):
+        cases = _sweep_cases(folder, relation_seed=data.config_seed)
     else:
         cases = _sweep_cases(folder / "states") if (folder / "states" / "sweep.json").is_file() else []
-        cases += _calibration_twins(record, data, states, cases)
-    return StateIndex(record, mode, pairs, cases)
+        cases += _calibration_twins(record, data, cases)
+    return StateIndex(record, data.mode, pairs, cases)
 
 
-def _sand_index(record: Path, data: dict) -> StateIndex:
+def _sand_index(record: Path, data: SandRecord) -> StateIndex:
     """``sand.json``: ``states``, each with n_lab, relative_density, seed and specimen."""
-    rows = data.get("states")
-    if not isinstance(rows, list):
-        raise InputError("SPECIMEN", str(record.parent), f"a folder whose {record.name} has a list 'states'")
-    mode = data.get("mode") if isinstance(data.get("mode"), str) else None
     states: dict[float, float | None] = {}
     cases = []
-    for k, row in enumerate(rows):
-        n_lab = _number(row.get("n_lab")) if isinstance(row, dict) else None
-        if n_lab is None:
-            raise InputError(f"{record} states[{k}]", row, "a dict with a number n_lab")
-        key = next((n for n in states if _same(n, n_lab)), n_lab)
-        dr = _number(row.get("relative_density"))
+    for k, row in enumerate(data.states):
+        key = next((n for n in states if _same(n, row.n_lab)), row.n_lab)
+        dr = row.relative_density
         states[key] = dr if dr is not None else states.get(key)
-        seed = row.get("seed")
-        seed = seed if isinstance(seed, int) and not isinstance(seed, bool) else None
-        spec = row.get("specimen")
-        folder = record.parent / spec if isinstance(spec, str) and spec else None
+        folder = record.parent / row.specimen if row.specimen is not None else None
         why = "" if folder is not None else f"{record} states[{k}] names no specimen folder"
         if not why:
-            why = _refused_by_row(row) or _not_accepted(folder)
-        cases.append(StateCase(key, seed, folder, why))
-    return StateIndex(record, mode, sorted(states.items(), key=lambda s: -s[0]), cases)
-
-
-def _refused_by_row(row: dict) -> str:
-    for key in ("accepted", "converged"):
-        if key in row and row[key] is not True:
-            return f"sand.json says {key} = {row[key]}"
-    return ""
+            why = row.refusal or _not_accepted(folder)
+        cases.append(StateCase(key, row.seed, folder, why))
+    return StateIndex(record, data.mode, sorted(states.items(), key=lambda s: -s[0]), cases)
 
 
 def _sweep_cases(sweep: Path, relation_seed: int | None = None) -> list[StateCase]:
     """Every case of the sweep in ``sweep`` (its ``sweep.json``), with n_lab, seed and folder."""
-    record = _json(sweep / "sweep.json", "SPECIMEN")
-    out = []
-    for case in record.get("cases") or []:
-        cid = case.get("id") if isinstance(case, dict) else None
-        if not isinstance(cid, str) or not cid or Path(cid).name != cid:
-            continue
-        out.append(_case(sweep / "cases" / cid, _dict(case.get("params")), relation_seed))
-    return out
+    listing = _read(sweep / "sweep.json", "SPECIMEN", SweepListing.from_json)
+    return [_case(sweep / "cases" / cid, params, relation_seed) for cid, params in listing.cases]
 
 
-def _case(case_dir: Path, params: dict, relation_seed: int | None, n_lab: float | None = None) -> StateCase:
+def _case(
+    case_dir: Path, params: CaseParams, relation_seed: int | None, n_lab: float | None = None
+) -> StateCase:
     """A sweep case: its parameters and status from ``result.json`` (``error.json`` if it failed),
     its seed and acceptance from the criterion's ``run/result.json``."""
-    row = _json(case_dir / "result.json", "SPECIMEN") if (case_dir / "result.json").is_file() else None
-    if row is None and (case_dir / "error.json").is_file():
-        row = _json(case_dir / "error.json", "SPECIMEN")
-    params = {**params, **_dict((row or {}).get("params"))}
+    row = None
+    for name in ("result.json", "error.json"):
+        if row is None and (case_dir / name).is_file():
+            row = _read(case_dir / name, "SPECIMEN", CaseRow.from_json)
+    if row is not None:
+        params = params.then(row.params)
     run = case_dir / CASE_RUN
-    crit = _json(run / "result.json", "SPECIMEN") if (run / "result.json").is_file() else {}
+    crit = (
+        _read(run / "result.json", "SPECIMEN", CriterionOutcome.from_json)
+        if (run / "result.json").is_file()
+        else None
+    )
     if n_lab is None:
-        n_lab = _number(params.get("criterion.n_lab"))
-        n_lab = n_lab if n_lab is not None else _number(((row or {}).get("results") or {}).get("n_lab"))
-    seed = crit.get("seed", params.get("seed", relation_seed))
-    seed = seed if isinstance(seed, int) and not isinstance(seed, bool) else None
+        n_lab = params.n_lab if params.n_lab is not None else (row.result_n_lab if row is not None else None)
+    if crit is not None and crit.names_seed:
+        seed = crit.seed
+    else:
+        seed = params.seed if "seed" in params.given else relation_seed
+        seed = seed if isinstance(seed, int) and not isinstance(seed, bool) else None
     if row is None:
         why = f"case {case_dir} has not finished"
-    elif row.get("status") != "done":
-        why = f"case {case_dir} failed: {row.get('error')}"
+    elif not row.done:
+        why = f"case {case_dir} failed: {row.error}"
     else:
         why = _not_accepted(run)
     return StateCase(n_lab if n_lab is not None else math.nan, seed, run, why)
@@ -309,20 +304,17 @@ def _not_accepted(folder: Path) -> str:
     result = folder / "result.json"
     if not result.is_file():
         return f"{result} is missing"
-    crit = _json(result, "SPECIMEN")
-    trials = crit.get("iterations") if isinstance(crit.get("iterations"), list) else []
-    if crit.get("converged") is not True:
-        return f"{result} says converged = {crit.get('converged')}: {crit.get('message')}"
-    if not any(isinstance(t, dict) and t.get("accepted") is True for t in trials):
+    crit = _read(result, "SPECIMEN", CriterionOutcome.from_json)
+    if not crit.converged:
+        return f"{result} says converged = {crit.converged_said}: {crit.message}"
+    if not crit.accepted_trial:
         return f"{result} lists no accepted trial"
     if not (folder / "specimen.npz").is_file():
         return f"{folder / 'specimen.npz'} is missing"
     return ""
 
 
-def _calibration_twins(
-    record: Path, data: dict, states: list[dict], found: list[StateCase]
-) -> list[StateCase]:
+def _calibration_twins(record: Path, data: StatesRecord, found: list[StateCase]) -> list[StateCase]:
     """The seeds of density states that the state sweep did not run: the calibration ran them.
 
     A state's check at a calibration friction (the densest or the loosest state) is the same
@@ -332,10 +324,10 @@ def _calibration_twins(
     folder is where ``sweeps.calibration.cases`` says (the cache), else ``calibration/``.
     """
     out = []
-    cal_cases: list[tuple[dict, Path]] | None = None
-    for state in states:
-        n_lab, mu, count = _number(state.get("n_lab")), _number(state.get("mu_prep")), state.get("seeds")
-        if n_lab is None or not isinstance(count, int) or isinstance(count, bool):
+    cal_cases: list[tuple[CaseParams, Path]] | None = None
+    for state in data.points:
+        n_lab, mu, count = state.n_lab, state.mu_prep, state.seeds
+        if n_lab is None or count is None:
             continue
         have = {c.seed for c in found if _same(c.n_lab, n_lab)}
         for seed in range(count):
@@ -346,12 +338,10 @@ def _calibration_twins(
             hits = [
                 d
                 for p, d in cal_cases
-                if mu is not None
-                and _same(_number(p.get("specimen.friction_prep")), round(mu, 6))
-                and p.get("seed") == seed
+                if mu is not None and _same(p.friction_prep, round(mu, 6)) and p.seed == seed
             ]
             if len(hits) == 1:
-                case = _case(hits[0], {}, None, n_lab=n_lab)
+                case = _case(hits[0], CaseParams(frozenset()), None, n_lab=n_lab)
                 out.append(StateCase(n_lab, seed, case.folder, case.why_not))
             else:
                 why = f"no case of this seed in {record.parent / 'states'} nor among the calibration's cases"
@@ -359,51 +349,34 @@ def _calibration_twins(
     return out
 
 
-def _calibration_cases(record: Path, data: dict) -> list[tuple[dict, Path]]:
+def _calibration_cases(record: Path, data: StatesRecord) -> list[tuple[CaseParams, Path]]:
     """(parameters, case folder) of every case in the state's calibration folder.
 
     Each case's ``params.json`` says what it ran: a cached calibration serves every run of its
     grading and settings, and its ``sweep.json`` lists only the last run's cases.
     """
-    cal = _dict(_dict(data.get("sweeps")).get("calibration"))
-    places = [Path(cal["cases"])] if isinstance(cal.get("cases"), str) else []
+    places = [Path(data.calibration_cases)] if data.calibration_cases is not None else []
     places.append(record.parent / "calibration")
     for place in places:
         if (place / "sweep.json").is_file() and (place / "cases").is_dir():
             out = []
             for params_file in sorted((place / "cases").glob("*/params.json")):
-                case = _json(params_file, "SPECIMEN")
-                out.append((_dict(case.get("params")), params_file.parent))
+                params = _read(params_file, "SPECIMEN", lambda d: CaseParams.from_json(d.get("params")))
+                out.append((params, params_file.parent))
             return out
     return []
 
 
-def _config_seed(data: dict) -> int | None:
-    seed = _dict(data.get("config")).get("seed", 0)
-    return seed if isinstance(seed, int) and not isinstance(seed, bool) else None
-
-
-def _json(path: Path, parameter: str) -> dict:
-    """The JSON object of a record the user pointed at, as it is (checked as every input file is; its
-    keys are checked where read)."""
+def _read(path: Path, parameter: str, parse: Callable[[dict], R]) -> R:
+    """The record at ``path`` the user pointed at, read by ``parse`` from its JSON object (checked
+    as every input file is; ``parse`` keeps what it needs)."""
     check_input_file(parameter, path)
     data = Store(path.parent, parameter=parameter).read_json(path.name)
     if data is None:
         raise InputError(parameter, str(path), "a readable JSON file", "it cannot be read or parsed")
     if not isinstance(data, dict):
         raise InputError(parameter, str(path), "a JSON file holding an object")
-    return data
-
-
-def _dict(value) -> dict:
-    """``value`` if it is a dict, else an empty one (a record of another shape names nothing)."""
-    return value if isinstance(value, dict) else {}
-
-
-def _number(value) -> float | None:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        return None
-    return float(value)
+    return parse(data)
 
 
 def _same(a: float | None, b: float | None) -> bool:

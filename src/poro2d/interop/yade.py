@@ -18,18 +18,30 @@ YADE is 3D. The choices made here:
   disk-wall contact to the PFC 4.0 values (from the step after the contact forms);
 * Cundall's local damping is ``NewtonIntegrator(damping=...)``, gravity its
   ``gravity``; the time step is poro2d's;
-* rolling friction is not written: YADE's rolling law (``CohFrictPhys``) sets its
-  rolling stiffness from the two radii and materials, not as ``ks R^2`` per contact, so
-  a specimen with rolling friction is refused (the LAMMPS and PFC 5+ exports carry it).
+* rolling friction (a rolled specimen only; without it the script is as it always was):
+  poro2d's rolling spring (:mod:`poro2d.dem.contact_law`: kr = ks R^2, cap mu_r R Fn) is
+  the spring of YADE's ``Law2_ScGeom6D_CohFrictPhys_CohesionMoment`` in its incremental
+  form (``useIncrementalForm``), on the contact's ``kr`` and ``maxRollPl`` (cap
+  ``maxRollPl * Fn``). YADE's ``Ip2_CohFrictMat_CohFrictMat_CohFrictPhys`` would set
+  them from the materials, ``kr = alphaKr ks r1 r2`` and ``maxRollPl = min(etaRoll_1 r1,
+  etaRoll_2 r2)``, and no per-body ``alphaKr`` or ``etaRoll`` gives ``ks (r1 r2 / (r1 +
+  r2))^2`` and ``mu_r r1 r2 / (r1 + r2)`` for every pair of radii. So the materials (a
+  ``CohFrictMat`` copy of each ``FrictMat``) give ``kr = 0``, and a ``PyRunner`` right
+  after the interaction loop sets ``kr`` and ``maxRollPl`` on each contact in the step it
+  forms and applies that step's moment itself (``rolling_contacts``): the spring is
+  poro2d's from a contact's first step.
 
-The numbers are in three literals at the top of the script (``SETTINGS``, ``DISKS``,
-``WALLS``), written with ``repr``, so that they can be read back exactly.
+The numbers are in literals at the top of the script (``SETTINGS``, ``DISKS``, ``WALLS``,
+and for a rolled specimen ``DISK_ROLLING`` and ``WALL_ROLLING``), written with ``repr``,
+so that they can be read back exactly.
 """
 
 from __future__ import annotations
 
 import os
 from pathlib import Path
+
+import numpy as np
 
 from poro2d.errors import InputError
 from poro2d.interop.specimen_data import SpecimenData
@@ -144,10 +156,86 @@ O.engines = [
     PyRunner(command="stop_at_rest()", iterPeriod=SETTINGS["check_every"]),
 ]
 O.dt = SETTINGS["dt"]
+'''
 
+_MAIN = """
 if __name__ == "__main__":
     O.run(SETTINGS["max_steps"], True)
     report()
+"""
+
+_ROLLING = '''
+
+# Rolling resistance, poro2d's rolling spring on every contact: the moment on the first body
+# grows by -kr (w1 - w2) dt each step and is capped at mu_r R Fn, with kr = ks R^2 (ks of the
+# contact), R = r1 r2 / (r1 + r2) (a disk's own radius against a wall) and mu_r the smaller
+# of the two bodies' values. YADE's Law2_ScGeom6D_CohFrictPhys_CohesionMoment in its
+# incremental form runs this spring on a contact's kr and maxRollPl (cap maxRollPl Fn), but
+# its Ip2 derives them from the materials (kr = alphaKr ks r1 r2, maxRollPl = min(etaRoll1 r1,
+# etaRoll2 r2)), which no per-body alphaKr and etaRoll turn into ks R^2 and mu_r R for every
+# pair. So the materials give kr = 0 and rolling_contacts() sets kr and maxRollPl on each
+# contact in the step it forms, and applies that step's moment itself.
+from yade.wrapper import (
+    CohFrictMat, Ig2_Box_Sphere_ScGeom6D, Ig2_Sphere_Sphere_ScGeom6D,
+    Ip2_CohFrictMat_CohFrictMat_CohFrictPhys, Law2_ScGeom6D_CohFrictPhys_CohesionMoment,
+)
+
+disk_radius = {i: d[2] for i, d in zip(disk_ids, DISKS)}
+rolling_friction = dict(zip(disk_ids, DISK_ROLLING))
+rolling_friction.update({wid: WALL_ROLLING[name] for name, wid in wall_ids.items()})
+shear_stiffness = {i: p[1] for i, p in {**disk_props, **wall_props}.items()}
+
+
+def with_moments(mat):
+    """The body's FrictMat as a CohFrictMat: moments on, never cohesive, kr = 0 until set per contact."""
+    new = CohFrictMat(
+        young=mat.young, poisson=mat.poisson, frictionAngle=mat.frictionAngle, density=mat.density,
+        isCohesive=False, momentRotationLaw=True, alphaKr=0.0, alphaKtw=0.0, etaRoll=-1.0, etaTwist=-1.0,
+    )
+    return O.materials[O.materials.append(new)]
+
+
+for body in O.bodies:
+    body.material = with_moments(body.material)
+
+
+def rolling_spring(i):
+    """(kr, mu_r R): poro2d's rolling stiffness and moment cap per unit normal force of a contact."""
+    a, b = i.id1, i.id2
+    if a in disk_radius and b in disk_radius:
+        r = disk_radius[a] * disk_radius[b] / (disk_radius[a] + disk_radius[b])
+    else:
+        r = disk_radius.get(a, disk_radius.get(b))
+    ks = series(shear_stiffness[a], shear_stiffness[b])
+    return ks * r * r, min(rolling_friction[a], rolling_friction[b]) * r
+
+
+def rolling_contacts():
+    """poro2d's rolling spring on every contact that formed in this step, and this step's moment."""
+    for i in O.interactions:
+        if i.iterMadeReal != O.iter:
+            continue
+        kr, limit = rolling_spring(i)
+        i.phys.kr, i.phys.maxRollPl = kr, limit
+        w = O.bodies[i.id2].state.angVel[2] - O.bodies[i.id1].state.angVel[2]
+        cap = limit * i.phys.normalForce.norm()
+        m = min(max(-kr * w * O.dt, -cap), cap)
+        i.phys.moment_bending = Vector3(0.0, 0.0, m)
+        O.forces.addT(i.id1, Vector3(0.0, 0.0, -m))
+        O.forces.addT(i.id2, Vector3(0.0, 0.0, m))
+
+
+O.engines = [
+    *O.engines[:2],
+    InteractionLoop(
+        [Ig2_Sphere_Sphere_ScGeom6D(), Ig2_Box_Sphere_ScGeom6D()],
+        [Ip2_CohFrictMat_CohFrictMat_CohFrictPhys()],
+        [Law2_ScGeom6D_CohFrictPhys_CohesionMoment(useIncrementalForm=True, always_use_moment_law=True)],
+    ),
+    PyRunner(command="rolling_contacts()", iterPeriod=1, initRun=True),
+    *O.engines[3:],
+]
+
 '''
 
 
@@ -183,7 +271,23 @@ def script(
         *(f"    ({w.name!r}, {', '.join(repr(float(v)) for v in _wall_numbers(w))})," for w in spec.walls),
         "]",
     ]
-    return "\n".join(lines) + _BODY
+    if not spec.rolled:
+        return "\n".join(lines) + _BODY + _MAIN
+    return "\n".join(lines + _rolling_lines(spec)) + _BODY + _ROLLING + _MAIN
+
+
+def _rolling_lines(spec: SpecimenData) -> list[str]:
+    """The rolling frictions of a rolled specimen, per disk (in DISKS order) and per wall."""
+    mu_r = np.zeros(spec.n) if spec.mu_r is None else np.asarray(spec.mu_r, dtype=float)
+    walls = {w.name: float(w.mu_r) for w in spec.walls}
+    return [
+        "",
+        "# rolling friction mu_r per disk (in DISKS order) and per wall, for poro2d's rolling spring (below)",
+        "DISK_ROLLING = [",
+        *(f"    {float(v)!r}," for v in mu_r),
+        "]",
+        f"WALL_ROLLING = {walls!r}",
+    ]
 
 
 def _wall_numbers(w) -> tuple[float, ...]:
@@ -197,12 +301,7 @@ def write_specimen(
     """Write ``specimen_yade.py`` into ``out`` (atomically), stopping at ``ratio`` (YADE's mean ratio)."""
     if not spec.dt:
         raise InputError("time step", spec.dt, "the time step of the specimen (a poro2d checkpoint has one)")
-    if spec.rolled:
-        raise InputError(
-            "rolling friction", spec.rolling_parameters().disks, "0 for a YADE export",
-            "YADE's rolling law cannot be given poro2d's rolling stiffness ks R^2 per contact; "
-            "export with --to lammps or --to pfc, which carry it",
-        )  # fmt: skip
+    spec.refuse_dashpot("YADE")
     slanted = [w.name for w in spec.walls if not (w.horizontal or w.vertical)]
     if slanted:
         raise InputError("walls", slanted, "horizontal or vertical walls (written as YADE boxes)")
