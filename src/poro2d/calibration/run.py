@@ -36,7 +36,7 @@ from poro2d.paper_data import QUICK_SHEAR
 from poro2d.shear.lab import LabData, read_lab_csv
 from poro2d.shear.parts import LabRecord, ShearSettingsRecord
 from poro2d.shear.series import check_stresses
-from poro2d.shear.settings import MAX_FRICTION, ShearSettings
+from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
 from poro2d.store import Store
 from poro2d.typed_result import TypedResult, part
 
@@ -313,7 +313,7 @@ def run_calibration(
     given = given_specimens(list(specimens or [])) if preset is None else None
     ranges = model.Ranges(
         check_range_pair("--fp-range", fp_range, 0.0, MAX_FRICTION, lo_open=True),
-        check_range_pair("--mu-r-range", mu_r_range, 0.0, 1.0),
+        check_range_pair("--mu-r-range", mu_r_range, 0.0, MAX_ROLLING_FRICTION),
     )
     try:
         points = check_int("--points", points, MIN_POINTS, MAX_POINTS)
