@@ -19,6 +19,7 @@ import numpy as np
 
 from poro2d.calibration import model
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
+from poro2d.calibration.identifiable import check_enough_lab_values
 from poro2d.calibration.specimens import (
     Replicates,
     check_preset,
@@ -331,6 +332,7 @@ def run_calibration(
         settings = dict(QUICK_SHEAR)
     base = _base_settings(settings)
     targets = _lab_targets(lab_data, base)
+    check_enough_lab_values(lab_data.source, targets, len(CALIBRATED))
     check_cluster_options(scheduler, workers)
     check_reachable(scheduler)
 
