@@ -75,8 +75,13 @@ class LabTable:
 
 
 def _number(table: LabTable, row: int, name: str, text: str) -> float:
-    """A cell as a finite number written as spreadsheets write numbers."""
-    parameter = f"lab {name} ({table.where(row, name)})"
+    return parse_number(text, f"lab {name} ({table.where(row, name)})")
+
+
+def parse_number(text: str, parameter: str) -> float:
+    """A cell as a finite number written as spreadsheets write numbers; ``parameter`` names the
+    cell in a refusal (file, line and column)."""
+    text = text.strip()
     if "_" in text:  # Python's float() reads 1_000; a spreadsheet never writes it
         raise InputError(parameter, text, "a number (digits, sign, point, exponent)")
     try:
@@ -103,7 +108,8 @@ def read_lab_table(path: str | os.PathLike) -> LabTable:
     ]
     if not numbered:
         raise InputError("lab", str(p), "a CSV with a header and data rows")
-    rows = list(csv.reader([ln for _, ln in numbered]))
+    # each line on its own: a stray quote must not join the lines after it into one row
+    rows = [next(csv.reader([ln])) for _, ln in numbered]
     header = tuple(h.strip().lower() for h in rows[0])
     for (line, _), row in zip(numbered[1:], rows[1:], strict=True):
         if len(row) != len(header):  # a cell too many is as unclear as one too few: which column moved?
@@ -141,5 +147,6 @@ __all__ = [
     "LabTable",
     "check_enough_points",
     "check_rising",
+    "parse_number",
     "read_lab_table",
 ]
