@@ -124,3 +124,16 @@ def test_a_csv_specimen_takes_the_same_range(tmp_path, specimen):
     with pytest.raises(InputError) as e:
         csv_table.read_specimen(tmp_path, defaults)
     assert printed_range(str(e.value)) == (0.0, MAX_ROLLING_FRICTION), str(e.value)
+
+
+@pytest.mark.parametrize("command", ["strength", "calibrate"])
+def test_a_rolling_friction_with_an_underscore_is_not_read_as_another_number(
+    command, tmp_path, capsys, monkeypatch
+):
+    """float() reads "0_1" as 1, inside the range: refused as a number, not taken as 1."""
+    argv = COMMANDS[command](tmp_path, 0.5, monkeypatch)
+    argv = [a.replace("0.5", "0_1") if isinstance(a, str) else a for a in argv]
+    with pytest.raises(SystemExit) as e:
+        main([str(a) for a in argv])
+    err = capsys.readouterr().err.strip()
+    assert e.value.code == 2 and "0_1" in err and "number" in err, err
