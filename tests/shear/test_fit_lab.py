@@ -126,6 +126,8 @@ def test_a_curve_of_the_largest_displacement_accepted_is_read(tmp_path):
         ({50.0: 0.0}, {}, ["the peak at 50 kPa", "weak"]),
         ({5e6: 10.0}, {}, ["the peak at 5e+06 kPa", "[1, 1000] kPa"]),
         ({}, {}, ["at least one normal stress"]),
+        ({50.0: "40"}, {}, ["finite numbers"]),
+        ({50.0: float("nan")}, {}, ["finite numbers"]),
         (
             {50.0: 30.0},
             {50.0: (np.array([0.0, 1e-3]), np.array([0.0, 30.0]))},

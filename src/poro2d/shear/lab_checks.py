@@ -23,9 +23,11 @@ curve is named by its normal stress instead.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from poro2d.errors import InputError
+from poro2d.errors import InputError, is_number
 from poro2d.lab_table import MAX_TAN_PHI, MIN_CURVE_POINTS
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA
 
@@ -64,10 +66,17 @@ def check_lab_values(peaks: dict[float, float], curves: dict[float, tuple[np.nda
     if curves and set(curves) != set(peaks):
         raise InputError("lab curves", sorted(curves), f"one curve per peak's normal stress {sorted(peaks)}")
     for sigma, tau in peaks.items():
+        if not (is_number(sigma) and is_number(tau) and math.isfinite(sigma) and math.isfinite(tau)):
+            raise InputError("lab peaks", {sigma: tau}, "finite numbers: normal stress (kPa) -> peak (kPa)")
         where = f"the peak at {sigma:g} kPa"
         check_normal_stress(where, float(sigma))
         check_peak(where, "peak_shear_stress_kpa", float(sigma), float(tau))
-    for sigma, (d, t) in curves.items():
+    for sigma, pair in curves.items():
+        if not (isinstance(pair, tuple | list) and len(pair) == 2):
+            raise InputError(
+                f"lab curve at {sigma:g} kPa", type(pair).__name__, "a pair (displacement m, stress kPa)"
+            )
+        d, t = pair
         _check_curve_arrays(float(sigma), np.asarray(d, float), np.asarray(t, float))
         if float(np.max(t)) != float(peaks[sigma]):
             raise InputError(
