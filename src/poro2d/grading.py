@@ -20,7 +20,6 @@ class, diameters are drawn uniformly in ``d`` (default) or uniformly in ``log d`
 from __future__ import annotations
 
 import csv
-import io
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -31,7 +30,8 @@ from typing import Any
 import numpy as np
 
 from poro2d.errors import InputError, as_float_array, check_int, check_range, is_number
-from poro2d.io_utils import check_input_file
+from poro2d.io_utils import check_input_file, read_utf8
+from poro2d.lab_table import parse_number
 
 __all__ = [
     "MAX_DRAW",
@@ -183,17 +183,9 @@ class GradingCurve:
     ) -> GradingCurve:
         """Read a CSV with columns ``size_mm,percent_passing`` (lines starting ``#`` skipped)."""
         p = check_input_file("csv", path)
-        try:
-            text = p.read_text(encoding="utf-8")
-        except OSError:
-            raise InputError(
-                "csv", str(path), "a readable CSV file with columns size_mm,percent_passing"
-            ) from None
-        except UnicodeDecodeError as exc:  # a binary file given by mistake
-            raise InputError(
-                "csv", str(path), "a text (UTF-8) CSV file with columns size_mm,percent_passing",
-                f"byte {exc.start} is not text",
-            ) from None  # fmt: skip
+        # read as every laboratory file is: a byte order mark dropped, other bytes than UTF-8
+        # refused naming their line and column
+        text = read_utf8("csv", p, "a text (UTF-8) CSV file with columns size_mm,percent_passing")
         sizes, percent = _parse_csv(text, str(p))
         return cls.from_lists(
             sizes,
@@ -378,26 +370,30 @@ def _apply_cutoffs(
 
 
 def _parse_csv(text: str, origin: str) -> tuple[list[float], list[float]]:
+    """The sieve curve's columns; each number is read as every laboratory file's are
+    (:func:`poro2d.lab_table.parse_number`), a refusal naming its line and column."""
     if "\x00" in text:  # valid UTF-8 but binary (the csv module would stop on it with its own error)
         raise InputError("csv", origin, "a text CSV file with columns size_mm,percent_passing",
                          "it contains NUL bytes")  # fmt: skip
-    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
-    reader = csv.DictReader(io.StringIO("\n".join(lines)))
-    fields = [f.strip() for f in (reader.fieldnames or [])]
+    numbered = [
+        (k + 1, ln)
+        for k, ln in enumerate(text.splitlines())
+        if ln.strip() and not ln.lstrip().startswith("#")
+    ]
+    # each line on its own: a stray quote must not join the lines after it into one row
+    rows = [next(csv.reader([ln])) for _, ln in numbered]
+    fields = [f.strip() for f in rows[0]] if rows else []
     if "size_mm" not in fields or "percent_passing" not in fields:
         raise InputError("csv", origin, "a header with columns size_mm,percent_passing")
-    reader.fieldnames = fields
-    sizes: list[float] = []
-    percent: list[float] = []
-    for row_no, row in enumerate(reader, start=2):
-        try:
-            sizes.append(float(row["size_mm"]))
-            percent.append(float(row["percent_passing"]))
-        except (TypeError, ValueError):
-            raise InputError(
-                "csv", f"{origin} data row {row_no - 1}", "numbers in size_mm and percent_passing"
-            ) from None
-    return sizes, percent
+    columns = {name: fields.index(name) for name in ("size_mm", "percent_passing")}
+    values: dict[str, list[float]] = {"size_mm": [], "percent_passing": []}
+    for (line, _), row in zip(numbered[1:], rows[1:], strict=True):
+        for name, k in columns.items():
+            where = f"csv {name} (line {line}, column {k + 1} of {origin})"
+            if k >= len(row):
+                raise InputError(where, ",".join(row), "numbers in size_mm and percent_passing")
+            values[name].append(parse_number(row[k], where))
+    return values["size_mm"], values["percent_passing"]
 
 
 def paper_grading(

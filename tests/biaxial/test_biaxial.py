@@ -32,7 +32,8 @@ def full(tmp_path_factory):
     out = tmp_path_factory.mktemp("biaxial")
     lab = out.parent / "lab.csv"
     lab.write_text("# my own test\naxial_strain,sigma_1_kpa,sigma_3_kpa,volumetric_strain\n"
-                   "0,100,100,0\n0.02,250,100,0.004\n0.1,210,100,-0.02\n")  # fmt: skip
+                   "0,100,100,0\n0.01,200,100,0.003\n0.02,250,100,0.004\n0.05,230,100,-0.01\n"
+                   "0.1,210,100,-0.02\n")  # fmt: skip
     result = run_biaxial(BiaxialCase.quick(100.0, seed=0), Store(out), lab=lab)
     return out, result
 
@@ -95,7 +96,7 @@ def test_files_and_typed_results(full):
     assert r.to_dict() == stored
     assert BiaxialResult.from_dict(stored).to_dict() == stored
     assert stored["provenance"]["poro2d_version"] and stored["settings"]["max_strain"] == 0.2
-    assert stored["lab"]["rows"] == 3 and stored["lab"]["peak_friction_angle_deg"] == pytest.approx(
+    assert stored["lab"]["rows"] == 5 and stored["lab"]["peak_friction_angle_deg"] == pytest.approx(
         math.degrees(math.asin(150 / 350))
     )
     one = BiaxialTestResult.read(Store(out / "replicate1"))
@@ -185,7 +186,7 @@ def test_bad_input_is_refused_on_one_line(argv, words, specimen, tmp_path, capsy
 
     monkeypatch.setattr(single.BiaxialTest, "run", no_work)
     back = tmp_path / "back.csv"
-    back.write_text("axial_strain,stress_ratio\n0.02,0.3\n0.01,0.35\n")
+    back.write_text("axial_strain,stress_ratio\n0,0\n0.01,0.2\n0.02,0.3\n0.01,0.35\n0.04,0.3\n")
     cols = tmp_path / "cols.csv"
     cols.write_text("strain,q\n0.01,0.3\n0.02,0.35\n")
     files = {"SPEC": str(specimen), "LAB_BACK": str(back), "LAB_COLUMNS": str(cols)}

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from poro2d.errors import InputError
-from poro2d.shear import inertial_number, mohr_coulomb, peak, read_lab_csv, smooth
+from poro2d.shear import LabData, inertial_number, mohr_coulomb, peak, read_lab_csv, smooth
 
 
 def test_fit_recovers_an_exact_line():
@@ -75,6 +75,13 @@ LAB_CURVES = "normal_stress_kpa,shear_displacement_mm,shear_stress_kpa\n"
         ("50,0,0\n50,1,300\n50,2,0\n50,3,0\n50,4,0\n", ["line 3", "(0, 2.5]", "strong"]),
         ("50000,0,0\n50000,1,3\n50000,2,3\n50000,3,3\n50000,4,3\n", ["normal_stress_kpa", "in kPa"]),
         ("50,0,0\n50,1,1_000\n50,2,3\n50,3,3\n50,4,3\n", ["line 3", "1_000", "a number"]),
+        # absurd magnitudes, each named by file, line and column
+        ("50,0,0\n50,1,30\n50,2,30\n50,3,30\n50,1e300,30\n", ["line 6, column 2", "[0, 300] mm", "in mm?"]),
+        ("50,0,0\n50,1,30\n50,2,30\n50,3,30\n50,4,1e300\n", ["line 6, column 3", "strong"]),
+        ("50,0,0\n50,1,30\n50,2,-30\n50,3,30\n50,4,30\n", ["line 4, column 3", "[0, inf) kPa"]),
+        ("50,0,0\n50,1,30\n50,2,inf\n50,3,30\n50,4,30\n", ["line 4, column 3", "a finite number"]),
+        ("50,0,0\n50,1,30\n50,2,nan\n50,3,30\n50,4,30\n", ["line 4, column 3", "a finite number"]),
+        ("50,0,0\n50,0,0\n50,0,0\n50,0,0\n50,0,0\n", ["line 3, column 2", "rises"]),  # all zero
     ],
 )
 def test_lab_curves_that_cannot_be_right_are_refused(tmp_path, body, words):
@@ -100,6 +107,49 @@ def test_lab_peaks_that_cannot_be_right_are_refused(tmp_path, body, words):
     p.write_text("normal_stress_kpa,peak_shear_stress_kpa\n" + body)
     with pytest.raises(InputError) as e:
         read_lab_csv(p)
+    for w in words:
+        assert w in str(e.value), (w, str(e.value))
+
+
+def test_a_curve_of_the_largest_displacement_accepted_is_read(tmp_path):
+    """300 mm, the bound, is read (and kept in m); the refusals above are the bound's other side."""
+    p = tmp_path / "lab.csv"
+    p.write_text(LAB_CURVES + "50,0,0\n50,100,30\n50,200,35\n50,250,30\n50,300,30\n")
+    d, t = read_lab_csv(p).curves[50.0]
+    assert d[-1] == pytest.approx(0.3) and t.max() == 35.0
+
+
+@pytest.mark.parametrize(
+    ("peaks", "curves", "words"),
+    [
+        ({50.0: 1e300}, {}, ["the peak at 50 kPa", "strong"]),
+        ({50.0: 0.0}, {}, ["the peak at 50 kPa", "weak"]),
+        ({5e6: 10.0}, {}, ["the peak at 5e+06 kPa", "[1, 1000] kPa"]),
+        ({}, {}, ["at least one normal stress"]),
+        ({50.0: "40"}, {}, ["finite numbers"]),
+        ({50.0: float("nan")}, {}, ["finite numbers"]),
+        (
+            {50.0: 30.0},
+            {50.0: (np.array([0.0, 1e-3]), np.array([0.0, 30.0]))},
+            ["curve at 50 kPa", "5 readings"],
+        ),
+        (
+            {50.0: 30.0},
+            {50.0: (np.array([0, 1, 1, 2, 3]) * 1e-3, np.array([0, 30, 30, 20, 20.0]))},
+            ["repeats"],
+        ),
+        ({50.0: 30.0}, {50.0: (np.array([0, 1, 2, 3, 1e300]), np.array([0, 30, 30, 20, 20.0]))}, ["0.3] m"]),
+        (
+            {50.0: 31.0},
+            {50.0: (np.arange(5) * 1e-3, np.array([0, 30, 30, 20, 20.0]))},
+            ["largest reading 30"],
+        ),
+    ],
+)
+def test_lab_data_made_in_python_pass_the_files_checks(peaks, curves, words):
+    """A calibration or a series handed LabData is held to what a CSV is held to."""
+    with pytest.raises(InputError) as e:
+        LabData("mine", peaks, curves)
     for w in words:
         assert w in str(e.value), (w, str(e.value))
 

@@ -8,22 +8,41 @@ lines starting with ``#`` are comments, UTF-8 text):
   ``sigma_3_kpa`` from which it is computed;
 * ``volumetric_strain`` (optional): a fraction, compression positive.
 
-Data that cannot be right are refused before any work: a strain outside [0, 1) or stepping
-back, a stress ratio outside [0, 1), fewer than two rows.
+The file is read as every laboratory file is (:mod:`poro2d.lab_table`: a byte order mark is
+read, numbers with underscores or not finite are refused, each refusal names the file, line and
+column). Data that cannot be right are refused before any work: fewer than five rows, an axial
+strain outside [0, 0.5] or not rising strictly from row to row (a repeat is a row pasted twice),
+a volumetric strain outside [-0.5, 0.5] (a column in percent), a stress ratio outside [0, 1] or
+a peak ratio of 0 (an all-zero curve) or above sin 68 degrees (the largest friction angle the
+direct shear files accept), stresses outside the confining range a biaxial test runs at.
 """
 
 from __future__ import annotations
 
-import csv
 import math
 import os
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
+from poro2d.biaxial.settings import CONFINING_RANGE_KPA
 from poro2d.errors import InputError
-from poro2d.io_utils import check_input_file, read_utf8
+from poro2d.lab_table import (
+    MAX_TAN_PHI,
+    MIN_CURVE_POINTS,
+    LabTable,
+    check_enough_points,
+    check_rising,
+    read_lab_table,
+)
+
+#: largest peak (sigma_1 - sigma_3) / (sigma_1 + sigma_3): sin of the direct shear files' largest
+#: friction angle (atan 2.5, 68 degrees), one bound for both kinds of laboratory file
+MAX_SIN_PHI = math.sin(math.atan(MAX_TAN_PHI))
+#: largest sigma_1 / sigma_3 (the same angle: (1 + sin phi) / (1 - sin phi))
+MAX_PRINCIPAL_RATIO = (1.0 + MAX_SIN_PHI) / (1.0 - MAX_SIN_PHI)
+#: largest axial or volumetric strain (a fraction): a biaxial specimen is not sheared past half its height
+MAX_STRAIN = 0.5
 
 
 @dataclass(frozen=True)
@@ -42,68 +61,56 @@ class LabCurve:
         return math.degrees(math.asin(float(self.stress_ratio[-1])))
 
 
-def _number(path: Path, line: int, column: str, text: str) -> float:
-    try:
-        v = float(text) if "_" not in text else math.nan
-    except ValueError:
-        v = math.nan
-    if not math.isfinite(v):
-        raise InputError(f"lab {column} (line {line} of {path})", text, "a finite number")
-    return v
-
-
 def read_lab_curve(path: str | os.PathLike) -> LabCurve:
     """Read and check a laboratory biaxial CSV (the columns are the module's)."""
-    p = Path(path)
-    if p.exists():
-        check_input_file("lab", p)
-    if not p.is_file():
-        raise InputError("lab", str(p), "an existing CSV file")
-    text = read_utf8("lab", p, "a UTF-8 CSV file")
-    lines = [
-        (k + 1, ln)
-        for k, ln in enumerate(text.splitlines())
-        if ln.strip() and not ln.lstrip().startswith("#")
-    ]
-    if len(lines) < 3:
-        raise InputError("lab", str(p), "a CSV with a header and at least two data rows")
-    rows = list(csv.reader([ln for _, ln in lines]))
-    header = [h.strip().lower() for h in rows[0]]
-    by_stresses = "sigma_1_kpa" in header and "sigma_3_kpa" in header
-    if "axial_strain" not in header or not ("stress_ratio" in header or by_stresses):
+    table = read_lab_table(path)
+    by_stresses = table.has("sigma_1_kpa", "sigma_3_kpa")
+    if not table.has("axial_strain") or not (table.has("stress_ratio") or by_stresses):
         raise InputError(
-            "lab columns", ",".join(header),
+            "lab columns", ",".join(table.header),
             "axial_strain with stress_ratio (or sigma_1_kpa and sigma_3_kpa), volumetric_strain optional",
         )  # fmt: skip
-    wanted = ["axial_strain"] + (
-        ["stress_ratio"] if "stress_ratio" in header else ["sigma_1_kpa", "sigma_3_kpa"]
-    )
-    if "volumetric_strain" in header:
-        wanted.append("volumetric_strain")
-    data = []
-    for (line, _), row in zip(lines[1:], rows[1:], strict=True):
-        if len(row) != len(header):
+    rows = np.arange(len(table.rows))
+    if len(rows) == 0:
+        raise InputError("lab", table.path, f"a CSV with a header and at least {MIN_CURVE_POINTS} data rows")
+    check_enough_points(table, rows, "curve")
+    e1 = table.column("axial_strain", 0.0, MAX_STRAIN, "(a fraction)", "is the column in percent?")
+    check_rising(table, "axial_strain", e1, rows, "the axial strain")
+    ratio = _stress_ratio(table) if not table.has("stress_ratio") else table.column("stress_ratio", 0.0, 1.0)
+    _check_peak_ratio(table, ratio)
+    ev = None
+    if table.has("volumetric_strain"):
+        ev = table.column(
+            "volumetric_strain", -MAX_STRAIN, MAX_STRAIN, "(a fraction)", "is the column in percent?"
+        )
+    return LabCurve(table.path, e1, ratio, ev)
+
+
+def _stress_ratio(table: LabTable) -> np.ndarray:
+    """(sigma_1 - sigma_3) / (sigma_1 + sigma_3) of each row, from stresses a test runs at."""
+    lo, hi = CONFINING_RANGE_KPA
+    s3 = table.column("sigma_3_kpa", lo, hi, "kPa", "the confining stresses a biaxial test runs at")
+    s1 = table.column("sigma_1_kpa", lo, math.inf, "kPa")
+    for i in range(len(s1)):
+        if not s3[i] <= s1[i] <= MAX_PRINCIPAL_RATIO * s3[i]:
             raise InputError(
-                f"lab row (line {line} of {p})", ",".join(row), f"{len(header)} columns, as the header"
-            )
-        data.append({c: _number(p, line, c, row[header.index(c)].strip()) for c in wanted})
-    e1 = np.array([d["axial_strain"] for d in data])
-    if "stress_ratio" in wanted:
-        ratio = np.array([d["stress_ratio"] for d in data])
-    else:
-        s1 = np.array([d["sigma_1_kpa"] for d in data])
-        s3 = np.array([d["sigma_3_kpa"] for d in data])
-        if np.any(s3 <= 0) or np.any(s1 < s3):
-            raise InputError("lab sigma_1_kpa, sigma_3_kpa", str(p), "sigma_1 >= sigma_3 > 0 on every row")
-        ratio = (s1 - s3) / (s1 + s3)
-    if np.any(e1 < 0) or np.any(e1 >= 1) or np.any(np.diff(e1) < 0):
-        raise InputError("lab axial_strain", str(p), "fractions in [0, 1), rising from row to row")
-    if np.any(ratio < 0) or np.any(ratio >= 1):
-        raise InputError("lab stress_ratio", str(p), "[0, 1): (sigma_1 - sigma_3) / (sigma_1 + sigma_3)")
-    ev = np.array([d["volumetric_strain"] for d in data]) if "volumetric_strain" in wanted else None
-    if ev is not None and np.any(np.abs(ev) >= 1):
-        raise InputError("lab volumetric_strain", str(p), "fractions in (-1, 1)")
-    return LabCurve(str(p), e1, ratio, ev)
+                f"lab sigma_1_kpa ({table.where(i, 'sigma_1_kpa')})", float(s1[i]),
+                f"[1, {MAX_PRINCIPAL_RATIO:.3g}] times sigma_3 ({s3[i]:g} kPa)",
+                "the major stress of a soil sheared at this confining stress",
+            )  # fmt: skip
+    return (s1 - s3) / (s1 + s3)
+
+
+def _check_peak_ratio(table: LabTable, ratio: np.ndarray) -> None:
+    """The peak stress ratio is sin(phi) of a soil: above 0 and at most :data:`MAX_SIN_PHI`."""
+    k = int(np.argmax(ratio))
+    if not 0.0 < ratio[k] <= MAX_SIN_PHI:
+        name = "stress_ratio" if table.has("stress_ratio") else "sigma_1_kpa"
+        raise InputError(
+            f"lab {name} (the curve's peak, {table.where(k, name)})", float(ratio[k]),
+            f"a peak stress ratio in (0, {MAX_SIN_PHI:.3f}]",
+            f"sin(phi) = {ratio[k]:.3g}: no soil is that {'weak' if ratio[k] <= 0.0 else 'strong'}",
+        )  # fmt: skip
 
 
 __all__ = ["LabCurve", "read_lab_curve"]

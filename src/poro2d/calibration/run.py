@@ -20,6 +20,7 @@ import numpy as np
 from poro2d.calibration import model
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
 from poro2d.calibration.evaluations import DesignPoint, Observed, target_key
+from poro2d.calibration.identifiable import check_enough_lab_values
 from poro2d.calibration.specimens import (
     check_preset,
     check_replicates,
@@ -36,7 +37,7 @@ from poro2d.paper_data import QUICK_SHEAR
 from poro2d.shear.lab import LabData, read_lab_csv
 from poro2d.shear.parts import LabRecord, ShearSettingsRecord
 from poro2d.shear.series import check_stresses
-from poro2d.shear.settings import MAX_FRICTION, ShearSettings
+from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 from poro2d.typed_result import Keyed, TypedResult
@@ -302,7 +303,7 @@ def run_calibration(
     given = SpecimenSet.named(specimens or []).read() if preset is None else None
     ranges = model.Ranges(
         check_range_pair("--fp-range", fp_range, 0.0, MAX_FRICTION, lo_open=True),
-        check_range_pair("--mu-r-range", mu_r_range, 0.0, 1.0),
+        check_range_pair("--mu-r-range", mu_r_range, 0.0, MAX_ROLLING_FRICTION),
     )
     try:
         points = check_int("--points", points, MIN_POINTS, MAX_POINTS)
@@ -320,6 +321,7 @@ def run_calibration(
         settings = dict(QUICK_SHEAR)
     base = _base_settings(settings)
     targets = _lab_targets(lab_data, base)
+    check_enough_lab_values(lab_data.source, targets, len(CALIBRATED))
     check_cluster_options(scheduler, workers)
     check_reachable(scheduler)
 

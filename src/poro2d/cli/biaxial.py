@@ -34,6 +34,11 @@ def register(app: typer.Typer) -> None:
         particle_friction: float = typer.Option(
             None, "--particle-friction", help="Disk friction for the tests (default: the specimen's)."
         ),
+        rolling_friction: float = typer.Option(
+            None,
+            "--rolling-friction",
+            help="Disk rolling friction mu_r for the tests (default: the specimen's).",
+        ),
         lab: Path = typer.Option(
             None, "--lab", help="Your laboratory curves (CSV, docs/biaxial.md), overlaid."
         ),
@@ -46,9 +51,9 @@ def register(app: typer.Typer) -> None:
         """Biaxial tests: peak and critical-state friction angles, dilatancy, their spread over replicates."""
         from poro2d.biaxial import BiaxialCase, BiaxialSettings, run_biaxial
         from poro2d.biaxial.settings import CONFINING_RANGE_KPA
+        from poro2d.cli.shear import check_friction_options
         from poro2d.errors import InputError, check_int, check_range
         from poro2d.io_utils import check_output_dir
-        from poro2d.shear.settings import MAX_FRICTION
         from poro2d.store import Store
 
         check_output_dir("--out", out)
@@ -65,9 +70,9 @@ def register(app: typer.Typer) -> None:
             )
         n = check_int("--replicates", replicates, 1, 50) if replicates is not None else 1
         first = check_int("--seed", seed, 0, 2**31 - 1) if seed is not None else 0
-        if particle_friction is not None:
-            check_range("--particle-friction", particle_friction, 0.0, MAX_FRICTION)
-        changes = {"max_strain": strain, "strain_rate": strain_rate, "particle_friction": particle_friction}
+        check_friction_options(particle_friction, rolling_friction)  # the ranges shear takes
+        changes = {"max_strain": strain, "strain_rate": strain_rate, "particle_friction": particle_friction,
+                   "rolling_friction": rolling_friction}  # fmt: skip
         options = {k: v for k, v in changes.items() if v is not None}
         try:
             settings = BiaxialSettings(**options)

@@ -23,6 +23,8 @@ def parse_range(option: str, text: str | None, default: tuple[float, float]) -> 
         return default
     parts = [p.strip() for p in str(text).split(",")]
     try:
+        if any("_" in p for p in parts):  # float() reads 0_5 as 5: a typing mistake, not a number
+            raise ValueError(text)
         low, high = (float(p) for p in parts)
     except ValueError:
         raise InputError(option, text, "two numbers LOW,HIGH") from None

@@ -24,6 +24,8 @@ def parse_values(text: str, option: str, hi: float) -> list[float]:
     values = []
     for part in str(text).split(","):
         try:
+            if "_" in part:  # float() reads 0_1 as 1: a typing mistake, not a number
+                raise ValueError(part)
             v = float(part.strip())
         except ValueError:
             raise InputError(option, text, allowed, f"{part.strip()!r} is not a number") from None

@@ -55,7 +55,7 @@ from poro2d.criterion.measures import (
 )
 from poro2d.criterion.outputs import force_figure, write_accepted
 from poro2d.criterion.result import CriterionResult, CriterionSettingsRecord, SpecimenRecord
-from poro2d.criterion.servo import PlateServo, in_window
+from poro2d.criterion.servo import PlateServo, in_window, rises_free_to_roll
 from poro2d.criterion.trial import Decision, PlateStage, Preparation, StageFailure, Trial, trial_name
 from poro2d.dem import Simulation
 from poro2d.errors import Integer, OneOf, Ranges, Real, check_fields, check_range
@@ -472,14 +472,17 @@ class PorosityCriterion:
         Paper acceptance: the plate moves down when F_top = 0 and up when it is too large,
         and n' is the box porosity under it. Fill acceptance: the lid replaces the plate
         and n' is the porosity of the area under it (:func:`~poro2d.criterion.lid.fill_porosity`).
-        An over-full box with rolling friction first rises free to roll
-        (:meth:`~poro2d.criterion.servo.PlateServo.relax_rolling`).
+        A plate that must rise (an over-full box, or F_top above the window) over a specimen
+        with rolling friction first rises free to roll
+        (:meth:`~poro2d.criterion.servo.PlateServo.relax_rolling`): a dense trial squeezed
+        short of over-full locks its side stress too, and a fine disk stayed pressed into a
+        side wall past the in-box check (trial 0.12 of the wide grading at rolling friction 1.0).
         """
         width = self.spec.width
         servo = self.plate_servo()
         free = None
         mu_r = self.spec.rolling_friction
-        if overfull and mu_r > 0.0:
+        if rises_free_to_roll(f_top, weight, self.settings.force_fraction, overfull, mu_r):
             free = servo.relax_rolling(sim, weight, mu_r)
             f_top = FlatPlate(sim).force(sim) / sim.particles.thickness
         if self.settings.acceptance == "fill":

@@ -60,6 +60,20 @@ def in_window(f_top: float, weight: float, fraction: float) -> bool:
     return 0.0 < f_top < fraction * weight
 
 
+def rises_free_to_roll(
+    f_top: float, weight: float, fraction: float, overfull: bool, rolling_friction: float
+) -> bool:
+    """Whether the plate first rises with rolling friction off (:meth:`PlateServo.relax_rolling`).
+
+    It does whenever it must rise (an over-full box, or F_top at or above the window's limit
+    ``fraction`` x ``weight``, N/m) over disks with rolling friction: rolling friction locks the
+    side stress of a squeezed packing, over-full or merely dense, and a disk left pressed into
+    a side wall fails the in-box check. A plate that moves down, or disks free to roll, change
+    nothing.
+    """
+    return rolling_friction > 0.0 and (overfull or f_top >= fraction * weight)
+
+
 class ServoSettings(Protocol):
     """What the servo reads of the criterion's settings (``CriterionSettings`` has them all)."""
 
@@ -227,4 +241,4 @@ class PlateServo:
         return settled
 
 
-__all__ = ["PlateServo", "PlateSettle", "ServoSettings", "in_window"]
+__all__ = ["PlateServo", "PlateSettle", "ServoSettings", "in_window", "rises_free_to_roll"]

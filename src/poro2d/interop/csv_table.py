@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
 from poro2d.errors import InputError
 from poro2d.interop.specimen_data import SpecimenData, WallData
 from poro2d.interop.validate import text_of
@@ -174,16 +175,18 @@ def _check_ids(path: Path, rows: list[tuple[int, list[str]]]) -> None:
 
 
 def _check_rolling(disks_path: Path, drows, disk_mu_r, walls_path: Path, wrows, wall_mu_r) -> None:
-    """Rolling friction is >= 0, and given in both tables or in neither."""
+    """Rolling friction is in [0, MAX_ROLLING_FRICTION], the range every other input of it takes,
+    and given in both tables or in neither."""
     if wrows and len(wrows[0][1]) != len(WALL_COLUMNS) + 1:
         raise InputError(str(walls_path), "no mu_r column", f"a mu_r column, as {disks_path.name} has")
     column = len(DISK_COLUMNS) + 1
+    allowed = f"[0, {MAX_ROLLING_FRICTION:g}]"
     for (k, _), v in zip(drows, disk_mu_r, strict=True):
-        if v < 0.0:
-            raise InputError(f"{disks_path} line {k} column {column} (mu_r)", float(v), "[0, inf)")
+        if not 0.0 <= v <= MAX_ROLLING_FRICTION:
+            raise InputError(f"{disks_path} line {k} column {column} (mu_r)", float(v), allowed)
     for (k, _), v in zip(wrows, wall_mu_r, strict=True):
-        if v < 0.0:
-            raise InputError(f"{walls_path} line {k} column {column} (mu_r)", float(v), "[0, inf)")
+        if not 0.0 <= v <= MAX_ROLLING_FRICTION:
+            raise InputError(f"{walls_path} line {k} column {column} (mu_r)", float(v), allowed)
 
 
 def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[dict, list[tuple[int, list[str]]]]:

@@ -11,35 +11,44 @@ comments; the file is UTF-8 text):
 The peak of a curve is its largest shear stress as measured (laboratory curves
 are smooth enough; no smoothing is applied). Data that cannot be right (a peak of 0 or
 ten times its normal stress, a curve whose displacement steps back, a one-point curve)
-are refused before any work (:mod:`poro2d.shear.lab_checks`).
+are refused before any work (:mod:`poro2d.shear.lab_checks`). The file is read as every
+laboratory file is (:mod:`poro2d.lab_table`: a byte order mark is read, each refusal names
+the file, line and column).
 """
 
 from __future__ import annotations
 
-import csv
 import math
 import os
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from poro2d.errors import InputError
-from poro2d.io_utils import check_input_file, read_utf8
-from poro2d.shear.lab_checks import check_curve, check_normal_stress, check_peak
+from poro2d.lab_table import LabTable, check_enough_points, check_rising, read_lab_table
+from poro2d.shear.lab_checks import MAX_DISPLACEMENT_MM, check_lab_values, check_peak
 from poro2d.shear.parts import LabPeak, LabRecord
+from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA
 
 CURVE_COLUMNS = ("normal_stress_kpa", "shear_displacement_mm", "shear_stress_kpa")
 PEAK_COLUMNS = ("normal_stress_kpa", "peak_shear_stress_kpa")
 
 
-@dataclass
+@dataclass(frozen=True)
 class LabData:
-    """Laboratory results: peaks per normal stress, and curves when the CSV had them."""
+    """Laboratory results: peaks per normal stress, and curves when the CSV had them.
+
+    Made in Python, the data pass the checks a file passes (:mod:`poro2d.shear.lab_checks`):
+    a calibration handed a ``LabData`` is as safe as one handed a CSV."""
 
     source: str
     peaks: dict[float, float]
     curves: dict[float, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.peaks, dict) or not isinstance(self.curves, dict):
+            raise InputError("lab", type(self.peaks).__name__, "peaks and curves as dicts by normal stress")
+        check_lab_values(self.peaks, self.curves)
 
     @property
     def kind(self) -> str:
@@ -57,81 +66,61 @@ class LabData:
         return LabRecord(source=self.source, kind=self.kind, peaks=self.peak_rows())
 
 
-def _number(path: str, line: int, col: str, text: str) -> float:
-    if "_" in text:  # Python's float() reads 1_000; a spreadsheet never writes it
-        raise InputError(
-            f"lab {col} (line {line} of {path})", text, "a number (digits, sign, point, exponent)"
-        )
-    try:
-        v = float(text)
-    except (TypeError, ValueError):
-        raise InputError(f"lab {col} (line {line} of {path})", text, "a number") from None
-    if not math.isfinite(v):
-        raise InputError(f"lab {col} (line {line} of {path})", text, "a finite number")
-    return v
-
-
 def read_lab_csv(path: str | os.PathLike) -> LabData:
     """Read and validate a laboratory CSV (see the module docstring for the columns)."""
-    p = Path(path)
-    if p.exists():  # a device, a FIFO or a folder is named as such
-        check_input_file("lab", p)
-    if not p.is_file():
-        raise InputError("lab", str(p), "an existing CSV file")
-    text = read_utf8("lab", p, "a UTF-8 CSV file")
-    lines = [
-        (k + 1, ln)
-        for k, ln in enumerate(text.splitlines())
-        if ln.strip() and not ln.lstrip().startswith("#")
-    ]
-    if not lines:
-        raise InputError("lab", str(p), "a CSV with a header and data rows")
-    reader = csv.reader([ln for _, ln in lines])
-    rows = list(reader)
-    header = [h.strip().lower() for h in rows[0]]
-    if all(c in header for c in CURVE_COLUMNS):
-        cols, kind = CURVE_COLUMNS, "curves"
-    elif all(c in header for c in PEAK_COLUMNS):
-        cols, kind = PEAK_COLUMNS, "peaks"
+    table = read_lab_table(path)
+    if table.has(*CURVE_COLUMNS):
+        read = _curves
+    elif table.has(*PEAK_COLUMNS):
+        read = _peaks
     else:
         raise InputError(
-            "lab columns", ",".join(header),
+            "lab columns", ",".join(table.header),
             f"the columns {','.join(CURVE_COLUMNS)} (curves) or {','.join(PEAK_COLUMNS)} (peaks)",
         )  # fmt: skip
-    idx = [header.index(c) for c in cols]
-    data, numbers = [], []
-    for (line, _), row in zip(lines[1:], rows[1:], strict=True):
-        if len(row) != len(header):  # a cell too many is as unclear as one too few: which column moved?
-            where = f"line {line}, column {min(len(row), len(header)) + 1} of {p}"
-            raise InputError(f"lab row ({where})", ",".join(row), f"{len(header)} columns, as the header")
-        vals = [_number(str(p), line, c, row[i].strip()) for c, i in zip(cols, idx, strict=True)]
-        for c, v in zip(cols, vals, strict=True):
-            if v < 0:
-                raise InputError(f"lab {c} (line {line} of {p})", v, "[0, inf)")
-        check_normal_stress(str(p), line, vals[0])
-        data.append(vals)
-        numbers.append(line)
-    if not data:
-        raise InputError("lab", str(p), "at least one data row")
-    a, at = np.array(data), np.array(numbers)
-    if kind == "peaks":
-        peaks: dict[float, float] = {}
-        for (s, t), line in zip(a, at, strict=True):
-            if float(s) in peaks:
-                raise InputError("lab normal_stress_kpa", float(s), "each normal stress once in a peaks CSV")
-            check_peak(str(p), int(line), "peak_shear_stress_kpa", float(s), float(t))
-            peaks[float(s)] = float(t)
-        return LabData(str(p), peaks)
+    if not table.rows:
+        raise InputError("lab", table.path, "at least one data row")
+    return read(table)
+
+
+def _normal_stresses(table: LabTable) -> np.ndarray:
+    lo, hi = NORMAL_STRESS_RANGE_KPA
+    why = "the range of normal stresses a shear test runs at; is the column in kPa?"
+    return table.column("normal_stress_kpa", lo, hi, "kPa", why)
+
+
+def _peaks(table: LabTable) -> LabData:
+    sigma = _normal_stresses(table)
+    tau = table.column("peak_shear_stress_kpa", 0.0, math.inf, "kPa")
+    peaks: dict[float, float] = {}
+    for i, (s, t) in enumerate(zip(sigma, tau, strict=True)):
+        if float(s) in peaks:
+            where = table.where(i, "normal_stress_kpa")
+            raise InputError(
+                f"lab normal_stress_kpa ({where})", float(s), "each normal stress once in a peaks CSV"
+            )
+        check_peak(table.where(i, "peak_shear_stress_kpa"), "peak_shear_stress_kpa", float(s), float(t))
+        peaks[float(s)] = float(t)
+    return LabData(table.path, peaks)
+
+
+def _curves(table: LabTable) -> LabData:
+    sigma = _normal_stresses(table)
+    why = "a reading of a shear box; is the column in mm?"
+    d = table.column("shear_displacement_mm", 0.0, MAX_DISPLACEMENT_MM, "mm", why)
+    tau = table.column("shear_stress_kpa", 0.0, math.inf, "kPa")
     curves: dict[float, tuple[np.ndarray, np.ndarray]] = {}
-    for s in np.unique(a[:, 0]):
-        m = a[:, 0] == s
-        d, t = a[m, 1], a[m, 2]
-        check_curve(str(p), float(s), at[m], d)  # rows in file order, displacement rising
-        k = int(np.argmax(t))
-        check_peak(str(p), int(at[m][k]), "shear_stress_kpa (the curve's peak)", float(s), float(t[k]))
-        curves[float(s)] = (d * 1e-3, t)  # displacement in m
+    for s in np.unique(sigma):
+        rows = np.flatnonzero(sigma == s)  # rows in file order, never re-sorted
+        check_enough_points(table, rows, f"curve at {s:g} kPa")
+        check_rising(table, "shear_displacement_mm", d[rows], rows, "a curve's displacement")
+        k = int(rows[np.argmax(tau[rows])])
+        check_peak(
+            table.where(k, "shear_stress_kpa"), "shear_stress_kpa (the curve's peak)", float(s), float(tau[k])
+        )
+        curves[float(s)] = (d[rows] * 1e-3, tau[rows])  # displacement in m
     peaks = {s: float(np.max(t)) for s, (_, t) in curves.items()}
-    return LabData(str(p), peaks, curves)
+    return LabData(table.path, peaks, curves)
 
 
 __all__ = ["CURVE_COLUMNS", "PEAK_COLUMNS", "LabData", "read_lab_csv"]

@@ -8,63 +8,107 @@ its answer printed as if it were identified. The checks here are physical, not s
   (:data:`~poro2d.shear.settings.NORMAL_STRESS_RANGE_KPA`);
 * every peak's stress ratio tau/sigma lies in (0, :data:`MAX_STRESS_RATIO`]: a soil with
   no strength has no peak, and 2.5 is a friction angle of 68 degrees, past any sand or
-  gravel at the stresses of a direct shear box (rough rock joints stay below it too);
+  gravel at the stresses of a direct shear box (:data:`poro2d.lab_table.MAX_TAN_PHI`);
+* a shear displacement lies in [0, :data:`MAX_DISPLACEMENT_MM`] mm: the largest shear boxes
+  (1 m rockfill boxes) are sheared by a fifth of their length, 200 mm; more is a column in
+  micrometres or a typing mistake;
 * a curve is a test: displacements rise from row to row (a step back or a repeat is a
   curve pasted twice or sorted by another column), with at least :data:`MIN_CURVE_POINTS`
   readings, so that a peak and what follows it are measured.
 
 Each refusal names the file, the line and the column (``InputError``: one line at the CLI).
+The same checks hold for :class:`~poro2d.shear.lab.LabData` made in Python, where the peak or
+curve is named by its normal stress instead.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from poro2d.errors import InputError
+from poro2d.errors import InputError, is_number
+from poro2d.lab_table import MAX_TAN_PHI, MIN_CURVE_POINTS
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA
 
 #: largest peak stress ratio tau/sigma accepted (a friction angle of 68 degrees)
-MAX_STRESS_RATIO = 2.5
-#: fewest readings of a whole curve
-MIN_CURVE_POINTS = 5
+MAX_STRESS_RATIO = MAX_TAN_PHI
+#: largest shear displacement of a laboratory reading (mm)
+MAX_DISPLACEMENT_MM = 300.0
 
 
-def check_normal_stress(path: str, line: int, sigma: float) -> None:
-    """A normal stress (kPa) a shear test can be run at."""
+def check_normal_stress(where: str, sigma: float) -> None:
+    """A normal stress (kPa) a shear test can be run at; ``where`` names the cell."""
     lo, hi = NORMAL_STRESS_RANGE_KPA
     if not lo <= sigma <= hi:
         raise InputError(
-            f"lab normal_stress_kpa (line {line} of {path})", sigma, f"[{lo:g}, {hi:g}] kPa",
+            f"lab normal_stress_kpa ({where})", sigma, f"[{lo:g}, {hi:g}] kPa",
             "the range of normal stresses a shear test runs at; is the column in kPa?",
         )  # fmt: skip
 
 
-def check_peak(path: str, line: int, column: str, sigma: float, tau: float) -> None:
+def check_peak(where: str, column: str, sigma: float, tau: float) -> None:
     """A peak shear stress whose ratio to its normal stress is in (0, MAX_STRESS_RATIO]."""
     ratio = tau / sigma
     if not 0.0 < ratio <= MAX_STRESS_RATIO:
         raise InputError(
-            f"lab {column} (line {line} of {path})", tau,
+            f"lab {column} ({where})", tau,
             f"(0, {MAX_STRESS_RATIO:g}] times the normal stress ({sigma:g} kPa)",
             f"tau/sigma = {ratio:.3g}: no soil is that {'weak' if ratio <= 0.0 else 'strong'}",
         )  # fmt: skip
 
 
-def check_curve(path: str, sigma: float, lines: np.ndarray, displacement: np.ndarray) -> None:
-    """One curve's rows in file order: enough of them, displacement strictly rising."""
-    if len(displacement) < MIN_CURVE_POINTS:
-        raise InputError(
-            f"lab curve at {sigma:g} kPa (line {int(lines[0])} of {path})", f"{len(displacement)} reading(s)",
-            f"at least {MIN_CURVE_POINTS} readings (a peak and what follows it)",
-        )  # fmt: skip
-    steps = np.diff(displacement)
-    if np.any(steps <= 0.0):
-        k = int(np.argmax(steps <= 0.0)) + 1
-        raise InputError(
-            f"lab shear_displacement_mm (line {int(lines[k])} of {path})", float(displacement[k]),
-            f"more than {float(displacement[k - 1]):g} (line {int(lines[k - 1])}): a curve's "
-            "displacement rises from row to row",
-        )  # fmt: skip
+def check_lab_values(peaks: dict[float, float], curves: dict[float, tuple[np.ndarray, np.ndarray]]) -> None:
+    """Peaks and curves given in Python (no file lines): the checks a file passes, each named by
+    its normal stress. Curves hold displacement in m, as :class:`~poro2d.shear.lab.LabData` does."""
+    if not peaks:
+        raise InputError("lab peaks", peaks, "at least one normal stress")
+    if curves and set(curves) != set(peaks):
+        raise InputError("lab curves", sorted(curves), f"one curve per peak's normal stress {sorted(peaks)}")
+    for sigma, tau in peaks.items():
+        if not (is_number(sigma) and is_number(tau) and math.isfinite(sigma) and math.isfinite(tau)):
+            raise InputError("lab peaks", {sigma: tau}, "finite numbers: normal stress (kPa) -> peak (kPa)")
+        where = f"the peak at {sigma:g} kPa"
+        check_normal_stress(where, float(sigma))
+        check_peak(where, "peak_shear_stress_kpa", float(sigma), float(tau))
+    for sigma, pair in curves.items():
+        if not (isinstance(pair, tuple | list) and len(pair) == 2):
+            raise InputError(
+                f"lab curve at {sigma:g} kPa", type(pair).__name__, "a pair (displacement m, stress kPa)"
+            )
+        d, t = pair
+        _check_curve_arrays(float(sigma), np.asarray(d, float), np.asarray(t, float))
+        if float(np.max(t)) != float(peaks[sigma]):
+            raise InputError(
+                f"lab peak at {sigma:g} kPa", peaks[sigma], f"its curve's largest reading {np.max(t):g}"
+            )
 
 
-__all__ = ["MAX_STRESS_RATIO", "MIN_CURVE_POINTS", "check_curve", "check_normal_stress", "check_peak"]
+def _check_curve_arrays(sigma: float, d: np.ndarray, t: np.ndarray) -> None:
+    where = f"lab curve at {sigma:g} kPa"
+    if d.ndim != 1 or d.shape != t.shape:
+        raise InputError(where, (d.shape, t.shape), "displacement and shear stress of one length")
+    if len(t) < MIN_CURVE_POINTS:
+        raise InputError(where, f"{len(t)} reading(s)", f"at least {MIN_CURVE_POINTS} readings")
+    top = MAX_DISPLACEMENT_MM * 1e-3 * (1.0 + 1e-12)  # in m; the margin absorbs the mm -> m rounding
+    if (
+        not (np.all(np.isfinite(d)) and np.all(np.isfinite(t)))
+        or d.min() < 0.0
+        or d.max() > top
+        or t.min() < 0.0
+    ):
+        raise InputError(
+            where,
+            "a reading out of range",
+            f"displacement in [0, {MAX_DISPLACEMENT_MM * 1e-3:g}] m, shear stress >= 0",
+        )
+    if np.any(np.diff(d) <= 0.0):
+        raise InputError(
+            where, "displacement that steps back or repeats", "displacement rising from row to row"
+        )
+
+
+__all__ = [
+    "MAX_DISPLACEMENT_MM", "MAX_STRESS_RATIO", "MIN_CURVE_POINTS", "check_lab_values", "check_normal_stress",
+    "check_peak",
+]  # fmt: skip
