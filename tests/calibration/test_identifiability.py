@@ -8,6 +8,7 @@ posterior that is not finite is no answer at all.
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from poro2d.calibration import model, run_calibration
@@ -156,3 +157,10 @@ def test_one_specimen_reports_its_intervals_as_unknown(specimen, lab, tmp_path, 
     printed = capsys.readouterr().out
     assert "interval unknown" in printed and "Not identified" in printed
     assert "narrower than half" not in printed
+    # the box the frictions were fitted in: a few hundred disks is a box-scale box, said at the
+    # command, in the report and in the file
+    radii = np.load(specimen)["particles.radius"]
+    assert res.box_scale.disks == radii.size and res.box_scale.d_max_m == 2 * radii.max()
+    assert res.box_scale.box_scale and kept["box_scale"]["box_scale"] is True
+    assert "fitted to a box-scale box" in printed
+    assert "fitted to a box-scale box" in (out / "calibration.md").read_text()

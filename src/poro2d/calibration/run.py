@@ -34,6 +34,7 @@ from poro2d.execute.dask_cluster import check_reachable
 from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import holds_output
 from poro2d.paper_data import QUICK_SHEAR
+from poro2d.shear.box_scale import BoxScale, box_scale
 from poro2d.shear.lab import LabData, read_lab_csv
 from poro2d.shear.parts import LabRecord, ShearSettingsRecord
 from poro2d.shear.series import check_stresses
@@ -155,7 +156,9 @@ class CalibrationResult(TypedResult):
     ``intervals``: central credible intervals at ``level``; ``posterior``: its correlation
     (near +-1: a ridge), whether each interval is wide, the observables fitted;
     ``evaluations``: one :class:`DesignPoint` per design point (each observable's replicate values);
-    ``fit``: the surrogate per observable; ``lab``: the laboratory values fitted.
+    ``fit``: the surrogate per observable; ``lab``: the laboratory values fitted;
+    ``box_scale``: the smallest box of the specimens against ASTM D3080 and the size-insensitive
+    2D box: parameters fitted to a box-scale box carry its biases (docs/shear.md).
     """
 
     best: FrictionValues
@@ -176,8 +179,9 @@ class CalibrationResult(TypedResult):
     #: why the intervals are unknown (then ``intervals`` and ``posterior["wide"]`` hold None);
     #: absent from the file of a calibration whose design estimates its own noise
     unidentified: str | None = None
+    box_scale: BoxScale | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("unidentified",)
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("unidentified", "box_scale")
     #: the fields read as their records from a file's dict (``fit``: a surrogate per observable)
     PARTS: ClassVar[dict[str, type[TypedResult] | Keyed]] = {
         "best": FrictionValues,
@@ -192,6 +196,7 @@ class CalibrationResult(TypedResult):
         "failures": UnitFailure,
         "fit": Keyed(SurrogateRecord),
         "evaluations": DesignPoint,
+        "box_scale": BoxScale,
     }
 
     @classmethod
@@ -372,6 +377,12 @@ def run_calibration(
     return result
 
 
+def smallest_box(found: SpecimenSet) -> BoxScale:
+    """The :class:`BoxScale` of the narrowest box (in largest grains) among the read specimens."""
+    scales = [box_scale(*s.box(), s.arrays["particles.radius"]) for s in found.contents()]
+    return min(scales, key=lambda b: b.width_over_d_max)
+
+
 def _child(store: Store | None, name: str) -> Store | None:
     return None if store is None else store.child(name)
 
@@ -520,6 +531,7 @@ def _result(
         config=dict(config, points=points, refine=refine, design_seed=design_seed, lab_error=lab_error),
         provenance=Provenance.now(),
         unidentified=unknown,
+        box_scale=smallest_box(found),
     )
 
 

@@ -109,11 +109,13 @@ def register(app: typer.Typer) -> None:
 
 
 def print_result(result, out: Path) -> None:
-    from poro2d.report.calibration_report import identifiability_note, interval_text
+    from poro2d.report.calibration_report import box_note, identifiability_note, interval_text
 
     for name, label in (("particle_friction", "f_p"), ("rolling_friction", "mu_r")):
         console.print(f"  {label:<5} {interval_text(result, name)}")
     console.print(f"  {identifiability_note(result)}")
+    if box_note(result):
+        console.print(f"  {box_note(result)}")
     console.print(
         f"results in {out}/result.json; config {out}/calibrated.toml; report {out}/calibration.html"
     )

@@ -44,6 +44,17 @@ def identifiability_note(result) -> str:
     return text
 
 
+def box_note(result) -> str | None:
+    """The box the frictions were fitted in, in one line (None for a file written before boxes were
+    recorded): parameters fitted to a box-scale box carry its biases (docs/shear.md)."""
+    scale = result.get("box_scale")
+    if scale is None:  # the shear package's BoxScale (a result read back through its class)
+        return None
+    fitted = "fitted to a box-scale box: they carry its biases" if scale.box_scale else "fitted"
+    warning = f" Warning: {scale.warning()}." if scale.warning() else ""
+    return f"{scale.note()}; the frictions are {fitted}.{warning}"
+
+
 def calibration_blocks(result, out: Path) -> list[tuple]:
     """The section's blocks: best values, identifiability, the fit table and the two figures."""
     rows = [
@@ -66,6 +77,7 @@ def calibration_blocks(result, out: Path) -> list[tuple]:
             ],
         ),
         ("p", identifiability_note(result)),
+        *([("p", box_note(result))] if box_note(result) else []),
         (
             "table",
             ["observable", "normal stress (kPa)", "laboratory (kPa)", "model (kPa)", "noise sd (kPa)"],
@@ -93,4 +105,10 @@ def write_calibration_report(out: Path, result) -> list[Path]:
     return write_report(calibration_blocks(result, out), out, "calibration", "poro2d calibration")
 
 
-__all__ = ["calibration_blocks", "interval_text", "identifiability_note", "write_calibration_report"]
+__all__ = [
+    "box_note",
+    "calibration_blocks",
+    "interval_text",
+    "identifiability_note",
+    "write_calibration_report",
+]
