@@ -92,6 +92,7 @@ class SeedSummary(TypedResult):
     solid_fraction: float
     inertial_number: float
     coordination: float
+    normal_stress_kpa: float
     steady: bool
     wall_time_s: float
 

@@ -220,6 +220,7 @@ def summarize(cases, tests, workers, wall, config) -> CriticalStateResult:
             solid_fraction=t.solid_fraction,
             inertial_number=t.inertial_number,
             coordination=t.coordination,
+            normal_stress_kpa=t.normal_stress_kpa,
             steady=t.steady,
             wall_time_s=t.wall_time_s,
         )
