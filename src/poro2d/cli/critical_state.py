@@ -126,6 +126,9 @@ def print_result(result, out: Path) -> None:
             f"{s.wall_time_s:.0f}",
         )
     console.print(t)
+    for s in result.summaries:
+        if not s.steady:
+            console.print(f"[yellow]seed {s.seed}: {s.note}[/]")
     c = result.case
     console.print(
         f"periodic cell (Lees-Edwards), f_p = {c.particle_friction:g}, mu_r = {c.rolling_friction:g}, "

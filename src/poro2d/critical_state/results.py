@@ -82,7 +82,7 @@ class Spread(TypedResult):
 
 @dataclass(eq=False)
 class SeedSummary(TypedResult):
-    """One seed's row of a study's ``result.json``."""
+    """One seed's row of a study's ``result.json`` (``note``: steady, or which drift was too large)."""
 
     seed: int
     disks: int
@@ -93,7 +93,10 @@ class SeedSummary(TypedResult):
     inertial_number: float
     coordination: float
     normal_stress_kpa: float
+    stress_ratio_drift: float
+    solid_fraction_drift: float
     steady: bool
+    note: str
     wall_time_s: float
 
 

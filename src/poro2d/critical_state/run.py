@@ -221,7 +221,10 @@ def summarize(cases, tests, workers, wall, config) -> CriticalStateResult:
             inertial_number=t.inertial_number,
             coordination=t.coordination,
             normal_stress_kpa=t.normal_stress_kpa,
+            stress_ratio_drift=t.stress_ratio_drift,
+            solid_fraction_drift=t.solid_fraction_drift,
             steady=t.steady,
+            note=t.note,
             wall_time_s=t.wall_time_s,
         )
         for c, t in zip(cases, tests, strict=True)

@@ -75,7 +75,11 @@ def read_steady(
         )
     note = "steady: no drift of the stress ratio or the solid fraction over the window"
     if problems:
-        note = "not steady: " + "; ".join(problems) + " (shear further: a larger strain)"
+        note = (
+            "not steady: "
+            + "; ".join(problems)
+            + " (a larger strain, or more disks: a small cell's slow swings read as drift)"
+        )
     return SteadyState(
         stress_ratio=float(tau.mean() / sig.mean()),
         stress_ratio_se=_block_se(mu_blocks),
