@@ -141,3 +141,42 @@ def test_a_blocks_stress_is_the_love_weber_sum_of_its_contacts():
 def test_a_cell_too_small_for_one_image_per_pair_is_refused():
     with pytest.raises(InputError, match="cell width"):
         cell_of([1e-3, 1e-3], [[0.001, 0.001], [0.003, 0.003]], 0.004, 0.02)
+
+
+def test_a_pair_through_the_edge_moves_as_the_walled_engine_moves_it_in_the_open():
+    """An oblique impact with spin (sliding, rolling and the dashpot all at work): the same pair in
+    the walled engine (no walls, no gravity, no local damping) and through the periodic cell's
+    x edge keep the same branch vector, velocities and spins step for step."""
+    from poro2d.dem import Particles, Simulation
+
+    r = np.array([1.0e-3, 1.3e-3])
+    law = CellLaw(kn=KN, ks=KN, friction=0.3, rolling_friction=0.2, restitution=0.5)
+    vel = np.array([[-0.2, 0.05], [0.3, -0.04]])  # closing along x, sliding along y
+    omega = np.array([40.0, -25.0])
+    particles = Particles(
+        pos=np.array([[0.0100, 0.0100], [0.0100 - 0.00232, 0.0101]]),
+        radius=r,
+        density=np.full(2, RHO),
+        thickness=T,
+        kn=np.full(2, 2 * KN),
+        ks=np.full(2, 2 * KN),
+        mu=np.full(2, 0.3),
+        vel=vel.copy(),
+        omega=omega.copy(),
+        mu_r=np.full(2, 0.2),
+    )
+    cell = cell_of(r, [[0.0004, 0.0100], [0.0004 - 0.00232 + 0.02, 0.0101]], law=law)
+    sim = Simulation(particles, gravity=(0.0, 0.0), local_damping=0.0, restitution=0.5, dt=cell.dt)
+    cell.vel[:] = vel
+    cell.omega[:] = omega
+    cell.hold()
+    touched = 0
+    for _ in range(60):
+        sim.run(1)
+        touched += cell.run(1).coordination > 0.0
+        branch = cell.pos[1] - cell.pos[0] - [cell.width, 0.0]
+        np.testing.assert_allclose(branch, sim.particles.pos[1] - sim.particles.pos[0], rtol=1e-9, atol=1e-15)
+        np.testing.assert_allclose(cell.vel, sim.particles.vel, rtol=1e-9, atol=1e-12)
+        np.testing.assert_allclose(cell.omega, sim.particles.omega, rtol=1e-9, atol=1e-9)
+    assert 5 < touched < 60  # they met and parted
+    assert np.all(np.abs(cell.omega - omega) > 1.0)  # the contact turned both disks
