@@ -66,6 +66,8 @@ def register(app: typer.Typer) -> None:
         except InputError as exc:
             raise InputError("--grading", grading, exc.allowed) from None
         n = check_int("--seeds", seeds, 1, MAX_SEEDS)
+        if processes is not None:
+            check_int("--processes", processes, 1, 64)
         options = {
             "disks": disks,
             "particle_friction": particle_friction,
