@@ -109,6 +109,7 @@ def test_draw_disks_ceiling_uses_the_expected_count():
         ["paper", "--quick", "--quiet", "--out"],
         ["shear", "--specimen", "nowhere.npz", "--out"],
         ["plot", "relations", "-o"],
+        ["critical-state", "--quiet", "--out"],
     ],
 )
 def test_out_that_is_a_file(argv, tmp_path, capsys):

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import pytest
 
+import poro2d.critical_state as critical_state
 import poro2d.execute.dask_cluster as dask_cluster
 import poro2d.sweep.density as density_sweep
 import poro2d.sweep.runner as runner
@@ -197,6 +198,13 @@ CASES = [
     (["relation", "-o", "a", "--out", "b"], ["--out = '-o a, --out b'"]),
     (["plot", "relations", "-o", "a", "--out-dir", "b"], ["--out-dir = '-o a, --out-dir b'"]),
     (["criterion", "--quiet", "--quiet"], ["--quiet = '--quiet, --quiet'"]),
+    (["critical-state", "--disks", "5"], ["--disks = 5", "[200, 20000]"]),
+    (["critical-state", "--rolling-friction", "3"], ["--rolling-friction"]),
+    (["critical-state", "--inertial", "0.5"], ["--inertial = 0.5"]),
+    (["critical-state", "--strain", "1", "--window-start", "2"], ["--strain"]),
+    (["critical-state", "--seeds", "0"], ["--seeds = 0"]),
+    (["critical-state", "--processes", "0"], ["--processes = 0"]),
+    (["critical-state", "--grading", "loam"], ["--grading = 'loam'", "wide_cu4"]),
     (["nosuchcommand"], ["nosuchcommand"]),
 ]
 
@@ -213,6 +221,7 @@ def no_work(monkeypatch):
     monkeypatch.setattr(PorosityCriterion, "run", work)
     monkeypatch.setattr(ShearSeries, "run", work)
     monkeypatch.setattr(ReplicateShear, "run", work)
+    monkeypatch.setattr(critical_state, "run_critical_states", work)
 
 
 def _write_files(folder) -> None:

@@ -55,6 +55,7 @@ def _register() -> None:
         calibrate,
         convert,
         criterion,
+        critical_state,
         export,
         import_specimen,
         paper,
@@ -72,6 +73,7 @@ def _register() -> None:
     criterion.register(app)
     shear.register(app)
     biaxial.register(app)
+    critical_state.register(app)
     strength.register(app)
     paper.register(app)
     sweep.register(app)

@@ -1,0 +1,134 @@
+"""A critical-state case: everything one periodic shear run depends on, as one frozen value.
+
+The grading and the number of disks make the packing (radii drawn by
+:func:`poro2d.grading.draw_disks` from the seed); the micro-parameters are the particle
+friction ``f_p`` and the rolling friction ``mu_r`` (against R = r_i r_j / (r_i + r_j), as the
+engine writes it); the loading is the normal pressure ``P`` held by the barostat and the
+inertial number ``I = gamma_dot d_mean sqrt(rho / P)`` that sets the shear rate. Contact
+stiffnesses and density are Table 1's, as the direct shear test uses them (per body, combined
+in series: 2e5 N/m per contact). Cases for several seeds come from one with :meth:`with_seed`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field, replace
+
+from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
+from poro2d.errors import InputError, Integer, Real, check_fields
+from poro2d.grading import GradingCurve, paper_grading
+from poro2d.paper_data import TABLE_1
+from poro2d.typed_result import TypedResult
+
+#: disks of the cell: below about 200 the stress ratio's fluctuations swamp its mean; above
+#: 20000 one run takes hours on one thread
+DISKS_RANGE = (200, 20_000)
+#: the inertial numbers a case may ask for: quasi-static below 1e-3, dense flow up to 0.1
+INERTIAL_RANGE = (1e-5, 0.1)
+#: disk thickness (m), that of the specimens (SpecimenSpec): masses and stresses per volume
+THICKNESS = 0.008
+
+CASE_RANGES = {
+    "disks": Integer(*DISKS_RANGE),
+    "particle_friction": Real(0.0, 10.0),
+    "rolling_friction": Real(0.0, MAX_ROLLING_FRICTION),
+    "pressure_kpa": Real(1.0, 10_000.0),
+    "inertial_number": Real(*INERTIAL_RANGE),
+    "strain": Real(0.5, 100.0),
+    "window_start": Real(0.0, 99.0),
+    "seed": Integer(0, 2**31 - 1),
+    "kn_particle": Real(0.0, None, lo_open=True),
+    "ks_particle": Real(0.0, None, lo_open=True),
+    "solid_density": Real(0.0, None, lo_open=True),
+    "restitution": Real(0.1, 1.0),
+    "dt_safety": Real(0.0, 1.0, lo_open=True),
+    "barostat_time": Real(1.0, 1000.0),
+    "record_strain": Real(1e-4, 0.1),
+    "blocks": Integer(3, 100),
+    "mu_drift_limit": Real(0.0, 1.0, lo_open=True),
+    "solid_drift_limit": Real(0.0, 0.1, lo_open=True),
+}
+
+
+@dataclass(frozen=True)
+class CriticalStateCase:
+    """One periodic shear run (SI but the pressure in kPa; strains are shear strains gamma).
+
+    disks: about how many disks (the drawn total area is ``disks`` mean disk areas); strain:
+    gamma at which the run ends; window_start: gamma where the steady-state window begins
+    (it ends at ``strain``); restitution: of the contact dashpot (no local damping, which
+    would drag the flow); barostat_time: the barostat's relaxation time in sound-crossing times
+    of the cell (slow enough not to ring); record_strain: gamma between two rows of the
+    series; blocks: the window is cut into this many blocks for the standard error;
+    mu_drift_limit and solid_drift_limit: the largest change over the window (a least-squares
+    slope times its width) of the stress ratio and the solid fraction for a steady state.
+    """
+
+    grading: GradingCurve = field(default_factory=paper_grading)
+    disks: int = 1500
+    particle_friction: float = 0.5
+    rolling_friction: float = 0.0
+    pressure_kpa: float = 100.0
+    inertial_number: float = 1e-3
+    strain: float = 3.0
+    window_start: float = 1.0
+    seed: int = 0
+    kn_particle: float = TABLE_1.kn_particle
+    ks_particle: float = TABLE_1.ks_particle
+    solid_density: float = TABLE_1.solid_density
+    restitution: float = 0.5
+    dt_safety: float = 0.8
+    barostat_time: float = 4.0
+    record_strain: float = 0.01
+    blocks: int = 5
+    mu_drift_limit: float = 0.03
+    solid_drift_limit: float = 0.005
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.grading, GradingCurve):
+            raise InputError("grading", type(self.grading).__name__, "a GradingCurve")
+        check_fields(self, CASE_RANGES)
+        width = self.strain - self.window_start
+        if width < self.blocks * self.record_strain * 3:
+            least = self.window_start + self.blocks * self.record_strain * 3
+            raise InputError("strain", self.strain, f">= {least:g} (3 rows a block after window_start)")
+
+    def with_seed(self, seed: int) -> CriticalStateCase:
+        return replace(self, seed=seed)
+
+    def record(self) -> CaseRecord:
+        """The case as a result file keeps it (the grading as its model sizes and source)."""
+        values = asdict(self)
+        values["grading"] = {
+            "sizes_m": list(self.grading.sizes_m),
+            "percent_passing": list(self.grading.percent_passing),
+            "source": self.grading.source,
+        }
+        return CaseRecord(**values)
+
+
+@dataclass(eq=False)
+class CaseRecord(TypedResult):
+    """:class:`CriticalStateCase` as a result file keeps it (every field, in its order)."""
+
+    grading: dict
+    disks: int
+    particle_friction: float
+    rolling_friction: float
+    pressure_kpa: float
+    inertial_number: float
+    strain: float
+    window_start: float
+    seed: int
+    kn_particle: float
+    ks_particle: float
+    solid_density: float
+    restitution: float
+    dt_safety: float
+    barostat_time: float
+    record_strain: float
+    blocks: int
+    mu_drift_limit: float
+    solid_drift_limit: float
+
+
+__all__ = ["CASE_RANGES", "CaseRecord", "CriticalStateCase", "DISKS_RANGE", "INERTIAL_RANGE", "THICKNESS"]

@@ -1,0 +1,151 @@
+"""Typed results of the periodic reference: one run's ``result.json`` and a study's over seeds."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+
+from poro2d.critical_state.case import CaseRecord
+from poro2d.critical_state.series import CellSeries
+from poro2d.io_utils import Provenance
+from poro2d.typed_result import NOT_IN_FILE, TypedResult
+
+
+@dataclass(eq=False)
+class CriticalStateTestResult(TypedResult):
+    """One periodic shear run: its steady state over the window and how it was reached.
+
+    stress_ratio = tau / sigma_yy over the window with its standard error over blocks,
+    friction_angle_deg = atan of it; solid_fraction likewise; inertial_number the one reached
+    (at the measured sigma_yy), coordination 2 N_c / N; the drifts and ``steady`` as
+    :mod:`poro2d.critical_state.steady` reads them (``note`` says why not). ``series`` (not in
+    the file): the rows as arrays.
+    """
+
+    stress_ratio: float
+    stress_ratio_se: float
+    friction_angle_deg: float
+    solid_fraction: float
+    solid_fraction_se: float
+    inertial_number: float
+    coordination: float
+    normal_stress_kpa: float
+    stress_ratio_drift: float
+    solid_fraction_drift: float
+    steady: bool
+    note: str
+    window: list[float]
+    rows: int
+    disks: int
+    mean_diameter_m: float
+    cell_width_m: float
+    cell_height_m: float
+    shear_rate_per_s: float
+    dt_s: float
+    compression_steps: int
+    shear_steps: int
+    rebuilds: int
+    wall_time_s: float
+    particle_steps_per_s: float
+    case: CaseRecord
+    provenance: Provenance
+    series: CellSeries | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
+
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"case": CaseRecord, "provenance": Provenance}
+
+
+@dataclass(eq=False)
+class Spread(TypedResult):
+    """One number over the seeds: mean, sd (None for one seed), min, max and each value."""
+
+    mean: float
+    sd: float | None
+    min: float
+    max: float
+    values: list[float]
+
+    @classmethod
+    def of(cls, values: list[float]) -> Spread:
+        v = np.asarray(values, float)
+        sd = float(v.std(ddof=1)) if v.size > 1 else None
+        return cls(float(v.mean()), sd, float(v.min()), float(v.max()), [float(x) for x in v])
+
+    def text(self, digits: int = 3) -> str:
+        """``0.276 +- 0.004 (0.271-0.280)``, or ``0.276`` for one value."""
+        if self.sd is None or not math.isfinite(self.sd):
+            return f"{self.mean:.{digits}f}"
+        return f"{self.mean:.{digits}f} +- {self.sd:.{digits}f} ({self.min:.{digits}f}-{self.max:.{digits}f})"
+
+
+@dataclass(eq=False)
+class SeedSummary(TypedResult):
+    """One seed's row of a study's ``result.json`` (``note``: steady, or which drift was too large)."""
+
+    seed: int
+    disks: int
+    stress_ratio: float
+    stress_ratio_se: float
+    friction_angle_deg: float
+    solid_fraction: float
+    inertial_number: float
+    coordination: float
+    normal_stress_kpa: float
+    stress_ratio_drift: float
+    solid_fraction_drift: float
+    steady: bool
+    note: str
+    wall_time_s: float
+
+
+@dataclass(eq=False)
+class CriticalStateResult(TypedResult):
+    """Periodic shear runs of one case on several seeds (the study's ``result.json``).
+
+    Each number's spread over the seeds (:class:`Spread`); ``steady`` only if every seed's
+    window was steady (``note`` says which was not). ``tests`` (not in the file): each seed's
+    full result with its series.
+    """
+
+    seeds: list[int]
+    stress_ratio: Spread
+    friction_angle_deg: Spread
+    solid_fraction: Spread
+    inertial_number: Spread
+    coordination: Spread
+    steady: bool
+    note: str
+    summaries: list[SeedSummary]
+    case: CaseRecord
+    processes: int
+    wall_time_s: float
+    config: dict[str, Any]
+    provenance: Provenance
+    tests: list[CriticalStateTestResult] = field(
+        default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
+    )
+
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "stress_ratio": Spread,
+        "friction_angle_deg": Spread,
+        "solid_fraction": Spread,
+        "inertial_number": Spread,
+        "coordination": Spread,
+        "summaries": SeedSummary,
+        "case": CaseRecord,
+        "provenance": Provenance,
+    }
+
+    def headline(self) -> str:
+        """The steady-state friction (tau/sigma and angle) and solid fraction with their spread."""
+        n = len(self.seeds)
+        state = "critical state" if self.steady else "end state (NOT STEADY)"
+        return (
+            f"{state}: tau/sigma = {self.stress_ratio.text()}, phi = {self.friction_angle_deg.text(1)} deg, "
+            f"solid fraction = {self.solid_fraction.text()} ({n} seed{'s' if n > 1 else ''})"
+        )
+
+
+__all__ = ["CriticalStateResult", "CriticalStateTestResult", "SeedSummary", "Spread"]

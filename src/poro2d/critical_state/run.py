@@ -1,0 +1,253 @@
+"""``run_critical_state``: one periodic shear run; ``run_critical_states``: its spread over seeds.
+
+A run builds the case's cell (:mod:`poro2d.critical_state.cell`), compresses it to the
+pressure, then shears it at the rate of the case's inertial number with the height servoed
+to the pressure, recording a row every ``record_strain``; the steady state is read over the
+window (:mod:`poro2d.critical_state.steady`). Every input is checked (the case's own
+``__post_init__``) before any work. Seeds run as jobs of the one executor, on local processes.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from poro2d.critical_state.case import CriticalStateCase
+from poro2d.critical_state.cell import barostat_gain, compress, loose_cell, mean_diameter, shear_rate
+from poro2d.critical_state.results import CriticalStateResult, CriticalStateTestResult, SeedSummary, Spread
+from poro2d.critical_state.series import COLUMNS, CellSeries, row_of
+from poro2d.critical_state.steady import read_steady
+from poro2d.errors import InputError, check_int
+from poro2d.execute import Backend, Executor, Failed, Job, results_or_raise
+from poro2d.io_utils import Provenance, as_json, check_output_dir
+from poro2d.locks import output_folder
+from poro2d.progress import JobsProgress
+from poro2d.report.critical_state_figures import plot_critical_state
+from poro2d.store import Store
+
+#: the most seeds one call runs
+MAX_SEEDS = 50
+#: the figure of a run or a study
+FIGURE = "critical_state.png"
+#: the share of the progress bar the compression takes (the rest is the shear)
+COMPRESS_SHARE = 0.05
+
+Report = Callable[[str, float], None]
+
+
+def _shear(cell, case: CriticalStateCase, rate: float, report: Report | None) -> tuple[CellSeries, int, int]:
+    """Shear to the case's strain, a row every record_strain; returns the series, steps, rebuilds."""
+    pressure = case.pressure_kpa * 1e3
+    cell.shear(rate, pressure, barostat_gain(cell, case), rate)
+    per_row = max(1, round(case.record_strain / (rate * cell.dt)))
+    rows_total = math.ceil(case.strain / (per_row * rate * cell.dt))
+    rows, steps, rebuilds, d = [], 0, 0, mean_diameter(cell)
+    for k in range(rows_total):
+        block = cell.run(per_row)
+        steps += per_row
+        rebuilds += block.rebuilds
+        rows.append(row_of(cell.strain, block, rate, d, case.solid_density))
+        if report is not None:
+            report("shear", COMPRESS_SHARE + (1.0 - COMPRESS_SHARE) * (k + 1) / rows_total)
+    return CellSeries.of_rows(rows), steps, rebuilds
+
+
+def run_critical_state(
+    case: CriticalStateCase, store: Store | None = None, *, report: Report | None = None
+) -> CriticalStateTestResult:
+    """One periodic shear run of ``case``: its steady state, the series, the figure.
+
+    ``store``: where ``result.json``, ``series.csv`` and ``critical_state.png`` go (None: nothing
+    kept). ``report(phase, fraction)``: told how far the run is. Raises RuntimeError if the
+    compression does not reach the pressure.
+    """
+    if not isinstance(case, CriticalStateCase):
+        raise InputError("case", type(case).__name__, "a CriticalStateCase")
+    if store is not None and not isinstance(store, Store):
+        raise InputError("store", type(store).__name__, "a poro2d.store.Store or None")
+    t0 = time.perf_counter()
+    cell = loose_cell(case)
+    compression = compress(
+        cell, case, None if report is None else lambda f: report("compress", COMPRESS_SHARE * f)
+    )
+    rate = shear_rate(cell, case)
+    series, steps, rebuilds = _shear(cell, case, rate, report)
+    wall = time.perf_counter() - t0
+    state = read_steady(series, case.window_start, case.blocks, case.mu_drift_limit, case.solid_drift_limit)
+    result = CriticalStateTestResult(
+        stress_ratio=state.stress_ratio,
+        stress_ratio_se=state.stress_ratio_se,
+        friction_angle_deg=state.friction_angle_deg,
+        solid_fraction=state.solid_fraction,
+        solid_fraction_se=state.solid_fraction_se,
+        inertial_number=state.inertial_number,
+        coordination=state.coordination,
+        normal_stress_kpa=state.normal_stress_kpa,
+        stress_ratio_drift=state.stress_ratio_drift,
+        solid_fraction_drift=state.solid_fraction_drift,
+        steady=state.steady,
+        note=state.note,
+        window=[case.window_start, float(series.gamma[-1])],
+        rows=state.rows,
+        disks=cell.n,
+        mean_diameter_m=mean_diameter(cell),
+        cell_width_m=cell.width,
+        cell_height_m=cell.height,
+        shear_rate_per_s=rate,
+        dt_s=cell.dt,
+        compression_steps=compression,
+        shear_steps=steps,
+        rebuilds=rebuilds,
+        wall_time_s=wall,
+        particle_steps_per_s=cell.n * (compression + steps) / wall,
+        case=case.record(),
+        provenance=Provenance.now(),
+    )
+    stored = CriticalStateTestResult.from_dict(as_json(result))
+    stored.series = series
+    if store is not None:
+        store.write_csv("series.csv", series.rows(), header=list(COLUMNS))
+        plot_critical_state(
+            [(f"seed {case.seed}", series)], store.path(FIGURE), title=_title(case), window=case.window_start
+        )
+        store.write_result("result.json", stored)
+    return stored
+
+
+def _title(case: CriticalStateCase) -> str:
+    return (
+        f"periodic shear: f_p = {case.particle_friction:g}, mu_r = {case.rolling_friction:g}, "
+        f"P = {case.pressure_kpa:g} kPa, I = {case.inertial_number:g}, {case.disks} disks"
+    )
+
+
+@dataclass(frozen=True)
+class SeedJob:
+    """One seed's run (a value that pickles: a worker process runs it)."""
+
+    case: CriticalStateCase
+    label: str
+
+
+def _run_job(job: SeedJob, report) -> CriticalStateTestResult:
+    return run_critical_state(job.case, report=report)
+
+
+def run_critical_states(
+    case: CriticalStateCase,
+    store: Store | None = None,
+    *,
+    seeds: int = 3,
+    processes: int | None = None,
+    progress: bool = False,
+    config: dict | None = None,
+) -> CriticalStateResult:
+    """``case`` on ``seeds`` seeds (case.seed, case.seed + 1, ...): each number's spread over them.
+
+    ``store``: where ``result.json``, ``series.csv`` (every seed's rows) and the figure go;
+    ``processes``: worker processes (default one per seed, at most the CPU count). Several
+    processes spawn workers that import the calling script: call it under
+    ``if __name__ == "__main__":`` in a script.
+    """
+    if not isinstance(case, CriticalStateCase):
+        raise InputError("case", type(case).__name__, "a CriticalStateCase")
+    n = check_int("seeds", seeds, 1, MAX_SEEDS)
+    if case.seed + n - 1 > 2**31 - 1:
+        raise InputError("seeds", n, f"at most {2**31 - case.seed} from seed {case.seed}")
+    if store is not None and not isinstance(store, Store):
+        raise InputError("store", type(store).__name__, "a poro2d.store.Store or None")
+    workers = (
+        check_int("processes", processes, 1, 64) if processes is not None else min(n, os.cpu_count() or 1)
+    )
+    cases = [case.with_seed(case.seed + k) for k in range(n)]
+    if store is None:
+        return _study(cases, None, workers, progress, config)
+    check_output_dir(store.parameter, store.root)
+    with output_folder(store.parameter, store.root, kind="critical-state"):
+        return _study(cases, store, workers, progress, config)
+
+
+def _study(cases, store, workers, progress, config) -> CriticalStateResult:
+    t0 = time.perf_counter()
+    jobs = [SeedJob(c, f"seed {c.seed}") for c in cases]
+    with JobsProgress("critical state", [j.label for j in jobs], enabled=progress) as bars:
+
+        def ended(index: int, outcome) -> None:
+            if not isinstance(outcome, Failed):
+                bars.done(index)
+
+        outcomes = Executor(Backend.local(workers)).map(
+            [Job(_run_job, (job,), job.label, reports=True) for job in jobs],
+            on_report=bars.update,
+            on_done=ended,
+        )
+        tests: list[CriticalStateTestResult] = results_or_raise(outcomes, "periodic shear run(s)")
+    result = summarize(cases, tests, workers, time.perf_counter() - t0, config)
+    if store is not None:
+        rows = [{"seed": c.seed, **r} for c, t in zip(cases, tests, strict=True) for r in t.series.rows()]
+        store.write_csv("series.csv", rows, header=["seed", *COLUMNS])
+        plot_critical_state(
+            [(f"seed {c.seed}", t.series) for c, t in zip(cases, tests, strict=True)],
+            store.path(FIGURE),
+            title=_title(cases[0]),
+            window=cases[0].window_start,
+            steady=(result.stress_ratio.mean, result.solid_fraction.mean),
+        )
+        store.write_result("result.json", result)
+    return result
+
+
+def summarize(cases, tests, workers, wall, config) -> CriticalStateResult:
+    """The study's result from its seeds' results."""
+    missed = [c.seed for c, t in zip(cases, tests, strict=True) if not t.steady]
+    note = (
+        "every seed reached a steady state"
+        if not missed
+        else (
+            f"not steady for seed(s) {', '.join(map(str, missed))}: their numbers are not the critical state"
+        )
+    )
+    summaries = [
+        SeedSummary(
+            seed=c.seed,
+            disks=t.disks,
+            stress_ratio=t.stress_ratio,
+            stress_ratio_se=t.stress_ratio_se,
+            friction_angle_deg=t.friction_angle_deg,
+            solid_fraction=t.solid_fraction,
+            inertial_number=t.inertial_number,
+            coordination=t.coordination,
+            normal_stress_kpa=t.normal_stress_kpa,
+            stress_ratio_drift=t.stress_ratio_drift,
+            solid_fraction_drift=t.solid_fraction_drift,
+            steady=t.steady,
+            note=t.note,
+            wall_time_s=t.wall_time_s,
+        )
+        for c, t in zip(cases, tests, strict=True)
+    ]
+    result = CriticalStateResult(
+        seeds=[c.seed for c in cases],
+        stress_ratio=Spread.of([t.stress_ratio for t in tests]),
+        friction_angle_deg=Spread.of([t.friction_angle_deg for t in tests]),
+        solid_fraction=Spread.of([t.solid_fraction for t in tests]),
+        inertial_number=Spread.of([t.inertial_number for t in tests]),
+        coordination=Spread.of([t.coordination for t in tests]),
+        steady=not missed,
+        note=note,
+        summaries=summaries,
+        case=cases[0].record(),
+        processes=workers,
+        wall_time_s=wall,
+        config=config or {},
+        provenance=Provenance.now(),
+    )
+    stored = CriticalStateResult.from_dict(as_json(result))
+    stored.tests = list(tests)
+    return stored
+
+
+__all__ = ["MAX_SEEDS", "SeedJob", "run_critical_state", "run_critical_states"]

@@ -1,0 +1,73 @@
+"""The time series of a periodic shear run: one row per ``record_strain`` of shear strain.
+
+Each row holds the means over the steps since the previous row: stresses from the
+Love-Weber contact sum plus the kinetic part (kPa, compression positive for the normal
+stresses, the shear stress tau = sigma_xy with the sign that makes the stress ratio
+tau / sigma_yy positive in the direction of shearing), the solid fraction, the inertial
+number actually reached, I = gamma_dot d sqrt(rho / sigma_yy), and the coordination 2 N_c / N.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+#: the columns of ``series.csv``, in the order of :class:`CellSeries`' fields
+COLUMNS = (
+    "gamma",
+    "stress_ratio",
+    "normal_stress_kpa",
+    "shear_stress_kpa",
+    "mean_stress_kpa",
+    "solid_fraction",
+    "inertial_number",
+    "coordination",
+)
+
+
+@dataclass(frozen=True, eq=False)
+class CellSeries:
+    """The rows of a run as arrays (one entry per row)."""
+
+    gamma: np.ndarray
+    stress_ratio: np.ndarray
+    normal_stress_kpa: np.ndarray
+    shear_stress_kpa: np.ndarray
+    mean_stress_kpa: np.ndarray
+    solid_fraction: np.ndarray
+    inertial_number: np.ndarray
+    coordination: np.ndarray
+
+    @classmethod
+    def of_rows(cls, rows: list[dict[str, float]]) -> CellSeries:
+        return cls(**{c: np.array([r[c] for r in rows], dtype=float) for c in COLUMNS})
+
+    def rows(self) -> list[dict[str, float]]:
+        """One dict per row (the CSV's)."""
+        cols = [getattr(self, f.name) for f in fields(self)]
+        return [dict(zip(COLUMNS, (float(c[k]) for c in cols), strict=True)) for k in range(self.gamma.size)]
+
+    def window(self, start: float) -> np.ndarray:
+        """The rows at gamma >= start (a boolean mask)."""
+        return self.gamma >= start
+
+
+def row_of(gamma: float, block, shear_rate: float, d_mean: float, density: float) -> dict[str, float]:
+    """A row from a block of the cell (:class:`poro2d.dem.periodic.CellBlock`)."""
+    s = block.stress
+    syy = -float(s[1, 1])
+    inertial = shear_rate * d_mean * float(np.sqrt(density / syy)) if syy > 0.0 else float("inf")
+    return {
+        "gamma": gamma,
+        "stress_ratio": block.stress_ratio,
+        "normal_stress_kpa": syy / 1e3,
+        "shear_stress_kpa": float(s[0, 1]) / 1e3,
+        "mean_stress_kpa": -0.5 * float(s[0, 0] + s[1, 1]) / 1e3,
+        "solid_fraction": block.solid_fraction,
+        "inertial_number": inertial,
+        "coordination": block.coordination,
+    }
+
+
+__all__ = ["COLUMNS", "CellSeries", "row_of"]

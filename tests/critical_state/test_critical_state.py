@@ -1,0 +1,136 @@
+"""The critical-state protocol: same seed same numbers, the steady-state reading, refusals, files."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from poro2d.cli import main
+from poro2d.critical_state import CriticalStateCase, CriticalStateTestResult, run_critical_state
+from poro2d.critical_state.series import COLUMNS, CellSeries
+from poro2d.critical_state.steady import read_steady
+from poro2d.errors import InputError
+from poro2d.store import Store
+
+#: a small fast case: 200 disks sheared at I = 0.01 to gamma 0.6 (a few seconds)
+SMALL = {"disks": 200, "inertial_number": 1e-2, "strain": 0.6, "window_start": 0.3, "blocks": 3}
+
+
+def test_the_same_seed_gives_the_same_series_bit_for_bit():
+    a = run_critical_state(CriticalStateCase(**SMALL, seed=7))
+    b = run_critical_state(CriticalStateCase(**SMALL, seed=7))
+    other = run_critical_state(CriticalStateCase(**SMALL, seed=8))
+    for col in COLUMNS:
+        np.testing.assert_array_equal(getattr(a.series, col), getattr(b.series, col))
+    assert not np.array_equal(a.series.stress_ratio, other.series.stress_ratio)
+    assert a.stress_ratio == b.stress_ratio
+    # the barostat held the pressure and the rate gave the inertial number asked for
+    assert a.normal_stress_kpa == pytest.approx(100.0, rel=0.15)
+    assert a.inertial_number == pytest.approx(1e-2, rel=0.15)
+    assert 0.1 < a.stress_ratio < 0.5 and 0.7 < a.solid_fraction < 0.9
+
+
+def series_of(gamma, mu, phi) -> CellSeries:
+    n = gamma.size
+    sigma = np.full(n, 100.0)
+    return CellSeries(
+        gamma=gamma,
+        stress_ratio=mu,
+        normal_stress_kpa=sigma,
+        shear_stress_kpa=mu * sigma,
+        mean_stress_kpa=sigma,
+        solid_fraction=phi,
+        inertial_number=np.full(n, 1e-3),
+        coordination=np.full(n, 3.0),
+    )
+
+
+def test_a_flat_noisy_window_is_steady_and_its_error_is_the_blocks_spread():
+    rng = np.random.default_rng(0)
+    g = np.linspace(0.01, 3.0, 300)
+    mu = 0.27 + rng.normal(0.0, 0.02, g.size)
+    phi = 0.81 + rng.normal(0.0, 0.001, g.size)
+    state = read_steady(series_of(g, mu, phi), 1.0, 5, 0.03, 0.005)
+    assert state.steady and state.note.startswith("steady")
+    assert state.stress_ratio == pytest.approx(0.27, abs=0.006)
+    # independent rows: the block error is about sd / sqrt(rows in the window)
+    assert state.stress_ratio_se == pytest.approx(0.02 / np.sqrt(state.rows), rel=0.8)
+    assert state.rows == int(np.sum(g >= 1.0))
+
+
+def test_a_drifting_solid_fraction_or_stress_ratio_is_not_steady():
+    g = np.linspace(0.01, 3.0, 300)
+    flat_mu = np.full(g.size, 0.27)
+    compacting = 0.79 + 0.01 * g  # still compacting: +0.02 over the window
+    state = read_steady(series_of(g, flat_mu, compacting), 1.0, 5, 0.03, 0.005)
+    assert not state.steady and "solid fraction drifts" in state.note and state.note.startswith("not steady")
+    rising = 0.2 + 0.05 * g
+    state = read_steady(series_of(g, rising, np.full(g.size, 0.81)), 1.0, 5, 0.03, 0.005)
+    assert not state.steady and "stress ratio drifts" in state.note
+
+
+@pytest.mark.parametrize(
+    ("changes", "parameter"),
+    [
+        ({"inertial_number": 0.5}, "inertial_number"),
+        ({"disks": 10}, "disks"),
+        ({"rolling_friction": 2.0}, "rolling_friction"),
+        ({"strain": 1.0, "window_start": 1.0}, "strain"),
+        ({"pressure_kpa": -5.0}, "pressure_kpa"),
+        ({"restitution": 0.01}, "restitution"),
+    ],
+)
+def test_a_bad_case_is_refused_naming_its_field(changes, parameter):
+    with pytest.raises(InputError) as exc:
+        CriticalStateCase(**changes)
+    assert exc.value.parameter == parameter
+
+
+def test_a_run_keeps_its_result_series_and_figure_in_the_store(tmp_path):
+    case = CriticalStateCase(**SMALL)
+    result = run_critical_state(case, Store(tmp_path))
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == [
+        "critical_state.png",
+        "result.json",
+        "series.csv",
+    ]
+    data = json.loads((tmp_path / "result.json").read_text())
+    assert CriticalStateTestResult.from_dict(data).to_dict() == result.to_dict()
+    assert data["case"]["disks"] == 200 and data["provenance"]["poro2d_version"]
+    assert len((tmp_path / "series.csv").read_text().splitlines()) == result.series.gamma.size + 1
+
+
+def test_the_command_refuses_a_bad_option_on_one_line(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as exc:
+        main(["critical-state", "--inertial", "3"])
+    _out, err = capsys.readouterr()
+    assert exc.value.code == 2
+    assert err.strip().splitlines() == [err.strip()] and "--inertial" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_command_prints_the_steady_state_first(tmp_path, capsys):
+    argv = [
+        "critical-state",
+        "--disks",
+        "200",
+        "--inertial",
+        "0.01",
+        "--strain",
+        "0.6",
+        "--window-start",
+        "0.3",
+        "--quiet",
+        "--processes",
+        "1",
+        "--out",
+        str(tmp_path / "out"),
+    ]
+    main(argv)
+    out, _err = capsys.readouterr()
+    first = out.strip().splitlines()[0]
+    assert "tau/sigma = " in first and "solid fraction = " in first and "deg" in first
+    assert (tmp_path / "out" / "result.json").exists()
