@@ -134,3 +134,27 @@ def test_the_command_prints_the_steady_state_first(tmp_path, capsys):
     first = out.strip().splitlines()[0]
     assert "tau/sigma = " in first and "solid fraction = " in first and "deg" in first
     assert (tmp_path / "out" / "result.json").exists()
+
+
+def test_a_users_sieve_curve_is_the_cells_grading(tmp_path, capsys):
+    """``--grading`` takes a sieve curve CSV: the cell's disks span its sizes (mm in, m kept)."""
+    soil = tmp_path / "soil.csv"
+    soil.write_text("size_mm,percent_passing\n0.25,0\n0.5,30\n1.0,70\n2.0,100\n")
+    argv = ["critical-state", "--grading", str(soil), "--disks", "200", "--inertial", "0.01"]
+    argv += ["--strain", "0.6", "--window-start", "0.3", "--quiet", "--processes", "1"]
+    argv += ["--out", str(tmp_path / "out")]
+    main(argv)
+    kept = json.loads((tmp_path / "out" / "result.json").read_text())
+    assert kept["config"]["grading"] == str(soil)
+    grading = kept["case"]["grading"]
+    assert grading["sizes_m"] == [0.25e-3, 0.5e-3, 1.0e-3, 2.0e-3] and grading["source"] == str(soil)
+
+
+def test_a_bad_sieve_curve_is_refused_naming_its_line_and_column(tmp_path, capsys):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("size_mm,percent_passing\n0.25,0\n0.5,x\n")
+    with pytest.raises(SystemExit) as exc:
+        main(["critical-state", "--grading", str(bad), "--out", str(tmp_path / "out")])
+    _out, err = capsys.readouterr()
+    assert exc.value.code == 2 and "--grading" in err and "line 3, column 2" in err
+    assert not (tmp_path / "out").exists()

@@ -31,7 +31,10 @@ def register(app: typer.Typer) -> None:
     @app.command("critical-state")
     def critical_state_cmd(
         grading: str = typer.Option(
-            "paper", "--grading", help="A built-in grading: paper, wide_cu4, wide_cu6."
+            "paper",
+            "--grading",
+            help="A built-in grading (paper, wide_cu4, wide_cu6) or a sieve curve CSV of your soil "
+            "(columns size_mm,percent_passing; docs/grading.md).",
         ),
         disks: int = typer.Option(1500, "--disks", help="About how many disks in the cell."),
         particle_friction: float = typer.Option(0.5, "--particle-friction", help="Particle friction f_p."),
@@ -56,15 +59,11 @@ def register(app: typer.Typer) -> None:
         from poro2d.critical_state import CriticalStateCase, run_critical_states
         from poro2d.critical_state.run import MAX_SEEDS
         from poro2d.errors import InputError, check_int
-        from poro2d.grading import preset_grading
         from poro2d.io_utils import check_output_dir
         from poro2d.store import Store
 
         check_output_dir("--out", out)
-        try:
-            curve = preset_grading(grading)
-        except InputError as exc:
-            raise InputError("--grading", grading, exc.allowed) from None
+        curve = _grading(grading)
         n = check_int("--seeds", seeds, 1, MAX_SEEDS)
         if processes is not None:
             check_int("--processes", processes, 1, 64)
@@ -91,6 +90,23 @@ def register(app: typer.Typer) -> None:
             console.print(f"[bold red]failed:[/] {exc}")
             raise typer.Exit(1) from None
         print_result(result, out)
+
+
+def _grading(text: str):
+    """A built-in grading by name, or a user's sieve curve read from a CSV file."""
+    from poro2d.errors import InputError
+    from poro2d.grading import GradingCurve, preset_grading
+
+    if text.lower().endswith(".csv") or Path(text).is_file():
+        try:
+            return GradingCurve.from_csv(text)
+        except InputError as exc:  # named as the option the user typed, where in the file kept
+            where = exc.parameter.removeprefix("csv").strip()
+            raise InputError(f"--grading {where}".strip(), exc.value, exc.allowed, exc.hint) from None
+    try:
+        return preset_grading(text)
+    except InputError as exc:
+        raise InputError("--grading", text, f"{exc.allowed}, or a sieve curve .csv") from None
 
 
 def print_result(result, out: Path) -> None:
