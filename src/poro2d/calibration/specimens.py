@@ -50,10 +50,19 @@ class Replicates:
 
     @classmethod
     def read(cls, paths: dict[str, Path]) -> Replicates:
-        """The replicates of the files ``paths`` (by label), each file's content hashed once."""
-        from poro2d.dem.checkpoint import state_digest
+        """The replicates of the files ``paths`` (by label), each file's content hashed once.
 
-        return cls(dict(paths), {label: state_digest(path) for label, path in paths.items()})
+        Each file is read whole through its folder's store: a specimen changed since it was
+        written (a preset's, kept in the output folder) or unreadable is refused on one line
+        naming it, before any test.
+        """
+        from poro2d.dem.checkpoint import content_digest
+
+        digests = {}
+        for label, path in paths.items():
+            meta, arrays = Store(path.parent).read_state(path.name)
+            digests[label] = content_digest(meta, arrays)
+        return cls(dict(paths), digests)
 
     def __len__(self) -> int:
         return len(self.paths)
