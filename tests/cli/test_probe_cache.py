@@ -26,6 +26,9 @@ from poro2d.store import Store
 #: what a calibration answers: a rerun on a damaged cache must answer the same
 ANSWER = ("best", "intervals", "posterior", "evaluations", "fit")
 LAB = "normal_stress_kpa,peak_shear_stress_kpa\n50,30\n100,60\n"
+#: the tests of the calibration's cache: end to end, on one tiny calibration (36 shear tests) that
+#: the module builds once
+ON_THE_CALIBRATION = pytest.mark.scenario
 
 
 def _argv(lab, specimens, out) -> list[str]:
@@ -107,6 +110,7 @@ def _truncate(path, keep: int = 2000) -> None:
     path.write_bytes(path.read_bytes()[:keep])
 
 
+@ON_THE_CALIBRATION
 def test_a_peak_edited_by_hand_is_refused_naming_the_file(damaged):
     entry, rerun = damaged
     _edit_peak(entry, "150.0")
@@ -114,6 +118,7 @@ def test_a_peak_edited_by_hand_is_refused_naming_the_file(damaged):
     _refused(code, err, f"{entry.name}/result.json", "changed since it was written")
 
 
+@ON_THE_CALIBRATION
 def test_a_peak_edited_with_its_manifest_gone_is_computed_again(damaged, calibrated):
     entry, rerun = damaged
     _edit_peak(entry, "150.0")
@@ -123,6 +128,7 @@ def test_a_peak_edited_with_its_manifest_gone_is_computed_again(damaged, calibra
     _same_answer(calibrated, res, ran=1)
 
 
+@ON_THE_CALIBRATION
 def test_a_peak_of_nan_with_its_manifest_gone_is_computed_again(damaged, calibrated):
     entry, rerun = damaged
     _edit_peak(entry, "NaN")
@@ -132,6 +138,7 @@ def test_a_peak_of_nan_with_its_manifest_gone_is_computed_again(damaged, calibra
     _same_answer(calibrated, res, ran=1)
 
 
+@ON_THE_CALIBRATION
 def test_a_truncated_state_of_a_finished_test_changes_nothing(damaged, calibrated):
     entry, rerun = damaged
     _truncate(entry / "consolidated.npz")  # a finished test reads its result, never this state
@@ -140,6 +147,7 @@ def test_a_truncated_state_of_a_finished_test_changes_nothing(damaged, calibrate
     _same_answer(calibrated, res, ran=0)
 
 
+@ON_THE_CALIBRATION
 def test_a_truncated_state_of_an_unfinished_test_is_refused_naming_it(damaged):
     entry, rerun = damaged
     _truncate(entry / "consolidated.npz")
@@ -148,6 +156,7 @@ def test_a_truncated_state_of_an_unfinished_test_is_refused_naming_it(damaged):
     _refused(code, err, f"{entry.name}/consolidated.npz")
 
 
+@ON_THE_CALIBRATION
 def test_a_truncated_state_with_its_manifest_gone_is_consolidated_again(damaged, calibrated):
     entry, rerun = damaged
     _truncate(entry / "consolidated.npz")
@@ -158,6 +167,7 @@ def test_a_truncated_state_with_its_manifest_gone_is_consolidated_again(damaged,
     _same_answer(calibrated, res, ran=1)
 
 
+@ON_THE_CALIBRATION
 def test_a_file_where_a_tests_folder_belongs_is_refused_naming_it(damaged):
     entry, rerun = damaged
     shutil.rmtree(entry)
@@ -166,6 +176,7 @@ def test_a_file_where_a_tests_folder_belongs_is_refused_naming_it(damaged):
     _refused(code, err, entry.name, "a file")
 
 
+@ON_THE_CALIBRATION
 def test_a_file_where_the_cache_belongs_is_refused_naming_it(damaged):
     entry, rerun = damaged
     shutil.rmtree(entry.parent)
@@ -174,6 +185,7 @@ def test_a_file_where_the_cache_belongs_is_refused_naming_it(damaged):
     _refused(code, err, "cal/cache", "a file")
 
 
+@ON_THE_CALIBRATION
 @pytest.mark.parametrize("name", ["result.json", "curve.csv"])
 def test_a_missing_result_or_curve_is_computed_again(damaged, calibrated, name):
     entry, rerun = damaged
@@ -183,6 +195,7 @@ def test_a_missing_result_or_curve_is_computed_again(damaged, calibrated, name):
     _same_answer(calibrated, res, ran=1)
 
 
+@ON_THE_CALIBRATION
 def test_a_missing_state_of_a_finished_test_changes_nothing(damaged, calibrated):
     entry, rerun = damaged
     (entry / "consolidated.npz").unlink()
@@ -191,6 +204,7 @@ def test_a_missing_state_of_a_finished_test_changes_nothing(damaged, calibrated)
     _same_answer(calibrated, res, ran=0)
 
 
+@ON_THE_CALIBRATION
 def test_a_missing_record_of_a_test_is_refused_naming_its_folder(damaged):
     entry, rerun = damaged
     (entry / "test.json").unlink()
@@ -199,6 +213,7 @@ def test_a_missing_record_of_a_test_is_refused_naming_its_folder(damaged):
     _refused(code, err, entry.name, "without the record of its test")
 
 
+@ON_THE_CALIBRATION
 def test_a_curve_edited_by_hand_is_refused_naming_the_file(damaged):
     entry, rerun = damaged
     path = entry / "curve.csv"
@@ -211,6 +226,7 @@ def test_a_curve_edited_by_hand_is_refused_naming_the_file(damaged):
     _refused(code, err, f"{entry.name}/curve.csv")
 
 
+@ON_THE_CALIBRATION
 def test_a_curve_cut_short_with_its_manifest_gone_is_computed_again(damaged, calibrated):
     entry, rerun = damaged
     _truncate(entry / "curve.csv", 3000)  # ends inside a row
@@ -220,6 +236,7 @@ def test_a_curve_cut_short_with_its_manifest_gone_is_computed_again(damaged, cal
     _same_answer(calibrated, res, ran=1)
 
 
+@ON_THE_CALIBRATION
 def test_a_truncated_specimen_is_refused_naming_it(calibrated, tmp_path, capfd):
     bad = tmp_path / "seed1.npz"
     bad.write_bytes(calibrated["specimens"][1].read_bytes()[:5000])
@@ -251,6 +268,7 @@ def _shear_argv(specimen, out) -> list[str]:
     return ["shear", "-s", str(specimen), "-n", "50", "--max-displacement", "0.002", "--out", str(out)]
 
 
+@ON_THE_CALIBRATION
 @pytest.mark.parametrize("damage", ["peak", "nan", "curve"])
 def test_a_resumed_shear_test_damaged_with_its_manifest_gone_is_computed_again(
     damage, sheared, specimen, tmp_path, capfd
