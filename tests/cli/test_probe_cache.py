@@ -246,11 +246,15 @@ def test_a_truncated_specimen_is_refused_naming_it(calibrated, tmp_path, capfd):
     assert not out.exists()
 
 
-def test_a_kept_specimen_changed_since_it_was_written_is_refused_naming_it(specimen, tmp_path):
+@pytest.mark.parametrize(("damage", "words"), [("truncate", "changed"), ("delete", "missing")])
+def test_a_kept_specimen_damaged_since_it_was_written_is_refused_naming_it(specimen, tmp_path, damage, words):
     # the preset's specimens are kept in the calibration's folder and read back on a rerun
     path = Store(specimen.parent).copy(specimen.name, Store(tmp_path / "specimens"))
-    path.write_bytes(path.read_bytes()[:5000])
-    with pytest.raises(InputError, match="changed since it was written") as e:
+    if damage == "truncate":
+        path.write_bytes(path.read_bytes()[:5000])
+    else:
+        path.unlink()
+    with pytest.raises(InputError, match=f"{words} since it was written") as e:
         Replicates.read({"seed0": path})
     assert str(path) in str(e.value)
 

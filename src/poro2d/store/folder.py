@@ -257,8 +257,9 @@ class Store:
     def check_intact(self, name: str) -> None:
         """Refuse, on one line naming it, a file that differs from what this store wrote."""
         if not self.intact(name):
+            what = "changed since it was written" if self.has(name) else "missing since it was written"
             raise InputError(
-                str(self._root / name), "changed since it was written", "the file as poro2d wrote it",
+                str(self._root / name), what, "the file as poro2d wrote it",
                 "delete it (or its folder) to have it computed again",
             )  # fmt: skip
 
