@@ -98,6 +98,29 @@ def check_no_escape(parameter: str, folder: str | os.PathLike) -> None:
                 )  # fmt: skip
 
 
+#: files that only one kind of run writes at the top of its folder. A folder without a marker
+#: is known by them: one written before markers existed, or one that a run keeps inside its
+#: own (a calibration's criterion, the paper's shear replicates), which no command claims
+KIND_SIGNS = {
+    "calibrate": ("calibrated.toml",),
+    "criterion": ("iterations.csv", "density.json"),
+    "paper": ("paper.json", "conversions.json"),
+    "shear": ("peaks.csv", "replicates.json", "test.json"),
+    "strength": ("strength.json",),
+    "relation": ("relation.json",),
+    "sensitivity": ("sensitivity.json",),
+    "sand": ("sand.json", "preflight.json"),
+    "sweep": ("sweep.json",),
+    "biaxial": ("biaxial.png",),
+    "critical-state": ("critical_state.png",),
+    "export": ("specimen.data", "specimen_yade.py", "specimen_pfc4.dat", "disks.csv"),
+    "import": ("check.json",),
+}
+
+#: the store's manifest (poro2d.store.digests.MANIFEST): a folder holding one keeps a run's results
+_MANIFEST = ".digests.json"
+
+
 def folder_kind(folder: str | os.PathLike) -> str | None:
     """The kind of run ``folder`` belongs to (its marker), None without one."""
     try:
@@ -106,18 +129,49 @@ def folder_kind(folder: str | os.PathLike) -> str | None:
         return None
 
 
+def signed_kinds(folder: str | os.PathLike) -> list[str]:
+    """The kinds of run whose own files (:data:`KIND_SIGNS`) lie at the top of ``folder``, sorted."""
+    root = Path(folder)
+    return sorted(k for k, names in KIND_SIGNS.items() if any((root / n).exists() for n in names))
+
+
+def _a(kind: str) -> str:
+    return f"an {kind}" if kind[:1] in "aeiou" else f"a {kind}"
+
+
 def claim_kind(parameter: str, folder: Path, kind: str) -> None:
-    """Mark ``folder`` as ``kind``'s, or refuse it if it belongs to another kind of run."""
+    """Mark ``folder`` as ``kind``'s, or refuse it if it belongs to another kind of run.
+
+    A folder without a marker belongs to the kind whose own files it holds (:func:`signed_kinds`),
+    if any: it is marked when that is ``kind``, refused otherwise.
+    """
     from poro2d.io_utils import atomic_path
 
     owner = folder_kind(folder)
     if owner is None:
-        with atomic_path(folder / KIND_NAME, suffix="") as tmp:
-            tmp.write_text(kind + "\n")
-    elif owner != kind:
+        signed = signed_kinds(folder)
+        owner = kind if not signed or kind in signed else signed[0]
+        if owner == kind:
+            with atomic_path(folder / KIND_NAME, suffix="") as tmp:
+                tmp.write_text(kind + "\n")
+    if owner != kind:
         raise InputError(
-            parameter, str(folder), f"an empty folder or one of a {kind} run",
-            f"it holds the results of a {owner} run; choose another folder",
+            parameter, str(folder), f"an empty folder or one of {_a(kind)} run",
+            f"it holds the results of {_a(owner)} run; choose another folder",
+        )  # fmt: skip
+
+
+def check_no_run(parameter: str, folder: str | os.PathLike) -> None:
+    """Refuse ``folder`` if it holds a run's results: for a command that writes loose files
+    (figures) and keeps no folder of its own, which would otherwise replace a run's files."""
+    root = Path(folder)
+    owner = folder_kind(root) or next(iter(signed_kinds(root)), None)
+    if owner is None and (root / _MANIFEST).is_file():
+        owner = "poro2d"
+    if owner is not None:
+        raise InputError(
+            parameter, str(root), "a folder that holds no poro2d run's results",
+            f"it holds the results of {_a(owner)} run; choose another folder",
         )  # fmt: skip
 
 
@@ -273,8 +327,11 @@ def _remove_if_empty(folder: Path) -> None:
 __all__ = [
     "KIND_NAME",
     "LOCK_NAME",
+    "KIND_SIGNS",
+    "check_no_run",
     "claim_kind",
     "folder_kind",
+    "signed_kinds",
     "cache_entry",
     "check_no_escape",
     "holds_output",

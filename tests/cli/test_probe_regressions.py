@@ -2,12 +2,14 @@
 each is refused on one line (exit 2, no traceback) before any work, or handled with nothing lost.
 
 The other groups of that probe have their tests beside the code they check: damaged caches
-(tests/store/test_folder.py, tests/calibration/test_cache_damage.py), folders of another kind
+(tests/store/test_folder.py, tests/calibration/test_cache_damage.py, tests/shear/test_readback.py,
+and as a user meets them, tests/cli/test_probe_cache.py), folders of another kind
 (tests/cli/test_folder_kinds.py), rolling friction on export (tests/interop/test_rolling_export.py),
 laboratory files (tests/shear/test_fit_lab.py), identifiability (tests/calibration/test_identifiability.py),
 unaccepted specimens (tests/specimen/test_accepted.py, tests/specimen/test_specimen_set.py), the
 over-full box with rolling friction (tests/criterion/test_overfull_rolling.py), dashboards and
-schedulers (tests/ground/test_cluster_checks.py).
+schedulers (tests/ground/test_cluster_checks.py,
+and for every command that takes them, tests/cli/test_probe_dask.py).
 """
 
 from __future__ import annotations

@@ -19,6 +19,7 @@ from poro2d.errors import InputError
 from poro2d.execute.dask_cluster import pin_numba_threads
 from poro2d.identity import identity_digest
 from poro2d.shear.case import ShearCase
+from poro2d.shear.record import content_record, folder_stage
 from poro2d.shear.settings import ShearSettings
 from poro2d.shear.single import DirectShearTest
 from poro2d.specimen.saved import Specimen
@@ -149,6 +150,20 @@ def check_entry(unit: CalibrationUnit, cache: Store | None) -> None:
     for name in store.names():
         if store.has(name):
             store.check_intact(name)
+    _check_record(unit, store)
+
+
+def _check_record(unit: CalibrationUnit, store: Store) -> None:
+    """Refuse an entry holding work without the record of its test (``test.json`` deleted) or
+    with another test's (a folder copied in): its test would refuse it on the worker."""
+    content = content_record(unit.digest, unit.sigma, ShearSettings(**unit.settings).record())
+    try:
+        folder_stage(store, content, unit.specimen).check()
+    except InputError:
+        raise InputError(
+            str(store.root), "work without the record of its test", "a cache entry of this shear test",
+            "delete it to have the test computed again",
+        ) from None  # fmt: skip
 
 
 def compute_unit(unit: CalibrationUnit, cache: Store | None) -> UnitRow:

@@ -45,9 +45,11 @@ def plot_relations(
     if mark_n_lab is not None:
         check_range("--mark-n-lab", mark_n_lab, 0.0, 0.5)
     from poro2d.io_utils import check_output_dir
+    from poro2d.locks import check_no_run
     from poro2d.report.conversion_figures import write_relation_figures
 
     check_output_dir("--out-dir", out_dir)
+    check_no_run("--out-dir", out_dir)  # the figures would replace a run's own (the paper's Figs. 1-2)
 
     paths = write_relation_figures(
         out_dir,

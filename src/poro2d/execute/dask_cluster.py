@@ -85,7 +85,7 @@ def connect(scheduler: str):
     from distributed import Client
 
     address = check_scheduler_address(scheduler)
-    silent = not_a_scheduler(address)
+    silent = not_a_scheduler(address, CONNECT_TIMEOUT_S)
     if silent:
         raise InputError(
             "--scheduler",
@@ -104,7 +104,7 @@ def connect(scheduler: str):
         ) from None
 
 
-def not_a_scheduler(address: str, timeout: float = CONNECT_TIMEOUT_S) -> str | None:
+def not_a_scheduler(address: str, timeout: float) -> str | None:
     """Why the server at a ``tcp://`` ``address`` is not a Dask scheduler; None when it may be.
 
     A Dask server speaks first: on a new connection it sends its handshake, a message whose
@@ -285,8 +285,20 @@ class DaskCluster:
 
 
 def _run_task(job: Job):
-    """A job on a Dask worker (importing this module there makes the worker ignore Ctrl-C)."""
-    return job.run()
+    """A job on a Dask worker (importing this module there makes the worker ignore Ctrl-C).
+
+    A job that raises comes back as its :class:`Failed` value, as from the other backends:
+    raised, it would make the worker log Dask's "Compute Failed" lines on the command's
+    terminal for a failure the caller reports in its own words (or, for a calibration test
+    without equilibrium, as an expected outcome). A job with retries raises instead, so that
+    Dask runs it again.
+    """
+    if job.retries:
+        return job.run()
+    try:
+        return job.run()
+    except Exception as exc:
+        return Failed.of(job, exc)
 
 
 __all__ = [

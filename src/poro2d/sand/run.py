@@ -307,10 +307,12 @@ def run_sand(
     Rerun to resume: finished cases are read back.
     """
     from poro2d.execute.cluster_options import check_cluster_options
+    from poro2d.execute.dask_cluster import check_reachable
 
     check_output_dir(store.parameter, store.root)
     check_cluster_options(scheduler, workers)
     case, pf = check_soil(config, seeds=seeds, workers=workers, budget_minutes=budget_minutes)
+    check_reachable(scheduler)  # a scheduler that does not answer is refused before the pre-flight is kept
     store.write_json(
         "preflight.json",
         {

@@ -124,9 +124,49 @@ def curve_rows(curve: Mapping[str, np.ndarray]) -> list[dict]:
 
 
 def read_curve(store: Store, name: str = "curve.csv") -> ShearCurve | None:
-    """The curve in a test's ``curve.csv`` in ``store`` (as :func:`curve_columns`; None without it)."""
+    """The curve in a test's ``curve.csv`` in ``store`` (as :func:`curve_columns`); None without
+    it, or when a row cannot be read as numbers (a file cut short, or not a curve)."""
     rows = store.read_rows(name)
-    return None if rows is None else curve_columns(rows)
+    try:
+        return None if rows is None else curve_columns(rows)
+    except (KeyError, TypeError, ValueError):
+        return None
+
+
+def contradiction(result: Mapping, curve: ShearCurve | None, window: float) -> str | None:
+    """Why a stored test's ``result.json`` cannot be what its ``curve.csv`` records; None when it can.
+
+    A finished test is read back, not run again, so what it reads must be checked: a
+    result edited by hand, a curve cut short by a full disk, or a folder copied together
+    from two runs would otherwise change every answer built on it, and the folder's manifest
+    (:mod:`poro2d.store.digests`) may be gone with the damage. The peak and the end value
+    are read off the curve again (``window``: the test's peak window) and must agree with the
+    result, both finite, and the curve must have the rows the result counts, with a finite
+    displacement and shear stress in each (other columns may hold NaN: an earlier version's,
+    or a ratio of a record without forces).
+    """
+    if curve is None:
+        return "curve.csv is missing"
+    x, tau = curve.shear_displacement_mm * 1e-3, curve.shear_stress_kpa
+    if not (np.isfinite(x).all() and np.isfinite(tau).all()):
+        return "curve.csv holds a displacement or shear stress that is not finite"
+    end = result.get("end")
+    stored = {
+        "records": result.get("records"),
+        "peak_shear_stress_kpa": result.get("peak_shear_stress_kpa"),
+        "end shear_stress_kpa": end.get("shear_stress_kpa") if isinstance(end, Mapping) else None,
+    }
+    read = {
+        "records": len(x),
+        "peak_shear_stress_kpa": peak(x, tau, window).value,
+        "end shear_stress_kpa": float(smooth(x, tau, window)[-1]),
+    }
+    for name, value in stored.items():
+        if not (isinstance(value, int | float) and math.isfinite(value)):
+            return f"result.json's {name} is {value!r}"
+        if not math.isclose(value, read[name], rel_tol=1e-9, abs_tol=1e-9):
+            return f"result.json's {name} is {value:g}, curve.csv's {read[name]:g}"
+    return None
 
 
 def curve_row(
@@ -272,6 +312,7 @@ __all__ = [
     "CurveRow",
     "ShearCurve",
     "CurveSummary",
+    "contradiction",
     "curve_row",
     "curve_summary",
     "ended_by",

@@ -21,13 +21,21 @@ from dataclasses import replace
 import numpy as np
 
 from poro2d.dem import Simulation
+from poro2d.errors import InputError
 from poro2d.io_utils import Provenance, as_json
 from poro2d.measure.coordination import coordination_number
 from poro2d.shear import record
 from poro2d.shear.box import SplitBox, build_split_box
 from poro2d.shear.case import ShearCase
 from poro2d.shear.controllers import Consolidation, ProgressFn
-from poro2d.shear.curve import CURVE_COLUMNS, CurveRow, curve_columns, curve_summary
+from poro2d.shear.curve import (
+    CURVE_COLUMNS,
+    CurveRow,
+    contradiction,
+    curve_columns,
+    curve_summary,
+    read_curve,
+)
 from poro2d.shear.parts import ConsolidationRecord
 from poro2d.shear.peak_frame import PeakFrame
 from poro2d.shear.results import ShearTestResult
@@ -88,8 +96,14 @@ class DirectShearTest:
 
     def stored(self) -> ShearTestResult | None:
         """The result of this test when ``store`` holds it finished, else None (it has to run)."""
-        data = self.stage().stored() if self.store is not None else None
+        data = self.stage().stored(accept=self._agrees) if self.store is not None else None
         return None if data is None else ShearTestResult.read(self.store, data)
+
+    def _agrees(self, data: dict) -> bool:
+        """Whether a stored ``result.json`` is what its ``curve.csv`` records (:func:`contradiction`):
+        one that is not (edited, cut short, from another copy) is not used; the test runs again."""
+        assert self.store is not None
+        return contradiction(data, read_curve(self.store), self.settings.peak_window) is None
 
     # ----------------------------------------------------------------- stages
     def _build_box(self) -> tuple[Simulation, SplitBox]:
@@ -108,7 +122,8 @@ class DirectShearTest:
     def consolidate(self) -> tuple[Simulation, ConsolidationRecord]:
         """The consolidated specimen and its record; with ``store`` read back once done.
 
-        Done means ``consolidation.json`` (written last) beside ``consolidated.npz``.
+        Done means ``consolidation.json`` (written last) beside ``consolidated.npz``; a state
+        that cannot be read back as written (changed, truncated) is consolidated again.
         """
         store = self.store
         if store is None:
@@ -128,8 +143,14 @@ class DirectShearTest:
         )  # fmt: skip
         if fresh:
             return fresh[0], info
+        try:
+            sim = store.load_state(CONSOLIDATED, threads=self.threads)
+        except InputError:  # changed since written, or unreadable: the stage is not done after all
+            store.remove("consolidation.json")
+            store.remove(CONSOLIDATED)
+            return self.consolidate()
         self.box = SplitBox(**info.box)
-        return store.load_state(CONSOLIDATED, threads=self.threads), info
+        return sim, info
 
     def _consolidate(self) -> tuple[Simulation, ConsolidationRecord]:
         """Build the split box and servo the top plate to the normal stress until equilibrium."""
@@ -230,7 +251,7 @@ class DirectShearTest:
             fresh.append(self._consolidate_and_shear())
             return fresh[0]
 
-        data = self.stage().run(compute)
+        data = self.stage().run(compute, accept=self._agrees)
         remove_stage_files(self.store)  # the shear stage's checkpoints, once result.json is written
         # a test run now keeps its curve in memory; a finished one is read back with its curve.csv
         return self._as_stored(fresh[0], data) if fresh else ShearTestResult.read(self.store, data)

@@ -75,6 +75,8 @@ def accepted_file(path: str | os.PathLike) -> Path:
     if p.is_dir():
         p = p / "specimen.npz"
     if not p.is_file():
+        # a file poro2d wrote there (a preset's kept specimen) and lost since: said as such
+        Store(p.parent, parameter="specimen").check_intact(p.name)
         raise InputError(
             "specimen",
             str(path),

@@ -257,8 +257,9 @@ class Store:
     def check_intact(self, name: str) -> None:
         """Refuse, on one line naming it, a file that differs from what this store wrote."""
         if not self.intact(name):
+            what = "changed since it was written" if self.has(name) else "missing since it was written"
             raise InputError(
-                str(self._root / name), "changed since it was written", "the file as poro2d wrote it",
+                str(self._root / name), what, "the file as poro2d wrote it",
                 "delete it (or its folder) to have it computed again",
             )  # fmt: skip
 
@@ -290,15 +291,17 @@ class Checkpoints:
     def resume(self, threads: int | None = None) -> tuple[Simulation, dict] | None:
         """The saved state and the ``extra`` it was saved with; None when there is none.
 
-        A checkpoint that differs from what was saved is dropped: the stage starts again.
+        A checkpoint that differs from what was saved, or cannot be read (truncated where no
+        manifest tells), is dropped: the stage starts again.
         """
         if not self.store.has(self.name):
             return None
-        if not self.store.intact(self.name):
+        try:
+            extra = self.store.state_meta(self.name).get("extra", {})
+            return self.store.load_state(self.name, threads=threads), extra
+        except InputError:
             self.store.remove(self.name)
             return None
-        extra = self.store.state_meta(self.name).get("extra", {})
-        return self.store.load_state(self.name, threads=threads), extra
 
     def save(self, sim: Simulation, extra: dict | None = None) -> None:
         """Keep ``sim``'s state now (atomically), with ``extra`` (where the protocol was)."""
