@@ -13,6 +13,7 @@ SCRIPT = textwrap.dedent(
     import os, signal, threading, time
     from poro2d.worker_signals import hold_interrupts, release_interrupts
 
+    before = signal.getsignal(signal.SIGINT)  # default_int_handler, or SIG_IGN under a runner that ignores it
     stop = threading.Event()
     other = threading.Thread(target=stop.wait)  # another thread of the command (numba's, the display's)
     other.start()
@@ -27,7 +28,7 @@ SCRIPT = textwrap.dedent(
     except KeyboardInterrupt:
         print("raised at release")
     release_interrupts(held)  # a second release (an error path) changes nothing
-    print("handler", signal.getsignal(signal.SIGINT) is signal.default_int_handler)
+    print("handler", signal.getsignal(signal.SIGINT) is before)
     quiet = hold_interrupts()
     release_interrupts(quiet)
     print("quiet release")
