@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar, TypeVar
 
 from poro2d.dem.summary import EngineSummary
+from poro2d.shear.residual import ResidualAtRest
 from poro2d.typed_result import TypedResult, part
 
 P = TypeVar("P", bound=TypedResult)
@@ -168,11 +169,13 @@ class TestSummary(TypedResult):
     consolidation_normal_stress_error: float
     folder: str
     plane_load_fraction_at_peak: float | None = None
+    residual_dilation_stopped: ResidualAtRest | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("plane_load_fraction_at_peak",)
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("plane_load_fraction_at_peak", "residual_dilation_stopped")
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "end": EndValues,
         "force_balance": ForceBalance,
+        "residual_dilation_stopped": ResidualAtRest,
     }
 
 
@@ -288,7 +291,9 @@ class StrengthCase(TypedResult):
 
     Peak and residual friction angles and the dilation angle, mean and sd over the specimens
     (None when no specimen gave one; the sd None with one specimen); the pooled fits over
-    every specimen's points with their intervals; the mean residual stress ratio.
+    every specimen's points with their intervals; the mean residual stress ratio (the last fifth of
+    each curve), and the mean tau/sigma where dilation stopped, on the plate and on the plane,
+    over the ``tests_dilation_stopped`` tests that reached it.
     """
 
     mu_r: float
@@ -306,6 +311,16 @@ class StrengthCase(TypedResult):
     residual_friction_angle_pooled_deg: float
     residual_friction_angle_pooled_ci_deg: list[float] | None
     residual_stress_ratio_mean: float
+    residual_dilation_stopped_ratio_mean: float | None = None
+    residual_dilation_stopped_plane_ratio_mean: float | None = None
+    tests_dilation_stopped: int | None = None
+
+    # the residual read where dilation stopped (poro2d.shear.residual): the means over the tests
+    # that reached it (None when none did) and how many did; absent in a study of an earlier poro2d
+    OPTIONAL: ClassVar[tuple[str, ...]] = (
+        "residual_dilation_stopped_ratio_mean", "residual_dilation_stopped_plane_ratio_mean",
+        "tests_dilation_stopped",
+    )  # fmt: skip
 
 
 __all__ = [

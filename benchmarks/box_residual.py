@@ -1,0 +1,209 @@
+"""The direct shear box's residual against the periodic critical-state reference, with its biases.
+
+    python benchmarks/box_residual.py SPECIMEN [SPECIMEN ...] [--friction 3,0.5]
+        [--wall-friction 1.5,0.5,0] [--damping 0.3,0.1] [--damping-wall 0] [--half-velocity 0.5]
+        [--normal-stress 100] [--max-displacement 0.05] [--processes 2] [--keep DIR]
+
+Each specimen (a criterion folder that accepted it; one per seed) is sheared at the normal
+stress, long enough for the plate to stop rising, for every particle friction f_p and:
+
+* every wall friction (``--wall-friction``) at the paper's local damping 0.7;
+* every other local damping (``--damping``) at the wall friction ``--damping-wall``;
+* at half the velocity (f_p in ``--half-velocity``, first specimen only), wall friction
+  ``--damping-wall``, damping 0.7: the drag of local damping scales with the disks' speed.
+
+Per test it prints the residual read where dilation has stopped
+(:func:`poro2d.shear.residual.dilation_stopped_residual`): tau/sigma on the plate's stress
+and on the shear plane's own normal stress, the plane's share of the plate's load, the
+upper walls' friction, and the mean over the last fifth of the curve (the strength study's
+window) for comparison. The reference to read them against is the periodic cell's steady
+tau/sigma of the same disks (docs/critical-state.md: 0.289 +- 0.001 at f_p 0.5, no rolling
+friction, 100 kPa, I = 1e-3). Tests are kept in DIR (default: a temporary folder; a rerun
+with the same DIR reads finished tests back) and the table is written as box_residual.json.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import tempfile
+import time
+from dataclasses import replace
+from pathlib import Path
+
+PAPER_DAMPING = 0.7
+
+
+def numbers(text: str) -> list[float]:
+    return [float(v) for v in text.split(",") if v.strip()]
+
+
+def cases(args) -> list[dict]:
+    """The settings varied, one dict per case, in the order they run (first specimen first)."""
+    out = []
+    for fp in args.friction:
+        for wall in args.wall_friction:
+            out.append(
+                {"particle_friction": fp, "friction_wall": wall, "local_damping": PAPER_DAMPING, "speed": 1.0}
+            )
+        for alpha in args.damping:
+            out.append(
+                {
+                    "particle_friction": fp,
+                    "friction_wall": args.damping_wall,
+                    "local_damping": alpha,
+                    "speed": 1.0,
+                }
+            )
+    for fp in args.half_velocity:
+        out.append(
+            {
+                "particle_friction": fp,
+                "friction_wall": args.damping_wall,
+                "local_damping": PAPER_DAMPING,
+                "speed": 0.5,
+            }
+        )
+    return out
+
+
+def case_name(c: dict) -> str:
+    return f"fp{c['particle_friction']:g}_wall{c['friction_wall']:g}_damping{c['local_damping']:g}" + (
+        "" if c["speed"] == 1.0 else f"_v{c['speed']:g}"
+    )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("specimens", nargs="+", type=Path, help="criterion folders (one per seed)")
+    ap.add_argument("--friction", type=numbers, default=[3.0, 0.5], help="particle frictions f_p")
+    ap.add_argument("--wall-friction", type=numbers, default=[1.5, 0.5, 0.0])
+    ap.add_argument("--damping", type=numbers, default=[0.3, 0.1], help="local damping besides 0.7")
+    ap.add_argument("--damping-wall", type=float, default=0.0, help="wall friction of the damping cases")
+    ap.add_argument("--half-velocity", type=numbers, default=[0.5], help="f_p of the v/2 case ('' for none)")
+    ap.add_argument("--normal-stress", type=float, default=100.0)
+    ap.add_argument("--max-displacement", type=float, default=0.05)
+    ap.add_argument("--processes", type=int, default=2)
+    ap.add_argument("--keep", type=Path, default=None)
+    ap.add_argument("--reference", type=float, default=0.289, help="the periodic cell's steady tau/sigma")
+    args = ap.parse_args()
+
+    from poro2d.shear import ShearSettings
+    from poro2d.shear.case import ShearCase
+    from poro2d.shear.pool import ShearJob, execute_jobs
+    from poro2d.specimen.specimen_set import SpecimenSet
+
+    out = args.keep or Path(tempfile.mkdtemp(prefix="poro2d-box-residual-"))
+    labels = [f"s{k}" for k in range(len(args.specimens))]
+    specimens = SpecimenSet.accepted(dict(zip(labels, args.specimens, strict=True))).read()
+    base = ShearSettings(max_displacement=args.max_displacement, stop_after_peak=0.0)
+    jobs = []
+    for spec_label, specimen in zip(labels, specimens.contents(), strict=True):
+        for c in cases(args):
+            if c["speed"] != 1.0 and spec_label != labels[0]:
+                continue
+            settings = replace(
+                base,
+                particle_friction=c["particle_friction"],
+                friction_wall=c["friction_wall"],
+                local_damping=c["local_damping"],
+                velocity=base.velocity * c["speed"],
+            )
+            case = ShearCase(specimen, args.normal_stress, settings)
+            folder = out / case_name(c) / spec_label
+            jobs.append(
+                (
+                    c,
+                    spec_label,
+                    ShearJob(
+                        ("test", args.normal_stress, case_name(c), spec_label),
+                        case,
+                        str(folder),
+                        figures=False,
+                        series=f"{case_name(c)} {spec_label}",
+                    ),
+                )
+            )
+    t0 = time.perf_counter()
+    results = execute_jobs([j for _, _, j in jobs], args.processes, progress=False)
+    print(f"{len(jobs)} tests in {time.perf_counter() - t0:.0f} s (finished ones read back); kept in {out}")
+    report(jobs, results, args, out)
+
+
+def report(jobs, results, args, out: Path) -> None:
+    from poro2d.shear.residual import dilation_stopped_residual, tail_residual
+
+    rows = []
+    head = (
+        f"{'f_p':>4} {'wall':>4} {'damp':>4} {'v':>4} {'spec':>4} {'from mm':>7} {'tau/sig plate':>13} "
+        f"{'tau/sig plane':>13} {'share':>5} {'wall kPa':>8} {'tail plate':>10} {'peak':>6} {'time s':>6}"
+    )
+    print(head)
+    for (c, spec_label, _job), res in zip(jobs, results, strict=True):
+        r = dilation_stopped_residual(res.curve)
+        tail = tail_residual(res.curve)
+        row = {
+            **c,
+            "specimen": spec_label,
+            "normal_stress_kpa": res.normal_stress_kpa,
+            "peak_stress_ratio": res.peak_stress_ratio,
+            "tail_ratio_plate": tail,
+            "wall_time_shear_s": res.wall_time_shear_s,
+            **r.to_dict(),
+        }
+        rows.append(row)
+        if r.reached:
+            nums = (
+                f"{r.start_mm:7.1f} {r.stress_ratio:13.3f} {r.plane_stress_ratio:13.3f} "
+                f"{r.plane_share:5.2f} {r.upper_wall_friction_kpa:8.1f}"
+            )
+        else:
+            nums = f"{'not reached':>51}"
+        print(
+            f"{c['particle_friction']:4g} {c['friction_wall']:4g} {c['local_damping']:4g} {c['speed']:4g} "
+            f"{spec_label:>4} {nums} {tail:10.3f} {res.peak_stress_ratio:6.3f} {res.wall_time_shear_s:6.0f}"
+        )
+    summarise(rows, args.reference)
+    (out / "box_residual.json").write_text(
+        json.dumps(
+            {"specimens": [str(s) for s in args.specimens], "reference": args.reference, "rows": rows},
+            indent=2,
+        )
+    )
+    print(f"table in {out / 'box_residual.json'}")
+
+
+def summarise(rows: list[dict], reference: float) -> None:
+    """Per case: the mean over the specimens of the residual on the plate and on the plane,
+    against the reference."""
+    print(f"\nmeans over specimens (reference tau/sigma {reference:g}):")
+    keys = sorted(
+        {(r["particle_friction"], r["friction_wall"], r["local_damping"], r["speed"]) for r in rows},
+        key=lambda k: (-k[0], -k[1], -k[2], -k[3]),
+    )
+    for key in keys:
+        got = [
+            r
+            for r in rows
+            if (r["particle_friction"], r["friction_wall"], r["local_damping"], r["speed"]) == key
+        ]
+        done = [r for r in got if r["reached"]]
+        if not done:
+            print(
+                f"  f_p {key[0]:g} wall {key[1]:g} damping {key[2]:g} v x{key[3]:g}: not reached ({len(got)})"
+            )
+            continue
+        plate = sum(r["stress_ratio"] for r in done) / len(done)
+        plane = sum(r["plane_stress_ratio"] for r in done) / len(done)
+        spread = max(r["plane_stress_ratio"] for r in done) - min(r["plane_stress_ratio"] for r in done)
+        print(
+            f"  f_p {key[0]:g} wall {key[1]:g} damping {key[2]:g} v x{key[3]:g}: plate {plate:.3f} "
+            f"({plate - reference:+.3f}), plane {plane:.3f} ({plane - reference:+.3f}), "
+            f"range on the plane {spread:.3f}, {len(done)} of {len(got)} specimens"
+            + ("" if math.isfinite(plane) else " (no plane record)")
+        )
+
+
+if __name__ == "__main__":
+    main()
