@@ -123,3 +123,27 @@ def test_a_test_written_before_the_residual_reading_still_reads():
     assert "residual_dilation_stopped" not in data
     old = ShearTestResult.from_dict(data)
     assert old.residual_dilation_stopped is None and old.to_dict() == data
+
+
+def test_poro2d_shear_prints_the_residual_beside_the_end_values_with_its_label(specimen, tmp_path, capsys):
+    from poro2d.cli import main
+
+    main(["shear", "--specimen", str(specimen), "-n", "100", "--max-displacement", "0.004",
+          "--stop-after-peak", "0", "-p", "1", "--quiet", "--out", str(tmp_path / "o")])  # fmt: skip
+    out = capsys.readouterr().out
+    assert "resid." in out and "plate" in out and "plane" in out
+    assert "the residual tau/sigma where dilation stopped" in out and "100 kPa: " in out
+
+
+def test_the_table_cells_say_not_reached_and_leave_earlier_tests_blank():
+    from poro2d.cli.shear import residual_cells
+    from poro2d.cli.strength import _stopped
+
+    x = np.arange(0.0, 30.0 + 1e-9, STEP_MM)
+    assert residual_cells(dilation_stopped_residual(curve(0.05 * x, x))) == ("not reached", "not reached")
+    assert residual_cells(dilation_stopped_residual(curve(0.0 * x, x))) == ("0.300", "0.375")
+    assert residual_cells(None) == ("-", "-")
+    assert _stopped({"tests_dilation_stopped": 0}) == "not reached" and _stopped({}) == "-"
+    case = {"tests_dilation_stopped": 2, "residual_dilation_stopped_ratio_mean": 0.31,
+            "residual_dilation_stopped_plane_ratio_mean": 0.29}  # fmt: skip
+    assert _stopped(case) == "0.310 / 0.290 (2)"
