@@ -141,7 +141,7 @@ def report(jobs, results, args, out: Path) -> None:
     )
     print(head)
     for (c, spec_label, _job), res in zip(jobs, results, strict=True):
-        r = dilation_stopped_residual(res.curve)
+        r = dilation_stopped_residual(res.curve, res.d_mean_m)
         tail = tail_residual(res.curve)
         row = {
             **c,

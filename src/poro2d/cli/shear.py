@@ -233,9 +233,10 @@ def print_residual_note(tests) -> None:
         f"{t['normal_stress_kpa']:g} kPa: {t['residual_dilation_stopped']['status']}" for t in read
     )
     console.print(
-        f"resid. t/s: the residual tau/sigma where dilation stopped (|d plate / d shear| <= "
-        f"{first['rate_limit']:g} over {1e3 * first['rate_window_m']:g} mm to the end of the curve), on "
-        f"the plate's and on the shear plane's normal stress ({stretches})"
+        f"resid. t/s: the residual tau/sigma where dilation stopped (the plate's net slope against the "
+        f"shear displacement within {first['rate_limit']:g} over the final stretch and its halves, at least "
+        f"{1e3 * first['min_stretch_m']:.3g} mm long), on the plate's and on the shear plane's normal stress "
+        f"({stretches})"
     )
 
 

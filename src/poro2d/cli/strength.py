@@ -198,8 +198,9 @@ def print_strength(result: StrengthResult, out: Path) -> None:
     if any(r.get("tests_dilation_stopped") is not None for r in result["cases"]):
         console.print(
             "tau/sigma residual: over the last fifth of each curve, whether or not the plate still rises; "
-            "t/s dilation stopped: over the tests whose plate stopped rising (|d plate / d shear| <= "
-            f"{DILATION_RATE_LIMIT:g}), on the plate's / the shear plane's normal stress, with how many did"
+            "t/s dilation stopped: over the tests whose plate stopped rising (net d plate / d shear within "
+            f"{DILATION_RATE_LIMIT:g} over a final stretch), on the plate's / the shear plane's normal "
+            "stress, with how many did"
         )
     if scale is not None:
         console.print(scale.note())

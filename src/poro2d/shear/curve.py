@@ -19,7 +19,6 @@ from poro2d.dem.contacts import ContactSet
 from poro2d.shear.box import UPPER_SIDE_WALLS, SplitBox
 from poro2d.shear.fit import peak, smooth
 from poro2d.shear.parts import EndValues, ForceBalance
-from poro2d.shear.residual import ResidualAtRest, dilation_stopped_residual
 from poro2d.shear.settings import ShearSettings, inertial_number
 from poro2d.store import Store
 from poro2d.typed_result import TypedResult
@@ -222,7 +221,6 @@ class CurveSummary:
     normal_stress_mean_error: float
     force_balance: ForceBalance
     plane_load_fraction_at_peak: float
-    residual_dilation_stopped: ResidualAtRest
 
 
 def curve_summary(rows: list[CurveRow], sigma_kpa: float, settings: ShearSettings) -> CurveSummary:
@@ -254,7 +252,6 @@ def curve_summary(rows: list[CurveRow], sigma_kpa: float, settings: ShearSetting
         normal_stress_mean_error=float(np.mean(sig_err)),
         force_balance=force_balance(x, col, s.peak_window),
         plane_load_fraction_at_peak=plane_load_fraction(x, col, k, s.peak_window),
-        residual_dilation_stopped=dilation_stopped_residual(col, s.peak_window),
     )
 
 

@@ -98,8 +98,12 @@ def _mean_sd(values: list[float]) -> tuple[float, float | None]:
 
 
 def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float, friction: float,
-                 window_m: float) -> tuple[StrengthCase, list[dict]]:  # fmt: skip
-    """One case's row (means and spreads over the specimens) and its rows of ``strength_tests.csv``."""
+                 window_m: float, d_mean_m: Mapping[str, float]
+                 ) -> tuple[StrengthCase, list[dict]]:  # fmt: skip
+    """One case's row (means and spreads over the specimens) and its rows of ``strength_tests.csv``.
+
+    ``d_mean_m``: each specimen's mean disk diameter by label (the residual stretch's length).
+    """
     tests = []
     per_specimen = []
     for label, res in summary.series.items():
@@ -110,7 +114,7 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
             curve = res.curves[sigma]
             s_res, tau_res = residual_point(curve)
             psi = max_dilation_angle(curve, window_m)
-            stopped = dilation_stopped_residual(curve, window_m)
+            stopped = dilation_stopped_residual(curve, d_mean_m[label])
             res_pts.append((s_res, tau_res))
             psis.append(psi)
             tests.append({
@@ -217,6 +221,10 @@ class StrengthStudy:
         values = read_specimens(specimens, normal_stresses_kpa, base)
         scales = [box_scale(*v.box(), v.arrays["particles.radius"]) for v in values.contents()]
         self.box_scale = min(scales, key=lambda b: b.width_over_d_max)
+        self.d_mean_m = {
+            label: float(2.0 * np.mean(v.arrays["particles.radius"]))
+            for label, v in zip(values, values.contents(), strict=True)
+        }
         self.store = store
         self.progress = progress
         self.config = config or {}
@@ -248,7 +256,7 @@ class StrengthStudy:
             count = len(rep.jobs())
             summary = rep.finish(results[start : start + count], t0)
             start += count
-            row, case_tests = case_summary(rep, summary, *case, self.settings.peak_window)
+            row, case_tests = case_summary(rep, summary, *case, self.settings.peak_window, self.d_mean_m)
             rows.append(row)
             tests += case_tests
         result = StrengthResult(
