@@ -86,6 +86,9 @@ def main() -> None:
     ap.add_argument("--max-displacement", type=float, default=0.05)
     ap.add_argument("--processes", type=int, default=2)
     ap.add_argument("--keep", type=Path, default=None)
+    ap.add_argument(
+        "--labels", default="", help="the specimens' folder names, e.g. s0,s1 (default: s0, s1, ...)"
+    )
     ap.add_argument("--reference", type=float, default=0.289, help="the periodic cell's steady tau/sigma")
     args = ap.parse_args()
 
@@ -95,7 +98,7 @@ def main() -> None:
     from poro2d.specimen.specimen_set import SpecimenSet
 
     out = args.keep or Path(tempfile.mkdtemp(prefix="poro2d-box-residual-"))
-    labels = [f"s{k}" for k in range(len(args.specimens))]
+    labels = args.labels.split(",") if args.labels else [f"s{k}" for k in range(len(args.specimens))]
     specimens = SpecimenSet.accepted(dict(zip(labels, args.specimens, strict=True))).read()
     base = ShearSettings(max_displacement=args.max_displacement, stop_after_peak=0.0)
     jobs = []

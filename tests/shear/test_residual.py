@@ -9,6 +9,7 @@ import pytest
 from poro2d.shear import run_shear
 from poro2d.shear.residual import (
     DILATION_RATE_LIMIT,
+    built_up_mm,
     dilation_stopped_residual,
     final_stretch_rates,
     tail_residual,
@@ -107,6 +108,20 @@ def test_a_curve_shorter_than_the_least_stretch_is_not_reached():
     x = np.arange(0.0, 12.0 + 1e-9, STEP_MM)
     r = dilation_stopped_residual(curve(0.0 * x, x), D_MEAN)
     assert not r.reached and "shorter than 15 mm" in r.status and r.end_rate is None
+
+
+def test_the_stretch_starts_once_the_stress_has_built_up():
+    # no stress to 20 mm, 30 kPa after: smoothed over the 15 mm least stretch it reaches 90 % of 30 kPa
+    # where 90 % of the window lies beyond 20 mm, at 26 mm; the loading before is no residual
+    x = np.arange(0.0, 45.0 + 1e-9, STEP_MM)
+    c = curve(0.0 * x, x)
+    c["shear_stress_kpa"] = np.where(x < 20.0, 0.0, 30.0)
+    assert built_up_mm(c, 0.015) == pytest.approx(26.0, abs=0.06)
+    r = dilation_stopped_residual(c, D_MEAN)
+    assert r.start_mm == pytest.approx(26.0, abs=0.06) and r.stress_ratio == pytest.approx(0.3)
+    # 40 mm of it leave 14 mm after the build-up: under the least stretch
+    short = {k: v[x <= 40.0] for k, v in c.items()}
+    assert not dilation_stopped_residual(short, D_MEAN).reached
 
 
 def test_servo_jitter_does_not_hide_a_flat_curve():

@@ -14,7 +14,6 @@ from dataclasses import dataclass
 from typing import Any, ClassVar, TypeVar
 
 from poro2d.dem.summary import EngineSummary
-from poro2d.shear.residual import ResidualAtRest
 from poro2d.typed_result import TypedResult, part
 
 P = TypeVar("P", bound=TypedResult)
@@ -143,6 +142,40 @@ class FitInterval(FitRecord):
     dof: int | None = None
     friction_angle_ci_deg: list[float] | None = None
     cohesion_ci_kpa: list[float] | None = None
+
+
+@dataclass(eq=False)
+class ResidualAtRest(TypedResult):
+    """A test's residual read where the plate has stopped rising (a test's ``residual_dilation_stopped``).
+
+    ``reached``: whether the curve ends in a stretch at least ``min_stretch_m`` long whose
+    plate slope, and its halves' slopes, stay within ``rate_limit``; ``status`` says so in
+    words. The stretch runs from ``start_mm`` to ``end_mm`` of shear displacement; over it, the
+    means of the shear stress, the plate's and the plane's normal stress and the upper walls'
+    upward friction (kPa), the shear stress over each normal stress (``stress_ratio``: the
+    plate's, ``plane_stress_ratio``: the plane's), the plane's share of the plate's stress, and
+    the plate's slope (``dilation_rate``) and the larger of its halves' (``max_part_rate``,
+    absolute). ``end_rate``: the slope over the last ``min_stretch_m`` of the curve, reached or
+    not. The numbers are None when it was not reached (the plane's when the curve has no plane
+    record, an earlier poro2d's).
+    """
+
+    reached: bool
+    status: str
+    rate_limit: float
+    min_stretch_m: float
+    start_mm: float | None
+    end_mm: float
+    shear_stress_kpa: float | None
+    normal_stress_kpa: float | None
+    plane_normal_stress_kpa: float | None
+    upper_wall_friction_kpa: float | None
+    stress_ratio: float | None
+    plane_stress_ratio: float | None
+    plane_share: float | None
+    dilation_rate: float | None
+    max_part_rate: float | None
+    end_rate: float | None
 
 
 @dataclass(eq=False)
@@ -326,6 +359,6 @@ class StrengthCase(TypedResult):
 __all__ = [
     "BoxRecord", "ConsolidationRecord", "EndValues", "FitInterval", "FitRecord", "ForceBalance",
     "LabComparison", "LabPeak", "LabRecord", "QuasiStatic", "RateCheck", "RateCheckRow",
-    "ShearSettingsRecord", "StrengthCase", "StrengthDefinitions", "StressPeaks", "TestSummary",
-    "part", "parts",
+    "ResidualAtRest", "ShearSettingsRecord", "StrengthCase", "StrengthDefinitions", "StressPeaks",
+    "TestSummary", "part", "parts",
 ]  # fmt: skip

@@ -11,7 +11,8 @@ tenths of a millimetre as force chains build and buckle, so its slope over a few
 swings by +-0.05 to 0.1 long after the dilation has ended (measured on the paper's box,
 docs/shear.md). What Taylor's balance needs is the plate's net rate over the stretch averaged.
 So the rate here is the least-squares slope of the plate's height against shear displacement,
-and the residual stretch is the longest final stretch of the curve, at least
+and the residual stretch is the longest final stretch of the curve once the stress has built up
+(:data:`BUILT_UP_FRACTION` of its largest value), at least
 :data:`MIN_STRETCH_DIAMETERS` mean disk diameters long, whose slope, and the slope of each of its
 two halves (a rise followed by a fall is no rest), stay within :data:`DILATION_RATE_LIMIT`: the
 dilatancy left in its tau/sigma is below that limit. A curve with no such stretch says "not
@@ -27,11 +28,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
 
 import numpy as np
 
-from poro2d.typed_result import TypedResult
+from poro2d.shear.fit import smooth
+from poro2d.shear.parts import ResidualAtRest
 
 #: the largest |net d(plate height) / d(shear displacement)| of a stretch read as "dilation stopped":
 #: by Taylor's balance the dilatancy left in its mean tau/sigma is below this
@@ -39,42 +40,11 @@ DILATION_RATE_LIMIT = 0.02
 #: the shortest residual stretch, in mean disk diameters: over shorter ones the plate's rise and
 #: fall by a few tenths of a millimetre reads as a rate beyond the limit
 MIN_STRETCH_DIAMETERS = 4.0
+#: the residual stretch starts once the smoothed shear stress has first reached this part of its
+#: largest value: the loading before it is no residual, whatever the plate does there
+BUILT_UP_FRACTION = 0.9
 #: the part of each test's shear displacement, at its end, that the strength study's residual averages
 TAIL_FRACTION = 0.2
-
-
-@dataclass(eq=False)
-class ResidualAtRest(TypedResult):
-    """A test's residual read where the plate has stopped rising (a test's ``residual_dilation_stopped``).
-
-    ``reached``: whether the curve ends in a stretch at least ``min_stretch_m`` long whose
-    plate slope, and its halves' slopes, stay within ``rate_limit``; ``status`` says so in
-    words. The stretch runs from ``start_mm`` to ``end_mm`` of shear displacement; over it, the
-    means of the shear stress, the plate's and the plane's normal stress and the upper walls'
-    upward friction (kPa), the shear stress over each normal stress (``stress_ratio``: the
-    plate's, ``plane_stress_ratio``: the plane's), the plane's share of the plate's stress, and
-    the plate's slope (``dilation_rate``) and the larger of its halves' (``max_part_rate``,
-    absolute). ``end_rate``: the slope over the last ``min_stretch_m`` of the curve, reached or
-    not. The numbers are None when it was not reached (the plane's when the curve has no plane
-    record, an earlier poro2d's).
-    """
-
-    reached: bool
-    status: str
-    rate_limit: float
-    min_stretch_m: float
-    start_mm: float | None
-    end_mm: float
-    shear_stress_kpa: float | None
-    normal_stress_kpa: float | None
-    plane_normal_stress_kpa: float | None
-    upper_wall_friction_kpa: float | None
-    stress_ratio: float | None
-    plane_stress_ratio: float | None
-    plane_share: float | None
-    dilation_rate: float | None
-    max_part_rate: float | None
-    end_rate: float | None
 
 
 def _sums(x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -89,13 +59,15 @@ def _slope(sums: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return (n * sxy - sx * sy) / (n * sxx - sx * sx)
 
 
-def final_stretch_rates(x_mm: np.ndarray, plate_mm: np.ndarray, min_mm: float) -> tuple[np.ndarray, ...]:
-    """For every start record i whose final stretch [x_i, x_end] is at least ``min_mm`` long:
-    (i, the plate's slope over the stretch, the larger absolute slope of its two halves)."""
+def final_stretch_rates(
+    x_mm: np.ndarray, plate_mm: np.ndarray, min_mm: float, after_mm: float = -math.inf
+) -> tuple[np.ndarray, ...]:
+    """For every start record i at or after ``after_mm`` whose final stretch [x_i, x_end] is at least
+    ``min_mm`` long: (i, the plate's slope over the stretch, the larger absolute slope of its two halves)."""
     x, y = np.asarray(x_mm, float), np.asarray(plate_mm, float)
     sums = _sums(x - x[0], y)
     n = x.size
-    start = np.flatnonzero(x[-1] - x >= min_mm)
+    start = np.flatnonzero((x[-1] - x >= min_mm) & (x >= after_mm))
     start = start[n - start >= 4]  # two records a half at least
     end = np.full(start.size, n)
     mid = start + (end - start) // 2
@@ -108,21 +80,37 @@ def _mean(values) -> float | None:
     return m if math.isfinite(m) else None
 
 
+def built_up_mm(curve: Mapping[str, np.ndarray], window_m: float) -> float:
+    """Where the shear stress, smoothed over ``window_m``, first reaches ``BUILT_UP_FRACTION`` of its
+    largest smoothed value (mm of shear displacement)."""
+    x = np.asarray(curve["shear_displacement_mm"], float)
+    tau = smooth(x, curve["shear_stress_kpa"], 1e3 * window_m)
+    return float(x[np.argmax(tau >= BUILT_UP_FRACTION * tau.max())])
+
+
 def dilation_stopped_residual(
     curve: Mapping[str, np.ndarray], d_mean_m: float, limit: float = DILATION_RATE_LIMIT
 ) -> ResidualAtRest:
     """The residual over the longest final stretch of ``curve`` (at least ``MIN_STRETCH_DIAMETERS``
-    times ``d_mean_m`` long) whose plate slope and halves' slopes stay within ``limit``.
+    times ``d_mean_m`` long, starting once the stress has built up: :func:`built_up_mm`, smoothed
+    over that least stretch) whose plate slope and halves' slopes stay within ``limit``.
 
-    Without such a stretch the result says "not reached" and holds no numbers.
+    The loading is no residual: a plate that sank while the stress built up and rose as much by
+    the peak has a net slope of zero without any rest. The start is not the peak itself: in a box
+    of a few thousand disks the largest stress may come late, in one of the stick-slip surges of
+    the residual stretch, which the long smoothing evens out. Without such a stretch the result
+    says "not reached" and holds no numbers.
     """
     min_m = MIN_STRETCH_DIAMETERS * d_mean_m
     x = np.asarray(curve["shear_displacement_mm"], float)
-    start, whole, parts = final_stretch_rates(x, curve["plate_displacement_mm"], 1e3 * min_m)
+    start, whole, parts = final_stretch_rates(
+        x, curve["plate_displacement_mm"], 1e3 * min_m, built_up_mm(curve, min_m)
+    )
     end = float(x[-1])
     if start.size == 0:
         status = (
-            f"not reached: the curve is shorter than {1e3 * min_m:.3g} mm ({MIN_STRETCH_DIAMETERS:g} d_mean)"
+            f"not reached: the curve after the stress built up is shorter than {1e3 * min_m:.3g} mm "
+            f"({MIN_STRETCH_DIAMETERS:g} d_mean)"
         )
         return ResidualAtRest(False, status, limit, min_m, None, end, *([None] * 10))
     last = float(whole[-1])
@@ -165,6 +153,6 @@ def tail_residual(curve: Mapping[str, np.ndarray], fraction: float = TAIL_FRACTI
 
 
 __all__ = [
-    "DILATION_RATE_LIMIT", "MIN_STRETCH_DIAMETERS", "TAIL_FRACTION", "ResidualAtRest",
-    "dilation_stopped_residual", "final_stretch_rates", "tail_residual",
+    "BUILT_UP_FRACTION", "DILATION_RATE_LIMIT", "MIN_STRETCH_DIAMETERS", "TAIL_FRACTION", "ResidualAtRest",
+    "built_up_mm", "dilation_stopped_residual", "final_stretch_rates", "tail_residual",
 ]  # fmt: skip
