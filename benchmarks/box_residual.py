@@ -90,6 +90,7 @@ def main() -> None:
         "--labels", default="", help="the specimens' folder names, e.g. s0,s1 (default: s0, s1, ...)"
     )
     ap.add_argument("--reference", type=float, default=0.289, help="the periodic cell's steady tau/sigma")
+    ap.add_argument("--window-from", type=float, default=20.0, help="mm: the fixed window's start")
     args = ap.parse_args()
 
     from poro2d.shear import ShearSettings
@@ -134,78 +135,81 @@ def main() -> None:
     report(jobs, results, args, out)
 
 
+def window(curve, from_mm: float) -> dict:
+    """Over [from_mm, end]: mean tau over the plate's and the plane's mean normal stress, the plate's
+    least-squares slope, and each ratio less that slope (Taylor's balance averaged over the window:
+    mean tau / sigma = mu + net rise / shear, so the slope is the dilatancy left in the mean)."""
+    import numpy as np
+
+    x = curve["shear_displacement_mm"]
+    inside = x >= from_mm
+    tau = float(np.mean(curve["shear_stress_kpa"][inside]))
+    plate = tau / float(np.mean(curve["normal_stress_kpa"][inside]))
+    plane = tau / float(np.mean(curve["plane_normal_stress_kpa"][inside]))
+    slope = float(np.polyfit(x[inside], curve["plate_displacement_mm"][inside], 1)[0])
+    return {"window_from_mm": from_mm, "window_ratio_plate": plate, "window_ratio_plane": plane,
+            "window_plate_slope": slope, "window_taylor_plate": plate - slope,
+            "window_taylor_plane": plane - slope}  # fmt: skip
+
+
 def report(jobs, results, args, out: Path) -> None:
     from poro2d.shear.residual import dilation_stopped_residual, tail_residual
 
     rows = []
-    head = (
-        f"{'f_p':>4} {'wall':>4} {'damp':>4} {'v':>4} {'spec':>4} {'from mm':>7} {'tau/sig plate':>13} "
-        f"{'tau/sig plane':>13} {'share':>5} {'wall kPa':>8} {'tail plate':>10} {'peak':>6} {'time s':>6}"
-    )
-    print(head)
+    print(f"{'f_p':>4} {'wall':>4} {'damp':>4} {'v':>4} {'spec':>4} | dilation stopped: {'from':>5} "
+          f"{'plate':>6} {'plane':>6} {'share':>5} | from {args.window_from:g} mm: {'plate':>6} {'plane':>6} "
+          f"{'slope':>6} {'pl-sl':>6} {'pn-sl':>6} | {'tail':>6} {'peak':>6} {'time s':>6}")  # fmt: skip
     for (c, spec_label, _job), res in zip(jobs, results, strict=True):
         r = dilation_stopped_residual(res.curve, res.d_mean_m)
+        w = window(res.curve, args.window_from)
         tail = tail_residual(res.curve)
-        row = {
-            **c,
-            "specimen": spec_label,
-            "normal_stress_kpa": res.normal_stress_kpa,
-            "peak_stress_ratio": res.peak_stress_ratio,
-            "tail_ratio_plate": tail,
-            "wall_time_shear_s": res.wall_time_shear_s,
-            **r.to_dict(),
-        }
+        row = {**c, "specimen": spec_label, "normal_stress_kpa": res.normal_stress_kpa,
+               "peak_stress_ratio": res.peak_stress_ratio, "tail_ratio_plate": tail,
+               "wall_time_shear_s": res.wall_time_shear_s, **w, **r.to_dict()}  # fmt: skip
         rows.append(row)
-        if r.reached:
-            nums = (
-                f"{r.start_mm:7.1f} {r.stress_ratio:13.3f} {r.plane_stress_ratio:13.3f} "
-                f"{r.plane_share:5.2f} {r.upper_wall_friction_kpa:8.1f}"
-            )
-        else:
-            nums = f"{'not reached':>51}"
-        print(
-            f"{c['particle_friction']:4g} {c['friction_wall']:4g} {c['local_damping']:4g} {c['speed']:4g} "
-            f"{spec_label:>4} {nums} {tail:10.3f} {res.peak_stress_ratio:6.3f} {res.wall_time_shear_s:6.0f}"
-        )
+        stopped = (f"{r.start_mm:5.1f} {r.stress_ratio:6.3f} {r.plane_stress_ratio:6.3f} {r.plane_share:5.2f}"
+                   if r.reached else f"{'not reached':>26}")  # fmt: skip
+        print(f"{c['particle_friction']:4g} {c['friction_wall']:4g} {c['local_damping']:4g} {c['speed']:4g} "
+              f"{spec_label:>4} | {'':17} {stopped} | {'':{len(f'from {args.window_from:g} mm:')}} "
+              f"{w['window_ratio_plate']:6.3f} {w['window_ratio_plane']:6.3f} "
+              f"{w['window_plate_slope']:+6.3f} "
+              f"{w['window_taylor_plate']:6.3f} {w['window_taylor_plane']:6.3f} | {tail:6.3f} "
+              f"{res.peak_stress_ratio:6.3f} {res.wall_time_shear_s:6.0f}")  # fmt: skip
     summarise(rows, args.reference)
     (out / "box_residual.json").write_text(
         json.dumps(
             {"specimens": [str(s) for s in args.specimens], "reference": args.reference, "rows": rows},
             indent=2,
-        )
+        )  # fmt: skip
     )
     print(f"table in {out / 'box_residual.json'}")
 
 
 def summarise(rows: list[dict], reference: float) -> None:
-    """Per case: the mean over the specimens of the residual on the plate and on the plane,
-    against the reference."""
-    print(f"\nmeans over specimens (reference tau/sigma {reference:g}):")
-    keys = sorted(
-        {(r["particle_friction"], r["friction_wall"], r["local_damping"], r["speed"]) for r in rows},
-        key=lambda k: (-k[0], -k[1], -k[2], -k[3]),
-    )
+    """Per case, means over the specimens: the residual where dilation stopped (those that reached
+    it) and the window's Taylor-corrected ratios, on the plate and on the plane, against the reference."""
+    print(f"\nmeans over specimens (reference tau/sigma {reference:g}; differences in brackets):")
+    case_of = lambda r: (r["particle_friction"], r["friction_wall"], r["local_damping"], r["speed"])  # noqa: E731
+    keys = sorted({case_of(r) for r in rows}, key=lambda k: (-k[0], -k[1], -k[2], -k[3]))
+
+    def mean(got, key):
+        vals = [r[key] for r in got if r.get(key) is not None]
+        return (sum(vals) / len(vals), len(vals)) if vals else (math.nan, 0)
+
     for key in keys:
         got = [
             r
             for r in rows
             if (r["particle_friction"], r["friction_wall"], r["local_damping"], r["speed"]) == key
         ]
-        done = [r for r in got if r["reached"]]
-        if not done:
-            print(
-                f"  f_p {key[0]:g} wall {key[1]:g} damping {key[2]:g} v x{key[3]:g}: not reached ({len(got)})"
-            )
-            continue
-        plate = sum(r["stress_ratio"] for r in done) / len(done)
-        plane = sum(r["plane_stress_ratio"] for r in done) / len(done)
-        spread = max(r["plane_stress_ratio"] for r in done) - min(r["plane_stress_ratio"] for r in done)
-        print(
-            f"  f_p {key[0]:g} wall {key[1]:g} damping {key[2]:g} v x{key[3]:g}: plate {plate:.3f} "
-            f"({plate - reference:+.3f}), plane {plane:.3f} ({plane - reference:+.3f}), "
-            f"range on the plane {spread:.3f}, {len(done)} of {len(got)} specimens"
-            + ("" if math.isfinite(plane) else " (no plane record)")
-        )
+        plate, k = mean(got, "stress_ratio")
+        plane, _ = mean(got, "plane_stress_ratio")
+        tp, n = mean(got, "window_taylor_plate")
+        tn, _ = mean(got, "window_taylor_plane")
+        print(f"  f_p {key[0]:g} wall {key[1]:g} damping {key[2]:g} v x{key[3]:g}: dilation stopped in {k} "
+              f"of {len(got)}: plate {plate:.3f} ({plate - reference:+.3f}), plane {plane:.3f} "
+              f"({plane - reference:+.3f}); window less slope, {n}: plate {tp:.3f} ({tp - reference:+.3f}), "
+              f"plane {tn:.3f} ({tn - reference:+.3f})")  # fmt: skip
 
 
 if __name__ == "__main__":
