@@ -1,8 +1,8 @@
 """The direct shear box's residual against the periodic critical-state reference, with its biases.
 
-    python benchmarks/box_residual.py SPECIMEN [SPECIMEN ...] [--friction 3,0.5]
+    python benchmarks/box_residual.py SPECIMEN [SPECIMEN ...] [--labels s0,s1] [--friction 3,0.5]
         [--wall-friction 1.5,0.5,0] [--damping 0.3,0.1] [--damping-wall 0] [--half-velocity 0.5]
-        [--normal-stress 100] [--max-displacement 0.05] [--processes 2] [--keep DIR]
+        [--normal-stress 100] [--max-displacement 0.05] [--window-from 20] [--processes 2] [--keep DIR]
 
 Each specimen (a criterion folder that accepted it; one per seed) is sheared at the normal
 stress, long enough for the plate to stop rising, for every particle friction f_p and:
@@ -13,13 +13,17 @@ stress, long enough for the plate to stop rising, for every particle friction f_
   ``--damping-wall``, damping 0.7: the drag of local damping scales with the disks' speed.
 
 Per test it prints the residual read where dilation has stopped
-(:func:`poro2d.shear.residual.dilation_stopped_residual`): tau/sigma on the plate's stress
-and on the shear plane's own normal stress, the plane's share of the plate's load, the
-upper walls' friction, and the mean over the last fifth of the curve (the strength study's
-window) for comparison. The reference to read them against is the periodic cell's steady
-tau/sigma of the same disks (docs/critical-state.md: 0.289 +- 0.001 at f_p 0.5, no rolling
-friction, 100 kPa, I = 1e-3). Tests are kept in DIR (default: a temporary folder; a rerun
-with the same DIR reads finished tests back) and the table is written as box_residual.json.
+(:func:`poro2d.shear.residual.dilation_stopped_residual`): tau/sigma on the plate's stress and
+on the shear plane's own normal stress, and the plane's share of the plate's load; beside it,
+over a fixed window from ``--window-from`` mm to the end, the same ratios, the plate's net
+slope and each ratio less that slope (Taylor's correction, which every test has), the mean
+over the last fifth of the curve (the strength study's window) and the peak. Then, per case,
+the means over the specimens against the periodic cell's steady tau/sigma of the same disks
+(``--reference``; docs/critical-state.md: 0.289 +- 0.001 at f_p 0.5, no rolling friction,
+100 kPa, I = 1e-3). Tests are kept in DIR/<case>/<label> (default: a temporary folder; a rerun
+with the same DIR reads finished tests back, so cases run in parts are printed together) and
+the table is written as box_residual.json. docs/shear.md ("The box's biases measured") has the
+numbers.
 """
 
 from __future__ import annotations

@@ -195,3 +195,20 @@ def test_the_table_cells_say_not_reached_and_leave_earlier_tests_blank():
     case = {"tests_dilation_stopped": 2, "residual_dilation_stopped_ratio_mean": 0.31,
             "residual_dilation_stopped_plane_ratio_mean": 0.29}  # fmt: skip
     assert _stopped(case) == "0.310 / 0.290 (2)"
+
+
+def test_a_strength_case_averages_only_the_tests_that_reached_a_residual():
+    from poro2d.shear.strength import dilation_stopped_means
+
+    tests = [
+        {"residual_dilation_stopped_ratio": 0.30, "residual_dilation_stopped_plane_ratio": 0.28},
+        {"residual_dilation_stopped_ratio": None, "residual_dilation_stopped_plane_ratio": None},
+        {"residual_dilation_stopped_ratio": 0.36, "residual_dilation_stopped_plane_ratio": 0.32},
+    ]
+    means = dilation_stopped_means(tests)
+    assert means["tests_dilation_stopped"] == 2
+    assert means["residual_dilation_stopped_ratio_mean"] == pytest.approx(0.33)
+    assert means["residual_dilation_stopped_plane_ratio_mean"] == pytest.approx(0.30)
+    none = dilation_stopped_means(tests[1:2])
+    assert none["tests_dilation_stopped"] == 0 and none["residual_dilation_stopped_ratio_mean"] is None
+    assert none["residual_dilation_stopped_plane_ratio_mean"] is None
