@@ -211,6 +211,35 @@ def _sci(v) -> str:
     return "inf" if v is None else f"{v:.2e}"
 
 
+def residual_cells(residual) -> tuple[str, str]:
+    """The residual read where dilation stopped, on the plate's and the plane's normal stress:
+    two cells of the table ("not reached" when the plate never stopped; "-" for a test of an
+    earlier poro2d, which did not read it)."""
+    if residual is None:
+        return "-", "-"
+    if not residual["reached"]:
+        return "not reached", "not reached"
+    plane = residual["plane_stress_ratio"]
+    return f"{residual['stress_ratio']:.3f}", "-" if plane is None else f"{plane:.3f}"
+
+
+def print_residual_note(tests) -> None:
+    """What the residual columns are, and where each test's stretch lies."""
+    read = [t for t in tests if t.get("residual_dilation_stopped") is not None]
+    if not read:
+        return
+    first = read[0]["residual_dilation_stopped"]
+    stretches = "; ".join(
+        f"{t['normal_stress_kpa']:g} kPa: {t['residual_dilation_stopped']['status']}" for t in read
+    )
+    console.print(
+        f"resid. t/s: the residual tau/sigma where dilation stopped (the plate's net slope against the "
+        f"shear displacement within {first['rate_limit']:g} over the final stretch and its halves, at least "
+        f"{1e3 * first['min_stretch_m']:.3g} mm long), on the plate's and on the shear plane's normal stress "
+        f"({stretches})"
+    )
+
+
 def print_result(result: ShearSeriesResult, out: Path) -> None:
     t = Table(title="direct shear")
     for col in (
@@ -220,6 +249,8 @@ def print_result(result: ShearSeriesResult, out: Path) -> None:
         "tau/sigma",
         "end kPa",
         "dy_end mm",
+        "resid. t/s plate",
+        "resid. t/s plane",
         "max I",
         "time s",
     ):
@@ -229,9 +260,11 @@ def print_result(result: ShearSeriesResult, out: Path) -> None:
             f"{r['normal_stress_kpa']:g}", f"{r['peak_shear_stress_kpa']:.2f}",
             f"{1e3 * r['shear_displacement_at_peak_m']:.2f}", f"{r['peak_stress_ratio']:.3f}",
             f"{r['end']['shear_stress_kpa']:.2f}", f"{r['end']['plate_displacement_mm']:.3f}",
+            *residual_cells(r.get("residual_dilation_stopped")),
             _sci(r["max_inertial_number"]), f"{r['wall_time_s']:.0f}",
         )  # fmt: skip
     console.print(t)
+    print_residual_note(result["tests"])
     from poro2d.shear.box_scale import box_scale_of
 
     scale = box_scale_of(result)

@@ -160,13 +160,31 @@ def _deg(mean, sd) -> str:
     return f"{mean:.1f}" + ("" if sd is None else f" +- {sd:.1f}")
 
 
+def _stopped(case) -> str:
+    """A case's residual where dilation stopped: plate / plane (k tests), "not reached", or "-"
+    (a study of an earlier poro2d)."""
+    k = case.get("tests_dilation_stopped")
+    if k is None:
+        return "-"
+    if not k:
+        return "not reached"
+    plane = case.get("residual_dilation_stopped_plane_ratio_mean")
+    return (
+        f"{case['residual_dilation_stopped_ratio_mean']:.3f} / "
+        + ("-" if plane is None else f"{plane:.3f}")
+        + f" ({k})"
+    )
+
+
 def print_strength(result: StrengthResult, out: Path) -> None:
     from poro2d.shear.box_scale import box_scale_of
+    from poro2d.shear.residual import DILATION_RATE_LIMIT
 
     scale = box_scale_of(result)
     label = f"{scale.label()} " if scale is not None and scale.label() else ""
     t = Table(title=f"{label}strength against rolling and particle friction (mean +- sd over specimens)")
-    for col in ("mu_r", "f_p", "phi peak deg", "phi residual deg", "psi max deg", "tau/sigma residual"):
+    for col in ("mu_r", "f_p", "phi peak deg", "phi residual deg", "psi max deg", "tau/sigma residual",
+                "t/s dilation stopped"):  # fmt: skip
         t.add_column(col, justify="right")
     for r in result["cases"]:
         t.add_row(
@@ -174,9 +192,16 @@ def print_strength(result: StrengthResult, out: Path) -> None:
             _deg(r["peak_friction_angle_mean_deg"], r["peak_friction_angle_sd_deg"]),
             _deg(r["residual_friction_angle_mean_deg"], r["residual_friction_angle_sd_deg"]),
             _deg(r["max_dilation_angle_mean_deg"], r["max_dilation_angle_sd_deg"]),
-            f"{r['residual_stress_ratio_mean']:.3f}",
+            f"{r['residual_stress_ratio_mean']:.3f}", _stopped(r),
         )  # fmt: skip
     console.print(t)
+    if any(r.get("tests_dilation_stopped") is not None for r in result["cases"]):
+        console.print(
+            "tau/sigma residual: over the last fifth of each curve, whether or not the plate still rises; "
+            "t/s dilation stopped: over the tests whose plate stopped rising (net d plate / d shear within "
+            f"{DILATION_RATE_LIMIT:g} over a final stretch), on the plate's / the shear plane's normal "
+            "stress, with how many did"
+        )
     if scale is not None:
         console.print(scale.note())
         if scale.warning():

@@ -145,6 +145,40 @@ class FitInterval(FitRecord):
 
 
 @dataclass(eq=False)
+class ResidualAtRest(TypedResult):
+    """A test's residual read where the plate has stopped rising (a test's ``residual_dilation_stopped``).
+
+    ``reached``: whether the curve ends in a stretch at least ``min_stretch_m`` long whose
+    plate slope, and its halves' slopes, stay within ``rate_limit``; ``status`` says so in
+    words. The stretch runs from ``start_mm`` to ``end_mm`` of shear displacement; over it, the
+    means of the shear stress, the plate's and the plane's normal stress and the upper walls'
+    upward friction (kPa), the shear stress over each normal stress (``stress_ratio``: the
+    plate's, ``plane_stress_ratio``: the plane's), the plane's share of the plate's stress, and
+    the plate's slope (``dilation_rate``) and the larger of its halves' (``max_part_rate``,
+    absolute). ``end_rate``: the slope over the last ``min_stretch_m`` of the curve, reached or
+    not. The numbers are None when it was not reached (the plane's when the curve has no plane
+    record, an earlier poro2d's).
+    """
+
+    reached: bool
+    status: str
+    rate_limit: float
+    min_stretch_m: float
+    start_mm: float | None
+    end_mm: float
+    shear_stress_kpa: float | None
+    normal_stress_kpa: float | None
+    plane_normal_stress_kpa: float | None
+    upper_wall_friction_kpa: float | None
+    stress_ratio: float | None
+    plane_stress_ratio: float | None
+    plane_share: float | None
+    dilation_rate: float | None
+    max_part_rate: float | None
+    end_rate: float | None
+
+
+@dataclass(eq=False)
 class TestSummary(TypedResult):
     """One test's line of a series' ``result.json`` (and ``peaks.csv``, without its nested parts)."""
 
@@ -168,11 +202,13 @@ class TestSummary(TypedResult):
     consolidation_normal_stress_error: float
     folder: str
     plane_load_fraction_at_peak: float | None = None
+    residual_dilation_stopped: ResidualAtRest | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("plane_load_fraction_at_peak",)
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("plane_load_fraction_at_peak", "residual_dilation_stopped")
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "end": EndValues,
         "force_balance": ForceBalance,
+        "residual_dilation_stopped": ResidualAtRest,
     }
 
 
@@ -288,7 +324,9 @@ class StrengthCase(TypedResult):
 
     Peak and residual friction angles and the dilation angle, mean and sd over the specimens
     (None when no specimen gave one; the sd None with one specimen); the pooled fits over
-    every specimen's points with their intervals; the mean residual stress ratio.
+    every specimen's points with their intervals; the mean residual stress ratio (the last fifth of
+    each curve), and the mean tau/sigma where dilation stopped, on the plate and on the plane,
+    over the ``tests_dilation_stopped`` tests that reached it.
     """
 
     mu_r: float
@@ -306,11 +344,21 @@ class StrengthCase(TypedResult):
     residual_friction_angle_pooled_deg: float
     residual_friction_angle_pooled_ci_deg: list[float] | None
     residual_stress_ratio_mean: float
+    residual_dilation_stopped_ratio_mean: float | None = None
+    residual_dilation_stopped_plane_ratio_mean: float | None = None
+    tests_dilation_stopped: int | None = None
+
+    # the residual read where dilation stopped (poro2d.shear.residual): the means over the tests
+    # that reached it (None when none did) and how many did; absent in a study of an earlier poro2d
+    OPTIONAL: ClassVar[tuple[str, ...]] = (
+        "residual_dilation_stopped_ratio_mean", "residual_dilation_stopped_plane_ratio_mean",
+        "tests_dilation_stopped",
+    )  # fmt: skip
 
 
 __all__ = [
     "BoxRecord", "ConsolidationRecord", "EndValues", "FitInterval", "FitRecord", "ForceBalance",
     "LabComparison", "LabPeak", "LabRecord", "QuasiStatic", "RateCheck", "RateCheckRow",
-    "ShearSettingsRecord", "StrengthCase", "StrengthDefinitions", "StressPeaks", "TestSummary",
-    "part", "parts",
+    "ResidualAtRest", "ShearSettingsRecord", "StrengthCase", "StrengthDefinitions", "StressPeaks",
+    "TestSummary", "part", "parts",
 ]  # fmt: skip

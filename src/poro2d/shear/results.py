@@ -25,6 +25,7 @@ from poro2d.shear.parts import (
     StressPeaks,
     TestSummary,
 )
+from poro2d.shear.residual import ResidualAtRest
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
@@ -74,12 +75,16 @@ class ShearTestResult(TypedResult):
     # the part of the plate's load the shear plane carries at the peak (absent in a test of an
     # earlier poro2d): see poro2d.shear.curve.plane_load_fraction
     plane_load_fraction_at_peak: float | None = None
+    # the residual read where the plate has stopped rising (absent in a test of an earlier
+    # poro2d): see poro2d.shear.residual
+    residual_dilation_stopped: ResidualAtRest | None = None
     curve: ShearCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("plane_load_fraction_at_peak",)
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("plane_load_fraction_at_peak", "residual_dilation_stopped")
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "end": EndValues,
         "force_balance": ForceBalance,
+        "residual_dilation_stopped": ResidualAtRest,
         "consolidation": ConsolidationRecord,
         "settings": ShearSettingsRecord,
         "engine": EngineSummary,

@@ -204,6 +204,7 @@ class ShearSeries:
             consolidation_normal_stress_error=t.consolidation["normal_stress_error"],
             folder=folder_name(t.normal_stress_kpa),
             plane_load_fraction_at_peak=t.plane_load_fraction_at_peak,
+            residual_dilation_stopped=t.residual_dilation_stopped,
         )
 
     def _quasi_static(self, tests: list[ShearTestResult]) -> QuasiStatic:

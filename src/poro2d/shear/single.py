@@ -38,6 +38,7 @@ from poro2d.shear.curve import (
 )
 from poro2d.shear.parts import ConsolidationRecord
 from poro2d.shear.peak_frame import PeakFrame
+from poro2d.shear.residual import dilation_stopped_residual
 from poro2d.shear.results import ShearTestResult
 from poro2d.shear.settings import inertial_number
 from poro2d.shear.shear_stage import ShearStage, remove_stage_files
@@ -191,7 +192,6 @@ class DirectShearTest:
         )  # fmt: skip
         wall = stage.run()
         result = self._result(stage.rows, info, stage.sim, wall)
-        result.curve = curve_columns(stage.rows)
         if self.store is not None:
             self.store.write_csv("curve.csv", stage.rows, header=CURVE_COLUMNS)
             if self.figures and stage.peak.frame is not None:
@@ -216,6 +216,8 @@ class DirectShearTest:
         """The test's ``result.json``: what the curve says, and how it was obtained."""
         s = self.settings
         rho = float(np.mean(sim.particles.density)) * sim.density_scale
+        d_mean = float(2.0 * np.mean(sim.particles.radius))
+        curve = curve_columns(rows)
         return ShearTestResult(
             **vars(curve_summary(rows, self.sigma_kpa, s)),
             inertial_number_at_target_stress=inertial_number(
@@ -226,7 +228,7 @@ class DirectShearTest:
             density_scale=sim.density_scale,
             local_damping=sim.local_damping,
             dt_s=sim.dt,
-            d_mean_m=float(2.0 * np.mean(sim.particles.radius)),
+            d_mean_m=d_mean,
             shear_steps=int(rows[-1].step) if rows else 0,
             records=len(rows),
             wall_time_shear_s=wall,
@@ -235,6 +237,8 @@ class DirectShearTest:
             specimen=self.case.specimen.source,
             engine=sim.summary(),
             provenance=Provenance.now(),
+            residual_dilation_stopped=dilation_stopped_residual(curve, d_mean),
+            curve=curve,
         )
 
     def run(self) -> ShearTestResult:

@@ -34,13 +34,14 @@ from poro2d.shear.case import ShearCase
 from poro2d.shear.fit import mohr_coulomb
 from poro2d.shear.parts import StrengthCase, StrengthDefinitions
 from poro2d.shear.replicates import ReplicateShear, mohr_coulomb_ci
+from poro2d.shear.residual import TAIL_FRACTION, dilation_stopped_residual
 from poro2d.shear.results import ReplicateShearResult, StrengthResult
 from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 
 #: the part of each test's shear displacement, at its end, that the residual strength averages
-RESIDUAL_FRACTION = 0.2
+RESIDUAL_FRACTION = TAIL_FRACTION
 #: the quick study: the paper's quick specimen sheared over a fifth of its 80 mm width (16 mm, about
 #: 4.6 d50): over 8 mm the curves with rolling resistance were still rising at the end (docs/shear.md)
 QUICK_STRENGTH_SHEAR = {"max_displacement": 0.016, "stop_after_peak": 0.0}
@@ -97,8 +98,12 @@ def _mean_sd(values: list[float]) -> tuple[float, float | None]:
 
 
 def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float, friction: float,
-                 window_m: float) -> tuple[StrengthCase, list[dict]]:  # fmt: skip
-    """One case's row (means and spreads over the specimens) and its rows of ``strength_tests.csv``."""
+                 window_m: float, d_mean_m: Mapping[str, float]
+                 ) -> tuple[StrengthCase, list[dict]]:  # fmt: skip
+    """One case's row (means and spreads over the specimens) and its rows of ``strength_tests.csv``.
+
+    ``d_mean_m``: each specimen's mean disk diameter by label (the residual stretch's length).
+    """
     tests = []
     per_specimen = []
     for label, res in summary.series.items():
@@ -109,6 +114,7 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
             curve = res.curves[sigma]
             s_res, tau_res = residual_point(curve)
             psi = max_dilation_angle(curve, window_m)
+            stopped = dilation_stopped_residual(curve, d_mean_m[label])
             res_pts.append((s_res, tau_res))
             psis.append(psi)
             tests.append({
@@ -118,6 +124,9 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
                 "residual_normal_stress_kpa": s_res, "residual_shear_stress_kpa": tau_res,
                 "residual_stress_ratio": tau_res / s_res, "max_dilation_angle_deg": psi,
                 "end_shear_displacement_m": t["end_shear_displacement_m"],
+                "residual_dilation_stopped_ratio": stopped.stress_ratio,
+                "residual_dilation_stopped_plane_ratio": stopped.plane_stress_ratio,
+                "residual_dilation_stopped_from_mm": stopped.start_mm if stopped.reached else None,
             })  # fmt: skip
         s, tau = np.array(res_pts).T
         per_specimen.append({
@@ -150,8 +159,26 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
         residual_friction_angle_pooled_deg=res_fit.friction_angle_deg,
         residual_friction_angle_pooled_ci_deg=res_fit.friction_angle_ci_deg,
         residual_stress_ratio_mean=float(np.mean([r["residual_stress_ratio"] for r in tests])),
+        **dilation_stopped_means(tests),
     )
     return row, tests
+
+
+def dilation_stopped_means(tests: list[dict]) -> dict:
+    """A case's mean residual tau/sigma where dilation stopped, on the plate and on the plane, over
+    the tests that reached it (None when none did), and how many did."""
+    plate = [
+        r["residual_dilation_stopped_ratio"]
+        for r in tests
+        if r["residual_dilation_stopped_ratio"] is not None
+    ]
+    plane = [r["residual_dilation_stopped_plane_ratio"] for r in tests
+             if r["residual_dilation_stopped_plane_ratio"] is not None]  # fmt: skip
+    return {
+        "residual_dilation_stopped_ratio_mean": float(np.mean(plate)) if plate else None,
+        "residual_dilation_stopped_plane_ratio_mean": float(np.mean(plane)) if plane else None,
+        "tests_dilation_stopped": len(plate),
+    }
 
 
 # ---------------------------------------------------------------------- the study
@@ -194,6 +221,10 @@ class StrengthStudy:
         values = read_specimens(specimens, normal_stresses_kpa, base)
         scales = [box_scale(*v.box(), v.arrays["particles.radius"]) for v in values.contents()]
         self.box_scale = min(scales, key=lambda b: b.width_over_d_max)
+        self.d_mean_m = {
+            label: float(2.0 * np.mean(v.arrays["particles.radius"]))
+            for label, v in zip(values, values.contents(), strict=True)
+        }
         self.store = store
         self.progress = progress
         self.config = config or {}
@@ -225,7 +256,7 @@ class StrengthStudy:
             count = len(rep.jobs())
             summary = rep.finish(results[start : start + count], t0)
             start += count
-            row, case_tests = case_summary(rep, summary, *case, self.settings.peak_window)
+            row, case_tests = case_summary(rep, summary, *case, self.settings.peak_window, self.d_mean_m)
             rows.append(row)
             tests += case_tests
         result = StrengthResult(
