@@ -21,16 +21,15 @@ from poro2d.criterion import run_criterion
 from poro2d.store import Store
 
 
-def config(mu_prep: float, rolling: float, seed: int, first: float, keep: bool) -> dict:
-    """The criterion config of one case: density mode's settings on the quick box."""
-    specimen = {
-        "width": 0.08, "height": 0.04, "layers": 2, "friction_prep": mu_prep,
-        "rolling_friction_prep": rolling, "settle_drift": 1e-3,
-    }  # fmt: skip
+def config(mu_prep: float, rolling: float, seed: int, first: float, keep: bool, full: bool = False) -> dict:
+    """The criterion config of one case: density mode's settings on the quick box (``full``: on
+    the paper's box under the fill acceptance, as the relation runs it)."""
+    box = {} if full else {"width": 0.08, "height": 0.04, "layers": 2}
+    specimen = {**box, "friction_prep": mu_prep, "rolling_friction_prep": rolling, "settle_drift": 1e-3}
     if keep:
         specimen["rolling_friction"] = rolling
     criterion = {
-        "acceptance": "plate", "force_fraction": 0.02, "refine_tolerance": 0.002,
+        "acceptance": "fill" if full else "plate", "force_fraction": 0.02, "refine_tolerance": 0.002,
         "max_iterations": 10, "trial_porosity": first,
     }  # fmt: skip
     return {"seed": seed, "specimen": specimen, "grading": {"preset": "paper"}, "criterion": criterion}
@@ -43,6 +42,7 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
     ap.add_argument("--first", type=float, default=0.22, help="first trial porosity")
     ap.add_argument("--keep-working", action="store_true", help="keep mu_r in the working values")
+    ap.add_argument("--full", action="store_true", help="the paper's box under the fill acceptance")
     ap.add_argument("--out", default=None, help="folder to keep each case's criterion files")
     args = ap.parse_args()
     print(
@@ -50,10 +50,12 @@ def main() -> None:
     )
     for rolling in args.rolling:
         for seed in args.seeds:
-            cfg = config(args.mu_prep, rolling, seed, args.first, args.keep_working)
+            cfg = config(args.mu_prep, rolling, seed, args.first, args.keep_working, args.full)
             store = None
             if args.out:
-                tag = f"mu{args.mu_prep:g}_r{rolling:g}{'_kept' if args.keep_working else ''}_s{seed}"
+                box = "full_" if args.full else ""
+                kept = "_kept" if args.keep_working else ""
+                tag = f"{box}mu{args.mu_prep:g}_r{rolling:g}{kept}_s{seed}"
                 store = Store(Path(args.out) / tag)
             t0 = time.perf_counter()
             res = run_criterion(cfg, store=store, progress=False)
