@@ -38,7 +38,7 @@ def solid_fraction(q: QuickSpecimen) -> float:
     return 1.0 - measure_specimen(p.pos, p.radius, q.width, q.height).interior_porosity
 
 
-def report(label: str, case: BiaxialCase, fraction: float) -> None:
+def report(label: str, case: BiaxialCase, fraction: float | None) -> None:
     t0 = time.perf_counter()
     test = run_biaxial(case, None, replicates=1, processes=1, progress=False).tests[0]
     c = test.curve
@@ -49,7 +49,8 @@ def report(label: str, case: BiaxialCase, fraction: float) -> None:
     )
     peak, end = test.peak_friction_angle_deg, test.critical_state_friction_angle_deg
     print(
-        f"{label:34s} {fraction:6.3f}  {eps}  {peak:5.1f} {end:5.1f} {peak - end:5.1f}  "
+        f"{label:34s} {'-' if fraction is None else f'{fraction:.3f}':>6s}  {eps}  "
+        f"{peak:5.1f} {end:5.1f} {peak - end:5.1f}  "
         f"{test.end_volumetric_strain:+.4f}  {time.perf_counter() - t0:5.0f}",
         flush=True,
     )
@@ -73,7 +74,7 @@ def main() -> None:
             q = QuickSpecimen(seed, **recipe)
             report(f"{name} quick, seed {seed}", BiaxialCase(q, args.confining, settings), solid_fraction(q))
     for folder in args.folders:
-        report(folder[-34:], BiaxialCase.of(folder, args.confining, settings), float("nan"))
+        report(folder[-34:], BiaxialCase.of(folder, args.confining, settings), None)
     p = args.confining
     print(f"Bolton (sands), p' {p:g} kPa: phi_peak - phi_cv = {bolton(0.0, p):.1f} deg at Dr 0, "
           f"{bolton(0.5, p):.1f} at Dr 0.5, {bolton(1.0, p):.1f} at Dr 1")  # fmt: skip
