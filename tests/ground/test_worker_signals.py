@@ -8,6 +8,8 @@ import subprocess
 import sys
 import textwrap
 
+from tests.conftest import default_sigint
+
 SCRIPT = textwrap.dedent(
     """
     import os, signal, threading, time
@@ -40,7 +42,9 @@ SCRIPT = textwrap.dedent(
 def test_interrupt_during_the_hold_is_raised_at_the_release(tmp_path):
     script = tmp_path / "hold.py"
     script.write_text(SCRIPT)
-    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
+    done = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, timeout=120, preexec_fn=default_sigint
+    )
     assert done.returncode == 0, done.stderr
     expected = ["held", "raised at release", "handler True", "quiet release"]
     assert done.stdout.splitlines() == expected, done.stdout
@@ -75,6 +79,8 @@ CHILD = textwrap.dedent(
 def test_a_spawned_child_of_the_command_ignores_interrupts_from_its_first_import(tmp_path):
     script = tmp_path / "command.py"
     script.write_text(CHILD)
-    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=120)
+    done = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, timeout=120, preexec_fn=default_sigint
+    )
     assert done.returncode == 0, done.stderr
     assert done.stdout.splitlines() == ["child ignores True", "command ignores False"], done.stdout
