@@ -227,3 +227,39 @@ def test_bad_confining_stresses_are_refused_on_one_line(text, tmp_path, capsys, 
     assert exc.value.code == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "--confining" in err, err
+
+
+@pytest.mark.scenario
+def test_a_series_killed_midway_resumes_where_it_stopped(tmp_path, monkeypatch):
+    """The command killed (SIGKILL) once its first test is kept: the rerun reads that test back,
+    runs the rest, and gives the numbers of an uninterrupted run."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "o"
+    argv = ["biaxial", "--quick", "--seed", "6", "--confining", "50,100", "--strain", "0.02",
+            "--processes", "1", "--out", str(out), "--quiet"]  # fmt: skip
+    cfg = tmp_path / "tiny.toml"
+    cfg.write_text("[biaxial]\ncritical_window = 0.5\n")
+    argv += ["--config", str(cfg)]
+    proc = subprocess.Popen([sys.executable, "-m", "poro2d.cli", *argv], start_new_session=True)
+    first = out / "sigma3_50kPa" / "replicate1" / "result.json"
+    second = out / "sigma3_100kPa" / "replicate1" / "result.json"
+    deadline = time.monotonic() + 600
+    while not first.is_file() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    assert first.is_file() and not (out / "result.json").exists()
+    kept = first.read_bytes()
+    second_done = second.is_file()
+    ran = _count_computes(monkeypatch)
+    main(argv)
+    assert first.read_bytes() == kept  # read back, not run again
+    assert ran == ([] if second_done else [(100.0, 6)])
+    alone = BiaxialTest(BiaxialCase.quick(100.0, seed=6, settings=BiaxialSettings(**TINY))).run()
+    resumed = BiaxialSeriesResult.from_dict(json.loads((out / "result.json").read_text()))
+    assert resumed.stresses[1].peak_friction_angle.values == [alone.peak_friction_angle_deg]

@@ -79,7 +79,7 @@ def register(app: typer.Typer) -> None:
         kw = {"replicates": n, "lab": lab if lab is not None else table.path("lab"),
               "processes": processes if processes is not None else run.get("processes"),
               "progress": not quiet, "config": recorded}  # fmt: skip
-        run_and_print(case, stresses, Store(out), kw, out)
+        start_and_print(case, stresses, Store(out), kw, out)
 
 
 def confining_stresses(text: str | None, from_config) -> list[float]:
@@ -142,7 +142,7 @@ def make_case(quick: bool, specimen, sigma: float, first: int, settings):
     return [BiaxialCase.of(p, sigma, settings) for p in specimen]
 
 
-def run_and_print(case, stresses: list[float], store, kw: dict, out: Path) -> None:
+def start_and_print(case, stresses: list[float], store, kw: dict, out: Path) -> None:
     """One stress: run_biaxial; several: run_biaxial_series; the answer printed (a failed test: exit 1)."""
     from poro2d.biaxial import run_biaxial, run_biaxial_series
 
