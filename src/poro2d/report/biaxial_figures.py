@@ -4,7 +4,9 @@
 axial strain, one line per replicate, the mean over the replicates' end windows (where the
 critical state is read) as a dotted line; (b) the volumetric strain (compression positive, so dilation goes
 down) against the axial strain. Laboratory curves, when the user gives them, are drawn in
-black, dashed. Made from arrays: no file is opened here.
+black, dashed. A series (:func:`plot_biaxial_series`) draws every confining stress in a colour of
+its own, its replicates overlaid, beside the peak circles of Mohr and their envelope. Made from
+arrays: no file is opened here.
 """
 
 from __future__ import annotations
