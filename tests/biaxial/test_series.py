@@ -11,6 +11,7 @@ import pytest
 import poro2d.biaxial as biaxial
 from poro2d.biaxial import BiaxialCase, BiaxialSeriesResult, BiaxialSettings, BiaxialTest, run_biaxial_series
 from poro2d.biaxial.envelope import envelope, peak_circle
+from poro2d.biaxial.series import sigma_3_at_peak
 from poro2d.cli import main
 from poro2d.errors import InputError
 from poro2d.store import Store
@@ -72,7 +73,10 @@ def test_a_series_runs_each_stress_on_its_replicates(series):
     assert r.specimens == ["quick specimen (seed 2)", "quick specimen (seed 3)"]
     assert r.peak_friction_angle.values == [t.peak_friction_angle_deg for t in tests]
     assert r.stresses[1].peak_friction_angle.values == [t.peak_friction_angle_deg for t in tests[2:]]
-    s1, s3 = zip(*(peak_circle(t.confining_stress_kpa, t.peak_sin_phi) for t in tests), strict=True)
+    # each circle stands on the side walls' stress at its peak: the target, within the servo's tolerance
+    at_peak = [sigma_3_at_peak(t) for t in tests]
+    assert np.allclose(at_peak, [50.0, 50.0, 100.0, 100.0], rtol=0.03) and r.sigma_3_held
+    s1, s3 = zip(*(peak_circle(s, t.peak_sin_phi) for s, t in zip(at_peak, tests, strict=True)), strict=True)
     assert r.envelope.to_dict() == envelope(s1, s3).to_dict() and r.envelope.points == 4
     assert r.headline().startswith(
         "biaxial at sigma_3 = 50, 100 kPa, 2 replicate(s) each, pooled over 4 tests"

@@ -145,7 +145,9 @@ class BiaxialSeriesResult(TypedResult):
     folder); ``peak_friction_angle``, ``critical_state_friction_angle`` and
     ``max_dilatancy_angle``: pooled over every test of every stress; ``envelope`` (and
     ``envelope_through_origin``): the Mohr-Coulomb line of the peak circles
-    (:mod:`poro2d.biaxial.envelope`). ``studies`` (not in the file): each stress's
+    (:mod:`poro2d.biaxial.envelope`), each circle on the side walls' sigma_3 at its peak;
+    ``sigma_3_held`` only if every test kept sigma_3 on target (``sigma_3_note`` says how far
+    off it went otherwise). ``studies`` (not in the file): each stress's
     :class:`BiaxialResult`, its tests with their curves.
     """
 
@@ -162,6 +164,8 @@ class BiaxialSeriesResult(TypedResult):
     envelope_definition: str
     critical_state_reached: bool
     critical_state_note: str
+    sigma_3_held: bool
+    sigma_3_note: str
     definitions: Definitions
     settings: BiaxialSettingsRecord
     specimens: list[str]

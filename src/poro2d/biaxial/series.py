@@ -14,11 +14,14 @@ import time
 from collections.abc import Sequence
 from dataclasses import replace
 
+import numpy as np
+
+from poro2d.biaxial.angles import smoothed
 from poro2d.biaxial.case import BiaxialCase
 from poro2d.biaxial.envelope import envelope, peak_circle
 from poro2d.biaxial.lab import LabCurve
 from poro2d.biaxial.parts import DEFINITIONS, ENVELOPE_DEFINITION, AngleSpread, Definitions, StressSummary
-from poro2d.biaxial.results import BiaxialResult, BiaxialSeriesResult
+from poro2d.biaxial.results import BiaxialResult, BiaxialSeriesResult, BiaxialTestResult
 from poro2d.biaxial.run import (
     MAX_REPLICATES,
     check_run,
@@ -126,10 +129,33 @@ def _summary(study: BiaxialResult) -> StressSummary:
     )  # fmt: skip
 
 
+def sigma_3_at_peak(test: BiaxialTestResult) -> float:
+    """The side walls' stress (kPa) where the peak is read, smoothed as sin(phi) is there: the
+    peak's circle is the one the specimen stood on, even where the servo let sigma_3 drift."""
+    c = test.curve
+    if c is None:
+        return test.confining_stress_kpa
+    s3 = smoothed(c.axial_strain, c.sigma_3_kpa, test.settings["smoothing_strain"])
+    return float(np.interp(test.axial_strain_at_peak, c.axial_strain, s3))
+
+
+def _held_note(tests: list[BiaxialTestResult]) -> str:
+    """Whether sigma_3 stayed on its target in every test, and the worst mean error if not."""
+    off = [t for t in tests if not t.checks.sigma_3_held]
+    if not off:
+        return "sigma_3 held in every test"
+    worst = max(t.checks.sigma_3_mean_error for t in off)
+    return (
+        f"sigma_3 not held in {len(off)} of {len(tests)} tests (mean error up to {100 * worst:.0f} %): "
+        "the side walls lag behind a dilating specimen; a larger servo_max_speed or a slower strain_rate "
+        "(docs/biaxial.md)"
+    )
+
+
 def summarize_series(studies: list[BiaxialResult], workers: int, wall: float, config) -> BiaxialSeriesResult:
     """The series' result from each stress's study: pooled angles and the peak envelope."""
     tests = [t for st in studies for t in st.tests]
-    circles = [peak_circle(t.confining_stress_kpa, t.peak_sin_phi) for t in tests]
+    circles = [peak_circle(sigma_3_at_peak(t), t.peak_sin_phi) for t in tests]
     s1, s3 = [c[0] for c in circles], [c[1] for c in circles]
     missed = [f"{st.confining_stress_kpa:g} kPa" for st in studies if not st.critical_state_reached]
     note = (
@@ -147,6 +173,7 @@ def summarize_series(studies: list[BiaxialResult], workers: int, wall: float, co
         max_dilatancy_angle=AngleSpread.of([t.max_dilatancy_angle_deg for t in tests]),
         envelope=envelope(s1, s3), envelope_through_origin=envelope(s1, s3, through_origin=True),
         envelope_definition=ENVELOPE_DEFINITION, critical_state_reached=not missed, critical_state_note=note,
+        sigma_3_held=all(t.checks.sigma_3_held for t in tests), sigma_3_note=_held_note(tests),
         definitions=Definitions(**DEFINITIONS), settings=first.settings, specimens=first.specimens,
         processes=workers, wall_time_s=wall, config=config or {}, provenance=Provenance.now(), lab=first.lab,
     )  # fmt: skip
@@ -162,7 +189,8 @@ def _write(store: Store, result: BiaxialSeriesResult) -> None:
         curves, store.path(SERIES_FIGURE),
         title=f"biaxial tests, replicates: {result.replicates} per stress",
         envelope=(result.envelope.friction_angle_deg, result.envelope.cohesion_kpa),
-        peaks=[(t.confining_stress_kpa, t.peak_sin_phi) for st in result.studies for t in st.tests],
+        peaks=[(t.confining_stress_kpa, sigma_3_at_peak(t), t.peak_sin_phi)
+               for st in result.studies for t in st.tests],
     )  # fmt: skip
     store.write_result("result.json", result)
 

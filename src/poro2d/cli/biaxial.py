@@ -200,6 +200,8 @@ def print_series(result, out: Path) -> None:
     console.print(f"[bold]{result.headline()}[/]")
     if not result.critical_state_reached:
         console.print(f"[yellow]{result.critical_state_note}[/]")
+    if not result.sigma_3_held:
+        console.print(f"[yellow]{result.sigma_3_note}[/]")
     t = Table(title="per confining stress (over its replicates)")
     for col in ("sigma_3 kPa", "phi peak deg", "phi end deg", "critical", "psi max deg", "eps_1 peak %"):
         t.add_column(col, justify="right")

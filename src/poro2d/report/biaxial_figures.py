@@ -77,7 +77,8 @@ def plot_biaxial_series(
     """Every stress's curves, a colour per stress (its replicates overlaid), and the peak circles.
 
     ``curves``: (sigma_3 in kPa, the replicates' curves); ``envelope``: (phi in degrees or None,
-    c in kPa) of the Mohr-Coulomb line; ``peaks``: (sigma_3, sin phi at the peak) of every test.
+    c in kPa) of the Mohr-Coulomb line; ``peaks``: (the target sigma_3, the measured sigma_3 at the
+    peak, sin phi at the peak) of every test, all in kPa but sin phi.
     """
     fig, axes = plt.subplots(1, 3, figsize=(14.0, 4.6))
     ax, bx, cx = axes
@@ -109,10 +110,12 @@ def _circles(ax, peaks, colours, envelope) -> None:
     """The peak circles of Mohr in (sigma, tau), a colour per sigma_3, and the envelope's line."""
     angle = np.linspace(0.0, np.pi, 90)
     top = 0.0
-    for s3, sin_phi in peaks:
+    for target, s3, sin_phi in peaks:
         s1 = s3 * (1.0 + sin_phi) / (1.0 - sin_phi)
         centre, radius = 0.5 * (s1 + s3), 0.5 * (s1 - s3)
-        ax.plot(centre + radius * np.cos(angle), radius * np.sin(angle), color=colours.get(s3, "0.3"), lw=0.8)
+        ax.plot(
+            centre + radius * np.cos(angle), radius * np.sin(angle), color=colours.get(target, "0.3"), lw=0.8
+        )
         top = max(top, s1)
     phi, c = envelope
     if phi is not None:
