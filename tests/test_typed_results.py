@@ -9,7 +9,8 @@ density mode of ``poro2d criterion`` (density_state.json), ``poro2d sensitivity`
 (relation_density_mode.json), and from ``poro2d paper --quick`` the replicate specimens'
 shear summary and the accepted specimen's state and porosity files. Written before the
 calibration's and the sand's results had typed parts: ``poro2d calibrate --preset paper --quick``
-(calibration_result.json) and ``poro2d sand`` on a small toy soil (sand_result.json).
+(calibration_result.json) and ``poro2d sand`` on a small toy soil (sand_result.json). Written before
+biaxial series existed: a one-stress ``poro2d biaxial`` on a paper-size specimen (biaxial_result.json).
 """
 
 import dataclasses
@@ -20,6 +21,7 @@ from pathlib import Path
 
 import pytest
 
+from poro2d.biaxial.results import BiaxialResult
 from poro2d.calibration.run import CalibrationResult
 from poro2d.criterion.result import (
     CriterionResult,
@@ -49,6 +51,7 @@ FILES = [
     (SpecimenPorosity, "specimen_porosity.json"),
     (CalibrationResult, "calibration_result.json"),
     (SandResult, "sand_result.json"),
+    (BiaxialResult, "biaxial_result.json"),
 ]
 
 

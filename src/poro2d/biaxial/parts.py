@@ -103,6 +103,27 @@ class TestSummary(TypedResult):
 
 
 @dataclass(eq=False)
+class StressSummary(TypedResult):
+    """One confining stress of a series: its replicates' spread and where its files are."""
+
+    confining_stress_kpa: float
+    folder: str
+    peak_friction_angle: AngleSpread
+    critical_state_friction_angle: AngleSpread
+    max_dilatancy_angle: AngleSpread
+    axial_strain_at_peak: AngleSpread
+    critical_state_reached: bool
+    critical_state_note: str
+
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "peak_friction_angle": AngleSpread,
+        "critical_state_friction_angle": AngleSpread,
+        "max_dilatancy_angle": AngleSpread,
+        "axial_strain_at_peak": AngleSpread,
+    }
+
+
+@dataclass(eq=False)
 class LabCurveRecord(TypedResult):
     """Laboratory curves given with the test (the user's own data): where they came from and what they say."""
 
@@ -133,9 +154,15 @@ DEFINITIONS: dict[str, Any] = {
     "|d eps_v / d eps_1| there is at most critical_rate_limit",
     "dilatancy": "sin(psi) = -d eps_v / d eps_s over secants of smoothing_strain; psi_max its largest value",
 }
+#: how a series' envelope is read (:mod:`poro2d.biaxial.envelope`)
+ENVELOPE_DEFINITION = (
+    "least-squares line through the tops (s, t) = ((sigma_1 + sigma_3) / 2, (sigma_1 - sigma_3) / 2) "
+    "of every test's peak circle, sigma_1 = sigma_3 (1 + sin phi_peak) / (1 - sin phi_peak): "
+    "slope sin(phi), intercept c cos(phi); the line is tangent to the circles"
+)
 
 
 __all__ = [
-    "DEFINITIONS", "AngleSpread", "BoxRecord", "ConsolidationRecord", "Definitions", "LabCurveRecord",
-    "ShearChecks", "TestSummary",
+    "DEFINITIONS", "ENVELOPE_DEFINITION", "AngleSpread", "BoxRecord", "ConsolidationRecord", "Definitions",
+    "LabCurveRecord", "ShearChecks", "StressSummary", "TestSummary",
 ]  # fmt: skip

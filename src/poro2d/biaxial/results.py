@@ -6,12 +6,14 @@ from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 from poro2d.biaxial.curve import BiaxialCurve, read_curve
+from poro2d.biaxial.envelope import EnvelopeRecord
 from poro2d.biaxial.parts import (
     AngleSpread,
     ConsolidationRecord,
     Definitions,
     LabCurveRecord,
     ShearChecks,
+    StressSummary,
     TestSummary,
 )
 from poro2d.biaxial.settings import BiaxialSettingsRecord
@@ -135,4 +137,74 @@ class BiaxialResult(TypedResult):
         )
 
 
-__all__ = ["BiaxialResult", "BiaxialTestResult"]
+@dataclass(eq=False)
+class BiaxialSeriesResult(TypedResult):
+    """Biaxial tests at several confining stresses on replicate specimens (the series' ``result.json``).
+
+    ``stresses``: per confining stress the replicates' spread (each stress's own study is in its
+    folder); ``peak_friction_angle``, ``critical_state_friction_angle`` and
+    ``max_dilatancy_angle``: pooled over every test of every stress; ``envelope`` (and
+    ``envelope_through_origin``): the Mohr-Coulomb line of the peak circles
+    (:mod:`poro2d.biaxial.envelope`), each circle on the side walls' sigma_3 at its peak;
+    ``sigma_3_held`` only if every test kept sigma_3 on target (``sigma_3_note`` says how far
+    off it went otherwise). ``studies`` (not in the file): each stress's
+    :class:`BiaxialResult`, its tests with their curves.
+    """
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("lab",)
+
+    confining_stresses_kpa: list[float]
+    replicates: int
+    stresses: list[StressSummary]
+    peak_friction_angle: AngleSpread
+    critical_state_friction_angle: AngleSpread
+    max_dilatancy_angle: AngleSpread
+    envelope: EnvelopeRecord
+    envelope_through_origin: EnvelopeRecord
+    envelope_definition: str
+    critical_state_reached: bool
+    critical_state_note: str
+    sigma_3_held: bool
+    sigma_3_note: str
+    definitions: Definitions
+    settings: BiaxialSettingsRecord
+    specimens: list[str]
+    processes: int
+    wall_time_s: float
+    config: dict[str, Any]
+    provenance: Provenance
+    lab: LabCurveRecord | None = None
+    studies: list[BiaxialResult] = field(default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE)
+
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "stresses": StressSummary,
+        "peak_friction_angle": AngleSpread,
+        "critical_state_friction_angle": AngleSpread,
+        "max_dilatancy_angle": AngleSpread,
+        "envelope": EnvelopeRecord,
+        "envelope_through_origin": EnvelopeRecord,
+        "definitions": Definitions,
+        "settings": BiaxialSettingsRecord,
+        "provenance": Provenance,
+        "lab": LabCurveRecord,
+    }
+
+    def headline(self) -> str:
+        """The number to take away, one line: the angles pooled over every test, then the envelope."""
+        n = sum(len(s.peak_friction_angle.values) for s in self.stresses)
+        cs = "phi_cs" if self.critical_state_reached else "phi_end (not yet at critical state)"
+        stresses = ", ".join(f"{v:g}" for v in self.confining_stresses_kpa)
+        env = self.envelope
+        fit = (
+            f"peak envelope phi = {env.friction_angle_deg:.1f} deg, c = {env.cohesion_kpa:.1f} kPa"
+            if env.friction_angle_deg is not None
+            else "no peak envelope"
+        )
+        return (
+            f"biaxial at sigma_3 = {stresses} kPa, {self.replicates} replicate(s) each, "
+            f"pooled over {n} tests: phi_peak = {self.peak_friction_angle.text()}, "
+            f"{cs} = {self.critical_state_friction_angle.text()}; {fit}"
+        )
+
+
+__all__ = ["BiaxialResult", "BiaxialSeriesResult", "BiaxialTestResult"]

@@ -40,9 +40,16 @@ class BiaxialJob:
     folder: str | None
     label: str
 
-    def run(self, report) -> BiaxialTestResult:
+    def test(self, report=None) -> BiaxialTest:
         store = Store(self.folder) if self.folder is not None else None
-        return BiaxialTest(self.case, store, progress=report).run()
+        return BiaxialTest(self.case, store, progress=report)
+
+    def run(self, report) -> BiaxialTestResult:
+        return self.test(report).run()
+
+    def stored(self) -> BiaxialTestResult | None:
+        """The test's result when its folder holds it finished (read here: no process started)."""
+        return self.test().stored()
 
 
 def _run_job(job: BiaxialJob, report) -> BiaxialTestResult:
@@ -50,7 +57,7 @@ def _run_job(job: BiaxialJob, report) -> BiaxialTestResult:
     return job.run(report)
 
 
-def _cases(case, replicates: int) -> list[BiaxialCase]:
+def replicate_cases(case, replicates: int) -> list[BiaxialCase]:
     """One case per replicate: ``case`` and its quick specimen's next seeds, or the given cases."""
     if isinstance(case, BiaxialCase):
         return [case.replicate(k) for k in range(replicates)]
@@ -66,12 +73,25 @@ def _cases(case, replicates: int) -> list[BiaxialCase]:
     raise InputError("case", type(case).__name__, "a BiaxialCase or a list of them (one per replicate)")
 
 
-def _lab(value) -> LabCurve | None:
+def lab_curve(value) -> LabCurve | None:
+    """Laboratory curves as given, read from a CSV path, or None."""
     if value is None or isinstance(value, LabCurve):
         return value
     if isinstance(value, str | os.PathLike):
         return read_lab_curve(value)
     raise InputError("lab", type(value).__name__, "a laboratory CSV path, a LabCurve or None")
+
+
+def check_run(store, progress, processes, tests: int) -> int:
+    """``store`` and ``progress`` checked; the worker processes (default one per test, at most the
+    CPU count)."""
+    if store is not None and not isinstance(store, Store):
+        raise InputError("store", type(store).__name__, "a poro2d.store.Store or None")
+    if not isinstance(progress, bool):
+        raise InputError("progress", progress, "True or False")
+    if processes is not None:
+        return check_int("processes", processes, 1, 64)
+    return min(tests, os.cpu_count() or 1)
 
 
 def run_biaxial(
@@ -100,33 +120,24 @@ def run_biaxial(
     ``if __name__ == "__main__":`` in a script.
     """
     n = check_int("replicates", replicates, 1, MAX_REPLICATES)
-    cases = _cases(case, n)
-    lab_curve = _lab(lab)
-    if store is not None and not isinstance(store, Store):
-        raise InputError("store", type(store).__name__, "a poro2d.store.Store or None")
-    if not isinstance(progress, bool):
-        raise InputError("progress", progress, "True or False")
-    workers = (
-        check_int("processes", processes, 1, 64)
-        if processes is not None
-        else min(len(cases), os.cpu_count() or 1)
-    )
+    cases = replicate_cases(case, n)
+    lab_data = lab_curve(lab)
+    workers = check_run(store, progress, processes, len(cases))
     if store is None:
-        return _run(cases, None, lab_curve, workers, progress, config)
+        return _run(cases, None, lab_data, workers, progress, config)
     check_output_dir(store.parameter, store.root)
     with output_folder(store.parameter, store.root, kind="biaxial"):
-        return _run(cases, store, lab_curve, workers, progress, config)
+        return _run(cases, store, lab_data, workers, progress, config)
 
 
-def _run(cases, store, lab, workers, progress, config) -> BiaxialResult:
-    t0 = time.perf_counter()
-    jobs = [
-        BiaxialJob(
-            c, None if store is None else str(store.child(f"replicate{k + 1}").root), f"replicate {k + 1}"
-        )
-        for k, c in enumerate(cases)
-    ]
-    with JobsProgress("biaxial", [j.label for j in jobs], enabled=progress) as bars:
+def execute_tests(jobs: list[BiaxialJob], workers: int, progress: bool) -> list[BiaxialTestResult]:
+    """The tests of ``jobs`` in job order: finished ones read back, the others run on up to
+    ``workers`` processes (a test that fails raises once the others have ended)."""
+    results = [job.stored() for job in jobs]
+    todo = [k for k, res in enumerate(results) if res is None]
+    if not todo:
+        return results  # type: ignore[return-value]
+    with JobsProgress("biaxial", [jobs[k].label for k in todo], enabled=progress) as bars:
 
         def show(index: int, phase: str, fraction: float) -> None:
             bars.update(index, phase, fraction)
@@ -135,13 +146,31 @@ def _run(cases, store, lab, workers, progress, config) -> BiaxialResult:
             if not isinstance(outcome, Failed):
                 bars.done(index)
 
-        outcomes = Executor(Backend.local(workers)).map(
-            [Job(_run_job, (job,), job.label, reports=True) for job in jobs], on_report=show, on_done=ended
-        )
-        tests: list[BiaxialTestResult] = results_or_raise(outcomes, "biaxial test(s)")
+        outcomes = Executor(Backend.local(min(workers, len(todo)))).map(
+            [Job(_run_job, (jobs[k],), jobs[k].label, reports=True) for k in todo], on_report=show,
+            on_done=ended,
+        )  # fmt: skip
+        done: list[BiaxialTestResult] = results_or_raise(outcomes, "biaxial test(s)")
+    for k, res in zip(todo, done, strict=True):
+        results[k] = res
+    return results  # type: ignore[return-value]
+
+
+def replicate_jobs(cases: list[BiaxialCase], store: Store | None, label: str = "") -> list[BiaxialJob]:
+    """One job per replicate case, kept in ``store``'s ``replicate<k>`` (None: nothing kept)."""
+    return [
+        BiaxialJob(c, None if store is None else str(store.child(f"replicate{k + 1}").root),
+                   f"{label}replicate {k + 1}")
+        for k, c in enumerate(cases)
+    ]  # fmt: skip
+
+
+def _run(cases, store, lab, workers, progress, config) -> BiaxialResult:
+    t0 = time.perf_counter()
+    tests = execute_tests(replicate_jobs(cases, store), workers, progress)
     result = summarize(cases, tests, lab, workers, time.perf_counter() - t0, config)
     if store is not None:
-        _write(store, result, lab)
+        write_study(store, result, lab)
     return result
 
 
@@ -189,7 +218,7 @@ def summarize(cases, tests, lab, workers, wall, config) -> BiaxialResult:
     return stored
 
 
-def _write(store: Store, result: BiaxialResult, lab: LabCurve | None) -> None:
+def write_study(store: Store, result: BiaxialResult, lab: LabCurve | None) -> None:
     """``curves.csv`` (every replicate's rows), the figure, then ``result.json``."""
     rows = []
     for k, t in enumerate(result.tests):
@@ -210,4 +239,15 @@ def _write(store: Store, result: BiaxialResult, lab: LabCurve | None) -> None:
     store.write_result("result.json", result)
 
 
-__all__ = ["BiaxialJob", "MAX_REPLICATES", "run_biaxial"]
+__all__ = [
+    "BiaxialJob",
+    "MAX_REPLICATES",
+    "check_run",
+    "execute_tests",
+    "lab_curve",
+    "replicate_cases",
+    "replicate_jobs",
+    "run_biaxial",
+    "summarize",
+    "write_study",
+]

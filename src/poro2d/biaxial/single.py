@@ -9,7 +9,8 @@
 4. shearing (:class:`poro2d.biaxial.stages.Shearing`) to ``max_strain``;
 5. the angles read off the curve (:func:`poro2d.biaxial.angles.read_angles`).
 
-With a store the test keeps ``curve.csv`` and then ``result.json`` there (each atomic).
+With a store the test keeps ``curve.csv`` and then ``result.json`` there (each atomic), bound to
+the test by ``test.json`` (:mod:`poro2d.biaxial.record`): a rerun reads a finished test back.
 """
 
 from __future__ import annotations
@@ -23,8 +24,9 @@ import numpy as np
 from poro2d.biaxial.angles import read_angles
 from poro2d.biaxial.box import BiaxialBox, build_biaxial_box
 from poro2d.biaxial.case import BiaxialCase
-from poro2d.biaxial.curve import CURVE_COLUMNS, BiaxialCurve
+from poro2d.biaxial.curve import CURVE_COLUMNS, BiaxialCurve, read_curve
 from poro2d.biaxial.parts import ShearChecks
+from poro2d.biaxial.record import claim, folder_stage
 from poro2d.biaxial.results import BiaxialTestResult
 from poro2d.biaxial.settings import inertial_number
 from poro2d.biaxial.stages import SIDE_START_STRAIN, ProgressFn, Shearing, consolidate
@@ -39,6 +41,11 @@ def median_diameter(radius: np.ndarray) -> float:
     d = np.sort(2.0 * radius)
     area = np.cumsum(d**2)
     return float(np.interp(0.5, area / area[-1], d))
+
+
+def _curve_kept(store: Store) -> bool:
+    """The test's ``curve.csv`` is there as it was written (a finished test needs it beside its result)."""
+    return store.has("curve.csv") and store.intact("curve.csv")
 
 
 class BiaxialTest:
@@ -81,8 +88,45 @@ class BiaxialTest:
         self.i0 = i0
         return sim
 
+    def stored(self) -> BiaxialTestResult | None:
+        """This test's result when ``store`` holds it finished (with its curve), else None."""
+        if self.store is None:
+            return None
+        store = self.store
+        data = folder_stage(store, self.case).stored(accept=lambda _: _curve_kept(store))
+        if data is None:
+            return None
+        result = BiaxialTestResult.from_dict(data)
+        result.curve = read_curve(store)
+        return result if result.curve is not None else None
+
     def run(self) -> BiaxialTestResult:
-        """Consolidate, shear, read the angles; with a store write ``curve.csv``, then ``result.json``."""
+        """The test's result: with a store, read back when it holds this test finished, else
+        computed and kept there (``curve.csv``, then ``result.json``, the stage's marker).
+
+        A test killed midway left no marker: it runs again from the start (a paper-size test
+        is about half a minute, docs/biaxial.md, so it keeps no checkpoint).
+        """
+        if self.store is None:
+            return self.compute()
+        done = self.stored()
+        if done is not None:
+            return done
+        store = self.store
+        stage = folder_stage(store, self.case)
+        claim(store, stage)
+        fresh: list[BiaxialTestResult] = []
+
+        def compute() -> BiaxialTestResult:
+            fresh.append(self.compute())
+            store.write_csv("curve.csv", fresh[0].curve.rows(), header=list(CURVE_COLUMNS))
+            return fresh[0]
+
+        stage.run(compute, accept=lambda _: _curve_kept(store))  # nothing stored (above): it computes
+        return fresh[0]
+
+    def compute(self) -> BiaxialTestResult:
+        """Consolidate, shear and read the angles (nothing kept)."""
         t0 = time.perf_counter()
         s = self.case.settings
         sim = self.build()
@@ -101,9 +145,6 @@ class BiaxialTest:
         )  # fmt: skip
         stored = BiaxialTestResult.from_dict(as_json(result))
         stored.curve = curve
-        if self.store is not None:
-            self.store.write_csv("curve.csv", curve.rows(), header=list(CURVE_COLUMNS))
-            self.store.write_result("result.json", stored)
         return stored
 
     def checks(self, curve: BiaxialCurve) -> ShearChecks:

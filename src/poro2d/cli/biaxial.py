@@ -1,4 +1,4 @@
-"""``poro2d biaxial``: biaxial tests at a confining stress on replicate specimens."""
+"""``poro2d biaxial``: biaxial tests at one or several confining stresses on replicate specimens."""
 
 from __future__ import annotations
 
@@ -20,7 +20,9 @@ def register(app: typer.Typer) -> None:
         quick: bool = typer.Option(
             False, "--quick", help="The built-in quick specimen (0.05 m x 0.10 m, about 320 disks) of --seed."
         ),
-        confining: float = typer.Option(100.0, "--confining", help="Confining stress sigma_3 (kPa)."),
+        confining: str = typer.Option(
+            None, "--confining", help="Confining stresses sigma_3 in kPa: 100, or 50,100,200 (default 100)."
+        ),
         strain: float = typer.Option(
             None, "--strain", help="Axial strain where the test ends (default 0.20)."
         ),
@@ -46,52 +48,116 @@ def register(app: typer.Typer) -> None:
         processes: int = typer.Option(
             None, "--processes", "-p", help="Worker processes (default one per replicate)."
         ),
+        config: Path = typer.Option(None, "--config", "-c", help="TOML config with a \\[biaxial] table."),
         quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
     ) -> None:
-        """Biaxial tests: peak and critical-state friction angles, dilatancy, their spread over replicates."""
-        from poro2d.biaxial import BiaxialCase, BiaxialSettings, run_biaxial
-        from poro2d.biaxial.settings import CONFINING_RANGE_KPA
+        """Biaxial tests at one or several confining stresses: peak and critical-state friction angles,
+        dilatancy and their spread over replicates; the peak envelope over the stresses."""
+        from poro2d.biaxial.config import load_biaxial_config
         from poro2d.cli.shear import check_friction_options
-        from poro2d.errors import InputError, check_int, check_range
         from poro2d.io_utils import check_output_dir
         from poro2d.store import Store
 
         check_output_dir("--out", out)
-        check_range("--confining", confining, *CONFINING_RANGE_KPA)
-        if bool(quick) == bool(specimen):
-            raise InputError(
-                "SPECIMEN.../--quick", specimen or None, "one of them: specimen paths, or --quick"
-            )
-        if not quick and seed is not None:
-            raise InputError("--seed", seed, "only with --quick (a specimen file has its own disks)")
-        if not quick and replicates is not None:
-            raise InputError(
-                "--replicates", replicates, "only with --quick (give one specimen path per replicate)"
-            )
-        n = check_int("--replicates", replicates, 1, 50) if replicates is not None else 1
-        first = check_int("--seed", seed, 0, 2**31 - 1) if seed is not None else 0
+        table = load_biaxial_config(config)
+        run = table.run
+        stresses = confining_stresses(confining, run.get("confining_kpa"))
+        quick = quick or bool(run.get("quick", False))
+        specimen = specimen or (None if quick else table.specimens())
+        first, n = check_replicates(quick, specimen, seed, replicates, run)
         check_friction_options(particle_friction, rolling_friction)  # the ranges shear takes
         changes = {"max_strain": strain, "strain_rate": strain_rate, "particle_friction": particle_friction,
                    "rolling_friction": rolling_friction}  # fmt: skip
         options = {k: v for k, v in changes.items() if v is not None}
-        try:
-            settings = BiaxialSettings(**options)
-        except InputError as exc:  # named as the option the user typed
-            names = {"max_strain": "--strain", "strain_rate": "--strain-rate"}
-            raise InputError(names.get(exc.parameter, exc.parameter), exc.value, exc.allowed) from None
-        if quick:
-            case = BiaxialCase.quick(confining, first, settings)
+        settings = build_settings(table, options)
+        case = make_case(quick, specimen, stresses[0], first, settings)
+        recorded = {"quick": quick, "specimens": specimen or None, "seed": first if quick else None,
+                    "confining_kpa": stresses[0] if len(stresses) == 1 else stresses,
+                    "settings": {**table.settings, **options}}  # fmt: skip
+        if config is not None:
+            recorded["config_file"] = str(config)
+        kw = {"replicates": n, "lab": lab if lab is not None else table.path("lab"),
+              "processes": processes if processes is not None else run.get("processes"),
+              "progress": not quiet, "config": recorded}  # fmt: skip
+        start_and_print(case, stresses, Store(out), kw, out)
+
+
+def confining_stresses(text: str | None, from_config) -> list[float]:
+    """--confining (``100`` or ``50,100,200``), else the config's confining_kpa, else 100 kPa."""
+    from poro2d.cli.shear import parse_stresses
+    from poro2d.errors import InputError
+
+    if text is not None:
+        values, name = parse_stresses(text, "--confining"), "--confining"
+    elif from_config is not None:
+        values = [float(v) for v in (from_config if isinstance(from_config, list) else [from_config])]
+        name = "biaxial.confining_kpa"
+    else:
+        return [100.0]
+    if len(set(values)) != len(values):
+        raise InputError(name, text if text is not None else from_config, "different confining stresses")
+    return sorted(values)
+
+
+def check_replicates(quick: bool, specimen, seed, replicates, run: dict) -> tuple[int, int]:
+    """(first seed, replicates): --seed and --replicates with --quick only, the config's as defaults."""
+    from poro2d.errors import InputError, check_int
+
+    if bool(quick) == bool(specimen):
+        raise InputError("SPECIMEN.../--quick", specimen or None, "one of them: specimen paths, or --quick")
+    if not quick and seed is not None:
+        raise InputError("--seed", seed, "only with --quick (a specimen file has its own disks)")
+    if not quick and replicates is not None:
+        raise InputError(
+            "--replicates", replicates, "only with --quick (give one specimen path per replicate)"
+        )
+    n = check_int("--replicates", replicates, 1, 50) if replicates is not None else run.get("replicates", 1)
+    first = check_int("--seed", seed, 0, 2**31 - 1) if seed is not None else run.get("seed", 0)
+    if not quick and (n != 1 or "seed" in run):
+        key = "biaxial.replicates" if n != 1 else "biaxial.seed"
+        raise InputError(
+            key, run.get(key.split(".")[1]), "only with quick = true (one specimen path per replicate)"
+        )
+    return first, n
+
+
+def build_settings(table, options: dict):
+    """BiaxialSettings from the config's table, the options winning; an option's error named as typed."""
+    from poro2d.errors import InputError
+
+    try:
+        return table.build(**options)
+    except InputError as exc:  # named as the option the user typed
+        names = {"max_strain": "--strain", "strain_rate": "--strain-rate"}
+        name = names.get(exc.parameter, exc.parameter) if exc.parameter in options else exc.parameter
+        raise InputError(name, exc.value, exc.allowed) from None
+
+
+def make_case(quick: bool, specimen, sigma: float, first: int, settings):
+    """The case of the quick specimen of ``first``, or one case per specimen path."""
+    from poro2d.biaxial import BiaxialCase
+
+    if quick:
+        return BiaxialCase.quick(sigma, first, settings)
+    return [BiaxialCase.of(p, sigma, settings) for p in specimen]
+
+
+def start_and_print(case, stresses: list[float], store, kw: dict, out: Path) -> None:
+    """One stress: run_biaxial; several: run_biaxial_series; the answer printed (a failed test: exit 1)."""
+    from poro2d.biaxial import run_biaxial, run_biaxial_series
+
+    try:
+        if len(stresses) == 1:
+            result = run_biaxial(case, store, **kw)
         else:
-            case = [BiaxialCase.of(p, confining, settings) for p in specimen]
-        config = {"quick": quick, "specimens": specimen or None, "seed": first if quick else None,
-                  "confining_kpa": confining, "settings": options}  # fmt: skip
-        try:
-            result = run_biaxial(case, Store(out), replicates=n, lab=lab, processes=processes,
-                                 progress=not quiet, config=config)  # fmt: skip
-        except RuntimeError as exc:
-            console.print(f"[bold red]failed:[/] {exc}")
-            raise typer.Exit(1) from None
+            result = run_biaxial_series(case, stresses, store, **kw)
+    except RuntimeError as exc:
+        console.print(f"[bold red]failed:[/] {exc}")
+        raise typer.Exit(1) from None
+    if len(stresses) == 1:
         print_result(result, out)
+    else:
+        print_series(result, out)
 
 
 def print_result(result, out: Path) -> None:
@@ -126,4 +192,37 @@ def print_result(result, out: Path) -> None:
                       f"phi_end = {result.lab.end_friction_angle_deg:.1f} deg")  # fmt: skip
     console.print(
         f"results in {out}/result.json, curves.csv, biaxial.png; each replicate in {out}/replicate<k>/"
+    )
+
+
+def print_series(result, out: Path) -> None:
+    """The pooled angles and the envelope first, then a row per stress and the envelope through the origin."""
+    console.print(f"[bold]{result.headline()}[/]")
+    if not result.critical_state_reached:
+        console.print(f"[yellow]{result.critical_state_note}[/]")
+    if not result.sigma_3_held:
+        console.print(f"[yellow]{result.sigma_3_note}[/]")
+    t = Table(title="per confining stress (over its replicates)")
+    for col in ("sigma_3 kPa", "phi peak deg", "phi end deg", "critical", "psi max deg", "eps_1 peak %"):
+        t.add_column(col, justify="right")
+    for s in result.stresses:
+        strain = s.axial_strain_at_peak
+        t.add_row(
+            f"{s.confining_stress_kpa:g}", s.peak_friction_angle.text(),
+            s.critical_state_friction_angle.text(), "yes" if s.critical_state_reached else "not yet",
+            s.max_dilatancy_angle.text(),
+            f"{100 * strain.min:.1f}-{100 * strain.max:.1f}",
+        )  # fmt: skip
+    console.print(t)
+    env, env0 = result.envelope, result.envelope_through_origin
+    if env.friction_angle_deg is not None:
+        console.print(
+            f"peak envelope (tangent to {env.points} peak circles): phi = {env.friction_angle_deg:.2f} deg, "
+            f"c = {env.cohesion_kpa:.2f} kPa, R2 = {env.r2:.4f}; through the origin phi = "
+            f"{env0.friction_angle_deg:.2f} deg"
+        )
+    console.print(f"psi_max pooled = {result.max_dilatancy_angle.text()} (sin psi = -d eps_v / d eps_s)")
+    console.print(
+        f"results in {out}/result.json, biaxial_series.png; each stress in {out}/sigma3_<s>kPa/ "
+        "(its result.json, curves.csv, biaxial.png, replicate<k>/)"
     )

@@ -4,7 +4,9 @@
 axial strain, one line per replicate, the mean over the replicates' end windows (where the
 critical state is read) as a dotted line; (b) the volumetric strain (compression positive, so dilation goes
 down) against the axial strain. Laboratory curves, when the user gives them, are drawn in
-black, dashed. Made from arrays: no file is opened here.
+black, dashed. A series (:func:`plot_biaxial_series`) draws every confining stress in a colour of
+its own, its replicates overlaid, beside the peak circles of Mohr and their envelope. Made from
+arrays: no file is opened here.
 """
 
 from __future__ import annotations
@@ -64,4 +66,69 @@ def plot_biaxial(
     return save_figure(fig, path)
 
 
-__all__ = ["plot_biaxial"]
+def plot_biaxial_series(
+    curves: Sequence[tuple[float, Sequence[Mapping[str, np.ndarray]]]],
+    path: str | os.PathLike,
+    *,
+    title: str,
+    envelope: tuple[float | None, float],
+    peaks: Sequence[tuple[float, float]],
+) -> Path:
+    """Every stress's curves, a colour per stress (its replicates overlaid), and the peak circles.
+
+    ``curves``: (sigma_3 in kPa, the replicates' curves); ``envelope``: (phi in degrees or None,
+    c in kPa) of the Mohr-Coulomb line; ``peaks``: (the target sigma_3, the measured sigma_3 at the
+    peak, sin phi at the peak) of every test, all in kPa but sin phi.
+    """
+    fig, axes = plt.subplots(1, 3, figsize=(14.0, 4.6))
+    ax, bx, cx = axes
+    colours = {sigma: COLORS[k % len(COLORS)] for k, (sigma, _) in enumerate(curves)}
+    for sigma, reps in curves:
+        for j, c in enumerate(reps):
+            label = f"sigma_3 = {sigma:g} kPa" if j == 0 else None
+            ax.plot(
+                100 * c["axial_strain"], c["sin_phi"], color=colours[sigma], lw=0.9, alpha=0.8, label=label
+            )
+            bx.plot(
+                100 * c["axial_strain"], 100 * c["volumetric_strain"], color=colours[sigma], lw=0.9, alpha=0.8
+            )
+    _circles(cx, peaks, colours, envelope)
+    ax.set_xlabel("axial strain eps_1 (%)")
+    ax.set_ylabel("sin(phi) = (sigma_1 - sigma_3) / (sigma_1 + sigma_3)")
+    ax.legend(fontsize=8, loc="lower right")
+    bx.axhline(0.0, color="0.6", lw=0.6)
+    bx.set_xlabel("axial strain eps_1 (%)")
+    bx.set_ylabel("volumetric strain eps_v (%) (compression +)")
+    for a in axes:
+        a.grid(alpha=0.3)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def _circles(ax, peaks, colours, envelope) -> None:
+    """The peak circles of Mohr in (sigma, tau), a colour per sigma_3, and the envelope's line."""
+    angle = np.linspace(0.0, np.pi, 90)
+    top = 0.0
+    for target, s3, sin_phi in peaks:
+        s1 = s3 * (1.0 + sin_phi) / (1.0 - sin_phi)
+        centre, radius = 0.5 * (s1 + s3), 0.5 * (s1 - s3)
+        ax.plot(
+            centre + radius * np.cos(angle), radius * np.sin(angle), color=colours.get(target, "0.3"), lw=0.8
+        )
+        top = max(top, s1)
+    phi, c = envelope
+    if phi is not None:
+        sig = np.array([0.0, top])
+        ax.plot(sig, c + sig * np.tan(np.radians(phi)), "k--", lw=1.0,
+                label=f"peak envelope: phi = {phi:.1f} deg, c = {c:.1f} kPa")  # fmt: skip
+        ax.legend(fontsize=8, loc="upper left")
+    right = 1.05 * top if top > 0 else 1.0
+    ax.set_xlim(0.0, right)
+    ax.set_ylim(0.0, 0.55 * right)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel("normal stress sigma (kPa)")
+    ax.set_ylabel("shear stress tau (kPa)")
+
+
+__all__ = ["plot_biaxial", "plot_biaxial_series"]

@@ -1,0 +1,205 @@
+"""``run_biaxial_series``: biaxial tests at several confining stresses, each on replicate specimens.
+
+Every test of every stress is one job of the executor, so two processes stay busy over the
+whole series; each finished test is read back on a rerun (:mod:`poro2d.biaxial.record`).
+Per stress the files are those of :func:`poro2d.biaxial.run.run_biaxial` in a folder of their
+own (``sigma3_100kPa/``); over the stresses, the pooled angles and the Mohr-Coulomb envelope
+of the peak circles (:mod:`poro2d.biaxial.envelope`), one figure with every curve.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Sequence
+from dataclasses import replace
+
+import numpy as np
+
+from poro2d.biaxial.angles import smoothed
+from poro2d.biaxial.case import BiaxialCase
+from poro2d.biaxial.envelope import envelope, peak_circle
+from poro2d.biaxial.lab import LabCurve
+from poro2d.biaxial.parts import DEFINITIONS, ENVELOPE_DEFINITION, AngleSpread, Definitions, StressSummary
+from poro2d.biaxial.results import BiaxialResult, BiaxialSeriesResult, BiaxialTestResult
+from poro2d.biaxial.run import (
+    MAX_REPLICATES,
+    check_run,
+    execute_tests,
+    lab_curve,
+    replicate_cases,
+    replicate_jobs,
+    summarize,
+    write_study,
+)
+from poro2d.biaxial.settings import CONFINING_RANGE_KPA
+from poro2d.errors import InputError, check_int, check_range, is_number
+from poro2d.io_utils import Provenance, as_json, check_output_dir
+from poro2d.locks import output_folder
+from poro2d.report.biaxial_figures import plot_biaxial_series
+from poro2d.store import Store
+
+#: the most confining stresses one series runs
+MAX_STRESSES = 20
+#: the figure of a series
+SERIES_FIGURE = "biaxial_series.png"
+
+
+def stress_folder(sigma_kpa: float) -> str:
+    """The folder of one confining stress in a series (``sigma3_100kPa``)."""
+    return f"sigma3_{sigma_kpa:g}kPa"
+
+
+def check_confining(values) -> list[float]:
+    """Two or more different confining stresses (kPa) in :data:`CONFINING_RANGE_KPA`, sorted."""
+    if isinstance(values, str | bytes) or not isinstance(values, Sequence) or is_number(values):
+        raise InputError("confining_kpa", values, "a list of confining stresses in kPa")
+    stresses = [check_range("confining stress (kPa)", v, *CONFINING_RANGE_KPA) for v in values]
+    if not 2 <= len(stresses) <= MAX_STRESSES or len(set(stresses)) != len(stresses):
+        raise InputError(
+            "confining_kpa", stresses, f"2 to {MAX_STRESSES} different values (one stress: run_biaxial)"
+        )
+    return sorted(stresses)
+
+
+def run_biaxial_series(
+    case: BiaxialCase | Sequence[BiaxialCase],
+    confining_kpa: Sequence[float],
+    store: Store | None = None,
+    *,
+    replicates: int = 1,
+    lab: str | os.PathLike | LabCurve | None = None,
+    processes: int | None = None,
+    progress: bool = False,
+    config: dict | None = None,
+) -> BiaxialSeriesResult:
+    """Biaxial tests of ``case`` (its specimen and settings; its own sigma_3 is not used) at each of
+    ``confining_kpa``, on ``replicates`` specimens each (quick specimens of seed, seed + 1, ...; or
+    a list of cases, one per replicate specimen).
+
+    ``store``: the series' ``result.json``, ``biaxial_series.png`` and per stress a folder
+    (``sigma3_100kPa/``) holding what :func:`run_biaxial` keeps; a rerun into it reads finished
+    tests back and runs the rest (a test whose record differs, another setting, runs again).
+    None: nothing kept. ``processes``: worker processes for all the tests (default one per
+    test, at most the CPU count). Returns the :class:`BiaxialSeriesResult` (``studies``: each
+    stress's :class:`BiaxialResult` with its tests and curves). Call it under
+    ``if __name__ == "__main__":`` in a script (the tests run in spawned processes).
+    """
+    n = check_int("replicates", replicates, 1, MAX_REPLICATES)
+    stresses = check_confining(confining_kpa)
+    base = replicate_cases(case, n)
+    cases = {s: [replace(c, confining_kpa=s) for c in base] for s in stresses}
+    lab_data = lab_curve(lab)
+    workers = check_run(store, progress, processes, len(stresses) * len(base))
+    if store is None:
+        return _run(cases, None, lab_data, workers, progress, config)
+    check_output_dir(store.parameter, store.root)
+    with output_folder(store.parameter, store.root, kind="biaxial"):
+        return _run(cases, store, lab_data, workers, progress, config)
+
+
+def _run(cases: dict[float, list[BiaxialCase]], store, lab, workers, progress, config) -> BiaxialSeriesResult:
+    t0 = time.perf_counter()
+    jobs = {
+        s: replicate_jobs(cs, None if store is None else store.child(stress_folder(s)), f"{s:g} kPa, ")
+        for s, cs in cases.items()
+    }
+    flat = [job for js in jobs.values() for job in js]
+    tests = iter(execute_tests(flat, workers, progress))
+    wall = time.perf_counter() - t0
+    studies = []
+    for s, cs in cases.items():
+        study = summarize(cs, [next(tests) for _ in cs], lab, workers, wall, config)
+        if store is not None:
+            write_study(store.child(stress_folder(s)), study, lab)
+        studies.append(study)
+    result = summarize_series(studies, workers, time.perf_counter() - t0, config)
+    if store is not None:
+        _write(store, result)
+    return result
+
+
+def _summary(study: BiaxialResult) -> StressSummary:
+    return StressSummary(
+        confining_stress_kpa=study.confining_stress_kpa, folder=stress_folder(study.confining_stress_kpa),
+        peak_friction_angle=study.peak_friction_angle,
+        critical_state_friction_angle=study.critical_state_friction_angle,
+        max_dilatancy_angle=study.max_dilatancy_angle, axial_strain_at_peak=study.axial_strain_at_peak,
+        critical_state_reached=study.critical_state_reached, critical_state_note=study.critical_state_note,
+    )  # fmt: skip
+
+
+def sigma_3_at_peak(test: BiaxialTestResult) -> float:
+    """The side walls' stress (kPa) where the peak is read, smoothed as sin(phi) is there: the
+    peak's circle is the one the specimen stood on, even where the servo let sigma_3 drift."""
+    c = test.curve
+    if c is None:
+        return test.confining_stress_kpa
+    s3 = smoothed(c.axial_strain, c.sigma_3_kpa, test.settings["smoothing_strain"])
+    return float(np.interp(test.axial_strain_at_peak, c.axial_strain, s3))
+
+
+def _held_note(tests: list[BiaxialTestResult]) -> str:
+    """Whether sigma_3 stayed on its target in every test, and the worst mean error if not."""
+    off = [t for t in tests if not t.checks.sigma_3_held]
+    if not off:
+        return "sigma_3 held in every test"
+    worst = max(t.checks.sigma_3_mean_error for t in off)
+    return (
+        f"sigma_3 not held in {len(off)} of {len(tests)} tests (mean error up to {100 * worst:.0f} %): "
+        "the side walls lag behind a dilating specimen; a larger servo_max_speed or a slower strain_rate "
+        "(docs/biaxial.md)"
+    )
+
+
+def summarize_series(studies: list[BiaxialResult], workers: int, wall: float, config) -> BiaxialSeriesResult:
+    """The series' result from each stress's study: pooled angles and the peak envelope."""
+    tests = [t for st in studies for t in st.tests]
+    circles = [peak_circle(sigma_3_at_peak(t), t.peak_sin_phi) for t in tests]
+    s1, s3 = [c[0] for c in circles], [c[1] for c in circles]
+    missed = [f"{st.confining_stress_kpa:g} kPa" for st in studies if not st.critical_state_reached]
+    note = (
+        "every test reached the critical state"
+        if not missed
+        else f"not yet at critical state in some replicate(s) at {', '.join(missed)}: their end angles are "
+        "not critical-state angles (a longer --strain, or a larger specimen)"
+    )
+    first = studies[0]
+    result = BiaxialSeriesResult(
+        confining_stresses_kpa=[st.confining_stress_kpa for st in studies], replicates=first.replicates,
+        stresses=[_summary(st) for st in studies],
+        peak_friction_angle=AngleSpread.of([t.peak_friction_angle_deg for t in tests]),
+        critical_state_friction_angle=AngleSpread.of([t.critical_state_friction_angle_deg for t in tests]),
+        max_dilatancy_angle=AngleSpread.of([t.max_dilatancy_angle_deg for t in tests]),
+        envelope=envelope(s1, s3), envelope_through_origin=envelope(s1, s3, through_origin=True),
+        envelope_definition=ENVELOPE_DEFINITION, critical_state_reached=not missed, critical_state_note=note,
+        sigma_3_held=all(t.checks.sigma_3_held for t in tests), sigma_3_note=_held_note(tests),
+        definitions=Definitions(**DEFINITIONS), settings=first.settings, specimens=first.specimens,
+        processes=workers, wall_time_s=wall, config=config or {}, provenance=Provenance.now(), lab=first.lab,
+    )  # fmt: skip
+    stored = BiaxialSeriesResult.from_dict(as_json(result))
+    stored.studies = list(studies)
+    return stored
+
+
+def _write(store: Store, result: BiaxialSeriesResult) -> None:
+    """The figure of every stress, then the series' ``result.json``."""
+    curves = [(st.confining_stress_kpa, [t.curve for t in st.tests]) for st in result.studies]
+    plot_biaxial_series(
+        curves, store.path(SERIES_FIGURE),
+        title=f"biaxial tests, replicates: {result.replicates} per stress",
+        envelope=(result.envelope.friction_angle_deg, result.envelope.cohesion_kpa),
+        peaks=[(t.confining_stress_kpa, sigma_3_at_peak(t), t.peak_sin_phi)
+               for st in result.studies for t in st.tests],
+    )  # fmt: skip
+    store.write_result("result.json", result)
+
+
+__all__ = [
+    "MAX_STRESSES",
+    "SERIES_FIGURE",
+    "check_confining",
+    "run_biaxial_series",
+    "stress_folder",
+    "summarize_series",
+]
