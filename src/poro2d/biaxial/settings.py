@@ -27,7 +27,7 @@ MAX_RECORDS = 100_000
 
 #: what each setting of :class:`BiaxialSettings` may be (checked in this order)
 BIAXIAL_RANGES: Ranges = {
-    "strain_rate": Real(0.0, 100.0, lo_open=True),
+    "strain_rate": Real(0.0, 100.0, lo_open=True, or_none=True),
     "max_strain": Real(0.0, MAX_AXIAL_STRAIN, lo_open=True),
     "record_strain": Real(0.0, 0.05, lo_open=True),
     "consolidation_ratio": Real(0.0, 1.0, lo_open=True),
@@ -56,7 +56,8 @@ class BiaxialSettings:
     """Settings of a biaxial test (SI units; strains are fractions, compression positive).
 
     strain_rate (1/s): the top plate moves down at ``strain_rate * H0`` (H0 the specimen's
-    height after consolidation); max_strain: the axial strain where the test ends;
+    height after consolidation); None (the default): :func:`auto_strain_rate`, 0.2 /s or slower
+    in a box so wide that its side walls could not follow; max_strain: the axial strain where the test ends;
     record_strain: axial strain between two rows of the curve; consolidation_ratio,
     consolidation_max_steps and stress_tolerance: when consolidation has ended (the maximum
     unbalanced-force ratio below the first, every wall's stress within the last of sigma_3);
@@ -71,7 +72,7 @@ class BiaxialSettings:
     largest |d eps_v / d eps_1| over that window for it to count as critical.
     """
 
-    strain_rate: float = 0.2
+    strain_rate: float | None = None
     max_strain: float = 0.20
     record_strain: float = 0.001
     consolidation_ratio: float = 1e-3
@@ -117,7 +118,7 @@ class BiaxialSettings:
 class BiaxialSettingsRecord(TypedResult):
     """:class:`BiaxialSettings` as a result file keeps them (its ``settings``)."""
 
-    strain_rate: float
+    strain_rate: float | None
     max_strain: float
     record_strain: float
     consolidation_ratio: float
@@ -138,6 +139,27 @@ class BiaxialSettingsRecord(TypedResult):
     smoothing_strain: float
     critical_window: float
     critical_rate_limit: float
+
+
+#: the strain rate of a test whose box lets its side walls follow (1/s)
+DEFAULT_STRAIN_RATE = 0.2
+#: a dilating specimen widens at up to about twice its axial strain rate at the peak; each side
+#: wall then moves at up to ``strain_rate * W``: the automatic rate keeps that below this share
+#: of the servo's top speed, so the servo's error stays a small proportional lag
+SIDE_SPEED_SHARE = 0.25
+
+
+def auto_strain_rate(width_m: float, settings: BiaxialSettings) -> float:
+    """The strain rate of a test in a box ``width_m`` wide: ``settings.strain_rate`` when given,
+    else 0.2 /s, slowed so that each side wall's speed stays within a quarter of the servo's top.
+
+    Measured on the paper's specimen (W 0.305 m): at 0.2 /s the side walls reach their top
+    speed (0.05 m/s) near the peak and sigma_3 drifts by 44-123 %; at 0.05 /s it stays within
+    2.3 % (docs/biaxial.md). The quick specimen (W 0.05 m) keeps 0.2 /s.
+    """
+    if settings.strain_rate is not None:
+        return settings.strain_rate
+    return min(DEFAULT_STRAIN_RATE, SIDE_SPEED_SHARE * settings.servo_max_speed / width_m)
 
 
 def inertial_number(strain_rate: float, d50: float, rho: float, pressure_pa: float) -> float:

@@ -28,7 +28,7 @@ from poro2d.biaxial.curve import CURVE_COLUMNS, BiaxialCurve, read_curve
 from poro2d.biaxial.parts import ShearChecks
 from poro2d.biaxial.record import claim, folder_stage
 from poro2d.biaxial.results import BiaxialTestResult
-from poro2d.biaxial.settings import inertial_number
+from poro2d.biaxial.settings import auto_strain_rate, inertial_number
 from poro2d.biaxial.stages import SIDE_START_STRAIN, ProgressFn, Shearing, consolidate
 from poro2d.dem import Simulation
 from poro2d.errors import InputError
@@ -64,6 +64,7 @@ class BiaxialTest:
         self.d50 = math.nan
         self.rho = math.nan
         self.i0 = math.nan
+        self.strain_rate = math.nan
 
     def build(self) -> Simulation:
         """The specimen in its box, with the test's damping; the inertial number checked."""
@@ -77,11 +78,12 @@ class BiaxialTest:
             sim.set_local_damping(float(s.local_damping))
         self.d50 = median_diameter(sim.particles.radius)
         self.rho = float(np.mean(sim.particles.density)) * sim.density_scale
-        i0 = inertial_number(s.strain_rate, self.d50, self.rho, self.case.confining_kpa * 1e3)
+        self.strain_rate = auto_strain_rate(self.box.width, s)
+        i0 = inertial_number(self.strain_rate, self.d50, self.rho, self.case.confining_kpa * 1e3)
         if i0 > s.inertial_limit:
-            fastest = s.strain_rate * s.inertial_limit / i0
+            fastest = self.strain_rate * s.inertial_limit / i0
             raise InputError(
-                "strain_rate", s.strain_rate, f"(0, {fastest:.3g}] 1/s",
+                "strain_rate", self.strain_rate, f"(0, {fastest:.3g}] 1/s",
                 f"I = rate d50 sqrt(rho / sigma_3) = {i0:.2e} at {self.case.confining_kpa:g} kPa, above the "
                 f"quasi-static limit {s.inertial_limit:g}",
             )  # fmt: skip
@@ -132,12 +134,14 @@ class BiaxialTest:
         sim = self.build()
         assert self.box is not None
         info = consolidate(sim, self.box, self.case.confining_kpa, s, self.progress)
-        rows, velocity = Shearing(sim, self.case.confining_kpa, s, self.d50, self.rho, self.progress).run()
+        sigma = self.case.confining_kpa
+        shearing = Shearing(sim, sigma, s, self.strain_rate, self.d50, self.rho, self.progress)
+        rows, velocity = shearing.run()
         curve = BiaxialCurve.of_rows(rows)
         angles = read_angles(curve, s.smoothing_strain, s.critical_window, s.critical_rate_limit)
         result = BiaxialTestResult(
             confining_stress_kpa=self.case.confining_kpa, **asdict(angles),
-            checks=self.checks(curve), consolidation=info, strain_rate_per_s=s.strain_rate,
+            checks=self.checks(curve), consolidation=info, strain_rate_per_s=self.strain_rate,
             plate_velocity_m_per_s=velocity, d50_m=self.d50, dt_s=sim.dt, local_damping=sim.local_damping,
             density_scale=sim.density_scale, shear_steps=int(rows[-1]["step"]), records=len(rows),
             wall_time_s=time.perf_counter() - t0, settings=s.record(), specimen=self.case.specimen.source,

@@ -101,6 +101,8 @@ def consolidate(
 class Shearing:
     """The plate moves down at ``strain_rate * H0``; the side walls stay servoed at sigma_3.
 
+    ``strain_rate``: the test's (:func:`poro2d.biaxial.settings.auto_strain_rate`).
+
     One row per ``record_strain`` of axial strain (:func:`poro2d.biaxial.curve.curve_row`)
     until the axial strain reaches ``max_strain``; the side walls' targets are renewed at
     every row (sigma_3 over the current height).
@@ -109,6 +111,7 @@ class Shearing:
     sim: Simulation
     confining_kpa: float
     settings: BiaxialSettings
+    strain_rate: float
     d50: float
     rho: float
     progress: ProgressFn | None = None
@@ -118,18 +121,18 @@ class Shearing:
         sim, s = self.sim, self.settings
         sigma = self.confining_kpa * 1e3
         start: BoxSize = BiaxialBox.size(sim)
-        velocity = s.strain_rate * start.height
+        velocity = self.strain_rate * start.height
         sim.set_wall_velocity("top", (0.0, -velocity))
         servo_targets(sim, sigma, s, top=False)
         steps_per_row = max(1, round(s.record_strain * start.height / (velocity * sim.dt)))
         sim.reset_clock()
-        rows = [curve_row(sim, start, 0, self.d50, self.rho, s.strain_rate)]
+        rows = [curve_row(sim, start, 0, self.d50, self.rho, self.strain_rate)]
         step = 0
         while rows[-1]["axial_strain"] < s.max_strain:
             sim.run(steps_per_row)
             step += steps_per_row
             servo_targets(sim, sigma, s, top=False)
-            rows.append(curve_row(sim, start, step, self.d50, self.rho, s.strain_rate))
+            rows.append(curve_row(sim, start, step, self.d50, self.rho, self.strain_rate))
             if self.progress is not None:
                 self.progress("shearing", min(rows[-1]["axial_strain"] / s.max_strain, 1.0))
         return rows, velocity

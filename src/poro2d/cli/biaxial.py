@@ -27,7 +27,9 @@ def register(app: typer.Typer) -> None:
             None, "--strain", help="Axial strain where the test ends (default 0.20)."
         ),
         strain_rate: float = typer.Option(
-            None, "--strain-rate", help="Axial strain rate (1/s, default 0.2)."
+            None,
+            "--strain-rate",
+            help="Axial strain rate (1/s; default 0.2, slower in a box too wide for its walls to follow).",
         ),
         replicates: int = typer.Option(
             None, "--replicates", "-r", help="With --quick: specimens of seeds S, S+1, ..."
@@ -154,10 +156,21 @@ def start_and_print(case, stresses: list[float], store, kw: dict, out: Path) -> 
     except RuntimeError as exc:
         console.print(f"[bold red]failed:[/] {exc}")
         raise typer.Exit(1) from None
+    tests = result.tests if len(stresses) == 1 else [t for study in result.studies for t in study.tests]
+    off = [t for t in tests if not t.checks.sigma_3_held]
+    if off:  # said first: the angles below are not those of a test at constant sigma_3
+        worst = max(t.checks.sigma_3_mean_error for t in off)
+        console.print(
+            f"[bold red]sigma_3 not held[/] in {len(off)} of {len(tests)} tests (mean error up to "
+            f"{100 * worst:.0f} %, tolerance {100 * off[0].checks.stress_tolerance:g} %): these are not "
+            "constant-sigma_3 angles; rerun with a slower --strain-rate (docs/biaxial.md)"
+        )
     if len(stresses) == 1:
         print_result(result, out)
     else:
         print_series(result, out)
+    if off:
+        raise typer.Exit(1)
 
 
 def print_result(result, out: Path) -> None:

@@ -1,0 +1,33 @@
+"""The strain rate a biaxial test runs at, and a test whose side walls could not hold sigma_3."""
+
+import json
+
+import pytest
+
+from poro2d.biaxial.settings import DEFAULT_STRAIN_RATE, BiaxialSettings, auto_strain_rate
+from poro2d.cli import main
+
+
+def test_the_automatic_rate_keeps_each_side_walls_speed_within_a_quarter_of_the_servos_top():
+    s = BiaxialSettings()
+    assert s.strain_rate is None
+    assert auto_strain_rate(0.05, s) == DEFAULT_STRAIN_RATE  # the quick specimen: unchanged
+    paper = auto_strain_rate(0.305, s)  # the paper's box: its walls at 0.2 /s would need 0.06 m/s
+    assert paper == pytest.approx(0.25 * 0.05 / 0.305) and paper * 0.305 <= 0.25 * s.servo_max_speed
+    assert auto_strain_rate(0.305, BiaxialSettings(strain_rate=0.2)) == 0.2  # given: taken as given
+    assert auto_strain_rate(0.305, BiaxialSettings(servo_max_speed=0.5)) == DEFAULT_STRAIN_RATE
+
+
+def test_a_test_that_did_not_hold_sigma_3_says_so_first_and_fails(tmp_path, capsys):
+    """Side walls too slow to follow the specimen: the first line says the angles are not those of
+    a test at constant sigma_3, and the command exits 1 (the files keep sigma_3_held = false)."""
+    cfg = tmp_path / "slow_walls.toml"
+    cfg.write_text("[biaxial]\nservo_max_speed = 0.0002\nstrain_rate = 0.2\nmax_strain = 0.03\n")
+    out = tmp_path / "b"
+    with pytest.raises(SystemExit) as exc:
+        main(["biaxial", "--quick", "--config", str(cfg), "--out", str(out), "--quiet"])
+    printed = capsys.readouterr().out
+    assert exc.value.code == 1
+    assert printed.strip().splitlines()[0].startswith("sigma_3 not held in 1 of 1 tests")
+    kept = json.loads((out / "replicate1" / "result.json").read_text())
+    assert kept["checks"]["sigma_3_held"] is False and kept["checks"]["sigma_3_mean_error"] > 0.02
