@@ -2,12 +2,10 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-import numpy as np
-
+from poro2d.measure.spread import Spread
 from poro2d.typed_result import TypedResult
 
 
@@ -64,26 +62,12 @@ class ShearChecks(TypedResult):
 
 
 @dataclass(eq=False)
-class AngleSpread(TypedResult):
+class AngleSpread(Spread):
     """One angle over the replicates (degrees): mean, sd (None for one), min, max and each value."""
 
-    mean: float
-    sd: float | None
-    min: float
-    max: float
-    values: list[float]
-
-    @classmethod
-    def of(cls, values: list[float]) -> AngleSpread:
-        v = np.asarray(values, float)
-        sd = float(v.std(ddof=1)) if v.size > 1 else None
-        return cls(float(v.mean()), sd, float(v.min()), float(v.max()), [float(x) for x in v])
-
-    def text(self) -> str:
+    def text(self, digits: int = 1, unit: str = " deg") -> str:
         """``31.2 +- 1.4 deg (29.9-32.8)``, or ``31.2 deg`` for one value."""
-        if self.sd is None or not math.isfinite(self.sd):
-            return f"{self.mean:.1f} deg"
-        return f"{self.mean:.1f} +- {self.sd:.1f} deg ({self.min:.1f}-{self.max:.1f})"
+        return super().text(digits, unit)
 
 
 @dataclass(eq=False)

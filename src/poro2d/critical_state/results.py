@@ -2,15 +2,13 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
-
-import numpy as np
 
 from poro2d.critical_state.case import CaseRecord
 from poro2d.critical_state.series import CellSeries
 from poro2d.io_utils import Provenance
+from poro2d.measure.spread import Spread
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
@@ -55,29 +53,6 @@ class CriticalStateTestResult(TypedResult):
     series: CellSeries | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {"case": CaseRecord, "provenance": Provenance}
-
-
-@dataclass(eq=False)
-class Spread(TypedResult):
-    """One number over the seeds: mean, sd (None for one seed), min, max and each value."""
-
-    mean: float
-    sd: float | None
-    min: float
-    max: float
-    values: list[float]
-
-    @classmethod
-    def of(cls, values: list[float]) -> Spread:
-        v = np.asarray(values, float)
-        sd = float(v.std(ddof=1)) if v.size > 1 else None
-        return cls(float(v.mean()), sd, float(v.min()), float(v.max()), [float(x) for x in v])
-
-    def text(self, digits: int = 3) -> str:
-        """``0.276 +- 0.004 (0.271-0.280)``, or ``0.276`` for one value."""
-        if self.sd is None or not math.isfinite(self.sd):
-            return f"{self.mean:.{digits}f}"
-        return f"{self.mean:.{digits}f} +- {self.sd:.{digits}f} ({self.min:.{digits}f}-{self.max:.{digits}f})"
 
 
 @dataclass(eq=False)
