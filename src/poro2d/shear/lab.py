@@ -5,7 +5,9 @@ ignored, every row has as many cells as the header, lines starting with ``#`` ar
 comments; the file is UTF-8 text):
 
 * curves: ``normal_stress_kpa, shear_displacement_mm, shear_stress_kpa``, one row
-  per reading, one curve per normal stress;
+  per reading, one curve per normal stress, and optionally ``vertical_displacement_mm``:
+  the top plate's rise (positive: the specimen dilates; the sign of poro2d's own
+  ``plate_displacement_mm``), which a calibration fits as the dilation;
 * peaks: ``normal_stress_kpa, peak_shear_stress_kpa``, one row per test.
 
 The peak of a curve is its largest shear stress as measured (laboratory curves
@@ -26,11 +28,13 @@ import numpy as np
 
 from poro2d.errors import InputError
 from poro2d.lab_table import LabTable, check_enough_points, check_rising, read_lab_table
-from poro2d.shear.lab_checks import MAX_DISPLACEMENT_MM, check_lab_values, check_peak
+from poro2d.shear.lab_checks import MAX_DISPLACEMENT_MM, MAX_VERTICAL_MM, check_lab_values, check_peak
 from poro2d.shear.parts import LabPeak, LabRecord
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA
 
 CURVE_COLUMNS = ("normal_stress_kpa", "shear_displacement_mm", "shear_stress_kpa")
+#: the optional column of a curves CSV: the top plate's rise (mm, positive: dilation)
+VERTICAL_COLUMN = "vertical_displacement_mm"
 PEAK_COLUMNS = ("normal_stress_kpa", "peak_shear_stress_kpa")
 
 
@@ -38,17 +42,20 @@ PEAK_COLUMNS = ("normal_stress_kpa", "peak_shear_stress_kpa")
 class LabData:
     """Laboratory results: peaks per normal stress, and curves when the CSV had them.
 
-    Made in Python, the data pass the checks a file passes (:mod:`poro2d.shear.lab_checks`):
-    a calibration handed a ``LabData`` is as safe as one handed a CSV."""
+    ``vertical``: per normal stress, the top plate's rise at each reading of its curve (m,
+    positive: dilation), when the curves CSV had the column (else empty). Made in Python,
+    the data pass the checks a file passes (:mod:`poro2d.shear.lab_checks`): a calibration
+    handed a ``LabData`` is as safe as one handed a CSV."""
 
     source: str
     peaks: dict[float, float]
     curves: dict[float, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)
+    vertical: dict[float, np.ndarray] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if not isinstance(self.peaks, dict) or not isinstance(self.curves, dict):
             raise InputError("lab", type(self.peaks).__name__, "peaks and curves as dicts by normal stress")
-        check_lab_values(self.peaks, self.curves)
+        check_lab_values(self.peaks, self.curves, self.vertical)
 
     @property
     def kind(self) -> str:
@@ -109,7 +116,9 @@ def _curves(table: LabTable) -> LabData:
     why = "a reading of a shear box; is the column in mm?"
     d = table.column("shear_displacement_mm", 0.0, MAX_DISPLACEMENT_MM, "mm", why)
     tau = table.column("shear_stress_kpa", 0.0, math.inf, "kPa")
+    rise = _vertical(table)
     curves: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+    vertical: dict[float, np.ndarray] = {}
     for s in np.unique(sigma):
         rows = np.flatnonzero(sigma == s)  # rows in file order, never re-sorted
         check_enough_points(table, rows, f"curve at {s:g} kPa")
@@ -119,8 +128,19 @@ def _curves(table: LabTable) -> LabData:
             table.where(k, "shear_stress_kpa"), "shear_stress_kpa (the curve's peak)", float(s), float(tau[k])
         )
         curves[float(s)] = (d[rows] * 1e-3, tau[rows])  # displacement in m
+        if rise is not None:
+            vertical[float(s)] = rise[rows] * 1e-3
     peaks = {s: float(np.max(t)) for s, (_, t) in curves.items()}
-    return LabData(table.path, peaks, curves)
+    return LabData(table.path, peaks, curves, vertical)
 
 
-__all__ = ["CURVE_COLUMNS", "PEAK_COLUMNS", "LabData", "read_lab_csv"]
+def _vertical(table: LabTable) -> np.ndarray | None:
+    """The optional column of the plate's rise (mm), or None when the file has none."""
+    if not table.has(VERTICAL_COLUMN):
+        return None
+    top = MAX_VERTICAL_MM
+    why = "the rise or fall of a shear box's top plate; is the column in mm?"
+    return table.column(VERTICAL_COLUMN, -top, top, "mm", why)
+
+
+__all__ = ["CURVE_COLUMNS", "PEAK_COLUMNS", "VERTICAL_COLUMN", "LabData", "read_lab_csv"]

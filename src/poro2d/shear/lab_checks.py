@@ -12,6 +12,9 @@ its answer printed as if it were identified. The checks here are physical, not s
 * a shear displacement lies in [0, :data:`MAX_DISPLACEMENT_MM`] mm: the largest shear boxes
   (1 m rockfill boxes) are sheared by a fifth of their length, 200 mm; more is a column in
   micrometres or a typing mistake;
+* the top plate's vertical displacement of a curve (optional), within
+  +-:data:`MAX_VERTICAL_MM` mm: a plate rises or sinks by a fraction of the specimen's height,
+  which is under half a metre even in the largest boxes; more is a column in micrometres;
 * a curve is a test: displacements rise from row to row (a step back or a repeat is a
   curve pasted twice or sorted by another column), with at least :data:`MIN_CURVE_POINTS`
   readings, so that a peak and what follows it are measured.
@@ -35,6 +38,10 @@ from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA
 MAX_STRESS_RATIO = MAX_TAN_PHI
 #: largest shear displacement of a laboratory reading (mm)
 MAX_DISPLACEMENT_MM = 300.0
+#: largest rise or fall of the top plate in a laboratory reading (mm): a specimen dilates or
+#: contracts by a few percent of its height, and the tallest boxes (1 m rockfill boxes) hold
+#: specimens under half a metre high, so 100 mm is past any soil; more is a unit mistake
+MAX_VERTICAL_MM = 100.0
 
 
 def check_normal_stress(where: str, sigma: float) -> None:
@@ -58,9 +65,14 @@ def check_peak(where: str, column: str, sigma: float, tau: float) -> None:
         )  # fmt: skip
 
 
-def check_lab_values(peaks: dict[float, float], curves: dict[float, tuple[np.ndarray, np.ndarray]]) -> None:
+def check_lab_values(
+    peaks: dict[float, float],
+    curves: dict[float, tuple[np.ndarray, np.ndarray]],
+    vertical: dict[float, np.ndarray] | None = None,
+) -> None:
     """Peaks and curves given in Python (no file lines): the checks a file passes, each named by
-    its normal stress. Curves hold displacement in m, as :class:`~poro2d.shear.lab.LabData` does."""
+    its normal stress. Curves hold displacement in m, as :class:`~poro2d.shear.lab.LabData` does,
+    and so does ``vertical`` (the plate's rise along each curve, optional)."""
     if not peaks:
         raise InputError("lab peaks", peaks, "at least one normal stress")
     if curves and set(curves) != set(peaks):
@@ -82,6 +94,25 @@ def check_lab_values(peaks: dict[float, float], curves: dict[float, tuple[np.nda
             raise InputError(
                 f"lab peak at {sigma:g} kPa", peaks[sigma], f"its curve's largest reading {np.max(t):g}"
             )
+    _check_vertical(curves, vertical or {})
+
+
+def _check_vertical(curves: dict, vertical: dict) -> None:
+    """The plate's vertical displacement (m) of every curve or of none, one reading per reading
+    of its curve, finite and within +-:data:`MAX_VERTICAL_MM`."""
+    if not isinstance(vertical, dict):
+        raise InputError("lab vertical", type(vertical).__name__, "a dict by normal stress, or None")
+    if vertical and set(vertical) != set(curves):
+        raise InputError("lab vertical", sorted(vertical), f"one per curve's normal stress {sorted(curves)}")
+    top = MAX_VERTICAL_MM * 1e-3 * (1.0 + 1e-12)  # in m; the margin absorbs the mm -> m rounding
+    for sigma, v in vertical.items():
+        v = np.asarray(v, float)
+        where = f"lab vertical displacement at {sigma:g} kPa"
+        if v.shape != np.shape(curves[sigma][0]):
+            raise InputError(where, v.shape, "one reading per reading of its curve")
+        if not np.all(np.isfinite(v)) or np.max(np.abs(v)) > top:
+            allowed = f"finite, within +-{MAX_VERTICAL_MM * 1e-3:g} m"
+            raise InputError(where, "a reading out of range", allowed)
 
 
 def _check_curve_arrays(sigma: float, d: np.ndarray, t: np.ndarray) -> None:
@@ -109,6 +140,6 @@ def _check_curve_arrays(sigma: float, d: np.ndarray, t: np.ndarray) -> None:
 
 
 __all__ = [
-    "MAX_DISPLACEMENT_MM", "MAX_STRESS_RATIO", "MIN_CURVE_POINTS", "check_lab_values", "check_normal_stress",
-    "check_peak",
+    "MAX_DISPLACEMENT_MM", "MAX_STRESS_RATIO", "MAX_VERTICAL_MM", "MIN_CURVE_POINTS", "check_lab_values",
+    "check_normal_stress", "check_peak",
 ]  # fmt: skip
