@@ -105,8 +105,25 @@ def tiny(specimen, tmp_path_factory):
         paths[seed] = root / f"seed{seed}.npz"
         checkpoint.save(sim, paths[seed])
     lab = synthetic_lab(paths[2], [50, 100], TRUTH["particle_friction"], TRUTH["rolling_friction"],
-                        root / "lab.csv", settings=SHORT)  # fmt: skip
-    return paths, lab
+                        root / "lab_dilation.csv", settings=SHORT)  # fmt: skip
+    return paths, _without_vertical(lab, root / "lab.csv")
+
+
+@pytest.fixture(scope="module")
+def tiny_dilation(tiny):
+    """The 'laboratory' of ``tiny`` as synthetic_lab writes it: with the plate's vertical displacement."""
+    paths, plain = tiny
+    return paths, plain.with_name("lab_dilation.csv")
+
+
+def _without_vertical(path, to):
+    """A copy of a synthetic curves CSV without its last column (vertical_displacement_mm): the
+    peaks and end stresses alone, as laboratory files had before the plate's rise was fitted."""
+    lines = path.read_text().splitlines()
+    kept = [ln if ln.startswith("#") else ln.rsplit(",", 1)[0] for ln in lines]
+    assert lines[4].endswith(",vertical_displacement_mm") and "vertical" not in kept[4]
+    to.write_text("\n".join(kept) + "\n")
+    return to
 
 
 def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tmp_path):
@@ -146,7 +163,8 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     assert again.best == res.best
     # a weaker 'laboratory' (the same specimen at lower frictions) moves the answer to weaker
     # parameters: the calibration follows its data (round 1 comes from the cache)
-    weak_lab = synthetic_lab(paths[2], [50, 100], 0.3, 0.0, tmp_path / "weak.csv", settings=SHORT)
+    weak_lab = synthetic_lab(paths[2], [50, 100], 0.3, 0.0, tmp_path / "weak_dilation.csv", settings=SHORT)
+    weak_lab = _without_vertical(weak_lab, tmp_path / "weak.csv")
     weak = run_calibration(weak_lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2,
                            settings=SHORT, workers=1, dashboard=None, progress=False)  # fmt: skip
     peaks = {
@@ -158,6 +176,85 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
         if o["observable"] == "peak":
             assert o["model_kpa"] < peaks[o["normal_stress_kpa"]]
     assert weak.posterior["median"]["particle_friction"] < res.posterior["median"]["particle_friction"]
+
+
+def test_synthetic_lab_writes_the_plates_rise_of_its_tests(tiny_dilation):
+    """The curves CSV carries each test's ``plate_displacement_mm`` as the vertical column; the
+    other columns are those of a file without it."""
+    import csv
+
+    from poro2d.shear.lab import read_lab_csv
+
+    _, lab = tiny_dilation
+    lines = [ln for ln in lab.read_text().splitlines() if not ln.startswith("#")]
+    assert lines[0] == "normal_stress_kpa,shear_displacement_mm,shear_stress_kpa,vertical_displacement_mm"
+    plain = [ln for ln in lab.with_name("lab.csv").read_text().splitlines() if not ln.startswith("#")]
+    assert [ln.rsplit(",", 1)[0] for ln in lines] == plain
+    read = read_lab_csv(lab)
+    for sigma in (50.0, 100.0):
+        with open(lab.with_name("lab_dilation-tests") / f"sn{sigma:g}kPa" / "curve.csv") as f:
+            rise = np.array([float(r["plate_displacement_mm"]) for r in csv.DictReader(f)])
+        assert np.allclose(read.vertical[sigma] * 1e3, rise, atol=5e-7)
+        assert rise[-1] > 0.0  # a dense specimen dilates: the plate rises
+
+
+def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, tiny_dilation, tmp_path):
+    """With the plate's rise in the lab curves, the calibration fits ``dilation_<s>kPa`` (mm) beside
+    the peaks and end stresses, from the same shear tests (their keys do not change: a calibration
+    on the plain file reuses them all)."""
+    from poro2d.calibration.run import _base_settings, _lab_targets
+    from poro2d.calibration.specimens import replicate_unit
+    from poro2d.calibration.units import CalibrationUnit, end_rise_mm, stored_row
+    from poro2d.shear.lab import read_lab_csv
+    from poro2d.specimen.specimen_set import SpecimenSet
+
+    paths, plain = tiny
+    _, lab = tiny_dilation
+    out = tmp_path / "cal"
+    kw = dict(store=Store(out), points=9, refine=0, settings=SHORT, workers=1, dashboard=None, progress=False)
+    res = run_calibration(lab, [paths[0], paths[1]], **kw)
+    keys = [f"{o}_{s}kPa" for o in ("peak", "end", "dilation") for s in (50, 100)]
+    assert list(res.fit) == keys
+    saved = json.loads((out / "result.json").read_text())
+    for s in (50, 100):
+        fit = saved["fit"][f"dilation_{s}kPa"]
+        assert "seed_scatter_mm" in fit and "surrogate_residual_mm" in fit and "seed_scatter_kpa" not in fit
+        assert 0.0 < fit["seed_scatter_mm"] < 1.0  # mm, not kPa: a 3 cm specimen rises by tenths of mm
+        assert "seed_scatter_kpa" in saved["fit"][f"peak_{s}kPa"]
+    fitted = {(o["observable"], o["normal_stress_kpa"]): o for o in saved["posterior"]["observables"]}
+    targets = _lab_targets(read_lab_csv(lab), _base_settings(SHORT))
+    for obs, s, y in targets:
+        o = fitted[(obs, s)]
+        unit = "mm" if obs == "dilation" else "kpa"
+        assert o[f"lab_{unit}"] == y and {f"model_{unit}", f"noise_sd_{unit}"} <= set(o)
+        assert not ({"lab_kpa", "lab_mm"} - {f"lab_{unit}"}) & set(o)
+    assert 0.0 < fitted[("dilation", 50.0)]["lab_mm"] < 2.0
+    # each design point's dilation is the stored test's plate rise at its end, smoothed as its end stress
+    first = res.evaluations[0]
+    assert len(first["dilation_50kPa"]) == 2 and all(0.0 < v < 2.0 for v in first["dilation_50kPa"])
+    digest = res.specimens  # labels -> files; the units of the first point, specimen by specimen
+    found = SpecimenSet.named([paths[0], paths[1]]).read()
+    for k, label in enumerate(found):
+        unit = replicate_unit(found, label, 50.0, _base_settings(SHORT), first.particle_friction,
+                              first.rolling_friction)  # fmt: skip
+        assert isinstance(unit, CalibrationUnit) and str(found[label]) == digest[label]
+        row = stored_row(unit, Store(out).child("cache"))
+        assert row.dilation == first["dilation_50kPa"][k]
+        test = json.loads((out / "cache" / unit.key / "result.json").read_text())
+        assert row.dilation == pytest.approx(test["end"]["plate_displacement_mm"], rel=1e-12)
+    # the mean over the last window (2 mm: the readings at 1 and 2 mm)
+    curve = {
+        "shear_displacement_mm": np.array([0.0, 1.0, 2.0]),
+        "plate_displacement_mm": np.array([0, 0.1, 0.3]),
+    }
+    assert end_rise_mm(curve, 2e-3) == pytest.approx(0.2)
+    report = (out / "calibration.md").read_text()
+    assert "| dilation | 50 | mm |" in report and "| peak | 50 | kPa |" in report
+    assert (out / "calibration_fit.png").stat().st_size > 0
+    again = run_calibration(plain, [paths[0], paths[1]], **kw)
+    assert again.cluster.tests_run == 0 and again.cluster.tests_reused == 9 * 2 * 2
+    assert list(again.fit) == keys[:4]
+    assert [e["peak_50kPa"] for e in again.evaluations] == [e["peak_50kPa"] for e in res.evaluations]
 
 
 @pytest.mark.parametrize(

@@ -1,9 +1,10 @@
 """A calibration's evaluations: each design point with its observables' replicate values.
 
 ``result.json`` keeps one row per design point (``evaluations``): the parameter pair, then a
-key per laboratory target (``peak_50kPa``, ``end_100kPa``) with the value of each replicate
-specimen. The targets vary with the laboratory data, so the keys are formed from them
-(:func:`target_key`) and read back into the observable and stress they name.
+key per laboratory target (``peak_50kPa``, ``end_100kPa``, ``dilation_50kPa``) with the value of
+each replicate specimen (kPa for the stresses, mm for the dilation). The targets vary with the
+laboratory data, so the keys are formed from them (:func:`target_key`) and read back into the
+observable and stress they name.
 """
 
 from __future__ import annotations
@@ -23,7 +24,8 @@ def target_key(observable: str, normal_stress_kpa: float) -> str:
 @dataclass(frozen=True)
 class Observed(Record):
     """One observable of a design point at one normal stress: its value per replicate specimen
-    (kPa, in the specimens' order; NaN where the test failed), written under :func:`target_key`."""
+    (in the specimens' order; NaN where the test failed; kPa for a stress, mm for the dilation),
+    written under :func:`target_key`."""
 
     observable: str
     normal_stress_kpa: float

@@ -5,7 +5,8 @@ with the logarithm of its friction far more evenly than with the friction itself
 mu_r, each scaled to [0, 1] over its range.
 
 * design: a Latin hypercube over the unit square (``scipy.stats.qmc``), seeded;
-* surrogate: per observable (a peak or an end shear stress at one normal stress), a
+* surrogate: per observable (a peak or an end shear stress at one normal stress, or the
+  plate's rise at the end of the test: the dilation), a
   full quadratic in the two coordinates fitted by least squares to the replicate means;
   the seed scatter is pooled over the design points; what the quadratic cannot follow
   (its residual) is counted as extra noise;
@@ -74,9 +75,10 @@ N_COEFFICIENTS = 6
 class Surrogate:
     """A quadratic response surface of one observable's replicate mean, and its noise terms.
 
-    ``scatter``: the seed standard deviation pooled over the design (kPa); ``residual``:
-    the root mean square misfit of the quadratic to the means, corrected for its degrees
-    of freedom (kPa); ``replicates``: the specimens per design point.
+    ``scatter``: the seed standard deviation pooled over the design; ``residual``: the root
+    mean square misfit of the quadratic to the means, corrected for its degrees of freedom
+    (both in the observable's unit: kPa for a stress, mm for the dilation); ``replicates``:
+    the specimens per design point.
     """
 
     coefficients: np.ndarray
@@ -89,7 +91,7 @@ class Surrogate:
 
 
 def fit_surrogate(unit: np.ndarray, values: np.ndarray) -> Surrogate:
-    """The surrogate of one observable: ``values`` (design points x replicates, kPa; NaN: failed)."""
+    """The surrogate of one observable: ``values`` (design points x replicates; NaN: failed)."""
     means = np.nanmean(values, axis=1)
     counts = np.sum(np.isfinite(values), axis=1)
     coefficients, *_ = np.linalg.lstsq(_features(unit), means, rcond=None)
@@ -113,7 +115,7 @@ class Posterior:
     u: np.ndarray  # grid coordinates of log f_p, [0, 1]
     v: np.ndarray  # and of mu_r
     density: np.ndarray  # (len(v), len(u))
-    noise_sd: list[float] = field(default_factory=list)  # per observable (kPa), set by the caller
+    noise_sd: list[float] = field(default_factory=list)  # per observable (its unit), set by the caller
     noise_correlation: list[list[float]] = field(default_factory=list)
 
     @property
@@ -169,7 +171,8 @@ SHRINK = 0.2
 
 
 def seed_covariance(values: np.ndarray) -> np.ndarray:
-    """The covariance (kPa^2) of one specimen's deviations across observables.
+    """The covariance of one specimen's deviations across observables (each in its unit: kPa^2
+    between stresses, mm^2 between dilations, kPa mm across).
 
     ``values``: (design points, observables, replicates); design points with a missing
     test are left out. Deviations from each point's replicate mean, pooled over the points
@@ -186,17 +189,39 @@ def seed_covariance(values: np.ndarray) -> np.ndarray:
     return (1.0 - SHRINK) * cov + SHRINK * np.diag(np.diag(cov))
 
 
-def noise_covariance(surrogates: list[Surrogate], seed_cov: np.ndarray, lab_values, lab_error: float):
-    """The covariance (kPa^2) of the misfit between the laboratory values and the surrogates.
+def noise_covariance(
+    surrogates: list[Surrogate], seed_cov: np.ndarray, lab_values, lab_error: float, units=None
+) -> np.ndarray:
+    """The covariance of the misfit between the laboratory values and the surrogates.
 
     The laboratory specimen is one more realisation (``seed_cov``), the mean of the
     replicates is uncertain too (``seed_cov / replicates``), each quadratic misses by its
-    residual and the laboratory reading carries ``lab_error`` (a fraction of each value).
+    residual and the laboratory reading carries ``lab_error`` (a fraction of each value, so in
+    its unit). The observables may be in different units (``units``: one label per observable;
+    None: all in kPa): the likelihood's Mahalanobis distance does not depend on them, and the
+    small ridge added to the diagonal against a singular matrix (:func:`_ridge`) is scaled per
+    unit, so that the stresses' kPa^2 do not swamp the dilations' mm^2.
     """
     replicates = max(max(s.replicates for s in surrogates), 1)
     extra = [s.residual**2 + (lab_error * y) ** 2 for s, y in zip(surrogates, lab_values, strict=True)]
     cov = seed_cov * (1.0 + 1.0 / replicates) + np.diag(extra)
-    return cov + np.eye(len(extra)) * 1e-9 * max(float(np.trace(cov)), 1.0)
+    labels = np.array(["kPa" if units is None else units[k] for k in range(len(extra))])
+    ridge = np.zeros(len(extra))
+    for label in dict.fromkeys(labels):
+        same = labels == label
+        ridge[same] = _ridge(float(np.trace(cov[np.ix_(same, same)])), label)
+    return cov + np.diag(ridge)
+
+
+def _ridge(trace: float, unit: str) -> float:
+    """1e-9 of the trace of one unit's block: far below any noise, enough to invert a singular one.
+
+    The stresses keep their floor of 1 kPa^2 (a block of zeros gets 1e-9 kPa^2); another unit
+    is floored only where its block is zero, so that its ridge scales with it: the same
+    dilation in mm or in m gives the same posterior."""
+    if unit == "kPa":
+        return 1e-9 * max(trace, 1.0)
+    return 1e-9 * (trace if trace > 0.0 else 1.0)
 
 
 def posterior(ranges: Ranges, surrogates: list[Surrogate], lab_values, cov: np.ndarray) -> Posterior:

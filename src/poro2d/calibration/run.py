@@ -27,7 +27,7 @@ from poro2d.calibration.specimens import (
     preset_specimens,
     replicate_unit,
 )
-from poro2d.calibration.units import CACHE, CalibrationUnit, UnitRow
+from poro2d.calibration.units import CACHE, OBSERVABLE_UNITS, CalibrationUnit, UnitRow
 from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
 from poro2d.execute.dask_cluster import check_reachable
@@ -86,19 +86,30 @@ class FrictionFlags(TypedResult):
 
 @dataclass(eq=False)
 class SurrogateRecord(TypedResult):
-    """One observable's quadratic surrogate as a file keeps it."""
+    """One observable's quadratic surrogate as a file keeps it.
+
+    The seed scatter and the residual are in the observable's unit, named by their keys:
+    ``seed_scatter_kpa`` and ``surrogate_residual_kpa`` for a shear stress, ``seed_scatter_mm``
+    and ``surrogate_residual_mm`` for the dilation (the other pair is absent from the file).
+    """
 
     coefficients: list[float]
-    seed_scatter_kpa: float
-    surrogate_residual_kpa: float
-    replicates: int
+    seed_scatter_kpa: float | None = None
+    surrogate_residual_kpa: float | None = None
+    replicates: int = 0
+    seed_scatter_mm: float | None = None
+    surrogate_residual_mm: float | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = (
+        "seed_scatter_kpa", "surrogate_residual_kpa", "seed_scatter_mm", "surrogate_residual_mm",
+    )  # fmt: skip
 
     @classmethod
-    def of(cls, surrogate: model.Surrogate) -> SurrogateRecord:
-        """The record of a fitted surrogate (its coefficients as a list)."""
-        return cls(
-            surrogate.coefficients.tolist(), surrogate.scatter, surrogate.residual, surrogate.replicates
-        )
+    def of(cls, surrogate: model.Surrogate, unit: str = "kPa") -> SurrogateRecord:
+        """The record of a fitted surrogate (its coefficients as a list) of an observable in ``unit``."""
+        u = unit.lower()
+        noise = {f"seed_scatter_{u}": surrogate.scatter, f"surrogate_residual_{u}": surrogate.residual}
+        return cls(surrogate.coefficients.tolist(), replicates=surrogate.replicates, **noise)
 
 
 @dataclass(eq=False)
@@ -110,14 +121,36 @@ class CalibrationTimings(TypedResult):
 
 @dataclass(eq=False)
 class FittedObservable(TypedResult):
-    """One laboratory value fitted: the observable (``peak`` or ``end``) at a normal stress, the
-    laboratory's value, the surrogate's at the best parameters and the noise it was given (kPa)."""
+    """One laboratory value fitted: the observable (``peak``, ``end`` or ``dilation``) at a normal
+    stress, the laboratory's value, the surrogate's at the best parameters and the noise it was
+    given, in the observable's unit, named by the keys: ``lab_kpa``, ``model_kpa`` and
+    ``noise_sd_kpa`` for a shear stress, ``lab_mm``, ``model_mm`` and ``noise_sd_mm`` for the
+    dilation (the other three are absent from the file)."""
 
     observable: str
     normal_stress_kpa: float
-    lab_kpa: float
-    model_kpa: float
-    noise_sd_kpa: float
+    lab_kpa: float | None = None
+    model_kpa: float | None = None
+    noise_sd_kpa: float | None = None
+    lab_mm: float | None = None
+    model_mm: float | None = None
+    noise_sd_mm: float | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = (
+        "lab_kpa", "model_kpa", "noise_sd_kpa", "lab_mm", "model_mm", "noise_sd_mm",
+    )  # fmt: skip
+
+    @classmethod
+    def of(cls, observable: str, normal_stress_kpa: float, lab: float, fitted: float, noise_sd: float):
+        """The record of one target, its values under the keys of its unit."""
+        u = OBSERVABLE_UNITS[observable].lower()
+        values = {f"lab_{u}": lab, f"model_{u}": fitted, f"noise_sd_{u}": noise_sd}
+        return cls(observable, normal_stress_kpa, **values)
+
+    @property
+    def unit(self) -> str:
+        """The unit of the values (``kPa`` or ``mm``)."""
+        return OBSERVABLE_UNITS[self.observable]
 
 
 @dataclass(eq=False)
@@ -237,25 +270,33 @@ def _base_settings(settings: dict | None) -> ShearSettings:
 
 
 def _lab_targets(lab: LabData, base: ShearSettings) -> list[tuple[str, float, float]]:
-    """(observable, normal stress, laboratory value) fitted: every peak, and with curves the end stress.
+    """(observable, normal stress, laboratory value) fitted: every peak; with curves the end stress;
+    with the plate's vertical displacement too the dilation (mm).
 
-    The end stress of a laboratory curve is its mean over the last peak window before the
-    tests' ``max_displacement`` (the simulated end value is smoothed over the same window).
+    The end values of a laboratory curve are its means over the last peak window before the
+    tests' ``max_displacement`` (the simulated end values are smoothed over the same window).
     """
     targets = [("peak", s, lab.peaks[s]) for s in lab.normal_stresses()]
-    end, window = base.max_displacement, base.peak_window
     for s in lab.normal_stresses() if lab.curves else []:
         d, t = lab.curves[s]
-        if d[-1] < end:
+        if d[-1] < base.max_displacement:
             raise InputError(
                 "settings.max_displacement",
-                end,
+                base.max_displacement,
                 f"at most {d[-1]:g} m, where the lab curve at {s:g} kPa ends",
             )
-        inside = (d >= end - window) & (d <= end)
-        value = float(np.mean(t[inside])) if inside.any() else float(np.interp(end, d, t))
-        targets.append(("end", s, value))
+        targets.append(("end", s, _end_mean(d, t, base)))
+    for s in lab.normal_stresses() if lab.vertical else []:
+        targets.append(("dilation", s, 1e3 * _end_mean(lab.curves[s][0], lab.vertical[s], base)))
     return targets
+
+
+def _end_mean(d: np.ndarray, y: np.ndarray, base: ShearSettings) -> float:
+    """The mean of ``y`` over the readings within the last peak window before ``max_displacement``
+    (the value at ``max_displacement`` interpolated when no reading lies in that window)."""
+    end, window = base.max_displacement, base.peak_window
+    inside = (d >= end - window) & (d <= end)
+    return float(np.mean(y[inside])) if inside.any() else float(np.interp(end, d, y))
 
 
 @holds_output("store", kind=KIND)
@@ -426,7 +467,9 @@ def _infer(ranges, design, specimens: SpecimenSet, stresses, rows: list[UnitRow 
     lab_values = [y for *_, y in targets]
     try:  # an overflow or a 0/0 here would end in a posterior of NaN read as an answer
         with np.errstate(divide="raise", over="raise", invalid="raise"):
-            cov = model.noise_covariance(surrogates, model.seed_covariance(values), lab_values, lab_error)
+            units = [OBSERVABLE_UNITS[obs] for obs, *_ in targets]
+            seed_cov = model.seed_covariance(values)
+            cov = model.noise_covariance(surrogates, seed_cov, lab_values, lab_error, units)
             post = model.posterior(ranges, surrogates, lab_values, cov)
             post.noise_sd = np.sqrt(np.diag(cov)).tolist()
             post.noise_correlation = (cov / np.sqrt(np.outer(np.diag(cov), np.diag(cov)))).round(3).tolist()
@@ -492,13 +535,7 @@ def _result(
         wide = dict.fromkeys(wide)
     best_unit = ranges.to_unit([fp], [mu_r])
     fitted = [
-        FittedObservable(
-            observable=obs,
-            normal_stress_kpa=s,
-            lab_kpa=y,
-            model_kpa=float(sg.mean(best_unit)[0]),
-            noise_sd_kpa=sd,
-        )
+        FittedObservable.of(obs, s, y, float(sg.mean(best_unit)[0]), sd)
         for (obs, s, y), sg, sd in zip(targets, surrogates, post.noise_sd, strict=True)
     ]
     return CalibrationResult(
@@ -516,9 +553,7 @@ def _result(
         ),
         evaluations=table,
         fit={
-            target_key(obs, s): SurrogateRecord(
-                sg.coefficients.tolist(), sg.scatter, sg.residual, sg.replicates
-            )
+            target_key(obs, s): SurrogateRecord.of(sg, OBSERVABLE_UNITS[obs])
             for (obs, s, _), sg in zip(targets, surrogates, strict=True)
         },
         lab=lab_data.record(),

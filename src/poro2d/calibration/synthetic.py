@@ -29,7 +29,8 @@ def synthetic_lab(
 ) -> Path:
     """Shear ``specimen`` at each stress with the given frictions; write the lab CSV at ``path``.
 
-    ``curves``: the whole curves (the lab curve layout), else one peak per stress.
+    ``curves``: the whole curves (the lab curve layout, with the plate's rise as
+    ``vertical_displacement_mm``: the dilation a calibration fits), else one peak per stress.
     ``work``: the store the tests keep their files in (default: a folder beside ``path``).
     The curves are the tests' own (:attr:`poro2d.shear.results.ShearTestResult.curve`).
     """
@@ -45,7 +46,7 @@ def synthetic_lab(
         f"# shear settings: max_displacement = {sset.max_displacement} m, velocity = {sset.velocity} m/s",
     ]
     lines = [
-        "normal_stress_kpa,shear_displacement_mm,shear_stress_kpa"
+        "normal_stress_kpa,shear_displacement_mm,shear_stress_kpa,vertical_displacement_mm"
         if curves
         else "normal_stress_kpa,peak_shear_stress_kpa"
     ]
@@ -57,8 +58,11 @@ def synthetic_lab(
         if not curves:
             lines.append(f"{sigma:g},{res['peak_shear_stress_kpa']:.4f}")
             continue
-        for d, t in zip(res.curve["shear_displacement_mm"], res.curve["shear_stress_kpa"], strict=True):
-            lines.append(f"{sigma:g},{d:.5f},{t:.4f}")
+        c = res.curve
+        for d, t, v in zip(
+            c["shear_displacement_mm"], c["shear_stress_kpa"], c["plate_displacement_mm"], strict=True
+        ):
+            lines.append(f"{sigma:g},{d:.5f},{t:.4f},{v:.6f}")
     Store(path.parent).write_text(path.name, "\n".join(header + lines) + "\n")
     return path
 

@@ -19,6 +19,7 @@ from poro2d.errors import InputError
 from poro2d.execute.dask_cluster import pin_numba_threads
 from poro2d.identity import identity_digest
 from poro2d.shear.case import ShearCase
+from poro2d.shear.fit import smooth
 from poro2d.shear.record import content_record, folder_stage
 from poro2d.shear.settings import ShearSettings
 from poro2d.shear.single import DirectShearTest
@@ -26,7 +27,9 @@ from poro2d.specimen.saved import Specimen
 from poro2d.store import Store
 
 #: what a unit returns besides its identity: the observables a calibration may fit
-OBSERVABLES = ("peak", "end")
+OBSERVABLES = ("peak", "end", "dilation")
+#: the unit of each observable: the peak and end shear stresses in kPa, the plate's rise in mm
+OBSERVABLE_UNITS = {"peak": "kPa", "end": "kPa", "dilation": "mm"}
 #: the sub-store of a calibration's store that holds its units, each under its key
 CACHE = "cache"
 
@@ -86,7 +89,11 @@ class CalibrationUnit:
 
 @dataclass(frozen=True)
 class UnitRow:
-    """What a finished unit gives the fit: its observables (kPa) and its cost."""
+    """What a finished unit gives the fit: its observables and its cost.
+
+    ``peak`` and ``end``: shear stresses (kPa); ``dilation``: the plate's rise at the end of
+    the test (mm, positive: dilation), smoothed over the peak window as the end stress is.
+    """
 
     key: str
     sigma: float
@@ -95,11 +102,12 @@ class UnitRow:
     specimen: str
     peak: float
     end: float
+    dilation: float
     wall_time_s: float
 
     def observable(self, name: str) -> float:
-        """The value of the observable ``name`` (:data:`OBSERVABLES`)."""
-        return {"peak": self.peak, "end": self.end}[name]
+        """The value of the observable ``name`` (:data:`OBSERVABLES`, in :data:`OBSERVABLE_UNITS`)."""
+        return {"peak": self.peak, "end": self.end, "dilation": self.dilation}[name]
 
 
 def _test(unit: CalibrationUnit, store: Store | None, threads: int = 1) -> DirectShearTest:
@@ -116,8 +124,16 @@ def _row(unit: CalibrationUnit, res) -> UnitRow:
         specimen=unit.specimen,
         peak=float(res["peak_shear_stress_kpa"]),
         end=float(res["end"]["shear_stress_kpa"]),
+        dilation=end_rise_mm(res.curve, ShearSettings(**unit.settings).peak_window),
         wall_time_s=float(res["wall_time_s"]),
     )
+
+
+def end_rise_mm(curve, window: float) -> float:
+    """The plate's rise (mm) at the end of a test's ``curve``, smoothed over ``window`` (m) as
+    its end stress is: read from the curve, so tests cached before dilation was fitted serve it."""
+    x = np.asarray(curve["shear_displacement_mm"], float) * 1e-3
+    return float(smooth(x, curve["plate_displacement_mm"], window)[-1])
 
 
 def stored_row(unit: CalibrationUnit, cache: Store | None) -> UnitRow | None:
@@ -184,10 +200,12 @@ def unit_curve(unit: CalibrationUnit, cache: Store | None) -> tuple[np.ndarray, 
 __all__ = [
     "CACHE",
     "OBSERVABLES",
+    "OBSERVABLE_UNITS",
     "CalibrationUnit",
     "UnitRow",
     "check_entry",
     "compute_unit",
+    "end_rise_mm",
     "stored_row",
     "unit_curve",
     "unit_key",

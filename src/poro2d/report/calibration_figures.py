@@ -21,13 +21,19 @@ from poro2d.report.figure_file import save_figure  # noqa: E402
 
 
 def plot_calibration_fit(result, lab, curves: dict[float, list], nearest, path: str | os.PathLike) -> Path:
-    """Left: laboratory peaks (and ends) against the calibrated model's; right: the model's curves
+    """Left: laboratory peaks (and ends) against the calibrated model's; middle: the model's curves
     at the design point ``nearest`` the best parameters (``curves[sigma]``: (d, tau) per specimen)
-    against the laboratory curves, or its peak as a dotted line where the laboratory gave no curve.
+    against the laboratory curves, or its peak as a dotted line where the laboratory gave no curve;
+    right, when the dilation was fitted: the plate's rise at the end, laboratory against model (mm).
 
     ``result`` is a :class:`poro2d.calibration.run.CalibrationResult`, ``lab`` its laboratory data.
     """
-    fig, (ax_peak, ax_curve) = plt.subplots(1, 2, figsize=(11, 4.2))
+    dilation = [o for o in result.posterior["observables"] if o["observable"] == "dilation"]
+    if dilation:
+        fig, (ax_peak, ax_curve, ax_dil) = plt.subplots(1, 3, figsize=(15, 4.2))
+        _plot_dilation(ax_dil, dilation)
+    else:
+        fig, (ax_peak, ax_curve) = plt.subplots(1, 2, figsize=(11, 4.2))
     obs = [o for o in result.posterior["observables"] if o["observable"] == "peak"]
     s = np.array([o["normal_stress_kpa"] for o in obs])
     ax_peak.plot(s, [o["lab_kpa"] for o in obs], "ks", label="laboratory peak")
@@ -74,6 +80,27 @@ def plot_calibration_fit(result, lab, curves: dict[float, list], nearest, path: 
     ax_curve.legend(fontsize=7)
     fig.tight_layout()
     return save_figure(fig, path)
+
+
+def _plot_dilation(ax, dilation: list) -> None:
+    """The dilation targets (mm) against normal stress: the laboratory's and the model's (+-2 sd)."""
+    s = [o["normal_stress_kpa"] for o in dilation]
+    ax.plot(s, [o["lab_mm"] for o in dilation], "ks", label="laboratory")
+    ax.errorbar(
+        s,
+        [o["model_mm"] for o in dilation],
+        yerr=[2 * o["noise_sd_mm"] for o in dilation],
+        fmt="o",
+        color="#b2182b",
+        capsize=3,
+        label="calibrated model (surrogate, +-2 sd)",
+    )
+    ax.axhline(0.0, color="0.6", lw=0.6)
+    ax.set_xlim(left=0)
+    ax.set_xlabel("normal stress (kPa)")
+    ax.set_ylabel("plate rise at the end (mm; + dilation)")
+    ax.set_title("dilation", fontsize=10)
+    ax.legend(fontsize=8)
 
 
 def plot_calibration_posterior(result, post, path: str | os.PathLike) -> Path:

@@ -36,8 +36,8 @@ def identifiability_note(result) -> str:
         text += (
             f" The interval of {names} {verb} more than half the search range: these data do not identify"
             " it well. Peak strengths alone often cannot separate sliding from rolling resistance;"
-            " whole curves that soften (the end stress), more normal stresses or more replicate"
-            " specimens narrow it."
+            " whole curves that soften (the end stress) or that carry the plate's rise (the"
+            " dilation), more normal stresses or more replicate specimens narrow it."
         )
     else:
         text += " Both intervals are narrower than half their search ranges."
@@ -55,12 +55,26 @@ def box_note(result) -> str | None:
     return f"{scale.note()}; the frictions are {fitted}.{warning}"
 
 
+def fit_table(observables) -> tuple[list[str], list[list]]:
+    """The fit table's header and rows: in kPa while every target is a stress; with dilation
+    targets (mm) each row names its unit."""
+    units = {"lab_kpa": "kPa", "lab_mm": "mm"}
+    named = [(o, next(u for k, u in units.items() if o.get(k) is not None)) for o in observables]
+    if all(u == "kPa" for _, u in named):
+        header = ["observable", "normal stress (kPa)", "laboratory (kPa)", "model (kPa)", "noise sd (kPa)"]
+        return header, [[o["observable"], o["normal_stress_kpa"], *_values(o, "kpa")] for o, _ in named]
+    header = ["observable", "normal stress (kPa)", "unit", "laboratory", "model", "noise sd"]
+    rows = [[o["observable"], o["normal_stress_kpa"], u, *_values(o, u.lower())] for o, u in named]
+    return header, rows
+
+
+def _values(o, u: str) -> list[float]:
+    return [o[f"lab_{u}"], o[f"model_{u}"], o[f"noise_sd_{u}"]]
+
+
 def calibration_blocks(result, out: Path) -> list[tuple]:
     """The section's blocks: best values, identifiability, the fit table and the two figures."""
-    rows = [
-        [o["observable"], o["normal_stress_kpa"], o["lab_kpa"], o["model_kpa"], o["noise_sd_kpa"]]
-        for o in result.posterior["observables"]
-    ]
+    header, rows = fit_table(result.posterior["observables"])
     info = result.cluster
     return [
         ("h2", "Calibration of particle and rolling friction"),
@@ -78,11 +92,7 @@ def calibration_blocks(result, out: Path) -> list[tuple]:
         ),
         ("p", identifiability_note(result)),
         *([("p", box_note(result))] if box_note(result) else []),
-        (
-            "table",
-            ["observable", "normal stress (kPa)", "laboratory (kPa)", "model (kPa)", "noise sd (kPa)"],
-            rows,
-        ),
+        ("table", header, rows),
         (
             "img",
             str(out / "calibration_fit.png"),
@@ -108,6 +118,7 @@ def write_calibration_report(out: Path, result) -> list[Path]:
 __all__ = [
     "box_note",
     "calibration_blocks",
+    "fit_table",
     "interval_text",
     "identifiability_note",
     "write_calibration_report",
