@@ -198,6 +198,7 @@ def test_synthetic_lab_writes_the_plates_rise_of_its_tests(tiny_dilation):
         assert rise[-1] > 0.0  # a dense specimen dilates: the plate rises
 
 
+@pytest.mark.scenario
 def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, tiny_dilation, tmp_path):
     """With the plate's rise in the lab curves, the calibration fits ``dilation_<s>kPa`` (mm) beside
     the peaks and end stresses, from the same shear tests (their keys do not change: a calibration

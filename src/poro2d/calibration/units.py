@@ -9,6 +9,7 @@ that was killed.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import Any
@@ -92,7 +93,8 @@ class UnitRow:
     """What a finished unit gives the fit: its observables and its cost.
 
     ``peak`` and ``end``: shear stresses (kPa); ``dilation``: the plate's rise at the end of
-    the test (mm, positive: dilation), smoothed over the peak window as the end stress is.
+    the test (mm, positive: dilation), smoothed over the peak window as the end stress is (NaN:
+    not given, for a row made by hand).
     """
 
     key: str
@@ -102,8 +104,8 @@ class UnitRow:
     specimen: str
     peak: float
     end: float
-    dilation: float
     wall_time_s: float
+    dilation: float = math.nan
 
     def observable(self, name: str) -> float:
         """The value of the observable ``name`` (:data:`OBSERVABLES`, in :data:`OBSERVABLE_UNITS`)."""
@@ -124,8 +126,8 @@ def _row(unit: CalibrationUnit, res) -> UnitRow:
         specimen=unit.specimen,
         peak=float(res["peak_shear_stress_kpa"]),
         end=float(res["end"]["shear_stress_kpa"]),
-        dilation=end_rise_mm(res.curve, ShearSettings(**unit.settings).peak_window),
         wall_time_s=float(res["wall_time_s"]),
+        dilation=end_rise_mm(res.curve, ShearSettings(**unit.settings).peak_window),
     )
 
 
