@@ -117,6 +117,7 @@ class Posterior:
     density: np.ndarray  # (len(v), len(u))
     noise_sd: list[float] = field(default_factory=list)  # per observable (its unit), set by the caller
     noise_correlation: list[list[float]] = field(default_factory=list)
+    precision_factor: float = 1.0  # the covariance's correction for being estimated, set by the caller
 
     @property
     def fp_values(self) -> np.ndarray:
@@ -224,6 +225,20 @@ def _ridge(trace: float, unit: str) -> float:
     return 1e-9 * (trace if trace > 0.0 else 1.0)
 
 
+def precision_factor(dof: int, observables: int) -> float:
+    """The factor (dof - p - 1) / dof that makes the inverse of an estimated covariance unbiased.
+
+    The noise covariance is estimated from the replicates' deviations (``dof``: complete design
+    points x (replicates - 1)). Inverted, an estimate from few degrees of freedom overstates
+    the precision, the more so the more observables ``p`` it spans: the mean of the inverse of a
+    Wishart estimate is dof / (dof - p - 1) times the true precision (Hartlap, Simon & Schneider
+    2007, A&A 464:399). Without it, many readings of a curve on three replicates give intervals
+    that miss a known truth; the factor widens them by sqrt(dof / (dof - p - 1)). Zero or less:
+    too many observables for the replicates, no honest interval.
+    """
+    return (dof - observables - 1) / dof if dof > 0 else 0.0
+
+
 def posterior(ranges: Ranges, surrogates: list[Surrogate], lab_values, cov: np.ndarray) -> Posterior:
     """The grid posterior of (f_p, mu_r) given the laboratory values (one per surrogate) and
     the covariance of their misfit (:func:`noise_covariance`)."""
@@ -249,6 +264,7 @@ __all__ = [
     "noise_covariance",
     "seed_covariance",
     "posterior",
+    "precision_factor",
     "rounded",
     "space_filling",
 ]

@@ -27,7 +27,7 @@ from poro2d.calibration.specimens import (
     preset_specimens,
     replicate_unit,
 )
-from poro2d.calibration.units import CACHE, OBSERVABLE_UNITS, CalibrationUnit, UnitRow
+from poro2d.calibration.units import CACHE, CalibrationUnit, UnitRow, observable_unit, station, window_mean
 from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
 from poro2d.execute.dask_cluster import check_reachable
@@ -50,6 +50,9 @@ DEFAULT_FP_RANGE = (0.3, 3.0)
 DEFAULT_MU_R_RANGE = (0.0, 0.5)
 #: most design points of a round (each is replicates x stresses shear tests)
 MAX_POINTS = 500
+#: most stations along a curve (``stations``): each adds one or two observables per normal stress,
+#: and the replicates must estimate the noise covariance of them all
+MAX_STATIONS = 10
 #: the degrees of freedom left to the surrogate's residual beyond its coefficients: with fewer,
 #: the quadratic passes (nearly) through every replicate mean and its misfit, one of the noise
 #: terms, cannot be estimated (six points fit its six coefficients exactly: a residual of zero)
@@ -143,14 +146,14 @@ class FittedObservable(TypedResult):
     @classmethod
     def of(cls, observable: str, normal_stress_kpa: float, lab: float, fitted: float, noise_sd: float):
         """The record of one target, its values under the keys of its unit."""
-        u = OBSERVABLE_UNITS[observable].lower()
+        u = observable_unit(observable).lower()
         values = {f"lab_{u}": lab, f"model_{u}": fitted, f"noise_sd_{u}": noise_sd}
         return cls(observable, normal_stress_kpa, **values)
 
     @property
     def unit(self) -> str:
         """The unit of the values (``kPa`` or ``mm``)."""
-        return OBSERVABLE_UNITS[self.observable]
+        return observable_unit(self.observable)
 
 
 @dataclass(eq=False)
@@ -171,6 +174,11 @@ class PosteriorSummary(TypedResult):
     prior: str
     observables: list[FittedObservable]
     noise_correlation: list[list[float]]
+    #: the covariance's correction for being estimated (model.precision_factor): the noise sd are
+    #: divided by its square root; absent from files of earlier versions
+    precision_factor: float | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("precision_factor",)
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "median": FrictionValues,
@@ -269,12 +277,15 @@ def _base_settings(settings: dict | None) -> ShearSettings:
     return dataclass_from_table(ShearSettings, "settings", given)
 
 
-def _lab_targets(lab: LabData, base: ShearSettings) -> list[tuple[str, float, float]]:
+def _lab_targets(lab: LabData, base: ShearSettings, stations: int = 1) -> list[tuple[str, float, float]]:
     """(observable, normal stress, laboratory value) fitted: every peak; with curves the end stress;
-    with the plate's vertical displacement too the dilation (mm).
+    with the plate's vertical displacement too the dilation (mm); with ``stations`` > 1 the
+    readings of each curve at ``stations`` - 1 evenly spaced displacements before the end.
 
     The end values of a laboratory curve are its means over the last peak window before the
-    tests' ``max_displacement`` (the simulated end values are smoothed over the same window).
+    tests' ``max_displacement`` (the simulated end values are smoothed over the same window);
+    a reading is its mean over the peak window before its station, on both sides
+    (:func:`poro2d.calibration.units.window_mean`).
     """
     targets = [("peak", s, lab.peaks[s]) for s in lab.normal_stresses()]
     for s in lab.normal_stresses() if lab.curves else []:
@@ -288,15 +299,28 @@ def _lab_targets(lab: LabData, base: ShearSettings) -> list[tuple[str, float, fl
         targets.append(("end", s, _end_mean(d, t, base)))
     for s in lab.normal_stresses() if lab.vertical else []:
         targets.append(("dilation", s, 1e3 * _end_mean(lab.curves[s][0], lab.vertical[s], base)))
+    return targets + _station_targets(lab, base, stations)
+
+
+def _station_targets(lab: LabData, base: ShearSettings, stations: int) -> list[tuple[str, float, float]]:
+    """The readings of the laboratory curves before their end: the shear stress (kPa) and, when the
+    file has it, the plate's rise (mm) at ``max_displacement`` x j / ``stations``, j < ``stations``."""
+    targets = []
+    for j in range(1, stations):
+        at = base.max_displacement * j / stations
+        for s in lab.normal_stresses():
+            d, t = lab.curves[s]
+            targets.append((station("stress", at), s, window_mean(d, t, at, base.peak_window)))
+            if lab.vertical:
+                rise = window_mean(d, lab.vertical[s], at, base.peak_window)
+                targets.append((station("rise", at), s, 1e3 * rise))
     return targets
 
 
 def _end_mean(d: np.ndarray, y: np.ndarray, base: ShearSettings) -> float:
     """The mean of ``y`` over the readings within the last peak window before ``max_displacement``
     (the value at ``max_displacement`` interpolated when no reading lies in that window)."""
-    end, window = base.max_displacement, base.peak_window
-    inside = (d >= end - window) & (d <= end)
-    return float(np.mean(y[inside])) if inside.any() else float(np.interp(end, d, y))
+    return window_mean(d, y, base.max_displacement, base.peak_window)
 
 
 @holds_output("store", kind=KIND)
@@ -316,6 +340,7 @@ def run_calibration(
     design_seed: int = 0,
     lab_error: float = 0.0,
     level: float = 0.95,
+    stations: int = 1,
     settings: dict | None = None,
     scheduler: str | None = None,
     workers: int | None = None,
@@ -330,7 +355,9 @@ def run_calibration(
     search ranges. ``points``: the space-filling design's size; ``refine``: points of the
     second round, drawn from the posterior (0: none). ``lab_error``: the laboratory's own
     error as a fraction of each value, added to the seed scatter. ``level``: of the
-    credible intervals. ``settings``: shear settings of every test (the quick preset's
+    credible intervals. ``stations``: with laboratory curves, each curve is also read (shear stress,
+    and the plate's rise when given) at ``stations`` - 1 evenly spaced displacements before its end
+    (1: peaks, end values and dilation only). ``settings``: shear settings of every test (the quick preset's
     ``max_displacement`` 4 mm by default). ``scheduler``/``workers``/``dashboard``: as the sweeps.
     A rerun reuses every finished shear test (cached by content in the store's ``cache``);
     ``store=None`` keeps nothing (every test runs, no figure or report is made).
@@ -366,8 +393,13 @@ def run_calibration(
     if settings is None and quick:
         settings = dict(QUICK_SHEAR)
     base = _base_settings(settings)
-    targets = _lab_targets(lab_data, base)
+    stations = check_int("--stations", stations, 1, MAX_STATIONS)
+    if stations > 1 and not lab_data.curves:
+        why = "readings along a curve need the lab curves"
+        raise InputError("--stations", stations, "1 with a peaks file", why)
+    targets = _lab_targets(lab_data, base, stations)
     check_enough_lab_values(lab_data.source, targets, len(CALIBRATED))
+    check_noise_dof(points, len(given) if given is not None else replicates, len(targets))
     check_cluster_options(scheduler, workers)
     check_reachable(scheduler)
 
@@ -410,12 +442,27 @@ def run_calibration(
         design_seed,
         points,
         refine,
+        stations,
     )
     if store is not None:
         from poro2d.calibration.outputs import write_outputs
 
         write_outputs(store, result, post, surrogates, lab_data, found, base)
     return result
+
+
+def check_noise_dof(points: int, replicates: int, observables: int) -> None:
+    """Refuse, before any test, a design whose replicates cannot estimate the noise of its
+    observables: the covariance of ``observables`` values needs points x (replicates - 1) >
+    observables + 1 degrees of freedom (:func:`poro2d.calibration.model.precision_factor`).
+    One specimen is let through: its intervals are reported as unknown."""
+    if replicates < 2 or model.precision_factor(points * (replicates - 1), observables) > 0:
+        return
+    need = -(-(observables + 2) // (replicates - 1))
+    raise InputError(
+        "--points", points, f"at least {need} for {observables} observables on {replicates} replicates",
+        "the noise covariance needs points x (replicates - 1) > observables + 1; or give fewer --stations",
+    )  # fmt: skip
 
 
 def smallest_box(found: SpecimenSet) -> BoxScale:
@@ -467,10 +514,13 @@ def _infer(ranges, design, specimens: SpecimenSet, stresses, rows: list[UnitRow 
     lab_values = [y for *_, y in targets]
     try:  # an overflow or a 0/0 here would end in a posterior of NaN read as an answer
         with np.errstate(divide="raise", over="raise", invalid="raise"):
-            units = [OBSERVABLE_UNITS[obs] for obs, *_ in targets]
+            units = [observable_unit(obs) for obs, *_ in targets]
             seed_cov = model.seed_covariance(values)
             cov = model.noise_covariance(surrogates, seed_cov, lab_values, lab_error, units)
+            factor = _precision_factor(values, len(targets))
+            cov = cov / factor
             post = model.posterior(ranges, surrogates, lab_values, cov)
+            post.precision_factor = factor
             post.noise_sd = np.sqrt(np.diag(cov)).tolist()
             post.noise_correlation = (cov / np.sqrt(np.outer(np.diag(cov), np.diag(cov)))).round(3).tolist()
     except (FloatingPointError, np.linalg.LinAlgError) as exc:
@@ -478,6 +528,23 @@ def _infer(ranges, design, specimens: SpecimenSet, stresses, rows: list[UnitRow 
     if not np.isfinite(post.density).all():
         raise RuntimeError("the posterior is not finite: no answer is reported")
     return post, surrogates, table
+
+
+def _precision_factor(values: np.ndarray, observables: int) -> float:
+    """The covariance's correction for being estimated (:func:`poro2d.calibration.model.precision_factor`)
+    from the complete design points' replicates; 1 with one specimen (no scatter estimated: the
+    intervals are reported as unknown). Failed tests can leave too few: then no answer."""
+    replicates = values.shape[2]
+    if replicates < 2:
+        return 1.0
+    dof = int(np.isfinite(values).all(axis=(1, 2)).sum()) * (replicates - 1)
+    factor = model.precision_factor(dof, observables)
+    if factor <= 0:
+        raise RuntimeError(
+            f"{dof} degrees of freedom of the seed scatter for {observables} observables: the noise"
+            " covariance cannot be estimated, no answer is reported"
+        )
+    return factor
 
 
 def unidentified_reason(specimens: int, intervals: dict) -> str | None:
@@ -515,6 +582,7 @@ def _result(
     design_seed,
     points,
     refine,
+    stations=1,
 ) -> CalibrationResult:
     fp, mu_r = post.best()
     intervals = {
@@ -550,10 +618,11 @@ def _result(
             prior="uniform in log(f_p) and mu_r over the ranges",
             observables=fitted,
             noise_correlation=post.noise_correlation,
+            precision_factor=post.precision_factor,
         ),
         evaluations=table,
         fit={
-            target_key(obs, s): SurrogateRecord.of(sg, OBSERVABLE_UNITS[obs])
+            target_key(obs, s): SurrogateRecord.of(sg, observable_unit(obs))
             for (obs, s, _), sg in zip(targets, surrogates, strict=True)
         },
         lab=lab_data.record(),
@@ -563,7 +632,14 @@ def _result(
         cluster=runner.info(),
         failures=runner.failures,
         timings=CalibrationTimings(wall_time_s=time.perf_counter() - t0),
-        config=dict(config, points=points, refine=refine, design_seed=design_seed, lab_error=lab_error),
+        config=dict(
+            config,
+            points=points,
+            refine=refine,
+            design_seed=design_seed,
+            lab_error=lab_error,
+            **({"stations": stations} if stations > 1 else {}),
+        ),  # fmt: skip
         provenance=Provenance.now(),
         unidentified=unknown,
         box_scale=smallest_box(found),

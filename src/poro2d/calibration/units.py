@@ -31,8 +31,57 @@ from poro2d.store import Store
 OBSERVABLES = ("peak", "end", "dilation")
 #: the unit of each observable: the peak and end shear stresses in kPa, the plate's rise in mm
 OBSERVABLE_UNITS = {"peak": "kPa", "end": "kPa", "dilation": "mm"}
+#: the readings of a curve before its end (``stations``): the shear stress and the plate's rise
+#: at a shear displacement, named ``stress_at_5mm``, ``rise_at_5mm``
+STATION_UNITS = {"stress": "kPa", "rise": "mm"}
 #: the sub-store of a calibration's store that holds its units, each under its key
 CACHE = "cache"
+
+
+def station(kind: str, displacement_m: float) -> str:
+    """The name of a reading of the curve: ``kind`` (:data:`STATION_UNITS`) at ``displacement_m``."""
+    return f"{kind}_at_{displacement_m * 1e3:g}mm"
+
+
+def parse_station(name: str) -> tuple[str, float] | None:
+    """(kind, displacement in m) of a reading's name (:func:`station`), or None for another observable."""
+    kind, sep, rest = name.partition("_at_")
+    if not sep or kind not in STATION_UNITS or not rest.endswith("mm"):
+        return None
+    return kind, float(rest.removesuffix("mm")) * 1e-3
+
+
+def observable_unit(name: str) -> str:
+    """The unit of the observable ``name``: ``kPa`` or ``mm``."""
+    reading = parse_station(name)
+    return OBSERVABLE_UNITS[name] if reading is None else STATION_UNITS[reading[0]]
+
+
+def window_mean(d: np.ndarray, y: np.ndarray, at: float, window: float) -> float:
+    """The mean of ``y`` over the readings of displacement ``d`` (m) within ``window`` before ``at``
+    (the value at ``at`` interpolated when no reading lies there): how a curve is read at a station,
+    the laboratory's and the simulated one alike."""
+    d, y = np.asarray(d, float), np.asarray(y, float)
+    inside = (d >= at - window) & (d <= at)
+    return float(np.mean(y[inside])) if inside.any() else float(np.interp(at, d, y))
+
+
+@dataclass(frozen=True)
+class CurveReadings:
+    """A finished test's curve as the fit reads it at its stations (:func:`window_mean`).
+
+    Kept in the unit's row, so that readings at any stations come from the cached test without
+    running it again."""
+
+    displacement_m: np.ndarray
+    stress_kpa: np.ndarray
+    rise_mm: np.ndarray
+    window_m: float
+
+    def at(self, kind: str, displacement_m: float) -> float:
+        """The reading of ``kind`` (``stress`` or ``rise``) at ``displacement_m``."""
+        y = self.stress_kpa if kind == "stress" else self.rise_mm
+        return window_mean(self.displacement_m, y, displacement_m, self.window_m)
 
 
 def unit_key(specimen_digest: str, sigma: float, settings: dict) -> str:
@@ -106,10 +155,15 @@ class UnitRow:
     end: float
     wall_time_s: float
     dilation: float = math.nan
+    readings: CurveReadings | None = None
 
     def observable(self, name: str) -> float:
-        """The value of the observable ``name`` (:data:`OBSERVABLES`, in :data:`OBSERVABLE_UNITS`)."""
-        return {"peak": self.peak, "end": self.end, "dilation": self.dilation}[name]
+        """The value of the observable ``name`` (:data:`OBSERVABLES`, or a reading of the curve,
+        :func:`station`; in :func:`observable_unit`)."""
+        reading = parse_station(name)
+        if reading is None:
+            return {"peak": self.peak, "end": self.end, "dilation": self.dilation}[name]
+        return math.nan if self.readings is None else self.readings.at(*reading)
 
 
 def _test(unit: CalibrationUnit, store: Store | None, threads: int = 1) -> DirectShearTest:
@@ -118,6 +172,7 @@ def _test(unit: CalibrationUnit, store: Store | None, threads: int = 1) -> Direc
 
 
 def _row(unit: CalibrationUnit, res) -> UnitRow:
+    window = ShearSettings(**unit.settings).peak_window
     return UnitRow(
         key=unit.key,
         sigma=unit.sigma,
@@ -127,7 +182,13 @@ def _row(unit: CalibrationUnit, res) -> UnitRow:
         peak=float(res["peak_shear_stress_kpa"]),
         end=float(res["end"]["shear_stress_kpa"]),
         wall_time_s=float(res["wall_time_s"]),
-        dilation=end_rise_mm(res.curve, ShearSettings(**unit.settings).peak_window),
+        dilation=end_rise_mm(res.curve, window),
+        readings=CurveReadings(
+            np.asarray(res.curve["shear_displacement_mm"], float) * 1e-3,
+            np.asarray(res.curve["shear_stress_kpa"], float),
+            np.asarray(res.curve["plate_displacement_mm"], float),
+            window,
+        ),
     )
 
 
@@ -203,6 +264,12 @@ __all__ = [
     "CACHE",
     "OBSERVABLES",
     "OBSERVABLE_UNITS",
+    "STATION_UNITS",
+    "CurveReadings",
+    "observable_unit",
+    "parse_station",
+    "station",
+    "window_mean",
     "CalibrationUnit",
     "UnitRow",
     "check_entry",

@@ -55,6 +55,9 @@ def register(app: typer.Typer) -> None:
             0.0, "--lab-error", help="Laboratory error, a fraction of each value."
         ),
         level: float = typer.Option(0.95, "--level", help="Level of the credible intervals."),
+        stations: int = typer.Option(
+            1, "--stations", help="Readings of each lab curve up to its end (1-10; 1: the end only)."
+        ),
         max_displacement: float = typer.Option(None, "--max-displacement", help="Shear displacement (m)."),
         out: Path = typer.Option(Path("calibrate-out"), "--out", "-o", help="Output folder (resumable)."),
         scheduler: str = typer.Option(None, "--scheduler", help=_SCHED),
@@ -95,6 +98,7 @@ def register(app: typer.Typer) -> None:
                 design_seed=design_seed,
                 lab_error=lab_error,
                 level=level,
+                stations=stations,
                 settings=settings,
                 scheduler=scheduler,
                 workers=workers,
