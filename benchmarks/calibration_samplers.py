@@ -405,6 +405,11 @@ def whitened(problem: Problem):
     return obs, simulate
 
 
+def last_sigma(sigmas: list) -> float:
+    """The last scale GrainLearning gave its likelihood (it keeps scalars and 1-element arrays)."""
+    return float(np.ravel(sigmas[-1])[0])
+
+
 def run_grainlearning(gl, problem: Problem, how: GrainLearningRun) -> Summary:
     """GrainLearning's ``BayesianCalibration`` with the surrogate as its simulation (a callback)."""
     obs, simulate = whitened(problem)
@@ -437,16 +442,20 @@ def run_grainlearning(gl, problem: Problem, how: GrainLearningRun) -> Summary:
     )
     problem.evaluations = 0
     t0 = time.perf_counter()
+    name = "GrainLearning SMC" + (" (exact)" if how.exact else " (defaults)")
+    sigmas = calib.inference.sigma_list
     with contextlib.redirect_stdout(io.StringIO()), warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        calib.run()
+        try:
+            calib.run()
+        except (ValueError, FloatingPointError, np.linalg.LinAlgError) as exc:
+            raise RuntimeError(
+                f"{name} failed in iteration {len(sigmas) + 1} after {problem.evaluations} evaluations"
+                f" (sigma so far {', '.join(f'{last_sigma([x]):.3g}' for x in sigmas)}): {exc}"
+            ) from None
     seconds = time.perf_counter() - t0
-    sigmas = calib.inference.sigma_list
     samples = calib.inference.param_data_list[-2]  # the last ensemble weighted (the last one is unrun)
-    note = (
-        f"{how.samples} samples x {len(sigmas)} iterations, last sigma {float(np.ravel(sigmas[-1])[0]):.3g}"
-    )
-    name = "GrainLearning SMC" + (" (exact)" if how.exact else " (defaults)")
+    note = f"{how.samples} samples x {len(sigmas)} iterations, last sigma {last_sigma(sigmas):.3g}"
     return summarize(name, samples, calib.inference.posterior, problem.evaluations, seconds, note)
 
 
@@ -541,15 +550,18 @@ def compare(problem: Problem, args, emcee, gl, grid_per_axis: int | None) -> Non
     if emcee is not None:
         steps = args.steps * max(problem.dim // 2, 1)  # chains of 50 autocorrelation times and more
         rows.append(run_emcee(emcee, problem, args.walkers, steps, args.seed))
+    failed = []
     if gl is not None:
         samples = args.gl_samples * (problem.dim // 2)
         for exact in (True, False):
-            rows.append(
-                run_grainlearning(
-                    gl, problem, GrainLearningRun(samples, args.gl_iterations, exact, args.seed)
-                )
-            )
+            how = GrainLearningRun(samples, args.gl_iterations, exact, args.seed)
+            try:
+                rows.append(run_grainlearning(gl, problem, how))
+            except RuntimeError as exc:  # its answer is then no answer: say so beside the table
+                failed.append(str(exc))
     print_table(problem, rows)
+    for line in failed:
+        print(f"  {line}")
     print_agreement(grid, rows[1:], step)
 
 
