@@ -144,6 +144,7 @@ def fit_quadratic(unit: np.ndarray, values: np.ndarray) -> tuple[np.ndarray, Noi
 def problem_from_result(path: Path) -> Problem:
     """The posterior of a finished calibration, rebuilt from its evaluations as ``poro2d calibrate`` does."""
     from poro2d.calibration.run import CalibrationResult
+    from poro2d.calibration.units import observable_unit
     from poro2d.store import Store
 
     res = CalibrationResult.read(Store(path.parent)) if path.name == "result.json" else None
@@ -160,9 +161,12 @@ def problem_from_result(path: Path) -> Problem:
     for k in range(values.shape[1]):
         ok = np.isfinite(values[:, k]).any(axis=1)
         surrogates.append(model.fit_surrogate(unit[ok], values[ok, k]))
+    units = [observable_unit(obs.observable) for obs in res.posterior.observables]
     cov = model.noise_covariance(
-        surrogates, model.seed_covariance(values), lab, res.config.get("lab_error", 0.0)
+        surrogates, model.seed_covariance(values), lab, res.config.get("lab_error", 0.0), units
     )
+    # the covariance's correction for being estimated (files of earlier versions: none)
+    cov = cov / (res.posterior.precision_factor or 1.0)
     reported = {"median": res.posterior.median.to_dict(), "intervals": res.intervals.to_dict()}
     return two_parameter_problem(str(path), ranges, surrogates, lab, cov, reported=reported)
 
