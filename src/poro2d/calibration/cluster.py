@@ -10,7 +10,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-from poro2d.calibration.units import CalibrationUnit, UnitRow, check_entry, compute_unit, stored_row
+from poro2d.calibration.units import CalibrationUnit, UnitRow, compute_unit
 from poro2d.execute import Backend, Executor, Failed, Job
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD
 from poro2d.store import Store
@@ -68,10 +68,10 @@ class UnitRunner:
         back when ``cache`` holds them, else run as Dask tasks."""
         from poro2d.progress import CountProgress
 
-        rows = [stored_row(unit, cache) for unit in units]
+        rows = [unit.stored_row(cache) for unit in units]
         todo = [k for k, row in enumerate(rows) if row is None]
         for k in todo:
-            check_entry(units[k], cache)  # a damaged entry is refused here, before any test runs
+            units[k].check_entry(cache)  # a damaged entry is refused here, before any test runs
         cached = len(units) - len(todo)
         self.reused += cached
         if not todo:
@@ -79,7 +79,8 @@ class UnitRunner:
         t0 = time.perf_counter()
         done_before = f" ({cached} of {len(units)} cached)" if cached else ""
         try:
-            with CountProgress(label + done_before, len(todo), "shear tests", enabled=self.progress) as bar:
+            what = units[0].WHAT  # shear or biaxial tests: one kind per calibration
+            with CountProgress(label + done_before, len(todo), what, enabled=self.progress) as bar:
 
                 def ended(index: int, outcome) -> None:
                     rows[todo[index]] = self._take(units[todo[index]], outcome)
