@@ -41,9 +41,11 @@ from poro2d.store import Store
 
 
 def peak_ratio(axial_strain, ratio, settings: BiaxialSettings) -> float:
-    """The peak of the stress ratio smoothed over ``smoothing_strain``, up to ``max_strain``."""
+    """The peak of the stress ratio smoothed over ``smoothing_strain`` up to where a test ends: its
+    last row lies past ``max_strain`` by less than ``record_strain``, so a laboratory curve is read
+    as far (the test's own ``peak_sin_phi`` is this reading of its curve)."""
     e1, r = np.asarray(axial_strain, float), np.asarray(ratio, float)
-    upto = e1 <= settings.max_strain
+    upto = e1 <= settings.max_strain + settings.record_strain
     return float(np.nanmax(smoothed(e1[upto], r[upto], settings.smoothing_strain)))
 
 
