@@ -8,6 +8,10 @@ lines starting with ``#`` are comments, UTF-8 text):
   ``sigma_3_kpa`` from which it is computed;
 * ``volumetric_strain`` (optional): a fraction, compression positive.
 
+A calibration against biaxial tests (``poro2d calibrate --biaxial-lab``) reads the same columns
+with ``confining_stress_kpa``, the sigma_3 of each row's test (:func:`read_lab_tests`: one file
+per test, or several tests in one file).
+
 The file is read as every laboratory file is (:mod:`poro2d.lab_table`: a byte order mark is
 read, numbers with underscores or not finite are refused, each refusal names the file, line and
 column). Data that cannot be right are refused before any work: fewer than five rows, an axial

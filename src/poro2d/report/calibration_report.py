@@ -36,8 +36,13 @@ def identifiability_note(result) -> str:
         text += (
             f" The interval of {names} {verb} more than half the search range: these data do not identify"
             " it well. Peak strengths alone often cannot separate sliding from rolling resistance;"
-            " whole curves that soften (the end stress) or that carry the plate's rise (the"
-            " dilation), more normal stresses or more replicate specimens narrow it."
+            + (
+                " the volumetric strain, readings along the curves (--stations), more confining stresses"
+                " or more replicate specimens narrow it."
+                if result.get("test") == "biaxial"
+                else " whole curves that soften (the end stress) or that carry the plate's rise (the"
+                " dilation), more normal stresses or more replicate specimens narrow it."
+            )
         )
     else:
         text += " Both intervals are narrower than half their search ranges."
