@@ -195,6 +195,10 @@ def test_the_api_refuses_a_biaxial_calibration_that_cannot_be_run(specimen, tmp_
         biaxial_lab=lab, specimens=[specimen], settings={"max_displacement": 0.002}
     )  # a shear setting is not a biaxial one
     assert "--stations" in _refused(biaxial_lab=lab, specimens=[specimen], stations=11)
+    # a strain rate too fast for the specimen (its inertial number) is refused before any test
+    fast = _refused(biaxial_lab=lab, specimens=[specimen], settings={"max_strain": 0.05, "strain_rate": 50.0},
+                    store=Store(tmp_path / "fast"))  # fmt: skip
+    assert "strain_rate" in fast and "quasi-static" in fast and not (tmp_path / "fast" / "cache").exists()
     # 2 stresses x (3 end values + 4 stations x 2 readings): 22 observables on 9 points x 2 replicates
     words = _refused(biaxial_lab=lab, specimens=[specimen, specimen], stations=5, points=9,
                      settings={"max_strain": 0.05})  # fmt: skip

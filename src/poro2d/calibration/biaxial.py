@@ -113,6 +113,17 @@ def biaxial_targets(
     return targets
 
 
+def check_quasi_static(specimens: SpecimenSet, stresses, base: BiaxialSettings) -> None:
+    """Refuse, before any test, a strain rate whose inertial number is above ``inertial_limit`` on a
+    specimen (and a specimen with a disk outside its box): each specimen is put in its biaxial box
+    at the lowest confining stress, where the inertial number is largest, and no step is run."""
+    from poro2d.biaxial.case import BiaxialCase
+    from poro2d.biaxial.single import BiaxialTest
+
+    for label in specimens:
+        BiaxialTest(BiaxialCase.of(specimens.specimen(label), min(stresses), base)).build()
+
+
 def biaxial_unit(specimens: SpecimenSet, label: str, sigma: float, base: BiaxialSettings, fp: float,
                  mu_r: float) -> BiaxialUnit:  # fmt: skip
     """The biaxial test of specimen ``label`` (of a read set) at sigma_3 = ``sigma`` with (f_p, mu_r)."""
@@ -126,5 +137,6 @@ __all__ = [
     "base_settings",
     "biaxial_targets",
     "biaxial_unit",
+    "check_quasi_static",
     "read_biaxial_lab",
 ]

@@ -58,6 +58,7 @@ class UnitRunner:
         self.scheduler, self.workers, self.progress, self.dashboard = scheduler, workers, progress, dashboard
         self.executor = Executor(Backend.dask(scheduler, workers, dashboard=dashboard))
         self.failures: list[UnitFailure] = []
+        self.what = "shear tests"  # the kind of the units run last (their WHAT)
         self.broken: set[str] = set()  # keys of units that failed for another reason than their test
         self.ran = self.reused = 0
         self.busy_s = 0.0
@@ -79,8 +80,8 @@ class UnitRunner:
         t0 = time.perf_counter()
         done_before = f" ({cached} of {len(units)} cached)" if cached else ""
         try:
-            what = units[0].WHAT  # shear or biaxial tests: one kind per calibration
-            with CountProgress(label + done_before, len(todo), what, enabled=self.progress) as bar:
+            self.what = units[0].WHAT  # shear or biaxial tests: one kind per calibration
+            with CountProgress(label + done_before, len(todo), self.what, enabled=self.progress) as bar:
 
                 def ended(index: int, outcome) -> None:
                     rows[todo[index]] = self._take(units[todo[index]], outcome)
@@ -111,7 +112,8 @@ class UnitRunner:
             f = broken[0]
             more = f" (and {len(broken) - 1} more)" if len(broken) > 1 else ""
             raise RuntimeError(
-                f"the shear test {f.key} ({f.specimen} at {f.sigma:g} kPa, f_p {f.fp:g}, mu_r {f.mu_r:g})"
+                f"the {self.what.removesuffix('s')} {f.key} ({f.specimen} at {f.sigma:g} kPa,"
+                f" f_p {f.fp:g}, mu_r {f.mu_r:g})"
                 f" failed on a worker{more}: {f.error}; no answer is computed without it"
             )
 

@@ -27,6 +27,7 @@ from poro2d.calibration.biaxial import (
     base_settings,
     biaxial_targets,
     biaxial_unit,
+    check_quasi_static,
     read_biaxial_lab,
 )
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
@@ -457,6 +458,8 @@ def run_calibration(
         ).read()
     )
     check_replicates(found)
+    if biaxial:
+        check_quasi_static(found, lab_data.confining_stresses(), base)
     runner = UnitRunner(scheduler, workers, progress=progress, dashboard=dashboard)
     stresses = lab_data.confining_stresses() if biaxial else lab_data.normal_stresses()
     make = biaxial_unit if biaxial else replicate_unit
