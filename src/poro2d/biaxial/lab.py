@@ -8,6 +8,10 @@ lines starting with ``#`` are comments, UTF-8 text):
   ``sigma_3_kpa`` from which it is computed;
 * ``volumetric_strain`` (optional): a fraction, compression positive.
 
+A calibration against biaxial tests (``poro2d calibrate --biaxial-lab``) reads the same columns
+with ``confining_stress_kpa``, the sigma_3 of each row's test (:func:`read_lab_tests`: one file
+per test, or several tests in one file).
+
 The file is read as every laboratory file is (:mod:`poro2d.lab_table`: a byte order mark is
 read, numbers with underscores or not finite are refused, each refusal names the file, line and
 column). Data that cannot be right are refused before any work: fewer than five rows, an axial
@@ -64,26 +68,86 @@ class LabCurve:
 def read_lab_curve(path: str | os.PathLike) -> LabCurve:
     """Read and check a laboratory biaxial CSV (the columns are the module's)."""
     table = read_lab_table(path)
+    rows = np.arange(len(table.rows))
+    e1, ratio, ev = _columns(table)
+    return _curve(table, rows, e1, ratio, ev, "curve")
+
+
+def _columns(table: LabTable) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """The axial strain, the stress ratio and (or None) the volumetric strain of every row, each
+    value checked on its own (the checks of a whole curve are :func:`_curve`'s)."""
     by_stresses = table.has("sigma_1_kpa", "sigma_3_kpa")
     if not table.has("axial_strain") or not (table.has("stress_ratio") or by_stresses):
         raise InputError(
             "lab columns", ",".join(table.header),
             "axial_strain with stress_ratio (or sigma_1_kpa and sigma_3_kpa), volumetric_strain optional",
         )  # fmt: skip
-    rows = np.arange(len(table.rows))
-    if len(rows) == 0:
+    if len(table.rows) == 0:
         raise InputError("lab", table.path, f"a CSV with a header and at least {MIN_CURVE_POINTS} data rows")
-    check_enough_points(table, rows, "curve")
     e1 = table.column("axial_strain", 0.0, MAX_STRAIN, "(a fraction)", "is the column in percent?")
-    check_rising(table, "axial_strain", e1, rows, "the axial strain")
     ratio = _stress_ratio(table) if not table.has("stress_ratio") else table.column("stress_ratio", 0.0, 1.0)
-    _check_peak_ratio(table, ratio)
     ev = None
     if table.has("volumetric_strain"):
         ev = table.column(
             "volumetric_strain", -MAX_STRAIN, MAX_STRAIN, "(a fraction)", "is the column in percent?"
         )
-    return LabCurve(table.path, e1, ratio, ev)
+    return e1, ratio, ev
+
+
+def _curve(table: LabTable, rows: np.ndarray, e1, ratio, ev, what: str) -> LabCurve:
+    """The curve of ``rows`` (in file order): enough readings, a rising axial strain, a peak of a soil."""
+    check_enough_points(table, rows, what)
+    check_rising(table, "axial_strain", e1[rows], rows, "the axial strain")
+    _check_peak_ratio(table, ratio, rows)
+    return LabCurve(table.path, e1[rows], ratio[rows], None if ev is None else ev[rows])
+
+
+#: the column that names each row's test in a file of several tests (:func:`read_lab_tests`)
+CONFINING_COLUMN = "confining_stress_kpa"
+
+
+@dataclass(frozen=True)
+class LabTests:
+    """Laboratory biaxial tests at several confining stresses: a :class:`LabCurve` per sigma_3 (kPa)."""
+
+    sources: tuple[str, ...]
+    curves: dict[float, LabCurve]
+
+    @property
+    def source(self) -> str:
+        return ", ".join(self.sources)
+
+    def confining_stresses(self) -> list[float]:
+        return sorted(self.curves)
+
+
+def read_lab_tests(paths) -> LabTests:
+    """Read laboratory biaxial tests from one CSV or several: each row names its test's confining
+    stress in ``confining_stress_kpa`` (one file per test, or every test in one file); each test's
+    rows are a curve as :func:`read_lab_curve` checks it. A confining stress given twice is refused."""
+    paths = [paths] if isinstance(paths, str | os.PathLike) else list(paths)
+    if not paths:
+        raise InputError("--biaxial-lab", "nothing", "one laboratory CSV or more")
+    curves: dict[float, LabCurve] = {}
+    for path in paths:
+        table = read_lab_table(path)
+        if not table.has(CONFINING_COLUMN):
+            raise InputError(
+                "lab columns", ",".join(table.header), f"{CONFINING_COLUMN} beside the curve's columns",
+                "the confining stress sigma_3 each test was run at",
+            )  # fmt: skip
+        e1, ratio, ev = _columns(table)
+        lo, hi = CONFINING_RANGE_KPA
+        s3 = table.column(CONFINING_COLUMN, lo, hi, "kPa", "the confining stresses a biaxial test runs at")
+        for sigma in np.unique(s3):
+            rows = np.flatnonzero(s3 == sigma)  # rows in file order, never re-sorted
+            if float(sigma) in curves:
+                raise InputError(
+                    f"lab {CONFINING_COLUMN} ({table.where(int(rows[0]), CONFINING_COLUMN)})", float(sigma),
+                    "each confining stress in one test", f"a test at {sigma:g} kPa was read before",
+                )  # fmt: skip
+            curves[float(sigma)] = _curve(table, rows, e1, ratio, ev, f"curve at {sigma:g} kPa")
+    return LabTests(tuple(str(p) for p in paths), curves)
 
 
 def _stress_ratio(table: LabTable) -> np.ndarray:
@@ -101,9 +165,9 @@ def _stress_ratio(table: LabTable) -> np.ndarray:
     return (s1 - s3) / (s1 + s3)
 
 
-def _check_peak_ratio(table: LabTable, ratio: np.ndarray) -> None:
-    """The peak stress ratio is sin(phi) of a soil: above 0 and at most :data:`MAX_SIN_PHI`."""
-    k = int(np.argmax(ratio))
+def _check_peak_ratio(table: LabTable, ratio: np.ndarray, rows: np.ndarray) -> None:
+    """The peak stress ratio of ``rows`` is sin(phi) of a soil: above 0 and at most :data:`MAX_SIN_PHI`."""
+    k = int(rows[np.argmax(ratio[rows])])
     if not 0.0 < ratio[k] <= MAX_SIN_PHI:
         name = "stress_ratio" if table.has("stress_ratio") else "sigma_1_kpa"
         raise InputError(
@@ -113,4 +177,4 @@ def _check_peak_ratio(table: LabTable, ratio: np.ndarray) -> None:
         )  # fmt: skip
 
 
-__all__ = ["LabCurve", "read_lab_curve"]
+__all__ = ["CONFINING_COLUMN", "LabCurve", "LabTests", "read_lab_curve", "read_lab_tests"]

@@ -1,10 +1,11 @@
-"""Calibration of particle friction and rolling friction against laboratory direct shear.
+"""Calibration of particle friction and rolling friction against laboratory direct shear or biaxial tests.
 
-:func:`run_calibration` (``poro2d calibrate``) and :func:`synthetic_lab`, which makes
-"laboratory" data with poro2d itself at known parameters (the identifiability check).
+:func:`run_calibration` (``poro2d calibrate``), and :func:`synthetic_lab` and
+:func:`synthetic_biaxial_lab`, which make "laboratory" data with poro2d itself at known
+parameters (the identifiability check).
 """
 
 from poro2d.calibration.run import CalibrationResult, run_calibration
-from poro2d.calibration.synthetic import synthetic_lab
+from poro2d.calibration.synthetic import synthetic_biaxial_lab, synthetic_lab
 
-__all__ = ["CalibrationResult", "run_calibration", "synthetic_lab"]
+__all__ = ["CalibrationResult", "run_calibration", "synthetic_biaxial_lab", "synthetic_lab"]

@@ -10,7 +10,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-from poro2d.calibration.units import CalibrationUnit, UnitRow, check_entry, compute_unit, stored_row
+from poro2d.calibration.units import CalibrationUnit, UnitRow, compute_unit
 from poro2d.execute import Backend, Executor, Failed, Job
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD
 from poro2d.store import Store
@@ -58,6 +58,7 @@ class UnitRunner:
         self.scheduler, self.workers, self.progress, self.dashboard = scheduler, workers, progress, dashboard
         self.executor = Executor(Backend.dask(scheduler, workers, dashboard=dashboard))
         self.failures: list[UnitFailure] = []
+        self.what = "shear tests"  # the kind of the units run last (their WHAT)
         self.broken: set[str] = set()  # keys of units that failed for another reason than their test
         self.ran = self.reused = 0
         self.busy_s = 0.0
@@ -68,10 +69,10 @@ class UnitRunner:
         back when ``cache`` holds them, else run as Dask tasks."""
         from poro2d.progress import CountProgress
 
-        rows = [stored_row(unit, cache) for unit in units]
+        rows = [unit.stored_row(cache) for unit in units]
         todo = [k for k, row in enumerate(rows) if row is None]
         for k in todo:
-            check_entry(units[k], cache)  # a damaged entry is refused here, before any test runs
+            units[k].check_entry(cache)  # a damaged entry is refused here, before any test runs
         cached = len(units) - len(todo)
         self.reused += cached
         if not todo:
@@ -79,7 +80,8 @@ class UnitRunner:
         t0 = time.perf_counter()
         done_before = f" ({cached} of {len(units)} cached)" if cached else ""
         try:
-            with CountProgress(label + done_before, len(todo), "shear tests", enabled=self.progress) as bar:
+            self.what = units[0].WHAT  # shear or biaxial tests: one kind per calibration
+            with CountProgress(label + done_before, len(todo), self.what, enabled=self.progress) as bar:
 
                 def ended(index: int, outcome) -> None:
                     rows[todo[index]] = self._take(units[todo[index]], outcome)
@@ -110,7 +112,8 @@ class UnitRunner:
             f = broken[0]
             more = f" (and {len(broken) - 1} more)" if len(broken) > 1 else ""
             raise RuntimeError(
-                f"the shear test {f.key} ({f.specimen} at {f.sigma:g} kPa, f_p {f.fp:g}, mu_r {f.mu_r:g})"
+                f"the {self.what.removesuffix('s')} {f.key} ({f.specimen} at {f.sigma:g} kPa,"
+                f" f_p {f.fp:g}, mu_r {f.mu_r:g})"
                 f" failed on a worker{more}: {f.error}; no answer is computed without it"
             )
 

@@ -5,8 +5,7 @@ from __future__ import annotations
 import math
 
 from poro2d.calibration.evaluations import DesignPoint
-from poro2d.calibration.specimens import replicate_unit
-from poro2d.calibration.units import CACHE, unit_curve
+from poro2d.calibration.units import CACHE
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 
@@ -15,14 +14,24 @@ POSTERIOR_PNG = "calibration_posterior.png"
 CONFIG_TOML = "calibrated.toml"
 
 
-def write_outputs(store: Store, result, post, surrogates, lab, specimens: SpecimenSet, base) -> None:
-    """Figures, config and report first; ``result.json`` last (its presence says: finished)."""
-    from poro2d.report.calibration_figures import plot_calibration_fit, plot_calibration_posterior
+def write_outputs(store: Store, result, post, lab, specimens: SpecimenSet, make, stresses) -> None:
+    """Figures, config and report first; ``result.json`` last (its presence says: finished).
 
-    curves, nearest = _best_curves(result, lab, specimens, base, store.child(CACHE))
-    plot_calibration_fit(result, lab, curves, nearest, store.path(FIT_PNG))
+    ``make(specimens, label, sigma, fp=, mu_r=)``: the unit of one test (shear or biaxial, its base
+    settings bound); ``stresses``: the laboratory's normal (or confining) stresses."""
+    from poro2d.report.calibration_figures import (
+        plot_biaxial_calibration_fit,
+        plot_calibration_fit,
+        plot_calibration_posterior,
+    )
+
+    curves, nearest = _best_curves(result, stresses, specimens, make, store.child(CACHE))
+    plot = plot_biaxial_calibration_fit if result.biaxial else plot_calibration_fit
+    plot(result, lab, curves, nearest, store.path(FIT_PNG))
     plot_calibration_posterior(result, post, store.path(POSTERIOR_PNG))
-    store.write_text(CONFIG_TOML, _config(result, lab))
+    store.write_text(
+        CONFIG_TOML, _biaxial_config(result, stresses) if result.biaxial else _config(result, lab)
+    )
     from poro2d.report.calibration_report import write_calibration_report
 
     write_calibration_report(store.root, result)
@@ -30,7 +39,7 @@ def write_outputs(store: Store, result, post, surrogates, lab, specimens: Specim
 
 
 def _best_curves(
-    result, lab, specimens: SpecimenSet, base, cache: Store
+    result, stresses, specimens: SpecimenSet, make, cache: Store
 ) -> tuple[dict[float, list], DesignPoint]:
     """The curves of the design point nearest the best parameters, per normal stress (all
     specimens), and that design point: what the fit figure draws."""
@@ -43,12 +52,10 @@ def _best_curves(
         ),
     )
     curves: dict[float, list] = {}
-    for s in lab.normal_stresses():
+    for s in stresses:
         for label in specimens:
-            unit = replicate_unit(
-                specimens, label, s, base, nearest.particle_friction, nearest.rolling_friction
-            )
-            curve = unit_curve(unit, cache)
+            unit = make(specimens, label, s, fp=nearest.particle_friction, mu_r=nearest.rolling_friction)
+            curve = unit.curve(cache)
             if curve is not None:
                 curves.setdefault(s, []).append(curve)
     return curves, nearest
@@ -64,6 +71,36 @@ def _toml_value(v) -> str:
     return '"' + str(v).replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
+def _known(result) -> str:
+    """The intervals in a line of the config's header, or why they are unknown."""
+    if result.unidentified is not None:
+        return f"NOT IDENTIFIED, intervals unknown: {result.unidentified}"
+    fp_lo, fp_hi = result.intervals["particle_friction"]
+    mr_lo, mr_hi = result.intervals["rolling_friction"]
+    return f"{result.level:.0%} intervals: f_p {fp_lo:.3g} to {fp_hi:.3g}, mu_r {mr_lo:.3g} to {mr_hi:.3g}"
+
+
+def _biaxial_config(result, stresses) -> str:
+    """A ``[biaxial]`` table for ``poro2d biaxial --config`` (the settings used, the calibrated
+    frictions, the laboratory's confining stresses) and ``[specimen]`` for new specimens."""
+    b = result.best
+    table = {k: v for k, v in result.settings.items() if v is not None}
+    table.update(particle_friction=b["particle_friction"], rolling_friction=b["rolling_friction"],
+                 confining_kpa=list(stresses))  # fmt: skip
+    lines = [
+        "# poro2d calibrate (biaxial laboratory tests):",
+        "# the posterior maximum of particle and rolling friction",
+        f"# ({_known(result)}); see result.json and calibration.md before using them",
+        "",
+        "[specimen]",
+        f"friction_particle = {_toml_value(b['particle_friction'])}",
+        f"rolling_friction = {_toml_value(b['rolling_friction'])}",
+        "",
+        "[biaxial]",
+    ] + [f"{k} = {_toml_value(v)}" for k, v in table.items()]
+    return "\n".join(lines) + "\n"
+
+
 def _config(result, lab) -> str:
     """The text of a config with the calibrated values: ``[shear]`` for ``poro2d shear --config``,
     ``[specimen]``
@@ -75,17 +112,9 @@ def _config(result, lab) -> str:
         rolling_friction=b["rolling_friction"],
         normal_stress_kpa=lab.normal_stresses(),
     )
-    if result.unidentified is None:
-        fp_lo, fp_hi = result.intervals["particle_friction"]
-        mr_lo, mr_hi = result.intervals["rolling_friction"]
-        known = (
-            f"{result.level:.0%} intervals: f_p {fp_lo:.3g} to {fp_hi:.3g}, mu_r {mr_lo:.3g} to {mr_hi:.3g}"
-        )
-    else:
-        known = f"NOT IDENTIFIED, intervals unknown: {result.unidentified}"
     lines = [
         "# poro2d calibrate: the posterior maximum of particle and rolling friction",
-        f"# ({known}); see result.json and calibration.md before using them",
+        f"# ({_known(result)}); see result.json and calibration.md before using them",
         "",
         "[specimen]",
         f"friction_particle = {_toml_value(b['particle_friction'])}",

@@ -13,11 +13,23 @@ from __future__ import annotations
 import os
 import time
 from dataclasses import dataclass
+from functools import partial
 from typing import Any, ClassVar
 
 import numpy as np
 
+from poro2d.biaxial.lab import LabTests
+from poro2d.biaxial.settings import BiaxialSettingsRecord
 from poro2d.calibration import model
+from poro2d.calibration.biaxial import (
+    BIAXIAL,
+    BiaxialLabRecord,
+    base_settings,
+    biaxial_targets,
+    biaxial_unit,
+    check_quasi_static,
+    read_biaxial_lab,
+)
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
 from poro2d.calibration.evaluations import DesignPoint, Observed, target_key
 from poro2d.calibration.identifiable import check_enough_lab_values
@@ -27,7 +39,7 @@ from poro2d.calibration.specimens import (
     preset_specimens,
     replicate_unit,
 )
-from poro2d.calibration.units import CACHE, CalibrationUnit, UnitRow, observable_unit, station, window_mean
+from poro2d.calibration.units import CACHE, UnitRow, observable_unit, station, window_mean
 from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
 from poro2d.execute.dask_cluster import check_reachable
@@ -41,7 +53,7 @@ from poro2d.shear.series import check_stresses
 from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
-from poro2d.typed_result import Keyed, TypedResult
+from poro2d.typed_result import Keyed, TypedResult, part
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
 KIND = "calibrate"
@@ -102,9 +114,13 @@ class SurrogateRecord(TypedResult):
     replicates: int = 0
     seed_scatter_mm: float | None = None
     surrogate_residual_mm: float | None = None
+    #: a dimensionless observable's (a biaxial stress ratio or volumetric strain)
+    seed_scatter_ratio: float | None = None
+    surrogate_residual_ratio: float | None = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = (
         "seed_scatter_kpa", "surrogate_residual_kpa", "seed_scatter_mm", "surrogate_residual_mm",
+        "seed_scatter_ratio", "surrogate_residual_ratio",
     )  # fmt: skip
 
     @classmethod
@@ -138,9 +154,14 @@ class FittedObservable(TypedResult):
     lab_mm: float | None = None
     model_mm: float | None = None
     noise_sd_mm: float | None = None
+    #: a dimensionless observable's (biaxial: ``lab_ratio``, ``model_ratio``, ``noise_sd_ratio``)
+    lab_ratio: float | None = None
+    model_ratio: float | None = None
+    noise_sd_ratio: float | None = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = (
         "lab_kpa", "model_kpa", "noise_sd_kpa", "lab_mm", "model_mm", "noise_sd_mm",
+        "lab_ratio", "model_ratio", "noise_sd_ratio",
     )  # fmt: skip
 
     @classmethod
@@ -152,7 +173,7 @@ class FittedObservable(TypedResult):
 
     @property
     def unit(self) -> str:
-        """The unit of the values (``kPa`` or ``mm``)."""
+        """The unit of the values (``kPa``, ``mm`` or ``ratio``: dimensionless)."""
         return observable_unit(self.observable)
 
 
@@ -208,10 +229,10 @@ class CalibrationResult(TypedResult):
     posterior: PosteriorSummary
     evaluations: list[DesignPoint]
     fit: dict[str, SurrogateRecord]
-    lab: LabRecord
+    lab: LabRecord | BiaxialLabRecord
     specimens: dict[str, str]
     ranges: FrictionBounds
-    settings: ShearSettingsRecord
+    settings: ShearSettingsRecord | BiaxialSettingsRecord
     cluster: ClusterRecord
     failures: list[UnitFailure]
     timings: CalibrationTimings
@@ -221,8 +242,11 @@ class CalibrationResult(TypedResult):
     #: absent from the file of a calibration whose design estimates its own noise
     unidentified: str | None = None
     box_scale: BoxScale | None = None
+    #: the laboratory test fitted: "biaxial" (then ``lab`` and ``settings`` are the biaxial ones);
+    #: absent from a direct shear calibration's file
+    test: str | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("unidentified", "box_scale")
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("unidentified", "box_scale", "test")
     #: the fields read as their records from a file's dict (``fit``: a surrogate per observable)
     PARTS: ClassVar[dict[str, type[TypedResult] | Keyed]] = {
         "best": FrictionValues,
@@ -239,6 +263,20 @@ class CalibrationResult(TypedResult):
         "evaluations": DesignPoint,
         "box_scale": BoxScale,
     }
+
+    @classmethod
+    def from_dict(cls, data) -> CalibrationResult:
+        """A calibration from its file; a biaxial one's ``lab`` and ``settings`` read as theirs."""
+        obj = super().from_dict(data)
+        if data.get("test") == BIAXIAL:
+            obj.lab = part(BiaxialLabRecord, data.get("lab"))
+            obj.settings = part(BiaxialSettingsRecord, data.get("settings"))
+        return obj
+
+    @property
+    def biaxial(self) -> bool:
+        """Whether the laboratory data were biaxial tests (the stress of each target is sigma_3)."""
+        return self.test == BIAXIAL
 
     @classmethod
     def read(cls, store: Store) -> CalibrationResult | None:
@@ -325,9 +363,10 @@ def _end_mean(d: np.ndarray, y: np.ndarray, base: ShearSettings) -> float:
 
 @holds_output("store", kind=KIND)
 def run_calibration(
-    lab: str | os.PathLike | LabData,
+    lab: str | os.PathLike | LabData | LabTests | None = None,
     specimens: list[str | os.PathLike] | None = None,
     *,
+    biaxial_lab: str | os.PathLike | list | LabTests | None = None,
     store: Store | None = None,
     preset: str | None = None,
     quick: bool = False,
@@ -361,12 +400,20 @@ def run_calibration(
     ``max_displacement`` 4 mm by default). ``scheduler``/``workers``/``dashboard``: as the sweeps.
     A rerun reuses every finished shear test (cached by content in the store's ``cache``);
     ``store=None`` keeps nothing (every test runs, no figure or report is made).
+
+    ``biaxial_lab`` instead of ``lab``: laboratory biaxial tests (one CSV or several, rows named by
+    ``confining_stress_kpa``; or a :class:`poro2d.biaxial.lab.LabTests`, which ``lab`` also takes):
+    every unit is then a biaxial test at a laboratory confining stress, the targets its stress
+    ratios and volumetric strain (:mod:`poro2d.calibration.biaxial`), and ``settings`` are biaxial
+    settings (``max_strain`` 0.2 by default).
     """
     t0 = time.perf_counter()
     if store is not None:
         check_output_dir(store.parameter, store.root)
-    lab_data = lab if isinstance(lab, LabData) else read_lab_csv(lab)
-    check_stresses(lab_data.normal_stresses())
+    lab_data = _read_lab(lab, biaxial_lab)
+    biaxial = isinstance(lab_data, LabTests)
+    if not biaxial:
+        check_stresses(lab_data.normal_stresses())
     check_preset(preset, quick, replicates)
     if preset is not None and specimens:
         raise InputError("--specimen", ", ".join(map(str, specimens)), "nothing with --preset")
@@ -390,14 +437,14 @@ def run_calibration(
     design_seed = check_int("--design-seed", design_seed, 0)
     check_range("--lab-error", lab_error, 0.0, 1.0)
     check_range("--level", level, 0.0, 1.0, lo_open=True, hi_open=True)
-    if settings is None and quick:
+    if settings is None and quick and not biaxial:
         settings = dict(QUICK_SHEAR)
-    base = _base_settings(settings)
+    base = base_settings(settings, CALIBRATED) if biaxial else _base_settings(settings)
     stations = check_int("--stations", stations, 1, MAX_STATIONS)
-    if stations > 1 and not lab_data.curves:
+    if stations > 1 and not biaxial and not lab_data.curves:
         why = "readings along a curve need the lab curves"
         raise InputError("--stations", stations, "1 with a peaks file", why)
-    targets = _lab_targets(lab_data, base, stations)
+    targets = biaxial_targets(lab_data, base, stations) if biaxial else _lab_targets(lab_data, base, stations)
     check_enough_lab_values(lab_data.source, targets, len(CALIBRATED))
     check_noise_dof(points, len(given) if given is not None else replicates, len(targets))
     check_cluster_options(scheduler, workers)
@@ -411,17 +458,20 @@ def run_calibration(
         ).read()
     )
     check_replicates(found)
+    if biaxial:
+        check_quasi_static(found, lab_data.confining_stresses(), base)
     runner = UnitRunner(scheduler, workers, progress=progress, dashboard=dashboard)
-    stresses = lab_data.normal_stresses()
+    stresses = lab_data.confining_stresses() if biaxial else lab_data.normal_stresses()
+    make = biaxial_unit if biaxial else replicate_unit
     cache = _child(store, CACHE)
     try:
         design = model.space_filling(ranges, points, design_seed)
-        rows = runner.run(_units(design, found, stresses, base), cache, "round 1")
+        rows = runner.run(_units(design, found, stresses, base, make), cache, "round 1")
         post, surrogates, table = _infer(ranges, design, found, stresses, rows, targets, lab_error)
         if refine:
             extra = [p for p in post.draw(refine, design_seed + 1) if p not in design]
             design = design + extra
-            rows += runner.run(_units(extra, found, stresses, base), cache, "round 2")
+            rows += runner.run(_units(extra, found, stresses, base, make), cache, "round 2")
             post, surrogates, table = _infer(ranges, design, found, stresses, rows, targets, lab_error)
     finally:
         runner.close()
@@ -447,8 +497,24 @@ def run_calibration(
     if store is not None:
         from poro2d.calibration.outputs import write_outputs
 
-        write_outputs(store, result, post, surrogates, lab_data, found, base)
+        write_outputs(store, result, post, lab_data, found, partial(make, base=base), stresses)
     return result
+
+
+def _read_lab(lab, biaxial_lab) -> LabData | LabTests:
+    """The laboratory data: direct shear (``lab``) or biaxial tests (``biaxial_lab``), exactly one."""
+    if isinstance(lab, LabTests) and biaxial_lab is None:
+        lab, biaxial_lab = None, lab
+    if (lab is None) == (biaxial_lab is None):
+        given = "neither" if lab is None else "both"
+        raise InputError(
+            "--lab",
+            given,
+            "exactly one of --lab (direct shear peaks or curves) and --biaxial-lab (biaxial curves)",
+        )
+    if biaxial_lab is not None:
+        return read_biaxial_lab(biaxial_lab)
+    return lab if isinstance(lab, LabData) else read_lab_csv(lab)
 
 
 def check_noise_dof(points: int, replicates: int, observables: int) -> None:
@@ -475,11 +541,12 @@ def _child(store: Store | None, name: str) -> Store | None:
     return None if store is None else store.child(name)
 
 
-def _units(design, specimens: SpecimenSet, stresses, base) -> list[CalibrationUnit]:
-    """The units of ``design``: per design point, per specimen, per normal stress (the order of
-    the rows :func:`_infer` reads; the units of more points follow those of the first)."""
+def _units(design, specimens: SpecimenSet, stresses, base, make=replicate_unit) -> list:
+    """The units of ``design``: per design point, per specimen, per normal (or confining) stress (the
+    order of the rows :func:`_infer` reads; the units of more points follow those of the first).
+    ``make``: the unit of one test (:func:`replicate_unit`, or a biaxial one)."""
     return [
-        replicate_unit(specimens, label, s, base, fp, mu_r)
+        make(specimens, label, s, base, fp, mu_r)
         for fp, mu_r in design
         for label in specimens
         for s in stresses
@@ -585,6 +652,7 @@ def _result(
     stations=1,
 ) -> CalibrationResult:
     fp, mu_r = post.best()
+    biaxial = isinstance(lab_data, LabTests)
     intervals = {
         "particle_friction": list(post.interval("fp", level)),
         "rolling_friction": list(post.interval("mu_r", level)),
@@ -625,7 +693,7 @@ def _result(
             target_key(obs, s): SurrogateRecord.of(sg, observable_unit(obs))
             for (obs, s, _), sg in zip(targets, surrogates, strict=True)
         },
-        lab=lab_data.record(),
+        lab=BiaxialLabRecord.of(lab_data) if biaxial else lab_data.record(),
         specimens={label: str(found[label]) for label in found},
         ranges=FrictionBounds(list(ranges.fp), list(ranges.mu_r)),
         settings=base.record(),
@@ -642,7 +710,8 @@ def _result(
         ),  # fmt: skip
         provenance=Provenance.now(),
         unidentified=unknown,
-        box_scale=smallest_box(found),
+        box_scale=None if biaxial else smallest_box(found),  # ASTM D3080 speaks of shear boxes only
+        test=BIAXIAL if biaxial else None,
     )
 
 

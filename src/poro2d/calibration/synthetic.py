@@ -1,4 +1,4 @@
-"""Synthetic "laboratory" data: poro2d's own direct shear at known (f_p, mu_r).
+"""Synthetic "laboratory" data: poro2d's own direct shear or biaxial test at known (f_p, mu_r).
 
 Used to check that a calibration recovers what it claims (never as real laboratory data):
 the CSV says so in its header, with the parameters, specimen and settings that made it.
@@ -9,6 +9,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+from poro2d.biaxial.case import BiaxialCase
+from poro2d.biaxial.settings import BiaxialSettings
+from poro2d.biaxial.single import BiaxialTest
 from poro2d.shear.case import ShearCase
 from poro2d.shear.settings import ShearSettings
 from poro2d.shear.single import DirectShearTest
@@ -67,4 +70,47 @@ def synthetic_lab(
     return path
 
 
-__all__ = ["synthetic_lab"]
+def synthetic_biaxial_lab(
+    specimen: str | os.PathLike,
+    confining_stresses_kpa,
+    particle_friction: float,
+    rolling_friction: float,
+    path: str | os.PathLike,
+    *,
+    settings: dict | None = None,
+    work: Store | None = None,
+) -> Path:
+    """Run poro2d's biaxial test of ``specimen`` at each confining stress with the given frictions;
+    write the curves at ``path`` in the biaxial laboratory layout (``--biaxial-lab``).
+
+    The columns: ``confining_stress_kpa``, ``axial_strain``, ``stress_ratio``, ``volumetric_strain``
+    (the tests' own curves, :class:`poro2d.biaxial.curve.BiaxialCurve`). The first readings of a test
+    may have sigma_1 a little below sigma_3 (the servo's tolerance after consolidation): a
+    laboratory file holds no negative stress ratio, so those are written as 0 (the header says so).
+    ``settings``: biaxial settings other than the two frictions; ``work``: where the tests keep
+    their files (default: a folder beside ``path``).
+    """
+    sset = BiaxialSettings(
+        **dict(settings or {}, particle_friction=particle_friction, rolling_friction=rolling_friction)
+    )
+    path = Path(path)
+    work = work if work is not None else Store(path.with_name(path.stem + "-tests"))
+    header = [
+        "# SYNTHETIC laboratory data, not measured: made by poro2d's own biaxial test",
+        f"# at particle_friction = {particle_friction}, rolling_friction = {rolling_friction}",
+        f"# on the specimen {specimen}",
+        f"# biaxial settings: max_strain = {sset.max_strain}, record_strain = {sset.record_strain}",
+        "# stress ratios below 0 (sigma_1 just under sigma_3 at the start) are written as 0",
+        "confining_stress_kpa,axial_strain,stress_ratio,volumetric_strain",
+    ]
+    lines = []
+    value = Specimen.read(specimen)  # read once for every test
+    for sigma in sorted(float(s) for s in confining_stresses_kpa):
+        c = BiaxialTest(BiaxialCase(value, sigma, sset), work.child(f"sigma3_{sigma:g}kPa")).run().curve
+        for e1, ratio, ev in zip(c.axial_strain, c.sin_phi, c.volumetric_strain, strict=True):
+            lines.append(f"{sigma:g},{e1:.7f},{max(ratio, 0.0):.6f},{ev:.7f}")
+    Store(path.parent).write_text(path.name, "\n".join(header + lines) + "\n")
+    return path
+
+
+__all__ = ["synthetic_biaxial_lab", "synthetic_lab"]

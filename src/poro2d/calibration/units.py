@@ -34,6 +34,15 @@ OBSERVABLE_UNITS = {"peak": "kPa", "end": "kPa", "dilation": "mm"}
 #: the readings of a curve before its end (``stations``): the shear stress and the plate's rise
 #: at a shear displacement, named ``stress_at_5mm``, ``rise_at_5mm``
 STATION_UNITS = {"stress": "kPa", "rise": "mm"}
+#: the observables of a biaxial test (:mod:`poro2d.calibration.biaxial_units`), all dimensionless:
+#: the peak and end stress ratios (sigma_1 - sigma_3) / (sigma_1 + sigma_3) and the volumetric
+#: strain at the end (a fraction, compression positive)
+BIAXIAL_OBSERVABLES = ("peak_ratio", "end_ratio", "end_volumetric")
+#: the unit of a dimensionless observable, as the file's keys name it (``lab_ratio``)
+RATIO = "ratio"
+#: the readings of a biaxial curve before its end: the stress ratio and the volumetric strain at
+#: an axial strain, named ``ratio_at_4pct``, ``volumetric_at_4pct`` (percent of axial strain)
+STRAIN_STATION_KINDS = ("ratio", "volumetric")
 #: the sub-store of a calibration's store that holds its units, each under its key
 CACHE = "cache"
 
@@ -51,8 +60,25 @@ def parse_station(name: str) -> tuple[str, float] | None:
     return kind, float(rest.removesuffix("mm")) * 1e-3
 
 
+def strain_station(kind: str, axial_strain: float) -> str:
+    """The name of a reading of a biaxial curve: ``kind`` (:data:`STRAIN_STATION_KINDS`) at an axial
+    strain (a fraction; the name says it in percent)."""
+    return f"{kind}_at_{100 * axial_strain:.4g}pct"
+
+
+def parse_strain_station(name: str) -> tuple[str, float] | None:
+    """(kind, axial strain as a fraction) of a biaxial reading's name (:func:`strain_station`), or None."""
+    kind, sep, rest = name.partition("_at_")
+    if not sep or kind not in STRAIN_STATION_KINDS or not rest.endswith("pct"):
+        return None
+    return kind, float(rest.removesuffix("pct")) / 100.0
+
+
 def observable_unit(name: str) -> str:
-    """The unit of the observable ``name``: ``kPa`` or ``mm``."""
+    """The unit of the observable ``name``: ``kPa`` or ``mm`` (direct shear), :data:`RATIO` (biaxial:
+    dimensionless)."""
+    if name in BIAXIAL_OBSERVABLES or parse_strain_station(name) is not None:
+        return RATIO
     reading = parse_station(name)
     return OBSERVABLE_UNITS[name] if reading is None else STATION_UNITS[reading[0]]
 
@@ -132,9 +158,25 @@ class CalibrationUnit:
         """The unit's identity: the name of its store in the cache (:func:`unit_key`)."""
         return unit_key(self.digest, self.sigma, self.settings)
 
+    #: what the progress display counts (:class:`poro2d.calibration.cluster.UnitRunner`)
+    WHAT = "shear tests"
+
     def store(self, cache: Store | None) -> Store | None:
         """The unit's store in ``cache`` (None: nothing kept)."""
         return None if cache is None else cache.child(self.key)
+
+    # the protocol the runner reads every kind of unit through (the biaxial units keep it too)
+    def stored_row(self, cache: Store | None) -> UnitRow | None:
+        return stored_row(self, cache)
+
+    def check_entry(self, cache: Store | None) -> None:
+        check_entry(self, cache)
+
+    def compute(self, cache: Store | None) -> UnitRow:
+        return _row(self, _test(self, self.store(cache)).run())
+
+    def curve(self, cache: Store | None) -> tuple[np.ndarray, np.ndarray] | None:
+        return unit_curve(self, cache)
 
 
 @dataclass(frozen=True)
@@ -214,22 +256,25 @@ def check_entry(unit: CalibrationUnit, cache: Store | None) -> None:
     would fail the test on its worker, and a calibration must not answer without it.
     """
     store = unit.store(cache)
-    if store is None:
+    if store is None or not check_files(cache, store, "one shear test of the cache"):
         return
-    for folder, what in (
-        (cache.root, "the calibration's cache"),
-        (store.root, "one shear test of the cache"),
-    ):
+    _check_record(unit, store)
+
+
+def check_files(cache: Store, store: Store, what: str) -> bool:
+    """Refuse a file where the cache or a unit's folder belongs, and a file of the unit's folder that
+    differs from what the store wrote; whether the folder exists (then its record is checked)."""
+    for folder, name in ((cache.root, "the calibration's cache"), (store.root, what)):
         if folder.exists() and not folder.is_dir():
             raise InputError(
-                str(folder), "a file", f"a folder ({what})", "delete it to have the tests computed again"
+                str(folder), "a file", f"a folder ({name})", "delete it to have the tests computed again"
             )
     if not store.root.exists():
-        return
+        return False
     for name in store.names():
         if store.has(name):
             store.check_intact(name)
-    _check_record(unit, store)
+    return True
 
 
 def _check_record(unit: CalibrationUnit, store: Store) -> None:
@@ -245,10 +290,11 @@ def _check_record(unit: CalibrationUnit, store: Store) -> None:
         ) from None  # fmt: skip
 
 
-def compute_unit(unit: CalibrationUnit, cache: Store | None) -> UnitRow:
-    """Run (or finish) one unit, on one numba thread: the task a Dask worker runs."""
+def compute_unit(unit, cache: Store | None):
+    """Run (or finish) one unit of any kind (its ``compute``), on one numba thread: the task a Dask
+    worker runs."""
     pin_numba_threads()
-    return _row(unit, _test(unit, unit.store(cache)).run())
+    return unit.compute(cache)
 
 
 def unit_curve(unit: CalibrationUnit, cache: Store | None) -> tuple[np.ndarray, np.ndarray] | None:
@@ -261,7 +307,12 @@ def unit_curve(unit: CalibrationUnit, cache: Store | None) -> tuple[np.ndarray, 
 
 
 __all__ = [
+    "BIAXIAL_OBSERVABLES",
     "CACHE",
+    "RATIO",
+    "STRAIN_STATION_KINDS",
+    "parse_strain_station",
+    "strain_station",
     "OBSERVABLES",
     "OBSERVABLE_UNITS",
     "STATION_UNITS",
@@ -273,6 +324,7 @@ __all__ = [
     "CalibrationUnit",
     "UnitRow",
     "check_entry",
+    "check_files",
     "compute_unit",
     "end_rise_mm",
     "stored_row",

@@ -35,7 +35,13 @@ def register(app: typer.Typer) -> None:
     @app.command("calibrate")
     def calibrate_cmd(
         lab: Path = typer.Option(
-            ..., "--lab", help="Laboratory CSV: peaks, or whole curves (docs/shear.md)."
+            None, "--lab", help="Laboratory direct shear CSV: peaks, or whole curves (docs/shear.md)."
+        ),
+        biaxial_lab: list[Path] = typer.Option(
+            None,
+            "--biaxial-lab",
+            help="Laboratory biaxial CSV (rows named by confining_stress_kpa); repeat for more files."
+            " Instead of --lab.",
         ),
         specimen: list[str] = typer.Option(
             None, "--specimen", "-s", help="A specimen (.npz or criterion folder); repeat for replicates."
@@ -59,20 +65,25 @@ def register(app: typer.Typer) -> None:
             1, "--stations", help="Readings of each lab curve up to its end (1-10; 1: the end only)."
         ),
         max_displacement: float = typer.Option(None, "--max-displacement", help="Shear displacement (m)."),
+        max_strain: float = typer.Option(
+            None, "--max-strain", help="With --biaxial-lab: axial strain of every test (0.2)."
+        ),
         out: Path = typer.Option(Path("calibrate-out"), "--out", "-o", help="Output folder (resumable)."),
         scheduler: str = typer.Option(None, "--scheduler", help=_SCHED),
         workers: int = typer.Option(None, "--workers", help=_WORKERS),
         dashboard: str = typer.Option(None, "--dashboard", help=_DASHBOARD),
         quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
     ) -> None:
-        """Calibrate particle friction f_p and rolling friction mu_r against laboratory direct shear."""
+        """Calibrate particle friction f_p and rolling friction mu_r against laboratory direct shear or
+        biaxial tests."""
         from poro2d.calibration.run import DEFAULT_FP_RANGE, DEFAULT_MU_R_RANGE, run_calibration
         from poro2d.execute.cluster_options import check_dashboard
         from poro2d.store import Store
 
-        settings = None if max_displacement is None else {"max_displacement": max_displacement}
+        settings = test_settings(bool(biaxial_lab), max_displacement, max_strain)
         options = {
-            "lab": str(lab),
+            "lab": None if lab is None else str(lab),
+            **({"biaxial_lab": [str(p) for p in biaxial_lab]} if biaxial_lab else {}),
             "specimen": specimen or None,
             "preset": preset,
             "quick": quick,
@@ -81,11 +92,13 @@ def register(app: typer.Typer) -> None:
             "fp_range": fp_range,
             "mu_r_range": mu_r_range,
             "max_displacement": max_displacement,
+            **({"max_strain": max_strain} if max_strain is not None else {}),
         }
         try:
             result = run_calibration(
                 lab,
                 list(specimen or []),
+                biaxial_lab=list(biaxial_lab) if biaxial_lab else None,
                 store=Store(out),
                 preset=preset,
                 quick=quick,
@@ -110,6 +123,22 @@ def register(app: typer.Typer) -> None:
             console.print(f"[bold red]failed:[/] {exc}")
             raise typer.Exit(1) from None
         print_result(result, out)
+
+
+def test_settings(biaxial: bool, max_displacement: float | None, max_strain: float | None) -> dict | None:
+    """The settings the options give every test: a shear test's displacement, or a biaxial test's
+    axial strain; the option of the other kind of test is refused."""
+    from poro2d.errors import InputError
+
+    if biaxial:
+        if max_displacement is not None:
+            raise InputError(
+                "--max-displacement", max_displacement, "nothing with --biaxial-lab (--max-strain)"
+            )
+        return None if max_strain is None else {"max_strain": max_strain}
+    if max_strain is not None:
+        raise InputError("--max-strain", max_strain, "only with --biaxial-lab (--max-displacement for --lab)")
+    return None if max_displacement is None else {"max_displacement": max_displacement}
 
 
 def print_result(result, out: Path) -> None:

@@ -103,6 +103,74 @@ def _plot_dilation(ax, dilation: list) -> None:
     ax.legend(fontsize=8)
 
 
+def plot_biaxial_calibration_fit(
+    result, lab, curves: dict[float, list], nearest, path: str | os.PathLike
+) -> Path:
+    """The fit of a calibration against laboratory biaxial tests (every value dimensionless).
+
+    Left: the peak and end stress ratios (sigma_1 - sigma_3) / (sigma_1 + sigma_3) against sigma_3,
+    laboratory and calibrated model (+-2 noise sd); middle: the stress ratio against axial strain of
+    the design point ``nearest`` the best (``curves[sigma]``: (axial strain, ratio) per specimen)
+    with the laboratory curves (``lab``: a :class:`poro2d.biaxial.lab.LabTests`); right, when the
+    laboratory gave it: the volumetric strain at the end (compression positive).
+    """
+    fitted = result.posterior["observables"]
+    volumetric = [o for o in fitted if o["observable"] == "end_volumetric"]
+    panels = 3 if volumetric else 2
+    fig, axes = plt.subplots(1, panels, figsize=(5 * panels, 4.2))
+    ax_ratio, ax_curve = axes[0], axes[1]
+    for name, marker, label in (("peak_ratio", "s", "peak"), ("end_ratio", "^", "end")):
+        _plot_targets(ax_ratio, [o for o in fitted if o["observable"] == name], marker, label)
+    ax_ratio.set_ylabel("stress ratio (sigma_1 - sigma_3) / (sigma_1 + sigma_3)")
+    b = result.best
+    ax_ratio.set_title(f"f_p = {b['particle_friction']:.3g}, mu_r = {b['rolling_friction']:.3g}", fontsize=10)
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for k, sigma in enumerate(lab.confining_stresses()):
+        c = colors[k % len(colors)]
+        for j, (e1, ratio) in enumerate(curves.get(sigma, [])):
+            ax_curve.plot(
+                100 * e1, ratio, color=c, lw=0.8, alpha=0.7, label=f"model {sigma:g} kPa" if j == 0 else None
+            )
+        curve = lab.curves[sigma]
+        ax_curve.plot(
+            100 * curve.axial_strain,
+            curve.stress_ratio,
+            "k--",
+            lw=1.0,
+            label="laboratory" if k == 0 else None,
+        )
+    ax_curve.set_xlabel("axial strain (%)")
+    ax_curve.set_ylabel("stress ratio")
+    ax_curve.set_title(
+        f"curves at the design point nearest the best (f_p = {nearest.particle_friction:.3g}, "
+        f"mu_r = {nearest.rolling_friction:.3g})",
+        fontsize=9,
+    )
+    ax_curve.legend(fontsize=7)
+    if volumetric:
+        _plot_targets(axes[2], volumetric, "s", "end")
+        axes[2].axhline(0.0, color="0.6", lw=0.6)
+        axes[2].set_ylabel("volumetric strain at the end (+ contraction)")
+        axes[2].set_title("volumetric strain", fontsize=10)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def _plot_targets(ax, observed: list, marker: str, label: str) -> None:
+    """Dimensionless targets against sigma_3: the laboratory's and the model's (+-2 noise sd)."""
+    if not observed:
+        return
+    s = [o["normal_stress_kpa"] for o in observed]
+    ax.plot(s, [o["lab_ratio"] for o in observed], "k" + marker, mfc="none", label=f"laboratory {label}")
+    ax.errorbar(
+        s, [o["model_ratio"] for o in observed], yerr=[2 * o["noise_sd_ratio"] for o in observed],
+        fmt=marker, capsize=3, label=f"model {label} (surrogate, +-2 sd)",
+    )  # fmt: skip
+    ax.set_xlabel("confining stress sigma_3 (kPa)")
+    ax.set_xlim(left=0)
+    ax.legend(fontsize=8)
+
+
 def plot_calibration_posterior(result, post, path: str | os.PathLike) -> Path:
     """The posterior density over (f_p, mu_r) with the evaluated design points, its maximum and
     the intervals of ``result`` shaded; ``post`` holds the grid (``fp_values``, ``mu_r_values``,

@@ -36,8 +36,13 @@ def identifiability_note(result) -> str:
         text += (
             f" The interval of {names} {verb} more than half the search range: these data do not identify"
             " it well. Peak strengths alone often cannot separate sliding from rolling resistance;"
-            " whole curves that soften (the end stress) or that carry the plate's rise (the"
-            " dilation), more normal stresses or more replicate specimens narrow it."
+            + (
+                " the volumetric strain, readings along the curves (--stations), more confining stresses"
+                " or more replicate specimens narrow it."
+                if result.get("test") == "biaxial"
+                else " whole curves that soften (the end stress) or that carry the plate's rise (the"
+                " dilation), more normal stresses or more replicate specimens narrow it."
+            )
         )
     else:
         text += " Both intervals are narrower than half their search ranges."
@@ -58,14 +63,26 @@ def box_note(result) -> str | None:
 def fit_table(observables) -> tuple[list[str], list[list]]:
     """The fit table's header and rows: in kPa while every target is a stress; with dilation
     targets (mm) each row names its unit."""
-    units = {"lab_kpa": "kPa", "lab_mm": "mm"}
+    units = {"lab_kpa": "kPa", "lab_mm": "mm", "lab_ratio": "ratio"}
     named = [(o, next(u for k, u in units.items() if o.get(k) is not None)) for o in observables]
     if all(u == "kPa" for _, u in named):
         header = ["observable", "normal stress (kPa)", "laboratory (kPa)", "model (kPa)", "noise sd (kPa)"]
         return header, [[o["observable"], o["normal_stress_kpa"], *_values(o, "kpa")] for o, _ in named]
-    header = ["observable", "normal stress (kPa)", "unit", "laboratory", "model", "noise sd"]
-    rows = [[o["observable"], o["normal_stress_kpa"], u, *_values(o, u.lower())] for o, u in named]
+    # biaxial targets: the stress is sigma_3, every value dimensionless ("1")
+    stress = "confining stress (kPa)" if all(u == "ratio" for _, u in named) else "normal stress (kPa)"
+    header = ["observable", stress, "unit", "laboratory", "model", "noise sd"]
+    rows = [[o["observable"], o["normal_stress_kpa"], _shown(u), *_values(o, u.lower())] for o, u in named]
     return header, rows
+
+
+def _tests(result) -> str:
+    """What the calibration ran, as the report names it."""
+    return "Biaxial tests" if result.get("test") == "biaxial" else "Shear tests"
+
+
+def _shown(unit: str) -> str:
+    """A unit as the table shows it: a dimensionless value's as 1."""
+    return "1" if unit == "ratio" else unit
 
 
 def _values(o, u: str) -> list[float]:
@@ -105,7 +122,7 @@ def calibration_blocks(result, out: Path) -> list[tuple]:
         ),
         (
             "p",
-            f"Shear tests: {info['tests_run']} run, {info['tests_reused']} reused from the cache, "
+            f"{_tests(result)}: {info['tests_run']} run, {info['tests_reused']} reused from the cache, "
             f"{info['tests_failed']} failed; wall time {result.timings['wall_time_s']:.0f} s.",
         ),
     ]
