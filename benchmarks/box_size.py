@@ -17,8 +17,10 @@ A rerun with the same DIR reads finished specimens and tests back.
 Per test and per box (mean +- sd over the seeds) it prints: the box in d_max and its disks,
 the peak tau/sigma on the plate and on the shear plane, the residual where dilation stopped
 (:func:`poro2d.shear.residual.dilation_stopped_residual`, plate and plane, or "not reached"),
-the plate's rise at the peak and at the end, the largest dilation rate (the 2 mm secant of
-``poro2d strength``, as an angle) and the wall times; the table goes to DIR/box_size.json.
+beside it the residual study's window from 20 mm to the end less the plate's slope there
+(Taylor's correction, which every test has), the plate's rise at the peak and at the end, the
+largest dilation rate (the 2 mm secant of ``poro2d strength``, as an angle) and the wall times;
+the table goes to DIR/box_size.json.
 docs/shear.md ("Box size") has the numbers.
 """
 
@@ -36,6 +38,9 @@ from pathlib import Path
 #: the paper's layer height (0.124 m in 4 layers): a larger box keeps it, so every layer is
 #: compacted as the paper's are
 PAPER_LAYER_M = 0.031
+#: mm: the fixed window's start (to the end) of the residual study's Taylor-corrected ratios, which every
+#: test has, also where its plate still rises (``benchmarks/box_residual.py``)
+WINDOW_FROM_MM = 20.0
 
 
 @dataclass(frozen=True)
@@ -150,6 +155,8 @@ def shear_jobs(out: Path, found: dict[tuple[str, int], Path], args) -> list:
 
 def test_row(name: str, seed: int, specimen, res, folder: Path) -> dict:
     """What one test says of its box: size, peak, residual where dilation stopped, dilation, times."""
+    from box_residual import window  # the residual study's fixed window with Taylor's correction
+
     from poro2d.shear.box_scale import box_scale
     from poro2d.shear.residual import dilation_stopped_residual
     from poro2d.shear.strength import max_dilation_angle
@@ -158,6 +165,7 @@ def test_row(name: str, seed: int, specimen, res, folder: Path) -> dict:
     stopped = dilation_stopped_residual(res.curve, res.d_mean_m)
     psi = max_dilation_angle(res.curve, res.peak_window_m)
     share = res.plane_load_fraction_at_peak
+    fixed = window(res.curve, WINDOW_FROM_MM)
     build = criterion_record(folder) or {}
     return {
         "box": name, "seed": seed, "width_m": scale.width_m, "height_m": scale.height_m,
@@ -168,6 +176,8 @@ def test_row(name: str, seed: int, specimen, res, folder: Path) -> dict:
         "peak_at_mm": 1e3 * res.shear_displacement_at_peak_m,
         "residual_reached": stopped.reached, "residual_plate": stopped.stress_ratio,
         "residual_plane": stopped.plane_stress_ratio, "residual_from_mm": stopped.start_mm,
+        "taylor_plate": fixed["window_taylor_plate"], "taylor_plane": fixed["window_taylor_plane"],
+        "slope_from_window": fixed["window_plate_slope"],
         "rise_at_peak_mm": res.plate_displacement_at_peak_mm, "rise_at_end_mm": res.end.plate_displacement_mm,
         "max_dilation_rate": math.tan(math.radians(psi)), "max_dilation_angle_deg": psi,
         "sheared_mm": 1e3 * res.end_shear_displacement_m, "shear_time_s": res.wall_time_shear_s,
@@ -197,6 +207,8 @@ def text(values: list, digits: int = 3) -> str:
 COLUMNS = [
     ("peak t/s plate", "peak_plate", 3), ("peak t/s plane", "peak_plane", 3), ("peak at mm", "peak_at_mm", 1),
     ("resid. plate", "residual_plate", 3), ("resid. plane", "residual_plane", 3),
+    ("window less slope plate", "taylor_plate", 3), ("plane", "taylor_plane", 3),
+    ("slope", "slope_from_window", 3),
     ("rise at peak mm", "rise_at_peak_mm", 2), ("rise at end mm", "rise_at_end_mm", 2),
     ("max dy/dx", "max_dilation_rate", 3), ("psi_max deg", "max_dilation_angle_deg", 1),
     ("build s", "build_time_s", 0), ("shear s", "shear_time_s", 0),
@@ -206,14 +218,16 @@ COLUMNS = [
 def print_tests(rows: list[dict]) -> None:
     """One line a test."""
     print(f"{'box':>5} {'seed':>4} {'W/dmax':>6} {'H/dmax':>6} {'disks':>5} {'n2D':>6} | {'peak':>5} "
-          f"{'plane':>5} {'at mm':>5} | {'resid':>5} {'plane':>5} {'from':>5} | {'rise pk':>7} "
-          f"{'end':>5} {'dy/dx':>5} {'psi':>4} | {'build':>5} {'shear':>5}")  # fmt: skip
+          f"{'plane':>5} {'at mm':>5} | {'resid':>5} {'plane':>5} {'from':>5} | {'w-sl':>5} {'plane':>5} "
+          f"{'slope':>6} | {'rise pk':>7} {'end':>5} {'dy/dx':>5} {'psi':>4} | "
+          f"{'build':>5} {'shear':>5}")  # fmt: skip
     for r in rows:
         resid = (f"{r['residual_plate']:5.3f} {r['residual_plane']:5.3f} {r['residual_from_mm']:5.1f}"
                  if r["residual_reached"] else f"{'not reached':>17}")  # fmt: skip
         print(f"{r['box']:>5} {r['seed']:4d} {r['width_over_d_max']:6.1f} {r['height_over_d_max']:6.1f} "
               f"{r['disks']:5d} {r['n2d']:6.4f} | {r['peak_plate']:5.3f} {r['peak_plane']:5.3f} "
-              f"{r['peak_at_mm']:5.1f} | {resid} | {r['rise_at_peak_mm']:7.2f} {r['rise_at_end_mm']:5.2f} "
+              f"{r['peak_at_mm']:5.1f} | {resid} | {r['taylor_plate']:5.3f} {r['taylor_plane']:5.3f} "
+              f"{r['slope_from_window']:+6.3f} | {r['rise_at_peak_mm']:7.2f} {r['rise_at_end_mm']:5.2f} "
               f"{r['max_dilation_rate']:5.3f} {r['max_dilation_angle_deg']:4.1f} | "
               f"{r['build_time_s'] or math.nan:5.0f} {r['shear_time_s']:5.0f}")  # fmt: skip
 
@@ -256,6 +270,7 @@ def main() -> None:
     ap.add_argument("--friction", type=float, default=0.5, help="particle friction f_p of the tests")
     ap.add_argument("--normal-stress", type=float, default=100.0, help="kPa")
     ap.add_argument("--processes", type=int, default=2, help="DEM processes at once")
+    ap.add_argument("--report", action="store_true", help="build and shear nothing: print the finished tests")
     args = ap.parse_args()
     names = [b for b in args.boxes.split(",") if b]
     unknown = [b for b in names if b not in BOXES]
@@ -266,13 +281,17 @@ def main() -> None:
     from poro2d.shear.pool import execute_jobs
 
     t0 = time.perf_counter()
-    build_missing(args.out, plan, args.processes)
+    if not args.report:
+        build_missing(args.out, plan, args.processes)
     found = accepted_specimens(args.out, plan)
     jobs = shear_jobs(args.out, found, args)
-    results = execute_jobs([j for *_, j in jobs], args.processes, progress=False)
+    if args.report:  # a study still running elsewhere: its finished tests only
+        results = [job.test().stored() for *_, job in jobs]
+    else:
+        results = execute_jobs([j for *_, j in jobs], args.processes, progress=False)
     elapsed = time.perf_counter() - t0
     print(f"{len(plan)} specimens, {len(jobs)} tests in {elapsed:.0f} s (finished ones read back)")
-    pairs = zip(jobs, results, strict=True)
+    pairs = [(job, res) for job, res in zip(jobs, results, strict=True) if res is not None]
     rows = [test_row(n, s, spec, res, found[(n, s)]) for (n, s, spec, _), res in pairs]
     print_tests(rows)
     summaries = box_summaries(rows)
