@@ -41,7 +41,8 @@ def identifiability_note(result) -> str:
                 " or more replicate specimens narrow it."
                 if result.get("test") == "biaxial"
                 else " whole curves that soften (the end stress) or that carry the plate's rise (the"
-                " dilation), more normal stresses or more replicate specimens narrow it."
+                " dilation), readings along them (--stations), more normal stresses or more replicate"
+                " specimens narrow it."
             )
         )
     else:
