@@ -24,9 +24,8 @@ The laboratory's curves are read by the same functions (:func:`peak_ratio`, :fun
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import cached_property
-from typing import Any
 
 import numpy as np
 
@@ -34,7 +33,7 @@ from poro2d.biaxial.angles import smoothed
 from poro2d.biaxial.case import BiaxialCase
 from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.biaxial.single import BiaxialTest
-from poro2d.calibration.units import check_files, parse_strain_station, window_mean
+from poro2d.calibration.units import FrictionUnit, check_files, parse_strain_station, window_mean
 from poro2d.identity import identity_digest
 from poro2d.specimen.saved import Specimen
 from poro2d.store import Store
@@ -106,44 +105,16 @@ def biaxial_unit_key(specimen_digest: str, sigma: float, settings: dict) -> str:
 
 
 @dataclass(frozen=True)
-class BiaxialUnit:
-    """One biaxial test of a calibration, as a value that travels to a Dask worker.
-
-    ``specimen``: the specimen's file; ``digest``: its content (what the key hashes);
-    ``sigma``: the confining stress (kPa); ``settings``: every biaxial setting, the two
-    frictions included.
-    """
-
-    specimen: str
-    digest: str
-    sigma: float
-    settings: dict[str, Any]
+class BiaxialUnit(FrictionUnit):
+    """One biaxial test of a calibration (:class:`~poro2d.calibration.units.FrictionUnit` with
+    ``sigma`` the confining stress and the biaxial settings)."""
 
     #: what the progress display counts
     WHAT = "biaxial tests"
 
-    @classmethod
-    def at(cls, specimen, digest: str, sigma: float, base: BiaxialSettings, fp: float, mu_r: float
-           ) -> BiaxialUnit:  # fmt: skip
-        """The unit of ``specimen`` at sigma_3 = ``sigma`` with (f_p, mu_r) on the ``base`` settings
-        (checked here, on the driver, before any work)."""
-        settings = replace(base, particle_friction=fp, rolling_friction=mu_r)
-        return cls(str(specimen), digest, float(sigma), settings.record().to_dict())
-
-    @property
-    def fp(self) -> float:
-        return self.settings["particle_friction"]
-
-    @property
-    def mu_r(self) -> float:
-        return self.settings["rolling_friction"]
-
     @cached_property
     def key(self) -> str:
         return biaxial_unit_key(self.digest, self.sigma, self.settings)
-
-    def store(self, cache: Store | None) -> Store | None:
-        return None if cache is None else cache.child(self.key)
 
     def test(self, store: Store | None) -> BiaxialTest:
         case = BiaxialCase(

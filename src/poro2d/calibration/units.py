@@ -121,11 +121,13 @@ def unit_key(specimen_digest: str, sigma: float, settings: dict) -> str:
 
 
 @dataclass(frozen=True)
-class CalibrationUnit:
-    """One shear test of a calibration, as a value that travels to a Dask worker.
+class FrictionUnit:
+    """One test of a calibration at a pair (f_p, mu_r), as a value that travels to a Dask worker:
+    what every kind of unit (a shear test, a biaxial test) holds and how it is made.
 
     ``specimen``: the specimen's file; ``digest``: its content (what the cache key hashes,
-    not the path); ``settings``: every shear setting, the two frictions included.
+    not the path); ``sigma``: the test's stress (kPa); ``settings``: every setting of the test,
+    the two frictions included.
     """
 
     specimen: str
@@ -134,9 +136,7 @@ class CalibrationUnit:
     settings: dict[str, Any]
 
     @classmethod
-    def at(
-        cls, specimen, digest: str, sigma: float, base: ShearSettings, fp: float, mu_r: float
-    ) -> CalibrationUnit:
+    def at(cls, specimen, digest: str, sigma: float, base, fp: float, mu_r: float):
         """The unit of ``specimen`` at ``sigma`` with the frictions (f_p, mu_r) on the ``base`` settings.
 
         The settings are checked here, on the driver, before any work; the unit keeps them as
@@ -153,6 +153,19 @@ class CalibrationUnit:
     def mu_r(self) -> float:
         return self.settings["rolling_friction"]
 
+    @property
+    def key(self) -> str:
+        raise NotImplementedError
+
+    def store(self, cache: Store | None) -> Store | None:
+        """The unit's store in ``cache``, under its key (None: nothing kept)."""
+        return None if cache is None else cache.child(self.key)
+
+
+@dataclass(frozen=True)
+class CalibrationUnit(FrictionUnit):
+    """One shear test of a calibration (:class:`FrictionUnit` with the shear settings)."""
+
     @cached_property
     def key(self) -> str:
         """The unit's identity: the name of its store in the cache (:func:`unit_key`)."""
@@ -160,10 +173,6 @@ class CalibrationUnit:
 
     #: what the progress display counts (:class:`poro2d.calibration.cluster.UnitRunner`)
     WHAT = "shear tests"
-
-    def store(self, cache: Store | None) -> Store | None:
-        """The unit's store in ``cache`` (None: nothing kept)."""
-        return None if cache is None else cache.child(self.key)
 
     # the protocol the runner reads every kind of unit through (the biaxial units keep it too)
     def stored_row(self, cache: Store | None) -> UnitRow | None:
@@ -322,6 +331,7 @@ __all__ = [
     "station",
     "window_mean",
     "CalibrationUnit",
+    "FrictionUnit",
     "UnitRow",
     "check_entry",
     "check_files",
