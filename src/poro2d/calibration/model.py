@@ -118,6 +118,8 @@ class Posterior:
     noise_sd: list[float] = field(default_factory=list)  # per observable (its unit), set by the caller
     noise_correlation: list[list[float]] = field(default_factory=list)
     precision_factor: float = 1.0  # the covariance's correction for being estimated, set by the caller
+    lab_repeats: int = 1  # laboratory series averaged, set by the caller
+    lab_scatter_ratio: float | None = None  # their scatter over a simulated specimen's (repeats only)
 
     @property
     def fp_values(self) -> np.ndarray:
@@ -191,11 +193,17 @@ def seed_covariance(values: np.ndarray) -> np.ndarray:
 
 
 def noise_covariance(
-    surrogates: list[Surrogate], seed_cov: np.ndarray, lab_values, lab_error: float, units=None
+    surrogates: list[Surrogate],
+    seed_cov: np.ndarray,
+    lab_values,
+    lab_error: float,
+    units=None,
+    lab_share: float = 1.0,
 ) -> np.ndarray:
     """The covariance of the misfit between the laboratory values and the surrogates.
 
-    The laboratory specimen is one more realisation (``seed_cov``), the mean of the
+    The laboratory specimen is one more realisation (``seed_cov``; the mean of several laboratory
+    repeats ``lab_share`` times it, :func:`poro2d.calibration.lab_repeats.lab_share`), the mean of the
     replicates is uncertain too (``seed_cov / replicates``), each quadratic misses by its
     residual and the laboratory reading carries ``lab_error`` (a fraction of each value, so in
     its unit). The observables may be in different units (``units``: one label per observable;
@@ -205,7 +213,7 @@ def noise_covariance(
     """
     replicates = max(max(s.replicates for s in surrogates), 1)
     extra = [s.residual**2 + (lab_error * y) ** 2 for s, y in zip(surrogates, lab_values, strict=True)]
-    cov = seed_cov * (1.0 + 1.0 / replicates) + np.diag(extra)
+    cov = seed_cov * (lab_share + 1.0 / replicates) + np.diag(extra)
     labels = np.array(["kPa" if units is None else units[k] for k in range(len(extra))])
     ridge = np.zeros(len(extra))
     for label in dict.fromkeys(labels):

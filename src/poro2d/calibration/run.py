@@ -33,6 +33,7 @@ from poro2d.calibration.biaxial import (
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
 from poro2d.calibration.evaluations import DesignPoint, Observed, target_key
 from poro2d.calibration.identifiable import check_enough_lab_values
+from poro2d.calibration.lab_repeats import LabRepeats, lab_scatter_ratio, lab_share, mean_targets
 from poro2d.calibration.specimens import (
     check_preset,
     check_replicates,
@@ -47,7 +48,7 @@ from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import holds_output
 from poro2d.paper_data import QUICK_SHEAR
 from poro2d.shear.box_scale import BoxScale, box_scale
-from poro2d.shear.lab import LabData, read_lab_csv
+from poro2d.shear.lab import LabData
 from poro2d.shear.parts import LabRecord, ShearSettingsRecord
 from poro2d.shear.series import check_stresses
 from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
@@ -198,8 +199,12 @@ class PosteriorSummary(TypedResult):
     #: the covariance's correction for being estimated (model.precision_factor): the noise sd are
     #: divided by its square root; absent from files of earlier versions
     precision_factor: float | None = None
+    #: laboratory repeats averaged (:mod:`poro2d.calibration.lab_repeats`) and their pooled variance
+    #: over a simulated specimen's; absent from the file of a calibration against one series
+    lab_repeats: int | None = None
+    lab_scatter_ratio: float | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("precision_factor",)
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("precision_factor", "lab_repeats", "lab_scatter_ratio")
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "median": FrictionValues,
@@ -363,7 +368,7 @@ def _end_mean(d: np.ndarray, y: np.ndarray, base: ShearSettings) -> float:
 
 @holds_output("store", kind=KIND)
 def run_calibration(
-    lab: str | os.PathLike | LabData | LabTests | None = None,
+    lab: str | os.PathLike | LabData | LabTests | list | None = None,
     specimens: list[str | os.PathLike] | None = None,
     *,
     biaxial_lab: str | os.PathLike | list | LabTests | None = None,
@@ -401,6 +406,11 @@ def run_calibration(
     A rerun reuses every finished shear test (cached by content in the store's ``cache``);
     ``store=None`` keeps nothing (every test runs, no figure or report is made).
 
+    ``lab`` may be a list: repeats of one laboratory programme (the same normal stresses and
+    readings, new specimens). Their mean values are fitted and the laboratory's share of the noise
+    is one simulated specimen's scatter over their number, scaled up when the repeats scatter more
+    (:mod:`poro2d.calibration.lab_repeats`).
+
     ``biaxial_lab`` instead of ``lab``: laboratory biaxial tests (one CSV or several, rows named by
     ``confining_stress_kpa``; or a :class:`poro2d.biaxial.lab.LabTests`, which ``lab`` also takes):
     every unit is then a biaxial test at a laboratory confining stress, the targets its stress
@@ -410,8 +420,9 @@ def run_calibration(
     t0 = time.perf_counter()
     if store is not None:
         check_output_dir(store.parameter, store.root)
-    lab_data = _read_lab(lab, biaxial_lab)
-    biaxial = isinstance(lab_data, LabTests)
+    repeats = _read_lab(lab, biaxial_lab)
+    biaxial = isinstance(repeats, LabTests)
+    lab_data = repeats if biaxial else repeats.first
     if not biaxial:
         check_stresses(lab_data.normal_stresses())
     check_preset(preset, quick, replicates)
@@ -444,7 +455,11 @@ def run_calibration(
     if stations > 1 and not biaxial and not lab_data.curves:
         why = "readings along a curve need the lab curves"
         raise InputError("--stations", stations, "1 with a peaks file", why)
-    targets = biaxial_targets(lab_data, base, stations) if biaxial else _lab_targets(lab_data, base, stations)
+    lab_series = None  # every laboratory series' values (series x targets), shear only
+    if biaxial:
+        targets = biaxial_targets(lab_data, base, stations)
+    else:
+        targets, lab_series = mean_targets([_lab_targets(x, base, stations) for x in repeats.series])
     check_enough_lab_values(lab_data.source, targets, len(CALIBRATED))
     check_noise_dof(points, len(given) if given is not None else replicates, len(targets))
     check_cluster_options(scheduler, workers)
@@ -467,12 +482,16 @@ def run_calibration(
     try:
         design = model.space_filling(ranges, points, design_seed)
         rows = runner.run(_units(design, found, stresses, base, make), cache, "round 1")
-        post, surrogates, table = _infer(ranges, design, found, stresses, rows, targets, lab_error)
+        post, surrogates, table = _infer(
+            ranges, design, found, stresses, rows, targets, lab_error, lab_series
+        )
         if refine:
             extra = [p for p in post.draw(refine, design_seed + 1) if p not in design]
             design = design + extra
             rows += runner.run(_units(extra, found, stresses, base, make), cache, "round 2")
-            post, surrogates, table = _infer(ranges, design, found, stresses, rows, targets, lab_error)
+            post, surrogates, table = _infer(
+                ranges, design, found, stresses, rows, targets, lab_error, lab_series
+            )
     finally:
         runner.close()
     result = _result(
@@ -481,7 +500,7 @@ def run_calibration(
         table,
         targets,
         level,
-        lab_data,
+        repeats,
         found,
         ranges,
         base,
@@ -497,12 +516,13 @@ def run_calibration(
     if store is not None:
         from poro2d.calibration.outputs import write_outputs
 
-        write_outputs(store, result, post, lab_data, found, partial(make, base=base), stresses)
+        write_outputs(store, result, post, repeats, found, partial(make, base=base), stresses)
     return result
 
 
-def _read_lab(lab, biaxial_lab) -> LabData | LabTests:
-    """The laboratory data: direct shear (``lab``) or biaxial tests (``biaxial_lab``), exactly one."""
+def _read_lab(lab, biaxial_lab) -> LabRepeats | LabTests:
+    """The laboratory data: direct shear (``lab``: one series or repeats) or biaxial tests
+    (``biaxial_lab``), exactly one."""
     if isinstance(lab, LabTests) and biaxial_lab is None:
         lab, biaxial_lab = None, lab
     if (lab is None) == (biaxial_lab is None):
@@ -514,7 +534,7 @@ def _read_lab(lab, biaxial_lab) -> LabData | LabTests:
         )
     if biaxial_lab is not None:
         return read_biaxial_lab(biaxial_lab)
-    return lab if isinstance(lab, LabData) else read_lab_csv(lab)
+    return LabRepeats.of(lab)
 
 
 def check_noise_dof(points: int, replicates: int, observables: int) -> None:
@@ -553,10 +573,20 @@ def _units(design, specimens: SpecimenSet, stresses, base, make=replicate_unit) 
     ]
 
 
-def _infer(ranges, design, specimens: SpecimenSet, stresses, rows: list[UnitRow | None], targets, lab_error):
+def _infer(
+    ranges,
+    design,
+    specimens: SpecimenSet,
+    stresses,
+    rows: list[UnitRow | None],
+    targets,
+    lab_error,
+    lab_series=None,
+):
     """The surrogates (one per target), the posterior and the table of replicate values per design point.
 
-    ``rows``: the units' rows in the order of :func:`_units` (None: the test failed)."""
+    ``rows``: the units' rows in the order of :func:`_units` (None: the test failed);
+    ``lab_series``: every laboratory repeat's values (series x targets; None: one series)."""
     per_point = len(specimens) * len(stresses)
     table = []
     for k, (fp, mu_r) in enumerate(design):
@@ -583,11 +613,15 @@ def _infer(ranges, design, specimens: SpecimenSet, stresses, rows: list[UnitRow 
         with np.errstate(divide="raise", over="raise", invalid="raise"):
             units = [observable_unit(obs) for obs, *_ in targets]
             seed_cov = model.seed_covariance(values)
-            cov = model.noise_covariance(surrogates, seed_cov, lab_values, lab_error, units)
+            ratio = None if lab_series is None else lab_scatter_ratio(lab_series, seed_cov)
+            count = 1 if lab_series is None else lab_series.shape[0]
+            share = lab_share(count, ratio)
+            cov = model.noise_covariance(surrogates, seed_cov, lab_values, lab_error, units, share)
             factor = _precision_factor(values, len(targets))
             cov = cov / factor
             post = model.posterior(ranges, surrogates, lab_values, cov)
             post.precision_factor = factor
+            post.lab_repeats, post.lab_scatter_ratio = count, ratio
             post.noise_sd = np.sqrt(np.diag(cov)).tolist()
             post.noise_correlation = (cov / np.sqrt(np.outer(np.diag(cov), np.diag(cov)))).round(3).tolist()
     except (FloatingPointError, np.linalg.LinAlgError) as exc:
@@ -687,6 +721,8 @@ def _result(
             observables=fitted,
             noise_correlation=post.noise_correlation,
             precision_factor=post.precision_factor,
+            lab_repeats=post.lab_repeats if post.lab_repeats > 1 else None,
+            lab_scatter_ratio=post.lab_scatter_ratio,
         ),
         evaluations=table,
         fit={

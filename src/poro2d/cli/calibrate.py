@@ -34,8 +34,11 @@ def parse_range(option: str, text: str | None, default: tuple[float, float]) -> 
 def register(app: typer.Typer) -> None:
     @app.command("calibrate")
     def calibrate_cmd(
-        lab: Path = typer.Option(
-            None, "--lab", help="Laboratory direct shear CSV: peaks, or whole curves (docs/shear.md)."
+        lab: list[Path] = typer.Option(
+            None,
+            "--lab",
+            help="Laboratory direct shear CSV: peaks, or whole curves (docs/shear.md); repeat for"
+            " repeats of the same tests (their mean is fitted).",
         ),
         biaxial_lab: list[Path] = typer.Option(
             None,
@@ -81,8 +84,9 @@ def register(app: typer.Typer) -> None:
         from poro2d.store import Store
 
         settings = test_settings(bool(biaxial_lab), max_displacement, max_strain)
+        labs = [str(p) for p in lab or []]
         options = {
-            "lab": None if lab is None else str(lab),
+            "lab": (labs[0] if len(labs) == 1 else labs) or None,
             **({"biaxial_lab": [str(p) for p in biaxial_lab]} if biaxial_lab else {}),
             "specimen": specimen or None,
             "preset": preset,
@@ -96,7 +100,7 @@ def register(app: typer.Typer) -> None:
         }
         try:
             result = run_calibration(
-                lab,
+                (lab[0] if len(lab) == 1 else list(lab)) if lab else None,
                 list(specimen or []),
                 biaxial_lab=list(biaxial_lab) if biaxial_lab else None,
                 store=Store(out),

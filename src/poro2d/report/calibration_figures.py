@@ -26,7 +26,8 @@ def plot_calibration_fit(result, lab, curves: dict[float, list], nearest, path: 
     against the laboratory curves, or its peak as a dotted line where the laboratory gave no curve;
     right, when the dilation was fitted: the plate's rise at the end, laboratory against model (mm).
 
-    ``result`` is a :class:`poro2d.calibration.run.CalibrationResult`, ``lab`` its laboratory data.
+    ``result`` is a :class:`poro2d.calibration.run.CalibrationResult`, ``lab`` its laboratory data
+    (one series, or repeats with ``series``: each drawn; the points are their means).
     """
     dilation = [o for o in result.posterior["observables"] if o["observable"] == "dilation"]
     if dilation:
@@ -65,11 +66,13 @@ def plot_calibration_fit(result, lab, curves: dict[float, list], nearest, path: 
             ax_curve.plot(
                 d * 1e3, t, color=c, lw=0.8, alpha=0.7, label=f"model {sigma:g} kPa" if j == 0 else None
             )
-        if sigma in lab.curves:
-            d, t = lab.curves[sigma]
-            ax_curve.plot(d * 1e3, t, "k--", lw=1.0, label="laboratory" if k == 0 else None)
-        else:
-            ax_curve.axhline(lab.peaks[sigma], color=c, ls=":", lw=1.0)
+        for i, series in enumerate(getattr(lab, "series", (lab,))):  # every laboratory repeat
+            first = k == 0 and i == 0
+            if sigma in series.curves:
+                d, t = series.curves[sigma]
+                ax_curve.plot(d * 1e3, t, "k--", lw=1.0, label="laboratory" if first else None)
+            else:
+                ax_curve.axhline(series.peaks[sigma], color=c, ls=":", lw=1.0)
     ax_curve.set_xlabel("shear displacement (mm)")
     ax_curve.set_ylabel("shear stress (kPa)")
     ax_curve.set_title(
