@@ -28,7 +28,13 @@ import numpy as np
 
 from poro2d.errors import InputError
 from poro2d.lab_table import LabTable, check_enough_points, check_rising, read_lab_table
-from poro2d.shear.lab_checks import MAX_DISPLACEMENT_MM, MAX_VERTICAL_MM, check_lab_values, check_peak
+from poro2d.shear.lab_checks import (
+    MAX_DISPLACEMENT_MM,
+    MAX_VERTICAL_MM,
+    check_lab_values,
+    check_peak,
+    check_reading,
+)
 from poro2d.shear.parts import LabPeak, LabRecord
 from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA
 
@@ -115,7 +121,9 @@ def _curves(table: LabTable) -> LabData:
     sigma = _normal_stresses(table)
     why = "a reading of a shear box; is the column in mm?"
     d = table.column("shear_displacement_mm", 0.0, MAX_DISPLACEMENT_MM, "mm", why)
-    tau = table.column("shear_stress_kpa", 0.0, math.inf, "kPa")
+    tau = table.column("shear_stress_kpa", -math.inf, math.inf, "kPa")
+    for i, (s, t) in enumerate(zip(sigma, tau, strict=True)):
+        check_reading(table.where(i, "shear_stress_kpa"), float(s), float(t))
     rise = _vertical(table)
     curves: dict[float, tuple[np.ndarray, np.ndarray]] = {}
     vertical: dict[float, np.ndarray] = {}

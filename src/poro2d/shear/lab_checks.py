@@ -15,6 +15,10 @@ its answer printed as if it were identified. The checks here are physical, not s
 * the top plate's vertical displacement of a curve (optional), within
   +-:data:`MAX_VERTICAL_MM` mm: a plate rises or sinks by a fraction of the specimen's height,
   which is under half a metre even in the largest boxes; more is a column in micrometres;
+* a reading of a curve is at least :data:`MIN_READING_RATIO` times its normal stress: at the
+  start of a test the shear stress may dip below zero (the halves settle, a load cell's zero
+  drifts; poro2d's own tests read down to -0.05 sigma in their first 0.1 mm), while a curve far
+  below zero has its sign or its column wrong;
 * a curve is a test: displacements rise from row to row (a step back or a repeat is a
   curve pasted twice or sorted by another column), with at least :data:`MIN_CURVE_POINTS`
   readings, so that a peak and what follows it are measured.
@@ -42,6 +46,18 @@ MAX_DISPLACEMENT_MM = 300.0
 #: contracts by a few percent of its height, and the tallest boxes (1 m rockfill boxes) hold
 #: specimens under half a metre high, so 100 mm is past any soil; more is a unit mistake
 MAX_VERTICAL_MM = 100.0
+#: lowest shear stress of a curve's reading, as a fraction of its normal stress
+MIN_READING_RATIO = -0.1
+
+
+def check_reading(where: str, sigma: float, tau: float) -> None:
+    """A reading of a curve (kPa) no lower than :data:`MIN_READING_RATIO` times its normal stress."""
+    if not tau >= MIN_READING_RATIO * sigma:
+        raise InputError(
+            f"lab shear_stress_kpa ({where})", tau,
+            f"at least {MIN_READING_RATIO:g} times the normal stress ({MIN_READING_RATIO * sigma:g} kPa)",
+            "a curve may dip below zero at its start, not further: is the sign or the column right?",
+        )  # fmt: skip
 
 
 def check_normal_stress(where: str, sigma: float) -> None:
@@ -126,12 +142,13 @@ def _check_curve_arrays(sigma: float, d: np.ndarray, t: np.ndarray) -> None:
         not (np.all(np.isfinite(d)) and np.all(np.isfinite(t)))
         or d.min() < 0.0
         or d.max() > top
-        or t.min() < 0.0
+        or t.min() < MIN_READING_RATIO * sigma
     ):
         raise InputError(
             where,
             "a reading out of range",
-            f"displacement in [0, {MAX_DISPLACEMENT_MM * 1e-3:g}] m, shear stress >= 0",
+            f"displacement in [0, {MAX_DISPLACEMENT_MM * 1e-3:g}] m,"
+            f" shear stress >= {MIN_READING_RATIO:g} x sigma",
         )
     if np.any(np.diff(d) <= 0.0):
         raise InputError(
