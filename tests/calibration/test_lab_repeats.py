@@ -94,3 +94,15 @@ def test_the_command_refuses_repeats_of_another_programme_on_one_line(tmp_path, 
     lines = err.strip().splitlines()
     assert len(lines) == 1 and "b.csv" in lines[0] and "normal stresses" in lines[0], lines
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_the_report_says_how_many_repeats_and_whether_their_share_was_scaled():
+    from types import SimpleNamespace
+
+    from poro2d.report.calibration_report import repeats_note
+
+    assert repeats_note(SimpleNamespace(posterior={"precision_factor": 0.6})) is None
+    calm = repeats_note(SimpleNamespace(posterior={"lab_repeats": 3, "lab_scatter_ratio": 0.5}))
+    assert calm.startswith("3 laboratory repeats") and "0.33 of one" in calm and "scaled" not in calm
+    loud = repeats_note(SimpleNamespace(posterior={"lab_repeats": 3, "lab_scatter_ratio": 2.4}))
+    assert "scaled up by 2.40" in loud and "0.80 of one" in loud

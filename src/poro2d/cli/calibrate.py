@@ -146,11 +146,13 @@ def test_settings(biaxial: bool, max_displacement: float | None, max_strain: flo
 
 
 def print_result(result, out: Path) -> None:
-    from poro2d.report.calibration_report import box_note, identifiability_note, interval_text
+    from poro2d.report.calibration_report import box_note, identifiability_note, interval_text, repeats_note
 
     for name, label in (("particle_friction", "f_p"), ("rolling_friction", "mu_r")):
         console.print(f"  {label:<5} {interval_text(result, name)}")
     console.print(f"  {identifiability_note(result)}")
+    if repeats_note(result):
+        console.print(f"  {repeats_note(result)}")
     if box_note(result):
         console.print(f"  {box_note(result)}")
     console.print(

@@ -61,6 +61,21 @@ def box_note(result) -> str | None:
     return f"{scale.note()}; the frictions are {fitted}.{warning}"
 
 
+def repeats_note(result) -> str | None:
+    """The laboratory repeats fitted as their mean, in one line (None for a single series)."""
+    post = result.posterior
+    count = post.get("lab_repeats")
+    if not count:
+        return None
+    ratio = post.get("lab_scatter_ratio")
+    scaled = "" if ratio is None or ratio <= 1.0 else f", so their share was scaled up by {ratio:.2f}"
+    return (
+        f"{count} laboratory repeats fitted as their mean; their scatter is {ratio:.2f} times a simulated "
+        f"specimen's{scaled}; the laboratory's share of the noise is {max(1.0, ratio or 1.0) / count:.2f}"
+        " of one specimen's."
+    )
+
+
 def fit_table(observables) -> tuple[list[str], list[list]]:
     """The fit table's header and rows: in kPa while every target is a stress; with dilation
     targets (mm) each row names its unit."""
@@ -109,6 +124,7 @@ def calibration_blocks(result, out: Path) -> list[tuple]:
             ],
         ),
         ("p", identifiability_note(result)),
+        *([("p", repeats_note(result))] if repeats_note(result) else []),
         *([("p", box_note(result))] if box_note(result) else []),
         ("table", header, rows),
         (
