@@ -38,6 +38,8 @@ OTHER = {
     "local_damping": 0.5,
     "undercompaction": 0.05,
     "gap": 1e-4,
+    "particle_kn": 1e6,
+    "particle_ks": 5e5,
 }
 
 

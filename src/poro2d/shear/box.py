@@ -150,6 +150,23 @@ def _specimen_box(sim: Simulation) -> tuple[float, float]:
     return right, top
 
 
+def _replaced(values: np.ndarray, value: float | None) -> np.ndarray:
+    """A copy of a per-disk array, every entry ``value`` when given."""
+    return values.copy() if value is None else np.full(values.shape, float(value))
+
+
+def _pair_type_contact(contact: ContactModel, mu: float | None, kn: float | None, ks: float | None):
+    """The contact model with the disk-disk (kn, ks, mu) replaced where given: under the
+    ``per_pair_type`` convention one triple serves every disk pair and the disks' own arrays are
+    not read, so a replaced value must go there too (``per_body``: the disks' arrays suffice)."""
+    if contact.convention != "per_pair_type" or (mu is None and kn is None and ks is None):
+        return contact
+    assert contact.pp is not None
+    given = (kn, ks, mu)
+    pp = tuple(float(old if new is None else new) for old, new in zip(contact.pp, given, strict=True))
+    return ContactModel("per_pair_type", pp, contact.pw)
+
+
 def build_split_box(
     specimen: Simulation,
     max_displacement: float,
@@ -162,11 +179,15 @@ def build_split_box(
     dt_safety: float = 0.8,
     threads: int = 1,
     rolling_friction: float | None = None,
+    particle_kn: float | None = None,
+    particle_ks: float | None = None,
 ) -> tuple[Simulation, SplitBox]:
     """A new simulation of the specimen's disks in a split box (all walls at rest).
 
     The disks keep their positions, velocities and properties (``particle_friction``
-    replaces their friction when given, ``rolling_friction`` their rolling friction mu_r);
+    replaces their friction when given, ``rolling_friction`` their rolling friction mu_r,
+    ``particle_kn`` and ``particle_ks`` their normal and shear stiffness, N/m: the time step is
+    chosen from the stiffness the new simulation holds, so a stiffer disk gets a shorter one);
     the box walls take the disks' largest mu_r, so that under the engine's rule (a contact
     takes the smaller of its two bodies' values) a disk meets a wall with its own mu_r, as
     it meets another disk of its kind. The engine settings (contact convention,
@@ -185,6 +206,9 @@ def build_split_box(
         check_range("particle_friction", particle_friction, 0.0, None)
     if rolling_friction is not None:
         check_range("rolling_friction", rolling_friction, 0.0, MAX_ROLLING_FRICTION)
+    for name, k in (("particle_kn", particle_kn), ("particle_ks", particle_ks)):
+        if k is not None:
+            check_range(name, k, 0.0, None, lo_open=True)
     p0 = specimen.particles
     if p0.n == 0:
         raise InputError("specimen", "no disks", "a specimen with disks")
@@ -209,16 +233,11 @@ def build_split_box(
     walls.add((W + e, H), (-e, H), *k, name="top", mu_r=wall_mu_r)
     particles = Particles(
         pos=p0.pos.copy(), radius=p0.radius.copy(), density=p0.density.copy(), thickness=p0.thickness,
-        kn=p0.kn.copy(), ks=p0.ks.copy(),
+        kn=_replaced(p0.kn, particle_kn), ks=_replaced(p0.ks, particle_ks),
         mu=p0.mu.copy() if particle_friction is None else np.full(p0.n, float(particle_friction)),
         vel=p0.vel.copy(), theta=p0.theta.copy(), omega=p0.omega.copy(), mode=p0.mode.copy(), mu_r=mu_r,
     )  # fmt: skip
-    contact = specimen.contact
-    if particle_friction is not None and contact.convention == "per_pair_type":
-        assert contact.pp is not None
-        contact = ContactModel(
-            "per_pair_type", (contact.pp[0], contact.pp[1], float(particle_friction)), contact.pw
-        )
+    contact = _pair_type_contact(specimen.contact, particle_friction, particle_kn, particle_ks)
     sim = Simulation(
         particles, walls, contact, gravity=specimen.gravity, local_damping=specimen.local_damping,
         restitution=specimen.restitution, dt_safety=dt_safety, density_scale=density_scale,

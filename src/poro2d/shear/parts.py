@@ -51,7 +51,9 @@ class ShearSettingsRecord(TypedResult):
     """The shear settings as a result file keeps them (:meth:`poro2d.shear.settings.ShearSettings.record`).
 
     A file written before a setting existed lacks its key, and keeps lacking it when written
-    again (``stop_after_peak`` and ``rolling_friction`` are newer than the first files).
+    again (``stop_after_peak`` and ``rolling_friction`` are newer than the first files). The disks'
+    stiffnesses ``particle_kn`` and ``particle_ks`` are written only when given: a test on the
+    specimen's own stiffness keeps the file, and the cache key, it had before they existed.
     """
 
     velocity: float
@@ -77,6 +79,10 @@ class ShearSettingsRecord(TypedResult):
     shear_zone_factor: float
     inertial_limit: float
     stress_tolerance: float
+    particle_kn: float | None = None
+    particle_ks: float | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("particle_kn", "particle_ks")
 
 
 @dataclass(eq=False)

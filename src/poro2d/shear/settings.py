@@ -28,6 +28,10 @@ MAX_CONSOLIDATION_STEPS = 10_000_000
 MAX_WALL_STIFFNESS = 1e10
 #: friction coefficients beyond 10 hold as a rough wall does; larger ones are typos
 MAX_FRICTION = 10.0
+#: a disk's normal or shear stiffness (N/m): from 1e3 (a contact of 2.5 mm disks overlaps by a
+#: tenth of their diameter at 2 kPa: softer is no longer a soft-contact model) up to 1e10 (as the
+#: walls; the time step falls with its square root)
+PARTICLE_STIFFNESS_RANGE = (1e3, 1e10)
 #: the largest rolling friction (the engine's bound, see poro2d.dem.contact_law)
 MAX_ROLLING_FRICTION = ENGINE_MAX_ROLLING_FRICTION
 #: inertial masses up to 1000 times the real ones: the inertial number grows with its root
@@ -56,6 +60,8 @@ SHEAR_RANGES: Ranges = {
     "gap": Real(0.0, None),
     "particle_friction": Real(0.0, MAX_FRICTION, or_none=True),
     "rolling_friction": Real(0.0, MAX_ROLLING_FRICTION, or_none=True),
+    "particle_kn": Real(*PARTICLE_STIFFNESS_RANGE, or_none=True),
+    "particle_ks": Real(*PARTICLE_STIFFNESS_RANGE, or_none=True),
     "local_damping": Real(0.0, 1.0, hi_open=True, or_none=True),
     "density_scale": Real(1.0, MAX_DENSITY_SCALE),
     "dt_safety": Real(0.0, 1.0, lo_open=True),
@@ -80,7 +86,9 @@ class ShearSettings:
     gap (m) of the box; particle_friction replaces the specimen's when given;
     rolling_friction likewise replaces every disk's rolling friction mu_r (None: the
     specimen's own), and the box walls take the disks' largest mu_r;
-    local_damping likewise (None: the specimen's); density_scale >= 1 scales the
+    local_damping likewise (None: the specimen's); particle_kn and particle_ks (N/m) replace
+    every disk's normal and shear stiffness (None: the specimen's; the time step follows the
+    stiffness used, a stiffer disk a shorter one); density_scale >= 1 scales the
     inertial masses; dt_safety the automatic time step; peak_window (m) the
     smoothing of the peak; shear_zone_factor k in gamma_dot = v / (k d_mean);
     inertial_limit and stress_tolerance the quasi-static and servo checks.
@@ -109,6 +117,8 @@ class ShearSettings:
     shear_zone_factor: float = 10.0
     inertial_limit: float = 1e-3
     stress_tolerance: float = 0.02
+    particle_kn: float | None = None
+    particle_ks: float | None = None
 
     def __post_init__(self) -> None:
         check_fields(self, SHEAR_RANGES)
@@ -146,4 +156,10 @@ def inertial_number(velocity: float, sigma_pa: float, rho_inertial: float, shear
     return velocity / shear_zone_factor * math.sqrt(rho_inertial / sigma_pa)
 
 
-__all__ = ["MAX_ROLLING_FRICTION", "NORMAL_STRESS_RANGE_KPA", "ShearSettings", "inertial_number"]
+__all__ = [
+    "MAX_ROLLING_FRICTION",
+    "NORMAL_STRESS_RANGE_KPA",
+    "PARTICLE_STIFFNESS_RANGE",
+    "ShearSettings",
+    "inertial_number",
+]

@@ -114,7 +114,7 @@ class DirectShearTest:
         sim, box = build_split_box(
             spec, s.max_displacement, s.kn_wall, s.ks_wall, s.friction_wall, s.gap,
             s.particle_friction, s.density_scale, s.dt_safety, self.threads,
-            rolling_friction=s.rolling_friction,
+            rolling_friction=s.rolling_friction, particle_kn=s.particle_kn, particle_ks=s.particle_ks,
         )  # fmt: skip
         if s.local_damping is not None:
             sim.set_local_damping(float(s.local_damping))
