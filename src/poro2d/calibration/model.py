@@ -1,17 +1,22 @@
-"""The statistics of a calibration: design, surrogate, posterior (numpy and scipy only).
+"""The statistics of a calibration: design, surrogate, posterior (numpy, scipy and emcee).
 
 The parameters live in design coordinates: log(f_p) (the strength of a packing grows
 with the logarithm of its friction far more evenly than with the friction itself) and
-mu_r, each scaled to [0, 1] over its range.
+mu_r, each scaled to [0, 1] over its range; when the disks' stiffnesses are calibrated too,
+log(kn) and log(ks) (a stiffness spans decades, and a packing's response follows its
+logarithm), scaled likewise.
 
-* design: a Latin hypercube over the unit square (``scipy.stats.qmc``), seeded;
+* design: a Latin hypercube over the unit square (or cube, in d coordinates:
+  ``scipy.stats.qmc``), seeded;
 * surrogate: per observable (a peak or an end shear stress at one normal stress, or the
   plate's rise at the end of the test: the dilation), a
-  full quadratic in the two coordinates fitted by least squares to the replicate means;
+  full quadratic in the d coordinates fitted by least squares to the replicate means;
   the seed scatter is pooled over the design points; what the quadratic cannot follow
   (its residual) is counted as extra noise;
 * posterior: a flat prior on the unit square, a Gaussian likelihood of the laboratory
-  values, evaluated on a grid (two parameters: the grid is exact, no sampler to tune).
+  values, evaluated on a grid (two parameters: the grid is exact, no sampler to tune); in
+  three or four coordinates a grid of the same resolution would cost 161^d evaluations, so the
+  posterior is sampled with emcee's affine-invariant ensemble (:func:`sampled_posterior`).
 """
 
 from __future__ import annotations
@@ -25,50 +30,92 @@ import numpy as np
 GRID = 161
 #: a credible interval wider than this fraction of its range is reported as poorly identified
 WIDE_FRACTION = 0.5
+#: the axes of a posterior, in the order of the design coordinates: particle friction, rolling
+#: friction, and the disks' normal and shear stiffness when they are calibrated
+AXES = ("fp", "mu_r", "kn", "ks")
+#: the axes searched in the logarithm of the parameter
+LOG_AXES = ("fp", "kn", "ks")
 
 
 @dataclass(frozen=True)
 class Ranges:
-    """The search ranges of particle friction f_p (> 0) and rolling friction mu_r (>= 0)."""
+    """The search ranges of particle friction f_p (> 0) and rolling friction mu_r (>= 0), and
+    optionally of the disks' normal and shear stiffness kn, ks (N/m, > 0; None: not calibrated)."""
 
     fp: tuple[float, float]
     mu_r: tuple[float, float]
+    kn: tuple[float, float] | None = None
+    ks: tuple[float, float] | None = None
 
-    def to_unit(self, fp, mu_r) -> np.ndarray:
-        """(n, 2) design coordinates of parameter values."""
+    @property
+    def axes(self) -> tuple[str, ...]:
+        """The calibrated parameters' axes (:data:`AXES`), in the order of the design coordinates."""
+        return tuple(a for a in AXES if getattr(self, a) is not None)
+
+    @property
+    def dim(self) -> int:
+        return len(self.axes)
+
+    def to_unit(self, fp, mu_r, *stiffness) -> np.ndarray:
+        """(n, d) design coordinates of parameter values (``stiffness``: kn, ks as calibrated)."""
         lo, hi = np.log(self.fp[0]), np.log(self.fp[1])
         u = (np.log(np.asarray(fp, float)) - lo) / (hi - lo)
         v = (np.asarray(mu_r, float) - self.mu_r[0]) / (self.mu_r[1] - self.mu_r[0])
-        return np.column_stack([np.atleast_1d(u), np.atleast_1d(v)])
+        columns = [np.atleast_1d(u), np.atleast_1d(v)]
+        for axis, values in zip(self.axes[2:], stiffness, strict=True):
+            lo, hi = np.log(getattr(self, axis))
+            columns.append(np.atleast_1d((np.log(np.asarray(values, float)) - lo) / (hi - lo)))
+        return np.column_stack(columns)
 
-    def from_unit(self, unit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(f_p, mu_r) arrays of design coordinates."""
+    def from_unit(self, unit: np.ndarray) -> tuple[np.ndarray, ...]:
+        """(f_p, mu_r, then kn, ks as calibrated) arrays of design coordinates."""
         unit = np.atleast_2d(unit)
         lo, hi = np.log(self.fp[0]), np.log(self.fp[1])
         fp = np.exp(lo + unit[:, 0] * (hi - lo))
         mu_r = self.mu_r[0] + unit[:, 1] * (self.mu_r[1] - self.mu_r[0])
-        return fp, mu_r
+        stiffness = []
+        for k, axis in enumerate(self.axes[2:], start=2):
+            lo, hi = np.log(getattr(self, axis))
+            stiffness.append(np.exp(lo + unit[:, k] * (hi - lo)))
+        return (fp, mu_r, *stiffness)
+
+    def axis_values(self, axis: str, unit_values: np.ndarray) -> np.ndarray:
+        """The parameter values of one axis at design coordinates ``unit_values`` of it."""
+        unit = np.full((len(unit_values), self.dim), 0.0)
+        unit[:, self.axes.index(axis)] = unit_values
+        return self.from_unit(unit)[self.axes.index(axis)]
 
 
-def rounded(fp: np.ndarray, mu_r: np.ndarray) -> list[tuple[float, float]]:
-    """Parameter pairs rounded to 4 significant digits: the identity of a shear test in the cache."""
-    return [(float(f"{a:.4g}"), float(f"{b:.4g}")) for a, b in zip(fp, mu_r, strict=True)]
+def rounded(*columns: np.ndarray) -> list[tuple[float, ...]]:
+    """Parameter tuples (f_p, mu_r, then kn, ks as calibrated) rounded to 4 significant digits:
+    the identity of a shear test in the cache."""
+    return [tuple(float(f"{x:.4g}") for x in row) for row in zip(*columns, strict=True)]
 
 
-def space_filling(ranges: Ranges, n: int, seed: int) -> list[tuple[float, float]]:
-    """``n`` parameter pairs of a Latin hypercube (optimised for its centred discrepancy)."""
+def space_filling(ranges: Ranges, n: int, seed: int) -> list[tuple[float, ...]]:
+    """``n`` parameter tuples of a Latin hypercube (optimised for its centred discrepancy)."""
     from scipy.stats import qmc
 
-    sampler = qmc.LatinHypercube(d=2, optimization="random-cd", rng=np.random.default_rng(seed))
+    sampler = qmc.LatinHypercube(d=ranges.dim, optimization="random-cd", rng=np.random.default_rng(seed))
     return rounded(*ranges.from_unit(sampler.random(n)))
 
 
 def _features(unit: np.ndarray) -> np.ndarray:
-    u, v = unit[:, 0], unit[:, 1]
-    return np.column_stack([np.ones_like(u), u, v, u * u, u * v, v * v])
+    """The full quadratic's terms: 1, each coordinate, then each product x_i x_j (i <= j) in
+    order (two coordinates u, v: 1, u, v, uu, uv, vv)."""
+    d = unit.shape[1]
+    columns = [np.ones_like(unit[:, 0]), *(unit[:, i] for i in range(d))]
+    columns += [unit[:, i] * unit[:, j] for i in range(d) for j in range(i, d)]
+    return np.column_stack(columns)
 
 
-N_COEFFICIENTS = 6
+def n_coefficients(d: int) -> int:
+    """The coefficients of a full quadratic in ``d`` coordinates: (d + 1)(d + 2) / 2."""
+    return (d + 1) * (d + 2) // 2
+
+
+#: the coefficients of the two-parameter quadratic
+N_COEFFICIENTS = n_coefficients(2)
 
 
 @dataclass
@@ -96,7 +143,7 @@ def fit_surrogate(unit: np.ndarray, values: np.ndarray) -> Surrogate:
     counts = np.sum(np.isfinite(values), axis=1)
     coefficients, *_ = np.linalg.lstsq(_features(unit), means, rcond=None)
     misfit = means - _features(unit) @ coefficients
-    dof = max(len(means) - N_COEFFICIENTS, 1)
+    dof = max(len(means) - n_coefficients(unit.shape[1]), 1)
     residual = math.sqrt(float(np.sum(misfit**2)) / dof)
     several = counts > 1
     if several.any():  # pooled variance: each point's sum of squares over its degrees of freedom
@@ -107,19 +154,28 @@ def fit_surrogate(unit: np.ndarray, values: np.ndarray) -> Surrogate:
     return Surrogate(coefficients, scatter, residual, int(np.max(counts)))
 
 
+@dataclass(kw_only=True)
+class NoiseTerms:
+    """What the caller records beside a posterior: the noise it was computed with."""
+
+    noise_sd: list[float] = field(default_factory=list)  # per observable (its unit)
+    noise_correlation: list[list[float]] = field(default_factory=list)
+    precision_factor: float = 1.0  # the covariance's correction for being estimated
+    lab_repeats: int = 1  # laboratory series averaged
+    lab_scatter_ratio: float | None = None  # their scatter over a simulated specimen's (repeats only)
+
+
 @dataclass
-class Posterior:
+class Posterior(NoiseTerms):
     """The posterior on the grid of design coordinates (``density`` sums to 1)."""
 
     ranges: Ranges
     u: np.ndarray  # grid coordinates of log f_p, [0, 1]
     v: np.ndarray  # and of mu_r
     density: np.ndarray  # (len(v), len(u))
-    noise_sd: list[float] = field(default_factory=list)  # per observable (its unit), set by the caller
-    noise_correlation: list[list[float]] = field(default_factory=list)
-    precision_factor: float = 1.0  # the covariance's correction for being estimated, set by the caller
-    lab_repeats: int = 1  # laboratory series averaged, set by the caller
-    lab_scatter_ratio: float | None = None  # their scatter over a simulated specimen's (repeats only)
+
+    def finite(self) -> bool:
+        return bool(np.isfinite(self.density).all())
 
     @property
     def fp_values(self) -> np.ndarray:
@@ -262,8 +318,129 @@ def posterior(ranges: Ranges, surrogates: list[Surrogate], lab_values, cov: np.n
     return Posterior(ranges, u, v, density / density.sum())
 
 
+#: walkers of the ensemble sampler (emcee's rule: at least twice the parameters; 32 as measured
+#: in docs/calibration.md, for 2 to 4 parameters)
+WALKERS = 32
+#: the chain's first length (steps of every walker); a quarter of the chain is discarded as burn-in
+CHAIN_STEPS = 2000
+#: the chain, burn-in discarded, must be this many autocorrelation times long (emcee's own default):
+#: its estimate of the autocorrelation time is reliable only then
+AUTOCORR_MULTIPLE = 50
+#: the longest chain: doubled from CHAIN_STEPS until long enough, refused beyond
+MAX_CHAIN_STEPS = 64_000
+
+
+@dataclass
+class SampledPosterior(NoiseTerms):
+    """The posterior in d > 2 design coordinates as emcee's chain (burn-in discarded).
+
+    ``chain``: (samples, d) design coordinates, every walker's steps after the burn-in;
+    ``log_prob``: each sample's log posterior (up to a constant); ``steps``, ``burn_in``:
+    of each walker; ``autocorrelation``: the integrated autocorrelation time per coordinate (steps).
+    """
+
+    ranges: Ranges
+    chain: np.ndarray
+    log_prob: np.ndarray
+    steps: int
+    burn_in: int
+    autocorrelation: list[float]
+    walkers: int = WALKERS
+
+    def finite(self) -> bool:
+        return bool(np.isfinite(self.chain).all() and np.isfinite(self.log_prob).all())
+
+    def best(self) -> tuple[float, ...]:
+        """The chain's sample of the highest posterior (f_p, mu_r, kn, ks as calibrated)."""
+        row = self.chain[int(np.argmax(self.log_prob))]
+        return tuple(float(x[0]) for x in self.ranges.from_unit(row))
+
+    def interval(self, axis: str, level: float) -> tuple[float, float]:
+        """The central credible interval of one parameter's marginal: the chain's quantiles."""
+        tail = (1.0 - level) / 2.0
+        q = np.quantile(self.chain[:, self.ranges.axes.index(axis)], [tail, 1.0 - tail])
+        lo, hi = self.ranges.axis_values(axis, q)
+        return float(lo), float(hi)
+
+    def median(self, axis: str) -> float:
+        return self.interval(axis, 0.0)[0]
+
+    def correlation(self, a: str = "fp", b: str = "mu_r") -> float:
+        """The posterior correlation of two design coordinates (near +-1: a ridge)."""
+        axes = self.ranges.axes
+        return float(np.corrcoef(self.chain[:, axes.index(a)], self.chain[:, axes.index(b)])[0, 1])
+
+    def draw(self, n: int, seed: int) -> list[tuple[float, ...]]:
+        """Up to ``n`` distinct samples of the chain (the second round's design): the chain is
+        distributed as the posterior, so each sample is equally likely."""
+        rng = np.random.default_rng(seed)
+        picks = rng.choice(len(self.chain), size=min(n, len(self.chain)), replace=False)
+        return list(dict.fromkeys(rounded(*self.ranges.from_unit(self.chain[picks]))))
+
+
+def log_posterior(surrogates: list[Surrogate], lab_values, precision: np.ndarray):
+    """The log posterior of design coordinates ``x`` (walkers x d; a flat prior on the unit cube):
+    the Gaussian log-likelihood of the laboratory values, -inf outside the cube."""
+    lab = np.asarray(lab_values, float)
+
+    def log_prob(x: np.ndarray) -> np.ndarray:
+        misfit = np.column_stack([s.mean(x) for s in surrogates]) - lab
+        lp = -0.5 * np.einsum("ki,ij,kj->k", misfit, precision, misfit)
+        inside = np.all((x >= 0.0) & (x <= 1.0), axis=1)
+        return np.where(inside, lp, -np.inf)
+
+    return log_prob
+
+
+def sampled_posterior(
+    ranges: Ranges, surrogates: list[Surrogate], lab_values, cov: np.ndarray, seed: int,
+    steps: int = CHAIN_STEPS,
+) -> SampledPosterior:  # fmt: skip
+    """The posterior of d > 2 parameters sampled by emcee's ensemble on the surrogates.
+
+    The walkers start uniform in the unit cube; the sampler's own random state and the start
+    come from ``seed``, so the same inputs give the same chain bit for bit. The chain is doubled
+    until its part after the burn-in (a quarter) spans :data:`AUTOCORR_MULTIPLE` autocorrelation
+    times; a chain still shorter at :data:`MAX_CHAIN_STEPS` is refused (its intervals would be
+    the sampler's noise, not the posterior's).
+    """
+    import emcee
+
+    rng = np.random.default_rng(seed)
+    start = rng.random((WALKERS, ranges.dim))
+    log_prob = log_posterior(surrogates, lab_values, np.linalg.inv(cov))
+    sampler = emcee.EnsembleSampler(WALKERS, ranges.dim, log_prob, vectorize=True)
+    sampler.random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
+    sampler.run_mcmc(start, steps, progress=False)
+    while True:
+        burn = steps // 4
+        tau = sampler.get_autocorr_time(discard=burn, tol=0)
+        if np.all(np.isfinite(tau)) and steps - burn >= AUTOCORR_MULTIPLE * float(tau.max()):
+            break
+        if 2 * steps > MAX_CHAIN_STEPS:
+            raise RuntimeError(
+                f"the posterior chain of {WALKERS} walkers x {steps} steps spans only"
+                f" {(steps - burn) / float(np.nanmax(tau)):.0f} autocorrelation times"
+                f" (needs {AUTOCORR_MULTIPLE}): no answer is reported"
+            )
+        sampler.run_mcmc(None, steps, progress=False)
+        steps *= 2
+    return SampledPosterior(
+        ranges,
+        sampler.get_chain(discard=burn, flat=True),
+        sampler.get_log_prob(discard=burn, flat=True),
+        steps,
+        burn,
+        [float(t) for t in tau],
+    )
+
+
 __all__ = [
+    "AXES",
     "GRID",
+    "SampledPosterior",
+    "n_coefficients",
+    "sampled_posterior",
     "WIDE_FRACTION",
     "Posterior",
     "Ranges",
