@@ -15,6 +15,14 @@ from typing import Any
 
 from poro2d.record import Record, Spliced
 
+#: the key of each calibrated parameter (an axis of :mod:`poro2d.calibration.model`) in the files
+PARAMETER_KEYS = {
+    "fp": "particle_friction",
+    "mu_r": "rolling_friction",
+    "kn": "particle_kn",
+    "ks": "particle_ks",
+}
+
 
 def target_key(observable: str, normal_stress_kpa: float) -> str:
     """How a file names an observable at a normal stress (``peak_50kPa``): in ``evaluations`` and ``fit``."""
@@ -45,24 +53,33 @@ class Observed(Record):
 
 @dataclass(frozen=True, eq=False)
 class DesignPoint(Record, Mapping):
-    """One evaluated design point (a row of ``evaluations``): the parameter pair, then each
-    observable's replicate values in the order of the laboratory targets.
+    """One evaluated design point (a row of ``evaluations``): the parameter pair (and the disks'
+    stiffnesses ``particle_kn``, ``particle_ks`` in N/m when they are calibrated: absent from the
+    row otherwise), then each observable's replicate values in the order of the laboratory targets.
 
     It reads as the dict of its row (``point["peak_50kPa"]``, equal to the row read from a
     file), as a result's other parts do.
     """
 
-    ROW = ("particle_friction", "rolling_friction", Spliced("observed"))
+    ROW = ("particle_friction", "rolling_friction", "particle_kn", "particle_ks", Spliced("observed"))
+    OMITTED = {"particle_kn": None, "particle_ks": None}
 
     particle_friction: float
     rolling_friction: float
     observed: tuple[Observed, ...]
+    particle_kn: float | None = None
+    particle_ks: float | None = None
 
     @classmethod
     def from_dict(cls, row: Mapping[str, Any]) -> DesignPoint:
         """A design point from its row in a file: every key beside the pair is an observable."""
         observed = tuple(Observed.from_key(k, v) for k, v in row.items() if k not in cls.ROW)
-        return cls(row["particle_friction"], row["rolling_friction"], observed)
+        stiffness = {k: row[k] for k in ("particle_kn", "particle_ks") if k in row}
+        return cls(row["particle_friction"], row["rolling_friction"], observed, **stiffness)
+
+    def parameters(self, axes: tuple[str, ...]) -> tuple[float, ...]:
+        """The point's values of the calibrated parameters ``axes`` (:data:`PARAMETER_KEYS`' keys)."""
+        return tuple(getattr(self, PARAMETER_KEYS[a]) for a in axes)
 
     # read-only mapping access: the point reads as the dict of its row
     def __getitem__(self, key: str) -> Any:
@@ -75,4 +92,4 @@ class DesignPoint(Record, Mapping):
         return len(self.to_dict())
 
 
-__all__ = ["DesignPoint", "Observed", "target_key"]
+__all__ = ["PARAMETER_KEYS", "DesignPoint", "Observed", "target_key"]

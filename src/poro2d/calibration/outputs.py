@@ -42,19 +42,27 @@ def _best_curves(
     result, stresses, specimens: SpecimenSet, make, cache: Store
 ) -> tuple[dict[float, list], DesignPoint]:
     """The curves of the design point nearest the best parameters, per normal stress (all
-    specimens), and that design point: what the fit figure draws."""
+    specimens), and that design point: what the fit figure draws. Near in log f_p and mu_r (the
+    two-parameter rule), and in log kn and log ks over their decades when they are calibrated."""
     best = result.best
-    nearest = min(
-        result.evaluations,
-        key=lambda e: (
-            (math.log(e.particle_friction / best["particle_friction"])) ** 2
-            + (e.rolling_friction - best["rolling_friction"]) ** 2
-        ),
-    )
+    stiffness = [k for k in ("particle_kn", "particle_ks") if best.get(k) is not None]
+
+    def distance(e: DesignPoint) -> float:
+        d = (math.log(e.particle_friction / best["particle_friction"])) ** 2
+        d += (e.rolling_friction - best["rolling_friction"]) ** 2
+        for k in stiffness:
+            lo, hi = result.ranges[k]
+            d += (math.log(getattr(e, k) / best[k]) / math.log(hi / lo)) ** 2
+        return d
+
+    nearest = min(result.evaluations, key=distance)
+    given = {k.removeprefix("particle_"): getattr(nearest, k) for k in stiffness}
     curves: dict[float, list] = {}
     for s in stresses:
         for label in specimens:
-            unit = make(specimens, label, s, fp=nearest.particle_friction, mu_r=nearest.rolling_friction)
+            unit = make(
+                specimens, label, s, fp=nearest.particle_friction, mu_r=nearest.rolling_friction, **given
+            )
             curve = unit.curve(cache)
             if curve is not None:
                 curves.setdefault(s, []).append(curve)
@@ -75,9 +83,28 @@ def _known(result) -> str:
     """The intervals in a line of the config's header, or why they are unknown."""
     if result.unidentified is not None:
         return f"NOT IDENTIFIED, intervals unknown: {result.unidentified}"
-    fp_lo, fp_hi = result.intervals["particle_friction"]
-    mr_lo, mr_hi = result.intervals["rolling_friction"]
-    return f"{result.level:.0%} intervals: f_p {fp_lo:.3g} to {fp_hi:.3g}, mu_r {mr_lo:.3g} to {mr_hi:.3g}"
+    names = {"particle_friction": "f_p", "rolling_friction": "mu_r", "particle_kn": "kn", "particle_ks": "ks"}
+    spans = [
+        f"{names[k]} {lo:.3g} to {hi:.3g}" + (" N/m" if k in _STIFFNESS else "")
+        for k, (lo, hi) in result.intervals.items()
+        if k in names
+    ]
+    return f"{result.level:.0%} intervals: " + ", ".join(spans)
+
+
+#: the calibrated stiffnesses: their key in a result and in a ``[specimen]`` table
+_STIFFNESS = {"particle_kn": "kn_particle", "particle_ks": "ks_particle"}
+
+
+def _specimen_lines(best) -> list[str]:
+    """The ``[specimen]`` table's calibrated values: both frictions, and kn, ks where calibrated."""
+    lines = [
+        f"friction_particle = {_toml_value(best['particle_friction'])}",
+        f"rolling_friction = {_toml_value(best['rolling_friction'])}",
+    ]
+    return lines + [
+        f"{name} = {_toml_value(best[k])}" for k, name in _STIFFNESS.items() if best.get(k) is not None
+    ]
 
 
 def _biaxial_config(result, stresses) -> str:
@@ -93,8 +120,7 @@ def _biaxial_config(result, stresses) -> str:
         f"# ({_known(result)}); see result.json and calibration.md before using them",
         "",
         "[specimen]",
-        f"friction_particle = {_toml_value(b['particle_friction'])}",
-        f"rolling_friction = {_toml_value(b['rolling_friction'])}",
+        *_specimen_lines(b),
         "",
         "[biaxial]",
     ] + [f"{k} = {_toml_value(v)}" for k, v in table.items()]
@@ -107,18 +133,18 @@ def _config(result, lab) -> str:
     for a new specimen (``poro2d criterion``) to export with ``poro2d export``."""
     b = result.best
     shear = {k: v for k, v in result.settings.items() if v is not None}
-    shear.update(
-        particle_friction=b["particle_friction"],
-        rolling_friction=b["rolling_friction"],
-        normal_stress_kpa=lab.normal_stresses(),
+    shear.update(particle_friction=b["particle_friction"], rolling_friction=b["rolling_friction"])
+    shear.update({k: b[k] for k in _STIFFNESS if b.get(k) is not None})
+    shear.update(normal_stress_kpa=lab.normal_stresses())
+    what = "particle and rolling friction" + (
+        " and the disks' stiffness" if any(b.get(k) is not None for k in _STIFFNESS) else ""
     )
     lines = [
-        "# poro2d calibrate: the posterior maximum of particle and rolling friction",
+        f"# poro2d calibrate: the posterior maximum of {what}",
         f"# ({_known(result)}); see result.json and calibration.md before using them",
         "",
         "[specimen]",
-        f"friction_particle = {_toml_value(b['particle_friction'])}",
-        f"rolling_friction = {_toml_value(b['rolling_friction'])}",
+        *_specimen_lines(b),
         "",
         "[shear]",
     ] + [f"{k} = {_toml_value(v)}" for k, v in shear.items()]

@@ -1,4 +1,5 @@
-"""``run_calibration``: the micro-parameters (f_p, mu_r) that reproduce laboratory direct shear.
+"""``run_calibration``: the micro-parameters (f_p, mu_r; optionally the disks' kn and ks) that
+reproduce laboratory direct shear.
 
 Every evaluation of a parameter pair is a shear test per replicate specimen and per
 laboratory normal stress (the units, :mod:`poro2d.calibration.units`), run on Dask.
@@ -31,7 +32,7 @@ from poro2d.calibration.biaxial import (
     read_biaxial_lab,
 )
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
-from poro2d.calibration.evaluations import DesignPoint, Observed, target_key
+from poro2d.calibration.evaluations import PARAMETER_KEYS, DesignPoint, Observed, target_key
 from poro2d.calibration.identifiable import check_enough_lab_values
 from poro2d.calibration.lab_repeats import LabRepeats, lab_scatter_ratio, lab_share, mean_targets
 from poro2d.calibration.specimens import (
@@ -51,7 +52,12 @@ from poro2d.shear.box_scale import BoxScale, box_scale
 from poro2d.shear.lab import LabData
 from poro2d.shear.parts import LabRecord, ShearSettingsRecord
 from poro2d.shear.series import check_stresses
-from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
+from poro2d.shear.settings import (
+    MAX_FRICTION,
+    MAX_ROLLING_FRICTION,
+    PARTICLE_STIFFNESS_RANGE,
+    ShearSettings,
+)
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 from poro2d.typed_result import Keyed, TypedResult, part
@@ -74,14 +80,32 @@ RESIDUAL_DOF = 3
 MIN_POINTS = model.N_COEFFICIENTS + RESIDUAL_DOF
 #: the settings calibrated here: given ones would be overridden, so they are refused
 CALIBRATED = ("particle_friction", "rolling_friction")
+#: the names of the stiffness options, per axis
+STIFFNESS_OPTIONS = {"kn": "--kn-range", "ks": "--ks-range"}
+
+
+def min_points(d: int) -> int:
+    """The fewest design points of the first round in ``d`` parameters: the quadratic's
+    (d + 1)(d + 2) / 2 coefficients and :data:`RESIDUAL_DOF` more (9, 13 and 18 for 2, 3, 4)."""
+    return model.n_coefficients(d) + RESIDUAL_DOF
+
+
+#: the disks' stiffnesses (N/m) beside the frictions of a calibration's records: absent from the
+#: file of a calibration that did not calibrate them
+STIFFNESS_KEYS = ("particle_kn", "particle_ks")
 
 
 @dataclass(eq=False)
 class FrictionValues(TypedResult):
-    """A value per calibrated parameter: the posterior maximum or median of f_p and mu_r."""
+    """A value per calibrated parameter: the posterior maximum or median of f_p and mu_r (and of
+    the disks' kn, ks in N/m when calibrated)."""
 
     particle_friction: float
     rolling_friction: float
+    particle_kn: float | None = None
+    particle_ks: float | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = STIFFNESS_KEYS
 
 
 @dataclass(eq=False)
@@ -90,6 +114,10 @@ class FrictionBounds(TypedResult):
 
     particle_friction: list[float] | None
     rolling_friction: list[float] | None
+    particle_kn: list[float] | None = None
+    particle_ks: list[float] | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = STIFFNESS_KEYS
 
 
 @dataclass(eq=False)
@@ -98,6 +126,23 @@ class FrictionFlags(TypedResult):
 
     particle_friction: bool | None
     rolling_friction: bool | None
+    particle_kn: bool | None = None
+    particle_ks: bool | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = STIFFNESS_KEYS
+
+
+@dataclass(eq=False)
+class ChainRecord(TypedResult):
+    """The emcee chain a posterior in more than two parameters was sampled with: walkers, steps of
+    each (the burn-in included), the burn-in discarded and the autocorrelation time per parameter
+    (steps, in the order of ``ranges``)."""
+
+    sampler: str
+    walkers: int
+    steps: int
+    burn_in: int
+    autocorrelation_steps: list[float]
 
 
 @dataclass(eq=False)
@@ -203,13 +248,16 @@ class PosteriorSummary(TypedResult):
     #: over a simulated specimen's; absent from the file of a calibration against one series
     lab_repeats: int | None = None
     lab_scatter_ratio: float | None = None
+    #: with kn or ks calibrated (``grid`` None): the chain the posterior was sampled with
+    chain: ChainRecord | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("precision_factor", "lab_repeats", "lab_scatter_ratio")
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("precision_factor", "lab_repeats", "lab_scatter_ratio", "chain")
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "median": FrictionValues,
         "wide": FrictionFlags,
         "observables": FittedObservable,
+        "chain": ChainRecord,
     }
 
 
@@ -303,15 +351,17 @@ def check_range_pair(name: str, value, lo: float, hi: float, lo_open: bool = Fal
     return float(a), float(b)
 
 
-def _base_settings(settings: dict | None) -> ShearSettings:
+def _base_settings(settings: dict | None, calibrated: tuple[str, ...] = CALIBRATED) -> ShearSettings:
     """The shear settings of every test (frictions apart); ``stop_after_peak`` 0 by default so
     that every test ends at ``max_displacement``, where the end stress is compared.
 
-    ``settings``: the caller's table of shear settings (a command's options), read once here."""
+    ``settings``: the caller's table of shear settings (a command's options), read once here;
+    ``calibrated``: the settings the calibration sets (a disk stiffness given is kept when it is
+    not calibrated)."""
     given = dict(settings or {})
     if not isinstance(settings, dict | None):
         raise InputError("settings", type(settings).__name__, "a dict of shear settings or None")
-    for name in CALIBRATED:
+    for name in calibrated:
         if name in given:
             raise InputError(f"settings.{name}", given[name], "not given: it is calibrated")
     given.setdefault("stop_after_peak", 0.0)
@@ -379,6 +429,8 @@ def run_calibration(
     seed: int = 0,
     fp_range=DEFAULT_FP_RANGE,
     mu_r_range=DEFAULT_MU_R_RANGE,
+    kn_range=None,
+    ks_range=None,
     points: int = 12,
     refine: int = 6,
     design_seed: int = 0,
@@ -396,7 +448,10 @@ def run_calibration(
 
     ``specimens``: checkpoints or criterion folders, or ``preset="paper"`` (``quick``: the
     small box) with ``replicates`` seeds from ``seed``. ``fp_range``, ``mu_r_range``: the
-    search ranges. ``points``: the space-filling design's size; ``refine``: points of the
+    search ranges. ``kn_range``, ``ks_range``: (low, high) N/m to calibrate the disks' normal and
+    shear stiffness too, searched in their logarithm (None: the specimen's, or the settings');
+    with either, the posterior is sampled with emcee (docs/calibration.md).
+    ``points``: the space-filling design's size; ``refine``: points of the
     second round, drawn from the posterior (0: none). ``lab_error``: the laboratory's own
     error as a fraction of each value, added to the seed scatter. ``level``: of the
     credible intervals. ``stations``: with laboratory curves, each curve is also read (shear stress,
@@ -435,14 +490,16 @@ def run_calibration(
     ranges = model.Ranges(
         check_range_pair("--fp-range", fp_range, 0.0, MAX_FRICTION, lo_open=True),
         check_range_pair("--mu-r-range", mu_r_range, 0.0, MAX_ROLLING_FRICTION),
+        **_stiffness_ranges(kn_range, ks_range, biaxial),
     )
+    fewest = min_points(ranges.dim)
     try:
-        points = check_int("--points", points, MIN_POINTS, MAX_POINTS)
+        points = check_int("--points", points, fewest, MAX_POINTS)
     except InputError:
         raise InputError(
-            "--points", points, f"an integer in [{MIN_POINTS}, {MAX_POINTS}]",
-            f"the surrogate's {model.N_COEFFICIENTS} coefficients and {RESIDUAL_DOF} degrees of freedom"
-            " to estimate its residual",
+            "--points", points, f"an integer in [{fewest}, {MAX_POINTS}]",
+            f"the surrogate's {model.n_coefficients(ranges.dim)} coefficients and {RESIDUAL_DOF} degrees"
+            " of freedom to estimate its residual",
         ) from None  # fmt: skip
     refine = check_int("--refine", refine, 0, MAX_POINTS)
     design_seed = check_int("--design-seed", design_seed, 0)
@@ -450,7 +507,8 @@ def run_calibration(
     check_range("--level", level, 0.0, 1.0, lo_open=True, hi_open=True)
     if settings is None and quick and not biaxial:
         settings = dict(QUICK_SHEAR)
-    base = base_settings(settings, CALIBRATED) if biaxial else _base_settings(settings)
+    calibrated = CALIBRATED + tuple(PARAMETER_KEYS[a] for a in ranges.axes[2:])
+    base = base_settings(settings, CALIBRATED) if biaxial else _base_settings(settings, calibrated)
     stations = check_int("--stations", stations, 1, MAX_STATIONS)
     if stations > 1 and not biaxial and not lab_data.curves:
         why = "readings along a curve need the lab curves"
@@ -460,7 +518,7 @@ def run_calibration(
         targets = biaxial_targets(lab_data, base, stations)
     else:
         targets, lab_series = mean_targets([_lab_targets(x, base, stations) for x in repeats.series])
-    check_enough_lab_values(lab_data.source, targets, len(CALIBRATED))
+    check_enough_lab_values(lab_data.source, targets, ranges.dim)
     check_noise_dof(points, len(given) if given is not None else replicates, len(targets))
     check_cluster_options(scheduler, workers)
     check_reachable(scheduler)
@@ -481,16 +539,16 @@ def run_calibration(
     cache = _child(store, CACHE)
     try:
         design = model.space_filling(ranges, points, design_seed)
-        rows = runner.run(_units(design, found, stresses, base, make), cache, "round 1")
+        rows = runner.run(_units(design, found, stresses, base, make, ranges.axes), cache, "round 1")
         post, surrogates, table = _infer(
-            ranges, design, found, stresses, rows, targets, lab_error, lab_series
+            ranges, design, found, stresses, rows, targets, lab_error, lab_series, design_seed
         )
         if refine:
             extra = [p for p in post.draw(refine, design_seed + 1) if p not in design]
             design = design + extra
-            rows += runner.run(_units(extra, found, stresses, base, make), cache, "round 2")
+            rows += runner.run(_units(extra, found, stresses, base, make, ranges.axes), cache, "round 2")
             post, surrogates, table = _infer(
-                ranges, design, found, stresses, rows, targets, lab_error, lab_series
+                ranges, design, found, stresses, rows, targets, lab_error, lab_series, design_seed
             )
     finally:
         runner.close()
@@ -518,6 +576,23 @@ def run_calibration(
 
         write_outputs(store, result, post, repeats, found, partial(make, base=base), stresses)
     return result
+
+
+def _stiffness_ranges(kn_range, ks_range, biaxial: bool) -> dict[str, tuple[float, float]]:
+    """The search ranges of the disks' stiffnesses that are calibrated (N/m), checked; refused
+    with biaxial laboratory tests, whose settings do not replace the disks' stiffness."""
+    given = {"kn": kn_range, "ks": ks_range}
+    out = {}
+    for axis, value in given.items():
+        if value is None:
+            continue
+        option = STIFFNESS_OPTIONS[axis]
+        if biaxial:
+            raise InputError(
+                option, value, "not given with --biaxial-lab", "kn and ks are calibrated on direct shear only"
+            )
+        out[axis] = check_range_pair(option, value, *PARTICLE_STIFFNESS_RANGE)
+    return out
 
 
 def _read_lab(lab, biaxial_lab) -> LabRepeats | LabTests:
@@ -561,13 +636,14 @@ def _child(store: Store | None, name: str) -> Store | None:
     return None if store is None else store.child(name)
 
 
-def _units(design, specimens: SpecimenSet, stresses, base, make=replicate_unit) -> list:
+def _units(design, specimens: SpecimenSet, stresses, base, make=replicate_unit, axes=("fp", "mu_r")) -> list:
     """The units of ``design``: per design point, per specimen, per normal (or confining) stress (the
     order of the rows :func:`_infer` reads; the units of more points follow those of the first).
-    ``make``: the unit of one test (:func:`replicate_unit`, or a biaxial one)."""
+    ``make``: the unit of one test (:func:`replicate_unit`, or a biaxial one); ``axes``: the
+    parameters of each design point (``kn``, ``ks`` after the two frictions when calibrated)."""
     return [
-        make(specimens, label, s, base, fp, mu_r)
-        for fp, mu_r in design
+        make(specimens, label, s, base, fp, mu_r, **dict(zip(axes[2:], stiffness, strict=True)))
+        for fp, mu_r, *stiffness in design
         for label in specimens
         for s in stresses
     ]
@@ -582,30 +658,33 @@ def _infer(
     targets,
     lab_error,
     lab_series=None,
+    seed: int = 0,
 ):
     """The surrogates (one per target), the posterior and the table of replicate values per design point.
 
     ``rows``: the units' rows in the order of :func:`_units` (None: the test failed);
-    ``lab_series``: every laboratory repeat's values (series x targets; None: one series)."""
+    ``lab_series``: every laboratory repeat's values (series x targets; None: one series); ``seed``:
+    of the sampler, when kn or ks are calibrated (the grid of two parameters needs none)."""
     per_point = len(specimens) * len(stresses)
     table = []
-    for k, (fp, mu_r) in enumerate(design):
+    for k, (fp, mu_r, *stiffness) in enumerate(design):
         point = rows[k * per_point : (k + 1) * per_point]
         observed = []
         for obs, s, _ in targets:
             at_s = point[stresses.index(s) :: len(stresses)]  # one row per specimen
             values = [row.observable(obs) if row is not None else float("nan") for row in at_s]
             observed.append(Observed(obs, s, values))
-        table.append(DesignPoint(fp, mu_r, tuple(observed)))
-    unit = ranges.to_unit([e.particle_friction for e in table], [e.rolling_friction for e in table])
+        given = {PARAMETER_KEYS[a]: v for a, v in zip(ranges.axes[2:], stiffness, strict=True)}
+        table.append(DesignPoint(fp, mu_r, tuple(observed), **given))
+    unit = ranges.to_unit(*zip(*(e.parameters(ranges.axes) for e in table), strict=True))
     values = np.array([[o.values for o in e.observed] for e in table], float)
     surrogates = []
     for k, (obs, s, _) in enumerate(targets):
         ok = np.isfinite(values[:, k]).any(axis=1)
-        if ok.sum() < MIN_POINTS:
+        if ok.sum() < min_points(ranges.dim):
             raise RuntimeError(
                 f"only {int(ok.sum())} design points have a {obs} at {s:g} kPa; "
-                f"the surrogate needs {MIN_POINTS}"
+                f"the surrogate needs {min_points(ranges.dim)}"
             )
         surrogates.append(model.fit_surrogate(unit[ok], values[ok, k]))
     lab_values = [y for *_, y in targets]
@@ -619,14 +698,17 @@ def _infer(
             cov = model.noise_covariance(surrogates, seed_cov, lab_values, lab_error, units, share)
             factor = _precision_factor(values, len(targets))
             cov = cov / factor
-            post = model.posterior(ranges, surrogates, lab_values, cov)
+            if ranges.dim == 2:
+                post = model.posterior(ranges, surrogates, lab_values, cov)
+            else:
+                post = model.sampled_posterior(ranges, surrogates, lab_values, cov, seed)
             post.precision_factor = factor
             post.lab_repeats, post.lab_scatter_ratio = count, ratio
             post.noise_sd = np.sqrt(np.diag(cov)).tolist()
             post.noise_correlation = (cov / np.sqrt(np.outer(np.diag(cov), np.diag(cov)))).round(3).tolist()
     except (FloatingPointError, np.linalg.LinAlgError) as exc:
         raise RuntimeError(f"the posterior cannot be computed ({exc}): no answer is reported") from None
-    if not np.isfinite(post.density).all():
+    if not post.finite():
         raise RuntimeError("the posterior is not finite: no answer is reported")
     return post, surrogates, table
 
@@ -646,6 +728,33 @@ def _precision_factor(values: np.ndarray, observables: int) -> float:
             " covariance cannot be estimated, no answer is reported"
         )
     return factor
+
+
+def _wide(ranges: model.Ranges, axis: str, lo: float, hi: float) -> bool:
+    """Whether an interval spans more than :data:`~poro2d.calibration.model.WIDE_FRACTION` of its
+    range, in the coordinate searched (the logarithm of f_p, kn and ks; mu_r itself)."""
+    r_lo, r_hi = getattr(ranges, axis)
+    if axis in model.LOG_AXES:
+        return bool(np.log(hi / lo) > model.WIDE_FRACTION * np.log(r_hi / r_lo))
+    return bool(hi - lo > model.WIDE_FRACTION * (r_hi - r_lo))
+
+
+def _prior(ranges: model.Ranges) -> str:
+    """The prior in words: the two-parameter text of earlier files, the stiffnesses added."""
+    if ranges.dim == 2:
+        return "uniform in log(f_p) and mu_r over the ranges"
+    words = {"fp": "log(f_p)", "mu_r": "mu_r", "kn": "log(kn)", "ks": "log(ks)"}
+    names = [words[a] for a in ranges.axes]
+    return f"uniform in {', '.join(names[:-1])} and {names[-1]} over the ranges"
+
+
+def _chain_record(post: model.SampledPosterior) -> ChainRecord:
+    import emcee
+
+    return ChainRecord(
+        sampler=f"emcee {emcee.__version__}", walkers=post.walkers, steps=post.steps, burn_in=post.burn_in,
+        autocorrelation_steps=[round(t, 1) for t in post.autocorrelation],
+    )  # fmt: skip
 
 
 def unidentified_reason(specimens: int, intervals: dict) -> str | None:
@@ -685,44 +794,37 @@ def _result(
     refine,
     stations=1,
 ) -> CalibrationResult:
-    fp, mu_r = post.best()
+    best = dict(zip(ranges.axes, post.best(), strict=True))
     biaxial = isinstance(lab_data, LabTests)
-    intervals = {
-        "particle_friction": list(post.interval("fp", level)),
-        "rolling_friction": list(post.interval("mu_r", level)),
-    }
-    spans = {"particle_friction": ranges.fp, "rolling_friction": ranges.mu_r}
-    wide: dict[str, bool | None] = {}
+    keys = {axis: PARAMETER_KEYS[axis] for axis in ranges.axes}
+    intervals = {keys[a]: list(post.interval(a, level)) for a in ranges.axes}
+    wide: dict[str, bool | None] = {keys[a]: _wide(ranges, a, *intervals[keys[a]]) for a in ranges.axes}
     unknown = unidentified_reason(len(found), intervals)
-    for name, (lo, hi) in intervals.items():
-        r_lo, r_hi = spans[name]
-        if name == "particle_friction":  # the fraction of the range in the coordinate searched: log f_p
-            wide[name] = bool(np.log(hi / lo) > model.WIDE_FRACTION * np.log(r_hi / r_lo))
-        else:
-            wide[name] = bool(hi - lo > model.WIDE_FRACTION * (r_hi - r_lo))
     if unknown is not None:
         intervals = dict.fromkeys(intervals)
         wide = dict.fromkeys(wide)
-    best_unit = ranges.to_unit([fp], [mu_r])
+    best_unit = ranges.to_unit(*best.values())
     fitted = [
         FittedObservable.of(obs, s, y, float(sg.mean(best_unit)[0]), sd)
         for (obs, s, y), sg, sd in zip(targets, surrogates, post.noise_sd, strict=True)
     ]
+    sampled = isinstance(post, model.SampledPosterior)
     return CalibrationResult(
-        best=FrictionValues(particle_friction=fp, rolling_friction=mu_r),
+        best=FrictionValues.from_dict({keys[a]: v for a, v in best.items()}),
         intervals=FrictionBounds.from_dict(intervals),
         level=level,
         posterior=PosteriorSummary(
-            median=FrictionValues(particle_friction=post.median("fp"), rolling_friction=post.median("mu_r")),
+            median=FrictionValues.from_dict({keys[a]: post.median(a) for a in ranges.axes}),
             correlation=post.correlation(),
             wide=FrictionFlags.from_dict(wide),
-            grid=model.GRID,
-            prior="uniform in log(f_p) and mu_r over the ranges",
+            grid=None if sampled else model.GRID,
+            prior=_prior(ranges),
             observables=fitted,
             noise_correlation=post.noise_correlation,
             precision_factor=post.precision_factor,
             lab_repeats=post.lab_repeats if post.lab_repeats > 1 else None,
             lab_scatter_ratio=post.lab_scatter_ratio,
+            chain=_chain_record(post) if sampled else None,
         ),
         evaluations=table,
         fit={
@@ -731,7 +833,7 @@ def _result(
         },
         lab=BiaxialLabRecord.of(lab_data) if biaxial else lab_data.record(),
         specimens={label: str(found[label]) for label in found},
-        ranges=FrictionBounds(list(ranges.fp), list(ranges.mu_r)),
+        ranges=FrictionBounds.from_dict({keys[a]: list(getattr(ranges, a)) for a in ranges.axes}),
         settings=base.record(),
         cluster=runner.info(),
         failures=runner.failures,
@@ -755,6 +857,7 @@ __all__ = [
     "DEFAULT_FP_RANGE",
     "DEFAULT_MU_R_RANGE",
     "CalibrationResult",
+    "ChainRecord",
     "FittedObservable",
     "PosteriorSummary",
     "run_calibration",

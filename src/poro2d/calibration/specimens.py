@@ -21,11 +21,12 @@ from poro2d.store import Store
 MAX_REPLICATES = 20
 
 
-def replicate_unit(specimens: SpecimenSet, label: str, sigma: float, base, fp: float, mu_r: float
-                   ) -> CalibrationUnit:  # fmt: skip
+def replicate_unit(specimens: SpecimenSet, label: str, sigma: float, base, fp: float, mu_r: float,
+                   **stiffness) -> CalibrationUnit:  # fmt: skip
     """The shear test of specimen ``label`` (of a read set) at ``sigma`` with the frictions (f_p, mu_r)
-    on ``base``: its key hashes the specimen's content, not where it lies."""
-    return CalibrationUnit.at(specimens[label], specimens.digest(label), sigma, base, fp, mu_r)
+    on ``base`` (``stiffness``: the disks' ``kn``, ``ks`` where calibrated): its key hashes the
+    specimen's content, not where it lies."""
+    return CalibrationUnit.at(specimens[label], specimens.digest(label), sigma, base, fp, mu_r, **stiffness)
 
 
 #: a two-sample Kolmogorov-Smirnov test of two specimens' radii below this p-value says they were

@@ -29,8 +29,13 @@ def synthetic_lab(
     settings: dict | None = None,
     work: Store | None = None,
     curves: bool = True,
+    particle_kn: float | None = None,
+    particle_ks: float | None = None,
 ) -> Path:
     """Shear ``specimen`` at each stress with the given frictions; write the lab CSV at ``path``.
+
+    ``particle_kn``, ``particle_ks``: the disks' stiffness (N/m; None: the specimen's), the truth of
+    a calibration of kn and ks.
 
     ``curves``: the whole curves (the lab curve layout, with the plate's rise as
     ``vertical_displacement_mm``: the dilation a calibration fits), else one peak per stress.
@@ -38,6 +43,9 @@ def synthetic_lab(
     The curves are the tests' own (:attr:`poro2d.shear.results.ShearTestResult.curve`).
     """
     base = dict(settings or {}, particle_friction=particle_friction, rolling_friction=rolling_friction)
+    base.update(
+        {k: v for k, v in (("particle_kn", particle_kn), ("particle_ks", particle_ks)) if v is not None}
+    )
     base.setdefault("stop_after_peak", 0.0)
     sset = ShearSettings(**base)
     path = Path(path)
@@ -45,6 +53,11 @@ def synthetic_lab(
     header = [
         "# SYNTHETIC laboratory data, not measured: made by poro2d's own direct shear",
         f"# at particle_friction = {particle_friction}, rolling_friction = {rolling_friction}",
+        *(
+            [f"# and the disks' particle_kn = {sset.particle_kn}, particle_ks = {sset.particle_ks} N/m"]
+            if sset.particle_kn is not None or sset.particle_ks is not None
+            else []
+        ),
         f"# on the specimen {specimen}",
         f"# shear settings: max_displacement = {sset.max_displacement} m, velocity = {sset.velocity} m/s",
     ]
@@ -98,6 +111,11 @@ def synthetic_biaxial_lab(
     header = [
         "# SYNTHETIC laboratory data, not measured: made by poro2d's own biaxial test",
         f"# at particle_friction = {particle_friction}, rolling_friction = {rolling_friction}",
+        *(
+            [f"# and the disks' particle_kn = {sset.particle_kn}, particle_ks = {sset.particle_ks} N/m"]
+            if sset.particle_kn is not None or sset.particle_ks is not None
+            else []
+        ),
         f"# on the specimen {specimen}",
         f"# biaxial settings: max_strain = {sset.max_strain}, record_strain = {sset.record_strain}",
         "# stress ratios below 0 (sigma_1 just under sigma_3 at the start) are written as 0",

@@ -136,13 +136,15 @@ class FrictionUnit:
     settings: dict[str, Any]
 
     @classmethod
-    def at(cls, specimen, digest: str, sigma: float, base, fp: float, mu_r: float):
-        """The unit of ``specimen`` at ``sigma`` with the frictions (f_p, mu_r) on the ``base`` settings.
+    def at(cls, specimen, digest: str, sigma: float, base, fp: float, mu_r: float, **stiffness):
+        """The unit of ``specimen`` at ``sigma`` with the frictions (f_p, mu_r) on the ``base`` settings
+        (``stiffness``: ``kn``, ``ks`` of the disks where calibrated, N/m; else the base's own).
 
         The settings are checked here, on the driver, before any work; the unit keeps them as
         the table its key hashes (and its worker reads back).
         """
-        settings = replace(base, particle_friction=fp, rolling_friction=mu_r)
+        given = {f"particle_{k}": v for k, v in stiffness.items() if v is not None}
+        settings = replace(base, particle_friction=fp, rolling_friction=mu_r, **given)
         return cls(str(specimen), digest, float(sigma), settings.record().to_dict())
 
     @property

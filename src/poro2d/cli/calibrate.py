@@ -1,4 +1,5 @@
-"""``poro2d calibrate``: particle and rolling friction from laboratory direct shear."""
+"""``poro2d calibrate``: particle and rolling friction (and optionally the disks' kn and ks) from
+laboratory direct shear."""
 
 from __future__ import annotations
 
@@ -15,7 +16,9 @@ _WORKERS = "LocalCluster worker processes (default: one per core)."
 _DASHBOARD = "LocalCluster dashboard: HOST:PORT or none (default 127.0.0.1:0, this machine only)."
 
 
-def parse_range(option: str, text: str | None, default: tuple[float, float]) -> tuple[float, float]:
+def parse_range(
+    option: str, text: str | None, default: tuple[float, float] | None
+) -> tuple[float, float] | None:
     """``LOW,HIGH`` as two numbers (checked against the allowed range later), or the default."""
     from poro2d.errors import InputError
 
@@ -55,7 +58,15 @@ def register(app: typer.Typer) -> None:
         seed: int = typer.Option(0, "--seed", help="First seed of the preset's specimens."),
         fp_range: str = typer.Option(None, "--fp-range", help="Particle friction range LOW,HIGH (0.3,3)."),
         mu_r_range: str = typer.Option(None, "--mu-r-range", help="Rolling friction range LOW,HIGH (0,0.5)."),
-        points: int = typer.Option(12, "--points", help="Design points of round 1 (9-500)."),
+        kn_range: str = typer.Option(
+            None, "--kn-range", help="Also calibrate the disks' normal stiffness kn: range LOW,HIGH (N/m)."
+        ),
+        ks_range: str = typer.Option(
+            None, "--ks-range", help="Also calibrate the disks' shear stiffness ks: range LOW,HIGH (N/m)."
+        ),
+        points: int = typer.Option(
+            12, "--points", help="Design points of round 1 (9-500; 13 with kn or ks, 18 with both)."
+        ),
         refine: int = typer.Option(
             6, "--refine", help="Points of round 2, drawn from the posterior (0: none)."
         ),
@@ -95,6 +106,7 @@ def register(app: typer.Typer) -> None:
             "seed": seed,
             "fp_range": fp_range,
             "mu_r_range": mu_r_range,
+            **{k: v for k, v in (("kn_range", kn_range), ("ks_range", ks_range)) if v is not None},
             "max_displacement": max_displacement,
             **({"max_strain": max_strain} if max_strain is not None else {}),
         }
@@ -110,6 +122,8 @@ def register(app: typer.Typer) -> None:
                 seed=seed,
                 fp_range=parse_range("--fp-range", fp_range, DEFAULT_FP_RANGE),
                 mu_r_range=parse_range("--mu-r-range", mu_r_range, DEFAULT_MU_R_RANGE),
+                kn_range=parse_range("--kn-range", kn_range, None),
+                ks_range=parse_range("--ks-range", ks_range, None),
                 points=points,
                 refine=refine,
                 design_seed=design_seed,
@@ -146,9 +160,15 @@ def test_settings(biaxial: bool, max_displacement: float | None, max_strain: flo
 
 
 def print_result(result, out: Path) -> None:
-    from poro2d.report.calibration_report import box_note, identifiability_note, interval_text, repeats_note
+    from poro2d.report.calibration_report import (
+        box_note,
+        calibrated,
+        identifiability_note,
+        interval_text,
+        repeats_note,
+    )
 
-    for name, label in (("particle_friction", "f_p"), ("rolling_friction", "mu_r")):
+    for name, label, _ in calibrated(result):
         console.print(f"  {label:<5} {interval_text(result, name)}")
     console.print(f"  {identifiability_note(result)}")
     if repeats_note(result):

@@ -177,7 +177,10 @@ def _plot_targets(ax, observed: list, marker: str, label: str) -> None:
 def plot_calibration_posterior(result, post, path: str | os.PathLike) -> Path:
     """The posterior density over (f_p, mu_r) with the evaluated design points, its maximum and
     the intervals of ``result`` shaded; ``post`` holds the grid (``fp_values``, ``mu_r_values``,
-    ``density``)."""
+    ``density``), or, when the disks' stiffnesses were calibrated too, the sampler's chain
+    (``chain``, ``ranges``): then a corner of pairwise marginals (:func:`plot_posterior_corner`)."""
+    if getattr(post, "chain", None) is not None:
+        return plot_posterior_corner(result, post, path)
     fig, ax = plt.subplots(figsize=(6.2, 4.8))
     fp, mu_r = post.fp_values, post.mu_r_values
     mesh = ax.pcolormesh(fp, mu_r, post.density / post.density.max(), shading="auto", cmap="viridis")
@@ -214,4 +217,80 @@ def plot_calibration_posterior(result, post, path: str | os.PathLike) -> Path:
     return save_figure(fig, path)
 
 
-__all__ = ["plot_calibration_fit", "plot_calibration_posterior"]
+#: the label and the key in a result of each axis of a posterior (``post.ranges.axes``)
+_AXES = {
+    "fp": ("particle friction f_p", "particle_friction"),
+    "mu_r": ("rolling friction mu_r", "rolling_friction"),
+    "kn": ("disk kn (N/m)", "particle_kn"),
+    "ks": ("disk ks (N/m)", "particle_ks"),
+}
+#: bins per axis of the corner's histograms
+CORNER_BINS = 30
+
+
+def plot_posterior_corner(result, post, path: str | os.PathLike) -> Path:
+    """A corner of the sampled posterior: each parameter's marginal on the diagonal (its interval of
+    ``result`` shaded), each pair's joint histogram below it with the design points and the maximum.
+
+    Drawn in design coordinates, so that the logarithmic axes (f_p, kn, ks) are evenly binned; the
+    ticks are labelled in the parameters' values."""
+    axes = post.ranges.axes
+    d = len(axes)
+    fig, grid = plt.subplots(d, d, figsize=(2.2 * d, 2.2 * d), squeeze=False)
+    design = post.ranges.to_unit(*zip(*(e.parameters(axes) for e in result.evaluations), strict=True))
+    best = post.ranges.to_unit(*(result.best[_AXES[a][1]] for a in axes))[0]
+    for i in range(d):
+        for j in range(d):
+            ax = grid[i][j]
+            if j > i:
+                ax.axis("off")
+            elif i == j:
+                _corner_marginal(ax, result, post, axes[i])
+            else:
+                ax.hist2d(post.chain[:, j], post.chain[:, i], bins=CORNER_BINS, range=[[0, 1], [0, 1]],
+                          cmap="viridis")  # fmt: skip
+                ax.plot(design[:, j], design[:, i], "w.", ms=4, mec="k")
+                ax.plot(best[j], best[i], "r*", ms=9)
+                _corner_ticks(ax.set_yticks, ax.set_yticklabels, post, axes[i])
+            if i == d - 1:
+                _corner_ticks(ax.set_xticks, ax.set_xticklabels, post, axes[j])
+                ax.set_xlabel(_AXES[axes[j]][0], fontsize=8)
+            if j == 0 and i > 0:
+                ax.set_ylabel(_AXES[axes[i]][0], fontsize=8)
+    fig.suptitle(
+        f"posterior sampled with emcee ({len(post.chain):,} samples); white: design points, red: maximum;"
+        f" shaded: {result.level:.0%} intervals",
+        fontsize=9,
+    )
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def _corner_marginal(ax, result, post, axis: str) -> None:
+    """One parameter's marginal histogram, its interval shaded when known."""
+    k = post.ranges.axes.index(axis)
+    ax.hist(post.chain[:, k], bins=CORNER_BINS, range=(0, 1), color="0.4")
+    interval = result.intervals.get(_AXES[axis][1])
+    if interval is not None:
+        lo, hi = post.ranges.to_unit(*_at_axis(result, post, axis, interval))[:, k]
+        ax.axvspan(lo, hi, color="tab:blue", alpha=0.2)
+    ax.set_yticks([])
+    ax.set_xlim(0, 1)
+
+
+def _at_axis(result, post, axis: str, values) -> list:
+    """Parameter columns for :meth:`to_unit` that hold ``values`` on ``axis`` (the best elsewhere)."""
+    return [
+        np.asarray(values, float) if a == axis else np.full(len(values), result.best[_AXES[a][1]])
+        for a in post.ranges.axes
+    ]
+
+
+def _corner_ticks(set_ticks, set_labels, post, axis: str) -> None:
+    """Ticks at 0, 1/2 and 1 of a design coordinate, labelled with the parameter's values there."""
+    ticks = np.array([0.0, 0.5, 1.0])
+    set_ticks(ticks)
+    set_labels([f"{v:.3g}" for v in post.ranges.axis_values(axis, ticks)], fontsize=7)
+
+
+__all__ = ["plot_calibration_fit", "plot_calibration_posterior", "plot_posterior_corner"]

@@ -6,6 +6,19 @@ from pathlib import Path
 
 from poro2d.report.document import write_report
 
+#: every parameter a calibration may calibrate: its key in the result, its symbol and its name
+PARAMETERS = (
+    ("particle_friction", "f_p", "particle friction"),
+    ("rolling_friction", "mu_r", "rolling friction"),
+    ("particle_kn", "kn", "disk normal stiffness (N/m)"),
+    ("particle_ks", "ks", "disk shear stiffness (N/m)"),
+)
+
+
+def calibrated(result) -> list[tuple[str, str, str]]:
+    """The parameters ``result`` calibrated (:data:`PARAMETERS` whose range it holds)."""
+    return [p for p in PARAMETERS if result.ranges.get(p[0]) is not None]
+
 
 def interval_text(result, name: str) -> str:
     if result.intervals[name] is None:  # a design that cannot estimate its noise (``unidentified``)
@@ -31,7 +44,8 @@ def identifiability_note(result) -> str:
             " figure) better than either one."
         )
     if wide:
-        names = " and ".join("f_p" if n == "particle_friction" else "mu_r" for n in wide)
+        symbols = {key: symbol for key, symbol, _ in PARAMETERS}
+        names = " and ".join(symbols[n] for n in wide)
         verb = "spans" if len(wide) == 1 else "span"
         text += (
             f" The interval of {names} {verb} more than half the search range: these data do not identify"
@@ -46,7 +60,11 @@ def identifiability_note(result) -> str:
             )
         )
     else:
-        text += " Both intervals are narrower than half their search ranges."
+        text += (
+            " Both intervals are narrower than half their search ranges."
+            if len(result.posterior["wide"]) == 2
+            else " Every interval is narrower than half its search range."
+        )
     return text
 
 
@@ -110,7 +128,11 @@ def calibration_blocks(result, out: Path) -> list[tuple]:
     header, rows = fit_table(result.posterior["observables"])
     info = result.cluster
     return [
-        ("h2", "Calibration of particle and rolling friction"),
+        (
+            "h2",
+            "Calibration of particle and rolling friction"
+            + (" and stiffness" if len(calibrated(result)) > 2 else ""),
+        ),
         (
             "p",
             f"Laboratory data: {result.lab['source']} ({result.lab['kind']}); "
@@ -118,10 +140,7 @@ def calibration_blocks(result, out: Path) -> list[tuple]:
         ),
         (
             "ul",
-            [
-                f"particle friction f_p = {interval_text(result, 'particle_friction')}",
-                f"rolling friction mu_r = {interval_text(result, 'rolling_friction')}",
-            ],
+            [f"{name} {symbol} = {interval_text(result, key)}" for key, symbol, name in calibrated(result)],
         ),
         ("p", identifiability_note(result)),
         *([("p", repeats_note(result))] if repeats_note(result) else []),
@@ -135,7 +154,9 @@ def calibration_blocks(result, out: Path) -> list[tuple]:
         (
             "img",
             str(out / "calibration_posterior.png"),
-            "The posterior over (f_p, mu_r), with the evaluated points.",
+            "The posterior over (f_p, mu_r), with the evaluated points."
+            if len(calibrated(result)) == 2
+            else "The pairwise marginals of the sampled posterior, with the evaluated points.",
         ),
         (
             "p",
@@ -150,7 +171,9 @@ def write_calibration_report(out: Path, result) -> list[Path]:
 
 
 __all__ = [
+    "PARAMETERS",
     "box_note",
+    "calibrated",
     "calibration_blocks",
     "fit_table",
     "interval_text",
