@@ -252,8 +252,9 @@ def plot_posterior_corner(result, post, path: str | os.PathLike) -> Path:
                 ax.plot(design[:, j], design[:, i], "w.", ms=4, mec="k")
                 ax.plot(best[j], best[i], "r*", ms=9)
                 _corner_ticks(ax.set_yticks, ax.set_yticklabels, post, axes[i])
+            if j <= i:  # the tick labels in the parameters' values, on the bottom row only
+                _corner_ticks(ax.set_xticks, ax.set_xticklabels, post, axes[j], shown=i == d - 1)
             if i == d - 1:
-                _corner_ticks(ax.set_xticks, ax.set_xticklabels, post, axes[j])
                 ax.set_xlabel(_AXES[axes[j]][0], fontsize=8)
             if j == 0 and i > 0:
                 ax.set_ylabel(_AXES[axes[i]][0], fontsize=8)
@@ -286,11 +287,13 @@ def _at_axis(result, post, axis: str, values) -> list:
     ]
 
 
-def _corner_ticks(set_ticks, set_labels, post, axis: str) -> None:
-    """Ticks at 0, 1/2 and 1 of a design coordinate, labelled with the parameter's values there."""
+def _corner_ticks(set_ticks, set_labels, post, axis: str, shown: bool = True) -> None:
+    """Ticks at 0, 1/2 and 1 of a design coordinate, labelled with the parameter's values there
+    (``shown`` False: unlabelled)."""
     ticks = np.array([0.0, 0.5, 1.0])
     set_ticks(ticks)
-    set_labels([f"{v:.3g}" for v in post.ranges.axis_values(axis, ticks)], fontsize=7)
+    labels = [f"{v:.3g}" for v in post.ranges.axis_values(axis, ticks)] if shown else [""] * len(ticks)
+    set_labels(labels, fontsize=7)
 
 
 __all__ = ["plot_calibration_fit", "plot_calibration_posterior", "plot_posterior_corner"]
