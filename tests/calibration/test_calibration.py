@@ -287,6 +287,12 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
         ({"workers": 0}, "--workers"),
         ({"quick": True}, "--quick"),
         ({"preset": "other"}, "--preset"),
+        ({"kn_range": (0.0, 1e6)}, "--kn-range"),
+        ({"ks_range": (2e6, 1e6)}, "--ks-range"),
+        ({"ks_range": (1e5, 1e11)}, "--ks-range"),
+        ({"kn_range": (1e5, 1e6), "points": 12}, "--points"),  # 10 coefficients + 3
+        ({"kn_range": (1e5, 1e6), "ks_range": (1e5, 1e6), "points": 17}, "--points"),  # 15 + 3
+        ({"kn_range": (1e5, 1e6), "settings": {"particle_kn": 1e6}}, "settings.particle_kn"),
     ],
 )
 def test_bad_input_is_refused_before_any_test(tiny, tmp_path, kw, name):
@@ -315,6 +321,9 @@ def _refusal(argv: list[str], capsys) -> str:
         (["--fp-range", "1"], ["--fp-range"]),
         (["--mu-r-range", "0.2,0.1"], ["--mu-r-range"]),
         (["--points", "2"], ["--points"]),
+        (["--kn-range", "1e5"], ["--kn-range"]),
+        (["--ks-range", "1e5,1e12"], ["--ks-range"]),
+        (["--kn-range", "1e5,1e6", "--points", "12"], ["--points", "13"]),
         (["--preset", "paper"], ["--specimen"]),
         (["--specimen", "damaged"], ["checkpoint"]),
     ],
