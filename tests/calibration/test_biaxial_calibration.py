@@ -226,6 +226,8 @@ def _one_line(argv, capsys) -> str:
             ["--biaxial-lab", "LAB", "--max-strain", "0.3"],
             ["max_strain", "where the lab curve at 50 kPa ends"],
         ),
+        (["--biaxial-lab", "LAB", "--kn-range", "1e5,1e6"], ["--kn-range", "not given with --biaxial-lab"]),
+        (["--biaxial-lab", "LAB", "--ks-range", "1e5,1e6"], ["--ks-range", "direct shear only"]),
     ],
 )
 def test_the_command_refuses_on_one_line_before_any_work(specimen, tmp_path, capsys, extra, words):

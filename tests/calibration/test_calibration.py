@@ -292,7 +292,7 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
         ({"ks_range": (1e5, 1e11)}, "--ks-range"),
         ({"kn_range": (1e5, 1e6), "points": 12}, "--points"),  # 10 coefficients + 3
         ({"kn_range": (1e5, 1e6), "ks_range": (1e5, 1e6), "points": 17}, "--points"),  # 15 + 3
-        ({"kn_range": (1e5, 1e6), "settings": {"particle_kn": 1e6}}, "settings.particle_kn"),
+        ({"kn_range": (1e5, 1e6), "points": 13, "settings": {"particle_kn": 1e6}}, "settings.particle_kn"),
     ],
 )
 def test_bad_input_is_refused_before_any_test(tiny, tmp_path, kw, name):

@@ -111,11 +111,6 @@ def synthetic_biaxial_lab(
     header = [
         "# SYNTHETIC laboratory data, not measured: made by poro2d's own biaxial test",
         f"# at particle_friction = {particle_friction}, rolling_friction = {rolling_friction}",
-        *(
-            [f"# and the disks' particle_kn = {sset.particle_kn}, particle_ks = {sset.particle_ks} N/m"]
-            if sset.particle_kn is not None or sset.particle_ks is not None
-            else []
-        ),
         f"# on the specimen {specimen}",
         f"# biaxial settings: max_strain = {sset.max_strain}, record_strain = {sset.record_strain}",
         "# stress ratios below 0 (sigma_1 just under sigma_3 at the start) are written as 0",

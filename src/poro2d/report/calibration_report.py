@@ -45,7 +45,8 @@ def identifiability_note(result) -> str:
         )
     if wide:
         symbols = {key: symbol for key, symbol, _ in PARAMETERS}
-        names = " and ".join(symbols[n] for n in wide)
+        listed = [symbols[n] for n in wide]
+        names = " and ".join(listed) if len(listed) < 3 else ", ".join(listed[:-1]) + " and " + listed[-1]
         verb = "spans" if len(wide) == 1 else "span"
         text += (
             f" The interval of {names} {verb} more than half the search range: these data do not identify"
@@ -59,6 +60,11 @@ def identifiability_note(result) -> str:
                 " specimens narrow it."
             )
         )
+        if any(n in ("particle_kn", "particle_ks") for n in wide):
+            text += (
+                " The disks' stiffness shows in a curve's first slope more than in its peak or end: readings"
+                " early along the curves (--stations) are what see it."
+            )
     else:
         text += (
             " Both intervals are narrower than half their search ranges."
