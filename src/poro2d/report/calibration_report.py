@@ -47,10 +47,12 @@ def identifiability_note(result) -> str:
         symbols = {key: symbol for key, symbol, _ in PARAMETERS}
         listed = [symbols[n] for n in wide]
         names = " and ".join(listed) if len(listed) < 3 else ", ".join(listed[:-1]) + " and " + listed[-1]
-        verb = "spans" if len(wide) == 1 else "span"
+        one = len(wide) == 1
+        subject = f"The interval of {names} spans" if one else f"The intervals of {names} span"
         text += (
-            f" The interval of {names} {verb} more than half the search range: these data do not identify"
-            " it well. Peak strengths alone often cannot separate sliding from rolling resistance;"
+            f" {subject} more than half the search range: these data do not identify"
+            f" {'it' if one else 'them'} well."
+            " Peak strengths alone often cannot separate sliding from rolling resistance;"
             + (
                 " the volumetric strain, readings along the curves (--stations), more confining stresses"
                 " or more replicate specimens narrow it."
