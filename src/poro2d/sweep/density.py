@@ -51,7 +51,8 @@ CALIBRATION_FIRST_TRIAL = 0.19
 #: (the trials still converge to it, in more steps). Above 1.0 the accepted n' under the lid
 #: from first trials near it (benchmarks/loose_states.py --full, docs/criterion.md): 0.2208 on
 #: both seeds of four accepted at 2.0 (from 0.222), 0.2220 over four seeds at 5.0 (0.2211-0.2231,
-#: from 0.224); beyond the last point the table stays flat (np.interp).
+#: from 0.224; from 0.222 every seed was accepted too, at 0.2201-0.2211); beyond the last point
+#: the table stays flat (np.interp).
 FILL_FIRST_TRIALS = (
     (0.0, 0.163), (0.05, 0.171), (0.1, 0.176), (0.2, 0.185), (0.5, 0.202), (1.0, 0.216),
     (2.0, 0.221), (5.0, 0.222),
