@@ -7,6 +7,8 @@ the accepted trial, the box porosity n' and the specimen's interior solid fracti
 interior porosity of measurement circles, as the relation reports it), with the run time.
 ``--keep-working`` keeps the preparation's rolling friction in the working values
 (``rolling_friction``), a choice a user must make knowingly (docs/criterion.md).
+``--growth-steps`` sets the steps of each of the layers' growth increments (150 by default):
+more steps grow the disks more gently.
 
     PYTHONPATH=src python benchmarks/loose_states.py --rolling 0 0.2 0.5 1.0 --seeds 0 1 2
 """
@@ -21,13 +23,18 @@ from poro2d.criterion import run_criterion
 from poro2d.store import Store
 
 
-def config(mu_prep: float, rolling: float, seed: int, first: float, keep: bool, full: bool = False) -> dict:
+def config(
+    mu_prep: float, rolling: float, seed: int, first: float, keep: bool, full: bool = False,
+    growth_steps: int | None = None,
+) -> dict:  # fmt: skip
     """The criterion config of one case: density mode's settings on the quick box (``full``: on
     the paper's box under the fill acceptance, as the relation runs it)."""
     box = {} if full else {"width": 0.08, "height": 0.04, "layers": 2}
     specimen = {**box, "friction_prep": mu_prep, "rolling_friction_prep": rolling, "settle_drift": 1e-3}
     if keep:
         specimen["rolling_friction"] = rolling
+    if growth_steps is not None:
+        specimen["growth_steps"] = growth_steps
     criterion = {
         "acceptance": "fill" if full else "plate", "force_fraction": 0.02, "refine_tolerance": 0.002,
         "max_iterations": 10, "trial_porosity": first,
@@ -43,6 +50,7 @@ def main() -> None:
     ap.add_argument("--first", type=float, default=0.22, help="first trial porosity")
     ap.add_argument("--keep-working", action="store_true", help="keep mu_r in the working values")
     ap.add_argument("--full", action="store_true", help="the paper's box under the fill acceptance")
+    ap.add_argument("--growth-steps", type=int, default=None, help="steps per growth increment")
     ap.add_argument("--out", default=None, help="folder to keep each case's criterion files")
     args = ap.parse_args()
     print(
@@ -50,12 +58,15 @@ def main() -> None:
     )
     for rolling in args.rolling:
         for seed in args.seeds:
-            cfg = config(args.mu_prep, rolling, seed, args.first, args.keep_working, args.full)
+            cfg = config(
+                args.mu_prep, rolling, seed, args.first, args.keep_working, args.full, args.growth_steps
+            )
             store = None
             if args.out:
                 box = "full_" if args.full else ""
                 kept = "_kept" if args.keep_working else ""
-                tag = f"{box}mu{args.mu_prep:g}_r{rolling:g}{kept}_s{seed}"
+                grow = "" if args.growth_steps is None else f"_g{args.growth_steps}"
+                tag = f"{box}mu{args.mu_prep:g}_r{rolling:g}{kept}{grow}_s{seed}"
                 store = Store(Path(args.out) / tag)
             t0 = time.perf_counter()
             res = run_criterion(cfg, store=store, progress=False)

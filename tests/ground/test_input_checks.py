@@ -30,7 +30,7 @@ from poro2d.sweep.density import check_mus
         ([0.1], "= [0.1] is invalid"),
         ([0.0, "0.5"], "'0.5' is not a number"),
         ([0.0, True], "True is not a number"),
-        ([0.05, 0.5, 2.5], "2.5 is out of range"),
+        ([0.05, 0.5, 5.5], "5.5 is out of range"),
         ([0.0, 1e6], "1000000.0 is out of range"),
         ([-0.1, 0.5], "-0.1 is out of range"),
         ([0.0, float("nan")], "nan is out of range"),
@@ -44,11 +44,12 @@ def test_preparation_frictions(value, why):
     with pytest.raises(InputError, match="relation.mu_prep") as exc:
         check_mus(value, "relation.mu_prep")
     assert why in str(exc.value)
-    assert "a list of 2 to 20 preparation frictions in [0, 1]" in str(exc.value)
+    assert "a list of 2 to 20 preparation frictions in [0, 5]" in str(exc.value)
 
 
 def test_frictions_accepted_as_floats():
     assert check_mus((0, 0.05, 1)) == [0.0, 0.05, 1.0]
+    assert check_mus((0, 1, 5)) == [0.0, 1.0, 5.0]  # up to MU_PREP_MAX, the loosest preparation measured
     assert check_number_list("x", [0.3, 0.4], 0.3, 0.4) == [0.3, 0.4]
     with pytest.raises(InputError, match=r"in \(1, 20\]"):
         check_number_list("cu", [1.0, 2.0], 1.0, 20.0, lo_open=True)

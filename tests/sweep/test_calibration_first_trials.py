@@ -39,6 +39,20 @@ def test_under_the_fill_each_friction_starts_from_its_own_first_trial():
     assert by_mu == {0.0: {0.163}, 0.05: {0.171}, 0.5: {0.202}, 0.75: {0.209}, 1.0: {0.216}}
 
 
+def test_frictions_above_one_start_from_their_measured_answers():
+    """2.0 and 5.0 from the n' they were accepted at; 1.5 between; the frictions up to 1.0 as before."""
+    trials = _trials(_fill(), [0.0, 1.0, 1.5, 2.0, 5.0], 1)
+    assert {mu: t for (mu, _), t in trials.items()} == {
+        0.0: 0.163,
+        1.0: 0.216,
+        1.5: 0.218,
+        2.0: 0.221,
+        5.0: 0.222,
+    }
+    # past its last point the table stays flat (np.interp)
+    assert D.first_trial({"acceptance": "fill", "refine_tolerance": 0.002}, 8.0) == D.FILL_FIRST_TRIALS[-1][1]
+
+
 def test_the_first_trial_lies_on_the_grid_the_criterion_steps_on():
     # the paper's 0.01 grid without refinement, half the refined tolerance with it
     assert D.first_trial({"acceptance": "fill"}, 0.0) == 0.16

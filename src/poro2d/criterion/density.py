@@ -39,10 +39,13 @@ from poro2d.record import Record
 #: falling near mu = 1, Silbert 2010; on the paper grading the interior porosity is about 0.152
 #: at 0 and 0.21 at 1.0)
 DEFAULT_MUS = (0.0, 0.05, 0.1, 0.2, 0.5, 1.0)
-#: the highest preparation friction a calibration may ask for: frictional disks jam no looser
-#: above mu = 1 (Silbert 2010), so a higher friction adds run time and no looser state, and a
-#: value far beyond (2.5, 1e6) is a typo, not a preparation
-MU_PREP_MAX = 1.0
+#: the highest preparation friction a calibration may ask for. Frictional disks jam hardly
+#: looser above mu = 1 (Silbert 2010): on the paper's box the loosest state's interior solid
+#: fraction is 0.792-0.796 at 1.0 and 0.781-0.792 at 5.0 (four seeds from two first trials,
+#: each accepted; at 2.0 two of four, docs/criterion.md), its coordination at the frictional
+#: floor of 3 from 1.0 on. So 5.0 is the most a study may want for a slightly looser loose end;
+#: a value far beyond (1e6) is a typo, not a preparation
+MU_PREP_MAX = 5.0
 
 
 def void_ratio(n: float) -> float:
