@@ -38,15 +38,7 @@ def plot_calibration_fit(result, lab, curves: dict[float, list], nearest, path: 
     obs = [o for o in result.posterior["observables"] if o["observable"] == "peak"]
     s = np.array([o["normal_stress_kpa"] for o in obs])
     ax_peak.plot(s, [o["lab_kpa"] for o in obs], "ks", label="laboratory peak")
-    ax_peak.errorbar(
-        s,
-        [o["model_kpa"] for o in obs],
-        yerr=[2 * o["noise_sd_kpa"] for o in obs],
-        fmt="o",
-        color="#b2182b",
-        capsize=3,
-        label="calibrated model (surrogate, +-2 sd)",
-    )
+    _model_points(ax_peak, s, obs, "kpa")
     ends = [o for o in result.posterior["observables"] if o["observable"] == "end"]
     if ends:
         se = [o["normal_stress_kpa"] for o in ends]
@@ -85,19 +77,25 @@ def plot_calibration_fit(result, lab, curves: dict[float, list], nearest, path: 
     return save_figure(fig, path)
 
 
-def _plot_dilation(ax, dilation: list) -> None:
-    """The dilation targets (mm) against normal stress: the laboratory's and the model's (+-2 sd)."""
-    s = [o["normal_stress_kpa"] for o in dilation]
-    ax.plot(s, [o["lab_mm"] for o in dilation], "ks", label="laboratory")
+def _model_points(ax, s, observed: list, unit: str) -> None:
+    """The calibrated model's values of ``observed`` (in ``unit``: their keys' suffix) at the
+    stresses ``s``, with +-2 noise sd."""
     ax.errorbar(
         s,
-        [o["model_mm"] for o in dilation],
-        yerr=[2 * o["noise_sd_mm"] for o in dilation],
+        [o[f"model_{unit}"] for o in observed],
+        yerr=[2 * o[f"noise_sd_{unit}"] for o in observed],
         fmt="o",
         color="#b2182b",
         capsize=3,
         label="calibrated model (surrogate, +-2 sd)",
     )
+
+
+def _plot_dilation(ax, dilation: list) -> None:
+    """The dilation targets (mm) against normal stress: the laboratory's and the model's (+-2 sd)."""
+    s = [o["normal_stress_kpa"] for o in dilation]
+    ax.plot(s, [o["lab_mm"] for o in dilation], "ks", label="laboratory")
+    _model_points(ax, s, dilation, "mm")
     ax.axhline(0.0, color="0.6", lw=0.6)
     ax.set_xlim(left=0)
     ax.set_xlabel("normal stress (kPa)")
