@@ -112,7 +112,7 @@ KIND_SIGNS = {
     "sand": ("sand.json", "preflight.json"),
     "sweep": ("sweep.json",),
     "biaxial": ("biaxial.png",),
-    "critical-state": ("critical_state.png",),
+    "critical-state": ("critical_state.png", "critical_state_line.png"),
     "export": ("specimen.data", "specimen_yade.py", "specimen_pfc4.dat", "disks.csv"),
     "import": ("check.json",),
 }

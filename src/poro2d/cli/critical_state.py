@@ -24,6 +24,9 @@ OPTION_NAMES = {
     "strain": "--strain",
     "window_start": "--window-start",
     "seed": "--seed",
+    "stiffness_number": "--stiffness-number",
+    "kn_particle": "--calibrated particle_kn",
+    "ks_particle": "--calibrated particle_ks",
 }
 
 
@@ -37,11 +40,29 @@ def register(app: typer.Typer) -> None:
             "(columns size_mm,percent_passing; docs/grading.md).",
         ),
         disks: int = typer.Option(1500, "--disks", help="About how many disks in the cell."),
-        particle_friction: float = typer.Option(0.5, "--particle-friction", help="Particle friction f_p."),
-        rolling_friction: float = typer.Option(
-            0.0, "--rolling-friction", help="Rolling friction mu_r (against R = r_i r_j / (r_i + r_j))."
+        particle_friction: float = typer.Option(
+            None, "--particle-friction", help="Particle friction f_p (default 0.5, or the calibrated one)."
         ),
-        pressure: float = typer.Option(100.0, "--pressure", help="Normal pressure P (kPa)."),
+        rolling_friction: float = typer.Option(
+            None,
+            "--rolling-friction",
+            help="Rolling friction mu_r (against R = r_i r_j / (r_i + r_j); default 0, or the calibrated).",
+        ),
+        pressure: str = typer.Option(
+            "100",
+            "--pressure",
+            help="Normal pressure P (kPa), or several, 25,50,100,200,400: the critical-state line e_cs(p').",
+        ),
+        calibrated: Path = typer.Option(
+            None,
+            "--calibrated",
+            help="A calibrated.toml of poro2d calibrate: its f_p and mu_r (and kn, ks where calibrated).",
+        ),
+        stiffness_number: float = typer.Option(
+            None,
+            "--stiffness-number",
+            help="kappa = kn / (P t) held at every pressure (contacts scaled with P; >= 1000: rigid grains).",
+        ),
         inertial: float = typer.Option(1e-3, "--inertial", help="Inertial number I (sets the shear rate)."),
         strain: float = typer.Option(3.0, "--strain", help="Shear strain gamma where the run ends."),
         window_start: float = typer.Option(
@@ -56,9 +77,15 @@ def register(app: typer.Typer) -> None:
         quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
     ) -> None:
         """Steady-state friction tau/sigma and solid fraction of the disks, free of any box."""
+        from poro2d.cli.shear import parse_stresses
         from poro2d.critical_state import CriticalStateCase, run_critical_states
+        from poro2d.critical_state.case import CASE_RANGES
+        from poro2d.critical_state.line import MAX_PRESSURES, run_critical_state_line
         from poro2d.critical_state.run import MAX_SEEDS
         from poro2d.errors import InputError, check_int
+
+        rule = CASE_RANGES["pressure_kpa"]
+        PRESSURE_RANGE_KPA = (rule.lo, rule.hi)
         from poro2d.io_utils import check_output_dir
         from poro2d.store import Store
 
@@ -67,29 +94,64 @@ def register(app: typer.Typer) -> None:
         n = check_int("--seeds", seeds, 1, MAX_SEEDS)
         if processes is not None:
             check_int("--processes", processes, 1, 64)
-        options = {
-            "disks": disks,
-            "particle_friction": particle_friction,
-            "rolling_friction": rolling_friction,
-            "pressure_kpa": pressure,
-            "inertial_number": inertial,
-            "strain": strain,
-            "window_start": window_start,
-            "seed": seed,
-        }
+        pressures = parse_stresses(pressure, "--pressure", PRESSURE_RANGE_KPA)
+        if len(pressures) > MAX_PRESSURES or len(set(pressures)) != len(pressures):
+            raise InputError("--pressure", pressure, f"at most {MAX_PRESSURES} distinct pressures")
+        options = _case_options(calibrated, particle_friction, rolling_friction)
+        options.update(
+            pressure_kpa=pressures[0], inertial_number=inertial, strain=strain, window_start=window_start,
+            seed=seed, disks=disks, stiffness_number=stiffness_number,
+        )  # fmt: skip
         try:
             case = CriticalStateCase(grading=curve, **options)
+            for p in pressures[1:]:  # a stiffness number out of range at another pressure
+                case.at_pressure(p).kappa()
         except InputError as exc:  # named as the option the user typed
             raise InputError(OPTION_NAMES.get(exc.parameter, exc.parameter), exc.value, exc.allowed) from None
-        config = {"grading": grading, **options, "seeds": n}
+        config = {
+            "grading": grading, **options, "pressure_kpa": pressures, "seeds": n,
+            "calibrated": None if calibrated is None else str(calibrated),
+        }  # fmt: skip
+        store = Store(out)
         try:
-            result = run_critical_states(
-                case, Store(out), seeds=n, processes=processes, progress=not quiet, config=config
-            )
+            if len(pressures) == 1:
+                result = run_critical_states(
+                    case, store, seeds=n, processes=processes, progress=not quiet, config=config
+                )
+            else:
+                result = run_critical_state_line(
+                    case, pressures, store, seeds=n, processes=processes, progress=not quiet, config=config
+                )
         except RuntimeError as exc:
             console.print(f"[bold red]failed:[/] {exc}")
             raise typer.Exit(1) from None
-        print_result(result, out)
+        if len(pressures) == 1:
+            print_result(result, out)
+        else:
+            print_line(result, out)
+
+
+def _case_options(calibrated: Path | None, particle_friction, rolling_friction) -> dict:
+    """The micro-parameters: a calibration's, then the options typed (they win), then the defaults."""
+    from poro2d.critical_state.calibrated import calibrated_values
+    from poro2d.errors import InputError
+
+    options: dict = {}
+    if calibrated is not None:
+        try:
+            options.update(calibrated_values(calibrated))
+        except InputError as exc:
+            name = (
+                "--calibrated"
+                if exc.parameter in ("config", "calibrated")
+                else f"--calibrated {exc.parameter}"
+            )
+            raise InputError(name, exc.value, exc.allowed, exc.hint) from None
+    if particle_friction is not None:
+        options["particle_friction"] = particle_friction
+    if rolling_friction is not None:
+        options["rolling_friction"] = rolling_friction
+    return options
 
 
 def _grading(text: str):
@@ -154,3 +216,52 @@ def print_result(result, out: Path) -> None:
         f"steady window gamma {c.window_start:g}-{c.strain:g}"
     )
     console.print(f"results in {out}/result.json, series.csv, critical_state.png")
+
+
+def print_line(result, out: Path) -> None:
+    """The line first (one line), then a row per pressure with kappa and the overlaps."""
+    console.print(f"[bold]{result.headline()}[/]")
+    if not result.steady:
+        console.print(f"[yellow]{result.note}[/]")
+    t = Table(title="critical state per pressure (mean +- sd over seeds)")
+    for col in (
+        "P kPa",
+        "p' kPa",
+        "e_cs",
+        "solid fraction",
+        "tau/sigma",
+        "phi deg",
+        "z",
+        "kappa",
+        "overlap/d",
+        "steady",
+    ):
+        t.add_column(col, justify="right")
+    for p in result.points:
+        t.add_row(
+            f"{p.pressure_kpa:g}",
+            f"{p.mean_stress_kpa.mean:.1f}",
+            p.void_ratio.text(4),
+            f"{p.solid_fraction.mean:.4f}",
+            p.stress_ratio.text(),
+            f"{p.friction_angle_deg.mean:.1f}",
+            f"{p.coordination.mean:.2f}",
+            f"{p.stiffness_number:.0f}",
+            f"{p.mean_overlap_ratio.mean:.1e}",
+            "yes" if p.steady else "NO",
+        )
+    console.print(t)
+    line = result.line
+    c = result.case
+    console.print(
+        f"line: {line.text()}, {line.lambda_log10:.4f} per decade, residual sd {line.residual_sd:.4f} "
+        f"({line.points} runs); f_p = {c.particle_friction:g}, mu_r = {c.rolling_friction:g}, "
+        f"I = {c.inertial_number:g}"
+        + ("" if c.stiffness_number is None else f", kappa held at {c.stiffness_number:g}")
+    )
+    if c.stiffness_number is None:
+        console.print(
+            "the slope is the linear contacts' softness (kappa falls as 1/P), not grain crushing: "
+            "--stiffness-number 1000 holds kappa and shows the rigid-grain line (docs/critical-state.md)"
+        )
+    console.print(f"results in {out}/result.json, line.csv, critical_state_line.png, p<P>kPa/")

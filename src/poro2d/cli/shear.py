@@ -17,8 +17,11 @@ console = OutputConsole()
 SHEAR_KEYS_EXTRA = {"normal_stress_kpa", "specimen", "lab", "processes", "rate_check"}
 
 
-def parse_stresses(text: str, parameter: str = "--normal-stress") -> list[float]:
-    """'50,100,200' -> [50.0, 100.0, 200.0] (kPa), each in the range a test can hold.
+def parse_stresses(
+    text: str, parameter: str = "--normal-stress", bounds: tuple[float, float] | None = None
+) -> list[float]:
+    """'50,100,200' -> [50.0, 100.0, 200.0] (kPa), each in the range a test can hold (``bounds``,
+    kPa; default the shear test's).
 
     An empty item (``50,,100``, a trailing comma) is refused: it is a value left out, and
     the tests run would not be the ones asked for.
@@ -26,7 +29,7 @@ def parse_stresses(text: str, parameter: str = "--normal-stress") -> list[float]
     from poro2d.errors import InputError
     from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA
 
-    lo, hi = NORMAL_STRESS_RANGE_KPA
+    lo, hi = bounds or NORMAL_STRESS_RANGE_KPA
     allowed = f"comma-separated numbers in [{lo:g}, {hi:g}] kPa, e.g. 50,100,200"
     vals = []
     for part in str(text).split(","):

@@ -6,14 +6,18 @@ friction ``f_p`` and the rolling friction ``mu_r`` (against R = r_i r_j / (r_i +
 engine writes it); the loading is the normal pressure ``P`` held by the barostat and the
 inertial number ``I = gamma_dot d_mean sqrt(rho / P)`` that sets the shear rate. Contact
 stiffnesses and density are Table 1's, as the direct shear test uses them (per body, combined
-in series: 2e5 N/m per contact). Cases for several seeds come from one with :meth:`with_seed`.
+in series: 2e5 N/m per contact), unless ``stiffness_number`` asks for the rigid-grain limit:
+then the contact stiffness is scaled with the pressure, kn = kappa P t, so that every pressure
+sees the same kappa = kn / (P t) (the inverse of the typical contact strain). Cases for several
+seeds come from one with :meth:`with_seed`, for several pressures with :meth:`at_pressure`.
 """
 
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field, replace
+from typing import ClassVar
 
-from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
+from poro2d.dem.contact_law import MAX_ROLLING_FRICTION, series
 from poro2d.errors import InputError, Integer, Real, check_fields
 from poro2d.grading import GradingCurve, paper_grading
 from poro2d.paper_data import TABLE_1
@@ -24,6 +28,10 @@ from poro2d.typed_result import TypedResult
 DISKS_RANGE = (200, 20_000)
 #: the inertial numbers a case may ask for: quasi-static below 1e-3, dense flow up to 0.1
 INERTIAL_RANGE = (1e-5, 0.1)
+#: kappa = kn / (P t) a case may ask for: below 10 contacts overlap by a tenth of a diameter;
+#: 1e4 is the stiff end of the rigid-grain limit (1e3-1e4, Roux & Combe), and the time step
+#: shrinks as 1 / sqrt(kappa): at 1e4 and 100 kPa it is a sixth of Table 1's
+STIFFNESS_NUMBER_RANGE = (10.0, 1e4)
 #: disk thickness (m), that of the specimens (SpecimenSpec): masses and stresses per volume
 THICKNESS = 0.008
 
@@ -45,6 +53,7 @@ CASE_RANGES = {
     "record_strain": Real(1e-4, 0.1),
     "blocks": Integer(3, 100),
     "mu_drift_limit": Real(0.0, 1.0, lo_open=True),
+    "stiffness_number": Real(*STIFFNESS_NUMBER_RANGE, or_none=True),
     "solid_drift_limit": Real(0.0, 0.1, lo_open=True),
 }
 
@@ -82,6 +91,7 @@ class CriticalStateCase:
     blocks: int = 5
     mu_drift_limit: float = 0.03
     solid_drift_limit: float = 0.005
+    stiffness_number: float | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.grading, GradingCurve):
@@ -94,6 +104,23 @@ class CriticalStateCase:
 
     def with_seed(self, seed: int) -> CriticalStateCase:
         return replace(self, seed=seed)
+
+    def at_pressure(self, pressure_kpa: float) -> CriticalStateCase:
+        return replace(self, pressure_kpa=pressure_kpa)
+
+    def contact_stiffness(self) -> tuple[float, float]:
+        """(kn, ks) of a contact (N/m): Table 1's per-body values in series, or, with
+        ``stiffness_number``, kn = kappa P t and ks in Table 1's ratio ks / kn."""
+        kn = float(series(self.kn_particle, self.kn_particle))
+        ks = float(series(self.ks_particle, self.ks_particle))
+        if self.stiffness_number is None:
+            return kn, ks
+        scaled = self.stiffness_number * self.pressure_kpa * 1e3 * THICKNESS
+        return scaled, scaled * ks / kn
+
+    def kappa(self) -> float:
+        """The stiffness number kn / (P t) of the case's contacts at its pressure."""
+        return self.contact_stiffness()[0] / (self.pressure_kpa * 1e3 * THICKNESS)
 
     def record(self) -> CaseRecord:
         """The case as a result file keeps it (the grading as its model sizes and source)."""
@@ -129,6 +156,17 @@ class CaseRecord(TypedResult):
     blocks: int
     mu_drift_limit: float
     solid_drift_limit: float
+    stiffness_number: float | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("stiffness_number",)
 
 
-__all__ = ["CASE_RANGES", "CaseRecord", "CriticalStateCase", "DISKS_RANGE", "INERTIAL_RANGE", "THICKNESS"]
+__all__ = [
+    "CASE_RANGES",
+    "CaseRecord",
+    "CriticalStateCase",
+    "DISKS_RANGE",
+    "INERTIAL_RANGE",
+    "STIFFNESS_NUMBER_RANGE",
+    "THICKNESS",
+]

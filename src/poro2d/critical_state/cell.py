@@ -16,7 +16,6 @@ from collections.abc import Callable
 import numpy as np
 
 from poro2d.critical_state.case import THICKNESS, CriticalStateCase
-from poro2d.dem.contact_law import series
 from poro2d.dem.periodic import CellLaw, PeriodicCell
 from poro2d.grading import draw_disks
 
@@ -30,10 +29,11 @@ MAX_COMPRESS_BLOCKS = 1000
 
 
 def contact_law(case: CriticalStateCase) -> CellLaw:
-    """The case's contact values: Table 1's per-body stiffnesses in series, one friction for all."""
+    """The case's contact values (:meth:`CriticalStateCase.contact_stiffness`), one friction for all."""
+    kn, ks = case.contact_stiffness()
     return CellLaw(
-        kn=float(series(case.kn_particle, case.kn_particle)),
-        ks=float(series(case.ks_particle, case.ks_particle)),
+        kn=kn,
+        ks=ks,
         friction=case.particle_friction,
         rolling_friction=case.rolling_friction,
         restitution=case.restitution,
@@ -96,6 +96,16 @@ def compress(
     )
 
 
+def mean_overlap_ratio(cell: PeriodicCell) -> float:
+    """The touching contacts' mean overlap over the disks' mean diameter now (0 without contacts):
+    the typical contact strain, about 1 / kappa."""
+    c = cell.contacts()
+    if c["i"].size == 0:
+        return 0.0
+    overlap = cell.radius[c["i"]] + cell.radius[c["j"]] - np.hypot(c["lx"], c["ly"])
+    return float(overlap.mean()) / mean_diameter(cell)
+
+
 def mean_diameter(cell: PeriodicCell) -> float:
     """The disks' number-mean diameter (m): the d of the inertial number."""
     return 2.0 * float(cell.radius.mean())
@@ -108,4 +118,12 @@ def shear_rate(cell: PeriodicCell, case: CriticalStateCase) -> float:
     )
 
 
-__all__ = ["barostat_gain", "compress", "contact_law", "loose_cell", "mean_diameter", "shear_rate"]
+__all__ = [
+    "barostat_gain",
+    "compress",
+    "contact_law",
+    "loose_cell",
+    "mean_diameter",
+    "mean_overlap_ratio",
+    "shear_rate",
+]

@@ -19,8 +19,11 @@ class CriticalStateTestResult(TypedResult):
     stress_ratio = tau / sigma_yy over the window with its standard error over blocks,
     friction_angle_deg = atan of it; solid_fraction likewise; inertial_number the one reached
     (at the measured sigma_yy), coordination 2 N_c / N; the drifts and ``steady`` as
-    :mod:`poro2d.critical_state.steady` reads them (``note`` says why not). ``series`` (not in
-    the file): the rows as arrays.
+    :mod:`poro2d.critical_state.steady` reads them (``note`` says why not);
+    ``stiffness_number`` kappa = kn / (P t) of the contacts at the case's pressure and
+    ``mean_overlap_ratio`` the touching contacts' mean overlap over the mean diameter at the
+    end (about 1 / kappa: the share of the solid fraction that is the contacts' softness; both
+    absent in files of earlier versions). ``series`` (not in the file): the rows as arrays.
     """
 
     stress_ratio: float
@@ -50,9 +53,22 @@ class CriticalStateTestResult(TypedResult):
     particle_steps_per_s: float
     case: CaseRecord
     provenance: Provenance
+    stiffness_number: float | None = None
+    mean_overlap_ratio: float | None = None
     series: CellSeries | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {"case": CaseRecord, "provenance": Provenance}
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("stiffness_number", "mean_overlap_ratio")
+
+    @property
+    def void_ratio(self) -> float:
+        """The 2D void ratio (1 - solid fraction) / solid fraction of the steady state."""
+        return void_ratio(self.solid_fraction)
+
+
+def void_ratio(solid_fraction: float) -> float:
+    """The 2D void ratio e = (1 - phi) / phi of a solid (area) fraction phi."""
+    return (1.0 - solid_fraction) / solid_fraction
 
 
 @dataclass(eq=False)
@@ -73,15 +89,20 @@ class SeedSummary(TypedResult):
     steady: bool
     note: str
     wall_time_s: float
+    stiffness_number: float | None = None
+    mean_overlap_ratio: float | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("stiffness_number", "mean_overlap_ratio")
 
 
 @dataclass(eq=False)
 class CriticalStateResult(TypedResult):
     """Periodic shear runs of one case on several seeds (the study's ``result.json``).
 
-    Each number's spread over the seeds (:class:`Spread`); ``steady`` only if every seed's
-    window was steady (``note`` says which was not). ``tests`` (not in the file): each seed's
-    full result with its series.
+    Each number's spread over the seeds (:class:`Spread`), the void ratio (1 - phi) / phi with
+    them; ``steady`` only if every seed's window was steady (``note`` says which was not);
+    ``stiffness_number`` kappa at the pressure and the mean overlap over d (absent in files of
+    earlier versions). ``tests`` (not in the file): each seed's full result with its series.
     """
 
     seeds: list[int]
@@ -98,6 +119,9 @@ class CriticalStateResult(TypedResult):
     wall_time_s: float
     config: dict[str, Any]
     provenance: Provenance
+    void_ratio: Spread | None = None
+    stiffness_number: float | None = None
+    mean_overlap_ratio: Spread | None = None
     tests: list[CriticalStateTestResult] = field(
         default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
@@ -111,7 +135,10 @@ class CriticalStateResult(TypedResult):
         "summaries": SeedSummary,
         "case": CaseRecord,
         "provenance": Provenance,
+        "void_ratio": Spread,
+        "mean_overlap_ratio": Spread,
     }
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("void_ratio", "stiffness_number", "mean_overlap_ratio")
 
     def headline(self) -> str:
         """The steady-state friction (tau/sigma and angle) and solid fraction with their spread."""
@@ -119,8 +146,10 @@ class CriticalStateResult(TypedResult):
         state = "critical state" if self.steady else "end state (NOT STEADY)"
         return (
             f"{state}: tau/sigma = {self.stress_ratio.text()}, phi = {self.friction_angle_deg.text(1)} deg, "
-            f"solid fraction = {self.solid_fraction.text()} ({n} seed{'s' if n > 1 else ''})"
+            f"solid fraction = {self.solid_fraction.text()}"
+            + (f", e = {self.void_ratio.text(4)}" if self.void_ratio is not None else "")
+            + f" ({n} seed{'s' if n > 1 else ''})"
         )
 
 
-__all__ = ["CriticalStateResult", "CriticalStateTestResult", "SeedSummary", "Spread"]
+__all__ = ["CriticalStateResult", "CriticalStateTestResult", "SeedSummary", "Spread", "void_ratio"]

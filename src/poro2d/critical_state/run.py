@@ -15,9 +15,24 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import numpy as np
+
 from poro2d.critical_state.case import CriticalStateCase
-from poro2d.critical_state.cell import barostat_gain, compress, loose_cell, mean_diameter, shear_rate
-from poro2d.critical_state.results import CriticalStateResult, CriticalStateTestResult, SeedSummary, Spread
+from poro2d.critical_state.cell import (
+    barostat_gain,
+    compress,
+    loose_cell,
+    mean_diameter,
+    mean_overlap_ratio,
+    shear_rate,
+)
+from poro2d.critical_state.results import (
+    CriticalStateResult,
+    CriticalStateTestResult,
+    SeedSummary,
+    Spread,
+    void_ratio,
+)
 from poro2d.critical_state.series import COLUMNS, CellSeries, row_of
 from poro2d.critical_state.steady import read_steady
 from poro2d.errors import InputError, check_int
@@ -38,21 +53,28 @@ COMPRESS_SHARE = 0.05
 Report = Callable[[str, float], None]
 
 
-def _shear(cell, case: CriticalStateCase, rate: float, report: Report | None) -> tuple[CellSeries, int, int]:
-    """Shear to the case's strain, a row every record_strain; returns the series, steps, rebuilds."""
+def _shear(
+    cell, case: CriticalStateCase, rate: float, report: Report | None
+) -> tuple[CellSeries, int, int, float]:
+    """Shear to the case's strain, a row every record_strain; returns the series, steps, rebuilds
+    and the mean overlap over d of the rows' ends in the steady window (a snapshot alone swings
+    with the pressure's fluctuations)."""
     pressure = case.pressure_kpa * 1e3
     cell.shear(rate, pressure, barostat_gain(cell, case), rate)
     per_row = max(1, round(case.record_strain / (rate * cell.dt)))
     rows_total = math.ceil(case.strain / (per_row * rate * cell.dt))
-    rows, steps, rebuilds, d = [], 0, 0, mean_diameter(cell)
+    rows, overlaps, steps, rebuilds, d = [], [], 0, 0, mean_diameter(cell)
     for k in range(rows_total):
         block = cell.run(per_row)
         steps += per_row
         rebuilds += block.rebuilds
         rows.append(row_of(cell.strain, block, rate, d, case.solid_density))
+        if cell.strain >= case.window_start:
+            overlaps.append(mean_overlap_ratio(cell))
         if report is not None:
             report("shear", COMPRESS_SHARE + (1.0 - COMPRESS_SHARE) * (k + 1) / rows_total)
-    return CellSeries.of_rows(rows), steps, rebuilds
+    overlap = float(np.mean(overlaps)) if overlaps else mean_overlap_ratio(cell)
+    return CellSeries.of_rows(rows), steps, rebuilds, overlap
 
 
 def run_critical_state(
@@ -74,7 +96,7 @@ def run_critical_state(
         cell, case, None if report is None else lambda f: report("compress", COMPRESS_SHARE * f)
     )
     rate = shear_rate(cell, case)
-    series, steps, rebuilds = _shear(cell, case, rate, report)
+    series, steps, rebuilds, overlap = _shear(cell, case, rate, report)
     wall = time.perf_counter() - t0
     state = read_steady(series, case.window_start, case.blocks, case.mu_drift_limit, case.solid_drift_limit)
     result = CriticalStateTestResult(
@@ -105,6 +127,8 @@ def run_critical_state(
         particle_steps_per_s=cell.n * (compression + steps) / wall,
         case=case.record(),
         provenance=Provenance.now(),
+        stiffness_number=case.kappa(),
+        mean_overlap_ratio=overlap,
     )
     stored = CriticalStateTestResult.from_dict(as_json(result))
     stored.series = series
@@ -172,7 +196,20 @@ def run_critical_states(
 
 def _study(cases, store, workers, progress, config) -> CriticalStateResult:
     t0 = time.perf_counter()
-    jobs = [SeedJob(c, f"seed {c.seed}") for c in cases]
+    tests, workers = seed_runs(cases, workers, progress)
+    result = study_of(cases, tests, workers, time.perf_counter() - t0, config)
+    if store is not None:
+        write_study(store, cases, result)
+    return result
+
+
+def seed_runs(
+    cases: list[CriticalStateCase], processes: int | None, progress: bool
+) -> tuple[list[CriticalStateTestResult], int]:
+    """Every case one job of the executor's local processes (default one per case, at most the
+    CPU count); the results in the cases' order and the number of workers. Raises if any failed."""
+    workers = processes if processes is not None else min(len(cases), os.cpu_count() or 1)
+    jobs = [SeedJob(c, _label(c, cases)) for c in cases]
     with JobsProgress("critical state", [j.label for j in jobs], enabled=progress) as bars:
 
         def ended(index: int, outcome) -> None:
@@ -184,23 +221,31 @@ def _study(cases, store, workers, progress, config) -> CriticalStateResult:
             on_report=bars.update,
             on_done=ended,
         )
-        tests: list[CriticalStateTestResult] = results_or_raise(outcomes, "periodic shear run(s)")
-    result = summarize(cases, tests, workers, time.perf_counter() - t0, config)
-    if store is not None:
-        rows = [{"seed": c.seed, **r} for c, t in zip(cases, tests, strict=True) for r in t.series.rows()]
-        store.write_csv("series.csv", rows, header=["seed", *COLUMNS])
-        plot_critical_state(
-            [(f"seed {c.seed}", t.series) for c, t in zip(cases, tests, strict=True)],
-            store.path(FIGURE),
-            title=_title(cases[0]),
-            window=cases[0].window_start,
-            steady=(result.stress_ratio.mean, result.solid_fraction.mean),
-        )
-        store.write_result("result.json", result)
-    return result
+        return results_or_raise(outcomes, "periodic shear run(s)"), workers
 
 
-def summarize(cases, tests, workers, wall, config) -> CriticalStateResult:
+def _label(case: CriticalStateCase, cases: list[CriticalStateCase]) -> str:
+    """``seed 3``, or ``100 kPa seed 3`` when the jobs hold several pressures."""
+    several = len({c.pressure_kpa for c in cases}) > 1
+    return f"{case.pressure_kpa:g} kPa seed {case.seed}" if several else f"seed {case.seed}"
+
+
+def write_study(store: Store, cases: list[CriticalStateCase], result: CriticalStateResult) -> None:
+    """A study's ``series.csv`` (every seed's rows), its figure, then ``result.json``."""
+    tests = result.tests
+    rows = [{"seed": c.seed, **r} for c, t in zip(cases, tests, strict=True) for r in t.series.rows()]
+    store.write_csv("series.csv", rows, header=["seed", *COLUMNS])
+    plot_critical_state(
+        [(f"seed {c.seed}", t.series) for c, t in zip(cases, tests, strict=True)],
+        store.path(FIGURE),
+        title=_title(cases[0]),
+        window=cases[0].window_start,
+        steady=(result.stress_ratio.mean, result.solid_fraction.mean),
+    )
+    store.write_result("result.json", result)
+
+
+def study_of(cases, tests, workers, wall, config) -> CriticalStateResult:
     """The study's result from its seeds' results."""
     missed = [c.seed for c, t in zip(cases, tests, strict=True) if not t.steady]
     note = (
@@ -226,6 +271,8 @@ def summarize(cases, tests, workers, wall, config) -> CriticalStateResult:
             steady=t.steady,
             note=t.note,
             wall_time_s=t.wall_time_s,
+            stiffness_number=t.stiffness_number,
+            mean_overlap_ratio=t.mean_overlap_ratio,
         )
         for c, t in zip(cases, tests, strict=True)
     ]
@@ -244,10 +291,21 @@ def summarize(cases, tests, workers, wall, config) -> CriticalStateResult:
         wall_time_s=wall,
         config=config or {},
         provenance=Provenance.now(),
+        void_ratio=Spread.of([void_ratio(t.solid_fraction) for t in tests]),
+        stiffness_number=cases[0].kappa(),
+        mean_overlap_ratio=Spread.of([t.mean_overlap_ratio for t in tests]),
     )
     stored = CriticalStateResult.from_dict(as_json(result))
     stored.tests = list(tests)
     return stored
 
 
-__all__ = ["MAX_SEEDS", "SeedJob", "run_critical_state", "run_critical_states"]
+__all__ = [
+    "MAX_SEEDS",
+    "SeedJob",
+    "run_critical_state",
+    "run_critical_states",
+    "seed_runs",
+    "study_of",
+    "write_study",
+]

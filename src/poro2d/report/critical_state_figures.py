@@ -1,4 +1,5 @@
-"""The periodic reference's figure: stress ratio and solid fraction against shear strain.
+"""The periodic reference's figures: stress ratio and solid fraction against shear strain, and
+the critical-state line (void ratio against the mean stress on a log axis).
 
 (a) tau / sigma_yy against gamma, one line per seed; (b) the solid fraction. The start of the
 steady-state window is a vertical line, the study's means over it dotted horizontal lines.
@@ -14,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 import matplotlib
+import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -48,4 +50,48 @@ def plot_critical_state(
     return save_figure(fig, path)
 
 
-__all__ = ["plot_critical_state"]
+def plot_critical_state_line(
+    result: Any, path: str | os.PathLike, *, marks: Sequence[tuple[str, float, float]] = ()
+) -> Path:
+    """The critical-state line of ``result`` (a ``CriticalStateLineResult``): (a) e against p' on a
+    log axis, every seed a dot, each pressure's mean with the seeds' sd, the fitted line;
+    (b) tau / sigma_yy against p'. ``marks``: (label, p' kPa, e) states to draw beside the line
+    (the 2D ends of a specimen, a laboratory state as mapped)."""
+    fig, (ax, bx) = plt.subplots(2, 1, figsize=(7.0, 7.0), sharex=True, height_ratios=(3, 2))
+    for k, point in enumerate(result.points):
+        p, e = point.mean_stress_kpa, point.void_ratio
+        ax.plot(p.values, e.values, ".", color="0.6", ms=4, label="a seed" if k == 0 else None)
+        ax.errorbar(p.mean, e.mean, yerr=e.sd or 0.0, fmt="o", color=COLORS[0], ms=6, capsize=3,
+                    label="mean +- sd over seeds" if k == 0 else None)  # fmt: skip
+        sr = point.stress_ratio
+        bx.errorbar(p.mean, sr.mean, yerr=sr.sd or 0.0, fmt="o", color=COLORS[1], ms=6, capsize=3)
+    lo = min(pt.mean_stress_kpa.min for pt in result.points)
+    hi = max(pt.mean_stress_kpa.max for pt in result.points)
+    for _, p, _ in marks:
+        lo, hi = min(lo, p), max(hi, p)
+    grid = np.geomspace(lo / 1.3, hi * 1.3, 50)
+    line = result.line
+    ax.plot(grid, [line.void_ratio_at(g) for g in grid], color="k", lw=1.0, label=line.text())
+    for k, (label, p, e) in enumerate(marks):
+        ax.plot(
+            [p], [e], marker="sD^v"[k % 4], ls="none", color=COLORS[(k + 2) % len(COLORS)], ms=7, label=label
+        )
+    ax.set_xscale("log")
+    ax.set_ylabel("2D void ratio e = (1 - phi) / phi")
+    c = result.case
+    kappa = "" if c.stiffness_number is None else f", kappa = {c.stiffness_number:g} at every p"
+    ax.set_title(
+        f"critical-state line: f_p = {c.particle_friction:g}, mu_r = {c.rolling_friction:g}, "
+        f"I = {c.inertial_number:g}, {c.disks} disks{kappa}",
+        fontsize=9,
+    )
+    ax.legend(fontsize=8)
+    bx.set_ylabel("tau / sigma_yy")
+    bx.set_xlabel("mean stress p' (kPa)")
+    for axis in (ax, bx):
+        axis.grid(alpha=0.3, which="both")
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+__all__ = ["plot_critical_state", "plot_critical_state_line"]
