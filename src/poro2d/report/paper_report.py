@@ -291,10 +291,32 @@ def _state_blocks(criterion) -> list[Block]:
         + (f"in the bottom band sigma_v is {ratio:.2f} x the geostatic stress "
            "(F_top / W plus the weight above; the side walls carry the rest by friction)." if ratio else ""),
     ))  # fmt: skip
+    if k0 is not None:
+        b.append(("p", k0_note(k0)))
     if "specimen_state.png" in criterion.figures:
         cap = "Porosity and stresses of the accepted specimen, by height"
         b.append(("img", criterion.figures["specimen_state.png"], cap))
     return b
+
+
+#: K0 of these disks measured under one-dimensional loading and after unloading (the quick
+#: specimens of seeds 0-2, benchmarks/k0_one_dimensional.py; docs/criterion.md, "K0")
+K0_LOADING = 0.44
+K0_UNLOADED = 0.82
+
+
+def k0_note(k0: float) -> str:
+    """Why the prepared specimen's K0 is not Jaky's, with the numbers that say so."""
+    return (
+        f"K0 {k0:.2f} is not Jaky's 1 - sin phi (about 0.4-0.5 for sands): that is the K0 of a soil "
+        "loaded one-dimensionally from a loose deposit, while this specimen was built by growing its "
+        "disks in layers under a lid, which presses them in every direction and locks in a lateral "
+        "stress near the vertical one, as in an overconsolidated soil; under self-weight alone "
+        "nothing has loaded it since. Loaded one-dimensionally (side walls held, 25-200 kPa), the "
+        f"same disks give K0 = {K0_LOADING:.2f}, Jaky's value for phi near 34 deg, and "
+        f"{K0_UNLOADED:.2f} once unloaded to a quarter of that stress: a K0 near 1 says how the "
+        'specimen was made, not what the disks are (docs/criterion.md, "K0").'
+    )
 
 
 def _porosity_blocks(criterion) -> list[Block]:
