@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from poro2d.errors import InputError, check_range, is_number
+from poro2d.lab_table import read_lab_table
 
 #: the mean stresses a line may be read at (kPa): the laboratory range of sands, below crushing
 PRESSURE_RANGE_KPA = (1.0, 10_000.0)
@@ -196,6 +197,25 @@ def map_state(
     )  # fmt: skip
 
 
+def read_lab_line(text: str) -> tuple[LabCriticalStateLine, float | None, float | None]:
+    """A laboratory line by a published name (with its e_max, e_min) or from a CSV file of
+    ``p_kpa,e_cs`` rows (extremes then come from elsewhere: None)."""
+    if str(text).strip().lower() in PUBLISHED_LINES:
+        return published_line(text)
+    if not str(text).lower().endswith(".csv"):
+        raise InputError(
+            "lab line", text, f"{', '.join(sorted(PUBLISHED_LINES))}, or a CSV of p_kpa,e_cs rows"
+        )
+    table = read_lab_table(text)
+    if not table.has("p_kpa", "e_cs"):
+        raise InputError(
+            "lab line", text, "a CSV with columns p_kpa,e_cs", f"its header: {','.join(table.header)}"
+        )
+    p = table.column("p_kpa", *PRESSURE_RANGE_KPA, unit="kPa")
+    e = table.column("e_cs", 0.01, 5.0)
+    return line_of_table(list(zip(p.tolist(), e.tolist(), strict=True)), source=str(text)), None, None
+
+
 def line_of_table(points: Sequence[Sequence[float]], source: str = "") -> LabCriticalStateLine:
     """A laboratory line from (p' kPa, e_cs) pairs, sorted by pressure."""
     pairs = tuple(sorted((tuple(p) for p in points), key=lambda pe: pe[0] if is_number(pe[0]) else 0.0))
@@ -212,4 +232,5 @@ __all__ = [
     "line_of_table",
     "map_state",
     "published_line",
+    "read_lab_line",
 ]

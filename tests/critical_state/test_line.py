@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -118,4 +119,63 @@ def test_a_calibrated_file_without_its_table_is_refused_on_one_line(tmp_path, ca
         main(["critical-state", "--calibrated", str(bad), "--out", str(tmp_path / "out")])
     _out, err = capsys.readouterr()
     assert exc.value.code == 2 and "--calibrated" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "out").exists()
+
+
+SAND_JSON = Path(__file__).resolve().parents[1] / "data" / "before_typed_results" / "sand_result.json"
+
+
+def test_a_sand_folder_is_held_against_the_line_with_both_maps(tmp_path, capsys):
+    """``--sand``: the 2D ends and the answer of a ``poro2d sand`` run (Toyoura sand, Dr 0.8) get
+    psi at each pressure; ``--lab-line toyoura`` adds the laboratory's psi and the state map."""
+    sand = tmp_path / "sand"
+    sand.mkdir()
+    (sand / "sand.json").write_text(SAND_JSON.read_text())
+    argv = [
+        "critical-state",
+        "--pressure",
+        "50,200",
+        "--disks",
+        "200",
+        "--inertial",
+        "0.01",
+        "--strain",
+        "0.6",
+    ]
+    argv += [
+        "--window-start",
+        "0.3",
+        "--quiet",
+        "--processes",
+        "1",
+        "--sand",
+        str(sand),
+        "--lab-line",
+        "toyoura",
+    ]
+    main([*argv, "--out", str(tmp_path / "out")])
+    out, _err = capsys.readouterr()
+    assert "2D loose end" in out and "Dr map, Dr 0.80" in out and "state map" in out
+    kept = json.loads((tmp_path / "out" / "result.json").read_text())
+    loose, dense, answer = kept["marks"]
+    line = LineFit.from_dict(kept["line"])
+    # the loose end's psi is its void ratio less the line's at each pressure, over the 2D span
+    span = loose["void_ratio"] - dense["void_ratio"]
+    assert loose["span"] == pytest.approx(span)
+    for p, psi, norm in zip(kept["pressures_kpa"], loose["psi"], loose["psi_normalised"], strict=True):
+        assert psi == pytest.approx(loose["void_ratio"] - line.void_ratio_at(p))
+        assert norm == pytest.approx(psi / span)
+    assert dense["void_ratio"] < answer["void_ratio"] < loose["void_ratio"]
+
+
+def test_sand_and_lab_line_refusals(tmp_path, capsys):
+    for argv, name in [
+        (["--lab-line", "toyoura"], "--lab-line"),
+        (["--sand", str(tmp_path)], "--sand"),
+        (["--pressure", "50,100", "--sand", str(tmp_path)], "--sand"),
+    ]:
+        with pytest.raises(SystemExit) as exc:
+            main(["critical-state", *argv, "--out", str(tmp_path / "out")])
+        _out, err = capsys.readouterr()
+        assert exc.value.code == 2 and name in err
     assert not (tmp_path / "out").exists()

@@ -58,6 +58,20 @@ def register(app: typer.Typer) -> None:
             "--calibrated",
             help="A calibrated.toml of poro2d calibrate: its f_p and mu_r (and kn, ks where calibrated).",
         ),
+        sand: Path = typer.Option(
+            None,
+            "--sand",
+            help="A poro2d sand folder: its 2D ends and answer held against the line (psi at each p').",
+        ),
+        lab_line: str = typer.Option(
+            None,
+            "--lab-line",
+            help="The laboratory's critical-state line (toyoura, or a CSV p_kpa,e_cs) for --sand: "
+            "the state-parameter map beside the Dr map.",
+        ),
+        test_stress: float = typer.Option(
+            100.0, "--test-stress", help="Mean stress p' (kPa) of the state map's mark on the figure."
+        ),
         stiffness_number: float = typer.Option(
             None,
             "--stiffness-number",
@@ -77,6 +91,7 @@ def register(app: typer.Typer) -> None:
         quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
     ) -> None:
         """Steady-state friction tau/sigma and solid fraction of the disks, free of any box."""
+        from poro2d.cli.critical_state_held import held_states, print_held
         from poro2d.cli.shear import parse_stresses
         from poro2d.critical_state import CriticalStateCase, run_critical_states
         from poro2d.critical_state.case import CASE_RANGES
@@ -112,6 +127,7 @@ def register(app: typer.Typer) -> None:
             "grading": grading, **options, "pressure_kpa": pressures, "seeds": n,
             "calibrated": None if calibrated is None else str(calibrated),
         }  # fmt: skip
+        held = held_states(sand, lab_line, pressures, test_stress)
         store = Store(out)
         try:
             if len(pressures) == 1:
@@ -120,8 +136,9 @@ def register(app: typer.Typer) -> None:
                 )
             else:
                 result = run_critical_state_line(
-                    case, pressures, store, seeds=n, processes=processes, progress=not quiet, config=config
-                )
+                    case, pressures, store, seeds=n, processes=processes, progress=not quiet, config=config,
+                    marks=held.marks if held else None, span=held.span if held else None,
+                )  # fmt: skip
         except RuntimeError as exc:
             console.print(f"[bold red]failed:[/] {exc}")
             raise typer.Exit(1) from None
@@ -129,6 +146,8 @@ def register(app: typer.Typer) -> None:
             print_result(result, out)
         else:
             print_line(result, out)
+            if held is not None:
+                print_held(result, held)
 
 
 def _case_options(calibrated: Path | None, particle_friction, rolling_friction) -> dict:

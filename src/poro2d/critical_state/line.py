@@ -174,6 +174,24 @@ class LineFit(TypedResult):
 
 
 @dataclass(eq=False)
+class StateMark(TypedResult):
+    """A 2D state held against the line: its label, its void ratio, and at each of the line's
+    pressures its state parameter psi = e - e_cs(p') (``psi``, in the order of ``pressures_kpa``)
+    and psi over ``span`` (the 2D preparation's e_max - e_min; None when not given)."""
+
+    label: str
+    void_ratio: float
+    psi: list[float]
+    span: float | None
+    psi_normalised: list[float] | None
+
+    @classmethod
+    def of(cls, label: str, e: float, fit: LineFit, pressures: list[float], span: float | None) -> StateMark:
+        psi = [e - fit.void_ratio_at(p) for p in pressures]
+        return cls(label, float(e), psi, span, None if not span else [v / span for v in psi])
+
+
+@dataclass(eq=False)
 class CriticalStateLineResult(TypedResult):
     """The line over ``pressures_kpa`` (the study's ``result.json``): a point per pressure, the fit
     through every seed, the stress ratio pooled over every run; ``steady`` only if every run was
@@ -192,6 +210,7 @@ class CriticalStateLineResult(TypedResult):
     wall_time_s: float
     config: dict[str, Any]
     provenance: Provenance
+    marks: list[StateMark] | None = None
     studies: list[CriticalStateResult] = field(
         default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
@@ -203,7 +222,9 @@ class CriticalStateLineResult(TypedResult):
         "friction_angle_deg": Spread,
         "case": CaseRecord,
         "provenance": Provenance,
+        "marks": StateMark,
     }
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("marks",)
 
     def headline(self) -> str:
         """The line and the pooled friction, with the range of pressures and seeds."""
@@ -221,8 +242,10 @@ class CriticalStateLineResult(TypedResult):
 def line_result(
     case: CriticalStateCase, pressures: list[float], studies: list[CriticalStateResult], *,
     processes: int, wall_time_s: float, config: dict | None,
+    marks: list[tuple[str, float]] | None = None, span: float | None = None,
 ) -> CriticalStateLineResult:  # fmt: skip
-    """The line's result from its pressures' studies (each holding its seeds' tests)."""
+    """The line's result from its pressures' studies (each holding its seeds' tests); ``marks``:
+    (label, 2D void ratio) states to hold against the line, ``span`` the 2D e_max - e_min."""
     points = [LinePoint.of(p, s) for p, s in zip(pressures, studies, strict=True)]
     tests = [t for s in studies for t in s.tests]
     fit = LineFit.through(
@@ -249,6 +272,7 @@ def line_result(
         wall_time_s=wall_time_s,
         config=config or {},
         provenance=Provenance.now(),
+        marks=[StateMark.of(label, e, fit, list(pressures), span) for label, e in marks] if marks else None,
     )
     stored = CriticalStateLineResult.from_dict(as_json(result))
     stored.studies = list(studies)
@@ -285,10 +309,15 @@ def run_critical_state_line(
     processes: int | None = None,
     progress: bool = False,
     config: dict | None = None,
+    marks: list[tuple[str, float]] | None = None,
+    span: float | None = None,
 ) -> CriticalStateLineResult:
     """``case`` at every pressure of ``pressures`` (kPa) on ``seeds`` seeds: the line e_cs(p').
 
-    Every (pressure, seed) run is one job of the executor. ``store``: the line's ``result.json``,
+    ``marks``: (label, 2D void ratio) states to hold against the line (a specimen's 2D ends, a
+    state as mapped): each gets its state parameter at every pressure, drawn on the figure;
+    ``span``: the 2D e_max - e_min that normalises it. Every (pressure, seed) run is one job of
+    the executor. ``store``: the line's ``result.json``,
     ``line.csv`` and ``critical_state_line.png``, and per pressure a folder ``p<P>kPa/`` holding
     what a one-pressure study holds. Call it under ``if __name__ == "__main__":`` in a script
     when ``processes`` > 1 (worker processes import the calling script).
@@ -314,8 +343,9 @@ def run_critical_state_line(
             if store is not None:
                 write_study(store.child(pressure_folder(values[k])), row, studies[-1])
         result = line_result(
-            case, values, studies, processes=workers, wall_time_s=time.perf_counter() - t0, config=config
-        )
+            case, values, studies, processes=workers, wall_time_s=time.perf_counter() - t0, config=config,
+            marks=marks, span=span,
+        )  # fmt: skip
         if store is not None:
             write_line(store, result)
         return result
@@ -338,6 +368,7 @@ __all__ = [
     "CriticalStateLineResult",
     "LineFit",
     "LinePoint",
+    "StateMark",
     "check_pressures",
     "line_result",
     "pressure_folder",

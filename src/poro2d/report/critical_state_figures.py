@@ -50,13 +50,11 @@ def plot_critical_state(
     return save_figure(fig, path)
 
 
-def plot_critical_state_line(
-    result: Any, path: str | os.PathLike, *, marks: Sequence[tuple[str, float, float]] = ()
-) -> Path:
+def plot_critical_state_line(result: Any, path: str | os.PathLike) -> Path:
     """The critical-state line of ``result`` (a ``CriticalStateLineResult``): (a) e against p' on a
-    log axis, every seed a dot, each pressure's mean with the seeds' sd, the fitted line;
-    (b) tau / sigma_yy against p'. ``marks``: (label, p' kPa, e) states to draw beside the line
-    (the 2D ends of a specimen, a laboratory state as mapped)."""
+    log axis, every seed a dot, each pressure's mean with the seeds' sd, the fitted line, and the
+    result's marks (2D states held against the line: a specimen's ends, a state as mapped) as
+    horizontal lines, loose of the line above it; (b) tau / sigma_yy against p'."""
     fig, (ax, bx) = plt.subplots(2, 1, figsize=(7.0, 7.0), sharex=True, height_ratios=(3, 2))
     for k, point in enumerate(result.points):
         p, e = point.mean_stress_kpa, point.void_ratio
@@ -67,15 +65,13 @@ def plot_critical_state_line(
         bx.errorbar(p.mean, sr.mean, yerr=sr.sd or 0.0, fmt="o", color=COLORS[1], ms=6, capsize=3)
     lo = min(pt.mean_stress_kpa.min for pt in result.points)
     hi = max(pt.mean_stress_kpa.max for pt in result.points)
-    for _, p, _ in marks:
-        lo, hi = min(lo, p), max(hi, p)
     grid = np.geomspace(lo / 1.3, hi * 1.3, 50)
     line = result.line
     ax.plot(grid, [line.void_ratio_at(g) for g in grid], color="k", lw=1.0, label=line.text())
-    for k, (label, p, e) in enumerate(marks):
-        ax.plot(
-            [p], [e], marker="sD^v"[k % 4], ls="none", color=COLORS[(k + 2) % len(COLORS)], ms=7, label=label
-        )
+    for k, mark in enumerate(result.marks or []):
+        style = ("--", ":", "-.")[k % 3]
+        ax.axhline(mark.void_ratio, color=COLORS[(k + 2) % len(COLORS)], lw=1.0, ls=style,
+                   label=f"{mark.label}: e = {mark.void_ratio:.4f}")  # fmt: skip
     ax.set_xscale("log")
     ax.set_ylabel("2D void ratio e = (1 - phi) / phi")
     c = result.case
