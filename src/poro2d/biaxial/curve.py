@@ -19,7 +19,7 @@ from typing import ClassVar
 import numpy as np
 
 from poro2d.biaxial.box import BiaxialBox, BoxSize
-from poro2d.biaxial.stiffness import overlap_ratio
+from poro2d.biaxial.stiffness import contact_strain, overlap_ratio
 from poro2d.dem import Simulation
 from poro2d.store import Store
 from poro2d.typed_result import TypedResult
@@ -42,10 +42,12 @@ CURVE_COLUMNS = (
     "inertial_number",
 )
 #: columns written since the elastic strain was told apart from the plastic (absent from a curve of
-#: before, and the plastic ones from a test without its elastic probe): the mean overlap over the
-#: mean diameter of the disk-disk contacts (:mod:`poro2d.biaxial.stiffness`) and the plastic
-#: strains (:mod:`poro2d.biaxial.elastic`)
-OPTIONAL_COLUMNS = ("mean_overlap_ratio", "plastic_volumetric_strain", "plastic_shear_strain")
+#: before): the mean overlap over the mean diameter of the disk-disk contacts and the elastic strain
+#: they hold (:mod:`poro2d.biaxial.stiffness`), the plastic strains (:mod:`poro2d.biaxial.elastic`)
+OPTIONAL_COLUMNS = (
+    "mean_overlap_ratio", "elastic_axial_strain", "elastic_lateral_strain", "plastic_volumetric_strain",
+    "plastic_shear_strain",
+)  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
@@ -71,6 +73,8 @@ class BiaxialCurve(Mapping):
     max_unbalanced_ratio: np.ndarray
     inertial_number: np.ndarray
     mean_overlap_ratio: np.ndarray | None = None
+    elastic_axial_strain: np.ndarray | None = None
+    elastic_lateral_strain: np.ndarray | None = None
     plastic_volumetric_strain: np.ndarray | None = None
     plastic_shear_strain: np.ndarray | None = None
 
@@ -127,8 +131,14 @@ class CurveRow(TypedResult):
     max_unbalanced_ratio: float
     inertial_number: float
     mean_overlap_ratio: float | None = None
+    elastic_axial_strain: float | None = None
+    elastic_lateral_strain: float | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("mean_overlap_ratio",)
+    OPTIONAL: ClassVar[tuple[str, ...]] = (
+        "mean_overlap_ratio",
+        "elastic_axial_strain",
+        "elastic_lateral_strain",
+    )
 
 
 def read_curve(store: Store, name: str = "curve.csv") -> BiaxialCurve | None:
@@ -147,6 +157,7 @@ def curve_row(
     e3 = math.log(start.width / now.width)
     p = 0.5 * (s1 + s3)
     ratio, _ = sim.unbalanced_ratios()
+    elastic_1, elastic_3 = contact_strain(sim)
     return CurveRow(
         step=step,
         axial_strain=e1,
@@ -163,6 +174,8 @@ def curve_row(
         max_unbalanced_ratio=ratio,
         inertial_number=strain_rate * d50 * math.sqrt(rho / p) if p > 0 else math.inf,
         mean_overlap_ratio=overlap_ratio(sim),
+        elastic_axial_strain=elastic_1,
+        elastic_lateral_strain=elastic_3,
     )
 
 

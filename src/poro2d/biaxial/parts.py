@@ -56,8 +56,9 @@ class ElasticProbe(TypedResult):
     ``axial_compliance`` and ``lateral_compliance`` (1/MPa): d eps_1 / d sigma_1 and
     d eps_3 / d sigma_1 over the unloading; ``bulk_modulus_mpa`` K = 1 / (2 (C1 + C3)) and
     ``shear_modulus_mpa`` G = 1 / (2 (C1 - C3)) (2D: p and t = (sigma_1 - sigma_3) / 2 against
-    eps_v and eps_s); ``reached``: both equilibria reached (otherwise no compliance and no
-    plastic strain).
+    eps_v and eps_s); ``contact_axial_compliance`` and ``contact_lateral_compliance``: the same
+    secants of the contacts' elastic strain (:func:`poro2d.biaxial.stiffness.contact_strain`), what
+    the plastic strains take out; ``reached``: both equilibria reached (otherwise no compliance).
     """
 
     definition: str
@@ -71,6 +72,8 @@ class ElasticProbe(TypedResult):
     lateral_compliance: float | None
     bulk_modulus_mpa: float | None
     shear_modulus_mpa: float | None
+    contact_axial_compliance: float | None
+    contact_lateral_compliance: float | None
 
 
 @dataclass(eq=False)
@@ -213,9 +216,9 @@ DEFINITIONS: dict[str, Any] = {
     "critical_state": "mean sin(phi) over the last critical_window of the axial strain, critical only if "
     "|d eps_v / d eps_1| there is at most critical_rate_limit",
     "dilatancy": "sin(psi) = -d eps_v / d eps_s over secants of smoothing_strain; psi_max its largest value",
-    "plastic": "eps_1^p = eps_1 - C1 (sigma_1 - sigma_1,0), eps_3^p = eps_3 - C3 (sigma_1 - sigma_1,0), "
-    "C1, C3 the compliances of the elastic probe (the plate unloaded by probe_unload of the deviator at "
-    "constant sigma_3 after shearing); plastic psi_max from eps_v^p and eps_s^p as psi_max from eps_v, eps_s",
+    "plastic": "eps_1^p = eps_1 - (eps_1^e - eps_1,0^e), eps_3^p = eps_3 - (eps_3^e - eps_3,0^e), eps^e the "
+    "uniform strain whose contact overlaps best fit the measured ones (least squares over the disk-disk "
+    "contacts, each row); plastic psi_max from eps_v^p and eps_s^p as psi_max from eps_v, eps_s",
     "stiffness_number": STIFFNESS_DEFINITION,
 }
 #: how a series' envelope is read (:mod:`poro2d.biaxial.envelope`)

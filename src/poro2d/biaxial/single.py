@@ -154,13 +154,10 @@ class BiaxialTest:
         rows, velocity = shearing.run()
         curve = BiaxialCurve.of_rows(rows)
         angles = read_angles(curve, s.smoothing_strain, s.critical_window, s.critical_rate_limit)
+        curve = curve.with_plastic(*plastic_strains(curve))
         probe = None
         if s.probe_unload is not None:  # after the curve: the test's own numbers stay as they were
-            probe = probe_compliance(sim, start, sigma, s, self.progress)
-            if probe.reached:
-                curve = curve.with_plastic(
-                    *plastic_strains(curve, probe.axial_compliance, probe.lateral_compliance)
-                )
+            probe = probe_compliance(sim, start, sigma, s, velocity, self.progress)
         plastic = read_plastic(curve, s.smoothing_strain, s.critical_window)
         result = BiaxialTestResult(
             confining_stress_kpa=self.case.confining_kpa, **asdict(angles),

@@ -34,14 +34,26 @@ STIFFNESS_DEFINITION = (
 )
 
 
-def _disk_pairs(sim: Simulation) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(i, j, overlap in m) of the touching disk-disk contacts (the contact set's branch vectors)."""
+@dataclass(frozen=True)
+class DiskContacts:
+    """The touching disk-disk contacts: their disks ``i``, ``j``, unit normals, the sum of the two
+    radii (m) and the overlap (m), read from the contact set's branch vectors."""
+
+    i: np.ndarray
+    j: np.ndarray
+    normal: np.ndarray
+    reach: np.ndarray
+    overlap: np.ndarray
+
+
+def disk_contacts(sim: Simulation) -> DiskContacts:
+    """The touching disk-disk contacts of ``sim`` (:meth:`poro2d.dem.Simulation.contacts`)."""
     c = sim.contacts()
     pp = c.kind == 0
     i, j = c.i[pp], c.j[pp]
     r = sim.particles.radius
-    overlap = r[i] + r[j] - np.hypot(c.branch[pp, 0], c.branch[pp, 1])
-    return i, j, overlap
+    reach = r[i] + r[j]
+    return DiskContacts(i, j, c.normal[pp], reach, reach - np.hypot(c.branch[pp, 0], c.branch[pp, 1]))
 
 
 def contact_kn(sim: Simulation) -> float:
@@ -54,10 +66,10 @@ def contact_kn(sim: Simulation) -> float:
         assert sim.contact.pp is not None
         return float(sim.contact.pp[0])
     kn = sim.particles.kn
-    i, j, _ = _disk_pairs(sim)
-    if i.size == 0:
+    c = disk_contacts(sim)
+    if c.i.size == 0:
         return 0.5 * float(np.mean(kn))
-    return float(np.mean(kn[i] * kn[j] / (kn[i] + kn[j])))
+    return float(np.mean(kn[c.i] * kn[c.j] / (kn[c.i] + kn[c.j])))
 
 
 def stiffness_number(kn: float, sigma_pa: float, thickness: float) -> float:
@@ -67,11 +79,29 @@ def stiffness_number(kn: float, sigma_pa: float, thickness: float) -> float:
 
 def overlap_ratio(sim: Simulation) -> float:
     """mean(overlap) / mean(d) over the touching disk-disk contacts (d: the two disks' mean diameter)."""
-    i, j, overlap = _disk_pairs(sim)
-    if i.size == 0:
+    c = disk_contacts(sim)
+    if c.i.size == 0:
         return float("nan")
-    r = sim.particles.radius
-    return float(np.mean(overlap) / np.mean(r[i] + r[j]))
+    return float(np.mean(c.overlap) / np.mean(c.reach))
+
+
+def contact_strain(sim: Simulation) -> tuple[float, float]:
+    """(eps_1^e, eps_3^e): the elastic strain the contacts hold, compression positive (nan without
+    three contacts).
+
+    A linear contact's overlap is its elastic shortening. Were the strain uniform (affine), a
+    contact of normal n between disks whose radii add to d would overlap by d n.eps.n; the strain
+    whose overlaps fit the measured ones best (least squares over the disk-disk contacts) is the
+    packing's elastic strain in that approximation: eps_1^e along y (the plate's axis), eps_3^e
+    along x. The disks' non-affine relaxation makes the true elastic strain somewhat larger.
+    """
+    c = disk_contacts(sim)
+    if c.i.size < 3:
+        return float("nan"), float("nan")
+    nx, ny = c.normal[:, 0], c.normal[:, 1]
+    rows = np.column_stack([nx * nx, ny * ny, 2.0 * nx * ny])
+    fit = np.linalg.lstsq(rows, c.overlap / c.reach, rcond=None)[0]
+    return float(fit[1]), float(fit[0])
 
 
 @dataclass(frozen=True)
@@ -100,7 +130,10 @@ def scaled_stiffness(sim: Simulation, kappa: float, sigma_pa: float) -> DiskStif
 __all__ = [
     "STIFFNESS_DEFINITION",
     "DiskStiffness",
+    "DiskContacts",
     "contact_kn",
+    "contact_strain",
+    "disk_contacts",
     "overlap_ratio",
     "scaled_stiffness",
     "stiffness_number",
