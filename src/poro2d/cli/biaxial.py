@@ -267,18 +267,17 @@ def _number(value: float | None, digits: int, scale: float = 1.0) -> str:
 
 
 def print_elastic(plastic, kappa, tests) -> None:
-    """The plastic psi_max, the stiffness number and the probe's moduli (docs/biaxial.md)."""
+    """The plastic psi_max, the stiffness number and the probe's compliances (docs/biaxial.md)."""
     if plastic is not None:
-        console.print(
-            f"plastic psi_max = {plastic.text()} (elastic strain C (sigma_1 - sigma_1,0) taken out)"
-        )
-    probes = [t.elastic_probe for t in tests if t.elastic_probe is not None and t.elastic_probe.reached]
+        console.print(f"plastic psi_max = {plastic.text()} (the contacts' elastic strain taken out)")
     if kappa is not None:
         console.print(f"stiffness number kappa = kn / (sigma_3 t) = {kappa.text(0)}")
+    probes = [t.elastic_probe for t in tests if t.elastic_probe is not None and t.elastic_probe.reached]
     if probes:
-        k = [p.bulk_modulus_mpa for p in probes]
-        g = [p.shear_modulus_mpa for p in probes]
+        c1 = [p.axial_compliance for p in probes]
+        cc1 = [p.contact_axial_compliance for p in probes]
         console.print(
-            f"elastic probe (unloading by {probes[0].unload:g} of the deviator after shearing): "
-            f"K = {min(k):.3g}-{max(k):.3g} MPa, G = {min(g):.3g}-{max(g):.3g} MPa over {len(probes)} test(s)"
+            f"unloading probe ({probes[0].unload:g} of the deviator after shearing, {len(probes)} test(s)): "
+            f"d eps_1 / d sigma_1 = {min(c1):.3g}-{max(c1):.3g} /MPa measured, "
+            f"{min(cc1):.3g}-{max(cc1):.3g} /MPa in the contacts' elastic strain"
         )
