@@ -22,7 +22,7 @@ from dataclasses import asdict
 import numpy as np
 
 from poro2d.biaxial.angles import read_angles, read_plastic
-from poro2d.biaxial.box import BiaxialBox, build_biaxial_box
+from poro2d.biaxial.box import BiaxialBox, BoxSize, build_biaxial_box
 from poro2d.biaxial.case import BiaxialCase
 from poro2d.biaxial.curve import BiaxialCurve, read_curve
 from poro2d.biaxial.elastic import plastic_strains, probe_compliance
@@ -154,11 +154,7 @@ class BiaxialTest:
         rows, velocity = shearing.run()
         curve = BiaxialCurve.of_rows(rows)
         angles = read_angles(curve, s.smoothing_strain, s.critical_window, s.critical_rate_limit)
-        curve = curve.with_plastic(*plastic_strains(curve))
-        probe = None
-        if s.probe_unload is not None:  # after the curve: the test's own numbers stay as they were
-            probe = probe_compliance(sim, start, sigma, s, velocity, self.progress)
-        plastic = read_plastic(curve, s.smoothing_strain, s.critical_window)
+        curve, elastic = self.elastic(sim, start, curve, velocity)
         result = BiaxialTestResult(
             confining_stress_kpa=self.case.confining_kpa, **asdict(angles),
             checks=self.checks(curve), consolidation=info, strain_rate_per_s=self.strain_rate,
@@ -166,14 +162,29 @@ class BiaxialTest:
             density_scale=sim.density_scale, shear_steps=int(rows[-1]["step"]), records=len(rows),
             wall_time_s=time.perf_counter() - t0, settings=s.record(), specimen=self.case.specimen.source,
             specimen_digest=self.case.specimen.digest, provenance=Provenance.now(),
-            stiffness_number=info.stiffness_number, stiffness_scale=self.scale, elastic_probe=probe,
+            stiffness_number=info.stiffness_number, stiffness_scale=self.scale,
             mean_overlap_ratio_at_peak=float(np.interp(angles.axial_strain_at_peak, curve.axial_strain,
-                                                       curve.mean_overlap_ratio)),
-            **(asdict(plastic) if plastic is not None else {}),
+                                                       curve.mean_overlap_ratio)), **elastic,
         )  # fmt: skip
         stored = BiaxialTestResult.from_dict(as_json(result))
         stored.curve = curve
         return stored
+
+    def elastic(
+        self, sim: Simulation, start: BoxSize, curve: BiaxialCurve, velocity: float
+    ) -> tuple[BiaxialCurve, dict]:
+        """The curve with its plastic strains, and the result's elastic fields: the plastic angles and
+        the unloading probe, run on ``sim`` as shearing left it (the curve is recorded: the test's
+        own numbers stay as they were)."""
+        s = self.case.settings
+        curve = curve.with_plastic(*plastic_strains(curve))
+        plastic = read_plastic(curve, s.smoothing_strain, s.critical_window)
+        fields = asdict(plastic) if plastic is not None else {}
+        if s.probe_unload is not None:
+            fields["elastic_probe"] = probe_compliance(
+                sim, start, self.case.confining_kpa, s, velocity, self.progress
+            )
+        return curve, fields
 
     def checks(self, curve: BiaxialCurve) -> ShearChecks:
         """sigma_3 held, equilibrium and the inertial number over the shearing stage."""
