@@ -12,6 +12,7 @@ from poro2d.biaxial.angles import read_angles, read_plastic
 from poro2d.biaxial.config import load_biaxial_config
 from poro2d.biaxial.curve import CURVE_COLUMNS, BiaxialCurve
 from poro2d.biaxial.elastic import plastic_strains
+from poro2d.biaxial.parts import AngleSpread, spread_of
 from poro2d.cli import main
 from poro2d.errors import InputError
 
@@ -49,6 +50,11 @@ def test_plastic_strain_is_the_total_less_the_elastic_strain_change():
     assert abs(plastic.plastic_max_dilatancy_angle_deg) < 1e-6
     assert abs(plastic.plastic_end_dilatancy_angle_deg) < 1e-6
     assert read_plastic(curve, 0.01, 0.25) is None  # no plastic columns, no plastic angles
+
+
+def test_a_study_holding_a_test_of_before_has_no_spread_of_the_new_numbers():
+    assert spread_of(AngleSpread, [12.0, None]) is None and spread_of(AngleSpread, []) is None
+    assert spread_of(AngleSpread, [12.0, 14.0]).mean == 13.0
 
 
 def test_a_curve_of_before_has_no_new_columns_and_writes_none():

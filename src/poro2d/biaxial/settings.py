@@ -26,8 +26,9 @@ MAX_AXIAL_STRAIN = 0.5
 #: most rows a curve may hold
 MAX_RECORDS = 100_000
 
-#: the share of the end deviator the elastic probe unloads (:mod:`poro2d.biaxial.elastic`): enough
-#: to read a slope above the equilibrium's noise, little enough that few contacts slide back
+#: the share of the end deviator the unloading probe takes off (:mod:`poro2d.biaxial.elastic`): enough
+#: to read a slope above the equilibrium's noise (0.05-0.1 was not on the quick specimen at 50 kPa),
+#: little enough that fewer contacts slide back
 PROBE_UNLOAD_RANGE = (0.05, 0.9)
 #: the stiffness numbers a test may be run at (:mod:`poro2d.biaxial.stiffness`): below 10 the
 #: overlaps pass a tenth of a diameter, above 1e5 the time step makes a test last hours
@@ -80,8 +81,9 @@ class BiaxialSettings:
     is averaged before its peak is read; critical_window the last part of the axial strain
     (a fraction of max_strain) where the critical state is read; critical_rate_limit the
     largest |d eps_v / d eps_1| over that window for it to count as critical; probe_unload
-    the share of the end deviator the elastic probe unloads after shearing (None: no probe, no
-    plastic strains; :mod:`poro2d.biaxial.elastic`); stiffness_number, when given, the
+    the share of the end deviator the unloading probe takes off after shearing, the check of the
+    contacts' elastic strain (None: no probe; the plastic strains do not need it;
+    :mod:`poro2d.biaxial.elastic`); stiffness_number, when given, the
     stiffness number kappa = kn / (sigma_3 t) the disks' kn and ks are scaled to for the test
     (:mod:`poro2d.biaxial.stiffness`; >= 1000 the rigid-grain limit; None: the specimen's).
     """
