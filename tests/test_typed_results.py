@@ -11,6 +11,9 @@ shear summary and the accepted specimen's state and porosity files. Written befo
 calibration's and the sand's results had typed parts: ``poro2d calibrate --preset paper --quick``
 (calibration_result.json) and ``poro2d sand`` on a small toy soil (sand_result.json). Written before
 biaxial series existed: a one-stress ``poro2d biaxial`` on a paper-size specimen (biaxial_result.json).
+Written before the biaxial test recorded its stiffness number, overlap and plastic strains:
+``poro2d biaxial --quick --confining 50,200 --replicates 2`` (biaxial_series_result.json, and its
+first test at 50 kPa, biaxial_test_result.json).
 """
 
 import dataclasses
@@ -21,7 +24,7 @@ from pathlib import Path
 
 import pytest
 
-from poro2d.biaxial.results import BiaxialResult
+from poro2d.biaxial.results import BiaxialResult, BiaxialSeriesResult, BiaxialTestResult
 from poro2d.calibration.run import CalibrationResult
 from poro2d.criterion.result import (
     CriterionResult,
@@ -52,6 +55,8 @@ FILES = [
     (CalibrationResult, "calibration_result.json"),
     (SandResult, "sand_result.json"),
     (BiaxialResult, "biaxial_result.json"),
+    (BiaxialSeriesResult, "biaxial_series_result.json"),
+    (BiaxialTestResult, "biaxial_test_result.json"),
 ]
 
 

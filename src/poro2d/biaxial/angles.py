@@ -14,7 +14,9 @@ Definitions (docs/biaxial.md):
   the angle is the end value, not a critical-state one;
 * dilatancy: sin(psi) = -d eps_v / d eps_s with eps_s = eps_1 - eps_3 (positive: the
   specimen dilates), each increment a secant over ``smoothing_strain`` of axial strain;
-  its largest value gives psi_max.
+  its largest value gives psi_max;
+* plastic dilatancy: the same of the plastic strains, the elastic part C (sigma_1 - sigma_1,0)
+  taken out (:mod:`poro2d.biaxial.elastic`), over the same windows.
 """
 
 from __future__ import annotations
@@ -72,12 +74,8 @@ def read_angles(
     sin_phi = smoothed(e1, curve.sin_phi, smoothing_strain)
     k = int(np.nanargmax(sin_phi))
     end = float(e1[-1])
-    tail = e1 >= (1.0 - critical_window) * end
-    if np.count_nonzero(tail) < 3:
-        tail = np.zeros(e1.size, bool)
-        tail[-3:] = True
-    rate = float(np.polyfit(e1[tail], ev[tail], 1)[0])
-    shear_rate = float(np.polyfit(e1[tail], es[tail], 1)[0])
+    tail = _tail(e1, critical_window)
+    rate, shear_rate = _end_rates(e1, ev, es, tail)
     s_cs = float(np.mean(curve.sin_phi[tail]))
     reached = abs(rate) <= rate_limit
     note = (
@@ -96,7 +94,7 @@ def read_angles(
         critical_state_mean_stress_kpa=float(np.mean(curve.mean_stress_kpa[tail])),
         critical_window=[float(e1[tail][0]), end],
         end_dilatancy_rate=rate,
-        end_dilatancy_angle_deg=_asin_deg(-rate / shear_rate) if shear_rate > 0 else math.nan,
+        end_dilatancy_angle_deg=_end_angle(rate, shear_rate),
         critical_state_reached=bool(reached),
         critical_state_note=note,
         max_dilatancy_angle_deg=psi,
@@ -104,6 +102,50 @@ def read_angles(
         end_volumetric_strain=float(ev[-1]),
         min_volumetric_strain=float(ev.min()),
     )
+
+
+@dataclass(frozen=True)
+class PlasticAngles:
+    """The dilatancy of a curve's plastic strains (:mod:`poro2d.biaxial.elastic`), read as
+    :func:`read_angles` reads the total ones (degrees; strains as fractions)."""
+
+    plastic_max_dilatancy_angle_deg: float
+    plastic_axial_strain_at_max_dilatancy: float
+    plastic_end_dilatancy_angle_deg: float
+    plastic_end_volumetric_strain: float
+
+
+def read_plastic(
+    curve: BiaxialCurve, smoothing_strain: float, critical_window: float
+) -> PlasticAngles | None:
+    """psi_max and the end dilatancy of ``curve``'s plastic strains (None: it has none), over the
+    windows of the total ones (the axial strain the abscissa)."""
+    ev, es = curve.plastic_volumetric_strain, curve.plastic_shear_strain
+    if ev is None or es is None:
+        return None
+    e1 = curve.axial_strain
+    psi, at = _max_dilatancy(e1, ev, es, smoothing_strain)
+    rate, shear_rate = _end_rates(e1, ev, es, _tail(e1, critical_window))
+    return PlasticAngles(psi, at, _end_angle(rate, shear_rate), float(ev[-1]))
+
+
+def _tail(e1: np.ndarray, critical_window: float) -> np.ndarray:
+    """The rows of the last ``critical_window`` of the axial strain (at least the last 3)."""
+    tail = e1 >= (1.0 - critical_window) * float(e1[-1])
+    if np.count_nonzero(tail) < 3:
+        tail = np.zeros(e1.size, bool)
+        tail[-3:] = True
+    return tail
+
+
+def _end_rates(e1: np.ndarray, ev: np.ndarray, es: np.ndarray, tail: np.ndarray) -> tuple[float, float]:
+    """The least-squares slopes d eps_v / d eps_1 and d eps_s / d eps_1 over ``tail``."""
+    return float(np.polyfit(e1[tail], ev[tail], 1)[0]), float(np.polyfit(e1[tail], es[tail], 1)[0])
+
+
+def _end_angle(rate: float, shear_rate: float) -> float:
+    """The dilatancy angle of the end slopes: sin(psi) = -(d eps_v) / (d eps_s)."""
+    return _asin_deg(-rate / shear_rate) if shear_rate > 0 else math.nan
 
 
 def _max_dilatancy(e1: np.ndarray, ev: np.ndarray, es: np.ndarray, window: float) -> tuple[float, float]:
@@ -120,4 +162,4 @@ def _max_dilatancy(e1: np.ndarray, ev: np.ndarray, es: np.ndarray, window: float
     return _asin_deg(float(sin_psi[k])), float(centre[k])
 
 
-__all__ = ["Angles", "read_angles", "smoothed"]
+__all__ = ["Angles", "PlasticAngles", "read_angles", "read_plastic", "smoothed"]

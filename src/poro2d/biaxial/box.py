@@ -23,9 +23,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from poro2d.dem import ContactModel, Particles, Simulation, Walls
+from poro2d.dem import Particles, Simulation, Walls
 from poro2d.dem.ordering import strip_order
 from poro2d.errors import InputError
+from poro2d.shear.box import pair_type_contact, replaced_values
 from poro2d.specimen.box import box_faces
 
 #: the four walls and the way each moves to compress the specimen
@@ -109,11 +110,15 @@ def build_biaxial_box(
     density_scale: float = 1.0,
     dt_safety: float = 0.8,
     threads: int = 1,
+    particle_kn: float | None = None,
+    particle_ks: float | None = None,
 ) -> tuple[Simulation, BiaxialBox]:
     """A new simulation of the specimen's disks in the biaxial box, without gravity.
 
     The disks keep their positions and properties (``particle_friction`` and
-    ``rolling_friction`` replace theirs when given; the walls take the disks' largest mu_r,
+    ``rolling_friction`` replace theirs when given, ``particle_kn`` and ``particle_ks`` their
+    stiffness (N/m), as :func:`poro2d.shear.box.build_split_box` replaces them: the time step is
+    the new simulation's, so it follows the stiffness; the walls take the disks' largest mu_r,
     as the direct shear box does). Gravity is switched off: a biaxial specimen is a small
     element of soil under its confining stress, and gravity would make its stress vary with
     height. A specimen whose box is not at (0, 0) or whose disks are not all inside it is
@@ -138,17 +143,12 @@ def build_biaxial_box(
     walls.add((0.0, H + e), (0.0, -e), *k, name="left", mu_r=wall_mu_r)
     particles = Particles(
         pos=p0.pos.copy(), radius=p0.radius.copy(), density=p0.density.copy(), thickness=p0.thickness,
-        kn=p0.kn.copy(), ks=p0.ks.copy(),
+        kn=replaced_values(p0.kn, particle_kn), ks=replaced_values(p0.ks, particle_ks),
         mu=p0.mu.copy() if particle_friction is None else np.full(p0.n, float(particle_friction)),
         vel=np.zeros_like(p0.vel), theta=p0.theta.copy(), omega=np.zeros_like(p0.omega), mode=p0.mode.copy(),
         mu_r=mu_r,
     )  # fmt: skip
-    contact = specimen.contact
-    if particle_friction is not None and contact.convention == "per_pair_type":
-        assert contact.pp is not None
-        contact = ContactModel(
-            "per_pair_type", (contact.pp[0], contact.pp[1], float(particle_friction)), contact.pw
-        )
+    contact = pair_type_contact(specimen.contact, particle_friction, particle_kn, particle_ks)
     sim = Simulation(
         particles, walls, contact, gravity=(0.0, 0.0), local_damping=specimen.local_damping,
         restitution=specimen.restitution, dt_safety=dt_safety, density_scale=density_scale,

@@ -13,11 +13,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import ClassVar
 
 import numpy as np
 
 from poro2d.biaxial.box import BiaxialBox, BoxSize
+from poro2d.biaxial.stiffness import contact_strain, overlap_ratio
 from poro2d.dem import Simulation
 from poro2d.store import Store
 from poro2d.typed_result import TypedResult
@@ -39,13 +41,21 @@ CURVE_COLUMNS = (
     "max_unbalanced_ratio",
     "inertial_number",
 )
+#: columns written since the elastic strain was told apart from the plastic (absent from a curve of
+#: before): the mean overlap over the mean diameter of the disk-disk contacts and the elastic strain
+#: they hold (:mod:`poro2d.biaxial.stiffness`), the plastic strains (:mod:`poro2d.biaxial.elastic`)
+OPTIONAL_COLUMNS = (
+    "mean_overlap_ratio", "elastic_axial_strain", "elastic_lateral_strain", "plastic_volumetric_strain",
+    "plastic_shear_strain",
+)  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
 class BiaxialCurve(Mapping):
-    """A test's recorded curve: one float array per column of :data:`CURVE_COLUMNS`.
+    """A test's recorded curve: one float array per column of :data:`CURVE_COLUMNS`, and of
+    :data:`OPTIONAL_COLUMNS` where it has them (None where not).
 
-    Also a read-only mapping of the column names to the arrays, in the file's order.
+    Also a read-only mapping of the column names it has to the arrays, in the file's order.
     """
 
     step: np.ndarray
@@ -62,27 +72,44 @@ class BiaxialCurve(Mapping):
     sin_phi: np.ndarray
     max_unbalanced_ratio: np.ndarray
     inertial_number: np.ndarray
+    mean_overlap_ratio: np.ndarray | None = None
+    elastic_axial_strain: np.ndarray | None = None
+    elastic_lateral_strain: np.ndarray | None = None
+    plastic_volumetric_strain: np.ndarray | None = None
+    plastic_shear_strain: np.ndarray | None = None
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        """The columns this curve has, in the file's order."""
+        return CURVE_COLUMNS + tuple(k for k in OPTIONAL_COLUMNS if getattr(self, k) is not None)
 
     def __getitem__(self, name: str) -> np.ndarray:
-        if name not in CURVE_COLUMNS:
+        if name not in self.columns:
             raise KeyError(name)
         return getattr(self, name)
 
     def __iter__(self) -> Iterator[str]:
-        return iter(CURVE_COLUMNS)
+        return iter(self.columns)
 
     def __len__(self) -> int:
-        return len(CURVE_COLUMNS)
+        return len(self.columns)
 
     @classmethod
     def of_rows(cls, rows: list[Mapping]) -> BiaxialCurve:
-        """The rows as columns, every value through ``float`` as ``curve.csv`` stores it."""
-        return cls(**{k: np.array([float(r[k]) for r in rows]) for k in CURVE_COLUMNS})
+        """The rows as columns, every value through ``float`` as ``curve.csv`` stores it; an optional
+        column only where every row has it."""
+        kept = [k for k in OPTIONAL_COLUMNS if rows and all(r.get(k) not in (None, "") for r in rows)]
+        return cls(**{k: np.array([float(r[k]) for r in rows]) for k in (*CURVE_COLUMNS, *kept)})
 
     def rows(self) -> list[dict]:
         """The curve as rows of Python floats (for ``curve.csv``)."""
-        cols = [self[k].tolist() for k in CURVE_COLUMNS]
-        return [dict(zip(CURVE_COLUMNS, values, strict=True)) for values in zip(*cols, strict=True)]
+        names = self.columns
+        cols = [self[k].tolist() for k in names]
+        return [dict(zip(names, values, strict=True)) for values in zip(*cols, strict=True)]
+
+    def with_plastic(self, volumetric: np.ndarray, shear: np.ndarray) -> BiaxialCurve:
+        """This curve with its plastic strains (:func:`poro2d.biaxial.elastic.plastic_strains`)."""
+        return replace(self, plastic_volumetric_strain=volumetric, plastic_shear_strain=shear)
 
 
 @dataclass(eq=False)
@@ -103,6 +130,15 @@ class CurveRow(TypedResult):
     sin_phi: float
     max_unbalanced_ratio: float
     inertial_number: float
+    mean_overlap_ratio: float | None = None
+    elastic_axial_strain: float | None = None
+    elastic_lateral_strain: float | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = (
+        "mean_overlap_ratio",
+        "elastic_axial_strain",
+        "elastic_lateral_strain",
+    )
 
 
 def read_curve(store: Store, name: str = "curve.csv") -> BiaxialCurve | None:
@@ -121,6 +157,7 @@ def curve_row(
     e3 = math.log(start.width / now.width)
     p = 0.5 * (s1 + s3)
     ratio, _ = sim.unbalanced_ratios()
+    elastic_1, elastic_3 = contact_strain(sim)
     return CurveRow(
         step=step,
         axial_strain=e1,
@@ -136,7 +173,10 @@ def curve_row(
         sin_phi=(s1 - s3) / (s1 + s3) if s1 + s3 > 0 else math.nan,
         max_unbalanced_ratio=ratio,
         inertial_number=strain_rate * d50 * math.sqrt(rho / p) if p > 0 else math.inf,
+        mean_overlap_ratio=overlap_ratio(sim),
+        elastic_axial_strain=elastic_1,
+        elastic_lateral_strain=elastic_3,
     )
 
 
-__all__ = ["CURVE_COLUMNS", "BiaxialCurve", "CurveRow", "curve_row", "read_curve"]
+__all__ = ["CURVE_COLUMNS", "OPTIONAL_COLUMNS", "BiaxialCurve", "CurveRow", "curve_row", "read_curve"]

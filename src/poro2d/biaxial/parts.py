@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
+from poro2d.biaxial.stiffness import STIFFNESS_DEFINITION
 from poro2d.measure.spread import Spread
 from poro2d.typed_result import TypedResult
 
@@ -35,8 +36,55 @@ class ConsolidationRecord(TypedResult):
     coordination_number: float
     wall_time_s: float
     box: BoxRecord
+    contact_kn: float | None = None
+    stiffness_number: float | None = None
+    mean_overlap_ratio: float | None = None
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {"box": BoxRecord}
+    #: written since the stiffness number was recorded (:mod:`poro2d.biaxial.stiffness`): the disk-disk
+    #: contacts' mean kn (N/m), kappa = kn / (sigma_3 t) and mean overlap / mean diameter
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("contact_kn", "stiffness_number", "mean_overlap_ratio")
+
+
+@dataclass(eq=False)
+class ElasticProbe(TypedResult):
+    """The specimen's elastic compliance along the test's stress path, read after shearing
+    (:mod:`poro2d.biaxial.elastic`): the plate held, then unloaded by ``unload`` of the deviator at
+    constant sigma_3.
+
+    ``before`` and ``after``: (sigma_1 in kPa, eps_1, eps_3) at the two equilibria;
+    ``axial_compliance`` and ``lateral_compliance`` (1/MPa): d eps_1 / d sigma_1 and
+    d eps_3 / d sigma_1 over the unloading; ``bulk_modulus_mpa`` K = 1 / (2 (C1 + C3)) and
+    ``shear_modulus_mpa`` G = 1 / (2 (C1 - C3)) (2D: p and t = (sigma_1 - sigma_3) / 2 against
+    eps_v and eps_s); ``contact_axial_compliance`` and ``contact_lateral_compliance``: the same
+    secants of the contacts' elastic strain (:func:`poro2d.biaxial.stiffness.contact_strain`), what
+    the plastic strains take out; ``reached``: both equilibria reached (otherwise no compliance).
+    """
+
+    definition: str
+    unload: float
+    before: list[float]
+    after: list[float]
+    sigma_3_kpa: list[float]
+    steps: int
+    reached: bool
+    axial_compliance: float | None
+    lateral_compliance: float | None
+    bulk_modulus_mpa: float | None
+    shear_modulus_mpa: float | None
+    contact_axial_compliance: float | None
+    contact_lateral_compliance: float | None
+
+
+@dataclass(eq=False)
+class StiffnessScale(TypedResult):
+    """What ``stiffness_number`` did to a test (:mod:`poro2d.biaxial.stiffness`): the asked kappa,
+    the disks' new kn and ks (N/m) and the factor on the specimen's contact stiffness."""
+
+    stiffness_number: float
+    disk_kn: float
+    disk_ks: float
+    factor: float
 
 
 @dataclass(eq=False)
@@ -61,6 +109,11 @@ class ShearChecks(TypedResult):
     quasi_static: bool
 
 
+#: the spreads over replicates a study adds once tests carry their elastic numbers (None for a
+#: study holding a test read back from before: see ``of_all``)
+ELASTIC_SPREADS = ("plastic_max_dilatancy_angle", "stiffness_number", "mean_overlap_ratio_at_peak")
+
+
 @dataclass(eq=False)
 class AngleSpread(Spread):
     """One angle over the replicates (degrees): mean, sd (None for one), min, max and each value."""
@@ -68,6 +121,14 @@ class AngleSpread(Spread):
     def text(self, digits: int = 1, unit: str = " deg") -> str:
         """``31.2 +- 1.4 deg (29.9-32.8)``, or ``31.2 deg`` for one value."""
         return super().text(digits, unit)
+
+
+def spread_of(kind: type[Spread], values: list[float | None]) -> Spread | None:
+    """The spread of ``values``, or None when a test lacks the number (one read back from before it
+    was recorded, or without its probe): a spread over some replicates would pass for all of them."""
+    if not values or any(v is None for v in values):
+        return None
+    return kind.of(values)
 
 
 @dataclass(eq=False)
@@ -84,6 +145,13 @@ class TestSummary(TypedResult):
     end_volumetric_strain: float
     sigma_3_max_error: float
     wall_time_s: float
+    stiffness_number: float | None = None
+    mean_overlap_ratio_at_peak: float | None = None
+    plastic_max_dilatancy_angle_deg: float | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = (
+        "stiffness_number", "mean_overlap_ratio_at_peak", "plastic_max_dilatancy_angle_deg",
+    )  # fmt: skip
 
 
 @dataclass(eq=False)
@@ -98,13 +166,20 @@ class StressSummary(TypedResult):
     axial_strain_at_peak: AngleSpread
     critical_state_reached: bool
     critical_state_note: str
+    plastic_max_dilatancy_angle: AngleSpread | None = None
+    stiffness_number: Spread | None = None
+    mean_overlap_ratio_at_peak: Spread | None = None
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "peak_friction_angle": AngleSpread,
         "critical_state_friction_angle": AngleSpread,
         "max_dilatancy_angle": AngleSpread,
         "axial_strain_at_peak": AngleSpread,
+        "plastic_max_dilatancy_angle": AngleSpread,
+        "stiffness_number": Spread,
+        "mean_overlap_ratio_at_peak": Spread,
     }
+    OPTIONAL: ClassVar[tuple[str, ...]] = ELASTIC_SPREADS
 
 
 @dataclass(eq=False)
@@ -126,6 +201,10 @@ class Definitions(TypedResult):
     peak: str
     critical_state: str
     dilatancy: str
+    plastic: str | None = None
+    stiffness_number: str | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("plastic", "stiffness_number")
 
 
 DEFINITIONS: dict[str, Any] = {
@@ -137,6 +216,10 @@ DEFINITIONS: dict[str, Any] = {
     "critical_state": "mean sin(phi) over the last critical_window of the axial strain, critical only if "
     "|d eps_v / d eps_1| there is at most critical_rate_limit",
     "dilatancy": "sin(psi) = -d eps_v / d eps_s over secants of smoothing_strain; psi_max its largest value",
+    "plastic": "eps_1^p = eps_1 - (eps_1^e - eps_1,0^e), eps_3^p = eps_3 - (eps_3^e - eps_3,0^e), eps^e the "
+    "uniform strain whose contact overlaps best fit the measured ones (least squares over the disk-disk "
+    "contacts, each row); plastic psi_max from eps_v^p and eps_s^p as psi_max from eps_v, eps_s",
+    "stiffness_number": STIFFNESS_DEFINITION,
 }
 #: how a series' envelope is read (:mod:`poro2d.biaxial.envelope`)
 ENVELOPE_DEFINITION = (
@@ -147,6 +230,7 @@ ENVELOPE_DEFINITION = (
 
 
 __all__ = [
-    "DEFINITIONS", "ENVELOPE_DEFINITION", "AngleSpread", "BoxRecord", "ConsolidationRecord", "Definitions",
-    "LabCurveRecord", "ShearChecks", "StressSummary", "TestSummary",
+    "DEFINITIONS", "ELASTIC_SPREADS", "ENVELOPE_DEFINITION", "AngleSpread", "BoxRecord",
+    "ConsolidationRecord", "Definitions", "ElasticProbe", "LabCurveRecord", "ShearChecks",
+    "StiffnessScale", "StressSummary", "TestSummary", "spread_of",
 ]  # fmt: skip

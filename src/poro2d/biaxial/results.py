@@ -8,16 +8,20 @@ from typing import Any, ClassVar
 from poro2d.biaxial.curve import BiaxialCurve, read_curve
 from poro2d.biaxial.envelope import EnvelopeRecord
 from poro2d.biaxial.parts import (
+    ELASTIC_SPREADS,
     AngleSpread,
     ConsolidationRecord,
     Definitions,
+    ElasticProbe,
     LabCurveRecord,
     ShearChecks,
+    StiffnessScale,
     StressSummary,
     TestSummary,
 )
 from poro2d.biaxial.settings import BiaxialSettingsRecord
 from poro2d.io_utils import Provenance
+from poro2d.measure.spread import Spread
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
@@ -27,8 +31,12 @@ class BiaxialTestResult(TypedResult):
     """One biaxial test (a replicate folder's ``result.json``): its angles and how they were obtained.
 
     Angles in degrees, strains as fractions (compression positive), stresses in kPa; the
-    definitions are :mod:`poro2d.biaxial.angles`'. ``curve`` (not in the file): the recorded
-    curve (:class:`~poro2d.biaxial.curve.BiaxialCurve`).
+    definitions are :mod:`poro2d.biaxial.angles`'. ``stiffness_number``: kappa = kn / (sigma_3 t)
+    of the test (:mod:`poro2d.biaxial.stiffness`; the consolidation record has it too, with the
+    overlap then), ``mean_overlap_ratio_at_peak`` the mean overlap / mean diameter at the peak;
+    ``elastic_probe`` the compliance measured after shearing and ``plastic_*`` the dilatancy of
+    the plastic strains (:mod:`poro2d.biaxial.elastic`). ``curve`` (not in the file): the
+    recorded curve (:class:`~poro2d.biaxial.curve.BiaxialCurve`).
     """
 
     confining_stress_kpa: float
@@ -62,6 +70,14 @@ class BiaxialTestResult(TypedResult):
     specimen: str
     specimen_digest: str
     provenance: Provenance
+    stiffness_number: float | None = None
+    mean_overlap_ratio_at_peak: float | None = None
+    stiffness_scale: StiffnessScale | None = None
+    elastic_probe: ElasticProbe | None = None
+    plastic_max_dilatancy_angle_deg: float | None = None
+    plastic_axial_strain_at_max_dilatancy: float | None = None
+    plastic_end_dilatancy_angle_deg: float | None = None
+    plastic_end_volumetric_strain: float | None = None
     curve: BiaxialCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
@@ -69,7 +85,16 @@ class BiaxialTestResult(TypedResult):
         "consolidation": ConsolidationRecord,
         "provenance": Provenance,
         "settings": BiaxialSettingsRecord,
+        "stiffness_scale": StiffnessScale,
+        "elastic_probe": ElasticProbe,
     }
+    #: written since the elastic strain was told apart (a test of before has none of them; a test
+    #: without its probe no plastic ones; ``stiffness_scale`` only with ``stiffness_number``)
+    OPTIONAL: ClassVar[tuple[str, ...]] = (
+        "stiffness_number", "mean_overlap_ratio_at_peak", "stiffness_scale", "elastic_probe",
+        "plastic_max_dilatancy_angle_deg", "plastic_axial_strain_at_max_dilatancy",
+        "plastic_end_dilatancy_angle_deg", "plastic_end_volumetric_strain",
+    )  # fmt: skip
 
     @classmethod
     def read(cls, store: Store) -> BiaxialTestResult | None:
@@ -92,7 +117,7 @@ class BiaxialResult(TypedResult):
     laboratory curves. ``tests`` (not in the file): each replicate's full result.
     """
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("lab",)
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("lab", *ELASTIC_SPREADS)
 
     confining_stress_kpa: float
     replicates: int
@@ -111,6 +136,9 @@ class BiaxialResult(TypedResult):
     config: dict[str, Any]
     provenance: Provenance
     lab: LabCurveRecord | None = None
+    plastic_max_dilatancy_angle: AngleSpread | None = None
+    stiffness_number: Spread | None = None
+    mean_overlap_ratio_at_peak: Spread | None = None
     tests: list[BiaxialTestResult] = field(
         default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
@@ -124,6 +152,9 @@ class BiaxialResult(TypedResult):
         "definitions": Definitions,
         "provenance": Provenance,
         "lab": LabCurveRecord,
+        "plastic_max_dilatancy_angle": AngleSpread,
+        "stiffness_number": Spread,
+        "mean_overlap_ratio_at_peak": Spread,
     }
 
     def headline(self) -> str:
@@ -151,7 +182,7 @@ class BiaxialSeriesResult(TypedResult):
     :class:`BiaxialResult`, its tests with their curves.
     """
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("lab",)
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("lab", "plastic_max_dilatancy_angle")
 
     confining_stresses_kpa: list[float]
     replicates: int
@@ -174,6 +205,7 @@ class BiaxialSeriesResult(TypedResult):
     config: dict[str, Any]
     provenance: Provenance
     lab: LabCurveRecord | None = None
+    plastic_max_dilatancy_angle: AngleSpread | None = None
     studies: list[BiaxialResult] = field(default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
@@ -187,6 +219,7 @@ class BiaxialSeriesResult(TypedResult):
         "settings": BiaxialSettingsRecord,
         "provenance": Provenance,
         "lab": LabCurveRecord,
+        "plastic_max_dilatancy_angle": AngleSpread,
     }
 
     def headline(self) -> str:

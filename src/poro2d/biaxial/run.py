@@ -13,15 +13,16 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from poro2d.biaxial.case import BiaxialCase
-from poro2d.biaxial.curve import CURVE_COLUMNS
+from poro2d.biaxial.curve import CURVE_COLUMNS, OPTIONAL_COLUMNS
 from poro2d.biaxial.lab import LabCurve, read_lab_curve
-from poro2d.biaxial.parts import DEFINITIONS, AngleSpread, Definitions, LabCurveRecord, TestSummary
+from poro2d.biaxial.parts import DEFINITIONS, AngleSpread, Definitions, LabCurveRecord, TestSummary, spread_of
 from poro2d.biaxial.results import BiaxialResult, BiaxialTestResult
 from poro2d.biaxial.single import BiaxialTest
 from poro2d.errors import InputError, check_int
 from poro2d.execute import Backend, Executor, Failed, Job, results_or_raise
 from poro2d.io_utils import Provenance, as_json, check_output_dir
 from poro2d.locks import output_folder
+from poro2d.measure.spread import Spread
 from poro2d.progress import JobsProgress
 from poro2d.report.biaxial_figures import plot_biaxial
 from poro2d.store import Store
@@ -195,6 +196,9 @@ def summarize(cases, tests, lab, workers, wall, config) -> BiaxialResult:
             end_volumetric_strain=t.end_volumetric_strain,
             sigma_3_max_error=t.checks.sigma_3_max_error,
             wall_time_s=t.wall_time_s,
+            stiffness_number=t.stiffness_number,
+            mean_overlap_ratio_at_peak=t.mean_overlap_ratio_at_peak,
+            plastic_max_dilatancy_angle_deg=t.plastic_max_dilatancy_angle_deg,
         )  # fmt: skip
         for k, t in enumerate(tests)
     ]
@@ -212,6 +216,10 @@ def summarize(cases, tests, lab, workers, wall, config) -> BiaxialResult:
         definitions=Definitions(**DEFINITIONS), settings=cases[0].settings.record(),
         specimens=[c.specimen.source for c in cases], processes=workers, wall_time_s=wall,
         config=config or {}, provenance=Provenance.now(), lab=lab_record,
+        plastic_max_dilatancy_angle=spread_of(AngleSpread, [t.plastic_max_dilatancy_angle_deg
+                                                            for t in tests]),
+        stiffness_number=spread_of(Spread, [t.stiffness_number for t in tests]),
+        mean_overlap_ratio_at_peak=spread_of(Spread, [t.mean_overlap_ratio_at_peak for t in tests]),
     )  # fmt: skip
     stored = BiaxialResult.from_dict(as_json(result))
     stored.tests = list(tests)
@@ -223,7 +231,10 @@ def write_study(store: Store, result: BiaxialResult, lab: LabCurve | None) -> No
     rows = []
     for k, t in enumerate(result.tests):
         rows += [{"replicate": k + 1, **r} for r in t.curve.rows()]
-    store.write_csv("curves.csv", rows, header=["replicate", *CURVE_COLUMNS])
+    columns = [
+        k for k in (*CURVE_COLUMNS, *OPTIONAL_COLUMNS) if any(k in t.curve.columns for t in result.tests)
+    ]
+    store.write_csv("curves.csv", rows, header=["replicate", *columns])  # a column a test lacks stays empty
     starts = [t.critical_window[0] for t in result.tests]
     end_mean = sum(t.critical_state_sin_phi for t in result.tests) / len(result.tests)
     lab_arrays = None

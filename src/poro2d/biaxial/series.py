@@ -20,7 +20,15 @@ from poro2d.biaxial.angles import smoothed
 from poro2d.biaxial.case import BiaxialCase
 from poro2d.biaxial.envelope import envelope, peak_circle
 from poro2d.biaxial.lab import LabCurve
-from poro2d.biaxial.parts import DEFINITIONS, ENVELOPE_DEFINITION, AngleSpread, Definitions, StressSummary
+from poro2d.biaxial.parts import (
+    DEFINITIONS,
+    ELASTIC_SPREADS,
+    ENVELOPE_DEFINITION,
+    AngleSpread,
+    Definitions,
+    StressSummary,
+    spread_of,
+)
 from poro2d.biaxial.results import BiaxialResult, BiaxialSeriesResult, BiaxialTestResult
 from poro2d.biaxial.run import (
     MAX_REPLICATES,
@@ -126,6 +134,7 @@ def _summary(study: BiaxialResult) -> StressSummary:
         critical_state_friction_angle=study.critical_state_friction_angle,
         max_dilatancy_angle=study.max_dilatancy_angle, axial_strain_at_peak=study.axial_strain_at_peak,
         critical_state_reached=study.critical_state_reached, critical_state_note=study.critical_state_note,
+        **{k: getattr(study, k) for k in ELASTIC_SPREADS},
     )  # fmt: skip
 
 
@@ -176,6 +185,8 @@ def summarize_series(studies: list[BiaxialResult], workers: int, wall: float, co
         sigma_3_held=all(t.checks.sigma_3_held for t in tests), sigma_3_note=_held_note(tests),
         definitions=Definitions(**DEFINITIONS), settings=first.settings, specimens=first.specimens,
         processes=workers, wall_time_s=wall, config=config or {}, provenance=Provenance.now(), lab=first.lab,
+        plastic_max_dilatancy_angle=spread_of(AngleSpread, [t.plastic_max_dilatancy_angle_deg
+                                                            for t in tests]),
     )  # fmt: skip
     stored = BiaxialSeriesResult.from_dict(as_json(result))
     stored.studies = list(studies)

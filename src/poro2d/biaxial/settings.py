@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from typing import ClassVar
 
 from poro2d.errors import InputError, Integer, Ranges, Real, check_fields
 from poro2d.paper_data import TABLE_1
@@ -24,6 +25,14 @@ CONFINING_RANGE_KPA = NORMAL_STRESS_RANGE_KPA
 MAX_AXIAL_STRAIN = 0.5
 #: most rows a curve may hold
 MAX_RECORDS = 100_000
+
+#: the share of the end deviator the unloading probe takes off (:mod:`poro2d.biaxial.elastic`): enough
+#: to read a slope above the equilibrium's noise (0.05-0.1 was not on the quick specimen at 50 kPa),
+#: little enough that fewer contacts slide back
+PROBE_UNLOAD_RANGE = (0.05, 0.9)
+#: the stiffness numbers a test may be run at (:mod:`poro2d.biaxial.stiffness`): below 10 the
+#: overlaps pass a tenth of a diameter, above 1e5 the time step makes a test last hours
+STIFFNESS_NUMBER_RANGE = (10.0, 1e5)
 
 #: what each setting of :class:`BiaxialSettings` may be (checked in this order)
 BIAXIAL_RANGES: Ranges = {
@@ -48,6 +57,8 @@ BIAXIAL_RANGES: Ranges = {
     "smoothing_strain": Real(0.0, 0.1),
     "critical_window": Real(0.0, 0.5, lo_open=True),
     "critical_rate_limit": Real(0.0, 1.0, lo_open=True),
+    "probe_unload": Real(*PROBE_UNLOAD_RANGE, or_none=True),
+    "stiffness_number": Real(*STIFFNESS_NUMBER_RANGE, or_none=True),
 }
 
 
@@ -69,7 +80,12 @@ class BiaxialSettings:
     a test may run at; smoothing_strain the window (axial strain) over which the stress ratio
     is averaged before its peak is read; critical_window the last part of the axial strain
     (a fraction of max_strain) where the critical state is read; critical_rate_limit the
-    largest |d eps_v / d eps_1| over that window for it to count as critical.
+    largest |d eps_v / d eps_1| over that window for it to count as critical; probe_unload
+    the share of the end deviator the unloading probe takes off after shearing, the check of the
+    contacts' elastic strain (None: no probe; the plastic strains do not need it;
+    :mod:`poro2d.biaxial.elastic`); stiffness_number, when given, the
+    stiffness number kappa = kn / (sigma_3 t) the disks' kn and ks are scaled to for the test
+    (:mod:`poro2d.biaxial.stiffness`; >= 1000 the rigid-grain limit; None: the specimen's).
     """
 
     strain_rate: float | None = None
@@ -93,6 +109,8 @@ class BiaxialSettings:
     smoothing_strain: float = 0.01
     critical_window: float = 0.25
     critical_rate_limit: float = 0.1
+    probe_unload: float | None = 0.3
+    stiffness_number: float | None = None
 
     def __post_init__(self) -> None:
         check_fields(self, BIAXIAL_RANGES)
@@ -139,6 +157,10 @@ class BiaxialSettingsRecord(TypedResult):
     smoothing_strain: float
     critical_window: float
     critical_rate_limit: float
+    probe_unload: float | None = None
+    stiffness_number: float | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("probe_unload", "stiffness_number")
 
 
 #: the strain rate of a test whose box lets its side walls follow (1/s)
@@ -175,6 +197,8 @@ def inertial_number(strain_rate: float, d50: float, rho: float, pressure_pa: flo
 __all__ = [
     "BIAXIAL_RANGES",
     "CONFINING_RANGE_KPA",
+    "PROBE_UNLOAD_RANGE",
+    "STIFFNESS_NUMBER_RANGE",
     "BiaxialSettings",
     "BiaxialSettingsRecord",
     "inertial_number",

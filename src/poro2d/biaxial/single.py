@@ -21,15 +21,17 @@ from dataclasses import asdict
 
 import numpy as np
 
-from poro2d.biaxial.angles import read_angles
-from poro2d.biaxial.box import BiaxialBox, build_biaxial_box
+from poro2d.biaxial.angles import read_angles, read_plastic
+from poro2d.biaxial.box import BiaxialBox, BoxSize, build_biaxial_box
 from poro2d.biaxial.case import BiaxialCase
-from poro2d.biaxial.curve import CURVE_COLUMNS, BiaxialCurve, read_curve
-from poro2d.biaxial.parts import ShearChecks
+from poro2d.biaxial.curve import BiaxialCurve, read_curve
+from poro2d.biaxial.elastic import plastic_strains, probe_compliance
+from poro2d.biaxial.parts import ShearChecks, StiffnessScale
 from poro2d.biaxial.record import claim, folder_stage
 from poro2d.biaxial.results import BiaxialTestResult
 from poro2d.biaxial.settings import auto_strain_rate, inertial_number
 from poro2d.biaxial.stages import SIDE_START_STRAIN, ProgressFn, Shearing, consolidate
+from poro2d.biaxial.stiffness import DiskStiffness, scaled_stiffness
 from poro2d.dem import Simulation
 from poro2d.errors import InputError
 from poro2d.io_utils import Provenance, as_json
@@ -65,14 +67,17 @@ class BiaxialTest:
         self.rho = math.nan
         self.i0 = math.nan
         self.strain_rate = math.nan
+        self.scale: StiffnessScale | None = None
 
     def build(self) -> Simulation:
         """The specimen in its box, with the test's damping; the inertial number checked."""
         s = self.case.settings
         spec = self.case.specimen.simulation(threads=self.threads)
+        disks = self.scaled(spec)
         sim, self.box = build_biaxial_box(
             spec, s.kn_wall, s.ks_wall, s.friction_wall, s.particle_friction, s.rolling_friction,
-            s.density_scale, s.dt_safety, self.threads,
+            s.density_scale, s.dt_safety, self.threads, particle_kn=disks.kn if disks else None,
+            particle_ks=disks.ks if disks else None,
         )  # fmt: skip
         if s.local_damping is not None:
             sim.set_local_damping(float(s.local_damping))
@@ -89,6 +94,15 @@ class BiaxialTest:
             )  # fmt: skip
         self.i0 = i0
         return sim
+
+    def scaled(self, spec: Simulation) -> DiskStiffness | None:
+        """The disks' stiffness for ``stiffness_number`` (None: the specimen's), kept as ``scale``."""
+        kappa = self.case.settings.stiffness_number
+        if kappa is None:
+            return None
+        disks = scaled_stiffness(spec, kappa, self.case.confining_kpa * 1e3)
+        self.scale = StiffnessScale(kappa, disks.kn, disks.ks, disks.factor)
+        return disks
 
     def stored(self) -> BiaxialTestResult | None:
         """This test's result when ``store`` holds it finished (with its curve), else None."""
@@ -121,7 +135,7 @@ class BiaxialTest:
 
         def compute() -> BiaxialTestResult:
             fresh.append(self.compute())
-            store.write_csv("curve.csv", fresh[0].curve.rows(), header=list(CURVE_COLUMNS))
+            store.write_csv("curve.csv", fresh[0].curve.rows(), header=list(fresh[0].curve.columns))
             return fresh[0]
 
         stage.run(compute, accept=lambda _: _curve_kept(store))  # nothing stored (above): it computes
@@ -135,10 +149,12 @@ class BiaxialTest:
         assert self.box is not None
         info = consolidate(sim, self.box, self.case.confining_kpa, s, self.progress)
         sigma = self.case.confining_kpa
+        start = BiaxialBox.size(sim)
         shearing = Shearing(sim, sigma, s, self.strain_rate, self.d50, self.rho, self.progress)
         rows, velocity = shearing.run()
         curve = BiaxialCurve.of_rows(rows)
         angles = read_angles(curve, s.smoothing_strain, s.critical_window, s.critical_rate_limit)
+        curve, elastic = self.elastic(sim, start, curve, velocity)
         result = BiaxialTestResult(
             confining_stress_kpa=self.case.confining_kpa, **asdict(angles),
             checks=self.checks(curve), consolidation=info, strain_rate_per_s=self.strain_rate,
@@ -146,10 +162,29 @@ class BiaxialTest:
             density_scale=sim.density_scale, shear_steps=int(rows[-1]["step"]), records=len(rows),
             wall_time_s=time.perf_counter() - t0, settings=s.record(), specimen=self.case.specimen.source,
             specimen_digest=self.case.specimen.digest, provenance=Provenance.now(),
+            stiffness_number=info.stiffness_number, stiffness_scale=self.scale,
+            mean_overlap_ratio_at_peak=float(np.interp(angles.axial_strain_at_peak, curve.axial_strain,
+                                                       curve.mean_overlap_ratio)), **elastic,
         )  # fmt: skip
         stored = BiaxialTestResult.from_dict(as_json(result))
         stored.curve = curve
         return stored
+
+    def elastic(
+        self, sim: Simulation, start: BoxSize, curve: BiaxialCurve, velocity: float
+    ) -> tuple[BiaxialCurve, dict]:
+        """The curve with its plastic strains, and the result's elastic fields: the plastic angles and
+        the unloading probe, run on ``sim`` as shearing left it (the curve is recorded: the test's
+        own numbers stay as they were)."""
+        s = self.case.settings
+        curve = curve.with_plastic(*plastic_strains(curve))
+        plastic = read_plastic(curve, s.smoothing_strain, s.critical_window)
+        fields = asdict(plastic) if plastic is not None else {}
+        if s.probe_unload is not None:
+            fields["elastic_probe"] = probe_compliance(
+                sim, start, self.case.confining_kpa, s, velocity, self.progress
+            )
+        return curve, fields
 
     def checks(self, curve: BiaxialCurve) -> ShearChecks:
         """sigma_3 held, equilibrium and the inertial number over the shearing stage."""

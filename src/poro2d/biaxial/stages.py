@@ -18,6 +18,7 @@ from poro2d.biaxial.box import BiaxialBox, BoxSize
 from poro2d.biaxial.curve import curve_row
 from poro2d.biaxial.parts import BoxRecord, ConsolidationRecord
 from poro2d.biaxial.settings import BiaxialSettings
+from poro2d.biaxial.stiffness import contact_kn, overlap_ratio, stiffness_number
 from poro2d.dem import Simulation
 from poro2d.measure.coordination import coordination_number
 
@@ -30,20 +31,72 @@ CONSOLIDATION_CHECK = 500
 SIDE_START_STRAIN = 0.01
 
 
-def servo_targets(sim: Simulation, sigma_pa: float, settings: BiaxialSettings, *, top: bool) -> None:
-    """Servo the side walls (and the plate when ``top``) to ``sigma_pa`` over their current contact length."""
+def servo_targets(
+    sim: Simulation, sigma_pa: float, settings: BiaxialSettings, *, top: bool, top_pa: float | None = None
+) -> None:
+    """Servo the side walls to ``sigma_pa`` over their current contact length, and the plate when
+    ``top`` (to ``top_pa``, by default ``sigma_pa``)."""
     s = BiaxialBox.size(sim)
     side = sigma_pa * s.height * s.thickness
     BiaxialBox.servo(sim, "left", side, settings)
     BiaxialBox.servo(sim, "right", side, settings)
     if top:
-        BiaxialBox.servo(sim, "top", sigma_pa * s.width * s.thickness, settings)
+        plate = sigma_pa if top_pa is None else top_pa
+        BiaxialBox.servo(sim, "top", plate * s.width * s.thickness, settings)
 
 
-def stress_errors(sim: Simulation, sigma_pa: float) -> list[float]:
-    """|stress / sigma - 1| of the plate, the left and the right wall."""
+def stress_errors(sim: Simulation, sigma_pa: float, top_pa: float | None = None) -> list[float]:
+    """|stress / target - 1| of the plate (target ``top_pa``, by default ``sigma_pa``), the left and
+    the right wall (target ``sigma_pa``)."""
     s1, _, left, right = BiaxialBox.stresses(sim)
-    return [abs(v / sigma_pa - 1.0) for v in (s1, left, right)]
+    plate = sigma_pa if top_pa is None else top_pa
+    return [abs(s1 / plate - 1.0), abs(left / sigma_pa - 1.0), abs(right / sigma_pa - 1.0)]
+
+
+@dataclass
+class Settled:
+    """How :func:`settle` ended: steps run, the last unbalanced ratio and largest stress error."""
+
+    steps: int
+    ratio: float
+    error: float
+    reached: bool
+
+
+def settle(
+    sim: Simulation, sigma_pa: float, settings: BiaxialSettings, *, top_pa: float | None,
+    phase: str, progress: ProgressFn | None = None, fixed_plate: bool = False,
+) -> Settled:  # fmt: skip
+    """Run until equilibrium: the side walls servoed to ``sigma_pa`` and the plate to ``top_pa`` (or
+    held where it is, ``fixed_plate``), their targets renewed every :data:`CONSOLIDATION_CHECK`
+    steps as the box changes. Reached: the maximum unbalanced-force ratio below
+    ``consolidation_ratio`` and each servoed wall's stress within ``stress_tolerance`` of its
+    target, within ``consolidation_max_steps`` steps."""
+    state = {"ratio": math.inf, "err": math.inf}
+    top = not fixed_plate
+
+    def errors(sm: Simulation) -> list[float]:
+        err = stress_errors(sm, sigma_pa, top_pa)
+        return err if top else err[1:]
+
+    def check(sm: Simulation) -> bool:
+        rmax, _ = sm.unbalanced_ratios()
+        err = max(errors(sm))
+        state.update(ratio=rmax, err=err)
+        if progress is not None:
+            progress(phase, min(sm.step_count / settings.consolidation_max_steps, 1.0))
+        if rmax < settings.consolidation_ratio and err < settings.stress_tolerance:
+            return True
+        servo_targets(sm, sigma_pa, settings, top=top, top_pa=top_pa)
+        return False
+
+    if fixed_plate:
+        sim.set_wall_velocity("top", (0.0, 0.0))
+    servo_targets(sim, sigma_pa, settings, top=top, top_pa=top_pa)
+    sim.reset_clock()
+    res = sim.run(settings.consolidation_max_steps, every=CONSOLIDATION_CHECK, callback=check)
+    reached = state["ratio"] < settings.consolidation_ratio and state["err"] < settings.stress_tolerance
+    return Settled(res.steps, state["ratio"], state["err"], bool(reached))
 
 
 def porosity(sim: Simulation) -> float:
@@ -63,37 +116,24 @@ def consolidate(
     """
     t0 = time.perf_counter()
     sigma = confining_kpa * 1e3
-    state = {"ratio": math.inf, "err": math.inf}
-
-    def check(sm: Simulation) -> bool:
-        rmax, _ = sm.unbalanced_ratios()
-        err = max(stress_errors(sm, sigma))
-        state.update(ratio=rmax, err=err)
-        if progress is not None:
-            progress("consolidating", min(sm.step_count / settings.consolidation_max_steps, 1.0))
-        if rmax < settings.consolidation_ratio and err < settings.stress_tolerance:
-            return True
-        servo_targets(sm, sigma, settings, top=True)
-        return False
-
-    servo_targets(sim, sigma, settings, top=True)
-    sim.reset_clock()
-    res = sim.run(settings.consolidation_max_steps, every=CONSOLIDATION_CHECK, callback=check)
-    if not (state["ratio"] < settings.consolidation_ratio and state["err"] < settings.stress_tolerance):
+    end = settle(sim, sigma, settings, top_pa=None, phase="consolidating", progress=progress)
+    if not end.reached:
         raise RuntimeError(
             f"consolidation to sigma_3 = {confining_kpa:g} kPa did not reach equilibrium within "
-            f"{settings.consolidation_max_steps} steps (unbalanced ratio {state['ratio']:.2e}, limit "
-            f"{settings.consolidation_ratio:g}; stress error {state['err']:.2%}, "
+            f"{settings.consolidation_max_steps} steps (unbalanced ratio {end.ratio:.2e}, limit "
+            f"{settings.consolidation_ratio:g}; stress error {end.error:.2%}, "
             f"limit {settings.stress_tolerance:.0%})"
         )
     s1, _, left, right = BiaxialBox.stresses(sim)
     size = BiaxialBox.size(sim)
+    kn = contact_kn(sim)
     return ConsolidationRecord(
-        confining_stress_kpa=confining_kpa, steps=res.steps, max_unbalanced_ratio=state["ratio"],
+        confining_stress_kpa=confining_kpa, steps=end.steps, max_unbalanced_ratio=end.ratio,
         sigma_1_kpa=s1 / 1e3, sigma_3_left_kpa=left / 1e3, sigma_3_right_kpa=right / 1e3,
-        max_stress_error=state["err"], width_m=size.width, height_m=size.height, porosity=porosity(sim),
+        max_stress_error=end.error, width_m=size.width, height_m=size.height, porosity=porosity(sim),
         coordination_number=coordination_number(sim), wall_time_s=time.perf_counter() - t0,
-        box=BoxRecord(box.width, box.height, box.thickness),
+        box=BoxRecord(box.width, box.height, box.thickness), contact_kn=kn,
+        stiffness_number=stiffness_number(kn, sigma, size.thickness), mean_overlap_ratio=overlap_ratio(sim),
     )  # fmt: skip
 
 
@@ -138,4 +178,7 @@ class Shearing:
         return rows, velocity
 
 
-__all__ = ["CONSOLIDATION_CHECK", "ProgressFn", "Shearing", "consolidate", "porosity", "servo_targets"]
+__all__ = [
+    "CONSOLIDATION_CHECK", "ProgressFn", "Settled", "Shearing", "consolidate", "porosity", "servo_targets",
+    "settle",
+]  # fmt: skip

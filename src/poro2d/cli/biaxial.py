@@ -43,6 +43,12 @@ def register(app: typer.Typer) -> None:
             "--rolling-friction",
             help="Disk rolling friction mu_r for the tests (default: the specimen's).",
         ),
+        stiffness_number: float = typer.Option(
+            None,
+            "--stiffness-number",
+            help="Scale the disks' kn and ks so that kappa = kn / (sigma_3 t) is this "
+            "(>= 1000: rigid grains; default: the specimen's stiffness).",
+        ),
         lab: Path = typer.Option(
             None, "--lab", help="Your laboratory curves (CSV, docs/biaxial.md), overlaid."
         ),
@@ -69,7 +75,7 @@ def register(app: typer.Typer) -> None:
         first, n = check_replicates(quick, specimen, seed, replicates, run)
         check_friction_options(particle_friction, rolling_friction)  # the ranges shear takes
         changes = {"max_strain": strain, "strain_rate": strain_rate, "particle_friction": particle_friction,
-                   "rolling_friction": rolling_friction}  # fmt: skip
+                   "rolling_friction": rolling_friction, "stiffness_number": stiffness_number}  # fmt: skip
         options = {k: v for k, v in changes.items() if v is not None}
         settings = build_settings(table, options)
         case = make_case(quick, specimen, stresses[0], first, settings)
@@ -130,7 +136,11 @@ def build_settings(table, options: dict):
     try:
         return table.build(**options)
     except InputError as exc:  # named as the option the user typed
-        names = {"max_strain": "--strain", "strain_rate": "--strain-rate"}
+        names = {
+            "max_strain": "--strain",
+            "strain_rate": "--strain-rate",
+            "stiffness_number": "--stiffness-number",
+        }
         name = names.get(exc.parameter, exc.parameter) if exc.parameter in options else exc.parameter
         raise InputError(name, exc.value, exc.allowed) from None
 
@@ -180,17 +190,21 @@ def print_result(result, out: Path) -> None:
         console.print(f"[yellow]{result.critical_state_note}[/]")
     t = Table(title="replicates")
     for col in ("replicate", "phi peak deg", "eps_1 peak %", "phi end deg", "critical", "psi max deg",
-                "eps_v end %", "sigma_3 err %", "time s"):  # fmt: skip
+                "psi_p max deg", "kappa", "overlap/d peak %", "eps_v end %", "sigma_3 err %",
+                "time s"):  # fmt: skip
         t.add_column(col, justify="right")
     for s in result.summaries:
         t.add_row(
             str(s.replicate), f"{s.peak_friction_angle_deg:.1f}", f"{100 * s.axial_strain_at_peak:.1f}",
             f"{s.critical_state_friction_angle_deg:.1f}", "yes" if s.critical_state_reached else "not yet",
-            f"{s.max_dilatancy_angle_deg:.1f}", f"{100 * s.end_volumetric_strain:+.2f}",
-            f"{100 * s.sigma_3_max_error:.1f}", f"{s.wall_time_s:.0f}",
+            f"{s.max_dilatancy_angle_deg:.1f}", _number(s.plastic_max_dilatancy_angle_deg, 1),
+            _number(s.stiffness_number, 0), _number(s.mean_overlap_ratio_at_peak, 2, 100.0),
+            f"{100 * s.end_volumetric_strain:+.2f}", f"{100 * s.sigma_3_max_error:.1f}",
+            f"{s.wall_time_s:.0f}",
         )  # fmt: skip
     console.print(t)
     console.print(f"psi_max = {result.max_dilatancy_angle.text()} (sin psi = -d eps_v / d eps_s)")
+    print_elastic(result.plastic_max_dilatancy_angle, result.stiffness_number, result.tests)
     test = result.tests[0] if result.tests else None
     if test is not None:
         c = test.checks
@@ -216,7 +230,8 @@ def print_series(result, out: Path) -> None:
     if not result.sigma_3_held:
         console.print(f"[yellow]{result.sigma_3_note}[/]")
     t = Table(title="per confining stress (over its replicates)")
-    for col in ("sigma_3 kPa", "phi peak deg", "phi end deg", "critical", "psi max deg", "eps_1 peak %"):
+    for col in ("sigma_3 kPa", "phi peak deg", "phi end deg", "critical", "psi max deg", "psi_p max deg",
+                "kappa", "overlap/d peak %", "eps_1 peak %"):  # fmt: skip
         t.add_column(col, justify="right")
     for s in result.stresses:
         strain = s.axial_strain_at_peak
@@ -224,6 +239,9 @@ def print_series(result, out: Path) -> None:
             f"{s.confining_stress_kpa:g}", s.peak_friction_angle.text(),
             s.critical_state_friction_angle.text(), "yes" if s.critical_state_reached else "not yet",
             s.max_dilatancy_angle.text(),
+            s.plastic_max_dilatancy_angle.text() if s.plastic_max_dilatancy_angle is not None else "-",
+            _number(s.stiffness_number.mean if s.stiffness_number else None, 0),
+            _number(s.mean_overlap_ratio_at_peak.mean if s.mean_overlap_ratio_at_peak else None, 2, 100.0),
             f"{100 * strain.min:.1f}-{100 * strain.max:.1f}",
         )  # fmt: skip
     console.print(t)
@@ -235,7 +253,31 @@ def print_series(result, out: Path) -> None:
             f"{env0.friction_angle_deg:.2f} deg"
         )
     console.print(f"psi_max pooled = {result.max_dilatancy_angle.text()} (sin psi = -d eps_v / d eps_s)")
+    tests = [t for study in result.studies for t in study.tests]
+    print_elastic(result.plastic_max_dilatancy_angle, None, tests)
     console.print(
         f"results in {out}/result.json, biaxial_series.png; each stress in {out}/sigma3_<s>kPa/ "
         "(its result.json, curves.csv, biaxial.png, replicate<k>/)"
     )
+
+
+def _number(value: float | None, digits: int, scale: float = 1.0) -> str:
+    """``scale * value`` with ``digits`` decimals, "-" if None (a test read back from before it was kept)."""
+    return "-" if value is None else f"{scale * value:.{digits}f}"
+
+
+def print_elastic(plastic, kappa, tests) -> None:
+    """The plastic psi_max, the stiffness number and the probe's compliances (docs/biaxial.md)."""
+    if plastic is not None:
+        console.print(f"plastic psi_max = {plastic.text()} (the contacts' elastic strain taken out)")
+    if kappa is not None:
+        console.print(f"stiffness number kappa = kn / (sigma_3 t) = {kappa.text(0)}")
+    probes = [t.elastic_probe for t in tests if t.elastic_probe is not None and t.elastic_probe.reached]
+    if probes:
+        c1 = [p.axial_compliance for p in probes]
+        cc1 = [p.contact_axial_compliance for p in probes]
+        console.print(
+            f"unloading probe ({probes[0].unload:g} of the deviator after shearing, {len(probes)} test(s)): "
+            f"d eps_1 / d sigma_1 = {min(c1):.3g}-{max(c1):.3g} /MPa measured, "
+            f"{min(cc1):.3g}-{max(cc1):.3g} /MPa in the contacts' elastic strain"
+        )

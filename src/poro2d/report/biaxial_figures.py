@@ -34,7 +34,8 @@ def plot_biaxial(
     lab: Mapping[str, np.ndarray | None] | None = None,
     lab_label: str = "laboratory",
 ) -> Path:
-    """The figure of ``curves`` (label, arrays ``axial_strain``, ``sin_phi``, ``volumetric_strain``).
+    """The figure of ``curves`` (label, arrays ``axial_strain``, ``sin_phi``, ``volumetric_strain``, and
+    ``plastic_volumetric_strain`` where a curve has it, dashed).
 
     ``critical``: (sin phi, start of the window as axial strain) of the critical state, drawn as
     a line; ``lab``: arrays ``axial_strain``, ``stress_ratio`` and ``volumetric_strain`` (or None).
@@ -46,6 +47,9 @@ def plot_biaxial(
         col = COLORS[k % len(COLORS)]
         ax.plot(100 * c["axial_strain"], c["sin_phi"], color=col, lw=1.0, label=label)
         bx.plot(100 * c["axial_strain"], 100 * c["volumetric_strain"], color=col, lw=1.0)
+        if "plastic_volumetric_strain" in c:  # the contacts' elastic strain taken out (biaxial/elastic.py)
+            bx.plot(100 * c["axial_strain"], 100 * c["plastic_volumetric_strain"], color=col, lw=0.7, ls="--")
+    plastic = any("plastic_volumetric_strain" in c for _, c in curves)
     if critical is not None:
         s_cs, start = critical
         ax.axhline(s_cs, color="0.4", lw=0.8, ls=":", label=f"mean from {100 * start:.0f} %: {s_cs:.3f}")
@@ -60,7 +64,7 @@ def plot_biaxial(
     ax.grid(alpha=0.3)
     bx.axhline(0.0, color="0.6", lw=0.6)
     bx.set_xlabel("axial strain eps_1 (%)")
-    bx.set_ylabel("volumetric strain eps_v (%)\n(compression +)")
+    bx.set_ylabel("volumetric strain eps_v (%)\n(compression +" + ("; dashed: plastic)" if plastic else ")"))
     bx.grid(alpha=0.3)
     fig.tight_layout()
     return save_figure(fig, path)

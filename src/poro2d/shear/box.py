@@ -150,12 +150,12 @@ def _specimen_box(sim: Simulation) -> tuple[float, float]:
     return right, top
 
 
-def _replaced(values: np.ndarray, value: float | None) -> np.ndarray:
+def replaced_values(values: np.ndarray, value: float | None) -> np.ndarray:
     """A copy of a per-disk array, every entry ``value`` when given."""
     return values.copy() if value is None else np.full(values.shape, float(value))
 
 
-def _pair_type_contact(contact: ContactModel, mu: float | None, kn: float | None, ks: float | None):
+def pair_type_contact(contact: ContactModel, mu: float | None, kn: float | None, ks: float | None):
     """The contact model with the disk-disk (kn, ks, mu) replaced where given: under the
     ``per_pair_type`` convention one triple serves every disk pair and the disks' own arrays are
     not read, so a replaced value must go there too (``per_body``: the disks' arrays suffice)."""
@@ -233,11 +233,11 @@ def build_split_box(
     walls.add((W + e, H), (-e, H), *k, name="top", mu_r=wall_mu_r)
     particles = Particles(
         pos=p0.pos.copy(), radius=p0.radius.copy(), density=p0.density.copy(), thickness=p0.thickness,
-        kn=_replaced(p0.kn, particle_kn), ks=_replaced(p0.ks, particle_ks),
+        kn=replaced_values(p0.kn, particle_kn), ks=replaced_values(p0.ks, particle_ks),
         mu=p0.mu.copy() if particle_friction is None else np.full(p0.n, float(particle_friction)),
         vel=p0.vel.copy(), theta=p0.theta.copy(), omega=p0.omega.copy(), mode=p0.mode.copy(), mu_r=mu_r,
     )  # fmt: skip
-    contact = _pair_type_contact(specimen.contact, particle_friction, particle_kn, particle_ks)
+    contact = pair_type_contact(specimen.contact, particle_friction, particle_kn, particle_ks)
     sim = Simulation(
         particles, walls, contact, gravity=specimen.gravity, local_damping=specimen.local_damping,
         restitution=specimen.restitution, dt_safety=dt_safety, density_scale=density_scale,
@@ -249,4 +249,6 @@ def build_split_box(
     return sim, box
 
 
-__all__ = ["LOWER", "UPPER", "PlaneForce", "SplitBox", "build_split_box"]
+__all__ = [
+    "LOWER", "UPPER", "PlaneForce", "SplitBox", "build_split_box", "pair_type_contact", "replaced_values",
+]  # fmt: skip
