@@ -82,7 +82,7 @@ class BiaxialSettings:
     (a fraction of max_strain) where the critical state is read; critical_rate_limit the
     largest |d eps_v / d eps_1| over that window for it to count as critical; probe_unload
     the share of the end deviator the unloading probe takes off after shearing, the check of the
-    contacts' elastic strain (None: no probe; the plastic strains do not need it;
+    contacts' elastic strain (None, the default: no probe; the plastic strains do not need it;
     :mod:`poro2d.biaxial.elastic`); stiffness_number, when given, the
     stiffness number kappa = kn / (sigma_3 t) the disks' kn and ks are scaled to for the test
     (:mod:`poro2d.biaxial.stiffness`; >= 1000 the rigid-grain limit; None: the specimen's).
@@ -109,7 +109,7 @@ class BiaxialSettings:
     smoothing_strain: float = 0.01
     critical_window: float = 0.25
     critical_rate_limit: float = 0.1
-    probe_unload: float | None = 0.3
+    probe_unload: float | None = None
     stiffness_number: float | None = None
 
     def __post_init__(self) -> None:
