@@ -299,10 +299,11 @@ def _state_blocks(criterion) -> list[Block]:
     return b
 
 
-#: K0 of these disks measured under one-dimensional loading and after unloading (the quick
-#: specimens of seeds 0-2, benchmarks/k0_one_dimensional.py; docs/criterion.md, "K0")
-K0_LOADING = 0.44
-K0_UNLOADED = 0.82
+#: K0 of the paper's accepted specimen (seed 0, f_p 3.0) under one-dimensional loading (d sigma_h /
+#: d sigma_v from 100 to 200 kPa) and unloaded to 50 kPa (benchmarks/k0_one_dimensional.py;
+#: docs/criterion.md, "K0")
+K0_LOADING = 0.40
+K0_UNLOADED = 0.76
 
 
 def k0_note(k0: float) -> str:
@@ -312,8 +313,8 @@ def k0_note(k0: float) -> str:
         "loaded one-dimensionally from a loose deposit, while this specimen was built by growing its "
         "disks in layers under a lid, which presses them in every direction and locks in a lateral "
         "stress near the vertical one, as in an overconsolidated soil; under self-weight alone "
-        "nothing has loaded it since. Loaded one-dimensionally (side walls held, 25-200 kPa), the "
-        f"same disks give K0 = {K0_LOADING:.2f}, Jaky's value for phi near 34 deg, and "
+        "nothing has loaded it since. Loaded one-dimensionally (side walls held, up to 200 kPa), the "
+        f"paper's specimen gives K0 = {K0_LOADING:.2f} (Jaky's value for phi near 37 deg) and "
         f"{K0_UNLOADED:.2f} once unloaded to a quarter of that stress: a K0 near 1 says how the "
         'specimen was made, not what the disks are (docs/criterion.md, "K0").'
     )
