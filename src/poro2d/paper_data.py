@@ -63,5 +63,16 @@ QUICK_SPECIMEN = {"width": 0.08, "height": 0.04, "layers": 2}
 QUICK_CRITERION = {"force_fraction": 0.05, "acceptance": "plate"}
 #: the quick look's direct shear (and the quick calibration's): sheared to 4 mm
 QUICK_SHEAR = {"max_displacement": 0.004}
+#: where the quick box reads soil-like strength (measured, docs/calibration.md "What the quick box can
+#: measure"): its tests at larger frictions are box-dominated (poro2d.shear.box_dominated)
+QUICK_BOX_SOIL_LIKE = {"particle_friction": 0.0, "rolling_friction": 0.0, "max_displacement": 0.016}
 
-__all__ = ["PAPER", "QUICK_CRITERION", "QUICK_SHEAR", "QUICK_SPECIMEN", "TABLE_1", "Table1"]
+__all__ = [
+    "PAPER",
+    "QUICK_BOX_SOIL_LIKE",
+    "QUICK_CRITERION",
+    "QUICK_SHEAR",
+    "QUICK_SPECIMEN",
+    "TABLE_1",
+    "Table1",
+]

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import os
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import partial
 from typing import Any, ClassVar
 
@@ -32,7 +32,14 @@ from poro2d.calibration.biaxial import (
     read_biaxial_lab,
 )
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
-from poro2d.calibration.evaluations import PARAMETER_KEYS, DesignPoint, Observed, target_key
+from poro2d.calibration.evaluations import (
+    PARAMETER_KEYS,
+    BoxDominatedPoint,
+    BoxDominatedPoints,
+    DesignPoint,
+    Observed,
+    target_key,
+)
 from poro2d.calibration.identifiable import check_enough_lab_values
 from poro2d.calibration.lab_repeats import LabRepeats, lab_scatter_ratio, lab_share, mean_targets
 from poro2d.calibration.specimens import (
@@ -47,7 +54,9 @@ from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_opti
 from poro2d.execute.dask_cluster import check_reachable
 from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import holds_output
-from poro2d.paper_data import QUICK_SHEAR
+from poro2d.paper_data import QUICK_BOX_SOIL_LIKE, QUICK_SHEAR
+from poro2d.shear.box_dominated import MEANING as BOX_DOMINATED
+from poro2d.shear.box_dominated import PLANE_LOAD_BAND
 from poro2d.shear.box_scale import BoxScale, box_scale
 from poro2d.shear.lab import LabData
 from poro2d.shear.parts import LabRecord, ShearSettingsRecord
@@ -298,8 +307,12 @@ class CalibrationResult(TypedResult):
     #: the laboratory test fitted: "biaxial" (then ``lab`` and ``settings`` are the biaxial ones);
     #: absent from a direct shear calibration's file
     test: str | None = None
+    #: the design points left out of the fit because a test of theirs was box-dominated, with the
+    #: calibration's sentence on what its box can measure; absent from a biaxial calibration's file
+    #: and from files of earlier versions
+    box_dominated: BoxDominatedPoints | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("unidentified", "box_scale", "test")
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("unidentified", "box_scale", "test", "box_dominated")
     #: the fields read as their records from a file's dict (``fit``: a surrogate per observable)
     PARTS: ClassVar[dict[str, type[TypedResult] | Keyed]] = {
         "best": FrictionValues,
@@ -315,6 +328,7 @@ class CalibrationResult(TypedResult):
         "fit": Keyed(SurrogateRecord),
         "evaluations": DesignPoint,
         "box_scale": BoxScale,
+        "box_dominated": BoxDominatedPoints,
     }
 
     @classmethod
@@ -443,6 +457,7 @@ def run_calibration(
     dashboard: str | None = DEFAULT_DASHBOARD,
     progress: bool = True,
     config: dict | None = None,
+    keep_box_dominated: bool = False,
 ) -> CalibrationResult:
     """Calibrate f_p and mu_r against ``lab`` on replicate specimens; keeps ``result.json`` in ``store``.
 
@@ -471,6 +486,12 @@ def run_calibration(
     every unit is then a biaxial test at a laboratory confining stress, the targets its stress
     ratios and volumetric strain (:mod:`poro2d.calibration.biaxial`), and ``settings`` are biaxial
     settings (``max_strain`` 0.2 by default).
+
+    A design point any of whose direct shear tests is box-dominated (:mod:`poro2d.shear.box_dominated`:
+    its shear plane carries outside 0.7-1.3 times the plate's load at the peak, or its stress never
+    peaked) is left out of the fit, and the result says how many were (``box_dominated``); too few
+    left for the surrogate is no answer. ``keep_box_dominated``: fit them all the same (a box where
+    every test is box-dominated: the frictions then describe the box).
     """
     t0 = time.perf_counter()
     if store is not None:
@@ -505,6 +526,8 @@ def run_calibration(
     design_seed = check_int("--design-seed", design_seed, 0)
     check_range("--lab-error", lab_error, 0.0, 1.0)
     check_range("--level", level, 0.0, 1.0, lo_open=True, hi_open=True)
+    if not isinstance(keep_box_dominated, bool):
+        raise InputError("--keep-box-dominated", keep_box_dominated, "true or false")
     if settings is None and quick and not biaxial:
         settings = dict(QUICK_SHEAR)
     calibrated = CALIBRATED + tuple(PARAMETER_KEYS[a] for a in ranges.axes[2:])
@@ -540,16 +563,14 @@ def run_calibration(
     try:
         design = model.space_filling(ranges, points, design_seed)
         rows = runner.run(_units(design, found, stresses, base, make, ranges.axes), cache, "round 1")
-        post, surrogates, table = _infer(
-            ranges, design, found, stresses, rows, targets, lab_error, lab_series, design_seed
-        )
+        infer = partial(_infer, ranges, lab_error=lab_error, lab_series=lab_series, seed=design_seed,
+                        keep_box_dominated=keep_box_dominated)  # fmt: skip
+        post, surrogates, table = infer(design, found, stresses, rows, targets)
         if refine:
             extra = [p for p in post.draw(refine, design_seed + 1) if p not in design]
             design = design + extra
             rows += runner.run(_units(extra, found, stresses, base, make, ranges.axes), cache, "round 2")
-            post, surrogates, table = _infer(
-                ranges, design, found, stresses, rows, targets, lab_error, lab_series, design_seed
-            )
+            post, surrogates, table = infer(design, found, stresses, rows, targets)
     finally:
         runner.close()
     result = _result(
@@ -570,6 +591,7 @@ def run_calibration(
         points,
         refine,
         stations,
+        quick=quick,
     )
     if store is not None:
         from poro2d.calibration.outputs import write_outputs
@@ -659,12 +681,16 @@ def _infer(
     lab_error,
     lab_series=None,
     seed: int = 0,
+    *,
+    keep_box_dominated: bool = False,
 ):
     """The surrogates (one per target), the posterior and the table of replicate values per design point.
 
     ``rows``: the units' rows in the order of :func:`_units` (None: the test failed);
     ``lab_series``: every laboratory repeat's values (series x targets; None: one series); ``seed``:
-    of the sampler, when kn or ks are calibrated (the grid of two parameters needs none)."""
+    of the sampler, when kn or ks are calibrated (the grid of two parameters needs none). A design point
+    with a box-dominated test is left out of the fit (:func:`box_dominated_points`) unless
+    ``keep_box_dominated``; the posterior's ``box_dominated`` says which."""
     per_point = len(specimens) * len(stresses)
     table = []
     for k, (fp, mu_r, *stiffness) in enumerate(design):
@@ -676,8 +702,13 @@ def _infer(
             observed.append(Observed(obs, s, values))
         given = {PARAMETER_KEYS[a]: v for a, v in zip(ranges.axes[2:], stiffness, strict=True)}
         table.append(DesignPoint(fp, mu_r, tuple(observed), **given))
-    unit = ranges.to_unit(*zip(*(e.parameters(ranges.axes) for e in table), strict=True))
-    values = np.array([[o.values for o in e.observed] for e in table], float)
+    # a design point any of whose tests read the box, not the material, is left out of the fit
+    flagged = [[r for r in rows[k * per_point : (k + 1) * per_point] if r is not None and r.box_dominated]
+               for k in range(len(table))]  # fmt: skip
+    left_out = box_dominated_points(flagged, table, ranges.dim, keep_box_dominated)
+    kept = np.array([keep_box_dominated or not f for f in flagged], bool)
+    unit = ranges.to_unit(*zip(*(e.parameters(ranges.axes) for e in table), strict=True))[kept]
+    values = np.array([[o.values for o in e.observed] for e in table], float)[kept]
     surrogates = []
     for k, (obs, s, _) in enumerate(targets):
         ok = np.isfinite(values[:, k]).any(axis=1)
@@ -710,7 +741,34 @@ def _infer(
         raise RuntimeError(f"the posterior cannot be computed ({exc}): no answer is reported") from None
     if not post.finite():
         raise RuntimeError("the posterior is not finite: no answer is reported")
+    post.box_dominated = left_out
     return post, surrogates, table
+
+
+def box_dominated_points(
+    flagged: list[list], table: list[DesignPoint], dim: int, keep: bool
+) -> BoxDominatedPoints:
+    """The design points of ``table`` with box-dominated tests (``flagged``: per point, the rows of its
+    tests that are), left out of the fit unless ``keep``. Refused (no answer) when fewer than the
+    quadratic surrogate's :func:`min_points` in ``dim`` parameters are left."""
+    points = [
+        BoxDominatedPoint(entry.particle_friction, entry.rolling_friction, len(rows),
+                          f"{rows[0].specimen} at {rows[0].sigma:g} kPa: {rows[0].box_note}")
+        for entry, rows in zip(table, flagged, strict=True)
+        if rows
+    ]  # fmt: skip
+    left_out = 0 if keep else len(points)
+    record = BoxDominatedPoints(len(points), left_out, len(table), list(PLANE_LOAD_BAND), points)
+    left = len(table) - left_out
+    if left < min_points(dim):
+        raise RuntimeError(
+            f"{left_out} of {len(table)} design points are box-dominated ({BOX_DOMINATED}) and are "
+            f"left out: the {left} left cannot fit the quadratic surrogate, which needs {min_points(dim)}; "
+            "narrow --fp-range and --mu-r-range to where the box reads soil-like strength, shear further "
+            "(--max-displacement), use a larger specimen, or fit the box as it is (--keep-box-dominated; "
+            "docs/calibration.md)"
+        )
+    return record
 
 
 def _precision_factor(values: np.ndarray, observables: int) -> float:
@@ -793,9 +851,12 @@ def _result(
     points,
     refine,
     stations=1,
+    *,
+    quick: bool = False,
 ) -> CalibrationResult:
     best = dict(zip(ranges.axes, post.best(), strict=True))
     biaxial = isinstance(lab_data, LabTests)
+    scale = None if biaxial else smallest_box(found)  # ASTM D3080 speaks of shear boxes only
     keys = {axis: PARAMETER_KEYS[axis] for axis in ranges.axes}
     intervals = {keys[a]: list(post.interval(a, level)) for a in ranges.axes}
     wide: dict[str, bool | None] = {keys[a]: _wide(ranges, a, *intervals[keys[a]]) for a in ranges.axes}
@@ -848,9 +909,31 @@ def _result(
         ),  # fmt: skip
         provenance=Provenance.now(),
         unidentified=unknown,
-        box_scale=None if biaxial else smallest_box(found),  # ASTM D3080 speaks of shear boxes only
+        box_scale=scale,
         test=BIAXIAL if biaxial else None,
+        box_dominated=None if scale is None else with_box_note(post.box_dominated, quick, scale.disks),
     )
+
+
+def with_box_note(points: BoxDominatedPoints, quick: bool, disks: int) -> BoxDominatedPoints:
+    """``points`` with the calibration's sentence on them: how many design points were box-dominated,
+    whether they were left out and, for the quick box, where it measured soil-like strength
+    (``QUICK_BOX_SOIL_LIKE`` of paper_data)."""
+    fate = (
+        ""
+        if not points.flagged
+        else ", left out of the fit"
+        if points.left_out == points.flagged
+        else ", kept in the fit (--keep-box-dominated): the frictions describe the box, not the soil"
+    )
+    flagged = f"{points.flagged} of {points.design_points} design points were box-dominated"
+    text = f"{flagged} ({BOX_DOMINATED}){fate}"
+    if quick:
+        fp, mu_r = QUICK_BOX_SOIL_LIKE["particle_friction"], QUICK_BOX_SOIL_LIKE["rolling_friction"]
+        text = (f"the quick box ({disks} disks) measures soil-like strength only for f_p <= {fp:g} and "
+                f"mu_r <= {mu_r:g}, sheared {1e3 * QUICK_BOX_SOIL_LIKE['max_displacement']:g} mm "
+                f"(docs/calibration.md); {text}")  # fmt: skip
+    return replace(points, note=text)
 
 
 __all__ = [
