@@ -571,6 +571,10 @@ def run_calibration(
             design = design + extra
             rows += runner.run(_units(extra, found, stresses, base, make, ranges.axes), cache, "round 2")
             post, surrogates, table = infer(design, found, stresses, rows, targets)
+    except TooFewPoints as exc:
+        if not quick or biaxial:
+            raise
+        raise TooFewPoints(f"{quick_box_note(smallest_box(found).disks)}; {exc}") from None
     finally:
         runner.close()
     result = _result(
@@ -745,6 +749,22 @@ def _infer(
     return post, surrogates, table
 
 
+class TooFewPoints(RuntimeError):
+    """Too few design points are left for the surrogate once the box-dominated ones are left out: no
+    answer (one line at the command)."""
+
+
+def quick_box_note(disks: int) -> str:
+    """Where the quick box of ``disks`` disks reads soil-like strength (``QUICK_BOX_SOIL_LIKE`` of
+    paper_data, measured: docs/calibration.md)."""
+    fp, mu_r = QUICK_BOX_SOIL_LIKE["particle_friction"], QUICK_BOX_SOIL_LIKE["rolling_friction"]
+    travel = 1e3 * QUICK_BOX_SOIL_LIKE["max_displacement"]
+    return (
+        f"the quick box ({disks} disks) measures soil-like strength only for f_p <= {fp:g} and mu_r <= "
+        f"{mu_r:g}, sheared {travel:g} mm (docs/calibration.md)"
+    )
+
+
 def box_dominated_points(
     flagged: list[list], table: list[DesignPoint], dim: int, keep: bool
 ) -> BoxDominatedPoints:
@@ -761,7 +781,7 @@ def box_dominated_points(
     record = BoxDominatedPoints(len(points), left_out, len(table), list(PLANE_LOAD_BAND), points)
     left = len(table) - left_out
     if left < min_points(dim):
-        raise RuntimeError(
+        raise TooFewPoints(
             f"{left_out} of {len(table)} design points are box-dominated ({BOX_DOMINATED}) and are "
             f"left out: the {left} left cannot fit the quadratic surrogate, which needs {min_points(dim)}; "
             "narrow --fp-range and --mu-r-range to where the box reads soil-like strength, shear further "
@@ -928,12 +948,7 @@ def with_box_note(points: BoxDominatedPoints, quick: bool, disks: int) -> BoxDom
     )
     flagged = f"{points.flagged} of {points.design_points} design points were box-dominated"
     text = f"{flagged} ({BOX_DOMINATED}){fate}"
-    if quick:
-        fp, mu_r = QUICK_BOX_SOIL_LIKE["particle_friction"], QUICK_BOX_SOIL_LIKE["rolling_friction"]
-        text = (f"the quick box ({disks} disks) measures soil-like strength only for f_p <= {fp:g} and "
-                f"mu_r <= {mu_r:g}, sheared {1e3 * QUICK_BOX_SOIL_LIKE['max_displacement']:g} mm "
-                f"(docs/calibration.md); {text}")  # fmt: skip
-    return replace(points, note=text)
+    return replace(points, note=f"{quick_box_note(disks)}; {text}" if quick else text)
 
 
 __all__ = [
