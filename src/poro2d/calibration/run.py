@@ -574,7 +574,9 @@ def run_calibration(
     except TooFewPoints as exc:
         if not quick or biaxial:
             raise
-        raise TooFewPoints(f"{quick_box_note(smallest_box(found).disks)}; {exc}") from None
+        raise TooFewPoints(
+            f"{quick_box_note(smallest_box(found).disks, base.max_displacement)}; {exc}"
+        ) from None
     finally:
         runner.close()
     result = _result(
@@ -754,14 +756,20 @@ class TooFewPoints(RuntimeError):
     answer (one line at the command)."""
 
 
-def quick_box_note(disks: int) -> str:
+def quick_box_note(disks: int, max_displacement: float) -> str:
     """Where the quick box of ``disks`` disks reads soil-like strength (``QUICK_BOX_SOIL_LIKE`` of
-    paper_data, measured: docs/calibration.md)."""
+    paper_data, measured: docs/shear.md), and whether tests of ``max_displacement`` (m) are long
+    enough to peak there."""
     fp, mu_r = QUICK_BOX_SOIL_LIKE["particle_friction"], QUICK_BOX_SOIL_LIKE["rolling_friction"]
-    travel = 1e3 * QUICK_BOX_SOIL_LIKE["max_displacement"]
+    travel = QUICK_BOX_SOIL_LIKE["max_displacement"]
+    short = (
+        f": its tests of {1e3 * max_displacement:g} mm end before their peak (--max-displacement)"
+        if max_displacement < travel
+        else ""
+    )
     return (
         f"the quick box ({disks} disks) measures soil-like strength only for f_p <= {fp:g} and mu_r <= "
-        f"{mu_r:g}, sheared {travel:g} mm (docs/calibration.md)"
+        f"{mu_r:g}, sheared {1e3 * travel:g} mm (docs/shear.md){short}"
     )
 
 
@@ -931,11 +939,13 @@ def _result(
         unidentified=unknown,
         box_scale=scale,
         test=BIAXIAL if biaxial else None,
-        box_dominated=None if scale is None else with_box_note(post.box_dominated, quick, scale.disks),
+        box_dominated=None if scale is None else with_box_note(post.box_dominated, quick, scale.disks, base),
     )
 
 
-def with_box_note(points: BoxDominatedPoints, quick: bool, disks: int) -> BoxDominatedPoints:
+def with_box_note(
+    points: BoxDominatedPoints, quick: bool, disks: int, base: ShearSettings
+) -> BoxDominatedPoints:
     """``points`` with the calibration's sentence on them: how many design points were box-dominated,
     whether they were left out and, for the quick box, where it measured soil-like strength
     (``QUICK_BOX_SOIL_LIKE`` of paper_data)."""
@@ -948,7 +958,8 @@ def with_box_note(points: BoxDominatedPoints, quick: bool, disks: int) -> BoxDom
     )
     flagged = f"{points.flagged} of {points.design_points} design points were box-dominated"
     text = f"{flagged} ({BOX_DOMINATED}){fate}"
-    return replace(points, note=f"{quick_box_note(disks)}; {text}" if quick else text)
+    quick_note = quick_box_note(disks, base.max_displacement) if quick else None
+    return replace(points, note=f"{quick_note}; {text}" if quick_note else text)
 
 
 __all__ = [
