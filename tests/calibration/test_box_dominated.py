@@ -9,15 +9,8 @@ import numpy as np
 import pytest
 
 from poro2d.calibration import model
-from poro2d.calibration.evaluations import BoxDominatedPoint, BoxDominatedPoints
-from poro2d.calibration.run import (
-    MIN_POINTS,
-    CalibrationResult,
-    _base_settings,
-    _infer,
-    _units,
-    with_box_note,
-)
+from poro2d.calibration.box_dominated import BoxDominatedPoint, BoxDominatedPoints, with_box_note
+from poro2d.calibration.run import MIN_POINTS, CalibrationResult, _base_settings, _infer, _units
 from poro2d.calibration.units import CalibrationUnit, UnitRow, stored_row
 from poro2d.cli import main
 from poro2d.paper_data import QUICK_BOX_SOIL_LIKE
@@ -30,7 +23,7 @@ STRESSES = [50.0, 100.0]
 TARGETS = [("peak", 50.0, 40.0), ("peak", 100.0, 75.0)]
 FOUND = SpecimenSet(tuple("ab"), tuple(Path(f"{k}.npz") for k in "ab"), tuple(k * 64 for k in "ab"))
 BASE = _base_settings({"max_displacement": 0.002})
-LONG = _base_settings({"max_displacement": QUICK_BOX_SOIL_LIKE["max_displacement"]})
+TRAVEL = QUICK_BOX_SOIL_LIKE["max_displacement"]  # m: long enough for the quick box to peak
 CALIBRATION = "calibration_result.json"  # a calibration's file written before the flag
 
 
@@ -99,20 +92,20 @@ def _record(flagged: int, left_out: int) -> BoxDominatedPoints:
 
 
 def test_the_note_says_how_many_were_left_out_and_what_the_quick_box_measures():
-    plain = with_box_note(_record(3, 3), False, 201, LONG)
+    plain = with_box_note(_record(3, 3), False, 201, TRAVEL)
     assert plain.note.startswith("3 of 12 design points were box-dominated (a test whose shear plane")
     assert plain.note.endswith("left out of the fit") and "quick box" not in plain.note
-    quick = with_box_note(_record(3, 3), True, 201, LONG).note
+    quick = with_box_note(_record(3, 3), True, 201, TRAVEL).note
     fp, mu_r = QUICK_BOX_SOIL_LIKE["particle_friction"], QUICK_BOX_SOIL_LIKE["rolling_friction"]
     assert quick.startswith(f"the quick box (201 disks) measures soil-like strength only for f_p <= {fp:g}")
     assert f"mu_r <= {mu_r:g}" in quick and quick.endswith("left out of the fit")
     assert "end before their peak" not in quick
     # the quick calibration's own 4 mm are too short for its box to peak: the note says so
-    short = with_box_note(_record(3, 3), True, 201, _base_settings({"max_displacement": 0.004})).note
+    short = with_box_note(_record(3, 3), True, 201, 0.004).note
     assert "its tests of 4 mm end before their peak (--max-displacement)" in short
-    kept = with_box_note(_record(3, 0), False, 201, LONG).note
+    kept = with_box_note(_record(3, 0), False, 201, TRAVEL).note
     assert "kept in the fit (--keep-box-dominated)" in kept
-    assert "left out" not in with_box_note(_record(0, 0), False, 201, LONG).note
+    assert "left out" not in with_box_note(_record(0, 0), False, 201, TRAVEL).note
 
 
 def test_a_calibration_file_keeps_the_record_typed_and_an_earlier_one_reads_without_it():
@@ -120,7 +113,7 @@ def test_a_calibration_file_keeps_the_record_typed_and_an_earlier_one_reads_with
     old = CalibrationResult.from_dict(data)
     assert old.box_dominated is None and box_dominated_note(old) is None
     new = CalibrationResult.from_dict(
-        dict(data, box_dominated=with_box_note(_record(1, 1), False, 201, LONG).to_dict())
+        dict(data, box_dominated=with_box_note(_record(1, 1), False, 201, TRAVEL).to_dict())
     )
     assert isinstance(new.box_dominated, BoxDominatedPoints)
     assert isinstance(new.box_dominated.points[0], BoxDominatedPoint)

@@ -11,10 +11,9 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any
 
 from poro2d.record import Record, Spliced
-from poro2d.typed_result import TypedResult
 
 #: the key of each calibrated parameter (an axis of :mod:`poro2d.calibration.model`) in the files
 PARAMETER_KEYS = {
@@ -93,39 +92,4 @@ class DesignPoint(Record, Mapping):
         return len(self.to_dict())
 
 
-@dataclass(eq=False)
-class BoxDominatedPoint(TypedResult):
-    """A design point with box-dominated tests: its pair, how many of its tests were and the first
-    one's verdict (with its specimen and stress)."""
-
-    particle_friction: float
-    rolling_friction: float
-    tests: int
-    note: str
-
-
-@dataclass(eq=False)
-class BoxDominatedPoints(TypedResult):
-    """The design points of a direct shear calibration with a box-dominated test
-    (:mod:`poro2d.shear.box_dominated`): how many of how many (``flagged``), how many of them were
-    left out of the fit (``left_out``: all, unless the calibration was told to keep them), the band
-    of the plane's load a test had to stay in, each point, and the calibration's sentence on them."""
-
-    flagged: int
-    left_out: int
-    design_points: int
-    plane_load_band: list[float]
-    points: list[BoxDominatedPoint]
-    note: str = ""
-
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"points": BoxDominatedPoint}
-
-
-__all__ = [
-    "PARAMETER_KEYS",
-    "BoxDominatedPoint",
-    "BoxDominatedPoints",
-    "DesignPoint",
-    "Observed",
-    "target_key",
-]
+__all__ = ["PARAMETER_KEYS", "DesignPoint", "Observed", "target_key"]

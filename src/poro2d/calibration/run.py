@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import os
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import partial
 from typing import Any, ClassVar
 
@@ -31,15 +31,15 @@ from poro2d.calibration.biaxial import (
     check_quasi_static,
     read_biaxial_lab,
 )
-from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
-from poro2d.calibration.evaluations import (
-    PARAMETER_KEYS,
-    BoxDominatedPoint,
+from poro2d.calibration.box_dominated import (
     BoxDominatedPoints,
-    DesignPoint,
-    Observed,
-    target_key,
+    TooFewPoints,
+    box_dominated_points,
+    quick_box_note,
+    with_box_note,
 )
+from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
+from poro2d.calibration.evaluations import PARAMETER_KEYS, DesignPoint, Observed, target_key
 from poro2d.calibration.identifiable import check_enough_lab_values
 from poro2d.calibration.lab_repeats import LabRepeats, lab_scatter_ratio, lab_share, mean_targets
 from poro2d.calibration.specimens import (
@@ -54,9 +54,7 @@ from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_opti
 from poro2d.execute.dask_cluster import check_reachable
 from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import holds_output
-from poro2d.paper_data import QUICK_BOX_SOIL_LIKE, QUICK_SHEAR
-from poro2d.shear.box_dominated import MEANING as BOX_DOMINATED
-from poro2d.shear.box_dominated import PLANE_LOAD_BAND
+from poro2d.paper_data import QUICK_SHEAR
 from poro2d.shear.box_scale import BoxScale, box_scale
 from poro2d.shear.lab import LabData
 from poro2d.shear.parts import LabRecord, ShearSettingsRecord
@@ -711,7 +709,7 @@ def _infer(
     # a design point any of whose tests read the box, not the material, is left out of the fit
     flagged = [[r for r in rows[k * per_point : (k + 1) * per_point] if r is not None and r.box_dominated]
                for k in range(len(table))]  # fmt: skip
-    left_out = box_dominated_points(flagged, table, ranges.dim, keep_box_dominated)
+    left_out = box_dominated_points(flagged, table, min_points(ranges.dim), keep_box_dominated)
     kept = np.array([keep_box_dominated or not f for f in flagged], bool)
     unit = ranges.to_unit(*zip(*(e.parameters(ranges.axes) for e in table), strict=True))[kept]
     values = np.array([[o.values for o in e.observed] for e in table], float)[kept]
@@ -749,54 +747,6 @@ def _infer(
         raise RuntimeError("the posterior is not finite: no answer is reported")
     post.box_dominated = left_out
     return post, surrogates, table
-
-
-class TooFewPoints(RuntimeError):
-    """Too few design points are left for the surrogate once the box-dominated ones are left out: no
-    answer (one line at the command)."""
-
-
-def quick_box_note(disks: int, max_displacement: float) -> str:
-    """Where the quick box of ``disks`` disks reads soil-like strength (``QUICK_BOX_SOIL_LIKE`` of
-    paper_data, measured: docs/shear.md), and whether tests of ``max_displacement`` (m) are long
-    enough to peak there."""
-    fp, mu_r = QUICK_BOX_SOIL_LIKE["particle_friction"], QUICK_BOX_SOIL_LIKE["rolling_friction"]
-    travel = QUICK_BOX_SOIL_LIKE["max_displacement"]
-    short = (
-        f": its tests of {1e3 * max_displacement:g} mm end before their peak (--max-displacement)"
-        if max_displacement < travel
-        else ""
-    )
-    return (
-        f"the quick box ({disks} disks) measures soil-like strength only for f_p <= {fp:g} and mu_r <= "
-        f"{mu_r:g}, sheared {1e3 * travel:g} mm (docs/shear.md){short}"
-    )
-
-
-def box_dominated_points(
-    flagged: list[list], table: list[DesignPoint], dim: int, keep: bool
-) -> BoxDominatedPoints:
-    """The design points of ``table`` with box-dominated tests (``flagged``: per point, the rows of its
-    tests that are), left out of the fit unless ``keep``. Refused (no answer) when fewer than the
-    quadratic surrogate's :func:`min_points` in ``dim`` parameters are left."""
-    points = [
-        BoxDominatedPoint(entry.particle_friction, entry.rolling_friction, len(rows),
-                          f"{rows[0].specimen} at {rows[0].sigma:g} kPa: {rows[0].box_note}")
-        for entry, rows in zip(table, flagged, strict=True)
-        if rows
-    ]  # fmt: skip
-    left_out = 0 if keep else len(points)
-    record = BoxDominatedPoints(len(points), left_out, len(table), list(PLANE_LOAD_BAND), points)
-    left = len(table) - left_out
-    if left < min_points(dim):
-        raise TooFewPoints(
-            f"{left_out} of {len(table)} design points are box-dominated ({BOX_DOMINATED}) and are "
-            f"left out: the {left} left cannot fit the quadratic surrogate, which needs {min_points(dim)}; "
-            "narrow --fp-range and --mu-r-range to where the box reads soil-like strength, shear further "
-            "(--max-displacement), use a larger specimen, or fit the box as it is (--keep-box-dominated; "
-            "docs/calibration.md)"
-        )
-    return record
 
 
 def _precision_factor(values: np.ndarray, observables: int) -> float:
@@ -939,27 +889,10 @@ def _result(
         unidentified=unknown,
         box_scale=scale,
         test=BIAXIAL if biaxial else None,
-        box_dominated=None if scale is None else with_box_note(post.box_dominated, quick, scale.disks, base),
+        box_dominated=None
+        if scale is None
+        else with_box_note(post.box_dominated, quick, scale.disks, base.max_displacement),
     )
-
-
-def with_box_note(
-    points: BoxDominatedPoints, quick: bool, disks: int, base: ShearSettings
-) -> BoxDominatedPoints:
-    """``points`` with the calibration's sentence on them: how many design points were box-dominated,
-    whether they were left out and, for the quick box, where it measured soil-like strength
-    (``QUICK_BOX_SOIL_LIKE`` of paper_data)."""
-    fate = (
-        ""
-        if not points.flagged
-        else ", left out of the fit"
-        if points.left_out == points.flagged
-        else ", kept in the fit (--keep-box-dominated): the frictions describe the box, not the soil"
-    )
-    flagged = f"{points.flagged} of {points.design_points} design points were box-dominated"
-    text = f"{flagged} ({BOX_DOMINATED}){fate}"
-    quick_note = quick_box_note(disks, base.max_displacement) if quick else None
-    return replace(points, note=f"{quick_note}; {text}" if quick_note else text)
 
 
 __all__ = [
