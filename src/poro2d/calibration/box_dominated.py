@@ -58,7 +58,7 @@ def quick_box_note(disks: int, max_displacement: float) -> str:
     paper_data, measured: docs/shear.md), and whether tests of ``max_displacement`` (m) are long
     enough to peak there."""
     fp, mu_r = QUICK_BOX_SOIL_LIKE["particle_friction"], QUICK_BOX_SOIL_LIKE["rolling_friction"]
-    travel = QUICK_BOX_SOIL_LIKE["max_displacement"]
+    travel, share = QUICK_BOX_SOIL_LIKE["max_displacement"], QUICK_BOX_SOIL_LIKE["box_dominated_fraction"]
     short = (
         f": its tests of {1e3 * max_displacement:g} mm end before their peak (--max-displacement)"
         if max_displacement < travel
@@ -66,7 +66,8 @@ def quick_box_note(disks: int, max_displacement: float) -> str:
     )
     return (
         f"the quick box ({disks} disks) measures soil-like strength only for f_p <= {fp:g} and mu_r <= "
-        f"{mu_r:g}, sheared {1e3 * travel:g} mm (docs/shear.md){short}"
+        f"{mu_r:g}, sheared {1e3 * travel:g} mm, and even there {share:.0%} of its tests were box-dominated "
+        f"(docs/shear.md){short}"
     )
 
 
