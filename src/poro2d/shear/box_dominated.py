@@ -7,7 +7,7 @@ things break it, both read here off a finished curve (a reading, like the residu
 
 - **the plane's load.** The side walls' friction moves load between the plate and the plane
   (docs/shear.md, "What reaches the shear plane"). Laboratory boxes put 0.65-0.85 of the plate's
-  load on the plane (Amsiejus et al. 2014), the paper's box 1.03-1.23 at its own frictions; a
+  load on the plane (Amsiejus et al. 2014), the paper's box 1.03-1.27 at f_p 0.5 (docs/shear.md); a
   test whose plane carries less than :data:`PLANE_LOAD_BAND`'s 0.7 or more than its 1.3 times the
   plate's stress at the peak reads a tau/sigma off by more than 30 %: the box's walls, jammed struts
   between them, decide it, not the soil;
@@ -34,7 +34,7 @@ from poro2d.shear.fit import peak
 
 #: the plane's share of the plate's normal stress at the peak within which a test reads its
 #: material: laboratory boxes hold 0.65-0.85 (Amsiejus et al. 2014) and the paper's box measured
-#: 1.03-1.23; outside it tau over the plate's stress is off by more than 30 % of the plane's ratio
+#: 1.03-1.27 at f_p 0.5; outside it tau over the plate's stress is off by more than 30 % of the plane's ratio
 PLANE_LOAD_BAND = (0.7, 1.3)
 #: a curve whose smoothed peak lies in the last ``peak_window`` of its travel has not peaked when its
 #: shear stress still rises there by more than this part of that peak over the window (least
