@@ -49,7 +49,7 @@ def test_four_parameters_recover_a_known_truth_within_their_intervals(stiff_lab,
     specimens, lab = stiff_lab
     out = tmp_path / "cal"
     kw = dict(points=18, refine=4, settings=SHORT, stations=4, kn_range=KN_RANGE, ks_range=KS_RANGE,
-              workers=1, dashboard=None, progress=False)  # fmt: skip
+              workers=1, dashboard=None, progress=False, keep_box_dominated=True)  # fmt: skip
     res = run_calibration(lab, specimens, store=Store(out), **kw)
     for name, value in TRUTH.items():
         lo, hi = res.intervals[name]

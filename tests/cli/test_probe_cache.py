@@ -35,6 +35,7 @@ def _argv(lab, specimens, out) -> list[str]:
     given = [a for s in specimens for a in ("--specimen", str(s))]
     return ["calibrate", "--lab", str(lab), *given, "--points", "9", "--refine", "0",
             "--max-displacement", "0.002", "--workers", "1", "--dashboard", "none", "--quiet",
+            "--keep-box-dominated",
             "--out", str(out)]  # fmt: skip
 
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from typing import ClassVar
 
 import numpy as np
 
@@ -87,6 +88,10 @@ class BiaxialRow:
     end_volumetric: float
     wall_time_s: float
     readings: BiaxialReadings
+    #: a biaxial box has no split box whose plane could carry another load than its plate: never
+    #: judged box-dominated (poro2d.shear.box_dominated judges direct shear tests)
+    box_dominated: ClassVar[bool] = False
+    box_note: ClassVar[str] = ""
 
     def observable(self, name: str) -> float:
         """The value of the observable ``name`` (:data:`poro2d.calibration.units.BIAXIAL_OBSERVABLES`,

@@ -31,6 +31,13 @@ from poro2d.calibration.biaxial import (
     check_quasi_static,
     read_biaxial_lab,
 )
+from poro2d.calibration.box_dominated import (
+    BoxDominatedPoints,
+    TooFewPoints,
+    box_dominated_points,
+    quick_box_note,
+    with_box_note,
+)
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
 from poro2d.calibration.evaluations import PARAMETER_KEYS, DesignPoint, Observed, target_key
 from poro2d.calibration.identifiable import check_enough_lab_values
@@ -298,8 +305,12 @@ class CalibrationResult(TypedResult):
     #: the laboratory test fitted: "biaxial" (then ``lab`` and ``settings`` are the biaxial ones);
     #: absent from a direct shear calibration's file
     test: str | None = None
+    #: the design points left out of the fit because a test of theirs was box-dominated, with the
+    #: calibration's sentence on what its box can measure; absent from a biaxial calibration's file
+    #: and from files of earlier versions
+    box_dominated: BoxDominatedPoints | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("unidentified", "box_scale", "test")
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("unidentified", "box_scale", "test", "box_dominated")
     #: the fields read as their records from a file's dict (``fit``: a surrogate per observable)
     PARTS: ClassVar[dict[str, type[TypedResult] | Keyed]] = {
         "best": FrictionValues,
@@ -315,6 +326,7 @@ class CalibrationResult(TypedResult):
         "fit": Keyed(SurrogateRecord),
         "evaluations": DesignPoint,
         "box_scale": BoxScale,
+        "box_dominated": BoxDominatedPoints,
     }
 
     @classmethod
@@ -443,6 +455,7 @@ def run_calibration(
     dashboard: str | None = DEFAULT_DASHBOARD,
     progress: bool = True,
     config: dict | None = None,
+    keep_box_dominated: bool = False,
 ) -> CalibrationResult:
     """Calibrate f_p and mu_r against ``lab`` on replicate specimens; keeps ``result.json`` in ``store``.
 
@@ -471,6 +484,12 @@ def run_calibration(
     every unit is then a biaxial test at a laboratory confining stress, the targets its stress
     ratios and volumetric strain (:mod:`poro2d.calibration.biaxial`), and ``settings`` are biaxial
     settings (``max_strain`` 0.2 by default).
+
+    A design point any of whose direct shear tests is box-dominated (:mod:`poro2d.shear.box_dominated`:
+    its shear plane carries outside 0.7-1.3 times the plate's load at the peak, or its stress never
+    peaked) is left out of the fit, and the result says how many were (``box_dominated``); too few
+    left for the surrogate is no answer. ``keep_box_dominated``: fit them all the same (a box where
+    every test is box-dominated: the frictions then describe the box).
     """
     t0 = time.perf_counter()
     if store is not None:
@@ -505,6 +524,8 @@ def run_calibration(
     design_seed = check_int("--design-seed", design_seed, 0)
     check_range("--lab-error", lab_error, 0.0, 1.0)
     check_range("--level", level, 0.0, 1.0, lo_open=True, hi_open=True)
+    if not isinstance(keep_box_dominated, bool):
+        raise InputError("--keep-box-dominated", keep_box_dominated, "true or false")
     if settings is None and quick and not biaxial:
         settings = dict(QUICK_SHEAR)
     calibrated = CALIBRATED + tuple(PARAMETER_KEYS[a] for a in ranges.axes[2:])
@@ -540,16 +561,20 @@ def run_calibration(
     try:
         design = model.space_filling(ranges, points, design_seed)
         rows = runner.run(_units(design, found, stresses, base, make, ranges.axes), cache, "round 1")
-        post, surrogates, table = _infer(
-            ranges, design, found, stresses, rows, targets, lab_error, lab_series, design_seed
-        )
+        infer = partial(_infer, ranges, lab_error=lab_error, lab_series=lab_series, seed=design_seed,
+                        keep_box_dominated=keep_box_dominated)  # fmt: skip
+        post, surrogates, table = infer(design, found, stresses, rows, targets)
         if refine:
             extra = [p for p in post.draw(refine, design_seed + 1) if p not in design]
             design = design + extra
             rows += runner.run(_units(extra, found, stresses, base, make, ranges.axes), cache, "round 2")
-            post, surrogates, table = _infer(
-                ranges, design, found, stresses, rows, targets, lab_error, lab_series, design_seed
-            )
+            post, surrogates, table = infer(design, found, stresses, rows, targets)
+    except TooFewPoints as exc:
+        if not quick or biaxial:
+            raise
+        raise TooFewPoints(
+            f"{quick_box_note(smallest_box(found).disks, base.max_displacement)}; {exc}"
+        ) from None
     finally:
         runner.close()
     result = _result(
@@ -570,6 +595,7 @@ def run_calibration(
         points,
         refine,
         stations,
+        quick=quick,
     )
     if store is not None:
         from poro2d.calibration.outputs import write_outputs
@@ -659,12 +685,16 @@ def _infer(
     lab_error,
     lab_series=None,
     seed: int = 0,
+    *,
+    keep_box_dominated: bool = False,
 ):
     """The surrogates (one per target), the posterior and the table of replicate values per design point.
 
     ``rows``: the units' rows in the order of :func:`_units` (None: the test failed);
     ``lab_series``: every laboratory repeat's values (series x targets; None: one series); ``seed``:
-    of the sampler, when kn or ks are calibrated (the grid of two parameters needs none)."""
+    of the sampler, when kn or ks are calibrated (the grid of two parameters needs none). A design point
+    with a box-dominated test is left out of the fit (:func:`box_dominated_points`) unless
+    ``keep_box_dominated``; the posterior's ``box_dominated`` says which."""
     per_point = len(specimens) * len(stresses)
     table = []
     for k, (fp, mu_r, *stiffness) in enumerate(design):
@@ -676,8 +706,13 @@ def _infer(
             observed.append(Observed(obs, s, values))
         given = {PARAMETER_KEYS[a]: v for a, v in zip(ranges.axes[2:], stiffness, strict=True)}
         table.append(DesignPoint(fp, mu_r, tuple(observed), **given))
-    unit = ranges.to_unit(*zip(*(e.parameters(ranges.axes) for e in table), strict=True))
-    values = np.array([[o.values for o in e.observed] for e in table], float)
+    # a design point any of whose tests read the box, not the material, is left out of the fit
+    flagged = [[r for r in rows[k * per_point : (k + 1) * per_point] if r is not None and r.box_dominated]
+               for k in range(len(table))]  # fmt: skip
+    left_out = box_dominated_points(flagged, table, min_points(ranges.dim), keep_box_dominated)
+    kept = np.array([keep_box_dominated or not f for f in flagged], bool)
+    unit = ranges.to_unit(*zip(*(e.parameters(ranges.axes) for e in table), strict=True))[kept]
+    values = np.array([[o.values for o in e.observed] for e in table], float)[kept]
     surrogates = []
     for k, (obs, s, _) in enumerate(targets):
         ok = np.isfinite(values[:, k]).any(axis=1)
@@ -710,6 +745,7 @@ def _infer(
         raise RuntimeError(f"the posterior cannot be computed ({exc}): no answer is reported") from None
     if not post.finite():
         raise RuntimeError("the posterior is not finite: no answer is reported")
+    post.box_dominated = left_out
     return post, surrogates, table
 
 
@@ -793,9 +829,12 @@ def _result(
     points,
     refine,
     stations=1,
+    *,
+    quick: bool = False,
 ) -> CalibrationResult:
     best = dict(zip(ranges.axes, post.best(), strict=True))
     biaxial = isinstance(lab_data, LabTests)
+    scale = None if biaxial else smallest_box(found)  # ASTM D3080 speaks of shear boxes only
     keys = {axis: PARAMETER_KEYS[axis] for axis in ranges.axes}
     intervals = {keys[a]: list(post.interval(a, level)) for a in ranges.axes}
     wide: dict[str, bool | None] = {keys[a]: _wide(ranges, a, *intervals[keys[a]]) for a in ranges.axes}
@@ -848,8 +887,11 @@ def _result(
         ),  # fmt: skip
         provenance=Provenance.now(),
         unidentified=unknown,
-        box_scale=None if biaxial else smallest_box(found),  # ASTM D3080 speaks of shear boxes only
+        box_scale=scale,
         test=BIAXIAL if biaxial else None,
+        box_dominated=None
+        if scale is None
+        else with_box_note(post.box_dominated, quick, scale.disks, base.max_displacement),
     )
 
 

@@ -196,7 +196,9 @@ class UnitRow:
 
     ``peak`` and ``end``: shear stresses (kPa); ``dilation``: the plate's rise at the end of
     the test (mm, positive: dilation), smoothed over the peak window as the end stress is (NaN:
-    not given, for a row made by hand).
+    not given, for a row made by hand). ``box_dominated``: the test's verdict, read off its curve
+    for a test cached before there was one (:meth:`poro2d.shear.results.ShearTestResult.read`): the
+    fit leaves its design point out.
     """
 
     key: str
@@ -209,6 +211,9 @@ class UnitRow:
     wall_time_s: float
     dilation: float = math.nan
     readings: CurveReadings | None = None
+    #: whether the test read its box rather than its material (poro2d.shear.box_dominated), and why
+    box_dominated: bool = False
+    box_note: str = ""
 
     def observable(self, name: str) -> float:
         """The value of the observable ``name`` (:data:`OBSERVABLES`, or a reading of the curve,
@@ -242,6 +247,8 @@ def _row(unit: CalibrationUnit, res) -> UnitRow:
             np.asarray(res.curve["plate_displacement_mm"], float),
             window,
         ),
+        box_dominated=bool(res.box_dominated),
+        box_note=res.box_note or "",
     )
 
 

@@ -86,6 +86,12 @@ def register(app: typer.Typer) -> None:
         scheduler: str = typer.Option(None, "--scheduler", help=_SCHED),
         workers: int = typer.Option(None, "--workers", help=_WORKERS),
         dashboard: str = typer.Option(None, "--dashboard", help=_DASHBOARD),
+        keep_box_dominated: bool = typer.Option(
+            False,
+            "--keep-box-dominated",
+            help="Fit design points whose tests are box-dominated too (left out by default): the"
+            " frictions then describe the box.",
+        ),
         quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
     ) -> None:
         """Calibrate particle friction f_p and rolling friction mu_r against laboratory direct shear or
@@ -109,6 +115,7 @@ def register(app: typer.Typer) -> None:
             **{k: v for k, v in (("kn_range", kn_range), ("ks_range", ks_range)) if v is not None},
             "max_displacement": max_displacement,
             **({"max_strain": max_strain} if max_strain is not None else {}),
+            **({"keep_box_dominated": True} if keep_box_dominated else {}),
         }
         try:
             result = run_calibration(
@@ -136,6 +143,7 @@ def register(app: typer.Typer) -> None:
                 dashboard=check_dashboard(dashboard),
                 progress=not quiet,
                 config={"cli": options},
+                keep_box_dominated=keep_box_dominated,
             )
         except RuntimeError as exc:
             console.print(f"[bold red]failed:[/] {exc}")
@@ -161,6 +169,7 @@ def test_settings(biaxial: bool, max_displacement: float | None, max_strain: flo
 
 def print_result(result, out: Path) -> None:
     from poro2d.report.calibration_report import (
+        box_dominated_note,
         box_note,
         calibrated,
         identifiability_note,
@@ -175,6 +184,8 @@ def print_result(result, out: Path) -> None:
         console.print(f"  {repeats_note(result)}")
     if box_note(result):
         console.print(f"  {box_note(result)}")
+    if box_dominated_note(result):
+        console.print(f"  {box_dominated_note(result)}")
     console.print(
         f"results in {out}/result.json; config {out}/calibrated.toml; report {out}/calibration.html"
     )

@@ -243,7 +243,24 @@ def print_residual_note(tests) -> None:
     )
 
 
+def box_warning(tests) -> str | None:
+    """The warning that tests are box-dominated (poro2d.shear.box_dominated), one line naming each; None
+    when none is."""
+    flagged = [t for t in tests if t.get("box_dominated")]
+    if not flagged:
+        return None
+    each = "; ".join(f"{t['normal_stress_kpa']:g} kPa: {t['box_note'].removeprefix('box-dominated: ')}"
+                     for t in flagged)  # fmt: skip
+    return (
+        f"warning: {len(flagged)} of {len(tests)} tests are box-dominated, their tau/sigma is the box's, "
+        f"not the soil's ({each})"
+    )
+
+
 def print_result(result: ShearSeriesResult, out: Path) -> None:
+    warning = box_warning(result["tests"])
+    if warning:  # before the answer: a reader who stops at the table must not miss it
+        console.print(warning, style="bold red", markup=False, soft_wrap=True)
     t = Table(title="direct shear")
     for col in (
         "sigma_n kPa",

@@ -87,6 +87,13 @@ def box_note(result) -> str | None:
     return f"{scale.note()}; the frictions are {fitted}.{warning}"
 
 
+def box_dominated_note(result) -> str | None:
+    """How many design points were left out as box-dominated, in one line (None for a biaxial
+    calibration or a file written before they were)."""
+    left = result.get("box_dominated")
+    return None if left is None else f"{left['note'][:1].upper()}{left['note'][1:]}."
+
+
 def repeats_note(result) -> str | None:
     """The laboratory repeats fitted as their mean, in one line (None for a single series)."""
     post = result.posterior
@@ -153,6 +160,7 @@ def calibration_blocks(result, out: Path) -> list[tuple]:
         ("p", identifiability_note(result)),
         *([("p", repeats_note(result))] if repeats_note(result) else []),
         *([("p", box_note(result))] if box_note(result) else []),
+        *([("p", box_dominated_note(result))] if box_dominated_note(result) else []),
         ("table", header, rows),
         (
             "img",

@@ -209,8 +209,12 @@ class TestSummary(TypedResult):
     folder: str
     plane_load_fraction_at_peak: float | None = None
     residual_dilation_stopped: ResidualAtRest | None = None
+    box_dominated: bool | None = None
+    box_note: str | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("plane_load_fraction_at_peak", "residual_dilation_stopped")
+    OPTIONAL: ClassVar[tuple[str, ...]] = (
+        "plane_load_fraction_at_peak", "residual_dilation_stopped", "box_dominated", "box_note",
+    )  # fmt: skip
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "end": EndValues,
         "force_balance": ForceBalance,

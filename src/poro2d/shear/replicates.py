@@ -19,6 +19,7 @@ import numpy as np
 
 from poro2d.errors import InputError, check_range
 from poro2d.io_utils import Provenance
+from poro2d.shear.box_dominated import box_dominated_count
 from poro2d.shear.fit import mohr_coulomb
 from poro2d.shear.parts import FitInterval, StressPeaks
 from poro2d.shear.pool import ShearJob
@@ -95,6 +96,7 @@ def summarize_replicate_peaks(
         friction_angle_mean_deg=float(np.mean(phis)) if phis else None,
         friction_angle_sd_deg=float(np.std(phis, ddof=1)) if len(phis) > 1 else None,
         method="peaks of every specimen pooled; Student-t intervals of the least-squares line",
+        box_dominated_tests=box_dominated_count([t for r in series.values() for t in r["tests"]]),
     )
 
 

@@ -8,6 +8,7 @@ from typing import Any, ClassVar
 
 from poro2d.dem.summary import EngineSummary
 from poro2d.io_utils import Provenance
+from poro2d.shear.box_dominated import box_verdict
 from poro2d.shear.box_scale import BoxScale
 from poro2d.shear.curve import ShearCurve, read_curve
 from poro2d.shear.parts import (
@@ -78,9 +79,15 @@ class ShearTestResult(TypedResult):
     # the residual read where the plate has stopped rising (absent in a test of an earlier
     # poro2d): see poro2d.shear.residual
     residual_dilation_stopped: ResidualAtRest | None = None
+    # whether the test read its box rather than its material (absent in a test of an earlier
+    # poro2d, read off its curve when at hand): see poro2d.shear.box_dominated
+    box_dominated: bool | None = None
+    box_note: str | None = None
     curve: ShearCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("plane_load_fraction_at_peak", "residual_dilation_stopped")
+    OPTIONAL: ClassVar[tuple[str, ...]] = (
+        "plane_load_fraction_at_peak", "residual_dilation_stopped", "box_dominated", "box_note",
+    )  # fmt: skip
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "end": EndValues,
         "force_balance": ForceBalance,
@@ -103,6 +110,10 @@ class ShearTestResult(TypedResult):
             raise FileNotFoundError(f"no finished direct shear test in {store.root} (result.json)")
         result = cls.from_dict(data)
         result.curve = read_curve(store)
+        if result.box_dominated is None and result.curve is not None:
+            # a test of an earlier poro2d: the verdict is read off its stored curve
+            verdict = box_verdict(result.curve, result.peak_window_m)
+            result.box_dominated, result.box_note = verdict.dominated, verdict.note
         return result
 
 
@@ -117,7 +128,7 @@ class ShearSeriesResult(TypedResult):
     by normal stress, for figures and summaries made from the result.
     """
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("rate_check", "lab", "box_scale")
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("rate_check", "lab", "box_scale", "box_dominated_tests")
 
     normal_stresses_kpa: list[float]
     tests: list[TestSummary]
@@ -143,6 +154,9 @@ class ShearSeriesResult(TypedResult):
     box_scale: BoxScale | None = None
     wall_time_s: float | None = None
     provenance: Provenance | None = None
+    #: how many of ``tests`` are box-dominated (poro2d.shear.box_dominated); absent in a series
+    #: of an earlier poro2d
+    box_dominated_tests: int | None = None
     curves: dict[float, ShearCurve] = field(
         default_factory=dict, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
@@ -183,8 +197,12 @@ class ReplicateShearResult(TypedResult):
     processes: int | None = None
     config: dict[str, Any] | None = None
     provenance: Provenance | None = None
+    #: how many tests of every specimen are box-dominated (poro2d.shear.box_dominated); absent in
+    #: a study of an earlier poro2d
+    box_dominated_tests: int | None = None
     series: dict[str, ShearSeriesResult] = field(default_factory=dict, kw_only=True, metadata=NOT_IN_FILE)
 
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("box_dominated_tests",)
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "per_normal_stress": StressPeaks,
         "fit": FitInterval,

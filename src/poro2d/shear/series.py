@@ -11,6 +11,7 @@ import numpy as np
 
 from poro2d.errors import InputError, check_range
 from poro2d.io_utils import Provenance
+from poro2d.shear.box_dominated import box_dominated_count
 from poro2d.shear.box_scale import box_scale
 from poro2d.shear.case import ShearCase
 from poro2d.shear.fit import mohr_coulomb, smooth
@@ -177,6 +178,7 @@ class ShearSeries:
             specimen_meta=self.specimen.extra,
             processes=self.processes,
             config=self.config,
+            box_dominated_tests=box_dominated_count(summary),
         )
         width, height = self.specimen.box()
         result.box_scale = box_scale(width, height, self.specimen.arrays["particles.radius"])
@@ -205,6 +207,8 @@ class ShearSeries:
             folder=folder_name(t.normal_stress_kpa),
             plane_load_fraction_at_peak=t.plane_load_fraction_at_peak,
             residual_dilation_stopped=t.residual_dilation_stopped,
+            box_dominated=t.box_dominated,
+            box_note=t.box_note,
         )
 
     def _quasi_static(self, tests: list[ShearTestResult]) -> QuasiStatic:

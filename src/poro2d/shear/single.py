@@ -26,6 +26,7 @@ from poro2d.io_utils import Provenance, as_json
 from poro2d.measure.coordination import coordination_number
 from poro2d.shear import record
 from poro2d.shear.box import SplitBox, build_split_box
+from poro2d.shear.box_dominated import box_verdict
 from poro2d.shear.case import ShearCase
 from poro2d.shear.controllers import Consolidation, ProgressFn
 from poro2d.shear.curve import (
@@ -218,6 +219,7 @@ class DirectShearTest:
         rho = float(np.mean(sim.particles.density)) * sim.density_scale
         d_mean = float(2.0 * np.mean(sim.particles.radius))
         curve = curve_columns(rows)
+        verdict = box_verdict(curve, s.peak_window)  # a reading of the curve: no number of the test changes
         return ShearTestResult(
             **vars(curve_summary(rows, self.sigma_kpa, s)),
             inertial_number_at_target_stress=inertial_number(
@@ -238,6 +240,8 @@ class DirectShearTest:
             engine=sim.summary(),
             provenance=Provenance.now(),
             residual_dilation_stopped=dilation_stopped_residual(curve, d_mean),
+            box_dominated=verdict.dominated,
+            box_note=verdict.note,
             curve=curve,
         )
 
