@@ -190,26 +190,20 @@ def _grading(text: str):
         raise InputError("--grading", text, f"{exc.allowed}, or a sieve curve .csv") from None
 
 
+def _table(title: str, columns: str) -> Table:
+    """A table of right-justified columns (``columns``: names apart, '_' for a space in a name)."""
+    t = Table(title=title)
+    for col in columns.split():
+        t.add_column(col.replace("_", " "), justify="right")
+    return t
+
+
 def print_result(result, out: Path) -> None:
     """The steady state first (one line), then each seed and how it was measured."""
     console.print(f"[bold]{result.headline()}[/]")
     if not result.steady:
         console.print(f"[yellow]{result.note}[/]")
-    t = Table(title="seeds")
-    for col in (
-        "seed",
-        "disks",
-        "tau/sigma",
-        "+- se",
-        "phi deg",
-        "solid fraction",
-        "I",
-        "sigma_yy kPa",
-        "z",
-        "steady",
-        "time s",
-    ):
-        t.add_column(col, justify="right")
+    t = _table("seeds", "seed disks tau/sigma +-_se phi_deg solid_fraction I sigma_yy_kPa z steady time_s")
     for s in result.summaries:
         t.add_row(
             str(s.seed),
@@ -234,6 +228,12 @@ def print_result(result, out: Path) -> None:
         f"P = {c.pressure_kpa:g} kPa, I = {c.inertial_number:g}; "
         f"steady window gamma {c.window_start:g}-{c.strain:g}"
     )
+    if result.stiffness_number is not None:
+        held = "" if c.stiffness_number is None else " (held by --stiffness-number)"
+        console.print(
+            f"stiffness number kappa = kn / (P t) = {result.stiffness_number:.0f}{held}, mean overlap / d = "
+            f"{result.mean_overlap_ratio.text(4)}: an elastic strain of about 1 / kappa in the solid fraction"
+        )
     console.print(f"results in {out}/result.json, series.csv, critical_state.png")
 
 
@@ -242,20 +242,10 @@ def print_line(result, out: Path) -> None:
     console.print(f"[bold]{result.headline()}[/]")
     if not result.steady:
         console.print(f"[yellow]{result.note}[/]")
-    t = Table(title="critical state per pressure (mean +- sd over seeds)")
-    for col in (
-        "P kPa",
-        "p' kPa",
-        "e_cs",
-        "solid fraction",
-        "tau/sigma",
-        "phi deg",
-        "z",
-        "kappa",
-        "overlap/d",
-        "steady",
-    ):
-        t.add_column(col, justify="right")
+    t = _table(
+        "critical state per pressure (mean +- sd over seeds)",
+        "P_kPa p'_kPa e_cs solid_fraction tau/sigma phi_deg z kappa overlap/d steady",
+    )
     for p in result.points:
         t.add_row(
             f"{p.pressure_kpa:g}",
