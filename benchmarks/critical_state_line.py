@@ -1,6 +1,6 @@
 """The 2D critical-state line e_cs(p') of a grading and its micro-parameters, over seeds.
 
-    python benchmarks/critical_state_line.py [--pressures 50,100,200,400] [--friction 0.5]
+    python benchmarks/critical_state_line.py [--pressures 50,100,200,400] [--grading paper] [--friction 0.5]
         [--rolling 0] [--stiffness-number K] [--seeds 2] [--disks 1500] [--inertial 1e-3]
         [--strain 3] [--processes 2] [--keep DIR]
 
@@ -28,6 +28,7 @@ def numbers(text: str) -> list[float]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--pressures", type=numbers, default=[50.0, 100.0, 200.0, 400.0])
+    ap.add_argument("--grading", default="paper", help="a built-in grading or a sieve curve CSV")
     ap.add_argument("--friction", type=float, default=0.5)
     ap.add_argument("--rolling", type=float, default=0.0)
     ap.add_argument("--stiffness-number", type=float, default=None)
@@ -44,7 +45,12 @@ def main() -> None:
     from poro2d.store import Store
 
     root = args.keep or Path(tempfile.mkdtemp(prefix="critical-state-line-"))
+    from poro2d.grading import GradingCurve, preset_grading
+
+    is_csv = args.grading.lower().endswith(".csv")
+    grading = GradingCurve.from_csv(args.grading) if is_csv else preset_grading(args.grading)
     case = CriticalStateCase(
+        grading=grading,
         disks=args.disks,
         particle_friction=args.friction,
         rolling_friction=args.rolling,
@@ -55,7 +61,8 @@ def main() -> None:
     t0 = time.perf_counter()
     r = run_critical_state_line(case, args.pressures, Store(root), seeds=args.seeds, processes=args.processes)
     print(
-        f"f_p {args.friction:g}, mu_r {args.rolling:g}, I {args.inertial:g}, {args.disks} disks, "
+        f"{args.grading}: f_p {args.friction:g}, mu_r {args.rolling:g}, I {args.inertial:g}, "
+        f"{args.disks} disks, "
         f"{args.seeds} seeds, kappa {'Table 1' if args.stiffness_number is None else args.stiffness_number}"
     )
     print(

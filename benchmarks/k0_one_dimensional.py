@@ -112,7 +112,8 @@ def main() -> None:
     labels = args.specimen or [f"quick seed {s}" for s in args.seeds]
     head = " ".join(f"{'K @' + format(s, 'g'):>8}" for s in args.stresses)
     print(
-        f"{'specimen':>16} {'prepared':>8} {head} {'loading':>8} {'unl ' + format(args.unload, 'g'):>8} {'s':>5}"
+        f"{'specimen':>16} {'prepared':>8} {head} {'loading':>8} "
+        f"{'unl ' + format(args.unload, 'g'):>8} {'s':>5}"
     )
     found = []
     for label, case in zip(labels, cases, strict=True):
