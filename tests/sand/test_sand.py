@@ -233,6 +233,16 @@ def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
     assert again.box_porosity_mean == res.box_porosity_mean
     assert [k.box_porosity for k in again.specimens] == [k.box_porosity for k in res.specimens]
     assert again.mu_prep == res.mu_prep
+    assert res.state_map is None and "state_map" not in data
+    # a [state] table added afterwards reads the same run back and adds the state parameter only
+    stated = run_sand({**TINY, "state": {"lab_line": "toyoura"}}, store=Store(out), progress=False)
+    assert stated.box_porosity_mean == res.box_porosity_mean and stated.n2d_target == res.n2d_target
+    rec = stated.state_map
+    assert rec.e2d_by_state is None and "poro2d critical-state" in rec.note
+    assert rec.psi_norm_lab == pytest.approx(
+        (0.40 / 0.60 - rec.e_cs_lab) / (0.4571 / 0.5429 - 0.3253 / 0.6747)
+    )
+    assert "## State parameter" in (out / "summary.md").read_text()
 
 
 def test_preflight_says_what_a_cut_of_fines_does(tmp_path, monkeypatch):

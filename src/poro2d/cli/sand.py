@@ -109,6 +109,11 @@ def print_result(res, out: Path) -> None:
     for k in res.specimens:
         if not k.accepted:
             console.print(f"[bold red]seed {k.seed} not accepted:[/] {escape(k.message)}", soft_wrap=True)
+    if res.state_map is not None:
+        from poro2d.sand.state import state_map_lines
+
+        for line in state_map_lines(res.state_map):
+            console.print(escape(line), soft_wrap=True)
     from poro2d.sand.result import warnings
 
     for w in warnings(res):

@@ -34,13 +34,14 @@ from poro2d.criterion.density import DEFAULT_MUS, check_mus
 from poro2d.errors import InputError, check_int
 from poro2d.grading import GradingCurve
 from poro2d.lab_state import LabState, lab_state_from_table
+from poro2d.sand.state import StateRequest, state_request
 from poro2d.specimen.compaction import SpecimenSpec, time_step
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.density import DEFAULT_SEEDS, with_density_defaults
 from poro2d.typed_result import TypedResult, part
 
 #: the tables a sand config adds to a criterion config
-SAND_TABLES = ("soil", "lab", "sand")
+SAND_TABLES = ("soil", "lab", "sand", "state")
 SOIL_KEYS = {"name", "reference"}
 SAND_KEYS = {"seeds", "calibration_seeds", "calibration_disks", "mu_prep"}
 #: disks in the calibration box unless ``[sand] calibration_disks`` says otherwise: the dense and
@@ -108,6 +109,7 @@ class SandCase:
     calibration_disks: int = CALIBRATION_DISKS
     mus: tuple[float, ...] = DEFAULT_MUS
     calibration_seeds: int = CALIBRATION_SEEDS
+    state: StateRequest | None = None
 
     @property
     def n_max(self) -> float:
@@ -251,7 +253,12 @@ def load_sand_case(config: ConfigLike, *, seeds: int | None = None) -> SandCase:
     spec, grading, _settings, _seed = crit.build()
     crit = with_step_budgets(crit, spec, grading)
     spec, grading, _settings, _seed = crit.build()
-    return SandCase(name, reference, lab, crit, base_dir, spec, grading, n_seeds, cal_disks, mus, cal_seeds)
+    state = state_request(
+        cfg.get("state"), lab, base_dir, spec.friction_particle, spec.rolling_friction, grading
+    )
+    return SandCase(
+        name, reference, lab, crit, base_dir, spec, grading, n_seeds, cal_disks, mus, cal_seeds, state
+    )
 
 
 __all__ = ["CALIBRATION_DISKS", "CALIBRATION_SEEDS", "SandCase", "SoilRecord", "load_sand_case"]

@@ -19,6 +19,7 @@ from poro2d.io_utils import Provenance
 from poro2d.sand.case import LabStateRecord, SoilRecord
 from poro2d.sand.preflight import Preflight
 from poro2d.sand.profile import StageProfile
+from poro2d.sand.state import StateMapRecord, state_map_lines, state_map_record
 from poro2d.store import Store
 from poro2d.sweep.records import DensityCalibrationRecord
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
@@ -220,6 +221,8 @@ class SandResult(TypedResult):
     wall_seconds: float
     config: dict[str, Any]
     provenance: Provenance
+    #: both maps at the test stress, with a ``[state]`` table (:mod:`poro2d.sand.state`)
+    state_map: StateMapRecord | None = None
     specimens: list[SeedSpecimen] = field(default_factory=list, metadata=NOT_IN_FILE)
 
     #: the typed parts, as their classes read them
@@ -231,7 +234,9 @@ class SandResult(TypedResult):
         "seed_results": SeedSpecimen,
         "preflight": PreflightRecord,
         "provenance": Provenance,
+        "state_map": StateMapRecord,
     }
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("state_map",)
 
     @classmethod
     def build(
@@ -260,6 +265,12 @@ class SandResult(TypedResult):
             if k.accepted
         ]
         n_ok = sum(k.accepted for k in kept)
+        state_map = (
+            None
+            if case.state is None
+            else state_map_record(case.state, lab, cal_record.n2d_max, cal_record.n2d_min, target.n2d_target,
+                                  case.grading.source)
+        )  # fmt: skip
         return cls(
             mode="density",
             soil=case.soil_record(),
@@ -286,6 +297,7 @@ class SandResult(TypedResult):
             wall_seconds=seconds,
             config=case.config.as_config(),
             provenance=Provenance.now(),
+            state_map=state_map,
             specimens=list(kept),
         )
 
@@ -394,6 +406,8 @@ def summary_markdown(res: SandResult, store: Store) -> str:
             f"poro2d export {out / first.folder} --to yade --out {out / 'yade'}",
             "```",
         ]
+    if res.state_map is not None:
+        lines += ["", "## State parameter", "", *state_map_lines(res.state_map)]
     return "\n".join(lines) + "\n"
 
 
