@@ -25,6 +25,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from poro2d.dem import Simulation
+from poro2d.measure.stiffness import (
+    DiskContacts,
+    contact_kn,
+    disk_contacts,
+    overlap_ratio,
+    stiffness_number,
+)
 
 #: how the stiffness number is read (kept with the numbers)
 STIFFNESS_DEFINITION = (
@@ -32,57 +39,6 @@ STIFFNESS_DEFINITION = (
     "(per_body: the two disks' kn in series), t the disks' thickness, sigma_3 the confining stress; "
     "overlap ratio = mean overlap / mean diameter of the touching disk-disk contacts"
 )
-
-
-@dataclass(frozen=True)
-class DiskContacts:
-    """The touching disk-disk contacts: their disks ``i``, ``j``, unit normals, the sum of the two
-    radii (m) and the overlap (m), read from the contact set's branch vectors."""
-
-    i: np.ndarray
-    j: np.ndarray
-    normal: np.ndarray
-    reach: np.ndarray
-    overlap: np.ndarray
-
-
-def disk_contacts(sim: Simulation) -> DiskContacts:
-    """The touching disk-disk contacts of ``sim`` (:meth:`poro2d.dem.Simulation.contacts`)."""
-    c = sim.contacts()
-    pp = c.kind == 0
-    i, j = c.i[pp], c.j[pp]
-    r = sim.particles.radius
-    reach = r[i] + r[j]
-    return DiskContacts(i, j, c.normal[pp], reach, reach - np.hypot(c.branch[pp, 0], c.branch[pp, 1]))
-
-
-def contact_kn(sim: Simulation) -> float:
-    """The mean normal stiffness (N/m) of ``sim``'s disk-disk contacts, as the engine forms it.
-
-    ``per_pair_type``: the one disk-disk kn. ``per_body``: kA kB / (kA + kB) over the touching
-    pairs (two equal disks of kn each when none touch: kn / 2).
-    """
-    if sim.contact.convention == "per_pair_type":
-        assert sim.contact.pp is not None
-        return float(sim.contact.pp[0])
-    kn = sim.particles.kn
-    c = disk_contacts(sim)
-    if c.i.size == 0:
-        return 0.5 * float(np.mean(kn))
-    return float(np.mean(kn[c.i] * kn[c.j] / (kn[c.i] + kn[c.j])))
-
-
-def stiffness_number(kn: float, sigma_pa: float, thickness: float) -> float:
-    """kappa = kn / (sigma t): the inverse of a contact's typical strain under ``sigma_pa``."""
-    return kn / (sigma_pa * thickness)
-
-
-def overlap_ratio(sim: Simulation) -> float:
-    """mean(overlap) / mean(d) over the touching disk-disk contacts (d: the two disks' mean diameter)."""
-    c = disk_contacts(sim)
-    if c.i.size == 0:
-        return float("nan")
-    return float(np.mean(c.overlap) / np.mean(c.reach))
 
 
 def contact_strain(sim: Simulation) -> tuple[float, float]:

@@ -78,6 +78,24 @@ def check_extra_types(extra: dict) -> None:
             raise InputError("shear.normal_stress_kpa", v, "a number or a list of numbers in kPa")
 
 
+def print_stiffness_note(tests) -> None:
+    """kappa = kn / (sigma t) and the overlap at the peak per stress: how much strain is the contacts'."""
+    rows = [t for t in tests if t.get("stiffness_number") is not None]
+    if not rows:
+        return
+    parts = [
+        f"{t['normal_stress_kpa']:g} kPa: kappa {t['stiffness_number']:.0f}, overlap / d "
+        f"{t['mean_overlap_ratio_at_peak']:.1e}"
+        for t in rows
+    ]
+    console.print(
+        "stiffness number kappa = kn / (sigma t) and mean overlap at the peak: "
+        + "; ".join(parts)
+        + " (an elastic strain of about 1 / kappa rides on the plate's rise: docs/shear.md)",
+        soft_wrap=True,
+    )
+
+
 def register(app: typer.Typer) -> None:
     @app.command("shear")
     def shear_cmd(
@@ -284,6 +302,7 @@ def print_result(result: ShearSeriesResult, out: Path) -> None:
             _sci(r["max_inertial_number"]), f"{r['wall_time_s']:.0f}",
         )  # fmt: skip
     console.print(t)
+    print_stiffness_note(result["tests"])
     print_residual_note(result["tests"])
     from poro2d.shear.box_scale import box_scale_of
 

@@ -211,9 +211,12 @@ class TestSummary(TypedResult):
     residual_dilation_stopped: ResidualAtRest | None = None
     box_dominated: bool | None = None
     box_note: str | None = None
+    stiffness_number: float | None = None
+    mean_overlap_ratio_at_peak: float | None = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = (
         "plane_load_fraction_at_peak", "residual_dilation_stopped", "box_dominated", "box_note",
+        "stiffness_number", "mean_overlap_ratio_at_peak",
     )  # fmt: skip
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "end": EndValues,

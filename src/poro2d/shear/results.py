@@ -83,10 +83,15 @@ class ShearTestResult(TypedResult):
     # poro2d, read off its curve when at hand): see poro2d.shear.box_dominated
     box_dominated: bool | None = None
     box_note: str | None = None
+    # kappa = kn / (sigma t) at the normal stress and the mean overlap over d at the peak (absent
+    # in a test of an earlier poro2d): see poro2d.measure.stiffness
+    stiffness_number: float | None = None
+    mean_overlap_ratio_at_peak: float | None = None
     curve: ShearCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     OPTIONAL: ClassVar[tuple[str, ...]] = (
         "plane_load_fraction_at_peak", "residual_dilation_stopped", "box_dominated", "box_note",
+        "stiffness_number", "mean_overlap_ratio_at_peak",
     )  # fmt: skip
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "end": EndValues,

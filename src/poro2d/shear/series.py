@@ -209,6 +209,8 @@ class ShearSeries:
             residual_dilation_stopped=t.residual_dilation_stopped,
             box_dominated=t.box_dominated,
             box_note=t.box_note,
+            stiffness_number=t.stiffness_number,
+            mean_overlap_ratio_at_peak=t.mean_overlap_ratio_at_peak,
         )
 
     def _quasi_static(self, tests: list[ShearTestResult]) -> QuasiStatic:

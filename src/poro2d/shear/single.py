@@ -24,6 +24,13 @@ from poro2d.dem import Simulation
 from poro2d.errors import InputError
 from poro2d.io_utils import Provenance, as_json
 from poro2d.measure.coordination import coordination_number
+from poro2d.measure.stiffness import (
+    contact_kn,
+    contacts_of,
+    mean_overlap_ratio,
+    overlap_ratio,
+    stiffness_number,
+)
 from poro2d.shear import record
 from poro2d.shear.box import SplitBox, build_split_box
 from poro2d.shear.box_dominated import box_verdict
@@ -192,7 +199,7 @@ class DirectShearTest:
             store=self.store, threads=self.threads, figures=self.figures, progress=self.progress,
         )  # fmt: skip
         wall = stage.run()
-        result = self._result(stage.rows, info, stage.sim, wall)
+        result = self._result(stage.rows, info, stage.sim, wall, stage.peak.frame)
         if self.store is not None:
             self.store.write_csv("curve.csv", stage.rows, header=CURVE_COLUMNS)
             if self.figures and stage.peak.frame is not None:
@@ -212,9 +219,12 @@ class DirectShearTest:
         )  # fmt: skip
 
     def _result(
-        self, rows: list[CurveRow], info: ConsolidationRecord, sim: Simulation, wall: float
-    ) -> ShearTestResult:
-        """The test's ``result.json``: what the curve says, and how it was obtained."""
+        self, rows: list[CurveRow], info: ConsolidationRecord, sim: Simulation, wall: float,
+        peak: PeakFrame | None = None,
+    ) -> ShearTestResult:  # fmt: skip
+        """The test's ``result.json``: what the curve says, and how it was obtained; the stiffness
+        number at the normal stress and the mean overlap at the peak (``peak``'s frame, else the
+        end) say how much of its strain is the contacts' (:mod:`poro2d.measure.stiffness`)."""
         s = self.settings
         rho = float(np.mean(sim.particles.density)) * sim.density_scale
         d_mean = float(2.0 * np.mean(sim.particles.radius))
@@ -242,6 +252,12 @@ class DirectShearTest:
             residual_dilation_stopped=dilation_stopped_residual(curve, d_mean),
             box_dominated=verdict.dominated,
             box_note=verdict.note,
+            stiffness_number=stiffness_number(contact_kn(sim), self.sigma_kpa * 1e3, sim.particles.thickness),
+            mean_overlap_ratio_at_peak=(
+                overlap_ratio(sim)
+                if peak is None
+                else mean_overlap_ratio(contacts_of(peak.contacts, peak.radius))
+            ),
             curve=curve,
         )
 
