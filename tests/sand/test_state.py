@@ -6,11 +6,11 @@ import pytest
 
 from poro2d.critical_state import CriticalStateCase
 from poro2d.critical_state.line import run_critical_state_line
+from poro2d.critical_state.state_table import state_map_lines, state_map_record, state_request
 from poro2d.errors import InputError
 from poro2d.grading import paper_grading
 from poro2d.lab_state import lab_state_from_table
 from poro2d.sand import load_sand_case
-from poro2d.sand.state import state_map_lines, state_map_record, state_request
 from poro2d.state_map import map_state, published_line
 from poro2d.store import Store
 

@@ -218,11 +218,32 @@ def test_density_relation_command_on_tiny_specimens(tmp_path, monkeypatch):
     again = json.loads((out2 / "calibration.json").read_text())
     assert again["source"] == "cache" and again["ran"] == 0 and again["reused"] == 4
     assert again["calibration"] == cal["calibration"]
+    assert "state_maps" not in rel
+    # a [state] table adds the state parameter of every state beside its answer, and nothing else
+    stated = tmp_path / "stated.toml"
+    stated.write_text(cfg.read_text() + '[state]\nlab_line = "toyoura"\ntest_stress_kpa = 100\n')
+    main(["relation", "--config", str(stated), *args[3:], "--out", str(tmp_path / "out4")])
+    rel4 = json.loads((tmp_path / "out4" / "relation.json").read_text())
+    assert [p["n2d_target"] for p in rel4["points"]] == [p["n2d_target"] for p in pts]
+    maps = rel4["state_maps"]
+    assert len(maps) == len(pts) and all(m["e2d_by_state"] is None for m in maps)
+    e = [p["n_lab"] / (1.0 - p["n_lab"]) for p in pts]
+    assert [m["psi_lab"] for m in maps] == pytest.approx([v - maps[0]["e_cs_lab"] for v in e])
     # one more seed runs only that seed's cases; the others are read back
     args3 = [a if a != "2" or args[i - 1] != "--seeds" else "3" for i, a in enumerate(args)]
     main([*args3, "--out", str(tmp_path / "out3")])
     third = json.loads((tmp_path / "out3" / "calibration.json").read_text())
     assert third["ran"] == 2 and third["reused"] == 4
+
+
+def test_a_state_table_needs_density_mode(tmp_path):
+    cfg = tmp_path / "rel.toml"
+    cfg.write_text(
+        '[relation]\nn_max = 0.4571\nn_min = 0.3253\nmode = "paper"\n[state]\nlab_line = "toyoura"\n'
+    )
+    with pytest.raises(SystemExit) as ei:
+        main(["relation", "--config", str(cfg), "--out", str(tmp_path / "o")])
+    assert ei.value.code == 2 and not (tmp_path / "o").exists()
 
 
 def test_density_mode_errors(tmp_path):

@@ -135,4 +135,30 @@ def print_relation(rel: dict, out: Path) -> None:
         )
     else:
         console.print(f"[yellow]{escape(rel['fit_note'])}[/]")
+    if rel.get("state_maps"):
+        print_state_maps(rel)
     console.print(f"figure {out}/relation.png, table {out}/relation.csv")
+
+
+def print_state_maps(rel) -> None:
+    """Each state's answer (the relative-density map's) beside the state-parameter map's."""
+    maps = rel["state_maps"]
+    first = maps[0]
+    t = Table(title=f"the state parameter at p' = {first['test_stress_kpa']:g} kPa")
+    for c in ("nLab", "Dr", "lab psi/span", "answer n2D", "answer psi/span (2D)", "state map n2D"):
+        t.add_column(c, justify="right")
+    for p, m in zip(rel["points"], maps, strict=True):
+        by_state = "" if m["n2d_by_state"] is None else f"{m['n2d_by_state']:.4f}"
+        if by_state and not m["state_within_ends"]:
+            by_state += " (beyond the ends)"
+        t.add_row(
+            f"{p['n_lab']:.4f}", f"{p['relative_density']:.2f}", f"{m['psi_norm_lab']:+.3f}",
+            f"{p['n2d_target']:.4f}",
+            "" if m["psi_norm_by_dr"] is None else f"{m['psi_norm_by_dr']:+.3f}", by_state or "no 2D line",
+        )  # fmt: skip
+    console.print(t)
+    console.print(
+        f"laboratory line: {escape(first['lab_line'])}; the answers stay the relative-density map's "
+        "(docs/equivalence.md)" + ("" if first["e_cs_2d"] is not None else f"; {escape(first['note'])}"),
+        soft_wrap=True,
+    )

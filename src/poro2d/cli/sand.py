@@ -110,7 +110,7 @@ def print_result(res, out: Path) -> None:
         if not k.accepted:
             console.print(f"[bold red]seed {k.seed} not accepted:[/] {escape(k.message)}", soft_wrap=True)
     if res.state_map is not None:
-        from poro2d.sand.state import state_map_lines
+        from poro2d.critical_state.state_table import state_map_lines
 
         for line in state_map_lines(res.state_map):
             console.print(escape(line), soft_wrap=True)

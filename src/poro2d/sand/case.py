@@ -31,10 +31,10 @@ from typing import Any
 
 from poro2d.config import check_keys
 from poro2d.criterion.density import DEFAULT_MUS, check_mus
+from poro2d.critical_state.state_table import StateRequest, state_request
 from poro2d.errors import InputError, check_int
 from poro2d.grading import GradingCurve
 from poro2d.lab_state import LabState, lab_state_from_table
-from poro2d.sand.state import StateRequest, state_request
 from poro2d.specimen.compaction import SpecimenSpec, time_step
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.density import DEFAULT_SEEDS, with_density_defaults

@@ -15,11 +15,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from poro2d.critical_state.state_table import StateMapRecord, state_map_lines, state_map_record
 from poro2d.io_utils import Provenance
 from poro2d.sand.case import LabStateRecord, SoilRecord
 from poro2d.sand.preflight import Preflight
 from poro2d.sand.profile import StageProfile
-from poro2d.sand.state import StateMapRecord, state_map_lines, state_map_record
 from poro2d.store import Store
 from poro2d.sweep.records import DensityCalibrationRecord
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
@@ -221,7 +221,7 @@ class SandResult(TypedResult):
     wall_seconds: float
     config: dict[str, Any]
     provenance: Provenance
-    #: both maps at the test stress, with a ``[state]`` table (:mod:`poro2d.sand.state`)
+    #: both maps at the test stress, with a ``[state]`` table (:mod:`poro2d.critical_state.state_table`)
     state_map: StateMapRecord | None = None
     specimens: list[SeedSpecimen] = field(default_factory=list, metadata=NOT_IN_FILE)
 

@@ -360,6 +360,36 @@ def density_relation(
     return rel, DensitySweeps.from_dict(record)
 
 
+def relation_state(table, base: CriterionBase, settings: RelationSettings, mode: str):
+    """The ``[state]`` table checked against the relation's disks and extremes (None without one):
+    the state-parameter map beside every state's answer (:mod:`poro2d.critical_state.state_table`)."""
+    from poro2d.critical_state.state_table import state_request
+    from poro2d.lab_state import lab_state_from_table
+
+    if table is None:
+        return None
+    if mode != "density":
+        raise InputError("state", "a [state] table", "density mode only (paper mode has no 2D extremes)")
+    spec, grading, _settings, _seed = base.build()
+    ends = lab_state_from_table({"n_max": settings.n_max, "n_min": settings.n_min, "n": settings.n_max})
+    return state_request(table, ends, base.base_dir, spec.friction_particle, spec.rolling_friction, grading)
+
+
+def state_maps(state, rel: RelationResult, settings: RelationSettings, base: CriterionBase) -> list[dict]:
+    """Both maps of every state of ``rel`` at the ``[state]`` stress (rows of ``state_maps``)."""
+    from poro2d.critical_state.state_table import state_map_record
+    from poro2d.lab_state import lab_state_from_table
+
+    source = base.build()[1].source
+    return [
+        state_map_record(
+            state, lab_state_from_table({"n_max": settings.n_max, "n_min": settings.n_min, "n": p["n_lab"]}),
+            rel["n2d_max"], rel["n2d_min"], p["n2d_target"], source,
+        ).to_dict()
+        for p in rel["points"]
+    ]  # fmt: skip
+
+
 def refuse_density_options(table: dict, seeds: int | None) -> None:
     """Paper mode prepares every state at friction_prep, once: seeds and frictions would be ignored."""
     if seeds is not None:
@@ -410,13 +440,15 @@ def run_relation(
         check_output_dir(store.parameter, store.root)
     check_cluster_options(scheduler, workers)
     dashboard_address = check_dashboard(dashboard)
-    cfg, base_dir = load(config, preset, extra_tables=("relation",))
-    base = CriterionBase.from_config(cfg, base_dir)
+    cfg, base_dir = load(config, preset, extra_tables=("relation", "state"))
+    # [state] reads the relation's answers; the criterion cases never see it
+    base = CriterionBase.from_config({k: v for k, v in cfg.items() if k != "state"}, base_dir)
     table = cfg.get("relation") or {}
     settings = relation_settings(
         table or None, points=points, n_max=n_max, n_min=n_min, preset=config is None
     )
     mode = check_mode(mode if mode is not None else table.get("mode", "density"))
+    state = relation_state(cfg.get("state"), base, settings, mode)
     if mode == "density":
         n_seeds = check_seeds(seeds if seeds is not None else table.get("seeds", 3), "relation.seeds")
         mus = check_mus(table["mu_prep"], "relation.mu_prep") if "mu_prep" in table else None
@@ -438,6 +470,8 @@ def run_relation(
             rel, record = density_relation(base, settings, kept, quick=quick, seeds=n_seeds, mus=mus,
                                            **sweep_kw)  # fmt: skip
             extra = {"quick": quick, "config": cfg, "sweeps": record}
+            if state is not None:
+                extra["state_maps"] = state_maps(state, rel, settings, base)
         else:
             res = run_sweep(states, kept, **sweep_kw)
             rel = analyse(res.rows, settings.n_max, settings.n_min)

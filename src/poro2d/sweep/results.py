@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from poro2d.critical_state.state_table import StateMapRecord
 from poro2d.execute.dask_cluster import ClusterInfo
 from poro2d.io_utils import Provenance
 from poro2d.sweep.records import (
@@ -130,7 +131,10 @@ class RelationResult(TypedResult):
 
     PARTS = {"points": RelationPoint, "fit": QuadraticFit, "spread": Spread,
              "sweep_summary": SweepSummary, "sweeps": DensitySweeps, "eq12": Eq12Coefficients,
-             "calibration": DensityCalibrationRecord, "provenance": Provenance}  # fmt: skip
+             "calibration": DensityCalibrationRecord, "provenance": Provenance,
+             "state_maps": StateMapRecord}  # fmt: skip
+    #: with a ``[state]`` table, both maps of every state (:mod:`poro2d.critical_state.state_table`)
+    OPTIONAL = ("state_maps",)
 
     n_max: float
     n_min: float
@@ -150,6 +154,7 @@ class RelationResult(TypedResult):
     config: dict[str, Any] | None = None
     sweeps: DensitySweeps | None = None
     provenance: Provenance | None = None
+    state_maps: list[StateMapRecord] | None = None
 
     @property
     def failed_cases(self) -> int:

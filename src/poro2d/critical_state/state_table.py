@@ -1,4 +1,6 @@
-"""The state-parameter map beside the relative-density map: a sand config's ``[state]`` table.
+"""The state-parameter map beside the relative-density map: a config's ``[state]`` table.
+
+``poro2d sand`` and ``poro2d relation`` read it alike.
 
 ``[state]`` names the laboratory's critical-state line and the test's mean stress, and points at
 the disks' own line (a folder of ``poro2d critical-state --pressure ...`` made with the soil's
@@ -11,11 +13,12 @@ test_stress_kpa = 100         # p' at which psi is matched
 line_2d = "cs-toyoura"        # the 2D critical-state line (relative to this file); optional
 ```
 
-The answer of ``poro2d sand`` stays the relative-density map's (docs/equivalence.md says why);
-with ``[state]`` the result adds the state map's 2D void ratio and porosity at the test stress,
-the laboratory's and the answer's normalised state parameters, and whether a preparation can
-reach the state map's answer (:func:`poro2d.state_map.map_state`). Without ``line_2d`` it says
-which command makes the line. Everything is read and checked when the config is.
+The answers of ``poro2d sand`` and ``poro2d relation`` stay the relative-density map's
+(docs/equivalence.md says why); with ``[state]`` the result adds the state map's 2D void ratio
+and porosity at the test stress, the laboratory's and the answer's normalised state parameters,
+and whether a preparation can reach the state map's answer
+(:func:`poro2d.state_map.map_state`). Without ``line_2d`` it says which command makes the line.
+Everything is read and checked when the config is.
 """
 
 from __future__ import annotations
