@@ -31,7 +31,7 @@ def main() -> None:
     result = CriticalStateLineResult.from_dict(json.loads((args.line / "result.json").read_text()))
     held = held_states(args.sand, args.lab_line, result.pressures_kpa, args.test_stress)
     result.marks = [
-        StateMark.of(label, e, result.line, result.pressures_kpa, held.span) for label, e in held.marks
+        StateMark.of(label, e, result.measured(), result.pressures_kpa, held.span) for label, e in held.marks
     ]
     print(result.headline())
     print_held(result, held)

@@ -158,13 +158,16 @@ def test_a_sand_folder_is_held_against_the_line_with_both_maps(tmp_path, capsys)
     assert "2D loose end" in out and "Dr map, Dr 0.80" in out and "state map" in out
     kept = json.loads((tmp_path / "out" / "result.json").read_text())
     loose, dense, answer = kept["marks"]
-    line = LineFit.from_dict(kept["line"])
+    line = CriticalStateLineResult.from_dict(kept).measured()
     # the loose end's psi is its void ratio less the line's at each pressure, over the 2D span
     span = loose["void_ratio"] - dense["void_ratio"]
     assert loose["span"] == pytest.approx(span)
     for p, psi, norm in zip(kept["pressures_kpa"], loose["psi"], loose["psi_normalised"], strict=True):
         assert psi == pytest.approx(loose["void_ratio"] - line.void_ratio_at(p))
         assert norm == pytest.approx(psi / span)
+    # the points' own line: at a point's mean stress it reads that point's void ratio
+    point = kept["points"][0]
+    assert line.void_ratio_at(point["mean_stress_kpa"]["mean"]) == pytest.approx(point["void_ratio"]["mean"])
     assert dense["void_ratio"] < answer["void_ratio"] < loose["void_ratio"]
 
 
@@ -179,3 +182,14 @@ def test_sand_and_lab_line_refusals(tmp_path, capsys):
         _out, err = capsys.readouterr()
         assert exc.value.code == 2 and name in err
     assert not (tmp_path / "out").exists()
+
+
+def test_the_measured_line_reads_between_its_points_and_not_far_beyond():
+    from poro2d.critical_state.line import MeasuredLine
+
+    line = MeasuredLine((50.0, 100.0, 200.0), (0.24, 0.24, 0.23))
+    assert line.void_ratio_at(math.sqrt(100.0 * 200.0)) == pytest.approx(0.235)
+    assert line.void_ratio_at(100.0) == pytest.approx(0.24)
+    assert line.void_ratio_at(210.0) == pytest.approx(0.23 - 0.01 * math.log(1.05) / math.log(2.0))
+    with pytest.raises(InputError):
+        line.void_ratio_at(30.0)

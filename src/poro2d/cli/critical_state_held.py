@@ -96,8 +96,9 @@ def print_held(result, held: HeldStates) -> None:
     for m in result.marks:
         t.add_row(m.label, f"{m.void_ratio:.4f}", *(f"{v:+.3f}" for v in m.psi_normalised))
     if held.lab_line is not None:
+        line = result.measured()
         maps = [
-            map_state(held.e_lab, held.e_max, held.e_min, held.lab_line, p, result.line.void_ratio_at,
+            map_state(held.e_lab, held.e_max, held.e_min, held.lab_line, p, line.void_ratio_at,
                       held.e2d_max, held.e2d_min)
             for p in result.pressures_kpa
         ]  # fmt: skip

@@ -173,6 +173,31 @@ class LineFit(TypedResult):
         return f"e_cs = {self.e_gamma:.4f} - {self.lambda_ln:.4f} ln(p'/kPa)"
 
 
+#: how far beyond its outermost points a measured line is read (a share of p'): the nominal
+#: pressures sit within about 2 % of the measured mean stresses
+READ_BEYOND = 0.1
+
+
+@dataclass(frozen=True)
+class MeasuredLine:
+    """The line through a study's points themselves: e_cs(p') read linearly in ln p' between the
+    pressures' mean (p', e) points. With linear contacts the line bends (its slope grows as
+    1 / kappa), so the points, not the fitted straight line, say e_cs at a given stress."""
+
+    p_kpa: tuple[float, ...]
+    e: tuple[float, ...]
+
+    def void_ratio_at(self, p_kpa: float) -> float:
+        """e_cs at ``p_kpa``, refused beyond the points by more than :data:`READ_BEYOND`."""
+        lo, hi = self.p_kpa[0], self.p_kpa[-1]
+        if not lo * (1.0 - READ_BEYOND) <= p_kpa <= hi * (1.0 + READ_BEYOND):
+            raise InputError("p'", p_kpa, f"[{lo:.3g}, {hi:.3g}] kPa, the 2D line's pressures")
+        x = np.log(self.p_kpa)
+        k = int(np.clip(np.searchsorted(x, math.log(p_kpa)), 1, x.size - 1))
+        w = (math.log(p_kpa) - x[k - 1]) / (x[k] - x[k - 1])
+        return float(self.e[k - 1] + w * (self.e[k] - self.e[k - 1]))
+
+
 @dataclass(eq=False)
 class StateMark(TypedResult):
     """A 2D state held against the line: its label, its void ratio, and at each of the line's
@@ -186,8 +211,9 @@ class StateMark(TypedResult):
     psi_normalised: list[float] | None
 
     @classmethod
-    def of(cls, label: str, e: float, fit: LineFit, pressures: list[float], span: float | None) -> StateMark:
-        psi = [e - fit.void_ratio_at(p) for p in pressures]
+    def of(cls, label: str, e: float, line, pressures: list[float], span: float | None) -> StateMark:
+        """``line``: what reads e_cs at a pressure (:class:`MeasuredLine`)."""
+        psi = [e - line.void_ratio_at(p) for p in pressures]
         return cls(label, float(e), psi, span, None if not span else [v / span for v in psi])
 
 
@@ -225,6 +251,13 @@ class CriticalStateLineResult(TypedResult):
         "marks": StateMark,
     }
     OPTIONAL: ClassVar[tuple[str, ...]] = ("marks",)
+
+    def measured(self) -> MeasuredLine:
+        """The line through the points (:class:`MeasuredLine`), by rising mean stress."""
+        pts = sorted(self.points, key=lambda pt: pt.mean_stress_kpa.mean)
+        return MeasuredLine(
+            tuple(pt.mean_stress_kpa.mean for pt in pts), tuple(pt.void_ratio.mean for pt in pts)
+        )
 
     def headline(self) -> str:
         """The line and the pooled friction, with the range of pressures and seeds."""
@@ -272,8 +305,10 @@ def line_result(
         wall_time_s=wall_time_s,
         config=config or {},
         provenance=Provenance.now(),
-        marks=[StateMark.of(label, e, fit, list(pressures), span) for label, e in marks] if marks else None,
     )
+    if marks:
+        line = result.measured()
+        result.marks = [StateMark.of(label, e, line, list(pressures), span) for label, e in marks]
     stored = CriticalStateLineResult.from_dict(as_json(result))
     stored.studies = list(studies)
     return stored
@@ -368,6 +403,7 @@ __all__ = [
     "CriticalStateLineResult",
     "LineFit",
     "LinePoint",
+    "MeasuredLine",
     "StateMark",
     "check_pressures",
     "line_result",

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from poro2d.config import check_keys
-from poro2d.critical_state.line import CriticalStateLineResult, LineFit
+from poro2d.critical_state.line import CriticalStateLineResult, MeasuredLine
 from poro2d.errors import InputError, check_range, is_number
 from poro2d.lab_state import LabState
 from poro2d.state_map import PRESSURE_RANGE_KPA, LabCriticalStateLine, map_state, read_lab_line
@@ -46,7 +46,7 @@ class StateRequest:
 
     lab_line: LabCriticalStateLine
     test_stress_kpa: float
-    line_2d: LineFit | None
+    line_2d: MeasuredLine | None
     line_2d_folder: str | None
 
 
@@ -66,13 +66,13 @@ def _same_shape(grading: dict, sizes: tuple[float, ...], percent: tuple[float, .
     )
 
 
-def _line_2d(folder: Path, friction: float, rolling: float, grading) -> LineFit:
+def _line_2d(folder: Path, friction: float, rolling: float, grading) -> MeasuredLine:
     """The fit of a 2D line folder, refused unless it is a line of the soil's grading (to a scale)
     at the specimens' working frictions."""
     res = Store(folder, parameter="state.line_2d").read_result(
         "result.json", CriticalStateLineResult.from_dict
     )
-    if res is None or not isinstance(getattr(res, "line", None), LineFit):
+    if res is None or not res.points:
         raise InputError(
             "state.line_2d", str(folder), "a finished poro2d critical-state folder of several pressures"
         )
@@ -89,7 +89,7 @@ def _line_2d(folder: Path, friction: float, rolling: float, grading) -> LineFit:
             "state.line_2d grading", case.grading.get("source", "?"), "the soil's grading (to a scale)",
             "make the line with --grading set to the soil's sieve curve",
         )  # fmt: skip
-    return res.line
+    return res.measured()
 
 
 def state_request(
@@ -117,6 +117,11 @@ def state_request(
     if folder is not None and not isinstance(folder, str):
         raise InputError("state.line_2d", folder, "a folder path (a string)")
     fit = None if folder is None else _line_2d(_path(base_dir, folder), friction, rolling, grading)
+    if fit is not None:
+        try:
+            fit.void_ratio_at(float(stress))
+        except InputError as exc:
+            raise InputError("state.test_stress_kpa", stress, exc.allowed) from None
     if lab.n_max is None or lab.n_min is None:
         raise InputError("lab.e_max/e_min", None, "both extremes, for the state parameter's span")
     return StateRequest(line, float(stress), fit, None if folder is None else str(_path(base_dir, folder)))
