@@ -1,49 +1,54 @@
-"""A direct shear test states how stiff its contacts are against its stress (issue: elastic
-strain is not dilatancy): kappa = kn / (sigma t) and the mean overlap over d at the peak."""
+"""The disks' stiffness as shear settings: replaced in the split box, the time step chosen from the
+stiffness used, and absent from every record (so from every cache key) when not given."""
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import pytest
 
-from poro2d.measure.stiffness import contacts_of, mean_overlap_ratio, stiffness_number
-from poro2d.shear.case import ShearCase
-from poro2d.shear.settings import ShearSettings
-from poro2d.shear.single import DirectShearTest
-from poro2d.specimen.saved import Specimen
+from poro2d.calibration.units import unit_key
+from poro2d.dem import checkpoint
+from poro2d.errors import InputError
+from poro2d.shear import DirectShearTest, ShearCase, ShearSettings, build_split_box
 
 
-@pytest.fixture(scope="module")
-def tests_at(specimen):
-    value = Specimen.read(specimen)
-    settings = ShearSettings(max_displacement=0.002, particle_friction=0.5)
-    return {s: DirectShearTest(ShearCase(value, s, settings)).run() for s in (50.0, 200.0)}
+def test_split_box_replaces_the_disks_stiffness_and_shortens_the_step(specimen):
+    own, _ = build_split_box(checkpoint.load(specimen), 0.01)
+    kn = 4.0 * float(own.particles.kn.max())
+    stiff, _ = build_split_box(checkpoint.load(specimen), 0.01, particle_kn=kn, particle_ks=kn)
+    assert np.all(stiff.particles.kn == kn) and np.all(stiff.particles.ks == kn)
+    # the critical step of a leapfrog spring goes as 1 / sqrt(k): four times stiffer, half the step
+    # (the walls, stiffer still than the disks of Table 1, add their share through series springs)
+    ratio = stiff.dt / own.dt
+    assert 0.45 < ratio < 0.55
+    assert math.isclose(stiff.dt, stiff.dt_safety * stiff.dt_critical)
 
 
-def test_kappa_is_the_contact_stiffness_over_the_normal_stress(tests_at):
-    # Table 1's disks: 4e5 N/m each, 2e5 N/m a contact in series; 8 mm thick
-    for sigma, result in tests_at.items():
-        assert result.stiffness_number == pytest.approx(2e5 / (sigma * 1e3 * 0.008))
-        assert result.to_dict()["stiffness_number"] == result.stiffness_number
+def test_split_box_keeps_the_specimens_stiffness_when_not_given(specimen):
+    spec = checkpoint.load(specimen)
+    sim, _ = build_split_box(spec, 0.01, particle_ks=1e5)
+    assert np.array_equal(np.sort(sim.particles.kn), np.sort(spec.particles.kn))
+    assert np.all(sim.particles.ks == 1e5)
 
 
-def test_the_overlap_at_the_peak_grows_as_kappa_falls(tests_at):
-    low, high = tests_at[50.0], tests_at[200.0]
-    assert 0.0 < low.mean_overlap_ratio_at_peak < high.mean_overlap_ratio_at_peak
-    # the typical contact strain is of the order of 1 / kappa
-    for r in (low, high):
-        assert 0.2 / r.stiffness_number < r.mean_overlap_ratio_at_peak < 5.0 / r.stiffness_number
+@pytest.mark.parametrize("name", ["particle_kn", "particle_ks"])
+@pytest.mark.parametrize("value", [0.0, 10.0, 1e11, float("nan"), float("inf")])
+def test_settings_refuse_a_stiffness_out_of_range(name, value):
+    with pytest.raises(InputError, match=name):
+        ShearSettings(**{name: value})
 
 
-def test_the_overlap_ratio_reads_a_contact_set_by_hand():
-    import numpy as np
+def test_a_stiffness_not_given_is_absent_from_the_record_and_the_key():
+    record = ShearSettings().record().to_dict()
+    assert "particle_kn" not in record and "particle_ks" not in record
+    given = ShearSettings(particle_kn=2e6).record().to_dict()
+    assert given["particle_kn"] == 2e6 and "particle_ks" not in given
+    assert unit_key("abc", 50.0, given) != unit_key("abc", 50.0, record)
 
-    from poro2d.dem.contacts import ContactSet
 
-    radius = np.array([1.0, 1.0, 2.0])
-    z = np.zeros((3, 2))
-    c = ContactSet(i=np.array([0, 1, 2]), j=np.array([1, 2, 0]), kind=np.array([0, 0, 1]), point=z,
-                   normal=z, fn=np.ones(3), fs=np.zeros(3), force=z,
-                   branch=np.array([[1.9, 0.0], [0.0, 2.8], [5.0, 0.0]]))  # fmt: skip
-    # disk-disk rows only: overlaps 0.1 and 0.2 over reaches 2 and 3
-    assert mean_overlap_ratio(contacts_of(c, radius)) == pytest.approx(0.15 / 2.5)
-    assert stiffness_number(2e5, 1e5, 0.008) == pytest.approx(250.0)
+def test_a_shear_test_runs_on_the_stiffness_of_its_settings(specimen):
+    settings = ShearSettings(max_displacement=0.002, particle_kn=1e6, particle_ks=2e5)
+    sim, _ = DirectShearTest(ShearCase.of(specimen, 50, settings)).consolidate()
+    assert np.all(sim.particles.kn == 1e6) and np.all(sim.particles.ks == 2e5)
