@@ -1,6 +1,6 @@
 """A finished sand answer held against a finished 2D critical-state line: both maps side by side.
 
-    python benchmarks/state_maps.py LINE_DIR SAND_DIR [--lab-line toyoura] [--test-stress 100]
+    python benchmarks/state_maps.py LINE_DIR SAND_DIR [--lab-line toyoura]
 
 LINE_DIR: a ``poro2d critical-state --pressure ...`` folder (or ``benchmarks/critical_state_line.py
 --keep``); SAND_DIR: a ``poro2d sand`` folder (its ``sand.json``). Prints what
@@ -22,14 +22,13 @@ def main() -> None:
     ap.add_argument("line", type=Path)
     ap.add_argument("sand", type=Path)
     ap.add_argument("--lab-line", default="toyoura")
-    ap.add_argument("--test-stress", type=float, default=100.0)
     args = ap.parse_args()
 
     from poro2d.cli.critical_state_held import held_states, print_held
     from poro2d.critical_state.line import CriticalStateLineResult, StateMark
 
     result = CriticalStateLineResult.from_dict(json.loads((args.line / "result.json").read_text()))
-    held = held_states(args.sand, args.lab_line, result.pressures_kpa, args.test_stress)
+    held = held_states(args.sand, args.lab_line, result.pressures_kpa)
     result.marks = [
         StateMark.of(label, e, result.measured(), result.pressures_kpa, held.span) for label, e in held.marks
     ]

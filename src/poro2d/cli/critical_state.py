@@ -69,9 +69,6 @@ def register(app: typer.Typer) -> None:
             help="The laboratory's critical-state line (toyoura, or a CSV p_kpa,e_cs) for --sand: "
             "the state-parameter map beside the Dr map.",
         ),
-        test_stress: float = typer.Option(
-            100.0, "--test-stress", help="Mean stress p' (kPa) of the state map's mark on the figure."
-        ),
         stiffness_number: float = typer.Option(
             None,
             "--stiffness-number",
@@ -119,15 +116,15 @@ def register(app: typer.Typer) -> None:
         )  # fmt: skip
         try:
             case = CriticalStateCase(grading=curve, **options)
-            for p in pressures[1:]:  # a stiffness number out of range at another pressure
-                case.at_pressure(p).kappa()
+            for p in pressures[1:]:  # each pressure's case checked before any work
+                case.at_pressure(p)
         except InputError as exc:  # named as the option the user typed
             raise InputError(OPTION_NAMES.get(exc.parameter, exc.parameter), exc.value, exc.allowed) from None
         config = {
             "grading": grading, **options, "pressure_kpa": pressures, "seeds": n,
             "calibrated": None if calibrated is None else str(calibrated),
         }  # fmt: skip
-        held = held_states(sand, lab_line, pressures, test_stress)
+        held = held_states(sand, lab_line, pressures)
         store = Store(out)
         try:
             if len(pressures) == 1:

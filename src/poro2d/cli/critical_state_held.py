@@ -29,18 +29,17 @@ class HeldStates:
     e2d_max: float
     e2d_min: float
     lab_line: object | None
-    test_stress: float
 
 
 def _void(n: float) -> float:
     return n / (1.0 - n)
 
 
-def held_states(sand: Path | None, lab_line: str | None, pressures, test_stress: float) -> HeldStates | None:
+def held_states(sand: Path | None, lab_line: str | None, pressures) -> HeldStates | None:
     """The 2D ends and the answer of a ``poro2d sand`` folder (void ratios), and the laboratory line."""
-    from poro2d.errors import InputError, check_range
+    from poro2d.errors import InputError
     from poro2d.sand.result import SandResult
-    from poro2d.state_map import PRESSURE_RANGE_KPA, read_lab_line
+    from poro2d.state_map import read_lab_line
     from poro2d.store import Store
 
     if sand is None:
@@ -51,7 +50,6 @@ def held_states(sand: Path | None, lab_line: str | None, pressures, test_stress:
         raise InputError(
             "--sand", str(sand), "given with several --pressure values (a line to hold it against)"
         )
-    check_range("--test-stress", test_stress, *PRESSURE_RANGE_KPA)
     res = (
         Store(sand, parameter="--sand").read_result("sand.json", SandResult.from_dict)
         if sand.is_dir()
@@ -72,7 +70,7 @@ def held_states(sand: Path | None, lab_line: str | None, pressures, test_stress:
     dr = res.state.relative_density
     marks = [("2D loose end", hi), ("2D dense end", lo), (f"Dr map, Dr {dr:.2f}", target)]
     return HeldStates(marks, hi - lo, res.state.e, _void(res.state.n_max), _void(res.state.n_min), hi, lo,
-                      line, test_stress)  # fmt: skip
+                      line)  # fmt: skip
 
 
 def _mapped(m) -> str:

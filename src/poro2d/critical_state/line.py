@@ -364,8 +364,6 @@ def run_critical_state_line(
     if store is not None and not isinstance(store, Store):
         raise InputError("store", type(store).__name__, "a poro2d.store.Store or None")
     cases = [[case.at_pressure(p).with_seed(case.seed + k) for k in range(n)] for p in values]
-    for row in cases:  # every case checked (a stiffness number out of range at one pressure) before work
-        row[-1].kappa()
 
     def work() -> CriticalStateLineResult:
         t0 = time.perf_counter()
