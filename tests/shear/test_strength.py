@@ -57,6 +57,11 @@ def test_tiny_study_writes_one_row_per_case_and_test(study):
         assert r["residual_stress_ratio_mean"] == pytest.approx(
             np.mean([float(t["residual_stress_ratio"]) for t in tests if float(t["mu_r"]) == r["mu_r"]])
         )
+        # kappa = kn / (sigma t): the 100 kPa tests' is half the 50 kPa tests' (Table 1's disks)
+        assert r["stiffness_number_max"] == pytest.approx(2.0 * r["stiffness_number_min"], rel=1e-6)
+        kappa = sorted({round(float(t["stiffness_number"]), 6) for t in tests})
+        assert kappa == pytest.approx([r["stiffness_number_min"], r["stiffness_number_max"]])
+        assert 0.0 < r["mean_overlap_ratio_at_peak_max"] < 0.05
     assert (out / "fig_strength.png").stat().st_size > 0
     stored = json.loads((out / "strength.json").read_text())
     assert stored["cases"][1]["mu_r"] == 0.3 and "residual_friction_angle" in stored["definitions"]

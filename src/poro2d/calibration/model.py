@@ -26,6 +26,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from poro2d.calibration.discrepancy import Discrepancy, Levels, level_posterior, log_likelihood
+
 #: points per axis of the posterior grid
 GRID = 161
 #: a credible interval wider than this fraction of its range is reported as poorly identified
@@ -163,6 +165,14 @@ class NoiseTerms:
     precision_factor: float = 1.0  # the covariance's correction for being estimated
     lab_repeats: int = 1  # laboratory series averaged
     lab_scatter_ratio: float | None = None  # their scatter over a simulated specimen's (repeats only)
+    discrepancy: Discrepancy | None = None  # the model-discrepancy term (None: none)
+    discrepancy_weights: np.ndarray | None = None  # its levels' posterior (sums to 1)
+
+    def discrepancy_at(self, q: float) -> float | None:
+        """The quantile ``q`` of the discrepancy fraction s under the posterior (None: no term)."""
+        if self.discrepancy is None or self.discrepancy_weights is None:
+            return None
+        return self.discrepancy.level_at(self.discrepancy_weights, q)
 
 
 @dataclass
@@ -303,19 +313,24 @@ def precision_factor(dof: int, observables: int) -> float:
     return (dof - observables - 1) / dof if dof > 0 else 0.0
 
 
-def posterior(ranges: Ranges, surrogates: list[Surrogate], lab_values, cov: np.ndarray) -> Posterior:
-    """The grid posterior of (f_p, mu_r) given the laboratory values (one per surrogate) and
-    the covariance of their misfit (:func:`noise_covariance`)."""
+def posterior(
+    ranges: Ranges, surrogates: list[Surrogate], lab_values, cov: np.ndarray, discrepancy: Discrepancy | None = None
+) -> Posterior:  # fmt: skip
+    """The grid posterior of (f_p, mu_r) given the laboratory values (one per surrogate), the
+    covariance of their misfit (:func:`noise_covariance`) and the model-discrepancy term
+    (:mod:`poro2d.calibration.discrepancy`; None: none), integrated over its levels."""
     u = np.linspace(0.0, 1.0, GRID)
     v = np.linspace(0.0, 1.0, GRID)
     uu, vv = np.meshgrid(u, v)
     points = np.column_stack([uu.ravel(), vv.ravel()])
     misfit = np.column_stack([s.mean(points) - y for s, y in zip(surrogates, lab_values, strict=True)])
-    precision = np.linalg.inv(cov)
-    log_like = -0.5 * np.einsum("ki,ij,kj->k", misfit, precision, misfit)
+    log_like, terms = log_likelihood(misfit, cov, discrepancy)
     log_like -= log_like.max()
     density = np.exp(log_like).reshape(uu.shape)
-    return Posterior(ranges, u, v, density / density.sum())
+    post = Posterior(ranges, u, v, density / density.sum())
+    if terms is not None:
+        post.discrepancy, post.discrepancy_weights = discrepancy, level_posterior(terms)
+    return post
 
 
 #: walkers of the ensemble sampler (emcee's rule: at least twice the parameters; 32 as measured
@@ -378,14 +393,26 @@ class SampledPosterior(NoiseTerms):
         return list(dict.fromkeys(rounded(*self.ranges.from_unit(self.chain[picks]))))
 
 
-def log_posterior(surrogates: list[Surrogate], lab_values, precision: np.ndarray):
+def log_posterior(
+    surrogates: list[Surrogate], lab_values, cov: np.ndarray, discrepancy: Discrepancy | None = None
+):
     """The log posterior of design coordinates ``x`` (walkers x d; a flat prior on the unit cube):
-    the Gaussian log-likelihood of the laboratory values, -inf outside the cube."""
+    the Gaussian log-likelihood of the laboratory values (summed over the discrepancy's levels),
+    -inf outside the cube."""
     lab = np.asarray(lab_values, float)
+    if discrepancy is not None and discrepancy.none:
+        discrepancy = None
+    if discrepancy is None:  # the precision inverted once, as before the term existed
+        precision = np.linalg.inv(cov)
+    else:
+        levels = Levels.of(cov, discrepancy)
 
     def log_prob(x: np.ndarray) -> np.ndarray:
         misfit = np.column_stack([s.mean(x) for s in surrogates]) - lab
-        lp = -0.5 * np.einsum("ki,ij,kj->k", misfit, precision, misfit)
+        if discrepancy is None:
+            lp = -0.5 * np.einsum("ki,ij,kj->k", misfit, precision, misfit)
+        else:
+            lp = levels.log_likelihood(misfit)[0]
         inside = np.all((x >= 0.0) & (x <= 1.0), axis=1)
         return np.where(inside, lp, -np.inf)
 
@@ -394,7 +421,7 @@ def log_posterior(surrogates: list[Surrogate], lab_values, precision: np.ndarray
 
 def sampled_posterior(
     ranges: Ranges, surrogates: list[Surrogate], lab_values, cov: np.ndarray, seed: int,
-    steps: int = CHAIN_STEPS,
+    steps: int = CHAIN_STEPS, discrepancy: Discrepancy | None = None,
 ) -> SampledPosterior:  # fmt: skip
     """The posterior of d > 2 parameters sampled by emcee's ensemble on the surrogates.
 
@@ -408,7 +435,7 @@ def sampled_posterior(
 
     rng = np.random.default_rng(seed)
     start = rng.random((WALKERS, ranges.dim))
-    log_prob = log_posterior(surrogates, lab_values, np.linalg.inv(cov))
+    log_prob = log_posterior(surrogates, lab_values, cov, discrepancy)
     sampler = emcee.EnsembleSampler(WALKERS, ranges.dim, log_prob, vectorize=True)
     sampler.random_state = np.random.RandomState(int(rng.integers(2**32))).get_state()
     sampler.run_mcmc(start, steps, progress=False)
@@ -425,7 +452,7 @@ def sampled_posterior(
             )
         sampler.run_mcmc(None, steps, progress=False)
         steps *= 2
-    return SampledPosterior(
+    post = SampledPosterior(
         ranges,
         sampler.get_chain(discard=burn, flat=True),
         sampler.get_log_prob(discard=burn, flat=True),
@@ -433,6 +460,12 @@ def sampled_posterior(
         burn,
         [float(t) for t in tau],
     )
+    if discrepancy is not None and not discrepancy.none:
+        misfit = np.column_stack([s.mean(post.chain) for s in surrogates]) - np.asarray(lab_values, float)
+        _, terms = log_likelihood(misfit, cov, discrepancy)
+        weights = np.full(len(post.chain), 1.0 / len(post.chain))
+        post.discrepancy, post.discrepancy_weights = discrepancy, level_posterior(terms, weights)
+    return post
 
 
 __all__ = [

@@ -39,6 +39,7 @@ from poro2d.calibration.box_dominated import (
     with_box_note,
 )
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
+from poro2d.calibration.discrepancy import Discrepancy, DiscrepancyRecord, discrepancy_record, resolve_mode
 from poro2d.calibration.evaluations import PARAMETER_KEYS, DesignPoint, Observed, target_key
 from poro2d.calibration.identifiable import check_enough_lab_values
 from poro2d.calibration.lab_repeats import LabRepeats, lab_scatter_ratio, lab_share, mean_targets
@@ -257,14 +258,19 @@ class PosteriorSummary(TypedResult):
     lab_scatter_ratio: float | None = None
     #: with kn or ks calibrated (``grid`` None): the chain the posterior was sampled with
     chain: ChainRecord | None = None
+    #: the model-discrepancy term (:mod:`poro2d.calibration.discrepancy`); absent without one
+    discrepancy: DiscrepancyRecord | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("precision_factor", "lab_repeats", "lab_scatter_ratio", "chain")
+    OPTIONAL: ClassVar[tuple[str, ...]] = (
+        "precision_factor", "lab_repeats", "lab_scatter_ratio", "chain", "discrepancy"
+    )  # fmt: skip
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "median": FrictionValues,
         "wide": FrictionFlags,
         "observables": FittedObservable,
         "chain": ChainRecord,
+        "discrepancy": DiscrepancyRecord,
     }
 
 
@@ -456,6 +462,7 @@ def run_calibration(
     progress: bool = True,
     config: dict | None = None,
     keep_box_dominated: bool = False,
+    discrepancy: str | float = "auto",
 ) -> CalibrationResult:
     """Calibrate f_p and mu_r against ``lab`` on replicate specimens; keeps ``result.json`` in ``store``.
 
@@ -490,6 +497,10 @@ def run_calibration(
     peaked) is left out of the fit, and the result says how many were (``box_dominated``); too few
     left for the surrogate is no answer. ``keep_box_dominated``: fit them all the same (a box where
     every test is box-dominated: the frictions then describe the box).
+
+    ``discrepancy``: the model-discrepancy term (:mod:`poro2d.calibration.discrepancy`): ``estimate``
+    (integrated over its unknown size), ``none`` (the noise covariance alone), ``auto`` (``none`` for
+    laboratory files poro2d wrote itself, else ``estimate``) or a fixed fraction of each observable's scale.
     """
     t0 = time.perf_counter()
     if store is not None:
@@ -524,6 +535,7 @@ def run_calibration(
     design_seed = check_int("--design-seed", design_seed, 0)
     check_range("--lab-error", lab_error, 0.0, 1.0)
     check_range("--level", level, 0.0, 1.0, lo_open=True, hi_open=True)
+    discrepancy = resolve_mode(discrepancy, biaxial_lab if lab is None else lab)
     if not isinstance(keep_box_dominated, bool):
         raise InputError("--keep-box-dominated", keep_box_dominated, "true or false")
     if settings is None and quick and not biaxial:
@@ -562,7 +574,7 @@ def run_calibration(
         design = model.space_filling(ranges, points, design_seed)
         rows = runner.run(_units(design, found, stresses, base, make, ranges.axes), cache, "round 1")
         infer = partial(_infer, ranges, lab_error=lab_error, lab_series=lab_series, seed=design_seed,
-                        keep_box_dominated=keep_box_dominated)  # fmt: skip
+                        keep_box_dominated=keep_box_dominated, discrepancy=discrepancy)  # fmt: skip
         post, surrogates, table = infer(design, found, stresses, rows, targets)
         if refine:
             extra = [p for p in post.draw(refine, design_seed + 1) if p not in design]
@@ -596,6 +608,7 @@ def run_calibration(
         refine,
         stations,
         quick=quick,
+        discrepancy=discrepancy,
     )
     if store is not None:
         from poro2d.calibration.outputs import write_outputs
@@ -687,12 +700,14 @@ def _infer(
     seed: int = 0,
     *,
     keep_box_dominated: bool = False,
+    discrepancy="none",
 ):
     """The surrogates (one per target), the posterior and the table of replicate values per design point.
 
     ``rows``: the units' rows in the order of :func:`_units` (None: the test failed);
     ``lab_series``: every laboratory repeat's values (series x targets; None: one series); ``seed``:
-    of the sampler, when kn or ks are calibrated (the grid of two parameters needs none). A design point
+    of the sampler, when kn or ks are calibrated (the grid of two parameters needs none);
+    ``discrepancy``: the model-discrepancy mode (:mod:`poro2d.calibration.discrepancy`). A design point
     with a box-dominated test is left out of the fit (:func:`box_dominated_points`) unless
     ``keep_box_dominated``; the posterior's ``box_dominated`` says which."""
     per_point = len(specimens) * len(stresses)
@@ -733,12 +748,14 @@ def _infer(
             cov = model.noise_covariance(surrogates, seed_cov, lab_values, lab_error, units, share)
             factor = _precision_factor(values, len(targets))
             cov = cov / factor
+            term = Discrepancy.of(discrepancy, [obs for obs, *_ in targets], lab_values)
             if ranges.dim == 2:
-                post = model.posterior(ranges, surrogates, lab_values, cov)
+                post = model.posterior(ranges, surrogates, lab_values, cov, term)
             else:
-                post = model.sampled_posterior(ranges, surrogates, lab_values, cov, seed)
+                post = model.sampled_posterior(ranges, surrogates, lab_values, cov, seed, discrepancy=term)
             post.precision_factor = factor
             post.lab_repeats, post.lab_scatter_ratio = count, ratio
+            cov = _with_discrepancy(cov, post)
             post.noise_sd = np.sqrt(np.diag(cov)).tolist()
             post.noise_correlation = (cov / np.sqrt(np.outer(np.diag(cov), np.diag(cov)))).round(3).tolist()
     except (FloatingPointError, np.linalg.LinAlgError) as exc:
@@ -747,6 +764,16 @@ def _infer(
         raise RuntimeError("the posterior is not finite: no answer is reported")
     post.box_dominated = left_out
     return post, surrogates, table
+
+
+def _with_discrepancy(cov: np.ndarray, post) -> np.ndarray:
+    """The noise covariance with the discrepancy at its posterior median added (the noise sd a
+    fit is shown with); ``cov`` itself without a discrepancy term."""
+    median = post.discrepancy_at(0.5)
+    if median is None:
+        return cov
+    one = Discrepancy(np.array([median]), np.zeros(1), post.discrepancy.scales)
+    return one.covariances(cov)[0]
 
 
 def _precision_factor(values: np.ndarray, observables: int) -> float:
@@ -831,6 +858,7 @@ def _result(
     stations=1,
     *,
     quick: bool = False,
+    discrepancy="none",
 ) -> CalibrationResult:
     best = dict(zip(ranges.axes, post.best(), strict=True))
     biaxial = isinstance(lab_data, LabTests)
@@ -864,6 +892,7 @@ def _result(
             lab_repeats=post.lab_repeats if post.lab_repeats > 1 else None,
             lab_scatter_ratio=post.lab_scatter_ratio,
             chain=_chain_record(post) if sampled else None,
+            discrepancy=discrepancy_record(post, level),
         ),
         evaluations=table,
         fit={
@@ -884,6 +913,7 @@ def _result(
             design_seed=design_seed,
             lab_error=lab_error,
             **({"stations": stations} if stations > 1 else {}),
+            **({"discrepancy": discrepancy} if discrepancy != "none" else {}),
         ),  # fmt: skip
         provenance=Provenance.now(),
         unidentified=unknown,

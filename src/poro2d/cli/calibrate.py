@@ -75,6 +75,13 @@ def register(app: typer.Typer) -> None:
             0.0, "--lab-error", help="Laboratory error, a fraction of each value."
         ),
         level: float = typer.Option(0.95, "--level", help="Level of the credible intervals."),
+        discrepancy: str = typer.Option(
+            "auto",
+            "--discrepancy",
+            help="Model-discrepancy term: estimate (integrated over its size), none, auto (none for a"
+            " laboratory file poro2d made itself, else estimate), or a fixed fraction of each"
+            " observable's laboratory scale.",
+        ),
         stations: int = typer.Option(
             1, "--stations", help="Readings of each lab curve up to its end (1-10; 1: the end only)."
         ),
@@ -116,6 +123,7 @@ def register(app: typer.Typer) -> None:
             "max_displacement": max_displacement,
             **({"max_strain": max_strain} if max_strain is not None else {}),
             **({"keep_box_dominated": True} if keep_box_dominated else {}),
+            **({"discrepancy": discrepancy} if discrepancy != "auto" else {}),
         }
         try:
             result = run_calibration(
@@ -144,6 +152,7 @@ def register(app: typer.Typer) -> None:
                 progress=not quiet,
                 config={"cli": options},
                 keep_box_dominated=keep_box_dominated,
+                discrepancy=discrepancy,
             )
         except RuntimeError as exc:
             console.print(f"[bold red]failed:[/] {exc}")
@@ -172,6 +181,7 @@ def print_result(result, out: Path) -> None:
         box_dominated_note,
         box_note,
         calibrated,
+        discrepancy_note,
         identifiability_note,
         interval_text,
         repeats_note,
@@ -182,6 +192,8 @@ def print_result(result, out: Path) -> None:
     console.print(f"  {identifiability_note(result)}")
     if repeats_note(result):
         console.print(f"  {repeats_note(result)}")
+    if discrepancy_note(result):
+        console.print(f"  {discrepancy_note(result)}")
     if box_note(result):
         console.print(f"  {box_note(result)}")
     if box_dominated_note(result):

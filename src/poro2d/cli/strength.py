@@ -176,6 +176,23 @@ def _stopped(case) -> str:
     )
 
 
+def stiffness_note(cases) -> str | None:
+    """The contacts' stiffness over the study in one line: kappa's extent and the largest overlap."""
+    ranges = [
+        (c["stiffness_number_min"], c["stiffness_number_max"]) for c in cases if c.get("stiffness_number_min")
+    ]
+    overlaps = [
+        c.get("mean_overlap_ratio_at_peak_max") for c in cases if c.get("mean_overlap_ratio_at_peak_max")
+    ]
+    if not ranges:
+        return None
+    lo, hi = min(r[0] for r in ranges), max(r[1] for r in ranges)
+    text = f"kappa = kn / (sigma t) {lo:.0f} to {hi:.0f}"
+    if overlaps:
+        text += f", mean overlap / d at the peak up to {max(overlaps):.1e}"
+    return text + ": below kappa 1000 psi max carries the contacts' elastic strain (docs/critical-state.md)"
+
+
 def print_strength(result: StrengthResult, out: Path) -> None:
     from poro2d.shear.box_scale import box_scale_of
     from poro2d.shear.residual import DILATION_RATE_LIMIT
@@ -202,6 +219,9 @@ def print_strength(result: StrengthResult, out: Path) -> None:
             f"{DILATION_RATE_LIMIT:g} over a final stretch), on the plate's / the shear plane's normal "
             "stress, with how many did"
         )
+    stiffness = stiffness_note(result["cases"])
+    if stiffness:
+        console.print(stiffness)
     if scale is not None:
         console.print(scale.note())
         if scale.warning():

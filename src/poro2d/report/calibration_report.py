@@ -109,6 +109,21 @@ def repeats_note(result) -> str | None:
     )
 
 
+def discrepancy_note(result) -> str | None:
+    """The model-discrepancy term in one line (None without one, or in a file written before it)."""
+    term = result.posterior.get("discrepancy")
+    if not term:
+        return None
+    lo, hi = term["interval"]
+    if lo == hi:
+        return f"Model discrepancy fixed at {term['median']:.3g} of each observable's laboratory scale."
+    return (
+        f"Model discrepancy (the misfit no parameter explains, a fraction of each observable's laboratory"
+        f" scale): median {term['median']:.3g}, {100 * result.level:g} % interval {lo:.3g} to {hi:.3g};"
+        " the intervals above include it."
+    )
+
+
 def fit_table(observables) -> tuple[list[str], list[list]]:
     """The fit table's header and rows: in kPa while every target is a stress; with dilation
     targets (mm) each row names its unit."""
@@ -159,6 +174,7 @@ def calibration_blocks(result, out: Path) -> list[tuple]:
         ),
         ("p", identifiability_note(result)),
         *([("p", repeats_note(result))] if repeats_note(result) else []),
+        *([("p", discrepancy_note(result))] if discrepancy_note(result) else []),
         *([("p", box_note(result))] if box_note(result) else []),
         *([("p", box_dominated_note(result))] if box_dominated_note(result) else []),
         ("table", header, rows),

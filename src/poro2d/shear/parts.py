@@ -360,12 +360,18 @@ class StrengthCase(TypedResult):
     residual_dilation_stopped_ratio_mean: float | None = None
     residual_dilation_stopped_plane_ratio_mean: float | None = None
     tests_dilation_stopped: int | None = None
+    #: kappa = kn / (sigma t) over the case's tests, lowest and highest, and the largest mean overlap
+    #: / d at a peak (poro2d.measure.stiffness): how much elastic strain psi max carries
+    stiffness_number_min: float | None = None
+    stiffness_number_max: float | None = None
+    mean_overlap_ratio_at_peak_max: float | None = None
 
     # the residual read where dilation stopped (poro2d.shear.residual): the means over the tests
     # that reached it (None when none did) and how many did; absent in a study of an earlier poro2d
     OPTIONAL: ClassVar[tuple[str, ...]] = (
         "residual_dilation_stopped_ratio_mean", "residual_dilation_stopped_plane_ratio_mean",
-        "tests_dilation_stopped",
+        "tests_dilation_stopped", "stiffness_number_min", "stiffness_number_max",
+        "mean_overlap_ratio_at_peak_max",
     )  # fmt: skip
 
 

@@ -127,6 +127,8 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
                 "residual_dilation_stopped_ratio": stopped.stress_ratio,
                 "residual_dilation_stopped_plane_ratio": stopped.plane_stress_ratio,
                 "residual_dilation_stopped_from_mm": stopped.start_mm if stopped.reached else None,
+                "stiffness_number": t.get("stiffness_number"),
+                "mean_overlap_ratio_at_peak": t.get("mean_overlap_ratio_at_peak"),
             })  # fmt: skip
         s, tau = np.array(res_pts).T
         per_specimen.append({
@@ -160,8 +162,24 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
         residual_friction_angle_pooled_ci_deg=res_fit.friction_angle_ci_deg,
         residual_stress_ratio_mean=float(np.mean([r["residual_stress_ratio"] for r in tests])),
         **dilation_stopped_means(tests),
+        **stiffness_extent(tests),
     )
     return row, tests
+
+
+def stiffness_extent(tests: list[dict]) -> dict:
+    """A case's kappa over its tests, lowest and highest, and its largest mean overlap / d at a
+    peak (absent when its tests did not record them)."""
+    kappa = [t["stiffness_number"] for t in tests if t.get("stiffness_number") is not None]
+    overlap = [
+        t["mean_overlap_ratio_at_peak"] for t in tests if t.get("mean_overlap_ratio_at_peak") is not None
+    ]
+    out = {}
+    if kappa:
+        out["stiffness_number_min"], out["stiffness_number_max"] = float(min(kappa)), float(max(kappa))
+    if overlap:
+        out["mean_overlap_ratio_at_peak_max"] = float(max(overlap))
+    return out
 
 
 def dilation_stopped_means(tests: list[dict]) -> dict:
