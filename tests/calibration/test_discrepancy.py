@@ -60,7 +60,7 @@ def _calibrate(repeat: int, discrepancy_sd: float, mode):
     units = [u for _, _, u, _ in OBSERVABLES]
     cov = model.noise_covariance(surrogates, model.seed_covariance(values), lab, 0.0, units)
     cov = cov / model.precision_factor(12 * (REPLICATES - 1), len(OBSERVABLES))
-    term = None if mode is None else Discrepancy.of(mode, [n for *_, n in OBSERVABLES], lab)
+    term = None if mode is None else Discrepancy.of(mode)
     return model.posterior(RANGES, surrogates, lab, cov, term)
 
 
@@ -76,9 +76,10 @@ def test_a_discrepancy_the_model_cannot_fit_is_covered_only_with_the_term():
     held = sum(_holds(p) for p in with_term)
     assert held >= 18  # at least 90 % of 20 repeats
     assert alone <= 12  # the noise covariance alone misses: the test can tell them apart
-    # the term's size is found near the discrepancy that was put in (10 % of each value)
+    # the term's size is found near the discrepancy that was put in: 10 % of each value is 1.25
+    # to 2.5 noise sd on the peaks (4 % of the stress) and 2 to 6 on the rises (0.03 mm)
     medians = [p.discrepancy_at(0.5) for p in with_term]
-    assert 0.04 <= float(np.median(medians)) <= 0.2
+    assert 0.8 <= float(np.median(medians)) <= 3.0
 
 
 def test_a_laboratory_the_model_fits_keeps_intervals_of_the_same_order():
@@ -89,7 +90,7 @@ def test_a_laboratory_the_model_fits_keeps_intervals_of_the_same_order():
         assert _holds(alone) and _holds(with_term)
         w0, w1 = (math.log(p.interval("fp", 0.95)[1] / p.interval("fp", 0.95)[0]) for p in (alone, with_term))
         assert w0 <= w1 < 1.6 * w0
-        assert with_term.discrepancy_at(0.5) <= 0.06
+        assert with_term.discrepancy_at(0.5) <= 1.5
 
 
 def test_none_is_the_posterior_without_a_term_bit_for_bit():
@@ -99,11 +100,11 @@ def test_none_is_the_posterior_without_a_term_bit_for_bit():
 
 
 def test_a_fixed_fraction_widens_the_intervals():
-    alone, fixed = _calibrate(1, 0.0, "none"), _calibrate(1, 0.0, 0.2)
+    alone, fixed = _calibrate(1, 0.0, "none"), _calibrate(1, 0.0, 1.0)
     lo0, hi0 = alone.interval("mu_r", 0.95)
     lo1, hi1 = fixed.interval("mu_r", 0.95)
     assert hi1 - lo1 > 1.2 * (hi0 - lo0)
-    assert fixed.discrepancy_at(0.5) == pytest.approx(0.2)
+    assert fixed.discrepancy_at(0.5) == pytest.approx(1.0)
 
 
 def test_the_sampled_posterior_integrates_the_term_too():
@@ -112,10 +113,10 @@ def test_the_sampled_posterior_integrates_the_term_too():
     lab = [0.5, 0.5, 0.5, 0.9]  # the fourth observable cannot be met where the first three are
     cov = np.diag([0.02**2] * 4)
     post = model.sampled_posterior(
-        ranges, surrogates, lab, cov, seed=2, discrepancy=Discrepancy.of("estimate", list("abcd"), lab)
+        ranges, surrogates, lab, cov, seed=2, discrepancy=Discrepancy.of("estimate")
     )
     assert post.discrepancy_weights is not None and post.discrepancy_weights.sum() == pytest.approx(1.0)
-    assert post.discrepancy_at(0.5) > 0.05
+    assert post.discrepancy_at(0.5) > 1.0
 
 
 def _linear(d: int) -> list[list[float]]:
@@ -131,7 +132,7 @@ def _linear(d: int) -> list[list[float]]:
     return rows
 
 
-@pytest.mark.parametrize("mode", ["often", "-0.1", 0.0, 1.5, float("nan"), None])
+@pytest.mark.parametrize("mode", ["often", "-0.1", 0.0, 10.5, float("nan"), None])
 def test_a_bad_mode_is_refused_by_name(mode):
     with pytest.raises(InputError, match="--discrepancy"):
         check_mode(mode)

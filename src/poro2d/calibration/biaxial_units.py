@@ -88,6 +88,9 @@ class BiaxialRow:
     end_volumetric: float
     wall_time_s: float
     readings: BiaxialReadings
+    #: kappa = kn / (sigma_3 t) and the mean overlap / d at the peak (None: a test cached before them)
+    stiffness_number: float | None = None
+    mean_overlap_ratio: float | None = None
     #: a biaxial box has no split box whose plane could carry another load than its plate: never
     #: judged box-dominated (poro2d.shear.box_dominated judges direct shear tests)
     box_dominated: ClassVar[bool] = False
@@ -158,6 +161,8 @@ class BiaxialUnit(FrictionUnit):
                 np.asarray(c.axial_strain, float), np.asarray(c.sin_phi, float),
                 np.asarray(c.volumetric_strain, float), s.smoothing_strain,
             ),
+            stiffness_number=res.stiffness_number,
+            mean_overlap_ratio=res.mean_overlap_ratio_at_peak,
         )  # fmt: skip
 
     def curve(self, cache: Store | None) -> tuple[np.ndarray, np.ndarray] | None:

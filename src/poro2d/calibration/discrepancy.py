@@ -7,24 +7,23 @@ discrepancy: it is right for a laboratory made by poro2d itself, and too narrow 
 values no (f_p, mu_r) reproduces within the seed scatter.
 
 Here the discrepancy is independent between observables, with a standard deviation of ``s``
-times its observable's scale: the root mean square of the laboratory's values of that observable
-over the stresses (its peaks, its rises, ...). ``s = 0.05`` lets each peak miss by about 5 % of
-the laboratory's peaks beyond the seed scatter. ``s`` is not known. It gets a uniform prior over
-:data:`LEVELS` (0 to 50 %) and is integrated out: the likelihood of a parameter point is the
-prior-weighted sum over the levels of the Gaussian likelihood with covariance
-C + s^2 diag(scale^2).
+times the observable's own noise sd (the square root of C's diagonal): the likelihood's
+covariance becomes C + s^2 diag(C). The unit is the noise, not the observable's value, because
+the values can be near zero (a volumetric strain, a rise) where a discrepancy is not, and
+because what a discrepancy does to a posterior depends on its size beside the noise alone.
+``s`` is not known: it gets a uniform prior over :data:`LEVELS` (0 to 4 noise sd) and is
+integrated out, the likelihood of a parameter point being the prior-weighted sum over the levels.
 
-Where the model fits the laboratory within C, the large levels pay for their determinant and
-the small ones carry the posterior. Where no parameter point fits, the levels that explain the
-misfit take over and the intervals widen. The prior is uniform, not log-uniform: a log-uniform
-one piles its mass on levels far below the seed scatter, which all say "no discrepancy", and on
-known surfaces with a 10 % discrepancy its intervals held the truth in 82 % of 40 repeats
-against 95 % for the uniform one (docs/calibration.md).
+Where the model fits the laboratory within C, the large levels pay for their determinant and the
+small ones carry the posterior; where no parameter point fits, the levels that explain the misfit
+take over and the intervals widen. A discrepancy that a wrong (f_p, mu_r) can absorb (softer
+contacts read as less friction) is not seen in the misfit at all; the prior's larger levels widen
+the intervals against it all the same. Measured coverage: docs/calibration.md.
 
 Modes: ``estimate`` (the above); ``none`` (C alone: the intervals of earlier versions, bit for
 bit); ``auto`` (the default: ``none`` for a laboratory file poro2d wrote itself, its
 :mod:`poro2d.calibration.synthetic` header says so, ``estimate`` for any other); a number fixes
-``s``, for example from a validation study's held-out errors.
+``s`` (in noise sd, up to :data:`MAX_FIXED`), for example from a validation study's held-out errors.
 """
 
 from __future__ import annotations
@@ -37,8 +36,10 @@ import numpy as np
 from poro2d.errors import InputError, is_number
 from poro2d.typed_result import TypedResult
 
-#: the discrepancy fractions s integrated over (``estimate``): a uniform prior from 0 to 50 %
-LEVELS = np.linspace(0.0, 0.5, 26)
+#: the discrepancy sizes s (in noise sd) integrated over (``estimate``): a uniform prior from 0 to 4
+LEVELS = np.linspace(0.0, 4.0, 41)
+#: the largest fixed size (noise sd)
+MAX_FIXED = 10.0
 #: the modes besides a fixed fraction
 MODES = ("auto", "estimate", "none")
 #: how the header of a laboratory file poro2d wrote itself begins (:mod:`poro2d.calibration.synthetic`)
@@ -55,9 +56,11 @@ def check_mode(mode) -> str | float:
             value = float(mode)
         except ValueError:
             value = None
-    if is_number(value) and 0.0 < float(value) <= 1.0:
+    if is_number(value) and 0.0 < float(value) <= MAX_FIXED:
         return float(value)
-    raise InputError("--discrepancy", mode, "auto, estimate, none, or a fraction in (0, 1]")
+    raise InputError(
+        "--discrepancy", mode, f"auto, estimate, none, or a size in noise sd in (0, {MAX_FIXED:g}]"
+    )
 
 
 def made_by_poro2d(lab) -> bool:
@@ -89,30 +92,24 @@ def resolve_mode(mode, lab) -> str | float:
 
 @dataclass(frozen=True)
 class Discrepancy:
-    """The levels of ``s`` a likelihood sums over, their prior log weights and each observable's scale."""
+    """The levels of ``s`` (noise sd) a likelihood sums over and their prior log weights."""
 
     levels: np.ndarray
     log_weights: np.ndarray
-    scales: np.ndarray
 
     @classmethod
-    def of(cls, mode, observables, lab_values) -> Discrepancy:
-        """The term of ``mode`` for laboratory values ``lab_values``, one per observable name in
-        ``observables`` (the same name at several stresses shares one scale)."""
+    def of(cls, mode) -> Discrepancy:
+        """The term of ``mode`` (``estimate``, ``none`` or a fixed size; ``auto`` resolved first)."""
         mode = check_mode(mode)
         if mode == "auto":
             raise ValueError("resolve the auto mode against the laboratory first (resolve_mode)")
-        lab = np.abs(np.asarray(lab_values, float))
-        names = list(observables)
-        scales = np.array([np.sqrt(np.mean([y**2 for n, y in zip(names, lab, strict=True) if n == name]))
-                           for name in names])  # fmt: skip
         if mode == "none":
             levels = np.zeros(1)
         elif mode == "estimate":
             levels = LEVELS
         else:
             levels = np.array([float(mode)])
-        return cls(levels, np.full(len(levels), -np.log(len(levels))), scales)
+        return cls(levels, np.full(len(levels), -np.log(len(levels))))
 
     @property
     def none(self) -> bool:
@@ -120,16 +117,19 @@ class Discrepancy:
         return len(self.levels) == 1 and self.levels[0] == 0.0
 
     def covariances(self, cov: np.ndarray) -> np.ndarray:
-        """The covariance at every level: ``cov`` + s^2 diag(scale^2), stacked (levels, n, n).
-
-        An observable whose laboratory values are all zero gets its own noise sd as its scale."""
-        scales = np.where(self.scales > 0.0, self.scales, np.sqrt(np.diag(cov)))
-        return np.stack([cov + np.diag((s * scales) ** 2) for s in self.levels])
+        """The covariance at every level, C + s^2 diag(C), stacked (levels, n, n)."""
+        noise = np.diag(np.diag(cov))
+        return np.stack([cov + s**2 * noise for s in self.levels])
 
     def level_at(self, weights: np.ndarray, q: float) -> float:
         """The quantile ``q`` of ``s`` under the posterior ``weights`` over the levels (summing to 1)."""
         cdf = np.cumsum(weights)
         return float(self.levels[min(int(np.searchsorted(cdf, q)), len(self.levels) - 1)])
+
+    def saturated(self, weights: np.ndarray, level: float) -> bool:
+        """Whether the posterior's upper ``level`` quantile of ``s`` is the prior's top level: the
+        laboratory may lie further from the model than the term allows."""
+        return len(self.levels) > 1 and self.level_at(weights, 1.0 - (1.0 - level) / 2.0) >= self.levels[-1]
 
 
 @dataclass(frozen=True)
@@ -187,13 +187,15 @@ def level_posterior(terms: np.ndarray, row_weights: np.ndarray | None = None) ->
 
 @dataclass(eq=False)
 class DiscrepancyRecord(TypedResult):
-    """What ``result.json`` keeps of the discrepancy term (``posterior.discrepancy``): the
-    fraction ``s`` of each observable's scale, its prior, and its posterior median and central
-    interval at the calibration's level (one value twice when it was fixed)."""
+    """What ``result.json`` keeps of the discrepancy term (``posterior.discrepancy``): its size
+    ``s`` in each observable's noise sd, its prior, its posterior median and central interval at
+    the calibration's level (one value twice when it was fixed), and whether that interval reached
+    the prior's top (``saturated``: the laboratory may lie further from the model than allowed)."""
 
     prior: str
     median: float
     interval: list[float]
+    saturated: bool = False
 
 
 def discrepancy_record(post, level: float) -> DiscrepancyRecord | None:

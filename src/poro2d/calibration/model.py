@@ -314,8 +314,12 @@ def precision_factor(dof: int, observables: int) -> float:
 
 
 def posterior(
-    ranges: Ranges, surrogates: list[Surrogate], lab_values, cov: np.ndarray, discrepancy: Discrepancy | None = None
-) -> Posterior:  # fmt: skip
+    ranges: Ranges,
+    surrogates: list[Surrogate],
+    lab_values,
+    cov: np.ndarray,
+    discrepancy: Discrepancy | None = None,
+) -> Posterior:
     """The grid posterior of (f_p, mu_r) given the laboratory values (one per surrogate), the
     covariance of their misfit (:func:`noise_covariance`) and the model-discrepancy term
     (:mod:`poro2d.calibration.discrepancy`; None: none), integrated over its levels."""

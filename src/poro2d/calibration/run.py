@@ -212,18 +212,26 @@ class FittedObservable(TypedResult):
     lab_ratio: float | None = None
     model_ratio: float | None = None
     noise_sd_ratio: float | None = None
+    #: the design's tests at this stress: median kappa = kn / (sigma t) and mean overlap / d at the
+    #: peak (how much elastic strain a dilation or volumetric observable carries; None: not recorded)
+    stiffness_number: float | None = None
+    mean_overlap_ratio_at_peak: float | None = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = (
         "lab_kpa", "model_kpa", "noise_sd_kpa", "lab_mm", "model_mm", "noise_sd_mm",
-        "lab_ratio", "model_ratio", "noise_sd_ratio",
+        "lab_ratio", "model_ratio", "noise_sd_ratio", "stiffness_number", "mean_overlap_ratio_at_peak",
     )  # fmt: skip
 
     @classmethod
-    def of(cls, observable: str, normal_stress_kpa: float, lab: float, fitted: float, noise_sd: float):
-        """The record of one target, its values under the keys of its unit."""
+    def of(cls, observable: str, normal_stress_kpa: float, lab: float, fitted: float, noise_sd: float,
+           stiffness: tuple[float | None, float | None] = (None, None)):  # fmt: skip
+        """The record of one target, its values under the keys of its unit; ``stiffness``: the
+        design's kappa and overlap at its stress."""
         u = observable_unit(observable).lower()
         values = {f"lab_{u}": lab, f"model_{u}": fitted, f"noise_sd_{u}": noise_sd}
-        return cls(observable, normal_stress_kpa, **values)
+        kappa, overlap = stiffness
+        return cls(observable, normal_stress_kpa, **values, stiffness_number=kappa,
+                   mean_overlap_ratio_at_peak=overlap)  # fmt: skip
 
     @property
     def unit(self) -> str:
@@ -748,7 +756,7 @@ def _infer(
             cov = model.noise_covariance(surrogates, seed_cov, lab_values, lab_error, units, share)
             factor = _precision_factor(values, len(targets))
             cov = cov / factor
-            term = Discrepancy.of(discrepancy, [obs for obs, *_ in targets], lab_values)
+            term = Discrepancy.of(discrepancy)
             if ranges.dim == 2:
                 post = model.posterior(ranges, surrogates, lab_values, cov, term)
             else:
@@ -763,7 +771,23 @@ def _infer(
     if not post.finite():
         raise RuntimeError("the posterior is not finite: no answer is reported")
     post.box_dominated = left_out
+    post.stiffness = stiffness_at(rows)
     return post, surrogates, table
+
+
+def stiffness_at(rows) -> dict[float, tuple[float | None, float | None]]:
+    """Per stress, the median kappa and mean overlap / d at the peak of the design's tests (None
+    where no test recorded them: tests cached before they were)."""
+    out = {}
+    for sigma in sorted({r.sigma for r in rows if r is not None}):
+        at = [r for r in rows if r is not None and r.sigma == sigma]
+        kappa = [r.stiffness_number for r in at if r.stiffness_number is not None]
+        overlap = [r.mean_overlap_ratio for r in at if r.mean_overlap_ratio is not None]
+        out[sigma] = (
+            float(np.median(kappa)) if kappa else None,
+            float(np.median(overlap)) if overlap else None,
+        )
+    return out
 
 
 def _with_discrepancy(cov: np.ndarray, post) -> np.ndarray:
@@ -772,8 +796,7 @@ def _with_discrepancy(cov: np.ndarray, post) -> np.ndarray:
     median = post.discrepancy_at(0.5)
     if median is None:
         return cov
-    one = Discrepancy(np.array([median]), np.zeros(1), post.discrepancy.scales)
-    return one.covariances(cov)[0]
+    return Discrepancy(np.array([median]), np.zeros(1)).covariances(cov)[0]
 
 
 def _precision_factor(values: np.ndarray, observables: int) -> float:
@@ -871,8 +894,9 @@ def _result(
         intervals = dict.fromkeys(intervals)
         wide = dict.fromkeys(wide)
     best_unit = ranges.to_unit(*best.values())
+    stiffness = getattr(post, "stiffness", {})
     fitted = [
-        FittedObservable.of(obs, s, y, float(sg.mean(best_unit)[0]), sd)
+        FittedObservable.of(obs, s, y, float(sg.mean(best_unit)[0]), sd, stiffness.get(s, (None, None)))
         for (obs, s, y), sg, sd in zip(targets, surrogates, post.noise_sd, strict=True)
     ]
     sampled = isinstance(post, model.SampledPosterior)

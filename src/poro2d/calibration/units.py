@@ -214,6 +214,9 @@ class UnitRow:
     #: whether the test read its box rather than its material (poro2d.shear.box_dominated), and why
     box_dominated: bool = False
     box_note: str = ""
+    #: kappa = kn / (sigma t) and the mean overlap / d at the peak (None: a test cached before them)
+    stiffness_number: float | None = None
+    mean_overlap_ratio: float | None = None
 
     def observable(self, name: str) -> float:
         """The value of the observable ``name`` (:data:`OBSERVABLES`, or a reading of the curve,
@@ -249,6 +252,8 @@ def _row(unit: CalibrationUnit, res) -> UnitRow:
         ),
         box_dominated=bool(res.box_dominated),
         box_note=res.box_note or "",
+        stiffness_number=res.stiffness_number,
+        mean_overlap_ratio=res.mean_overlap_ratio_at_peak,
     )
 
 

@@ -79,8 +79,7 @@ def register(app: typer.Typer) -> None:
             "auto",
             "--discrepancy",
             help="Model-discrepancy term: estimate (integrated over its size), none, auto (none for a"
-            " laboratory file poro2d made itself, else estimate), or a fixed fraction of each"
-            " observable's laboratory scale.",
+            " laboratory file poro2d made itself, else estimate), or a fixed size in noise sd.",
         ),
         stations: int = typer.Option(
             1, "--stations", help="Readings of each lab curve up to its end (1-10; 1: the end only)."

@@ -116,12 +116,19 @@ def discrepancy_note(result) -> str | None:
         return None
     lo, hi = term["interval"]
     if lo == hi:
-        return f"Model discrepancy fixed at {term['median']:.3g} of each observable's laboratory scale."
-    return (
-        f"Model discrepancy (the misfit no parameter explains, a fraction of each observable's laboratory"
-        f" scale): median {term['median']:.3g}, {100 * result.level:g} % interval {lo:.3g} to {hi:.3g};"
+        fixed = term["median"]
+        return f"Model discrepancy fixed at {fixed:.3g} noise sd per observable; the intervals include it."
+    text = (
+        f"Model discrepancy (what the laboratory may miss the model by, in each observable's noise sd):"
+        f" median {term['median']:.3g}, {100 * result.level:g} % interval {lo:.3g} to {hi:.3g};"
         " the intervals above include it."
     )
+    if term.get("saturated"):
+        text += (
+            " Its interval reaches the prior's top: the laboratory may lie further from the model than"
+            " the term allows, and the intervals may still be too narrow."
+        )
+    return text
 
 
 def fit_table(observables) -> tuple[list[str], list[list]]:
@@ -131,11 +138,17 @@ def fit_table(observables) -> tuple[list[str], list[list]]:
     named = [(o, next(u for k, u in units.items() if o.get(k) is not None)) for o in observables]
     if all(u == "kPa" for _, u in named):
         header = ["observable", "normal stress (kPa)", "laboratory (kPa)", "model (kPa)", "noise sd (kPa)"]
-        return header, [[o["observable"], o["normal_stress_kpa"], *_values(o, "kpa")] for o, _ in named]
-    # biaxial targets: the stress is sigma_3, every value dimensionless ("1")
-    stress = "confining stress (kPa)" if all(u == "ratio" for _, u in named) else "normal stress (kPa)"
-    header = ["observable", stress, "unit", "laboratory", "model", "noise sd"]
-    rows = [[o["observable"], o["normal_stress_kpa"], _shown(u), *_values(o, u.lower())] for o, u in named]
+        rows = [[o["observable"], o["normal_stress_kpa"], *_values(o, "kpa")] for o, _ in named]
+    else:  # biaxial targets: the stress is sigma_3, every value dimensionless ("1")
+        stress = "confining stress (kPa)" if all(u == "ratio" for _, u in named) else "normal stress (kPa)"
+        header = ["observable", stress, "unit", "laboratory", "model", "noise sd"]
+        rows = [[o["observable"], o["normal_stress_kpa"], _shown(u), *_values(o, u.lower())]
+                for o, u in named]  # fmt: skip
+    if any(o.get("stiffness_number") is not None for o in observables):
+        # how much elastic strain a volumetric observable carries: kappa and the overlap at the peak
+        header = [*header, "kappa", "overlap / d at peak"]
+        rows = [[*r, o.get("stiffness_number"), o.get("mean_overlap_ratio_at_peak")]
+                for r, o in zip(rows, observables, strict=True)]  # fmt: skip
     return header, rows
 
 
