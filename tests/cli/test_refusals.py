@@ -179,6 +179,11 @@ CASES = [
     (["strength", "{d}/unconverged"], ["converged = False"]),
     (["calibrate", "--lab", "{d}/lab_ok.csv", "-s", "{d}/refused/after_plate.npz"], ["accepted = False"]),
     (["calibrate", "--lab", "{d}/lab_ok.csv", "-s", "{d}/sp.npz", "-s", "{d}/unconverged"], ["converged"]),
+    (
+        ["calibrate", "--lab", "{d}/lab_ok.csv", "-s", "{d}/sp.npz", "--discrepancy", "often"],
+        ["--discrepancy = 'often'"],
+    ),
+    (["calibrate", "--lab", "{d}/lab_ok.csv", "-s", "{d}/sp.npz", "--discrepancy", "11"], ["(0, 10]"]),
     (["convert", "--dry-density", "1600", "--solid-density", "1e300"], ["--solid-density = 1e+300", "23000"]),
     # usage errors of the option parser: one line too
     (["shear", "--stop-after-peak", "abc"], ["--stop-after-peak = 'abc'", "a valid number"]),
