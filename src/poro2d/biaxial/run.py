@@ -19,11 +19,11 @@ from poro2d.biaxial.parts import DEFINITIONS, AngleSpread, Definitions, LabCurve
 from poro2d.biaxial.results import BiaxialResult, BiaxialTestResult
 from poro2d.biaxial.single import BiaxialTest
 from poro2d.errors import InputError, check_int
-from poro2d.execute import Backend, Executor, Failed, Job, results_or_raise
+from poro2d.execute import Job
+from poro2d.execute.batch import run_jobs
 from poro2d.io_utils import Provenance, as_json, check_output_dir
 from poro2d.locks import output_folder
 from poro2d.measure.spread import Spread
-from poro2d.progress import JobsProgress
 from poro2d.report.biaxial_figures import plot_biaxial
 from poro2d.store import Store
 
@@ -134,27 +134,12 @@ def run_biaxial(
 def execute_tests(jobs: list[BiaxialJob], workers: int, progress: bool) -> list[BiaxialTestResult]:
     """The tests of ``jobs`` in job order: finished ones read back, the others run on up to
     ``workers`` processes (a test that fails raises once the others have ended)."""
-    results = [job.stored() for job in jobs]
-    todo = [k for k, res in enumerate(results) if res is None]
-    if not todo:
-        return results  # type: ignore[return-value]
-    with JobsProgress("biaxial", [jobs[k].label for k in todo], enabled=progress) as bars:
-
-        def show(index: int, phase: str, fraction: float) -> None:
-            bars.update(index, phase, fraction)
-
-        def ended(index: int, outcome) -> None:
-            if not isinstance(outcome, Failed):
-                bars.done(index)
-
-        outcomes = Executor(Backend.local(min(workers, len(todo)))).map(
-            [Job(_run_job, (jobs[k],), jobs[k].label, reports=True) for k in todo], on_report=show,
-            on_done=ended,
-        )  # fmt: skip
-        done: list[BiaxialTestResult] = results_or_raise(outcomes, "biaxial test(s)")
-    for k, res in zip(todo, done, strict=True):
-        results[k] = res
-    return results  # type: ignore[return-value]
+    finished = [job.stored() for job in jobs]
+    return run_jobs(
+        [Job(_run_job, (job,), job.label, reports=True) for job in jobs], title="biaxial",
+        what="biaxial test(s)", workers=min(workers, max(1, finished.count(None))), progress=progress,
+        finished=finished,
+    )  # fmt: skip
 
 
 def replicate_jobs(cases: list[BiaxialCase], store: Store | None, label: str = "") -> list[BiaxialJob]:

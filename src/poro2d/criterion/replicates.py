@@ -18,9 +18,9 @@ from dataclasses import replace
 from poro2d.console import OutputConsole
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.criterion.result import ReplicateRow, ReplicatesResult
-from poro2d.execute import Backend, Executor, Failed, Job, results_or_raise
+from poro2d.execute import Job
+from poro2d.execute.batch import run_jobs
 from poro2d.grading import GradingCurve
-from poro2d.progress import JobsProgress
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
@@ -59,15 +59,8 @@ def run_replicates(
     first = replace(settings, trial_porosity=n2d)
     jobs = [Job(_run_one, (spec1, grading, first, sd, store.child(f"seed{sd}")), f"seed {sd}", reports=True)
             for sd in seeds]  # fmt: skip
-    names = [job.label for job in jobs]
-
-    def ended(index: int, outcome) -> None:
-        if not isinstance(outcome, Failed):
-            display.done(index, _outcome(outcome))
-
-    with JobsProgress("replicate criterion", names, enabled=progress) as display:
-        outcomes = Executor(Backend.local(processes)).map(jobs, on_report=display.update, on_done=ended)
-        rows = results_or_raise(outcomes, "replicate criterion run(s)")
+    rows = run_jobs(jobs, title="replicate criterion", what="replicate criterion run(s)", workers=processes,
+                    progress=progress, done_text=_outcome)  # fmt: skip
     return ReplicatesResult(rows, store=store)
 
 

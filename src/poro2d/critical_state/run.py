@@ -36,10 +36,10 @@ from poro2d.critical_state.results import (
 from poro2d.critical_state.series import COLUMNS, CellSeries, row_of
 from poro2d.critical_state.steady import read_steady
 from poro2d.errors import InputError, check_int
-from poro2d.execute import Backend, Executor, Failed, Job, results_or_raise
+from poro2d.execute import Job
+from poro2d.execute.batch import run_jobs
 from poro2d.io_utils import Provenance, as_json, check_output_dir
 from poro2d.locks import output_folder
-from poro2d.progress import JobsProgress
 from poro2d.report.critical_state_figures import plot_critical_state
 from poro2d.store import Store
 
@@ -210,18 +210,11 @@ def seed_runs(
     CPU count); the results in the cases' order and the number of workers. Raises if any failed."""
     workers = processes if processes is not None else min(len(cases), os.cpu_count() or 1)
     jobs = [SeedJob(c, _label(c, cases)) for c in cases]
-    with JobsProgress("critical state", [j.label for j in jobs], enabled=progress) as bars:
-
-        def ended(index: int, outcome) -> None:
-            if not isinstance(outcome, Failed):
-                bars.done(index)
-
-        outcomes = Executor(Backend.local(workers)).map(
-            [Job(_run_job, (job,), job.label, reports=True) for job in jobs],
-            on_report=bars.update,
-            on_done=ended,
-        )
-        return results_or_raise(outcomes, "periodic shear run(s)"), workers
+    results = run_jobs(
+        [Job(_run_job, (job,), job.label, reports=True) for job in jobs], title="critical state",
+        what="periodic shear run(s)", workers=workers, progress=progress,
+    )  # fmt: skip
+    return results, workers
 
 
 def _label(case: CriticalStateCase, cases: list[CriticalStateCase]) -> str:

@@ -6,16 +6,16 @@ its case (the specimen's content travels with it: the worker reads no specimen f
 folder its test keeps its files in (a path string: the worker makes the store from it),
 whether it draws its figure and a label for progress lines. Each test is a job of the
 executor's local processes (:mod:`poro2d.execute.local`: a fresh process, one numba
-thread) and reports its phase there; :class:`poro2d.progress.JobsProgress` shows a bar per
-test on a terminal, plain periodic lines in a log.
+thread) and reports its phase there; :func:`poro2d.execute.batch.run_jobs` reads the finished
+tests back and shows a bar per test on a terminal, plain periodic lines in a log.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from poro2d.execute import Backend, Executor, Failed, Job, results_or_raise
-from poro2d.progress import JobsProgress
+from poro2d.execute import Job
+from poro2d.execute.batch import run_jobs
 from poro2d.shear.case import ShearCase
 from poro2d.shear.results import ShearTestResult
 from poro2d.shear.single import DirectShearTest
@@ -73,28 +73,16 @@ def execute_jobs(jobs: list[ShearJob], processes: int, progress: bool) -> list[S
     error of a test is raised as it is, other failures together
     (:class:`poro2d.execute.JobsFailed`, each test named).
     """
-    results = _finished(jobs)
-    todo = [k for k, res in enumerate(results) if res is None]
-    if not todo:
-        return results
-    names = [jobs[k].label for k in todo]
-    with JobsProgress("direct shear", names, enabled=progress) as bars:
+    return run_jobs(
+        [Job(_run_job, (job,), job.label, reports=True) for job in jobs], title="direct shear",
+        what="direct shear test(s)", workers=processes, progress=progress, finished=_finished(jobs),
+        show=_show, start_first=lambda j: _slowest_first(j.args[0]),
+    )  # fmt: skip
 
-        def show(index: int, phase: str, fraction: float) -> None:
-            bars.update(index, phase, fraction if phase == "shearing" else None)
 
-        def ended(index: int, outcome) -> None:
-            if not isinstance(outcome, Failed):
-                bars.done(index)
-
-        outcomes = Executor(Backend.local(processes)).map(
-            [Job(_run_job, (jobs[k],), name, reports=True) for k, name in zip(todo, names, strict=True)],
-            on_report=show, on_done=ended, start_first=lambda j: _slowest_first(j.args[0]),
-        )  # fmt: skip
-        done = results_or_raise(outcomes, "direct shear test(s)")
-    for k, res in zip(todo, done, strict=True):
-        results[k] = res
-    return results
+def _show(bars, index: int, phase: str, fraction: float) -> None:
+    """A test's bar fills while it shears; its other phases show without a fraction."""
+    bars.update(index, phase, fraction if phase == "shearing" else None)
 
 
 __all__ = ["ShearJob", "execute_jobs"]
