@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from poro2d.errors import InputError, is_number
+from poro2d.io_utils import read_utf8
 from poro2d.typed_result import TypedResult
 
 #: the discrepancy sizes s (in noise sd) integrated over (``estimate``): a uniform prior from 0 to 4
@@ -73,11 +74,10 @@ def made_by_poro2d(lab) -> bool:
         if not isinstance(path, str | os.PathLike):
             return False
         try:
-            with open(path, encoding="utf-8-sig") as f:
-                first = f.readline()
-        except (OSError, UnicodeDecodeError):
+            text = read_utf8("--lab", path, "a laboratory CSV file")
+        except InputError:  # the calibration's own reader says what is wrong with it
             return False
-        if not first.startswith(SYNTHETIC_HEADER):
+        if not text.startswith(SYNTHETIC_HEADER):
             return False
     return True
 
