@@ -20,7 +20,7 @@ from poro2d.biaxial.results import BiaxialResult, BiaxialTestResult
 from poro2d.biaxial.single import BiaxialTest
 from poro2d.errors import InputError, check_int
 from poro2d.execute import Job
-from poro2d.execute.batch import run_jobs
+from poro2d.execute.batch import complete_jobs
 from poro2d.io_utils import Provenance, as_json, check_output_dir
 from poro2d.locks import output_folder
 from poro2d.measure.spread import Spread
@@ -135,7 +135,7 @@ def execute_tests(jobs: list[BiaxialJob], workers: int, progress: bool) -> list[
     """The tests of ``jobs`` in job order: finished ones read back, the others run on up to
     ``workers`` processes (a test that fails raises once the others have ended)."""
     finished = [job.stored() for job in jobs]
-    return run_jobs(
+    return complete_jobs(
         [Job(_run_job, (job,), job.label, reports=True) for job in jobs], title="biaxial",
         what="biaxial test(s)", workers=min(workers, max(1, finished.count(None))), progress=progress,
         finished=finished,

@@ -19,7 +19,7 @@ from poro2d.console import OutputConsole
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.criterion.result import ReplicateRow, ReplicatesResult
 from poro2d.execute import Job
-from poro2d.execute.batch import run_jobs
+from poro2d.execute.batch import complete_jobs
 from poro2d.grading import GradingCurve
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.specimen_set import SpecimenSet
@@ -59,8 +59,8 @@ def run_replicates(
     first = replace(settings, trial_porosity=n2d)
     jobs = [Job(_run_one, (spec1, grading, first, sd, store.child(f"seed{sd}")), f"seed {sd}", reports=True)
             for sd in seeds]  # fmt: skip
-    rows = run_jobs(jobs, title="replicate criterion", what="replicate criterion run(s)", workers=processes,
-                    progress=progress, done_text=_outcome)  # fmt: skip
+    rows = complete_jobs(jobs, title="replicate criterion", what="replicate criterion run(s)",
+                         workers=processes, progress=progress, done_text=_outcome)  # fmt: skip
     return ReplicatesResult(rows, store=store)
 
 

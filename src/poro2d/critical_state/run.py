@@ -37,7 +37,7 @@ from poro2d.critical_state.series import COLUMNS, CellSeries, row_of
 from poro2d.critical_state.steady import read_steady
 from poro2d.errors import InputError, check_int
 from poro2d.execute import Job
-from poro2d.execute.batch import run_jobs
+from poro2d.execute.batch import complete_jobs
 from poro2d.io_utils import Provenance, as_json, check_output_dir
 from poro2d.locks import output_folder
 from poro2d.report.critical_state_figures import plot_critical_state
@@ -210,7 +210,7 @@ def seed_runs(
     CPU count); the results in the cases' order and the number of workers. Raises if any failed."""
     workers = processes if processes is not None else min(len(cases), os.cpu_count() or 1)
     jobs = [SeedJob(c, _label(c, cases)) for c in cases]
-    results = run_jobs(
+    results = complete_jobs(
         [Job(_run_job, (job,), job.label, reports=True) for job in jobs], title="critical state",
         what="periodic shear run(s)", workers=workers, progress=progress,
     )  # fmt: skip

@@ -1,4 +1,5 @@
-"""``run_jobs``: the one way a laboratory test runs its jobs on local processes.
+"""``complete_jobs``: the one way a laboratory test runs its jobs on local processes (named so
+because it hands back a list, not a typed result as the API's ``run_*`` do).
 
 Every test that runs replicates, seeds or stresses in parallel does the same four things: it
 reads the finished jobs back, draws a bar per job still to run, runs those on the executor's
@@ -17,7 +18,7 @@ from poro2d.execute.jobs import Failed, Job, results_or_raise
 from poro2d.progress import JobsProgress
 
 
-def run_jobs(
+def complete_jobs(
     jobs: Sequence[Job],
     *,
     title: str,
@@ -58,4 +59,4 @@ def run_jobs(
     return results
 
 
-__all__ = ["run_jobs"]
+__all__ = ["complete_jobs"]

@@ -6,7 +6,7 @@ its case (the specimen's content travels with it: the worker reads no specimen f
 folder its test keeps its files in (a path string: the worker makes the store from it),
 whether it draws its figure and a label for progress lines. Each test is a job of the
 executor's local processes (:mod:`poro2d.execute.local`: a fresh process, one numba
-thread) and reports its phase there; :func:`poro2d.execute.batch.run_jobs` reads the finished
+thread) and reports its phase there; :func:`poro2d.execute.batch.complete_jobs` reads the finished
 tests back and shows a bar per test on a terminal, plain periodic lines in a log.
 """
 
@@ -15,7 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from poro2d.execute import Job
-from poro2d.execute.batch import run_jobs
+from poro2d.execute.batch import complete_jobs
 from poro2d.shear.case import ShearCase
 from poro2d.shear.results import ShearTestResult
 from poro2d.shear.single import DirectShearTest
@@ -73,7 +73,7 @@ def execute_jobs(jobs: list[ShearJob], processes: int, progress: bool) -> list[S
     error of a test is raised as it is, other failures together
     (:class:`poro2d.execute.JobsFailed`, each test named).
     """
-    return run_jobs(
+    return complete_jobs(
         [Job(_run_job, (job,), job.label, reports=True) for job in jobs], title="direct shear",
         what="direct shear test(s)", workers=processes, progress=progress, finished=_finished(jobs),
         show=_show, start_first=lambda j: _slowest_first(j.args[0]),
