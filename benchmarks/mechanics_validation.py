@@ -304,7 +304,7 @@ def critical_line(cache, fp, mur, pressures, seeds, disks, strain) -> dict:
     return {
         "pressures": pressures,
         "e_cs": [pt["void_ratio"]["mean"] for pt in pts],
-        "e_cs_sd": [pt["void_ratio"]["sd"] for pt in pts],
+        "e_cs_sd": [pt["void_ratio"]["sd"] or 0.0 for pt in pts],
         "mean_stress": [pt["mean_stress_kpa"]["mean"] for pt in pts],
         "stress_ratio": [pt["stress_ratio"]["mean"] for pt in pts],
         "steady": [pt["steady"] for pt in pts],
