@@ -133,7 +133,7 @@ def paper_simulation(out: Path, rebuild: bool, threads: int = 2):
 
     t0 = time.perf_counter()
     sim, report = prepare_specimen(SpecimenSpec(threads=threads), paper_grading(), 0.15, seed=0)
-    report = json.loads(json.dumps(report, default=float))
+    report = json.loads(json.dumps(report.to_dict(), default=float))
     print(
         f"[paper] prepared {sim.particles.n} disks in {time.perf_counter() - t0:.0f} s "
         f"(converged={report['converged']}, porosity {report['measured_porosity']:.4f})",
