@@ -411,3 +411,31 @@ def test_the_preset_needs_a_store_to_keep_its_specimens(tiny):
     _, lab = tiny
     with pytest.raises(InputError, match="store"):
         run_calibration(lab, preset="paper", quick=True, store=None, progress=False)
+
+
+def test_a_laboratory_poro2d_did_not_write_gets_the_discrepancy_term(tiny, tmp_path):
+    """The same values without poro2d's synthetic header: ``auto`` adds the model-discrepancy term
+    (poro2d.calibration.discrepancy), the result and the report say what it found, and every noise
+    sd is at least the plain one; poro2d's own file keeps the plain posterior (no term recorded).
+    Every fitted observable carries the design's kappa and overlap at the peak."""
+    paths, lab = tiny
+    real = tmp_path / "real.csv"
+    real.write_text("".join(ln for ln in lab.read_text().splitlines(keepends=True) if not ln.startswith("#")))
+    kw = dict(store=Store(tmp_path / "cal"), points=9, refine=0, settings=SHORT, workers=1, dashboard=None,
+              progress=False, **FIT_BOX)  # fmt: skip
+    own = run_calibration(lab, [paths[0], paths[1]], **kw)
+    other = run_calibration(real, [paths[0], paths[1]], **kw)  # the same tests, from the cache
+    assert other.cluster.tests_run == 0
+    assert "discrepancy" not in own.posterior.to_dict() and "discrepancy" not in own.config
+    term = other.posterior["discrepancy"]
+    assert term["prior"].startswith("uniform over 41 levels from 0 to 4")
+    assert 0.0 <= term["interval"][0] <= term["median"] <= term["interval"][1] <= 4.0
+    assert other.config["discrepancy"] == "estimate"
+    for a, b in zip(own.posterior["observables"], other.posterior["observables"], strict=True):
+        assert b["noise_sd_kpa"] >= a["noise_sd_kpa"]
+        # kappa = kn / (sigma t): halved from 50 to 100 kPa; the overlap at the peak a small fraction of d
+        assert b["stiffness_number"] == pytest.approx(a["stiffness_number"])
+        assert 0.0 < b["mean_overlap_ratio_at_peak"] < 0.05
+    kappa = {o["normal_stress_kpa"]: o["stiffness_number"] for o in other.posterior["observables"]}
+    assert kappa[50.0] == pytest.approx(2.0 * kappa[100.0], rel=1e-6)
+    assert "Model discrepancy" in (tmp_path / "cal" / "calibration.md").read_text()
