@@ -41,14 +41,15 @@ from poro2d.typed_result import TypedResult
 LEVELS = np.linspace(0.0, 4.0, 41)
 #: the largest fixed size (noise sd)
 MAX_FIXED = 10.0
-#: the modes besides a fixed fraction
+#: the modes besides a fixed size
 MODES = ("auto", "estimate", "none")
 #: how the header of a laboratory file poro2d wrote itself begins (:mod:`poro2d.calibration.synthetic`)
 SYNTHETIC_HEADER = "# SYNTHETIC laboratory data"
 
 
 def check_mode(mode) -> str | float:
-    """``estimate``, ``none`` or a fixed fraction in (0, 1], as given (a numeric string is read)."""
+    """``auto``, ``estimate``, ``none`` or a fixed size in noise sd in (0, :data:`MAX_FIXED`], as
+    given (a numeric string is read); anything else an InputError naming ``--discrepancy``."""
     if isinstance(mode, str) and mode.strip().lower() in MODES:
         return mode.strip().lower()
     value = mode
