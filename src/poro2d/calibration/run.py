@@ -508,7 +508,7 @@ def run_calibration(
 
     ``discrepancy``: the model-discrepancy term (:mod:`poro2d.calibration.discrepancy`): ``estimate``
     (integrated over its unknown size), ``none`` (the noise covariance alone), ``auto`` (``none`` for
-    laboratory files poro2d wrote itself, else ``estimate``) or a fixed fraction of each observable's scale.
+    laboratory files poro2d wrote itself, else ``estimate``) or a fixed size in each observable's noise sd.
     """
     t0 = time.perf_counter()
     if store is not None:
