@@ -169,7 +169,7 @@ class NoiseTerms:
     discrepancy_weights: np.ndarray | None = None  # its levels' posterior (sums to 1)
 
     def discrepancy_at(self, q: float) -> float | None:
-        """The quantile ``q`` of the discrepancy fraction s under the posterior (None: no term)."""
+        """The quantile ``q`` of the discrepancy size s (noise sd) under the posterior (None: no term)."""
         if self.discrepancy is None or self.discrepancy_weights is None:
             return None
         return self.discrepancy.level_at(self.discrepancy_weights, q)
