@@ -3,10 +3,12 @@
 :mod:`poro2d.execute.jobs` holds the values (``Job``, ``Failed``), :mod:`~poro2d.execute.executor`
 the executor and its backend spec, :mod:`~poro2d.execute.local` the inline and process
 backends with their live progress queue, :mod:`~poro2d.execute.dask_cluster` the Dask
-backend and :mod:`~poro2d.execute.cluster_options` the checks of a command's cluster options.
+backend and :mod:`~poro2d.execute.cluster_options` the checks of a command's cluster options, :mod:`~poro2d.execute.options` the
+``RunOptions`` every ``run_*`` takes.
 """
 
 from poro2d.execute.executor import Backend, Executor
 from poro2d.execute.jobs import Failed, Job, JobsFailed, results_or_raise
+from poro2d.execute.options import RunOptions
 
-__all__ = ["Backend", "Executor", "Failed", "Job", "JobsFailed", "results_or_raise"]
+__all__ = ["Backend", "Executor", "Failed", "Job", "JobsFailed", "RunOptions", "results_or_raise"]
