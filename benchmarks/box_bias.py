@@ -1,7 +1,7 @@
 """The direct shear box's biases on one specimen: wall friction and local damping against the shear plane.
 
     python benchmarks/box_bias.py SPECIMEN [--wall-friction 1.5,0.5,0] [--damping 0.7]
-        [--normal-stress 50,100,200] [--max-displacement 0.004] [--processes 2] [--keep DIR]
+        [--normal-stress 50,100,200] [--max-displacement 0.004] [--workers 2] [--keep DIR]
 
 For each (wall friction, local damping) it shears the specimen at every normal stress and
 prints one row per test: the peak tau/sigma on the plate's stress (what every result reports),
@@ -19,6 +19,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from poro2d.execute import RunOptions
+
 
 def numbers(text: str) -> list[float]:
     return [float(v) for v in text.split(",") if v.strip()]
@@ -31,7 +33,7 @@ def main() -> None:
     ap.add_argument("--damping", type=numbers, default=[0.7])
     ap.add_argument("--normal-stress", type=numbers, default=[50.0, 100.0, 200.0])
     ap.add_argument("--max-displacement", type=float, default=0.004)
-    ap.add_argument("--processes", type=int, default=2)
+    ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--keep", type=Path, default=None)
     args = ap.parse_args()
 
@@ -49,7 +51,7 @@ def main() -> None:
             t0 = time.perf_counter()
             series = run_shear(args.specimen, args.normal_stress, settings,
                                store=Store(out / f"wall{mu_wall:g}_damping{alpha:g}"),
-                               processes=args.processes, progress=False)  # fmt: skip
+                               options=RunOptions(workers=args.workers, progress=False))  # fmt: skip
             wall_s = time.perf_counter() - t0
             for t in series.tests:
                 share = t.plane_load_fraction_at_peak

@@ -2,7 +2,7 @@
 
     python benchmarks/box_residual.py SPECIMEN [SPECIMEN ...] [--labels s0,s1] [--friction 3,0.5]
         [--wall-friction 1.5,0.5,0] [--damping 0.3,0.1] [--damping-wall 0] [--half-velocity 0.5]
-        [--normal-stress 100] [--max-displacement 0.05] [--window-from 20] [--processes 2] [--keep DIR]
+        [--normal-stress 100] [--max-displacement 0.05] [--window-from 20] [--workers 2] [--keep DIR]
 
 Each specimen (a criterion folder that accepted it; one per seed) is sheared at the normal
 stress, long enough for the plate to stop rising, for every particle friction f_p and:
@@ -35,6 +35,8 @@ import tempfile
 import time
 from dataclasses import replace
 from pathlib import Path
+
+from poro2d.execute import RunOptions
 
 PAPER_DAMPING = 0.7
 
@@ -88,7 +90,7 @@ def main() -> None:
     ap.add_argument("--half-velocity", type=numbers, default=[0.5], help="f_p of the v/2 case ('' for none)")
     ap.add_argument("--normal-stress", type=float, default=100.0)
     ap.add_argument("--max-displacement", type=float, default=0.05)
-    ap.add_argument("--processes", type=int, default=2)
+    ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--keep", type=Path, default=None)
     ap.add_argument(
         "--labels", default="", help="the specimens' folder names, e.g. s0,s1 (default: s0, s1, ...)"
@@ -134,7 +136,7 @@ def main() -> None:
                 )
             )
     t0 = time.perf_counter()
-    results = execute_jobs([j for _, _, j in jobs], args.processes, progress=False)
+    results = execute_jobs([j for _, _, j in jobs], args.workers, RunOptions(progress=False))
     print(f"{len(jobs)} tests in {time.perf_counter() - t0:.0f} s (finished ones read back); kept in {out}")
     report(jobs, results, args, out)
 

@@ -1,7 +1,7 @@
 """The box-size study: peak, residual and dilation of the paper's sand in boxes of four sizes.
 
     python benchmarks/box_size.py --out DIR [--boxes quick,paper,x1.5,x2] [--seeds 2]
-        [--quick-seeds 3] [--friction 0.5] [--normal-stress 100] [--processes 2]
+        [--quick-seeds 3] [--friction 0.5] [--normal-stress 100] [--workers 2]
 
 The boxes (``BOXES``): the quick look's (0.08 m x 0.04 m, as ``poro2d paper --quick`` builds
 it), the paper's (0.305 m x 0.124 m, ``poro2d criterion --preset paper``) and two larger ones
@@ -34,6 +34,8 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from poro2d.execute import RunOptions
 
 #: the paper's layer height (0.124 m in 4 layers): a larger box keeps it, so every layer is
 #: compacted as the paper's are
@@ -269,7 +271,7 @@ def main() -> None:
     ap.add_argument("--quick-seeds", type=int, default=3, help="specimens of the quick box")
     ap.add_argument("--friction", type=float, default=0.5, help="particle friction f_p of the tests")
     ap.add_argument("--normal-stress", type=float, default=100.0, help="kPa")
-    ap.add_argument("--processes", type=int, default=2, help="DEM processes at once")
+    ap.add_argument("--workers", type=int, default=2, help="DEM processes at once")
     ap.add_argument("--report", action="store_true", help="build and shear nothing: print the finished tests")
     args = ap.parse_args()
     names = [b for b in args.boxes.split(",") if b]
@@ -282,13 +284,13 @@ def main() -> None:
 
     t0 = time.perf_counter()
     if not args.report:
-        build_missing(args.out, plan, args.processes)
+        build_missing(args.out, plan, args.workers)
     found = accepted_specimens(args.out, plan)
     jobs = shear_jobs(args.out, found, args)
     if args.report:  # a study still running elsewhere: its finished tests only
         results = [job.test().stored() for *_, job in jobs]
     else:
-        results = execute_jobs([j for *_, j in jobs], args.processes, progress=False)
+        results = execute_jobs([j for *_, j in jobs], args.workers, RunOptions(progress=False))
     elapsed = time.perf_counter() - t0
     print(f"{len(plan)} specimens, {len(jobs)} tests in {elapsed:.0f} s (finished ones read back)")
     pairs = [(job, res) for job, res in zip(jobs, results, strict=True) if res is not None]

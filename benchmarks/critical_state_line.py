@@ -2,7 +2,7 @@
 
     python benchmarks/critical_state_line.py [--pressures 50,100,200,400] [--grading paper] [--friction 0.5]
         [--rolling 0] [--stiffness-number K] [--seeds 2] [--disks 1500] [--inertial 1e-3]
-        [--strain 3] [--processes 2] [--keep DIR]
+        [--strain 3] [--workers 2] [--keep DIR]
 
 Runs the periodic cell at every pressure on the seeds (every run one job) and prints a row per
 pressure: the mean stress p', the void ratio e = (1 - phi) / phi and tau/sigma with their spread
@@ -20,6 +20,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from poro2d.execute import RunOptions
+
 
 def numbers(text: str) -> list[float]:
     return [float(v) for v in text.split(",") if v.strip()]
@@ -36,7 +38,7 @@ def main() -> None:
     ap.add_argument("--disks", type=int, default=1500)
     ap.add_argument("--inertial", type=float, default=1e-3)
     ap.add_argument("--strain", type=float, default=3.0)
-    ap.add_argument("--processes", type=int, default=2)
+    ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--keep", type=Path, default=None)
     args = ap.parse_args()
 
@@ -59,7 +61,9 @@ def main() -> None:
         stiffness_number=args.stiffness_number,
     )
     t0 = time.perf_counter()
-    r = run_critical_state_line(case, args.pressures, Store(root), seeds=args.seeds, processes=args.processes)
+    r = run_critical_state_line(
+        case, args.pressures, Store(root), seeds=args.seeds, options=RunOptions(workers=args.workers)
+    )
     print(
         f"{args.grading}: f_p {args.friction:g}, mu_r {args.rolling:g}, I {args.inertial:g}, "
         f"{args.disks} disks, "

@@ -1,7 +1,7 @@
 """The periodic reference against the literature: the steady state for several I and mu_r.
 
     python benchmarks/critical_state_reference.py [--inertial 1e-3,1e-2] [--rolling 0]
-        [--seeds 3] [--disks 1500] [--strain 3] [--friction 0.5] [--processes 2] [--keep DIR]
+        [--seeds 3] [--disks 1500] [--strain 3] [--friction 0.5] [--workers 2] [--keep DIR]
 
 For each (inertial number, rolling friction) it runs the periodic cell on the seeds and prints
 one row: tau/sigma and the angle with their spread over the seeds, the solid fraction, the
@@ -17,6 +17,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from poro2d.execute import RunOptions
+
 
 def numbers(text: str) -> list[float]:
     return [float(v) for v in text.split(",") if v.strip()]
@@ -30,7 +32,7 @@ def main() -> None:
     ap.add_argument("--disks", type=int, default=1500)
     ap.add_argument("--strain", type=float, default=3.0)
     ap.add_argument("--friction", type=float, default=0.5)
-    ap.add_argument("--processes", type=int, default=2)
+    ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--keep", type=Path, default=None)
     args = ap.parse_args()
 
@@ -54,7 +56,10 @@ def main() -> None:
             )
             t0 = time.perf_counter()
             r = run_critical_states(
-                case, Store(root / f"I{inertial:g}_mur{mu_r:g}"), seeds=args.seeds, processes=args.processes
+                case,
+                Store(root / f"I{inertial:g}_mur{mu_r:g}"),
+                seeds=args.seeds,
+                options=RunOptions(workers=args.workers),
             )
             print(
                 f"{inertial:7.0e} {mu_r:5.2f} {r.stress_ratio.text():>22} {r.friction_angle_deg.mean:6.1f} "

@@ -21,6 +21,7 @@ import numpy as np
 
 from poro2d.biaxial import BiaxialCase, BiaxialSettings, run_biaxial
 from poro2d.biaxial.quick import QuickSpecimen
+from poro2d.execute import RunOptions
 from poro2d.measure.specimen_porosity import measure_specimen
 
 #: the loose quick specimen: built at sliding friction 1.0 and rolling resistance 0.5
@@ -40,7 +41,7 @@ def solid_fraction(q: QuickSpecimen) -> float:
 
 def report(label: str, case: BiaxialCase, fraction: float | None) -> None:
     t0 = time.perf_counter()
-    test = run_biaxial(case, None, replicates=1, processes=1, progress=False).tests[0]
+    test = run_biaxial(case, None, replicates=1, options=RunOptions(workers=1, progress=False)).tests[0]
     c = test.curve
     eps = "  ".join(
         f"{np.interp(e, c.axial_strain, c.volumetric_strain):+.4f}"

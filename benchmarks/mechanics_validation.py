@@ -35,6 +35,7 @@ import numpy as np
 
 from poro2d.biaxial import BiaxialCase, BiaxialSettings, run_biaxial
 from poro2d.dem import checkpoint
+from poro2d.execute import RunOptions
 from poro2d.grading import GradingCurve
 from poro2d.measure.specimen_porosity import measure_specimen
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
@@ -172,7 +173,7 @@ def biaxial(cache: Cache, spc: dict, sigma3: float, fp: float, mur: float, max_s
         meta, arrays = checkpoint.read(spc["checkpoint"])
         value = Specimen(spc["checkpoint"], meta, arrays, checkpoint.content_digest(meta, arrays))
         settings = BiaxialSettings(max_strain=max_strain, particle_friction=fp, rolling_friction=mur)
-        t = run_biaxial(BiaxialCase(value, sigma3, settings), None, processes=1).tests[0]
+        t = run_biaxial(BiaxialCase(value, sigma3, settings), None, options=RunOptions(workers=1)).tests[0]
         return {
             "phi_peak": t.peak_friction_angle_deg,
             "phi_cs": t.critical_state_friction_angle_deg,
@@ -296,7 +297,9 @@ def critical_line(cache, fp, mur, pressures, seeds, disks, strain) -> dict:
             strain=strain, window_start=strain / 2, seed=seeds[0],
         )  # fmt: skip
         t0 = time.perf_counter()
-        res = run_critical_state_line(case, pressures, seeds=len(seeds), processes=1).to_dict()
+        res = run_critical_state_line(
+            case, pressures, seeds=len(seeds), options=RunOptions(workers=1)
+        ).to_dict()
         return {"result": res, "seconds": time.perf_counter() - t0}
 
     raw = cache.get(key, make)

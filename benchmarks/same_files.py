@@ -101,12 +101,22 @@ def _run_sand(root: Path) -> None:
 
 RUNS = {
     "paper": lambda root: _poro2d("paper", "--quick", "--threads", "1", "--out", "paper", cwd=root),
-    "relation": lambda root: _poro2d("relation", "--preset", "paper", "--quick", "--workers", "1",
-                                     "--out", "relation", cwd=root),  # fmt: skip
+    "relation": lambda root: _poro2d(
+        "relation", "--preset", "paper", "--quick", "--workers", "1", "--out", "relation", cwd=root
+    ),  # fmt: skip
     "biaxial": lambda root: _poro2d("biaxial", "--quick", "--strain", "0.02", "--out", "biaxial", cwd=root),
-    "critical-state": lambda root: _poro2d("critical-state", "--disks", "150", "--strain", "0.5",
-                                           "--window-start", "0.25", "--out", "critical-state",
-                                           cwd=root),  # fmt: skip
+    "critical-state": lambda root: _poro2d(
+        "critical-state",
+        "--disks",
+        "200",
+        "--strain",
+        "0.5",
+        "--window-start",
+        "0.25",
+        "--out",
+        "critical-state",
+        cwd=root,
+    ),  # fmt: skip
     "sand": _run_sand,
     "calibrate": _run_calibrate,  # after paper: its laboratory shears paper's specimen
 }

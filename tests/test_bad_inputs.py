@@ -208,7 +208,7 @@ def test_integers_are_accepted_for_floats(tmp_path):
 def test_shear_config_extras(tmp_path, capsys):
     good = checkpoint.save(_small_sim(), tmp_path / "good.npz")
     for toml, word in (
-        ("[shear]\nprocesses = true\n", "shear.processes"),
+        ("[shear]\nworkers = true\n", "shear.workers"),
         ('[shear]\nrate_check = "yes"\n', "shear.rate_check"),
         ('[shear]\nnormal_stress_kpa = ["50"]\n', "shear.normal_stress_kpa"),
         ('[shear]\nvelocity = "0.01"\n', "shear.velocity"),

@@ -21,6 +21,7 @@ from poro2d.biaxial.angles import read_angles
 from poro2d.biaxial.curve import BiaxialCurve
 from poro2d.cli import main
 from poro2d.errors import InputError
+from poro2d.execute import RunOptions
 from poro2d.store import Store
 
 SHORT = {"max_strain": 0.03, "critical_window": 0.34}
@@ -128,7 +129,7 @@ def test_same_seed_same_curve_bit_for_bit():
 
 def test_replicates_are_seeds_and_their_spread(tmp_path):
     res = run_biaxial(BiaxialCase.quick(50.0, seed=7, settings=BiaxialSettings(**SHORT)), replicates=2,
-                      processes=1)  # fmt: skip
+                      options=RunOptions(workers=1))  # fmt: skip
     assert res.specimens == ["quick specimen (seed 7)", "quick specimen (seed 8)"]
     values = [s.peak_friction_angle_deg for s in res.summaries]
     assert res.peak_friction_angle.values == values and res.peak_friction_angle.mean == pytest.approx(
@@ -221,7 +222,7 @@ def test_a_folder_of_another_kind_is_refused_before_any_work(tmp_path, capsys):
         (lambda: run_biaxial(BiaxialCase.quick(100.0), replicates="2"), "replicates"),
         (lambda: run_biaxial(BiaxialCase.quick(100.0), lab=5), "lab"),
         (lambda: run_biaxial(BiaxialCase.quick(100.0), store="out"), "store"),
-        (lambda: run_biaxial(BiaxialCase.quick(100.0), progress=None), "progress"),
+        (lambda: run_biaxial(BiaxialCase.quick(100.0), options=RunOptions(progress=None)), "progress"),
         (lambda: run_biaxial([BiaxialCase.quick(100.0), BiaxialCase.quick(50.0, seed=1)]), "case"),
         (lambda: BiaxialSettings(max_strain=0.9), "max_strain"),
         (lambda: BiaxialSettings(record_strain=0.2, max_strain=0.1), "record_strain"),

@@ -13,6 +13,7 @@ import pytest
 from poro2d.biaxial import BiaxialCase, BiaxialSettings, run_biaxial
 from poro2d.biaxial.quick import QuickSpecimen
 from poro2d.errors import InputError
+from poro2d.execute import RunOptions
 from poro2d.measure.specimen_porosity import measure_specimen
 
 #: the loose recipe of docs/biaxial.md
@@ -29,7 +30,7 @@ def _interior_solid_fraction(q: QuickSpecimen) -> float:
 def _volumetric_strain_at(q: QuickSpecimen, strain: float) -> tuple[float, float]:
     """(eps_v at ``strain``, largest sin phi) of a biaxial test at 100 kPa, contraction positive."""
     case = BiaxialCase(q, 100.0, BiaxialSettings(max_strain=strain, critical_window=0.34))
-    c = run_biaxial(case, None, replicates=1, processes=1, progress=False).tests[0].curve
+    c = run_biaxial(case, None, replicates=1, options=RunOptions(workers=1, progress=False)).tests[0].curve
     return float(c.volumetric_strain[-1]), float(np.max(c.sin_phi))
 
 

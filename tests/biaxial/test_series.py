@@ -14,6 +14,7 @@ from poro2d.biaxial.envelope import envelope, peak_circle
 from poro2d.biaxial.series import sigma_3_at_peak
 from poro2d.cli import main
 from poro2d.errors import InputError
+from poro2d.execute import RunOptions
 from poro2d.store import Store
 
 TINY = {"max_strain": 0.02, "critical_window": 0.5}
@@ -61,7 +62,9 @@ def test_an_envelope_needs_two_stresses():
 def series(tmp_path_factory):
     out = tmp_path_factory.mktemp("series")
     case = BiaxialCase.quick(100.0, seed=2, settings=BiaxialSettings(**TINY))
-    return out, run_biaxial_series(case, [100.0, 50.0], Store(out), replicates=2, processes=1)
+    return out, run_biaxial_series(
+        case, [100.0, 50.0], Store(out), replicates=2, options=RunOptions(workers=1)
+    )
 
 
 def test_a_series_runs_each_stress_on_its_replicates(series):
@@ -118,22 +121,22 @@ def _count_computes(monkeypatch) -> list:
 
 def test_a_rerun_reads_finished_tests_and_reruns_a_changed_or_unfinished_one(tmp_path, monkeypatch):
     case = BiaxialCase.quick(100.0, seed=1, settings=BiaxialSettings(**TINY))
-    first = run_biaxial_series(case, [50.0, 100.0], Store(tmp_path), processes=1)
+    first = run_biaxial_series(case, [50.0, 100.0], Store(tmp_path), options=RunOptions(workers=1))
     ran = _count_computes(monkeypatch)
-    again = run_biaxial_series(case, [50.0, 100.0], Store(tmp_path), processes=1)
+    again = run_biaxial_series(case, [50.0, 100.0], Store(tmp_path), options=RunOptions(workers=1))
     assert ran == [] and again.peak_friction_angle.to_dict() == first.peak_friction_angle.to_dict()
     for a, b in zip(first.studies, again.studies, strict=True):
         assert np.array_equal(a.tests[0].curve.sin_phi, b.tests[0].curve.sin_phi)
     # a test killed midway: its record and a partial curve, no result.json (the marker)
     (tmp_path / "sigma3_100kPa" / "replicate1" / "result.json").unlink()
-    resumed = run_biaxial_series(case, [50.0, 100.0], Store(tmp_path), processes=1)
+    resumed = run_biaxial_series(case, [50.0, 100.0], Store(tmp_path), options=RunOptions(workers=1))
     assert ran == [(100.0, 1)]
     assert np.array_equal(
         resumed.studies[1].tests[0].curve.sigma_1_kpa, first.studies[1].tests[0].curve.sigma_1_kpa
     )
     # a changed setting: both tests run again, and the folder holds the new ones
     changed = case.with_settings(smoothing_strain=0.005)
-    run_biaxial_series(changed, [50.0, 100.0], Store(tmp_path), processes=1)
+    run_biaxial_series(changed, [50.0, 100.0], Store(tmp_path), options=RunOptions(workers=1))
     assert ran[1:] == [(50.0, 1), (100.0, 1)]
     record = json.loads((tmp_path / "sigma3_50kPa" / "replicate1" / "test.json").read_text())
     assert record["run"]["settings"]["smoothing_strain"] == 0.005
@@ -141,10 +144,10 @@ def test_a_rerun_reads_finished_tests_and_reruns_a_changed_or_unfinished_one(tmp
 
 def test_a_test_folder_written_before_records_runs_again(tmp_path, monkeypatch):
     case = BiaxialCase.quick(100.0, seed=1, settings=BiaxialSettings(**TINY))
-    biaxial.run_biaxial(case, Store(tmp_path), processes=1)
+    biaxial.run_biaxial(case, Store(tmp_path), options=RunOptions(workers=1))
     (tmp_path / "replicate1" / "test.json").unlink()
     ran = _count_computes(monkeypatch)
-    biaxial.run_biaxial(case, Store(tmp_path), processes=1)
+    biaxial.run_biaxial(case, Store(tmp_path), options=RunOptions(workers=1))
     assert ran == [(100.0, 1)] and (tmp_path / "replicate1" / "test.json").is_file()
 
 
@@ -245,7 +248,7 @@ def test_a_series_killed_midway_resumes_where_it_stopped(tmp_path, monkeypatch):
 
     out = tmp_path / "o"
     argv = ["biaxial", "--quick", "--seed", "6", "--confining", "50,100", "--strain", "0.02",
-            "--processes", "1", "--out", str(out), "--quiet"]  # fmt: skip
+            "--workers", "1", "--out", str(out), "--quiet"]  # fmt: skip
     cfg = tmp_path / "tiny.toml"
     cfg.write_text("[biaxial]\ncritical_window = 0.5\n")
     argv += ["--config", str(cfg)]

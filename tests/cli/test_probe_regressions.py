@@ -48,7 +48,7 @@ def test_strength_refuses_a_refused_trial_and_shears_the_accepted_one(specimen, 
         shutil.copyfile(specimen, trials / name / "after_plate.npz")
         Store(trials / name).write_json("trial.json", {"accepted": accepted})
     out = tmp_path / "o"
-    tiny = ["--mu-r", "0", "--friction", "0.5", "-n", "50", "--max-displacement", "0.002", "-p", "1"]
+    tiny = ["--mu-r", "0", "--friction", "0.5", "-n", "50", "--max-displacement", "0.002", "--workers", "1"]
     accepted, refused = trials / "02_n0.22" / "after_plate.npz", trials / "01_n0.14" / "after_plate.npz"
     err = _refused(["strength", accepted, refused, *tiny, "--out", out], capsys)
     assert "01_n0.14/trial.json says accepted = False" in err and not out.exists()

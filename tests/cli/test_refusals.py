@@ -208,7 +208,7 @@ CASES = [
     (["critical-state", "--inertial", "0.5"], ["--inertial = 0.5"]),
     (["critical-state", "--strain", "1", "--window-start", "2"], ["--strain"]),
     (["critical-state", "--seeds", "0"], ["--seeds = 0"]),
-    (["critical-state", "--processes", "0"], ["--processes = 0"]),
+    (["critical-state", "--workers", "0"], ["--workers = 0"]),
     (["critical-state", "--grading", "loam"], ["--grading = 'loam'", "wide_cu4"]),
     (["nosuchcommand"], ["nosuchcommand"]),
 ]

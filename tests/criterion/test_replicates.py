@@ -6,9 +6,13 @@ from poro2d.criterion.protocol import CriterionSettings
 from poro2d.criterion.replicates import run_replicates
 from poro2d.criterion.result import ReplicatesResult
 from poro2d.dem import checkpoint
+from poro2d.execute import RunOptions
 from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.store import Store
+
+#: the tests one after the other in this process, no bars
+SERIAL = RunOptions(workers=1, progress=False)
 
 SPEC = SpecimenSpec(width=0.05, height=0.025, layers=2, threads=2)
 SETTINGS = CriterionSettings(force_fraction=0.05)
@@ -17,11 +21,11 @@ SETTINGS = CriterionSettings(force_fraction=0.05)
 def test_processes_give_the_specimens_of_a_serial_run(tmp_path):
     """Two processes with one thread each build, seed for seed, the specimens of a serial run."""
     seeds = [1, 2]
-    res = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, Store(tmp_path / "p"), progress=False)
+    res = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, Store(tmp_path / "p"),
+                         options=RunOptions(progress=False))  # fmt: skip
     assert isinstance(res, ReplicatesResult)
     par, rows_par = res.specimens, res.rows
-    res = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, Store(tmp_path / "s"), processes=1,
-                         progress=False)  # fmt: skip
+    res = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, Store(tmp_path / "s"), options=SERIAL)
     ser, rows_ser = res.specimens, res.rows
     assert [r.seed for r in rows_par] == seeds and [r.folder for r in rows_par] == ["seed1", "seed2"]
     for a, b in zip(rows_par, rows_ser, strict=True):
@@ -32,6 +36,7 @@ def test_processes_give_the_specimens_of_a_serial_run(tmp_path):
         np.testing.assert_array_equal(pa.pos, pb.pos)
         np.testing.assert_array_equal(pa.radius, pb.radius)
     # a rerun reads every seed back from its folder
-    res = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, Store(tmp_path / "p"), progress=False)
+    res = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, Store(tmp_path / "p"),
+                         options=RunOptions(progress=False))  # fmt: skip
     again, rows_again = res.specimens, res.rows
     assert again == par and [r.final_porosity for r in rows_again] == [r.final_porosity for r in rows_par]

@@ -124,7 +124,7 @@ def test_the_command_prints_the_steady_state_first(tmp_path, capsys):
         "--window-start",
         "0.3",
         "--quiet",
-        "--processes",
+        "--workers",
         "1",
         "--out",
         str(tmp_path / "out"),
@@ -141,7 +141,7 @@ def test_a_users_sieve_curve_is_the_cells_grading(tmp_path, capsys):
     soil = tmp_path / "soil.csv"
     soil.write_text("size_mm,percent_passing\n0.25,0\n0.5,30\n1.0,70\n2.0,100\n")
     argv = ["critical-state", "--grading", str(soil), "--disks", "200", "--inertial", "0.01"]
-    argv += ["--strain", "0.6", "--window-start", "0.3", "--quiet", "--processes", "1"]
+    argv += ["--strain", "0.6", "--window-start", "0.3", "--quiet", "--workers", "1"]
     argv += ["--out", str(tmp_path / "out")]
     main(argv)
     kept = json.loads((tmp_path / "out" / "result.json").read_text())

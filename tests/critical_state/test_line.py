@@ -15,6 +15,7 @@ from poro2d.critical_state import CriticalStateCase, run_critical_state
 from poro2d.critical_state.calibrated import calibrated_values
 from poro2d.critical_state.line import CriticalStateLineResult, LineFit, run_critical_state_line
 from poro2d.errors import InputError
+from poro2d.execute import RunOptions
 from poro2d.store import Store
 
 #: a small fast case (as test_critical_state's): 200 disks at I = 0.01 to gamma 0.6
@@ -72,7 +73,9 @@ def test_the_line_fit_recovers_a_known_line_and_its_scatter():
 
 def test_a_line_keeps_a_study_per_pressure_and_its_own_files(tmp_path):
     case = CriticalStateCase(**SMALL)
-    result = run_critical_state_line(case, [50.0, 200.0], Store(tmp_path), seeds=1, processes=1)
+    result = run_critical_state_line(
+        case, [50.0, 200.0], Store(tmp_path), seeds=1, options=RunOptions(workers=1)
+    )
     names = sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith("."))
     assert names == ["critical_state_line.png", "line.csv", "p200kPa", "p50kPa", "result.json"]
     assert (tmp_path / "p50kPa" / "result.json").exists() and (tmp_path / "p200kPa" / "series.csv").exists()
@@ -100,7 +103,7 @@ def test_the_command_prints_the_line_first_with_a_calibrations_frictions(tmp_pat
         "[specimen]\nfriction_particle = 0.3\n\n[shear]\nparticle_friction = 0.3\nrolling_friction = 0.1\n"
     )
     argv = ["critical-state", "--calibrated", str(cal), "--pressure", "50,100", "--disks", "200"]
-    argv += ["--inertial", "0.01", "--strain", "0.6", "--window-start", "0.3", "--quiet", "--processes", "1"]
+    argv += ["--inertial", "0.01", "--strain", "0.6", "--window-start", "0.3", "--quiet", "--workers", "1"]
     main([*argv, "--out", str(tmp_path / "out")])
     out, _err = capsys.readouterr()
     first = out.strip().splitlines()[0]
@@ -146,7 +149,7 @@ def test_a_sand_folder_is_held_against_the_line_with_both_maps(tmp_path, capsys)
         "--window-start",
         "0.3",
         "--quiet",
-        "--processes",
+        "--workers",
         "1",
         "--sand",
         str(sand),

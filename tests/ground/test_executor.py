@@ -13,7 +13,7 @@ import pytest
 
 from poro2d import progress
 from poro2d.errors import InputError
-from poro2d.execute import Backend, Executor, Failed, Job, JobsFailed, results_or_raise
+from poro2d.execute import Backend, Executor, Failed, Job, JobsFailed, RunOptions, results_or_raise
 from tests.conftest import default_sigint
 
 SRC = Path(__file__).resolve().parents[2] / "src"
@@ -172,3 +172,51 @@ def test_ctrl_c_ends_the_workers_and_starts_no_more_jobs(tmp_path):
             proc.wait()
     assert proc.returncode == 130 and err.strip() == "interrupted", err  # no worker's traceback
     assert not (tmp_path / "c").exists()  # the job not started stays so
+
+
+# ------------------------------------------------------------------ RunOptions
+@pytest.mark.parametrize(
+    ("kw", "name"),
+    [
+        ({"workers": 0}, "--workers"),
+        ({"workers": 2.5}, "--workers"),
+        ({"workers": 2, "scheduler": "tcp://127.0.0.1:8786"}, "--workers"),
+        ({"scheduler": "http://host"}, "--scheduler"),
+        ({"progress": None}, "progress"),
+    ],
+)
+def test_run_options_refuse_bad_values_naming_them(kw, name):
+    with pytest.raises(InputError, match=re.escape(name)):
+        RunOptions(**kw)
+
+
+def test_run_options_default_to_one_process_per_job_up_to_the_cores():
+    cores = os.cpu_count() or 1
+    assert RunOptions().local_workers(1) == 1 and RunOptions().local_workers(0) == 1
+    assert RunOptions().local_workers(100) == cores
+    assert RunOptions().local_workers(100, per_core=2) == 2 * cores
+    assert RunOptions(workers=1).local_workers(100) == 1
+    assert RunOptions(workers=1).test_backend(1).kind == "inline"
+    assert RunOptions(scheduler="tcp://127.0.0.1:8786").test_backend(1).kind == "dask"
+    assert RunOptions(progress=True).quiet() == RunOptions(progress=False)
+
+
+def test_a_laboratory_tests_jobs_run_on_a_running_scheduler_as_on_this_machine():
+    """complete_jobs (the tests' batch) sends its jobs to ``options.scheduler`` when given: the
+    same results, in job order, as one after the other here."""
+    import distributed
+
+    from poro2d.execute.batch import complete_jobs
+
+    def jobs():
+        return [Job(square_late_first, (j,), f"job {j}", reports=True) for j in (3, 1, 2)]
+
+    here = complete_jobs(jobs(), title="t", what="job(s)", options=RunOptions(workers=1, progress=False),
+                         workers=1)  # fmt: skip
+    with distributed.LocalCluster(
+        processes=False, n_workers=1, threads_per_worker=1, protocol="tcp", dashboard_address=None
+    ) as cluster:
+        there = complete_jobs(jobs(), title="t", what="job(s)", workers=1,
+                              options=RunOptions(scheduler=cluster.scheduler_address,
+                                                 progress=False))  # fmt: skip
+    assert [r[:2] for r in there] == [r[:2] for r in here] == [(3, 9), (1, 1), (2, 4)]

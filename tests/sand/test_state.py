@@ -8,6 +8,7 @@ from poro2d.critical_state import CriticalStateCase
 from poro2d.critical_state.line import run_critical_state_line
 from poro2d.critical_state.state_table import state_map_lines, state_map_record, state_request
 from poro2d.errors import InputError
+from poro2d.execute import RunOptions
 from poro2d.grading import paper_grading
 from poro2d.lab_state import lab_state_from_table
 from poro2d.sand import load_sand_case
@@ -23,7 +24,7 @@ def line_folder(tmp_path_factory):
     """A tiny 2D line of the paper grading at Table 1's working friction 3.0 (the specimens')."""
     folder = tmp_path_factory.mktemp("line")
     case = CriticalStateCase(**SMALL, particle_friction=3.0)
-    run_critical_state_line(case, [50.0, 200.0], Store(folder), seeds=1, processes=1)
+    run_critical_state_line(case, [50.0, 200.0], Store(folder), seeds=1, options=RunOptions(workers=1))
     return folder
 
 

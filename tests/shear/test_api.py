@@ -9,10 +9,14 @@ import pytest
 
 from poro2d.dem import checkpoint
 from poro2d.errors import InputError
+from poro2d.execute import RunOptions
 from poro2d.shear import ShearSeries, ShearSettings, build_split_box, run_shear
 from poro2d.shear.curve import CURVE_COLUMNS, CurveRow
 from poro2d.shear.peak_frame import PeakFrame, PeakTracker
 from poro2d.store import Store
+
+#: the tests one after the other in this process, no bars
+SERIAL = RunOptions(workers=1, progress=False)
 
 SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4}
 # the keys of peak_frame.npz as earlier versions of poro2d wrote them: a test they left
@@ -26,7 +30,7 @@ def test_run_shear_is_the_series_with_its_files(specimen, tmp_path):
     lab = tmp_path / "lab.csv"
     lab.write_text("normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,75\n")
     out = tmp_path / "api"
-    res = run_shear(specimen.parent, [50, 100], SHORT, store=Store(out), lab=lab, processes=1, progress=False,
+    res = run_shear(specimen.parent, [50, 100], SHORT, store=Store(out), lab=lab, options=SERIAL,
                     config={"note": "kept"})  # fmt: skip
     assert res == json.loads((out / "result.json").read_text())
     assert res["config"] == {"note": "kept"} and res["settings"]["max_displacement"] == 0.002
@@ -36,12 +40,11 @@ def test_run_shear_is_the_series_with_its_files(specimen, tmp_path):
         assert (out / f).stat().st_size > 0, f
     assert not (out / "sn50kPa" / "peak_frame.npz").exists()  # removed with the checkpoint
     ref = ShearSeries(specimen, [50, 100], ShearSettings(**SHORT), store=Store(tmp_path / "series"),
-                      processes=1, progress=False, figures=False).run()  # fmt: skip
+                      options=SERIAL, figures=False).run()  # fmt: skip
     assert [t["peak_shear_stress_kpa"] for t in res["tests"]] == [
         t["peak_shear_stress_kpa"] for t in ref["tests"]
     ]
-    again = run_shear(specimen, 100, ShearSettings(**SHORT), store=Store(out / "one"), processes=1,
-                      progress=False)  # fmt: skip
+    again = run_shear(specimen, 100, ShearSettings(**SHORT), store=Store(out / "one"), options=SERIAL)
     assert again["tests"][0]["peak_shear_stress_kpa"] == ref["tests"][1]["peak_shear_stress_kpa"]
 
 
@@ -58,13 +61,11 @@ def test_run_shear_is_the_series_with_its_files(specimen, tmp_path):
         ({"lab": 5}, "lab"),
         ({"lab": "missing.csv"}, "lab"),
         ({"rate_check": "yes"}, "rate_check"),
-        ({"progress": None}, "progress"),
-        ({"processes": 0}, "processes"),
         ({"specimen": "nowhere.npz"}, "specimen"),
     ],
 )
 def test_run_shear_refuses_bad_input_before_any_test(specimen, tmp_path, kw, name):
-    args = {"specimen": specimen, "normal_stresses_kpa": [50], "settings": SHORT, "progress": False} | kw
+    args = {"specimen": specimen, "normal_stresses_kpa": [50], "settings": SHORT, "options": SERIAL} | kw
     out = tmp_path / "out"
     with pytest.raises(InputError, match=name):
         run_shear(args.pop("specimen"), args.pop("normal_stresses_kpa"), args.pop("settings"),

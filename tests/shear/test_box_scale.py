@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from poro2d.execute import RunOptions
 from poro2d.shear.box_scale import BoxScale, box_scale
 
 
@@ -55,7 +56,7 @@ def test_a_series_records_and_prints_its_box_scale(specimen, tmp_path):
     from poro2d.store import Store
 
     res = run_shear(specimen, [100], {"max_displacement": 0.0005, "peak_window": 2e-4},
-                    store=Store(tmp_path / "s"), progress=False)  # fmt: skip
+                    store=Store(tmp_path / "s"), options=RunOptions(progress=False))  # fmt: skip
     assert res.box_scale is not None and res.box_scale.box_scale  # the ~110-disk test box
     import json
 

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from poro2d.errors import InputError
+from poro2d.execute import RunOptions
 from poro2d.shear.replicates import mohr_coulomb_ci, summarize_replicate_peaks
 
 
@@ -96,8 +97,7 @@ def test_replicate_series_on_small_specimens(tmp_path):
         [50, 100],
         ShearSettings(**short),
         store=Store(out),
-        processes=2,
-        progress=False,
+        options=RunOptions(workers=2, progress=False),
     ).run()
     assert isinstance(res, ReplicateShearResult) and "series" not in res.to_dict()
     assert res.to_dict() == json.loads((out / "replicates.json").read_text())

@@ -6,6 +6,7 @@ import math
 import numpy as np
 import pytest
 
+from poro2d.execute import RunOptions
 from poro2d.shear import run_shear
 from poro2d.shear.residual import (
     DILATION_RATE_LIMIT,
@@ -142,7 +143,7 @@ def test_a_curve_without_the_plane_record_gives_the_plate_ratio_only():
 
 def test_a_real_test_reads_its_residual_into_its_result_and_the_series(specimen, tmp_path):
     res = run_shear(specimen, [100], {"max_displacement": 0.02, "stop_after_peak": 0.0},
-                    store=Store(tmp_path / "s"), progress=False)  # fmt: skip
+                    store=Store(tmp_path / "s"), options=RunOptions(progress=False))  # fmt: skip
     summary = res.tests[0]
     r = summary.residual_dilation_stopped
     d_mean = json.loads((tmp_path / "s" / "sn100kPa" / "result.json").read_text())["d_mean_m"]
@@ -174,7 +175,7 @@ def test_poro2d_shear_prints_the_residual_beside_the_end_values_with_its_label(s
     from poro2d.cli import main
 
     main(["shear", "--specimen", str(specimen), "-n", "100", "--max-displacement", "0.004",
-          "--stop-after-peak", "0", "-p", "1", "--quiet", "--out", str(tmp_path / "o")])  # fmt: skip
+          "--stop-after-peak", "0", "--workers", "1", "--quiet", "--out", str(tmp_path / "o")])  # fmt: skip
     out = capsys.readouterr().out
     assert "resid." in out and "plate" in out and "plane" in out
     assert "the residual tau/sigma where dilation stopped" in out and "100 kPa: " in out

@@ -97,7 +97,7 @@ def test_config_shear_table_takes_the_frictions_and_the_cli_wins(specimen, tmp_p
     )
     dest = tmp_path / "out"
     main(["shear", "-s", str(specimen), "-n", "50", "-c", str(cfg), "--out", str(dest), "--quiet",
-          "--rolling-friction", "0.25", "-p", "1"])  # fmt: skip
+          "--rolling-friction", "0.25", "--workers", "1"])  # fmt: skip
     result = json.loads((dest / "result.json").read_text())
     assert result["settings"]["particle_friction"] == 0.7
     assert result["settings"]["rolling_friction"] == 0.25
@@ -108,7 +108,7 @@ def test_config_shear_table_takes_the_frictions_and_the_cli_wins(specimen, tmp_p
     capsys.readouterr()
     with pytest.raises(SystemExit) as exc:
         main(["shear", "-s", str(specimen), "-n", "50", "-c", str(cfg), "--out", str(dest), "--quiet",
-              "--rolling-friction", "0.3", "-p", "1"])  # fmt: skip
+              "--rolling-friction", "0.3", "--workers", "1"])  # fmt: skip
     assert exc.value.code == 2 and "rolling_friction" in capsys.readouterr().err
 
 

@@ -9,10 +9,14 @@ import pytest
 from poro2d.cli import main
 from poro2d.dem import checkpoint
 from poro2d.errors import InputError
+from poro2d.execute import RunOptions
 from poro2d.shear import DirectShearTest, ShearSeries, ShearSettings, build_split_box, smooth
 from poro2d.shear.box import LOWER, UPPER
 from poro2d.shear.case import ShearCase
 from poro2d.store import Store
+
+#: the tests one after the other in this process, no bars
+SERIAL = RunOptions(workers=1, progress=False)
 
 # 2 mm of shear in the 60 mm box: the peak of this small specimen lies near the end
 SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4}
@@ -22,7 +26,7 @@ SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 
 def series(specimen, tmp_path_factory):
     out = tmp_path_factory.mktemp("series")
     s = ShearSeries(
-        specimen, [50, 100, 200], ShearSettings(**SHORT), store=Store(out), processes=1, progress=False,
+        specimen, [50, 100, 200], ShearSettings(**SHORT), store=Store(out), options=SERIAL,
         figures=False,
     )  # fmt: skip
     return out, s.run()
@@ -98,7 +102,7 @@ def test_each_curve_travels_in_the_result_as_its_file_holds_it(specimen, series)
         back = pickle.loads(pickle.dumps(read))
         np.testing.assert_array_equal(back.curve["shear_stress_kpa"], curve["shear_stress_kpa"])
     again = ShearSeries(
-        specimen, [50, 100, 200], ShearSettings(**SHORT), store=Store(out), processes=1, progress=False,
+        specimen, [50, 100, 200], ShearSettings(**SHORT), store=Store(out), options=SERIAL,
         figures=False,
     ).run()  # fmt: skip  # every test finished: read back, nothing run
     for sigma, curve in r.curves.items():
@@ -182,7 +186,7 @@ def test_cli_parallel_with_lab_peaks_and_skip_on_rerun(specimen, series, tmp_pat
     )
     dest = tmp_path / "cli"
     args = ["shear", "--specimen", str(specimen), "--normal-stress", "50,100", "--lab", str(lab),
-            "--out", str(dest), "--max-displacement", "0.002", "--processes", "2", "--quiet",
+            "--out", str(dest), "--max-displacement", "0.002", "--workers", "2", "--quiet",
             "--config", str(_cfg(tmp_path))]  # fmt: skip
     main(args)
     res = json.loads((dest / "result.json").read_text())
@@ -278,8 +282,8 @@ def test_rate_check_reruns_at_half_velocity(specimen, series, tmp_path):
     out, r = series
     shutil.copytree(out / "sn100kPa", tmp_path / "sn100kPa")  # done: only the v/2 rerun runs
     s = ShearSeries(
-        specimen, [100], ShearSettings(**SHORT), store=Store(tmp_path), rate_check=True, processes=1,
-        progress=False, figures=False,
+        specimen, [100], ShearSettings(**SHORT), store=Store(tmp_path), rate_check=True, options=SERIAL,
+        figures=False,
     )  # fmt: skip
     res = s.run()
     rc = res["rate_check"]
@@ -324,7 +328,7 @@ def test_replaced_specimen_is_refused(specimen, series, tmp_path, capsys):
     dest = tmp_path / "shear"
     shutil.copytree(out, dest)
     args = ["shear", "--specimen", str(folder), "--normal-stress", "50,100,200,400", "--out", str(dest),
-            "--max-displacement", "0.002", "--processes", "1", "--quiet",
+            "--max-displacement", "0.002", "--workers", "1", "--quiet",
             "--config", str(_cfg(tmp_path))]  # fmt: skip
     with pytest.raises(SystemExit) as exc:
         main(args)
@@ -346,7 +350,7 @@ def test_moved_folders_resume_without_recomputing(specimen, series, tmp_path):
     done = sorted(dest.glob("sn*/result.json"))
     stamps = [f.stat().st_mtime_ns for f in done]
     again = ShearSeries(
-        spec_dir, [50, 100, 200], ShearSettings(**SHORT), store=Store(dest), processes=1, progress=False,
+        spec_dir, [50, 100, 200], ShearSettings(**SHORT), store=Store(dest), options=SERIAL,
         figures=False,
     ).run()  # fmt: skip
     assert [f.stat().st_mtime_ns for f in done] == stamps
@@ -362,9 +366,11 @@ def test_settings_bind_only_once_a_test_started(specimen, tmp_path):
         [50, 100],
         ShearSettings(**dict(SHORT, velocity=0.03)),
         store=Store(tmp_path),
-        progress=False,
+        options=RunOptions(progress=False),
     )
-    s = ShearSeries(specimen, [50, 100], ShearSettings(**SHORT), store=Store(tmp_path), progress=False)
+    s = ShearSeries(
+        specimen, [50, 100], ShearSettings(**SHORT), store=Store(tmp_path), options=RunOptions(progress=False)
+    )
     stored = json.loads((tmp_path / "sn50kPa" / "test.json").read_text())
     assert stored["run"]["settings"]["velocity"] == s.settings.velocity
     assert str(tmp_path) not in json.dumps(stored["run"])  # no paths in what is compared

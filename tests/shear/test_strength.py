@@ -12,6 +12,7 @@ import pytest
 
 from poro2d.cli import main
 from poro2d.errors import InputError
+from poro2d.execute import RunOptions
 from poro2d.shear import ShearSettings
 from poro2d.shear.strength import StrengthStudy, max_dilation_angle, residual_point
 from poro2d.specimen.specimen_set import SpecimenSet
@@ -41,7 +42,7 @@ def study(specimen, tmp_path_factory):
     out = tmp_path_factory.mktemp("strength")
     twice = SpecimenSet.accepted({"a": specimen, "b": specimen})
     s = StrengthStudy(twice, [0.0, 0.3], [0.5], [50, 100], ShearSettings(**TINY),
-                      store=Store(out), processes=2, progress=False)  # fmt: skip
+                      store=Store(out), options=RunOptions(workers=2, progress=False))  # fmt: skip
     return out, s.run()
 
 
@@ -77,7 +78,7 @@ def test_a_rerun_reads_the_tests_back(specimen, study):
     stamp = test_json.stat().st_mtime_ns
     twice = SpecimenSet.accepted({"a": specimen, "b": specimen})
     again = StrengthStudy(twice, [0.0, 0.3], [0.5], [50, 100], ShearSettings(**TINY),
-                          store=Store(out), processes=1, progress=False).run()  # fmt: skip
+                          store=Store(out), options=RunOptions(workers=1, progress=False)).run()  # fmt: skip
     assert test_json.stat().st_mtime_ns == stamp
     assert again["cases"] == result["cases"]
 
@@ -114,7 +115,7 @@ def test_study_refuses_bad_grids(specimen, tmp_path):
 def test_cli_runs_a_tiny_study_and_records_its_grid(specimen, tmp_path, capsys):
     out = tmp_path / "out"
     main(["strength", str(specimen), "--mu-r", "0,0.2", "--friction", "0.5", "-n", "50",
-          "--max-displacement", "0.002", "-p", "1", "--out", str(out), "--quiet"])  # fmt: skip
+          "--max-displacement", "0.002", "--workers", "1", "--out", str(out), "--quiet"])  # fmt: skip
     result = json.loads((out / "strength.json").read_text())
     assert [c["mu_r"] for c in result["cases"]] == [0.0, 0.2]
     assert result["config"]["particle_friction"] == [0.5] and result["settings"]["stop_after_peak"] == 0.0

@@ -21,7 +21,7 @@ from poro2d.criterion.config import TOP_KEYS
 from poro2d.errors import InputError, check_int, is_number
 
 #: keys of the table that say what to run, not how a test runs
-RUN_KEYS = ("confining_kpa", "replicates", "seed", "quick", "specimens", "lab", "processes")
+RUN_KEYS = ("confining_kpa", "replicates", "seed", "quick", "specimens", "lab", "workers")
 #: the fields of the settings
 SETTING_KEYS = tuple(f.name for f in dataclasses.fields(BiaxialSettings))
 
@@ -81,7 +81,7 @@ def check_run_keys(run: dict[str, Any]) -> None:
         check_number_list(
             "biaxial.confining_kpa", [v] if is_number(v) else v, *CONFINING_RANGE_KPA, max_items=20
         )
-    for key, lo, hi in (("replicates", 1, 50), ("seed", 0, 2**31 - 1), ("processes", 1, 64)):
+    for key, lo, hi in (("replicates", 1, 50), ("seed", 0, 2**31 - 1), ("workers", 1, 64)):
         if key in run:
             check_int(f"biaxial.{key}", run[key], lo, hi)
     if "quick" in run and not isinstance(run["quick"], bool):

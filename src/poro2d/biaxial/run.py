@@ -19,7 +19,7 @@ from poro2d.biaxial.parts import DEFINITIONS, AngleSpread, Definitions, LabCurve
 from poro2d.biaxial.results import BiaxialResult, BiaxialTestResult
 from poro2d.biaxial.single import BiaxialTest
 from poro2d.errors import InputError, check_int
-from poro2d.execute import Job
+from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
 from poro2d.io_utils import Provenance, as_json, check_output_dir
 from poro2d.locks import output_folder
@@ -83,16 +83,11 @@ def lab_curve(value) -> LabCurve | None:
     raise InputError("lab", type(value).__name__, "a laboratory CSV path, a LabCurve or None")
 
 
-def check_run(store, progress, processes, tests: int) -> int:
-    """``store`` and ``progress`` checked; the worker processes (default one per test, at most the
-    CPU count)."""
+def check_run(store, options: RunOptions, tests: int) -> int:
+    """``store`` checked; the worker processes (default one per test, at most one per core)."""
     if store is not None and not isinstance(store, Store):
         raise InputError("store", type(store).__name__, "a poro2d.store.Store or None")
-    if not isinstance(progress, bool):
-        raise InputError("progress", progress, "True or False")
-    if processes is not None:
-        return check_int("processes", processes, 1, 64)
-    return min(tests, os.cpu_count() or 1)
+    return options.local_workers(tests)
 
 
 def run_biaxial(
@@ -101,8 +96,7 @@ def run_biaxial(
     *,
     replicates: int = 1,
     lab: str | os.PathLike | LabCurve | None = None,
-    processes: int | None = None,
-    progress: bool = False,
+    options: RunOptions = RunOptions(),
     config: dict | None = None,
 ) -> BiaxialResult:
     """Biaxial tests of ``case`` on ``replicates`` specimens (quick specimens of seed, seed + 1, ...).
@@ -111,8 +105,9 @@ def run_biaxial(
     ``replicates`` stays 1). ``store``: where the files go (``result.json``, ``curves.csv``,
     ``biaxial.png``, and per replicate ``replicate<k>/result.json`` and ``curve.csv``); None:
     nothing is kept. ``lab``: a laboratory CSV of the user's (:mod:`poro2d.biaxial.lab`),
-    overlaid on the figure. ``processes``: worker processes (default one per replicate, at
-    most the CPU count). ``config``: recorded as it is.
+    overlaid on the figure. ``options``: where the tests run (``workers`` processes, default one
+    per replicate and at most one per core, or a running ``scheduler``) and whether bars show.
+    ``config``: recorded as it is.
 
     Returns the :class:`BiaxialResult`: the spread of each angle over the replicates, and each
     replicate's result with its curve (``tests``). A test whose consolidation does not reach
@@ -123,21 +118,21 @@ def run_biaxial(
     n = check_int("replicates", replicates, 1, MAX_REPLICATES)
     cases = replicate_cases(case, n)
     lab_data = lab_curve(lab)
-    workers = check_run(store, progress, processes, len(cases))
+    workers = check_run(store, options, len(cases))
     if store is None:
-        return _run(cases, None, lab_data, workers, progress, config)
+        return _run(cases, None, lab_data, workers, options, config)
     check_output_dir(store.parameter, store.root)
     with output_folder(store.parameter, store.root, kind="biaxial"):
-        return _run(cases, store, lab_data, workers, progress, config)
+        return _run(cases, store, lab_data, workers, options, config)
 
 
-def execute_tests(jobs: list[BiaxialJob], workers: int, progress: bool) -> list[BiaxialTestResult]:
+def execute_tests(jobs: list[BiaxialJob], workers: int, options: RunOptions) -> list[BiaxialTestResult]:
     """The tests of ``jobs`` in job order: finished ones read back, the others run on up to
     ``workers`` processes (a test that fails raises once the others have ended)."""
     finished = [job.stored() for job in jobs]
     return complete_jobs(
         [Job(_run_job, (job,), job.label, reports=True) for job in jobs], title="biaxial",
-        what="biaxial test(s)", workers=min(workers, max(1, finished.count(None))), progress=progress,
+        what="biaxial test(s)", options=options, workers=min(workers, max(1, finished.count(None))),
         finished=finished,
     )  # fmt: skip
 
@@ -151,9 +146,9 @@ def replicate_jobs(cases: list[BiaxialCase], store: Store | None, label: str = "
     ]  # fmt: skip
 
 
-def _run(cases, store, lab, workers, progress, config) -> BiaxialResult:
+def _run(cases, store, lab, workers, options, config) -> BiaxialResult:
     t0 = time.perf_counter()
-    tests = execute_tests(replicate_jobs(cases, store), workers, progress)
+    tests = execute_tests(replicate_jobs(cases, store), workers, options)
     result = summarize(cases, tests, lab, workers, time.perf_counter() - t0, config)
     if store is not None:
         write_study(store, result, lab)

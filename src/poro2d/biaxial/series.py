@@ -42,6 +42,7 @@ from poro2d.biaxial.run import (
 )
 from poro2d.biaxial.settings import CONFINING_RANGE_KPA
 from poro2d.errors import InputError, check_int, check_range, is_number
+from poro2d.execute import RunOptions
 from poro2d.io_utils import Provenance, as_json, check_output_dir
 from poro2d.locks import output_folder
 from poro2d.report.biaxial_figures import plot_biaxial_series
@@ -77,8 +78,7 @@ def run_biaxial_series(
     *,
     replicates: int = 1,
     lab: str | os.PathLike | LabCurve | None = None,
-    processes: int | None = None,
-    progress: bool = False,
+    options: RunOptions = RunOptions(),
     config: dict | None = None,
 ) -> BiaxialSeriesResult:
     """Biaxial tests of ``case`` (its specimen and settings; its own sigma_3 is not used) at each of
@@ -88,32 +88,33 @@ def run_biaxial_series(
     ``store``: the series' ``result.json``, ``biaxial_series.png`` and per stress a folder
     (``sigma3_100kPa/``) holding what :func:`run_biaxial` keeps; a rerun into it reads finished
     tests back and runs the rest (a test whose record differs, another setting, runs again).
-    None: nothing kept. ``processes``: worker processes for all the tests (default one per
-    test, at most the CPU count). Returns the :class:`BiaxialSeriesResult` (``studies``: each
-    stress's :class:`BiaxialResult` with its tests and curves). Call it under
-    ``if __name__ == "__main__":`` in a script (the tests run in spawned processes).
+    None: nothing kept. ``options``: where all the tests run (``workers`` processes, default one
+    per test and at most one per core, or a running ``scheduler``) and whether bars show.
+    Returns the :class:`BiaxialSeriesResult` (``studies``: each stress's :class:`BiaxialResult`
+    with its tests and curves). Call it under ``if __name__ == "__main__":`` in a script (the
+    tests run in spawned processes).
     """
     n = check_int("replicates", replicates, 1, MAX_REPLICATES)
     stresses = check_confining(confining_kpa)
     base = replicate_cases(case, n)
     cases = {s: [replace(c, confining_kpa=s) for c in base] for s in stresses}
     lab_data = lab_curve(lab)
-    workers = check_run(store, progress, processes, len(stresses) * len(base))
+    workers = check_run(store, options, len(stresses) * len(base))
     if store is None:
-        return _run(cases, None, lab_data, workers, progress, config)
+        return _run(cases, None, lab_data, workers, options, config)
     check_output_dir(store.parameter, store.root)
     with output_folder(store.parameter, store.root, kind="biaxial"):
-        return _run(cases, store, lab_data, workers, progress, config)
+        return _run(cases, store, lab_data, workers, options, config)
 
 
-def _run(cases: dict[float, list[BiaxialCase]], store, lab, workers, progress, config) -> BiaxialSeriesResult:
+def _run(cases: dict[float, list[BiaxialCase]], store, lab, workers, options, config) -> BiaxialSeriesResult:
     t0 = time.perf_counter()
     jobs = {
         s: replicate_jobs(cs, None if store is None else store.child(stress_folder(s)), f"{s:g} kPa, ")
         for s, cs in cases.items()
     }
     flat = [job for js in jobs.values() for job in js]
-    tests = iter(execute_tests(flat, workers, progress))
+    tests = iter(execute_tests(flat, workers, options))
     wall = time.perf_counter() - t0
     studies = []
     for s, cs in cases.items():

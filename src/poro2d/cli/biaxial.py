@@ -6,6 +6,7 @@ from pathlib import Path
 
 import typer
 
+from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, run_options, tests_workers_help
 from poro2d.console import OutputConsole, Table
 
 console = OutputConsole()
@@ -53,9 +54,8 @@ def register(app: typer.Typer) -> None:
             None, "--lab", help="Your laboratory curves (CSV, docs/biaxial.md), overlaid."
         ),
         out: Path = typer.Option(Path("biaxial-out"), "--out", "-o", help="Output folder."),
-        processes: int = typer.Option(
-            None, "--processes", "-p", help="Worker processes (default one per replicate)."
-        ),
+        workers: int = typer.Option(None, "--workers", help=tests_workers_help("test, at most one per core")),
+        scheduler: str = typer.Option(None, "--scheduler", help=TESTS_SCHEDULER_HELP),
         config: Path = typer.Option(None, "--config", "-c", help="TOML config with a \\[biaxial] table."),
         quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
     ) -> None:
@@ -84,9 +84,9 @@ def register(app: typer.Typer) -> None:
                     "settings": {**table.settings, **options}}  # fmt: skip
         if config is not None:
             recorded["config_file"] = str(config)
-        kw = {"replicates": n, "lab": lab if lab is not None else table.path("lab"),
-              "processes": processes if processes is not None else run.get("processes"),
-              "progress": not quiet, "config": recorded}  # fmt: skip
+        jobs = run_options(workers if workers is not None else run.get("workers"), scheduler, quiet)
+        kw = {"replicates": n, "lab": lab if lab is not None else table.path("lab"), "options": jobs,
+              "config": recorded}  # fmt: skip
         start_and_print(case, stresses, Store(out), kw, out)
 
 

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import typer
 
+from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, run_options, tests_workers_help
 from poro2d.console import OutputConsole, Table
 
 console = OutputConsole()
@@ -82,9 +83,8 @@ def register(app: typer.Typer) -> None:
         seed: int = typer.Option(0, "--seed", help="The first seed."),
         seeds: int = typer.Option(1, "--seeds", "-n", help="Seeds S, S+1, ...: the spread over them."),
         out: Path = typer.Option(Path("critical-state-out"), "--out", "-o", help="Output folder."),
-        processes: int = typer.Option(
-            None, "--processes", "-p", help="Worker processes (default one per seed)."
-        ),
+        workers: int = typer.Option(None, "--workers", help=tests_workers_help("seed, at most one per core")),
+        scheduler: str = typer.Option(None, "--scheduler", help=TESTS_SCHEDULER_HELP),
         quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
     ) -> None:
         """Steady-state friction tau/sigma and solid fraction of the disks, free of any box."""
@@ -104,8 +104,7 @@ def register(app: typer.Typer) -> None:
         check_output_dir("--out", out)
         curve = _grading(grading)
         n = check_int("--seeds", seeds, 1, MAX_SEEDS)
-        if processes is not None:
-            check_int("--processes", processes, 1, 64)
+        run = run_options(workers, scheduler, quiet)
         pressures = parse_stresses(pressure, "--pressure", PRESSURE_RANGE_KPA)
         if len(pressures) > MAX_PRESSURES or len(set(pressures)) != len(pressures):
             raise InputError("--pressure", pressure, f"at most {MAX_PRESSURES} distinct pressures")
@@ -128,12 +127,10 @@ def register(app: typer.Typer) -> None:
         store = Store(out)
         try:
             if len(pressures) == 1:
-                result = run_critical_states(
-                    case, store, seeds=n, processes=processes, progress=not quiet, config=config
-                )
+                result = run_critical_states(case, store, seeds=n, options=run, config=config)
             else:
                 result = run_critical_state_line(
-                    case, pressures, store, seeds=n, processes=processes, progress=not quiet, config=config,
+                    case, pressures, store, seeds=n, options=run, config=config,
                     marks=held.marks if held else None, span=held.span if held else None,
                 )  # fmt: skip
         except RuntimeError as exc:

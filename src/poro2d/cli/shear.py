@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
+from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, run_options, tests_workers_help
 from poro2d.console import OutputConsole, Table
 
 if TYPE_CHECKING:
@@ -14,7 +15,7 @@ if TYPE_CHECKING:
 
 console = OutputConsole()
 
-SHEAR_KEYS_EXTRA = {"normal_stress_kpa", "specimen", "lab", "processes", "rate_check"}
+SHEAR_KEYS_EXTRA = {"normal_stress_kpa", "specimen", "lab", "workers", "rate_check"}
 
 
 def parse_stresses(
@@ -68,8 +69,8 @@ def check_extra_types(extra: dict) -> None:
     for key in ("specimen", "lab"):
         if key in extra and not isinstance(extra[key], str):
             raise InputError(f"shear.{key}", extra[key], "a path (a string)")
-    if "processes" in extra:
-        check_int("shear.processes", extra["processes"], 1)
+    if "workers" in extra:
+        check_int("shear.workers", extra["workers"], 1)
     if "rate_check" in extra and not isinstance(extra["rate_check"], bool):
         raise InputError("shear.rate_check", extra["rate_check"], "true or false")
     if "normal_stress_kpa" in extra:
@@ -123,9 +124,8 @@ def register(app: typer.Typer) -> None:
         rate_check: bool = typer.Option(
             False, "--rate-check", help="Repeat every test at half the velocity."
         ),
-        processes: int = typer.Option(
-            None, "--processes", "-p", help="Worker processes (default: one per test, up to 2 x CPUs)."
-        ),
+        workers: int = typer.Option(None, "--workers", help=tests_workers_help("test, at most two per core")),
+        scheduler: str = typer.Option(None, "--scheduler", help=TESTS_SCHEDULER_HELP),
         config: Path = typer.Option(None, "--config", "-c", help="TOML config with a \\[shear] table."),
         quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
     ) -> None:
@@ -139,6 +139,7 @@ def register(app: typer.Typer) -> None:
         table, base = load_shear_config(config)
         extra = {k: table.pop(k) for k in list(table) if k in SHEAR_KEYS_EXTRA}
         check_extra_types(extra)
+        run = run_options(workers if workers is not None else extra.get("workers"), scheduler, quiet)
         options = {
             "velocity": velocity,
             "max_displacement": max_displacement,
@@ -162,8 +163,7 @@ def register(app: typer.Typer) -> None:
                 store=Store(out),
                 lab=resolve_path("--lab", lab, extra.get("lab"), base),
                 rate_check=rate_check or bool(extra.get("rate_check", False)),
-                processes=processes if processes is not None else extra.get("processes"),
-                progress=not quiet,
+                options=run,
                 config=recorded,
             )
         except RuntimeError as exc:

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
+from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, run_options, tests_workers_help
 from poro2d.console import OutputConsole, Table
 
 if TYPE_CHECKING:
@@ -81,7 +82,8 @@ def register(app: typer.Typer) -> None:
         normal_stress: str = typer.Option(None, "--normal-stress", "-n", help="Normal stresses (kPa)."),
         max_displacement: float = typer.Option(None, "--max-displacement", help="Shear displacement (m)."),
         out: Path = typer.Option(Path("strength-out"), "--out", "-o", help="Output folder (resumable)."),
-        processes: int = typer.Option(None, "--processes", "-p", help="Worker processes (default 2 x CPUs)."),
+        workers: int = typer.Option(None, "--workers", help=tests_workers_help("test, at most two per core")),
+        scheduler: str = typer.Option(None, "--scheduler", help=TESTS_SCHEDULER_HELP),
         max_tests: int = typer.Option(
             MAX_TESTS,
             "--max-tests",
@@ -114,8 +116,7 @@ def register(app: typer.Typer) -> None:
             parse_values(friction, "--friction", MAX_FRICTION) if friction else list(st.QUICK_FRICTION)
         )
         stresses = parse_stresses(normal_stress) if normal_stress else list(st.QUICK_NORMAL_STRESSES)
-        if processes is not None:
-            check_int("--processes", processes, 1, 64)
+        run = run_options(workers, scheduler, quiet)
         check_int("--max-tests", max_tests, 1, 1_000_000)
         n_tests = len(mu_values) * len(fp_values) * (n_seeds if quick else len(specimen)) * len(stresses)
         if n_tests > max_tests:
@@ -141,7 +142,7 @@ def register(app: typer.Typer) -> None:
             else:
                 specimens = given
             study = st.StrengthStudy(specimens, mu_values, fp_values, stresses, settings, store=Store(out),
-                                     processes=processes, progress=not quiet, config=config)  # fmt: skip
+                                     options=run, config=config)  # fmt: skip
             console.print(
                 f"[bold]direct shear[/] over {len(study.cases)} (mu_r, f_p) cases x {len(specimens)} "
                 f"specimen(s) x {len(stresses)} normal stresses on {study.processes} processes"

@@ -18,7 +18,7 @@ from dataclasses import replace
 from poro2d.console import OutputConsole
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.criterion.result import ReplicateRow, ReplicatesResult
-from poro2d.execute import Job
+from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
 from poro2d.grading import GradingCurve
 from poro2d.specimen.compaction import SpecimenSpec
@@ -46,10 +46,10 @@ def run_replicates(
     seeds: list[int],
     store: Store,
     *,
-    processes: int = 2,
-    progress: bool = True,
+    options: RunOptions = RunOptions(),
 ) -> ReplicatesResult:
-    """Criterion runs of ``seeds`` from the first trial ``n2d``, ``processes`` at a time.
+    """Criterion runs of ``seeds`` from the first trial ``n2d``, on ``options``' workers (default
+    one per seed, at most one per core) or its running scheduler.
 
     Returns one summary row per seed (accepted or not, the criterion's message, its sub-store
     of ``store``), in seed order, and the accepted specimens by label (``seed1``, ...) as
@@ -60,7 +60,8 @@ def run_replicates(
     jobs = [Job(_run_one, (spec1, grading, first, sd, store.child(f"seed{sd}")), f"seed {sd}", reports=True)
             for sd in seeds]  # fmt: skip
     rows = complete_jobs(jobs, title="replicate criterion", what="replicate criterion run(s)",
-                         workers=processes, progress=progress, done_text=_outcome)  # fmt: skip
+                         options=options, workers=options.local_workers(len(jobs)),
+                         done_text=_outcome)  # fmt: skip
     return ReplicatesResult(rows, store=store)
 
 
@@ -87,7 +88,7 @@ def accepted_and_replicates(
     more_seeds = list(range(seed + 1, seed + replicates))
     console.print(f"  replicate specimens: seeds {', '.join(map(str, more_seeds))} from n2D = {n2d:.2f}")
     more = run_replicates(spec, grading, settings, n2d, more_seeds, store.child("replicates"),
-                          processes=spec.threads, progress=progress)  # fmt: skip
+                          options=RunOptions(workers=spec.threads, progress=progress))  # fmt: skip
     return specimens + more.specimens, more.rows
 
 

@@ -27,6 +27,7 @@ from poro2d.critical_state.case import CaseRecord, CriticalStateCase
 from poro2d.critical_state.results import CriticalStateResult, CriticalStateTestResult, void_ratio
 from poro2d.critical_state.run import MAX_SEEDS, seed_runs, study_of, write_study
 from poro2d.errors import InputError, check_int
+from poro2d.execute import RunOptions
 from poro2d.io_utils import Provenance, as_json, check_output_dir
 from poro2d.locks import output_folder
 from poro2d.measure.spread import Spread
@@ -341,8 +342,7 @@ def run_critical_state_line(
     store: Store | None = None,
     *,
     seeds: int = 3,
-    processes: int | None = None,
-    progress: bool = False,
+    options: RunOptions = RunOptions(),
     config: dict | None = None,
     marks: list[tuple[str, float]] | None = None,
     span: float | None = None,
@@ -355,7 +355,7 @@ def run_critical_state_line(
     the executor. ``store``: the line's ``result.json``,
     ``line.csv`` and ``critical_state_line.png``, and per pressure a folder ``p<P>kPa/`` holding
     what a one-pressure study holds. Call it under ``if __name__ == "__main__":`` in a script
-    when ``processes`` > 1 (worker processes import the calling script).
+    when it runs on several processes (``options``; worker processes import the calling script).
     """
     if not isinstance(case, CriticalStateCase):
         raise InputError("case", type(case).__name__, "a CriticalStateCase")
@@ -367,7 +367,7 @@ def run_critical_state_line(
 
     def work() -> CriticalStateLineResult:
         t0 = time.perf_counter()
-        tests, workers = seed_runs([c for row in cases for c in row], processes, progress)
+        tests, workers = seed_runs([c for row in cases for c in row], options)
         studies = []
         for k, row in enumerate(cases):
             studies.append(

@@ -10,7 +10,6 @@ window (:mod:`poro2d.critical_state.steady`). Every input is checked (the case's
 from __future__ import annotations
 
 import math
-import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -36,7 +35,7 @@ from poro2d.critical_state.results import (
 from poro2d.critical_state.series import COLUMNS, CellSeries, row_of
 from poro2d.critical_state.steady import read_steady
 from poro2d.errors import InputError, check_int
-from poro2d.execute import Job
+from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
 from poro2d.io_utils import Provenance, as_json, check_output_dir
 from poro2d.locks import output_folder
@@ -165,15 +164,15 @@ def run_critical_states(
     store: Store | None = None,
     *,
     seeds: int = 3,
-    processes: int | None = None,
-    progress: bool = False,
+    options: RunOptions = RunOptions(),
     config: dict | None = None,
 ) -> CriticalStateResult:
     """``case`` on ``seeds`` seeds (case.seed, case.seed + 1, ...): each number's spread over them.
 
     ``store``: where ``result.json``, ``series.csv`` (every seed's rows) and the figure go;
-    ``processes``: worker processes (default one per seed, at most the CPU count). Several
-    processes spawn workers that import the calling script: call it under
+    ``options``: where the seeds run (``workers`` processes, default one per seed and at most
+    one per core, or a running ``scheduler``) and whether bars show. Several processes spawn
+    workers that import the calling script: call it under
     ``if __name__ == "__main__":`` in a script.
     """
     if not isinstance(case, CriticalStateCase):
@@ -183,20 +182,17 @@ def run_critical_states(
         raise InputError("seeds", n, f"at most {2**31 - case.seed} from seed {case.seed}")
     if store is not None and not isinstance(store, Store):
         raise InputError("store", type(store).__name__, "a poro2d.store.Store or None")
-    workers = (
-        check_int("processes", processes, 1, 64) if processes is not None else min(n, os.cpu_count() or 1)
-    )
     cases = [case.with_seed(case.seed + k) for k in range(n)]
     if store is None:
-        return _study(cases, None, workers, progress, config)
+        return _study(cases, None, options, config)
     check_output_dir(store.parameter, store.root)
     with output_folder(store.parameter, store.root, kind="critical-state"):
-        return _study(cases, store, workers, progress, config)
+        return _study(cases, store, options, config)
 
 
-def _study(cases, store, workers, progress, config) -> CriticalStateResult:
+def _study(cases, store, options, config) -> CriticalStateResult:
     t0 = time.perf_counter()
-    tests, workers = seed_runs(cases, workers, progress)
+    tests, workers = seed_runs(cases, options)
     result = study_of(cases, tests, workers, time.perf_counter() - t0, config)
     if store is not None:
         write_study(store, cases, result)
@@ -204,15 +200,15 @@ def _study(cases, store, workers, progress, config) -> CriticalStateResult:
 
 
 def seed_runs(
-    cases: list[CriticalStateCase], processes: int | None, progress: bool
+    cases: list[CriticalStateCase], options: RunOptions
 ) -> tuple[list[CriticalStateTestResult], int]:
-    """Every case one job of the executor's local processes (default one per case, at most the
-    CPU count); the results in the cases' order and the number of workers. Raises if any failed."""
-    workers = processes if processes is not None else min(len(cases), os.cpu_count() or 1)
+    """Every case one job of the executor (local processes: default one per case, at most one per
+    core); the results in the cases' order and the number of workers. Raises if any failed."""
+    workers = options.local_workers(len(cases))
     jobs = [SeedJob(c, _label(c, cases)) for c in cases]
     results = complete_jobs(
         [Job(_run_job, (job,), job.label, reports=True) for job in jobs], title="critical state",
-        what="periodic shear run(s)", workers=workers, progress=progress,
+        what="periodic shear run(s)", options=options, workers=workers,
     )  # fmt: skip
     return results, workers
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from poro2d.execute import Job
+from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
 from poro2d.shear.case import ShearCase
 from poro2d.shear.results import ShearTestResult
@@ -66,8 +66,9 @@ def _slowest_first(job: ShearJob) -> tuple:
     return (not job.rate, -job.case.normal_stress_kpa)
 
 
-def execute_jobs(jobs: list[ShearJob], processes: int, progress: bool) -> list[ShearTestResult]:
-    """Run the tests of ``jobs`` (finished ones are read back) in up to ``processes`` processes.
+def execute_jobs(jobs: list[ShearJob], processes: int, options: RunOptions) -> list[ShearTestResult]:
+    """Run the tests of ``jobs`` (finished ones are read back) in up to ``processes`` processes
+    (or on the running scheduler of ``options``).
 
     Returns their results in job order. Every test runs even when one fails; then an input
     error of a test is raised as it is, other failures together
@@ -75,7 +76,7 @@ def execute_jobs(jobs: list[ShearJob], processes: int, progress: bool) -> list[S
     """
     return complete_jobs(
         [Job(_run_job, (job,), job.label, reports=True) for job in jobs], title="direct shear",
-        what="direct shear test(s)", workers=processes, progress=progress, finished=_finished(jobs),
+        what="direct shear test(s)", options=options, workers=processes, finished=_finished(jobs),
         show=_show, start_first=lambda j: _slowest_first(j.args[0]),
     )  # fmt: skip
 

@@ -18,6 +18,7 @@ from dataclasses import replace
 import numpy as np
 
 from poro2d.errors import InputError, check_range
+from poro2d.execute import RunOptions
 from poro2d.io_utils import Provenance
 from poro2d.shear.box_dominated import box_dominated_count
 from poro2d.shear.fit import mohr_coulomb
@@ -110,16 +111,14 @@ class ReplicateShear:
     """
 
     def __init__(self, specimens: SpecimenSet, normal_stresses_kpa, settings=None, *,
-                 store: Store | None = None, lab=None, processes: int | None = None, progress: bool = True,
+                 store: Store | None = None, lab=None, options: RunOptions = RunOptions(),
                  config: dict | None = None, figures: bool = True) -> None:  # fmt: skip
-        import os
-
         from poro2d.shear.series import ShearSeries
 
         if not specimens:
             raise InputError("specimens", "none", "at least one specimen")
         self.store = store
-        self.progress = progress
+        self.options = options
         self.config = config or {}
         self.figures = figures
         self.series = {
@@ -129,15 +128,14 @@ class ReplicateShear:
                 settings,
                 store=store.child(label) if store is not None else None,
                 lab=lab,
-                progress=False,
-                processes=1,
+                options=RunOptions(workers=1, progress=False),
                 config=self.config,
                 figures=figures,
             )  # fmt: skip
             for label in specimens
         }
         njobs = sum(len(s.jobs) for s in self.series.values())
-        self.processes = processes if processes is not None else min(njobs, 2 * (os.cpu_count() or 1))
+        self.processes = options.local_workers(njobs, per_core=2)
 
     def jobs(self) -> list[ShearJob]:
         """Every specimen's tests as pool jobs, a specimen after the other (a caller may pool several)."""
@@ -147,7 +145,7 @@ class ReplicateShear:
         from poro2d.shear.pool import execute_jobs
 
         t0 = time.perf_counter()
-        return self.finish(execute_jobs(self.jobs(), self.processes, self.progress), t0)
+        return self.finish(execute_jobs(self.jobs(), self.processes, self.options), t0)
 
     def finish(self, results: list[ShearTestResult], t0: float) -> ReplicateShearResult:
         """Each specimen's fit and files, then the summary, from the results in the order of :meth:`jobs`."""

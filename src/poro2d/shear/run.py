@@ -11,6 +11,7 @@ from collections.abc import Iterable
 
 from poro2d.config import dataclass_from_table
 from poro2d.errors import InputError, is_number
+from poro2d.execute import RunOptions
 from poro2d.io_utils import check_output_dir
 from poro2d.locks import output_folder
 from poro2d.shear.lab import LabData, read_lab_csv
@@ -58,8 +59,7 @@ def run_shear(
     store: Store,
     lab: str | os.PathLike | LabData | None = None,
     rate_check: bool = False,
-    processes: int | None = None,
-    progress: bool = True,
+    options: RunOptions = RunOptions(),
     config: dict | None = None,
 ) -> ShearSeriesResult:
     """Direct shear tests on ``specimen`` at ``normal_stresses_kpa``, the fit and Fig. 8.
@@ -70,8 +70,9 @@ def run_shear(
     the defaults. ``store``: where the results are kept (``Store("shear-out")``); a rerun
     with the same inputs skips finished tests and resumes a killed one. ``lab``: a
     laboratory CSV (or :class:`LabData`) to compare with. ``rate_check``: repeat every
-    test at half the velocity. ``processes``: worker processes (default one per test, at
-    most twice the CPU count). ``progress``: bars on a terminal, periodic lines in a log.
+    test at half the velocity. ``options``: where the tests run (``workers`` processes, default
+    one per test and at most two per core, or a running ``scheduler``) and whether bars show
+    (:class:`~poro2d.execute.options.RunOptions`).
     ``config``: recorded in ``result.json`` as it is.
 
     Returns the :class:`ShearSeriesResult` kept as ``result.json`` (per test ``tests``, the fit
@@ -87,13 +88,12 @@ def run_shear(
     stresses = _stresses(normal_stresses_kpa)
     lab_data = _lab(lab)
     shear_settings = _settings(settings)
-    for name, flag in (("rate_check", rate_check), ("progress", progress)):
-        if not isinstance(flag, bool):
-            raise InputError(name, flag, "True or False")
+    if not isinstance(rate_check, bool):
+        raise InputError("rate_check", rate_check, "True or False")
     with output_folder(store.parameter, store.root, kind="shear"):
         series = ShearSeries(
             value, stresses, shear_settings, store=store, lab=lab_data, rate_check=rate_check,
-            processes=processes, progress=progress, config=config,
+            options=options, config=config,
         )  # fmt: skip
         return series.run()
 

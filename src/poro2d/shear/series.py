@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import math
-import os
 import time
 from pathlib import Path
 
 import numpy as np
 
 from poro2d.errors import InputError, check_range
+from poro2d.execute import RunOptions
 from poro2d.io_utils import Provenance
 from poro2d.shear.box_dominated import box_dominated_count
 from poro2d.shear.box_scale import box_scale
@@ -82,8 +82,7 @@ class ShearSeries:
         lab=None,
         rate_check: bool = False,
         rate_tolerance: float = 0.02,
-        processes: int | None = None,
-        progress: bool = True,
+        options: RunOptions = RunOptions(),
         config: dict | None = None,
         figures: bool = True,
     ) -> None:
@@ -94,16 +93,13 @@ class ShearSeries:
         self.lab = lab
         self.rate_check = bool(rate_check)
         self.rate_tolerance = check_range("rate_tolerance", rate_tolerance, 0.0, 1.0, lo_open=True)
-        if processes is not None and not (isinstance(processes, int) and 1 <= processes <= 64):
-            raise InputError("processes", processes, "an integer in [1, 64]")
-        self.progress = progress
+        self.options = options
         self.config = config or {}
         self.figures = figures
         self.jobs = self._jobs()
         # the tests are about equally long: one process per test (up to twice the cores)
         # leaves no core idle at the end (3 tests on 2 cores take 1.5 test times, not 2)
-        ncpu = os.cpu_count() or 1
-        self.processes = processes if processes is not None else min(len(self.jobs), 2 * ncpu)
+        self.processes = options.local_workers(len(self.jobs), per_core=2)
         self._bind_tests()
 
     @property
@@ -142,7 +138,7 @@ class ShearSeries:
     def run(self) -> ShearSeriesResult:
         """Run the tests (finished ones are read back), then the fit, figures and ``result.json``."""
         t0 = time.perf_counter()
-        return self.finish(execute_jobs(self.jobs, self.processes, self.progress), t0)
+        return self.finish(execute_jobs(self.jobs, self.processes, self.options), t0)
 
     # ------------------------------------------------------------------ results
     def finish(self, results: list[ShearTestResult], t0: float) -> ShearSeriesResult:

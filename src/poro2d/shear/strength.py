@@ -28,6 +28,7 @@ from dataclasses import replace
 import numpy as np
 
 from poro2d.errors import InputError, check_range
+from poro2d.execute import RunOptions
 from poro2d.io_utils import Provenance
 from poro2d.shear.box_scale import box_scale
 from poro2d.shear.case import ShearCase
@@ -228,10 +229,7 @@ class StrengthStudy:
 
     def __init__(self, specimens: SpecimenSet, mu_r, friction, normal_stresses_kpa,
                  settings: ShearSettings | None = None, *, store: Store | None = None,
-                 processes: int | None = None, progress: bool = True,
-                 config: dict | None = None) -> None:  # fmt: skip
-        import os
-
+                 options: RunOptions = RunOptions(), config: dict | None = None) -> None:  # fmt: skip
         self.mu_r = check_grid("mu_r", mu_r, MAX_ROLLING_FRICTION)
         self.friction = check_grid("particle friction", friction, MAX_FRICTION)
         base = settings if settings is not None else ShearSettings()
@@ -244,7 +242,7 @@ class StrengthStudy:
             for label, v in zip(values, values.contents(), strict=True)
         }
         self.store = store
-        self.progress = progress
+        self.options = options
         self.config = config or {}
         self.cases = {
             (m, f): ReplicateShear(
@@ -252,7 +250,7 @@ class StrengthStudy:
                 normal_stresses_kpa,
                 replace(base, rolling_friction=m, particle_friction=f),
                 store=store.child(case_label(m, f)) if store is not None else None,
-                progress=False,
+                options=RunOptions(progress=False),
                 config=self.config,
                 figures=False,
             )  # fmt: skip
@@ -260,7 +258,7 @@ class StrengthStudy:
             for f in self.friction
         }
         njobs = sum(len(rep.jobs()) for rep in self.cases.values())
-        self.processes = processes if processes is not None else min(njobs, 2 * (os.cpu_count() or 1))
+        self.processes = options.local_workers(njobs, per_core=2)
 
     def run(self) -> StrengthResult:
         from poro2d.shear.pool import execute_jobs
@@ -268,7 +266,7 @@ class StrengthStudy:
         t0 = time.perf_counter()
         jobs = [replace(j, series=f"{case_label(*case)} {j.series}")
                 for case, rep in self.cases.items() for j in rep.jobs()]  # fmt: skip
-        results = execute_jobs(jobs, self.processes, self.progress)  # in job order: a case after the other
+        results = execute_jobs(jobs, self.processes, self.options)  # in job order: a case after the other
         rows, tests, start = [], [], 0
         for case, rep in self.cases.items():
             count = len(rep.jobs())
