@@ -51,6 +51,31 @@ def _plain(value: Any) -> Any:
     return value
 
 
+def _as_stored(value: Any) -> Any:
+    """``value`` as its file reads back: NumPy numbers and arrays as plain ones, tuples as lists,
+    NaN and infinities as None (:func:`poro2d.io_utils.as_json`); a typed part as it is (it holds
+    its own values so already), a list or map of them with each one so."""
+    from poro2d.io_utils import as_json
+
+    if isinstance(value, TypedResult | Record):
+        return value
+    if isinstance(value, list | tuple) and any(isinstance(v, TypedResult | Record) for v in value):
+        return [_as_stored(v) for v in value]
+    if isinstance(value, dict) and any(isinstance(v, TypedResult | Record) for v in value.values()):
+        return {k: _as_stored(v) for k, v in value.items()}
+    return as_json(value)
+
+
+def _typed(kind: Any, value: Any) -> Any:
+    """``value`` of a field whose ``PARTS`` entry is ``kind``: the dict of a part (or each dict of
+    a list of them, or each value of a :class:`Keyed` map) read as the part; else as it is."""
+    if isinstance(kind, Keyed):
+        return kind.read(value)
+    if isinstance(kind, type) and issubclass(kind, TypedResult | Record):  # not a decoder of its own
+        return [part(kind, v) for v in value] if isinstance(value, list) else part(kind, value)
+    return value
+
+
 def part(cls: type[R], value: Any) -> Any:
     """``value`` as the part ``cls`` when it is the dict of one (as read from a file), else as it is."""
     if isinstance(value, Mapping) and not isinstance(value, cls):
@@ -92,6 +117,11 @@ class TypedResult(Mapping):
     def __post_init__(self) -> None:
         # keys a file read by from_dict lacked: they stay out of to_dict() while unset
         self._absent: frozenset[str] = frozenset()
+        # every value as its file holds it, typed parts typed, so that a fresh result equals the
+        # one read back from its file
+        for key in _keys(type(self)):
+            setattr(self, key, _as_stored(_typed(self.PARTS.get(key), getattr(self, key))))
+        self.extra = _as_stored(self.extra)
 
     def _present(self, key: str) -> bool:
         """Whether ``key`` is in the file: unless unset (None) where a file lacked it or it is optional."""
@@ -113,15 +143,6 @@ class TypedResult(Mapping):
         keys = _keys(cls)
         obj = cls(**{k: data.get(k) for k in keys}, extra={k: v for k, v in data.items() if k not in keys})
         obj._absent = frozenset(k for k in keys if k not in data)
-        for key, kind in cls.PARTS.items():
-            if isinstance(kind, Keyed):
-                setattr(obj, key, kind.read(getattr(obj, key)))
-            elif isinstance(kind, type) and issubclass(
-                kind, TypedResult | Record
-            ):  # not a decoder of its own
-                value = getattr(obj, key)
-                rows = isinstance(value, list)
-                setattr(obj, key, [part(kind, v) for v in value] if rows else part(kind, value))
         return obj
 
     # read-only mapping access, for code that reads results as dicts

@@ -21,7 +21,7 @@ from poro2d.biaxial.single import BiaxialTest
 from poro2d.errors import InputError, check_int
 from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
-from poro2d.io_utils import Provenance, as_json, check_output_dir
+from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import output_folder
 from poro2d.measure.spread import Spread
 from poro2d.report.biaxial_figures import plot_biaxial
@@ -186,7 +186,7 @@ def summarize(cases, tests, lab, workers, wall, config) -> BiaxialResult:
     if lab is not None:
         lab_record = LabCurveRecord(lab.source, int(lab.axial_strain.size), lab.peak_friction_angle_deg(),
                                     lab.end_friction_angle_deg())  # fmt: skip
-    result = BiaxialResult(
+    return BiaxialResult(
         confining_stress_kpa=cases[0].confining_kpa, replicates=len(tests),
         peak_friction_angle=AngleSpread.of([t.peak_friction_angle_deg for t in tests]),
         critical_state_friction_angle=AngleSpread.of([t.critical_state_friction_angle_deg for t in tests]),
@@ -200,10 +200,8 @@ def summarize(cases, tests, lab, workers, wall, config) -> BiaxialResult:
                                                             for t in tests]),
         stiffness_number=spread_of(Spread, [t.stiffness_number for t in tests]),
         mean_overlap_ratio_at_peak=spread_of(Spread, [t.mean_overlap_ratio_at_peak for t in tests]),
+        tests=list(tests),
     )  # fmt: skip
-    stored = BiaxialResult.from_dict(as_json(result))
-    stored.tests = list(tests)
-    return stored
 
 
 def write_study(store: Store, result: BiaxialResult, lab: LabCurve | None) -> None:

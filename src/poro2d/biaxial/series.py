@@ -43,7 +43,7 @@ from poro2d.biaxial.run import (
 from poro2d.biaxial.settings import CONFINING_RANGE_KPA
 from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.execute import RunOptions
-from poro2d.io_utils import Provenance, as_json, check_output_dir
+from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import output_folder
 from poro2d.report.biaxial_figures import plot_biaxial_series
 from poro2d.store import Store
@@ -175,7 +175,7 @@ def summarize_series(studies: list[BiaxialResult], workers: int, wall: float, co
         "not critical-state angles (a longer --strain, or a larger specimen)"
     )
     first = studies[0]
-    result = BiaxialSeriesResult(
+    return BiaxialSeriesResult(
         confining_stresses_kpa=[st.confining_stress_kpa for st in studies], replicates=first.replicates,
         stresses=[_summary(st) for st in studies],
         peak_friction_angle=AngleSpread.of([t.peak_friction_angle_deg for t in tests]),
@@ -188,10 +188,8 @@ def summarize_series(studies: list[BiaxialResult], workers: int, wall: float, co
         processes=workers, wall_time_s=wall, config=config or {}, provenance=Provenance.now(), lab=first.lab,
         plastic_max_dilatancy_angle=spread_of(AngleSpread, [t.plastic_max_dilatancy_angle_deg
                                                             for t in tests]),
+        studies=list(studies),
     )  # fmt: skip
-    stored = BiaxialSeriesResult.from_dict(as_json(result))
-    stored.studies = list(studies)
-    return stored
 
 
 def _write(store: Store, result: BiaxialSeriesResult) -> None:

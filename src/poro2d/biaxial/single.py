@@ -34,7 +34,7 @@ from poro2d.biaxial.stages import SIDE_START_STRAIN, ProgressFn, Shearing, conso
 from poro2d.biaxial.stiffness import DiskStiffness, scaled_stiffness
 from poro2d.dem import Simulation
 from poro2d.errors import InputError
-from poro2d.io_utils import Provenance, as_json
+from poro2d.io_utils import Provenance
 from poro2d.store import Store
 
 
@@ -155,7 +155,7 @@ class BiaxialTest:
         curve = BiaxialCurve.of_rows(rows)
         angles = read_angles(curve, s.smoothing_strain, s.critical_window, s.critical_rate_limit)
         curve, elastic = self.elastic(sim, start, curve, velocity)
-        result = BiaxialTestResult(
+        return BiaxialTestResult(
             confining_stress_kpa=self.case.confining_kpa, **asdict(angles),
             checks=self.checks(curve), consolidation=info, strain_rate_per_s=self.strain_rate,
             plate_velocity_m_per_s=velocity, d50_m=self.d50, dt_s=sim.dt, local_damping=sim.local_damping,
@@ -164,11 +164,8 @@ class BiaxialTest:
             specimen_digest=self.case.specimen.digest, provenance=Provenance.now(),
             stiffness_number=info.stiffness_number, stiffness_scale=self.scale,
             mean_overlap_ratio_at_peak=float(np.interp(angles.axial_strain_at_peak, curve.axial_strain,
-                                                       curve.mean_overlap_ratio)), **elastic,
+                                                       curve.mean_overlap_ratio)), **elastic, curve=curve,
         )  # fmt: skip
-        stored = BiaxialTestResult.from_dict(as_json(result))
-        stored.curve = curve
-        return stored
 
     def elastic(
         self, sim: Simulation, start: BoxSize, curve: BiaxialCurve, velocity: float

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, run_options, tests_workers_help
+from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, job_options, tests_workers_help
 from poro2d.console import OutputConsole, Table
 
 console = OutputConsole()
@@ -84,7 +84,7 @@ def register(app: typer.Typer) -> None:
                     "settings": {**table.settings, **options}}  # fmt: skip
         if config is not None:
             recorded["config_file"] = str(config)
-        jobs = run_options(workers if workers is not None else run.get("workers"), scheduler, quiet)
+        jobs = job_options(workers if workers is not None else run.get("workers"), scheduler, quiet)
         kw = {"replicates": n, "lab": lab if lab is not None else table.path("lab"), "options": jobs,
               "config": recorded}  # fmt: skip
         start_and_print(case, stresses, Store(out), kw, out)

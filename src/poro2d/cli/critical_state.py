@@ -10,7 +10,7 @@ from pathlib import Path
 
 import typer
 
-from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, run_options, tests_workers_help
+from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, job_options, tests_workers_help
 from poro2d.console import OutputConsole, Table
 
 console = OutputConsole()
@@ -104,7 +104,7 @@ def register(app: typer.Typer) -> None:
         check_output_dir("--out", out)
         curve = _grading(grading)
         n = check_int("--seeds", seeds, 1, MAX_SEEDS)
-        run = run_options(workers, scheduler, quiet)
+        run = job_options(workers, scheduler, quiet)
         pressures = parse_stresses(pressure, "--pressure", PRESSURE_RANGE_KPA)
         if len(pressures) > MAX_PRESSURES or len(set(pressures)) != len(pressures):
             raise InputError("--pressure", pressure, f"at most {MAX_PRESSURES} distinct pressures")

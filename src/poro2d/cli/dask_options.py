@@ -12,7 +12,7 @@ def tests_workers_help(per: str) -> str:
     return f"Worker processes on this machine (default: one per {per})."
 
 
-def run_options(workers: int | None, scheduler: str | None, quiet: bool, dashboard: str | None = None):
+def job_options(workers: int | None, scheduler: str | None, quiet: bool, dashboard: str | None = None):
     """The :class:`~poro2d.execute.options.RunOptions` of a command's ``--workers``, ``--scheduler``,
     ``--quiet`` (and ``--dashboard``), checked: a bad value is refused naming its option."""
     from poro2d.execute.cluster_options import check_dashboard

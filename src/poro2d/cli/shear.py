@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, run_options, tests_workers_help
+from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, job_options, tests_workers_help
 from poro2d.console import OutputConsole, Table
 
 if TYPE_CHECKING:
@@ -139,7 +139,7 @@ def register(app: typer.Typer) -> None:
         table, base = load_shear_config(config)
         extra = {k: table.pop(k) for k in list(table) if k in SHEAR_KEYS_EXTRA}
         check_extra_types(extra)
-        run = run_options(workers if workers is not None else extra.get("workers"), scheduler, quiet)
+        run = job_options(workers if workers is not None else extra.get("workers"), scheduler, quiet)
         options = {
             "velocity": velocity,
             "max_displacement": max_displacement,

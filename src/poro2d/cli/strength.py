@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, run_options, tests_workers_help
+from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, job_options, tests_workers_help
 from poro2d.console import OutputConsole, Table
 
 if TYPE_CHECKING:
@@ -116,7 +116,7 @@ def register(app: typer.Typer) -> None:
             parse_values(friction, "--friction", MAX_FRICTION) if friction else list(st.QUICK_FRICTION)
         )
         stresses = parse_stresses(normal_stress) if normal_stress else list(st.QUICK_NORMAL_STRESSES)
-        run = run_options(workers, scheduler, quiet)
+        run = job_options(workers, scheduler, quiet)
         check_int("--max-tests", max_tests, 1, 1_000_000)
         n_tests = len(mu_values) * len(fp_values) * (n_seeds if quick else len(specimen)) * len(stresses)
         if n_tests > max_tests:

@@ -28,7 +28,7 @@ from poro2d.critical_state.results import CriticalStateResult, CriticalStateTest
 from poro2d.critical_state.run import MAX_SEEDS, seed_runs, study_of, write_study
 from poro2d.errors import InputError, check_int
 from poro2d.execute import RunOptions
-from poro2d.io_utils import Provenance, as_json, check_output_dir
+from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import output_folder
 from poro2d.measure.spread import Spread
 from poro2d.report.critical_state_figures import plot_critical_state_line
@@ -255,10 +255,7 @@ class CriticalStateLineResult(TypedResult):
 
     def measured(self) -> MeasuredLine:
         """The line through the points (:class:`MeasuredLine`), by rising mean stress."""
-        pts = sorted(self.points, key=lambda pt: pt.mean_stress_kpa.mean)
-        return MeasuredLine(
-            tuple(pt.mean_stress_kpa.mean for pt in pts), tuple(pt.void_ratio.mean for pt in pts)
-        )
+        return measured_line(self.points)
 
     def headline(self) -> str:
         """The line and the pooled friction, with the range of pressures and seeds."""
@@ -306,13 +303,18 @@ def line_result(
         wall_time_s=wall_time_s,
         config=config or {},
         provenance=Provenance.now(),
+        marks=[StateMark.of(label, e, measured_line(points), list(pressures), span) for label, e in marks]
+        if marks
+        else None,
+        studies=list(studies),
     )
-    if marks:
-        line = result.measured()
-        result.marks = [StateMark.of(label, e, line, list(pressures), span) for label, e in marks]
-    stored = CriticalStateLineResult.from_dict(as_json(result))
-    stored.studies = list(studies)
-    return stored
+    return result
+
+
+def measured_line(points: list[LinePoint]) -> MeasuredLine:
+    """The line through ``points`` (:class:`MeasuredLine`), by rising mean stress."""
+    pts = sorted(points, key=lambda pt: pt.mean_stress_kpa.mean)
+    return MeasuredLine(tuple(pt.mean_stress_kpa.mean for pt in pts), tuple(pt.void_ratio.mean for pt in pts))
 
 
 def pressure_folder(pressure_kpa: float) -> str:

@@ -37,7 +37,7 @@ from poro2d.critical_state.steady import read_steady
 from poro2d.errors import InputError, check_int
 from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
-from poro2d.io_utils import Provenance, as_json, check_output_dir
+from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import output_folder
 from poro2d.report.critical_state_figures import plot_critical_state
 from poro2d.store import Store
@@ -128,16 +128,15 @@ def run_critical_state(
         provenance=Provenance.now(),
         stiffness_number=case.kappa(),
         mean_overlap_ratio=overlap,
+        series=series,
     )
-    stored = CriticalStateTestResult.from_dict(as_json(result))
-    stored.series = series
     if store is not None:
         store.write_csv("series.csv", series.rows(), header=list(COLUMNS))
         plot_critical_state(
             [(f"seed {case.seed}", series)], store.path(FIGURE), title=_title(case), window=case.window_start
         )
-        store.write_result("result.json", stored)
-    return stored
+        store.write_result("result.json", result)
+    return result
 
 
 def _title(case: CriticalStateCase) -> str:
@@ -265,7 +264,7 @@ def study_of(cases, tests, workers, wall, config) -> CriticalStateResult:
         )
         for c, t in zip(cases, tests, strict=True)
     ]
-    result = CriticalStateResult(
+    return CriticalStateResult(
         seeds=[c.seed for c in cases],
         stress_ratio=Spread.of([t.stress_ratio for t in tests]),
         friction_angle_deg=Spread.of([t.friction_angle_deg for t in tests]),
@@ -283,10 +282,8 @@ def study_of(cases, tests, workers, wall, config) -> CriticalStateResult:
         void_ratio=Spread.of([void_ratio(t.solid_fraction) for t in tests]),
         stiffness_number=cases[0].kappa(),
         mean_overlap_ratio=Spread.of([t.mean_overlap_ratio for t in tests]),
+        tests=list(tests),
     )
-    stored = CriticalStateResult.from_dict(as_json(result))
-    stored.tests = list(tests)
-    return stored
 
 
 __all__ = [
