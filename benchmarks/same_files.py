@@ -124,7 +124,6 @@ RUNS = {
 
 def run(root: Path, only: list[str] | None) -> None:
     root.mkdir(parents=True, exist_ok=True)
-    os.environ.setdefault("NUMBA_NUM_THREADS", "1")
     os.environ["PORO2D_CACHE"] = str(root / ".cache")
     for name, job in RUNS.items():
         if not only or name in only:

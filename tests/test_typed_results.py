@@ -483,12 +483,12 @@ def test_a_sands_calibration_record_and_seed_results_are_typed_parts():
 
 def test_a_sands_preflight_is_a_typed_part():
     """``sand.json``'s pre-flight (its boxes, jamming porosity and estimates) is a typed part."""
-    from poro2d.sand.result import BoxPlanRecord, JammingRecord, PreflightRecord, StageEstimate
+    from poro2d.sand.preflight import BoxPlan, Jamming, Preflight, StageEstimate
 
     stored = json.loads((DATA / "sand_result.json").read_text())
     pf = SandResult.from_dict(stored).preflight
-    assert isinstance(pf, PreflightRecord) and isinstance(pf.box, BoxPlanRecord) and pf.box.layers == 4
-    assert isinstance(pf.jamming, JammingRecord) and pf.jamming.seeds == 3
+    assert isinstance(pf, Preflight) and isinstance(pf.box, BoxPlan) and pf.box.layers == 4
+    assert isinstance(pf.jamming, Jamming) and pf.jamming.seeds == 3
     assert isinstance(pf.seconds, StageEstimate)
     assert pf.seconds.total == stored["preflight"]["seconds"]["total"]
     assert "total" not in pf.particle_steps.to_dict() and pf.to_dict() == stored["preflight"]

@@ -161,7 +161,7 @@ def test_preflight_reports_before_any_dem_work(tmp_path, monkeypatch):
     pf = PF.preflight(case, workers=2, budget_minutes=1.0)
     assert pf.box.disks == pytest.approx(2560, rel=0.05)  # the paper's box at the first trial
     assert pf.first_trial < pf.eq12_trial
-    assert pf.seconds["total"] > 60.0 and "exceeds the budget" in pf.suggestion
+    assert pf.seconds.total > 60.0 and "exceeds the budget" in pf.suggestion
     assert math.isclose(pf.band_over_d_max, 0.031 / paper_grading().d_max_m, rel_tol=1e-9)
 
 

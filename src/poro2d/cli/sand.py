@@ -53,10 +53,10 @@ def print_preflight(case, pf) -> None:
             f"{pf.first_trial:.3f} (Eq. 12 would start at {pf.eq12_trial:.3f})",
         ),
         ("cases", f"calibration {pf.cases_calibration} at most, specimens {pf.cases_specimens}"),
-        ("estimated particle-steps", f"{sum(pf.particle_steps.values()):.3g}"),
+        ("estimated particle-steps", f"{pf.particle_steps.calibration + pf.particle_steps.specimens:.3g}"),
         (
             "estimated run time",
-            f"{pf.seconds['total'] / 60:.0f} min on {pf.workers} core(s) (a model: "
+            f"{pf.seconds.total / 60:.0f} min on {pf.workers} core(s) (a model: "
             "the run prints its measured pace)",
         ),
     ]

@@ -17,7 +17,8 @@ and an up-scaling with, printed as such; the run prints its own measured pace.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
+from typing import ClassVar
 
 import numpy as np
 
@@ -26,6 +27,7 @@ from poro2d.grading import GradingCurve, paper_grading
 from poro2d.porosity import parabolic
 from poro2d.sand.case import SandCase
 from poro2d.specimen.compaction import SpecimenSpec, check_feasible, estimate_size, time_step
+from poro2d.typed_result import TypedResult
 
 #: particle-steps per second per core assumed by the estimate: measured 2.0e7 (lid) to 2.7e7
 #: (preparation) per core with both cores running cases (Toyoura sand, 4 100 and 10 800 disks,
@@ -45,9 +47,9 @@ JAMMING_DISKS = 1500
 JAMMING_MAX_DISKS = 8000
 
 
-@dataclass(frozen=True)
-class BoxPlan:
-    """A box the run prepares specimens in, and what one specimen holds."""
+@dataclass(eq=False)
+class BoxPlan(TypedResult):
+    """A box the run prepares specimens in, and what one specimen holds (m, disks)."""
 
     width: float
     height: float
@@ -59,8 +61,8 @@ class BoxPlan:
         return self.height / self.layers
 
 
-@dataclass(frozen=True)
-class Jamming:
+@dataclass(eq=False)
+class Jamming(TypedResult):
     """The grading's frictionless jamming porosity (n_J = 1 - phi_J) over seeds, or why not."""
 
     porosity: float | None
@@ -71,9 +73,21 @@ class Jamming:
     note: str = ""
 
 
-@dataclass(frozen=True)
-class Preflight:
-    """The pre-flight of one soil: printed before any DEM work, kept as ``preflight.json``."""
+@dataclass(eq=False)
+class StageEstimate(TypedResult):
+    """The pre-flight's estimate for the calibration and the specimens (particle steps or s)."""
+
+    calibration: float
+    specimens: float
+    total: float | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("total",)
+
+
+@dataclass(eq=False)
+class Preflight(TypedResult):
+    """The pre-flight of one soil: printed before any DEM work, kept as ``preflight.json`` and in
+    ``sand.json``."""
 
     soil: str
     d_min_m: float
@@ -92,12 +106,21 @@ class Preflight:
     eq12_trial: float
     cases_calibration: int
     cases_specimens: int
-    particle_steps: dict
-    seconds: dict
+    particle_steps: StageEstimate
+    seconds: StageEstimate
     workers: int
     budget_minutes: float | None
     suggestion: str
     notes: list[str] = field(default_factory=list)
+
+    #: the typed parts, as their classes read them
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
+        "box": BoxPlan,
+        "calibration_box": BoxPlan,
+        "jamming": Jamming,
+        "particle_steps": StageEstimate,
+        "seconds": StageEstimate,
+    }
 
 
 #: a lid must rest in the calibration box: its force window at least this many times the
@@ -176,7 +199,7 @@ def jamming_of(grading: GradingCurve, seeds: int = 3, *, use_cache: bool = True)
         return jam
     jam = _compute_jamming(grading, seeds)
     try:
-        store.write_json(name, asdict(jam))
+        store.write_json(name, jam.to_dict())
     except OSError:  # a read-only cache: the reference is simply computed again next time
         pass
     return jam
@@ -294,7 +317,7 @@ def _fines_cut_for(case: SandCase, budget: float, first: float, workers: int) ->
         d_mm = float(f"{d * 1e3:.3g}")
         try:
             cut = GradingCurve.from_config(dict(table, d_min_mm=d_mm), base_dir=case.base_dir)
-            secs = workload(case, case.spec, cut, first, workers).seconds["total"]
+            secs = workload(case, case.spec, cut, first, workers).seconds.total
         except InputError:
             continue
         if secs <= budget:
@@ -311,8 +334,8 @@ class Workload:
     calibration: BoxPlan
     dt: float
     dt_paper: float
-    particle_steps: dict
-    seconds: dict
+    particle_steps: StageEstimate
+    seconds: StageEstimate
 
 
 def workload(case: SandCase, spec: SpecimenSpec, g: GradingCurve, first: float, workers: int) -> Workload:
@@ -326,15 +349,13 @@ def workload(case: SandCase, spec: SpecimenSpec, g: GradingCurve, first: float, 
     dt_paper = time_step(spec, paper_grading().d_min_m)
     n_cal, n_spec = _cases(case)
     cal_spec = replace(spec, width=cal.width, height=cal.height, layers=cal.layers)
-    psteps = {
-        "calibration": cal.disks * _steps_per_trial(cal_spec, dt, dt_paper) * TRIALS_PER_CASE * n_cal,
-        "specimens": full.disks * _steps_per_trial(spec, dt, dt_paper) * TRIALS_PER_CASE * n_spec,
-    }
-    secs = {
-        "calibration": _seconds(psteps["calibration"], n_cal, workers),
-        "specimens": _seconds(psteps["specimens"], n_spec, workers),
-    }
-    secs["total"] = secs["calibration"] + secs["specimens"]
+    psteps = StageEstimate(
+        calibration=cal.disks * _steps_per_trial(cal_spec, dt, dt_paper) * TRIALS_PER_CASE * n_cal,
+        specimens=full.disks * _steps_per_trial(spec, dt, dt_paper) * TRIALS_PER_CASE * n_spec,
+    )
+    calibration = _seconds(psteps.calibration, n_cal, workers)
+    specimens = _seconds(psteps.specimens, n_spec, workers)
+    secs = StageEstimate(calibration=calibration, specimens=specimens, total=calibration + specimens)
     return Workload(full, cal, dt, dt_paper, psteps, secs)
 
 
@@ -378,7 +399,7 @@ def preflight(case: SandCase, *, workers: int = 2, budget_minutes: float | None 
         seconds=secs,
         workers=workers,
         budget_minutes=budget_minutes,
-        suggestion=budget_suggestion(case, secs["total"], budget_minutes, first, workers),
+        suggestion=budget_suggestion(case, secs.total, budget_minutes, first, workers),
         notes=notes,
     )
 

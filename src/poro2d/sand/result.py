@@ -10,7 +10,7 @@ from __future__ import annotations
 import csv
 import io
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
@@ -68,83 +68,6 @@ class SeedSpecimen(TypedResult):
             folder,
             "" if ok else str(why),
         )
-
-
-@dataclass(eq=False)
-class BoxPlanRecord(TypedResult):
-    """A box of the pre-flight as a file keeps it (:class:`~poro2d.sand.preflight.BoxPlan`): m, disks."""
-
-    width: float
-    height: float
-    layers: int
-    disks: float
-
-
-@dataclass(eq=False)
-class JammingRecord(TypedResult):
-    """The pre-flight's jamming porosity as a file keeps it (:class:`~poro2d.sand.preflight.Jamming`)."""
-
-    porosity: float | None
-    sd: float | None
-    disks: int
-    seeds: int
-    seconds: float
-    note: str
-
-
-@dataclass(eq=False)
-class StageEstimate(TypedResult):
-    """The pre-flight's estimate for the calibration and the specimens (particle steps or s)."""
-
-    calibration: float
-    specimens: float
-    total: float | None = None
-
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("total",)
-
-
-@dataclass(eq=False)
-class PreflightRecord(TypedResult):
-    """A :class:`~poro2d.sand.preflight.Preflight` as ``preflight.json`` and ``sand.json`` keep it."""
-
-    soil: str
-    d_min_m: float
-    d50_m: float
-    d_max_m: float
-    cu: float
-    size_ratio: float
-    upscale: float
-    box: BoxPlanRecord
-    calibration_box: BoxPlanRecord
-    band_over_d_max: float
-    time_step_s: float
-    time_step_paper_s: float
-    jamming: JammingRecord
-    first_trial: float
-    eq12_trial: float
-    cases_calibration: int
-    cases_specimens: int
-    particle_steps: StageEstimate
-    seconds: StageEstimate
-    workers: int
-    budget_minutes: float | None
-    suggestion: str
-    notes: list[str]
-
-    #: the typed parts, as their classes read them
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "box": BoxPlanRecord,
-        "calibration_box": BoxPlanRecord,
-        "jamming": JammingRecord,
-        "particle_steps": StageEstimate,
-        "seconds": StageEstimate,
-    }
-
-    @classmethod
-    def of(cls, pf: Preflight) -> PreflightRecord:
-        """The record of a pre-flight (``preflight.json``'s and ``sand.json``'s): its fields, in
-        their order, the boxes, the jamming porosity and the estimates as their records."""
-        return cls.from_dict(asdict(pf))
 
 
 @dataclass(eq=False)
@@ -217,7 +140,7 @@ class SandResult(TypedResult):
     calibration: SandCalibration
     states: list[AcceptedState]
     seed_results: list[SeedSpecimen]
-    preflight: PreflightRecord
+    preflight: Preflight
     wall_seconds: float
     config: dict[str, Any]
     provenance: Provenance
@@ -232,7 +155,7 @@ class SandResult(TypedResult):
         "state": LabStateRecord,
         "states": AcceptedState,
         "seed_results": SeedSpecimen,
-        "preflight": PreflightRecord,
+        "preflight": Preflight,
         "provenance": Provenance,
         "state_map": StateMapRecord,
     }
@@ -293,7 +216,7 @@ class SandResult(TypedResult):
             calibration=cal_record,
             states=states,
             seed_results=list(kept),
-            preflight=PreflightRecord.of(pf),
+            preflight=pf,
             wall_seconds=seconds,
             config=case.config.as_config(),
             provenance=Provenance.now(),
@@ -368,7 +291,7 @@ def summary_markdown(res: SandResult, store: Store) -> str:
         "| --- | --- |",
         f"| soil | {soil.get('name')} ({soil.get('reference') or 'no reference given'}) |",
         f"| grading | {soil.get('grading_source')}, up-scaled x{soil.get('upscale'):g} |",
-        f"| disks (full box) | {res.preflight['box']['disks']:.0f} |",
+        f"| disks (full box) | {res.preflight.box.disks:.0f} |",
         f"| laboratory state | n = {st['n_lab']:.4f}, e = {st['e']:.4f}"
         + (f", Dr = {dr:.3f}" if dr is not None else "")
         + f" (given as {st['given']}) |",

@@ -32,10 +32,9 @@ from poro2d.interop.origin import SOIL_FILE
 from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import holds_output
 from poro2d.sand.case import ConfigLike, SandCase, load_sand_case
-from poro2d.sand.preflight import Preflight, preflight
+from poro2d.sand.preflight import Preflight, StageEstimate, preflight
 from poro2d.sand.profile import case_runs, stage_profile
 from poro2d.sand.result import (
-    PreflightRecord,
     SandCalibration,
     SandResult,
     SeedSpecimen,
@@ -67,14 +66,14 @@ class StageClock:
     """Elapsed time and an overall ETA across the stages, from the pre-flight's estimate
     corrected by the pace measured so far."""
 
-    def __init__(self, estimate: dict, say: Announce) -> None:
+    def __init__(self, estimate: StageEstimate, say: Announce) -> None:
         self.t0 = time.perf_counter()
-        self.estimate = dict(estimate)
+        self.estimate = {"calibration": estimate.calibration, "specimens": estimate.specimens}
         self.say = say
         self.pace = 1.0  # measured / estimated, from finished stages
 
     def begin(self, what: str) -> float:
-        left = sum(v for k, v in self.estimate.items() if k != "total") * self.pace
+        left = sum(self.estimate.values()) * self.pace
         self.say(f"{what}; elapsed {_clock(self.elapsed())}, about {_clock(left)} left (estimate)")
         return time.perf_counter()
 
@@ -316,7 +315,7 @@ def run_sand(
     store.write_json(
         "preflight.json",
         {
-            "preflight": PreflightRecord.of(pf).to_dict(),
+            "preflight": pf.to_dict(),
             "soil": case.soil_record(),
             "provenance": Provenance.now().to_dict(),
         },
