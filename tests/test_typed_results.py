@@ -31,6 +31,7 @@ from poro2d.criterion.result import (
     ReplicatesResult,
     SpecimenStateResult,
 )
+from poro2d.io_utils import as_json
 from poro2d.measure.specimen_porosity import SpecimenPorosity
 from poro2d.paper import PaperSummary
 from poro2d.sand.result import SandResult
@@ -74,13 +75,13 @@ def test_files_written_before_round_trip(cls, name):
 def test_results_read_as_the_dicts_they_were(cls, name):
     stored = json.loads((DATA / name).read_text())
     result = cls.from_dict(stored)
-    assert result == stored and dict(result) == stored and len(result) == len(stored)
+    assert result.to_dict() == stored and as_json(dict(result)) == stored and len(result) == len(stored)
     for key, value in stored.items():
-        assert result[key] == value and result.get(key) == value and key in result
+        assert as_json(result[key]) == value and as_json(result.get(key)) == value and key in result
     assert "no such key" not in result and result.get("no such key") is None
     with pytest.raises(KeyError):
         result["no such key"]
-    assert pickle.loads(pickle.dumps(result)) == stored  # results cross process pools
+    assert pickle.loads(pickle.dumps(result)).to_dict() == stored  # results cross process pools
 
 
 def test_attributes_are_the_files_keys():
@@ -409,13 +410,13 @@ def test_a_calibrations_per_parameter_values_are_typed_parts():
 
 def test_a_sands_laboratory_state_and_accepted_states_are_typed_parts():
     """``sand.json``'s state (and the soil's), and each accepted specimen's row, are typed parts."""
-    from poro2d.sand.case import LabStateRecord
+    from poro2d.lab_state import LabState
     from poro2d.sand.result import AcceptedState
 
     stored = json.loads((DATA / "sand_result.json").read_text())
     sand = SandResult.from_dict(stored)
-    assert isinstance(sand.state, LabStateRecord) and sand.state.given == "Dr"
-    assert isinstance(sand.soil.lab, LabStateRecord) and sand.soil.lab.n_lab == sand.state.n_lab
+    assert isinstance(sand.state, LabState) and sand.state.given == "Dr"
+    assert isinstance(sand.soil.lab, LabState) and sand.soil.lab.n_lab == sand.state.n_lab
     assert all(isinstance(s, AcceptedState) for s in sand.states) and sand.states[1].seed == 1
     assert json.dumps(sand.to_dict(), indent=2) == json.dumps(stored, indent=2)
 

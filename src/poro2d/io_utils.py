@@ -177,6 +177,8 @@ def _default(o):
         return o.tolist()
     if isinstance(o, Path):
         return str(o)
+    if callable(getattr(o, "to_dict", None)):  # a typed result or record: the dict of its file
+        return o.to_dict()
     raise TypeError(f"not JSON serialisable: {type(o)}")
 
 

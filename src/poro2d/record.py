@@ -79,6 +79,14 @@ class Record:
         """The entries of this record's row: ``ROW`` (a record of two shapes picks one)."""
         return self.ROW or tuple(f.name for f in fields(self))  # type: ignore[arg-type]
 
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]):
+        """A record read back from its row, for a record whose row is every field under its own
+        name (no ``ROW`` of its own); a key the row lacks reads as None."""
+        if cls.ROW:
+            raise TypeError(f"{cls.__name__} writes a row of its own shape: it reads it back itself")
+        return cls(**{f.name: data.get(f.name) for f in fields(cls)})  # type: ignore[arg-type]
+
     def to_dict(self) -> dict[str, Any]:
         """The record's row: its keys in the order of :meth:`layout`, parts as their rows."""
         row: dict[str, Any] = {}

@@ -117,6 +117,8 @@ class TypedResult(Mapping):
     def __post_init__(self) -> None:
         # keys a file read by from_dict lacked: they stay out of to_dict() while unset
         self._absent: frozenset[str] = frozenset()
+        if isinstance(self, Record):  # a row of its own shape (ROW): it writes and reads it itself
+            return
         # every value as its file holds it, typed parts typed, so that a fresh result equals the
         # one read back from its file
         for key in _keys(type(self)):

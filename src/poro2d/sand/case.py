@@ -27,7 +27,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from poro2d.config import check_keys
 from poro2d.criterion.density import DEFAULT_MUS, check_mus
@@ -38,7 +38,7 @@ from poro2d.lab_state import LabState, lab_state_from_table
 from poro2d.specimen.compaction import SpecimenSpec, time_step
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.density import DEFAULT_SEEDS, with_density_defaults
-from poro2d.typed_result import TypedResult, part
+from poro2d.typed_result import TypedResult
 
 #: the tables a sand config adds to a criterion config
 SAND_TABLES = ("soil", "lab", "sand", "state")
@@ -57,18 +57,6 @@ ConfigLike = dict | str | os.PathLike
 
 
 @dataclass(eq=False)
-class LabStateRecord(TypedResult):
-    """A laboratory state as a file keeps it (:meth:`poro2d.lab_state.LabState.to_dict`)."""
-
-    n_lab: float
-    e: float
-    n_max: float | None
-    n_min: float | None
-    relative_density: float | None
-    given: str
-
-
-@dataclass(eq=False)
 class SoilRecord(TypedResult):
     """The soil as every result file names it (``soil`` in ``preflight.json``, ``sand.json`` and
     each kept specimen's ``soil.json``): who it is, its ``[grading]`` table, the grading's source
@@ -79,13 +67,10 @@ class SoilRecord(TypedResult):
     grading: dict[str, Any]
     grading_source: str
     upscale: float
-    lab: LabStateRecord
+    lab: LabState
 
-    @classmethod
-    def from_dict(cls, data) -> SoilRecord:
-        obj = super().from_dict(data)
-        obj.lab = part(LabStateRecord, obj.lab)
-        return obj
+    #: the laboratory state, as its class reads it
+    PARTS: ClassVar[dict[str, type]] = {"lab": LabState}
 
 
 @dataclass(frozen=True)
@@ -129,7 +114,7 @@ class SandCase:
             grading=self.config.table("grading"),
             grading_source=self.grading.source,
             upscale=self.grading.upscale,
-            lab=LabStateRecord.from_dict(self.lab.to_dict()),
+            lab=self.lab,
         )
 
 

@@ -17,7 +17,8 @@ import numpy as np
 
 from poro2d.critical_state.state_table import StateMapRecord, state_map_lines, state_map_record
 from poro2d.io_utils import Provenance
-from poro2d.sand.case import LabStateRecord, SoilRecord
+from poro2d.lab_state import LabState
+from poro2d.sand.case import SoilRecord
 from poro2d.sand.preflight import Preflight
 from poro2d.sand.profile import StageProfile
 from poro2d.store import Store
@@ -121,7 +122,7 @@ class SandResult(TypedResult):
 
     mode: str
     soil: SoilRecord
-    state: LabStateRecord
+    state: LabState
     interior_porosity_mean: float
     interior_porosity_sd: float
     box_porosity_mean: float
@@ -152,7 +153,7 @@ class SandResult(TypedResult):
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "soil": SoilRecord,
         "calibration": SandCalibration,
-        "state": LabStateRecord,
+        "state": LabState,
         "states": AcceptedState,
         "seed_results": SeedSpecimen,
         "preflight": Preflight,
@@ -197,7 +198,7 @@ class SandResult(TypedResult):
         return cls(
             mode="density",
             soil=case.soil_record(),
-            state=LabStateRecord.from_dict(lab.to_dict()),
+            state=lab,
             interior_porosity_mean=inner_m,
             interior_porosity_sd=inner_sd,
             box_porosity_mean=box_m,
