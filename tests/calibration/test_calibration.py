@@ -298,7 +298,6 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
         ({"level": 1.0}, "--level"),
         ({"settings": {"particle_friction": 1.0}}, "settings.particle_friction"),
         ({"settings": {"max_displacement": 0.05}}, "max_displacement"),
-        ({"workers": 0}, "--workers"),
         ({"quick": True}, "--quick"),
         ({"preset": "other"}, "--preset"),
         ({"kn_range": (0.0, 1e6)}, "--kn-range"),
@@ -312,10 +311,15 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
 def test_bad_input_is_refused_before_any_test(tiny, tmp_path, kw, name):
     paths, lab = tiny
     out = tmp_path / "out"
-    args = {"settings": SHORT, "progress": False} | kw
+    args = {"settings": SHORT, "options": QUIET} | kw
     with pytest.raises(InputError, match=name):
         run_calibration(lab, [paths[0]], store=Store(out), **args)
     assert not (out / "result.json").exists() and not (out / "cache").exists()
+
+
+def test_a_bad_worker_count_is_refused_before_the_calibration_is_called():
+    with pytest.raises(InputError, match="--workers"):  # the options check themselves when made
+        RunOptions(workers=0)
 
 
 def _refusal(argv: list[str], capsys) -> str:
