@@ -61,6 +61,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", type=Path, default=None, help="also write the numbers here")
     args = ap.parse_args(argv)
 
+    from poro2d.execute.options import RunOptions
     from poro2d.sand import run_sand
     from poro2d.store import Store
 
@@ -72,8 +73,7 @@ def main(argv: list[str] | None = None) -> int:
     res = run_sand(
         _config(args.config, args.calibration_seeds),
         store=Store(out),
-        workers=args.workers,
-        progress=False,
+        options=RunOptions(workers=args.workers, progress=False),
         announce=lambda line: stages.append((time.perf_counter() - t0, line)),
     )
     wall = time.perf_counter() - t0

@@ -26,6 +26,7 @@ from pathlib import Path
 from poro2d.biaxial.quick import QuickSpecimen
 from poro2d.calibration import run_calibration, synthetic_biaxial_lab
 from poro2d.dem import checkpoint
+from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance
 from poro2d.store import Store
 
@@ -77,7 +78,8 @@ def calibrate(lab: Path, replicates: list[Path], out: Path, mode: str, args) -> 
     result = run_calibration(
         biaxial_lab=str(lab), specimens=[str(p) for p in replicates], store=Store(out),
         fp_range=FP_RANGE, mu_r_range=MU_R_RANGE, points=args.points, refine=0,
-        settings={"max_strain": args.strain}, workers=args.workers, progress=False, discrepancy=mode,
+        settings={"max_strain": args.strain}, options=RunOptions(workers=args.workers, progress=False),
+        discrepancy=mode,
     )  # fmt: skip
     fp, mu_r = result.intervals["particle_friction"], result.intervals["rolling_friction"]
     term = result.posterior.get("discrepancy")

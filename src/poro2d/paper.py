@@ -18,6 +18,7 @@ from poro2d.console import OutputConsole
 from poro2d.criterion.config import paper_config
 from poro2d.criterion.replicates import accepted_and_replicates
 from poro2d.criterion.result import CriterionResult, ReplicateRow
+from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance
 from poro2d.locks import holds_output
 from poro2d.paper_data import PAPER, QUICK_SHEAR
@@ -216,10 +217,11 @@ def run_paper(
     seed: int = 0,
     threads: int | None = None,
     replicates: int = 3,
-    progress: bool = True,
+    options: RunOptions = RunOptions(),
 ) -> PaperSummary:
     """The paper's case study: conversions, the criterion (Fig. 3), direct shear on replicate
-    specimens (Fig. 8), the report. Resumable: finished stages are read back.
+    specimens (Fig. 8), the report. Resumable: finished stages are read back. ``options``: whether
+    bars show (:class:`~poro2d.execute.options.RunOptions`).
 
     Returns the summary kept as the store's ``results.json``; ``summary.criterion.converged``
     says whether the criterion found its porosity (no shear tests otherwise).
@@ -243,12 +245,12 @@ def run_paper(
     nthreads = threads if threads is not None else min(os.cpu_count() or 1, 2)
     spec, grading, settings, sd = cfg.build(threads=nthreads)
     crit = PorosityCriterion(spec, grading, settings, seed=sd, store=store.child("criterion"),
-                             progress=progress, config=cfg.as_config())  # fmt: skip
+                             progress=options.progress, config=cfg.as_config())  # fmt: skip
     crit.validate()  # every option is checked before the first file is written
     stage = paper_stage(store, quick, seed)
     stage.check()  # and the folder: one of another paper run is refused before anything is written
     summary, criterion, shear_figures = _run_stages(store, stage, crit, quick=quick, replicates=replicates,
-                                                    lab_data=lab_data, progress=progress)  # fmt: skip
+                                                    lab_data=lab_data, progress=options.progress)  # fmt: skip
     store.write_result("results.json", summary)
     from poro2d.calibration.run import CalibrationResult
     from poro2d.report.paper_report import CALIBRATION_FOLDER, write_paper_report
@@ -333,7 +335,7 @@ def _shear_stage(specimens: SpecimenSet, store: Store, quick: bool, lab_data,
     )
     sset = ShearSettings(**(QUICK_SHEAR if quick else {}))
     rep = ReplicateShear(specimens, NORMAL_STRESSES_KPA, sset, store=store, lab=lab_data,
-                         progress=progress).run()  # fmt: skip
+                         options=RunOptions(progress=progress)).run()  # fmt: skip
     first_label, first = next(iter(rep.series.items()))
     fit = rep.fit or {}
     ci = fit.get("friction_angle_ci_deg")

@@ -24,7 +24,11 @@ from poro2d.calibration.units import (
 )
 from poro2d.cli import main
 from poro2d.errors import InputError
+from poro2d.execute.options import RunOptions
 from poro2d.store import Store
+
+QUIET = RunOptions(progress=False)
+ONE_WORKER = RunOptions(workers=1, dashboard=None, progress=False)
 
 E1 = np.linspace(0.0, 0.10, 101)  # a reading every 0.1 % of axial strain
 RATIO = 0.5 * E1 / (0.01 + E1) + 0.1 * np.exp(-(((E1 - 0.03) / 0.01) ** 2))  # a peak near 3 %
@@ -175,7 +179,7 @@ def test_a_biaxial_units_key_is_stable_and_never_a_shear_key():
 
 def _refused(**kw):
     with pytest.raises(InputError) as exc:
-        run_calibration(progress=False, **kw)
+        run_calibration(options=QUIET, **kw)
     return str(exc.value)
 
 
@@ -292,8 +296,7 @@ def test_a_small_synthetic_biaxial_calibration_fits_the_ratios_and_the_volumetri
         and "confining_stress_kpa,axial_strain,stress_ratio,volumetric_strain" in text
     )
     out = tmp_path / "cal"
-    kw = dict(specimens=paths[:2], store=Store(out), points=9, refine=0, settings=FAST, workers=1,
-              dashboard=None, progress=False)  # fmt: skip
+    kw = dict(specimens=paths[:2], store=Store(out), points=9, refine=0, settings=FAST, options=ONE_WORKER)
     res = run_calibration(biaxial_lab=lab, **kw)
     assert res.test == "biaxial" and res.cluster.tests_run == 9 * 2 and res.box_scale is None
     assert list(res.fit) == ["peak_ratio_50kPa", "end_ratio_50kPa", "end_volumetric_50kPa"]

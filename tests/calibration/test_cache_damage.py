@@ -9,7 +9,7 @@ from poro2d.calibration.cluster import UnitRunner
 from poro2d.calibration.run import _base_settings
 from poro2d.calibration.units import CalibrationUnit, UnitRow, check_entry
 from poro2d.errors import InputError
-from poro2d.execute import Backend, Executor
+from poro2d.execute import Backend, Executor, RunOptions
 from poro2d.store import Store
 
 BASE = _base_settings({"max_displacement": 0.002})
@@ -72,7 +72,7 @@ def _runner(monkeypatch, error: BaseException | None) -> UnitRunner:
         return UnitRow(unit.key, unit.sigma, unit.fp, unit.mu_r, unit.specimen, 40.0, 30.0, 1.0)
 
     monkeypatch.setattr(cluster, "compute_unit", compute)
-    runner = UnitRunner(None, 1, progress=False, dashboard=None)
+    runner = UnitRunner(RunOptions(workers=1, dashboard=None, progress=False))
     runner.executor = Executor(Backend("inline"))
     return runner
 

@@ -14,9 +14,13 @@ from poro2d.cli import main
 from poro2d.cli.shear import load_shear_config
 from poro2d.dem import checkpoint
 from poro2d.errors import InputError
+from poro2d.execute.options import RunOptions
 from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
 from poro2d.store import Store
+
+QUIET = RunOptions(progress=False)
+ONE_WORKER = RunOptions(workers=1, dashboard=None, progress=False)
 
 RANGES = model.Ranges((0.3, 3.0), (0.0, 0.5))
 
@@ -134,7 +138,7 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     assert lab.read_text().startswith("# SYNTHETIC")
     out = tmp_path / "cal"
     res = run_calibration(lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2, settings=SHORT,
-                          workers=1, dashboard=None, progress=False, **FIT_BOX)  # fmt: skip
+                          options=ONE_WORKER, **FIT_BOX)  # fmt: skip
     for name, value in TRUTH.items():
         lo, hi = res.intervals[name]
         assert lo <= value <= hi, (name, value, lo, hi)
@@ -161,16 +165,15 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     assert table["particle_friction"] == res.best["particle_friction"]
     assert table["rolling_friction"] == res.best["rolling_friction"]
     again = run_calibration(lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2, settings=SHORT,
-                            workers=1, dashboard=None, progress=False, **FIT_BOX)  # fmt: skip
+                            options=ONE_WORKER, **FIT_BOX)  # fmt: skip
     assert again.cluster.tests_run == 0 and again.cluster.tests_reused == 44
     assert again.best == res.best
     # the same series given twice is two repeats that agree: their mean is the same values, the
     # laboratory's share of the noise halves, so the intervals narrow (from the cache, no test)
     twice = run_calibration([lab, lab], [paths[0], paths[1]], store=Store(tmp_path / "twice"), points=9,
-                            refine=0, settings=SHORT, workers=1, dashboard=None, progress=False,
-                            **FIT_BOX)  # fmt: skip
+                            refine=0, settings=SHORT, options=ONE_WORKER, **FIT_BOX)  # fmt: skip
     once = run_calibration(lab, [paths[0], paths[1]], store=Store(tmp_path / "once"), points=9, refine=0,
-                           settings=SHORT, workers=1, dashboard=None, progress=False, **FIT_BOX)  # fmt: skip
+                           settings=SHORT, options=ONE_WORKER, **FIT_BOX)  # fmt: skip
     assert twice.posterior["lab_repeats"] == 2 and twice.posterior["lab_scatter_ratio"] == 0.0
     assert "lab_repeats" not in once.posterior.to_dict()
     assert [o["lab_kpa"] for o in twice.posterior["observables"]] == [
@@ -184,7 +187,7 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     weak_lab = synthetic_lab(paths[2], [50, 100], 0.3, 0.0, tmp_path / "weak_dilation.csv", settings=SHORT)
     weak_lab = _without_vertical(weak_lab, tmp_path / "weak.csv")
     weak = run_calibration(weak_lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2,
-                           settings=SHORT, workers=1, dashboard=None, progress=False, **FIT_BOX)  # fmt: skip
+                           settings=SHORT, options=ONE_WORKER, **FIT_BOX)  # fmt: skip
     peaks = {
         o["normal_stress_kpa"]: o["model_kpa"]
         for o in res.posterior["observables"]
@@ -235,9 +238,7 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
         points=9,
         refine=0,
         settings=SHORT,
-        workers=1,
-        dashboard=None,
-        progress=False,
+        options=ONE_WORKER,
         **FIT_BOX,
     )
     res = run_calibration(lab, [paths[0], paths[1]], **kw)
@@ -297,7 +298,6 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
         ({"level": 1.0}, "--level"),
         ({"settings": {"particle_friction": 1.0}}, "settings.particle_friction"),
         ({"settings": {"max_displacement": 0.05}}, "max_displacement"),
-        ({"workers": 0}, "--workers"),
         ({"quick": True}, "--quick"),
         ({"preset": "other"}, "--preset"),
         ({"kn_range": (0.0, 1e6)}, "--kn-range"),
@@ -311,10 +311,15 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
 def test_bad_input_is_refused_before_any_test(tiny, tmp_path, kw, name):
     paths, lab = tiny
     out = tmp_path / "out"
-    args = {"settings": SHORT, "progress": False} | kw
+    args = {"settings": SHORT, "options": QUIET} | kw
     with pytest.raises(InputError, match=name):
         run_calibration(lab, [paths[0]], store=Store(out), **args)
     assert not (out / "result.json").exists() and not (out / "cache").exists()
+
+
+def test_a_bad_worker_count_is_refused_before_the_calibration_is_called():
+    with pytest.raises(InputError, match="--workers"):  # the options check themselves when made
+        RunOptions(workers=0)
 
 
 def _refusal(argv: list[str], capsys) -> str:
@@ -377,7 +382,7 @@ def test_lab_curves_shorter_than_the_tests_are_refused_and_their_end_is_the_last
     short.write_text("normal_stress_kpa,shear_displacement_mm,shear_stress_kpa\n"
                      "50,0.2,10\n50,0.4,20\n50,0.6,25\n50,0.8,28\n50,1.0,30\n")  # fmt: skip
     with pytest.raises(InputError, match="settings.max_displacement"):
-        run_calibration(short, [paths[0]], store=Store(tmp_path / "o"), settings=SHORT, progress=False)
+        run_calibration(short, [paths[0]], store=Store(tmp_path / "o"), settings=SHORT, options=QUIET)
     assert not (tmp_path / "o" / "cache").exists()
     curves = tmp_path / "curves.csv"
     curves.write_text("normal_stress_kpa,shear_displacement_mm,shear_stress_kpa\n"
@@ -410,7 +415,7 @@ def test_a_units_identity_is_the_digest_its_cache_folder_was_named_by():
 def test_the_preset_needs_a_store_to_keep_its_specimens(tiny):
     _, lab = tiny
     with pytest.raises(InputError, match="store"):
-        run_calibration(lab, preset="paper", quick=True, store=None, progress=False)
+        run_calibration(lab, preset="paper", quick=True, store=None, options=QUIET)
 
 
 def test_a_laboratory_poro2d_did_not_write_gets_the_discrepancy_term(tiny, tmp_path):
@@ -421,8 +426,8 @@ def test_a_laboratory_poro2d_did_not_write_gets_the_discrepancy_term(tiny, tmp_p
     paths, lab = tiny
     real = tmp_path / "real.csv"
     real.write_text("".join(ln for ln in lab.read_text().splitlines(keepends=True) if not ln.startswith("#")))
-    kw = dict(store=Store(tmp_path / "cal"), points=9, refine=0, settings=SHORT, workers=1, dashboard=None,
-              progress=False, **FIT_BOX)  # fmt: skip
+    kw = dict(store=Store(tmp_path / "cal"), points=9, refine=0, settings=SHORT, options=ONE_WORKER,
+              **FIT_BOX)  # fmt: skip
     own = run_calibration(lab, [paths[0], paths[1]], **kw)
     other = run_calibration(real, [paths[0], paths[1]], **kw)  # the same tests, from the cache
     assert other.cluster.tests_run == 0

@@ -18,8 +18,12 @@ from poro2d.calibration.units import CalibrationUnit, UnitRow
 from poro2d.cli.calibrate import print_result
 from poro2d.dem import checkpoint
 from poro2d.errors import InputError
+from poro2d.execute.options import RunOptions
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
+
+QUIET = RunOptions(progress=False)
+ONE_WORKER = RunOptions(workers=1, dashboard=None, progress=False)
 
 SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4, "record_interval": 5e-5}
 LAB = "normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,75\n"
@@ -43,7 +47,7 @@ def test_a_design_that_fits_the_surrogate_exactly_is_refused_before_any_test(spe
     out = tmp_path / "out"
     with pytest.raises(InputError, match="--points"):
         run_calibration(
-            lab, [specimen, other], store=Store(out), points=points, settings=SHORT, progress=False
+            lab, [specimen, other], store=Store(out), points=points, settings=SHORT, options=QUIET
         )
     assert not (out / "cache").exists()
 
@@ -53,7 +57,7 @@ def test_twin_specimens_are_refused_naming_the_twin(specimen, lab, tmp_path):
     shutil.copyfile(specimen, twin)  # another file, the same content
     out = tmp_path / "out"
     with pytest.raises(InputError, match="twin") as exc:
-        run_calibration(lab, [specimen, twin], store=Store(out), settings=SHORT, progress=False)
+        run_calibration(lab, [specimen, twin], store=Store(out), settings=SHORT, options=QUIET)
     assert "twin.npz" in str(exc.value) and len(str(exc.value).splitlines()) == 1
     assert not (out / "cache").exists()
 
@@ -65,7 +69,7 @@ def test_replicates_of_another_grading_are_refused(specimen, lab, tmp_path):
     checkpoint.save(sim, coarse)
     out = tmp_path / "out"
     with pytest.raises(InputError, match="another grading") as exc:
-        run_calibration(lab, [specimen, coarse], store=Store(out), settings=SHORT, progress=False)
+        run_calibration(lab, [specimen, coarse], store=Store(out), settings=SHORT, options=QUIET)
     assert "coarse.npz" in str(exc.value)
     assert not (out / "cache").exists()
 
@@ -145,7 +149,7 @@ def test_the_table_reads_each_units_row_in_the_units_order():
 def test_one_specimen_reports_its_intervals_as_unknown(specimen, lab, tmp_path, capsys):
     out = tmp_path / "out"
     res = run_calibration(lab, [specimen], store=Store(out), points=MIN_POINTS, refine=0, settings=SHORT,
-                          workers=1, dashboard=None, progress=False, keep_box_dominated=True)  # fmt: skip
+                          options=ONE_WORKER, keep_box_dominated=True)  # fmt: skip
     assert "one specimen" in res.unidentified
     assert res.intervals == {"particle_friction": None, "rolling_friction": None}
     assert res.posterior["wide"] == {"particle_friction": None, "rolling_friction": None}

@@ -13,9 +13,12 @@ from poro2d.calibration import run_calibration, synthetic_lab
 from poro2d.calibration.run import CalibrationResult
 from poro2d.cli.shear import load_shear_config
 from poro2d.dem import checkpoint
+from poro2d.execute.options import RunOptions
 from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
 from poro2d.store import Store
+
+ONE_WORKER = RunOptions(workers=1, dashboard=None, progress=False)
 
 SHORT = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4, "record_interval": 5e-5}
 #: the synthetic laboratory's truth: Table 1's disks are 4e5 N/m in both directions
@@ -49,7 +52,7 @@ def test_four_parameters_recover_a_known_truth_within_their_intervals(stiff_lab,
     specimens, lab = stiff_lab
     out = tmp_path / "cal"
     kw = dict(points=18, refine=4, settings=SHORT, stations=4, kn_range=KN_RANGE, ks_range=KS_RANGE,
-              workers=1, dashboard=None, progress=False, keep_box_dominated=True)  # fmt: skip
+              options=ONE_WORKER, keep_box_dominated=True)  # fmt: skip
     res = run_calibration(lab, specimens, store=Store(out), **kw)
     for name, value in TRUTH.items():
         lo, hi = res.intervals[name]

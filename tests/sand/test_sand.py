@@ -9,11 +9,14 @@ import pytest
 
 from poro2d.criterion.density import Calibration
 from poro2d.errors import InputError
+from poro2d.execute.options import RunOptions
 from poro2d.grading import paper_grading
 from poro2d.sand import load_sand_case
 from poro2d.sand import preflight as PF
 from poro2d.sand.run import bracket, full_box_trial, predicted_mu
 from poro2d.specimen.compaction import SpecimenSpec, estimate_size
+
+QUIET = RunOptions(progress=False)
 
 LAB = {"e_max": 0.977, "e_min": 0.597, "dr": 0.5}
 
@@ -192,7 +195,7 @@ def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
     res = run_sand(
         TINY,
         store=Store(out),
-        progress=False,
+        options=QUIET,
         announce=lines.append,
         on_preflight=lambda c, p: seen.append(p),
     )
@@ -229,13 +232,13 @@ def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
         .startswith("soil,upscale,disks,n_lab,e,Dr,mu_prep,interior_porosity")
     )
     # a rerun reads every finished case back: the same numbers
-    again = run_sand(TINY, store=Store(out), progress=False)
+    again = run_sand(TINY, store=Store(out), options=QUIET)
     assert again.box_porosity_mean == res.box_porosity_mean
     assert [k.box_porosity for k in again.specimens] == [k.box_porosity for k in res.specimens]
     assert again.mu_prep == res.mu_prep
     assert res.state_map is None and "state_map" not in data
     # a [state] table added afterwards reads the same run back and adds the state parameter only
-    stated = run_sand({**TINY, "state": {"lab_line": "toyoura"}}, store=Store(out), progress=False)
+    stated = run_sand({**TINY, "state": {"lab_line": "toyoura"}}, store=Store(out), options=QUIET)
     assert stated.box_porosity_mean == res.box_porosity_mean and stated.n2d_target == res.n2d_target
     rec = stated.state_map
     assert rec.e2d_by_state is None and "poro2d critical-state" in rec.note

@@ -5,6 +5,9 @@ import json
 import pytest
 
 from poro2d.cli import main
+from poro2d.execute.options import RunOptions
+
+QUIET = RunOptions(progress=False)
 
 # a box this small cannot rest the lid of the fill acceptance (its window is the weight of
 # one grain): the paper's plate, as the quick look uses
@@ -38,7 +41,7 @@ def test_density_mode_of_the_criterion(tmp_path, monkeypatch):
     from poro2d.sweep.density_criterion import run_density_criterion
     from poro2d.sweep.results import DensityStateResult
 
-    again = run_density_criterion(cfg, store=Store(out), n_lab=0.40, progress=False)
+    again = run_density_criterion(cfg, store=Store(out), n_lab=0.40, options=QUIET)
     assert isinstance(again, DensityStateResult) and again.n_lab == 0.40
     assert again.final_porosity_per_seed == res["final_porosity_per_seed"] and again.mu_prep == res["mu_prep"]
     assert as_json(again.to_dict()) == json.loads((out / "density.json").read_text())  # NaN: null

@@ -5,9 +5,12 @@ import pytest
 from poro2d.criterion import run_criterion
 from poro2d.criterion.result import CriterionResult
 from poro2d.errors import InputError
+from poro2d.execute.options import RunOptions
 from poro2d.store import Store
 from poro2d.sweep.density_criterion import run_criterion_modes, run_density_criterion
 from poro2d.sweep.relation import run_relation
+
+QUIET = RunOptions(progress=False)
 
 SMALL = {
     "seed": 0,
@@ -31,7 +34,7 @@ def test_run_criterion_refuses_bad_input_before_writing(tmp_path, run, kw, name)
     kw = {"config": SMALL, **kw}
     where = {"store": Store(out)}
     with pytest.raises(InputError) as e:
-        run(kw.pop("config"), progress=False, **where, **kw)
+        run(kw.pop("config"), options=QUIET, **where, **kw)
     assert e.value.parameter == name
     assert not out.exists()
 
@@ -42,7 +45,7 @@ def test_run_criterion_matches_the_command(tmp_path):
 
     from poro2d.cli import main
 
-    res = run_criterion(SMALL, store=Store(tmp_path / "api"), progress=False)
+    res = run_criterion(SMALL, store=Store(tmp_path / "api"), options=QUIET)
     assert isinstance(res, CriterionResult)
     cfg = tmp_path / "c.toml"
     cfg.write_text(
@@ -60,6 +63,6 @@ def test_run_criterion_matches_the_command(tmp_path):
 def test_run_relation_refuses_bad_input_before_writing(tmp_path, kw, name):
     out = tmp_path / "o"
     with pytest.raises(InputError) as e:
-        run_relation(None, store=Store(out), quick=True, progress=False, **kw)
+        run_relation(None, store=Store(out), quick=True, options=QUIET, **kw)
     assert name in e.value.parameter
     assert not out.exists()

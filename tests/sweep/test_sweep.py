@@ -12,8 +12,11 @@ import pytest
 from poro2d.cli import main
 from poro2d.errors import InputError
 from poro2d.execute.dask_cluster import SINGLE_THREAD_ENV
+from poro2d.execute.options import RunOptions
 from poro2d.store import Store
 from poro2d.sweep import SweepResult, parse_sweep, register_kind, run_sweep
+
+QUIET = RunOptions(progress=False)
 
 TINY = {"width": 0.05, "height": 0.025, "layers": 2}
 # one trial and a short plate servo: each case takes about a second of DEM
@@ -67,7 +70,7 @@ def test_criterion_sweep_uses_both_workers_and_rerun_skips(client, tmp_path):
     sweep = parse_sweep(cfg)
     assert len(sweep.cases) == 8 and sweep.axes == ["criterion.n_lab", "specimen.friction_particle"]
     t0 = time.perf_counter()
-    res = run_sweep(sweep, Store(tmp_path), client=client, progress=False)
+    res = run_sweep(sweep, Store(tmp_path), client=client, options=QUIET)
     wall = time.perf_counter() - t0
     assert [r["status"] for r in res.rows] == ["done"] * 8, [r.get("error") for r in res.rows]
     # the result is sweep.json's content, typed, with the rows and the table beside the file
@@ -109,7 +112,7 @@ def test_criterion_sweep_uses_both_workers_and_rerun_skips(client, tmp_path):
     )
 
     stamps = {c.id: (tmp_path / "cases" / c.id / "result.json").stat().st_mtime_ns for c in sweep.cases}
-    again = run_sweep(parse_sweep(cfg), Store(tmp_path), client=client, progress=False)
+    again = run_sweep(parse_sweep(cfg), Store(tmp_path), client=client, options=QUIET)
     assert again.summary["ran"] == 0 and again.summary["reused"] == 8
     assert all(r["reused"] for r in again.rows)
     for c in sweep.cases:
@@ -132,7 +135,7 @@ def test_killed_worker_does_not_lose_the_sweep(client, tmp_path):
             ],
         }
     }
-    res = run_sweep(parse_sweep(cfg), Store(tmp_path / "out"), client=client, progress=False)
+    res = run_sweep(parse_sweep(cfg), Store(tmp_path / "out"), client=client, options=QUIET)
     assert marker.is_file()  # the worker really died once
     assert [r["status"] for r in res.rows] == ["done"] * 4
     killed = res.rows[1]
@@ -143,11 +146,11 @@ def test_killed_worker_does_not_lose_the_sweep(client, tmp_path):
 
 def test_interrupted_sweep_rerun_skips_finished_cases(client, tmp_path):
     out = tmp_path / "out"
-    first = run_sweep(parse_sweep(probe_cfg([1, 2])), Store(out), client=client, progress=False)
+    first = run_sweep(parse_sweep(probe_cfg([1, 2])), Store(out), client=client, options=QUIET)
     assert first.summary["ran"] == 2
     # the "interrupted" sweep finished two of four cases; the rerun runs only the rest
     full = parse_sweep(probe_cfg([1, 2, 3, 4]))
-    res = run_sweep(full, Store(out), client=client, progress=False)
+    res = run_sweep(full, Store(out), client=client, options=QUIET)
     assert res.summary["reused"] == 2 and res.summary["ran"] == 2
     assert [r["reused"] for r in res.rows] == [True, True, False, False]
     for c in full.cases:  # every case ran exactly once
@@ -168,7 +171,7 @@ def test_failing_case_is_reported_and_others_finish(client, tmp_path):
         }
     }
     sweep = parse_sweep(cfg)
-    res = run_sweep(sweep, Store(tmp_path), client=client, progress=False)
+    res = run_sweep(sweep, Store(tmp_path), client=client, options=QUIET)
     assert [r["status"] for r in res.rows] == ["done", "failed", "done"]
     bad = tmp_path / "cases" / sweep.cases[1].id
     assert "RuntimeError: probe failure x=2" in (bad / "error.txt").read_text()
@@ -178,7 +181,7 @@ def test_failing_case_is_reported_and_others_finish(client, tmp_path):
     assert df["status"].tolist() == ["done", "failed", "done"]
     assert df["error"].isna().tolist() == [True, False, True]
     assert "probe failure" in df["error"][1]
-    rerun = run_sweep(sweep, Store(tmp_path), client=client, progress=False)
+    rerun = run_sweep(sweep, Store(tmp_path), client=client, options=QUIET)
     assert rerun.summary["reused"] == 2 and rerun.summary["ran"] == 1 and rerun.summary["failed"] == 1
 
 

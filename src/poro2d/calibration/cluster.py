@@ -1,8 +1,8 @@
 """The calibration's shear tests on the executor's Dask backend: one job per unit, the cluster started once.
 
 The cluster is a LocalCluster of ``workers`` single-threaded processes, or a running
-scheduler at ``scheduler`` (:mod:`poro2d.execute`); it starts at the first unit that is
-not cached and serves both rounds.
+scheduler at ``scheduler`` (:class:`~poro2d.execute.options.RunOptions`); it starts at the first
+unit that is not cached and serves both rounds.
 """
 
 from __future__ import annotations
@@ -11,8 +11,8 @@ import time
 from dataclasses import dataclass
 
 from poro2d.calibration.units import CalibrationUnit, UnitRow, compute_unit
-from poro2d.execute import Backend, Executor, Failed, Job
-from poro2d.execute.cluster_options import DEFAULT_DASHBOARD
+from poro2d.execute import Executor, Failed, Job
+from poro2d.execute.options import RunOptions
 from poro2d.store import Store
 from poro2d.typed_result import TypedResult
 
@@ -45,18 +45,12 @@ class ClusterRecord(TypedResult):
 
 
 class UnitRunner:
-    """Runs units on a Dask cluster started at the first unit that is not cached."""
+    """Runs units on a Dask cluster started at the first unit that is not cached; ``options``: where
+    the jobs run and whether bars show (:class:`~poro2d.execute.options.RunOptions`)."""
 
-    def __init__(
-        self,
-        scheduler: str | None,
-        workers: int | None,
-        *,
-        progress: bool,
-        dashboard: str | None = DEFAULT_DASHBOARD,
-    ) -> None:
-        self.scheduler, self.workers, self.progress, self.dashboard = scheduler, workers, progress, dashboard
-        self.executor = Executor(Backend.dask(scheduler, workers, dashboard=dashboard))
+    def __init__(self, options: RunOptions) -> None:
+        self.options = options
+        self.executor = Executor(options.dask_backend())
         self.failures: list[UnitFailure] = []
         self.what = "shear tests"  # the kind of the units run last (their WHAT)
         self.broken: set[str] = set()  # keys of units that failed for another reason than their test
@@ -81,7 +75,8 @@ class UnitRunner:
         done_before = f" ({cached} of {len(units)} cached)" if cached else ""
         try:
             self.what = units[0].WHAT  # shear or biaxial tests: one kind per calibration
-            with CountProgress(label + done_before, len(todo), self.what, enabled=self.progress) as bar:
+            bars = self.options.progress
+            with CountProgress(label + done_before, len(todo), self.what, enabled=bars) as bar:
 
                 def ended(index: int, outcome) -> None:
                     rows[todo[index]] = self._take(units[todo[index]], outcome)
@@ -143,7 +138,7 @@ class UnitRunner:
         """What is recorded of the cluster and the work: workers, tests run and reused, times."""
         cluster = self.executor.cluster_info()  # None: not a Dask cluster (inline, one worker)
         return ClusterRecord(
-            scheduler=self.scheduler,
+            scheduler=self.options.scheduler,
             workers=None if cluster is None else cluster.workers,
             local_cluster=False if cluster is None else cluster.local_cluster,
             tests_run=self.ran,

@@ -51,8 +51,8 @@ from poro2d.calibration.specimens import (
 )
 from poro2d.calibration.units import CACHE, UnitRow, observable_unit, station, window_mean
 from poro2d.errors import InputError, check_int, check_range, is_number
-from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
 from poro2d.execute.dask_cluster import check_reachable
+from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import holds_output
 from poro2d.paper_data import QUICK_SHEAR
@@ -464,10 +464,7 @@ def run_calibration(
     level: float = 0.95,
     stations: int = 1,
     settings: dict | None = None,
-    scheduler: str | None = None,
-    workers: int | None = None,
-    dashboard: str | None = DEFAULT_DASHBOARD,
-    progress: bool = True,
+    options: RunOptions = RunOptions(),
     config: dict | None = None,
     keep_box_dominated: bool = False,
     discrepancy: str | float = "auto",
@@ -485,7 +482,8 @@ def run_calibration(
     credible intervals. ``stations``: with laboratory curves, each curve is also read (shear stress,
     and the plate's rise when given) at ``stations`` - 1 evenly spaced displacements before its end
     (1: peaks, end values and dilation only). ``settings``: shear settings of every test (the quick preset's
-    ``max_displacement`` 4 mm by default). ``scheduler``/``workers``/``dashboard``: as the sweeps.
+    ``max_displacement`` 4 mm by default). ``options``: where the jobs run and whether bars show
+    (:class:`~poro2d.execute.options.RunOptions`, as the sweeps).
     A rerun reuses every finished shear test (cached by content in the store's ``cache``);
     ``store=None`` keeps nothing (every test runs, no figure or report is made).
 
@@ -561,20 +559,19 @@ def run_calibration(
         targets, lab_series = mean_targets([_lab_targets(x, base, stations) for x in repeats.series])
     check_enough_lab_values(lab_data.source, targets, ranges.dim)
     check_noise_dof(points, len(given) if given is not None else replicates, len(targets))
-    check_cluster_options(scheduler, workers)
-    check_reachable(scheduler)
+    check_reachable(options.scheduler)
 
     found = (
         given
         if given is not None
         else preset_specimens(
-            store.child("specimens"), quick=quick, seed=seed, replicates=replicates, progress=progress
+            store.child("specimens"), quick=quick, seed=seed, replicates=replicates, progress=options.progress
         ).read()
     )
     check_replicates(found)
     if biaxial:
         check_quasi_static(found, lab_data.confining_stresses(), base)
-    runner = UnitRunner(scheduler, workers, progress=progress, dashboard=dashboard)
+    runner = UnitRunner(options)
     stresses = lab_data.confining_stresses() if biaxial else lab_data.normal_stresses()
     make = biaxial_unit if biaxial else replicate_unit
     cache = _child(store, CACHE)

@@ -13,6 +13,7 @@ import numpy as np
 
 from poro2d.calibration.units import CalibrationUnit
 from poro2d.errors import InputError, check_int
+from poro2d.execute.options import RunOptions
 from poro2d.specimen.saved import Specimen
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
@@ -128,8 +129,7 @@ def preset_specimens(store: Store, *, quick: bool, seed: int, replicates: int, p
             result.final_porosity,
             extra,
             store.child("replicates"),
-            processes=spec.threads,
-            progress=progress,
+            options=RunOptions(workers=spec.threads, progress=progress),
         )
         specimens += more.specimens
     return specimens

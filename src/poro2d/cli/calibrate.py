@@ -103,7 +103,7 @@ def register(app: typer.Typer) -> None:
         """Calibrate particle friction f_p and rolling friction mu_r against laboratory direct shear or
         biaxial tests."""
         from poro2d.calibration.run import DEFAULT_FP_RANGE, DEFAULT_MU_R_RANGE, run_calibration
-        from poro2d.execute.cluster_options import check_dashboard
+        from poro2d.cli.dask_options import job_options
         from poro2d.store import Store
 
         settings = test_settings(bool(biaxial_lab), max_displacement, max_strain)
@@ -145,10 +145,7 @@ def register(app: typer.Typer) -> None:
                 level=level,
                 stations=stations,
                 settings=settings,
-                scheduler=scheduler,
-                workers=workers,
-                dashboard=check_dashboard(dashboard),
-                progress=not quiet,
+                options=job_options(workers, scheduler, quiet, dashboard),
                 config={"cli": options},
                 keep_box_dominated=keep_box_dominated,
                 discrepancy=discrepancy,

@@ -55,11 +55,13 @@ def register(app: typer.Typer) -> None:
         grading (preparation friction -> accepted n2D, cached), sets the preparation friction
         from the laboratory relative density and runs the criterion over seeds.
         """
+        from poro2d.execute.options import RunOptions
         from poro2d.sweep.density_criterion import run_criterion_modes
 
         result = run_criterion_modes(
             config, preset=preset, store=Store(out), seed=seed, n_lab=n_lab, trial_porosity=trial,
-            threads=threads, mode=mode, n_max=n_max, n_min=n_min, seeds=seeds, progress=not quiet,
+            threads=threads, mode=mode, n_max=n_max, n_min=n_min, seeds=seeds,
+            options=RunOptions(progress=not quiet),
         )  # fmt: skip
         if isinstance(result, DensityStateResult):
             print_density(result, out)

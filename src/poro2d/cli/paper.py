@@ -6,6 +6,7 @@ from pathlib import Path
 
 import typer
 
+from poro2d.execute.options import RunOptions
 from poro2d.paper import run_paper
 from poro2d.store import Store
 
@@ -29,6 +30,6 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Run the paper's case study: conversions, criterion (Fig. 3), direct shear (Fig. 8), report."""
         summary = run_paper(Store(out), quick=quick, lab=lab, seed=seed, threads=threads,
-                            replicates=replicates, progress=not quiet)  # fmt: skip
+                            replicates=replicates, options=RunOptions(progress=not quiet))  # fmt: skip
         if not summary.criterion.converged:
             raise typer.Exit(1)

@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 from rich.markup import escape
 
-from poro2d.cli.dask_options import DASHBOARD_HELP, SCHEDULER_HELP, WORKERS_HELP
+from poro2d.cli.dask_options import DASHBOARD_HELP, SCHEDULER_HELP, WORKERS_HELP, job_options
 from poro2d.console import OutputConsole, Table
 
 console = OutputConsole()
@@ -49,8 +49,8 @@ def relation_cmd(
 
     rel = run_relation(
         config, preset=preset, store=Store(out), points=points, n_max=n_max, n_min=n_min, mode=mode,
-        seeds=seeds, quick=quick, scheduler=scheduler, workers=workers, progress=not quiet,
-        dashboard=dashboard, announce=banner,
+        seeds=seeds, quick=quick, options=job_options(workers, scheduler, quiet, dashboard),
+        announce=banner,
     )  # fmt: skip
     print_relation(rel, out)
     if rel.failed_cases:

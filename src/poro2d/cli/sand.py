@@ -147,6 +147,7 @@ def sand_cmd(
     density: a pre-flight (disks, time step, jamming porosity, run time), a calibration in a
     small box, specimens at full size, and the interior porosity to use in other codes.
     """
+    from poro2d.execute.options import RunOptions
     from poro2d.sand.run import check_soil, run_sand
     from poro2d.store import Store
 
@@ -159,9 +160,7 @@ def sand_cmd(
         store=Store(out),
         seeds=seeds,
         budget_minutes=budget,
-        workers=workers,
-        scheduler=scheduler,
-        progress=not quiet,
+        options=RunOptions(workers, scheduler, progress=not quiet),
         announce=lambda line: console.print(escape(line), soft_wrap=True),
         on_preflight=print_preflight,
     )

@@ -37,28 +37,25 @@ def register(app: typer.Typer) -> None:
         """Why the paper's case gives what it gives: the criterion in the paper's protocol
         (mu_prep 0.05, first trial from Eq. 12) against grading width (Cu) and against
         preparation friction, over seeds, beside the paper's 0.15."""
+        from poro2d.cli.dask_options import job_options
         from poro2d.criterion.config import load_config
         from poro2d.errors import check_int
-        from poro2d.execute.cluster_options import check_cluster_options, check_dashboard
         from poro2d.io_utils import check_output_dir
         from poro2d.store import Store
         from poro2d.sweep.criterion_base import CriterionBase
         from poro2d.sweep.sensitivity import run_sensitivity
 
-        check_cluster_options(scheduler, workers)
+        options = job_options(workers, scheduler, quiet, dashboard)
         if seeds is not None:
             check_int("--seeds", seeds, 1, 50)
         check_output_dir("--out", out)
-        dashboard_address = check_dashboard(dashboard)
         cfg, base_dir = load_config(config, preset, extra_tables=("sensitivity",))
         base = CriterionBase.from_config(cfg, base_dir)
 
         def banner() -> None:  # once every input is checked: a refusal is the only line
             console.print(f"sensitivity study{' (quick)' if quick else ''} -> {out}")
 
-        sens = run_sensitivity(base, Store(out), quick=quick, seeds=seeds, scheduler=scheduler,
-                               workers=workers, progress=not quiet, dashboard=dashboard_address,
-                               announce=banner)  # fmt: skip
+        sens = run_sensitivity(base, Store(out), quick=quick, seeds=seeds, options=options, announce=banner)
         print_sensitivity(sens, out)
         failed = sens.sweeps["failed_cases"]
         if failed:

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 from rich.markup import escape
 
-from poro2d.cli.dask_options import DASHBOARD_HELP, SCHEDULER_HELP, WORKERS_HELP
+from poro2d.cli.dask_options import DASHBOARD_HELP, SCHEDULER_HELP, WORKERS_HELP, job_options
 from poro2d.console import OutputConsole, Table
 
 console = OutputConsole()
@@ -25,22 +25,19 @@ def sweep_cmd(
 ) -> None:
     """Run a grid or list of cases as Dask tasks; one table of results."""
     from poro2d.config import load_toml
-    from poro2d.execute.cluster_options import check_cluster_options, check_dashboard
     from poro2d.execute.dask_cluster import check_reachable
     from poro2d.io_utils import check_output_dir
     from poro2d.store import Store
     from poro2d.sweep.cases import parse_sweep
     from poro2d.sweep.runner import run_sweep
 
-    check_cluster_options(scheduler, workers)
-    dashboard_address = check_dashboard(dashboard)
+    options = job_options(workers, scheduler, quiet, dashboard)
     check_output_dir("--out", out)
     cfg = load_toml(config)
     sweep = parse_sweep(cfg, Path(config).resolve().parent)
     check_reachable(scheduler)  # before the first line: an unreachable scheduler is the only one
     console.print(f"{len(sweep.cases)} case(s) of kind {sweep.kind!r} -> {out}")
-    res = run_sweep(sweep, Store(out), scheduler=scheduler, workers=workers, progress=not quiet,
-                    dashboard=dashboard_address)  # fmt: skip
+    res = run_sweep(sweep, Store(out), options=options)
     print_summary(res, out)
     if res.failed:
         raise typer.Exit(1)

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.criterion.result import CriterionResult
+from poro2d.execute.options import RunOptions
 from poro2d.grading import GradingCurve
 from poro2d.locks import output_folder
 from poro2d.specimen.compaction import SpecimenSpec
@@ -160,10 +161,16 @@ def criterion_inputs(
     return CriterionInputs(cfg, base, dens, spec, grading, settings, sd)
 
 
-def run_paper_mode(inputs: CriterionInputs, store: Store | None, *, progress: bool = True) -> CriterionResult:
-    """The criterion of Fig. 3 once, on checked inputs, kept in ``store`` (resumable; None: kept nowhere)."""
+def run_paper_mode(
+    inputs: CriterionInputs, store: Store | None, *, options: RunOptions = RunOptions()
+) -> CriterionResult:
+    """The criterion of Fig. 3 once, on checked inputs, kept in ``store`` (resumable; None: kept nowhere).
+
+    ``options``: whether bars show (:class:`~poro2d.execute.options.RunOptions`; the criterion
+    runs in this process).
+    """
     return PorosityCriterion(inputs.spec, inputs.grading, inputs.settings, seed=inputs.seed, store=store,
-                             progress=progress, config=inputs.config).run()  # fmt: skip
+                             progress=options.progress, config=inputs.config).run()  # fmt: skip
 
 
 def run_criterion(
@@ -175,16 +182,17 @@ def run_criterion(
     n_lab: float | None = None,
     trial_porosity: float | None = None,
     threads: int | None = None,
-    progress: bool = True,
+    options: RunOptions = RunOptions(),
 ) -> CriterionResult:
     """The criterion of Fig. 3 for a config (a dict, a TOML file, or the paper preset when None).
 
     Runs it once, as the paper does, and returns the
     :class:`~poro2d.criterion.result.CriterionResult` kept as ``result.json`` in ``store``
     (held for the call, resumable; None: nothing is kept). The keyword options override the
-    config as the command's options do. Density mode (a
-    config whose ``[density]`` table says ``mode = "density"``) runs on the sweep layer:
-    :func:`poro2d.sweep.density_criterion.run_density_criterion` is its call, and it is
+    config as the command's options do; ``threads``: the DEM kernels' threads, ``options``: whether
+    bars show (:class:`~poro2d.execute.options.RunOptions`; the criterion runs in this process).
+    Density mode (a config whose ``[density]`` table says ``mode = "density"``) runs on the sweep
+    layer: :func:`poro2d.sweep.density_criterion.run_density_criterion` is its call, and it is
     refused here. Bad input raises :class:`~poro2d.errors.InputError` before anything is
     written.
     """
@@ -196,7 +204,7 @@ def run_criterion(
         if inputs.mode == "density":
             raise InputError("density.mode", "density", "paper here (density mode: "
                              "poro2d.sweep.density_criterion.run_density_criterion)")  # fmt: skip
-        return run_paper_mode(inputs, store, progress=progress)
+        return run_paper_mode(inputs, store, options=options)
 
     if store is None:
         return run()

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.criterion.density import Calibration, StateTarget, state_target
+from poro2d.execute.options import RunOptions
 from poro2d.interop.origin import SOIL_FILE
 from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import holds_output
@@ -173,7 +174,7 @@ def calibration_stage(
 ) -> tuple[StateTarget, SandCalibration]:
     """The ends, then the two frictions around the state: its target and friction.
 
-    ``cal_kw``: the sweep's options and ``use_cache`` (:func:`poro2d.sweep.density.calibrate`).
+    ``cal_kw``: ``options`` and ``use_cache`` (:func:`poro2d.sweep.density.calibrate`).
     """
     cal_ends, usable, ends_info = calibrate_ends(case, pf, store, cal_kw)
     ends = [usable[0], usable[-1]]
@@ -224,7 +225,7 @@ def calibrate_ends(
             raise AssertionError("unreachable: usable() refuses fewer than two frictions")
 
 
-def specimen_stage(case: SandCase, trial: StateTarget, store: Store, sweep_kw: dict) -> list[dict]:
+def specimen_stage(case: SandCase, trial: StateTarget, store: Store, options: RunOptions) -> list[dict]:
     """One criterion case per seed at full size, at the state's friction, from ``trial``."""
     from poro2d.criterion.protocol import trial_grid
     from poro2d.sweep.runner import run_sweep
@@ -232,7 +233,7 @@ def specimen_stage(case: SandCase, trial: StateTarget, store: Store, sweep_kw: d
     crit = case.config.table("criterion")
     grid = trial_grid(float(crit.get("resolution", 0.01)), crit.get("refine_tolerance"))
     sweep = D.StateChecks(case.config, (trial,), case.seeds, grid).sweep
-    res = run_sweep(sweep, store.child("states"), **sweep_kw)
+    res = run_sweep(sweep, store.child("states"), options=options)
     return sorted(res.rows, key=lambda r: int((r.get("params") or {}).get("seed", 0)))
 
 
@@ -288,9 +289,7 @@ def run_sand(
     store: Store,
     seeds: int | None = None,
     budget_minutes: float | None = None,
-    workers: int | None = None,
-    scheduler: str | None = None,
-    progress: bool = True,
+    options: RunOptions = RunOptions(),
     use_cache: bool = True,
     announce: Announce = _quiet,
     on_preflight: Callable[[SandCase, Preflight], None] | None = None,
@@ -303,15 +302,14 @@ def run_sand(
     ``sand.json`` (returned as a :class:`~poro2d.sand.result.SandResult`). ``on_preflight``
     is called with the case and its pre-flight before any DEM work (the command prints it
     there), ``announce`` with one line per stage, with the elapsed time and an overall ETA.
-    Rerun to resume: finished cases are read back.
+    ``options``: where the jobs run and whether bars show (:class:`~poro2d.execute.options.RunOptions`;
+    the pre-flight's estimate counts ``workers``). Rerun to resume: finished cases are read back.
     """
-    from poro2d.execute.cluster_options import check_cluster_options
     from poro2d.execute.dask_cluster import check_reachable
 
     check_output_dir(store.parameter, store.root)
-    check_cluster_options(scheduler, workers)
-    case, pf = check_soil(config, seeds=seeds, workers=workers, budget_minutes=budget_minutes)
-    check_reachable(scheduler)  # a scheduler that does not answer is refused before the pre-flight is kept
+    case, pf = check_soil(config, seeds=seeds, workers=options.workers, budget_minutes=budget_minutes)
+    check_reachable(options.scheduler)  # one that does not answer is refused before the pre-flight is kept
     store.write_json(
         "preflight.json",
         {
@@ -322,19 +320,18 @@ def run_sand(
     )
     if on_preflight is not None:
         on_preflight(case, pf)
-    sweep_kw = {"scheduler": scheduler, "workers": workers, "progress": progress}
     clock = StageClock(pf.seconds, announce)
     t = clock.begin(
         f"calibration: {pf.cases_calibration} cases at most, {pf.calibration_box.disks:.0f} disks each",
     )
-    target, cal_record = calibration_stage(case, pf, store, dict(sweep_kw, use_cache=use_cache))
+    target, cal_record = calibration_stage(case, pf, store, {"options": options, "use_cache": use_cache})
     clock.end("calibration", t)
     trial = full_box_trial(target.n2d_target, pf.jamming.porosity, cal_record.n2d_min, pf)
     t = clock.begin(
         f"specimens: {case.seeds} at full size ({pf.box.disks:.0f} disks), "
         f"mu_prep {target.mu_prep:.3f}, first trial {trial:.4f}",
     )
-    rows = specimen_stage(case, replace(target, n2d_target=trial), store, sweep_kw)
+    rows = specimen_stage(case, replace(target, n2d_target=trial), store, options)
     clock.end("specimens", t)
     kept = keep_specimens(rows, store, _state_label(case), case.soil_record(), case.lab.to_dict())
     cal_ids = [c.id for c in calibration_cases(case, pf, [float(m) for m in cal_record.mus])]

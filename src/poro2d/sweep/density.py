@@ -25,6 +25,7 @@ import numpy as np
 from poro2d import __version__
 from poro2d.criterion.density import DEFAULT_MUS, Calibration, StateTarget, check_mus
 from poro2d.errors import check_int
+from poro2d.execute.options import RunOptions
 from poro2d.identity import identity_digest, outside_fields
 from poro2d.io_utils import Provenance
 from poro2d.locks import cache_entry
@@ -290,7 +291,8 @@ def calibrate(
     *,
     use_cache: bool = True,
     record: str = "calibration.json",
-    **sweep_kw,
+    options: RunOptions = RunOptions(),
+    client=None,
 ) -> tuple[Calibration, CalibrationRun]:
     """The grading's calibration, its cases run on the sweep runner (resumable).
 
@@ -298,7 +300,10 @@ def calibrate(
     settings (:func:`cache_dir` / ``calibrations`` / key): a case done once, for any list of
     frictions or number of seeds, is read back, not run again. Without it they go to
     ``calibration`` in ``store``. ``record`` (in ``store``) records the calibration and where
-    its cases are. Returns the calibration and a record (key, folder, how many cases ran).
+    its cases are. ``options``: where the jobs run and whether bars show
+    (:class:`~poro2d.execute.options.RunOptions`), ``client``: an existing Dask client instead
+    (:func:`~poro2d.sweep.runner.run_sweep`). Returns the calibration and a record (key, folder,
+    how many cases ran).
     """
     from poro2d.sweep.runner import run_sweep
 
@@ -306,7 +311,7 @@ def calibrate(
     cases = calibration_store(case, store, use_cache=use_cache)
     # another run of the same grading may be computing this entry: wait, then reuse its cases
     with cache_entry(cases.root):
-        res = run_sweep(case.sweep, cases, **sweep_kw)
+        res = run_sweep(case.sweep, cases, options=options, client=client)
     cal = calibration_from_rows(res.rows, mus, seeds)
     ran, reused = res.summary["ran"], res.summary["reused"]
     info = {"key": case.key, "cases": str(cases.root), "ran": ran, "reused": reused,

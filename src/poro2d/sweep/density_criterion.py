@@ -16,6 +16,7 @@ from poro2d.criterion.density import lab_relative_density
 from poro2d.criterion.result import CriterionResult
 from poro2d.criterion.run import ConfigLike, CriterionInputs, criterion_inputs, run_paper_mode
 from poro2d.errors import InputError
+from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.store import Store
 from poro2d.sweep.criterion_base import CriterionBase
@@ -35,19 +36,20 @@ def run_density_state(
     seeds: int = DEFAULT_SEEDS,
     mus=None,
     use_cache: bool = True,
-    **sweep_kw,
+    options: RunOptions = RunOptions(),
 ) -> DensityStateResult:
     """The density-controlled criterion for one laboratory state, over seeds.
 
     Calibrates (or reads the cached calibration), maps ``n_lab`` to its 2D target and
     preparation friction, runs the criterion with them for every seed and writes
     ``density.json`` to ``store``: the accepted n2D (mean, sd, per seed), the target, mu_prep
-    and Dr, returned as a :class:`~poro2d.sweep.results.DensityStateResult`.
+    and Dr, returned as a :class:`~poro2d.sweep.results.DensityStateResult`. ``options``: where the
+    jobs run and whether bars show (:class:`~poro2d.execute.options.RunOptions`).
     """
     lab_relative_density(n_lab, n_max, n_min)  # nLab outside [n_min, n_max]: refused before any run
     settings = RelationSettings(n_max, n_min, (round(float(n_lab), 4),))
     rel, sweeps = density_relation(base, settings, store, seeds=seeds, mus=mus, use_cache=use_cache,
-                                   **sweep_kw)  # fmt: skip
+                                   options=options)  # fmt: skip
     (point,) = rel["points"]
     record = {
         "mode": "density",
@@ -78,7 +80,7 @@ def run_density_state(
 
 
 def _run_density_mode(inputs: CriterionInputs, store: Store, *, threads: int | None,
-                      progress: bool) -> DensityStateResult:  # fmt: skip
+                      options: RunOptions) -> DensityStateResult:  # fmt: skip
     """Calibration (cached), the state's friction and first trial, the criterion over seeds."""
     rest = {k: v for k, v in inputs.config.items() if k != "density"}
     if threads is not None:  # the option's thread count, as the specimen was built with it
@@ -86,7 +88,7 @@ def _run_density_mode(inputs: CriterionInputs, store: Store, *, threads: int | N
     dens = inputs.density
     base = CriterionBase(rest, inputs.base)
     return run_density_state(base, inputs.settings.n_lab, dens.n_max, dens.n_min, store,
-                             seeds=dens.seeds, mus=dens.mu_prep, progress=progress)  # fmt: skip
+                             seeds=dens.seeds, mus=dens.mu_prep, options=options)  # fmt: skip
 
 
 def _refuse_paper_options(seed: int | None, trial_porosity: float | None) -> None:
@@ -107,7 +109,7 @@ def run_density_criterion(
     n_max: float | None = None,
     n_min: float | None = None,
     seeds: int | None = None,
-    progress: bool = True,
+    options: RunOptions = RunOptions(),
 ) -> DensityStateResult:
     """``poro2d criterion --mode density`` as one call: the criterion for one laboratory state.
 
@@ -116,11 +118,12 @@ def run_density_criterion(
     returns the :class:`~poro2d.sweep.results.DensityStateResult` written to
     ``density.json`` in ``store`` (None: nothing kept but the calibration cache). ``config`` as
     for :func:`poro2d.criterion.run_criterion`, whose ``[density]`` table the options override.
+    ``options``: where the jobs run and whether bars show (:class:`~poro2d.execute.options.RunOptions`).
     Bad input raises :class:`~poro2d.errors.InputError` before anything is written.
     """
     return run_criterion_modes(config, preset=preset, store=store, n_lab=n_lab, threads=threads,
                                mode="density", n_max=n_max, n_min=n_min, seeds=seeds,
-                               progress=progress)  # fmt: skip
+                               options=options)  # fmt: skip
 
 
 def run_criterion_modes(
@@ -136,14 +139,15 @@ def run_criterion_modes(
     n_max: float | None = None,
     n_min: float | None = None,
     seeds: int | None = None,
-    progress: bool = True,
+    options: RunOptions = RunOptions(),
 ) -> CriterionResult | DensityStateResult:
     """``poro2d criterion``: the mode the options or ``[density] mode`` ask for (paper by default).
 
     Paper mode returns the :class:`~poro2d.criterion.result.CriterionResult` of
     :func:`poro2d.criterion.run_criterion`, density mode the
     :class:`~poro2d.sweep.results.DensityStateResult` of :func:`run_density_criterion`.
-    ``store``: where the run is kept (None: nothing is kept).
+    ``store``: where the run is kept (None: nothing is kept); ``options``: where the jobs run and
+    whether bars show (:class:`~poro2d.execute.options.RunOptions`).
     """
     if store is not None:
         check_output_dir(store.parameter, store.root)
@@ -152,9 +156,9 @@ def run_criterion_modes(
                                   trial_porosity=trial_porosity, threads=threads, mode=mode, n_max=n_max,
                                   n_min=n_min, seeds=seeds)  # fmt: skip
         if inputs.mode == "paper":
-            return run_paper_mode(inputs, kept, progress=progress)
+            return run_paper_mode(inputs, kept, options=options)
         _refuse_paper_options(seed, trial_porosity)
-        return _run_density_mode(inputs, kept, threads=threads, progress=progress)
+        return _run_density_mode(inputs, kept, threads=threads, options=options)
 
 
 __all__ = ["run_criterion_modes", "run_density_criterion", "run_density_state"]

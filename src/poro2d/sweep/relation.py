@@ -22,6 +22,7 @@ import numpy as np
 from poro2d import porosity as P
 from poro2d.config import check_keys, check_number_list
 from poro2d.errors import InputError, check_range
+from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance, check_output_dir, float_or_nan
 from poro2d.paper_data import QUICK_SPECIMEN as PAPER_QUICK_SPECIMEN
 from poro2d.store import Store
@@ -321,13 +322,14 @@ def density_relation(
     seeds: int = 3,
     mus=None,
     use_cache: bool = True,
-    **sweep_kw,
+    options: RunOptions = RunOptions(),
 ) -> tuple[RelationResult, DensitySweeps]:
     """The density-controlled relation: calibrate, map every state, check it over seeds.
 
     ``base``: the criterion config as read; ``settings``: from :func:`relation_settings`;
     ``store``: where the calibration's record and the states' sweep are kept (the
-    calibration's cases in the shared cache with ``use_cache``). Returns the analysed
+    calibration's cases in the shared cache with ``use_cache``); ``options``: where the jobs run
+    and whether bars show (:class:`~poro2d.execute.options.RunOptions`). Returns the analysed
     relation and a record of the two sweeps (calibration source, summaries).
     """
     from poro2d.criterion.density import DEFAULT_MUS, state_target
@@ -337,7 +339,7 @@ def density_relation(
 
     states_base = D.with_density_defaults(relation_base(base, quick=quick))
     calibration = D.CalibrationCase(states_base, tuple(mus or DEFAULT_MUS), seeds)
-    cal, cal_info = D.calibrate(calibration, store, use_cache=use_cache, **sweep_kw)
+    cal, cal_info = D.calibrate(calibration, store, use_cache=use_cache, options=options)
     targets = tuple(state_target(n, settings.n_max, settings.n_min, cal) for n in settings.n_lab)
     crit = states_base.table("criterion")
     # the first trial on the grid the criterion steps on: half the refined tolerance, else the resolution
@@ -348,7 +350,7 @@ def density_relation(
     if len(twins) < len(sweep.cases):
         twin_ids = {row.case_id for row in twins}
         left = replace(sweep, cases=[c for c in sweep.cases if c.id not in twin_ids])
-        res = run_sweep(left, store.child("states"), **sweep_kw)
+        res = run_sweep(left, store.child("states"), options=options)
         rows, summary, failed = res.rows + rows, res.summary, res.failed
     summary = dict(summary, from_calibration=len(twins))
     rel = analyse_states(rows, list(targets), cal, settings.n_max, settings.n_min)
@@ -410,10 +412,7 @@ def run_relation(
     mode: str | None = None,
     seeds: int | None = None,
     quick: bool = False,
-    scheduler: str | None = None,
-    workers: int | None = None,
-    progress: bool = True,
-    dashboard: str | None = None,
+    options: RunOptions = RunOptions(),
     announce=None,
 ) -> RelationResult:
     """``poro2d relation`` as one call: the grading's n2D(nLab) relation, written to ``store``.
@@ -426,20 +425,17 @@ def run_relation(
     its ``failed_cases`` counts the cases that raised (their tracebacks are in ``store``; None:
     nothing is kept but the shared calibration cache). Every input is
     checked before the first case runs; ``announce`` (no arguments) is called then, before
-    any work (the command prints its banner there, so a refusal stays one line). ``dashboard``: where a
-    LocalCluster serves its dashboard (default 127.0.0.1:0, this machine; ``"none"``: none).
+    any work (the command prints its banner there, so a refusal stays one line). ``options``: where
+    the jobs run and whether bars show (:class:`~poro2d.execute.options.RunOptions`).
     """
     from poro2d.criterion.density import check_mus
     from poro2d.criterion.run import load
-    from poro2d.execute.cluster_options import check_cluster_options, check_dashboard
     from poro2d.execute.dask_cluster import check_reachable
     from poro2d.sweep.density import check_seeds
     from poro2d.sweep.runner import run_sweep
 
     if store is not None:
         check_output_dir(store.parameter, store.root)
-    check_cluster_options(scheduler, workers)
-    dashboard_address = check_dashboard(dashboard)
     cfg, base_dir = load(config, preset, extra_tables=("relation", "state"))
     # [state] reads the relation's answers; the criterion cases never see it
     base = CriterionBase.from_config({k: v for k, v in cfg.items() if k != "state"}, base_dir)
@@ -457,23 +453,21 @@ def run_relation(
     # every criterion case of the relation built once, without running: a bad specimen, grading
     # or criterion setting is refused before the calibration starts, not when its case comes up
     states = relation_sweep(relation_base(base, quick=quick), settings.n_lab)
-    check_reachable(scheduler)
+    check_reachable(options.scheduler)
     if announce is not None:
         announce()
-    sweep_kw = {"scheduler": scheduler, "workers": workers, "progress": progress,
-                "dashboard": dashboard_address}  # fmt: skip
     title = "2D porosity from the criterion vs laboratory porosity" + (
         " (quick: 0.08 m x 0.04 m box)" if quick else ""
     )
     with held(store, kind="relation") as kept:
         if mode == "density":
             rel, record = density_relation(base, settings, kept, quick=quick, seeds=n_seeds, mus=mus,
-                                           **sweep_kw)  # fmt: skip
+                                           options=options)  # fmt: skip
             extra = {"quick": quick, "config": cfg, "sweeps": record}
             if state is not None:
                 extra["state_maps"] = state_maps(state, rel, settings, base)
         else:
-            res = run_sweep(states, kept, **sweep_kw)
+            res = run_sweep(states, kept, options=options)
             rel = analyse(res.rows, settings.n_max, settings.n_min)
             extra = {"quick": quick, "sweep_summary": res.summary, "config": cfg}
         result = RelationResult.from_dict(dict(rel, **extra, provenance=Provenance.now().to_dict()))

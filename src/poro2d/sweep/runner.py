@@ -29,9 +29,9 @@ from dataclasses import asdict
 from datetime import UTC, datetime
 from typing import Any
 
-from poro2d.execute import Backend, Executor, Failed, Job
-from poro2d.execute.cluster_options import DEFAULT_DASHBOARD, check_cluster_options
+from poro2d.execute import Executor, Failed, Job
 from poro2d.execute.dask_cluster import ClusterInfo, pin_numba_threads
+from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance
 from poro2d.locks import cache_entry, output_folder
 from poro2d.store import Store
@@ -228,32 +228,21 @@ def write_tables(df, store: Store) -> None:
 
 
 def run_sweep(
-    sweep: SweepConfig,
-    store: Store,
-    *,
-    scheduler: str | None = None,
-    workers: int | None = None,
-    client=None,
-    progress: bool = True,
-    dashboard: str | None = DEFAULT_DASHBOARD,
+    sweep: SweepConfig, store: Store, *, options: RunOptions = RunOptions(), client=None
 ) -> SweepResult:
     """Run every unfinished case of ``sweep`` into ``store``; returns its ``sweep.json``, rows and table.
 
     The store's folder is held for the call (another run writing there is refused).
-    ``client``: an existing ``distributed.Client`` (tests, notebooks); otherwise one is
-    made for ``scheduler`` (an address such as ``tcp://host:8786``) or for a new
-    LocalCluster with ``workers`` processes (default: one per core) of one thread each,
-    its dashboard on ``dashboard`` (this machine only by default; None: none).
+    ``options``: where the jobs run and whether bars show
+    (:class:`~poro2d.execute.options.RunOptions`): a running scheduler, or a new LocalCluster of
+    ``workers`` processes (default: one per core) of one thread each, its dashboard on
+    ``dashboard``. ``client``: an existing ``distributed.Client`` (tests, notebooks) instead.
     """
-    if client is None:
-        check_cluster_options(scheduler, workers)
     with output_folder(store.parameter, store.root, kind="sweep"):
-        return _run_sweep(sweep, store, client=client, scheduler=scheduler, workers=workers,
-                          progress=progress, dashboard=dashboard)  # fmt: skip
+        return _run_sweep(sweep, store, options, client)
 
 
-def _run_sweep(sweep: SweepConfig, store: Store, *, client, scheduler, workers, progress: bool,
-               dashboard: str | None) -> SweepResult:  # fmt: skip
+def _run_sweep(sweep: SweepConfig, store: Store, options: RunOptions, client) -> SweepResult:
     cases = store.child("cases")
     t_start = time.perf_counter()
     record = {
@@ -280,9 +269,7 @@ def _run_sweep(sweep: SweepConfig, store: Store, *, client, scheduler, workers, 
     n_reused = len(rows)
     cluster_info: ClusterInfo | None = None
     if pending:
-        cluster_info = _run_pending(sweep, pending, rows, cases, n_reused, client=client,
-                                    scheduler=scheduler, workers=workers, progress=progress,
-                                    dashboard=dashboard)  # fmt: skip
+        cluster_info = _run_pending(sweep, pending, rows, cases, n_reused, options, client)
     ordered = [type(rows[c.id]).from_dict(dict(rows[c.id], reused=bool(rows[c.id].get("reused", False))))
                for c in sweep.cases]  # fmt: skip
     df = table_from_rows(ordered, sweep.axes)
@@ -296,25 +283,23 @@ def _run_sweep(sweep: SweepConfig, store: Store, *, client, scheduler, workers, 
     return result
 
 
-def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Store, n_reused: int, *,
-                 client, scheduler, workers, progress: bool,
-                 dashboard: str | None) -> ClusterInfo | None:  # fmt: skip
+def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Store, n_reused: int,
+                 options: RunOptions, client) -> ClusterInfo | None:  # fmt: skip
     """Run the unfinished cases on ``client`` (or a cluster made for them) into ``rows``.
 
     Returns what is recorded of the cluster (scheduler, workers, threads, dashboard).
     """
     threads = max(int((c.config.get("specimen") or {}).get("threads", 1) or 1) for c in pending)
-    backend = Backend.dask(scheduler, workers, dashboard=dashboard, threads=threads)
-    with Executor(backend, client=client) as executor:
+    with Executor(options.dask_backend(threads), client=client) as executor:
         executor.start()
         cluster_info = executor.cluster_info()
-        if progress and cluster_info is not None and cluster_info.dashboard:
+        if options.progress and cluster_info is not None and cluster_info.dashboard:
             from poro2d.console import OutputConsole
 
             err = OutputConsole(stderr=True)
             err.print(f"Dask dashboard: {cluster_info.dashboard}", highlight=False)
         n_total = len(sweep.cases)
-        ended = _submit_all(executor, pending, cases, sweep.retries, progress, n_reused, n_total)
+        ended = _submit_all(executor, pending, cases, sweep.retries, options.progress, n_reused, n_total)
         rows.update((c.id, row) for c, row in zip(pending, ended, strict=True))
     return cluster_info
 

@@ -29,6 +29,7 @@ import numpy as np
 
 from poro2d.config import check_keys, check_number_list
 from poro2d.errors import InputError
+from poro2d.execute.options import RunOptions
 from poro2d.io_utils import check_output_dir
 from poro2d.paper_data import QUICK_CRITERION
 from poro2d.store import Store
@@ -424,7 +425,8 @@ def run_sensitivity(
     seeds: int | None = None,
     use_cache: bool = True,
     announce=None,
-    **sweep_kw,
+    options: RunOptions = RunOptions(),
+    client=None,
 ) -> SensitivityResult:
     """The whole study into ``store``; returns the :class:`SensitivityResult` of its ``sensitivity.json``.
 
@@ -432,17 +434,15 @@ def run_sensitivity(
     ``mu_prep``, ``seeds``); ``store``: where the study is kept (None: nothing is kept but
     the shared calibration cache). Everything is checked before the first case runs; ``announce``
     (no arguments) is called then, before any work.
-    ``sweep_kw``: ``scheduler``, ``workers``, ``client``, ``progress`` of the sweep runner.
+    ``options``: where the jobs run and whether bars show (:class:`~poro2d.execute.options.RunOptions`);
+    ``client``: an existing Dask client instead (:func:`~poro2d.sweep.runner.run_sweep`).
     """
     from poro2d.criterion.config import build
-    from poro2d.execute.cluster_options import check_cluster_options
     from poro2d.execute.dask_cluster import check_reachable
     from poro2d.sweep import density as D
 
     if store is not None:
         check_output_dir(store.parameter, store.root)
-    if sweep_kw.get("client") is None:
-        check_cluster_options(sweep_kw.get("scheduler"), sweep_kw.get("workers"))
     settings = study_settings(base.config.get("sensitivity"), quick=quick, seeds=seeds)
     study = study_base(base, quick=quick)
     _, _, crit, _ = build(study.as_config(), study.base_dir)
@@ -453,27 +453,29 @@ def run_sensitivity(
     # the same cases as the relation's, read back from the shared cache when it ran them
     calibration = D.CalibrationCase(D.with_density_defaults(study), tuple(settings["mus"]), settings["seeds"])
     calibration.sweep  # noqa: B018 (its cases are built, so checked, now)
-    check_reachable(sweep_kw.get("scheduler"))
+    check_reachable(options.scheduler)
     if announce is not None:
         announce()
     with held(store, kind="sensitivity") as kept:
         return _run_study(study, crit, cases, sweep, calibration, settings, kept, use_cache=use_cache,
-                          **sweep_kw)  # fmt: skip
+                          options=options, client=client)  # fmt: skip
 
 
 def _run_study(study: CriterionBase, crit, cases: list[GradingCase], sweep: SweepConfig, calibration,
-               settings: dict, store: Store, *, use_cache: bool,
-               **sweep_kw) -> SensitivityResult:  # fmt: skip
+               settings: dict, store: Store, *, use_cache: bool, options: RunOptions,
+               client) -> SensitivityResult:  # fmt: skip
     """The grading sweep, the calibration, and the study's record of both (checked inputs)."""
     from poro2d.sweep import density as D
     from poro2d.sweep.runner import run_sweep
 
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
-    res = run_sweep(sweep, store.child("grading"), **sweep_kw)
+    res = run_sweep(sweep, store.child("grading"), options=options, client=client)
     timings["grading_s"] = time.perf_counter() - t0
     t1 = time.perf_counter()
-    cal, cal_info = D.calibrate(calibration, store.child("mu_prep"), use_cache=use_cache, **sweep_kw)
+    cal, cal_info = D.calibrate(
+        calibration, store.child("mu_prep"), use_cache=use_cache, options=options, client=client
+    )
     timings["mu_prep_s"] = time.perf_counter() - t1
 
     grads = [g.describe() for g in cases]
