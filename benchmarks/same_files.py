@@ -21,7 +21,9 @@ with times and paths masked.
 from __future__ import annotations
 
 import argparse
+import csv
 import hashlib
+import io
 import json
 import os
 import re
@@ -32,7 +34,8 @@ from pathlib import Path
 #: JSON keys whose values cannot repeat from one run to the next
 UNREPEATABLE = re.compile(
     r"(wall|elapsed|seconds|_s$|time|date|created|started|finished|pid|host|path|folder_abs|"
-    r"poro2d_version|version|python|numba|numpy|platform|per_s|threads|cpu)",
+    r"poro2d_version|version|python|numba|numpy|platform|per_s|threads|cpu|efficiency|address|"
+    r"scheduler|dashboard|worker|cluster)",
     re.I,
 )
 #: text patterns that cannot repeat: times, dates, absolute paths, durations
@@ -90,8 +93,8 @@ def _synthetic_lab(root: Path) -> Path:
 def _run_calibrate(root: Path) -> None:
     lab = _synthetic_lab(root)
     _poro2d("calibrate", "--lab", str(lab), "--preset", "paper", "--quick", "--points", "9",
-            "--refine", "0", "--max-displacement", "0.002", "--workers", "1", "--out", "calibrate",
-            cwd=root)  # fmt: skip
+            "--refine", "0", "--max-displacement", "0.002", "--keep-box-dominated", "--workers", "1",
+            "--out", "calibrate", cwd=root)  # fmt: skip
 
 
 def _run_sand(root: Path) -> None:
@@ -153,17 +156,49 @@ def _digest(path: Path) -> str:
         except ValueError:
             return "unreadable JSON"
         return json.dumps(_masked(data), sort_keys=False)
+    if path.suffix == ".csv":
+        return _csv_digest(path)
+    if path.suffix == ".npz":
+        return _npz_digest(path)
     if path.suffix in {".html", ".md", ".svg", ".txt", ".log"}:
         return _mask_text(path.read_text(errors="replace"))
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
+def _csv_digest(path: Path) -> str:
+    """The table with its unrepeatable columns (times, workers) masked."""
+    rows = list(csv.reader(io.StringIO(path.read_text())))
+    data = [r for r in rows if r and not r[0].startswith("#")]
+    if not data:
+        return path.read_text()
+    keep = [k for k, name in enumerate(data[0]) if not UNREPEATABLE.search(name)]
+    return "\n".join(",".join(r[k] for k in keep if k < len(r)) for r in data)
+
+
+def _npz_digest(path: Path) -> str:
+    """Every array's bytes; a JSON text array (the file's metadata) masked as JSON is."""
+    import numpy as np
+
+    parts = []
+    with np.load(path, allow_pickle=False) as data:
+        for name in sorted(data.files):
+            arr = data[name]
+            if arr.dtype.kind == "U" and arr.ndim == 0:
+                try:
+                    parts.append(name + json.dumps(_masked(json.loads(str(arr)))))
+                    continue
+                except ValueError:
+                    pass
+            parts.append(name + hashlib.sha256(arr.tobytes()).hexdigest())
+    return "\n".join(parts)
+
+
 def _files(root: Path) -> dict[str, Path]:
-    skip = {".cache", "__pycache__"}
+    skip = {".cache", "__pycache__", ".digests.json"}
     return {
         str(p.relative_to(root)): p
         for p in sorted(root.rglob("*"))
-        if p.is_file() and not skip & set(p.relative_to(root).parts) and not p.name.endswith(".lock")
+        if p.is_file() and not skip & {*p.relative_to(root).parts} and not p.name.endswith((".lock", ".log"))
     }
 
 
