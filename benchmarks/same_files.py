@@ -14,8 +14,9 @@ against a synthetic laboratory made by poro2d's own direct shear (its header say
 about 25 minutes on one core. ``run --only NAME`` runs one of them.
 
 JSON files are compared value by value with the unrepeatable keys masked; every other file
-byte for byte, except the HTML and Markdown reports and SVG figures, whose lines are compared
-with times and paths masked.
+byte for byte, except tables (CSV, Parquet: the unrepeatable columns left out), checkpoints
+(every array; their metadata masked as JSON is) and the HTML and Markdown reports and SVG
+figures, whose text is compared with times, paths and matplotlib's random ids masked.
 """
 
 from __future__ import annotations
@@ -44,6 +45,8 @@ TEXT_MASKS = [
     (re.compile(r"(/[\w.+-]+){2,}"), "<path>"),
     (re.compile(r"\d+(\.\d+)?\s*(s|min|h|ms)\b"), "<dur>"),
     (re.compile(r"[\d.]+e[+-]?\d+ particle-steps"), "<rate>"),
+    (re.compile(r"\b[mp][0-9a-f]{6,14}\b"), "<svg-id>"),  # matplotlib's clip-path, marker ids: random
+    (re.compile(r"(time[^|<]*\|\s*|<td>[^<]*_s</td><td>)[\d.e+-]+"), r"\1<t>"),  # report time rows
 ]
 
 SAND_TOML = """\
@@ -160,6 +163,11 @@ def _digest(path: Path) -> str:
         return _csv_digest(path)
     if path.suffix == ".npz":
         return _npz_digest(path)
+    if path.suffix == ".parquet":
+        import pandas as pd
+
+        table = pd.read_parquet(path)
+        return table[[c for c in table.columns if not UNREPEATABLE.search(str(c))]].to_csv()
     if path.suffix in {".html", ".md", ".svg", ".txt", ".log"}:
         return _mask_text(path.read_text(errors="replace"))
     return hashlib.sha256(path.read_bytes()).hexdigest()
@@ -183,9 +191,12 @@ def _npz_digest(path: Path) -> str:
     with np.load(path, allow_pickle=False) as data:
         for name in sorted(data.files):
             arr = data[name]
-            if arr.dtype.kind == "U" and arr.ndim == 0:
+            text = str(arr) if arr.dtype.kind == "U" and arr.ndim == 0 else None
+            if arr.dtype == np.uint8 and arr.ndim == 1:  # a JSON document stored as its bytes
+                text = arr.tobytes().decode(errors="replace")
+            if text is not None:
                 try:
-                    parts.append(name + json.dumps(_masked(json.loads(str(arr)))))
+                    parts.append(name + json.dumps(_masked(json.loads(text))))
                     continue
                 except ValueError:
                     pass
