@@ -226,8 +226,9 @@ class SandResult(TypedResult):
         )
 
 
-def _pm(mean: float, sd: float) -> str:
-    return "n/a" if not math.isfinite(mean) else f"{mean:.4f} +- {sd:.4f}"
+def _pm(mean: float | None, sd: float | None) -> str:
+    """``mean +- sd``, or n/a without a number (None, as a file keeps NaN)."""
+    return "n/a" if mean is None or not math.isfinite(mean) else f"{mean:.4f} +- {sd or 0.0:.4f}"
 
 
 @dataclass(eq=False)
@@ -255,12 +256,12 @@ class SummaryRow(TypedResult):
         """The row of a finished run."""
         st, pf = res.state, res.preflight
         return cls(
-            res.soil.get("name"),
-            res.soil.get("upscale"),
-            round(pf["box"]["disks"]),
-            st["n_lab"],
-            st["e"],
-            st.get("relative_density"),
+            res.soil.name,
+            res.soil.upscale,
+            round(pf.box.disks),
+            st.n_lab,
+            st.e,
+            st.relative_density,
             res.mu_prep,
             res.interior_porosity_mean,
             res.interior_porosity_sd,
@@ -278,10 +279,10 @@ def summary_markdown(res: SandResult, store: Store) -> str:
     (the export commands name the store's folder)."""
     out = store.root
     st, soil = res.state, res.soil
-    dr = st.get("relative_density")
+    dr = st.relative_density
     jam = res.jamming_porosity
     lines = [
-        f"# {soil.get('name')}: 2D porosity at nLab = {st['n_lab']:.4f}"
+        f"# {soil.name}: 2D porosity at nLab = {st.n_lab:.4f}"
         + (f" (Dr = {dr:.3f})" if dr is not None else ""),
         "",
         "**Interior porosity (use this in other codes): "
@@ -290,12 +291,12 @@ def summary_markdown(res: SandResult, store: Store) -> str:
         "",
         "| quantity | value |",
         "| --- | --- |",
-        f"| soil | {soil.get('name')} ({soil.get('reference') or 'no reference given'}) |",
-        f"| grading | {soil.get('grading_source')}, up-scaled x{soil.get('upscale'):g} |",
+        f"| soil | {soil.name} ({soil.reference or 'no reference given'}) |",
+        f"| grading | {soil.grading_source}, up-scaled x{soil.upscale:g} |",
         f"| disks (full box) | {res.preflight.box.disks:.0f} |",
-        f"| laboratory state | n = {st['n_lab']:.4f}, e = {st['e']:.4f}"
+        f"| laboratory state | n = {st.n_lab:.4f}, e = {st.e:.4f}"
         + (f", Dr = {dr:.3f}" if dr is not None else "")
-        + f" (given as {st['given']}) |",
+        + f" (given as {st.given}) |",
         f"| preparation friction mu_prep | {res.mu_prep:.3f} |",
         f"| interior porosity | {_pm(res.interior_porosity_mean, res.interior_porosity_sd)} |",
         f"| box porosity n' (under the lid) | {_pm(res.box_porosity_mean, res.box_porosity_sd)} |",
@@ -304,7 +305,7 @@ def summary_markdown(res: SandResult, store: Store) -> str:
         + ("n/a" if jam is None else f"{jam:.4f} +- {res.jamming_porosity_sd or 0.0:.4f}")
         + " |",
         f"| 2D extremes n' (calibration box) | {res.n2d_min:.4f} dense, {res.n2d_max:.4f} loose |",
-        f"| dense end, interior (calibration box) | {_fmt(res.calibration.get('dense_end_interior'))} "
+        f"| dense end, interior (calibration box) | {_fmt(res.calibration.dense_end_interior)} "
         f"(against the jamming porosity {_fmt(jam)}) |",
         f"| wall time | {res.wall_seconds / 60:.1f} min |",
         *_profile_rows(res),
@@ -320,7 +321,7 @@ def summary_markdown(res: SandResult, store: Store) -> str:
         )
     first = next((k for k in res.specimens if k.accepted), None)
     if first is not None:
-        state = f"--n-lab {st['n_lab']:.6g} --seed {first.seed}"
+        state = f"--n-lab {st.n_lab:.6g} --seed {first.seed}"
         lines += [
             "",
             "Export, e.g.:",
@@ -339,25 +340,25 @@ def _profile_rows(res: SandResult) -> list[str]:
     """Where the time went: per stage (calibration, specimens) and phase (preparation, lid)."""
     rows = []
     for label, key in (("calibration", "time_profile"), ("specimens", "specimens_time_profile")):
-        prof = res.calibration.get(key)
+        prof = getattr(res.calibration, key)
         if not prof:
             continue
         parts = []
         for phase in ("prepare", "plate"):
-            p = prof[phase]
-            rate = p["particle_steps_per_s"]
-            pace = "" if not math.isfinite(rate) else f" ({rate:.3g} particle-steps/s)"
-            parts.append(f"{phase} {p['steps']:,} steps in {p['seconds'] / 60:.1f} min{pace}")
-        rows.append(f"| {label}: {prof['trials']} trials | {'; '.join(parts)} |")
+            p = getattr(prof, phase)
+            rate = p.particle_steps_per_s
+            pace = "" if rate is None or not math.isfinite(rate) else f" ({rate:.3g} particle-steps/s)"
+            parts.append(f"{phase} {p.steps:,} steps in {p.seconds / 60:.1f} min{pace}")
+        rows.append(f"| {label}: {prof.trials} trials | {'; '.join(parts)} |")
     return rows
 
 
 def warnings(res: SandResult) -> list[str]:
     """What the answer must be read with: preparations that could not be made, seeds refused."""
     out = []
-    dropped = res.calibration.get("dropped_ends") or []
+    dropped = res.calibration.dropped_ends or []
     if dropped:
-        mus = res.calibration.get("mus") or []
+        mus = res.calibration.mus or []
         out.append(
             f"no seed could be prepared at mu_prep {', '.join(f'{m:g}' for m in dropped)}: the 2D extremes "
             f"are those of mu_prep {mus[0]:g} to {mus[-1]:g}, so a state's Dr is mapped onto a narrower "
