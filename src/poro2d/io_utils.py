@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from poro2d import __version__
+from poro2d.json_types import as_json, json_value, to_json_types
 from poro2d.typed_result import TypedResult
 
 
@@ -168,53 +169,6 @@ class Provenance(TypedResult):
         )
 
 
-def _default(o):
-    import numpy as np
-
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    if isinstance(o, Path):
-        return str(o)
-    if callable(getattr(o, "to_dict", None)):  # a typed result or record: the dict of its file
-        return o.to_dict()
-    raise TypeError(f"not JSON serialisable: {type(o)}")
-
-
-def to_json_types(obj: Any) -> Any:
-    """``obj`` with NumPy scalars and arrays, tuples and paths as plain JSON types.
-
-    A NumPy boolean becomes ``True``/``False`` (never the string ``"True"``), so a
-    value reads back with the type it was written with.
-    """
-    if isinstance(obj, Mapping):
-        return {_key(k): to_json_types(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [to_json_types(v) for v in obj]
-    if isinstance(obj, (str, bool, int, float, type(None))):
-        return obj
-    return to_json_types(_default(obj))
-
-
-def _key(k: Any) -> Any:
-    """A mapping key as JSON accepts it (json itself spells numbers and booleans as text)."""
-    if isinstance(k, (str, bool, int, float, type(None))):
-        return k
-    return str(_default(k)) if isinstance(k, Path) else _default(k)
-
-
-def _finite_or_null(obj: Any) -> Any:
-    """NaN and infinities as ``None``: JSON has no token for them (``NaN`` is not JSON)."""
-    if isinstance(obj, dict):
-        return {k: _finite_or_null(v) for k, v in obj.items()}
-    if isinstance(obj, list):
-        return [_finite_or_null(v) for v in obj]
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
-
-
 def float_or_nan(value: Any) -> float:
     """A number read back from a result: NaN for ``None`` (how :func:`write_json` stores NaN)
     or for anything that is not a number (a value a failed case never wrote)."""
@@ -222,15 +176,6 @@ def float_or_nan(value: Any) -> float:
         return float(value)
     except (TypeError, ValueError):
         return math.nan
-
-
-def as_json(data: Any) -> Any:
-    """``data`` as :func:`write_json` stores it and ``json.loads`` reads it back.
-
-    Code that uses a result both fresh and, on a resumed run, from its file gets
-    the same types either way (booleans, not NumPy booleans; ``None``, not NaN).
-    """
-    return _finite_or_null(to_json_types(data))
 
 
 def write_json(path: str | os.PathLike, data: Mapping, *, config: bool = False) -> None:
@@ -261,7 +206,7 @@ def write_csv(path: str | os.PathLike, rows: Iterable[Mapping], header: list[str
         for r in rows:
             w.writerow(
                 {
-                    k: _default(v) if not isinstance(v, (str, int, float, type(None))) else v
+                    k: json_value(v) if not isinstance(v, (str, int, float, type(None))) else v
                     for k, v in r.items()
                 }
             )

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field, fields
 from functools import cache
 from typing import Any, ClassVar, Self, TypeVar
 
+from poro2d.json_types import as_json
 from poro2d.record import Record
 
 #: the metadata of a field that is not a key of the result's file
@@ -53,10 +54,8 @@ def _plain(value: Any) -> Any:
 
 def _as_stored(value: Any) -> Any:
     """``value`` as its file reads back: NumPy numbers and arrays as plain ones, tuples as lists,
-    NaN and infinities as None (:func:`poro2d.io_utils.as_json`); a typed part as it is (it holds
+    NaN and infinities as None (:func:`poro2d.json_types.as_json`); a typed part as it is (it holds
     its own values so already), a list or map of them with each one so."""
-    from poro2d.io_utils import as_json
-
     if isinstance(value, TypedResult | Record):
         return value
     if isinstance(value, list | tuple) and any(isinstance(v, TypedResult | Record) for v in value):

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import typer
@@ -72,11 +71,9 @@ def print_preflight(case, pf) -> None:
 def print_result(res, out: Path) -> None:
     """The answer: the interior porosity first, then n', the friction, every seed."""
     st = res.state
-    dr = st.get("relative_density")
-    head = f"{res.soil.get('name')} at nLab = {st['n_lab']:.4f}" + (
-        f" (Dr = {dr:.3f})" if dr is not None else ""
-    )
-    if math.isfinite(res.interior_porosity_mean):
+    dr = st.relative_density
+    head = f"{res.soil.name} at nLab = {st.n_lab:.4f}" + (f" (Dr = {dr:.3f})" if dr is not None else "")
+    if res.interior_porosity_mean is not None:
         console.print(
             f"[bold]interior porosity {res.interior_porosity_mean:.4f} +- {res.interior_porosity_sd:.4f}[/] "
             f"({res.seeds_accepted} of {res.seeds} seeds): the 2D porosity of {escape(head)}",
@@ -96,7 +93,7 @@ def print_result(res, out: Path) -> None:
         )
     console.print(t)
     console.print(
-        f"box porosity n' {res.box_porosity_mean:.4f} +- {res.box_porosity_sd:.4f}; "
+        f"box porosity n' {_f(res.box_porosity_mean) or 'n/a'} +- {_f(res.box_porosity_sd) or 'n/a'}; "
         f"mu_prep {res.mu_prep:.3f}; "
         f"2D extremes {res.n2d_min:.4f}-{res.n2d_max:.4f}; jamming porosity "
         + ("n/a" if res.jamming_porosity is None else f"{res.jamming_porosity:.4f}"),
