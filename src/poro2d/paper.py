@@ -300,7 +300,7 @@ def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, *,
         quick=quick,
         seed=crit.seed,
         conversions=conv,
-        criterion=CriterionResult.from_dict({k: result[k] for k in CRITERION_KEYS}),
+        criterion=CriterionResult.from_dict({k: getattr(result, k) for k in CRITERION_KEYS}),
         replicate_specimens=reps,
         shear=shear,
         paper=PaperFacts.from_dict(PAPER),
@@ -317,8 +317,8 @@ def _conversions_stage(store: Store, stage: ResumableStage) -> ConversionsRecord
     conv = stage.run(lambda: conversion_files(store.child("conversions")), "conversions/conversions.json",
                      decode=ConversionsRecord.from_dict)  # fmt: skip
     for m in conv.methods:
-        v = "skipped" if m["n2d"] is None else f"{m['n2d']:.4f}"
-        console.print(f"  {m['method']:<24} {m['equation']:<10} {v:>8} {m['flags']}")
+        v = "skipped" if m.n2d is None else f"{m.n2d:.4f}"
+        console.print(f"  {m.method:<24} {m.equation:<10} {v:>8} {m.flags}")
     return conv
 
 
@@ -337,12 +337,13 @@ def _shear_stage(specimens: SpecimenSet, store: Store, quick: bool, lab_data,
     rep = ReplicateShear(specimens, NORMAL_STRESSES_KPA, sset, store=store, lab=lab_data,
                          options=RunOptions(progress=progress)).run()  # fmt: skip
     first_label, first = next(iter(rep.series.items()))
-    fit = rep.fit or {}
-    ci = fit.get("friction_angle_ci_deg")
+    fit = rep.fit  # None with one normal stress
+    phi, c, r2 = (fit.friction_angle_deg, fit.cohesion_kpa, fit.r2) if fit is not None else (None,) * 3
+    ci = fit.friction_angle_ci_deg if fit is not None else None
     console.print(
-        f"  friction angle {fit.get('friction_angle_deg', float('nan')):.1f} deg"
-        + (f" ({fit['level']:.0%} interval {ci[0]:.1f} to {ci[1]:.1f})" if ci else "")
-        + f", cohesion {fit.get('cohesion_kpa', float('nan')):.1f} kPa over {len(specimens)} specimen(s); "
+        f"  friction angle {float('nan') if phi is None else phi:.1f} deg"
+        + (f" ({fit.level:.0%} interval {ci[0]:.1f} to {ci[1]:.1f})" if ci else "")
+        + f", cohesion {float('nan') if c is None else c:.1f} kPa over {len(specimens)} specimen(s); "
         + "per specimen "
         + ", ".join(f"{v:.1f}" for v in rep.friction_angle_per_specimen_deg)
         + " deg"
@@ -350,9 +351,9 @@ def _shear_stage(specimens: SpecimenSet, store: Store, quick: bool, lab_data,
     summary = PaperShear(
         # the pooled fit over every specimen's peaks; "tests" and quasi_static of the first specimen
         tests=first.tests,
-        friction_angle_deg=fit.get("friction_angle_deg"),
-        cohesion_kpa=fit.get("cohesion_kpa"),
-        r2=fit.get("r2"),
+        friction_angle_deg=phi,
+        cohesion_kpa=c,
+        r2=r2,
         quasi_static=first.quasi_static,
         replicates=ReplicateShearResult.from_dict(rep.to_dict()),
     )

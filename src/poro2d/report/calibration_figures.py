@@ -29,28 +29,28 @@ def plot_calibration_fit(result, lab, curves: dict[float, list], nearest, path: 
     ``result`` is a :class:`poro2d.calibration.run.CalibrationResult`, ``lab`` its laboratory data
     (one series, or repeats with ``series``: each drawn; the points are their means).
     """
-    dilation = [o for o in result.posterior["observables"] if o["observable"] == "dilation"]
+    dilation = [o for o in result.posterior.observables if o.observable == "dilation"]
     if dilation:
         fig, (ax_peak, ax_curve, ax_dil) = plt.subplots(1, 3, figsize=(15, 4.2))
         _plot_dilation(ax_dil, dilation)
     else:
         fig, (ax_peak, ax_curve) = plt.subplots(1, 2, figsize=(11, 4.2))
-    obs = [o for o in result.posterior["observables"] if o["observable"] == "peak"]
-    s = np.array([o["normal_stress_kpa"] for o in obs])
-    ax_peak.plot(s, [o["lab_kpa"] for o in obs], "ks", label="laboratory peak")
+    obs = [o for o in result.posterior.observables if o.observable == "peak"]
+    s = np.array([o.normal_stress_kpa for o in obs])
+    ax_peak.plot(s, [o.lab_kpa for o in obs], "ks", label="laboratory peak")
     _model_points(ax_peak, s, obs, "kpa")
-    ends = [o for o in result.posterior["observables"] if o["observable"] == "end"]
+    ends = [o for o in result.posterior.observables if o.observable == "end"]
     if ends:
-        se = [o["normal_stress_kpa"] for o in ends]
-        ax_peak.plot(se, [o["lab_kpa"] for o in ends], "k^", mfc="none", label="laboratory end")
-        ax_peak.plot(se, [o["model_kpa"] for o in ends], "v", color="#2166ac", label="model end")
+        se = [o.normal_stress_kpa for o in ends]
+        ax_peak.plot(se, [o.lab_kpa for o in ends], "k^", mfc="none", label="laboratory end")
+        ax_peak.plot(se, [o.model_kpa for o in ends], "v", color="#2166ac", label="model end")
     ax_peak.set_xlabel("normal stress (kPa)")
     ax_peak.set_ylabel("shear stress (kPa)")
     ax_peak.set_xlim(left=0)
     ax_peak.set_ylim(bottom=0)
     ax_peak.legend(fontsize=8)
     b = result.best
-    ax_peak.set_title(f"f_p = {b['particle_friction']:.3g}, mu_r = {b['rolling_friction']:.3g}", fontsize=10)
+    ax_peak.set_title(f"f_p = {b.particle_friction:.3g}, mu_r = {b.rolling_friction:.3g}", fontsize=10)
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for k, sigma in enumerate(lab.normal_stresses()):
         c = colors[k % len(colors)]
@@ -82,8 +82,8 @@ def _model_points(ax, s, observed: list, unit: str) -> None:
     stresses ``s``, with +-2 noise sd."""
     ax.errorbar(
         s,
-        [o[f"model_{unit}"] for o in observed],
-        yerr=[2 * o[f"noise_sd_{unit}"] for o in observed],
+        [getattr(o, f"model_{unit}") for o in observed],
+        yerr=[2 * getattr(o, f"noise_sd_{unit}") for o in observed],
         fmt="o",
         color="#b2182b",
         capsize=3,
@@ -93,8 +93,8 @@ def _model_points(ax, s, observed: list, unit: str) -> None:
 
 def _plot_dilation(ax, dilation: list) -> None:
     """The dilation targets (mm) against normal stress: the laboratory's and the model's (+-2 sd)."""
-    s = [o["normal_stress_kpa"] for o in dilation]
-    ax.plot(s, [o["lab_mm"] for o in dilation], "ks", label="laboratory")
+    s = [o.normal_stress_kpa for o in dilation]
+    ax.plot(s, [o.lab_mm for o in dilation], "ks", label="laboratory")
     _model_points(ax, s, dilation, "mm")
     ax.axhline(0.0, color="0.6", lw=0.6)
     ax.set_xlim(left=0)
@@ -115,16 +115,16 @@ def plot_biaxial_calibration_fit(
     with the laboratory curves (``lab``: a :class:`poro2d.biaxial.lab.LabTests`); right, when the
     laboratory gave it: the volumetric strain at the end (compression positive).
     """
-    fitted = result.posterior["observables"]
-    volumetric = [o for o in fitted if o["observable"] == "end_volumetric"]
+    fitted = result.posterior.observables
+    volumetric = [o for o in fitted if o.observable == "end_volumetric"]
     panels = 3 if volumetric else 2
     fig, axes = plt.subplots(1, panels, figsize=(5 * panels, 4.2))
     ax_ratio, ax_curve = axes[0], axes[1]
     for name, marker, label in (("peak_ratio", "s", "peak"), ("end_ratio", "^", "end")):
-        _plot_targets(ax_ratio, [o for o in fitted if o["observable"] == name], marker, label)
+        _plot_targets(ax_ratio, [o for o in fitted if o.observable == name], marker, label)
     ax_ratio.set_ylabel("stress ratio (sigma_1 - sigma_3) / (sigma_1 + sigma_3)")
     b = result.best
-    ax_ratio.set_title(f"f_p = {b['particle_friction']:.3g}, mu_r = {b['rolling_friction']:.3g}", fontsize=10)
+    ax_ratio.set_title(f"f_p = {b.particle_friction:.3g}, mu_r = {b.rolling_friction:.3g}", fontsize=10)
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for k, sigma in enumerate(lab.confining_stresses()):
         c = colors[k % len(colors)]
@@ -161,10 +161,10 @@ def _plot_targets(ax, observed: list, marker: str, label: str) -> None:
     """Dimensionless targets against sigma_3: the laboratory's and the model's (+-2 noise sd)."""
     if not observed:
         return
-    s = [o["normal_stress_kpa"] for o in observed]
-    ax.plot(s, [o["lab_ratio"] for o in observed], "k" + marker, mfc="none", label=f"laboratory {label}")
+    s = [o.normal_stress_kpa for o in observed]
+    ax.plot(s, [o.lab_ratio for o in observed], "k" + marker, mfc="none", label=f"laboratory {label}")
     ax.errorbar(
-        s, [o["model_ratio"] for o in observed], yerr=[2 * o["noise_sd_ratio"] for o in observed],
+        s, [o.model_ratio for o in observed], yerr=[2 * o.noise_sd_ratio for o in observed],
         fmt=marker, capsize=3, label=f"model {label} (surrogate, +-2 sd)",
     )  # fmt: skip
     ax.set_xlabel("confining stress sigma_3 (kPa)")
@@ -193,11 +193,11 @@ def plot_calibration_posterior(result, post, path: str | os.PathLike) -> Path:
         label="evaluated design points",
     )
     b = result.best
-    ax.plot(b["particle_friction"], b["rolling_friction"], "r*", ms=13, label="posterior maximum")
-    if result.intervals["particle_friction"] is not None:  # None: unknown (``unidentified``)
-        lo, hi = result.intervals["particle_friction"]
+    ax.plot(b.particle_friction, b.rolling_friction, "r*", ms=13, label="posterior maximum")
+    if result.intervals.particle_friction is not None:  # None: unknown (``unidentified``)
+        lo, hi = result.intervals.particle_friction
         ax.axvspan(lo, hi, color="w", alpha=0.12)
-        lo, hi = result.intervals["rolling_friction"]
+        lo, hi = result.intervals.rolling_friction
         ax.axhspan(lo, hi, color="w", alpha=0.12)
     ax.set_xscale("log")
     ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
@@ -206,8 +206,8 @@ def plot_calibration_posterior(result, post, path: str | os.PathLike) -> Path:
     ax.set_xlabel("particle friction f_p")
     ax.set_ylabel("rolling friction mu_r")
     ax.set_title(
-        f"posterior (correlation {result.posterior['correlation']:+.2f}); shaded: "
-        f"{result.level:.0%} intervals" + (" (unknown: not shaded)" if result.get("unidentified") else ""),
+        f"posterior (correlation {result.posterior.correlation:+.2f}); shaded: "
+        f"{result.level:.0%} intervals" + (" (unknown: not shaded)" if result.unidentified else ""),
         fontsize=9,
     )
     ax.legend(fontsize=7, loc="upper right")
@@ -236,7 +236,7 @@ def plot_posterior_corner(result, post, path: str | os.PathLike) -> Path:
     d = len(axes)
     fig, grid = plt.subplots(d, d, figsize=(2.2 * d, 2.2 * d), squeeze=False)
     design = post.ranges.to_unit(*zip(*(e.parameters(axes) for e in result.evaluations), strict=True))
-    best = post.ranges.to_unit(*(result.best[_AXES[a][1]] for a in axes))[0]
+    best = post.ranges.to_unit(*(getattr(result.best, _AXES[a][1]) for a in axes))[0]
     for i in range(d):
         for j in range(d):
             ax = grid[i][j]
@@ -269,7 +269,7 @@ def _corner_marginal(ax, result, post, axis: str) -> None:
     """One parameter's marginal histogram, its interval shaded when known."""
     k = post.ranges.axes.index(axis)
     ax.hist(post.chain[:, k], bins=CORNER_BINS, range=(0, 1), color="0.4")
-    interval = result.intervals.get(_AXES[axis][1])
+    interval = getattr(result.intervals, _AXES[axis][1])
     if interval is not None:
         lo, hi = post.ranges.to_unit(*_at_axis(result, post, axis, interval))[:, k]
         ax.axvspan(lo, hi, color="tab:blue", alpha=0.2)
@@ -280,7 +280,7 @@ def _corner_marginal(ax, result, post, axis: str) -> None:
 def _at_axis(result, post, axis: str, values) -> list:
     """Parameter columns for :meth:`to_unit` that hold ``values`` on ``axis`` (the best elsewhere)."""
     return [
-        np.asarray(values, float) if a == axis else np.full(len(values), result.best[_AXES[a][1]])
+        np.asarray(values, float) if a == axis else np.full(len(values), getattr(result.best, _AXES[a][1]))
         for a in post.ranges.axes
     ]
 

@@ -17,26 +17,28 @@ PARAMETERS = (
 
 def calibrated(result) -> list[tuple[str, str, str]]:
     """The parameters ``result`` calibrated (:data:`PARAMETERS` whose range it holds)."""
-    return [p for p in PARAMETERS if result.ranges.get(p[0]) is not None]
+    return [p for p in PARAMETERS if getattr(result.ranges, p[0]) is not None]
 
 
 def interval_text(result, name: str) -> str:
-    if result.intervals[name] is None:  # a design that cannot estimate its noise (``unidentified``)
-        return f"{result.best[name]:.3g} at the posterior maximum; {result.level:.0%} interval unknown"
-    lo, hi = result.intervals[name]
-    median = result.posterior["median"][name]
+    best, interval = getattr(result.best, name), getattr(result.intervals, name)
+    if interval is None:  # a design that cannot estimate its noise (``unidentified``)
+        return f"{best:.3g} at the posterior maximum; {result.level:.0%} interval unknown"
+    lo, hi = interval
+    median = getattr(result.posterior.median, name)
     return (
-        f"{result.best[name]:.3g} at the posterior maximum; marginal median {median:.3g},"
+        f"{best:.3g} at the posterior maximum; marginal median {median:.3g},"
         f" {result.level:.0%} interval {lo:.3g} to {hi:.3g}"
     )
 
 
 def identifiability_note(result) -> str:
     """What the posterior says about identifiability, in words."""
-    if result.get("unidentified"):
-        return f"Not identified: {result['unidentified']}."
-    wide = [n for n, w in result.posterior["wide"].items() if w]
-    corr = result.posterior["correlation"]
+    if result.unidentified:
+        return f"Not identified: {result.unidentified}."
+    flags = result.posterior.wide.to_dict()  # one per calibrated parameter
+    wide = [n for n, w in flags.items() if w]
+    corr = result.posterior.correlation
     text = f"The posterior correlation of log(f_p) and mu_r is {corr:+.2f}."
     if abs(corr) > 0.7:
         text += (
@@ -56,7 +58,7 @@ def identifiability_note(result) -> str:
             + (
                 " the volumetric strain, readings along the curves (--stations), more confining stresses"
                 " or more replicate specimens narrow it."
-                if result.get("test") == "biaxial"
+                if result.test == "biaxial"
                 else " whole curves that soften (the end stress) or that carry the plate's rise (the"
                 " dilation), readings along them (--stations), more normal stresses or more replicate"
                 " specimens narrow it."
@@ -70,7 +72,7 @@ def identifiability_note(result) -> str:
     else:
         text += (
             " Both intervals are narrower than half their search ranges."
-            if len(result.posterior["wide"]) == 2
+            if len(flags) == 2
             else " Every interval is narrower than half its search range."
         )
     return text
@@ -79,7 +81,7 @@ def identifiability_note(result) -> str:
 def box_note(result) -> str | None:
     """The box the frictions were fitted in, in one line (None for a file written before boxes were
     recorded): parameters fitted to a box-scale box carry its biases (docs/shear.md)."""
-    scale = result.get("box_scale")
+    scale = result.box_scale
     if scale is None:  # the shear package's BoxScale (a result read back through its class)
         return None
     fitted = "fitted to a box-scale box: they carry its biases" if scale.box_scale else "fitted"
@@ -90,17 +92,17 @@ def box_note(result) -> str | None:
 def box_dominated_note(result) -> str | None:
     """How many design points were left out as box-dominated, in one line (None for a biaxial
     calibration or a file written before they were)."""
-    left = result.get("box_dominated")
-    return None if left is None else f"{left['note'][:1].upper()}{left['note'][1:]}."
+    left = result.box_dominated
+    return None if left is None else f"{left.note[:1].upper()}{left.note[1:]}."
 
 
 def repeats_note(result) -> str | None:
     """The laboratory repeats fitted as their mean, in one line (None for a single series)."""
     post = result.posterior
-    count = post.get("lab_repeats")
+    count = post.lab_repeats
     if not count:
         return None
-    ratio = post.get("lab_scatter_ratio")
+    ratio = post.lab_scatter_ratio
     scaled = "" if ratio is None or ratio <= 1.0 else f", so their share was scaled up by {ratio:.2f}"
     return (
         f"{count} laboratory repeats fitted as their mean; their scatter is {ratio:.2f} times a simulated "
@@ -111,19 +113,19 @@ def repeats_note(result) -> str | None:
 
 def discrepancy_note(result) -> str | None:
     """The model-discrepancy term in one line (None without one, or in a file written before it)."""
-    term = result.posterior.get("discrepancy")
-    if not term:
+    term = result.posterior.discrepancy
+    if term is None:
         return None
-    lo, hi = term["interval"]
+    lo, hi = term.interval
     if lo == hi:
-        fixed = term["median"]
+        fixed = term.median
         return f"Model discrepancy fixed at {fixed:.3g} noise sd per observable; the intervals include it."
     text = (
         f"Model discrepancy (what the laboratory may miss the model by, in each observable's noise sd):"
-        f" median {term['median']:.3g}, {100 * result.level:g} % interval {lo:.3g} to {hi:.3g};"
+        f" median {term.median:.3g}, {100 * result.level:g} % interval {lo:.3g} to {hi:.3g};"
         " the intervals above include it."
     )
-    if term.get("saturated"):
+    if term.saturated:
         text += (
             " Its interval reaches the prior's top: the laboratory may lie further from the model than"
             " the term allows, and the intervals may still be too narrow."
@@ -135,26 +137,26 @@ def fit_table(observables) -> tuple[list[str], list[list]]:
     """The fit table's header and rows: in kPa while every target is a stress; with dilation
     targets (mm) each row names its unit."""
     units = {"lab_kpa": "kPa", "lab_mm": "mm", "lab_ratio": "ratio"}
-    named = [(o, next(u for k, u in units.items() if o.get(k) is not None)) for o in observables]
+    named = [(o, next(u for k, u in units.items() if getattr(o, k) is not None)) for o in observables]
     if all(u == "kPa" for _, u in named):
         header = ["observable", "normal stress (kPa)", "laboratory (kPa)", "model (kPa)", "noise sd (kPa)"]
-        rows = [[o["observable"], o["normal_stress_kpa"], *_values(o, "kpa")] for o, _ in named]
+        rows = [[o.observable, o.normal_stress_kpa, *_values(o, "kpa")] for o, _ in named]
     else:  # biaxial targets: the stress is sigma_3, every value dimensionless ("1")
         stress = "confining stress (kPa)" if all(u == "ratio" for _, u in named) else "normal stress (kPa)"
         header = ["observable", stress, "unit", "laboratory", "model", "noise sd"]
-        rows = [[o["observable"], o["normal_stress_kpa"], _shown(u), *_values(o, u.lower())]
+        rows = [[o.observable, o.normal_stress_kpa, _shown(u), *_values(o, u.lower())]
                 for o, u in named]  # fmt: skip
-    if any(o.get("stiffness_number") is not None for o in observables):
+    if any(o.stiffness_number is not None for o in observables):
         # how much elastic strain a volumetric observable carries: kappa and the overlap at the peak
         header = [*header, "kappa", "overlap / d at peak"]
-        rows = [[*r, o.get("stiffness_number"), o.get("mean_overlap_ratio_at_peak")]
+        rows = [[*r, o.stiffness_number, o.mean_overlap_ratio_at_peak]
                 for r, o in zip(rows, observables, strict=True)]  # fmt: skip
     return header, rows
 
 
 def _tests(result) -> str:
     """What the calibration ran, as the report names it."""
-    return "Biaxial tests" if result.get("test") == "biaxial" else "Shear tests"
+    return "Biaxial tests" if result.test == "biaxial" else "Shear tests"
 
 
 def _shown(unit: str) -> str:
@@ -163,12 +165,12 @@ def _shown(unit: str) -> str:
 
 
 def _values(o, u: str) -> list[float]:
-    return [o[f"lab_{u}"], o[f"model_{u}"], o[f"noise_sd_{u}"]]
+    return [getattr(o, f"lab_{u}"), getattr(o, f"model_{u}"), getattr(o, f"noise_sd_{u}")]
 
 
 def calibration_blocks(result, out: Path) -> list[tuple]:
     """The section's blocks: best values, identifiability, the fit table and the two figures."""
-    header, rows = fit_table(result.posterior["observables"])
+    header, rows = fit_table(result.posterior.observables)
     info = result.cluster
     return [
         (
@@ -178,7 +180,7 @@ def calibration_blocks(result, out: Path) -> list[tuple]:
         ),
         (
             "p",
-            f"Laboratory data: {result.lab['source']} ({result.lab['kind']}); "
+            f"Laboratory data: {result.lab.source} ({result.lab.kind}); "
             f"{len(result.specimens)} replicate specimen(s); {len(result.evaluations)} design points.",
         ),
         (
@@ -205,8 +207,8 @@ def calibration_blocks(result, out: Path) -> list[tuple]:
         ),
         (
             "p",
-            f"{_tests(result)}: {info['tests_run']} run, {info['tests_reused']} reused from the cache, "
-            f"{info['tests_failed']} failed; wall time {result.timings['wall_time_s']:.0f} s.",
+            f"{_tests(result)}: {info.tests_run} run, {info.tests_reused} reused from the cache, "
+            f"{info.tests_failed} failed; wall time {result.timings.wall_time_s:.0f} s.",
         ),
     ]
 

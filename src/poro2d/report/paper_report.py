@@ -54,7 +54,7 @@ def build_blocks(
     b = _intro_blocks(summary, crit)
     b += _inputs_blocks(summary, crit)
     b += _conversion_blocks(out, summary.conversions)
-    b += _criterion_blocks(criterion, summary.paper["criterion"])
+    b += _criterion_blocks(criterion, summary.paper.criterion)
     if sensitivity is not None:  # why the paper gets what it gets, when the run holds a sensitivity study
         from poro2d.report.sensitivity_report import report_blocks
 
@@ -78,41 +78,41 @@ def _calibration_blocks(calibration: Any, folder: Path) -> list[Block]:
 def _intro_blocks(summary, crit) -> list[Block]:
     """The title, the paper's case in one paragraph, and the summary table beside the paper."""
     paper = summary.paper
-    pc = paper["criterion"]
-    its = crit.iterations or []
+    pc = paper.criterion
+    its = [r.to_dict() for r in crit.iterations or []]  # each trial's row (its keys are not its fields)
     shear = summary.shear
     b: list[Block] = [("h1", "poro2d: the paper's case study")]
     b.append((
         "p",
         "Wang, Jacobs and Ziegler, 'A new suggestion for determining 2D porosities in DEM studies': "
-        f"laboratory porosity nLab = {paper['n_lab']} (dry density {paper['dry_density_kg_m3']:.0f} "
-        f"kg/m3, solid density {paper['solid_density_kg_m3']:.0f} kg/m3), nLab,max = {paper['n_max']}, "
-        f"nLab,min = {paper['n_min']}."
+        f"laboratory porosity nLab = {paper.n_lab} (dry density {paper.dry_density_kg_m3:.0f} "
+        f"kg/m3, solid density {paper.solid_density_kg_m3:.0f} kg/m3), nLab,max = {paper.n_max}, "
+        f"nLab,min = {paper.n_min}."
         + (" Quick mode: a reduced specimen, not the paper's box." if summary.quick else ""),
     ))  # fmt: skip
     b.append(("h2", "Summary"))
-    rows = [["accepted 2D porosity", crit.final_porosity, pc["accepted_porosity"]]]
+    rows = [["accepted 2D porosity", crit.final_porosity, pc.accepted_porosity]]
     if crit.interior_porosity is not None:
         rows.append(["box porosity n' of the accepted specimen (gap under the plate included)",
                      crit.box_porosity, "-"])  # fmt: skip
         inner = f"{crit.interior_porosity:.4f} +- {crit.interior_porosity_std:.4f}"
         rows.append(["interior porosity of the accepted specimen (the packing's own)", inner, "-"])
     if its:
-        rows.append(["first trial porosity (Eq. 12, rounded)", its[0]["trial_porosity"], pc["trials"][0]])
-        rows.append(["number of trials", len(its), len(pc["trials"])])
+        rows.append(["first trial porosity (Eq. 12, rounded)", its[0]["trial_porosity"], pc.trials[0]])
+        rows.append(["number of trials", len(its), len(pc.trials)])
     reps = summary.replicate_specimens or []
     if reps:
-        n2d = [r["final_porosity"] for r in reps if r["converged"]]
+        n2d = [r.final_porosity for r in reps if r.converged]
         rows.append([
             "accepted n2D of the replicate seeds", ", ".join(f"{v:.2f}" for v in n2d) or "none accepted", "-",
         ])  # fmt: skip
     if shear:
-        fit = (shear.get("replicates") or {}).get("fit") or {}
-        ci = fit.get("friction_angle_ci_deg")
-        phi = shear.get("friction_angle_deg")
+        fit = getattr(shear.replicates, "fit", None)
+        ci = fit.friction_angle_ci_deg if fit is not None else None
+        phi = shear.friction_angle_deg
         if phi is not None and ci:
-            phi = f"{phi:.1f} ({fit['level']:.0%} interval {ci[0]:.1f} to {ci[1]:.1f})"
-        scale = shear.get("box_scale")  # the shear package's BoxScale: box-scale angles are labelled
+            phi = f"{phi:.1f} ({fit.level:.0%} interval {ci[0]:.1f} to {ci[1]:.1f})"
+        scale = shear.extra.get("box_scale")  # the shear package's BoxScale: box-scale angles are labelled
         label = f" ({scale.label()})" if scale is not None and scale.label() else ""
         rows.append([f"friction angle from peak strengths{label} (deg)", phi, "not stated"])
     b.append(("table", ["quantity", "poro2d", "paper"], rows))
@@ -122,26 +122,26 @@ def _intro_blocks(summary, crit) -> list[Block]:
 
 def _inputs_blocks(summary, crit) -> list[Block]:
     """What is reconstructed or assumed where the paper is silent."""
-    spec, pc = crit.specimen, summary.paper["criterion"]
-    pairs = enumerate(zip(pc["particle_counts"], pc["trials"], strict=True))
+    spec, pc = crit.specimen, summary.paper.criterion
+    pairs = enumerate(zip(pc.particle_counts, pc.trials, strict=True))
     counts = ", ".join(f"{n} disks at {t:g}" if i == 0 else f"{n} at {t:g}" for i, (n, t) in pairs)
     quick = [
-        f"Quick mode: a {spec['width']} m x {spec['height']} m box in {spec['layers']} "
+        f"Quick mode: a {spec.width} m x {spec.height} m box in {spec.layers} "
         "layers, the criterion's force window widened to "
-        f"{crit.settings['force_fraction']:.0%} of G (in so small a box 1 % "
+        f"{crit.settings.force_fraction:.0%} of G (in so small a box 1 % "
         "of G is about two disks' weight), shear to 4 mm: a first look, not the paper's case.",
     ] if summary.quick else []  # fmt: skip
     return [("h2", "Inputs the paper does not give"), ("ul", [
         "Grading curve: a reconstruction of the paper's Fig. 4 (a medium sand, up-scaled x10), matched "
         f"to the paper's particle counts ({counts}); see docs/grading.md. The "
         "real curve can replace it ([grading] csv = ...).",
-        f"Local damping {spec['local_damping']} (PFC 4.0's default; the paper does not state it).",
+        f"Local damping {spec.local_damping} (PFC 4.0's default; the paper does not state it).",
         "Contact properties combined PFC 4.0 style (springs in series, smaller friction), as Table 1 lists "
         "them per body.",
-        f"Disk thickness {spec['thickness']} m (the paper's 8 mm); forces per metre of thickness.",
+        f"Disk thickness {spec.thickness} m (the paper's 8 mm); forces per metre of thickness.",
         "Multilayer compaction by radius expansion inside each band under a temporary lid "
-        f"({spec['layers']} layers), equilibrium at a maximum unbalanced-force ratio of "
-        f"{spec['ratio']}.",
+        f"({spec.layers} layers), equilibrium at a maximum unbalanced-force ratio of "
+        f"{spec.ratio}.",
         *quick,
         "Direct shear: the shear velocity is far above the laboratory rate of 0.384 mm/min "
         f"(quasi-static checks below); {_lab_text(summary)} A test ends once its smoothed peak lies "
@@ -158,22 +158,22 @@ def _lab_text(summary) -> str:
             "no laboratory curves are built in (Fig. 8's data are not published as numbers): "
             "pass them with --lab."
         )
-    peaks = len(lab.get("peaks") or [])
-    what = f"laboratory {lab.get('kind', 'data')} from {lab.get('source')} ({peaks} peak(s))"
+    peaks = len(lab.peaks or [])
+    what = f"laboratory {lab.kind or 'data'} from {lab.source} ({peaks} peak(s))"
     if not summary.shear:
         return f"{what} were given, but no test ran to compare them with."
     return f"{what} are drawn beside the DEM's in Fig. 8."
 
 
-def _conversion_blocks(out: Path, conv: dict) -> list[Block]:
+def _conversion_blocks(out: Path, conv) -> list[Block]:
     """The table of Eqs. 1-12 and Figs. 1-2 (the figures the conversions stage lists)."""
     cdir = out / "conversions"
-    figures = [("img", cdir / name, CONVERSION_FIGURES[name]) for name in conv.get("figures", [])
+    figures = [("img", cdir / name, CONVERSION_FIGURES[name]) for name in conv.figures or []
                if name in CONVERSION_FIGURES]  # fmt: skip
     return [
         ("h2", "3D-to-2D conversions (Eqs. 1-12)"),
         ("table", ["method", "equation", "n2D", "flags"],
-         [[m["method"], m["equation"], m["n2d"], m["flags"]] for m in conv["methods"]]),
+         [[m.method, m.equation, m.n2d, m.flags] for m in conv.methods]),
         *figures,
     ]  # fmt: skip
 
@@ -186,10 +186,10 @@ CRITERION_CAPTIONS = {
 }
 
 
-def _criterion_blocks(criterion, pc: dict) -> list[Block]:
+def _criterion_blocks(criterion, pc) -> list[Block]:
     """poro2d's trials beside the paper's, the discussion, Figs. 5-7 and the specimen's state."""
     b: list[Block] = [("h2", "The criterion (Fig. 3)")]
-    its = criterion.result.iterations or []
+    its = [r.to_dict() for r in criterion.result.iterations or []]  # each trial's row
     if its:
         b.append((
             "table",
@@ -216,13 +216,12 @@ def _criterion_blocks(criterion, pc: dict) -> list[Block]:
             "table",
             ["", "trial 1", "trial 2"],
             [
-                ["trial n2D", *pc["trials"]],
-                ["disks", *pc["particle_counts"]],
-                ["F_top at H (N/m)", 1e3 * pc["f_top_first_trial_kn_per_m"], pc["f_top_accepted_n_per_m"]],
-                ["F_bottom at H (N/m)", 1e3 * pc["f_bottom_first_trial_kn_per_m"],
-                 pc["f_bottom_accepted_n_per_m"]],
-                ["G (N/m)", pc["self_weight_first_trial_n_per_m"], pc["self_weight_accepted_n_per_m"]],
-                ["|n' - n2D|", pc["porosity_change_first_trial"], "-"],
+                ["trial n2D", *pc.trials],
+                ["disks", *pc.particle_counts],
+                ["F_top at H (N/m)", 1e3 * pc.f_top_first_trial_kn_per_m, pc.f_top_accepted_n_per_m],
+                ["F_bottom at H (N/m)", 1e3 * pc.f_bottom_first_trial_kn_per_m, pc.f_bottom_accepted_n_per_m],
+                ["G (N/m)", pc.self_weight_first_trial_n_per_m, pc.self_weight_accepted_n_per_m],
+                ["|n' - n2D|", pc.porosity_change_first_trial, "-"],
                 ["accepted", "no", "yes"],
             ],
         ))  # fmt: skip
@@ -237,22 +236,27 @@ def _provenance_blocks(summary, crit) -> list[Block]:
     """Version, machine, seed, timings and the settings of the run."""
     return [
         ("h2", "Provenance"),
-        ("table", ["item", "value"], [[k, str(v)] for k, v in (summary.provenance or {}).items()]
+        ("table", ["item", "value"], [[k, str(v)] for k, v in _as_dict(summary.provenance).items()]
          + [["seed", summary.seed]]
-         + [[f"time: {k}", v] for k, v in (summary.timings or {}).items()]),
-        ("code", json.dumps({"specimen": dict(crit.specimen or {}), "criterion": dict(crit.settings or {})},
+         + [[f"time: {k}", v] for k, v in _as_dict(summary.timings).items()]),
+        ("code", json.dumps({"specimen": _as_dict(crit.specimen), "criterion": _as_dict(crit.settings)},
                             indent=1)),
     ]  # fmt: skip
 
 
-def _criterion_discussion(its: list[dict], pc: dict) -> list[Block]:
+def _as_dict(part) -> dict:
+    """A typed part as the dict of its file (empty when missing)."""
+    return part.to_dict() if part is not None else {}
+
+
+def _criterion_discussion(its: list[dict], pc) -> list[Block]:
     first = its[0]
     out: list[Block] = [("h3", "Where poro2d differs from the paper")]
     notes = []
-    ratio = first["f_top_n_per_m"] / (1e3 * pc["f_top_first_trial_kn_per_m"])
+    ratio = first["f_top_n_per_m"] / (1e3 * pc.f_top_first_trial_kn_per_m)
     notes.append(
         f"At the first trial the top plate carries {first['f_top_n_per_m']:.4g} N/m, "
-        f"{ratio:.2g} times the paper's {pc['f_top_first_trial_kn_per_m']:g} kN/m; both are far above the "
+        f"{ratio:.2g} times the paper's {pc.f_top_first_trial_kn_per_m:g} kN/m; both are far above the "
         "self weight, so the "
         "branch taken is the same (the plate moves up)."
     )
@@ -260,15 +264,15 @@ def _criterion_discussion(its: list[dict], pc: dict) -> list[Block]:
         notes.append(
             f"After the plate moved, n' = {first['new_porosity']:.4f} "
             f"(change {first['porosity_change']:.4f}; "
-            f"paper: {pc['trials'][0] + pc['porosity_change_first_trial']:.3f}, change "
-            f"{pc['porosity_change_first_trial']:g}). The reconstructed grading is narrow (Cu about 1.7): "
+            f"paper: {pc.trials[0] + pc.porosity_change_first_trial:.3f}, change "
+            f"{pc.porosity_change_first_trial:g}). The reconstructed grading is narrow (Cu about 1.7): "
             "disks of similar size leave larger voids than a well-graded sand, so the specimen relaxes to a "
             "looser state than the paper's. The accepted porosity follows from the grading; with the real "
             "Fig. 4 curve the result may differ."
         )
     notes.append(
-        f"The paper's F_bottom ({pc['f_bottom_accepted_n_per_m']:g} N/m) is close to G "
-        f"({pc['self_weight_accepted_n_per_m']:g} N/m). poro2d reports F_bottom and the vertical "
+        f"The paper's F_bottom ({pc.f_bottom_accepted_n_per_m:g} N/m) is close to G "
+        f"({pc.self_weight_accepted_n_per_m:g} N/m). poro2d reports F_bottom and the vertical "
         "friction of the side walls separately: their sum balances the weight plus F_top."
     )
     out.append(("ul", notes))
@@ -358,12 +362,12 @@ def _porosity_blocks(criterion) -> list[Block]:
     return b
 
 
-def _shear_blocks(shear: dict, figures: dict[str, Path]) -> list[Block]:
+def _shear_blocks(shear, figures: dict[str, Path]) -> list[Block]:
     """Fig. 8 over the replicate specimens: peaks mean +- sd, the pooled fit with its intervals."""
     b: list[Block] = [("h2", "Direct shear tests (Fig. 8)")]
-    rep = shear.get("replicates") or {}
-    rows = rep.get("per_normal_stress", [])
-    n = len(rep.get("specimens", []))
+    rep = shear.replicates  # None in a summary without replicates: no rows, no fits
+    rows = getattr(rep, "per_normal_stress", None) or []
+    n = len(getattr(rep, "specimens", None) or [])
     if rows:
         b.append((
             "p",
@@ -374,31 +378,28 @@ def _shear_blocks(shear: dict, figures: dict[str, Path]) -> list[Block]:
         b.append((
             "table",
             ["normal stress (kPa)", "peak mean (kPa)", "peak sd (kPa)", "specimens", "peaks (kPa)"],
-            [[r["normal_stress_kpa"], r["peak_mean_kpa"], r["peak_sd_kpa"], r["n"],
-              ", ".join(f"{v:.1f}" for v in r["peaks_kpa"])] for r in rows],
+            [[r.normal_stress_kpa, r.peak_mean_kpa, r.peak_sd_kpa, r.n,
+              ", ".join(f"{v:.1f}" for v in r.peaks_kpa)] for r in rows],
         ))  # fmt: skip
     fits = []
     for key, name in (("fit", "least squares"), ("fit_through_origin", "through the origin (c = 0)")):
-        f = rep.get(key)
-        if not f:
+        f = getattr(rep, key, None)
+        if f is None:
             continue
-        ci = f.get("friction_angle_ci_deg")
-        cci = f.get("cohesion_ci_kpa")
+        ci, cci = f.friction_angle_ci_deg, f.cohesion_ci_kpa
         fits.append(
-            f"{name}: phi = {f['friction_angle_deg']:.1f} deg"
-            + (f" ({f['level']:.0%} interval {ci[0]:.1f} to {ci[1]:.1f})" if ci else " (too few points)")
-            + (f", c = {f['cohesion_kpa']:.1f} kPa ({cci[0]:.1f} to {cci[1]:.1f})" if cci else "")
+            f"{name}: phi = {f.friction_angle_deg:.1f} deg"
+            + (f" ({f.level:.0%} interval {ci[0]:.1f} to {ci[1]:.1f})" if ci else " (too few points)")
+            + (f", c = {f.cohesion_kpa:.1f} kPa ({cci[0]:.1f} to {cci[1]:.1f})" if cci else "")
         )  # fmt: skip
-    per = rep.get("friction_angle_per_specimen_deg") or []
+    per = getattr(rep, "friction_angle_per_specimen_deg", None) or []
     if per:
         fits.append("phi of each specimen alone: " + ", ".join(f"{v:.1f}" for v in per) + " deg")
     if fits:
         b.append(("ul", fits))
-    elif shear.get("friction_angle_deg") is not None:
-        b.append(
-            ("p", f"Mohr-Coulomb fit of the peaks: friction angle {shear['friction_angle_deg']:.3g} deg.")
-        )
-    scale = shear.get("box_scale")
+    elif shear.friction_angle_deg is not None:
+        b.append(("p", f"Mohr-Coulomb fit of the peaks: friction angle {shear.friction_angle_deg:.3g} deg."))
+    scale = shear.extra.get("box_scale")
     if scale is not None:
         b.append(("note", scale.note() + ("" if scale.warning() is None else f"; {scale.warning()}")))
     for name, cap in SHEAR_FIGURES.items():

@@ -1,7 +1,7 @@
 """The figure of a grading's relation n2D(nLab): the criterion's points against the conversions.
 
-Drawn from an analysed relation (the dict of :func:`poro2d.sweep.relation.analyse`, or a
-:class:`poro2d.sweep.results.RelationResult`): the DEM points, hollow where the criterion
+Drawn from an analysed relation (the :class:`poro2d.sweep.results.RelationResult` of
+:func:`poro2d.sweep.relation.analyse`, or one read back): the DEM points, hollow where the criterion
 did not converge, the parabola fitted to them, Eq. 12 and the other conversion methods
 (those the relation's table compares, in its order).
 """
@@ -19,36 +19,36 @@ from poro2d import porosity as P
 from poro2d.report.figure_file import save_figure
 
 
-def write_relation_figure(rel: dict, out: Path, title: str = "") -> list[Path]:
+def write_relation_figure(rel, out: Path, title: str = "") -> list[Path]:
     """``relation.png`` and ``relation.svg`` in ``out``; returns both paths."""
     paths = [out / "relation.png", out / "relation.svg"]
     save_figure(plot_relation(rel, title), *paths)
     return paths
 
 
-def plot_relation(rel: dict, title: str = "") -> Figure:
+def plot_relation(rel, title: str = "") -> Figure:
     """DEM points (hollow = not converged), the fit, Eq. 12 and other methods vs nLab."""
-    hi, lo = rel["n_max"], rel["n_min"]
-    pts = rel["points"]
-    xs = [p["n_lab"] for p in pts] + [hi, lo]
+    hi, lo = rel.n_max, rel.n_min
+    pts = rel.points
+    xs = [p.n_lab for p in pts] + [hi, lo]
     pad = 0.08 * (max(xs) - min(xs))
     x = np.linspace(min(xs) - pad, max(xs) + pad, 201)
     fig = Figure(figsize=(9.5, 6.0), layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     ax.axvspan(lo, hi, color="0.5", alpha=0.07, lw=0)
-    _method_curves(ax, x, hi, lo, rel.get("fit"))
+    _method_curves(ax, x, hi, lo, rel.fit)
     _dem_points(ax, rel)
-    failed = [p for p in pts if not math.isfinite(p["n2d_dem"])]
+    failed = [p for p in pts if not _finite(p.n2d_dem)]
     for p in failed:
-        ax.axvline(p["n_lab"], color="tab:red", ls=":", lw=1.0)
+        ax.axvline(p.n_lab, color="tab:red", ls=":", lw=1.0)
     ax.set_xlim(x[0], x[-1])
     ax.set_xlabel("laboratory porosity nLab [-]   (shaded: between n_min and n_max)")
     ax.set_ylabel("2D porosity n2D [-]")
     head = title or "2D porosity from the criterion vs laboratory porosity"
     sub = f"n_max = {hi:g} (Dr = 0), n_min = {lo:g} (Dr = 1)"
-    if rel.get("mode") == "density":
-        seeds = max((p["seeds"] for p in pts), default=0)
+    if rel.mode == "density":
+        seeds = max((p.seeds for p in pts), default=0)
         sub += f"; density-controlled preparation, {seeds} seed(s) per state"
     if failed:
         sub += f"; {len(failed)} failed case(s) dotted"
@@ -58,7 +58,12 @@ def plot_relation(rel: dict, title: str = "") -> Figure:
     return fig
 
 
-def _method_curves(ax, x: np.ndarray, hi: float, lo: float, fit: dict | None) -> None:
+def _finite(v) -> bool:
+    """Whether ``v`` is a number (a failed case's n2D is None, as its file keeps NaN)."""
+    return v is not None and math.isfinite(v)
+
+
+def _method_curves(ax, x: np.ndarray, hi: float, lo: float, fit) -> None:
     """Eq. 12 and the other conversion methods over ``x``, and the parabola fitted to the DEM."""
     styles = {
         "parabolic": ("Parabola, Eq. 12 (0.42 n^2 + 0.25 n)", dict(color="black", lw=2.0)),
@@ -75,40 +80,40 @@ def _method_curves(ax, x: np.ndarray, hi: float, lo: float, fit: dict | None) ->
     for m, (label, st) in styles.items():
         ax.plot(x, funcs[m](x), label=label, **st)
     if fit is not None:
-        label = f"fit to DEM: {fit['a']:.3f} n^2 + {fit['b']:.3f} n (rms {fit['rms_residual']:.4f})"
-        ax.plot(x, fit["a"] * x * x + fit["b"] * x, color="tab:red", lw=2.0, ls="-.", label=label)
+        label = f"fit to DEM: {fit.a:.3f} n^2 + {fit.b:.3f} n (rms {fit.rms_residual:.4f})"
+        ax.plot(x, fit.a * x * x + fit.b * x, color="tab:red", lw=2.0, ls="-.", label=label)
 
 
-def _interior_points(ax, ok: list[dict]) -> None:
+def _interior_points(ax, ok: list) -> None:
     """The accepted specimens' interior porosity (the packing's own) beside the box porosity."""
-    ins = [p for p in ok if math.isfinite(p.get("n2d_interior", math.nan))]
+    ins = [p for p in ok if _finite(p.n2d_interior)]
     if ins:
-        ax.errorbar([p["n_lab"] for p in ins], [p["n2d_interior"] for p in ins],
-                    yerr=[p["n2d_interior_sd"] for p in ins], fmt="s", color="tab:purple", ms=6, capsize=3,
+        ax.errorbar([p.n_lab for p in ins], [p.n2d_interior for p in ins],
+                    yerr=[p.n2d_interior_sd for p in ins], fmt="s", color="tab:purple", ms=6, capsize=3,
                     label="DEM interior porosity (2 d50 clear of walls, surface; mean +- sd)")  # fmt: skip
 
 
-def _dem_points(ax, rel: dict) -> None:
+def _dem_points(ax, rel) -> None:
     """Accepted points (with seed error bars in density mode), unconverged ones hollow, Dr labels."""
-    pts = rel["points"]
-    ok = [p for p in pts if p["converged"]]
-    bad = [p for p in pts if not p["converged"] and math.isfinite(p["n2d_dem"])]
-    ox, oy = [p["n_lab"] for p in ok], [p["n2d_dem"] for p in ok]
-    if ok and rel.get("mode") == "density":
+    pts = rel.points
+    ok = [p for p in pts if p.converged]
+    bad = [p for p in pts if not p.converged and _finite(p.n2d_dem)]
+    ox, oy = [p.n_lab for p in ok], [p.n2d_dem for p in ok]
+    if ok and rel.mode == "density":
         label = "DEM criterion, density-controlled (mean accepted n2D +- sd over seeds)"
-        ax.errorbar(ox, oy, yerr=[p["n2d_sd"] for p in ok], fmt="o", color="tab:red", ms=8, capsize=4,
+        ax.errorbar(ox, oy, yerr=[p.n2d_sd for p in ok], fmt="o", color="tab:red", ms=8, capsize=4,
                     label=label)  # fmt: skip
-        ax.axhline(rel["n2d_max"], color="0.4", lw=0.8, ls=":", label="2D extremes (calibrated)")
-        ax.axhline(rel["n2d_min"], color="0.4", lw=0.8, ls=":")
+        ax.axhline(rel.n2d_max, color="0.4", lw=0.8, ls=":", label="2D extremes (calibrated)")
+        ax.axhline(rel.n2d_min, color="0.4", lw=0.8, ls=":")
         _interior_points(ax, ok)
     elif ok:
         ax.plot(ox, oy, "o", color="tab:red", ms=8, label="DEM criterion (accepted n2D)")
     if bad:
-        ax.plot([p["n_lab"] for p in bad], [p["n2d_dem"] for p in bad], "o", mfc="none", mec="tab:red",
+        ax.plot([p.n_lab for p in bad], [p.n2d_dem for p in bad], "o", mfc="none", mec="tab:red",
                 mew=1.8, ms=9, label="DEM, not converged (last n')")  # fmt: skip
     for p in pts:
-        if math.isfinite(p["n2d_dem"]):
-            ax.annotate(f"Dr={p['relative_density']:.2f}", (p["n_lab"], p["n2d_dem"]),
+        if _finite(p.n2d_dem):
+            ax.annotate(f"Dr={p.relative_density:.2f}", (p.n_lab, p.n2d_dem),
                         textcoords="offset points", xytext=(6, -12), fontsize=8, color="0.25")  # fmt: skip
 
 

@@ -1,8 +1,9 @@
 """The figure and the report section of the sensitivity study (``poro2d sensitivity``).
 
 Both read only the study's result dict (as written to ``sensitivity.json``), so a
-report can be rebuilt from the file. Values that were undefined (no converged seed)
-come back from JSON as ``None`` and are shown as such.
+report can be rebuilt from the file; the typed study (a ``SensitivityResult``, or the dict of
+its typed parts being written) is read as that dict. Values that were undefined (no converged
+seed) come back from JSON as ``None`` and are shown as such.
 """
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from poro2d.io_utils import float_or_nan
+from poro2d.io_utils import as_json, float_or_nan
 from poro2d.report.document import Block
 
 
@@ -25,6 +26,7 @@ def plot_sensitivity(sens: dict, stem: Path) -> list[Path]:
 
     from poro2d.report.figure_file import save_figure
 
+    sens = as_json(sens)  # the dict of sensitivity.json
     paper = sens["paper"]
     target, tol = float(paper["accepted_porosity"]), float(sens["answer"]["tolerance"])
     fig = Figure(figsize=(12.0, 5.2), layout="constrained")
@@ -102,6 +104,7 @@ def report_blocks(sens: dict, figure: str | Path | None = None) -> list[Block]:
 
     ``figure``: the study's PNG; by default the one recorded in ``sens["figure"]``.
     """
+    sens = as_json(sens)  # the dict of sensitivity.json
     s, paper = sens["settings"], sens["paper"]
     b: list[Block] = [("h2", "Why the paper gets 0.15: grading width and preparation friction")]
     b.append((

@@ -173,27 +173,27 @@ def plot_replicate_curves(
     return save_figure(fig, path)
 
 
-def plot_replicate_peaks(summary: dict, path: str | os.PathLike, lab=None, lab_fit=None) -> Path:
+def plot_replicate_peaks(summary, path: str | os.PathLike, lab=None, lab_fit=None) -> Path:
     """Fig. 8(b) over specimens: peaks mean +- sd, every specimen's peaks, the pooled fit."""
-    rows = summary["per_normal_stress"]
-    s = np.array([r["normal_stress_kpa"] for r in rows])
+    rows = summary.per_normal_stress
+    s = np.array([r.normal_stress_kpa for r in rows])
     fig, ax = plt.subplots(figsize=(6.5, 5.0))
     smax = float(max(s.max(), max(lab.peaks) if lab is not None else 0.0)) * 1.1
     xs = np.linspace(0.0, smax, 50)
     for r in rows:
-        ax.plot([r["normal_stress_kpa"]] * r["n"], r["peaks_kpa"], ".", color="0.55", ms=5, zorder=3)
-    ax.errorbar(s, [r["peak_mean_kpa"] for r in rows], yerr=[r["peak_sd_kpa"] for r in rows], fmt="o",
+        ax.plot([r.normal_stress_kpa] * r.n, r.peaks_kpa, ".", color="0.55", ms=5, zorder=3)
+    ax.errorbar(s, [r.peak_mean_kpa for r in rows], yerr=[r.peak_sd_kpa for r in rows], fmt="o",
                 color="#d95f02", mec="k", ms=7, capsize=4, zorder=5,
-                label=f"DEM peaks, mean +- sd over {len(summary['specimens'])} specimens")  # fmt: skip
-    for fit, ls in ((summary.get("fit"), "-"), (summary.get("fit_through_origin"), ":")):
+                label=f"DEM peaks, mean +- sd over {len(summary.specimens)} specimens")  # fmt: skip
+    for fit, ls in ((summary.fit, "-"), (summary.fit_through_origin, ":")):
         if fit is None:
             continue
-        tan = math.tan(math.radians(fit["friction_angle_deg"]))
-        ci = fit.get("friction_angle_ci_deg")
+        tan = math.tan(math.radians(fit.friction_angle_deg))
+        ci = fit.friction_angle_ci_deg
         txt = f" [{ci[0]:.1f}, {ci[1]:.1f}]" if ci else ""
-        c = f", c = {fit['cohesion_kpa']:.1f} kPa" if not fit["through_origin"] else ", c = 0"
-        ax.plot(xs, fit["cohesion_kpa"] + tan * xs, color="#d95f02", lw=1.3 if ls == "-" else 1.0, ls=ls,
-                label=f"phi = {fit['friction_angle_deg']:.1f} deg{txt} ({fit['level']:.0%}){c}")  # fmt: skip
+        c = f", c = {fit.cohesion_kpa:.1f} kPa" if not fit.through_origin else ", c = 0"
+        ax.plot(xs, fit.cohesion_kpa + tan * xs, color="#d95f02", lw=1.3 if ls == "-" else 1.0, ls=ls,
+                label=f"phi = {fit.friction_angle_deg:.1f} deg{txt} ({fit.level:.0%}){c}")  # fmt: skip
     title = "Direct shear: peak strength over specimens"
     return _finish_peaks(fig, ax, xs, smax, lab, lab_fit, title, path)
 

@@ -34,19 +34,19 @@ def plot_specimen_state(state: SpecimenStateResult, path: str | os.PathLike, tit
     ``state``: the record of :func:`poro2d.measure.specimen_state.specimen_state`.
     """
     rows = state.bands
-    z = np.array([r["z_mid_m"] for r in rows]) * 1e3
+    z = np.array([r.z_mid_m for r in rows]) * 1e3
     fig = Figure(figsize=(9.0, 4.8), layout="constrained")
     FigureCanvasAgg(fig)
     a1, a2 = fig.subplots(1, 2, sharey=True)
-    a1.plot([r["porosity"] for r in rows], z, "o-", color="tab:blue")
+    a1.plot([r.porosity for r in rows], z, "o-", color="tab:blue")
     a1.axvline(state.porosity_mean, color="0.5", ls=":", lw=1)
     a1.set_xlabel("porosity of the band [-]")
     a1.set_ylabel("height of the band's middle [mm]")
     a1.set_title(f"porosity: mean {state.porosity_mean:.4f}, range {state.porosity_range:.4f}", fontsize=10)
     kpa = 1e-3
-    a2.plot([r["sigma_v_pa"] * kpa for r in rows], z, "o-", color="tab:red", label="sigma_v (disks)")
-    a2.plot([r["sigma_h_pa"] * kpa for r in rows], z, "s-", color="tab:green", label="sigma_h (disks)")
-    a2.plot([r["sigma_v_geostatic_pa"] * kpa for r in rows], z, "--", color="black",
+    a2.plot([r.sigma_v_pa * kpa for r in rows], z, "o-", color="tab:red", label="sigma_v (disks)")
+    a2.plot([r.sigma_h_pa * kpa for r in rows], z, "s-", color="tab:green", label="sigma_h (disks)")
+    a2.plot([r.sigma_v_geostatic_pa * kpa for r in rows], z, "--", color="black",
             label="geostatic: F_top / W + rho_s g (1 - n) (H - z)")  # fmt: skip
     k0 = state.k0_mean
     a2.set_title(

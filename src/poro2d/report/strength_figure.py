@@ -19,20 +19,20 @@ from poro2d.report.figure_file import save_figure  # noqa: E402
 from poro2d.report.shear_figures import COLORS  # noqa: E402
 
 
-def _series(rows: list[dict], friction: float, key: str) -> tuple[list, list, list]:
+def _series(rows: list, friction: float, key: str) -> tuple[list, list, list]:
     """(mu_r, mean, sd) of one quantity for one particle friction, sorted by mu_r."""
-    picked = sorted((r for r in rows if r["particle_friction"] == friction), key=lambda r: r["mu_r"])
-    picked = [r for r in picked if r[f"{key}_mean_deg"] is not None]
+    picked = sorted((r for r in rows if r.particle_friction == friction), key=lambda r: r.mu_r)
+    picked = [r for r in picked if getattr(r, f"{key}_mean_deg") is not None]
     return (
-        [r["mu_r"] for r in picked],
-        [r[f"{key}_mean_deg"] for r in picked],
-        [r[f"{key}_sd_deg"] or 0.0 for r in picked],
+        [r.mu_r for r in picked],
+        [getattr(r, f"{key}_mean_deg") for r in picked],
+        [getattr(r, f"{key}_sd_deg") or 0.0 for r in picked],
     )
 
 
-def plot_strength(rows: list[dict], path: str | os.PathLike) -> Path:
+def plot_strength(rows: list, path: str | os.PathLike) -> Path:
     """Peak and residual friction angles (left) and max dilation angle (right) against mu_r."""
-    frictions = sorted({r["particle_friction"] for r in rows})
+    frictions = sorted({r.particle_friction for r in rows})
     fig, (ax_phi, ax_psi) = plt.subplots(1, 2, figsize=(10, 4.2))
     for k, fp in enumerate(frictions):
         color = COLORS[k % len(COLORS)]
@@ -43,7 +43,7 @@ def plot_strength(rows: list[dict], path: str | os.PathLike) -> Path:
                         label=f"residual, f_p = {fp:g}")  # fmt: skip
         x, y, e = _series(rows, fp, "max_dilation_angle")
         ax_psi.errorbar(x, y, yerr=e, color=color, marker="o", capsize=3, label=f"f_p = {fp:g}")
-    n = max((r["specimens"] for r in rows), default=0)
+    n = max((r.specimens for r in rows), default=0)
     ax_phi.set(xlabel="rolling friction mu_r", ylabel="friction angle (deg)",
                title=f"Peak and residual friction angle (mean +- sd, {n} specimens)")  # fmt: skip
     ax_psi.set(
