@@ -4,12 +4,17 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 from rich.markup import escape
 
 from poro2d.cli.dask_options import DASHBOARD_HELP, SCHEDULER_HELP, WORKERS_HELP, job_options
 from poro2d.console import OutputConsole, Table
+
+if TYPE_CHECKING:
+    from poro2d.sweep.records import Spread
+    from poro2d.sweep.results import RelationResult
 
 console = OutputConsole()
 
@@ -62,16 +67,20 @@ def register(app: typer.Typer) -> None:
     app.command("relation")(relation_cmd)
 
 
-def _print_interior_spread(sp: dict) -> None:
+def _print_interior_spread(sp: Spread) -> None:
     """The loose-to-dense spread of the interior porosity (the packing's own, no gap under the plate)."""
-    d = sp.get("interior_loose_minus_dense")
+    d = sp.interior_loose_minus_dense
     if d is None or not math.isfinite(d):
         return
-    order = "monotone" if sp["interior_monotone"] else "NOT monotone"
-    console.print(f"interior porosity, loose - dense: {d:+.4f} +- {sp['interior_sd']:.4f}; {order} in nLab")
+    order = "monotone" if sp.interior_monotone else "NOT monotone"
+    console.print(f"interior porosity, loose - dense: {d:+.4f} +- {sp.interior_sd:.4f}; {order} in nLab")
 
 
-def print_relation(rel: dict, out: Path) -> None:
+def print_relation(rel: RelationResult | dict, out: Path) -> None:
+    from poro2d.sweep.results import RelationResult
+    from poro2d.typed_result import part
+
+    rel = part(RelationResult, rel)  # a relation's dict (relation.json as read) typed
     t = Table(title="n2D(nLab) from the criterion")
     for c in (
         "nLab",
@@ -89,76 +98,76 @@ def print_relation(rel: dict, out: Path) -> None:
     def f(v) -> str:
         return "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.4f}"
 
-    for p in rel["points"]:
-        dem = f(p["n2d_dem"])
-        if rel.get("mode") == "density" and dem:
-            dem += f" +- {p['n2d_sd']:.4f} ({p['seeds_converged']}/{p['seeds']})"
-        inner = f(p.get("n2d_interior"))
-        if inner and p.get("n2d_interior_sd") is not None:
-            inner += f" +- {p['n2d_interior_sd']:.4f}"
+    for p in rel.points:
+        dem = f(p.n2d_dem)
+        if rel.mode == "density" and dem:
+            dem += f" +- {p.n2d_sd:.4f} ({p.seeds_converged}/{p.seeds})"
+        inner = f(getattr(p, "n2d_interior", None))  # a paper-mode point has none
+        if inner and p.n2d_interior_sd is not None:
+            inner += f" +- {p.n2d_interior_sd:.4f}"
         t.add_row(
-            f"{p['n_lab']:.4f}",
-            f"{p['relative_density']:.2f}",
+            f"{p.n_lab:.4f}",
+            f"{p.relative_density:.2f}",
             dem,
             inner,
-            f(p["n2d_fit"]),
-            f(p["n2d_parabolic"]),
-            f(p["n2d_lim_3d"]),
-            f(p["n2d_lim_lab"]),
-            p["flag"] or "ok",
+            f(p.n2d_fit),
+            f(p.n2d_parabolic),
+            f(p.n2d_lim_3d),
+            f(p.n2d_lim_lab),
+            p.flag or "ok",
         )
     console.print(t)
-    if rel.get("mode") == "density":
+    if rel.mode == "density":
         console.print(
-            f"grading's 2D extremes (criterion end state): n2D,min {rel['n2d_min']:.4f} (densest "
-            f"preparation), n2D,max {rel['n2d_max']:.4f} (loosest); mu_prep per state: "
-            + ", ".join(f"{p['mu_prep']:.3f}" for p in rel["points"])
+            f"grading's 2D extremes (criterion end state): n2D,min {rel.n2d_min:.4f} (densest "
+            f"preparation), n2D,max {rel.n2d_max:.4f} (loosest); mu_prep per state: "
+            + ", ".join(f"{p.mu_prep:.3f}" for p in rel.points)
         )
-        dropped = rel["calibration"].get("dropped") or []
+        dropped = rel.calibration.dropped or []
         if dropped:
             console.print(
                 f"[yellow]left out of the calibration (no seed could be prepared): mu_prep = {dropped}[/]; "
                 "the extremes are those of the frictions that were"
             )
-        sp = rel.get("spread")
-        if sp:
+        sp = rel.spread
+        if sp is not None:
             console.print(
-                f"loose - dense: {sp['n2d_loose_minus_dense']:+.4f} +- {sp['sd']:.4f} (measured, not a fit); "
-                f"{'monotone' if sp['monotone'] else 'NOT monotone'} in nLab"
+                f"loose - dense: {sp.n2d_loose_minus_dense:+.4f} +- {sp.sd:.4f} (measured, not a fit); "
+                f"{'monotone' if sp.monotone else 'NOT monotone'} in nLab"
             )
             _print_interior_spread(sp)
-    fit = rel["fit"]
-    if fit:
+    fit = rel.fit
+    if fit is not None:
         console.print(
-            f"fit: n2D = {fit['a']:.4f} nLab^2 + {fit['b']:.4f} nLab (Eq. 12: 0.42, 0.25); "
-            f"rms residual {fit['rms_residual']:.4g}, max {fit['max_abs_residual']:.4g}"
+            f"fit: n2D = {fit.a:.4f} nLab^2 + {fit.b:.4f} nLab (Eq. 12: 0.42, 0.25); "
+            f"rms residual {fit.rms_residual:.4g}, max {fit.max_abs_residual:.4g}"
         )
     else:
-        console.print(f"[yellow]{escape(rel['fit_note'])}[/]")
-    if rel.get("state_maps"):
+        console.print(f"[yellow]{escape(rel.fit_note)}[/]")
+    if rel.state_maps:
         print_state_maps(rel)
     console.print(f"figure {out}/relation.png, table {out}/relation.csv")
 
 
-def print_state_maps(rel) -> None:
+def print_state_maps(rel: RelationResult) -> None:
     """Each state's answer (the relative-density map's) beside the state-parameter map's."""
-    maps = rel["state_maps"]
+    maps = rel.state_maps
     first = maps[0]
-    t = Table(title=f"the state parameter at p' = {first['test_stress_kpa']:g} kPa")
+    t = Table(title=f"the state parameter at p' = {first.test_stress_kpa:g} kPa")
     for c in ("nLab", "Dr", "lab psi/span", "answer n2D", "answer psi/span (2D)", "state map n2D"):
         t.add_column(c, justify="right")
-    for p, m in zip(rel["points"], maps, strict=True):
-        by_state = "" if m["n2d_by_state"] is None else f"{m['n2d_by_state']:.4f}"
-        if by_state and not m["state_within_ends"]:
+    for p, m in zip(rel.points, maps, strict=True):
+        by_state = "" if m.n2d_by_state is None else f"{m.n2d_by_state:.4f}"
+        if by_state and not m.state_within_ends:
             by_state += " (beyond the ends)"
         t.add_row(
-            f"{p['n_lab']:.4f}", f"{p['relative_density']:.2f}", f"{m['psi_norm_lab']:+.3f}",
-            f"{p['n2d_target']:.4f}",
-            "" if m["psi_norm_by_dr"] is None else f"{m['psi_norm_by_dr']:+.3f}", by_state or "no 2D line",
+            f"{p.n_lab:.4f}", f"{p.relative_density:.2f}", f"{m.psi_norm_lab:+.3f}",
+            f"{p.n2d_target:.4f}",
+            "" if m.psi_norm_by_dr is None else f"{m.psi_norm_by_dr:+.3f}", by_state or "no 2D line",
         )  # fmt: skip
     console.print(t)
     console.print(
-        f"laboratory line: {escape(first['lab_line'])}; the answers stay the relative-density map's "
-        "(docs/equivalence.md)" + ("" if first["e_cs_2d"] is not None else f"; {escape(first['note'])}"),
+        f"laboratory line: {escape(first.lab_line)}; the answers stay the relative-density map's "
+        "(docs/equivalence.md)" + ("" if first.e_cs_2d is not None else f"; {escape(first.note)}"),
         soft_wrap=True,
     )

@@ -70,10 +70,12 @@ def print_preflight(case, pf) -> None:
 
 def print_result(res, out: Path) -> None:
     """The answer: the interior porosity first, then n', the friction, every seed."""
+    from poro2d.sand.result import _pm, warnings
+
     st = res.state
     dr = st.relative_density
     head = f"{res.soil.name} at nLab = {st.n_lab:.4f}" + (f" (Dr = {dr:.3f})" if dr is not None else "")
-    if res.interior_porosity_mean is not None:
+    if res.interior_porosity_mean is not None:  # None: no seed accepted (as sand.json keeps NaN)
         console.print(
             f"[bold]interior porosity {res.interior_porosity_mean:.4f} +- {res.interior_porosity_sd:.4f}[/] "
             f"({res.seeds_accepted} of {res.seeds} seeds): the 2D porosity of {escape(head)}",
@@ -93,7 +95,7 @@ def print_result(res, out: Path) -> None:
         )
     console.print(t)
     console.print(
-        f"box porosity n' {_f(res.box_porosity_mean) or 'n/a'} +- {_f(res.box_porosity_sd) or 'n/a'}; "
+        f"box porosity n' {_pm(res.box_porosity_mean, res.box_porosity_sd)}; "
         f"mu_prep {res.mu_prep:.3f}; "
         f"2D extremes {res.n2d_min:.4f}-{res.n2d_max:.4f}; jamming porosity "
         + ("n/a" if res.jamming_porosity is None else f"{res.jamming_porosity:.4f}"),
@@ -111,8 +113,6 @@ def print_result(res, out: Path) -> None:
 
         for line in state_map_lines(res.state_map):
             console.print(escape(line), soft_wrap=True)
-    from poro2d.sand.result import warnings
-
     for w in warnings(res):
         if not w.startswith("seed(s)"):  # the refused seeds were named above, with why
             console.print(f"[yellow]note:[/] {escape(w)}", soft_wrap=True)

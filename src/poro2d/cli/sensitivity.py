@@ -4,10 +4,14 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from poro2d.console import OutputConsole, Table
+
+if TYPE_CHECKING:
+    from poro2d.sweep.results import SensitivityResult
 
 console = OutputConsole()
 
@@ -57,7 +61,7 @@ def register(app: typer.Typer) -> None:
 
         sens = run_sensitivity(base, Store(out), quick=quick, seeds=seeds, options=options, announce=banner)
         print_sensitivity(sens, out)
-        failed = sens.sweeps["failed_cases"]
+        failed = sens.sweeps.failed_cases
         if failed:
             console.print(
                 f"[bold red]{failed} case(s) failed[/]; tracebacks in {out}/grading/cases/*/error.txt"
@@ -69,31 +73,31 @@ def _f(v, digits: int = 4) -> str:
     return "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.{digits}f}"
 
 
-def print_sensitivity(sens: dict, out: Path) -> None:
+def print_sensitivity(sens: SensitivityResult, out: Path) -> None:
     """The two tables of points, the answer, and where the files are."""
-    t = Table(title=f"accepted n2D against grading width (mu_prep = {sens['settings']['mu_prep']:g})")
+    t = Table(title=f"accepted n2D against grading width (mu_prep = {sens.settings.mu_prep:g})")
     for c in ("grading", "Cu", "d_max mm", "accepted n2D", "sd", "n", "unconv.", "n' accepted",
               "interior n", "1st F_top N/m", "1st G N/m", "1st F_top/G", "1st n'"):  # fmt: skip
         t.add_column(c, justify="right")
-    for p in sens["points"]["grading"]:
+    for p in sens.points.grading:
         t.add_row(
-            p["label"], _f(p["cu"], 3), _f(p["d_max_mm"], 2), _f(p["n2d_mean"]), _f(p["n2d_sd"]),
-            str(p["n"]), str(p["unconverged"]), _f(p["measured_mean"]), _f(p.get("interior_mean")),
-            _f(p["first_f_top_mean"], 1),
-            _f(p["first_g_mean"], 1), _f(p["first_f_top_over_g_mean"], 1), _f(p["first_n_prime_mean"]),
+            p.label, _f(p.cu, 3), _f(p.d_max_mm, 2), _f(p.n2d_mean), _f(p.n2d_sd),
+            str(p.n), str(p.unconverged), _f(p.measured_mean), _f(p.interior_mean),
+            _f(p.first_f_top_mean, 1),
+            _f(p.first_g_mean, 1), _f(p.first_f_top_over_g_mean, 1), _f(p.first_n_prime_mean),
         )  # fmt: skip
     console.print(t)
     t = Table(title="n' of the accepted trial against preparation friction (reference grading)")
     for c in ("mu_prep", "n2D", "sd", "n", "unconv."):
         t.add_column(c, justify="right")
-    for p in sens["points"]["mu_prep"]:
-        t.add_row(f"{p['mu_prep']:g}", _f(p["n2d_mean"]), _f(p["n2d_sd"]), str(p["n"]), str(p["unconverged"]))
+    for p in sens.points.mu_prep:
+        t.add_row(f"{p.mu_prep:g}", _f(p.n2d_mean), _f(p.n2d_sd), str(p.n), str(p.unconverged))
     console.print(t)
-    for line in sens["answer"]["lines"]:
+    for line in sens.answer.lines:
         console.print(f"- {line}", highlight=False)
-    tm = sens["timings"]
+    tm = sens.timings
     console.print(
-        f"time: grading sweep {tm['grading_s']:.0f} s, mu_prep {tm['mu_prep_s']:.0f} s "
-        f"(calibration from {sens['calibration'].get('source')}), total {tm['total_s']:.0f} s"
+        f"time: grading sweep {tm.grading_s:.0f} s, mu_prep {tm.mu_prep_s:.0f} s "
+        f"(calibration from {sens.calibration.source}), total {tm.total_s:.0f} s"
     )
     console.print(f"figure {out}/sensitivity.png, tables {out}/sensitivity.csv, {out}/sensitivity.json")

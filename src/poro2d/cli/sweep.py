@@ -49,28 +49,26 @@ def register(app: typer.Typer) -> None:
 
 def print_summary(res, out: Path) -> None:
     s = res.summary
-    t = Table(
-        title=f"sweep: {s['cases']} case(s), {s['ran']} run, {s['reused']} already done, {s['failed']} failed"
-    )
+    t = Table(title=f"sweep: {s.cases} case(s), {s.ran} run, {s.reused} already done, {s.failed} failed")
     t.add_column("case")
     t.add_column("status")
     t.add_column("time s", justify="right")
     t.add_column("result / error")
     for r in res.rows:
-        rs = r.get("results", {}) or {}
-        if r["status"] == "failed":
-            txt = f"[red]{escape(str(r.get('error')))}[/]"
+        rs = r.results or {}
+        if r.status == "failed":
+            txt = f"[red]{escape(str(r.error))}[/]"
         elif "final_porosity" in rs:
             fp = rs.get("final_porosity")
             txt = f"n2D = {fp:.4f}" if fp is not None else f"not converged ({escape(str(rs.get('message')))})"
         else:
             txt = escape(", ".join(f"{k}={v}" for k, v in list(rs.items())[:4]))
-        ts = r.get("time_s")
-        t.add_row(r["case_id"], "reused" if r.get("reused") else r["status"], f"{ts:.1f}" if ts else "", txt)
+        ts = r.time_s
+        t.add_row(r.case_id, "reused" if r.extra.get("reused") else r.status, f"{ts:.1f}" if ts else "", txt)
     console.print(t)
-    eff = s.get("parallel_efficiency")
+    eff = s.parallel_efficiency
     console.print(
-        f"wall {s['wall_time_s']:.1f} s, case time {s['case_time_sum_s']:.1f} s"
+        f"wall {s.wall_time_s:.1f} s, case time {s.case_time_sum_s:.1f} s"
         + (f", parallel efficiency {eff:.0%}" if eff else "")
         + f"; table in {out}/results.csv"
     )

@@ -22,7 +22,7 @@ from poro2d.sand.case import SoilRecord
 from poro2d.sand.preflight import Preflight
 from poro2d.sand.profile import StageProfile
 from poro2d.store import Store
-from poro2d.sweep.records import DensityCalibrationRecord
+from poro2d.sweep.records import CaseRow, DensityCalibrationRecord, LostCaseRow
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
@@ -50,15 +50,15 @@ class SeedSpecimen(TypedResult):
     message: str = ""
 
     @classmethod
-    def from_row(cls, seed: int, row: dict, folder: str | None) -> SeedSpecimen:
-        res = row.get("results") or {}
-        ok = row.get("status") == "done" and bool(res.get("converged")) and folder is not None
+    def from_row(cls, seed: int, row: CaseRow | LostCaseRow, folder: str | None) -> SeedSpecimen:
+        res = row.results or {}
+        ok = row.status == "done" and bool(res.get("converged")) and folder is not None
 
         def num(key):
             v = res.get(key)
             return float(v) if v is not None and math.isfinite(float(v)) else None
 
-        why = res.get("message") or row.get("error") or ""
+        why = res.get("message") or row.error or ""
         return cls(
             seed,
             ok,
@@ -341,7 +341,7 @@ def _profile_rows(res: SandResult) -> list[str]:
     rows = []
     for label, key in (("calibration", "time_profile"), ("specimens", "specimens_time_profile")):
         prof = getattr(res.calibration, key)
-        if not prof:
+        if prof is None:
             continue
         parts = []
         for phase in ("prepare", "plate"):

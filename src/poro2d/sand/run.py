@@ -44,7 +44,7 @@ from poro2d.sand.result import (
 from poro2d.store import Store, walk
 from poro2d.sweep import density as D
 from poro2d.sweep.criterion_base import CriterionBase
-from poro2d.sweep.records import DensityCalibrationRecord
+from poro2d.sweep.records import CalibrationRun, CaseRow, DensityCalibrationRecord, LostCaseRow
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
 KIND = "sand"
@@ -164,7 +164,7 @@ def _calibration_case(case: SandCase, pf: Preflight, mus: list[float], loosest_f
     return D.CalibrationCase(base, tuple(mus), case.calibration_seeds, **shifts, loosest_first=loosest_first)
 
 
-def _calibrate(case, pf, store: Store, mus, record, cal_kw) -> tuple[Calibration, dict]:
+def _calibrate(case, pf, store: Store, mus, record, cal_kw) -> tuple[Calibration, CalibrationRun]:
     calibration = _calibration_case(case, pf, mus, loosest_first=True)
     return D.calibrate(calibration, store, record=record, **cal_kw)
 
@@ -189,15 +189,15 @@ def calibration_stage(
         )
     target = state_target(case.lab.n_lab, case.n_max, case.n_min, cal)
     dropped = [mu for mu in case.mus if mu < ends[0] or mu > ends[1]]
-    dense = [v for v in info["interior"][0] if v is not None]
+    dense = [v for v in info.interior[0] if v is not None]
     return target, SandCalibration(
         mus=mus,
         calibration=DensityCalibrationRecord.from_dict(cal.to_dict()),
         n2d_min=cal.n2d_min,
         n2d_max=cal.n2d_max,
         dropped_ends=dropped,
-        cases=info["cases"],
-        interior_by_friction=info["interior"],
+        cases=info.cases,
+        interior_by_friction=info.interior,
         # the densest preparation's own porosity: to hold against the jamming porosity
         dense_end_interior=float(np.mean(dense)) if dense else None,
         dense_end_interior_sd=float(np.std(dense, ddof=1)) if len(dense) > 1 else None,
@@ -206,7 +206,7 @@ def calibration_stage(
 
 def calibrate_ends(
     case: SandCase, pf: Preflight, store: Store, cal_kw: dict
-) -> tuple[Calibration, tuple, dict]:
+) -> tuple[Calibration, tuple, CalibrationRun]:
     """The densest and loosest preparations that at least one seed could prepare.
 
     An end whose every seed was refused (e.g. a lid that does not settle on a very frictional
@@ -225,7 +225,9 @@ def calibrate_ends(
             raise AssertionError("unreachable: usable() refuses fewer than two frictions")
 
 
-def specimen_stage(case: SandCase, trial: StateTarget, store: Store, options: RunOptions) -> list[dict]:
+def specimen_stage(
+    case: SandCase, trial: StateTarget, store: Store, options: RunOptions
+) -> list[CaseRow | LostCaseRow]:
     """One criterion case per seed at full size, at the state's friction, from ``trial``."""
     from poro2d.criterion.protocol import trial_grid
     from poro2d.sweep.runner import run_sweep
@@ -234,19 +236,20 @@ def specimen_stage(case: SandCase, trial: StateTarget, store: Store, options: Ru
     grid = trial_grid(float(crit.get("resolution", 0.01)), crit.get("refine_tolerance"))
     sweep = D.StateChecks(case.config, (trial,), case.seeds, grid).sweep
     res = run_sweep(sweep, store.child("states"), options=options)
-    return sorted(res.rows, key=lambda r: int((r.get("params") or {}).get("seed", 0)))
+    return sorted(res.rows, key=lambda r: int((r.params or {}).get("seed", 0)))
 
 
-def keep_specimens(rows: list[dict], store: Store, label: str, soil: dict, state: dict) -> list[SeedSpecimen]:
+def keep_specimens(rows: list[CaseRow | LostCaseRow], store: Store, label: str, soil: dict,
+                   state: dict) -> list[SeedSpecimen]:  # fmt: skip
     """Each seed's accepted specimen in a named store (``specimens/<label>-seed<k>``), with a
     ``soil.json`` naming the soil and its laboratory state."""
     kept = []
     for r in rows:
-        seed = int((r.get("params") or {}).get("seed", 0))
-        res = r.get("results") or {}
-        ok = r.get("status") == "done" and bool(res.get("converged"))
+        seed = int((r.params or {}).get("seed", 0))
+        res = r.results or {}
+        ok = r.status == "done" and bool(res.get("converged"))
         # the criterion's store of the case
-        src = store.child("states", "cases", str(r.get("case_id")), "run")
+        src = store.child("states", "cases", str(r.case_id), "run")
         folder = None
         if ok and src.has("specimen.npz"):
             name = f"{label}-seed{seed}"

@@ -33,7 +33,7 @@ from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.store import Store
 from poro2d.sweep.cases import Case, SweepConfig, criterion_objects, grid_cases
 from poro2d.sweep.criterion_base import CriterionBase
-from poro2d.sweep.records import CaseRow
+from poro2d.sweep.records import CaseRow, LostCaseRow, case_row
 from poro2d.sweep.results import CalibrationRun
 
 #: seeds per friction and per state unless the config says otherwise
@@ -237,34 +237,37 @@ class CalibrationCase:
         return tables.sweep(dict(table, cases=cases), cases)
 
 
-def _sample(row: dict) -> float | None:
+def _sample(row: CaseRow | LostCaseRow) -> float | None:
     """The measured porosity n' of a case's accepted trial; None if it was not accepted."""
-    res = row.get("results") or {}
-    if row.get("status") != "done" or not res.get("converged"):
+    res = row.results or {}
+    if row.status != "done" or not res.get("converged"):
         return None
     v = res.get("last_new_porosity")
     return float(v) if v is not None and math.isfinite(float(v)) else None
 
 
-def interior_by_friction(rows: list[dict], mus: list[float], seeds: int) -> list[list[float | None]]:
+def interior_by_friction(rows: list[CaseRow | LostCaseRow | dict], mus: list[float],
+                         seeds: int) -> list[list[float | None]]:  # fmt: skip
     """The interior porosity of every calibration case's accepted specimen, per friction and seed.
 
     Beside the calibration's samples (box porosities n'), the packing's own porosity: at the
     lowest friction it is the dense end to hold against the grading's jamming porosity.
     """
     out: list[list[float | None]] = [[None] * seeds for _ in mus]
-    for r in rows:
-        p, res = r.get("params") or {}, r.get("results") or {}
+    for r in map(case_row, rows):
+        p, res = r.params or {}, r.results or {}
         v = res.get("interior_porosity")
         if _sample(r) is not None and v is not None and math.isfinite(float(v)):
             out[mus.index(float(p["specimen.friction_prep"]))][int(p["seed"])] = float(v)
     return out
 
 
-def calibration_from_rows(rows: list[dict], mus: list[float], seeds: int) -> Calibration:
+def calibration_from_rows(
+    rows: list[CaseRow | LostCaseRow | dict], mus: list[float], seeds: int
+) -> Calibration:
     samples: list[list[float | None]] = [[None] * seeds for _ in mus]
-    for r in rows:
-        p = r.get("params") or {}
+    for r in map(case_row, rows):
+        p = r.params or {}
         mu, seed = float(p["specimen.friction_prep"]), int(p["seed"])
         samples[mus.index(mu)][seed] = _sample(r)
     return Calibration(list(mus), samples, list(range(seeds)))
@@ -313,7 +316,7 @@ def calibrate(
     with cache_entry(cases.root):
         res = run_sweep(case.sweep, cases, options=options, client=client)
     cal = calibration_from_rows(res.rows, mus, seeds)
-    ran, reused = res.summary["ran"], res.summary["reused"]
+    ran, reused = res.summary.ran, res.summary.reused
     info = {"key": case.key, "cases": str(cases.root), "ran": ran, "reused": reused,
             "source": "computed" if ran else "cache"}  # fmt: skip
     if case.moves_first_trials:  # new callers only: earlier records keep their keys
@@ -419,8 +422,8 @@ def calibration_twins(
         if hit is None:
             continue
         cal_case, row = hit
-        results = dict(row.get("results") or {}, n_lab=c.config["criterion"]["n_lab"])
-        relabelled = dict(row, case_id=c.id, params=dict(c.params), results=results, reused=True,
+        results = dict(row.results or {}, n_lab=c.config["criterion"]["n_lab"])
+        relabelled = dict(row.to_dict(), case_id=c.id, params=dict(c.params), results=results, reused=True,
                           reused_calibration_case=cal_case.id)  # fmt: skip
         twins.append(CaseRow.from_dict(relabelled))
     return twins

@@ -13,9 +13,12 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Self
+from typing import TYPE_CHECKING, Any, Self
 
 from poro2d.typed_result import TypedResult
+
+if TYPE_CHECKING:
+    from poro2d.criterion.result import CriterionResult
 
 
 @dataclass(eq=False)
@@ -77,21 +80,21 @@ class CriterionCaseResults(TypedResult):
     plate_contact_fraction: float | None
 
     @classmethod
-    def of(cls, res: Mapping[str, Any]) -> CriterionCaseResults:
-        """The cells of a criterion result (a ``CriterionResult``: its trials as the dicts of its file).
+    def of(cls, res: CriterionResult) -> CriterionCaseResults:
+        """The cells of a criterion result (its trials as the dicts of its file).
 
         The accepted trial is not always the last (see ``poro2d.criterion.protocol.closed_bracket``).
         """
-        its = res["iterations"]
+        its = [trial.to_dict() for trial in res.iterations]  # each trial's cells as its row holds them
         first = its[0] if its else {}
         last = next((r for r in its if r.get("accepted")), its[-1] if its else {})
         return cls(
-            n_lab=res["n_lab"],
-            final_porosity=res["final_porosity"],
-            converged=bool(res["converged"]),
+            n_lab=res.n_lab,
+            final_porosity=res.final_porosity,
+            converged=bool(res.converged),
             iterations=len(its),
-            message=res["message"],
-            initial_trial_porosity=res["initial_trial_porosity"],
+            message=res.message,
+            initial_trial_porosity=res.initial_trial_porosity,
             last_trial_porosity=last.get("trial_porosity"),
             last_new_porosity=last.get("new_porosity"),
             particle_count=last.get("particle_count"),
@@ -108,12 +111,12 @@ class CriterionCaseResults(TypedResult):
             first_self_weight_n_per_m=first.get("self_weight_n_per_m"),
             first_plate_moved=first.get("plate_moved"),
             first_new_porosity=first.get("new_porosity"),
-            criterion_time_s=res.get("time_total_s"),
-            box_porosity=res.get("box_porosity"),
-            interior_porosity=res.get("interior_porosity"),
-            interior_porosity_std=res.get("interior_porosity_std"),
-            surface_gap_mean_d50=res.get("surface_gap_mean_d50"),
-            plate_contact_fraction=res.get("plate_contact_fraction"),
+            criterion_time_s=res.time_total_s,
+            box_porosity=res.box_porosity,
+            interior_porosity=res.interior_porosity,
+            interior_porosity_std=res.interior_porosity_std,
+            surface_gap_mean_d50=res.surface_gap_mean_d50,
+            plate_contact_fraction=res.plate_contact_fraction,
         )
 
 
@@ -132,6 +135,11 @@ class LostCaseRow(TypedResult):
     pid: int | None
     worker: str | None
     finished_utc: str
+
+
+def case_row(row: Mapping[str, Any] | CaseRow | LostCaseRow) -> CaseRow | LostCaseRow:
+    """A case's row typed: the dict of one (built by hand, or read from a file) as a :class:`CaseRow`."""
+    return row if isinstance(row, CaseRow | LostCaseRow) else CaseRow.from_dict(row)
 
 
 @dataclass(eq=False)
@@ -355,4 +363,5 @@ __all__ = [
     "RelationPoint",
     "Spread",
     "SweepSummary",
+    "case_row",
 ]

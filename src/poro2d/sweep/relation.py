@@ -29,7 +29,7 @@ from poro2d.store import Store
 from poro2d.sweep.cases import SweepConfig
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.output import held
-from poro2d.sweep.records import DensitySweeps, Eq12Coefficients, QuadraticFit
+from poro2d.sweep.records import CaseRow, DensitySweeps, Eq12Coefficients, LostCaseRow, QuadraticFit, case_row
 from poro2d.sweep.results import RelationResult
 
 RELATION_KEYS = {"n_max", "n_min", "points", "n_lab", "mode", "seeds", "mu_prep"}
@@ -151,22 +151,22 @@ def relation_sweep(base: CriterionBase, n_labs: tuple[float, ...]) -> SweepConfi
     return base.sweep(table, [{"criterion.n_lab": n} for n in n_labs])
 
 
-def analyse(rows: list[dict], n_max: float, n_min: float) -> RelationResult:
+def analyse(rows: list[CaseRow | LostCaseRow | dict], n_max: float, n_min: float) -> RelationResult:
     """Relation points (one per case), the fit through the converged ones, comparisons."""
     pts = []
-    for r in rows:
-        res = r.get("results", {}) or {}
-        n_lab = float_or_nan(res.get("n_lab", (r.get("params") or {}).get("criterion.n_lab")))
-        converged = bool(res.get("converged")) and r["status"] == "done"
+    for r in map(case_row, rows):
+        res = r.results or {}
+        n_lab = float_or_nan(res.get("n_lab", (r.params or {}).get("criterion.n_lab")))
+        converged = bool(res.get("converged")) and r.status == "done"
         if converged:
             n2d, source = float_or_nan(res.get("final_porosity")), "accepted"
-        elif r["status"] == "done":
+        elif r.status == "done":
             n2d, source = float_or_nan(res.get("last_new_porosity")), "last estimate n' (not converged)"
         else:
             n2d, source = math.nan, "case failed"
         conv = P.convert_all(n_lab, n_max, n_min)
         pt = {
-            "case_id": r["case_id"],
+            "case_id": r.case_id,
             "n_lab": n_lab,
             "relative_density": float(P.relative_density(n_lab, n_max, n_min)),
             "degree_of_density": float(P.degree_of_density(n_lab, n_max, n_min)),
@@ -176,7 +176,7 @@ def analyse(rows: list[dict], n_max: float, n_min: float) -> RelationResult:
             "iterations": res.get("iterations"),
             "initial_trial_porosity": res.get("initial_trial_porosity"),
             "particle_count": res.get("particle_count"),
-            "message": res.get("message") or r.get("error"),
+            "message": res.get("message") or r.error,
         }
         for m in COMPARE:
             pt[f"n2d_{m}"] = conv.results[m].value
@@ -193,28 +193,29 @@ def _stats(values: list[float]) -> tuple[float, float]:
     return float(a.mean()), float(a.std(ddof=1)) if a.size > 1 else 0.0
 
 
-def _why(row: dict) -> str:
-    return str((row.get("results") or {}).get("message") or row.get("error"))
+def _why(row: CaseRow | LostCaseRow) -> str:
+    return str((row.results or {}).get("message") or row.error)
 
 
-def analyse_states(rows: list[dict], targets: list, cal, n_max: float, n_min: float) -> RelationResult:
+def analyse_states(rows: list[CaseRow | LostCaseRow | dict], targets: list, cal, n_max: float,
+                   n_min: float) -> RelationResult:  # fmt: skip
     """Density-controlled relation: one point per laboratory state, mean and spread over seeds.
 
     ``n2d_dem`` is the mean accepted n2D of the seeds whose criterion converged (the
     criterion's answer, on its trial grid); ``n2d_measured`` the mean measured porosity
     n' of those accepted trials. Seeds that did not converge are counted, not averaged.
     """
-    by_lab: dict[float, list[dict]] = {}
-    for r in rows:
-        n_lab = float_or_nan((r.get("params") or {}).get("criterion.n_lab"))
+    by_lab: dict[float, list[CaseRow | LostCaseRow]] = {}
+    for r in map(case_row, rows):
+        n_lab = float_or_nan((r.params or {}).get("criterion.n_lab"))
         by_lab.setdefault(round(n_lab, 6), []).append(r)
     pts = []
     for t in targets:
         group = by_lab.get(round(t.n_lab, 6), [])
-        ok = [r for r in group if r["status"] == "done" and (r.get("results") or {}).get("converged")]
-        acc = [float_or_nan(r["results"]["final_porosity"]) for r in ok]
-        meas = [float_or_nan(r["results"]["last_new_porosity"]) for r in ok]
-        inner = [float_or_nan(r["results"].get("interior_porosity")) for r in ok]
+        ok = [r for r in group if r.status == "done" and (r.results or {}).get("converged")]
+        acc = [float_or_nan(r.results["final_porosity"]) for r in ok]
+        meas = [float_or_nan(r.results["last_new_porosity"]) for r in ok]
+        inner = [float_or_nan(r.results.get("interior_porosity")) for r in ok]
         mean, sd = _stats(acc)
         m_mean, m_sd = _stats(meas)
         i_mean, i_sd = _stats(inner)
@@ -237,7 +238,7 @@ def analyse_states(rows: list[dict], targets: list, cal, n_max: float, n_min: fl
             "seeds_converged": len(ok),
             "converged": len(ok) > 0,
             "flag": "" if group and len(ok) == len(group) else f"{len(group) - len(ok)} seed(s) unconverged",
-            "message": "; ".join(_why(r) for r in group if r not in ok),
+            "message": "; ".join(_why(r) for r in group if not any(r is o for o in ok)),
         }  # fmt: skip
         for m in COMPARE:
             pt[f"n2d_{m}"] = conv.results[m].value
@@ -297,17 +298,19 @@ def _relation(pts: list[dict], n_max: float, n_min: float, mode: str, **extra: A
     })  # fmt: skip
 
 
-def write_relation(rel: dict, store: Store, title: str = "", extra: dict | None = None) -> list[Path]:
+def write_relation(rel: RelationResult, store: Store, title: str = "", extra: dict | None = None
+                   ) -> list[Path]:  # fmt: skip
     """relation.csv, relation.json, relation.png and relation.svg in ``store``.
 
     ``rel``: an analysed relation (with ``extra`` keys for the file) or a :class:`RelationResult`.
     """
     from poro2d.report.relation_figure import write_relation_figure
 
-    flat = [{k: " ".join(f"{x:.4f}" for x in v) if isinstance(v, list) else v for k, v in p.items()}
-            for p in rel["points"]]  # fmt: skip
+    # a seed's missing number is None (NaN as the file keeps it): written as NaN was
+    flat = [{k: " ".join(f"{float_or_nan(x):.4f}" for x in v) if isinstance(v, list) else v
+             for k, v in p.to_dict().items()} for p in rel.points]  # fmt: skip
     table = store.write_csv("relation.csv", flat)
-    record = dict(rel, **(extra or {}))
+    record = dict(rel.to_dict(), **(extra or {}))
     record.setdefault("provenance", Provenance.now().to_dict())  # a RelationResult carries its own
     file = store.write_json("relation.json", record)
     return [table, file, *write_relation_figure(rel, store.root, title)]
@@ -351,7 +354,7 @@ def density_relation(
         twin_ids = {row.case_id for row in twins}
         left = replace(sweep, cases=[c for c in sweep.cases if c.id not in twin_ids])
         res = run_sweep(left, store.child("states"), options=options)
-        rows, summary, failed = res.rows + rows, res.summary, res.failed
+        rows, summary, failed = res.rows + rows, res.summary.to_dict(), res.failed
     summary = dict(summary, from_calibration=len(twins))
     rel = analyse_states(rows, list(targets), cal, settings.n_max, settings.n_min)
     record = {
@@ -385,10 +388,10 @@ def state_maps(state, rel: RelationResult, settings: RelationSettings, base: Cri
     source = base.build()[1].source
     return [
         state_map_record(
-            state, lab_state_from_table({"n_max": settings.n_max, "n_min": settings.n_min, "n": p["n_lab"]}),
-            rel["n2d_max"], rel["n2d_min"], p["n2d_target"], source,
+            state, lab_state_from_table({"n_max": settings.n_max, "n_min": settings.n_min, "n": p.n_lab}),
+            rel.n2d_max, rel.n2d_min, p.n2d_target, source,
         ).to_dict()
-        for p in rel["points"]
+        for p in rel.points
     ]  # fmt: skip
 
 
@@ -470,6 +473,6 @@ def run_relation(
             res = run_sweep(states, kept, options=options)
             rel = analyse(res.rows, settings.n_max, settings.n_min)
             extra = {"quick": quick, "sweep_summary": res.summary, "config": cfg}
-        result = RelationResult.from_dict(dict(rel, **extra, provenance=Provenance.now().to_dict()))
+        result = RelationResult.from_dict(dict(rel.to_dict(), **extra, provenance=Provenance.now().to_dict()))
         write_relation(result, kept, title=title)
     return result

@@ -80,7 +80,7 @@ class SweepResult(TypedResult):
     @property
     def failed(self) -> list[CaseRow | LostCaseRow]:
         """The rows of the cases that failed."""
-        return [r for r in self.rows if r["status"] == "failed"]
+        return [r for r in self.rows if r.status == "failed"]
 
 
 @dataclass(eq=False)
@@ -161,7 +161,7 @@ class RelationResult(TypedResult):
         """Cases that raised (their tracebacks are in the output folder), over every sweep."""
         if self.sweeps is not None:
             return int(self.sweeps.failed_cases)
-        return int((self.sweep_summary or {}).get("failed", 0))
+        return int(self.sweep_summary.failed or 0) if self.sweep_summary is not None else 0
 
 
 @dataclass(eq=False)

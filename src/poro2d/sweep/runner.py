@@ -185,28 +185,28 @@ def _failed_row(case: Case, store: Store, err: BaseException, tb: str) -> LostCa
     return row
 
 
-def table_from_rows(rows: list[dict], axes: list[str]):
+def table_from_rows(rows: list[CaseRow | LostCaseRow], axes: list[str]):
     """One row per case: id, kind, parameters, status, results, timing, worker, error."""
     import pandas as pd
 
     flat = []
     result_keys: list[str] = []
     for r in rows:
-        for k in r.get("results", {}):
+        for k in r.results or {}:
             if k not in result_keys:
                 result_keys.append(k)
     for r in rows:
-        rec: dict[str, Any] = {"case_id": r["case_id"], "kind": r["kind"]}
+        rec: dict[str, Any] = {"case_id": r.case_id, "kind": r.kind}
         for a in axes:
-            rec[a] = _scalar(r.get("params", {}).get(a))
-        rec["status"] = r["status"]
+            rec[a] = _scalar((r.params or {}).get(a))
+        rec["status"] = r.status
         for k in result_keys:
-            rec[k] = r.get("results", {}).get(k)
-        rec["time_s"] = r.get("time_s")
-        rec["worker"] = r.get("worker")
-        rec["host"] = r.get("host")
-        rec["pid"] = r.get("pid")
-        rec["error"] = r.get("error")
+            rec[k] = (r.results or {}).get(k)
+        rec["time_s"] = r.time_s
+        rec["worker"] = r.worker
+        rec["host"] = r.host
+        rec["pid"] = r.pid
+        rec["error"] = r.error
         flat.append(rec)
     df = pd.DataFrame(flat)
     for col in df.columns:  # mixed object columns (None + numbers) become numeric or text
@@ -263,17 +263,17 @@ def _run_sweep(sweep: SweepConfig, store: Store, options: RunOptions, client) ->
     for c in sweep.cases:
         done = finished_row(asdict(c), cases.child(c.id))
         if done is not None:
-            rows[c.id] = CaseRow.from_dict(dict(done, status="done", reused=True))
+            rows[c.id] = CaseRow.from_dict(dict(done.to_dict(), status="done", reused=True))
         else:
             pending.append(c)
     n_reused = len(rows)
     cluster_info: ClusterInfo | None = None
     if pending:
         cluster_info = _run_pending(sweep, pending, rows, cases, n_reused, options, client)
-    ordered = [type(rows[c.id]).from_dict(dict(rows[c.id], reused=bool(rows[c.id].get("reused", False))))
-               for c in sweep.cases]  # fmt: skip
+    ordered = [type(r).from_dict(dict(r.to_dict(), reused=bool(r.extra.get("reused", False))))
+               for r in (rows[c.id] for c in sweep.cases)]  # fmt: skip
     df = table_from_rows(ordered, sweep.axes)
-    df["reused"] = [r["reused"] for r in ordered]
+    df["reused"] = [r.extra["reused"] for r in ordered]
     write_tables(df, store)
     summary = _summary(ordered, n_reused, time.perf_counter() - t_start, cluster_info)
     record.update(status="finished", cluster=cluster_info or {}, summary=summary, finished_utc=_now())
@@ -305,21 +305,19 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Sto
 
 
 def _summary(
-    ordered: list[dict], n_reused: int, wall: float, cluster_info: ClusterInfo | None
+    ordered: list[CaseRow | LostCaseRow], n_reused: int, wall: float, cluster_info: ClusterInfo | None
 ) -> SweepSummary:
     """Counts, wall and case time, the worker processes and the parallel efficiency of a sweep."""
-    busy = sum(r.get("time_s") or 0.0 for r in ordered if not r["reused"])
+    busy = sum(r.time_s or 0.0 for r in ordered if not r.extra["reused"])
     summary = {
         "cases": len(ordered),
         "ran": len(ordered) - n_reused,
         "reused": n_reused,
-        "done": sum(r["status"] == "done" for r in ordered),
-        "failed": sum(r["status"] == "failed" for r in ordered),
+        "done": sum(r.status == "done" for r in ordered),
+        "failed": sum(r.status == "failed" for r in ordered),
         "wall_time_s": wall,
         "case_time_sum_s": busy,
-        "worker_processes": sorted(
-            {f"{r.get('host')}:{r.get('pid')}" for r in ordered if not r["reused"] and r.get("pid")}
-        ),
+        "worker_processes": sorted({f"{r.host}:{r.pid}" for r in ordered if not r.extra["reused"] and r.pid}),
     }
     if cluster_info is not None and cluster_info.threads:
         summary["parallel_efficiency"] = busy / (wall * cluster_info.threads) if wall > 0 else None
@@ -356,7 +354,7 @@ def _submit_all(
                     c, cases.child(c.id), exc, f"{outcome.traceback}{type(exc).__name__}: {exc}\n"
                 )
             rows[index] = outcome
-            n_failed = sum(r is not None and r["status"] == "failed" for r in rows)
+            n_failed = sum(r is not None and r.status == "failed" for r in rows)
             bar.advance(f"{n_failed} failed" if n_failed else "")
 
         executor.map(jobs, on_done=ended)

@@ -30,12 +30,13 @@ import numpy as np
 from poro2d.config import check_keys, check_number_list
 from poro2d.errors import InputError
 from poro2d.execute.options import RunOptions
-from poro2d.io_utils import check_output_dir
+from poro2d.io_utils import check_output_dir, float_or_nan
 from poro2d.paper_data import QUICK_CRITERION
 from poro2d.store import Store
 from poro2d.sweep.cases import SweepConfig
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.output import held
+from poro2d.sweep.records import CaseRow, LostCaseRow, case_row
 from poro2d.sweep.results import SensitivityResult
 from poro2d.sweep.sensitivity_records import (
     Answer,
@@ -49,6 +50,7 @@ from poro2d.sweep.sensitivity_records import (
     SeedRecord,
     StudySettings,
 )
+from poro2d.typed_result import part
 
 #: grading widths of the full study (Cu = d60 / d10), and of ``--quick``: at the paper
 #: grading's mean disk area Cu = 4 has disks of about 26 mm, taller than the 20 mm layer
@@ -209,21 +211,28 @@ def finite_mean_sd(values: list) -> MeanSd:
     return MeanSd(float(a.mean()), float(a.std(ddof=1)) if a.size > 1 else 0.0, int(a.size))
 
 
+def _finite(v) -> bool:
+    """Whether ``v`` is a number (a result keeps a missing one, NaN, as None)."""
+    return v is not None and math.isfinite(v)
+
+
 def _ratio(a, b) -> float | None:
     if a is None or b is None or not b:
         return None
     return float(a) / float(b)
 
 
-def seed_record(row: dict, grading: GradingDescription, seed: int) -> SeedRecord:
+def seed_record(row: CaseRow | LostCaseRow | dict, grading: GradingDescription | dict,
+                seed: int) -> SeedRecord:  # fmt: skip
     """One criterion run of the grading study, flattened: accepted n2D, first and last trial."""
-    res = row.get("results") or {}
-    ok = row.get("status") == "done" and bool(res.get("converged"))
+    row, grading = case_row(row), part(GradingDescription, grading)
+    res = row.results or {}
+    ok = row.status == "done" and bool(res.get("converged"))
     return SeedRecord.from_dict({
-        "grading": grading["label"],
-        "cu": grading["cu"],
+        "grading": grading.label,
+        "cu": grading.cu,
         "seed": seed,
-        "status": row.get("status"),
+        "status": row.status,
         "converged": ok,
         "accepted_n2d": res.get("final_porosity") if ok else None,
         "accepted_measured_n2d": res.get("last_new_porosity") if ok else None,
@@ -239,8 +248,8 @@ def seed_record(row: dict, grading: GradingDescription, seed: int) -> SeedRecord
         "accepted_f_top_n_per_m": res.get("f_top_after_n_per_m") if ok else None,
         "accepted_f_bottom_n_per_m": res.get("f_bottom_after_n_per_m") if ok else None,
         "accepted_self_weight_n_per_m": res.get("self_weight_n_per_m") if ok else None,
-        "message": res.get("message") or row.get("error"),
-        "time_s": row.get("time_s"),
+        "message": res.get("message") or row.error,
+        "time_s": row.time_s,
     })  # fmt: skip
 
 
@@ -256,28 +265,28 @@ AVERAGED = (
 )
 
 
-def grading_points(records: list[SeedRecord], grads: list[GradingDescription]) -> list[GradingPoint]:
+def grading_points(records: list[SeedRecord], grads: list[GradingDescription | dict]) -> list[GradingPoint]:
     """One point per grading: accepted n2D and first-trial forces over its seeds."""
     pts = []
-    for g in grads:
-        recs = [r for r in records if r["grading"] == g["label"]]
-        acc = finite_mean_sd([r["accepted_n2d"] for r in recs])
-        means = {name: finite_mean_sd([r.get(key) for r in recs]) for name, key in AVERAGED}
+    for g in (part(GradingDescription, g) for g in grads):
+        recs = [r for r in records if r.grading == g.label]
+        acc = finite_mean_sd([r.accepted_n2d for r in recs])
+        means = {name: finite_mean_sd([getattr(r, key) for r in recs]) for name, key in AVERAGED}
         pts.append(GradingPoint.from_dict({
             "axis": "grading",
-            "label": g["label"],
-            "cu": g["cu"],
-            "cu_nominal": g["cu_nominal"],
-            "d50_mm": g["d50_mm"],
-            "d_max_mm": g["d_max_mm"],
-            "n2d_mean": acc["mean"],
-            "n2d_sd": acc["sd"],
-            "n": acc["n"],
+            "label": g.label,
+            "cu": g.cu,
+            "cu_nominal": g.cu_nominal,
+            "d50_mm": g.d50_mm,
+            "d_max_mm": g.d_max_mm,
+            "n2d_mean": acc.mean,
+            "n2d_sd": acc.sd,
+            "n": acc.n,
             "seeds": len(recs),
-            "unconverged": len(recs) - acc["n"],
+            "unconverged": len(recs) - acc.n,
             "quantity": "accepted trial n2D",
             **{f"{name}_{stat}": getattr(m, stat) for name, m in means.items() for stat in ("mean", "sd")},
-            "first_trial_porosity": next((r["first_trial_porosity"] for r in recs), None),
+            "first_trial_porosity": next((r.first_trial_porosity for r in recs), None),
         }))  # fmt: skip
     return pts
 
@@ -296,31 +305,34 @@ def mu_points(cal: dict) -> list[MuPoint]:
 
 
 # -------------------------------------------------------------------------------- answer
-def closest_match(points: list[dict], x: str, target: float, tol: float = MATCH_TOLERANCE) -> Match:
+def closest_match(points: list[GradingPoint | MuPoint | dict], x: str, target: float,
+                  tol: float = MATCH_TOLERANCE) -> Match:  # fmt: skip
     """Points within ``tol`` of ``target``, the closest point, and where the means cross it.
 
-    ``x`` names the swept quantity. The crossing is a linear interpolation between two
-    neighbouring points (sorted by ``x``) whose means lie on either side of the target.
+    ``x`` names the swept quantity ("cu" or "mu_prep"; a point given as a dict is read as the
+    point of that axis). The crossing is a linear interpolation between two neighbouring points
+    (sorted by ``x``) whose means lie on either side of the target.
     """
-    good = sorted((p for p in points if math.isfinite(p["n2d_mean"])), key=lambda p: p[x])
+    points = [part(MuPoint if x == "mu_prep" else GradingPoint, p) for p in points]
+    good = sorted((p for p in points if _finite(p.n2d_mean)), key=lambda p: getattr(p, x))
     if not good:
         return Match.from_dict({"matches": [], "closest": None, "distance": None, "crossing": None})
-    best = min(good, key=lambda p: abs(p["n2d_mean"] - target))
+    best = min(good, key=lambda p: abs(p.n2d_mean - target))
     crossing = None
     for a, b in zip(good, good[1:], strict=False):
-        ya, yb = a["n2d_mean"] - target, b["n2d_mean"] - target
+        ya, yb = a.n2d_mean - target, b.n2d_mean - target
         if ya * yb <= 0.0 and ya != yb:
-            crossing = a[x] + (b[x] - a[x]) * ya / (ya - yb)
+            crossing = getattr(a, x) + (getattr(b, x) - getattr(a, x)) * ya / (ya - yb)
             break
     return Match.from_dict({
-        "matches": [p[x] for p in good if abs(p["n2d_mean"] - target) <= tol + 1e-12],
-        "closest": best[x],
-        "closest_mean": best["n2d_mean"],
-        "closest_sd": best["n2d_sd"],
-        "closest_n": best["n"],
-        "distance": best["n2d_mean"] - target,
+        "matches": [getattr(p, x) for p in good if abs(p.n2d_mean - target) <= tol + 1e-12],
+        "closest": getattr(best, x),
+        "closest_mean": best.n2d_mean,
+        "closest_sd": best.n2d_sd,
+        "closest_n": best.n,
+        "distance": best.n2d_mean - target,
         "crossing": crossing,
-        "ends": [[good[0][x], good[0]["n2d_mean"]], [good[-1][x], good[-1]["n2d_mean"]]],
+        "ends": [[getattr(good[0], x), good[0].n2d_mean], [getattr(good[-1], x), good[-1].n2d_mean]],
     })  # fmt: skip
 
 
@@ -328,22 +340,23 @@ def _pm(p_mean: float, sd: float, n: int) -> str:
     return f"{p_mean:.4f} +- {sd:.4f} (n = {n})"
 
 
-def _axis_text(name: str, unit: str, m: dict, points: list[dict], x: str, target: float, tol: float) -> str:
-    if m["closest"] is None:
+def _axis_text(name: str, unit: str, m: Match, points: list[GradingPoint | MuPoint], x: str, target: float,
+               tol: float) -> str:  # fmt: skip
+    if m.closest is None:
         return f"{name}: no point was accepted by any seed."
-    if m["matches"]:
-        hits = [p for p in points if p[x] in m["matches"]]
-        vals = "; ".join(f"{unit}{p[x]:g}: {_pm(p['n2d_mean'], p['n2d_sd'], p['n'])}" for p in hits)
+    if m.matches:
+        hits = [p for p in points if getattr(p, x) in m.matches]
+        vals = "; ".join(f"{unit}{getattr(p, x):g}: {_pm(p.n2d_mean, p.n2d_sd, p.n)}" for p in hits)
         text = f"{name}: within {tol:g} of {target:g}: {vals}"
     else:
-        best = _pm(m["closest_mean"], m["closest_sd"], m["closest_n"])
-        side = "above" if m["distance"] > 0 else "below"
-        text = f"{name}: no point within {tol:g} of {target:g}; the closest is {unit}{m['closest']:g} with "
-        text += f"{best}, {abs(m['distance']):.4f} {side}"
-    if m["crossing"] is not None:
-        text += f"; the means cross {target:g} at {unit}{m['crossing']:.3g} (linear interpolation)"
+        best = _pm(m.closest_mean, m.closest_sd, m.closest_n)
+        side = "above" if m.distance > 0 else "below"
+        text = f"{name}: no point within {tol:g} of {target:g}; the closest is {unit}{m.closest:g} with "
+        text += f"{best}, {abs(m.distance):.4f} {side}"
+    if m.crossing is not None:
+        text += f"; the means cross {target:g} at {unit}{m.crossing:.3g} (linear interpolation)"
     else:
-        (x0, y0), (x1, y1) = m["ends"]
+        (x0, y0), (x1, y1) = m.ends
         text += f"; from {unit}{x0:g} to {unit}{x1:g} the means run from {y0:.4f} to {y1:.4f}"
     return text + "."
 
@@ -351,10 +364,10 @@ def _axis_text(name: str, unit: str, m: dict, points: list[dict], x: str, target
 def answer(sens: dict, tol: float = MATCH_TOLERANCE) -> Answer:
     """Which grading width and which mu_prep accept the paper's n2D, from the measured points."""
     paper = sens["paper"]
-    target = float(paper["accepted_porosity"])
+    target = float(paper.accepted_porosity)
     g_pts = sens["points"]["grading"]
-    family = [p for p in g_pts if p["cu_nominal"] is not None]
-    ref = next((p for p in g_pts if p["cu_nominal"] is None), None)
+    family = [p for p in g_pts if p.cu_nominal is not None]
+    ref = next((p for p in g_pts if p.cu_nominal is None), None)
     g = closest_match(family, "cu", target, tol)
     mu = closest_match(sens["points"]["mu_prep"], "mu_prep", target, tol)
     lines = [
@@ -362,32 +375,33 @@ def answer(sens: dict, tol: float = MATCH_TOLERANCE) -> Answer:
         _axis_text("Preparation friction (reference grading)", "mu_prep = ", mu, sens["points"]["mu_prep"],
                    "mu_prep", target, tol),
     ]  # fmt: skip
-    if ref is not None and math.isfinite(ref["n2d_mean"]):
-        d = ref["n2d_mean"] - target
-        acc = _pm(ref["n2d_mean"], ref["n2d_sd"], ref["n"])
+    if ref is not None and _finite(ref.n2d_mean):
+        d = ref.n2d_mean - target
+        acc = _pm(ref.n2d_mean, ref.n2d_sd, ref.n)
         lines.append(
-            f"The reference grading (Cu = {ref['cu']:.3g}) accepts {acc} with the paper's protocol, "
+            f"The reference grading (Cu = {ref.cu:.3g}) accepts {acc} with the paper's protocol, "
             f"{abs(d):.4f} {'above' if d > 0 else 'below'} the paper's {target:g}"
             f"{'' if abs(d) > tol else ' (within the tolerance)'}."
         )
     lines.extend(_protocol_lines(sens, ref))
     lines.extend(_first_trial_lines(ref, paper))
-    unconv = sum(p["unconverged"] for p in g_pts + sens["points"]["mu_prep"])
+    unconv = sum(p.unconverged for p in g_pts + sens["points"]["mu_prep"])
     if unconv:
         lines.append(f"{unconv} seed(s) did not converge; they are counted, not averaged.")
     return Answer(target=target, tolerance=tol, grading=g, mu_prep=mu, lines=lines)
 
 
-def _protocol_lines(sens: dict, ref: dict | None) -> list[str]:
+def _protocol_lines(sens: dict, ref: GradingPoint | dict | None) -> list[str]:
     """The paper's protocol (first trial from Eq. 12) against the calibration's (its own first trial)."""
     from poro2d.sweep.density import first_trial, with_density_defaults
 
+    ref = part(GradingPoint, ref)
     mu0 = sens["settings"]["mu_prep"]
-    cal = next((p for p in sens["points"]["mu_prep"] if abs(p["mu_prep"] - mu0) < 1e-12), None)
+    cal = next((p for p in sens["points"]["mu_prep"] if abs(p.mu_prep - mu0) < 1e-12), None)
     if ref is None or cal is None:
         return []
-    a, b = ref["measured_mean"], cal["n2d_mean"]
-    if not (math.isfinite(a) and math.isfinite(b)):
+    a, b = ref.measured_mean, cal.n2d_mean
+    if not (_finite(a) and _finite(b)):
         return []
     # each trial is a fresh specimen seeded by the seed and the trial porosity: where the two
     # protocols reach the same trial porosity they prepare the same specimen
@@ -395,24 +409,27 @@ def _protocol_lines(sens: dict, ref: dict | None) -> list[str]:
     first = first_trial(study.table("criterion"), mu0)
     return [
         f"At mu_prep = {mu0:g} the measured porosity n' of the accepted trial is {a:.4f} starting from "
-        f"the first trial {ref['first_trial_porosity']:g} and {b:.4f} starting from {first:g} (the "
+        f"the first trial {ref.first_trial_porosity:g} and {b:.4f} starting from {first:g} (the "
         f"calibration), a difference of {a - b:+.4f}; every trial is prepared afresh, so the first trial "
         "acts only through the trial porosity it leads to."
     ]
 
 
-def _first_trial_lines(ref: dict | None, paper: dict) -> list[str]:
-    if ref is None or not math.isfinite(ref["first_f_top_mean"]):
+def _first_trial_lines(ref: GradingPoint | None, paper: PaperNumbers) -> list[str]:
+    if ref is None or not _finite(ref.first_f_top_mean):
         return []
-    paper_f = 1e3 * paper["f_top_first_trial_kn_per_m"]
-    paper_g = paper["self_weight_first_trial_n_per_m"]
-    paper_n = paper["trials"][0] + paper["porosity_change_first_trial"]
-    f, sd, g = ref["first_f_top_mean"], ref["first_f_top_sd"], ref["first_g_mean"]
+    paper_f = 1e3 * paper.f_top_first_trial_kn_per_m
+    paper_g = paper.self_weight_first_trial_n_per_m
+    paper_n = paper.trials[0] + paper.porosity_change_first_trial
+    # a mean over no seed is None (NaN as the file keeps it): printed as NaN was
+    means = (ref.first_f_top_mean, ref.first_f_top_sd, ref.first_g_mean, ref.first_f_top_over_g_mean,
+             ref.first_n_prime_mean)  # fmt: skip
+    f, sd, g, ratio, n_prime = map(float_or_nan, means)
     return [
-        f"First trial ({ref['first_trial_porosity']:g}) with the reference grading: F_top = {f:.4g} +- "
-        f"{sd:.3g} N/m = {ref['first_f_top_over_g_mean']:.4g} G (G = {g:.4g} N/m); the paper: {paper_f:.4g} "
+        f"First trial ({ref.first_trial_porosity:g}) with the reference grading: F_top = {f:.4g} +- "
+        f"{sd:.3g} N/m = {ratio:.4g} G (G = {g:.4g} N/m); the paper: {paper_f:.4g} "
         f"N/m = {paper_f / paper_g:.4g} G (G = {paper_g:g} N/m), {paper_f / f:.3g} times poro2d's; after "
-        f"the plate moved n' = {ref['first_n_prime_mean']:.4f} (paper: {paper_n:.3f})."
+        f"the plate moved n' = {n_prime:.4f} (paper: {paper_n:.3f})."
     ]
 
 
@@ -446,12 +463,12 @@ def run_sensitivity(
     settings = study_settings(base.config.get("sensitivity"), quick=quick, seeds=seeds)
     study = study_base(base, quick=quick)
     _, _, crit, _ = build(study.as_config(), study.base_dir)
-    cases = gradings(study, settings["cus"])
+    cases = gradings(study, settings.cus)
     check_gradings(study, cases)
-    sweep = grading_sweep(study, cases, settings["seeds"])
+    sweep = grading_sweep(study, cases, settings.seeds)
     # the friction axis is the density calibration, with its settings (layers that settle):
     # the same cases as the relation's, read back from the shared cache when it ran them
-    calibration = D.CalibrationCase(D.with_density_defaults(study), tuple(settings["mus"]), settings["seeds"])
+    calibration = D.CalibrationCase(D.with_density_defaults(study), tuple(settings.mus), settings.seeds)
     calibration.sweep  # noqa: B018 (its cases are built, so checked, now)
     check_reachable(options.scheduler)
     if announce is not None:
@@ -462,7 +479,7 @@ def run_sensitivity(
 
 
 def _run_study(study: CriterionBase, crit, cases: list[GradingCase], sweep: SweepConfig, calibration,
-               settings: dict, store: Store, *, use_cache: bool, options: RunOptions,
+               settings: StudySettings, store: Store, *, use_cache: bool, options: RunOptions,
                client) -> SensitivityResult:  # fmt: skip
     """The grading sweep, the calibration, and the study's record of both (checked inputs)."""
     from poro2d.sweep import density as D
@@ -479,14 +496,14 @@ def _run_study(study: CriterionBase, crit, cases: list[GradingCase], sweep: Swee
     timings["mu_prep_s"] = time.perf_counter() - t1
 
     grads = [g.describe() for g in cases]
-    labels = [(g, s) for g in grads for s in range(settings["seeds"])]
+    labels = [(g, s) for g in grads for s in range(settings.seeds)]
     records = [seed_record(r, g, s) for r, (g, s) in zip(res.rows, labels, strict=True)]
     spec = study.table("specimen")
     sens = {
         "title": "accepted n2D against grading width and preparation friction (paper protocol)",
         "settings": dict(
-            settings,
-            seed_list=list(range(settings["seeds"])),
+            settings.to_dict(),
+            seed_list=list(range(settings.seeds)),
             mu_prep=float(spec.get("friction_prep", 0.05)),
             n_lab=crit.n_lab,
             first_trial=crit.initial_trial(),

@@ -187,7 +187,7 @@ class PointRow(Record):
         """The row of ``point``: it reproduces the paper when its mean lies within ``tolerance``
         of ``target``."""
         mean = point.n2d_mean
-        close = math.isfinite(mean) and abs(mean - target) <= tolerance + 1e-12
+        close = mean is not None and math.isfinite(mean) and abs(mean - target) <= tolerance + 1e-12
         return cls(point, close, " ".join(map(str, seeds)), version)
 
 
