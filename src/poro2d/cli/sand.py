@@ -70,7 +70,7 @@ def print_preflight(case, pf) -> None:
 
 def print_result(res, out: Path) -> None:
     """The answer: the interior porosity first, then n', the friction, every seed."""
-    from poro2d.sand.result import _pm, warnings
+    from poro2d.sand.result import mean_sd_text, warnings
 
     st = res.state
     dr = st.relative_density
@@ -95,7 +95,7 @@ def print_result(res, out: Path) -> None:
         )
     console.print(t)
     console.print(
-        f"box porosity n' {_pm(res.box_porosity_mean, res.box_porosity_sd)}; "
+        f"box porosity n' {mean_sd_text(res.box_porosity_mean, res.box_porosity_sd)}; "
         f"mu_prep {res.mu_prep:.3f}; "
         f"2D extremes {res.n2d_min:.4f}-{res.n2d_max:.4f}; jamming porosity "
         + ("n/a" if res.jamming_porosity is None else f"{res.jamming_porosity:.4f}"),

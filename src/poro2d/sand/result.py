@@ -226,7 +226,7 @@ class SandResult(TypedResult):
         )
 
 
-def _pm(mean: float | None, sd: float | None) -> str:
+def mean_sd_text(mean: float | None, sd: float | None) -> str:
     """``mean +- sd``, or n/a without a number (None, as a file keeps NaN)."""
     return "n/a" if mean is None or not math.isfinite(mean) else f"{mean:.4f} +- {sd or 0.0:.4f}"
 
@@ -286,7 +286,7 @@ def summary_markdown(res: SandResult, store: Store) -> str:
         + (f" (Dr = {dr:.3f})" if dr is not None else ""),
         "",
         "**Interior porosity (use this in other codes): "
-        f"{_pm(res.interior_porosity_mean, res.interior_porosity_sd)}**"
+        f"{mean_sd_text(res.interior_porosity_mean, res.interior_porosity_sd)}**"
         f" over {res.seeds_accepted} of {res.seeds} seeds",
         "",
         "| quantity | value |",
@@ -298,8 +298,8 @@ def summary_markdown(res: SandResult, store: Store) -> str:
         + (f", Dr = {dr:.3f}" if dr is not None else "")
         + f" (given as {st.given}) |",
         f"| preparation friction mu_prep | {res.mu_prep:.3f} |",
-        f"| interior porosity | {_pm(res.interior_porosity_mean, res.interior_porosity_sd)} |",
-        f"| box porosity n' (under the lid) | {_pm(res.box_porosity_mean, res.box_porosity_sd)} |",
+        f"| interior porosity | {mean_sd_text(res.interior_porosity_mean, res.interior_porosity_sd)} |",
+        f"| box porosity n' (under the lid) | {mean_sd_text(res.box_porosity_mean, res.box_porosity_sd)} |",
         f"| solid fraction (interior) | {_fmt(res.solid_fraction_mean)} |",
         "| jamming porosity of the grading | "
         + ("n/a" if jam is None else f"{jam:.4f} +- {res.jamming_porosity_sd or 0.0:.4f}")
