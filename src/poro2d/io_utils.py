@@ -193,7 +193,8 @@ def write_json(path: str | os.PathLike, data: Mapping, *, config: bool = False) 
 
 
 def write_csv(path: str | os.PathLike, rows: Iterable[Mapping], header: list[str] | None = None) -> None:
-    rows = list(rows)
+    # a typed result or record is written as the dict of its file
+    rows = [r.to_dict() if not isinstance(r, dict) and hasattr(r, "to_dict") else r for r in rows]
     if header is None:
         header = []
         for r in rows:

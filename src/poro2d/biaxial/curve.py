@@ -95,9 +95,10 @@ class BiaxialCurve(Mapping):
         return len(self.columns)
 
     @classmethod
-    def of_rows(cls, rows: list[Mapping]) -> BiaxialCurve:
+    def of_rows(cls, rows: list[CurveRow] | list[Mapping]) -> BiaxialCurve:
         """The rows as columns, every value through ``float`` as ``curve.csv`` stores it; an optional
         column only where every row has it."""
+        rows = [r.to_dict() if isinstance(r, CurveRow) else r for r in rows]  # as curve.csv holds them
         kept = [k for k in OPTIONAL_COLUMNS if rows and all(r.get(k) not in (None, "") for r in rows)]
         return cls(**{k: np.array([float(r[k]) for r in rows]) for k in (*CURVE_COLUMNS, *kept)})
 

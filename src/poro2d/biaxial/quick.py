@@ -82,8 +82,8 @@ class QuickSpecimen:
         """The specimen, prepared now (a few seconds); refused if its preparation did not converge."""
         spec = self._spec(threads or 1)
         sim, report = prepare_specimen(spec, paper_grading(), self.porosity, seed=self.seed)
-        if not report["converged"]:
-            raise RuntimeError(f"the {self.source} did not reach equilibrium ({report['failed_stage']})")
+        if not report.converged:
+            raise RuntimeError(f"the {self.source} did not reach equilibrium ({report.failed_stage})")
         return sim
 
 

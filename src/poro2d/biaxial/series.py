@@ -145,7 +145,7 @@ def sigma_3_at_peak(test: BiaxialTestResult) -> float:
     c = test.curve
     if c is None:
         return test.confining_stress_kpa
-    s3 = smoothed(c.axial_strain, c.sigma_3_kpa, test.settings["smoothing_strain"])
+    s3 = smoothed(c.axial_strain, c.sigma_3_kpa, test.settings.smoothing_strain)
     return float(np.interp(test.axial_strain_at_peak, c.axial_strain, s3))
 
 

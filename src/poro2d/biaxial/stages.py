@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from poro2d.biaxial.box import BiaxialBox, BoxSize
-from poro2d.biaxial.curve import curve_row
+from poro2d.biaxial.curve import CurveRow, curve_row
 from poro2d.biaxial.parts import BoxRecord, ConsolidationRecord
 from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.biaxial.stiffness import contact_kn, overlap_ratio, stiffness_number
@@ -156,7 +156,7 @@ class Shearing:
     rho: float
     progress: ProgressFn | None = None
 
-    def run(self) -> tuple[list[dict], float]:
+    def run(self) -> tuple[list[CurveRow], float]:
         """The curve's rows and the plate's velocity (m/s)."""
         sim, s = self.sim, self.settings
         sigma = self.confining_kpa * 1e3
@@ -168,13 +168,13 @@ class Shearing:
         sim.reset_clock()
         rows = [curve_row(sim, start, 0, self.d50, self.rho, self.strain_rate)]
         step = 0
-        while rows[-1]["axial_strain"] < s.max_strain:
+        while rows[-1].axial_strain < s.max_strain:
             sim.run(steps_per_row)
             step += steps_per_row
             servo_targets(sim, sigma, s, top=False)
             rows.append(curve_row(sim, start, step, self.d50, self.rho, self.strain_rate))
             if self.progress is not None:
-                self.progress("shearing", min(rows[-1]["axial_strain"] / s.max_strain, 1.0))
+                self.progress("shearing", min(rows[-1].axial_strain / s.max_strain, 1.0))
         return rows, velocity
 
 

@@ -45,14 +45,14 @@ def _best_curves(
     specimens), and that design point: what the fit figure draws. Near in log f_p and mu_r (the
     two-parameter rule), and in log kn and log ks over their decades when they are calibrated."""
     best = result.best
-    stiffness = [k for k in ("particle_kn", "particle_ks") if best.get(k) is not None]
+    stiffness = [k for k in ("particle_kn", "particle_ks") if getattr(best, k) is not None]
 
     def distance(e: DesignPoint) -> float:
-        d = (math.log(e.particle_friction / best["particle_friction"])) ** 2
-        d += (e.rolling_friction - best["rolling_friction"]) ** 2
+        d = (math.log(e.particle_friction / best.particle_friction)) ** 2
+        d += (e.rolling_friction - best.rolling_friction) ** 2
         for k in stiffness:
-            lo, hi = result.ranges[k]
-            d += (math.log(getattr(e, k) / best[k]) / math.log(hi / lo)) ** 2
+            lo, hi = getattr(result.ranges, k)
+            d += (math.log(getattr(e, k) / getattr(best, k)) / math.log(hi / lo)) ** 2
         return d
 
     nearest = min(result.evaluations, key=distance)
@@ -86,7 +86,7 @@ def _known(result) -> str:
     names = {"particle_friction": "f_p", "rolling_friction": "mu_r", "particle_kn": "kn", "particle_ks": "ks"}
     spans = [
         f"{names[k]} {lo:.3g} to {hi:.3g}" + (" N/m" if k in _STIFFNESS else "")
-        for k, (lo, hi) in result.intervals.items()
+        for k, (lo, hi) in result.intervals.to_dict().items()
         if k in names
     ]
     return f"{result.level:.0%} intervals: " + ", ".join(spans)
@@ -99,20 +99,19 @@ _STIFFNESS = {"particle_kn": "kn_particle", "particle_ks": "ks_particle"}
 def _specimen_lines(best) -> list[str]:
     """The ``[specimen]`` table's calibrated values: both frictions, and kn, ks where calibrated."""
     lines = [
-        f"friction_particle = {_toml_value(best['particle_friction'])}",
-        f"rolling_friction = {_toml_value(best['rolling_friction'])}",
+        f"friction_particle = {_toml_value(best.particle_friction)}",
+        f"rolling_friction = {_toml_value(best.rolling_friction)}",
     ]
-    return lines + [
-        f"{name} = {_toml_value(best[k])}" for k, name in _STIFFNESS.items() if best.get(k) is not None
-    ]
+    given = [(name, getattr(best, k)) for k, name in _STIFFNESS.items()]
+    return lines + [f"{name} = {_toml_value(v)}" for name, v in given if v is not None]
 
 
 def _biaxial_config(result, stresses) -> str:
     """A ``[biaxial]`` table for ``poro2d biaxial --config`` (the settings used, the calibrated
     frictions, the laboratory's confining stresses) and ``[specimen]`` for new specimens."""
     b = result.best
-    table = {k: v for k, v in result.settings.items() if v is not None}
-    table.update(particle_friction=b["particle_friction"], rolling_friction=b["rolling_friction"],
+    table = {k: v for k, v in result.settings.to_dict().items() if v is not None}
+    table.update(particle_friction=b.particle_friction, rolling_friction=b.rolling_friction,
                  confining_kpa=list(stresses))  # fmt: skip
     lines = [
         "# poro2d calibrate (biaxial laboratory tests):",
@@ -132,12 +131,12 @@ def _config(result, lab) -> str:
     ``[specimen]``
     for a new specimen (``poro2d criterion``) to export with ``poro2d export``."""
     b = result.best
-    shear = {k: v for k, v in result.settings.items() if v is not None}
-    shear.update(particle_friction=b["particle_friction"], rolling_friction=b["rolling_friction"])
-    shear.update({k: b[k] for k in _STIFFNESS if b.get(k) is not None})
+    shear = {k: v for k, v in result.settings.to_dict().items() if v is not None}
+    shear.update(particle_friction=b.particle_friction, rolling_friction=b.rolling_friction)
+    shear.update({k: getattr(b, k) for k in _STIFFNESS if getattr(b, k) is not None})
     shear.update(normal_stress_kpa=lab.normal_stresses())
     what = "particle and rolling friction" + (
-        " and the disks' stiffness" if any(b.get(k) is not None for k in _STIFFNESS) else ""
+        " and the disks' stiffness" if any(getattr(b, k) is not None for k in _STIFFNESS) else ""
     )
     lines = [
         f"# poro2d calibrate: the posterior maximum of {what}",

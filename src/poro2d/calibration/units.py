@@ -240,9 +240,9 @@ def _row(unit: CalibrationUnit, res) -> UnitRow:
         fp=unit.fp,
         mu_r=unit.mu_r,
         specimen=unit.specimen,
-        peak=float(res["peak_shear_stress_kpa"]),
-        end=float(res["end"]["shear_stress_kpa"]),
-        wall_time_s=float(res["wall_time_s"]),
+        peak=float(res.peak_shear_stress_kpa),
+        end=float(res.end.shear_stress_kpa),
+        wall_time_s=float(res.wall_time_s),
         dilation=end_rise_mm(res.curve, window),
         readings=CurveReadings(
             np.asarray(res.curve["shear_displacement_mm"], float) * 1e-3,

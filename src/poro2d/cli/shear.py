@@ -81,12 +81,12 @@ def check_extra_types(extra: dict) -> None:
 
 def print_stiffness_note(tests) -> None:
     """kappa = kn / (sigma t) and the overlap at the peak per stress: how much strain is the contacts'."""
-    rows = [t for t in tests if t.get("stiffness_number") is not None]
+    rows = [t for t in tests if t.stiffness_number is not None]
     if not rows:
         return
     parts = [
-        f"{t['normal_stress_kpa']:g} kPa: kappa {t['stiffness_number']:.0f}, overlap / d "
-        f"{t['mean_overlap_ratio_at_peak']:.1e}"
+        f"{t.normal_stress_kpa:g} kPa: kappa {t.stiffness_number:.0f}, overlap / d "
+        f"{t.mean_overlap_ratio_at_peak:.1e}"
         for t in rows
     ]
     console.print(
@@ -238,25 +238,23 @@ def residual_cells(residual) -> tuple[str, str]:
     earlier poro2d, which did not read it)."""
     if residual is None:
         return "-", "-"
-    if not residual["reached"]:
+    if not residual.reached:
         return "not reached", "not reached"
-    plane = residual["plane_stress_ratio"]
-    return f"{residual['stress_ratio']:.3f}", "-" if plane is None else f"{plane:.3f}"
+    plane = residual.plane_stress_ratio
+    return f"{residual.stress_ratio:.3f}", "-" if plane is None else f"{plane:.3f}"
 
 
 def print_residual_note(tests) -> None:
     """What the residual columns are, and where each test's stretch lies."""
-    read = [t for t in tests if t.get("residual_dilation_stopped") is not None]
+    read = [t for t in tests if t.residual_dilation_stopped is not None]
     if not read:
         return
-    first = read[0]["residual_dilation_stopped"]
-    stretches = "; ".join(
-        f"{t['normal_stress_kpa']:g} kPa: {t['residual_dilation_stopped']['status']}" for t in read
-    )
+    first = read[0].residual_dilation_stopped
+    stretches = "; ".join(f"{t.normal_stress_kpa:g} kPa: {t.residual_dilation_stopped.status}" for t in read)
     console.print(
         f"resid. t/s: the residual tau/sigma where dilation stopped (the plate's net slope against the "
-        f"shear displacement within {first['rate_limit']:g} over the final stretch and its halves, at least "
-        f"{1e3 * first['min_stretch_m']:.3g} mm long), on the plate's and on the shear plane's normal stress "
+        f"shear displacement within {first.rate_limit:g} over the final stretch and its halves, at least "
+        f"{1e3 * first.min_stretch_m:.3g} mm long), on the plate's and on the shear plane's normal stress "
         f"({stretches})"
     )
 
@@ -264,10 +262,10 @@ def print_residual_note(tests) -> None:
 def box_warning(tests) -> str | None:
     """The warning that tests are box-dominated (poro2d.shear.box_dominated), one line naming each; None
     when none is."""
-    flagged = [t for t in tests if t.get("box_dominated")]
+    flagged = [t for t in tests if t.box_dominated]
     if not flagged:
         return None
-    each = "; ".join(f"{t['normal_stress_kpa']:g} kPa: {t['box_note'].removeprefix('box-dominated: ')}"
+    each = "; ".join(f"{t.normal_stress_kpa:g} kPa: {t.box_note.removeprefix('box-dominated: ')}"
                      for t in flagged)  # fmt: skip
     return (
         f"warning: {len(flagged)} of {len(tests)} tests are box-dominated, their tau/sigma is the box's, "
@@ -275,8 +273,12 @@ def box_warning(tests) -> str | None:
     )
 
 
-def print_result(result: ShearSeriesResult, out: Path) -> None:
-    warning = box_warning(result["tests"])
+def print_result(result: ShearSeriesResult | dict, out: Path) -> None:
+    from poro2d.shear.results import ShearSeriesResult
+    from poro2d.typed_result import part
+
+    result = part(ShearSeriesResult, result)  # a series read back as its dict, too
+    warning = box_warning(result.tests)
     if warning:  # before the answer: a reader who stops at the table must not miss it
         console.print(warning, style="bold red", markup=False, soft_wrap=True)
     t = Table(title="direct shear")
@@ -293,31 +295,31 @@ def print_result(result: ShearSeriesResult, out: Path) -> None:
         "time s",
     ):
         t.add_column(col, justify="right")
-    for r in result["tests"]:
+    for r in result.tests:
         t.add_row(
-            f"{r['normal_stress_kpa']:g}", f"{r['peak_shear_stress_kpa']:.2f}",
-            f"{1e3 * r['shear_displacement_at_peak_m']:.2f}", f"{r['peak_stress_ratio']:.3f}",
-            f"{r['end']['shear_stress_kpa']:.2f}", f"{r['end']['plate_displacement_mm']:.3f}",
-            *residual_cells(r.get("residual_dilation_stopped")),
-            _sci(r["max_inertial_number"]), f"{r['wall_time_s']:.0f}",
+            f"{r.normal_stress_kpa:g}", f"{r.peak_shear_stress_kpa:.2f}",
+            f"{1e3 * r.shear_displacement_at_peak_m:.2f}", f"{r.peak_stress_ratio:.3f}",
+            f"{r.end.shear_stress_kpa:.2f}", f"{r.end.plate_displacement_mm:.3f}",
+            *residual_cells(r.residual_dilation_stopped),
+            _sci(r.max_inertial_number), f"{r.wall_time_s:.0f}",
         )  # fmt: skip
     console.print(t)
-    print_stiffness_note(result["tests"])
-    print_residual_note(result["tests"])
+    print_stiffness_note(result.tests)
+    print_residual_note(result.tests)
     from poro2d.shear.box_scale import box_scale_of
 
     scale = box_scale_of(result)
     label = f"{scale.label()} " if scale is not None and scale.label() else ""
-    if result.get("friction_angle_deg") is not None:
+    if result.friction_angle_deg is not None:
         console.print(
-            f"Mohr-Coulomb: {label}phi = {result['friction_angle_deg']:.2f} deg, "
-            f"c = {result['cohesion_kpa']:.2f} kPa, R2 = {result['r2']:.4f}; "
-            f"through the origin phi = {result['friction_angle_through_origin_deg']:.2f} deg"
+            f"Mohr-Coulomb: {label}phi = {result.friction_angle_deg:.2f} deg, "
+            f"c = {result.cohesion_kpa:.2f} kPa, R2 = {result.r2:.4f}; "
+            f"through the origin phi = {result.friction_angle_through_origin_deg:.2f} deg"
         )
-    on_plane = [t for t in result["tests"] if t.get("plane_load_fraction_at_peak") is not None]
+    on_plane = [t for t in result.tests if t.plane_load_fraction_at_peak is not None]
     if on_plane:
-        fractions = [t["plane_load_fraction_at_peak"] for t in on_plane]
-        ratios = [t["peak_stress_ratio"] / t["plane_load_fraction_at_peak"] for t in on_plane]
+        fractions = [t.plane_load_fraction_at_peak for t in on_plane]
+        ratios = [t.peak_stress_ratio / t.plane_load_fraction_at_peak for t in on_plane]
         console.print(
             f"the shear plane carries {100 * min(fractions):.0f}-{100 * max(fractions):.0f} % of the plate's "
             f"normal stress at the peaks (side wall friction: below 100 % it holds load up, above it drags "
@@ -328,18 +330,18 @@ def print_result(result: ShearSeriesResult, out: Path) -> None:
         console.print(scale.note())
         if scale.warning():
             console.print(f"warning: {scale.warning()}")
-    qs = result["quasi_static"]
-    console.print(f"max inertial number {qs['max_inertial_number']:.2e} (limit {qs['inertial_limit']:g})")
-    rc = result.get("rate_check")
+    qs = result.quasi_static
+    console.print(f"max inertial number {_sci(qs.max_inertial_number)} (limit {qs.inertial_limit:g})")
+    rc = result.rate_check
     if rc is not None:
         console.print(
-            f"rate check (v/2): largest peak change {100 * rc['max_abs_relative_change']:.2f} % "
-            f"(tolerance {100 * rc['tolerance']:g} %): {'passed' if rc['passed'] else 'NOT passed'}"
+            f"rate check (v/2): largest peak change {100 * rc.max_abs_relative_change:.2f} % "
+            f"(tolerance {100 * rc.tolerance:g} %): {'passed' if rc.passed else 'NOT passed'}"
         )
-    lab = result.get("lab")
-    if lab is not None and lab.get("friction_angle_deg") is not None:
+    lab = result.lab
+    if lab is not None and lab.friction_angle_deg is not None:
         console.print(
-            f"lab: phi = {lab['friction_angle_deg']:.2f} deg; "
-            f"DEM - lab = {lab['friction_angle_difference_deg']:+.2f} deg"
+            f"lab: phi = {lab.friction_angle_deg:.2f} deg; "
+            f"DEM - lab = {lab.friction_angle_difference_deg:+.2f} deg"
         )
     console.print(f"results in {out}/result.json, figures fig8a_shear_curves.png, fig8b_peak_strength.png")

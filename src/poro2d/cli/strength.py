@@ -164,14 +164,18 @@ def _deg(mean, sd) -> str:
 def _stopped(case) -> str:
     """A case's residual where dilation stopped: plate / plane (k tests), "not reached", or "-"
     (a study of an earlier poro2d)."""
-    k = case.get("tests_dilation_stopped")
+    from poro2d.shear.parts import StrengthCase
+    from poro2d.typed_result import part
+
+    case = part(StrengthCase, case)  # a row read back as its dict, too
+    k = case.tests_dilation_stopped
     if k is None:
         return "-"
     if not k:
         return "not reached"
-    plane = case.get("residual_dilation_stopped_plane_ratio_mean")
+    plane = case.residual_dilation_stopped_plane_ratio_mean
     return (
-        f"{case['residual_dilation_stopped_ratio_mean']:.3f} / "
+        f"{case.residual_dilation_stopped_ratio_mean:.3f} / "
         + ("-" if plane is None else f"{plane:.3f}")
         + f" ({k})"
     )
@@ -179,12 +183,8 @@ def _stopped(case) -> str:
 
 def stiffness_note(cases) -> str | None:
     """The contacts' stiffness over the study in one line: kappa's extent and the largest overlap."""
-    ranges = [
-        (c["stiffness_number_min"], c["stiffness_number_max"]) for c in cases if c.get("stiffness_number_min")
-    ]
-    overlaps = [
-        c.get("mean_overlap_ratio_at_peak_max") for c in cases if c.get("mean_overlap_ratio_at_peak_max")
-    ]
+    ranges = [(c.stiffness_number_min, c.stiffness_number_max) for c in cases if c.stiffness_number_min]
+    overlaps = [c.mean_overlap_ratio_at_peak_max for c in cases if c.mean_overlap_ratio_at_peak_max]
     if not ranges:
         return None
     lo, hi = min(r[0] for r in ranges), max(r[1] for r in ranges)
@@ -204,23 +204,23 @@ def print_strength(result: StrengthResult, out: Path) -> None:
     for col in ("mu_r", "f_p", "phi peak deg", "phi residual deg", "psi max deg", "tau/sigma residual",
                 "t/s dilation stopped"):  # fmt: skip
         t.add_column(col, justify="right")
-    for r in result["cases"]:
+    for r in result.cases:
         t.add_row(
-            f"{r['mu_r']:g}", f"{r['particle_friction']:g}",
-            _deg(r["peak_friction_angle_mean_deg"], r["peak_friction_angle_sd_deg"]),
-            _deg(r["residual_friction_angle_mean_deg"], r["residual_friction_angle_sd_deg"]),
-            _deg(r["max_dilation_angle_mean_deg"], r["max_dilation_angle_sd_deg"]),
-            f"{r['residual_stress_ratio_mean']:.3f}", _stopped(r),
+            f"{r.mu_r:g}", f"{r.particle_friction:g}",
+            _deg(r.peak_friction_angle_mean_deg, r.peak_friction_angle_sd_deg),
+            _deg(r.residual_friction_angle_mean_deg, r.residual_friction_angle_sd_deg),
+            _deg(r.max_dilation_angle_mean_deg, r.max_dilation_angle_sd_deg),
+            f"{r.residual_stress_ratio_mean:.3f}", _stopped(r),
         )  # fmt: skip
     console.print(t)
-    if any(r.get("tests_dilation_stopped") is not None for r in result["cases"]):
+    if any(r.tests_dilation_stopped is not None for r in result.cases):
         console.print(
             "tau/sigma residual: over the last fifth of each curve, whether or not the plate still rises; "
             "t/s dilation stopped: over the tests whose plate stopped rising (net d plate / d shear within "
             f"{DILATION_RATE_LIMIT:g} over a final stretch), on the plate's / the shear plane's normal "
             "stress, with how many did"
         )
-    stiffness = stiffness_note(result["cases"])
+    stiffness = stiffness_note(result.cases)
     if stiffness:
         console.print(stiffness)
     if scale is not None:

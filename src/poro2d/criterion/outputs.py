@@ -52,13 +52,13 @@ def write_accepted(result: CriterionResult, store: Store, width: float, *, figur
         return
     first = trials[0]
     pairs = [(_trial_store(store, first), "forces_trial.png", "fig5_forces_initial_trial.png")]
-    moved = next((t for t in trials if t.get("plate_moved") in MOVED), None)
+    moved = next((t for t in trials if t.plate.moved in MOVED), None)
     if moved is not None:
         pairs.append((_trial_store(store, moved), "forces_after_plate.png", "fig6_forces_after_plate.png"))
-    accepted = next((t for t in trials if t.get("accepted")), None) if result.converged else None
+    accepted = next((t for t in trials if t.decision.accepted), None) if result.converged else None
     if accepted is not None:
         folder = _trial_store(store, accepted)
-        moved_last = accepted.get("plate_moved") in MOVED and folder.has("after_plate.npz")
+        moved_last = accepted.plate.moved in MOVED and folder.has("after_plate.npz")
         state = "after_plate" if moved_last else "prepared"
         figure = "forces_after_plate.png" if moved_last else "forces_trial.png"
         pairs.append((folder, figure, "fig7_forces_accepted.png"))
@@ -72,7 +72,7 @@ def write_accepted(result: CriterionResult, store: Store, width: float, *, figur
         from poro2d.dem.export import write_vtu
 
         write_vtu(sim, store.path("vtu"), "accepted_specimen")
-        n2d = accepted["trial_porosity"]
+        n2d = accepted.trial_porosity
         write_specimen_state(store, sim, width, n2d, figures=figures)
         write_specimen_porosity(store, sim, width, n2d, figures=figures)
     for folder, name, as_name in pairs:
@@ -81,7 +81,7 @@ def write_accepted(result: CriterionResult, store: Store, width: float, *, figur
 
 
 def _trial_store(store: Store, trial) -> Store:
-    return store.child(trial_name(trial["iteration"], trial["trial_porosity"]))
+    return store.child(trial_name(trial.iteration, trial.trial_porosity))
 
 
 def write_specimen_state(store: Store, sim: Simulation, width: float, n2d: float, *, figures: bool) -> None:

@@ -171,6 +171,7 @@ def next_trial(rows: Sequence[Mapping], s: CriterionSettings) -> float:
     replaced by the bracket's midpoint: bisection, which converges where the paper's rule
     can cycle between two values a resolution apart.
     """
+    rows = [r.to_dict() if isinstance(r, Trial) else r for r in rows]  # a trial as its row
     row = rows[-1]
     n, new = row["trial_porosity"], row["new_porosity"]
     if s.refine_tolerance is None:
@@ -278,17 +279,17 @@ def closed_bracket(trials: list[Trial], s: CriterionSettings) -> Trial | None:
         return None
     fit = [
         t for t in trials
-        if t["converged"] and t.get("plate_settled") and not t["failed_check"]
-        and t["porosity_change"] is not None and t["porosity_change"] < s.porosity_tolerance
+        if t.converged and t.plate.is_settled and not t.decision.failed_check
+        and t.porosity_change is not None and t.porosity_change < s.porosity_tolerance
     ]  # fmt: skip
     if not fit:
         return None
-    best = min(fit, key=lambda t: t["porosity_change"])
+    best = min(fit, key=lambda t: t.porosity_change)
     best.decision = replace(
         best.decision, accepted=True, condition_met=True, accepted_at="closed bracket",
         reason=(
             f"the trials bracket the fixed point a grid step apart: |n' - n2D| = "
-            f"{best['porosity_change']:.4f}, below the paper's {s.porosity_tolerance:g} (refining to "
+            f"{best.porosity_change:.4f}, below the paper's {s.porosity_tolerance:g} (refining to "
             f"{s.refine_tolerance:g} cannot go finer than the specimens' scatter), all checks passed"
         ),
     )  # fmt: skip
@@ -407,7 +408,7 @@ class PorosityCriterion:
         s = self.settings
         t0 = time.perf_counter()
         sim, prep = self._prepare(k, n)
-        t_prep = prep.report.get("time_s", time.perf_counter() - t0)
+        t_prep = prep.report.time_s if prep.report.time_s is not None else time.perf_counter() - t0
         weight = self.spec.self_weight(n)
         forces0 = wall_forces(sim)
         t1 = time.perf_counter()
@@ -575,7 +576,7 @@ class PorosityCriterion:
                 break
             if trial.decision.refused:
                 failed_trial = k
-                message = f"trial {k} (n2D = {n:.4f}) refused: {trial['reason']}"
+                message = f"trial {k} (n2D = {n:.4f}) refused: {trial.decision.reason}"
                 break
             nxt = next_trial(trials, s)
             if nxt in tried:
@@ -583,7 +584,7 @@ class PorosityCriterion:
                 if accepted is not None:
                     self._write_table(trials)
                     message = (
-                        f"accepted n2D = {accepted['trial_porosity']:.4f} after {k} trial(s), "
+                        f"accepted n2D = {accepted.trial_porosity:.4f} after {k} trial(s), "
                         "when the bracket closed (docs/criterion.md)"
                     )
                     break
@@ -595,12 +596,13 @@ class PorosityCriterion:
             n = nxt
         else:
             message = f"no convergence within max_iterations = {s.max_iterations} (trials {tried})"
-        final = None if accepted is None else accepted["trial_porosity"]
+        final = None if accepted is None else accepted.trial_porosity
         result = self._result(trials, final=final, converged=accepted is not None, message=message)
         result.failed_trial = failed_trial
         if accepted is not None:
+            row = accepted.to_dict()  # the accepted trial's row: its numbers as its file keeps them
             for key in CriterionResult.OPTIONAL:
-                setattr(result, key, accepted.get(key))
+                setattr(result, key, row.get(key))
         result.preparation_note = preparation_note(self.spec, self.grading)
         result.time_total_s = time.perf_counter() - t_start
         return result

@@ -19,7 +19,8 @@ def print_result(result: CriterionResult, store: Store) -> None:
     for col in ("trial n2D", "disks", "F_top N/m", "F_bottom N/m", "G N/m", "plate", "dz (mm)", "n' (box)",
                 "|n'-n2D|", "interior n", "gap/d50", "accepted"):  # fmt: skip
         t.add_column(col, justify="right")
-    for r in result.iterations:
+    rows = [trial.to_dict() for trial in result.iterations]  # each trial as its row
+    for r in rows:
         t.add_row(
             f"{r['trial_porosity']:.3f}", str(r["particle_count"]), f"{r['f_top_n_per_m']:.4g}",
             f"{r['f_bottom_n_per_m']:.4g}", f"{r['self_weight_n_per_m']:.4g}", r["plate_moved"],
@@ -28,7 +29,7 @@ def print_result(result: CriterionResult, store: Store) -> None:
             _fixed_or_dash(r.get("surface_gap_mean_d50"), 2), _verdict(r),
         )  # fmt: skip
     console.print(t)
-    for r in result.iterations:
+    for r in rows:
         if r.get("overfull_m"):
             console.print(
                 f"trial {r['iteration']} (n2D = {r['trial_porosity']:.4f}): over-full box, the specimen "
@@ -39,7 +40,7 @@ def print_result(result: CriterionResult, store: Store) -> None:
         console.print(f"preparation: {result.preparation_note}", soft_wrap=True)
     console.print(f"{result.message}; results in {store.root}/result.json")
     if result.interior_porosity is not None:
-        under_lid = result.settings.get("acceptance") == "fill"
+        under_lid = result.settings.acceptance == "fill"
         what = (
             "under the lid: the box the specimen fills"
             if under_lid

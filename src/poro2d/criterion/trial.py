@@ -71,7 +71,8 @@ class Preparation:
     def failure(self, equilibrium: str) -> StageFailure:
         """The stage of a preparation that did not reach equilibrium (``equilibrium``: its measure)."""
         r = self.report
-        ratio = r.failed_max_ratio if "failed_ratio" not in r else r.failed_ratio
+        # a report of an older file lacks failed_ratio
+        ratio = r.failed_ratio if "failed_ratio" in r.to_dict() else r.failed_max_ratio
         return StageFailure(r.failed_stage, r.failed_max_ratio, r.failed_steps, ratio, equilibrium)
 
 

@@ -91,7 +91,8 @@ def box_verdict(curve: Mapping[str, np.ndarray], window_m: float) -> BoxVerdict:
 def box_dominated_count(tests) -> int | None:
     """How many of ``tests`` (results or their summaries) are box-dominated; None when none was
     judged (every one of an earlier poro2d, its curve not at hand)."""
-    judged = [t.get("box_dominated") for t in tests if t.get("box_dominated") is not None]
+    flags = (t.get("box_dominated") if isinstance(t, dict) else t.box_dominated for t in tests)
+    judged = [flag for flag in flags if flag is not None]
     return sum(judged) if judged else None
 
 

@@ -85,12 +85,12 @@ class BoxScale(TypedResult):
         )
 
 
-def box_scale_of(result: Mapping) -> BoxScale | None:
+def box_scale_of(result: TypedResult | dict) -> BoxScale | None:
     """The ``box_scale`` of a series or strength result as its record (None when it has none).
 
     A result read back as a plain dict (``json.loads`` of its file) holds the record's dict.
     """
-    scale = result.get("box_scale")
+    scale = result.get("box_scale") if isinstance(result, dict) else result.box_scale
     if isinstance(scale, Mapping) and not isinstance(scale, BoxScale):
         return BoxScale.from_dict(scale)
     return scale

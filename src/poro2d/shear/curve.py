@@ -99,7 +99,7 @@ class CurveRow(TypedResult):
     upper_wall_friction_kpa: float = math.nan
 
 
-def curve_columns(rows: list[Mapping]) -> ShearCurve | None:
+def curve_columns(rows: list[CurveRow] | list[Mapping]) -> ShearCurve | None:
     """A curve's records as one float array per column of :data:`CURVE_COLUMNS` (None without rows).
 
     Every value goes through ``float`` as ``curve.csv`` stores it (an integer column reads
@@ -108,7 +108,10 @@ def curve_columns(rows: list[Mapping]) -> ShearCurve | None:
     if not rows:
         return None
 
-    def value(row: Mapping, k: str) -> float:
+    def value(row: CurveRow | Mapping, k: str) -> float:
+        if isinstance(row, CurveRow):  # NaN is held as None; a column an old checkpoint lacks too
+            v = getattr(row, k)
+            return math.nan if v is None else float(v)
         return float(row.get(k, math.nan)) if k in LATER_COLUMNS else float(row[k])
 
     return ShearCurve(**{k: np.array([value(r, k) for r in rows]) for k in CURVE_COLUMNS})
@@ -266,8 +269,8 @@ class CurveSummary:
 def curve_summary(rows: list[CurveRow], sigma_kpa: float, settings: ShearSettings) -> CurveSummary:
     """Peak, end values, servo error, inertial number and force balance read off the curve."""
     s = settings
-    x = np.array([r["shear_displacement_mm"] for r in rows]) * 1e-3
-    col = {k: np.array([r[k] for r in rows], float) for k in CURVE_COLUMNS}
+    x = np.array([r.shear_displacement_mm for r in rows]) * 1e-3
+    col = {k: np.array([getattr(r, k) for r in rows], float) for k in CURVE_COLUMNS}
     k, xp, tp = peak(x, col["shear_stress_kpa"], s.peak_window)
     end = {}
     for name in ("shear_stress_kpa", "normal_stress_kpa", "plate_displacement_mm", "coordination_number"):

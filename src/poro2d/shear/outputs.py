@@ -8,6 +8,7 @@ from poro2d.shear.curve import CURVE_COLUMNS, ShearCurve, curve_rows
 from poro2d.shear.fit import MohrCoulombFit, mohr_coulomb
 from poro2d.shear.lab import LabData
 from poro2d.shear.parts import TestSummary
+from poro2d.shear.results import ShearTestResult
 from poro2d.store import Store
 
 
@@ -35,27 +36,25 @@ def write_tables(store: Store, curves: dict[float, ShearCurve], summary: list[Te
     store.write_csv("curves.csv", long_rows, header=["normal_stress_kpa"] + CURVE_COLUMNS)
     # the nested parts of a test's summary (end values, force balance) are in result.json only
     store.write_csv(
-        "peaks.csv", [{k: v for k, v in r.items() if not isinstance(v, Mapping)} for r in summary]
+        "peaks.csv", [{k: v for k, v in r.to_dict().items() if not isinstance(v, Mapping)} for r in summary]
     )
 
 
 def write_figures(
-    store: Store, tests: list[dict], curves: dict[float, ShearCurve], fit, fit0, settings,
+    store: Store, tests: list[ShearTestResult], curves: dict[float, ShearCurve], fit, fit0, settings,
     lab: LabData | None,
 ) -> None:  # fmt: skip
     """``fig8a_shear_curves.png`` (curves, peaks marked) and ``fig8b_peak_strength.png`` (the fits)."""
     from poro2d.report.shear_figures import plot_peak_strength, plot_shear_curves
 
-    peaks = {
-        t["normal_stress_kpa"]: (t["shear_displacement_at_peak_m"], t["peak_shear_stress_kpa"]) for t in tests
-    }
+    peaks = {t.normal_stress_kpa: (t.shear_displacement_at_peak_m, t.peak_shear_stress_kpa) for t in tests}
     plot_shear_curves(
         curves, store.path("fig8a_shear_curves.png"), lab=lab, peaks=peaks,
         smoothing_note=f"v = {1e3 * settings.velocity:g} mm/s; peaks (dots) smoothed over "
         f"{1e3 * settings.peak_window:g} mm",
     )  # fmt: skip
     plot_peak_strength(
-        [t["normal_stress_kpa"] for t in tests], [t["peak_shear_stress_kpa"] for t in tests], fit,
+        [t.normal_stress_kpa for t in tests], [t.peak_shear_stress_kpa for t in tests], fit,
         store.path("fig8b_peak_strength.png"), fit_origin=fit0, lab=lab, lab_fit=lab_fit(lab),
     )  # fmt: skip
 

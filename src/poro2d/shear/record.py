@@ -47,11 +47,15 @@ class TestContent(TypedResult):
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {"settings": ShearSettingsRecord}
 
 
-def content_record(specimen_digest: str, sigma_kpa: float, settings: Mapping[str, Any]) -> TestContent:
+def content_record(
+    specimen_digest: str, sigma_kpa: float, settings: ShearSettingsRecord | Mapping[str, Any]
+) -> TestContent:
     """What a stored test must share with this one to be reused: content, never paths.
 
     ``settings``: :meth:`ShearSettings.record` (or its dict, as a ``test.json`` holds it).
     """
+    if isinstance(settings, ShearSettingsRecord):
+        settings = settings.to_dict()
     kept = {k: v for k, v in settings.items() if not (k in LATER_SETTINGS and v is None)}
     return TestContent(specimen_digest, sigma_kpa, ShearSettingsRecord.from_dict(kept))
 

@@ -27,6 +27,7 @@ from poro2d.shear.pool import ShearJob
 from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult, ShearTestResult
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
+from poro2d.typed_result import part
 
 
 def mohr_coulomb_ci(sigma_kpa, tau_kpa, through_origin: bool = False, level: float = 0.95) -> FitInterval:
@@ -43,7 +44,7 @@ def mohr_coulomb_ci(sigma_kpa, tau_kpa, through_origin: bool = False, level: flo
     t = np.asarray(tau_kpa, float).ravel()
     fit = mohr_coulomb(s, t, through_origin=through_origin)
     df = s.size - (1 if through_origin else 2)
-    out = FitInterval(**fit.record(), level=level, dof=df)
+    out = FitInterval(**fit.record().to_dict(), level=level, dof=df)
     if df < 1:
         return out
     resid = t - fit.predict(s)
@@ -71,10 +72,11 @@ def summarize_replicate_peaks(
     """
     if not series:
         raise InputError("replicates", 0, "at least one specimen's tests")
+    series = {label: part(ShearSeriesResult, res) for label, res in series.items()}  # a dict read back, too
     by_sigma: dict[float, list[float]] = {}
     for res in series.values():
-        for t in res["tests"]:
-            by_sigma.setdefault(float(t["normal_stress_kpa"]), []).append(float(t["peak_shear_stress_kpa"]))
+        for t in res.tests:
+            by_sigma.setdefault(float(t.normal_stress_kpa), []).append(float(t.peak_shear_stress_kpa))
     rows = []
     for sig in sorted(by_sigma):
         v = np.array(by_sigma[sig])
@@ -87,7 +89,7 @@ def summarize_replicate_peaks(
         ))  # fmt: skip
     sig = np.concatenate([[r.normal_stress_kpa] * r.n for r in rows])
     tau = np.concatenate([r.peaks_kpa for r in rows])
-    phis = [r["friction_angle_deg"] for r in series.values() if r.get("friction_angle_deg") is not None]
+    phis = [r.friction_angle_deg for r in series.values() if r.friction_angle_deg is not None]
     return ReplicateShearResult(
         specimens=list(series),
         per_normal_stress=rows,
@@ -97,7 +99,7 @@ def summarize_replicate_peaks(
         friction_angle_mean_deg=float(np.mean(phis)) if phis else None,
         friction_angle_sd_deg=float(np.std(phis, ddof=1)) if len(phis) > 1 else None,
         method="peaks of every specimen pooled; Student-t intervals of the least-squares line",
-        box_dominated_tests=box_dominated_count([t for r in series.values() for t in r["tests"]]),
+        box_dominated_tests=box_dominated_count([t for r in series.values() for t in r.tests]),
     )
 
 
@@ -161,7 +163,7 @@ class ReplicateShear:
         summary.series = per
         if self.store is None:
             return summary
-        self.store.write_csv("replicates.csv", [{k: v for k, v in r.items() if k != "peaks_kpa"}
+        self.store.write_csv("replicates.csv", [{k: v for k, v in r.to_dict().items() if k != "peaks_kpa"}
                                                 for r in summary.per_normal_stress])  # fmt: skip
         self.store.write_json("replicates.json", summary.to_dict())
         if self.figures:
@@ -175,7 +177,7 @@ class ReplicateShear:
 
         bands = {}
         for row in summary.per_normal_stress:
-            sigma = row["normal_stress_kpa"]
+            sigma = row.normal_stress_kpa
             bands[sigma] = curve_band([res.curves[sigma] for res in summary.series.values()])
         n = len(self.series)
         lab = next(iter(self.series.values())).lab

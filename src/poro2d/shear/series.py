@@ -146,8 +146,8 @@ class ShearSeries:
         (a test per stress, then the rate check's reruns)."""
         n = len(self.stresses)
         tests = results[:n]
-        sig = np.array([t["normal_stress_kpa"] for t in tests])
-        tau = np.array([t["peak_shear_stress_kpa"] for t in tests])
+        sig = np.array([t.normal_stress_kpa for t in tests])
+        tau = np.array([t.peak_shear_stress_kpa for t in tests])
         fit = mohr_coulomb(sig, tau) if len(sig) >= 2 else None
         fit0 = mohr_coulomb(sig, tau, through_origin=True)
         s = self.settings
@@ -184,7 +184,7 @@ class ShearSeries:
             result.lab = self._lab_part(fit)
         result.wall_time_s = time.perf_counter() - t0
         result.provenance = Provenance.now()
-        curves = {t["normal_stress_kpa"]: t.curve for t in tests}
+        curves = {t.normal_stress_kpa: t.curve for t in tests}
         if self.store is not None:
             write_tables(self.store, curves, summary)
             if self.figures:
@@ -196,10 +196,10 @@ class ShearSeries:
     @staticmethod
     def _test_summary(t: ShearTestResult) -> TestSummary:
         """One test's line of the series' result."""
-        # tests written before a test said why it ended lack ``ended_by``
+        # tests written before a test said why it ended lack ``ended_by`` (None)
         return TestSummary(
-            **{k: t.get(k) if k == "ended_by" else t[k] for k in SUMMARY_KEYS},
-            consolidation_normal_stress_error=t.consolidation["normal_stress_error"],
+            **{k: getattr(t, k) for k in SUMMARY_KEYS},
+            consolidation_normal_stress_error=t.consolidation.normal_stress_error,
             folder=folder_name(t.normal_stress_kpa),
             plane_load_fraction_at_peak=t.plane_load_fraction_at_peak,
             residual_dilation_stopped=t.residual_dilation_stopped,
@@ -212,7 +212,7 @@ class ShearSeries:
     def _quasi_static(self, tests: list[ShearTestResult]) -> QuasiStatic:
         s = self.settings
         # a stored infinity reads back as null (JSON has no infinity): the check failed
-        max_i = max(math.inf if t["max_inertial_number"] is None else t["max_inertial_number"] for t in tests)
+        max_i = max(math.inf if t.max_inertial_number is None else t.max_inertial_number for t in tests)
         return QuasiStatic(
             max_inertial_number=max_i,
             inertial_limit=s.inertial_limit,
@@ -264,11 +264,11 @@ class ShearSeries:
         xb = b["shear_displacement_mm"] * 1e-3
         ya = smooth(xa, a["shear_stress_kpa"], w)
         yb = np.interp(xa, xb, smooth(xb, b["shear_stress_kpa"], w))
-        end = min(t["shear_displacement_at_peak_m"], h["shear_displacement_at_peak_m"])
+        end = min(t.shear_displacement_at_peak_m, h.shear_displacement_at_peak_m)
         m = (xa >= 0.5 * w) & (xa <= end)
         if not m.any():
             return math.nan
-        return float(np.mean(np.abs(yb[m] - ya[m])) / t["peak_shear_stress_kpa"])
+        return float(np.mean(np.abs(yb[m] - ya[m])) / t.peak_shear_stress_kpa)
 
     def _lab_part(self, fit) -> LabComparison:
         """The laboratory data, their fit and the difference of the friction angles."""

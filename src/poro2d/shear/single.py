@@ -158,7 +158,7 @@ class DirectShearTest:
             store.remove("consolidation.json")
             store.remove(CONSOLIDATED)
             return self.consolidate()
-        self.box = SplitBox(**info.box)
+        self.box = SplitBox(**info.box.to_dict())
         return sim, info
 
     def _consolidate(self) -> tuple[Simulation, ConsolidationRecord]:
@@ -206,7 +206,7 @@ class DirectShearTest:
                 self._figure(stage.peak.frame, result)
         return result
 
-    def _figure(self, frame: PeakFrame, result: dict) -> None:
+    def _figure(self, frame: PeakFrame, result: ShearTestResult) -> None:
         """``forces_peak.png``: the force chains at the (smoothed) peak."""
         assert self.store is not None and self.box is not None
         b = self.box
@@ -214,7 +214,7 @@ class DirectShearTest:
             self.store.path("forces_peak.png"),
             title=f"direct shear at {self.sigma_kpa:g} kPa, at the peak: d = {frame.displacement_mm:.2f} mm",
             box=(-0.02 * b.width, 0.0, b.width + b.max_displacement, b.height),
-            notes=[f"tau_peak = {result['peak_shear_stress_kpa']:.1f} kPa (smoothed over "
+            notes=[f"tau_peak = {result.peak_shear_stress_kpa:.1f} kPa (smoothed over "
                    f"{1e3 * self.settings.peak_window:g} mm)"],
         )  # fmt: skip
 

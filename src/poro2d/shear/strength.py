@@ -110,8 +110,8 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
     for label, res in summary.series.items():
         res_pts = []
         psis = []
-        for t in res["tests"]:
-            sigma = t["normal_stress_kpa"]
+        for t in res.tests:
+            sigma = t.normal_stress_kpa
             curve = res.curves[sigma]
             s_res, tau_res = residual_point(curve)
             psi = max_dilation_angle(curve, window_m)
@@ -120,20 +120,20 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
             psis.append(psi)
             tests.append({
                 "mu_r": mu_r, "particle_friction": friction, "specimen": label, "normal_stress_kpa": sigma,
-                "peak_shear_stress_kpa": t["peak_shear_stress_kpa"],
-                "peak_stress_ratio": t["peak_stress_ratio"],
+                "peak_shear_stress_kpa": t.peak_shear_stress_kpa,
+                "peak_stress_ratio": t.peak_stress_ratio,
                 "residual_normal_stress_kpa": s_res, "residual_shear_stress_kpa": tau_res,
                 "residual_stress_ratio": tau_res / s_res, "max_dilation_angle_deg": psi,
-                "end_shear_displacement_m": t["end_shear_displacement_m"],
+                "end_shear_displacement_m": t.end_shear_displacement_m,
                 "residual_dilation_stopped_ratio": stopped.stress_ratio,
                 "residual_dilation_stopped_plane_ratio": stopped.plane_stress_ratio,
                 "residual_dilation_stopped_from_mm": stopped.start_mm if stopped.reached else None,
-                "stiffness_number": t.get("stiffness_number"),
-                "mean_overlap_ratio_at_peak": t.get("mean_overlap_ratio_at_peak"),
+                "stiffness_number": t.stiffness_number,
+                "mean_overlap_ratio_at_peak": t.mean_overlap_ratio_at_peak,
             })  # fmt: skip
         s, tau = np.array(res_pts).T
         per_specimen.append({
-            "peak": res["friction_angle_deg"],
+            "peak": res.friction_angle_deg,
             "residual": mohr_coulomb(s, tau, through_origin=True).friction_angle_deg,
             "dilation": float(np.mean(psis)),
         })  # fmt: skip
@@ -299,7 +299,7 @@ class StrengthStudy:
 
         rows = result.cases
         store.write_csv("strength_tests.csv", tests)
-        store.write_csv("strength.csv", [{k: v for k, v in r.items() if not k.endswith("_ci_deg")}
+        store.write_csv("strength.csv", [{k: v for k, v in r.to_dict().items() if not k.endswith("_ci_deg")}
                                          for r in rows])  # fmt: skip
         store.write_result("strength.json", result)
         plot_strength(rows, store.path("fig_strength.png"))
