@@ -23,7 +23,7 @@ def specimen(tmp_path_factory):
     Built once for the whole session: the shear, strength, rolling, protocol, export and
     calibration tests read it (a test that needs to change it works on a copy)."""
     sim, rep = prepare_specimen(SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.2, seed=0)
-    assert rep["converged"]
+    assert rep.converged
     path = tmp_path_factory.mktemp("specimen") / "specimen.npz"
     checkpoint.save(sim, path)
     return path

@@ -108,7 +108,7 @@ def tiny(specimen, tmp_path_factory):
     for seed in (1, 2):
         sim, rep = prepare_specimen(SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.2,
                                     seed=seed)  # fmt: skip
-        assert rep["converged"]
+        assert rep.converged
         paths[seed] = root / f"seed{seed}.npz"
         checkpoint.save(sim, paths[seed])
     lab = synthetic_lab(paths[2], [50, 100], TRUTH["particle_friction"], TRUTH["rolling_friction"],
@@ -140,12 +140,12 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     res = run_calibration(lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2, settings=SHORT,
                           options=ONE_WORKER, **FIT_BOX)  # fmt: skip
     for name, value in TRUTH.items():
-        lo, hi = res.intervals[name]
+        lo, hi = getattr(res.intervals, name)
         assert lo <= value <= hi, (name, value, lo, hi)
-        assert lo <= res.posterior["median"][name] <= hi
-    assert res == json.loads((out / "result.json").read_text())
+        assert lo <= getattr(res.posterior.median, name) <= hi
+    assert res.to_dict() == json.loads((out / "result.json").read_text())
     assert len(res.evaluations) == 11 and res.cluster.tests_run == 11 * 2 * 2
-    assert {o["observable"] for o in res.posterior["observables"]} == {"peak", "end"}
+    assert {o.observable for o in res.posterior.observables} == {"peak", "end"}
     for f in ("calibration_fit.png", "calibration_posterior.png", "calibration.md", "calibration.html"):
         assert (out / f).stat().st_size > 0, f
     # the paper report shows a calibration kept in its output folder (paper-out/calibration)
@@ -153,7 +153,7 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     from poro2d.report.paper_report import _calibration_blocks
 
     kept = CalibrationResult.read(Store(out))
-    assert isinstance(kept, CalibrationResult) and kept == res
+    assert isinstance(kept, CalibrationResult) and kept.to_dict() == res.to_dict()
     blocks = _calibration_blocks(kept, out)
     assert blocks[0] == ("h2", "Calibration of particle and rolling friction")
     assert any(b[0] == "img" and str(b[1]).endswith("calibration_posterior.png") for b in blocks)
@@ -162,25 +162,23 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
         and _calibration_blocks(None, tmp_path) == []
     )
     table, _ = load_shear_config(out / "calibrated.toml")
-    assert table["particle_friction"] == res.best["particle_friction"]
-    assert table["rolling_friction"] == res.best["rolling_friction"]
+    assert table["particle_friction"] == res.best.particle_friction
+    assert table["rolling_friction"] == res.best.rolling_friction
     again = run_calibration(lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2, settings=SHORT,
                             options=ONE_WORKER, **FIT_BOX)  # fmt: skip
     assert again.cluster.tests_run == 0 and again.cluster.tests_reused == 44
-    assert again.best == res.best
+    assert again.best.to_dict() == res.best.to_dict()
     # the same series given twice is two repeats that agree: their mean is the same values, the
     # laboratory's share of the noise halves, so the intervals narrow (from the cache, no test)
     twice = run_calibration([lab, lab], [paths[0], paths[1]], store=Store(tmp_path / "twice"), points=9,
                             refine=0, settings=SHORT, options=ONE_WORKER, **FIT_BOX)  # fmt: skip
     once = run_calibration(lab, [paths[0], paths[1]], store=Store(tmp_path / "once"), points=9, refine=0,
                            settings=SHORT, options=ONE_WORKER, **FIT_BOX)  # fmt: skip
-    assert twice.posterior["lab_repeats"] == 2 and twice.posterior["lab_scatter_ratio"] == 0.0
+    assert twice.posterior.lab_repeats == 2 and twice.posterior.lab_scatter_ratio == 0.0
     assert "lab_repeats" not in once.posterior.to_dict()
-    assert [o["lab_kpa"] for o in twice.posterior["observables"]] == [
-        o["lab_kpa"] for o in once.posterior["observables"]
-    ]
+    assert [o.lab_kpa for o in twice.posterior.observables] == [o.lab_kpa for o in once.posterior.observables]
     for name in TRUTH:
-        assert np.diff(twice.intervals[name]) < np.diff(once.intervals[name]), name
+        assert np.diff(getattr(twice.intervals, name)) < np.diff(getattr(once.intervals, name)), name
     assert twice.lab.source == f"{lab}; {lab}"
     # a weaker 'laboratory' (the same specimen at lower frictions) moves the answer to weaker
     # parameters: the calibration follows its data (round 1 comes from the cache)
@@ -188,15 +186,11 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     weak_lab = _without_vertical(weak_lab, tmp_path / "weak.csv")
     weak = run_calibration(weak_lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2,
                            settings=SHORT, options=ONE_WORKER, **FIT_BOX)  # fmt: skip
-    peaks = {
-        o["normal_stress_kpa"]: o["model_kpa"]
-        for o in res.posterior["observables"]
-        if o["observable"] == "peak"
-    }
-    for o in weak.posterior["observables"]:
-        if o["observable"] == "peak":
-            assert o["model_kpa"] < peaks[o["normal_stress_kpa"]]
-    assert weak.posterior["median"]["particle_friction"] < res.posterior["median"]["particle_friction"]
+    peaks = {o.normal_stress_kpa: o.model_kpa for o in res.posterior.observables if o.observable == "peak"}
+    for o in weak.posterior.observables:
+        if o.observable == "peak":
+            assert o.model_kpa < peaks[o.normal_stress_kpa]
+    assert weak.posterior.median.particle_friction < res.posterior.median.particle_friction
 
 
 def test_synthetic_lab_writes_the_plates_rise_of_its_tests(tiny_dilation):
@@ -432,15 +426,15 @@ def test_a_laboratory_poro2d_did_not_write_gets_the_discrepancy_term(tiny, tmp_p
     other = run_calibration(real, [paths[0], paths[1]], **kw)  # the same tests, from the cache
     assert other.cluster.tests_run == 0
     assert "discrepancy" not in own.posterior.to_dict() and "discrepancy" not in own.config
-    term = other.posterior["discrepancy"]
-    assert term["prior"].startswith("uniform over 41 levels from 0 to 4")
-    assert 0.0 <= term["interval"][0] <= term["median"] <= term["interval"][1] <= 4.0
+    term = other.posterior.discrepancy
+    assert term.prior.startswith("uniform over 41 levels from 0 to 4")
+    assert 0.0 <= term.interval[0] <= term.median <= term.interval[1] <= 4.0
     assert other.config["discrepancy"] == "estimate"
-    for a, b in zip(own.posterior["observables"], other.posterior["observables"], strict=True):
-        assert b["noise_sd_kpa"] >= a["noise_sd_kpa"]
+    for a, b in zip(own.posterior.observables, other.posterior.observables, strict=True):
+        assert b.noise_sd_kpa >= a.noise_sd_kpa
         # kappa = kn / (sigma t): halved from 50 to 100 kPa; the overlap at the peak a small fraction of d
-        assert b["stiffness_number"] == pytest.approx(a["stiffness_number"])
-        assert 0.0 < b["mean_overlap_ratio_at_peak"] < 0.05
-    kappa = {o["normal_stress_kpa"]: o["stiffness_number"] for o in other.posterior["observables"]}
+        assert b.stiffness_number == pytest.approx(a.stiffness_number)
+        assert 0.0 < b.mean_overlap_ratio_at_peak < 0.05
+    kappa = {o.normal_stress_kpa: o.stiffness_number for o in other.posterior.observables}
     assert kappa[50.0] == pytest.approx(2.0 * kappa[100.0], rel=1e-6)
     assert "Model discrepancy" in (tmp_path / "cal" / "calibration.md").read_text()

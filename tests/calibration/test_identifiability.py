@@ -151,8 +151,8 @@ def test_one_specimen_reports_its_intervals_as_unknown(specimen, lab, tmp_path, 
     res = run_calibration(lab, [specimen], store=Store(out), points=MIN_POINTS, refine=0, settings=SHORT,
                           options=ONE_WORKER, keep_box_dominated=True)  # fmt: skip
     assert "one specimen" in res.unidentified
-    assert res.intervals == {"particle_friction": None, "rolling_friction": None}
-    assert res.posterior["wide"] == {"particle_friction": None, "rolling_friction": None}
+    assert res.intervals.to_dict() == {"particle_friction": None, "rolling_friction": None}
+    assert res.posterior.wide.to_dict() == {"particle_friction": None, "rolling_friction": None}
     kept = Store(out).read_json("result.json")
     assert kept["unidentified"] == res.unidentified and kept["intervals"]["particle_friction"] is None
     assert "Not identified" in (out / "calibration.md").read_text()

@@ -36,7 +36,7 @@ def stiff_lab(specimen, tmp_path_factory):
     for seed in (1, 2):
         sim, rep = prepare_specimen(SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.2,
                                     seed=seed)  # fmt: skip
-        assert rep["converged"]
+        assert rep.converged
         checkpoint.save(sim, paths[seed])
     made = synthetic_lab(paths[2], [50, 100], 0.8, 0.15, root / "lab_rise.csv", settings=SHORT,
                          particle_kn=TRUTH["particle_kn"], particle_ks=TRUTH["particle_ks"])  # fmt: skip
@@ -55,30 +55,34 @@ def test_four_parameters_recover_a_known_truth_within_their_intervals(stiff_lab,
               options=ONE_WORKER, keep_box_dominated=True)  # fmt: skip
     res = run_calibration(lab, specimens, store=Store(out), **kw)
     for name, value in TRUTH.items():
-        lo, hi = res.intervals[name]
+        lo, hi = getattr(res.intervals, name)
         assert lo <= value <= hi, (name, value, lo, hi)
-        assert lo <= res.posterior["median"][name] <= hi
+        assert lo <= getattr(res.posterior.median, name) <= hi
     # the stiffness moves the curve's first slope, hardly its peak: its interval spans decades
     for name, (r_lo, r_hi) in (("particle_kn", KN_RANGE), ("particle_ks", KS_RANGE)):
-        lo, hi = res.intervals[name]
+        lo, hi = getattr(res.intervals, name)
         assert r_lo <= lo < hi <= r_hi and hi / lo > 2.0
-    chain = res.posterior["chain"]
+    chain = res.posterior.chain
     assert chain.walkers == 32 and chain.steps - chain.burn_in >= 50 * max(chain.autocorrelation_steps)
-    assert res.posterior["grid"] is None and "log(kn)" in res.posterior["prior"]
+    assert res.posterior.grid is None and "log(kn)" in res.posterior.prior
     assert all(e.particle_kn is not None and e.particle_ks is not None for e in res.evaluations)
     assert len(res.evaluations) <= 22 and res.cluster.tests_run == len(res.evaluations) * 2 * 2
     # the file reads back as written, kn and ks in every record
     data = json.loads((out / "result.json").read_text())
-    assert res == data and CalibrationResult.from_dict(data).to_dict() == data
+    assert res.to_dict() == data and CalibrationResult.from_dict(data).to_dict() == data
     assert data["ranges"]["particle_kn"] == list(KN_RANGE) and "particle_ks" in data["best"]
     # calibrated.toml: a [shear] table poro2d shear reads, and the [specimen] stiffness
     table, _ = load_shear_config(out / "calibrated.toml")
-    assert table["particle_kn"] == res.best["particle_kn"]
+    assert table["particle_kn"] == res.best.particle_kn
     text = (out / "calibrated.toml").read_text()
-    assert f"kn_particle = {res.best['particle_kn']!r}" in text and "ks_particle = " in text
+    assert f"kn_particle = {res.best.particle_kn!r}" in text and "ks_particle = " in text
     assert (out / "calibration_posterior.png").stat().st_size > 0
     assert "disk normal stiffness" in (out / "calibration.md").read_text()
     # the same inputs give the same numbers bit for bit (every test from the cache, the same chain)
     again = run_calibration(lab, specimens, store=Store(out), **kw)
-    assert again.cluster.tests_run == 0 and again.best == res.best and again.intervals == res.intervals
-    assert again.posterior["median"] == res.posterior["median"]
+    assert (
+        again.cluster.tests_run == 0
+        and again.best.to_dict() == res.best.to_dict()
+        and again.intervals.to_dict() == res.intervals.to_dict()
+    )
+    assert again.posterior.median.to_dict() == res.posterior.median.to_dict()

@@ -55,7 +55,7 @@ def calibrated(specimen, tmp_path_factory):
     """One finished calibration of two tiny specimens at two stresses (36 cached tests)."""
     root = tmp_path_factory.mktemp("probe_cache")
     sim, rep = prepare_specimen(SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.2, seed=1)
-    assert rep["converged"]
+    assert rep.converged
     second = root / "seed1.npz"
     checkpoint.save(sim, second)
     lab = root / "lab.csv"

@@ -35,8 +35,8 @@ def test_accept_at_once(tmp_path):
     # this small specimen at 0.21 (seed 0) just fills its box: F_top is about 1 % of G
     # (chaotic packing: another engine sum order may need another trial porosity here)
     r = _run(tmp_path, 0.21, force_fraction=0.05)
-    assert r["converged"] and r["final_porosity"] == 0.21
-    (it,) = r["iterations"]
+    assert r.converged and r.final_porosity == 0.21
+    (it,) = r.iterations
     assert it["plate_moved"] == "no" and it["plate_displacement_m"] == 0.0
     assert 0.0 < it["f_top_n_per_m"] < 0.05 * it["self_weight_n_per_m"]
     assert it["accepted"] and it["porosity_change"] == 0.0
@@ -50,7 +50,7 @@ def test_accept_at_once(tmp_path):
 
 def test_plate_moves_up_when_the_top_force_is_too_large(tmp_path):
     r = _run(tmp_path, 0.19, max_iterations=1)
-    (it,) = r["iterations"]
+    (it,) = r.iterations
     assert it["f_top_n_per_m"] > 0.01 * it["self_weight_n_per_m"]
     assert it["plate_moved"] == "up" and it["plate_displacement_m"] > 0
     assert it["new_porosity"] > 0.19
@@ -62,7 +62,7 @@ def test_plate_moves_up_when_the_top_force_is_too_large(tmp_path):
 
 def test_plate_moves_down_when_nothing_touches_it(down):
     _, r = down
-    (it,) = r["iterations"]
+    (it,) = r.iterations
     assert it["f_top_n_per_m"] == 0.0
     assert it["plate_moved"] == "down" and it["plate_displacement_m"] < 0
     assert it["new_porosity"] < 0.30
@@ -74,8 +74,8 @@ def test_plate_moves_down_when_nothing_touches_it(down):
 
 def test_no_convergence_keeps_every_iteration(down):
     out, r = down
-    assert not r["converged"] and r["final_porosity"] is None
-    assert "max_iterations" in r["message"]
+    assert not r.converged and r.final_porosity is None
+    assert "max_iterations" in r.message
     saved = json.loads((out / "result.json").read_text())
     assert len(saved["iterations"]) == 1 and not saved["converged"]
     assert (out / "fig6_forces_after_plate.png").stat().st_size > 0
@@ -87,7 +87,7 @@ def test_resume_skips_finished_trials(down):
     trial_dir = next((out / "trials").iterdir())
     stamp = (trial_dir / "prepared.npz").stat().st_mtime_ns
     again = _run(out, 0.30, max_iterations=1)
-    assert again["iterations"] == r["iterations"]
+    assert again.to_dict()["iterations"] == r.to_dict()["iterations"]
     assert (trial_dir / "prepared.npz").stat().st_mtime_ns == stamp
 
 
@@ -165,17 +165,17 @@ def test_rerun_with_other_threads_resumes(down):
     spec = replace(SMALL, threads=2)
     settings = CriterionSettings(trial_porosity=0.30, max_iterations=1)
     again = PorosityCriterion(spec, paper_grading(), settings, seed=0, store=Store(out)).run()
-    assert again["iterations"] == r["iterations"]
+    assert again.to_dict()["iterations"] == r.to_dict()["iterations"]
     assert (trial_dir / "trial.json").stat().st_mtime_ns == stamp
 
 
 def test_flags_are_booleans_in_new_and_resumed_trials(down):
     out, r = down
-    (new,) = r["iterations"]
-    (resumed,) = _run(out, 0.30, max_iterations=1)["iterations"]
+    (new,) = r.iterations
+    (resumed,) = _run(out, 0.30, max_iterations=1).iterations
     for key in ("plate_settled", "accepted", "preparation_converged"):
         assert type(new[key]) is bool and type(resumed[key]) is bool, key
-    assert new == resumed
+    assert new.to_dict() == resumed.to_dict()
     saved = json.loads((out / "result.json").read_text())
     assert type(saved["iterations"][0]["plate_settled"]) is bool
     header, row = (out / "iterations.csv").read_text().splitlines()
@@ -225,7 +225,7 @@ def test_config_of_a_run_that_never_started_does_not_bind(tmp_path):
         SMALL, paper_grading(), CriterionSettings(trial_porosity=0.25), store=Store(tmp_path)
     ).stage().bind()
     r = _run(tmp_path, 0.30, max_iterations=1)
-    assert r["iterations"][0]["trial_porosity"] == 0.30
+    assert r.iterations[0].trial_porosity == 0.30
     stored = json.loads((tmp_path / "config.json").read_text())
     assert stored["run"]["criterion"]["trial_porosity"] == 0.30
 
@@ -286,15 +286,15 @@ def test_half_built_frictionless_specimen_is_refused(tmp_path):
     r = PorosityCriterion(
         _frictionless(), paper_grading(), settings, seed=0, store=Store(tmp_path), figures=False
     ).run()
-    assert not r["converged"] and r["final_porosity"] is None and r["failed_trial"] == 1
-    (it,) = r["iterations"]
+    assert not r.converged and r.final_porosity is None and r.failed_trial == 1
+    (it,) = r.iterations
     assert not it["accepted"] and it["refused"] and not it["converged"]
     assert it["failed_stage"] == "layer 2" and it["failed_check"] == "preparation_converged"
     assert it["failed_max_ratio"] > 1e-3 and it["failed_steps"] == 29_000 + 1000 + 1000 + 1000
     assert it["particle_count"] < it["planned_particle_count"]
     assert it["checks"]["all_disks_present"] is False and it["checks"]["porosity_after_generation"] is False
     assert it["plate_moved"] == "not run" and it["new_porosity"] is None
-    assert "trial 1" in r["message"] and "layer 2" in r["message"] and "ratio" in r["message"]
+    assert "trial 1" in r.message and "layer 2" in r.message and "ratio" in r.message
     # every trial's files are kept, nothing looks like an accepted specimen
     trial = next((tmp_path / "trials").iterdir())
     assert (trial / "prepared.npz").is_file() and (trial / "trial.json").is_file()
@@ -303,7 +303,7 @@ def test_half_built_frictionless_specimen_is_refused(tmp_path):
     again = PorosityCriterion(
         _frictionless(), paper_grading(), settings, seed=0, store=Store(tmp_path), figures=False
     )
-    assert again.run()["iterations"] == r["iterations"]
+    assert again.run().to_dict()["iterations"] == r.to_dict()["iterations"]
 
 
 def test_layer_forced_to_fail_ends_the_cli_with_one_line(tmp_path, capsys):
@@ -334,12 +334,12 @@ def test_layer_forced_to_fail_ends_the_cli_with_one_line(tmp_path, capsys):
 
 def test_plate_that_does_not_settle_refuses_the_trial(tmp_path):
     r = _run(tmp_path, 0.30, max_plate_steps=1000)
-    (it,) = r["iterations"]
+    (it,) = r.iterations
     assert it["plate_moved"] == "down" and not it["plate_settled"]
     assert it["refused"] and not it["accepted"] and not it["converged"]
     assert it["failed_stage"] == "top plate" and it["checks"]["plate_settled"] is False
-    assert not r["converged"] and r["failed_trial"] == 1
-    assert "top plate did not settle within 1000 steps" in r["message"] and "ratio" in r["message"]
+    assert not r.converged and r.failed_trial == 1
+    assert "top plate did not settle within 1000 steps" in r.message and "ratio" in r.message
 
 
 def test_accepted_specimen_is_the_state_after_the_plate_moved(tmp_path):

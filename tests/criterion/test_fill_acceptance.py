@@ -53,7 +53,7 @@ def test_a_measured_lid_must_lie_over_the_box():
 def prepared():
     spec = SpecimenSpec(width=0.14, height=0.06, layers=2)
     sim, rep = prepare_specimen(spec, paper_grading(), 0.18, seed=3)
-    assert rep["converged"]
+    assert rep.converged
     return spec, sim
 
 

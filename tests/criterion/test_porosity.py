@@ -11,7 +11,7 @@ from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
 def quick():
     spec = SpecimenSpec(width=0.08, height=0.04, layers=2)
     sim, rep = prepare_specimen(spec, paper_grading(), 0.2, seed=0)
-    assert rep["converged"]
+    assert rep.converged
     return spec, sim
 
 

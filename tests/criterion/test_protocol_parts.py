@@ -63,12 +63,12 @@ def test_the_shear_test_is_its_controllers(specimen):
     sim, info = test.consolidate()
     phases = []
     stage = ShearStage(
-        sim, test.box, settings, info["plate_height_m"], figures=False, progress=lambda p, f: phases.append(p)
+        sim, test.box, settings, info.plate_height_m, figures=False, progress=lambda p, f: phases.append(p)
     )
     stage.run()
-    assert len(stage.rows) == whole["records"] and set(phases) == {"shearing"}
+    assert len(stage.rows) == whole.records and set(phases) == {"shearing"}
     summary = curve_summary(stage.rows, 50.0, settings)
-    assert summary.peak_shear_stress_kpa == whole["peak_shear_stress_kpa"]
+    assert summary.peak_shear_stress_kpa == whole.peak_shear_stress_kpa
     lower = [stage.sim.walls.vel[stage.sim.walls.index(n), 0] for n in ("bottom", "lower_left")]
     assert lower == [settings.velocity] * 2  # ShearDrive set the lower half moving
 

@@ -93,7 +93,7 @@ def test_a_wall_added_after_construction_takes_part():
     assert sim.wall_force("lid")[1] == pytest.approx(target, rel=0.03)
     assert sum(sim.wall_force(w)[1] for w in sim.walls.names) == pytest.approx(-weight, rel=1e-3)
     assert -sim.wall_force("bottom")[1] > 1.2 * weight
-    assert sim.summary()["n_walls"] == 5
+    assert sim.summary().n_walls == 5
 
 
 def test_a_checkpoint_after_adding_a_wall_continues_the_run(tmp_path):
@@ -129,10 +129,10 @@ def test_walls_cannot_be_taken_away():
 # ------------------------------------------------------------------ threads and results
 def test_summary_reports_the_threads_used():
     sim = _grid_box()
-    assert sim.summary()["threads_used"] == 0  # the kernel has not run yet
+    assert sim.summary().threads_used == 0  # the kernel has not run yet
     sim.run(10)
     s = sim.summary()
-    assert s["threads_used"] == sim.threads_used == 1 and s["threads_intended"] == 1
+    assert s.threads_used == sim.threads_used == 1 and s.threads_intended == 1
 
 
 #: the keys of a file's ``engine``, in their order (the rolling frictions only when a disk has one)
@@ -174,7 +174,7 @@ def test_summary_tells_a_fallback_to_one_thread(monkeypatch):
     two = _grid_box(33, 33, threads=2)
     two.run(300)
     s = two.summary()
-    assert s["threads_intended"] == 2 and s["threads_used"] == two.threads_used == 1
+    assert s.threads_intended == 2 and s.threads_used == two.threads_used == 1
     _assert_same(_state(one), _state(two))
 
 
@@ -202,7 +202,7 @@ def test_local_damping_is_changed_by_its_method_only():
     with pytest.raises(AttributeError):
         b.local_damping = 0.3  # would bypass the check
     b.set_local_damping(0.3)
-    assert b.local_damping == 0.3 and b.summary()["local_damping"] == 0.3
+    assert b.local_damping == 0.3 and b.summary().local_damping == 0.3
     for s in (a, b):
         s.run(1500)
     _assert_same(_state(a), _state(b))

@@ -305,6 +305,6 @@ def test_specimen_rolling_friction_is_set_with_the_working_friction():
         SpecimenSpec(rolling_friction=-0.1)
     spec = SpecimenSpec(width=0.06, height=0.03, layers=2, rolling_friction=0.2)
     sim, report = prepare_specimen(spec, paper_grading(), 0.21, seed=3)
-    assert report["converged"]
+    assert report.converged
     assert np.all(sim.particles.mu_r == 0.2) and np.all(sim.walls.rolling_friction() == 0.2)
     assert np.count_nonzero(sim.rolling_moments()[0]) > 0.5 * sim.rolling_moments()[0].size

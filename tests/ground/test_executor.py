@@ -79,7 +79,7 @@ def test_the_dask_backend_gives_the_same_outcomes_in_job_order():
     ) as client:
         executor = Executor(Backend.dask(), client=client)
         outcomes = executor.map(jobs, on_done=lambda i, res: ended.append(i))
-        assert executor.cluster_info()["workers"] == 1 and not executor.cluster_info()["local_cluster"]
+        assert executor.cluster_info().workers == 1 and not executor.cluster_info().local_cluster
         executor.close()  # a given client stays open
         assert client.status == "running"
     assert sorted(ended) == [0, 1, 2, 3]

@@ -178,7 +178,7 @@ def test_a_case_still_running_elsewhere_is_waited_for_and_read_back(tmp_path):
         row = compute_case(_CASE, Store(folder), lambda config, store: {"by": "a second worker"})
     finally:
         assert proc.wait(60) == 0
-    assert row["results"] == {"by": "the first worker"}
+    assert row.results == {"by": "the first worker"}
 
 
 def test_links_leading_out_of_the_output_folder_are_refused(tmp_path, capsys):

@@ -28,11 +28,11 @@ def test_vertical_stress_carries_the_weight_above(settled):
     sim, spec, surface = settled
     st = specimen_state(sim, spec.width, surface, bands=5)
     rows = st.bands
-    sv = np.array([r["sigma_v_pa"] for r in rows])
+    sv = np.array([r.sigma_v_pa for r in rows])
     assert np.all(np.diff(sv) < 0)  # grows with depth
     # the top band holds only a few disks and its own surface: compare the four below it
     for r in rows[:-1]:
-        assert r["sigma_v_pa"] == pytest.approx(r["sigma_v_geostatic_pa"], rel=0.08)
+        assert r.sigma_v_pa == pytest.approx(r.sigma_v_geostatic_pa, rel=0.08)
     # the weight of everything reaches the floor: the bottom wall force is the disks' weight
     weight = float(np.sum(sim.particles.mass)) * 9.81 / sim.particles.thickness
     assert -sim.wall_force("bottom")[1] / sim.particles.thickness == pytest.approx(weight, rel=1e-3)
@@ -42,7 +42,7 @@ def test_vertical_stress_carries_the_weight_above(settled):
 def test_figure_and_band_count(settled, tmp_path):
     sim, spec, surface = settled
     st = specimen_state(sim, spec.width, surface, bands=4)
-    assert len(st.bands) == 4 and st.bands[-1]["z_top_m"] == pytest.approx(surface)
+    assert len(st.bands) == 4 and st.bands[-1].z_top_m == pytest.approx(surface)
     path = plot_specimen_state(st, tmp_path / "state.png", title="t")
     assert path.stat().st_size > 10_000
     with pytest.raises(InputError, match="bands"):

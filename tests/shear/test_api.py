@@ -32,20 +32,18 @@ def test_run_shear_is_the_series_with_its_files(specimen, tmp_path):
     out = tmp_path / "api"
     res = run_shear(specimen.parent, [50, 100], SHORT, store=Store(out), lab=lab, options=SERIAL,
                     config={"note": "kept"})  # fmt: skip
-    assert res == json.loads((out / "result.json").read_text())
-    assert res["config"] == {"note": "kept"} and res["settings"]["max_displacement"] == 0.002
-    assert res["lab"]["friction_angle_deg"] == pytest.approx(np.degrees(np.arctan(35 / 50)))
+    assert res.to_dict() == json.loads((out / "result.json").read_text())
+    assert res.config == {"note": "kept"} and res.settings.max_displacement == 0.002
+    assert res.lab.friction_angle_deg == pytest.approx(np.degrees(np.arctan(35 / 50)))
     for f in ("curves.csv", "peaks.csv", "fig8a_shear_curves.png", "fig8b_peak_strength.png",
               "sn50kPa/forces_peak.png", "sn100kPa/curve.csv"):  # fmt: skip
         assert (out / f).stat().st_size > 0, f
     assert not (out / "sn50kPa" / "peak_frame.npz").exists()  # removed with the checkpoint
     ref = ShearSeries(specimen, [50, 100], ShearSettings(**SHORT), store=Store(tmp_path / "series"),
                       options=SERIAL, figures=False).run()  # fmt: skip
-    assert [t["peak_shear_stress_kpa"] for t in res["tests"]] == [
-        t["peak_shear_stress_kpa"] for t in ref["tests"]
-    ]
+    assert [t.peak_shear_stress_kpa for t in res.tests] == [t.peak_shear_stress_kpa for t in ref.tests]
     again = run_shear(specimen, 100, ShearSettings(**SHORT), store=Store(out / "one"), options=SERIAL)
-    assert again["tests"][0]["peak_shear_stress_kpa"] == ref["tests"][1]["peak_shear_stress_kpa"]
+    assert again.tests[0].peak_shear_stress_kpa == ref.tests[1].peak_shear_stress_kpa
 
 
 @pytest.mark.parametrize(

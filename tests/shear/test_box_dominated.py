@@ -119,7 +119,7 @@ def _series(flags: list[bool | None]) -> ShearSeriesResult:
 def test_a_series_counts_its_box_dominated_tests_and_an_earlier_one_does_not_know():
     assert _series([True, False]).box_dominated_tests == 1
     assert _series([False, False]).box_dominated_tests == 0
-    assert box_dominated_count(_series([None, None])["tests"]) is None
+    assert box_dominated_count(_series([None, None]).tests) is None
     assert "box_dominated_tests" not in _series([None, None]).to_dict()
 
 
@@ -130,6 +130,6 @@ def test_the_command_warns_on_its_first_line_before_the_answer(capsys, tmp_path)
     assert lines[0].startswith("warning: 1 of 2 tests are box-dominated")
     sigma = series.tests[0].normal_stress_kpa
     assert f"{sigma:g} kPa: no peak" in lines[0]
-    assert box_warning(_series([False, False])["tests"]) is None
+    assert box_warning(_series([False, False]).tests) is None
     print_result(_series([False, False]), tmp_path)
     assert "box-dominated" not in capsys.readouterr().out

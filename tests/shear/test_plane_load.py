@@ -26,7 +26,7 @@ def test_plane_carries_the_plate_load_plus_weight_minus_wall_friction_at_the_sta
     assert 0.0 <= residual < 0.015 * plate[0]
     t = res.tests[0]
     assert 0.5 < t.plane_load_fraction_at_peak < 2.0
-    assert t.plane_load_fraction_at_peak == res.tests[0]["plane_load_fraction_at_peak"]
+    assert t.plane_load_fraction_at_peak == res.tests[0].to_dict()["plane_load_fraction_at_peak"]
 
 
 def test_a_curve_of_an_earlier_poro2d_reads_with_the_new_columns_as_nan():

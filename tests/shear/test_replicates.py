@@ -23,10 +23,10 @@ def test_intervals_cover_the_true_angle_at_their_level(through_origin):
     for _ in range(n):
         tau = c + sig * math.tan(math.radians(phi)) + rng.normal(0.0, 6.0, sig.size)
         f = mohr_coulomb_ci(sig, tau, through_origin=through_origin)
-        lo, hi = f["friction_angle_ci_deg"]
+        lo, hi = f.friction_angle_ci_deg
         hits_phi += lo <= phi <= hi
         if not through_origin:
-            clo, chi = f["cohesion_ci_kpa"]
+            clo, chi = f.cohesion_ci_kpa
             hits_c += clo <= c <= chi
     # 95 % +- 3.5 standard errors of a binomial proportion over 2000 draws
     assert abs(hits_phi / n - 0.95) < 3.5 * math.sqrt(0.95 * 0.05 / n)
@@ -37,10 +37,10 @@ def test_intervals_cover_the_true_angle_at_their_level(through_origin):
 def test_exact_points_give_a_zero_width_interval_and_two_points_none():
     sig = [50.0, 100.0, 200.0]
     f = mohr_coulomb_ci(sig, [10 + 0.7 * s for s in sig])
-    assert f["friction_angle_deg"] == pytest.approx(math.degrees(math.atan(0.7)))
-    assert f["friction_angle_ci_deg"] == pytest.approx([f["friction_angle_deg"]] * 2)
+    assert f.friction_angle_deg == pytest.approx(math.degrees(math.atan(0.7)))
+    assert f.friction_angle_ci_deg == pytest.approx([f.friction_angle_deg] * 2)
     f2 = mohr_coulomb_ci([50.0, 100.0], [40.0, 75.0])
-    assert f2["dof"] == 0 and f2["friction_angle_ci_deg"] is None
+    assert f2.dof == 0 and f2.friction_angle_ci_deg is None
     with pytest.raises(InputError):
         mohr_coulomb_ci(sig, [1.0, 2.0, 3.0], level=1.5)
 
@@ -57,16 +57,14 @@ def test_summary_over_specimens():
         "seed2": _series({50.0: 42.0, 100.0: 79.0, 200.0: 145.0}, 35.0),
     }
     s = summarize_replicate_peaks(series)
-    rows = {r["normal_stress_kpa"]: r for r in s["per_normal_stress"]}
-    assert rows[50.0]["peak_mean_kpa"] == pytest.approx(42.0)
-    assert rows[50.0]["peak_sd_kpa"] == pytest.approx(2.0)
-    assert rows[200.0]["n"] == 3
-    assert s["fit"]["n_points"] == 9 and s["fit"]["dof"] == 7
-    lo, hi = s["fit"]["friction_angle_ci_deg"]
-    assert lo < s["fit"]["friction_angle_deg"] < hi
-    assert s["friction_angle_mean_deg"] == pytest.approx(35.0) and s[
-        "friction_angle_sd_deg"
-    ] == pytest.approx(1.0)
+    rows = {r.normal_stress_kpa: r for r in s.per_normal_stress}
+    assert rows[50.0].peak_mean_kpa == pytest.approx(42.0)
+    assert rows[50.0].peak_sd_kpa == pytest.approx(2.0)
+    assert rows[200.0].n == 3
+    assert s.fit.n_points == 9 and s.fit.dof == 7
+    lo, hi = s.fit.friction_angle_ci_deg
+    assert lo < s.fit.friction_angle_deg < hi
+    assert s.friction_angle_mean_deg == pytest.approx(35.0) and s.friction_angle_sd_deg == pytest.approx(1.0)
     with pytest.raises(InputError):
         summarize_replicate_peaks({})
 
@@ -87,7 +85,7 @@ def test_replicate_series_on_small_specimens(tmp_path):
         sim, rep = prepare_specimen(
             SpecimenSpec(width=0.06, height=0.03, layers=2), paper_grading(), 0.2, seed
         )
-        assert rep["converged"]
+        assert rep.converged
         specimens[f"seed{seed}"] = tmp_path / f"s{seed}.npz"
         checkpoint.save(sim, specimens[f"seed{seed}"])
     short = {"max_displacement": 0.002, "peak_window": 5e-4, "checkpoint_interval": 5e-4}
@@ -101,12 +99,12 @@ def test_replicate_series_on_small_specimens(tmp_path):
     ).run()
     assert isinstance(res, ReplicateShearResult) and "series" not in res.to_dict()
     assert res.to_dict() == json.loads((out / "replicates.json").read_text())
-    peaks = {k: [t["peak_shear_stress_kpa"] for t in s.tests] for k, s in res.series.items()}
+    peaks = {k: [t.peak_shear_stress_kpa for t in s.tests] for k, s in res.series.items()}
     assert peaks["seed0"] != peaks["seed1"]  # two specimens, two samples of the strength
-    row = res["per_normal_stress"][0]
-    assert row["normal_stress_kpa"] == 50.0
-    assert row["peak_mean_kpa"] == pytest.approx(np.mean([peaks["seed0"][0], peaks["seed1"][0]]))
-    assert res["fit"]["n_points"] == 4
+    row = res.per_normal_stress[0]
+    assert row.normal_stress_kpa == 50.0
+    assert row.peak_mean_kpa == pytest.approx(np.mean([peaks["seed0"][0], peaks["seed1"][0]]))
+    assert res.fit.n_points == 4
     files = [
         "replicates.json",
         "replicates.csv",

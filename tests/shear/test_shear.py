@@ -66,21 +66,23 @@ def test_split_box_walls(specimen):
 
 def test_peak_grows_with_normal_stress_and_outputs(series):
     out, r = series
-    peaks = [t["peak_shear_stress_kpa"] for t in r["tests"]]
+    peaks = [t.peak_shear_stress_kpa for t in r.tests]
     assert peaks[0] < peaks[1] < peaks[2]
-    assert r["friction_angle_deg"] > 0 and r["r2"] > 0.5
-    assert r["fit_through_origin"]["cohesion_kpa"] == 0.0
-    for t in r["tests"]:
-        assert {"normal_stress_kpa", "peak_shear_stress_kpa", "shear_displacement_at_peak_m", "end"} <= set(t)
-        assert 0 < t["shear_displacement_at_peak_m"] <= 0.0021
-        assert t["max_inertial_number"] < 1e-3
+    assert r.friction_angle_deg > 0 and r.r2 > 0.5
+    assert r.fit_through_origin.cohesion_kpa == 0.0
+    for t in r.tests:
+        assert {"normal_stress_kpa", "peak_shear_stress_kpa", "shear_displacement_at_peak_m", "end"} <= set(
+            t.to_dict()
+        )
+        assert 0 < t.shear_displacement_at_peak_m <= 0.0021
+        assert t.max_inertial_number < 1e-3
     for f in ("result.json", "curves.csv", "peaks.csv"):
         assert (out / f).stat().st_size > 0
     for sig in ("sn50kPa", "sn100kPa", "sn200kPa"):
         assert (out / sig / "curve.csv").stat().st_size > 0
         assert not (out / sig / "shear_checkpoint.npz").exists()  # removed once the test is done
-    assert r["settings"]["velocity"] == r["velocity_m_per_s"] and r["density_scale"] == 1.0
-    assert "poro2d_version" in r["provenance"]
+    assert r.settings.velocity == r.velocity_m_per_s and r.density_scale == 1.0
+    assert "poro2d_version" in r.provenance.to_dict()
 
 
 def test_each_curve_travels_in_the_result_as_its_file_holds_it(specimen, series):
@@ -146,8 +148,8 @@ def test_frictionless_disks_are_far_weaker(specimen, series, tmp_path):
     _, r = series
     s = ShearSettings(particle_friction=0.0, **SHORT)
     r0 = DirectShearTest(ShearCase.of(specimen, 100, s), Store(tmp_path), figures=False).run()
-    tau3 = next(t["peak_shear_stress_kpa"] for t in r["tests"] if t["normal_stress_kpa"] == 100)
-    assert r0["peak_shear_stress_kpa"] < 0.5 * tau3
+    tau3 = next(t.peak_shear_stress_kpa for t in r.tests if t.normal_stress_kpa == 100)
+    assert r0.peak_shear_stress_kpa < 0.5 * tau3
 
 
 class _Stop(Exception):
@@ -173,7 +175,7 @@ def test_killed_test_resumes_from_its_checkpoint(specimen, series, tmp_path):
     np.testing.assert_array_equal(a["shear_stress_kpa"], b["shear_stress_kpa"])
     np.testing.assert_array_equal(a["plate_displacement_mm"], b["plate_displacement_mm"])
     assert (
-        r["peak_shear_stress_kpa"]
+        r.peak_shear_stress_kpa
         == json.loads((out / "sn100kPa" / "result.json").read_text())["peak_shear_stress_kpa"]
     )
 
@@ -199,8 +201,8 @@ def test_cli_parallel_with_lab_peaks_and_skip_on_rerun(specimen, series, tmp_pat
     )
     # same settings as the series fixture: the same peaks, from independent processes
     for t in res["tests"]:
-        ref = next(u for u in r["tests"] if u["normal_stress_kpa"] == t["normal_stress_kpa"])
-        assert t["peak_shear_stress_kpa"] == ref["peak_shear_stress_kpa"]
+        ref = next(u for u in r.tests if u.normal_stress_kpa == t["normal_stress_kpa"])
+        assert t["peak_shear_stress_kpa"] == ref.peak_shear_stress_kpa
     stamp = (dest / "sn50kPa" / "result.json").stat().st_mtime_ns
     main(args)  # finished tests are skipped
     assert (dest / "sn50kPa" / "result.json").stat().st_mtime_ns == stamp
@@ -286,17 +288,17 @@ def test_rate_check_reruns_at_half_velocity(specimen, series, tmp_path):
         figures=False,
     )  # fmt: skip
     res = s.run()
-    rc = res["rate_check"]
-    assert rc["half_velocity_m_per_s"] == pytest.approx(0.5 * ShearSettings().velocity)
-    (row,) = rc["tests"]
+    rc = res.rate_check
+    assert rc.half_velocity_m_per_s == pytest.approx(0.5 * ShearSettings().velocity)
+    (row,) = rc.tests
     half = json.loads((tmp_path / "rate_check" / "sn100kPa" / "result.json").read_text())
     assert half["velocity_m_per_s"] == pytest.approx(0.5 * ShearSettings().velocity)
-    assert row["relative_change"] == pytest.approx(
-        half["peak_shear_stress_kpa"] / r["tests"][1]["peak_shear_stress_kpa"] - 1
+    assert row.relative_change == pytest.approx(
+        half["peak_shear_stress_kpa"] / r.tests[1].peak_shear_stress_kpa - 1
     )
-    assert row["max_inertial_number_half_velocity"] < r["tests"][1]["max_inertial_number"]
-    assert 0 <= row["mean_abs_change_before_peak"] < 1
-    assert rc["passed"] == (abs(row["relative_change"]) < 0.02)
+    assert row.max_inertial_number_half_velocity < r.tests[1].max_inertial_number
+    assert 0 <= row.mean_abs_change_before_peak < 1
+    assert rc.passed == (abs(row.relative_change) < 0.02)
 
 
 def _other_state(src, dest):
@@ -354,9 +356,7 @@ def test_moved_folders_resume_without_recomputing(specimen, series, tmp_path):
         figures=False,
     ).run()  # fmt: skip
     assert [f.stat().st_mtime_ns for f in done] == stamps
-    assert [t["peak_shear_stress_kpa"] for t in again["tests"]] == [
-        t["peak_shear_stress_kpa"] for t in r["tests"]
-    ]
+    assert [t.peak_shear_stress_kpa for t in again.tests] == [t.peak_shear_stress_kpa for t in r.tests]
 
 
 def test_settings_bind_only_once_a_test_started(specimen, tmp_path):
@@ -390,12 +390,12 @@ def test_stop_after_peak_ends_the_test_with_the_same_peak(specimen):
     base = {"max_displacement": 0.004, "peak_window": 5e-4}
     full = DirectShearTest(ShearCase.of(specimen, 100, ShearSettings(**base, stop_after_peak=0.0))).run()
     short = DirectShearTest(ShearCase.of(specimen, 100, ShearSettings(**base, stop_after_peak=5e-4))).run()
-    assert full["ended_by"] == "max_displacement"
-    assert short["ended_by"].startswith("peak passed by 0.5 mm")
-    assert short["records"] < full["records"]
-    assert short["end_shear_displacement_m"] >= short["shear_displacement_at_peak_m"] + 5e-4
-    assert short["peak_shear_stress_kpa"] == full["peak_shear_stress_kpa"]
-    assert short["shear_displacement_at_peak_m"] == full["shear_displacement_at_peak_m"]
+    assert full.ended_by == "max_displacement"
+    assert short.ended_by.startswith("peak passed by 0.5 mm")
+    assert short.records < full.records
+    assert short.end_shear_displacement_m >= short.shear_displacement_at_peak_m + 5e-4
+    assert short.peak_shear_stress_kpa == full.peak_shear_stress_kpa
+    assert short.shear_displacement_at_peak_m == full.shear_displacement_at_peak_m
 
 
 @pytest.mark.parametrize("value", [-1e-3, 1e-4])

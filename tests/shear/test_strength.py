@@ -48,21 +48,21 @@ def study(specimen, tmp_path_factory):
 
 def test_tiny_study_writes_one_row_per_case_and_test(study):
     out, result = study
-    assert [(r["mu_r"], r["particle_friction"]) for r in result["cases"]] == [(0.0, 0.5), (0.3, 0.5)]
+    assert [(r.mu_r, r.particle_friction) for r in result.cases] == [(0.0, 0.5), (0.3, 0.5)]
     with open(out / "strength_tests.csv", newline="") as fh:
         tests = list(csv.DictReader(fh))
     assert len(tests) == 2 * 2 * 2
-    for r in result["cases"]:
-        assert r["specimens"] == 2 and 0.0 < r["peak_friction_angle_mean_deg"] < 90.0
-        assert 0.0 < r["residual_friction_angle_mean_deg"] < 90.0
-        assert r["residual_stress_ratio_mean"] == pytest.approx(
-            np.mean([float(t["residual_stress_ratio"]) for t in tests if float(t["mu_r"]) == r["mu_r"]])
+    for r in result.cases:
+        assert r.specimens == 2 and 0.0 < r.peak_friction_angle_mean_deg < 90.0
+        assert 0.0 < r.residual_friction_angle_mean_deg < 90.0
+        assert r.residual_stress_ratio_mean == pytest.approx(
+            np.mean([float(t["residual_stress_ratio"]) for t in tests if float(t["mu_r"]) == r.mu_r])
         )
         # kappa = kn / (sigma t): the 100 kPa tests' is half the 50 kPa tests' (Table 1's disks)
-        assert r["stiffness_number_max"] == pytest.approx(2.0 * r["stiffness_number_min"], rel=1e-6)
+        assert r.stiffness_number_max == pytest.approx(2.0 * r.stiffness_number_min, rel=1e-6)
         kappa = sorted({round(float(t["stiffness_number"]), 6) for t in tests})
-        assert kappa == pytest.approx([r["stiffness_number_min"], r["stiffness_number_max"]])
-        assert 0.0 < r["mean_overlap_ratio_at_peak_max"] < 0.05
+        assert kappa == pytest.approx([r.stiffness_number_min, r.stiffness_number_max])
+        assert 0.0 < r.mean_overlap_ratio_at_peak_max < 0.05
     assert (out / "fig_strength.png").stat().st_size > 0
     stored = json.loads((out / "strength.json").read_text())
     assert stored["cases"][1]["mu_r"] == 0.3 and "residual_friction_angle" in stored["definitions"]
@@ -80,7 +80,7 @@ def test_a_rerun_reads_the_tests_back(specimen, study):
     again = StrengthStudy(twice, [0.0, 0.3], [0.5], [50, 100], ShearSettings(**TINY),
                           store=Store(out), options=RunOptions(workers=1, progress=False)).run()  # fmt: skip
     assert test_json.stat().st_mtime_ns == stamp
-    assert again["cases"] == result["cases"]
+    assert again.to_dict()["cases"] == result.to_dict()["cases"]
 
 
 @pytest.mark.parametrize(

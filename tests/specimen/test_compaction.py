@@ -25,10 +25,10 @@ def loose():
 
 def test_box_porosity_equals_trial_after_generation(loose):
     spec, sim, rep = loose
-    assert rep["converged"]
-    assert rep["box_porosity"] == pytest.approx(0.22, abs=1e-12)
+    assert rep.converged
+    assert rep.box_porosity == pytest.approx(0.22, abs=1e-12)
     # disks clipped exactly by the box: equal unless a disk pokes into a wall
-    assert rep["measured_porosity"] == pytest.approx(0.22, abs=2e-3)
+    assert rep.measured_porosity == pytest.approx(0.22, abs=2e-3)
     assert sim.particles.area() == pytest.approx((1 - 0.22) * spec.width * spec.height, rel=1e-12)
 
 
@@ -104,23 +104,23 @@ def test_a_layer_short_of_steps_gets_the_fallback():
     # than the first budget, finishes in the second one, and the specimen is complete
     spec = SpecimenSpec(**SMALL, friction_prep=0.0, max_steps_per_stage=20_000)
     sim, rep = prepare_specimen(spec, paper_grading(), 0.20, seed=200_000)
-    assert rep["converged"] and rep["failed_stage"] is None
-    assert rep["particle_count"] == rep["planned_count"] == sim.particles.n
-    first, second = rep["layers"]
-    assert [a["attempt"] for a in first["attempts"]] == ["normal"]
-    assert [a["attempt"] for a in second["attempts"]] == ["normal", "second budget"]
-    assert second["attempts"][0]["max_ratio"] > 1e-3 > second["max_ratio"]
-    assert second["converged"] and rep["final_stage"]["converged"]
+    assert rep.converged and rep.failed_stage is None
+    assert rep.particle_count == rep.planned_count == sim.particles.n
+    first, second = rep.layers
+    assert [a.attempt for a in first.attempts] == ["normal"]
+    assert [a.attempt for a in second.attempts] == ["normal", "second budget"]
+    assert second.attempts[0].max_ratio > 1e-3 > second.max_ratio
+    assert second.converged and rep.final_stage.converged
 
 
 def test_a_layer_that_fails_ends_the_preparation():
     spec = SpecimenSpec(**SMALL, max_steps_per_stage=200, fallback_steps=100, calm_steps=100)
     sim, rep = prepare_specimen(spec, paper_grading(), 0.20, seed=200_000)
-    assert not rep["converged"] and rep["failed_stage"] == "layer 1" and rep["failed_max_ratio"] > 1e-3
-    (only,) = rep["layers"]
-    assert [a["attempt"] for a in only["attempts"]] == ["normal", "second budget", "calm", "normal again"]
-    assert rep["particle_count"] == only["n_particles"] < rep["planned_count"]
-    assert rep["final_stage"] is None  # the working friction is not applied to a broken specimen
+    assert not rep.converged and rep.failed_stage == "layer 1" and rep.failed_max_ratio > 1e-3
+    (only,) = rep.layers
+    assert [a.attempt for a in only.attempts] == ["normal", "second budget", "calm", "normal again"]
+    assert rep.particle_count == only.n_particles < rep.planned_count
+    assert rep.final_stage is None  # the working friction is not applied to a broken specimen
     assert sim.local_damping == spec.local_damping  # the calm stage's damping is undone
 
 
@@ -144,9 +144,9 @@ def test_specimen_is_numbered_across_its_short_side(loose, tmp_path):
 
 def test_layers_each_reach_equilibrium(loose):
     _, _, rep = loose
-    assert [lay["layer"] for lay in rep["layers"]] == [1, 2]
-    assert all(lay["converged"] and lay["max_ratio"] < 1e-3 for lay in rep["layers"])
-    assert sum(lay["n_particles"] for lay in rep["layers"]) == rep["particle_count"]
+    assert [lay.layer for lay in rep.layers] == [1, 2]
+    assert all(lay.converged and lay.max_ratio < 1e-3 for lay in rep.layers)
+    assert sum(lay.n_particles for lay in rep.layers) == rep.particle_count
 
 
 def test_undercompaction_band_tops():

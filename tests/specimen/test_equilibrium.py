@@ -100,13 +100,13 @@ def test_a_frictionless_wide_grading_settles_then_comes_to_equilibrium():
     budget = {"max_steps_per_stage": 200_000, "fallback_steps": 20_000, "calm_steps": 5_000}
     g = preset_grading("wide_cu4")
     sim, rep = prepare_specimen(SpecimenSpec(**QUICK_WIDE, **budget), g, 0.142, seed=142000)
-    assert not rep["converged"] and rep["failed_stage"].startswith("layer")
-    assert rep["failed_ratio"] > 1e-3
+    assert not rep.converged and rep.failed_stage.startswith("layer")
+    assert rep.failed_ratio > 1e-3
     spec = SpecimenSpec(**QUICK_WIDE, **budget, settle_drift=1e-3)
     sim, rep = prepare_specimen(spec, g, 0.142, seed=142000)
-    assert rep["converged"]
-    assert rep["layers"][-1]["attempts"][-1]["ended_by"] == "settled"
-    assert rep["final_stage"]["ended_by"] == "ratio"  # the working friction: by its ratio alone
+    assert rep.converged
+    assert rep.layers[-1].attempts[-1].ended_by == "settled"
+    assert rep.final_stage.ended_by == "ratio"  # the working friction: by its ratio alone
     assert sim.unbalanced_ratios()[0] < spec.ratio
     f = wall_forces(sim)
     weight = float(np.sum(sim.particles.mass)) * spec.gravity / spec.thickness

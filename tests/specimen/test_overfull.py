@@ -148,12 +148,12 @@ def test_an_overfull_gravel_specimen_is_built_above_h_not_refused_mid_run():
     """The report's crash: layer 2 of the gravel at Eq. 12's 0.08 found no room below H."""
     spec = SpecimenSpec(max_steps_per_stage=20_000, fallback_steps=1_000, calm_steps=1_000)
     sim, rep = prepare_specimen(spec, _gravel(), 0.08, seed=80_000)
-    assert rep["particle_count"] <= rep["planned_count"]
-    raised = [layer for layer in rep["layers"] if "band_raised_m" in layer]
+    assert rep.particle_count <= rep.planned_count
+    raised = [layer for layer in rep.layers if "band_raised_m" in layer.to_dict()]
     assert raised, "a band rose above its planned top"
-    if rep["converged"]:
-        assert rep["overfull_m"] > 0.0
-        assert rep["top_height_m"] == pytest.approx(float(sim.walls.p0[sim.walls.index("top"), 1]))
+    if rep.converged:
+        assert rep.overfull_m > 0.0
+        assert rep.top_height_m == pytest.approx(float(sim.walls.p0[sim.walls.index("top"), 1]))
 
 
 @pytest.mark.slow

@@ -90,10 +90,10 @@ def test_under_the_fill_a_check_at_a_calibration_friction_is_its_calibration_cas
     states = D.StateChecks(CriterionBase(cfg), (dense, loose, between), 2, 0.001).sweep
     twins = D.calibration_twins(cal, states, None, Store(folder))
     assert len(twins) == 4
-    got = {(r["params"]["criterion.n_lab"], r["params"]["seed"]): r for r in twins}
+    got = {(r.params["criterion.n_lab"], r.params["seed"]): r for r in twins}
     assert set(got) == {(0.3253, 0), (0.3253, 1), (0.4571, 0), (0.4571, 1)}
     for (n_lab, seed), r in got.items():
-        assert r["results"]["n_lab"] == n_lab and r["results"]["final_porosity"] == seed + 0.1
+        assert r.results["n_lab"] == n_lab and r.results["final_porosity"] == seed + 0.1
     # under the paper's plate only the same first trial makes a twin (none here: 0.19 vs 0.213)
     plate = dict(BASE, criterion={"refine_tolerance": 0.002})
     cal_p = _calibration(plate, [0.0, 1.0], 2)

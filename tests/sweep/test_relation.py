@@ -19,19 +19,19 @@ from poro2d.sweep import relation as R
 def test_fit_recovers_known_coefficients():
     x = np.linspace(0.32, 0.46, 5)
     fit = R.fit_quadratic_origin(x, 0.5 * x**2 + 0.2 * x)
-    assert fit["a"] == pytest.approx(0.5, abs=1e-10) and fit["b"] == pytest.approx(0.2, abs=1e-10)
-    assert fit["rms_residual"] < 1e-12 and fit["points"] == 5
+    assert fit.a == pytest.approx(0.5, abs=1e-10) and fit.b == pytest.approx(0.2, abs=1e-10)
+    assert fit.rms_residual < 1e-12 and fit.points == 5
     # Eq. 12 itself, with noise: the least-squares answer of the normal equations
     rng = np.random.default_rng(3)
     y = P.parabolic(x) + rng.normal(0, 0.002, x.size)
     fit = R.fit_quadratic_origin(x, y)
     A = np.column_stack([x * x, x])
     a, b = np.linalg.solve(A.T @ A, A.T @ y)
-    assert (fit["a"], fit["b"]) == pytest.approx((a, b), rel=1e-9)
-    assert np.allclose(fit["residuals"], y - (a * x * x + b * x))
+    assert (fit.a, fit.b) == pytest.approx((a, b), rel=1e-9)
+    assert np.allclose(fit.residuals, y - (a * x * x + b * x))
     # two points determine the curve exactly
     fit = R.fit_quadratic_origin([0.3, 0.4], [0.42 * 0.09 + 0.25 * 0.3, 0.42 * 0.16 + 0.25 * 0.4])
-    assert (fit["a"], fit["b"]) == pytest.approx((0.42, 0.25), abs=1e-12)
+    assert (fit.a, fit.b) == pytest.approx((0.42, 0.25), abs=1e-12)
 
 
 @pytest.mark.parametrize("x, y", [([0.3], [0.1]), ([0.3, 0.3], [0.1, 0.11]), ([0.3, math.nan], [0.1, 0.2])])
@@ -90,17 +90,17 @@ def test_analysis_flags_points_and_writes_files(tmp_path):
     rows.append(_row("nc", 0.3253, converged=False, final=None, last=0.2))
     rows.append(_row("bad", 0.34, status="failed"))
     rel = R.analyse(rows, P.PAPER_N_MAX, P.PAPER_N_MIN)
-    assert rel["fit"]["a"] == pytest.approx(a) and rel["fit"]["b"] == pytest.approx(b)
-    assert rel["converged_points"] == 4 and rel["flagged_points"] == 2
-    pts = {p["case_id"]: p for p in rel["points"]}
-    assert not pts["nc"]["converged"] and pts["nc"]["n2d_dem"] == 0.2 and "not converged" in pts["nc"]["flag"]
-    assert pts["nc"]["residual"] == pytest.approx(0.2 - (a * 0.3253**2 + b * 0.3253))
-    assert math.isnan(pts["bad"]["n2d_dem"]) and pts["bad"]["flag"] == "case failed"
-    assert pts["c0"]["relative_density"] == pytest.approx(0.0) and pts["nc"][
-        "relative_density"
-    ] == pytest.approx(1.0)
-    assert pts["c0"]["n2d_parabolic"] == pytest.approx(float(P.parabolic(0.4571)))
-    assert pts["c0"]["n2d_lim_3d"] == pytest.approx(float(P.lim_3d(0.4571)))
+    assert rel.fit.a == pytest.approx(a) and rel.fit.b == pytest.approx(b)
+    assert rel.converged_points == 4 and rel.flagged_points == 2
+    pts = {p.case_id: p for p in rel.points}
+    assert not pts["nc"].converged and pts["nc"].n2d_dem == 0.2 and "not converged" in pts["nc"].flag
+    assert pts["nc"].residual == pytest.approx(0.2 - (a * 0.3253**2 + b * 0.3253))
+    assert pts["bad"].n2d_dem is None and pts["bad"].flag == "case failed"
+    assert pts["c0"].relative_density == pytest.approx(0.0) and pts["nc"].relative_density == pytest.approx(
+        1.0
+    )
+    assert pts["c0"].n2d_parabolic == pytest.approx(float(P.parabolic(0.4571)))
+    assert pts["c0"].n2d_lim_3d == pytest.approx(float(P.lim_3d(0.4571)))
     files = R.write_relation(rel, Store(tmp_path))
     for f in files:
         assert f.stat().st_size > 0
@@ -113,8 +113,8 @@ def test_analysis_flags_points_and_writes_files(tmp_path):
 def test_no_fit_with_one_converged_point():
     rows = [_row("a", 0.45, final=0.2), _row("b", 0.35, converged=False, last=0.21)]
     rel = R.analyse(rows, P.PAPER_N_MAX, P.PAPER_N_MIN)
-    assert rel["fit"] is None and "no fit" in rel["fit_note"]
-    assert all(p["n2d_fit"] is None for p in rel["points"])
+    assert rel.fit is None and "no fit" in rel.fit_note
+    assert all(p.n2d_fit is None for p in rel.points)
     plot_relation(rel)  # draws without a fitted curve
 
 
@@ -177,16 +177,16 @@ def test_density_states_are_averaged_over_seeds_and_the_spread_is_measured():
         _state_row(0.3253, 0, 0.17, 0.171), _state_row(0.3253, 1, 0.17, 0.169),
     ]  # fmt: skip
     rel = R.analyse_states(rows, targets, cal, P.PAPER_N_MAX, P.PAPER_N_MIN)
-    pts = {p["n_lab"]: p for p in rel["points"]}
-    assert pts[0.4571]["n2d_dem"] == pytest.approx(0.225)
-    assert pts[0.4571]["n2d_sd"] == pytest.approx(np.std([0.22, 0.23], ddof=1))
-    assert pts[0.4571]["n2d_measured"] == pytest.approx(0.2235)
-    assert pts[0.3912]["seeds_converged"] == 1 and "1 seed(s)" in pts[0.3912]["flag"]
-    assert pts[0.3912]["n2d_dem"] == pytest.approx(0.20)  # the unconverged seed is not averaged
-    assert pts[0.4571]["mu_prep"] == pytest.approx(0.5) and pts[0.3253]["mu_prep"] == pytest.approx(0.0)
-    sp = rel["spread"]
-    assert sp["n2d_loose_minus_dense"] == pytest.approx(0.055) and sp["monotone"]
-    assert rel["mode"] == "density" and rel["n2d_min"] == pytest.approx(0.171)
+    pts = {p.n_lab: p for p in rel.points}
+    assert pts[0.4571].n2d_dem == pytest.approx(0.225)
+    assert pts[0.4571].n2d_sd == pytest.approx(np.std([0.22, 0.23], ddof=1))
+    assert pts[0.4571].n2d_measured == pytest.approx(0.2235)
+    assert pts[0.3912].seeds_converged == 1 and "1 seed(s)" in pts[0.3912].flag
+    assert pts[0.3912].n2d_dem == pytest.approx(0.20)  # the unconverged seed is not averaged
+    assert pts[0.4571].mu_prep == pytest.approx(0.5) and pts[0.3253].mu_prep == pytest.approx(0.0)
+    sp = rel.spread
+    assert sp.n2d_loose_minus_dense == pytest.approx(0.055) and sp.monotone
+    assert rel.mode == "density" and rel.n2d_min == pytest.approx(0.171)
 
 
 @pytest.mark.scenario  # three relations end to end, each with its calibration and Dask cluster
@@ -285,11 +285,11 @@ def test_a_state_check_that_is_a_calibration_case_is_read_back(tmp_path):
         c.id for c in states.cases if c.id in {r.case_id for r in twins}
     ]
     for row in twins:
-        assert row["params"]["criterion.n_lab"] == 0.33 and row["results"]["n_lab"] == 0.33
-        assert row["params"]["specimen.friction_prep"] == 0.05
-        assert row["results"]["final_porosity"] == pytest.approx(0.195)
-        assert row["reused_calibration_case"] in {c.id for c in cal.cases}
-    assert {r["params"]["seed"] for r in twins} == {0, 1}
+        assert row.params["criterion.n_lab"] == 0.33 and row.results["n_lab"] == 0.33
+        assert row.params["specimen.friction_prep"] == 0.05
+        assert row.results["final_porosity"] == pytest.approx(0.195)
+        assert row.extra["reused_calibration_case"] in {c.id for c in cal.cases}
+    assert {r.params["seed"] for r in twins} == {0, 1}
     # an unfinished calibration case is not a twin: the check then runs
     (folder / "cases" / cal.cases[0].id / "result.json").unlink()
     assert len(D.calibration_twins(cal, states, None, Store(folder))) == 1

@@ -67,19 +67,19 @@ def _synthetic_sens():
 def test_points_are_mean_sd_and_n_over_converged_seeds():
     sens, recs = _synthetic_sens()
     ref, cu2, cu3 = sens["points"]["grading"]
-    assert ref["n2d_mean"] == pytest.approx(np.mean([0.19, 0.19, 0.20]))
-    assert ref["n2d_sd"] == pytest.approx(np.std([0.19, 0.19, 0.20], ddof=1))
-    assert ref["measured_mean"] == pytest.approx(np.mean([0.188, 0.191, 0.197]))
-    assert (ref["n"], ref["unconverged"]) == (3, 0)
+    assert ref.n2d_mean == pytest.approx(np.mean([0.19, 0.19, 0.20]))
+    assert ref.n2d_sd == pytest.approx(np.std([0.19, 0.19, 0.20], ddof=1))
+    assert ref.measured_mean == pytest.approx(np.mean([0.188, 0.191, 0.197]))
+    assert (ref.n, ref.unconverged) == (3, 0)
     # an unconverged seed is counted, not averaged
-    assert (cu2["n"], cu2["unconverged"], cu2["seeds"]) == (2, 1, 3)
-    assert cu2["n2d_mean"] == pytest.approx(0.165)
-    assert recs[5]["accepted_n2d"] is None and recs[5]["last_estimate_n2d"] == 0.2
+    assert (cu2.n, cu2.unconverged, cu2.seeds) == (2, 1, 3)
+    assert cu2.n2d_mean == pytest.approx(0.165)
+    assert recs[5].accepted_n2d is None and recs[5].last_estimate_n2d == 0.2
     # first-trial force ratio per seed, then averaged
-    assert ref["first_f_top_over_g_mean"] == pytest.approx(np.mean([1000 / 800, 1000 / 800, 3000 / 800]))
+    assert ref.first_f_top_over_g_mean == pytest.approx(np.mean([1000 / 800, 1000 / 800, 3000 / 800]))
     mu = sens["points"]["mu_prep"]
-    assert mu[1]["n2d_mean"] == pytest.approx(0.1875) and mu[1]["unconverged"] == 1
-    assert mu[1]["n2d_sd"] == pytest.approx(np.std([0.19, 0.185], ddof=1))
+    assert mu[1].n2d_mean == pytest.approx(0.1875) and mu[1].unconverged == 1
+    assert mu[1].n2d_sd == pytest.approx(np.std([0.19, 0.185], ddof=1))
 
 
 def test_a_csv_row_is_the_points_columns_then_the_answer_seeds_and_version():
@@ -100,25 +100,25 @@ def test_a_csv_row_is_the_points_columns_then_the_answer_seeds_and_version():
 
 
 def test_finite_mean_sd_edge_cases():
-    assert S.finite_mean_sd([0.2]) == {"mean": 0.2, "sd": 0.0, "n": 1}
+    assert S.finite_mean_sd([0.2]).to_dict() == {"mean": 0.2, "sd": 0.0, "n": 1}
     s = S.finite_mean_sd([None, float("nan")])
-    assert s["n"] == 0 and math.isnan(s["mean"]) and math.isnan(s["sd"])
+    assert s.n == 0 and s.mean is None and s.sd is None
 
 
 def test_answer_names_the_matching_width_and_the_closest_friction():
     sens, _ = _synthetic_sens()
     ans = sens["answer"]
-    g, mu = ans["grading"], ans["mu_prep"]
+    g, mu = ans.grading, ans.mu_prep
     # Cu 3: mean 0.1467, within 0.005 of 0.15; Cu 2 (0.165) is not
-    assert g["matches"] == [3.0] and g["closest"] == 3.0
+    assert g.matches == [3.0] and g.closest == 3.0
     # Cu 2 (0.165) and Cu 3 (0.1467) lie on either side of 0.15: linear interpolation between them
     m2, m3 = 0.165, np.mean([0.15, 0.14, 0.15])
-    assert g["crossing"] == pytest.approx(2.0 + (m2 - 0.15) / (m2 - m3))
-    assert g["distance"] == pytest.approx(np.mean([0.15, 0.14, 0.15]) - 0.15)
+    assert g.crossing == pytest.approx(2.0 + (m2 - 0.15) / (m2 - m3))
+    assert g.distance == pytest.approx(np.mean([0.15, 0.14, 0.15]) - 0.15)
     # no friction reaches 0.15: the closest is the lowest, 0.175 - 0.15 above
-    assert mu["matches"] == [] and mu["closest"] == 0.0
-    assert mu["distance"] == pytest.approx(0.025)
-    text = " ".join(ans["lines"])
+    assert mu.matches == [] and mu.closest == 0.0
+    assert mu.distance == pytest.approx(0.025)
+    text = " ".join(ans.lines)
     assert "within 0.005 of 0.15: Cu = 3: 0.1467 +- 0.0058 (n = 3)" in text
     assert "no point within 0.005 of 0.15; the closest is mu_prep = 0 with 0.1750" in text
     assert "0.0250 above" in text
@@ -135,9 +135,9 @@ def test_crossing_is_interpolated_between_neighbours():
         {"cu": 4.0, "n2d_mean": math.nan, "n2d_sd": math.nan, "n": 0},
     ]
     m = S.closest_match(pts, "cu", 0.15)
-    assert m["crossing"] == pytest.approx(3.0) and m["matches"] == []
-    assert m["closest"] in (2.5, 3.5) and abs(m["distance"]) == pytest.approx(0.01)
-    assert S.closest_match(pts[3:], "cu", 0.15)["closest"] is None
+    assert m.crossing == pytest.approx(3.0) and m.matches == []
+    assert m.closest in (2.5, 3.5) and abs(m.distance) == pytest.approx(0.01)
+    assert S.closest_match(pts[3:], "cu", 0.15).closest is None
 
 
 @pytest.mark.parametrize("cus", [[1.0, 2.0], [0.5], [2.0, 2.0], ["2"], [], [25.0], [float("inf")]])
@@ -149,8 +149,8 @@ def test_bad_cu_lists_are_refused(cus):
 
 def test_settings_defaults_and_seeds():
     s = S.study_settings(None, quick=True, seeds=None)
-    assert s["cus"] == list(S.QUICK_CUS) and s["seeds"] == S.QUICK_SEEDS
-    assert S.study_settings(None, quick=False, seeds=None)["cus"] == list(S.DEFAULT_CUS)
+    assert s.cus == list(S.QUICK_CUS) and s.seeds == S.QUICK_SEEDS
+    assert S.study_settings(None, quick=False, seeds=None).cus == list(S.DEFAULT_CUS)
     for bad in (0, 51, True, 2.0):
         with pytest.raises(InputError):
             S.study_settings(None, quick=False, seeds=bad)
@@ -179,7 +179,7 @@ def test_family_keeps_the_reference_mean_disk_area():
     g = S.gradings(S.study_base(CriterionBase(paper_preset().config), quick=False), [1.5, 3.0])
     areas = [x.curve.mean_disk_area() for x in g]
     assert areas == pytest.approx([areas[0]] * 3, rel=1e-9)
-    assert [x.describe()["cu"] for x in g[1:]] == pytest.approx([1.5, 3.0])
+    assert [x.describe().cu for x in g[1:]] == pytest.approx([1.5, 3.0])
     assert g[0].params == {"grading.preset": "paper"}
 
 

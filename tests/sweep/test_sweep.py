@@ -72,15 +72,15 @@ def test_criterion_sweep_uses_both_workers_and_rerun_skips(client, tmp_path):
     t0 = time.perf_counter()
     res = run_sweep(sweep, Store(tmp_path), client=client, options=QUIET)
     wall = time.perf_counter() - t0
-    assert [r["status"] for r in res.rows] == ["done"] * 8, [r.get("error") for r in res.rows]
+    assert [r.status for r in res.rows] == ["done"] * 8, [r.error for r in res.rows]
     # the result is sweep.json's content, typed, with the rows and the table beside the file
-    assert isinstance(res, SweepResult) and res == json.loads((tmp_path / "sweep.json").read_text())
+    assert isinstance(res, SweepResult) and res.to_dict() == json.loads((tmp_path / "sweep.json").read_text())
     assert res.status == "finished" and len(res.table) == 8 and res.failed == []
-    pids = {r["pid"] for r in res.rows}
+    pids = {r.pid for r in res.rows}
     assert len(pids) == 2, pids  # both worker processes ran cases
     print(
-        f"\n8 criterion cases: wall {wall:.1f} s, case time {res.summary['case_time_sum_s']:.1f} s, "
-        f"efficiency {res.summary.get('parallel_efficiency', 0):.0%}, pids {sorted(pids)}"
+        f"\n8 criterion cases: wall {wall:.1f} s, case time {res.summary.case_time_sum_s:.1f} s, "
+        f"efficiency {(res.summary.parallel_efficiency or 0):.0%}, pids {sorted(pids)}"
     )
 
     df = pd.read_csv(tmp_path / "results.csv")
@@ -113,8 +113,8 @@ def test_criterion_sweep_uses_both_workers_and_rerun_skips(client, tmp_path):
 
     stamps = {c.id: (tmp_path / "cases" / c.id / "result.json").stat().st_mtime_ns for c in sweep.cases}
     again = run_sweep(parse_sweep(cfg), Store(tmp_path), client=client, options=QUIET)
-    assert again.summary["ran"] == 0 and again.summary["reused"] == 8
-    assert all(r["reused"] for r in again.rows)
+    assert again.summary.ran == 0 and again.summary.reused == 8
+    assert all(r.extra["reused"] for r in again.rows)
     for c in sweep.cases:
         assert (tmp_path / "cases" / c.id / "result.json").stat().st_mtime_ns == stamps[c.id]
     pd.testing.assert_series_equal(
@@ -137,22 +137,22 @@ def test_killed_worker_does_not_lose_the_sweep(client, tmp_path):
     }
     res = run_sweep(parse_sweep(cfg), Store(tmp_path / "out"), client=client, options=QUIET)
     assert marker.is_file()  # the worker really died once
-    assert [r["status"] for r in res.rows] == ["done"] * 4
+    assert [r.status for r in res.rows] == ["done"] * 4
     killed = res.rows[1]
-    assert killed["results"]["runs"] == 2  # ran again after the worker was lost
-    assert killed["pid"] != int(marker.read_text())  # on another (or a restarted) process
-    assert [r["results"]["value"] for r in res.rows] == [2, 4, 6, 8]
+    assert killed.results["runs"] == 2  # ran again after the worker was lost
+    assert killed.pid != int(marker.read_text())  # on another (or a restarted) process
+    assert [r.results["value"] for r in res.rows] == [2, 4, 6, 8]
 
 
 def test_interrupted_sweep_rerun_skips_finished_cases(client, tmp_path):
     out = tmp_path / "out"
     first = run_sweep(parse_sweep(probe_cfg([1, 2])), Store(out), client=client, options=QUIET)
-    assert first.summary["ran"] == 2
+    assert first.summary.ran == 2
     # the "interrupted" sweep finished two of four cases; the rerun runs only the rest
     full = parse_sweep(probe_cfg([1, 2, 3, 4]))
     res = run_sweep(full, Store(out), client=client, options=QUIET)
-    assert res.summary["reused"] == 2 and res.summary["ran"] == 2
-    assert [r["reused"] for r in res.rows] == [True, True, False, False]
+    assert res.summary.reused == 2 and res.summary.ran == 2
+    assert [r.extra["reused"] for r in res.rows] == [True, True, False, False]
     for c in full.cases:  # every case ran exactly once
         assert (out / "cases" / c.id / "run" / "runs.txt").read_text() == "1"
     df = pd.read_parquet(out / "results.parquet")
@@ -172,7 +172,7 @@ def test_failing_case_is_reported_and_others_finish(client, tmp_path):
     }
     sweep = parse_sweep(cfg)
     res = run_sweep(sweep, Store(tmp_path), client=client, options=QUIET)
-    assert [r["status"] for r in res.rows] == ["done", "failed", "done"]
+    assert [r.status for r in res.rows] == ["done", "failed", "done"]
     bad = tmp_path / "cases" / sweep.cases[1].id
     assert "RuntimeError: probe failure x=2" in (bad / "error.txt").read_text()
     assert "Traceback" in (bad / "error.txt").read_text()
@@ -182,7 +182,7 @@ def test_failing_case_is_reported_and_others_finish(client, tmp_path):
     assert df["error"].isna().tolist() == [True, False, True]
     assert "probe failure" in df["error"][1]
     rerun = run_sweep(sweep, Store(tmp_path), client=client, options=QUIET)
-    assert rerun.summary["reused"] == 2 and rerun.summary["ran"] == 1 and rerun.summary["failed"] == 1
+    assert rerun.summary.reused == 2 and rerun.summary.ran == 1 and rerun.summary.failed == 1
 
 
 def test_cli_sweep_on_its_own_local_cluster(tmp_path):
@@ -289,14 +289,17 @@ def test_a_case_runs_in_this_process_once_and_its_folder_binds(tmp_path):
     case["config"]["specimen"] = {"threads": 1}
     d = tmp_path / case["id"]
     row = compute_case(case, Store(d), probe)
-    assert row["status"] == "done" and row["results"]["value"] == 6
-    assert compute_case(case, Store(d), probe) == row == finished_row(case, Store(d))  # read back: ran once
+    assert row.status == "done" and row.results["value"] == 6
+    # read back: ran once
+    again = compute_case(case, Store(d), probe)
+    assert again.to_dict() == row.to_dict() == finished_row(case, Store(d)).to_dict()
     assert (d / "run" / "runs.txt").read_text() == "1"
     assert json.loads((d / "params.json").read_text()) == case
     threads = dict(case, config=dict(case["config"], specimen={"threads": 2}))
     relabelled = dict(threads, params={"x": 3}, id="same-config")
-    assert finished_row(relabelled, Store(d)) == row  # labels and threads are not what the case depends on
+    # labels and threads are not what the case depends on
+    assert finished_row(relabelled, Store(d)).to_dict() == row.to_dict()
     other = dict(case, config={"probe": {"x": 4, "seconds": 0.0}})
     assert finished_row(other, Store(d)) is None
     failed = compute_case(other, Store(d), probe)  # a case folder holding another case
-    assert failed["status"] == "failed" and "probe.x" in failed["error"]
+    assert failed.status == "failed" and "probe.x" in failed.error
