@@ -12,15 +12,13 @@ an option, such as a shear series' ``rate_check``). A field declared with
 run hands its caller beside the file (a replicate study's per-specimen series), and
 ``from_dict`` leaves it at its default.
 
-A result is also a read-only mapping (``result["final_porosity"]``, ``result.get(...)``,
-``dict(result)``, ``"lab" in result``) that equals the dict of its file: code written when
-results were plain dicts, and readers of the files, keep working. New code uses attributes
-(``result.final_porosity``).
+Results are values: two results of one class are equal when their files are (``to_dict()``),
+and code reads their fields as attributes (``result.final_porosity``), never by key.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from functools import cache
 from typing import Any, ClassVar, Self, TypeVar
@@ -98,7 +96,7 @@ class Keyed:
 
 
 @dataclass(eq=False)
-class TypedResult(Mapping):
+class TypedResult:
     """Base of typed results; subclasses are ``@dataclass(eq=False)`` with one field per key."""
 
     #: keys written only when their value is not None
@@ -146,20 +144,13 @@ class TypedResult(Mapping):
         obj._absent = frozenset(k for k in keys if k not in data)
         return obj
 
-    # read-only mapping access, for code that reads results as dicts
-    def __getitem__(self, key: str) -> Any:
-        if key in _keys(type(self)):
-            if self._present(key):
-                return getattr(self, key)
-        elif key in self.extra:
-            return self.extra[key]
-        raise KeyError(key)
+    def __eq__(self, other: object) -> bool:
+        """Equal to a result of the same class whose file is the same."""
+        if type(other) is not type(self):
+            return NotImplemented
+        return self.to_dict() == other.to_dict()  # type: ignore[attr-defined]
 
-    def __iter__(self) -> Iterator[str]:
-        return iter(self.to_dict())
-
-    def __len__(self) -> int:
-        return len(self.to_dict())
+    __hash__ = None  # type: ignore[assignment]  # results are not frozen
 
 
 __all__ = ["NOT_IN_FILE", "Keyed", "TypedResult", "part"]
