@@ -108,13 +108,17 @@ class TypedResult:
     #: them back as dicts
     PARTS: ClassVar[Mapping[str, Any]] = {}
 
+    #: False for a row of a CSV table, whose file tells NaN ("nan") from no value (empty): its
+    #: values stay as given (a JSON file holds both as null, so a result of one is made so)
+    JSON_VALUES: ClassVar[bool] = True
+
     #: keys of the file that the class does not model, written back after the modelled ones
     extra: dict[str, Any] = field(default_factory=dict, kw_only=True, repr=False)
 
     def __post_init__(self) -> None:
         # keys a file read by from_dict lacked: they stay out of to_dict() while unset
         self._absent: frozenset[str] = frozenset()
-        if isinstance(self, Record):  # a row of its own shape (ROW): it writes and reads it itself
+        if isinstance(self, Record) or not self.JSON_VALUES:  # a row of its own shape (ROW), or CSV's
             return
         # every value as its file holds it, typed parts typed, so that a fresh result equals the
         # one read back from its file

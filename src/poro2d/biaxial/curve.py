@@ -117,6 +117,8 @@ class BiaxialCurve(Mapping):
 class CurveRow(TypedResult):
     """One row of ``curve.csv``, its fields the columns in order (see the module's conventions)."""
 
+    JSON_VALUES: ClassVar[bool] = False  # a row of a CSV table: NaN stays NaN ("nan")
+
     step: int
     axial_strain: float
     lateral_strain: float

@@ -235,6 +235,8 @@ def mean_sd_text(mean: float | None, sd: float | None) -> str:
 class SummaryRow(TypedResult):
     """The row of ``summary.csv``: the soil, its state, the answer over seeds (fields in column order)."""
 
+    JSON_VALUES: ClassVar[bool] = False  # a row of a CSV table: NaN stays NaN ("nan")
+
     soil: str | None
     upscale: float | None
     disks: int

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
@@ -81,6 +82,8 @@ class CurveRow(TypedResult):
     ``upper_wall_friction_kpa`` the upward friction of the upper side walls on the disks:
     part of the plate's load that never reaches the plane (NaN in a curve of an earlier poro2d).
     """
+
+    JSON_VALUES: ClassVar[bool] = False  # a row of a CSV table: NaN stays NaN ("nan")
 
     step: int
     shear_displacement_mm: float
