@@ -16,7 +16,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from poro2d.critical_state.state_table import StateMapRecord, state_map_lines, state_map_record
-from poro2d.io_utils import Provenance
+from poro2d.io_utils import Provenance, float_or_nan
 from poro2d.lab_state import LabState
 from poro2d.sand.case import SoilRecord
 from poro2d.sand.preflight import Preflight
@@ -265,11 +265,12 @@ class SummaryRow(TypedResult):
             st.e,
             st.relative_density,
             res.mu_prep,
-            res.interior_porosity_mean,
-            res.interior_porosity_sd,
-            res.box_porosity_mean,
-            res.box_porosity_sd,
-            res.solid_fraction_mean,
+            # a mean over no specimen is NaN in the table (None in sand.json)
+            float_or_nan(res.interior_porosity_mean),
+            float_or_nan(res.interior_porosity_sd),
+            float_or_nan(res.box_porosity_mean),
+            float_or_nan(res.box_porosity_sd),
+            float_or_nan(res.solid_fraction_mean),
             res.jamming_porosity,
             res.seeds,
             res.seeds_accepted,
