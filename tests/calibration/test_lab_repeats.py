@@ -101,8 +101,11 @@ def test_the_report_says_how_many_repeats_and_whether_their_share_was_scaled():
 
     from poro2d.report.calibration_report import repeats_note
 
-    assert repeats_note(SimpleNamespace(posterior={"precision_factor": 0.6})) is None
-    calm = repeats_note(SimpleNamespace(posterior={"lab_repeats": 3, "lab_scatter_ratio": 0.5}))
+    def result(**posterior):
+        return SimpleNamespace(posterior=SimpleNamespace(**{"lab_repeats": None, **posterior}))
+
+    assert repeats_note(result(precision_factor=0.6)) is None
+    calm = repeats_note(result(lab_repeats=3, lab_scatter_ratio=0.5))
     assert calm.startswith("3 laboratory repeats") and "0.33 of one" in calm and "scaled" not in calm
-    loud = repeats_note(SimpleNamespace(posterior={"lab_repeats": 3, "lab_scatter_ratio": 2.4}))
+    loud = repeats_note(result(lab_repeats=3, lab_scatter_ratio=2.4))
     assert "scaled up by 2.40" in loud and "0.80 of one" in loud
