@@ -198,7 +198,6 @@ def test_run_options_default_to_one_process_per_job_up_to_the_cores():
     assert RunOptions(workers=1).local_workers(100) == 1
     assert RunOptions(workers=1).test_backend(1).kind == "inline"
     assert RunOptions(scheduler="tcp://127.0.0.1:8786").test_backend(1).kind == "dask"
-    assert RunOptions(progress=True).quiet() == RunOptions(progress=False)
 
 
 def test_a_laboratory_tests_jobs_run_on_a_running_scheduler_as_on_this_machine():

@@ -25,7 +25,6 @@ def sweep_cmd(
 ) -> None:
     """Run a grid or list of cases as Dask tasks; one table of results."""
     from poro2d.config import load_toml
-    from poro2d.execute.dask_cluster import check_reachable
     from poro2d.io_utils import check_output_dir
     from poro2d.store import Store
     from poro2d.sweep.cases import parse_sweep
@@ -35,7 +34,6 @@ def sweep_cmd(
     check_output_dir("--out", out)
     cfg = load_toml(config)
     sweep = parse_sweep(cfg, Path(config).resolve().parent)
-    check_reachable(scheduler)  # before the first line: an unreachable scheduler is the only one
     console.print(f"{len(sweep.cases)} case(s) of kind {sweep.kind!r} -> {out}")
     res = run_sweep(sweep, Store(out), options=options)
     print_summary(res, out)

@@ -56,9 +56,5 @@ class RunOptions:
         """A Dask backend: the running scheduler, or a LocalCluster of ``workers`` processes."""
         return Backend.dask(self.scheduler, self.workers, dashboard=self.dashboard, threads=threads)
 
-    def quiet(self) -> RunOptions:
-        """The same options without progress bars (a run inside another run's bars)."""
-        return RunOptions(self.workers, self.scheduler, self.dashboard, progress=False)
-
 
 __all__ = ["RunOptions"]
