@@ -441,27 +441,25 @@ def test_a_sands_laboratory_state_and_accepted_states_are_typed_parts():
 
 
 def test_shear_settings_are_a_record_that_keeps_the_keys_a_file_had():
-    """A result's shear settings read as a :class:`~poro2d.shear.parts.ShearSettingsRecord`; a file
+    """A result's shear settings read as :class:`~poro2d.shear.settings.ShearSettings`; a file
     written before ``stop_after_peak`` and ``rolling_friction`` existed is written back without them."""
-    from poro2d.shear.parts import ShearSettingsRecord
     from poro2d.shear.settings import ShearSettings
 
     stored = json.loads((DATA / "shear_test_result.json").read_text())
     test = ShearTestResult.from_dict(stored)
     assert (
-        isinstance(test.settings, ShearSettingsRecord)
-        and test.settings.velocity == stored["settings"]["velocity"]
+        isinstance(test.settings, ShearSettings) and test.settings.velocity == stored["settings"]["velocity"]
     )
     assert "stop_after_peak" not in test.to_dict()["settings"] and test.to_dict() == stored
     cal = CalibrationResult.from_dict(json.loads((DATA / "calibration_result.json").read_text()))
-    assert isinstance(cal.settings, ShearSettingsRecord) and cal.settings.stop_after_peak == 0.0
+    assert isinstance(cal.settings, ShearSettings) and cal.settings.stop_after_peak == 0.0
     fresh = ShearSettings(velocity=0.01)
     # every setting, in the class's order; the disks' stiffness only when given (earlier files' keys)
     given = {k: v for k, v in dataclasses.asdict(fresh).items() if k not in ("particle_kn", "particle_ks")}
-    assert fresh.record().to_dict() == given and list(fresh.record().to_dict()) == list(given)
-    stiff = ShearSettings(velocity=0.01, particle_ks=2e5).record().to_dict()
+    assert fresh.to_dict() == given and list(fresh.to_dict()) == list(given)
+    stiff = ShearSettings(velocity=0.01, particle_ks=2e5).to_dict()
     assert stiff == dict(given, particle_ks=2e5) and "particle_kn" not in stiff
-    assert ShearSettingsRecord.from_dict(fresh.record().to_dict()).to_dict() == fresh.record().to_dict()
+    assert ShearSettings.from_dict(fresh.to_dict()).to_dict() == fresh.to_dict()
 
 
 def test_a_criterion_keeps_its_settings_and_specimen_as_records():

@@ -315,7 +315,7 @@ def test_a_small_synthetic_biaxial_calibration_fits_the_ratios_and_the_volumetri
     assert 0.2 < peak["lab_ratio"] < 0.9 and 0.0 < peak["noise_sd_ratio"] < 0.5
     kept = CalibrationResult.read(Store(out))
     assert (
-        kept.to_dict() == saved and kept.biaxial and type(kept.settings).__name__ == "BiaxialSettingsRecord"
+        kept.to_dict() == saved and kept.biaxial and type(kept.settings).__name__ == "BiaxialSettings"
     )
     report = (out / "calibration.md").read_text()
     assert "| peak_ratio | 50 | 1 |" in report and "Biaxial tests: 18 run" in report

@@ -138,7 +138,7 @@ def test_calibration_key_and_fields(name):
 
 @pytest.mark.parametrize("name", each_field(ShearSettings))
 def test_calibration_unit_and_shear_test_record_and_shear_fields(tmp_path, name):
-    base, other = ShearSettings().record(), changed(ShearSettings, name).record()
+    base, other = ShearSettings(), changed(ShearSettings, name)
     assert unit_key("abc", 50.0, other) != unit_key("abc", 50.0, base)
     record = folder_stage(Store(tmp_path), content_record("abc", 50.0, base), "s.npz").fingerprint
     assert record.differences(content_record("abc", 50.0, other).to_dict()) == [f"settings.{name}"]

@@ -41,9 +41,9 @@ def test_settings_refuse_a_stiffness_out_of_range(name, value):
 
 
 def test_a_stiffness_not_given_is_absent_from_the_record_and_the_key():
-    record = ShearSettings().record().to_dict()
+    record = ShearSettings().to_dict()
     assert "particle_kn" not in record and "particle_ks" not in record
-    given = ShearSettings(particle_kn=2e6).record().to_dict()
+    given = ShearSettings(particle_kn=2e6).to_dict()
     assert given["particle_kn"] == 2e6 and "particle_ks" not in given
     assert unit_key("abc", 50.0, given) != unit_key("abc", 50.0, record)
 

@@ -34,7 +34,7 @@ class BiaxialCase:
             raise InputError("settings", type(self.settings).__name__, "a BiaxialSettings")
         sigma = check_range("confining stress (kPa)", self.confining_kpa, *CONFINING_RANGE_KPA)
         object.__setattr__(self, "confining_kpa", sigma)
-        check_finite("biaxial", self.settings.record().to_dict())
+        check_finite("biaxial", self.settings.to_dict())
 
     @classmethod
     def of(

@@ -36,7 +36,7 @@ def content_of(case: BiaxialCase) -> dict[str, Any]:
     return {
         "specimen_digest": case.specimen.digest,
         "confining_kpa": case.confining_kpa,
-        "settings": case.settings.record().to_dict(),
+        "settings": case.settings.to_dict(),
     }
 
 

@@ -19,7 +19,7 @@ from poro2d.biaxial.parts import (
     StressSummary,
     TestSummary,
 )
-from poro2d.biaxial.settings import BiaxialSettingsRecord
+from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.io_utils import Provenance
 from poro2d.measure.spread import Spread
 from poro2d.store import Store
@@ -66,7 +66,7 @@ class BiaxialTestResult(TypedResult):
     shear_steps: int
     records: int
     wall_time_s: float
-    settings: BiaxialSettingsRecord
+    settings: BiaxialSettings
     specimen: str
     specimen_digest: str
     provenance: Provenance
@@ -84,7 +84,7 @@ class BiaxialTestResult(TypedResult):
         "checks": ShearChecks,
         "consolidation": ConsolidationRecord,
         "provenance": Provenance,
-        "settings": BiaxialSettingsRecord,
+        "settings": BiaxialSettings,
         "stiffness_scale": StiffnessScale,
         "elastic_probe": ElasticProbe,
     }
@@ -129,7 +129,7 @@ class BiaxialResult(TypedResult):
     critical_state_note: str
     summaries: list[TestSummary]
     definitions: Definitions
-    settings: BiaxialSettingsRecord
+    settings: BiaxialSettings
     specimens: list[str]
     processes: int
     wall_time_s: float
@@ -198,7 +198,7 @@ class BiaxialSeriesResult(TypedResult):
     sigma_3_held: bool
     sigma_3_note: str
     definitions: Definitions
-    settings: BiaxialSettingsRecord
+    settings: BiaxialSettings
     specimens: list[str]
     processes: int
     wall_time_s: float
@@ -216,7 +216,7 @@ class BiaxialSeriesResult(TypedResult):
         "envelope": EnvelopeRecord,
         "envelope_through_origin": EnvelopeRecord,
         "definitions": Definitions,
-        "settings": BiaxialSettingsRecord,
+        "settings": BiaxialSettings,
         "provenance": Provenance,
         "lab": LabCurveRecord,
         "plastic_max_dilatancy_angle": AngleSpread,

@@ -193,7 +193,7 @@ def summarize(cases, tests, lab, workers, wall, config) -> BiaxialResult:
         max_dilatancy_angle=AngleSpread.of([t.max_dilatancy_angle_deg for t in tests]),
         axial_strain_at_peak=AngleSpread.of([t.axial_strain_at_peak for t in tests]),
         critical_state_reached=not missed, critical_state_note=note, summaries=summaries,
-        definitions=Definitions(**DEFINITIONS), settings=cases[0].settings.record(),
+        definitions=Definitions(**DEFINITIONS), settings=cases[0].settings,
         specimens=[c.specimen.source for c in cases], processes=workers, wall_time_s=wall,
         config=config or {}, provenance=Provenance.now(), lab=lab_record,
         plastic_max_dilatancy_angle=spread_of(AngleSpread, [t.plastic_max_dilatancy_angle_deg

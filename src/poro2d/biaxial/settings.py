@@ -3,20 +3,12 @@
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from typing import ClassVar
 
-from poro2d.errors import InputError, Integer, Ranges, Real, check_fields
+from poro2d.errors import InputError, Ranges, Real, check_fields
+from poro2d.labtest.settings import NORMAL_STRESS_RANGE_KPA, SERVO_AND_WALLS, TestSettings, lab_ranges
 from poro2d.paper_data import TABLE_1
-from poro2d.shear.settings import (
-    MAX_CONSOLIDATION_STEPS,
-    MAX_DENSITY_SCALE,
-    MAX_FRICTION,
-    MAX_ROLLING_FRICTION,
-    MAX_WALL_STIFFNESS,
-    NORMAL_STRESS_RANGE_KPA,
-)
-from poro2d.typed_result import TypedResult
 
 #: the confining stresses (kPa) a test may be run at: the direct shear test's normal stresses,
 #: for the same reasons (a soft contact's overlap above, the specimen's weight below)
@@ -39,20 +31,8 @@ BIAXIAL_RANGES: Ranges = {
     "strain_rate": Real(0.0, 100.0, lo_open=True, or_none=True),
     "max_strain": Real(0.0, MAX_AXIAL_STRAIN, lo_open=True),
     "record_strain": Real(0.0, 0.05, lo_open=True),
-    "consolidation_ratio": Real(0.0, 1.0, lo_open=True),
-    "consolidation_max_steps": Integer(1000, MAX_CONSOLIDATION_STEPS),
-    "stress_tolerance": Real(0.0, 1.0, lo_open=True),
-    "servo_gain": Real(0.0, 1.0, lo_open=True),
-    "servo_integral": Real(0.0, 0.1),
-    "servo_max_speed": Real(0.0, 10.0, lo_open=True),
-    "kn_wall": Real(0.0, MAX_WALL_STIFFNESS, lo_open=True),
-    "ks_wall": Real(0.0, MAX_WALL_STIFFNESS),
-    "friction_wall": Real(0.0, MAX_FRICTION),
-    "particle_friction": Real(0.0, MAX_FRICTION, or_none=True),
-    "rolling_friction": Real(0.0, MAX_ROLLING_FRICTION, or_none=True),
-    "local_damping": Real(0.0, 1.0, hi_open=True, or_none=True),
-    "density_scale": Real(1.0, MAX_DENSITY_SCALE),
-    "dt_safety": Real(0.0, 1.0, lo_open=True),
+    **lab_ranges("consolidation_ratio", "consolidation_max_steps", "stress_tolerance", *SERVO_AND_WALLS),
+    **lab_ranges("particle_friction", "rolling_friction", "local_damping", "density_scale", "dt_safety"),
     "inertial_limit": Real(0.0, 0.1, lo_open=True),
     "smoothing_strain": Real(0.0, 0.1),
     "critical_window": Real(0.0, 0.5, lo_open=True),
@@ -63,8 +43,10 @@ BIAXIAL_RANGES: Ranges = {
 
 
 @dataclass
-class BiaxialSettings:
-    """Settings of a biaxial test (SI units; strains are fractions, compression positive).
+class BiaxialSettings(TestSettings):
+    """Settings of a biaxial test (SI units; strains are fractions, compression positive), also
+    the ``settings`` its files keep (:class:`~poro2d.labtest.settings.TestSettings`; ``probe_unload``
+    and ``stiffness_number`` only when given, as before they existed).
 
     strain_rate (1/s): the top plate moves down at ``strain_rate * H0`` (H0 the specimen's
     height after consolidation); None (the default): :func:`auto_strain_rate`, 0.2 /s or slower
@@ -87,6 +69,8 @@ class BiaxialSettings:
     stiffness number kappa = kn / (sigma_3 t) the disks' kn and ks are scaled to for the test
     (:mod:`poro2d.biaxial.stiffness`; >= 1000 the rigid-grain limit; None: the specimen's).
     """
+
+    OMITTED: ClassVar[dict] = {"probe_unload": None, "stiffness_number": None}
 
     strain_rate: float | None = None
     max_strain: float = 0.20
@@ -127,41 +111,6 @@ class BiaxialSettings:
                 f"at least 3 rows of the curve: >= {3 * self.record_strain / self.max_strain:.3g}",
             )  # fmt: skip
 
-    def record(self) -> BiaxialSettingsRecord:
-        """The settings as a result file keeps them (every setting, in this class's order)."""
-        return BiaxialSettingsRecord(**asdict(self))
-
-
-@dataclass(eq=False)
-class BiaxialSettingsRecord(TypedResult):
-    """:class:`BiaxialSettings` as a result file keeps them (its ``settings``)."""
-
-    strain_rate: float | None
-    max_strain: float
-    record_strain: float
-    consolidation_ratio: float
-    consolidation_max_steps: int
-    stress_tolerance: float
-    servo_gain: float
-    servo_integral: float
-    servo_max_speed: float
-    kn_wall: float
-    ks_wall: float
-    friction_wall: float
-    particle_friction: float | None
-    rolling_friction: float | None
-    local_damping: float | None
-    density_scale: float
-    dt_safety: float
-    inertial_limit: float
-    smoothing_strain: float
-    critical_window: float
-    critical_rate_limit: float
-    probe_unload: float | None = None
-    stiffness_number: float | None = None
-
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("probe_unload", "stiffness_number")
-
 
 #: the strain rate of a test whose box lets its side walls follow (1/s)
 DEFAULT_STRAIN_RATE = 0.2
@@ -200,6 +149,5 @@ __all__ = [
     "PROBE_UNLOAD_RANGE",
     "STIFFNESS_NUMBER_RANGE",
     "BiaxialSettings",
-    "BiaxialSettingsRecord",
     "inertial_number",
 ]

@@ -160,7 +160,7 @@ class BiaxialTest:
             checks=self.checks(curve), consolidation=info, strain_rate_per_s=self.strain_rate,
             plate_velocity_m_per_s=velocity, d50_m=self.d50, dt_s=sim.dt, local_damping=sim.local_damping,
             density_scale=sim.density_scale, shear_steps=int(rows[-1].step), records=len(rows),
-            wall_time_s=time.perf_counter() - t0, settings=s.record(), specimen=self.case.specimen.source,
+            wall_time_s=time.perf_counter() - t0, settings=s, specimen=self.case.specimen.source,
             specimen_digest=self.case.specimen.digest, provenance=Provenance.now(),
             stiffness_number=info.stiffness_number, stiffness_scale=self.scale,
             mean_overlap_ratio_at_peak=float(np.interp(angles.axial_strain_at_peak, curve.axial_strain,

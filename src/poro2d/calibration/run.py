@@ -20,7 +20,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from poro2d.biaxial.lab import LabTests
-from poro2d.biaxial.settings import BiaxialSettingsRecord
+from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.calibration import model
 from poro2d.calibration.biaxial import (
     BIAXIAL,
@@ -58,7 +58,7 @@ from poro2d.locks import holds_output
 from poro2d.paper_data import QUICK_SHEAR
 from poro2d.shear.box_scale import BoxScale, box_scale
 from poro2d.shear.lab import LabData
-from poro2d.shear.parts import LabRecord, ShearSettingsRecord
+from poro2d.shear.parts import LabRecord
 from poro2d.shear.series import check_stresses
 from poro2d.shear.settings import (
     MAX_FRICTION,
@@ -306,7 +306,7 @@ class CalibrationResult(TypedResult):
     lab: LabRecord | BiaxialLabRecord
     specimens: dict[str, str]
     ranges: FrictionBounds
-    settings: ShearSettingsRecord | BiaxialSettingsRecord
+    settings: ShearSettings | BiaxialSettings
     cluster: ClusterRecord
     failures: list[UnitFailure]
     timings: CalibrationTimings
@@ -331,7 +331,7 @@ class CalibrationResult(TypedResult):
         "intervals": FrictionBounds,
         "lab": LabRecord,
         "ranges": FrictionBounds,
-        "settings": ShearSettingsRecord,
+        "settings": ShearSettings,
         "timings": CalibrationTimings,
         "provenance": Provenance,
         "posterior": PosteriorSummary,
@@ -349,7 +349,7 @@ class CalibrationResult(TypedResult):
         obj = super().from_dict(data)
         if data.get("test") == BIAXIAL:
             obj.lab = part(BiaxialLabRecord, data.get("lab"))
-            obj.settings = part(BiaxialSettingsRecord, data.get("settings"))
+            obj.settings = part(BiaxialSettings, data.get("settings"))
         return obj
 
     @property
@@ -923,7 +923,7 @@ def _result(
         lab=BiaxialLabRecord.of(lab_data) if biaxial else lab_data.record(),
         specimens={label: str(found[label]) for label in found},
         ranges=FrictionBounds.from_dict({keys[a]: list(getattr(ranges, a)) for a in ranges.axes}),
-        settings=base.record(),
+        settings=base,
         cluster=runner.info(),
         failures=runner.failures,
         timings=CalibrationTimings(wall_time_s=time.perf_counter() - t0),

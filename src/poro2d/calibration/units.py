@@ -145,7 +145,7 @@ class FrictionUnit:
         """
         given = {f"particle_{k}": v for k, v in stiffness.items() if v is not None}
         settings = replace(base, particle_friction=fp, rolling_friction=mu_r, **given)
-        return cls(str(specimen), digest, float(sigma), settings.record().to_dict())
+        return cls(str(specimen), digest, float(sigma), settings.to_dict())
 
     @property
     def fp(self) -> float:
@@ -303,7 +303,7 @@ def check_files(cache: Store, store: Store, what: str) -> bool:
 def _check_record(unit: CalibrationUnit, store: Store) -> None:
     """Refuse an entry holding work without the record of its test (``test.json`` deleted) or
     with another test's (a folder copied in): its test would refuse it on the worker."""
-    content = content_record(unit.digest, unit.sigma, ShearSettings(**unit.settings).record())
+    content = content_record(unit.digest, unit.sigma, ShearSettings(**unit.settings))
     try:
         folder_stage(store, content, unit.specimen).check()
     except InputError:

@@ -35,7 +35,7 @@ class ShearCase:
     def __post_init__(self) -> None:
         sigma = check_range("normal stress (kPa)", self.normal_stress_kpa, *NORMAL_STRESS_RANGE_KPA)
         object.__setattr__(self, "normal_stress_kpa", sigma)
-        check_finite("shear", self.settings.record().to_dict())  # open ranges let an infinity through
+        check_finite("shear", self.settings.to_dict())  # open ranges let an infinity through
         W, H = self.specimen.box()
         if self.settings.max_displacement > W / 2:
             raise InputError(
@@ -62,7 +62,7 @@ class ShearCase:
 
     def record(self) -> TestContent:
         """The content a stored test must share with this one (:func:`poro2d.shear.record.content_record`)."""
-        return content_record(self.specimen.digest, self.normal_stress_kpa, self.settings.record())
+        return content_record(self.specimen.digest, self.normal_stress_kpa, self.settings)
 
 
 __all__ = ["ShearCase"]

@@ -47,45 +47,6 @@ class EndValues(TypedResult):
 
 
 @dataclass(eq=False)
-class ShearSettingsRecord(TypedResult):
-    """The shear settings as a result file keeps them (:meth:`poro2d.shear.settings.ShearSettings.record`).
-
-    A file written before a setting existed lacks its key, and keeps lacking it when written
-    again (``stop_after_peak`` and ``rolling_friction`` are newer than the first files). The disks'
-    stiffnesses ``particle_kn`` and ``particle_ks`` are written only when given: a test on the
-    specimen's own stiffness keeps the file, and the cache key, it had before they existed.
-    """
-
-    velocity: float
-    max_displacement: float
-    stop_after_peak: float
-    record_interval: float
-    checkpoint_interval: float
-    consolidation_ratio: float
-    consolidation_max_steps: int
-    servo_gain: float
-    servo_integral: float
-    servo_max_speed: float
-    kn_wall: float
-    ks_wall: float
-    friction_wall: float
-    gap: float
-    particle_friction: float | None
-    rolling_friction: float | None
-    local_damping: float | None
-    density_scale: float
-    dt_safety: float
-    peak_window: float
-    shear_zone_factor: float
-    inertial_limit: float
-    stress_tolerance: float
-    particle_kn: float | None = None
-    particle_ks: float | None = None
-
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("particle_kn", "particle_ks")
-
-
-@dataclass(eq=False)
 class BoxRecord(TypedResult):
     """The split box's geometry as a file keeps it (:meth:`poro2d.shear.box.SplitBox.record`), in m."""
 
@@ -378,6 +339,6 @@ class StrengthCase(TypedResult):
 __all__ = [
     "BoxRecord", "ConsolidationRecord", "EndValues", "FitInterval", "FitRecord", "ForceBalance",
     "LabComparison", "LabPeak", "LabRecord", "QuasiStatic", "RateCheck", "RateCheckRow",
-    "ResidualAtRest", "ShearSettingsRecord", "StrengthCase", "StrengthDefinitions", "StressPeaks",
+    "ResidualAtRest", "StrengthCase", "StrengthDefinitions", "StressPeaks",
     "TestSummary", "part", "parts",
 ]  # fmt: skip

@@ -14,7 +14,6 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from poro2d.io_utils import Provenance
-from poro2d.shear.parts import ShearSettingsRecord
 from poro2d.shear.settings import ShearSettings
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
@@ -42,22 +41,22 @@ class TestContent(TypedResult):
 
     specimen_digest: str
     normal_stress_kpa: float
-    settings: ShearSettingsRecord
+    settings: ShearSettings
 
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"settings": ShearSettingsRecord}
+    PARTS: ClassVar[dict[str, type]] = {"settings": ShearSettings}
 
 
 def content_record(
-    specimen_digest: str, sigma_kpa: float, settings: ShearSettingsRecord | Mapping[str, Any]
+    specimen_digest: str, sigma_kpa: float, settings: ShearSettings | Mapping[str, Any]
 ) -> TestContent:
     """What a stored test must share with this one to be reused: content, never paths.
 
-    ``settings``: :meth:`ShearSettings.record` (or its dict, as a ``test.json`` holds it).
+    ``settings``: the test's (or their dict, as a ``test.json`` holds it).
     """
-    if isinstance(settings, ShearSettingsRecord):
+    if isinstance(settings, ShearSettings):
         settings = settings.to_dict()
     kept = {k: v for k, v in settings.items() if not (k in LATER_SETTINGS and v is None)}
-    return TestContent(specimen_digest, sigma_kpa, ShearSettingsRecord.from_dict(kept))
+    return TestContent(specimen_digest, sigma_kpa, ShearSettings.from_dict(kept))
 
 
 def stale_reason(keys: list[str] | None, old: Mapping | None) -> str:

@@ -20,13 +20,13 @@ from poro2d.shear.parts import (
     LabComparison,
     QuasiStatic,
     RateCheck,
-    ShearSettingsRecord,
     StrengthCase,
     StrengthDefinitions,
     StressPeaks,
     TestSummary,
 )
 from poro2d.shear.residual import ResidualAtRest
+from poro2d.shear.settings import ShearSettings
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
@@ -69,7 +69,7 @@ class ShearTestResult(TypedResult):
     records: int
     wall_time_shear_s: float
     wall_time_s: float
-    settings: ShearSettingsRecord
+    settings: ShearSettings
     specimen: str
     engine: EngineSummary
     provenance: Provenance
@@ -98,7 +98,7 @@ class ShearTestResult(TypedResult):
         "force_balance": ForceBalance,
         "residual_dilation_stopped": ResidualAtRest,
         "consolidation": ConsolidationRecord,
-        "settings": ShearSettingsRecord,
+        "settings": ShearSettings,
         "engine": EngineSummary,
         "provenance": Provenance,
     }
@@ -146,7 +146,7 @@ class ShearSeriesResult(TypedResult):
     quasi_static: QuasiStatic
     peak_definition: str
     shear_stress_definition: str
-    settings: ShearSettingsRecord
+    settings: ShearSettings
     velocity_m_per_s: float
     density_scale: float
     specimen: str
@@ -174,7 +174,7 @@ class ShearSeriesResult(TypedResult):
         "rate_check": RateCheck,
         "lab": LabComparison,
         "box_scale": BoxScale,
-        "settings": ShearSettingsRecord,
+        "settings": ShearSettings,
         "provenance": Provenance,
     }
 
@@ -230,7 +230,7 @@ class StrengthResult(TypedResult):
     mu_r: list[float]
     particle_friction: list[float]
     specimens: list[str]
-    settings: ShearSettingsRecord
+    settings: ShearSettings
     definitions: StrengthDefinitions
     wall_time_s: float | None = None
     processes: int | None = None
@@ -243,7 +243,7 @@ class StrengthResult(TypedResult):
         "box_scale": BoxScale,
         "cases": StrengthCase,
         "definitions": StrengthDefinitions,
-        "settings": ShearSettingsRecord,
+        "settings": ShearSettings,
         "provenance": Provenance,
     }
 

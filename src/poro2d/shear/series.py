@@ -166,7 +166,7 @@ class ShearSeries:
             f"{1e3 * s.peak_window:g} mm of shear displacement",
             shear_stress_definition="horizontal force of the disks on the upper half (upper walls, upper "
             "lip, top plate friction) / (W t), W the box width (no area correction)",
-            settings=s.record(),
+            settings=s,
             velocity_m_per_s=s.velocity,
             density_scale=s.density_scale,
             specimen=self.specimen.source,

@@ -3,39 +3,32 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
+from typing import ClassVar
 
-from poro2d.dem.contact_law import MAX_ROLLING_FRICTION as ENGINE_MAX_ROLLING_FRICTION
-from poro2d.errors import InputError, Integer, Ranges, Real, check_fields
+from poro2d.dem.contact_law import MAX_ROLLING_FRICTION  # the engine's bound
+from poro2d.errors import InputError, Ranges, Real, check_fields
+from poro2d.labtest.settings import (
+    MAX_CONSOLIDATION_STEPS,
+    MAX_DENSITY_SCALE,
+    MAX_FRICTION,
+    MAX_WALL_STIFFNESS,
+    NORMAL_STRESS_RANGE_KPA,
+    SERVO_AND_WALLS,
+    TestSettings,
+    lab_ranges,
+)
 from poro2d.paper_data import TABLE_1
-from poro2d.shear.parts import ShearSettingsRecord
 
-#: the normal stresses (kPa) a test may be run at. A contact carries about sigma d t, so two
-#: disks of the paper's stiffness (kn = 4e5 N/m each, in series 2e5; 8 mm thick) overlap by
-#: sigma t / k = 4 % of their diameter at 1 MPa, and more above: beyond what a soft-contact
-#: model describes. Below 1 kPa the plate pushes less than the specimen's own weight does at
-#: mid-height (about 1.3 kPa in the paper's box), so the stress held is not the one the shear
-#: plane feels. docs/shear.md has the reasoning.
-NORMAL_STRESS_RANGE_KPA = (1.0, 1000.0)
 #: the longest shear displacement (m) of any test
 MAX_DISPLACEMENT = 1.0
 #: most rows of a test's curve, and most checkpoints, that its intervals may ask for
 MAX_RECORDS = 1_000_000
 MAX_CHECKPOINTS = 1000
-#: 30 times the default step budget of the consolidation (hours of one core for the paper's box)
-MAX_CONSOLIDATION_STEPS = 10_000_000
-#: wall stiffness (N/m): 1000 times Table 1's; the time step falls with its square root
-MAX_WALL_STIFFNESS = 1e10
-#: friction coefficients beyond 10 hold as a rough wall does; larger ones are typos
-MAX_FRICTION = 10.0
 #: a disk's normal or shear stiffness (N/m): from 1e3 (a contact of 2.5 mm disks overlaps by a
 #: tenth of their diameter at 2 kPa: softer is no longer a soft-contact model) up to 1e10 (as the
 #: walls; the time step falls with its square root)
 PARTICLE_STIFFNESS_RANGE = (1e3, 1e10)
-#: the largest rolling friction (the engine's bound, see poro2d.dem.contact_law)
-MAX_ROLLING_FRICTION = ENGINE_MAX_ROLLING_FRICTION
-#: inertial masses up to 1000 times the real ones: the inertial number grows with its root
-MAX_DENSITY_SCALE = 1000.0
 
 
 #: what each setting of :class:`ShearSettings` may be (checked in this order); the intervals
@@ -49,32 +42,23 @@ SHEAR_RANGES: Ranges = {
     # beyond max_displacement it never ends a test (as a short quick test with the default)
     "stop_after_peak": Real(0.0, MAX_DISPLACEMENT),
     "checkpoint_interval": Real(0.0, None, lo_open=True),
-    "consolidation_ratio": Real(0.0, 1.0, lo_open=True),
-    "consolidation_max_steps": Integer(1000, MAX_CONSOLIDATION_STEPS),
-    "servo_gain": Real(0.0, 1.0, lo_open=True),
-    "servo_integral": Real(0.0, 0.1),
-    "servo_max_speed": Real(0.0, 10.0, lo_open=True),
-    "kn_wall": Real(0.0, MAX_WALL_STIFFNESS, lo_open=True),
-    "ks_wall": Real(0.0, MAX_WALL_STIFFNESS),
-    "friction_wall": Real(0.0, MAX_FRICTION),
+    **lab_ranges("consolidation_ratio", "consolidation_max_steps", *SERVO_AND_WALLS),
     "gap": Real(0.0, None),
-    "particle_friction": Real(0.0, MAX_FRICTION, or_none=True),
-    "rolling_friction": Real(0.0, MAX_ROLLING_FRICTION, or_none=True),
+    **lab_ranges("particle_friction", "rolling_friction"),
     "particle_kn": Real(*PARTICLE_STIFFNESS_RANGE, or_none=True),
     "particle_ks": Real(*PARTICLE_STIFFNESS_RANGE, or_none=True),
-    "local_damping": Real(0.0, 1.0, hi_open=True, or_none=True),
-    "density_scale": Real(1.0, MAX_DENSITY_SCALE),
-    "dt_safety": Real(0.0, 1.0, lo_open=True),
+    **lab_ranges("local_damping", "density_scale", "dt_safety"),
     "peak_window": Real(0.0, None),
     "shear_zone_factor": Real(0.0, None, lo_open=True),
     "inertial_limit": Real(0.0, None, lo_open=True),
-    "stress_tolerance": Real(0.0, 1.0, lo_open=True),
+    **lab_ranges("stress_tolerance"),
 }
 
 
 @dataclass
-class ShearSettings:
-    """Settings of a direct shear test (SI units; the box walls default to Table 1).
+class ShearSettings(TestSettings):
+    """Settings of a direct shear test (SI units; the box walls default to Table 1), also the
+    ``settings`` its files keep (:class:`~poro2d.labtest.settings.TestSettings`).
 
     velocity (m/s) and max_displacement (m) of the lower half; stop_after_peak (m): the
     test ends once the smoothed peak lies that far behind (0: always run to
@@ -92,7 +76,13 @@ class ShearSettings:
     inertial masses; dt_safety the automatic time step; peak_window (m) the
     smoothing of the peak; shear_zone_factor k in gamma_dot = v / (k d_mean);
     inertial_limit and stress_tolerance the quasi-static and servo checks.
+
+    Its files hold every setting in this order; the disks' stiffnesses ``particle_kn`` and
+    ``particle_ks`` only when given, so a test on the specimen's own stiffness keeps the file,
+    and the cache key, it had before they existed.
     """
+
+    OMITTED: ClassVar[dict] = {"particle_kn": None, "particle_ks": None}
 
     velocity: float = 0.025
     max_displacement: float = 0.02
@@ -139,10 +129,6 @@ class ShearSettings:
         if interval < shortest:
             raise InputError(name, interval, f"[max_displacement / {most} = {shortest:.3g}, inf) m")
 
-    def record(self) -> ShearSettingsRecord:
-        """The settings as a result file keeps them (every setting, in this class's order)."""
-        return ShearSettingsRecord(**{f.name: getattr(self, f.name) for f in fields(self)})
-
 
 def inertial_number(velocity: float, sigma_pa: float, rho_inertial: float, shear_zone_factor: float) -> float:
     """I = gamma_dot d_mean sqrt(rho / sigma_n) with gamma_dot = v / (k d_mean).
@@ -157,7 +143,11 @@ def inertial_number(velocity: float, sigma_pa: float, rho_inertial: float, shear
 
 
 __all__ = [
+    "MAX_CONSOLIDATION_STEPS",
+    "MAX_DENSITY_SCALE",
+    "MAX_FRICTION",
     "MAX_ROLLING_FRICTION",
+    "MAX_WALL_STIFFNESS",
     "NORMAL_STRESS_RANGE_KPA",
     "PARTICLE_STIFFNESS_RANGE",
     "ShearSettings",

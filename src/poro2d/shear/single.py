@@ -245,7 +245,7 @@ class DirectShearTest:
             records=len(rows),
             wall_time_shear_s=wall,
             wall_time_s=wall + float(info.wall_time_s or 0.0),
-            settings=s.record(),
+            settings=s,
             specimen=self.case.specimen.source,
             engine=sim.summary(),
             provenance=Provenance.now(),

@@ -280,7 +280,7 @@ class StrengthStudy:
             mu_r=self.mu_r,
             particle_friction=self.friction,
             specimens=list(next(iter(self.cases.values())).series),
-            settings=self.settings.record(),
+            settings=self.settings,
             definitions=StrengthDefinitions.from_dict(DEFINITIONS),
             wall_time_s=time.perf_counter() - t0,
             processes=self.processes,
