@@ -368,7 +368,8 @@ def test_known_structures_of_shear_and_paper_files_are_typed_parts():
     """The split box, laboratory peaks, a strength study's definitions and the case study's
     facts, timings, conversion rows and shear summary are typed parts; the files are the same."""
     from poro2d.paper import ConversionRow, PaperFacts, PaperTimings
-    from poro2d.shear.parts import BoxRecord, LabPeak, QuasiStatic, StrengthDefinitions, TestSummary
+    from poro2d.labtest.records import BoxRecord
+    from poro2d.shear.parts import LabPeak, QuasiStatic, ShearTestSummary, StrengthDefinitions
     from poro2d.shear.results import StrengthResult
 
     test = ShearTestResult.from_dict(json.loads((DATA / "shear_test_result.json").read_text()))
@@ -380,7 +381,9 @@ def test_known_structures_of_shear_and_paper_files_are_typed_parts():
     assert isinstance(paper.paper, PaperFacts) and paper.paper.criterion.accepted_porosity == 0.15
     assert isinstance(paper.timings, PaperTimings) and paper.timings.shear_s > 0
     assert isinstance(paper.conversions.methods[0], ConversionRow)
-    assert isinstance(paper.shear.tests[0], TestSummary) and isinstance(paper.shear.quasi_static, QuasiStatic)
+    assert isinstance(paper.shear.tests[0], ShearTestSummary) and isinstance(
+        paper.shear.quasi_static, QuasiStatic
+    )
     for result, name in (
         (test, "shear_test_result.json"),
         (series, "shear_series_result.json"),

@@ -22,7 +22,7 @@ from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance
 from poro2d.locks import holds_output
 from poro2d.paper_data import PAPER, QUICK_SHEAR
-from poro2d.shear.parts import LabRecord, QuasiStatic, TestSummary
+from poro2d.shear.parts import LabRecord, QuasiStatic, ShearTestSummary
 from poro2d.shear.results import ReplicateShearResult
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
@@ -74,7 +74,7 @@ class PaperShear(TypedResult):
     """The direct shear stage's summary: the pooled fit over every specimen's peaks; ``tests``
     and ``quasi_static`` of the first specimen; ``replicates``: the replicate specimens' summary."""
 
-    tests: list[TestSummary]
+    tests: list[ShearTestSummary]
     friction_angle_deg: float | None
     cohesion_kpa: float | None
     r2: float | None
@@ -83,7 +83,7 @@ class PaperShear(TypedResult):
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "replicates": ReplicateShearResult,
-        "tests": TestSummary,
+        "tests": ShearTestSummary,
         "quasi_static": QuasiStatic,
     }
 

@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.shear.curve import CURVE_COLUMNS, CurveRow, ShearCurve, curve_columns, curve_rows
+from poro2d.labtest.records import ConsolidationRecord
 from poro2d.shear.fit import mohr_coulomb, peak
 from poro2d.shear.parts import (
-    ConsolidationRecord,
     EndValues,
     FitInterval,
     FitRecord,
@@ -20,7 +20,7 @@ from poro2d.shear.parts import (
     RateCheck,
     RateCheckRow,
     StressPeaks,
-    TestSummary,
+    ShearTestSummary,
 )
 from poro2d.shear.replicates import mohr_coulomb_ci
 from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult, ShearTestResult
@@ -45,7 +45,7 @@ def test_a_test_result_reads_into_its_parts():
 def test_a_series_result_reads_into_its_parts():
     stored = _stored("shear_series_result.json")
     s = ShearSeriesResult.from_dict(stored)
-    assert all(isinstance(t, TestSummary) and isinstance(t.end, EndValues) for t in s.tests)
+    assert all(isinstance(t, ShearTestSummary) and isinstance(t.end, EndValues) for t in s.tests)
     assert isinstance(s.fit, FitRecord) and isinstance(s.fit_through_origin, FitRecord)
     assert isinstance(s.quasi_static, QuasiStatic) and isinstance(s.lab, LabComparison)
     assert isinstance(s.rate_check, RateCheck) and all(

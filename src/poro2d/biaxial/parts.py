@@ -6,44 +6,9 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from poro2d.biaxial.stiffness import STIFFNESS_DEFINITION
+from poro2d.labtest.records import TestSummary
 from poro2d.measure.spread import Spread
 from poro2d.typed_result import TypedResult
-
-
-@dataclass(eq=False)
-class BoxRecord(TypedResult):
-    """The box as built (m): the specimen's width and height, the disks' thickness."""
-
-    width: float
-    height: float
-    thickness: float
-
-
-@dataclass(eq=False)
-class ConsolidationRecord(TypedResult):
-    """How consolidation to sigma_3 ended: steps, the unbalanced-force ratio and each wall's stress."""
-
-    confining_stress_kpa: float
-    steps: int
-    max_unbalanced_ratio: float
-    sigma_1_kpa: float
-    sigma_3_left_kpa: float
-    sigma_3_right_kpa: float
-    max_stress_error: float
-    width_m: float
-    height_m: float
-    porosity: float
-    coordination_number: float
-    wall_time_s: float
-    box: BoxRecord
-    contact_kn: float | None = None
-    stiffness_number: float | None = None
-    mean_overlap_ratio: float | None = None
-
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"box": BoxRecord}
-    #: written since the stiffness number was recorded (:mod:`poro2d.biaxial.stiffness`): the disk-disk
-    #: contacts' mean kn (N/m), kappa = kn / (sigma_3 t) and mean overlap / mean diameter
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("contact_kn", "stiffness_number", "mean_overlap_ratio")
 
 
 @dataclass(eq=False)
@@ -132,7 +97,7 @@ def spread_of(kind: type[Spread], values: list[float | None]) -> Spread | None:
 
 
 @dataclass(eq=False)
-class TestSummary(TypedResult):
+class BiaxialTestSummary(TestSummary):
     """One replicate's row of a study's ``result.json``."""
 
     replicate: int
@@ -230,7 +195,7 @@ ENVELOPE_DEFINITION = (
 
 
 __all__ = [
-    "DEFINITIONS", "ELASTIC_SPREADS", "ENVELOPE_DEFINITION", "AngleSpread", "BoxRecord",
-    "ConsolidationRecord", "Definitions", "ElasticProbe", "LabCurveRecord", "ShearChecks",
-    "StiffnessScale", "StressSummary", "TestSummary", "spread_of",
+    "DEFINITIONS", "ELASTIC_SPREADS", "ENVELOPE_DEFINITION", "AngleSpread", "BiaxialTestSummary",
+    "Definitions", "ElasticProbe", "LabCurveRecord", "ShearChecks",
+    "StiffnessScale", "StressSummary", "spread_of",
 ]  # fmt: skip

@@ -10,17 +10,17 @@ from poro2d.biaxial.envelope import EnvelopeRecord
 from poro2d.biaxial.parts import (
     ELASTIC_SPREADS,
     AngleSpread,
-    ConsolidationRecord,
+    BiaxialTestSummary,
     Definitions,
     ElasticProbe,
     LabCurveRecord,
     ShearChecks,
     StiffnessScale,
     StressSummary,
-    TestSummary,
 )
 from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.io_utils import Provenance
+from poro2d.labtest.records import ConsolidationRecord
 from poro2d.measure.spread import Spread
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
@@ -127,7 +127,7 @@ class BiaxialResult(TypedResult):
     axial_strain_at_peak: AngleSpread
     critical_state_reached: bool
     critical_state_note: str
-    summaries: list[TestSummary]
+    summaries: list[BiaxialTestSummary]
     definitions: Definitions
     settings: BiaxialSettings
     specimens: list[str]
@@ -148,7 +148,7 @@ class BiaxialResult(TypedResult):
         "critical_state_friction_angle": AngleSpread,
         "max_dilatancy_angle": AngleSpread,
         "axial_strain_at_peak": AngleSpread,
-        "summaries": TestSummary,
+        "summaries": BiaxialTestSummary,
         "definitions": Definitions,
         "provenance": Provenance,
         "lab": LabCurveRecord,

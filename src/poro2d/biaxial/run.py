@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from poro2d.biaxial.case import BiaxialCase
 from poro2d.biaxial.curve import CURVE_COLUMNS, OPTIONAL_COLUMNS
 from poro2d.biaxial.lab import LabCurve, read_lab_curve
-from poro2d.biaxial.parts import DEFINITIONS, AngleSpread, Definitions, LabCurveRecord, TestSummary, spread_of
+from poro2d.biaxial.parts import DEFINITIONS, AngleSpread, Definitions, LabCurveRecord, BiaxialTestSummary, spread_of
 from poro2d.biaxial.results import BiaxialResult, BiaxialTestResult
 from poro2d.biaxial.single import BiaxialTest
 from poro2d.errors import InputError, check_int
@@ -165,21 +165,7 @@ def summarize(cases, tests, lab, workers, wall, config) -> BiaxialResult:
         "not critical-state angles (a longer --strain, or a larger specimen)"
     )
     summaries = [
-        TestSummary(
-            replicate=k + 1,
-            specimen=t.specimen,
-            peak_friction_angle_deg=t.peak_friction_angle_deg,
-            axial_strain_at_peak=t.axial_strain_at_peak,
-            critical_state_friction_angle_deg=t.critical_state_friction_angle_deg,
-            critical_state_reached=t.critical_state_reached,
-            max_dilatancy_angle_deg=t.max_dilatancy_angle_deg,
-            end_volumetric_strain=t.end_volumetric_strain,
-            sigma_3_max_error=t.checks.sigma_3_max_error,
-            wall_time_s=t.wall_time_s,
-            stiffness_number=t.stiffness_number,
-            mean_overlap_ratio_at_peak=t.mean_overlap_ratio_at_peak,
-            plastic_max_dilatancy_angle_deg=t.plastic_max_dilatancy_angle_deg,
-        )  # fmt: skip
+        BiaxialTestSummary.of(t, replicate=k + 1, sigma_3_max_error=t.checks.sigma_3_max_error)
         for k, t in enumerate(tests)
     ]
     lab_record = None

@@ -16,10 +16,10 @@ import numpy as np
 
 from poro2d.biaxial.box import BiaxialBox, BoxSize
 from poro2d.biaxial.curve import CurveRow, curve_row
-from poro2d.biaxial.parts import BoxRecord, ConsolidationRecord
 from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.biaxial.stiffness import contact_kn, overlap_ratio, stiffness_number
 from poro2d.dem import Simulation
+from poro2d.labtest.records import BoxRecord, ConsolidationRecord
 from poro2d.measure.coordination import coordination_number
 
 #: ``progress(phase, fraction)``: called between blocks of steps
@@ -132,7 +132,7 @@ def consolidate(
         sigma_1_kpa=s1 / 1e3, sigma_3_left_kpa=left / 1e3, sigma_3_right_kpa=right / 1e3,
         max_stress_error=end.error, width_m=size.width, height_m=size.height, porosity=porosity(sim),
         coordination_number=coordination_number(sim), wall_time_s=time.perf_counter() - t0,
-        box=BoxRecord(box.width, box.height, box.thickness), contact_kn=kn,
+        box=BoxRecord(width=box.width, height=box.height, thickness=box.thickness), contact_kn=kn,
         stiffness_number=stiffness_number(kn, sigma, size.thickness), mean_overlap_ratio=overlap_ratio(sim),
     )  # fmt: skip
 

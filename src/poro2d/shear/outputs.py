@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from poro2d.shear.curve import CURVE_COLUMNS, ShearCurve, curve_rows
 from poro2d.shear.fit import MohrCoulombFit, mohr_coulomb
 from poro2d.shear.lab import LabData
-from poro2d.shear.parts import TestSummary
+from poro2d.shear.parts import ShearTestSummary
 from poro2d.shear.results import ShearTestResult
 from poro2d.store import Store
 
@@ -25,7 +25,7 @@ def lab_fit(lab: LabData | None) -> MohrCoulombFit | None:
     return mohr_coulomb(ls, [lab.peaks[v] for v in ls])
 
 
-def write_tables(store: Store, curves: dict[float, ShearCurve], summary: list[TestSummary]) -> None:
+def write_tables(store: Store, curves: dict[float, ShearCurve], summary: list[ShearTestSummary]) -> None:
     """``curves.csv`` (every curve, long format) and ``peaks.csv`` (one row per test).
 
     ``curves``: each test's curve (:attr:`ShearTestResult.curve`) by normal stress.

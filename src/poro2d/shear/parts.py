@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, ClassVar, TypeVar
 
-from poro2d.dem.summary import EngineSummary
+from poro2d.labtest.records import TestSummary
 from poro2d.typed_result import TypedResult, part
 
 P = TypeVar("P", bound=TypedResult)
@@ -44,49 +44,6 @@ class EndValues(TypedResult):
     normal_stress_kpa: float
     plate_displacement_mm: float
     coordination_number: float
-
-
-@dataclass(eq=False)
-class BoxRecord(TypedResult):
-    """The split box's geometry as a file keeps it (:meth:`poro2d.shear.box.SplitBox.record`), in m."""
-
-    width: float
-    height: float
-    split_y: float
-    gap: float
-    max_displacement: float
-    thickness: float
-    x0_lower: float
-
-
-@dataclass(eq=False)
-class ConsolidationRecord(TypedResult):
-    """A test's consolidation (``consolidation.json``; in ``result.json`` without ``engine``).
-
-    ``box``: the split box's geometry (:meth:`poro2d.shear.box.SplitBox.record`); ``engine``:
-    the simulation's summary after consolidating.
-    """
-
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("engine",)
-
-    normal_stress_kpa: float
-    target_force_n: float
-    steps: int
-    max_unbalanced_ratio: float
-    normal_stress_measured_kpa: float
-    normal_stress_error: float
-    plate_height_before_m: float
-    plate_height_m: float
-    plate_settlement_m: float
-    coordination_number: float
-    wall_time_s: float
-    box: BoxRecord
-    engine: EngineSummary | None = None
-
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "box": BoxRecord,
-        "engine": EngineSummary,
-    }
 
 
 @dataclass(eq=False)
@@ -146,10 +103,8 @@ class ResidualAtRest(TypedResult):
 
 
 @dataclass(eq=False)
-class TestSummary(TypedResult):
+class ShearTestSummary(TestSummary):
     """One test's line of a series' ``result.json`` (and ``peaks.csv``, without its nested parts)."""
-
-    __test__ = False  # not a test class, whatever its name
 
     normal_stress_kpa: float
     peak_shear_stress_kpa: float
@@ -337,8 +292,8 @@ class StrengthCase(TypedResult):
 
 
 __all__ = [
-    "BoxRecord", "ConsolidationRecord", "EndValues", "FitInterval", "FitRecord", "ForceBalance",
+    "EndValues", "FitInterval", "FitRecord", "ForceBalance",
     "LabComparison", "LabPeak", "LabRecord", "QuasiStatic", "RateCheck", "RateCheckRow",
     "ResidualAtRest", "StrengthCase", "StrengthDefinitions", "StressPeaks",
-    "TestSummary", "part", "parts",
+    "ShearTestSummary", "part", "parts",
 ]  # fmt: skip

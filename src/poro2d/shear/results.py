@@ -8,11 +8,11 @@ from typing import Any, ClassVar
 
 from poro2d.dem.summary import EngineSummary
 from poro2d.io_utils import Provenance
+from poro2d.labtest.records import ConsolidationRecord
 from poro2d.shear.box_dominated import box_verdict
 from poro2d.shear.box_scale import BoxScale
 from poro2d.shear.curve import ShearCurve, read_curve
 from poro2d.shear.parts import (
-    ConsolidationRecord,
     EndValues,
     FitInterval,
     FitRecord,
@@ -23,7 +23,7 @@ from poro2d.shear.parts import (
     StrengthCase,
     StrengthDefinitions,
     StressPeaks,
-    TestSummary,
+    ShearTestSummary,
 )
 from poro2d.shear.residual import ResidualAtRest
 from poro2d.shear.settings import ShearSettings
@@ -126,7 +126,7 @@ class ShearTestResult(TypedResult):
 class ShearSeriesResult(TypedResult):
     """Tests at several normal stresses on one specimen (a series' ``result.json``), with the fit.
 
-    ``tests``: one :class:`~poro2d.shear.parts.TestSummary` per test. The Mohr-Coulomb fit (``fit``, and
+    ``tests``: one :class:`~poro2d.shear.parts.ShearTestSummary` per test. The Mohr-Coulomb fit (``fit``, and
     its ``friction_angle_deg``, ``cohesion_kpa``, ``r2``) needs two stresses or more, else
     they are None. ``rate_check`` and ``lab`` are in the file only when the series ran with
     them. ``curves`` (not in the file): each test's curve (:attr:`ShearTestResult.curve`)
@@ -136,7 +136,7 @@ class ShearSeriesResult(TypedResult):
     OPTIONAL: ClassVar[tuple[str, ...]] = ("rate_check", "lab", "box_scale", "box_dominated_tests")
 
     normal_stresses_kpa: list[float]
-    tests: list[TestSummary]
+    tests: list[ShearTestSummary]
     friction_angle_deg: float | None
     cohesion_kpa: float | None
     r2: float | None
@@ -167,7 +167,7 @@ class ShearSeriesResult(TypedResult):
     )
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "tests": TestSummary,
+        "tests": ShearTestSummary,
         "fit": FitRecord,
         "fit_through_origin": FitRecord,
         "quasi_static": QuasiStatic,

@@ -26,7 +26,7 @@ from poro2d.shear.parts import (
     QuasiStatic,
     RateCheck,
     RateCheckRow,
-    TestSummary,
+    ShearTestSummary,
 )
 from poro2d.shear.pool import ShearJob, execute_jobs
 from poro2d.shear.results import ShearSeriesResult, ShearTestResult
@@ -34,13 +34,6 @@ from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings
 from poro2d.specimen.saved import Specimen
 from poro2d.store import Store
 
-#: what a series' ``result.json`` keeps of each test
-SUMMARY_KEYS = (
-    "normal_stress_kpa", "peak_shear_stress_kpa", "shear_displacement_at_peak_m", "peak_stress_ratio",
-    "peak_shear_stress_raw_kpa", "normal_stress_at_peak_kpa", "plate_displacement_at_peak_mm", "end",
-    "end_shear_displacement_m", "ended_by", "max_inertial_number", "inertial_number_ok",
-    "normal_stress_max_error_after_consolidation", "force_balance", "wall_time_s",
-)  # fmt: skip
 RATE_CHECK_NOTE = (
     "relative_change compares the smoothed peaks; mean_abs_change_before_peak the "
     "smoothed curves from half a window to the earlier of the two peaks, over the peak. "
@@ -194,20 +187,13 @@ class ShearSeries:
         return result
 
     @staticmethod
-    def _test_summary(t: ShearTestResult) -> TestSummary:
+    def _test_summary(t: ShearTestResult) -> ShearTestSummary:
         """One test's line of the series' result."""
         # tests written before a test said why it ended lack ``ended_by`` (None)
-        return TestSummary(
-            **{k: getattr(t, k) for k in SUMMARY_KEYS},
-            consolidation_normal_stress_error=t.consolidation.normal_stress_error,
+        return ShearTestSummary.of(
+            t, consolidation_normal_stress_error=t.consolidation.normal_stress_error,
             folder=folder_name(t.normal_stress_kpa),
-            plane_load_fraction_at_peak=t.plane_load_fraction_at_peak,
-            residual_dilation_stopped=t.residual_dilation_stopped,
-            box_dominated=t.box_dominated,
-            box_note=t.box_note,
-            stiffness_number=t.stiffness_number,
-            mean_overlap_ratio_at_peak=t.mean_overlap_ratio_at_peak,
-        )
+        )  # fmt: skip
 
     def _quasi_static(self, tests: list[ShearTestResult]) -> QuasiStatic:
         s = self.settings

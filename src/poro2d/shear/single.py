@@ -44,7 +44,7 @@ from poro2d.shear.curve import (
     curve_summary,
     read_curve,
 )
-from poro2d.shear.parts import ConsolidationRecord
+from poro2d.labtest.records import ConsolidationRecord
 from poro2d.shear.peak_frame import PeakFrame
 from poro2d.shear.residual import dilation_stopped_residual
 from poro2d.shear.results import ShearTestResult

@@ -1,0 +1,107 @@
+"""The records every box test keeps: its box, its consolidation, and its line in a study.
+
+One :class:`BoxRecord` and one :class:`ConsolidationRecord` serve the direct shear test and the
+biaxial test. Each holds the keys every box test writes and, after them in the file's order,
+those of one kind of test, written only when set (a biaxial file has no split box; a shear file
+no side walls): one class reads and writes both tests' files as they were written before.
+:class:`TestSummary` is the base of a test's line in its study's ``result.json``, made from the
+test's result by name (:meth:`TestSummary.of`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from typing import Any, ClassVar, Self
+
+from poro2d.dem.summary import EngineSummary
+from poro2d.typed_result import TypedResult
+
+
+@dataclass(eq=False, kw_only=True)
+class BoxRecord(TypedResult):
+    """A test's box as built (m): its width and height and the disks' thickness; a split box
+    (:meth:`poro2d.shear.box.SplitBox.record`) also where it splits, its gap, how far its lower
+    half may travel and where that half starts."""
+
+    width: float
+    height: float
+    split_y: float | None = None
+    gap: float | None = None
+    max_displacement: float | None = None
+    thickness: float
+    x0_lower: float | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("split_y", "gap", "max_displacement", "x0_lower")
+
+
+#: the keys only a direct shear test's consolidation writes (its plate servoed to the normal stress)
+SPLIT_BOX_KEYS = (
+    "normal_stress_kpa", "target_force_n", "normal_stress_measured_kpa", "normal_stress_error",
+    "plate_height_before_m", "plate_height_m", "plate_settlement_m", "engine",
+)  # fmt: skip
+#: the keys only a biaxial test's consolidation writes (its plate and side walls servoed to sigma_3)
+BIAXIAL_KEYS = (
+    "confining_stress_kpa", "sigma_1_kpa", "sigma_3_left_kpa", "sigma_3_right_kpa", "max_stress_error",
+    "width_m", "height_m", "porosity",
+)  # fmt: skip
+
+
+@dataclass(eq=False, kw_only=True)
+class ConsolidationRecord(TypedResult):
+    """How a test's consolidation ended (a shear test's ``consolidation.json``, a ``consolidation`` of
+    either test's ``result.json``): the steps, the unbalanced-force ratio, the coordination number,
+    the wall time and the box, with the stresses each kind of test servoes.
+
+    Direct shear: the normal stress, the plate's target force, the measured stress and its error,
+    the plate's heights and settlement, ``engine`` the simulation's summary after consolidating (not
+    in a test's ``result.json``). Biaxial: sigma_3, each wall's stress and the largest error, the
+    box's size and porosity; ``contact_kn``, ``stiffness_number`` and ``mean_overlap_ratio``
+    (:mod:`poro2d.biaxial.stiffness`: the disk-disk contacts' mean kn in N/m, kappa = kn /
+    (sigma_3 t), mean overlap / mean diameter) since the stiffness number was recorded.
+    """
+
+    normal_stress_kpa: float | None = None
+    target_force_n: float | None = None
+    confining_stress_kpa: float | None = None
+    steps: int
+    max_unbalanced_ratio: float
+    normal_stress_measured_kpa: float | None = None
+    normal_stress_error: float | None = None
+    plate_height_before_m: float | None = None
+    plate_height_m: float | None = None
+    plate_settlement_m: float | None = None
+    sigma_1_kpa: float | None = None
+    sigma_3_left_kpa: float | None = None
+    sigma_3_right_kpa: float | None = None
+    max_stress_error: float | None = None
+    width_m: float | None = None
+    height_m: float | None = None
+    porosity: float | None = None
+    coordination_number: float
+    wall_time_s: float
+    box: BoxRecord
+    engine: EngineSummary | None = None
+    contact_kn: float | None = None
+    stiffness_number: float | None = None
+    mean_overlap_ratio: float | None = None
+
+    OPTIONAL: ClassVar[tuple[str, ...]] = (
+        *SPLIT_BOX_KEYS, *BIAXIAL_KEYS, "contact_kn", "stiffness_number", "mean_overlap_ratio",
+    )  # fmt: skip
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"box": BoxRecord, "engine": EngineSummary}
+
+
+@dataclass(eq=False)
+class TestSummary(TypedResult):
+    """Base of a test's line in its study's ``result.json``: the test's numbers a study lists."""
+
+    __test__ = False  # not a test class, whatever its name
+
+    @classmethod
+    def of(cls, result: TypedResult, **given: Any) -> Self:
+        """The line of the test ``result``: each field ``given``, the others read off ``result`` by name."""
+        names = (f.name for f in fields(cls) if f.name != "extra")
+        return cls(**{name: given[name] if name in given else getattr(result, name) for name in names})
+
+
+__all__ = ["BoxRecord", "ConsolidationRecord", "TestSummary"]
