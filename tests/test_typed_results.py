@@ -367,8 +367,8 @@ def test_provenance_is_a_record_written_as_before(cls, name):
 def test_known_structures_of_shear_and_paper_files_are_typed_parts():
     """The split box, laboratory peaks, a strength study's definitions and the case study's
     facts, timings, conversion rows and shear summary are typed parts; the files are the same."""
-    from poro2d.paper import ConversionRow, PaperFacts, PaperTimings
     from poro2d.labtest.records import BoxRecord
+    from poro2d.paper import ConversionRow, PaperFacts, PaperTimings
     from poro2d.shear.parts import LabPeak, QuasiStatic, ShearTestSummary, StrengthDefinitions
     from poro2d.shear.results import StrengthResult
 

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from poro2d.shear.curve import CURVE_COLUMNS, CurveRow, ShearCurve, curve_columns, curve_rows
 from poro2d.labtest.records import ConsolidationRecord
+from poro2d.shear.curve import CURVE_COLUMNS, CurveRow, ShearCurve, curve_columns, curve_rows
 from poro2d.shear.fit import mohr_coulomb, peak
 from poro2d.shear.parts import (
     EndValues,
@@ -19,8 +19,8 @@ from poro2d.shear.parts import (
     QuasiStatic,
     RateCheck,
     RateCheckRow,
-    StressPeaks,
     ShearTestSummary,
+    StressPeaks,
 )
 from poro2d.shear.replicates import mohr_coulomb_ci
 from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult, ShearTestResult

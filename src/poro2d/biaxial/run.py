@@ -15,7 +15,14 @@ from dataclasses import dataclass
 from poro2d.biaxial.case import BiaxialCase
 from poro2d.biaxial.curve import CURVE_COLUMNS, OPTIONAL_COLUMNS
 from poro2d.biaxial.lab import LabCurve, read_lab_curve
-from poro2d.biaxial.parts import DEFINITIONS, AngleSpread, Definitions, LabCurveRecord, BiaxialTestSummary, spread_of
+from poro2d.biaxial.parts import (
+    DEFINITIONS,
+    AngleSpread,
+    BiaxialTestSummary,
+    Definitions,
+    LabCurveRecord,
+    spread_of,
+)
 from poro2d.biaxial.results import BiaxialResult, BiaxialTestResult
 from poro2d.biaxial.single import BiaxialTest
 from poro2d.errors import InputError, check_int

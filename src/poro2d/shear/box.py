@@ -33,8 +33,8 @@ from poro2d.dem import ContactModel, Particles, Simulation, Walls
 from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
 from poro2d.dem.ordering import strip_order
 from poro2d.errors import InputError, check_range
-from poro2d.paper_data import TABLE_1
 from poro2d.labtest.records import BoxRecord
+from poro2d.paper_data import TABLE_1
 from poro2d.specimen.box import box_faces
 
 LOWER = ("bottom", "lower_left", "lower_right", "lower_lip")

@@ -20,10 +20,10 @@ from poro2d.shear.parts import (
     LabComparison,
     QuasiStatic,
     RateCheck,
+    ShearTestSummary,
     StrengthCase,
     StrengthDefinitions,
     StressPeaks,
-    ShearTestSummary,
 )
 from poro2d.shear.residual import ResidualAtRest
 from poro2d.shear.settings import ShearSettings

@@ -23,6 +23,7 @@ import numpy as np
 from poro2d.dem import Simulation
 from poro2d.errors import InputError
 from poro2d.io_utils import Provenance, as_json
+from poro2d.labtest.records import ConsolidationRecord
 from poro2d.measure.coordination import coordination_number
 from poro2d.measure.stiffness import (
     contact_kn,
@@ -44,7 +45,6 @@ from poro2d.shear.curve import (
     curve_summary,
     read_curve,
 )
-from poro2d.labtest.records import ConsolidationRecord
 from poro2d.shear.peak_frame import PeakFrame
 from poro2d.shear.residual import dilation_stopped_residual
 from poro2d.shear.results import ShearTestResult
