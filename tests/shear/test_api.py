@@ -11,7 +11,7 @@ from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.execute import RunOptions
 from poro2d.shear import ShearSeries, ShearSettings, build_split_box, run_shear
-from poro2d.shear.curve import CURVE_COLUMNS, CurveRow
+from poro2d.shear.curve import CURVE_COLUMNS, ShearRow
 from poro2d.shear.peak_frame import PeakFrame, PeakTracker
 from poro2d.store import Store
 
@@ -118,7 +118,7 @@ def test_peak_tracker_keeps_the_frame_of_the_smoothed_maximum(tmp_path):
     # a lone spike at record 2 and a broad hump around record 8: the smoothed peak is the hump
     tau = [0.0, 1.0, 9.0, 1.0, 0.0, 0.0, 4.0, 5.0, 6.0, 5.0, 4.0, 0.0, 0.0]
     zeros = dict.fromkeys(CURVE_COLUMNS, 0.0)
-    rows = [CurveRow(**dict(zeros, shear_displacement_mm=k, shear_stress_kpa=t)) for k, t in enumerate(tau)]
+    rows = [ShearRow(**dict(zeros, shear_displacement_mm=k, shear_stress_kpa=t)) for k, t in enumerate(tau)]
     tracker = PeakTracker(window=4e-3)  # five records wide
     for k in range(len(rows)):
         tracker.add(_frame(k))

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.labtest.records import ConsolidationRecord
-from poro2d.shear.curve import CURVE_COLUMNS, CurveRow, ShearCurve, curve_columns, curve_rows
+from poro2d.shear.curve import CURVE_COLUMNS, ShearCurve, ShearRow, curve_columns
 from poro2d.shear.fit import mohr_coulomb, peak
 from poro2d.shear.parts import (
     EndValues,
@@ -82,12 +82,12 @@ def test_fits_are_kept_as_their_dicts_were():
 
 
 def test_a_curve_row_is_a_record_of_the_files_columns():
-    assert [f.name for f in dataclasses.fields(CurveRow) if f.name != "extra"] == CURVE_COLUMNS
-    row = CurveRow(*range(len(CURVE_COLUMNS)))
+    assert [f.name for f in dataclasses.fields(ShearRow) if f.name != "extra"] == CURVE_COLUMNS
+    row = ShearRow(*range(len(CURVE_COLUMNS)))
     assert (
         list(row.to_dict()) == CURVE_COLUMNS and {k: getattr(row, k) for k in CURVE_COLUMNS} == row.to_dict()
     )
-    assert CurveRow.from_dict(json.loads(json.dumps(row.to_dict()))).to_dict() == row.to_dict()
+    assert ShearRow.from_dict(json.loads(json.dumps(row.to_dict()))).to_dict() == row.to_dict()
 
 
 def test_a_curve_is_its_columns():
@@ -95,6 +95,6 @@ def test_a_curve_is_its_columns():
     curve = curve_columns(rows)
     assert isinstance(curve, ShearCurve) and list(curve) == CURVE_COLUMNS and len(curve) == len(CURVE_COLUMNS)
     np.testing.assert_array_equal(curve.shear_stress_kpa, curve["shear_stress_kpa"])
-    assert curve_rows(curve) == rows and curve_columns([]) is None
+    assert curve.rows() == rows and curve_columns([]) is None
     k, x, value = peak(curve.shear_displacement_mm, curve.shear_stress_kpa, 0.0)
     assert peak(curve.shear_displacement_mm, curve.shear_stress_kpa, 0.0).index == k == 3 and value == x + 1

@@ -12,7 +12,6 @@ p = (sigma_1 + sigma_3) / 2 and the mobilized friction sin(phi) = q / (sigma_1 +
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, replace
 from typing import ClassVar
 
@@ -21,8 +20,8 @@ import numpy as np
 from poro2d.biaxial.box import BiaxialBox, BoxSize
 from poro2d.biaxial.stiffness import contact_strain, overlap_ratio
 from poro2d.dem import Simulation
+from poro2d.labtest.curve import ColumnCurve, CurveRow
 from poro2d.store import Store
-from poro2d.typed_result import TypedResult
 
 #: the columns of ``curve.csv``, in order
 CURVE_COLUMNS = (
@@ -51,12 +50,13 @@ OPTIONAL_COLUMNS = (
 
 
 @dataclass(frozen=True, eq=False)
-class BiaxialCurve(Mapping):
+class BiaxialCurve(ColumnCurve):
     """A test's recorded curve: one float array per column of :data:`CURVE_COLUMNS`, and of
-    :data:`OPTIONAL_COLUMNS` where it has them (None where not).
+    :data:`OPTIONAL_COLUMNS` where it has them (None where not); a mapping of the names it has
+    to the arrays, in the file's order."""
 
-    Also a read-only mapping of the column names it has to the arrays, in the file's order.
-    """
+    COLUMNS: ClassVar[tuple[str, ...]] = CURVE_COLUMNS
+    OPTIONAL: ClassVar[tuple[str, ...]] = OPTIONAL_COLUMNS
 
     step: np.ndarray
     axial_strain: np.ndarray
@@ -78,46 +78,14 @@ class BiaxialCurve(Mapping):
     plastic_volumetric_strain: np.ndarray | None = None
     plastic_shear_strain: np.ndarray | None = None
 
-    @property
-    def columns(self) -> tuple[str, ...]:
-        """The columns this curve has, in the file's order."""
-        return CURVE_COLUMNS + tuple(k for k in OPTIONAL_COLUMNS if getattr(self, k) is not None)
-
-    def __getitem__(self, name: str) -> np.ndarray:
-        if name not in self.columns:
-            raise KeyError(name)
-        return getattr(self, name)
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self.columns)
-
-    def __len__(self) -> int:
-        return len(self.columns)
-
-    @classmethod
-    def of_rows(cls, rows: list[CurveRow] | list[Mapping]) -> BiaxialCurve:
-        """The rows as columns, every value through ``float`` as ``curve.csv`` stores it; an optional
-        column only where every row has it."""
-        rows = [r.to_dict() if isinstance(r, CurveRow) else r for r in rows]  # as curve.csv holds them
-        kept = [k for k in OPTIONAL_COLUMNS if rows and all(r.get(k) not in (None, "") for r in rows)]
-        return cls(**{k: np.array([float(r[k]) for r in rows]) for k in (*CURVE_COLUMNS, *kept)})
-
-    def rows(self) -> list[dict]:
-        """The curve as rows of Python floats (for ``curve.csv``)."""
-        names = self.columns
-        cols = [self[k].tolist() for k in names]
-        return [dict(zip(names, values, strict=True)) for values in zip(*cols, strict=True)]
-
     def with_plastic(self, volumetric: np.ndarray, shear: np.ndarray) -> BiaxialCurve:
         """This curve with its plastic strains (:func:`poro2d.biaxial.elastic.plastic_strains`)."""
         return replace(self, plastic_volumetric_strain=volumetric, plastic_shear_strain=shear)
 
 
 @dataclass(eq=False)
-class CurveRow(TypedResult):
+class BiaxialRow(CurveRow):
     """One row of ``curve.csv``, its fields the columns in order (see the module's conventions)."""
-
-    JSON_VALUES: ClassVar[bool] = False  # a row of a CSV table: NaN stays NaN ("nan")
 
     step: int
     axial_strain: float
@@ -137,11 +105,7 @@ class CurveRow(TypedResult):
     elastic_axial_strain: float | None = None
     elastic_lateral_strain: float | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = (
-        "mean_overlap_ratio",
-        "elastic_axial_strain",
-        "elastic_lateral_strain",
-    )
+    OPTIONAL: ClassVar[tuple[str, ...]] = OPTIONAL_COLUMNS[:3]
 
 
 def read_curve(store: Store, name: str = "curve.csv") -> BiaxialCurve | None:
@@ -152,7 +116,7 @@ def read_curve(store: Store, name: str = "curve.csv") -> BiaxialCurve | None:
 
 def curve_row(
     sim: Simulation, start: BoxSize, step: int, d50: float, rho: float, strain_rate: float
-) -> CurveRow:
+) -> BiaxialRow:
     """One row of the curve: the box's strains and stresses now (see the module's conventions)."""
     now = BiaxialBox.size(sim)
     s1, s3, left, right = BiaxialBox.stresses(sim)
@@ -161,7 +125,7 @@ def curve_row(
     p = 0.5 * (s1 + s3)
     ratio, _ = sim.unbalanced_ratios()
     elastic_1, elastic_3 = contact_strain(sim)
-    return CurveRow(
+    return BiaxialRow(
         step=step,
         axial_strain=e1,
         lateral_strain=e3,
@@ -182,4 +146,4 @@ def curve_row(
     )
 
 
-__all__ = ["CURVE_COLUMNS", "OPTIONAL_COLUMNS", "BiaxialCurve", "CurveRow", "curve_row", "read_curve"]
+__all__ = ["CURVE_COLUMNS", "OPTIONAL_COLUMNS", "BiaxialCurve", "BiaxialRow", "curve_row", "read_curve"]

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from poro2d.biaxial.box import BiaxialBox, BoxSize
-from poro2d.biaxial.curve import CurveRow, curve_row
+from poro2d.biaxial.curve import BiaxialRow, curve_row
 from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.biaxial.stiffness import contact_kn, overlap_ratio, stiffness_number
 from poro2d.dem import Simulation
@@ -156,7 +156,7 @@ class Shearing:
     rho: float
     progress: ProgressFn | None = None
 
-    def run(self) -> tuple[list[CurveRow], float]:
+    def run(self) -> tuple[list[BiaxialRow], float]:
         """The curve's rows and the plate's velocity (m/s)."""
         sim, s = self.sim, self.settings
         sigma = self.confining_kpa * 1e3

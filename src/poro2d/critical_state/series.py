@@ -9,9 +9,12 @@ number actually reached, I = gamma_dot d sqrt(rho / sigma_yy), and the coordinat
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
+
+from poro2d.labtest.curve import ColumnCurve
 
 #: the columns of ``series.csv``, in the order of :class:`CellSeries`' fields
 COLUMNS = (
@@ -27,8 +30,10 @@ COLUMNS = (
 
 
 @dataclass(frozen=True, eq=False)
-class CellSeries:
-    """The rows of a run as arrays (one entry per row)."""
+class CellSeries(ColumnCurve):
+    """The rows of a run as arrays (one entry per row), a curve of the columns of ``series.csv``."""
+
+    COLUMNS: ClassVar[tuple[str, ...]] = COLUMNS
 
     gamma: np.ndarray
     stress_ratio: np.ndarray
@@ -38,15 +43,6 @@ class CellSeries:
     solid_fraction: np.ndarray
     inertial_number: np.ndarray
     coordination: np.ndarray
-
-    @classmethod
-    def of_rows(cls, rows: list[dict[str, float]]) -> CellSeries:
-        return cls(**{c: np.array([r[c] for r in rows], dtype=float) for c in COLUMNS})
-
-    def rows(self) -> list[dict[str, float]]:
-        """One dict per row (the CSV's)."""
-        cols = [getattr(self, f.name) for f in fields(self)]
-        return [dict(zip(COLUMNS, (float(c[k]) for c in cols), strict=True)) for k in range(self.gamma.size)]
 
     def window(self, start: float) -> np.ndarray:
         """The rows at gamma >= start (a boolean mask)."""

@@ -9,7 +9,7 @@ shear displacement.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import ClassVar
 
@@ -17,12 +17,12 @@ import numpy as np
 
 from poro2d.dem import Simulation
 from poro2d.dem.contacts import ContactSet
+from poro2d.labtest.curve import ColumnCurve, CurveRow
 from poro2d.shear.box import UPPER_SIDE_WALLS, SplitBox
 from poro2d.shear.fit import peak, smooth
 from poro2d.shear.parts import EndValues, ForceBalance
 from poro2d.shear.settings import ShearSettings, inertial_number
 from poro2d.store import Store
-from poro2d.typed_result import TypedResult
 
 CURVE_COLUMNS = [
     "step", "shear_displacement_mm", "shear_stress_kpa", "normal_stress_kpa", "plate_displacement_mm",
@@ -35,12 +35,12 @@ LATER_COLUMNS = ("plane_normal_stress_kpa", "upper_wall_friction_kpa")
 
 
 @dataclass(frozen=True, eq=False)
-class ShearCurve(Mapping):
-    """A test's recorded curve: one float array per column of ``curve.csv`` (:data:`CURVE_COLUMNS`).
+class ShearCurve(ColumnCurve):
+    """A test's recorded curve: one float array per column of ``curve.csv`` (:data:`CURVE_COLUMNS`;
+    the later ones NaN in a curve of an earlier poro2d), and a mapping of the names to them."""
 
-    Also a read-only mapping of the column names to the arrays, in the file's order (the
-    figures take a curve as such).
-    """
+    COLUMNS: ClassVar[tuple[str, ...]] = tuple(CURVE_COLUMNS)
+    LATER: ClassVar[tuple[str, ...]] = LATER_COLUMNS
 
     step: np.ndarray
     shear_displacement_mm: np.ndarray
@@ -58,20 +58,9 @@ class ShearCurve(Mapping):
     plane_normal_stress_kpa: np.ndarray
     upper_wall_friction_kpa: np.ndarray
 
-    def __getitem__(self, name: str) -> np.ndarray:
-        if name not in CURVE_COLUMNS:
-            raise KeyError(name)
-        return getattr(self, name)
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(CURVE_COLUMNS)
-
-    def __len__(self) -> int:
-        return len(CURVE_COLUMNS)
-
 
 @dataclass(eq=False)
-class CurveRow(TypedResult):
+class ShearRow(CurveRow):
     """One record of a test's curve: a row of ``curve.csv``, its fields the columns in order.
 
     The stresses are over the nominal area ``W t``: the force on the upper half (``shear_stress_kpa``),
@@ -82,8 +71,6 @@ class CurveRow(TypedResult):
     ``upper_wall_friction_kpa`` the upward friction of the upper side walls on the disks:
     part of the plate's load that never reaches the plane (NaN in a curve of an earlier poro2d).
     """
-
-    JSON_VALUES: ClassVar[bool] = False  # a row of a CSV table: NaN stays NaN ("nan")
 
     step: int
     shear_displacement_mm: float
@@ -102,31 +89,9 @@ class CurveRow(TypedResult):
     upper_wall_friction_kpa: float = math.nan
 
 
-def curve_columns(rows: list[CurveRow] | list[Mapping]) -> ShearCurve | None:
-    """A curve's records as one float array per column of :data:`CURVE_COLUMNS` (None without rows).
-
-    Every value goes through ``float`` as ``curve.csv`` stores it (an integer column reads
-    back as floats), so a curve in memory and one read from its file are the same arrays.
-    """
-    if not rows:
-        return None
-
-    def value(row: CurveRow | Mapping, k: str) -> float:
-        if isinstance(row, CurveRow):  # NaN is held as None; a column an old checkpoint lacks too
-            v = getattr(row, k)
-            return math.nan if v is None else float(v)
-        return float(row.get(k, math.nan)) if k in LATER_COLUMNS else float(row[k])
-
-    return ShearCurve(**{k: np.array([value(r, k) for r in rows]) for k in CURVE_COLUMNS})
-
-
-def curve_rows(curve: Mapping[str, np.ndarray]) -> list[dict]:
-    """The records of a curve held as columns (:func:`curve_columns`), as rows of Python floats."""
-    names = list(curve)
-    return [
-        dict(zip(names, values, strict=True))
-        for values in zip(*(curve[k].tolist() for k in names), strict=True)
-    ]
+def curve_columns(rows: list[ShearRow] | list[Mapping]) -> ShearCurve | None:
+    """A curve's records as one float array per column (:meth:`ColumnCurve.of_rows`), None without rows."""
+    return ShearCurve.of_rows(rows) if rows else None
 
 
 def read_curve(store: Store, name: str = "curve.csv") -> ShearCurve | None:
@@ -178,7 +143,7 @@ def contradiction(result: Mapping, curve: ShearCurve | None, window: float) -> s
 def curve_row(
     sim: Simulation, box: SplitBox, settings: ShearSettings, contacts: ContactSet,
     y_plate0: float, step0: int, rho: float,
-) -> CurveRow:  # fmt: skip
+) -> ShearRow:  # fmt: skip
     """One record of the curve from the simulation's current state.
 
     ``contacts`` are the simulation's current contacts, ``y_plate0`` the plate height after
@@ -190,7 +155,7 @@ def curve_row(
     pl = box.plane_force(sim, contacts)
     sigma = box.plate_force(sim) / area
     c = contacts
-    return CurveRow(
+    return ShearRow(
         step=sim.step_count - step0,
         shear_displacement_mm=1e3 * box.shear_displacement(sim),
         shear_stress_kpa=fu[0] / area / 1e3,
@@ -269,7 +234,7 @@ class CurveSummary:
     plane_load_fraction_at_peak: float
 
 
-def curve_summary(rows: list[CurveRow], sigma_kpa: float, settings: ShearSettings) -> CurveSummary:
+def curve_summary(rows: list[ShearRow], sigma_kpa: float, settings: ShearSettings) -> CurveSummary:
     """Peak, end values, servo error, inertial number and force balance read off the curve."""
     s = settings
     x = np.array([r.shear_displacement_mm for r in rows]) * 1e-3
@@ -315,8 +280,8 @@ def plane_load_fraction(x: np.ndarray, col: Mapping[str, np.ndarray], k: int, wi
 
 __all__ = [
     "CURVE_COLUMNS",
-    "CurveRow",
     "ShearCurve",
+    "ShearRow",
     "CurveSummary",
     "contradiction",
     "curve_row",

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from poro2d.shear.curve import CURVE_COLUMNS, ShearCurve, curve_rows
+from poro2d.shear.curve import CURVE_COLUMNS, ShearCurve
 from poro2d.shear.fit import MohrCoulombFit, mohr_coulomb
 from poro2d.shear.lab import LabData
 from poro2d.shear.parts import ShearTestSummary
@@ -31,7 +31,7 @@ def write_tables(store: Store, curves: dict[float, ShearCurve], summary: list[Sh
     ``curves``: each test's curve (:attr:`ShearTestResult.curve`) by normal stress.
     """
     long_rows = [
-        {"normal_stress_kpa": sigma, **row} for sigma, curve in curves.items() for row in curve_rows(curve)
+        {"normal_stress_kpa": sigma, **row} for sigma, curve in curves.items() for row in curve.rows()
     ]
     store.write_csv("curves.csv", long_rows, header=["normal_stress_kpa"] + CURVE_COLUMNS)
     # the nested parts of a test's summary (end values, force balance) are in result.json only

@@ -18,7 +18,7 @@ import numpy as np
 
 from poro2d.dem import Simulation
 from poro2d.dem.contacts import ContactSet
-from poro2d.shear.curve import CurveRow
+from poro2d.shear.curve import ShearRow
 from poro2d.shear.fit import smooth
 from poro2d.store import Store
 
@@ -101,7 +101,7 @@ class PeakTracker:
         self.frame: PeakFrame | None = None
         self.saved = True  # nothing new to save
 
-    def restore(self, store: Store | None, name: str, rows: list[CurveRow]) -> None:
+    def restore(self, store: Store | None, name: str, rows: list[ShearRow]) -> None:
         """Continue from the frame saved with a shear checkpoint (if any)."""
         frame = PeakFrame.load(store, name) if store is not None and rows else None
         if frame is None:
@@ -113,7 +113,7 @@ class PeakTracker:
     def add(self, frame: PeakFrame) -> None:
         self.pending.append(frame)
 
-    def settle(self, rows: list[CurveRow], upto: float | None) -> None:
+    def settle(self, rows: list[ShearRow], upto: float | None) -> None:
         xs, ys = _curve(rows)
         half = 0.5 * self.window
         while self.pending and (upto is None or xs[self.pending[0].record] + half <= upto):
@@ -132,7 +132,7 @@ class PeakTracker:
             self.saved = True
 
 
-def _curve(rows: list[CurveRow]) -> tuple[np.ndarray, np.ndarray]:
+def _curve(rows: list[ShearRow]) -> tuple[np.ndarray, np.ndarray]:
     """Shear displacement (m) and shear stress (kPa) of the records so far."""
     xs = np.array([r.shear_displacement_mm for r in rows]) * 1e-3
     ys = np.array([r.shear_stress_kpa for r in rows])

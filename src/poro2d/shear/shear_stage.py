@@ -16,7 +16,7 @@ import numpy as np
 from poro2d.dem import Simulation
 from poro2d.shear.box import SplitBox
 from poro2d.shear.controllers import ProgressFn, ShearDrive
-from poro2d.shear.curve import CurveRow, curve_row, peak_passed
+from poro2d.shear.curve import ShearRow, curve_row, peak_passed
 from poro2d.shear.fit import peak
 from poro2d.shear.peak_frame import PeakFrame, PeakTracker
 from poro2d.shear.settings import ShearSettings
@@ -70,12 +70,12 @@ class ShearStage:
         self.peak = PeakTracker(s.peak_window)
         self.peak.restore(store, PEAK_FRAME, self.rows)
 
-    def _start(self, sim: Simulation) -> tuple[Simulation, list[CurveRow], int, float]:
+    def _start(self, sim: Simulation) -> tuple[Simulation, list[ShearRow], int, float]:
         """(simulation, rows, step shearing began at, wall time so far): resumed or new."""
         saved = None if self.checkpoints is None else self.checkpoints.resume(threads=self.threads)
         if saved is not None:
             resumed, meta = saved
-            rows = [CurveRow.from_dict(row) for row in meta["rows"]]
+            rows = [ShearRow.from_dict(row) for row in meta["rows"]]
             return resumed, rows, meta["step0"], meta.get("wall_time_s", 0.0)
         ShearDrive(self.settings.velocity).start(sim)
         return sim, [], sim.step_count, 0.0

@@ -39,7 +39,7 @@ from poro2d.shear.case import ShearCase
 from poro2d.shear.controllers import Consolidation, ProgressFn
 from poro2d.shear.curve import (
     CURVE_COLUMNS,
-    CurveRow,
+    ShearRow,
     contradiction,
     curve_columns,
     curve_summary,
@@ -219,7 +219,7 @@ class DirectShearTest:
         )  # fmt: skip
 
     def _result(
-        self, rows: list[CurveRow], info: ConsolidationRecord, sim: Simulation, wall: float,
+        self, rows: list[ShearRow], info: ConsolidationRecord, sim: Simulation, wall: float,
         peak: PeakFrame | None = None,
     ) -> ShearTestResult:  # fmt: skip
         """The test's ``result.json``: what the curve says, and how it was obtained; the stiffness
