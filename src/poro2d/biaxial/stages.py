@@ -7,9 +7,7 @@ length) and a row is read.
 
 from __future__ import annotations
 
-import math
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,12 +18,10 @@ from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.biaxial.stiffness import contact_kn, overlap_ratio, stiffness_number
 from poro2d.dem import Simulation
 from poro2d.labtest.records import BoxRecord, ConsolidationRecord
+from poro2d.labtest.settle import ProgressFn, Settled
+from poro2d.labtest.settle import settle as settle_servoed
 from poro2d.measure.coordination import coordination_number
 
-#: ``progress(phase, fraction)``: called between blocks of steps
-ProgressFn = Callable[[str, float], None]
-#: how often (steps) consolidation renews the walls' targets and checks for equilibrium
-CONSOLIDATION_CHECK = 500
 #: the first part of the axial strain, where the side walls only start to follow, left out of
 #: the sigma_3 check
 SIDE_START_STRAIN = 0.01
@@ -53,50 +49,31 @@ def stress_errors(sim: Simulation, sigma_pa: float, top_pa: float | None = None)
     return [abs(s1 / plate - 1.0), abs(left / sigma_pa - 1.0), abs(right / sigma_pa - 1.0)]
 
 
-@dataclass
-class Settled:
-    """How :func:`settle` ended: steps run, the last unbalanced ratio and largest stress error."""
-
-    steps: int
-    ratio: float
-    error: float
-    reached: bool
-
-
 def settle(
     sim: Simulation, sigma_pa: float, settings: BiaxialSettings, *, top_pa: float | None,
     phase: str, progress: ProgressFn | None = None, fixed_plate: bool = False,
 ) -> Settled:  # fmt: skip
-    """Run until equilibrium: the side walls servoed to ``sigma_pa`` and the plate to ``top_pa`` (or
-    held where it is, ``fixed_plate``), their targets renewed every :data:`CONSOLIDATION_CHECK`
-    steps as the box changes. Reached: the maximum unbalanced-force ratio below
+    """Run until equilibrium (:func:`poro2d.labtest.settle.settle`): the side walls servoed to
+    ``sigma_pa`` and the plate to ``top_pa`` (or held where it is, ``fixed_plate``), their targets
+    renewed at every check as the box changes. Reached: the maximum unbalanced-force ratio below
     ``consolidation_ratio`` and each servoed wall's stress within ``stress_tolerance`` of its
     target, within ``consolidation_max_steps`` steps."""
-    state = {"ratio": math.inf, "err": math.inf}
     top = not fixed_plate
 
-    def errors(sm: Simulation) -> list[float]:
+    def error(sm: Simulation) -> float:
         err = stress_errors(sm, sigma_pa, top_pa)
-        return err if top else err[1:]
+        return max(err if top else err[1:])
 
-    def check(sm: Simulation) -> bool:
-        rmax, _ = sm.unbalanced_ratios()
-        err = max(errors(sm))
-        state.update(ratio=rmax, err=err)
-        if progress is not None:
-            progress(phase, min(sm.step_count / settings.consolidation_max_steps, 1.0))
-        if rmax < settings.consolidation_ratio and err < settings.stress_tolerance:
-            return True
+    def renew(sm: Simulation) -> None:
         servo_targets(sm, sigma_pa, settings, top=top, top_pa=top_pa)
-        return False
 
     if fixed_plate:
         sim.set_wall_velocity("top", (0.0, 0.0))
-    servo_targets(sim, sigma_pa, settings, top=top, top_pa=top_pa)
-    sim.reset_clock()
-    res = sim.run(settings.consolidation_max_steps, every=CONSOLIDATION_CHECK, callback=check)
-    reached = state["ratio"] < settings.consolidation_ratio and state["err"] < settings.stress_tolerance
-    return Settled(res.steps, state["ratio"], state["err"], bool(reached))
+    renew(sim)
+    return settle_servoed(
+        sim, error, ratio_limit=settings.consolidation_ratio, tolerance=settings.stress_tolerance,
+        max_steps=settings.consolidation_max_steps, renew=renew, progress=progress, phase=phase,
+    )  # fmt: skip
 
 
 def porosity(sim: Simulation) -> float:
@@ -179,6 +156,6 @@ class Shearing:
 
 
 __all__ = [
-    "CONSOLIDATION_CHECK", "ProgressFn", "Settled", "Shearing", "consolidate", "porosity", "servo_targets",
+    "Shearing", "consolidate", "porosity", "servo_targets",
     "settle",
 ]  # fmt: skip

@@ -9,31 +9,20 @@ controller (:class:`poro2d.criterion.lid.FlatPlate`); its stop rule is the shear
 
 from __future__ import annotations
 
-import math
-from collections.abc import Callable
 from dataclasses import dataclass
 
 from poro2d.criterion.lid import FlatPlate
 from poro2d.dem import Simulation
+from poro2d.labtest.settle import ProgressFn, Settled, settle
 from poro2d.shear.box import LOWER
 from poro2d.shear.settings import ShearSettings
 
-#: ``progress(phase, fraction)``: called between blocks of steps, for a progress display
-ProgressFn = Callable[[str, float], None]
-
-#: how often (steps) consolidation checks for equilibrium
-CONSOLIDATION_CHECK = 500
-
 
 @dataclass(frozen=True)
-class Settling:
-    """How a consolidation ended: ``settled`` (equilibrium and stress on target), its ``steps``, the
-    maximum unbalanced-force ratio and |F / target - 1| at the last check, the plate's height before."""
+class Settling(Settled):
+    """How a consolidation ended (:class:`~poro2d.labtest.settle.Settled`: ``error`` the plate's
+    |F / target - 1|), and the plate's height before it."""
 
-    settled: bool
-    steps: int
-    max_unbalanced_ratio: float
-    normal_stress_error: float
     plate_height_before_m: float
 
 
@@ -43,7 +32,8 @@ class Consolidation:
 
     Settled means the maximum unbalanced-force ratio below ``consolidation_ratio`` and the
     plate's force within ``stress_tolerance`` of the target, the servo on (``servo_gain``,
-    ``servo_integral``, ``servo_max_speed``); at most ``consolidation_max_steps`` steps.
+    ``servo_integral``, ``servo_max_speed``); at most ``consolidation_max_steps`` steps
+    (:func:`poro2d.labtest.settle.settle`).
     """
 
     settings: ShearSettings
@@ -58,25 +48,11 @@ class Consolidation:
         plate = FlatPlate(sim)
         plate.servo(sim, target, s.servo_max_speed, s.servo_gain, s.servo_integral)
         y0 = plate.height(sim)
-        state = {"ratio": math.inf, "err": math.inf}
-
-        def settled(sm: Simulation) -> bool:
-            rmax, _ = sm.unbalanced_ratios()
-            err = abs(plate.force(sm) / target - 1.0)
-            state.update(ratio=rmax, err=err)
-            if self.progress is not None:
-                self.progress("consolidating", min(sm.step_count / s.consolidation_max_steps, 1.0))
-            return rmax < s.consolidation_ratio and err < s.stress_tolerance
-
-        sim.reset_clock()
-        res = sim.run(s.consolidation_max_steps, every=CONSOLIDATION_CHECK, callback=settled)
-        return Settling(
-            settled=state["ratio"] < s.consolidation_ratio and state["err"] < s.stress_tolerance,
-            steps=res.steps,
-            max_unbalanced_ratio=state["ratio"],
-            normal_stress_error=state["err"],
-            plate_height_before_m=y0,
-        )
+        end = settle(
+            sim, lambda sm: abs(plate.force(sm) / target - 1.0), ratio_limit=s.consolidation_ratio,
+            tolerance=s.stress_tolerance, max_steps=s.consolidation_max_steps, progress=self.progress,
+        )  # fmt: skip
+        return Settling(end.steps, end.ratio, end.error, end.reached, plate_height_before_m=y0)
 
 
 @dataclass(frozen=True)
@@ -91,4 +67,4 @@ class ShearDrive:
             sim.set_wall_velocity(name, (self.velocity, 0.0))
 
 
-__all__ = ["CONSOLIDATION_CHECK", "Consolidation", "ProgressFn", "Settling", "ShearDrive"]
+__all__ = ["Consolidation", "Settling", "ShearDrive"]

@@ -169,18 +169,18 @@ class DirectShearTest:
         self.box = box
         target = self.sigma_kpa * 1e3 * box.width * box.thickness
         done = Consolidation(s, progress=self.progress).settle(sim, target)
-        if not done.settled:
+        if not done.reached:
             raise RuntimeError(
                 f"consolidation at {self.sigma_kpa:g} kPa did not reach equilibrium within "
-                f"{s.consolidation_max_steps} steps (ratio {done.max_unbalanced_ratio:.2e}, "
-                f"stress error {done.normal_stress_error:.2%})"
+                f"{s.consolidation_max_steps} steps (ratio {done.ratio:.2e}, "
+                f"stress error {done.error:.2%})"
             )
         y0 = done.plate_height_before_m
         info = ConsolidationRecord(
             normal_stress_kpa=self.sigma_kpa, target_force_n=target, steps=done.steps,
-            max_unbalanced_ratio=done.max_unbalanced_ratio,
+            max_unbalanced_ratio=done.ratio,
             normal_stress_measured_kpa=box.plate_force(sim) / (box.width * box.thickness) / 1e3,
-            normal_stress_error=done.normal_stress_error, plate_height_before_m=y0,
+            normal_stress_error=done.error, plate_height_before_m=y0,
             plate_height_m=box.plate_height(sim), plate_settlement_m=y0 - box.plate_height(sim),
             coordination_number=coordination_number(sim), wall_time_s=time.perf_counter() - t0,
             box=box.record(), engine=sim.summary(),
