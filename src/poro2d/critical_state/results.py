@@ -8,6 +8,7 @@ from typing import Any, ClassVar
 from poro2d.critical_state.case import CaseRecord
 from poro2d.critical_state.series import CellSeries
 from poro2d.io_utils import Provenance
+from poro2d.labtest.records import TestSummary
 from poro2d.measure.spread import Spread
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
@@ -72,7 +73,7 @@ def void_ratio(solid_fraction: float) -> float:
 
 
 @dataclass(eq=False)
-class SeedSummary(TypedResult):
+class SeedSummary(TestSummary):
     """One seed's row of a study's ``result.json`` (``note``: steady, or which drift was too large)."""
 
     seed: int

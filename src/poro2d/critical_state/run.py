@@ -243,27 +243,7 @@ def study_of(cases, tests, workers, wall, config) -> CriticalStateResult:
             f"not steady for seed(s) {', '.join(map(str, missed))}: their numbers are not the critical state"
         )
     )
-    summaries = [
-        SeedSummary(
-            seed=c.seed,
-            disks=t.disks,
-            stress_ratio=t.stress_ratio,
-            stress_ratio_se=t.stress_ratio_se,
-            friction_angle_deg=t.friction_angle_deg,
-            solid_fraction=t.solid_fraction,
-            inertial_number=t.inertial_number,
-            coordination=t.coordination,
-            normal_stress_kpa=t.normal_stress_kpa,
-            stress_ratio_drift=t.stress_ratio_drift,
-            solid_fraction_drift=t.solid_fraction_drift,
-            steady=t.steady,
-            note=t.note,
-            wall_time_s=t.wall_time_s,
-            stiffness_number=t.stiffness_number,
-            mean_overlap_ratio=t.mean_overlap_ratio,
-        )
-        for c, t in zip(cases, tests, strict=True)
-    ]
+    summaries = [SeedSummary.of(t, seed=c.seed) for c, t in zip(cases, tests, strict=True)]
     return CriticalStateResult(
         seeds=[c.seed for c in cases],
         stress_ratio=Spread.of([t.stress_ratio for t in tests]),
