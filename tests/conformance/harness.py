@@ -6,8 +6,9 @@
 * A "killed" run is one that raises ``KeyboardInterrupt`` right after its store has written its
   k-th file (:func:`killed_after`): the store is the only code that keeps a run's files, so
   this stops every protocol between two of its files, where a real kill leaves it.
-* Results are compared as their files hold them (:func:`comparable`), with what may differ
-  between two runs of one case taken out: times, hosts, process ids, the output folder's path.
+* Results are compared as their files hold them, with what travels beside the file (a test's
+  curve) (:func:`comparable`), and with what may differ between two runs of one case taken out:
+  times, hosts, process ids, the output folder's path.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from poro2d.store import digests
 #: keys whose values say when, where or how long, never what: left out of every comparison
 VOLATILE = {"provenance", "host", "pid", "hostname", "python", "time_s", "created", "started", "finished"}
 #: key endings of rates, which vary between runs of one case (durations: a key with "time" ending "_s")
-VOLATILE_SUFFIXES = ("per_s", "_seconds", "elapsed_s")
+VOLATILE_SUFFIXES = ("per_s", "seconds", "elapsed_s")
 
 
 class Captured(Exception):  # noqa: N818 - not an error: how a capture stops the run it captured
@@ -100,11 +101,13 @@ def files_under(folder: Path) -> list[str]:
     return sorted(str(p.relative_to(folder)) for p in folder.rglob("*"))
 
 
-def comparable(value: Any, *roots: Path, volatile: frozenset[str] = frozenset(), keep_all: bool = False) -> Any:
+def comparable(
+    value: Any, *roots: Path, volatile: frozenset[str] = frozenset(), keep_all: bool = False
+) -> Any:
     """``value`` as plain JSON data to compare: a result's file (``to_dict()``), a record's fields;
     arrays as lists; times, hosts and process ids left out (``volatile``: more keys to leave out;
     ``keep_all``: nothing left out); each of ``roots`` (output folders) written ``<out>``."""
-    data = json.loads(json.dumps(_plain(value), default=str, allow_nan=True))
+    data = json.loads(json.dumps(_plain(value, carried=not keep_all), default=str, allow_nan=True))
     if not keep_all:
         data = _strip(data, VOLATILE | volatile)
     text = json.dumps(data)
@@ -113,15 +116,22 @@ def comparable(value: Any, *roots: Path, volatile: frozenset[str] = frozenset(),
     return json.loads(text)
 
 
-def _plain(value: Any) -> Any:
+def _plain(value: Any, carried: bool = True) -> Any:
+    """``value`` as lists, dicts and scalars; a result as its file, with (``carried``) what travels
+    with it beside the file (its fields marked ``NOT_IN_FILE``: a test's curve) under ``~name``."""
     if hasattr(value, "to_dict"):
-        return _plain(value.to_dict())
+        out = _plain(value.to_dict(), carried)
+        if carried and dataclasses.is_dataclass(value):
+            for f in dataclasses.fields(value):
+                if f.metadata.get("in_file", True) is False:
+                    out[f"~{f.name}"] = _plain(getattr(value, f.name), carried)
+        return out
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return {f.name: _plain(getattr(value, f.name)) for f in dataclasses.fields(value)}
+        return {f.name: _plain(getattr(value, f.name), carried) for f in dataclasses.fields(value)}
     if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
+        return {str(k): _plain(v, carried) for k, v in value.items()}
     if isinstance(value, list | tuple):
-        return [_plain(v) for v in value]
+        return [_plain(v, carried) for v in value]
     if isinstance(value, np.ndarray):
         return value.tolist()
     if isinstance(value, np.generic):
@@ -142,17 +152,14 @@ def differences(a: Any, b: Any, where: str = "") -> list[str]:
             out += differences(a[k], b[k], f"{where}.{k}")
         return out
     if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
-        return [d for i, (x, y) in enumerate(zip(a, b, strict=True)) for d in differences(x, y, f"{where}[{i}]")]
+        pairs = enumerate(zip(a, b, strict=True))
+        return [d for i, (x, y) in pairs for d in differences(x, y, f"{where}[{i}]")]
     return [] if a == b else [f"{where}: {str(a)[:80]} != {str(b)[:80]}"]
 
 
 def _strip(data: Any, volatile: set[str] | frozenset[str]) -> Any:
     if isinstance(data, dict):
-        return {
-            k: _strip(v, volatile)
-            for k, v in data.items()
-            if k not in volatile and not _duration(k)
-        }
+        return {k: _strip(v, volatile) for k, v in data.items() if k not in volatile and not _duration(k)}
     if isinstance(data, list):
         return [_strip(v, volatile) for v in data]
     return data

@@ -36,14 +36,16 @@ class Context:
 class Protocol:
     """One protocol as the battery drives it.
 
-    ``run(ctx, store)``: the case run into ``store`` (a :class:`Store`, or None where
-    ``keeps_nothing`` says the protocol takes one); ``result_file``: where the result is kept,
-    relative to the store; ``read(ctx, store, like)``: the result read back from its file, None when
-    the store holds none (default: ``like``'s class read from ``result_file``); ``bad(ctx, store)``: a call with one bad input,
-    whose :class:`~poro2d.errors.InputError` must name ``parameter``; ``jobs(ctx, store)``: a call
-    that hands the protocol's jobs to the executor (default: the reference run's own);
+    ``run(ctx, store)``: the case run into ``store`` (a :class:`Store`, or None unless ``skip``
+    names ``store_none``); ``result_file``: where the result is kept, relative to the store;
+    ``read(ctx, store, like)``: the result read back from its file, None when the store holds
+    none (default: ``like``'s class read from ``result_file``); ``bad(ctx, store)``: a call with
+    one bad input, whose :class:`~poro2d.errors.InputError` must name ``parameter``;
+    ``jobs(ctx, store)``: a call that hands the protocol's jobs to the executor (default: the
+    reference run's own);
     ``volatile``: keys of its result that say how a run went, not what it found (left out when
-    two runs are compared); ``skip``: check name -> why it does not apply.
+    two runs are compared); ``skip``: check name -> why it does not apply; ``setup(monkeypatch)``:
+    what its runs change to stay small.
     """
 
     name: str
@@ -55,6 +57,7 @@ class Protocol:
     jobs: Callable[[Context, Store], Any] | None = None
     volatile: frozenset[str] = frozenset()
     skip: dict[str, str] = field(default_factory=dict)
+    setup: Callable[[Any], None] | None = None
 
     def __str__(self) -> str:
         return self.name
@@ -85,7 +88,8 @@ def _criterion_jobs(ctx: Context, store: Store):
     from poro2d.specimen.compaction import SpecimenSpec
 
     settings = CriterionSettings(force_fraction=0.05)
-    return run_replicates(SpecimenSpec(**SMALL_BOX), paper_grading(), settings, 0.21, [1, 2], store, options=QUIET)
+    spec = SpecimenSpec(**SMALL_BOX)
+    return run_replicates(spec, paper_grading(), settings, 0.21, [1, 2], store, options=QUIET)
 
 
 def _criterion_bad(ctx: Context, store: Store):
@@ -161,6 +165,13 @@ def _sand(ctx: Context, store: Store | None):
     return run_sand(SAND, store=store, options=QUIET, use_cache=False)
 
 
+def _sand_setup(monkeypatch) -> None:
+    """The pre-flight's jamming reference on 200 disks (as tests/sand do): seconds, not a minute."""
+    from poro2d.sand import preflight
+
+    monkeypatch.setattr(preflight, "JAMMING_DISKS", 200)
+
+
 def _sand_bad(ctx: Context, store: Store):
     from poro2d.sand import run_sand
 
@@ -214,24 +225,30 @@ def _calibration_unit_bad(ctx: Context, store: Store):
     return _unit(ctx, particle_friction=-0.5)
 
 
+# fmt: off
+#: the battery's table: one row per protocol
 PROTOCOLS = [
     Protocol("criterion", _criterion, "result.json", _criterion_bad, "n_lab", jobs=_criterion_jobs),
     Protocol(
-        "shear", _shear, "result.json", _shear_bad, "normal stress",
+        "shear", _shear, "result.json", _shear_bad, "normal stress (kPa)",
         skip={"store_none": "run_shear takes a store: a series' tests resume from their folders"},
-    ),  # fmt: skip
+    ),
     Protocol("biaxial", _biaxial, "result.json", _biaxial_bad, "replicates"),
-    Protocol("critical_state", _critical_state, "result.json", _critical_state_bad, "seeds"),
     Protocol(
-        "sand", _sand, "sand.json", _sand_bad, "lab.n",
+        "critical_state", _critical_state, "result.json", _critical_state_bad, "seeds",
+        skip={"reads_back": "run_critical_states keeps its files at the end only: a rerun runs every seed"},
+    ),
+    Protocol(
+        "sand", _sand, "sand.json", _sand_bad, "lab.n", setup=_sand_setup,
         skip={"store_none": "run_sand takes a store: its answer is the specimens it keeps there"},
-    ),  # fmt: skip
+    ),
     Protocol(
         "relation", _relation, "relation.json", _relation_bad, "points",
-        volatile=frozenset({"sweep_summary"}),
-    ),  # fmt: skip
+        volatile=frozenset({"ran", "reused", "worker_processes", "parallel_efficiency"}),
+    ),
     Protocol(
-        "calibration_unit", _calibration_unit, "<key>/result.json", _calibration_unit_bad, "particle_friction",
-        read=_calibration_unit_read,
-    ),  # fmt: skip
+        "calibration_unit", _calibration_unit, "<key>/result.json", _calibration_unit_bad,
+        "particle_friction", read=_calibration_unit_read,
+    ),
 ]
+# fmt: on
