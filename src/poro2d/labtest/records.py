@@ -5,7 +5,7 @@ biaxial test. Each holds the keys every box test writes and, after them in the f
 those of one kind of test, written only when set (a biaxial file has no split box; a shear file
 no side walls): one class reads and writes both tests' files as they were written before.
 :class:`TestSummary` is the base of a test's line in its study's ``result.json``, made from the
-test's result by name (:meth:`TestSummary.of`).
+test's result by name (:class:`ByName`, as a test's result is made from the reading of its curve).
 """
 
 from __future__ import annotations
@@ -91,17 +91,26 @@ class ConsolidationRecord(TypedResult):
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {"box": BoxRecord, "engine": EngineSummary}
 
 
+class ByName:
+    """Mixin of a typed result made from another value by name (:meth:`of`): a test's line from the
+    test's result, a test's result from what its curve says."""
+
+    @classmethod
+    def of(cls, source: Any, **given: Any) -> Self:
+        """Each field ``given``, the others read off ``source`` by name (those it lacks left at their
+        defaults)."""
+        names = [f.name for f in fields(cls) if f.name != "extra"]  # type: ignore[arg-type]
+        values = {name: given[name] if name in given else getattr(source, name) for name in names
+                  if name in given or hasattr(source, name)}  # fmt: skip
+        return cls(**values)
+
+
 @dataclass(eq=False)
-class TestSummary(TypedResult):
-    """Base of a test's line in its study's ``result.json``: the test's numbers a study lists."""
+class TestSummary(ByName, TypedResult):
+    """Base of a test's line in its study's ``result.json``: the test's numbers a study lists, read off
+    the test's result by name (:meth:`ByName.of`)."""
 
     __test__ = False  # not a test class, whatever its name
 
-    @classmethod
-    def of(cls, result: TypedResult, **given: Any) -> Self:
-        """The line of the test ``result``: each field ``given``, the others read off ``result`` by name."""
-        names = (f.name for f in fields(cls) if f.name != "extra")
-        return cls(**{name: given[name] if name in given else getattr(result, name) for name in names})
 
-
-__all__ = ["BoxRecord", "ConsolidationRecord", "TestSummary"]
+__all__ = ["BoxRecord", "ByName", "ConsolidationRecord", "TestSummary"]
