@@ -23,7 +23,7 @@ def test_a_valid_curve_is_read_with_or_without_a_byte_order_mark(tmp_path):
     for bom in (False, True):
         lab = read_lab_curve(_write(tmp_path, HEAD + GOOD, bom))
         assert np.array_equal(lab.axial_strain, [0, 0.01, 0.02, 0.05, 0.1])
-        assert lab.peak_friction_angle_deg() == pytest.approx(math.degrees(math.asin(0.45)))
+        assert lab.peak_friction_angle_deg == pytest.approx(math.degrees(math.asin(0.45)))
 
 
 def test_the_peak_bound_is_the_direct_shear_files_friction_angle():

@@ -148,16 +148,6 @@ class StressSummary(TypedResult):
 
 
 @dataclass(eq=False)
-class LabCurveRecord(TypedResult):
-    """Laboratory curves given with the test (the user's own data): where they came from and what they say."""
-
-    source: str
-    rows: int
-    peak_friction_angle_deg: float | None
-    end_friction_angle_deg: float | None
-
-
-@dataclass(eq=False)
 class Definitions(TypedResult):
     """How each number is read (the text of docs/biaxial.md, kept with the numbers)."""
 
@@ -196,6 +186,6 @@ ENVELOPE_DEFINITION = (
 
 __all__ = [
     "DEFINITIONS", "ELASTIC_SPREADS", "ENVELOPE_DEFINITION", "AngleSpread", "BiaxialTestSummary",
-    "Definitions", "ElasticProbe", "LabCurveRecord", "ShearChecks",
+    "Definitions", "ElasticProbe", "ShearChecks",
     "StiffnessScale", "StressSummary", "spread_of",
 ]  # fmt: skip
