@@ -8,10 +8,10 @@ from typing import Any, ClassVar
 
 from poro2d.dem.summary import EngineSummary
 from poro2d.io_utils import Provenance
-from poro2d.labtest.records import ConsolidationRecord
+from poro2d.labtest.records import ByName, ConsolidationRecord
 from poro2d.shear.box_dominated import box_verdict
 from poro2d.shear.box_scale import BoxScale
-from poro2d.shear.curve import ShearCurve, read_curve
+from poro2d.shear.curve import CurveSummary, ShearCurve, read_curve
 from poro2d.shear.parts import (
     EndValues,
     FitInterval,
@@ -32,32 +32,17 @@ from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
 @dataclass(eq=False)
-class ShearTestResult(TypedResult):
+class ShearTestResult(ByName, CurveSummary):
     """One test (a test folder's ``result.json``): what its curve says, and how it was obtained.
 
-    The first fields are read off the curve (:func:`poro2d.shear.curve.curve_summary`):
-    the smoothed peak and where it lies, the end values (``end``: smoothed over one peak
-    window), the servo's stress error, the inertial number and the force balance. Stresses
-    in kPa, lengths in m unless the name says mm. ``curve`` (not in the file): the recorded
-    curve (:class:`~poro2d.shear.curve.ShearCurve`; None when the test is not at hand).
+    The first fields are read off the curve (:class:`~poro2d.shear.curve.CurveSummary`, by
+    :func:`poro2d.shear.curve.curve_summary`): the smoothed peak and where it lies, the end values
+    (``end``: smoothed over one peak window), the servo's stress error, the inertial number and
+    the force balance. Stresses in kPa, lengths in m unless the name says mm. ``curve`` (not in
+    the file): the recorded curve (:class:`~poro2d.shear.curve.ShearCurve`; None when the test is
+    not at hand).
     """
 
-    normal_stress_kpa: float
-    peak_shear_stress_kpa: float
-    shear_displacement_at_peak_m: float
-    peak_stress_ratio: float
-    peak_shear_stress_raw_kpa: float
-    peak_window_m: float
-    normal_stress_at_peak_kpa: float
-    plate_displacement_at_peak_mm: float
-    end: EndValues
-    end_shear_displacement_m: float
-    ended_by: str | None
-    max_inertial_number: float | None
-    inertial_number_ok: bool
-    normal_stress_max_error_after_consolidation: float
-    normal_stress_mean_error: float
-    force_balance: ForceBalance
     inertial_number_at_target_stress: float
     consolidation: ConsolidationRecord
     velocity_m_per_s: float
