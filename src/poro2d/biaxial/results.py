@@ -21,12 +21,13 @@ from poro2d.biaxial.parts import (
 )
 from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.io_utils import Provenance
-from poro2d.labtest.records import ByName, ConsolidationRecord
+from poro2d.labtest.records import ByName, ConsolidationRecord, typed_parts
 from poro2d.measure.spread import Spread
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
+@typed_parts
 @dataclass(eq=False)
 class BiaxialTestResult(ByName, Angles):
     """One biaxial test (a replicate folder's ``result.json``): its angles (its first keys, those of
@@ -66,14 +67,6 @@ class BiaxialTestResult(ByName, Angles):
     plastic_end_volumetric_strain: float | None = None
     curve: BiaxialCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "checks": ShearChecks,
-        "consolidation": ConsolidationRecord,
-        "provenance": Provenance,
-        "settings": BiaxialSettings,
-        "stiffness_scale": StiffnessScale,
-        "elastic_probe": ElasticProbe,
-    }
     #: written since the elastic strain was told apart (a test of before has none of them; a test
     #: without its probe no plastic ones; ``stiffness_scale`` only with ``stiffness_number``)
     OPTIONAL: ClassVar[tuple[str, ...]] = (
@@ -93,6 +86,7 @@ class BiaxialTestResult(ByName, Angles):
         return result
 
 
+@typed_parts
 @dataclass(eq=False)
 class BiaxialResult(TypedResult):
     """Biaxial tests at one confining stress on replicate specimens (the study's ``result.json``).
@@ -129,20 +123,6 @@ class BiaxialResult(TypedResult):
         default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
 
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "peak_friction_angle": AngleSpread,
-        "critical_state_friction_angle": AngleSpread,
-        "max_dilatancy_angle": AngleSpread,
-        "axial_strain_at_peak": AngleSpread,
-        "summaries": BiaxialTestSummary,
-        "definitions": Definitions,
-        "provenance": Provenance,
-        "lab": LabCurve,
-        "plastic_max_dilatancy_angle": AngleSpread,
-        "stiffness_number": Spread,
-        "mean_overlap_ratio_at_peak": Spread,
-    }
-
     def headline(self) -> str:
         """The number to take away, one line: peak and critical-state angles with their spread."""
         n = self.replicates
@@ -154,6 +134,7 @@ class BiaxialResult(TypedResult):
         )
 
 
+@typed_parts
 @dataclass(eq=False)
 class BiaxialSeriesResult(TypedResult):
     """Biaxial tests at several confining stresses on replicate specimens (the series' ``result.json``).
@@ -193,20 +174,6 @@ class BiaxialSeriesResult(TypedResult):
     lab: LabCurve | None = None
     plastic_max_dilatancy_angle: AngleSpread | None = None
     studies: list[BiaxialResult] = field(default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE)
-
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "stresses": StressSummary,
-        "peak_friction_angle": AngleSpread,
-        "critical_state_friction_angle": AngleSpread,
-        "max_dilatancy_angle": AngleSpread,
-        "envelope": EnvelopeRecord,
-        "envelope_through_origin": EnvelopeRecord,
-        "definitions": Definitions,
-        "settings": BiaxialSettings,
-        "provenance": Provenance,
-        "lab": LabCurve,
-        "plastic_max_dilatancy_angle": AngleSpread,
-    }
 
     def headline(self) -> str:
         """The number to take away, one line: the angles pooled over every test, then the envelope."""

@@ -9,11 +9,12 @@ from poro2d.critical_state.case import CriticalStateCase
 from poro2d.critical_state.series import CellSeries
 from poro2d.critical_state.steady import SteadyState
 from poro2d.io_utils import Provenance
-from poro2d.labtest.records import ByName, TestSummary
+from poro2d.labtest.records import ByName, TestSummary, typed_parts
 from poro2d.measure.spread import Spread
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
+@typed_parts
 @dataclass(eq=False)
 class CriticalStateTestResult(ByName, SteadyState):
     """One periodic shear run: its steady state over the window (its first keys, those of
@@ -46,7 +47,6 @@ class CriticalStateTestResult(ByName, SteadyState):
     mean_overlap_ratio: float | None = None
     series: CellSeries | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"case": CriticalStateCase, "provenance": Provenance}
     OPTIONAL: ClassVar[tuple[str, ...]] = ("stiffness_number", "mean_overlap_ratio")
 
     @property
@@ -84,6 +84,7 @@ class SeedSummary(TestSummary):
     OPTIONAL: ClassVar[tuple[str, ...]] = ("stiffness_number", "mean_overlap_ratio")
 
 
+@typed_parts
 @dataclass(eq=False)
 class CriticalStateResult(TypedResult):
     """Periodic shear runs of one case on several seeds (the study's ``result.json``).
@@ -115,18 +116,6 @@ class CriticalStateResult(TypedResult):
         default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
 
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "stress_ratio": Spread,
-        "friction_angle_deg": Spread,
-        "solid_fraction": Spread,
-        "inertial_number": Spread,
-        "coordination": Spread,
-        "summaries": SeedSummary,
-        "case": CriticalStateCase,
-        "provenance": Provenance,
-        "void_ratio": Spread,
-        "mean_overlap_ratio": Spread,
-    }
     OPTIONAL: ClassVar[tuple[str, ...]] = ("void_ratio", "stiffness_number", "mean_overlap_ratio")
 
     def headline(self) -> str:

@@ -10,11 +10,40 @@ test's result by name (:class:`ByName`, as a test's result is made from the read
 
 from __future__ import annotations
 
+import types
+import typing
 from dataclasses import dataclass, fields
-from typing import Any, ClassVar, Self
+from typing import Any, ClassVar, Self, TypeVar
 
 from poro2d.dem.summary import EngineSummary
+from poro2d.record import Record
 from poro2d.typed_result import TypedResult
+
+T = TypeVar("T", bound=type)
+
+
+def _part_kind(hint: Any) -> type | None:
+    """The part class of a field typed ``hint``: a result or record class, alone, optional or in a
+    list (None: not a part)."""
+    if typing.get_origin(hint) in (typing.Union, types.UnionType):
+        kinds = [a for a in typing.get_args(hint) if a is not type(None)]
+        hint = kinds[0] if len(kinds) == 1 else None
+    if typing.get_origin(hint) is list:
+        hint = typing.get_args(hint)[0]
+    return hint if isinstance(hint, type) and issubclass(hint, TypedResult | Record) else None
+
+
+def typed_parts(cls: T) -> T:
+    """Class decorator of a typed result (above its ``@dataclass``): its ``PARTS`` read off its
+    fields' types, so that the file's keys and their classes are declared once, as fields.
+
+    Every field of the file typed as a result or a record class (or an optional one, or a list of
+    them) is a part read back as that class.
+    """
+    hints = typing.get_type_hints(cls)
+    kinds = {f.name: _part_kind(hints[f.name]) for f in fields(cls) if f.metadata.get("in_file", True)}
+    cls.PARTS = {name: kind for name, kind in kinds.items() if kind is not None and name != "extra"}
+    return cls
 
 
 @dataclass(eq=False, kw_only=True)
@@ -46,6 +75,7 @@ BIAXIAL_KEYS = (
 )  # fmt: skip
 
 
+@typed_parts
 @dataclass(eq=False, kw_only=True)
 class ConsolidationRecord(TypedResult):
     """How a test's consolidation ended (a shear test's ``consolidation.json``, a ``consolidation`` of
@@ -88,7 +118,6 @@ class ConsolidationRecord(TypedResult):
     OPTIONAL: ClassVar[tuple[str, ...]] = (
         *SPLIT_BOX_KEYS, *BIAXIAL_KEYS, "contact_kn", "stiffness_number", "mean_overlap_ratio",
     )  # fmt: skip
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"box": BoxRecord, "engine": EngineSummary}
 
 
 class ByName:
@@ -113,4 +142,4 @@ class TestSummary(ByName, TypedResult):
     __test__ = False  # not a test class, whatever its name
 
 
-__all__ = ["BoxRecord", "ByName", "ConsolidationRecord", "TestSummary"]
+__all__ = ["BoxRecord", "ByName", "ConsolidationRecord", "TestSummary", "typed_parts"]

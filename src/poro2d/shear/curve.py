@@ -18,6 +18,7 @@ import numpy as np
 from poro2d.dem import Simulation
 from poro2d.dem.contacts import ContactSet
 from poro2d.labtest.curve import ColumnCurve, CurveRow
+from poro2d.labtest.records import typed_parts
 from poro2d.shear.box import UPPER_SIDE_WALLS, SplitBox
 from poro2d.shear.fit import peak, smooth
 from poro2d.shear.parts import EndValues, ForceBalance
@@ -212,6 +213,7 @@ def ended_by(x: np.ndarray, x_peak: float, s: ShearSettings) -> str:
     return "max_displacement"
 
 
+@typed_parts
 @dataclass(eq=False)
 class CurveSummary(TypedResult):
     """What a test's curve says: the first keys of its ``result.json``, in their order
@@ -234,8 +236,6 @@ class CurveSummary(TypedResult):
     normal_stress_max_error_after_consolidation: float
     normal_stress_mean_error: float
     force_balance: ForceBalance
-
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"end": EndValues, "force_balance": ForceBalance}
 
 
 def _columns(rows: list[ShearRow]) -> tuple[np.ndarray, dict[str, np.ndarray]]:

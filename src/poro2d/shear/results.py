@@ -8,15 +8,13 @@ from typing import Any, ClassVar
 
 from poro2d.dem.summary import EngineSummary
 from poro2d.io_utils import Provenance
-from poro2d.labtest.records import ByName, ConsolidationRecord
+from poro2d.labtest.records import ByName, ConsolidationRecord, typed_parts
 from poro2d.shear.box_dominated import box_verdict
 from poro2d.shear.box_scale import BoxScale
 from poro2d.shear.curve import CurveSummary, ShearCurve, read_curve
 from poro2d.shear.parts import (
-    EndValues,
     FitInterval,
     FitRecord,
-    ForceBalance,
     LabComparison,
     QuasiStatic,
     RateCheck,
@@ -31,6 +29,7 @@ from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
+@typed_parts
 @dataclass(eq=False)
 class ShearTestResult(ByName, CurveSummary):
     """One test (a test folder's ``result.json``): what its curve says, and how it was obtained.
@@ -78,15 +77,6 @@ class ShearTestResult(ByName, CurveSummary):
         "plane_load_fraction_at_peak", "residual_dilation_stopped", "box_dominated", "box_note",
         "stiffness_number", "mean_overlap_ratio_at_peak",
     )  # fmt: skip
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "end": EndValues,
-        "force_balance": ForceBalance,
-        "residual_dilation_stopped": ResidualAtRest,
-        "consolidation": ConsolidationRecord,
-        "settings": ShearSettings,
-        "engine": EngineSummary,
-        "provenance": Provenance,
-    }
 
     @classmethod
     def read(cls, store: Store, data: dict[str, Any] | None = None) -> ShearTestResult:
@@ -107,6 +97,7 @@ class ShearTestResult(ByName, CurveSummary):
         return result
 
 
+@typed_parts
 @dataclass(eq=False)
 class ShearSeriesResult(TypedResult):
     """Tests at several normal stresses on one specimen (a series' ``result.json``), with the fit.
@@ -151,19 +142,8 @@ class ShearSeriesResult(TypedResult):
         default_factory=dict, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
 
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "tests": ShearTestSummary,
-        "fit": FitRecord,
-        "fit_through_origin": FitRecord,
-        "quasi_static": QuasiStatic,
-        "rate_check": RateCheck,
-        "lab": LabComparison,
-        "box_scale": BoxScale,
-        "settings": ShearSettings,
-        "provenance": Provenance,
-    }
 
-
+@typed_parts
 @dataclass(eq=False)
 class ReplicateShearResult(TypedResult):
     """The same tests on several specimens (``replicates.json``): peaks over specimens, pooled fits.
@@ -193,14 +173,9 @@ class ReplicateShearResult(TypedResult):
     series: dict[str, ShearSeriesResult] = field(default_factory=dict, kw_only=True, metadata=NOT_IN_FILE)
 
     OPTIONAL: ClassVar[tuple[str, ...]] = ("box_dominated_tests",)
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "per_normal_stress": StressPeaks,
-        "fit": FitInterval,
-        "fit_through_origin": FitInterval,
-        "provenance": Provenance,
-    }
 
 
+@typed_parts
 @dataclass(eq=False)
 class StrengthResult(TypedResult):
     """Strength against rolling and particle friction (a strength study's ``strength.json``).
@@ -224,13 +199,6 @@ class StrengthResult(TypedResult):
     box_scale: BoxScale | None = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = ("box_scale",)
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "box_scale": BoxScale,
-        "cases": StrengthCase,
-        "definitions": StrengthDefinitions,
-        "settings": ShearSettings,
-        "provenance": Provenance,
-    }
 
 
 __all__ = ["ReplicateShearResult", "ShearSeriesResult", "ShearTestResult", "StrengthResult"]
