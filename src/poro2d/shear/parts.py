@@ -102,6 +102,15 @@ class ResidualAtRest(TypedResult):
     end_rate: float | None
 
 
+#: the keys a test's ``result.json`` and its line in a series have had since a later poro2d (a test of
+#: before lacks them): the plane's share of the load, the residual where dilation stopped, the box
+#: verdict, the stiffness number and overlap
+LATER_KEYS = (
+    "plane_load_fraction_at_peak", "residual_dilation_stopped", "box_dominated", "box_note",
+    "stiffness_number", "mean_overlap_ratio_at_peak",
+)  # fmt: skip
+
+
 @typed_parts
 @dataclass(eq=False)
 class ShearTestSummary(TestSummary):
@@ -131,10 +140,7 @@ class ShearTestSummary(TestSummary):
     stiffness_number: float | None = None
     mean_overlap_ratio_at_peak: float | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = (
-        "plane_load_fraction_at_peak", "residual_dilation_stopped", "box_dominated", "box_note",
-        "stiffness_number", "mean_overlap_ratio_at_peak",
-    )  # fmt: skip
+    OPTIONAL: ClassVar[tuple[str, ...]] = LATER_KEYS
 
 
 @dataclass(eq=False)
@@ -277,7 +283,7 @@ class StrengthCase(TypedResult):
 
 
 __all__ = [
-    "EndValues", "FitInterval", "FitRecord", "ForceBalance",
+    "LATER_KEYS", "EndValues", "FitInterval", "FitRecord", "ForceBalance",
     "LabComparison", "LabPeak", "LabRecord", "QuasiStatic", "RateCheck", "RateCheckRow",
     "ResidualAtRest", "StrengthCase", "StrengthDefinitions", "StressPeaks",
     "ShearTestSummary", "part", "parts",

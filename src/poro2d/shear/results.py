@@ -13,6 +13,7 @@ from poro2d.shear.box_dominated import box_verdict
 from poro2d.shear.box_scale import BoxScale
 from poro2d.shear.curve import CurveSummary, ShearCurve, read_curve
 from poro2d.shear.parts import (
+    LATER_KEYS,
     FitInterval,
     FitRecord,
     LabComparison,
@@ -73,10 +74,7 @@ class ShearTestResult(ByName, CurveSummary):
     mean_overlap_ratio_at_peak: float | None = None
     curve: ShearCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = (
-        "plane_load_fraction_at_peak", "residual_dilation_stopped", "box_dominated", "box_note",
-        "stiffness_number", "mean_overlap_ratio_at_peak",
-    )  # fmt: skip
+    OPTIONAL: ClassVar[tuple[str, ...]] = LATER_KEYS
 
     @classmethod
     def read(cls, store: Store, data: dict[str, Any] | None = None) -> ShearTestResult:
