@@ -112,7 +112,7 @@ def test_the_critical_state_check_can_say_not_yet(full):
     # cut the curve where the specimen still dilates fast: not a critical state
     k = int(np.searchsorted(c.axial_strain, 0.04))
     early = BiaxialCurve(**{name: c[name][:k] for name in c})
-    a = read_angles(early, 0.01, 0.25, 0.1)
+    a = read_angles(early, 100.0, 0.01, 0.25, 0.1)
     assert not a.critical_state_reached and a.critical_state_note.startswith("not yet at critical state")
     assert a.end_dilatancy_rate < -0.1
 

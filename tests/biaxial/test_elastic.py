@@ -44,7 +44,7 @@ def test_plastic_strain_is_the_total_less_the_elastic_strain_change():
     ev, es = plastic_strains(curve)
     assert np.allclose(ev, e1p + e3p, atol=1e-15) and np.allclose(es, e1p - e3p, atol=1e-15)
     # the elastic strain given back in softening reads as dilation in the total strains only
-    total = read_angles(curve, 0.01, 0.25, 0.1)
+    total = read_angles(curve, 100.0, 0.01, 0.25, 0.1)
     plastic = read_plastic(curve.with_plastic(ev, es), 0.01, 0.25)
     assert total.max_dilatancy_angle_deg > 1.0 and total.axial_strain_at_max_dilatancy > 0.05
     assert abs(plastic.plastic_max_dilatancy_angle_deg) < 1e-6

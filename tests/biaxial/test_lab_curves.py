@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from poro2d.biaxial.lab import MAX_SIN_PHI, read_lab_curve
+from poro2d.biaxial.lab import MAX_SIN_PHI, LabCurve, read_lab_curve
 from poro2d.errors import InputError
 
 HEAD = "axial_strain,stress_ratio,volumetric_strain\n"
@@ -23,7 +23,14 @@ def test_a_valid_curve_is_read_with_or_without_a_byte_order_mark(tmp_path):
     for bom in (False, True):
         lab = read_lab_curve(_write(tmp_path, HEAD + GOOD, bom))
         assert np.array_equal(lab.axial_strain, [0, 0.01, 0.02, 0.05, 0.1])
-        assert lab.peak_friction_angle_deg() == pytest.approx(math.degrees(math.asin(0.45)))
+        assert lab.peak_friction_angle_deg == pytest.approx(math.degrees(math.asin(0.45)))
+    # a study's file keeps the curve as its source, rows and angles; read back, it has no arrays
+    kept = lab.to_dict()
+    assert list(kept) == ["source", "rows", "peak_friction_angle_deg", "end_friction_angle_deg"]
+    assert kept["rows"] == 5
+    assert kept["end_friction_angle_deg"] == pytest.approx(math.degrees(math.asin(0.35)))
+    back = LabCurve.from_dict(kept)
+    assert back == lab and back.axial_strain is None and back.to_dict() == kept
 
 
 def test_the_peak_bound_is_the_direct_shear_files_friction_angle():

@@ -47,6 +47,18 @@ def series_of(gamma, mu, phi) -> CellSeries:
     )
 
 
+def test_the_case_is_its_own_file_record():
+    """Every field in order, the grading as its sizes, percent passing and source, stiffness_number
+    only when set; read back, the grading is a curve again and the case writes the same keys."""
+    case = CriticalStateCase(**SMALL)
+    kept = case.to_dict()
+    assert list(kept)[:3] == ["grading", "disks", "particle_friction"] and "stiffness_number" not in kept
+    assert list(kept["grading"]) == ["sizes_m", "percent_passing", "source"]
+    back = CriticalStateCase.from_dict(json.loads(json.dumps(kept)))
+    assert back.grading.sizes_m == case.grading.sizes_m and back.to_dict() == kept
+    assert CriticalStateCase(**SMALL, stiffness_number=100.0).to_dict()["stiffness_number"] == 100.0
+
+
 def test_a_flat_noisy_window_is_steady_and_its_error_is_the_blocks_spread():
     rng = np.random.default_rng(0)
     g = np.linspace(0.01, 3.0, 300)

@@ -1,5 +1,6 @@
 """The laboratory-test kit: settings that are their files' table, one box and consolidation record
-for both box tests, a test's line made from its result, a curve of named columns."""
+for both box tests, a test's line made from its result, a curve of named columns, the one settle
+loop and a result's parts read off its fields."""
 
 import math
 from dataclasses import dataclass
@@ -11,8 +12,10 @@ import pytest
 from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.errors import InputError
 from poro2d.labtest.curve import ColumnCurve, CurveRow
-from poro2d.labtest.records import BoxRecord, ConsolidationRecord, TestSummary
+from poro2d.labtest.records import BoxRecord, ByName, ConsolidationRecord, TestSummary, typed_parts
+from poro2d.labtest.settle import AtEquilibrium, Settled, settle, settle_until
 from poro2d.shear.settings import ShearSettings
+from poro2d.typed_result import TypedResult
 
 
 def test_settings_read_back_keep_the_keys_their_file_had():
@@ -97,3 +100,63 @@ def test_a_column_curve_reads_rows_as_its_file_holds_them():
     assert list(recorded) == ["x", "y", "late"] and np.isnan(recorded.y[1]) and np.isnan(recorded.late).all()
     with pytest.raises(KeyError):
         Curve.of_rows([{"x": 1}])
+
+
+class Clock:
+    """A stand-in simulation for the settle loop: steps a counter, asks the callback every block."""
+
+    def __init__(self, step_count=0):
+        self.step_count = step_count
+        self.ratio = 1.0
+
+    def run(self, steps, *, every, callback, progress=False):
+        start = self.step_count
+        while self.step_count - start < steps:
+            self.step_count += min(every, steps - (self.step_count - start))
+            self.ratio /= 2.0
+            if callback(self):
+                break
+        return type("Ran", (), {"steps": self.step_count - start})()
+
+    def unbalanced_ratios(self):
+        return (self.ratio,)
+
+    def reset_clock(self):
+        self.step_count = 0
+
+
+def test_one_settle_loop_runs_until_its_stop_rule_says_settled():
+    """settle_until counts its own steps and tells progress its share; AtEquilibrium, the box tests'
+    rule, renews the servos while it has not settled and keeps the last ratio and error."""
+    sim, seen = Clock(step_count=1000), []
+    steps = settle_until(sim, lambda sm: sm.step_count >= 1300, 1000, every=100,
+                         progress=lambda phase, f: seen.append((phase, f)), phase="probing")  # fmt: skip
+    assert steps == 300 and seen == [("probing", 0.1), ("probing", 0.2), ("probing", 0.3)]
+    renewed = []
+    end = settle(Clock(step_count=7), lambda sm: 0.0, ratio_limit=0.1, tolerance=0.01, max_steps=10_000,
+                 every=100, renew=renewed.append)  # fmt: skip
+    assert end == Settled(400, 0.0625, 0.0, True) and len(renewed) == 3
+    never = AtEquilibrium(lambda sm: 1.0, ratio_limit=0.1, tolerance=0.01)
+    assert settle_until(Clock(), never, 250, every=100) == 250 and not never.reached
+
+
+def test_a_results_parts_are_its_fields_types_and_it_is_made_from_its_reading_by_name():
+    @typed_parts
+    @dataclass(eq=False)
+    class Reading(TypedResult):
+        peak: float
+        box: BoxRecord
+
+    @typed_parts
+    @dataclass(eq=False)
+    class Result(ByName, Reading):
+        boxes: list[BoxRecord]
+        consolidation: ConsolidationRecord | None = None
+        label: str = ""
+
+    assert Result.PARTS == {"box": BoxRecord, "boxes": BoxRecord, "consolidation": ConsolidationRecord}
+    box = BoxRecord(width=0.05, height=0.1, thickness=0.008)
+    made = Result.of(Reading(31.0, box), boxes=[box])
+    assert list(made.to_dict()) == ["peak", "box", "boxes", "consolidation", "label"]
+    back = Result.from_dict(made.to_dict())
+    assert back == made and isinstance(back.box, BoxRecord) and isinstance(back.boxes[0], BoxRecord)

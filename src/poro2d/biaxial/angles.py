@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from poro2d.biaxial.curve import BiaxialCurve
+from poro2d.typed_result import TypedResult
 
 
 def smoothed(x: np.ndarray, y: np.ndarray, window: float) -> np.ndarray:
@@ -43,10 +44,12 @@ def _asin_deg(s: float) -> float:
     return math.degrees(math.asin(min(1.0, max(-1.0, s))))
 
 
-@dataclass(frozen=True)
-class Angles:
-    """The angles of one curve (degrees; strains as fractions)."""
+@dataclass(eq=False)
+class Angles(TypedResult):
+    """The angles of one curve at its confining stress (degrees; strains as fractions; kPa): the
+    first keys of a test's ``result.json`` (:class:`~poro2d.biaxial.results.BiaxialTestResult`)."""
 
+    confining_stress_kpa: float
     peak_friction_angle_deg: float
     peak_sin_phi: float
     axial_strain_at_peak: float
@@ -65,9 +68,10 @@ class Angles:
 
 
 def read_angles(
-    curve: BiaxialCurve, smoothing_strain: float, critical_window: float, rate_limit: float
-) -> Angles:
-    """The angles of ``curve`` (see the module's definitions)."""
+    curve: BiaxialCurve, confining_kpa: float, smoothing_strain: float, critical_window: float,
+    rate_limit: float,
+) -> Angles:  # fmt: skip
+    """The angles of ``curve``, sheared at ``confining_kpa`` (see the module's definitions)."""
     e1 = curve.axial_strain
     ev = curve.volumetric_strain
     es = curve.shear_strain
@@ -86,6 +90,7 @@ def read_angles(
     )
     psi, at = _max_dilatancy(e1, ev, es, smoothing_strain)
     return Angles(
+        confining_stress_kpa=confining_kpa,
         peak_friction_angle_deg=_asin_deg(float(sin_phi[k])),
         peak_sin_phi=float(sin_phi[k]),
         axial_strain_at_peak=float(e1[k]),

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -39,6 +39,7 @@ from poro2d.lab_table import (
     check_rising,
     read_lab_table,
 )
+from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 #: largest peak (sigma_1 - sigma_3) / (sigma_1 + sigma_3): sin of the direct shear files' largest
 #: friction angle (atan 2.5, 68 degrees), one bound for both kinds of laboratory file
@@ -49,20 +50,29 @@ MAX_PRINCIPAL_RATIO = (1.0 + MAX_SIN_PHI) / (1.0 - MAX_SIN_PHI)
 MAX_STRAIN = 0.5
 
 
-@dataclass(frozen=True)
-class LabCurve:
-    """A laboratory curve: axial strain, stress ratio and (or None) volumetric strain, as arrays."""
+@dataclass(eq=False)
+class LabCurve(TypedResult):
+    """A laboratory curve: axial strain, stress ratio and (or None) volumetric strain, as arrays.
+
+    A biaxial study's file keeps it as its ``lab``: where it came from, its rows and the friction
+    angles of its peak and last ratios, set from the arrays when made from them; a curve read back
+    from that file has no arrays.
+    """
 
     source: str
-    axial_strain: np.ndarray
-    stress_ratio: np.ndarray
-    volumetric_strain: np.ndarray | None
+    axial_strain: np.ndarray | None = field(default=None, metadata=NOT_IN_FILE)
+    stress_ratio: np.ndarray | None = field(default=None, metadata=NOT_IN_FILE)
+    volumetric_strain: np.ndarray | None = field(default=None, metadata=NOT_IN_FILE)
+    rows: int | None = None
+    peak_friction_angle_deg: float | None = None
+    end_friction_angle_deg: float | None = None
 
-    def peak_friction_angle_deg(self) -> float:
-        return math.degrees(math.asin(float(self.stress_ratio.max())))
-
-    def end_friction_angle_deg(self) -> float:
-        return math.degrees(math.asin(float(self.stress_ratio[-1])))
+    def __post_init__(self) -> None:
+        if self.axial_strain is not None and self.rows is None:  # made from its arrays
+            self.rows = int(self.axial_strain.size)
+            self.peak_friction_angle_deg = math.degrees(math.asin(float(self.stress_ratio.max())))
+            self.end_friction_angle_deg = math.degrees(math.asin(float(self.stress_ratio[-1])))
+        super().__post_init__()
 
 
 def read_lab_curve(path: str | os.PathLike) -> LabCurve:

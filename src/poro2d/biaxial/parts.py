@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from poro2d.biaxial.stiffness import STIFFNESS_DEFINITION
-from poro2d.labtest.records import TestSummary
+from poro2d.labtest.records import TestSummary, typed_parts
 from poro2d.measure.spread import Spread
 from poro2d.typed_result import TypedResult
 
@@ -119,6 +119,7 @@ class BiaxialTestSummary(TestSummary):
     )  # fmt: skip
 
 
+@typed_parts
 @dataclass(eq=False)
 class StressSummary(TypedResult):
     """One confining stress of a series: its replicates' spread and where its files are."""
@@ -135,26 +136,7 @@ class StressSummary(TypedResult):
     stiffness_number: Spread | None = None
     mean_overlap_ratio_at_peak: Spread | None = None
 
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "peak_friction_angle": AngleSpread,
-        "critical_state_friction_angle": AngleSpread,
-        "max_dilatancy_angle": AngleSpread,
-        "axial_strain_at_peak": AngleSpread,
-        "plastic_max_dilatancy_angle": AngleSpread,
-        "stiffness_number": Spread,
-        "mean_overlap_ratio_at_peak": Spread,
-    }
     OPTIONAL: ClassVar[tuple[str, ...]] = ELASTIC_SPREADS
-
-
-@dataclass(eq=False)
-class LabCurveRecord(TypedResult):
-    """Laboratory curves given with the test (the user's own data): where they came from and what they say."""
-
-    source: str
-    rows: int
-    peak_friction_angle_deg: float | None
-    end_friction_angle_deg: float | None
 
 
 @dataclass(eq=False)
@@ -196,6 +178,6 @@ ENVELOPE_DEFINITION = (
 
 __all__ = [
     "DEFINITIONS", "ELASTIC_SPREADS", "ENVELOPE_DEFINITION", "AngleSpread", "BiaxialTestSummary",
-    "Definitions", "ElasticProbe", "LabCurveRecord", "ShearChecks",
+    "Definitions", "ElasticProbe", "ShearChecks",
     "StiffnessScale", "StressSummary", "spread_of",
 ]  # fmt: skip

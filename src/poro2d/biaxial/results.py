@@ -5,30 +5,33 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
+from poro2d.biaxial.angles import Angles
 from poro2d.biaxial.curve import BiaxialCurve, read_curve
 from poro2d.biaxial.envelope import EnvelopeRecord
+from poro2d.biaxial.lab import LabCurve
 from poro2d.biaxial.parts import (
     ELASTIC_SPREADS,
     AngleSpread,
     BiaxialTestSummary,
     Definitions,
     ElasticProbe,
-    LabCurveRecord,
     ShearChecks,
     StiffnessScale,
     StressSummary,
 )
 from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.io_utils import Provenance
-from poro2d.labtest.records import ConsolidationRecord
+from poro2d.labtest.records import ByName, ConsolidationRecord, typed_parts
 from poro2d.measure.spread import Spread
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
+@typed_parts
 @dataclass(eq=False)
-class BiaxialTestResult(TypedResult):
-    """One biaxial test (a replicate folder's ``result.json``): its angles and how they were obtained.
+class BiaxialTestResult(ByName, Angles):
+    """One biaxial test (a replicate folder's ``result.json``): its angles (its first keys, those of
+    :class:`~poro2d.biaxial.angles.Angles`) and how they were obtained.
 
     Angles in degrees, strains as fractions (compression positive), stresses in kPa; the
     definitions are :mod:`poro2d.biaxial.angles`'. ``stiffness_number``: kappa = kn / (sigma_3 t)
@@ -39,22 +42,6 @@ class BiaxialTestResult(TypedResult):
     recorded curve (:class:`~poro2d.biaxial.curve.BiaxialCurve`).
     """
 
-    confining_stress_kpa: float
-    peak_friction_angle_deg: float
-    peak_sin_phi: float
-    axial_strain_at_peak: float
-    critical_state_friction_angle_deg: float
-    critical_state_sin_phi: float
-    critical_state_mean_stress_kpa: float
-    critical_window: list[float]
-    end_dilatancy_rate: float
-    end_dilatancy_angle_deg: float
-    critical_state_reached: bool
-    critical_state_note: str
-    max_dilatancy_angle_deg: float
-    axial_strain_at_max_dilatancy: float
-    end_volumetric_strain: float
-    min_volumetric_strain: float
     checks: ShearChecks
     consolidation: ConsolidationRecord
     strain_rate_per_s: float
@@ -80,14 +67,6 @@ class BiaxialTestResult(TypedResult):
     plastic_end_volumetric_strain: float | None = None
     curve: BiaxialCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "checks": ShearChecks,
-        "consolidation": ConsolidationRecord,
-        "provenance": Provenance,
-        "settings": BiaxialSettings,
-        "stiffness_scale": StiffnessScale,
-        "elastic_probe": ElasticProbe,
-    }
     #: written since the elastic strain was told apart (a test of before has none of them; a test
     #: without its probe no plastic ones; ``stiffness_scale`` only with ``stiffness_number``)
     OPTIONAL: ClassVar[tuple[str, ...]] = (
@@ -107,6 +86,7 @@ class BiaxialTestResult(TypedResult):
         return result
 
 
+@typed_parts
 @dataclass(eq=False)
 class BiaxialResult(TypedResult):
     """Biaxial tests at one confining stress on replicate specimens (the study's ``result.json``).
@@ -135,27 +115,13 @@ class BiaxialResult(TypedResult):
     wall_time_s: float
     config: dict[str, Any]
     provenance: Provenance
-    lab: LabCurveRecord | None = None
+    lab: LabCurve | None = None
     plastic_max_dilatancy_angle: AngleSpread | None = None
     stiffness_number: Spread | None = None
     mean_overlap_ratio_at_peak: Spread | None = None
     tests: list[BiaxialTestResult] = field(
         default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
-
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "peak_friction_angle": AngleSpread,
-        "critical_state_friction_angle": AngleSpread,
-        "max_dilatancy_angle": AngleSpread,
-        "axial_strain_at_peak": AngleSpread,
-        "summaries": BiaxialTestSummary,
-        "definitions": Definitions,
-        "provenance": Provenance,
-        "lab": LabCurveRecord,
-        "plastic_max_dilatancy_angle": AngleSpread,
-        "stiffness_number": Spread,
-        "mean_overlap_ratio_at_peak": Spread,
-    }
 
     def headline(self) -> str:
         """The number to take away, one line: peak and critical-state angles with their spread."""
@@ -168,6 +134,7 @@ class BiaxialResult(TypedResult):
         )
 
 
+@typed_parts
 @dataclass(eq=False)
 class BiaxialSeriesResult(TypedResult):
     """Biaxial tests at several confining stresses on replicate specimens (the series' ``result.json``).
@@ -204,23 +171,9 @@ class BiaxialSeriesResult(TypedResult):
     wall_time_s: float
     config: dict[str, Any]
     provenance: Provenance
-    lab: LabCurveRecord | None = None
+    lab: LabCurve | None = None
     plastic_max_dilatancy_angle: AngleSpread | None = None
     studies: list[BiaxialResult] = field(default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE)
-
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "stresses": StressSummary,
-        "peak_friction_angle": AngleSpread,
-        "critical_state_friction_angle": AngleSpread,
-        "max_dilatancy_angle": AngleSpread,
-        "envelope": EnvelopeRecord,
-        "envelope_through_origin": EnvelopeRecord,
-        "definitions": Definitions,
-        "settings": BiaxialSettings,
-        "provenance": Provenance,
-        "lab": LabCurveRecord,
-        "plastic_max_dilatancy_angle": AngleSpread,
-    }
 
     def headline(self) -> str:
         """The number to take away, one line: the angles pooled over every test, then the envelope."""

@@ -20,7 +20,6 @@ from poro2d.biaxial.parts import (
     AngleSpread,
     BiaxialTestSummary,
     Definitions,
-    LabCurveRecord,
     spread_of,
 )
 from poro2d.biaxial.results import BiaxialResult, BiaxialTestResult
@@ -175,10 +174,6 @@ def summarize(cases, tests, lab, workers, wall, config) -> BiaxialResult:
         BiaxialTestSummary.of(t, replicate=k + 1, sigma_3_max_error=t.checks.sigma_3_max_error)
         for k, t in enumerate(tests)
     ]
-    lab_record = None
-    if lab is not None:
-        lab_record = LabCurveRecord(lab.source, int(lab.axial_strain.size), lab.peak_friction_angle_deg(),
-                                    lab.end_friction_angle_deg())  # fmt: skip
     return BiaxialResult(
         confining_stress_kpa=cases[0].confining_kpa, replicates=len(tests),
         peak_friction_angle=AngleSpread.of([t.peak_friction_angle_deg for t in tests]),
@@ -188,7 +183,7 @@ def summarize(cases, tests, lab, workers, wall, config) -> BiaxialResult:
         critical_state_reached=not missed, critical_state_note=note, summaries=summaries,
         definitions=Definitions(**DEFINITIONS), settings=cases[0].settings,
         specimens=[c.specimen.source for c in cases], processes=workers, wall_time_s=wall,
-        config=config or {}, provenance=Provenance.now(), lab=lab_record,
+        config=config or {}, provenance=Provenance.now(), lab=lab,
         plastic_max_dilatancy_angle=spread_of(AngleSpread, [t.plastic_max_dilatancy_angle_deg
                                                             for t in tests]),
         stiffness_number=spread_of(Spread, [t.stiffness_number for t in tests]),

@@ -153,11 +153,10 @@ class BiaxialTest:
         shearing = Shearing(sim, sigma, s, self.strain_rate, self.d50, self.rho, self.progress)
         rows, velocity = shearing.run()
         curve = BiaxialCurve.of_rows(rows)
-        angles = read_angles(curve, s.smoothing_strain, s.critical_window, s.critical_rate_limit)
+        angles = read_angles(curve, sigma, s.smoothing_strain, s.critical_window, s.critical_rate_limit)
         curve, elastic = self.elastic(sim, start, curve, velocity)
-        return BiaxialTestResult(
-            confining_stress_kpa=self.case.confining_kpa, **asdict(angles),
-            checks=self.checks(curve), consolidation=info, strain_rate_per_s=self.strain_rate,
+        return BiaxialTestResult.of(
+            angles, checks=self.checks(curve), consolidation=info, strain_rate_per_s=self.strain_rate,
             plate_velocity_m_per_s=velocity, d50_m=self.d50, dt_s=sim.dt, local_damping=sim.local_damping,
             density_scale=sim.density_scale, shear_steps=int(rows[-1].step), records=len(rows),
             wall_time_s=time.perf_counter() - t0, settings=s, specimen=self.case.specimen.source,

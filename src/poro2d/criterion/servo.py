@@ -6,18 +6,19 @@ any simulation whose top is one of the controllers of :mod:`poro2d.criterion.lid
 paper's :class:`~poro2d.criterion.lid.FlatPlate`, or the fill acceptance's
 :class:`~poro2d.criterion.lid.SegmentedLid`): the criterion's trials use it, and so does
 the check of an imported specimen (:mod:`poro2d.interop.check`), with the same settings
-and so the same steps.
+and so the same steps. Its phases run through the laboratory-test kit's one servo-settle loop
+(:func:`poro2d.labtest.settle.settle_until`), each with its own stop rule.
 """
 
 from __future__ import annotations
 
 import logging
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
 from poro2d.criterion.lid import FlatPlate, SegmentedLid
 from poro2d.dem import Simulation
+from poro2d.labtest.settle import StopRule, settle_until
 from poro2d.record import Record
 
 _log = logging.getLogger(__name__)
@@ -182,10 +183,11 @@ class PlateServo:
 
         top.servo(sim, target, s.servo_max_speed, s.servo_gain)
         label = f"top {top.name} (round {rounds})" if self.progress else False
-        steady = self._approached(top, target, weight)
-        steps += sim.run(left(), every=s.check_every, callback=steady, progress=label).steps
+        steps += settle_until(
+            sim, self._approached(top, target, weight), left(), every=s.check_every, bar=label
+        )
         top.servo(sim, target, s.settle_max_speed, s.settle_gain)
-        steps += sim.run(left(), every=s.check_every, callback=self._settled(top, target, weight)).steps
+        steps += settle_until(sim, self._settled(top, target, weight), left(), every=s.check_every)
         top.hold(sim)
         res = sim.solve(self.ratio, min(left(), 20 * s.check_every), measure=self.equilibrium)
         steps += res.steps
@@ -202,9 +204,7 @@ class PlateServo:
         f = top.force(sim) / sim.particles.thickness
         return in_window(f, weight, self.settings.force_fraction) and top.resting(sim, target)
 
-    def _approached(
-        self, top: FlatPlate | SegmentedLid, target: float, weight: float
-    ) -> Callable[[Simulation], bool]:
+    def _approached(self, top: FlatPlate | SegmentedLid, target: float, weight: float) -> StopRule:
         """The approach's stop test: F_top in the window for ``window_checks`` checks running."""
         s = self.settings
         streak = [0]
@@ -215,9 +215,7 @@ class PlateServo:
 
         return steady
 
-    def _settled(
-        self, top: FlatPlate | SegmentedLid, target: float, weight: float
-    ) -> Callable[[Simulation], bool]:
+    def _settled(self, top: FlatPlate | SegmentedLid, target: float, weight: float) -> StopRule:
         """The settling phase's stop test: F_top in the window and the specimen at rest.
 
         At rest means at equilibrium, or a plate that rests in the window while the

@@ -14,14 +14,14 @@ seeds come from one with :meth:`with_seed`, for several pressures with :meth:`at
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field, replace
-from typing import ClassVar
+from dataclasses import dataclass, field, replace
+from typing import Any, ClassVar, Self
 
 from poro2d.dem.contact_law import MAX_ROLLING_FRICTION, series
 from poro2d.errors import InputError, Integer, Real, check_fields
 from poro2d.grading import GradingCurve, paper_grading
+from poro2d.labtest.settings import TestSettings
 from poro2d.paper_data import TABLE_1
-from poro2d.typed_result import TypedResult
 
 #: disks of the cell: below about 200 the stress ratio's fluctuations swamp its mean; above
 #: 20000 one run takes hours on one thread
@@ -59,8 +59,9 @@ CASE_RANGES = {
 
 
 @dataclass(frozen=True)
-class CriticalStateCase:
-    """One periodic shear run (SI but the pressure in kPa; strains are shear strains gamma).
+class CriticalStateCase(TestSettings):
+    """One periodic shear run (SI but the pressure in kPa; strains are shear strains gamma), also
+    the ``case`` its result files keep (:class:`~poro2d.labtest.settings.TestSettings`).
 
     disks: about how many disks (the drawn total area is ``disks`` mean disk areas); strain:
     gamma at which the run ends; window_start: gamma where the steady-state window begins
@@ -93,6 +94,8 @@ class CriticalStateCase:
     solid_drift_limit: float = 0.005
     stiffness_number: float | None = None
 
+    OMITTED: ClassVar[dict] = {"stiffness_number": None}
+
     def __post_init__(self) -> None:
         if not isinstance(self.grading, GradingCurve):
             raise InputError("grading", type(self.grading).__name__, "a GradingCurve")
@@ -122,48 +125,28 @@ class CriticalStateCase:
         """The stiffness number kn / (P t) of the case's contacts at its pressure."""
         return self.contact_stiffness()[0] / (self.pressure_kpa * 1e3 * THICKNESS)
 
-    def record(self) -> CaseRecord:
-        """The case as a result file keeps it (the grading as its model sizes and source)."""
-        values = asdict(self)
-        values["grading"] = {
-            "sizes_m": list(self.grading.sizes_m),
-            "percent_passing": list(self.grading.percent_passing),
-            "source": self.grading.source,
-        }
-        return CaseRecord(**values)
+    def to_dict(self) -> dict[str, Any]:
+        """The case as its result files keep it: every field in order, the grading as its model
+        sizes, percent passing and source, ``stiffness_number`` only when set."""
+        row = super().to_dict()
+        g = self.grading
+        row["grading"] = {
+            "sizes_m": list(g.sizes_m), "percent_passing": list(g.percent_passing), "source": g.source,
+        }  # fmt: skip
+        return row
 
-
-@dataclass(eq=False)
-class CaseRecord(TypedResult):
-    """:class:`CriticalStateCase` as a result file keeps it (every field, in its order)."""
-
-    grading: dict
-    disks: int
-    particle_friction: float
-    rolling_friction: float
-    pressure_kpa: float
-    inertial_number: float
-    strain: float
-    window_start: float
-    seed: int
-    kn_particle: float
-    ks_particle: float
-    solid_density: float
-    restitution: float
-    dt_safety: float
-    barostat_time: float
-    record_strain: float
-    blocks: int
-    mu_drift_limit: float
-    solid_drift_limit: float
-    stiffness_number: float | None = None
-
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("stiffness_number",)
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Self:
+        """The case a result file keeps, as kept (:meth:`TestSettings.from_dict`), its grading a curve."""
+        case = super().from_dict(data)
+        g = case.grading
+        curve = GradingCurve(g["sizes_m"], g["percent_passing"], source=g["source"])
+        object.__setattr__(case, "grading", curve)  # frozen, and read unchecked as the kit reads a file
+        return case
 
 
 __all__ = [
     "CASE_RANGES",
-    "CaseRecord",
     "CriticalStateCase",
     "DISKS_RANGE",
     "INERTIAL_RANGE",

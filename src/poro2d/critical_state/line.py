@@ -23,7 +23,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from poro2d.critical_state.case import CaseRecord, CriticalStateCase
+from poro2d.critical_state.case import CriticalStateCase
 from poro2d.critical_state.results import CriticalStateResult, CriticalStateTestResult, void_ratio
 from poro2d.critical_state.run import MAX_SEEDS, seed_runs, study_of, write_study
 from poro2d.errors import InputError, check_int
@@ -232,7 +232,7 @@ class CriticalStateLineResult(TypedResult):
     friction_angle_deg: Spread
     steady: bool
     note: str
-    case: CaseRecord
+    case: CriticalStateCase
     processes: int
     wall_time_s: float
     config: dict[str, Any]
@@ -247,7 +247,7 @@ class CriticalStateLineResult(TypedResult):
         "points": LinePoint,
         "stress_ratio": Spread,
         "friction_angle_deg": Spread,
-        "case": CaseRecord,
+        "case": CriticalStateCase,
         "provenance": Provenance,
         "marks": StateMark,
     }
@@ -298,7 +298,7 @@ def line_result(
         friction_angle_deg=Spread.of([t.friction_angle_deg for t in tests]),
         steady=not missed,
         note=note,
-        case=case.record(),
+        case=case,
         processes=processes,
         wall_time_s=wall_time_s,
         config=config or {},

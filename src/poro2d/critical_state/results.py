@@ -5,17 +5,20 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
-from poro2d.critical_state.case import CaseRecord
+from poro2d.critical_state.case import CriticalStateCase
 from poro2d.critical_state.series import CellSeries
+from poro2d.critical_state.steady import SteadyState
 from poro2d.io_utils import Provenance
-from poro2d.labtest.records import TestSummary
+from poro2d.labtest.records import ByName, TestSummary, typed_parts
 from poro2d.measure.spread import Spread
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
+@typed_parts
 @dataclass(eq=False)
-class CriticalStateTestResult(TypedResult):
-    """One periodic shear run: its steady state over the window and how it was reached.
+class CriticalStateTestResult(ByName, SteadyState):
+    """One periodic shear run: its steady state over the window (its first keys, those of
+    :class:`~poro2d.critical_state.steady.SteadyState`) and how it was reached.
 
     stress_ratio = tau / sigma_yy over the window with its standard error over blocks,
     friction_angle_deg = atan of it; solid_fraction likewise; inertial_number the one reached
@@ -27,20 +30,6 @@ class CriticalStateTestResult(TypedResult):
     absent in files of earlier versions). ``series`` (not in the file): the rows as arrays.
     """
 
-    stress_ratio: float
-    stress_ratio_se: float
-    friction_angle_deg: float
-    solid_fraction: float
-    solid_fraction_se: float
-    inertial_number: float
-    coordination: float
-    normal_stress_kpa: float
-    stress_ratio_drift: float
-    solid_fraction_drift: float
-    steady: bool
-    note: str
-    window: list[float]
-    rows: int
     disks: int
     mean_diameter_m: float
     cell_width_m: float
@@ -52,13 +41,12 @@ class CriticalStateTestResult(TypedResult):
     rebuilds: int
     wall_time_s: float
     particle_steps_per_s: float
-    case: CaseRecord
+    case: CriticalStateCase
     provenance: Provenance
     stiffness_number: float | None = None
     mean_overlap_ratio: float | None = None
     series: CellSeries | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"case": CaseRecord, "provenance": Provenance}
     OPTIONAL: ClassVar[tuple[str, ...]] = ("stiffness_number", "mean_overlap_ratio")
 
     @property
@@ -96,6 +84,7 @@ class SeedSummary(TestSummary):
     OPTIONAL: ClassVar[tuple[str, ...]] = ("stiffness_number", "mean_overlap_ratio")
 
 
+@typed_parts
 @dataclass(eq=False)
 class CriticalStateResult(TypedResult):
     """Periodic shear runs of one case on several seeds (the study's ``result.json``).
@@ -115,7 +104,7 @@ class CriticalStateResult(TypedResult):
     steady: bool
     note: str
     summaries: list[SeedSummary]
-    case: CaseRecord
+    case: CriticalStateCase
     processes: int
     wall_time_s: float
     config: dict[str, Any]
@@ -127,18 +116,6 @@ class CriticalStateResult(TypedResult):
         default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
 
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "stress_ratio": Spread,
-        "friction_angle_deg": Spread,
-        "solid_fraction": Spread,
-        "inertial_number": Spread,
-        "coordination": Spread,
-        "summaries": SeedSummary,
-        "case": CaseRecord,
-        "provenance": Provenance,
-        "void_ratio": Spread,
-        "mean_overlap_ratio": Spread,
-    }
     OPTIONAL: ClassVar[tuple[str, ...]] = ("void_ratio", "stiffness_number", "mean_overlap_ratio")
 
     def headline(self) -> str:

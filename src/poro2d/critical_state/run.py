@@ -98,21 +98,8 @@ def run_critical_state(
     series, steps, rebuilds, overlap = _shear(cell, case, rate, report)
     wall = time.perf_counter() - t0
     state = read_steady(series, case.window_start, case.blocks, case.mu_drift_limit, case.solid_drift_limit)
-    result = CriticalStateTestResult(
-        stress_ratio=state.stress_ratio,
-        stress_ratio_se=state.stress_ratio_se,
-        friction_angle_deg=state.friction_angle_deg,
-        solid_fraction=state.solid_fraction,
-        solid_fraction_se=state.solid_fraction_se,
-        inertial_number=state.inertial_number,
-        coordination=state.coordination,
-        normal_stress_kpa=state.normal_stress_kpa,
-        stress_ratio_drift=state.stress_ratio_drift,
-        solid_fraction_drift=state.solid_fraction_drift,
-        steady=state.steady,
-        note=state.note,
-        window=[case.window_start, float(series.gamma[-1])],
-        rows=state.rows,
+    result = CriticalStateTestResult.of(
+        state,
         disks=cell.n,
         mean_diameter_m=mean_diameter(cell),
         cell_width_m=cell.width,
@@ -124,7 +111,7 @@ def run_critical_state(
         rebuilds=rebuilds,
         wall_time_s=wall,
         particle_steps_per_s=cell.n * (compression + steps) / wall,
-        case=case.record(),
+        case=case,
         provenance=Provenance.now(),
         stiffness_number=case.kappa(),
         mean_overlap_ratio=overlap,
@@ -254,7 +241,7 @@ def study_of(cases, tests, workers, wall, config) -> CriticalStateResult:
         steady=not missed,
         note=note,
         summaries=summaries,
-        case=cases[0].record(),
+        case=cases[0],
         processes=workers,
         wall_time_s=wall,
         config=config or {},

@@ -30,6 +30,7 @@ from pathlib import Path
 from poro2d.config import check_keys
 from poro2d.critical_state.line import CriticalStateLineResult, MeasuredLine
 from poro2d.errors import InputError, check_range, is_number
+from poro2d.grading import GradingCurve
 from poro2d.lab_state import LabState
 from poro2d.state_map import PRESSURE_RANGE_KPA, LabCriticalStateLine, map_state, read_lab_line
 from poro2d.store import Store
@@ -55,10 +56,10 @@ def _path(base_dir: Path | None, text: str) -> Path:
     return p if p.is_absolute() or base_dir is None else base_dir / p
 
 
-def _same_shape(grading: dict, sizes: tuple[float, ...], percent: tuple[float, ...]) -> bool:
+def _same_shape(grading: GradingCurve, sizes: tuple[float, ...], percent: tuple[float, ...]) -> bool:
     """Whether a line's grading is the soil's up to a scale (void ratios do not depend on scale)."""
-    theirs, pct = list(grading.get("sizes_m", [])), list(grading.get("percent_passing", []))
-    if len(theirs) != len(sizes) or len(pct) != len(percent) or not theirs:
+    theirs, pct = grading.sizes_m, grading.percent_passing
+    if len(theirs) != len(sizes) or len(pct) != len(percent):
         return False
     scale = sizes[0] / theirs[0]
     return all(math.isclose(a, b * scale, rel_tol=1e-6) for a, b in zip(sizes, theirs, strict=True)) and all(
@@ -86,7 +87,7 @@ def _line_2d(folder: Path, friction: float, rolling: float, grading) -> Measured
             )  # fmt: skip
     if not _same_shape(case.grading, tuple(grading.sizes_m), tuple(grading.percent_passing)):
         raise InputError(
-            "state.line_2d grading", case.grading.get("source", "?"), "the soil's grading (to a scale)",
+            "state.line_2d grading", case.grading.source, "the soil's grading (to a scale)",
             "make the line with --grading set to the soil's sieve curve",
         )  # fmt: skip
     return res.measured()

@@ -18,14 +18,18 @@ from dataclasses import dataclass
 import numpy as np
 
 from poro2d.critical_state.series import CellSeries
+from poro2d.typed_result import TypedResult
 
 
-@dataclass(frozen=True)
-class SteadyState:
-    """What the window says: means, standard errors over blocks, drifts, and whether it is steady."""
+@dataclass(eq=False)
+class SteadyState(TypedResult):
+    """What the window says: means, standard errors over blocks, drifts, whether it is steady, the
+    window (gamma from its start to the last row) and its rows; the first keys of a run's
+    ``result.json`` (:class:`~poro2d.critical_state.results.CriticalStateTestResult`)."""
 
     stress_ratio: float
     stress_ratio_se: float
+    friction_angle_deg: float
     solid_fraction: float
     solid_fraction_se: float
     inertial_number: float
@@ -33,13 +37,10 @@ class SteadyState:
     normal_stress_kpa: float
     stress_ratio_drift: float
     solid_fraction_drift: float
-    rows: int
     steady: bool
     note: str
-
-    @property
-    def friction_angle_deg(self) -> float:
-        return math.degrees(math.atan(self.stress_ratio))
+    window: list[float]
+    rows: int
 
 
 def _drift(gamma: np.ndarray, values: np.ndarray) -> float:
@@ -80,9 +81,11 @@ def read_steady(
             + "; ".join(problems)
             + " (a larger strain, or more disks: a small cell's slow swings read as drift)"
         )
+    mu = float(tau.mean() / sig.mean())
     return SteadyState(
-        stress_ratio=float(tau.mean() / sig.mean()),
+        stress_ratio=mu,
         stress_ratio_se=_block_se(mu_blocks),
+        friction_angle_deg=math.degrees(math.atan(mu)),
         solid_fraction=float(phi.mean()),
         solid_fraction_se=_block_se(phi_blocks),
         inertial_number=float(series.inertial_number[m].mean()),
@@ -90,9 +93,10 @@ def read_steady(
         normal_stress_kpa=float(sig.mean()),
         stress_ratio_drift=mu_drift,
         solid_fraction_drift=phi_drift,
-        rows=int(g.size),
         steady=not problems,
         note=note,
+        window=[window_start, float(series.gamma[-1])],
+        rows=int(g.size),
     )
 
 

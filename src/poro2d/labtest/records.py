@@ -5,16 +5,45 @@ biaxial test. Each holds the keys every box test writes and, after them in the f
 those of one kind of test, written only when set (a biaxial file has no split box; a shear file
 no side walls): one class reads and writes both tests' files as they were written before.
 :class:`TestSummary` is the base of a test's line in its study's ``result.json``, made from the
-test's result by name (:meth:`TestSummary.of`).
+test's result by name (:class:`ByName`, as a test's result is made from the reading of its curve).
 """
 
 from __future__ import annotations
 
+import types
+import typing
 from dataclasses import dataclass, fields
-from typing import Any, ClassVar, Self
+from typing import Any, ClassVar, Self, TypeVar
 
 from poro2d.dem.summary import EngineSummary
+from poro2d.record import Record
 from poro2d.typed_result import TypedResult
+
+T = TypeVar("T", bound=type)
+
+
+def _part_kind(hint: Any) -> type | None:
+    """The part class of a field typed ``hint``: a result or record class, alone, optional or in a
+    list (None: not a part)."""
+    if typing.get_origin(hint) in (typing.Union, types.UnionType):
+        kinds = [a for a in typing.get_args(hint) if a is not type(None)]
+        hint = kinds[0] if len(kinds) == 1 else None
+    if typing.get_origin(hint) is list:
+        hint = typing.get_args(hint)[0]
+    return hint if isinstance(hint, type) and issubclass(hint, TypedResult | Record) else None
+
+
+def typed_parts(cls: T) -> T:
+    """Class decorator of a typed result (above its ``@dataclass``): its ``PARTS`` read off its
+    fields' types, so that the file's keys and their classes are declared once, as fields.
+
+    Every field of the file typed as a result or a record class (or an optional one, or a list of
+    them) is a part read back as that class.
+    """
+    hints = typing.get_type_hints(cls)
+    kinds = {f.name: _part_kind(hints[f.name]) for f in fields(cls) if f.metadata.get("in_file", True)}
+    cls.PARTS = {name: kind for name, kind in kinds.items() if kind is not None and name != "extra"}
+    return cls
 
 
 @dataclass(eq=False, kw_only=True)
@@ -46,6 +75,7 @@ BIAXIAL_KEYS = (
 )  # fmt: skip
 
 
+@typed_parts
 @dataclass(eq=False, kw_only=True)
 class ConsolidationRecord(TypedResult):
     """How a test's consolidation ended (a shear test's ``consolidation.json``, a ``consolidation`` of
@@ -88,20 +118,28 @@ class ConsolidationRecord(TypedResult):
     OPTIONAL: ClassVar[tuple[str, ...]] = (
         *SPLIT_BOX_KEYS, *BIAXIAL_KEYS, "contact_kn", "stiffness_number", "mean_overlap_ratio",
     )  # fmt: skip
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"box": BoxRecord, "engine": EngineSummary}
+
+
+class ByName:
+    """Mixin of a typed result made from another value by name (:meth:`of`): a test's line from the
+    test's result, a test's result from what its curve says."""
+
+    @classmethod
+    def of(cls, source: Any, **given: Any) -> Self:
+        """Each field ``given``, the others read off ``source`` by name (those it lacks left at their
+        defaults)."""
+        names = [f.name for f in fields(cls) if f.name != "extra"]  # type: ignore[arg-type]
+        values = {name: given[name] if name in given else getattr(source, name) for name in names
+                  if name in given or hasattr(source, name)}  # fmt: skip
+        return cls(**values)
 
 
 @dataclass(eq=False)
-class TestSummary(TypedResult):
-    """Base of a test's line in its study's ``result.json``: the test's numbers a study lists."""
+class TestSummary(ByName, TypedResult):
+    """Base of a test's line in its study's ``result.json``: the test's numbers a study lists, read off
+    the test's result by name (:meth:`ByName.of`)."""
 
     __test__ = False  # not a test class, whatever its name
 
-    @classmethod
-    def of(cls, result: TypedResult, **given: Any) -> Self:
-        """The line of the test ``result``: each field ``given``, the others read off ``result`` by name."""
-        names = (f.name for f in fields(cls) if f.name != "extra")
-        return cls(**{name: given[name] if name in given else getattr(result, name) for name in names})
 
-
-__all__ = ["BoxRecord", "ConsolidationRecord", "TestSummary"]
+__all__ = ["BoxRecord", "ByName", "ConsolidationRecord", "TestSummary", "typed_parts"]

@@ -1,12 +1,15 @@
-"""The servo-settle action: run a servoed specimen until it is at equilibrium on its targets.
+"""The servo-settle action: run a servoed specimen until a stop rule says it has settled.
 
 Every consolidation of a box test, and the criterion's plate stage, servo walls to their
-targets and run the engine until the specimen settles. :func:`settle` is that loop, once: the
-engine's clock starts again at 0, the engine runs in blocks of ``every`` steps (a block's end
-changes no number), and after each block the maximum unbalanced-force ratio and the walls' stress
-error are read. Settled: the ratio below ``ratio_limit`` and the error below ``tolerance``;
-otherwise ``renew`` may set the servos' targets again (a stress over a changing contact
-length), until ``max_steps``.
+targets and run the engine until the specimen settles. :func:`settle_until` is that loop, once:
+the engine runs in blocks of ``every`` steps (a block's end changes no number) and after each
+block a stop rule, ``done(sim) -> bool``, is asked whether the specimen has settled, until
+``max_steps``. The rule is what differs from test to test: the box tests' is
+:class:`AtEquilibrium` (the maximum unbalanced-force ratio below a limit and the walls' stress
+error below a tolerance, the servos' targets renewed while not), which :func:`settle` applies
+on a clock started again at 0; the criterion's plate stage brings its own (the force window
+held for a streak of checks, then the window at equilibrium or a plate that only creeps:
+:mod:`poro2d.criterion.servo`).
 """
 
 from __future__ import annotations
@@ -19,9 +22,56 @@ from poro2d.dem import Simulation
 
 #: ``progress(phase, fraction)``: called between blocks of steps, for a progress display
 ProgressFn = Callable[[str, float], None]
+#: ``done(sim)``: a stop rule, asked after each block of steps whether the specimen has settled
+StopRule = Callable[[Simulation], bool]
 
 #: how often (steps) a settling specimen is checked (and its servos' targets renewed)
 SETTLE_CHECK = 500
+
+
+def settle_until(
+    sim: Simulation, done: StopRule, max_steps: int, *, every: int = SETTLE_CHECK,
+    progress: ProgressFn | None = None, phase: str = "consolidating", bar: bool | str = False,
+) -> int:  # fmt: skip
+    """Run ``sim`` (its servos already on) in blocks of ``every`` steps until ``done(sim)``, at most
+    ``max_steps`` steps; the steps run.
+
+    ``progress``: told ``phase`` and the share of ``max_steps`` run before each check; ``bar``: the
+    engine's own progress bar (:meth:`~poro2d.dem.Simulation.run`), its label when a string.
+    """
+    start = sim.step_count
+
+    def check(sm: Simulation) -> bool:
+        if progress is not None:
+            progress(phase, min((sm.step_count - start) / max_steps, 1.0))
+        return done(sm)
+
+    return sim.run(max_steps, every=every, callback=check, progress=bar).steps
+
+
+@dataclass
+class AtEquilibrium:
+    """The box tests' stop rule: the maximum unbalanced-force ratio below ``ratio_limit`` and
+    ``error(sim)`` (the walls' relative stress error) below ``tolerance``; ``renew`` (the servos'
+    targets set again, a stress over a changing contact length) after each check that has not
+    settled. ``ratio`` and ``stress_error``: their values at the last check."""
+
+    error: Callable[[Simulation], float]
+    ratio_limit: float
+    tolerance: float
+    renew: Callable[[Simulation], None] | None = None
+    ratio: float = math.inf
+    stress_error: float = math.inf
+
+    @property
+    def reached(self) -> bool:
+        return bool(self.ratio < self.ratio_limit and self.stress_error < self.tolerance)
+
+    def __call__(self, sim: Simulation) -> bool:
+        self.ratio, self.stress_error = sim.unbalanced_ratios()[0], self.error(sim)
+        if not self.reached and self.renew is not None:
+            self.renew(sim)
+        return self.reached
 
 
 @dataclass(frozen=True)
@@ -40,28 +90,12 @@ def settle(
     max_steps: int, every: int = SETTLE_CHECK, renew: Callable[[Simulation], None] | None = None,
     progress: ProgressFn | None = None, phase: str = "consolidating",
 ) -> Settled:  # fmt: skip
-    """Run ``sim`` (its servos already on) until its maximum unbalanced-force ratio is below
-    ``ratio_limit`` and ``error(sim)`` (the walls' relative stress error) below ``tolerance``,
-    within ``max_steps`` steps counted from a clock started again at 0.
-
-    ``renew``: called after each check that has not settled (the servos' targets set again);
-    ``progress``: told ``phase`` and the share of ``max_steps`` run after each check.
-    """
-    last = {"ratio": math.inf, "error": math.inf}
-
-    def settled(sm: Simulation) -> bool:
-        last.update(ratio=sm.unbalanced_ratios()[0], error=error(sm))
-        if progress is not None:
-            progress(phase, min(sm.step_count / max_steps, 1.0))
-        done = last["ratio"] < ratio_limit and last["error"] < tolerance
-        if not done and renew is not None:
-            renew(sm)
-        return done
-
+    """Settle ``sim`` by :class:`AtEquilibrium` (its arguments are the rule's) within ``max_steps``
+    steps counted from a clock started again at 0 (:func:`settle_until`)."""
+    rule = AtEquilibrium(error, ratio_limit, tolerance, renew)
     sim.reset_clock()
-    steps = sim.run(max_steps, every=every, callback=settled).steps
-    reached = last["ratio"] < ratio_limit and last["error"] < tolerance
-    return Settled(steps, last["ratio"], last["error"], bool(reached))
+    steps = settle_until(sim, rule, max_steps, every=every, progress=progress, phase=phase)
+    return Settled(steps, rule.ratio, rule.stress_error, rule.reached)
 
 
-__all__ = ["SETTLE_CHECK", "ProgressFn", "Settled", "settle"]
+__all__ = ["SETTLE_CHECK", "AtEquilibrium", "ProgressFn", "Settled", "StopRule", "settle", "settle_until"]

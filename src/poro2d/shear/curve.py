@@ -18,11 +18,13 @@ import numpy as np
 from poro2d.dem import Simulation
 from poro2d.dem.contacts import ContactSet
 from poro2d.labtest.curve import ColumnCurve, CurveRow
+from poro2d.labtest.records import typed_parts
 from poro2d.shear.box import UPPER_SIDE_WALLS, SplitBox
 from poro2d.shear.fit import peak, smooth
 from poro2d.shear.parts import EndValues, ForceBalance
 from poro2d.shear.settings import ShearSettings, inertial_number
 from poro2d.store import Store
+from poro2d.typed_result import TypedResult
 
 CURVE_COLUMNS = [
     "step", "shear_displacement_mm", "shear_stress_kpa", "normal_stress_kpa", "plate_displacement_mm",
@@ -211,9 +213,12 @@ def ended_by(x: np.ndarray, x_peak: float, s: ShearSettings) -> str:
     return "max_displacement"
 
 
-@dataclass(frozen=True)
-class CurveSummary:
-    """What a test's curve says (the first keys of its ``result.json``, in their order)."""
+@typed_parts
+@dataclass(eq=False)
+class CurveSummary(TypedResult):
+    """What a test's curve says: the first keys of its ``result.json``, in their order
+    (:class:`~poro2d.shear.results.ShearTestResult`; the plane's share of the load at the peak,
+    :func:`plane_load_at_peak`, is a later key of it)."""
 
     normal_stress_kpa: float
     peak_shear_stress_kpa: float
@@ -225,20 +230,24 @@ class CurveSummary:
     plate_displacement_at_peak_mm: float
     end: EndValues
     end_shear_displacement_m: float
-    ended_by: str
-    max_inertial_number: float
+    ended_by: str | None
+    max_inertial_number: float | None
     inertial_number_ok: bool
     normal_stress_max_error_after_consolidation: float
     normal_stress_mean_error: float
     force_balance: ForceBalance
-    plane_load_fraction_at_peak: float
+
+
+def _columns(rows: list[ShearRow]) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """The shear displacement (m) and every column of ``rows``, as arrays."""
+    x = np.array([r.shear_displacement_mm for r in rows]) * 1e-3
+    return x, {k: np.array([getattr(r, k) for r in rows], float) for k in CURVE_COLUMNS}
 
 
 def curve_summary(rows: list[ShearRow], sigma_kpa: float, settings: ShearSettings) -> CurveSummary:
     """Peak, end values, servo error, inertial number and force balance read off the curve."""
     s = settings
-    x = np.array([r.shear_displacement_mm for r in rows]) * 1e-3
-    col = {k: np.array([getattr(r, k) for r in rows], float) for k in CURVE_COLUMNS}
+    x, col = _columns(rows)
     k, xp, tp = peak(x, col["shear_stress_kpa"], s.peak_window)
     end = {}
     for name in ("shear_stress_kpa", "normal_stress_kpa", "plate_displacement_mm", "coordination_number"):
@@ -262,8 +271,15 @@ def curve_summary(rows: list[ShearRow], sigma_kpa: float, settings: ShearSetting
         normal_stress_max_error_after_consolidation=float(np.max(sig_err)),
         normal_stress_mean_error=float(np.mean(sig_err)),
         force_balance=force_balance(x, col, s.peak_window),
-        plane_load_fraction_at_peak=plane_load_fraction(x, col, k, s.peak_window),
     )
+
+
+def plane_load_at_peak(rows: list[ShearRow], window: float) -> float:
+    """The plane's share of the plate's load at the smoothed peak of ``rows`` (:func:`plane_load_fraction`,
+    a later key of the test's ``result.json`` than those of :class:`CurveSummary`)."""
+    x, col = _columns(rows)
+    k = peak(x, col["shear_stress_kpa"], window)[0]
+    return plane_load_fraction(x, col, k, window)
 
 
 def plane_load_fraction(x: np.ndarray, col: Mapping[str, np.ndarray], k: int, window: float) -> float:
@@ -286,6 +302,7 @@ __all__ = [
     "contradiction",
     "curve_row",
     "curve_summary",
+    "plane_load_at_peak",
     "ended_by",
     "force_balance",
     "peak_passed",

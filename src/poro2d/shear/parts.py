@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, ClassVar, TypeVar
 
-from poro2d.labtest.records import TestSummary
+from poro2d.labtest.records import TestSummary, typed_parts
 from poro2d.typed_result import TypedResult, part
 
 P = TypeVar("P", bound=TypedResult)
@@ -102,6 +102,16 @@ class ResidualAtRest(TypedResult):
     end_rate: float | None
 
 
+#: the keys a test's ``result.json`` and its line in a series have had since a later poro2d (a test of
+#: before lacks them): the plane's share of the load, the residual where dilation stopped, the box
+#: verdict, the stiffness number and overlap
+LATER_KEYS = (
+    "plane_load_fraction_at_peak", "residual_dilation_stopped", "box_dominated", "box_note",
+    "stiffness_number", "mean_overlap_ratio_at_peak",
+)  # fmt: skip
+
+
+@typed_parts
 @dataclass(eq=False)
 class ShearTestSummary(TestSummary):
     """One test's line of a series' ``result.json`` (and ``peaks.csv``, without its nested parts)."""
@@ -130,15 +140,7 @@ class ShearTestSummary(TestSummary):
     stiffness_number: float | None = None
     mean_overlap_ratio_at_peak: float | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = (
-        "plane_load_fraction_at_peak", "residual_dilation_stopped", "box_dominated", "box_note",
-        "stiffness_number", "mean_overlap_ratio_at_peak",
-    )  # fmt: skip
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "end": EndValues,
-        "force_balance": ForceBalance,
-        "residual_dilation_stopped": ResidualAtRest,
-    }
+    OPTIONAL: ClassVar[tuple[str, ...]] = LATER_KEYS
 
 
 @dataclass(eq=False)
@@ -166,6 +168,7 @@ class RateCheckRow(TypedResult):
     wall_time_s: float
 
 
+@typed_parts
 @dataclass(eq=False)
 class RateCheck(TypedResult):
     """How the peaks change at half the velocity (a series run with ``rate_check``)."""
@@ -181,10 +184,6 @@ class RateCheck(TypedResult):
     max_mean_abs_change_before_peak: float | None
     note: str
 
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "tests": RateCheckRow,
-    }
-
 
 @dataclass(eq=False)
 class LabPeak(TypedResult):
@@ -194,6 +193,7 @@ class LabPeak(TypedResult):
     peak_shear_stress_kpa: float
 
 
+@typed_parts
 @dataclass(eq=False)
 class LabRecord(TypedResult):
     """Laboratory data as a file keeps them (:meth:`poro2d.shear.lab.LabData.record`)."""
@@ -202,11 +202,8 @@ class LabRecord(TypedResult):
     kind: str
     peaks: list[LabPeak]
 
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "peaks": LabPeak,
-    }
 
-
+@typed_parts
 @dataclass(eq=False)
 class LabComparison(TypedResult):
     """The laboratory data a series is compared with, their fits and the difference of the angles."""
@@ -219,12 +216,6 @@ class LabComparison(TypedResult):
     cohesion_kpa: float | None
     friction_angle_difference_deg: float | None
     fit_through_origin: FitRecord
-
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "peaks": LabPeak,
-        "fit": FitRecord,
-        "fit_through_origin": FitRecord,
-    }
 
 
 @dataclass(eq=False)
@@ -292,7 +283,7 @@ class StrengthCase(TypedResult):
 
 
 __all__ = [
-    "EndValues", "FitInterval", "FitRecord", "ForceBalance",
+    "LATER_KEYS", "EndValues", "FitInterval", "FitRecord", "ForceBalance",
     "LabComparison", "LabPeak", "LabRecord", "QuasiStatic", "RateCheck", "RateCheckRow",
     "ResidualAtRest", "StrengthCase", "StrengthDefinitions", "StressPeaks",
     "ShearTestSummary", "part", "parts",

@@ -8,15 +8,14 @@ from typing import Any, ClassVar
 
 from poro2d.dem.summary import EngineSummary
 from poro2d.io_utils import Provenance
-from poro2d.labtest.records import ConsolidationRecord
+from poro2d.labtest.records import ByName, ConsolidationRecord, typed_parts
 from poro2d.shear.box_dominated import box_verdict
 from poro2d.shear.box_scale import BoxScale
-from poro2d.shear.curve import ShearCurve, read_curve
+from poro2d.shear.curve import CurveSummary, ShearCurve, read_curve
 from poro2d.shear.parts import (
-    EndValues,
+    LATER_KEYS,
     FitInterval,
     FitRecord,
-    ForceBalance,
     LabComparison,
     QuasiStatic,
     RateCheck,
@@ -31,33 +30,19 @@ from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
+@typed_parts
 @dataclass(eq=False)
-class ShearTestResult(TypedResult):
+class ShearTestResult(ByName, CurveSummary):
     """One test (a test folder's ``result.json``): what its curve says, and how it was obtained.
 
-    The first fields are read off the curve (:func:`poro2d.shear.curve.curve_summary`):
-    the smoothed peak and where it lies, the end values (``end``: smoothed over one peak
-    window), the servo's stress error, the inertial number and the force balance. Stresses
-    in kPa, lengths in m unless the name says mm. ``curve`` (not in the file): the recorded
-    curve (:class:`~poro2d.shear.curve.ShearCurve`; None when the test is not at hand).
+    The first fields are read off the curve (:class:`~poro2d.shear.curve.CurveSummary`, by
+    :func:`poro2d.shear.curve.curve_summary`): the smoothed peak and where it lies, the end values
+    (``end``: smoothed over one peak window), the servo's stress error, the inertial number and
+    the force balance. Stresses in kPa, lengths in m unless the name says mm. ``curve`` (not in
+    the file): the recorded curve (:class:`~poro2d.shear.curve.ShearCurve`; None when the test is
+    not at hand).
     """
 
-    normal_stress_kpa: float
-    peak_shear_stress_kpa: float
-    shear_displacement_at_peak_m: float
-    peak_stress_ratio: float
-    peak_shear_stress_raw_kpa: float
-    peak_window_m: float
-    normal_stress_at_peak_kpa: float
-    plate_displacement_at_peak_mm: float
-    end: EndValues
-    end_shear_displacement_m: float
-    ended_by: str | None
-    max_inertial_number: float | None
-    inertial_number_ok: bool
-    normal_stress_max_error_after_consolidation: float
-    normal_stress_mean_error: float
-    force_balance: ForceBalance
     inertial_number_at_target_stress: float
     consolidation: ConsolidationRecord
     velocity_m_per_s: float
@@ -89,19 +74,7 @@ class ShearTestResult(TypedResult):
     mean_overlap_ratio_at_peak: float | None = None
     curve: ShearCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = (
-        "plane_load_fraction_at_peak", "residual_dilation_stopped", "box_dominated", "box_note",
-        "stiffness_number", "mean_overlap_ratio_at_peak",
-    )  # fmt: skip
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "end": EndValues,
-        "force_balance": ForceBalance,
-        "residual_dilation_stopped": ResidualAtRest,
-        "consolidation": ConsolidationRecord,
-        "settings": ShearSettings,
-        "engine": EngineSummary,
-        "provenance": Provenance,
-    }
+    OPTIONAL: ClassVar[tuple[str, ...]] = LATER_KEYS
 
     @classmethod
     def read(cls, store: Store, data: dict[str, Any] | None = None) -> ShearTestResult:
@@ -122,6 +95,7 @@ class ShearTestResult(TypedResult):
         return result
 
 
+@typed_parts
 @dataclass(eq=False)
 class ShearSeriesResult(TypedResult):
     """Tests at several normal stresses on one specimen (a series' ``result.json``), with the fit.
@@ -166,19 +140,8 @@ class ShearSeriesResult(TypedResult):
         default_factory=dict, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
 
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "tests": ShearTestSummary,
-        "fit": FitRecord,
-        "fit_through_origin": FitRecord,
-        "quasi_static": QuasiStatic,
-        "rate_check": RateCheck,
-        "lab": LabComparison,
-        "box_scale": BoxScale,
-        "settings": ShearSettings,
-        "provenance": Provenance,
-    }
 
-
+@typed_parts
 @dataclass(eq=False)
 class ReplicateShearResult(TypedResult):
     """The same tests on several specimens (``replicates.json``): peaks over specimens, pooled fits.
@@ -208,14 +171,9 @@ class ReplicateShearResult(TypedResult):
     series: dict[str, ShearSeriesResult] = field(default_factory=dict, kw_only=True, metadata=NOT_IN_FILE)
 
     OPTIONAL: ClassVar[tuple[str, ...]] = ("box_dominated_tests",)
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "per_normal_stress": StressPeaks,
-        "fit": FitInterval,
-        "fit_through_origin": FitInterval,
-        "provenance": Provenance,
-    }
 
 
+@typed_parts
 @dataclass(eq=False)
 class StrengthResult(TypedResult):
     """Strength against rolling and particle friction (a strength study's ``strength.json``).
@@ -239,13 +197,6 @@ class StrengthResult(TypedResult):
     box_scale: BoxScale | None = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = ("box_scale",)
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "box_scale": BoxScale,
-        "cases": StrengthCase,
-        "definitions": StrengthDefinitions,
-        "settings": ShearSettings,
-        "provenance": Provenance,
-    }
 
 
 __all__ = ["ReplicateShearResult", "ShearSeriesResult", "ShearTestResult", "StrengthResult"]

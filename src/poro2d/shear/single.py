@@ -43,6 +43,7 @@ from poro2d.shear.curve import (
     contradiction,
     curve_columns,
     curve_summary,
+    plane_load_at_peak,
     read_curve,
 )
 from poro2d.shear.peak_frame import PeakFrame
@@ -230,8 +231,8 @@ class DirectShearTest:
         d_mean = float(2.0 * np.mean(sim.particles.radius))
         curve = curve_columns(rows)
         verdict = box_verdict(curve, s.peak_window)  # a reading of the curve: no number of the test changes
-        return ShearTestResult(
-            **vars(curve_summary(rows, self.sigma_kpa, s)),
+        return ShearTestResult.of(
+            curve_summary(rows, self.sigma_kpa, s),
             inertial_number_at_target_stress=inertial_number(
                 s.velocity, self.sigma_kpa * 1e3, rho, s.shear_zone_factor
             ),
@@ -249,6 +250,7 @@ class DirectShearTest:
             specimen=self.case.specimen.source,
             engine=sim.summary(),
             provenance=Provenance.now(),
+            plane_load_fraction_at_peak=plane_load_at_peak(rows, s.peak_window),
             residual_dilation_stopped=dilation_stopped_residual(curve, d_mean),
             box_dominated=verdict.dominated,
             box_note=verdict.note,
