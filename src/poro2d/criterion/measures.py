@@ -139,10 +139,6 @@ class CheckNumbers(Record):
     weight_from_masses_n_per_m: float | None = None
     force_balance_error: float | None = None
 
-    @classmethod
-    def from_row(cls, row: dict) -> CheckNumbers:
-        return cls(**{f.name: row.get(f.name) for f in fields(cls)})
-
 
 class SpecimenChecks(NamedTuple):
     """The checks of a trial's specimen and the numbers behind them."""

@@ -274,7 +274,7 @@ class Trial(Record, TypedResult):
             plate=PlateStage.from_row(row),
             forces_after=WallForces.from_row(dict(row), "_after"),
             porosity_change=row.get("porosity_change"),
-            check_numbers=CheckNumbers.from_row(dict(row)),
+            check_numbers=CheckNumbers.from_dict(dict(row)),
             checks=Checks(**{f.name: (row.get("checks") or {}).get(f.name) for f in fields(Checks)}),
             decision=Decision.from_row(row),
             overfull_m=row.get("overfull_m") or 0.0,
