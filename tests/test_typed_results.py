@@ -154,7 +154,7 @@ def test_a_criterion_folder_written_before_is_read_back_and_still_binds(tmp_path
     run = json.loads((out / "config.json").read_text())["run"]
 
     def crit(threads=1, **changes):
-        spec = SpecimenSpec.from_record(dict(run["specimen"], threads=threads))
+        spec = SpecimenSpec.from_dict(dict(run["specimen"], threads=threads))
         settings = CriterionSettings(**dict(run["criterion"], **changes))
         return PorosityCriterion(spec, paper_grading(), settings, seed=run["seed"], store=Store(out))
 
@@ -406,12 +406,12 @@ def test_known_structures_of_shear_and_paper_files_are_typed_parts():
 def test_a_calibrations_per_parameter_values_are_typed_parts():
     """A calibration's best pair, intervals, ranges, posterior median and wide flags, its
     laboratory data and timings are typed parts; the file is the same."""
+    from poro2d.calibration.model import Surrogate
     from poro2d.calibration.run import (
         CalibrationTimings,
         FrictionBounds,
         FrictionFlags,
         FrictionValues,
-        SurrogateRecord,
     )
     from poro2d.shear.parts import LabRecord
 
@@ -423,7 +423,7 @@ def test_a_calibrations_per_parameter_values_are_typed_parts():
     assert cal.ranges.rolling_friction == [0.0, 0.5] and isinstance(cal.posterior.wide, FrictionFlags)
     assert isinstance(cal.posterior.median, FrictionValues) and isinstance(cal.lab, LabRecord)
     assert isinstance(cal.timings, CalibrationTimings) and cal.timings.wall_time_s > 0
-    assert isinstance(cal.fit["peak_50kPa"], SurrogateRecord) and cal.fit["peak_50kPa"].replicates == 2
+    assert isinstance(cal.fit["peak_50kPa"], Surrogate) and cal.fit["peak_50kPa"].replicates == 2
     assert json.dumps(cal.to_dict(), indent=2) == json.dumps(stored, indent=2)
     unknown = FrictionBounds.from_dict({"particle_friction": None, "rolling_friction": None})
     assert unknown.to_dict() == {"particle_friction": None, "rolling_friction": None}
@@ -465,34 +465,39 @@ def test_shear_settings_are_a_record_that_keeps_the_keys_a_file_had():
     assert ShearSettings.from_dict(fresh.to_dict()).to_dict() == fresh.to_dict()
 
 
-def test_a_criterion_keeps_its_settings_and_specimen_as_records():
-    """A criterion result's settings and specimen are records that write the keys the file had:
-    options left out at their default stay out, the specimen's former ``extra`` key stays in."""
-    from poro2d.criterion.protocol import CriterionSettings
-    from poro2d.criterion.result import CriterionSettingsRecord, SpecimenRecord
+def test_a_criterion_keeps_its_settings_and_specimen_as_the_runs_values():
+    """A criterion result's settings and specimen are the run's own values, read back from the
+    keys the file had: options left out at their default stay out, the specimen's former ``extra``
+    key stays in, and a preparation rolling friction stands after the other settings."""
+    from poro2d.criterion.settings import CriterionSettings
     from poro2d.specimen.compaction import SpecimenSpec
 
     stored = json.loads((DATA / "criterion_result.json").read_text())
     crit = CriterionResult.from_dict(stored)
-    assert isinstance(crit.settings, CriterionSettingsRecord) and crit.settings.max_iterations == 6
-    assert isinstance(crit.specimen, SpecimenRecord) and crit.specimen.width == 0.05
-    assert crit.specimen.extra == {"extra": {}} and json.dumps(crit.to_dict()) == json.dumps(stored)
-    for record, made in (
-        (CriterionSettingsRecord, CriterionSettings(refine_tolerance=0.002).to_dict()),
-        (CriterionSettingsRecord, CriterionSettings(acceptance="fill").to_dict()),
-        (SpecimenRecord, SpecimenSpec(width=0.05, height=0.025, rolling_friction=0.1).to_dict()),
-        (SpecimenRecord, SpecimenSpec().to_dict()),
+    assert isinstance(crit.settings, CriterionSettings) and crit.settings.max_iterations == 6
+    assert isinstance(crit.specimen, SpecimenSpec) and crit.specimen.width == 0.05
+    assert json.dumps(crit.to_dict()) == json.dumps(stored)
+    for made in (
+        CriterionSettings(refine_tolerance=0.002),
+        CriterionSettings(acceptance="fill"),
+        SpecimenSpec(width=0.05, height=0.025, rolling_friction=0.1),
+        SpecimenSpec(),
     ):
-        assert list(record.from_dict(made).to_dict().items()) == list(made.items())
+        row = made.to_dict()
+        assert list(type(made).from_dict(row).to_dict().items()) == list(row.items())
+    prep = dict(stored, specimen=SpecimenSpec(rolling_friction_prep=0.2).to_dict())
+    keys = list(CriterionResult.from_dict(prep).to_dict()["specimen"])
+    assert keys[-2:] == ["rolling_friction_prep", "extra"] and keys[-3] == "threads"
 
 
 def test_a_sands_calibration_record_and_seed_results_are_typed_parts():
     """The small box's calibration record and each seed's row are typed parts, written as before."""
-    from poro2d.sand.result import DensityCalibrationRecord, SeedSpecimen
+    from poro2d.criterion.density import Calibration
+    from poro2d.sand.result import SeedSpecimen
 
     stored = json.loads((DATA / "sand_result.json").read_text())
     sand = SandResult.from_dict(stored)
-    assert isinstance(sand.calibration.calibration, DensityCalibrationRecord)
+    assert isinstance(sand.calibration.calibration, Calibration)
     assert sand.calibration.calibration.mus == stored["calibration"]["calibration"]["mus"]
     assert "seed_results" not in sand.to_dict()  # a file written before the key stays without it
     seed = SeedSpecimen(1, True, 0.17, 0.16, 900, 2, "specimens/seed1")
@@ -543,13 +548,11 @@ def test_a_map_of_parts_and_a_list_of_records_are_read_typed_and_written_back():
     """``Keyed`` reads a map of parts (names that vary, values of one class); a Record class
     with ``from_dict`` reads a list of rows: a calibration's surrogates and design points."""
     from poro2d.calibration.evaluations import DesignPoint, Observed
-    from poro2d.calibration.run import SurrogateRecord
+    from poro2d.calibration.model import Surrogate
 
     stored = json.loads((DATA / "calibration_result.json").read_text())
     cal = CalibrationResult.from_dict(stored)
-    assert list(cal.fit) == list(stored["fit"]) and all(
-        isinstance(v, SurrogateRecord) for v in cal.fit.values()
-    )
+    assert list(cal.fit) == list(stored["fit"]) and all(isinstance(v, Surrogate) for v in cal.fit.values())
     assert [type(e) for e in cal.evaluations] == [DesignPoint] * len(stored["evaluations"])
     first = cal.evaluations[0]
     assert first.observed[1] == Observed("peak", 100.0, stored["evaluations"][0]["peak_100kPa"])

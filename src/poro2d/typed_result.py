@@ -45,7 +45,7 @@ def _plain(value: Any) -> Any:
         return value.to_dict()
     if isinstance(value, list) and any(isinstance(v, TypedResult | Record) for v in value):
         return [_plain(v) for v in value]
-    if isinstance(value, dict) and any(isinstance(v, TypedResult) for v in value.values()):
+    if isinstance(value, dict) and any(isinstance(v, TypedResult | Record) for v in value.values()):
         return {k: _plain(v) for k, v in value.items()}
     return value
 
@@ -86,7 +86,7 @@ class Keyed:
     values are the objects of ``kind``, such as a calibration's surrogate per observable): its
     names are data (they vary from run to run), its values are typed."""
 
-    kind: type[TypedResult]
+    kind: type[TypedResult] | type[Record]
 
     def read(self, value: Any) -> Any:
         """``value`` with each of its values read as ``kind`` (as it is when not a map)."""

@@ -36,7 +36,7 @@ def test_accept_at_once(tmp_path):
     # (chaotic packing: another engine sum order may need another trial porosity here)
     r = _run(tmp_path, 0.21, force_fraction=0.05)
     assert r.converged and r.final_porosity == 0.21
-    (it,) = r.iterations
+    (it,) = [t.to_dict() for t in r.iterations]  # the trial's row
     assert it["plate_moved"] == "no" and it["plate_displacement_m"] == 0.0
     assert 0.0 < it["f_top_n_per_m"] < 0.05 * it["self_weight_n_per_m"]
     assert it["accepted"] and it["porosity_change"] == 0.0
@@ -50,7 +50,7 @@ def test_accept_at_once(tmp_path):
 
 def test_plate_moves_up_when_the_top_force_is_too_large(tmp_path):
     r = _run(tmp_path, 0.19, max_iterations=1)
-    (it,) = r.iterations
+    (it,) = [t.to_dict() for t in r.iterations]  # the trial's row
     assert it["f_top_n_per_m"] > 0.01 * it["self_weight_n_per_m"]
     assert it["plate_moved"] == "up" and it["plate_displacement_m"] > 0
     assert it["new_porosity"] > 0.19
@@ -62,7 +62,7 @@ def test_plate_moves_up_when_the_top_force_is_too_large(tmp_path):
 
 def test_plate_moves_down_when_nothing_touches_it(down):
     _, r = down
-    (it,) = r.iterations
+    (it,) = [t.to_dict() for t in r.iterations]  # the trial's row
     assert it["f_top_n_per_m"] == 0.0
     assert it["plate_moved"] == "down" and it["plate_displacement_m"] < 0
     assert it["new_porosity"] < 0.30
@@ -174,7 +174,7 @@ def test_flags_are_booleans_in_new_and_resumed_trials(down):
     (new,) = r.iterations
     (resumed,) = _run(out, 0.30, max_iterations=1).iterations
     for key in ("plate_settled", "accepted", "preparation_converged"):
-        assert type(new[key]) is bool and type(resumed[key]) is bool, key
+        assert type(new.to_dict()[key]) is bool and type(resumed.to_dict()[key]) is bool, key
     assert new.to_dict() == resumed.to_dict()
     saved = json.loads((out / "result.json").read_text())
     assert type(saved["iterations"][0]["plate_settled"]) is bool
@@ -287,7 +287,7 @@ def test_half_built_frictionless_specimen_is_refused(tmp_path):
         _frictionless(), paper_grading(), settings, seed=0, store=Store(tmp_path), figures=False
     ).run()
     assert not r.converged and r.final_porosity is None and r.failed_trial == 1
-    (it,) = r.iterations
+    (it,) = [t.to_dict() for t in r.iterations]  # the trial's row
     assert not it["accepted"] and it["refused"] and not it["converged"]
     assert it["failed_stage"] == "layer 2" and it["failed_check"] == "preparation_converged"
     assert it["failed_max_ratio"] > 1e-3 and it["failed_steps"] == 29_000 + 1000 + 1000 + 1000
@@ -334,7 +334,7 @@ def test_layer_forced_to_fail_ends_the_cli_with_one_line(tmp_path, capsys):
 
 def test_plate_that_does_not_settle_refuses_the_trial(tmp_path):
     r = _run(tmp_path, 0.30, max_plate_steps=1000)
-    (it,) = r.iterations
+    (it,) = [t.to_dict() for t in r.iterations]  # the trial's row
     assert it["plate_moved"] == "down" and not it["plate_settled"]
     assert it["refused"] and not it["accepted"] and not it["converged"]
     assert it["failed_stage"] == "top plate" and it["checks"]["plate_settled"] is False

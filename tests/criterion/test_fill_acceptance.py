@@ -82,7 +82,7 @@ def _one_trial(spec, acceptance: str) -> dict:
     # the few highest disks of a rough surface
     settings = CriterionSettings(trial_porosity=0.20, max_iterations=1, acceptance=acceptance)
     crit = PorosityCriterion(spec, paper_grading(), settings, seed=3)
-    return crit.run().iterations[0]
+    return crit.run().iterations[0].to_dict()  # the trial's row
 
 
 @pytest.fixture(scope="module")

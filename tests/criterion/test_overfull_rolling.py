@@ -49,9 +49,9 @@ def test_a_dense_trial_short_of_overfull_with_rolling_friction_keeps_every_disk_
     res = PorosityCriterion(
         spec, grading, settings, seed=seed, store=Store(tmp_path / "c"), figures=False
     ).run()
-    first = res.iterations[0]
+    first = res.iterations[0].to_dict()  # the trial's row
     assert first["f_top_n_per_m"] > 1e4 and first["plate_moved"] == "up" and first["plate_settled"]
-    for row in res.iterations:
+    for row in (t.to_dict() for t in res.iterations):
         assert row["disks_outside_box"] == 0 and row["checks"]["disks_inside_box"], row["reason"]
         assert not row["refused"], row["reason"]
     assert res.failed_trial is None
@@ -75,11 +75,11 @@ def test_an_overfull_first_trial_with_rolling_friction_keeps_every_disk_in_the_b
     res = PorosityCriterion(
         spec, grading, settings, seed=seed, store=Store(tmp_path / "c"), figures=False
     ).run()
-    first = res.iterations[0]
+    first = res.iterations[0].to_dict()  # the trial's row
     assert first["overfull_m"] > 0.0 and first["plate_moved"] == "up" and first["plate_settled"]
     assert first["new_porosity"] > 0.07 and "over-full box" in first["reason"]
-    for row in res.iterations:
+    for row in (t.to_dict() for t in res.iterations):
         assert row["disks_outside_box"] == 0 and row["checks"]["disks_inside_box"], row["reason"]
         assert not row["refused"], row["reason"]
-    assert res.iterations[1]["trial_porosity"] > 0.07
+    assert res.iterations[1].trial_porosity > 0.07
     assert res.failed_trial is None

@@ -73,11 +73,12 @@ def test_a_closed_bracket_accepts_the_closest_trial_within_the_papers_tolerance(
     # the relation's seed that cycled: n' scatters by about 0.003 from specimen to specimen
     rows = [_row(0.19, 0.1753), _row(0.175, 0.1719), _row(0.172, 0.1753), _row(0.1735, 0.1702),
             _row(0.1725, 0.1683)]  # fmt: skip
-    assert next_trial(rows, s) in {r["trial_porosity"] for r in rows}
+    assert next_trial(rows, s) in {r.trial_porosity for r in rows}
     best = closed_bracket(rows, s)
-    assert best is rows[1] and best["accepted"] and best["accepted_at"] == "closed bracket"
-    assert "0.0031" in best["reason"]
-    assert list(best)[-1] == "accepted_at"  # the key a closed bracket adds comes last in the row
+    row = best.to_dict()
+    assert best is rows[1] and row["accepted"] and row["accepted_at"] == "closed bracket"
+    assert "0.0031" in row["reason"]
+    assert list(row)[-1] == "accepted_at"  # the key a closed bracket adds comes last in the row
 
 
 def test_a_closed_bracket_accepts_nothing_outside_the_papers_tolerance_or_a_failed_check():

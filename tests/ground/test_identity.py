@@ -182,6 +182,4 @@ def test_specimen_records_keep_their_keys():
 
 def test_a_record_gives_back_its_spec():
     spec = SpecimenSpec(threads=2, layers=3)
-    assert SpecimenSpec.from_record(json.loads(json.dumps(spec.to_dict()))) == SpecimenSpec(
-        threads=2, layers=3
-    )
+    assert SpecimenSpec.from_dict(json.loads(json.dumps(spec.to_dict()))) == SpecimenSpec(threads=2, layers=3)

@@ -11,7 +11,7 @@ import pytest
 
 from poro2d.cli.shear import parse_stresses
 from poro2d.config import check_number_list
-from poro2d.criterion.protocol import CRITERION_RANGES, CriterionSettings
+from poro2d.criterion.settings import CRITERION_RANGES, CriterionSettings
 from poro2d.errors import InputError, Integer, OneOf, Real, check_fields
 from poro2d.execute import cluster_options, dask_cluster
 from poro2d.io_utils import read_utf8, text_position

@@ -173,11 +173,11 @@ def test_an_overfull_first_trial_ends_in_a_looser_accepted_trial(tmp_path):
     res = PorosityCriterion(
         spec, grading, settings, seed=seed, store=Store(tmp_path / "c"), figures=False
     ).run()
-    first = res.iterations[0]
+    first = res.iterations[0].to_dict()  # the trial's row
     assert first["overfull_m"] > 0.0 and first["plate_moved"] == "up"
     assert "over-full box" in first["reason"] and not first["refused"]
     assert first["new_porosity"] > 0.07 and first["checks"]["disks_inside_box"]
-    assert res.iterations[1]["trial_porosity"] > 0.07
+    assert res.iterations[1].trial_porosity > 0.07
     assert res.converged and res.final_porosity > 0.07
     assert "layers end once settled" in res.preparation_note
     assert res.to_dict()["preparation_note"] == res.preparation_note
@@ -205,9 +205,9 @@ def test_an_overfull_first_trial_under_the_lid_leads_to_a_looser_trial(tmp_path)
     res = PorosityCriterion(
         spec, grading, settings, seed=seed, store=Store(tmp_path / "c"), figures=False
     ).run()
-    first = res.iterations[0]
+    first = res.iterations[0].to_dict()  # the trial's row
     assert first["overfull_m"] > 0.0 and first["plate_moved"] == "lid"
     assert not first["refused"] and first["checks"]["disks_inside_box"] and first["disks_outside_box"] == 0
     assert first["new_porosity"] > 0.07
-    assert len(res.iterations) == 2 and res.iterations[1]["trial_porosity"] > 0.07
-    assert not res.iterations[1]["refused"]
+    assert len(res.iterations) == 2 and res.iterations[1].trial_porosity > 0.07
+    assert not res.iterations[1].decision.refused

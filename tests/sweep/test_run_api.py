@@ -54,7 +54,7 @@ def test_run_criterion_matches_the_command(tmp_path):
     main(["criterion", "--config", str(cfg), "--out", str(tmp_path / "cli"), "--quiet"])
     cli = json.loads((tmp_path / "cli" / "result.json").read_text())
     assert res.final_porosity == cli["final_porosity"] and res.converged
-    assert [r["new_porosity"] for r in res.iterations] == [r["new_porosity"] for r in cli["iterations"]]
+    assert [r.new_porosity for r in res.iterations] == [r["new_porosity"] for r in cli["iterations"]]
 
 
 @pytest.mark.parametrize(

@@ -106,6 +106,7 @@ def test_criterion_sweep_uses_both_workers_and_rerun_skips(client, tmp_path):
         d = tmp_path / "cases" / c.id
         assert json.loads((d / "params.json").read_text())["params"] == c.params
         assert (d / "run" / "result.json").is_file() and (d / "run" / "iterations.csv").is_file()
+        assert res.case_store(c.id).has("result.json")  # the result hands out what the case wrote
     rec = json.loads((tmp_path / "sweep.json").read_text())
     assert (
         rec["status"] == "finished" and rec["summary"]["done"] == 8 and "poro2d_version" in rec["provenance"]

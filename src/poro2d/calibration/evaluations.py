@@ -9,7 +9,7 @@ observable and stress they name.
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -52,13 +52,13 @@ class Observed(Record):
 
 
 @dataclass(frozen=True, eq=False)
-class DesignPoint(Record, Mapping):
+class DesignPoint(Record):
     """One evaluated design point (a row of ``evaluations``): the parameter pair (and the disks'
     stiffnesses ``particle_kn``, ``particle_ks`` in N/m when they are calibrated: absent from the
     row otherwise), then each observable's replicate values in the order of the laboratory targets.
 
-    It reads as the dict of its row (``point["peak_50kPa"]``, equal to the row read from a
-    file), as a result's other parts do.
+    Its row (:meth:`~poro2d.record.Record.to_dict`) is the file's; its values are read by
+    attribute (``point.observed``).
     """
 
     ROW = ("particle_friction", "rolling_friction", "particle_kn", "particle_ks", Spliced("observed"))
@@ -80,16 +80,6 @@ class DesignPoint(Record, Mapping):
     def parameters(self, axes: tuple[str, ...]) -> tuple[float, ...]:
         """The point's values of the calibrated parameters ``axes`` (:data:`PARAMETER_KEYS`' keys)."""
         return tuple(getattr(self, PARAMETER_KEYS[a]) for a in axes)
-
-    # read-only mapping access: the point reads as the dict of its row
-    def __getitem__(self, key: str) -> Any:
-        return self.to_dict()[key]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self.to_dict())
-
-    def __len__(self) -> int:
-        return len(self.to_dict())
 
 
 __all__ = ["PARAMETER_KEYS", "DesignPoint", "Observed", "target_key"]

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from poro2d.calibration.discrepancy import Discrepancy, Levels, level_posterior, log_likelihood
+from poro2d.record import Record
 
 #: points per axis of the posterior grid
 GRID = 161
@@ -120,27 +121,49 @@ def n_coefficients(d: int) -> int:
 N_COEFFICIENTS = n_coefficients(2)
 
 
-@dataclass
-class Surrogate:
+@dataclass(eq=False)
+class Surrogate(Record):
     """A quadratic response surface of one observable's replicate mean, and its noise terms.
 
     ``scatter``: the seed standard deviation pooled over the design; ``residual``: the root
     mean square misfit of the quadratic to the means, corrected for its degrees of freedom
-    (both in the observable's unit: kPa for a stress, mm for the dilation); ``replicates``:
-    the specimens per design point.
+    (both in the observable's ``unit``: kPa for a stress, mm for the dilation, ``ratio`` for a
+    dimensionless one); ``replicates``: the specimens per design point.
+
+    It is also its entry of a calibration file's ``fit``: the noise terms under keys named by
+    the unit (``seed_scatter_kpa``, ``surrogate_residual_kpa``), after ``replicates`` but for a
+    stress, whose keys were the first ones and stay before it.
     """
 
     coefficients: np.ndarray
     scatter: float
     residual: float
     replicates: int
+    unit: str = "kPa"
+
+    def layout(self) -> tuple:
+        u = self.unit.lower()
+        noise = ((f"seed_scatter_{u}", "scatter"), (f"surrogate_residual_{u}", "residual"))
+        if u == "kpa":
+            return ("coefficients", *noise, "replicates")
+        return ("coefficients", "replicates", *noise)
+
+    @classmethod
+    def from_dict(cls, data) -> Surrogate:
+        """A surrogate read back from its entry of a file's ``fit`` (its unit named by the keys)."""
+        key = next((k for k in data if k.startswith("seed_scatter_")), "seed_scatter_kpa")
+        u = key.removeprefix("seed_scatter_")
+        unit = {"kpa": "kPa"}.get(u, u)
+        noise = data.get(key), data.get(f"surrogate_residual_{u}")
+        return cls(np.asarray(data["coefficients"], float), *noise, data.get("replicates", 0), unit)
 
     def mean(self, unit: np.ndarray) -> np.ndarray:
         return _features(np.atleast_2d(unit)) @ self.coefficients
 
 
-def fit_surrogate(unit: np.ndarray, values: np.ndarray) -> Surrogate:
-    """The surrogate of one observable: ``values`` (design points x replicates; NaN: failed)."""
+def fit_surrogate(unit: np.ndarray, values: np.ndarray, measured_in: str = "kPa") -> Surrogate:
+    """The surrogate of one observable in unit ``measured_in``: ``values`` (design points x
+    replicates; NaN: failed) at the design points ``unit``."""
     means = np.nanmean(values, axis=1)
     counts = np.sum(np.isfinite(values), axis=1)
     coefficients, *_ = np.linalg.lstsq(_features(unit), means, rcond=None)
@@ -153,7 +176,7 @@ def fit_surrogate(unit: np.ndarray, values: np.ndarray) -> Surrogate:
         scatter = math.sqrt(float(ss) / float(np.sum(counts[several] - 1)))
     else:
         scatter = 0.0
-    return Surrogate(coefficients, scatter, residual, int(np.max(counts)))
+    return Surrogate(coefficients, scatter, residual, int(np.max(counts)), measured_in)
 
 
 @dataclass(kw_only=True)

@@ -154,38 +154,6 @@ class ChainRecord(TypedResult):
 
 
 @dataclass(eq=False)
-class SurrogateRecord(TypedResult):
-    """One observable's quadratic surrogate as a file keeps it.
-
-    The seed scatter and the residual are in the observable's unit, named by their keys:
-    ``seed_scatter_kpa`` and ``surrogate_residual_kpa`` for a shear stress, ``seed_scatter_mm``
-    and ``surrogate_residual_mm`` for the dilation (the other pair is absent from the file).
-    """
-
-    coefficients: list[float]
-    seed_scatter_kpa: float | None = None
-    surrogate_residual_kpa: float | None = None
-    replicates: int = 0
-    seed_scatter_mm: float | None = None
-    surrogate_residual_mm: float | None = None
-    #: a dimensionless observable's (a biaxial stress ratio or volumetric strain)
-    seed_scatter_ratio: float | None = None
-    surrogate_residual_ratio: float | None = None
-
-    OPTIONAL: ClassVar[tuple[str, ...]] = (
-        "seed_scatter_kpa", "surrogate_residual_kpa", "seed_scatter_mm", "surrogate_residual_mm",
-        "seed_scatter_ratio", "surrogate_residual_ratio",
-    )  # fmt: skip
-
-    @classmethod
-    def of(cls, surrogate: model.Surrogate, unit: str = "kPa") -> SurrogateRecord:
-        """The record of a fitted surrogate (its coefficients as a list) of an observable in ``unit``."""
-        u = unit.lower()
-        noise = {f"seed_scatter_{u}": surrogate.scatter, f"surrogate_residual_{u}": surrogate.residual}
-        return cls(surrogate.coefficients.tolist(), replicates=surrogate.replicates, **noise)
-
-
-@dataclass(eq=False)
 class CalibrationTimings(TypedResult):
     """Where a calibration's time went (s)."""
 
@@ -302,7 +270,7 @@ class CalibrationResult(TypedResult):
     level: float
     posterior: PosteriorSummary
     evaluations: list[DesignPoint]
-    fit: dict[str, SurrogateRecord]
+    fit: dict[str, model.Surrogate]
     lab: LabRecord | BiaxialLabRecord
     specimens: dict[str, str]
     ranges: FrictionBounds
@@ -337,7 +305,7 @@ class CalibrationResult(TypedResult):
         "posterior": PosteriorSummary,
         "cluster": ClusterRecord,
         "failures": UnitFailure,
-        "fit": Keyed(SurrogateRecord),
+        "fit": Keyed(model.Surrogate),
         "evaluations": DesignPoint,
         "box_scale": BoxScale,
         "box_dominated": BoxDominatedPoints,
@@ -741,7 +709,7 @@ def _infer(
                 f"only {int(ok.sum())} design points have a {obs} at {s:g} kPa; "
                 f"the surrogate needs {min_points(ranges.dim)}"
             )
-        surrogates.append(model.fit_surrogate(unit[ok], values[ok, k]))
+        surrogates.append(model.fit_surrogate(unit[ok], values[ok, k], observable_unit(obs)))
     lab_values = [y for *_, y in targets]
     try:  # an overflow or a 0/0 here would end in a posterior of NaN read as an answer
         with np.errstate(divide="raise", over="raise", invalid="raise"):
@@ -916,10 +884,7 @@ def _result(
             discrepancy=discrepancy_record(post, level),
         ),
         evaluations=table,
-        fit={
-            target_key(obs, s): SurrogateRecord.of(sg, observable_unit(obs))
-            for (obs, s, _), sg in zip(targets, surrogates, strict=True)
-        },
+        fit={target_key(obs, s): sg for (obs, s, _), sg in zip(targets, surrogates, strict=True)},
         lab=BiaxialLabRecord.of(lab_data) if biaxial else lab_data.record(),
         specimens={label: str(found[label]) for label in found},
         ranges=FrictionBounds.from_dict({keys[a]: list(getattr(ranges, a)) for a in ranges.axes}),

@@ -31,6 +31,7 @@ import numpy as np
 from poro2d import porosity as P
 from poro2d.config import check_number_list
 from poro2d.errors import InputError, check_range
+from poro2d.json_types import as_json
 from poro2d.record import Record
 
 #: the preparation frictions of a calibration, densest first: frictionless preparation gives
@@ -235,7 +236,13 @@ class Calibration(Record):
     # ------------------------------------------------------------------ io
     @classmethod
     def from_dict(cls, d: dict) -> Calibration:
+        """The calibration of a row: its samples (the statistics beside them are computed again)."""
         return cls(list(d["mus"]), [list(s) for s in d["samples"]], list(d.get("seeds", [])))
+
+    def to_dict(self) -> dict:
+        """Its row as its files hold it (a statistic of no accepted seed as None): the
+        ``calibration`` of ``density.json``, ``relation.json`` and ``sand.json``."""
+        return as_json(super().to_dict())
 
 
 @dataclass

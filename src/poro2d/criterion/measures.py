@@ -8,7 +8,7 @@ names; the trial (:mod:`poro2d.criterion.trial`) is made of them.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, NamedTuple, Protocol
 
 import numpy as np
@@ -139,10 +139,6 @@ class CheckNumbers(Record):
     weight_from_masses_n_per_m: float | None = None
     force_balance_error: float | None = None
 
-    @classmethod
-    def from_row(cls, row: dict) -> CheckNumbers:
-        return cls(**{f.name: row.get(f.name) for f in fields(cls)})
-
 
 class SpecimenChecks(NamedTuple):
     """The checks of a trial's specimen and the numbers behind them."""
@@ -251,7 +247,7 @@ class PorosityNumbers(Record):
         """The porosities of a trial's row; None for a row without them (a trial that did not converge)."""
         if "box_porosity" not in row:
             return None
-        return cls(**{f.name: row.get(f.name) for f in fields(cls)})
+        return cls.from_dict(row)
 
 
 def porosity_numbers(

@@ -6,84 +6,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
 
+from poro2d.criterion.settings import CriterionSettings
 from poro2d.criterion.trial import Trial
 from poro2d.io_utils import Provenance
 from poro2d.measure.specimen_porosity import SpecimenPorosity
 from poro2d.measure.specimen_state import SpecimenStateResult
+from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
-
-
-@dataclass(eq=False)
-class CriterionSettingsRecord(TypedResult):
-    """The criterion's settings as a result keeps them (``CriterionSettings.to_dict()``).
-
-    ``refine_tolerance`` and ``acceptance`` are keys only when set (the plate acceptance is
-    left out), as in every file written before they existed: a record is read from that dict
-    (``from_dict``), so the keys it lacks stay out of the file.
-    """
-
-    n_lab: float
-    trial_porosity: float | None
-    force_fraction: float
-    porosity_tolerance: float
-    resolution: float
-    max_iterations: int
-    servo_target_fraction: float
-    servo_max_speed: float
-    servo_gain: float
-    settle_gain: float
-    settle_max_speed: float
-    settle_checks: int
-    plate_drift: float
-    max_plate_steps: int
-    check_every: int
-    window_checks: int
-    generation_tolerance: float
-    balance_tolerance: float
-    refine_tolerance: float | None
-    acceptance: str | None
-
-
-@dataclass(eq=False)
-class SpecimenRecord(TypedResult):
-    """The specimen's settings as a result keeps them (``SpecimenSpec.to_dict()``).
-
-    Settings newer than the first files are keys only when they leave their default, and a
-    file's former ``extra`` key (always empty) is kept, like any key not modelled, in
-    :attr:`~poro2d.typed_result.TypedResult.extra`.
-    """
-
-    width: float
-    height: float
-    thickness: float
-    solid_density: float
-    kn_particle: float
-    ks_particle: float
-    kn_wall: float
-    ks_wall: float
-    friction_prep: float
-    friction_particle: float
-    friction_wall: float
-    rolling_friction: float | None
-    layers: int | None
-    undercompaction: float | None
-    ratio: float | None
-    equilibrium: str | None
-    settle_drift: float | None
-    settle_window: int | None
-    settle_checks: int | None
-    local_damping: float | None
-    gravity: float | None
-    growth_increments: int | None
-    growth_steps: int | None
-    max_steps_per_stage: int | None
-    fallback_steps: int | None
-    calm_steps: int | None
-    calm_damping: float | None
-    dt_safety: float | None
-    threads: int | None
 
 
 @dataclass(eq=False)
@@ -102,9 +33,10 @@ class CriterionResult(TypedResult):
         "box_porosity", "interior_porosity", "interior_porosity_std", "surface_gap_mean_d50",
         "plate_contact_fraction", "preparation_note",
     )  # fmt: skip
-    #: every trial as its row (:class:`~poro2d.criterion.trial.Trial`), the settings and specimen as records
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "iterations": Trial, "settings": CriterionSettingsRecord, "specimen": SpecimenRecord,
+    #: every trial as its row (:class:`~poro2d.criterion.trial.Trial`), the settings and specimen
+    #: as the run's own values (their rows the file's ``settings`` and ``specimen``)
+    PARTS: ClassVar[dict[str, type]] = {
+        "iterations": Trial, "settings": CriterionSettings, "specimen": SpecimenSpec,
         "provenance": Provenance,
     }  # fmt: skip
 
@@ -116,8 +48,8 @@ class CriterionResult(TypedResult):
     initial_from: str
     iterations: list[Trial]
     seed: int
-    settings: CriterionSettingsRecord
-    specimen: SpecimenRecord
+    settings: CriterionSettings
+    specimen: SpecimenSpec
     local_damping_note: str
     provenance: Provenance
     failed_trial: int | None = None
@@ -129,6 +61,18 @@ class CriterionResult(TypedResult):
     plate_contact_fraction: float | None = None
     # a wide grading's equilibrium test and why (poro2d.specimen.compaction.preparation_note)
     preparation_note: str | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """The file's keys; the specimen's preparation rolling friction, when set, stands after its
+        other settings, where the files of the criterion have always had it."""
+        out = super().to_dict()
+        specimen = out.get("specimen")
+        if isinstance(specimen, dict) and "rolling_friction_prep" in specimen:
+            specimen = dict(specimen)
+            specimen["rolling_friction_prep"] = specimen.pop("rolling_friction_prep")
+            specimen["extra"] = specimen.pop("extra")
+            out["specimen"] = specimen
+        return out
 
 
 @dataclass(eq=False)

@@ -15,7 +15,7 @@ file has it, keeping keys it does not model.
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
 from typing import Any
 
@@ -182,7 +182,7 @@ DECISION_KEYS = ("condition_met", "failed_check", "accepted", "refused", "reason
 
 @dataclass(eq=False)
 class Trial(Record, TypedResult):
-    """One trial of Fig. 3, made of its parts; read as the dict of its row (``trial["new_porosity"]``).
+    """One trial of Fig. 3, made of its parts; its row (:meth:`to_dict`) is what files keep of it.
 
     ``preparation`` is the prepared specimen's report for a trial run now, None for a trial
     read back from its row (the row keeps what the trial uses of it: counts, porosity,
@@ -274,7 +274,7 @@ class Trial(Record, TypedResult):
             plate=PlateStage.from_row(row),
             forces_after=WallForces.from_row(dict(row), "_after"),
             porosity_change=row.get("porosity_change"),
-            check_numbers=CheckNumbers.from_row(dict(row)),
+            check_numbers=CheckNumbers.from_dict(dict(row)),
             checks=Checks(**{f.name: (row.get("checks") or {}).get(f.name) for f in fields(Checks)}),
             decision=Decision.from_row(row),
             overfull_m=row.get("overfull_m") or 0.0,
@@ -290,16 +290,6 @@ class Trial(Record, TypedResult):
             trial.extra["checks"] = checks  # checks this version does not know: kept as they were
         trial.order = tuple(row)
         return trial
-
-    # read-only mapping access: the trial reads as the dict of its row
-    def __getitem__(self, key: str) -> Any:
-        return self.to_dict()[key]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self.to_dict())
-
-    def __len__(self) -> int:
-        return len(self.to_dict())
 
 
 __all__ = ["Decision", "PlateStage", "Preparation", "StageFailure", "Trial", "trial_name"]

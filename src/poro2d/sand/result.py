@@ -15,6 +15,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from poro2d.criterion.density import Calibration
 from poro2d.critical_state.state_table import StateMapRecord, state_map_lines, state_map_record
 from poro2d.io_utils import Provenance, float_or_nan
 from poro2d.lab_state import LabState
@@ -22,7 +23,7 @@ from poro2d.sand.case import SoilRecord
 from poro2d.sand.preflight import Preflight
 from poro2d.sand.profile import StageProfile
 from poro2d.store import Store
-from poro2d.sweep.records import CaseRow, DensityCalibrationRecord, LostCaseRow
+from poro2d.sweep.records import CaseRow, LostCaseRow
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
@@ -86,7 +87,7 @@ class SandCalibration(TypedResult):
     OPTIONAL: ClassVar[tuple[str, ...]] = ("time_profile", "specimens_time_profile")
 
     mus: list[float]
-    calibration: DensityCalibrationRecord
+    calibration: Calibration
     n2d_min: float
     n2d_max: float
     dropped_ends: list[float]
@@ -98,7 +99,7 @@ class SandCalibration(TypedResult):
     specimens_time_profile: StageProfile | None = None
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "calibration": DensityCalibrationRecord,
+        "calibration": Calibration,
         "time_profile": StageProfile,
         "specimens_time_profile": StageProfile,
     }

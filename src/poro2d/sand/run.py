@@ -44,7 +44,7 @@ from poro2d.sand.result import (
 from poro2d.store import Store, walk
 from poro2d.sweep import density as D
 from poro2d.sweep.criterion_base import CriterionBase
-from poro2d.sweep.records import CalibrationRun, CaseRow, DensityCalibrationRecord, LostCaseRow
+from poro2d.sweep.records import CalibrationRun, CaseRow, LostCaseRow
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
 KIND = "sand"
@@ -192,7 +192,7 @@ def calibration_stage(
     dense = [v for v in info.interior[0] if v is not None]
     return target, SandCalibration(
         mus=mus,
-        calibration=DensityCalibrationRecord.from_dict(cal.to_dict()),
+        calibration=cal,
         n2d_min=cal.n2d_min,
         n2d_max=cal.n2d_max,
         dropped_ends=dropped,

@@ -166,9 +166,11 @@ class SpecimenSpec(Record):
         return (*(f.name for f in fields(self) if f.name != "max_disks"), Fixed("extra", {}))
 
     @classmethod
-    def from_record(cls, record: dict) -> SpecimenSpec:
-        """The spec a record (:meth:`to_dict`, a ``config.json``'s ``run.specimen``) describes."""
-        return cls(**{k: v for k, v in record.items() if k != "extra"})
+    def from_dict(cls, row: dict) -> SpecimenSpec:
+        """The spec a row describes (:meth:`to_dict`: a ``config.json``'s ``run.specimen``, a
+        criterion result's ``specimen``); a setting the row lacks takes its default, as it was
+        when the row was written."""
+        return cls(**{f.name: row[f.name] for f in fields(cls) if f.name in row})
 
     def self_weight(self, porosity: float) -> float:
         """G = rho_s (1 - n) W H g per metre of thickness (N/m), as in the paper."""

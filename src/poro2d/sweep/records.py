@@ -329,28 +329,8 @@ class Eq12Coefficients(TypedResult):
     b: float
 
 
-@dataclass(eq=False)
-class DensityCalibrationRecord(TypedResult):
-    """mu_prep -> accepted n2D over seeds as a file keeps it (``Calibration.to_dict()``).
-
-    ``samples``: per friction, each seed's accepted n2D (None: not accepted); ``mean``, ``sd``
-    and ``fitted``: per friction, over the accepted seeds; ``failed``: per friction, the seeds
-    not accepted; ``dropped``: frictions left out of the fit.
-    """
-
-    mus: list[float]
-    samples: list[list[float | None]]
-    seeds: list[int]
-    mean: list[float | None]
-    sd: list[float | None]
-    fitted: list[float | None]
-    failed: list[int]
-    dropped: list[float]
-
-
 __all__ = [
     "Eq12Coefficients",
-    "DensityCalibrationRecord",
     "CalibrationRun",
     "CaseEntry",
     "CaseRow",

@@ -12,14 +12,15 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from poro2d.criterion.density import Calibration
 from poro2d.critical_state.state_table import StateMapRecord
 from poro2d.execute.dask_cluster import ClusterInfo
 from poro2d.io_utils import Provenance
+from poro2d.store import Store
 from poro2d.sweep.records import (
     CalibrationRun,
     CaseEntry,
     CaseRow,
-    DensityCalibrationRecord,
     DensityPoint,
     DensitySweeps,
     Eq12Coefficients,
@@ -55,7 +56,8 @@ class SweepResult(TypedResult):
     ``cluster``: where the cases ran (empty when every case was reused); ``summary``: cases
     run, reused and failed, their times. ``rows`` (not in the file): one row per case in
     the sweep's order (``status``, ``results``, ``reused``, where and when it ran);
-    ``table``: the same as a pandas DataFrame (``results.csv``).
+    ``table``: the same as a pandas DataFrame (``results.csv``); ``store`` (not in the file):
+    the sweep's store, which hands out each case's (:meth:`case_store`).
     """
 
     PARTS = {"cases": CaseEntry, "summary": SweepSummary, "cluster": ClusterInfo, "provenance": Provenance}
@@ -76,11 +78,17 @@ class SweepResult(TypedResult):
         default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
     table: pd.DataFrame | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
+    store: Store | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     @property
     def failed(self) -> list[CaseRow | LostCaseRow]:
         """The rows of the cases that failed."""
         return [r for r in self.rows if r.status == "failed"]
+
+    def case_store(self, case_id: str) -> Store:
+        """What case ``case_id`` wrote (``cases/<id>/run``: its kind's files, a criterion run's)."""
+        assert self.store is not None, "a sweep read from its file alone knows no store"
+        return self.store.child("cases", case_id, "run")
 
 
 @dataclass(eq=False)
@@ -94,7 +102,7 @@ class DensityStateResult(TypedResult):
     the state sweep's summary.
     """
 
-    PARTS = {"sweeps": DensitySweeps, "calibration": DensityCalibrationRecord, "provenance": Provenance}
+    PARTS = {"sweeps": DensitySweeps, "calibration": Calibration, "provenance": Provenance}
 
     mode: str
     n_lab: float
@@ -113,7 +121,7 @@ class DensityStateResult(TypedResult):
     converged: bool
     n2d_min: float
     n2d_max: float
-    calibration: DensityCalibrationRecord
+    calibration: Calibration
     sweeps: DensitySweeps
     config: dict[str, Any]
     provenance: Provenance
@@ -131,7 +139,7 @@ class RelationResult(TypedResult):
 
     PARTS = {"points": RelationPoint, "fit": QuadraticFit, "spread": Spread,
              "sweep_summary": SweepSummary, "sweeps": DensitySweeps, "eq12": Eq12Coefficients,
-             "calibration": DensityCalibrationRecord, "provenance": Provenance,
+             "calibration": Calibration, "provenance": Provenance,
              "state_maps": StateMapRecord}  # fmt: skip
     #: with a ``[state]`` table, both maps of every state (:mod:`poro2d.critical_state.state_table`)
     OPTIONAL = ("state_maps",)
@@ -145,7 +153,7 @@ class RelationResult(TypedResult):
     converged_points: int
     flagged_points: int
     mode: str
-    calibration: DensityCalibrationRecord | None = None
+    calibration: Calibration | None = None
     n2d_max: float | None = None
     n2d_min: float | None = None
     spread: Spread | None = None

@@ -25,7 +25,7 @@ import os
 import socket
 import time
 import traceback
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from datetime import UTC, datetime
 from typing import Any
 
@@ -278,9 +278,7 @@ def _run_sweep(sweep: SweepConfig, store: Store, options: RunOptions, client) ->
     summary = _summary(ordered, n_reused, time.perf_counter() - t_start, cluster_info)
     record.update(status="finished", cluster=cluster_info or {}, summary=summary, finished_utc=_now())
     store.write_json("sweep.json", record)
-    result = SweepResult.from_dict(record)
-    result.rows, result.table = ordered, df
-    return result
+    return replace(SweepResult.from_dict(record), rows=ordered, table=df, store=store)
 
 
 def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Store, n_reused: int,

@@ -11,7 +11,7 @@ import math
 from dataclasses import dataclass
 
 from poro2d.record import Record, Spliced
-from poro2d.sweep.records import DensityCalibrationRecord, SweepSummary
+from poro2d.sweep.records import SweepSummary
 from poro2d.typed_result import TypedResult
 
 
@@ -230,16 +230,24 @@ class GradingSweeps(TypedResult):
 
 
 @dataclass(eq=False)
-class StudyCalibration(DensityCalibrationRecord):
-    """The density calibration of a sensitivity study (its ``calibration``): mu_prep -> n2D over
-    seeds merged with where it ran (the fields of :class:`~poro2d.sweep.records.CalibrationRun`);
-    ``failed`` is the run's count of failed cases, which takes the place of the per-friction
-    seeds not accepted (the field keeps its place in the file).
+class StudyCalibration(TypedResult):
+    """The density calibration of a sensitivity study (its ``calibration``): the row of its
+    :class:`~poro2d.criterion.density.Calibration` (mu_prep -> n2D over seeds) merged with where
+    it ran (the fields of :class:`~poro2d.sweep.records.CalibrationRun`); ``failed`` is the run's
+    count of failed cases, which takes the place of the per-friction seeds not accepted (the
+    field keeps its place in the file).
     """
 
     PARTS = {"summary": SweepSummary}
 
+    mus: list[float]
+    samples: list[list[float | None]]
+    seeds: list[int]
+    mean: list[float | None]
+    sd: list[float | None]
+    fitted: list[float | None]
     failed: int | list[int] | None
+    dropped: list[float]
     key: str
     cases: str
     ran: int
