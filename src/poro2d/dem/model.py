@@ -14,8 +14,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from poro2d.dem.contact_law import PER_BODY, PER_PAIR_TYPE, in_series, mix
-from poro2d.dem.state import Particles, Walls
+from poro2d.dem.contact_law import in_series, mix
+from poro2d.dem.state import Particles, Walls, check_contact_values
 from poro2d.errors import InputError
 
 #: the per-body rule in words, as every exported file's header states it
@@ -58,17 +58,7 @@ class ContactModel:
                 v = getattr(self, name)
                 if v is None or len(v) != 3:
                     raise InputError(f"contact {name}", v, "(kn, ks, mu) for per_pair_type")
-                kn, ks, mu = (float(x) for x in v)
-                if not kn > 0:
-                    raise InputError(f"contact {name} kn", kn, "(0, inf) N/m")
-                if not ks >= 0:
-                    raise InputError(f"contact {name} ks", ks, "[0, inf) N/m")
-                if not mu >= 0:
-                    raise InputError(f"contact {name} friction", mu, "[0, inf)")
-
-    @property
-    def mode(self) -> int:
-        return PER_BODY if self.convention == "per_body" else PER_PAIR_TYPE
+                check_contact_values(f"contact {name}", *(float(x) for x in v))
 
     def to_dict(self) -> dict:
         return asdict(self)
