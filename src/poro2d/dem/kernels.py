@@ -578,16 +578,10 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, ro
     """Run the steps of this call on thread t of nthr: partitions t P / nthr to (t + 1) P / nthr - 1."""
     wp0, wall_build = walls.p0, walls.p0_build
     part, dstart, tmax, sync = work.part, work.dstart, work.tmax, work.sync
-    dt = prm[DT]
-    gx = prm[GX]
-    gy = prm[GY]
-    damp = prm[DAMP]
-    target = prm[RATIO_TARGET]
-    measure = iprm[MEASURE]
+    dt, gx, gy, damp, target = prm[DT], prm[GX], prm[GY], prm[DAMP], prm[RATIO_TARGET]
+    measure, nsteps, check_every = iprm[MEASURE], iprm[NSTEPS], iprm[CHECK_EVERY]
     lim2 = (0.5 * prm[SKIN]) ** 2
     pw_body = iprm[MODE_PW] == PER_BODY
-    nsteps = iprm[NSTEPS]
-    check_every = iprm[CHECK_EVERY]
     # steps of the run since its last stop test: the test schedule ignores where calls begin
     since_check = iprm[CHECK_OFFSET] % check_every if check_every > 0 else 0
     need_build = iprm[NEED_BUILD] != 0

@@ -223,24 +223,12 @@ def contact_forces(
     vector from i to j's image (Love-Weber; V = L H t). Returns the touching contacts and this
     step's sigma_xx and sigma_yy.
     """
-    L = cell[L_]
-    H = cell[H_]
-    delta = cell[DELTA]
-    gdot = prm[GAMMA_DOT]
-    exx = cell[EXX]
-    eyy = cell[EYY]
-    dt = prm[DT]
-    kn = prm[KN]
-    ks = prm[KS]
-    mu = prm[MU]
-    mu_r = prm[MU_R]
-    beta = prm[BETA]
+    L, H, delta, exx, eyy = cell[L_], cell[H_], cell[DELTA], cell[EXX], cell[EYY]
+    dt, gdot = prm[DT], prm[GAMMA_DOT]
+    kn, ks, mu, mu_r, beta = prm[KN], prm[KS], prm[MU], prm[MU_R], prm[BETA]  # the cell's one law
     force[:] = 0.0
     moment[:] = 0.0
-    wxx = 0.0
-    wxy = 0.0
-    wyx = 0.0
-    wyy = 0.0
+    wxx = wxy = wyx = wyy = 0.0  # the contacts' sum of f l, before the volume
     touching = 0
     for p in range(pj.shape[0]):
         i = pi[p]
