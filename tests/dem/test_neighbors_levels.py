@@ -22,7 +22,6 @@ from poro2d.dem import Particles, Simulation, Walls, checkpoint
 from poro2d.dem.neighbors import (
     LV_COUNT,
     brute_force_pairs,
-    build_level_pairs,
     build_pairs,
     level_scratch,
 )
@@ -69,10 +68,10 @@ def test_level_list_equals_brute_force(n, spread, ratio, skin, seed, runaway):
     lv = level_scratch(n)
     if len(oracle) > 1:  # too small: reports the size, changes nothing
         lists = _lists(n, 1)
-        assert build_level_pairs(pos, rad, skin, lv, *lists) == -len(oracle)
+        assert build_pairs(pos, rad, skin, *lists, lv) == -len(oracle)
         assert np.all(lists[0] == 0)
     lists = _lists(n, max(1, len(oracle)))
-    assert build_level_pairs(pos, rad, skin, lv, *lists) == len(oracle)
+    assert build_pairs(pos, rad, skin, *lists, lv) == len(oracle)
     start, other = lists[0], lists[1]
     assert _pairs_of(start, other, n) == oracle
     for i in range(n):  # rows hold partners j > i, ascending
@@ -107,7 +106,7 @@ def test_packed_wide_list_equals_brute_force_and_single_grid():
     skin = 0.3 * RF
     oracle = brute_force_pairs(pos, rad, skin)
     lists = _lists(n, len(oracle))
-    assert build_level_pairs(pos, rad, skin, level_scratch(n), *lists) == len(oracle)
+    assert build_pairs(pos, rad, skin, *lists, level_scratch(n)) == len(oracle)
     assert _pairs_of(lists[0], lists[1], n) == oracle
     one = _lists(n, len(oracle))
     build_pairs(pos, rad, skin, *one)
@@ -125,7 +124,7 @@ def test_level_rebuild_carries_history(shuffled):
     lists = _lists(n, 200_000)
     nb_start, nb_j, nb_fs = lists[:3]
     lv = level_scratch(n)
-    build_level_pairs(pos, rad, skin, lv, *lists)
+    build_pairs(pos, rad, skin, *lists, lv)
     old = _pairs_of(nb_start, nb_j, n)
     total = int(nb_start[n])
     if shuffled:
@@ -135,7 +134,7 @@ def test_level_rebuild_carries_history(shuffled):
     rows = np.repeat(np.arange(n), np.diff(nb_start))
     nb_fs[:total] = rows * 1e5 + nb_j[:total]  # a recognisable history per pair
     pos2 = pos + rng.uniform(-0.4 * RF, 0.4 * RF, pos.shape)
-    build_level_pairs(pos2, rad, skin, lv, *lists)
+    build_pairs(pos2, rad, skin, *lists, lv)
     new = _pairs_of(nb_start, nb_j, n)
     assert new == brute_force_pairs(pos2, rad, skin)
     rows = np.repeat(np.arange(n), np.diff(nb_start))

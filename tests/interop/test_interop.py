@@ -10,11 +10,12 @@ import pytest
 
 from poro2d.cli import main
 from poro2d.dem import checkpoint
+from poro2d.dem.contact_law import in_series as series
 from poro2d.errors import InputError
 from poro2d.interop import csv_table, pfc, yade
 from poro2d.interop import lammps as lmp
 from poro2d.interop.check import DEFAULTS, check_specimen, read_specimen
-from poro2d.interop.specimen_data import from_checkpoint, from_simulation, series
+from poro2d.interop.specimen_data import from_checkpoint, from_simulation
 from poro2d.locks import KIND_NAME
 
 

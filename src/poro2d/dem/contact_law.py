@@ -1,6 +1,16 @@
-"""The linear contact law (Cundall and Strack 1979), as in PFC's linear model.
+"""The linear contact law (Cundall and Strack 1979), as in PFC's linear model: written once here.
 
-One contact between a disk ``i`` and a body ``j`` (another disk or a wall):
+As YADE splits it (Ip2 / Law2), in two parts that the walled kernels (:mod:`poro2d.dem.kernels`)
+and the periodic cell's (:mod:`poro2d.dem.periodic_kernels`) both call:
+
+* **mixing** (:func:`mix`, :func:`mix_rolling`, :func:`rolling_radius`, :func:`reduced_mass`):
+  two bodies' own properties to the parameters of their contact. PFC 4.0's rule: springs in
+  series, the smaller friction, the smaller rolling friction. The description the driver and
+  the exporters read (:class:`poro2d.dem.model.ContactModel`) names the same rule.
+* **the law** (:func:`contact_force`, :func:`rolling_moment`): one touching contact of a disk
+  ``i`` and a body ``j`` (another disk or a wall), from its parameters and its history.
+
+One contact:
 
 * unit normal ``n`` from ``i`` towards ``j``, tangent ``t = (-n_y, n_x)``;
 * normal force ``Fn = kn * overlap`` (+ an optional normal dashpot), never tensile;
@@ -11,9 +21,8 @@ One contact between a disk ``i`` and a body ``j`` (another disk or a wall):
 In 2D the shear force is kept as its component along the current tangent, so it
 turns with the contact frame by construction; that scalar is the contact's history.
 The force on ``i`` is ``-Fn n + Fs t`` and its moment ``a_i * Fs`` with the lever arm
-``a_i = r_i - overlap / 2`` (contact point in the middle of the overlap).
-
-Property combination (PFC 4.0): springs in series, the smaller friction.
+``a_i = r_i - overlap / 2`` (contact point in the middle of the overlap). A wall is a body
+that does not turn, with no lever arm.
 
 Rolling resistance (optional; the elastic-plastic spring of Iwashita and Oda 1998, type
 A of Ai et al. 2011, PFC's rolling-resistance linear model): a contact also carries a
@@ -42,11 +51,17 @@ PER_PAIR_TYPE = 1  # PFC 5 style: one (kn, ks, mu) for disk-disk, one for disk-w
 MAX_ROLLING_FRICTION = 1.0
 
 
+# ------------------------------------------------------------------ mixing (YADE's Ip2)
+# Two bodies' own properties to the parameters of their contact. The kernels of the walled
+# engine and of the periodic cell, and the driver's constants for bodies all alike, mix here.
+
+
 @njit(inline="always", cache=True)
-def series(ka, kb):
-    """Two springs in series; 0 if either is 0 (equal springs: half, without a division)."""
-    if ka == kb:
-        return 0.5 * ka
+def in_series(ka, kb):
+    """Two springs in series as one quotient, ``ka kb / (ka + kb)`` (0 when both are 0).
+
+    The time-step bound and the exported files compute it so; the kernels take :func:`series`.
+    """
     s = ka + kb
     if s <= 0.0:
         return 0.0
@@ -54,36 +69,38 @@ def series(ka, kb):
 
 
 @njit(inline="always", cache=True)
-def linear_force(overlap, vn, vt, fs_old, kn, ks, mu, cn, dt):
-    """Normal and shear force magnitudes of one touching contact.
+def series(ka, kb):
+    """Two springs in series as the kernels take them: equal springs halved, without a division.
 
-    overlap > 0; vn is the normal approach speed (positive when closing);
-    cn the normal dashpot coefficient (0 for none). Returns (fn, fs, sliding).
+    Half of a spring is exact; the quotient of :func:`in_series` may round it a bit off.
     """
-    fn = kn * overlap + cn * vn
-    if fn < 0.0:  # the dashpot may not pull the bodies together
-        fn = 0.0
-    fs = fs_old + ks * vt * dt
-    cap = mu * fn
-    sliding = False
-    if fs > cap:
-        fs = cap
-        sliding = True
-    elif fs < -cap:
-        fs = -cap
-        sliding = True
-    return fn, fs, sliding
+    if ka == kb:
+        return 0.5 * ka
+    return in_series(ka, kb)
 
 
 @njit(inline="always", cache=True)
-def rolling_moment(m_old, kr, dtheta, cap):
-    """Rolling moment on disk ``i`` after a relative rotation ``dtheta`` of ``i`` against ``j``.
+def mix(kn_a, ks_a, mu_a, kn_b, ks_b, mu_b):
+    """A contact's (kn, ks, mu) from its two bodies' (PFC 4.0): springs in series, the smaller friction."""
+    return series(kn_a, kn_b), series(ks_a, ks_b), min(mu_a, mu_b)
 
-    The elastic spring ``kr`` resists the rotation; beyond ``cap`` (>= 0) it slips.
-    """
-    # min / max rather than branches: a packing holds contacts on and below the limit in
-    # no order, and a mispredicted branch per contact costs more than both comparisons
-    return min(max(m_old - kr * dtheta, -cap), cap)
+
+@njit(inline="always", cache=True)
+def mix_rolling(mu_r_a, mu_r_b):
+    """A contact's rolling friction: the smaller of its bodies'."""
+    return min(mu_r_a, mu_r_b)
+
+
+@njit(inline="always", cache=True)
+def rolling_radius(ra, rb):
+    """The effective radius ``R = ra rb / (ra + rb)`` of a disk pair (a disk's own against a wall)."""
+    return ra * rb / (ra + rb)
+
+
+@njit(inline="always", cache=True)
+def reduced_mass(ma, mb):
+    """The mass the normal dashpot of a disk pair damps (a disk's own against a wall)."""
+    return ma * mb / (ma + mb)
 
 
 @njit(inline="always", cache=True)
@@ -92,6 +109,45 @@ def dashpot(beta, kn, m_eff):
     if beta <= 0.0:
         return 0.0
     return 2.0 * beta * math.sqrt(kn * m_eff)
+
+
+# ------------------------------------------------------------------ the law (YADE's Law2)
+
+
+@njit(inline="always", cache=True)
+def contact_force(ov, nx, ny, dvx, dvy, ai, aj, wi, wj, fs_old, kn, ks, mu, cn, dt):
+    """One touching contact: (fn, fs, fx, fy), (fx, fy) the force on ``i``.
+
+    ov > 0 the overlap; (nx, ny) the unit normal from i towards j; dvx, dvy the velocity of
+    j relative to i; ai, aj the lever arms r - ov / 2, wi, wj the spins (a wall: 0 and 0,
+    which leaves every number as without them); cn the normal dashpot (0 for none).
+    Scalars only: helpers that take arrays cost reference counting in the pair loop.
+    """
+    vn = -(dvx * nx + dvy * ny)  # approach speed, positive when closing
+    vt = dvx * -ny + dvy * nx - ai * wi - aj * wj
+    fn = kn * ov + cn * vn
+    if fn < 0.0:  # the dashpot may not pull the bodies together
+        fn = 0.0
+    fs = fs_old + ks * vt * dt
+    cap = mu * fn
+    if fs > cap:
+        fs = cap
+    elif fs < -cap:
+        fs = -cap
+    return fn, fs, -fn * nx - fs * ny, -fn * ny + fs * nx
+
+
+@njit(inline="always", cache=True)
+def rolling_moment(m_old, ks, reff, dw, dt, mu_r, fn):
+    """Rolling moment on disk ``i`` after it turned at ``dw`` against ``j`` for a step ``dt``.
+
+    The elastic spring ``kr = ks R^2`` resists the rotation; beyond ``mu_r R fn`` it slips.
+    """
+    kr = ks * reff * reff
+    cap = mu_r * reff * fn
+    # min / max rather than branches: a packing holds contacts on and below the limit in
+    # no order, and a mispredicted branch per contact costs more than both comparisons
+    return min(max(m_old - kr * (dw * dt), -cap), cap)
 
 
 @njit(inline="always", cache=True)

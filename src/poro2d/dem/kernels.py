@@ -43,7 +43,17 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from poro2d.dem.contact_law import PER_BODY, dashpot, linear_force, rolling_moment, segment_closest, series
+from poro2d.dem.contact_law import (
+    PER_BODY,
+    contact_force,
+    dashpot,
+    mix,
+    mix_rolling,
+    reduced_mass,
+    rolling_moment,
+    rolling_radius,
+    segment_closest,
+)
 from poro2d.dem.neighbors import (
     cell_grid,
     copy_rows,
@@ -149,45 +159,13 @@ def equilibrium_measures(force, pmode, nb_start, nb_j, nb_fn, nb_fs, nb_ov, wb_s
 
 
 @njit(inline="always", cache=True)
-def _pair_law(dx, dy, d, ov, dvx, dvy, ai, aj, wi, wj, fs_old, kn, ks, mu, cn, dt):
-    """One touching disk pair: (fn, fs, nx, ny), unit normal from i towards j.
-
-    dx, dy, d: centre offset j - i and distance; ov > 0 the overlap; dvx, dvy the
-    velocity of j relative to i; ai, aj the lever arms r - ov / 2; wi, wj the spins.
-    Scalars only: helpers that take arrays cost reference counting in the pair loop.
-    """
+def _wall_normal(dx, dy, d, sx, sy):
+    """Unit normal from a disk to a wall: along dx, dy (closest wall point minus centre, length
+    d), or, with the centre on the wall line, the normal of the wall's direction sx, sy."""
     if d > 0.0:
-        inv = 1.0 / d
-        nx = dx * inv
-        ny = dy * inv
-    else:
-        nx = 1.0
-        ny = 0.0
-    vn = -(dvx * nx + dvy * ny)
-    vt = dvx * -ny + dvy * nx - ai * wi - aj * wj
-    fn, fs, _sl = linear_force(ov, vn, vt, fs_old, kn, ks, mu, cn, dt)
-    return fn, fs, nx, ny
-
-
-@njit(inline="always", cache=True)
-def _wall_law(dx, dy, d, ov, sx, sy, dvx, dvy, ai, wi, fs_old, kn, ks, mu, cn, dt):
-    """One touching disk-wall pair: (fn, fs, nx, ny), unit normal from the disk to the wall.
-
-    dx, dy, d: closest wall point minus centre and its length; sx, sy the wall's
-    direction (used when the centre lies on the wall); dvx, dvy the wall's velocity
-    relative to the disk.
-    """
-    if d > 0.0:
-        nx = dx / d
-        ny = dy / d
-    else:  # centre on the wall line: push along the wall's normal
-        sl = math.sqrt(sx * sx + sy * sy)
-        nx = sy / sl
-        ny = -sx / sl
-    vn = -(dvx * nx + dvy * ny)
-    vt = dvx * -ny + dvy * nx - ai * wi
-    fn, fs, _sl = linear_force(ov, vn, vt, fs_old, kn, ks, mu, cn, dt)
-    return fn, fs, nx, ny
+        return dx / d, dy / d
+    sl = math.sqrt(sx * sx + sy * sy)
+    return sy / sl, -sx / sl
 
 
 @njit(inline="always", cache=True)
@@ -267,33 +245,38 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
                     nb_mr[p] = 0.0
                 continue
             if props is not None:
-                kn = series(props.kn[i], props.kn[j])
-                ks = series(props.ks[i], props.ks[j])
-                mu = min(props.mu[i], props.mu[j])
+                kn, ks, mu = mix(props.kn[i], props.ks[i], props.mu[i], props.kn[j], props.ks[j], props.mu[j])
             cn = 0.0
             if dash is not None:
-                cn = dashpot(dash, kn, mass[i] * mass[j] / (mass[i] + mass[j]))
+                cn = dashpot(dash, kn, reduced_mass(mass[i], mass[j]))
+            if d > 0.0:  # a product by the inverse: one division for both components
+                inv = 1.0 / d
+                nx = dx * inv
+                ny = dy * inv
+            else:
+                nx = 1.0
+                ny = 0.0
             ai = ri - 0.5 * ov
             aj = radius[j] - 0.5 * ov
             dvx = velf[U2 * j] - velf[U2 * i]
             dvy = velf[U2 * j + U1] - velf[U2 * i + U1]
             wi = omega[i]
             wj = omega[j]
-            fn, fs, nx, ny = _pair_law(dx, dy, d, ov, dvx, dvy, ai, aj, wi, wj, nb_fs[p], kn, ks, mu, cn, dt)
+            fn, fs, fxp, fyp = contact_force(
+                ov, nx, ny, dvx, dvy, ai, aj, wi, wj, nb_fs[p], kn, ks, mu, cn, dt
+            )
             nb_fn[p] = fn
             nb_fs[p] = fs
             nb_nx[p] = nx
             nb_ny[p] = ny
-            fxp = -fn * nx - fs * ny
-            fyp = -fn * ny + fs * nx
             fx += fxp
             fy += fyp
             mi = ai * fs  # the contact's moments on i and on j
             mj = aj * fs
             if roll is not None:
-                mur = min(mur_i, roll.disk_mu_r[j])
-                reff = ri * radius[j] / (ri + radius[j])
-                mr = rolling_moment(nb_mr[p], ks * reff * reff, (wi - wj) * dt, mur * reff * fn)
+                reff = rolling_radius(ri, radius[j])
+                mur = mix_rolling(mur_i, roll.disk_mu_r[j])
+                mr = rolling_moment(nb_mr[p], ks, reff, wi - wj, dt, mur, fn)
                 nb_mr[p] = mr
                 mi += mr
                 mj -= mr
@@ -318,9 +301,7 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
                     wb_mr[p] = 0.0
                 continue
             if pw_body:
-                wkn_ = series(pkn[i], wkn[w])
-                wks_ = series(pks[i], wks[w])
-                wmu_ = min(pmu[i], wmu[w])
+                wkn_, wks_, wmu_ = mix(pkn[i], pks[i], pmu[i], wkn[w], wks[w], wmu[w])
             else:
                 wkn_ = prm[KN_PW]
                 wks_ = prm[KS_PW]
@@ -329,22 +310,21 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
             if dash is not None:
                 cn = dashpot(dash, wkn_, mass[i])
             ai = ri - 0.5 * ov
-            fn, fs, nx, ny = _wall_law(
-                dx, dy, d, ov, wp1[w, 0] - wp0[w, 0], wp1[w, 1] - wp0[w, 1], wvel[w, 0] - velf[U2 * i],
-                wvel[w, 1] - velf[U2 * i + U1], ai, omega[i], wb_fs[p], wkn_, wks_, wmu_, cn, dt,
+            nx, ny = _wall_normal(dx, dy, d, wp1[w, 0] - wp0[w, 0], wp1[w, 1] - wp0[w, 1])
+            fn, fs, fxp, fyp = contact_force(
+                ov, nx, ny, wvel[w, 0] - velf[U2 * i], wvel[w, 1] - velf[U2 * i + U1], ai, 0.0, omega[i], 0.0,
+                wb_fs[p], wkn_, wks_, wmu_, cn, dt,
             )  # fmt: skip
             wb_fn[p] = fn
             wb_fs[p] = fs
             wb_nx[p] = nx
             wb_ny[p] = ny
-            fxp = -fn * nx - fs * ny
-            fyp = -fn * ny + fs * nx
             fx += fxp
             fy += fyp
             mi = ai * fs
             if roll is not None:  # a wall does not turn: the disk's spin is the relative one
-                mur = min(mur_i, roll.wall_mu_r[w])
-                mr = rolling_moment(wb_mr[p], wks_ * ri * ri, omega[i] * dt, mur * ri * fn)
+                mur = mix_rolling(mur_i, roll.wall_mu_r[w])
+                mr = rolling_moment(wb_mr[p], wks_, ri, omega[i], dt, mur, fn)
                 wb_mr[p] = mr
                 mi += mr
             mz += mi
@@ -598,16 +578,10 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, ro
     """Run the steps of this call on thread t of nthr: partitions t P / nthr to (t + 1) P / nthr - 1."""
     wp0, wall_build = walls.p0, walls.p0_build
     part, dstart, tmax, sync = work.part, work.dstart, work.tmax, work.sync
-    dt = prm[DT]
-    gx = prm[GX]
-    gy = prm[GY]
-    damp = prm[DAMP]
-    target = prm[RATIO_TARGET]
-    measure = iprm[MEASURE]
+    dt, gx, gy, damp, target = prm[DT], prm[GX], prm[GY], prm[DAMP], prm[RATIO_TARGET]
+    measure, nsteps, check_every = iprm[MEASURE], iprm[NSTEPS], iprm[CHECK_EVERY]
     lim2 = (0.5 * prm[SKIN]) ** 2
     pw_body = iprm[MODE_PW] == PER_BODY
-    nsteps = iprm[NSTEPS]
-    check_every = iprm[CHECK_EVERY]
     # steps of the run since its last stop test: the test schedule ignores where calls begin
     since_check = iprm[CHECK_OFFSET] % check_every if check_every > 0 else 0
     need_build = iprm[NEED_BUILD] != 0

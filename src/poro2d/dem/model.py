@@ -1,15 +1,38 @@
-"""Contact-property conventions and the time step."""
+"""The contact law's description (what a contact's parameters are, how bodies mix) and the time step.
+
+:class:`ContactModel` is the one description of the law that the driver hands the kernels
+and that every exporter translates: per body (PFC 4.0, the paper's) or per pair type
+(PFC 5 style), and how two bodies' properties make a contact's (:meth:`ContactModel.pair`,
+the rule of :mod:`poro2d.dem.contact_law`).
+"""
 
 from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from typing import NamedTuple
 
 import numpy as np
 
-from poro2d.dem.contact_law import PER_BODY, PER_PAIR_TYPE
-from poro2d.dem.state import Particles, Walls
+from poro2d.dem.contact_law import in_series, mix
+from poro2d.dem.state import Particles, Walls, check_contact_values
 from poro2d.errors import InputError
+
+#: the per-body rule in words, as every exported file's header states it
+PER_BODY_RULE = "kn = kA kB / (kA + kB), ks likewise, mu = min(muA, muB)"
+
+
+class ContactValues(NamedTuple):
+    """The values of the linear law: a body's own, or a contact's once two bodies are mixed.
+
+    Springs kn, ks (N/m), sliding friction mu, rolling friction mu_r; a contact's rolling
+    stiffness is ``ks R^2`` (:func:`poro2d.dem.contact_law.rolling_moment`).
+    """
+
+    kn: float
+    ks: float
+    mu: float
+    mu_r: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -35,20 +58,45 @@ class ContactModel:
                 v = getattr(self, name)
                 if v is None or len(v) != 3:
                     raise InputError(f"contact {name}", v, "(kn, ks, mu) for per_pair_type")
-                kn, ks, mu = (float(x) for x in v)
-                if not kn > 0:
-                    raise InputError(f"contact {name} kn", kn, "(0, inf) N/m")
-                if not ks >= 0:
-                    raise InputError(f"contact {name} ks", ks, "[0, inf) N/m")
-                if not mu >= 0:
-                    raise InputError(f"contact {name} friction", mu, "[0, inf)")
-
-    @property
-    def mode(self) -> int:
-        return PER_BODY if self.convention == "per_body" else PER_PAIR_TYPE
+                check_contact_values(f"contact {name}", *(float(x) for x in v))
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+    def pair(self, a: ContactValues, b: ContactValues, wall: bool = False) -> ContactValues:
+        """The values of a contact of body ``a`` with body ``b`` (a wall when ``wall``), as files state them.
+
+        Per body: :data:`PER_BODY_RULE`, springs in series as one quotient (the numbers every
+        exported file has carried; for two equal springs the kernels halve instead, which may
+        differ in the last bit); per pair type the constants. The rolling friction is the
+        smaller of the bodies' either way.
+        """
+        mu_r = min(a.mu_r, b.mu_r)
+        if self.convention == "per_pair_type":
+            kn, ks, mu = self.pw if wall else self.pp  # type: ignore[misc]
+            return ContactValues(float(kn), float(ks), float(mu), mu_r)
+        kn, ks = in_series(float(a.kn), float(b.kn)), in_series(float(a.ks), float(b.ks))
+        return ContactValues(kn, ks, min(a.mu, b.mu), mu_r)
+
+    def kernel_constants(
+        self, particles: Particles, walls: Walls
+    ) -> tuple[ContactValues | None, ContactValues | None]:
+        """The (kn, ks, mu) the kernel takes for every disk-disk and every disk-wall contact.
+
+        None where it mixes the bodies' values per contact itself. Bodies all alike get
+        their mixed values once here (the kernel's own :func:`~poro2d.dem.contact_law.mix`),
+        the same numbers without reading both bodies' properties for every pair.
+        """
+        if self.convention == "per_pair_type":
+            return ContactValues(*self.pp), ContactValues(*self.pw)  # type: ignore[misc]
+        p, w = particles, walls
+        if p.n == 0 or not all(np.all(a == a[0]) for a in (p.kn, p.ks, p.mu)):
+            return None, None
+        disk = (float(p.kn[0]), float(p.ks[0]), float(p.mu[0]))
+        pp = ContactValues(*mix(*disk, *disk))
+        if not (w.n and all(np.all(a == a[0]) for a in (w.kn, w.ks, w.mu))):
+            return pp, None
+        return pp, ContactValues(*mix(*disk, float(w.kn[0]), float(w.ks[0]), float(w.mu[0])))
 
     def max_stiffness(self, particles: Particles, walls: Walls) -> float:
         """Upper bound of any one contact's kn or ks (N/m)."""
@@ -72,11 +120,11 @@ class ContactModel:
         if particles.n == 0:
             return 0.0, 0.0
         kp = max(float(particles.kn.max()), float(particles.ks.max()))
-        kpp = kp * kp / (kp + kp)  # series springs grow with both members
+        kpp = in_series(kp, kp)  # series springs grow with both members
         kpw = 0.0
         if walls.n:
             kw = max(float(walls.kn.max()), float(walls.ks.max()))
-            kpw = kp * kw / (kp + kw)
+            kpw = in_series(kp, kw)
         return kpp, kpw
 
 

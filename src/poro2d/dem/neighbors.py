@@ -108,16 +108,22 @@ def cell_grid(pos, radius, skin, cell, members, cstart, cfill, ginfo):
         c = cy * ncx + cx
         cell[i] = c
         cstart[c + 1] += 1
+    _members_by_cell(n, ncell, cell, members, cstart, cfill)
+    ginfo[0] = ncx
+    ginfo[1] = ncy
+
+
+@njit(cache=True)
+def _members_by_cell(n, ncell, cell, members, cstart, cfill):
+    """The disks ordered by cell: ``cstart[c + 1]`` holds cell c's count on entry, its end on
+    exit; members of a cell stay in index order."""
     for c in range(ncell):
         cstart[c + 1] += cstart[c]
-    for c in range(ncell):
         cfill[c] = cstart[c]
-    for i in range(n):  # stable: members of a cell stay in index order
+    for i in range(n):
         c = cell[i]
         members[cfill[c]] = i
         cfill[c] += 1
-    ginfo[0] = ncx
-    ginfo[1] = ncy
 
 
 @njit(inline="always", cache=True)
@@ -134,16 +140,23 @@ def _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, out_j, k0, 
         for nx_ in range(max(cx - 1, 0), min(cx + 2, ncx)):
             cc = ny_ * ncx + nx_
             for m in range(cstart[cc], cstart[cc + 1]):
-                j = members[m]
-                if j <= i:
-                    continue
-                dx = pos[j, 0] - xi
-                dy = pos[j, 1] - yi
-                reach = ri + radius[j] + skin
-                if dx * dx + dy * dy < reach * reach:
-                    if write:
-                        out_j[k0 + k] = j
-                    k += 1
+                k = _take(i, members[m], xi, yi, ri, pos, radius, skin, out_j, k0, k, write)
+    return k
+
+
+@njit(inline="always", cache=True)
+def _take(i, j, xi, yi, ri, pos, radius, skin, out_j, k0, k, write):
+    """Count (and write at k0 + k) disk j as a partner of disk i when j > i lies within reach;
+    returns the count so far."""
+    if j <= i:
+        return k
+    dx = pos[j, 0] - xi
+    dy = pos[j, 1] - yi
+    reach = ri + radius[j] + skin
+    if dx * dx + dy * dy < reach * reach:
+        if write:
+            out_j[k0 + k] = j
+        return k + 1
     return k
 
 
@@ -231,21 +244,13 @@ def fill_wall_rows(
     for i in range(lo, hi):
         k = wnew_start[i]
         reach = radius[i] + skin
-        o0 = wb_start[i]
-        o1 = wb_start[i + 1]
         for w in range(nw):
             if _near_wall(pos[i, 0], pos[i, 1], reach, wp0, wp1, w):
                 wnew_w[k] = w
-                h = 0.0
-                hr = 0.0
-                for o in range(o0, o1):
-                    if wb_w[o] == w:
-                        h = wb_fs[o]
-                        hr = wb_mr[o]
-                        break
-                wnew_fs[k] = h
-                wnew_mr[k] = hr
                 k += 1
+        _carry_history(
+            wnew_start[i], k, wb_start[i], wb_start[i + 1], wb_w, wb_fs, wb_mr, wnew_w, wnew_fs, wnew_mr
+        )
 
 
 @njit(cache=True)
@@ -262,30 +267,36 @@ def copy_rows(lo, hi, new_start, new_j, new_fs, nb_start, nb_j, nb_fs, new_mr, n
 
 
 @njit(cache=True)
-def build_pairs(pos, radius, skin, nb_start, nb_j, nb_fs, new_start, new_j, new_fs):
-    """Rebuild the disk-disk half list in place, keeping shear history.
+def build_pairs(pos, radius, skin, nb_start, nb_j, nb_fs, new_start, new_j, new_fs, levels=None):
+    """Rebuild the disk-disk half list in place, keeping shear history: the kernel's phases one
+    after the other, from one cell grid or, given ``levels`` (:func:`level_scratch`), the grids
+    by size level.
 
     Returns the number of pairs, or ``-needed`` when the capacity is too small
     (nothing is changed then).
     """
     n = pos.shape[0]
-    nc = max_cells(n) + 1
-    cell = np.empty(n, dtype=np.int64)
-    members = np.empty(n, dtype=np.int64)
-    cstart = np.empty(nc, dtype=np.int64)
-    cfill = np.empty(nc, dtype=np.int64)
-    ginfo = np.zeros(4, dtype=np.int64)
-    cell_grid(pos, radius, skin, cell, members, cstart, cfill, ginfo)
-    count_pair_rows(0, n, pos, radius, skin, cell, members, cstart, ginfo, new_start)
+    g_cell = np.empty(n, dtype=np.int64)
+    g_members = np.empty(n, dtype=np.int64)
+    g_cstart = np.empty(max_cells(n) + 1, dtype=np.int64)
+    g_ginfo = np.zeros(4, dtype=np.int64)
+    if levels is None:
+        cell_grid(pos, radius, skin, g_cell, g_members, g_cstart, np.empty_like(g_cstart), g_ginfo)
+        count_pair_rows(0, n, pos, radius, skin, g_cell, g_members, g_cstart, g_ginfo, new_start)
+    else:
+        level_grid(pos, radius, skin, levels)
+        count_level_rows(0, n, pos, radius, skin, levels, new_start)
     total = prefix_rows(n, new_start)
     if total > nb_j.shape[0]:
         return -total
     nb_mr = np.zeros(nb_j.shape[0])  # no rolling history in this stand-alone build
     new_mr = np.zeros(nb_j.shape[0])
-    fill_pair_rows(
-        0, n, pos, radius, skin, cell, members, cstart, ginfo, nb_start, nb_j, nb_fs,
-        new_start, new_j, new_fs, nb_mr, new_mr,
-    )  # fmt: skip
+    if levels is None:
+        fill_pair_rows(0, n, pos, radius, skin, g_cell, g_members, g_cstart, g_ginfo, nb_start, nb_j, nb_fs,
+                       new_start, new_j, new_fs, nb_mr, new_mr)  # fmt: skip
+    else:
+        fill_level_rows(0, n, pos, radius, skin, levels, nb_start, nb_j, nb_fs, nb_mr, new_start, new_j,
+                        new_fs, new_mr)  # fmt: skip
     copy_rows(0, n, new_start, new_j, new_fs, nb_start, nb_j, nb_fs, new_mr, nb_mr)
     return total
 
@@ -467,13 +478,7 @@ def level_grid(pos, radius, skin, lv):
         c = info[b, LV_CELL0] + cy * info[b, LV_NCX] + cx
         cell[i] = c
         cstart[c + 1] += 1
-    for c in range(ncell):
-        cstart[c + 1] += cstart[c]
-        cfill[c] = cstart[c]
-    for i in range(n):  # stable: members of a cell stay in index order
-        c = cell[i]
-        members[cfill[c]] = i
-        cfill[c] += 1
+    _members_by_cell(n, ncell, cell, members, cstart, cfill)
     lv.count[0] = nlev
 
 
@@ -511,16 +516,7 @@ def _scan_level_row(i, pos, radius, skin, members, cstart, geo, info, nlev, out_
             c0 = row + _cell_index(xi - half - x0, inv, ncx)
             c1 = row + _cell_index(xi + half - x0, inv, ncx)
             for m in range(cstart[c0], cstart[c1 + 1]):
-                j = members[m]
-                if j <= i:
-                    continue
-                dx = pos[j, 0] - xi
-                dy = pos[j, 1] - yi
-                rij = ri + radius[j] + skin
-                if dx * dx + dy * dy < rij * rij:
-                    if write:
-                        out_j[k0 + k] = j
-                    k += 1
+                k = _take(i, members[m], xi, yi, ri, pos, radius, skin, out_j, k0, k, write)
     return k
 
 
@@ -599,22 +595,3 @@ def fill_level_rows(
             _merge_history(k0, k1, o0, o1, nb_j, nb_fs, nb_mr, new_j, new_fs, new_mr)
         else:
             _carry_history(k0, k1, o0, o1, nb_j, nb_fs, nb_mr, new_j, new_fs, new_mr)
-
-
-@njit(cache=True)
-def build_level_pairs(pos, radius, skin, lv, nb_start, nb_j, nb_fs, new_start, new_j, new_fs):
-    """Rebuild the disk-disk half list in place with the grids by size level (stand-alone,
-    as :func:`build_pairs`). Returns the number of pairs, or ``-needed`` (nothing changed)."""
-    n = pos.shape[0]
-    level_grid(pos, radius, skin, lv)
-    count_level_rows(0, n, pos, radius, skin, lv, new_start)
-    total = prefix_rows(n, new_start)
-    if total > nb_j.shape[0]:
-        return -total
-    nb_mr = np.zeros(nb_j.shape[0])  # no rolling history in this stand-alone build
-    new_mr = np.zeros(nb_j.shape[0])
-    fill_level_rows(
-        0, n, pos, radius, skin, lv, nb_start, nb_j, nb_fs, nb_mr, new_start, new_j, new_fs, new_mr
-    )
-    copy_rows(0, n, new_start, new_j, new_fs, nb_start, nb_j, nb_fs, new_mr, nb_mr)
-    return total

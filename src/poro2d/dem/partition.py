@@ -50,26 +50,13 @@ def partition(n, nb_start, nb_j, wb_start, part, xstart, xpair, dlist, dstart):
 
     for j in range(n + 1):
         xstart[j] = 0
-    for q in range(npart):
-        end = part[q + 1]
-        for i in range(part[q], end):
-            for p in range(nb_start[i], nb_start[i + 1]):
-                j = nb_j[p]
-                if j >= end:
-                    xstart[j + 1] += 1
+    _cross_pairs(npart, part, nb_start, nb_j, xstart, xpair, False)
     for j in range(n):
         xstart[j + 1] += xstart[j]
     # dlist serves as the fill cursor of each disk's cross list before it gets its own content
     for j in range(n):
         dlist[j] = xstart[j]
-    for q in range(npart):
-        end = part[q + 1]
-        for i in range(part[q], end):
-            for p in range(nb_start[i], nb_start[i + 1]):
-                j = nb_j[p]
-                if j >= end:
-                    xpair[dlist[j]] = p
-                    dlist[j] += 1
+    _cross_pairs(npart, part, nb_start, nb_j, dlist, xpair, True)
     m = 0
     for q in range(npart):
         dstart[q] = m
@@ -79,3 +66,20 @@ def partition(n, nb_start, nb_j, wb_start, part, xstart, xpair, dlist, dstart):
                 m += 1
     dstart[npart] = m
     return xstart[n]
+
+
+@njit(inline="always", cache=True)
+def _cross_pairs(npart, part, nb_start, nb_j, slot, xpair, fill):
+    """The pairs whose partner j lies in a later partition than their row: counted into
+    ``slot[j + 1]``, or, with ``fill``, listed in ``xpair`` at the cursor ``slot[j]``."""
+    for q in range(npart):
+        end = part[q + 1]
+        for i in range(part[q], end):
+            for p in range(nb_start[i], nb_start[i + 1]):
+                j = nb_j[p]
+                if j >= end:
+                    if fill:
+                        xpair[slot[j]] = p
+                        slot[j] += 1
+                    else:
+                        slot[j + 1] += 1

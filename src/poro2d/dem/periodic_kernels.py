@@ -13,7 +13,7 @@ start from the affine profile and makes the Lees-Edwards rule (a disk leaving at
 re-enters at the bottom with the same peculiar velocity) need no velocity jump.
 
 One contact uses the engine's contact law (:mod:`poro2d.dem.contact_law`): the same
-``linear_force``, ``rolling_moment``, ``dashpot``, with the relative velocity at the contact
+``contact_force``, ``rolling_moment``, ``dashpot``, with the relative velocity at the contact
 made of the peculiar velocities plus the affine velocity difference across the branch vector.
 A contact's branch vector goes to the partner's image: ``x_j - x_i + sx L + sy delta``,
 ``y_j - y_i + sy H`` with the integer shifts ``sx, sy`` chosen when the pair list is built.
@@ -32,7 +32,7 @@ import math
 import numpy as np
 from numba import njit
 
-from poro2d.dem.contact_law import dashpot, linear_force, rolling_moment
+from poro2d.dem.contact_law import contact_force, dashpot, reduced_mass, rolling_moment, rolling_radius
 
 # the cell's state, ``cell``
 L_, H_, DELTA, GAMMA, TIME, EXX, EYY, L_BUILD, H_BUILD, GAMMA_BUILD = range(10)
@@ -110,14 +110,9 @@ def _scan_disk(i, pos, radius, cell, skin, grid, head, nxt, fill, pj, psx, psy, 
             j = head[r * nx + c]
             while j >= 0:
                 if j > i:
-                    sx, sy, dx, dy = nearest_image(pos[j, 0] - xi, pos[j, 1] - yi, L, H, delta)
-                    reach = radius[i] + radius[j] + skin
-                    if dx * dx + dy * dy < reach * reach:
-                        if fill:
-                            pj[k] = j
-                            psx[k] = sx
-                            psy[k] = sy
-                        k += 1
+                    k = _keep_pair(
+                        i, j, pos[j, 0] - xi, pos[j, 1] - yi, radius, skin, L, H, delta, fill, pj, psx, psy, k
+                    )
                 j = nxt[j]
     return k
 
@@ -125,17 +120,25 @@ def _scan_disk(i, pos, radius, cell, skin, grid, head, nxt, fill, pj, psx, psy, 
 @njit(cache=True)
 def _scan_all(i, pos, radius, cell, skin, fill, pj, psx, psy, k):
     """The partners j > i within reach of disk i by trying every disk (cells under 3 x 3 bins)."""
+    L, H, delta = cell[L_], cell[H_], cell[DELTA]
     for j in range(i + 1, pos.shape[0]):
-        dx0 = pos[j, 0] - pos[i, 0]
-        dy0 = pos[j, 1] - pos[i, 1]
-        sx, sy, dx, dy = nearest_image(dx0, dy0, cell[L_], cell[H_], cell[DELTA])
-        reach = radius[i] + radius[j] + skin
-        if dx * dx + dy * dy < reach * reach:
-            if fill:
-                pj[k] = j
-                psx[k] = sx
-                psy[k] = sy
-            k += 1
+        dx, dy = pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1]
+        k = _keep_pair(i, j, dx, dy, radius, skin, L, H, delta, fill, pj, psx, psy, k)
+    return k
+
+
+@njit(inline="always", cache=True)
+def _keep_pair(i, j, dx, dy, radius, skin, L, H, delta, fill, pj, psx, psy, k):
+    """Count (and write at row k when ``fill``) the pair i, j when j's nearest image lies within
+    reach of i (``dx, dy``: j's centre minus i's); returns the next free row."""
+    sx, sy, dx, dy = nearest_image(dx, dy, L, H, delta)
+    reach = radius[i] + radius[j] + skin
+    if dx * dx + dy * dy < reach * reach:
+        if fill:
+            pj[k] = j
+            psx[k] = sx
+            psy[k] = sy
+        return k + 1
     return k
 
 
@@ -220,24 +223,12 @@ def contact_forces(
     vector from i to j's image (Love-Weber; V = L H t). Returns the touching contacts and this
     step's sigma_xx and sigma_yy.
     """
-    L = cell[L_]
-    H = cell[H_]
-    delta = cell[DELTA]
-    gdot = prm[GAMMA_DOT]
-    exx = cell[EXX]
-    eyy = cell[EYY]
-    dt = prm[DT]
-    kn = prm[KN]
-    ks = prm[KS]
-    mu = prm[MU]
-    mu_r = prm[MU_R]
-    beta = prm[BETA]
+    L, H, delta, exx, eyy = cell[L_], cell[H_], cell[DELTA], cell[EXX], cell[EYY]
+    dt, gdot = prm[DT], prm[GAMMA_DOT]
+    kn, ks, mu, mu_r, beta = prm[KN], prm[KS], prm[MU], prm[MU_R], prm[BETA]  # the cell's one law
     force[:] = 0.0
     moment[:] = 0.0
-    wxx = 0.0
-    wxy = 0.0
-    wyx = 0.0
-    wyy = 0.0
+    wxx = wxy = wyx = wyy = 0.0  # the contacts' sum of f l, before the volume
     touching = 0
     for p in range(pj.shape[0]):
         i = pi[p]
@@ -258,23 +249,21 @@ def contact_forces(
         dvy = vel[j, 1] - vel[i, 1] + eyy * dy
         ai = radius[i] - 0.5 * ov
         aj = radius[j] - 0.5 * ov
-        vn = -(dvx * nx + dvy * ny)
-        vt = -dvx * ny + dvy * nx - ai * omega[i] - aj * omega[j]
-        cn = dashpot(beta, kn, mass[i] * mass[j] / (mass[i] + mass[j]))
-        fn, fs, _sliding = linear_force(ov, vn, vt, pfs[p], kn, ks, mu, cn, dt)
+        cn = dashpot(beta, kn, reduced_mass(mass[i], mass[j]))
+        fn, fs, fx, fy = contact_force(
+            ov, nx, ny, dvx, dvy, ai, aj, omega[i], omega[j], pfs[p], kn, ks, mu, cn, dt
+        )
         pfn[p] = fn
         pfs[p] = fs
-        fx = -fn * nx - fs * ny  # on i
-        fy = -fn * ny + fs * nx
-        force[i, 0] += fx
+        force[i, 0] += fx  # (fx, fy) on i
         force[i, 1] += fy
         force[j, 0] -= fx
         force[j, 1] -= fy
         mi = ai * fs
         mj = aj * fs
         if mu_r > 0.0:
-            reff = radius[i] * radius[j] / (radius[i] + radius[j])
-            mr = rolling_moment(pmr[p], ks * reff * reff, (omega[i] - omega[j]) * dt, mu_r * reff * fn)
+            reff = rolling_radius(radius[i], radius[j])
+            mr = rolling_moment(pmr[p], ks, reff, omega[i] - omega[j], dt, mu_r, fn)
             pmr[p] = mr
             mi += mr
             mj -= mr

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from poro2d.dem import kernels as K
+from poro2d.dem.contact_law import PER_BODY, PER_PAIR_TYPE
 from poro2d.dem.layout import check_layout
 from poro2d.dem.model import (
     ContactModel,
@@ -586,12 +587,14 @@ class Simulation:
         prm[K.DAMP] = self.local_damping
         prm[K.SKIN] = self.skin
         prm[K.BETA] = self._beta
-        if self.contact.convention == "per_pair_type":
-            prm[K.KN_PP], prm[K.KS_PP], prm[K.MU_PP] = self.contact.pp  # type: ignore[misc]
-            prm[K.KN_PW], prm[K.KS_PW], prm[K.MU_PW] = self.contact.pw  # type: ignore[misc]
-            iprm[K.MODE] = iprm[K.MODE_PW] = self.contact.mode
-        else:
-            self._uniform_constants()
+        # the kernel mixes the bodies' values per contact where no constant stands for them
+        pp, pw = self.contact.kernel_constants(self.particles, self.walls)
+        iprm[K.MODE] = PER_BODY if pp is None else PER_PAIR_TYPE
+        iprm[K.MODE_PW] = PER_BODY if pw is None else PER_PAIR_TYPE
+        if pp is not None:
+            prm[K.KN_PP], prm[K.KS_PP], prm[K.MU_PP] = pp.kn, pp.ks, pp.mu
+        if pw is not None:
+            prm[K.KN_PW], prm[K.KS_PW], prm[K.MU_PW] = pw.kn, pw.ks, pw.mu
         prm[K.RATIO_TARGET] = ratio_target
         prm[K.TIME] = self.time
         iprm[K.NSTEPS] = nsteps
@@ -599,28 +602,6 @@ class Simulation:
         iprm[K.CHECK_OFFSET] = offset
         iprm[K.MEASURE] = measure
         iprm[K.THREADS] = self.effective_threads
-
-    def _uniform_constants(self) -> None:
-        """Per-body properties that are all equal: hand the kernel the combined constants.
-
-        The same numbers as combining per pair (the kernel's own ``series`` and ``min``
-        make them), without reading three properties of both bodies for every pair.
-        """
-        from poro2d.dem.contact_law import PER_BODY, PER_PAIR_TYPE, series
-
-        p, w = self.particles, self.walls
-        prm, iprm = self.kernel_params.prm, self.kernel_params.iprm
-        iprm[K.MODE] = iprm[K.MODE_PW] = PER_BODY
-        if p.n == 0 or not all(np.all(a == a[0]) for a in (p.kn, p.ks, p.mu)):
-            return
-        kn, ks, mu = float(p.kn[0]), float(p.ks[0]), float(p.mu[0])
-        prm[K.KN_PP], prm[K.KS_PP], prm[K.MU_PP] = series(kn, kn), series(ks, ks), mu
-        iprm[K.MODE] = PER_PAIR_TYPE
-        if w.n and all(np.all(a == a[0]) for a in (w.kn, w.ks, w.mu)):
-            prm[K.KN_PW] = series(kn, float(w.kn[0]))
-            prm[K.KS_PW] = series(ks, float(w.ks[0]))
-            prm[K.MU_PW] = min(mu, float(w.mu[0]))
-            iprm[K.MODE_PW] = PER_PAIR_TYPE
 
     def kernel_records(self) -> KernelRecords:
         """The kernel's records of the current arrays (views: the kernel advances them in place)."""

@@ -190,12 +190,7 @@ class Walls:
             raise InputError(f"wall {name} end points", (a.tolist(), b.tolist()), "two (x, y) pairs")
         if np.hypot(*(b - a)) <= 0.0:
             raise InputError(f"wall {name} length", 0.0, "(0, inf) m; its end points coincide")
-        if not kn > 0.0:
-            raise InputError(f"wall {name} kn", kn, "(0, inf) N/m")
-        if not ks >= 0.0:
-            raise InputError(f"wall {name} ks", ks, "[0, inf) N/m")
-        if not mu >= 0.0:
-            raise InputError(f"wall {name} friction", mu, "[0, inf)")
+        check_contact_values(f"wall {name}", kn, ks, mu)
         if not (is_number(mu_r) and 0.0 <= mu_r < np.inf):
             raise InputError(f"wall {name} rolling friction", mu_r, "[0, inf)")
         if name in self.names:
@@ -264,3 +259,13 @@ def _segments_overlap(a0, a1, b0, b1, tol: float = 1e-12) -> bool:
     s1 = float(np.dot(b1 - a0, u))
     lo, hi = min(s0, s1), max(s0, s1)
     return min(hi, L) - max(lo, 0.0) > tol * max(1.0, L)
+
+
+def check_contact_values(whose: str, kn: float, ks: float, mu: float) -> None:
+    """Refuse (InputError, naming ``whose`` value) springs or a friction out of range: kn > 0, ks, mu >= 0."""
+    if not kn > 0.0:
+        raise InputError(f"{whose} kn", kn, "(0, inf) N/m")
+    if not ks >= 0.0:
+        raise InputError(f"{whose} ks", ks, "[0, inf) N/m")
+    if not mu >= 0.0:
+        raise InputError(f"{whose} friction", mu, "[0, inf)")

@@ -93,10 +93,12 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
     if not drows:
         raise InputError(str(disks_path), "no disks", "at least one disk row below the header")
     _check_ids(disks_path, drows)
-    a = np.array([[_number(disks_path, k, c, v) for c, v in enumerate(r[1:], start=2)] for k, r in drows])
+    a = np.array([[read_number(disks_path, k, c, v) for c, v in enumerate(r[1:], start=2)] for k, r in drows])
     walls = []
     for k, r in wrows:
-        walls.append(WallData(r[0], *(_number(walls_path, k, c, v) for c, v in enumerate(r[1:], start=2))))
+        walls.append(
+            WallData(r[0], *(read_number(walls_path, k, c, v) for c, v in enumerate(r[1:], start=2)))
+        )
     if rolled:
         _check_rolling(disks_path, drows, a[:, 7], walls_path, wrows, [w.mu_r for w in walls])
     t = _setting(notes, "thickness", 1)
@@ -233,7 +235,8 @@ def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[dict, list[tuple[
     return notes, rows
 
 
-def _number(path: Path, line: int, column: int, text: str) -> float:
+def read_number(path: Path | str, line: int, column: int, text: str) -> float:
+    """``text`` as a finite number, or an InputError naming its file, line and column."""
     try:
         v = float(text)
     except ValueError:
@@ -250,4 +253,4 @@ def _setting(notes: dict, key: str, count: int) -> list[float] | None:
     path, line, vals = notes[key]
     if len(vals) != count:
         raise InputError(f"{path} line {line}", " ".join(vals), f"{count} numbers after '# poro2d {key}'")
-    return [_number(path, line, c, v) for c, v in enumerate(vals, start=4)]
+    return [read_number(path, line, c, v) for c, v in enumerate(vals, start=4)]

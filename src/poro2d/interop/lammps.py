@@ -44,6 +44,7 @@ import numpy as np
 from poro2d import __version__
 from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
+from poro2d.interop.csv_table import read_number
 from poro2d.interop.specimen_data import SpecimenData, WallData
 from poro2d.interop.validate import LIMITS, check_value, text_of
 
@@ -274,16 +275,7 @@ def _numbers(p: Path, k: int, words: list[str], lo: int, hi: int) -> list[float]
         raise InputError(
             f"{p} line {k} column {column}", found, f"{lo} to {hi} numbers" if lo != hi else f"{lo} numbers"
         )
-    out = []
-    for c, w in enumerate(words, start=1):
-        try:
-            v = float(w)
-        except ValueError:
-            raise InputError(f"{p} line {k} column {c}", w, "a number") from None
-        if not math.isfinite(v):
-            raise InputError(f"{p} line {k} column {c}", w, "a finite number")
-        out.append(v)
-    return out
+    return [read_number(p, k, c, w) for c, w in enumerate(words, start=1)]
 
 
 # ------------------------------------------------------------------ input script

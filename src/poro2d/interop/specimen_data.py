@@ -30,6 +30,7 @@ import numpy as np
 
 from poro2d import __version__
 from poro2d.dem import ContactModel, Particles, Simulation, Walls
+from poro2d.dem.model import PER_BODY_RULE, ContactValues
 from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
 from poro2d.interop.origin import origin_lines
@@ -184,9 +185,12 @@ class SpecimenData:
                     f"disk {name}", f"from {a.min():g} to {a.max():g}",
                     "one value for every disk (the target takes one set of contact properties)",
                 )  # fmt: skip
-        kn, ks, mu = float(self.kn[0]), float(self.ks[0]), float(self.mu[0])
-        walls = {w.name: ContactLaw(series(kn, w.kn), series(ks, w.ks), min(mu, w.mu)) for w in self.walls}
-        return ByPairType(ContactLaw(series(kn, kn), series(ks, ks), mu), walls)
+        law, disk = ContactModel(), ContactValues(float(self.kn[0]), float(self.ks[0]), float(self.mu[0]))
+        walls = {
+            w.name: ContactLaw(*law.pair(disk, ContactValues(w.kn, w.ks, w.mu), wall=True)[:3])
+            for w in self.walls
+        }
+        return ByPairType(ContactLaw(*law.pair(disk, disk)[:3]), walls)
 
     def rolling_parameters(self) -> ByPairType[float]:
         """The contact-level rolling friction of disk-disk contacts and of each wall's.
@@ -200,8 +204,11 @@ class SpecimenData:
                 "disk rolling friction", f"from {mu_r.min():g} to {mu_r.max():g}",
                 "one value for every disk (the target takes one set of contact properties)",
             )  # fmt: skip
-        disk = float(mu_r[0]) if self.n else 0.0
-        return ByPairType(disk, {w.name: min(disk, w.mu_r) for w in self.walls})
+        law, disk = ContactModel(), ContactValues(0.0, 0.0, 0.0, float(mu_r[0]) if self.n else 0.0)
+        walls = {
+            w.name: law.pair(disk, ContactValues(0.0, 0.0, 0.0, w.mu_r), wall=True).mu_r for w in self.walls
+        }
+        return ByPairType(disk.mu_r, walls)
 
     def header(self, comment: str) -> list[str]:
         """Lines that every exported file starts with: units, thickness convention, version."""
@@ -209,7 +216,7 @@ class SpecimenData:
             f"poro2d {__version__} specimen: {self.n} disks, {len(self.walls)} walls",
             "units: SI (m, kg, s, N); stiffness N/m; friction coefficients",
             f"disk thickness t = {self.thickness!r} m: disk mass rho pi r^2 t, inertia m r^2 / 2",
-            "contact properties per body (PFC 4.0): kn = kA kB / (kA + kB), ks likewise, mu = min(muA, muB)",
+            f"contact properties per body (PFC 4.0): {PER_BODY_RULE}",
             f"gravity {self.gravity[0]!r} {self.gravity[1]!r} m/s2; local damping {self.local_damping!r}"
             + (f"; time step {self.dt!r} s" if self.dt else ""),
         ]
@@ -264,11 +271,6 @@ class SpecimenData:
             p, walls, ContactModel("per_body"), gravity=self.gravity, local_damping=self.local_damping,
             dt=dt, threads=threads, restitution=self.restitution,
         )  # fmt: skip
-
-
-def series(ka: float, kb: float) -> float:
-    """Two springs in series (PFC 4.0 property combination)."""
-    return ka * kb / (ka + kb) if ka + kb > 0 else 0.0
 
 
 def resolve_specimen(path: str | os.PathLike) -> Path:
