@@ -93,9 +93,9 @@ def register(app: typer.Typer) -> None:
         from poro2d.critical_state import CriticalStateCase, run_critical_states
         from poro2d.critical_state.case import CASE_RANGES
         from poro2d.critical_state.line import MAX_PRESSURES, run_critical_state_line
-        from poro2d.report.critical_state_figures import draw_critical_state, draw_critical_state_line
         from poro2d.critical_state.run import MAX_SEEDS
         from poro2d.errors import InputError, check_int
+        from poro2d.report.critical_state_figures import draw_critical_state, draw_critical_state_line
 
         rule = CASE_RANGES["pressure_kpa"]
         PRESSURE_RANGE_KPA = (rule.lo, rule.hi)

@@ -97,6 +97,7 @@ def register(app: typer.Typer) -> None:
         from poro2d.errors import InputError, check_int
         from poro2d.io_utils import check_output_dir
         from poro2d.locks import output_folder
+        from poro2d.report.strength_figure import draw_strength
         from poro2d.shear import strength as st
         from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
         from poro2d.specimen.specimen_set import SpecimenSet
@@ -152,6 +153,7 @@ def register(app: typer.Typer) -> None:
             except RuntimeError as exc:
                 console.print(f"[bold red]failed:[/] {exc}")
                 raise typer.Exit(1) from None
+            draw_strength(result, study.store)
         print_strength(result, out)
 
 

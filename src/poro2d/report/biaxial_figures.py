@@ -175,4 +175,11 @@ def _circles(ax, peaks, colours, envelope) -> None:
     ax.set_ylabel("shear stress tau (kPa)")
 
 
-__all__ = ["FIGURE", "SERIES_FIGURE", "draw_biaxial", "draw_biaxial_series", "plot_biaxial", "plot_biaxial_series"]
+__all__ = [
+    "FIGURE",
+    "SERIES_FIGURE",
+    "draw_biaxial",
+    "draw_biaxial_series",
+    "plot_biaxial",
+    "plot_biaxial_series",
+]
