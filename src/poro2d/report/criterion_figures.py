@@ -42,6 +42,14 @@ def draw_criterion(result: CriterionResult, store: Store) -> None:
     _accepted_figures(result, store, width)
 
 
+def draw_stored_criterion(store: Store) -> None:
+    """:func:`draw_criterion` of a finished run kept in ``store`` (its ``result.json`` read through
+    the store: a replicate seed's, a sweep case's); nothing without one."""
+    result = store.read_result("result.json", CriterionResult.from_dict)
+    if result is not None:
+        draw_criterion(result, store)
+
+
 def _force_figure(folder: Store, state: tuple[str, str], width: float, title: str, forces: WallForces,
                   weight: float) -> None:  # fmt: skip
     """The force chains of a kept state in the box under its top, with F_top, F_bottom and G noted."""
@@ -96,4 +104,4 @@ def _accepted_figures(result: CriterionResult, store: Store, width: float) -> No
     plot_local_porosity(p.pos, p.radius, width, top, m, store.path("local_porosity.png"), title=title)
 
 
-__all__ = ["draw_criterion"]
+__all__ = ["draw_criterion", "draw_stored_criterion"]
