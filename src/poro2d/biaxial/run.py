@@ -101,7 +101,7 @@ def run_biaxial(
     ``case``: a :class:`BiaxialCase`, or a list of them, one per replicate specimen (then
     ``replicates`` stays 1). ``store``: where the files go (``result.json``, ``curves.csv``,
     and per replicate ``replicate<k>/result.json`` and ``curve.csv``; the figure, ``biaxial.png``,
-    is drawn from the result by :func:`poro2d.report.biaxial_figures.draw_biaxial`); None:
+    is drawn from the result by ``draw_biaxial`` (``report/biaxial_figures.py``)); None:
     nothing is kept. ``lab``: a laboratory CSV of the user's (:mod:`poro2d.biaxial.lab`),
     recorded in the result. ``options``: where the tests run (``workers`` processes, default one
     per replicate and at most one per core, or a running ``scheduler``) and whether bars show.

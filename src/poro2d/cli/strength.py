@@ -47,17 +47,21 @@ def quick_specimens(out: Path, seeds: int, progress: bool) -> SpecimenSet:
     from poro2d.criterion.config import paper_config
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.criterion.replicates import accepted_and_replicates
+    from poro2d.report.criterion_figures import draw_specimens
     from poro2d.store import Store
 
     cfg = paper_config(True, 0)
     spec, grading, settings, seed = cfg.build(threads=1)
     crit = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(out / "criterion"),
                              progress=progress, config=cfg.as_config())  # fmt: skip
-    result = crit.run()
-    if not result.converged:
-        raise RuntimeError(f"the quick specimen was not accepted: {result.message}")
-    specimens, _ = accepted_and_replicates(crit.spec, crit.grading, crit.settings, result.final_porosity,
-                                           crit.seed, seeds, Store(out), progress=progress)  # fmt: skip
+    try:
+        result = crit.run()
+        if not result.converged:
+            raise RuntimeError(f"the quick specimen was not accepted: {result.message}")
+        specimens, _ = accepted_and_replicates(crit.spec, crit.grading, crit.settings, result.final_porosity,
+                                               crit.seed, seeds, Store(out), progress=progress)  # fmt: skip
+    finally:  # the specimens' figures, drawn from the states their runs kept
+        draw_specimens(Store(out))
     return specimens
 
 

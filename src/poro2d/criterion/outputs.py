@@ -5,7 +5,7 @@ states; once the run ends, the accepted specimen is written here (``specimen.npz
 VTU), with its homogeneity and stress state (``specimen_state.json``) and its porosities
 (``specimen_porosity.json``). Every file goes through the :class:`~poro2d.store.Store`. The
 figures (force chains, Figs. 5-7, the state and the local porosity map) are drawn afterwards
-from the states the trials keep (:mod:`poro2d.report.criterion_figures`).
+from the states the trials keep (``report/criterion_figures.py``).
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ stops with a clear message and keeps every trial's results. A trial is a typed r
 made of its parts (:mod:`poro2d.criterion.trial`), its measures are those of
 :mod:`poro2d.criterion.measures`, and the accepted specimen's files are written by
 :mod:`poro2d.criterion.outputs`, outside the loop (the figures are drawn afterwards from the
-states every trial keeps, by :mod:`poro2d.report.criterion_figures`).
+states every trial keeps, by ``report/criterion_figures.py``).
 
 A trial is only accepted when, besides the paper's condition, its specimen passes
 the checks of :func:`specimen_checks` (every planned disk built and inside the box,
@@ -310,7 +310,7 @@ class PorosityCriterion:
 
     ``store``: where the trials, the table and the result are kept, and from which a rerun
     resumes; None keeps nothing (compute only). The figures are drawn from the states it keeps,
-    once it has returned (:func:`poro2d.report.criterion_figures.draw_criterion`).
+    once it has returned (``draw_criterion`` (``report/criterion_figures.py``)).
     """
 
     def __init__(

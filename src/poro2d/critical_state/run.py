@@ -79,7 +79,7 @@ def run_critical_state(
     """One periodic shear run of ``case``: its steady state and the series.
 
     ``store``: where ``result.json`` and ``series.csv`` go (None: nothing kept; the figure is
-    drawn from the result by :func:`poro2d.report.critical_state_figures.draw_critical_state`).
+    drawn from the result by ``draw_critical_state`` (``report/critical_state_figures.py``)).
     ``report(phase, fraction)``: told how far the run is. Raises RuntimeError if the
     compression does not reach the pressure.
     """

@@ -18,7 +18,7 @@ from poro2d.measure.specimen_porosity import measure_specimen
 from poro2d.measure.specimen_state import specimen_state
 from poro2d.report.force_chains import plot_simulation_force_chains
 from poro2d.report.specimen_figures import plot_local_porosity, plot_specimen_state
-from poro2d.store import Store
+from poro2d.store import Store, walk
 
 #: a trial's figure of each state it keeps
 PREPARED = ("prepared.npz", "forces_trial.png")
@@ -48,6 +48,14 @@ def draw_stored_criterion(store: Store) -> None:
     result = store.read_result("result.json", CriterionResult.from_dict)
     if result is not None:
         draw_criterion(result, store)
+
+
+def draw_specimens(store: Store) -> None:
+    """The figures of the preset specimens a run made in ``store`` (``poro2d calibrate``, ``strength
+    --quick``): its ``criterion`` and each seed of its ``replicates``; nothing where none were made."""
+    draw_stored_criterion(store.child("criterion"))
+    for seed in walk(store.child("replicates"), "seed*"):
+        draw_stored_criterion(seed)
 
 
 def _force_figure(folder: Store, state: tuple[str, str], width: float, title: str, forces: WallForces,
@@ -104,4 +112,4 @@ def _accepted_figures(result: CriterionResult, store: Store, width: float) -> No
     plot_local_porosity(p.pos, p.radius, width, top, m, store.path("local_porosity.png"), title=title)
 
 
-__all__ = ["draw_criterion", "draw_stored_criterion"]
+__all__ = ["draw_criterion", "draw_specimens", "draw_stored_criterion"]

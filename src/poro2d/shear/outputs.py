@@ -1,5 +1,5 @@
 """The files of a direct shear series: test folders, curves and peaks tables (Fig. 8 is drawn from
-the result by :mod:`poro2d.report.shear_figures`)."""
+the result by ``report/shear_figures.py``)."""
 
 from __future__ import annotations
 

@@ -5,7 +5,7 @@ a window past it exist. So every record's state is kept as a :class:`PeakFrame` 
 arrays: disks, walls, contacts) until its smoothed value is final; :class:`PeakTracker`
 keeps the frame of the largest one. The frame is saved beside the shear checkpoint, so a
 resumed test still finds it, and at the end of the shear: the figure of the peak's forces is
-drawn from it once the test has returned (:func:`poro2d.report.shear_figures.draw_peak_forces`).
+drawn from it once the test has returned (``draw_peak_forces`` (``report/shear_figures.py``)).
 """
 
 from __future__ import annotations

@@ -63,7 +63,7 @@ def run_shear(
     config: dict | None = None,
 ) -> ShearSeriesResult:
     """Direct shear tests on ``specimen`` at ``normal_stresses_kpa`` and the fit (Fig. 8 is drawn from
-    the result: :func:`poro2d.report.shear_figures.draw_shear_series`).
+    the result: ``draw_shear_series`` (``report/shear_figures.py``)).
 
     ``specimen``: a checkpoint (.npz) or a criterion output folder holding ``specimen.npz``
     (read once: every test starts from that content). ``normal_stresses_kpa``: a number or

@@ -62,10 +62,10 @@ class ShearSeries:
     ``specimen``: a :class:`~poro2d.specimen.saved.Specimen`, or its path (read once,
     here). With ``store`` it keeps ``result.json`` (per test and overall), ``peaks.csv``,
     ``curves.csv`` and one sub-store per test (see :class:`DirectShearTest`; Fig. 8 is drawn from
-    the result by :func:`poro2d.report.shear_figures.draw_shear_series`); with ``rate_check``
+    the result by ``draw_shear_series`` (``report/shear_figures.py``)); with ``rate_check``
     every test is repeated at half the velocity under ``rate_check/`` and the change of the peak
-    is reported. Finished tests are skipped on a rerun; a killed test resumes from its checkpoint. ``store=None``:
-    nothing is kept.
+    is reported. Finished tests are skipped on a rerun; a killed test resumes from its
+    checkpoint. ``store=None``: nothing is kept.
     """
 
     def __init__(

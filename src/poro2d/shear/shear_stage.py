@@ -123,7 +123,7 @@ class ShearStage:
 
 def remove_stage_files(store: Store) -> None:
     """The checkpoint of a test in ``store``, once its results are written (the peak's frame stays
-    until its figure is drawn: :func:`poro2d.report.shear_figures.draw_peak_forces`)."""
+    until its figure is drawn: ``draw_peak_forces`` (``report/shear_figures.py``))."""
     store.checkpoints(CHECKPOINT).clear()
 
 

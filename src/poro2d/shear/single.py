@@ -63,7 +63,7 @@ class DirectShearTest:
     With ``store`` every stage is kept there as it finishes (``consolidated.npz``,
     ``consolidation.json``, ``shear_checkpoint.npz`` during shearing, ``curve.csv``,
     ``result.json`` and, with ``keep_peak``, the state at the smoothed peak, ``peak_frame.npz``,
-    from which :func:`poro2d.report.shear_figures.draw_peak_forces` draws its force chains); a
+    from which ``draw_peak_forces`` (``report/shear_figures.py``) draws its force chains); a
     rerun skips what is done and continues a shear stage from its last checkpoint.
     ``store=None``: nothing is kept. ``progress(phase, fraction)`` is called between blocks of
     steps. Without ``keep_peak`` no state is kept at the peak and the mean overlap is the end's.

@@ -295,7 +295,7 @@ class StrengthStudy:
     @staticmethod
     def _write(store: Store, result: StrengthResult, tests: list[dict]) -> None:
         """The study's tables and ``strength.json`` (its figure is drawn from the result:
-        :func:`poro2d.report.strength_figure.draw_strength`)."""
+        ``draw_strength`` (``report/strength_figure.py``))."""
         rows = result.cases
         store.write_csv("strength_tests.csv", tests)
         store.write_csv("strength.csv", [{k: v for k, v in r.to_dict().items() if not k.endswith("_ci_deg")}

@@ -300,7 +300,7 @@ def _relation(pts: list[dict], n_max: float, n_min: float, mode: str, **extra: A
 
 def write_relation(rel: RelationResult, store: Store, extra: dict | None = None) -> list[Path]:
     """relation.csv and relation.json in ``store`` (the figures, relation.png and relation.svg, are
-    drawn from the result by :func:`poro2d.report.relation_figure.draw_relation`).
+    drawn from the result by ``draw_relation`` (``report/relation_figure.py``)).
 
     ``rel``: an analysed relation (with ``extra`` keys for the file) or a :class:`RelationResult`.
     """

@@ -531,7 +531,7 @@ def write_sensitivity(sens: dict, store: Store) -> SensitivityResult:
     """sensitivity.json, sensitivity.csv (points) and sensitivity_seeds.csv; the study typed.
 
     Its ``figure`` names ``sensitivity.png`` in ``store``, which
-    :func:`poro2d.report.sensitivity_report.draw_sensitivity` draws from the result."""
+    ``draw_sensitivity`` (``report/sensitivity_report.py``) draws from the result."""
     from poro2d.io_utils import Provenance
 
     sens = dict(sens, figure=str(store.path("sensitivity.png")), provenance=Provenance.now().to_dict())
