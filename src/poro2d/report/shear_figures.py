@@ -43,20 +43,13 @@ def draw_peak_forces(store: Store) -> None:
         return
     b = test.consolidation.box
     plot_force_chains(
-        frame.contacts,
-        frame.pos,
-        frame.radius,
-        frame.walls,
-        store.path("forces_peak.png"),
-        thickness=frame.thickness,
+        frame.contacts, frame.pos, frame.radius, frame.walls, store.path("forces_peak.png"),
+        thickness=frame.thickness, box=(-0.02 * b.width, 0.0, b.width + b.max_displacement, b.height),
         title=f"direct shear at {test.normal_stress_kpa:g} kPa, at the peak: "
-        f"d = {frame.displacement_mm:.2f} mm",
-        box=(-0.02 * b.width, 0.0, b.width + b.max_displacement, b.height),
-        notes=[
-            f"tau_peak = {test.peak_shear_stress_kpa:.1f} kPa (smoothed over "
-            f"{1e3 * test.settings.peak_window:g} mm)"
-        ],
-    )
+              f"d = {frame.displacement_mm:.2f} mm",
+        notes=[f"tau_peak = {test.peak_shear_stress_kpa:.1f} kPa (smoothed over "
+               f"{1e3 * test.settings.peak_window:g} mm)"],
+    )  # fmt: skip
     store.remove(PEAK_FRAME)
 
 
@@ -65,31 +58,19 @@ def draw_shear_series(result: ShearSeriesResult, store: Store, lab: LabData | No
     ``fig8b_peak_strength.png`` (the fits); ``lab``: the laboratory data the series was given."""
     for t in result.tests:
         draw_peak_forces(store.child(t.folder))
-    sig = [t.normal_stress_kpa for t in result.tests]
-    tau = [t.peak_shear_stress_kpa for t in result.tests]
-    fit = mohr_coulomb(np.array(sig), np.array(tau)) if len(sig) >= 2 else None
-    fit0 = mohr_coulomb(np.array(sig), np.array(tau), through_origin=True)
-    s = result.settings
-    peaks = {
-        t.normal_stress_kpa: (t.shear_displacement_at_peak_m, t.peak_shear_stress_kpa) for t in result.tests
-    }
+    tests, s = result.tests, result.settings
+    sig, tau = [t.normal_stress_kpa for t in tests], [t.peak_shear_stress_kpa for t in tests]
+    peaks = {t.normal_stress_kpa: (t.shear_displacement_at_peak_m, t.peak_shear_stress_kpa) for t in tests}
     plot_shear_curves(
-        result.curves,
-        store.path("fig8a_shear_curves.png"),
-        lab=lab,
-        peaks=peaks,
+        result.curves, store.path("fig8a_shear_curves.png"), lab=lab, peaks=peaks,
         smoothing_note=f"v = {1e3 * s.velocity:g} mm/s; peaks (dots) smoothed over "
-        f"{1e3 * s.peak_window:g} mm",
-    )
+                       f"{1e3 * s.peak_window:g} mm",
+    )  # fmt: skip
     plot_peak_strength(
-        sig,
-        tau,
-        fit,
-        store.path("fig8b_peak_strength.png"),
-        fit_origin=fit0,
-        lab=lab,
-        lab_fit=lab_fit(lab),
-    )
+        sig, tau, mohr_coulomb(np.array(sig), np.array(tau)) if len(sig) >= 2 else None,
+        store.path("fig8b_peak_strength.png"), lab=lab, lab_fit=lab_fit(lab),
+        fit_origin=mohr_coulomb(np.array(sig), np.array(tau), through_origin=True),
+    )  # fmt: skip
 
 
 def draw_replicate_shear(result: ReplicateShearResult, store: Store, lab: LabData | None = None) -> None:
@@ -97,14 +78,11 @@ def draw_replicate_shear(result: ReplicateShearResult, store: Store, lab: LabDat
     +- sd bands, peaks with the pooled fit."""
     for label, series in result.series.items():
         draw_shear_series(series, store.child(label), lab)
-    bands = {}
-    for row in result.per_normal_stress:
-        sigma = row.normal_stress_kpa
-        bands[sigma] = curve_band([res.curves[sigma] for res in result.series.values()])
+    bands = {r.normal_stress_kpa: curve_band([s.curves[r.normal_stress_kpa] for s in result.series.values()])
+             for r in result.per_normal_stress}  # fmt: skip
     plot_replicate_curves(bands, store.path("fig8a_shear_curves_replicates.png"), len(result.series), lab=lab)
-    plot_replicate_peaks(
-        result, store.path("fig8b_peak_strength_replicates.png"), lab=lab, lab_fit=lab_fit(lab)
-    )
+    peaks_png = store.path("fig8b_peak_strength_replicates.png")
+    plot_replicate_peaks(result, peaks_png, lab=lab, lab_fit=lab_fit(lab))
 
 
 def plot_shear_curves(
