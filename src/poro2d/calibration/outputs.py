@@ -117,17 +117,9 @@ def _biaxial_config(result, stresses) -> str:
     table = {k: v for k, v in result.settings.to_dict().items() if v is not None}
     table.update(particle_friction=b.particle_friction, rolling_friction=b.rolling_friction,
                  confining_kpa=list(stresses))  # fmt: skip
-    lines = [
-        "# poro2d calibrate (biaxial laboratory tests):",
-        "# the posterior maximum of particle and rolling friction",
-        f"# ({_known(result)}); see result.json and calibration.md before using them",
-        "",
-        "[specimen]",
-        *_specimen_lines(b),
-        "",
-        "[biaxial]",
-    ] + [f"{k} = {_toml_value(v)}" for k, v in table.items()]
-    return "\n".join(lines) + "\n"
+    head = ["# poro2d calibrate (biaxial laboratory tests):", "# the posterior maximum of particle and "
+            "rolling friction"]  # fmt: skip
+    return _config_text(head, result, "biaxial", table)
 
 
 def _config(result, lab) -> str:
@@ -142,16 +134,14 @@ def _config(result, lab) -> str:
     what = "particle and rolling friction" + (
         " and the disks' stiffness" if any(getattr(b, k) is not None for k in _STIFFNESS) else ""
     )
-    lines = [
-        f"# poro2d calibrate: the posterior maximum of {what}",
-        f"# ({_known(result)}); see result.json and calibration.md before using them",
-        "",
-        "[specimen]",
-        *_specimen_lines(b),
-        "",
-        "[shear]",
-    ] + [f"{k} = {_toml_value(v)}" for k, v in shear.items()]
-    return "\n".join(lines) + "\n"
+    return _config_text([f"# poro2d calibrate: the posterior maximum of {what}"], result, "shear", shear)
+
+
+def _config_text(head: list[str], result, name: str, table: dict) -> str:
+    """``head`` comments, the calibrated ``[specimen]`` lines, then the table ``[name]``."""
+    lines = [*head, f"# ({_known(result)}); see result.json and calibration.md before using them", "",
+             "[specimen]", *_specimen_lines(result.best), "", f"[{name}]"]  # fmt: skip
+    return "\n".join(lines + [f"{k} = {_toml_value(v)}" for k, v in table.items()]) + "\n"
 
 
 __all__ = ["CONFIG_TOML", "FIT_PNG", "POSTERIOR_PNG", "FitDrawing", "write_outputs"]
