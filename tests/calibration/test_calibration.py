@@ -427,6 +427,7 @@ def test_a_laboratory_poro2d_did_not_write_gets_the_discrepancy_term(tiny, tmp_p
               **FIT_BOX)  # fmt: skip
     own = run_calibration(lab, [paths[0], paths[1]], **kw)
     other = run_calibration(real, [paths[0], paths[1]], **kw)  # the same tests, from the cache
+    draw_calibration(other, kw["store"])  # its report, as the command draws it
     assert other.cluster.tests_run == 0
     assert "discrepancy" not in own.posterior.to_dict() and "discrepancy" not in own.config
     term = other.posterior.discrepancy
