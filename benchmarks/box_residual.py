@@ -130,7 +130,7 @@ def main() -> None:
                         ("test", args.normal_stress, case_name(c), spec_label),
                         case,
                         str(folder),
-                        figures=False,
+                        keep_peak=False,
                         series=f"{case_name(c)} {spec_label}",
                     ),
                 )

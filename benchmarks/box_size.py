@@ -149,7 +149,7 @@ def shear_jobs(out: Path, found: dict[tuple[str, int], Path], args) -> list:
         settings = ShearSettings(max_displacement=length, stop_after_peak=0.0, particle_friction=fp)
         folder = out / "shear" / name / f"s{seed}"
         case = ShearCase(specimen, args.normal_stress, settings)
-        job = ShearJob(("test", args.normal_stress, name, seed), case, str(folder), figures=False,
+        job = ShearJob(("test", args.normal_stress, name, seed), case, str(folder), keep_peak=False,
                        series=f"{name} s{seed}")  # fmt: skip
         jobs.append((name, seed, specimen, job))
     return jobs

@@ -273,6 +273,7 @@ def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, *,
     """
     from poro2d.criterion.result import CriterionOutputs
     from poro2d.criterion.table import print_result
+    from poro2d.report.criterion_figures import draw_criterion, draw_stored_criterion
 
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
@@ -283,6 +284,7 @@ def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, *,
     t1 = time.perf_counter()
     result = crit.run()
     timings["criterion_s"] = time.perf_counter() - t1
+    draw_criterion(result, store.child("criterion"))
     print_result(result, store.child("criterion"))
     shear = reps = None
     shear_figures: dict[str, Path] = {}
@@ -292,6 +294,8 @@ def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, *,
         specimens, reps = accepted_and_replicates(crit.spec, crit.grading, crit.settings, n2d, crit.seed,
                                                   replicates, store, progress=progress)  # fmt: skip
         timings["replicates_s"] = time.perf_counter() - t2
+        for row in reps or []:
+            draw_stored_criterion(store.child("replicates", row.folder))
         shear, shear_figures = _shear_stage(specimens, store.child("shear"), quick, lab_data, progress)
         timings["shear_s"] = time.perf_counter() - t2 - timings["replicates_s"]
     else:
@@ -326,6 +330,7 @@ def _shear_stage(specimens: SpecimenSet, store: Store, quick: bool, lab_data,
                  progress: bool) -> tuple[PaperShear, dict[str, Path]]:  # fmt: skip
     """Direct shear at the paper's normal stresses on every specimen; the summary over them and
     the figures written (Fig. 8 over the specimens, the first specimen's curves)."""
+    from poro2d.report.shear_figures import draw_replicate_shear
     from poro2d.shear.replicates import ReplicateShear
     from poro2d.shear.settings import ShearSettings
 
@@ -336,6 +341,7 @@ def _shear_stage(specimens: SpecimenSet, store: Store, quick: bool, lab_data,
     sset = ShearSettings(**(QUICK_SHEAR if quick else {}))
     rep = ReplicateShear(specimens, NORMAL_STRESSES_KPA, sset, store=store, lab=lab_data,
                          options=RunOptions(progress=progress)).run()  # fmt: skip
+    draw_replicate_shear(rep, store, lab_data)
     first_label, first = next(iter(rep.series.items()))
     fit = rep.fit  # None with one normal stress
     phi, c, r2 = (fit.friction_angle_deg, fit.cohesion_kpa, fit.r2) if fit is not None else (None,) * 3

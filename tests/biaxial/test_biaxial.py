@@ -19,9 +19,11 @@ from poro2d.biaxial import (
 )
 from poro2d.biaxial.angles import read_angles
 from poro2d.biaxial.curve import BiaxialCurve
+from poro2d.biaxial.lab import read_lab_curve
 from poro2d.cli import main
 from poro2d.errors import InputError
 from poro2d.execute import RunOptions
+from poro2d.report.biaxial_figures import draw_biaxial
 from poro2d.store import Store
 
 SHORT = {"max_strain": 0.03, "critical_window": 0.34}
@@ -36,6 +38,7 @@ def full(tmp_path_factory):
                    "0,100,100,0\n0.01,200,100,0.003\n0.02,250,100,0.004\n0.05,230,100,-0.01\n"
                    "0.1,210,100,-0.02\n")  # fmt: skip
     result = run_biaxial(BiaxialCase.quick(100.0, seed=0), Store(out), lab=lab)
+    draw_biaxial(result, Store(out), read_lab_curve(lab))  # as the command draws it, after the run
     return out, result
 
 

@@ -15,6 +15,7 @@ from poro2d.biaxial.series import sigma_3_at_peak
 from poro2d.cli import main
 from poro2d.errors import InputError
 from poro2d.execute import RunOptions
+from poro2d.report.biaxial_figures import draw_biaxial_series
 from poro2d.store import Store
 
 TINY = {"max_strain": 0.02, "critical_window": 0.5}
@@ -62,9 +63,9 @@ def test_an_envelope_needs_two_stresses():
 def series(tmp_path_factory):
     out = tmp_path_factory.mktemp("series")
     case = BiaxialCase.quick(100.0, seed=2, settings=BiaxialSettings(**TINY))
-    return out, run_biaxial_series(
-        case, [100.0, 50.0], Store(out), replicates=2, options=RunOptions(workers=1)
-    )
+    result = run_biaxial_series(case, [100.0, 50.0], Store(out), replicates=2, options=RunOptions(workers=1))
+    draw_biaxial_series(result, Store(out))  # as the command draws them, after the run
+    return out, result
 
 
 def test_a_series_runs_each_stress_on_its_replicates(series):

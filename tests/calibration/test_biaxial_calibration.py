@@ -25,6 +25,7 @@ from poro2d.calibration.units import (
 from poro2d.cli import main
 from poro2d.errors import InputError
 from poro2d.execute.options import RunOptions
+from poro2d.report.calibration_figures import draw_calibration
 from poro2d.store import Store
 
 QUIET = RunOptions(progress=False)
@@ -298,6 +299,7 @@ def test_a_small_synthetic_biaxial_calibration_fits_the_ratios_and_the_volumetri
     out = tmp_path / "cal"
     kw = dict(specimens=paths[:2], store=Store(out), points=9, refine=0, settings=FAST, options=ONE_WORKER)
     res = run_calibration(biaxial_lab=lab, **kw)
+    draw_calibration(res, Store(out))  # the figures and the report, as the command draws them
     assert res.test == "biaxial" and res.cluster.tests_run == 9 * 2 and res.box_scale is None
     assert list(res.fit) == ["peak_ratio_50kPa", "end_ratio_50kPa", "end_volumetric_50kPa"]
     saved = json.loads((out / "result.json").read_text())
@@ -314,9 +316,7 @@ def test_a_small_synthetic_biaxial_calibration_fits_the_ratios_and_the_volumetri
     peak = next(o for o in saved["posterior"]["observables"] if o["observable"] == "peak_ratio")
     assert 0.2 < peak["lab_ratio"] < 0.9 and 0.0 < peak["noise_sd_ratio"] < 0.5
     kept = CalibrationResult.read(Store(out))
-    assert (
-        kept.to_dict() == saved and kept.biaxial and type(kept.settings).__name__ == "BiaxialSettings"
-    )
+    assert kept.to_dict() == saved and kept.biaxial and type(kept.settings).__name__ == "BiaxialSettings"
     report = (out / "calibration.md").read_text()
     assert "| peak_ratio | 50 | 1 |" in report and "Biaxial tests: 18 run" in report
     assert "confining stress (kPa)" in report

@@ -15,6 +15,7 @@ from poro2d.cli.shear import load_shear_config
 from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.execute.options import RunOptions
+from poro2d.report.calibration_figures import draw_calibration
 from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
 from poro2d.store import Store
@@ -139,6 +140,7 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     out = tmp_path / "cal"
     res = run_calibration(lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2, settings=SHORT,
                           options=ONE_WORKER, **FIT_BOX)  # fmt: skip
+    draw_calibration(res, Store(out))  # the figures and the report, as the command draws them
     for name, value in TRUTH.items():
         lo, hi = getattr(res.intervals, name)
         assert lo <= value <= hi, (name, value, lo, hi)
@@ -236,6 +238,7 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
         **FIT_BOX,
     )
     res = run_calibration(lab, [paths[0], paths[1]], **kw)
+    draw_calibration(res, Store(out))
     keys = [f"{o}_{s}kPa" for o in ("peak", "end", "dilation") for s in (50, 100)]
     assert list(res.fit) == keys
     saved = json.loads((out / "result.json").read_text())
@@ -424,6 +427,7 @@ def test_a_laboratory_poro2d_did_not_write_gets_the_discrepancy_term(tiny, tmp_p
               **FIT_BOX)  # fmt: skip
     own = run_calibration(lab, [paths[0], paths[1]], **kw)
     other = run_calibration(real, [paths[0], paths[1]], **kw)  # the same tests, from the cache
+    draw_calibration(other, kw["store"])  # its report, as the command draws it
     assert other.cluster.tests_run == 0
     assert "discrepancy" not in own.posterior.to_dict() and "discrepancy" not in own.config
     term = other.posterior.discrepancy

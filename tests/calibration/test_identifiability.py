@@ -19,6 +19,7 @@ from poro2d.cli.calibrate import print_result
 from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.execute.options import RunOptions
+from poro2d.report.calibration_figures import draw_calibration
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 
@@ -150,6 +151,7 @@ def test_one_specimen_reports_its_intervals_as_unknown(specimen, lab, tmp_path, 
     out = tmp_path / "out"
     res = run_calibration(lab, [specimen], store=Store(out), points=MIN_POINTS, refine=0, settings=SHORT,
                           options=ONE_WORKER, keep_box_dominated=True)  # fmt: skip
+    draw_calibration(res, Store(out))  # the figures and the report, as the command draws them
     assert "one specimen" in res.unidentified
     assert res.intervals.to_dict() == {"particle_friction": None, "rolling_friction": None}
     assert res.posterior.wide.to_dict() == {"particle_friction": None, "rolling_friction": None}

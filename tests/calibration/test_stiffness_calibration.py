@@ -14,6 +14,7 @@ from poro2d.calibration.run import CalibrationResult
 from poro2d.cli.shear import load_shear_config
 from poro2d.dem import checkpoint
 from poro2d.execute.options import RunOptions
+from poro2d.report.calibration_figures import draw_calibration
 from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
 from poro2d.store import Store
@@ -54,6 +55,7 @@ def test_four_parameters_recover_a_known_truth_within_their_intervals(stiff_lab,
     kw = dict(points=18, refine=4, settings=SHORT, stations=4, kn_range=KN_RANGE, ks_range=KS_RANGE,
               options=ONE_WORKER, keep_box_dominated=True)  # fmt: skip
     res = run_calibration(lab, specimens, store=Store(out), **kw)
+    draw_calibration(res, Store(out))  # the figures and the report, as the command draws them
     for name, value in TRUTH.items():
         lo, hi = getattr(res.intervals, name)
         assert lo <= value <= hi, (name, value, lo, hi)

@@ -9,6 +9,7 @@ from poro2d.cli import main
 from poro2d.criterion import CriterionSettings, PorosityCriterion
 from poro2d.criterion.protocol import round_to
 from poro2d.errors import InputError
+from poro2d.report.criterion_figures import draw_criterion
 from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.store import Store
@@ -21,8 +22,11 @@ REQUIRED = {
 
 
 def _run(out, trial, **kw):
+    """A run kept in ``out``, its figures drawn afterwards from what it kept (as the command does)."""
     settings = CriterionSettings(trial_porosity=trial, **kw)
-    return PorosityCriterion(SMALL, paper_grading(), settings, seed=0, store=Store(out)).run()
+    result = PorosityCriterion(SMALL, paper_grading(), settings, seed=0, store=Store(out)).run()
+    draw_criterion(result, Store(out))
+    return result
 
 
 @pytest.fixture(scope="module")
@@ -283,9 +287,7 @@ def test_half_built_frictionless_specimen_is_refused(tmp_path):
     # does not settle used to end the preparation with the lid mid-height and a fraction of the
     # disks (here 2 layers of 3), and that specimen went on to be accepted (before: 0.23, 75 disks)
     settings = CriterionSettings(trial_porosity=0.20, force_fraction=0.05)
-    r = PorosityCriterion(
-        _frictionless(), paper_grading(), settings, seed=0, store=Store(tmp_path), figures=False
-    ).run()
+    r = PorosityCriterion(_frictionless(), paper_grading(), settings, seed=0, store=Store(tmp_path)).run()
     assert not r.converged and r.final_porosity is None and r.failed_trial == 1
     (it,) = [t.to_dict() for t in r.iterations]  # the trial's row
     assert not it["accepted"] and it["refused"] and not it["converged"]
@@ -300,9 +302,7 @@ def test_half_built_frictionless_specimen_is_refused(tmp_path):
     assert (trial / "prepared.npz").is_file() and (trial / "trial.json").is_file()
     assert not (tmp_path / "specimen.npz").exists()
     # the refusal is read back on resume, not recomputed into an acceptance
-    again = PorosityCriterion(
-        _frictionless(), paper_grading(), settings, seed=0, store=Store(tmp_path), figures=False
-    )
+    again = PorosityCriterion(_frictionless(), paper_grading(), settings, seed=0, store=Store(tmp_path))
     assert again.run().to_dict()["iterations"] == r.to_dict()["iterations"]
 
 

@@ -46,9 +46,7 @@ def test_a_dense_trial_short_of_overfull_with_rolling_friction_keeps_every_disk_
         "criterion": {"trial_porosity": 0.12, "force_fraction": 0.05, "max_iterations": 2},
     }
     spec, grading, settings, seed = build(cfg)
-    res = PorosityCriterion(
-        spec, grading, settings, seed=seed, store=Store(tmp_path / "c"), figures=False
-    ).run()
+    res = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(tmp_path / "c")).run()
     first = res.iterations[0].to_dict()  # the trial's row
     assert first["f_top_n_per_m"] > 1e4 and first["plate_moved"] == "up" and first["plate_settled"]
     for row in (t.to_dict() for t in res.iterations):
@@ -72,9 +70,7 @@ def test_an_overfull_first_trial_with_rolling_friction_keeps_every_disk_in_the_b
         "criterion": {"trial_porosity": 0.07, "force_fraction": 0.05, "max_iterations": 2},
     }
     spec, grading, settings, seed = build(cfg)
-    res = PorosityCriterion(
-        spec, grading, settings, seed=seed, store=Store(tmp_path / "c"), figures=False
-    ).run()
+    res = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(tmp_path / "c")).run()
     first = res.iterations[0].to_dict()  # the trial's row
     assert first["overfull_m"] > 0.0 and first["plate_moved"] == "up" and first["plate_settled"]
     assert first["new_porosity"] > 0.07 and "over-full box" in first["reason"]

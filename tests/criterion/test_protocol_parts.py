@@ -57,13 +57,13 @@ def test_the_plate_servo_brings_a_raised_plate_into_the_window(specimen):
 def test_the_shear_test_is_its_controllers(specimen):
     """Consolidation, then the shear stage driven by ShearDrive: the test's own curve, number for number."""
     settings = ShearSettings(**SHORT)
-    whole = DirectShearTest(ShearCase.of(specimen, 50.0, settings), figures=False).run()
+    whole = DirectShearTest(ShearCase.of(specimen, 50.0, settings), keep_peak=False).run()
 
-    test = DirectShearTest(ShearCase.of(specimen, 50.0, settings), figures=False)
+    test = DirectShearTest(ShearCase.of(specimen, 50.0, settings), keep_peak=False)
     sim, info = test.consolidate()
     phases = []
     stage = ShearStage(
-        sim, test.box, settings, info.plate_height_m, figures=False, progress=lambda p, f: phases.append(p)
+        sim, test.box, settings, info.plate_height_m, keep_peak=False, progress=lambda p, f: phases.append(p)
     )
     stage.run()
     assert len(stage.rows) == whole.records and set(phases) == {"shearing"}

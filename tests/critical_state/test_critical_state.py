@@ -12,6 +12,7 @@ from poro2d.critical_state import CriticalStateCase, CriticalStateTestResult, ru
 from poro2d.critical_state.series import COLUMNS, CellSeries
 from poro2d.critical_state.steady import read_steady
 from poro2d.errors import InputError
+from poro2d.report.critical_state_figures import draw_critical_state
 from poro2d.store import Store
 
 #: a small fast case: 200 disks sheared at I = 0.01 to gamma 0.6 (a few seconds)
@@ -103,6 +104,7 @@ def test_a_bad_case_is_refused_naming_its_field(changes, parameter):
 def test_a_run_keeps_its_result_series_and_figure_in_the_store(tmp_path):
     case = CriticalStateCase(**SMALL)
     result = run_critical_state(case, Store(tmp_path))
+    draw_critical_state(result, Store(tmp_path))  # the figure, drawn from the result after the run
     assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == [
         "critical_state.png",
         "result.json",

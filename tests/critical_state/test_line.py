@@ -16,6 +16,7 @@ from poro2d.critical_state.calibrated import calibrated_values
 from poro2d.critical_state.line import CriticalStateLineResult, LineFit, run_critical_state_line
 from poro2d.errors import InputError
 from poro2d.execute import RunOptions
+from poro2d.report.critical_state_figures import draw_critical_state_line
 from poro2d.store import Store
 
 #: a small fast case (as test_critical_state's): 200 disks at I = 0.01 to gamma 0.6
@@ -76,7 +77,9 @@ def test_a_line_keeps_a_study_per_pressure_and_its_own_files(tmp_path):
     result = run_critical_state_line(
         case, [50.0, 200.0], Store(tmp_path), seeds=1, options=RunOptions(workers=1)
     )
+    draw_critical_state_line(result, Store(tmp_path))  # the figures, drawn from the result after the run
     names = sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith("."))
+    assert (tmp_path / "p50kPa" / "critical_state.png").exists()
     assert names == ["critical_state_line.png", "line.csv", "p200kPa", "p50kPa", "result.json"]
     assert (tmp_path / "p50kPa" / "result.json").exists() and (tmp_path / "p200kPa" / "series.csv").exists()
     data = json.loads((tmp_path / "result.json").read_text())

@@ -37,7 +37,7 @@ def paper_specimen(tmp_path_factory):
     cfg = cfg.with_tables(criterion=dict(cfg.table("criterion"), trial_porosity=ACCEPTED_N2D))
     spec, grading, settings, seed = cfg.build()
     out = tmp_path_factory.mktemp("paper_criterion")
-    result = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(out), figures=False).run()
+    result = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(out)).run()
     assert result.converged
     return from_checkpoint(out)
 

@@ -11,6 +11,7 @@ from poro2d.criterion.density import Calibration
 from poro2d.errors import InputError
 from poro2d.execute.options import RunOptions
 from poro2d.grading import paper_grading
+from poro2d.report.grading_figure import draw_grading
 from poro2d.sand import load_sand_case
 from poro2d.sand import preflight as PF
 from poro2d.sand.run import bracket, full_box_trial, predicted_mu
@@ -197,8 +198,10 @@ def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
         store=Store(out),
         options=QUIET,
         announce=lines.append,
-        on_preflight=lambda c, p: seen.append(p),
+        on_preflight=lambda c, p: seen.append((c, p)),
     )
+    assert not (out / "fig_grading.png").exists()  # drawn from the result, after the run
+    draw_grading(res, seen[0][0], Store(out))
     assert isinstance(res, SandResult) and seen and len(lines) == 2 and "left (estimate)" in lines[0]
     assert isinstance(StageClock, type)
     assert (out / "preflight.json").is_file() and (out / "fig_grading.png").stat().st_size > 0

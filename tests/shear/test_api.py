@@ -10,8 +10,11 @@ import pytest
 from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.execute import RunOptions
+from poro2d.report.force_chains import plot_force_chains
+from poro2d.report.shear_figures import draw_shear_series
 from poro2d.shear import ShearSeries, ShearSettings, build_split_box, run_shear
 from poro2d.shear.curve import CURVE_COLUMNS, ShearRow
+from poro2d.shear.lab import read_lab_csv
 from poro2d.shear.peak_frame import PeakFrame, PeakTracker
 from poro2d.store import Store
 
@@ -35,12 +38,15 @@ def test_run_shear_is_the_series_with_its_files(specimen, tmp_path):
     assert res.to_dict() == json.loads((out / "result.json").read_text())
     assert res.config == {"note": "kept"} and res.settings.max_displacement == 0.002
     assert res.lab.friction_angle_deg == pytest.approx(np.degrees(np.arctan(35 / 50)))
+    assert (out / "sn50kPa" / "peak_frame.npz").is_file()  # the peak's state, kept for its figure
+    assert not (out / "sn50kPa" / "forces_peak.png").exists()  # no figure during a run
+    draw_shear_series(res, Store(out), read_lab_csv(lab))
     for f in ("curves.csv", "peaks.csv", "fig8a_shear_curves.png", "fig8b_peak_strength.png",
               "sn50kPa/forces_peak.png", "sn100kPa/curve.csv"):  # fmt: skip
         assert (out / f).stat().st_size > 0, f
-    assert not (out / "sn50kPa" / "peak_frame.npz").exists()  # removed with the checkpoint
+    assert not (out / "sn50kPa" / "peak_frame.npz").exists()  # removed once drawn
     ref = ShearSeries(specimen, [50, 100], ShearSettings(**SHORT), store=Store(tmp_path / "series"),
-                      options=SERIAL, figures=False).run()  # fmt: skip
+                      options=SERIAL, keep_peak=False).run()  # fmt: skip
     assert [t.peak_shear_stress_kpa for t in res.tests] == [t.peak_shear_stress_kpa for t in ref.tests]
     again = run_shear(specimen, 100, ShearSettings(**SHORT), store=Store(out / "one"), options=SERIAL)
     assert again.tests[0].peak_shear_stress_kpa == ref.tests[1].peak_shear_stress_kpa
@@ -101,7 +107,16 @@ def test_peak_frame_round_trip_and_figure(specimen, tmp_path):
     sim.particles.pos[0, 0] += 1.0  # the frame is a copy, not a view of the running state
     assert back.pos[0, 0] != sim.particles.pos[0, 0] and frame.pos[0, 0] != sim.particles.pos[0, 0]
     b = box
-    png = back.draw(tmp_path / "forces.png", title="peak", box=(0.0, 0.0, b.width + 0.002, b.height))
+    png = plot_force_chains(
+        back.contacts,
+        back.pos,
+        back.radius,
+        back.walls,
+        tmp_path / "forces.png",
+        thickness=back.thickness,
+        title="peak",
+        box=(0.0, 0.0, b.width + 0.002, b.height),
+    )
     assert png.stat().st_size > 0
 
 

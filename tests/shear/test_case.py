@@ -53,7 +53,7 @@ def test_a_case_is_checked_against_its_specimen(specimen):
 
 def test_a_job_pickles_with_its_case_and_makes_its_store(specimen, tmp_path):
     case = ShearCase.of(specimen, 50.0, ShearSettings(max_displacement=0.002))
-    job = ShearJob(("test", 50.0), case, str(tmp_path / "sn50kPa"), figures=False, series="a")
+    job = ShearJob(("test", 50.0), case, str(tmp_path / "sn50kPa"), keep_peak=False, series="a")
     back = pickle.loads(pickle.dumps(job))
     assert back.label == "a: 50 kPa" and back.case.specimen.digest == case.specimen.digest
     test = back.test()

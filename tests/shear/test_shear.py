@@ -27,7 +27,7 @@ def series(specimen, tmp_path_factory):
     out = tmp_path_factory.mktemp("series")
     s = ShearSeries(
         specimen, [50, 100, 200], ShearSettings(**SHORT), store=Store(out), options=SERIAL,
-        figures=False,
+        keep_peak=False,
     )  # fmt: skip
     return out, s.run()
 
@@ -105,7 +105,7 @@ def test_each_curve_travels_in_the_result_as_its_file_holds_it(specimen, series)
         np.testing.assert_array_equal(back.curve["shear_stress_kpa"], curve["shear_stress_kpa"])
     again = ShearSeries(
         specimen, [50, 100, 200], ShearSettings(**SHORT), store=Store(out), options=SERIAL,
-        figures=False,
+        keep_peak=False,
     ).run()  # fmt: skip  # every test finished: read back, nothing run
     for sigma, curve in r.curves.items():
         for k in curve:
@@ -147,7 +147,7 @@ def test_servo_holds_the_normal_stress(series):
 def test_frictionless_disks_are_far_weaker(specimen, series, tmp_path):
     _, r = series
     s = ShearSettings(particle_friction=0.0, **SHORT)
-    r0 = DirectShearTest(ShearCase.of(specimen, 100, s), Store(tmp_path), figures=False).run()
+    r0 = DirectShearTest(ShearCase.of(specimen, 100, s), Store(tmp_path), keep_peak=False).run()
     tau3 = next(t.peak_shear_stress_kpa for t in r.tests if t.normal_stress_kpa == 100)
     assert r0.peak_shear_stress_kpa < 0.5 * tau3
 
@@ -285,7 +285,7 @@ def test_rate_check_reruns_at_half_velocity(specimen, series, tmp_path):
     shutil.copytree(out / "sn100kPa", tmp_path / "sn100kPa")  # done: only the v/2 rerun runs
     s = ShearSeries(
         specimen, [100], ShearSettings(**SHORT), store=Store(tmp_path), rate_check=True, options=SERIAL,
-        figures=False,
+        keep_peak=False,
     )  # fmt: skip
     res = s.run()
     rc = res.rate_check
@@ -353,7 +353,7 @@ def test_moved_folders_resume_without_recomputing(specimen, series, tmp_path):
     stamps = [f.stat().st_mtime_ns for f in done]
     again = ShearSeries(
         spec_dir, [50, 100, 200], ShearSettings(**SHORT), store=Store(dest), options=SERIAL,
-        figures=False,
+        keep_peak=False,
     ).run()  # fmt: skip
     assert [f.stat().st_mtime_ns for f in done] == stamps
     assert [t.peak_shear_stress_kpa for t in again.tests] == [t.peak_shear_stress_kpa for t in r.tests]

@@ -13,6 +13,7 @@ import pytest
 from poro2d.cli import main
 from poro2d.errors import InputError
 from poro2d.execute import RunOptions
+from poro2d.report.strength_figure import draw_strength
 from poro2d.shear import ShearSettings
 from poro2d.shear.strength import StrengthStudy, max_dilation_angle, residual_point
 from poro2d.specimen.specimen_set import SpecimenSet
@@ -43,7 +44,9 @@ def study(specimen, tmp_path_factory):
     twice = SpecimenSet.accepted({"a": specimen, "b": specimen})
     s = StrengthStudy(twice, [0.0, 0.3], [0.5], [50, 100], ShearSettings(**TINY),
                       store=Store(out), options=RunOptions(workers=2, progress=False))  # fmt: skip
-    return out, s.run()
+    result = s.run()
+    draw_strength(result, Store(out))  # the figure, as the command draws it after the run
+    return out, result
 
 
 def test_tiny_study_writes_one_row_per_case_and_test(study):

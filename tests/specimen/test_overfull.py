@@ -170,9 +170,7 @@ def test_an_overfull_first_trial_ends_in_a_looser_accepted_trial(tmp_path):
         "criterion": {"trial_porosity": 0.07, "force_fraction": 0.05, "max_iterations": 4},
     }
     spec, grading, settings, seed = build(cfg)
-    res = PorosityCriterion(
-        spec, grading, settings, seed=seed, store=Store(tmp_path / "c"), figures=False
-    ).run()
+    res = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(tmp_path / "c")).run()
     first = res.iterations[0].to_dict()  # the trial's row
     assert first["overfull_m"] > 0.0 and first["plate_moved"] == "up"
     assert "over-full box" in first["reason"] and not first["refused"]
@@ -202,9 +200,7 @@ def test_an_overfull_first_trial_under_the_lid_leads_to_a_looser_trial(tmp_path)
         },  # fmt: skip
     }
     spec, grading, settings, seed = build(cfg)
-    res = PorosityCriterion(
-        spec, grading, settings, seed=seed, store=Store(tmp_path / "c"), figures=False
-    ).run()
+    res = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(tmp_path / "c")).run()
     first = res.iterations[0].to_dict()  # the trial's row
     assert first["overfull_m"] > 0.0 and first["plate_moved"] == "lid"
     assert not first["refused"] and first["checks"]["disks_inside_box"] and first["disks_outside_box"] == 0

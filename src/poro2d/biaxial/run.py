@@ -1,4 +1,4 @@
-"""``run_biaxial``: biaxial tests on replicate specimens, the spread of their angles and a figure.
+"""``run_biaxial``: biaxial tests on replicate specimens and the spread of their angles.
 
 Everything is checked before the first test starts; bad input raises
 :class:`poro2d.errors.InputError` naming the parameter. The replicates run as jobs of the
@@ -30,13 +30,10 @@ from poro2d.execute.batch import complete_jobs
 from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import output_folder
 from poro2d.measure.spread import Spread
-from poro2d.report.biaxial_figures import plot_biaxial
 from poro2d.store import Store
 
 #: the most replicates one call runs
 MAX_REPLICATES = 50
-#: the figure of a study
-FIGURE = "biaxial.png"
 
 
 @dataclass(frozen=True)
@@ -109,9 +106,10 @@ def run_biaxial(
 
     ``case``: a :class:`BiaxialCase`, or a list of them, one per replicate specimen (then
     ``replicates`` stays 1). ``store``: where the files go (``result.json``, ``curves.csv``,
-    ``biaxial.png``, and per replicate ``replicate<k>/result.json`` and ``curve.csv``); None:
+    and per replicate ``replicate<k>/result.json`` and ``curve.csv``; the figure, ``biaxial.png``,
+    is drawn from the result by ``draw_biaxial`` (``report/biaxial_figures.py``)); None:
     nothing is kept. ``lab``: a laboratory CSV of the user's (:mod:`poro2d.biaxial.lab`),
-    overlaid on the figure. ``options``: where the tests run (``workers`` processes, default one
+    recorded in the result. ``options``: where the tests run (``workers`` processes, default one
     per replicate and at most one per core, or a running ``scheduler``) and whether bars show.
     ``config``: recorded as it is.
 
@@ -157,7 +155,7 @@ def _run(cases, store, lab, workers, options, config) -> BiaxialResult:
     tests = execute_tests(replicate_jobs(cases, store), workers, options)
     result = summarize(cases, tests, lab, workers, time.perf_counter() - t0, config)
     if store is not None:
-        write_study(store, result, lab)
+        write_study(store, result)
     return result
 
 
@@ -192,8 +190,8 @@ def summarize(cases, tests, lab, workers, wall, config) -> BiaxialResult:
     )  # fmt: skip
 
 
-def write_study(store: Store, result: BiaxialResult, lab: LabCurve | None) -> None:
-    """``curves.csv`` (every replicate's rows), the figure, then ``result.json``."""
+def write_study(store: Store, result: BiaxialResult) -> None:
+    """``curves.csv`` (every replicate's rows), then ``result.json``."""
     rows = []
     for k, t in enumerate(result.tests):
         rows += [{"replicate": k + 1, **r} for r in t.curve.rows()]
@@ -201,18 +199,6 @@ def write_study(store: Store, result: BiaxialResult, lab: LabCurve | None) -> No
         k for k in (*CURVE_COLUMNS, *OPTIONAL_COLUMNS) if any(k in t.curve.columns for t in result.tests)
     ]
     store.write_csv("curves.csv", rows, header=["replicate", *columns])  # a column a test lacks stays empty
-    starts = [t.critical_window[0] for t in result.tests]
-    end_mean = sum(t.critical_state_sin_phi for t in result.tests) / len(result.tests)
-    lab_arrays = None
-    if lab is not None:
-        lab_arrays = {"axial_strain": lab.axial_strain, "stress_ratio": lab.stress_ratio,
-                      "volumetric_strain": lab.volumetric_strain}  # fmt: skip
-    plot_biaxial(
-        [(f"replicate {k + 1}", t.curve) for k, t in enumerate(result.tests)], store.path(FIGURE),
-        title=f"biaxial test, sigma_3 = {result.confining_stress_kpa:g} kPa, replicates: {result.replicates}",
-        critical=(end_mean, min(starts)), lab=lab_arrays,
-        lab_label=f"laboratory ({os.path.basename(lab.source)})" if lab is not None else "laboratory",
-    )  # fmt: skip
     store.write_result("result.json", result)
 
 

@@ -45,13 +45,10 @@ from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.execute import RunOptions
 from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import output_folder
-from poro2d.report.biaxial_figures import plot_biaxial_series
 from poro2d.store import Store
 
 #: the most confining stresses one series runs
 MAX_STRESSES = 20
-#: the figure of a series
-SERIES_FIGURE = "biaxial_series.png"
 
 
 def stress_folder(sigma_kpa: float) -> str:
@@ -85,7 +82,7 @@ def run_biaxial_series(
     ``confining_kpa``, on ``replicates`` specimens each (quick specimens of seed, seed + 1, ...; or
     a list of cases, one per replicate specimen).
 
-    ``store``: the series' ``result.json``, ``biaxial_series.png`` and per stress a folder
+    ``store``: the series' ``result.json`` and per stress a folder
     (``sigma3_100kPa/``) holding what :func:`run_biaxial` keeps; a rerun into it reads finished
     tests back and runs the rest (a test whose record differs, another setting, runs again).
     None: nothing kept. ``options``: where all the tests run (``workers`` processes, default one
@@ -120,11 +117,11 @@ def _run(cases: dict[float, list[BiaxialCase]], store, lab, workers, options, co
     for s, cs in cases.items():
         study = summarize(cs, [next(tests) for _ in cs], lab, workers, wall, config)
         if store is not None:
-            write_study(store.child(stress_folder(s)), study, lab)
+            write_study(store.child(stress_folder(s)), study)
         studies.append(study)
     result = summarize_series(studies, workers, time.perf_counter() - t0, config)
     if store is not None:
-        _write(store, result)
+        store.write_result("result.json", result)
     return result
 
 
@@ -192,22 +189,8 @@ def summarize_series(studies: list[BiaxialResult], workers: int, wall: float, co
     )  # fmt: skip
 
 
-def _write(store: Store, result: BiaxialSeriesResult) -> None:
-    """The figure of every stress, then the series' ``result.json``."""
-    curves = [(st.confining_stress_kpa, [t.curve for t in st.tests]) for st in result.studies]
-    plot_biaxial_series(
-        curves, store.path(SERIES_FIGURE),
-        title=f"biaxial tests, replicates: {result.replicates} per stress",
-        envelope=(result.envelope.friction_angle_deg, result.envelope.cohesion_kpa),
-        peaks=[(t.confining_stress_kpa, sigma_3_at_peak(t), t.peak_sin_phi)
-               for st in result.studies for t in st.tests],
-    )  # fmt: skip
-    store.write_result("result.json", result)
-
-
 __all__ = [
     "MAX_STRESSES",
-    "SERIES_FIGURE",
     "check_confining",
     "run_biaxial_series",
     "stress_folder",

@@ -1,8 +1,10 @@
-"""What a calibration writes: result.json, the fit and posterior figures, a ready config, a report."""
+"""What a calibration writes: result.json and a ready config; what its figures are drawn from."""
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Any
 
 from poro2d.calibration.evaluations import DesignPoint
 from poro2d.calibration.units import CACHE
@@ -14,28 +16,30 @@ POSTERIOR_PNG = "calibration_posterior.png"
 CONFIG_TOML = "calibrated.toml"
 
 
-def write_outputs(store: Store, result, post, lab, specimens: SpecimenSet, make, stresses) -> None:
-    """Figures, config and report first; ``result.json`` last (its presence says: finished).
+@dataclass(frozen=True)
+class FitDrawing:
+    """What a calibration's figures are drawn from besides its result: the posterior (``post``,
+    its grid or chain), the laboratory values fitted (``lab``), and the curves of the design
+    point nearest the best parameters (``curves`` per normal or confining stress, ``nearest``)."""
+
+    post: Any
+    lab: Any
+    curves: dict[float, list]
+    nearest: DesignPoint
+
+
+def write_outputs(store: Store, result, post, lab, specimens: SpecimenSet, make, stresses) -> FitDrawing:
+    """The ready config, then ``result.json`` (its presence says: finished); what the figures and
+    the report are drawn from (``draw_calibration`` (``report/calibration_figures.py``)).
 
     ``make(specimens, label, sigma, fp=, mu_r=)``: the unit of one test (shear or biaxial, its base
     settings bound); ``stresses``: the laboratory's normal (or confining) stresses."""
-    from poro2d.report.calibration_figures import (
-        plot_biaxial_calibration_fit,
-        plot_calibration_fit,
-        plot_calibration_posterior,
-    )
-
     curves, nearest = _best_curves(result, stresses, specimens, make, store.child(CACHE))
-    plot = plot_biaxial_calibration_fit if result.biaxial else plot_calibration_fit
-    plot(result, lab, curves, nearest, store.path(FIT_PNG))
-    plot_calibration_posterior(result, post, store.path(POSTERIOR_PNG))
     store.write_text(
         CONFIG_TOML, _biaxial_config(result, stresses) if result.biaxial else _config(result, lab)
     )
-    from poro2d.report.calibration_report import write_calibration_report
-
-    write_calibration_report(store.root, result)
     store.write_result("result.json", result)
+    return FitDrawing(post, lab, curves, nearest)
 
 
 def _best_curves(
@@ -113,17 +117,9 @@ def _biaxial_config(result, stresses) -> str:
     table = {k: v for k, v in result.settings.to_dict().items() if v is not None}
     table.update(particle_friction=b.particle_friction, rolling_friction=b.rolling_friction,
                  confining_kpa=list(stresses))  # fmt: skip
-    lines = [
-        "# poro2d calibrate (biaxial laboratory tests):",
-        "# the posterior maximum of particle and rolling friction",
-        f"# ({_known(result)}); see result.json and calibration.md before using them",
-        "",
-        "[specimen]",
-        *_specimen_lines(b),
-        "",
-        "[biaxial]",
-    ] + [f"{k} = {_toml_value(v)}" for k, v in table.items()]
-    return "\n".join(lines) + "\n"
+    head = ["# poro2d calibrate (biaxial laboratory tests):", "# the posterior maximum of particle and "
+            "rolling friction"]  # fmt: skip
+    return _config_text(head, result, "biaxial", table)
 
 
 def _config(result, lab) -> str:
@@ -138,16 +134,14 @@ def _config(result, lab) -> str:
     what = "particle and rolling friction" + (
         " and the disks' stiffness" if any(getattr(b, k) is not None for k in _STIFFNESS) else ""
     )
-    lines = [
-        f"# poro2d calibrate: the posterior maximum of {what}",
-        f"# ({_known(result)}); see result.json and calibration.md before using them",
-        "",
-        "[specimen]",
-        *_specimen_lines(b),
-        "",
-        "[shear]",
-    ] + [f"{k} = {_toml_value(v)}" for k, v in shear.items()]
-    return "\n".join(lines) + "\n"
+    return _config_text([f"# poro2d calibrate: the posterior maximum of {what}"], result, "shear", shear)
 
 
-__all__ = ["CONFIG_TOML", "FIT_PNG", "POSTERIOR_PNG", "write_outputs"]
+def _config_text(head: list[str], result, name: str, table: dict) -> str:
+    """``head`` comments, the calibrated ``[specimen]`` lines, then the table ``[name]``."""
+    lines = [*head, f"# ({_known(result)}); see result.json and calibration.md before using them", "",
+             "[specimen]", *_specimen_lines(result.best), "", f"[{name}]"]  # fmt: skip
+    return "\n".join(lines + [f"{k} = {_toml_value(v)}" for k, v in table.items()]) + "\n"
+
+
+__all__ = ["CONFIG_TOML", "FIT_PNG", "POSTERIOR_PNG", "FitDrawing", "write_outputs"]

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import os
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import partial
 from typing import Any, ClassVar
 
@@ -68,7 +68,7 @@ from poro2d.shear.settings import (
 )
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
-from poro2d.typed_result import Keyed, TypedResult, part
+from poro2d.typed_result import NOT_IN_FILE, Keyed, TypedResult, part
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
 KIND = "calibrate"
@@ -291,6 +291,8 @@ class CalibrationResult(TypedResult):
     #: calibration's sentence on what its box can measure; absent from a biaxial calibration's file
     #: and from files of earlier versions
     box_dominated: BoxDominatedPoints | None = None
+    #: what the figures are drawn from (the posterior, the curves nearest the best), with a store
+    drawing: Any = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     OPTIONAL: ClassVar[tuple[str, ...]] = ("unidentified", "box_scale", "test", "box_dominated")
     #: the fields read as their records from a file's dict (``fit``: a surrogate per observable)
@@ -586,7 +588,8 @@ def run_calibration(
     if store is not None:
         from poro2d.calibration.outputs import write_outputs
 
-        write_outputs(store, result, post, repeats, found, partial(make, base=base), stresses)
+        make_unit = partial(make, base=base)
+        result.drawing = write_outputs(store, result, post, repeats, found, make_unit, stresses)
     return result
 
 

@@ -69,7 +69,7 @@ def synthetic_lab(
     value = Specimen.read(specimen)  # read once for every test
     for sigma in sorted(float(s) for s in normal_stresses_kpa):
         res = DirectShearTest(
-            ShearCase(value, sigma, sset), work.child(f"sn{sigma:g}kPa"), figures=False, threads=1
+            ShearCase(value, sigma, sset), work.child(f"sn{sigma:g}kPa"), keep_peak=False, threads=1
         ).run()
         if not curves:
             lines.append(f"{sigma:g},{res['peak_shear_stress_kpa']:.4f}")

@@ -229,7 +229,7 @@ class UnitRow:
 
 def _test(unit: CalibrationUnit, store: Store | None, threads: int = 1) -> DirectShearTest:
     case = ShearCase(Specimen.read(unit.specimen, unit.digest), unit.sigma, ShearSettings(**unit.settings))
-    return DirectShearTest(case, store, figures=False, threads=threads)
+    return DirectShearTest(case, store, keep_peak=False, threads=threads)
 
 
 def _row(unit: CalibrationUnit, res) -> UnitRow:

@@ -155,14 +155,20 @@ def make_case(quick: bool, specimen, sigma: float, first: int, settings):
 
 
 def start_and_print(case, stresses: list[float], store, kw: dict, out: Path) -> None:
-    """One stress: run_biaxial; several: run_biaxial_series; the answer printed (a failed test: exit 1)."""
+    """One stress: run_biaxial; several: run_biaxial_series; the figures drawn from the result; the
+    answer printed (a failed test: exit 1)."""
     from poro2d.biaxial import run_biaxial, run_biaxial_series
+    from poro2d.biaxial.run import lab_curve
+    from poro2d.report.biaxial_figures import draw_biaxial, draw_biaxial_series
 
+    kw = dict(kw, lab=lab_curve(kw.get("lab")))  # read once: the run records it, the figure draws it
     try:
         if len(stresses) == 1:
             result = run_biaxial(case, store, **kw)
+            draw_biaxial(result, store, kw["lab"])
         else:
             result = run_biaxial_series(case, stresses, store, **kw)
+            draw_biaxial_series(result, store, kw["lab"])
     except RuntimeError as exc:
         console.print(f"[bold red]failed:[/] {exc}")
         raise typer.Exit(1) from None

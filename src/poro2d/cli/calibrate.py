@@ -104,6 +104,8 @@ def register(app: typer.Typer) -> None:
         biaxial tests."""
         from poro2d.calibration.run import DEFAULT_FP_RANGE, DEFAULT_MU_R_RANGE, run_calibration
         from poro2d.cli.dask_options import job_options
+        from poro2d.report.calibration_figures import draw_calibration
+        from poro2d.report.criterion_figures import draw_specimens
         from poro2d.store import Store
 
         settings = test_settings(bool(biaxial_lab), max_displacement, max_strain)
@@ -124,12 +126,13 @@ def register(app: typer.Typer) -> None:
             **({"keep_box_dominated": True} if keep_box_dominated else {}),
             **({"discrepancy": discrepancy} if discrepancy != "auto" else {}),
         }
+        store = Store(out)
         try:
             result = run_calibration(
                 (lab[0] if len(lab) == 1 else list(lab)) if lab else None,
                 list(specimen or []),
                 biaxial_lab=list(biaxial_lab) if biaxial_lab else None,
-                store=Store(out),
+                store=store,
                 preset=preset,
                 quick=quick,
                 replicates=replicates,
@@ -153,6 +156,9 @@ def register(app: typer.Typer) -> None:
         except RuntimeError as exc:
             console.print(f"[bold red]failed:[/] {exc}")
             raise typer.Exit(1) from None
+        finally:  # the preset specimens' figures, also when the calibration after them failed
+            draw_specimens(store.child("specimens"))
+        draw_calibration(result, store)
         print_result(result, out)
 
 

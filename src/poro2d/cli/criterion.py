@@ -56,17 +56,20 @@ def register(app: typer.Typer) -> None:
         from the laboratory relative density and runs the criterion over seeds.
         """
         from poro2d.execute.options import RunOptions
+        from poro2d.report.criterion_figures import draw_criterion
         from poro2d.sweep.density_criterion import run_criterion_modes
 
+        store = Store(out)
         result = run_criterion_modes(
-            config, preset=preset, store=Store(out), seed=seed, n_lab=n_lab, trial_porosity=trial,
+            config, preset=preset, store=store, seed=seed, n_lab=n_lab, trial_porosity=trial,
             threads=threads, mode=mode, n_max=n_max, n_min=n_min, seeds=seeds,
             options=RunOptions(progress=not quiet),
         )  # fmt: skip
         if isinstance(result, DensityStateResult):
             print_density(result, out)
             return
-        print_result(result, Store(out))
+        draw_criterion(result, store)
+        print_result(result, store)
         console.print(PAPER_MODE_NOTE, soft_wrap=True)
         if not result.converged:
             # one line, whole: the reason names the trial, the stage or check, the ratio

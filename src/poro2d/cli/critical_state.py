@@ -95,6 +95,7 @@ def register(app: typer.Typer) -> None:
         from poro2d.critical_state.line import MAX_PRESSURES, run_critical_state_line
         from poro2d.critical_state.run import MAX_SEEDS
         from poro2d.errors import InputError, check_int
+        from poro2d.report.critical_state_figures import draw_critical_state, draw_critical_state_line
 
         rule = CASE_RANGES["pressure_kpa"]
         PRESSURE_RANGE_KPA = (rule.lo, rule.hi)
@@ -128,11 +129,13 @@ def register(app: typer.Typer) -> None:
         try:
             if len(pressures) == 1:
                 result = run_critical_states(case, store, seeds=n, options=run, config=config)
+                draw_critical_state(result, store)
             else:
                 result = run_critical_state_line(
                     case, pressures, store, seeds=n, options=run, config=config,
                     marks=held.marks if held else None, span=held.span if held else None,
                 )  # fmt: skip
+                draw_critical_state_line(result, store)
         except RuntimeError as exc:
             console.print(f"[bold red]failed:[/] {exc}")
             raise typer.Exit(1) from None

@@ -145,6 +145,7 @@ def sand_cmd(
     small box, specimens at full size, and the interior porosity to use in other codes.
     """
     from poro2d.execute.options import RunOptions
+    from poro2d.report.grading_figure import draw_grading
     from poro2d.sand.run import check_soil, run_sand
     from poro2d.store import Store
 
@@ -152,15 +153,23 @@ def sand_cmd(
         case, pf = check_soil(config, seeds=seeds, workers=workers, budget_minutes=budget)
         print_preflight(case, pf)
         return
+    cases = []  # the soil as checked, handed over with its pre-flight: the grading figure's
+
+    def preflight(case, pf) -> None:
+        cases.append(case)
+        print_preflight(case, pf)
+
+    store = Store(out)
     res = run_sand(
         config,
-        store=Store(out),
+        store=store,
         seeds=seeds,
         budget_minutes=budget,
         options=RunOptions(workers, scheduler, progress=not quiet),
         announce=lambda line: console.print(escape(line), soft_wrap=True),
-        on_preflight=print_preflight,
+        on_preflight=preflight,
     )
+    draw_grading(res, cases[0], store)
     print_result(res, out)
     if not res.converged:
         raise typer.Exit(1)

@@ -45,6 +45,7 @@ def register(app: typer.Typer) -> None:
         from poro2d.criterion.config import load_config
         from poro2d.errors import check_int
         from poro2d.io_utils import check_output_dir
+        from poro2d.report.sensitivity_report import draw_sensitivity
         from poro2d.store import Store
         from poro2d.sweep.criterion_base import CriterionBase
         from poro2d.sweep.sensitivity import run_sensitivity
@@ -59,7 +60,9 @@ def register(app: typer.Typer) -> None:
         def banner() -> None:  # once every input is checked: a refusal is the only line
             console.print(f"sensitivity study{' (quick)' if quick else ''} -> {out}")
 
-        sens = run_sensitivity(base, Store(out), quick=quick, seeds=seeds, options=options, announce=banner)
+        store = Store(out)
+        sens = run_sensitivity(base, store, quick=quick, seeds=seeds, options=options, announce=banner)
+        draw_sensitivity(sens, store)
         print_sensitivity(sens, out)
         failed = sens.sweeps.failed_cases
         if failed:

@@ -131,6 +131,8 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Direct shear tests (the paper's Fig. 8): peak strengths, friction angle, figures."""
         from poro2d.io_utils import check_output_dir
+        from poro2d.report.shear_figures import draw_shear_series
+        from poro2d.shear.lab import read_lab_csv
         from poro2d.shear.run import run_shear
         from poro2d.store import Store
 
@@ -148,6 +150,9 @@ def register(app: typer.Typer) -> None:
             "rolling_friction": rolling_friction,
         }
         recorded = {"shear": table, **extra, "cli": options}
+        lab_path = resolve_path("--lab", lab, extra.get("lab"), base)
+        lab_data = read_lab_csv(lab_path) if lab_path is not None else None  # the run's and the figures'
+        store = Store(out)
         try:
             result = run_shear(
                 resolve_path("--specimen", specimen, extra.get("specimen"), base, required=True),
@@ -160,8 +165,8 @@ def register(app: typer.Typer) -> None:
                     particle_friction=particle_friction,
                     rolling_friction=rolling_friction,
                 ),  # fmt: skip
-                store=Store(out),
-                lab=resolve_path("--lab", lab, extra.get("lab"), base),
+                store=store,
+                lab=lab_data,
                 rate_check=rate_check or bool(extra.get("rate_check", False)),
                 options=run,
                 config=recorded,
@@ -169,6 +174,7 @@ def register(app: typer.Typer) -> None:
         except RuntimeError as exc:
             console.print(f"[bold red]failed:[/] {exc}")
             raise typer.Exit(1) from None
+        draw_shear_series(result, store, lab_data)
         print_result(result, out)
 
 

@@ -47,17 +47,21 @@ def quick_specimens(out: Path, seeds: int, progress: bool) -> SpecimenSet:
     from poro2d.criterion.config import paper_config
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.criterion.replicates import accepted_and_replicates
+    from poro2d.report.criterion_figures import draw_specimens
     from poro2d.store import Store
 
     cfg = paper_config(True, 0)
     spec, grading, settings, seed = cfg.build(threads=1)
     crit = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(out / "criterion"),
                              progress=progress, config=cfg.as_config())  # fmt: skip
-    result = crit.run()
-    if not result.converged:
-        raise RuntimeError(f"the quick specimen was not accepted: {result.message}")
-    specimens, _ = accepted_and_replicates(crit.spec, crit.grading, crit.settings, result.final_porosity,
-                                           crit.seed, seeds, Store(out), progress=progress)  # fmt: skip
+    try:
+        result = crit.run()
+        if not result.converged:
+            raise RuntimeError(f"the quick specimen was not accepted: {result.message}")
+        specimens, _ = accepted_and_replicates(crit.spec, crit.grading, crit.settings, result.final_porosity,
+                                               crit.seed, seeds, Store(out), progress=progress)  # fmt: skip
+    finally:  # the specimens' figures, drawn from the states their runs kept
+        draw_specimens(Store(out))
     return specimens
 
 
@@ -97,6 +101,7 @@ def register(app: typer.Typer) -> None:
         from poro2d.errors import InputError, check_int
         from poro2d.io_utils import check_output_dir
         from poro2d.locks import output_folder
+        from poro2d.report.strength_figure import draw_strength
         from poro2d.shear import strength as st
         from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
         from poro2d.specimen.specimen_set import SpecimenSet
@@ -152,6 +157,7 @@ def register(app: typer.Typer) -> None:
             except RuntimeError as exc:
                 console.print(f"[bold red]failed:[/] {exc}")
                 raise typer.Exit(1) from None
+            draw_strength(result, study.store)
         print_strength(result, out)
 
 

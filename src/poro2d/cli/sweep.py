@@ -36,6 +36,11 @@ def sweep_cmd(
     sweep = parse_sweep(cfg, Path(config).resolve().parent)
     console.print(f"{len(sweep.cases)} case(s) of kind {sweep.kind!r} -> {out}")
     res = run_sweep(sweep, Store(out), options=options)
+    if sweep.figures and sweep.kind == "criterion":  # [sweep] figures = true: each case's force chains
+        from poro2d.report.criterion_figures import draw_stored_criterion
+
+        for row in res.rows:
+            draw_stored_criterion(Store(out).child("cases", row.case_id, "run"))
     print_summary(res, out)
     if res.failed:
         raise typer.Exit(1)

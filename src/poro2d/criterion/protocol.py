@@ -14,8 +14,9 @@ With a :class:`~poro2d.store.Store`, every trial is kept in its own sub-store as
 finishes, so an interrupted run resumes where it stopped; a run that does not converge
 stops with a clear message and keeps every trial's results. A trial is a typed record
 made of its parts (:mod:`poro2d.criterion.trial`), its measures are those of
-:mod:`poro2d.criterion.measures`, and the figures and accepted specimen's files are
-written by :mod:`poro2d.criterion.outputs`, outside the loop.
+:mod:`poro2d.criterion.measures`, and the accepted specimen's files are written by
+:mod:`poro2d.criterion.outputs`, outside the loop (the figures are drawn afterwards from the
+states every trial keeps, by ``report/criterion_figures.py``).
 
 A trial is only accepted when, besides the paper's condition, its specimen passes
 the checks of :func:`specimen_checks` (every planned disk built and inside the box,
@@ -53,7 +54,7 @@ from poro2d.criterion.measures import (
     specimen_checks,
     wall_forces,
 )
-from poro2d.criterion.outputs import force_figure, write_accepted
+from poro2d.criterion.outputs import write_accepted
 from poro2d.criterion.result import CriterionResult
 from poro2d.criterion.servo import PlateServo, in_window, rises_free_to_roll
 from poro2d.criterion.settings import CriterionSettings, round_to
@@ -223,7 +224,8 @@ class PorosityCriterion:
     """Run Fig. 3 for one grading and laboratory porosity, keeping its results in ``store``.
 
     ``store``: where the trials, the table and the result are kept, and from which a rerun
-    resumes; None keeps nothing (compute only). ``figures``: draw the force-chain figures.
+    resumes; None keeps nothing (compute only). The figures are drawn from the states it keeps,
+    once it has returned (``draw_criterion`` (``report/criterion_figures.py``)).
     """
 
     def __init__(
@@ -235,7 +237,6 @@ class PorosityCriterion:
         store: Store | None = None,
         progress: bool = False,
         config: dict | None = None,
-        figures: bool = True,
     ) -> None:
         self.spec = spec
         self.grading = grading
@@ -244,7 +245,6 @@ class PorosityCriterion:
         self.store = store
         self.progress = progress
         self.config = config or {}
-        self.figures = figures
         self._stage: ResumableStage | None = None
 
     # ------------------------------------------------------------------ stages
@@ -282,10 +282,6 @@ class PorosityCriterion:
         def compute() -> PreparationReport:
             sim, prep = self._build(n)
             folder.save_state("prepared.npz", sim, extra={"stage": "prepared", "trial_porosity": n})
-            if self.figures:
-                title = f"trial n2D = {n:.3f}, top plate at H"
-                force_figure(folder, "forces_trial.png", sim, self.spec.width, title, wall_forces(sim),
-                             self.spec.self_weight(n))  # fmt: skip
             built.append(sim)
             return prep.report
 
@@ -410,7 +406,7 @@ class PorosityCriterion:
                     stage = PlateStage(
                         "lid", box_porosity(sim.particles.area(), width, first.height_m), first
                     )
-                    return stage, self._after_top(sim, k, n, weight, stage)
+                    return stage, self._after_top(sim, k, n)
             lid = SegmentedLid(sim, width, mass_d50(sim.particles.radius))
             settle = servo.settle(sim, weight, lid)
             profile = lid_profile(sim, width)
@@ -425,19 +421,14 @@ class PorosityCriterion:
             if free is not None:
                 moved, settle = "up", free.then(settle)
             stage = PlateStage(moved, box_porosity(sim.particles.area(), width, settle.height_m), settle)
-        return stage, self._after_top(sim, k, n, weight, stage)
+        return stage, self._after_top(sim, k, n)
 
-    def _after_top(self, sim: Simulation, k: int, n: float, weight: float, stage: PlateStage) -> WallForces:
-        """Keep the state after the plate or lid stage (and its figure); the wall forces then."""
-        after = wall_forces(sim)
+    def _after_top(self, sim: Simulation, k: int, n: float) -> WallForces:
+        """Keep the state after the plate or lid stage; the wall forces then."""
         folder = self._trial_store(k, n)
         if folder is not None:
             folder.save_state("after_plate.npz", sim, extra={"stage": "after_plate"})
-            if self.figures:
-                what = "resting the lid" if stage.moved == "lid" else f"moving the top plate {stage.moved}"
-                force_figure(folder, "forces_after_plate.png", sim, self.spec.width,
-                             f"after {what}: n' = {stage.new_porosity:.4f}", after, weight)  # fmt: skip
-        return after
+        return wall_forces(sim)
 
     def _top_at_disks(self, sim: Simulation) -> float | np.ndarray:
         """The height of the plate, or of the lid above each disk, for the in-box check."""
@@ -452,8 +443,8 @@ class PorosityCriterion:
 
         Every input is checked first (:meth:`validate`), then the store (:meth:`stage`): a
         folder holding a run of another config is refused before anything is written.
-        Once the run ends, the side outputs (figures, the accepted specimen and its files)
-        are written by :func:`poro2d.criterion.outputs.write_accepted`, before the result.
+        Once the run ends, the accepted specimen and its files are written by
+        :func:`poro2d.criterion.outputs.write_accepted`, before the result.
         """
         self.validate()
         if self.store is None:
@@ -462,7 +453,7 @@ class PorosityCriterion:
 
         def compute() -> CriterionResult:
             result = self._search()
-            write_accepted(result, store, self.spec.width, figures=self.figures)
+            write_accepted(result, store, self.spec.width)
             return result
 
         return self.stage().run(compute, decode=CriterionResult.from_dict)

@@ -31,7 +31,6 @@ from poro2d.execute import RunOptions
 from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import output_folder
 from poro2d.measure.spread import Spread
-from poro2d.report.critical_state_figures import plot_critical_state_line
 from poro2d.store import Store
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
@@ -40,8 +39,7 @@ MAX_PRESSURES = 12
 MIN_PRESSURES = 2
 #: the reference pressure of e_Gamma (kPa): the line's intercept is its void ratio at 1 kPa
 REFERENCE_KPA = 1.0
-#: the figure and the table of a line
-LINE_FIGURE = "critical_state_line.png"
+#: the table of a line
 LINE_CSV = "line.csv"
 LINE_COLUMNS = (
     "pressure_kpa",
@@ -352,10 +350,10 @@ def run_critical_state_line(
     """``case`` at every pressure of ``pressures`` (kPa) on ``seeds`` seeds: the line e_cs(p').
 
     ``marks``: (label, 2D void ratio) states to hold against the line (a specimen's 2D ends, a
-    state as mapped): each gets its state parameter at every pressure, drawn on the figure;
+    state as mapped): each gets its state parameter at every pressure;
     ``span``: the 2D e_max - e_min that normalises it. Every (pressure, seed) run is one job of
-    the executor. ``store``: the line's ``result.json``,
-    ``line.csv`` and ``critical_state_line.png``, and per pressure a folder ``p<P>kPa/`` holding
+    the executor. ``store``: the line's ``result.json``
+    and ``line.csv``, and per pressure a folder ``p<P>kPa/`` holding
     what a one-pressure study holds. Call it under ``if __name__ == "__main__":`` in a script
     when it runs on several processes (``options``; worker processes import the calling script).
     """
@@ -393,9 +391,8 @@ def run_critical_state_line(
 
 
 def write_line(store: Store, result: CriticalStateLineResult) -> None:
-    """``line.csv``, the e-log p figure, then ``result.json`` (last: it says the line is done)."""
+    """``line.csv``, then ``result.json`` (last: it says the line is done)."""
     store.write_csv(LINE_CSV, [p.row() for p in result.points], header=list(LINE_COLUMNS))
-    plot_critical_state_line(result, store.path(LINE_FIGURE))
     store.write_result("result.json", result)
 
 

@@ -39,13 +39,10 @@ from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
 from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.locks import output_folder
-from poro2d.report.critical_state_figures import plot_critical_state
 from poro2d.store import Store
 
 #: the most seeds one call runs
 MAX_SEEDS = 50
-#: the figure of a run or a study
-FIGURE = "critical_state.png"
 #: the share of the progress bar the compression takes (the rest is the shear)
 COMPRESS_SHARE = 0.05
 
@@ -79,10 +76,11 @@ def _shear(
 def run_critical_state(
     case: CriticalStateCase, store: Store | None = None, *, report: Report | None = None
 ) -> CriticalStateTestResult:
-    """One periodic shear run of ``case``: its steady state, the series, the figure.
+    """One periodic shear run of ``case``: its steady state and the series.
 
-    ``store``: where ``result.json``, ``series.csv`` and ``critical_state.png`` go (None: nothing
-    kept). ``report(phase, fraction)``: told how far the run is. Raises RuntimeError if the
+    ``store``: where ``result.json`` and ``series.csv`` go (None: nothing kept; the figure is
+    drawn from the result by ``draw_critical_state`` (``report/critical_state_figures.py``)).
+    ``report(phase, fraction)``: told how far the run is. Raises RuntimeError if the
     compression does not reach the pressure.
     """
     if not isinstance(case, CriticalStateCase):
@@ -119,18 +117,8 @@ def run_critical_state(
     )
     if store is not None:
         store.write_csv("series.csv", series.rows(), header=list(COLUMNS))
-        plot_critical_state(
-            [(f"seed {case.seed}", series)], store.path(FIGURE), title=_title(case), window=case.window_start
-        )
         store.write_result("result.json", result)
     return result
-
-
-def _title(case: CriticalStateCase) -> str:
-    return (
-        f"periodic shear: f_p = {case.particle_friction:g}, mu_r = {case.rolling_friction:g}, "
-        f"P = {case.pressure_kpa:g} kPa, I = {case.inertial_number:g}, {case.disks} disks"
-    )
 
 
 @dataclass(frozen=True)
@@ -155,7 +143,7 @@ def run_critical_states(
 ) -> CriticalStateResult:
     """``case`` on ``seeds`` seeds (case.seed, case.seed + 1, ...): each number's spread over them.
 
-    ``store``: where ``result.json``, ``series.csv`` (every seed's rows) and the figure go;
+    ``store``: where ``result.json`` and ``series.csv`` (every seed's rows) go;
     ``options``: where the seeds run (``workers`` processes, default one per seed and at most
     one per core, or a running ``scheduler``) and whether bars show. Several processes spawn
     workers that import the calling script: call it under
@@ -206,17 +194,9 @@ def _label(case: CriticalStateCase, cases: list[CriticalStateCase]) -> str:
 
 
 def write_study(store: Store, cases: list[CriticalStateCase], result: CriticalStateResult) -> None:
-    """A study's ``series.csv`` (every seed's rows), its figure, then ``result.json``."""
-    tests = result.tests
-    rows = [{"seed": c.seed, **r} for c, t in zip(cases, tests, strict=True) for r in t.series.rows()]
+    """A study's ``series.csv`` (every seed's rows), then ``result.json``."""
+    rows = [{"seed": c.seed, **r} for c, t in zip(cases, result.tests, strict=True) for r in t.series.rows()]
     store.write_csv("series.csv", rows, header=["seed", *COLUMNS])
-    plot_critical_state(
-        [(f"seed {c.seed}", t.series) for c, t in zip(cases, tests, strict=True)],
-        store.path(FIGURE),
-        title=_title(cases[0]),
-        window=cases[0].window_start,
-        steady=(result.stress_ratio.mean, result.solid_fraction.mean),
-    )
     store.write_result("result.json", result)
 
 

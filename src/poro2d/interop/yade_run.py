@@ -67,7 +67,7 @@ def execute_script(workdir: str | os.PathLike, settings: dict | None = None, tim
 class ResultLine:
     """What the exported script reports last (``poro2d-result key value ...``, its ``report()``).
 
-    The wall forces per metre of thickness (N/m) as poro2d reports them, YADE's mean
+    The wall forces per metre of thickness (N/m) as poro2d gives them, YADE's mean
     ``unbalanced_force`` and the ``steps`` cycled (printed as a number).
     """
 

@@ -6,7 +6,7 @@ top plate. The plate rests on a few high disks, so the band just under it is mos
 against them. Both are properties of the box, not of the sand: a user who wants the
 porosity of the packing, as a field measurement would give it, needs it measured where
 neither reaches. :func:`measure_specimen` gives, in one :class:`SpecimenPorosity` (its
-figure is :func:`poro2d.report.specimen_figures.plot_local_porosity`):
+figure is ``plot_local_porosity`` (``report/specimen_figures.py``)):
 
 - the free surface of the packing, h(x), and how the plate sits on it (mean and largest
   gap, the share of the plate's width in contact, the disks touching it;

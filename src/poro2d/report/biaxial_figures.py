@@ -6,7 +6,8 @@ critical state is read) as a dotted line; (b) the volumetric strain (compression
 down) against the axial strain. Laboratory curves, when the user gives them, are drawn in
 black, dashed. A series (:func:`plot_biaxial_series`) draws every confining stress in a colour of
 its own, its replicates overlaid, beside the peak circles of Mohr and their envelope. Made from
-arrays: no file is opened here.
+arrays: no file is opened here. :func:`draw_biaxial` and :func:`draw_biaxial_series` draw them from
+a finished run's result into its store, once the run has returned.
 """
 
 from __future__ import annotations
@@ -21,8 +22,47 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from poro2d.biaxial.lab import LabCurve  # noqa: E402
+from poro2d.biaxial.results import BiaxialResult, BiaxialSeriesResult  # noqa: E402
+from poro2d.biaxial.series import sigma_3_at_peak, stress_folder  # noqa: E402
 from poro2d.report.figure_file import save_figure  # noqa: E402
 from poro2d.report.shear_figures import COLORS  # noqa: E402
+from poro2d.store import Store  # noqa: E402
+
+#: the figure of one confining stress, and of a series
+FIGURE = "biaxial.png"
+SERIES_FIGURE = "biaxial_series.png"
+
+
+def draw_biaxial(result: BiaxialResult, store: Store, lab: LabCurve | None = None) -> None:
+    """``biaxial.png`` of a run at one confining stress: its replicates' curves, the mean of their
+    end windows, and ``lab``'s curves (the laboratory CSV the run was given) overlaid."""
+    starts = [t.critical_window[0] for t in result.tests]
+    end_mean = sum(t.critical_state_sin_phi for t in result.tests) / len(result.tests)
+    lab_arrays = None
+    if lab is not None:
+        lab_arrays = {"axial_strain": lab.axial_strain, "stress_ratio": lab.stress_ratio,
+                      "volumetric_strain": lab.volumetric_strain}  # fmt: skip
+    plot_biaxial(
+        [(f"replicate {k + 1}", t.curve) for k, t in enumerate(result.tests)], store.path(FIGURE),
+        title=f"biaxial test, sigma_3 = {result.confining_stress_kpa:g} kPa, replicates: {result.replicates}",
+        critical=(end_mean, min(starts)), lab=lab_arrays,
+        lab_label=f"laboratory ({os.path.basename(lab.source)})" if lab is not None else "laboratory",
+    )  # fmt: skip
+
+
+def draw_biaxial_series(result: BiaxialSeriesResult, store: Store, lab: LabCurve | None = None) -> None:
+    """Every stress's ``biaxial.png`` in its folder, then the series' ``biaxial_series.png``."""
+    for study in result.studies:
+        draw_biaxial(study, store.child(stress_folder(study.confining_stress_kpa)), lab)
+    plot_biaxial_series(
+        [(st.confining_stress_kpa, [t.curve for t in st.tests]) for st in result.studies],
+        store.path(SERIES_FIGURE),
+        title=f"biaxial tests, replicates: {result.replicates} per stress",
+        envelope=(result.envelope.friction_angle_deg, result.envelope.cohesion_kpa),
+        peaks=[(t.confining_stress_kpa, sigma_3_at_peak(t), t.peak_sin_phi)
+               for st in result.studies for t in st.tests],
+    )  # fmt: skip
 
 
 def plot_biaxial(
@@ -135,4 +175,11 @@ def _circles(ax, peaks, colours, envelope) -> None:
     ax.set_ylabel("shear stress tau (kPa)")
 
 
-__all__ = ["plot_biaxial", "plot_biaxial_series"]
+__all__ = [
+    "FIGURE",
+    "SERIES_FIGURE",
+    "draw_biaxial",
+    "draw_biaxial_series",
+    "plot_biaxial",
+    "plot_biaxial_series",
+]

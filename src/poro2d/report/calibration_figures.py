@@ -3,6 +3,7 @@
 ``calibration_fit.png`` and ``calibration_posterior.png`` of ``poro2d calibrate``, drawn from
 the :class:`poro2d.calibration.run.CalibrationResult`, its posterior grid and the curves the
 calibration found for its best design point (the calibration reads those from its cache).
+:func:`draw_calibration` draws both, and the report, into a finished calibration's store.
 """
 
 from __future__ import annotations
@@ -17,7 +18,20 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import FormatStrFormatter  # noqa: E402
 
+from poro2d.calibration.outputs import FIT_PNG, POSTERIOR_PNG  # noqa: E402
+from poro2d.report.calibration_report import write_calibration_report  # noqa: E402
 from poro2d.report.figure_file import save_figure  # noqa: E402
+from poro2d.store import Store  # noqa: E402
+
+
+def draw_calibration(result, store: Store) -> None:
+    """``calibration_fit.png``, ``calibration_posterior.png`` and the report (``calibration.md``,
+    ``.html``) of a calibration just run into ``store`` (its ``drawing``: the posterior, the curves)."""
+    d = result.drawing
+    plot = plot_biaxial_calibration_fit if result.biaxial else plot_calibration_fit
+    plot(result, d.lab, d.curves, d.nearest, store.path(FIT_PNG))
+    plot_calibration_posterior(result, d.post, store.path(POSTERIOR_PNG))
+    write_calibration_report(store.root, result)
 
 
 def plot_calibration_fit(result, lab, curves: dict[float, list], nearest, path: str | os.PathLike) -> Path:
@@ -294,4 +308,9 @@ def _corner_ticks(set_ticks, set_labels, post, axis: str, shown: bool = True) ->
     set_labels(labels, fontsize=7)
 
 
-__all__ = ["plot_calibration_fit", "plot_calibration_posterior", "plot_posterior_corner"]
+__all__ = [
+    "draw_calibration",
+    "plot_calibration_fit",
+    "plot_calibration_posterior",
+    "plot_posterior_corner",
+]

@@ -4,7 +4,8 @@ the critical-state line (void ratio against the mean stress on a log axis).
 (a) tau / sigma_yy against gamma, one line per seed; (b) the solid fraction. The start of the
 steady-state window is a vertical line, the study's means over it dotted horizontal lines.
 Made from arrays (each series needs ``gamma``, ``stress_ratio`` and ``solid_fraction``): no
-file is opened here.
+file is opened here. :func:`draw_critical_state` and :func:`draw_critical_state_line` draw them
+from a finished run's result into its store.
 """
 
 from __future__ import annotations
@@ -20,8 +21,43 @@ import numpy as np
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from poro2d.critical_state.case import CaseRecord  # noqa: E402
+from poro2d.critical_state.line import CriticalStateLineResult, pressure_folder  # noqa: E402
+from poro2d.critical_state.results import CriticalStateResult, CriticalStateTestResult  # noqa: E402
 from poro2d.report.figure_file import save_figure  # noqa: E402
 from poro2d.report.shear_figures import COLORS  # noqa: E402
+from poro2d.store import Store  # noqa: E402
+
+#: the figure of a run or a study, and of a line
+FIGURE = "critical_state.png"
+LINE_FIGURE = "critical_state_line.png"
+
+
+def _title(case: CaseRecord) -> str:
+    return (
+        f"periodic shear: f_p = {case.particle_friction:g}, mu_r = {case.rolling_friction:g}, "
+        f"P = {case.pressure_kpa:g} kPa, I = {case.inertial_number:g}, {case.disks} disks"
+    )
+
+
+def draw_critical_state(result: CriticalStateTestResult | CriticalStateResult, store: Store) -> None:
+    """``critical_state.png`` of one run (its series) or of a study (every seed's, its means dotted)."""
+    case = result.case
+    if isinstance(result, CriticalStateTestResult):
+        series, steady = [(f"seed {case.seed}", result.series)], None
+    else:
+        series = [(f"seed {s}", t.series) for s, t in zip(result.seeds, result.tests, strict=True)]
+        steady = (result.stress_ratio.mean, result.solid_fraction.mean)
+    plot_critical_state(
+        series, store.path(FIGURE), title=_title(case), window=case.window_start, steady=steady
+    )
+
+
+def draw_critical_state_line(result: CriticalStateLineResult, store: Store) -> None:
+    """Every pressure's ``critical_state.png`` in its folder, then the line's e-log p figure."""
+    for study in result.studies:
+        draw_critical_state(study, store.child(pressure_folder(study.case.pressure_kpa)))
+    plot_critical_state_line(result, store.path(LINE_FIGURE))
 
 
 def plot_critical_state(
@@ -90,4 +126,11 @@ def plot_critical_state_line(result: Any, path: str | os.PathLike) -> Path:
     return save_figure(fig, path)
 
 
-__all__ = ["plot_critical_state", "plot_critical_state_line"]
+__all__ = [
+    "FIGURE",
+    "LINE_FIGURE",
+    "draw_critical_state",
+    "draw_critical_state_line",
+    "plot_critical_state",
+    "plot_critical_state_line",
+]

@@ -25,6 +25,23 @@ from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 from poro2d.grading import GradingCurve, realised_curve  # noqa: E402
 from poro2d.report.figure_file import DPI, save_figure  # noqa: E402
+from poro2d.store import Store  # noqa: E402
+
+
+def draw_grading(result, case, store: Store) -> Path:
+    """``fig_grading.png`` of a sand run (a :class:`~poro2d.sand.result.SandResult` of ``case``, a
+    :class:`~poro2d.sand.case.SandCase`): the grading it used beside the one its first kept
+    specimen realised (read from that specimen's state in ``store``)."""
+    kept = next((k for k in result.seed_results if k.folder), None)
+    radii = None if kept is None else store.child(kept.folder).load_state("specimen.npz").particles.radius
+    return grading_figure(
+        case.config.table("grading"),
+        case.base_dir,
+        case.grading,
+        radii,
+        store.path("fig_grading.png"),
+        title=case.name,
+    )
 
 
 def uncut_curve(table: dict, base_dir: str | os.PathLike | None, used: GradingCurve) -> GradingCurve:

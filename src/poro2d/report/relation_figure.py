@@ -3,7 +3,8 @@
 Drawn from an analysed relation (the :class:`poro2d.sweep.results.RelationResult` of
 :func:`poro2d.sweep.relation.analyse`, or one read back): the DEM points, hollow where the criterion
 did not converge, the parabola fitted to them, Eq. 12 and the other conversion methods
-(those the relation's table compares, in its order).
+(those the relation's table compares, in its order). :func:`draw_relation` draws a finished
+``poro2d relation`` run's figures into its store.
 """
 
 from __future__ import annotations
@@ -17,6 +18,8 @@ from matplotlib.figure import Figure
 
 from poro2d import porosity as P
 from poro2d.report.figure_file import save_figure
+from poro2d.store import Store
+from poro2d.sweep.results import RelationResult
 
 
 def write_relation_figure(rel, out: Path, title: str = "") -> list[Path]:
@@ -24,6 +27,14 @@ def write_relation_figure(rel, out: Path, title: str = "") -> list[Path]:
     paths = [out / "relation.png", out / "relation.svg"]
     save_figure(plot_relation(rel, title), *paths)
     return paths
+
+
+def draw_relation(rel: RelationResult, store: Store) -> list[Path]:
+    """``relation.png`` and ``relation.svg`` of a relation run in its store; returns both paths."""
+    title = "2D porosity from the criterion vs laboratory porosity"
+    return write_relation_figure(
+        rel, store.root, title + (" (quick: 0.08 m x 0.04 m box)" if rel.quick else "")
+    )
 
 
 def plot_relation(rel, title: str = "") -> Figure:

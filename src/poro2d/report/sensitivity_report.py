@@ -15,6 +15,11 @@ from poro2d.io_utils import as_json, float_or_nan
 from poro2d.report.document import Block
 
 
+def draw_sensitivity(result, store) -> list[Path]:
+    """``sensitivity.png`` and ``.svg`` of a finished study (a :class:`SensitivityResult`) in its store."""
+    return plot_sensitivity(result.to_dict(), store.path("sensitivity"))
+
+
 def _ok(p: dict) -> bool:
     return math.isfinite(float_or_nan(p.get("n2d_mean")))
 

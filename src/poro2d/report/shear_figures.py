@@ -3,7 +3,8 @@
 (a) shear stress against shear displacement, one curve per normal stress (the
 vertical plate displacement below); (b) peak strength against normal stress with
 the Mohr-Coulomb line(s). Laboratory data, when given, are drawn as open markers
-and dashed lines.
+and dashed lines. The ``draw_*`` functions draw them, and each test's force chains at its
+peak, from a finished run's result and the data files its store keeps.
 """
 
 from __future__ import annotations
@@ -20,9 +21,68 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from poro2d.report.figure_file import save_figure  # noqa: E402
+from poro2d.report.force_chains import plot_force_chains  # noqa: E402
+from poro2d.shear.fit import mohr_coulomb  # noqa: E402
+from poro2d.shear.lab import LabData  # noqa: E402
+from poro2d.shear.outputs import lab_fit  # noqa: E402
+from poro2d.shear.peak_frame import PeakFrame  # noqa: E402
+from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult, ShearTestResult  # noqa: E402
+from poro2d.shear.shear_stage import PEAK_FRAME  # noqa: E402
+from poro2d.store import Store  # noqa: E402
 
 #: the colours of the normal stresses (or series), in turn
 COLORS = ["#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#666666"]
+
+
+def draw_peak_forces(store: Store) -> None:
+    """``forces_peak.png`` of a finished test, from the state its run kept at the smoothed peak
+    (``peak_frame.npz``, removed once drawn: the figure is what the folder keeps of it)."""
+    frame = PeakFrame.load(store, PEAK_FRAME)
+    test = store.read_result("result.json", ShearTestResult.from_dict) if frame is not None else None
+    if test is None:
+        return
+    b = test.consolidation.box
+    plot_force_chains(
+        frame.contacts, frame.pos, frame.radius, frame.walls, store.path("forces_peak.png"),
+        thickness=frame.thickness, box=(-0.02 * b.width, 0.0, b.width + b.max_displacement, b.height),
+        title=f"direct shear at {test.normal_stress_kpa:g} kPa, at the peak: "
+              f"d = {frame.displacement_mm:.2f} mm",
+        notes=[f"tau_peak = {test.peak_shear_stress_kpa:.1f} kPa (smoothed over "
+               f"{1e3 * test.settings.peak_window:g} mm)"],
+    )  # fmt: skip
+    store.remove(PEAK_FRAME)
+
+
+def draw_shear_series(result: ShearSeriesResult, store: Store, lab: LabData | None = None) -> None:
+    """Each test's ``forces_peak.png``, then ``fig8a_shear_curves.png`` (curves, peaks marked) and
+    ``fig8b_peak_strength.png`` (the fits); ``lab``: the laboratory data the series was given."""
+    for t in result.tests:
+        draw_peak_forces(store.child(t.folder))
+    tests, s = result.tests, result.settings
+    sig, tau = [t.normal_stress_kpa for t in tests], [t.peak_shear_stress_kpa for t in tests]
+    peaks = {t.normal_stress_kpa: (t.shear_displacement_at_peak_m, t.peak_shear_stress_kpa) for t in tests}
+    plot_shear_curves(
+        result.curves, store.path("fig8a_shear_curves.png"), lab=lab, peaks=peaks,
+        smoothing_note=f"v = {1e3 * s.velocity:g} mm/s; peaks (dots) smoothed over "
+                       f"{1e3 * s.peak_window:g} mm",
+    )  # fmt: skip
+    plot_peak_strength(
+        sig, tau, mohr_coulomb(np.array(sig), np.array(tau)) if len(sig) >= 2 else None,
+        store.path("fig8b_peak_strength.png"), lab=lab, lab_fit=lab_fit(lab),
+        fit_origin=mohr_coulomb(np.array(sig), np.array(tau), through_origin=True),
+    )  # fmt: skip
+
+
+def draw_replicate_shear(result: ReplicateShearResult, store: Store, lab: LabData | None = None) -> None:
+    """Every specimen's figures in its folder, then Fig. 8 over the specimens: mean curves with
+    +- sd bands, peaks with the pooled fit."""
+    for label, series in result.series.items():
+        draw_shear_series(series, store.child(label), lab)
+    bands = {r.normal_stress_kpa: curve_band([s.curves[r.normal_stress_kpa] for s in result.series.values()])
+             for r in result.per_normal_stress}  # fmt: skip
+    plot_replicate_curves(bands, store.path("fig8a_shear_curves_replicates.png"), len(result.series), lab=lab)
+    peaks_png = store.path("fig8b_peak_strength_replicates.png")
+    plot_replicate_peaks(result, peaks_png, lab=lab, lab_fit=lab_fit(lab))
 
 
 def plot_shear_curves(
@@ -202,6 +262,9 @@ __all__ = [
     "COLORS",
     "CurveBand",
     "curve_band",
+    "draw_peak_forces",
+    "draw_replicate_shear",
+    "draw_shear_series",
     "plot_peak_strength",
     "plot_replicate_curves",
     "plot_replicate_peaks",

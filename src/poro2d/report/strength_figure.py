@@ -30,6 +30,11 @@ def _series(rows: list, friction: float, key: str) -> tuple[list, list, list]:
     )
 
 
+def draw_strength(result, store) -> Path:
+    """``fig_strength.png`` of a finished strength study (a :class:`StrengthResult`) in its store."""
+    return plot_strength(result.cases, store.path("fig_strength.png"))
+
+
 def plot_strength(rows: list, path: str | os.PathLike) -> Path:
     """Peak and residual friction angles (left) and max dilation angle (right) against mu_r."""
     frictions = sorted({r.particle_friction for r in rows})
@@ -56,4 +61,4 @@ def plot_strength(rows: list, path: str | os.PathLike) -> Path:
     return save_figure(fig, path)
 
 
-__all__ = ["plot_strength"]
+__all__ = ["draw_strength", "plot_strength"]

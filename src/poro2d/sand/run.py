@@ -301,10 +301,11 @@ def run_sand(
 
     ``config``: a sand config (:mod:`poro2d.sand.case`), a TOML file or a dict. Keeps in ``store``
     ``preflight.json`` before any DEM work, then the calibration, the specimens
-    (``specimens/<state>-seed<k>``), ``fig_grading.png``, ``summary.md``, ``summary.csv`` and
-    ``sand.json`` (returned as a :class:`~poro2d.sand.result.SandResult`). ``on_preflight``
-    is called with the case and its pre-flight before any DEM work (the command prints it
-    there), ``announce`` with one line per stage, with the elapsed time and an overall ETA.
+    (``specimens/<state>-seed<k>``), ``summary.md``, ``summary.csv`` and ``sand.json`` (returned
+    as a :class:`~poro2d.sand.result.SandResult`). ``on_preflight`` is called with the case and
+    its pre-flight before any DEM work (the command prints it there, and draws ``fig_grading.png``
+    with it afterwards: ``draw_grading`` of ``report/grading_figure.py``), ``announce`` with one
+    line per stage, with the elapsed time and an overall ETA.
     ``options``: where the jobs run and whether bars show (:class:`~poro2d.execute.options.RunOptions`;
     the pre-flight's estimate counts ``workers``). Rerun to resume: finished cases are read back.
     """
@@ -344,31 +345,9 @@ def run_sand(
         time_profile=stage_profile(case_runs(Store(cal_record.cases), cal_ids)),
         specimens_time_profile=stage_profile(runs),
     )
-    radii = _drawn_radii(store, kept)
-    _grading_figure(case, radii, store)
     result = SandResult.build(case, pf, target, trial, cal_record, kept, clock.elapsed())
     write_summary(result, store)
     return result
-
-
-def _drawn_radii(store: Store, kept: list[SeedSpecimen]) -> np.ndarray | None:
-    for k in kept:
-        if k.folder:
-            return store.child(k.folder).load_state("specimen.npz").particles.radius.copy()
-    return None
-
-
-def _grading_figure(case: SandCase, radii, store: Store) -> None:
-    from poro2d.report.grading_figure import grading_figure
-
-    grading_figure(
-        case.config.table("grading"),
-        case.base_dir,
-        case.grading,
-        radii,
-        store.path("fig_grading.png"),
-        title=case.name,
-    )
 
 
 __all__ = ["bracket", "full_box_trial", "predicted_mu", "check_soil", "run_sand"]

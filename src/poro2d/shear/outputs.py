@@ -1,4 +1,5 @@
-"""The files of a direct shear series: test folders, curves and peaks tables, Fig. 8 figures."""
+"""The files of a direct shear series: test folders, curves and peaks tables (Fig. 8 is drawn from
+the result by ``report/shear_figures.py``)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,6 @@ from poro2d.shear.curve import CURVE_COLUMNS, ShearCurve
 from poro2d.shear.fit import MohrCoulombFit, mohr_coulomb
 from poro2d.shear.lab import LabData
 from poro2d.shear.parts import ShearTestSummary
-from poro2d.shear.results import ShearTestResult
 from poro2d.store import Store
 
 
@@ -40,23 +40,4 @@ def write_tables(store: Store, curves: dict[float, ShearCurve], summary: list[Sh
     )
 
 
-def write_figures(
-    store: Store, tests: list[ShearTestResult], curves: dict[float, ShearCurve], fit, fit0, settings,
-    lab: LabData | None,
-) -> None:  # fmt: skip
-    """``fig8a_shear_curves.png`` (curves, peaks marked) and ``fig8b_peak_strength.png`` (the fits)."""
-    from poro2d.report.shear_figures import plot_peak_strength, plot_shear_curves
-
-    peaks = {t.normal_stress_kpa: (t.shear_displacement_at_peak_m, t.peak_shear_stress_kpa) for t in tests}
-    plot_shear_curves(
-        curves, store.path("fig8a_shear_curves.png"), lab=lab, peaks=peaks,
-        smoothing_note=f"v = {1e3 * settings.velocity:g} mm/s; peaks (dots) smoothed over "
-        f"{1e3 * settings.peak_window:g} mm",
-    )  # fmt: skip
-    plot_peak_strength(
-        [t.normal_stress_kpa for t in tests], [t.peak_shear_stress_kpa for t in tests], fit,
-        store.path("fig8b_peak_strength.png"), fit_origin=fit0, lab=lab, lab_fit=lab_fit(lab),
-    )  # fmt: skip
-
-
-__all__ = ["folder_name", "lab_fit", "write_figures", "write_tables"]
+__all__ = ["folder_name", "lab_fit", "write_tables"]

@@ -4,7 +4,8 @@ The peak is a maximum of the *smoothed* curve, which is known only once the reco
 a window past it exist. So every record's state is kept as a :class:`PeakFrame` (plain
 arrays: disks, walls, contacts) until its smoothed value is final; :class:`PeakTracker`
 keeps the frame of the largest one. The frame is saved beside the shear checkpoint, so a
-resumed test still draws the peak's forces.
+resumed test still finds it, and at the end of the shear: the figure of the peak's forces is
+drawn from it once the test has returned (``draw_peak_forces`` (``report/shear_figures.py``)).
 """
 
 from __future__ import annotations
@@ -12,7 +13,6 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -76,14 +76,6 @@ class PeakFrame:
         """The frame kept in ``store`` as ``name``; None when it is missing or damaged."""
         data = store.read_arrays(name)
         return None if data is None else cls.from_arrays(data)
-
-    def draw(self, path: Path, **kw) -> Path:
-        """The force chains of this frame (keywords as :func:`plot_force_chains`), in N/m."""
-        from poro2d.report.force_chains import plot_force_chains
-
-        return plot_force_chains(
-            self.contacts, self.pos, self.radius, self.walls, path, thickness=self.thickness, **kw
-        )
 
 
 class PeakTracker:

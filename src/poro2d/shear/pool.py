@@ -25,12 +25,13 @@ from poro2d.store import Store
 @dataclass(frozen=True)
 class ShearJob:
     """One test of a pool: ``key`` says which (``("test", sigma)``, a rate check's ``("rate", sigma)``),
-    ``folder`` names its store (None: nothing kept)."""
+    ``folder`` names its store (None: nothing kept); ``keep_peak``: keep the state at the peak
+    (:class:`~poro2d.shear.single.DirectShearTest`)."""
 
     key: tuple
     case: ShearCase
     folder: str | None
-    figures: bool = True
+    keep_peak: bool = True
     series: str = ""
 
     @property
@@ -47,7 +48,7 @@ class ShearJob:
     def test(self, progress=None) -> DirectShearTest:
         """The job's test, on one thread."""
         store = Store(self.folder) if self.folder is not None else None
-        return DirectShearTest(self.case, store, progress=progress, figures=self.figures, threads=1)
+        return DirectShearTest(self.case, store, progress=progress, keep_peak=self.keep_peak, threads=1)
 
 
 def _run_job(job: ShearJob, report) -> ShearTestResult:

@@ -114,7 +114,7 @@ class ReplicateShear:
 
     def __init__(self, specimens: SpecimenSet, normal_stresses_kpa, settings=None, *,
                  store: Store | None = None, lab=None, options: RunOptions = RunOptions(),
-                 config: dict | None = None, figures: bool = True) -> None:  # fmt: skip
+                 config: dict | None = None, keep_peak: bool = True) -> None:  # fmt: skip
         from poro2d.shear.series import ShearSeries
 
         if not specimens:
@@ -122,7 +122,6 @@ class ReplicateShear:
         self.store = store
         self.options = options
         self.config = config or {}
-        self.figures = figures
         self.series = {
             label: ShearSeries(
                 specimens.specimen(label),
@@ -132,7 +131,7 @@ class ReplicateShear:
                 lab=lab,
                 options=RunOptions(workers=1, progress=False),
                 config=self.config,
-                figures=figures,
+                keep_peak=keep_peak,
             )  # fmt: skip
             for label in specimens
         }
@@ -166,24 +165,7 @@ class ReplicateShear:
         self.store.write_csv("replicates.csv", [{k: v for k, v in r.to_dict().items() if k != "peaks_kpa"}
                                                 for r in summary.per_normal_stress])  # fmt: skip
         self.store.write_json("replicates.json", summary.to_dict())
-        if self.figures:
-            self._figures(summary, self.store)
         return summary
-
-    def _figures(self, summary: ReplicateShearResult, store: Store) -> None:
-        """fig8a/fig8b over specimens: mean curves with +- sd bands, peaks with the pooled fit."""
-        from poro2d.report.shear_figures import curve_band, plot_replicate_curves, plot_replicate_peaks
-        from poro2d.shear.outputs import lab_fit
-
-        bands = {}
-        for row in summary.per_normal_stress:
-            sigma = row.normal_stress_kpa
-            bands[sigma] = curve_band([res.curves[sigma] for res in summary.series.values()])
-        n = len(self.series)
-        lab = next(iter(self.series.values())).lab
-        plot_replicate_curves(bands, store.path("fig8a_shear_curves_replicates.png"), n, lab=lab)
-        peaks_png = store.path("fig8b_peak_strength_replicates.png")
-        plot_replicate_peaks(summary, peaks_png, lab=lab, lab_fit=lab_fit(lab))
 
 
 __all__ = ["ReplicateShear", "mohr_coulomb_ci", "summarize_replicate_peaks"]

@@ -62,7 +62,8 @@ def run_shear(
     options: RunOptions = RunOptions(),
     config: dict | None = None,
 ) -> ShearSeriesResult:
-    """Direct shear tests on ``specimen`` at ``normal_stresses_kpa``, the fit and Fig. 8.
+    """Direct shear tests on ``specimen`` at ``normal_stresses_kpa`` and the fit (Fig. 8 is drawn from
+    the result: ``draw_shear_series`` (``report/shear_figures.py``)).
 
     ``specimen``: a checkpoint (.npz) or a criterion output folder holding ``specimen.npz``
     (read once: every test starts from that content). ``normal_stresses_kpa``: a number or

@@ -15,12 +15,7 @@ from poro2d.shear.box_dominated import box_dominated_count
 from poro2d.shear.box_scale import box_scale
 from poro2d.shear.case import ShearCase
 from poro2d.shear.fit import mohr_coulomb, smooth
-from poro2d.shear.outputs import (
-    folder_name,
-    lab_fit,
-    write_figures,
-    write_tables,
-)
+from poro2d.shear.outputs import folder_name, lab_fit, write_tables
 from poro2d.shear.parts import (
     LabComparison,
     QuasiStatic,
@@ -59,11 +54,11 @@ class ShearSeries:
 
     ``specimen``: a :class:`~poro2d.specimen.saved.Specimen`, or its path (read once,
     here). With ``store`` it keeps ``result.json`` (per test and overall), ``peaks.csv``,
-    ``curves.csv``, ``fig8a_shear_curves.png``, ``fig8b_peak_strength.png`` and one sub-store
-    per test (see :class:`DirectShearTest`); with ``rate_check`` every test is repeated at
-    half the velocity under ``rate_check/`` and the change of the peak is reported. Finished
-    tests are skipped on a rerun; a killed test resumes from its checkpoint. ``store=None``:
-    nothing is kept.
+    ``curves.csv`` and one sub-store per test (see :class:`DirectShearTest`; Fig. 8 is drawn from
+    the result by ``draw_shear_series`` (``report/shear_figures.py``)); with ``rate_check``
+    every test is repeated at half the velocity under ``rate_check/`` and the change of the peak
+    is reported. Finished tests are skipped on a rerun; a killed test resumes from its
+    checkpoint. ``store=None``: nothing is kept.
     """
 
     def __init__(
@@ -77,7 +72,7 @@ class ShearSeries:
         rate_tolerance: float = 0.02,
         options: RunOptions = RunOptions(),
         config: dict | None = None,
-        figures: bool = True,
+        keep_peak: bool = True,
     ) -> None:
         self.specimen = Specimen.of(specimen)
         self.stresses = check_stresses(normal_stresses_kpa)
@@ -88,7 +83,7 @@ class ShearSeries:
         self.rate_tolerance = check_range("rate_tolerance", rate_tolerance, 0.0, 1.0, lo_open=True)
         self.options = options
         self.config = config or {}
-        self.figures = figures
+        self.keep_peak = keep_peak
         self.jobs = self._jobs()
         # the tests are about equally long: one process per test (up to twice the cores)
         # leaves no core idle at the end (3 tests on 2 cores take 1.5 test times, not 2)
@@ -118,7 +113,7 @@ class ShearSeries:
         base = ShearCase(self.specimen, self.stresses[0], self.settings)
         half = base.with_settings(velocity=0.5 * self.settings.velocity)
         jobs = [
-            ShearJob(("test", sig), base.at(sig), self._folder(folder_name(sig)), self.figures)
+            ShearJob(("test", sig), base.at(sig), self._folder(folder_name(sig)), self.keep_peak)
             for sig in self.stresses
         ]
         if self.rate_check:
@@ -129,13 +124,13 @@ class ShearSeries:
         return jobs
 
     def run(self) -> ShearSeriesResult:
-        """Run the tests (finished ones are read back), then the fit, figures and ``result.json``."""
+        """Run the tests (finished ones are read back), then the fit, the tables and ``result.json``."""
         t0 = time.perf_counter()
         return self.finish(execute_jobs(self.jobs, self.processes, self.options), t0)
 
     # ------------------------------------------------------------------ results
     def finish(self, results: list[ShearTestResult], t0: float) -> ShearSeriesResult:
-        """Fit, figures and ``result.json`` from the tests' results, in the order of :attr:`jobs`
+        """Fit, tables and ``result.json`` from the tests' results, in the order of :attr:`jobs`
         (a test per stress, then the rate check's reruns)."""
         n = len(self.stresses)
         tests = results[:n]
@@ -180,8 +175,6 @@ class ShearSeries:
         curves = {t.normal_stress_kpa: t.curve for t in tests}
         if self.store is not None:
             write_tables(self.store, curves, summary)
-            if self.figures:
-                write_figures(self.store, tests, curves, fit, fit0, self.settings, self.lab)
             self.store.write_json("result.json", result)
         result.curves = curves
         return result

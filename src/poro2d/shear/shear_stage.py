@@ -1,7 +1,7 @@
 """The shear stage of a direct shear test: the lower half moves, one row per record.
 
 Every ``record_interval`` of shear displacement one row of the curve is recorded (and,
-with figures, the state kept for the peak's force chains); every
+with ``keep_peak``, the state kept for the peak's force chains); every
 ``checkpoint_interval`` the whole engine state and the rows so far are saved in
 ``shear_checkpoint.npz``, so a killed test continues from there bit for bit.
 """
@@ -36,11 +36,11 @@ class ShearStage:
     consolidation (the dilation's zero); ``store``: where the checkpoint (through its
     :class:`~poro2d.store.Checkpoints`) and the peak's frame are kept (None: nowhere);
     ``threads``: for a state read back from the checkpoint;
-    ``figures``: keep the state at the peak for its force chains; ``progress(phase,
+    ``keep_peak``: keep the state at the peak (its force chains, its overlap); ``progress(phase,
     fraction)``: called at every record.
 
     After :meth:`run`: ``rows`` (the curve), ``sim`` (the final state) and ``peak.frame``
-    (the state at the smoothed peak, when ``figures``).
+    (the state at the smoothed peak, when ``keep_peak``).
     """
 
     def __init__(
@@ -51,12 +51,12 @@ class ShearStage:
         y_plate0: float,
         store: Store | None = None,
         threads: int = 1,
-        figures: bool = True,
+        keep_peak: bool = True,
         progress: ProgressFn | None = None,
     ) -> None:
         s = settings
         self.box, self.settings = box, s
-        self.threads, self.figures, self.progress = threads, figures, progress
+        self.threads, self.keep_peak, self.progress = threads, keep_peak, progress
         self.t0 = time.perf_counter()
         self.store = store
         self.checkpoints = None if store is None else store.checkpoints(CHECKPOINT)
@@ -86,7 +86,7 @@ class ShearStage:
         contacts = sim.contacts()
         rows.append(curve_row(sim, self.box, self.settings, contacts, self.y_plate0, self.step0, self.rho))
         x_mm = rows[-1].shear_displacement_mm
-        if self.figures:
+        if self.keep_peak:
             self.peak.add(PeakFrame.capture(sim, contacts, len(rows) - 1, x_mm))
         self.peak.settle(rows, x_mm * 1e-3)
         done = sim.step_count - self.step0
@@ -122,9 +122,9 @@ class ShearStage:
 
 
 def remove_stage_files(store: Store) -> None:
-    """The checkpoint and the stored frame of a test in ``store``, once its results are written."""
+    """The checkpoint of a test in ``store``, once its results are written (the peak's frame stays
+    until its figure is drawn: ``draw_peak_forces`` (``report/shear_figures.py``))."""
     store.checkpoints(CHECKPOINT).clear()
-    store.remove(PEAK_FRAME)
 
 
 __all__ = ["CHECKPOINT", "PEAK_FRAME", "ShearStage", "remove_stage_files"]

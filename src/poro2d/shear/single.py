@@ -50,7 +50,7 @@ from poro2d.shear.peak_frame import PeakFrame
 from poro2d.shear.residual import dilation_stopped_residual
 from poro2d.shear.results import ShearTestResult
 from poro2d.shear.settings import inertial_number
-from poro2d.shear.shear_stage import ShearStage, remove_stage_files
+from poro2d.shear.shear_stage import PEAK_FRAME, ShearStage, remove_stage_files
 from poro2d.store import Store
 from poro2d.store.stage import ResumableStage
 
@@ -63,9 +63,11 @@ class DirectShearTest:
 
     With ``store`` every stage is kept there as it finishes (``consolidated.npz``,
     ``consolidation.json``, ``shear_checkpoint.npz`` during shearing, ``curve.csv``,
-    ``result.json``, ``forces_peak.png``); a rerun skips what is done and continues a
-    shear stage from its last checkpoint. ``store=None``: nothing is kept. ``progress(phase,
-    fraction)`` is called between blocks of steps.
+    ``result.json`` and, with ``keep_peak``, the state at the smoothed peak, ``peak_frame.npz``,
+    from which ``draw_peak_forces`` (``report/shear_figures.py``) draws its force chains); a
+    rerun skips what is done and continues a shear stage from its last checkpoint.
+    ``store=None``: nothing is kept. ``progress(phase, fraction)`` is called between blocks of
+    steps. Without ``keep_peak`` no state is kept at the peak and the mean overlap is the end's.
     """
 
     def __init__(
@@ -74,7 +76,7 @@ class DirectShearTest:
         store: Store | None = None,
         *,
         progress: ProgressFn | None = None,
-        figures: bool = True,
+        keep_peak: bool = True,
         threads: int = 1,
     ) -> None:
         self.case = case
@@ -82,7 +84,7 @@ class DirectShearTest:
         self.settings = case.settings
         self.store = store
         self.progress = progress
-        self.figures = figures
+        self.keep_peak = keep_peak
         self.threads = threads
         self.box: SplitBox | None = None
         self._stage: ResumableStage | None = None
@@ -191,33 +193,20 @@ class DirectShearTest:
     def shear(self, sim: Simulation, info: ConsolidationRecord) -> ShearTestResult:
         """Shear the consolidated specimen to ``max_displacement``; returns the test result.
 
-        With ``store``: ``curve.csv`` and ``forces_peak.png`` are written here, ``result.json``
+        With ``store``: ``curve.csv`` and ``peak_frame.npz`` are written here, ``result.json``
         after them by :meth:`run`.
         """
         assert self.box is not None
         stage = ShearStage(
             sim, self.box, self.settings, info.plate_height_m,
-            store=self.store, threads=self.threads, figures=self.figures, progress=self.progress,
+            store=self.store, threads=self.threads, keep_peak=self.keep_peak, progress=self.progress,
         )  # fmt: skip
         wall = stage.run()
         result = self._result(stage.rows, info, stage.sim, wall, stage.peak.frame)
         if self.store is not None:
             self.store.write_csv("curve.csv", stage.rows, header=CURVE_COLUMNS)
-            if self.figures and stage.peak.frame is not None:
-                self._figure(stage.peak.frame, result)
+            stage.peak.save(self.store, PEAK_FRAME)  # its force chains are drawn from it afterwards
         return result
-
-    def _figure(self, frame: PeakFrame, result: ShearTestResult) -> None:
-        """``forces_peak.png``: the force chains at the (smoothed) peak."""
-        assert self.store is not None and self.box is not None
-        b = self.box
-        frame.draw(
-            self.store.path("forces_peak.png"),
-            title=f"direct shear at {self.sigma_kpa:g} kPa, at the peak: d = {frame.displacement_mm:.2f} mm",
-            box=(-0.02 * b.width, 0.0, b.width + b.max_displacement, b.height),
-            notes=[f"tau_peak = {result.peak_shear_stress_kpa:.1f} kPa (smoothed over "
-                   f"{1e3 * self.settings.peak_window:g} mm)"],
-        )  # fmt: skip
 
     def _result(
         self, rows: list[ShearRow], info: ConsolidationRecord, sim: Simulation, wall: float,

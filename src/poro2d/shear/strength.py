@@ -252,7 +252,7 @@ class StrengthStudy:
                 store=store.child(case_label(m, f)) if store is not None else None,
                 options=RunOptions(progress=False),
                 config=self.config,
-                figures=False,
+                keep_peak=False,
             )  # fmt: skip
             for m in self.mu_r
             for f in self.friction
@@ -294,15 +294,13 @@ class StrengthStudy:
 
     @staticmethod
     def _write(store: Store, result: StrengthResult, tests: list[dict]) -> None:
-        """The study's tables, ``strength.json`` and its figure."""
-        from poro2d.report.strength_figure import plot_strength
-
+        """The study's tables and ``strength.json`` (its figure is drawn from the result:
+        ``draw_strength`` (``report/strength_figure.py``))."""
         rows = result.cases
         store.write_csv("strength_tests.csv", tests)
         store.write_csv("strength.csv", [{k: v for k, v in r.to_dict().items() if not k.endswith("_ci_deg")}
                                          for r in rows])  # fmt: skip
         store.write_result("strength.json", result)
-        plot_strength(rows, store.path("fig_strength.png"))
 
 
 DEFINITIONS = {

@@ -108,11 +108,11 @@ def criterion_case(config: dict, store: Store) -> CriterionCaseResults:
     from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.store import Store
 
-    out_dir = store.root
     spec, grading, settings, seed = criterion_objects(config)
-    figures = bool(config.get("sweep_options", {}).get("figures", False))
-    crit = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(out_dir), progress=False,
-                             config=config, figures=figures)  # fmt: skip
+    # a [sweep] figures = true is drawn by the command once the sweep ends (its sweep_options
+    # stay in the case's config: they are part of its identity)
+    crit = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(store.root), progress=False,
+                             config=config)  # fmt: skip
     return CriterionCaseResults.of(crit.run())
 
 

@@ -298,14 +298,12 @@ def _relation(pts: list[dict], n_max: float, n_min: float, mode: str, **extra: A
     })  # fmt: skip
 
 
-def write_relation(rel: RelationResult, store: Store, title: str = "", extra: dict | None = None
-                   ) -> list[Path]:  # fmt: skip
-    """relation.csv, relation.json, relation.png and relation.svg in ``store``.
+def write_relation(rel: RelationResult, store: Store, extra: dict | None = None) -> list[Path]:
+    """relation.csv and relation.json in ``store`` (the figures, relation.png and relation.svg, are
+    drawn from the result by ``draw_relation`` (``report/relation_figure.py``)).
 
     ``rel``: an analysed relation (with ``extra`` keys for the file) or a :class:`RelationResult`.
     """
-    from poro2d.report.relation_figure import write_relation_figure
-
     # a seed's missing number is None (NaN as the file keeps it): written as NaN was
     flat = [{k: " ".join(f"{float_or_nan(x):.4f}" for x in v) if isinstance(v, list) else v
              for k, v in p.to_dict().items()} for p in rel.points]  # fmt: skip
@@ -313,7 +311,7 @@ def write_relation(rel: RelationResult, store: Store, title: str = "", extra: di
     record = dict(rel.to_dict(), **(extra or {}))
     record.setdefault("provenance", Provenance.now().to_dict())  # a RelationResult carries its own
     file = store.write_json("relation.json", record)
-    return [table, file, *write_relation_figure(rel, store.root, title)]
+    return [table, file]
 
 
 def density_relation(
@@ -459,9 +457,6 @@ def run_relation(
     check_reachable(options.scheduler)
     if announce is not None:
         announce()
-    title = "2D porosity from the criterion vs laboratory porosity" + (
-        " (quick: 0.08 m x 0.04 m box)" if quick else ""
-    )
     with held(store, kind="relation") as kept:
         if mode == "density":
             rel, record = density_relation(base, settings, kept, quick=quick, seeds=n_seeds, mus=mus,
@@ -474,5 +469,5 @@ def run_relation(
             rel = analyse(res.rows, settings.n_max, settings.n_min)
             extra = {"quick": quick, "sweep_summary": res.summary, "config": cfg}
         result = RelationResult.from_dict(dict(rel.to_dict(), **extra, provenance=Provenance.now().to_dict()))
-        write_relation(result, kept, title=title)
+        write_relation(result, kept)
     return result

@@ -528,12 +528,13 @@ def _first_from(crit) -> str:
 
 
 def write_sensitivity(sens: dict, store: Store) -> SensitivityResult:
-    """sensitivity.json, sensitivity.csv (points), sensitivity_seeds.csv and the figure; the study typed."""
-    from poro2d.io_utils import Provenance
-    from poro2d.report.sensitivity_report import plot_sensitivity
+    """sensitivity.json, sensitivity.csv (points) and sensitivity_seeds.csv; the study typed.
 
-    figs = plot_sensitivity(sens, store.path("sensitivity"))
-    sens = dict(sens, figure=str(figs[0]), provenance=Provenance.now().to_dict())
+    Its ``figure`` names ``sensitivity.png`` in ``store``, which
+    ``draw_sensitivity`` (``report/sensitivity_report.py``) draws from the result."""
+    from poro2d.io_utils import Provenance
+
+    sens = dict(sens, figure=str(store.path("sensitivity.png")), provenance=Provenance.now().to_dict())
     result = SensitivityResult.from_dict(sens)
     store.write_csv("sensitivity_seeds.csv", sens["seeds"])
     store.write_csv("sensitivity.csv", [row.to_dict() for row in _csv_rows(result)])
