@@ -26,6 +26,8 @@ import time
 
 import numpy as np
 
+from poro2d.dem import Every
+
 #: the equilibrium every stage reaches before it is read
 RATIO = 1e-3
 #: the isotropic start (kPa): small against the loading stresses
@@ -62,7 +64,7 @@ def settle(sim, sigma_v: float, settings, box_cls, *, sides: float | None) -> tu
         return done
 
     targets(sim)
-    sim.run(2_000_000, every=500, callback=check)
+    sim.run(2_000_000, reporters=[Every(500, check)])
     if not state["ok"]:
         raise RuntimeError(f"no equilibrium at sigma_v = {sigma_v / 1e3:g} kPa")
     s1, s3, _, _ = box_cls.stresses(sim)

@@ -20,6 +20,7 @@ from poro2d.criterion.lid import (
     segment_count,
 )
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion, wall_forces
+from poro2d.dem import Every
 from poro2d.errors import InputError
 from poro2d.grading import paper_grading
 from poro2d.measure.disks import mass_d50
@@ -138,7 +139,7 @@ def test_a_lid_counts_as_resting_only_while_it_bears_on_most_of_the_width(prepar
     sim.run(100)
     assert not lid.resting(sim, total)
     lid.servo(sim, total, max_speed=0.05, gain=0.3)
-    sim.run(40_000, every=500, callback=lambda s: lid.resting(s, total))
+    sim.run(40_000, reporters=[Every(500, lambda s: lid.resting(s, total))])
     assert lid.resting(sim, total)
     lid.servo(sim, total, max_speed=0.001, gain=0.02)  # the criterion's gentle settling servo
     sim.run(30_000)

@@ -21,7 +21,7 @@ import numba
 import numpy as np
 import pytest
 
-from poro2d.dem import Particles, Simulation, Walls
+from poro2d.dem import Every, Particles, Simulation, Walls
 from poro2d.dem.state import SERVO_ERROR_SUM
 
 R = 1e-3
@@ -94,13 +94,13 @@ def test_progress_bar_changes_nothing(one_block):
 
 
 @pytest.mark.parametrize("every", [1, 7, 100, 999, 4096])
-def test_callbacks_change_nothing(one_block, every):
+def test_reporters_change_nothing(one_block, every):
     seen = []
 
     def look(sim):  # reads the state like a protocol's check does
         seen.append((sim.step_count, sim.unbalanced_ratios()[0], float(sim.wall_force("top")[1])))
 
-    _, state = _settle(every=every, callback=look)
+    _, state = _settle(reporters=[Every(every, look)])
     _assert_same(one_block, state)
     # called on every multiple of ``every`` before the stop (not on the step that stops)
     assert [s for s, _, _ in seen] == list(range(every, int(one_block["steps"]), every))
@@ -133,7 +133,7 @@ def test_two_runs_equal_one_without_a_stop_ratio():
     a, b = _settling_box(), _settling_box()
     ra = a.run(3000)
     b.run(1234)
-    rb = b.run(1766, every=333, callback=lambda sim: None)
+    rb = b.run(1766, reporters=[Every(333, lambda sim: None)])
     assert ra.rebuilds > 0 and b.step_count == a.step_count == 3000
     skip = ("steps",)
     _assert_same(*({k: v for k, v in _state(s, r).items() if k not in skip} for s, r in ((a, ra), (b, rb))))
@@ -150,8 +150,8 @@ def test_threads_and_blocks_change_nothing_on_a_large_packing():
         sim.run(1100)
         sim.threads = threads
         assert sim.effective_threads == threads
-        res = sim.run(500, until_ratio=0.9, check_every=16, every=every,
-                      callback=None if every is None else (lambda s: None))  # fmt: skip
+        looks = [] if every is None else [Every(every, lambda s: None)]
+        res = sim.run(500, until_ratio=0.9, check_every=16, reporters=looks)
         assert sim.threads_used == threads
         runs.append(_state(sim, res))
     assert runs[0]["converged"] and runs[0]["steps"] < 500

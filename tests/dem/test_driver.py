@@ -15,7 +15,7 @@ import numba
 import numpy as np
 import pytest
 
-from poro2d.dem import Particles, Simulation, Walls, checkpoint
+from poro2d.dem import Every, Particles, Simulation, Walls, checkpoint
 from poro2d.dem import kernels as K
 from poro2d.dem.summary import EngineSummary
 from poro2d.errors import InputError
@@ -56,15 +56,32 @@ def _raises(parameter: str, fn, *a, **kw) -> InputError:
     return e.value
 
 
-# ------------------------------------------------------------------ callbacks
-def test_a_callback_needs_its_interval():
+# ------------------------------------------------------------------ reporters
+class _Both:
+    """A reporter that notes the steps it is called at and stops the run at the fifth call."""
+
+    def __init__(self, period: int, calls: list) -> None:
+        self.period, self.calls = period, calls
+
+    def report(self, sim, step):
+        self.calls.append((self.period, step, sim.step_count))
+        return len(self.calls) >= 5
+
+
+def test_reporters_need_a_period_and_run_on_their_own():
     sim = _grid_box()
     calls = []
-    err = _raises("every", sim.run, 100, callback=lambda s: calls.append(s.step_count))
-    assert "callback" in str(err)
+    err = _raises("reporters", sim.run, 100, reporters=[lambda s: calls.append(s.step_count)])
+    assert "period" in str(err)
+    _raises("reporters", sim.run, 100, reporters=[Every(0, lambda s: None)])
     assert sim.step_count == 0  # refused before any step
-    sim.run(100, every=40, callback=lambda s: calls.append(s.step_count))
+    sim.run(100, reporters=[Every(40, lambda s: calls.append(s.step_count))])
     assert calls == [40, 80]
+    # two periods: each on its own multiples, in the order given; a True ends the run after all due
+    calls.clear()
+    res = sim.run(1000, reporters=[_Both(30, calls), _Both(20, calls)])
+    assert calls == [(20, 20, 120), (30, 30, 130), (20, 40, 140), (30, 60, 160), (20, 60, 160)]
+    assert res.steps == 60
 
 
 # ------------------------------------------------------------------ walls added later
@@ -181,7 +198,7 @@ def test_summary_tells_a_fallback_to_one_thread(monkeypatch):
 def test_run_result_counts():
     a, b = _grid_box(), _grid_box()
     ra = a.run(2000)
-    rb = b.run(2000, every=150, callback=lambda s: None)
+    rb = b.run(2000, reporters=[Every(150, lambda s: None)])
     n = a.particles.n
     assert ra.particle_steps == rb.particle_steps == 2000 * n
     assert ra.rebuilds > 2 and rb.rebuilds == ra.rebuilds  # summed over the blocks

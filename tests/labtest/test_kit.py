@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from poro2d.biaxial.settings import BiaxialSettings
+from poro2d.dem.reporters import next_event, report_due
 from poro2d.errors import InputError
 from poro2d.labtest.curve import ColumnCurve, CurveRow
 from poro2d.labtest.records import BoxRecord, ByName, ConsolidationRecord, TestSummary, typed_parts
@@ -103,20 +104,20 @@ def test_a_column_curve_reads_rows_as_its_file_holds_them():
 
 
 class Clock:
-    """A stand-in simulation for the settle loop: steps a counter, asks the callback every block."""
+    """A stand-in simulation for the settle loop: steps a counter, its reporters due after each block."""
 
     def __init__(self, step_count=0):
         self.step_count = step_count
         self.ratio = 1.0
 
-    def run(self, steps, *, every, callback, progress=False):
-        start = self.step_count
-        while self.step_count - start < steps:
-            self.step_count += min(every, steps - (self.step_count - start))
-            self.ratio /= 2.0
-            if callback(self):
+    def run(self, steps, *, reporters, progress=False):
+        done = 0
+        while done < steps:
+            k = next_event(reporters, done, steps) - done
+            done, self.step_count, self.ratio = done + k, self.step_count + k, self.ratio / 2.0
+            if report_due(reporters, self, done):
                 break
-        return type("Ran", (), {"steps": self.step_count - start})()
+        return type("Ran", (), {"steps": done})()
 
     def unbalanced_ratios(self):
         return (self.ratio,)

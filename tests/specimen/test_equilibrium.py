@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from poro2d.criterion.protocol import wall_forces
-from poro2d.dem import Simulation
+from poro2d.dem import Every, Simulation
 from poro2d.dem.contacts import contact_set
 from poro2d.errors import InputError
 from poro2d.grading import preset_grading
@@ -54,7 +54,7 @@ def test_the_stop_test_compares_the_measure_it_is_given():
     target, horizon = 3e-5, 20_000
     seen = []
     sim = _column(seed=2)
-    sim.run(horizon, every=100, callback=lambda s: seen.append(s.equilibrium_measures()) and False)
+    sim.run(horizon, reporters=[Every(100, lambda s: seen.append(s.equilibrium_measures()))])
     for measure in ("max", "mean", "loaded_max"):
         first = next((100 * (k + 1) for k, m in enumerate(seen) if m[measure] < target), None)
         assert first is not None, measure  # the packing gets there within the horizon

@@ -1,12 +1,13 @@
 """The biaxial test's two stages: consolidation to sigma_3 and shearing at constant sigma_3.
 
 Both drive the engine in blocks of steps (:meth:`poro2d.dem.Simulation.run`); between the
-blocks, in Python, only the walls' targets are renewed (a stress times the current contact
-length) and a row is read.
+blocks, in Python, their reporters (:mod:`poro2d.labtest.reporters`) only renew the walls'
+targets (a stress times the current contact length) and read a row.
 """
 
 from __future__ import annotations
 
+import sys
 import time
 from dataclasses import dataclass
 
@@ -18,6 +19,7 @@ from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.biaxial.stiffness import contact_kn, overlap_ratio, stiffness_number
 from poro2d.dem import Simulation
 from poro2d.labtest.records import BoxRecord, ConsolidationRecord
+from poro2d.labtest.reporters import CurveRecorder, ProgressReporter, StopTest
 from poro2d.labtest.settle import ProgressFn, Settled
 from poro2d.labtest.settle import settle as settle_servoed
 from poro2d.measure.coordination import coordination_number
@@ -143,15 +145,25 @@ class Shearing:
         servo_targets(sim, sigma, s, top=False)
         steps_per_row = max(1, round(s.record_strain * start.height / (velocity * sim.dt)))
         sim.reset_clock()
+
+        def row(sm: Simulation) -> BiaxialRow:  # the side walls' targets renewed first
+            servo_targets(sm, sigma, s, top=False)
+            return curve_row(sm, start, sm.step_count, self.d50, self.rho, self.strain_rate)
+
         rows = [curve_row(sim, start, 0, self.d50, self.rho, self.strain_rate)]
-        step = 0
-        while rows[-1].axial_strain < s.max_strain:
-            sim.run(steps_per_row)
-            step += steps_per_row
-            servo_targets(sim, sigma, s, top=False)
-            rows.append(curve_row(sim, start, step, self.d50, self.rho, self.strain_rate))
-            if self.progress is not None:
-                self.progress("shearing", min(rows[-1].axial_strain / s.max_strain, 1.0))
+
+        def strained(_sim: Simulation | None = None) -> bool:
+            return rows[-1].axial_strain >= s.max_strain
+
+        share = ProgressReporter(
+            steps_per_row,
+            self.progress,
+            "shearing",
+            lambda *_: min(rows[-1].axial_strain / s.max_strain, 1.0),
+        )
+        if not strained():  # then as many rows as reaching max_strain takes
+            recorder = CurveRecorder(steps_per_row, row, rows)
+            sim.run(sys.maxsize, reporters=[recorder, share, StopTest(steps_per_row, strained)])
         return rows, velocity
 
 

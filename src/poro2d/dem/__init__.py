@@ -2,7 +2,18 @@
 
 from poro2d.dem import checkpoint
 from poro2d.dem.model import ContactModel
+from poro2d.dem.reporters import Every, Reporter
 from poro2d.dem.simulation import RunResult, Simulation, SimulationError
 from poro2d.dem.state import Particles, Walls
 
-__all__ = ["checkpoint", "ContactModel", "Particles", "RunResult", "Simulation", "SimulationError", "Walls"]
+__all__ = [
+    "checkpoint",
+    "ContactModel",
+    "Every",
+    "Particles",
+    "Reporter",
+    "RunResult",
+    "Simulation",
+    "SimulationError",
+    "Walls",
+]

@@ -3,7 +3,8 @@
 A :class:`Simulation` owns the particle and wall state, the contact lists and
 the time step. :meth:`Simulation.run` hands whole blocks of steps to the
 compiled kernel and only comes back to Python for events: progress updates,
-callbacks (writers, protocol checks) and growing the contact storage.
+reporters (:mod:`poro2d.dem.reporters`: rows, checkpoints, stop tests) and growing the
+contact storage.
 
 Beside ``particles`` and ``walls`` it holds its arrays in public stores
 (:mod:`poro2d.dem.stores`): ``pairs`` and ``wall_pairs`` (the contact lists), ``masses``,
@@ -16,7 +17,7 @@ import math
 import os
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,6 +33,7 @@ from poro2d.dem.model import (
     single_contact_limit,
 )
 from poro2d.dem.records import KernelRecords, kernel_records
+from poro2d.dem.reporters import Reporter, check_reporters, next_event, report_due
 from poro2d.dem.state import (
     FREE,
     PARTICLE_FIELDS,
@@ -668,8 +670,7 @@ class Simulation:
         *,
         until_ratio: float | None = None,
         check_every: int = 100,
-        callback: Callable[[Simulation], bool | None] | None = None,
-        every: int | None = None,
+        reporters: Sequence[Reporter] = (),
         progress: bool | str = False,
         measure: str = "max",
     ) -> RunResult:
@@ -685,16 +686,15 @@ class Simulation:
             average ratio) or ``"loaded_max"`` (the maximum over the disks touching two
             bodies or more: rattlers, which never carry a balanced load, left out); see
             :func:`poro2d.dem.kernels.equilibrium_measures`.
-        callback, every
-            call ``callback(sim)`` every ``every`` steps (a Python event); if it
-            returns True the run stops. A callback needs ``every``; ``every``
-            alone only cuts the run into blocks (which changes no number).
+        reporters
+            each called every ``period`` steps of this run (:mod:`poro2d.dem.reporters`):
+            ``report(sim, step)``, True stops the run. Blocks end where one is due.
         progress
             show a rich progress bar (steps/s, particle-steps/s, ETA) on a terminal,
             plain lines now and then elsewhere (:mod:`poro2d.progress`); a string is
             used as its label.
 
-        Neither ``progress`` nor ``every`` changes a number: callbacks that only read
+        Neither ``progress`` nor the reporters' periods change a number: reporters that only read
         the state leave the run bit for bit as it is without them, and the stop tests
         fall on the same steps.
         """
@@ -705,10 +705,8 @@ class Simulation:
         if not (isinstance(check_every, (int, np.integer)) and check_every >= 1):
             raise InputError("check_every", check_every, "an integer >= 1")
         code = measure_code(measure)
-        if every is not None and not (isinstance(every, (int, np.integer)) and every >= 1):
-            raise InputError("every", every, "an integer >= 1")
-        if callback is not None and every is None:
-            raise InputError("every", None, "an integer >= 1 with a callback: the steps between its calls")
+        reporters = tuple(reporters)
+        check_reporters(reporters)
         self.sync_walls()
         target = 0.0 if until_ratio is None else float(until_ratio)
         n = self.particles.n
@@ -717,20 +715,20 @@ class Simulation:
         converged = False
         rebuilds = 0
         self._checked_ratio = None
-        # Block length: the next Python event, or about a quarter second for progress. It
+        # Blocks end where a reporter is due, or every 2000 steps or so for a bar alone. It
         # changes no number: the kernel counts its stop tests from the start of this run.
-        block = every if every is not None else steps
+        block = steps
         bar = None
         if progress:
             from poro2d.progress import StepProgress
 
             bar = StepProgress(str(progress) if isinstance(progress, str) else "DEM", steps, n)
             bar.start()
-            if every is None:
+            if not reporters:
                 block = max(check_every, min(steps, 2000))
         try:
             while done < steps:
-                nb = min(block, steps - done)
+                nb = min(block, next_event(reporters, done, steps) - done)
                 k, status, block_rebuilds = self._kernel_block(nb, check_every, target, done, code)
                 done += k
                 rebuilds += block_rebuilds
@@ -739,9 +737,8 @@ class Simulation:
                 if status == K.CONVERGED:
                     converged = True
                     break
-                if callback is not None and every is not None and done % every == 0:
-                    if callback(self):
-                        break
+                if report_due(reporters, self, done):
+                    break
         finally:
             if bar is not None:
                 bar.stop()

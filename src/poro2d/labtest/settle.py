@@ -19,9 +19,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from poro2d.dem import Simulation
+from poro2d.labtest.reporters import ProgressFn, ProgressReporter, StopTest
 
-#: ``progress(phase, fraction)``: called between blocks of steps, for a progress display
-ProgressFn = Callable[[str, float], None]
 #: ``done(sim)``: a stop rule, asked after each block of steps whether the specimen has settled
 StopRule = Callable[[Simulation], bool]
 
@@ -39,14 +38,8 @@ def settle_until(
     ``progress``: told ``phase`` and the share of ``max_steps`` run before each check; ``bar``: the
     engine's own progress bar (:meth:`~poro2d.dem.Simulation.run`), its label when a string.
     """
-    start = sim.step_count
-
-    def check(sm: Simulation) -> bool:
-        if progress is not None:
-            progress(phase, min((sm.step_count - start) / max_steps, 1.0))
-        return done(sm)
-
-    return sim.run(max_steps, every=every, callback=check, progress=bar).steps
+    told = ProgressReporter(every, progress, phase, lambda _, k: min(k / max_steps, 1.0))
+    return sim.run(max_steps, reporters=[told, StopTest(every, done)], progress=bar).steps
 
 
 @dataclass

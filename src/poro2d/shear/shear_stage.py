@@ -3,7 +3,8 @@
 Every ``record_interval`` of shear displacement one row of the curve is recorded (and,
 with ``keep_peak``, the state kept for the peak's force chains); every
 ``checkpoint_interval`` the whole engine state and the rows so far are saved in
-``shear_checkpoint.npz``, so a killed test continues from there bit for bit.
+``shear_checkpoint.npz``, so a killed test continues from there bit for bit. These are the
+stage's reporters on the engine (:mod:`poro2d.labtest.reporters`), with the stop test last.
 """
 
 from __future__ import annotations
@@ -14,6 +15,8 @@ import time
 import numpy as np
 
 from poro2d.dem import Simulation
+from poro2d.dem.reporters import Every, Reporter
+from poro2d.labtest.reporters import Checkpointer, CurveRecorder, ProgressReporter, StopTest
 from poro2d.shear.box import SplitBox
 from poro2d.shear.controllers import ProgressFn, ShearDrive
 from poro2d.shear.curve import ShearRow, curve_row, peak_passed
@@ -80,25 +83,39 @@ class ShearStage:
         ShearDrive(self.settings.velocity).start(sim)
         return sim, [], sim.step_count, 0.0
 
-    def record(self, sim: Simulation) -> bool:
-        """One record (the engine's callback): a row, the peak's frame, maybe a checkpoint."""
-        rows = self.rows
-        contacts = sim.contacts()
-        rows.append(curve_row(sim, self.box, self.settings, contacts, self.y_plate0, self.step0, self.rho))
-        x_mm = rows[-1].shear_displacement_mm
+    def _row(self, sim: Simulation) -> ShearRow:
+        """The curve's row now; its contacts stay for the peak's frame of the same record."""
+        self.contacts = sim.contacts()
+        return curve_row(sim, self.box, self.settings, self.contacts, self.y_plate0, self.step0, self.rho)
+
+    def _keep_peak(self, sim: Simulation) -> None:
+        """Queue the last record's frame; keep the frame at the smoothed peak found so far."""
+        x_mm = self.rows[-1].shear_displacement_mm
+        self.peak.add(PeakFrame.capture(sim, self.contacts, len(self.rows) - 1, x_mm))
+        self.peak.settle(self.rows, x_mm * 1e-3)
+
+    def _checkpoint(self) -> dict:
+        """Where the stage is, saved with the engine's state (the peak's frame saved first, so a
+        resumed run still draws the peak's forces)."""
+        self.peak.save(self.store, PEAK_FRAME)
+        wall = self.wall_before + time.perf_counter() - self.t0
+        rows = [row.to_dict() for row in self.rows]
+        return {"stage": "shear", "rows": rows, "step0": self.step0, "wall_time_s": wall}
+
+    def reporters(self, remaining: int) -> list[Reporter]:
+        """What a record does, in order: the row, the peak's frame, the progress, a checkpoint every
+        ``ck_every`` records (not at the end: ``remaining`` steps are left to run), the stop test."""
+        every = self.every
+        out: list[Reporter] = [CurveRecorder(every, self._row, self.rows)]
         if self.keep_peak:
-            self.peak.add(PeakFrame.capture(sim, contacts, len(rows) - 1, x_mm))
-        self.peak.settle(rows, x_mm * 1e-3)
-        done = sim.step_count - self.step0
-        if self.progress is not None:
-            self.progress("shearing", done / self.total)
-        if self.checkpoints is not None and len(rows) % self.ck_every == 0 and done < self.total:
-            self.peak.save(self.store, PEAK_FRAME)  # a resumed run still draws the peak's forces
-            wall = self.wall_before + time.perf_counter() - self.t0
-            kept = [row.to_dict() for row in rows]
-            extra = {"stage": "shear", "rows": kept, "step0": self.step0, "wall_time_s": wall}
-            self.checkpoints.save(sim, extra=extra)
-        return self.peak_passed()
+            out.append(Every(every, self._keep_peak))
+        out.append(ProgressReporter(every, self.progress, "shearing", self._fraction))
+        if self.checkpoints is not None:
+            out.append(Checkpointer(every * self.ck_every, self.checkpoints, self._checkpoint, remaining))
+        return [*out, StopTest(every, lambda _: self.peak_passed())]
+
+    def _fraction(self, sim: Simulation, _step: int) -> float:
+        return (sim.step_count - self.step0) / self.total
 
     def peak_passed(self) -> bool:
         """True once the smoothed peak lies ``stop_after_peak`` behind the last record.
@@ -116,7 +133,7 @@ class ShearStage:
         """Shear to the end; returns the stage's wall time (s), resumed parts included."""
         remaining = self.total - (self.sim.step_count - self.step0)
         if remaining > 0 and not (self.rows and self.peak_passed()):
-            self.sim.run(remaining, every=self.every, callback=self.record)
+            self.sim.run(remaining, reporters=self.reporters(remaining))
         self.peak.settle(self.rows, None)
         return self.wall_before + time.perf_counter() - self.t0
 

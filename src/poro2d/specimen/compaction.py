@@ -31,7 +31,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from poro2d.dem import ContactModel, Particles, Simulation, Walls
+from poro2d.dem import ContactModel, Every, Particles, Simulation, Walls
 from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
 from poro2d.dem.ordering import strip_order
 from poro2d.dem.simulation import MEASURES
@@ -607,8 +607,8 @@ def equilibrate(
             calm = False
         else:
             test = SettledTest(sim, drift, spec.settle_checks)
-            res = sim.run(budget, until_ratio=spec.ratio, measure=spec.equilibrium, every=spec.settle_window,
-                          callback=test, progress=bar)  # fmt: skip
+            res = sim.run(budget, until_ratio=spec.ratio, measure=spec.equilibrium,
+                          reporters=[Every(spec.settle_window, test)], progress=bar)  # fmt: skip
             calm = test.settled
         ended = "ratio" if res.converged else ("settled" if calm else "budget")
         attempts.append(Attempt(
