@@ -34,10 +34,12 @@ from poro2d.critical_state.results import (
 )
 from poro2d.critical_state.series import COLUMNS, CellSeries, row_of
 from poro2d.critical_state.steady import read_steady
+from poro2d.dem.reporters import Every, run_blocks
 from poro2d.errors import InputError, check_int
 from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
 from poro2d.io_utils import Provenance, check_output_dir
+from poro2d.labtest.reporters import CurveRecorder, ProgressReporter
 from poro2d.locks import output_folder
 from poro2d.store import Store
 
@@ -58,19 +60,24 @@ def _shear(
     pressure = case.pressure_kpa * 1e3
     cell.shear(rate, pressure, barostat_gain(cell, case), rate)
     per_row = max(1, round(case.record_strain / (rate * cell.dt)))
-    rows_total = math.ceil(case.strain / (per_row * rate * cell.dt))
-    rows, overlaps, steps, rebuilds, d = [], [], 0, 0, mean_diameter(cell)
-    for k in range(rows_total):
-        block = cell.run(per_row)
-        steps += per_row
-        rebuilds += block.rebuilds
-        rows.append(row_of(cell.strain, block, rate, d, case.solid_density))
-        if cell.strain >= case.window_start:
-            overlaps.append(mean_overlap_ratio(cell))
-        if report is not None:
-            report("shear", COMPRESS_SHARE + (1.0 - COMPRESS_SHARE) * (k + 1) / rows_total)
-    overlap = float(np.mean(overlaps)) if overlaps else mean_overlap_ratio(cell)
-    return CellSeries.of_rows(rows), steps, rebuilds, overlap
+    steps = math.ceil(case.strain / (per_row * rate * cell.dt)) * per_row
+    blocks, overlaps, d = [], [], mean_diameter(cell)
+
+    def advance(n: int) -> tuple[int, bool]:
+        blocks.append(cell.run(n))
+        return n, False
+
+    def overlap(c) -> None:  # over the steady window's rows
+        if c.strain >= case.window_start:
+            overlaps.append(mean_overlap_ratio(c))
+
+    recorder = CurveRecorder(per_row, lambda c: row_of(c.strain, blocks[-1], rate, d, case.solid_density))
+    share = ProgressReporter(
+        per_row, report, "shear", lambda _, k: COMPRESS_SHARE + (1.0 - COMPRESS_SHARE) * k / steps
+    )
+    run_blocks(advance, steps, [recorder, Every(per_row, overlap), share], cell)
+    mean = float(np.mean(overlaps)) if overlaps else mean_overlap_ratio(cell)
+    return CellSeries.of_rows(recorder.rows), steps, sum(b.rebuilds for b in blocks), mean
 
 
 def run_critical_state(

@@ -53,6 +53,30 @@ def report_due(reporters: Sequence[Reporter], sim: Any, step: int) -> bool:
     return stop
 
 
+def run_blocks(
+    advance: Callable[[int], tuple[int, bool]],
+    steps: int,
+    reporters: Sequence[Reporter],
+    engine: Any,
+    block: int | None = None,
+) -> int:
+    """Run ``steps`` steps of ``engine`` as ``advance(n)`` calls of at most ``block`` steps that end
+    where a reporter is due, the due reporters called after each; the steps run.
+
+    ``advance(n)`` runs up to n steps and returns the steps run and whether the engine stopped by
+    itself (its own stop test met): the run ends there, before the reporters. Every engine, the
+    walled one and the periodic cell, runs its reporters so.
+    """
+    done = 0
+    while done < steps:
+        n = min(block or steps, next_event(reporters, done, steps) - done)
+        ran, stopped = advance(n)
+        done += ran
+        if stopped or report_due(reporters, engine, done):
+            break
+    return done
+
+
 def check_reporters(reporters: Sequence[Reporter]) -> None:
     """Refuse a reporter without a positive whole period (named as the engine's input)."""
     for r in reporters:

@@ -33,7 +33,7 @@ from poro2d.dem.model import (
     single_contact_limit,
 )
 from poro2d.dem.records import KernelRecords, kernel_records
-from poro2d.dem.reporters import Reporter, check_reporters, next_event, report_due
+from poro2d.dem.reporters import Reporter, check_reporters, run_blocks
 from poro2d.dem.state import (
     FREE,
     PARTICLE_FIELDS,
@@ -711,9 +711,7 @@ class Simulation:
         target = 0.0 if until_ratio is None else float(until_ratio)
         n = self.particles.n
         t0 = time.perf_counter()
-        done = 0
-        converged = False
-        rebuilds = 0
+        ran = {"steps": 0, "converged": False, "rebuilds": 0}  # the blocks' sums, as they end
         self._checked_ratio = None
         # Blocks end where a reporter is due, or every 2000 steps or so for a bar alone. It
         # changes no number: the kernel counts its stop tests from the start of this run.
@@ -726,26 +724,25 @@ class Simulation:
             bar.start()
             if not reporters:
                 block = max(check_every, min(steps, 2000))
+
+        def advance(nb: int) -> tuple[int, bool]:
+            k, status, block_rebuilds = self._kernel_block(nb, check_every, target, ran["steps"], code)
+            ran["steps"] += k
+            ran["rebuilds"] += block_rebuilds
+            if bar is not None:
+                bar.update(ran["steps"], self._checked_ratio)
+            ran["converged"] = status == K.CONVERGED
+            return k, ran["converged"]
+
         try:
-            while done < steps:
-                nb = min(block, next_event(reporters, done, steps) - done)
-                k, status, block_rebuilds = self._kernel_block(nb, check_every, target, done, code)
-                done += k
-                rebuilds += block_rebuilds
-                if bar is not None:
-                    bar.update(done, self._checked_ratio)
-                if status == K.CONVERGED:
-                    converged = True
-                    break
-                if report_due(reporters, self, done):
-                    break
+            done = run_blocks(advance, steps, reporters, self, block)
         finally:
             if bar is not None:
                 bar.stop()
         wall = time.perf_counter() - t0
         m = self.equilibrium_measures()
         return RunResult(
-            done, converged, m["max"], m["mean"], wall, rebuilds, particle_steps=done * n,
+            done, ran["converged"], m["max"], m["mean"], wall, ran["rebuilds"], particle_steps=done * n,
             loaded_ratio=m["loaded_max"], rattler_fraction=m["rattler_fraction"], measure=measure,
         )  # fmt: skip
 
