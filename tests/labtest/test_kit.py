@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from poro2d.biaxial.settings import BiaxialSettings
-from poro2d.dem.reporters import next_event, report_due
+from poro2d.dem.reporters import run_blocks
 from poro2d.errors import InputError
 from poro2d.labtest.curve import ColumnCurve, CurveRow
 from poro2d.labtest.records import BoxRecord, ByName, ConsolidationRecord, TestSummary, typed_parts
@@ -111,13 +111,11 @@ class Clock:
         self.ratio = 1.0
 
     def run(self, steps, *, reporters, progress=False):
-        done = 0
-        while done < steps:
-            k = next_event(reporters, done, steps) - done
-            done, self.step_count, self.ratio = done + k, self.step_count + k, self.ratio / 2.0
-            if report_due(reporters, self, done):
-                break
-        return type("Ran", (), {"steps": done})()
+        return type("Ran", (), {"steps": run_blocks(self.advance, steps, reporters, self)})()
+
+    def advance(self, n):
+        self.step_count, self.ratio = self.step_count + n, self.ratio / 2.0
+        return n, False
 
     def unbalanced_ratios(self):
         return (self.ratio,)

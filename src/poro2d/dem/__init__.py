@@ -7,13 +7,6 @@ from poro2d.dem.simulation import RunResult, Simulation, SimulationError
 from poro2d.dem.state import Particles, Walls
 
 __all__ = [
-    "checkpoint",
-    "ContactModel",
-    "Every",
-    "Particles",
-    "Reporter",
-    "RunResult",
-    "Simulation",
-    "SimulationError",
-    "Walls",
-]
+    "checkpoint", "ContactModel", "Every", "Particles", "Reporter", "RunResult", "Simulation",
+    "SimulationError", "Walls",
+]  # fmt: skip

@@ -39,40 +39,27 @@ class Every:
         return self.call(sim)
 
 
-def next_event(reporters: Sequence[Reporter], step: int, steps: int) -> int:
-    """The first step after ``step`` (at most ``steps``) at which a reporter is due."""
-    return min([steps] + [(step // r.period + 1) * r.period for r in reporters])
-
-
-def report_due(reporters: Sequence[Reporter], sim: Any, step: int) -> bool:
-    """Call every reporter due at ``step``, in order; True when one of them asks to stop."""
-    stop = False
-    for r in reporters:
-        if step % r.period == 0:
-            stop = bool(r.report(sim, step)) or stop
-    return stop
-
-
 def run_blocks(
-    advance: Callable[[int], tuple[int, bool]],
-    steps: int,
-    reporters: Sequence[Reporter],
-    engine: Any,
+    advance: Callable[[int], tuple[int, bool]], steps: int, reporters: Sequence[Reporter], engine: Any,
     block: int | None = None,
-) -> int:
+) -> int:  # fmt: skip
     """Run ``steps`` steps of ``engine`` as ``advance(n)`` calls of at most ``block`` steps that end
-    where a reporter is due, the due reporters called after each; the steps run.
+    where a reporter is due, the due reporters called after each, all of them in order; the steps run.
 
     ``advance(n)`` runs up to n steps and returns the steps run and whether the engine stopped by
     itself (its own stop test met): the run ends there, before the reporters. Every engine, the
     walled one and the periodic cell, runs its reporters so.
     """
+    check_reporters(reporters)
     done = 0
     while done < steps:
-        n = min(block or steps, next_event(reporters, done, steps) - done)
-        ran, stopped = advance(n)
+        due = min([steps] + [(done // r.period + 1) * r.period for r in reporters])
+        ran, stopped = advance(min(block or steps, due - done))
         done += ran
-        if stopped or report_due(reporters, engine, done):
+        if stopped:
+            break
+        # every reporter due is told, even after one asked to stop (a checkpoint before the stop test)
+        if any([r.report(engine, done) for r in reporters if done % r.period == 0]):
             break
     return done
 
@@ -81,12 +68,10 @@ def check_reporters(reporters: Sequence[Reporter]) -> None:
     """Refuse a reporter without a positive whole period (named as the engine's input)."""
     for r in reporters:
         period = getattr(r, "period", None)
-        if not (
-            isinstance(period, (int, np.integer)) and period >= 1 and callable(getattr(r, "report", None))
-        ):
+        if not (isinstance(period, (int, np.integer)) and period >= 1 and hasattr(r, "report")):
             raise InputError(
                 "reporters", type(r).__name__, "reporters with a period (an integer >= 1) and report()"
             )
 
 
-__all__ = ["Every", "Reporter", "check_reporters", "next_event", "report_due"]
+__all__ = ["Every", "Reporter", "check_reporters", "run_blocks"]

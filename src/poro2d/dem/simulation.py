@@ -33,7 +33,7 @@ from poro2d.dem.model import (
     single_contact_limit,
 )
 from poro2d.dem.records import KernelRecords, kernel_records
-from poro2d.dem.reporters import Reporter, check_reporters, run_blocks
+from poro2d.dem.reporters import Reporter, run_blocks
 from poro2d.dem.state import (
     FREE,
     PARTICLE_FIELDS,
@@ -706,7 +706,6 @@ class Simulation:
             raise InputError("check_every", check_every, "an integer >= 1")
         code = measure_code(measure)
         reporters = tuple(reporters)
-        check_reporters(reporters)
         self.sync_walls()
         target = 0.0 if until_ratio is None else float(until_ratio)
         n = self.particles.n
