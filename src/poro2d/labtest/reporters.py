@@ -50,15 +50,16 @@ class ProgressReporter:
 @dataclass
 class Checkpointer:
     """Saves the engine's state with ``extra()`` (where the stage was) through ``checkpoints`` every
-    ``period`` steps before step ``last`` of the run: at the stage's end its results are kept instead."""
+    ``period`` steps before step ``last`` of the run: at the stage's end its results are kept instead
+    (nothing with no ``checkpoints``: a run that keeps nothing)."""
 
     period: int
-    checkpoints: Checkpoints
+    checkpoints: Checkpoints | None
     extra: Callable[[], dict]
     last: int
 
     def report(self, sim: Any, step: int) -> None:
-        if step < self.last:
+        if self.checkpoints is not None and step < self.last:
             self.checkpoints.save(sim, extra=self.extra())
 
 

@@ -106,16 +106,18 @@ class ShearStage:
         """What a record does, in order: the row, the peak's frame, the progress, a checkpoint every
         ``ck_every`` records (not at the end: ``remaining`` steps are left to run), the stop test."""
         every = self.every
-        out: list[Reporter] = [CurveRecorder(every, self._row, self.rows)]
-        if self.keep_peak:
-            out.append(Every(every, self._keep_peak))
-        out.append(ProgressReporter(every, self.progress, "shearing", self._fraction))
-        if self.checkpoints is not None:
-            out.append(Checkpointer(every * self.ck_every, self.checkpoints, self._checkpoint, remaining))
-        return [*out, StopTest(every, lambda _: self.peak_passed())]
-
-    def _fraction(self, sim: Simulation, _step: int) -> float:
-        return (sim.step_count - self.step0) / self.total
+        peak = [Every(every, self._keep_peak)] if self.keep_peak else []
+        share = ProgressReporter(
+            every, self.progress, "shearing", lambda sm, _: (sm.step_count - self.step0) / self.total
+        )
+        saved = Checkpointer(every * self.ck_every, self.checkpoints, self._checkpoint, remaining)
+        return [
+            CurveRecorder(every, self._row, self.rows),
+            *peak,
+            share,
+            saved,
+            StopTest(every, lambda _: self.peak_passed()),
+        ]
 
     def peak_passed(self) -> bool:
         """True once the smoothed peak lies ``stop_after_peak`` behind the last record.
