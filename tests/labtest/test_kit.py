@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from poro2d.biaxial.settings import BiaxialSettings
-from poro2d.dem.reporters import run_blocks
+from poro2d.dem.reporters import drive_blocks
 from poro2d.errors import InputError
 from poro2d.labtest.curve import ColumnCurve, CurveRow
 from poro2d.labtest.records import BoxRecord, ByName, ConsolidationRecord, TestSummary, typed_parts
@@ -111,7 +111,7 @@ class Clock:
         self.ratio = 1.0
 
     def run(self, steps, *, reporters, progress=False):
-        return type("Ran", (), {"steps": run_blocks(self.advance, steps, reporters, self)})()
+        return type("Ran", (), {"steps": drive_blocks(self.advance, steps, reporters, self)})()
 
     def advance(self, n):
         self.step_count, self.ratio = self.step_count + n, self.ratio / 2.0

@@ -34,7 +34,7 @@ from poro2d.critical_state.results import (
 )
 from poro2d.critical_state.series import COLUMNS, CellSeries, row_of
 from poro2d.critical_state.steady import read_steady
-from poro2d.dem.reporters import Every, run_blocks
+from poro2d.dem.reporters import Every, drive_blocks
 from poro2d.errors import InputError, check_int
 from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
@@ -75,7 +75,7 @@ def _shear(
     share = ProgressReporter(
         per_row, report, "shear", lambda _, k: COMPRESS_SHARE + (1.0 - COMPRESS_SHARE) * k / steps
     )
-    run_blocks(advance, steps, [recorder, Every(per_row, overlap), share], cell)
+    drive_blocks(advance, steps, [recorder, Every(per_row, overlap), share], cell)
     mean = float(np.mean(overlaps)) if overlaps else mean_overlap_ratio(cell)
     return CellSeries.of_rows(recorder.rows), steps, sum(b.rebuilds for b in blocks), mean
 

@@ -39,7 +39,7 @@ class Every:
         return self.call(sim)
 
 
-def run_blocks(
+def drive_blocks(
     advance: Callable[[int], tuple[int, bool]], steps: int, reporters: Sequence[Reporter], engine: Any,
     block: int | None = None,
 ) -> int:  # fmt: skip
@@ -74,4 +74,4 @@ def check_reporters(reporters: Sequence[Reporter]) -> None:
             )
 
 
-__all__ = ["Every", "Reporter", "check_reporters", "run_blocks"]
+__all__ = ["Every", "Reporter", "check_reporters", "drive_blocks"]

@@ -33,7 +33,7 @@ from poro2d.dem.model import (
     single_contact_limit,
 )
 from poro2d.dem.records import KernelRecords, kernel_records
-from poro2d.dem.reporters import Reporter, run_blocks
+from poro2d.dem.reporters import Reporter, drive_blocks
 from poro2d.dem.state import (
     FREE,
     PARTICLE_FIELDS,
@@ -734,7 +734,7 @@ class Simulation:
             return k, ran["converged"]
 
         try:
-            done = run_blocks(advance, steps, reporters, self, block)
+            done = drive_blocks(advance, steps, reporters, self, block)
         finally:
             if bar is not None:
                 bar.stop()
