@@ -111,13 +111,8 @@ class ShearStage:
             every, self.progress, "shearing", lambda sm, _: (sm.step_count - self.step0) / self.total
         )
         saved = Checkpointer(every * self.ck_every, self.checkpoints, self._checkpoint, remaining)
-        return [
-            CurveRecorder(every, self._row, self.rows),
-            *peak,
-            share,
-            saved,
-            StopTest(every, lambda _: self.peak_passed()),
-        ]
+        stop = StopTest(every, lambda _: self.peak_passed())
+        return [CurveRecorder(every, self._row, self.rows), *peak, share, saved, stop]
 
     def peak_passed(self) -> bool:
         """True once the smoothed peak lies ``stop_after_peak`` behind the last record.
