@@ -229,10 +229,7 @@ def _calibration_unit_bad(ctx: Context, store: Store):
 #: the battery's table: one row per protocol
 PROTOCOLS = [
     Protocol("criterion", _criterion, "result.json", _criterion_bad, "n_lab", jobs=_criterion_jobs),
-    Protocol(
-        "shear", _shear, "result.json", _shear_bad, "normal stress (kPa)",
-        skip={"store_none": "run_shear takes a store: a series' tests resume from their folders"},
-    ),
+    Protocol("shear", _shear, "result.json", _shear_bad, "normal stress (kPa)"),
     Protocol("biaxial", _biaxial, "result.json", _biaxial_bad, "replicates"),
     Protocol(
         "critical_state", _critical_state, "result.json", _critical_state_bad, "seeds",

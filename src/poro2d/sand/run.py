@@ -31,7 +31,6 @@ from poro2d.criterion.density import Calibration, StateTarget, state_target
 from poro2d.execute.options import RunOptions
 from poro2d.interop.origin import SOIL_FILE
 from poro2d.io_utils import Provenance, check_output_dir
-from poro2d.locks import holds_output
 from poro2d.sand.case import ConfigLike, SandCase, load_sand_case
 from poro2d.sand.preflight import Preflight, StageEstimate, preflight
 from poro2d.sand.profile import case_runs, stage_profile
@@ -41,12 +40,12 @@ from poro2d.sand.result import (
     SeedSpecimen,
     write_summary,
 )
-from poro2d.store import Store, walk
+from poro2d.store import Store, claims, walk
 from poro2d.sweep import density as D
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.records import CalibrationRun, CaseRow, LostCaseRow
 
-#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+#: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
 KIND = "sand"
 
 Announce = Callable[[str], None]
@@ -285,7 +284,7 @@ def check_soil(
     return case, preflight(case, workers=workers or os.cpu_count() or 1, budget_minutes=budget_minutes)
 
 
-@holds_output("store", kind=KIND)
+@claims(KIND)
 def run_sand(
     config: ConfigLike,
     *,
