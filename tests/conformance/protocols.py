@@ -235,9 +235,8 @@ PROTOCOLS = [
         "critical_state", _critical_state, "result.json", _critical_state_bad, "seeds",
         skip={"reads_back": "run_critical_states keeps its files at the end only: a rerun runs every seed"},
     ),
-    Protocol(
-        "sand", _sand, "sand.json", _sand_bad, "lab.n", setup=_sand_setup,
-        skip={"store_none": "run_sand takes a store: its answer is the specimens it keeps there"},
+    Protocol(  # the calibration's cases folder: with store=None, a scratch folder removed at the end
+        "sand", _sand, "sand.json", _sand_bad, "lab.n", setup=_sand_setup, volatile=frozenset({"cases"}),
     ),
     Protocol(
         "relation", _relation, "relation.json", _relation_bad, "points",

@@ -84,7 +84,7 @@ def run_biaxial_series(
 
     ``store``: the series' ``result.json`` and per stress a folder
     (``sigma3_100kPa/``) holding what :func:`run_biaxial` keeps; a rerun into it reads finished
-    tests back and runs the rest (a test whose record differs, another setting, runs again).
+    tests back and runs the rest (a folder holding another test, another setting, is refused).
     None: nothing kept. ``options``: where all the tests run (``workers`` processes, default one
     per test and at most one per core, or a running ``scheduler``) and whether bars show.
     Returns the :class:`BiaxialSeriesResult` (``studies``: each stress's :class:`BiaxialResult`
