@@ -195,3 +195,16 @@ def test_a_claim_marks_the_folder_refuses_another_kind_and_resumes_its_own(tmp_p
     with Store(tmp_path / "empty").claim("shear"):  # a block that writes nothing leaves no folder
         pass
     assert not (tmp_path / "empty").exists()
+
+
+def test_every_package_claims_a_kind_the_locks_know():
+    """Each package names its kind (``KIND``); the locks list every kind's own files (``KIND_SIGNS``)."""
+    import importlib
+
+    from poro2d.locks import KIND_SIGNS
+
+    modules = ["poro2d.criterion.run", "poro2d.shear.run", "poro2d.biaxial.run", "poro2d.critical_state.run",
+               "poro2d.sweep.runner", "poro2d.sand.run", "poro2d.calibration.run", "poro2d.paper",
+               "poro2d.cli.strength", "poro2d.cli.export", "poro2d.cli.import_specimen"]  # fmt: skip
+    kinds = [importlib.import_module(m).KIND for m in modules]
+    assert sorted(kinds) == sorted(set(kinds)) and set(kinds) <= set(KIND_SIGNS)
