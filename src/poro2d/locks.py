@@ -6,7 +6,8 @@ through a lock file inside it (``.poro2d.lock``, an ``flock`` taken with the
 ``filelock`` library), released when the run ends, or by the kernel when the process
 dies, so a killed run never leaves a folder locked. The lock files are removed on release.
 
-- :func:`output_folder`: an ``--out`` folder. A second writer is refused at once
+- :func:`output_folder`: an ``--out`` folder (a run claims it through its store,
+  :meth:`poro2d.store.Store.claim`). A second writer is refused at once
   (an :class:`~poro2d.errors.InputError` naming the holder's pid): its inputs may well
   differ, and waiting for hours behind a run the user forgot is worse than a clear line.
 - :func:`cache_entry`: a cache entry. A second process waits, then reuses what the first
@@ -23,8 +24,6 @@ refuse itself.
 
 from __future__ import annotations
 
-import functools
-import inspect
 import os
 import socket
 import sys
@@ -100,7 +99,10 @@ def check_no_escape(parameter: str, folder: str | os.PathLike) -> None:
 
 #: files that only one kind of run writes at the top of its folder. A folder without a marker
 #: is known by them: one written before markers existed, or one that a run keeps inside its
-#: own (a calibration's criterion, the paper's shear replicates), which no command claims
+#: own (a calibration's criterion, the paper's shear replicates), which no command claims.
+#: Every kind's files are listed here, below the packages, rather than registered by them: a
+#: run must know another kind's folder even when that kind's package is not imported. Each
+#: package names its kind by a ``KIND`` constant (``poro2d.shear.run.KIND``) for its claim.
 KIND_SIGNS = {
     "calibrate": ("calibrated.toml",),
     "criterion": ("iterations.csv", "density.json"),
@@ -139,7 +141,7 @@ def _a(kind: str) -> str:
     return f"an {kind}" if kind[:1] in "aeiou" else f"a {kind}"
 
 
-def claim_kind(parameter: str, folder: Path, kind: str) -> None:
+def _mark_kind(parameter: str, folder: Path, kind: str) -> None:
     """Mark ``folder`` as ``kind``'s, or refuse it if it belongs to another kind of run.
 
     A folder without a marker belongs to the kind whose own files it holds (:func:`signed_kinds`),
@@ -194,35 +196,6 @@ def cache_entry(folder: str | os.PathLike, parameter: str = "PORO2D_CACHE") -> I
         yield path
 
 
-def holds_output(argument: str = "out", parameter: str = "--out", kind: str | None = None):
-    """Decorator: the call holds its ``argument`` folder (see :func:`output_folder`) throughout.
-
-    ``argument`` may be a folder or a store (held by its folder); None holds nothing.
-    ``kind`` marks the folder as that kind of run's (see :func:`claim_kind`).
-    """
-
-    def decorate(func):
-        signature = inspect.signature(func)
-
-        @functools.wraps(func)
-        def run(*args, **kwargs):
-            bound = signature.bind(*args, **kwargs)
-            bound.apply_defaults()
-            target = bound.arguments[argument]
-            if target is None:  # a store of None keeps nothing: there is no folder to hold
-                return func(*args, **kwargs)
-            # a store (poro2d.store.Store: a root and the option it came from) is held by its folder
-            folder, name = (
-                (target.root, target.parameter) if hasattr(target, "parameter") else (target, parameter)
-            )
-            with output_folder(name, folder, kind=kind):
-                return func(*args, **kwargs)
-
-        return run
-
-    return decorate
-
-
 @contextmanager
 def _hold(parameter: str, folder: Path, *, wait: bool, kind: str | None = None) -> Iterator[Path]:
     from poro2d.io_utils import check_output_dir
@@ -240,7 +213,7 @@ def _hold(parameter: str, folder: Path, *, wait: bool, kind: str | None = None) 
         try:
             check_no_escape(parameter, folder)
             if kind is not None:
-                claim_kind(parameter, folder, kind)
+                _mark_kind(parameter, folder, kind)
             _write_owner(folder)
         except BaseException:
             _release(lock, folder, created)
@@ -329,12 +302,10 @@ __all__ = [
     "LOCK_NAME",
     "KIND_SIGNS",
     "check_no_run",
-    "claim_kind",
     "folder_kind",
     "signed_kinds",
     "cache_entry",
     "check_no_escape",
-    "holds_output",
     "is_lock_file",
     "output_folder",
 ]

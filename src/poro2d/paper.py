@@ -20,16 +20,15 @@ from poro2d.criterion.replicates import accepted_and_replicates
 from poro2d.criterion.result import CriterionResult, ReplicateRow
 from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance
-from poro2d.locks import holds_output
 from poro2d.paper_data import PAPER, QUICK_SHEAR
 from poro2d.shear.parts import LabRecord, QuasiStatic, ShearTestSummary
 from poro2d.shear.results import ReplicateShearResult
 from poro2d.specimen.specimen_set import SpecimenSet
-from poro2d.store import Store
+from poro2d.store import Store, claims
 from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.typed_result import TypedResult
 
-#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+#: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
 KIND = "paper"
 
 if TYPE_CHECKING:
@@ -208,7 +207,7 @@ def conversion_files(store: Store) -> ConversionsRecord:
                              figures=[str(f.name) for f in figs], provenance=Provenance.now())  # fmt: skip
 
 
-@holds_output("store", kind=KIND)
+@claims(KIND)
 def run_paper(
     store: Store,
     *,

@@ -135,12 +135,15 @@ def test_a_rerun_reads_finished_tests_and_reruns_a_changed_or_unfinished_one(tmp
     assert np.array_equal(
         resumed.studies[1].tests[0].curve.sigma_1_kpa, first.studies[1].tests[0].curve.sigma_1_kpa
     )
-    # a changed setting: both tests run again, and the folder holds the new ones
+    # a changed setting: the folders hold other tests, refused before any test runs, kept as they were
     changed = case.with_settings(smoothing_strain=0.005)
-    run_biaxial_series(changed, [50.0, 100.0], Store(tmp_path), options=RunOptions(workers=1))
-    assert ran[1:] == [(50.0, 1), (100.0, 1)]
-    record = json.loads((tmp_path / "sigma3_50kPa" / "replicate1" / "test.json").read_text())
-    assert record["run"]["settings"]["smoothing_strain"] == 0.005
+    record = (tmp_path / "sigma3_50kPa" / "replicate1" / "test.json").read_text()
+    with pytest.raises(
+        InputError, match=r"replicate1.*it holds a test of other settings \(smoothing_strain\)"
+    ):
+        run_biaxial_series(changed, [50.0, 100.0], Store(tmp_path), options=RunOptions(workers=1))
+    assert ran == [(100.0, 1)]
+    assert (tmp_path / "sigma3_50kPa" / "replicate1" / "test.json").read_text() == record
 
 
 def test_a_test_folder_written_before_records_runs_again(tmp_path, monkeypatch):

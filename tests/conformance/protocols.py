@@ -229,18 +229,14 @@ def _calibration_unit_bad(ctx: Context, store: Store):
 #: the battery's table: one row per protocol
 PROTOCOLS = [
     Protocol("criterion", _criterion, "result.json", _criterion_bad, "n_lab", jobs=_criterion_jobs),
-    Protocol(
-        "shear", _shear, "result.json", _shear_bad, "normal stress (kPa)",
-        skip={"store_none": "run_shear takes a store: a series' tests resume from their folders"},
-    ),
+    Protocol("shear", _shear, "result.json", _shear_bad, "normal stress (kPa)"),
     Protocol("biaxial", _biaxial, "result.json", _biaxial_bad, "replicates"),
     Protocol(
         "critical_state", _critical_state, "result.json", _critical_state_bad, "seeds",
         skip={"reads_back": "run_critical_states keeps its files at the end only: a rerun runs every seed"},
     ),
-    Protocol(
-        "sand", _sand, "sand.json", _sand_bad, "lab.n", setup=_sand_setup,
-        skip={"store_none": "run_sand takes a store: its answer is the specimens it keeps there"},
+    Protocol(  # the calibration's cases folder: with store=None, a scratch folder removed at the end
+        "sand", _sand, "sand.json", _sand_bad, "lab.n", setup=_sand_setup, volatile=frozenset({"cases"}),
     ),
     Protocol(
         "relation", _relation, "relation.json", _relation_bad, "points",

@@ -159,12 +159,52 @@ def test_csv_rows_read_back_as_written(tmp_path):
 
 
 def test_a_call_holds_the_folder_of_the_store_it_is_given(tmp_path):
-    """``holds_output`` holds a store by its folder; None holds nothing."""
-    from poro2d.locks import holds_output
+    """``claims`` holds a store (or a command's folder) by its folder; None holds nothing."""
+    from poro2d.store import claims
 
-    @holds_output("store")
+    @claims("shear")
     def run(store):
         return None if store is None else store.root.is_dir()  # held: made for the call
 
     assert run(None) is None and not list(tmp_path.iterdir())
     assert run(Store(tmp_path / "out", parameter="--into"))
+
+    @claims("export", "out")
+    def command(out):
+        return out.is_dir()
+
+    assert command(tmp_path / "path")
+
+
+def test_a_claim_marks_the_folder_refuses_another_kind_and_resumes_its_own(tmp_path):
+    from poro2d.locks import KIND_NAME, folder_kind
+    from poro2d.store import claimed
+
+    store = Store(tmp_path / "out", parameter="--into")
+    with store.claim("shear") as held:
+        assert held is store and folder_kind(store.root) == "shear"
+        store.write_json("result.json", {"x": 1})
+    with store.claim("shear"):  # the same kind: resumes
+        pass
+    with pytest.raises(InputError) as e, store.claim("biaxial"):
+        pass
+    assert "--into" in str(e.value) and "a shear run" in str(e.value)
+    assert (store.root / KIND_NAME).read_text() == "shear\n"
+    with claimed(None, "shear") as nothing:  # a run that keeps nothing holds nothing
+        assert nothing is None
+    with Store(tmp_path / "empty").claim("shear"):  # a block that writes nothing leaves no folder
+        pass
+    assert not (tmp_path / "empty").exists()
+
+
+def test_every_package_claims_a_kind_the_locks_know():
+    """Each package names its kind (``KIND``); the locks list every kind's own files (``KIND_SIGNS``)."""
+    import importlib
+
+    from poro2d.locks import KIND_SIGNS
+
+    modules = ["poro2d.criterion.run", "poro2d.shear.run", "poro2d.biaxial.run", "poro2d.critical_state.run",
+               "poro2d.sweep.runner", "poro2d.sand.run", "poro2d.calibration.run", "poro2d.paper",
+               "poro2d.cli.strength", "poro2d.cli.export", "poro2d.cli.import_specimen"]  # fmt: skip
+    kinds = [importlib.import_module(m).KIND for m in modules]
+    assert sorted(kinds) == sorted(set(kinds)) and set(kinds) <= set(KIND_SIGNS)

@@ -168,3 +168,35 @@ def test_fingerprint_digest_and_differences():
     assert a.digest == b.digest and a.differences(b.content) == []
     assert a.differences({"s": {"w": 0.2}, "n": [1, 2, 3], "extra": 0}) == ["extra", "n", "s.w"]
     assert differing_keys({"a": {"b": 1}}, {"a": {"b": 1, "c": 2}}) == ["a.c"]
+
+
+# -- the one rule of a laboratory test's folder (direct shear and biaxial alike) ------------------
+TEST = {"specimen_digest": "abc", "confining_kpa": 100.0, "settings": {"max_strain": 0.02}}
+
+
+def _test_stage(folder, **changes):
+    from poro2d.store.stage import test_stage
+
+    fp = Fingerprint({**TEST, **changes})
+    return test_stage(folder, fp, specimen="s.npz", stress=("confining_kpa", "confining stress"))
+
+
+@pytest.mark.parametrize(
+    ("changes", "words"),
+    [
+        ({"confining_kpa": 50.0}, "a test of another confining stress (100.0 kPa); use a new --out"),
+        ({"specimen_digest": "def"}, "a test of another specimen"),
+        ({"settings": {"max_strain": 0.03}}, "a test of other settings (max_strain)"),
+    ],
+)
+def test_a_test_folder_holding_another_test_is_refused_naming_it_and_kept(tmp_path, changes, words):
+    first = _test_stage(tmp_path)
+    first.run(lambda: {"done": 1})
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    with pytest.raises(InputError) as e:
+        _test_stage(tmp_path, **changes).run(lambda: {"done": 2})
+    assert str(tmp_path) in str(e.value) and words in str(e.value), str(e.value)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before  # nothing emptied
+    assert _test_stage(tmp_path).run(lambda: {"done": 3}) == {"done": 1}  # the same test resumes
+    record = json.loads((tmp_path / "test.json").read_text())
+    assert record["specimen"] == "s.npz" and record["key"] == first.fingerprint.digest

@@ -22,15 +22,18 @@ from poro2d.biaxial.parts import (
     Definitions,
     spread_of,
 )
+from poro2d.biaxial.record import folder_stage
 from poro2d.biaxial.results import BiaxialResult, BiaxialTestResult
 from poro2d.biaxial.single import BiaxialTest
 from poro2d.errors import InputError, check_int
 from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
-from poro2d.io_utils import Provenance, check_output_dir
-from poro2d.locks import output_folder
+from poro2d.io_utils import Provenance
 from poro2d.measure.spread import Spread
-from poro2d.store import Store
+from poro2d.store import Store, claimed
+
+#: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
+KIND = "biaxial"
 
 #: the most replicates one call runs
 MAX_REPLICATES = 50
@@ -52,8 +55,13 @@ class BiaxialJob:
         return self.test(report).run()
 
     def stored(self) -> BiaxialTestResult | None:
-        """The test's result when its folder holds it finished (read here: no process started)."""
-        return self.test().stored()
+        """The test's result when its folder holds it finished (read here: no process started).
+
+        A folder holding another test is refused here, before any test of the study runs."""
+        test = self.test()
+        if test.store is not None:
+            folder_stage(test.store, self.case).check()
+        return test.stored()
 
 
 def _run_job(job: BiaxialJob, report) -> BiaxialTestResult:
@@ -123,10 +131,7 @@ def run_biaxial(
     cases = replicate_cases(case, n)
     lab_data = lab_curve(lab)
     workers = check_run(store, options, len(cases))
-    if store is None:
-        return _run(cases, None, lab_data, workers, options, config)
-    check_output_dir(store.parameter, store.root)
-    with output_folder(store.parameter, store.root, kind="biaxial"):
+    with claimed(store, KIND):
         return _run(cases, store, lab_data, workers, options, config)
 
 

@@ -31,6 +31,7 @@ from poro2d.biaxial.parts import (
 )
 from poro2d.biaxial.results import BiaxialResult, BiaxialSeriesResult, BiaxialTestResult
 from poro2d.biaxial.run import (
+    KIND,
     MAX_REPLICATES,
     check_run,
     execute_tests,
@@ -43,9 +44,8 @@ from poro2d.biaxial.run import (
 from poro2d.biaxial.settings import CONFINING_RANGE_KPA
 from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.execute import RunOptions
-from poro2d.io_utils import Provenance, check_output_dir
-from poro2d.locks import output_folder
-from poro2d.store import Store
+from poro2d.io_utils import Provenance
+from poro2d.store import Store, claimed
 
 #: the most confining stresses one series runs
 MAX_STRESSES = 20
@@ -84,7 +84,7 @@ def run_biaxial_series(
 
     ``store``: the series' ``result.json`` and per stress a folder
     (``sigma3_100kPa/``) holding what :func:`run_biaxial` keeps; a rerun into it reads finished
-    tests back and runs the rest (a test whose record differs, another setting, runs again).
+    tests back and runs the rest (a folder holding another test, another setting, is refused).
     None: nothing kept. ``options``: where all the tests run (``workers`` processes, default one
     per test and at most one per core, or a running ``scheduler``) and whether bars show.
     Returns the :class:`BiaxialSeriesResult` (``studies``: each stress's :class:`BiaxialResult`
@@ -97,10 +97,7 @@ def run_biaxial_series(
     cases = {s: [replace(c, confining_kpa=s) for c in base] for s in stresses}
     lab_data = lab_curve(lab)
     workers = check_run(store, options, len(stresses) * len(base))
-    if store is None:
-        return _run(cases, None, lab_data, workers, options, config)
-    check_output_dir(store.parameter, store.root)
-    with output_folder(store.parameter, store.root, kind="biaxial"):
+    with claimed(store, KIND):
         return _run(cases, store, lab_data, workers, options, config)
 
 

@@ -27,7 +27,7 @@ from poro2d.biaxial.case import BiaxialCase
 from poro2d.biaxial.curve import BiaxialCurve, read_curve
 from poro2d.biaxial.elastic import plastic_strains, probe_compliance
 from poro2d.biaxial.parts import ShearChecks, StiffnessScale
-from poro2d.biaxial.record import claim, folder_stage
+from poro2d.biaxial.record import folder_stage
 from poro2d.biaxial.results import BiaxialTestResult
 from poro2d.biaxial.settings import auto_strain_rate, inertial_number
 from poro2d.biaxial.stages import SIDE_START_STRAIN, ProgressFn, Shearing, consolidate
@@ -129,8 +129,7 @@ class BiaxialTest:
         if done is not None:
             return done
         store = self.store
-        stage = folder_stage(store, self.case)
-        claim(store, stage)
+        stage = folder_stage(store, self.case)  # a folder of another test is refused here
         fresh: list[BiaxialTestResult] = []
 
         def compute() -> BiaxialTestResult:

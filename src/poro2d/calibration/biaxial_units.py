@@ -138,7 +138,7 @@ class BiaxialUnit(FrictionUnit):
 
     def check_entry(self, cache: Store | None) -> None:
         """Refuse a damaged entry on one line (a file where the folder belongs, a file changed since
-        written). A folder holding another test is not refused: the biaxial test empties it."""
+        written). A folder holding another test is refused by its test (poro2d.store.test_stage)."""
         store = self.store(cache)
         if store is not None:
             check_files(cache, store, "one biaxial test of the cache")

@@ -54,7 +54,6 @@ from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.execute.dask_cluster import check_reachable
 from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance, check_output_dir
-from poro2d.locks import holds_output
 from poro2d.paper_data import QUICK_SHEAR
 from poro2d.shear.box_scale import BoxScale, box_scale
 from poro2d.shear.lab import LabData
@@ -67,10 +66,10 @@ from poro2d.shear.settings import (
     ShearSettings,
 )
 from poro2d.specimen.specimen_set import SpecimenSet
-from poro2d.store import Store
+from poro2d.store import Store, claims
 from poro2d.typed_result import NOT_IN_FILE, Keyed, TypedResult, part
 
-#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+#: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
 KIND = "calibrate"
 
 DEFAULT_FP_RANGE = (0.3, 3.0)
@@ -412,7 +411,7 @@ def _end_mean(d: np.ndarray, y: np.ndarray, base: ShearSettings) -> float:
     return window_mean(d, y, base.max_displacement, base.peak_window)
 
 
-@holds_output("store", kind=KIND)
+@claims(KIND)
 def run_calibration(
     lab: str | os.PathLike | LabData | LabTests | list | None = None,
     specimens: list[str | os.PathLike] | None = None,

@@ -7,9 +7,9 @@ from pathlib import Path
 import typer
 
 from poro2d.console import OutputConsole, Table
-from poro2d.locks import holds_output
+from poro2d.store import claims
 
-#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+#: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
 KIND = "export"
 
 console = OutputConsole()
@@ -17,7 +17,7 @@ console = OutputConsole()
 TARGETS = ("lammps", "yade", "pfc", "csv")
 
 
-@holds_output("out", kind=KIND)
+@claims(KIND, "out")
 def export_cmd(
     specimen: str = typer.Argument(
         ...,

@@ -7,9 +7,9 @@ from pathlib import Path
 import typer
 
 from poro2d.console import OutputConsole, Table
-from poro2d.locks import holds_output
+from poro2d.store import claims
 
-#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+#: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
 KIND = "import"
 
 console = OutputConsole()
@@ -28,7 +28,7 @@ IMPORT_OPTIONS = (
 MAX_STEPS_LIMIT = 100_000_000
 
 
-@holds_output("out", kind=KIND)
+@claims(KIND, "out")
 def import_cmd(
     file: Path = typer.Argument(
         ..., help="disks.csv (walls.csv beside it), a LAMMPS data file or a checkpoint."

@@ -16,6 +16,9 @@ if TYPE_CHECKING:
 
 console = OutputConsole()
 
+#: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
+KIND = "strength"
+
 
 def parse_values(text: str, option: str, hi: float) -> list[float]:
     """'0,0.1,0.2' -> [0.0, 0.1, 0.2], each in [0, hi], all different; refused on one line."""
@@ -100,7 +103,6 @@ def register(app: typer.Typer) -> None:
         from poro2d.cli.shear import parse_stresses
         from poro2d.errors import InputError, check_int
         from poro2d.io_utils import check_output_dir
-        from poro2d.locks import output_folder
         from poro2d.report.strength_figure import draw_strength
         from poro2d.shear import strength as st
         from poro2d.shear.settings import MAX_FRICTION, MAX_ROLLING_FRICTION, ShearSettings
@@ -140,13 +142,14 @@ def register(app: typer.Typer) -> None:
         config = {"quick": quick, "seeds": n_seeds if quick else None, "specimens": specimen or None,
                   "mu_r": mu_values, "particle_friction": fp_values, "normal_stress_kpa": stresses,
                   "shear": shear}  # fmt: skip
-        with output_folder("--out", out, kind="strength"):
+        store = Store(out)
+        with store.claim(KIND):
             if quick:
                 console.print(f"[bold]quick specimens[/] (the paper's quick preset), {n_seeds} seed(s)")
                 specimens = quick_specimens(out / "specimens", n_seeds, not quiet)
             else:
                 specimens = given
-            study = st.StrengthStudy(specimens, mu_values, fp_values, stresses, settings, store=Store(out),
+            study = st.StrengthStudy(specimens, mu_values, fp_values, stresses, settings, store=store,
                                      options=run, config=config)  # fmt: skip
             console.print(
                 f"[bold]direct shear[/] over {len(study.cases)} (mu_r, f_p) cases x {len(specimens)} "

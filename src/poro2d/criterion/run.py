@@ -17,9 +17,11 @@ from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.criterion.result import CriterionResult
 from poro2d.execute.options import RunOptions
 from poro2d.grading import GradingCurve
-from poro2d.locks import output_folder
 from poro2d.specimen.compaction import SpecimenSpec
-from poro2d.store import Store
+from poro2d.store import Store, claimed
+
+#: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
+KIND = "criterion"
 
 ConfigLike = dict | str | os.PathLike | None
 
@@ -206,9 +208,7 @@ def run_criterion(
                              "poro2d.sweep.density_criterion.run_density_criterion)")  # fmt: skip
         return run_paper_mode(inputs, store, options=options)
 
-    if store is None:
-        return run()
-    with output_folder(store.parameter, store.root, kind="criterion"):
+    with claimed(store, KIND):
         return run()
 
 

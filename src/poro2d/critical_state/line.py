@@ -25,13 +25,12 @@ import numpy as np
 
 from poro2d.critical_state.case import CriticalStateCase
 from poro2d.critical_state.results import CriticalStateResult, CriticalStateTestResult, void_ratio
-from poro2d.critical_state.run import MAX_SEEDS, seed_runs, study_of, write_study
+from poro2d.critical_state.run import KIND, MAX_SEEDS, seed_runs, study_of, write_study
 from poro2d.errors import InputError, check_int
 from poro2d.execute import RunOptions
-from poro2d.io_utils import Provenance, check_output_dir
-from poro2d.locks import output_folder
+from poro2d.io_utils import Provenance
 from poro2d.measure.spread import Spread
-from poro2d.store import Store
+from poro2d.store import Store, claimed
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 #: the most pressures one line may hold, and the fewest it needs for a slope with a scatter
@@ -383,10 +382,7 @@ def run_critical_state_line(
             write_line(store, result)
         return result
 
-    if store is None:
-        return work()
-    check_output_dir(store.parameter, store.root)
-    with output_folder(store.parameter, store.root, kind="critical-state"):
+    with claimed(store, KIND):
         return work()
 
 

@@ -38,11 +38,12 @@ from poro2d.dem.reporters import Every, drive_blocks
 from poro2d.errors import InputError, check_int
 from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
-from poro2d.io_utils import Provenance, check_output_dir
+from poro2d.io_utils import Provenance
 from poro2d.labtest.reporters import CurveRecorder, ProgressReporter
-from poro2d.locks import output_folder
-from poro2d.store import Store
+from poro2d.store import Store, claimed
 
+#: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
+KIND = "critical-state"
 #: the most seeds one call runs
 MAX_SEEDS = 50
 #: the share of the progress bar the compression takes (the rest is the shear)
@@ -164,10 +165,7 @@ def run_critical_states(
     if store is not None and not isinstance(store, Store):
         raise InputError("store", type(store).__name__, "a poro2d.store.Store or None")
     cases = [case.with_seed(case.seed + k) for k in range(n)]
-    if store is None:
-        return _study(cases, None, options, config)
-    check_output_dir(store.parameter, store.root)
-    with output_folder(store.parameter, store.root, kind="critical-state"):
+    with claimed(store, KIND):
         return _study(cases, store, options, config)
 
 

@@ -31,7 +31,6 @@ from poro2d.criterion.density import Calibration, StateTarget, state_target
 from poro2d.execute.options import RunOptions
 from poro2d.interop.origin import SOIL_FILE
 from poro2d.io_utils import Provenance, check_output_dir
-from poro2d.locks import holds_output
 from poro2d.sand.case import ConfigLike, SandCase, load_sand_case
 from poro2d.sand.preflight import Preflight, StageEstimate, preflight
 from poro2d.sand.profile import case_runs, stage_profile
@@ -44,9 +43,10 @@ from poro2d.sand.result import (
 from poro2d.store import Store, walk
 from poro2d.sweep import density as D
 from poro2d.sweep.criterion_base import CriterionBase
+from poro2d.sweep.output import held
 from poro2d.sweep.records import CalibrationRun, CaseRow, LostCaseRow
 
-#: the kind of run an output folder of this command belongs to (poro2d.locks.claim_kind)
+#: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
 KIND = "sand"
 
 Announce = Callable[[str], None]
@@ -285,11 +285,10 @@ def check_soil(
     return case, preflight(case, workers=workers or os.cpu_count() or 1, budget_minutes=budget_minutes)
 
 
-@holds_output("store", kind=KIND)
 def run_sand(
     config: ConfigLike,
     *,
-    store: Store,
+    store: Store | None = None,
     seeds: int | None = None,
     budget_minutes: float | None = None,
     options: RunOptions = RunOptions(),
@@ -308,10 +307,18 @@ def run_sand(
     line per stage, with the elapsed time and an overall ETA.
     ``options``: where the jobs run and whether bars show (:class:`~poro2d.execute.options.RunOptions`;
     the pre-flight's estimate counts ``workers``). Rerun to resume: finished cases are read back.
+    ``store=None``: nothing is kept (the run works in a scratch folder, removed at the end; the
+    specimens' folders then name nothing).
     """
+    if store is not None:
+        check_output_dir(store.parameter, store.root)
+    with held(store, KIND) as kept:
+        return _run_sand(config, kept, seeds, budget_minutes, options, use_cache, announce, on_preflight)
+
+
+def _run_sand(config, store, seeds, budget_minutes, options, use_cache, announce, on_preflight) -> SandResult:
     from poro2d.execute.dask_cluster import check_reachable
 
-    check_output_dir(store.parameter, store.root)
     case, pf = check_soil(config, seeds=seeds, workers=options.workers, budget_minutes=budget_minutes)
     check_reachable(options.scheduler)  # one that does not answer is refused before the pre-flight is kept
     store.write_json(

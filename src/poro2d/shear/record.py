@@ -3,8 +3,8 @@
 The record holds what a test's results depend on: a digest of the specimen's state, the
 normal stress and the settings. It holds no path, so a moved or copied folder resumes
 without recomputing; a folder whose work belongs to another test is refused. The rules
-(record, markers, binding once work has started) are those of
-:class:`poro2d.store.stage.ResumableStage`; this module words them for a test.
+(record, markers, binding once work has started, the refusal) are those of every laboratory
+test's folder (:func:`poro2d.store.test_stage`).
 """
 
 from __future__ import annotations
@@ -13,14 +13,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from poro2d.io_utils import Provenance
 from poro2d.shear.settings import ShearSettings
-from poro2d.store import Store
-from poro2d.store.stage import Fingerprint, ResumableStage
+from poro2d.store import Fingerprint, ResumableStage, Store, test_stage
 from poro2d.typed_result import TypedResult
-
-RECORD = "test.json"
-
 
 #: settings added after tests were first recorded, left out of the record while they hold their
 #: default (None: the specimen's own value, which the specimen's digest already covers), so
@@ -59,48 +54,18 @@ def content_record(
     return TestContent(specimen_digest, sigma_kpa, ShearSettings.from_dict(kept))
 
 
-def stale_reason(keys: list[str] | None, old: Mapping | None) -> str:
-    """Why a folder's test is another one, from the keys its record differs in (None: no record)."""
-    if keys is None or old is None:
-        return "no record of its specimen and settings"
-    if "specimen_digest" not in old:
-        return "no content key of its specimen (written by an older poro2d)"
-    if "specimen_digest" in keys:
-        return "another specimen (the content of the specimen file differs)"
-    if "normal_stress_kpa" in keys:
-        return f"another normal stress ({old.get('normal_stress_kpa')} kPa)"
-    return "other settings (" + ", ".join(k.removeprefix("settings.") for k in keys) + ")"
-
-
-def _explain(keys: list[str] | None, old: Mapping | None) -> str:
-    # stale tests are not recomputed: their folder may hold hours of work the user still
-    # wants (a mistyped --specimen, say), so the choice of a new folder is left to the user
-    return f"it holds a test of {stale_reason(keys, old)}; use a new --out"
-
-
 def folder_stage(store: Store, record: TestContent | Mapping, specimen: str) -> ResumableStage:
-    """The stages of one test in ``store`` (consolidation, shearing), bound by ``test.json``.
+    """The stages of one test in ``store`` (consolidation, shearing), bound by ``test.json``
+    (:func:`poro2d.store.test_stage`: a folder of another test is refused).
 
-    ``record``: :func:`content_record` (or its dict, as a ``test.json`` holds it under ``run``);
-    the record file keeps its digest (``key``) and the specimen's path (for information: not
-    compared) beside it.
+    ``record``: :func:`content_record` (or its dict, as a ``test.json`` holds it under ``run``).
     """
     content = record.to_dict() if isinstance(record, TestContent) else record
     fingerprint = Fingerprint(content, tables={"settings": ShearSettings})
-    return store.stage(
-        fingerprint,
-        record=RECORD,
-        key="run",
-        extra={
-            "key": fingerprint.digest,
-            "specimen": str(specimen),
-            "provenance": Provenance.now().to_dict(),
-        },
-        parameter="out",
-        allowed="an empty folder or one holding the same test",
-        explain=_explain,
-        unrecorded="refuse",
-    )
+    return test_stage(
+        store.root, fingerprint, specimen=str(specimen), stress=("normal_stress_kpa", "normal stress"),
+        parameter=store.parameter,
+    )  # fmt: skip
 
 
-__all__ = ["TestContent", "content_record", "folder_stage", "stale_reason"]
+__all__ = ["TestContent", "content_record", "folder_stage"]

@@ -13,13 +13,15 @@ from poro2d.config import dataclass_from_table
 from poro2d.errors import InputError, is_number
 from poro2d.execute import RunOptions
 from poro2d.io_utils import check_output_dir
-from poro2d.locks import output_folder
 from poro2d.shear.lab import LabData, read_lab_csv
 from poro2d.shear.results import ShearSeriesResult
 from poro2d.shear.series import ShearSeries, check_stresses
 from poro2d.shear.settings import ShearSettings
 from poro2d.specimen.saved import Specimen
-from poro2d.store import Store
+from poro2d.store import Store, claimed
+
+#: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
+KIND = "shear"
 
 
 def _stresses(value) -> list[float]:
@@ -56,7 +58,7 @@ def run_shear(
     normal_stresses_kpa,
     settings: ShearSettings | dict | None = None,
     *,
-    store: Store,
+    store: Store | None,
     lab: str | os.PathLike | LabData | None = None,
     rate_check: bool = False,
     options: RunOptions = RunOptions(),
@@ -69,7 +71,7 @@ def run_shear(
     (read once: every test starts from that content). ``normal_stresses_kpa``: a number or
     a list (kPa). ``settings``: a :class:`ShearSettings`, a dict of its fields, or None for
     the defaults. ``store``: where the results are kept (``Store("shear-out")``); a rerun
-    with the same inputs skips finished tests and resumes a killed one. ``lab``: a
+    with the same inputs skips finished tests and resumes a killed one; None: nothing is kept. ``lab``: a
     laboratory CSV (or :class:`LabData`) to compare with. ``rate_check``: repeat every
     test at half the velocity. ``options``: where the tests run (``workers`` processes, default
     one per test and at most two per core, or a running ``scheduler``) and whether bars show
@@ -82,16 +84,17 @@ def run_shear(
     ``if __name__ == "__main__":`` in a script. A test that fails to run (consolidation
     without equilibrium) raises RuntimeError once the others have finished.
     """
-    if not isinstance(store, Store):
-        raise InputError("store", type(store).__name__, "a poro2d.store.Store (Store('shear-out'))")
-    check_output_dir(store.parameter, store.root)
+    if store is not None and not isinstance(store, Store):
+        raise InputError("store", type(store).__name__, "a poro2d.store.Store (Store('shear-out')) or None")
+    if store is not None:  # a bad folder is refused before the specimen is read
+        check_output_dir(store.parameter, store.root)
     value = Specimen.read(specimen)  # a damaged file is refused here, in one line
     stresses = _stresses(normal_stresses_kpa)
     lab_data = _lab(lab)
     shear_settings = _settings(settings)
     if not isinstance(rate_check, bool):
         raise InputError("rate_check", rate_check, "True or False")
-    with output_folder(store.parameter, store.root, kind="shear"):
+    with claimed(store, KIND):
         series = ShearSeries(
             value, stresses, shear_settings, store=store, lab=lab_data, rate_check=rate_check,
             options=options, config=config,

@@ -18,16 +18,23 @@ A store is a folder and the rules every result file follows:
 
 Sub-stores (:meth:`Store.child`) are the folders of the parts of a run (a trial, a test):
 the names a protocol uses are relative, so a moved or copied folder resumes.
+
+A run holds its folder through :meth:`Store.claim`, the one claim of an output folder: no
+other run writes there meanwhile, and a folder of another kind of run is refused
+(:mod:`poro2d.locks`).
 """
 
 from __future__ import annotations
 
 import csv
+import functools
+import inspect
 import json
 import os
 import shutil
 import zipfile
 from collections.abc import Callable, Iterable, Iterator, Mapping
+from contextlib import AbstractContextManager, contextmanager, nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypeVar
 
@@ -36,6 +43,7 @@ import numpy as np
 from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.io_utils import atomic_path, write_csv, write_json
+from poro2d.locks import output_folder
 from poro2d.store import digests
 from poro2d.store.stage import Fingerprint, ResumableStage
 
@@ -73,6 +81,18 @@ class Store:
     def root(self) -> Path:
         """The folder (for messages, and for tools that write whole folders: figures, VTU)."""
         return self._root
+
+    @contextmanager
+    def claim(self, kind: str | None = None) -> Iterator[Store]:
+        """Hold this store's folder for the block, as a ``kind`` run's (``"shear"``, ...).
+
+        Refused, before any work, while another run writes the folder, or when it belongs to
+        another kind of run (its marker, or its kind's own files); a rerun of the same kind
+        goes on. A folder the block leaves empty is removed again (see
+        :func:`poro2d.locks.output_folder`).
+        """
+        with output_folder(self.parameter, self._root, kind=kind):
+            yield self
 
     def child(self, *parts: str) -> Store:
         """The store of a part of the run (``trials/02_n0.2300``), in a sub-folder."""
@@ -312,6 +332,34 @@ class Checkpoints:
         self.store.remove(self.name)
 
 
+def claimed(store: Store | None, kind: str | None = None) -> AbstractContextManager[Store | None]:
+    """``store.claim(kind)``; for None (a run that keeps nothing) nothing is held."""
+    return nullcontext() if store is None else store.claim(kind)
+
+
+def claims(kind: str, argument: str = "store"):
+    """Decorator: the call holds its ``argument`` claimed as ``kind``'s (:meth:`Store.claim`) throughout.
+
+    ``argument`` is a store, None (nothing held), or a command's folder (a path, named ``--out``).
+    """
+
+    def decorate(func):
+        signature = inspect.signature(func)
+
+        @functools.wraps(func)
+        def run(*args, **kwargs):
+            bound = signature.bind(*args, **kwargs)
+            bound.apply_defaults()
+            target = bound.arguments[argument]
+            store = target if target is None or isinstance(target, Store) else Store(target)
+            with claimed(store, kind):
+                return func(*args, **kwargs)
+
+        return run
+
+    return decorate
+
+
 def walk(store: Store, pattern: str) -> Iterator[Store]:
     """The sub-stores of ``store`` whose folder names match ``pattern``, sorted."""
     for name in store.names(pattern):
@@ -319,4 +367,4 @@ def walk(store: Store, pattern: str) -> Iterator[Store]:
             yield store.child(name)
 
 
-__all__ = ["Checkpoints", "Store", "walk"]
+__all__ = ["Checkpoints", "Store", "claimed", "claims", "walk"]

@@ -22,6 +22,10 @@ continues where the last one stopped. They share one set of rules, kept here:
 
 One record may serve several stages in the same folder (a criterion run and each of its
 trials, a shear test's consolidation and the test): each stage has its own marker.
+
+A laboratory test's folder (a direct shear or a biaxial test) is bound by :func:`test_stage`,
+the one policy for a folder holding another test: it is refused, naming the folder and the
+test it holds; a rerun of the same test resumes.
 """
 
 from __future__ import annotations
@@ -34,7 +38,7 @@ from typing import Any, Literal
 
 from poro2d.errors import InputError
 from poro2d.identity import identity_digest, identity_view
-from poro2d.io_utils import as_json, write_json
+from poro2d.io_utils import Provenance, as_json, write_json
 from poro2d.locks import is_lock_file
 from poro2d.store import digests
 
@@ -231,4 +235,50 @@ class ResumableStage:
         return data if decode is None else decode(data)
 
 
-__all__ = ["Fingerprint", "ResumableStage", "differing_keys"]
+#: the record of a laboratory test's folder
+TEST_RECORD = "test.json"
+
+
+def other_test(keys: list[str] | None, old: Mapping | None, stress: tuple[str, str]) -> str:
+    """The test a folder holds, as it differs from this one (``keys``: where its record differs;
+    None: no record). ``stress``: the key of the test's stress in the record and its name."""
+    key, name = stress
+    if keys is None or old is None:
+        return "no record of its specimen and settings"
+    if "specimen_digest" not in old:
+        return "no content key of its specimen (written by an older poro2d)"
+    if "specimen_digest" in keys:
+        return "another specimen (the content of the specimen file differs)"
+    if key in keys:
+        return f"another {name} ({old.get(key)} kPa)"
+    return "other settings (" + ", ".join(k.removeprefix("settings.") for k in keys) + ")"
+
+
+def test_stage(
+    folder: str | Path,
+    fingerprint: Fingerprint,
+    *,
+    specimen: str,
+    stress: tuple[str, str],
+    parameter: str = "--out",
+    unrecorded: Literal["refuse", "adopt"] = "refuse",
+) -> ResumableStage:
+    """The stages of one laboratory test in ``folder``, bound by ``test.json`` to ``fingerprint``.
+
+    A folder holding another test is refused (an :class:`~poro2d.errors.InputError` naming the
+    folder and that test, :func:`other_test`): it may be hours of work the user still wants, so
+    the choice of another folder is left to them. The same test resumes. The record keeps the
+    fingerprint's digest (``key``), the specimen's path and the provenance beside it (not compared).
+    """
+
+    def explain(keys: list[str] | None, old: Mapping | None) -> str:
+        return f"it holds a test of {other_test(keys, old, stress)}; use a new {parameter}"
+
+    extra = {"key": fingerprint.digest, "specimen": specimen, "provenance": Provenance.now().to_dict()}
+    return ResumableStage(
+        folder, fingerprint, record=TEST_RECORD, key="run", extra=extra, parameter=parameter,
+        allowed="an empty folder or one holding the same test", explain=explain, unrecorded=unrecorded,
+    )  # fmt: skip
+
+
+__all__ = ["TEST_RECORD", "Fingerprint", "ResumableStage", "differing_keys", "other_test", "test_stage"]

@@ -2,7 +2,7 @@
 
 A study (the relation, the sensitivity study, the criterion's density mode) is given a
 :class:`~poro2d.store.Store` by its caller, the command making it from ``--out``. While the
-study runs, its folder is held (:func:`poro2d.locks.output_folder`): a second run writing
+study runs, its folder is held (:meth:`poro2d.store.Store.claim`): a second run writing
 to the same folder is refused, not interleaved. Without a store nothing is kept: the
 study's sweeps run in a scratch folder removed when it ends (a calibration still goes to
 the shared cache, which is kept for every later run).
@@ -14,19 +14,18 @@ import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 
-from poro2d.locks import output_folder
 from poro2d.store import Store
 
 
 @contextmanager
 def held(store: Store | None, kind: str | None = None) -> Iterator[Store]:
-    """``store`` held for the block, as a ``kind`` run's folder (:func:`poro2d.locks.claim_kind`);
+    """``store`` held for the block, as a ``kind`` run's folder (:meth:`~poro2d.store.Store.claim`);
     None: a scratch store, removed after the block."""
     if store is None:
         with tempfile.TemporaryDirectory(prefix="poro2d-") as scratch:
             yield Store(scratch)
         return
-    with output_folder(store.parameter, store.root, kind=kind):
+    with store.claim(kind):
         yield store
 
 

@@ -33,13 +33,16 @@ from poro2d.execute import Executor, Failed, Job
 from poro2d.execute.dask_cluster import ClusterInfo, pin_numba_threads
 from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance
-from poro2d.locks import cache_entry, output_folder
+from poro2d.locks import cache_entry
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
 from poro2d.sweep.cases import KINDS, Case, SweepConfig, config_tables
 from poro2d.sweep.records import CaseRow, LostCaseRow, SweepSummary
 from poro2d.sweep.results import SweepResult
 from poro2d.typed_result import TypedResult
+
+#: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
+KIND = "sweep"
 
 RESULT = "result.json"
 PARAMS = "params.json"
@@ -238,7 +241,7 @@ def run_sweep(
     ``workers`` processes (default: one per core) of one thread each, its dashboard on
     ``dashboard``. ``client``: an existing ``distributed.Client`` (tests, notebooks) instead.
     """
-    with output_folder(store.parameter, store.root, kind="sweep"):
+    with store.claim(KIND):
         return _run_sweep(sweep, store, options, client)
 
 
