@@ -149,3 +149,14 @@ def test_auto_leaves_poro2d_own_laboratory_files_alone(tmp_path):
     assert not made_by_poro2d(real) and not made_by_poro2d([own, real]) and not made_by_poro2d([])
     assert resolve_mode("auto", own) == "none" and resolve_mode("auto", real) == "estimate"
     assert resolve_mode("AUTO", [own, real]) == "estimate" and resolve_mode("0.1", own) == 0.1
+
+
+def test_the_record_says_saturated_when_the_interval_reaches_the_prior_top():
+    """A laboratory far off every surface (300 % of its values) pushes the term's interval to the
+    prior's top level, and the record says so; a laboratory the model fits does not."""
+    from poro2d.calibration.discrepancy import discrepancy_record
+
+    far = discrepancy_record(_calibrate(0, 3.0, "estimate"), 0.95)
+    near = discrepancy_record(_calibrate(0, 0.0, "estimate"), 0.95)
+    assert far.saturated and far.interval[1] == 4.0  # the top of the estimate prior
+    assert not near.saturated

@@ -209,9 +209,10 @@ def discrepancy_record(post, level: float) -> DiscrepancyRecord | None:
         return DiscrepancyRecord(f"fixed at {s:g}", s, [s, s])
     tail = (1.0 - level) / 2.0
     prior = f"uniform over {len(term.levels)} levels from {term.levels[0]:g} to {term.levels[-1]:g}"
-    return DiscrepancyRecord(
-        prior, post.discrepancy_at(0.5), [post.discrepancy_at(tail), post.discrepancy_at(1.0 - tail)]
-    )
+    weights = post.discrepancy_weights
+    saturated = weights is not None and term.saturated(weights, level)
+    interval = [post.discrepancy_at(tail), post.discrepancy_at(1.0 - tail)]
+    return DiscrepancyRecord(prior, post.discrepancy_at(0.5), interval, saturated)
 
 
 __all__ = [
