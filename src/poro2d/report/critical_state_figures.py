@@ -21,7 +21,7 @@ import numpy as np
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from poro2d.critical_state.case import CaseRecord  # noqa: E402
+from poro2d.critical_state.case import CriticalStateCase  # noqa: E402
 from poro2d.critical_state.line import CriticalStateLineResult, pressure_folder  # noqa: E402
 from poro2d.critical_state.results import CriticalStateResult, CriticalStateTestResult  # noqa: E402
 from poro2d.report.figure_file import save_figure  # noqa: E402
@@ -33,7 +33,7 @@ FIGURE = "critical_state.png"
 LINE_FIGURE = "critical_state_line.png"
 
 
-def _title(case: CaseRecord) -> str:
+def _title(case: CriticalStateCase) -> str:
     return (
         f"periodic shear: f_p = {case.particle_friction:g}, mu_r = {case.rolling_friction:g}, "
         f"P = {case.pressure_kpa:g} kPa, I = {case.inertial_number:g}, {case.disks} disks"
