@@ -8,24 +8,18 @@ import os
 import tomllib
 import types
 import typing
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from poro2d.errors import InputError, is_integer, is_number
-from poro2d.io_utils import check_input_file, read_utf8
+from poro2d.io_utils import read_user_text
 
 
 def load_toml(path: str | os.PathLike) -> dict:
     """The raw tables of the TOML file at ``path``: read at the edge, where each command turns them
     into its settings and cases once."""
-    p = Path(path)
-    if p.exists():  # a device, a FIFO or a folder is named as such
-        check_input_file("config", p)
-    if not p.is_file():
-        raise InputError("config", str(p), "an existing TOML file")
-    text = read_utf8("config", p, "a UTF-8 TOML file")
+    p, text = read_user_text("config", path, "TOML")
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

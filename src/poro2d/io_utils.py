@@ -277,6 +277,19 @@ def _file_kind(mode: int) -> str:
     return next((name for test, name in kinds if test(mode)), "not a regular file")
 
 
+def read_user_text(parameter: str, path: str | os.PathLike, kind: str) -> tuple[Path, str]:
+    """The path and text of a ``kind`` file (TOML, CSV) the user named: one that is missing is
+    refused as such before :func:`read_utf8` checks and reads it."""
+    from poro2d.errors import InputError
+
+    p = Path(path)
+    if p.exists():  # a device, a FIFO or a folder is named as such
+        check_input_file(parameter, p)
+    if not p.is_file():
+        raise InputError(parameter, str(p), f"an existing {kind} file")
+    return p, read_utf8(parameter, p, f"a UTF-8 {kind} file")
+
+
 def read_utf8(parameter: str, path: str | os.PathLike, allowed: str) -> str:
     """The text of a UTF-8 file (a regular file of a sane size: :func:`check_input_file`);
     a file of other bytes (binary, Latin-1) is an InputError.

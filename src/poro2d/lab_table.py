@@ -27,12 +27,11 @@ import csv
 import math
 import os
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from poro2d.errors import InputError
-from poro2d.io_utils import check_input_file, read_utf8
+from poro2d.io_utils import read_user_text
 
 #: Largest peak tau/sigma accepted: tan(68.2 degrees). Bolton (1986, Geotechnique 36(1)) bounds
 #: the peak angle of sands by the critical-state angle (at most about 40 degrees for angular
@@ -95,12 +94,7 @@ def parse_number(text: str, parameter: str) -> float:
 
 def read_lab_table(path: str | os.PathLike) -> LabTable:
     """Read a laboratory CSV's header and data rows (the rules are the module's)."""
-    p = Path(path)
-    if p.exists():  # a device, a FIFO or a folder is named as such
-        check_input_file("lab", p)
-    if not p.is_file():
-        raise InputError("lab", str(p), "an existing CSV file")
-    text = read_utf8("lab", p, "a UTF-8 CSV file")
+    p, text = read_user_text("lab", path, "CSV")
     numbered = [
         (k + 1, ln)
         for k, ln in enumerate(text.splitlines())

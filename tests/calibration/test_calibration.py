@@ -257,7 +257,8 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
     assert 0.0 < fitted[("dilation", 50.0)]["lab_mm"] < 2.0
     # each design point's dilation is the stored test's plate rise at its end, smoothed as its end stress
     first = res.evaluations[0]
-    assert len(first["dilation_50kPa"]) == 2 and all(0.0 < v < 2.0 for v in first["dilation_50kPa"])
+    dilation = first.to_dict()["dilation_50kPa"]  # a design point is read by attribute, its row by key
+    assert len(dilation) == 2 and all(0.0 < v < 2.0 for v in dilation)
     digest = res.specimens  # labels -> files; the units of the first point, specimen by specimen
     found = SpecimenSet.named([paths[0], paths[1]]).read()
     for k, label in enumerate(found):
@@ -265,7 +266,7 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
                               first.rolling_friction)  # fmt: skip
         assert isinstance(unit, CalibrationUnit) and str(found[label]) == digest[label]
         row = stored_row(unit, Store(out).child("cache"))
-        assert row.dilation == first["dilation_50kPa"][k]
+        assert row.dilation == dilation[k]
         test = json.loads((out / "cache" / unit.key / "result.json").read_text())
         assert row.dilation == pytest.approx(test["end"]["plate_displacement_mm"], rel=1e-12)
     # the mean over the last window (2 mm: the readings at 1 and 2 mm)
@@ -280,7 +281,8 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
     again = run_calibration(plain, [paths[0], paths[1]], **kw)
     assert again.cluster.tests_run == 0 and again.cluster.tests_reused == 9 * 2 * 2
     assert list(again.fit) == keys[:4]
-    assert [e["peak_50kPa"] for e in again.evaluations] == [e["peak_50kPa"] for e in res.evaluations]
+    peaks = [[e.to_dict()["peak_50kPa"] for e in r.evaluations] for r in (again, res)]
+    assert peaks[0] == peaks[1]
 
 
 @pytest.mark.parametrize(

@@ -54,7 +54,7 @@ def test_stations_read_the_lab_curves_at_evenly_spaced_displacements():
 
 
 def test_a_unit_row_reads_its_own_curve_at_a_station_as_the_lab_is_read():
-    readings = CurveReadings(D, TAU, 1e3 * RISE, 0.002)
+    readings = CurveReadings(D, {"stress": TAU, "rise": 1e3 * RISE}, 0.002)
     row = UnitRow("k", 100.0, 0.5, 0.1, "s", float(TAU.max()), float(TAU[-1]), 1.0, 3.0, readings)
     assert row.observable("stress_at_4mm") == pytest.approx(_window_mean(TAU, 0.004))
     assert row.observable("rise_at_6mm") == pytest.approx(1e3 * _window_mean(RISE, 0.006))

@@ -18,7 +18,7 @@ What the fit reads of a finished test (:class:`BiaxialRow`), every value dimensi
   ``smoothing_strain`` before an axial strain.
 
 The laboratory's curves are read by the same functions (:func:`peak_ratio`, :func:`end_mean`,
-:func:`BiaxialReadings.at`), so both sides are one reading.
+:meth:`~poro2d.calibration.units.CurveReadings.at`), so both sides are one reading.
 """
 
 from __future__ import annotations
@@ -34,7 +34,13 @@ from poro2d.biaxial.angles import smoothed
 from poro2d.biaxial.case import BiaxialCase
 from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.biaxial.single import BiaxialTest
-from poro2d.calibration.units import FrictionUnit, check_files, parse_strain_station, window_mean
+from poro2d.calibration.units import (
+    CurveReadings,
+    FrictionUnit,
+    check_files,
+    parse_strain_station,
+    window_mean,
+)
 from poro2d.identity import identity_digest
 from poro2d.specimen.saved import Specimen
 from poro2d.store import Store
@@ -60,21 +66,6 @@ def end_window(settings: BiaxialSettings) -> float:
 
 
 @dataclass(frozen=True)
-class BiaxialReadings:
-    """A finished test's curve as the fit reads it at its stations (axial strain, ratio, eps_v)."""
-
-    axial_strain: np.ndarray
-    ratio: np.ndarray
-    volumetric: np.ndarray
-    window: float
-
-    def at(self, kind: str, axial_strain: float) -> float:
-        """The reading of ``kind`` (``ratio`` or ``volumetric``) at ``axial_strain``."""
-        y = self.ratio if kind == "ratio" else self.volumetric
-        return window_mean(self.axial_strain, y, axial_strain, self.window)
-
-
-@dataclass(frozen=True)
 class BiaxialRow:
     """What a finished biaxial unit gives the fit: its observables (dimensionless) and its cost."""
 
@@ -87,7 +78,7 @@ class BiaxialRow:
     end_ratio: float
     end_volumetric: float
     wall_time_s: float
-    readings: BiaxialReadings
+    readings: CurveReadings
     #: kappa = kn / (sigma_3 t) and the mean overlap / d at the peak (None: a test cached before them)
     stiffness_number: float | None = None
     mean_overlap_ratio: float | None = None
@@ -157,10 +148,10 @@ class BiaxialUnit(FrictionUnit):
             end_ratio=end_mean(c.axial_strain, c.sin_phi, s, end_window(s)),
             end_volumetric=end_mean(c.axial_strain, c.volumetric_strain, s, s.smoothing_strain),
             wall_time_s=float(res.wall_time_s),
-            readings=BiaxialReadings(
-                np.asarray(c.axial_strain, float), np.asarray(c.sin_phi, float),
-                np.asarray(c.volumetric_strain, float), s.smoothing_strain,
-            ),
+            readings=CurveReadings(np.asarray(c.axial_strain, float), {
+                "ratio": np.asarray(c.sin_phi, float),
+                "volumetric": np.asarray(c.volumetric_strain, float),
+            }, s.smoothing_strain),
             stiffness_number=res.stiffness_number,
             mean_overlap_ratio=res.mean_overlap_ratio_at_peak,
         )  # fmt: skip
@@ -168,11 +159,10 @@ class BiaxialUnit(FrictionUnit):
     def curve(self, cache: Store | None) -> tuple[np.ndarray, np.ndarray] | None:
         """The finished test's (axial strain, stress ratio), or None."""
         row = self.stored_row(cache)
-        return None if row is None else (row.readings.axial_strain, row.readings.ratio)
+        return None if row is None else (row.readings.x, row.readings.columns["ratio"])
 
 
 __all__ = [
-    "BiaxialReadings",
     "BiaxialRow",
     "BiaxialUnit",
     "biaxial_unit_key",

@@ -94,20 +94,20 @@ def window_mean(d: np.ndarray, y: np.ndarray, at: float, window: float) -> float
 
 @dataclass(frozen=True)
 class CurveReadings:
-    """A finished test's curve as the fit reads it at its stations (:func:`window_mean`).
+    """A finished test's curve as the fit reads it at its stations (:func:`window_mean`): ``x`` (the
+    shear displacement in m, or the axial strain of a biaxial test), a column per kind of reading
+    (``stress`` in kPa and ``rise`` in mm, or ``ratio`` and ``volumetric``) and the window in x.
 
     Kept in the unit's row, so that readings at any stations come from the cached test without
     running it again."""
 
-    displacement_m: np.ndarray
-    stress_kpa: np.ndarray
-    rise_mm: np.ndarray
-    window_m: float
+    x: np.ndarray
+    columns: dict[str, np.ndarray]
+    window: float
 
-    def at(self, kind: str, displacement_m: float) -> float:
-        """The reading of ``kind`` (``stress`` or ``rise``) at ``displacement_m``."""
-        y = self.stress_kpa if kind == "stress" else self.rise_mm
-        return window_mean(self.displacement_m, y, displacement_m, self.window_m)
+    def at(self, kind: str, x: float) -> float:
+        """The reading of ``kind`` at ``x``."""
+        return window_mean(self.x, self.columns[kind], x, self.window)
 
 
 def unit_key(specimen_digest: str, sigma: float, settings: dict) -> str:
@@ -246,8 +246,10 @@ def _row(unit: CalibrationUnit, res) -> UnitRow:
         dilation=end_rise_mm(res.curve, window),
         readings=CurveReadings(
             np.asarray(res.curve["shear_displacement_mm"], float) * 1e-3,
-            np.asarray(res.curve["shear_stress_kpa"], float),
-            np.asarray(res.curve["plate_displacement_mm"], float),
+            {
+                "stress": np.asarray(res.curve["shear_stress_kpa"], float),
+                "rise": np.asarray(res.curve["plate_displacement_mm"], float),
+            },
             window,
         ),
         box_dominated=bool(res.box_dominated),

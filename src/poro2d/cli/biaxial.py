@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, job_options, tests_workers_help
+from poro2d.cli import options as opt
 from poro2d.console import OutputConsole, Table
 
 console = OutputConsole()
@@ -36,14 +36,8 @@ def register(app: typer.Typer) -> None:
             None, "--replicates", "-r", help="With --quick: specimens of seeds S, S+1, ..."
         ),
         seed: int = typer.Option(None, "--seed", help="With --quick: the first specimen's seed (default 0)."),
-        particle_friction: float = typer.Option(
-            None, "--particle-friction", help="Disk friction for the tests (default: the specimen's)."
-        ),
-        rolling_friction: float = typer.Option(
-            None,
-            "--rolling-friction",
-            help="Disk rolling friction mu_r for the tests (default: the specimen's).",
-        ),
+        particle_friction: float = opt.particle_friction(),
+        rolling_friction: float = opt.rolling_friction(),
         stiffness_number: float = typer.Option(
             None,
             "--stiffness-number",
@@ -53,11 +47,11 @@ def register(app: typer.Typer) -> None:
         lab: Path = typer.Option(
             None, "--lab", help="Your laboratory curves (CSV, docs/biaxial.md), overlaid."
         ),
-        out: Path = typer.Option(Path("biaxial-out"), "--out", "-o", help="Output folder."),
-        workers: int = typer.Option(None, "--workers", help=tests_workers_help("test, at most one per core")),
-        scheduler: str = typer.Option(None, "--scheduler", help=TESTS_SCHEDULER_HELP),
-        config: Path = typer.Option(None, "--config", "-c", help="TOML config with a \\[biaxial] table."),
-        quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+        out: Path = opt.out("biaxial-out", "Output folder."),
+        workers: int = opt.tests_workers("test, at most one per core"),
+        scheduler: str = opt.tests_scheduler(),
+        config: Path = opt.config(help="TOML config with a \\[biaxial] table."),
+        quiet: bool = opt.quiet(),
     ) -> None:
         """Biaxial tests at one or several confining stresses: peak and critical-state friction angles,
         dilatancy and their spread over replicates; the peak envelope over the stresses."""
@@ -84,7 +78,7 @@ def register(app: typer.Typer) -> None:
                     "settings": {**table.settings, **options}}  # fmt: skip
         if config is not None:
             recorded["config_file"] = str(config)
-        jobs = job_options(workers if workers is not None else run.get("workers"), scheduler, quiet)
+        jobs = opt.job_options(workers if workers is not None else run.get("workers"), scheduler, quiet)
         kw = {"replicates": n, "lab": lab if lab is not None else table.path("lab"), "options": jobs,
               "config": recorded}  # fmt: skip
         start_and_print(case, stresses, Store(out), kw, out)

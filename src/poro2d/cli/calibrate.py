@@ -7,13 +7,10 @@ from pathlib import Path
 
 import typer
 
+from poro2d.cli import options as opt
 from poro2d.console import OutputConsole
 
 console = OutputConsole()
-
-_SCHED = "Address of a running Dask scheduler (e.g. tcp://host:8786); default: a LocalCluster."
-_WORKERS = "LocalCluster worker processes (default: one per core)."
-_DASHBOARD = "LocalCluster dashboard: HOST:PORT or none (default 127.0.0.1:0, this machine only)."
 
 
 def parse_range(
@@ -52,7 +49,7 @@ def register(app: typer.Typer) -> None:
         specimen: list[str] = typer.Option(
             None, "--specimen", "-s", help="A specimen (.npz or criterion folder); repeat for replicates."
         ),
-        preset: str = typer.Option(None, "--preset", help="paper: replicate specimens of the paper's case."),
+        preset: str = opt.preset(help="paper: replicate specimens of the paper's case."),
         quick: bool = typer.Option(False, "--quick", help="With --preset paper: the small specimen."),
         replicates: int = typer.Option(3, "--replicates", help="Seeds of the preset's specimens (1-20)."),
         seed: int = typer.Option(0, "--seed", help="First seed of the preset's specimens."),
@@ -84,26 +81,25 @@ def register(app: typer.Typer) -> None:
         stations: int = typer.Option(
             1, "--stations", help="Readings of each lab curve up to its end (1-10; 1: the end only)."
         ),
-        max_displacement: float = typer.Option(None, "--max-displacement", help="Shear displacement (m)."),
+        max_displacement: float = opt.max_displacement(),
         max_strain: float = typer.Option(
             None, "--max-strain", help="With --biaxial-lab: axial strain of every test (0.2)."
         ),
-        out: Path = typer.Option(Path("calibrate-out"), "--out", "-o", help="Output folder (resumable)."),
-        scheduler: str = typer.Option(None, "--scheduler", help=_SCHED),
-        workers: int = typer.Option(None, "--workers", help=_WORKERS),
-        dashboard: str = typer.Option(None, "--dashboard", help=_DASHBOARD),
+        out: Path = opt.out("calibrate-out"),
+        scheduler: str = opt.scheduler(),
+        workers: int = opt.workers(help="LocalCluster worker processes (default: one per core)."),
+        dashboard: str = opt.dashboard(),
         keep_box_dominated: bool = typer.Option(
             False,
             "--keep-box-dominated",
             help="Fit design points whose tests are box-dominated too (left out by default): the"
             " frictions then describe the box.",
         ),
-        quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+        quiet: bool = opt.quiet(),
     ) -> None:
         """Calibrate particle friction f_p and rolling friction mu_r against laboratory direct shear or
         biaxial tests."""
         from poro2d.calibration.run import DEFAULT_FP_RANGE, DEFAULT_MU_R_RANGE, run_calibration
-        from poro2d.cli.dask_options import job_options
         from poro2d.report.calibration_figures import draw_calibration
         from poro2d.report.criterion_figures import draw_specimens
         from poro2d.store import Store
@@ -148,7 +144,7 @@ def register(app: typer.Typer) -> None:
                 level=level,
                 stations=stations,
                 settings=settings,
-                options=job_options(workers, scheduler, quiet, dashboard),
+                options=opt.job_options(workers, scheduler, quiet, dashboard),
                 config={"cli": options},
                 keep_box_dominated=keep_box_dominated,
                 discrepancy=discrepancy,

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import typer
 
+from poro2d.cli import options as opt
 from poro2d.console import OutputConsole, Table
 from poro2d.criterion.table import print_result
 from poro2d.store import Store
@@ -29,15 +30,13 @@ PAPER_MODE_NOTE = (
 def register(app: typer.Typer) -> None:
     @app.command("criterion")
     def criterion_cmd(
-        config: Path = typer.Option(
-            None, "--config", "-c", help="TOML config with \\[specimen], \\[grading], \\[criterion] tables."
-        ),
-        preset: str = typer.Option(None, "--preset", help="Built-in case: 'paper'."),
-        out: Path = typer.Option(Path("criterion-out"), "--out", "-o", help="Output folder (resumable)."),
+        config: Path = opt.config(help="TOML config with \\[specimen], \\[grading], \\[criterion] tables."),
+        preset: str = opt.preset(),
+        out: Path = opt.out("criterion-out"),
         seed: int = typer.Option(None, "--seed", help="Random seed (overrides the config)."),
         n_lab: float = typer.Option(None, "--n-lab", help="Laboratory porosity (overrides the config)."),
         trial: float = typer.Option(None, "--trial-porosity", help="First trial n2D instead of Eq. 12."),
-        threads: int = typer.Option(None, "--threads", help="Threads for the DEM kernels."),
+        threads: int = opt.threads(),
         mode: str = typer.Option(
             None,
             "--mode",
@@ -47,7 +46,7 @@ def register(app: typer.Typer) -> None:
         n_max: float = typer.Option(None, "--n-max", help="Density mode: loosest laboratory porosity."),
         n_min: float = typer.Option(None, "--n-min", help="Density mode: densest laboratory porosity."),
         seeds: int = typer.Option(None, "--seeds", help="Density mode: specimens per state (3)."),
-        quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+        quiet: bool = opt.quiet(),
     ) -> None:
         """Find the final 2D porosity with the criterion of the paper's Fig. 3.
 

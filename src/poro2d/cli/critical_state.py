@@ -10,7 +10,7 @@ from pathlib import Path
 
 import typer
 
-from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, job_options, tests_workers_help
+from poro2d.cli import options as opt
 from poro2d.console import OutputConsole, Table
 
 console = OutputConsole()
@@ -41,13 +41,11 @@ def register(app: typer.Typer) -> None:
             "(columns size_mm,percent_passing; docs/grading.md).",
         ),
         disks: int = typer.Option(1500, "--disks", help="About how many disks in the cell."),
-        particle_friction: float = typer.Option(
-            None, "--particle-friction", help="Particle friction f_p (default 0.5, or the calibrated one)."
+        particle_friction: float = opt.particle_friction(
+            help="Particle friction f_p (default 0.5, or the calibrated one)."
         ),
-        rolling_friction: float = typer.Option(
-            None,
-            "--rolling-friction",
-            help="Rolling friction mu_r (against R = r_i r_j / (r_i + r_j); default 0, or the calibrated).",
+        rolling_friction: float = opt.rolling_friction(
+            help="Rolling friction mu_r (against R = r_i r_j / (r_i + r_j); default 0, or the calibrated)."
         ),
         pressure: str = typer.Option(
             "100",
@@ -82,10 +80,10 @@ def register(app: typer.Typer) -> None:
         ),
         seed: int = typer.Option(0, "--seed", help="The first seed."),
         seeds: int = typer.Option(1, "--seeds", "-n", help="Seeds S, S+1, ...: the spread over them."),
-        out: Path = typer.Option(Path("critical-state-out"), "--out", "-o", help="Output folder."),
-        workers: int = typer.Option(None, "--workers", help=tests_workers_help("seed, at most one per core")),
-        scheduler: str = typer.Option(None, "--scheduler", help=TESTS_SCHEDULER_HELP),
-        quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+        out: Path = opt.out("critical-state-out", "Output folder."),
+        workers: int = opt.tests_workers("seed, at most one per core"),
+        scheduler: str = opt.tests_scheduler(),
+        quiet: bool = opt.quiet(),
     ) -> None:
         """Steady-state friction tau/sigma and solid fraction of the disks, free of any box."""
         from poro2d.cli.critical_state_held import held_states, print_held
@@ -105,7 +103,7 @@ def register(app: typer.Typer) -> None:
         check_output_dir("--out", out)
         curve = _grading(grading)
         n = check_int("--seeds", seeds, 1, MAX_SEEDS)
-        run = job_options(workers, scheduler, quiet)
+        run = opt.job_options(workers, scheduler, quiet)
         pressures = parse_stresses(pressure, "--pressure", PRESSURE_RANGE_KPA)
         if len(pressures) > MAX_PRESSURES or len(set(pressures)) != len(pressures):
             raise InputError("--pressure", pressure, f"at most {MAX_PRESSURES} distinct pressures")

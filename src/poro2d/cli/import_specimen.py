@@ -6,6 +6,7 @@ from pathlib import Path
 
 import typer
 
+from poro2d.cli import options as opt
 from poro2d.console import OutputConsole, Table
 from poro2d.store import claims
 
@@ -33,7 +34,7 @@ def import_cmd(
     file: Path = typer.Argument(
         ..., help="disks.csv (walls.csv beside it), a LAMMPS data file or a checkpoint."
     ),
-    out: Path = typer.Option(Path("import-out"), "--out", "-o", help="Output folder."),
+    out: Path = opt.out("import-out", "Output folder."),
     ratio: float = typer.Option(1e-3, "--ratio", help="Equilibrium: max unbalanced-force ratio."),
     max_steps: int = typer.Option(400_000, "--max-steps", help="Step limit of each stage."),
     thickness: float = typer.Option(None, "--thickness", help="Disk thickness (m) if the file has none."),
@@ -52,7 +53,7 @@ def import_cmd(
         help="Force window: F_top below this fraction of G (default: the file's, else the paper's 0.01).",
     ),  # fmt: skip
     threads: int = typer.Option(1, "--threads", help="Threads for the DEM kernels."),
-    quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+    quiet: bool = opt.quiet(),
 ) -> None:
     """Bring a specimen into poro2d and run the criterion's check on it as it stands."""
     import numba

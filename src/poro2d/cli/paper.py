@@ -6,6 +6,7 @@ from pathlib import Path
 
 import typer
 
+from poro2d.cli import options as opt
 from poro2d.execute.options import RunOptions
 from poro2d.paper import run_paper
 from poro2d.store import Store
@@ -14,7 +15,7 @@ from poro2d.store import Store
 def register(app: typer.Typer) -> None:
     @app.command("paper")
     def paper_cmd(
-        out: Path = typer.Option(Path("paper-out"), "--out", "-o", help="Output folder (resumable)."),
+        out: Path = opt.out("paper-out"),
         quick: bool = typer.Option(
             False, "--quick", help="Reduced specimen for a first look (about a minute)."
         ),
@@ -23,10 +24,8 @@ def register(app: typer.Typer) -> None:
         replicates: int = typer.Option(
             3, "--replicates", help="Specimens (seeds) for the direct shear tests; 1 for one specimen."
         ),
-        threads: int = typer.Option(
-            None, "--threads", help="Threads for the DEM kernels (default: all cores)."
-        ),
-        quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+        threads: int = opt.threads(help="Threads for the DEM kernels (default: all cores)."),
+        quiet: bool = opt.quiet(),
     ) -> None:
         """Run the paper's case study: conversions, criterion (Fig. 3), direct shear (Fig. 8), report."""
         summary = run_paper(Store(out), quick=quick, lab=lab, seed=seed, threads=threads,

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import typer
 from rich.markup import escape
 
-from poro2d.cli.dask_options import DASHBOARD_HELP, SCHEDULER_HELP, WORKERS_HELP, job_options
+from poro2d.cli import options as opt
 from poro2d.console import OutputConsole, Table
 
 if TYPE_CHECKING:
@@ -20,25 +20,23 @@ console = OutputConsole()
 
 
 def relation_cmd(
-    config: Path = typer.Option(
-        None, "--config", "-c", help="Criterion config; optional \\[relation] table."
-    ),
-    preset: str = typer.Option(None, "--preset", help="Built-in case: 'paper'."),
+    config: Path = opt.config(help="Criterion config; optional \\[relation] table."),
+    preset: str = opt.preset(),
     points: int = typer.Option(
         None, "--points", help="Laboratory porosities from n_max to n_min (default 5)."
     ),
     n_max: float = typer.Option(None, "--n-max", help="Loosest laboratory porosity (paper: 0.4571)."),
     n_min: float = typer.Option(None, "--n-min", help="Densest laboratory porosity (paper: 0.3253)."),
-    out: Path = typer.Option(Path("relation-out"), "--out", "-o", help="Output folder (resumable)."),
-    scheduler: str = typer.Option(None, "--scheduler", help=SCHEDULER_HELP),
-    workers: int = typer.Option(None, "--workers", help=WORKERS_HELP),
+    out: Path = opt.out("relation-out"),
+    scheduler: str = opt.scheduler(),
+    workers: int = opt.workers(),
     quick: bool = typer.Option(False, "--quick", help="Small specimen (0.08 m x 0.04 m, 2 layers)."),
     mode: str = typer.Option(
         None, "--mode", help="density (default): preparation friction from the state; paper: fixed 0.05."
     ),
     seeds: int = typer.Option(None, "--seeds", help="Specimens per state and per calibration point (3)."),
-    dashboard: str = typer.Option(None, "--dashboard", help=DASHBOARD_HELP),
-    quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
+    dashboard: str = opt.dashboard(),
+    quiet: bool = opt.quiet(help="No progress bar."),
 ) -> None:
     """The grading's n2D(nLab) relation from the criterion at several relative densities.
 
@@ -56,7 +54,7 @@ def relation_cmd(
     store = Store(out)
     rel = run_relation(
         config, preset=preset, store=store, points=points, n_max=n_max, n_min=n_min, mode=mode,
-        seeds=seeds, quick=quick, options=job_options(workers, scheduler, quiet, dashboard),
+        seeds=seeds, quick=quick, options=opt.job_options(workers, scheduler, quiet, dashboard),
         announce=banner,
     )  # fmt: skip
     draw_relation(rel, store)

@@ -7,6 +7,7 @@ from pathlib import Path
 import typer
 from rich.markup import escape
 
+from poro2d.cli import options as opt
 from poro2d.console import OutputConsole, Table
 
 console = OutputConsole()
@@ -126,7 +127,7 @@ def sand_cmd(
     config: Path = typer.Argument(
         ..., help="Sand config: \\[soil], \\[grading], \\[lab] (and \\[specimen], \\[sand])."
     ),
-    out: Path = typer.Option(Path("sand-out"), "--out", "-o", help="Output folder (resumable)."),
+    out: Path = opt.out("sand-out"),
     seeds: int = typer.Option(None, "--seeds", help="Specimens at full size (default 3, or \\[sand] seeds)."),
     budget: float = typer.Option(
         None, "--budget", help="Target run time in minutes: the pre-flight says what fits."
@@ -134,9 +135,9 @@ def sand_cmd(
     preflight_only: bool = typer.Option(
         False, "--preflight", help="Print the pre-flight and stop (no DEM work)."
     ),
-    workers: int = typer.Option(None, "--workers", help="Worker processes (default: one per core)."),
-    scheduler: str = typer.Option(None, "--scheduler", help="Address of a running Dask scheduler."),
-    quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+    workers: int = opt.workers(help="Worker processes (default: one per core)."),
+    scheduler: str = opt.scheduler(help="Address of a running Dask scheduler."),
+    quiet: bool = opt.quiet(),
 ) -> None:
     """The density-aware 2D porosity of your soil at its laboratory state, over seeds.
 

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
+from poro2d.cli import options as opt
 from poro2d.console import OutputConsole, Table
 
 if TYPE_CHECKING:
@@ -19,29 +20,25 @@ console = OutputConsole()
 def register(app: typer.Typer) -> None:
     @app.command("sensitivity")
     def sensitivity_cmd(
-        config: Path = typer.Option(
-            None,
-            "--config",
-            "-c",
-            help="Criterion config; optional \\[sensitivity] table (cu, mu_prep, seeds).",
+        config: Path = opt.config(
+            help="Criterion config; optional \\[sensitivity] table (cu, mu_prep, seeds)."
         ),
-        preset: str = typer.Option(None, "--preset", help="Built-in case: 'paper' (the default)."),
-        out: Path = typer.Option(Path("sensitivity-out"), "--out", "-o", help="Output folder (resumable)."),
+        preset: str = opt.preset(help="Built-in case: 'paper' (the default)."),
+        out: Path = opt.out("sensitivity-out"),
         quick: bool = typer.Option(
             False, "--quick", help="Small box (0.08 m x 0.04 m, 2 layers), Cu up to 3, 2 seeds."
         ),
         seeds: int = typer.Option(None, "--seeds", help="Specimens per point (default 3, quick 2)."),
-        scheduler: str = typer.Option(None, "--scheduler", help="Address of a running Dask scheduler."),
-        workers: int = typer.Option(None, "--workers", help="Worker processes of the local cluster."),
-        dashboard: str = typer.Option(
-            None, "--dashboard", help="Local cluster dashboard: HOST:PORT or none (default 127.0.0.1:0)."
+        scheduler: str = opt.scheduler(help="Address of a running Dask scheduler."),
+        workers: int = opt.workers(help="Worker processes of the local cluster."),
+        dashboard: str = opt.dashboard(
+            help="Local cluster dashboard: HOST:PORT or none (default 127.0.0.1:0)."
         ),
-        quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
+        quiet: bool = opt.quiet(help="No progress bar."),
     ) -> None:
         """Why the paper's case gives what it gives: the criterion in the paper's protocol
         (mu_prep 0.05, first trial from Eq. 12) against grading width (Cu) and against
         preparation friction, over seeds, beside the paper's 0.15."""
-        from poro2d.cli.dask_options import job_options
         from poro2d.criterion.config import load_config
         from poro2d.errors import check_int
         from poro2d.io_utils import check_output_dir
@@ -50,7 +47,7 @@ def register(app: typer.Typer) -> None:
         from poro2d.sweep.criterion_base import CriterionBase
         from poro2d.sweep.sensitivity import run_sensitivity
 
-        options = job_options(workers, scheduler, quiet, dashboard)
+        options = opt.job_options(workers, scheduler, quiet, dashboard)
         if seeds is not None:
             check_int("--seeds", seeds, 1, 50)
         check_output_dir("--out", out)

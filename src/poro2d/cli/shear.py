@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, job_options, tests_workers_help
+from poro2d.cli import options as opt
 from poro2d.console import OutputConsole, Table
 
 if TYPE_CHECKING:
@@ -107,27 +107,21 @@ def register(app: typer.Typer) -> None:
             None, "--normal-stress", "-n", help="Normal stresses in kPa, e.g. 50,100,200."
         ),
         lab: Path = typer.Option(None, "--lab", help="Laboratory CSV (curves or peaks), optional."),
-        out: Path = typer.Option(Path("shear-out"), "--out", "-o", help="Output folder (resumable)."),
+        out: Path = opt.out("shear-out"),
         velocity: float = typer.Option(None, "--velocity", help="Shear velocity of the lower half (m/s)."),
-        max_displacement: float = typer.Option(None, "--max-displacement", help="Shear displacement (m)."),
+        max_displacement: float = opt.max_displacement(),
         stop_after_peak: float = typer.Option(
             None, "--stop-after-peak", help="End once the smoothed peak lies this far behind (m; 0: never)."
         ),
-        particle_friction: float = typer.Option(
-            None, "--particle-friction", help="Disk friction for the tests (default: the specimen's)."
-        ),
-        rolling_friction: float = typer.Option(
-            None,
-            "--rolling-friction",
-            help="Disk rolling friction mu_r for the tests (default: the specimen's).",
-        ),
+        particle_friction: float = opt.particle_friction(),
+        rolling_friction: float = opt.rolling_friction(),
         rate_check: bool = typer.Option(
             False, "--rate-check", help="Repeat every test at half the velocity."
         ),
-        workers: int = typer.Option(None, "--workers", help=tests_workers_help("test, at most two per core")),
-        scheduler: str = typer.Option(None, "--scheduler", help=TESTS_SCHEDULER_HELP),
-        config: Path = typer.Option(None, "--config", "-c", help="TOML config with a \\[shear] table."),
-        quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+        workers: int = opt.tests_workers("test, at most two per core"),
+        scheduler: str = opt.tests_scheduler(),
+        config: Path = opt.config(help="TOML config with a \\[shear] table."),
+        quiet: bool = opt.quiet(),
     ) -> None:
         """Direct shear tests (the paper's Fig. 8): peak strengths, friction angle, figures."""
         from poro2d.io_utils import check_output_dir
@@ -141,7 +135,7 @@ def register(app: typer.Typer) -> None:
         table, base = load_shear_config(config)
         extra = {k: table.pop(k) for k in list(table) if k in SHEAR_KEYS_EXTRA}
         check_extra_types(extra)
-        run = job_options(workers if workers is not None else extra.get("workers"), scheduler, quiet)
+        run = opt.job_options(workers if workers is not None else extra.get("workers"), scheduler, quiet)
         options = {
             "velocity": velocity,
             "max_displacement": max_displacement,

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import typer
 
-from poro2d.cli.dask_options import TESTS_SCHEDULER_HELP, job_options, tests_workers_help
+from poro2d.cli import options as opt
 from poro2d.console import OutputConsole, Table
 
 if TYPE_CHECKING:
@@ -87,17 +87,17 @@ def register(app: typer.Typer) -> None:
         mu_r: str = typer.Option(None, "--mu-r", help="Rolling frictions, e.g. 0,0.1,0.2,0.4."),
         friction: str = typer.Option(None, "--friction", help="Particle frictions f_p, e.g. 0.5,1,3."),
         normal_stress: str = typer.Option(None, "--normal-stress", "-n", help="Normal stresses (kPa)."),
-        max_displacement: float = typer.Option(None, "--max-displacement", help="Shear displacement (m)."),
-        out: Path = typer.Option(Path("strength-out"), "--out", "-o", help="Output folder (resumable)."),
-        workers: int = typer.Option(None, "--workers", help=tests_workers_help("test, at most two per core")),
-        scheduler: str = typer.Option(None, "--scheduler", help=TESTS_SCHEDULER_HELP),
+        max_displacement: float = opt.max_displacement(),
+        out: Path = opt.out("strength-out"),
+        workers: int = opt.tests_workers("test, at most two per core"),
+        scheduler: str = opt.tests_scheduler(),
         max_tests: int = typer.Option(
             MAX_TESTS,
             "--max-tests",
             help="Most direct shear tests the grid may start (cases x specimens x stresses); "
             "a larger grid is refused before any work.",
         ),
-        quiet: bool = typer.Option(False, "--quiet", help="No progress bars."),
+        quiet: bool = opt.quiet(),
     ) -> None:
         """Peak and residual friction angles and dilation against rolling and particle friction."""
         from poro2d.cli.shear import parse_stresses
@@ -123,7 +123,7 @@ def register(app: typer.Typer) -> None:
             parse_values(friction, "--friction", MAX_FRICTION) if friction else list(st.QUICK_FRICTION)
         )
         stresses = parse_stresses(normal_stress) if normal_stress else list(st.QUICK_NORMAL_STRESSES)
-        run = job_options(workers, scheduler, quiet)
+        run = opt.job_options(workers, scheduler, quiet)
         check_int("--max-tests", max_tests, 1, 1_000_000)
         n_tests = len(mu_values) * len(fp_values) * (n_seeds if quick else len(specimen)) * len(stresses)
         if n_tests > max_tests:

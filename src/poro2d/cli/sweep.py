@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 from rich.markup import escape
 
-from poro2d.cli.dask_options import DASHBOARD_HELP, SCHEDULER_HELP, WORKERS_HELP, job_options
+from poro2d.cli import options as opt
 from poro2d.console import OutputConsole, Table
 
 console = OutputConsole()
@@ -15,13 +15,11 @@ console = OutputConsole()
 
 def sweep_cmd(
     config: Path = typer.Argument(..., help="TOML config: base case tables and a \\[sweep] table."),
-    out: Path = typer.Option(
-        Path("sweep-out"), "--out", "-o", help="Output folder (reruns skip done cases)."
-    ),
-    scheduler: str = typer.Option(None, "--scheduler", help=SCHEDULER_HELP),
-    workers: int = typer.Option(None, "--workers", help=WORKERS_HELP),
-    dashboard: str = typer.Option(None, "--dashboard", help=DASHBOARD_HELP),
-    quiet: bool = typer.Option(False, "--quiet", help="No progress bar."),
+    out: Path = opt.out("sweep-out", "Output folder (reruns skip done cases)."),
+    scheduler: str = opt.scheduler(),
+    workers: int = opt.workers(),
+    dashboard: str = opt.dashboard(),
+    quiet: bool = opt.quiet(help="No progress bar."),
 ) -> None:
     """Run a grid or list of cases as Dask tasks; one table of results."""
     from poro2d.config import load_toml
@@ -30,7 +28,7 @@ def sweep_cmd(
     from poro2d.sweep.cases import parse_sweep
     from poro2d.sweep.runner import run_sweep
 
-    options = job_options(workers, scheduler, quiet, dashboard)
+    options = opt.job_options(workers, scheduler, quiet, dashboard)
     check_output_dir("--out", out)
     cfg = load_toml(config)
     sweep = parse_sweep(cfg, Path(config).resolve().parent)

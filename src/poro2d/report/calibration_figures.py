@@ -63,15 +63,9 @@ def plot_calibration_fit(result, lab, curves: dict[float, list], nearest, path: 
     ax_peak.set_xlim(left=0)
     ax_peak.set_ylim(bottom=0)
     ax_peak.legend(fontsize=8)
-    b = result.best
-    ax_peak.set_title(f"f_p = {b.particle_friction:.3g}, mu_r = {b.rolling_friction:.3g}", fontsize=10)
-    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    _best_title(ax_peak, result)
     for k, sigma in enumerate(lab.normal_stresses()):
-        c = colors[k % len(colors)]
-        for j, (d, t) in enumerate(curves.get(sigma, [])):
-            ax_curve.plot(
-                d * 1e3, t, color=c, lw=0.8, alpha=0.7, label=f"model {sigma:g} kPa" if j == 0 else None
-            )
+        c = _model_curves(ax_curve, k, sigma, curves, 1e3)
         for i, series in enumerate(getattr(lab, "series", (lab,))):  # every laboratory repeat
             first = k == 0 and i == 0
             if sigma in series.curves:
@@ -79,16 +73,35 @@ def plot_calibration_fit(result, lab, curves: dict[float, list], nearest, path: 
                 ax_curve.plot(d * 1e3, t, "k--", lw=1.0, label="laboratory" if first else None)
             else:
                 ax_curve.axhline(series.peaks[sigma], color=c, ls=":", lw=1.0)
-    ax_curve.set_xlabel("shear displacement (mm)")
-    ax_curve.set_ylabel("shear stress (kPa)")
-    ax_curve.set_title(
+    _curves_axes(ax_curve, nearest, "shear displacement (mm)", "shear stress (kPa)")
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def _best_title(ax, result) -> None:
+    b = result.best
+    ax.set_title(f"f_p = {b.particle_friction:.3g}, mu_r = {b.rolling_friction:.3g}", fontsize=10)
+
+
+def _model_curves(ax, k: int, sigma: float, curves: dict[float, list], scale: float) -> str:
+    """The model's curves at the ``k``-th stress ``sigma`` (x times ``scale``) in its colour, returned."""
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    c = colors[k % len(colors)]
+    for j, (x, y) in enumerate(curves.get(sigma, [])):
+        ax.plot(scale * x, y, color=c, lw=0.8, alpha=0.7, label=f"model {sigma:g} kPa" if j == 0 else None)
+    return c
+
+
+def _curves_axes(ax, nearest, xlabel: str, ylabel: str) -> None:
+    """The labels, title and legend of the panel of curves at the design point ``nearest`` the best."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(
         f"curves at the design point nearest the best (f_p = {nearest.particle_friction:.3g}, "
         f"mu_r = {nearest.rolling_friction:.3g})",
         fontsize=9,
     )
-    ax_curve.legend(fontsize=7)
-    fig.tight_layout()
-    return save_figure(fig, path)
+    ax.legend(fontsize=7)
 
 
 def _model_points(ax, s, observed: list, unit: str) -> None:
@@ -137,15 +150,9 @@ def plot_biaxial_calibration_fit(
     for name, marker, label in (("peak_ratio", "s", "peak"), ("end_ratio", "^", "end")):
         _plot_targets(ax_ratio, [o for o in fitted if o.observable == name], marker, label)
     ax_ratio.set_ylabel("stress ratio (sigma_1 - sigma_3) / (sigma_1 + sigma_3)")
-    b = result.best
-    ax_ratio.set_title(f"f_p = {b.particle_friction:.3g}, mu_r = {b.rolling_friction:.3g}", fontsize=10)
-    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    _best_title(ax_ratio, result)
     for k, sigma in enumerate(lab.confining_stresses()):
-        c = colors[k % len(colors)]
-        for j, (e1, ratio) in enumerate(curves.get(sigma, [])):
-            ax_curve.plot(
-                100 * e1, ratio, color=c, lw=0.8, alpha=0.7, label=f"model {sigma:g} kPa" if j == 0 else None
-            )
+        _model_curves(ax_curve, k, sigma, curves, 100)
         curve = lab.curves[sigma]
         ax_curve.plot(
             100 * curve.axial_strain,
@@ -154,14 +161,7 @@ def plot_biaxial_calibration_fit(
             lw=1.0,
             label="laboratory" if k == 0 else None,
         )
-    ax_curve.set_xlabel("axial strain (%)")
-    ax_curve.set_ylabel("stress ratio")
-    ax_curve.set_title(
-        f"curves at the design point nearest the best (f_p = {nearest.particle_friction:.3g}, "
-        f"mu_r = {nearest.rolling_friction:.3g})",
-        fontsize=9,
-    )
-    ax_curve.legend(fontsize=7)
+    _curves_axes(ax_curve, nearest, "axial strain (%)", "stress ratio")
     if volumetric:
         _plot_targets(axes[2], volumetric, "s", "end")
         axes[2].axhline(0.0, color="0.6", lw=0.6)
