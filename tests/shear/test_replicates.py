@@ -73,6 +73,7 @@ def test_replicate_series_on_small_specimens(tmp_path):
     """Two specimens (two seeds), two stresses each, one pool: the summary matches each series."""
     from poro2d.dem import checkpoint
     from poro2d.shear import ShearSettings
+    from poro2d.report.shear_figures import draw_replicate_shear
     from poro2d.shear.replicates import ReplicateShear
     from poro2d.shear.results import ReplicateShearResult
     from poro2d.specimen import paper_grading
@@ -105,6 +106,7 @@ def test_replicate_series_on_small_specimens(tmp_path):
     assert row.normal_stress_kpa == 50.0
     assert row.peak_mean_kpa == pytest.approx(np.mean([peaks["seed0"][0], peaks["seed1"][0]]))
     assert res.fit.n_points == 4
+    draw_replicate_shear(res, Store(out))  # the figures, as the command draws them after the run
     files = [
         "replicates.json",
         "replicates.csv",

@@ -125,7 +125,7 @@ def wall_contacts():
 
 
 def report():
-    """Wall forces per metre of disk thickness (N/m), as poro2d gives them."""
+    """Wall forces per metre of disk thickness (N/m), as poro2d reports them."""
     f = {name: O.forces.f(wid) for name, wid in wall_ids.items()}
     out = {
         "f_top_n_per_m": f["top"][1] / T if "top" in f else float("nan"),
