@@ -72,8 +72,8 @@ def test_summary_over_specimens():
 def test_replicate_series_on_small_specimens(tmp_path):
     """Two specimens (two seeds), two stresses each, one pool: the summary matches each series."""
     from poro2d.dem import checkpoint
-    from poro2d.shear import ShearSettings
     from poro2d.report.shear_figures import draw_replicate_shear
+    from poro2d.shear import ShearSettings
     from poro2d.shear.replicates import ReplicateShear
     from poro2d.shear.results import ReplicateShearResult
     from poro2d.specimen import paper_grading
