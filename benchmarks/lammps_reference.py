@@ -56,6 +56,7 @@ from pathlib import Path
 
 import numpy as np
 
+from poro2d.dem.contact_law import in_series as series  # the quotient the exported files write
 from poro2d.interop.lammps import WallFix, critical_dt, disk_mass, model_commands, write_data
 from poro2d.interop.lammps_run import (
     LOOP_RE,
@@ -68,7 +69,6 @@ from poro2d.interop.lammps_run import (
     read_dump,
     version_from_log,
 )
-from poro2d.interop.specimen_data import series
 
 # ------------------------------------------------------------------ test packing
 

@@ -16,7 +16,7 @@ import pytest
 
 from poro2d import progress
 from poro2d.console import FILE_WIDTH, OutputConsole, Table
-from poro2d.dem import Particles, Simulation, Walls
+from poro2d.dem import Every, Particles, Simulation, Walls
 
 ELLIPSIS = "\u2026"
 LONG = 0.123456789012
@@ -151,7 +151,9 @@ def test_run_progress_in_a_log_is_one_line_at_the_end(capsys):
 def test_run_progress_in_a_log_writes_periodic_lines(capsys, monkeypatch):
     monkeypatch.setattr(progress, "LINE_INTERVAL_S", 0.0)  # a line at every update
     quiet = lambda sim: None  # noqa: E731
-    res = _drop().run(3000, until_ratio=1e-12, check_every=250, every=500, callback=quiet, progress="drop")
+    res = _drop().run(
+        3000, until_ratio=1e-12, check_every=250, reporters=[Every(500, quiet)], progress="drop"
+    )
     lines = capsys.readouterr().err.splitlines()
     # one per block; the last block's line is the last line (not written twice)
     done = [int(STEP_LINE.match(line).group(1).replace(",", "")) for line in lines]
