@@ -83,3 +83,17 @@ def release_interrupts(held: _HeldInterrupt | None) -> None:
     signal.signal(signal.SIGINT, held.previous if held.previous is not None else signal.SIG_DFL)
     if held.came:
         raise KeyboardInterrupt
+
+
+def forget_unhandled_interrupt() -> None:
+    """Let a handled Ctrl-C end the process with its exit code, not by SIGINT.
+
+    CPython notes a KeyboardInterrupt that leaves any code it runs through its string-running
+    C interface, which compiled extensions call while they import. Even when the command
+    catches that interrupt and exits with code 130, the note makes the interpreter end by
+    signalling itself (exit status -2, as if nothing had handled it). Running one empty
+    statement through the same interface clears the note.
+    """
+    import ctypes
+
+    ctypes.pythonapi.PyRun_SimpleStringFlags(b"pass", None)

@@ -29,6 +29,20 @@ def test_keyboard_interrupt_in_a_command_prints_what_was_kept(tmp_path, monkeypa
     assert err == f"interrupted: finished trials are kept in {out}; rerun the same command to resume"
 
 
+def test_keyboard_interrupt_while_the_options_are_parsed_prints_its_line(monkeypatch, capsys):
+    # typer turns a Ctrl-C outside the command into a silent Exit(130), returned as 130
+    import typer.core
+
+    def interrupted(self, *args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(typer.core.TyperGroup, "make_context", interrupted)
+    with pytest.raises(SystemExit) as e:
+        main(["relation", "--preset", "paper", "--quiet"])
+    assert e.value.code == 130
+    assert capsys.readouterr().err.strip() == "interrupted"
+
+
 def test_sigint_during_a_run(tmp_path):
     # the paper's full specimen takes minutes to prepare: the signal arrives mid-run
     out = tmp_path / "o"

@@ -5,7 +5,7 @@ and prints the answer; :mod:`poro2d.cli.app` registers them all and holds :func:
 console entry point.
 """
 
-from poro2d.worker_signals import ignore_interrupts_in_spawned_child
+from poro2d.worker_signals import forget_unhandled_interrupt, ignore_interrupts_in_spawned_child
 
 # a worker process of the command (a local Dask cluster's, a process pool's) imports this
 # package first of all, before any signal handling of its own: Ctrl-C is the command's
@@ -17,6 +17,7 @@ except KeyboardInterrupt:  # a Ctrl-C while the command still imports (a second 
     import sys
 
     print("interrupted", file=sys.stderr)
+    forget_unhandled_interrupt()
     raise SystemExit(130) from None
 
 __all__ = ["app", "main"]

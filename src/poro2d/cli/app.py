@@ -17,7 +17,7 @@ from rich.markup import escape
 
 from poro2d import __version__
 from poro2d.errors import InputError, Interrupted
-from poro2d.worker_signals import ignore_interrupts_in_dask_worker
+from poro2d.worker_signals import forget_unhandled_interrupt, ignore_interrupts_in_dask_worker
 
 # a worker process of the local cluster imports this module first (as its main module)
 ignore_interrupts_in_dask_worker()
@@ -134,6 +134,8 @@ def main(argv: list[str] | None = None) -> None:
         args = sys.argv[1:] if argv is None else argv
         check_raw_arguments(args)
         rc = app(args=argv, standalone_mode=False)
+        if rc == 130:  # a Ctrl-C while the options are parsed, outside the command: typer's silent Exit(130)
+            raise KeyboardInterrupt
         if isinstance(rc, int) and rc != 0:  # typer.Exit(code) comes back as a return value here
             sys.exit(rc)
     except InputError as exc:
@@ -142,9 +144,11 @@ def main(argv: list[str] | None = None) -> None:
         sys.exit(2)
     except Interrupted as exc:
         err_console.print(f"[yellow]{exc}[/]", highlight=False, soft_wrap=True)
+        forget_unhandled_interrupt()
         sys.exit(130)
     except KeyboardInterrupt:  # outside a command (while parsing the options, say)
         err_console.print("[yellow]interrupted[/]")
+        forget_unhandled_interrupt()
         sys.exit(130)
     except SystemExit:
         raise
