@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 
@@ -57,14 +55,13 @@ def test_deterministic_and_seed_dependent(layer_radii):
     assert not np.array_equal(a.positions, c.positions)
 
 
-def test_full_box_is_fast():
+def test_full_box_places_every_disk():
+    # its time is part of the preparation wall time benchmarks/bench_preparation.py prints
     radii = draw_disks(paper_grading(), 0.86 * W * H, 3)
     assert 2500 < radii.size < 2700
     band = Band(0.0, W, 0.0, H)
-    place_disks(radii[:20], band, 0)  # compile or load the cached kernel first
-    t0 = time.perf_counter()
     p = place_disks(radii, band, 3)
-    assert time.perf_counter() - t0 < 1.0
+    assert p.positions.shape == (radii.size, 2)
     assert_valid(p, band)
 
 
