@@ -99,18 +99,13 @@ def run_critical_state(
         raise InputError("store", type(store).__name__, "a poro2d.store.Store or None")
     if store is None:
         return _compute(case, report)
-    done = stored_run(store, case)
-    if done is not None:
-        return done
-    fresh: list[CriticalStateTestResult] = []
-
-    def compute() -> CriticalStateTestResult:  # the series first: the result is the marker
-        fresh.append(_compute(case, report))
-        store.write_csv(SERIES_CSV, fresh[0].series.rows(), header=list(COLUMNS))
-        return fresh[0]
-
-    folder_stage(store, case).run(compute)
-    return fresh[0]
+    done = stored_run(store, case)  # a folder of another case's run is refused here, before any step
+    if done is None:
+        done = _compute(case, report)
+        # the series first: the result, written by the stage, is the marker of a finished run
+        store.write_csv(SERIES_CSV, done.series.rows(), header=list(COLUMNS))
+        folder_stage(store, case).run(lambda: done)
+    return done
 
 
 def _compute(case: CriticalStateCase, report: Report | None) -> CriticalStateTestResult:
@@ -147,25 +142,21 @@ def _compute(case: CriticalStateCase, report: Report | None) -> CriticalStateTes
 
 @dataclass(frozen=True)
 class SeedJob:
-    """One seed's run (a value that pickles: a worker process runs it), kept in ``folder`` (a path
-    string; None: nothing kept)."""
+    """One seed's run (a value that pickles: a worker process runs it), kept in ``store`` (None:
+    nothing kept)."""
 
     case: CriticalStateCase
     label: str
-    folder: str | None = None
-
-    def store(self) -> Store | None:
-        return None if self.folder is None else Store(self.folder)
+    store: Store | None = None
 
     def stored(self) -> CriticalStateTestResult | None:
-        """The run when its folder holds it finished (read here: no process started); a folder
+        """The run when its store holds it finished (read here: no process started); a folder
         holding another case's run is refused here, before any seed runs."""
-        store = self.store()
-        return None if store is None else stored_run(store, self.case)
+        return None if self.store is None else stored_run(self.store, self.case)
 
 
 def _run_job(job: SeedJob, report) -> CriticalStateTestResult:
-    return run_critical_state(job.case, job.store(), report=report)
+    return run_critical_state(job.case, job.store, report=report)
 
 
 def run_critical_states(
@@ -213,10 +204,7 @@ def seed_runs(
     core), kept in its store of ``stores`` (None: nothing kept) where finished ones are read back;
     the results in the cases' order and the number of workers. Raises if any failed."""
     workers = options.local_workers(len(cases))
-    jobs = [
-        SeedJob(c, _label(c, cases), None if s is None else str(s.root))
-        for c, s in zip(cases, stores, strict=True)
-    ]
+    jobs = [SeedJob(c, _label(c, cases), s) for c, s in zip(cases, stores, strict=True)]
     results = complete_jobs(
         [Job(_run_job, (job,), job.label, reports=True) for job in jobs], title="critical state",
         what="periodic shear run(s)", options=options, workers=workers, finished=[j.stored() for j in jobs],
