@@ -231,10 +231,7 @@ PROTOCOLS = [
     Protocol("criterion", _criterion, "result.json", _criterion_bad, "n_lab", jobs=_criterion_jobs),
     Protocol("shear", _shear, "result.json", _shear_bad, "normal stress (kPa)"),
     Protocol("biaxial", _biaxial, "result.json", _biaxial_bad, "replicates"),
-    Protocol(
-        "critical_state", _critical_state, "result.json", _critical_state_bad, "seeds",
-        skip={"reads_back": "run_critical_states keeps its files at the end only: a rerun runs every seed"},
-    ),
+    Protocol("critical_state", _critical_state, "result.json", _critical_state_bad, "seeds"),
     Protocol(  # the calibration's cases folder: with store=None, a scratch folder removed at the end
         "sand", _sand, "sand.json", _sand_bad, "lab.n", setup=_sand_setup, volatile=frozenset({"cases"}),
     ),

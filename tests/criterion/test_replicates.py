@@ -1,7 +1,9 @@
 """Replicate specimens: criterion runs of several seeds, in processes or one after the other."""
 
 import numpy as np
+import pytest
 
+from poro2d.criterion import replicates
 from poro2d.criterion.protocol import CriterionSettings
 from poro2d.criterion.replicates import run_replicates
 from poro2d.criterion.result import ReplicatesResult
@@ -18,7 +20,7 @@ SPEC = SpecimenSpec(width=0.05, height=0.025, layers=2, threads=2)
 SETTINGS = CriterionSettings(force_fraction=0.05)
 
 
-def test_processes_give_the_specimens_of_a_serial_run(tmp_path):
+def test_processes_give_the_specimens_of_a_serial_run(tmp_path, monkeypatch):
     """Two processes with one thread each build, seed for seed, the specimens of a serial run."""
     seeds = [1, 2]
     res = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, Store(tmp_path / "p"),
@@ -35,8 +37,8 @@ def test_processes_give_the_specimens_of_a_serial_run(tmp_path):
         pa, pb = checkpoint.load(par[label]).particles, checkpoint.load(ser[label]).particles
         np.testing.assert_array_equal(pa.pos, pb.pos)
         np.testing.assert_array_equal(pa.radius, pb.radius)
-    # a rerun reads every seed back from its folder
-    res = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, Store(tmp_path / "p"),
-                         options=RunOptions(progress=False))  # fmt: skip
+    # a rerun reads every seed back from its folder, with no job run
+    monkeypatch.setattr(replicates, "_run_one", lambda *_: pytest.fail("a finished seed ran again"))
+    res = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, Store(tmp_path / "p"), options=SERIAL)
     again, rows_again = res.specimens, res.rows
     assert again == par and [r.final_porosity for r in rows_again] == [r.final_porosity for r in rows_par]

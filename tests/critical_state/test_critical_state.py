@@ -9,6 +9,7 @@ import pytest
 
 from poro2d.cli import main
 from poro2d.critical_state import CriticalStateCase, CriticalStateTestResult, run_critical_state
+from poro2d.critical_state import run as run_module
 from poro2d.critical_state.series import COLUMNS, CellSeries
 from poro2d.critical_state.steady import read_steady
 from poro2d.errors import InputError
@@ -101,7 +102,7 @@ def test_a_bad_case_is_refused_naming_its_field(changes, parameter):
     assert exc.value.parameter == parameter
 
 
-def test_a_run_keeps_its_result_series_and_figure_in_the_store(tmp_path):
+def test_a_run_keeps_its_result_series_and_figure_in_the_store(tmp_path, monkeypatch):
     case = CriticalStateCase(**SMALL)
     result = run_critical_state(case, Store(tmp_path))
     draw_critical_state(result, Store(tmp_path))  # the figure, drawn from the result after the run
@@ -109,11 +110,19 @@ def test_a_run_keeps_its_result_series_and_figure_in_the_store(tmp_path):
         "critical_state.png",
         "result.json",
         "series.csv",
+        "test.json",
     ]
     data = json.loads((tmp_path / "result.json").read_text())
     assert CriticalStateTestResult.from_dict(data).to_dict() == result.to_dict()
     assert data["case"]["disks"] == 200 and data["provenance"]["poro2d_version"]
     assert len((tmp_path / "series.csv").read_text().splitlines()) == result.series.gamma.size + 1
+    # a rerun reads the finished run back, series and all; a run of another case is refused
+    monkeypatch.setattr(run_module, "_compute", lambda *_: pytest.fail("a finished run ran again"))
+    back = run_critical_state(case, Store(tmp_path))
+    assert back == result and np.array_equal(back.series.stress_ratio, result.series.stress_ratio)
+    with pytest.raises(InputError, match="another pressure") as exc:
+        run_critical_state(case.at_pressure(200.0), Store(tmp_path))
+    assert exc.value.parameter == "--out"
 
 
 def test_the_command_refuses_a_bad_option_on_one_line(tmp_path, capsys, monkeypatch):

@@ -12,6 +12,7 @@ import pytest
 
 from poro2d.cli import main
 from poro2d.critical_state import CriticalStateCase, run_critical_state
+from poro2d.critical_state import run as run_module
 from poro2d.critical_state.calibrated import calibrated_values
 from poro2d.critical_state.line import CriticalStateLineResult, LineFit, run_critical_state_line
 from poro2d.errors import InputError
@@ -72,7 +73,7 @@ def test_the_line_fit_recovers_a_known_line_and_its_scatter():
         LineFit.through(np.array([100.0, 100.0]), np.array([0.2, 0.21]))
 
 
-def test_a_line_keeps_a_study_per_pressure_and_its_own_files(tmp_path):
+def test_a_line_keeps_a_study_per_pressure_and_its_own_files(tmp_path, monkeypatch):
     case = CriticalStateCase(**SMALL)
     result = run_critical_state_line(
         case, [50.0, 200.0], Store(tmp_path), seeds=1, options=RunOptions(workers=1)
@@ -91,6 +92,16 @@ def test_a_line_keeps_a_study_per_pressure_and_its_own_files(tmp_path):
     # the pressures' own studies are the single-pressure runs of the same cases, bit for bit
     alone = run_critical_state(case.at_pressure(200.0))
     assert result.studies[1].tests[0].stress_ratio == alone.stress_ratio
+    # each run was kept in its pressure's seed folder: a rerun after losing a study's files reads
+    # every seed back (no run again) and writes the same study
+    before = (tmp_path / "p50kPa" / "series.csv").read_bytes()
+    (tmp_path / "p50kPa" / "series.csv").unlink()
+    monkeypatch.setattr(run_module, "_compute", lambda *_: pytest.fail("a finished run ran again"))
+    again = run_critical_state_line(
+        case, [50.0, 200.0], Store(tmp_path), seeds=1, options=RunOptions(workers=1)
+    )
+    assert (tmp_path / "p50kPa" / "series.csv").read_bytes() == before
+    assert again.line.to_dict() == result.line.to_dict()
 
 
 @pytest.mark.parametrize("pressures", [[100.0], [50.0, 50.0], [50.0, 1e6]])

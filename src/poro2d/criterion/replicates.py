@@ -6,8 +6,8 @@ own seed, first trial the porosity the main seed accepted, in the sub-store ``se
 pass the criterion itself (a seed may settle on a neighbouring trial porosity: that is
 part of the spread). The runs are jobs of the executor's local processes
 (:mod:`poro2d.execute`) with one numba thread each: two threads on one specimen of a few
-thousand disks run only about 1.6 times as fast as one, two processes twice. Each run
-resumes from its own folder, so a rerun continues.
+thousand disks run only about 1.6 times as fast as one, two processes twice. A finished seed
+is read back from its folder without a process, an unfinished one resumes there.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from dataclasses import replace
 
 from poro2d.console import OutputConsole
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
-from poro2d.criterion.result import ReplicateRow, ReplicatesResult
+from poro2d.criterion.result import CriterionResult, ReplicateRow, ReplicatesResult
 from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
 from poro2d.grading import GradingCurve
@@ -34,6 +34,19 @@ def _run_one(spec: SpecimenSpec, grading: GradingCurve, settings: CriterionSetti
     report("running")
     t0 = time.perf_counter()
     res = PorosityCriterion(spec, grading, settings, seed=seed, store=store, progress=False).run()
+    return _row(res, seed, store, t0)
+
+
+def _stored(spec: SpecimenSpec, grading: GradingCurve, settings: CriterionSettings, seed: int, store: Store,
+            ) -> ReplicateRow | None:  # fmt: skip
+    """A finished replicate's row, read back here (no process started); None when it is to run
+    (a folder of another config is left to the run, which refuses it)."""
+    t0 = time.perf_counter()
+    data = PorosityCriterion(spec, grading, settings, seed=seed, store=store, progress=False).stage().stored()
+    return None if data is None else _row(CriterionResult.from_dict(data), seed, store, t0)
+
+
+def _row(res: CriterionResult, seed: int, store: Store, t0: float) -> ReplicateRow:
     return ReplicateRow(seed, res.final_porosity, bool(res.converged), len(res.iterations), res.message,
                         store.root.name, time.perf_counter() - t0)  # fmt: skip
 
@@ -61,7 +74,7 @@ def run_replicates(
             for sd in seeds]  # fmt: skip
     rows = complete_jobs(jobs, title="replicate criterion", what="replicate criterion run(s)",
                          options=options, workers=options.local_workers(len(jobs)),
-                         done_text=_outcome)  # fmt: skip
+                         finished=[_stored(*job.args) for job in jobs], done_text=_outcome)  # fmt: skip
     return ReplicatesResult(rows, store=store)
 
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from poro2d.critical_state.case import CriticalStateCase
 from poro2d.critical_state.results import CriticalStateResult, CriticalStateTestResult, void_ratio
-from poro2d.critical_state.run import KIND, MAX_SEEDS, seed_runs, study_of, write_study
+from poro2d.critical_state.run import KIND, MAX_SEEDS, seed_runs, seed_store, study_of, write_study
 from poro2d.errors import InputError, check_int
 from poro2d.execute import RunOptions
 from poro2d.io_utils import Provenance
@@ -351,9 +351,9 @@ def run_critical_state_line(
     ``marks``: (label, 2D void ratio) states to hold against the line (a specimen's 2D ends, a
     state as mapped): each gets its state parameter at every pressure;
     ``span``: the 2D e_max - e_min that normalises it. Every (pressure, seed) run is one job of
-    the executor. ``store``: the line's ``result.json``
-    and ``line.csv``, and per pressure a folder ``p<P>kPa/`` holding
-    what a one-pressure study holds. Call it under ``if __name__ == "__main__":`` in a script
+    the executor. ``store``: the line's ``result.json`` and ``line.csv``, and per pressure a
+    folder ``p<P>kPa/`` holding what a one-pressure study holds (its seeds' runs kept as they
+    finish, read back on a rerun). Call it under ``if __name__ == "__main__":`` in a script
     when it runs on several processes (``options``; worker processes import the calling script).
     """
     if not isinstance(case, CriticalStateCase):
@@ -366,14 +366,16 @@ def run_critical_state_line(
 
     def work() -> CriticalStateLineResult:
         t0 = time.perf_counter()
-        tests, workers = seed_runs([c for row in cases for c in row], options)
+        kept = [None if store is None else store.child(pressure_folder(p)) for p in values]
+        flat = [(c, at) for row, at in zip(cases, kept, strict=True) for c in row]
+        tests, workers = seed_runs([c for c, _ in flat], options, [seed_store(at, c) for c, at in flat])
         studies = []
         for k, row in enumerate(cases):
             studies.append(
                 study_of(row, tests[k * n : (k + 1) * n], workers, time.perf_counter() - t0, config)
             )
-            if store is not None:
-                write_study(store.child(pressure_folder(values[k])), row, studies[-1])
+            if kept[k] is not None:
+                write_study(kept[k], row, studies[-1])
         result = line_result(
             case, values, studies, processes=workers, wall_time_s=time.perf_counter() - t0, config=config,
             marks=marks, span=span,

@@ -25,6 +25,7 @@ from poro2d.critical_state.cell import (
     mean_overlap_ratio,
     shear_rate,
 )
+from poro2d.critical_state.record import SERIES_CSV, folder_stage, stored_run
 from poro2d.critical_state.results import (
     CriticalStateResult,
     CriticalStateTestResult,
@@ -86,15 +87,29 @@ def run_critical_state(
 ) -> CriticalStateTestResult:
     """One periodic shear run of ``case``: its steady state and the series.
 
-    ``store``: where ``result.json`` and ``series.csv`` go (None: nothing kept; the figure is
-    drawn from the result by ``draw_critical_state`` (``report/critical_state_figures.py``)).
-    ``report(phase, fraction)``: told how far the run is. Raises RuntimeError if the
-    compression does not reach the pressure.
+    ``store``: where ``series.csv`` and ``result.json`` go, bound to the case by ``test.json``
+    (:mod:`poro2d.critical_state.record`): a finished run of the case is read back, a folder of
+    another case's run refused (None: nothing kept; the figure is drawn from the result by
+    ``draw_critical_state`` (``report/critical_state_figures.py``)). ``report(phase, fraction)``:
+    told how far the run is. Raises RuntimeError if the compression does not reach the pressure.
     """
     if not isinstance(case, CriticalStateCase):
         raise InputError("case", type(case).__name__, "a CriticalStateCase")
     if store is not None and not isinstance(store, Store):
         raise InputError("store", type(store).__name__, "a poro2d.store.Store or None")
+    if store is None:
+        return _compute(case, report)
+    done = stored_run(store, case)  # a folder of another case's run is refused here, before any step
+    if done is None:
+        done = _compute(case, report)
+        # the series first: the result, written by the stage, is the marker of a finished run
+        store.write_csv(SERIES_CSV, done.series.rows(), header=list(COLUMNS))
+        folder_stage(store, case).run(lambda: done)
+    return done
+
+
+def _compute(case: CriticalStateCase, report: Report | None) -> CriticalStateTestResult:
+    """Build, compress and shear the cell; read its steady state (nothing kept)."""
     t0 = time.perf_counter()
     cell = loose_cell(case)
     compression = compress(
@@ -104,7 +119,7 @@ def run_critical_state(
     series, steps, rebuilds, overlap = _shear(cell, case, rate, report)
     wall = time.perf_counter() - t0
     state = read_steady(series, case.window_start, case.blocks, case.mu_drift_limit, case.solid_drift_limit)
-    result = CriticalStateTestResult.of(
+    return CriticalStateTestResult.of(
         state,
         disks=cell.n,
         mean_diameter_m=mean_diameter(cell),
@@ -123,22 +138,25 @@ def run_critical_state(
         mean_overlap_ratio=overlap,
         series=series,
     )
-    if store is not None:
-        store.write_csv("series.csv", series.rows(), header=list(COLUMNS))
-        store.write_result("result.json", result)
-    return result
 
 
 @dataclass(frozen=True)
 class SeedJob:
-    """One seed's run (a value that pickles: a worker process runs it)."""
+    """One seed's run (a value that pickles: a worker process runs it), kept in ``store`` (None:
+    nothing kept)."""
 
     case: CriticalStateCase
     label: str
+    store: Store | None = None
+
+    def stored(self) -> CriticalStateTestResult | None:
+        """The run when its store holds it finished (read here: no process started); a folder
+        holding another case's run is refused here, before any seed runs."""
+        return None if self.store is None else stored_run(self.store, self.case)
 
 
 def _run_job(job: SeedJob, report) -> CriticalStateTestResult:
-    return run_critical_state(job.case, report=report)
+    return run_critical_state(job.case, job.store, report=report)
 
 
 def run_critical_states(
@@ -151,7 +169,8 @@ def run_critical_states(
 ) -> CriticalStateResult:
     """``case`` on ``seeds`` seeds (case.seed, case.seed + 1, ...): each number's spread over them.
 
-    ``store``: where ``result.json`` and ``series.csv`` (every seed's rows) go;
+    ``store``: where ``result.json`` and ``series.csv`` (every seed's rows) go, and each seed's
+    run as it finishes, in ``seed<N>/`` (a rerun after a kill reads the finished seeds back);
     ``options``: where the seeds run (``workers`` processes, default one per seed and at most
     one per core, or a running ``scheduler``) and whether bars show. Several processes spawn
     workers that import the calling script: call it under
@@ -171,7 +190,7 @@ def run_critical_states(
 
 def _study(cases, store, options, config) -> CriticalStateResult:
     t0 = time.perf_counter()
-    tests, workers = seed_runs(cases, options)
+    tests, workers = seed_runs(cases, options, [seed_store(store, c) for c in cases])
     result = study_of(cases, tests, workers, time.perf_counter() - t0, config)
     if store is not None:
         write_study(store, cases, result)
@@ -179,17 +198,23 @@ def _study(cases, store, options, config) -> CriticalStateResult:
 
 
 def seed_runs(
-    cases: list[CriticalStateCase], options: RunOptions
+    cases: list[CriticalStateCase], options: RunOptions, stores: list[Store | None]
 ) -> tuple[list[CriticalStateTestResult], int]:
     """Every case one job of the executor (local processes: default one per case, at most one per
-    core); the results in the cases' order and the number of workers. Raises if any failed."""
+    core), kept in its store of ``stores`` (None: nothing kept) where finished ones are read back;
+    the results in the cases' order and the number of workers. Raises if any failed."""
     workers = options.local_workers(len(cases))
-    jobs = [SeedJob(c, _label(c, cases)) for c in cases]
+    jobs = [SeedJob(c, _label(c, cases), s) for c, s in zip(cases, stores, strict=True)]
     results = complete_jobs(
         [Job(_run_job, (job,), job.label, reports=True) for job in jobs], title="critical state",
-        what="periodic shear run(s)", options=options, workers=workers,
+        what="periodic shear run(s)", options=options, workers=workers, finished=[j.stored() for j in jobs],
     )  # fmt: skip
     return results, workers
+
+
+def seed_store(store: Store | None, case: CriticalStateCase) -> Store | None:
+    """Where a study kept in ``store`` keeps ``case``'s run: ``seed<N>/`` (None: nothing kept)."""
+    return None if store is None else store.child(f"seed{case.seed}")
 
 
 def _label(case: CriticalStateCase, cases: list[CriticalStateCase]) -> str:
@@ -201,7 +226,7 @@ def _label(case: CriticalStateCase, cases: list[CriticalStateCase]) -> str:
 def write_study(store: Store, cases: list[CriticalStateCase], result: CriticalStateResult) -> None:
     """A study's ``series.csv`` (every seed's rows), then ``result.json``."""
     rows = [{"seed": c.seed, **r} for c, t in zip(cases, result.tests, strict=True) for r in t.series.rows()]
-    store.write_csv("series.csv", rows, header=["seed", *COLUMNS])
+    store.write_csv(SERIES_CSV, rows, header=["seed", *COLUMNS])
     store.write_result("result.json", result)
 
 
@@ -244,6 +269,7 @@ __all__ = [
     "run_critical_state",
     "run_critical_states",
     "seed_runs",
+    "seed_store",
     "study_of",
     "write_study",
 ]
