@@ -116,8 +116,43 @@ class CalibrationCase:
         keep_box_dominated: bool = False,
         discrepancy: str | float = "auto",
     ) -> CalibrationCase:
-        """The case of the given options (their meaning: :func:`~poro2d.calibration.run.run_calibration`),
-        every one checked and every file read here, so that a bad one is refused before any test."""
+        """The case of the given options, every one checked and every file read here, so that a bad
+        one is refused before any test.
+
+        ``specimens``: checkpoints or criterion folders, or ``preset="paper"`` (``quick``: the small box)
+        with ``replicates`` seeds from ``seed``. ``fp_range``, ``mu_r_range``: the search ranges.
+        ``kn_range``, ``ks_range``: (low, high) N/m to calibrate the disks' normal and shear stiffness
+        too, searched in their logarithm (None: the specimen's, or the settings'); with either, the
+        posterior is sampled with emcee (docs/calibration.md). ``points``: the space-filling design's
+        size; ``refine``: points of the second round, drawn from the posterior (0: none).
+        ``lab_error``: the laboratory's own error as a fraction of each value, added to the seed
+        scatter. ``level``: of the credible intervals. ``stations``: with laboratory curves, each curve
+        is also read (shear stress, and the plate's rise when given) at ``stations`` - 1 evenly spaced
+        displacements before its end (1: peaks, end values and dilation only). ``settings``: shear
+        settings of every test (the quick preset's ``max_displacement`` 4 mm by default).
+
+        ``lab`` may be a list: repeats of one laboratory programme (the same normal stresses and
+        readings, new specimens). Their mean values are fitted and the laboratory's share of the noise
+        is one simulated specimen's scatter over their number, scaled up when the repeats scatter more
+        (:mod:`poro2d.calibration.lab_repeats`).
+
+        ``biaxial_lab`` instead of ``lab``: laboratory biaxial tests (one CSV or several, rows named by
+        ``confining_stress_kpa``; or a :class:`poro2d.biaxial.lab.LabTests`, which ``lab`` also takes):
+        every unit is then a biaxial test at a laboratory confining stress, the targets its stress
+        ratios and volumetric strain (:mod:`poro2d.calibration.biaxial`), and ``settings`` are biaxial
+        settings (``max_strain`` 0.2 by default).
+
+        A design point any of whose direct shear tests is box-dominated (:mod:`poro2d.shear.box_dominated`:
+        its shear plane carries outside 0.7-1.3 times the plate's load at the peak, or its stress never
+        peaked) is left out of the fit, and the result says how many were (``box_dominated``); too few
+        left for the surrogate is no answer. ``keep_box_dominated``: fit them all the same (a box where
+        every test is box-dominated: the frictions then describe the box).
+
+        ``discrepancy``: the model-discrepancy term (:mod:`poro2d.calibration.discrepancy`): ``estimate``
+        (integrated over its unknown size), ``none`` (the noise covariance alone), ``auto`` (``none`` for
+        laboratory files poro2d wrote itself, else ``estimate``) or a fixed size in each observable's
+        noise sd.
+        """
         repeats = read_lab(lab, biaxial_lab)
         biaxial = isinstance(repeats, LabTests)
         lab_data = repeats if biaxial else repeats.first

@@ -299,46 +299,12 @@ class CalibrationResult(TypedResult):
 def run_calibration(
     case: CalibrationCase, store: Store | None = None, *, options: RunOptions = RunOptions()
 ) -> CalibrationResult:
-    """Calibrate f_p and mu_r (and kn, ks when ranged) of ``case`` on its replicate specimens; keeps
-    ``result.json`` in ``store``.
-
-    ``case``: a :class:`~poro2d.calibration.case.CalibrationCase` (``CalibrationCase.of(lab, specimens,
-    ...)``, every option checked there). ``specimens``: checkpoints or criterion folders, or
-    ``preset="paper"`` (``quick``: the small box) with ``replicates`` seeds from ``seed``, made in
-    ``store``. ``fp_range``, ``mu_r_range``: the search ranges. ``kn_range``, ``ks_range``: (low, high)
-    N/m to calibrate the disks' normal and shear stiffness too, searched in their logarithm (None: the
-    specimen's, or the settings'); with either, the posterior is sampled with emcee (docs/calibration.md).
-    ``points``: the space-filling design's size; ``refine``: points of the
-    second round, drawn from the posterior (0: none). ``lab_error``: the laboratory's own
-    error as a fraction of each value, added to the seed scatter. ``level``: of the
-    credible intervals. ``stations``: with laboratory curves, each curve is also read (shear stress,
-    and the plate's rise when given) at ``stations`` - 1 evenly spaced displacements before its end
-    (1: peaks, end values and dilation only). ``settings``: shear settings of every test (the quick preset's
-    ``max_displacement`` 4 mm by default). ``options``: where the jobs run and whether bars show
-    (:class:`~poro2d.execute.options.RunOptions`, as the sweeps).
-    A rerun reuses every finished shear test (cached by content in the store's ``cache``);
-    ``store=None`` keeps nothing (every test runs, no figure or report is made).
-
-    ``lab`` may be a list: repeats of one laboratory programme (the same normal stresses and
-    readings, new specimens). Their mean values are fitted and the laboratory's share of the noise
-    is one simulated specimen's scatter over their number, scaled up when the repeats scatter more
-    (:mod:`poro2d.calibration.lab_repeats`).
-
-    ``biaxial_lab`` instead of ``lab``: laboratory biaxial tests (one CSV or several, rows named by
-    ``confining_stress_kpa``; or a :class:`poro2d.biaxial.lab.LabTests`, which ``lab`` also takes):
-    every unit is then a biaxial test at a laboratory confining stress, the targets its stress
-    ratios and volumetric strain (:mod:`poro2d.calibration.biaxial`), and ``settings`` are biaxial
-    settings (``max_strain`` 0.2 by default).
-
-    A design point any of whose direct shear tests is box-dominated (:mod:`poro2d.shear.box_dominated`:
-    its shear plane carries outside 0.7-1.3 times the plate's load at the peak, or its stress never
-    peaked) is left out of the fit, and the result says how many were (``box_dominated``); too few
-    left for the surrogate is no answer. ``keep_box_dominated``: fit them all the same (a box where
-    every test is box-dominated: the frictions then describe the box).
-
-    ``discrepancy``: the model-discrepancy term (:mod:`poro2d.calibration.discrepancy`): ``estimate``
-    (integrated over its unknown size), ``none`` (the noise covariance alone), ``auto`` (``none`` for
-    laboratory files poro2d wrote itself, else ``estimate``) or a fixed size in each observable's noise sd.
+    """Calibrate f_p and mu_r (and kn, ks when ranged) of ``case`` (a
+    :class:`~poro2d.calibration.case.CalibrationCase`: what each option means) on its replicate
+    specimens; keeps ``result.json`` in ``store``. ``options``: where the jobs run and whether bars
+    show (:class:`~poro2d.execute.options.RunOptions`, as the sweeps). A rerun reuses every finished
+    shear test (cached by content in the store's ``cache``); ``store=None`` keeps nothing (every test
+    runs, no figure or report is made; a preset's specimens need a store).
     """
     t0 = time.perf_counter()
     if not isinstance(case, CalibrationCase):

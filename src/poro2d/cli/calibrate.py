@@ -124,29 +124,19 @@ def register(app: typer.Typer) -> None:
             **({"discrepancy": discrepancy} if discrepancy != "auto" else {}),
         }
         run = opt.job_options(workers, scheduler, quiet, dashboard)  # a scheduler that does not answer: now
+        ranges = {
+            name: parse_range(f"--{name.replace('_', '-')}", text, default)
+            for name, text, default in (("fp_range", fp_range, DEFAULT_FP_RANGE),
+                                        ("mu_r_range", mu_r_range, DEFAULT_MU_R_RANGE),
+                                        ("kn_range", kn_range, None), ("ks_range", ks_range, None))
+        }  # fmt: skip
         case = CalibrationCase.of(
-            (lab[0] if len(lab) == 1 else list(lab)) if lab else None,
-            list(specimen or []),
-            biaxial_lab=list(biaxial_lab) if biaxial_lab else None,
-            preset=preset,
-            quick=quick,
-            replicates=replicates,
-            seed=seed,
-            fp_range=parse_range("--fp-range", fp_range, DEFAULT_FP_RANGE),
-            mu_r_range=parse_range("--mu-r-range", mu_r_range, DEFAULT_MU_R_RANGE),
-            kn_range=parse_range("--kn-range", kn_range, None),
-            ks_range=parse_range("--ks-range", ks_range, None),
-            points=points,
-            refine=refine,
-            design_seed=design_seed,
-            lab_error=lab_error,
-            level=level,
-            stations=stations,
-            settings=settings,
-            config={"cli": options},
-            keep_box_dominated=keep_box_dominated,
-            discrepancy=discrepancy,
-        )
+            (lab[0] if len(lab) == 1 else list(lab)) if lab else None, list(specimen or []),
+            biaxial_lab=list(biaxial_lab) if biaxial_lab else None, settings=settings,
+            config={"cli": options}, preset=preset, quick=quick, replicates=replicates, seed=seed, **ranges,
+            points=points, refine=refine, design_seed=design_seed, lab_error=lab_error, level=level,
+            stations=stations, keep_box_dominated=keep_box_dominated, discrepancy=discrepancy,
+        )  # fmt: skip
         store = Store(out)
         try:
             result = run_calibration(case, store, options=run)
