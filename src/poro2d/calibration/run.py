@@ -326,7 +326,7 @@ def run_calibration(
         check_quasi_static(found, case.lab.confining_stresses(), case.base)
     runner = UnitRunner(options)
     try:
-        post, surrogates, table = _rounds(case, found, runner, _child(store, CACHE))
+        post, surrogates, table = _rounds(case, found, runner, None if store is None else store.child(CACHE))
     except TooFewPoints as exc:
         if not case.quick or case.biaxial:
             raise
@@ -365,10 +365,6 @@ def smallest_box(found: SpecimenSet) -> BoxScale:
     """The :class:`BoxScale` of the narrowest box (in largest grains) among the read specimens."""
     scales = [box_scale(*s.box(), s.arrays["particles.radius"]) for s in found.contents()]
     return min(scales, key=lambda b: b.width_over_d_max)
-
-
-def _child(store: Store | None, name: str) -> Store | None:
-    return None if store is None else store.child(name)
 
 
 def _units(design, specimens: SpecimenSet, stresses, base, make=replicate_unit, axes=("fp", "mu_r")) -> list:
