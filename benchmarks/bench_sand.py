@@ -62,7 +62,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
 
     from poro2d.execute.options import RunOptions
-    from poro2d.sand import run_sand
+    from poro2d.sand import load_sand_case, run_sand
     from poro2d.store import Store
 
     scratch = tempfile.mkdtemp(prefix="bench-sand-")
@@ -71,8 +71,8 @@ def main(argv: list[str] | None = None) -> int:
     stages: list[tuple[float, str]] = []
     t0 = time.perf_counter()
     res = run_sand(
-        _config(args.config, args.calibration_seeds),
-        store=Store(out),
+        load_sand_case(_config(args.config, args.calibration_seeds)),
+        Store(out),
         options=RunOptions(workers=args.workers, progress=False),
         announce=lambda line: stages.append((time.perf_counter() - t0, line)),
     )

@@ -37,7 +37,7 @@ def main() -> None:
     ap.add_argument("--keep", type=Path, default=None)
     args = ap.parse_args()
 
-    from poro2d.shear import run_shear
+    from poro2d.shear import ShearSeriesCase, run_shear
     from poro2d.store import Store
 
     out = args.keep or Path(tempfile.mkdtemp(prefix="poro2d-box-bias-"))
@@ -49,9 +49,11 @@ def main() -> None:
             settings = {"friction_wall": mu_wall, "local_damping": alpha,
                         "max_displacement": args.max_displacement}  # fmt: skip
             t0 = time.perf_counter()
-            series = run_shear(args.specimen, args.normal_stress, settings,
-                               store=Store(out / f"wall{mu_wall:g}_damping{alpha:g}"),
-                               options=RunOptions(workers=args.workers, progress=False))  # fmt: skip
+            series = run_shear(
+                ShearSeriesCase(args.specimen, args.normal_stress, settings),
+                Store(out / f"wall{mu_wall:g}_damping{alpha:g}"),
+                options=RunOptions(workers=args.workers, progress=False),
+            )
             wall_s = time.perf_counter() - t0
             for t in series.tests:
                 share = t.plane_load_fraction_at_peak

@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 from poro2d.biaxial.quick import QuickSpecimen
-from poro2d.calibration import run_calibration, synthetic_biaxial_lab
+from poro2d.calibration import CalibrationCase, run_calibration, synthetic_biaxial_lab
 from poro2d.dem import checkpoint
 from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance
@@ -76,11 +76,19 @@ def keep_cache(out: Path, folder: Path) -> None:
 
 def calibrate(lab: Path, replicates: list[Path], out: Path, mode: str, args) -> dict:
     result = run_calibration(
-        biaxial_lab=str(lab), specimens=[str(p) for p in replicates], store=Store(out),
-        fp_range=FP_RANGE, mu_r_range=MU_R_RANGE, points=args.points, refine=0,
-        settings={"max_strain": args.strain}, options=RunOptions(workers=args.workers, progress=False),
-        discrepancy=mode,
-    )  # fmt: skip
+        CalibrationCase.of(
+            biaxial_lab=str(lab),
+            specimens=[str(p) for p in replicates],
+            fp_range=FP_RANGE,
+            mu_r_range=MU_R_RANGE,
+            points=args.points,
+            refine=0,
+            settings={"max_strain": args.strain},
+            discrepancy=mode,
+        ),
+        Store(out),
+        options=RunOptions(workers=args.workers, progress=False),
+    )
     fp, mu_r = result.intervals["particle_friction"], result.intervals["rolling_friction"]
     term = result.posterior.get("discrepancy")
     return {

@@ -21,6 +21,7 @@ from poro2d.criterion.result import CriterionResult, ReplicateRow
 from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance
 from poro2d.paper_data import PAPER, QUICK_SHEAR
+from poro2d.shear.lab import LabData, read_lab_csv
 from poro2d.shear.parts import LabRecord, QuasiStatic, ShearTestSummary
 from poro2d.shear.results import ReplicateShearResult
 from poro2d.specimen.specimen_set import SpecimenSet
@@ -207,20 +208,33 @@ def conversion_files(store: Store) -> ConversionsRecord:
                              figures=[str(f.name) for f in figs], provenance=Provenance.now())  # fmt: skip
 
 
+@dataclass(frozen=True, eq=False)
+class PaperCase:
+    """The case study's choices, checked when made: ``quick`` (the reduced specimen), the first
+    specimen's ``seed``, ``replicates`` specimens (1-20) for direct shear, a laboratory CSV ``lab``
+    (a path, read here: a bad file fails before any simulation) overlaid on Fig. 8, and ``threads``
+    of the DEM kernels (None: at most two)."""
+
+    quick: bool = False
+    seed: int = 0
+    replicates: int = 3
+    lab: LabData | str | Path | None = None
+    threads: int | None = None
+
+    def __post_init__(self) -> None:
+        from poro2d.errors import check_int
+
+        object.__setattr__(self, "seed", check_int("--seed", self.seed, 0))
+        object.__setattr__(self, "replicates", check_int("--replicates", self.replicates, 1, 20))
+        if self.lab is not None and not isinstance(self.lab, LabData):
+            object.__setattr__(self, "lab", read_lab_csv(self.lab))
+
+
 @claims(KIND)
-def run_paper(
-    store: Store,
-    *,
-    quick: bool = False,
-    lab: str | Path | None = None,
-    seed: int = 0,
-    threads: int | None = None,
-    replicates: int = 3,
-    options: RunOptions = RunOptions(),
-) -> PaperSummary:
-    """The paper's case study: conversions, the criterion (Fig. 3), direct shear on replicate
-    specimens (Fig. 8), the report. Resumable: finished stages are read back. ``options``: whether
-    bars show (:class:`~poro2d.execute.options.RunOptions`).
+def run_paper(case: PaperCase, store: Store, *, options: RunOptions = RunOptions()) -> PaperSummary:
+    """The paper's case study of ``case``: conversions, the criterion (Fig. 3), direct shear on
+    replicate specimens (Fig. 8), the report, kept in ``store``. Resumable: finished stages are read
+    back. ``options``: whether bars show (:class:`~poro2d.execute.options.RunOptions`).
 
     Returns the summary kept as the store's ``results.json``; ``summary.criterion.converged``
     says whether the criterion found its porosity (no shear tests otherwise).
@@ -228,28 +242,20 @@ def run_paper(
     import os
 
     from poro2d.criterion.protocol import PorosityCriterion
-    from poro2d.errors import check_int
     from poro2d.io_utils import check_output_dir
 
     out = store.root
-    seed = check_int("--seed", seed, 0)
-    replicates = check_int("--replicates", replicates, 1, 20)
     check_output_dir(store.parameter, out)
+    quick, seed = case.quick, case.seed
     cfg = paper_config(quick, seed)
-    lab_data = None
-    if lab is not None:
-        from poro2d.shear.lab import read_lab_csv
-
-        lab_data = read_lab_csv(lab)  # bad lab files fail here, before any simulation
-    nthreads = threads if threads is not None else min(os.cpu_count() or 1, 2)
+    nthreads = case.threads if case.threads is not None else min(os.cpu_count() or 1, 2)
     spec, grading, settings, sd = cfg.build(threads=nthreads)
     crit = PorosityCriterion(spec, grading, settings, seed=sd, store=store.child("criterion"),
                              progress=options.progress, config=cfg.as_config())  # fmt: skip
     crit.validate()  # every option is checked before the first file is written
     stage = paper_stage(store, quick, seed)
     stage.check()  # and the folder: one of another paper run is refused before anything is written
-    summary, criterion, shear_figures = _run_stages(store, stage, crit, quick=quick, replicates=replicates,
-                                                    lab_data=lab_data, progress=options.progress)  # fmt: skip
+    summary, criterion, shear_figures = _run_stages(store, stage, crit, case, progress=options.progress)
     store.write_result("results.json", summary)
     from poro2d.calibration.run import CalibrationResult
     from poro2d.report.paper_report import CALIBRATION_FOLDER, write_paper_report
@@ -263,8 +269,8 @@ def run_paper(
     return summary
 
 
-def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, *, quick: bool, replicates: int,
-                lab_data, progress: bool) -> tuple[PaperSummary, CriterionOutputs, dict]:  # fmt: skip
+def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, case: PaperCase, *,
+                progress: bool) -> tuple[PaperSummary, CriterionOutputs, dict]:  # fmt: skip
     """Conversions, criterion, replicate specimens and direct shear (each read back when done).
 
     Returns the summary, the criterion's results (its side files read through their classes)
@@ -274,6 +280,7 @@ def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, *,
     from poro2d.criterion.table import print_result
     from poro2d.report.criterion_figures import draw_criterion, draw_stored_criterion
 
+    quick, replicates, lab_data = case.quick, case.replicates, case.lab
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
     conv = _conversions_stage(store, stage)

@@ -12,10 +12,11 @@ import pytest
 
 from poro2d.biaxial.lab import LabCurve, LabTests, read_lab_tests
 from poro2d.biaxial.settings import BiaxialSettings
-from poro2d.calibration import model, run_calibration, synthetic_biaxial_lab
+from poro2d.calibration import model, synthetic_biaxial_lab
 from poro2d.calibration.biaxial import base_settings, biaxial_targets
 from poro2d.calibration.biaxial_units import BiaxialUnit, biaxial_unit_key
-from poro2d.calibration.run import CALIBRATED, CalibrationResult, _base_settings
+from poro2d.calibration.case import CALIBRATED, shear_base_settings
+from poro2d.calibration.run import CalibrationResult
 from poro2d.calibration.units import (
     CalibrationUnit,
     observable_unit,
@@ -27,6 +28,7 @@ from poro2d.errors import InputError
 from poro2d.execute.options import RunOptions
 from poro2d.report.calibration_figures import draw_calibration
 from poro2d.store import Store
+from tests.calibration import calibrate
 
 QUIET = RunOptions(progress=False)
 ONE_WORKER = RunOptions(workers=1, dashboard=None, progress=False)
@@ -172,7 +174,7 @@ def test_a_biaxial_units_key_is_stable_and_never_a_shear_key():
     )
     assert pickle.loads(pickle.dumps(unit)) == unit and (unit.fp, unit.mu_r) == (0.8, 0.15)
     shear = CalibrationUnit.at(
-        "s.npz", "ab" * 32, 100.0, _base_settings({"max_displacement": 0.002}), 0.8, 0.15
+        "s.npz", "ab" * 32, 100.0, shear_base_settings({"max_displacement": 0.002}), 0.8, 0.15
     )
     assert shear.key == "47911f67c9214a97b5a2"  # the shear keys are those of earlier calibrations
     assert shear.key != unit.key
@@ -180,7 +182,7 @@ def test_a_biaxial_units_key_is_stable_and_never_a_shear_key():
 
 def _refused(**kw):
     with pytest.raises(InputError) as exc:
-        run_calibration(options=QUIET, **kw)
+        calibrate(options=QUIET, **kw)
     return str(exc.value)
 
 
@@ -298,7 +300,7 @@ def test_a_small_synthetic_biaxial_calibration_fits_the_ratios_and_the_volumetri
     )
     out = tmp_path / "cal"
     kw = dict(specimens=paths[:2], store=Store(out), points=9, refine=0, settings=FAST, options=ONE_WORKER)
-    res = run_calibration(biaxial_lab=lab, **kw)
+    res = calibrate(biaxial_lab=lab, **kw)
     draw_calibration(res, Store(out))  # the figures and the report, as the command draws them
     assert res.test == "biaxial" and res.cluster.tests_run == 9 * 2 and res.box_scale is None
     assert list(res.fit) == ["peak_ratio_50kPa", "end_ratio_50kPa", "end_volumetric_50kPa"]
@@ -327,7 +329,7 @@ def test_a_small_synthetic_biaxial_calibration_fits_the_ratios_and_the_volumetri
     table = load_biaxial_config(out / "calibrated.toml")
     assert table.build().particle_friction == res.best.particle_friction
     assert (out / "calibration_fit.png").stat().st_size > 0
-    again = run_calibration(biaxial_lab=lab, **kw)
+    again = calibrate(biaxial_lab=lab, **kw)
     assert (
         again.cluster.tests_run == 0
         and again.cluster.tests_reused == 18

@@ -10,7 +10,8 @@ import pytest
 
 from poro2d.calibration import model
 from poro2d.calibration.box_dominated import BoxDominatedPoint, BoxDominatedPoints, with_box_note
-from poro2d.calibration.run import MIN_POINTS, CalibrationResult, _base_settings, _infer, _units
+from poro2d.calibration.case import MIN_POINTS, CalibrationCase, shear_base_settings
+from poro2d.calibration.run import CalibrationResult, _infer, _units
 from poro2d.calibration.units import CalibrationUnit, UnitRow, stored_row
 from poro2d.cli import main
 from poro2d.paper_data import QUICK_BOX_SOIL_LIKE
@@ -22,7 +23,7 @@ RANGES = model.Ranges((0.3, 3.0), (0.0, 0.5))
 STRESSES = [50.0, 100.0]
 TARGETS = [("peak", 50.0, 40.0), ("peak", 100.0, 75.0)]
 FOUND = SpecimenSet(tuple("ab"), tuple(Path(f"{k}.npz") for k in "ab"), tuple(k * 64 for k in "ab"))
-BASE = _base_settings({"max_displacement": 0.002})
+BASE = shear_base_settings({"max_displacement": 0.002})
 TRAVEL = QUICK_BOX_SOIL_LIKE["max_displacement"]  # m: long enough for the quick box to peak
 CALIBRATION = "calibration_result.json"  # a calibration's file written before the flag
 
@@ -129,6 +130,7 @@ def test_the_command_refuses_on_one_line_when_too_few_points_are_left(tmp_path, 
         _infer(RANGES, design, FOUND, STRESSES, _rows(design, set(range(MIN_POINTS))), TARGETS, 0.0)
 
     monkeypatch.setattr(run, "run_calibration", refused)
+    monkeypatch.setattr(CalibrationCase, "of", classmethod(lambda cls, *args, **kwargs: None))
     lab = tmp_path / "lab.csv"
     lab.write_text("normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,75\n")
     with pytest.raises(SystemExit) as exc:
@@ -139,7 +141,7 @@ def test_the_command_refuses_on_one_line_when_too_few_points_are_left(tmp_path, 
 
 
 def test_a_unit_cached_before_the_flag_is_judged_from_its_curve_under_the_same_key(specimen, tmp_path):
-    base = _base_settings({"max_displacement": 0.0005, "peak_window": 2e-4})
+    base = shear_base_settings({"max_displacement": 0.0005, "peak_window": 2e-4})
     found = SpecimenSet.named([specimen]).read()
     unit = CalibrationUnit.at(specimen, found.digest(next(iter(found))), 100.0, base, 0.5, 0.1)
     cache = Store(tmp_path / "cache")

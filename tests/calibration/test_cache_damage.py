@@ -5,14 +5,14 @@ import numpy as np
 import pytest
 
 import poro2d.calibration.cluster as cluster
+from poro2d.calibration.case import shear_base_settings
 from poro2d.calibration.cluster import UnitRunner
-from poro2d.calibration.run import _base_settings
 from poro2d.calibration.units import CalibrationUnit, UnitRow, check_entry
 from poro2d.errors import InputError
 from poro2d.execute import Backend, Executor, RunOptions
 from poro2d.store import Store
 
-BASE = _base_settings({"max_displacement": 0.002})
+BASE = shear_base_settings({"max_displacement": 0.002})
 
 
 def _unit(sigma: float = 50.0, specimen="s.npz") -> CalibrationUnit:

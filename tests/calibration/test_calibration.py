@@ -9,7 +9,7 @@ import shutil
 import numpy as np
 import pytest
 
-from poro2d.calibration import model, run_calibration, synthetic_lab
+from poro2d.calibration import CalibrationCase, model, run_calibration, synthetic_lab
 from poro2d.cli import main
 from poro2d.cli.shear import load_shear_config
 from poro2d.dem import checkpoint
@@ -19,6 +19,7 @@ from poro2d.report.calibration_figures import draw_calibration
 from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
 from poro2d.store import Store
+from tests.calibration import calibrate
 
 QUIET = RunOptions(progress=False)
 ONE_WORKER = RunOptions(workers=1, dashboard=None, progress=False)
@@ -138,7 +139,7 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     paths, lab = tiny
     assert lab.read_text().startswith("# SYNTHETIC")
     out = tmp_path / "cal"
-    res = run_calibration(lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2, settings=SHORT,
+    res = calibrate(lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2, settings=SHORT,
                           options=ONE_WORKER, **FIT_BOX)  # fmt: skip
     draw_calibration(res, Store(out))  # the figures and the report, as the command draws them
     for name, value in TRUTH.items():
@@ -166,15 +167,15 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     table, _ = load_shear_config(out / "calibrated.toml")
     assert table["particle_friction"] == res.best.particle_friction
     assert table["rolling_friction"] == res.best.rolling_friction
-    again = run_calibration(lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2, settings=SHORT,
+    again = calibrate(lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2, settings=SHORT,
                             options=ONE_WORKER, **FIT_BOX)  # fmt: skip
     assert again.cluster.tests_run == 0 and again.cluster.tests_reused == 44
     assert again.best.to_dict() == res.best.to_dict()
     # the same series given twice is two repeats that agree: their mean is the same values, the
     # laboratory's share of the noise halves, so the intervals narrow (from the cache, no test)
-    twice = run_calibration([lab, lab], [paths[0], paths[1]], store=Store(tmp_path / "twice"), points=9,
+    twice = calibrate([lab, lab], [paths[0], paths[1]], store=Store(tmp_path / "twice"), points=9,
                             refine=0, settings=SHORT, options=ONE_WORKER, **FIT_BOX)  # fmt: skip
-    once = run_calibration(lab, [paths[0], paths[1]], store=Store(tmp_path / "once"), points=9, refine=0,
+    once = calibrate(lab, [paths[0], paths[1]], store=Store(tmp_path / "once"), points=9, refine=0,
                            settings=SHORT, options=ONE_WORKER, **FIT_BOX)  # fmt: skip
     assert twice.posterior.lab_repeats == 2 and twice.posterior.lab_scatter_ratio == 0.0
     assert "lab_repeats" not in once.posterior.to_dict()
@@ -186,7 +187,7 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     # parameters: the calibration follows its data (round 1 comes from the cache)
     weak_lab = synthetic_lab(paths[2], [50, 100], 0.3, 0.0, tmp_path / "weak_dilation.csv", settings=SHORT)
     weak_lab = _without_vertical(weak_lab, tmp_path / "weak.csv")
-    weak = run_calibration(weak_lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2,
+    weak = calibrate(weak_lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2,
                            settings=SHORT, options=ONE_WORKER, **FIT_BOX)  # fmt: skip
     peaks = {o.normal_stress_kpa: o.model_kpa for o in res.posterior.observables if o.observable == "peak"}
     for o in weak.posterior.observables:
@@ -220,7 +221,7 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
     """With the plate's rise in the lab curves, the calibration fits ``dilation_<s>kPa`` (mm) beside
     the peaks and end stresses, from the same shear tests (their keys do not change: a calibration
     on the plain file reuses them all)."""
-    from poro2d.calibration.run import _base_settings, _lab_targets
+    from poro2d.calibration.case import lab_targets, shear_base_settings
     from poro2d.calibration.specimens import replicate_unit
     from poro2d.calibration.units import CalibrationUnit, end_rise_mm, stored_row
     from poro2d.shear.lab import read_lab_csv
@@ -237,7 +238,7 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
         options=ONE_WORKER,
         **FIT_BOX,
     )
-    res = run_calibration(lab, [paths[0], paths[1]], **kw)
+    res = calibrate(lab, [paths[0], paths[1]], **kw)
     draw_calibration(res, Store(out))
     keys = [f"{o}_{s}kPa" for o in ("peak", "end", "dilation") for s in (50, 100)]
     assert list(res.fit) == keys
@@ -248,7 +249,7 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
         assert 0.0 < fit["seed_scatter_mm"] < 1.0  # mm, not kPa: a 3 cm specimen rises by tenths of mm
         assert "seed_scatter_kpa" in saved["fit"][f"peak_{s}kPa"]
     fitted = {(o["observable"], o["normal_stress_kpa"]): o for o in saved["posterior"]["observables"]}
-    targets = _lab_targets(read_lab_csv(lab), _base_settings(SHORT))
+    targets = lab_targets(read_lab_csv(lab), shear_base_settings(SHORT))
     for obs, s, y in targets:
         o = fitted[(obs, s)]
         unit = "mm" if obs == "dilation" else "kpa"
@@ -262,7 +263,7 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
     digest = res.specimens  # labels -> files; the units of the first point, specimen by specimen
     found = SpecimenSet.named([paths[0], paths[1]]).read()
     for k, label in enumerate(found):
-        unit = replicate_unit(found, label, 50.0, _base_settings(SHORT), first.particle_friction,
+        unit = replicate_unit(found, label, 50.0, shear_base_settings(SHORT), first.particle_friction,
                               first.rolling_friction)  # fmt: skip
         assert isinstance(unit, CalibrationUnit) and str(found[label]) == digest[label]
         row = stored_row(unit, Store(out).child("cache"))
@@ -278,7 +279,7 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
     report = (out / "calibration.md").read_text()
     assert "| dilation | 50 | mm |" in report and "| peak | 50 | kPa |" in report
     assert (out / "calibration_fit.png").stat().st_size > 0
-    again = run_calibration(plain, [paths[0], paths[1]], **kw)
+    again = calibrate(plain, [paths[0], paths[1]], **kw)
     assert again.cluster.tests_run == 0 and again.cluster.tests_reused == 9 * 2 * 2
     assert list(again.fit) == keys[:4]
     peaks = [[e.to_dict()["peak_50kPa"] for e in r.evaluations] for r in (again, res)]
@@ -312,7 +313,7 @@ def test_bad_input_is_refused_before_any_test(tiny, tmp_path, kw, name):
     out = tmp_path / "out"
     args = {"settings": SHORT, "options": QUIET} | kw
     with pytest.raises(InputError, match=name):
-        run_calibration(lab, [paths[0]], store=Store(out), **args)
+        calibrate(lab, [paths[0]], store=Store(out), **args)
     assert not (out / "result.json").exists() and not (out / "cache").exists()
 
 
@@ -373,7 +374,7 @@ def test_shear_settings_take_a_rolling_friction_for_every_disk(tiny):
 
 
 def test_lab_curves_shorter_than_the_tests_are_refused_and_their_end_is_the_last_window(tiny, tmp_path):
-    from poro2d.calibration.run import _base_settings, _lab_targets
+    from poro2d.calibration.case import lab_targets, shear_base_settings
     from poro2d.shear.lab import read_lab_csv
 
     paths, _ = tiny
@@ -381,13 +382,15 @@ def test_lab_curves_shorter_than_the_tests_are_refused_and_their_end_is_the_last
     short.write_text("normal_stress_kpa,shear_displacement_mm,shear_stress_kpa\n"
                      "50,0.2,10\n50,0.4,20\n50,0.6,25\n50,0.8,28\n50,1.0,30\n")  # fmt: skip
     with pytest.raises(InputError, match="settings.max_displacement"):
-        run_calibration(short, [paths[0]], store=Store(tmp_path / "o"), settings=SHORT, options=QUIET)
+        run_calibration(
+            CalibrationCase.of(short, [paths[0]], settings=SHORT), Store(tmp_path / "o"), options=QUIET
+        )
     assert not (tmp_path / "o" / "cache").exists()
     curves = tmp_path / "curves.csv"
     curves.write_text("normal_stress_kpa,shear_displacement_mm,shear_stress_kpa\n"
                       "50,0.5,40\n50,1.0,30\n50,1.7,22\n50,2.0,18\n50,2.5,5\n")  # fmt: skip
-    base = _base_settings({"max_displacement": 0.002, "peak_window": 5e-4})
-    targets = _lab_targets(read_lab_csv(curves), base)
+    base = shear_base_settings({"max_displacement": 0.002, "peak_window": 5e-4})
+    targets = lab_targets(read_lab_csv(curves), base)
     # the peak, and the mean of the readings within the last window before 2 mm (1.5 to 2 mm)
     assert targets == [("peak", 50.0, 40.0), ("end", 50.0, 20.0)]
 
@@ -398,11 +401,11 @@ def test_a_units_identity_is_the_digest_its_cache_folder_was_named_by():
     import dataclasses
     import pickle
 
-    from poro2d.calibration.run import _base_settings
+    from poro2d.calibration.case import shear_base_settings
     from poro2d.calibration.units import CalibrationUnit
 
     unit = CalibrationUnit.at(
-        "s.npz", "ab" * 32, 100.0, _base_settings({"max_displacement": 0.002}), 0.8, 0.15
+        "s.npz", "ab" * 32, 100.0, shear_base_settings({"max_displacement": 0.002}), 0.8, 0.15
     )
     assert unit.key == "47911f67c9214a97b5a2"
     assert (unit.fp, unit.mu_r) == (0.8, 0.15) and pickle.loads(pickle.dumps(unit)) == unit
@@ -413,8 +416,9 @@ def test_a_units_identity_is_the_digest_its_cache_folder_was_named_by():
 
 def test_the_preset_needs_a_store_to_keep_its_specimens(tiny):
     _, lab = tiny
+    case = CalibrationCase.of(lab, preset="paper", quick=True, settings=SHORT)  # a case that is right
     with pytest.raises(InputError, match="store"):
-        run_calibration(lab, preset="paper", quick=True, store=None, options=QUIET)
+        run_calibration(case, None, options=QUIET)
 
 
 def test_a_laboratory_poro2d_did_not_write_gets_the_discrepancy_term(tiny, tmp_path):
@@ -427,8 +431,8 @@ def test_a_laboratory_poro2d_did_not_write_gets_the_discrepancy_term(tiny, tmp_p
     real.write_text("".join(ln for ln in lab.read_text().splitlines(keepends=True) if not ln.startswith("#")))
     kw = dict(store=Store(tmp_path / "cal"), points=9, refine=0, settings=SHORT, options=ONE_WORKER,
               **FIT_BOX)  # fmt: skip
-    own = run_calibration(lab, [paths[0], paths[1]], **kw)
-    other = run_calibration(real, [paths[0], paths[1]], **kw)  # the same tests, from the cache
+    own = calibrate(lab, [paths[0], paths[1]], **kw)
+    other = calibrate(real, [paths[0], paths[1]], **kw)  # the same tests, from the cache
     draw_calibration(other, kw["store"])  # its report, as the command draws it
     assert other.cluster.tests_run == 0
     assert "discrepancy" not in own.posterior.to_dict() and "discrepancy" not in own.config

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from poro2d.calibration import model
-from poro2d.calibration.run import _base_settings, _lab_targets
+from poro2d.calibration.case import lab_targets, shear_base_settings
 from poro2d.shear import LabData
 
 RANGES = model.Ranges((0.3, 3.0), (0.0, 0.5))
@@ -107,10 +107,10 @@ def test_the_laboratory_dilation_is_the_mean_rise_over_the_last_peak_window_in_m
         {50.0: (d, np.array([40.0, 30.0, 22.0, 18.0, 5.0]))},
         {50.0: np.array([-0.01, 0.02, 0.10, 0.14, 0.3]) * 1e-3},
     )
-    base = _base_settings({"max_displacement": 0.002, "peak_window": 5e-4})
-    targets = _lab_targets(lab, base)
+    base = shear_base_settings({"max_displacement": 0.002, "peak_window": 5e-4})
+    targets = lab_targets(lab, base)
     assert targets[:2] == [("peak", 50.0, 40.0), ("end", 50.0, 20.0)]
     # the readings at 1.7 and 2.0 mm lie within the window (1.5 to 2 mm): a rise of 0.12 mm
     assert targets[2][:2] == ("dilation", 50.0) and targets[2][2] == pytest.approx(0.12)
     plain = LabData("lab.csv", lab.peaks, lab.curves)
-    assert _lab_targets(plain, base) == targets[:2]
+    assert lab_targets(plain, base) == targets[:2]

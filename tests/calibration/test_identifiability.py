@@ -11,8 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from poro2d.calibration import model, run_calibration
-from poro2d.calibration.run import MIN_POINTS, _base_settings, _infer, _units, unidentified_reason
+from poro2d.calibration import CalibrationCase, model, run_calibration
+from poro2d.calibration.case import MIN_POINTS, shear_base_settings
+from poro2d.calibration.run import _infer, _units, unidentified_reason
 from poro2d.calibration.specimens import check_replicates, replicate_unit
 from poro2d.calibration.units import CalibrationUnit, UnitRow
 from poro2d.cli.calibrate import print_result
@@ -48,7 +49,9 @@ def test_a_design_that_fits_the_surrogate_exactly_is_refused_before_any_test(spe
     out = tmp_path / "out"
     with pytest.raises(InputError, match="--points"):
         run_calibration(
-            lab, [specimen, other], store=Store(out), points=points, settings=SHORT, options=QUIET
+            CalibrationCase.of(lab, [specimen, other], points=points, settings=SHORT),
+            Store(out),
+            options=QUIET,
         )
     assert not (out / "cache").exists()
 
@@ -58,7 +61,7 @@ def test_twin_specimens_are_refused_naming_the_twin(specimen, lab, tmp_path):
     shutil.copyfile(specimen, twin)  # another file, the same content
     out = tmp_path / "out"
     with pytest.raises(InputError, match="twin") as exc:
-        run_calibration(lab, [specimen, twin], store=Store(out), settings=SHORT, options=QUIET)
+        run_calibration(CalibrationCase.of(lab, [specimen, twin], settings=SHORT), Store(out), options=QUIET)
     assert "twin.npz" in str(exc.value) and len(str(exc.value).splitlines()) == 1
     assert not (out / "cache").exists()
 
@@ -70,7 +73,9 @@ def test_replicates_of_another_grading_are_refused(specimen, lab, tmp_path):
     checkpoint.save(sim, coarse)
     out = tmp_path / "out"
     with pytest.raises(InputError, match="another grading") as exc:
-        run_calibration(lab, [specimen, coarse], store=Store(out), settings=SHORT, options=QUIET)
+        run_calibration(
+            CalibrationCase.of(lab, [specimen, coarse], settings=SHORT), Store(out), options=QUIET
+        )
     assert "coarse.npz" in str(exc.value)
     assert not (out / "cache").exists()
 
@@ -97,7 +102,7 @@ def test_zero_width_intervals_are_unknown_and_wide_ones_are_not():
 def test_a_posterior_that_is_not_finite_is_no_answer():
     ranges = model.Ranges((0.3, 3.0), (0.0, 0.5))
     design = model.space_filling(ranges, MIN_POINTS, 0)
-    base = _base_settings({"max_displacement": 0.002})
+    base = shear_base_settings({"max_displacement": 0.002})
     found, digests = {"a": "a.npz", "b": "b.npz"}, {"a": "a" * 64, "b": "b" * 64}
     rows = []  # in the units' order: per design point, per specimen, per stress
     for k, (fp, mu_r) in enumerate(design):
@@ -116,7 +121,7 @@ def test_the_table_reads_each_units_row_in_the_units_order():
     specimens' at its own stress, whatever the number of specimens and stresses."""
     ranges = model.Ranges((0.3, 3.0), (0.0, 0.5))
     design = model.space_filling(ranges, MIN_POINTS, 0)
-    base = _base_settings({"max_displacement": 0.002})
+    base = shear_base_settings({"max_displacement": 0.002})
     found = SpecimenSet(tuple("abc"), tuple(Path(f"{k}.npz") for k in "abc"), tuple(k * 64 for k in "abc"))
     stresses = [50.0, 100.0]
     units = _units(design, found, stresses, base)
@@ -149,8 +154,13 @@ def test_the_table_reads_each_units_row_in_the_units_order():
 
 def test_one_specimen_reports_its_intervals_as_unknown(specimen, lab, tmp_path, capsys):
     out = tmp_path / "out"
-    res = run_calibration(lab, [specimen], store=Store(out), points=MIN_POINTS, refine=0, settings=SHORT,
-                          options=ONE_WORKER, keep_box_dominated=True)  # fmt: skip
+    res = run_calibration(
+        CalibrationCase.of(
+            lab, [specimen], points=MIN_POINTS, refine=0, settings=SHORT, keep_box_dominated=True
+        ),
+        Store(out),
+        options=ONE_WORKER,
+    )
     draw_calibration(res, Store(out))  # the figures and the report, as the command draws them
     assert "one specimen" in res.unidentified
     assert res.intervals.to_dict() == {"particle_friction": None, "rolling_friction": None}

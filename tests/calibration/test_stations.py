@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from poro2d.calibration import model
-from poro2d.calibration.run import _base_settings, _lab_targets, check_noise_dof, run_calibration
+from poro2d.calibration.case import check_noise_dof, lab_targets, shear_base_settings
+from poro2d.calibration.run import CalibrationCase, run_calibration
 from poro2d.calibration.units import CurveReadings, UnitRow, observable_unit, parse_station, station
 from poro2d.errors import InputError
 from poro2d.shear import LabData
@@ -35,8 +36,8 @@ def test_station_names_read_back_with_their_units():
 
 
 def test_stations_read_the_lab_curves_at_evenly_spaced_displacements():
-    base = _base_settings({"max_displacement": 0.012})
-    targets = _lab_targets(_lab(vertical=True), base, stations=3)
+    base = shear_base_settings({"max_displacement": 0.012})
+    targets = lab_targets(_lab(vertical=True), base, stations=3)
     names = [(obs, s) for obs, s, _ in targets]
     # peaks, ends and dilations first, as with one station: earlier files keep their order
     assert names[:6] == [(o, s) for o in ("peak", "end", "dilation") for s in (50.0, 100.0)]
@@ -48,9 +49,9 @@ def test_stations_read_the_lab_curves_at_evenly_spaced_displacements():
     assert values["stress_at_4mm", 100.0] == pytest.approx(_window_mean(TAU, 0.004))
     assert values["rise_at_8mm", 50.0] == pytest.approx(1e3 * _window_mean(RISE, 0.008))  # in mm
     # one station is what a calibration did before: no readings
-    assert len(_lab_targets(_lab(vertical=True), base, stations=1)) == 6
+    assert len(lab_targets(_lab(vertical=True), base, stations=1)) == 6
     # without the plate's rise only the stresses are read
-    assert [o for o, *_ in _lab_targets(_lab(vertical=False), base, stations=2)][4:] == ["stress_at_6mm"] * 2
+    assert [o for o, *_ in lab_targets(_lab(vertical=False), base, stations=2)][4:] == ["stress_at_6mm"] * 2
 
 
 def test_a_unit_row_reads_its_own_curve_at_a_station_as_the_lab_is_read():
@@ -95,11 +96,15 @@ def test_a_design_too_small_for_its_observables_is_refused_before_any_work():
 def test_stations_out_of_range_are_refused(specimen, stations, words):
     with pytest.raises(InputError, match=words):
         run_calibration(
-            _lab(vertical=False), [specimen], stations=stations, settings={"max_displacement": 0.01}
+            CalibrationCase.of(
+                _lab(vertical=False), [specimen], stations=stations, settings={"max_displacement": 0.01}
+            )
         )
 
 
 def test_stations_need_lab_curves(specimen):
     peaks = LabData("mine", {50.0: 40.0, 100.0: 80.0})
     with pytest.raises(InputError, match=r"--stations.*1 with a peaks file"):
-        run_calibration(peaks, [specimen], stations=2, settings={"max_displacement": 0.01})
+        run_calibration(
+            CalibrationCase.of(peaks, [specimen], stations=2, settings={"max_displacement": 0.01})
+        )

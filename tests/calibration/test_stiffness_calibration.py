@@ -9,7 +9,7 @@ import shutil
 
 import pytest
 
-from poro2d.calibration import run_calibration, synthetic_lab
+from poro2d.calibration import synthetic_lab
 from poro2d.calibration.run import CalibrationResult
 from poro2d.cli.shear import load_shear_config
 from poro2d.dem import checkpoint
@@ -18,6 +18,7 @@ from poro2d.report.calibration_figures import draw_calibration
 from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
 from poro2d.store import Store
+from tests.calibration import calibrate
 
 ONE_WORKER = RunOptions(workers=1, dashboard=None, progress=False)
 
@@ -54,7 +55,7 @@ def test_four_parameters_recover_a_known_truth_within_their_intervals(stiff_lab,
     out = tmp_path / "cal"
     kw = dict(points=18, refine=4, settings=SHORT, stations=4, kn_range=KN_RANGE, ks_range=KS_RANGE,
               options=ONE_WORKER, keep_box_dominated=True)  # fmt: skip
-    res = run_calibration(lab, specimens, store=Store(out), **kw)
+    res = calibrate(lab, specimens, store=Store(out), **kw)
     draw_calibration(res, Store(out))  # the figures and the report, as the command draws them
     for name, value in TRUTH.items():
         lo, hi = getattr(res.intervals, name)
@@ -81,7 +82,7 @@ def test_four_parameters_recover_a_known_truth_within_their_intervals(stiff_lab,
     assert (out / "calibration_posterior.png").stat().st_size > 0
     assert "disk normal stiffness" in (out / "calibration.md").read_text()
     # the same inputs give the same numbers bit for bit (every test from the cache, the same chain)
-    again = run_calibration(lab, specimens, store=Store(out), **kw)
+    again = calibrate(lab, specimens, store=Store(out), **kw)
     assert (
         again.cluster.tests_run == 0
         and again.best.to_dict() == res.best.to_dict()

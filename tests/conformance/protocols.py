@@ -100,15 +100,15 @@ def _criterion_bad(ctx: Context, store: Store):
 
 # -- direct shear ---------------------------------------------------------------------------
 def _shear(ctx: Context, store: Store | None):
-    from poro2d.shear import run_shear
+    from poro2d.shear import ShearSeriesCase, run_shear
 
-    return run_shear(ctx.specimen, [50, 100], SHORT_SHEAR, store=store, options=QUIET)
+    return run_shear(ShearSeriesCase(ctx.specimen, [50, 100], SHORT_SHEAR), store, options=QUIET)
 
 
 def _shear_bad(ctx: Context, store: Store):
-    from poro2d.shear import run_shear
+    from poro2d.shear import ShearSeriesCase, run_shear
 
-    return run_shear(ctx.specimen, [50, -100], SHORT_SHEAR, store=store, options=QUIET)
+    return run_shear(ShearSeriesCase(ctx.specimen, [50, -100], SHORT_SHEAR), store, options=QUIET)
 
 
 # -- biaxial ----------------------------------------------------------------------------------
@@ -160,9 +160,9 @@ SAND = {
 
 
 def _sand(ctx: Context, store: Store | None):
-    from poro2d.sand import run_sand
+    from poro2d.sand import load_sand_case, run_sand
 
-    return run_sand(SAND, store=store, options=QUIET, use_cache=False)
+    return run_sand(load_sand_case(SAND), store, options=QUIET, use_cache=False)
 
 
 def _sand_setup(monkeypatch) -> None:
@@ -173,9 +173,9 @@ def _sand_setup(monkeypatch) -> None:
 
 
 def _sand_bad(ctx: Context, store: Store):
-    from poro2d.sand import run_sand
+    from poro2d.sand import load_sand_case, run_sand
 
-    return run_sand({**SAND, "lab": {**SAND["lab"], "n": 0.5}}, store=store, options=QUIET)
+    return run_sand(load_sand_case({**SAND, "lab": {**SAND["lab"], "n": 0.5}}), store, options=QUIET)
 
 
 # -- the relation n2D(nLab) -------------------------------------------------------------------

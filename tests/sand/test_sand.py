@@ -194,8 +194,8 @@ def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
     seen = []
     out = tmp_path / "sand"
     res = run_sand(
-        TINY,
-        store=Store(out),
+        load_sand_case(TINY),
+        Store(out),
         options=QUIET,
         announce=lines.append,
         on_preflight=lambda c, p: seen.append((c, p)),
@@ -235,13 +235,13 @@ def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
         .startswith("soil,upscale,disks,n_lab,e,Dr,mu_prep,interior_porosity")
     )
     # a rerun reads every finished case back: the same numbers
-    again = run_sand(TINY, store=Store(out), options=QUIET)
+    again = run_sand(load_sand_case(TINY), Store(out), options=QUIET)
     assert again.box_porosity_mean == res.box_porosity_mean
     assert [k.box_porosity for k in again.specimens] == [k.box_porosity for k in res.specimens]
     assert again.mu_prep == res.mu_prep
     assert res.state_map is None and "state_map" not in data
     # a [state] table added afterwards reads the same run back and adds the state parameter only
-    stated = run_sand({**TINY, "state": {"lab_line": "toyoura"}}, store=Store(out), options=QUIET)
+    stated = run_sand(load_sand_case({**TINY, "state": {"lab_line": "toyoura"}}), Store(out), options=QUIET)
     assert stated.box_porosity_mean == res.box_porosity_mean and stated.n2d_target == res.n2d_target
     rec = stated.state_map
     assert rec.e2d_by_state is None and "poro2d critical-state" in rec.note

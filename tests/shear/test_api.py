@@ -12,7 +12,7 @@ from poro2d.errors import InputError
 from poro2d.execute import RunOptions
 from poro2d.report.force_chains import plot_force_chains
 from poro2d.report.shear_figures import draw_shear_series
-from poro2d.shear import ShearSeries, ShearSettings, build_split_box, run_shear
+from poro2d.shear import ShearSeries, ShearSeriesCase, ShearSettings, build_split_box, run_shear
 from poro2d.shear.curve import CURVE_COLUMNS, ShearRow
 from poro2d.shear.lab import read_lab_csv
 from poro2d.shear.peak_frame import PeakFrame, PeakTracker
@@ -33,8 +33,11 @@ def test_run_shear_is_the_series_with_its_files(specimen, tmp_path):
     lab = tmp_path / "lab.csv"
     lab.write_text("normal_stress_kpa,peak_shear_stress_kpa\n50,40\n100,75\n")
     out = tmp_path / "api"
-    res = run_shear(specimen.parent, [50, 100], SHORT, store=Store(out), lab=lab, options=SERIAL,
-                    config={"note": "kept"})  # fmt: skip
+    res = run_shear(
+        ShearSeriesCase(specimen.parent, [50, 100], SHORT, lab=lab, config={"note": "kept"}),
+        Store(out),
+        options=SERIAL,
+    )
     assert res.to_dict() == json.loads((out / "result.json").read_text())
     assert res.config == {"note": "kept"} and res.settings.max_displacement == 0.002
     assert res.lab.friction_angle_deg == pytest.approx(np.degrees(np.arctan(35 / 50)))
@@ -48,7 +51,9 @@ def test_run_shear_is_the_series_with_its_files(specimen, tmp_path):
     ref = ShearSeries(specimen, [50, 100], ShearSettings(**SHORT), store=Store(tmp_path / "series"),
                       options=SERIAL, keep_peak=False).run()  # fmt: skip
     assert [t.peak_shear_stress_kpa for t in res.tests] == [t.peak_shear_stress_kpa for t in ref.tests]
-    again = run_shear(specimen, 100, ShearSettings(**SHORT), store=Store(out / "one"), options=SERIAL)
+    again = run_shear(
+        ShearSeriesCase(specimen, 100, ShearSettings(**SHORT)), Store(out / "one"), options=SERIAL
+    )
     assert again.tests[0].peak_shear_stress_kpa == ref.tests[1].peak_shear_stress_kpa
 
 
@@ -69,12 +74,10 @@ def test_run_shear_is_the_series_with_its_files(specimen, tmp_path):
     ],
 )
 def test_run_shear_refuses_bad_input_before_any_test(specimen, tmp_path, kw, name):
-    args = {"specimen": specimen, "normal_stresses_kpa": [50], "settings": SHORT, "options": SERIAL} | kw
+    args = {"specimen": specimen, "normal_stresses_kpa": [50], "settings": SHORT} | kw
     out = tmp_path / "out"
     with pytest.raises(InputError, match=name):
-        run_shear(args.pop("specimen"), args.pop("normal_stresses_kpa"), args.pop("settings"),
-                  store=Store(out),
-                  **args)  # fmt: skip
+        run_shear(ShearSeriesCase(**args), Store(out), options=SERIAL)
     assert not out.exists()
 
 
@@ -82,13 +85,13 @@ def test_run_shear_refuses_a_file_as_out_and_a_damaged_specimen(specimen, tmp_pa
     taken = tmp_path / "taken"
     taken.write_text("x")
     with pytest.raises(InputError, match="out"):
-        run_shear(specimen, [50], store=Store(taken))
+        run_shear(ShearSeriesCase(specimen, [50]), Store(taken))
     with pytest.raises(InputError, match="store"):
-        run_shear(specimen, [50], store=taken)  # a path is not a store
+        run_shear(ShearSeriesCase(specimen, [50]), taken)  # a path is not a store
     bad = tmp_path / "bad.npz"
     bad.write_bytes(specimen.read_bytes()[:100])
     with pytest.raises(InputError, match="checkpoint"):
-        run_shear(bad, [50], store=Store(tmp_path / "o"))
+        run_shear(ShearSeriesCase(bad, [50]), Store(tmp_path / "o"))
     assert not (tmp_path / "o").exists()
 
 

@@ -52,11 +52,14 @@ def test_the_record_reads_back_from_its_file():
 
 
 def test_a_series_records_and_prints_its_box_scale(specimen, tmp_path):
-    from poro2d.shear import run_shear
+    from poro2d.shear import ShearSeriesCase, run_shear
     from poro2d.store import Store
 
-    res = run_shear(specimen, [100], {"max_displacement": 0.0005, "peak_window": 2e-4},
-                    store=Store(tmp_path / "s"), options=RunOptions(progress=False))  # fmt: skip
+    res = run_shear(
+        ShearSeriesCase(specimen, [100], {"max_displacement": 0.0005, "peak_window": 2e-4}),
+        Store(tmp_path / "s"),
+        options=RunOptions(progress=False),
+    )
     assert res.box_scale is not None and res.box_scale.box_scale  # the ~110-disk test box
     import json
 

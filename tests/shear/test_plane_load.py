@@ -5,14 +5,17 @@ import math
 import numpy as np
 
 from poro2d.execute import RunOptions
-from poro2d.shear import run_shear
+from poro2d.shear import ShearSeriesCase, run_shear
 from poro2d.shear.curve import curve_columns
 from poro2d.store import Store
 
 
 def test_plane_carries_the_plate_load_plus_weight_minus_wall_friction_at_the_start(specimen, tmp_path):
-    res = run_shear(specimen, [100], {"max_displacement": 0.0005, "peak_window": 2e-4},
-                    store=Store(tmp_path / "s"), options=RunOptions(progress=False))  # fmt: skip
+    res = run_shear(
+        ShearSeriesCase(specimen, [100], {"max_displacement": 0.0005, "peak_window": 2e-4}),
+        Store(tmp_path / "s"),
+        options=RunOptions(progress=False),
+    )
     curve = res.curves[100.0]
     plane, plate, wall = (
         curve["plane_normal_stress_kpa"],

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from poro2d.execute import RunOptions
-from poro2d.shear import run_shear
+from poro2d.shear import ShearSeriesCase, run_shear
 from poro2d.shear.residual import (
     DILATION_RATE_LIMIT,
     built_up_mm,
@@ -142,8 +142,11 @@ def test_a_curve_without_the_plane_record_gives_the_plate_ratio_only():
 
 
 def test_a_real_test_reads_its_residual_into_its_result_and_the_series(specimen, tmp_path):
-    res = run_shear(specimen, [100], {"max_displacement": 0.02, "stop_after_peak": 0.0},
-                    store=Store(tmp_path / "s"), options=RunOptions(progress=False))  # fmt: skip
+    res = run_shear(
+        ShearSeriesCase(specimen, [100], {"max_displacement": 0.02, "stop_after_peak": 0.0}),
+        Store(tmp_path / "s"),
+        options=RunOptions(progress=False),
+    )
     summary = res.tests[0]
     r = summary.residual_dilation_stopped
     d_mean = json.loads((tmp_path / "s" / "sn100kPa" / "result.json").read_text())["d_mean_m"]

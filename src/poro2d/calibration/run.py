@@ -11,7 +11,6 @@ Everything is checked before the first test starts.
 
 from __future__ import annotations
 
-import os
 import time
 from dataclasses import dataclass, field
 from functools import partial
@@ -19,17 +18,12 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from poro2d.biaxial.lab import LabTests
 from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.calibration import model
 from poro2d.calibration.biaxial import (
     BIAXIAL,
     BiaxialLabRecord,
-    base_settings,
-    biaxial_targets,
-    biaxial_unit,
     check_quasi_static,
-    read_biaxial_lab,
 )
 from poro2d.calibration.box_dominated import (
     BoxDominatedPoints,
@@ -38,31 +32,24 @@ from poro2d.calibration.box_dominated import (
     quick_box_note,
     with_box_note,
 )
+from poro2d.calibration.case import CalibrationCase, min_points
 from poro2d.calibration.cluster import ClusterRecord, UnitFailure, UnitRunner
-from poro2d.calibration.discrepancy import Discrepancy, DiscrepancyRecord, discrepancy_record, resolve_mode
+from poro2d.calibration.discrepancy import Discrepancy, DiscrepancyRecord, discrepancy_record
 from poro2d.calibration.evaluations import PARAMETER_KEYS, DesignPoint, Observed, target_key
-from poro2d.calibration.identifiable import check_enough_lab_values
-from poro2d.calibration.lab_repeats import LabRepeats, lab_scatter_ratio, lab_share, mean_targets
+from poro2d.calibration.lab_repeats import lab_scatter_ratio, lab_share
 from poro2d.calibration.specimens import (
-    check_preset,
     check_replicates,
     preset_specimens,
     replicate_unit,
 )
-from poro2d.calibration.units import CACHE, UnitRow, observable_unit, station, window_mean
-from poro2d.errors import InputError, check_int, check_range, is_number
+from poro2d.calibration.units import CACHE, UnitRow, observable_unit
+from poro2d.errors import InputError
 from poro2d.execute.dask_cluster import check_reachable
 from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance, check_output_dir
-from poro2d.paper_data import QUICK_SHEAR
 from poro2d.shear.box_scale import BoxScale, box_scale
-from poro2d.shear.lab import LabData
 from poro2d.shear.parts import LabRecord
-from poro2d.shear.series import check_stresses
 from poro2d.shear.settings import (
-    MAX_FRICTION,
-    MAX_ROLLING_FRICTION,
-    PARTICLE_STIFFNESS_RANGE,
     ShearSettings,
 )
 from poro2d.specimen.specimen_set import SpecimenSet
@@ -71,30 +58,6 @@ from poro2d.typed_result import NOT_IN_FILE, Keyed, TypedResult, part
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
 KIND = "calibrate"
-
-DEFAULT_FP_RANGE = (0.3, 3.0)
-DEFAULT_MU_R_RANGE = (0.0, 0.5)
-#: most design points of a round (each is replicates x stresses shear tests)
-MAX_POINTS = 500
-#: most stations along a curve (``stations``): each adds one or two observables per normal stress,
-#: and the replicates must estimate the noise covariance of them all
-MAX_STATIONS = 10
-#: the degrees of freedom left to the surrogate's residual beyond its coefficients: with fewer,
-#: the quadratic passes (nearly) through every replicate mean and its misfit, one of the noise
-#: terms, cannot be estimated (six points fit its six coefficients exactly: a residual of zero)
-RESIDUAL_DOF = 3
-#: the fewest design points of the first round (the quadratic surrogate has 6 coefficients)
-MIN_POINTS = model.N_COEFFICIENTS + RESIDUAL_DOF
-#: the settings calibrated here: given ones would be overridden, so they are refused
-CALIBRATED = ("particle_friction", "rolling_friction")
-#: the names of the stiffness options, per axis
-STIFFNESS_OPTIONS = {"kn": "--kn-range", "ks": "--ks-range"}
-
-
-def min_points(d: int) -> int:
-    """The fewest design points of the first round in ``d`` parameters: the quadratic's
-    (d + 1)(d + 2) / 2 coefficients and :data:`RESIDUAL_DOF` more (9, 13 and 18 for 2, 3, 4)."""
-    return model.n_coefficients(d) + RESIDUAL_DOF
 
 
 #: the disks' stiffnesses (N/m) beside the frictions of a calibration's records: absent from the
@@ -332,322 +295,76 @@ class CalibrationResult(TypedResult):
         return store.read_result("result.json", cls.from_dict)
 
 
-def check_range_pair(name: str, value, lo: float, hi: float, lo_open: bool = False) -> tuple[float, float]:
-    """A (low, high) pair inside [lo, hi] with low < high."""
-    if isinstance(value, str | bytes) or not hasattr(value, "__len__") or len(value) != 2:
-        raise InputError(name, value, f"two numbers LOW,HIGH in [{lo}, {hi}]")
-    a, b = value
-    for v in (a, b):
-        if not is_number(v):
-            raise InputError(name, value, f"two numbers LOW,HIGH in [{lo}, {hi}]")
-        check_range(name, float(v), lo, hi, lo_open=lo_open)
-    if not float(a) < float(b):
-        raise InputError(name, value, "LOW < HIGH")
-    return float(a), float(b)
-
-
-def _base_settings(settings: dict | None, calibrated: tuple[str, ...] = CALIBRATED) -> ShearSettings:
-    """The shear settings of every test (frictions apart); ``stop_after_peak`` 0 by default so
-    that every test ends at ``max_displacement``, where the end stress is compared.
-
-    ``settings``: the caller's table of shear settings (a command's options), read once here;
-    ``calibrated``: the settings the calibration sets (a disk stiffness given is kept when it is
-    not calibrated)."""
-    given = dict(settings or {})
-    if not isinstance(settings, dict | None):
-        raise InputError("settings", type(settings).__name__, "a dict of shear settings or None")
-    for name in calibrated:
-        if name in given:
-            raise InputError(f"settings.{name}", given[name], "not given: it is calibrated")
-    given.setdefault("stop_after_peak", 0.0)
-    from poro2d.config import dataclass_from_table
-
-    return dataclass_from_table(ShearSettings, "settings", given)
-
-
-def _lab_targets(lab: LabData, base: ShearSettings, stations: int = 1) -> list[tuple[str, float, float]]:
-    """(observable, normal stress, laboratory value) fitted: every peak; with curves the end stress;
-    with the plate's vertical displacement too the dilation (mm); with ``stations`` > 1 the
-    readings of each curve at ``stations`` - 1 evenly spaced displacements before the end.
-
-    The end values of a laboratory curve are its means over the last peak window before the
-    tests' ``max_displacement`` (the simulated end values are smoothed over the same window);
-    a reading is its mean over the peak window before its station, on both sides
-    (:func:`poro2d.calibration.units.window_mean`).
-    """
-    targets = [("peak", s, lab.peaks[s]) for s in lab.normal_stresses()]
-    for s in lab.normal_stresses() if lab.curves else []:
-        d, t = lab.curves[s]
-        if d[-1] < base.max_displacement:
-            raise InputError(
-                "settings.max_displacement",
-                base.max_displacement,
-                f"at most {d[-1]:g} m, where the lab curve at {s:g} kPa ends",
-            )
-        targets.append(("end", s, _end_mean(d, t, base)))
-    for s in lab.normal_stresses() if lab.vertical else []:
-        targets.append(("dilation", s, 1e3 * _end_mean(lab.curves[s][0], lab.vertical[s], base)))
-    return targets + _station_targets(lab, base, stations)
-
-
-def _station_targets(lab: LabData, base: ShearSettings, stations: int) -> list[tuple[str, float, float]]:
-    """The readings of the laboratory curves before their end: the shear stress (kPa) and, when the
-    file has it, the plate's rise (mm) at ``max_displacement`` x j / ``stations``, j < ``stations``."""
-    targets = []
-    for j in range(1, stations):
-        at = base.max_displacement * j / stations
-        for s in lab.normal_stresses():
-            d, t = lab.curves[s]
-            targets.append((station("stress", at), s, window_mean(d, t, at, base.peak_window)))
-            if lab.vertical:
-                rise = window_mean(d, lab.vertical[s], at, base.peak_window)
-                targets.append((station("rise", at), s, 1e3 * rise))
-    return targets
-
-
-def _end_mean(d: np.ndarray, y: np.ndarray, base: ShearSettings) -> float:
-    """The mean of ``y`` over the readings within the last peak window before ``max_displacement``
-    (the value at ``max_displacement`` interpolated when no reading lies in that window)."""
-    return window_mean(d, y, base.max_displacement, base.peak_window)
-
-
 @claims(KIND)
 def run_calibration(
-    lab: str | os.PathLike | LabData | LabTests | list | None = None,
-    specimens: list[str | os.PathLike] | None = None,
-    *,
-    biaxial_lab: str | os.PathLike | list | LabTests | None = None,
-    store: Store | None = None,
-    preset: str | None = None,
-    quick: bool = False,
-    replicates: int = 3,
-    seed: int = 0,
-    fp_range=DEFAULT_FP_RANGE,
-    mu_r_range=DEFAULT_MU_R_RANGE,
-    kn_range=None,
-    ks_range=None,
-    points: int = 12,
-    refine: int = 6,
-    design_seed: int = 0,
-    lab_error: float = 0.0,
-    level: float = 0.95,
-    stations: int = 1,
-    settings: dict | None = None,
-    options: RunOptions = RunOptions(),
-    config: dict | None = None,
-    keep_box_dominated: bool = False,
-    discrepancy: str | float = "auto",
+    case: CalibrationCase, store: Store | None = None, *, options: RunOptions = RunOptions()
 ) -> CalibrationResult:
-    """Calibrate f_p and mu_r against ``lab`` on replicate specimens; keeps ``result.json`` in ``store``.
-
-    ``specimens``: checkpoints or criterion folders, or ``preset="paper"`` (``quick``: the
-    small box) with ``replicates`` seeds from ``seed``. ``fp_range``, ``mu_r_range``: the
-    search ranges. ``kn_range``, ``ks_range``: (low, high) N/m to calibrate the disks' normal and
-    shear stiffness too, searched in their logarithm (None: the specimen's, or the settings');
-    with either, the posterior is sampled with emcee (docs/calibration.md).
-    ``points``: the space-filling design's size; ``refine``: points of the
-    second round, drawn from the posterior (0: none). ``lab_error``: the laboratory's own
-    error as a fraction of each value, added to the seed scatter. ``level``: of the
-    credible intervals. ``stations``: with laboratory curves, each curve is also read (shear stress,
-    and the plate's rise when given) at ``stations`` - 1 evenly spaced displacements before its end
-    (1: peaks, end values and dilation only). ``settings``: shear settings of every test (the quick preset's
-    ``max_displacement`` 4 mm by default). ``options``: where the jobs run and whether bars show
-    (:class:`~poro2d.execute.options.RunOptions`, as the sweeps).
-    A rerun reuses every finished shear test (cached by content in the store's ``cache``);
-    ``store=None`` keeps nothing (every test runs, no figure or report is made).
-
-    ``lab`` may be a list: repeats of one laboratory programme (the same normal stresses and
-    readings, new specimens). Their mean values are fitted and the laboratory's share of the noise
-    is one simulated specimen's scatter over their number, scaled up when the repeats scatter more
-    (:mod:`poro2d.calibration.lab_repeats`).
-
-    ``biaxial_lab`` instead of ``lab``: laboratory biaxial tests (one CSV or several, rows named by
-    ``confining_stress_kpa``; or a :class:`poro2d.biaxial.lab.LabTests`, which ``lab`` also takes):
-    every unit is then a biaxial test at a laboratory confining stress, the targets its stress
-    ratios and volumetric strain (:mod:`poro2d.calibration.biaxial`), and ``settings`` are biaxial
-    settings (``max_strain`` 0.2 by default).
-
-    A design point any of whose direct shear tests is box-dominated (:mod:`poro2d.shear.box_dominated`:
-    its shear plane carries outside 0.7-1.3 times the plate's load at the peak, or its stress never
-    peaked) is left out of the fit, and the result says how many were (``box_dominated``); too few
-    left for the surrogate is no answer. ``keep_box_dominated``: fit them all the same (a box where
-    every test is box-dominated: the frictions then describe the box).
-
-    ``discrepancy``: the model-discrepancy term (:mod:`poro2d.calibration.discrepancy`): ``estimate``
-    (integrated over its unknown size), ``none`` (the noise covariance alone), ``auto`` (``none`` for
-    laboratory files poro2d wrote itself, else ``estimate``) or a fixed size in each observable's noise sd.
+    """Calibrate f_p and mu_r (and kn, ks when ranged) of ``case`` (a
+    :class:`~poro2d.calibration.case.CalibrationCase`: what each option means) on its replicate
+    specimens; keeps ``result.json`` in ``store``. ``options``: where the jobs run and whether bars
+    show (:class:`~poro2d.execute.options.RunOptions`, as the sweeps). A rerun reuses every finished
+    shear test (cached by content in the store's ``cache``); ``store=None`` keeps nothing (every test
+    runs, no figure or report is made; a preset's specimens need a store).
     """
     t0 = time.perf_counter()
+    if not isinstance(case, CalibrationCase):
+        raise InputError(
+            "case", type(case).__name__, "a CalibrationCase: CalibrationCase.of(lab, specimens, ...)"
+        )
     if store is not None:
         check_output_dir(store.parameter, store.root)
-    repeats = _read_lab(lab, biaxial_lab)
-    biaxial = isinstance(repeats, LabTests)
-    lab_data = repeats if biaxial else repeats.first
-    if not biaxial:
-        check_stresses(lab_data.normal_stresses())
-    check_preset(preset, quick, replicates)
-    if preset is not None and specimens:
-        raise InputError("--specimen", ", ".join(map(str, specimens)), "nothing with --preset")
-    if preset is not None and store is None:
+    if case.preset is not None and store is None:
         raise InputError("store", None, "a store to keep the preset's specimens in")
-    # every given specimen accepted and read whole (a damaged file refused on one line) before any work
-    given = SpecimenSet.named(specimens or []).read() if preset is None else None
-    ranges = model.Ranges(
-        check_range_pair("--fp-range", fp_range, 0.0, MAX_FRICTION, lo_open=True),
-        check_range_pair("--mu-r-range", mu_r_range, 0.0, MAX_ROLLING_FRICTION),
-        **_stiffness_ranges(kn_range, ks_range, biaxial),
-    )
-    fewest = min_points(ranges.dim)
-    try:
-        points = check_int("--points", points, fewest, MAX_POINTS)
-    except InputError:
-        raise InputError(
-            "--points", points, f"an integer in [{fewest}, {MAX_POINTS}]",
-            f"the surrogate's {model.n_coefficients(ranges.dim)} coefficients and {RESIDUAL_DOF} degrees"
-            " of freedom to estimate its residual",
-        ) from None  # fmt: skip
-    refine = check_int("--refine", refine, 0, MAX_POINTS)
-    design_seed = check_int("--design-seed", design_seed, 0)
-    check_range("--lab-error", lab_error, 0.0, 1.0)
-    check_range("--level", level, 0.0, 1.0, lo_open=True, hi_open=True)
-    discrepancy = resolve_mode(discrepancy, biaxial_lab if lab is None else lab)
-    if not isinstance(keep_box_dominated, bool):
-        raise InputError("--keep-box-dominated", keep_box_dominated, "true or false")
-    if settings is None and quick and not biaxial:
-        settings = dict(QUICK_SHEAR)
-    calibrated = CALIBRATED + tuple(PARAMETER_KEYS[a] for a in ranges.axes[2:])
-    base = base_settings(settings, CALIBRATED) if biaxial else _base_settings(settings, calibrated)
-    stations = check_int("--stations", stations, 1, MAX_STATIONS)
-    if stations > 1 and not biaxial and not lab_data.curves:
-        why = "readings along a curve need the lab curves"
-        raise InputError("--stations", stations, "1 with a peaks file", why)
-    lab_series = None  # every laboratory series' values (series x targets), shear only
-    if biaxial:
-        targets = biaxial_targets(lab_data, base, stations)
-    else:
-        targets, lab_series = mean_targets([_lab_targets(x, base, stations) for x in repeats.series])
-    check_enough_lab_values(lab_data.source, targets, ranges.dim)
-    check_noise_dof(points, len(given) if given is not None else replicates, len(targets))
     check_reachable(options.scheduler)
-
-    found = (
-        given
-        if given is not None
-        else preset_specimens(
-            store.child("specimens"), quick=quick, seed=seed, replicates=replicates, progress=options.progress
-        ).read()
-    )
+    found = case.specimens
+    if found is None:
+        made = preset_specimens(store.child("specimens"), quick=case.quick, seed=case.seed,
+                                replicates=case.replicates, progress=options.progress)  # fmt: skip
+        found = made.read()
     check_replicates(found)
-    if biaxial:
-        check_quasi_static(found, lab_data.confining_stresses(), base)
+    if case.biaxial:
+        check_quasi_static(found, case.lab.confining_stresses(), case.base)
     runner = UnitRunner(options)
-    stresses = lab_data.confining_stresses() if biaxial else lab_data.normal_stresses()
-    make = biaxial_unit if biaxial else replicate_unit
-    cache = _child(store, CACHE)
     try:
-        design = model.space_filling(ranges, points, design_seed)
-        rows = runner.run(_units(design, found, stresses, base, make, ranges.axes), cache, "round 1")
-        infer = partial(_infer, ranges, lab_error=lab_error, lab_series=lab_series, seed=design_seed,
-                        keep_box_dominated=keep_box_dominated, discrepancy=discrepancy)  # fmt: skip
-        post, surrogates, table = infer(design, found, stresses, rows, targets)
-        if refine:
-            extra = [p for p in post.draw(refine, design_seed + 1) if p not in design]
-            design = design + extra
-            rows += runner.run(_units(extra, found, stresses, base, make, ranges.axes), cache, "round 2")
-            post, surrogates, table = infer(design, found, stresses, rows, targets)
+        post, surrogates, table = _rounds(case, found, runner, None if store is None else store.child(CACHE))
     except TooFewPoints as exc:
-        if not quick or biaxial:
+        if not case.quick or case.biaxial:
             raise
-        raise TooFewPoints(
-            f"{quick_box_note(smallest_box(found).disks, base.max_displacement)}; {exc}"
-        ) from None
+        note = quick_box_note(smallest_box(found).disks, case.base.max_displacement)
+        raise TooFewPoints(f"{note}; {exc}") from None
     finally:
         runner.close()
-    result = _result(
-        post,
-        surrogates,
-        table,
-        targets,
-        level,
-        repeats,
-        found,
-        ranges,
-        base,
-        runner,
-        t0,
-        config or {},
-        lab_error,
-        design_seed,
-        points,
-        refine,
-        stations,
-        quick=quick,
-        discrepancy=discrepancy,
-    )
+    result = _result(case, post, surrogates, table, found, runner, t0)
     if store is not None:
         from poro2d.calibration.outputs import write_outputs
 
-        make_unit = partial(make, base=base)
-        result.drawing = write_outputs(store, result, post, repeats, found, make_unit, stresses)
+        make_unit = partial(case.make, base=case.base)
+        result.drawing = write_outputs(store, result, post, case.repeats, found, make_unit, case.stresses)
     return result
 
 
-def _stiffness_ranges(kn_range, ks_range, biaxial: bool) -> dict[str, tuple[float, float]]:
-    """The search ranges of the disks' stiffnesses that are calibrated (N/m), checked; refused
-    with biaxial laboratory tests, whose settings do not replace the disks' stiffness."""
-    given = {"kn": kn_range, "ks": ks_range}
-    out = {}
-    for axis, value in given.items():
-        if value is None:
-            continue
-        option = STIFFNESS_OPTIONS[axis]
-        if biaxial:
-            raise InputError(
-                option, value, "not given with --biaxial-lab", "kn and ks are calibrated on direct shear only"
-            )
-        out[axis] = check_range_pair(option, value, *PARTICLE_STIFFNESS_RANGE)
-    return out
-
-
-def _read_lab(lab, biaxial_lab) -> LabRepeats | LabTests:
-    """The laboratory data: direct shear (``lab``: one series or repeats) or biaxial tests
-    (``biaxial_lab``), exactly one."""
-    if isinstance(lab, LabTests) and biaxial_lab is None:
-        lab, biaxial_lab = None, lab
-    if (lab is None) == (biaxial_lab is None):
-        given = "neither" if lab is None else "both"
-        raise InputError(
-            "--lab",
-            given,
-            "exactly one of --lab (direct shear peaks or curves) and --biaxial-lab (biaxial curves)",
-        )
-    if biaxial_lab is not None:
-        return read_biaxial_lab(biaxial_lab)
-    return LabRepeats.of(lab)
-
-
-def check_noise_dof(points: int, replicates: int, observables: int) -> None:
-    """Refuse, before any test, a design whose replicates cannot estimate the noise of its
-    observables: the covariance of ``observables`` values needs points x (replicates - 1) >
-    observables + 1 degrees of freedom (:func:`poro2d.calibration.model.precision_factor`).
-    One specimen is let through: its intervals are reported as unknown."""
-    if replicates < 2 or model.precision_factor(points * (replicates - 1), observables) > 0:
-        return
-    need = -(-(observables + 2) // (replicates - 1))
-    raise InputError(
-        "--points", points, f"at least {need} for {observables} observables on {replicates} replicates",
-        "the noise covariance needs points x (replicates - 1) > observables + 1; or give fewer --stations",
-    )  # fmt: skip
+def _rounds(case: CalibrationCase, found: SpecimenSet, runner: UnitRunner, cache: Store | None):
+    """Round 1 on the space-filling design, round 2 (``refine``) on draws from its posterior; the
+    posterior, surrogates and table of the last fit."""
+    stresses, axes = case.stresses, case.ranges.axes
+    design = model.space_filling(case.ranges, case.points, case.design_seed)
+    rows = runner.run(_units(design, found, stresses, case.base, case.make, axes), cache, "round 1")
+    infer = partial(_infer, case.ranges, lab_error=case.lab_error, lab_series=case.lab_series,
+                    seed=case.design_seed, keep_box_dominated=case.keep_box_dominated,
+                    discrepancy=case.discrepancy)  # fmt: skip
+    post, surrogates, table = infer(design, found, stresses, rows, case.targets)
+    if case.refine:
+        extra = [p for p in post.draw(case.refine, case.design_seed + 1) if p not in design]
+        design = design + extra
+        rows += runner.run(_units(extra, found, stresses, case.base, case.make, axes), cache, "round 2")
+        post, surrogates, table = infer(design, found, stresses, rows, case.targets)
+    return post, surrogates, table
 
 
 def smallest_box(found: SpecimenSet) -> BoxScale:
     """The :class:`BoxScale` of the narrowest box (in largest grains) among the read specimens."""
     scales = [box_scale(*s.box(), s.arrays["particles.radius"]) for s in found.contents()]
     return min(scales, key=lambda b: b.width_over_d_max)
-
-
-def _child(store: Store | None, name: str) -> Store | None:
-    return None if store is None else store.child(name)
 
 
 def _units(design, specimens: SpecimenSet, stresses, base, make=replicate_unit, axes=("fp", "mu_r")) -> list:
@@ -829,29 +546,11 @@ def unidentified_reason(specimens: int, intervals: dict) -> str | None:
 
 
 def _result(
-    post,
-    surrogates,
-    table,
-    targets,
-    level,
-    lab_data,
-    found: SpecimenSet,
-    ranges,
-    base,
-    runner,
-    t0,
-    config,
-    lab_error,
-    design_seed,
-    points,
-    refine,
-    stations=1,
-    *,
-    quick: bool = False,
-    discrepancy="none",
+    case: CalibrationCase, post, surrogates, table, found: SpecimenSet, runner, t0: float
 ) -> CalibrationResult:
+    """The result of the last fit: best values, intervals at ``case.level``, the posterior's summary."""
+    ranges, targets, level, base, biaxial = case.ranges, case.targets, case.level, case.base, case.biaxial
     best = dict(zip(ranges.axes, post.best(), strict=True))
-    biaxial = isinstance(lab_data, LabTests)
     scale = None if biaxial else smallest_box(found)  # ASTM D3080 speaks of shear boxes only
     keys = {axis: PARAMETER_KEYS[axis] for axis in ranges.axes}
     intervals = {keys[a]: list(post.interval(a, level)) for a in ranges.axes}
@@ -887,7 +586,7 @@ def _result(
         ),
         evaluations=table,
         fit={target_key(obs, s): sg for (obs, s, _), sg in zip(targets, surrogates, strict=True)},
-        lab=BiaxialLabRecord.of(lab_data) if biaxial else lab_data.record(),
+        lab=BiaxialLabRecord.of(case.lab) if biaxial else case.repeats.record(),
         specimens={label: str(found[label]) for label in found},
         ranges=FrictionBounds.from_dict({keys[a]: list(getattr(ranges, a)) for a in ranges.axes}),
         settings=base,
@@ -895,13 +594,13 @@ def _result(
         failures=runner.failures,
         timings=CalibrationTimings(wall_time_s=time.perf_counter() - t0),
         config=dict(
-            config,
-            points=points,
-            refine=refine,
-            design_seed=design_seed,
-            lab_error=lab_error,
-            **({"stations": stations} if stations > 1 else {}),
-            **({"discrepancy": discrepancy} if discrepancy != "none" else {}),
+            case.config,
+            points=case.points,
+            refine=case.refine,
+            design_seed=case.design_seed,
+            lab_error=case.lab_error,
+            **({"stations": case.stations} if case.stations > 1 else {}),
+            **({"discrepancy": case.discrepancy} if case.discrepancy != "none" else {}),
         ),  # fmt: skip
         provenance=Provenance.now(),
         unidentified=unknown,
@@ -909,13 +608,11 @@ def _result(
         test=BIAXIAL if biaxial else None,
         box_dominated=None
         if scale is None
-        else with_box_note(post.box_dominated, quick, scale.disks, base.max_displacement),
+        else with_box_note(post.box_dominated, case.quick, scale.disks, base.max_displacement),
     )
 
 
 __all__ = [
-    "DEFAULT_FP_RANGE",
-    "DEFAULT_MU_R_RANGE",
     "CalibrationResult",
     "ChainRecord",
     "FittedObservable",

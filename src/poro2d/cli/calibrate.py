@@ -99,7 +99,8 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Calibrate particle friction f_p and rolling friction mu_r against laboratory direct shear or
         biaxial tests."""
-        from poro2d.calibration.run import DEFAULT_FP_RANGE, DEFAULT_MU_R_RANGE, run_calibration
+        from poro2d.calibration.case import DEFAULT_FP_RANGE, DEFAULT_MU_R_RANGE, CalibrationCase
+        from poro2d.calibration.run import run_calibration
         from poro2d.report.calibration_figures import draw_calibration
         from poro2d.report.criterion_figures import draw_specimens
         from poro2d.store import Store
@@ -122,33 +123,23 @@ def register(app: typer.Typer) -> None:
             **({"keep_box_dominated": True} if keep_box_dominated else {}),
             **({"discrepancy": discrepancy} if discrepancy != "auto" else {}),
         }
+        run = opt.job_options(workers, scheduler, quiet, dashboard)  # a scheduler that does not answer: now
+        ranges = {
+            name: parse_range(f"--{name.replace('_', '-')}", text, default)
+            for name, text, default in (("fp_range", fp_range, DEFAULT_FP_RANGE),
+                                        ("mu_r_range", mu_r_range, DEFAULT_MU_R_RANGE),
+                                        ("kn_range", kn_range, None), ("ks_range", ks_range, None))
+        }  # fmt: skip
+        case = CalibrationCase.of(
+            (lab[0] if len(lab) == 1 else list(lab)) if lab else None, list(specimen or []),
+            biaxial_lab=list(biaxial_lab) if biaxial_lab else None, settings=settings,
+            config={"cli": options}, preset=preset, quick=quick, replicates=replicates, seed=seed, **ranges,
+            points=points, refine=refine, design_seed=design_seed, lab_error=lab_error, level=level,
+            stations=stations, keep_box_dominated=keep_box_dominated, discrepancy=discrepancy,
+        )  # fmt: skip
         store = Store(out)
         try:
-            result = run_calibration(
-                (lab[0] if len(lab) == 1 else list(lab)) if lab else None,
-                list(specimen or []),
-                biaxial_lab=list(biaxial_lab) if biaxial_lab else None,
-                store=store,
-                preset=preset,
-                quick=quick,
-                replicates=replicates,
-                seed=seed,
-                fp_range=parse_range("--fp-range", fp_range, DEFAULT_FP_RANGE),
-                mu_r_range=parse_range("--mu-r-range", mu_r_range, DEFAULT_MU_R_RANGE),
-                kn_range=parse_range("--kn-range", kn_range, None),
-                ks_range=parse_range("--ks-range", ks_range, None),
-                points=points,
-                refine=refine,
-                design_seed=design_seed,
-                lab_error=lab_error,
-                level=level,
-                stations=stations,
-                settings=settings,
-                options=opt.job_options(workers, scheduler, quiet, dashboard),
-                config={"cli": options},
-                keep_box_dominated=keep_box_dominated,
-                discrepancy=discrepancy,
-            )
+            result = run_calibration(case, store, options=run)
         except RuntimeError as exc:
             console.print(f"[bold red]failed:[/] {exc}")
             raise typer.Exit(1) from None

@@ -8,7 +8,7 @@ import typer
 
 from poro2d.cli import options as opt
 from poro2d.execute.options import RunOptions
-from poro2d.paper import run_paper
+from poro2d.paper import PaperCase, run_paper
 from poro2d.store import Store
 
 
@@ -28,7 +28,7 @@ def register(app: typer.Typer) -> None:
         quiet: bool = opt.quiet(),
     ) -> None:
         """Run the paper's case study: conversions, criterion (Fig. 3), direct shear (Fig. 8), report."""
-        summary = run_paper(Store(out), quick=quick, lab=lab, seed=seed, threads=threads,
-                            replicates=replicates, options=RunOptions(progress=not quiet))  # fmt: skip
+        case = PaperCase(quick=quick, seed=seed, replicates=replicates, lab=lab, threads=threads)
+        summary = run_paper(case, Store(out), options=RunOptions(progress=not quiet))
         if not summary.criterion.converged:
             raise typer.Exit(1)

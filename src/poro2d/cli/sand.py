@@ -147,6 +147,7 @@ def sand_cmd(
     """
     from poro2d.execute.options import RunOptions
     from poro2d.report.grading_figure import draw_grading
+    from poro2d.sand.case import load_sand_case
     from poro2d.sand.run import check_soil, run_sand
     from poro2d.store import Store
 
@@ -162,10 +163,8 @@ def sand_cmd(
 
     store = Store(out)
     res = run_sand(
-        config,
-        store=store,
-        seeds=seeds,
-        budget_minutes=budget,
+        load_sand_case(config, seeds=seeds, budget_minutes=budget),
+        store,
         options=RunOptions(workers, scheduler, progress=not quiet),
         announce=lambda line: console.print(escape(line), soft_wrap=True),
         on_preflight=preflight,

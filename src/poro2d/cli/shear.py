@@ -127,7 +127,7 @@ def register(app: typer.Typer) -> None:
         from poro2d.io_utils import check_output_dir
         from poro2d.report.shear_figures import draw_shear_series
         from poro2d.shear.lab import read_lab_csv
-        from poro2d.shear.run import run_shear
+        from poro2d.shear.run import ShearSeriesCase, run_shear
         from poro2d.store import Store
 
         check_output_dir("--out", out)
@@ -148,7 +148,7 @@ def register(app: typer.Typer) -> None:
         lab_data = read_lab_csv(lab_path) if lab_path is not None else None  # the run's and the figures'
         store = Store(out)
         try:
-            result = run_shear(
+            case = ShearSeriesCase(
                 resolve_path("--specimen", specimen, extra.get("specimen"), base, required=True),
                 resolve_stresses(normal_stress, extra),
                 settings_from_options(
@@ -159,12 +159,11 @@ def register(app: typer.Typer) -> None:
                     particle_friction=particle_friction,
                     rolling_friction=rolling_friction,
                 ),  # fmt: skip
-                store=store,
                 lab=lab_data,
                 rate_check=rate_check or bool(extra.get("rate_check", False)),
-                options=run,
                 config=recorded,
             )
+            result = run_shear(case, store, options=run)
         except RuntimeError as exc:
             console.print(f"[bold red]failed:[/] {exc}")
             raise typer.Exit(1) from None

@@ -32,7 +32,7 @@ from typing import Any, ClassVar
 from poro2d.config import check_keys
 from poro2d.criterion.density import DEFAULT_MUS, check_mus
 from poro2d.critical_state.state_table import StateRequest, state_request
-from poro2d.errors import InputError, check_int
+from poro2d.errors import InputError, check_int, check_range
 from poro2d.grading import GradingCurve
 from poro2d.lab_state import LabState, lab_state_from_table
 from poro2d.specimen.compaction import SpecimenSpec, time_step
@@ -95,6 +95,8 @@ class SandCase:
     mus: tuple[float, ...] = DEFAULT_MUS
     calibration_seeds: int = CALIBRATION_SEEDS
     state: StateRequest | None = None
+    #: the run time the pre-flight measures its estimate against (minutes; None: none)
+    budget_minutes: float | None = None
 
     @property
     def n_max(self) -> float:
@@ -200,10 +202,13 @@ def with_step_budgets(config: CriterionBase, spec: SpecimenSpec, grading: Gradin
     return config.with_tables(**tables)
 
 
-def load_sand_case(config: ConfigLike, *, seeds: int | None = None) -> SandCase:
+def load_sand_case(
+    config: ConfigLike, *, seeds: int | None = None, budget_minutes: float | None = None
+) -> SandCase:
     """A :class:`SandCase` from a sand config (a TOML file or a dict), every value checked.
 
-    ``seeds`` overrides ``[sand] seeds``. Raises :class:`~poro2d.errors.InputError` naming
+    ``seeds`` overrides ``[sand] seeds``; ``budget_minutes``: the run time the pre-flight's
+    estimate is held against (``--budget``). Raises :class:`~poro2d.errors.InputError` naming
     the key, its value and what is allowed.
     """
     from poro2d.criterion.config import check_tables, load_config
@@ -241,9 +246,12 @@ def load_sand_case(config: ConfigLike, *, seeds: int | None = None) -> SandCase:
     state = state_request(
         cfg.get("state"), lab, base_dir, spec.friction_particle, spec.rolling_friction, grading
     )
+    if budget_minutes is not None:
+        check_range("--budget", budget_minutes, 0.0, 7 * 24 * 60.0, lo_open=True)
     return SandCase(
-        name, reference, lab, crit, base_dir, spec, grading, n_seeds, cal_disks, mus, cal_seeds, state
-    )
+        name, reference, lab, crit, base_dir, spec, grading, n_seeds, cal_disks, mus, cal_seeds, state,
+        budget_minutes,
+    )  # fmt: skip
 
 
 __all__ = ["CALIBRATION_DISKS", "CALIBRATION_SEEDS", "SandCase", "SoilRecord", "load_sand_case"]

@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.criterion.density import Calibration, StateTarget, state_target
+from poro2d.errors import InputError
 from poro2d.execute.options import RunOptions
 from poro2d.interop.origin import SOIL_FILE
 from poro2d.io_utils import Provenance, check_output_dir
@@ -277,20 +278,18 @@ def check_soil(
     budget_minutes: float | None = None,
 ) -> tuple[SandCase, Preflight]:
     """The soil checked and its pre-flight, with no DEM work (``poro2d sand --preflight``)."""
-    case = load_sand_case(config, seeds=seeds)
-    if budget_minutes is not None:
-        from poro2d.errors import check_range
+    case = load_sand_case(config, seeds=seeds, budget_minutes=budget_minutes)
+    return case, _preflight(case, workers)
 
-        check_range("--budget", budget_minutes, 0.0, 7 * 24 * 60.0, lo_open=True)
-    return case, preflight(case, workers=workers or os.cpu_count() or 1, budget_minutes=budget_minutes)
+
+def _preflight(case: SandCase, workers: int | None) -> Preflight:
+    return preflight(case, workers=workers or os.cpu_count() or 1, budget_minutes=case.budget_minutes)
 
 
 def run_sand(
-    config: ConfigLike,
-    *,
+    case: SandCase,
     store: Store | None = None,
-    seeds: int | None = None,
-    budget_minutes: float | None = None,
+    *,
     options: RunOptions = RunOptions(),
     use_cache: bool = True,
     announce: Announce = _quiet,
@@ -298,7 +297,8 @@ def run_sand(
 ) -> SandResult:
     """The density-aware 2D porosity of a soil at its laboratory state, over seeds.
 
-    ``config``: a sand config (:mod:`poro2d.sand.case`), a TOML file or a dict. Keeps in ``store``
+    ``case``: a sand config read and checked (:func:`~poro2d.sand.case.load_sand_case` of a TOML
+    file or a dict, with ``seeds`` and ``budget_minutes``). Keeps in ``store``
     ``preflight.json`` before any DEM work, then the calibration, the specimens
     (``specimens/<state>-seed<k>``), ``summary.md``, ``summary.csv`` and ``sand.json`` (returned
     as a :class:`~poro2d.sand.result.SandResult`). ``on_preflight`` is called with the case and
@@ -306,20 +306,24 @@ def run_sand(
     with it afterwards: ``draw_grading`` of ``report/grading_figure.py``), ``announce`` with one
     line per stage, with the elapsed time and an overall ETA.
     ``options``: where the jobs run and whether bars show (:class:`~poro2d.execute.options.RunOptions`;
-    the pre-flight's estimate counts ``workers``). Rerun to resume: finished cases are read back.
+    the pre-flight's estimate counts ``workers``). ``use_cache``: the calibration's cases live in the
+    shared cache, where another run finds them (else in the store's ``calibration``). Rerun to
+    resume: finished cases are read back.
     ``store=None``: nothing is kept (the run works in a scratch folder, removed at the end; the
     specimens' folders then name nothing).
     """
+    if not isinstance(case, SandCase):
+        raise InputError("case", type(case).__name__, "a SandCase: load_sand_case(config)")
     if store is not None:
         check_output_dir(store.parameter, store.root)
     with held(store, KIND) as kept:
-        return _run_sand(config, kept, seeds, budget_minutes, options, use_cache, announce, on_preflight)
+        return _run_sand(case, kept, options, use_cache, announce, on_preflight)
 
 
-def _run_sand(config, store, seeds, budget_minutes, options, use_cache, announce, on_preflight) -> SandResult:
+def _run_sand(case, store, options, use_cache, announce, on_preflight) -> SandResult:
     from poro2d.execute.dask_cluster import check_reachable
 
-    case, pf = check_soil(config, seeds=seeds, workers=options.workers, budget_minutes=budget_minutes)
+    pf = _preflight(case, options.workers)
     check_reachable(options.scheduler)  # one that does not answer is refused before the pre-flight is kept
     store.write_json(
         "preflight.json",
