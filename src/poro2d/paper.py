@@ -27,6 +27,7 @@ from poro2d.shear.results import ReplicateShearResult
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store, claims
 from poro2d.store.stage import Fingerprint, ResumableStage
+from poro2d.sweep.sensitivity_records import PaperNumbers
 from poro2d.typed_result import TypedResult
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
@@ -89,22 +90,6 @@ class PaperShear(TypedResult):
 
 
 @dataclass(eq=False)
-class PaperCriterionFacts(TypedResult):
-    """What the paper reports of its criterion run (section 3): trials, disks, forces (per m of depth)."""
-
-    trials: list[float]
-    particle_counts: list[int]
-    porosity_change_first_trial: float
-    f_top_first_trial_kn_per_m: float
-    f_bottom_first_trial_kn_per_m: float
-    self_weight_first_trial_n_per_m: float
-    f_top_accepted_n_per_m: float
-    f_bottom_accepted_n_per_m: float
-    self_weight_accepted_n_per_m: float
-    accepted_porosity: float
-
-
-@dataclass(eq=False)
 class PaperFacts(TypedResult):
     """What the paper states (:data:`poro2d.paper_data.PAPER`), kept in the summary for the comparison."""
 
@@ -113,9 +98,9 @@ class PaperFacts(TypedResult):
     n_min: float
     dry_density_kg_m3: float
     solid_density_kg_m3: float
-    criterion: PaperCriterionFacts
+    criterion: PaperNumbers
 
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"criterion": PaperCriterionFacts}
+    PARTS: ClassVar[dict[str, type[TypedResult]]] = {"criterion": PaperNumbers}
 
 
 @dataclass(eq=False)

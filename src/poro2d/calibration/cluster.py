@@ -13,13 +13,15 @@ from dataclasses import dataclass
 from poro2d.calibration.units import CalibrationUnit, UnitRow, compute_unit
 from poro2d.execute import Executor, Failed, Job
 from poro2d.execute.options import RunOptions
+from poro2d.labtest.records import ByName
 from poro2d.store import Store
 from poro2d.typed_result import TypedResult
 
 
 @dataclass(eq=False)
-class UnitFailure(TypedResult):
-    """A unit whose test failed (no equilibrium): left out of the fit, and said in ``failures``."""
+class UnitFailure(ByName, TypedResult):
+    """A unit whose test failed (no equilibrium): left out of the fit, and said in ``failures``; the
+    unit's own values read off it by name (:meth:`~poro2d.labtest.records.ByName.of`)."""
 
     key: str
     sigma: float
@@ -122,14 +124,8 @@ class UnitRunner:
         if type(exc) is not RuntimeError:  # not the test's own outcome (no equilibrium)
             self.broken.add(unit.key)
         self.failures.append(
-            UnitFailure(
-                key=unit.key,
-                sigma=unit.sigma,
-                fp=unit.fp,
-                mu_r=unit.mu_r,
-                specimen=unit.specimen,
-                error=f"{type(exc).__name__}: {exc}".splitlines()[0],
-                traceback=outcome.traceback,
+            UnitFailure.of(
+                unit, error=f"{type(exc).__name__}: {exc}".splitlines()[0], traceback=outcome.traceback
             )
         )
         return None

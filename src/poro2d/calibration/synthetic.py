@@ -72,7 +72,7 @@ def synthetic_lab(
             ShearCase(value, sigma, sset), work.child(f"sn{sigma:g}kPa"), keep_peak=False, threads=1
         ).run()
         if not curves:
-            lines.append(f"{sigma:g},{res['peak_shear_stress_kpa']:.4f}")
+            lines.append(f"{sigma:g},{res.peak_shear_stress_kpa:.4f}")
             continue
         c = res.curve
         for d, t, v in zip(

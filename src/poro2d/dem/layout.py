@@ -27,29 +27,36 @@ def check_layout(pos: np.ndarray, radius: np.ndarray, walls: Walls) -> None:
     or lies outside the box the walls close."""
     if pos.shape[0] == 0:
         return
+    for disk, allowed, why in _misplaced(pos, radius, walls):  # the first one found is refused
+        raise InputError(f"disk {disk} position", _xy(pos[disk]), allowed, why)
+
+
+def _misplaced(pos: np.ndarray, radius: np.ndarray, walls: Walls):
+    """Each check's first misplaced disk, as (disk, where its centre must be, why it is not),
+    check by check: a generator, so that a later (costlier) check runs only when needed."""
     pair = coincident_pair(pos, radius)
     if pair is not None:
         i, j, d = pair
-        raise InputError(
-            f"disk {j} position", _xy(pos[j]), f"a centre apart from that of disk {i}",
-            f"disks {i} and {j} are {d:.3g} m apart, less than {COINCIDENT:g} of the smaller radius",
-        )  # fmt: skip
+        why = f"disks {i} and {j} are {d:.3g} m apart, less than {COINCIDENT:g} of the smaller radius"
+        yield j, f"a centre apart from that of disk {i}", why
     if walls.n == 0:
         return
     hit = on_wall(pos, radius, walls)
     if hit is not None:
         i, w, d = hit
-        raise InputError(
-            f"disk {i} position", _xy(pos[i]), f"a centre off wall {walls.names[w]!r}",
+        yield (
+            i,
+            f"a centre off wall {walls.names[w]!r}",
             f"it lies {d:.3g} m from the wall, radius {radius[i]:.3g} m",
-        )  # fmt: skip
+        )
     out = outside(pos, walls)
     if out is not None:
         i, w = out
-        raise InputError(
-            f"disk {i} position", _xy(pos[i]), "a centre inside the walls",
+        yield (
+            i,
+            "a centre inside the walls",
             f"it lies beyond wall {walls.names[w]!r}, outside the box the walls close",
-        )  # fmt: skip
+        )
 
 
 def _xy(p: np.ndarray) -> tuple[float, float]:

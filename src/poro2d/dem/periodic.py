@@ -89,6 +89,18 @@ class CellBlock:
         return -float(self.stress[1, 1])
 
 
+class _CellValue:
+    """A number of the cell's state array (``PeriodicCell.cell``, its slots named in
+    :mod:`poro2d.dem.periodic_kernels`), read as a float: the cell's size, offset, strain and time."""
+
+    def __init__(self, slot: int, doc: str) -> None:
+        self.slot = slot
+        self.__doc__ = doc
+
+    def __get__(self, cell: PeriodicCell | None, owner: type | None = None):
+        return self if cell is None else float(cell.cell[self.slot])
+
+
 class PeriodicCell:
     """Disks of radii ``radius`` (m) at ``pos`` in a ``width`` x ``height`` cell.
 
@@ -147,27 +159,13 @@ class PeriodicCell:
     def n(self) -> int:
         return int(self.radius.size)
 
-    @property
-    def width(self) -> float:
-        return float(self.cell[K.L_])
-
-    @property
-    def height(self) -> float:
-        return float(self.cell[K.H_])
-
-    @property
-    def offset(self) -> float:
-        """The Lees-Edwards offset of the images above the cell (m, modulo the width)."""
-        return float(self.cell[K.DELTA])
-
-    @property
-    def strain(self) -> float:
-        """The shear strain gamma the cell has been sheared by."""
-        return float(self.cell[K.GAMMA])
-
-    @property
-    def time(self) -> float:
-        return float(self.cell[K.TIME])
+    width = _CellValue(K.L_, "The cell's width (m).")
+    height = _CellValue(K.H_, "The cell's height (m).")
+    offset = _CellValue(
+        K.DELTA, "The Lees-Edwards offset of the images above the cell (m, modulo the width)."
+    )
+    strain = _CellValue(K.GAMMA, "The shear strain gamma the cell has been sheared by.")
+    time = _CellValue(K.TIME, "The time the cell has run (s).")
 
     @property
     def solid_fraction(self) -> float:

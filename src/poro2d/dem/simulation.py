@@ -38,12 +38,6 @@ from poro2d.dem.state import (
     FREE,
     PARTICLE_FIELDS,
     PRESCRIBED,
-    SERVO_ERROR_SUM,
-    SERVO_GAIN,
-    SERVO_INTEGRAL,
-    SERVO_MAX_SPEED,
-    SERVO_TARGET,
-    WALL_SERVO,
     WALL_VELOCITY,
     Particles,
     Walls,
@@ -561,14 +555,7 @@ class Simulation:
             raise InputError("servo gain", gain, "(0, 1]")
         if not 0.0 <= integral <= 0.1:
             raise InputError("servo integral gain", integral, "[0, 0.1] per step")
-        self.walls.mode[w] = WALL_SERVO
-        self.walls.servo_dir[w] = d / nd
-        servo = self.walls.servo[w]
-        servo[SERVO_TARGET] = target_force
-        servo[SERVO_GAIN] = gain
-        servo[SERVO_MAX_SPEED] = max_speed
-        servo[SERVO_INTEGRAL] = integral
-        servo[SERVO_ERROR_SUM] = 0.0  # a new servo starts without a summed error
+        self.walls.set_servo(w, d / nd, target_force, gain, max_speed, integral)
 
     def fix_particles(self, mask: np.ndarray, velocity=(0.0, 0.0), omega: float = 0.0) -> None:
         """Prescribe velocity and spin of the disks in ``mask`` (zero = fixed)."""

@@ -217,6 +217,26 @@ class Walls:
         self.names.append(name)
         return self.n - 1
 
+    def set_servo(
+        self,
+        w: int,
+        direction: np.ndarray,
+        target_force: float,
+        gain: float,
+        max_speed: float,
+        integral: float,
+    ) -> None:
+        """Servo wall ``w`` along the unit ``direction``: its row of ``servo``, column by column
+        (checked by :meth:`poro2d.dem.Simulation.set_wall_servo`)."""
+        self.mode[w] = WALL_SERVO
+        self.servo_dir[w] = direction
+        servo = self.servo[w]
+        servo[SERVO_TARGET] = target_force
+        servo[SERVO_GAIN] = gain
+        servo[SERVO_MAX_SPEED] = max_speed
+        servo[SERVO_INTEGRAL] = integral
+        servo[SERVO_ERROR_SUM] = 0.0  # a new servo starts without a summed error
+
     def index(self, name_or_index: str | int) -> int:
         if isinstance(name_or_index, (int, np.integer)):
             if not 0 <= int(name_or_index) < self.n:

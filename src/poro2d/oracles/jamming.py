@@ -206,6 +206,15 @@ def _build_pairs(pos, rad, lx, ly, skin):
 
 
 @njit(cache=True)
+def _pair_offset(pos, rad, lx, ly, pi, pj, k):
+    """Pair ``k``'s disks i and j, the nearest image's offset (dx, dy) from i to j and their radii's sum."""
+    i = pi[k]
+    j = pj[k]
+    dx, dy = _nearest_image(pos, i, j, lx, ly)
+    return i, j, dx, dy, rad[i] + rad[j]
+
+
+@njit(cache=True)
 def _forces(pos, rad, lx, ly, pi, pj, force, stats):
     """Harmonic energy; net forces into ``force``; ``stats`` = (sum of overlaps, contacts, virial)."""
     force[:, :] = 0.0
@@ -214,10 +223,7 @@ def _forces(pos, rad, lx, ly, pi, pj, force, stats):
     contacts = 0
     virial = 0.0
     for k in range(pi.shape[0]):
-        i = pi[k]
-        j = pj[k]
-        dx, dy = _nearest_image(pos, i, j, lx, ly)
-        s = rad[i] + rad[j]
+        i, j, dx, dy, s = _pair_offset(pos, rad, lx, ly, pi, pj, k)
         r2 = dx * dx + dy * dy
         if r2 >= s * s:
             continue
@@ -350,10 +356,7 @@ def _contact_counts(pos, rad, lx, ly):
     keep = np.zeros(pi.shape[0], np.bool_)
     virial = 0.0
     for k in range(pi.shape[0]):
-        i = pi[k]
-        j = pj[k]
-        dx, dy = _nearest_image(pos, i, j, lx, ly)
-        s = rad[i] + rad[j]
+        i, j, dx, dy, s = _pair_offset(pos, rad, lx, ly, pi, pj, k)
         r = math.sqrt(dx * dx + dy * dy)
         if r < s:
             z[i] += 1

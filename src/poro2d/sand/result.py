@@ -19,6 +19,7 @@ from poro2d.criterion.density import Calibration
 from poro2d.critical_state.state_table import StateMapRecord, state_map_lines, state_map_record
 from poro2d.io_utils import Provenance, float_or_nan
 from poro2d.lab_state import LabState
+from poro2d.labtest.records import ByName
 from poro2d.sand.case import SoilRecord
 from poro2d.sand.preflight import Preflight
 from poro2d.sand.profile import StageProfile
@@ -106,8 +107,9 @@ class SandCalibration(TypedResult):
 
 
 @dataclass(eq=False)
-class AcceptedState(TypedResult):
-    """One accepted specimen of ``sand.json``'s ``states``: its state, seed, folder and porosities."""
+class AcceptedState(ByName, TypedResult):
+    """One accepted specimen of ``sand.json``'s ``states``: its state, seed, folder and porosities (the
+    seed and porosities read off its :class:`SeedSpecimen` by name)."""
 
     n_lab: float
     relative_density: float | None
@@ -178,14 +180,7 @@ class SandResult(TypedResult):
         box_m, box_sd = _stats([k.box_porosity for k in kept if k.accepted])
         lab = case.lab
         states = [
-            AcceptedState(
-                n_lab=lab.n_lab,
-                relative_density=lab.relative_density,
-                seed=k.seed,
-                specimen=k.folder,
-                box_porosity=k.box_porosity,
-                interior_porosity=k.interior_porosity,
-            )
+            AcceptedState.of(k, n_lab=lab.n_lab, relative_density=lab.relative_density, specimen=k.folder)
             for k in kept
             if k.accepted
         ]

@@ -15,6 +15,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Self
 
+from poro2d.labtest.records import ByName
 from poro2d.typed_result import TypedResult
 
 if TYPE_CHECKING:
@@ -45,7 +46,7 @@ class CaseRow(TypedResult):
 
 
 @dataclass(eq=False)
-class CriterionCaseResults(TypedResult):
+class CriterionCaseResults(ByName, TypedResult):
     """The table cells of a criterion case (``results`` of its row): the run's answer, then the
     accepted trial (else the last), then the first trial (the paper reports its forces too, its
     Fig. 5), then the accepted specimen's own porosity beside the paper's box porosity n'."""
@@ -88,13 +89,11 @@ class CriterionCaseResults(TypedResult):
         its = [trial.to_dict() for trial in res.iterations]  # each trial's cells as its row holds them
         first = its[0] if its else {}
         last = next((r for r in its if r.get("accepted")), its[-1] if its else {})
-        return cls(
-            n_lab=res.n_lab,
-            final_porosity=res.final_porosity,
+        # the run's answer and the accepted specimen's porosities are read off it by name
+        return super().of(
+            res,
             converged=bool(res.converged),
             iterations=len(its),
-            message=res.message,
-            initial_trial_porosity=res.initial_trial_porosity,
             last_trial_porosity=last.get("trial_porosity"),
             last_new_porosity=last.get("new_porosity"),
             particle_count=last.get("particle_count"),
@@ -112,11 +111,6 @@ class CriterionCaseResults(TypedResult):
             first_plate_moved=first.get("plate_moved"),
             first_new_porosity=first.get("new_porosity"),
             criterion_time_s=res.time_total_s,
-            box_porosity=res.box_porosity,
-            interior_porosity=res.interior_porosity,
-            interior_porosity_std=res.interior_porosity_std,
-            surface_gap_mean_d50=res.surface_gap_mean_d50,
-            plate_contact_fraction=res.plate_contact_fraction,
         )
 
 

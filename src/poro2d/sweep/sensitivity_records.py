@@ -8,7 +8,8 @@ it was (``point["n2d_mean"]``), which the report's tables and figure use.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import ClassVar
 
 from poro2d.record import Record, Spliced
 from poro2d.sweep.records import SweepSummary
@@ -28,10 +29,13 @@ class MeanSd(TypedResult):
 class PaperNumbers(TypedResult):
     """The numbers the paper reports for its criterion run (``paper`` of the file): n_lab, the
     trials and their particle counts, the wall forces and self weights of the first and the
-    accepted trial, the accepted porosity.
+    accepted trial, the accepted porosity. The case study keeps them without n_lab, which it
+    states beside them (``paper.criterion`` of its summary): n_lab is written only when given.
     """
 
-    n_lab: float
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("n_lab",)
+
+    n_lab: float | None = field(default=None, kw_only=True)  # kw_only: first key, yet optional
     trials: list[float]
     particle_counts: list[int]
     porosity_change_first_trial: float
