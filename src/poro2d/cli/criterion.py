@@ -27,6 +27,12 @@ PAPER_MODE_NOTE = (
     "your density give both laboratory extremes (--n-max/--n-min or [density]) or use poro2d sand"
 )
 
+#: --mode's help: both modes, and when each is the default
+MODE_HELP = (
+    "density (friction from Dr; the default when both laboratory extremes are given) or paper "
+    "(preparation friction 0.05; the default otherwise)."
+)
+
 
 def register(app: typer.Typer) -> None:
     @app.command("criterion")
@@ -38,12 +44,7 @@ def register(app: typer.Typer) -> None:
         n_lab: float = typer.Option(None, "--n-lab", help="Laboratory porosity (overrides the config)."),
         trial: float = typer.Option(None, "--trial-porosity", help="First trial n2D instead of Eq. 12."),
         threads: int = opt.threads(),
-        mode: str = typer.Option(
-            None,
-            "--mode",
-            help="density (friction from Dr; the default when both laboratory extremes are "
-            "given) or paper (preparation friction 0.05; the default otherwise).",
-        ),
+        mode: str = typer.Option(None, "--mode", help=MODE_HELP),
         n_max: float = typer.Option(None, "--n-max", help="Density mode: loosest laboratory porosity."),
         n_min: float = typer.Option(None, "--n-min", help="Density mode: densest laboratory porosity."),
         seeds: int = typer.Option(None, "--seeds", help="Density mode: specimens per state (3)."),

@@ -133,20 +133,10 @@ class CriterionCase:
         return self.density.mode
 
     @classmethod
-    def from_config(
-        cls,
-        config: ConfigLike = None,
-        *,
-        preset: str | None = None,
-        seed: int | None = None,
-        n_lab: float | None = None,
-        trial_porosity: float | None = None,
-        threads: int | None = None,
-        mode: str | None = None,
-        n_max: float | None = None,
-        n_min: float | None = None,
-        seeds: int | None = None,
-    ) -> CriterionCase:
+    def from_config(cls, config: ConfigLike = None, *, preset: str | None = None, seed: int | None = None,
+                    n_lab: float | None = None, trial_porosity: float | None = None,
+                    threads: int | None = None, mode: str | None = None, n_max: float | None = None,
+                    n_min: float | None = None, seeds: int | None = None) -> CriterionCase:  # fmt: skip
         """The case of ``poro2d criterion``: ``config`` (a dict, a TOML file, or the paper preset
         when None) with the command's options applied, every input checked, the specimen's
         feasibility too (InputError if not)."""

@@ -424,18 +424,9 @@ class RelationCase:
     state: Any = None
 
     @classmethod
-    def from_config(
-        cls,
-        config=None,
-        *,
-        preset: str | None = None,
-        points: int | None = None,
-        n_max: float | None = None,
-        n_min: float | None = None,
-        mode: str | None = None,
-        seeds: int | None = None,
-        quick: bool = False,
-    ) -> RelationCase:
+    def from_config(cls, config=None, *, preset: str | None = None, points: int | None = None,
+                    n_max: float | None = None, n_min: float | None = None, mode: str | None = None,
+                    seeds: int | None = None, quick: bool = False) -> RelationCase:  # fmt: skip
         """The case of ``poro2d relation``: ``config`` (a dict, a TOML file, or the paper preset
         when None) with an optional ``[relation]`` table, which the keyword options override;
         every input checked (InputError if not)."""
