@@ -28,6 +28,7 @@ from typing import Any, Self
 import numpy as np
 
 from poro2d.config import check_keys, check_number_list
+from poro2d.criterion.settings import CriterionSettings
 from poro2d.errors import InputError
 from poro2d.execute.options import RunOptions
 from poro2d.io_utils import check_output_dir, float_or_nan
@@ -35,6 +36,7 @@ from poro2d.paper_data import QUICK_CRITERION
 from poro2d.store import Store
 from poro2d.sweep.cases import SweepConfig
 from poro2d.sweep.criterion_base import CriterionBase
+from poro2d.sweep.density import CalibrationCase
 from poro2d.sweep.output import held
 from poro2d.sweep.records import CaseRow, LostCaseRow, case_row
 from poro2d.sweep.results import SensitivityResult
@@ -446,10 +448,10 @@ class SensitivityCase:
 
     study: CriterionBase
     settings: StudySettings
-    crit: Any  # CriterionSettings
+    crit: CriterionSettings
     gradings: list[GradingCase]
     sweep: SweepConfig
-    calibration: Any  # poro2d.sweep.density.CalibrationCase
+    calibration: CalibrationCase
 
     @classmethod
     def from_config(
@@ -477,7 +479,7 @@ class SensitivityCase:
         sweep = grading_sweep(study, cases, settings.seeds)
         # the friction axis is the density calibration, with its settings (layers that settle):
         # the same cases as the relation's, read back from the shared cache when it ran them
-        calibration = D.CalibrationCase(D.with_density_defaults(study), tuple(settings.mus), settings.seeds)
+        calibration = CalibrationCase(D.with_density_defaults(study), tuple(settings.mus), settings.seeds)
         calibration.sweep  # noqa: B018 (its cases are built, so checked, now)
         return cls(study, settings, crit, cases, sweep, calibration)
 
