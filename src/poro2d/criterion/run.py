@@ -72,7 +72,6 @@ def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> D
     With no mode given, density mode when both laboratory extremes are (``[density]`` or the
     options), else paper mode.
     """
-    from poro2d import porosity as P
     from poro2d.config import check_keys
     from poro2d.criterion.density import check_mus
 
@@ -96,18 +95,24 @@ def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> D
         return DensitySettings(mode)
     mus = t.get("mu_prep")
     mu_prep = None if mus is None else check_mus(mus, "density.mu_prep")
+    hi, lo = lab_extremes(
+        "density", t, n_max, n_min, preset=preset, hint="set them in [density] or with --n-max/--n-min"
+    )
+    seeds = check_int("seeds", seeds if seeds is not None else t.get("seeds", 3), 1, 50)
+    return DensitySettings(mode, mu_prep, n_max=hi, n_min=lo, seeds=seeds)
+
+
+def lab_extremes(table: str, t: dict, n_max, n_min, *, preset: bool, hint: str) -> tuple[float, float]:
+    """The laboratory extremes (n_max, n_min): the options, else ``table``'s ``t``, else (the
+    preset) the paper's; both checked in (0, 1). ``hint``: where a user sets them."""
+    from poro2d import porosity as P
+
     hi = n_max if n_max is not None else t.get("n_max", P.PAPER_N_MAX if preset else None)
     lo = n_min if n_min is not None else t.get("n_min", P.PAPER_N_MIN if preset else None)
     if hi is None or lo is None:
-        raise InputError("density.n_max/n_min", (hi, lo), "both laboratory extremes",
-                         "set them in [density] or with --n-max/--n-min")  # fmt: skip
-    return DensitySettings(
-        mode,
-        mu_prep,
-        n_max=check_range("n_max", hi, 0.0, 1.0, lo_open=True, hi_open=True),
-        n_min=check_range("n_min", lo, 0.0, 1.0, lo_open=True, hi_open=True),
-        seeds=check_int("seeds", seeds if seeds is not None else t.get("seeds", 3), 1, 50),
-    )
+        raise InputError(f"{table}.n_max/n_min", (hi, lo), "both laboratory extremes", hint)
+    return (check_range("n_max", hi, 0.0, 1.0, lo_open=True, hi_open=True),
+            check_range("n_min", lo, 0.0, 1.0, lo_open=True, hi_open=True))  # fmt: skip
 
 
 @dataclass(frozen=True)

@@ -21,6 +21,7 @@ import numpy as np
 
 from poro2d import porosity as P
 from poro2d.config import check_keys, check_number_list
+from poro2d.criterion.run import lab_extremes
 from poro2d.errors import InputError, check_range
 from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance, check_output_dir, float_or_nan
@@ -103,17 +104,9 @@ def relation_settings(
     for key in ("n_max", "n_min"):  # a wrong value in the file is refused, even when an option wins
         if key in t:
             check_range(f"relation.{key}", t[key], 0.0, 1.0, lo_open=True, hi_open=True)
-    hi = n_max if n_max is not None else t.get("n_max", P.PAPER_N_MAX if preset else None)
-    lo = n_min if n_min is not None else t.get("n_min", P.PAPER_N_MIN if preset else None)
-    if hi is None or lo is None:
-        raise InputError(
-            "relation.n_max/n_min",
-            (hi, lo),
-            "both laboratory extremes",
-            "set them in [relation] or --n-max/--n-min",
-        )
-    hi = check_range("n_max", hi, 0.0, 1.0, lo_open=True, hi_open=True)
-    lo = check_range("n_min", lo, 0.0, 1.0, lo_open=True, hi_open=True)
+    hi, lo = lab_extremes(
+        "relation", t, n_max, n_min, preset=preset, hint="set them in [relation] or --n-max/--n-min"
+    )
     if not hi > lo:
         raise InputError("n_max", hi, f"greater than n_min = {lo}")
     if "n_lab" in t and points is None:
