@@ -196,4 +196,4 @@ def run_criterion(
                                  progress=options.progress, config=case.config).run()  # fmt: skip
 
 
-__all__ = ["CriterionCase", "DensitySettings", "run_criterion"]
+__all__ = ["CriterionCase", "DensitySettings", "lab_extremes", "run_criterion"]
