@@ -19,7 +19,7 @@ import argparse
 import time
 from pathlib import Path
 
-from poro2d.criterion import run_criterion
+from poro2d.criterion import CriterionCase, run_criterion
 from poro2d.execute.options import RunOptions
 from poro2d.store import Store
 
@@ -70,7 +70,7 @@ def main() -> None:
                 tag = f"{box}mu{args.mu_prep:g}_r{rolling:g}{kept}{grow}_s{seed}"
                 store = Store(Path(args.out) / tag)
             t0 = time.perf_counter()
-            res = run_criterion(cfg, store=store, options=RunOptions(progress=False))
+            res = run_criterion(CriterionCase.from_config(cfg), store, options=RunOptions(progress=False))
             print(row(args, rolling, seed, res, time.perf_counter() - t0), flush=True)
 
 

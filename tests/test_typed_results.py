@@ -232,13 +232,13 @@ def _public_runs():
     from poro2d.paper import run_paper
     from poro2d.shear.replicates import ReplicateShear
     from poro2d.shear.run import run_shear
-    from poro2d.sweep.density_criterion import run_criterion_modes, run_density_criterion, run_density_state
+    from poro2d.sweep.density_criterion import run_criterion_modes, run_density_criterion
     from poro2d.sweep.relation import run_relation
     from poro2d.sweep.sensitivity import run_sensitivity
 
     return [
         (run_criterion, CriterionResult), (run_density_criterion, DensityStateResult),
-        (run_density_state, DensityStateResult), (run_criterion_modes, CriterionResult | DensityStateResult),
+        (run_criterion_modes, CriterionResult | DensityStateResult),
         (run_replicates, ReplicatesResult), (run_shear, ShearSeriesResult),
         (ReplicateShear.run, ReplicateShearResult), (run_relation, RelationResult),
         (run_sensitivity, SensitivityResult), (run_paper, PaperSummary), (run_calibration, CalibrationResult),

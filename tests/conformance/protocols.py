@@ -75,9 +75,9 @@ CRITERION = {"seed": 0, "specimen": SMALL_BOX, "criterion": {"force_fraction": 0
 
 
 def _criterion(ctx: Context, store: Store | None):
-    from poro2d.criterion import run_criterion
+    from poro2d.criterion import CriterionCase, run_criterion
 
-    return run_criterion(CRITERION, store=store, options=QUIET)
+    return run_criterion(CriterionCase.from_config(CRITERION), store, options=QUIET)
 
 
 def _criterion_jobs(ctx: Context, store: Store):
@@ -93,9 +93,9 @@ def _criterion_jobs(ctx: Context, store: Store):
 
 
 def _criterion_bad(ctx: Context, store: Store):
-    from poro2d.criterion import run_criterion
+    from poro2d.criterion import CriterionCase, run_criterion
 
-    return run_criterion(CRITERION, store=store, n_lab=1.5, options=QUIET)
+    return run_criterion(CriterionCase.from_config(CRITERION, n_lab=1.5), store, options=QUIET)
 
 
 # -- direct shear ---------------------------------------------------------------------------
@@ -188,15 +188,15 @@ RELATION = {
 
 
 def _relation(ctx: Context, store: Store | None):
-    from poro2d.sweep.relation import run_relation
+    from poro2d.sweep.relation import RelationCase, run_relation
 
-    return run_relation(RELATION, store=store, points=2, options=QUIET)
+    return run_relation(RelationCase.from_config(RELATION, points=2), store, options=QUIET)
 
 
 def _relation_bad(ctx: Context, store: Store):
-    from poro2d.sweep.relation import run_relation
+    from poro2d.sweep.relation import RelationCase, run_relation
 
-    return run_relation(RELATION, store=store, points=1, options=QUIET)
+    return run_relation(RelationCase.from_config(RELATION, points=1), store, options=QUIET)
 
 
 # -- one shear test of a calibration ------------------------------------------------------------

@@ -2,7 +2,7 @@
 
 import pytest
 
-from poro2d.criterion.run import criterion_inputs
+from poro2d.criterion.run import CriterionCase
 from poro2d.errors import InputError
 
 SMALL = {"seed": 0, "specimen": {"width": 0.05, "height": 0.025, "layers": 2}, "grading": {"preset": "paper"},
@@ -11,23 +11,23 @@ SMALL = {"seed": 0, "specimen": {"width": 0.05, "height": 0.025, "layers": 2}, "
 
 def test_both_extremes_in_the_config_ask_for_density_mode():
     cfg = dict(SMALL, density={"n_max": 0.4571, "n_min": 0.3253})
-    assert criterion_inputs(cfg).mode == "density"
+    assert CriterionCase.from_config(cfg).mode == "density"
 
 
 def test_both_extremes_as_options_ask_for_density_mode():
-    assert criterion_inputs(SMALL, n_max=0.4571, n_min=0.3253).mode == "density"
+    assert CriterionCase.from_config(SMALL, n_max=0.4571, n_min=0.3253).mode == "density"
 
 
 def test_without_extremes_paper_mode_stays_the_default():
-    assert criterion_inputs(SMALL).mode == "paper"
-    assert criterion_inputs(None).mode == "paper"  # the paper preset: its case, unchanged
+    assert CriterionCase.from_config(SMALL).mode == "paper"
+    assert CriterionCase.from_config(None).mode == "paper"  # the paper preset: its case, unchanged
 
 
 def test_an_explicit_mode_wins_and_one_extreme_alone_is_refused():
     cfg = dict(SMALL, density={"mode": "paper"})
-    assert criterion_inputs(cfg).mode == "paper"
+    assert CriterionCase.from_config(cfg).mode == "paper"
     with pytest.raises(InputError) as e:
-        criterion_inputs(SMALL, n_max=0.4571)
+        CriterionCase.from_config(SMALL, n_max=0.4571)
     assert e.value.parameter == "--n-max"
 
 
@@ -51,5 +51,5 @@ def test_a_relation_config_serves_the_criterion_too(tmp_path):
     cfg.write_text(
         "seed = 0\n[criterion]\nn_lab = 0.40\n[relation]\npoints = 3\nn_max = 0.4571\nn_min = 0.3253\n"
     )
-    inputs = criterion_inputs(cfg)
-    assert inputs.mode == "paper" and inputs.config["relation"]["points"] == 3
+    case = CriterionCase.from_config(cfg)
+    assert case.mode == "paper" and case.config["relation"]["points"] == 3

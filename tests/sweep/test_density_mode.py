@@ -36,12 +36,13 @@ def test_density_mode_of_the_criterion(tmp_path, monkeypatch):
     assert res["calibration"]["mus"] == [0.0, 0.5]
     assert "provenance" in res and res["config"]["specimen"]["width"] == 0.05
     # the call of the command's density mode reads the same run back, typed
+    from poro2d.criterion.run import CriterionCase
     from poro2d.io_utils import as_json
     from poro2d.store import Store
     from poro2d.sweep.density_criterion import run_density_criterion
     from poro2d.sweep.results import DensityStateResult
 
-    again = run_density_criterion(cfg, store=Store(out), n_lab=0.40, options=QUIET)
+    again = run_density_criterion(CriterionCase.from_config(cfg, n_lab=0.40), Store(out), options=QUIET)
     assert isinstance(again, DensityStateResult) and again.n_lab == 0.40
     assert again.final_porosity_per_seed == res["final_porosity_per_seed"] and again.mu_prep == res["mu_prep"]
     assert as_json(again.to_dict()) == json.loads((out / "density.json").read_text())  # NaN: null

@@ -1,14 +1,15 @@
-"""``run_criterion`` and ``run_relation``: the commands as calls, with the commands' checks."""
+"""``run_criterion`` and ``run_relation``: the commands as calls on their cases, with the commands' checks."""
 
 import pytest
 
 from poro2d.criterion import run_criterion
 from poro2d.criterion.result import CriterionResult
+from poro2d.criterion.run import CriterionCase
 from poro2d.errors import InputError
 from poro2d.execute.options import RunOptions
 from poro2d.store import Store
 from poro2d.sweep.density_criterion import run_criterion_modes, run_density_criterion
-from poro2d.sweep.relation import run_relation
+from poro2d.sweep.relation import RelationCase, run_relation
 
 QUIET = RunOptions(progress=False)
 
@@ -24,7 +25,8 @@ SMALL = {
     [(run_criterion, {"seed": -1}, "--seed"), (run_criterion_modes, {"mode": "fast"}, "mode"),
      (run_criterion, {"n_lab": 1.5}, "n_lab"), (run_criterion, {"preset": "paper"}, "config/preset"),
      (run_criterion_modes, {"mode": "density"}, "density.n_max/n_min"),
-     (run_density_criterion, {}, "density.n_max/n_min"),
+     (run_density_criterion, {"mode": "density"}, "density.n_max/n_min"),
+     (run_density_criterion, {}, "mode"),
      (run_criterion, {"config": dict(SMALL, density={"mode": "density"})}, "density.n_max/n_min"),
      (run_criterion, {"config": dict(SMALL, density={"mode": "density", "n_max": 0.45, "n_min": 0.33})},
       "density.mode")],
@@ -32,9 +34,8 @@ SMALL = {
 def test_run_criterion_refuses_bad_input_before_writing(tmp_path, run, kw, name):
     out = tmp_path / "o"
     kw = {"config": SMALL, **kw}
-    where = {"store": Store(out)}
     with pytest.raises(InputError) as e:
-        run(kw.pop("config"), options=QUIET, **where, **kw)
+        run(CriterionCase.from_config(kw.pop("config"), **kw), Store(out), options=QUIET)
     assert e.value.parameter == name
     assert not out.exists()
 
@@ -45,7 +46,7 @@ def test_run_criterion_matches_the_command(tmp_path):
 
     from poro2d.cli import main
 
-    res = run_criterion(SMALL, store=Store(tmp_path / "api"), options=QUIET)
+    res = run_criterion(CriterionCase.from_config(SMALL), Store(tmp_path / "api"), options=QUIET)
     assert isinstance(res, CriterionResult)
     cfg = tmp_path / "c.toml"
     cfg.write_text(
@@ -63,6 +64,6 @@ def test_run_criterion_matches_the_command(tmp_path):
 def test_run_relation_refuses_bad_input_before_writing(tmp_path, kw, name):
     out = tmp_path / "o"
     with pytest.raises(InputError) as e:
-        run_relation(None, store=Store(out), quick=True, options=QUIET, **kw)
+        run_relation(RelationCase.from_config(None, quick=True, **kw), Store(out), options=QUIET)
     assert name in e.value.parameter
     assert not out.exists()

@@ -1,6 +1,7 @@
 """``poro2d criterion``: the paper's Fig. 3 from a config file or the paper preset, in either mode.
 
-Both modes run through :func:`poro2d.sweep.density_criterion.run_criterion_modes`; paper
+The options make one :class:`~poro2d.criterion.run.CriterionCase`; both modes run through
+:func:`poro2d.sweep.density_criterion.run_criterion_modes`; paper
 mode's table is the criterion layer's (:func:`poro2d.criterion.table.print_result`), which
 ``poro2d paper`` prints too.
 """
@@ -26,6 +27,12 @@ PAPER_MODE_NOTE = (
     "your density give both laboratory extremes (--n-max/--n-min or [density]) or use poro2d sand"
 )
 
+#: --mode's help: both modes, and when each is the default
+MODE_HELP = (
+    "density (friction from Dr; the default when both laboratory extremes are given) or paper "
+    "(preparation friction 0.05; the default otherwise)."
+)
+
 
 def register(app: typer.Typer) -> None:
     @app.command("criterion")
@@ -37,12 +44,7 @@ def register(app: typer.Typer) -> None:
         n_lab: float = typer.Option(None, "--n-lab", help="Laboratory porosity (overrides the config)."),
         trial: float = typer.Option(None, "--trial-porosity", help="First trial n2D instead of Eq. 12."),
         threads: int = opt.threads(),
-        mode: str = typer.Option(
-            None,
-            "--mode",
-            help="density (friction from Dr; the default when both laboratory extremes are "
-            "given) or paper (preparation friction 0.05; the default otherwise).",
-        ),
+        mode: str = typer.Option(None, "--mode", help=MODE_HELP),
         n_max: float = typer.Option(None, "--n-max", help="Density mode: loosest laboratory porosity."),
         n_min: float = typer.Option(None, "--n-min", help="Density mode: densest laboratory porosity."),
         seeds: int = typer.Option(None, "--seeds", help="Density mode: specimens per state (3)."),
@@ -54,16 +56,19 @@ def register(app: typer.Typer) -> None:
         grading (preparation friction -> accepted n2D, cached), sets the preparation friction
         from the laboratory relative density and runs the criterion over seeds.
         """
+        from poro2d.criterion.run import CriterionCase
         from poro2d.execute.options import RunOptions
+        from poro2d.io_utils import check_output_dir
         from poro2d.report.criterion_figures import draw_criterion
         from poro2d.sweep.density_criterion import run_criterion_modes
 
-        store = Store(out)
-        result = run_criterion_modes(
-            config, preset=preset, store=store, seed=seed, n_lab=n_lab, trial_porosity=trial,
-            threads=threads, mode=mode, n_max=n_max, n_min=n_min, seeds=seeds,
-            options=RunOptions(progress=not quiet),
+        check_output_dir("--out", out)  # a bad folder is named before the config is read
+        case = CriterionCase.from_config(
+            config, preset=preset, seed=seed, n_lab=n_lab, trial_porosity=trial, threads=threads, mode=mode,
+            n_max=n_max, n_min=n_min, seeds=seeds,
         )  # fmt: skip
+        store = Store(out)
+        result = run_criterion_modes(case, store, options=RunOptions(progress=not quiet))
         if isinstance(result, DensityStateResult):
             print_density(result, out)
             return

@@ -44,19 +44,20 @@ def relation_cmd(
     accepted n2D, the grading's densest and loosest 2D states), every laboratory state is
     mapped between them by its relative density, and checked by the criterion over seeds.
     """
+    from poro2d.io_utils import check_output_dir
     from poro2d.report.relation_figure import draw_relation
     from poro2d.store import Store
-    from poro2d.sweep.relation import run_relation
+    from poro2d.sweep.relation import RelationCase, run_relation
 
     def banner() -> None:  # once every input is checked: a refusal is the only line
         console.print(f"criterion relation{' (quick)' if quick else ''} -> {out}")
 
+    options = opt.job_options(workers, scheduler, quiet, dashboard)
+    check_output_dir("--out", out)  # a bad folder is named before the config is read
+    case = RelationCase.from_config(config, preset=preset, points=points, n_max=n_max, n_min=n_min, mode=mode,
+                                    seeds=seeds, quick=quick)  # fmt: skip
     store = Store(out)
-    rel = run_relation(
-        config, preset=preset, store=store, points=points, n_max=n_max, n_min=n_min, mode=mode,
-        seeds=seeds, quick=quick, options=opt.job_options(workers, scheduler, quiet, dashboard),
-        announce=banner,
-    )  # fmt: skip
+    rel = run_relation(case, store, options=options, announce=banner)
     draw_relation(rel, store)
     print_relation(rel, out)
     if rel.failed_cases:

@@ -39,26 +39,23 @@ def register(app: typer.Typer) -> None:
         """Why the paper's case gives what it gives: the criterion in the paper's protocol
         (mu_prep 0.05, first trial from Eq. 12) against grading width (Cu) and against
         preparation friction, over seeds, beside the paper's 0.15."""
-        from poro2d.criterion.config import load_config
         from poro2d.errors import check_int
         from poro2d.io_utils import check_output_dir
         from poro2d.report.sensitivity_report import draw_sensitivity
         from poro2d.store import Store
-        from poro2d.sweep.criterion_base import CriterionBase
-        from poro2d.sweep.sensitivity import run_sensitivity
+        from poro2d.sweep.sensitivity import SensitivityCase, run_sensitivity
 
         options = opt.job_options(workers, scheduler, quiet, dashboard)
         if seeds is not None:
             check_int("--seeds", seeds, 1, 50)
         check_output_dir("--out", out)
-        cfg, base_dir = load_config(config, preset, extra_tables=("sensitivity",))
-        base = CriterionBase.from_config(cfg, base_dir)
+        case = SensitivityCase.from_config(config, preset=preset, quick=quick, seeds=seeds)
 
         def banner() -> None:  # once every input is checked: a refusal is the only line
             console.print(f"sensitivity study{' (quick)' if quick else ''} -> {out}")
 
         store = Store(out)
-        sens = run_sensitivity(base, store, quick=quick, seeds=seeds, options=options, announce=banner)
+        sens = run_sensitivity(case, store, options=options, announce=banner)
         draw_sensitivity(sens, store)
         print_sensitivity(sens, out)
         failed = sens.sweeps.failed_cases

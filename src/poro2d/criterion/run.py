@@ -1,8 +1,8 @@
 """``run_criterion``: the criterion of ``poro2d criterion`` (paper mode) as one Python call.
 
-The command only parses its options and prints; the checks of every input of both modes
-(:func:`criterion_inputs`) and the paper mode's run are here, so a script gets the same
-checks, files and resuming. Density mode runs its specimens on the sweep layer
+The command only parses its options and prints; the case of both modes, every input checked
+when it is made (:meth:`CriterionCase.from_config`), and the paper mode's run are here, so a
+script gets the same checks, files and resuming. Density mode runs its specimens on the sweep layer
 (:mod:`poro2d.sweep.density_criterion`, which also dispatches the command's two modes).
 """
 
@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import copy
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.criterion.result import CriterionResult
+from poro2d.errors import InputError, check_int, check_range
 from poro2d.execute.options import RunOptions
 from poro2d.grading import GradingCurve
 from poro2d.specimen.compaction import SpecimenSpec
@@ -37,8 +38,6 @@ def load(
 
     if isinstance(config, dict):
         if preset is not None:
-            from poro2d.errors import InputError
-
             raise InputError("config/preset", f"a dict and {preset}", "one of the two, not both")
         from poro2d.criterion.config import check_tables
 
@@ -55,7 +54,8 @@ class DensitySettings:
     """The mode of ``poro2d criterion`` and, in density mode, its settings.
 
     ``mu_prep``: the calibration's preparation frictions (None: the defaults); ``n_max``,
-    ``n_min``: the laboratory extremes; ``seeds``: specimens per state (density mode only).
+    ``n_min``: the laboratory extremes; ``seeds``: specimens per state; ``threads``: the DEM
+    threads the option gave the states' specimens (None: the config's) (density mode only).
     """
 
     mode: str
@@ -63,6 +63,7 @@ class DensitySettings:
     n_max: float | None = None
     n_min: float | None = None
     seeds: int | None = None
+    threads: int | None = None
 
 
 def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> DensitySettings:
@@ -71,10 +72,8 @@ def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> D
     With no mode given, density mode when both laboratory extremes are (``[density]`` or the
     options), else paper mode.
     """
-    from poro2d import porosity as P
     from poro2d.config import check_keys
     from poro2d.criterion.density import check_mus
-    from poro2d.errors import InputError, check_int, check_range
 
     check_keys("density", cfg.get("density") or {}, DENSITY_KEYS)
     t = dict(cfg.get("density") or {})
@@ -96,28 +95,34 @@ def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> D
         return DensitySettings(mode)
     mus = t.get("mu_prep")
     mu_prep = None if mus is None else check_mus(mus, "density.mu_prep")
+    hi, lo = lab_extremes(
+        "density", t, n_max, n_min, preset=preset, hint="set them in [density] or with --n-max/--n-min"
+    )
+    seeds = check_int("seeds", seeds if seeds is not None else t.get("seeds", 3), 1, 50)
+    return DensitySettings(mode, mu_prep, n_max=hi, n_min=lo, seeds=seeds)
+
+
+def lab_extremes(table: str, t: dict, n_max, n_min, *, preset: bool, hint: str) -> tuple[float, float]:
+    """The laboratory extremes (n_max, n_min): the options, else ``table``'s ``t``, else (the
+    preset) the paper's; both checked in (0, 1). ``hint``: where a user sets them."""
+    from poro2d import porosity as P
+
     hi = n_max if n_max is not None else t.get("n_max", P.PAPER_N_MAX if preset else None)
     lo = n_min if n_min is not None else t.get("n_min", P.PAPER_N_MIN if preset else None)
     if hi is None or lo is None:
-        raise InputError("density.n_max/n_min", (hi, lo), "both laboratory extremes",
-                         "set them in [density] or with --n-max/--n-min")  # fmt: skip
-    return DensitySettings(
-        mode,
-        mu_prep,
-        n_max=check_range("n_max", hi, 0.0, 1.0, lo_open=True, hi_open=True),
-        n_min=check_range("n_min", lo, 0.0, 1.0, lo_open=True, hi_open=True),
-        seeds=check_int("seeds", seeds if seeds is not None else t.get("seeds", 3), 1, 50),
-    )
+        raise InputError(f"{table}.n_max/n_min", (hi, lo), "both laboratory extremes", hint)
+    return (check_range("n_max", hi, 0.0, 1.0, lo_open=True, hi_open=True),
+            check_range("n_min", lo, 0.0, 1.0, lo_open=True, hi_open=True))  # fmt: skip
 
 
 @dataclass(frozen=True)
-class CriterionInputs:
+class CriterionCase:
     """A criterion config checked and built, before anything runs (both modes start here).
 
     ``config``: the config as loaded, with the seed option applied; ``base``: the folder its
     relative paths start from; ``density``: the mode and, in density mode, its settings
     (:func:`density_settings`); ``spec``, ``grading``, ``settings``, ``seed``: the objects
-    the criterion runs on.
+    the criterion runs on. Made by :meth:`from_config`.
     """
 
     config: dict
@@ -132,84 +137,63 @@ class CriterionInputs:
     def mode(self) -> str:
         return self.density.mode
 
+    @classmethod
+    def from_config(cls, config: ConfigLike = None, *, preset: str | None = None, seed: int | None = None,
+                    n_lab: float | None = None, trial_porosity: float | None = None,
+                    threads: int | None = None, mode: str | None = None, n_max: float | None = None,
+                    n_min: float | None = None, seeds: int | None = None) -> CriterionCase:  # fmt: skip
+        """The case of ``poro2d criterion``: ``config`` (a dict, a TOML file, or the paper preset
+        when None) with the command's options applied, every input checked, the specimen's
+        feasibility too (InputError if not)."""
+        from poro2d.criterion.config import build
+        from poro2d.criterion.density import lab_relative_density
+        from poro2d.specimen.compaction import check_feasible
 
-def criterion_inputs(
-    config: ConfigLike = None,
-    *,
-    preset: str | None = None,
-    seed: int | None = None,
-    n_lab: float | None = None,
-    trial_porosity: float | None = None,
-    threads: int | None = None,
-    mode: str | None = None,
-    n_max: float | None = None,
-    n_min: float | None = None,
-    seeds: int | None = None,
-) -> CriterionInputs:
-    """Every input of ``poro2d criterion`` checked, the specimen's feasibility too (InputError if not)."""
-    from poro2d.criterion.config import build
-    from poro2d.errors import check_int
-    from poro2d.specimen.compaction import check_feasible
-
-    # a [relation] table is the relation's: one config serves both commands
-    cfg, base = load(config, preset, extra_tables=("relation",))
-    if seed is not None:
-        cfg["seed"] = check_int("--seed", seed, 0)
-    dens = density_settings(cfg, mode, n_max, n_min, seeds, preset=config is None)
-    spec, grading, settings, sd = build(
-        cfg, base, n_lab=n_lab, trial_porosity=trial_porosity, threads=threads
-    )
-    check_feasible(spec, grading, settings.initial_trial())
-    return CriterionInputs(cfg, base, dens, spec, grading, settings, sd)
+        # a [relation] table is the relation's: one config serves both commands
+        cfg, base = load(config, preset, extra_tables=("relation",))
+        if seed is not None:
+            cfg["seed"] = check_int("--seed", seed, 0)
+        dens = density_settings(cfg, mode, n_max, n_min, seeds, preset=config is None)
+        spec, grading, settings, sd = build(
+            cfg, base, n_lab=n_lab, trial_porosity=trial_porosity, threads=threads
+        )
+        check_feasible(spec, grading, settings.initial_trial())
+        if dens.mode == "density":
+            _refuse_paper_options(seed, trial_porosity)
+            # a state outside [n_min, n_max] has no relative density: refused before any run
+            lab_relative_density(settings.n_lab, dens.n_max, dens.n_min)
+            # the option's thread count goes to the density runs' specimens, as this one was built
+            dens = replace(dens, threads=None if threads is None else spec.threads)
+        return cls(cfg, base, dens, spec, grading, settings, sd)
 
 
-def run_paper_mode(
-    inputs: CriterionInputs, store: Store | None, *, options: RunOptions = RunOptions()
-) -> CriterionResult:
-    """The criterion of Fig. 3 once, on checked inputs, kept in ``store`` (resumable; None: kept nowhere).
-
-    ``options``: whether bars show (:class:`~poro2d.execute.options.RunOptions`; the criterion
-    runs in this process).
-    """
-    return PorosityCriterion(inputs.spec, inputs.grading, inputs.settings, seed=inputs.seed, store=store,
-                             progress=options.progress, config=inputs.config).run()  # fmt: skip
+def _refuse_paper_options(seed: int | None, trial_porosity: float | None) -> None:
+    # density mode runs seeds 0 .. seeds-1, each from its state's 2D target: a seed or a
+    # first trial of its own would be ignored, so they are refused
+    for option, value in (("--seed", seed), ("--trial-porosity", trial_porosity)):
+        if value is not None:
+            raise InputError(option, value, "only in paper mode (density: --seeds and the 2D target)")
 
 
 def run_criterion(
-    config: ConfigLike = None,
-    *,
-    preset: str | None = None,
-    store: Store | None = None,
-    seed: int | None = None,
-    n_lab: float | None = None,
-    trial_porosity: float | None = None,
-    threads: int | None = None,
-    options: RunOptions = RunOptions(),
+    case: CriterionCase, store: Store | None = None, *, options: RunOptions = RunOptions()
 ) -> CriterionResult:
-    """The criterion of Fig. 3 for a config (a dict, a TOML file, or the paper preset when None).
+    """The criterion of Fig. 3 for a paper-mode ``case`` (:meth:`CriterionCase.from_config`).
 
     Runs it once, as the paper does, and returns the
     :class:`~poro2d.criterion.result.CriterionResult` kept as ``result.json`` in ``store``
-    (held for the call, resumable; None: nothing is kept). The keyword options override the
-    config as the command's options do; ``threads``: the DEM kernels' threads, ``options``: whether
-    bars show (:class:`~poro2d.execute.options.RunOptions`; the criterion runs in this process).
-    Density mode (a config whose ``[density]`` table says ``mode = "density"``) runs on the sweep
-    layer: :func:`poro2d.sweep.density_criterion.run_density_criterion` is its call, and it is
-    refused here. Bad input raises :class:`~poro2d.errors.InputError` before anything is
-    written.
+    (held for the call, resumable; None: nothing is kept). ``options``: whether bars show
+    (:class:`~poro2d.execute.options.RunOptions`; the criterion runs in this process).
+    A density-mode case runs on the sweep layer:
+    :func:`poro2d.sweep.density_criterion.run_density_criterion` is its call, and it is
+    refused here before anything is written.
     """
-    from poro2d.errors import InputError
-
-    def run() -> CriterionResult:
-        inputs = criterion_inputs(config, preset=preset, seed=seed, n_lab=n_lab,
-                                  trial_porosity=trial_porosity, threads=threads)  # fmt: skip
-        if inputs.mode == "density":
-            raise InputError("density.mode", "density", "paper here (density mode: "
-                             "poro2d.sweep.density_criterion.run_density_criterion)")  # fmt: skip
-        return run_paper_mode(inputs, store, options=options)
-
+    if case.mode == "density":
+        raise InputError("density.mode", "density", "paper here (density mode: "
+                         "poro2d.sweep.density_criterion.run_density_criterion)")  # fmt: skip
     with claimed(store, KIND):
-        return run()
+        return PorosityCriterion(case.spec, case.grading, case.settings, seed=case.seed, store=store,
+                                 progress=options.progress, config=case.config).run()  # fmt: skip
 
 
-__all__ = ["CriterionInputs", "DensitySettings", "criterion_inputs", "run_criterion", "run_paper_mode"]
+__all__ = ["CriterionCase", "DensitySettings", "lab_extremes", "run_criterion"]

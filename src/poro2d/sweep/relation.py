@@ -21,6 +21,7 @@ import numpy as np
 
 from poro2d import porosity as P
 from poro2d.config import check_keys, check_number_list
+from poro2d.criterion.run import lab_extremes
 from poro2d.errors import InputError, check_range
 from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance, check_output_dir, float_or_nan
@@ -103,17 +104,9 @@ def relation_settings(
     for key in ("n_max", "n_min"):  # a wrong value in the file is refused, even when an option wins
         if key in t:
             check_range(f"relation.{key}", t[key], 0.0, 1.0, lo_open=True, hi_open=True)
-    hi = n_max if n_max is not None else t.get("n_max", P.PAPER_N_MAX if preset else None)
-    lo = n_min if n_min is not None else t.get("n_min", P.PAPER_N_MIN if preset else None)
-    if hi is None or lo is None:
-        raise InputError(
-            "relation.n_max/n_min",
-            (hi, lo),
-            "both laboratory extremes",
-            "set them in [relation] or --n-max/--n-min",
-        )
-    hi = check_range("n_max", hi, 0.0, 1.0, lo_open=True, hi_open=True)
-    lo = check_range("n_min", lo, 0.0, 1.0, lo_open=True, hi_open=True)
+    hi, lo = lab_extremes(
+        "relation", t, n_max, n_min, preset=preset, hint="set them in [relation] or --n-max/--n-min"
+    )
     if not hi > lo:
         raise InputError("n_max", hi, f"greater than n_min = {lo}")
     if "n_lab" in t and points is None:
@@ -402,72 +395,94 @@ def refuse_density_options(table: dict, seeds: int | None) -> None:
             raise InputError(f"relation.{key}", table[key], "only in density mode (paper mode: leave it out)")
 
 
+@dataclass(frozen=True)
+class RelationCase:
+    """A relation checked and built, before anything runs (:meth:`from_config`).
+
+    ``config``: the config as loaded (kept in ``relation.json``); ``base``: its criterion
+    config, without ``[state]``; ``settings``: the extremes and the states; ``mode``:
+    density or paper; ``quick``: the small box; ``seeds``, ``mus``: density mode's specimens
+    per state and calibration frictions (None: the defaults); ``state``: the ``[state]``
+    request (None without one); ``states``: paper mode's sweep, every case built.
+    """
+
+    config: dict
+    base: CriterionBase
+    settings: RelationSettings
+    mode: str
+    quick: bool
+    states: SweepConfig
+    seeds: int | None = None
+    mus: list[float] | None = None
+    state: Any = None
+
+    @classmethod
+    def from_config(cls, config=None, *, preset: str | None = None, points: int | None = None,
+                    n_max: float | None = None, n_min: float | None = None, mode: str | None = None,
+                    seeds: int | None = None, quick: bool = False) -> RelationCase:  # fmt: skip
+        """The case of ``poro2d relation``: ``config`` (a dict, a TOML file, or the paper preset
+        when None) with an optional ``[relation]`` table, which the keyword options override;
+        every input checked (InputError if not)."""
+        from poro2d.criterion.density import check_mus
+        from poro2d.criterion.run import load
+        from poro2d.sweep.density import check_seeds
+
+        cfg, base_dir = load(config, preset, extra_tables=("relation", "state"))
+        # [state] reads the relation's answers; the criterion cases never see it
+        base = CriterionBase.from_config({k: v for k, v in cfg.items() if k != "state"}, base_dir)
+        table = cfg.get("relation") or {}
+        settings = relation_settings(
+            table or None, points=points, n_max=n_max, n_min=n_min, preset=config is None
+        )
+        mode = check_mode(mode if mode is not None else table.get("mode", "density"))
+        state = relation_state(cfg.get("state"), base, settings, mode)
+        n_seeds = mus = None
+        if mode == "density":
+            n_seeds = check_seeds(seeds if seeds is not None else table.get("seeds", 3), "relation.seeds")
+            mus = check_mus(table["mu_prep"], "relation.mu_prep") if "mu_prep" in table else None
+        else:
+            refuse_density_options(table, seeds)
+        # every criterion case of the relation built once, without running: a bad specimen, grading
+        # or criterion setting is refused before the calibration starts, not when its case comes up
+        states = relation_sweep(relation_base(base, quick=quick), settings.n_lab)
+        return cls(cfg, base, settings, mode, bool(quick), states, n_seeds, mus, state)
+
+
 def run_relation(
-    config=None,
-    *,
-    preset: str | None = None,
-    store: Store | None = None,
-    points: int | None = None,
-    n_max: float | None = None,
-    n_min: float | None = None,
-    mode: str | None = None,
-    seeds: int | None = None,
-    quick: bool = False,
-    options: RunOptions = RunOptions(),
-    announce=None,
+    case: RelationCase, store: Store | None = None, *, options: RunOptions = RunOptions(), announce=None
 ) -> RelationResult:
     """``poro2d relation`` as one call: the grading's n2D(nLab) relation, written to ``store``.
 
-    ``config``: a criterion config (a dict, a TOML file, or the paper preset when None) with
-    an optional ``[relation]`` table, which the keyword options override. Density mode (the
-    default) calibrates the grading, maps every laboratory state by its relative density and
-    checks it over ``seeds``; paper mode runs the criterion once per state at the fixed
-    preparation friction. Returns the :class:`RelationResult` written to ``relation.json``;
-    its ``failed_cases`` counts the cases that raised (their tracebacks are in ``store``; None:
-    nothing is kept but the shared calibration cache). Every input is
-    checked before the first case runs; ``announce`` (no arguments) is called then, before
-    any work (the command prints its banner there, so a refusal stays one line). ``options``: where
-    the jobs run and whether bars show (:class:`~poro2d.execute.options.RunOptions`).
+    ``case``: the relation's :class:`RelationCase`. Density mode (the default) calibrates the
+    grading, maps every laboratory state by its relative density and checks it over the
+    case's seeds; paper mode runs the criterion once per state at the fixed preparation
+    friction. Returns the :class:`RelationResult` written to ``relation.json``; its
+    ``failed_cases`` counts the cases that raised (their tracebacks are in ``store``; None:
+    nothing is kept but the shared calibration cache). ``announce`` (no arguments) is called
+    once the folder and the scheduler are checked, before any work (the command prints its
+    banner there, so a refusal stays one line). ``options``: where the jobs run and whether
+    bars show (:class:`~poro2d.execute.options.RunOptions`).
     """
-    from poro2d.criterion.density import check_mus
-    from poro2d.criterion.run import load
     from poro2d.execute.dask_cluster import check_reachable
-    from poro2d.sweep.density import check_seeds
     from poro2d.sweep.runner import run_sweep
 
     if store is not None:
         check_output_dir(store.parameter, store.root)
-    cfg, base_dir = load(config, preset, extra_tables=("relation", "state"))
-    # [state] reads the relation's answers; the criterion cases never see it
-    base = CriterionBase.from_config({k: v for k, v in cfg.items() if k != "state"}, base_dir)
-    table = cfg.get("relation") or {}
-    settings = relation_settings(
-        table or None, points=points, n_max=n_max, n_min=n_min, preset=config is None
-    )
-    mode = check_mode(mode if mode is not None else table.get("mode", "density"))
-    state = relation_state(cfg.get("state"), base, settings, mode)
-    if mode == "density":
-        n_seeds = check_seeds(seeds if seeds is not None else table.get("seeds", 3), "relation.seeds")
-        mus = check_mus(table["mu_prep"], "relation.mu_prep") if "mu_prep" in table else None
-    else:
-        refuse_density_options(table, seeds)
-    # every criterion case of the relation built once, without running: a bad specimen, grading
-    # or criterion setting is refused before the calibration starts, not when its case comes up
-    states = relation_sweep(relation_base(base, quick=quick), settings.n_lab)
     check_reachable(options.scheduler)
     if announce is not None:
         announce()
+    extra: dict[str, Any] = {"quick": case.quick}
     with held(store, kind="relation") as kept:
-        if mode == "density":
-            rel, record = density_relation(base, settings, kept, quick=quick, seeds=n_seeds, mus=mus,
-                                           options=options)  # fmt: skip
-            extra = {"quick": quick, "config": cfg, "sweeps": record}
-            if state is not None:
-                extra["state_maps"] = state_maps(state, rel, settings, base)
+        if case.mode == "density":
+            rel, record = density_relation(case.base, case.settings, kept, quick=case.quick, seeds=case.seeds,
+                                           mus=case.mus, options=options)  # fmt: skip
+            extra.update(config=case.config, sweeps=record)
+            if case.state is not None:
+                extra["state_maps"] = state_maps(case.state, rel, case.settings, case.base)
         else:
-            res = run_sweep(states, kept, options=options)
-            rel = analyse(res.rows, settings.n_max, settings.n_min)
-            extra = {"quick": quick, "sweep_summary": res.summary, "config": cfg}
+            res = run_sweep(case.states, kept, options=options)
+            rel = analyse(res.rows, case.settings.n_max, case.settings.n_min)
+            extra.update(sweep_summary=res.summary, config=case.config)
         result = RelationResult.from_dict(dict(rel.to_dict(), **extra, provenance=Provenance.now().to_dict()))
         write_relation(result, kept)
     return result

@@ -23,11 +23,12 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Self
 
 import numpy as np
 
 from poro2d.config import check_keys, check_number_list
+from poro2d.criterion.settings import CriterionSettings
 from poro2d.errors import InputError
 from poro2d.execute.options import RunOptions
 from poro2d.io_utils import check_output_dir, float_or_nan
@@ -35,6 +36,7 @@ from poro2d.paper_data import QUICK_CRITERION
 from poro2d.store import Store
 from poro2d.sweep.cases import SweepConfig
 from poro2d.sweep.criterion_base import CriterionBase
+from poro2d.sweep.density import CalibrationCase
 from poro2d.sweep.output import held
 from poro2d.sweep.records import CaseRow, LostCaseRow, case_row
 from poro2d.sweep.results import SensitivityResult
@@ -434,68 +436,101 @@ def _first_trial_lines(ref: GradingPoint | None, paper: PaperNumbers) -> list[st
 
 
 # ----------------------------------------------------------------------------------- run
+@dataclass(frozen=True)
+class SensitivityCase:
+    """The study checked and built, before anything runs (:meth:`from_config`, :meth:`from_base`).
+
+    ``study``: the criterion base every case starts from (:func:`study_base`); ``settings``:
+    the Cu list, frictions and seeds; ``crit``: the base's criterion settings; ``gradings``:
+    the reference grading and the family; ``sweep``: the grading sweep, every case built;
+    ``calibration``: the friction axis, the density calibration of the reference grading.
+    """
+
+    study: CriterionBase
+    settings: StudySettings
+    crit: CriterionSettings
+    gradings: list[GradingCase]
+    sweep: SweepConfig
+    calibration: CalibrationCase
+
+    @classmethod
+    def from_config(
+        cls, config=None, *, preset: str | None = None, quick: bool = False, seeds: int | None = None
+    ) -> Self:
+        """The case of ``poro2d sensitivity``: ``config`` (a dict, a TOML file, or the paper preset
+        when None) with an optional ``[sensitivity]`` table (``cu``, ``mu_prep``, ``seeds``)."""
+        from poro2d.criterion.run import load
+
+        cfg, base_dir = load(config, preset, extra_tables=("sensitivity",))
+        return cls.from_base(CriterionBase.from_config(cfg, base_dir), quick=quick, seeds=seeds)
+
+    @classmethod
+    def from_base(cls, base: CriterionBase, *, quick: bool = False, seeds: int | None = None) -> Self:
+        """The case of a criterion config as read, ``seeds`` (None: the table's) and ``quick`` applied;
+        every grading checked against the box (InputError if not)."""
+        from poro2d.criterion.config import build
+        from poro2d.sweep import density as D
+
+        settings = study_settings(base.config.get("sensitivity"), quick=quick, seeds=seeds)
+        study = study_base(base, quick=quick)
+        _, _, crit, _ = build(study.as_config(), study.base_dir)
+        cases = gradings(study, settings.cus)
+        check_gradings(study, cases)
+        sweep = grading_sweep(study, cases, settings.seeds)
+        # the friction axis is the density calibration, with its settings (layers that settle):
+        # the same cases as the relation's, read back from the shared cache when it ran them
+        calibration = CalibrationCase(D.with_density_defaults(study), tuple(settings.mus), settings.seeds)
+        calibration.sweep  # noqa: B018 (its cases are built, so checked, now)
+        return cls(study, settings, crit, cases, sweep, calibration)
+
+
 def run_sensitivity(
-    base: CriterionBase,
+    case: SensitivityCase,
     store: Store | None = None,
     *,
-    quick: bool = False,
-    seeds: int | None = None,
-    use_cache: bool = True,
-    announce=None,
     options: RunOptions = RunOptions(),
+    announce=None,
+    use_cache: bool = True,
     client=None,
 ) -> SensitivityResult:
     """The whole study into ``store``; returns the :class:`SensitivityResult` of its ``sensitivity.json``.
 
-    ``base``: a criterion config as read, optionally with a ``[sensitivity]`` table (``cu``,
-    ``mu_prep``, ``seeds``); ``store``: where the study is kept (None: nothing is kept but
-    the shared calibration cache). Everything is checked before the first case runs; ``announce``
-    (no arguments) is called then, before any work.
-    ``options``: where the jobs run and whether bars show (:class:`~poro2d.execute.options.RunOptions`);
-    ``client``: an existing Dask client instead (:func:`~poro2d.sweep.runner.run_sweep`).
+    ``case``: the study's :class:`SensitivityCase`; ``store``: where the study is kept (None:
+    nothing is kept but the shared calibration cache). ``announce`` (no arguments) is called
+    once the folder and the scheduler are checked, before any work; ``use_cache``: the
+    calibration's cases in the shared cache. ``options``: where the jobs run and whether bars
+    show (:class:`~poro2d.execute.options.RunOptions`); ``client``: an existing Dask client
+    instead (:func:`~poro2d.sweep.runner.run_sweep`).
     """
-    from poro2d.criterion.config import build
     from poro2d.execute.dask_cluster import check_reachable
-    from poro2d.sweep import density as D
 
     if store is not None:
         check_output_dir(store.parameter, store.root)
-    settings = study_settings(base.config.get("sensitivity"), quick=quick, seeds=seeds)
-    study = study_base(base, quick=quick)
-    _, _, crit, _ = build(study.as_config(), study.base_dir)
-    cases = gradings(study, settings.cus)
-    check_gradings(study, cases)
-    sweep = grading_sweep(study, cases, settings.seeds)
-    # the friction axis is the density calibration, with its settings (layers that settle):
-    # the same cases as the relation's, read back from the shared cache when it ran them
-    calibration = D.CalibrationCase(D.with_density_defaults(study), tuple(settings.mus), settings.seeds)
-    calibration.sweep  # noqa: B018 (its cases are built, so checked, now)
     check_reachable(options.scheduler)
     if announce is not None:
         announce()
     with held(store, kind="sensitivity") as kept:
-        return _run_study(study, crit, cases, sweep, calibration, settings, kept, use_cache=use_cache,
-                          options=options, client=client)  # fmt: skip
+        return _run_study(case, kept, use_cache=use_cache, options=options, client=client)
 
 
-def _run_study(study: CriterionBase, crit, cases: list[GradingCase], sweep: SweepConfig, calibration,
-               settings: StudySettings, store: Store, *, use_cache: bool, options: RunOptions,
+def _run_study(case: SensitivityCase, store: Store, *, use_cache: bool, options: RunOptions,
                client) -> SensitivityResult:  # fmt: skip
-    """The grading sweep, the calibration, and the study's record of both (checked inputs)."""
+    """The grading sweep, the calibration, and the study's record of both."""
     from poro2d.sweep import density as D
     from poro2d.sweep.runner import run_sweep
 
+    study, crit, settings = case.study, case.crit, case.settings
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
-    res = run_sweep(sweep, store.child("grading"), options=options, client=client)
+    res = run_sweep(case.sweep, store.child("grading"), options=options, client=client)
     timings["grading_s"] = time.perf_counter() - t0
     t1 = time.perf_counter()
     cal, cal_info = D.calibrate(
-        calibration, store.child("mu_prep"), use_cache=use_cache, options=options, client=client
+        case.calibration, store.child("mu_prep"), use_cache=use_cache, options=options, client=client
     )
     timings["mu_prep_s"] = time.perf_counter() - t1
 
-    grads = [g.describe() for g in cases]
+    grads = [g.describe() for g in case.gradings]
     labels = [(g, s) for g in grads for s in range(settings.seeds)]
     records = [seed_record(r, g, s) for r, (g, s) in zip(res.rows, labels, strict=True)]
     spec = study.table("specimen")
@@ -571,6 +606,7 @@ __all__ = [
     "load_sensitivity",
     "mu_points",
     "run_sensitivity",
+    "SensitivityCase",
     "seed_record",
     "study_settings",
     "finite_mean_sd",
