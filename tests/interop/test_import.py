@@ -374,3 +374,15 @@ def test_an_option_for_what_the_file_sets_is_refused_not_ignored(spec, saved, tm
     refused(["import", tmp_path / "lmp" / lmp.DATA_FILE, "--out", tmp_path / "out", "--wall-friction", "0.3"],
             capsys, "--wall-friction = 0.3", "(wall top mu)")  # fmt: skip
     refused(["import", saved, "--out", tmp_path / "out", "--thickness", "0.01"], capsys, "a checkpoint")
+
+
+def test_a_refused_import_leaves_a_folder_of_other_files_as_it_was(spec, tmp_path, capsys):
+    """The file is read and checked before the output folder is claimed: no kind marker is left."""
+    lmp.write_specimen(spec, tmp_path)
+    data = tmp_path / lmp.DATA_FILE
+    data.write_text(data.read_text().replace("\n1 atom types\n", "\n2 atom types\n"))
+    folder = tmp_path / "mine"
+    folder.mkdir()
+    (folder / "notes.txt").write_text("mine\n")
+    refused(["import", data, "--out", folder], capsys, "(atom types) = '2'")
+    assert sorted(p.name for p in folder.iterdir()) == ["notes.txt"]

@@ -11,6 +11,7 @@ import pytest
 from poro2d import __version__
 from poro2d.cli import main
 from poro2d.cli.export import export_specimen
+from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.interop import csv_table, lammps, pfc, yade
 from poro2d.interop.check import DEFAULTS
@@ -296,3 +297,26 @@ def test_export_cli_refusals_name_the_option(relation, specimen, tmp_path, capsy
         err = capsys.readouterr().err
         assert e.value.code == 2 and words in err and len(err.strip().splitlines()) == 1, err
         assert not (tmp_path / "x").exists()
+
+
+@pytest.mark.parametrize("target", ["lammps", "pfc", "yade", "csv"])
+def test_a_refused_export_leaves_a_folder_of_other_files_as_it_was(tmp_path, specimen, capsys, target):
+    """A target's own refusal (disks of differing properties; YADE and CSV take them, so a state
+    that leaves its folder stands in for them) comes before the output folder is claimed:
+    a non-empty ``--out`` is left without a kind marker, and an import may still use it."""
+    sim = checkpoint.load(specimen)
+    sim.particles.kn[0] *= 2.0
+    mixed = checkpoint.save(sim, tmp_path / "mixed" / "specimen.npz")
+    sand = tmp_path / "sand"
+    sand.mkdir()
+    states = [{"n_lab": 0.45, "relative_density": 0.8, "seed": 0, "specimen": str(mixed.parent)}]
+    (sand / "sand.json").write_text(json.dumps({"mode": "density", "states": states}))
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine\n")
+    given = [mixed] if target in ("lammps", "pfc") else [sand, "--dr", "0.8"]
+    with pytest.raises(SystemExit) as e:
+        main(["export", *map(str, given), "--to", target, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert e.value.code == 2 and len(err.strip().splitlines()) == 1, err
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]

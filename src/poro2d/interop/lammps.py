@@ -45,7 +45,7 @@ from poro2d import __version__
 from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
 from poro2d.interop.csv_table import read_number
-from poro2d.interop.specimen_data import SpecimenData, WallData
+from poro2d.interop.specimen_data import SpecimenData, WallData, write_files
 from poro2d.interop.validate import LIMITS, Limit, check_value, text_of
 
 # positive stand-in for "no normal dashpot" (1/s, times the effective mass)
@@ -84,11 +84,11 @@ def critical_dt(radius, density: float, thickness: float, kn_max: float, factor:
 # ------------------------------------------------------------------ data file
 
 
-def write_data(
-    path: str | os.PathLike, x, y, radius, density, thickness: float, box, margin: float,
-    title: str = "poro2d disks", comments: list[str] | None = None,
-) -> None:  # fmt: skip
-    """A LAMMPS data file (``atom_style sphere``) of disks of thickness ``thickness``.
+def data_text(
+    x, y, radius, density, thickness: float, box, margin: float, title: str = "poro2d disks",
+    comments: list[str] | None = None,
+) -> str:  # fmt: skip
+    """The text of a LAMMPS data file (``atom_style sphere``) of disks of thickness ``thickness``.
 
     ``box`` is (xlo, xhi, ylo, yhi); the simulation box is larger by ``margin`` on each
     side, and spans ``-t/2 .. t/2`` in z. ``comments`` are written below the title as
@@ -112,7 +112,7 @@ def write_data(
         f"{i + 1} 1 {2.0 * float(radius[i])!r} {float(dens[i])!r} {float(x[i])!r} {float(y[i])!r} 0"
         for i in range(x.size)
     ]
-    Path(path).write_text("\n".join(lines + body) + "\n")
+    return "\n".join(lines + body) + "\n"
 
 
 @dataclass
@@ -513,18 +513,16 @@ def _wall_sums() -> str:
     return "\n".join(out)
 
 
-def write_specimen(spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e-3,
-                   max_steps: int = 2_000_000, check_every: int = 500) -> list[Path]:  # fmt: skip
-    """Write ``specimen.data`` and ``in.specimen`` into ``out``; returns their paths.
+def export_files(
+    spec: SpecimenData, ratio: float = 1e-3, max_steps: int = 2_000_000, check_every: int = 500
+) -> list[tuple[str, str]]:
+    """(name, text) of ``specimen.data`` and ``in.specimen``.
 
     The data file's comment lines record the thickness, the per-body properties of the
     disks and every wall (``# poro2d ...``), so that ``poro2d import`` reads the
-    specimen back whole. Each file is written atomically.
+    specimen back whole.
     """
-    from poro2d.io_utils import atomic_path
-
     spec.refuse_dashpot("LAMMPS")
-    out = Path(out)
     params = spec.contact_parameters()  # refuses disks of differing properties first
     box = spec.box()
     script = input_script(spec, ratio, max_steps, check_every)
@@ -541,18 +539,17 @@ def write_specimen(spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e
     if spec.rolling_parameters().disks > 0.0:  # the disks', then each wall's, in wall-line order
         values = [spec.rolling_parameters().disks, *(w.mu_r for w in spec.walls)]
         notes.append("# poro2d rolling_friction " + " ".join(repr(float(v)) for v in values))
-    paths = []
-    with atomic_path(out / DATA_FILE) as tmp:
-        write_data(
-            tmp, spec.x, spec.y, spec.radius, spec.density, spec.thickness, box,
-            margin=float(spec.radius.max()), title=f"poro2d {__version__} specimen (atom_style sphere)",
-            comments=notes,
-        )  # fmt: skip
-    paths.append(out / DATA_FILE)
-    with atomic_path(out / INPUT_FILE) as tmp:
-        tmp.write_text(script)
-    paths.append(out / INPUT_FILE)
-    return paths
+    data = data_text(
+        spec.x, spec.y, spec.radius, spec.density, spec.thickness, box, margin=float(spec.radius.max()),
+        title=f"poro2d {__version__} specimen (atom_style sphere)", comments=notes,
+    )  # fmt: skip
+    return [(DATA_FILE, data), (INPUT_FILE, script)]
+
+
+def write_specimen(spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e-3,
+                   max_steps: int = 2_000_000, check_every: int = 500) -> list[Path]:  # fmt: skip
+    """Write the files of :func:`export_files` into ``out`` (each atomically); returns their paths."""
+    return write_files(out, export_files(spec, ratio, max_steps, check_every))
 
 
 def _wall_note(w: WallData) -> str:
