@@ -23,8 +23,9 @@ import numpy as np
 
 from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
 from poro2d.errors import InputError
-from poro2d.interop.specimen_data import SpecimenData, WallData, write_files
+from poro2d.interop.specimen_data import SpecimenData, WallData
 from poro2d.interop.validate import text_of
+from poro2d.io_utils import write_texts
 
 DISKS_FILE = "disks.csv"
 WALLS_FILE = "walls.csv"
@@ -71,7 +72,7 @@ def export_files(spec: SpecimenData) -> list[tuple[str, str]]:
 
 def write_specimen(spec: SpecimenData, out: str | os.PathLike) -> list[Path]:
     """Write ``disks.csv`` and ``walls.csv`` into ``out`` (atomically); returns their paths."""
-    return write_files(out, export_files(spec))
+    return write_texts(out, export_files(spec))
 
 
 def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:

@@ -45,8 +45,9 @@ from poro2d import __version__
 from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
 from poro2d.interop.csv_table import read_number
-from poro2d.interop.specimen_data import SpecimenData, WallData, write_files
+from poro2d.interop.specimen_data import SpecimenData, WallData
 from poro2d.interop.validate import LIMITS, Limit, check_value, text_of
+from poro2d.io_utils import write_texts
 
 # positive stand-in for "no normal dashpot" (1/s, times the effective mass)
 GAMMA_TINY = 1e-9
@@ -549,7 +550,7 @@ def export_files(
 def write_specimen(spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e-3,
                    max_steps: int = 2_000_000, check_every: int = 500) -> list[Path]:  # fmt: skip
     """Write the files of :func:`export_files` into ``out`` (each atomically); returns their paths."""
-    return write_files(out, export_files(spec, ratio, max_steps, check_every))
+    return write_texts(out, export_files(spec, ratio, max_steps, check_every))
 
 
 def _wall_note(w: WallData) -> str:

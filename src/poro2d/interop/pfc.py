@@ -31,7 +31,8 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.errors import InputError
-from poro2d.interop.specimen_data import SpecimenData, write_files
+from poro2d.interop.specimen_data import SpecimenData
+from poro2d.io_utils import write_texts
 
 CURRENT_FILE = "specimen.p2dat"
 PFC4_FILE = "specimen_pfc4.dat"
@@ -154,4 +155,4 @@ def export_files(spec: SpecimenData) -> list[tuple[str, str]]:
 
 def write_specimen(spec: SpecimenData, out: str | os.PathLike) -> list[Path]:
     """Write the files of :func:`export_files` into ``out`` (atomically)."""
-    return write_files(out, export_files(spec))
+    return write_texts(out, export_files(spec))

@@ -34,7 +34,7 @@ from poro2d.dem.model import PER_BODY_RULE, ContactValues
 from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
 from poro2d.interop.origin import origin_lines
-from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, atomic_path, check_input_file
+from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
 from poro2d.specimen.box import box_faces
 from poro2d.store import Store
 
@@ -370,17 +370,3 @@ def accepted_window(checkpoint_path: Path) -> float | None:
         return None
     ok = isinstance(value, int | float) and not isinstance(value, bool) and 0.0 < value <= 1.0
     return float(value) if ok else None
-
-
-def write_files(out: str | os.PathLike, files: list[tuple[str, str]]) -> list[Path]:
-    """Write each (name, text) of an export into ``out``, atomically; returns their paths.
-
-    Every target composes its files whole first, so a specimen it refuses is refused before
-    anything is written (or an output folder claimed).
-    """
-    paths = []
-    for name, text in files:
-        with atomic_path(Path(out) / name) as tmp:
-            tmp.write_text(text)
-        paths.append(Path(out) / name)
-    return paths

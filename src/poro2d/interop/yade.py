@@ -44,7 +44,8 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.errors import InputError
-from poro2d.interop.specimen_data import SpecimenData, write_files
+from poro2d.interop.specimen_data import SpecimenData
+from poro2d.io_utils import write_texts
 
 SCRIPT_FILE = "specimen_yade.py"
 
@@ -311,4 +312,4 @@ def write_specimen(
     check_every: int = 500,
 ) -> list[Path]:  # fmt: skip
     """Write the script of :func:`export_files` into ``out`` (atomically)."""
-    return write_files(out, export_files(spec, ratio, max_steps, check_every))
+    return write_texts(out, export_files(spec, ratio, max_steps, check_every))
