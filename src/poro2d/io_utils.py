@@ -213,6 +213,20 @@ def write_csv(path: str | os.PathLike, rows: Iterable[Mapping], header: list[str
             )
 
 
+def write_texts(folder: str | os.PathLike, files: Iterable[tuple[str, str]]) -> list[Path]:
+    """Each (name, text) of ``files`` written into ``folder``, atomically; returns their paths.
+
+    For a writer that composes its files whole first (an export), so that what it refuses is
+    refused before anything is written.
+    """
+    paths = []
+    for name, text in files:
+        with atomic_path(Path(folder) / name) as tmp:
+            tmp.write_text(text)
+        paths.append(Path(folder) / name)
+    return paths
+
+
 def check_output_dir(parameter: str, path: str | os.PathLike) -> Path:
     """Refuse an output folder that cannot be created or written, before any work starts.
 

@@ -141,8 +141,9 @@ def _a(kind: str) -> str:
     return f"an {kind}" if kind[:1] in "aeiou" else f"a {kind}"
 
 
-def _mark_kind(parameter: str, folder: Path, kind: str) -> None:
-    """Mark ``folder`` as ``kind``'s, or refuse it if it belongs to another kind of run.
+def _mark_kind(parameter: str, folder: Path, kind: str) -> bool:
+    """Mark ``folder`` as ``kind``'s, or refuse it if it belongs to another kind of run; True
+    when the marker was written here.
 
     A folder without a marker belongs to the kind whose own files it holds (:func:`signed_kinds`),
     if any: it is marked when that is ``kind``, refused otherwise.
@@ -156,11 +157,13 @@ def _mark_kind(parameter: str, folder: Path, kind: str) -> None:
         if owner == kind:
             with atomic_path(folder / KIND_NAME, suffix="") as tmp:
                 tmp.write_text(kind + "\n")
+            return True
     if owner != kind:
         raise InputError(
             parameter, str(folder), f"an empty folder or one of {_a(kind)} run",
             f"it holds the results of {_a(owner)} run; choose another folder",
         )  # fmt: skip
+    return False
 
 
 def check_no_run(parameter: str, folder: str | os.PathLike) -> None:
@@ -208,12 +211,12 @@ def _hold(parameter: str, folder: Path, *, wait: bool, kind: str | None = None) 
         held = _held.get(key)
         if held is not None:  # this process holds it already: an inner run of the same folder
             held[1] += 1
+    marked = False
     if held is None:
         lock = _acquire(parameter, folder, wait=wait, created=created)
         try:
             check_no_escape(parameter, folder)
-            if kind is not None:
-                _mark_kind(parameter, folder, kind)
+            marked = kind is not None and _mark_kind(parameter, folder, kind)
             _write_owner(folder)
         except BaseException:
             _release(lock, folder, created)
@@ -223,6 +226,10 @@ def _hold(parameter: str, folder: Path, *, wait: bool, kind: str | None = None) 
             _held[key] = held
     try:
         yield folder
+    except InputError:
+        if marked:  # a run refused for its inputs leaves no mark in a folder of other files either
+            (folder / KIND_NAME).unlink(missing_ok=True)
+        raise
     finally:
         with _guard:
             held[1] -= 1

@@ -20,6 +20,9 @@ import shutil
 import pytest
 
 from poro2d.cli import main
+from poro2d.cli.strength import one_box
+from poro2d.dem import checkpoint
+from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store
 
 
@@ -88,3 +91,21 @@ def test_a_laboratory_file_that_cannot_be_right_stops_calibrate_before_work(tmp_
     for w in words:
         assert w in err, (w, err)
     assert "line 2" in err and not (tmp_path / "o").exists()
+
+
+def test_strength_refuses_specimens_of_two_boxes_as_seed_scatter(specimen, tmp_path, capsys):
+    """A specimen of another box is not a seed of the same one: refused naming both boxes,
+    before any test; seeds of one box whose plates settled apart by less than a disk are taken."""
+    sim = checkpoint.load(specimen)
+    sim.translate_wall("right", 0.01, 0.0)  # the same disks in a box 1 cm wider
+    wider = checkpoint.save(sim, tmp_path / "wider.npz")
+    sim.translate_wall("right", -0.01, 0.0)
+    sim.translate_wall("top", 0.0, 1e-4)  # a plate a tenth of a millimetre higher: the same box
+    taller = checkpoint.save(sim, tmp_path / "taller.npz")
+    out = tmp_path / "o"
+    tiny = ["--mu-r", "0", "--friction", "0.5", "-n", "50", "--max-displacement", "0.002", "--workers", "1"]
+    err = _refused(["strength", specimen, wider, *tiny, "--out", out], capsys)
+    assert "wider.npz" in err and "0.07 m x 0.03" in err and "that one's 0.06 m x 0.03" in err, err
+    assert not out.exists()
+    pair = SpecimenSet.accepted({"a": specimen, "b": taller}).read()
+    assert one_box(pair) is pair

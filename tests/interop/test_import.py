@@ -209,7 +209,13 @@ LMP_WORDS = [
     (1, "2.5", ["(id)", "a whole number >= 1"]),
     (1, "abc", ["'abc'", "a number"]),
     (5, "0.5", ["(x)", "inside the box"]),
-    (3, "-0.004", ["(diameter)", "a positive diameter"]),
+    (3, "-0.004", ["(diameter)", "a diameter in [2e-06, 2000] m"]),
+    # a huge or non-finite radius, refused where it is read (no overflow on the way)
+    (3, "1e308", ["(diameter) = 1e+308", "a diameter in [2e-06, 2000] m"]),
+    (3, "inf", ["'inf'", "a finite number"]),
+    (3, "1.0", ["(radius: half the diameter) = 0.5", "a disk that fits the box"]),
+    # a second atom type would be read with the first's properties
+    (2, "2", ["(type) = 2", "one atom type"]),
 ]
 
 
@@ -247,6 +253,24 @@ def test_lammps_notes_and_sections(spec, tmp_path, capsys):
     refused(["import", data, "--out", out], capsys, "Atoms section", "'0 atoms'", f"{spec.n} atoms, as line")
     data.write_bytes(bytes(range(256)))
     refused(["import", data, "--out", out], capsys, "specimen.data line", "column", "UTF-8 text")
+
+
+def test_a_second_note_or_atom_type_line_is_refused_naming_both_lines(spec, tmp_path, capsys):
+    """Only one of two wall lines of a name (or two thickness lines) could be read: the second is
+    refused with the line of the first; so is a header of two atom types."""
+    lmp.write_specimen(spec, tmp_path)
+    data = tmp_path / lmp.DATA_FILE
+    text = data.read_text()
+    out = tmp_path / "out"
+    for start in ("# poro2d wall top ", "# poro2d thickness "):
+        first = _line_of(data, start)
+        lines = text.splitlines()
+        data.write_text("\n".join([*lines[:first], lines[first - 1], *lines[first:]]) + "\n")
+        refused(["import", data, "--out", out], capsys, f"specimen.data line {first + 1} = '{start.strip()}",
+                f"one such line (line {first} has it)")  # fmt: skip
+    data.write_text(text.replace("\n1 atom types\n", "\n2 atom types\n"))
+    k = _line_of(data, "2 atom types")
+    refused(["import", data, "--out", out], capsys, f"line {k} column 1 (atom types) = '2'", "one atom type")
 
 
 def test_lammps_image_flags_must_be_zero(spec, tmp_path, capsys):
@@ -350,3 +374,15 @@ def test_an_option_for_what_the_file_sets_is_refused_not_ignored(spec, saved, tm
     refused(["import", tmp_path / "lmp" / lmp.DATA_FILE, "--out", tmp_path / "out", "--wall-friction", "0.3"],
             capsys, "--wall-friction = 0.3", "(wall top mu)")  # fmt: skip
     refused(["import", saved, "--out", tmp_path / "out", "--thickness", "0.01"], capsys, "a checkpoint")
+
+
+def test_a_refused_import_leaves_a_folder_of_other_files_as_it_was(spec, tmp_path, capsys):
+    """The file is read and checked before the output folder is claimed: no kind marker is left."""
+    lmp.write_specimen(spec, tmp_path)
+    data = tmp_path / lmp.DATA_FILE
+    data.write_text(data.read_text().replace("\n1 atom types\n", "\n2 atom types\n"))
+    folder = tmp_path / "mine"
+    folder.mkdir()
+    (folder / "notes.txt").write_text("mine\n")
+    refused(["import", data, "--out", folder], capsys, "(atom types) = '2'")
+    assert sorted(p.name for p in folder.iterdir()) == ["notes.txt"]

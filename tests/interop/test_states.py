@@ -11,6 +11,7 @@ import pytest
 from poro2d import __version__
 from poro2d.cli import main
 from poro2d.cli.export import export_specimen
+from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.interop import csv_table, lammps, pfc, yade
 from poro2d.interop.check import DEFAULTS
@@ -170,8 +171,8 @@ def test_a_sand_folder(tmp_path, specimen):
 
 def test_a_sand_folder_that_does_not_say_the_mode_takes_that_of_its_case(relation, tmp_path):
     sand = tmp_path / "sand"
-    sand.mkdir()
-    case = relation / "states" / "cases" / "zz" / "run"
+    shutil.copytree(relation, sand / "rel")  # a specimen names a folder inside its sand folder
+    case = sand / "rel" / "states" / "cases" / "zz" / "run"
     rel_path = os.path.relpath(case, sand)  # the specimen's folder, relative to the sand folder
     states = [{"n_lab": 0.3253, "relative_density": 1.0, "seed": 0, "specimen": rel_path}]
     (sand / "sand.json").write_text(json.dumps({"states": states}))
@@ -179,6 +180,35 @@ def test_a_sand_folder_that_does_not_say_the_mode_takes_that_of_its_case(relatio
     assert state.folder.resolve() == case.resolve() and state.mode is None
     assert any("mode density" in ln for ln in spec.origin)
     assert any(f"state read from {sand / 'sand.json'}" in ln for ln in spec.origin)
+
+
+def _export_refused(args, tmp_path, capsys, *words) -> None:
+    """``poro2d export ARGS --to csv`` exits 2 with one line holding every word, writing nothing."""
+    with pytest.raises(SystemExit) as e:
+        main(["export", *map(str, args), "--to", "csv", "--out", str(tmp_path / "x")])
+    err = capsys.readouterr().err
+    assert e.value.code == 2 and len(err.strip().splitlines()) == 1, err
+    for word in words:
+        assert word in err, (word, err)
+    assert not (tmp_path / "x").exists()
+
+
+def test_a_sand_record_that_leaves_its_folder_or_mislabels_a_seed_is_refused(tmp_path, specimen, capsys):
+    """With its manifest gone and ``sand.json`` edited, a state's specimen path that leaves the
+    sand folder, or that names the specimen of another seed, is refused rather than exported."""
+    other = _criterion(tmp_path / "other" / "crit", specimen, n_lab=0.45, seed=1, mu=0.5, n2d=0.23)
+    sand = tmp_path / "sand"
+    _criterion(sand / "crit" / "seed1", specimen, n_lab=0.45, seed=1, mu=0.5, n2d=0.23)
+    outside = os.path.relpath(other, sand)
+    for path, words in (
+        (outside, ["sand.json states[0] specimen = '../other/crit'", f"a path inside {sand}"]),
+        (str(other), ["sand.json states[0] specimen", "this one leaves it"]),  # absolute, too
+        ("crit/seed1", ["--seed = 0", "records seed 1, not the seed 0 of", "sand.json states[0]"]),
+    ):
+        states = [{"n_lab": 0.45, "relative_density": 0.8, "seed": 0, "specimen": path}]
+        (sand / "sand.json").write_text(json.dumps({"mode": "density", "states": states}))
+        _export_refused([sand, "--dr", "0.8", "--seed", "0"], tmp_path, capsys, *words)
+    _export_refused([sand, "--dr", "nan"], tmp_path, capsys, "--dr = nan", "allowed: [0, 1]")
 
 
 PROVENANCE = (
@@ -267,3 +297,26 @@ def test_export_cli_refusals_name_the_option(relation, specimen, tmp_path, capsy
         err = capsys.readouterr().err
         assert e.value.code == 2 and words in err and len(err.strip().splitlines()) == 1, err
         assert not (tmp_path / "x").exists()
+
+
+@pytest.mark.parametrize("target", ["lammps", "pfc", "yade", "csv"])
+def test_a_refused_export_leaves_a_folder_of_other_files_as_it_was(tmp_path, specimen, capsys, target):
+    """A target's own refusal (disks of differing properties; YADE and CSV take them, so a state
+    that leaves its folder stands in for them) comes before the output folder is claimed:
+    a non-empty ``--out`` is left without a kind marker, and an import may still use it."""
+    sim = checkpoint.load(specimen)
+    sim.particles.kn[0] *= 2.0
+    mixed = checkpoint.save(sim, tmp_path / "mixed" / "specimen.npz")
+    sand = tmp_path / "sand"
+    sand.mkdir()
+    states = [{"n_lab": 0.45, "relative_density": 0.8, "seed": 0, "specimen": str(mixed.parent)}]
+    (sand / "sand.json").write_text(json.dumps({"mode": "density", "states": states}))
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine\n")
+    given = [mixed] if target in ("lammps", "pfc") else [sand, "--dr", "0.8"]
+    with pytest.raises(SystemExit) as e:
+        main(["export", *map(str, given), "--to", target, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert e.value.code == 2 and len(err.strip().splitlines()) == 1, err
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]

@@ -68,6 +68,31 @@ def quick_specimens(out: Path, seeds: int, progress: bool) -> SpecimenSet:
     return specimens
 
 
+def one_box(specimens: SpecimenSet) -> SpecimenSet:
+    """``specimens``, refused unless all are in one box: the study takes them as seeds of one
+    specimen, and another box's angles would be counted as seed scatter.
+
+    The widths must be the same; the heights may differ by the plate's settling, less than a
+    largest disk (replicate seeds of one state differ by a fraction of one).
+    """
+    import numpy as np
+
+    from poro2d.errors import InputError
+
+    values = specimens.contents()
+    w0, h0 = values[0].box()
+    for label, value in zip(specimens, values, strict=True):
+        w, h = value.box()
+        d_max = 2.0 * max(float(np.max(v.arrays["particles.radius"])) for v in (values[0], value))
+        if abs(w - w0) > 1e-9 * w0 or abs(h - h0) > d_max:
+            first = specimens[next(iter(specimens))]
+            raise InputError(
+                "SPECIMEN...", str(specimens[label]), f"replicate specimens of one box, as {first}",
+                f"its box is {w:.4g} m x {h:.4g} m, that one's {w0:.4g} m x {h0:.4g} m",
+            )  # fmt: skip
+    return specimens
+
+
 #: the most tests a strength grid starts unless asked for more: the quick grid is 72 (8 cases,
 #: 3 specimens, 3 stresses, minutes); a grid of hundreds of cases is hours of work, which a
 #: typo in --mu-r or --friction should not start unannounced
@@ -138,7 +163,7 @@ def register(app: typer.Typer) -> None:
         settings = ShearSettings(**shear)
         # the given specimens: each one the criterion accepted, read whole, before the folder is claimed
         labelled = {f"specimen{k + 1}": p for k, p in enumerate(specimen or [])}
-        given = None if quick else SpecimenSet.accepted(labelled, "SPECIMEN").read()
+        given = None if quick else one_box(SpecimenSet.accepted(labelled, "SPECIMEN").read())
         config = {"quick": quick, "seeds": n_seeds if quick else None, "specimens": specimen or None,
                   "mu_r": mu_values, "particle_friction": fp_values, "normal_stress_kpa": stresses,
                   "shear": shear}  # fmt: skip

@@ -14,6 +14,7 @@ contacts with a normal dashpot, ``# poro2d restitution E`` are read back. Number
 from __future__ import annotations
 
 import csv
+import io
 import math
 import os
 from pathlib import Path
@@ -24,7 +25,7 @@ from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
 from poro2d.errors import InputError
 from poro2d.interop.specimen_data import SpecimenData, WallData
 from poro2d.interop.validate import text_of
-from poro2d.io_utils import atomic_path
+from poro2d.io_utils import write_texts
 
 DISKS_FILE = "disks.csv"
 WALLS_FILE = "walls.csv"
@@ -45,9 +46,8 @@ def _notes(spec: SpecimenData) -> list[str]:
     ]
 
 
-def write_specimen(spec: SpecimenData, out: str | os.PathLike) -> list[Path]:
-    """Write ``disks.csv`` and ``walls.csv`` into ``out`` (atomically); returns their paths."""
-    out = Path(out)
+def export_files(spec: SpecimenData) -> list[tuple[str, str]]:
+    """(name, text) of ``disks.csv`` and ``walls.csv``."""
     rolled = spec.rolled
     disks = [spec.x, spec.y, spec.radius, spec.density, spec.kn, spec.ks, spec.mu]
     if rolled:
@@ -58,16 +58,21 @@ def write_specimen(spec: SpecimenData, out: str | os.PathLike) -> list[Path]:
         for w in spec.walls
     ]
     extra = (ROLLING_COLUMN,) if rolled else ()
-    paths = []
+    files = []
     tables = ((DISKS_FILE, DISK_COLUMNS + extra, rows), (WALLS_FILE, WALL_COLUMNS + extra, wrows))
     for name, columns, body in tables:
-        with atomic_path(out / name) as tmp, open(tmp, "w", newline="") as fh:
-            fh.write("\n".join(_notes(spec)) + "\n")
-            w = csv.writer(fh, lineterminator="\n")
-            w.writerow(columns)
-            w.writerows(body)
-        paths.append(out / name)
-    return paths
+        text = io.StringIO()
+        text.write("\n".join(_notes(spec)) + "\n")
+        w = csv.writer(text, lineterminator="\n")
+        w.writerow(columns)
+        w.writerows(body)
+        files.append((name, text.getvalue()))
+    return files
+
+
+def write_specimen(spec: SpecimenData, out: str | os.PathLike) -> list[Path]:
+    """Write ``disks.csv`` and ``walls.csv`` into ``out`` (atomically); returns their paths."""
+    return write_texts(out, export_files(spec))
 
 
 def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:

@@ -46,7 +46,8 @@ from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
 from poro2d.interop.csv_table import read_number
 from poro2d.interop.specimen_data import SpecimenData, WallData
-from poro2d.interop.validate import LIMITS, check_value, text_of
+from poro2d.interop.validate import LIMITS, Limit, check_value, text_of
+from poro2d.io_utils import write_texts
 
 # positive stand-in for "no normal dashpot" (1/s, times the effective mass)
 GAMMA_TINY = 1e-9
@@ -84,11 +85,11 @@ def critical_dt(radius, density: float, thickness: float, kn_max: float, factor:
 # ------------------------------------------------------------------ data file
 
 
-def write_data(
-    path: str | os.PathLike, x, y, radius, density, thickness: float, box, margin: float,
-    title: str = "poro2d disks", comments: list[str] | None = None,
-) -> None:  # fmt: skip
-    """A LAMMPS data file (``atom_style sphere``) of disks of thickness ``thickness``.
+def data_text(
+    x, y, radius, density, thickness: float, box, margin: float, title: str = "poro2d disks",
+    comments: list[str] | None = None,
+) -> str:  # fmt: skip
+    """The text of a LAMMPS data file (``atom_style sphere``) of disks of thickness ``thickness``.
 
     ``box`` is (xlo, xhi, ylo, yhi); the simulation box is larger by ``margin`` on each
     side, and spans ``-t/2 .. t/2`` in z. ``comments`` are written below the title as
@@ -112,7 +113,7 @@ def write_data(
         f"{i + 1} 1 {2.0 * float(radius[i])!r} {float(dens[i])!r} {float(x[i])!r} {float(y[i])!r} 0"
         for i in range(x.size)
     ]
-    Path(path).write_text("\n".join(lines + body) + "\n")
+    return "\n".join(lines + body) + "\n"
 
 
 @dataclass
@@ -143,6 +144,9 @@ SECTIONS = {
     "BondAngle", "MiddleBondTorsion", "EndBondTorsion", "AngleTorsion", "AngleAngleTorsion",
     "BondBond13", "AngleAngle",
 }  # fmt: skip
+#: what an atom's type may be: the disks of a specimen share one set of properties, and a
+#: second type's (its mass, its pair coefficients) would be read as the first's
+ONE_TYPE = "1: one atom type (a second type's properties are not read)"
 #: a z spread larger than this fraction of the smallest radius makes a file 3D
 Z_TOLERANCE = 1e-3
 
@@ -167,7 +171,7 @@ def read_data(path: str | os.PathLike) -> DataFile:
         if raw.startswith("# poro2d "):
             key, *vals = raw[len("# poro2d ") :].split() or [""]
             notes.append((key, vals))
-            note_lines.setdefault(f"wall {vals[0]}" if key == "wall" and vals else key, k)
+            _note_line(p, k, f"wall {vals[0]}" if key == "wall" and vals else key, note_lines)
         line = raw.split("#", 1)[0].strip()
         if not line:
             continue
@@ -201,19 +205,41 @@ def read_data(path: str | os.PathLike) -> DataFile:
     a = a[order]
     atom_lines = np.array([atoms[i][0] for i in order])
     diam, dens = a[:, 2], a[:, 3]
-    for col, name, arr in ((3, "diameter", diam), (4, "density", dens)):
-        bad = np.flatnonzero(~(arr > 0.0) | ~np.isfinite(arr))
+    # a diameter is checked here, before a mass is made of it: a huge one would overflow
+    radius = LIMITS["radius"]
+    diameter = Limit(2.0 * radius.lo, 2.0 * radius.hi, "m")
+    checks = (
+        (3, "diameter", diameter.holding(diam), f"a diameter in {diameter.text}"),
+        (4, "density", (dens > 0.0) & np.isfinite(dens), "a positive density"),
+    )
+    for col, name, ok, allowed in checks:
+        bad = np.flatnonzero(~ok)
         if bad.size:
             k = atom_lines[bad[0]]
-            raise InputError(f"{p} line {k} column {col} ({name})", float(arr[bad[0]]), f"a positive {name}")
+            raise InputError(f"{p} line {k} column {col} ({name})", float(a[bad[0], col - 1]), allowed)
     _check_atoms(p, atoms, np.array([v[:7] for _, v in atoms]))
     r = 0.5 * diam
     zlo, zhi = header.get("zlo", ((-0.5, 0.5), 0))[0]
+    with np.errstate(over="ignore"):  # a mass too large for a float is refused by its density later
+        mass = 4.0 / 3.0 * math.pi * r**3 * dens
     return DataFile(
-        x=a[:, 4].copy(), y=a[:, 5].copy(), radius=r, mass=4.0 / 3.0 * math.pi * r**3 * dens,
+        x=a[:, 4].copy(), y=a[:, 5].copy(), radius=r, mass=mass,
         box=(*header["xlo"][0], *header["ylo"][0]), zspan=zhi - zlo, notes=notes, atom_lines=atom_lines,
         note_lines=note_lines, box_line={"x": header["xlo"][1], "y": header["ylo"][1]},
     )  # fmt: skip
+
+
+#: the ``# poro2d`` notes the reader takes, each once (a wall's once per name)
+NOTE_KEYS = ("thickness", "disk_properties", "settings", "window", "rolling_friction", "wall")
+
+
+def _note_line(p: Path, k: int, label: str, note_lines: dict) -> None:
+    """Record the line of a note; a second note of the same key (or wall) is refused, since
+    only one of the two could be read and the other would be dropped without a word."""
+    if label in note_lines and label.split()[0] in NOTE_KEYS:
+        where = f"{p} line {k}"
+        raise InputError(where, f"# poro2d {label}", f"one such line (line {note_lines[label]} has it)")
+    note_lines.setdefault(label, k)
 
 
 def _atom_style(p: Path, k: int, raw: str) -> None:
@@ -224,12 +250,15 @@ def _atom_style(p: Path, k: int, raw: str) -> None:
 
 
 def _check_atoms(p: Path, atoms: list[tuple[int, list[float]]], a: np.ndarray) -> None:
-    """Whole ids (>= 1, unique) and types (>= 1), one plane in z, image flags 0 in x and y."""
+    """Whole ids (>= 1, unique), atom type 1, one plane in z, image flags 0 in x and y."""
     seen: dict[float, int] = {}
     for k, v in atoms:
-        for c, name in ((1, "id"), (2, "type")):
-            if v[c - 1] != int(v[c - 1]) or v[c - 1] < 1:
-                raise InputError(f"{p} line {k} column {c} ({name})", v[c - 1], "a whole number >= 1")
+        if v[0] != int(v[0]) or v[0] < 1:
+            raise InputError(f"{p} line {k} column 1 (id)", v[0], "a whole number >= 1")
+        if v[1] != 1:
+            raise InputError(
+                f"{p} line {k} column 2 (type)", int(v[1]) if v[1] == int(v[1]) else v[1], ONE_TYPE
+            )
         if v[0] in seen:
             raise InputError(
                 f"{p} line {k} column 1 (id)", int(v[0]), f"an id of its own (line {seen[v[0]]} has it)"
@@ -262,6 +291,8 @@ def _header_line(p: Path, k: int, words: list[str], header: dict) -> None:
         if not lo < hi:
             raise InputError(f"{p} line {k} column 2 ({words[3]})", hi, f"above {words[2]} = {lo!r}")
         header[words[-2]] = ((lo, hi), k)
+    elif words[1:] == ["atom", "types"] and words[0] != "1":
+        raise InputError(f"{p} line {k} column 1 (atom types)", words[0], ONE_TYPE)
     elif words[-1] == "atoms" and len(words) == 2:
         v = _numbers(p, k, words[:1], 1, 1)[0]
         if v != int(v) or v < 1:
@@ -483,18 +514,16 @@ def _wall_sums() -> str:
     return "\n".join(out)
 
 
-def write_specimen(spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e-3,
-                   max_steps: int = 2_000_000, check_every: int = 500) -> list[Path]:  # fmt: skip
-    """Write ``specimen.data`` and ``in.specimen`` into ``out``; returns their paths.
+def export_files(
+    spec: SpecimenData, ratio: float = 1e-3, max_steps: int = 2_000_000, check_every: int = 500
+) -> list[tuple[str, str]]:
+    """(name, text) of ``specimen.data`` and ``in.specimen``.
 
     The data file's comment lines record the thickness, the per-body properties of the
     disks and every wall (``# poro2d ...``), so that ``poro2d import`` reads the
-    specimen back whole. Each file is written atomically.
+    specimen back whole.
     """
-    from poro2d.io_utils import atomic_path
-
     spec.refuse_dashpot("LAMMPS")
-    out = Path(out)
     params = spec.contact_parameters()  # refuses disks of differing properties first
     box = spec.box()
     script = input_script(spec, ratio, max_steps, check_every)
@@ -511,18 +540,17 @@ def write_specimen(spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e
     if spec.rolling_parameters().disks > 0.0:  # the disks', then each wall's, in wall-line order
         values = [spec.rolling_parameters().disks, *(w.mu_r for w in spec.walls)]
         notes.append("# poro2d rolling_friction " + " ".join(repr(float(v)) for v in values))
-    paths = []
-    with atomic_path(out / DATA_FILE) as tmp:
-        write_data(
-            tmp, spec.x, spec.y, spec.radius, spec.density, spec.thickness, box,
-            margin=float(spec.radius.max()), title=f"poro2d {__version__} specimen (atom_style sphere)",
-            comments=notes,
-        )  # fmt: skip
-    paths.append(out / DATA_FILE)
-    with atomic_path(out / INPUT_FILE) as tmp:
-        tmp.write_text(script)
-    paths.append(out / INPUT_FILE)
-    return paths
+    data = data_text(
+        spec.x, spec.y, spec.radius, spec.density, spec.thickness, box, margin=float(spec.radius.max()),
+        title=f"poro2d {__version__} specimen (atom_style sphere)", comments=notes,
+    )  # fmt: skip
+    return [(DATA_FILE, data), (INPUT_FILE, script)]
+
+
+def write_specimen(spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e-3,
+                   max_steps: int = 2_000_000, check_every: int = 500) -> list[Path]:  # fmt: skip
+    """Write the files of :func:`export_files` into ``out`` (each atomically); returns their paths."""
+    return write_texts(out, export_files(spec, ratio, max_steps, check_every))
 
 
 def _wall_note(w: WallData) -> str:
@@ -592,7 +620,7 @@ def _rolling_note(notes: list, walls: list[WallData], path, lines: dict | None) 
 #: where each value sits: an Atoms column, or a ``# poro2d`` note and its word
 _ATOM_COLUMN = {
     "id": (1, "id"),
-    "radius": (3, "diameter"),
+    "radius": (3, "radius: half the diameter"),
     "density": (4, "density"),
     "x": (5, "x"),
     "y": (6, "y"),

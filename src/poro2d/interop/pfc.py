@@ -32,7 +32,7 @@ import numpy as np
 
 from poro2d.errors import InputError
 from poro2d.interop.specimen_data import SpecimenData
-from poro2d.io_utils import atomic_path
+from poro2d.io_utils import write_texts
 
 CURRENT_FILE = "specimen.p2dat"
 PFC4_FILE = "specimen_pfc4.dat"
@@ -143,19 +143,16 @@ def _extent(spec: SpecimenData) -> tuple[float, float, float, float]:
     return float(xs.min()) - m, float(xs.max()) + m, float(ys.min()) - m, float(ys.max()) + m
 
 
-def write_specimen(spec: SpecimenData, out: str | os.PathLike) -> list[Path]:
-    """Write ``specimen.p2dat`` and ``specimen_pfc4.dat`` into ``out`` (atomically).
-
-    A specimen with rolling friction gets the PFC 5+ file only (see :func:`pfc4_refusal`).
-    """
+def export_files(spec: SpecimenData) -> list[tuple[str, str]]:
+    """(name, text) of ``specimen.p2dat`` and ``specimen_pfc4.dat``; a specimen with rolling
+    friction gets the PFC 5+ file only (see :func:`pfc4_refusal`)."""
     spec.refuse_dashpot("PFC2D")
-    out = Path(out)
-    paths = []
     files = [(CURRENT_FILE, current_commands(spec))]
     if pfc4_refusal(spec) is None:
         files.append((PFC4_FILE, pfc4_commands(spec)))
-    for name, text in files:
-        with atomic_path(out / name) as tmp:
-            tmp.write_text(text)
-        paths.append(out / name)
-    return paths
+    return files
+
+
+def write_specimen(spec: SpecimenData, out: str | os.PathLike) -> list[Path]:
+    """Write the files of :func:`export_files` into ``out`` (atomically)."""
+    return write_texts(out, export_files(spec))

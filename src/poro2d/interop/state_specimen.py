@@ -180,7 +180,7 @@ def state_specimen(
     if n_lab is not None:
         check_range("--n-lab", n_lab, 0.0, 1.0, lo_open=True, hi_open=True)
     if dr is not None:
-        check_range("--dr", dr)
+        check_range("--dr", dr, 0, 1)
     seed = check_int("--seed", seed, 0)
     index = read_state_index(record)
     if n_lab is None and dr is None:
@@ -252,18 +252,41 @@ def _sand_index(record: Path, data: SandRecord) -> StateIndex:
         key = next((n for n in states if _same(n, row.n_lab)), row.n_lab)
         dr = row.relative_density
         states[key] = dr if dr is not None else states.get(key)
-        folder = record.parent / row.specimen if row.specimen is not None else None
-        why = "" if folder is not None else f"{record} states[{k}] names no specimen folder"
-        if not why:
-            why = row.refusal or _not_accepted(folder)
+        where = f"{record} states[{k}]"
+        if row.specimen is None:
+            cases.append(StateCase(key, row.seed, None, f"{where} names no specimen folder"))
+            continue
+        folder = inside(record.parent, row.specimen, f"{where} specimen")
+        why = row.refusal or _not_accepted(folder) or _other_seed(folder, row.seed, where)
         cases.append(StateCase(key, row.seed, folder, why))
     return StateIndex(record, data.mode, sorted(states.items(), key=lambda s: -s[0]), cases)
+
+
+def inside(root: Path, name: str, where: str) -> Path:
+    """``root / name``, refused (InputError naming ``where``) when it resolves outside ``root``:
+    an edited record must not send an export to the files of another folder."""
+    path = root / name
+    if not path.resolve().is_relative_to(root.resolve()):
+        raise InputError(where, name, f"a path inside {root}", "this one leaves it")
+    return path
+
+
+def _other_seed(folder: Path, seed: int | None, where: str) -> str:
+    """Why a specimen is not the seed its record labels it ('' when its criterion's ``result.json``
+    records that seed, or none): a specimen is never written out under another seed's label."""
+    crit = _read(folder / "result.json", "SPECIMEN", CriterionOutcome.from_json)
+    if not crit.names_seed or crit.seed == seed:
+        return ""
+    return f"{folder / 'result.json'} records seed {crit.seed}, not the seed {seed} of {where}"
 
 
 def _sweep_cases(sweep: Path, relation_seed: int | None = None) -> list[StateCase]:
     """Every case of the sweep in ``sweep`` (its ``sweep.json``), with n_lab, seed and folder."""
     listing = _read(sweep / "sweep.json", "SPECIMEN", SweepListing.from_json)
-    return [_case(sweep / "cases" / cid, params, relation_seed) for cid, params in listing.cases]
+    where = f"{sweep / 'sweep.json'} case id"
+    return [
+        _case(inside(sweep / "cases", cid, where), params, relation_seed) for cid, params in listing.cases
+    ]
 
 
 def _case(

@@ -48,6 +48,10 @@ class Limit:
     def holds(self, v: float) -> bool:
         return bool(_holds(np.float64(v), self))  # NaN fails
 
+    def holding(self, values) -> np.ndarray:
+        """Which of ``values`` lie within the limit (NaN does not)."""
+        return _holds(np.asarray(values, dtype=float), self)
+
     @property
     def text(self) -> str:
         lo_s, hi_s = ("(" if self.lo_open else "["), (")" if self.hi_open else "]")

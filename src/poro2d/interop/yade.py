@@ -45,7 +45,7 @@ import numpy as np
 
 from poro2d.errors import InputError
 from poro2d.interop.specimen_data import SpecimenData
-from poro2d.io_utils import atomic_path
+from poro2d.io_utils import write_texts
 
 SCRIPT_FILE = "specimen_yade.py"
 
@@ -294,18 +294,22 @@ def _wall_numbers(w) -> tuple[float, ...]:
     return (w.x0, w.y0, w.x1, w.y1, w.kn, w.ks, w.mu)
 
 
-def write_specimen(
-    spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e-3, max_steps: int = 2_000_000,
-    check_every: int = 500,
-) -> list[Path]:  # fmt: skip
-    """Write ``specimen_yade.py`` into ``out`` (atomically), stopping at ``ratio`` (YADE's mean ratio)."""
+def export_files(
+    spec: SpecimenData, ratio: float = 1e-3, max_steps: int = 2_000_000, check_every: int = 500
+) -> list[tuple[str, str]]:
+    """(name, text) of ``specimen_yade.py``, stopping at ``ratio`` (YADE's mean ratio)."""
     if not spec.dt:
         raise InputError("time step", spec.dt, "the time step of the specimen (a poro2d checkpoint has one)")
     spec.refuse_dashpot("YADE")
     slanted = [w.name for w in spec.walls if not (w.horizontal or w.vertical)]
     if slanted:
         raise InputError("walls", slanted, "horizontal or vertical walls (written as YADE boxes)")
-    path = Path(out) / SCRIPT_FILE
-    with atomic_path(path) as tmp:
-        tmp.write_text(script(spec, ratio, max_steps, check_every))
-    return [path]
+    return [(SCRIPT_FILE, script(spec, ratio, max_steps, check_every))]
+
+
+def write_specimen(
+    spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e-3, max_steps: int = 2_000_000,
+    check_every: int = 500,
+) -> list[Path]:  # fmt: skip
+    """Write the script of :func:`export_files` into ``out`` (atomically)."""
+    return write_texts(out, export_files(spec, ratio, max_steps, check_every))
