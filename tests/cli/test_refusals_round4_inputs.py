@@ -15,6 +15,7 @@ import warnings
 import pytest
 
 import poro2d.critical_state as critical_state
+import poro2d.sand.preflight as sand_preflight
 import poro2d.sand.run as sand_run
 import poro2d.sweep.runner as runner
 from poro2d.cli import main
@@ -42,6 +43,7 @@ FILES = {
     "upscale_huge.toml": "[grading]\nsizes_mm = [1, 2]\npercent_passing = [0, 100]\nupscale = 1e300\n",
     "sand_n_lab.toml": SOIL + GRADING + LAB + '[criterion]\nn_lab = "abc"\n',
     "sand_upscale.toml": SOIL + GRADING.replace("upscale = 10", "upscale = 0.001") + LAB,
+    "sand_narrow.toml": SOIL + GRADING + LAB + "[specimen]\nwidth = 0.02\nheight = 0.01\nlayers = 1\n",
     "grain_huge.csv": "size_mm,percent_passing\n0.1,0\n1e308,100\n",
 }
 
@@ -72,6 +74,7 @@ CASES = [
     (["convert", "--dry-density", "1e-300", "--solid-density", "2650"], ["--dry-density = 1e-300", "2650"]),
     (["sand", "{d}/sand_upscale.toml", "--preflight"], ["grading.upscale = 0.001", "up-scale more"]),
     (["criterion", "-c", "{d}/box_1mm.toml"], ["box = '0.001 m x 0.001 m"]),
+    (["sand", "{d}/sand_narrow.toml", "--preflight"], ["box = '0.02 m x 0.01 m", "10 times as wide"]),
     (["critical-state", "--strain", "0.01"], ["--strain = 0.01"]),
 ]
 
@@ -87,6 +90,7 @@ def no_work(monkeypatch):
     monkeypatch.setattr(PorosityCriterion, "run", work)
     monkeypatch.setattr(critical_state, "run_critical_states", work)
     monkeypatch.setattr(sand_run, "calibration_stage", work)
+    monkeypatch.setattr(sand_preflight, "jamming_of", work)  # the pre-flight's only long part
 
 
 def _files(folder) -> None:

@@ -26,7 +26,7 @@ from poro2d.errors import InputError
 from poro2d.grading import GradingCurve, paper_grading
 from poro2d.porosity import parabolic
 from poro2d.sand.case import SandCase
-from poro2d.specimen.compaction import SpecimenSpec, check_feasible, estimate_size, time_step
+from poro2d.specimen.compaction import SpecimenSpec, check_box, check_feasible, estimate_size, time_step
 from poro2d.typed_result import TypedResult
 
 #: particle-steps per second per core assumed by the estimate: measured 2.0e7 (lid) to 2.7e7
@@ -132,6 +132,12 @@ class Preflight(TypedResult):
 LID_MARGIN = 3.5
 
 
+#: the largest disks a box must hold side by side, the calibration box's own floor: in a
+#: narrower one the walls' loose layer is most of the box, and the first trial is no porosity
+#: (a 1 mm box of Toyoura sand: 1.88)
+BOX_ACROSS = 10.0
+
+
 def calibration_box(
     spec: SpecimenSpec, grading: GradingCurve, disks: int, porosity: float, *, lid_window: float | None = None
 ) -> BoxPlan:
@@ -157,7 +163,7 @@ def calibration_box(
     # as many layers as keep the full box's band height (rounded up: thinner bands, not thicker)
     layers = max(1, min(spec.layers, math.ceil(spec.layers * scale - 1e-9)))
     height = max(spec.height * scale, 3.0 * d_max * layers)
-    width = max(spec.width * scale, 10.0 * d_max)
+    width = max(spec.width * scale, BOX_ACROSS * d_max)
     width, height = round(width, 4), round(height, 4)
     if width >= spec.width or height >= spec.height:
         return BoxPlan(spec.width, spec.height, spec.layers, full)
@@ -362,9 +368,11 @@ def workload(case: SandCase, spec: SpecimenSpec, g: GradingCurve, first: float, 
 def preflight(case: SandCase, *, workers: int = 2, budget_minutes: float | None = None) -> Preflight:
     """The pre-flight of ``case``: every number from the grading and the box, no DEM run.
 
-    Refuses (InputError) a box whose layers cannot hold the largest disk.
+    Refuses (InputError) a box whose layers cannot hold the largest disk, or fewer than
+    ``BOX_ACROSS`` of them wide, before the jamming porosity is computed.
     """
     spec, g = case.spec, case.grading
+    check_box(spec, g, BOX_ACROSS)
     jam = jamming_of(g)
     from poro2d.sweep.density import first_trial, wall_share
 
