@@ -43,7 +43,7 @@ FILES = {
     "upscale_huge.toml": "[grading]\nsizes_mm = [1, 2]\npercent_passing = [0, 100]\nupscale = 1e300\n",
     "sand_n_lab.toml": SOIL + GRADING + LAB + '[criterion]\nn_lab = "abc"\n',
     "sand_upscale.toml": SOIL + GRADING.replace("upscale = 10", "upscale = 0.001") + LAB,
-    "sand_narrow.toml": SOIL + GRADING + LAB + "[specimen]\nwidth = 0.02\nheight = 0.01\nlayers = 1\n",
+    "sand_low.toml": SOIL + GRADING + LAB + "[specimen]\nwidth = 0.02\nheight = 0.002\nlayers = 1\n",
     "grain_huge.csv": "size_mm,percent_passing\n0.1,0\n1e308,100\n",
 }
 
@@ -74,7 +74,7 @@ CASES = [
     (["convert", "--dry-density", "1e-300", "--solid-density", "2650"], ["--dry-density = 1e-300", "2650"]),
     (["sand", "{d}/sand_upscale.toml", "--preflight"], ["grading.upscale = 0.001", "up-scale more"]),
     (["criterion", "-c", "{d}/box_1mm.toml"], ["box = '0.001 m x 0.001 m"]),
-    (["sand", "{d}/sand_narrow.toml", "--preflight"], ["box = '0.02 m x 0.01 m", "10 times as wide"]),
+    (["sand", "{d}/sand_low.toml", "--preflight"], ["box = '0.02 m x 0.002 m", "the largest disk (0.003 m)"]),
     (["critical-state", "--strain", "0.01"], ["--strain = 0.01"]),
 ]
 

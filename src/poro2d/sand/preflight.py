@@ -132,12 +132,6 @@ class Preflight(TypedResult):
 LID_MARGIN = 3.5
 
 
-#: the largest disks a box must hold side by side, the calibration box's own floor: in a
-#: narrower one the walls' loose layer is most of the box, and the first trial is no porosity
-#: (a 1 mm box of Toyoura sand: 1.88)
-BOX_ACROSS = 10.0
-
-
 def calibration_box(
     spec: SpecimenSpec, grading: GradingCurve, disks: int, porosity: float, *, lid_window: float | None = None
 ) -> BoxPlan:
@@ -163,7 +157,7 @@ def calibration_box(
     # as many layers as keep the full box's band height (rounded up: thinner bands, not thicker)
     layers = max(1, min(spec.layers, math.ceil(spec.layers * scale - 1e-9)))
     height = max(spec.height * scale, 3.0 * d_max * layers)
-    width = max(spec.width * scale, BOX_ACROSS * d_max)
+    width = max(spec.width * scale, 10.0 * d_max)
     width, height = round(width, 4), round(height, 4)
     if width >= spec.width or height >= spec.height:
         return BoxPlan(spec.width, spec.height, spec.layers, full)
@@ -368,11 +362,12 @@ def workload(case: SandCase, spec: SpecimenSpec, g: GradingCurve, first: float, 
 def preflight(case: SandCase, *, workers: int = 2, budget_minutes: float | None = None) -> Preflight:
     """The pre-flight of ``case``: every number from the grading and the box, no DEM run.
 
-    Refuses (InputError) a box whose layers cannot hold the largest disk, or fewer than
-    ``BOX_ACROSS`` of them wide, before the jamming porosity is computed.
+    Refuses (InputError) a box whose layers cannot hold the largest disk, before the jamming
+    porosity is computed (the first trial's wall share in such a box is no porosity: 1.88 in a
+    1 mm box of Toyoura sand).
     """
     spec, g = case.spec, case.grading
-    check_box(spec, g, BOX_ACROSS)
+    check_box(spec, g)
     jam = jamming_of(g)
     from poro2d.sweep.density import first_trial, wall_share
 
