@@ -184,3 +184,13 @@ def test_a_soil_name_is_shown_as_text(tmp_path, capsys, monkeypatch):
     from poro2d.console import shown
 
     assert shown("[red]x[/]\t") == "\\[red]x\\[/]\\t"
+
+
+def test_the_paper_mode_note_names_the_density_table():
+    from rich.console import Console
+
+    from poro2d.cli.criterion import PAPER_MODE_NOTE
+
+    out = Console(record=True, width=400)
+    out.print(PAPER_MODE_NOTE)
+    assert "(--n-max/--n-min or [density])" in out.export_text()  # a table's name, not markup
