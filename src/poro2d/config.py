@@ -44,11 +44,16 @@ def dataclass_from_table(cls, section: str, table: dict | None, **overrides: Any
     check_keys(section, table, names)
     table = dict(table)
     check_types(cls, section, table)
-    table.update({k: v for k, v in overrides.items() if v is not None})
+    given = {k: v for k, v in overrides.items() if v is not None}
+    table.update(given)
     try:
         return cls(**table)
     except TypeError as exc:
         raise InputError(section, table, "values of the right type", str(exc)) from None
+    except InputError as exc:  # a field's own check: named as the key the user typed in the file
+        if exc.parameter not in table or exc.parameter in given:
+            raise
+        raise InputError(f"{section}.{exc.parameter}", exc.value, exc.allowed, exc.hint) from None
 
 
 # what a config value of each field type must be, and how the error names it

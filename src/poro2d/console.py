@@ -14,7 +14,10 @@ instead of cutting it, for terminals too narrow for the whole table.
 
 from __future__ import annotations
 
+import unicodedata
+
 from rich.console import Console, ConsoleDimensions
+from rich.markup import escape
 from rich.table import Table as _RichTable
 
 FILE_WIDTH = 1000  # columns when writing to a file or a pipe: no row or message is wrapped
@@ -44,3 +47,14 @@ class Table(_RichTable):
     def add_column(self, *args, **kwargs) -> None:
         kwargs.setdefault("overflow", "ellipsis" if kwargs.get("no_wrap") else "fold")
         super().add_column(*args, **kwargs)
+
+
+def shown(text: str) -> str:
+    """``text`` as a console prints it literally: rich markup escaped, and control and format
+    characters written as escapes (``\\x1b``), so that a name from a user's file can neither
+    style the output nor steer the terminal (colours, cursor moves, a reversed line)."""
+    safe = "".join(
+        c.encode("unicode_escape").decode("ascii") if unicodedata.category(c) in ("Cc", "Cf") else c
+        for c in str(text)
+    )
+    return escape(safe)

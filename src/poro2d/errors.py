@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -102,7 +103,8 @@ def check_int(parameter: str, value: Any, lo: int | None = None, hi: int | None 
 
 @dataclass(frozen=True)
 class Real:
-    """The interval a real setting must lie in: ``Real(0, None, lo_open=True)`` is (0, inf).
+    """The interval a real setting must lie in: ``Real(0, None, lo_open=True)`` is (0, inf),
+    the value always finite.
 
     ``or_none``: None is allowed too, for a setting that falls back on another when not given
     (a shear test's ``particle_friction`` takes the specimen's). The bounds are printed as
@@ -118,6 +120,8 @@ class Real:
     def check(self, parameter: str, value: Any) -> None:
         if value is None and self.or_none:
             return
+        if is_number(value) and not math.isfinite(float(value)):  # an open end admits no infinity
+            raise InputError(parameter, value, "a finite number")
         check_range(parameter, value, self.lo, self.hi, lo_open=self.lo_open, hi_open=self.hi_open)
 
 

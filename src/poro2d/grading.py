@@ -52,6 +52,10 @@ _TOP_TOL = 1e-6  # percent passing at the largest size must be 100 within this
 #: The most disks :func:`draw_disks` will draw (a hard ceiling against exhausting the memory;
 #: specimens have their own, lower limit: ``SpecimenSpec.max_disks``).
 MAX_DRAW = 50_000_000
+#: grain sizes (mm) a grading may hold, in the laboratory and in the model: from a clay's 0.1
+#: micrometre to a 10 m boulder. Beyond them a size is a typo or a unit slip, and its disk
+#: areas overflow or vanish in float arithmetic.
+GRAIN_RANGE_MM = (1e-4, 1e4)
 
 
 def _as_float_array(name: str, values: Any) -> np.ndarray:
@@ -103,6 +107,18 @@ def _check_curve(
             hint="the smallest size bounds the finest class: add the size of the finest "
             "particles with 0 %, or set d_min_mm above the smallest size to cut the fines",
         )
+
+
+def _check_grain_range(name: str, sizes_mm: np.ndarray, value: Any = None) -> None:
+    """Refuse sizes (mm) outside ``GRAIN_RANGE_MM``, naming ``name`` (its ``value``, or the sizes)."""
+    lo, hi = GRAIN_RANGE_MM
+    if sizes_mm[0] < lo or sizes_mm[-1] > hi:
+        which = "sizes" if value is None else "up-scaled sizes"
+        raise InputError(
+            name, sizes_mm.tolist() if value is None else value,
+            f"grain sizes in [{lo:g}, {hi:g}] mm (clay to boulders)",
+            f"the {which} run {sizes_mm[0]:.3g}-{sizes_mm[-1]:.3g} mm",
+        )  # fmt: skip
 
 
 def _interp_log(x: float, sizes: np.ndarray, percent: np.ndarray) -> float:
@@ -158,10 +174,12 @@ class GradingCurve:
         if sizes.size >= 2 and np.all(np.diff(sizes) < 0.0) and percent.size == sizes.size:
             sizes, percent = sizes[::-1].copy(), percent[::-1].copy()
         _check_curve(sizes, percent, "sizes_mm", "percent_passing", need_zero_start=False)
+        _check_grain_range("sizes_mm", sizes)
         percent[-1] = 100.0
         up = check_range("upscale", upscale, 0.0, None, lo_open=True)
         if not math.isfinite(up):
             raise InputError("upscale", upscale, "a finite number > 0")
+        _check_grain_range("upscale", sizes * up, upscale)
         d = sizes * up / 1000.0
         lo = _cutoff("d_min_mm", d_min_mm)
         hi = _cutoff("d_max_mm", d_max_mm)
@@ -202,8 +220,18 @@ class GradingCurve:
 
         Keys: exactly one of ``preset = "paper"``, ``csv = "path.csv"`` (relative to
         ``base_dir``) or ``sizes_mm = [...]`` with ``percent_passing = [...]``; optional
-        ``upscale`` (default 1, or 10 for the paper preset), ``d_min_mm``, ``d_max_mm``.
+        ``upscale`` (default 1, or 10 for the paper preset), ``d_min_mm``, ``d_max_mm``. A refusal
+        names the table's key as typed (``grading.upscale``).
         """
+        try:
+            return cls._from_table(table, base_dir)
+        except InputError as exc:
+            if exc.parameter not in table:
+                raise
+            raise InputError(f"grading.{exc.parameter}", exc.value, exc.allowed, exc.hint) from None
+
+    @classmethod
+    def _from_table(cls, table: Mapping[str, Any], base_dir: str | Path | None) -> GradingCurve:
         unknown = sorted(set(table) - set(_CONFIG_KEYS))
         if unknown:
             raise InputError(f"grading.{unknown[0]}", table[unknown[0]], ", ".join(_CONFIG_KEYS))
@@ -318,9 +346,10 @@ def _check_config_types(table: Mapping[str, Any]) -> None:
 def _cutoff(name: str, value: float | None) -> float | None:
     if value is None:
         return None
+    lo, hi = GRAIN_RANGE_MM
     v = check_range(name, value, 0.0, None, lo_open=True)
-    if not math.isfinite(v):
-        raise InputError(name, value, "a finite size in mm > 0")
+    if not lo <= v <= hi:  # an infinity too
+        raise InputError(name, value, f"a grain size in [{lo:g}, {hi:g}] mm")
     return v / 1000.0
 
 

@@ -22,7 +22,6 @@ extrapolate, a description of a laboratory state may not. Every bad input raises
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -35,6 +34,11 @@ from poro2d.record import Record
 #: kg/m3, the densities of solids accepted: from light volcanic grains to the densest metal
 #: (osmium, 22 590 kg/m3); 1e300 would give a porosity of 1 and an answer about nothing
 SOLID_DENSITY_RANGE = (500.0, 23000.0)
+
+#: the loosest void ratio a laboratory state may have (n = 0.990): looser than any soil (peats
+#: reach about 15); beyond it the porosity rounds to 1 and a later step refuses a quantity the
+#: user never typed
+MAX_VOID_RATIO = 100.0
 
 #: the ways a state can be given, as ``LabState.given`` records them (keyword -> name)
 _GIVEN = {"e": "e", "n": "n", "dr": "Dr", "dry_density": "dry_density"}
@@ -87,9 +91,9 @@ class LabState(Record):
 
 
 def _void_ratio_value(name: str, value: Any) -> float:
-    """A finite void ratio >= 0, or InputError naming ``name``."""
-    if not is_number(value) or not (math.isfinite(float(value)) and float(value) >= 0.0):
-        raise InputError(name, value, "a finite void ratio in [0, inf)")
+    """A void ratio in [0, ``MAX_VOID_RATIO``], or InputError naming ``name``."""
+    if not is_number(value) or not 0.0 <= float(value) <= MAX_VOID_RATIO:  # NaN fails too
+        raise InputError(name, value, f"a finite void ratio in [0, {MAX_VOID_RATIO:g}]")
     return float(value)
 
 
@@ -256,8 +260,12 @@ def lab_state(
                 "dry_density given without it",
             )
         rho_s = check_range("solid_density", solid_density, *SOLID_DENSITY_RANGE)
-        if not is_number(dry_density):
-            raise InputError("dry_density", dry_density, f"(0, {rho_s:g}] kg/m3")
+        loosest = rho_s / (1.0 + MAX_VOID_RATIO)
+        if not is_number(dry_density) or not loosest <= float(dry_density) <= rho_s:
+            raise InputError(
+                "dry_density", dry_density, f"[{loosest:.6g}, {rho_s:g}] kg/m3",
+                f"positive and at most the solid density, of a void ratio of at most {MAX_VOID_RATIO:g}",
+            )  # fmt: skip
         nv = float(P.porosity_from_densities(float(dry_density), rho_s))
         ev = float(P.void_ratio(nv))
     else:

@@ -65,10 +65,10 @@ def test_extremes_round_trip_through_void_ratios():
         ({"e_max": 0.597, "e_min": 0.977}, "e_max", ["greater than e_min = 0.977"]),
         ({"e_max": 0.6, "e_min": 0.6}, "e_max", ["greater than e_min = 0.6"]),
         ({"n_max": 0.3, "n_min": 0.4}, "n_max", ["greater than n_min = 0.4"]),
-        ({"e_max": 0.977, "e_min": -0.1}, "e_min", ["[0, inf)"]),
-        ({"e_max": -0.5, "e_min": -0.6}, "e_max", ["[0, inf)"]),
+        ({"e_max": 0.977, "e_min": -0.1}, "e_min", ["[0, 100]"]),
+        ({"e_max": -0.5, "e_min": -0.6}, "e_max", ["[0, 100]"]),
         ({"e_max": float("inf"), "e_min": 0.6}, "e_max", ["finite"]),
-        ({"e_max": float("nan"), "e_min": 0.6}, "e_max", ["[0, inf)"]),
+        ({"e_max": float("nan"), "e_min": 0.6}, "e_max", ["[0, 100]"]),
         ({"e_max": "0.977", "e_min": 0.6}, "e_max", []),
         ({"n_max": 1.0, "n_min": 0.3}, "n_max", ["[0.0, 1.0)"]),
         ({"n_max": 0.45, "n_min": -0.1}, "n_min", []),
@@ -208,7 +208,7 @@ def test_state_is_frozen():
         ({"dr": -0.1, **TOYOURA}, "dr", ["[0, 1]"]),
         ({"dr": float("nan"), **TOYOURA}, "dr", ["[0, 1]"]),
         ({"dr": "0.5", **TOYOURA}, "dr", ["[0, 1]"]),
-        ({"e": -0.1}, "e", ["[0, inf)"]),
+        ({"e": -0.1}, "e", ["[0, 100]"]),
         ({"e": float("inf")}, "e", ["finite"]),
         ({"e": float("nan")}, "e", []),
         ({"e": "0.7"}, "e", []),
@@ -322,7 +322,9 @@ def test_table_must_be_a_table(table):
     assert info.value.parameter == "lab"
 
 
-def test_solid_density_range_is_the_command_s():
-    from poro2d.cli import convert
+def test_solid_density_range_is_the_command_s(capsys):
+    from poro2d.cli import main
 
-    assert convert.SOLID_DENSITY_RANGE == SOLID_DENSITY_RANGE
+    with pytest.raises(SystemExit):  # the command refuses through lab_state, with its range
+        main(["convert", "--dry-density", "1600", "--solid-density", "100"])
+    assert "[{}, {}]".format(*SOLID_DENSITY_RANGE) in capsys.readouterr().err

@@ -13,9 +13,9 @@ import sys
 
 import typer
 from rich.console import Console
-from rich.markup import escape
 
 from poro2d import __version__
+from poro2d.console import shown
 from poro2d.errors import InputError, Interrupted
 from poro2d.worker_signals import forget_unhandled_interrupt, ignore_interrupts_in_dask_worker
 
@@ -139,8 +139,9 @@ def main(argv: list[str] | None = None) -> None:
         if isinstance(rc, int) and rc != 0:  # typer.Exit(code) comes back as a return value here
             sys.exit(rc)
     except InputError as exc:
-        # escaped: a message naming a config table ("[specimen] max_disks") is text, not markup
-        err_console.print(f"[bold red]error:[/] {escape(str(exc))}", highlight=False, soft_wrap=True)
+        # shown as text: a message naming a config table ("[specimen] max_disks") is not markup,
+        # and a name from the user's file may hold control characters
+        err_console.print(f"[bold red]error:[/] {shown(str(exc))}", highlight=False, soft_wrap=True)
         sys.exit(2)
     except Interrupted as exc:
         err_console.print(f"[yellow]{exc}[/]", highlight=False, soft_wrap=True)
@@ -156,7 +157,7 @@ def main(argv: list[str] | None = None) -> None:
         if _is_click(exc, "ClickException"):
             # one line as for every other refusal: no usage banner, no "Try --help" line
             line = usage_line(exc, sys.argv[1:] if argv is None else argv)
-            err_console.print(f"[bold red]error:[/] {escape(line)}", highlight=False, soft_wrap=True)
+            err_console.print(f"[bold red]error:[/] {shown(line)}", highlight=False, soft_wrap=True)
             sys.exit(exc.exit_code)  # type: ignore[attr-defined]
         if _is_click(exc, "Abort"):
             err_console.print("[yellow]aborted[/]")

@@ -41,7 +41,7 @@ from typer.core import TyperCommand
 from poro2d import __version__
 from poro2d import porosity as P
 from poro2d.errors import InputError, check_range
-from poro2d.lab_state import SOLID_DENSITY_RANGE, LabState, lab_state
+from poro2d.lab_state import LabState, lab_state
 
 _PARAM_ALLOWED = "a number in [0, 1)"
 
@@ -89,9 +89,10 @@ def _lab_porosities(
                 " ".join(nlab),
                 "no NLAB values when --dry-density/--solid-density are given",
             )
-        # the densities of solids (lab_state.SOLID_DENSITY_RANGE)
-        check_range("--solid-density", solid_density, *SOLID_DENSITY_RANGE)
-        n = float(P.porosity_from_densities(dry_density, solid_density))
+        try:  # the state's checks: the densities of solids, a dry density of a physical void ratio
+            n = lab_state(dry_density=dry_density, solid_density=solid_density).n_lab
+        except InputError as exc:
+            raise _cli_error(exc) from None
         extra = {"dry_density_kg_m3": dry_density, "solid_density_kg_m3": solid_density}
         return [n], extra
     if not nlab:

@@ -24,7 +24,7 @@ console = OutputConsole()
 PAPER_MODE_NOTE = (
     "[yellow]paper mode:[/] the specimen is prepared at the fixed friction_prep, so the accepted n2D "
     "does not follow the laboratory density (nLab only sets Eq. 12's first trial); for the answer at "
-    "your density give both laboratory extremes (--n-max/--n-min or [density]) or use poro2d sand"
+    "your density give both laboratory extremes (--n-max/--n-min or \\[density]) or use poro2d sand"
 )
 
 #: --mode's help: both modes, and when each is the default

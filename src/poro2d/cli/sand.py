@@ -5,10 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 
 import typer
-from rich.markup import escape
 
 from poro2d.cli import options as opt
-from poro2d.console import OutputConsole, Table
+from poro2d.console import OutputConsole, Table, shown
 
 console = OutputConsole()
 
@@ -16,7 +15,7 @@ console = OutputConsole()
 def print_preflight(case, pf) -> None:
     """The pre-flight table, printed before any DEM work."""
     lab = case.lab
-    t = Table(title=f"pre-flight: {case.name}")
+    t = Table(title=f"pre-flight: {shown(case.name)}")
     t.add_column("quantity")
     t.add_column("value", justify="right")
     dr = "" if lab.relative_density is None else f", Dr = {lab.relative_density:.3f}"
@@ -61,12 +60,12 @@ def print_preflight(case, pf) -> None:
         ),
     ]
     for k, v in rows:
-        t.add_row(k, escape(v))
+        t.add_row(k, shown(v))
     console.print(t)
     if pf.suggestion:
-        console.print(f"[bold]budget:[/] {escape(pf.suggestion)}", soft_wrap=True)
+        console.print(f"[bold]budget:[/] {shown(pf.suggestion)}", soft_wrap=True)
     for note in pf.notes:
-        console.print(f"[yellow]note:[/] {escape(note)}", soft_wrap=True)
+        console.print(f"[yellow]note:[/] {shown(note)}", soft_wrap=True)
 
 
 def print_result(res, out: Path) -> None:
@@ -79,7 +78,7 @@ def print_result(res, out: Path) -> None:
     if res.interior_porosity_mean is not None:  # None: no seed accepted (as sand.json keeps NaN)
         console.print(
             f"[bold]interior porosity {res.interior_porosity_mean:.4f} +- {res.interior_porosity_sd:.4f}[/] "
-            f"({res.seeds_accepted} of {res.seeds} seeds): the 2D porosity of {escape(head)}",
+            f"({res.seeds_accepted} of {res.seeds} seeds): the 2D porosity of {shown(head)}",
             soft_wrap=True,
         )
     t = Table(title="poro2d sand")
@@ -92,7 +91,7 @@ def print_result(res, out: Path) -> None:
             _f(k.interior_porosity),
             _f(k.box_porosity),
             str(k.particle_count or ""),
-            escape(str(out / k.folder)) if k.folder else "",
+            shown(str(out / k.folder)) if k.folder else "",
         )
     console.print(t)
     console.print(
@@ -103,20 +102,20 @@ def print_result(res, out: Path) -> None:
         soft_wrap=True,
     )
     console.print(
-        f"summary: {escape(str(out / 'summary.md'))} (also summary.csv, sand.json, fig_grading.png)",
+        f"summary: {shown(str(out / 'summary.md'))} (also summary.csv, sand.json, fig_grading.png)",
         soft_wrap=True,
     )
     for k in res.specimens:
         if not k.accepted:
-            console.print(f"[bold red]seed {k.seed} not accepted:[/] {escape(k.message)}", soft_wrap=True)
+            console.print(f"[bold red]seed {k.seed} not accepted:[/] {shown(k.message)}", soft_wrap=True)
     if res.state_map is not None:
         from poro2d.critical_state.state_table import state_map_lines
 
         for line in state_map_lines(res.state_map):
-            console.print(escape(line), soft_wrap=True)
+            console.print(shown(line), soft_wrap=True)
     for w in warnings(res):
         if not w.startswith("seed(s)"):  # the refused seeds were named above, with why
-            console.print(f"[yellow]note:[/] {escape(w)}", soft_wrap=True)
+            console.print(f"[yellow]note:[/] {shown(w)}", soft_wrap=True)
 
 
 def _f(v) -> str:
@@ -151,6 +150,7 @@ def sand_cmd(
     from poro2d.sand.run import check_soil, run_sand
     from poro2d.store import Store
 
+    options = RunOptions(workers, scheduler, progress=not quiet)  # --workers, --scheduler checked first
     if preflight_only:
         case, pf = check_soil(config, seeds=seeds, workers=workers, budget_minutes=budget)
         print_preflight(case, pf)
@@ -165,8 +165,8 @@ def sand_cmd(
     res = run_sand(
         load_sand_case(config, seeds=seeds, budget_minutes=budget),
         store,
-        options=RunOptions(workers, scheduler, progress=not quiet),
-        announce=lambda line: console.print(escape(line), soft_wrap=True),
+        options=options,
+        announce=lambda line: console.print(shown(line), soft_wrap=True),
         on_preflight=preflight,
     )
     draw_grading(res, cases[0], store)

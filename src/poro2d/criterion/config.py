@@ -151,8 +151,10 @@ def check_tables(cfg: dict) -> None:
 #: is a typo or a run that cannot end: stiffnesses (N/m) 1e5 times the paper's particles (the
 #: time step falls with their square root: 300 times as many steps), friction coefficients of
 #: 10 (a contact that never slides), up to 100 g of gravity (a centrifuge's), the solids of
-#: ``poro2d convert``, disks up to 1 m thick, and step budgets of 1e8 (days of one core)
+#: ``poro2d convert``, disks up to 1 m thick, boxes up to 10 m (a large-scale laboratory box
+#: is 1-2 m), and step budgets of 1e8 (days of one core)
 SPECIMEN_BOUNDS: dict[str, tuple[float, float]] = {
+    **{k: (0.0, 10.0) for k in ("width", "height")},
     **{k: (0.0, 1e12) for k in ("kn_particle", "ks_particle", "kn_wall", "ks_wall")},
     **{k: (0.0, 10.0) for k in ("friction_prep", "friction_particle", "friction_wall")},
     "gravity": (0.0, 981.0),
@@ -179,6 +181,17 @@ def check_config_bounds(obj, section: str, bounds: dict[str, tuple[float, float]
             raise InputError(f"{section}.{key}", value, f"[{lo:g}, {hi:g}]")
 
 
+def check_cut_in_box(d_max_mm: Any, spec: SpecimenSpec) -> None:
+    """A ``[grading] d_max_mm`` no larger than the box: a cut above every disk the box could hold
+    cuts nothing, and is a slip of units or of the key (the grading checked it is a size)."""
+    side = max(spec.width, spec.height)
+    if d_max_mm is not None and d_max_mm / 1000.0 > side:
+        raise InputError(
+            "grading.d_max_mm", d_max_mm, f"at most the box's larger side, {1000 * side:g} mm",
+            "the largest disk must fit a layer of the box",
+        )  # fmt: skip
+
+
 def build(cfg: dict, base_dir: Path | None = None, **overrides):
     """(SpecimenSpec, GradingCurve, CriterionSettings, seed) from a config dict."""
     spec_over = {k: overrides.pop(k) for k in ("threads",) if k in overrides}
@@ -188,6 +201,7 @@ def build(cfg: dict, base_dir: Path | None = None, **overrides):
         raise InputError("grading", g, "a table: preset, csv or sizes_mm with percent_passing")
     grading = paper_grading() if g == {"preset": "paper"} else GradingCurve.from_config(g, base_dir=base_dir)
     check_config_bounds(spec, "specimen", SPECIMEN_BOUNDS)
+    check_cut_in_box(g.get("d_max_mm"), spec)
     # a wide grading's preparation: the settled test unless the config says otherwise (the
     # paper's grading is not wide: its spec is unchanged)
     spec = wide_grading_spec(spec, grading, cfg.get("specimen"))

@@ -95,7 +95,8 @@ def connect(scheduler: str):
         )
     try:
         return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
-    except (OSError, TimeoutError) as exc:  # refused, unreachable, or no answer in time
+    except Exception as exc:  # refused, no answer in time, or another server's (a web server on
+        # ws:// answers the handshake with a page, tls:// asks for a security config first)
         raise InputError(
             "--scheduler",
             scheduler,

@@ -165,7 +165,9 @@ def _criterion_config(cfg: dict, lab: LabState, base_dir: Path | None) -> Criter
     crit = {k: copy.deepcopy(v) for k, v in cfg.items() if k not in SAND_TABLES}
     table = dict(crit.get("criterion") or {})
     given = table.get("n_lab")
-    if given is not None and not math.isclose(float(given), lab.n_lab, abs_tol=5e-5):
+    if given is not None and not math.isclose(
+        check_range("criterion.n_lab", given, 0.0, 1.0, hi_open=True), lab.n_lab, abs_tol=5e-5
+    ):
         raise InputError("criterion.n_lab", given, f"unset or the [lab] state's n = {lab.n_lab:.4f}")
     table["n_lab"] = round(lab.n_lab, 6)
     crit["criterion"] = table
@@ -198,8 +200,29 @@ def with_step_budgets(config: CriterionBase, spec: SpecimenSpec, grading: Gradin
         return config
     tables = {name: config.table(name) for name in dict.fromkeys(table for table, _ in STEP_BUDGETS)}
     for (table, key), default in STEP_BUDGETS.items():
-        tables[table].setdefault(key, int(math.ceil(default * slow / 1000.0) * 1000))
+        if key not in tables[table]:
+            tables[table][key] = _scaled_budget(config, grading, key, default, slow)
     return config.with_tables(**tables)
+
+
+def _scaled_budget(config: CriterionBase, grading: GradingCurve, key: str, default: int, slow: float) -> int:
+    """``default`` steps scaled by ``slow``; refused, naming the grading's key that sets the time
+    step, when that is more than a stage may take (the config would be refused for a key the
+    user never typed)."""
+    from poro2d.criterion.config import CRITERION_BOUNDS, SPECIMEN_BOUNDS
+
+    steps = int(math.ceil(default * slow / 1000.0) * 1000)
+    most = {**SPECIMEN_BOUNDS, **CRITERION_BOUNDS}[key][1]
+    if steps <= most:
+        return steps
+    table = config.table("grading")
+    name = "grading.upscale" if "upscale" in table else "grading.d_min_mm"
+    raise InputError(
+        name, table.get(name.split(".")[1]),
+        f"a finest disk whose time step is at least {default / most:.3g} of the paper grading's",
+        f"the finest disk, {grading.d_min_m * 1e3:.3g} mm in the model, steps at {1 / slow:.3g} of it: "
+        f"{key} would be {steps}, above its {most:g}; up-scale more or cut the fines (d_min_mm)",
+    )  # fmt: skip
 
 
 def load_sand_case(

@@ -29,6 +29,7 @@ import numpy as np
 
 from poro2d.criterion.density import Calibration, StateTarget, state_target
 from poro2d.errors import InputError
+from poro2d.execute.cluster_options import check_cluster_options
 from poro2d.execute.options import RunOptions
 from poro2d.interop.origin import SOIL_FILE
 from poro2d.io_utils import Provenance, check_output_dir
@@ -278,12 +279,15 @@ def check_soil(
     budget_minutes: float | None = None,
 ) -> tuple[SandCase, Preflight]:
     """The soil checked and its pre-flight, with no DEM work (``poro2d sand --preflight``)."""
+    check_cluster_options(None, workers)
     case = load_sand_case(config, seeds=seeds, budget_minutes=budget_minutes)
     return case, _preflight(case, workers)
 
 
 def _preflight(case: SandCase, workers: int | None) -> Preflight:
-    return preflight(case, workers=workers or os.cpu_count() or 1, budget_minutes=case.budget_minutes)
+    """The pre-flight on ``workers`` cores (None: every core of this machine)."""
+    cores = workers if workers is not None else os.cpu_count() or 1
+    return preflight(case, workers=cores, budget_minutes=case.budget_minutes)
 
 
 def run_sand(
@@ -314,17 +318,19 @@ def run_sand(
     """
     if not isinstance(case, SandCase):
         raise InputError("case", type(case).__name__, "a SandCase: load_sand_case(config)")
-    if store is not None:
-        check_output_dir(store.parameter, store.root)
-    with held(store, KIND) as kept:
-        return _run_sand(case, kept, options, use_cache, announce, on_preflight)
-
-
-def _run_sand(case, store, options, use_cache, announce, on_preflight) -> SandResult:
     from poro2d.execute.dask_cluster import check_reachable
 
+    if store is not None:
+        check_output_dir(store.parameter, store.root)
+    # the soil's own refusals (a box, a time step) and a scheduler that does not answer come
+    # before the folder is claimed: a refused run leaves no mark in it
     pf = _preflight(case, options.workers)
-    check_reachable(options.scheduler)  # one that does not answer is refused before the pre-flight is kept
+    check_reachable(options.scheduler)
+    with held(store, KIND) as kept:
+        return _run_sand(case, pf, kept, options, use_cache, announce, on_preflight)
+
+
+def _run_sand(case, pf, store, options, use_cache, announce, on_preflight) -> SandResult:
     store.write_json(
         "preflight.json",
         {

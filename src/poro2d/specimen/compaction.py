@@ -257,15 +257,8 @@ def make_walls(spec: SpecimenSpec, lid_height: float) -> Walls:
 
 def check_feasible(spec: SpecimenSpec, grading: GradingCurve, porosity: float) -> None:
     """Reject configurations that cannot work, before any simulation starts."""
+    check_box(spec, grading)  # first: a box too small for its disks is named as the box
     check_range("porosity", porosity, 0.0, 1.0, lo_open=True, hi_open=True)
-    dmax = grading.d_max_m
-    band_h = spec.height / spec.layers
-    if dmax >= min(spec.width, band_h):
-        raise InputError(
-            "box",
-            f"{spec.width} m x {spec.height} m in {spec.layers} layers (band {band_h:.4g} m)",
-            f"a band taller and wider than the largest disk ({dmax:.4g} m)",
-        )
     # Random close packing of polydisperse disks is near 0.16-0.18 porosity; below ~0.09
     # (hexagonal order, 0.0931) no disk arrangement without big overlaps exists.
     if porosity < 0.05:
@@ -275,6 +268,19 @@ def check_feasible(spec: SpecimenSpec, grading: GradingCurve, porosity: float) -
         )  # fmt: skip
     check_densest(spec, grading, porosity)
     check_size(spec, grading, porosity)
+
+
+def check_box(spec: SpecimenSpec, grading: GradingCurve) -> None:
+    """Refuse a box whose bands are not taller and wider than the largest disk (geometry alone:
+    checked before any estimate that needs the disks)."""
+    dmax = grading.d_max_m
+    band_h = spec.height / spec.layers
+    if dmax >= min(spec.width, band_h):
+        raise InputError(
+            "box",
+            f"{spec.width} m x {spec.height} m in {spec.layers} layers (band {band_h:.4g} m)",
+            f"a band taller and wider than the largest disk ({dmax:.4g} m)",
+        )
 
 
 #: a trial porosity more than this below the grading's frictionless jamming porosity n_J is
