@@ -70,7 +70,7 @@ def test_one_file_of_several_tests_reads_as_one_file_per_test(tmp_path):
     ("files", "words"),
     [
         ("no_column", r"lab columns.*confining_stress_kpa"),
-        ("twice", r"confining_stress_kpa.*each confining stress in one test.*50 kPa was read before"),
+        ("twice", r"confining_stress_kpa.*each confining stress in one test.*50 kPa was read from"),
         ("percent", r"lab axial_strain.*line 9.*is the column in percent"),
         ("short", r"curve at 100 kPa.*at least 5 readings"),
     ],

@@ -12,6 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+import numpy as np
+
 from poro2d.biaxial.quick import QuickSpecimen
 from poro2d.biaxial.settings import CONFINING_RANGE_KPA, BiaxialSettings
 from poro2d.config import check_finite
@@ -66,6 +68,14 @@ class BiaxialCase:
                 "1 for a specimen file (give one specimen file per replicate, or --quick)",
             )
         return replace(self, specimen=self.specimen.with_seed(self.specimen.seed + k))
+
+    def grains(self) -> tuple[float, np.ndarray, np.ndarray]:
+        """(box width in m, radii, densities) of the specimen's disks, with no step run: a file's as
+        saved, a quick specimen's as its recipe draws them."""
+        if isinstance(self.specimen, QuickSpecimen):
+            return self.specimen.grains()
+        arrays = self.specimen.arrays
+        return self.specimen.box()[0], arrays["particles.radius"], arrays["particles.density"]
 
     def with_settings(self, **changes) -> BiaxialCase:
         return replace(self, settings=replace(self.settings, **changes))

@@ -154,7 +154,8 @@ def read_lab_tests(paths) -> LabTests:
             if float(sigma) in curves:
                 raise InputError(
                     f"lab {CONFINING_COLUMN} ({table.where(int(rows[0]), CONFINING_COLUMN)})", float(sigma),
-                    "each confining stress in one test", f"a test at {sigma:g} kPa was read before",
+                    "each confining stress in one test",
+                    f"a test at {sigma:g} kPa was read from {curves[float(sigma)].source}",
                 )  # fmt: skip
             curves[float(sigma)] = _curve(table, rows, e1, ratio, ev, f"curve at {sigma:g} kPa")
     return LabTests(tuple(str(p) for p in paths), curves)

@@ -16,8 +16,11 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, replace
 
+import numpy as np
+
 from poro2d.dem import Simulation
 from poro2d.errors import check_int
+from poro2d.grading import draw_disks
 from poro2d.identity import identity_digest
 from poro2d.specimen import paper_grading
 from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
@@ -77,6 +80,14 @@ class QuickSpecimen:
             friction_prep=self.friction_prep, rolling_friction_prep=self.rolling_friction_prep,
             threads=threads,
         )  # fmt: skip
+
+    def grains(self) -> tuple[float, np.ndarray, np.ndarray]:
+        """(box width in m, radii, densities) of the specimen's disks as its preparation draws them
+        (:func:`~poro2d.specimen.compaction.prepare_specimen`'s first draw; no disk placed)."""
+        spec = self._spec(1)
+        radii = draw_disks(paper_grading(), (1.0 - self.porosity) * self.width * self.height,
+                           np.random.default_rng(self.seed))  # fmt: skip
+        return self.width, radii, np.full(len(radii), spec.solid_density)
 
     def simulation(self, threads: int | None = None) -> Simulation:
         """The specimen, prepared now (a few seconds); refused if its preparation did not converge."""

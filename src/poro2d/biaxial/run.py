@@ -24,7 +24,7 @@ from poro2d.biaxial.parts import (
 )
 from poro2d.biaxial.record import folder_stage
 from poro2d.biaxial.results import BiaxialResult, BiaxialTestResult
-from poro2d.biaxial.single import BiaxialTest
+from poro2d.biaxial.single import BiaxialTest, check_quasi_static
 from poro2d.errors import InputError, check_int
 from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
@@ -94,11 +94,14 @@ def lab_curve(value) -> LabCurve | None:
     raise InputError("lab", type(value).__name__, "a laboratory CSV path, a LabCurve or None")
 
 
-def check_run(store, options: RunOptions, tests: int) -> int:
-    """``store`` checked; the worker processes (default one per test, at most one per core)."""
+def check_run(store, options: RunOptions, cases: list[BiaxialCase]) -> int:
+    """``store`` and every case's strain rate checked, before any file or progress line; the worker
+    processes (default one per test, at most one per core)."""
     if store is not None and not isinstance(store, Store):
         raise InputError("store", type(store).__name__, "a poro2d.store.Store or None")
-    return options.local_workers(tests)
+    for case in cases:
+        check_quasi_static(case)
+    return options.local_workers(len(cases))
 
 
 def run_biaxial(
@@ -130,7 +133,7 @@ def run_biaxial(
     n = check_int("replicates", replicates, 1, MAX_REPLICATES)
     cases = replicate_cases(case, n)
     lab_data = lab_curve(lab)
-    workers = check_run(store, options, len(cases))
+    workers = check_run(store, options, cases)
     with claimed(store, KIND):
         return _run(cases, store, lab_data, workers, options, config)
 

@@ -96,7 +96,7 @@ def run_biaxial_series(
     base = replicate_cases(case, n)
     cases = {s: [replace(c, confining_kpa=s) for c in base] for s in stresses}
     lab_data = lab_curve(lab)
-    workers = check_run(store, options, len(stresses) * len(base))
+    workers = check_run(store, options, [c for cs in cases.values() for c in cs])
     with claimed(store, KIND):
         return _run(cases, store, lab_data, workers, options, config)
 

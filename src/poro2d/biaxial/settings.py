@@ -98,6 +98,23 @@ class BiaxialSettings(TestSettings):
 
     def __post_init__(self) -> None:
         check_fields(self, BIAXIAL_RANGES)
+        self.check_strains()
+
+    def check_strains(self) -> None:
+        """The curve's rows fit the test: with the rows and the window as they come, a test too short
+        for them is refused as ``max_strain``, the setting that was changed (``--strain``)."""
+        shortest = 3 * self.record_strain / self.critical_window
+        cls = type(self)  # the class attributes are the fields' defaults
+        rows_as_default = (self.record_strain, self.critical_window) == (
+            cls.record_strain,
+            cls.critical_window,
+        )
+        if rows_as_default and self.max_strain < shortest:
+            raise InputError(
+                "max_strain", self.max_strain, f"[{shortest:.3g}, {MAX_AXIAL_STRAIN:g}]",
+                f"3 rows of the curve, one every {self.record_strain:g}, in the last {self.critical_window:g}"
+                " of it",
+            )  # fmt: skip
         if self.record_strain > self.max_strain:
             raise InputError("record_strain", self.record_strain, f"(0, max_strain = {self.max_strain:g}]")
         if self.max_strain / self.record_strain > MAX_RECORDS:

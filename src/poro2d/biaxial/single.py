@@ -45,6 +45,29 @@ def median_diameter(radius: np.ndarray) -> float:
     return float(np.interp(0.5, area / area[-1], d))
 
 
+def quasi_static_rate(case: BiaxialCase, width: float, d50: float, rho: float) -> tuple[float, float]:
+    """(strain rate, inertial number at sigma_3) of ``case`` in a box ``width`` wide, of disks of
+    median diameter ``d50`` and inertial density ``rho``; refused above ``inertial_limit``."""
+    s, sigma = case.settings, case.confining_kpa
+    rate = auto_strain_rate(width, s)
+    i0 = inertial_number(rate, d50, rho, sigma * 1e3)
+    if i0 > s.inertial_limit:
+        raise InputError(
+            "strain_rate", rate, f"(0, {rate * s.inertial_limit / i0:.3g}] 1/s",
+            f"I = rate d50 sqrt(rho / sigma_3) = {i0:.2e} at {sigma:g} kPa, above the "
+            f"quasi-static limit {s.inertial_limit:g}",
+        )  # fmt: skip
+    return rate, i0
+
+
+def check_quasi_static(case: BiaxialCase) -> None:
+    """Refuse ``case``'s strain rate, if not quasi-static, before any file or step: read off the
+    specimen's disks as saved or as its recipe draws them, no box built (the test checks again)."""
+    width, radius, density = case.grains()
+    rho = float(np.mean(density)) * case.settings.density_scale
+    quasi_static_rate(case, width, median_diameter(radius), rho)
+
+
 def _curve_kept(store: Store) -> bool:
     """The test's ``curve.csv`` is there as it was written (a finished test needs it beside its result)."""
     return store.has("curve.csv") and store.intact("curve.csv")
@@ -83,16 +106,7 @@ class BiaxialTest:
             sim.set_local_damping(float(s.local_damping))
         self.d50 = median_diameter(sim.particles.radius)
         self.rho = float(np.mean(sim.particles.density)) * sim.density_scale
-        self.strain_rate = auto_strain_rate(self.box.width, s)
-        i0 = inertial_number(self.strain_rate, self.d50, self.rho, self.case.confining_kpa * 1e3)
-        if i0 > s.inertial_limit:
-            fastest = self.strain_rate * s.inertial_limit / i0
-            raise InputError(
-                "strain_rate", self.strain_rate, f"(0, {fastest:.3g}] 1/s",
-                f"I = rate d50 sqrt(rho / sigma_3) = {i0:.2e} at {self.case.confining_kpa:g} kPa, above the "
-                f"quasi-static limit {s.inertial_limit:g}",
-            )  # fmt: skip
-        self.i0 = i0
+        self.strain_rate, self.i0 = quasi_static_rate(self.case, self.box.width, self.d50, self.rho)
         return sim
 
     def scaled(self, spec: Simulation) -> DiskStiffness | None:
@@ -199,4 +213,4 @@ class BiaxialTest:
         )  # fmt: skip
 
 
-__all__ = ["BiaxialTest", "median_diameter"]
+__all__ = ["BiaxialTest", "check_quasi_static", "median_diameter", "quasi_static_rate"]

@@ -99,8 +99,8 @@ class CalibrationCase:
         biaxial_lab: str | os.PathLike | list | LabTests | None = None,
         preset: str | None = None,
         quick: bool = False,
-        replicates: int = 3,
-        seed: int = 0,
+        replicates: int | None = None,
+        seed: int | None = None,
         fp_range=DEFAULT_FP_RANGE,
         mu_r_range=DEFAULT_MU_R_RANGE,
         kn_range=None,
@@ -120,7 +120,8 @@ class CalibrationCase:
         one is refused before any test.
 
         ``specimens``: checkpoints or criterion folders, or ``preset="paper"`` (``quick``: the small box)
-        with ``replicates`` seeds from ``seed``. ``fp_range``, ``mu_r_range``: the search ranges.
+        with ``replicates`` seeds (3) from ``seed`` (0), both refused without the preset. ``fp_range``,
+        ``mu_r_range``: the search ranges.
         ``kn_range``, ``ks_range``: (low, high) N/m to calibrate the disks' normal and shear stiffness
         too, searched in their logarithm (None: the specimen's, or the settings'); with either, the
         posterior is sampled with emcee (docs/calibration.md). ``points``: the space-filling design's
@@ -158,7 +159,7 @@ class CalibrationCase:
         lab_data = repeats if biaxial else repeats.first
         if not biaxial:
             check_stresses(lab_data.normal_stresses())
-        check_preset(preset, quick, replicates)
+        replicates, seed = check_preset(preset, quick, replicates, seed)
         if preset is not None and specimens:
             raise InputError("--specimen", ", ".join(map(str, specimens)), "nothing with --preset")
         # every given specimen accepted and read whole (a damaged file refused on one line) before any work

@@ -9,6 +9,10 @@ That share is the scatter of one simulated specimen unless the repeats say other
 laboratory specimen is taken as one more realisation of the packing. When the repeats scatter
 more than the simulated specimens do, the whole share is scaled up by the ratio of the two
 (:func:`lab_scatter_ratio`), so a laboratory noisier than its model never buys narrow intervals.
+
+Repeats are distinct measurements: a series given twice (the same file, or a copy under another
+name or saved again) would halve the laboratory's share with no scatter, so it is refused
+(:func:`check_distinct`).
 """
 
 from __future__ import annotations
@@ -36,6 +40,7 @@ class LabRepeats:
             raise InputError("--lab", "[]", "one laboratory CSV, or several repeats of one programme")
         series = tuple(x if isinstance(x, LabData) else read_lab_csv(x) for x in items)
         check_same_programme(series)
+        check_distinct(series)
         return cls(series)
 
     @property
@@ -84,6 +89,26 @@ def check_same_programme(series: tuple[LabData, ...]) -> None:
                 )  # fmt: skip
 
 
+def check_distinct(series: tuple[LabData, ...]) -> None:
+    """Refuse a series whose readings are those of an earlier one: the same measurement counted
+    twice would narrow the intervals as a real repeat does, with no scatter to show for it."""
+    for k, other in enumerate(series):
+        for first in series[:k]:
+            if same_readings(first, other):
+                raise InputError(
+                    "--lab", other.source, f"a repeat with readings of its own, not those of {first.source}",
+                    "the same measurement twice is one laboratory series; give it once",
+                )  # fmt: skip
+
+
+def same_readings(a: LabData, b: LabData) -> bool:
+    """Whether two series hold the same numbers: peaks, and every curve and rise reading."""
+    if a.peaks != b.peaks or a.curves.keys() != b.curves.keys() or a.vertical.keys() != b.vertical.keys():
+        return False
+    curves = all(np.array_equal(a.curves[s][i], b.curves[s][i]) for s in a.curves for i in (0, 1))
+    return curves and all(np.array_equal(a.vertical[s], b.vertical[s]) for s in a.vertical)
+
+
 def _text(value) -> str:
     if isinstance(value, list):
         return ", ".join(f"{v:g} kPa" for v in value)
@@ -126,4 +151,11 @@ def lab_share(repeats: int, ratio: float | None) -> float:
     return max(1.0, ratio or 1.0) / repeats
 
 
-__all__ = ["LabRepeats", "check_same_programme", "lab_scatter_ratio", "lab_share", "mean_targets"]
+__all__ = [
+    "LabRepeats",
+    "check_distinct",
+    "check_same_programme",
+    "lab_scatter_ratio",
+    "lab_share",
+    "mean_targets",
+]

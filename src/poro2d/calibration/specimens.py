@@ -20,6 +20,9 @@ from poro2d.store import Store
 
 #: the most replicate specimens of the preset (each is a criterion run)
 MAX_REPLICATES = 20
+#: the preset's replicate specimens and first seed unless given
+PRESET_REPLICATES = 3
+PRESET_SEED = 0
 
 
 def replicate_unit(specimens: SpecimenSet, label: str, sigma: float, base, fp: float, mu_r: float,
@@ -83,13 +86,24 @@ def _mixed(a: tuple[float, float, np.ndarray], b: tuple[float, float, np.ndarray
     return None
 
 
-def check_preset(preset: str | None, quick: bool, replicates: int) -> None:
-    """``--preset`` is ``paper`` (the only one), ``--quick`` only with it, replicates in range."""
+def check_preset(
+    preset: str | None, quick: bool, replicates: int | None, seed: int | None
+) -> tuple[int, int]:
+    """``--preset`` is ``paper`` (the only one); ``--quick``, ``--replicates`` and ``--seed`` only
+    with it: given specimens are sheared as they are, so a count or a seed would be ignored
+    without a word. Returns (replicates, seed), the preset's defaults where not given."""
     if preset is not None and preset != "paper":
         raise InputError("--preset", preset, "paper")
-    if quick and preset is None:
-        raise InputError("--quick", True, "only with --preset paper")
-    check_int("--replicates", replicates, 1, MAX_REPLICATES)
+    if preset is None:
+        for name, value in (("--quick", quick or None), ("--replicates", replicates), ("--seed", seed)):
+            if value is not None:
+                raise InputError(
+                    name, value, "only with --preset paper", "given specimens are sheared as they are"
+                )
+    replicates = check_int(
+        "--replicates", PRESET_REPLICATES if replicates is None else replicates, 1, MAX_REPLICATES
+    )
+    return replicates, check_int("--seed", PRESET_SEED if seed is None else seed, 0)
 
 
 def preset_specimens(store: Store, *, quick: bool, seed: int, replicates: int, progress: bool) -> SpecimenSet:

@@ -57,6 +57,7 @@ def register(app: typer.Typer) -> None:
         dilatancy and their spread over replicates; the peak envelope over the stresses."""
         from poro2d.biaxial.config import load_biaxial_config
         from poro2d.cli.shear import check_friction_options
+        from poro2d.errors import InputError
         from poro2d.io_utils import check_output_dir
         from poro2d.store import Store
 
@@ -81,7 +82,10 @@ def register(app: typer.Typer) -> None:
         jobs = opt.job_options(workers if workers is not None else run.get("workers"), scheduler, quiet)
         kw = {"replicates": n, "lab": lab if lab is not None else table.path("lab"), "options": jobs,
               "config": recorded}  # fmt: skip
-        start_and_print(case, stresses, Store(out), kw, out)
+        try:  # a strain rate too fast for the specimen is refused before any test, named as typed
+            start_and_print(case, stresses, Store(out), kw, out)
+        except InputError as exc:
+            raise as_typed(exc, options, table.settings) from None
 
 
 def confining_stresses(text: str | None, from_config) -> list[float]:
@@ -123,20 +127,35 @@ def check_replicates(quick: bool, specimen, seed, replicates, run: dict) -> tupl
     return first, n
 
 
+#: the option that sets each setting
+OPTION_NAMES = {
+    "max_strain": "--strain",
+    "strain_rate": "--strain-rate",
+    "stiffness_number": "--stiffness-number",
+}
+
+
 def build_settings(table, options: dict):
-    """BiaxialSettings from the config's table, the options winning; an option's error named as typed."""
+    """BiaxialSettings from the config's table, the options winning; an error named as typed."""
     from poro2d.errors import InputError
 
     try:
         return table.build(**options)
-    except InputError as exc:  # named as the option the user typed
-        names = {
-            "max_strain": "--strain",
-            "strain_rate": "--strain-rate",
-            "stiffness_number": "--stiffness-number",
-        }
-        name = names.get(exc.parameter, exc.parameter) if exc.parameter in options else exc.parameter
-        raise InputError(name, exc.value, exc.allowed) from None
+    except InputError as exc:
+        raise as_typed(exc, options, table.settings) from None
+
+
+def as_typed(exc, options: dict, config: dict):
+    """``exc`` naming what the user typed for its setting: the option, else the config's key."""
+    from poro2d.errors import InputError
+
+    if exc.parameter in options:
+        name = OPTION_NAMES.get(exc.parameter, exc.parameter)
+    elif exc.parameter in config:
+        name = f"biaxial.{exc.parameter}"
+    else:
+        return exc
+    return InputError(name, exc.value, exc.allowed, exc.hint)
 
 
 def make_case(quick: bool, specimen, sigma: float, first: int, settings):

@@ -51,8 +51,12 @@ def register(app: typer.Typer) -> None:
         ),
         preset: str = opt.preset(help="paper: replicate specimens of the paper's case."),
         quick: bool = typer.Option(False, "--quick", help="With --preset paper: the small specimen."),
-        replicates: int = typer.Option(3, "--replicates", help="Seeds of the preset's specimens (1-20)."),
-        seed: int = typer.Option(0, "--seed", help="First seed of the preset's specimens."),
+        replicates: int = typer.Option(
+            None, "--replicates", help="With --preset: seeds of its specimens (1-20; default 3)."
+        ),
+        seed: int = typer.Option(
+            None, "--seed", help="With --preset: first seed of its specimens (default 0)."
+        ),
         fp_range: str = typer.Option(None, "--fp-range", help="Particle friction range LOW,HIGH (0.3,3)."),
         mu_r_range: str = typer.Option(None, "--mu-r-range", help="Rolling friction range LOW,HIGH (0,0.5)."),
         kn_range: str = typer.Option(
@@ -101,6 +105,7 @@ def register(app: typer.Typer) -> None:
         biaxial tests."""
         from poro2d.calibration.case import DEFAULT_FP_RANGE, DEFAULT_MU_R_RANGE, CalibrationCase
         from poro2d.calibration.run import run_calibration
+        from poro2d.calibration.specimens import PRESET_REPLICATES, PRESET_SEED
         from poro2d.report.calibration_figures import draw_calibration
         from poro2d.report.criterion_figures import draw_specimens
         from poro2d.store import Store
@@ -113,8 +118,8 @@ def register(app: typer.Typer) -> None:
             "specimen": specimen or None,
             "preset": preset,
             "quick": quick,
-            "replicates": replicates,
-            "seed": seed,
+            "replicates": PRESET_REPLICATES if replicates is None else replicates,  # as files recorded them
+            "seed": PRESET_SEED if seed is None else seed,
             "fp_range": fp_range,
             "mu_r_range": mu_r_range,
             **{k: v for k, v in (("kn_range", kn_range), ("ks_range", ks_range)) if v is not None},
