@@ -57,7 +57,7 @@ from pathlib import Path
 import numpy as np
 
 from poro2d.dem.contact_law import in_series as series  # the quotient the exported files write
-from poro2d.interop.lammps import WallFix, critical_dt, disk_mass, model_commands, write_data
+from poro2d.interop.lammps import WallFix, critical_dt, data_text, disk_mass, model_commands
 from poro2d.interop.lammps_run import (
     LOOP_RE,
     checked_log,
@@ -206,8 +206,7 @@ def _write_inputs(wd: Path, x, y, radius, box, density, thickness, params: dict)
     """Data file and ``in.bench`` in ``wd``; returns the full parameter set of the script."""
     xlo, xhi, ylo, yhi = map(float, box)
     data = wd / "packing.data"
-    write_data(
-        data,
+    text = data_text(
         x,
         y,
         radius,
@@ -217,6 +216,7 @@ def _write_inputs(wd: Path, x, y, radius, box, density, thickness, params: dict)
         margin=float(radius.max()),
         title="poro2d benchmark packing (LAMMPS reference)",
     )
+    data.write_text(text)
     params = dict(params, xlo=xlo, xhi=xhi, ylo=ylo, yhi=yhi, data=data.name)
     (wd / "in.bench").write_text(_input_script(params))
     return params

@@ -32,6 +32,13 @@ class InputError(ValueError):
         return type(self), (self.parameter, self.value, self.allowed, self.hint)
 
 
+def interval_text(lo: float | None, hi: float | None, *, lo_open: bool = False, hi_open: bool = False) -> str:
+    """An interval as a refusal prints it: ``[0.0, 1.0]``, ``(0, inf)``; None is an open end."""
+    lo_s = "(" if lo_open else "["
+    hi_s = ")" if hi_open else "]"
+    return f"{lo_s}{'-inf' if lo is None else lo}, {'inf' if hi is None else hi}{hi_s}"
+
+
 def check_range(
     parameter: str,
     value: float,
@@ -53,9 +60,7 @@ def check_range(
         v = float(value)
     except (TypeError, ValueError):
         raise InputError(parameter, value, "a number") from None
-    lo_s = "(" if lo_open else "["
-    hi_s = ")" if hi_open else "]"
-    allowed = f"{lo_s}{'-inf' if lo is None else lo}, {'inf' if hi is None else hi}{hi_s}"
+    allowed = interval_text(lo, hi, lo_open=lo_open, hi_open=hi_open)
     if v != v:  # NaN
         raise InputError(parameter, value, allowed)
     if lo is not None and (v < lo or (lo_open and v == lo)):
@@ -121,7 +126,8 @@ class Real:
         if value is None and self.or_none:
             return
         if is_number(value) and not math.isfinite(float(value)):  # an open end admits no infinity
-            raise InputError(parameter, value, "a finite number")
+            interval = interval_text(self.lo, self.hi, lo_open=self.lo_open, hi_open=self.hi_open)
+            raise InputError(parameter, value, f"a finite number in {interval}")
         check_range(parameter, value, self.lo, self.hi, lo_open=self.lo_open, hi_open=self.hi_open)
 
 

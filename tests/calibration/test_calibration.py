@@ -171,18 +171,12 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
                             options=ONE_WORKER, **FIT_BOX)  # fmt: skip
     assert again.cluster.tests_run == 0 and again.cluster.tests_reused == 44
     assert again.best.to_dict() == res.best.to_dict()
-    # the same series given twice is two repeats that agree: their mean is the same values, the
-    # laboratory's share of the noise halves, so the intervals narrow (from the cache, no test)
-    twice = calibrate([lab, lab], [paths[0], paths[1]], store=Store(tmp_path / "twice"), points=9,
-                            refine=0, settings=SHORT, options=ONE_WORKER, **FIT_BOX)  # fmt: skip
-    once = calibrate(lab, [paths[0], paths[1]], store=Store(tmp_path / "once"), points=9, refine=0,
-                           settings=SHORT, options=ONE_WORKER, **FIT_BOX)  # fmt: skip
-    assert twice.posterior.lab_repeats == 2 and twice.posterior.lab_scatter_ratio == 0.0
-    assert "lab_repeats" not in once.posterior.to_dict()
-    assert [o.lab_kpa for o in twice.posterior.observables] == [o.lab_kpa for o in once.posterior.observables]
-    for name in TRUTH:
-        assert np.diff(getattr(twice.intervals, name)) < np.diff(getattr(once.intervals, name)), name
-    assert twice.lab.source == f"{lab}; {lab}"
+    # the same series given twice is one measurement, not two repeats that agree: refused before
+    # any test, so a copy cannot halve the laboratory's share of the noise and narrow the intervals
+    with pytest.raises(InputError, match="the same measurement twice is one laboratory series"):
+        calibrate([lab, lab], [paths[0], paths[1]], store=Store(tmp_path / "twice"), points=9,
+                  refine=0, settings=SHORT, options=ONE_WORKER, **FIT_BOX)  # fmt: skip
+    assert not (tmp_path / "twice").exists()
     # a weaker 'laboratory' (the same specimen at lower frictions) moves the answer to weaker
     # parameters: the calibration follows its data (round 1 comes from the cache)
     weak_lab = synthetic_lab(paths[2], [50, 100], 0.3, 0.0, tmp_path / "weak_dilation.csv", settings=SHORT)

@@ -236,7 +236,7 @@ def test_non_finite_base_values_are_input_errors():
         ({"kind": "nope", "n_lab": [0.3]}, "sweep.kind"),
         ({"retries": -1, "n_lab": [0.3]}, "sweep.retries"),
         ({"n_lab": [0.33], "cases": [{"n_lab": 0.3}]}, "sweep.cases"),
-        ({"n_lab": [0.33, 1.5]}, "n_lab"),
+        ({"n_lab": [0.33, 1.5]}, "criterion.n_lab"),  # the axis as the cases name it
         ({"n_lab": [0.33, 0.33]}, "sweep"),
     ],
 )
