@@ -214,13 +214,19 @@ CASES = [
 ]
 
 
+def work(*args, **kwargs):
+    """Stands in for an entry point of real work: reaching it means the input was not refused in time."""
+    raise AssertionError("work started before the input was refused")
+
+
 @pytest.fixture
 def no_work(monkeypatch):
     """Every entry point of real work raises: a case that gets there was not refused in time."""
+    stop_real_work(monkeypatch)
 
-    def work(*args, **kwargs):
-        raise AssertionError("work started before the input was refused")
 
+def stop_real_work(monkeypatch) -> None:
+    """Make every entry point of the commands' real work raise (see :func:`work`)."""
     monkeypatch.setattr(runner, "run_sweep", work)
     monkeypatch.setattr(density_sweep, "calibrate", work)
     monkeypatch.setattr(PorosityCriterion, "run", work)

@@ -14,16 +14,14 @@ import warnings
 
 import pytest
 
-import poro2d.critical_state as critical_state
 import poro2d.sand.preflight as sand_preflight
 import poro2d.sand.run as sand_run
-import poro2d.sweep.runner as runner
 from poro2d.cli import main
-from poro2d.criterion.protocol import PorosityCriterion
 from poro2d.errors import InputError
 from poro2d.grading import GradingCurve
 from poro2d.lab_state import lab_state
 from poro2d.specimen.compaction import SpecimenSpec
+from tests.cli.test_refusals import stop_real_work, work
 
 GRADING = "[grading]\nsizes_mm = [0.1, 0.2, 0.3]\npercent_passing = [0, 50, 100]\nupscale = 10\n"
 LAB = "[lab]\ne_max = 0.977\ne_min = 0.597\ndr = 0.8\n"
@@ -81,14 +79,9 @@ CASES = [
 
 @pytest.fixture
 def no_work(monkeypatch):
-    """Every entry point of real work raises: a case that gets there was not refused in time."""
-
-    def work(*args, **kwargs):
-        raise AssertionError("work started before the input was refused")
-
-    monkeypatch.setattr(runner, "run_sweep", work)
-    monkeypatch.setattr(PorosityCriterion, "run", work)
-    monkeypatch.setattr(critical_state, "run_critical_states", work)
+    """Every entry point of real work raises, the sand pre-flight's too: a case that gets there
+    was not refused in time."""
+    stop_real_work(monkeypatch)
     monkeypatch.setattr(sand_run, "calibration_stage", work)
     monkeypatch.setattr(sand_preflight, "jamming_of", work)  # the pre-flight's only long part
 
