@@ -16,6 +16,7 @@ import sys
 
 from poro2d.console import OutputConsole, Table
 from poro2d.interop.agreement import QUANTITIES, compare
+from poro2d.interop.settled import RestCase
 from poro2d.interop.specimen_data import from_checkpoint
 from poro2d.io_utils import Provenance, write_json
 
@@ -30,7 +31,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
 
     spec = from_checkpoint(args.specimen)
-    r = compare(spec, ratio=args.ratio, max_steps=args.max_steps, workdir=args.workdir)
+    r = compare(RestCase(spec, args.ratio, args.max_steps), workdir=args.workdir)
     ours, theirs = r.poro2d, r.lammps
     t = Table(title=f"{spec.n} disks, G = {r.weight_n_per_m:.4g} N/m, stop ratio {args.ratio:g}")
     for col in ("quantity", "poro2d", "LAMMPS", "|diff| / poro2d", "|diff| / G"):

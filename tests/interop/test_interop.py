@@ -221,17 +221,19 @@ def test_import_of_a_loose_box_moves_the_plate_down(spec, tmp_path, capsys):
     assert "moving down" in capsys.readouterr().out
 
 
-def test_result_lines_read_as_typed_records():
-    """The last ``poro2d-result`` line a LAMMPS or YADE script prints, one field per key."""
-    from poro2d.interop.lammps_run import read_result_line
-    from poro2d.interop.yade_run import read_result
+def test_result_lines_read_as_numbers_by_key():
+    """The last ``poro2d-result`` line a LAMMPS or YADE script prints, one number per key."""
+    from poro2d.interop.lammps_run import LammpsError
+    from poro2d.interop.settled import result_numbers
 
     log = "poro2d-result ratio 9 f_top 9 f_bottom 9 side_friction_up 9 f_left 9 f_right 9 coordination 9\n"
     log += "poro2d-result ratio 1e-4 f_top 1.5 f_bottom 800 side_friction_up 2 f_left 3 f_right 4 "
     log += "coordination 3.5"
-    line = read_result_line(log)
-    assert (line.ratio, line.f_top, line.f_bottom, line.coordination) == (1e-4, 1.5, 800.0, 3.5)
+    line = result_numbers(log, LammpsError, "the LAMMPS log")
+    assert (line["ratio"], line["f_top"], line["f_bottom"], line["coordination"]) == (1e-4, 1.5, 800.0, 3.5)
     out = "poro2d-result f_top_n_per_m 1.0 f_bottom_n_per_m 2.0 side_friction_up_n_per_m 0.5 "
     out += "unbalanced_force 1e-05 steps 1200"
-    res = read_result(out)
-    assert (res.f_bottom_n_per_m, res.unbalanced_force, int(res.steps)) == (2.0, 1e-5, 1200)
+    res = result_numbers(out, LammpsError, "YADE's output")
+    assert (res["f_bottom_n_per_m"], res["unbalanced_force"], res["steps"]) == (2.0, 1e-5, 1200.0)
+    with pytest.raises(LammpsError, match="no 'poro2d-result' line in the LAMMPS log"):
+        result_numbers("Loop time of 1.0", LammpsError, "the LAMMPS log")

@@ -10,7 +10,8 @@ pytestmark = pytest.mark.scenario
 
 from poro2d.interop import lammps as lmp  # noqa: E402
 from poro2d.interop.agreement import compare  # noqa: E402
-from poro2d.interop.lammps_run import execute_script, read_result_line  # noqa: E402
+from poro2d.interop.lammps_run import LammpsError, execute_script  # noqa: E402
+from poro2d.interop.settled import RestCase, result_numbers  # noqa: E402
 from poro2d.interop.specimen_data import from_checkpoint  # noqa: E402
 
 
@@ -22,16 +23,16 @@ def spec(saved):
 def test_exported_script_runs_as_written(spec, tmp_path):
     lmp.write_specimen(spec, tmp_path)
     log = execute_script(tmp_path, lmp.INPUT_FILE)
-    res = read_result_line(log)
-    assert res.ratio < 1e-3
+    res = result_numbers(log, LammpsError, "the LAMMPS log")
+    assert res["ratio"] < 1e-3
     # the disks carry their weight: floor + side friction = G + plate (N/m)
     g = spec.weight_per_thickness()
-    assert res.f_bottom + res.side_friction_up == pytest.approx(g + res.f_top, rel=1e-3)
+    assert res["f_bottom"] + res["side_friction_up"] == pytest.approx(g + res["f_top"], rel=1e-3)
     assert (tmp_path / lmp.FINAL_DISKS).is_file() and (tmp_path / lmp.FINAL_CONTACTS).is_file()
 
 
 def test_lammps_and_poro2d_agree_at_rest_from_the_same_state(spec, tmp_path):
-    r = compare(spec, ratio=1e-9, workdir=tmp_path)
+    r = compare(RestCase(spec, ratio=1e-9), workdir=tmp_path)
     assert r.poro2d.converged and r.lammps.converged
     ours, theirs, g = r.poro2d, r.lammps, r.weight_n_per_m
     assert ours.f_top_n_per_m > 0.01 * g  # the plate carries a force: a real comparison

@@ -12,9 +12,10 @@ import pytest
 
 from poro2d.criterion.config import paper_preset
 from poro2d.criterion.protocol import PorosityCriterion
-from poro2d.interop.agreement import run_poro2d
+from poro2d.interop.agreement import settle_poro2d
+from poro2d.interop.settled import RestCase
 from poro2d.interop.specimen_data import from_checkpoint
-from poro2d.interop.yade_run import run_yade
+from poro2d.interop.yade_run import settle_yade
 from poro2d.store import Store
 
 pytestmark = pytest.mark.scenario
@@ -48,8 +49,8 @@ def test_exported_paper_specimen_runs_in_yade_and_agrees_with_poro2d_at_rest(pap
     assert spec.n == 2440 and g == pytest.approx(796.4, abs=0.05)  # the paper preset's specimen
     # YADE to a mean unbalanced-force ratio of 1e-6 (about 2500 steps, 3 s); poro2d to a
     # largest ratio of 1e-8: both at rest, the wall forces steady to 1e-5 of G
-    theirs = run_yade(spec, tmp_path, ratio=1e-6, max_steps=200_000)
-    ours = run_poro2d(spec, ratio=1e-8, max_steps=2_000_000)
+    theirs = settle_yade(RestCase(spec, ratio=1e-6, max_steps=200_000), tmp_path)
+    ours = settle_poro2d(RestCase(spec, ratio=1e-8))
     assert theirs.converged and ours.converged
     assert theirs.yade_version not in (None, "unknown")
     # YADE's walls carry the disks' weight and the plate's push: the masses are the disk masses

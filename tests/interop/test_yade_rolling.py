@@ -18,9 +18,10 @@ import pytest
 from poro2d.dem.simulation import Simulation
 from poro2d.dem.state import Particles, Walls
 from poro2d.interop import yade
-from poro2d.interop.agreement import run_poro2d
+from poro2d.interop.agreement import settle_poro2d
+from poro2d.interop.settled import RestCase
 from poro2d.interop.specimen_data import from_checkpoint, from_simulation
-from poro2d.interop.yade_run import find_yade, run_yade, yade_env
+from poro2d.interop.yade_run import find_yade, settle_yade, yade_env
 
 pytestmark = pytest.mark.scenario
 
@@ -139,14 +140,14 @@ def test_a_rolled_specimen_settles_in_yade_as_in_poro2d(saved, tmp_path):
     _yade()
     spec = from_checkpoint(saved)
     spec = replace(spec, mu_r=np.full(spec.n, 0.2), walls=[replace(w, mu_r=0.2) for w in spec.walls])
-    theirs = run_yade(spec, tmp_path, ratio=1e-6, max_steps=200_000)
-    ours = run_poro2d(spec, ratio=1e-8, max_steps=2_000_000)
+    theirs = settle_yade(RestCase(spec, ratio=1e-6, max_steps=200_000), tmp_path)
+    ours = settle_poro2d(RestCase(spec, ratio=1e-8))
     assert theirs.converged and ours.converged
     g = spec.weight_per_thickness()
     for key in ("f_top_n_per_m", "f_bottom_n_per_m", "side_friction_up_n_per_m"):
         assert getattr(theirs, key) == pytest.approx(getattr(ours, key), abs=1e-4 * g)
-    unrolled = run_poro2d(
-        replace(spec, mu_r=None, walls=[replace(w, mu_r=0.0) for w in spec.walls]), 1e-8, 2_000_000
+    unrolled = settle_poro2d(
+        RestCase(replace(spec, mu_r=None, walls=[replace(w, mu_r=0.0) for w in spec.walls]), ratio=1e-8)
     )
     # the plate's force moves with rolling resistance by more than the agreement: a real check
     assert abs(ours.f_top_n_per_m - unrolled.f_top_n_per_m) > 10 * abs(

@@ -29,15 +29,8 @@ import numpy as np
 from poro2d.criterion.protocol import wall_forces
 from poro2d.dem.state import BOX_WALLS
 from poro2d.interop import lammps as lmp
-from poro2d.interop.lammps_run import (
-    execute_script,
-    parse_thermo,
-    read_dump,
-    read_result_line,
-    version_from_log,
-)
-from poro2d.interop.settled import SettledRun
-from poro2d.interop.specimen_data import SpecimenData
+from poro2d.interop.lammps_run import LammpsError, execute_script, parse_thermo, read_dump, version_from_log
+from poro2d.interop.settled import RestCase, SettledRun, result_numbers
 from poro2d.measure.coordination import coordination_number
 from poro2d.typed_result import TypedResult
 
@@ -69,11 +62,12 @@ class Agreement(TypedResult):
     rel_to_weight: dict[str, float]
 
 
-def run_poro2d(spec: SpecimenData, ratio: float, max_steps: int) -> SettledRun:
-    """poro2d from the exported state: disks at rest, no history; cycled until ``ratio``."""
+def settle_poro2d(case: RestCase) -> SettledRun:
+    """poro2d from the exported state: disks at rest, no history; cycled until ``case.ratio``."""
+    spec = case.spec
     sim = spec.to_simulation(dt=spec.dt)
     t0 = time.perf_counter()
-    res = sim.solve(ratio, max_steps)
+    res = sim.solve(case.ratio, case.max_steps)
     mags = sim.contacts().magnitude
     forces = wall_forces(sim)
     return SettledRun(
@@ -90,14 +84,14 @@ def run_poro2d(spec: SpecimenData, ratio: float, max_steps: int) -> SettledRun:
     )
 
 
-def run_lammps(spec: SpecimenData, workdir: str | os.PathLike, ratio: float, max_steps: int) -> SettledRun:
+def settle_lammps(case: RestCase, workdir: str | os.PathLike) -> SettledRun:
     """LAMMPS on the exported files in ``workdir``, run as written but for the stop ratio and step cap."""
     wd = Path(workdir)
-    lmp.write_specimen(spec, wd, ratio=ratio, max_steps=max_steps)
+    lmp.write_specimen(case.spec, wd, ratio=case.ratio, max_steps=case.max_steps)
     t0 = time.perf_counter()
     log = execute_script(wd, lmp.INPUT_FILE)
     seconds = time.perf_counter() - t0
-    res = read_result_line(log)
+    res = result_numbers(log, LammpsError, "the LAMMPS log")
     pairs = read_dump(wd / lmp.FINAL_CONTACTS)
     fn, ft = pairs.column("c_pl[1]"), pairs.column("c_pl[2]")
     touching = fn > 0.0
@@ -109,35 +103,34 @@ def run_lammps(spec: SpecimenData, workdir: str | os.PathLike, ratio: float, max
     allm = np.concatenate(mags)
     head, rows = parse_thermo(log)[-1]
     return SettledRun(
-        f_top_n_per_m=res.f_top,
-        f_bottom_n_per_m=res.f_bottom,
-        side_friction_up_n_per_m=res.side_friction_up,
+        f_top_n_per_m=res["f_top"],
+        f_bottom_n_per_m=res["f_bottom"],
+        side_friction_up_n_per_m=res["side_friction_up"],
         mean_contact_force_n=float(allm.mean()) if allm.size else 0.0,
-        coordination_number=res.coordination,
+        coordination_number=res["coordination"],
         contacts=int(allm.size),
         steps=int(rows[-1][head.index("Step")]),
-        converged=res.ratio < ratio,
-        max_ratio=res.ratio,
+        converged=res["ratio"] < case.ratio,
+        max_ratio=res["ratio"],
         seconds=seconds,
         lammps_version=version_from_log(log),
     )
 
 
-def compare(spec: SpecimenData, ratio: float = 1e-5, max_steps: int = 2_000_000,
-            workdir: str | os.PathLike | None = None) -> Agreement:  # fmt: skip
+def compare(case: RestCase, workdir: str | os.PathLike | None = None) -> Agreement:
     """Run both engines from the same state; their results and relative differences.
 
     ``rel_diff[key]`` is |LAMMPS - poro2d| / |poro2d|; for the wall forces also
     ``rel_to_weight[key]``, the difference over the self weight G (F_top of an accepted
     specimen is below 1 % of G, so its own relative difference is a small number over
-    a small number).
+    a small number). LAMMPS' files are kept in ``workdir`` (None: a temporary folder).
     """
     if workdir is None:
         with tempfile.TemporaryDirectory(prefix="poro2d_lmp_") as tmp:
-            return compare(spec, ratio, max_steps, tmp)
-    ours = run_poro2d(spec, ratio, max_steps)
-    theirs = run_lammps(spec, workdir, ratio, max_steps)
-    weight = spec.weight_per_thickness()
+            return compare(case, tmp)
+    ours = settle_poro2d(case)
+    theirs = settle_lammps(case, workdir)
+    weight = case.spec.weight_per_thickness()
     rel, relg = {}, {}
     for key, _ in QUANTITIES:
         a, b = getattr(theirs, key), getattr(ours, key)
@@ -145,6 +138,6 @@ def compare(spec: SpecimenData, ratio: float = 1e-5, max_steps: int = 2_000_000,
         if key.endswith("_n_per_m"):
             relg[key] = abs(a - b) / weight
     return Agreement(
-        disks=spec.n, weight_n_per_m=weight, ratio=ratio, poro2d=ours, lammps=theirs,
+        disks=case.spec.n, weight_n_per_m=weight, ratio=case.ratio, poro2d=ours, lammps=theirs,
         rel_diff=rel, rel_to_weight=relg,
     )  # fmt: skip

@@ -162,30 +162,3 @@ def read_dump(path: str | os.PathLike) -> DumpFrame:
     names = tuple(lines[k].split()[2:])
     rows = [ln.split() for ln in lines[k + 1 :] if ln.strip()]
     return DumpFrame(str(path), names, np.array(rows, dtype=float).reshape(len(rows), len(names)))
-
-
-@dataclass(frozen=True)
-class ResultLine:
-    """What the exported script prints last (``poro2d-result key value ...``, keys ``lammps.RESULT_KEYS``).
-
-    The largest unbalanced-force ``ratio``, the wall forces per metre of thickness (N/m:
-    the plate's ``f_top``, the floor's ``f_bottom``, the side walls' upward friction and
-    their horizontal pushes) and the ``coordination`` number.
-    """
-
-    ratio: float
-    f_top: float
-    f_bottom: float
-    side_friction_up: float
-    f_left: float
-    f_right: float
-    coordination: float
-
-
-def read_result_line(log: str, tag: str = "poro2d-result") -> ResultLine:
-    """The ``tag key value key value ...`` line that a script printed last, as numbers."""
-    lines = [ln for ln in log.splitlines() if ln.startswith(tag + " ")]
-    if not lines:
-        raise LammpsError(f"no '{tag}' line in the LAMMPS log")
-    words = lines[-1].split()[1:]
-    return ResultLine(**{words[i]: float(words[i + 1]) for i in range(0, len(words) - 1, 2)})

@@ -13,15 +13,10 @@ import re
 import shutil
 import subprocess
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 from poro2d.interop import yade
-from poro2d.interop.settled import SettledRun
-from poro2d.interop.specimen_data import SpecimenData
-
-#: the tag of the line the exported script prints last
-RESULT_TAG = "poro2d-result"
+from poro2d.interop.settled import RESULT_TAG, RestCase, SettledRun, result_numbers
 
 
 class YadeError(RuntimeError):
@@ -63,53 +58,29 @@ def execute_script(workdir: str | os.PathLike, settings: dict | None = None, tim
     return proc.stdout
 
 
-@dataclass(frozen=True)
-class ResultLine:
-    """What the exported script reports last (``poro2d-result key value ...``, its ``report()``).
-
-    The wall forces per metre of thickness (N/m) as poro2d gives them, YADE's mean
-    ``unbalanced_force`` and the ``steps`` cycled (printed as a number).
-    """
-
-    f_top_n_per_m: float
-    f_bottom_n_per_m: float
-    side_friction_up_n_per_m: float
-    unbalanced_force: float
-    steps: float
-
-
-def read_result(output: str) -> ResultLine:
-    """The numbers of the script's last ``poro2d-result key value ...`` line."""
-    lines = [ln for ln in output.splitlines() if ln.startswith(RESULT_TAG + " ")]
-    if not lines:
-        raise YadeError(f"no '{RESULT_TAG}' line in YADE's output")
-    words = lines[-1].split()[1:]
-    return ResultLine(**{words[i]: float(words[i + 1]) for i in range(0, len(words) - 1, 2)})
-
-
 def version_from_output(output: str) -> str:
     """YADE's version from its greeting (``Welcome to Yade 2023.02a``)."""
     m = re.search(r"Welcome to Yade (\S+)", output)
     return m.group(1) if m else "unknown"
 
 
-def run_yade(spec: SpecimenData, workdir: str | os.PathLike, ratio: float, max_steps: int) -> SettledRun:
+def settle_yade(case: RestCase, workdir: str | os.PathLike) -> SettledRun:
     """YADE on the exported script in ``workdir``, run as written but for the stop settings.
 
-    ``ratio`` is YADE's own measure of rest (``utils.unbalancedForce()``: the mean
+    ``case.ratio`` is YADE's own measure of rest (``utils.unbalancedForce()``: the mean
     unbalanced force over the mean contact force).
     """
-    yade.write_specimen(spec, workdir, ratio=ratio, max_steps=max_steps)
+    yade.write_specimen(case.spec, workdir, ratio=case.ratio, max_steps=case.max_steps)
     t0 = time.perf_counter()
     output = execute_script(workdir)
-    res = read_result(output)
+    res = result_numbers(output, YadeError, "YADE's output")
     return SettledRun(
-        f_top_n_per_m=res.f_top_n_per_m,
-        f_bottom_n_per_m=res.f_bottom_n_per_m,
-        side_friction_up_n_per_m=res.side_friction_up_n_per_m,
-        unbalanced_force=res.unbalanced_force,
-        steps=int(res.steps),
-        converged=res.unbalanced_force < ratio,
+        f_top_n_per_m=res["f_top_n_per_m"],
+        f_bottom_n_per_m=res["f_bottom_n_per_m"],
+        side_friction_up_n_per_m=res["side_friction_up_n_per_m"],
+        unbalanced_force=res["unbalanced_force"],
+        steps=int(res["steps"]),
+        converged=res["unbalanced_force"] < case.ratio,
         seconds=time.perf_counter() - t0,
         yade_version=version_from_output(output),
         workdir=str(Path(workdir)),
