@@ -351,6 +351,12 @@ def test_export_carries_the_window_and_import_uses_it(saved, tmp_path, capsys):
         )
     assert e.value.code == 1
     assert json.loads((tmp_path / "strict" / "check.json").read_text())["window_from"] == "--window"
+    # the folder of an import that failed its check is no specimen to export; one that passed is
+    strict = tmp_path / "strict"
+    words = str(strict / "check.json"), "says passes = False: F_top = ", "outside the window 0 < F_top < "
+    refused(["export", strict, "--to", "csv", "--out", tmp_path / "again-out"], capsys, *words)
+    main(["export", str(tmp_path / "check-.csv"), "--to", "csv", "--out", str(tmp_path / "passed")])
+    assert (tmp_path / "passed" / "disks.csv").is_file()
 
 
 def test_the_box_of_a_file_of_another_origin_is_checked_on_its_line(spec, tmp_path, capsys):

@@ -52,11 +52,11 @@ def test_a_criterion_outcome_keeps_what_acceptance_needs_and_quotes_values_as_wr
     ok = CriterionOutcome.from_json(
         {"converged": True, "iterations": [{"accepted": False}, {"accepted": True}]}
     )
-    assert ok.converged and ok.accepted_trial and ok.converged_said == "True" and not ok.names_seed
+    assert ok.converged.true and ok.accepted_trial and ok.converged.said == "True" and not ok.names_seed
     odd = CriterionOutcome.from_json({"converged": "yes", "iterations": "all", "seed": 1.5, "message": None})
-    assert not odd.converged and odd.converged_said == "yes" and not odd.accepted_trial
+    assert not odd.converged.true and odd.converged.said == "yes" and not odd.accepted_trial
     assert odd.names_seed and odd.seed is None and odd.message == "None"  # a seed of another kind: unknown
-    assert CriterionOutcome.from_json({}).converged_said is None  # not a criterion's result
+    assert CriterionOutcome.from_json({}).converged.said is None  # not a criterion's result
 
 
 def test_case_parameters_given_later_win_key_by_key():

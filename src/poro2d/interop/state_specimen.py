@@ -328,8 +328,8 @@ def _not_accepted(folder: Path) -> str:
     if not result.is_file():
         return f"{result} is missing"
     crit = _read(result, "SPECIMEN", CriterionOutcome.from_json)
-    if not crit.converged:
-        return f"{result} says converged = {crit.converged_said}: {crit.message}"
+    if not crit.converged.true:
+        return f"{result} says converged = {crit.converged.said}: {crit.message}"
     if not crit.accepted_trial:
         return f"{result} lists no accepted trial"
     if not (folder / "specimen.npz").is_file():

@@ -10,31 +10,39 @@ turned down, so each asks :func:`check_accepted` (or takes its file through
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TypeVar
 
 from poro2d.errors import InputError
 from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
-from poro2d.json_fields import accepted_rows, int_at, said_at
+from poro2d.json_fields import accepted_rows, int_at, said_at, value_at
 from poro2d.store import Store
 
-R = TypeVar("R")
+
+@dataclass(frozen=True)
+class Flag:
+    """A yes-or-no key of a record: its value as a message quotes it (``said``; None: the key is
+    absent) and whether that value is JSON's true."""
+
+    said: str | None
+    true: bool
+
+    @classmethod
+    def at(cls, data: dict, key: str) -> Flag:
+        return cls(said_at(data, key), data.get(key) is True)
+
+    def refuses(self) -> bool:
+        """The record says it, and not true."""
+        return self.said is not None and not self.true
 
 
 @dataclass(frozen=True)
 class CriterionOutcome:
-    """A criterion's ``result.json`` as far as acceptance goes.
+    """A criterion's ``result.json`` as far as acceptance goes: ``converged`` (its ``said`` None:
+    not a criterion's result), ``accepted_trial`` (``iterations`` holds an accepted trial), the
+    run's own ``message`` (``"None"`` when missing) and its seed, when ``names_seed``."""
 
-    ``converged_said``: the ``converged`` value as written (None: the file has no such key,
-    it is not a criterion's result); ``converged``: that value is true; ``accepted_trial``:
-    ``iterations`` holds a trial with ``accepted = true``; ``message``: the run's own words
-    (``str`` of it, ``"None"`` when missing); ``seed``: the seed, when ``names_seed``.
-    """
-
-    converged_said: str | None
-    converged: bool
+    converged: Flag
     accepted_trial: bool
     message: str
     names_seed: bool
@@ -43,25 +51,43 @@ class CriterionOutcome:
     @classmethod
     def from_json(cls, data: dict) -> CriterionOutcome:
         return cls(
-            converged_said=said_at(data, "converged"),
-            converged=data.get("converged") is True,
-            accepted_trial=accepted_rows(data.get("iterations")),
-            message=str(data.get("message")),
-            names_seed="seed" in data,
-            seed=int_at(data, "seed"),
+            Flag.at(data, "converged"),
+            accepted_rows(data.get("iterations")),
+            str(data.get("message")),
+            "seed" in data,
+            int_at(data, "seed"),
         )
 
 
-@dataclass(frozen=True)
-class TrialVerdict:
-    """A trial's ``trial.json``: whether it says ``accepted`` (``accepted_said``, as written) and true."""
+def _result_says(data: dict) -> str:
+    """What a criterion's ``result.json`` says against its specimen ('' when nothing)."""
+    outcome = CriterionOutcome.from_json(data)
+    if outcome.converged.refuses():
+        return f"converged = {outcome.converged.said}"
+    return "no accepted trial" if outcome.converged.true and not outcome.accepted_trial else ""
 
-    accepted_said: str | None
-    accepted: bool
 
-    @classmethod
-    def from_json(cls, data: dict) -> TrialVerdict:
-        return cls(said_at(data, "accepted"), data.get("accepted") is True)
+def _trial_says(data: dict) -> str:
+    """What a trial's ``trial.json`` says against its checkpoint ('' when nothing)."""
+    accepted = Flag.at(data, "accepted")
+    return f"accepted = {accepted.said}" if accepted.refuses() else ""
+
+
+def _check_says(data: dict) -> str:
+    """What an import's ``check.json`` (``poro2d import``) says against its specimen: the check it failed."""
+    passes = Flag.at(data, "passes")
+    if not passes.refuses():
+        return ""
+    if value_at(data, "equilibrium", "converged") is not True:
+        failed = f"no equilibrium (ratio {said_at(data, 'equilibrium', 'max_ratio')})"
+    else:
+        f_top, limit = said_at(data, "f_top_n_per_m"), said_at(data, "force_limit_n_per_m")
+        failed = f"F_top = {f_top} N/m outside the window 0 < F_top < {limit} N/m"
+    return f"passes = {passes.said}: {failed}"
+
+
+#: the records beside a specimen that may refuse it, in the order they are read, and what each says
+VERDICTS = (("result.json", _result_says), ("trial.json", _trial_says), ("check.json", _check_says))
 
 
 def accepted_file(path: str | os.PathLike) -> Path:
@@ -88,29 +114,28 @@ def accepted_file(path: str | os.PathLike) -> Path:
 
 
 def check_accepted(path: str | os.PathLike) -> None:
-    """Refuse a specimen that the criterion beside it did not accept.
+    """Refuse a specimen that the record beside it says was not accepted.
 
     A criterion folder (or the folder of the checkpoint given) holds ``result.json``;
     when it says ``converged = false`` or lists no accepted trial, the specimen must not
     leave as if valid. A trial's checkpoint has ``trial.json`` beside it, which must say
-    ``accepted = true``. A checkpoint with neither beside it (a shear test's, an imported
-    one) is taken as it is.
+    ``accepted = true``; an import's folder ``check.json``, which must say ``passes = true``
+    (the specimen failed the criterion's check as it stood). A checkpoint with none of them
+    beside it (a shear test's) is taken as it is.
     """
     p = Path(path)
     folder = Store(p if p.is_dir() else p.parent, parameter="SPECIMEN")
-    result = _record(path, folder, "result.json", CriterionOutcome.from_json)
-    if result is not None and result.converged_said is not None:
-        if not result.converged or not result.accepted_trial:
-            state = "no accepted trial" if result.converged else f"converged = {result.converged_said}"
-            _refuse_unaccepted(path, folder.root / "result.json", state)
-    trial = _record(path, folder, "trial.json", TrialVerdict.from_json)
-    if trial is not None and trial.accepted_said is not None and not trial.accepted:
-        _refuse_unaccepted(path, folder.root / "trial.json", f"accepted = {trial.accepted_said}")
+    for name, says in VERDICTS:
+        data = _record(path, folder, name)
+        state = says(data) if data is not None else ""
+        if state:
+            why = f"{folder.root / name} says {state}; nothing written"
+            raise InputError("SPECIMEN", str(path), "a specimen the criterion accepted", why)
 
 
-def _record(path: str | os.PathLike, folder: Store, name: str, parse: Callable[[dict], R]) -> R | None:
-    """The record ``name`` beside the specimen, read by ``parse`` from its JSON object (a file of any
-    poro2d: ``parse`` keeps what it needs), None if there is none (or it holds something else)."""
+def _record(path: str | os.PathLike, folder: Store, name: str) -> dict | None:
+    """The JSON object of the record ``name`` beside the specimen (a file of any poro2d), None if
+    there is none (or it holds something else)."""
     if not folder.has(name):
         return None
     check_input_file("SPECIMEN", folder.root / name)
@@ -118,13 +143,7 @@ def _record(path: str | os.PathLike, folder: Store, name: str, parse: Callable[[
     if data is None:
         why = "it changed since poro2d wrote it" if not folder.intact(name) else "it is not valid JSON"
         raise InputError("SPECIMEN", str(path), f"a specimen with a readable {name}", why) from None
-    return parse(data) if isinstance(data, dict) else None
+    return data if isinstance(data, dict) else None
 
 
-def _refuse_unaccepted(path: str | os.PathLike, record: Path, state: str) -> None:
-    raise InputError(
-        "SPECIMEN", str(path), "a specimen the criterion accepted", f"{record} says {state}; nothing written"
-    )
-
-
-__all__ = ["CriterionOutcome", "TrialVerdict", "accepted_file", "check_accepted"]
+__all__ = ["CriterionOutcome", "Flag", "accepted_file", "check_accepted"]
