@@ -34,7 +34,7 @@ def test_checkpoint_reads_as_the_simulation_holds_it(saved, spec):
     assert np.array_equal(np.column_stack([spec.x, spec.y]), sim.particles.pos)
     assert spec.thickness == 0.008 and spec.dt == sim.dt and spec.gravity == (0.0, -9.81)
     assert spec.box() == (0.0, 0.06, 0.0, 0.03)
-    assert spec.contact_parameters().walls["top"] == (series(4e5, 1e7), series(4e5, 1e7), 1.5)
+    assert spec.contact_parameters().walls["top"] == (series(4e5, 1e7), series(4e5, 1e7), 1.5, 0.0)
     live = from_simulation(sim)  # a running Simulation gives the same numbers
     _same_disks(spec, live)
     assert live.walls == spec.walls and live.dt == spec.dt

@@ -26,7 +26,7 @@ def test_csv_round_trip_keeps_rolling_friction(rolled, tmp_path):
     back = csv_table.read_specimen(tmp_path, DEFAULTS)
     assert np.array_equal(back.mu_r, rolled.mu_r)
     assert [w.mu_r for w in back.walls] == [0.1] * len(rolled.walls)
-    assert back.rolling_parameters() == rolled.rolling_parameters()
+    assert back.contact_parameters() == rolled.contact_parameters()
 
 
 def test_csv_without_rolling_is_unchanged_and_reads_as_none(saved, tmp_path):

@@ -53,10 +53,7 @@ def export_files(spec: SpecimenData) -> list[tuple[str, str]]:
     if rolled:
         disks.append(np.zeros(spec.n) if spec.mu_r is None else np.asarray(spec.mu_r, dtype=float))
     rows = [[str(i + 1), *(repr(float(a[i])) for a in disks)] for i in range(spec.n)]
-    wrows = [
-        [w.name, *(repr(float(v)) for v in (w.x0, w.y0, w.x1, w.y1, w.kn, w.ks, w.mu, w.mu_r)[: 7 + rolled])]
-        for w in spec.walls
-    ]
+    wrows = [[w.name, *(repr(float(v)) for v in (*w.numbers, w.mu_r)[: 7 + rolled])] for w in spec.walls]
     extra = (ROLLING_COLUMN,) if rolled else ()
     files = []
     tables = ((DISKS_FILE, DISK_COLUMNS + extra, rows), (WALLS_FILE, WALL_COLUMNS + extra, wrows))

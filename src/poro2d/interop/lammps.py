@@ -408,7 +408,6 @@ def box_wall_fixes(spec: SpecimenData) -> list[WallFix]:
     """One plane per box wall, at its face, with that wall's disk-wall contact properties."""
     box = spec.box()
     params = spec.contact_parameters()
-    rolling = spec.rolling_parameters()
     faces = {"left": box[0], "right": box[1], "bottom": box[2], "top": box[3]}
     extra = [w.name for w in spec.walls if w.name not in BOX_WALLS]
     if extra:
@@ -417,8 +416,8 @@ def box_wall_fixes(spec: SpecimenData) -> list[WallFix]:
     for name in BOX_WALLS:
         style, side = _PLANES[name]
         lo, hi = (faces[name], None) if side == 0 else (None, faces[name])
-        kn, kt, mu = params.walls[name]
-        fixes.append(WallFix(f"w_{name}", style, lo, hi, kn, kt, mu, mu_r=rolling.walls[name]))
+        kn, kt, mu, mu_r = params.walls[name]
+        fixes.append(WallFix(f"w_{name}", style, lo, hi, kn, kt, mu, mu_r=mu_r))
     return fixes
 
 
@@ -433,10 +432,10 @@ def input_script(
     if spec.dt is None:
         raise InputError("time step", None, "the time step of the specimen (a poro2d checkpoint has one)")
     t = spec.thickness
+    pp = spec.contact_parameters().disks
     model = model_commands(
-        DATA_FILE, spec.contact_parameters().disks, box_wall_fixes(spec), spec.dt,
-        0.5 * float(spec.radius.min()), spec.gravity, spec.local_damping, store_force=True,
-        pp_mu_r=spec.rolling_parameters().disks,
+        DATA_FILE, pp[:3], box_wall_fixes(spec), spec.dt, 0.5 * float(spec.radius.min()), spec.gravity,
+        spec.local_damping, store_force=True, pp_mu_r=pp.mu_r,
     )  # fmt: skip
     head = "\n".join(spec.header("#")) + "\n"
     head += f"""# written by poro2d export --to lammps; run: lmp -in {INPUT_FILE}
@@ -537,8 +536,8 @@ def export_files(
         *([f"# poro2d window {spec.force_fraction!r}"] if spec.force_fraction is not None else []),
         f"# pair contact kn ks mu: {params.disks.kn!r} {params.disks.ks!r} {params.disks.mu!r}",
     ]
-    if spec.rolling_parameters().disks > 0.0:  # the disks', then each wall's, in wall-line order
-        values = [spec.rolling_parameters().disks, *(w.mu_r for w in spec.walls)]
+    if params.disks.mu_r > 0.0:  # the disks', then each wall's, in wall-line order
+        values = [params.disks.mu_r, *(w.mu_r for w in spec.walls)]
         notes.append("# poro2d rolling_friction " + " ".join(repr(float(v)) for v in values))
     data = data_text(
         spec.x, spec.y, spec.radius, spec.density, spec.thickness, box, margin=float(spec.radius.max()),
@@ -554,7 +553,7 @@ def write_specimen(spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e
 
 
 def _wall_note(w: WallData) -> str:
-    vals = " ".join(repr(float(v)) for v in (w.x0, w.y0, w.x1, w.y1, w.kn, w.ks, w.mu))
+    vals = " ".join(repr(float(v)) for v in w.numbers)
     return f"# poro2d wall {w.name} {vals}"
 
 

@@ -45,8 +45,7 @@ def _r(v) -> str:
 def current_commands(spec: SpecimenData, ratio: float = 1e-3) -> str:
     """The PFC 5+ command file (``;`` comments)."""
     params = spec.contact_parameters()  # refuses disks of differing properties
-    rolling = spec.rolling_parameters()
-    wall_sets = {(*params.walls[w.name], rolling.walls[w.name]) for w in spec.walls}
+    wall_sets = {params.walls[w.name] for w in spec.walls}
     if len(wall_sets) > 1:
         raise InputError(
             "walls", [w.name for w in spec.walls],
@@ -73,10 +72,10 @@ def current_commands(spec: SpecimenData, ratio: float = 1e-3) -> str:
         lines.append(
             f"wall create vertices {_r(w.x0)} {_r(w.y0)} {_r(w.x1)} {_r(w.y1)} id {k} name '{w.name}'"
         )
-    lines.append(_cmat("ball-ball", *params.disks, rolling.disks, rolled=spec.rolled))
+    lines.append(_cmat("ball-ball", *params.disks, rolled=spec.rolled))
     if spec.walls:
         name = spec.walls[0].name
-        lines.append(_cmat("ball-facet", *params.walls[name], rolling.walls[name], rolled=spec.rolled))
+        lines.append(_cmat("ball-facet", *params.walls[name], rolled=spec.rolled))
     if spec.dt:
         lines.append(f"model mechanical timestep fix {_r(spec.dt)}")
     lines += [
@@ -99,7 +98,8 @@ def pfc4_refusal(spec: SpecimenData) -> str | None:
         return None
     return (
         f"{PFC4_FILE} not written: PFC 4.0 has no rolling-resistance model and the specimen has "
-        f"rolling friction (disks {spec.rolling_parameters().disks:g}); {CURRENT_FILE} carries it (rrlinear)"
+        f"rolling friction (disks {spec.contact_parameters().disks.mu_r:g}); {CURRENT_FILE} carries it "
+        "(rrlinear)"
     )
 
 
@@ -107,7 +107,7 @@ def pfc4_commands(spec: SpecimenData) -> str:
     """The PFC 4.0 command file: per-body properties, as in the paper's Table 1."""
     reason = pfc4_refusal(spec)
     if reason is not None:
-        raise InputError("rolling friction", spec.rolling_parameters().disks, "0 for PFC 4.0", reason)
+        raise InputError("rolling friction", spec.contact_parameters().disks.mu_r, "0 for PFC 4.0", reason)
     t = spec.thickness
     lines = [
         *spec.header(";"),

@@ -24,7 +24,7 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Generic, NamedTuple, TypeVar
+from typing import Generic, TypeVar
 
 import numpy as np
 
@@ -38,17 +38,7 @@ from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
 from poro2d.specimen.box import box_faces
 from poro2d.store import Store
 
-
-class ContactLaw(NamedTuple):
-    """The contact-level springs and friction of one pair type (N/m, N/m, -)."""
-
-    kn: float
-    ks: float
-    mu: float
-
-
 T = TypeVar("T")
-R = TypeVar("R")  # a record read from a JSON file
 
 
 @dataclass(frozen=True)
@@ -72,6 +62,11 @@ class WallData:
     ks: float
     mu: float
     mu_r: float = 0.0  # rolling friction
+
+    @property
+    def numbers(self) -> tuple[float, ...]:
+        """x0, y0, x1, y1, kn, ks, mu: the numbers every target writes of a wall, in this order."""
+        return (self.x0, self.y0, self.x1, self.y1, self.kn, self.ks, self.mu)
 
     @property
     def horizontal(self) -> bool:
@@ -171,44 +166,26 @@ class SpecimenData:
         g = math.hypot(*self.gravity)
         return float(np.sum(self.mass)) * g / self.thickness
 
-    def contact_parameters(self) -> ByPairType[ContactLaw]:
-        """The contact-level (kn, ks, mu) of disk-disk contacts and of each wall's contacts.
+    def contact_parameters(self) -> ByPairType[ContactValues]:
+        """The contact-level values of disk-disk contacts and of each wall's, mixed by the engine's
+        own description of the law (:meth:`poro2d.dem.model.ContactModel.pair`: PFC 4.0's springs in
+        series, the smaller friction and rolling friction).
 
-        PFC 4.0 (``per_body``): springs in series, kn = kA kB / (kA + kB), the smaller
-        friction. Engines that take one value per contact type need every disk alike:
-        refused otherwise, naming the property that varies.
+        Engines that take one set per contact type need every disk alike: refused otherwise,
+        naming the property that varies.
         """
-        for name in ("kn", "ks", "mu", "density"):
-            a = getattr(self, name)
+        mu_r = np.zeros(self.n) if self.mu_r is None else np.asarray(self.mu_r, dtype=float)
+        varying = {"kn": self.kn, "ks": self.ks, "mu": self.mu, "density": self.density}
+        for name, a in {**varying, "rolling friction": mu_r}.items():
             if self.n and np.ptp(a) != 0.0:
                 raise InputError(
                     f"disk {name}", f"from {a.min():g} to {a.max():g}",
                     "one value for every disk (the target takes one set of contact properties)",
                 )  # fmt: skip
-        law, disk = ContactModel(), ContactValues(float(self.kn[0]), float(self.ks[0]), float(self.mu[0]))
-        walls = {
-            w.name: ContactLaw(*law.pair(disk, ContactValues(w.kn, w.ks, w.mu), wall=True)[:3])
-            for w in self.walls
-        }
-        return ByPairType(ContactLaw(*law.pair(disk, disk)[:3]), walls)
-
-    def rolling_parameters(self) -> ByPairType[float]:
-        """The contact-level rolling friction of disk-disk contacts and of each wall's.
-
-        The smaller of the two bodies' values, as for ``mu``; every disk alike, as in
-        :meth:`contact_parameters`.
-        """
-        mu_r = np.zeros(self.n) if self.mu_r is None else np.asarray(self.mu_r, dtype=float)
-        if self.n and np.ptp(mu_r) != 0.0:
-            raise InputError(
-                "disk rolling friction", f"from {mu_r.min():g} to {mu_r.max():g}",
-                "one value for every disk (the target takes one set of contact properties)",
-            )  # fmt: skip
-        law, disk = ContactModel(), ContactValues(0.0, 0.0, 0.0, float(mu_r[0]) if self.n else 0.0)
-        walls = {
-            w.name: law.pair(disk, ContactValues(0.0, 0.0, 0.0, w.mu_r), wall=True).mu_r for w in self.walls
-        }
-        return ByPairType(disk.mu_r, walls)
+        law = ContactModel()
+        disk = ContactValues(*(float(a[0]) for a in (self.kn, self.ks, self.mu, mu_r)))
+        walls = {w.name: law.pair(disk, ContactValues(*w.numbers[4:], w.mu_r), wall=True) for w in self.walls}
+        return ByPairType(law.pair(disk, disk), walls)
 
     def header(self, comment: str) -> list[str]:
         """Lines that every exported file starts with: units, thickness convention, version."""

@@ -268,7 +268,7 @@ def script(
         "",
         "# name, x0, y0, x1, y1, kn, ks, mu (the specimen lies to the left going from (x0, y0) to (x1, y1))",
         "WALLS = [",
-        *(f"    ({w.name!r}, {', '.join(repr(float(v)) for v in _wall_numbers(w))})," for w in spec.walls),
+        *(f"    ({w.name!r}, {', '.join(repr(float(v)) for v in w.numbers)})," for w in spec.walls),
         "]",
     ]
     if not spec.rolled:
@@ -288,10 +288,6 @@ def _rolling_lines(spec: SpecimenData) -> list[str]:
         "]",
         f"WALL_ROLLING = {walls!r}",
     ]
-
-
-def _wall_numbers(w) -> tuple[float, ...]:
-    return (w.x0, w.y0, w.x1, w.y1, w.kn, w.ks, w.mu)
 
 
 def export_files(
