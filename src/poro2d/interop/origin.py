@@ -20,7 +20,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TypeVar
 
-from poro2d.interop.provenance_records import ConfigFacts, GradingFacts, ResultFacts, SoilFacts
+from poro2d.interop.provenance_records import ConfigFacts, GradingFacts, ResultFacts, RunFacts, SoilFacts
 from poro2d.interop.state_specimen import KnownState, read_state_index, state_record
 from poro2d.store import Store
 
@@ -57,21 +57,17 @@ def origin_lines(checkpoint: str | Path, state: KnownState | None = None) -> lis
         case = _state_of_case(folder)
         state = replace(state, mode=case.mode if case is not None else None)
     result, config = result or ResultFacts(), config or ConfigFacts()
+    run = result.run.or_else(config.run)
     lines = [f"{PREFIX} grading {_grading(config.grading)}"]
     if soil is not None and soil.named:
         ref = f" ({_text(soil.reference)})" if soil.reference else ""
         lines.insert(0, f"{PREFIX} soil {_text(soil.name)}{ref}")
     lines.append(f"{PREFIX} laboratory state {_state(result, config, state, folder)}")
-    mu = (
-        result.friction_prep
-        if result.names_specimen
-        else config.friction_prep
-        if config.names_specimen
-        else None
+    lines.append(
+        f"{PREFIX} preparation friction mu_prep (specimen.friction_prep) = {_value(run.friction_prep)}"
     )
-    lines.append(f"{PREFIX} preparation friction mu_prep (specimen.friction_prep) = {_value(mu)}")
     lines.append(f"{PREFIX} {_porosities(result)}")
-    lines.append(f"{PREFIX} {_run(result, config, state)}")
+    lines.append(f"{PREFIX} {_run(run, state)}")
     if state is not None and state.record:
         lines.append(f"{PREFIX} state read from {_text(state.record)}")
     return lines
@@ -143,12 +139,9 @@ def _porosities(result: ResultFacts) -> str:
     return text + f"; interior porosity = {inner:.6g}" + (f" +- {sd:.4g}" if sd is not None else "")
 
 
-def _run(result: ResultFacts, config: ConfigFacts, state: KnownState | None) -> str:
-    if state is not None:
-        seed = state.seed
-    else:
-        seed = result.seed if result.names_seed else config.seed
-    stamp = result.stamp if result.stamp.given else config.stamp
+def _run(run: RunFacts, state: KnownState | None) -> str:
+    seed = state.seed if state is not None else run.seed
+    stamp = run.stamp
     text = f"seed {seed if isinstance(seed, int) and not isinstance(seed, bool) else 'unknown'}; "
     text += f"criterion run by poro2d {_text(stamp.version) if stamp.version else 'unknown'}"
     return text + (f" ({_text(stamp.created_utc)})" if stamp.created_utc else "")

@@ -42,35 +42,52 @@ class RunStamp:
 
 
 @dataclass(frozen=True)
-class ResultFacts:
-    """A criterion's ``result.json``: the state it ran, its preparation friction (when it names
-    its ``specimen``), the porosities of its accepted specimen, its seed and provenance."""
+class RunFacts:
+    """What a criterion's record says of its run: the preparation friction (when it names its
+    ``specimen``), the seed (when it names one) and who ran it (``stamp``)."""
 
-    n_lab: float | None = None
     names_specimen: bool = False
     friction_prep: float | None = None
-    final_porosity: float | None = None
-    box_porosity: float | None = None
-    interior_porosity: float | None = None
-    interior_porosity_std: float | None = None
     names_seed: bool = False
     seed: int | None = None
     stamp: RunStamp = RunStamp(False, None, None)
 
     @classmethod
-    def from_json(cls, data: dict) -> ResultFacts:
+    def from_json(cls, run, provenance) -> RunFacts:
+        """``run``: the object naming ``specimen`` and ``seed`` (``result.json`` itself, ``config.json``'s
+        ``run``), as it is; ``provenance``: the record's own."""
         return cls(
-            n_lab=number_at(data, "n_lab"),
-            names_specimen=bool(data.get("specimen")),
-            friction_prep=number_at(data, "specimen", "friction_prep"),
-            final_porosity=number_at(data, "final_porosity"),
-            box_porosity=number_at(data, "box_porosity"),
-            interior_porosity=number_at(data, "interior_porosity"),
-            interior_porosity_std=number_at(data, "interior_porosity_std"),
-            names_seed="seed" in data,
-            seed=int_at(data, "seed"),
-            stamp=RunStamp.from_json(data.get("provenance")),
+            bool(_member(run, "specimen")),
+            number_at(run, "specimen", "friction_prep"),
+            isinstance(run, dict) and "seed" in run,
+            int_at(run, "seed"),
+            RunStamp.from_json(provenance),
         )
+
+    def or_else(self, other: RunFacts) -> RunFacts:
+        """Each fact as this record says it, or as ``other`` does where this one is silent."""
+        specimen = self if self.names_specimen else other
+        seed = self if self.names_seed else other
+        stamp = self.stamp if self.stamp.given else other.stamp
+        return RunFacts(specimen.names_specimen, specimen.friction_prep, seed.names_seed, seed.seed, stamp)
+
+
+@dataclass(frozen=True)
+class ResultFacts:
+    """A criterion's ``result.json``: the state it ran, the porosities of its accepted specimen
+    and what it says of its run."""
+
+    n_lab: float | None = None
+    final_porosity: float | None = None
+    box_porosity: float | None = None
+    interior_porosity: float | None = None
+    interior_porosity_std: float | None = None
+    run: RunFacts = RunFacts()
+
+    @classmethod
+    def from_json(cls, data: dict) -> ResultFacts:
+        numbers = ("n_lab", "final_porosity", "box_porosity", "interior_porosity", "interior_porosity_std")
+        return cls(*(number_at(data, k) for k in numbers), RunFacts.from_json(data, data.get("provenance")))
 
 
 @dataclass(frozen=True)
@@ -111,33 +128,24 @@ class GradingFacts:
 @dataclass(frozen=True)
 class ConfigFacts:
     """A criterion's ``config.json``: the grading, the ``[density]`` table's mode and laboratory
-    extremes (``density_mode`` None: no such table), the run's seed (when it names one) and
-    preparation friction (when it names its ``specimen``), and its provenance."""
+    extremes (``density_mode`` None: no such table) and what its ``run`` says of the run."""
 
     grading: GradingFacts = GradingFacts("unknown")
     density_mode: str | None = None
     n_max: float | None = None
     n_min: float | None = None
-    names_specimen: bool = False
-    friction_prep: float | None = None
-    names_seed: bool = False
-    seed: int | None = None
-    stamp: RunStamp = RunStamp(False, None, None)
+    run: RunFacts = RunFacts()
 
     @classmethod
     def from_json(cls, data: dict) -> ConfigFacts:
         density = _member(data.get("config"), "density")
-        run = data.get("run")
+        table = isinstance(density, dict)
         return cls(
             grading=GradingFacts.from_json(data),
-            density_mode=str(density.get("mode", "paper")) if isinstance(density, dict) else None,
-            n_max=number_at(density, "n_max") if isinstance(density, dict) else None,
-            n_min=number_at(density, "n_min") if isinstance(density, dict) else None,
-            names_specimen=bool(_member(run, "specimen")),
-            friction_prep=number_at(data, "run", "specimen", "friction_prep"),
-            names_seed=isinstance(run, dict) and "seed" in run,
-            seed=int_at(data, "run", "seed"),
-            stamp=RunStamp.from_json(data.get("provenance")),
+            density_mode=str(density.get("mode", "paper")) if table else None,
+            n_max=number_at(density, "n_max") if table else None,
+            n_min=number_at(density, "n_min") if table else None,
+            run=RunFacts.from_json(data.get("run"), data.get("provenance")),
         )
 
 
