@@ -16,7 +16,7 @@ from poro2d.errors import InputError
 from poro2d.interop import csv_table, lammps, pfc, yade
 from poro2d.interop.check import DEFAULTS
 from poro2d.interop.specimen_data import from_checkpoint
-from poro2d.interop.state_specimen import find_state_specimen, state_specimen
+from poro2d.interop.state_specimen import state_specimen
 from poro2d.store import Store
 
 PROV = {"poro2d_version": "0.0.9", "created_utc": "2026-01-02T03:04:05+00:00"}
@@ -93,10 +93,10 @@ def relation(tmp_path_factory, specimen):
 
 def test_a_relation_gives_the_specimen_of_a_state_and_seed(relation):
     cases = relation / "states" / "cases"
-    assert find_state_specimen(relation, n_lab=0.4571) == cases / "x1" / "run"
-    assert find_state_specimen(Store(relation), n_lab=0.4571) == cases / "x1" / "run"  # a store reads alike
-    assert find_state_specimen(relation, dr=1.0, seed=0) == cases / "zz" / "run"
-    assert find_state_specimen(relation, n_lab=0.32531) == cases / "zz" / "run"  # 4 decimals
+    assert state_specimen(relation, n_lab=0.4571).folder == cases / "x1" / "run"
+    assert state_specimen(Store(relation), n_lab=0.4571).folder == cases / "x1" / "run"  # a store reads alike
+    assert state_specimen(relation, dr=1.0, seed=0).folder == cases / "zz" / "run"
+    assert state_specimen(relation, n_lab=0.32531).folder == cases / "zz" / "run"  # 4 decimals
     # the dense state's seed 1 was not run again: the calibration's case of its friction and seed
     twin = state_specimen(relation, dr=1.0, seed=1)
     assert twin.folder.parent.name == "q7" and twin.mode == "density" and twin.n_lab == 0.3253
@@ -104,27 +104,27 @@ def test_a_relation_gives_the_specimen_of_a_state_and_seed(relation):
 
 def test_a_relation_refuses_what_it_does_not_hold(relation):
     with pytest.raises(InputError) as e:  # no state named
-        find_state_specimen(relation)
+        state_specimen(relation)
     assert e.value.parameter == "--n-lab/--dr"
     assert "n_lab 0.4571 (Dr 0.0000): seed 0 (not accepted: 1)" in e.value.allowed
     assert "n_lab 0.3253 (Dr 1.0000): seeds 0, 1" in e.value.allowed
     with pytest.raises(InputError) as e:
-        find_state_specimen(relation, n_lab=0.40)
+        state_specimen(relation, n_lab=0.40)
     assert e.value.parameter == "--n-lab" and e.value.value == 0.40 and "n_lab 0.3253" in e.value.allowed
     with pytest.raises(InputError) as e:
-        find_state_specimen(relation, dr=0.5)
+        state_specimen(relation, dr=0.5)
     assert e.value.parameter == "--dr"
     with pytest.raises(InputError) as e:
-        find_state_specimen(relation, n_lab=0.3253, seed=2)
+        state_specimen(relation, n_lab=0.3253, seed=2)
     assert e.value.parameter == "--seed" and e.value.value == 2 and "seeds 0, 1" in e.value.allowed
     with pytest.raises(InputError) as e:  # there, but its criterion did not converge
-        find_state_specimen(relation, n_lab=0.4571, seed=1)
+        state_specimen(relation, n_lab=0.4571, seed=1)
     assert e.value.parameter == "--seed" and "converged = False" in e.value.hint
     with pytest.raises(InputError) as e:
-        find_state_specimen(relation, n_lab=0.4571, dr=0.0)
+        state_specimen(relation, n_lab=0.4571, dr=0.0)
     assert e.value.parameter == "--n-lab/--dr"
     with pytest.raises(InputError) as e:
-        find_state_specimen(relation, n_lab=0.4571, seed=-1)
+        state_specimen(relation, n_lab=0.4571, seed=-1)
     assert e.value.parameter == "--seed"
 
 
@@ -147,9 +147,9 @@ def test_a_density_criterion_folder_and_a_paper_relation(tmp_path, specimen):
     )
     (rel / "relation.json").write_text(json.dumps({"mode": "paper", "config": {"seed": 3}, "points": [
         {"n_lab": 0.4, "relative_density": 0.4872, "case_id": "p1"}]}))  # fmt: skip
-    assert find_state_specimen(rel, n_lab=0.4, seed=3) == rel / "cases" / "p1" / "run"
+    assert state_specimen(rel, n_lab=0.4, seed=3).folder == rel / "cases" / "p1" / "run"
     with pytest.raises(InputError) as e:
-        find_state_specimen(rel, n_lab=0.4)
+        state_specimen(rel, n_lab=0.4)
     assert e.value.parameter == "--seed" and "seed 3" in e.value.allowed
 
 
@@ -165,7 +165,7 @@ def test_a_sand_folder(tmp_path, specimen):
     got = state_specimen(sand, dr=0.05)
     assert got.folder == sand / "crit" / "loose" and got.mode == "density" and got.seed == 0
     with pytest.raises(InputError) as e:
-        find_state_specimen(sand, n_lab=0.33)
+        state_specimen(sand, n_lab=0.33)
     assert e.value.parameter == "--seed" and "no accepted seed" in e.value.allowed
 
 

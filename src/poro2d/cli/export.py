@@ -102,7 +102,7 @@ def export_specimen(specimen, out: Path, *, n_lab=None, dr=None, seed=None):
     check_output_dir("--out", out)
     check_accepted(state.folder)
     spec = from_checkpoint(state.folder)
-    spec.origin = origin_lines(resolve_specimen(state.folder), state.known())
+    spec.origin = origin_lines(resolve_specimen(state.folder), state)
     return spec, state
 
 

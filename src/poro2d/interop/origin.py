@@ -36,7 +36,7 @@ def origin_lines(checkpoint: str | Path, state: KnownState | None = None) -> lis
     """The provenance lines of the specimen saved at ``checkpoint`` (without comment signs).
 
     ``state``: the state the specimen was found by
-    (:meth:`~poro2d.interop.state_specimen.StateSpecimen.known`), None to look it up from the folder.
+    (:class:`~poro2d.interop.state_specimen.StateSpecimen`), None to look it up from the folder.
     """
     p = Path(checkpoint)
     folder = p.parent

@@ -69,7 +69,7 @@ class KnownState:
     n_lab: float | None
     relative_density: float | None
     seed: int | None
-    record: str | None = None
+    record: str | Path | None = None
 
 
 @dataclass(frozen=True)
@@ -86,25 +86,12 @@ class StateCase:
         return not self.why_not
 
 
-@dataclass(frozen=True)
-class StateSpecimen:
-    """The accepted specimen of one state and seed, and where the state was read.
-
-    ``folder``: the criterion folder holding ``specimen.npz``; ``record``: the state
-    folder's ``sand.json``, ``relation.json`` or ``density.json``; ``mode``: ``density`` or
-    ``paper`` (None when the record does not say).
-    """
+@dataclass(frozen=True, kw_only=True)
+class StateSpecimen(KnownState):
+    """The accepted specimen of one state and seed: the state, read from its state folder's
+    ``record``, and the criterion ``folder`` holding ``specimen.npz``."""
 
     folder: Path
-    record: Path
-    mode: str | None
-    n_lab: float
-    relative_density: float | None
-    seed: int
-
-    def known(self) -> KnownState:
-        """The state as the export's provenance lines name it (:func:`poro2d.interop.origin.origin_lines`)."""
-        return KnownState(self.mode, self.n_lab, self.relative_density, self.seed, record=str(self.record))
 
 
 @dataclass
@@ -149,10 +136,10 @@ def state_record(folder: str | os.PathLike | Store) -> Path | None:
     return next((store.root / name for name in STATE_RECORDS if store.has(name)), None)
 
 
-def find_state_specimen(
+def state_specimen(
     folder: str | os.PathLike | Store, n_lab: float | None = None, dr: float | None = None, seed: int = 0
-) -> Path:
-    """The criterion folder holding the accepted ``specimen.npz`` of one state and seed.
+) -> StateSpecimen:
+    """The accepted specimen of one state and seed, with the state it belongs to.
 
     ``folder``: a relation, a density-mode criterion or a sand run (its store or folder); the
     state by its laboratory porosity ``n_lab`` or its relative density ``dr`` (one of the
@@ -160,13 +147,6 @@ def find_state_specimen(
     ``--dr`` or ``--seed``, with the states and accepted seeds there are) when the state or
     seed is not there or its criterion did not accept a specimen.
     """
-    return state_specimen(folder, n_lab=n_lab, dr=dr, seed=seed).folder
-
-
-def state_specimen(
-    folder: str | os.PathLike | Store, n_lab: float | None = None, dr: float | None = None, seed: int = 0
-) -> StateSpecimen:
-    """:func:`find_state_specimen` with the state it belongs to (mode, n_lab, Dr, seed)."""
     store = _store(folder)
     record = state_record(store)
     if record is None:
@@ -200,7 +180,10 @@ def state_specimen(
         raise InputError(
             "--seed", seed, f"one specimen of n_lab {state[0]:g} and this seed", f"{where} both are"
         )
-    return StateSpecimen(accepted[0].folder, record, index.mode, state[0], state[1], seed)
+    folder = accepted[0].folder
+    return StateSpecimen(
+        mode=index.mode, n_lab=state[0], relative_density=state[1], seed=seed, record=record, folder=folder
+    )
 
 
 def _pick_state(index: StateIndex, n_lab: float | None, dr: float | None) -> tuple[float, float | None]:
@@ -414,7 +397,6 @@ __all__ = [
     "STATE_RECORDS",
     "KnownState",
     "StateSpecimen",
-    "find_state_specimen",
     "read_state_index",
     "state_record",
     "state_specimen",
