@@ -120,9 +120,9 @@ def data_text(
 class DataFile:
     """What a LAMMPS data file of disks holds: centres, radii, masses, box, and poro2d's notes.
 
-    ``atom_lines`` is the line of each atom (in id order), ``note_lines`` the line of each
-    ``# poro2d`` note (the first, and ``wall NAME`` per wall), ``box_line`` the lines of the
-    ``xlo xhi`` and ``ylo yhi`` header lines: where a value came from, for the checks.
+    ``notes``: each ``# poro2d`` note's line and words by its key (``wall NAME`` per wall), in file
+    order; ``atom_lines`` the line of each atom (in id order), ``box_line`` those of the ``xlo xhi``
+    and ``ylo yhi`` header lines: where a value came from, for the checks.
     """
 
     x: np.ndarray
@@ -131,10 +131,9 @@ class DataFile:
     mass: np.ndarray
     box: tuple[float, float, float, float]
     zspan: float
-    notes: list[tuple[str, list[str]]]
-    atom_lines: np.ndarray | None = None
-    note_lines: dict | None = None
-    box_line: dict | None = None
+    notes: dict[str, tuple[int, list[str]]]
+    atom_lines: np.ndarray
+    box_line: dict
 
 
 #: section titles of a LAMMPS data file (any other line that starts with a letter is malformed)
@@ -155,23 +154,21 @@ def read_data(path: str | os.PathLike) -> DataFile:
     """Read a LAMMPS data file of ``atom_style sphere`` (id type diameter density x y z [images]).
 
     Any other section (Velocities, ...) is skipped. Lines written by :func:`write_specimen`
-    as ``# poro2d <key> <values>`` are returned in ``notes``. A malformed line is an
+    as ``# poro2d <key> <values>`` are returned in ``notes`` (the first of a key). A malformed line is an
     InputError naming the file, the line and the column: ids and types must be whole numbers
     (ids >= 1, none twice), the atoms must lie in one plane (z constant) and in the box's
     own image (image flags 0 in x and y), and their count must be the header's.
     """
     p = Path(path)
     lines = text_of(p, "LAMMPS data file").splitlines()
-    notes: list[tuple[str, list[str]]] = []
-    note_lines: dict = {}
+    notes: dict[str, tuple[int, list[str]]] = {}
     header: dict = {}
     atoms: list[tuple[int, list[float]]] = []
     section = None
     for k, raw in enumerate(lines[1:], start=2):
         if raw.startswith("# poro2d "):
             key, *vals = raw[len("# poro2d ") :].split() or [""]
-            notes.append((key, vals))
-            _note_line(p, k, f"wall {vals[0]}" if key == "wall" and vals else key, note_lines)
+            _add_note(p, k, f"wall {vals[0]}" if key == "wall" and vals else key, vals, notes)
         line = raw.split("#", 1)[0].strip()
         if not line:
             continue
@@ -225,7 +222,7 @@ def read_data(path: str | os.PathLike) -> DataFile:
     return DataFile(
         x=a[:, 4].copy(), y=a[:, 5].copy(), radius=r, mass=mass,
         box=(*header["xlo"][0], *header["ylo"][0]), zspan=zhi - zlo, notes=notes, atom_lines=atom_lines,
-        note_lines=note_lines, box_line={"x": header["xlo"][1], "y": header["ylo"][1]},
+        box_line={"x": header["xlo"][1], "y": header["ylo"][1]},
     )  # fmt: skip
 
 
@@ -233,13 +230,13 @@ def read_data(path: str | os.PathLike) -> DataFile:
 NOTE_KEYS = ("thickness", "disk_properties", "settings", "window", "rolling_friction", "wall")
 
 
-def _note_line(p: Path, k: int, label: str, note_lines: dict) -> None:
-    """Record the line of a note; a second note of the same key (or wall) is refused, since
+def _add_note(p: Path, k: int, label: str, vals: list[str], notes: dict) -> None:
+    """Keep a note's line and words; a second note of the same key (or wall) is refused, since
     only one of the two could be read and the other would be dropped without a word."""
-    if label in note_lines and label.split()[0] in NOTE_KEYS:
+    if label in notes and label.split()[0] in NOTE_KEYS:
         where = f"{p} line {k}"
-        raise InputError(where, f"# poro2d {label}", f"one such line (line {note_lines[label]} has it)")
-    note_lines.setdefault(label, k)
+        raise InputError(where, f"# poro2d {label}", f"one such line (line {notes[label][0]} has it)")
+    notes.setdefault(label, (k, vals))
 
 
 def _atom_style(p: Path, k: int, raw: str) -> None:
@@ -568,28 +565,22 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
     The specimen's ``locate`` names the line and column each value was read from.
     """
     d = read_data(path)
-    notes = d.notes
-    keys = {k for k, _ in notes}
-    n = d.x.size
-    t = (
-        _note(notes, "thickness", 1, path, d.note_lines)[0]
-        if "thickness" in keys
-        else float(defaults["thickness"])
-    )
-    if "disk_properties" in keys:
-        rho, kn, ks, mu = _note(notes, "disk_properties", 4, path, d.note_lines)
+    notes, n = d.notes, d.x.size
+    t = _note(path, notes, "thickness", 1)[0] if "thickness" in notes else float(defaults["thickness"])
+    if "disk_properties" in notes:
+        rho, kn, ks, mu = _note(path, notes, "disk_properties", 4)
     else:
         rho = float(defaults["density"]) if defaults.get("density_given") else None
         kn, ks, mu = (float(defaults[k]) for k in ("kn", "ks", "mu"))
     # the file's masses define the density unless it is named (an exported file, or --density)
     density = np.full(n, rho) if rho is not None else d.mass / (math.pi * d.radius**2 * t)
     gravity, damping, dt = (0.0, -float(defaults["gravity"])), float(defaults["local_damping"]), None
-    if "settings" in keys:
-        gx, gy, damping, dt = _note(notes, "settings", 4, path, d.note_lines)
+    if "settings" in notes:
+        gx, gy, damping, dt = _note(path, notes, "settings", 4)
         gravity = (gx, gy)
-    window = _note(notes, "window", 1, path, d.note_lines)[0] if "window" in keys else None
-    walls = [WallData(name, *v) for name, v in _wall_notes(notes, path, d.note_lines)]
-    mu_r = _rolling_note(notes, walls, path, d.note_lines) if "rolling_friction" in keys else None
+    window = _note(path, notes, "window", 1)[0] if "window" in notes else None
+    walls = _wall_notes(path, notes)
+    mu_r = _rolling_note(path, notes, walls) if "rolling_friction" in notes else None
     if not walls:
         xlo, xhi, ylo, yhi = d.box
         kw = tuple(float(defaults[k]) for k in ("wall_kn", "wall_ks", "wall_mu"))
@@ -599,18 +590,18 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
         mu=np.full(n, mu), thickness=t, walls=walls, gravity=gravity, local_damping=damping,
         dt=dt if dt else None, source=str(path), force_fraction=window,
         mu_r=None if mu_r is None else np.full(n, mu_r),
-        locate=_locator(Path(path), d, keys, from_masses=rho is None),
+        locate=_locator(Path(path), d, from_masses=rho is None),
     )  # fmt: skip
 
 
-def _rolling_note(notes: list, walls: list[WallData], path, lines: dict | None) -> float:
+def _rolling_note(path, notes: dict, walls: list[WallData]) -> float:
     """The disks' rolling friction from ``# poro2d rolling_friction DISKS WALL...``; each wall
     (in the order of the wall lines) takes its own value here."""
-    values = _note(notes, "rolling_friction", 1 + len(walls), path, lines)
+    values = _note(path, notes, "rolling_friction", 1 + len(walls))
     for column, v in enumerate(values, start=4):
         if v < 0.0:
-            line = f" line {lines['rolling_friction']}" if lines and "rolling_friction" in lines else ""
-            raise InputError(f"{path}{line} '# poro2d rolling_friction' column {column}", v, "[0, inf)")
+            where = f"{path} line {notes['rolling_friction'][0]} '# poro2d rolling_friction' column {column}"
+            raise InputError(where, v, "[0, inf)")
     for wall, v in zip(walls, values[1:], strict=True):
         wall.mu_r = v
     return values[0]
@@ -635,9 +626,9 @@ _WALL_WORD = {name: c for c, name in enumerate(("x0", "y0", "x1", "y1", "kn", "k
 _OPTION = {"thickness": "--thickness", "density": "--density", "kn": "--kn", "ks": "--ks", "mu": "--friction"}
 
 
-def _locator(p: Path, d: DataFile, keys: set, from_masses: bool):
+def _locator(p: Path, d: DataFile, from_masses: bool):
     """``locate(quantity, atom)``: the line and column of a value, or the option that gave it."""
-    lines = d.note_lines or {}
+    lines = {label: k for label, (k, _) in d.notes.items()}
 
     def locate(quantity: str, i: int | None = None) -> str:
         if quantity == "disk":
@@ -646,7 +637,7 @@ def _locator(p: Path, d: DataFile, keys: set, from_masses: bool):
             column, name = _ATOM_COLUMN[quantity]
             extra = ", the disk density m / (pi r^2 t)" if quantity == "density" else ""
             return f"{p} line {d.atom_lines[i]} column {column} ({name}{extra})"
-        if quantity in _NOTE_WORD and _NOTE_WORD[quantity][0] in keys:
+        if quantity in _NOTE_WORD and _NOTE_WORD[quantity][0] in lines:
             key, word = _NOTE_WORD[quantity]
             return f"{p} line {lines[key]} column {word} ({quantity})"
         if quantity.startswith("wall:"):
@@ -677,11 +668,10 @@ def box_walls(xlo, xhi, ylo, yhi, kn, ks, mu) -> list[WallData]:
     ]
 
 
-def _note(notes: list, key: str, count: int, path, lines: dict | None = None) -> list[float]:
-    """The ``count`` numbers of the first ``# poro2d KEY ...`` line."""
-    vals = next(v for k, v in notes if k == key)
-    line = f" line {lines[key]}" if lines and key in lines else ""
-    return _note_numbers(vals, count, f"{path}{line} '# poro2d {key}'")
+def _note(path, notes: dict, key: str, count: int) -> list[float]:
+    """The ``count`` numbers of the ``# poro2d KEY ...`` line."""
+    line, vals = notes[key]
+    return _note_numbers(vals, count, f"{path} line {line} '# poro2d {key}'")
 
 
 def _note_numbers(vals: list[str], count: int, where: str, first: int = 4) -> list[float]:
@@ -700,14 +690,13 @@ def _note_numbers(vals: list[str], count: int, where: str, first: int = 4) -> li
     return out
 
 
-def _wall_notes(notes: list, path, lines: dict | None = None) -> list[tuple[str, list[float]]]:
-    """The ``# poro2d wall NAME x0 y0 x1 y1 kn ks mu`` lines, in file order."""
-    out = []
-    for key, vals in notes:
-        if key == "wall":
-            if not vals:
-                raise InputError(f"{path} '# poro2d wall' line", "", "a name and 7 numbers")
-            line = f" line {lines[f'wall {vals[0]}']}" if lines and f"wall {vals[0]}" in lines else ""
-            where = f"{path}{line} '# poro2d wall {vals[0]}'"
-            out.append((vals[0], _note_numbers(vals[1:], 7, where, first=5)))
-    return out
+def _wall_notes(path, notes: dict) -> list[WallData]:
+    """The walls of the ``# poro2d wall NAME x0 y0 x1 y1 kn ks mu`` lines, in file order."""
+    walls = []
+    for label, (line, vals) in notes.items():
+        if label == "wall":
+            raise InputError(f"{path} '# poro2d wall' line", "", "a name and 7 numbers")
+        if label.startswith("wall "):
+            where = f"{path} line {line} '# poro2d {label}'"
+            walls.append(WallData(vals[0], *_note_numbers(vals[1:], 7, where, first=5)))
+    return walls
