@@ -310,7 +310,7 @@ def test_a_file_of_another_origin_takes_the_given_density(spec, tmp_path):
     data = tmp_path / lmp.DATA_FILE
     data.write_text("\n".join(ln for ln in data.read_text().splitlines() if not ln.startswith("#")) + "\n")
     assert np.allclose(read_specimen(data).density, 2650.0)  # from the file's masses
-    given = read_specimen(data, {"density": 3000.0, "density_given": True})
+    given = read_specimen(data, {"solid_density": 3000.0, "density_given": True})
     assert np.all(given.density == 3000.0)
 
 

@@ -73,7 +73,7 @@ def test_lammps_data_of_another_origin_takes_its_box_and_the_given_thickness(spe
     assert np.allclose(back.density, 2650.0, rtol=1e-12)
     margin = float(spec.radius.max())
     assert back.box() == pytest.approx((-margin, 0.06 + margin, -margin, 0.03 + margin))
-    assert back.wall("top").mu == DEFAULTS["wall_mu"] and back.mu[0] == DEFAULTS["mu"]
+    assert back.wall("top").mu == DEFAULTS["friction_wall"] and back.mu[0] == DEFAULTS["friction_particle"]
 
 
 def _literal(tree: ast.Module, name: str):

@@ -19,11 +19,11 @@ console = OutputConsole()
 #: import options that give what a file does not say: (option as typed, key of the defaults, limit)
 IMPORT_OPTIONS = (
     ("--thickness", "thickness", "thickness"),
-    ("--density", "density", "density"),
-    ("--kn", "kn", "kn"),
-    ("--ks", "ks", "ks"),
-    ("--friction", "mu", "mu"),
-    ("--wall-friction", "wall_mu", "mu"),
+    ("--density", "solid_density", "density"),
+    ("--kn", "kn_particle", "kn"),
+    ("--ks", "ks_particle", "ks"),
+    ("--friction", "friction_particle", "mu"),
+    ("--wall-friction", "friction_wall", "mu"),
 )
 #: the longest equilibrium stage ``--max-steps`` may ask for
 MAX_STEPS_LIMIT = 100_000_000
@@ -77,7 +77,7 @@ def import_cmd(
     if window is not None:
         check_value("--window", window, LIMITS["window"], "a fraction of G in")
     check_output_dir("--out", out)
-    spec = read_specimen(file, {**given, "density_given": "density" in given})
+    spec = read_specimen(file, {**given, "density_given": "solid_density" in given})
     _refuse_options_the_file_overrides(spec, {o: values[o] for o, key, _ in IMPORT_OPTIONS if key in given})
     fraction = window if window is not None else (spec.force_fraction or CriterionSettings.force_fraction)
     window_from = "--window" if window is not None else ("the file" if spec.force_fraction else "the paper's")

@@ -29,24 +29,13 @@ from poro2d.interop import lammps as lmp
 from poro2d.interop.specimen_data import SpecimenData, from_checkpoint
 from poro2d.interop.validate import check_imported
 from poro2d.measure.porosity import box_porosity
-from poro2d.paper_data import TABLE_1
 from poro2d.specimen.compaction import SpecimenSpec, make_walls
 
-#: values for what a file does not say (a LAMMPS data file of another origin): Table 1, and
-#: the specimen's defaults for the rest
-_PREPARED = SpecimenSpec()
-DEFAULTS = {
-    "thickness": _PREPARED.thickness,
-    "density": TABLE_1.solid_density,
-    "kn": TABLE_1.kn_particle,
-    "ks": TABLE_1.ks_particle,
-    "mu": TABLE_1.friction_particle,
-    "wall_kn": TABLE_1.kn_wall,
-    "wall_ks": TABLE_1.ks_wall,
-    "wall_mu": TABLE_1.friction_wall,
-    "gravity": _PREPARED.gravity,
-    "local_damping": _PREPARED.local_damping,
-}
+#: the values a file may not say (a LAMMPS data file of another origin), by their SpecimenSpec names
+DEFAULT_FIELDS = ("thickness", "solid_density", "kn_particle", "ks_particle", "friction_particle")
+DEFAULT_FIELDS += ("kn_wall", "ks_wall", "friction_wall", "gravity", "local_damping")
+#: what those values are when neither the file nor an option says them: the prepared specimen's (Table 1's)
+DEFAULTS = {name: getattr(SpecimenSpec(), name) for name in DEFAULT_FIELDS}
 
 
 def read_specimen(path: str | os.PathLike, defaults: dict | None = None) -> SpecimenData:

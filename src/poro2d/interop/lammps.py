@@ -558,10 +558,9 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
     """A specimen from a LAMMPS data file, with its box.
 
     The disks' density, stiffness and friction, the walls and the run settings come from
-    the ``# poro2d`` notes of an exported file; a file without them takes ``defaults``
-    (keys: thickness, density, kn, ks, mu, wall_kn, wall_ks, wall_mu, gravity,
-    local_damping), its walls at the faces of its simulation box. Its disk masses are the
-    file's (LAMMPS' ``4/3 pi r^3 density``) unless ``defaults`` says ``density_given``.
+    the ``# poro2d`` notes of an exported file; a file without them takes ``defaults`` (keyed as
+    :data:`poro2d.interop.check.DEFAULTS`), its walls at the faces of its simulation box. Its disk
+    masses are the file's (LAMMPS' ``4/3 pi r^3 density``) unless ``defaults`` says ``density_given``.
     The specimen's ``locate`` names the line and column each value was read from.
     """
     d = read_data(path)
@@ -570,8 +569,8 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
     if "disk_properties" in notes:
         rho, kn, ks, mu = _note(path, notes, "disk_properties", 4)
     else:
-        rho = float(defaults["density"]) if defaults.get("density_given") else None
-        kn, ks, mu = (float(defaults[k]) for k in ("kn", "ks", "mu"))
+        rho = float(defaults["solid_density"]) if defaults.get("density_given") else None
+        kn, ks, mu = (float(defaults[k]) for k in ("kn_particle", "ks_particle", "friction_particle"))
     # the file's masses define the density unless it is named (an exported file, or --density)
     density = np.full(n, rho) if rho is not None else d.mass / (math.pi * d.radius**2 * t)
     gravity, damping, dt = (0.0, -float(defaults["gravity"])), float(defaults["local_damping"]), None
@@ -583,7 +582,7 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
     mu_r = _rolling_note(path, notes, walls) if "rolling_friction" in notes else None
     if not walls:
         xlo, xhi, ylo, yhi = d.box
-        kw = tuple(float(defaults[k]) for k in ("wall_kn", "wall_ks", "wall_mu"))
+        kw = tuple(float(defaults[k]) for k in ("kn_wall", "ks_wall", "friction_wall"))
         walls = box_walls(xlo, xhi, ylo, yhi, *kw)
     return SpecimenData(
         x=d.x, y=d.y, radius=d.radius, density=density, kn=np.full(n, kn), ks=np.full(n, ks),
