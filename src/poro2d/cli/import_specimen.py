@@ -16,14 +16,15 @@ KIND = "import"
 console = OutputConsole()
 
 
-#: import options that give what a file does not say: (option as typed, key of the defaults, limit)
+#: import options that give what a file does not say: (option as typed, key of the defaults, limit,
+#: the value it stands for as ``SpecimenData.locate`` names it)
 IMPORT_OPTIONS = (
-    ("--thickness", "thickness", "thickness"),
-    ("--density", "solid_density", "density"),
-    ("--kn", "kn_particle", "kn"),
-    ("--ks", "ks_particle", "ks"),
-    ("--friction", "friction_particle", "mu"),
-    ("--wall-friction", "friction_wall", "mu"),
+    ("--thickness", "thickness", "thickness", ("thickness", None)),
+    ("--density", "solid_density", "density", ("density", 0)),
+    ("--kn", "kn_particle", "kn", ("kn", 0)),
+    ("--ks", "ks_particle", "ks", ("ks", 0)),
+    ("--friction", "friction_particle", "mu", ("mu", 0)),
+    ("--wall-friction", "friction_wall", "mu", ("wall:top:mu", None)),
 )
 #: the longest equilibrium stage ``--max-steps`` may ask for
 MAX_STEPS_LIMIT = 100_000_000
@@ -71,14 +72,14 @@ def import_cmd(
     values = {"--thickness": thickness, "--density": density, "--kn": kn, "--ks": ks, "--friction": mu,
               "--wall-friction": wall_mu}  # fmt: skip
     given = {}
-    for option, key, limit in IMPORT_OPTIONS:
+    for option, key, limit, _ in IMPORT_OPTIONS:
         if values[option] is not None:
             given[key] = check_value(option, values[option], LIMITS[limit])
     if window is not None:
         check_value("--window", window, LIMITS["window"], "a fraction of G in")
     check_output_dir("--out", out)
     spec = read_specimen(file, {**given, "density_given": "solid_density" in given})
-    _refuse_options_the_file_overrides(spec, {o: values[o] for o, key, _ in IMPORT_OPTIONS if key in given})
+    _refuse_options_the_file_overrides(spec, values, given)
     fraction = window if window is not None else (spec.force_fraction or CriterionSettings.force_fraction)
     window_from = "--window" if window is not None else ("the file" if spec.force_fraction else "the paper's")
 
@@ -101,22 +102,15 @@ def import_cmd(
         raise typer.Exit(1)
 
 
-#: the value each option stands for, as ``SpecimenData.locate`` names it
-_OPTION_QUANTITY = {
-    "--thickness": ("thickness", None), "--density": ("density", 0), "--kn": ("kn", 0), "--ks": ("ks", 0),
-    "--friction": ("mu", 0), "--wall-friction": ("wall:top:mu", None),
-}  # fmt: skip
-
-
-def _refuse_options_the_file_overrides(spec, options: dict) -> None:
+def _refuse_options_the_file_overrides(spec, values: dict, given: dict) -> None:
     """An option is for what the file does not say: one the file overrides would be ignored
     without a word, so it is refused, naming where the file gives the value."""
     from poro2d.errors import InputError
 
-    for option, value in options.items():
-        where = spec.locate(*_OPTION_QUANTITY[option]) if spec.locate else f"{spec.source} (a checkpoint)"
-        if where != option:
-            raise InputError(option, value, f"not given: the file sets it ({where})")
+    for option, key, _, located in IMPORT_OPTIONS:
+        where = spec.locate(*located) if spec.locate else f"{spec.source} (a checkpoint)"
+        if key in given and where != option:
+            raise InputError(option, values[option], f"not given: the file sets it ({where})")
 
 
 def register(app: typer.Typer) -> None:
@@ -125,15 +119,8 @@ def register(app: typer.Typer) -> None:
 
 def print_check(report: dict, out: Path) -> None:
     t = Table(title=f"criterion check: {report['disks']} disks, n = {report['box_porosity']:.4f}")
-    for col in (
-        "F_top N/m",
-        "F_bottom N/m",
-        "side friction up N/m",
-        "G N/m",
-        "limit N/m",
-        "equilibrium",
-        "passes",
-    ):
+    columns = ("F_top N/m", "F_bottom N/m", "side friction up N/m", "G N/m", "limit N/m", "equilibrium")
+    for col in (*columns, "passes"):
         t.add_column(col, justify="right")
     eq = report["equilibrium"]
     fraction = report["criterion_settings"]["force_fraction"]
