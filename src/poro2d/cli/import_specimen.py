@@ -108,8 +108,10 @@ def _refuse_options_the_file_overrides(spec, values: dict, given: dict) -> None:
     from poro2d.errors import InputError
 
     for option, key, _, located in IMPORT_OPTIONS:
+        if key not in given:
+            continue
         where = spec.locate(*located) if spec.locate else f"{spec.source} (a checkpoint)"
-        if key in given and where != option:
+        if where != option:
             raise InputError(option, values[option], f"not given: the file sets it ({where})")
 
 
