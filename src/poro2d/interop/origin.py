@@ -14,7 +14,6 @@ saying its provenance is unknown: nothing is made up.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
@@ -22,6 +21,7 @@ from typing import TypeVar
 
 from poro2d.interop.provenance_records import ConfigFacts, GradingFacts, ResultFacts, RunFacts, SoilFacts
 from poro2d.interop.state_specimen import KnownState, read_state_index, state_record
+from poro2d.json_fields import finite_number
 from poro2d.store import Store
 
 #: every provenance line starts with this (after the target's comment sign)
@@ -114,7 +114,7 @@ def _state(result: ResultFacts, config: ConfigFacts, state: KnownState | None, f
         mode = "paper" if config.density_mode is None else config.density_mode
         mode = _text(mode) + " (a criterion folder of its own)"
     dr_text = "unknown" if dr is None else f"{dr:.4f}"
-    return f"n_lab = {_value(_num(n_lab))}, relative density Dr = {dr_text}; mode {mode}"
+    return f"n_lab = {_value(finite_number(n_lab))}, relative density Dr = {dr_text}; mode {mode}"
 
 
 def _config_dr(n_lab: float | None, config: ConfigFacts) -> float | None:
@@ -168,12 +168,6 @@ def _state_of_case(folder: Path) -> KnownState | None:
                 dr = next((d for n, d in index.states if abs(n - case.n_lab) <= 1e-9), None)
                 return KnownState(index.mode, case.n_lab, dr, case.seed, record=str(record))
     return None
-
-
-def _num(value) -> float | None:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        return None
-    return float(value)
 
 
 def _value(v: float | None, fmt: str = "") -> str:

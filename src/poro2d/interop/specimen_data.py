@@ -24,7 +24,6 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Generic, TypeVar
 
 import numpy as np
 
@@ -35,18 +34,17 @@ from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
 from poro2d.interop.origin import origin_lines
 from poro2d.io_utils import CHECKPOINT_FILE_LIMIT, check_input_file
+from poro2d.json_fields import number_at
 from poro2d.specimen.box import box_faces
 from poro2d.store import Store
 
-T = TypeVar("T")
-
 
 @dataclass(frozen=True)
-class ByPairType(Generic[T]):
-    """One value per contact pair type: the disk-disk pair's (``disks``) and each wall's, by wall name."""
+class ByPairType:
+    """A contact's values per pair type: the disk-disk pair's (``disks``) and each wall's, by wall name."""
 
-    disks: T
-    walls: dict[str, T]
+    disks: ContactValues
+    walls: dict[str, ContactValues]
 
 
 @dataclass
@@ -166,7 +164,7 @@ class SpecimenData:
         g = math.hypot(*self.gravity)
         return float(np.sum(self.mass)) * g / self.thickness
 
-    def contact_parameters(self) -> ByPairType[ContactValues]:
+    def contact_parameters(self) -> ByPairType:
         """The contact-level values of disk-disk contacts and of each wall's, mixed by the engine's
         own description of the law (:meth:`poro2d.dem.model.ContactModel.pair`: PFC 4.0's springs in
         series, the smaller friction and rolling friction).
@@ -341,9 +339,5 @@ def accepted_window(checkpoint_path: Path) -> float | None:
     paper, 5 % for ``paper --quick``). None for a checkpoint without one.
     """
     result = Store(Path(checkpoint_path).parent).read_json("result.json")
-    try:
-        value = result["settings"]["force_fraction"]
-    except (KeyError, TypeError):
-        return None
-    ok = isinstance(value, int | float) and not isinstance(value, bool) and 0.0 < value <= 1.0
-    return float(value) if ok else None
+    value = number_at(result, "settings", "force_fraction")
+    return value if value is not None and 0.0 < value <= 1.0 else None

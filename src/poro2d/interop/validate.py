@@ -28,7 +28,7 @@ import numpy as np
 from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
 from poro2d.interop.specimen_data import SpecimenData
-from poro2d.io_utils import check_input_file
+from poro2d.io_utils import check_input_file, text_position
 
 #: ``locate(quantity, disk_index)``: where a value was read ("FILE line L column C (name)"),
 #: or the option that gave it
@@ -46,11 +46,14 @@ class Limit:
     hi_open: bool = False
 
     def holds(self, v: float) -> bool:
-        return bool(_holds(np.float64(v), self))  # NaN fails
+        return bool(self.holding(np.float64(v)))
 
     def holding(self, values) -> np.ndarray:
         """Which of ``values`` lie within the limit (NaN does not)."""
-        return _holds(np.asarray(values, dtype=float), self)
+        v = np.asarray(values, dtype=float)
+        above = v > self.lo if self.lo_open else v >= self.lo
+        below = v < self.hi if self.hi_open else v <= self.hi
+        return above & below
 
     @property
     def text(self) -> str:
@@ -115,24 +118,13 @@ def _settings(spec: SpecimenData, locate: Locate) -> None:
         check_value(locate("window"), spec.force_fraction, LIMITS["window"], "a fraction of G in")
 
 
-def _first_bad(values: np.ndarray, limit: Limit) -> int | None:
-    bad = np.flatnonzero(~_holds(values, limit))
-    return int(bad[0]) if bad.size else None
-
-
-def _holds(values: np.ndarray, limit: Limit) -> np.ndarray:
-    above = values > limit.lo if limit.lo_open else values >= limit.lo
-    below = values < limit.hi if limit.hi_open else values <= limit.hi
-    return above & below
-
-
 def _disk_values(spec: SpecimenData, locate: Locate, names: tuple[str, ...]) -> None:
     for name in names:
         values = getattr(spec, name)
         limit = LIMITS.get(name, LIMITS["coordinate"])
-        i = _first_bad(np.asarray(values, dtype=float), limit)
-        if i is not None:
-            raise InputError(locate(name, i), _message_value(values[i]), limit.text)
+        bad = np.flatnonzero(~limit.holding(values))
+        if bad.size:
+            raise InputError(locate(name, int(bad[0])), _message_value(values[bad[0]]), limit.text)
 
 
 def _walls(spec: SpecimenData, locate: Locate) -> tuple[float, float, float, float]:
@@ -244,6 +236,5 @@ def text_of(path, what: str) -> str:
 
 
 def _not_text(path, data: bytes, at: int, found: str) -> InputError:
-    line = data.count(b"\n", 0, at) + 1
-    column = at - (data.rfind(b"\n", 0, at) + 1) + 1
+    line, column = text_position(data, at)
     return InputError(f"{path} line {line} column {column}", found, "UTF-8 text (not a binary file)")
