@@ -122,10 +122,10 @@ def _config_dr(n_lab: float | None, config: ConfigFacts) -> float | None:
     from poro2d.errors import InputError
     from poro2d.porosity import relative_density
 
-    if n_lab is None or config.n_max is None or config.n_min is None:
+    if n_lab is None or config.extremes is None or None in config.extremes:
         return None
     try:
-        return float(relative_density(n_lab, config.n_max, config.n_min))
+        return float(relative_density(n_lab, *config.extremes))
     except InputError:
         return None
 

@@ -128,12 +128,11 @@ class GradingFacts:
 @dataclass(frozen=True)
 class ConfigFacts:
     """A criterion's ``config.json``: the grading, the ``[density]`` table's mode and laboratory
-    extremes (``density_mode`` None: no such table) and what its ``run`` says of the run."""
+    ``extremes`` (n_max, n_min; both fields None: no such table) and what its ``run`` says of the run."""
 
     grading: GradingFacts = GradingFacts("unknown")
     density_mode: str | None = None
-    n_max: float | None = None
-    n_min: float | None = None
+    extremes: tuple[float | None, float | None] | None = None
     run: RunFacts = RunFacts()
 
     @classmethod
@@ -143,8 +142,7 @@ class ConfigFacts:
         return cls(
             grading=GradingFacts.from_json(data),
             density_mode=str(density.get("mode", "paper")) if table else None,
-            n_max=number_at(density, "n_max") if table else None,
-            n_min=number_at(density, "n_min") if table else None,
+            extremes=(number_at(density, "n_max"), number_at(density, "n_min")) if table else None,
             run=RunFacts.from_json(data.get("run"), data.get("provenance")),
         )
 

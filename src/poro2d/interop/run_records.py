@@ -176,19 +176,17 @@ class SweepListing:
 
 @dataclass(frozen=True)
 class CaseRow:
-    """A sweep case's ``result.json`` (or ``error.json``): its parameters, whether it is done, its
-    error as written and the n_lab among its results."""
+    """A sweep case's ``result.json`` (or ``error.json``): its parameters, its error as written when
+    it is not done (``failure``; None: done) and the n_lab among its results."""
 
     params: CaseParams
-    done: bool
-    error: str
+    failure: str | None
     result_n_lab: float | None
 
     @classmethod
     def from_json(cls, data: dict) -> CaseRow:
         return cls(
             CaseParams.from_json(data.get("params")),
-            data.get("status") == "done",
-            str(data.get("error")),
+            None if data.get("status") == "done" else str(data.get("error")),
             number_at(data, "results", "n_lab"),
         )

@@ -298,8 +298,8 @@ def _case(
         seed = seed if isinstance(seed, int) and not isinstance(seed, bool) else None
     if row is None:
         why = f"case {case_dir} has not finished"
-    elif not row.done:
-        why = f"case {case_dir} failed: {row.error}"
+    elif row.failure is not None:
+        why = f"case {case_dir} failed: {row.failure}"
     else:
         why = _not_accepted(run)
     return StateCase(n_lab if n_lab is not None else math.nan, seed, run, why)
