@@ -40,6 +40,7 @@ def export_cmd(
     """Write an accepted specimen for another DEM code (disks, walls, contact properties)."""
     from poro2d.errors import InputError, check_range
     from poro2d.interop import csv_table, lammps, pfc, yade
+    from poro2d.interop.state_specimen import dr_text
 
     if to not in TARGETS:
         raise InputError("--to", to, "one of " + ", ".join(TARGETS))
@@ -61,11 +62,8 @@ def export_cmd(
     if to == "pfc" and pfc.pfc4_refusal(spec):
         console.print(pfc.pfc4_refusal(spec))
     if state is not None:
-        dr_text = "unknown" if state.relative_density is None else f"{state.relative_density:.4f}"
-        console.print(
-            f"state n_lab = {state.n_lab:g} (Dr = {dr_text}), seed {state.seed} of {state.record}: "
-            f"{state.folder}"
-        )
+        where = f"seed {state.seed} of {state.record}: {state.folder}"
+        console.print(f"state n_lab = {state.n_lab:g} (Dr = {dr_text(state.relative_density)}), {where}")
     console.print(
         f"{spec.n} disks, {len(spec.walls)} walls; thickness t = {spec.thickness:g} m "
         "(disk masses rho pi r^2 t); SI units; see docs/export.md"

@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import TypeVar
 
 from poro2d.interop.provenance_records import ConfigFacts, GradingFacts, ResultFacts, RunFacts, SoilFacts
-from poro2d.interop.state_specimen import KnownState, read_state_index, state_record
+from poro2d.interop.state_specimen import KnownState, dr_text, read_state_index, state_record
 from poro2d.json_fields import finite_number
 from poro2d.store import Store
 
@@ -113,8 +113,7 @@ def _state(result: ResultFacts, config: ConfigFacts, state: KnownState | None, f
     else:
         mode = "paper" if config.density_mode is None else config.density_mode
         mode = _text(mode) + " (a criterion folder of its own)"
-    dr_text = "unknown" if dr is None else f"{dr:.4f}"
-    return f"n_lab = {_value(finite_number(n_lab))}, relative density Dr = {dr_text}; mode {mode}"
+    return f"n_lab = {_value(finite_number(n_lab))}, relative density Dr = {dr_text(dr)}; mode {mode}"
 
 
 def _config_dr(n_lab: float | None, config: ConfigFacts) -> float | None:

@@ -18,8 +18,7 @@ Three folders hold specimens by laboratory state:
 The cases are found by what their files say (the sweep's ``sweep.json`` lists them; each
 case's ``result.json`` gives its parameters, the criterion's ``result.json`` in its ``run``
 folder its seed and whether it converged), never by a folder name made up from a state.
-:func:`find_state_specimen` returns the criterion folder holding the specimen;
-:func:`state_specimen` the same with the state it belongs to (for the export's provenance).
+:func:`state_specimen` returns the state and the criterion folder holding its specimen.
 Everything refused is one :class:`~poro2d.errors.InputError` naming the option, its value
 and the states and seeds there are.
 """
@@ -115,7 +114,7 @@ class StateIndex:
             cases = self.cases_of(n_lab)
             ok = [str(c.seed) for c in cases if c.accepted]
             bad = [str(c.seed) for c in cases if not c.accepted]
-            text = f"n_lab {n_lab:g} (Dr {_dr_text(dr)}): "
+            text = f"n_lab {n_lab:g} (Dr {dr_text(dr)}): "
             text += f"seed{'s' if len(ok) != 1 else ''} {', '.join(ok)}" if ok else "no accepted seed"
             if bad:
                 text += f" (not accepted: {', '.join(bad)})"
@@ -389,7 +388,8 @@ def _same(a: float | None, b: float | None) -> bool:
     return a is not None and b is not None and abs(a - b) <= 1e-9
 
 
-def _dr_text(dr: float | None) -> str:
+def dr_text(dr: float | None) -> str:
+    """A relative density as the messages and provenance lines write it."""
     return "unknown" if dr is None else f"{dr:.4f}"
 
 
@@ -397,6 +397,7 @@ __all__ = [
     "STATE_RECORDS",
     "KnownState",
     "StateSpecimen",
+    "dr_text",
     "read_state_index",
     "state_record",
     "state_specimen",
