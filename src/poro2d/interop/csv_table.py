@@ -51,7 +51,7 @@ def export_files(spec: SpecimenData) -> list[tuple[str, str]]:
     rolled = spec.rolled
     disks = [spec.x, spec.y, spec.radius, spec.density, spec.kn, spec.ks, spec.mu]
     if rolled:
-        disks.append(np.zeros(spec.n) if spec.mu_r is None else np.asarray(spec.mu_r, dtype=float))
+        disks.append(spec.rolling_friction)
     rows = [[str(i + 1), *(repr(float(a[i])) for a in disks)] for i in range(spec.n)]
     wrows = [[w.name, *(repr(float(v)) for v in (*w.numbers, w.mu_r)[: 7 + rolled])] for w in spec.walls]
     extra = (ROLLING_COLUMN,) if rolled else ()
@@ -185,12 +185,10 @@ def _check_rolling(disks_path: Path, drows, disk_mu_r, walls_path: Path, wrows, 
         raise InputError(str(walls_path), "no mu_r column", f"a mu_r column, as {disks_path.name} has")
     column = len(DISK_COLUMNS) + 1
     allowed = f"[0, {MAX_ROLLING_FRICTION:g}]"
-    for (k, _), v in zip(drows, disk_mu_r, strict=True):
-        if not 0.0 <= v <= MAX_ROLLING_FRICTION:
-            raise InputError(f"{disks_path} line {k} column {column} (mu_r)", float(v), allowed)
-    for (k, _), v in zip(wrows, wall_mu_r, strict=True):
-        if not 0.0 <= v <= MAX_ROLLING_FRICTION:
-            raise InputError(f"{walls_path} line {k} column {column} (mu_r)", float(v), allowed)
+    for path, rows, values in ((disks_path, drows, disk_mu_r), (walls_path, wrows, wall_mu_r)):
+        for (k, _), v in zip(rows, values, strict=True):
+            if not 0.0 <= v <= MAX_ROLLING_FRICTION:
+                raise InputError(f"{path} line {k} column {column} (mu_r)", float(v), allowed)
 
 
 def _read_table(path: Path, columns: tuple[str, ...]) -> tuple[dict, list[tuple[int, list[str]]]]:

@@ -54,14 +54,8 @@ class StatesRecord:
     @classmethod
     def from_json(cls, data: dict, one_state: bool = False) -> StatesRecord:
         """``one_state``: the object is itself the state (``density.json``)."""
-        points = data.get("points")
-        rows = (
-            [data]
-            if one_state
-            else [p for p in points if isinstance(p, dict)]
-            if isinstance(points, list)
-            else []
-        )
+        points = data.get("points") if isinstance(data.get("points"), list) else []
+        rows = [data] if one_state else [p for p in points if isinstance(p, dict)]
         config = data.get("config")
         seed = config.get("seed", 0) if isinstance(config, dict) else 0
         return cls(

@@ -111,8 +111,12 @@ class SpecimenData:
     @property
     def rolled(self) -> bool:
         """True when any disk or wall has rolling friction (a target must carry it or refuse)."""
-        disks = self.mu_r is not None and bool(np.any(np.asarray(self.mu_r) > 0.0))
-        return disks or any(w.mu_r > 0.0 for w in self.walls)
+        return bool(np.any(self.rolling_friction > 0.0)) or any(w.mu_r > 0.0 for w in self.walls)
+
+    @property
+    def rolling_friction(self) -> np.ndarray:
+        """The disks' rolling friction (0 for every disk when ``mu_r`` is None)."""
+        return np.zeros(self.n) if self.mu_r is None else np.asarray(self.mu_r, dtype=float)
 
     @property
     def dashpot(self) -> bool:
@@ -172,7 +176,7 @@ class SpecimenData:
         Engines that take one set per contact type need every disk alike: refused otherwise,
         naming the property that varies.
         """
-        mu_r = np.zeros(self.n) if self.mu_r is None else np.asarray(self.mu_r, dtype=float)
+        mu_r = self.rolling_friction
         varying = {"kn": self.kn, "ks": self.ks, "mu": self.mu, "density": self.density}
         for name, a in {**varying, "rolling friction": mu_r}.items():
             if self.n and np.ptp(a) != 0.0:

@@ -41,8 +41,6 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-import numpy as np
-
 from poro2d.errors import InputError
 from poro2d.interop.specimen_data import SpecimenData
 from poro2d.io_utils import write_texts
@@ -278,13 +276,12 @@ def script(
 
 def _rolling_lines(spec: SpecimenData) -> list[str]:
     """The rolling frictions of a rolled specimen, per disk (in DISKS order) and per wall."""
-    mu_r = np.zeros(spec.n) if spec.mu_r is None else np.asarray(spec.mu_r, dtype=float)
     walls = {w.name: float(w.mu_r) for w in spec.walls}
     return [
         "",
         "# rolling friction mu_r per disk (in DISKS order) and per wall, for poro2d's rolling spring (below)",
         "DISK_ROLLING = [",
-        *(f"    {float(v)!r}," for v in mu_r),
+        *(f"    {float(v)!r}," for v in spec.rolling_friction),
         "]",
         f"WALL_ROLLING = {walls!r}",
     ]
