@@ -1,19 +1,15 @@
 """The same specimen in LAMMPS and in poro2d: do the two engines agree at rest?
 
-"The same state" here: both codes start from the exported centres and radii with the
-disks at rest and no contact history (LAMMPS cannot import poro2d's stored shear
-forces, so poro2d starts without them too, from a fresh :class:`Simulation`), with
-the same masses, contact law, walls (the plate fixed where it stands), time step,
-gravity and local damping; each cycles until its maximum unbalanced-force ratio is
-below ``ratio``. Then both measure the wall forces per metre (the plate's F_top, the
-floor's F_bottom, the side walls' upward friction), the mean contact force and the
-coordination number.
+Both start from the exported centres and radii, at rest, with no contact history (LAMMPS cannot
+import poro2d's stored shear forces, so poro2d drops them too), and the same masses, contact law,
+walls (the plate fixed), time step, gravity and damping; each cycles until its largest
+unbalanced-force ratio is below the case's ``ratio``, then both measure the wall forces per
+metre, the mean contact force and the coordination number.
 
-Known differences of the two implementations, both small at rest: LAMMPS' Hookean
-styles take the lever arm of a contact as the full radius, poro2d as the radius less
-half the overlap (the contact point in the middle of the overlap), and LAMMPS stores
-the shear displacement as a vector projected on the contact plane each step, poro2d
-the shear force as a component along the contact tangent.
+Known differences, both small at rest: LAMMPS' Hookean styles take a contact's lever arm as
+the full radius, poro2d as the radius less half the overlap, and LAMMPS stores the shear
+displacement as a vector projected on the contact plane each step, poro2d the shear force as a
+component along the contact tangent.
 """
 
 from __future__ import annotations

@@ -1,13 +1,11 @@
 """The criterion's check on a specimen brought in from elsewhere, as it stands.
 
-The specimen (a CSV pair, a LAMMPS data file or a poro2d checkpoint) is put in the
-paper's box (:func:`poro2d.specimen.compaction.make_walls`: bottom, sides and the top
-plate at the top of its box, moved so that the box starts at the origin), with its disks
-at rest and no contact history. It is cycled to equilibrium with the plate fixed; then
-F_top, F_bottom and the side walls' upward friction are measured and the window of
-Fig. 3 is tested: 0 < F_top < 1 % of the self weight G. When the specimen fails it, the
-criterion's own plate servo (:class:`poro2d.criterion.servo.PlateServo`) finds where the
-plate would settle, and so the porosity n' the box would have there.
+The specimen (a CSV pair, a LAMMPS data file or a poro2d checkpoint) is put in the paper's box
+(:func:`poro2d.specimen.compaction.make_walls`, moved so that the box starts at the origin),
+at rest with no contact history, and cycled to equilibrium with the plate fixed; then the
+window of Fig. 3 is tested on the wall forces: 0 < F_top < 1 % of the self weight G. For a
+specimen that fails it, the criterion's own plate servo finds where the plate would settle,
+and so the porosity n' the box would have there.
 """
 
 from __future__ import annotations

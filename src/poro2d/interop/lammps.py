@@ -5,26 +5,18 @@ Translation of poro2d's model into LAMMPS (``units si``, ``dimension 2``, GRANUL
 * ``atom_style sphere``: LAMMPS sets ``mass = 4/3 pi r^3 density`` even in 2D, so each
   atom gets the density ``3 rho t / (4 r)`` (:func:`lammps_density`), which gives the
   disk mass ``rho pi r^2 t``; ``fix nve/sphere disc`` uses the disk inertia ``m r^2 / 2``.
-* ``pair_style gran/hooke/history Kn Kt gamma_n gamma_t xmu dampflag``: for the Hookean
-  styles Kn and Kt are plain springs in N/m, as in PFC; the per-body stiffnesses of PFC
-  4.0 are combined in series beforehand, the friction is min(mu_a, mu_b). gamma_n is a
-  negligible positive value (:data:`GAMMA_TINY`): the model has no viscous damping, and
-  with a normal damping of exactly 0 LAMMPS gives NaN at the first wall contact.
-* walls: one ``fix wall/gran hooke/history`` per wall (``xplane``/``yplane``, the other
-  side NULL), with the disk-wall contact properties; the plate is a plane fixed at its
-  height. ``contacts`` makes each fix report the force on every disk it touches.
-* rolling resistance (disks with ``mu_r > 0``, ``granular`` law only): the sub-model
-  ``rolling sds k_roll 0 mu_roll``. LAMMPS accumulates a rolling displacement
-  ``R_eff (omega_i - omega_j) dt`` (``R_eff = r_i r_j / (r_i + r_j)``, a flat wall: ``r_i``),
-  pushes back with ``k_roll`` times it, capped at ``mu_roll Fn``, and applies the torque
-  ``R_eff`` times that force: a moment ``k_roll R_eff^2`` per unit of relative rotation up to
-  ``mu_roll R_eff Fn``. So ``k_roll = ks`` (the contact's shear stiffness) and
-  ``mu_roll = mu_r`` give poro2d's rolling spring ``kr = ks R^2`` capped at ``mu_r R Fn``;
-  no rolling dashpot (``gamma_roll = 0``), as in poro2d.
-* local damping: ``fix damping/cundall a a`` reduces each force and torque component by
-  ``a |F| sign(v)``, PFC's local damping. It comes after ``fix gravity`` so the weight is
-  part of the damped unbalanced force, as in PFC and poro2d, and ``fix store/force``
-  just before it keeps the undamped unbalanced force for the stop test.
+* Hookean styles take plain springs in N/m, as PFC does: the per-body values of PFC 4.0 are
+  mixed beforehand (:meth:`poro2d.dem.model.ContactModel.pair`). The classic form's gamma_n is a
+  negligible positive value (:data:`GAMMA_TINY`): the model has no viscous damping, and with a
+  normal damping of exactly 0 LAMMPS gives NaN at the first wall contact.
+* walls: one ``fix wall/gran`` plane per wall with the disk-wall contact's values, the plate a
+  plane fixed at its height.
+* rolling resistance (``granular`` law only): ``rolling sds k_roll 0 mu_roll`` with ``k_roll``
+  the contact's ks and ``mu_roll`` its mu_r is poro2d's rolling spring ``kr = ks R^2`` capped at
+  ``mu_r R Fn``, LAMMPS applying its rolling force at the lever arm ``R_eff`` (docs/export.md).
+* local damping: ``fix damping/cundall a a``, PFC's local damping, after ``fix gravity`` so
+  that the weight is part of the damped unbalanced force, as in PFC and poro2d; ``fix
+  store/force`` just before it keeps the undamped unbalanced force for the stop test.
 
 The stop test of the exported script is PFC's ratio: the largest unbalanced force over the
 largest contact force (for disk-disk contacts the normal force stands for the magnitude,

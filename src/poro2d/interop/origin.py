@@ -1,15 +1,12 @@
 """Where an exported specimen came from: the soil's provenance lines of every export header.
 
-The criterion's folder records its run beside ``specimen.npz``: ``config.json`` (the config
-as given, with the ``[grading]`` table, and the run's grading source) and ``result.json``
-(the laboratory porosity, the preparation friction, the accepted n2D, the box and interior
-porosity, the seed and the poro2d version that ran it). :func:`origin_lines` turns them into
-lines, each starting with ``provenance:``; the export writes them as comments. The mode
-(paper or density) and the relative density are the state folder's
-(:mod:`poro2d.interop.state_specimen`): a specimen exported by its state has them, a sweep
-case exported by its own folder is looked up in the state folder above it, and a criterion
-folder of its own is paper mode. A checkpoint without these records beside it gets one line
-saying its provenance is unknown: nothing is made up.
+The criterion's folder records its run beside ``specimen.npz`` (``config.json``: the grading
+table and source; ``result.json``: the laboratory porosity, the preparation friction, n2D, the
+box and interior porosities, the seed and the version). :func:`origin_lines` turns them into
+lines starting with ``provenance:``. The mode and relative density are the state folder's
+(:mod:`poro2d.interop.state_specimen`): given with a specimen found by its state, looked up in
+the state folder above a sweep case, paper mode for a criterion folder of its own. A checkpoint
+without these records gets one line saying its provenance is unknown: nothing is made up.
 """
 
 from __future__ import annotations

@@ -1,26 +1,17 @@
 """PFC2D: a command file for current PFC (5 and later) and one in the PFC 4.0 form.
 
-PFC2D treats a ball as a disk of unit thickness (1 m). To keep every mass as poro2d's
-``rho pi r^2 t``, the density written is ``rho t`` (kg/m^2 per metre of thickness); the
-stiffnesses are those of the disks, so the contact forces read in PFC are poro2d's, in
-N, and divided by ``t`` they give N/m, the paper's unit.
+PFC2D takes a ball as a disk 1 m thick. To keep every mass poro2d's ``rho pi r^2 t``, the
+density written is ``rho t``; the stiffnesses are the disks', so the contact forces read in
+PFC are poro2d's, in N (divided by ``t``: N/m, the paper's unit).
 
-* ``specimen.p2dat`` (PFC 5+): ``ball create id ... position (x,y) radius r``,
-  ``ball attribute density ... damp ... range id i``, ``wall create vertices ... id k
-  name '...'`` and the linear contact model with contact-level properties (PFC 5+
-  does not combine per-body values): springs in series, the smaller friction, as PFC
-  4.0 did, one set for ball-ball and one for ball-facet contacts. A specimen with
-  rolling friction gets PFC's rolling-resistance linear model (``rrlinear``, property
-  ``rr_fric``): its rolling stiffness ``ks R^2`` and limit ``rr_fric R Fn``, with ``R``
-  the contact's effective radius, are poro2d's rolling spring
-  (:mod:`poro2d.dem.contact_law`).
-* ``specimen_pfc4.dat`` (PFC 4.0, the paper's code): ``ball id=i x=... y=... rad=...``
-  with ``property`` lines of the per-body values (density, kn, ks, friction) of Table 1
-  and ``wall id=k kn=... ks=... friction=... nodes (x0,y0) (x1,y1)``. The nodes of each
-  wall are as poro2d stores them: the specimen lies to the left when going from the
-  first node to the second. PFC 4.0 has no rolling-resistance model: a specimen with
-  rolling friction gets no 4.0 file (:func:`pfc4_refusal` says why), never one that
-  silently drops it.
+* ``specimen.p2dat`` (PFC 5+): balls, walls and the linear contact model with contact-level
+  values (PFC 5+ does not mix per-body ones), one set for ball-ball and one for ball-facet
+  contacts; a specimen with rolling friction gets ``rrlinear``, whose rolling stiffness
+  ``ks R^2`` and limit ``rr_fric R Fn`` are poro2d's rolling spring.
+* ``specimen_pfc4.dat`` (PFC 4.0, the paper's code): the per-body values of Table 1, walls by
+  their nodes as poro2d stores them (the specimen to the left from the first node to the
+  second). PFC 4.0 has no rolling resistance: a rolled specimen gets no 4.0 file
+  (:func:`pfc4_refusal` says why), never one that silently drops it.
 """
 
 from __future__ import annotations

@@ -1,11 +1,9 @@
 """What the export's provenance lines read from a criterion folder: its records as values.
 
-A criterion folder keeps ``result.json`` (what the run found), ``config.json`` (the config as
-given and what the run made of it) and, named by ``poro2d sand``, ``soil.json``.
-:func:`poro2d.interop.origin.origin_lines` reads each once and hands its object to a
-``from_json`` here, which keeps the facts the lines name as typed fields; a value of another
-shape reads as not said, and the line says "unknown". Text a line quotes as the file wrote it
-(a preset's name, a version) is kept as that text.
+:func:`poro2d.interop.origin.origin_lines` reads ``result.json``, ``config.json`` and
+``soil.json`` once each and hands the object to a ``from_json`` here; a value of another shape
+reads as not said, and the line says "unknown". Text a line quotes (a preset's name, a version)
+is kept as written.
 """
 
 from __future__ import annotations

@@ -1,12 +1,9 @@
 """What the exporters read from the records a finished run leaves beside its specimens, as values.
 
-A specimen's folder (and a folder of specimens by state) holds JSON records written by
-poro2d's runs, possibly by an earlier version or edited by hand. The readers of
-:mod:`~poro2d.interop.specimen_data`, :mod:`~poro2d.interop.state_specimen` and
-:mod:`~poro2d.interop.origin` open a file once and hand its object to a ``from_json`` here,
-which keeps what they need as typed fields; a value of another shape reads as not said
-(None, False), so that the caller refuses it or names it unknown in its own words. A value
-that a refusal quotes as the file wrote it (``converged = False``) is kept as that text.
+A record may come from an earlier poro2d or a hand's edit: each is opened once and handed to a
+``from_json`` here, which keeps what the exporters need as typed fields; a value of another shape
+reads as not said (None, False), so that the caller refuses it or names it unknown in its own
+words. A value that a refusal quotes as the file wrote it (``converged = False``) is kept as text.
 """
 
 from __future__ import annotations

@@ -1,20 +1,13 @@
 """A specimen as plain numbers: what every export writes and every import reads.
 
-:class:`SpecimenData` holds the disks (centre, radius and the per-body properties of
-PFC 4.0: density, kn, ks, friction), the wall segments with their own per-body
-properties, the disk thickness and the run settings another code needs to continue
-from the same state (gravity, local damping, time step). Velocities, spins and the
-contact history are not part of it: an exported specimen starts at rest with no shear
-force stored, in any code (see docs/export.md).
+:class:`SpecimenData` holds the disks (centre, radius, PFC 4.0's per-body density, kn, ks,
+friction), the walls with their own, the disk thickness and the run settings another code needs
+to continue from the same state. Velocities, spins and contact history are not part of it: an
+exported specimen starts at rest with no shear force stored, in any code (docs/export.md).
 
-It is a view in the files' terms, not a second engine record: an importer fills it with
-the numbers as its file states them, unchecked, so that
-:func:`poro2d.interop.validate.check_imported` can refuse a bad one naming its file and
-line (the engine's ``Particles`` and ``Walls`` would refuse it first, in their own words,
-and they hold what no file carries: velocities, spins, modes, servos). It is made from
-the engine's records in one place (``_from_records``, for a simulation or a checkpoint),
-turned into them in one (:meth:`SpecimenData.to_simulation`), and reads its box with
-:func:`poro2d.specimen.box.box_faces`.
+It is a view in the files' terms, not a second engine record: an importer fills it unchecked,
+so that :func:`poro2d.interop.validate.check_imported` can refuse a bad value naming its file and
+line (the engine's ``Particles`` and ``Walls`` would refuse it first, in their own words).
 """
 
 from __future__ import annotations

@@ -1,26 +1,18 @@
 """A specimen by its laboratory state: the accepted specimen of one state and seed of a run.
 
-Three folders hold specimens by laboratory state:
+Three folders hold specimens by laboratory state (docs/export.md):
 
-* a relation folder (``poro2d relation``): ``relation.json`` lists the states (``points``:
-  ``n_lab``, ``relative_density``). In density mode the cases of the states are the sweep in
-  ``states/`` (one per state and seed, the state's ``criterion.n_lab`` and the ``seed`` among
-  the parameters each case's ``result.json`` records); a state's case that the calibration had
-  already run (its twin, at the same friction and seed) is not run again and is read from the
-  calibration's cases (``sweeps.calibration.cases``). In paper mode the cases are the sweep in
-  the folder itself, one per state, each at the config's seed;
-* a density-mode criterion folder (``poro2d criterion --mode density``): ``density.json``
-  is one state of the same layout as a density-mode relation;
-* a sand folder (``poro2d sand``): ``sand.json`` lists ``states``, each a dict with
-  ``n_lab``, ``relative_density``, ``seed`` and ``specimen``, the path (relative to the sand
-  folder) of the accepted criterion folder holding ``specimen.npz``.
+* a relation (``relation.json`` lists the ``points``): in density mode the cases are the sweep
+  in ``states/``, one per state and seed, and a state's twin that the calibration had already
+  run is read from the calibration's cases (``sweeps.calibration.cases``); in paper mode the
+  cases are the sweep in the folder itself, each at the config's seed;
+* a density-mode criterion (``density.json``): one state of the same layout;
+* a sand run (``sand.json`` lists ``states``, each naming its accepted criterion folder).
 
-The cases are found by what their files say (the sweep's ``sweep.json`` lists them; each
-case's ``result.json`` gives its parameters, the criterion's ``result.json`` in its ``run``
-folder its seed and whether it converged), never by a folder name made up from a state.
-:func:`state_specimen` returns the state and the criterion folder holding its specimen.
-Everything refused is one :class:`~poro2d.errors.InputError` naming the option, its value
-and the states and seeds there are.
+The cases are found by what their files say (``sweep.json``, each case's ``result.json``, the
+criterion's ``result.json`` in its ``run`` folder), never by a folder name made up from a state.
+Everything refused is one :class:`~poro2d.errors.InputError` naming the option, its value and
+the states and seeds there are.
 """
 
 from __future__ import annotations

@@ -1,20 +1,13 @@
 """Checks of an imported specimen, before any work: every number in a sane range, a box that
 closes, disks that fit in it without sitting on one another, and gravity the check can use.
 
-A refusal names where the value came from: the file, line and column (the readers of
-:mod:`poro2d.interop.csv_table` and :mod:`poro2d.interop.lammps` give a ``locate`` function
-for that), or the command-line option that set it. The ranges are wide enough for any
-granular specimen and narrow enough that nothing downstream overflows or runs for ever:
-
-* thickness up to 1 m (PFC takes its disks 1 m thick); densities of real solids (1 to
-  1e5 kg/m3: osmium, the densest, has 22 590); stiffnesses up to 1e12 N/m (a stiffer contact
-  needs sub-nanosecond steps); friction up to 10 (84 degrees);
-* disk radii from 1 um; coordinates within 1 km of the origin;
-* gravity pointing down the y axis (the criterion's plate is on top), 1e-3 to 1e3 m/s2 (a
-  check without gravity never comes to rest);
-* disks inside the box, overlapping one another or a wall by at most :data:`OVERLAP_LIMIT`
-  of a radius (a packing at rest overlaps by far less; more is a wrong radius or unit), and
-  a solid area below the box area.
+A refusal names where the value came from: the file, line and column (the readers' ``locate``),
+or the command-line option that set it. The ranges (:data:`LIMITS`) are wide enough for any
+granular specimen and narrow enough that nothing downstream overflows or runs for ever: densities
+of real solids, stiffnesses whose time steps stay above a nanosecond, gravity pointing down the y
+axis (the criterion's plate is on top; without gravity a check never comes to rest), disks
+overlapping one another or a wall by at most :data:`OVERLAP_LIMIT` of a radius (a packing at rest
+overlaps by far less; more is a wrong radius or unit).
 """
 
 from __future__ import annotations

@@ -2,38 +2,25 @@
 
 YADE is 3D. The choices made here:
 
-* each disk is a sphere of the disk's radius with its centre in the plane z = 0; its
-  motion is locked to the plane (``blockedDOFs = 'zXY'``: no z translation, rotation
-  about z only), its mass set to the disk mass ``rho pi r^2 t`` and its inertia to the
-  disk's ``m r^2 / 2``;
-* each sphere gets its own ``FrictMat`` with ``young = kn / (2 r)``: YADE's
-  ``Ip2_FrictMat_FrictMat_FrictPhys`` combines ``2 E_a r_a E_b r_b / (E_a r_a + E_b
-  r_b)``, which is then kn_a kn_b / (kn_a + kn_b), PFC 4.0's springs in series;
-  ``poisson`` holds ks/kn (YADE's ks is kn times the mean of the two ratios: exact
-  when every body has the same ks/kn, as in the paper's Table 1); the friction angle
-  is ``atan(mu)`` and YADE takes the smaller of the two, as PFC 4.0;
-* walls are fixed boxes whose face lies on the poro2d segment, on the side away from
-  the specimen. YADE's stiffness of a box contact depends on the sphere's radius, so a
-  ``PyRunner`` after the interaction loop sets kn, ks and the friction of every
-  disk-wall contact to the PFC 4.0 values (from the step after the contact forms);
-* Cundall's local damping is ``NewtonIntegrator(damping=...)``, gravity its
-  ``gravity``; the time step is poro2d's;
-* rolling friction (a rolled specimen only; without it the script is as it always was):
-  poro2d's rolling spring (:mod:`poro2d.dem.contact_law`: kr = ks R^2, cap mu_r R Fn) is
-  the spring of YADE's ``Law2_ScGeom6D_CohFrictPhys_CohesionMoment`` in its incremental
-  form (``useIncrementalForm``), on the contact's ``kr`` and ``maxRollPl`` (cap
-  ``maxRollPl * Fn``). YADE's ``Ip2_CohFrictMat_CohFrictMat_CohFrictPhys`` would set
-  them from the materials, ``kr = alphaKr ks r1 r2`` and ``maxRollPl = min(etaRoll_1 r1,
-  etaRoll_2 r2)``, and no per-body ``alphaKr`` or ``etaRoll`` gives ``ks (r1 r2 / (r1 +
-  r2))^2`` and ``mu_r r1 r2 / (r1 + r2)`` for every pair of radii. So the materials (a
-  ``CohFrictMat`` copy of each ``FrictMat``) give ``kr = 0``, and a ``PyRunner`` right
-  after the interaction loop sets ``kr`` and ``maxRollPl`` on each contact in the step it
-  forms and applies that step's moment itself (``rolling_contacts``): the spring is
-  poro2d's from a contact's first step.
+* each disk is a sphere of the disk's radius centred in the plane z = 0, its motion locked
+  to the plane (``blockedDOFs = 'zXY'``), its mass the disk mass ``rho pi r^2 t`` and its
+  inertia the disk's ``m r^2 / 2``;
+* each sphere gets its own ``FrictMat`` with ``young = kn / (2 r)``, which YADE's
+  ``Ip2_FrictMat_FrictMat_FrictPhys`` combines into kn_a kn_b / (kn_a + kn_b), PFC 4.0's
+  springs in series; ``poisson`` holds ks/kn (exact when every body has the same ks/kn, as
+  in the paper's Table 1); the friction angle is ``atan(mu)``, the smaller one taken;
+* walls are fixed boxes whose face lies on the poro2d segment, away from the specimen. YADE's
+  stiffness of a box contact depends on the sphere's radius, so a ``PyRunner`` sets kn, ks and
+  the friction of every disk-wall contact to the PFC 4.0 values;
+* Cundall's local damping and gravity are ``NewtonIntegrator``'s; the time step is poro2d's;
+* rolling friction (a rolled specimen only): no per-body material of YADE gives poro2d's
+  rolling spring (kr = ks R^2, cap mu_r R Fn) for every pair of radii, so the materials give
+  kr = 0 and a ``PyRunner`` sets each new contact's ``kr`` and ``maxRollPl`` for
+  ``Law2_ScGeom6D_CohFrictPhys_CohesionMoment`` (the script's own comment says how).
 
-The numbers are in literals at the top of the script (``SETTINGS``, ``DISKS``, ``WALLS``,
-and for a rolled specimen ``DISK_ROLLING`` and ``WALL_ROLLING``), written with ``repr``,
-so that they can be read back exactly.
+The numbers are literals at the top of the script (``SETTINGS``, ``DISKS``, ``WALLS``, and
+for a rolled specimen ``DISK_ROLLING`` and ``WALL_ROLLING``), written with ``repr`` so that
+they read back exactly.
 """
 
 from __future__ import annotations
