@@ -145,9 +145,9 @@ Z_TOLERANCE = 1e-3
 def read_data(path: str | os.PathLike) -> DataFile:
     """Read a LAMMPS data file of ``atom_style sphere`` (id type diameter density x y z [images]).
 
-    Any other section (Velocities, ...) is skipped. Lines written by :func:`write_specimen`
-    as ``# poro2d <key> <values>`` are returned in ``notes`` (the first of a key). A malformed line is an
-    InputError naming the file, the line and the column: ids and types must be whole numbers
+    Any other section (Velocities, ...) is skipped. Lines written by :func:`write_specimen` as
+    ``# poro2d <key> <values>`` are returned in ``notes`` (the first of a key). A malformed line is
+    an InputError naming the file, the line and the column: ids and types must be whole numbers
     (ids >= 1, none twice), the atoms must lie in one plane (z constant) and in the box's
     own image (image flags 0 in x and y), and their count must be the header's.
     """
@@ -174,17 +174,11 @@ def read_data(path: str | os.PathLike) -> DataFile:
             _header_line(p, k, words, header)
         elif section == "Atoms":
             atoms.append((k, _numbers(p, k, words, 7, 10)))
-    missing = [
-        what
-        for key, what in (("atoms", "N atoms"), ("xlo", "xlo xhi"), ("ylo", "ylo yhi"))
-        if key not in header
-    ]
+    needed = (("atoms", "N atoms"), ("xlo", "xlo xhi"), ("ylo", "ylo yhi"))
+    missing = next((what for key, what in needed if key not in header), None)
     if missing:
-        raise InputError(
-            f"{p} header",
-            f"no '{missing[0]}' line",
-            "a LAMMPS data file with 'N atoms', 'xlo xhi' and 'ylo yhi' lines",
-        )
+        allowed = "a LAMMPS data file with 'N atoms', 'xlo xhi' and 'ylo yhi' lines"
+        raise InputError(f"{p} header", f"no '{missing}' line", allowed)
     n, n_line = header["atoms"]
     if len(atoms) != n:
         where = f"{p} Atoms section (lines {atoms[0][0]}-{atoms[-1][0]})" if atoms else f"{p} Atoms section"
