@@ -48,13 +48,13 @@ def test_lammps_and_poro2d_agree_with_rolling_resistance(spec, tmp_path):
     """The same comparison with rolling friction 0.3 on disks and walls (LAMMPS' rolling sds)."""
     rolling = replace(spec, mu_r=np.full(spec.n, 0.3), walls=[replace(w, mu_r=0.3) for w in spec.walls])
     rolling.dt = 0.75 * spec.dt  # the rolling springs lower the critical step (ROLLING_STIFFNESS_FACTOR)
-    r = compare(rolling, ratio=1e-9, workdir=tmp_path / "rolling")
+    r = compare(RestCase(rolling, ratio=1e-9), workdir=tmp_path / "rolling")
     assert r.poro2d.converged and r.lammps.converged
     for key in ("f_top_n_per_m", "f_bottom_n_per_m", "mean_contact_force_n"):
         assert r.rel_diff[key] < 1e-3, key  # measured: 1e-6 and below
     assert r.rel_to_weight["side_friction_up_n_per_m"] < 1e-4
     assert abs(r.lammps.contacts - r.poro2d.contacts) <= 1
     # rolling resistance changes the plate force by far more than the two engines differ
-    plain = compare(replace(rolling, mu_r=None), ratio=1e-9, workdir=tmp_path / "plain")
+    plain = compare(RestCase(replace(rolling, mu_r=None), ratio=1e-9), workdir=tmp_path / "plain")
     change = abs(plain.poro2d.f_top_n_per_m / r.poro2d.f_top_n_per_m - 1.0)
     assert change > 100 * r.rel_diff["f_top_n_per_m"], change
