@@ -96,11 +96,10 @@ def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:
         raise InputError(str(disks_path), "no disks", "at least one disk row below the header")
     _check_ids(disks_path, drows)
     a = np.array([[read_number(disks_path, k, c, v) for c, v in enumerate(r[1:], start=2)] for k, r in drows])
-    walls = []
-    for k, r in wrows:
-        walls.append(
-            WallData(r[0], *(read_number(walls_path, k, c, v) for c, v in enumerate(r[1:], start=2)))
-        )
+    walls = [
+        WallData(r[0], *(read_number(walls_path, k, c, v) for c, v in enumerate(r[1:], start=2)))
+        for k, r in wrows
+    ]
     if rolled:
         _check_rolling(disks_path, drows, a[:, 7], walls_path, wrows, [w.mu_r for w in walls])
     t = _setting(notes, "thickness", 1)
@@ -149,11 +148,9 @@ def _locator(disks_path: Path, walls_path: Path, drows, wrows, notes: dict):
             if key in notes:
                 file, line, _ = notes[key]
                 return f"{file} line {line} column {column} ({quantity})"
-            return (
-                "--thickness"
-                if quantity == "thickness"
-                else f"{quantity} (not in {disks_path.name}: Table 1)"
-            )
+            if quantity == "thickness":
+                return "--thickness"
+            return f"{quantity} (not in {disks_path.name}: Table 1)"
         if quantity == "walls":
             return str(walls_path)
         return f"{disks_path} ({quantity})"
@@ -169,12 +166,11 @@ def _check_ids(path: Path, rows: list[tuple[int, list[str]]]) -> None:
             ident = int(r[0])
         except ValueError:
             ident = 0
+        where = f"{path} line {k} column 1 (id)"
         if ident < 1:
-            raise InputError(f"{path} line {k} column 1 (id)", r[0], "a whole number >= 1")
+            raise InputError(where, r[0], "a whole number >= 1")
         if ident in seen:
-            raise InputError(
-                f"{path} line {k} column 1 (id)", r[0], f"an id of its own (line {seen[ident]} has it)"
-            )
+            raise InputError(where, r[0], f"an id of its own (line {seen[ident]} has it)")
         seen[ident] = k
 
 
