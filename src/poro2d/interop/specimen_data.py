@@ -329,12 +329,8 @@ def _from_records(disks: dict, walls: dict, wall_names: list[str], **settings) -
 
 
 def accepted_window(checkpoint_path: Path) -> float | None:
-    """The force window of the criterion run whose folder holds the checkpoint, if any.
-
-    A criterion folder (or a replicate's) has ``result.json`` beside ``specimen.npz``; its
-    ``settings.force_fraction`` is the window the specimen was accepted with (1 % in the
-    paper, 5 % for ``paper --quick``). None for a checkpoint without one.
-    """
+    """The window the specimen was accepted with (its criterion's ``result.json``, beside it, says
+    ``settings.force_fraction``: 1 % in the paper, 5 % for ``paper --quick``), None if none says."""
     result = Store(Path(checkpoint_path).parent).read_json("result.json")
     value = number_at(result, "settings", "force_fraction")
     return value if value is not None and 0.0 < value <= 1.0 else None
