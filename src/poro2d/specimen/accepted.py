@@ -120,7 +120,7 @@ def check_accepted(path: str | os.PathLike) -> None:
     when it says ``converged = false`` or lists no accepted trial, the specimen must not
     leave as if valid. A trial's checkpoint has ``trial.json`` beside it, which must say
     ``accepted = true``; an import's folder ``check.json``, which must say ``passes = true``
-    (the specimen failed the criterion's check as it stood). A checkpoint with none of them
+    (false: the specimen failed the criterion's check as it stood). A checkpoint with none of them
     beside it (a shear test's) is taken as it is.
     """
     p = Path(path)
