@@ -37,7 +37,7 @@ from poro2d import __version__
 from poro2d.dem.state import BOX_WALLS
 from poro2d.errors import InputError
 from poro2d.interop.csv_table import read_number
-from poro2d.interop.specimen_data import SpecimenData, WallData
+from poro2d.interop.specimen_data import SpecimenData, WallData, exact
 from poro2d.interop.validate import LIMITS, Limit, check_value, text_of
 from poro2d.io_utils import write_texts
 
@@ -512,16 +512,15 @@ def export_files(
     notes = [
         *spec.header("#"),
         f"# poro2d thickness {spec.thickness!r}",
-        f"# poro2d disk_properties {float(spec.density[0])!r} {float(spec.kn[0])!r} "
-        f"{float(spec.ks[0])!r} {float(spec.mu[0])!r}",
+        f"# poro2d disk_properties {exact(a[0] for a in (spec.density, spec.kn, spec.ks, spec.mu))}",
         f"# poro2d settings {spec.gravity[0]!r} {spec.gravity[1]!r} {spec.local_damping!r} {spec.dt!r}",
-        *(_wall_note(w) for w in spec.walls),
+        *(f"# poro2d wall {w.name} {exact(w.numbers)}" for w in spec.walls),
         *([f"# poro2d window {spec.force_fraction!r}"] if spec.force_fraction is not None else []),
         f"# pair contact kn ks mu: {params.disks.kn!r} {params.disks.ks!r} {params.disks.mu!r}",
     ]
     if params.disks.mu_r > 0.0:  # the disks', then each wall's, in wall-line order
         values = [params.disks.mu_r, *(w.mu_r for w in spec.walls)]
-        notes.append("# poro2d rolling_friction " + " ".join(repr(float(v)) for v in values))
+        notes.append("# poro2d rolling_friction " + exact(values))
     data = data_text(
         spec.x, spec.y, spec.radius, spec.density, spec.thickness, box, margin=float(spec.radius.max()),
         title=f"poro2d {__version__} specimen (atom_style sphere)", comments=notes,
@@ -533,11 +532,6 @@ def write_specimen(spec: SpecimenData, out: str | os.PathLike, ratio: float = 1e
                    max_steps: int = 2_000_000, check_every: int = 500) -> list[Path]:  # fmt: skip
     """Write the files of :func:`export_files` into ``out`` (each atomically); returns their paths."""
     return write_texts(out, export_files(spec, ratio, max_steps, check_every))
-
-
-def _wall_note(w: WallData) -> str:
-    vals = " ".join(repr(float(v)) for v in w.numbers)
-    return f"# poro2d wall {w.name} {vals}"
 
 
 def read_specimen(path: str | os.PathLike, defaults: dict) -> SpecimenData:

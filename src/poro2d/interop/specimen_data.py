@@ -245,6 +245,11 @@ class SpecimenData:
         )  # fmt: skip
 
 
+def exact(values, sep: str = " ") -> str:
+    """Numbers as the exported files write them: ``repr`` of each float, which reads back the same."""
+    return sep.join(repr(float(v)) for v in values)
+
+
 def resolve_specimen(path: str | os.PathLike) -> Path:
     """A checkpoint file, or a folder holding ``specimen.npz`` (a criterion or paper output)."""
     p = Path(path)

@@ -29,7 +29,7 @@ import os
 from pathlib import Path
 
 from poro2d.errors import InputError
-from poro2d.interop.specimen_data import SpecimenData
+from poro2d.interop.specimen_data import SpecimenData, exact
 from poro2d.io_utils import write_texts
 
 SCRIPT_FILE = "specimen_yade.py"
@@ -248,12 +248,12 @@ def script(
         "",
         "# x, y, radius, density, kn, ks, mu (per body, PFC 4.0)",
         "DISKS = [",
-        *(f"    ({', '.join(repr(float(v)) for v in d)})," for d in disks),
+        *(f"    ({exact(d, ', ')})," for d in disks),
         "]",
         "",
         "# name, x0, y0, x1, y1, kn, ks, mu (the specimen lies to the left going from (x0, y0) to (x1, y1))",
         "WALLS = [",
-        *(f"    ({w.name!r}, {', '.join(repr(float(v)) for v in w.numbers)})," for w in spec.walls),
+        *(f"    ({w.name!r}, {exact(w.numbers, ', ')})," for w in spec.walls),
         "]",
     ]
     if not spec.rolled:
