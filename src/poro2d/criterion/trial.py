@@ -190,7 +190,8 @@ class Trial(Record, TypedResult):
 
     ``ROW`` is the row a trial records, its parts in place: the wall forces as prepared and
     after the plate stage under their own keys, ``overfull_m`` only when the box was
-    over-full, ``accepted_at`` only for a trial accepted when the bracket closed. A trial is the
+    over-full, ``balance_steps`` only for a specimen cycled further to balance, ``accepted_at`` only
+    for a trial accepted when the bracket closed. A trial is the
     typed result of its file (``trial.json``), and so a part of the criterion's result; keys of
     a row read back that it does not model are kept in ``extra``.
     """
@@ -205,10 +206,11 @@ class Trial(Record, TypedResult):
         ("f_top_after_n_per_m", "forces_after.f_top_n_per_m"),
         ("f_bottom_after_n_per_m", "forces_after.f_bottom_n_per_m"),
         ("side_friction_up_after_n_per_m", "forces_after.side_friction_up_n_per_m"),
-        "porosity_change", Spliced("check_numbers"), Spliced("porosity"), "checks", Spliced("decision"),
+        "porosity_change", Spliced("check_numbers"), Spliced("porosity"), "checks", "balance_steps",
+        Spliced("decision"),
         "time_prepare_s", "time_plate_s", ("accepted_at", "decision.accepted_at"),
     )  # fmt: skip
-    OMITTED = {"overfull_m": 0.0, "accepted_at": None}
+    OMITTED = {"overfull_m": 0.0, "accepted_at": None, "balance_steps": None}
 
     iteration: int
     trial_porosity: float
@@ -229,6 +231,8 @@ class Trial(Record, TypedResult):
     overfull_m: float = 0.0
     failure: StageFailure | None = None
     porosity: PorosityNumbers | None = None
+    #: the steps a specimen just out of balance was cycled further (None: it was not)
+    balance_steps: int | None = None
     time_prepare_s: float | None = None
     time_plate_s: float | None = None
     preparation: Preparation | None = field(default=None, repr=False)
@@ -280,6 +284,7 @@ class Trial(Record, TypedResult):
             overfull_m=row.get("overfull_m") or 0.0,
             failure=StageFailure.from_row(row),
             porosity=PorosityNumbers.from_row(dict(row)),
+            balance_steps=row.get("balance_steps"),
             time_prepare_s=row.get("time_prepare_s"),
             time_plate_s=row.get("time_plate_s"),
         )
