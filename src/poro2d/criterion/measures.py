@@ -19,18 +19,7 @@ from poro2d.errors import InputError
 from poro2d.record import Record
 
 if TYPE_CHECKING:
-    from poro2d.specimen.compaction import SpecimenSpec
-
-
-class Prepared(Protocol):
-    """What the checks read of a trial's preparation (:class:`~poro2d.criterion.trial.Preparation`)."""
-
-    @property
-    def planned_count(self) -> int: ...
-    @property
-    def measured_porosity(self) -> float: ...
-    @property
-    def converged(self) -> bool: ...
+    from poro2d.specimen.compaction import PreparationReport, SpecimenSpec
 
 
 class CheckTolerances(Protocol):
@@ -150,7 +139,7 @@ class SpecimenChecks(NamedTuple):
 def specimen_checks(
     sim: Simulation,
     spec: SpecimenSpec,
-    prep: Prepared,
+    prep: PreparationReport,
     trial: float,
     plate_height: float | np.ndarray,
     forces: WallForces,

@@ -60,7 +60,7 @@ from poro2d.criterion.outputs import write_accepted
 from poro2d.criterion.result import CriterionResult
 from poro2d.criterion.servo import PlateServo, in_window, rises_free_to_roll
 from poro2d.criterion.settings import CriterionSettings, round_to
-from poro2d.criterion.trial import Decision, PlateStage, Preparation, StageFailure, Trial, trial_name
+from poro2d.criterion.trial import Decision, PlateStage, StageFailure, Trial, trial_name
 from poro2d.dem import Simulation
 from poro2d.errors import InputError
 from poro2d.grading import GradingCurve
@@ -68,7 +68,13 @@ from poro2d.io_utils import Provenance
 from poro2d.measure.disks import mass_d50
 from poro2d.measure.porosity import box_porosity
 from poro2d.measure.surface import lid_height_at
-from poro2d.specimen.compaction import PreparationReport, SpecimenSpec, preparation_note, prepare_specimen
+from poro2d.specimen.compaction import (
+    PreparationReport,
+    SpecimenSpec,
+    densest_porosity,
+    preparation_note,
+    prepare_specimen,
+)
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
 
@@ -166,14 +172,20 @@ def thrown_out(exc: InputError) -> bool:
     return exc.parameter.startswith("disk ") and exc.parameter.endswith(" position")
 
 
-def thrown_out_note(exc: InputError, n: float) -> str:
-    """Why a trial whose disk left the box is refused: the physical cause, and the fix."""
+def thrown_out_note(exc: InputError, n: float, n_j: float | None) -> str:
+    """Why a trial whose disk left the box is refused: the physical cause, and the fix.
+
+    ``n_j``: the grading's frictionless jamming porosity
+    (:func:`~poro2d.specimen.compaction.densest_porosity`), None when no estimate could be made.
+    """
     disk = exc.parameter.removesuffix(" position")
+    jams = "what this grading jams at" if n_j is None else f"this grading's jamming porosity n_J = {n_j:.3f}"
+    start = "at or above it" if n_j is None else f"at {math.ceil(n_j * 100) / 100:.2f} or above"
     return (
         f"{disk} was thrown out of place while the layers were compacted ({exc.hint or exc.allowed}; at "
-        f"{exc.value} m): the overlaps of a layer grown denser than the grading packs exploded. The trial "
-        f"n2D = {n:.4f} is below what this grading jams at (its jamming porosity: poro2d sand --preflight); "
-        "start looser: [criterion] trial_porosity (--trial-porosity) at or above it, or check n_lab"
+        f"{exc.value} m): the overlaps of a layer grown denser than the grading packs exploded, the trial "
+        f"n2D = {n:.4f} being below {jams}; start looser: the criterion's trial_porosity "
+        f"(--trial-porosity) {start}, or check n_lab"
     )
 
 
@@ -321,7 +333,7 @@ class PorosityCriterion:
     def _trial_store(self, k: int, n: float) -> Store | None:
         return None if self.store is None else self.store.child(trial_name(k, n))
 
-    def _prepare(self, k: int, n: float) -> tuple[Simulation, Preparation]:
+    def _prepare(self, k: int, n: float) -> tuple[Simulation, PreparationReport]:
         """Trial ``k``'s specimen and its preparation: built, or read back once saved."""
         folder = self._trial_store(k, n)
         if folder is None:
@@ -329,18 +341,18 @@ class PorosityCriterion:
         built: list[Simulation] = []
 
         def compute() -> PreparationReport:
-            sim, prep = self._build(n)
+            sim, report = self._build(n)
             folder.save_state("prepared.npz", sim, extra={"stage": "prepared", "trial_porosity": n})
             built.append(sim)
-            return prep.report
+            return report
 
         report = self.stage().run(compute, f"{trial_name(k, n)}/prepared.json",
                                   accept=lambda _: folder.has("prepared.npz"),
                                   decode=PreparationReport.from_dict)  # fmt: skip
         sim = built[0] if built else folder.load_state("prepared.npz", threads=self.spec.threads)
-        return sim, Preparation(report)
+        return sim, report
 
-    def _build(self, n: float) -> tuple[Simulation, Preparation]:
+    def _build(self, n: float) -> tuple[Simulation, PreparationReport]:
         """A specimen at trial porosity ``n``, with its report (seed, time, weight, wall forces)."""
         t0 = time.perf_counter()
         # the same seed per trial porosity: a rerun of a trial rebuilds the same specimen
@@ -349,7 +361,7 @@ class PorosityCriterion:
         weight = self.spec.self_weight(n)
         rep = replace(rep, seed=seed, time_s=time.perf_counter() - t0, weight_n_per_m=weight,
                       **wall_forces(sim).to_dict())  # fmt: skip
-        return sim, Preparation(rep)
+        return sim, rep
 
     def plate_servo(self) -> PlateServo:
         """The plate (and lid) servo of step 3, with this run's settings and equilibrium."""
@@ -368,7 +380,8 @@ class PorosityCriterion:
         s = self.settings
         t0 = time.perf_counter()
         sim, prep = self._prepare(k, n)
-        t_prep = prep.report.time_s if prep.report.time_s is not None else time.perf_counter() - t0
+        t_prep = prep.time_s if prep.time_s is not None else time.perf_counter() - t0
+        overfull = float(prep.overfull_m or 0.0)  # how far the specimen stood above H
         weight = self.spec.self_weight(n)
         forces0 = wall_forces(sim)
         t1 = time.perf_counter()
@@ -376,18 +389,18 @@ class PorosityCriterion:
         if not prep.converged:
             # a half-built specimen: no plate stage, no n'; refused below
             plate = PlateStage("not run", None, displacement_m=0.0)
-            failure = prep.failure(self.spec.equilibrium)
+            failure = StageFailure.of_preparation(prep, self.spec.equilibrium)
             after = forces0
         elif (
             s.acceptance == "plate"
-            and prep.overfull_m == 0.0
+            and overfull == 0.0
             and in_window(forces0.f_top_n_per_m, weight, s.force_fraction)
         ):
             # an over-full box has its plate above H: n' is measured where the plate settles
             plate = PlateStage("no", n, settled=True, displacement_m=0.0)
             after = forces0
         else:
-            plate, after = self._top_stage(sim, k, n, weight, forces0.f_top_n_per_m, prep.overfull_m > 0.0)
+            plate, after = self._top_stage(sim, k, n, weight, forces0.f_top_n_per_m, overfull > 0.0)
             if not plate.is_settled:
                 assert plate.servo is not None
                 failure = StageFailure("top plate", plate.servo.final_max_ratio, plate.servo.steps)
@@ -420,18 +433,17 @@ class PorosityCriterion:
             checks=checks,
             balance_steps=balance_steps,
             decision=Decision(False, "", False, False, ""),
-            overfull_m=prep.overfull_m,
+            overfull_m=overfull,
             failure=failure,
             porosity=porosity,
             time_prepare_s=t_prep,
-            preparation=prep,
         )
         trial.decision = decide(trial, s)
         trial.time_plate_s = time.perf_counter() - t1
         return trial
 
     def _cycle_to_balance(
-        self, sim: Simulation, k: int, n: float, prep: Preparation
+        self, sim: Simulation, k: int, n: float, prep: PreparationReport
     ) -> tuple[int, WallForces, Checks, CheckNumbers]:
         """Cycle a specimen just out of balance further, the walls held, until it balances or
         :func:`balance_budget` is spent; the steps, wall forces, checks and numbers then.
@@ -553,7 +565,8 @@ class PorosityCriterion:
                 if not thrown_out(exc):
                     raise
                 failed_trial = k
-                message = f"trial {k} (n2D = {n:.4f}) refused: {thrown_out_note(exc, n)}"
+                note = thrown_out_note(exc, n, densest_porosity(self.grading))
+                message = f"trial {k} (n2D = {n:.4f}) refused: {note}"
                 break
             trials.append(trial)
             self._write_table(trials)

@@ -1,10 +1,10 @@
 """One trial of Fig. 3 as a typed record made of its parts.
 
-A trial is its preparation (:class:`Preparation`, what ``prepared.json`` holds), the wall
-forces as prepared, its plate (or lid) stage (:class:`PlateStage`), the stage that did not
-reach equilibrium if one did not (:class:`StageFailure`), the wall forces after the plate
-stage, the checks and the numbers behind them, the porosities of its decision state and
-the decision itself (:class:`Decision`).
+A trial is what its preparation built (``prepared.json``), the wall forces as prepared, its
+plate (or lid) stage (:class:`PlateStage`), the stage that did not reach equilibrium if one
+did not (:class:`StageFailure`), the wall forces after the plate stage, the checks and the
+numbers behind them, the porosities of its decision state and the decision itself
+(:class:`Decision`).
 
 The files keep the row a trial always had: :meth:`Trial.to_dict` gives the keys of
 ``trial.json`` (and of a trial of ``result.json``) in their order, with the values as they
@@ -34,49 +34,6 @@ def trial_name(k: int, n: float) -> str:
 
 
 @dataclass(frozen=True)
-class Preparation:
-    """A trial's specimen as prepared: its preparation's report (``prepared.json``).
-
-    ``report`` is the report of :func:`poro2d.specimen.compaction.prepare_specimen` with the
-    trial's seed, time, self weight and wall forces: the file's content, typed.
-    """
-
-    report: PreparationReport
-
-    @property
-    def particle_count(self) -> int:
-        return self.report.particle_count
-
-    @property
-    def planned_count(self) -> int:
-        return self.report.planned_count
-
-    @property
-    def measured_porosity(self) -> float:
-        return self.report.measured_porosity
-
-    @property
-    def converged(self) -> bool:
-        return self.report.converged
-
-    @property
-    def overfull_m(self) -> float:
-        """How far the specimen stood above H (0 unless the layers did not fit below it)."""
-        return float(self.report.overfull_m or 0.0)
-
-    @property
-    def time_s(self) -> float | None:
-        return self.report.time_s
-
-    def failure(self, equilibrium: str) -> StageFailure:
-        """The stage of a preparation that did not reach equilibrium (``equilibrium``: its measure)."""
-        r = self.report
-        # a report of an older file lacks failed_ratio
-        ratio = r.failed_ratio if "failed_ratio" in r.to_dict() else r.failed_max_ratio
-        return StageFailure(r.failed_stage, r.failed_max_ratio, r.failed_steps, ratio, equilibrium)
-
-
-@dataclass(frozen=True)
 class StageFailure(Record):
     """A stage that did not reach equilibrium: the preparation's or the top plate's.
 
@@ -95,6 +52,13 @@ class StageFailure(Record):
 
     def layout(self) -> tuple:
         return self.ROW if self.equilibrium is not None else self.ROW[:3]
+
+    @classmethod
+    def of_preparation(cls, report: PreparationReport, equilibrium: str) -> StageFailure:
+        """The stage of a preparation that did not reach equilibrium (``equilibrium``: its measure)."""
+        # a report of an older file lacks failed_ratio
+        ratio = report.failed_ratio if "failed_ratio" in report.to_dict() else report.failed_max_ratio
+        return cls(report.failed_stage, report.failed_max_ratio, report.failed_steps, ratio, equilibrium)
 
     @classmethod
     def from_row(cls, row: Mapping[str, Any]) -> StageFailure | None:
@@ -184,16 +148,12 @@ DECISION_KEYS = ("condition_met", "failed_check", "accepted", "refused", "reason
 class Trial(Record, TypedResult):
     """One trial of Fig. 3, made of its parts; its row (:meth:`to_dict`) is what files keep of it.
 
-    ``preparation`` is the prepared specimen's report for a trial run now, None for a trial
-    read back from its row (the row keeps what the trial uses of it: counts, porosity,
-    whether it converged and how far the box was over-full).
-
-    ``ROW`` is the row a trial records, its parts in place: the wall forces as prepared and
-    after the plate stage under their own keys, ``overfull_m`` only when the box was
-    over-full, ``balance_steps`` only for a specimen cycled further to balance, ``accepted_at`` only
-    for a trial accepted when the bracket closed. A trial is the
-    typed result of its file (``trial.json``), and so a part of the criterion's result; keys of
-    a row read back that it does not model are kept in ``extra``.
+    ``ROW`` is the row a trial records, its parts in place: the counts, porosity and convergence
+    of its preparation, the wall forces as prepared and after the plate stage under their own
+    keys, ``overfull_m`` only when the box was over-full, ``balance_steps`` only for a specimen
+    cycled further to balance, ``accepted_at`` only for a trial accepted when the bracket closed.
+    A trial is the typed result of its file (``trial.json``), and so a part of the criterion's
+    result; keys of a row read back that it does not model are kept in ``extra``.
     """
 
     ROW = (
@@ -235,7 +195,6 @@ class Trial(Record, TypedResult):
     balance_steps: int | None = None
     time_prepare_s: float | None = None
     time_plate_s: float | None = None
-    preparation: Preparation | None = field(default=None, repr=False)
     #: the key order of a row read back
     order: tuple[str, ...] | None = field(default=None, repr=False)
 
@@ -297,4 +256,4 @@ class Trial(Record, TypedResult):
         return trial
 
 
-__all__ = ["Decision", "PlateStage", "Preparation", "StageFailure", "Trial", "trial_name"]
+__all__ = ["Decision", "PlateStage", "StageFailure", "Trial", "trial_name"]
