@@ -9,24 +9,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, NamedTuple, Protocol
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
 from poro2d.criterion.lid import lid_force, lid_indices
+from poro2d.criterion.settings import CriterionSettings
 from poro2d.dem import Simulation
 from poro2d.errors import InputError
 from poro2d.record import Record
 
 if TYPE_CHECKING:
     from poro2d.specimen.compaction import PreparationReport, SpecimenSpec
-
-
-class CheckTolerances(Protocol):
-    """The tolerances of the checks (``CriterionSettings`` has them)."""
-
-    generation_tolerance: float
-    balance_tolerance: float
 
 
 @dataclass(frozen=True)
@@ -143,7 +137,7 @@ def specimen_checks(
     trial: float,
     plate_height: float | np.ndarray,
     forces: WallForces,
-    settings: CheckTolerances,
+    settings: CriterionSettings,
 ) -> SpecimenChecks:
     """The checks a trial must pass to be accepted, and the numbers behind them.
 

@@ -136,11 +136,10 @@ class Decision(Record):
 
     @classmethod
     def from_row(cls, row: Mapping[str, Any]) -> Decision:
-        return cls(row.get("condition_met"), row.get("failed_check"), row.get("accepted"), row.get("refused"),
-                   row.get("reason"), row.get("accepted_at"))  # fmt: skip
+        return cls(*(row.get(k) for k in DECISION_KEYS))
 
 
-#: the keys of a row that the decision sets
+#: the keys of a row that the decision sets (its fields, in order)
 DECISION_KEYS = ("condition_met", "failed_check", "accepted", "refused", "reason", "accepted_at")
 
 
@@ -223,29 +222,19 @@ class Trial(Record, TypedResult):
     @classmethod
     def from_dict(cls, row: Mapping[str, Any]) -> Trial:
         """A trial from its row (``trial.json``, a trial of ``result.json``, or :meth:`to_dict`)."""
+        # the row's own values: ROW's plain keys, but for the two read with a default or a type
+        plain = {k: row.get(k) for k in cls.ROW if isinstance(k, str) and k not in ("overfull_m", "checks")}
         trial = cls(
-            iteration=row.get("iteration"),
-            trial_porosity=row.get("trial_porosity"),
-            particle_count=row.get("particle_count"),
-            planned_particle_count=row.get("planned_particle_count"),
-            measured_porosity_after_generation=row.get("measured_porosity_after_generation"),
+            **plain,
             forces=WallForces.from_row(dict(row)),
-            self_weight_n_per_m=row.get("self_weight_n_per_m"),
-            force_limit_n_per_m=row.get("force_limit_n_per_m"),
-            preparation_converged=row.get("preparation_converged"),
-            converged=row.get("converged"),
             plate=PlateStage.from_row(row),
             forces_after=WallForces.from_row(dict(row), "_after"),
-            porosity_change=row.get("porosity_change"),
             check_numbers=CheckNumbers.from_dict(dict(row)),
             checks=Checks(**{f.name: (row.get("checks") or {}).get(f.name) for f in fields(Checks)}),
             decision=Decision.from_row(row),
             overfull_m=row.get("overfull_m") or 0.0,
             failure=StageFailure.from_row(row),
             porosity=PorosityNumbers.from_row(dict(row)),
-            balance_steps=row.get("balance_steps"),
-            time_prepare_s=row.get("time_prepare_s"),
-            time_plate_s=row.get("time_plate_s"),
         )
         modelled = Record.to_dict(trial)
         trial.extra = {k: v for k, v in row.items() if k not in modelled}

@@ -23,7 +23,7 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -142,34 +142,18 @@ def full_box_trial(target: float, dense_end: float | None, cal_dense: float, pf:
     return target - excess * (1.0 - ratio)
 
 
-@dataclass(frozen=True)
-class FirstTrialShifts:
-    """What moves the calibration's first trials: the grading's jamming porosity (the dense
-    end), the box's walls' share and the loose bias (:func:`poro2d.sweep.density.calibrate`)."""
-
-    dense_end: float | None
-    walls: float
-    loose_bias: float
-
-
-def _first_trial_shifts(pf: Preflight) -> FirstTrialShifts:
+def calibration_case(case: SandCase, pf: Preflight, mus: list[float]) -> D.CalibrationCase:
+    """The calibration at ``mus``, the loosest cases first (its case ids name their folders in the
+    cache). Its first trials move with the grading's jamming porosity (the dense end), the
+    calibration box's walls' share and the loose bias (:func:`poro2d.sweep.density.calibrate`)."""
     box = pf.calibration_box
-    return FirstTrialShifts(pf.jamming.porosity, D.wall_share(box.width, box.height, pf.d50_m), LOOSE_BIAS)
-
-
-def calibration_cases(case: SandCase, pf: Preflight, mus: list[float]) -> list:
-    """The calibration's cases at ``mus`` (their ids name their folders in the cache)."""
-    return _calibration_case(case, pf, mus).sweep.cases
-
-
-def _calibration_case(case: SandCase, pf: Preflight, mus: list[float], loosest_first: bool = False):
-    base, shifts = calibration_config(case, pf), asdict(_first_trial_shifts(pf))
-    return D.CalibrationCase(base, tuple(mus), case.calibration_seeds, **shifts, loosest_first=loosest_first)
+    walls = D.wall_share(box.width, box.height, pf.d50_m)
+    return D.CalibrationCase(calibration_config(case, pf), tuple(mus), case.calibration_seeds,
+                             pf.jamming.porosity, walls, LOOSE_BIAS, loosest_first=True)  # fmt: skip
 
 
 def _calibrate(case, pf, store: Store, mus, record, cal_kw) -> tuple[Calibration, CalibrationRun]:
-    calibration = _calibration_case(case, pf, mus, loosest_first=True)
-    return D.calibrate(calibration, store, record=record, **cal_kw)
+    return D.calibrate(calibration_case(case, pf, mus), store, record=record, **cal_kw)
 
 
 def calibration_stage(
@@ -379,7 +363,7 @@ def _run_sand(case, pf, store, options, use_cache, announce, on_preflight) -> Sa
     rows = specimen_stage(case, replace(target, n2d_target=trial), store, options, announce)
     clock.end("specimens", t)
     kept = keep_specimens(rows, store, _state_label(case), case.soil_record(), case.lab.to_dict())
-    cal_ids = [c.id for c in calibration_cases(case, pf, [float(m) for m in cal_record.mus])]
+    cal_ids = [c.id for c in calibration_case(case, pf, [float(m) for m in cal_record.mus]).sweep.cases]
     runs = [c.child("run") for c in walk(store.child("states", "cases"), "*")]
     cal_record = replace(
         cal_record,
