@@ -14,13 +14,13 @@ console = OutputConsole()
 
 def print_preflight(case, pf) -> None:
     """The pre-flight table, printed before any DEM work."""
-    lab = case.lab
+    from poro2d.sand.result import lab_text
+
     t = Table(title=f"pre-flight: {shown(case.name)}")
     t.add_column("quantity")
     t.add_column("value", justify="right")
-    dr = "" if lab.relative_density is None else f", Dr = {lab.relative_density:.3f}"
     rows = [
-        ("laboratory state", f"n = {lab.n_lab:.4f}, e = {lab.e:.4f}{dr} (given as {lab.given})"),
+        ("laboratory state", lab_text(case.lab)),
         (
             "grading",
             f"d {pf.d_min_m * 1e3:.3g}-{pf.d_max_m * 1e3:.3g} mm in the model (x{pf.upscale:g}), "
@@ -70,11 +70,9 @@ def print_preflight(case, pf) -> None:
 
 def print_result(res, out: Path) -> None:
     """The answer: the interior porosity first, then n', the friction, every seed."""
-    from poro2d.sand.result import mean_sd_text, used_seeds, warnings
+    from poro2d.sand.result import mean_sd_text, state_text, used_seeds, warnings
 
-    st = res.state
-    dr = st.relative_density
-    head = f"{res.soil.name} at nLab = {st.n_lab:.4f}" + (f" (Dr = {dr:.3f})" if dr is not None else "")
+    head = f"{res.soil.name} at {state_text(res.state)}"
     if res.interior_porosity_mean is not None:  # None: no seed accepted (as sand.json keeps NaN)
         console.print(
             f"[bold]interior porosity {res.interior_porosity_mean:.4f} +- {res.interior_porosity_sd:.4f}[/] "

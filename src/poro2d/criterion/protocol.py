@@ -408,8 +408,10 @@ class PorosityCriterion:
         checks, numbers = specimen_checks(sim, self.spec, prep, n, self._top_at_disks(sim), after, s)
         # the plate stage is part of the record: False when it did not settle or never ran
         checks = replace(checks, plate_settled=plate.is_settled)
+        change = None if plate.new_porosity is None else abs(plate.new_porosity - n)
         balance_steps = None
-        if just_out_of_balance(checks, numbers, s):
+        # only where the balance decides: a trial whose n' is off is rejected whatever it says
+        if change is not None and change < s.porosity_tolerance and just_out_of_balance(checks, numbers, s):
             balance_steps, after, checks, numbers = self._cycle_to_balance(sim, k, n, prep)
         porosity = None
         if converged:
@@ -428,7 +430,7 @@ class PorosityCriterion:
             converged=converged,
             plate=plate,
             forces_after=after,
-            porosity_change=None if plate.new_porosity is None else abs(plate.new_porosity - n),
+            porosity_change=change,
             check_numbers=numbers,
             checks=checks,
             balance_steps=balance_steps,

@@ -246,6 +246,18 @@ class SandResult(TypedResult):
         )
 
 
+def state_text(st: LabState) -> str:
+    """The laboratory state in a title: ``nLab = 0.4023 (Dr = 0.800)``."""
+    dr = st.relative_density
+    return f"nLab = {st.n_lab:.4f}" + (f" (Dr = {dr:.3f})" if dr is not None else "")
+
+
+def lab_text(st: LabState) -> str:
+    """The laboratory state in full: n, e, Dr when known, and how it was given."""
+    dr = "" if st.relative_density is None else f", Dr = {st.relative_density:.3f}"
+    return f"n = {st.n_lab:.4f}, e = {st.e:.4f}{dr} (given as {st.given})"
+
+
 def mean_sd_text(mean: float | None, sd: float | None) -> str:
     """``mean +- sd``, or n/a without a number (None, as a file keeps NaN)."""
     return "n/a" if mean is None or not math.isfinite(mean) else f"{mean:.4f} +- {sd or 0.0:.4f}"
@@ -302,11 +314,9 @@ def summary_markdown(res: SandResult, store: Store) -> str:
     (the export commands name the store's folder)."""
     out = store.root
     st, soil = res.state, res.soil
-    dr = st.relative_density
     jam = res.jamming_porosity
     lines = [
-        f"# {soil.name}: 2D porosity at nLab = {st.n_lab:.4f}"
-        + (f" (Dr = {dr:.3f})" if dr is not None else ""),
+        f"# {soil.name}: 2D porosity at {state_text(st)}",
         "",
         "**Interior porosity (use this in other codes): "
         f"{mean_sd_text(res.interior_porosity_mean, res.interior_porosity_sd)}**"
@@ -317,9 +327,7 @@ def summary_markdown(res: SandResult, store: Store) -> str:
         f"| soil | {soil.name} ({soil.reference or 'no reference given'}) |",
         f"| grading | {soil.grading_source}, up-scaled x{soil.upscale:g} |",
         f"| disks (full box) | {res.preflight.box.disks:.0f} |",
-        f"| laboratory state | n = {st.n_lab:.4f}, e = {st.e:.4f}"
-        + (f", Dr = {dr:.3f}" if dr is not None else "")
-        + f" (given as {st.given}) |",
+        f"| laboratory state | {lab_text(st)} |",
         f"| preparation friction mu_prep | {res.mu_prep:.3f} |",
         f"| interior porosity | {mean_sd_text(res.interior_porosity_mean, res.interior_porosity_sd)} |",
         f"| box porosity n' (under the lid) | {mean_sd_text(res.box_porosity_mean, res.box_porosity_sd)} |",
@@ -426,6 +434,8 @@ __all__ = [
     "replaced_seeds",
     "summary_markdown",
     "SummaryRow",
+    "lab_text",
+    "state_text",
     "used_seeds",
     "warnings",
     "write_summary",
