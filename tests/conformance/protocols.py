@@ -83,13 +83,13 @@ def _criterion(ctx: Context, store: Store | None):
 def _criterion_jobs(ctx: Context, store: Store):
     """The criterion runs as jobs where it has replicate seeds (its run alone has none)."""
     from poro2d.criterion import CriterionSettings
-    from poro2d.criterion.replicates import run_replicates
+    from poro2d.criterion.replicates import ReplicateCase, run_replicates
     from poro2d.specimen import paper_grading
     from poro2d.specimen.compaction import SpecimenSpec
 
     settings = CriterionSettings(force_fraction=0.05)
     spec = SpecimenSpec(**SMALL_BOX)
-    return run_replicates(spec, paper_grading(), settings, 0.21, [1, 2], store, options=QUIET)
+    return run_replicates(ReplicateCase(spec, paper_grading(), settings, 0.21, (1, 2)), store, options=QUIET)
 
 
 def _criterion_bad(ctx: Context, store: Store):

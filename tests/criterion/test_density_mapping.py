@@ -11,12 +11,11 @@ from poro2d.criterion.density import (
     Calibration,
     isotonic_increasing,
     lab_relative_density,
-    porosity_from_void_ratio,
     state_target,
     target_porosity_2d,
-    void_ratio,
 )
 from poro2d.errors import InputError
+from poro2d.porosity import porosity_from_void_ratio, void_ratio
 
 
 def test_paper_state_is_dense():

@@ -5,7 +5,7 @@ import pytest
 
 from poro2d.criterion import replicates
 from poro2d.criterion.protocol import CriterionSettings
-from poro2d.criterion.replicates import run_replicates
+from poro2d.criterion.replicates import ReplicateCase, run_replicates
 from poro2d.criterion.result import ReplicatesResult
 from poro2d.dem import checkpoint
 from poro2d.execute import RunOptions
@@ -18,16 +18,17 @@ SERIAL = RunOptions(workers=1, progress=False)
 
 SPEC = SpecimenSpec(width=0.05, height=0.025, layers=2, threads=2)
 SETTINGS = CriterionSettings(force_fraction=0.05)
+#: seeds 1 and 2 from n2D = 0.2
+CASE = ReplicateCase(SPEC, paper_grading(), SETTINGS, 0.2, (1, 2))
 
 
 def test_processes_give_the_specimens_of_a_serial_run(tmp_path, monkeypatch):
     """Two processes with one thread each build, seed for seed, the specimens of a serial run."""
-    seeds = [1, 2]
-    res = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, Store(tmp_path / "p"),
-                         options=RunOptions(progress=False))  # fmt: skip
+    seeds = list(CASE.seeds)
+    res = run_replicates(CASE, Store(tmp_path / "p"), options=RunOptions(progress=False))
     assert isinstance(res, ReplicatesResult)
     par, rows_par = res.specimens, res.rows
-    res = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, Store(tmp_path / "s"), options=SERIAL)
+    res = run_replicates(CASE, Store(tmp_path / "s"), options=SERIAL)
     ser, rows_ser = res.specimens, res.rows
     assert [r.seed for r in rows_par] == seeds and [r.folder for r in rows_par] == ["seed1", "seed2"]
     for a, b in zip(rows_par, rows_ser, strict=True):
@@ -39,6 +40,6 @@ def test_processes_give_the_specimens_of_a_serial_run(tmp_path, monkeypatch):
         np.testing.assert_array_equal(pa.radius, pb.radius)
     # a rerun reads every seed back from its folder, with no job run
     monkeypatch.setattr(replicates, "_run_one", lambda *_: pytest.fail("a finished seed ran again"))
-    res = run_replicates(SPEC, paper_grading(), SETTINGS, 0.2, seeds, Store(tmp_path / "p"), options=SERIAL)
+    res = run_replicates(CASE, Store(tmp_path / "p"), options=SERIAL)
     again, rows_again = res.specimens, res.rows
     assert again == par and [r.final_porosity for r in rows_again] == [r.final_porosity for r in rows_par]

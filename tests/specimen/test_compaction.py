@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from poro2d.criterion.protocol import CriterionSettings, specimen_checks, wall_forces
-from poro2d.criterion.trial import Preparation
 from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.specimen import GradingCurve, paper_grading
@@ -63,9 +62,7 @@ def test_dense_trial_loads_the_top_plate():
 
 def test_checks_hold_on_a_specimen_at_rest(loose):
     spec, sim, rep = loose
-    checks, nums = specimen_checks(
-        sim, spec, Preparation(rep), 0.22, spec.height, wall_forces(sim), CriterionSettings()
-    )
+    checks, nums = specimen_checks(sim, spec, rep, 0.22, spec.height, wall_forces(sim), CriterionSettings())
     assert checks.to_dict() == dict.fromkeys(checks.to_dict(), True) and len(checks.to_dict()) == 5
     # the weight the balance uses, against rho_s g pi r^2 summed over the radii (per metre of thickness)
     weight = spec.solid_density * spec.gravity * np.pi * float(np.sum(sim.particles.radius**2))
@@ -85,12 +82,12 @@ def test_checks_catch_a_falling_or_broken_specimen(loose, tmp_path):
     falling.run(10)
     lifted = spec.height + 0.01
     checks, nums = specimen_checks(
-        falling, spec, Preparation(rep), 0.22, lifted, wall_forces(falling), CriterionSettings()
+        falling, spec, rep, 0.22, lifted, wall_forces(falling), CriterionSettings()
     )
     assert not checks.force_balance and nums.force_balance_error > 0.5
     assert checks.disks_inside_box and checks.all_disks_present
     # a disk missing from the plan, a specimen built for another porosity, a disk through the plate
-    broken = Preparation(replace(rep, planned_count=rep.particle_count + 3))
+    broken = replace(rep, planned_count=rep.particle_count + 3)
     checks, nums = specimen_checks(
         sim, spec, broken, 0.22 + 2e-3, 0.8 * spec.height, wall_forces(sim), CriterionSettings()
     )

@@ -114,7 +114,7 @@ def preset_specimens(store: Store, *, quick: bool, seed: int, replicates: int, p
     """
     from poro2d.criterion.config import paper_config
     from poro2d.criterion.protocol import PorosityCriterion
-    from poro2d.criterion.replicates import run_replicates
+    from poro2d.criterion.replicates import ReplicateCase, run_replicates
 
     seed = check_int("--seed", seed, 0)
     cfg = paper_config(quick, seed)
@@ -135,13 +135,9 @@ def preset_specimens(store: Store, *, quick: bool, seed: int, replicates: int, p
         raise RuntimeError(f"the criterion of seed {seed} did not converge: {result.message}")
     specimens = SpecimenSet.made([(f"seed{seed}", out / "criterion" / "specimen.npz")])
     if replicates > 1:
-        extra = list(range(seed + 1, seed + replicates))
+        extra = tuple(range(seed + 1, seed + replicates))
         more = run_replicates(
-            spec,
-            grading,
-            settings,
-            result.final_porosity,
-            extra,
+            ReplicateCase(spec, grading, settings, result.final_porosity, extra),
             store.child("replicates"),
             options=RunOptions(workers=spec.threads, progress=progress),
         )

@@ -13,7 +13,7 @@ from pathlib import Path
 import typer
 
 from poro2d.cli import options as opt
-from poro2d.console import OutputConsole, Table
+from poro2d.console import OutputConsole, Table, shown
 from poro2d.criterion.table import print_result
 from poro2d.store import Store
 from poro2d.sweep.results import DensityStateResult
@@ -78,7 +78,7 @@ def register(app: typer.Typer) -> None:
         if not result.converged:
             # one line, whole: the reason names the trial, the stage or check, the ratio
             what = "failed" if result.failed_trial else "not converged"
-            console.print(f"[bold red]criterion {what}:[/] {result.message}", soft_wrap=True)
+            console.print(f"[bold red]criterion {what}:[/] {shown(result.message)}", soft_wrap=True)
             raise typer.Exit(1)
 
 

@@ -14,13 +14,13 @@ console = OutputConsole()
 
 def print_preflight(case, pf) -> None:
     """The pre-flight table, printed before any DEM work."""
-    lab = case.lab
+    from poro2d.sand.result import lab_text
+
     t = Table(title=f"pre-flight: {shown(case.name)}")
     t.add_column("quantity")
     t.add_column("value", justify="right")
-    dr = "" if lab.relative_density is None else f", Dr = {lab.relative_density:.3f}"
     rows = [
-        ("laboratory state", f"n = {lab.n_lab:.4f}, e = {lab.e:.4f}{dr} (given as {lab.given})"),
+        ("laboratory state", lab_text(case.lab)),
         (
             "grading",
             f"d {pf.d_min_m * 1e3:.3g}-{pf.d_max_m * 1e3:.3g} mm in the model (x{pf.upscale:g}), "
@@ -70,15 +70,13 @@ def print_preflight(case, pf) -> None:
 
 def print_result(res, out: Path) -> None:
     """The answer: the interior porosity first, then n', the friction, every seed."""
-    from poro2d.sand.result import mean_sd_text, warnings
+    from poro2d.sand.result import mean_sd_text, state_text, used_seeds, warnings
 
-    st = res.state
-    dr = st.relative_density
-    head = f"{res.soil.name} at nLab = {st.n_lab:.4f}" + (f" (Dr = {dr:.3f})" if dr is not None else "")
+    head = f"{res.soil.name} at {state_text(res.state)}"
     if res.interior_porosity_mean is not None:  # None: no seed accepted (as sand.json keeps NaN)
         console.print(
             f"[bold]interior porosity {res.interior_porosity_mean:.4f} +- {res.interior_porosity_sd:.4f}[/] "
-            f"({res.seeds_accepted} of {res.seeds} seeds): the 2D porosity of {shown(head)}",
+            f"({res.seeds_accepted} of {res.seeds} seeds{used_seeds(res)}): the 2D porosity of {shown(head)}",
             soft_wrap=True,
         )
     t = Table(title="poro2d sand")
@@ -105,16 +103,16 @@ def print_result(res, out: Path) -> None:
         f"summary: {shown(str(out / 'summary.md'))} (also summary.csv, sand.json, fig_grading.png)",
         soft_wrap=True,
     )
-    for k in res.specimens:
-        if not k.accepted:
-            console.print(f"[bold red]seed {k.seed} not accepted:[/] {shown(k.message)}", soft_wrap=True)
+    for r in res.seeds_replaced:
+        by = "" if r.replaced_by is None else f"; replaced by seed {r.replaced_by}"
+        console.print(f"[bold red]seed {r.seed} not accepted:[/] {shown(r.reason + by)}", soft_wrap=True)
     if res.state_map is not None:
         from poro2d.critical_state.state_table import state_map_lines
 
         for line in state_map_lines(res.state_map):
             console.print(shown(line), soft_wrap=True)
     for w in warnings(res):
-        if not w.startswith("seed(s)"):  # the refused seeds were named above, with why
+        if not w.startswith("seed"):  # the refused seeds were named above, with why
             console.print(f"[yellow]note:[/] {shown(w)}", soft_wrap=True)
 
 
@@ -172,6 +170,12 @@ def sand_cmd(
     draw_grading(res, cases[0], store)
     print_result(res, out)
     if not res.converged:
+        console.print(
+            f"[bold red]error:[/] {res.seeds_accepted} of {res.seeds} seeds accepted, with "
+            f"{sum(r.replaced_by is not None for r in res.seeds_replaced)} replaced (\\[sand] replacements "
+            "at most): the answer is over fewer specimens (summary.md says why each was refused)",
+            soft_wrap=True,
+        )
         raise typer.Exit(1)
 
 

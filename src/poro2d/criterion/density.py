@@ -49,16 +49,6 @@ DEFAULT_MUS = (0.0, 0.05, 0.1, 0.2, 0.5, 1.0)
 MU_PREP_MAX = 5.0
 
 
-def void_ratio(n: float) -> float:
-    """e = n / (1 - n)."""
-    return n / (1.0 - n)
-
-
-def porosity_from_void_ratio(e: float) -> float:
-    """n = e / (1 + e)."""
-    return e / (1.0 + e)
-
-
 def lab_relative_density(n_lab: float, n_max: float, n_min: float) -> float:
     """Dr of the laboratory state; refuses nLab outside [n_min, n_max] and n_min >= n_max."""
     hi = check_range("n_max", n_max, 0.0, 1.0, lo_open=True, hi_open=True)
@@ -81,8 +71,8 @@ def target_porosity_2d(dr: float, n2d_max: float, n2d_min: float) -> float:
             "a densest state below the loosest one",
             "the loosest preparation packs no looser than the densest: raise mu_loose",
         )  # fmt: skip
-    e_hi, e_lo = void_ratio(n2d_max), void_ratio(n2d_min)
-    return porosity_from_void_ratio(e_hi - dr * (e_hi - e_lo))
+    e_hi, e_lo = P.void_ratio(n2d_max), P.void_ratio(n2d_min)
+    return P.porosity_from_void_ratio(e_hi - dr * (e_hi - e_lo))
 
 
 def isotonic_increasing(y, w=None) -> np.ndarray:
@@ -276,8 +266,6 @@ __all__ = [
     "check_mus",
     "isotonic_increasing",
     "lab_relative_density",
-    "porosity_from_void_ratio",
     "state_target",
     "target_porosity_2d",
-    "void_ratio",
 ]

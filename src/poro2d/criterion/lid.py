@@ -130,18 +130,6 @@ def lid_force(sim: Simulation) -> float:
     return float(np.sum(segment_forces(sim))) if lid_indices(sim) else 0.0
 
 
-def servo_lid(sim: Simulation, total: float, width: float, max_speed: float, gain: float) -> None:
-    """Servo every segment down to its share (by width) of ``total`` newtons."""
-    prof = lid_profile(sim, width)
-    for i, w in zip(lid_indices(sim), prof.widths, strict=True):
-        sim.set_wall_servo(i, total * float(w) / width, (0.0, -1.0), max_speed, gain)
-
-
-def hold_lid(sim: Simulation) -> None:
-    for i in lid_indices(sim):
-        sim.set_wall_velocity(i, (0.0, 0.0))
-
-
 def touching_share(sim: Simulation, total: float, width: float) -> float:
     """Share of the lid's width whose segments carry more than ``TOUCH_SHARE`` of their target."""
     prof = lid_profile(sim, width)
@@ -202,10 +190,14 @@ class SegmentedLid:
             install_lid(sim, width, d50)
 
     def servo(self, sim: Simulation, total: float, max_speed: float, gain: float) -> None:
-        servo_lid(sim, total, self.width, max_speed, gain)
+        """Servo every segment down to its share (by width) of ``total`` newtons."""
+        prof = lid_profile(sim, self.width)
+        for i, w in zip(lid_indices(sim), prof.widths, strict=True):
+            sim.set_wall_servo(i, total * float(w) / self.width, (0.0, -1.0), max_speed, gain)
 
     def hold(self, sim: Simulation) -> None:
-        hold_lid(sim)
+        for i in lid_indices(sim):
+            sim.set_wall_velocity(i, (0.0, 0.0))
 
     def force(self, sim: Simulation) -> float:
         return lid_force(sim)

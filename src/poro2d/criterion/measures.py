@@ -9,35 +9,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, NamedTuple, Protocol
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
 from poro2d.criterion.lid import lid_force, lid_indices
+from poro2d.criterion.settings import CriterionSettings
 from poro2d.dem import Simulation
 from poro2d.errors import InputError
 from poro2d.record import Record
 
 if TYPE_CHECKING:
-    from poro2d.specimen.compaction import SpecimenSpec
-
-
-class Prepared(Protocol):
-    """What the checks read of a trial's preparation (:class:`~poro2d.criterion.trial.Preparation`)."""
-
-    @property
-    def planned_count(self) -> int: ...
-    @property
-    def measured_porosity(self) -> float: ...
-    @property
-    def converged(self) -> bool: ...
-
-
-class CheckTolerances(Protocol):
-    """The tolerances of the checks (``CriterionSettings`` has them)."""
-
-    generation_tolerance: float
-    balance_tolerance: float
+    from poro2d.specimen.compaction import PreparationReport, SpecimenSpec
 
 
 @dataclass(frozen=True)
@@ -150,11 +133,11 @@ class SpecimenChecks(NamedTuple):
 def specimen_checks(
     sim: Simulation,
     spec: SpecimenSpec,
-    prep: Prepared,
+    prep: PreparationReport,
     trial: float,
     plate_height: float | np.ndarray,
     forces: WallForces,
-    settings: CheckTolerances,
+    settings: CriterionSettings,
 ) -> SpecimenChecks:
     """The checks a trial must pass to be accepted, and the numbers behind them.
 

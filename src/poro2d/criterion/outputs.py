@@ -26,7 +26,8 @@ def write_accepted(result: CriterionResult, store: Store, width: float) -> None:
     """The accepted specimen at the top of ``store``, with its state and porosities.
 
     The accepted specimen is the state the decision was taken on: after the plate moved to
-    touch (when it moved), else as prepared with the plate at H.
+    touch (when it moved) or the specimen was cycled further to balance, else as prepared with
+    the plate at H.
     """
     found = accepted_state(result, store)
     if found is None:
@@ -53,7 +54,8 @@ def accepted_state(result: CriterionResult, store: Store) -> tuple[Store, str] |
     if accepted is None:
         return None
     folder = trial_store(store, accepted)
-    moved_last = accepted.plate.moved in MOVED and folder.has("after_plate.npz")
+    # a specimen cycled further to balance is taken as it was then, also when the plate stayed
+    moved_last = (accepted.plate.moved in MOVED or accepted.balance_steps) and folder.has("after_plate.npz")
     return folder, "after_plate.npz" if moved_last else "prepared.npz"
 
 

@@ -13,7 +13,7 @@ is read back from its folder without a process, an unfinished one resumes there.
 from __future__ import annotations
 
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 from poro2d.console import OutputConsole
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
@@ -28,21 +28,35 @@ from poro2d.store import Store
 console = OutputConsole()
 
 
-def _run_one(spec: SpecimenSpec, grading: GradingCurve, settings: CriterionSettings, seed: int, store: Store,
-             report) -> ReplicateRow:  # fmt: skip
+@dataclass(frozen=True)
+class ReplicateCase:
+    """Replicate criterion runs as one value: the specimen, grading and thresholds of the main
+    run, the first trial ``n2d`` (the porosity the main seed accepted) and the ``seeds`` to run."""
+
+    spec: SpecimenSpec
+    grading: GradingCurve
+    settings: CriterionSettings
+    n2d: float
+    seeds: tuple[int, ...]
+
+    def criterion(self, seed: int, store: Store) -> PorosityCriterion:
+        """Seed ``seed``'s criterion run in ``store``: one numba thread, first trial ``n2d``."""
+        spec, settings = replace(self.spec, threads=1), replace(self.settings, trial_porosity=self.n2d)
+        return PorosityCriterion(spec, self.grading, settings, seed=seed, store=store, progress=False)
+
+
+def _run_one(case: ReplicateCase, seed: int, store: Store, report) -> ReplicateRow:
     """One replicate's criterion run (in a worker process); its summary row."""
     report("running")
     t0 = time.perf_counter()
-    res = PorosityCriterion(spec, grading, settings, seed=seed, store=store, progress=False).run()
-    return _row(res, seed, store, t0)
+    return _row(case.criterion(seed, store).run(), seed, store, t0)
 
 
-def _stored(spec: SpecimenSpec, grading: GradingCurve, settings: CriterionSettings, seed: int, store: Store,
-            ) -> ReplicateRow | None:  # fmt: skip
+def _stored(case: ReplicateCase, seed: int, store: Store) -> ReplicateRow | None:
     """A finished replicate's row, read back here (no process started); None when it is to run
     (a folder of another config is left to the run, which refuses it)."""
     t0 = time.perf_counter()
-    data = PorosityCriterion(spec, grading, settings, seed=seed, store=store, progress=False).stage().stored()
+    data = case.criterion(seed, store).stage().stored()
     return None if data is None else _row(CriterionResult.from_dict(data), seed, store, t0)
 
 
@@ -52,26 +66,18 @@ def _row(res: CriterionResult, seed: int, store: Store, t0: float) -> ReplicateR
 
 
 def run_replicates(
-    spec: SpecimenSpec,
-    grading: GradingCurve,
-    settings: CriterionSettings,
-    n2d: float,
-    seeds: list[int],
-    store: Store,
-    *,
-    options: RunOptions = RunOptions(),
+    case: ReplicateCase, store: Store, *, options: RunOptions = RunOptions()
 ) -> ReplicatesResult:
-    """Criterion runs of ``seeds`` from the first trial ``n2d``, on ``options``' workers (default
-    one per seed, at most one per core) or its running scheduler.
+    """The criterion runs of ``case``'s seeds, each in ``store``'s ``seed<N>``, on ``options``'
+    workers (default one per seed, at most one per core) or its running scheduler.
 
     Returns one summary row per seed (accepted or not, the criterion's message, its sub-store
     of ``store``), in seed order, and the accepted specimens by label (``seed1``, ...) as
     the result's ``specimens``.
     """
-    spec1 = replace(spec, threads=1)
-    first = replace(settings, trial_porosity=n2d)
-    jobs = [Job(_run_one, (spec1, grading, first, sd, store.child(f"seed{sd}")), f"seed {sd}", reports=True)
-            for sd in seeds]  # fmt: skip
+    jobs = [
+        Job(_run_one, (case, sd, store.child(f"seed{sd}")), f"seed {sd}", reports=True) for sd in case.seeds
+    ]
     rows = complete_jobs(jobs, title="replicate criterion", what="replicate criterion run(s)",
                          options=options, workers=options.local_workers(len(jobs)),
                          finished=[_stored(*job.args) for job in jobs], done_text=_outcome)  # fmt: skip
@@ -98,10 +104,11 @@ def accepted_and_replicates(
     specimens = SpecimenSet.made([(f"seed{seed}", store.child("criterion").path("specimen.npz"))])
     if replicates == 1:
         return specimens, None
-    more_seeds = list(range(seed + 1, seed + replicates))
-    console.print(f"  replicate specimens: seeds {', '.join(map(str, more_seeds))} from n2D = {n2d:.2f}")
-    more = run_replicates(spec, grading, settings, n2d, more_seeds, store.child("replicates"),
-                          options=RunOptions(workers=spec.threads, progress=progress))  # fmt: skip
+    case = ReplicateCase(spec, grading, settings, n2d, tuple(range(seed + 1, seed + replicates)))
+    console.print(f"  replicate specimens: seeds {', '.join(map(str, case.seeds))} from n2D = {n2d:.2f}")
+    more = run_replicates(
+        case, store.child("replicates"), options=RunOptions(workers=spec.threads, progress=progress)
+    )
     return specimens + more.specimens, more.rows
 
 
@@ -111,4 +118,4 @@ def _outcome(row: ReplicateRow) -> str:
     return f"{what} ({row.trials} trial(s) in {row.time_s:.0f} s)"
 
 
-__all__ = ["accepted_and_replicates", "run_replicates"]
+__all__ = ["ReplicateCase", "accepted_and_replicates", "run_replicates"]

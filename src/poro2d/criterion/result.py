@@ -105,9 +105,6 @@ class ReplicatesResult(TypedResult):
     rows: list[ReplicateRow]
     store: Store | None = field(default=None, kw_only=True, metadata=NOT_IN_FILE)
 
-    def __getitem__(self, key: str) -> Any:
-        return self.to_dict()[key]
-
     @property
     def specimens(self) -> SpecimenSet:
         """The accepted specimens by label (``seed1``, ...), each seed's ``specimen.npz``, in seed order."""

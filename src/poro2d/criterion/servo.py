@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
-from typing import Protocol
 
 from poro2d.criterion.lid import FlatPlate, SegmentedLid
+from poro2d.criterion.settings import CriterionSettings
 from poro2d.dem import Simulation
 from poro2d.labtest.settle import StopRule, settle_until
 from poro2d.record import Record
@@ -75,22 +75,6 @@ def rises_free_to_roll(
     return rolling_friction > 0.0 and (overfull or f_top >= fraction * weight)
 
 
-class ServoSettings(Protocol):
-    """What the servo reads of the criterion's settings (``CriterionSettings`` has them all)."""
-
-    force_fraction: float
-    servo_target_fraction: float
-    servo_max_speed: float
-    servo_gain: float
-    settle_gain: float
-    settle_max_speed: float
-    settle_checks: int
-    plate_drift: float
-    max_plate_steps: int
-    check_every: int
-    window_checks: int
-
-
 @dataclass(frozen=True)
 class PlateServo:
     """Servo the top of a box until 0 < F_top < ``force_fraction`` G holds at equilibrium.
@@ -102,7 +86,7 @@ class PlateServo:
     ``progress``: a bar per approach when True.
     """
 
-    settings: ServoSettings
+    settings: CriterionSettings
     ratio: float
     equilibrium: str
     height: float
@@ -239,4 +223,4 @@ class PlateServo:
         return settled
 
 
-__all__ = ["PlateServo", "PlateSettle", "ServoSettings", "in_window", "rises_free_to_roll"]
+__all__ = ["PlateServo", "PlateSettle", "in_window", "rises_free_to_roll"]

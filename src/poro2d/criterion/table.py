@@ -6,7 +6,7 @@ command itself (its two modes) is :mod:`poro2d.cli.criterion`.
 
 from __future__ import annotations
 
-from poro2d.console import OutputConsole, Table
+from poro2d.console import OutputConsole, Table, shown
 from poro2d.criterion.result import CriterionResult
 from poro2d.store import Store
 
@@ -38,7 +38,7 @@ def print_result(result: CriterionResult, store: Store) -> None:
             )
     if result.preparation_note:
         console.print(f"preparation: {result.preparation_note}", soft_wrap=True)
-    console.print(f"{result.message}; results in {store.root}/result.json")
+    console.print(f"{shown(result.message)}; results in {store.root}/result.json")
     if result.interior_porosity is not None:
         under_lid = result.settings.acceptance == "fill"
         what = (

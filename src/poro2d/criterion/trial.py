@@ -1,10 +1,10 @@
 """One trial of Fig. 3 as a typed record made of its parts.
 
-A trial is its preparation (:class:`Preparation`, what ``prepared.json`` holds), the wall
-forces as prepared, its plate (or lid) stage (:class:`PlateStage`), the stage that did not
-reach equilibrium if one did not (:class:`StageFailure`), the wall forces after the plate
-stage, the checks and the numbers behind them, the porosities of its decision state and
-the decision itself (:class:`Decision`).
+A trial is what its preparation built (``prepared.json``), the wall forces as prepared, its
+plate (or lid) stage (:class:`PlateStage`), the stage that did not reach equilibrium if one
+did not (:class:`StageFailure`), the wall forces after the plate stage, the checks and the
+numbers behind them, the porosities of its decision state and the decision itself
+(:class:`Decision`).
 
 The files keep the row a trial always had: :meth:`Trial.to_dict` gives the keys of
 ``trial.json`` (and of a trial of ``result.json``) in their order, with the values as they
@@ -34,49 +34,6 @@ def trial_name(k: int, n: float) -> str:
 
 
 @dataclass(frozen=True)
-class Preparation:
-    """A trial's specimen as prepared: its preparation's report (``prepared.json``).
-
-    ``report`` is the report of :func:`poro2d.specimen.compaction.prepare_specimen` with the
-    trial's seed, time, self weight and wall forces: the file's content, typed.
-    """
-
-    report: PreparationReport
-
-    @property
-    def particle_count(self) -> int:
-        return self.report.particle_count
-
-    @property
-    def planned_count(self) -> int:
-        return self.report.planned_count
-
-    @property
-    def measured_porosity(self) -> float:
-        return self.report.measured_porosity
-
-    @property
-    def converged(self) -> bool:
-        return self.report.converged
-
-    @property
-    def overfull_m(self) -> float:
-        """How far the specimen stood above H (0 unless the layers did not fit below it)."""
-        return float(self.report.overfull_m or 0.0)
-
-    @property
-    def time_s(self) -> float | None:
-        return self.report.time_s
-
-    def failure(self, equilibrium: str) -> StageFailure:
-        """The stage of a preparation that did not reach equilibrium (``equilibrium``: its measure)."""
-        r = self.report
-        # a report of an older file lacks failed_ratio
-        ratio = r.failed_ratio if "failed_ratio" in r.to_dict() else r.failed_max_ratio
-        return StageFailure(r.failed_stage, r.failed_max_ratio, r.failed_steps, ratio, equilibrium)
-
-
-@dataclass(frozen=True)
 class StageFailure(Record):
     """A stage that did not reach equilibrium: the preparation's or the top plate's.
 
@@ -95,6 +52,13 @@ class StageFailure(Record):
 
     def layout(self) -> tuple:
         return self.ROW if self.equilibrium is not None else self.ROW[:3]
+
+    @classmethod
+    def of_preparation(cls, report: PreparationReport, equilibrium: str) -> StageFailure:
+        """The stage of a preparation that did not reach equilibrium (``equilibrium``: its measure)."""
+        # a report of an older file lacks failed_ratio
+        ratio = report.failed_ratio if "failed_ratio" in report.to_dict() else report.failed_max_ratio
+        return cls(report.failed_stage, report.failed_max_ratio, report.failed_steps, ratio, equilibrium)
 
     @classmethod
     def from_row(cls, row: Mapping[str, Any]) -> StageFailure | None:
@@ -172,11 +136,10 @@ class Decision(Record):
 
     @classmethod
     def from_row(cls, row: Mapping[str, Any]) -> Decision:
-        return cls(row.get("condition_met"), row.get("failed_check"), row.get("accepted"), row.get("refused"),
-                   row.get("reason"), row.get("accepted_at"))  # fmt: skip
+        return cls(*(row.get(k) for k in DECISION_KEYS))
 
 
-#: the keys of a row that the decision sets
+#: the keys of a row that the decision sets (its fields, in order)
 DECISION_KEYS = ("condition_met", "failed_check", "accepted", "refused", "reason", "accepted_at")
 
 
@@ -184,15 +147,12 @@ DECISION_KEYS = ("condition_met", "failed_check", "accepted", "refused", "reason
 class Trial(Record, TypedResult):
     """One trial of Fig. 3, made of its parts; its row (:meth:`to_dict`) is what files keep of it.
 
-    ``preparation`` is the prepared specimen's report for a trial run now, None for a trial
-    read back from its row (the row keeps what the trial uses of it: counts, porosity,
-    whether it converged and how far the box was over-full).
-
-    ``ROW`` is the row a trial records, its parts in place: the wall forces as prepared and
-    after the plate stage under their own keys, ``overfull_m`` only when the box was
-    over-full, ``accepted_at`` only for a trial accepted when the bracket closed. A trial is the
-    typed result of its file (``trial.json``), and so a part of the criterion's result; keys of
-    a row read back that it does not model are kept in ``extra``.
+    ``ROW`` is the row a trial records, its parts in place: the counts, porosity and convergence
+    of its preparation, the wall forces as prepared and after the plate stage under their own
+    keys, ``overfull_m`` only when the box was over-full, ``balance_steps`` only for a specimen
+    cycled further to balance, ``accepted_at`` only for a trial accepted when the bracket closed.
+    A trial is the typed result of its file (``trial.json``), and so a part of the criterion's
+    result; keys of a row read back that it does not model are kept in ``extra``.
     """
 
     ROW = (
@@ -205,10 +165,11 @@ class Trial(Record, TypedResult):
         ("f_top_after_n_per_m", "forces_after.f_top_n_per_m"),
         ("f_bottom_after_n_per_m", "forces_after.f_bottom_n_per_m"),
         ("side_friction_up_after_n_per_m", "forces_after.side_friction_up_n_per_m"),
-        "porosity_change", Spliced("check_numbers"), Spliced("porosity"), "checks", Spliced("decision"),
+        "porosity_change", Spliced("check_numbers"), Spliced("porosity"), "checks", "balance_steps",
+        Spliced("decision"),
         "time_prepare_s", "time_plate_s", ("accepted_at", "decision.accepted_at"),
     )  # fmt: skip
-    OMITTED = {"overfull_m": 0.0, "accepted_at": None}
+    OMITTED = {"overfull_m": 0.0, "accepted_at": None, "balance_steps": None}
 
     iteration: int
     trial_porosity: float
@@ -229,9 +190,10 @@ class Trial(Record, TypedResult):
     overfull_m: float = 0.0
     failure: StageFailure | None = None
     porosity: PorosityNumbers | None = None
+    #: the steps a specimen just out of balance was cycled further (None: it was not)
+    balance_steps: int | None = None
     time_prepare_s: float | None = None
     time_plate_s: float | None = None
-    preparation: Preparation | None = field(default=None, repr=False)
     #: the key order of a row read back
     order: tuple[str, ...] | None = field(default=None, repr=False)
 
@@ -260,28 +222,19 @@ class Trial(Record, TypedResult):
     @classmethod
     def from_dict(cls, row: Mapping[str, Any]) -> Trial:
         """A trial from its row (``trial.json``, a trial of ``result.json``, or :meth:`to_dict`)."""
+        # the row's own values: ROW's plain keys, but for the two read with a default or a type
+        plain = {k: row.get(k) for k in cls.ROW if isinstance(k, str) and k not in ("overfull_m", "checks")}
         trial = cls(
-            iteration=row.get("iteration"),
-            trial_porosity=row.get("trial_porosity"),
-            particle_count=row.get("particle_count"),
-            planned_particle_count=row.get("planned_particle_count"),
-            measured_porosity_after_generation=row.get("measured_porosity_after_generation"),
+            **plain,
             forces=WallForces.from_row(dict(row)),
-            self_weight_n_per_m=row.get("self_weight_n_per_m"),
-            force_limit_n_per_m=row.get("force_limit_n_per_m"),
-            preparation_converged=row.get("preparation_converged"),
-            converged=row.get("converged"),
             plate=PlateStage.from_row(row),
             forces_after=WallForces.from_row(dict(row), "_after"),
-            porosity_change=row.get("porosity_change"),
             check_numbers=CheckNumbers.from_dict(dict(row)),
             checks=Checks(**{f.name: (row.get("checks") or {}).get(f.name) for f in fields(Checks)}),
             decision=Decision.from_row(row),
             overfull_m=row.get("overfull_m") or 0.0,
             failure=StageFailure.from_row(row),
             porosity=PorosityNumbers.from_row(dict(row)),
-            time_prepare_s=row.get("time_prepare_s"),
-            time_plate_s=row.get("time_plate_s"),
         )
         modelled = Record.to_dict(trial)
         trial.extra = {k: v for k, v in row.items() if k not in modelled}
@@ -292,4 +245,4 @@ class Trial(Record, TypedResult):
         return trial
 
 
-__all__ = ["Decision", "PlateStage", "Preparation", "StageFailure", "Trial", "trial_name"]
+__all__ = ["Decision", "PlateStage", "StageFailure", "Trial", "trial_name"]

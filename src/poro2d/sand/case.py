@@ -12,6 +12,7 @@ three tables of its own::
     dr = 0.5               # or e, n, or dry_density with solid_density
     [sand]                 # how to run it (all optional)
     seeds = 3              # specimens at full size
+    replacements = 3       # seeds not accepted at full size replaced by the next ones, at most
     calibration_seeds = 2  # specimens per friction in the calibration
     calibration_disks = 1500
     mu_prep = [0.0, 0.05, 0.1, 0.2, 0.5, 1.0]
@@ -43,7 +44,7 @@ from poro2d.typed_result import TypedResult
 #: the tables a sand config adds to a criterion config
 SAND_TABLES = ("soil", "lab", "sand", "state")
 SOIL_KEYS = {"name", "reference"}
-SAND_KEYS = {"seeds", "calibration_seeds", "calibration_disks", "mu_prep"}
+SAND_KEYS = {"seeds", "replacements", "calibration_seeds", "calibration_disks", "mu_prep"}
 #: disks in the calibration box unless ``[sand] calibration_disks`` says otherwise: the dense and
 #: loose ends of the paper grading moved by less than their seed spread between this box and the
 #: full one (docs/sand.md)
@@ -52,6 +53,10 @@ CALIBRATION_DISKS = 1500
 #: a third seed moved the friction by 0.0004 (Toyoura sand) and 0.0035 (the paper's sand), the
 #: answer by under a tenth of its seed spread (docs/sand.md)
 CALIBRATION_SEEDS = 2
+#: seeds refused at full size replaced by the next unused ones, at most, unless ``[sand]
+#: replacements`` says otherwise: a seed refused at a threshold is one sample of a chaotic
+#: packing, and the answer is asked of ``seeds`` specimens
+REPLACEMENTS = 3
 
 ConfigLike = dict | str | os.PathLike
 
@@ -97,6 +102,7 @@ class SandCase:
     state: StateRequest | None = None
     #: the run time the pre-flight measures its estimate against (minutes; None: none)
     budget_minutes: float | None = None
+    replacements: int = REPLACEMENTS
 
     @property
     def n_max(self) -> float:
@@ -255,6 +261,7 @@ def load_sand_case(
         1,
         50,
     )
+    replacements = check_int("sand.replacements", sand.get("replacements", REPLACEMENTS), 0, 50)
     cal_seeds = check_int("sand.calibration_seeds", sand.get("calibration_seeds", CALIBRATION_SEEDS), 1, 50)
     cal_disks = check_int(
         "sand.calibration_disks", sand.get("calibration_disks", CALIBRATION_DISKS), 200, 50_000
@@ -273,8 +280,15 @@ def load_sand_case(
         check_range("--budget", budget_minutes, 0.0, 7 * 24 * 60.0, lo_open=True)
     return SandCase(
         name, reference, lab, crit, base_dir, spec, grading, n_seeds, cal_disks, mus, cal_seeds, state,
-        budget_minutes,
+        budget_minutes, replacements,
     )  # fmt: skip
 
 
-__all__ = ["CALIBRATION_DISKS", "CALIBRATION_SEEDS", "SandCase", "SoilRecord", "load_sand_case"]
+__all__ = [
+    "CALIBRATION_DISKS",
+    "CALIBRATION_SEEDS",
+    "REPLACEMENTS",
+    "SandCase",
+    "SoilRecord",
+    "load_sand_case",
+]

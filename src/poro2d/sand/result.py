@@ -74,6 +74,24 @@ class SeedSpecimen(TypedResult):
 
 
 @dataclass(eq=False)
+class SeedReplaced(TypedResult):
+    """A seed not accepted at full size (``seeds_replaced`` in ``sand.json``): why, and the seed
+    tried in its place (None once ``[sand] replacements`` were spent)."""
+
+    seed: int
+    reason: str
+    replaced_by: int | None
+
+
+def replaced_seeds(kept: list[SeedSpecimen], requested: int) -> list[SeedReplaced]:
+    """The seeds not accepted, in order, each with the seed tried after the requested ones in its place."""
+    extra = [k.seed for k in kept if k.seed >= requested]
+    refused = [k for k in kept if not k.accepted]
+    by = extra + [None] * (len(refused) - len(extra))
+    return [SeedReplaced(k.seed, k.message, b) for k, b in zip(refused, by, strict=True)]
+
+
+@dataclass(eq=False)
 class SandCalibration(TypedResult):
     """The calibration in the small box (``calibration`` in ``sand.json``).
 
@@ -133,6 +151,9 @@ class SandResult(TypedResult):
     solid_fraction_mean: float
     seeds: int
     seeds_accepted: int
+    #: the seeds whose specimens make the answer, and those not accepted (why, and their replacements)
+    seeds_used: list[int]
+    seeds_replaced: list[SeedReplaced]
     converged: bool
     mu_prep: float
     n2d_target: float
@@ -159,6 +180,7 @@ class SandResult(TypedResult):
         "state": LabState,
         "states": AcceptedState,
         "seed_results": SeedSpecimen,
+        "seeds_replaced": SeedReplaced,
         "preflight": Preflight,
         "provenance": Provenance,
         "state_map": StateMapRecord,
@@ -200,9 +222,11 @@ class SandResult(TypedResult):
             box_porosity_mean=box_m,
             box_porosity_sd=box_sd,
             solid_fraction_mean=1.0 - inner_m if math.isfinite(inner_m) else math.nan,
-            seeds=len(kept),
+            seeds=case.seeds,
             seeds_accepted=n_ok,
-            converged=n_ok == len(kept) and n_ok > 0,
+            seeds_used=[k.seed for k in kept if k.accepted],
+            seeds_replaced=replaced_seeds(kept, case.seeds),
+            converged=n_ok == case.seeds,
             mu_prep=target.mu_prep,
             n2d_target=target.n2d_target,
             first_trial_full_box=trial,
@@ -220,6 +244,18 @@ class SandResult(TypedResult):
             state_map=state_map,
             specimens=list(kept),
         )
+
+
+def state_text(st: LabState) -> str:
+    """The laboratory state in a title: ``nLab = 0.4023 (Dr = 0.800)``."""
+    dr = st.relative_density
+    return f"nLab = {st.n_lab:.4f}" + (f" (Dr = {dr:.3f})" if dr is not None else "")
+
+
+def lab_text(st: LabState) -> str:
+    """The laboratory state in full: n, e, Dr when known, and how it was given."""
+    dr = "" if st.relative_density is None else f", Dr = {st.relative_density:.3f}"
+    return f"n = {st.n_lab:.4f}, e = {st.e:.4f}{dr} (given as {st.given})"
 
 
 def mean_sd_text(mean: float | None, sd: float | None) -> str:
@@ -278,24 +314,20 @@ def summary_markdown(res: SandResult, store: Store) -> str:
     (the export commands name the store's folder)."""
     out = store.root
     st, soil = res.state, res.soil
-    dr = st.relative_density
     jam = res.jamming_porosity
     lines = [
-        f"# {soil.name}: 2D porosity at nLab = {st.n_lab:.4f}"
-        + (f" (Dr = {dr:.3f})" if dr is not None else ""),
+        f"# {soil.name}: 2D porosity at {state_text(st)}",
         "",
         "**Interior porosity (use this in other codes): "
         f"{mean_sd_text(res.interior_porosity_mean, res.interior_porosity_sd)}**"
-        f" over {res.seeds_accepted} of {res.seeds} seeds",
+        f" over {res.seeds_accepted} of {res.seeds} seeds{used_seeds(res)}",
         "",
         "| quantity | value |",
         "| --- | --- |",
         f"| soil | {soil.name} ({soil.reference or 'no reference given'}) |",
         f"| grading | {soil.grading_source}, up-scaled x{soil.upscale:g} |",
         f"| disks (full box) | {res.preflight.box.disks:.0f} |",
-        f"| laboratory state | n = {st.n_lab:.4f}, e = {st.e:.4f}"
-        + (f", Dr = {dr:.3f}" if dr is not None else "")
-        + f" (given as {st.given}) |",
+        f"| laboratory state | {lab_text(st)} |",
         f"| preparation friction mu_prep | {res.mu_prep:.3f} |",
         f"| interior porosity | {mean_sd_text(res.interior_porosity_mean, res.interior_porosity_sd)} |",
         f"| box porosity n' (under the lid) | {mean_sd_text(res.box_porosity_mean, res.box_porosity_sd)} |",
@@ -335,6 +367,11 @@ def summary_markdown(res: SandResult, store: Store) -> str:
     return "\n".join(lines) + "\n"
 
 
+def used_seeds(res: SandResult) -> str:
+    """The seeds the answer is over, when one was replaced (": 0, 2, 3"); "" otherwise."""
+    return f": {', '.join(map(str, res.seeds_used))}" if res.seeds_replaced else ""
+
+
 def _profile_rows(res: SandResult) -> list[str]:
     """Where the time went: per stage (calibration, specimens) and phase (preparation, lid)."""
     rows = []
@@ -363,9 +400,13 @@ def warnings(res: SandResult) -> list[str]:
             f"are those of mu_prep {mus[0]:g} to {mus[-1]:g}, so a state's Dr is mapped onto a narrower "
             "range than the preparation can span (see the calibration's cases for why)"
         )
-    refused = [k.seed for k in res.specimens if not k.accepted]
-    if refused:
-        out.append(f"seed(s) {', '.join(map(str, refused))} not accepted: the spread is over fewer specimens")
+    replaced = res.seeds_replaced or []  # None in a sand.json of an older poro2d
+    for r in replaced:
+        if r.replaced_by is not None:
+            out.append(f"seed {r.seed} not accepted ({r.reason}): replaced by seed {r.replaced_by}")
+    left = [r.seed for r in replaced if r.replaced_by is None]
+    if left:
+        out.append(f"seed(s) {', '.join(map(str, left))} not accepted: the spread is over fewer specimens")
     return out
 
 
@@ -388,9 +429,14 @@ def write_summary(res: SandResult, store: Store) -> None:
 __all__ = [
     "SandCalibration",
     "SandResult",
+    "SeedReplaced",
     "SeedSpecimen",
+    "replaced_seeds",
     "summary_markdown",
     "SummaryRow",
+    "lab_text",
+    "state_text",
+    "used_seeds",
     "warnings",
     "write_summary",
 ]

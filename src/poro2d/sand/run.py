@@ -11,7 +11,8 @@ Stages (each resumable: rerun the same command to go on):
    from the grading's own first trial (:func:`poro2d.sweep.density.first_trial` moved to its
    jamming porosity). Cases are cached per grading and box, as the relation's are.
 3. **Specimens at full size**, one per seed, at that friction, from the target moved by the
-   walls' share of the two boxes (:func:`full_box_trial`).
+   walls' share of the two boxes (:func:`full_box_trial`); a seed not accepted is replaced by
+   the next unused one (``[sand] replacements`` at most).
 4. **The answer**: the interior porosity (the number for other codes) and the box
    porosity n' over seeds, the accepted specimens in named folders, a grading figure and
    one summary (``summary.md``, ``summary.csv``, ``sand.json``).
@@ -22,7 +23,7 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -141,34 +142,18 @@ def full_box_trial(target: float, dense_end: float | None, cal_dense: float, pf:
     return target - excess * (1.0 - ratio)
 
 
-@dataclass(frozen=True)
-class FirstTrialShifts:
-    """What moves the calibration's first trials: the grading's jamming porosity (the dense
-    end), the box's walls' share and the loose bias (:func:`poro2d.sweep.density.calibrate`)."""
-
-    dense_end: float | None
-    walls: float
-    loose_bias: float
-
-
-def _first_trial_shifts(pf: Preflight) -> FirstTrialShifts:
+def calibration_case(case: SandCase, pf: Preflight, mus: list[float]) -> D.CalibrationCase:
+    """The calibration at ``mus``, the loosest cases first (its case ids name their folders in the
+    cache). Its first trials move with the grading's jamming porosity (the dense end), the
+    calibration box's walls' share and the loose bias (:func:`poro2d.sweep.density.calibrate`)."""
     box = pf.calibration_box
-    return FirstTrialShifts(pf.jamming.porosity, D.wall_share(box.width, box.height, pf.d50_m), LOOSE_BIAS)
-
-
-def calibration_cases(case: SandCase, pf: Preflight, mus: list[float]) -> list:
-    """The calibration's cases at ``mus`` (their ids name their folders in the cache)."""
-    return _calibration_case(case, pf, mus).sweep.cases
-
-
-def _calibration_case(case: SandCase, pf: Preflight, mus: list[float], loosest_first: bool = False):
-    base, shifts = calibration_config(case, pf), asdict(_first_trial_shifts(pf))
-    return D.CalibrationCase(base, tuple(mus), case.calibration_seeds, **shifts, loosest_first=loosest_first)
+    walls = D.wall_share(box.width, box.height, pf.d50_m)
+    return D.CalibrationCase(calibration_config(case, pf), tuple(mus), case.calibration_seeds,
+                             pf.jamming.porosity, walls, LOOSE_BIAS, loosest_first=True)  # fmt: skip
 
 
 def _calibrate(case, pf, store: Store, mus, record, cal_kw) -> tuple[Calibration, CalibrationRun]:
-    calibration = _calibration_case(case, pf, mus, loosest_first=True)
-    return D.calibrate(calibration, store, record=record, **cal_kw)
+    return D.calibrate(calibration_case(case, pf, mus), store, record=record, **cal_kw)
 
 
 def calibration_stage(
@@ -228,17 +213,42 @@ def calibrate_ends(
 
 
 def specimen_stage(
-    case: SandCase, trial: StateTarget, store: Store, options: RunOptions
+    case: SandCase, trial: StateTarget, store: Store, options: RunOptions, announce: Announce = _quiet
 ) -> list[CaseRow | LostCaseRow]:
-    """One criterion case per seed at full size, at the state's friction, from ``trial``."""
+    """One criterion case per seed at full size, at the state's friction, from ``trial``.
+
+    A seed not accepted is replaced by the next unused seed, at most ``case.replacements`` in
+    all, until ``case.seeds`` are accepted: the rows of every seed tried, in seed order. Seeds
+    are tried in order (0, 1, ...), so a rerun reads every finished seed back, replaced ones too.
+    """
     from poro2d.criterion.protocol import trial_grid
     from poro2d.sweep.runner import run_sweep
 
     crit = case.config.table("criterion")
     grid = trial_grid(float(crit.get("resolution", 0.01)), crit.get("refine_tolerance"))
-    sweep = D.StateChecks(case.config, (trial,), case.seeds, grid).sweep
-    res = run_sweep(sweep, store.child("states"), options=options)
-    return sorted(res.rows, key=lambda r: int((r.params or {}).get("seed", 0)))
+    tried = case.seeds
+    while True:
+        sweep = D.StateChecks(case.config, (trial,), tried, grid).sweep
+        res = run_sweep(sweep, store.child("states"), options=options)
+        rows = sorted(res.rows, key=_seed)
+        more = min(case.seeds - sum(map(seed_accepted, rows)), case.seeds + case.replacements - tried)
+        if more <= 0:
+            return rows
+        refused = [_seed(r) for r in rows if not seed_accepted(r)]
+        announce(
+            f"seed(s) {', '.join(map(str, refused))} not accepted: trying seed(s) "
+            f"{', '.join(map(str, range(tried, tried + more)))} in their place"
+        )
+        tried += more
+
+
+def _seed(row: CaseRow | LostCaseRow) -> int:
+    return int((row.params or {}).get("seed", 0))
+
+
+def seed_accepted(row: CaseRow | LostCaseRow) -> bool:
+    """Whether a seed's criterion case ended with an accepted specimen."""
+    return row.status == "done" and bool((row.results or {}).get("converged"))
 
 
 def keep_specimens(rows: list[CaseRow | LostCaseRow], store: Store, label: str, soil: dict,
@@ -247,13 +257,11 @@ def keep_specimens(rows: list[CaseRow | LostCaseRow], store: Store, label: str, 
     ``soil.json`` naming the soil and its laboratory state."""
     kept = []
     for r in rows:
-        seed = int((r.params or {}).get("seed", 0))
-        res = r.results or {}
-        ok = r.status == "done" and bool(res.get("converged"))
+        seed = _seed(r)
         # the criterion's store of the case
         src = store.child("states", "cases", str(r.case_id), "run")
         folder = None
-        if ok and src.has("specimen.npz"):
+        if seed_accepted(r) and src.has("specimen.npz"):
             name = f"{label}-seed{seed}"
             dest = store.child("specimens", name)
             for f in src.names():
@@ -352,10 +360,10 @@ def _run_sand(case, pf, store, options, use_cache, announce, on_preflight) -> Sa
         f"specimens: {case.seeds} at full size ({pf.box.disks:.0f} disks), "
         f"mu_prep {target.mu_prep:.3f}, first trial {trial:.4f}",
     )
-    rows = specimen_stage(case, replace(target, n2d_target=trial), store, options)
+    rows = specimen_stage(case, replace(target, n2d_target=trial), store, options, announce)
     clock.end("specimens", t)
     kept = keep_specimens(rows, store, _state_label(case), case.soil_record(), case.lab.to_dict())
-    cal_ids = [c.id for c in calibration_cases(case, pf, [float(m) for m in cal_record.mus])]
+    cal_ids = [c.id for c in calibration_case(case, pf, [float(m) for m in cal_record.mus]).sweep.cases]
     runs = [c.child("run") for c in walk(store.child("states", "cases"), "*")]
     cal_record = replace(
         cal_record,

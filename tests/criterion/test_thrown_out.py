@@ -1,0 +1,40 @@
+"""A disk thrown out of the box during a run is a physical event of the trial, never an input error."""
+
+from pathlib import Path
+
+import pytest
+
+from poro2d.cli import main
+from poro2d.criterion.protocol import thrown_out, thrown_out_note
+from poro2d.errors import InputError
+
+#: a well-graded sandy gravel (0.1-18.9 mm, Cu 18): its frictionless jamming porosity is about 0.105
+GRAVEL = Path(__file__).parents[2] / "examples" / "soils" / "g1-1_sandy_gravel.csv"
+
+
+@pytest.mark.slow
+def test_a_trial_denser_than_its_grading_jams_is_refused_naming_the_cause(tmp_path, capsys):
+    # 0.06 is within the margin the check before the run lets pass (n_J - 0.05), but in this
+    # box a layer's overlaps explode and throw a disk out: before, "disk 74 position is invalid"
+    cfg = tmp_path / "gravel.toml"
+    cfg.write_text(
+        "[specimen]\nwidth = 0.08\nheight = 0.04\nlayers = 2\n"
+        f'[grading]\ncsv = "{GRAVEL.as_posix()}"\n[criterion]\ntrial_porosity = 0.06\nmax_iterations = 1\n'
+    )
+    with pytest.raises(SystemExit) as e:
+        main(["criterion", "--config", str(cfg), "--out", str(tmp_path / "out"), "--quiet"])
+    assert e.value.code == 1  # a refused trial, not a refusal of the input (2)
+    out = capsys.readouterr()
+    assert "is invalid" not in out.out + out.err
+    line = next(x for x in out.out.splitlines() if x.startswith("criterion failed:"))
+    assert "trial 1 (n2D = 0.0600) refused: disk" in line and "thrown out of place" in line
+    assert "jamming porosity n_J = 0." in line and "trial_porosity (--trial-porosity) at 0." in line
+
+
+def test_only_a_disk_position_is_taken_for_a_thrown_out_disk():
+    moved = InputError("disk 850 position", (0.304224, 1.08571), "a centre inside the walls", "beyond")
+    assert thrown_out(moved) and not thrown_out(InputError("trial porosity", 0.05, ">= 0.101"))
+    note = thrown_out_note(moved, 0.08, 0.1049)
+    assert note.startswith("disk 850 was thrown out of place") and "(0.304224, 1.08571) m" in note
+    assert "n_J = 0.105" in note and "at 0.11 or above" in note
+    assert "what this grading jams at" in thrown_out_note(moved, 0.08, None)

@@ -1,0 +1,75 @@
+"""A seed refused at full size is replaced by the next unused one; the answer names both."""
+
+from types import SimpleNamespace
+
+import pytest
+
+from poro2d.criterion.density import StateTarget
+from poro2d.sand import load_sand_case
+from poro2d.sand.result import replaced_seeds
+from poro2d.sand.run import seed_accepted, specimen_stage
+from poro2d.store import Store
+from poro2d.sweep import runner
+from poro2d.sweep.records import CaseRow
+
+REFUSED = "trial 1 (n2D = 0.1720) refused: check force_balance failed"
+LAB = {"e_max": 0.977, "e_min": 0.597, "dr": 0.8}
+CFG = {"soil": {"name": "s"}, "grading": {"preset": "paper"}, "lab": LAB}
+
+
+def _fake_sweep(refused: set[int], calls: list[list[int]]):
+    """A sweep whose cases end at once: the seeds in ``refused`` not accepted."""
+
+    def run_sweep(sweep, store, *, options):
+        seeds = [c.params["seed"] for c in sweep.cases]
+        calls.append(seeds)
+        rows = [
+            CaseRow(c.id, "criterion", c.params, status="done",
+                    results={"converged": s not in refused, "message": "" if s not in refused else REFUSED})
+            for c, s in zip(sweep.cases, seeds, strict=True)
+        ]  # fmt: skip
+        return SimpleNamespace(rows=rows[::-1])  # in any order: the stage sorts them by seed
+
+    return run_sweep
+
+
+@pytest.mark.parametrize(
+    "refused, replacements, tried, used",
+    [
+        (set(), 3, [[0, 1, 2]], [0, 1, 2]),
+        ({1}, 3, [[0, 1, 2], [0, 1, 2, 3]], [0, 2, 3]),
+        ({1, 3}, 3, [[0, 1, 2], [0, 1, 2, 3], [0, 1, 2, 3, 4]], [0, 2, 4]),
+        ({0, 1}, 1, [[0, 1, 2], [0, 1, 2, 3]], [2, 3]),
+        ({1}, 0, [[0, 1, 2]], [0, 2]),
+    ],
+)
+def test_refused_seeds_are_replaced_by_the_next_ones(
+    tmp_path, monkeypatch, refused, replacements, tried, used
+):
+    calls: list[list[int]] = []
+    monkeypatch.setattr(runner, "run_sweep", _fake_sweep(refused, calls))
+    case = load_sand_case({**CFG, "sand": {"seeds": 3, "replacements": replacements}})
+    lines: list[str] = []
+    rows = specimen_stage(case, StateTarget(0.3, 0.5, 0.17, 0.3), Store(tmp_path), None, lines.append)
+    assert calls == tried  # a rerun asks the same sweeps: every finished seed is read back
+    assert [int(r.params["seed"]) for r in rows] == tried[-1]
+    assert [int(r.params["seed"]) for r in rows if seed_accepted(r)] == used
+    assert len(lines) == len(tried) - 1 and all("in their place" in line for line in lines)
+
+
+def test_the_answer_names_the_replaced_seed_and_why():
+    kept = [SimpleNamespace(seed=s, accepted=s != 1, message="" if s != 1 else REFUSED) for s in range(4)]
+    (gone,) = replaced_seeds(kept, 3)
+    assert (gone.seed, gone.replaced_by, gone.reason) == (1, 3, REFUSED)
+    assert gone.to_dict() == {"seed": 1, "reason": REFUSED, "replaced_by": 3}
+    (left,) = replaced_seeds(kept[:3], 3)  # no replacement left: said so
+    assert left.replaced_by is None
+
+
+def test_replacements_are_checked_where_they_enter():
+    from poro2d.errors import InputError
+
+    assert load_sand_case(CFG).replacements == 3
+    with pytest.raises(InputError) as e:
+        load_sand_case({**CFG, "sand": {"replacements": -1}})
+    assert e.value.parameter == "sand.replacements"
