@@ -85,24 +85,15 @@ def connect(scheduler: str):
     from distributed import Client
 
     address = check_scheduler_address(scheduler)
-    silent = not_a_scheduler(address, CONNECT_TIMEOUT_S)
-    if silent:
-        raise InputError(
-            "--scheduler",
-            scheduler,
-            f"a running Dask scheduler that answers within {CONNECT_TIMEOUT_S} s",
-            silent,
-        )
-    try:
-        return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
-    except Exception as exc:  # refused, no answer in time, or another server's (a web server on
-        # ws:// answers the handshake with a page, tls:// asks for a security config first)
-        raise InputError(
-            "--scheduler",
-            scheduler,
-            f"a running Dask scheduler that answers within {CONNECT_TIMEOUT_S} s",
-            f"{type(exc).__name__}: {exc}".splitlines()[0],
-        ) from None
+    problem = not_a_scheduler(address, CONNECT_TIMEOUT_S)
+    if problem is None:
+        try:
+            return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
+        except Exception as exc:  # refused, no answer in time, or another server's (a web server on
+            # ws:// answers the handshake with a page, tls:// asks for a security config first)
+            problem = f"{type(exc).__name__}: {exc}".splitlines()[0]
+    allowed = f"a running Dask scheduler that answers within {CONNECT_TIMEOUT_S} s"
+    raise InputError("--scheduler", scheduler, allowed, problem)
 
 
 def not_a_scheduler(address: str, timeout: float) -> str | None:
@@ -174,13 +165,6 @@ def check_reachable(scheduler: str | None) -> None:
         connect(scheduler).close()
 
 
-def _dashboard(client) -> str | None:
-    try:
-        return client.dashboard_link
-    except Exception:  # no dashboard (bokeh missing, or disabled on the scheduler)
-        return None
-
-
 @dataclass(eq=False)
 class ClusterInfo(TypedResult):
     """What a sweep records of the Dask cluster it ran on (the ``cluster`` key of its record)."""
@@ -236,14 +220,18 @@ class DaskCluster:
         if self.scheduler_info is None:
             return None
         workers = self.scheduler_info.get("workers", {})
+        dashboard = None
+        if self.client is not None and (self.dashboard is not None or self.scheduler):
+            try:
+                dashboard = self.client.dashboard_link
+            except Exception:  # no dashboard (bokeh missing, or disabled on the scheduler)
+                pass
         return ClusterInfo(
             scheduler=self.scheduler or self.scheduler_info.get("address"),
             workers=len(workers),
             threads=sum(w.get("nthreads", 0) for w in workers.values()),
             local_cluster=self.local_cluster,
-            dashboard=_dashboard(self.client)
-            if self.client is not None and (self.dashboard is not None or self.scheduler)
-            else None,
+            dashboard=dashboard,
         )
 
     def map(self, jobs: Sequence[Job], on_done: Callable[[int, Any], None] | None) -> list:

@@ -47,7 +47,7 @@ from typing import TYPE_CHECKING, Any
 from poro2d.config import check_finite, check_keys
 from poro2d.criterion.config import CriterionConfig, build
 from poro2d.criterion.settings import CriterionSettings
-from poro2d.errors import InputError
+from poro2d.errors import InputError, check_int
 from poro2d.identity import identity_digest
 from poro2d.specimen.compaction import SpecimenSpec, check_feasible
 from poro2d.sweep.records import CriterionCaseResults
@@ -241,9 +241,7 @@ def parse_sweep(cfg: dict, base_dir: Path | None = None, *, validate: bool = Tru
     kind = sw.get("kind", "criterion")
     if kind not in KINDS:
         raise InputError("sweep.kind", kind, ", ".join(sorted(KINDS)))
-    retries = sw.get("retries", 2)
-    if not (isinstance(retries, int) and not isinstance(retries, bool) and 0 <= retries <= 20):
-        raise InputError("sweep.retries", retries, "an integer in [0, 20]")
+    retries = check_int("sweep.retries", sw.get("retries", 2), 0, 20)
     figures = sw.get("figures", False)
     if not isinstance(figures, bool):
         raise InputError("sweep.figures", figures, "true or false")

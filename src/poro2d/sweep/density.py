@@ -205,11 +205,6 @@ class CalibrationCase:
         """The digest naming the calibration's cache entry (:func:`calibration_key`)."""
         return calibration_key(self.base)
 
-    @property
-    def moves_first_trials(self) -> bool:
-        """Whether the grading's dense end or the box's walls move the first trials."""
-        return self.dense_end is not None or self.walls is not None
-
     @cached_property
     def sweep(self) -> SweepConfig:
         """The calibration's criterion cases, each friction from its first trial.
@@ -315,7 +310,9 @@ def calibrate(
     ran, reused = res.summary.ran, res.summary.reused
     info = {"key": case.key, "cases": str(cases.root), "ran": ran, "reused": reused,
             "source": "computed" if ran else "cache"}  # fmt: skip
-    if case.moves_first_trials:  # new callers only: earlier records keep their keys
+    # the interior porosities for new callers only (the grading's dense end or the box's walls move
+    # their first trials): earlier records keep their keys
+    if case.dense_end is not None or case.walls is not None:
         info["interior"] = interior_by_friction(res.rows, mus, seeds)
     rec = {
         **info,

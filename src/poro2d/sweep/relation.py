@@ -22,7 +22,7 @@ import numpy as np
 from poro2d import porosity as P
 from poro2d.config import check_keys, check_number_list
 from poro2d.criterion.run import lab_extremes
-from poro2d.errors import InputError, check_range
+from poro2d.errors import InputError, check_int, check_range
 from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance, float_or_nan
 from poro2d.paper_data import QUICK_SPECIMEN as PAPER_QUICK_SPECIMEN
@@ -57,9 +57,7 @@ def check_mode(mode) -> str:
 def lab_porosities(n_max: float, n_min: float, points: int) -> list[float]:
     """``points`` laboratory porosities from loose (n_max) to dense (n_min), 4 decimals."""
     P.relative_density(n_min, n_max, n_min)  # validates the extremes
-    if not (isinstance(points, int) and not isinstance(points, bool) and 2 <= points <= 50):
-        raise InputError("points", points, "an integer in [2, 50]")
-    return [round(float(x), 4) for x in np.linspace(n_max, n_min, points)]
+    return [round(float(x), 4) for x in np.linspace(n_max, n_min, check_int("points", points, 2, 50))]
 
 
 def fit_quadratic_origin(n_lab, n2d) -> QuadraticFit:

@@ -151,20 +151,16 @@ class GradingCase:
         )
 
 
-def _reference_params(base: CriterionBase) -> dict[str, Any]:
-    """The config's own grading as a case's parameters (dotted names, a grading file's path made
-    absolute): the reference case names its grading as the family's cases name theirs."""
-    g = base.with_grading_file_absolute().table("grading") or {"preset": "paper"}
-    return {f"grading.{k}": v for k, v in g.items()}
-
-
 def gradings(base: CriterionBase, cus: list[float]) -> list[GradingCase]:
     """The config's grading, then the log-linear family at its mean disk area."""
     from poro2d.criterion.config import build
     from poro2d.grading import log_linear_grading
 
     _, ref, _, _ = build(base.as_config(), base.base_dir)
-    out = [GradingCase(REFERENCE, None, _reference_params(base), ref)]
+    # the config's own grading as a case's parameters (dotted names, a grading file's path made
+    # absolute): the reference case names its grading as the family's cases name theirs
+    own = base.with_grading_file_absolute().table("grading") or {"preset": "paper"}
+    out = [GradingCase(REFERENCE, None, {f"grading.{k}": v for k, v in own.items()}, ref)]
     area = ref.mean_disk_area()
     for cu in cus:
         g = log_linear_grading(cu, area)
@@ -195,13 +191,6 @@ def check_gradings(base: CriterionBase, cases: list[GradingCase]) -> None:
                 f"its largest disk is {1e3 * d_max:.4g} mm: use a smaller Cu or a taller box",
             )
         check_feasible(spec, g.curve, settings.initial_trial())
-
-
-def grading_sweep(base: CriterionBase, cases: list[GradingCase], seeds: int) -> SweepConfig:
-    """One criterion case per grading and seed, everything else as in ``base``."""
-    params = [dict(g.params, seed=s) for g in cases for s in range(seeds)]
-    table = {"kind": "criterion", "title": "accepted n2D against grading width", "cases": params}
-    return base.with_tables(grading={}).sweep(table, params)  # each case names its own grading
 
 
 # ------------------------------------------------------------------------------ analysis
@@ -468,7 +457,10 @@ class SensitivityCase:
         _, _, crit, _ = build(study.as_config(), study.base_dir)
         cases = gradings(study, settings.cus)
         check_gradings(study, cases)
-        sweep = grading_sweep(study, cases, settings.seeds)
+        # one criterion case per grading and seed, everything else as in the study's base
+        params = [dict(g.params, seed=s) for g in cases for s in range(settings.seeds)]
+        table = {"kind": "criterion", "title": "accepted n2D against grading width", "cases": params}
+        sweep = study.with_tables(grading={}).sweep(table, params)  # each case names its own grading
         # the friction axis is the density calibration, with its settings (layers that settle):
         # the same cases as the relation's, read back from the shared cache when it ran them
         calibration = CalibrationCase(D.with_density_defaults(study), tuple(settings.mus), settings.seeds)
