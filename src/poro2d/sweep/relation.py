@@ -288,18 +288,15 @@ def _relation(pts: list[dict], n_max: float, n_min: float, mode: str, **extra: A
     })  # fmt: skip
 
 
-def write_relation(rel: RelationResult, store: Store, extra: dict | None = None) -> list[Path]:
+def write_relation(rel: RelationResult, store: Store) -> list[Path]:
     """relation.csv and relation.json in ``store`` (the figures, relation.png and relation.svg, are
-    drawn from the result by ``draw_relation`` (``report/relation_figure.py``)).
-
-    ``rel``: an analysed relation (with ``extra`` keys for the file) or a :class:`RelationResult`.
-    """
+    drawn from the result by ``draw_relation`` (``report/relation_figure.py``))."""
     # a seed's missing number is None (NaN as the file keeps it): written as NaN was
     flat = [{k: " ".join(f"{float_or_nan(x):.4f}" for x in v) if isinstance(v, list) else v
              for k, v in p.to_dict().items()} for p in rel.points]  # fmt: skip
     table = store.write_csv("relation.csv", flat)
-    record = dict(rel.to_dict(), **(extra or {}))
-    record.setdefault("provenance", Provenance.now().to_dict())  # a RelationResult carries its own
+    record = rel.to_dict()
+    record.setdefault("provenance", Provenance.now().to_dict())  # a finished relation carries its own
     file = store.write_json("relation.json", record)
     return [table, file]
 

@@ -539,18 +539,15 @@ def write_sensitivity(sens: dict, store: Store) -> SensitivityResult:
     sens = dict(sens, figure=str(store.path("sensitivity.png")), provenance=Provenance.now().to_dict())
     result = SensitivityResult.from_dict(sens)
     store.write_csv("sensitivity_seeds.csv", sens["seeds"])
-    store.write_csv("sensitivity.csv", [row.to_dict() for row in _csv_rows(result)])
+    # the grading points, then the friction points, each saying whether it reproduces the paper
+    answer, version = result.answer, result.provenance.poro2d_version
+    points = result.points.grading + result.points.mu_prep
+    rows = [
+        PointRow.of(p, answer.target, answer.tolerance, result.settings.seed_list, version) for p in points
+    ]
+    store.write_csv("sensitivity.csv", rows)
     store.write_result("sensitivity.json", result)
     return result
-
-
-def _csv_rows(result: SensitivityResult) -> list[PointRow]:
-    """The rows of ``sensitivity.csv``: the grading points, then the friction points."""
-    answer, version = result.answer, result.provenance.poro2d_version
-    return [
-        PointRow.of(p, answer.target, answer.tolerance, result.settings.seed_list, version)
-        for p in result.points.grading + result.points.mu_prep
-    ]
 
 
 def load_sensitivity(store: Store) -> SensitivityResult:
