@@ -59,6 +59,13 @@ class CaseRow(TypedResult):
     results: dict[str, Any] | None
 
 
+#: a trial's porosities a criterion case keeps, of its last (``last_<name>``) and first trial
+PROBED = ("trial_porosity", "new_porosity")
+#: a trial's disks and walls a criterion case keeps, of its last trial as they are, of its first
+#: as ``first_<name>``
+WALLS = ("particle_count", "plate_moved", "f_top_n_per_m", "f_bottom_n_per_m", "self_weight_n_per_m")
+
+
 @dataclass(eq=False)
 class CriterionCaseResults(ByName, TypedResult):
     """The table cells of a criterion case (``results`` of its row): the run's answer, then the
@@ -113,13 +120,6 @@ class CriterionCaseResults(ByName, TypedResult):
             **{f"first_{key}": first.get(key) for key in (*PROBED, *WALLS)},
             criterion_time_s=res.time_total_s,
         )
-
-
-#: a trial's porosities a criterion case keeps, of its last (``last_<name>``) and first trial
-PROBED = ("trial_porosity", "new_porosity")
-#: a trial's disks and walls a criterion case keeps, of its last trial as they are, of its first
-#: as ``first_<name>``
-WALLS = ("particle_count", "plate_moved", "f_top_n_per_m", "f_bottom_n_per_m", "self_weight_n_per_m")
 
 
 @dataclass(eq=False)
