@@ -110,7 +110,10 @@ def not_a_scheduler(address: str, timeout: float) -> str | None:
         return None
     try:
         with socket.create_connection((parts.hostname, parts.port), timeout=timeout) as sock:
-            greeting = _receive(sock, 16, timeout)
+            try:  # the first 16 bytes, or what came of them before the end of the stream
+                greeting = sock.makefile("rb").read(16)
+            except TimeoutError:  # no complete handshake in time: whatever came is not one
+                greeting = b""
     except OSError as exc:  # refused or unreachable: the client says so in its own words
         return None if not isinstance(exc, TimeoutError) else f"no connection in {timeout:g} s"
     if len(greeting) < 16:
@@ -119,21 +122,6 @@ def not_a_scheduler(address: str, timeout: float) -> str | None:
     if not (16 <= length < 1 << 30 and 1 <= frames < 1 << 16):
         return f"the server at {parts.hostname}:{parts.port} does not speak Dask's protocol"
     return None
-
-
-def _receive(sock: socket.socket, count: int, timeout: float) -> bytes:
-    """Up to ``count`` bytes, as many as arrive before ``timeout`` or the end of the stream."""
-    sock.settimeout(timeout)
-    data = b""
-    try:
-        while len(data) < count:
-            chunk = sock.recv(count - len(data))
-            if not chunk:
-                break
-            data += chunk
-    except TimeoutError:
-        pass
-    return data
 
 
 def quiet_shutdown_logs(client) -> None:
