@@ -105,10 +105,9 @@ def compute_case(case: dict, store: Store, func) -> CaseRow:
 
 
 def _run_case(case: dict, store: Store, func) -> CaseRow:
-    stage = case_stage(case, store)
-    done = stage.stored(RESULT, accept=_is_done)
+    done = finished_row(case, store)
     if done is not None:  # a retry after the marker was written
-        return CaseRow.from_dict(done)
+        return done
     pin_numba_threads()
     row: dict[str, Any] = {
         "case_id": case["id"],
@@ -121,8 +120,8 @@ def _run_case(case: dict, store: Store, func) -> CaseRow:
     }
     t0 = time.perf_counter()
     try:
-        return stage.run(lambda: _done_row(case, store, func, row, t0), RESULT, accept=_is_done,
-                         decode=CaseRow.from_dict)  # fmt: skip
+        return case_stage(case, store).run(lambda: _done_row(case, store, func, row, t0), RESULT,
+                                           accept=_is_done, decode=CaseRow.from_dict)  # fmt: skip
     except Exception as exc:
         row.update(
             status="failed",
