@@ -13,10 +13,11 @@ from poro2d.cli import options as opt
 from poro2d.console import OutputConsole, Table
 
 if TYPE_CHECKING:
-    from poro2d.sweep.records import Spread
     from poro2d.sweep.results import RelationResult
 
 console = OutputConsole()
+#: the relation's table
+COLUMNS = ("nLab", "Dr", "n2D DEM (box n')", "interior n", "fit", "Eq. 12", "LIM 2D-3D", "LIM 2D-Lab", "flag")
 
 
 def relation_cmd(
@@ -69,32 +70,13 @@ def register(app: typer.Typer) -> None:
     app.command("relation")(relation_cmd)
 
 
-def _print_interior_spread(sp: Spread) -> None:
-    """The loose-to-dense spread of the interior porosity (the packing's own, no gap under the plate)."""
-    d = sp.interior_loose_minus_dense
-    if d is None or not math.isfinite(d):
-        return
-    order = "monotone" if sp.interior_monotone else "NOT monotone"
-    console.print(f"interior porosity, loose - dense: {d:+.4f} +- {sp.interior_sd:.4f}; {order} in nLab")
-
-
 def print_relation(rel: RelationResult | dict, out: Path) -> None:
     from poro2d.sweep.results import RelationResult
     from poro2d.typed_result import part
 
     rel = part(RelationResult, rel)  # a relation's dict (relation.json as read) typed
     t = Table(title="n2D(nLab) from the criterion")
-    for c in (
-        "nLab",
-        "Dr",
-        "n2D DEM (box n')",
-        "interior n",
-        "fit",
-        "Eq. 12",
-        "LIM 2D-3D",
-        "LIM 2D-Lab",
-        "flag",
-    ):
+    for c in COLUMNS:
         t.add_column(c, justify="right")
 
     def f(v) -> str:
@@ -107,17 +89,8 @@ def print_relation(rel: RelationResult | dict, out: Path) -> None:
         inner = f(getattr(p, "n2d_interior", None))  # a paper-mode point has none
         if inner and p.n2d_interior_sd is not None:
             inner += f" +- {p.n2d_interior_sd:.4f}"
-        t.add_row(
-            f"{p.n_lab:.4f}",
-            f"{p.relative_density:.2f}",
-            dem,
-            inner,
-            f(p.n2d_fit),
-            f(p.n2d_parabolic),
-            f(p.n2d_lim_3d),
-            f(p.n2d_lim_lab),
-            p.flag or "ok",
-        )
+        fits = (f(p.n2d_fit), f(p.n2d_parabolic), f(p.n2d_lim_3d), f(p.n2d_lim_lab))
+        t.add_row(f"{p.n_lab:.4f}", f"{p.relative_density:.2f}", dem, inner, *fits, p.flag or "ok")
     console.print(t)
     if rel.mode == "density":
         console.print(
@@ -137,7 +110,12 @@ def print_relation(rel: RelationResult | dict, out: Path) -> None:
                 f"loose - dense: {sp.n2d_loose_minus_dense:+.4f} +- {sp.sd:.4f} (measured, not a fit); "
                 f"{'monotone' if sp.monotone else 'NOT monotone'} in nLab"
             )
-            _print_interior_spread(sp)
+            d = sp.interior_loose_minus_dense  # the packing's own porosity, no gap under the plate
+            if d is not None and math.isfinite(d):
+                order = "monotone" if sp.interior_monotone else "NOT monotone"
+                console.print(
+                    f"interior porosity, loose - dense: {d:+.4f} +- {sp.interior_sd:.4f}; {order} in nLab"
+                )
     fit = rel.fit
     if fit is not None:
         console.print(

@@ -85,24 +85,15 @@ def connect(scheduler: str):
     from distributed import Client
 
     address = check_scheduler_address(scheduler)
-    silent = not_a_scheduler(address, CONNECT_TIMEOUT_S)
-    if silent:
-        raise InputError(
-            "--scheduler",
-            scheduler,
-            f"a running Dask scheduler that answers within {CONNECT_TIMEOUT_S} s",
-            silent,
-        )
-    try:
-        return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
-    except Exception as exc:  # refused, no answer in time, or another server's (a web server on
-        # ws:// answers the handshake with a page, tls:// asks for a security config first)
-        raise InputError(
-            "--scheduler",
-            scheduler,
-            f"a running Dask scheduler that answers within {CONNECT_TIMEOUT_S} s",
-            f"{type(exc).__name__}: {exc}".splitlines()[0],
-        ) from None
+    problem = not_a_scheduler(address, CONNECT_TIMEOUT_S)
+    if problem is None:
+        try:
+            return Client(address, timeout=f"{CONNECT_TIMEOUT_S}s")
+        except Exception as exc:  # refused, no answer in time, or another server's (a web server on
+            # ws:// answers the handshake with a page, tls:// asks for a security config first)
+            problem = f"{type(exc).__name__}: {exc}".splitlines()[0]
+    allowed = f"a running Dask scheduler that answers within {CONNECT_TIMEOUT_S} s"
+    raise InputError("--scheduler", scheduler, allowed, problem)
 
 
 def not_a_scheduler(address: str, timeout: float) -> str | None:
@@ -119,7 +110,10 @@ def not_a_scheduler(address: str, timeout: float) -> str | None:
         return None
     try:
         with socket.create_connection((parts.hostname, parts.port), timeout=timeout) as sock:
-            greeting = _receive(sock, 16, timeout)
+            try:  # the first 16 bytes, or what came of them before the end of the stream
+                greeting = sock.makefile("rb").read(16)
+            except TimeoutError:  # no complete handshake in time: whatever came is not one
+                greeting = b""
     except OSError as exc:  # refused or unreachable: the client says so in its own words
         return None if not isinstance(exc, TimeoutError) else f"no connection in {timeout:g} s"
     if len(greeting) < 16:
@@ -128,21 +122,6 @@ def not_a_scheduler(address: str, timeout: float) -> str | None:
     if not (16 <= length < 1 << 30 and 1 <= frames < 1 << 16):
         return f"the server at {parts.hostname}:{parts.port} does not speak Dask's protocol"
     return None
-
-
-def _receive(sock: socket.socket, count: int, timeout: float) -> bytes:
-    """Up to ``count`` bytes, as many as arrive before ``timeout`` or the end of the stream."""
-    sock.settimeout(timeout)
-    data = b""
-    try:
-        while len(data) < count:
-            chunk = sock.recv(count - len(data))
-            if not chunk:
-                break
-            data += chunk
-    except TimeoutError:
-        pass
-    return data
 
 
 def quiet_shutdown_logs(client) -> None:
@@ -172,13 +151,6 @@ def check_reachable(scheduler: str | None) -> None:
     """
     if scheduler:
         connect(scheduler).close()
-
-
-def _dashboard(client) -> str | None:
-    try:
-        return client.dashboard_link
-    except Exception:  # no dashboard (bokeh missing, or disabled on the scheduler)
-        return None
 
 
 @dataclass(eq=False)
@@ -236,14 +208,18 @@ class DaskCluster:
         if self.scheduler_info is None:
             return None
         workers = self.scheduler_info.get("workers", {})
+        dashboard = None
+        if self.client is not None and (self.dashboard is not None or self.scheduler):
+            try:
+                dashboard = self.client.dashboard_link
+            except Exception:  # no dashboard (bokeh missing, or disabled on the scheduler)
+                pass
         return ClusterInfo(
             scheduler=self.scheduler or self.scheduler_info.get("address"),
             workers=len(workers),
             threads=sum(w.get("nthreads", 0) for w in workers.values()),
             local_cluster=self.local_cluster,
-            dashboard=_dashboard(self.client)
-            if self.client is not None and (self.dashboard is not None or self.scheduler)
-            else None,
+            dashboard=dashboard,
         )
 
     def map(self, jobs: Sequence[Job], on_done: Callable[[int, Any], None] | None) -> list:

@@ -34,9 +34,10 @@ def map_inline(jobs: Sequence[Job], on_report, on_done) -> list:
     """The jobs one after the other in this process; outcomes in job order."""
     outcomes: list = []
     for i, job in enumerate(jobs):
-        send = (lambda *msg, i=i: on_report(i, *msg)) if on_report is not None else _ignore
-        try:
-            outcome = job.run(_Throttle(send))
+        try:  # without on_report, the job's messages go nowhere (Job.run)
+            outcome = job.run(
+                _Throttle(lambda *msg, i=i: on_report(i, *msg)) if on_report is not None else None
+            )
         except Exception as exc:  # noqa: BLE001 - returned with the job it belongs to
             outcome = Failed.of(job, exc)
         outcomes.append(outcome)
@@ -135,10 +136,6 @@ def _end_workers(before: set[int]) -> None:
     for child in mp.active_children():
         if child.pid not in before:
             child.terminate()
-
-
-def _ignore(*_msg) -> None:
-    pass
 
 
 __all__ = ["REPORT_INTERVAL_S", "map_in_processes", "map_inline"]

@@ -54,11 +54,9 @@ def record(folder: str | os.PathLike, name: str) -> None:
     manifest of the folder that holds the file, so a sub-folder moved on its own keeps it.
     """
     path = Path(folder) / name
-    home = path.parent
-    entries = _manifest(home)
+    entries = _manifest(path.parent)
     entries[path.name] = file_digest(path)
-    with atomic_path(home / MANIFEST) as tmp:
-        tmp.write_text(json.dumps(entries, indent=1, sort_keys=True) + "\n")
+    _save(path.parent, entries)
 
 
 def forget(folder: str | os.PathLike, name: str) -> None:
@@ -66,8 +64,12 @@ def forget(folder: str | os.PathLike, name: str) -> None:
     path = Path(folder) / name
     entries = _manifest(path.parent)
     if entries.pop(path.name, None) is not None:
-        with atomic_path(path.parent / MANIFEST) as tmp:
-            tmp.write_text(json.dumps(entries, indent=1, sort_keys=True) + "\n")
+        _save(path.parent, entries)
+
+
+def _save(folder: Path, entries: dict[str, str]) -> None:
+    with atomic_path(folder / MANIFEST) as tmp:
+        tmp.write_text(json.dumps(entries, indent=1, sort_keys=True) + "\n")
 
 
 def intact(folder: str | os.PathLike, name: str) -> bool:

@@ -128,12 +128,7 @@ class Store:
 
     def read_json(self, name: str) -> Any:
         """The JSON in ``name``; None when it is missing, damaged or cannot be parsed."""
-        if not self.intact(name):
-            return None
-        try:
-            return json.loads((self._root / name).read_text())
-        except (OSError, ValueError):
-            return None
+        return self._read(name, lambda path: json.loads(path.read_text()), (OSError, ValueError))
 
     def write_result(self, name: str, result: Any) -> Path:
         """A typed result's file (``result.to_dict()``), atomically."""
@@ -158,21 +153,17 @@ class Store:
         numbers written (a table parser may round the last digit). A table changed since
         it was written reads as missing.
         """
-        if not self.intact(name):
-            return None
-        try:
-            with open(self._root / name, newline="") as fh:
+
+        def rows(path: Path) -> list[dict[str, str]]:
+            with open(path, newline="") as fh:
                 return list(csv.DictReader(fh))
-        except (OSError, UnicodeDecodeError):
-            return None
+
+        return self._read(name, rows, (OSError, UnicodeDecodeError))
 
     def write_frame(self, name: str, frame: pd.DataFrame, **kw: Any) -> Path:
         """A pandas table as CSV, atomically (``kw`` go to ``DataFrame.to_csv``; no index by default)."""
-        path = self._root / name
         kw.setdefault("index", False)
-        with atomic_path(path) as tmp:
-            frame.to_csv(tmp, **kw)
-        return self._written(name)
+        return self._write(name, lambda tmp: frame.to_csv(tmp, **kw))
 
     def read_frame(self, name: str, **kw: Any) -> pd.DataFrame:
         """The CSV ``name`` as a pandas table (``kw`` go to ``pandas.read_csv``)."""
@@ -190,38 +181,26 @@ class Store:
 
     def write_text(self, name: str, text: str) -> Path:
         """A text file (a report, a script), atomically."""
-        path = self._root / name
-        with atomic_path(path) as tmp:
-            tmp.write_text(text)
-        return self._written(name)
+        return self._write(name, lambda tmp: tmp.write_text(text))
 
     def read_text(self, name: str) -> str | None:
         """The text in ``name``; None when it is missing, damaged or unreadable."""
-        if not self.intact(name):
-            return None
-        try:
-            return (self._root / name).read_text()
-        except (OSError, UnicodeDecodeError):
-            return None
+        return self._read(name, Path.read_text, (OSError, UnicodeDecodeError))
 
     # -- arrays and simulation states -------------------------------------------------
 
     def write_arrays(self, name: str, **arrays: Any) -> Path:
         """Named arrays in one ``.npz``, atomically."""
-        path = self._root / name
-        with atomic_path(path, suffix=".npz") as tmp:
-            np.savez(tmp, **arrays)
-        return self._written(name)
+        return self._write(name, lambda tmp: np.savez(tmp, **arrays), suffix=".npz")
 
     def read_arrays(self, name: str) -> dict[str, np.ndarray] | None:
         """The arrays of ``name`` by name (all read now, so the file is closed); None if missing or broken."""
-        if not self.intact(name):
-            return None
-        try:
-            with np.load(self._root / name, allow_pickle=False) as z:
+
+        def arrays(path: Path) -> dict[str, np.ndarray]:
+            with np.load(path, allow_pickle=False) as z:
                 return {k: z[k] for k in z.files}
-        except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile):
-            return None
+
+        return self._read(name, arrays, (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile))
 
     def save_state(self, name: str, sim: Simulation, extra: dict | None = None) -> Path:
         """A simulation's whole state (:func:`poro2d.dem.checkpoint.save`)."""
@@ -265,6 +244,22 @@ class Store:
         digests.forget(self._root, name)
 
     # -- integrity ------------------------------------------------------------------------
+
+    def _write(self, name: str, write: Callable[[Path], Any], suffix: str | None = None) -> Path:
+        """``write(tmp)`` made ``name`` atomically, its digest noted in the manifest."""
+        with atomic_path(self._root / name, suffix=suffix) as tmp:
+            write(tmp)
+        return self._written(name)
+
+    def _read(self, name: str, read: Callable[[Path], R], errors: tuple[type[Exception], ...]) -> R | None:
+        """``read`` of the file ``name``; None when it differs from what was written, or ``read`` raises
+        one of ``errors`` (missing, unreadable, not of its format)."""
+        if not self.intact(name):
+            return None
+        try:
+            return read(self._root / name)
+        except errors:
+            return None
 
     def _written(self, name: str) -> Path:
         digests.record(self._root, name)

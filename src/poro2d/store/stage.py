@@ -93,15 +93,6 @@ class Fingerprint:
         return differing_keys(self.compared(stored), self.compared())
 
 
-def _default_explain(parameter: str) -> Explain:
-    def explain(keys: list[str] | None, stored: Mapping | None) -> str:
-        if keys is None:
-            return f"it holds work without a record of its inputs; choose another {parameter}"
-        return f"it holds results of other inputs ({', '.join(keys)}); choose another {parameter}"
-
-    return explain
-
-
 class ResumableStage:
     """Stages of work in ``folder`` bound to ``fingerprint`` through the record file ``record``.
 
@@ -135,8 +126,14 @@ class ResumableStage:
         self.extra = dict(extra or {})
         self.parameter = parameter
         self.allowed = allowed
-        self.explain = explain or _default_explain(parameter)
+        self.explain = explain or self._explain
         self.unrecorded = unrecorded
+
+    def _explain(self, keys: list[str] | None, stored: Mapping | None) -> str:
+        """The default hint for a refused folder: the keys its work differs in, or that it has no record."""
+        if keys is None:
+            return f"it holds work without a record of its inputs; choose another {self.parameter}"
+        return f"it holds results of other inputs ({', '.join(keys)}); choose another {self.parameter}"
 
     def work_started(self) -> bool:
         """True once the folder holds anything besides its record (and temporaries of it)."""

@@ -45,9 +45,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from poro2d.config import check_finite, check_keys
-from poro2d.criterion.config import CriterionConfig
-from poro2d.errors import InputError
+from poro2d.criterion.config import CriterionConfig, build
+from poro2d.criterion.settings import CriterionSettings
+from poro2d.errors import InputError, check_int
 from poro2d.identity import identity_digest
+from poro2d.specimen.compaction import SpecimenSpec, check_feasible
 from poro2d.sweep.records import CriterionCaseResults
 
 if TYPE_CHECKING:
@@ -58,7 +60,7 @@ KINDS: dict[str, Callable[[dict, Store], Mapping[str, Any]]] = {}
 #: kind -> validate(config, base_dir); raises InputError before any case runs
 VALIDATORS: dict[str, Callable[[dict, Path | None], None]] = {}
 #: tables whose dataclass field names may be used without the table prefix
-BARE_NAME_TABLES: dict[str, type] = {}
+BARE_NAME_TABLES: dict[str, type] = {"specimen": SpecimenSpec, "criterion": CriterionSettings}
 
 #: keys of ``[sweep]`` that are options, not grid axes
 SWEEP_OPTIONS = {"kind", "cases", "figures", "retries", "title"}
@@ -86,18 +88,12 @@ def register_kind(
 
 # --------------------------------------------------------------------------- criterion kind
 def criterion_objects(config: dict, base_dir: Path | None = None):
-    """(spec, grading, settings, seed) of a criterion case's config, checked feasible."""
-    from poro2d.criterion.config import build
-    from poro2d.specimen.compaction import check_feasible
-
+    """(spec, grading, settings, seed) of a criterion case's config, checked feasible (the criterion
+    kind's validator)."""
     cfg = {k: v for k, v in config.items() if k in ("seed", "specimen", "grading", "criterion")}
     spec, grading, settings, seed = build(copy.deepcopy(cfg), base_dir)
     check_feasible(spec, grading, settings.initial_trial())
     return spec, grading, settings, seed
-
-
-def validate_criterion(config: dict, base_dir: Path | None = None) -> None:
-    criterion_objects(config, base_dir)
 
 
 def criterion_case(config: dict, store: Store) -> CriterionCaseResults:
@@ -114,15 +110,6 @@ def criterion_case(config: dict, store: Store) -> CriterionCaseResults:
     crit = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(store.root), progress=False,
                              config=config)  # fmt: skip
     return CriterionCaseResults.of(crit.run())
-
-
-def _register_builtin() -> None:
-    from poro2d.criterion.protocol import CriterionSettings
-    from poro2d.specimen.compaction import SpecimenSpec
-
-    BARE_NAME_TABLES.setdefault("specimen", SpecimenSpec)
-    BARE_NAME_TABLES.setdefault("criterion", CriterionSettings)
-    register_kind("criterion", criterion_case, validate_criterion)
 
 
 # --------------------------------------------------------------------------------- cases
@@ -166,8 +153,6 @@ def config_tables(prefix: str = "") -> dict[str, type]:
     Their fields marked as not changing results (:mod:`poro2d.identity`: the thread count)
     are left out of a case's identity.
     """
-    if not BARE_NAME_TABLES:
-        _register_builtin()
     return {f"{prefix}{table}": cls for table, cls in BARE_NAME_TABLES.items()}
 
 
@@ -186,8 +171,6 @@ def _field_names(cls: type) -> set[str]:
 
 def resolve_name(name: str) -> str:
     """``n_lab`` -> ``criterion.n_lab``; dotted names are checked against the case tables."""
-    if not BARE_NAME_TABLES:
-        _register_builtin()
     parts = name.split(".")
     if len(parts) == 1:
         if name == "seed":
@@ -250,8 +233,6 @@ def axes_of(cases: list[dict[str, Any]]) -> list[str]:
 
 def parse_sweep(cfg: dict, base_dir: Path | None = None, *, validate: bool = True) -> SweepConfig:
     """Cases of a sweep config dict (a TOML file's, read at the edge); every problem is an InputError."""
-    if not BARE_NAME_TABLES:
-        _register_builtin()
     check_keys("config", cfg, TOP_KEYS)
     check_finite("config", cfg)  # nothing non-finite reaches a case id or a stored config
     sw = cfg.get("sweep")
@@ -260,9 +241,7 @@ def parse_sweep(cfg: dict, base_dir: Path | None = None, *, validate: bool = Tru
     kind = sw.get("kind", "criterion")
     if kind not in KINDS:
         raise InputError("sweep.kind", kind, ", ".join(sorted(KINDS)))
-    retries = sw.get("retries", 2)
-    if not (isinstance(retries, int) and not isinstance(retries, bool) and 0 <= retries <= 20):
-        raise InputError("sweep.retries", retries, "an integer in [0, 20]")
+    retries = check_int("sweep.retries", sw.get("retries", 2), 0, 20)
     figures = sw.get("figures", False)
     if not isinstance(figures, bool):
         raise InputError("sweep.figures", figures, "true or false")
@@ -311,8 +290,6 @@ def make_sweep(
     which no case sees). Two cases with one id, or a case its kind refuses, are an
     :class:`InputError` naming the case.
     """
-    if not BARE_NAME_TABLES:
-        _register_builtin()
     check_keys("config", raw, TOP_KEYS)
     check_finite("config", raw)
     # the tables every case starts from: a study's own tables are recorded in sweep.json, not by a case
@@ -339,4 +316,4 @@ def make_sweep(
     return SweepConfig(kind, cases, dict(raw), base_dir, retries, figures, title, list(axes))
 
 
-_register_builtin()
+register_kind("criterion", criterion_case, criterion_objects)

@@ -205,11 +205,6 @@ class CalibrationCase:
         """The digest naming the calibration's cache entry (:func:`calibration_key`)."""
         return calibration_key(self.base)
 
-    @property
-    def moves_first_trials(self) -> bool:
-        """Whether the grading's dense end or the box's walls move the first trials."""
-        return self.dense_end is not None or self.walls is not None
-
     @cached_property
     def sweep(self) -> SweepConfig:
         """The calibration's criterion cases, each friction from its first trial.
@@ -237,13 +232,19 @@ class CalibrationCase:
         return tables.sweep(dict(table, cases=cases), cases)
 
 
-def _sample(row: CaseRow | LostCaseRow) -> float | None:
-    """The measured porosity n' of a case's accepted trial; None if it was not accepted."""
-    res = row.results or {}
-    if row.status != "done" or not res.get("converged"):
-        return None
-    v = res.get("last_new_porosity")
-    return float(v) if v is not None and math.isfinite(float(v)) else None
+def _per_friction(rows: list, mus: list[float], seeds: int, key: str) -> list[list[float | None]]:
+    """The results' ``key`` of every accepted calibration case (its n' measured), per friction and
+    seed; None for a case not accepted or not there, or a value that is not a number."""
+
+    def finite(v: Any) -> float | None:
+        return float(v) if v is not None and math.isfinite(float(v)) else None
+
+    out: list[list[float | None]] = [[None] * seeds for _ in mus]
+    for r in map(case_row, rows):
+        p, res = r.params or {}, r.results or {}
+        if r.status == "done" and res.get("converged") and finite(res.get("last_new_porosity")) is not None:
+            out[mus.index(float(p["specimen.friction_prep"]))][int(p["seed"])] = finite(res.get(key))
+    return out
 
 
 def interior_by_friction(rows: list[CaseRow | LostCaseRow | dict], mus: list[float],
@@ -253,24 +254,14 @@ def interior_by_friction(rows: list[CaseRow | LostCaseRow | dict], mus: list[flo
     Beside the calibration's samples (box porosities n'), the packing's own porosity: at the
     lowest friction it is the dense end to hold against the grading's jamming porosity.
     """
-    out: list[list[float | None]] = [[None] * seeds for _ in mus]
-    for r in map(case_row, rows):
-        p, res = r.params or {}, r.results or {}
-        v = res.get("interior_porosity")
-        if _sample(r) is not None and v is not None and math.isfinite(float(v)):
-            out[mus.index(float(p["specimen.friction_prep"]))][int(p["seed"])] = float(v)
-    return out
+    return _per_friction(rows, mus, seeds, "interior_porosity")
 
 
 def calibration_from_rows(
     rows: list[CaseRow | LostCaseRow | dict], mus: list[float], seeds: int
 ) -> Calibration:
-    samples: list[list[float | None]] = [[None] * seeds for _ in mus]
-    for r in map(case_row, rows):
-        p = r.params or {}
-        mu, seed = float(p["specimen.friction_prep"]), int(p["seed"])
-        samples[mus.index(mu)][seed] = _sample(r)
-    return Calibration(list(mus), samples, list(range(seeds)))
+    """mu_prep -> n2D: the measured porosity n' of every case's accepted trial, per friction and seed."""
+    return Calibration(list(mus), _per_friction(rows, mus, seeds, "last_new_porosity"), list(range(seeds)))
 
 
 def calibration_store(case: CalibrationCase, store: Store, *, use_cache: bool = True) -> Store:
@@ -319,7 +310,9 @@ def calibrate(
     ran, reused = res.summary.ran, res.summary.reused
     info = {"key": case.key, "cases": str(cases.root), "ran": ran, "reused": reused,
             "source": "computed" if ran else "cache"}  # fmt: skip
-    if case.moves_first_trials:  # new callers only: earlier records keep their keys
+    # the interior porosities for new callers only (the grading's dense end or the box's walls move
+    # their first trials): earlier records keep their keys
+    if case.dense_end is not None or case.walls is not None:
         info["interior"] = interior_by_friction(res.rows, mus, seeds)
     rec = {
         **info,

@@ -14,7 +14,24 @@ import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 
+from poro2d.execute.options import RunOptions
+from poro2d.io_utils import check_output_dir
 from poro2d.store import Store
+
+
+@contextmanager
+def study_store(store: Store | None, kind: str, options: RunOptions, announce=None) -> Iterator[Store]:
+    """``store`` for a study's call: its folder and the scheduler checked, then ``announce()`` (the
+    command's banner, so that a refusal stays its only line) and the store :func:`held`."""
+    from poro2d.execute.dask_cluster import check_reachable
+
+    if store is not None:
+        check_output_dir(store.parameter, store.root)
+    check_reachable(options.scheduler)
+    if announce is not None:
+        announce()
+    with held(store, kind) as kept:
+        yield kept
 
 
 @contextmanager
@@ -29,4 +46,4 @@ def held(store: Store | None, kind: str | None = None) -> Iterator[Store]:
         yield store
 
 
-__all__ = ["held"]
+__all__ = ["held", "study_store"]

@@ -21,6 +21,20 @@ from poro2d.typed_result import TypedResult
 if TYPE_CHECKING:
     from poro2d.criterion.result import CriterionResult
 
+#: the conversion methods a relation point is compared with (the table; the figure draws the same)
+COMPARE = ("parabolic", "lim_3d", "lim_lab", "densest_state")
+
+
+def ending_with(annotations: Mapping[str, str]):
+    """Class decorator, under ``@dataclass``: the fields ``annotations`` (name -> type) appended to
+    the class's own, so that keys several records end with are declared once, in one table."""
+
+    def add(cls: type) -> type:
+        cls.__annotations__.update(annotations)
+        return cls
+
+    return add
+
 
 @dataclass(eq=False)
 class CaseRow(TypedResult):
@@ -34,15 +48,22 @@ class CaseRow(TypedResult):
     case_id: str
     kind: str
     params: dict[str, Any]
-    host: str | None = None
-    pid: int | None = None
-    worker: str | None = None
-    started_utc: str | None = None
-    status: str | None = None
-    error: str | None = None
-    time_s: float | None = None
-    finished_utc: str | None = None
-    results: dict[str, Any] | None = None
+    host: str | None
+    pid: int | None
+    worker: str | None
+    started_utc: str | None
+    status: str | None
+    error: str | None
+    time_s: float | None
+    finished_utc: str | None
+    results: dict[str, Any] | None
+
+
+#: a trial's porosities a criterion case keeps, of its last (``last_<name>``) and first trial
+PROBED = ("trial_porosity", "new_porosity")
+#: a trial's disks and walls a criterion case keeps, of its last trial as they are, of its first
+#: as ``first_<name>``
+WALLS = ("particle_count", "plate_moved", "f_top_n_per_m", "f_bottom_n_per_m", "self_weight_n_per_m")
 
 
 @dataclass(eq=False)
@@ -94,22 +115,9 @@ class CriterionCaseResults(ByName, TypedResult):
             res,
             converged=bool(res.converged),
             iterations=len(its),
-            last_trial_porosity=last.get("trial_porosity"),
-            last_new_porosity=last.get("new_porosity"),
-            particle_count=last.get("particle_count"),
-            plate_moved=last.get("plate_moved"),
-            f_top_n_per_m=last.get("f_top_n_per_m"),
-            f_bottom_n_per_m=last.get("f_bottom_n_per_m"),
-            f_top_after_n_per_m=last.get("f_top_after_n_per_m"),
-            f_bottom_after_n_per_m=last.get("f_bottom_after_n_per_m"),
-            self_weight_n_per_m=last.get("self_weight_n_per_m"),
-            first_trial_porosity=first.get("trial_porosity"),
-            first_particle_count=first.get("particle_count"),
-            first_f_top_n_per_m=first.get("f_top_n_per_m"),
-            first_f_bottom_n_per_m=first.get("f_bottom_n_per_m"),
-            first_self_weight_n_per_m=first.get("self_weight_n_per_m"),
-            first_plate_moved=first.get("plate_moved"),
-            first_new_porosity=first.get("new_porosity"),
+            **{f"last_{key}": last.get(key) for key in PROBED},
+            **{key: last.get(key) for key in (*WALLS, "f_top_after_n_per_m", "f_bottom_after_n_per_m")},
+            **{f"first_{key}": first.get(key) for key in (*PROBED, *WALLS)},
             criterion_time_s=res.time_total_s,
         )
 
@@ -250,13 +258,20 @@ class RelationPoint(TypedResult):
         return super().from_dict(data)
 
 
+#: the keys every relation point ends with: the conversions compared, then the fitted parabola
+#: there, the point's distance from it and from Eq. 12 (None without a fit)
+POINT_ENDS = dict.fromkeys(
+    [*(f"n2d_{m}" for m in COMPARE), "n2d_fit", "residual", "dem_minus_parabola"], "float | None"
+)
+
+
 @dataclass(eq=False)
+@ending_with(POINT_ENDS)
 class PaperPoint(RelationPoint):
     """One laboratory state of a paper-mode relation: its case, the criterion's n2D, the methods.
 
     ``n2d_dem``: the accepted n2D, else the last estimate n' (``flag`` says which) or NaN for
-    a failed case; ``n2d_<method>``: the conversions compared; ``n2d_fit``, ``residual``:
-    the fitted parabola there and the point's distance from it.
+    a failed case.
     """
 
     case_id: str
@@ -270,16 +285,10 @@ class PaperPoint(RelationPoint):
     initial_trial_porosity: float | None
     particle_count: int | None
     message: str | None
-    n2d_parabolic: float
-    n2d_lim_3d: float
-    n2d_lim_lab: float
-    n2d_densest_state: float
-    n2d_fit: float | None = None
-    residual: float | None = None
-    dem_minus_parabola: float | None = None
 
 
 @dataclass(eq=False)
+@ending_with(POINT_ENDS)
 class DensityPoint(RelationPoint):
     """One laboratory state of a density-mode relation: its target, friction and n2D over seeds.
 
@@ -306,13 +315,6 @@ class DensityPoint(RelationPoint):
     converged: bool
     flag: str
     message: str
-    n2d_parabolic: float
-    n2d_lim_3d: float
-    n2d_lim_lab: float
-    n2d_densest_state: float
-    n2d_fit: float | None = None
-    residual: float | None = None
-    dem_minus_parabola: float | None = None
 
 
 @dataclass(eq=False)
@@ -324,6 +326,7 @@ class Eq12Coefficients(TypedResult):
 
 
 __all__ = [
+    "COMPARE",
     "Eq12Coefficients",
     "CalibrationRun",
     "CaseEntry",
@@ -338,4 +341,5 @@ __all__ = [
     "Spread",
     "SweepSummary",
     "case_row",
+    "ending_with",
 ]

@@ -22,15 +22,23 @@ import numpy as np
 from poro2d import porosity as P
 from poro2d.config import check_keys, check_number_list
 from poro2d.criterion.run import lab_extremes
-from poro2d.errors import InputError, check_range
+from poro2d.errors import InputError, check_int, check_range
 from poro2d.execute.options import RunOptions
-from poro2d.io_utils import Provenance, check_output_dir, float_or_nan
+from poro2d.io_utils import Provenance, float_or_nan
 from poro2d.paper_data import QUICK_SPECIMEN as PAPER_QUICK_SPECIMEN
 from poro2d.store import Store
 from poro2d.sweep.cases import SweepConfig
 from poro2d.sweep.criterion_base import CriterionBase
-from poro2d.sweep.output import held
-from poro2d.sweep.records import CaseRow, DensitySweeps, Eq12Coefficients, LostCaseRow, QuadraticFit, case_row
+from poro2d.sweep.output import study_store
+from poro2d.sweep.records import (
+    COMPARE,
+    CaseRow,
+    DensitySweeps,
+    Eq12Coefficients,
+    LostCaseRow,
+    QuadraticFit,
+    case_row,
+)
 from poro2d.sweep.results import RelationResult
 
 RELATION_KEYS = {"n_max", "n_min", "points", "n_lab", "mode", "seeds", "mu_prep"}
@@ -38,8 +46,6 @@ RELATION_KEYS = {"n_max", "n_min", "points", "n_lab", "mode", "seeds", "mu_prep"
 MODES = ("density", "paper")
 #: the small specimen of ``--quick`` (that of ``poro2d paper --quick``)
 QUICK_SPECIMEN = dict(PAPER_QUICK_SPECIMEN)
-#: conversion methods compared with the DEM points (the table; the figure draws the same)
-COMPARE = ("parabolic", "lim_3d", "lim_lab", "densest_state")
 
 
 def check_mode(mode) -> str:
@@ -51,9 +57,7 @@ def check_mode(mode) -> str:
 def lab_porosities(n_max: float, n_min: float, points: int) -> list[float]:
     """``points`` laboratory porosities from loose (n_max) to dense (n_min), 4 decimals."""
     P.relative_density(n_min, n_max, n_min)  # validates the extremes
-    if not (isinstance(points, int) and not isinstance(points, bool) and 2 <= points <= 50):
-        raise InputError("points", points, "an integer in [2, 50]")
-    return [round(float(x), 4) for x in np.linspace(n_max, n_min, points)]
+    return [round(float(x), 4) for x in np.linspace(n_max, n_min, check_int("points", points, 2, 50))]
 
 
 def fit_quadratic_origin(n_lab, n2d) -> QuadraticFit:
@@ -157,7 +161,6 @@ def analyse(rows: list[CaseRow | LostCaseRow | dict], n_max: float, n_min: float
             n2d, source = float_or_nan(res.get("last_new_porosity")), "last estimate n' (not converged)"
         else:
             n2d, source = math.nan, "case failed"
-        conv = P.convert_all(n_lab, n_max, n_min)
         pt = {
             "case_id": r.case_id,
             "n_lab": n_lab,
@@ -171,8 +174,6 @@ def analyse(rows: list[CaseRow | LostCaseRow | dict], n_max: float, n_min: float
             "particle_count": res.get("particle_count"),
             "message": res.get("message") or r.error,
         }
-        for m in COMPARE:
-            pt[f"n2d_{m}"] = conv.results[m].value
         pts.append(pt)
     pts.sort(key=lambda p: -p["n_lab"])  # loose to dense
     return _relation(pts, n_max, n_min, "paper")
@@ -184,10 +185,6 @@ def _stats(values: list[float]) -> tuple[float, float]:
     if a.size == 0:
         return math.nan, math.nan
     return float(a.mean()), float(a.std(ddof=1)) if a.size > 1 else 0.0
-
-
-def _why(row: CaseRow | LostCaseRow) -> str:
-    return str((row.results or {}).get("message") or row.error)
 
 
 def analyse_states(rows: list[CaseRow | LostCaseRow | dict], targets: list, cal, n_max: float,
@@ -212,8 +209,7 @@ def analyse_states(rows: list[CaseRow | LostCaseRow | dict], targets: list, cal,
         mean, sd = _stats(acc)
         m_mean, m_sd = _stats(meas)
         i_mean, i_sd = _stats(inner)
-        conv = P.convert_all(t.n_lab, n_max, n_min)
-        pt = {
+        pts.append({
             "n_lab": t.n_lab,
             "relative_density": t.relative_density,
             "degree_of_density": float(P.degree_of_density(t.n_lab, n_max, n_min)),
@@ -231,11 +227,9 @@ def analyse_states(rows: list[CaseRow | LostCaseRow | dict], targets: list, cal,
             "seeds_converged": len(ok),
             "converged": len(ok) > 0,
             "flag": "" if group and len(ok) == len(group) else f"{len(group) - len(ok)} seed(s) unconverged",
-            "message": "; ".join(_why(r) for r in group if not any(r is o for o in ok)),
-        }  # fmt: skip
-        for m in COMPARE:
-            pt[f"n2d_{m}"] = conv.results[m].value
-        pts.append(pt)
+            "message": "; ".join(str((r.results or {}).get("message") or r.error)
+                                 for r in group if not any(r is o for o in ok)),
+        })  # fmt: skip
     pts.sort(key=lambda p: -p["n_lab"])
     good = [p for p in pts if p["converged"]]
     spread = None
@@ -259,8 +253,11 @@ def analyse_states(rows: list[CaseRow | LostCaseRow | dict], targets: list, cal,
 
 
 def _relation(pts: list[dict], n_max: float, n_min: float, mode: str, **extra: Any) -> RelationResult:
-    """The relation of the points (loose to dense): the Eq. 12-form fit through the converged
-    ones, each point's residual and comparison, and ``extra`` keys after ``mode``."""
+    """The relation of the points (loose to dense): each point's conversions compared, the Eq. 12-form
+    fit through the converged ones, each point's residual, and ``extra`` keys after ``mode``."""
+    for p in pts:
+        conv = P.convert_all(p["n_lab"], n_max, n_min)
+        p.update((f"n2d_{m}", conv.results[m].value) for m in COMPARE)
     good = [p for p in pts if p["converged"] and math.isfinite(p["n2d_dem"])]
     fit: QuadraticFit | None = None
     note = ""
@@ -291,18 +288,15 @@ def _relation(pts: list[dict], n_max: float, n_min: float, mode: str, **extra: A
     })  # fmt: skip
 
 
-def write_relation(rel: RelationResult, store: Store, extra: dict | None = None) -> list[Path]:
+def write_relation(rel: RelationResult, store: Store) -> list[Path]:
     """relation.csv and relation.json in ``store`` (the figures, relation.png and relation.svg, are
-    drawn from the result by ``draw_relation`` (``report/relation_figure.py``)).
-
-    ``rel``: an analysed relation (with ``extra`` keys for the file) or a :class:`RelationResult`.
-    """
+    drawn from the result by ``draw_relation`` (``report/relation_figure.py``))."""
     # a seed's missing number is None (NaN as the file keeps it): written as NaN was
     flat = [{k: " ".join(f"{float_or_nan(x):.4f}" for x in v) if isinstance(v, list) else v
              for k, v in p.to_dict().items()} for p in rel.points]  # fmt: skip
     table = store.write_csv("relation.csv", flat)
-    record = dict(rel.to_dict(), **(extra or {}))
-    record.setdefault("provenance", Provenance.now().to_dict())  # a RelationResult carries its own
+    record = rel.to_dict()
+    record.setdefault("provenance", Provenance.now().to_dict())  # a finished relation carries its own
     file = store.write_json("relation.json", record)
     return [table, file]
 
@@ -463,16 +457,10 @@ def run_relation(
     banner there, so a refusal stays one line). ``options``: where the jobs run and whether
     bars show (:class:`~poro2d.execute.options.RunOptions`).
     """
-    from poro2d.execute.dask_cluster import check_reachable
     from poro2d.sweep.runner import run_sweep
 
-    if store is not None:
-        check_output_dir(store.parameter, store.root)
-    check_reachable(options.scheduler)
-    if announce is not None:
-        announce()
     extra: dict[str, Any] = {"quick": case.quick}
-    with held(store, kind="relation") as kept:
+    with study_store(store, "relation", options, announce) as kept:
         if case.mode == "density":
             rel, record = density_relation(case.base, case.settings, kept, quick=case.quick, seeds=case.seeds,
                                            mus=case.mus, options=options)  # fmt: skip

@@ -29,6 +29,8 @@ from dataclasses import asdict, replace
 from datetime import UTC, datetime
 from typing import Any
 
+import numpy as np
+
 from poro2d.execute import Executor, Failed, Job
 from poro2d.execute.dask_cluster import ClusterInfo, pin_numba_threads
 from poro2d.execute.options import RunOptions
@@ -36,7 +38,7 @@ from poro2d.io_utils import Provenance
 from poro2d.locks import cache_entry
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
-from poro2d.sweep.cases import KINDS, Case, SweepConfig, config_tables
+from poro2d.sweep.cases import KINDS, Case, SweepConfig, axes_of, config_tables
 from poro2d.sweep.records import CaseRow, LostCaseRow, SweepSummary
 from poro2d.sweep.results import SweepResult
 from poro2d.typed_result import TypedResult
@@ -58,14 +60,7 @@ def _scalar(v: Any) -> Any:
     """Values of a table cell: numbers, strings, bools or None; anything else as JSON."""
     if v is None or isinstance(v, (bool, int, float, str)):
         return v
-    try:
-        import numpy as np
-
-        if isinstance(v, np.generic):
-            return v.item()
-    except ImportError:  # pragma: no cover
-        pass
-    return json.dumps(v, default=str)
+    return v.item() if isinstance(v, np.generic) else json.dumps(v, default=str)
 
 
 def case_stage(case: dict, store: Store) -> ResumableStage:
@@ -110,10 +105,9 @@ def compute_case(case: dict, store: Store, func) -> CaseRow:
 
 
 def _run_case(case: dict, store: Store, func) -> CaseRow:
-    stage = case_stage(case, store)
-    done = stage.stored(RESULT, accept=_is_done)
+    done = finished_row(case, store)
     if done is not None:  # a retry after the marker was written
-        return CaseRow.from_dict(done)
+        return done
     pin_numba_threads()
     row: dict[str, Any] = {
         "case_id": case["id"],
@@ -126,8 +120,8 @@ def _run_case(case: dict, store: Store, func) -> CaseRow:
     }
     t0 = time.perf_counter()
     try:
-        return stage.run(lambda: _done_row(case, store, func, row, t0), RESULT, accept=_is_done,
-                         decode=CaseRow.from_dict)  # fmt: skip
+        return case_stage(case, store).run(lambda: _done_row(case, store, func, row, t0), RESULT,
+                                           accept=_is_done, decode=CaseRow.from_dict)  # fmt: skip
     except Exception as exc:
         row.update(
             status="failed",
@@ -169,19 +163,8 @@ def _worker_address() -> str:
 
 # ------------------------------------------------------------------------ driver side
 def _failed_row(case: Case, store: Store, err: BaseException, tb: str) -> LostCaseRow:
-    row = LostCaseRow(**{
-        "case_id": case.id,
-        "kind": case.kind,
-        "params": case.params,
-        "status": "failed",
-        "error": f"{type(err).__name__}: {err}",
-        "time_s": None,
-        "results": {},
-        "host": None,
-        "pid": None,
-        "worker": None,
-        "finished_utc": _now(),
-    })  # fmt: skip
+    error = f"{type(err).__name__}: {err}"
+    row = LostCaseRow(case.id, case.kind, case.params, "failed", error, None, {}, None, None, None, _now())
     case_stage(asdict(case), store).bind()
     store.write_text(ERROR_TXT, tb or row.error)
     store.write_result(ERROR_JSON, row)
@@ -192,24 +175,13 @@ def table_from_rows(rows: list[CaseRow | LostCaseRow], axes: list[str]):
     """One row per case: id, kind, parameters, status, results, timing, worker, error."""
     import pandas as pd
 
+    result_keys = axes_of([r.results or {} for r in rows])
     flat = []
-    result_keys: list[str] = []
     for r in rows:
-        for k in r.results or {}:
-            if k not in result_keys:
-                result_keys.append(k)
-    for r in rows:
-        rec: dict[str, Any] = {"case_id": r.case_id, "kind": r.kind}
-        for a in axes:
-            rec[a] = _scalar((r.params or {}).get(a))
+        rec = {"case_id": r.case_id, "kind": r.kind, **{a: _scalar((r.params or {}).get(a)) for a in axes}}
         rec["status"] = r.status
-        for k in result_keys:
-            rec[k] = (r.results or {}).get(k)
-        rec["time_s"] = r.time_s
-        rec["worker"] = r.worker
-        rec["host"] = r.host
-        rec["pid"] = r.pid
-        rec["error"] = r.error
+        rec.update((k, (r.results or {}).get(k)) for k in result_keys)
+        rec.update((k, getattr(r, k)) for k in ("time_s", "worker", "host", "pid", "error"))
         flat.append(rec)
     df = pd.DataFrame(flat)
     for col in df.columns:  # mixed object columns (None + numbers) become numeric or text
@@ -224,12 +196,6 @@ def table_from_rows(rows: list[CaseRow | LostCaseRow], axes: list[str]):
     return df
 
 
-def write_tables(df, store: Store) -> None:
-    """The table of a sweep's cases, ``results.csv`` and ``results.parquet``."""
-    store.write_frame("results.csv", df)
-    store.write_parquet("results.parquet", df)
-
-
 def run_sweep(
     sweep: SweepConfig, store: Store, *, options: RunOptions = RunOptions(), client=None
 ) -> SweepResult:
@@ -242,55 +208,55 @@ def run_sweep(
     ``dashboard``. ``client``: an existing ``distributed.Client`` (tests, notebooks) instead.
     """
     with store.claim(KIND):
-        return _run_sweep(sweep, store, options, client)
-
-
-def _run_sweep(sweep: SweepConfig, store: Store, options: RunOptions, client) -> SweepResult:
-    cases = store.child("cases")
-    t_start = time.perf_counter()
-    record = {
-        "status": "running",
-        "title": sweep.title,
-        "kind": sweep.kind,
-        "axes": sweep.axes,
-        "cases": [{"id": c.id, "params": c.params} for c in sweep.cases],
-        "config": sweep.raw,
-        "base_dir": str(sweep.base_dir) if sweep.base_dir else None,
-        "retries": sweep.retries,
-        "provenance": Provenance.now().to_dict(),
-    }
-    store.write_json("sweep.json", record)
-
-    rows: dict[str, CaseRow | LostCaseRow] = {}
-    pending: list[Case] = []
-    for c in sweep.cases:
-        done = finished_row(asdict(c), cases.child(c.id))
-        if done is not None:
-            rows[c.id] = CaseRow.from_dict(dict(done.to_dict(), status="done", reused=True))
-        else:
-            pending.append(c)
-    n_reused = len(rows)
-    cluster_info: ClusterInfo | None = None
-    if pending:
-        cluster_info = _run_pending(sweep, pending, rows, cases, n_reused, options, client)
-    ordered = [type(r).from_dict(dict(r.to_dict(), reused=bool(r.extra.get("reused", False))))
-               for r in (rows[c.id] for c in sweep.cases)]  # fmt: skip
-    df = table_from_rows(ordered, sweep.axes)
-    df["reused"] = [r.extra["reused"] for r in ordered]
-    write_tables(df, store)
-    summary = _summary(ordered, n_reused, time.perf_counter() - t_start, cluster_info)
-    record.update(status="finished", cluster=cluster_info or {}, summary=summary, finished_utc=_now())
-    store.write_json("sweep.json", record)
+        cases = store.child("cases")
+        t_start = time.perf_counter()
+        record = {
+            "status": "running",
+            "title": sweep.title,
+            "kind": sweep.kind,
+            "axes": sweep.axes,
+            "cases": [{"id": c.id, "params": c.params} for c in sweep.cases],
+            "config": sweep.raw,
+            "base_dir": str(sweep.base_dir) if sweep.base_dir else None,
+            "retries": sweep.retries,
+            "provenance": Provenance.now().to_dict(),
+        }
+        store.write_json("sweep.json", record)
+        rows: dict[str, CaseRow | LostCaseRow] = {}
+        for c in sweep.cases:
+            done = finished_row(asdict(c), cases.child(c.id))
+            if done is not None:
+                rows[c.id] = CaseRow.from_dict(dict(done.to_dict(), status="done", reused=True))
+        n_reused = len(rows)
+        pending = [c for c in sweep.cases if c.id not in rows]
+        cluster_info = _run_pending(sweep, pending, rows, cases, options, client) if pending else None
+        ordered = [type(r).from_dict(dict(r.to_dict(), reused=bool(r.extra.get("reused", False))))
+                   for r in (rows[c.id] for c in sweep.cases)]  # fmt: skip
+        df = table_from_rows(ordered, sweep.axes)
+        df["reused"] = [r.extra["reused"] for r in ordered]
+        store.write_frame("results.csv", df)
+        store.write_parquet("results.parquet", df)
+        summary = _summary(ordered, n_reused, time.perf_counter() - t_start, cluster_info)
+        record.update(status="finished", cluster=cluster_info or {}, summary=summary, finished_utc=_now())
+        store.write_json("sweep.json", record)
     return replace(SweepResult.from_dict(record), rows=ordered, table=df, store=store)
 
 
-def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Store, n_reused: int,
-                 options: RunOptions, client) -> ClusterInfo | None:  # fmt: skip
-    """Run the unfinished cases on ``client`` (or a cluster made for them) into ``rows``.
+def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Store, options: RunOptions,
+                 client) -> ClusterInfo | None:  # fmt: skip
+    """Every pending case as a job on ``client`` (or a cluster made for them), its row into ``rows`` (a
+    failed task gives an error row); returns what is recorded of the cluster (scheduler, workers,
+    threads, dashboard)."""
+    from poro2d.progress import CountProgress
 
-    Returns what is recorded of the cluster (scheduler, workers, threads, dashboard).
-    """
     threads = max(int((c.config.get("specimen") or {}).get("threads", 1) or 1) for c in pending)
+    jobs = [
+        Job(compute_case, (asdict(c), cases.child(c.id), KINDS[c.kind]), c.id, key=f"{c.kind}-{c.id}",
+            retries=sweep.retries)
+        for c in pending
+    ]  # fmt: skip
+    n_reused = len(sweep.cases) - len(pending)
+    label = f"sweep ({n_reused} of {len(sweep.cases)} already done)" if n_reused else "sweep"
     with Executor(options.dask_backend(threads), client=client) as executor:
         executor.start()
         cluster_info = executor.cluster_info()
@@ -299,9 +265,22 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Sto
 
             err = OutputConsole(stderr=True)
             err.print(f"Dask dashboard: {cluster_info.dashboard}", highlight=False)
-        n_total = len(sweep.cases)
-        ended = _submit_all(executor, pending, cases, sweep.retries, options.progress, n_reused, n_total)
-        rows.update((c.id, row) for c, row in zip(pending, ended, strict=True))
+        with CountProgress(label, len(pending), "cases", enabled=options.progress) as bar:
+
+            def ended(index: int, outcome) -> None:
+                c = pending[index]
+                if isinstance(
+                    outcome, Failed
+                ):  # the task itself failed: e.g. KilledWorker after worker deaths
+                    exc = outcome.error
+                    outcome = _failed_row(
+                        c, cases.child(c.id), exc, f"{outcome.traceback}{type(exc).__name__}: {exc}\n"
+                    )
+                rows[c.id] = outcome
+                n_failed = sum(r.status == "failed" for r in rows.values())  # a reused case is done
+                bar.advance(f"{n_failed} failed" if n_failed else "")
+
+            executor.map(jobs, on_done=ended)
     return cluster_info
 
 
@@ -325,43 +304,6 @@ def _summary(
     return SweepSummary.from_dict(summary)
 
 
-def _submit_all(
-    executor: Executor,
-    pending: list[Case],
-    cases: Store,
-    retries: int,
-    progress: bool,
-    n_reused: int,
-    n_total: int,
-) -> list[CaseRow | LostCaseRow]:
-    """Every pending case as a job; their rows in the order of ``pending`` (a failed task gives an
-    error row)."""
-    from poro2d.progress import CountProgress
-
-    jobs = [
-        Job(compute_case, (asdict(c), cases.child(c.id), KINDS[c.kind]), c.id, key=f"{c.kind}-{c.id}",
-            retries=retries)
-        for c in pending
-    ]  # fmt: skip
-    rows: list[CaseRow | LostCaseRow | None] = [None] * len(pending)
-    label = f"sweep ({n_reused} of {n_total} already done)" if n_reused else "sweep"
-    with CountProgress(label, len(pending), "cases", enabled=progress) as bar:
-
-        def ended(index: int, outcome) -> None:
-            c = pending[index]
-            if isinstance(outcome, Failed):  # the task itself failed: e.g. KilledWorker after worker deaths
-                exc = outcome.error
-                outcome = _failed_row(
-                    c, cases.child(c.id), exc, f"{outcome.traceback}{type(exc).__name__}: {exc}\n"
-                )
-            rows[index] = outcome
-            n_failed = sum(r is not None and r.status == "failed" for r in rows)
-            bar.advance(f"{n_failed} failed" if n_failed else "")
-
-        executor.map(jobs, on_done=ended)
-    return rows
-
-
 __all__ = [
     "SweepResult",
     "case_stage",
@@ -369,5 +311,4 @@ __all__ = [
     "compute_case",
     "run_sweep",
     "table_from_rows",
-    "write_tables",
 ]

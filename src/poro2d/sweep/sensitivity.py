@@ -31,21 +31,21 @@ from poro2d.config import check_keys, check_number_list
 from poro2d.criterion.settings import CriterionSettings
 from poro2d.errors import InputError
 from poro2d.execute.options import RunOptions
-from poro2d.io_utils import check_output_dir, float_or_nan
+from poro2d.io_utils import float_or_nan
 from poro2d.paper_data import QUICK_CRITERION
 from poro2d.store import Store
 from poro2d.sweep.cases import SweepConfig
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.density import CalibrationCase
-from poro2d.sweep.output import held
+from poro2d.sweep.output import study_store
 from poro2d.sweep.records import CaseRow, LostCaseRow, case_row
 from poro2d.sweep.results import SensitivityResult
 from poro2d.sweep.sensitivity_records import (
+    AVERAGED,
     Answer,
     GradingDescription,
     GradingPoint,
     Match,
-    MeanSd,
     MuPoint,
     PaperNumbers,
     PointRow,
@@ -151,20 +151,16 @@ class GradingCase:
         )
 
 
-def _reference_params(base: CriterionBase) -> dict[str, Any]:
-    """The config's own grading as a case's parameters (dotted names, a grading file's path made
-    absolute): the reference case names its grading as the family's cases name theirs."""
-    g = base.with_grading_file_absolute().table("grading") or {"preset": "paper"}
-    return {f"grading.{k}": v for k, v in g.items()}
-
-
 def gradings(base: CriterionBase, cus: list[float]) -> list[GradingCase]:
     """The config's grading, then the log-linear family at its mean disk area."""
     from poro2d.criterion.config import build
     from poro2d.grading import log_linear_grading
 
     _, ref, _, _ = build(base.as_config(), base.base_dir)
-    out = [GradingCase(REFERENCE, None, _reference_params(base), ref)]
+    # the config's own grading as a case's parameters (dotted names, a grading file's path made
+    # absolute): the reference case names its grading as the family's cases name theirs
+    own = base.with_grading_file_absolute().table("grading") or {"preset": "paper"}
+    out = [GradingCase(REFERENCE, None, {f"grading.{k}": v for k, v in own.items()}, ref)]
     area = ref.mean_disk_area()
     for cu in cus:
         g = log_linear_grading(cu, area)
@@ -197,20 +193,13 @@ def check_gradings(base: CriterionBase, cases: list[GradingCase]) -> None:
         check_feasible(spec, g.curve, settings.initial_trial())
 
 
-def grading_sweep(base: CriterionBase, cases: list[GradingCase], seeds: int) -> SweepConfig:
-    """One criterion case per grading and seed, everything else as in ``base``."""
-    params = [dict(g.params, seed=s) for g in cases for s in range(seeds)]
-    table = {"kind": "criterion", "title": "accepted n2D against grading width", "cases": params}
-    return base.with_tables(grading={}).sweep(table, params)  # each case names its own grading
-
-
 # ------------------------------------------------------------------------------ analysis
-def finite_mean_sd(values: list) -> MeanSd:
+def finite_mean_sd(values: list) -> tuple[float, float, int]:
     """Mean, sample sd (0 for one value) and n of the finite values; NaN when there are none."""
     a = np.array([float(v) for v in values if v is not None and math.isfinite(float(v))], dtype=float)
     if a.size == 0:
-        return MeanSd(math.nan, math.nan, 0)
-    return MeanSd(float(a.mean()), float(a.std(ddof=1)) if a.size > 1 else 0.0, int(a.size))
+        return math.nan, math.nan, 0
+    return float(a.mean()), float(a.std(ddof=1)) if a.size > 1 else 0.0, int(a.size)
 
 
 def _finite(v) -> bool:
@@ -255,25 +244,17 @@ def seed_record(row: CaseRow | LostCaseRow | dict, grading: GradingDescription |
     })  # fmt: skip
 
 
-#: the per-seed quantities a grading point averages: its key prefix, the seed record's key
-AVERAGED = (
-    ("measured", "accepted_measured_n2d"),
-    ("interior", "accepted_interior_porosity"),
-    ("first_f_top", "first_f_top_n_per_m"),
-    ("first_g", "first_self_weight_n_per_m"),
-    ("first_f_top_over_g", "first_f_top_over_g"),
-    ("first_n_prime", "first_new_porosity"),
-    ("accepted_f_top", "accepted_f_top_n_per_m"),
-)
-
-
 def grading_points(records: list[SeedRecord], grads: list[GradingDescription | dict]) -> list[GradingPoint]:
     """One point per grading: accepted n2D and first-trial forces over its seeds."""
     pts = []
     for g in (part(GradingDescription, g) for g in grads):
         recs = [r for r in records if r.grading == g.label]
-        acc = finite_mean_sd([r.accepted_n2d for r in recs])
-        means = {name: finite_mean_sd([getattr(r, key) for r in recs]) for name, key in AVERAGED}
+        mean, sd, n = finite_mean_sd([r.accepted_n2d for r in recs])
+        averaged = {}
+        for name, key in AVERAGED:
+            averaged[f"{name}_mean"], averaged[f"{name}_sd"], _ = finite_mean_sd(
+                [getattr(r, key) for r in recs]
+            )
         pts.append(GradingPoint.from_dict({
             "axis": "grading",
             "label": g.label,
@@ -281,13 +262,13 @@ def grading_points(records: list[SeedRecord], grads: list[GradingDescription | d
             "cu_nominal": g.cu_nominal,
             "d50_mm": g.d50_mm,
             "d_max_mm": g.d_max_mm,
-            "n2d_mean": acc.mean,
-            "n2d_sd": acc.sd,
-            "n": acc.n,
+            "n2d_mean": mean,
+            "n2d_sd": sd,
+            "n": n,
             "seeds": len(recs),
-            "unconverged": len(recs) - acc.n,
+            "unconverged": len(recs) - n,
             "quantity": "accepted trial n2D",
-            **{f"{name}_{stat}": getattr(m, stat) for name, m in means.items() for stat in ("mean", "sd")},
+            **averaged,
             "first_trial_porosity": next((r.first_trial_porosity for r in recs), None),
         }))  # fmt: skip
     return pts
@@ -297,11 +278,11 @@ def mu_points(cal: dict) -> list[MuPoint]:
     """One point per preparation friction, from a calibration's samples (n' per seed)."""
     pts = []
     for mu, samples in zip(cal["mus"], cal["samples"], strict=True):
-        s = finite_mean_sd(samples)
+        mean, sd, n = finite_mean_sd(samples)
         pts.append(MuPoint(
-            axis="mu_prep", label=f"mu_prep {mu:g}", mu_prep=mu,
-            n2d_mean=s.mean, n2d_sd=s.sd, n=s.n, seeds=len(samples),
-            unconverged=len(samples) - s.n, quantity="n' of the accepted trial (first trial 0.19)",
+            axis="mu_prep", label=f"mu_prep {mu:g}", mu_prep=mu, n2d_mean=mean, n2d_sd=sd, n=n,
+            seeds=len(samples), unconverged=len(samples) - n,
+            quantity="n' of the accepted trial (first trial 0.19)",
         ))  # fmt: skip
     return pts
 
@@ -476,7 +457,10 @@ class SensitivityCase:
         _, _, crit, _ = build(study.as_config(), study.base_dir)
         cases = gradings(study, settings.cus)
         check_gradings(study, cases)
-        sweep = grading_sweep(study, cases, settings.seeds)
+        # one criterion case per grading and seed, everything else as in the study's base
+        params = [dict(g.params, seed=s) for g in cases for s in range(settings.seeds)]
+        table = {"kind": "criterion", "title": "accepted n2D against grading width", "cases": params}
+        sweep = study.with_tables(grading={}).sweep(table, params)  # each case names its own grading
         # the friction axis is the density calibration, with its settings (layers that settle):
         # the same cases as the relation's, read back from the shared cache when it ran them
         calibration = CalibrationCase(D.with_density_defaults(study), tuple(settings.mus), settings.seeds)
@@ -502,64 +486,47 @@ def run_sensitivity(
     show (:class:`~poro2d.execute.options.RunOptions`); ``client``: an existing Dask client
     instead (:func:`~poro2d.sweep.runner.run_sweep`).
     """
-    from poro2d.execute.dask_cluster import check_reachable
-
-    if store is not None:
-        check_output_dir(store.parameter, store.root)
-    check_reachable(options.scheduler)
-    if announce is not None:
-        announce()
-    with held(store, kind="sensitivity") as kept:
-        return _run_study(case, kept, use_cache=use_cache, options=options, client=client)
-
-
-def _run_study(case: SensitivityCase, store: Store, *, use_cache: bool, options: RunOptions,
-               client) -> SensitivityResult:  # fmt: skip
-    """The grading sweep, the calibration, and the study's record of both."""
     from poro2d.sweep import density as D
     from poro2d.sweep.runner import run_sweep
 
-    study, crit, settings = case.study, case.crit, case.settings
-    timings: dict[str, float] = {}
-    t0 = time.perf_counter()
-    res = run_sweep(case.sweep, store.child("grading"), options=options, client=client)
-    timings["grading_s"] = time.perf_counter() - t0
-    t1 = time.perf_counter()
-    cal, cal_info = D.calibrate(
-        case.calibration, store.child("mu_prep"), use_cache=use_cache, options=options, client=client
-    )
-    timings["mu_prep_s"] = time.perf_counter() - t1
+    with study_store(store, "sensitivity", options, announce) as store:
+        study, crit, settings = case.study, case.crit, case.settings
+        timings: dict[str, float] = {}
+        t0 = time.perf_counter()
+        res = run_sweep(case.sweep, store.child("grading"), options=options, client=client)
+        timings["grading_s"] = time.perf_counter() - t0
+        t1 = time.perf_counter()
+        cal, cal_info = D.calibrate(
+            case.calibration, store.child("mu_prep"), use_cache=use_cache, options=options, client=client
+        )
+        timings["mu_prep_s"] = time.perf_counter() - t1
 
-    grads = [g.describe() for g in case.gradings]
-    labels = [(g, s) for g in grads for s in range(settings.seeds)]
-    records = [seed_record(r, g, s) for r, (g, s) in zip(res.rows, labels, strict=True)]
-    spec = study.table("specimen")
-    sens = {
-        "title": "accepted n2D against grading width and preparation friction (paper protocol)",
-        "settings": dict(
-            settings.to_dict(),
-            seed_list=list(range(settings.seeds)),
-            mu_prep=float(spec.get("friction_prep", 0.05)),
-            n_lab=crit.n_lab,
-            first_trial=crit.initial_trial(),
-            first_trial_from=_first_from(crit),
-        ),
-        "gradings": grads,
-        "seeds": records,
-        "points": {"grading": grading_points(records, grads), "mu_prep": mu_points(cal.to_dict())},
-        "calibration": dict(cal.to_dict(), **cal_info.to_dict()),
-        "paper": paper_numbers(),
-        "config": study.as_config(),
-        "sweeps": {"grading": res.summary, "failed_cases": len(res.failed)},
-        "timings": timings,
-    }
-    sens["answer"] = answer(sens)
-    timings["total_s"] = time.perf_counter() - t0
-    return write_sensitivity(sens, store)
-
-
-def _first_from(crit) -> str:
-    return "given" if crit.trial_porosity is not None else "Eq. 12"
+        grads = [g.describe() for g in case.gradings]
+        labels = [(g, s) for g in grads for s in range(settings.seeds)]
+        records = [seed_record(r, g, s) for r, (g, s) in zip(res.rows, labels, strict=True)]
+        spec = study.table("specimen")
+        sens = {
+            "title": "accepted n2D against grading width and preparation friction (paper protocol)",
+            "settings": dict(
+                settings.to_dict(),
+                seed_list=list(range(settings.seeds)),
+                mu_prep=float(spec.get("friction_prep", 0.05)),
+                n_lab=crit.n_lab,
+                first_trial=crit.initial_trial(),
+                first_trial_from="given" if crit.trial_porosity is not None else "Eq. 12",
+            ),
+            "gradings": grads,
+            "seeds": records,
+            "points": {"grading": grading_points(records, grads), "mu_prep": mu_points(cal.to_dict())},
+            "calibration": dict(cal.to_dict(), **cal_info.to_dict()),
+            "paper": paper_numbers(),
+            "config": study.as_config(),
+            "sweeps": {"grading": res.summary, "failed_cases": len(res.failed)},
+            "timings": timings,
+        }
+        sens["answer"] = answer(sens)
+        timings["total_s"] = time.perf_counter() - t0
+        return write_sensitivity(sens, store)
 
 
 def write_sensitivity(sens: dict, store: Store) -> SensitivityResult:
@@ -572,18 +539,15 @@ def write_sensitivity(sens: dict, store: Store) -> SensitivityResult:
     sens = dict(sens, figure=str(store.path("sensitivity.png")), provenance=Provenance.now().to_dict())
     result = SensitivityResult.from_dict(sens)
     store.write_csv("sensitivity_seeds.csv", sens["seeds"])
-    store.write_csv("sensitivity.csv", [row.to_dict() for row in _csv_rows(result)])
+    # the grading points, then the friction points, each saying whether it reproduces the paper
+    answer, version = result.answer, result.provenance.poro2d_version
+    points = result.points.grading + result.points.mu_prep
+    rows = [
+        PointRow.of(p, answer.target, answer.tolerance, result.settings.seed_list, version) for p in points
+    ]
+    store.write_csv("sensitivity.csv", rows)
     store.write_result("sensitivity.json", result)
     return result
-
-
-def _csv_rows(result: SensitivityResult) -> list[PointRow]:
-    """The rows of ``sensitivity.csv``: the grading points, then the friction points."""
-    answer, version = result.answer, result.provenance.poro2d_version
-    return [
-        PointRow.of(p, answer.target, answer.tolerance, result.settings.seed_list, version)
-        for p in result.points.grading + result.points.mu_prep
-    ]
 
 
 def load_sensitivity(store: Store) -> SensitivityResult:

@@ -12,17 +12,8 @@ from dataclasses import dataclass, field
 from typing import ClassVar
 
 from poro2d.record import Record, Spliced
-from poro2d.sweep.records import SweepSummary
+from poro2d.sweep.records import CalibrationRun, SweepSummary, ending_with
 from poro2d.typed_result import TypedResult
-
-
-@dataclass(eq=False)
-class MeanSd(TypedResult):
-    """Mean, sample sd (0 for one value) and count of the finite values (NaN mean for none)."""
-
-    mean: float
-    sd: float
-    n: int
 
 
 @dataclass(eq=False)
@@ -114,9 +105,36 @@ class SeedRecord(TypedResult):
     time_s: float | None
 
 
+#: the per-seed quantities a grading point averages: its key prefix, the seed record's field
+AVERAGED = (
+    ("measured", "accepted_measured_n2d"),
+    ("interior", "accepted_interior_porosity"),
+    ("first_f_top", "first_f_top_n_per_m"),
+    ("first_g", "first_self_weight_n_per_m"),
+    ("first_f_top_over_g", "first_f_top_over_g"),
+    ("first_n_prime", "first_new_porosity"),
+    ("accepted_f_top", "accepted_f_top_n_per_m"),
+)
+
+
+#: the keys a point of either axis goes on with: its n2D over the seeds and what that n2D is
+AXIS_POINT_KEYS = dict(
+    n2d_mean="float", n2d_sd="float", n="int", seeds="int", unconverged="int", quantity="str"
+)
+#: the keys a grading point ends with: the mean and sd of each of :data:`AVERAGED`, then its first trial
+GRADING_POINT_ENDS = [
+    *(f"{name}_{stat}" for name, _ in AVERAGED for stat in ("mean", "sd")),
+    "first_trial_porosity",
+]
+
+
 @dataclass(eq=False)
+@ending_with(dict.fromkeys(GRADING_POINT_ENDS, "float | None"))
+@ending_with(AXIS_POINT_KEYS)
 class GradingPoint(TypedResult):
-    """One grading over its seeds: the accepted n2D, and the first trial's forces beside it."""
+    """One grading over its seeds: its widths, the accepted n2D (:data:`AXIS_POINT_KEYS`), then the
+    mean and sd of each of :data:`AVERAGED` (the accepted trial's porosities, the first trial's forces
+    beside it), then the first trial."""
 
     axis: str
     label: str
@@ -124,42 +142,16 @@ class GradingPoint(TypedResult):
     cu_nominal: float | None
     d50_mm: float
     d_max_mm: float
-    n2d_mean: float
-    n2d_sd: float
-    n: int
-    seeds: int
-    unconverged: int
-    quantity: str
-    measured_mean: float
-    measured_sd: float
-    interior_mean: float | None = None
-    interior_sd: float | None = None
-    first_f_top_mean: float | None = None
-    first_f_top_sd: float | None = None
-    first_g_mean: float | None = None
-    first_g_sd: float | None = None
-    first_f_top_over_g_mean: float | None = None
-    first_f_top_over_g_sd: float | None = None
-    first_n_prime_mean: float | None = None
-    first_n_prime_sd: float | None = None
-    accepted_f_top_mean: float | None = None
-    accepted_f_top_sd: float | None = None
-    first_trial_porosity: float | None = None
 
 
 @dataclass(eq=False)
+@ending_with(AXIS_POINT_KEYS)
 class MuPoint(TypedResult):
     """One preparation friction of the calibration: n' of the accepted trial over its seeds."""
 
     axis: str
     label: str
     mu_prep: float
-    n2d_mean: float
-    n2d_sd: float
-    n: int
-    seeds: int
-    unconverged: int
-    quantity: str
 
 
 @dataclass(eq=False)
@@ -214,7 +206,7 @@ class Match(TypedResult):
 class Answer(TypedResult):
     """Which grading width and which friction accept the paper's n2D, and the lines saying so."""
 
-    PARTS = {"grading": Match, "mu_prep": Match}
+    PARTS = dict.fromkeys(("grading", "mu_prep"), Match)
 
     target: float
     tolerance: float
@@ -234,6 +226,7 @@ class GradingSweeps(TypedResult):
 
 
 @dataclass(eq=False)
+@ending_with({name: kind for name, kind in CalibrationRun.__annotations__.items() if name != "failed"})
 class StudyCalibration(TypedResult):
     """The density calibration of a sensitivity study (its ``calibration``): the row of its
     :class:`~poro2d.criterion.density.Calibration` (mu_prep -> n2D over seeds) merged with where
@@ -252,13 +245,6 @@ class StudyCalibration(TypedResult):
     fitted: list[float | None]
     failed: int | list[int] | None
     dropped: list[float]
-    key: str
-    cases: str
-    ran: int
-    reused: int
-    source: str
-    interior: list[list[float | None]] | None = None
-    summary: SweepSummary | None = None
 
 
 @dataclass(eq=False)
@@ -271,6 +257,9 @@ class StudyTimings(TypedResult):
 
 
 __all__ = [
+    "AVERAGED",
+    "AXIS_POINT_KEYS",
+    "GRADING_POINT_ENDS",
     "StudyCalibration",
     "StudyTimings",
     "Answer",
@@ -278,7 +267,6 @@ __all__ = [
     "GradingPoint",
     "GradingSweeps",
     "Match",
-    "MeanSd",
     "MuPoint",
     "PaperNumbers",
     "SeedRecord",
