@@ -237,3 +237,11 @@ def test_result_lines_read_as_numbers_by_key():
     assert (res["f_bottom_n_per_m"], res["unbalanced_force"], res["steps"]) == (2.0, 1e-5, 1200.0)
     with pytest.raises(LammpsError, match="no 'poro2d-result' line in the LAMMPS log"):
         result_numbers("Loop time of 1.0", LammpsError, "the LAMMPS log")
+
+
+def test_export_prints_a_folder_name_as_typed(saved, tmp_path, capsys):
+    """A folder named like rich markup is printed as its name, not read as styling."""
+    out = tmp_path / "run[bold]2[/bold]"
+    main(["export", str(saved.parent), "--to", "csv", "--out", str(out)])
+    printed = capsys.readouterr().out
+    assert "run[bold]2[/bold]" in printed.replace("\n", "")

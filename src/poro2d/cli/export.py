@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from poro2d.console import OutputConsole, Table
+from poro2d.console import OutputConsole, Table, shown
 from poro2d.store import claims
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
@@ -57,12 +57,12 @@ def export_cmd(
     t.add_column("file")
     t.add_column("bytes", justify="right")
     for p in paths:
-        t.add_row(str(p), f"{p.stat().st_size:,}")
+        t.add_row(shown(str(p)), f"{p.stat().st_size:,}")
     console.print(t)
     if to == "pfc" and pfc.pfc4_refusal(spec):
         console.print(pfc.pfc4_refusal(spec))
     if state is not None:
-        where = f"seed {state.seed} of {state.record}: {state.folder}"
+        where = shown(f"seed {state.seed} of {state.record}: {state.folder}")
         console.print(f"state n_lab = {state.n_lab:g} (Dr = {dr_text(state.relative_density)}), {where}")
     console.print(
         f"{spec.n} disks, {len(spec.walls)} walls; thickness t = {spec.thickness:g} m "

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from poro2d.cli import options as opt
-from poro2d.console import OutputConsole, Table
+from poro2d.console import OutputConsole, Table, shown
 from poro2d.store import claims
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
@@ -142,4 +142,4 @@ def print_check(report: dict, out: Path) -> None:
             f"{1e3 * plate['plate_displacement_m']:.4g} mm: n' = {plate['new_porosity']:.4f}, "
             f"F_top = {plate['f_top_after_n_per_m']:.4g} N/m"
         )
-    console.print(f"results in {out}/check.json; the specimen as checked in {out}/specimen.npz")
+    console.print(shown(f"results in {out}/check.json; the specimen as checked in {out}/specimen.npz"))
