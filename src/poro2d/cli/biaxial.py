@@ -170,7 +170,7 @@ def make_case(quick: bool, specimen, sigma: float, first: int, settings):
 def start_and_print(case, stresses: list[float], store, kw: dict, out: Path) -> None:
     """One stress: run_biaxial; several: run_biaxial_series; the figures drawn from the result; the
     answer printed (a failed test: exit 1)."""
-    from poro2d.biaxial import run_biaxial, run_biaxial_series
+    from poro2d.biaxial import BiaxialSeriesCase, run_biaxial, run_biaxial_series
     from poro2d.biaxial.run import lab_curve
     from poro2d.report.biaxial_figures import draw_biaxial, draw_biaxial_series
 
@@ -180,8 +180,9 @@ def start_and_print(case, stresses: list[float], store, kw: dict, out: Path) -> 
             result = run_biaxial(case, store, **kw)
             draw_biaxial(result, store, kw["lab"])
         else:
-            result = run_biaxial_series(case, stresses, store, **kw)
-            draw_biaxial_series(result, store, kw["lab"])
+            series = BiaxialSeriesCase(case, stresses, kw.pop("replicates"), kw.pop("lab"))
+            result = run_biaxial_series(series, store, **kw)
+            draw_biaxial_series(result, store, series.lab)
     except RuntimeError as exc:
         console.print(f"[bold red]failed:[/] {exc}")
         raise typer.Exit(1) from None

@@ -88,7 +88,7 @@ def register(app: typer.Typer) -> None:
         """Steady-state friction tau/sigma and solid fraction of the disks, free of any box."""
         from poro2d.cli.critical_state_held import held_states, print_held
         from poro2d.cli.shear import parse_stresses
-        from poro2d.critical_state import CriticalStateCase, run_critical_states
+        from poro2d.critical_state import CriticalStateCase, CriticalStateStudy, run_critical_states
         from poro2d.critical_state.case import CASE_RANGES
         from poro2d.critical_state.line import MAX_PRESSURES, run_critical_state_line
         from poro2d.critical_state.run import MAX_SEEDS
@@ -126,7 +126,7 @@ def register(app: typer.Typer) -> None:
         store = Store(out)
         try:
             if len(pressures) == 1:
-                result = run_critical_states(case, store, seeds=n, options=run, config=config)
+                result = run_critical_states(CriticalStateStudy(case, n), store, options=run, config=config)
                 draw_critical_state(result, store)
             else:
                 result = run_critical_state_line(
