@@ -12,5 +12,6 @@ from poro2d.biaxial.single import BiaxialTest
 
 __all__ = [
     "BiaxialCase", "BiaxialCurve", "BiaxialResult", "BiaxialSeriesCase", "BiaxialSeriesResult",
-    "BiaxialSettings", "BiaxialTest", "BiaxialTestResult", "QuickSpecimen", "inertial_number", "run_biaxial", "run_biaxial_series",
+    "BiaxialSettings", "BiaxialTest", "BiaxialTestResult", "QuickSpecimen", "inertial_number", "run_biaxial",
+    "run_biaxial_series",
 ]  # fmt: skip
