@@ -22,11 +22,11 @@ from poro2d.biaxial.envelope import envelope, peak_circle
 from poro2d.biaxial.lab import LabCurve
 from poro2d.biaxial.parts import (
     DEFINITIONS,
-    ELASTIC_SPREADS,
     ENVELOPE_DEFINITION,
     AngleSpread,
     Definitions,
     StressSummary,
+    angle_spreads,
     spread_of,
 )
 from poro2d.biaxial.results import BiaxialResult, BiaxialSeriesResult, BiaxialTestResult
@@ -142,14 +142,7 @@ def _run(cases: dict[float, list[BiaxialCase]], store, lab, workers, options, co
 
 
 def _summary(study: BiaxialResult) -> StressSummary:
-    return StressSummary(
-        confining_stress_kpa=study.confining_stress_kpa, folder=stress_folder(study.confining_stress_kpa),
-        peak_friction_angle=study.peak_friction_angle,
-        critical_state_friction_angle=study.critical_state_friction_angle,
-        max_dilatancy_angle=study.max_dilatancy_angle, axial_strain_at_peak=study.axial_strain_at_peak,
-        critical_state_reached=study.critical_state_reached, critical_state_note=study.critical_state_note,
-        **{k: getattr(study, k) for k in ELASTIC_SPREADS},
-    )  # fmt: skip
+    return StressSummary.of(study, folder=stress_folder(study.confining_stress_kpa))
 
 
 def sigma_3_at_peak(test: BiaxialTestResult) -> float:
@@ -190,10 +183,7 @@ def summarize_series(studies: list[BiaxialResult], workers: int, wall: float, co
     first = studies[0]
     return BiaxialSeriesResult(
         confining_stresses_kpa=[st.confining_stress_kpa for st in studies], replicates=first.replicates,
-        stresses=[_summary(st) for st in studies],
-        peak_friction_angle=AngleSpread.of([t.peak_friction_angle_deg for t in tests]),
-        critical_state_friction_angle=AngleSpread.of([t.critical_state_friction_angle_deg for t in tests]),
-        max_dilatancy_angle=AngleSpread.of([t.max_dilatancy_angle_deg for t in tests]),
+        stresses=[_summary(st) for st in studies], **angle_spreads(tests),
         envelope=envelope(s1, s3), envelope_through_origin=envelope(s1, s3, through_origin=True),
         envelope_definition=ENVELOPE_DEFINITION, critical_state_reached=not missed, critical_state_note=note,
         sigma_3_held=all(t.checks.sigma_3_held for t in tests), sigma_3_note=_held_note(tests),

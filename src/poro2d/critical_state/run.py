@@ -256,13 +256,10 @@ def study_of(cases, tests, workers, wall, config) -> CriticalStateResult:
         )
     )
     summaries = [SeedSummary.of(t, seed=c.seed) for c, t in zip(cases, tests, strict=True)]
+    spreads = ("stress_ratio", "friction_angle_deg", "solid_fraction", "inertial_number", "coordination")
     return CriticalStateResult(
         seeds=[c.seed for c in cases],
-        stress_ratio=Spread.of([t.stress_ratio for t in tests]),
-        friction_angle_deg=Spread.of([t.friction_angle_deg for t in tests]),
-        solid_fraction=Spread.of([t.solid_fraction for t in tests]),
-        inertial_number=Spread.of([t.inertial_number for t in tests]),
-        coordination=Spread.of([t.coordination for t in tests]),
+        **{k: Spread.of([getattr(t, k) for t in tests]) for k in (*spreads, "mean_overlap_ratio")},
         steady=not missed,
         note=note,
         summaries=summaries,
@@ -273,7 +270,6 @@ def study_of(cases, tests, workers, wall, config) -> CriticalStateResult:
         provenance=Provenance.now(),
         void_ratio=Spread.of([void_ratio(t.solid_fraction) for t in tests]),
         stiffness_number=cases[0].kappa(),
-        mean_overlap_ratio=Spread.of([t.mean_overlap_ratio for t in tests]),
         tests=list(tests),
     )
 
