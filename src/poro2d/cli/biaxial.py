@@ -15,11 +15,11 @@ console = OutputConsole()
 def register(app: typer.Typer) -> None:
     @app.command("biaxial")
     def biaxial_cmd(
-        specimen: list[str] = typer.Argument(
-            None, help="Specimen checkpoints or criterion/sand folders, one per replicate; or --quick."
+        specimen: list[str] = opt.specimens(
+            help="Specimen checkpoints or criterion/sand folders, one per replicate; or --quick."
         ),
-        quick: bool = typer.Option(
-            False, "--quick", help="The built-in quick specimen (0.05 m x 0.10 m, about 320 disks) of --seed."
+        quick: bool = opt.quick(
+            help="The built-in quick specimen (0.05 m x 0.10 m, about 320 disks) of --seed."
         ),
         confining: str = typer.Option(
             None, "--confining", help="Confining stresses sigma_3 in kPa: 100, or 50,100,200 (default 100)."
@@ -38,15 +38,11 @@ def register(app: typer.Typer) -> None:
         seed: int = typer.Option(None, "--seed", help="With --quick: the first specimen's seed (default 0)."),
         particle_friction: float = opt.particle_friction(),
         rolling_friction: float = opt.rolling_friction(),
-        stiffness_number: float = typer.Option(
-            None,
-            "--stiffness-number",
+        stiffness_number: float = opt.stiffness_number(
             help="Scale the disks' kn and ks so that kappa = kn / (sigma_3 t) is this "
             "(>= 1000: rigid grains; default: the specimen's stiffness).",
         ),
-        lab: Path = typer.Option(
-            None, "--lab", help="Your laboratory curves (CSV, docs/biaxial.md), overlaid."
-        ),
+        lab: Path = opt.lab(help="Your laboratory curves (CSV, docs/biaxial.md), overlaid."),
         out: Path = opt.out("biaxial-out", "Output folder."),
         workers: int = opt.tests_workers("test, at most one per core"),
         scheduler: str = opt.tests_scheduler(),

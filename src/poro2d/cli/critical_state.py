@@ -68,10 +68,8 @@ def register(app: typer.Typer) -> None:
             help="The laboratory's critical-state line (toyoura, or a CSV p_kpa,e_cs) for --sand: "
             "the state-parameter map beside the Dr map.",
         ),
-        stiffness_number: float = typer.Option(
-            None,
-            "--stiffness-number",
-            help="kappa = kn / (P t) held at every pressure (contacts scaled with P; >= 1000: rigid grains).",
+        stiffness_number: float = opt.stiffness_number(
+            help="kappa = kn / (P t) held at every pressure (contacts scaled with P; >= 1000: rigid grains)."
         ),
         inertial: float = typer.Option(1e-3, "--inertial", help="Inertial number I (sets the shear rate)."),
         strain: float = typer.Option(3.0, "--strain", help="Shear strain gamma where the run ends."),

@@ -106,7 +106,7 @@ def register(app: typer.Typer) -> None:
         normal_stress: str = typer.Option(
             None, "--normal-stress", "-n", help="Normal stresses in kPa, e.g. 50,100,200."
         ),
-        lab: Path = typer.Option(None, "--lab", help="Laboratory CSV (curves or peaks), optional."),
+        lab: Path = opt.lab(help="Laboratory CSV (curves or peaks), optional."),
         out: Path = opt.out("shear-out"),
         velocity: float = typer.Option(None, "--velocity", help="Shear velocity of the lower half (m/s)."),
         max_displacement: float = opt.max_displacement(),
