@@ -196,6 +196,10 @@ def _deg(mean, sd) -> str:
 def _stopped(case) -> str:
     """A case's residual where dilation stopped: plate / plane (k tests), "not reached", or "-"
     (a study of an earlier poro2d)."""
+    from poro2d.shear.parts import StrengthCase
+    from poro2d.typed_result import part
+
+    case = part(StrengthCase, case)  # a row read back as its dict, too
     k = case.tests_dilation_stopped
     if k is None:
         return "-"
