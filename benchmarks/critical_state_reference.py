@@ -36,7 +36,7 @@ def main() -> None:
     ap.add_argument("--keep", type=Path, default=None)
     args = ap.parse_args()
 
-    from poro2d.critical_state import CriticalStateCase, run_critical_states
+    from poro2d.critical_state import CriticalStateCase, CriticalStateStudy, run_critical_states
     from poro2d.store import Store
 
     root = args.keep or Path(tempfile.mkdtemp(prefix="critical-state-"))
@@ -56,9 +56,8 @@ def main() -> None:
             )
             t0 = time.perf_counter()
             r = run_critical_states(
-                case,
+                CriticalStateStudy(case, args.seeds),
                 Store(root / f"I{inertial:g}_mur{mu_r:g}"),
-                seeds=args.seeds,
                 options=RunOptions(workers=args.workers),
             )
             print(

@@ -103,18 +103,20 @@ def check_no_escape(parameter: str, folder: str | os.PathLike) -> None:
 #: Every kind's files are listed here, below the packages, rather than registered by them: a
 #: run must know another kind's folder even when that kind's package is not imported. Each
 #: package names its kind by a ``KIND`` constant (``poro2d.shear.run.KIND``) for its claim.
+#: A laboratory test's record, ``test.json``, is no sign: direct shear, biaxial and critical
+#: state tests all write one; a direct shear test is known by its consolidated state instead.
 KIND_SIGNS = {
     "calibrate": ("calibrated.toml",),
     "criterion": ("iterations.csv", "density.json"),
     "paper": ("paper.json", "conversions.json"),
-    "shear": ("peaks.csv", "replicates.json", "test.json"),
+    "shear": ("peaks.csv", "replicates.json", "consolidated.npz", "consolidation.json"),
     "strength": ("strength.json",),
     "relation": ("relation.json",),
     "sensitivity": ("sensitivity.json",),
     "sand": ("sand.json", "preflight.json"),
     "sweep": ("sweep.json",),
     "biaxial": ("biaxial.png",),
-    "critical-state": ("critical_state.png", "critical_state_line.png"),
+    "critical-state": ("critical_state.png", "critical_state_line.png", "series.csv"),
     "export": ("specimen.data", "specimen_yade.py", "specimen_pfc4.dat", "disks.csv"),
     "import": ("check.json",),
 }

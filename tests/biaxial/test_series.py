@@ -9,7 +9,14 @@ import numpy as np
 import pytest
 
 import poro2d.biaxial as biaxial
-from poro2d.biaxial import BiaxialCase, BiaxialSeriesResult, BiaxialSettings, BiaxialTest, run_biaxial_series
+from poro2d.biaxial import (
+    BiaxialCase,
+    BiaxialSeriesCase,
+    BiaxialSeriesResult,
+    BiaxialSettings,
+    BiaxialTest,
+    run_biaxial_series,
+)
 from poro2d.biaxial.envelope import envelope, peak_circle
 from poro2d.biaxial.series import sigma_3_at_peak
 from poro2d.cli import main
@@ -63,7 +70,9 @@ def test_an_envelope_needs_two_stresses():
 def series(tmp_path_factory):
     out = tmp_path_factory.mktemp("series")
     case = BiaxialCase.quick(100.0, seed=2, settings=BiaxialSettings(**TINY))
-    result = run_biaxial_series(case, [100.0, 50.0], Store(out), replicates=2, options=RunOptions(workers=1))
+    result = run_biaxial_series(
+        BiaxialSeriesCase(case, [100.0, 50.0], replicates=2), Store(out), options=RunOptions(workers=1)
+    )
     draw_biaxial_series(result, Store(out))  # as the command draws them, after the run
     return out, result
 
@@ -122,15 +131,21 @@ def _count_computes(monkeypatch) -> list:
 
 def test_a_rerun_reads_finished_tests_and_reruns_a_changed_or_unfinished_one(tmp_path, monkeypatch):
     case = BiaxialCase.quick(100.0, seed=1, settings=BiaxialSettings(**TINY))
-    first = run_biaxial_series(case, [50.0, 100.0], Store(tmp_path), options=RunOptions(workers=1))
+    first = run_biaxial_series(
+        BiaxialSeriesCase(case, [50.0, 100.0]), Store(tmp_path), options=RunOptions(workers=1)
+    )
     ran = _count_computes(monkeypatch)
-    again = run_biaxial_series(case, [50.0, 100.0], Store(tmp_path), options=RunOptions(workers=1))
+    again = run_biaxial_series(
+        BiaxialSeriesCase(case, [50.0, 100.0]), Store(tmp_path), options=RunOptions(workers=1)
+    )
     assert ran == [] and again.peak_friction_angle.to_dict() == first.peak_friction_angle.to_dict()
     for a, b in zip(first.studies, again.studies, strict=True):
         assert np.array_equal(a.tests[0].curve.sin_phi, b.tests[0].curve.sin_phi)
     # a test killed midway: its record and a partial curve, no result.json (the marker)
     (tmp_path / "sigma3_100kPa" / "replicate1" / "result.json").unlink()
-    resumed = run_biaxial_series(case, [50.0, 100.0], Store(tmp_path), options=RunOptions(workers=1))
+    resumed = run_biaxial_series(
+        BiaxialSeriesCase(case, [50.0, 100.0]), Store(tmp_path), options=RunOptions(workers=1)
+    )
     assert ran == [(100.0, 1)]
     assert np.array_equal(
         resumed.studies[1].tests[0].curve.sigma_1_kpa, first.studies[1].tests[0].curve.sigma_1_kpa
@@ -141,7 +156,9 @@ def test_a_rerun_reads_finished_tests_and_reruns_a_changed_or_unfinished_one(tmp
     with pytest.raises(
         InputError, match=r"replicate1.*it holds a test of other settings \(smoothing_strain\)"
     ):
-        run_biaxial_series(changed, [50.0, 100.0], Store(tmp_path), options=RunOptions(workers=1))
+        run_biaxial_series(
+            BiaxialSeriesCase(changed, [50.0, 100.0]), Store(tmp_path), options=RunOptions(workers=1)
+        )
     assert ran == [(100.0, 1)]
     assert (tmp_path / "sigma3_50kPa" / "replicate1" / "test.json").read_text() == record
 
@@ -166,7 +183,7 @@ def test_a_test_folder_written_before_records_runs_again(tmp_path, monkeypatch):
 )
 def test_a_series_refuses_bad_stresses(value, name):
     with pytest.raises(InputError) as exc:
-        run_biaxial_series(BiaxialCase.quick(100.0), value)
+        BiaxialSeriesCase(BiaxialCase.quick(100.0), value)
     assert exc.value.parameter.startswith(name)
 
 
@@ -192,10 +209,10 @@ def test_the_config_table_builds_the_case_and_options_win(tmp_path, monkeypatch)
                    "quick = true\nreplicates = 3\nseed = 4\n")  # fmt: skip
     with pytest.raises(SystemExit):
         main(["biaxial", "--config", str(cfg), "--strain", "0.08", "--out", str(tmp_path / "o"), "--quiet"])
-    assert seen["name"] == "series" and seen["args"][0] == [50.0, 100.0, 200.0]
-    case = seen["case"]
+    assert seen["name"] == "series" and seen["case"].confining_kpa == (50.0, 100.0, 200.0)
+    case = seen["case"].case
     assert case.settings.max_strain == 0.08 and case.settings.strain_rate == 0.1  # the option won
-    assert case.specimen.seed == 4 and seen["kw"]["replicates"] == 3
+    assert case.specimen.seed == 4 and seen["case"].replicates == 3
     with pytest.raises(SystemExit):
         main(["biaxial", "--config", str(cfg), "--confining", "75", "--out", str(tmp_path / "o"), "--quiet"])
     assert seen["name"] == "single" and seen["case"].confining_kpa == 75.0

@@ -31,3 +31,17 @@ def test_a_test_that_did_not_hold_sigma_3_says_so_first_and_fails(tmp_path, caps
     assert printed.strip().splitlines()[0].startswith("sigma_3 not held in 1 of 1 tests")
     kept = json.loads((out / "replicate1" / "result.json").read_text())
     assert kept["checks"]["sigma_3_held"] is False and kept["checks"]["sigma_3_mean_error"] > 0.02
+
+
+@pytest.mark.parametrize("rate", ["1e-300", "0.0005"])
+def test_a_strain_rate_too_slow_to_end_is_refused_before_any_work(rate, tmp_path, capsys):
+    """A test at 1e-300 /s would run for ever: refused on one line naming the option as typed and
+    its range, before any specimen is made or any file written."""
+    out = tmp_path / "b"
+    with pytest.raises(SystemExit) as exc:
+        main(["biaxial", "--quick", "--strain-rate", rate, "--out", str(out), "--quiet"])
+    printed = capsys.readouterr()
+    line = (printed.out + printed.err).strip()
+    assert exc.value.code == 2 and len(line.splitlines()) == 1
+    assert "--strain-rate" in line and "allowed: [0.001, 100.0]" in line, line
+    assert not out.exists()

@@ -136,15 +136,15 @@ CELL = {"disks": 200, "inertial_number": 1e-2, "strain": 0.5, "window_start": 0.
 
 
 def _critical_state(ctx: Context, store: Store | None):
-    from poro2d.critical_state import CriticalStateCase, run_critical_states
+    from poro2d.critical_state import CriticalStateCase, CriticalStateStudy, run_critical_states
 
-    return run_critical_states(CriticalStateCase(**CELL), store, seeds=2, options=QUIET)
+    return run_critical_states(CriticalStateStudy(CriticalStateCase(**CELL), seeds=2), store, options=QUIET)
 
 
 def _critical_state_bad(ctx: Context, store: Store):
-    from poro2d.critical_state import CriticalStateCase, run_critical_states
+    from poro2d.critical_state import CriticalStateCase, CriticalStateStudy, run_critical_states
 
-    return run_critical_states(CriticalStateCase(**CELL), store, seeds=0, options=QUIET)
+    return run_critical_states(CriticalStateStudy(CriticalStateCase(**CELL), seeds=0), store, options=QUIET)
 
 
 # -- a user's sand -----------------------------------------------------------------------------

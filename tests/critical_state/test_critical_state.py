@@ -181,3 +181,17 @@ def test_a_bad_sieve_curve_is_refused_naming_its_line_and_column(tmp_path, capsy
     _out, err = capsys.readouterr()
     assert exc.value.code == 2 and "--grading" in err and "line 3, column 2" in err
     assert not (tmp_path / "out").exists()
+
+
+def test_a_single_run_folder_is_taken_for_a_critical_state_folder_not_a_shear_one(tmp_path):
+    """Its test.json is every laboratory test's record, no shear sign: the critical-state command
+    resumes the folder and the shear command refuses it."""
+    from poro2d.locks import output_folder, signed_kinds
+
+    run_critical_state(CriticalStateCase(**SMALL), Store(tmp_path))
+    assert (tmp_path / "test.json").is_file() and signed_kinds(tmp_path) == ["critical-state"]
+    with pytest.raises(InputError, match="critical-state run"):
+        with output_folder("--out", tmp_path, kind="shear"):
+            pass
+    with output_folder("--out", tmp_path, kind="critical-state"):
+        pass

@@ -159,3 +159,14 @@ def test_a_results_parts_are_its_fields_types_and_it_is_made_from_its_reading_by
     assert list(made.to_dict()) == ["peak", "box", "boxes", "consolidation", "label"]
     back = Result.from_dict(made.to_dict())
     assert back == made and isinstance(back.box, BoxRecord) and isinstance(back.boxes[0], BoxRecord)
+
+
+def test_a_curve_class_made_of_its_rows_declares_its_columns_once():
+    """curve_of: the row's fields are the curve's columns, in order; later ones read as NaN, optional
+    ones (the row's and the curve's own) last, None where not given."""
+    from poro2d.labtest.curve import curve_of
+
+    made = curve_of(Row, "Made", __name__, later=("late",), optional=("more",))
+    assert made.COLUMNS == ("x", "y", "late") and made.OPTIONAL == ("more",)
+    curve = made.of_rows([Row(1, 2.0)])
+    assert curve.columns == ("x", "y", "late") and np.isnan(curve.late[0]) and curve.more is None

@@ -21,13 +21,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
-from poro2d.dem import Particles, Simulation, Walls
-from poro2d.dem.ordering import strip_order
+from poro2d.dem import Simulation
 from poro2d.errors import InputError
-from poro2d.shear.box import pair_type_contact, replaced_values
-from poro2d.specimen.box import box_faces
+from poro2d.labtest.box import box_simulation, specimen_box
 
 #: the four walls and the way each moves to compress the specimen
 COMPRESS = {"left": (1.0, 0.0), "right": (-1.0, 0.0), "top": (0.0, -1.0)}
@@ -113,52 +109,31 @@ def build_biaxial_box(
     particle_kn: float | None = None,
     particle_ks: float | None = None,
 ) -> tuple[Simulation, BiaxialBox]:
-    """A new simulation of the specimen's disks in the biaxial box, without gravity.
-
-    The disks keep their positions and properties (``particle_friction`` and
-    ``rolling_friction`` replace theirs when given, ``particle_kn`` and ``particle_ks`` their
-    stiffness (N/m), as :func:`poro2d.shear.box.build_split_box` replaces them: the time step is
-    the new simulation's, so it follows the stiffness; the walls take the disks' largest mu_r,
-    as the direct shear box does). Gravity is switched off: a biaxial specimen is a small
-    element of soil under its confining stress, and gravity would make its stress vary with
-    height. A specimen whose box is not at (0, 0) or whose disks are not all inside it is
-    refused.
+    """A new simulation of the specimen's disks in the biaxial box, at rest and without gravity
+    (:func:`poro2d.labtest.box.box_simulation`: ``particle_friction``, ``rolling_friction``,
+    ``particle_kn`` and ``particle_ks`` replace the disks' values when given, as in the direct
+    shear box). Gravity is off: a biaxial specimen is a small element of soil under its confining
+    stress, and gravity would make its stress vary with height. A specimen whose box is not at
+    (0, 0) or whose disks are not all inside it is refused.
     """
     hint = "a specimen saved by poro2d criterion, poro2d sand or poro2d.specimen.compaction"
-    left, right, bottom, top = box_faces(specimen.walls.names, specimen.walls.p0, "specimen walls", hint)
-    if abs(left) > 1e-9 or abs(bottom) > 1e-9:
-        raise InputError("specimen box", (left, bottom), "a box with its lower left corner at (0, 0)")
-    W, H = right, top
-    p0 = specimen.particles
-    if p0.n == 0:
-        raise InputError("specimen", "no disks", "a specimen with disks")
-    mu_r = p0.mu_r.copy() if rolling_friction is None else np.full(p0.n, float(rolling_friction))
+    W, H = specimen_box(specimen, hint)
     e = max(W, H)
-    walls = Walls()
-    k = (kn_wall, ks_wall, friction_wall)
-    wall_mu_r = float(mu_r.max())
-    walls.add((-e, 0.0), (W + e, 0.0), *k, name="bottom", mu_r=wall_mu_r)
-    walls.add((W, -e), (W, H + e), *k, name="right", mu_r=wall_mu_r)
-    walls.add((W + e, H), (-e, H), *k, name="top", mu_r=wall_mu_r)
-    walls.add((0.0, H + e), (0.0, -e), *k, name="left", mu_r=wall_mu_r)
-    particles = Particles(
-        pos=p0.pos.copy(), radius=p0.radius.copy(), density=p0.density.copy(), thickness=p0.thickness,
-        kn=replaced_values(p0.kn, particle_kn), ks=replaced_values(p0.ks, particle_ks),
-        mu=p0.mu.copy() if particle_friction is None else np.full(p0.n, float(particle_friction)),
-        vel=np.zeros_like(p0.vel), theta=p0.theta.copy(), omega=np.zeros_like(p0.omega), mode=p0.mode.copy(),
-        mu_r=mu_r,
+    segments = [
+        ((-e, 0.0), (W + e, 0.0), "bottom"),
+        ((W, -e), (W, H + e), "right"),
+        ((W + e, H), (-e, H), "top"),
+        ((0.0, H + e), (0.0, -e), "left"),
+    ]
+    sim = box_simulation(
+        specimen, segments, (kn_wall, ks_wall, friction_wall), particle_friction=particle_friction,
+        rolling_friction=rolling_friction, particle_kn=particle_kn, particle_ks=particle_ks, at_rest=True,
+        gravity=(0.0, 0.0), density_scale=density_scale, dt_safety=dt_safety, threads=threads,
     )  # fmt: skip
-    contact = pair_type_contact(specimen.contact, particle_friction, particle_kn, particle_ks)
-    sim = Simulation(
-        particles, walls, contact, gravity=(0.0, 0.0), local_damping=specimen.local_damping,
-        restitution=specimen.restitution, dt_safety=dt_safety, density_scale=density_scale,
-        skin=specimen.skin, threads=threads,
-    )  # fmt: skip
-    sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
     check_inside(sim)
     if not math.isfinite(sim.dt):
         raise InputError("specimen", "no finite time step", "disks with mass and stiffness")
-    return sim, BiaxialBox(W, H, p0.thickness)
+    return sim, BiaxialBox(W, H, specimen.particles.thickness)
 
 
 __all__ = ["COMPRESS", "BiaxialBox", "BoxSize", "build_biaxial_box", "check_inside"]

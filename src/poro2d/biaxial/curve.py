@@ -20,26 +20,9 @@ import numpy as np
 from poro2d.biaxial.box import BiaxialBox, BoxSize
 from poro2d.biaxial.stiffness import contact_strain, overlap_ratio
 from poro2d.dem import Simulation
-from poro2d.labtest.curve import ColumnCurve, CurveRow
+from poro2d.labtest.curve import CurveRow, curve_of
 from poro2d.store import Store
 
-#: the columns of ``curve.csv``, in order
-CURVE_COLUMNS = (
-    "step",
-    "axial_strain",
-    "lateral_strain",
-    "volumetric_strain",
-    "shear_strain",
-    "sigma_1_kpa",
-    "sigma_3_kpa",
-    "sigma_3_left_kpa",
-    "sigma_3_right_kpa",
-    "deviator_kpa",
-    "mean_stress_kpa",
-    "sin_phi",
-    "max_unbalanced_ratio",
-    "inertial_number",
-)
 #: columns written since the elastic strain was told apart from the plastic (absent from a curve of
 #: before): the mean overlap over the mean diameter of the disk-disk contacts and the elastic strain
 #: they hold (:mod:`poro2d.biaxial.stiffness`), the plastic strains (:mod:`poro2d.biaxial.elastic`)
@@ -47,40 +30,6 @@ OPTIONAL_COLUMNS = (
     "mean_overlap_ratio", "elastic_axial_strain", "elastic_lateral_strain", "plastic_volumetric_strain",
     "plastic_shear_strain",
 )  # fmt: skip
-
-
-@dataclass(frozen=True, eq=False)
-class BiaxialCurve(ColumnCurve):
-    """A test's recorded curve: one float array per column of :data:`CURVE_COLUMNS`, and of
-    :data:`OPTIONAL_COLUMNS` where it has them (None where not); a mapping of the names it has
-    to the arrays, in the file's order."""
-
-    COLUMNS: ClassVar[tuple[str, ...]] = CURVE_COLUMNS
-    OPTIONAL: ClassVar[tuple[str, ...]] = OPTIONAL_COLUMNS
-
-    step: np.ndarray
-    axial_strain: np.ndarray
-    lateral_strain: np.ndarray
-    volumetric_strain: np.ndarray
-    shear_strain: np.ndarray
-    sigma_1_kpa: np.ndarray
-    sigma_3_kpa: np.ndarray
-    sigma_3_left_kpa: np.ndarray
-    sigma_3_right_kpa: np.ndarray
-    deviator_kpa: np.ndarray
-    mean_stress_kpa: np.ndarray
-    sin_phi: np.ndarray
-    max_unbalanced_ratio: np.ndarray
-    inertial_number: np.ndarray
-    mean_overlap_ratio: np.ndarray | None = None
-    elastic_axial_strain: np.ndarray | None = None
-    elastic_lateral_strain: np.ndarray | None = None
-    plastic_volumetric_strain: np.ndarray | None = None
-    plastic_shear_strain: np.ndarray | None = None
-
-    def with_plastic(self, volumetric: np.ndarray, shear: np.ndarray) -> BiaxialCurve:
-        """This curve with its plastic strains (:func:`poro2d.biaxial.elastic.plastic_strains`)."""
-        return replace(self, plastic_volumetric_strain=volumetric, plastic_shear_strain=shear)
 
 
 @dataclass(eq=False)
@@ -106,6 +55,20 @@ class BiaxialRow(CurveRow):
     elastic_lateral_strain: float | None = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = OPTIONAL_COLUMNS[:3]
+
+
+class BiaxialCurve(curve_of(BiaxialRow, "BiaxialColumns", __name__, optional=OPTIONAL_COLUMNS)):
+    """A test's recorded curve: one float array per column of :data:`CURVE_COLUMNS`, and of
+    :data:`OPTIONAL_COLUMNS` where it has them (None where not); a mapping of the names it has
+    to the arrays, in the file's order."""
+
+    def with_plastic(self, volumetric: np.ndarray, shear: np.ndarray) -> BiaxialCurve:
+        """This curve with its plastic strains (:func:`poro2d.biaxial.elastic.plastic_strains`)."""
+        return replace(self, plastic_volumetric_strain=volumetric, plastic_shear_strain=shear)
+
+
+#: the columns of ``curve.csv``, in order (those every curve has)
+CURVE_COLUMNS = BiaxialCurve.COLUMNS
 
 
 def read_curve(store: Store, name: str = "curve.csv") -> BiaxialCurve | None:

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from poro2d.biaxial.stiffness import STIFFNESS_DEFINITION
-from poro2d.labtest.records import TestSummary, typed_parts
+from poro2d.labtest.records import ByName, TestSummary, typed_parts
 from poro2d.measure.spread import Spread
 from poro2d.typed_result import TypedResult
 
@@ -88,6 +88,16 @@ class AngleSpread(Spread):
         return super().text(digits, unit)
 
 
+#: the angles (and the strain at the peak) a study spreads over its tests: a test's number is the
+#: name with ``_deg`` (the strain: the name)
+ANGLES = ("peak_friction_angle", "critical_state_friction_angle", "max_dilatancy_angle")
+
+
+def angle_spreads(tests: list, names: tuple[str, ...] = ANGLES) -> dict[str, AngleSpread]:
+    """Each of the angles ``names`` spread over ``tests``, by name."""
+    return {k: AngleSpread.of([getattr(t, f"{k}_deg") for t in tests]) for k in names}
+
+
 def spread_of(kind: type[Spread], values: list[float | None]) -> Spread | None:
     """The spread of ``values``, or None when a test lacks the number (one read back from before it
     was recorded, or without its probe): a spread over some replicates would pass for all of them."""
@@ -121,8 +131,9 @@ class BiaxialTestSummary(TestSummary):
 
 @typed_parts
 @dataclass(eq=False)
-class StressSummary(TypedResult):
-    """One confining stress of a series: its replicates' spread and where its files are."""
+class StressSummary(ByName, TypedResult):
+    """One confining stress of a series: its replicates' spread and where its files are (read off
+    the stress's study by name)."""
 
     confining_stress_kpa: float
     folder: str

@@ -20,6 +20,7 @@ from poro2d.biaxial.parts import (
     AngleSpread,
     BiaxialTestSummary,
     Definitions,
+    angle_spreads,
     spread_of,
 )
 from poro2d.biaxial.record import folder_stage
@@ -181,10 +182,7 @@ def summarize(cases, tests, lab, workers, wall, config) -> BiaxialResult:
         for k, t in enumerate(tests)
     ]
     return BiaxialResult(
-        confining_stress_kpa=cases[0].confining_kpa, replicates=len(tests),
-        peak_friction_angle=AngleSpread.of([t.peak_friction_angle_deg for t in tests]),
-        critical_state_friction_angle=AngleSpread.of([t.critical_state_friction_angle_deg for t in tests]),
-        max_dilatancy_angle=AngleSpread.of([t.max_dilatancy_angle_deg for t in tests]),
+        confining_stress_kpa=cases[0].confining_kpa, replicates=len(tests), **angle_spreads(tests),
         axial_strain_at_peak=AngleSpread.of([t.axial_strain_at_peak for t in tests]),
         critical_state_reached=not missed, critical_state_note=note, summaries=summaries,
         definitions=Definitions(**DEFINITIONS), settings=cases[0].settings,

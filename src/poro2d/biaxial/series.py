@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -22,11 +22,11 @@ from poro2d.biaxial.envelope import envelope, peak_circle
 from poro2d.biaxial.lab import LabCurve
 from poro2d.biaxial.parts import (
     DEFINITIONS,
-    ELASTIC_SPREADS,
     ENVELOPE_DEFINITION,
     AngleSpread,
     Definitions,
     StressSummary,
+    angle_spreads,
     spread_of,
 )
 from poro2d.biaxial.results import BiaxialResult, BiaxialSeriesResult, BiaxialTestResult
@@ -68,19 +68,40 @@ def check_confining(values) -> list[float]:
     return sorted(stresses)
 
 
+@dataclass(frozen=True)
+class BiaxialSeriesCase:
+    """A biaxial series as one value, checked when made: ``case`` (its specimen and settings; its
+    own sigma_3 is not used), or a list of cases, one per replicate specimen; the confining
+    stresses (kPa); ``replicates`` specimens at each (quick specimens of seed, seed + 1, ...;
+    1 with a list of cases); ``lab``: laboratory curves (a CSV path, read here, or a
+    :class:`LabCurve`), recorded in the result."""
+
+    case: BiaxialCase | Sequence[BiaxialCase]
+    confining_kpa: Sequence[float]
+    replicates: int = 1
+    lab: str | os.PathLike | LabCurve | None = None
+
+    def __post_init__(self) -> None:
+        n = check_int("replicates", self.replicates, 1, MAX_REPLICATES)
+        object.__setattr__(self, "confining_kpa", tuple(check_confining(self.confining_kpa)))
+        cases = replicate_cases(self.case, n)
+        object.__setattr__(self, "case", self.case if isinstance(self.case, BiaxialCase) else tuple(cases))
+        object.__setattr__(self, "lab", lab_curve(self.lab))
+
+    def cases(self) -> dict[float, list[BiaxialCase]]:
+        """Each confining stress's replicate cases."""
+        base = replicate_cases(self.case, self.replicates)
+        return {s: [replace(c, confining_kpa=s) for c in base] for s in self.confining_kpa}
+
+
 def run_biaxial_series(
-    case: BiaxialCase | Sequence[BiaxialCase],
-    confining_kpa: Sequence[float],
+    series: BiaxialSeriesCase,
     store: Store | None = None,
     *,
-    replicates: int = 1,
-    lab: str | os.PathLike | LabCurve | None = None,
     options: RunOptions = RunOptions(),
     config: dict | None = None,
 ) -> BiaxialSeriesResult:
-    """Biaxial tests of ``case`` (its specimen and settings; its own sigma_3 is not used) at each of
-    ``confining_kpa``, on ``replicates`` specimens each (quick specimens of seed, seed + 1, ...; or
-    a list of cases, one per replicate specimen).
+    """Biaxial tests of ``series``: its case at each of its confining stresses, on its replicates.
 
     ``store``: the series' ``result.json`` and per stress a folder
     (``sigma3_100kPa/``) holding what :func:`run_biaxial` keeps; a rerun into it reads finished
@@ -91,14 +112,12 @@ def run_biaxial_series(
     with its tests and curves). Call it under ``if __name__ == "__main__":`` in a script (the
     tests run in spawned processes).
     """
-    n = check_int("replicates", replicates, 1, MAX_REPLICATES)
-    stresses = check_confining(confining_kpa)
-    base = replicate_cases(case, n)
-    cases = {s: [replace(c, confining_kpa=s) for c in base] for s in stresses}
-    lab_data = lab_curve(lab)
+    if not isinstance(series, BiaxialSeriesCase):
+        raise InputError("series", type(series).__name__, "a BiaxialSeriesCase")
+    cases = series.cases()
     workers = check_run(store, options, [c for cs in cases.values() for c in cs])
     with claimed(store, KIND):
-        return _run(cases, store, lab_data, workers, options, config)
+        return _run(cases, store, series.lab, workers, options, config)
 
 
 def _run(cases: dict[float, list[BiaxialCase]], store, lab, workers, options, config) -> BiaxialSeriesResult:
@@ -123,14 +142,7 @@ def _run(cases: dict[float, list[BiaxialCase]], store, lab, workers, options, co
 
 
 def _summary(study: BiaxialResult) -> StressSummary:
-    return StressSummary(
-        confining_stress_kpa=study.confining_stress_kpa, folder=stress_folder(study.confining_stress_kpa),
-        peak_friction_angle=study.peak_friction_angle,
-        critical_state_friction_angle=study.critical_state_friction_angle,
-        max_dilatancy_angle=study.max_dilatancy_angle, axial_strain_at_peak=study.axial_strain_at_peak,
-        critical_state_reached=study.critical_state_reached, critical_state_note=study.critical_state_note,
-        **{k: getattr(study, k) for k in ELASTIC_SPREADS},
-    )  # fmt: skip
+    return StressSummary.of(study, folder=stress_folder(study.confining_stress_kpa))
 
 
 def sigma_3_at_peak(test: BiaxialTestResult) -> float:
@@ -171,10 +183,7 @@ def summarize_series(studies: list[BiaxialResult], workers: int, wall: float, co
     first = studies[0]
     return BiaxialSeriesResult(
         confining_stresses_kpa=[st.confining_stress_kpa for st in studies], replicates=first.replicates,
-        stresses=[_summary(st) for st in studies],
-        peak_friction_angle=AngleSpread.of([t.peak_friction_angle_deg for t in tests]),
-        critical_state_friction_angle=AngleSpread.of([t.critical_state_friction_angle_deg for t in tests]),
-        max_dilatancy_angle=AngleSpread.of([t.max_dilatancy_angle_deg for t in tests]),
+        stresses=[_summary(st) for st in studies], **angle_spreads(tests),
         envelope=envelope(s1, s3), envelope_through_origin=envelope(s1, s3, through_origin=True),
         envelope_definition=ENVELOPE_DEFINITION, critical_state_reached=not missed, critical_state_note=note,
         sigma_3_held=all(t.checks.sigma_3_held for t in tests), sigma_3_note=_held_note(tests),
@@ -188,6 +197,7 @@ def summarize_series(studies: list[BiaxialResult], workers: int, wall: float, co
 
 __all__ = [
     "MAX_STRESSES",
+    "BiaxialSeriesCase",
     "check_confining",
     "run_biaxial_series",
     "stress_folder",

@@ -17,6 +17,11 @@ CONFINING_RANGE_KPA = NORMAL_STRESS_RANGE_KPA
 MAX_AXIAL_STRAIN = 0.5
 #: most rows a curve may hold
 MAX_RECORDS = 100_000
+#: the slowest strain rate a test may be run at (1/s): at the quick specimen's time step (about
+#: 5e-6 s with Table 1's stiffness) the default 0.2 of axial strain takes 0.2 / (1e-3 x 5e-6) = 4e7
+#: steps, four times the consolidation's largest budget (MAX_CONSOLIDATION_STEPS): days of one core.
+#: A slower test would not end in any run's time, and is refused before any work
+MIN_STRAIN_RATE = 1e-3
 
 #: the share of the end deviator the unloading probe takes off (:mod:`poro2d.biaxial.elastic`): enough
 #: to read a slope above the equilibrium's noise (0.05-0.1 was not on the quick specimen at 50 kPa),
@@ -28,7 +33,7 @@ STIFFNESS_NUMBER_RANGE = (10.0, 1e5)
 
 #: what each setting of :class:`BiaxialSettings` may be (checked in this order)
 BIAXIAL_RANGES: Ranges = {
-    "strain_rate": Real(0.0, 100.0, lo_open=True, or_none=True),
+    "strain_rate": Real(MIN_STRAIN_RATE, 100.0, or_none=True),
     "max_strain": Real(0.0, MAX_AXIAL_STRAIN, lo_open=True),
     "record_strain": Real(0.0, 0.05, lo_open=True),
     **lab_ranges("consolidation_ratio", "consolidation_max_steps", "stress_tolerance", *SERVO_AND_WALLS),
@@ -163,6 +168,7 @@ def inertial_number(strain_rate: float, d50: float, rho: float, pressure_pa: flo
 __all__ = [
     "BIAXIAL_RANGES",
     "CONFINING_RANGE_KPA",
+    "MIN_STRAIN_RATE",
     "PROBE_UNLOAD_RANGE",
     "STIFFNESS_NUMBER_RANGE",
     "BiaxialSettings",

@@ -15,11 +15,11 @@ console = OutputConsole()
 def register(app: typer.Typer) -> None:
     @app.command("biaxial")
     def biaxial_cmd(
-        specimen: list[str] = typer.Argument(
-            None, help="Specimen checkpoints or criterion/sand folders, one per replicate; or --quick."
+        specimen: list[str] = opt.specimens(
+            help="Specimen checkpoints or criterion/sand folders, one per replicate; or --quick."
         ),
-        quick: bool = typer.Option(
-            False, "--quick", help="The built-in quick specimen (0.05 m x 0.10 m, about 320 disks) of --seed."
+        quick: bool = opt.quick(
+            help="The built-in quick specimen (0.05 m x 0.10 m, about 320 disks) of --seed."
         ),
         confining: str = typer.Option(
             None, "--confining", help="Confining stresses sigma_3 in kPa: 100, or 50,100,200 (default 100)."
@@ -38,15 +38,11 @@ def register(app: typer.Typer) -> None:
         seed: int = typer.Option(None, "--seed", help="With --quick: the first specimen's seed (default 0)."),
         particle_friction: float = opt.particle_friction(),
         rolling_friction: float = opt.rolling_friction(),
-        stiffness_number: float = typer.Option(
-            None,
-            "--stiffness-number",
+        stiffness_number: float = opt.stiffness_number(
             help="Scale the disks' kn and ks so that kappa = kn / (sigma_3 t) is this "
             "(>= 1000: rigid grains; default: the specimen's stiffness).",
         ),
-        lab: Path = typer.Option(
-            None, "--lab", help="Your laboratory curves (CSV, docs/biaxial.md), overlaid."
-        ),
+        lab: Path = opt.lab(help="Your laboratory curves (CSV, docs/biaxial.md), overlaid."),
         out: Path = opt.out("biaxial-out", "Output folder."),
         workers: int = opt.tests_workers("test, at most one per core"),
         scheduler: str = opt.tests_scheduler(),
@@ -170,7 +166,7 @@ def make_case(quick: bool, specimen, sigma: float, first: int, settings):
 def start_and_print(case, stresses: list[float], store, kw: dict, out: Path) -> None:
     """One stress: run_biaxial; several: run_biaxial_series; the figures drawn from the result; the
     answer printed (a failed test: exit 1)."""
-    from poro2d.biaxial import run_biaxial, run_biaxial_series
+    from poro2d.biaxial import BiaxialSeriesCase, run_biaxial, run_biaxial_series
     from poro2d.biaxial.run import lab_curve
     from poro2d.report.biaxial_figures import draw_biaxial, draw_biaxial_series
 
@@ -180,8 +176,9 @@ def start_and_print(case, stresses: list[float], store, kw: dict, out: Path) -> 
             result = run_biaxial(case, store, **kw)
             draw_biaxial(result, store, kw["lab"])
         else:
-            result = run_biaxial_series(case, stresses, store, **kw)
-            draw_biaxial_series(result, store, kw["lab"])
+            series = BiaxialSeriesCase(case, stresses, kw.pop("replicates"), kw.pop("lab"))
+            result = run_biaxial_series(series, store, **kw)
+            draw_biaxial_series(result, store, series.lab)
     except RuntimeError as exc:
         console.print(f"[bold red]failed:[/] {exc}")
         raise typer.Exit(1) from None

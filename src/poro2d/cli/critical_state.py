@@ -68,10 +68,8 @@ def register(app: typer.Typer) -> None:
             help="The laboratory's critical-state line (toyoura, or a CSV p_kpa,e_cs) for --sand: "
             "the state-parameter map beside the Dr map.",
         ),
-        stiffness_number: float = typer.Option(
-            None,
-            "--stiffness-number",
-            help="kappa = kn / (P t) held at every pressure (contacts scaled with P; >= 1000: rigid grains).",
+        stiffness_number: float = opt.stiffness_number(
+            help="kappa = kn / (P t) held at every pressure (contacts scaled with P; >= 1000: rigid grains)."
         ),
         inertial: float = typer.Option(1e-3, "--inertial", help="Inertial number I (sets the shear rate)."),
         strain: float = typer.Option(3.0, "--strain", help="Shear strain gamma where the run ends."),
@@ -88,7 +86,7 @@ def register(app: typer.Typer) -> None:
         """Steady-state friction tau/sigma and solid fraction of the disks, free of any box."""
         from poro2d.cli.critical_state_held import held_states, print_held
         from poro2d.cli.shear import parse_stresses
-        from poro2d.critical_state import CriticalStateCase, run_critical_states
+        from poro2d.critical_state import CriticalStateCase, CriticalStateStudy, run_critical_states
         from poro2d.critical_state.case import CASE_RANGES
         from poro2d.critical_state.line import MAX_PRESSURES, run_critical_state_line
         from poro2d.critical_state.run import MAX_SEEDS
@@ -126,7 +124,7 @@ def register(app: typer.Typer) -> None:
         store = Store(out)
         try:
             if len(pressures) == 1:
-                result = run_critical_states(case, store, seeds=n, options=run, config=config)
+                result = run_critical_states(CriticalStateStudy(case, n), store, options=run, config=config)
                 draw_critical_state(result, store)
             else:
                 result = run_critical_state_line(

@@ -71,3 +71,11 @@ def job_options(
 
         check_reachable(scheduler)
     return options
+
+
+# the laboratory tests' own arguments and options (shear, strength, biaxial, critical-state); the help
+# given to each says the command's own
+specimens = partial(typer.Argument, None)
+quick = partial(typer.Option, False, "--quick")
+lab = partial(typer.Option, None, "--lab")
+stiffness_number = partial(typer.Option, None, "--stiffness-number")

@@ -106,7 +106,7 @@ def register(app: typer.Typer) -> None:
         normal_stress: str = typer.Option(
             None, "--normal-stress", "-n", help="Normal stresses in kPa, e.g. 50,100,200."
         ),
-        lab: Path = typer.Option(None, "--lab", help="Laboratory CSV (curves or peaks), optional."),
+        lab: Path = opt.lab(help="Laboratory CSV (curves or peaks), optional."),
         out: Path = opt.out("shear-out"),
         velocity: float = typer.Option(None, "--velocity", help="Shear velocity of the lower half (m/s)."),
         max_displacement: float = opt.max_displacement(),
@@ -272,11 +272,7 @@ def box_warning(tests) -> str | None:
     )
 
 
-def print_result(result: ShearSeriesResult | dict, out: Path) -> None:
-    from poro2d.shear.results import ShearSeriesResult
-    from poro2d.typed_result import part
-
-    result = part(ShearSeriesResult, result)  # a series read back as its dict, too
+def print_result(result: ShearSeriesResult, out: Path) -> None:
     warning = box_warning(result.tests)
     if warning:  # before the answer: a reader who stops at the table must not miss it
         console.print(warning, style="bold red", markup=False, soft_wrap=True)

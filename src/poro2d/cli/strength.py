@@ -102,12 +102,10 @@ MAX_TESTS = 300
 def register(app: typer.Typer) -> None:
     @app.command("strength")
     def strength_cmd(
-        specimen: list[str] = typer.Argument(
-            None, help="Replicate specimens (checkpoints or criterion folders), one per seed; or --quick."
+        specimen: list[str] = opt.specimens(
+            help="Replicate specimens (checkpoints or criterion folders), one per seed; or --quick."
         ),
-        quick: bool = typer.Option(
-            False, "--quick", help="The paper's quick specimen on --seeds seeds, a short grid (minutes)."
-        ),
+        quick: bool = opt.quick(help="The paper's quick specimen on --seeds seeds, a short grid (minutes)."),
         seeds: int = typer.Option(None, "--seeds", help="With --quick: replicate specimens (default 3)."),
         mu_r: str = typer.Option(None, "--mu-r", help="Rolling frictions, e.g. 0,0.1,0.2,0.4."),
         friction: str = typer.Option(None, "--friction", help="Particle frictions f_p, e.g. 0.5,1,3."),

@@ -8,11 +8,12 @@ seeds) out.
 
 from poro2d.critical_state.case import CriticalStateCase
 from poro2d.critical_state.results import CriticalStateResult, CriticalStateTestResult
-from poro2d.critical_state.run import run_critical_state, run_critical_states
+from poro2d.critical_state.run import CriticalStateStudy, run_critical_state, run_critical_states
 
 __all__ = [
     "CriticalStateCase",
     "CriticalStateResult",
+    "CriticalStateStudy",
     "CriticalStateTestResult",
     "run_critical_state",
     "run_critical_states",

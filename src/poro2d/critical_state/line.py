@@ -29,6 +29,7 @@ from poro2d.critical_state.run import KIND, MAX_SEEDS, seed_runs, seed_store, st
 from poro2d.errors import InputError, check_int
 from poro2d.execute import RunOptions
 from poro2d.io_utils import Provenance
+from poro2d.labtest.records import typed_parts
 from poro2d.measure.spread import Spread
 from poro2d.store import Store, claimed
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
@@ -38,22 +39,8 @@ MAX_PRESSURES = 12
 MIN_PRESSURES = 2
 #: the reference pressure of e_Gamma (kPa): the line's intercept is its void ratio at 1 kPa
 REFERENCE_KPA = 1.0
-#: the table of a line
+#: the table of a line: a row per pressure (:meth:`LinePoint.row`)
 LINE_CSV = "line.csv"
-LINE_COLUMNS = (
-    "pressure_kpa",
-    "mean_stress_kpa",
-    "void_ratio",
-    "void_ratio_sd",
-    "solid_fraction",
-    "stress_ratio",
-    "stress_ratio_sd",
-    "friction_angle_deg",
-    "coordination",
-    "stiffness_number",
-    "mean_overlap_ratio",
-    "steady",
-)
 
 
 def window_mean_stress(test: CriticalStateTestResult) -> float:
@@ -62,6 +49,7 @@ def window_mean_stress(test: CriticalStateTestResult) -> float:
     return float(s.mean_stress_kpa[s.window(test.case.window_start)].mean())
 
 
+@typed_parts
 @dataclass(eq=False)
 class LinePoint(TypedResult):
     """One pressure of the line: its study's numbers over the seeds (see the module)."""
@@ -77,16 +65,6 @@ class LinePoint(TypedResult):
     mean_overlap_ratio: Spread
     steady: bool
     note: str
-
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "mean_stress_kpa": Spread,
-        "void_ratio": Spread,
-        "solid_fraction": Spread,
-        "stress_ratio": Spread,
-        "friction_angle_deg": Spread,
-        "coordination": Spread,
-        "mean_overlap_ratio": Spread,
-    }
 
     @classmethod
     def of(cls, pressure_kpa: float, study: CriticalStateResult) -> LinePoint:
@@ -215,6 +193,7 @@ class StateMark(TypedResult):
         return cls(label, float(e), psi, span, None if not span else [v / span for v in psi])
 
 
+@typed_parts
 @dataclass(eq=False)
 class CriticalStateLineResult(TypedResult):
     """The line over ``pressures_kpa`` (the study's ``result.json``): a point per pressure, the fit
@@ -239,15 +218,6 @@ class CriticalStateLineResult(TypedResult):
         default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
 
-    PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "line": LineFit,
-        "points": LinePoint,
-        "stress_ratio": Spread,
-        "friction_angle_deg": Spread,
-        "case": CriticalStateCase,
-        "provenance": Provenance,
-        "marks": StateMark,
-    }
     OPTIONAL: ClassVar[tuple[str, ...]] = ("marks",)
 
     def measured(self) -> MeasuredLine:
@@ -390,7 +360,8 @@ def run_critical_state_line(
 
 def write_line(store: Store, result: CriticalStateLineResult) -> None:
     """``line.csv``, then ``result.json`` (last: it says the line is done)."""
-    store.write_csv(LINE_CSV, [p.row() for p in result.points], header=list(LINE_COLUMNS))
+    rows = [p.row() for p in result.points]
+    store.write_csv(LINE_CSV, rows, header=list(rows[0]))
     store.write_result("result.json", result)
 
 

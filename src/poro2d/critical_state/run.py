@@ -159,15 +159,34 @@ def _run_job(job: SeedJob, report) -> CriticalStateTestResult:
     return run_critical_state(job.case, job.store, report=report)
 
 
+@dataclass(frozen=True)
+class CriticalStateStudy:
+    """A critical-state study as one value, checked when made: ``case`` on ``seeds`` seeds
+    (case.seed, case.seed + 1, ...)."""
+
+    case: CriticalStateCase
+    seeds: int = 3
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.case, CriticalStateCase):
+            raise InputError("case", type(self.case).__name__, "a CriticalStateCase")
+        n = check_int("seeds", self.seeds, 1, MAX_SEEDS)
+        if self.case.seed + n - 1 > 2**31 - 1:
+            raise InputError("seeds", n, f"at most {2**31 - self.case.seed} from seed {self.case.seed}")
+
+    def cases(self) -> list[CriticalStateCase]:
+        """The case of each seed, in order."""
+        return [self.case.with_seed(self.case.seed + k) for k in range(self.seeds)]
+
+
 def run_critical_states(
-    case: CriticalStateCase,
+    study: CriticalStateStudy,
     store: Store | None = None,
     *,
-    seeds: int = 3,
     options: RunOptions = RunOptions(),
     config: dict | None = None,
 ) -> CriticalStateResult:
-    """``case`` on ``seeds`` seeds (case.seed, case.seed + 1, ...): each number's spread over them.
+    """The study's case on each of its seeds: each number's spread over them.
 
     ``store``: where ``result.json`` and ``series.csv`` (every seed's rows) go, and each seed's
     run as it finishes, in ``seed<N>/`` (a rerun after a kill reads the finished seeds back);
@@ -176,16 +195,12 @@ def run_critical_states(
     workers that import the calling script: call it under
     ``if __name__ == "__main__":`` in a script.
     """
-    if not isinstance(case, CriticalStateCase):
-        raise InputError("case", type(case).__name__, "a CriticalStateCase")
-    n = check_int("seeds", seeds, 1, MAX_SEEDS)
-    if case.seed + n - 1 > 2**31 - 1:
-        raise InputError("seeds", n, f"at most {2**31 - case.seed} from seed {case.seed}")
+    if not isinstance(study, CriticalStateStudy):
+        raise InputError("study", type(study).__name__, "a CriticalStateStudy")
     if store is not None and not isinstance(store, Store):
         raise InputError("store", type(store).__name__, "a poro2d.store.Store or None")
-    cases = [case.with_seed(case.seed + k) for k in range(n)]
     with claimed(store, KIND):
-        return _study(cases, store, options, config)
+        return _study(study.cases(), store, options, config)
 
 
 def _study(cases, store, options, config) -> CriticalStateResult:
@@ -241,13 +256,10 @@ def study_of(cases, tests, workers, wall, config) -> CriticalStateResult:
         )
     )
     summaries = [SeedSummary.of(t, seed=c.seed) for c, t in zip(cases, tests, strict=True)]
+    spreads = ("stress_ratio", "friction_angle_deg", "solid_fraction", "inertial_number", "coordination")
     return CriticalStateResult(
         seeds=[c.seed for c in cases],
-        stress_ratio=Spread.of([t.stress_ratio for t in tests]),
-        friction_angle_deg=Spread.of([t.friction_angle_deg for t in tests]),
-        solid_fraction=Spread.of([t.solid_fraction for t in tests]),
-        inertial_number=Spread.of([t.inertial_number for t in tests]),
-        coordination=Spread.of([t.coordination for t in tests]),
+        **{k: Spread.of([getattr(t, k) for t in tests]) for k in (*spreads, "mean_overlap_ratio")},
         steady=not missed,
         note=note,
         summaries=summaries,
@@ -258,13 +270,13 @@ def study_of(cases, tests, workers, wall, config) -> CriticalStateResult:
         provenance=Provenance.now(),
         void_ratio=Spread.of([void_ratio(t.solid_fraction) for t in tests]),
         stiffness_number=cases[0].kappa(),
-        mean_overlap_ratio=Spread.of([t.mean_overlap_ratio for t in tests]),
         tests=list(tests),
     )
 
 
 __all__ = [
     "MAX_SEEDS",
+    "CriticalStateStudy",
     "SeedJob",
     "run_critical_state",
     "run_critical_states",

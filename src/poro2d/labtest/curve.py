@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field, fields, make_dataclass
 from typing import Any, ClassVar, Self
 
 import numpy as np
@@ -87,4 +87,27 @@ class ColumnCurve(Mapping):
         return [dict(zip(names, values, strict=True)) for values in zip(*cols, strict=True)]
 
 
-__all__ = ["ColumnCurve", "CurveRow"]
+def curve_of(
+    row: type[CurveRow], name: str, module: str, doc: str | None = None, *, later: tuple[str, ...] = (),
+    optional: tuple[str, ...] = (),
+) -> type[ColumnCurve]:  # fmt: skip
+    """The curve class of the rows ``row``, named ``name`` in ``module``: a float array per field of
+    the row, in its order, ``later`` ones among them read as NaN where a row lacks them; ``optional``
+    ones last, None where a row lacks them (the row's, then those a curve is given afterwards).
+    Its columns are declared once, as the row's fields."""
+    required = tuple(f.name for f in fields(row) if f.name not in (*optional, "extra"))
+    columns = [
+        *((k, np.ndarray) for k in required),
+        *((k, np.ndarray | None, field(default=None)) for k in optional),
+    ]
+    namespace = {
+        "__doc__": doc,
+        "__module__": module,
+        "COLUMNS": required,
+        "LATER": later,
+        "OPTIONAL": optional,
+    }
+    return make_dataclass(name, columns, bases=(ColumnCurve,), namespace=namespace, frozen=True, eq=False)
+
+
+__all__ = ["ColumnCurve", "CurveRow", "curve_of"]

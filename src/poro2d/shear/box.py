@@ -29,13 +29,12 @@ from typing import NamedTuple
 
 import numpy as np
 
-from poro2d.dem import ContactModel, Particles, Simulation, Walls
+from poro2d.dem import Simulation
 from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
-from poro2d.dem.ordering import strip_order
 from poro2d.errors import InputError, check_range
+from poro2d.labtest.box import box_simulation, specimen_box
 from poro2d.labtest.records import BoxRecord
 from poro2d.paper_data import TABLE_1
-from poro2d.specimen.box import box_faces
 
 LOWER = ("bottom", "lower_left", "lower_right", "lower_lip")
 UPPER = ("upper_left", "upper_right", "upper_lip", "top")
@@ -142,31 +141,6 @@ class SplitBox:
         return PlaneForce(across, unbalanced, n_cross)
 
 
-def _specimen_box(sim: Simulation) -> tuple[float, float]:
-    hint = "a specimen saved by poro2d criterion or poro2d.specimen.compaction"
-    left, right, bottom, top = box_faces(sim.walls.names, sim.walls.p0, "specimen walls", hint)
-    if abs(left) > 1e-9 or abs(bottom) > 1e-9:
-        raise InputError("specimen box", (left, bottom), "a box with its lower left corner at (0, 0)")
-    return right, top
-
-
-def replaced_values(values: np.ndarray, value: float | None) -> np.ndarray:
-    """A copy of a per-disk array, every entry ``value`` when given."""
-    return values.copy() if value is None else np.full(values.shape, float(value))
-
-
-def pair_type_contact(contact: ContactModel, mu: float | None, kn: float | None, ks: float | None):
-    """The contact model with the disk-disk (kn, ks, mu) replaced where given: under the
-    ``per_pair_type`` convention one triple serves every disk pair and the disks' own arrays are
-    not read, so a replaced value must go there too (``per_body``: the disks' arrays suffice)."""
-    if contact.convention != "per_pair_type" or (mu is None and kn is None and ks is None):
-        return contact
-    assert contact.pp is not None
-    given = (kn, ks, mu)
-    pp = tuple(float(old if new is None else new) for old, new in zip(contact.pp, given, strict=True))
-    return ContactModel("per_pair_type", pp, contact.pw)
-
-
 def build_split_box(
     specimen: Simulation,
     max_displacement: float,
@@ -182,21 +156,13 @@ def build_split_box(
     particle_kn: float | None = None,
     particle_ks: float | None = None,
 ) -> tuple[Simulation, SplitBox]:
-    """A new simulation of the specimen's disks in a split box (all walls at rest).
-
-    The disks keep their positions, velocities and properties (``particle_friction``
-    replaces their friction when given, ``rolling_friction`` their rolling friction mu_r,
-    ``particle_kn`` and ``particle_ks`` their normal and shear stiffness, N/m: the time step is
-    chosen from the stiffness the new simulation holds, so a stiffer disk gets a shorter one);
-    the box walls take the disks' largest mu_r, so that under the engine's rule (a contact
-    takes the smaller of its two bodies' values) a disk meets a wall with its own mu_r, as
-    it meets another disk of its kind. The engine settings (contact convention,
-    gravity, damping) are the specimen's. Disk-disk shear histories are not carried
-    over: the consolidation that follows brings the specimen to a new equilibrium.
-    The disks are numbered anew (:func:`poro2d.dem.ordering.strip_order`).
-    ``max_displacement`` may not exceed W / 2.
+    """A new simulation of the specimen's disks in a split box (all walls at rest), the disks
+    keeping their velocities (:func:`poro2d.labtest.box.box_simulation`: ``particle_friction``,
+    ``rolling_friction``, ``particle_kn`` and ``particle_ks`` replace the disks' values when
+    given; the walls take the disks' largest mu_r); gravity and the engine's settings are the
+    specimen's. ``max_displacement`` may not exceed W / 2.
     """
-    W, H = _specimen_box(specimen)
+    W, H = specimen_box(specimen, "a specimen saved by poro2d criterion or poro2d.specimen.compaction")
     check_range("max_displacement", max_displacement, 0.0, W / 2, lo_open=True)
     check_range("gap", gap, 0.0, H / 4)
     check_range("kn_wall", kn_wall, 0.0, None, lo_open=True)
@@ -210,45 +176,28 @@ def build_split_box(
         if k is not None:
             check_range(name, k, 0.0, None, lo_open=True)
     p0 = specimen.particles
-    if p0.n == 0:
-        raise InputError("specimen", "no disks", "a specimen with disks")
     inside = (p0.pos[:, 0] > 0.0) & (p0.pos[:, 0] < W) & (p0.pos[:, 1] > 0.0) & (p0.pos[:, 1] < H)
     if not inside.all():
         raise InputError("specimen", f"{int((~inside).sum())} disk centres outside the box", "all inside")
     ys = 0.5 * H
-    dmax = 2.0 * float(p0.radius.max())
     e = max(W, H)
-    lip = max_displacement + dmax
-    mu_r = p0.mu_r.copy() if rolling_friction is None else np.full(p0.n, float(rolling_friction))
-    wall_mu_r = float(mu_r.max())
-    walls = Walls()
-    k = (kn_wall, ks_wall, friction_wall)
-    walls.add((-e, 0.0), (W + max_displacement + e, 0.0), *k, name="bottom", mu_r=wall_mu_r)
-    walls.add((0.0, -e), (0.0, ys), *k, name="lower_left", mu_r=wall_mu_r)
-    walls.add((W, -e), (W, ys), *k, name="lower_right", mu_r=wall_mu_r)
-    walls.add((-lip, ys), (0.0, ys), *k, name="lower_lip", mu_r=wall_mu_r)
-    walls.add((0.0, ys + gap), (0.0, H + e), *k, name="upper_left", mu_r=wall_mu_r)
-    walls.add((W, ys + gap), (W, H + e), *k, name="upper_right", mu_r=wall_mu_r)
-    walls.add((W, ys + gap), (W + lip, ys + gap), *k, name="upper_lip", mu_r=wall_mu_r)
-    walls.add((W + e, H), (-e, H), *k, name="top", mu_r=wall_mu_r)
-    particles = Particles(
-        pos=p0.pos.copy(), radius=p0.radius.copy(), density=p0.density.copy(), thickness=p0.thickness,
-        kn=replaced_values(p0.kn, particle_kn), ks=replaced_values(p0.ks, particle_ks),
-        mu=p0.mu.copy() if particle_friction is None else np.full(p0.n, float(particle_friction)),
-        vel=p0.vel.copy(), theta=p0.theta.copy(), omega=p0.omega.copy(), mode=p0.mode.copy(), mu_r=mu_r,
+    lip = max_displacement + 2.0 * float(p0.radius.max())
+    segments = [
+        ((-e, 0.0), (W + max_displacement + e, 0.0), "bottom"),
+        ((0.0, -e), (0.0, ys), "lower_left"),
+        ((W, -e), (W, ys), "lower_right"),
+        ((-lip, ys), (0.0, ys), "lower_lip"),
+        ((0.0, ys + gap), (0.0, H + e), "upper_left"),
+        ((W, ys + gap), (W, H + e), "upper_right"),
+        ((W, ys + gap), (W + lip, ys + gap), "upper_lip"),
+        ((W + e, H), (-e, H), "top"),
+    ]
+    sim = box_simulation(
+        specimen, segments, (kn_wall, ks_wall, friction_wall), particle_friction=particle_friction,
+        rolling_friction=rolling_friction, particle_kn=particle_kn, particle_ks=particle_ks, at_rest=False,
+        gravity=specimen.gravity, density_scale=density_scale, dt_safety=dt_safety, threads=threads,
     )  # fmt: skip
-    contact = pair_type_contact(specimen.contact, particle_friction, particle_kn, particle_ks)
-    sim = Simulation(
-        particles, walls, contact, gravity=specimen.gravity, local_damping=specimen.local_damping,
-        restitution=specimen.restitution, dt_safety=dt_safety, density_scale=density_scale,
-        skin=specimen.skin, threads=threads,
-    )  # fmt: skip
-    # numbered in strips across the short side, whatever order the specimen came in
-    sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
-    box = SplitBox(W, H, ys, float(gap), float(max_displacement), p0.thickness)
-    return sim, box
+    return sim, SplitBox(W, H, ys, float(gap), float(max_displacement), p0.thickness)
 
 
-__all__ = [
-    "LOWER", "UPPER", "PlaneForce", "SplitBox", "build_split_box", "pair_type_contact", "replaced_values",
-]  # fmt: skip
+__all__ = ["LOWER", "UPPER", "PlaneForce", "SplitBox", "build_split_box"]

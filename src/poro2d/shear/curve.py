@@ -11,13 +11,12 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import ClassVar
 
 import numpy as np
 
 from poro2d.dem import Simulation
 from poro2d.dem.contacts import ContactSet
-from poro2d.labtest.curve import ColumnCurve, CurveRow
+from poro2d.labtest.curve import CurveRow, curve_of
 from poro2d.labtest.records import typed_parts
 from poro2d.shear.box import UPPER_SIDE_WALLS, SplitBox
 from poro2d.shear.fit import peak, smooth
@@ -25,40 +24,6 @@ from poro2d.shear.parts import EndValues, ForceBalance
 from poro2d.shear.settings import ShearSettings, inertial_number
 from poro2d.store import Store
 from poro2d.typed_result import TypedResult
-
-CURVE_COLUMNS = [
-    "step", "shear_displacement_mm", "shear_stress_kpa", "normal_stress_kpa", "plate_displacement_mm",
-    "coordination_number", "lower_half_stress_kpa", "plane_stress_kpa", "upper_unbalanced_kpa",
-    "plate_friction_kpa", "contacts_across_plane", "max_unbalanced_ratio", "inertial_number",
-    "plane_normal_stress_kpa", "upper_wall_friction_kpa",
-]  # fmt: skip
-#: columns a curve of an earlier poro2d lacks: read back as NaN
-LATER_COLUMNS = ("plane_normal_stress_kpa", "upper_wall_friction_kpa")
-
-
-@dataclass(frozen=True, eq=False)
-class ShearCurve(ColumnCurve):
-    """A test's recorded curve: one float array per column of ``curve.csv`` (:data:`CURVE_COLUMNS`;
-    the later ones NaN in a curve of an earlier poro2d), and a mapping of the names to them."""
-
-    COLUMNS: ClassVar[tuple[str, ...]] = tuple(CURVE_COLUMNS)
-    LATER: ClassVar[tuple[str, ...]] = LATER_COLUMNS
-
-    step: np.ndarray
-    shear_displacement_mm: np.ndarray
-    shear_stress_kpa: np.ndarray
-    normal_stress_kpa: np.ndarray
-    plate_displacement_mm: np.ndarray
-    coordination_number: np.ndarray
-    lower_half_stress_kpa: np.ndarray
-    plane_stress_kpa: np.ndarray
-    upper_unbalanced_kpa: np.ndarray
-    plate_friction_kpa: np.ndarray
-    contacts_across_plane: np.ndarray
-    max_unbalanced_ratio: np.ndarray
-    inertial_number: np.ndarray
-    plane_normal_stress_kpa: np.ndarray
-    upper_wall_friction_kpa: np.ndarray
 
 
 @dataclass(eq=False)
@@ -89,6 +54,19 @@ class ShearRow(CurveRow):
     inertial_number: float
     plane_normal_stress_kpa: float = math.nan
     upper_wall_friction_kpa: float = math.nan
+
+
+#: columns a curve of an earlier poro2d lacks: read back as NaN
+LATER_COLUMNS = ("plane_normal_stress_kpa", "upper_wall_friction_kpa")
+ShearCurve = curve_of(
+    ShearRow, "ShearCurve", __name__, later=LATER_COLUMNS,
+    doc="A test's recorded curve: one float array per column of ``curve.csv`` (:data:`CURVE_COLUMNS`; the "
+    "later ones NaN in a curve of an earlier poro2d), and a mapping of the names to them.",
+)  # fmt: skip
+
+
+#: the columns of ``curve.csv``, in order: the fields of a row
+CURVE_COLUMNS = list(ShearCurve.COLUMNS)
 
 
 def curve_columns(rows: list[ShearRow] | list[Mapping]) -> ShearCurve | None:

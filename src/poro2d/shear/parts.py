@@ -11,17 +11,10 @@ replicate study's peaks at one normal stress.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, ClassVar, TypeVar
+from typing import ClassVar
 
 from poro2d.labtest.records import TestSummary, typed_parts
-from poro2d.typed_result import TypedResult, part
-
-P = TypeVar("P", bound=TypedResult)
-
-
-def parts(cls: type[P], values: Any) -> Any:
-    """Each item of the list ``values`` as the part ``cls`` (see :func:`part`); None stays None."""
-    return None if values is None else [part(cls, v) for v in values]
+from poro2d.typed_result import TypedResult
 
 
 @dataclass(eq=False)
@@ -205,12 +198,10 @@ class LabRecord(TypedResult):
 
 @typed_parts
 @dataclass(eq=False)
-class LabComparison(TypedResult):
-    """The laboratory data a series is compared with, their fits and the difference of the angles."""
+class LabComparison(LabRecord):
+    """The laboratory data a series is compared with (its first keys, a :class:`LabRecord`'s), their
+    fits and the difference of the angles."""
 
-    source: str
-    kind: str
-    peaks: list[LabPeak]
     fit: FitRecord | None
     friction_angle_deg: float | None
     cohesion_kpa: float | None
@@ -286,5 +277,5 @@ __all__ = [
     "LATER_KEYS", "EndValues", "FitInterval", "FitRecord", "ForceBalance",
     "LabComparison", "LabPeak", "LabRecord", "QuasiStatic", "RateCheck", "RateCheckRow",
     "ResidualAtRest", "StrengthCase", "StrengthDefinitions", "StressPeaks",
-    "ShearTestSummary", "part", "parts",
+    "ShearTestSummary",
 ]  # fmt: skip

@@ -137,10 +137,11 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
             "residual": mohr_coulomb(s, tau, through_origin=True).friction_angle_deg,
             "dilation": float(np.mean(psis)),
         })  # fmt: skip
-    spread = {}
-    for key in ("peak", "residual", "dilation"):
+    spread = {}  # each angle's mean and sd over the specimens, by its name in the file
+    for key, name in (("peak", "peak_friction_angle"), ("residual", "residual_friction_angle"),
+                      ("dilation", "max_dilation_angle")):  # fmt: skip
         values = [p[key] for p in per_specimen if p[key] is not None]
-        spread[key] = _mean_sd(values) if values else (None, None)
+        spread[f"{name}_mean_deg"], spread[f"{name}_sd_deg"] = _mean_sd(values) if values else (None, None)
     pooled = summary.fit
     res_fit = mohr_coulomb_ci(
         [r["residual_normal_stress_kpa"] for r in tests], [r["residual_shear_stress_kpa"] for r in tests],
@@ -150,12 +151,7 @@ def case_summary(rep: ReplicateShear, summary: ReplicateShearResult, mu_r: float
         mu_r=mu_r,
         particle_friction=friction,
         specimens=len(per_specimen),
-        peak_friction_angle_mean_deg=spread["peak"][0],
-        peak_friction_angle_sd_deg=spread["peak"][1],
-        residual_friction_angle_mean_deg=spread["residual"][0],
-        residual_friction_angle_sd_deg=spread["residual"][1],
-        max_dilation_angle_mean_deg=spread["dilation"][0],
-        max_dilation_angle_sd_deg=spread["dilation"][1],
+        **spread,
         peak_friction_angle_pooled_deg=pooled.friction_angle_deg if pooled else None,
         peak_friction_angle_pooled_ci_deg=pooled.friction_angle_ci_deg if pooled else None,
         cohesion_pooled_kpa=pooled.cohesion_kpa if pooled else None,
