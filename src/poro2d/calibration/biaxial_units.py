@@ -37,6 +37,7 @@ from poro2d.biaxial.single import BiaxialTest
 from poro2d.calibration.units import (
     CurveReadings,
     FrictionUnit,
+    UnitIdentity,
     check_files,
     parse_strain_station,
     window_mean,
@@ -66,14 +67,9 @@ def end_window(settings: BiaxialSettings) -> float:
 
 
 @dataclass(frozen=True)
-class BiaxialRow:
+class BiaxialRow(UnitIdentity):
     """What a finished biaxial unit gives the fit: its observables (dimensionless) and its cost."""
 
-    key: str
-    sigma: float
-    fp: float
-    mu_r: float
-    specimen: str
     peak_ratio: float
     end_ratio: float
     end_volumetric: float
@@ -121,11 +117,10 @@ class BiaxialUnit(FrictionUnit):
         )
         return BiaxialTest(case, store)
 
-    def stored_row(self, cache: Store | None) -> BiaxialRow | None:
-        """The row when ``cache`` holds the finished test, else None."""
+    def stored(self, cache: Store | None):
+        """The finished test's result in ``cache``, or None."""
         store = self.store(cache)
-        res = None if store is None or not store.root.is_dir() else self.test(store).stored()
-        return None if res is None else self.row(res)
+        return None if store is None or not store.root.is_dir() else self.test(store).stored()
 
     def check_entry(self, cache: Store | None) -> None:
         """Refuse a damaged entry on one line (a file where the folder belongs, a file changed since
@@ -133,11 +128,6 @@ class BiaxialUnit(FrictionUnit):
         store = self.store(cache)
         if store is not None:
             check_files(cache, store, "one biaxial test of the cache")
-
-    def compute(self, cache: Store | None) -> BiaxialRow:
-        """Run (or read back) the test: what a Dask worker runs (through
-        :func:`~poro2d.calibration.units.compute_unit`)."""
-        return self.row(self.test(self.store(cache)).run())
 
     def row(self, res) -> BiaxialRow:
         s = BiaxialSettings(**self.settings)

@@ -59,28 +59,29 @@ class Ranges:
     def dim(self) -> int:
         return len(self.axes)
 
-    def to_unit(self, fp, mu_r, *stiffness) -> np.ndarray:
-        """(n, d) design coordinates of parameter values (``stiffness``: kn, ks as calibrated)."""
-        lo, hi = np.log(self.fp[0]), np.log(self.fp[1])
-        u = (np.log(np.asarray(fp, float)) - lo) / (hi - lo)
-        v = (np.asarray(mu_r, float) - self.mu_r[0]) / (self.mu_r[1] - self.mu_r[0])
-        columns = [np.atleast_1d(u), np.atleast_1d(v)]
-        for axis, values in zip(self.axes[2:], stiffness, strict=True):
-            lo, hi = np.log(getattr(self, axis))
-            columns.append(np.atleast_1d((np.log(np.asarray(values, float)) - lo) / (hi - lo)))
+    def _span(self, axis: str) -> tuple[float, float]:
+        """The range of ``axis`` in its design coordinate's scale (the logarithm on :data:`LOG_AXES`)."""
+        lo, hi = getattr(self, axis)
+        return (np.log(lo), np.log(hi)) if axis in LOG_AXES else (lo, hi)
+
+    def to_unit(self, *values) -> np.ndarray:
+        """(n, d) design coordinates of parameter values (f_p, mu_r, then kn, ks as calibrated)."""
+        columns = []
+        for axis, x in zip(self.axes, values, strict=True):
+            lo, hi = self._span(axis)
+            x = np.asarray(x, float)
+            columns.append(np.atleast_1d(((np.log(x) if axis in LOG_AXES else x) - lo) / (hi - lo)))
         return np.column_stack(columns)
 
     def from_unit(self, unit: np.ndarray) -> tuple[np.ndarray, ...]:
         """(f_p, mu_r, then kn, ks as calibrated) arrays of design coordinates."""
         unit = np.atleast_2d(unit)
-        lo, hi = np.log(self.fp[0]), np.log(self.fp[1])
-        fp = np.exp(lo + unit[:, 0] * (hi - lo))
-        mu_r = self.mu_r[0] + unit[:, 1] * (self.mu_r[1] - self.mu_r[0])
-        stiffness = []
-        for k, axis in enumerate(self.axes[2:], start=2):
-            lo, hi = np.log(getattr(self, axis))
-            stiffness.append(np.exp(lo + unit[:, k] * (hi - lo)))
-        return (fp, mu_r, *stiffness)
+        values = []
+        for k, axis in enumerate(self.axes):
+            lo, hi = self._span(axis)
+            x = lo + unit[:, k] * (hi - lo)
+            values.append(np.exp(x) if axis in LOG_AXES else x)
+        return tuple(values)
 
     def axis_values(self, axis: str, unit_values: np.ndarray) -> np.ndarray:
         """The parameter values of one axis at design coordinates ``unit_values`` of it."""

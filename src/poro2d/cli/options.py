@@ -71,3 +71,16 @@ def job_options(
 
         check_reachable(scheduler)
     return options
+
+
+# the specimens a command makes itself or is given (help= says for which command)
+quick = partial(typer.Option, False, "--quick")
+seed = partial(typer.Option, None, "--seed")
+replicates = partial(typer.Option, None, "--replicates")
+specimens = partial(typer.Option, None, "--specimen", "-s")
+max_strain = partial(typer.Option, None, "--max-strain")
+
+
+def range_option(flag: str, text: str) -> Any:
+    """A search range ``flag`` given as ``LOW,HIGH`` (None: the command's default); ``text``: its help."""
+    return typer.Option(None, flag, help=text)

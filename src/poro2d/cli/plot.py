@@ -52,27 +52,16 @@ def plot_relations(
     check_no_run("--out-dir", out_dir)  # the figures would replace a run's own (the paper's Figs. 1-2)
 
     paths = write_relation_figures(
-        out_dir,
-        n_max,
-        n_min,
-        nu_reading=nu_reading.value,
-        lattice_exact=lattice_exact,
-        mark_n_lab=mark_n_lab,
+        out_dir, n_max, n_min, nu_reading=nu_reading.value, lattice_exact=lattice_exact, mark_n_lab=mark_n_lab
     )
     for p in paths:
         typer.echo(str(p))
 
 
 def register(app: typer.Typer) -> None:
-    """Attach ``plot relations`` to the root app, under its ``plot`` group."""
-    plot_app = None
-    for group in app.registered_groups:
-        if group.name == "plot" and group.typer_instance is not None:
-            plot_app = group.typer_instance
-            break
-    if plot_app is None:
-        plot_app = typer.Typer(help="Figures.", no_args_is_help=True)
-        app.add_typer(plot_app, name="plot")
+    """Attach the ``plot`` group, with ``plot relations``, to the root app."""
+    plot_app = typer.Typer(help="Figures.", no_args_is_help=True)
+    app.add_typer(plot_app, name="plot")
     plot_app.command(
         "relations",
         cls=OneLineUsageCommand,

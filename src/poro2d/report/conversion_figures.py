@@ -9,12 +9,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from poro2d import porosity as P
 from poro2d.errors import InputError, check_range
-from poro2d.report.figure_file import save_figure
+from poro2d.report.figure_file import new_figure, save_figure
 
 # name, function of n_lab, style
 _STYLE = {
@@ -40,13 +39,6 @@ def _eq2_label(reading: str) -> str:
 
 def _check_extremes(n_max: float, n_min: float) -> None:
     P.relative_density(n_min, n_max, n_min)  # validates both, raises InputError
-
-
-def _new_axes(figsize: tuple[float, float]):
-    """A figure with its own Agg canvas, so that no pyplot state is touched."""
-    fig = Figure(figsize=figsize, layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig, fig.add_subplot()
 
 
 def _fig1_curves(
@@ -130,7 +122,7 @@ def fig1_relations(
     x = np.linspace(n_min, n_max, num)
     curves = _fig1_curves(x, n_max, n_min, nu_reading, lattice_exact)
 
-    fig, ax = _new_axes((10.5, 6.0))
+    fig, ax = new_figure(figsize=(10.5, 6.0), layout="constrained")
     lo_y = min(0.0, min(float(np.nanmin(y)) for _, _, y in curves))
     hi_y = max(float(np.nanmax(y)) for _, _, y in curves)
     pad = 0.04 * (hi_y - lo_y)
@@ -251,7 +243,7 @@ def fig2_lim_parabola(
     """Fig. 2: LIM_2D-Lab, LIM_2D-3D and the parabola of Eq. 12, with its three points."""
     _check_extremes(n_max, n_min)
     x = np.linspace(0.0, x_max, num)
-    fig, ax = _new_axes((9.5, 6.0))
+    fig, ax = new_figure(figsize=(9.5, 6.0), layout="constrained")
     lab, l3 = _fig2_lines(ax, x, n_max, n_min, lattice_exact)
     _fig2_construction_points(ax)
     if mark_n_lab is not None:

@@ -61,18 +61,12 @@ def build_blocks(
         b += report_blocks(sensitivity)
     if summary.shear:
         b += _shear_blocks(summary.shear, shear_figures or {})
-    b += _calibration_blocks(calibration, out / CALIBRATION_FOLDER)
+    if calibration is not None:  # ``poro2d calibrate --out <paper-out>/calibration`` has run
+        from poro2d.report.calibration_report import calibration_blocks
+
+        b += calibration_blocks(calibration, out / CALIBRATION_FOLDER)
     b += _provenance_blocks(summary, crit)
     return b
-
-
-def _calibration_blocks(calibration: Any, folder: Path) -> list[Block]:
-    """The calibration's section, when ``poro2d calibrate --out <paper-out>/calibration`` has run."""
-    if calibration is None:
-        return []
-    from poro2d.report.calibration_report import calibration_blocks
-
-    return calibration_blocks(calibration, folder)
 
 
 def _intro_blocks(summary, crit) -> list[Block]:
@@ -186,31 +180,38 @@ CRITERION_CAPTIONS = {
 }
 
 
+#: the rows of the trials' table: a label and the key of a trial's row (None: a trial without it)
+TRIAL_ROWS = (
+    ("trial n2D", "trial_porosity"),
+    ("disks", "particle_count"),
+    ("F_top at H (N/m)", "f_top_n_per_m"),
+    ("F_bottom at H (N/m)", "f_bottom_n_per_m"),
+    ("G = rho_s (1-n) W H g (N/m)", "self_weight_n_per_m"),
+    ("top plate moved", "plate_moved"),
+    ("plate displacement (mm)", "plate_displacement_mm"),
+    ("F_top after (N/m)", "f_top_after_n_per_m"),
+    ("F_bottom after (N/m)", "f_bottom_after_n_per_m"),
+    ("n'", "new_porosity"),
+    ("|n' - n2D|", "porosity_change"),
+    ("interior porosity", "interior_porosity"),
+    ("mean gap under the plate (d50)", "surface_gap_mean_d50"),
+    ("accepted", "accepted"),
+)
+
+
+def _shown(trial: dict) -> dict:
+    """A trial's row as its table shows it: the plate's displacement in mm, the verdict in words."""
+    accepted = "yes" if trial["accepted"] else "no"
+    return dict(trial, plate_displacement_mm=1e3 * trial["plate_displacement_m"], accepted=accepted)
+
+
 def _criterion_blocks(criterion, pc) -> list[Block]:
     """poro2d's trials beside the paper's, the discussion, Figs. 5-7 and the specimen's state."""
     b: list[Block] = [("h2", "The criterion (Fig. 3)")]
     its = [r.to_dict() for r in criterion.result.iterations or []]  # each trial's row
     if its:
-        b.append((
-            "table",
-            ["", *[f"trial {r['iteration']}" for r in its]],
-            [
-                ["trial n2D", *[r["trial_porosity"] for r in its]],
-                ["disks", *[r["particle_count"] for r in its]],
-                ["F_top at H (N/m)", *[r["f_top_n_per_m"] for r in its]],
-                ["F_bottom at H (N/m)", *[r["f_bottom_n_per_m"] for r in its]],
-                ["G = rho_s (1-n) W H g (N/m)", *[r["self_weight_n_per_m"] for r in its]],
-                ["top plate moved", *[r["plate_moved"] for r in its]],
-                ["plate displacement (mm)", *[1e3 * r["plate_displacement_m"] for r in its]],
-                ["F_top after (N/m)", *[r.get("f_top_after_n_per_m") for r in its]],
-                ["F_bottom after (N/m)", *[r.get("f_bottom_after_n_per_m") for r in its]],
-                ["n'", *[r["new_porosity"] for r in its]],
-                ["|n' - n2D|", *[r["porosity_change"] for r in its]],
-                ["interior porosity", *[r.get("interior_porosity") for r in its]],
-                ["mean gap under the plate (d50)", *[r.get("surface_gap_mean_d50") for r in its]],
-                ["accepted", *["yes" if r["accepted"] else "no" for r in its]],
-            ],
-        ))  # fmt: skip
+        rows = [[label, *[_shown(r).get(key) for r in its]] for label, key in TRIAL_ROWS]
+        b.append(("table", ["", *[f"trial {r['iteration']}" for r in its]], rows))
         b.append(("p", "The paper's run, for comparison:"))
         b.append((
             "table",

@@ -13,11 +13,10 @@ import math
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from poro2d import porosity as P
-from poro2d.report.figure_file import save_figure
+from poro2d.report.figure_file import new_figure, save_figure
 from poro2d.store import Store
 from poro2d.sweep.results import RelationResult
 
@@ -44,9 +43,7 @@ def plot_relation(rel, title: str = "") -> Figure:
     xs = [p.n_lab for p in pts] + [hi, lo]
     pad = 0.08 * (max(xs) - min(xs))
     x = np.linspace(min(xs) - pad, max(xs) + pad, 201)
-    fig = Figure(figsize=(9.5, 6.0), layout="constrained")
-    FigureCanvasAgg(fig)
-    ax = fig.add_subplot()
+    fig, ax = new_figure(figsize=(9.5, 6.0), layout="constrained")
     ax.axvspan(lo, hi, color="0.5", alpha=0.07, lw=0)
     _method_curves(ax, x, hi, lo, rel.fit)
     _dem_points(ax, rel)
