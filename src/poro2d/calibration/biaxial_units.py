@@ -43,7 +43,6 @@ from poro2d.calibration.units import (
     window_mean,
 )
 from poro2d.identity import identity_digest
-from poro2d.specimen.saved import Specimen
 from poro2d.store import Store
 
 
@@ -106,16 +105,15 @@ class BiaxialUnit(FrictionUnit):
 
     #: what the progress display counts
     WHAT = "biaxial tests"
+    SETTINGS = BiaxialSettings
+    CASE = BiaxialCase
 
     @cached_property
     def key(self) -> str:
         return biaxial_unit_key(self.digest, self.sigma, self.settings)
 
     def test(self, store: Store | None) -> BiaxialTest:
-        case = BiaxialCase(
-            Specimen.read(self.specimen, self.digest), self.sigma, BiaxialSettings(**self.settings)
-        )
-        return BiaxialTest(case, store)
+        return BiaxialTest(self.case(), store)
 
     def stored(self, cache: Store | None):
         """The finished test's result in ``cache``, or None."""
@@ -130,7 +128,7 @@ class BiaxialUnit(FrictionUnit):
             check_files(cache, store, "one biaxial test of the cache")
 
     def row(self, res) -> BiaxialRow:
-        s = BiaxialSettings(**self.settings)
+        s = self.typed_settings
         c = res.curve
         return BiaxialRow(
             key=self.key, sigma=self.sigma, fp=self.fp, mu_r=self.mu_r, specimen=self.specimen,

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from poro2d.calibration.discrepancy import Discrepancy, Levels, level_posterior, log_likelihood
+from poro2d.calibration.discrepancy import Discrepancy, level_posterior, log_likelihood
 from poro2d.record import Record
 
 #: points per axis of the posterior grid
@@ -352,7 +352,7 @@ def posterior(
     uu, vv = np.meshgrid(u, v)
     points = np.column_stack([uu.ravel(), vv.ravel()])
     misfit = np.column_stack([s.mean(points) - y for s, y in zip(surrogates, lab_values, strict=True)])
-    log_like, terms = log_likelihood(misfit, cov, discrepancy)
+    log_like, terms = log_likelihood(cov, discrepancy)(misfit)
     log_like -= log_like.max()
     density = np.exp(log_like).reshape(uu.shape)
     post = Posterior(ranges, u, v, density / density.sum())
@@ -428,21 +428,12 @@ def log_posterior(
     the Gaussian log-likelihood of the laboratory values (summed over the discrepancy's levels),
     -inf outside the cube."""
     lab = np.asarray(lab_values, float)
-    if discrepancy is not None and discrepancy.none:
-        discrepancy = None
-    if discrepancy is None:  # the precision inverted once, as before the term existed
-        precision = np.linalg.inv(cov)
-    else:
-        levels = Levels.of(cov, discrepancy)
+    likelihood = log_likelihood(cov, discrepancy)
 
     def log_prob(x: np.ndarray) -> np.ndarray:
         misfit = np.column_stack([s.mean(x) for s in surrogates]) - lab
-        if discrepancy is None:
-            lp = -0.5 * np.einsum("ki,ij,kj->k", misfit, precision, misfit)
-        else:
-            lp = levels.log_likelihood(misfit)[0]
         inside = np.all((x >= 0.0) & (x <= 1.0), axis=1)
-        return np.where(inside, lp, -np.inf)
+        return np.where(inside, likelihood(misfit)[0], -np.inf)
 
     return log_prob
 
@@ -490,7 +481,7 @@ def sampled_posterior(
     )
     if discrepancy is not None and not discrepancy.none:
         misfit = np.column_stack([s.mean(post.chain) for s in surrogates]) - np.asarray(lab_values, float)
-        _, terms = log_likelihood(misfit, cov, discrepancy)
+        _, terms = log_likelihood(cov, discrepancy)(misfit)
         weights = np.full(len(post.chain), 1.0 / len(post.chain))
         post.discrepancy, post.discrepancy_weights = discrepancy, level_posterior(terms, weights)
     return post

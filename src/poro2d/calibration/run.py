@@ -478,9 +478,7 @@ def _wide(ranges: model.Ranges, axis: str, lo: float, hi: float) -> bool:
 
 
 def _prior(ranges: model.Ranges) -> str:
-    """The prior in words: the two-parameter text of earlier files, the stiffnesses added."""
-    if ranges.dim == 2:
-        return "uniform in log(f_p) and mu_r over the ranges"
+    """The prior in words (two parameters: "uniform in log(f_p) and mu_r over the ranges")."""
     words = {"fp": "log(f_p)", "mu_r": "mu_r", "kn": "log(kn)", "ks": "log(ks)"}
     names = [words[a] for a in ranges.axes]
     return f"uniform in {', '.join(names[:-1])} and {names[-1]} over the ranges"

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -153,6 +153,10 @@ class FrictionUnit:
     sigma: float
     settings: dict[str, Any]
 
+    #: the kind's settings and case classes (the shear test's or the biaxial test's)
+    SETTINGS: ClassVar[type]
+    CASE: ClassVar[type]
+
     @classmethod
     def at(cls, specimen, digest: str, sigma: float, base, fp: float, mu_r: float, **stiffness):
         """The unit of ``specimen`` at ``sigma`` with the frictions (f_p, mu_r) on the ``base`` settings
@@ -176,6 +180,16 @@ class FrictionUnit:
     @property
     def key(self) -> str:
         raise NotImplementedError
+
+    def case(self):
+        """The test's case: the specimen read (its content checked against ``digest``), the stress
+        and the settings."""
+        return self.CASE(Specimen.read(self.specimen, self.digest), self.sigma, self.typed_settings)
+
+    @property
+    def typed_settings(self):
+        """The settings as their class (the unit keeps them as the table its key hashes)."""
+        return self.SETTINGS(**self.settings)
 
     def store(self, cache: Store | None) -> Store | None:
         """The unit's store in ``cache``, under its key (None: nothing kept)."""
@@ -242,6 +256,8 @@ class CalibrationUnit(FrictionUnit):
 
     #: what the progress display counts (:class:`poro2d.calibration.cluster.UnitRunner`)
     WHAT = "shear tests"
+    SETTINGS = ShearSettings
+    CASE = ShearCase
 
     @cached_property
     def key(self) -> str:
@@ -249,10 +265,7 @@ class CalibrationUnit(FrictionUnit):
         return unit_key(self.digest, self.sigma, self.settings)
 
     def test(self, store: Store | None) -> DirectShearTest:
-        case = ShearCase(
-            Specimen.read(self.specimen, self.digest), self.sigma, ShearSettings(**self.settings)
-        )
-        return DirectShearTest(case, store, keep_peak=False)
+        return DirectShearTest(self.case(), store, keep_peak=False)
 
     def stored(self, cache: Store | None):
         """The finished test's result in ``cache``, or None."""
@@ -271,7 +284,7 @@ class CalibrationUnit(FrictionUnit):
         store = self.store(cache)
         if store is None or not check_files(cache, store, "one shear test of the cache"):
             return
-        content = content_record(self.digest, self.sigma, ShearSettings(**self.settings))
+        content = content_record(self.digest, self.sigma, self.typed_settings)
         try:
             folder_stage(store, content, self.specimen).check()
         except InputError:
@@ -289,7 +302,7 @@ class CalibrationUnit(FrictionUnit):
 
     def row(self, res) -> UnitRow:
         """What the fit reads of the test's result ``res``."""
-        window = ShearSettings(**self.settings).peak_window
+        window = self.typed_settings.peak_window
         curve = res.curve
         return UnitRow(
             key=self.key,

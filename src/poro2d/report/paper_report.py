@@ -325,6 +325,14 @@ def k0_note(k0: float) -> str:
     )
 
 
+#: what the box and the interior porosity each say
+POROSITY_NOTE = (
+    "The paper's n' counts the gap between the plate and the rough surface of the specimen; the "
+    "interior porosity is the packing's own and does not depend on the box's size. To build this "
+    "specimen in another code, take the interior porosity (docs/porosity.md)."
+)
+
+
 def _porosity_blocks(criterion) -> list[Block]:
     """Box against interior porosity of the accepted specimen, the plate's surface, the local map."""
     m = criterion.porosity
@@ -344,22 +352,10 @@ def _porosity_blocks(criterion) -> list[Block]:
         ["plate width in contact", contact],
     ]  # fmt: skip
     b.append(("table", ["measure", "value"], rows))
-    b.append(
-        (
-            "p",
-            "The paper's n' counts the gap between the plate and the rough surface of the specimen; the "
-            "interior porosity is the packing's own and does not depend on the box's size. To build this "
-            "specimen in another code, take the interior porosity (docs/porosity.md).",
-        )
-    )
+    b.append(("p", POROSITY_NOTE))
     if "local_porosity.png" in criterion.figures:
-        b.append(
-            (
-                "img",
-                criterion.figures["local_porosity.png"],
-                "Local porosity of the accepted specimen (Laguerre cells)",
-            )
-        )
+        cap = "Local porosity of the accepted specimen (Laguerre cells)"
+        b.append(("img", criterion.figures["local_porosity.png"], cap))
     return b
 
 
