@@ -61,12 +61,18 @@ def build_blocks(
         b += report_blocks(sensitivity)
     if summary.shear:
         b += _shear_blocks(summary.shear, shear_figures or {})
-    if calibration is not None:  # ``poro2d calibrate --out <paper-out>/calibration`` has run
-        from poro2d.report.calibration_report import calibration_blocks
-
-        b += calibration_blocks(calibration, out / CALIBRATION_FOLDER)
+    b += _calibration_blocks(calibration, out / CALIBRATION_FOLDER)
     b += _provenance_blocks(summary, crit)
     return b
+
+
+def _calibration_blocks(calibration: Any, folder: Path) -> list[Block]:
+    """The calibration's section, when ``poro2d calibrate --out <paper-out>/calibration`` has run."""
+    if calibration is None:
+        return []
+    from poro2d.report.calibration_report import calibration_blocks
+
+    return calibration_blocks(calibration, folder)
 
 
 def _intro_blocks(summary, crit) -> list[Block]:
