@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cached_property
 from typing import ClassVar
 
 import numpy as np
@@ -107,18 +106,10 @@ class BiaxialUnit(FrictionUnit):
     WHAT = "biaxial tests"
     SETTINGS = BiaxialSettings
     CASE = BiaxialCase
-
-    @cached_property
-    def key(self) -> str:
-        return biaxial_unit_key(self.digest, self.sigma, self.settings)
+    KEY = staticmethod(biaxial_unit_key)
 
     def test(self, store: Store | None) -> BiaxialTest:
         return BiaxialTest(self.case(), store)
-
-    def stored(self, cache: Store | None):
-        """The finished test's result in ``cache``, or None."""
-        store = self.store(cache)
-        return None if store is None or not store.root.is_dir() else self.test(store).stored()
 
     def check_entry(self, cache: Store | None) -> None:
         """Refuse a damaged entry on one line (a file where the folder belongs, a file changed since

@@ -10,6 +10,7 @@ that was killed.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import Any, ClassVar
@@ -153,9 +154,11 @@ class FrictionUnit:
     sigma: float
     settings: dict[str, Any]
 
-    #: the kind's settings and case classes (the shear test's or the biaxial test's)
+    #: the kind's settings and case classes (the shear test's or the biaxial test's), and the digest
+    #: that names a unit's folder in the cache
     SETTINGS: ClassVar[type]
     CASE: ClassVar[type]
+    KEY: ClassVar[Callable[[str, float, dict], str]]
 
     @classmethod
     def at(cls, specimen, digest: str, sigma: float, base, fp: float, mu_r: float, **stiffness):
@@ -177,9 +180,10 @@ class FrictionUnit:
     def mu_r(self) -> float:
         return self.settings["rolling_friction"]
 
-    @property
+    @cached_property
     def key(self) -> str:
-        raise NotImplementedError
+        """The unit's identity: the name of its store in the cache (its kind's ``KEY``)."""
+        return type(self).KEY(self.digest, self.sigma, self.settings)
 
     def case(self):
         """The test's case: the specimen read (its content checked against ``digest``), the stress
@@ -194,6 +198,11 @@ class FrictionUnit:
     def store(self, cache: Store | None) -> Store | None:
         """The unit's store in ``cache``, under its key (None: nothing kept)."""
         return None if cache is None else cache.child(self.key)
+
+    def stored(self, cache: Store | None):
+        """The finished test's result in ``cache``, or None (a folder not there holds none)."""
+        store = self.store(cache)
+        return None if store is None or not store.root.is_dir() else self.test(store).stored()
 
     def stored_row(self, cache: Store | None):
         """The unit's row when its store in ``cache`` holds the finished test, else None."""
@@ -258,19 +267,10 @@ class CalibrationUnit(FrictionUnit):
     WHAT = "shear tests"
     SETTINGS = ShearSettings
     CASE = ShearCase
-
-    @cached_property
-    def key(self) -> str:
-        """The unit's identity: the name of its store in the cache (:func:`unit_key`)."""
-        return unit_key(self.digest, self.sigma, self.settings)
+    KEY = staticmethod(unit_key)
 
     def test(self, store: Store | None) -> DirectShearTest:
         return DirectShearTest(self.case(), store, keep_peak=False)
-
-    def stored(self, cache: Store | None):
-        """The finished test's result in ``cache``, or None."""
-        store = self.store(cache)
-        return None if store is None else self.test(store).stored()
 
     def check_entry(self, cache: Store | None) -> None:
         """Refuse, on one line naming it, a unit's cache entry that is damaged: what a test resumes from.
