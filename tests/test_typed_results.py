@@ -407,25 +407,20 @@ def test_a_calibrations_per_parameter_values_are_typed_parts():
     """A calibration's best pair, intervals, ranges, posterior median and wide flags, its
     laboratory data and timings are typed parts; the file is the same."""
     from poro2d.calibration.model import Surrogate
-    from poro2d.calibration.run import (
-        CalibrationTimings,
-        FrictionBounds,
-        FrictionFlags,
-        FrictionValues,
-    )
+    from poro2d.calibration.run import CalibrationTimings, ParameterValues
     from poro2d.shear.parts import LabRecord
 
     stored = json.loads((DATA / "calibration_result.json").read_text())
     cal = CalibrationResult.from_dict(stored)
-    assert isinstance(cal.best, FrictionValues)
+    assert isinstance(cal.best, ParameterValues)
     assert cal.best.particle_friction == stored["best"]["particle_friction"]
-    assert isinstance(cal.intervals, FrictionBounds) and isinstance(cal.ranges, FrictionBounds)
-    assert cal.ranges.rolling_friction == [0.0, 0.5] and isinstance(cal.posterior.wide, FrictionFlags)
-    assert isinstance(cal.posterior.median, FrictionValues) and isinstance(cal.lab, LabRecord)
+    assert isinstance(cal.intervals, ParameterValues) and isinstance(cal.ranges, ParameterValues)
+    assert cal.ranges.rolling_friction == [0.0, 0.5] and isinstance(cal.posterior.wide, ParameterValues)
+    assert isinstance(cal.posterior.median, ParameterValues) and isinstance(cal.lab, LabRecord)
     assert isinstance(cal.timings, CalibrationTimings) and cal.timings.wall_time_s > 0
     assert isinstance(cal.fit["peak_50kPa"], Surrogate) and cal.fit["peak_50kPa"].replicates == 2
     assert json.dumps(cal.to_dict(), indent=2) == json.dumps(stored, indent=2)
-    unknown = FrictionBounds.from_dict({"particle_friction": None, "rolling_friction": None})
+    unknown = ParameterValues.from_dict({"particle_friction": None, "rolling_friction": None})
     assert unknown.to_dict() == {"particle_friction": None, "rolling_friction": None}
     assert unknown.rolling_friction is None
 

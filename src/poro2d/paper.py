@@ -14,8 +14,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, ClassVar
 
+from poro2d.calibration.specimens import paper_criterion
 from poro2d.console import OutputConsole
-from poro2d.criterion.config import paper_config
 from poro2d.criterion.replicates import accepted_and_replicates
 from poro2d.criterion.result import CriterionResult, ReplicateRow
 from poro2d.execute.options import RunOptions
@@ -224,20 +224,12 @@ def run_paper(case: PaperCase, store: Store, *, options: RunOptions = RunOptions
     Returns the summary kept as the store's ``results.json``; ``summary.criterion.converged``
     says whether the criterion found its porosity (no shear tests otherwise).
     """
-    import os
-
-    from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.io_utils import check_output_dir
 
     out = store.root
     check_output_dir(store.parameter, out)
     quick, seed = case.quick, case.seed
-    cfg = paper_config(quick, seed)
-    nthreads = case.threads if case.threads is not None else min(os.cpu_count() or 1, 2)
-    spec, grading, settings, sd = cfg.build(threads=nthreads)
-    crit = PorosityCriterion(spec, grading, settings, seed=sd, store=store.child("criterion"),
-                             progress=options.progress, config=cfg.as_config())  # fmt: skip
-    crit.validate()  # every option is checked before the first file is written
+    crit = paper_criterion(store, quick, seed, case.threads, options.progress)
     stage = paper_stage(store, quick, seed)
     stage.check()  # and the folder: one of another paper run is refused before anything is written
     summary, criterion, shear_figures = _run_stages(store, stage, crit, case, progress=options.progress)

@@ -12,7 +12,7 @@ from poro2d.calibration import model
 from poro2d.calibration.box_dominated import BoxDominatedPoint, BoxDominatedPoints, with_box_note
 from poro2d.calibration.case import MIN_POINTS, CalibrationCase, shear_base_settings
 from poro2d.calibration.run import CalibrationResult, _infer, _units
-from poro2d.calibration.units import CalibrationUnit, UnitRow, stored_row
+from poro2d.calibration.units import CalibrationUnit, UnitRow
 from poro2d.cli import main
 from poro2d.paper_data import QUICK_BOX_SOIL_LIKE
 from poro2d.report.calibration_report import box_dominated_note
@@ -155,6 +155,6 @@ def test_a_unit_cached_before_the_flag_is_judged_from_its_curve_under_the_same_k
     )
     again = replace(unit)
     assert again.key == unit.key
-    row = stored_row(again, cache)
+    row = again.stored_row(cache)
     assert row is not None and row.peak == fresh.peak
     assert (row.box_dominated, row.box_note) == (fresh.box_dominated, fresh.box_note)

@@ -7,7 +7,7 @@ import pytest
 import poro2d.calibration.cluster as cluster
 from poro2d.calibration.case import shear_base_settings
 from poro2d.calibration.cluster import UnitRunner
-from poro2d.calibration.units import CalibrationUnit, UnitRow, check_entry
+from poro2d.calibration.units import CalibrationUnit, UnitRow
 from poro2d.errors import InputError
 from poro2d.execute import Backend, Executor, RunOptions
 from poro2d.store import Store
@@ -22,10 +22,10 @@ def _unit(sigma: float = 50.0, specimen="s.npz") -> CalibrationUnit:
 def test_an_intact_or_absent_entry_passes(tmp_path):
     cache = Store(tmp_path / "cache")
     unit = _unit()
-    check_entry(unit, cache)  # absent: to be computed
+    unit.check_entry(cache)  # absent: to be computed
     unit.store(cache).write_json("test.json", {"a": 1})
-    check_entry(unit, cache)
-    check_entry(unit, None)
+    unit.check_entry(cache)
+    unit.check_entry(None)
 
 
 def test_a_file_where_the_tests_folder_belongs_is_refused_naming_it(tmp_path):
@@ -34,14 +34,14 @@ def test_a_file_where_the_tests_folder_belongs_is_refused_naming_it(tmp_path):
     (tmp_path / "cache").mkdir()
     (tmp_path / "cache" / unit.key).write_text("junk")
     with pytest.raises(InputError, match="a file") as exc:
-        check_entry(unit, cache)
+        unit.check_entry(cache)
     assert unit.key in str(exc.value) and len(str(exc.value).splitlines()) == 1
 
 
 def test_a_file_where_the_cache_belongs_is_refused_naming_it(tmp_path):
     (tmp_path / "cache").write_text("junk")
     with pytest.raises(InputError, match="a file") as exc:
-        check_entry(_unit(), Store(tmp_path / "cache"))
+        _unit().check_entry(Store(tmp_path / "cache"))
     assert str(tmp_path / "cache") in str(exc.value)
 
 
@@ -59,7 +59,7 @@ def test_a_changed_file_of_the_entry_is_refused_naming_it(tmp_path, damage):
         path = store.path("consolidated.npz")
         path.write_bytes(path.read_bytes()[:100])
     with pytest.raises(InputError, match="changed since it was written") as exc:
-        check_entry(unit, cache)
+        unit.check_entry(cache)
     assert path.name in str(exc.value)
 
 

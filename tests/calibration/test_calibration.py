@@ -183,10 +183,10 @@ def test_calibration_recovers_synthetic_parameters_within_its_intervals(tiny, tm
     weak_lab = _without_vertical(weak_lab, tmp_path / "weak.csv")
     weak = calibrate(weak_lab, [paths[0], paths[1]], store=Store(out), points=9, refine=2,
                            settings=SHORT, options=ONE_WORKER, **FIT_BOX)  # fmt: skip
-    peaks = {o.normal_stress_kpa: o.model_kpa for o in res.posterior.observables if o.observable == "peak"}
+    peaks = {o.normal_stress_kpa: o.model for o in res.posterior.observables if o.observable == "peak"}
     for o in weak.posterior.observables:
         if o.observable == "peak":
-            assert o.model_kpa < peaks[o.normal_stress_kpa]
+            assert o.model < peaks[o.normal_stress_kpa]
     assert weak.posterior.median.particle_friction < res.posterior.median.particle_friction
 
 
@@ -217,7 +217,7 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
     on the plain file reuses them all)."""
     from poro2d.calibration.case import lab_targets, shear_base_settings
     from poro2d.calibration.specimens import replicate_unit
-    from poro2d.calibration.units import CalibrationUnit, end_rise_mm, stored_row
+    from poro2d.calibration.units import CalibrationUnit, end_rise_mm
     from poro2d.shear.lab import read_lab_csv
     from poro2d.specimen.specimen_set import SpecimenSet
 
@@ -260,7 +260,7 @@ def test_a_calibration_fits_the_dilation_in_mm_from_the_same_cached_tests(tiny, 
         unit = replicate_unit(found, label, 50.0, shear_base_settings(SHORT), first.particle_friction,
                               first.rolling_friction)  # fmt: skip
         assert isinstance(unit, CalibrationUnit) and str(found[label]) == digest[label]
-        row = stored_row(unit, Store(out).child("cache"))
+        row = unit.stored_row(Store(out).child("cache"))
         assert row.dilation == dilation[k]
         test = json.loads((out / "cache" / unit.key / "result.json").read_text())
         assert row.dilation == pytest.approx(test["end"]["plate_displacement_mm"], rel=1e-12)
@@ -435,7 +435,7 @@ def test_a_laboratory_poro2d_did_not_write_gets_the_discrepancy_term(tiny, tmp_p
     assert 0.0 <= term.interval[0] <= term.median <= term.interval[1] <= 4.0
     assert other.config["discrepancy"] == "estimate"
     for a, b in zip(own.posterior.observables, other.posterior.observables, strict=True):
-        assert b.noise_sd_kpa >= a.noise_sd_kpa
+        assert b.noise_sd >= a.noise_sd
         # kappa = kn / (sigma t): halved from 50 to 100 kPa; the overlap at the peak a small fraction of d
         assert b.stiffness_number == pytest.approx(a.stiffness_number)
         assert 0.0 < b.mean_overlap_ratio_at_peak < 0.05

@@ -16,7 +16,7 @@ from typing import ClassVar
 from poro2d.biaxial.lab import LabTests, read_lab_tests
 from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.calibration.biaxial_units import BiaxialUnit, end_mean, end_window, peak_ratio
-from poro2d.calibration.units import strain_station, window_mean
+from poro2d.calibration.units import base_of, strain_station, window_mean
 from poro2d.errors import InputError
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.typed_result import TypedResult
@@ -67,15 +67,7 @@ def read_biaxial_lab(value) -> LabTests:
 
 def base_settings(settings: dict | None, calibrated: tuple[str, ...]) -> BiaxialSettings:
     """The biaxial settings of every test (the two frictions apart, which the calibration sets)."""
-    if not isinstance(settings, dict | None):
-        raise InputError("settings", type(settings).__name__, "a dict of biaxial settings or None")
-    given = dict(settings or {})
-    for name in calibrated:
-        if name in given:
-            raise InputError(f"settings.{name}", given[name], "not given: it is calibrated")
-    from poro2d.config import dataclass_from_table
-
-    return dataclass_from_table(BiaxialSettings, "settings", given)
+    return base_of(BiaxialSettings, settings, calibrated)
 
 
 def biaxial_targets(

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cached_property
 from typing import ClassVar
 
 import numpy as np
@@ -37,12 +36,12 @@ from poro2d.biaxial.single import BiaxialTest
 from poro2d.calibration.units import (
     CurveReadings,
     FrictionUnit,
+    UnitIdentity,
     check_files,
     parse_strain_station,
     window_mean,
 )
 from poro2d.identity import identity_digest
-from poro2d.specimen.saved import Specimen
 from poro2d.store import Store
 
 
@@ -66,14 +65,9 @@ def end_window(settings: BiaxialSettings) -> float:
 
 
 @dataclass(frozen=True)
-class BiaxialRow:
+class BiaxialRow(UnitIdentity):
     """What a finished biaxial unit gives the fit: its observables (dimensionless) and its cost."""
 
-    key: str
-    sigma: float
-    fp: float
-    mu_r: float
-    specimen: str
     peak_ratio: float
     end_ratio: float
     end_volumetric: float
@@ -110,22 +104,12 @@ class BiaxialUnit(FrictionUnit):
 
     #: what the progress display counts
     WHAT = "biaxial tests"
-
-    @cached_property
-    def key(self) -> str:
-        return biaxial_unit_key(self.digest, self.sigma, self.settings)
+    SETTINGS = BiaxialSettings
+    CASE = BiaxialCase
+    KEY = staticmethod(biaxial_unit_key)
 
     def test(self, store: Store | None) -> BiaxialTest:
-        case = BiaxialCase(
-            Specimen.read(self.specimen, self.digest), self.sigma, BiaxialSettings(**self.settings)
-        )
-        return BiaxialTest(case, store)
-
-    def stored_row(self, cache: Store | None) -> BiaxialRow | None:
-        """The row when ``cache`` holds the finished test, else None."""
-        store = self.store(cache)
-        res = None if store is None or not store.root.is_dir() else self.test(store).stored()
-        return None if res is None else self.row(res)
+        return BiaxialTest(self.case(), store)
 
     def check_entry(self, cache: Store | None) -> None:
         """Refuse a damaged entry on one line (a file where the folder belongs, a file changed since
@@ -134,13 +118,8 @@ class BiaxialUnit(FrictionUnit):
         if store is not None:
             check_files(cache, store, "one biaxial test of the cache")
 
-    def compute(self, cache: Store | None) -> BiaxialRow:
-        """Run (or read back) the test: what a Dask worker runs (through
-        :func:`~poro2d.calibration.units.compute_unit`)."""
-        return self.row(self.test(self.store(cache)).run())
-
     def row(self, res) -> BiaxialRow:
-        s = BiaxialSettings(**self.settings)
+        s = self.typed_settings
         c = res.curve
         return BiaxialRow(
             key=self.key, sigma=self.sigma, fp=self.fp, mu_r=self.mu_r, specimen=self.specimen,

@@ -23,7 +23,7 @@ from poro2d.calibration.evaluations import PARAMETER_KEYS
 from poro2d.calibration.identifiable import check_enough_lab_values
 from poro2d.calibration.lab_repeats import LabRepeats, mean_targets
 from poro2d.calibration.specimens import check_preset, replicate_unit
-from poro2d.calibration.units import station, window_mean
+from poro2d.calibration.units import base_of, station, window_mean
 from poro2d.errors import InputError, check_int, check_range, is_number
 from poro2d.paper_data import QUICK_SHEAR
 from poro2d.shear.lab import LabData
@@ -253,16 +253,7 @@ def shear_base_settings(settings: dict | None, calibrated: tuple[str, ...] = CAL
     ``settings``: the caller's table of shear settings (a command's options), read once here;
     ``calibrated``: the settings the calibration sets (a disk stiffness given is kept when it is
     not calibrated)."""
-    given = dict(settings or {})
-    if not isinstance(settings, dict | None):
-        raise InputError("settings", type(settings).__name__, "a dict of shear settings or None")
-    for name in calibrated:
-        if name in given:
-            raise InputError(f"settings.{name}", given[name], "not given: it is calibrated")
-    given.setdefault("stop_after_peak", 0.0)
-    from poro2d.config import dataclass_from_table
-
-    return dataclass_from_table(ShearSettings, "settings", given)
+    return base_of(ShearSettings, settings, calibrated, stop_after_peak=0.0)
 
 
 def lab_targets(lab: LabData, base: ShearSettings, stations: int = 1) -> list[Target]:

@@ -123,11 +123,8 @@ class UnitRunner:
         exc = outcome.error
         if type(exc) is not RuntimeError:  # not the test's own outcome (no equilibrium)
             self.broken.add(unit.key)
-        self.failures.append(
-            UnitFailure.of(
-                unit, error=f"{type(exc).__name__}: {exc}".splitlines()[0], traceback=outcome.traceback
-            )
-        )
+        error = f"{type(exc).__name__}: {exc}".splitlines()[0]
+        self.failures.append(UnitFailure.of(unit, error=error, traceback=outcome.traceback))
         return None
 
     def info(self) -> ClusterRecord:

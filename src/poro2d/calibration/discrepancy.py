@@ -163,13 +163,14 @@ class Levels:
         return (top + np.log(np.sum(np.exp(terms - top), axis=1, keepdims=True)))[:, 0], terms
 
 
-def log_likelihood(misfit: np.ndarray, cov: np.ndarray, discrepancy: Discrepancy | None):
-    """The log likelihood of each misfit row (up to a constant) and the log terms per level
-    (None without a discrepancy: then it is -0.5 m' C^-1 m exactly, as before the term existed)."""
+def log_likelihood(cov: np.ndarray, discrepancy: Discrepancy | None):
+    """The function of misfit rows that gives the log likelihood of each (up to a constant) and the
+    log terms per level, the covariance inverted once for many calls (None terms without a
+    discrepancy: then it is -0.5 m' C^-1 m exactly, as before the term existed)."""
     if discrepancy is None or discrepancy.none:
         precision = np.linalg.inv(cov)
-        return -0.5 * np.einsum("ki,ij,kj->k", misfit, precision, misfit), None
-    return Levels.of(cov, discrepancy).log_likelihood(misfit)
+        return lambda misfit: (-0.5 * np.einsum("ki,ij,kj->k", misfit, precision, misfit), None)
+    return Levels.of(cov, discrepancy).log_likelihood
 
 
 def level_posterior(terms: np.ndarray, row_weights: np.ndarray | None = None) -> np.ndarray:

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from poro2d.calibration.discrepancy import Discrepancy, Levels, level_posterior, log_likelihood
+from poro2d.calibration.discrepancy import Discrepancy, level_posterior, log_likelihood
 from poro2d.record import Record
 
 #: points per axis of the posterior grid
@@ -59,28 +59,29 @@ class Ranges:
     def dim(self) -> int:
         return len(self.axes)
 
-    def to_unit(self, fp, mu_r, *stiffness) -> np.ndarray:
-        """(n, d) design coordinates of parameter values (``stiffness``: kn, ks as calibrated)."""
-        lo, hi = np.log(self.fp[0]), np.log(self.fp[1])
-        u = (np.log(np.asarray(fp, float)) - lo) / (hi - lo)
-        v = (np.asarray(mu_r, float) - self.mu_r[0]) / (self.mu_r[1] - self.mu_r[0])
-        columns = [np.atleast_1d(u), np.atleast_1d(v)]
-        for axis, values in zip(self.axes[2:], stiffness, strict=True):
-            lo, hi = np.log(getattr(self, axis))
-            columns.append(np.atleast_1d((np.log(np.asarray(values, float)) - lo) / (hi - lo)))
+    def _span(self, axis: str) -> tuple[float, float]:
+        """The range of ``axis`` in its design coordinate's scale (the logarithm on :data:`LOG_AXES`)."""
+        lo, hi = getattr(self, axis)
+        return (np.log(lo), np.log(hi)) if axis in LOG_AXES else (lo, hi)
+
+    def to_unit(self, *values) -> np.ndarray:
+        """(n, d) design coordinates of parameter values (f_p, mu_r, then kn, ks as calibrated)."""
+        columns = []
+        for axis, x in zip(self.axes, values, strict=True):
+            lo, hi = self._span(axis)
+            x = np.asarray(x, float)
+            columns.append(np.atleast_1d(((np.log(x) if axis in LOG_AXES else x) - lo) / (hi - lo)))
         return np.column_stack(columns)
 
     def from_unit(self, unit: np.ndarray) -> tuple[np.ndarray, ...]:
         """(f_p, mu_r, then kn, ks as calibrated) arrays of design coordinates."""
         unit = np.atleast_2d(unit)
-        lo, hi = np.log(self.fp[0]), np.log(self.fp[1])
-        fp = np.exp(lo + unit[:, 0] * (hi - lo))
-        mu_r = self.mu_r[0] + unit[:, 1] * (self.mu_r[1] - self.mu_r[0])
-        stiffness = []
-        for k, axis in enumerate(self.axes[2:], start=2):
-            lo, hi = np.log(getattr(self, axis))
-            stiffness.append(np.exp(lo + unit[:, k] * (hi - lo)))
-        return (fp, mu_r, *stiffness)
+        values = []
+        for k, axis in enumerate(self.axes):
+            lo, hi = self._span(axis)
+            x = lo + unit[:, k] * (hi - lo)
+            values.append(np.exp(x) if axis in LOG_AXES else x)
+        return tuple(values)
 
     def axis_values(self, axis: str, unit_values: np.ndarray) -> np.ndarray:
         """The parameter values of one axis at design coordinates ``unit_values`` of it."""
@@ -351,7 +352,7 @@ def posterior(
     uu, vv = np.meshgrid(u, v)
     points = np.column_stack([uu.ravel(), vv.ravel()])
     misfit = np.column_stack([s.mean(points) - y for s, y in zip(surrogates, lab_values, strict=True)])
-    log_like, terms = log_likelihood(misfit, cov, discrepancy)
+    log_like, terms = log_likelihood(cov, discrepancy)(misfit)
     log_like -= log_like.max()
     density = np.exp(log_like).reshape(uu.shape)
     post = Posterior(ranges, u, v, density / density.sum())
@@ -427,21 +428,12 @@ def log_posterior(
     the Gaussian log-likelihood of the laboratory values (summed over the discrepancy's levels),
     -inf outside the cube."""
     lab = np.asarray(lab_values, float)
-    if discrepancy is not None and discrepancy.none:
-        discrepancy = None
-    if discrepancy is None:  # the precision inverted once, as before the term existed
-        precision = np.linalg.inv(cov)
-    else:
-        levels = Levels.of(cov, discrepancy)
+    likelihood = log_likelihood(cov, discrepancy)
 
     def log_prob(x: np.ndarray) -> np.ndarray:
         misfit = np.column_stack([s.mean(x) for s in surrogates]) - lab
-        if discrepancy is None:
-            lp = -0.5 * np.einsum("ki,ij,kj->k", misfit, precision, misfit)
-        else:
-            lp = levels.log_likelihood(misfit)[0]
         inside = np.all((x >= 0.0) & (x <= 1.0), axis=1)
-        return np.where(inside, lp, -np.inf)
+        return np.where(inside, likelihood(misfit)[0], -np.inf)
 
     return log_prob
 
@@ -489,7 +481,7 @@ def sampled_posterior(
     )
     if discrepancy is not None and not discrepancy.none:
         misfit = np.column_stack([s.mean(post.chain) for s in surrogates]) - np.asarray(lab_values, float)
-        _, terms = log_likelihood(misfit, cov, discrepancy)
+        _, terms = log_likelihood(cov, discrepancy)(misfit)
         weights = np.full(len(post.chain), 1.0 / len(post.chain))
         post.discrepancy, post.discrepancy_weights = discrepancy, level_posterior(terms, weights)
     return post

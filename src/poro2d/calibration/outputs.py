@@ -35,9 +35,7 @@ def write_outputs(store: Store, result, post, lab, specimens: SpecimenSet, make,
     ``make(specimens, label, sigma, fp=, mu_r=)``: the unit of one test (shear or biaxial, its base
     settings bound); ``stresses``: the laboratory's normal (or confining) stresses."""
     curves, nearest = _best_curves(result, stresses, specimens, make, store.child(CACHE))
-    store.write_text(
-        CONFIG_TOML, _biaxial_config(result, stresses) if result.biaxial else _config(result, lab)
-    )
+    store.write_text(CONFIG_TOML, _config(result, stresses))
     store.write_result("result.json", result)
     return FitDrawing(post, lab, curves, nearest)
 
@@ -110,31 +108,25 @@ def _specimen_lines(best) -> list[str]:
     return lines + [f"{name} = {_toml_value(v)}" for name, v in given if v is not None]
 
 
-def _biaxial_config(result, stresses) -> str:
-    """A ``[biaxial]`` table for ``poro2d biaxial --config`` (the settings used, the calibrated
-    frictions, the laboratory's confining stresses) and ``[specimen]`` for new specimens."""
+def _config(result, stresses) -> str:
+    """The text of a config with the calibrated values: ``[specimen]`` for a new specimen (``poro2d
+    criterion``) to export with ``poro2d export``, and ``[shear]`` for ``poro2d shear --config`` (or
+    ``[biaxial]`` for ``poro2d biaxial --config``): the settings used, the calibrated values and
+    the laboratory's normal (or confining) stresses."""
     b = result.best
     table = {k: v for k, v in result.settings.to_dict().items() if v is not None}
-    table.update(particle_friction=b.particle_friction, rolling_friction=b.rolling_friction,
-                 confining_kpa=list(stresses))  # fmt: skip
-    head = ["# poro2d calibrate (biaxial laboratory tests):", "# the posterior maximum of particle and "
-            "rolling friction"]  # fmt: skip
-    return _config_text(head, result, "biaxial", table)
-
-
-def _config(result, lab) -> str:
-    """The text of a config with the calibrated values: ``[shear]`` for ``poro2d shear --config``,
-    ``[specimen]``
-    for a new specimen (``poro2d criterion``) to export with ``poro2d export``."""
-    b = result.best
-    shear = {k: v for k, v in result.settings.to_dict().items() if v is not None}
-    shear.update(particle_friction=b.particle_friction, rolling_friction=b.rolling_friction)
-    shear.update({k: getattr(b, k) for k in _STIFFNESS if getattr(b, k) is not None})
-    shear.update(normal_stress_kpa=lab.normal_stresses())
+    table.update(particle_friction=b.particle_friction, rolling_friction=b.rolling_friction)
+    if result.biaxial:
+        table.update(confining_kpa=list(stresses))
+        head = ["# poro2d calibrate (biaxial laboratory tests):", "# the posterior maximum of particle and "
+                "rolling friction"]  # fmt: skip
+        return _config_text(head, result, "biaxial", table)
+    table.update({k: getattr(b, k) for k in _STIFFNESS if getattr(b, k) is not None})
+    table.update(normal_stress_kpa=list(stresses))
     what = "particle and rolling friction" + (
         " and the disks' stiffness" if any(getattr(b, k) is not None for k in _STIFFNESS) else ""
     )
-    return _config_text([f"# poro2d calibrate: the posterior maximum of {what}"], result, "shear", shear)
+    return _config_text([f"# poro2d calibrate: the posterior maximum of {what}"], result, "shear", table)
 
 
 def _config_text(head: list[str], result, name: str, table: dict) -> str:

@@ -66,38 +66,15 @@ STIFFNESS_KEYS = ("particle_kn", "particle_ks")
 
 
 @dataclass(eq=False)
-class FrictionValues(TypedResult):
-    """A value per calibrated parameter: the posterior maximum or median of f_p and mu_r (and of
-    the disks' kn, ks in N/m when calibrated)."""
+class ParameterValues(TypedResult):
+    """A value per calibrated parameter: a number (the posterior maximum or median; the disks' kn, ks
+    in N/m), a [low, high] pair (a range or an interval) or a yes/no (whether an interval is wide);
+    None where unknown."""
 
-    particle_friction: float
-    rolling_friction: float
-    particle_kn: float | None = None
-    particle_ks: float | None = None
-
-    OPTIONAL: ClassVar[tuple[str, ...]] = STIFFNESS_KEYS
-
-
-@dataclass(eq=False)
-class FrictionBounds(TypedResult):
-    """A [low, high] pair per calibrated parameter: its range, or its interval (None: unknown)."""
-
-    particle_friction: list[float] | None
-    rolling_friction: list[float] | None
-    particle_kn: list[float] | None = None
-    particle_ks: list[float] | None = None
-
-    OPTIONAL: ClassVar[tuple[str, ...]] = STIFFNESS_KEYS
-
-
-@dataclass(eq=False)
-class FrictionFlags(TypedResult):
-    """A yes/no per calibrated parameter: whether its interval is wide (None: unknown)."""
-
-    particle_friction: bool | None
-    rolling_friction: bool | None
-    particle_kn: bool | None = None
-    particle_ks: bool | None = None
+    particle_friction: Any
+    rolling_friction: Any
+    particle_kn: Any = None
+    particle_ks: Any = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = STIFFNESS_KEYS
 
@@ -124,49 +101,40 @@ class CalibrationTimings(TypedResult):
 
 @dataclass(eq=False)
 class FittedObservable(TypedResult):
-    """One laboratory value fitted: the observable (``peak``, ``end`` or ``dilation``) at a normal
-    stress, the laboratory's value, the surrogate's at the best parameters and the noise it was
-    given, in the observable's unit, named by the keys: ``lab_kpa``, ``model_kpa`` and
-    ``noise_sd_kpa`` for a shear stress, ``lab_mm``, ``model_mm`` and ``noise_sd_mm`` for the
-    dilation (the other three are absent from the file)."""
+    """One laboratory value fitted: the observable (``peak``, ``end``, ``dilation``, a reading, a
+    biaxial ratio) at a normal (or confining) stress, the laboratory's value, the surrogate's at the
+    best parameters and the noise it was given, in the observable's :attr:`unit`, which the file's
+    keys name: ``lab_kpa``, ``model_kpa``, ``noise_sd_kpa`` for a shear stress, ``lab_mm``, ...
+    for the dilation, ``lab_ratio``, ... for a dimensionless one."""
 
     observable: str
     normal_stress_kpa: float
-    lab_kpa: float | None = None
-    model_kpa: float | None = None
-    noise_sd_kpa: float | None = None
-    lab_mm: float | None = None
-    model_mm: float | None = None
-    noise_sd_mm: float | None = None
-    #: a dimensionless observable's (biaxial: ``lab_ratio``, ``model_ratio``, ``noise_sd_ratio``)
-    lab_ratio: float | None = None
-    model_ratio: float | None = None
-    noise_sd_ratio: float | None = None
+    lab: float | None
+    model: float | None
+    noise_sd: float | None
     #: the design's tests at this stress: median kappa = kn / (sigma t) and mean overlap / d at the
     #: peak (how much elastic strain a dilation or volumetric observable carries; None: not recorded)
     stiffness_number: float | None = None
     mean_overlap_ratio_at_peak: float | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = (
-        "lab_kpa", "model_kpa", "noise_sd_kpa", "lab_mm", "model_mm", "noise_sd_mm",
-        "lab_ratio", "model_ratio", "noise_sd_ratio", "stiffness_number", "mean_overlap_ratio_at_peak",
-    )  # fmt: skip
-
-    @classmethod
-    def of(cls, observable: str, normal_stress_kpa: float, lab: float, fitted: float, noise_sd: float,
-           stiffness: tuple[float | None, float | None] = (None, None)):  # fmt: skip
-        """The record of one target, its values under the keys of its unit; ``stiffness``: the
-        design's kappa and overlap at its stress."""
-        u = observable_unit(observable).lower()
-        values = {f"lab_{u}": lab, f"model_{u}": fitted, f"noise_sd_{u}": noise_sd}
-        kappa, overlap = stiffness
-        return cls(observable, normal_stress_kpa, **values, stiffness_number=kappa,
-                   mean_overlap_ratio_at_peak=overlap)  # fmt: skip
+    #: the values whose keys in the file end in the unit
+    IN_UNIT: ClassVar[tuple[str, ...]] = ("lab", "model", "noise_sd")
+    OPTIONAL: ClassVar[tuple[str, ...]] = (*IN_UNIT, "stiffness_number", "mean_overlap_ratio_at_peak")
 
     @property
     def unit(self) -> str:
         """The unit of the values (``kPa``, ``mm`` or ``ratio``: dimensionless)."""
         return observable_unit(self.observable)
+
+    def to_dict(self) -> dict[str, Any]:
+        u = self.unit.lower()
+        return {f"{k}_{u}" if k in self.IN_UNIT else k: v for k, v in super().to_dict().items()}
+
+    @classmethod
+    def from_dict(cls, data) -> FittedObservable:
+        """The record of its entry in a file, its values read under the keys of its unit."""
+        named = {f"{k}_{observable_unit(data['observable']).lower()}": k for k in cls.IN_UNIT}
+        return super().from_dict({named.get(k, k): v for k, v in data.items()})
 
 
 @dataclass(eq=False)
@@ -180,9 +148,9 @@ class PosteriorSummary(TypedResult):
     fitted; ``noise_correlation``: of the observables' noise.
     """
 
-    median: FrictionValues
+    median: ParameterValues
     correlation: float
-    wide: FrictionFlags
+    wide: ParameterValues
     grid: int
     prior: str
     observables: list[FittedObservable]
@@ -204,8 +172,8 @@ class PosteriorSummary(TypedResult):
     )  # fmt: skip
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
-        "median": FrictionValues,
-        "wide": FrictionFlags,
+        "median": ParameterValues,
+        "wide": ParameterValues,
         "observables": FittedObservable,
         "chain": ChainRecord,
         "discrepancy": DiscrepancyRecord,
@@ -227,15 +195,15 @@ class CalibrationResult(TypedResult):
     2D box: parameters fitted to a box-scale box carry its biases (docs/shear.md).
     """
 
-    best: FrictionValues
-    intervals: FrictionBounds
+    best: ParameterValues
+    intervals: ParameterValues
     level: float
     posterior: PosteriorSummary
     evaluations: list[DesignPoint]
     fit: dict[str, model.Surrogate]
     lab: LabRecord | BiaxialLabRecord
     specimens: dict[str, str]
-    ranges: FrictionBounds
+    ranges: ParameterValues
     settings: ShearSettings | BiaxialSettings
     cluster: ClusterRecord
     failures: list[UnitFailure]
@@ -259,10 +227,10 @@ class CalibrationResult(TypedResult):
     OPTIONAL: ClassVar[tuple[str, ...]] = ("unidentified", "box_scale", "test", "box_dominated")
     #: the fields read as their records from a file's dict (``fit``: a surrogate per observable)
     PARTS: ClassVar[dict[str, type[TypedResult] | Keyed]] = {
-        "best": FrictionValues,
-        "intervals": FrictionBounds,
+        "best": ParameterValues,
+        "intervals": ParameterValues,
         "lab": LabRecord,
-        "ranges": FrictionBounds,
+        "ranges": ParameterValues,
         "settings": ShearSettings,
         "timings": CalibrationTimings,
         "provenance": Provenance,
@@ -510,9 +478,7 @@ def _wide(ranges: model.Ranges, axis: str, lo: float, hi: float) -> bool:
 
 
 def _prior(ranges: model.Ranges) -> str:
-    """The prior in words: the two-parameter text of earlier files, the stiffnesses added."""
-    if ranges.dim == 2:
-        return "uniform in log(f_p) and mu_r over the ranges"
+    """The prior in words (two parameters: "uniform in log(f_p) and mu_r over the ranges")."""
     words = {"fp": "log(f_p)", "mu_r": "mu_r", "kn": "log(kn)", "ks": "log(ks)"}
     names = [words[a] for a in ranges.axes]
     return f"uniform in {', '.join(names[:-1])} and {names[-1]} over the ranges"
@@ -562,18 +528,18 @@ def _result(
     best_unit = ranges.to_unit(*best.values())
     stiffness = getattr(post, "stiffness", {})
     fitted = [
-        FittedObservable.of(obs, s, y, float(sg.mean(best_unit)[0]), sd, stiffness.get(s, (None, None)))
+        FittedObservable(obs, s, y, float(sg.mean(best_unit)[0]), sd, *stiffness.get(s, (None, None)))
         for (obs, s, y), sg, sd in zip(targets, surrogates, post.noise_sd, strict=True)
     ]
     sampled = isinstance(post, model.SampledPosterior)
     return CalibrationResult(
-        best=FrictionValues.from_dict({keys[a]: v for a, v in best.items()}),
-        intervals=FrictionBounds.from_dict(intervals),
+        best=ParameterValues.from_dict({keys[a]: v for a, v in best.items()}),
+        intervals=ParameterValues.from_dict(intervals),
         level=level,
         posterior=PosteriorSummary(
-            median=FrictionValues.from_dict({keys[a]: post.median(a) for a in ranges.axes}),
+            median=ParameterValues.from_dict({keys[a]: post.median(a) for a in ranges.axes}),
             correlation=post.correlation(),
-            wide=FrictionFlags.from_dict(wide),
+            wide=ParameterValues.from_dict(wide),
             grid=None if sampled else model.GRID,
             prior=_prior(ranges),
             observables=fitted,
@@ -588,7 +554,7 @@ def _result(
         fit={target_key(obs, s): sg for (obs, s, _), sg in zip(targets, surrogates, strict=True)},
         lab=BiaxialLabRecord.of(case.lab) if biaxial else case.repeats.record(),
         specimens={label: str(found[label]) for label in found},
-        ranges=FrictionBounds.from_dict({keys[a]: list(getattr(ranges, a)) for a in ranges.axes}),
+        ranges=ParameterValues.from_dict({keys[a]: list(getattr(ranges, a)) for a in ranges.axes}),
         settings=base,
         cluster=runner.info(),
         failures=runner.failures,

@@ -106,42 +106,44 @@ def check_preset(
     return replicates, check_int("--seed", PRESET_SEED if seed is None else seed, 0)
 
 
+def paper_criterion(store: Store, quick: bool, seed: int, threads: int | None, progress: bool):
+    """The criterion of the paper's case (``quick``: the small box) on ``seed``, kept in ``store``'s
+    ``criterion``, every option checked before a file is written; ``threads``: of the DEM kernels
+    (None: at most two)."""
+    from poro2d.criterion.config import paper_config
+    from poro2d.criterion.protocol import PorosityCriterion
+
+    cfg = paper_config(quick, seed)
+    threads = min(os.cpu_count() or 1, 2) if threads is None else threads
+    spec, grading, settings, sd = cfg.build(threads=threads)
+    kept = store.child("criterion")
+    crit = PorosityCriterion(
+        spec, grading, settings, seed=sd, store=kept, progress=progress, config=cfg.as_config()
+    )
+    crit.validate()
+    return crit
+
+
 def preset_specimens(store: Store, *, quick: bool, seed: int, replicates: int, progress: bool) -> SpecimenSet:
     """The paper preset's accepted specimens for ``replicates`` seeds from ``seed``, kept in ``store``.
 
     The criterion runs once on ``seed`` (its ``criterion``), then on the next seeds from its
     accepted porosity (its ``replicates``); seeds whose criterion does not converge are left out.
     """
-    from poro2d.criterion.config import paper_config
-    from poro2d.criterion.protocol import PorosityCriterion
     from poro2d.criterion.replicates import ReplicateCase, run_replicates
 
     seed = check_int("--seed", seed, 0)
-    cfg = paper_config(quick, seed)
-    spec, grading, settings, sd = cfg.build(threads=min(os.cpu_count() or 1, 2))
+    crit = paper_criterion(store, quick, seed, None, progress)
     out = store.root
-    crit = PorosityCriterion(
-        spec,
-        grading,
-        settings,
-        seed=sd,
-        store=store.child("criterion"),
-        progress=progress,
-        config=cfg.as_config(),
-    )
-    crit.validate()
     result = crit.run()
     if not result.converged:
         raise RuntimeError(f"the criterion of seed {seed} did not converge: {result.message}")
     specimens = SpecimenSet.made([(f"seed{seed}", out / "criterion" / "specimen.npz")])
     if replicates > 1:
         extra = tuple(range(seed + 1, seed + replicates))
-        more = run_replicates(
-            ReplicateCase(spec, grading, settings, result.final_porosity, extra),
-            store.child("replicates"),
-            options=RunOptions(workers=spec.threads, progress=progress),
-        )
-        specimens += more.specimens
+        options = RunOptions(workers=crit.spec.threads, progress=progress)
+        case = ReplicateCase(crit.spec, crit.grading, crit.settings, result.final_porosity, extra)
+        specimens += run_replicates(case, store.child("replicates"), options=options).specimens
     return specimens
 
 
@@ -150,6 +152,7 @@ __all__ = [
     "MAX_REPLICATES",
     "check_preset",
     "check_replicates",
+    "paper_criterion",
     "preset_specimens",
     "replicate_unit",
 ]

@@ -48,8 +48,6 @@ def synthetic_lab(
     )
     base.setdefault("stop_after_peak", 0.0)
     sset = ShearSettings(**base)
-    path = Path(path)
-    work = work if work is not None else Store(path.with_name(path.stem + "-tests"))
     header = [
         "# SYNTHETIC laboratory data, not measured: made by poro2d's own direct shear",
         f"# at particle_friction = {particle_friction}, rolling_friction = {rolling_friction}",
@@ -60,38 +58,25 @@ def synthetic_lab(
         ),
         f"# on the specimen {specimen}",
         f"# shear settings: max_displacement = {sset.max_displacement} m, velocity = {sset.velocity} m/s",
-    ]
-    lines = [
         "normal_stress_kpa,shear_displacement_mm,shear_stress_kpa,vertical_displacement_mm"
         if curves
-        else "normal_stress_kpa,peak_shear_stress_kpa"
+        else "normal_stress_kpa,peak_shear_stress_kpa",
     ]
-    value = Specimen.read(specimen)  # read once for every test
-    for sigma in sorted(float(s) for s in normal_stresses_kpa):
-        res = DirectShearTest(
-            ShearCase(value, sigma, sset), work.child(f"sn{sigma:g}kPa"), keep_peak=False, threads=1
-        ).run()
+
+    def rows(value: Specimen, sigma: float, work: Store) -> list[str]:
+        test = DirectShearTest(ShearCase(value, sigma, sset), work.child(f"sn{sigma:g}kPa"), keep_peak=False)
+        res = test.run()
         if not curves:
-            lines.append(f"{sigma:g},{res.peak_shear_stress_kpa:.4f}")
-            continue
+            return [f"{sigma:g},{res.peak_shear_stress_kpa:.4f}"]
         c = res.curve
-        for d, t, v in zip(
-            c["shear_displacement_mm"], c["shear_stress_kpa"], c["plate_displacement_mm"], strict=True
-        ):
-            lines.append(f"{sigma:g},{d:.5f},{t:.4f},{v:.6f}")
-    Store(path.parent).write_text(path.name, "\n".join(header + lines) + "\n")
-    return path
+        columns = (c["shear_displacement_mm"], c["shear_stress_kpa"], c["plate_displacement_mm"])
+        return [f"{sigma:g},{d:.5f},{t:.4f},{v:.6f}" for d, t, v in zip(*columns, strict=True)]
+
+    return _write_lab(specimen, normal_stresses_kpa, path, work, header, rows)
 
 
 def synthetic_biaxial_lab(
-    specimen: str | os.PathLike,
-    confining_stresses_kpa,
-    particle_friction: float,
-    rolling_friction: float,
-    path: str | os.PathLike,
-    *,
-    settings: dict | None = None,
-    work: Store | None = None,
+    specimen, confining_stresses_kpa, particle_friction, rolling_friction, path, *, settings=None, work=None
 ) -> Path:
     """Run poro2d's biaxial test of ``specimen`` at each confining stress with the given frictions;
     write the curves at ``path`` in the biaxial laboratory layout (``--biaxial-lab``).
@@ -100,14 +85,12 @@ def synthetic_biaxial_lab(
     (the tests' own curves, :class:`poro2d.biaxial.curve.BiaxialCurve`). The first readings of a test
     may have sigma_1 a little below sigma_3 (the servo's tolerance after consolidation): a
     laboratory file holds no negative stress ratio, so those are written as 0 (the header says so).
-    ``settings``: biaxial settings other than the two frictions; ``work``: where the tests keep
-    their files (default: a folder beside ``path``).
+    The arguments are :func:`synthetic_lab`'s: ``settings``, biaxial settings other than the two
+    frictions; ``work``, where the tests keep their files (default: a folder beside ``path``).
     """
     sset = BiaxialSettings(
         **dict(settings or {}, particle_friction=particle_friction, rolling_friction=rolling_friction)
     )
-    path = Path(path)
-    work = work if work is not None else Store(path.with_name(path.stem + "-tests"))
     header = [
         "# SYNTHETIC laboratory data, not measured: made by poro2d's own biaxial test",
         f"# at particle_friction = {particle_friction}, rolling_friction = {rolling_friction}",
@@ -116,12 +99,26 @@ def synthetic_biaxial_lab(
         "# stress ratios below 0 (sigma_1 just under sigma_3 at the start) are written as 0",
         "confining_stress_kpa,axial_strain,stress_ratio,volumetric_strain",
     ]
-    lines = []
-    value = Specimen.read(specimen)  # read once for every test
-    for sigma in sorted(float(s) for s in confining_stresses_kpa):
+
+    def rows(value: Specimen, sigma: float, work: Store) -> list[str]:
         c = BiaxialTest(BiaxialCase(value, sigma, sset), work.child(f"sigma3_{sigma:g}kPa")).run().curve
-        for e1, ratio, ev in zip(c.axial_strain, c.sin_phi, c.volumetric_strain, strict=True):
-            lines.append(f"{sigma:g},{e1:.7f},{max(ratio, 0.0):.6f},{ev:.7f}")
+        columns = (c.axial_strain, c.sin_phi, c.volumetric_strain)
+        return [
+            f"{sigma:g},{e1:.7f},{max(ratio, 0.0):.6f},{ev:.7f}"
+            for e1, ratio, ev in zip(*columns, strict=True)
+        ]
+
+    return _write_lab(specimen, confining_stresses_kpa, path, work, header, rows)
+
+
+def _write_lab(specimen, stresses, path, work: Store | None, header: list[str], rows) -> Path:
+    """The lab CSV at ``path``: ``header``, then ``rows(specimen, sigma, work)`` of each stress in
+    increasing order, the specimen read once for every test; ``work`` (None: a folder beside
+    ``path``) keeps the tests' files."""
+    path = Path(path)
+    work = work if work is not None else Store(path.with_name(path.stem + "-tests"))
+    value = Specimen.read(specimen)
+    lines = [line for sigma in sorted(float(s) for s in stresses) for line in rows(value, sigma, work)]
     Store(path.parent).write_text(path.name, "\n".join(header + lines) + "\n")
     return path
 

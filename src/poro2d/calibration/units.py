@@ -10,9 +10,10 @@ that was killed.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -52,26 +53,28 @@ def station(kind: str, displacement_m: float) -> str:
     return f"{kind}_at_{displacement_m * 1e3:g}mm"
 
 
-def parse_station(name: str) -> tuple[str, float] | None:
-    """(kind, displacement in m) of a reading's name (:func:`station`), or None for another observable."""
-    kind, sep, rest = name.partition("_at_")
-    if not sep or kind not in STATION_UNITS or not rest.endswith("mm"):
-        return None
-    return kind, float(rest.removesuffix("mm")) * 1e-3
-
-
 def strain_station(kind: str, axial_strain: float) -> str:
     """The name of a reading of a biaxial curve: ``kind`` (:data:`STRAIN_STATION_KINDS`) at an axial
     strain (a fraction; the name says it in percent)."""
     return f"{kind}_at_{100 * axial_strain:.4g}pct"
 
 
+def _parse(name: str, kinds, suffix: str, position) -> tuple[str, float] | None:
+    """(kind, ``position(x)``) of a reading named ``<kind>_at_<x><suffix>``, or None."""
+    kind, sep, rest = name.partition("_at_")
+    if not sep or kind not in kinds or not rest.endswith(suffix):
+        return None
+    return kind, position(float(rest.removesuffix(suffix)))
+
+
+def parse_station(name: str) -> tuple[str, float] | None:
+    """(kind, displacement in m) of a reading's name (:func:`station`), or None for another observable."""
+    return _parse(name, STATION_UNITS, "mm", lambda mm: mm * 1e-3)
+
+
 def parse_strain_station(name: str) -> tuple[str, float] | None:
     """(kind, axial strain as a fraction) of a biaxial reading's name (:func:`strain_station`), or None."""
-    kind, sep, rest = name.partition("_at_")
-    if not sep or kind not in STRAIN_STATION_KINDS or not rest.endswith("pct"):
-        return None
-    return kind, float(rest.removesuffix("pct")) / 100.0
+    return _parse(name, STRAIN_STATION_KINDS, "pct", lambda pct: pct / 100.0)
 
 
 def observable_unit(name: str) -> str:
@@ -120,6 +123,22 @@ def unit_key(specimen_digest: str, sigma: float, settings: dict) -> str:
     return identity_digest(unit, tables={"settings": ShearSettings}, length=20, layout="spaced")
 
 
+def base_of(kind: type, settings: dict | None, calibrated: tuple[str, ...], **defaults):
+    """The settings ``kind`` (shear or biaxial) of every test of a calibration, from the caller's
+    table (a command's options), read once here: a setting the calibration sets (``calibrated``) is
+    refused, ``defaults`` stand where the table is silent."""
+    what = kind.__name__.removesuffix("Settings").lower()
+    if not isinstance(settings, dict | None):
+        raise InputError("settings", type(settings).__name__, f"a dict of {what} settings or None")
+    given = dict(settings or {})
+    for name in calibrated:
+        if name in given:
+            raise InputError(f"settings.{name}", given[name], "not given: it is calibrated")
+    from poro2d.config import dataclass_from_table
+
+    return dataclass_from_table(kind, "settings", {**defaults, **given})
+
+
 @dataclass(frozen=True)
 class FrictionUnit:
     """One test of a calibration at a pair (f_p, mu_r), as a value that travels to a Dask worker:
@@ -134,6 +153,12 @@ class FrictionUnit:
     digest: str
     sigma: float
     settings: dict[str, Any]
+
+    #: the kind's settings and case classes (the shear test's or the biaxial test's), and the digest
+    #: that names a unit's folder in the cache
+    SETTINGS: ClassVar[type]
+    CASE: ClassVar[type]
+    KEY: ClassVar[Callable[[str, float, dict], str]]
 
     @classmethod
     def at(cls, specimen, digest: str, sigma: float, base, fp: float, mu_r: float, **stiffness):
@@ -155,43 +180,54 @@ class FrictionUnit:
     def mu_r(self) -> float:
         return self.settings["rolling_friction"]
 
-    @property
+    @cached_property
     def key(self) -> str:
-        raise NotImplementedError
+        """The unit's identity: the name of its store in the cache (its kind's ``KEY``)."""
+        return type(self).KEY(self.digest, self.sigma, self.settings)
+
+    def case(self):
+        """The test's case: the specimen read (its content checked against ``digest``), the stress
+        and the settings."""
+        return self.CASE(Specimen.read(self.specimen, self.digest), self.sigma, self.typed_settings)
+
+    @property
+    def typed_settings(self):
+        """The settings as their class (the unit keeps them as the table its key hashes)."""
+        return self.SETTINGS(**self.settings)
 
     def store(self, cache: Store | None) -> Store | None:
         """The unit's store in ``cache``, under its key (None: nothing kept)."""
         return None if cache is None else cache.child(self.key)
 
+    def stored(self, cache: Store | None):
+        """The finished test's result in ``cache``, or None (a folder not there holds none)."""
+        store = self.store(cache)
+        return None if store is None or not store.root.is_dir() else self.test(store).stored()
 
-@dataclass(frozen=True)
-class CalibrationUnit(FrictionUnit):
-    """One shear test of a calibration (:class:`FrictionUnit` with the shear settings)."""
+    def stored_row(self, cache: Store | None):
+        """The unit's row when its store in ``cache`` holds the finished test, else None."""
+        res = self.stored(cache)
+        return None if res is None else self.row(res)
 
-    @cached_property
-    def key(self) -> str:
-        """The unit's identity: the name of its store in the cache (:func:`unit_key`)."""
-        return unit_key(self.digest, self.sigma, self.settings)
-
-    #: what the progress display counts (:class:`poro2d.calibration.cluster.UnitRunner`)
-    WHAT = "shear tests"
-
-    # the protocol the runner reads every kind of unit through (the biaxial units keep it too)
-    def stored_row(self, cache: Store | None) -> UnitRow | None:
-        return stored_row(self, cache)
-
-    def check_entry(self, cache: Store | None) -> None:
-        check_entry(self, cache)
-
-    def compute(self, cache: Store | None) -> UnitRow:
-        return _row(self, _test(self, self.store(cache)).run())
-
-    def curve(self, cache: Store | None) -> tuple[np.ndarray, np.ndarray] | None:
-        return unit_curve(self, cache)
+    def compute(self, cache: Store | None):
+        """Run (or finish) the test: what a Dask worker runs (through :func:`compute_unit`)."""
+        return self.row(self.test(self.store(cache)).run())
 
 
 @dataclass(frozen=True)
-class UnitRow:
+class UnitIdentity:
+    """The first fields of what a finished unit of any kind gives the fit: its key, its stress (kPa),
+    the two frictions and the specimen's file."""
+
+    key: str
+    sigma: float
+    fp: float
+    mu_r: float
+    specimen: str
+
+
+@dataclass(frozen=True)
+class UnitRow(UnitIdentity):
     """What a finished unit gives the fit: its observables and its cost.
 
     ``peak`` and ``end``: shear stresses (kPa); ``dilation``: the plate's rise at the end of
@@ -201,11 +237,6 @@ class UnitRow:
     fit leaves its design point out.
     """
 
-    key: str
-    sigma: float
-    fp: float
-    mu_r: float
-    specimen: str
     peak: float
     end: float
     wall_time_s: float
@@ -227,36 +258,75 @@ class UnitRow:
         return math.nan if self.readings is None else self.readings.at(*reading)
 
 
-def _test(unit: CalibrationUnit, store: Store | None, threads: int = 1) -> DirectShearTest:
-    case = ShearCase(Specimen.read(unit.specimen, unit.digest), unit.sigma, ShearSettings(**unit.settings))
-    return DirectShearTest(case, store, keep_peak=False, threads=threads)
+@dataclass(frozen=True)
+class CalibrationUnit(FrictionUnit):
+    """One shear test of a calibration (:class:`FrictionUnit` with the shear settings), read through
+    the protocol the runner reads every kind of unit by (the biaxial units keep it too)."""
 
+    #: what the progress display counts (:class:`poro2d.calibration.cluster.UnitRunner`)
+    WHAT = "shear tests"
+    SETTINGS = ShearSettings
+    CASE = ShearCase
+    KEY = staticmethod(unit_key)
 
-def _row(unit: CalibrationUnit, res) -> UnitRow:
-    window = ShearSettings(**unit.settings).peak_window
-    return UnitRow(
-        key=unit.key,
-        sigma=unit.sigma,
-        fp=unit.fp,
-        mu_r=unit.mu_r,
-        specimen=unit.specimen,
-        peak=float(res.peak_shear_stress_kpa),
-        end=float(res.end.shear_stress_kpa),
-        wall_time_s=float(res.wall_time_s),
-        dilation=end_rise_mm(res.curve, window),
-        readings=CurveReadings(
-            np.asarray(res.curve["shear_displacement_mm"], float) * 1e-3,
-            {
-                "stress": np.asarray(res.curve["shear_stress_kpa"], float),
-                "rise": np.asarray(res.curve["plate_displacement_mm"], float),
-            },
-            window,
-        ),
-        box_dominated=bool(res.box_dominated),
-        box_note=res.box_note or "",
-        stiffness_number=res.stiffness_number,
-        mean_overlap_ratio=res.mean_overlap_ratio_at_peak,
-    )
+    def test(self, store: Store | None) -> DirectShearTest:
+        return DirectShearTest(self.case(), store, keep_peak=False)
+
+    def check_entry(self, cache: Store | None) -> None:
+        """Refuse, on one line naming it, a unit's cache entry that is damaged: what a test resumes from.
+
+        A file where the unit's folder belongs, or a file of the folder that differs from what
+        the store wrote (edited, truncated, replaced: :meth:`poro2d.store.Store.check_intact`),
+        would fail the test on its worker, and a calibration must not answer without it. So would
+        an entry holding work without the record of its test (``test.json`` deleted) or with
+        another test's (a folder copied in).
+        """
+        store = self.store(cache)
+        if store is None or not check_files(cache, store, "one shear test of the cache"):
+            return
+        content = content_record(self.digest, self.sigma, self.typed_settings)
+        try:
+            folder_stage(store, content, self.specimen).check()
+        except InputError:
+            raise InputError(
+                str(store.root), "work without the record of its test", "a cache entry of this shear test",
+                "delete it to have the test computed again",
+            ) from None  # fmt: skip
+
+    def curve(self, cache: Store | None) -> tuple[np.ndarray, np.ndarray] | None:
+        """The finished test's curve (shear displacement m, shear stress kPa), or None when it has none."""
+        res = self.stored(cache)
+        if res is None or not res.curve:
+            return None
+        return res.curve["shear_displacement_mm"] * 1e-3, res.curve["shear_stress_kpa"]
+
+    def row(self, res) -> UnitRow:
+        """What the fit reads of the test's result ``res``."""
+        window = self.typed_settings.peak_window
+        curve = res.curve
+        return UnitRow(
+            key=self.key,
+            sigma=self.sigma,
+            fp=self.fp,
+            mu_r=self.mu_r,
+            specimen=self.specimen,
+            peak=float(res.peak_shear_stress_kpa),
+            end=float(res.end.shear_stress_kpa),
+            wall_time_s=float(res.wall_time_s),
+            dilation=end_rise_mm(curve, window),
+            readings=CurveReadings(
+                np.asarray(curve["shear_displacement_mm"], float) * 1e-3,
+                {
+                    "stress": np.asarray(curve["shear_stress_kpa"], float),
+                    "rise": np.asarray(curve["plate_displacement_mm"], float),
+                },
+                window,
+            ),
+            box_dominated=bool(res.box_dominated),
+            box_note=res.box_note or "",
+            stiffness_number=res.stiffness_number,
+            mean_overlap_ratio=res.mean_overlap_ratio_at_peak,
+        )
 
 
 def end_rise_mm(curve, window: float) -> float:
@@ -264,26 +334,6 @@ def end_rise_mm(curve, window: float) -> float:
     its end stress is: read from the curve, so tests cached before dilation was fitted serve it."""
     x = np.asarray(curve["shear_displacement_mm"], float) * 1e-3
     return float(smooth(x, curve["plate_displacement_mm"], window)[-1])
-
-
-def stored_row(unit: CalibrationUnit, cache: Store | None) -> UnitRow | None:
-    """The unit's row when its store in ``cache`` holds the finished test, else None."""
-    store = unit.store(cache)
-    res = None if store is None else _test(unit, store).stored()
-    return None if res is None else _row(unit, res)
-
-
-def check_entry(unit: CalibrationUnit, cache: Store | None) -> None:
-    """Refuse, on one line naming it, a unit's cache entry that is damaged: what a test resumes from.
-
-    A file where the unit's folder belongs, or a file of the folder that differs from what
-    the store wrote (edited, truncated, replaced: :meth:`poro2d.store.Store.check_intact`),
-    would fail the test on its worker, and a calibration must not answer without it.
-    """
-    store = unit.store(cache)
-    if store is None or not check_files(cache, store, "one shear test of the cache"):
-        return
-    _check_record(unit, store)
 
 
 def check_files(cache: Store, store: Store, what: str) -> bool:
@@ -302,33 +352,11 @@ def check_files(cache: Store, store: Store, what: str) -> bool:
     return True
 
 
-def _check_record(unit: CalibrationUnit, store: Store) -> None:
-    """Refuse an entry holding work without the record of its test (``test.json`` deleted) or
-    with another test's (a folder copied in): its test would refuse it on the worker."""
-    content = content_record(unit.digest, unit.sigma, ShearSettings(**unit.settings))
-    try:
-        folder_stage(store, content, unit.specimen).check()
-    except InputError:
-        raise InputError(
-            str(store.root), "work without the record of its test", "a cache entry of this shear test",
-            "delete it to have the test computed again",
-        ) from None  # fmt: skip
-
-
 def compute_unit(unit, cache: Store | None):
     """Run (or finish) one unit of any kind (its ``compute``), on one numba thread: the task a Dask
     worker runs."""
     pin_numba_threads()
     return unit.compute(cache)
-
-
-def unit_curve(unit: CalibrationUnit, cache: Store | None) -> tuple[np.ndarray, np.ndarray] | None:
-    """The finished unit's curve (shear displacement m, shear stress kPa), or None when it has none."""
-    store = unit.store(cache)
-    res = None if store is None else _test(unit, store).stored()
-    if res is None or not res.curve:
-        return None
-    return res.curve["shear_displacement_mm"] * 1e-3, res.curve["shear_stress_kpa"]
 
 
 __all__ = [
@@ -348,12 +376,11 @@ __all__ = [
     "window_mean",
     "CalibrationUnit",
     "FrictionUnit",
+    "UnitIdentity",
     "UnitRow",
-    "check_entry",
+    "base_of",
     "check_files",
     "compute_unit",
     "end_rise_mm",
-    "stored_row",
-    "unit_curve",
     "unit_key",
 ]

@@ -46,24 +46,20 @@ def register(app: typer.Typer) -> None:
             help="Laboratory biaxial CSV (rows named by confining_stress_kpa); repeat for more files."
             " Instead of --lab.",
         ),
-        specimen: list[str] = typer.Option(
-            None, "--specimen", "-s", help="A specimen (.npz or criterion folder); repeat for replicates."
+        specimen: list[str] = opt.specimen_options(
+            help="A specimen (.npz or criterion folder); repeat for replicates."
         ),
         preset: str = opt.preset(help="paper: replicate specimens of the paper's case."),
-        quick: bool = typer.Option(False, "--quick", help="With --preset paper: the small specimen."),
-        replicates: int = typer.Option(
-            None, "--replicates", help="With --preset: seeds of its specimens (1-20; default 3)."
+        quick: bool = opt.quick(help="With --preset paper: the small specimen."),
+        replicates: int = opt.replicates(help="With --preset: seeds of its specimens (1-20; default 3)."),
+        seed: int = opt.seed(help="With --preset: first seed of its specimens (default 0)."),
+        fp_range: str = opt.range_option("--fp-range", "Particle friction range LOW,HIGH (0.3,3)."),
+        mu_r_range: str = opt.range_option("--mu-r-range", "Rolling friction range LOW,HIGH (0,0.5)."),
+        kn_range: str = opt.range_option(
+            "--kn-range", "Also calibrate the disks' normal stiffness kn: range LOW,HIGH (N/m)."
         ),
-        seed: int = typer.Option(
-            None, "--seed", help="With --preset: first seed of its specimens (default 0)."
-        ),
-        fp_range: str = typer.Option(None, "--fp-range", help="Particle friction range LOW,HIGH (0.3,3)."),
-        mu_r_range: str = typer.Option(None, "--mu-r-range", help="Rolling friction range LOW,HIGH (0,0.5)."),
-        kn_range: str = typer.Option(
-            None, "--kn-range", help="Also calibrate the disks' normal stiffness kn: range LOW,HIGH (N/m)."
-        ),
-        ks_range: str = typer.Option(
-            None, "--ks-range", help="Also calibrate the disks' shear stiffness ks: range LOW,HIGH (N/m)."
+        ks_range: str = opt.range_option(
+            "--ks-range", "Also calibrate the disks' shear stiffness ks: range LOW,HIGH (N/m)."
         ),
         points: int = typer.Option(
             12, "--points", help="Design points of round 1 (9-500; 13 with kn or ks, 18 with both)."
@@ -86,9 +82,7 @@ def register(app: typer.Typer) -> None:
             1, "--stations", help="Readings of each lab curve up to its end (1-10; 1: the end only)."
         ),
         max_displacement: float = opt.max_displacement(),
-        max_strain: float = typer.Option(
-            None, "--max-strain", help="With --biaxial-lab: axial strain of every test (0.2)."
-        ),
+        max_strain: float = opt.max_strain(help="With --biaxial-lab: axial strain of every test (0.2)."),
         out: Path = opt.out("calibrate-out"),
         scheduler: str = opt.scheduler(),
         workers: int = opt.workers(help="LocalCluster worker processes (default: one per core)."),
@@ -171,27 +165,12 @@ def test_settings(biaxial: bool, max_displacement: float | None, max_strain: flo
 
 
 def print_result(result, out: Path) -> None:
-    from poro2d.report.calibration_report import (
-        box_dominated_note,
-        box_note,
-        calibrated,
-        discrepancy_note,
-        identifiability_note,
-        interval_text,
-        repeats_note,
-    )
+    from poro2d.report.calibration_report import calibrated, interval_text, notes
 
     for name, label, _ in calibrated(result):
         console.print(f"  {label:<5} {interval_text(result, name)}")
-    console.print(f"  {identifiability_note(result)}")
-    if repeats_note(result):
-        console.print(f"  {repeats_note(result)}")
-    if discrepancy_note(result):
-        console.print(f"  {discrepancy_note(result)}")
-    if box_note(result):
-        console.print(f"  {box_note(result)}")
-    if box_dominated_note(result):
-        console.print(f"  {box_dominated_note(result)}")
+    for note in notes(result):
+        console.print(f"  {note}")
     console.print(
         f"results in {out}/result.json; config {out}/calibrated.toml; report {out}/calibration.html"
     )

@@ -73,9 +73,18 @@ def job_options(
     return options
 
 
-# the laboratory tests' own arguments and options (shear, strength, biaxial, critical-state); the help
-# given to each says the command's own
+# the laboratory tests' own arguments and options (shear, strength, biaxial, critical-state,
+# calibrate); the help given to each says the command's own
 specimens = partial(typer.Argument, None)
+specimen_options = partial(typer.Option, None, "--specimen", "-s")
 quick = partial(typer.Option, False, "--quick")
+seed = partial(typer.Option, None, "--seed")
+replicates = partial(typer.Option, None, "--replicates")
+max_strain = partial(typer.Option, None, "--max-strain")
 lab = partial(typer.Option, None, "--lab")
 stiffness_number = partial(typer.Option, None, "--stiffness-number")
+
+
+def range_option(flag: str, text: str) -> Any:
+    """A search range ``flag`` given as ``LOW,HIGH`` (None: the command's default); ``text``: its help."""
+    return typer.Option(None, flag, help=text)

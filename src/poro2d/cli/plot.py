@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
 
 import typer
 
@@ -14,30 +13,23 @@ from poro2d.errors import InputError, check_range
 
 def plot_relations(
     ctx: typer.Context,
-    n_max: Annotated[float, typer.Option("--n-max", help="Laboratory maximum porosity.")] = P.PAPER_N_MAX,
-    n_min: Annotated[float, typer.Option("--n-min", help="Laboratory minimum porosity.")] = P.PAPER_N_MIN,
-    out_dir: Annotated[
-        Path, typer.Option("-o", "--out-dir", help="Output directory (created if missing).")
-    ] = Path("."),
-    mark_n_lab: Annotated[
-        float | None,
-        typer.Option("--mark-n-lab", help="Mark one laboratory porosity on both figures (e.g. 0.3434)."),
-    ] = None,
-    nu_reading: Annotated[
-        NuReading,
-        typer.Option("--nu-reading", help="Reading of nu in Eq. 2 for the main Eq. 2 curve."),
-    ] = NuReading.printed,
-    lattice_exact: Annotated[
-        bool, typer.Option("--lattice-exact", help="Exact lattice 2D extremes in Eqs. 7-11.")
-    ] = False,
+    n_max: float = typer.Option(P.PAPER_N_MAX, "--n-max", help="Laboratory maximum porosity."),
+    n_min: float = typer.Option(P.PAPER_N_MIN, "--n-min", help="Laboratory minimum porosity."),
+    out_dir: Path = typer.Option(Path("."), "-o", "--out-dir", help="Output directory (created if missing)."),
+    mark_n_lab: float | None = typer.Option(
+        None, "--mark-n-lab", help="Mark one laboratory porosity on both figures (e.g. 0.3434)."
+    ),
+    nu_reading: NuReading = typer.Option(
+        NuReading.printed, "--nu-reading", help="Reading of nu in Eq. 2 for the main Eq. 2 curve."
+    ),
+    lattice_exact: bool = typer.Option(
+        False, "--lattice-exact", help="Exact lattice 2D extremes in Eqs. 7-11."
+    ),
 ) -> None:
     """Write the paper's Fig. 1 and Fig. 2 (PNG and SVG) into DIR."""
     if ctx.args:
-        raise InputError(
-            "option",
-            ctx.args[0],
-            "--n-max, --n-min, -o/--out-dir, --mark-n-lab, --nu-reading, --lattice-exact",
-        )
+        allowed = "--n-max, --n-min, -o/--out-dir, --mark-n-lab, --nu-reading, --lattice-exact"
+        raise InputError("option", ctx.args[0], allowed)
     check_range("--n-max", n_max, 0.0, 1.0, hi_open=True)
     check_range("--n-min", n_min, 0.0, 1.0, hi_open=True)
     if not n_max > n_min:
@@ -52,27 +44,16 @@ def plot_relations(
     check_no_run("--out-dir", out_dir)  # the figures would replace a run's own (the paper's Figs. 1-2)
 
     paths = write_relation_figures(
-        out_dir,
-        n_max,
-        n_min,
-        nu_reading=nu_reading.value,
-        lattice_exact=lattice_exact,
-        mark_n_lab=mark_n_lab,
+        out_dir, n_max, n_min, nu_reading=nu_reading.value, lattice_exact=lattice_exact, mark_n_lab=mark_n_lab
     )
     for p in paths:
         typer.echo(str(p))
 
 
 def register(app: typer.Typer) -> None:
-    """Attach ``plot relations`` to the root app, under its ``plot`` group."""
-    plot_app = None
-    for group in app.registered_groups:
-        if group.name == "plot" and group.typer_instance is not None:
-            plot_app = group.typer_instance
-            break
-    if plot_app is None:
-        plot_app = typer.Typer(help="Figures.", no_args_is_help=True)
-        app.add_typer(plot_app, name="plot")
+    """Attach the ``plot`` group, with ``plot relations``, to the root app."""
+    plot_app = typer.Typer(help="Figures.", no_args_is_help=True)
+    app.add_typer(plot_app, name="plot")
     plot_app.command(
         "relations",
         cls=OneLineUsageCommand,

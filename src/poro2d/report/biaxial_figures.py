@@ -16,18 +16,14 @@ import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from poro2d.biaxial.lab import LabCurve  # noqa: E402
-from poro2d.biaxial.results import BiaxialResult, BiaxialSeriesResult  # noqa: E402
-from poro2d.biaxial.series import sigma_3_at_peak, stress_folder  # noqa: E402
-from poro2d.report.figure_file import save_figure  # noqa: E402
-from poro2d.report.shear_figures import COLORS  # noqa: E402
-from poro2d.store import Store  # noqa: E402
+from poro2d.biaxial.lab import LabCurve
+from poro2d.biaxial.results import BiaxialResult, BiaxialSeriesResult
+from poro2d.biaxial.series import sigma_3_at_peak, stress_folder
+from poro2d.report.figure_file import new_figure, save_figure
+from poro2d.report.shear_figures import COLORS
+from poro2d.store import Store
 
 #: the figure of one confining stress, and of a series
 FIGURE = "biaxial.png"
@@ -80,9 +76,7 @@ def plot_biaxial(
     ``critical``: (sin phi, start of the window as axial strain) of the critical state, drawn as
     a line; ``lab``: arrays ``axial_strain``, ``stress_ratio`` and ``volumetric_strain`` (or None).
     """
-    fig, (ax, bx) = plt.subplots(
-        2, 1, figsize=(7.0, 7.0), sharex=True, gridspec_kw={"height_ratios": [1.6, 1]}
-    )
+    fig, (ax, bx) = new_figure(2, 1, figsize=(7.0, 7.0), sharex=True, gridspec_kw={"height_ratios": [1.6, 1]})
     for k, (label, c) in enumerate(curves):
         col = COLORS[k % len(COLORS)]
         ax.plot(100 * c["axial_strain"], c["sin_phi"], color=col, lw=1.0, label=label)
@@ -124,7 +118,7 @@ def plot_biaxial_series(
     c in kPa) of the Mohr-Coulomb line; ``peaks``: (the target sigma_3, the measured sigma_3 at the
     peak, sin phi at the peak) of every test, all in kPa but sin phi.
     """
-    fig, axes = plt.subplots(1, 3, figsize=(14.0, 4.6))
+    fig, axes = new_figure(1, 3, figsize=(14.0, 4.6))
     ax, bx, cx = axes
     colours = {sigma: COLORS[k % len(COLORS)] for k, (sigma, _) in enumerate(curves)}
     for sigma, reps in curves:

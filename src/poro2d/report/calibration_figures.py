@@ -11,17 +11,14 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib import rcParams
+from matplotlib.ticker import FormatStrFormatter
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.ticker import FormatStrFormatter  # noqa: E402
-
-from poro2d.calibration.outputs import FIT_PNG, POSTERIOR_PNG  # noqa: E402
-from poro2d.report.calibration_report import write_calibration_report  # noqa: E402
-from poro2d.report.figure_file import save_figure  # noqa: E402
-from poro2d.store import Store  # noqa: E402
+from poro2d.calibration.outputs import FIT_PNG, POSTERIOR_PNG
+from poro2d.report.calibration_report import write_calibration_report
+from poro2d.report.figure_file import new_figure, save_figure
+from poro2d.store import Store
 
 
 def draw_calibration(result, store: Store) -> None:
@@ -45,19 +42,19 @@ def plot_calibration_fit(result, lab, curves: dict[float, list], nearest, path: 
     """
     dilation = [o for o in result.posterior.observables if o.observable == "dilation"]
     if dilation:
-        fig, (ax_peak, ax_curve, ax_dil) = plt.subplots(1, 3, figsize=(15, 4.2))
+        fig, (ax_peak, ax_curve, ax_dil) = new_figure(1, 3, figsize=(15, 4.2))
         _plot_dilation(ax_dil, dilation)
     else:
-        fig, (ax_peak, ax_curve) = plt.subplots(1, 2, figsize=(11, 4.2))
+        fig, (ax_peak, ax_curve) = new_figure(1, 2, figsize=(11, 4.2))
     obs = [o for o in result.posterior.observables if o.observable == "peak"]
     s = np.array([o.normal_stress_kpa for o in obs])
-    ax_peak.plot(s, [o.lab_kpa for o in obs], "ks", label="laboratory peak")
-    _model_points(ax_peak, s, obs, "kpa")
+    ax_peak.plot(s, [o.lab for o in obs], "ks", label="laboratory peak")
+    _model_points(ax_peak, s, obs)
     ends = [o for o in result.posterior.observables if o.observable == "end"]
     if ends:
         se = [o.normal_stress_kpa for o in ends]
-        ax_peak.plot(se, [o.lab_kpa for o in ends], "k^", mfc="none", label="laboratory end")
-        ax_peak.plot(se, [o.model_kpa for o in ends], "v", color="#2166ac", label="model end")
+        ax_peak.plot(se, [o.lab for o in ends], "k^", mfc="none", label="laboratory end")
+        ax_peak.plot(se, [o.model for o in ends], "v", color="#2166ac", label="model end")
     ax_peak.set_xlabel("normal stress (kPa)")
     ax_peak.set_ylabel("shear stress (kPa)")
     ax_peak.set_xlim(left=0)
@@ -85,7 +82,7 @@ def _best_title(ax, result) -> None:
 
 def _model_curves(ax, k: int, sigma: float, curves: dict[float, list], scale: float) -> str:
     """The model's curves at the ``k``-th stress ``sigma`` (x times ``scale``) in its colour, returned."""
-    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    colors = rcParams["axes.prop_cycle"].by_key()["color"]
     c = colors[k % len(colors)]
     for j, (x, y) in enumerate(curves.get(sigma, [])):
         ax.plot(scale * x, y, color=c, lw=0.8, alpha=0.7, label=f"model {sigma:g} kPa" if j == 0 else None)
@@ -104,13 +101,12 @@ def _curves_axes(ax, nearest, xlabel: str, ylabel: str) -> None:
     ax.legend(fontsize=7)
 
 
-def _model_points(ax, s, observed: list, unit: str) -> None:
-    """The calibrated model's values of ``observed`` (in ``unit``: their keys' suffix) at the
-    stresses ``s``, with +-2 noise sd."""
+def _model_points(ax, s, observed: list) -> None:
+    """The calibrated model's values of ``observed`` at the stresses ``s``, with +-2 noise sd."""
     ax.errorbar(
         s,
-        [getattr(o, f"model_{unit}") for o in observed],
-        yerr=[2 * getattr(o, f"noise_sd_{unit}") for o in observed],
+        [o.model for o in observed],
+        yerr=[2 * o.noise_sd for o in observed],
         fmt="o",
         color="#b2182b",
         capsize=3,
@@ -121,8 +117,8 @@ def _model_points(ax, s, observed: list, unit: str) -> None:
 def _plot_dilation(ax, dilation: list) -> None:
     """The dilation targets (mm) against normal stress: the laboratory's and the model's (+-2 sd)."""
     s = [o.normal_stress_kpa for o in dilation]
-    ax.plot(s, [o.lab_mm for o in dilation], "ks", label="laboratory")
-    _model_points(ax, s, dilation, "mm")
+    ax.plot(s, [o.lab for o in dilation], "ks", label="laboratory")
+    _model_points(ax, s, dilation)
     ax.axhline(0.0, color="0.6", lw=0.6)
     ax.set_xlim(left=0)
     ax.set_xlabel("normal stress (kPa)")
@@ -145,7 +141,7 @@ def plot_biaxial_calibration_fit(
     fitted = result.posterior.observables
     volumetric = [o for o in fitted if o.observable == "end_volumetric"]
     panels = 3 if volumetric else 2
-    fig, axes = plt.subplots(1, panels, figsize=(5 * panels, 4.2))
+    fig, axes = new_figure(1, panels, figsize=(5 * panels, 4.2))
     ax_ratio, ax_curve = axes[0], axes[1]
     for name, marker, label in (("peak_ratio", "s", "peak"), ("end_ratio", "^", "end")):
         _plot_targets(ax_ratio, [o for o in fitted if o.observable == name], marker, label)
@@ -176,9 +172,9 @@ def _plot_targets(ax, observed: list, marker: str, label: str) -> None:
     if not observed:
         return
     s = [o.normal_stress_kpa for o in observed]
-    ax.plot(s, [o.lab_ratio for o in observed], "k" + marker, mfc="none", label=f"laboratory {label}")
+    ax.plot(s, [o.lab for o in observed], "k" + marker, mfc="none", label=f"laboratory {label}")
     ax.errorbar(
-        s, [o.model_ratio for o in observed], yerr=[2 * o.noise_sd_ratio for o in observed],
+        s, [o.model for o in observed], yerr=[2 * o.noise_sd for o in observed],
         fmt=marker, capsize=3, label=f"model {label} (surrogate, +-2 sd)",
     )  # fmt: skip
     ax.set_xlabel("confining stress sigma_3 (kPa)")
@@ -193,7 +189,7 @@ def plot_calibration_posterior(result, post, path: str | os.PathLike) -> Path:
     (``chain``, ``ranges``): then a corner of pairwise marginals (:func:`plot_posterior_corner`)."""
     if getattr(post, "chain", None) is not None:
         return plot_posterior_corner(result, post, path)
-    fig, ax = plt.subplots(figsize=(6.2, 4.8))
+    fig, ax = new_figure(figsize=(6.2, 4.8))
     fp, mu_r = post.fp_values, post.mu_r_values
     mesh = ax.pcolormesh(fp, mu_r, post.density / post.density.max(), shading="auto", cmap="viridis")
     fig.colorbar(mesh, ax=ax, label="posterior density / its maximum")
@@ -248,7 +244,7 @@ def plot_posterior_corner(result, post, path: str | os.PathLike) -> Path:
     ticks are labelled in the parameters' values."""
     axes = post.ranges.axes
     d = len(axes)
-    fig, grid = plt.subplots(d, d, figsize=(2.2 * d, 2.2 * d), squeeze=False)
+    fig, grid = new_figure(d, d, figsize=(2.2 * d, 2.2 * d), squeeze=False)
     design = post.ranges.to_unit(*zip(*(e.parameters(axes) for e in result.evaluations), strict=True))
     best = post.ranges.to_unit(*(getattr(result.best, _AXES[a][1]) for a in axes))[0]
     for i in range(d):

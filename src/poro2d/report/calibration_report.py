@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from poro2d.calibration.outputs import FIT_PNG, POSTERIOR_PNG
 from poro2d.report.document import write_report
 
 #: every parameter a calibration may calibrate: its key in the result, its symbol and its name
@@ -133,19 +134,28 @@ def discrepancy_note(result) -> str | None:
     return text
 
 
+def notes(result) -> list[str]:
+    """What the posterior says about identifiability, then the notes of the repeats, the discrepancy,
+    the box and the box-dominated points that apply, each a line."""
+    found = (repeats_note(result), discrepancy_note(result), box_note(result), box_dominated_note(result))
+    return [identifiability_note(result), *(note for note in found if note)]
+
+
 def fit_table(observables) -> tuple[list[str], list[list]]:
     """The fit table's header and rows: in kPa while every target is a stress; with dilation
     targets (mm) each row names its unit."""
-    units = {"lab_kpa": "kPa", "lab_mm": "mm", "lab_ratio": "ratio"}
-    named = [(o, next(u for k, u in units.items() if getattr(o, k) is not None)) for o in observables]
-    if all(u == "kPa" for _, u in named):
+    units = [o.unit for o in observables]
+    if all(u == "kPa" for u in units):
         header = ["observable", "normal stress (kPa)", "laboratory (kPa)", "model (kPa)", "noise sd (kPa)"]
-        rows = [[o.observable, o.normal_stress_kpa, *_values(o, "kpa")] for o, _ in named]
+        rows = [[o.observable, o.normal_stress_kpa, o.lab, o.model, o.noise_sd] for o in observables]
     else:  # biaxial targets: the stress is sigma_3, every value dimensionless ("1")
-        stress = "confining stress (kPa)" if all(u == "ratio" for _, u in named) else "normal stress (kPa)"
+        stress = "confining stress (kPa)" if all(u == "ratio" for u in units) else "normal stress (kPa)"
         header = ["observable", stress, "unit", "laboratory", "model", "noise sd"]
-        rows = [[o.observable, o.normal_stress_kpa, _shown(u), *_values(o, u.lower())]
-                for o, u in named]  # fmt: skip
+        unit = {"ratio": "1"}  # a dimensionless value's unit as the table shows it
+        rows = [
+            [o.observable, o.normal_stress_kpa, unit.get(o.unit, o.unit), o.lab, o.model, o.noise_sd]
+            for o in observables
+        ]
     if any(o.stiffness_number is not None for o in observables):
         # how much elastic strain a volumetric observable carries: kappa and the overlap at the peak
         header = [*header, "kappa", "overlap / d at peak"]
@@ -159,57 +169,29 @@ def _tests(result) -> str:
     return "Biaxial tests" if result.test == "biaxial" else "Shear tests"
 
 
-def _shown(unit: str) -> str:
-    """A unit as the table shows it: a dimensionless value's as 1."""
-    return "1" if unit == "ratio" else unit
-
-
-def _values(o, u: str) -> list[float]:
-    return [getattr(o, f"lab_{u}"), getattr(o, f"model_{u}"), getattr(o, f"noise_sd_{u}")]
-
-
 def calibration_blocks(result, out: Path) -> list[tuple]:
     """The section's blocks: best values, identifiability, the fit table and the two figures."""
     header, rows = fit_table(result.posterior.observables)
-    info = result.cluster
+    info, two = result.cluster, len(calibrated(result)) == 2
+    posterior = "The posterior over (f_p, mu_r)" if two else "The pairwise marginals of the sampled posterior"
+    lab = (
+        f"Laboratory data: {result.lab.source} ({result.lab.kind}); "
+        f"{len(result.specimens)} replicate specimen(s); {len(result.evaluations)} design points."
+    )
+    work = (
+        f"{_tests(result)}: {info.tests_run} run, {info.tests_reused} reused from the cache, "
+        f"{info.tests_failed} failed; wall time {result.timings.wall_time_s:.0f} s."
+    )
+    values = [f"{name} {symbol} = {interval_text(result, key)}" for key, symbol, name in calibrated(result)]
     return [
-        (
-            "h2",
-            "Calibration of particle and rolling friction"
-            + (" and stiffness" if len(calibrated(result)) > 2 else ""),
-        ),
-        (
-            "p",
-            f"Laboratory data: {result.lab.source} ({result.lab.kind}); "
-            f"{len(result.specimens)} replicate specimen(s); {len(result.evaluations)} design points.",
-        ),
-        (
-            "ul",
-            [f"{name} {symbol} = {interval_text(result, key)}" for key, symbol, name in calibrated(result)],
-        ),
-        ("p", identifiability_note(result)),
-        *([("p", repeats_note(result))] if repeats_note(result) else []),
-        *([("p", discrepancy_note(result))] if discrepancy_note(result) else []),
-        *([("p", box_note(result))] if box_note(result) else []),
-        *([("p", box_dominated_note(result))] if box_dominated_note(result) else []),
+        ("h2", "Calibration of particle and rolling friction" + ("" if two else " and stiffness")),
+        ("p", lab),
+        ("ul", values),
+        *(("p", note) for note in notes(result)),
         ("table", header, rows),
-        (
-            "img",
-            str(out / "calibration_fit.png"),
-            "The calibrated model beside the laboratory values and curves.",
-        ),
-        (
-            "img",
-            str(out / "calibration_posterior.png"),
-            "The posterior over (f_p, mu_r), with the evaluated points."
-            if len(calibrated(result)) == 2
-            else "The pairwise marginals of the sampled posterior, with the evaluated points.",
-        ),
-        (
-            "p",
-            f"{_tests(result)}: {info.tests_run} run, {info.tests_reused} reused from the cache, "
-            f"{info.tests_failed} failed; wall time {result.timings.wall_time_s:.0f} s.",
-        ),
+        ("img", str(out / FIT_PNG), "The calibrated model beside the laboratory values and curves."),
+        ("img", str(out / POSTERIOR_PNG), f"{posterior}, with the evaluated points."),
+        ("p", work),
     ]
 
 
@@ -225,5 +207,6 @@ __all__ = [
     "fit_table",
     "interval_text",
     "identifiability_note",
+    "notes",
     "write_calibration_report",
 ]

@@ -9,12 +9,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from poro2d import porosity as P
 from poro2d.errors import InputError, check_range
-from poro2d.report.figure_file import save_figure
+from poro2d.report.figure_file import new_figure, save_figure
 
 # name, function of n_lab, style
 _STYLE = {
@@ -42,43 +41,22 @@ def _check_extremes(n_max: float, n_min: float) -> None:
     P.relative_density(n_min, n_max, n_min)  # validates both, raises InputError
 
 
-def _new_axes(figsize: tuple[float, float]):
-    """A figure with its own Agg canvas, so that no pyplot state is touched."""
-    fig = Figure(figsize=figsize, layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig, fig.add_subplot()
-
-
 def _fig1_curves(
     x: np.ndarray, n_max: float, n_min: float, nu_reading: str, lattice_exact: bool
 ) -> list[tuple[str, str, np.ndarray]]:
     """Every method's line as (style key, legend label, n2D): the limits follow from all of them."""
     other = "solid_fraction" if nu_reading == "printed" else "printed"
+    lim_lab = P.lim_lab(x, n_max, n_min, lattice_exact=lattice_exact)
+    quasi = P.quasi_3d(x, n_max, n_min, lattice_exact=lattice_exact)
     return [
         ("densest_state", "Densest State (Eq. 1)", P.densest_state(x)),
-        (
-            "densest_state_modified",
-            _eq2_label(nu_reading),
-            P.densest_state_modified(x, n_min, nu_reading),
-        ),
-        (
-            "densest_state_modified_alt",
-            _eq2_label(other),
-            P.densest_state_modified(x, n_min, other),
-        ),
+        ("densest_state_modified", _eq2_label(nu_reading), P.densest_state_modified(x, n_min, nu_reading)),
+        ("densest_state_modified_alt", _eq2_label(other), P.densest_state_modified(x, n_min, other)),
         ("loosest_state", "Loosest State (Eq. 3)", P.loosest_state(x)),
         ("interval_mapping", "Interval Mapping (Eq. 4)", P.interval_mapping(x)),
         ("combination", "Combination (Eq. 5)", P.combination(x, n_max, n_min)),
-        (
-            "lim_lab",
-            "LIM 2D-Lab (Eqs. 6-7)",
-            P.lim_lab(x, n_max, n_min, lattice_exact=lattice_exact),
-        ),
-        (
-            "quasi_3d",
-            "Quasi 3D (Eqs. 8-11)\n(same line as LIM 2D-Lab)",
-            P.quasi_3d(x, n_max, n_min, lattice_exact=lattice_exact),
-        ),
+        ("lim_lab", "LIM 2D-Lab (Eqs. 6-7)", lim_lab),
+        ("quasi_3d", "Quasi 3D (Eqs. 8-11)\n(same line as LIM 2D-Lab)", quasi),
         ("lim_3d", "LIM 2D-3D (Sec. 2.2)", P.lim_3d(x)),
         ("parabolic", "Parabola (Eq. 12)", P.parabolic(x)),
     ]
@@ -103,15 +81,22 @@ def _fig1_negative_band(ax, lo_y: float, pad: float) -> None:
 def _fig1_mark(ax, mark_n_lab: float, y_text: float) -> None:
     """A vertical line at the user's n_lab, to read every method's n2D off the same abscissa."""
     check_range("mark_n_lab", mark_n_lab, 0.0, 1.0, hi_open=True)
-    ax.axvline(mark_n_lab, color="0.4", ls=":", lw=1.2)
-    ax.text(
-        mark_n_lab,
-        y_text,
-        f" n_lab = {mark_n_lab:g}",
-        color="0.3",
-        fontsize=9,
-        va="top",
-    )
+    _mark_line(ax, mark_n_lab, y_text, va="top")
+
+
+def _mark_line(ax, n_lab: float, y: float, **text) -> None:
+    """A dotted vertical line at the user's ``n_lab``, named at height ``y``."""
+    ax.axvline(n_lab, color="0.4", ls=":", lw=1.2)
+    ax.text(n_lab, y, f" n_lab = {n_lab:g}", color="0.3", fontsize=9, **text)
+
+
+def _finish(ax, title: str, **legend) -> None:
+    """The axes' labels (laboratory against 2D porosity), ``title``, grid and legend of both figures."""
+    ax.set_xlabel("laboratory porosity n_lab [-]")
+    ax.set_ylabel("2D porosity n2D [-]")
+    ax.set_title(title)
+    ax.grid(True, alpha=0.3)
+    ax.legend(**legend)
 
 
 def fig1_relations(
@@ -130,7 +115,7 @@ def fig1_relations(
     x = np.linspace(n_min, n_max, num)
     curves = _fig1_curves(x, n_max, n_min, nu_reading, lattice_exact)
 
-    fig, ax = _new_axes((10.5, 6.0))
+    fig, ax = new_figure(figsize=(10.5, 6.0), layout="constrained")
     lo_y = min(0.0, min(float(np.nanmin(y)) for _, _, y in curves))
     hi_y = max(float(np.nanmax(y)) for _, _, y in curves)
     pad = 0.04 * (hi_y - lo_y)
@@ -141,13 +126,10 @@ def fig1_relations(
         _fig1_mark(ax, mark_n_lab, hi_y + pad * 0.5)
     ax.set_xlim(n_min, n_max)
     ax.set_ylim(lo_y - pad, hi_y + pad)
-    ax.set_xlabel("laboratory porosity n_lab [-]")
-    ax.set_ylabel("2D porosity n2D [-]")
-    ax.set_title(
-        f"Fig. 1: 2D vs laboratory porosity, all methods\n(n_lab,max = {n_max:g}, n_lab,min = {n_min:g})"
+    title = f"Fig. 1: 2D vs laboratory porosity, all methods\n(n_lab,max = {n_max:g}, n_lab,min = {n_min:g})"
+    _finish(
+        ax, title, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=9, frameon=False, labelspacing=0.8
     )
-    ax.grid(True, alpha=0.3)
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=9, frameon=False, labelspacing=0.8)
     return fig
 
 
@@ -235,8 +217,7 @@ def _fig2_mark(ax, mark_n_lab: float, n_max: float, n_min: float, lattice_exact:
         fontsize=9,
         bbox=dict(boxstyle="round", fc="white", ec="0.6"),
     )
-    ax.axvline(mark_n_lab, color="0.4", ls=":", lw=1.2)
-    ax.text(mark_n_lab, 0.005, f" n_lab = {mark_n_lab:g}", color="0.3", fontsize=9)
+    _mark_line(ax, mark_n_lab, 0.005)
 
 
 def fig2_lim_parabola(
@@ -251,7 +232,7 @@ def fig2_lim_parabola(
     """Fig. 2: LIM_2D-Lab, LIM_2D-3D and the parabola of Eq. 12, with its three points."""
     _check_extremes(n_max, n_min)
     x = np.linspace(0.0, x_max, num)
-    fig, ax = _new_axes((9.5, 6.0))
+    fig, ax = new_figure(figsize=(9.5, 6.0), layout="constrained")
     lab, l3 = _fig2_lines(ax, x, n_max, n_min, lattice_exact)
     _fig2_construction_points(ax)
     if mark_n_lab is not None:
@@ -262,11 +243,7 @@ def fig2_lim_parabola(
     # The dashed extensions of the LIM lines run far below zero; keep the view on the
     # physical range and show only the start of the negative part.
     ax.set_ylim(max(-0.08, min(-0.02, float(y_all.min()) - 0.01)), float(y_all.max()) + 0.02)
-    ax.set_xlabel("laboratory porosity n_lab [-]")
-    ax.set_ylabel("2D porosity n2D [-]")
-    ax.set_title("Fig. 2: LIM 2D-Lab, LIM 2D-3D and the parabola of Eq. 12")
-    ax.grid(True, alpha=0.3)
-    ax.legend(loc="upper left", fontsize=9)
+    _finish(ax, "Fig. 2: LIM 2D-Lab, LIM 2D-3D and the parabola of Eq. 12", loc="upper left", fontsize=9)
     return fig
 
 

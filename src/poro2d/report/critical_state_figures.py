@@ -15,18 +15,14 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import matplotlib
 import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from poro2d.critical_state.case import CriticalStateCase  # noqa: E402
-from poro2d.critical_state.line import CriticalStateLineResult, pressure_folder  # noqa: E402
-from poro2d.critical_state.results import CriticalStateResult, CriticalStateTestResult  # noqa: E402
-from poro2d.report.figure_file import save_figure  # noqa: E402
-from poro2d.report.shear_figures import COLORS  # noqa: E402
-from poro2d.store import Store  # noqa: E402
+from poro2d.critical_state.case import CriticalStateCase
+from poro2d.critical_state.line import CriticalStateLineResult, pressure_folder
+from poro2d.critical_state.results import CriticalStateResult, CriticalStateTestResult
+from poro2d.report.figure_file import new_figure, save_figure
+from poro2d.report.shear_figures import COLORS
+from poro2d.store import Store
 
 #: the figure of a run or a study, and of a line
 FIGURE = "critical_state.png"
@@ -66,7 +62,7 @@ def plot_critical_state(
 ) -> Path:  # fmt: skip
     """The figure of ``series`` (label, series); ``window``: gamma where the steady window
     starts; ``steady``: (stress ratio, solid fraction) means to draw, or None."""
-    fig, (ax, bx) = plt.subplots(2, 1, figsize=(7.0, 6.5), sharex=True)
+    fig, (ax, bx) = new_figure(2, 1, figsize=(7.0, 6.5), sharex=True)
     for k, (label, s) in enumerate(series):
         col = COLORS[k % len(COLORS)]
         ax.plot(s.gamma, s.stress_ratio, color=col, lw=0.8, label=label)
@@ -91,7 +87,7 @@ def plot_critical_state_line(result: Any, path: str | os.PathLike) -> Path:
     log axis, every seed a dot, each pressure's mean with the seeds' sd, the fitted line, and the
     result's marks (2D states held against the line: a specimen's ends, a state as mapped) as
     horizontal lines, loose of the line above it; (b) tau / sigma_yy against p'."""
-    fig, (ax, bx) = plt.subplots(2, 1, figsize=(7.0, 7.0), sharex=True, height_ratios=(3, 2))
+    fig, (ax, bx) = new_figure(2, 1, figsize=(7.0, 7.0), sharex=True, height_ratios=(3, 2))
     for k, point in enumerate(result.points):
         p, e = point.mean_stress_kpa, point.void_ratio
         ax.plot(p.values, e.values, ".", color="0.6", ms=4, label="a seed" if k == 0 else None)

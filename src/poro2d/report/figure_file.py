@@ -1,9 +1,10 @@
-"""The one way a figure becomes a file: every figure of poro2d is saved by :func:`save_figure`.
+"""The one way a figure is made and becomes a file: every figure of poro2d is drawn on
+:func:`new_figure` and saved by :func:`save_figure`.
 
-One place decides the resolution (:data:`DPI`) and how a file appears: written to a
-temporary in the same folder and renamed onto its name, so that a reader (or a resumed
-run) never finds half a picture. The drawing functions lay their figure out themselves
-(constrained or tight); saving changes nothing in the drawing.
+A figure has its own Agg canvas (no pyplot state, no display). One place decides the resolution
+(:data:`DPI`) and how a file appears: written to a temporary in the same folder and renamed onto
+its name, so that a reader (or a resumed run) never finds half a picture. The drawing functions
+lay their figure out themselves (constrained or tight); saving changes nothing in the drawing.
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import os
 import sys
 from pathlib import Path
 
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from poro2d.io_utils import atomic_path
@@ -34,6 +36,15 @@ def save_figure(fig: Figure, path: str | os.PathLike, *more: str | os.PathLike) 
     return Path(path)
 
 
+def new_figure(*grid: int, figsize=None, layout=None, dpi=None, **axes):
+    """A figure on its own Agg canvas and its axes (:meth:`~matplotlib.figure.Figure.subplots` of
+    ``grid`` and ``axes``, as ``pyplot.subplots`` makes them): no pyplot state is touched, no display
+    is needed, and the figure is freed with its last reference."""
+    fig = Figure(figsize=figsize, layout=layout, dpi=dpi)
+    FigureCanvasAgg(fig)
+    return fig, fig.subplots(*grid, **axes)
+
+
 def _close(fig: Figure) -> None:
     """Let pyplot forget ``fig``, if pyplot made it: a figure drawn on its own canvas is
     freed with its last reference, and pyplot is not imported for it."""
@@ -42,4 +53,4 @@ def _close(fig: Figure) -> None:
         pyplot.close(fig)
 
 
-__all__ = ["DPI", "save_figure"]
+__all__ = ["DPI", "new_figure", "save_figure"]

@@ -11,18 +11,14 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib.collections import LineCollection, PatchCollection
+from matplotlib.lines import Line2D
+from matplotlib.patches import Circle
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.collections import LineCollection, PatchCollection  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.patches import Circle  # noqa: E402
-
-from poro2d.dem.contacts import ContactSet  # noqa: E402
-from poro2d.errors import InputError, check_range  # noqa: E402
-from poro2d.report.figure_file import save_figure  # noqa: E402
+from poro2d.dem.contacts import ContactSet
+from poro2d.errors import InputError, check_range
+from poro2d.report.figure_file import new_figure, save_figure
 
 FORCE_COLOR = "#b2182b"
 WALL_COLOR = "#333333"
@@ -118,7 +114,7 @@ def plot_force_chains(
     else:
         x0, y0, x1, y1 = box
     fig_w = 9.0
-    fig, ax = plt.subplots(figsize=(fig_w, fig_w * (y1 - y0) / (x1 - x0) + 1.6))
+    fig, ax = new_figure(figsize=(fig_w, fig_w * (y1 - y0) / (x1 - x0) + 1.6))
     if show_disks:
         disks = PatchCollection(
             [Circle(xy, r) for xy, r in zip(pos, radius, strict=True)],

@@ -14,18 +14,12 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+from matplotlib.ticker import FuncFormatter
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-from matplotlib.ticker import FuncFormatter  # noqa: E402
-
-from poro2d.grading import GradingCurve, realised_curve  # noqa: E402
-from poro2d.report.figure_file import DPI, save_figure  # noqa: E402
-from poro2d.store import Store  # noqa: E402
+from poro2d.grading import GradingCurve, realised_curve
+from poro2d.report.figure_file import DPI, new_figure, save_figure
+from poro2d.store import Store
 
 
 def draw_grading(result, case, store: Store) -> Path:
@@ -71,7 +65,7 @@ def grading_figure(
     """Write the grading figure (module docstring) to ``path``; returns the path."""
     whole = uncut_curve(table, base_dir, used)
     up = used.upscale
-    fig, ax = plt.subplots(figsize=(7.0, 4.4))
+    fig, ax = new_figure(figsize=(7.0, 4.4))
     ax.semilogx(
         whole.sizes * 1e3 / up, whole.percent, "-o", color="0.55", ms=4, label="laboratory curve (mass)"
     )
@@ -111,9 +105,7 @@ def plot_realised(curve: GradingCurve, radii, path: str | os.PathLike, *, title:
     dev = float(np.max(np.abs(realised - curve.percent)))
     d_mm = curve.sizes * 1e3
 
-    fig = Figure(figsize=(6.4, 4.2), dpi=DPI)
-    FigureCanvasAgg(fig)
-    ax = fig.add_subplot(1, 1, 1)
+    fig, ax = new_figure(figsize=(6.4, 4.2), dpi=DPI)
     ax.semilogx(d_mm, curve.percent, "-o", color="k", ms=4, label="requested (by mass)")
     ax.semilogx(d_mm, realised, "s", color="tab:red", mfc="none", ms=7, label="realised (by area)")
     ax.set_xlabel("diameter in the model d [mm]")

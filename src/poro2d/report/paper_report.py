@@ -186,31 +186,38 @@ CRITERION_CAPTIONS = {
 }
 
 
+#: the rows of the trials' table: a label and the key of a trial's row (None: a trial without it)
+TRIAL_ROWS = (
+    ("trial n2D", "trial_porosity"),
+    ("disks", "particle_count"),
+    ("F_top at H (N/m)", "f_top_n_per_m"),
+    ("F_bottom at H (N/m)", "f_bottom_n_per_m"),
+    ("G = rho_s (1-n) W H g (N/m)", "self_weight_n_per_m"),
+    ("top plate moved", "plate_moved"),
+    ("plate displacement (mm)", "plate_displacement_mm"),
+    ("F_top after (N/m)", "f_top_after_n_per_m"),
+    ("F_bottom after (N/m)", "f_bottom_after_n_per_m"),
+    ("n'", "new_porosity"),
+    ("|n' - n2D|", "porosity_change"),
+    ("interior porosity", "interior_porosity"),
+    ("mean gap under the plate (d50)", "surface_gap_mean_d50"),
+    ("accepted", "accepted"),
+)
+
+
+def _shown(trial: dict) -> dict:
+    """A trial's row as its table shows it: the plate's displacement in mm, the verdict in words."""
+    accepted = "yes" if trial["accepted"] else "no"
+    return dict(trial, plate_displacement_mm=1e3 * trial["plate_displacement_m"], accepted=accepted)
+
+
 def _criterion_blocks(criterion, pc) -> list[Block]:
     """poro2d's trials beside the paper's, the discussion, Figs. 5-7 and the specimen's state."""
     b: list[Block] = [("h2", "The criterion (Fig. 3)")]
     its = [r.to_dict() for r in criterion.result.iterations or []]  # each trial's row
     if its:
-        b.append((
-            "table",
-            ["", *[f"trial {r['iteration']}" for r in its]],
-            [
-                ["trial n2D", *[r["trial_porosity"] for r in its]],
-                ["disks", *[r["particle_count"] for r in its]],
-                ["F_top at H (N/m)", *[r["f_top_n_per_m"] for r in its]],
-                ["F_bottom at H (N/m)", *[r["f_bottom_n_per_m"] for r in its]],
-                ["G = rho_s (1-n) W H g (N/m)", *[r["self_weight_n_per_m"] for r in its]],
-                ["top plate moved", *[r["plate_moved"] for r in its]],
-                ["plate displacement (mm)", *[1e3 * r["plate_displacement_m"] for r in its]],
-                ["F_top after (N/m)", *[r.get("f_top_after_n_per_m") for r in its]],
-                ["F_bottom after (N/m)", *[r.get("f_bottom_after_n_per_m") for r in its]],
-                ["n'", *[r["new_porosity"] for r in its]],
-                ["|n' - n2D|", *[r["porosity_change"] for r in its]],
-                ["interior porosity", *[r.get("interior_porosity") for r in its]],
-                ["mean gap under the plate (d50)", *[r.get("surface_gap_mean_d50") for r in its]],
-                ["accepted", *["yes" if r["accepted"] else "no" for r in its]],
-            ],
-        ))  # fmt: skip
+        rows = [[label, *[_shown(r).get(key) for r in its]] for label, key in TRIAL_ROWS]
+        b.append(("table", ["", *[f"trial {r['iteration']}" for r in its]], rows))
         b.append(("p", "The paper's run, for comparison:"))
         b.append((
             "table",
@@ -324,6 +331,14 @@ def k0_note(k0: float) -> str:
     )
 
 
+#: what the box and the interior porosity each say
+POROSITY_NOTE = (
+    "The paper's n' counts the gap between the plate and the rough surface of the specimen; the "
+    "interior porosity is the packing's own and does not depend on the box's size. To build this "
+    "specimen in another code, take the interior porosity (docs/porosity.md)."
+)
+
+
 def _porosity_blocks(criterion) -> list[Block]:
     """Box against interior porosity of the accepted specimen, the plate's surface, the local map."""
     m = criterion.porosity
@@ -343,22 +358,10 @@ def _porosity_blocks(criterion) -> list[Block]:
         ["plate width in contact", contact],
     ]  # fmt: skip
     b.append(("table", ["measure", "value"], rows))
-    b.append(
-        (
-            "p",
-            "The paper's n' counts the gap between the plate and the rough surface of the specimen; the "
-            "interior porosity is the packing's own and does not depend on the box's size. To build this "
-            "specimen in another code, take the interior porosity (docs/porosity.md).",
-        )
-    )
+    b.append(("p", POROSITY_NOTE))
     if "local_porosity.png" in criterion.figures:
-        b.append(
-            (
-                "img",
-                criterion.figures["local_porosity.png"],
-                "Local porosity of the accepted specimen (Laguerre cells)",
-            )
-        )
+        cap = "Local porosity of the accepted specimen (Laguerre cells)"
+        b.append(("img", criterion.figures["local_porosity.png"], cap))
     return b
 
 

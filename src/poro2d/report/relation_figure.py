@@ -13,11 +13,10 @@ import math
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from poro2d import porosity as P
-from poro2d.report.figure_file import save_figure
+from poro2d.report.figure_file import new_figure, save_figure
 from poro2d.store import Store
 from poro2d.sweep.results import RelationResult
 
@@ -44,9 +43,7 @@ def plot_relation(rel, title: str = "") -> Figure:
     xs = [p.n_lab for p in pts] + [hi, lo]
     pad = 0.08 * (max(xs) - min(xs))
     x = np.linspace(min(xs) - pad, max(xs) + pad, 201)
-    fig = Figure(figsize=(9.5, 6.0), layout="constrained")
-    FigureCanvasAgg(fig)
-    ax = fig.add_subplot()
+    fig, ax = new_figure(figsize=(9.5, 6.0), layout="constrained")
     ax.axvspan(lo, hi, color="0.5", alpha=0.07, lw=0)
     _method_curves(ax, x, hi, lo, rel.fit)
     _dem_points(ax, rel)
@@ -76,20 +73,14 @@ def _finite(v) -> bool:
 
 def _method_curves(ax, x: np.ndarray, hi: float, lo: float, fit) -> None:
     """Eq. 12 and the other conversion methods over ``x``, and the parabola fitted to the DEM."""
-    styles = {
-        "parabolic": ("Parabola, Eq. 12 (0.42 n^2 + 0.25 n)", dict(color="black", lw=2.0)),
-        "lim_3d": ("LIM 2D-3D (Sec. 2.2)", dict(color="tab:brown", lw=1.4)),
-        "lim_lab": ("LIM 2D-Lab (Eqs. 6-7)", dict(color="tab:green", lw=1.4)),
-        "densest_state": ("Densest State (Eq. 1)", dict(color="tab:blue", lw=1.2, ls="--")),
-    }
-    funcs = {
-        "parabolic": lambda v: P.parabolic(v),
-        "lim_3d": lambda v: P.lim_3d(v),
-        "lim_lab": lambda v: P.lim_lab(v, hi, lo),
-        "densest_state": lambda v: P.densest_state(v),
-    }
-    for m, (label, st) in styles.items():
-        ax.plot(x, funcs[m](x), label=label, **st)
+    curves = (  # label, n2D of nLab, style
+        ("Parabola, Eq. 12 (0.42 n^2 + 0.25 n)", P.parabolic, dict(color="black", lw=2.0)),
+        ("LIM 2D-3D (Sec. 2.2)", P.lim_3d, dict(color="tab:brown", lw=1.4)),
+        ("LIM 2D-Lab (Eqs. 6-7)", lambda v: P.lim_lab(v, hi, lo), dict(color="tab:green", lw=1.4)),
+        ("Densest State (Eq. 1)", P.densest_state, dict(color="tab:blue", lw=1.2, ls="--")),
+    )
+    for label, n2d, style in curves:
+        ax.plot(x, n2d(x), label=label, **style)
     if fit is not None:
         label = f"fit to DEM: {fit.a:.3f} n^2 + {fit.b:.3f} n (rms {fit.rms_residual:.4f})"
         ax.plot(x, fit.a * x * x + fit.b * x, color="tab:red", lw=2.0, ls="-.", label=label)

@@ -26,17 +26,12 @@ def _ok(p: dict) -> bool:
 
 def plot_sensitivity(sens: dict, stem: Path) -> list[Path]:
     """Two panels, written as ``stem.png`` and ``stem.svg``: n2D against Cu and against mu_prep."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    from poro2d.report.figure_file import save_figure
+    from poro2d.report.figure_file import new_figure, save_figure
 
     sens = as_json(sens)  # the dict of sensitivity.json
     paper = sens["paper"]
     target, tol = float(paper["accepted_porosity"]), float(sens["answer"]["tolerance"])
-    fig = Figure(figsize=(12.0, 5.2), layout="constrained")
-    FigureCanvasAgg(fig)
-    ax1, ax2 = fig.subplots(1, 2, sharey=True)
+    fig, (ax1, ax2) = new_figure(1, 2, sharey=True, figsize=(12.0, 5.2), layout="constrained")
     for ax in (ax1, ax2):
         ax.axhspan(target - tol, target + tol, color="tab:green", alpha=0.12, lw=0)
         ax.axhline(target, color="tab:green", lw=1.5, label=f"paper: accepted n2D = {target:g} (+- {tol:g})")

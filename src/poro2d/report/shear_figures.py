@@ -14,21 +14,17 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from poro2d.report.figure_file import save_figure  # noqa: E402
-from poro2d.report.force_chains import plot_force_chains  # noqa: E402
-from poro2d.shear.fit import mohr_coulomb  # noqa: E402
-from poro2d.shear.lab import LabData  # noqa: E402
-from poro2d.shear.outputs import lab_fit  # noqa: E402
-from poro2d.shear.peak_frame import PeakFrame  # noqa: E402
-from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult, ShearTestResult  # noqa: E402
-from poro2d.shear.shear_stage import PEAK_FRAME  # noqa: E402
-from poro2d.store import Store  # noqa: E402
+from poro2d.report.figure_file import new_figure, save_figure
+from poro2d.report.force_chains import plot_force_chains
+from poro2d.shear.fit import mohr_coulomb
+from poro2d.shear.lab import LabData
+from poro2d.shear.outputs import lab_fit
+from poro2d.shear.peak_frame import PeakFrame
+from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult, ShearTestResult
+from poro2d.shear.shear_stage import PEAK_FRAME
+from poro2d.store import Store
 
 #: the colours of the normal stresses (or series), in turn
 COLORS = ["#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#666666"]
@@ -97,7 +93,7 @@ def plot_shear_curves(
     and optionally ``plate_displacement_mm``; ``peaks[sigma] = (d_m, tau_kpa)`` are marked;
     ``lab`` is a :class:`poro2d.shear.lab.LabData`."""
     dil = any("plate_displacement_mm" in c for c in curves.values())
-    fig, axes = plt.subplots(
+    fig, axes = new_figure(
         2 if dil else 1, 1, figsize=(7.5, 7.0 if dil else 4.8), sharex=True,
         gridspec_kw={"height_ratios": [2.2, 1]} if dil else None, squeeze=False,
     )  # fmt: skip
@@ -153,7 +149,7 @@ def plot_peak_strength(
     optionally the line through the origin and the laboratory points with their line."""
     s = np.asarray(sigma_kpa, float)
     t = np.asarray(peak_kpa, float)
-    fig, ax = plt.subplots(figsize=(6.5, 5.0))
+    fig, ax = new_figure(figsize=(6.5, 5.0))
     smax = float(max(s.max(), max(lab.peaks) if lab is not None else 0.0)) * 1.1
     xs = np.linspace(0.0, smax, 50)
     ax.plot(s, t, "o", color="#d95f02", ms=7, mec="k", label="DEM peaks", zorder=5)
@@ -211,7 +207,7 @@ def plot_replicate_curves(
     bands: dict[float, CurveBand], path: str | os.PathLike, n_specimens: int, lab=None
 ) -> Path:
     """Fig. 8(a) over specimens: the mean curve per normal stress with a +- sd band."""
-    fig, ax = plt.subplots(figsize=(7.5, 4.8))
+    fig, ax = new_figure(figsize=(7.5, 4.8))
     for k, sigma in enumerate(sorted(bands)):
         b, col = bands[sigma], COLORS[k % len(COLORS)]
         x = b.shear_displacement_mm
@@ -237,7 +233,7 @@ def plot_replicate_peaks(summary, path: str | os.PathLike, lab=None, lab_fit=Non
     """Fig. 8(b) over specimens: peaks mean +- sd, every specimen's peaks, the pooled fit."""
     rows = summary.per_normal_stress
     s = np.array([r.normal_stress_kpa for r in rows])
-    fig, ax = plt.subplots(figsize=(6.5, 5.0))
+    fig, ax = new_figure(figsize=(6.5, 5.0))
     smax = float(max(s.max(), max(lab.peaks) if lab is not None else 0.0)) * 1.1
     xs = np.linspace(0.0, smax, 50)
     for r in rows:

@@ -22,7 +22,7 @@ from poro2d.errors import InputError
 from poro2d.measure.laguerre import LaguerreCells
 from poro2d.measure.specimen_porosity import PorosityDetails, SpecimenPorosity
 from poro2d.measure.specimen_state import SpecimenStateResult
-from poro2d.report.figure_file import save_figure
+from poro2d.report.figure_file import new_figure, save_figure
 
 #: the local porosity figure writes each circle's value when there are at most this many circles
 MAX_LABELLED_CIRCLES = 60
@@ -35,9 +35,7 @@ def plot_specimen_state(state: SpecimenStateResult, path: str | os.PathLike, tit
     """
     rows = state.bands
     z = np.array([r.z_mid_m for r in rows]) * 1e3
-    fig = Figure(figsize=(9.0, 4.8), layout="constrained")
-    FigureCanvasAgg(fig)
-    a1, a2 = fig.subplots(1, 2, sharey=True)
+    fig, (a1, a2) = new_figure(1, 2, sharey=True, figsize=(9.0, 4.8), layout="constrained")
     a1.plot([r.porosity for r in rows], z, "o-", color="tab:blue")
     a1.axvline(state.porosity_mean, color="0.5", ls=":", lw=1)
     a1.set_xlabel("porosity of the band [-]")

@@ -10,13 +10,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from poro2d.report.figure_file import save_figure  # noqa: E402
-from poro2d.report.shear_figures import COLORS  # noqa: E402
+from poro2d.report.figure_file import new_figure, save_figure
+from poro2d.report.shear_figures import COLORS
 
 
 def _series(rows: list, friction: float, key: str) -> tuple[list, list, list]:
@@ -38,7 +33,7 @@ def draw_strength(result, store) -> Path:
 def plot_strength(rows: list, path: str | os.PathLike) -> Path:
     """Peak and residual friction angles (left) and max dilation angle (right) against mu_r."""
     frictions = sorted({r.particle_friction for r in rows})
-    fig, (ax_phi, ax_psi) = plt.subplots(1, 2, figsize=(10, 4.2))
+    fig, (ax_phi, ax_psi) = new_figure(1, 2, figsize=(10, 4.2))
     for k, fp in enumerate(frictions):
         color = COLORS[k % len(COLORS)]
         x, y, e = _series(rows, fp, "peak_friction_angle")
