@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from poro2d import porosity as P
+from poro2d.cli import options as opt
 from poro2d.cli.convert import NuReading, OneLineUsageCommand
 from poro2d.errors import InputError, check_range
 
@@ -24,12 +25,9 @@ def plot_relations(
         typer.Option("--mark-n-lab", help="Mark one laboratory porosity on both figures (e.g. 0.3434)."),
     ] = None,
     nu_reading: Annotated[
-        NuReading,
-        typer.Option("--nu-reading", help="Reading of nu in Eq. 2 for the main Eq. 2 curve."),
+        NuReading, opt.nu_reading(help="Reading of nu in Eq. 2 for the main Eq. 2 curve.")
     ] = NuReading.printed,
-    lattice_exact: Annotated[
-        bool, typer.Option("--lattice-exact", help="Exact lattice 2D extremes in Eqs. 7-11.")
-    ] = False,
+    lattice_exact: Annotated[bool, opt.lattice_exact(help="Exact lattice 2D extremes in Eqs. 7-11.")] = False,
 ) -> None:
     """Write the paper's Fig. 1 and Fig. 2 (PNG and SVG) into DIR."""
     if ctx.args:
