@@ -421,93 +421,38 @@ def _exact(o: dict) -> bool:
     return bool(o.get("lattice_exact", False))
 
 
-#: All methods, in the paper's order (section 2.1, then LIM_2D-3D, then Eq. 12).
-METHODS: dict[str, Method] = {
-    m.id: m
-    for m in (
-        Method(
-            "densest_state",
-            "Densest State",
-            "Eq. 1",
-            "Hoomans et al. 1996",
-            (),
-            False,
-            lambda n, hi, lo, o: densest_state(n),
-        ),
-        Method(
-            "densest_state_modified",
-            "Densest State (modified)",
-            "Eq. 2",
-            "van Wachem et al. 2001",
-            ("n_min",),
-            False,
-            lambda n, hi, lo, o: densest_state_modified(n, lo, o.get("nu_reading", "printed")),
-        ),
-        Method(
-            "loosest_state",
-            "Loosest State",
-            "Eq. 3",
-            "Helland et al. 2005",
-            (),
-            False,
-            lambda n, hi, lo, o: loosest_state(n),
-        ),
-        Method(
-            "interval_mapping",
-            "Interval Mapping",
-            "Eq. 4",
-            "Ouyang and Li 1999",
-            (),
-            False,
-            lambda n, hi, lo, o: interval_mapping(n),
-        ),
-        Method(
-            "combination",
-            "Combination",
-            "Eq. 5",
-            "Zhang 2007",
-            ("n_max", "n_min"),
-            True,
-            lambda n, hi, lo, o: combination(n, hi, lo),
-        ),
-        Method(
-            "lim_lab",
-            "LIM 2D-Lab",
-            "Eqs. 6-7",
-            "Giese 2002; Hainbuechner et al. 2002",
-            ("n_max", "n_min"),
-            True,
-            lambda n, hi, lo, o: lim_lab(n, hi, lo, lattice_exact=_exact(o)),
-        ),
-        Method(
-            "lim_3d",
-            "LIM 2D-3D",
-            "Sec. 2.2",
-            "Wang, Jacobs and Ziegler (Fig. 2)",
-            (),
-            False,
-            lambda n, hi, lo, o: lim_3d(n),
-        ),
-        Method(
-            "quasi_3d",
-            "Quasi 3D Porosity",
-            "Eqs. 8-11",
-            "Bezuijen and van den Berg 2002",
-            ("n_max", "n_min"),
-            True,
-            lambda n, hi, lo, o: quasi_3d(n, hi, lo, lattice_exact=_exact(o)),
-        ),
-        Method(
-            "parabolic",
-            "Parabola",
-            "Eq. 12",
-            "Wang, Jacobs and Ziegler",
-            (),
-            False,
-            lambda n, hi, lo, o: parabolic(n),
-        ),
-    )
+def _nu_reading(o: dict) -> str:
+    return o.get("nu_reading", "printed")
+
+
+#: Each method's id, name, equation, source, the extremes it needs and whether it interpolates,
+#: in the paper's order (section 2.1, then LIM_2D-3D, then Eq. 12).
+_BOTH, _MIN = ("n_max", "n_min"), ("n_min",)
+_METHOD_ROWS = (
+    ("densest_state", "Densest State", "Eq. 1", "Hoomans et al. 1996", (), False),
+    ("densest_state_modified", "Densest State (modified)", "Eq. 2", "van Wachem et al. 2001", _MIN, False),
+    ("loosest_state", "Loosest State", "Eq. 3", "Helland et al. 2005", (), False),
+    ("interval_mapping", "Interval Mapping", "Eq. 4", "Ouyang and Li 1999", (), False),
+    ("combination", "Combination", "Eq. 5", "Zhang 2007", _BOTH, True),
+    ("lim_lab", "LIM 2D-Lab", "Eqs. 6-7", "Giese 2002; Hainbuechner et al. 2002", _BOTH, True),
+    ("lim_3d", "LIM 2D-3D", "Sec. 2.2", "Wang, Jacobs and Ziegler (Fig. 2)", (), False),
+    ("quasi_3d", "Quasi 3D Porosity", "Eqs. 8-11", "Bezuijen and van den Berg 2002", _BOTH, True),
+    ("parabolic", "Parabola", "Eq. 12", "Wang, Jacobs and Ziegler", (), False),
+)
+#: each method's evaluation ``func(n_lab, n_max, n_min, options)``, by id
+_METHOD_FUNCS: dict[str, Callable[[ArrayLike, Any, Any, dict], ArrayLike]] = {
+    "densest_state": lambda n, hi, lo, o: densest_state(n),
+    "densest_state_modified": lambda n, hi, lo, o: densest_state_modified(n, lo, _nu_reading(o)),
+    "loosest_state": lambda n, hi, lo, o: loosest_state(n),
+    "interval_mapping": lambda n, hi, lo, o: interval_mapping(n),
+    "combination": lambda n, hi, lo, o: combination(n, hi, lo),
+    "lim_lab": lambda n, hi, lo, o: lim_lab(n, hi, lo, lattice_exact=_exact(o)),
+    "lim_3d": lambda n, hi, lo, o: lim_3d(n),
+    "quasi_3d": lambda n, hi, lo, o: quasi_3d(n, hi, lo, lattice_exact=_exact(o)),
+    "parabolic": lambda n, hi, lo, o: parabolic(n),
 }
+#: All methods, in the paper's order (section 2.1, then LIM_2D-3D, then Eq. 12).
+METHODS: dict[str, Method] = {row[0]: Method(*row, func=_METHOD_FUNCS[row[0]]) for row in _METHOD_ROWS}
 
 
 @dataclass
