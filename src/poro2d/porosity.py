@@ -304,7 +304,7 @@ def degree_of_density(n_lab: ArrayLike, n_max: float, n_min: float) -> ArrayLike
     return _out((hi - n) / (hi - lo), n_lab)
 
 
-def lim_lab(
+def _degree_and_2d_extremes(
     n_lab: ArrayLike,
     n_max: float,
     n_min: float,
@@ -312,18 +312,24 @@ def lim_lab(
     lattice_exact: bool = False,
     n2d_max: float | None = None,
     n2d_min: float | None = None,
-) -> ArrayLike:
+) -> tuple[np.ndarray, float, float]:
+    """D of Eq. (6) and the 2D extremes (n2D,max, n2D,min) that Eqs. (7)-(11) interpolate between:
+    the printed ones, the lattice values with ``lattice_exact``, or ``n2d_max``/``n2d_min``."""
+    d = np.asarray(degree_of_density(n_lab, n_max, n_min))
+    return d, *_n2d_extremes(n2d_max, n2d_min, lattice_exact)
+
+
+def lim_lab(n_lab: ArrayLike, n_max: float, n_min: float, **extremes_2d: Any) -> ArrayLike:
     """Linear Interpolation Method LIM_2D-Lab, Eqs. (6)-(7) (Giese 2002; Hainbuechner et al. 2002).
 
     n2D = n2D,max - D (n2D,max - n2D,min),  D = (n_lab,max - n_lab) / (n_lab,max - n_lab,min)
 
-    Same degree of density in 2D and in the laboratory. The 2D extremes default to the
-    printed values 0.2146 and 0.0931; ``lattice_exact=True`` uses 1 - pi/4 and
+    Same degree of density in 2D and in the laboratory. The 2D extremes (keywords) default to
+    the printed values 0.2146 and 0.0931; ``lattice_exact=True`` uses 1 - pi/4 and
     1 - pi/(2 sqrt 3) (they differ from the printed ones by less than 5e-6), explicit
     ``n2d_max``/``n2d_min`` override both. The paper's sand gives 0.11 at n_lab = 0.3434.
     """
-    d = np.asarray(degree_of_density(n_lab, n_max, n_min))
-    hi2, lo2 = _n2d_extremes(n2d_max, n2d_min, lattice_exact)
+    d, hi2, lo2 = _degree_and_2d_extremes(n_lab, n_max, n_min, **extremes_2d)
     return _out(hi2 - d * (hi2 - lo2), n_lab)
 
 
@@ -348,15 +354,7 @@ def quasi_3d_extremes(n2d_max: float, n2d_min: float) -> tuple[float, float]:
     return 1.0 / 3.0 + 2.0 / 3.0 * n2d_max, 1.0 / 3.0 + 2.0 / 3.0 * n2d_min
 
 
-def quasi_3d(
-    n_lab: ArrayLike,
-    n_max: float,
-    n_min: float,
-    *,
-    lattice_exact: bool = False,
-    n2d_max: float | None = None,
-    n2d_min: float | None = None,
-) -> ArrayLike:
+def quasi_3d(n_lab: ArrayLike, n_max: float, n_min: float, **extremes_2d: Any) -> ArrayLike:
     """Quasi 3D Porosity Method, Eqs. (8)-(11) (Bezuijen and van den Berg 2002).
 
     n'3D,max = 1/3 + 2/3 n2D,max                                   (8)
@@ -369,8 +367,7 @@ def quasi_3d(
     extremes the result equals LIM_2D-Lab (Eq. 7) identically; this function evaluates the
     four equations as printed. The 2D extremes are chosen as in :func:`lim_lab`.
     """
-    d = np.asarray(degree_of_density(n_lab, n_max, n_min))
-    hi2, lo2 = _n2d_extremes(n2d_max, n2d_min, lattice_exact)
+    d, hi2, lo2 = _degree_and_2d_extremes(n_lab, n_max, n_min, **extremes_2d)
     q_max, q_min = quasi_3d_extremes(hi2, lo2)
     q = q_max - d * (q_max - q_min)
     return _out(1.5 * q - 0.5, n_lab)
