@@ -71,6 +71,8 @@ def job_options(
 
         check_reachable(scheduler)
     return options
+
+
 # the porosity conversions' options (convert, plot relations), each with the command's own help
 nu_reading = partial(typer.Option, "--nu-reading")
 lattice_exact = partial(typer.Option, "--lattice-exact")
