@@ -39,7 +39,7 @@ from poro2d.shear.parts import LabComparison
 from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult, ShearTestResult
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.sweep.results import DensityStateResult, RelationResult, SensitivityResult
-from poro2d.typed_result import TypedResult
+from poro2d.typed_result import NOT_IN_FILE, TypedResult, with_fields
 
 DATA = Path(__file__).parent / "data" / "before_typed_results"
 FILES = [
@@ -223,6 +223,36 @@ def test_fields_not_in_the_file_stay_out_of_it(tmp_path):
     reps.store = Store(tmp_path / "reps")
     assert reps.to_dict() == {"rows": rows} and reps.rows[1].converged is False
     assert reps.specimens == SpecimenSet.made([("seed1", tmp_path / "reps" / "seed1" / "specimen.npz")])
+
+
+@dataclasses.dataclass
+class _Tail:
+    """A group of fields several results share (typed_result.with_fields)."""
+
+    processes: int
+    config: dict
+    note: str | None = None
+    hidden: list = dataclasses.field(default_factory=list, metadata=NOT_IN_FILE)
+
+
+@dataclasses.dataclass(eq=False)
+@with_fields(_Tail, after="replicates")
+class _GroupedResult(TypedResult):
+    replicates: int
+    label: str = "x"
+
+
+def test_a_group_of_fields_stands_where_it_is_put():
+    names = [f.name for f in dataclasses.fields(_GroupedResult) if f.name != "extra"]
+    assert names == ["replicates", "processes", "config", "note", "hidden", "label"]
+    r = _GroupedResult(replicates=2, processes=1, config={"a": 1})
+    # hidden: not in the file
+    assert list(r.to_dict()) == ["replicates", "processes", "config", "note", "label"]
+    assert r.hidden == [] and r.hidden is not _GroupedResult(replicates=2, processes=1, config={}).hidden
+    assert _GroupedResult.from_dict(r.to_dict()) == r
+    assert typing.get_type_hints(_GroupedResult)["note"] == str | None
+    # the group itself is left as it was
+    assert [f.name for f in dataclasses.fields(_Tail)] == ["processes", "config", "note", "hidden"]
 
 
 def _public_runs():

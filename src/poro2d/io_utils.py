@@ -195,12 +195,8 @@ def write_json(path: str | os.PathLike, data: Mapping, *, config: bool = False) 
 def write_csv(path: str | os.PathLike, rows: Iterable[Mapping], header: list[str] | None = None) -> None:
     # a typed result or record is written as the dict of its file
     rows = [r.to_dict() if not isinstance(r, dict) and hasattr(r, "to_dict") else r for r in rows]
-    if header is None:
-        header = []
-        for r in rows:
-            for k in r:
-                if k not in header:
-                    header.append(k)
+    if header is None:  # every row's keys, in the order they first appear
+        header = list(dict.fromkeys(k for r in rows for k in r))
     with atomic_path(path) as tmp, open(tmp, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=header, extrasaction="ignore")
         w.writeheader()

@@ -304,7 +304,7 @@ def degree_of_density(n_lab: ArrayLike, n_max: float, n_min: float) -> ArrayLike
     return _out((hi - n) / (hi - lo), n_lab)
 
 
-def lim_lab(
+def _degree_and_2d_extremes(
     n_lab: ArrayLike,
     n_max: float,
     n_min: float,
@@ -312,18 +312,24 @@ def lim_lab(
     lattice_exact: bool = False,
     n2d_max: float | None = None,
     n2d_min: float | None = None,
-) -> ArrayLike:
+) -> tuple[np.ndarray, float, float]:
+    """D of Eq. (6) and the 2D extremes (n2D,max, n2D,min) that Eqs. (7)-(11) interpolate between:
+    the printed ones, the lattice values with ``lattice_exact``, or ``n2d_max``/``n2d_min``."""
+    d = np.asarray(degree_of_density(n_lab, n_max, n_min))
+    return d, *_n2d_extremes(n2d_max, n2d_min, lattice_exact)
+
+
+def lim_lab(n_lab: ArrayLike, n_max: float, n_min: float, **extremes_2d: Any) -> ArrayLike:
     """Linear Interpolation Method LIM_2D-Lab, Eqs. (6)-(7) (Giese 2002; Hainbuechner et al. 2002).
 
     n2D = n2D,max - D (n2D,max - n2D,min),  D = (n_lab,max - n_lab) / (n_lab,max - n_lab,min)
 
-    Same degree of density in 2D and in the laboratory. The 2D extremes default to the
-    printed values 0.2146 and 0.0931; ``lattice_exact=True`` uses 1 - pi/4 and
+    Same degree of density in 2D and in the laboratory. The 2D extremes (keywords) default to
+    the printed values 0.2146 and 0.0931; ``lattice_exact=True`` uses 1 - pi/4 and
     1 - pi/(2 sqrt 3) (they differ from the printed ones by less than 5e-6), explicit
     ``n2d_max``/``n2d_min`` override both. The paper's sand gives 0.11 at n_lab = 0.3434.
     """
-    d = np.asarray(degree_of_density(n_lab, n_max, n_min))
-    hi2, lo2 = _n2d_extremes(n2d_max, n2d_min, lattice_exact)
+    d, hi2, lo2 = _degree_and_2d_extremes(n_lab, n_max, n_min, **extremes_2d)
     return _out(hi2 - d * (hi2 - lo2), n_lab)
 
 
@@ -348,15 +354,7 @@ def quasi_3d_extremes(n2d_max: float, n2d_min: float) -> tuple[float, float]:
     return 1.0 / 3.0 + 2.0 / 3.0 * n2d_max, 1.0 / 3.0 + 2.0 / 3.0 * n2d_min
 
 
-def quasi_3d(
-    n_lab: ArrayLike,
-    n_max: float,
-    n_min: float,
-    *,
-    lattice_exact: bool = False,
-    n2d_max: float | None = None,
-    n2d_min: float | None = None,
-) -> ArrayLike:
+def quasi_3d(n_lab: ArrayLike, n_max: float, n_min: float, **extremes_2d: Any) -> ArrayLike:
     """Quasi 3D Porosity Method, Eqs. (8)-(11) (Bezuijen and van den Berg 2002).
 
     n'3D,max = 1/3 + 2/3 n2D,max                                   (8)
@@ -369,8 +367,7 @@ def quasi_3d(
     extremes the result equals LIM_2D-Lab (Eq. 7) identically; this function evaluates the
     four equations as printed. The 2D extremes are chosen as in :func:`lim_lab`.
     """
-    d = np.asarray(degree_of_density(n_lab, n_max, n_min))
-    hi2, lo2 = _n2d_extremes(n2d_max, n2d_min, lattice_exact)
+    d, hi2, lo2 = _degree_and_2d_extremes(n_lab, n_max, n_min, **extremes_2d)
     q_max, q_min = quasi_3d_extremes(hi2, lo2)
     q = q_max - d * (q_max - q_min)
     return _out(1.5 * q - 0.5, n_lab)
@@ -421,93 +418,38 @@ def _exact(o: dict) -> bool:
     return bool(o.get("lattice_exact", False))
 
 
-#: All methods, in the paper's order (section 2.1, then LIM_2D-3D, then Eq. 12).
-METHODS: dict[str, Method] = {
-    m.id: m
-    for m in (
-        Method(
-            "densest_state",
-            "Densest State",
-            "Eq. 1",
-            "Hoomans et al. 1996",
-            (),
-            False,
-            lambda n, hi, lo, o: densest_state(n),
-        ),
-        Method(
-            "densest_state_modified",
-            "Densest State (modified)",
-            "Eq. 2",
-            "van Wachem et al. 2001",
-            ("n_min",),
-            False,
-            lambda n, hi, lo, o: densest_state_modified(n, lo, o.get("nu_reading", "printed")),
-        ),
-        Method(
-            "loosest_state",
-            "Loosest State",
-            "Eq. 3",
-            "Helland et al. 2005",
-            (),
-            False,
-            lambda n, hi, lo, o: loosest_state(n),
-        ),
-        Method(
-            "interval_mapping",
-            "Interval Mapping",
-            "Eq. 4",
-            "Ouyang and Li 1999",
-            (),
-            False,
-            lambda n, hi, lo, o: interval_mapping(n),
-        ),
-        Method(
-            "combination",
-            "Combination",
-            "Eq. 5",
-            "Zhang 2007",
-            ("n_max", "n_min"),
-            True,
-            lambda n, hi, lo, o: combination(n, hi, lo),
-        ),
-        Method(
-            "lim_lab",
-            "LIM 2D-Lab",
-            "Eqs. 6-7",
-            "Giese 2002; Hainbuechner et al. 2002",
-            ("n_max", "n_min"),
-            True,
-            lambda n, hi, lo, o: lim_lab(n, hi, lo, lattice_exact=_exact(o)),
-        ),
-        Method(
-            "lim_3d",
-            "LIM 2D-3D",
-            "Sec. 2.2",
-            "Wang, Jacobs and Ziegler (Fig. 2)",
-            (),
-            False,
-            lambda n, hi, lo, o: lim_3d(n),
-        ),
-        Method(
-            "quasi_3d",
-            "Quasi 3D Porosity",
-            "Eqs. 8-11",
-            "Bezuijen and van den Berg 2002",
-            ("n_max", "n_min"),
-            True,
-            lambda n, hi, lo, o: quasi_3d(n, hi, lo, lattice_exact=_exact(o)),
-        ),
-        Method(
-            "parabolic",
-            "Parabola",
-            "Eq. 12",
-            "Wang, Jacobs and Ziegler",
-            (),
-            False,
-            lambda n, hi, lo, o: parabolic(n),
-        ),
-    )
+def _nu_reading(o: dict) -> str:
+    return o.get("nu_reading", "printed")
+
+
+#: Each method's id, name, equation, source, the extremes it needs and whether it interpolates,
+#: in the paper's order (section 2.1, then LIM_2D-3D, then Eq. 12).
+_BOTH, _MIN = ("n_max", "n_min"), ("n_min",)
+_METHOD_ROWS = (
+    ("densest_state", "Densest State", "Eq. 1", "Hoomans et al. 1996", (), False),
+    ("densest_state_modified", "Densest State (modified)", "Eq. 2", "van Wachem et al. 2001", _MIN, False),
+    ("loosest_state", "Loosest State", "Eq. 3", "Helland et al. 2005", (), False),
+    ("interval_mapping", "Interval Mapping", "Eq. 4", "Ouyang and Li 1999", (), False),
+    ("combination", "Combination", "Eq. 5", "Zhang 2007", _BOTH, True),
+    ("lim_lab", "LIM 2D-Lab", "Eqs. 6-7", "Giese 2002; Hainbuechner et al. 2002", _BOTH, True),
+    ("lim_3d", "LIM 2D-3D", "Sec. 2.2", "Wang, Jacobs and Ziegler (Fig. 2)", (), False),
+    ("quasi_3d", "Quasi 3D Porosity", "Eqs. 8-11", "Bezuijen and van den Berg 2002", _BOTH, True),
+    ("parabolic", "Parabola", "Eq. 12", "Wang, Jacobs and Ziegler", (), False),
+)
+#: each method's evaluation ``func(n_lab, n_max, n_min, options)``, by id
+_METHOD_FUNCS: dict[str, Callable[[ArrayLike, Any, Any, dict], ArrayLike]] = {
+    "densest_state": lambda n, hi, lo, o: densest_state(n),
+    "densest_state_modified": lambda n, hi, lo, o: densest_state_modified(n, lo, _nu_reading(o)),
+    "loosest_state": lambda n, hi, lo, o: loosest_state(n),
+    "interval_mapping": lambda n, hi, lo, o: interval_mapping(n),
+    "combination": lambda n, hi, lo, o: combination(n, hi, lo),
+    "lim_lab": lambda n, hi, lo, o: lim_lab(n, hi, lo, lattice_exact=_exact(o)),
+    "lim_3d": lambda n, hi, lo, o: lim_3d(n),
+    "quasi_3d": lambda n, hi, lo, o: quasi_3d(n, hi, lo, lattice_exact=_exact(o)),
+    "parabolic": lambda n, hi, lo, o: parabolic(n),
 }
+#: All methods, in the paper's order (section 2.1, then LIM_2D-3D, then Eq. 12).
+METHODS: dict[str, Method] = {row[0]: Method(*row, func=_METHOD_FUNCS[row[0]]) for row in _METHOD_ROWS}
 
 
 @dataclass

@@ -94,9 +94,9 @@ class ProgressLines:
 class _Display:
     """What every display does: bars on a terminal or lines in a log, started and stopped once.
 
-    A subclass says what its bars show (:meth:`_columns`, :meth:`_add_tasks`,
-    :meth:`_draw`), its line (:meth:`line`) and what a line reports without the clock
-    (:meth:`_news`: a forced last line repeats no line just written). Usable as a
+    A subclass defines what its bars show (``_columns``, ``_add_tasks``, ``_draw``), its line
+    (``line``) and what a line reports without the clock (``_news``: a forced last line repeats
+    no line just written). Usable as a
     context manager; ``enabled=False`` shows nothing.
     """
 
@@ -141,21 +141,6 @@ class _Display:
             self._lines.write(self.line(), force=force, state=self._news())
         elif self._progress is not None:
             self._draw(self._progress)
-
-    def line(self) -> str:
-        raise NotImplementedError
-
-    def _news(self) -> object:
-        raise NotImplementedError
-
-    def _columns(self) -> tuple:
-        raise NotImplementedError
-
-    def _add_tasks(self, progress: Progress) -> None:
-        raise NotImplementedError
-
-    def _draw(self, progress: Progress) -> None:
-        raise NotImplementedError
 
 
 class StepProgress(_Display):

@@ -14,12 +14,29 @@ run hands its caller beside the file (a replicate study's per-specimen series), 
 
 Results are values: two results of one class are equal when their files are (``to_dict()``),
 and code reads their fields as attributes (``result.final_porosity``), never by key.
+
+Several result classes may share an ordered group of fields that stands at another place in
+each of their files (a study's ``settings``, ``processes``, ``wall_time_s``, ``config``,
+``provenance``): the group is declared once as a plain dataclass, and :func:`with_fields`
+puts its fields into each class at its place, as if typed there::
+
+    @dataclass
+    class StudyTail:
+        processes: int
+        wall_time_s: float
+
+    @dataclass(eq=False)
+    @with_fields(StudyTail, after="replicates")  # below @dataclass: it runs first
+    class MyResult(TypedResult):
+        replicates: int
+        note: str  # the file's keys: replicates, processes, wall_time_s, note
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass, field, fields
+import typing
+from collections.abc import Callable, Mapping
+from dataclasses import MISSING, dataclass, field, fields
 from functools import cache
 from typing import Any, ClassVar, Self, TypeVar
 
@@ -95,6 +112,27 @@ class Keyed:
         return {k: part(self.kind, v) for k, v in value.items()}
 
 
+def with_fields(group: type, *, after: str | None = None) -> Callable[[type], type]:
+    """A class decorator, written below ``@dataclass``: the fields of the dataclass ``group``
+    (names, types, defaults and metadata, in its order) become the decorated class's own, right
+    after its field ``after`` (first when None). See the module's docstring."""
+    hints = typing.get_type_hints(group)  # types, not their text: the class's module may not know them
+
+    def insert(cls: type) -> type:
+        own = dict(cls.__dict__.get("__annotations__", {}))
+        names = list(own)
+        at = 0 if after is None else names.index(after) + 1
+        shared = {f.name: hints[f.name] for f in fields(group)}
+        cls.__annotations__ = {**{k: own[k] for k in names[:at]}, **shared, **{k: own[k] for k in names[at:]}}
+        for f in fields(group):
+            if f.default is not MISSING or f.default_factory is not MISSING:
+                kinds = {"repr": f.repr, "compare": f.compare, "kw_only": f.kw_only, "metadata": f.metadata}
+                setattr(cls, f.name, field(default=f.default, default_factory=f.default_factory, **kinds))
+        return cls
+
+    return insert
+
+
 @dataclass(eq=False)
 class TypedResult:
     """Base of typed results; subclasses are ``@dataclass(eq=False)`` with one field per key."""
@@ -157,4 +195,4 @@ class TypedResult:
     __hash__ = None  # type: ignore[assignment]  # results are not frozen
 
 
-__all__ = ["NOT_IN_FILE", "Keyed", "TypedResult", "part"]
+__all__ = ["NOT_IN_FILE", "Keyed", "TypedResult", "part", "with_fields"]

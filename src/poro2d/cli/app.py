@@ -9,6 +9,7 @@ exit code 2 and no traceback.
 from __future__ import annotations
 
 import functools
+import importlib
 import sys
 
 import typer
@@ -47,42 +48,18 @@ def _root(
     """poro2d command line."""
 
 
+#: the command modules beside this one, in the order ``poro2d --help`` lists their commands
+COMMANDS = (
+    "convert plot criterion shear biaxial critical_state strength paper sweep relation export import_specimen"
+    " sensitivity calibrate sand"
+).split()
+
+
 def _register() -> None:
     # Imported here so that `poro2d --help` stays cheap and a broken optional
     # layer cannot take the whole CLI down at import time.
-    from poro2d.cli import (
-        biaxial,
-        calibrate,
-        convert,
-        criterion,
-        critical_state,
-        export,
-        import_specimen,
-        paper,
-        plot,
-        relation,
-        sand,
-        sensitivity,
-        shear,
-        strength,
-        sweep,
-    )
-
-    convert.register(app)
-    plot.register(app)
-    criterion.register(app)
-    shear.register(app)
-    biaxial.register(app)
-    critical_state.register(app)
-    strength.register(app)
-    paper.register(app)
-    sweep.register(app)
-    relation.register(app)
-    export.register(app)
-    import_specimen.register(app)
-    sensitivity.register(app)
-    calibrate.register(app)
-    sand.register(app)
+    for name in COMMANDS:
+        importlib.import_module(f"poro2d.cli.{name}").register(app)
     for info in app.registered_commands:
         info.callback = _interruptible(info.name or info.callback.__name__, info.callback)
 

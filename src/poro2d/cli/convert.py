@@ -40,6 +40,7 @@ from typer.core import TyperCommand
 
 from poro2d import __version__
 from poro2d import porosity as P
+from poro2d.cli import options as opt
 from poro2d.errors import InputError, check_range
 from poro2d.lab_state import LabState, lab_state
 
@@ -106,15 +107,11 @@ def _lab_porosities(
 
 #: the command's names of :func:`poro2d.lab_state.lab_state`'s keywords
 _CLI_NAMES = {
-    "e": "--e",
     "n": "NLAB",
-    "dr": "--dr",
-    "dry_density": "--dry-density",
-    "solid_density": "--solid-density",
-    "e_max": "--e-max",
-    "e_min": "--e-min",
-    "n_max": "--n-max",
-    "n_min": "--n-min",
+    **{
+        k: "--" + k.replace("_", "-")
+        for k in ("e", "dr", "dry_density", "solid_density", "e_max", "e_min", "n_max", "n_min")
+    },
 }
 _CLI_WORDS = re.compile(r"\b(dry_density|solid_density|e_max|e_min|n_max|n_min)\b")
 _STATE_KINDS = (
@@ -188,13 +185,10 @@ def _lab_states(
 
 def _state_line(state: LabState, extra: dict) -> str:
     """The state the command understood, in one line: what was given, then e, n and D_r."""
-    if state.given == "e":
-        given = f"e = {state.e:g}"
-    elif state.given == "n":
-        given = f"n = {state.n_lab:g}"
-    elif state.given == "Dr":
+    given = {"e": f"e = {state.e:g}", "n": f"n = {state.n_lab:g}"}.get(state.given)
+    if state.given == "Dr":
         given = f"D_r = {state.relative_density:g}"
-    else:
+    elif given is None:
         rho_d, rho_s = extra["dry_density_kg_m3"], extra["solid_density_kg_m3"]
         given = f"rho_d = {rho_d:g}, rho_s = {rho_s:g} kg/m3"
     line = f"lab state (given as {given}): e = {state.e:.4f}, n_lab = {state.n_lab:.4f}"
@@ -209,6 +203,17 @@ def _state_line(state: LabState, extra: dict) -> str:
 
 def _fmt(v: float | None, digits: int = 4) -> str:
     return "-" if v is None else f"{v:.{digits}f}"
+
+
+#: the help texts the laboratory state's options share
+_REPEAT = " (repeat for several states)."
+_EXTREME = "Laboratory {} void ratio {} ({} state), with {}."
+_N_EXTREME = "Laboratory {} porosity n_lab,{} ({} state)."
+
+
+def _option(name: str, *help: str):
+    """A ``convert`` option ``name``, its help the texts given one after the other."""
+    return typer.Option(name, help="".join(help))
 
 
 def conversion_to_json(
@@ -297,49 +302,28 @@ def _print_table(conv: P.Conversion, extra_inputs: dict, state: LabState | None 
         console.print(f"note: {note}")
 
 
-_CSV_HEADER = [
-    "n_lab",
-    "n_max",
-    "n_min",
-    "method",
-    "name",
-    "equation",
-    "n2d",
-    "flags",
-    "skipped",
-    "nu_reading",
-    "lattice_exact",
-]
-
-
+_CSV_HEADER = ["n_lab", "n_max", "n_min", "method", "name", "equation", "n2d", "flags", "skipped"]
+_CSV_HEADER += ["nu_reading", "lattice_exact"]
 #: the columns a state given in geotechnical terms adds to the csv
 _CSV_STATE_HEADER = ["e", "relative_density", "given"]
 
 
 def _csv_rows(conv: P.Conversion, state: LabState | None = None) -> list[list]:
-    rows = []
+    """A row per method (``_CSV_HEADER``), with ``_CSV_STATE_HEADER``'s columns for a ``state``."""
     more = []
     if state is not None:
-        dr = state.relative_density
-        more = [repr(state.e), "" if dr is None else repr(dr), state.given]
-    for r in conv.results.values():
-        rows.append(
-            [
-                repr(conv.n_lab),
-                "" if conv.n_max is None else repr(conv.n_max),
-                "" if conv.n_min is None else repr(conv.n_min),
-                r.id,
-                r.name,
-                r.equation,
-                "" if r.value is None else repr(r.value),
-                ";".join(r.flags),
-                r.skipped or "",
-                conv.options["nu_reading"],
-                str(conv.options["lattice_exact"]).lower(),
-                *more,
-            ]
-        )
-    return rows
+        more = [repr(state.e), _repr(state.relative_density), state.given]
+    options = [conv.options["nu_reading"], str(conv.options["lattice_exact"]).lower()]
+    head = [repr(conv.n_lab), _repr(conv.n_max), _repr(conv.n_min)]
+    return [
+        [*head, r.id, r.name, r.equation, _repr(r.value), ";".join(r.flags), r.skipped or "", *options, *more]
+        for r in conv.results.values()
+    ]
+
+
+def _repr(v: float | None) -> str:
+    """A number as the csv writes it, exactly (``repr``); empty for None."""
+    return "" if v is None else repr(v)
 
 
 def convert(
@@ -351,58 +335,37 @@ def convert(
             show_default=False,
         ),
     ] = None,
-    e: Annotated[
-        list[float] | None,
-        typer.Option("--e", help="Void ratio e of the laboratory state (repeat for several states)."),
-    ] = None,
+    e: Annotated[list[float] | None, _option("--e", "Void ratio e of the laboratory state", _REPEAT)] = None,
     dr: Annotated[
         list[float] | None,
-        typer.Option(
-            "--dr",
-            help="Relative density Dr = (e_max - e)/(e_max - e_min) in [0, 1], with the extremes "
-            "(repeat for several states).",
+        _option(
+            "--dr", "Relative density Dr = (e_max - e)/(e_max - e_min) in [0, 1], with the extremes", _REPEAT
         ),
     ] = None,
     e_max: Annotated[
-        float | None,
-        typer.Option("--e-max", help="Laboratory maximum void ratio e_max (loosest state), with --e-min."),
+        float | None, _option("--e-max", _EXTREME.format("maximum", "e_max", "loosest", "--e-min"))
     ] = None,
     e_min: Annotated[
-        float | None,
-        typer.Option("--e-min", help="Laboratory minimum void ratio e_min (densest state), with --e-max."),
+        float | None, _option("--e-min", _EXTREME.format("minimum", "e_min", "densest", "--e-max"))
     ] = None,
-    n_max: Annotated[
-        float | None,
-        typer.Option("--n-max", help="Laboratory maximum porosity n_lab,max (loosest state)."),
-    ] = None,
-    n_min: Annotated[
-        float | None,
-        typer.Option("--n-min", help="Laboratory minimum porosity n_lab,min (densest state)."),
-    ] = None,
+    n_max: Annotated[float | None, _option("--n-max", _N_EXTREME.format("maximum", "max", "loosest"))] = None,
+    n_min: Annotated[float | None, _option("--n-min", _N_EXTREME.format("minimum", "min", "densest"))] = None,
     dry_density: Annotated[
-        float | None,
-        typer.Option("--dry-density", help="Dry density rho_d in kg/m3; gives n_lab = 1 - rho_d/rho_s."),
+        float | None, _option("--dry-density", "Dry density rho_d in kg/m3; gives n_lab = 1 - rho_d/rho_s.")
     ] = None,
     solid_density: Annotated[
-        float | None,
-        typer.Option("--solid-density", help="Density of the solids rho_s in kg/m3 (e.g. 2650)."),
+        float | None, _option("--solid-density", "Density of the solids rho_s in kg/m3 (e.g. 2650).")
     ] = None,
     nu_reading: Annotated[
         NuReading,
-        typer.Option(
-            "--nu-reading",
-            help="Eq. 2: nu = n_min/n_FCC as printed, or (1-n_min)/(1-n_FCC) (solid fraction).",
-        ),
+        opt.nu_reading(help="Eq. 2: nu = n_min/n_FCC as printed, or (1-n_min)/(1-n_FCC) (solid fraction)."),
     ] = NuReading.printed,
     lattice_exact: Annotated[
         bool,
-        typer.Option(
-            "--lattice-exact",
-            help="Eqs. 7-11: 1-pi/4 and 1-pi/(2 sqrt 3) instead of the printed 0.2146/0.0931.",
-        ),
+        opt.lattice_exact(help="Eqs. 7-11: 1-pi/4 and 1-pi/(2 sqrt 3) instead of the printed 0.2146/0.0931."),
     ] = False,
     fmt: Annotated[
-        OutputFormat, typer.Option("--format", help="Output format: table, json or csv.")
+        OutputFormat, _option("--format", "Output format: table, json or csv.")
     ] = OutputFormat.table,
 ) -> None:
     """Convert laboratory porosities to 2D with every method of the paper (Eqs. 1-12).
@@ -427,20 +390,7 @@ def convert(
         P.convert_all(v, n_max, n_min, nu_reading=nu_reading.value, lattice_exact=lattice_exact)
         for v in values
     ]
-    if fmt is OutputFormat.json:
-        objs = [conversion_to_json(c, extra) for c in convs]
-        out = objs[0] if len(objs) == 1 else objs
-        typer.echo(json.dumps(out, indent=2, allow_nan=False))
-    elif fmt is OutputFormat.csv:
-        buf = io.StringIO()
-        w = csv.writer(buf, lineterminator="\n")
-        w.writerow(_CSV_HEADER)
-        for c in convs:
-            w.writerows(_csv_rows(c))
-        typer.echo(buf.getvalue(), nl=False)
-    else:
-        for c in convs:
-            _print_table(c, extra)
+    _write(convs, [None] * len(convs), extra, fmt)
 
 
 def _write_conversions(
@@ -451,18 +401,25 @@ def _write_conversions(
         P.convert_all(s.n_lab, s.n_max, s.n_min, nu_reading=nu_reading.value, lattice_exact=lattice_exact)
         for s in states
     ]
+    _write(convs, states, extra, fmt)
+
+
+def _write(convs: list[P.Conversion], states: list, extra: dict, fmt: OutputFormat) -> None:
+    """The conversions in the format asked for; ``states`` their laboratory states, or Nones when
+    the state was given as porosities (then without e, D_r and the state's csv columns)."""
+    pairs = list(zip(convs, states, strict=True))
     if fmt is OutputFormat.json:
-        objs = [conversion_to_json(c, extra, state=s) for s, c in zip(states, convs, strict=True)]
+        objs = [conversion_to_json(c, extra, state=s) for c, s in pairs]
         typer.echo(json.dumps(objs[0] if len(objs) == 1 else objs, indent=2, allow_nan=False))
     elif fmt is OutputFormat.csv:
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")
-        w.writerow(_CSV_HEADER + _CSV_STATE_HEADER)
-        for s, c in zip(states, convs, strict=True):
+        w.writerow(_CSV_HEADER + (_CSV_STATE_HEADER if states[0] is not None else []))
+        for c, s in pairs:
             w.writerows(_csv_rows(c, s))
         typer.echo(buf.getvalue(), nl=False)
     else:
-        for s, c in zip(states, convs, strict=True):
+        for c, s in pairs:
             _print_table(c, extra, s)
 
 

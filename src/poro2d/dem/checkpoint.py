@@ -47,6 +47,10 @@ _SIM_ARRAYS = {
     "_wb_ny": ("wall_pairs", "ny"),
     "_iprm": ("kernel_params", "iprm"),
 }  # fmt: skip
+# the simulation's settings in the file's metadata after its contact model and gravity, by name
+_SETTINGS = (
+    "local_damping restitution dt fixed_dt dt_safety density_scale skin threads partitions step_count time"
+)
 # the contacts' rolling moments, stored only with rolling resistance (module doc)
 _ROLLING_ARRAYS = {"_nb_mr": "pairs", "_wb_mr": "wall_pairs"}
 
@@ -84,17 +88,7 @@ def save(sim: Simulation, path: str | os.PathLike, extra: dict | None = None) ->
         "settings": {
             "contact": sim.contact.to_dict(),
             "gravity": list(sim.gravity),
-            "local_damping": sim.local_damping,
-            "restitution": sim.restitution,
-            "dt": sim.dt,
-            "fixed_dt": sim.fixed_dt,
-            "dt_safety": sim.dt_safety,
-            "density_scale": sim.density_scale,
-            "skin": sim.skin,
-            "threads": sim.threads,
-            "partitions": sim.partitions,
-            "step_count": sim.step_count,
-            "time": sim.time,
+            **{name: getattr(sim, name) for name in _SETTINGS.split()},
         },
         "extra": extra or {},
     }
@@ -215,12 +209,11 @@ def from_content(meta: dict, arrays: Mapping[str, np.ndarray], threads: int | No
 def _build(meta: dict, a: dict[str, np.ndarray], threads: int | None) -> Simulation:
     """The Simulation of a checkpoint's metadata and arrays."""
     s = meta["settings"]
-    pf = {f: a[f"particles.{f}"] for f in _CORE_PARTICLE_FIELDS}
     particles = Particles(
-        pos=pf["pos"], radius=pf["radius"], density=pf["density"], thickness=meta["thickness"],
-        kn=pf["kn"], ks=pf["ks"], mu=pf["mu"], vel=pf["vel"], theta=pf["theta"], omega=pf["omega"],
-        mode=pf["mode"], mu_r=a.get("particles.mu_r"),
-    )  # fmt: skip
+        **{f: a[f"particles.{f}"] for f in _CORE_PARTICLE_FIELDS},
+        thickness=meta["thickness"],
+        mu_r=a.get("particles.mu_r"),
+    )
     walls = Walls()
     for f in _WALL_FIELDS:
         setattr(walls, f, np.ascontiguousarray(a[f"walls.{f}"]))

@@ -563,9 +563,6 @@ class Simulation:
         self.particles.vel[mask] = velocity
         self.particles.omega[mask] = omega
 
-    def free_particles(self, mask: np.ndarray) -> None:
-        self.particles.mode[mask] = FREE
-
     # -------------------------------------------------------------------- run
     def _load_params(
         self, nsteps: int, check_every: int, ratio_target: float, offset: int, measure: int = 0

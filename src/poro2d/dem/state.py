@@ -204,16 +204,13 @@ class Walls:
                     "collinear overlapping walls would double the contact force",
                 )
         mu_r_before = self.rolling_friction()  # one entry per wall present, before this one
-        self.p0 = np.ascontiguousarray(np.vstack([self.p0, a]))
-        self.p1 = np.ascontiguousarray(np.vstack([self.p1, b]))
-        self.kn = np.append(self.kn, float(kn))
-        self.ks = np.append(self.ks, float(ks))
-        self.mu = np.append(self.mu, float(mu))
+        rows = {"p0": a, "p1": b, "vel": np.asarray(velocity, float), "servo_dir": np.zeros(2)}
+        for f, row in {**rows, "servo": np.zeros(SERVO_COLUMNS)}.items():
+            setattr(self, f, np.ascontiguousarray(np.vstack([getattr(self, f), row])))
+        for f, value in (("kn", kn), ("ks", ks), ("mu", mu)):
+            setattr(self, f, np.append(getattr(self, f), float(value)))
         self.mu_r = np.append(mu_r_before, float(mu_r))
-        self.vel = np.ascontiguousarray(np.vstack([self.vel, np.asarray(velocity, float)]))
         self.mode = np.append(self.mode, WALL_VELOCITY).astype(np.int64)
-        self.servo_dir = np.ascontiguousarray(np.vstack([self.servo_dir, np.zeros(2)]))
-        self.servo = np.ascontiguousarray(np.vstack([self.servo, np.zeros(SERVO_COLUMNS)]))
         self.names.append(name)
         return self.n - 1
 
@@ -230,12 +227,9 @@ class Walls:
         (checked by :meth:`poro2d.dem.Simulation.set_wall_servo`)."""
         self.mode[w] = WALL_SERVO
         self.servo_dir[w] = direction
-        servo = self.servo[w]
-        servo[SERVO_TARGET] = target_force
-        servo[SERVO_GAIN] = gain
-        servo[SERVO_MAX_SPEED] = max_speed
-        servo[SERVO_INTEGRAL] = integral
-        servo[SERVO_ERROR_SUM] = 0.0  # a new servo starts without a summed error
+        # a new servo starts without a summed error
+        columns = [SERVO_TARGET, SERVO_GAIN, SERVO_MAX_SPEED, SERVO_INTEGRAL, SERVO_ERROR_SUM]
+        self.servo[w, columns] = (target_force, gain, max_speed, integral, 0.0)
 
     def index(self, name_or_index: str | int) -> int:
         if isinstance(name_or_index, (int, np.integer)):

@@ -57,33 +57,30 @@ def atomic_load(typingctx, arr, idx):
     return types.int64(arr, idx), codegen
 
 
-@intrinsic
-def atomic_store(typingctx, arr, idx, val):
-    """``arr[idx] = val``, written atomically (release)."""
-    if not (_is_i64_vector(arr) and isinstance(idx, types.Integer) and isinstance(val, types.Integer)):
-        return None
+def _slot_update(returns, emit):
+    """An intrinsic ``f(arr, idx, val)`` on an int64 slot: ``emit(builder, ptr, v)`` writes ``v`` there.
 
-    def codegen(context, builder, sig, args):
-        ptr = _slot_pointer(context, builder, sig, args)
-        v = context.cast(builder, args[2], sig.args[2], types.int64)
-        builder.store_atomic(v, ptr, "release", 8)
-        return context.get_dummy_value()
+    ``returns`` is its numba type: ``types.none`` (a store) or ``types.int64`` (the old value).
+    """
 
-    return types.none(arr, idx, val), codegen
+    def typer(typingctx, arr, idx, val):
+        if not (_is_i64_vector(arr) and isinstance(idx, types.Integer) and isinstance(val, types.Integer)):
+            return None
+
+        def codegen(context, builder, sig, args):
+            ptr = _slot_pointer(context, builder, sig, args)
+            old = emit(builder, ptr, context.cast(builder, args[2], sig.args[2], types.int64))
+            return context.get_dummy_value() if returns is types.none else old
+
+        return returns(arr, idx, val), codegen
+
+    return intrinsic(typer)
 
 
-@intrinsic
-def atomic_add(typingctx, arr, idx, val):
-    """``arr[idx] += val`` atomically; returns the old value."""
-    if not (_is_i64_vector(arr) and isinstance(idx, types.Integer) and isinstance(val, types.Integer)):
-        return None
-
-    def codegen(context, builder, sig, args):
-        ptr = _slot_pointer(context, builder, sig, args)
-        v = context.cast(builder, args[2], sig.args[2], types.int64)
-        return builder.atomic_rmw("add", ptr, v, "seq_cst")
-
-    return types.int64(arr, idx, val), codegen
+#: ``arr[idx] = val``, written atomically (release)
+atomic_store = _slot_update(types.none, lambda builder, ptr, v: builder.store_atomic(v, ptr, "release", 8))
+#: ``arr[idx] += val`` atomically; returns the old value
+atomic_add = _slot_update(types.int64, lambda builder, ptr, v: builder.atomic_rmw("add", ptr, v, "seq_cst"))
 
 
 @intrinsic

@@ -31,6 +31,14 @@ def check_disks(pos: Any, radius: Any) -> tuple[np.ndarray, np.ndarray]:
     return np.ascontiguousarray(pos), np.ascontiguousarray(radius)
 
 
+def check_specimen(
+    pos: Any, radius: Any, width: Any, plate_y: Any
+) -> tuple[np.ndarray, np.ndarray, float, float]:
+    """The disks and the box they stand in, checked: :func:`check_disks`, then :func:`check_box`."""
+    pos, radius = check_disks(pos, radius)
+    return pos, radius, *check_box(pos, width, plate_y)
+
+
 def check_box(pos: np.ndarray, width: Any, plate_y: Any) -> tuple[float, float]:
     """The box [0, width] x [0, plate_y], with every disk centre strictly inside it.
 
@@ -74,4 +82,4 @@ def mass_d50(radius: Any) -> float:
     return float(2.0 * r[min(k, r.size - 1)])
 
 
-__all__ = ["check_box", "check_d50", "check_disks", "mass_d50"]
+__all__ = ["check_box", "check_d50", "check_disks", "check_specimen", "mass_d50"]

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from poro2d.errors import InputError, check_range
-from poro2d.measure.disks import check_box, check_d50, check_disks
+from poro2d.measure.disks import check_d50, check_specimen
 from poro2d.measure.porosity import porosity_circle, porosity_rect
 from poro2d.measure.surface import profile_bins, surface_level, surface_profile
 
@@ -143,8 +143,7 @@ def interior_regions(
     :func:`surface_profile` if already computed. Disks are clipped exactly at each circle
     and at the rectangle.
     """
-    pos, radius = check_disks(pos, radius)
-    width, plate_y = check_box(pos, width, plate_y)
+    pos, radius, width, plate_y = check_specimen(pos, radius, width, plate_y)
     d50 = check_d50(d50, radius)
     margin = check_range("margin_d50", margin_d50, 0.0) * d50
     R = check_range("circle_d50", circle_d50, 0.0, lo_open=True) * d50

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from poro2d.errors import InputError
-from poro2d.measure.disks import check_box, check_disks
+from poro2d.measure.disks import check_specimen
 
 #: the Laguerre cells must tile the box to this relative precision, else the tessellation failed
 TILING_TOL = 1e-6
@@ -59,8 +59,7 @@ def laguerre_cells(pos: Any, radius: Any, width: Any, plate_y: Any) -> LaguerreC
     """
     from scipy.spatial import ConvexHull
 
-    pos, radius = check_disks(pos, radius)
-    width, plate_y = check_box(pos, width, plate_y)
+    pos, radius, width, plate_y = check_specimen(pos, radius, width, plate_y)
     n = pos.shape[0]
     # centred and scaled to O(1), so the lifted coordinates keep their precision in qhull
     origin, scale = np.array([0.5 * width, 0.5 * plate_y]), max(width, plate_y)

@@ -32,7 +32,7 @@ import numpy as np
 
 from poro2d.errors import InputError, as_float_array, check_range
 from poro2d.io_utils import Provenance
-from poro2d.measure.disks import check_box, check_d50, check_disks
+from poro2d.measure.disks import check_d50, check_specimen
 from poro2d.measure.interior import DEFAULT_CIRCLE_D50, DEFAULT_MARGIN_D50, InteriorRegions, interior_regions
 from poro2d.measure.laguerre import LaguerreCells, laguerre_cells, laguerre_porosity
 from poro2d.measure.porosity import box_porosity, disk_area
@@ -144,8 +144,7 @@ def measure_specimen(
     :mod:`poro2d.criterion.lid`): the box porosity is then that of the area under the
     lid, and the gap and contact are measured to the lid instead of the flat plate.
     """
-    pos, radius = check_disks(pos, radius)
-    width, plate_y = check_box(pos, width, plate_y)
+    pos, radius, width, plate_y = check_specimen(pos, radius, width, plate_y)
     d50 = check_d50(d50, radius)
     margin_d50 = check_range("margin_d50", margin_d50, 0.0)
     tol = check_range("contact_tol_d50", contact_tol_d50, 0.0) * d50

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from poro2d.errors import check_int, check_range
-from poro2d.measure.disks import check_box, check_disks, mass_d50
+from poro2d.measure.disks import check_disks, check_specimen, mass_d50
 
 #: samples of the surface profile per median diameter
 PROFILE_SAMPLES_PER_D50 = 16
@@ -131,8 +131,7 @@ def plate_surface(
     specimen's. ``contact_tol_d50`` (in d50) sets how close the surface must come to the
     plate to count as in contact; ``bins`` as in :func:`surface_profile`.
     """
-    pos, radius = check_disks(pos, radius)
-    width, plate_y = check_box(pos, width, plate_y)
+    pos, radius, width, plate_y = check_specimen(pos, radius, width, plate_y)
     d50 = check_range("d50", d50, 0.0, lo_open=True)
     tol = check_range("contact_tol_d50", contact_tol_d50, 0.0) * d50
     if bins is None:

@@ -27,7 +27,6 @@ velocity).
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -243,30 +242,15 @@ class ReferenceDEM:
         dvy = vel[j, 1] - vel[i, 1]
         vn = -(dvx * nx + dvy * ny)
         vt = dvx * tx + dvy * ty - (r[i] - 0.5 * ov) * omega[i] - (r[j] - 0.5 * ov) * omega[j]
-        if self.per_body:
-            kn = _series(self.pkn[i], self.pkn[j])
-            ks = _series(self.pks[i], self.pks[j])
-            mu = np.minimum(self.pmu[i], self.pmu[j])
-        else:
-            assert self.pp is not None
-            kn = np.full(len(i), float(self.pp[0]))
-            ks = np.full(len(i), float(self.pp[1]))
-            mu = np.full(len(i), float(self.pp[2]))
+        kn, ks, mu = self._law(i, (self.pkn, self.pks, self.pmu), j, self.pp)
         m_eff = m[i] * m[j] / (m[i] + m[j])
-        cn = 2.0 * self.beta * np.sqrt(kn * m_eff) if self.beta > 0.0 else np.zeros(len(i))
-        fs_old = np.array(
-            [self.history.get((a, b), 0.0) for a, b in zip(i.tolist(), j.tolist(), strict=True)]
-        )
-        fn, fs, sl = _contact_forces(ov, vn, vt, fs_old, kn, ks, mu, cn, dt)
-        for k, (a, b) in enumerate(zip(i.tolist(), j.tolist(), strict=True)):
-            new_hist[(a, b)] = float(fs[k])
-            contacts[(a, b)] = (float(fn[k]), float(fs[k]), bool(sl[k]))
+        pairs = list(zip(i.tolist(), j.tolist(), strict=True))
+        fn, fs = self._forces(pairs, ov, vn, vt, kn, ks, mu, m_eff, new_hist, contacts)
         cfx = -fn * nx - fs * ny  # force on i
         cfy = -fn * ny + fs * nx
         mr = np.zeros(len(i))
         if rolls:
             reff = r[i] * r[j] / (r[i] + r[j])
-            pairs = list(zip(i.tolist(), j.tolist(), strict=True))
             mr_old = np.array([self.rolling.get(pair, 0.0) for pair in pairs])
             mur = np.minimum(self.pmu_r[i], self.pmu_r[j])
             mr = _rolling_moments(mr_old, ks * reff * reff, (omega[i] - omega[j]) * dt, mur * reff * fn)
@@ -289,22 +273,9 @@ class ReferenceDEM:
         wdvy = self.wvel[ww, 1] - vel[wi, 1]
         wvn = -(wdvx * wnx + wdvy * wny)
         wvt = wdvx * wtx + wdvy * wty - (r[wi] - 0.5 * wov) * omega[wi]
-        if self.per_body:
-            wkn = _series(self.pkn[wi], self.wkn[ww])
-            wks = _series(self.pks[wi], self.wks[ww])
-            wmu = np.minimum(self.pmu[wi], self.wmu[ww])
-        else:
-            assert self.pw is not None
-            wkn = np.full(len(wi), float(self.pw[0]))
-            wks = np.full(len(wi), float(self.pw[1]))
-            wmu = np.full(len(wi), float(self.pw[2]))
-        wcn = 2.0 * self.beta * np.sqrt(wkn * m[wi]) if self.beta > 0.0 else np.zeros(len(wi))
+        wkn, wks, wmu = self._law(wi, (self.wkn, self.wks, self.wmu), ww, self.pw)
         keys = [(a, "wall", b) for a, b in zip(wi.tolist(), ww.tolist(), strict=True)]
-        wfs_old = np.array([self.history.get(key, 0.0) for key in keys])
-        wfn, wfs, wsl = _contact_forces(wov, wvn, wvt, wfs_old, wkn, wks, wmu, wcn, dt)
-        for k, key in enumerate(keys):
-            new_hist[key] = float(wfs[k])
-            contacts[key] = (float(wfn[k]), float(wfs[k]), bool(wsl[k]))
+        wfn, wfs = self._forces(keys, wov, wvn, wvt, wkn, wks, wmu, m[wi], new_hist, contacts)
         wcfx = -wfn * wnx - wfs * wny
         wcfy = -wfn * wny + wfs * wnx
         wmr = np.zeros(len(wi))
@@ -378,6 +349,25 @@ class ReferenceDEM:
         self.rolling = new_rolling
         self.contacts = contacts
 
+    def _law(self, i, other: tuple, j, constants: tuple | None) -> tuple:
+        """The contacts' (kn, ks, mu): disk ``i``'s values mixed with ``other``'s at ``j`` (per
+        body: springs in series, the smaller friction), or the pair type's ``constants``."""
+        if self.per_body:
+            kn, ks, mu = other
+            return _series(self.pkn[i], kn[j]), _series(self.pks[i], ks[j]), np.minimum(self.pmu[i], mu[j])
+        assert constants is not None
+        return tuple(np.full(len(i), float(v)) for v in constants[:3])
+
+    def _forces(self, keys, ov, vn, vt, kn, ks, mu, m_eff, new_hist, contacts) -> tuple:
+        """(fn, fs) of the touching contacts ``keys``, their shear history and contacts recorded."""
+        cn = 2.0 * self.beta * np.sqrt(kn * m_eff) if self.beta > 0.0 else np.zeros(len(keys))
+        fs_old = np.array([self.history.get(key, 0.0) for key in keys])
+        fn, fs, sl = _contact_forces(ov, vn, vt, fs_old, kn, ks, mu, cn, self.dt)
+        for k, key in enumerate(keys):
+            new_hist[key] = float(fs[k])
+            contacts[key] = (float(fn[k]), float(fs[k]), bool(sl[k]))
+        return fn, fs
+
     def run(self, steps: int) -> None:
         for _ in range(steps):
             self.step()
@@ -417,10 +407,3 @@ def _ranks(pairs: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
     asked = i.astype(np.int64) * span + j
     at = np.maximum(np.searchsorted(listed, asked, side="right") - 1, 0)
     return np.where(listed[at] == asked, order[at], missing)
-
-
-def max_rel_diff(a: np.ndarray, b: np.ndarray, scale: float) -> float:
-    """Largest |a - b| over ``scale`` (a helper for lock-step comparisons)."""
-    if a.size == 0:
-        return 0.0
-    return float(np.max(np.abs(np.asarray(a) - np.asarray(b)))) / scale if scale > 0 else math.inf
