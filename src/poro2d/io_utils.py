@@ -318,6 +318,9 @@ def read_utf8(parameter: str, path: str | os.PathLike, allowed: str) -> str:
     try:
         return data.decode("utf-8").removeprefix("\ufeff")
     except UnicodeDecodeError as exc:
+        if data.startswith((b"\xff\xfe", b"\xfe\xff")):  # a spreadsheet's "Unicode text"
+            where = "the file is UTF-16 text: save it as UTF-8, a spreadsheet's CSV UTF-8"
+            raise InputError(parameter, str(p), allowed, where) from None
         line, column = text_position(data, exc.start)
         where = f"byte 0x{data[exc.start]:02x} at line {line}, column {column} is not UTF-8"
         raise InputError(parameter, str(p), allowed, where) from None

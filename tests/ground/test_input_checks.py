@@ -201,3 +201,13 @@ def test_a_table_of_ranges_words_its_refusals_as_check_range_does(kw, message):
 def test_every_range_names_a_field_of_its_settings(cls, ranges):
     assert set(ranges) <= {f.name for f in fields(cls)}
     cls()  # the defaults keep every range
+
+
+@pytest.mark.parametrize("encoding", ["utf-16", "utf-16-be"])
+def test_utf16_named_as_such(tmp_path, encoding):
+    """A spreadsheet's "Unicode text" (UTF-16 with its byte order mark) is named, with the fix."""
+    f = tmp_path / "lab.csv"
+    text = "normal_stress_kpa,shear_stress_kpa\n100,50\n"
+    f.write_bytes((b"\xfe\xff" if encoding == "utf-16-be" else b"") + text.encode(encoding))
+    with pytest.raises(InputError, match=r"UTF-16 text: save it as UTF-8"):
+        read_utf8("--lab", f, "a UTF-8 CSV file")

@@ -89,6 +89,7 @@ def range_option(flag: str, text: str) -> Any:
     """A search range ``flag`` given as ``LOW,HIGH`` (None: the command's default); ``text``: its help."""
     return typer.Option(None, flag, help=text)
 
+
 # the porosity conversions' options (convert, plot relations), each with the command's own help
 nu_reading = partial(typer.Option, "--nu-reading")
 lattice_exact = partial(typer.Option, "--lattice-exact")
