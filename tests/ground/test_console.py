@@ -88,6 +88,7 @@ def test_criterion_table_numbers_in_full(capsys):
 def test_shear_and_relation_tables_in_full(capsys):
     from poro2d.cli.relation import print_relation
     from poro2d.cli.shear import print_result
+    from poro2d.shear.results import ShearSeriesResult
 
     test = {
         "normal_stress_kpa": 100.0, "peak_shear_stress_kpa": 87.654321,
@@ -95,10 +96,9 @@ def test_shear_and_relation_tables_in_full(capsys):
         "end": {"shear_stress_kpa": 71.2345, "plate_displacement_mm": 0.123456},
         "max_inertial_number": 1.23456e-4, "wall_time_s": 1234.5,
     }  # fmt: skip
-    print_result(
-        {"tests": [test], "friction_angle_deg": None, "quasi_static": {"max_inertial_number": 1.2e-4,
-         "inertial_limit": 1e-3}}, "out",
-    )  # fmt: skip
+    series = {"tests": [test], "friction_angle_deg": None,
+              "quasi_static": {"max_inertial_number": 1.2e-4, "inertial_limit": 1e-3}}  # fmt: skip
+    print_result(ShearSeriesResult.from_dict(series), "out")
     rel = {
         "points": [{"n_lab": 0.3434, "relative_density": 0.886, "n2d_dem": 0.15123, "n2d_fit": 0.14987,
                     "n2d_parabolic": 0.13541, "n2d_lim_3d": 0.14012, "n2d_lim_lab": 0.10983, "flag": None}],

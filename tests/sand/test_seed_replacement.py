@@ -14,6 +14,8 @@ from poro2d.sweep.records import CaseRow
 
 REFUSED = "trial 1 (n2D = 0.1720) refused: check force_balance failed"
 LAB = {"e_max": 0.977, "e_min": 0.597, "dr": 0.8}
+#: where and when a case ran: nothing these tests read
+UNTIMED = dict.fromkeys(("host", "pid", "worker", "started_utc", "time_s", "finished_utc"))
 CFG = {"soil": {"name": "s"}, "grading": {"preset": "paper"}, "lab": LAB}
 
 
@@ -24,7 +26,7 @@ def _fake_sweep(refused: set[int], calls: list[list[int]]):
         seeds = [c.params["seed"] for c in sweep.cases]
         calls.append(seeds)
         rows = [
-            CaseRow(c.id, "criterion", c.params, status="done",
+            CaseRow(c.id, "criterion", c.params, **UNTIMED, status="done", error=None,
                     results={"converged": s not in refused, "message": "" if s not in refused else REFUSED})
             for c, s in zip(sweep.cases, seeds, strict=True)
         ]  # fmt: skip
