@@ -16,6 +16,7 @@ from dataclasses import dataclass, fields
 from typing import Any, ClassVar, Self, TypeVar
 
 from poro2d.dem.summary import EngineSummary
+from poro2d.io_utils import Provenance
 from poro2d.record import Record
 from poro2d.typed_result import TypedResult
 
@@ -142,4 +143,16 @@ class TestSummary(ByName, TypedResult):
     __test__ = False  # not a test class, whatever its name
 
 
-__all__ = ["BoxRecord", "ByName", "ConsolidationRecord", "TestSummary", "typed_parts"]
+@dataclass
+class StudyRun:
+    """How a study of tests ran, the same run of fields in each study's ``result.json`` (put into it
+    by :func:`poro2d.typed_result.with_fields`): the processes its tests ran on, its wall time (s),
+    the config it was given and its provenance."""
+
+    processes: int
+    wall_time_s: float
+    config: dict[str, Any]
+    provenance: Provenance
+
+
+__all__ = ["BoxRecord", "ByName", "ConsolidationRecord", "StudyRun", "TestSummary", "typed_parts"]
