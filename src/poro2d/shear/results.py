@@ -129,8 +129,21 @@ class ShearSeriesResult(TypedResult):
     )
 
 
+@dataclass
+class ShearStudyRun:
+    """How a study of direct shear series ran, in the order its files keep them (absent in a file of
+    an earlier poro2d; put in by :func:`poro2d.typed_result.with_fields`): its wall time (s), the
+    processes its tests ran on, the config it was given and its provenance."""
+
+    wall_time_s: float
+    processes: int
+    config: dict[str, Any]
+    provenance: Provenance
+
+
 @typed_parts
 @dataclass(eq=False)
+@with_fields(ShearStudyRun, after="method", optional=True)
 class ReplicateShearResult(TypedResult):
     """The same tests on several specimens (``replicates.json``): peaks over specimens, pooled fits.
 
@@ -149,10 +162,6 @@ class ReplicateShearResult(TypedResult):
     friction_angle_mean_deg: float | None
     friction_angle_sd_deg: float | None
     method: str
-    wall_time_s: float | None = None
-    processes: int | None = None
-    config: dict[str, Any] | None = None
-    provenance: Provenance | None = None
     #: how many tests of every specimen are box-dominated (poro2d.shear.box_dominated); absent in
     #: a study of an earlier poro2d
     box_dominated_tests: int | None = None
@@ -163,6 +172,7 @@ class ReplicateShearResult(TypedResult):
 
 @typed_parts
 @dataclass(eq=False)
+@with_fields(ShearStudyRun, after="definitions", optional=True)
 class StrengthResult(TypedResult):
     """Strength against rolling and particle friction (a strength study's ``strength.json``).
 
@@ -178,13 +188,9 @@ class StrengthResult(TypedResult):
     specimens: list[str]
     settings: ShearSettings
     definitions: StrengthDefinitions
-    wall_time_s: float | None = None
-    processes: int | None = None
-    config: dict[str, Any] | None = None
-    provenance: Provenance | None = None
     box_scale: BoxScale | None = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = ("box_scale",)
 
 
-__all__ = ["ReplicateShearResult", "ShearSeriesResult", "ShearTestResult", "StrengthResult"]
+__all__ = ["ReplicateShearResult", "ShearSeriesResult", "ShearStudyRun", "ShearTestResult", "StrengthResult"]
