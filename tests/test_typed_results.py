@@ -275,6 +275,19 @@ def test_a_group_put_in_as_optional_is_none_unless_set():
     assert typing.get_type_hints(_Tail)["processes"] is int
 
 
+@dataclasses.dataclass(eq=False, kw_only=True)
+@with_fields(_Tail, after="replicates")
+class _KeywordGroupedResult(TypedResult):
+    replicates: int
+
+
+def test_a_group_in_a_keyword_only_class_is_keyword_only():
+    # the group's own fields are positional: in a keyword-only class they are keyword-only too
+    assert all(f.kw_only for f in dataclasses.fields(_KeywordGroupedResult))
+    with pytest.raises(TypeError):
+        _KeywordGroupedResult(2, 1, {})  # type: ignore[misc]
+
+
 def _public_runs():
     from poro2d.calibration.run import CalibrationResult, run_calibration
     from poro2d.criterion.replicates import run_replicates

@@ -131,7 +131,9 @@ def with_fields(group: type, *, after: str | None = None, optional: bool = False
         for f in fields(group):
             default, factory = (None, MISSING) if optional else (f.default, f.default_factory)
             if default is not MISSING or factory is not MISSING:
-                kinds = {"repr": f.repr, "compare": f.compare, "kw_only": f.kw_only, "metadata": f.metadata}
+                # keyword-only where the group says so, else as the class's own fields are
+                only = True if f.kw_only else MISSING
+                kinds = {"repr": f.repr, "compare": f.compare, "kw_only": only, "metadata": f.metadata}
                 setattr(cls, f.name, field(default=default, default_factory=factory, **kinds))
         return cls
 
