@@ -207,6 +207,5 @@ ENVELOPE_DEFINITION = (
 __all__ = [
     "DEFINITIONS", "ELASTIC_SPREADS", "ENVELOPE_DEFINITION", "AngleSpread", "BiaxialTestSummary",
     "Definitions", "ElasticProbe", "ElasticSpreads", "ShearChecks",
-    "StudySpreads",
-    "StiffnessScale", "StressSummary", "spread_of",
+    "StiffnessScale", "StressSummary", "StudySpreads", "spread_of",
 ]  # fmt: skip

@@ -281,8 +281,8 @@ class StrengthCase(TypedResult):
 
 
 __all__ = [
-    "LATER_KEYS", "EndValues", "LaterParts", "FitInterval", "FitRecord", "ForceBalance",
-    "LabComparison", "LabPeak", "LabRecord", "QuasiStatic", "RateCheck", "RateCheckRow",
+    "LATER_KEYS", "EndValues", "FitInterval", "FitRecord", "ForceBalance",
+    "LabComparison", "LabPeak", "LabRecord", "LaterParts", "QuasiStatic", "RateCheck", "RateCheckRow",
     "ResidualAtRest", "StrengthCase", "StrengthDefinitions", "StressPeaks",
     "ShearTestSummary",
 ]  # fmt: skip
