@@ -255,6 +255,39 @@ def test_a_group_of_fields_stands_where_it_is_put():
     assert [f.name for f in dataclasses.fields(_Tail)] == ["processes", "config", "note", "hidden"]
 
 
+@dataclasses.dataclass(eq=False)
+@with_fields(_Tail, after="replicates", optional=True)
+class _LaterGroupedResult(TypedResult):
+    replicates: int
+    label: str = "x"
+
+    OPTIONAL = ("processes", "config", "note")
+
+
+def test_a_group_put_in_as_optional_is_none_unless_set():
+    assert typing.get_type_hints(_LaterGroupedResult)["processes"] == int | None
+    r = _LaterGroupedResult(replicates=2)
+    assert r.processes is None and r.hidden is None and list(r.to_dict()) == ["replicates", "label"]
+    full = _LaterGroupedResult(replicates=2, processes=1, config={"a": 1})
+    assert list(full.to_dict()) == ["replicates", "processes", "config", "label"]
+    assert _LaterGroupedResult.from_dict(full.to_dict()) == full
+    # the group itself is left as it was
+    assert typing.get_type_hints(_Tail)["processes"] is int
+
+
+@dataclasses.dataclass(eq=False, kw_only=True)
+@with_fields(_Tail, after="replicates")
+class _KeywordGroupedResult(TypedResult):
+    replicates: int
+
+
+def test_a_group_in_a_keyword_only_class_is_keyword_only():
+    # the group's own fields are positional: in a keyword-only class they are keyword-only too
+    assert all(f.kw_only for f in dataclasses.fields(_KeywordGroupedResult))
+    with pytest.raises(TypeError):
+        _KeywordGroupedResult(2, 1, {})  # type: ignore[misc]
+
+
 def _public_runs():
     from poro2d.calibration.run import CalibrationResult, run_calibration
     from poro2d.criterion.replicates import run_replicates

@@ -112,11 +112,15 @@ class Keyed:
         return {k: part(self.kind, v) for k, v in value.items()}
 
 
-def with_fields(group: type, *, after: str | None = None) -> Callable[[type], type]:
+def with_fields(group: type, *, after: str | None = None, optional: bool = False) -> Callable[[type], type]:
     """A class decorator, written below ``@dataclass``: the fields of the dataclass ``group``
     (names, types, defaults and metadata, in its order) become the decorated class's own, right
-    after its field ``after`` (first when None). See the module's docstring."""
+    after its field ``after`` (first when None). With ``optional`` each is ``T | None = None``
+    instead (a group of values that a file of an earlier version, or a run without them, lacks).
+    See the module's docstring."""
     hints = typing.get_type_hints(group)  # types, not their text: the class's module may not know them
+    if optional:
+        hints = {name: kind | None for name, kind in hints.items()}
 
     def insert(cls: type) -> type:
         own = dict(cls.__dict__.get("__annotations__", {}))
@@ -125,9 +129,12 @@ def with_fields(group: type, *, after: str | None = None) -> Callable[[type], ty
         shared = {f.name: hints[f.name] for f in fields(group)}
         cls.__annotations__ = {**{k: own[k] for k in names[:at]}, **shared, **{k: own[k] for k in names[at:]}}
         for f in fields(group):
-            if f.default is not MISSING or f.default_factory is not MISSING:
-                kinds = {"repr": f.repr, "compare": f.compare, "kw_only": f.kw_only, "metadata": f.metadata}
-                setattr(cls, f.name, field(default=f.default, default_factory=f.default_factory, **kinds))
+            default, factory = (None, MISSING) if optional else (f.default, f.default_factory)
+            if default is not MISSING or factory is not MISSING:
+                # keyword-only where the group says so, else as the class's own fields are
+                only = True if f.kw_only else MISSING
+                kinds = {"repr": f.repr, "compare": f.compare, "kw_only": only, "metadata": f.metadata}
+                setattr(cls, f.name, field(default=default, default_factory=factory, **kinds))
         return cls
 
     return insert

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Any, ClassVar
 
 from poro2d.biaxial.stiffness import STIFFNESS_DEFINITION
 from poro2d.labtest.records import ByName, TestSummary, typed_parts
 from poro2d.measure.spread import Spread
-from poro2d.typed_result import TypedResult
+from poro2d.measure.stiffness import StiffnessAtPeak
+from poro2d.typed_result import TypedResult, with_fields
 
 
 @dataclass(eq=False)
@@ -74,11 +75,6 @@ class ShearChecks(TypedResult):
     quasi_static: bool
 
 
-#: the spreads over replicates a study adds once tests carry their elastic numbers (None for a
-#: study holding a test read back from before: see ``of_all``)
-ELASTIC_SPREADS = ("plastic_max_dilatancy_angle", "stiffness_number", "mean_overlap_ratio_at_peak")
-
-
 @dataclass(eq=False)
 class AngleSpread(Spread):
     """One angle over the replicates (degrees): mean, sd (None for one), min, max and each value."""
@@ -86,6 +82,35 @@ class AngleSpread(Spread):
     def text(self, digits: int = 1, unit: str = " deg") -> str:
         """``31.2 +- 1.4 deg (29.9-32.8)``, or ``31.2 deg`` for one value."""
         return super().text(digits, unit)
+
+
+@dataclass
+class StudySpreads:
+    """A study's numbers over its replicates, the same in its ``result.json`` and in its line in a
+    series: each angle's spread (and the axial strain at the peak's); ``critical_state_reached``
+    only if every replicate reached it (``critical_state_note`` says which did not)."""
+
+    peak_friction_angle: AngleSpread
+    critical_state_friction_angle: AngleSpread
+    max_dilatancy_angle: AngleSpread
+    axial_strain_at_peak: AngleSpread
+    critical_state_reached: bool
+    critical_state_note: str
+
+
+@dataclass
+class ElasticSpreads:
+    """The spreads over replicates a study adds once tests carry their elastic numbers (None for a
+    study holding a test read back from before: see ``of_all``), the last fields of a study's
+    ``result.json`` and of its line in a series."""
+
+    plastic_max_dilatancy_angle: AngleSpread | None = None
+    stiffness_number: Spread | None = None
+    mean_overlap_ratio_at_peak: Spread | None = None
+
+
+#: the keys of :class:`ElasticSpreads`, written only when known
+ELASTIC_SPREADS = tuple(f.name for f in fields(ElasticSpreads))
 
 
 #: the angles (and the strain at the peak) a study spreads over its tests: a test's number is the
@@ -107,6 +132,7 @@ def spread_of(kind: type[Spread], values: list[float | None]) -> Spread | None:
 
 
 @dataclass(eq=False)
+@with_fields(StiffnessAtPeak, after="wall_time_s")
 class BiaxialTestSummary(TestSummary):
     """One replicate's row of a study's ``result.json``."""
 
@@ -120,8 +146,6 @@ class BiaxialTestSummary(TestSummary):
     end_volumetric_strain: float
     sigma_3_max_error: float
     wall_time_s: float
-    stiffness_number: float | None = None
-    mean_overlap_ratio_at_peak: float | None = None
     plastic_max_dilatancy_angle_deg: float | None = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = (
@@ -131,21 +155,14 @@ class BiaxialTestSummary(TestSummary):
 
 @typed_parts
 @dataclass(eq=False)
+@with_fields(ElasticSpreads, after="critical_state_note")
+@with_fields(StudySpreads, after="folder")
 class StressSummary(ByName, TypedResult):
     """One confining stress of a series: its replicates' spread and where its files are (read off
     the stress's study by name)."""
 
     confining_stress_kpa: float
     folder: str
-    peak_friction_angle: AngleSpread
-    critical_state_friction_angle: AngleSpread
-    max_dilatancy_angle: AngleSpread
-    axial_strain_at_peak: AngleSpread
-    critical_state_reached: bool
-    critical_state_note: str
-    plastic_max_dilatancy_angle: AngleSpread | None = None
-    stiffness_number: Spread | None = None
-    mean_overlap_ratio_at_peak: Spread | None = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = ELASTIC_SPREADS
 
@@ -189,6 +206,6 @@ ENVELOPE_DEFINITION = (
 
 __all__ = [
     "DEFINITIONS", "ELASTIC_SPREADS", "ENVELOPE_DEFINITION", "AngleSpread", "BiaxialTestSummary",
-    "Definitions", "ElasticProbe", "ShearChecks",
-    "StiffnessScale", "StressSummary", "spread_of",
+    "Definitions", "ElasticProbe", "ElasticSpreads", "ShearChecks",
+    "StiffnessScale", "StressSummary", "StudySpreads", "spread_of",
 ]  # fmt: skip

@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import ClassVar
 
-from poro2d.biaxial.angles import Angles
+from poro2d.biaxial.angles import Angles, PlasticAngles
 from poro2d.biaxial.curve import BiaxialCurve, read_curve
 from poro2d.biaxial.envelope import EnvelopeRecord
 from poro2d.biaxial.lab import LabCurve
@@ -15,20 +15,24 @@ from poro2d.biaxial.parts import (
     BiaxialTestSummary,
     Definitions,
     ElasticProbe,
+    ElasticSpreads,
     ShearChecks,
     StiffnessScale,
     StressSummary,
+    StudySpreads,
 )
 from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.io_utils import Provenance
-from poro2d.labtest.records import ByName, ConsolidationRecord, typed_parts
-from poro2d.measure.spread import Spread
+from poro2d.labtest.records import ByName, ConsolidationRecord, StudyRun, typed_parts
+from poro2d.measure.stiffness import StiffnessAtPeak
 from poro2d.store import Store
-from poro2d.typed_result import NOT_IN_FILE, TypedResult
+from poro2d.typed_result import NOT_IN_FILE, TypedResult, with_fields
 
 
 @typed_parts
 @dataclass(eq=False)
+@with_fields(PlasticAngles, after="elastic_probe", optional=True)
+@with_fields(StiffnessAtPeak, after="provenance")
 class BiaxialTestResult(ByName, Angles):
     """One biaxial test (a replicate folder's ``result.json``): its angles (its first keys, those of
     :class:`~poro2d.biaxial.angles.Angles`) and how they were obtained.
@@ -38,8 +42,9 @@ class BiaxialTestResult(ByName, Angles):
     of the test (:mod:`poro2d.biaxial.stiffness`; the consolidation record has it too, with the
     overlap then), ``mean_overlap_ratio_at_peak`` the mean overlap / mean diameter at the peak;
     ``elastic_probe`` the compliance measured after shearing and ``plastic_*`` the dilatancy of
-    the plastic strains (:mod:`poro2d.biaxial.elastic`). ``curve`` (not in the file): the
-    recorded curve (:class:`~poro2d.biaxial.curve.BiaxialCurve`).
+    the plastic strains (:class:`~poro2d.biaxial.angles.PlasticAngles`, absent without them;
+    :mod:`poro2d.biaxial.elastic`). ``curve`` (not in the file): the recorded curve
+    (:class:`~poro2d.biaxial.curve.BiaxialCurve`).
     """
 
     checks: ShearChecks
@@ -57,14 +62,8 @@ class BiaxialTestResult(ByName, Angles):
     specimen: str
     specimen_digest: str
     provenance: Provenance
-    stiffness_number: float | None = None
-    mean_overlap_ratio_at_peak: float | None = None
     stiffness_scale: StiffnessScale | None = None
     elastic_probe: ElasticProbe | None = None
-    plastic_max_dilatancy_angle_deg: float | None = None
-    plastic_axial_strain_at_max_dilatancy: float | None = None
-    plastic_end_dilatancy_angle_deg: float | None = None
-    plastic_end_volumetric_strain: float | None = None
     curve: BiaxialCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     #: written since the elastic strain was told apart (a test of before has none of them; a test
@@ -86,8 +85,24 @@ class BiaxialTestResult(ByName, Angles):
         return result
 
 
+@dataclass
+@with_fields(StudyRun, after="specimens")
+class BiaxialStudy:
+    """The fields of a biaxial study's ``result.json`` after its own numbers, the same in a series':
+    how each number is read, the settings and specimens of its tests, how it ran
+    (:class:`~poro2d.labtest.records.StudyRun`) and the laboratory curve (only with one)."""
+
+    definitions: Definitions
+    settings: BiaxialSettings
+    specimens: list[str]
+    lab: LabCurve | None = None
+
+
 @typed_parts
 @dataclass(eq=False)
+@with_fields(ElasticSpreads, after="lab")
+@with_fields(BiaxialStudy, after="summaries")
+@with_fields(StudySpreads, after="replicates")
 class BiaxialResult(TypedResult):
     """Biaxial tests at one confining stress on replicate specimens (the study's ``result.json``).
 
@@ -101,24 +116,7 @@ class BiaxialResult(TypedResult):
 
     confining_stress_kpa: float
     replicates: int
-    peak_friction_angle: AngleSpread
-    critical_state_friction_angle: AngleSpread
-    max_dilatancy_angle: AngleSpread
-    axial_strain_at_peak: AngleSpread
-    critical_state_reached: bool
-    critical_state_note: str
     summaries: list[BiaxialTestSummary]
-    definitions: Definitions
-    settings: BiaxialSettings
-    specimens: list[str]
-    processes: int
-    wall_time_s: float
-    config: dict[str, Any]
-    provenance: Provenance
-    lab: LabCurve | None = None
-    plastic_max_dilatancy_angle: AngleSpread | None = None
-    stiffness_number: Spread | None = None
-    mean_overlap_ratio_at_peak: Spread | None = None
     tests: list[BiaxialTestResult] = field(
         default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
@@ -136,6 +134,7 @@ class BiaxialResult(TypedResult):
 
 @typed_parts
 @dataclass(eq=False)
+@with_fields(BiaxialStudy, after="sigma_3_note")
 class BiaxialSeriesResult(TypedResult):
     """Biaxial tests at several confining stresses on replicate specimens (the series' ``result.json``).
 
@@ -164,14 +163,6 @@ class BiaxialSeriesResult(TypedResult):
     critical_state_note: str
     sigma_3_held: bool
     sigma_3_note: str
-    definitions: Definitions
-    settings: BiaxialSettings
-    specimens: list[str]
-    processes: int
-    wall_time_s: float
-    config: dict[str, Any]
-    provenance: Provenance
-    lab: LabCurve | None = None
     plastic_max_dilatancy_angle: AngleSpread | None = None
     studies: list[BiaxialResult] = field(default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
@@ -193,4 +184,4 @@ class BiaxialSeriesResult(TypedResult):
         )
 
 
-__all__ = ["BiaxialResult", "BiaxialSeriesResult", "BiaxialTestResult"]
+__all__ = ["BiaxialResult", "BiaxialSeriesResult", "BiaxialStudy", "BiaxialTestResult"]

@@ -7,8 +7,15 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from poro2d.errors import InputError, Ranges, Real, check_fields
-from poro2d.labtest.settings import NORMAL_STRESS_RANGE_KPA, SERVO_AND_WALLS, TestSettings, lab_ranges
+from poro2d.labtest.settings import (
+    NORMAL_STRESS_RANGE_KPA,
+    SERVO_AND_WALLS,
+    DisksAndEngine,
+    TestSettings,
+    lab_ranges,
+)
 from poro2d.paper_data import TABLE_1
+from poro2d.typed_result import with_fields
 
 #: the confining stresses (kPa) a test may be run at: the direct shear test's normal stresses,
 #: for the same reasons (a soft contact's overlap above, the specimen's weight below)
@@ -48,6 +55,7 @@ BIAXIAL_RANGES: Ranges = {
 
 
 @dataclass
+@with_fields(DisksAndEngine, after="friction_wall")
 class BiaxialSettings(TestSettings):
     """Settings of a biaxial test (SI units; strains are fractions, compression positive), also
     the ``settings`` its files keep (:class:`~poro2d.labtest.settings.TestSettings`; ``probe_unload``
@@ -89,11 +97,6 @@ class BiaxialSettings(TestSettings):
     kn_wall: float = TABLE_1.kn_wall
     ks_wall: float = TABLE_1.ks_wall
     friction_wall: float = 0.0
-    particle_friction: float | None = None
-    rolling_friction: float | None = None
-    local_damping: float | None = None
-    density_scale: float = 1.0
-    dt_safety: float = 0.8
     inertial_limit: float = 1e-3
     smoothing_strain: float = 0.01
     critical_window: float = 0.25

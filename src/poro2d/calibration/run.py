@@ -47,6 +47,7 @@ from poro2d.errors import InputError
 from poro2d.execute.dask_cluster import check_reachable
 from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance, check_output_dir
+from poro2d.measure.stiffness import StiffnessAtPeak
 from poro2d.shear.box_scale import BoxScale, box_scale
 from poro2d.shear.parts import LabRecord
 from poro2d.shear.settings import (
@@ -54,7 +55,7 @@ from poro2d.shear.settings import (
 )
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store, claims
-from poro2d.typed_result import NOT_IN_FILE, Keyed, TypedResult, part
+from poro2d.typed_result import NOT_IN_FILE, Keyed, TypedResult, part, with_fields
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
 KIND = "calibrate"
@@ -100,22 +101,21 @@ class CalibrationTimings(TypedResult):
 
 
 @dataclass(eq=False)
+@with_fields(StiffnessAtPeak, after="noise_sd")
 class FittedObservable(TypedResult):
     """One laboratory value fitted: the observable (``peak``, ``end``, ``dilation``, a reading, a
     biaxial ratio) at a normal (or confining) stress, the laboratory's value, the surrogate's at the
     best parameters and the noise it was given, in the observable's :attr:`unit`, which the file's
     keys name: ``lab_kpa``, ``model_kpa``, ``noise_sd_kpa`` for a shear stress, ``lab_mm``, ...
-    for the dilation, ``lab_ratio``, ... for a dimensionless one."""
+    for the dilation, ``lab_ratio``, ... for a dimensionless one; then, of the design's tests at this
+    stress, the median kappa = kn / (sigma t) and mean overlap / d at the peak (how much elastic
+    strain a dilation or volumetric observable carries; None: not recorded)."""
 
     observable: str
     normal_stress_kpa: float
     lab: float | None
     model: float | None
     noise_sd: float | None
-    #: the design's tests at this stress: median kappa = kn / (sigma t) and mean overlap / d at the
-    #: peak (how much elastic strain a dilation or volumetric observable carries; None: not recorded)
-    stiffness_number: float | None = None
-    mean_overlap_ratio_at_peak: float | None = None
 
     #: the values whose keys in the file end in the unit
     IN_UNIT: ClassVar[tuple[str, ...]] = ("lab", "model", "noise_sd")

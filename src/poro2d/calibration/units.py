@@ -20,6 +20,7 @@ import numpy as np
 from poro2d.errors import InputError
 from poro2d.execute.dask_cluster import pin_numba_threads
 from poro2d.identity import identity_digest
+from poro2d.measure.stiffness import ContactStiffness
 from poro2d.shear.case import ShearCase
 from poro2d.shear.fit import smooth
 from poro2d.shear.record import content_record, folder_stage
@@ -27,6 +28,7 @@ from poro2d.shear.settings import ShearSettings
 from poro2d.shear.single import DirectShearTest
 from poro2d.specimen.saved import Specimen
 from poro2d.store import Store
+from poro2d.typed_result import with_fields
 
 #: what a unit returns besides its identity: the observables a calibration may fit
 OBSERVABLES = ("peak", "end", "dilation")
@@ -227,6 +229,7 @@ class UnitIdentity:
 
 
 @dataclass(frozen=True)
+@with_fields(ContactStiffness, after="box_note")
 class UnitRow(UnitIdentity):
     """What a finished unit gives the fit: its observables and its cost.
 
@@ -234,7 +237,8 @@ class UnitRow(UnitIdentity):
     the test (mm, positive: dilation), smoothed over the peak window as the end stress is (NaN:
     not given, for a row made by hand). ``box_dominated``: the test's verdict, read off its curve
     for a test cached before there was one (:meth:`poro2d.shear.results.ShearTestResult.read`): the
-    fit leaves its design point out.
+    fit leaves its design point out. ``stiffness_number`` and ``mean_overlap_ratio``: kappa = kn /
+    (sigma t) and the mean overlap / d at the peak (None: a test cached before them).
     """
 
     peak: float
@@ -245,9 +249,6 @@ class UnitRow(UnitIdentity):
     #: whether the test read its box rather than its material (poro2d.shear.box_dominated), and why
     box_dominated: bool = False
     box_note: str = ""
-    #: kappa = kn / (sigma t) and the mean overlap / d at the peak (None: a test cached before them)
-    stiffness_number: float | None = None
-    mean_overlap_ratio: float | None = None
 
     def observable(self, name: str) -> float:
         """The value of the observable ``name`` (:data:`OBSERVABLES`, or a reading of the curve,

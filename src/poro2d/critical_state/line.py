@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import numpy as np
 
@@ -29,10 +29,10 @@ from poro2d.critical_state.run import KIND, MAX_SEEDS, seed_runs, seed_store, st
 from poro2d.errors import InputError, check_int
 from poro2d.execute import RunOptions
 from poro2d.io_utils import Provenance
-from poro2d.labtest.records import typed_parts
+from poro2d.labtest.records import StudyRun, typed_parts
 from poro2d.measure.spread import Spread
 from poro2d.store import Store, claimed
-from poro2d.typed_result import NOT_IN_FILE, TypedResult
+from poro2d.typed_result import NOT_IN_FILE, TypedResult, with_fields
 
 #: the most pressures one line may hold, and the fewest it needs for a slope with a scatter
 MAX_PRESSURES = 12
@@ -195,6 +195,7 @@ class StateMark(TypedResult):
 
 @typed_parts
 @dataclass(eq=False)
+@with_fields(StudyRun, after="case")
 class CriticalStateLineResult(TypedResult):
     """The line over ``pressures_kpa`` (the study's ``result.json``): a point per pressure, the fit
     through every seed, the stress ratio pooled over every run; ``steady`` only if every run was
@@ -209,10 +210,6 @@ class CriticalStateLineResult(TypedResult):
     steady: bool
     note: str
     case: CriticalStateCase
-    processes: int
-    wall_time_s: float
-    config: dict[str, Any]
-    provenance: Provenance
     marks: list[StateMark] | None = None
     studies: list[CriticalStateResult] = field(
         default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE

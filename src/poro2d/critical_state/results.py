@@ -3,15 +3,15 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import ClassVar
 
 from poro2d.critical_state.case import CriticalStateCase
 from poro2d.critical_state.series import CellSeries
 from poro2d.critical_state.steady import SteadyState
 from poro2d.io_utils import Provenance
-from poro2d.labtest.records import ByName, TestSummary, typed_parts
+from poro2d.labtest.records import ByName, StudyRun, TestSummary, typed_parts
 from poro2d.measure.spread import Spread
-from poro2d.typed_result import NOT_IN_FILE, TypedResult
+from poro2d.typed_result import NOT_IN_FILE, TypedResult, with_fields
 
 
 @typed_parts
@@ -86,6 +86,7 @@ class SeedSummary(TestSummary):
 
 @typed_parts
 @dataclass(eq=False)
+@with_fields(StudyRun, after="case")
 class CriticalStateResult(TypedResult):
     """Periodic shear runs of one case on several seeds (the study's ``result.json``).
 
@@ -105,10 +106,6 @@ class CriticalStateResult(TypedResult):
     note: str
     summaries: list[SeedSummary]
     case: CriticalStateCase
-    processes: int
-    wall_time_s: float
-    config: dict[str, Any]
-    provenance: Provenance
     void_ratio: Spread | None = None
     stiffness_number: float | None = None
     mean_overlap_ratio: Spread | None = None

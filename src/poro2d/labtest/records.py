@@ -16,8 +16,10 @@ from dataclasses import dataclass, fields
 from typing import Any, ClassVar, Self, TypeVar
 
 from poro2d.dem.summary import EngineSummary
+from poro2d.io_utils import Provenance
+from poro2d.measure.stiffness import ContactStiffness
 from poro2d.record import Record
-from poro2d.typed_result import TypedResult
+from poro2d.typed_result import TypedResult, with_fields
 
 T = TypeVar("T", bound=type)
 
@@ -77,6 +79,7 @@ BIAXIAL_KEYS = (
 
 @typed_parts
 @dataclass(eq=False, kw_only=True)
+@with_fields(ContactStiffness, after="contact_kn")
 class ConsolidationRecord(TypedResult):
     """How a test's consolidation ended (a shear test's ``consolidation.json``, a ``consolidation`` of
     either test's ``result.json``): the steps, the unbalanced-force ratio, the coordination number,
@@ -112,8 +115,6 @@ class ConsolidationRecord(TypedResult):
     box: BoxRecord
     engine: EngineSummary | None = None
     contact_kn: float | None = None
-    stiffness_number: float | None = None
-    mean_overlap_ratio: float | None = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = (
         *SPLIT_BOX_KEYS, *BIAXIAL_KEYS, "contact_kn", "stiffness_number", "mean_overlap_ratio",
@@ -142,4 +143,16 @@ class TestSummary(ByName, TypedResult):
     __test__ = False  # not a test class, whatever its name
 
 
-__all__ = ["BoxRecord", "ByName", "ConsolidationRecord", "TestSummary", "typed_parts"]
+@dataclass
+class StudyRun:
+    """How a study of tests ran, the same run of fields in each study's ``result.json`` (put into it
+    by :func:`poro2d.typed_result.with_fields`): the processes its tests ran on, its wall time (s),
+    the config it was given and its provenance."""
+
+    processes: int
+    wall_time_s: float
+    config: dict[str, Any]
+    provenance: Provenance
+
+
+__all__ = ["BoxRecord", "ByName", "ConsolidationRecord", "StudyRun", "TestSummary", "typed_parts"]

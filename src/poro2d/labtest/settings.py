@@ -16,7 +16,7 @@ table takes its entries from (:func:`lab_ranges`).
 
 from __future__ import annotations
 
-from dataclasses import fields
+from dataclasses import dataclass, fields
 from typing import Any, Self
 
 from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
@@ -60,6 +60,20 @@ LAB_RANGES: Ranges = {
 SERVO_AND_WALLS = ("servo_gain", "servo_integral", "servo_max_speed", "kn_wall", "ks_wall", "friction_wall")
 
 
+@dataclass
+class DisksAndEngine:
+    """The settings of the disks' frictions and of the engine that every box test has, in this order
+    (put into each test's settings by :func:`poro2d.typed_result.with_fields`): the disks' sliding
+    and rolling friction and the local damping for the test (None: the specimen's), the inertial
+    masses' scale and the time step's safety factor."""
+
+    particle_friction: float | None = None
+    rolling_friction: float | None = None
+    local_damping: float | None = None
+    density_scale: float = 1.0
+    dt_safety: float = 0.8
+
+
 def lab_ranges(*names: str) -> Ranges:
     """The entries ``names`` of :data:`LAB_RANGES`, in that order (a test's table splices them in
     where it checks them)."""
@@ -99,5 +113,5 @@ class TestSettings(Record):
 
 __all__ = [
     "LAB_RANGES", "MAX_CONSOLIDATION_STEPS", "MAX_DENSITY_SCALE", "MAX_FRICTION", "MAX_WALL_STIFFNESS",
-    "NORMAL_STRESS_RANGE_KPA", "SERVO_AND_WALLS", "TestSettings", "lab_ranges",
+    "NORMAL_STRESS_RANGE_KPA", "SERVO_AND_WALLS", "DisksAndEngine", "TestSettings", "lab_ranges",
 ]  # fmt: skip

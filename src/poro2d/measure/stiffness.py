@@ -21,6 +21,28 @@ from dataclasses import dataclass
 import numpy as np
 
 
+@dataclass
+class ContactStiffness:
+    """The fields of a record that say how stiff a packing's contacts were: kappa = kn / (sigma t)
+    and the mean overlap over d of the touching contacts (each record says when: after a test's
+    consolidation, at its peak), None in a record of an earlier poro2d (put into each record by
+    :func:`poro2d.typed_result.with_fields`)."""
+
+    stiffness_number: float | None = None
+    mean_overlap_ratio: float | None = None
+
+
+@dataclass
+class StiffnessAtPeak:
+    """The fields of a test's result (and of its line in a study) that say how stiff its contacts
+    were: kappa = kn / (sigma t) at the test's stress and the mean overlap over d at the peak,
+    None in a test of an earlier poro2d (put into each result by
+    :func:`poro2d.typed_result.with_fields`)."""
+
+    stiffness_number: float | None = None
+    mean_overlap_ratio_at_peak: float | None = None
+
+
 @dataclass(frozen=True)
 class DiskContacts:
     """The touching disk-disk contacts: their disks ``i``, ``j``, unit normals, the sum of the two

@@ -10,11 +10,12 @@ replicate study's peaks at one normal stress.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import ClassVar
 
 from poro2d.labtest.records import TestSummary, typed_parts
-from poro2d.typed_result import TypedResult
+from poro2d.measure.stiffness import StiffnessAtPeak
+from poro2d.typed_result import TypedResult, with_fields
 
 
 @dataclass(eq=False)
@@ -95,17 +96,29 @@ class ResidualAtRest(TypedResult):
     end_rate: float | None
 
 
-#: the keys a test's ``result.json`` and its line in a series have had since a later poro2d (a test of
-#: before lacks them): the plane's share of the load, the residual where dilation stopped, the box
-#: verdict, the stiffness number and overlap
-LATER_KEYS = (
-    "plane_load_fraction_at_peak", "residual_dilation_stopped", "box_dominated", "box_note",
-    "stiffness_number", "mean_overlap_ratio_at_peak",
-)  # fmt: skip
+@dataclass
+@with_fields(StiffnessAtPeak, after="box_note")
+class LaterParts:
+    """The fields a test's ``result.json`` and its line in a series have had since a later poro2d (a
+    test of before lacks them): the part of the plate's load the shear plane carries at the peak
+    (:func:`poro2d.shear.curve.plane_load_fraction`), the residual read where the plate has stopped
+    rising (:mod:`poro2d.shear.residual`), whether the test read its box rather than its material
+    (:mod:`poro2d.shear.box_dominated`), the stiffness number and the overlap
+    (:mod:`poro2d.measure.stiffness`)."""
+
+    plane_load_fraction_at_peak: float | None = None
+    residual_dilation_stopped: ResidualAtRest | None = None
+    box_dominated: bool | None = None
+    box_note: str | None = None
+
+
+#: the keys of :class:`LaterParts`, written only when known
+LATER_KEYS = tuple(f.name for f in fields(LaterParts))
 
 
 @typed_parts
 @dataclass(eq=False)
+@with_fields(LaterParts, after="folder")
 class ShearTestSummary(TestSummary):
     """One test's line of a series' ``result.json`` (and ``peaks.csv``, without its nested parts)."""
 
@@ -126,12 +139,6 @@ class ShearTestSummary(TestSummary):
     wall_time_s: float
     consolidation_normal_stress_error: float
     folder: str
-    plane_load_fraction_at_peak: float | None = None
-    residual_dilation_stopped: ResidualAtRest | None = None
-    box_dominated: bool | None = None
-    box_note: str | None = None
-    stiffness_number: float | None = None
-    mean_overlap_ratio_at_peak: float | None = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = LATER_KEYS
 
@@ -275,7 +282,7 @@ class StrengthCase(TypedResult):
 
 __all__ = [
     "LATER_KEYS", "EndValues", "FitInterval", "FitRecord", "ForceBalance",
-    "LabComparison", "LabPeak", "LabRecord", "QuasiStatic", "RateCheck", "RateCheckRow",
+    "LabComparison", "LabPeak", "LabRecord", "LaterParts", "QuasiStatic", "RateCheck", "RateCheckRow",
     "ResidualAtRest", "StrengthCase", "StrengthDefinitions", "StressPeaks",
     "ShearTestSummary",
 ]  # fmt: skip

@@ -17,6 +17,7 @@ from poro2d.shear.parts import (
     FitInterval,
     FitRecord,
     LabComparison,
+    LaterParts,
     QuasiStatic,
     RateCheck,
     ShearTestSummary,
@@ -24,21 +25,22 @@ from poro2d.shear.parts import (
     StrengthDefinitions,
     StressPeaks,
 )
-from poro2d.shear.residual import ResidualAtRest
 from poro2d.shear.settings import ShearSettings
 from poro2d.store import Store
-from poro2d.typed_result import NOT_IN_FILE, TypedResult
+from poro2d.typed_result import NOT_IN_FILE, TypedResult, with_fields
 
 
 @typed_parts
 @dataclass(eq=False)
+@with_fields(LaterParts, after="provenance")
 class ShearTestResult(ByName, CurveSummary):
     """One test (a test folder's ``result.json``): what its curve says, and how it was obtained.
 
     The first fields are read off the curve (:class:`~poro2d.shear.curve.CurveSummary`, by
     :func:`poro2d.shear.curve.curve_summary`): the smoothed peak and where it lies, the end values
     (``end``: smoothed over one peak window), the servo's stress error, the inertial number and
-    the force balance. Stresses in kPa, lengths in m unless the name says mm. ``curve`` (not in
+    the force balance; the last ones those of :class:`~poro2d.shear.parts.LaterParts`. Stresses
+    in kPa, lengths in m unless the name says mm. ``curve`` (not in
     the file): the recorded curve (:class:`~poro2d.shear.curve.ShearCurve`; None when the test is
     not at hand).
     """
@@ -58,20 +60,6 @@ class ShearTestResult(ByName, CurveSummary):
     specimen: str
     engine: EngineSummary
     provenance: Provenance
-    # the part of the plate's load the shear plane carries at the peak (absent in a test of an
-    # earlier poro2d): see poro2d.shear.curve.plane_load_fraction
-    plane_load_fraction_at_peak: float | None = None
-    # the residual read where the plate has stopped rising (absent in a test of an earlier
-    # poro2d): see poro2d.shear.residual
-    residual_dilation_stopped: ResidualAtRest | None = None
-    # whether the test read its box rather than its material (absent in a test of an earlier
-    # poro2d, read off its curve when at hand): see poro2d.shear.box_dominated
-    box_dominated: bool | None = None
-    box_note: str | None = None
-    # kappa = kn / (sigma t) at the normal stress and the mean overlap over d at the peak (absent
-    # in a test of an earlier poro2d): see poro2d.measure.stiffness
-    stiffness_number: float | None = None
-    mean_overlap_ratio_at_peak: float | None = None
     curve: ShearCurve | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     OPTIONAL: ClassVar[tuple[str, ...]] = LATER_KEYS
@@ -141,8 +129,21 @@ class ShearSeriesResult(TypedResult):
     )
 
 
+@dataclass
+class ShearStudyRun:
+    """How a study of direct shear series ran, in the order its files keep them (absent in a file of
+    an earlier poro2d; put in by :func:`poro2d.typed_result.with_fields`): its wall time (s), the
+    processes its tests ran on, the config it was given and its provenance."""
+
+    wall_time_s: float
+    processes: int
+    config: dict[str, Any]
+    provenance: Provenance
+
+
 @typed_parts
 @dataclass(eq=False)
+@with_fields(ShearStudyRun, after="method", optional=True)
 class ReplicateShearResult(TypedResult):
     """The same tests on several specimens (``replicates.json``): peaks over specimens, pooled fits.
 
@@ -161,10 +162,6 @@ class ReplicateShearResult(TypedResult):
     friction_angle_mean_deg: float | None
     friction_angle_sd_deg: float | None
     method: str
-    wall_time_s: float | None = None
-    processes: int | None = None
-    config: dict[str, Any] | None = None
-    provenance: Provenance | None = None
     #: how many tests of every specimen are box-dominated (poro2d.shear.box_dominated); absent in
     #: a study of an earlier poro2d
     box_dominated_tests: int | None = None
@@ -175,6 +172,7 @@ class ReplicateShearResult(TypedResult):
 
 @typed_parts
 @dataclass(eq=False)
+@with_fields(ShearStudyRun, after="definitions", optional=True)
 class StrengthResult(TypedResult):
     """Strength against rolling and particle friction (a strength study's ``strength.json``).
 
@@ -190,13 +188,9 @@ class StrengthResult(TypedResult):
     specimens: list[str]
     settings: ShearSettings
     definitions: StrengthDefinitions
-    wall_time_s: float | None = None
-    processes: int | None = None
-    config: dict[str, Any] | None = None
-    provenance: Provenance | None = None
     box_scale: BoxScale | None = None
 
     OPTIONAL: ClassVar[tuple[str, ...]] = ("box_scale",)
 
 
-__all__ = ["ReplicateShearResult", "ShearSeriesResult", "ShearTestResult", "StrengthResult"]
+__all__ = ["ReplicateShearResult", "ShearSeriesResult", "ShearStudyRun", "ShearTestResult", "StrengthResult"]

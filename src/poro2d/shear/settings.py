@@ -15,10 +15,12 @@ from poro2d.labtest.settings import (
     MAX_WALL_STIFFNESS,
     NORMAL_STRESS_RANGE_KPA,
     SERVO_AND_WALLS,
+    DisksAndEngine,
     TestSettings,
     lab_ranges,
 )
 from poro2d.paper_data import TABLE_1
+from poro2d.typed_result import with_fields
 
 #: the longest shear displacement (m) of any test
 MAX_DISPLACEMENT = 1.0
@@ -56,6 +58,7 @@ SHEAR_RANGES: Ranges = {
 
 
 @dataclass
+@with_fields(DisksAndEngine, after="gap")
 class ShearSettings(TestSettings):
     """Settings of a direct shear test (SI units; the box walls default to Table 1), also the
     ``settings`` its files keep (:class:`~poro2d.labtest.settings.TestSettings`).
@@ -98,11 +101,6 @@ class ShearSettings(TestSettings):
     ks_wall: float = TABLE_1.ks_wall
     friction_wall: float = TABLE_1.friction_wall
     gap: float = 0.0
-    particle_friction: float | None = None
-    rolling_friction: float | None = None
-    local_damping: float | None = None
-    density_scale: float = 1.0
-    dt_safety: float = 0.8
     peak_window: float = 2e-3
     shear_zone_factor: float = 10.0
     inertial_limit: float = 1e-3
