@@ -1,4 +1,4 @@
-"""The short public API at the top level: each name is its module's own object, and ``import poro2d`` is light."""
+"""The short public API at the top level: each name is its module's own object; ``import poro2d`` is light."""
 
 from __future__ import annotations
 
