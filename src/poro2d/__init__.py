@@ -51,6 +51,7 @@ PUBLIC: dict[str, tuple[str, str]] = {
     "run_critical_states": ("poro2d.critical_state", "run_critical_states"),
     # studies
     "PaperCase": ("poro2d.paper", "PaperCase"),
+    "paper_preset": ("poro2d.criterion.config", "paper_preset"),
     "run_paper": ("poro2d.paper", "run_paper"),
     "RelationCase": ("poro2d.sweep.relation", "RelationCase"),
     "run_relation": ("poro2d.sweep.relation", "run_relation"),
