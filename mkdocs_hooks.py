@@ -8,7 +8,10 @@ that every link is still checked by ``mkdocs build --strict``.
 
 from __future__ import annotations
 
+import json
+import os
 import re
+import tempfile
 from pathlib import Path
 
 from mkdocs.structure.files import File
@@ -30,12 +33,27 @@ LINKS = {
     "ARCHITECTURE.md": "architecture.md",
 }
 
+#: seconds a notebook cell may run before the build fails (the longest measured: docs/building-docs.md)
+CELL_TIMEOUT = 600
+
 _LINK = re.compile(r"\]\((" + "|".join(re.escape(k) for k in LINKS) + r")")
 
 
 def rewrite_links(markdown: str) -> str:
     """``markdown`` with the repository paths of :data:`LINKS` replaced by their site pages."""
     return _LINK.sub(lambda m: "](" + LINKS[m.group(1)], markdown)
+
+
+def on_config(config):
+    """A timeout on every notebook cell: mkdocs-jupyter has no option for it, but its nbconvert
+    reads the user's Jupyter config, where ``NotebookClient.timeout`` reaches the cells' executor."""
+    folder = Path(tempfile.mkdtemp(prefix="poro2d-docs-jupyter-"))
+    settings = {"NotebookClient": {"timeout": CELL_TIMEOUT}}
+    (folder / "jupyter_nbconvert_config.json").write_text(json.dumps(settings))
+    os.environ["JUPYTER_CONFIG_PATH"] = os.pathsep.join(
+        p for p in (str(folder), os.environ.get("JUPYTER_CONFIG_PATH", "")) if p
+    )
+    return config
 
 
 def on_files(files, config):
