@@ -59,7 +59,7 @@ PUBLIC: dict[str, tuple[str, str]] = {
     "run_calibration": ("poro2d.calibration", "run_calibration"),
     "synthetic_lab": ("poro2d.calibration", "synthetic_lab"),
     # export to other DEM codes, and their runs of a specimen
-    "export_specimen": ("poro2d.cli.export", "export_specimen"),
+    "export_specimen": ("poro2d.interop.exported", "export_specimen"),
     "load_specimen": ("poro2d.interop.specimen_data", "from_checkpoint"),
     "export_lammps": ("poro2d.interop.lammps", "write_specimen"),
     "export_yade": ("poro2d.interop.yade", "write_specimen"),

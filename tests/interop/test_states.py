@@ -10,11 +10,11 @@ import pytest
 
 from poro2d import __version__
 from poro2d.cli import main
-from poro2d.cli.export import export_specimen
 from poro2d.dem import checkpoint
 from poro2d.errors import InputError
 from poro2d.interop import csv_table, lammps, pfc, yade
 from poro2d.interop.check import DEFAULTS
+from poro2d.interop.exported import export_specimen
 from poro2d.interop.specimen_data import from_checkpoint
 from poro2d.interop.state_specimen import state_specimen
 from poro2d.store import Store

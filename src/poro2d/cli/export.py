@@ -40,6 +40,7 @@ def export_cmd(
     """Write an accepted specimen for another DEM code (disks, walls, contact properties)."""
     from poro2d.errors import InputError, check_range
     from poro2d.interop import csv_table, lammps, pfc, yade
+    from poro2d.interop.exported import export_specimen
     from poro2d.interop.state_specimen import dr_text
 
     if to not in TARGETS:
@@ -68,40 +69,6 @@ def export_cmd(
         f"{spec.n} disks, {len(spec.walls)} walls; thickness t = {spec.thickness:g} m "
         "(disk masses rho pi r^2 t); SI units; see docs/export.md"
     )
-
-
-def export_specimen(specimen, out: Path, *, n_lab=None, dr=None, seed=None):
-    """(specimen, state) of ``export``: the specimen with its provenance lines, and the
-    :class:`~poro2d.interop.state_specimen.StateSpecimen` it was found by (None for a checkpoint
-    or criterion folder given as such).
-
-    A specimen the criterion did not accept is refused; so are the options of a folder of
-    states given with anything else (rather than ignored).
-    """
-    from poro2d.errors import InputError
-    from poro2d.interop.origin import origin_lines
-    from poro2d.interop.specimen_data import from_checkpoint, resolve_specimen
-    from poro2d.interop.state_specimen import STATE_RECORDS, state_record, state_specimen
-    from poro2d.io_utils import check_output_dir
-    from poro2d.specimen.accepted import check_accepted
-
-    has_specimen = Path(specimen).is_file() or (Path(specimen) / "specimen.npz").is_file()
-    record = None if has_specimen else state_record(specimen)
-    if record is None:
-        for option, value in (("--n-lab", n_lab), ("--dr", dr), ("--seed", seed)):
-            if value is not None:
-                what = "is a specimen" if has_specimen else "holds neither a specimen nor a record of states"
-                allowed = "only with a folder of states (" + ", ".join(STATE_RECORDS) + ")"
-                raise InputError(option, value, allowed, f"{specimen} {what}")
-        check_output_dir("--out", out)
-        check_accepted(specimen)
-        return from_checkpoint(specimen), None
-    state = state_specimen(specimen, n_lab=n_lab, dr=dr, seed=0 if seed is None else seed)
-    check_output_dir("--out", out)
-    check_accepted(state.folder)
-    spec = from_checkpoint(state.folder)
-    spec.origin = origin_lines(resolve_specimen(state.folder), state)
-    return spec, state
 
 
 def register(app: typer.Typer) -> None:
