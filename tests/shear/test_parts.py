@@ -2,6 +2,7 @@
 
 import dataclasses
 import json
+import math
 import pickle
 from pathlib import Path
 
@@ -13,9 +14,9 @@ from poro2d.shear.fit import mohr_coulomb, peak
 from poro2d.shear.parts import (
     EndValues,
     FitInterval,
-    FitRecord,
     ForceBalance,
     LabComparison,
+    MohrCoulombFit,
     QuasiStatic,
     RateCheck,
     RateCheckRow,
@@ -46,7 +47,7 @@ def test_a_series_result_reads_into_its_parts():
     stored = _stored("shear_series_result.json")
     s = ShearSeriesResult.from_dict(stored)
     assert all(isinstance(t, ShearTestSummary) and isinstance(t.end, EndValues) for t in s.tests)
-    assert isinstance(s.fit, FitRecord) and isinstance(s.fit_through_origin, FitRecord)
+    assert isinstance(s.fit, MohrCoulombFit) and isinstance(s.fit_through_origin, MohrCoulombFit)
     assert isinstance(s.quasi_static, QuasiStatic) and isinstance(s.lab, LabComparison)
     assert isinstance(s.rate_check, RateCheck) and all(
         isinstance(t, RateCheckRow) for t in s.rate_check.tests
@@ -68,10 +69,12 @@ def test_a_replicate_result_reads_into_its_parts():
 def test_fits_are_kept_as_their_dicts_were():
     s, t = [50.0, 100.0, 200.0], [40.0, 76.0, 139.0]
     fit = mohr_coulomb(s, t)
-    assert fit.record().to_dict() == {**dataclasses.asdict(fit), "tan_phi": fit.tan_phi}
+    named = {f.name: getattr(fit, f.name) for f in dataclasses.fields(fit) if f.name != "extra"}
+    assert fit.to_dict() == named
+    assert fit.tan_phi == math.tan(math.radians(fit.friction_angle_deg))
     ci = mohr_coulomb_ci(s, t)
     assert list(ci.to_dict()) == [
-        *fit.record().to_dict(),
+        *fit.to_dict(),
         "level",
         "dof",
         "friction_angle_ci_deg",

@@ -3,44 +3,12 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
 
 from poro2d.errors import InputError
-from poro2d.shear.parts import FitRecord
-
-
-@dataclass(frozen=True)
-class MohrCoulombFit:
-    """tau = c + sigma tan(phi), least squares over the points (stresses in kPa).
-
-    ``through_origin`` fits are tau = sigma tan(phi) (c = 0). ``r2`` is the
-    coefficient of determination of the fitted line against the points (for the
-    fit through the origin it is taken about the mean as well, so it can be
-    negative when the line is poor).
-    """
-
-    friction_angle_deg: float
-    cohesion_kpa: float
-    r2: float
-    n_points: int
-    through_origin: bool
-
-    @property
-    def tan_phi(self) -> float:
-        return math.tan(math.radians(self.friction_angle_deg))
-
-    def predict(self, sigma_kpa) -> np.ndarray:
-        return self.cohesion_kpa + self.tan_phi * np.asarray(sigma_kpa, float)
-
-    def record(self) -> FitRecord:
-        """The fit as a result file keeps it (its fields and ``tan_phi``)."""
-        return FitRecord(
-            friction_angle_deg=self.friction_angle_deg, cohesion_kpa=self.cohesion_kpa, r2=self.r2,
-            n_points=self.n_points, through_origin=self.through_origin, tan_phi=self.tan_phi,
-        )  # fmt: skip
+from poro2d.shear.parts import MohrCoulombFit
 
 
 def mohr_coulomb(sigma_kpa, tau_kpa, through_origin: bool = False) -> MohrCoulombFit:
@@ -68,7 +36,10 @@ def mohr_coulomb(sigma_kpa, tau_kpa, through_origin: bool = False) -> MohrCoulom
     ss_res = float(np.sum((t - pred) ** 2))
     ss_tot = float(np.sum((t - t.mean()) ** 2))
     r2 = 1.0 - ss_res / ss_tot if ss_tot > 0 else (1.0 if ss_res == 0 else 0.0)
-    return MohrCoulombFit(math.degrees(math.atan(slope)), c, r2, int(s.size), through_origin)
+    phi = math.degrees(math.atan(slope))
+    # tan_phi as the files have always kept it: the tangent of the angle, not the fitted slope
+    # (the two can differ in the last bits)
+    return MohrCoulombFit(phi, c, r2, int(s.size), through_origin, math.tan(math.radians(phi)))
 
 
 def smooth(x, y, window: float) -> np.ndarray:

@@ -13,6 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass, fields
 from typing import ClassVar
 
+import numpy as np
+
 from poro2d.labtest.records import TestSummary, typed_parts
 from poro2d.measure.stiffness import StiffnessAtPeak
 from poro2d.typed_result import TypedResult, with_fields
@@ -41,8 +43,14 @@ class EndValues(TypedResult):
 
 
 @dataclass(eq=False)
-class FitRecord(TypedResult):
-    """A Mohr-Coulomb line as a file keeps it (:meth:`poro2d.shear.fit.MohrCoulombFit.record`)."""
+class MohrCoulombFit(TypedResult):
+    """tau = c + sigma tan(phi), least squares over the points (stresses in kPa), as a file keeps it
+    (:func:`poro2d.shear.fit.mohr_coulomb` makes it).
+
+    ``through_origin`` fits are tau = sigma tan(phi) (c = 0). ``r2`` is the coefficient of
+    determination of the fitted line against the points (for the fit through the origin it is
+    taken about the mean as well, so it can be negative when the line is poor).
+    """
 
     friction_angle_deg: float
     cohesion_kpa: float
@@ -51,9 +59,12 @@ class FitRecord(TypedResult):
     through_origin: bool
     tan_phi: float
 
+    def predict(self, sigma_kpa) -> np.ndarray:
+        return self.cohesion_kpa + self.tan_phi * np.asarray(sigma_kpa, float)
+
 
 @dataclass(eq=False)
-class FitInterval(FitRecord):
+class FitInterval(MohrCoulombFit):
     """A Mohr-Coulomb line with ``level`` Student-t intervals of phi and c (None without dof)."""
 
     level: float | None = None
@@ -209,11 +220,11 @@ class LabComparison(LabRecord):
     """The laboratory data a series is compared with (its first keys, a :class:`LabRecord`'s), their
     fits and the difference of the angles."""
 
-    fit: FitRecord | None
+    fit: MohrCoulombFit | None
     friction_angle_deg: float | None
     cohesion_kpa: float | None
     friction_angle_difference_deg: float | None
-    fit_through_origin: FitRecord
+    fit_through_origin: MohrCoulombFit
 
 
 @dataclass(eq=False)
@@ -281,7 +292,7 @@ class StrengthCase(TypedResult):
 
 
 __all__ = [
-    "LATER_KEYS", "EndValues", "FitInterval", "FitRecord", "ForceBalance",
+    "LATER_KEYS", "EndValues", "FitInterval", "MohrCoulombFit", "ForceBalance",
     "LabComparison", "LabPeak", "LabRecord", "LaterParts", "QuasiStatic", "RateCheck", "RateCheckRow",
     "ResidualAtRest", "StrengthCase", "StrengthDefinitions", "StressPeaks",
     "ShearTestSummary",

@@ -44,7 +44,7 @@ def mohr_coulomb_ci(sigma_kpa, tau_kpa, through_origin: bool = False, level: flo
     t = np.asarray(tau_kpa, float).ravel()
     fit = mohr_coulomb(s, t, through_origin=through_origin)
     df = s.size - (1 if through_origin else 2)
-    out = FitInterval(**fit.record().to_dict(), level=level, dof=df)
+    out = FitInterval(**fit.to_dict(), level=level, dof=df)
     if df < 1:
         return out
     resid = t - fit.predict(s)

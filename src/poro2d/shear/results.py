@@ -15,9 +15,9 @@ from poro2d.shear.curve import CurveSummary, ShearCurve, read_curve
 from poro2d.shear.parts import (
     LATER_KEYS,
     FitInterval,
-    FitRecord,
     LabComparison,
     LaterParts,
+    MohrCoulombFit,
     QuasiStatic,
     RateCheck,
     ShearTestSummary,
@@ -102,9 +102,9 @@ class ShearSeriesResult(TypedResult):
     friction_angle_deg: float | None
     cohesion_kpa: float | None
     r2: float | None
-    fit: FitRecord | None
+    fit: MohrCoulombFit | None
     friction_angle_through_origin_deg: float
-    fit_through_origin: FitRecord
+    fit_through_origin: MohrCoulombFit
     quasi_static: QuasiStatic
     peak_definition: str
     shear_stress_definition: str

@@ -146,9 +146,9 @@ class ShearSeries:
             friction_angle_deg=fit.friction_angle_deg if fit else None,
             cohesion_kpa=fit.cohesion_kpa if fit else None,
             r2=fit.r2 if fit else None,
-            fit=fit.record() if fit else None,
+            fit=fit,
             friction_angle_through_origin_deg=fit0.friction_angle_deg,
-            fit_through_origin=fit0.record(),
+            fit_through_origin=fit0,
             quasi_static=self._quasi_static(tests),
             peak_definition=f"maximum of the shear stress curve smoothed by a centred moving average over "
             f"{1e3 * s.peak_window:g} mm of shear displacement",
@@ -258,13 +258,13 @@ class ShearSeries:
             source=lab.source,
             kind=lab.kind,
             peaks=lab.peak_rows(),
-            fit=lf.record() if lf else None,
+            fit=lf,
             friction_angle_deg=lf.friction_angle_deg if lf else None,
             cohesion_kpa=lf.cohesion_kpa if lf else None,
             friction_angle_difference_deg=fit.friction_angle_deg - lf.friction_angle_deg
             if (fit and lf)
             else None,
-            fit_through_origin=mohr_coulomb(ls, [lab.peaks[v] for v in ls], through_origin=True).record(),
+            fit_through_origin=mohr_coulomb(ls, [lab.peaks[v] for v in ls], through_origin=True),
         )
 
 
