@@ -5,7 +5,8 @@ from pathlib import Path
 import pytest
 
 from poro2d.cli import main
-from poro2d.criterion.protocol import thrown_out, thrown_out_note
+from poro2d.criterion.protocol import thrown_out_note
+from poro2d.dem.layout import MisplacedDisk
 from poro2d.errors import InputError
 
 #: a well-graded sandy gravel (0.1-18.9 mm, Cu 18): its frictionless jamming porosity is about 0.105
@@ -32,8 +33,9 @@ def test_a_trial_denser_than_its_grading_jams_is_refused_naming_the_cause(tmp_pa
 
 
 def test_only_a_disk_position_is_taken_for_a_thrown_out_disk():
-    moved = InputError("disk 850 position", (0.304224, 1.08571), "a centre inside the walls", "beyond")
-    assert thrown_out(moved) and not thrown_out(InputError("trial porosity", 0.05, ">= 0.101"))
+    moved = MisplacedDisk("disk 850 position", (0.304224, 1.08571), "a centre inside the walls", "beyond")
+    assert isinstance(moved, InputError)  # built by hand, a misplaced disk is still bad input
+    assert not isinstance(InputError("trial porosity", 0.05, ">= 0.101"), MisplacedDisk)
     note = thrown_out_note(moved, 0.08, 0.1049)
     assert note.startswith("disk 850 was thrown out of place") and "(0.304224, 1.08571) m" in note
     assert "n_J = 0.105" in note and "at 0.11 or above" in note

@@ -62,7 +62,7 @@ from poro2d.criterion.servo import PlateServo, in_window, rises_free_to_roll
 from poro2d.criterion.settings import CriterionSettings, round_to
 from poro2d.criterion.trial import Decision, PlateStage, StageFailure, Trial, trial_name
 from poro2d.dem import Simulation
-from poro2d.errors import InputError
+from poro2d.dem.layout import MisplacedDisk
 from poro2d.grading import GradingCurve
 from poro2d.io_utils import Provenance
 from poro2d.measure.disks import mass_d50
@@ -162,18 +162,11 @@ def balance_budget(s: CriterionSettings) -> int:
     return s.max_plate_steps // 6
 
 
-def thrown_out(exc: InputError) -> bool:
-    """Whether ``exc`` is the engine's refusal of a disk's position (:mod:`poro2d.dem.layout`).
+def thrown_out_note(exc: MisplacedDisk, n: float, n_j: float | None) -> str:
+    """Why a trial whose disk was thrown out of place is refused: the physical cause, and the fix.
 
     No disk of a criterion run comes from the user: every one is drawn and placed by the
-    preparation, so a disk outside the walls (or on one, or on another disk) is an event of the
-    run, overlaps that exploded in a layer grown denser than the grading packs, not an input.
-    """
-    return exc.parameter.startswith("disk ") and exc.parameter.endswith(" position")
-
-
-def thrown_out_note(exc: InputError, n: float, n_j: float | None) -> str:
-    """Why a trial whose disk left the box is refused: the physical cause, and the fix.
+    preparation, so a misplaced disk is an event of the run, not an input.
 
     ``n_j``: the grading's frictionless jamming porosity
     (:func:`~poro2d.specimen.compaction.densest_porosity`), None when no estimate could be made.
@@ -563,9 +556,7 @@ class PorosityCriterion:
             tried.append(n)
             try:
                 trial = self._trial(k, n)
-            except InputError as exc:
-                if not thrown_out(exc):
-                    raise
+            except MisplacedDisk as exc:
                 failed_trial = k
                 note = thrown_out_note(exc, n, densest_porosity(self.grading))
                 message = f"trial {k} (n2D = {n:.4f}) refused: {note}"

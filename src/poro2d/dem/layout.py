@@ -22,13 +22,19 @@ COINCIDENT = 0.01
 ON_WALL = 0.01
 
 
+class MisplacedDisk(InputError):
+    """A disk on top of another, on a wall or outside the walls: bad input where the disks come
+    from the user; where a protocol drew and placed them, an event of its run (a layer compacted
+    denser than its grading packs throws disks out), which the protocol names as such."""
+
+
 def check_layout(pos: np.ndarray, radius: np.ndarray, walls: Walls) -> None:
-    """Raise InputError naming the first disk that coincides with another, sits on a wall
-    or lies outside the box the walls close."""
+    """Raise :class:`MisplacedDisk` naming the first disk that coincides with another, sits on
+    a wall or lies outside the box the walls close."""
     if pos.shape[0] == 0:
         return
     for disk, allowed, why in _misplaced(pos, radius, walls):  # the first one found is refused
-        raise InputError(f"disk {disk} position", _xy(pos[disk]), allowed, why)
+        raise MisplacedDisk(f"disk {disk} position", _xy(pos[disk]), allowed, why)
 
 
 def _misplaced(pos: np.ndarray, radius: np.ndarray, walls: Walls):
