@@ -108,6 +108,7 @@ def test_a_run_keeps_its_result_series_and_figure_in_the_store(tmp_path, monkeyp
     draw_critical_state(result, Store(tmp_path))  # the figure, drawn from the result after the run
     assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == [
         "critical_state.png",
+        "fabric_rose.json",
         "result.json",
         "series.csv",
         "test.json",
@@ -120,6 +121,12 @@ def test_a_run_keeps_its_result_series_and_figure_in_the_store(tmp_path, monkeyp
     monkeypatch.setattr(run_module, "_compute", lambda *_: pytest.fail("a finished run ran again"))
     back = run_critical_state(case, Store(tmp_path))
     assert back == result and np.array_equal(back.series.stress_ratio, result.series.stress_ratio)
+    # the fabric is recorded along the series, its orientations kept at the peak and the end
+    assert np.array_equal(back.series.a_c, result.series.a_c) and np.isfinite(result.series.a_c[-1])
+    assert (
+        back.roses.to_dict() == result.roses.to_dict()
+        and back.roses.end.record == result.series.gamma.size - 1
+    )
     with pytest.raises(InputError, match="another pressure") as exc:
         run_critical_state(case.at_pressure(200.0), Store(tmp_path))
     assert exc.value.parameter == "--out"

@@ -92,6 +92,7 @@ def register(app: typer.Typer) -> None:
         from poro2d.critical_state.run import MAX_SEEDS
         from poro2d.errors import InputError, check_int
         from poro2d.report.critical_state_figures import draw_critical_state, draw_critical_state_line
+        from poro2d.report.fabric_figures import draw_critical_state_fabric
 
         rule = CASE_RANGES["pressure_kpa"]
         PRESSURE_RANGE_KPA = (rule.lo, rule.hi)
@@ -132,6 +133,7 @@ def register(app: typer.Typer) -> None:
                     marks=held.marks if held else None, span=held.span if held else None,
                 )  # fmt: skip
                 draw_critical_state_line(result, store)
+            draw_critical_state_fabric(result, store)
         except RuntimeError as exc:
             console.print(f"[bold red]failed:[/] {exc}")
             raise typer.Exit(1) from None

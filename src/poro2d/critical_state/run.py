@@ -41,6 +41,7 @@ from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
 from poro2d.io_utils import Provenance
 from poro2d.labtest.reporters import CurveRecorder, ProgressReporter
+from poro2d.measure.fabric import ROSE_FILE, FabricRoses, cell_fabric, cell_rose
 from poro2d.store import Store, claimed
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
@@ -55,15 +56,16 @@ Report = Callable[[str, float], None]
 
 def _shear(
     cell, case: CriticalStateCase, rate: float, report: Report | None
-) -> tuple[CellSeries, int, int, float]:
-    """Shear to the case's strain, a row every record_strain; returns the series, steps, rebuilds
-    and the mean overlap over d of the rows' ends in the steady window (a snapshot alone swings
-    with the pressure's fluctuations)."""
+) -> tuple[CellSeries, int, int, float, FabricRoses | None]:
+    """Shear to the case's strain, a row every record_strain; returns the series, steps, rebuilds,
+    the mean overlap over d of the rows' ends in the steady window (a snapshot alone swings
+    with the pressure's fluctuations) and the contact orientations at the largest stress ratio
+    and at the end."""
     pressure = case.pressure_kpa * 1e3
     cell.shear(rate, pressure, barostat_gain(cell, case), rate)
     per_row = max(1, round(case.record_strain / (rate * cell.dt)))
     steps = math.ceil(case.strain / (per_row * rate * cell.dt)) * per_row
-    blocks, overlaps, d = [], [], mean_diameter(cell)
+    blocks, overlaps, roses, d = [], [], [], mean_diameter(cell)
 
     def advance(n: int) -> tuple[int, bool]:
         blocks.append(cell.run(n))
@@ -73,13 +75,21 @@ def _shear(
         if c.strain >= case.window_start:
             overlaps.append(mean_overlap_ratio(c))
 
-    recorder = CurveRecorder(per_row, lambda c: row_of(c.strain, blocks[-1], rate, d, case.solid_density))
+    def row(c) -> dict[str, float]:  # the fabric of the cell now, its orientations kept for the rose
+        contacts = c.contacts()
+        roses.append(cell_rose(contacts))
+        return row_of(c.strain, blocks[-1], rate, d, case.solid_density, cell_fabric(contacts, c.n))
+
+    recorder = CurveRecorder(per_row, row)
     share = ProgressReporter(
         per_row, report, "shear", lambda _, k: COMPRESS_SHARE + (1.0 - COMPRESS_SHARE) * k / steps
     )
     drive_blocks(advance, steps, [recorder, Every(per_row, overlap), share], cell)
     mean = float(np.mean(overlaps)) if overlaps else mean_overlap_ratio(cell)
-    return CellSeries.of_rows(recorder.rows), steps, sum(b.rebuilds for b in blocks), mean
+    series = CellSeries.of_rows(recorder.rows)
+    at_peak = int(np.argmax(series.stress_ratio)) if len(roses) else 0
+    fabric = FabricRoses.of("gamma", series.gamma, roses, at_peak) if roses else None
+    return series, steps, sum(b.rebuilds for b in blocks), mean, fabric
 
 
 def run_critical_state(
@@ -104,6 +114,8 @@ def run_critical_state(
         done = _compute(case, report)
         # the series first: the result, written by the stage, is the marker of a finished run
         store.write_csv(SERIES_CSV, done.series.rows(), header=list(COLUMNS))
+        if done.roses is not None:
+            store.write_result(ROSE_FILE, done.roses)
         folder_stage(store, case).run(lambda: done)
     return done
 
@@ -116,7 +128,7 @@ def _compute(case: CriticalStateCase, report: Report | None) -> CriticalStateTes
         cell, case, None if report is None else lambda f: report("compress", COMPRESS_SHARE * f)
     )
     rate = shear_rate(cell, case)
-    series, steps, rebuilds, overlap = _shear(cell, case, rate, report)
+    series, steps, rebuilds, overlap, roses = _shear(cell, case, rate, report)
     wall = time.perf_counter() - t0
     state = read_steady(series, case.window_start, case.blocks, case.mu_drift_limit, case.solid_drift_limit)
     return CriticalStateTestResult.of(
@@ -137,6 +149,7 @@ def _compute(case: CriticalStateCase, report: Report | None) -> CriticalStateTes
         stiffness_number=case.kappa(),
         mean_overlap_ratio=overlap,
         series=series,
+        roses=roses,
     )
 
 
