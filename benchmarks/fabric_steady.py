@@ -42,7 +42,8 @@ def main() -> None:
         disks=args.disks, particle_friction=0.5, strain=args.strain, window_start=args.window, seed=args.seed
     )
     study = CriticalStateStudy(case, args.seeds)
-    result = run_critical_states(study, Store(args.out), options=RunOptions(workers=args.workers, progress=False))
+    options = RunOptions(workers=args.workers, progress=False)
+    result = run_critical_states(study, Store(args.out), options=options)
     per_seed = {}
     for seed, test in zip(result.seeds, result.tests, strict=True):
         s = test.series
