@@ -49,6 +49,22 @@ def series_of(gamma, mu, phi) -> CellSeries:
     )
 
 
+def test_the_study_keeps_each_seeds_steady_contact_anisotropy():
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from poro2d.critical_state.run import steady_anisotropy
+
+    g = np.linspace(0.01, 2.0, 200)
+    base = series_of(g, np.full(g.size, 0.3), np.full(g.size, 0.82))
+    assert np.isnan(base.a_c).all()  # a series of an earlier poro2d: no fabric
+    assert steady_anisotropy([SimpleNamespace(series=base)], 1.0) is None
+    # a_c rising to its steady value 0.2 (seed 1) and 0.3 (seed 2) before the window starts
+    seeds = [SimpleNamespace(series=replace(base, a_c=np.minimum(g, 1.0) * v)) for v in (0.2, 0.3)]
+    spread = steady_anisotropy(seeds, 1.0)
+    assert spread.values == pytest.approx([0.2, 0.3]) and spread.mean == pytest.approx(0.25)
+
+
 def test_the_case_is_its_own_file_record():
     """Every field in order, the grading as its sizes, percent passing and source, stiffness_number
     only when set; read back, the grading is a curve again and the case writes the same keys."""

@@ -229,6 +229,9 @@ def print_result(result, out: Path) -> None:
             f"stiffness number kappa = kn / (P t) = {result.stiffness_number:.0f}{held}, mean overlap / d = "
             f"{result.mean_overlap_ratio.text(4)}: an elastic strain of about 1 / kappa in the solid fraction"
         )
+    if result.contact_anisotropy is not None:
+        a_c = result.contact_anisotropy.text()
+        console.print(f"contact anisotropy a_c over the steady window = {a_c} (fabric.png, docs/fabric.md)")
     console.print(f"results in {out}/result.json, series.csv, critical_state.png")
 
 

@@ -97,7 +97,9 @@ class CriticalStateResult(TypedResult):
     Each number's spread over the seeds (:class:`Spread`), the void ratio (1 - phi) / phi with
     them; ``steady`` only if every seed's window was steady (``note`` says which was not);
     ``stiffness_number`` kappa at the pressure and the mean overlap over d (absent in files of
-    earlier versions). ``tests`` (not in the file): each seed's full result with its series.
+    earlier versions); ``contact_anisotropy``: each seed's mean a_c over the steady window
+    (:mod:`poro2d.measure.fabric`; absent in files of earlier versions). ``tests`` (not in the
+    file): each seed's full result with its series.
     """
 
     seeds: list[int]
@@ -113,11 +115,14 @@ class CriticalStateResult(TypedResult):
     void_ratio: Spread | None = None
     stiffness_number: float | None = None
     mean_overlap_ratio: Spread | None = None
+    contact_anisotropy: Spread | None = None
     tests: list[CriticalStateTestResult] = field(
         default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("void_ratio", "stiffness_number", "mean_overlap_ratio")
+    OPTIONAL: ClassVar[tuple[str, ...]] = (
+        "void_ratio", "stiffness_number", "mean_overlap_ratio", "contact_anisotropy",
+    )  # fmt: skip
 
     def headline(self) -> str:
         """The steady-state friction (tau/sigma and angle) and solid fraction with their spread."""

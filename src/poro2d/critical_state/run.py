@@ -283,8 +283,23 @@ def study_of(cases, tests, workers, wall, config) -> CriticalStateResult:
         provenance=Provenance.now(),
         void_ratio=Spread.of([void_ratio(t.solid_fraction) for t in tests]),
         stiffness_number=cases[0].kappa(),
+        contact_anisotropy=steady_anisotropy(tests, cases[0].window_start),
         tests=list(tests),
     )
+
+
+def steady_anisotropy(tests: list[CriticalStateTestResult], window_start: float) -> Spread | None:
+    """Each seed's mean contact anisotropy a_c over its steady window, as a spread; None when a
+    series did not record it (a run of an earlier poro2d read back)."""
+    means = []
+    for t in tests:
+        if t.series is None:
+            return None
+        a_c = t.series.a_c[t.series.window(window_start)]
+        if not (a_c.size and np.isfinite(a_c).all()):
+            return None
+        means.append(float(np.mean(a_c)))
+    return Spread.of(means)
 
 
 __all__ = [
