@@ -12,15 +12,17 @@ N = <f_n n (x) n> / <f_n>, and of the whole contact force, X = sym <f (x) n> / <
     a_c + a_n = 2 (N1 - N2) / (N1 + N2),    a_c + a_n + a_t = 2 (X1 - X2) / (X1 + X2),
 
 so that the stress-force-fabric relation q / p = (a_c + a_n + a_t) / 2 holds exactly when
-every branch vector has the same length (the branch-length anisotropy, left out here, is
-small for disks: Rothenburg & Bathurst 1989). Only disk-disk contacts enter the orientations:
-a flat wall's normals are fixed by the box, not by the packing.
+every branch vector has the same length (the branch lengths' anisotropy is left out: on this
+project's sheared packings the relation holds to a few per cent, tests/measure/test_fabric.py).
+Only disk-disk contacts enter the orientations: a flat wall's normals are fixed by the box,
+not by the packing.
 
 The mechanical coordination Z_m counts force-carrying contacts (f_n > 0) per disk after the
 rattlers are removed: disks with fewer than two such contacts, left out repeatedly until
 none remains (a disk losing a neighbour may become one). A disk-wall contact counts once,
-for the disk, as a force-carrying contact (as :func:`poro2d.measure.coordination_number`
-counts it; Thornton 2000, Geotechnique 50(1), 43-53, counts boundary contacts the same way).
+for the disk, as a force-carrying contact, as :func:`poro2d.measure.coordination_number`
+counts it: a disk held between a wall and one neighbour carries load and is no rattler. In
+the periodic cell there are no walls, and the number is the usual one of rattler-free disks.
 
 Everything here reads arrays: the walled engine's :class:`~poro2d.dem.contacts.ContactSet`
 (:func:`measure_fabric`) or the periodic cell's contact arrays (:func:`cell_fabric`), never the
