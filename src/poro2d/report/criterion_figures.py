@@ -32,11 +32,11 @@ def draw_criterion(result: CriterionResult, store: Store) -> None:
         folder = trial_store(store, t)
         weight = t.self_weight_n_per_m
         if folder.has(PREPARED[0]):
-            title = f"trial n2D = {t.trial_porosity:.3f}, top plate at H"
+            title = f"trial $n_{{2D}}$ = {t.trial_porosity:.3f}, top plate at $H$"
             _force_figure(folder, PREPARED, width, title, t.forces, weight)
         if folder.has(AFTER_PLATE[0]):
             what = "resting the lid" if t.plate.moved == "lid" else f"moving the top plate {t.plate.moved}"
-            title = f"after {what}: n' = {t.plate.new_porosity:.4f}"
+            title = f"after {what}: $n'$ = {t.plate.new_porosity:.4f}"
             _force_figure(folder, AFTER_PLATE, width, title, t.forces_after, weight)
     _paper_figures(result, store)
     _accepted_figures(result, store, width)
@@ -65,9 +65,9 @@ def _force_figure(folder: Store, state: tuple[str, str], width: float, title: st
     plot_simulation_force_chains(
         sim, folder.path(state[1]), title=title, box=(0.0, 0.0, width, top_height(sim, width)),
         notes=[
-            f"F_top = {forces.f_top_n_per_m:.4g} N/m",
-            f"F_bottom = {forces.f_bottom_n_per_m:.4g} N/m",
-            f"G = {weight:.4g} N/m",
+            f"$F_{{top}}$ = {forces.f_top_n_per_m:.4g} N/m",
+            f"$F_{{bottom}}$ = {forces.f_bottom_n_per_m:.4g} N/m",
+            f"$G$ = {weight:.4g} N/m",
         ],
     )  # fmt: skip
 
@@ -101,14 +101,14 @@ def _accepted_figures(result: CriterionResult, store: Store, width: float) -> No
     n2d = next(t for t in result.iterations if t.decision.accepted).trial_porosity
     top = top_height(sim, width)
     state = specimen_state(sim, width, top, trial_porosity=n2d)
-    title = f"accepted specimen, n2D = {n2d:.3f}: bands of equal height"
+    title = f"accepted specimen, $n_{{2D}}$ = {n2d:.3f}: bands of equal height"
     plot_specimen_state(state, store.path("specimen_state.png"), title=title)
     p = sim.particles
     try:
         m = measure_specimen(p.pos, p.radius, width, top, lid=lid_shape(sim, width))
     except (InputError, RuntimeError):  # no map: the run's specimen_porosity.json says why
         return
-    title = f"accepted specimen, n2D = {n2d:.3f}: local porosity (Laguerre cells)"
+    title = f"accepted specimen, $n_{{2D}}$ = {n2d:.3f}: local porosity (Laguerre cells)"
     plot_local_porosity(p.pos, p.radius, width, top, m, store.path("local_porosity.png"), title=title)
 
 

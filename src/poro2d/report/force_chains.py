@@ -18,9 +18,9 @@ from matplotlib.patches import Circle
 
 from poro2d.dem.contacts import ContactSet
 from poro2d.errors import InputError, check_range
-from poro2d.report.figure_file import new_figure, save_figure
+from poro2d.report.figure_file import VERMILION, new_figure, save_figure
 
-FORCE_COLOR = "#b2182b"
+FORCE_COLOR = VERMILION
 WALL_COLOR = "#333333"
 
 
