@@ -462,7 +462,8 @@ def _shear_blocks(shear, figures: dict[str, Path]) -> list[Block]:
 #: the columns of the quasi-static checks' table, one row per test
 CHECK_COLUMNS = [
     "normal stress (kPa)", "max inertial number I", "I below the limit",
-    "upper half vs shear plane (mean |diff| / tau)", "largest normal stress error after consolidation",
+    "upper half against shear plane (mean abs. difference / tau)",
+    "largest normal stress error after consolidation",
     "coordination number at the end", "ended by",
 ]  # fmt: skip
 

@@ -60,10 +60,14 @@ def plot_specimen_state(state: SpecimenStateResult, path: str | os.PathLike, tit
 
 
 def porosity_axis(porosity: list[float]) -> tuple[float, float]:
-    """The porosity axis of a profile, scaled to the packing: to the bands below the top one, whose
-    porosity counts the gap under the plate and may lie far beyond the rest, with a margin."""
-    packing = porosity[:-1] if len(porosity) > 2 else porosity
-    lo, hi = min(packing), max(packing)
+    """The porosity axis of a profile (bands bottom to top), scaled to the packing: the top band counts
+    the gap under the plate, so it sets the axis only when it lies within the spread of the bands
+    below it (at least 0.02) of their range; a margin of 15 % of the range (at least 0.01) either side."""
+    below = porosity[:-1] if len(porosity) > 2 else porosity
+    lo, hi = min(below), max(below)
+    top, reach = porosity[-1], max(hi - lo, 0.02)
+    if lo - reach <= top <= hi + reach:
+        lo, hi = min(lo, top), max(hi, top)
     pad = max(0.15 * (hi - lo), 0.01)
     return lo - pad, hi + pad
 
