@@ -12,12 +12,10 @@ from __future__ import annotations
 
 import json
 import math
-import re
 from pathlib import Path
 
 import numpy as np
 import pytest
-from PIL import Image
 
 from poro2d.criterion.result import CriterionOutputs, CriterionResult
 from poro2d.measure.specimen_state import SpecimenStateResult
@@ -33,37 +31,9 @@ from poro2d.report.shear_figures import (
 )
 from poro2d.report.specimen_figures import plot_specimen_state, porosity_axis
 from poro2d.shear.fit import mohr_coulomb
+from tests.report.print_checks import check_print_ready, typed_text
 
 STORED = Path(__file__).parents[1] / "data" / "before_typed_results"
-#: text a figure must not show as typed text (outside mathtext)
-FORBIDDEN = ("tau_peak", "+-", "sigma_", "phi_")
-
-
-def svg_texts(svg: Path) -> list[str]:
-    """The text of every Text artist in an SVG written by matplotlib (each one precedes its glyphs
-    as a comment), ``--`` unescaped."""
-    return [t.strip() for t in re.findall(r"<!-- (.*?) -->", svg.read_text(), flags=re.S)]
-
-
-def typed_text(text: str) -> str:
-    """``text`` without its mathtext parts (``$...$``), which render as symbols."""
-    return re.sub(r"(?<!\\)\$.*?(?<!\\)\$", " ", text)
-
-
-def check_print_ready(png: Path) -> list[str]:
-    """Assert ``png`` is a 300 dpi PNG with an SVG beside it and no symbol typed as text; return
-    the SVG's texts."""
-    with Image.open(png) as im:
-        assert im.format == "PNG"
-        assert im.info["dpi"] == pytest.approx((DPI, DPI), abs=0.01)
-    svg = png.with_suffix(".svg")
-    assert svg.read_text().lstrip().startswith("<?xml")
-    texts = svg_texts(svg)
-    assert texts, svg
-    for text in texts:
-        for bad in FORBIDDEN:
-            assert bad not in typed_text(text), (png.name, text)
-    return texts
 
 
 def test_dpi_and_palette_are_chosen_once():
