@@ -41,7 +41,7 @@ _STYLE = {
 
 
 def _eq2_label(reading: str) -> str:
-    label = f"Densest State modified\n(Eq. 2, nu {reading.replace('_', ' ')})"
+    label = f"Densest State modified\n(Eq. 2, $\\nu$ {reading.replace('_', ' ')})"
     if reading == "solid_fraction":
         label = label[:-1] + "; near LIM 2D-Lab)"
     return label
