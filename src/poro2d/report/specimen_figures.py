@@ -74,18 +74,21 @@ def porosity_axis(porosity: list[float]) -> tuple[float, float]:
 
 def _porosity_profile(ax, porosity: list[float], z: np.ndarray) -> None:
     """The porosity per band against height on the packing's scale; a band beyond it (the top one,
-    with the gap under the plate) is drawn at the axis' edge as an arrow with its value."""
+    with the gap under the plate) is not joined to the rest but drawn at the axis' edge as an
+    arrow with its value."""
     lo, hi = porosity_axis(porosity)
-    shown = np.clip(porosity, lo, hi)
-    ax.plot(shown, z, "o-", color=BLUE)
+    n = np.asarray(porosity, dtype=float)
+    inside = (n >= lo) & (n <= hi)
+    ax.plot(np.where(inside, n, np.nan), z, "o-", color=BLUE)
     ax.set_xlim(lo, hi)
-    for n, x, h in zip(porosity, shown, z, strict=True):
-        if n != x:
-            right = n > hi
-            ax.plot([x], [h], ">" if right else "<", color=VERMILION, ms=9, zorder=5)
-            ax.annotate(f"{n:.3f}\n(gap under\nthe plate)", (x, h), xytext=(-8 if right else 8, 0),
-                        textcoords="offset points", ha="right" if right else "left", va="center",
-                        fontsize=8, color=VERMILION)  # fmt: skip
+    for value, h in zip(n[~inside], z[~inside], strict=True):
+        right = value > hi
+        inset = 0.03 * (hi - lo)  # the arrow inside the axes, pointing past its edge
+        edge = hi - inset if right else lo + inset
+        ax.plot([edge], [h], ">" if right else "<", color=VERMILION, ms=9, zorder=5)
+        ax.annotate(f"{value:.3f}\n(gap under\nthe plate)", (edge, h), xytext=(-8 if right else 8, -8),
+                    textcoords="offset points", ha="right" if right else "left", va="top",
+                    fontsize=8, color=VERMILION)  # fmt: skip
 
 
 def plot_local_porosity(
