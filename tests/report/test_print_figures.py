@@ -175,3 +175,10 @@ def test_report_compares_k0_with_jaky_for_the_measured_angle():
     assert f"phi = {phi:.1f} deg (this run's direct shear peaks) | {jaky:.2f} |" in md
     assert f"| ratio of the two | {state.k0_mean / jaky:.2f} |" in md
     assert f"is not Jaky's 1 - sin phi ({jaky:.2f} for the angle this run measured)" in md
+
+
+def test_force_legend_writes_numbers_as_a_reader_does():
+    from poro2d.report.force_chains import force_text
+
+    assert [force_text(v) for v in (1e4, 2500.0, 500.0, 2.5)] == ["10,000", "2,500", "500", "2.5"]
+    assert force_text(3.854e6) == r"$3.85 \times 10^{6}$" and force_text(2e-5) == r"$2 \times 10^{-5}$"

@@ -175,7 +175,7 @@ def _draw_regions(ax, d: PorosityDetails, plate_y: float, width: float) -> list:
     ax.plot([0.0, width * 1e3], [plate_y * 1e3] * 2, color="black", lw=2.5)
     return [
         Line2D([], [], color="black", lw=2.5, label="top plate"),
-        Line2D([], [], color=ORANGE, lw=0.9, label="free surface h(x)"),
+        Line2D([], [], color=ORANGE, lw=0.9, label=r"free surface $h(x)$"),
         Line2D([], [], color="0.35", ls="--", lw=1.4, label="interior: margin from walls, surface"),
         Line2D([], [], color=VERMILION, lw=1.3, label="measurement circles (porosity)"),
     ]
@@ -193,7 +193,7 @@ def _summary_text(m: SpecimenPorosity) -> str:
     touching = f"{m.plate_touching_disks} disk{'s' if m.plate_touching_disks != 1 else ''}"
     g, mn = m.surface_gap_mean_m * mm, m.surface_gap_mean_d50
     rows = [
-        ("box porosity n' (W x H_plate)", f"{m.box_porosity:.4f}"),
+        ("box porosity n' (W x plate height)", f"{m.box_porosity:.4f}"),
         (
             f"interior, {m.interior_regions} circles",
             f"{m.interior_porosity:.4f} ± {m.interior_porosity_std:.4f}",
