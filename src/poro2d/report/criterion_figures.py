@@ -16,6 +16,7 @@ from poro2d.criterion.result import CriterionResult
 from poro2d.errors import InputError
 from poro2d.measure.specimen_porosity import measure_specimen
 from poro2d.measure.specimen_state import specimen_state
+from poro2d.report.figure_file import figure_files
 from poro2d.report.force_chains import plot_simulation_force_chains
 from poro2d.report.specimen_figures import plot_local_porosity, plot_specimen_state
 from poro2d.store import Store, walk
@@ -74,7 +75,8 @@ def _force_figure(folder: Store, state: tuple[str, str], width: float, title: st
 
 def _paper_figures(result: CriterionResult, store: Store) -> None:
     """Fig. 5 (the first trial as prepared), Fig. 6 (the first trial whose top moved) and Fig. 7
-    (the accepted trial, in the state it was accepted on), copied to the top of ``store``."""
+    (the accepted trial, in the state it was accepted on), copied to the top of ``store`` with
+    their SVGs."""
     trials = result.iterations
     if not trials:
         return
@@ -87,8 +89,10 @@ def _paper_figures(result: CriterionResult, store: Store) -> None:
         figure = AFTER_PLATE[1] if found[1] == AFTER_PLATE[0] else PREPARED[1]
         pairs.append((found[0], figure, "fig7_forces_accepted.png"))
     for folder, name, as_name in pairs:
-        if folder.has(name):
-            folder.copy(name, store, as_name)
+        # the figure and its vector twin, each copied when the trial has it
+        for source, target in zip(figure_files(name), figure_files(as_name), strict=True):
+            if folder.has(source.name):
+                folder.copy(source.name, store, target.name)
 
 
 def _accepted_figures(result: CriterionResult, store: Store, width: float) -> None:
