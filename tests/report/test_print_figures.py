@@ -182,3 +182,13 @@ def test_force_legend_writes_numbers_as_a_reader_does():
 
     assert [force_text(v) for v in (1e4, 2500.0, 500.0, 2.5)] == ["10,000", "2,500", "500", "2.5"]
     assert force_text(3.854e6) == r"$3.85 \times 10^{6}$" and force_text(2e-5) == r"$2 \times 10^{-5}$"
+
+
+def test_k0_note_says_agreement_only_when_k0_is_near_jakys():
+    from poro2d.report.paper_report import k0_blocks, k0_note
+
+    assert "is within 15% of Jaky's" in k0_note(0.42, jaky_k0(36.0))  # 0.42 against 0.41
+    assert "is not Jaky's 1 - sin phi (0.41" in k0_note(0.90, jaky_k0(36.0))
+    assert "about 0.4-0.5 for sands" in k0_note(0.90)  # no angle measured: the sands' range
+    table = k0_blocks(0.9, None, None)[0]
+    assert len(table[2]) == 1  # without an angle, only the specimen's K0
