@@ -59,3 +59,20 @@ def test_relation_and_sensitivity_figures_are_print_ready(tmp_path):
     sens = json.loads((STORED / "sensitivity.json").read_text())
     png, svg = plot_sensitivity(sens, tmp_path / "sensitivity")
     check_print_ready(png)
+
+
+def test_fabric_figures_are_print_ready(tmp_path):
+    from poro2d.measure.fabric import FabricRoses, orientation_histogram
+    from poro2d.report.fabric_figures import plot_fabric, plot_rose
+
+    angle = np.radians(np.linspace(0.0, 180.0, 400, endpoint=False))
+    normals = np.column_stack([np.cos(angle), np.sin(angle)])
+    hist = orientation_histogram(normals)
+    roses = FabricRoses.of("gamma", np.array([0.0, 1.0]), [hist, hist], peak=0)
+    texts = check_print_ready(plot_rose(roses, tmp_path / "rose.png", title=r"$\sigma_3$ = 100 kPa"))
+    assert any("a_c" in t for t in texts)
+    gamma = np.linspace(0.0, 2.0, 20)
+    curve = {"gamma": gamma, "a_c": 0.2 + 0 * gamma, "a_n": 0.3 + 0 * gamma, "a_t": 0.05 + 0 * gamma,
+             "z_mech": 3.4 + 0 * gamma}  # fmt: skip
+    check_print_ready(plot_fabric([("seed 1", curve)], tmp_path / "fabric.png", x="gamma",
+                                  xlabel=r"shear strain $\gamma$", title="periodic shear"))  # fmt: skip

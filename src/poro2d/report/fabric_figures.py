@@ -34,10 +34,10 @@ ROSE_FIGURE = "fabric_rose.png"
 CURVE_FIGURE = "fabric.png"
 #: the panels of ``fabric.png``: column, axis label
 PANELS = (
-    ("a_c", "contact anisotropy a_c"),
-    ("a_n", "normal-force anisotropy a_n"),
-    ("a_t", "tangential-force anisotropy a_t"),
-    ("z_mech", "mechanical coordination Z_m"),
+    ("a_c", "contact anisotropy $a_c$"),
+    ("a_n", "normal-force anisotropy $a_n$"),
+    ("a_t", "tangential-force anisotropy $a_t$"),
+    ("z_mech", "mechanical coordination $Z_m$"),
 )
 
 
@@ -68,7 +68,7 @@ def plot_rose(roses: FabricRoses, path: str | os.PathLike, *, title: str) -> Pat
         ax.plot(theta, fourier_rose(np.degrees(theta), a_c, theta_c), color="k", lw=1.2)
         ax.set_title(
             f"{name}: {roses.axis} = {rose.at:.4g}, {rose.contacts} contacts\n"
-            f"2nd-order fit (line): a_c = {a_c:.3f}, theta_c = {theta_c:.0f} deg", fontsize=8,
+            f"2nd-order fit (line): $a_c$ = {a_c:.3f}, $\\theta_c$ = {theta_c:.0f}$\\degree$", fontsize=8,
         )  # fmt: skip
         ax.set_yticklabels([])
     fig.suptitle(title, fontsize=9)
@@ -128,7 +128,7 @@ def draw_biaxial_fabric(result: BiaxialResult | BiaxialSeriesResult, store: Stor
         for study in result.studies:
             draw_biaxial_fabric(study, store.child(stress_folder(study.confining_stress_kpa)))
         return
-    title = f"biaxial test, sigma_3 = {result.confining_stress_kpa:g} kPa"
+    title = f"biaxial test, $\\sigma_3$ = {result.confining_stress_kpa:g} kPa"
     for k in range(len(result.tests)):
         draw_rose(store.child(f"replicate{k + 1}"), f"{title}, replicate {k + 1}")
     plot_fabric(
@@ -148,7 +148,7 @@ def draw_critical_state_fabric(result: CriticalStateResult | CriticalStateLineRe
         draw_rose(store.child(f"seed{seed}"), f"{title}, seed {seed}")
     plot_fabric(
         [(f"seed {s}", t.series) for s, t in zip(result.seeds, result.tests, strict=True)],
-        store.path(CURVE_FIGURE), x="gamma", xlabel="shear strain gamma", title=f"{title}: fabric",
+        store.path(CURVE_FIGURE), x="gamma", xlabel=r"shear strain $\gamma$", title=f"{title}: fabric",
     )  # fmt: skip
 
 
