@@ -433,11 +433,14 @@ def estimate_size(spec: SpecimenSpec, grading: GradingCurve, porosity: float) ->
     in every layer plus a stage's equilibrium per stage: ``EQUILIBRIUM_STEPS`` at the paper's
     time step, more in proportion when the smallest disk sets a smaller one (:func:`time_step`;
     the paper's grading and Table 1 give exactly ``EQUILIBRIUM_STEPS``). The time assumes
-    ``THROUGHPUT``.
+    ``THROUGHPUT``. A grading whose light disks get raised masses (:func:`mass_scaling_step`)
+    steps at the shared step.
     """
     solid_area = (1.0 - porosity) * spec.width * spec.height
     disks = grading.expected_count(solid_area)
     dt = time_step(spec, grading.d_min_m)
+    if spec.mass_scaling != "off" and disks <= spec.max_disks:  # drawn only when they will be
+        dt = grading_mass_scaling_step(spec, grading, porosity) or dt
     dt_paper = time_step(SpecimenSpec(), PAPER_D_MIN)
     stage = max(EQUILIBRIUM_STEPS, math.ceil(EQUILIBRIUM_STEPS * dt_paper / dt - 1e-9))
     steps = spec.layers * (spec.growth_increments * spec.growth_steps + stage) + stage
