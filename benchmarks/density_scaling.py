@@ -60,7 +60,8 @@ def run_one(name: str, scaled: bool, seed: int) -> dict:
         "grading": name, "scaled": scaled, "seed": seed, "n2d": res.final_porosity,
         "interior": res.interior_porosity, "box": res.box_porosity, "trials": len(res.iterations),
         "disks": res.iterations[-1].particle_count, "plate_steps": steps,
-        "dt_shared_s": res.iterations[-1].mass_scaling_dt_s, "scaled_disks": res.iterations[-1].mass_scaled_disks,
+        "dt_shared_s": res.iterations[-1].mass_scaling_dt_s,
+        "scaled_disks": res.iterations[-1].mass_scaled_disks,
         "wall_s": time.perf_counter() - t0, "message": res.message,
     }  # fmt: skip
 
@@ -76,10 +77,10 @@ def table(rows: list[dict]) -> str:
                 continue
             n2d, inner = [r["n2d"] for r in got], [r["interior"] for r in got]
             sd = lambda v: statistics.stdev(v) if len(v) > 1 else float("nan")  # noqa: E731
+            trials, wall = (statistics.mean(r[k] for r in got) for k in ("trials", "wall_s"))
             out.append(
                 f"| {name} | {'scaled' if scaled else 'true'} | {len(got)} | {statistics.mean(n2d):.4f} | "
-                f"{sd(n2d):.4f} | {statistics.mean(inner):.4f} | {sd(inner):.4f} | "
-                f"{statistics.mean(r['trials'] for r in got):.1f} | {statistics.mean(r['wall_s'] for r in got):.0f} |"
+                f"{sd(n2d):.4f} | {statistics.mean(inner):.4f} | {sd(inner):.4f} | {trials:.1f} | {wall:.0f} |"
             )
     return "\n".join(out)
 
