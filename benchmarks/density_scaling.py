@@ -78,9 +78,10 @@ def table(rows: list[dict]) -> str:
             n2d, inner = [r["n2d"] for r in got], [r["interior"] for r in got]
             sd = lambda v: statistics.stdev(v) if len(v) > 1 else float("nan")  # noqa: E731
             trials, wall = (statistics.mean(r[k] for r in got) for k in ("trials", "wall_s"))
+            mode = "scaled" if scaled else "true"
             out.append(
-                f"| {name} | {'scaled' if scaled else 'true'} | {len(got)} | {statistics.mean(n2d):.4f} | "
-                f"{sd(n2d):.4f} | {statistics.mean(inner):.4f} | {sd(inner):.4f} | {trials:.1f} | {wall:.0f} |"
+                f"| {name} | {mode} | {len(got)} | {statistics.mean(n2d):.4f} | {sd(n2d):.4f} | "
+                f"{statistics.mean(inner):.4f} | {sd(inner):.4f} | {trials:.1f} | {wall:.0f} |"
             )
     return "\n".join(out)
 
