@@ -24,20 +24,20 @@ SOILS = Path(__file__).resolve().parents[1] / "examples" / "soils"
 
 #: name -> (grading table, box (W, H, layers), first trial porosity, the scaled run's settings)
 CASES = {
-    # G1-1's fines whole (0.1 mm), its coarse end cut at 4.75 mm to fit a 40 x 20 mm box:
-    # r_mean / r_min 10.5, so "auto" raises the masses (shared step 5.3 times the finest disk's)
-    "g1-1 (d <= 4.75 mm)": (
-        {"csv": str(SOILS / "g1-1_sandy_gravel.csv"), "upscale": 1, "d_max_mm": 4.75},
-        (0.04, 0.02, 2),
+    # G1-1's fines whole (0.1 mm), its coarse end cut at 2.36 mm to fit a 20 x 10 mm box:
+    # r_mean / r_min 9, so "auto" raises the masses (shared step 4.6 times the finest disk's)
+    "g1-1 (d <= 2.36 mm)": (
+        {"csv": str(SOILS / "g1-1_sandy_gravel.csv"), "upscale": 1, "d_max_mm": 2.36},
+        (0.02, 0.01, 1),
         0.16,
         {"mass_scaling": "auto"},
     ),
     # the paper's grading and CB-Mix-2 lie below the trigger: forced on, raised to the MEAN disk
     # (mass_scaling_ratio 1), a stronger scaling than "auto" ever applies (about half the disks)
-    "paper": ({"preset": "paper"}, (0.08, 0.04, 2), 0.16, {"mass_scaling": "on", "mass_scaling_ratio": 1.0}),
+    "paper": ({"preset": "paper"}, (0.06, 0.03, 2), 0.16, {"mass_scaling": "on", "mass_scaling_ratio": 1.0}),
     "cb-mix-2": (
         {"csv": str(SOILS / "cb-mix-2_sand.csv"), "upscale": 4},
-        (0.06, 0.03, 2),
+        (0.04, 0.02, 2),
         0.17,
         {"mass_scaling": "on", "mass_scaling_ratio": 1.0},
     ),
