@@ -25,7 +25,7 @@ SOILS = Path(__file__).resolve().parents[1] / "examples" / "soils"
 #: name -> (grading table, box (W, H, layers), first trial porosity, the scaled run's settings)
 CASES = {
     # G1-1's fines whole (0.1 mm), its coarse end cut at 2.36 mm to fit a 20 x 10 mm box:
-    # r_mean / r_min 9, so "auto" raises the masses (shared step 4.6 times the finest disk's)
+    # r_mean / r_min 9, so "auto" raises the masses (shared step 4.4 times the finest disk's)
     "g1-1 (d <= 2.36 mm)": (
         {"csv": str(SOILS / "g1-1_sandy_gravel.csv"), "upscale": 1, "d_max_mm": 2.36},
         (0.02, 0.01, 1),
