@@ -9,7 +9,7 @@ frame of one runner page, so that one browser renders them all. For each page it
   if any, is an element of that page;
 * every ``<img>`` rendered: its ``naturalWidth`` is above zero once the page has loaded;
 * a notebook page (``notebooks/...``) shows outputs: at least one of its code cells has one, and
-  none is an error.
+  none is a traceback (its outputs on stderr, a library's warnings, are counted in the table).
 
 It prints one row per page and exits with 1 if any page has a problem (2 if the check could not
 run: no Chromium, no site). Only the Python standard library and the ``chromium`` executable are
@@ -56,11 +56,14 @@ function imagesDone(doc) {
 function notebook(doc) {
   const cells = [...doc.querySelectorAll(".jp-CodeCell")];
   if (!cells.length) return null;
+  const stderr = [...doc.querySelectorAll(
+    '.jp-OutputArea-output[data-mime-type="application/vnd.jupyter.stderr"]')];
+  const traceback = /Traceback \(most recent call last\)|^\w+(Error|Exception)\b/m;
   return {
     code_cells: cells.length,
     with_output: cells.filter((c) => c.querySelector(".jp-OutputArea-output")).length,
-    errors: doc.querySelectorAll('.jp-OutputArea-output[data-mime-type="application/vnd.jupyter.stderr"]'
-      + ', .jp-RenderedText[data-mime-type="application/vnd.jupyter.error"]').length,
+    stderr: stderr.length,
+    errors: stderr.filter((o) => traceback.test(o.textContent)).length,
   };
 }
 async function check(url) {
@@ -305,10 +308,12 @@ def page_report(found: dict, base: str, ids: dict[str, set[str]], site: Path) ->
             report.problems.append("a notebook page without code cells")
         else:
             report.outputs = f"{cells['with_output']}/{cells['code_cells']}"
+            if cells["stderr"]:  # shown to the reader (warnings, logs), but no failure: said, not refused
+                report.outputs += f" ({cells['stderr']} stderr)"
             if cells["with_output"] == 0:
                 report.problems.append("no cell output: the notebook was not executed")
             if cells["errors"]:
-                report.problems.append(f"{cells['errors']} error output(s)")
+                report.problems.append(f"{cells['errors']} error output(s): a traceback")
     return report
 
 
@@ -324,11 +329,10 @@ def check_site(site: Path, timeout: float = 300.0) -> list[PageReport]:
 def table(reports: list[PageReport]) -> str:
     """The reports as a plain table: page, links, images, notebook outputs, problems."""
     width = max([len(r.path) for r in reports] + [4])
-    lines = [f"{'page':<{width}}  {'links':>5}  {'images':>6}  {'outputs':>7}  problems"]
+    lines = [f"{'page':<{width}}  {'links':>5}  {'images':>6}  {'outputs':>16}  problems"]
     for r in reports:
-        lines.append(
-            f"{r.path:<{width}}  {r.links:>5}  {r.images:>6}  {r.outputs:>7}  {'; '.join(r.problems) or 'ok'}"
-        )
+        problems = "; ".join(r.problems) or "ok"
+        lines.append(f"{r.path:<{width}}  {r.links:>5}  {r.images:>6}  {r.outputs:>16}  {problems}")
     return "\n".join(lines)
 
 

@@ -23,12 +23,19 @@ def page(body: str) -> str:
     return f"<!doctype html><html><head><title>t</title></head><body>{body}</body></html>"
 
 
-def notebook(outputs: int) -> str:
-    """A page as mkdocs-jupyter renders a notebook: two code cells, ``outputs`` of them with one."""
+STDERR = (
+    '<div class="jp-OutputArea-output" data-mime-type="application/vnd.jupyter.stderr"><pre>{}</pre></div>'
+)
+
+
+def notebook(outputs: int, stderr: str) -> str:
+    """A page as mkdocs-jupyter renders a notebook: three code cells, ``outputs`` of the first two
+    with an output, the third with ``stderr`` written to the standard error."""
     cells = []
     for k in range(2):
         output = '<div class="jp-OutputArea-output"><pre>42</pre></div>' if k < outputs else ""
         cells.append(f'<div class="jp-Cell jp-CodeCell"><pre>x = {k}</pre>{output}</div>')
+    cells.append(f'<div class="jp-Cell jp-CodeCell"><pre>run()</pre>{STDERR.format(stderr)}</div>')
     return page("".join(cells))
 
 
@@ -49,7 +56,11 @@ def make_site(root: Path, *, faults: bool) -> Path:
     if faults:
         figure += '<img src="../img/absent.png">'
     (site / "guide" / "index.html").write_text(page(figure + '<a href="../">home</a>'))
-    (site / "notebooks" / "demo" / "index.html").write_text(notebook(outputs=0 if faults else 1))
+    traceback = "Traceback (most recent call last):\n  File ...\nValueError: bad"
+    stderr = traceback if faults else "WARNING - Worker process still alive"  # a log line is no fault
+    (site / "notebooks" / "demo" / "index.html").write_text(
+        notebook(outputs=0 if faults else 1, stderr=stderr)
+    )
     (site / "404.html").write_text(page("not found"))
     return site
 
@@ -84,7 +95,7 @@ def test_a_page_report_from_what_the_browser_found(tmp_path):
 
 def test_a_notebook_page_needs_outputs(tmp_path):
     site = make_site(tmp_path, faults=False)
-    cells = {"code_cells": 2, "with_output": 0, "errors": 0}
+    cells = {"code_cells": 2, "with_output": 0, "stderr": 0, "errors": 0}
     found = {"url": "http://127.0.0.1:1/notebooks/demo/", "links": [], "images": [], "notebook": cells}
     report = check_site.page_report(found, "http://127.0.0.1:1", {}, site)
     assert report.outputs == "0/2" and report.problems == ["no cell output: the notebook was not executed"]
@@ -109,7 +120,7 @@ def test_a_sound_site_passes_in_the_browser(tmp_path, capsys):
     assert "3 pages" in out and "all ok" in out
     rows = {line.split()[0]: line for line in out.splitlines()[1:4]}
     assert rows["/guide/"].split()[1:4] == ["1", "1", "ok"]  # one link, one image, rendered
-    assert rows["/notebooks/demo/"].split()[3] == "1/2"
+    assert rows["/notebooks/demo/"].split()[3:] == ["2/3", "(1", "stderr)", "ok"]
 
 
 @pytest.mark.scenario
@@ -121,7 +132,7 @@ def test_each_fault_is_found_in_the_browser(tmp_path, capsys):
     assert reports == {
         "/": ["broken link /missing/", "missing anchor /guide/#no-such-part"],
         "/guide/": ["image not rendered ../img/absent.png"],
-        "/notebooks/demo/": ["no cell output: the notebook was not executed"],
+        "/notebooks/demo/": ["1 error output(s): a traceback"],
     }
 
 
