@@ -86,3 +86,27 @@ def test_sensitivity_refuses_a_taken_dashboard_port_on_one_line_before_work(busy
     err = capsys.readouterr().err.strip()
     assert "--dashboard" in err and "in use" in err and len(err.splitlines()) == 1
     assert not (tmp_path / "s").exists()
+
+
+def test_closing_a_finished_local_cluster_hides_the_nannys_kill_notice(caplog):
+    import logging
+
+    from poro2d.execute.dask_cluster import DaskCluster
+
+    class SlowToStop:  # a LocalCluster whose worker outlived the nanny's wait as it closed
+        def close(self):
+            logging.getLogger("distributed.nanny").warning(
+                "Worker process still alive after 4 seconds, killing"
+            )
+            logging.getLogger("distributed.nanny").error("a real failure")
+
+    cluster = DaskCluster(None, 1, None, 1)
+    cluster.local = SlowToStop()
+    nanny = logging.getLogger("distributed.nanny")
+    before = nanny.level
+    with caplog.at_level(logging.DEBUG, logger="distributed"):
+        nanny.setLevel(before)
+        cluster.close()
+    messages = [r.getMessage() for r in caplog.records]
+    assert "a real failure" in messages and not any("still alive" in m for m in messages)
+    assert nanny.level == before and cluster.local is None

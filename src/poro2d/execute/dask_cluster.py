@@ -257,7 +257,16 @@ class DaskCluster:
         if self.client is not None:
             self.client.close()
         if self.local is not None:
-            self.local.close()
+            # a finished run's workers are told to stop; on a loaded machine one may take longer
+            # than the nanny waits, and it says so ("Worker process still alive ... killing") for
+            # a worker whose work is done: noise under a command's or a notebook's answer
+            nanny = logging.getLogger("distributed.nanny")
+            level = nanny.level
+            nanny.setLevel(logging.ERROR)
+            try:
+                self.local.close()
+            finally:
+                nanny.setLevel(level)
         self.client = self.local = None
 
 
