@@ -39,6 +39,10 @@ MAX_FRICTION = 10.0
 #: inertial masses up to 1000 times the real ones: the inertial number grows with its root
 MAX_DENSITY_SCALE = 1000.0
 
+#: the longest interval (steps) between two steps of a run's ParaView series: beyond the steps of
+#: any test (the longest run about 4e7 steps), so a larger one is a typo
+MAX_VTK_EVERY = 100_000_000
+
 #: what the settings every box test has may be (a test's table takes them with :func:`lab_ranges`)
 LAB_RANGES: Ranges = {
     "consolidation_ratio": Real(0.0, 1.0, lo_open=True),
@@ -55,6 +59,8 @@ LAB_RANGES: Ranges = {
     "local_damping": Real(0.0, 1.0, hi_open=True, or_none=True),
     "density_scale": Real(1.0, MAX_DENSITY_SCALE),
     "dt_safety": Real(0.0, 1.0, lo_open=True),
+    # steps between two steps of the ParaView series (poro2d.labtest.vtk_series); 0: none
+    "vtk_every": Integer(0, MAX_VTK_EVERY),
 }
 #: the servo and the box's walls, in the order both tests check them
 SERVO_AND_WALLS = ("servo_gain", "servo_integral", "servo_max_speed", "kn_wall", "ks_wall", "friction_wall")
@@ -112,6 +118,6 @@ class TestSettings(Record):
 
 
 __all__ = [
-    "LAB_RANGES", "MAX_CONSOLIDATION_STEPS", "MAX_DENSITY_SCALE", "MAX_FRICTION", "MAX_WALL_STIFFNESS",
+    "LAB_RANGES", "MAX_CONSOLIDATION_STEPS", "MAX_VTK_EVERY", "MAX_DENSITY_SCALE", "MAX_FRICTION", "MAX_WALL_STIFFNESS",
     "NORMAL_STRESS_RANGE_KPA", "SERVO_AND_WALLS", "DisksAndEngine", "TestSettings", "lab_ranges",
 ]  # fmt: skip
