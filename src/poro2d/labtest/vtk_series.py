@@ -3,14 +3,16 @@
 A test asked for a series (its ``vtk_every``) keeps it in the ``vtk/`` folder of its store:
 ``step_<step>.vtu`` (:func:`poro2d.dem.export.step_mesh`: disks, walls, contact network),
 ``series.pvd`` (each step at the engine's time, in s) and ``series_<measure>.pvd`` (each step at
-the test's own measure: the shear displacement, the axial strain, the shear strain), both read by
-ParaView as one time series. ``series.json`` lists the steps written; a run resumed from a
-checkpoint drops the steps after it and writes them again, so the series reads as one run's.
-The files go through the store (atomic, in its manifest), the collections last.
+the test's own measure: the shear displacement, the axial strain, the shear strain, the plate's
+height), both read by ParaView as one time series. A run resumed from a checkpoint reads the
+steps back from ``series.pvd``, drops those after its checkpoint and writes them again, so the
+series reads as one run's. The files go through the store (atomic, in its manifest), the
+collections after the step's file.
 """
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from xml.sax.saxutils import quoteattr
 
@@ -20,7 +22,6 @@ from poro2d.store import Store
 #: the folder of a run's store that holds its series, and the files that list its steps
 FOLDER = "vtk"
 SERIES = "series.pvd"
-STEPS = "series.json"
 
 
 def collection(entries: list[dict], key: str) -> str:
@@ -36,6 +37,20 @@ def collection(entries: list[dict], key: str) -> str:
         lines.append(f'    <DataSet timestep="{e[key]!r}" part="0" file={quoteattr(e["file"])} {extra}/>')
     lines += ["  </Collection>", "</VTKFile>", ""]
     return "\n".join(lines)
+
+
+def read_entries(text: str | None, measure: str) -> list[dict]:
+    """The steps a ``series.pvd`` written by :func:`collection` lists (none when it is missing,
+    damaged or of another measure)."""
+    try:
+        sets = ET.fromstring(text).findall("./Collection/DataSet") if text else []
+        return [
+            {"step": int(d.get("step")), "time": float(d.get("timestep")), measure: float(d.get(measure)),
+             "file": d.get("file")}
+            for d in sets
+        ]  # fmt: skip
+    except (ET.ParseError, TypeError, ValueError):
+        return []
 
 
 @dataclass
@@ -59,9 +74,8 @@ class VtkSeries:
         if store is None:
             return None
         folder = store.child(FOLDER)
-        kept = folder.read_json(STEPS) if start > 0 else None
-        steps = kept.get("steps", []) if isinstance(kept, dict) and kept.get("measure") == measure else []
-        return cls(folder, measure, [e for e in steps if isinstance(e, dict) and e.get("step", -1) <= start])
+        kept = read_entries(folder.read_text(SERIES), measure) if start > 0 else []
+        return cls(folder, measure, [e for e in kept if e["step"] <= start])
 
     def write(self, frame: Frame, step: int, time: float, value: float) -> None:
         """Keep ``frame`` as stage step ``step`` at engine time ``time`` (s) and measure ``value``."""
@@ -69,9 +83,8 @@ class VtkSeries:
         numbers = {"step": int(step), "time": float(time), self.measure: float(value)}
         self.store.write_mesh(name, step_mesh(frame))
         self.entries = [e for e in self.entries if e["step"] < step] + [{**numbers, "file": name}]
-        self.store.write_json(STEPS, {"measure": self.measure, "steps": self.entries})
         self.store.write_text(f"series_{self.measure}.pvd", collection(self.entries, self.measure))
         self.store.write_text(SERIES, collection(self.entries, "time"))
 
 
-__all__ = ["FOLDER", "SERIES", "STEPS", "VtkSeries", "collection"]
+__all__ = ["FOLDER", "SERIES", "VtkSeries", "collection", "read_entries"]
