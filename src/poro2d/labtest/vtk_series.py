@@ -73,9 +73,9 @@ class VtkSeries:
         """
         if store is None:
             return None
-        folder = store.child(FOLDER)
-        kept = read_entries(folder.read_text(SERIES), measure) if start > 0 else []
-        return cls(folder, measure, [e for e in kept if e["step"] <= start])
+        series_store = store.child(FOLDER)
+        kept = read_entries(series_store.read_text(SERIES), measure) if start > 0 else []
+        return cls(series_store, measure, [e for e in kept if e["step"] <= start])
 
     def write(self, frame: Frame, step: int, time: float, value: float) -> None:
         """Keep ``frame`` as stage step ``step`` at engine time ``time`` (s) and measure ``value``."""
