@@ -10,7 +10,16 @@ import meshio
 import numpy as np
 import pytest
 
-from poro2d.dem.export import DISK, DISK_CONTACT, WALL, WALL_CONTACT, Frame, frame_of, frame_of_cell, step_mesh
+from poro2d.dem.export import (
+    DISK,
+    DISK_CONTACT,
+    WALL,
+    WALL_CONTACT,
+    Frame,
+    frame_of,
+    frame_of_cell,
+    step_mesh,
+)
 from poro2d.dem.reporters import drive_blocks
 from poro2d.errors import InputError
 from poro2d.identity import identity_digest
@@ -60,7 +69,9 @@ def _entries(folder, measure: str) -> list[dict]:
     assert [d.get("file") for d in by_time] == [d.get("file") for d in by_measure]
     out = []
     for t, m in zip(by_time, by_measure, strict=True):
-        assert float(t.get("timestep")) == float(m.get("time")) and float(m.get("timestep")) == float(t.get(measure))
+        assert float(t.get("timestep")) == float(m.get("time")) and float(m.get("timestep")) == float(
+            t.get(measure)
+        )
         out.append({"file": t.get("file"), "step": int(t.get("step")), "time": float(t.get("timestep")),
                     measure: float(m.get("timestep"))})  # fmt: skip
     return out
@@ -167,7 +178,9 @@ def test_a_biaxial_series_reads_back_as_the_run(tmp_path, monkeypatch):
     from poro2d.biaxial import BiaxialCase, BiaxialSettings, BiaxialTest
 
     short = {"max_strain": 0.005, "record_strain": 0.0005, "critical_window": 0.3}
-    plain = BiaxialTest(BiaxialCase.quick(100.0, seed=0, settings=BiaxialSettings(**short)), Store(tmp_path / "a")).run()
+    plain = BiaxialTest(
+        BiaxialCase.quick(100.0, seed=0, settings=BiaxialSettings(**short)), Store(tmp_path / "a")
+    ).run()
     every = 2 * int(plain.curve.step[1] - plain.curve.step[0]) + 1  # not on the rows: blocks end elsewhere
     snaps = _snapshots(monkeypatch, "poro2d.biaxial.stages", frame_of)
     settings = BiaxialSettings(**short, vtk_every=every)
@@ -225,7 +238,9 @@ def test_a_criterion_trial_keeps_its_plate_stage_as_a_series(tmp_path, monkeypat
     run("a")
     snaps = _snapshots(monkeypatch, "poro2d.criterion.servo", frame_of)
     run("b", vtk_every=4000)
-    assert _rows_without_times(tmp_path / "b/iterations.csv") == _rows_without_times(tmp_path / "a/iterations.csv")
+    assert _rows_without_times(tmp_path / "b/iterations.csv") == _rows_without_times(
+        tmp_path / "a/iterations.csv"
+    )
     (trial,) = (tmp_path / "b/trials").iterdir()
     entries = _entries(trial / "vtk", "plate_height")
     assert len(entries) == len(snaps) >= 3 and all(e["step"] % 4000 == 0 for e in entries)
@@ -237,7 +252,16 @@ def test_a_criterion_trial_keeps_its_plate_stage_as_a_series(tmp_path, monkeypat
 
 def test_the_series_is_outside_the_identity_and_checked():
     assert identity_digest(ShearSettings(vtk_every=50), tables={}) == identity_digest(ShearSettings())
-    assert "vtk_every" not in ShearSettings().to_dict() and ShearSettings(vtk_every=5).to_dict()["vtk_every"] == 5
+    assert (
+        "vtk_every" not in ShearSettings().to_dict()
+        and ShearSettings(vtk_every=5).to_dict()["vtk_every"] == 5
+    )
+    from poro2d.biaxial import BiaxialSettings
+    from poro2d.critical_state import CriticalStateCase
+
+    # a file written without the key reads it as its default: no series, not None
+    assert BiaxialSettings.from_dict(BiaxialSettings().to_dict()).vtk_every == 0
+    assert CriticalStateCase.from_dict(CriticalStateCase().to_dict()).vtk_every == 0
     for bad in (-1, 10**9, 2.5, True):
         with pytest.raises(InputError) as err:
             ShearSettings(vtk_every=bad)
@@ -260,8 +284,9 @@ def test_the_commands_refuse_a_bad_interval_on_one_line(command, value, tmp_path
 def test_a_step_mesh_of_a_hand_made_frame():
     """Two disks touching each other and a wall: the cells, their kinds and the points as laid out."""
     f = Frame(
-        pos=np.array([[0.0, 1.0], [2.0, 1.0]]), radius=np.array([1.0, 1.0]), velocity=np.array([[1.0, 0], [0, 2.0]]),
-        omega=np.array([3.0, 4.0]), theta=np.zeros(2), contact_force=np.array([[-5.0, 0.0], [5.0, 7.0]]),
+        pos=np.array([[0.0, 1.0], [2.0, 1.0]]), radius=np.array([1.0, 1.0]),
+        velocity=np.array([[1.0, 0], [0, 2.0]]), omega=np.array([3.0, 4.0]), theta=np.zeros(2),
+        contact_force=np.array([[-5.0, 0.0], [5.0, 7.0]]),
         wall_p0=np.array([[-1.0, 0.0]]), wall_p1=np.array([[3.0, 0.0]]), wall_force=np.array([[0.0, -7.0]]),
         contact_i=np.array([0, 1]), contact_j=np.array([1, 0]), contact_wall=np.array([False, True]),
         contact_end=np.array([[2.0, 1.0], [2.0, 0.0]]), fn=np.array([5.0, 7.0]), fs=np.array([0.0, -0.5]),

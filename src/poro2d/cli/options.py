@@ -100,7 +100,7 @@ vtk_every = partial(
     typer.Option,
     None,
     "--vtk-every",
-    help="Write a ParaView series (vtk/series.pvd) with a step every N engine steps (0: none; docs/paraview.md).",
+    help="A ParaView series (vtk/series.pvd), a step every N engine steps (0: none; docs/paraview.md).",
 )
 
 

@@ -362,7 +362,9 @@ class PorosityCriterion:
         ``vtk_every``, its ParaView series kept in the trial's ``folder``."""
         sp = self.spec
         series = VtkSeries.open(folder, "plate_height", 0) if self.settings.vtk_every else None
-        return PlateServo(self.settings, sp.ratio, sp.equilibrium, sp.height, progress=self.progress, series=series)
+        return PlateServo(
+            self.settings, sp.ratio, sp.equilibrium, sp.height, progress=self.progress, series=series
+        )
 
     def _trial(self, k: int, n: float) -> Trial:
         """Trial ``k`` at porosity ``n``: run, or read back from its ``trial.json`` once written."""

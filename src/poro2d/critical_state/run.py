@@ -35,12 +35,12 @@ from poro2d.critical_state.results import (
 )
 from poro2d.critical_state.series import COLUMNS, CellSeries, row_of
 from poro2d.critical_state.steady import read_steady
+from poro2d.dem.export import frame_of_cell
 from poro2d.dem.reporters import Every, drive_blocks
 from poro2d.errors import InputError, check_int
 from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
 from poro2d.io_utils import Provenance
-from poro2d.dem.export import frame_of_cell
 from poro2d.labtest.reporters import CurveRecorder, ProgressReporter, series_reporters
 from poro2d.store import Store, claimed
 
@@ -121,7 +121,9 @@ def run_critical_state(
     return done
 
 
-def _compute(case: CriticalStateCase, report: Report | None, store: Store | None = None) -> CriticalStateTestResult:
+def _compute(
+    case: CriticalStateCase, report: Report | None, store: Store | None = None
+) -> CriticalStateTestResult:
     """Build, compress and shear the cell; read its steady state (only its ParaView series kept in
     ``store``, when the case asks for one)."""
     t0 = time.perf_counter()

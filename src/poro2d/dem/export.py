@@ -206,7 +206,10 @@ def step_mesh(frame: Frame) -> meshio.Mesh:
     zeros_n = np.zeros(n)
     cell_data = {
         "cell_kind": [np.full(n, DISK, np.int32), kind.astype(np.int32)],
-        "body_i": [np.arange(n, dtype=np.int32), np.concatenate([np.arange(w), f.contact_i]).astype(np.int32)],
+        "body_i": [
+            np.arange(n, dtype=np.int32),
+            np.concatenate([np.arange(w), f.contact_i]).astype(np.int32),
+        ],
         "body_j": [np.full(n, -1, np.int32), np.concatenate([np.full(w, -1), f.contact_j]).astype(np.int32)],
         "normal_force": [zeros_n, np.concatenate([np.zeros(w), f.fn])],
         "tangential_force": [zeros_n, np.concatenate([np.zeros(w), np.abs(f.fs)])],

@@ -1,13 +1,14 @@
 """Reporters: what a run does between its blocks of compiled steps.
 
-A reporter has a ``period`` (steps) and ``report(sim, step) -> stop?``, called at every multiple
-of its period counted from the start of :meth:`~poro2d.dem.Simulation.run` (``step``: the steps
-of this run so far), or, for a reporter with a ``start`` (the steps its stage ran before this run,
-as when resumed from a checkpoint), where ``start + step`` is a multiple of its period. The engine runs compiled blocks up to the next step any reporter is due at,
-so reporters decide only where blocks end (which changes no number) and what is read there.
-Reporters due at the same step are called in the order given, all of them, and the run stops
-after them when any returned True. The laboratory tests' own reporters (a curve's rows,
-checkpoints, progress, stop tests) are in :mod:`poro2d.labtest.reporters`.
+A reporter has a ``period`` (steps) and ``report(sim, step) -> stop?``, called at every multiple of
+its period counted from the start of :meth:`~poro2d.dem.Simulation.run` (``step``: the steps of
+this run so far), or, for a reporter with a ``start`` (the steps its stage ran before this run, as
+when resumed from a checkpoint), where ``start + step`` is a multiple of its period. The engine
+runs compiled blocks up to the next step any reporter is due at, so reporters decide only where
+blocks end (which changes no number) and what is read there. Reporters due at the same step are
+called in the order given, all of them, and the run stops after them when any returned True. The
+laboratory tests' own reporters (a curve's rows, checkpoints, progress, stop tests) are in
+:mod:`poro2d.labtest.reporters`.
 """
 
 from __future__ import annotations

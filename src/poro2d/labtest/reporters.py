@@ -3,8 +3,9 @@
 A test's stage runs the engine once with the reporters it needs, each on its own period: the
 curve's rows (:class:`CurveRecorder`), the progress display (:class:`ProgressReporter`), the
 saved state a killed run continues from (:class:`Checkpointer`), the ParaView time series asked
-for (:class:`SeriesRecorder`) and the test that ends the stage (:class:`StopTest`). They are called in the order given, so a stage that checkpoints
-before its stop test saves its state at the step it stops at too, as the test's files expect.
+for (:class:`SeriesRecorder`) and the test that ends the stage (:class:`StopTest`). They are
+called in the order given, so a stage that checkpoints before its stop test saves its state at
+the step it stops at too, as the test's files expect.
 """
 
 from __future__ import annotations
@@ -93,7 +94,7 @@ def series_reporters(
     ``every`` is 0 or nothing is kept (``store`` None); else one :class:`SeriesRecorder` every
     ``every`` steps, the stage's first state written now when the stage starts afresh.
     """
-    if every <= 0 or store is None:
+    if not every or store is None:
         return []
     start = clock(engine)[0]
     series = VtkSeries.open(store, measure, start)
@@ -108,6 +109,6 @@ StopTest = Every
 
 
 __all__ = [
-    "Checkpointer", "ClockFn", "CurveRecorder", "ProgressFn", "ProgressReporter", "SeriesRecorder", "StopTest",
-    "series_reporters",
+    "Checkpointer", "ClockFn", "CurveRecorder", "ProgressFn", "ProgressReporter", "SeriesRecorder",
+    "StopTest", "series_reporters",
 ]  # fmt: skip

@@ -21,6 +21,7 @@ from typing import Any, Self
 
 from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
 from poro2d.errors import Integer, Ranges, Real
+from poro2d.identity import outside_fields
 from poro2d.record import Record
 
 #: the normal (or confining) stresses (kPa) a box test may be run at. A contact carries about
@@ -98,12 +99,14 @@ class TestSettings(Record):
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> Self:
-        """The settings a file keeps, as kept: a setting the file lacks reads as None and is left
-        out when written back; a key of another version is written back after the settings."""
+        """The settings a file keeps, as kept: a setting the file lacks reads as None (one outside
+        the run's identity, an output such as ``vtk_every``, as its default) and is left out when
+        written back; a key of another version is written back after the settings."""
         names = [f.name for f in fields(cls)]  # type: ignore[arg-type]
+        outputs = {f.name: f.default for f in fields(cls) if f.name in outside_fields(cls)}  # type: ignore[arg-type]
         obj = cls.__new__(cls)  # not checked again: a file holds what was run
         for name in names:
-            object.__setattr__(obj, name, data.get(name))
+            object.__setattr__(obj, name, data.get(name, outputs.get(name)))
         object.__setattr__(obj, "_absent", frozenset(n for n in names if n not in data))
         object.__setattr__(obj, "_extra", {k: v for k, v in data.items() if k not in names})
         return obj
@@ -118,6 +121,7 @@ class TestSettings(Record):
 
 
 __all__ = [
-    "LAB_RANGES", "MAX_CONSOLIDATION_STEPS", "MAX_VTK_EVERY", "MAX_DENSITY_SCALE", "MAX_FRICTION", "MAX_WALL_STIFFNESS",
-    "NORMAL_STRESS_RANGE_KPA", "SERVO_AND_WALLS", "DisksAndEngine", "TestSettings", "lab_ranges",
+    "LAB_RANGES", "MAX_CONSOLIDATION_STEPS", "MAX_DENSITY_SCALE", "MAX_FRICTION", "MAX_VTK_EVERY",
+    "MAX_WALL_STIFFNESS", "NORMAL_STRESS_RANGE_KPA", "SERVO_AND_WALLS", "DisksAndEngine", "TestSettings",
+    "lab_ranges",
 ]  # fmt: skip
