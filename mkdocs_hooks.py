@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import posixpath
 import re
 import tempfile
 from pathlib import Path
@@ -65,3 +66,30 @@ def on_files(files, config):
 
 def on_page_markdown(markdown, page, config, files):
     return rewrite_links(markdown)
+
+
+#: a relative link to a Markdown page in a rendered notebook: href="../shear.md#anchor"
+_NOTEBOOK_LINK = re.compile(r'href="((?:\.\./|\./)?[\w./-]+)\.md(#[^"]*)?"')
+
+
+def notebook_links(html: str, source: str, url: str) -> str:
+    """``html`` of the notebook ``source`` (``notebooks/own-soil.ipynb``), shown at ``url``
+    (``notebooks/own-soil/``), with its links to pages (``../sand.md``, right beside the file)
+    pointed at those pages' site addresses (``../../sand/``).
+
+    A notebook's Markdown cells are not Markdown pages: MkDocs neither rewrites nor checks their
+    links (benchmarks/check_site.py finds those that still break in the built site).
+    """
+
+    def site_link(match: re.Match) -> str:
+        page = posixpath.normpath(posixpath.join(posixpath.dirname(source), match.group(1)))
+        target = "" if page == "index" else page.removesuffix("/index") + "/"
+        return f'href="{posixpath.relpath(target or ".", url)}/{match.group(2) or ""}"'
+
+    return _NOTEBOOK_LINK.sub(site_link, html)
+
+
+def on_post_page(output, page, config):
+    if page.file.src_uri.endswith(".ipynb"):
+        return notebook_links(output, page.file.src_uri, page.url)
+    return output

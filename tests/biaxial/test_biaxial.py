@@ -109,6 +109,24 @@ def test_files_and_typed_results(full):
     assert one.to_dict() == r.tests[0].to_dict()
 
 
+def test_the_contacts_turn_towards_the_compression_axis(full):
+    """Axial compression adds contacts along the vertical (the major principal stress) and takes
+    them from the horizontal: a_c grows from its consolidated value and theta_c nears 90 degrees;
+    the rose at the peak and at the end is kept and drawn."""
+    from poro2d.measure.fabric import FabricRoses
+    from poro2d.report.fabric_figures import draw_biaxial_fabric
+
+    out, r = full
+    c = r.tests[0].curve
+    roses = FabricRoses.from_dict(json.loads((out / "replicate1" / "fabric_rose.json").read_text()))
+    k = roses.peak.record
+    assert c["a_c"][k] > c["a_c"][0] + 0.05
+    assert abs(c["theta_c"][k] - 90.0) < 25.0
+    assert roses.end.record == c["a_c"].size - 1 and roses.peak.at == c["axial_strain"][k]
+    draw_biaxial_fabric(r, Store(out))
+    assert (out / "fabric.png").stat().st_size > 0 and (out / "replicate1" / "fabric_rose.png").exists()
+
+
 def test_the_critical_state_check_can_say_not_yet(full):
     _, r = full
     c = r.tests[0].curve

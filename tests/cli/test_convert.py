@@ -5,6 +5,8 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
+from pathlib import Path
 
 import pytest
 
@@ -330,3 +332,50 @@ def test_geotechnical_errors_exit_2_one_line(argv, needle, capsys):
     assert "Traceback" not in out + err
     assert needle in err, err
     assert len(err.strip().splitlines()) == 1
+
+
+def eq2(n_lab: float, nu: float) -> float:
+    """Eq. 2 written out here, apart from poro2d.porosity: 1 - [sqrt(pi sqrt 3) / (2 nu) (1 - n)]^(2/3)."""
+    return 1.0 - (math.sqrt(math.pi * math.sqrt(3.0)) / (2.0 * nu) * (1.0 - n_lab)) ** (2.0 / 3.0)
+
+
+@pytest.mark.parametrize(("reading", "other"), [("printed", "solid_fraction"), ("solid_fraction", "printed")])
+def test_table_shows_the_other_reading_of_nu(capsys, reading, other):
+    """Eq. 2's row names the chosen reading of nu and gives the other's n2D beside it."""
+    n_fcc = 1.0 - math.pi / (3.0 * math.sqrt(2.0))
+    nus = {"printed": 0.3253 / n_fcc, "solid_fraction": (1.0 - 0.3253) / (1.0 - n_fcc)}
+    code, out, err = run(["convert", "0.3434", *PAPER, "--nu-reading", reading], capsys)
+    assert code == 0, err
+    row = next(line for line in out.splitlines() if "densest_state_modified" in line)
+    assert f"{eq2(0.3434, nus[reading]):.4f}" in row
+    assert f"nu={reading} ({other}: {eq2(0.3434, nus[other]):.4f})" in row
+
+
+def test_the_documented_table_is_what_the_command_prints(capsys):
+    """docs/conversions.md shows the paper's sand as `poro2d convert` prints it, row by row."""
+    page = (Path(__file__).parents[2] / "docs" / "conversions.md").read_text(encoding="utf-8")
+    section = page.split("## The table for the paper's sand")[1].split("\n## ")[0]
+    documented = [
+        [cell.strip() for cell in line.strip("|").split("|")]
+        for line in section.splitlines()
+        if line.startswith("| ") and not line.startswith(("| id ", "| ---"))
+    ]
+    code, out, _ = run(["convert", "0.3434", *PAPER], capsys)
+    assert code == 0
+    printed = {
+        cells[0]: cells
+        for line in out.splitlines()
+        if line.startswith("│")
+        for cells in [[c.strip() for c in line.strip().strip("│").split("│")]]
+    }
+    assert len(documented) == len(METHODS)
+    for row in documented:
+        assert printed[row[0]] == row, row[0]
+    for line in ("n_lab = 0.3434, n_max = 0.4571, n_min = 0.3253, D_r = 0.886", *conversion_notes(section)):
+        assert line in out
+
+
+def conversion_notes(section: str) -> list[str]:
+    """The lines of the page's fenced block of what the command prints after its table."""
+    block = section.split("```")[1]
+    return [line for line in block.splitlines() if line.startswith(("warning:", "note:"))]

@@ -47,3 +47,16 @@ def test_a_closed_bracket_adds_its_key_last_to_a_row_read_back():
     best = closed_bracket(trials, CriterionSettings(refine_tolerance=0.002))
     assert best is trials[-1] and best.decision.accepted_at == "closed bracket"
     assert list(best.to_dict())[-1] == "accepted_at" and best.decision.accepted is True
+
+
+def test_a_scaled_specimens_row_keeps_its_time_step_and_disks_and_a_true_one_has_no_such_keys():
+    row = _rows()[0]
+    assert "mass_scaling_dt_s" not in Trial.from_dict(row).to_dict()
+    trial = Trial.from_dict(row)
+    trial.mass_scaling_dt_s, trial.mass_scaled_disks = 1.57e-6, 412
+    trial.order = None  # as a trial is made by the run, not read back
+    written = trial.to_dict()
+    assert written["mass_scaling_dt_s"] == 1.57e-6 and written["mass_scaled_disks"] == 412
+    back = Trial.from_dict(json.loads(json.dumps(written)))
+    assert back.mass_scaling_dt_s == 1.57e-6 and back.mass_scaled_disks == 412 and not back.extra
+    assert back.flat()["mass_scaled_disks"] == 412  # a column of iterations.csv

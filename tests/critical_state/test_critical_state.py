@@ -49,6 +49,22 @@ def series_of(gamma, mu, phi) -> CellSeries:
     )
 
 
+def test_the_study_keeps_each_seeds_steady_contact_anisotropy():
+    from dataclasses import replace
+    from types import SimpleNamespace
+
+    from poro2d.critical_state.run import steady_anisotropy
+
+    g = np.linspace(0.01, 2.0, 200)
+    base = series_of(g, np.full(g.size, 0.3), np.full(g.size, 0.82))
+    assert np.isnan(base.a_c).all()  # a series of an earlier poro2d: no fabric
+    assert steady_anisotropy([SimpleNamespace(series=base)], 1.0) is None
+    # a_c rising to its steady value 0.2 (seed 1) and 0.3 (seed 2) before the window starts
+    seeds = [SimpleNamespace(series=replace(base, a_c=np.minimum(g, 1.0) * v)) for v in (0.2, 0.3)]
+    spread = steady_anisotropy(seeds, 1.0)
+    assert spread.values == pytest.approx([0.2, 0.3]) and spread.mean == pytest.approx(0.25)
+
+
 def test_the_case_is_its_own_file_record():
     """Every field in order, the grading as its sizes, percent passing and source, stiffness_number
     only when set; read back, the grading is a curve again and the case writes the same keys."""
@@ -108,6 +124,7 @@ def test_a_run_keeps_its_result_series_and_figure_in_the_store(tmp_path, monkeyp
     draw_critical_state(result, Store(tmp_path))  # the figure, drawn from the result after the run
     assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == [
         "critical_state.png",
+        "fabric_rose.json",
         "result.json",
         "series.csv",
         "test.json",
@@ -120,6 +137,12 @@ def test_a_run_keeps_its_result_series_and_figure_in_the_store(tmp_path, monkeyp
     monkeypatch.setattr(run_module, "_compute", lambda *_: pytest.fail("a finished run ran again"))
     back = run_critical_state(case, Store(tmp_path))
     assert back == result and np.array_equal(back.series.stress_ratio, result.series.stress_ratio)
+    # the fabric is recorded along the series, its orientations kept at the peak and the end
+    assert np.array_equal(back.series.a_c, result.series.a_c) and np.isfinite(result.series.a_c[-1])
+    assert (
+        back.roses.to_dict() == result.roses.to_dict()
+        and back.roses.end.record == result.series.gamma.size - 1
+    )
     with pytest.raises(InputError, match="another pressure") as exc:
         run_critical_state(case.at_pressure(200.0), Store(tmp_path))
     assert exc.value.parameter == "--out"

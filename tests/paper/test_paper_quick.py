@@ -151,3 +151,25 @@ def test_bad_option_writes_nothing(tmp_path, capsys):
         main(["paper", "--quick", "--threads", "0", "--out", str(out), "--quiet"])
     assert e.value.code == 2 and "threads" in capsys.readouterr().err
     assert not out.exists()
+
+
+@pytest.mark.scenario
+def test_every_figure_is_print_ready(quick):
+    """Every figure `poro2d paper` wrote is a 300 dpi PNG with an SVG beside it, its symbols as symbols."""
+    from tests.report.print_checks import check_print_ready
+
+    pngs = sorted(quick.rglob("*.png"))
+    assert len(pngs) >= 20  # conversions, every trial's force chains, Figs. 5-8, the specimens' states
+    for png in pngs:
+        check_print_ready(png)
+    assert not {p.with_suffix(".png") for p in quick.rglob("*.svg")} - set(pngs)  # no SVG alone
+
+
+@pytest.mark.scenario
+def test_report_states_the_caveat_and_the_checks(quick):
+    from poro2d.report.paper_report import PAPER_MODE_CAVEAT
+
+    md = (quick / "report.md").read_text()
+    assert md.index(PAPER_MODE_CAVEAT) < md.index("## Summary")
+    assert "### Quasi-static checks" in md and "coordination number at the end" in md
+    assert "Jaky (1944): K0 = 1 - sin phi" in md

@@ -85,6 +85,27 @@ def test_peak_grows_with_normal_stress_and_outputs(series):
     assert "poro2d_version" in r.provenance.to_dict()
 
 
+def test_the_fabric_is_recorded_along_each_curve_and_drawn(series):
+    """The fabric columns close each curve.csv; the orientations at the peak and the end are kept
+    (fabric_rose.json) and drawn with the anisotropies against displacement by the command's figures."""
+    from poro2d.measure.fabric import FABRIC_COLUMNS, FabricRoses
+    from poro2d.report.fabric_figures import draw_shear_fabric
+
+    out, r = series
+    draw_shear_fabric(r, Store(out))
+    assert (out / "fabric.png").stat().st_size > 0
+    for t in r.tests:
+        folder = out / t.folder
+        curve = _curve(folder / "curve.csv")
+        assert list(curve)[-len(FABRIC_COLUMNS) :] == list(FABRIC_COLUMNS)
+        assert np.isfinite(curve["a_c"]).all() and ((curve["a_c"] >= 0) & (curve["a_c"] <= 2)).all()
+        assert ((curve["z_mech"] > 2.0) & (curve["z_mech"] < 6.0)).all()
+        roses = FabricRoses.from_dict(json.loads((folder / "fabric_rose.json").read_text()))
+        assert roses.end.record == curve["step"].size - 1 and roses.peak is not None
+        assert roses.peak.at == pytest.approx(1e3 * t.shear_displacement_at_peak_m)
+        assert (folder / "fabric_rose.png").stat().st_size > 0
+
+
 def test_each_curve_travels_in_the_result_as_its_file_holds_it(specimen, series):
     """The series' result carries every test's curve (not in result.json); a rerun reads them back
     through ShearTestResult.read, with the same values bit for bit, and they pickle (the pool's way)."""

@@ -11,7 +11,7 @@ import pytest
 
 from poro2d.dem import Particles, Simulation, Walls
 from poro2d.errors import InputError
-from poro2d.store import Store, digests, walk
+from poro2d.store import Store, digests, folder, walk
 from poro2d.store.stage import Fingerprint
 from poro2d.typed_result import TypedResult
 
@@ -40,6 +40,24 @@ def test_damaged_files_read_as_missing(tmp_path):
     assert s.read_arrays("a.npz") is None
 
 
+def test_parquet_written_with_an_engine(tmp_path):
+    pytest.importorskip("pyarrow", reason="pyarrow is optional (the parquet and test extras bring it)")
+    assert folder.parquet_engine_available()
+    Store(tmp_path).write_parquet("f.parquet", pd.DataFrame({"y": [0.5, 0.25]}))
+    assert pd.read_parquet(tmp_path / "f.parquet")["y"].tolist() == [0.5, 0.25]
+
+
+def test_no_parquet_engine_writes_nothing_and_drops_a_stale_file(tmp_path, monkeypatch):
+    """Without pyarrow the store writes no Parquet file, and one left by an earlier run (out of
+    date once the table is rewritten) is removed, from the manifest too."""
+    s = Store(tmp_path)
+    s.write_text("f.parquet", "an earlier run's table")
+    monkeypatch.setattr(folder, "parquet_engine_available", lambda: False)
+    assert s.write_parquet("f.parquet", pd.DataFrame({"y": [0.5]})) is None
+    assert not (tmp_path / "f.parquet").exists() and not s.has("f.parquet")
+    assert "f.parquet" not in (tmp_path / digests.MANIFEST).read_text()
+
+
 def test_tables_and_arrays(tmp_path):
     s = Store(tmp_path)
     s.write_csv("rows.csv", [{"a": 1, "b": 2.5}, {"a": 2, "c": "x"}])
@@ -47,8 +65,6 @@ def test_tables_and_arrays(tmp_path):
     assert list(frame.columns) == ["a", "b", "c"] and frame["a"].tolist() == [1, 2]
     s.write_frame("f.csv", pd.DataFrame({"y": [0.5, 0.25]}))
     assert s.read_frame("f.csv")["y"].tolist() == [0.5, 0.25]
-    s.write_parquet("f.parquet", pd.DataFrame({"y": [0.5, 0.25]}))
-    assert pd.read_parquet(tmp_path / "f.parquet")["y"].tolist() == [0.5, 0.25]
     s.write_arrays("a.npz", x=np.arange(3.0), y=np.ones(2, dtype=np.int64))
     arrays = s.read_arrays("a.npz")
     assert arrays["x"].tolist() == [0.0, 1.0, 2.0] and arrays["y"].dtype == np.int64

@@ -14,6 +14,7 @@ from poro2d.errors import InputError
 from poro2d.execute.dask_cluster import SINGLE_THREAD_ENV
 from poro2d.execute.options import RunOptions
 from poro2d.store import Store
+from poro2d.store.folder import parquet_engine_available
 from poro2d.sweep import SweepResult, parse_sweep, register_kind, run_sweep
 
 QUIET = RunOptions(progress=False)
@@ -84,8 +85,9 @@ def test_criterion_sweep_uses_both_workers_and_rerun_skips(client, tmp_path):
     )
 
     df = pd.read_csv(tmp_path / "results.csv")
-    pq = pd.read_parquet(tmp_path / "results.parquet")
-    assert len(df) == len(pq) == 8
+    assert len(df) == 8
+    if parquet_engine_available():  # the Parquet copy is optional (pyarrow, the parquet extra)
+        assert len(pd.read_parquet(tmp_path / "results.parquet")) == 8
     for col in (
         "case_id",
         "criterion.n_lab",
@@ -156,8 +158,11 @@ def test_interrupted_sweep_rerun_skips_finished_cases(client, tmp_path):
     assert [r.extra["reused"] for r in res.rows] == [True, True, False, False]
     for c in full.cases:  # every case ran exactly once
         assert (out / "cases" / c.id / "run" / "runs.txt").read_text() == "1"
-    df = pd.read_parquet(out / "results.parquet")
+    df = pd.read_csv(out / "results.csv")
     assert list(df["probe.x"]) == [1, 2, 3, 4] and list(df["value"]) == [2, 4, 6, 8]
+    if parquet_engine_available():  # the same table, typed, where pyarrow is installed
+        pq = pd.read_parquet(out / "results.parquet")
+        assert list(pq["probe.x"]) == [1, 2, 3, 4] and list(pq["value"]) == [2, 4, 6, 8]
 
 
 def test_failing_case_is_reported_and_others_finish(client, tmp_path):
@@ -304,3 +309,16 @@ def test_a_case_runs_in_this_process_once_and_its_folder_binds(tmp_path):
     assert finished_row(other, Store(d)) is None
     failed = compute_case(other, Store(d), probe)  # a case folder holding another case
     assert failed.status == "failed" and "probe.x" in failed.error
+
+
+def test_without_pyarrow_the_table_is_csv_only_said_once(client, tmp_path, monkeypatch, capsys):
+    """No Parquet engine: results.csv as always, no results.parquet, and one line saying why."""
+    from poro2d.store import folder
+
+    monkeypatch.setattr(folder, "parquet_engine_available", lambda: False)
+    res = run_sweep(parse_sweep(probe_cfg([1, 2])), Store(tmp_path), client=client, options=QUIET)
+    assert [r.status for r in res.rows] == ["done", "done"]
+    assert list(pd.read_csv(tmp_path / "results.csv")["value"]) == [2, 4]
+    assert not (tmp_path / "results.parquet").exists()
+    err = capsys.readouterr().err
+    assert err.count("pyarrow is not installed") == 1 and "poro2d[parquet]" in err

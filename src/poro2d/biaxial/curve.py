@@ -21,18 +21,22 @@ from poro2d.biaxial.box import BiaxialBox, BoxSize
 from poro2d.biaxial.stiffness import contact_strain, overlap_ratio
 from poro2d.dem import Simulation
 from poro2d.labtest.curve import CurveRow, curve_of
+from poro2d.measure.fabric import FABRIC_COLUMNS, Fabric, measure_fabric
 from poro2d.store import Store
+from poro2d.typed_result import with_fields
 
 #: columns written since the elastic strain was told apart from the plastic (absent from a curve of
 #: before): the mean overlap over the mean diameter of the disk-disk contacts and the elastic strain
-#: they hold (:mod:`poro2d.biaxial.stiffness`), the plastic strains (:mod:`poro2d.biaxial.elastic`)
+#: they hold (:mod:`poro2d.biaxial.stiffness`), the plastic strains (:mod:`poro2d.biaxial.elastic`);
+#: and since the fabric was recorded, the disks' (:class:`~poro2d.measure.fabric.Fabric`)
 OPTIONAL_COLUMNS = (
     "mean_overlap_ratio", "elastic_axial_strain", "elastic_lateral_strain", "plastic_volumetric_strain",
-    "plastic_shear_strain",
+    "plastic_shear_strain", *FABRIC_COLUMNS,
 )  # fmt: skip
 
 
 @dataclass(eq=False)
+@with_fields(Fabric, after="elastic_lateral_strain", optional=True)
 class BiaxialRow(CurveRow):
     """One row of ``curve.csv``, its fields the columns in order (see the module's conventions)."""
 
@@ -54,7 +58,7 @@ class BiaxialRow(CurveRow):
     elastic_axial_strain: float | None = None
     elastic_lateral_strain: float | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = OPTIONAL_COLUMNS[:3]
+    OPTIONAL: ClassVar[tuple[str, ...]] = (*OPTIONAL_COLUMNS[:3], *FABRIC_COLUMNS)
 
 
 class BiaxialCurve(curve_of(BiaxialRow, "BiaxialColumns", __name__, optional=OPTIONAL_COLUMNS)):
@@ -78,9 +82,10 @@ def read_curve(store: Store, name: str = "curve.csv") -> BiaxialCurve | None:
 
 
 def curve_row(
-    sim: Simulation, start: BoxSize, step: int, d50: float, rho: float, strain_rate: float
+    sim: Simulation, start: BoxSize, step: int, d50: float, rho: float, strain_rate: float, contacts=None
 ) -> BiaxialRow:
-    """One row of the curve: the box's strains and stresses now (see the module's conventions)."""
+    """One row of the curve: the box's strains and stresses now (see the module's conventions);
+    ``contacts``: the simulation's contacts now (read here when None)."""
     now = BiaxialBox.size(sim)
     s1, s3, left, right = BiaxialBox.stresses(sim)
     e1 = math.log(start.height / now.height)
@@ -106,6 +111,7 @@ def curve_row(
         mean_overlap_ratio=overlap_ratio(sim),
         elastic_axial_strain=elastic_1,
         elastic_lateral_strain=elastic_3,
+        **measure_fabric(sim.contacts() if contacts is None else contacts, sim.particles.n).row(),
     )
 
 

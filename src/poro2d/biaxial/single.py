@@ -35,6 +35,7 @@ from poro2d.biaxial.stiffness import DiskStiffness, scaled_stiffness
 from poro2d.dem import Simulation
 from poro2d.errors import InputError
 from poro2d.io_utils import Provenance
+from poro2d.measure.fabric import ROSE_FILE, FabricRoses
 from poro2d.store import Store
 
 
@@ -91,6 +92,8 @@ class BiaxialTest:
         self.i0 = math.nan
         self.strain_rate = math.nan
         self.scale: StiffnessScale | None = None
+        #: the contact orientations at the peak and at the end, once computed (``fabric_rose.json``)
+        self.roses: FabricRoses | None = None
 
     def build(self) -> Simulation:
         """The specimen in its box, with the test's damping; the inertial number checked."""
@@ -149,6 +152,7 @@ class BiaxialTest:
         def compute() -> BiaxialTestResult:
             fresh.append(self.compute())
             store.write_csv("curve.csv", fresh[0].curve.rows(), header=list(fresh[0].curve.columns))
+            store.write_result(ROSE_FILE, self.roses)
             return fresh[0]
 
         stage.run(compute, accept=lambda _: _curve_kept(store))  # nothing stored (above): it computes
@@ -167,6 +171,8 @@ class BiaxialTest:
         rows, velocity = shearing.run()
         curve = BiaxialCurve.of_rows(rows)
         angles = read_angles(curve, sigma, s.smoothing_strain, s.critical_window, s.critical_rate_limit)
+        at_peak = int(np.argmin(np.abs(curve.axial_strain - angles.axial_strain_at_peak)))
+        self.roses = FabricRoses.of("axial_strain", curve.axial_strain, shearing.roses, at_peak)
         curve, elastic = self.elastic(sim, start, curve, velocity)
         return BiaxialTestResult.of(
             angles, checks=self.checks(curve), consolidation=info, strain_rate_per_s=self.strain_rate,

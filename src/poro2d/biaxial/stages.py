@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -25,6 +25,7 @@ from poro2d.labtest.reporters import CurveRecorder, ProgressReporter, StopTest, 
 from poro2d.labtest.settle import ProgressFn, Settled
 from poro2d.labtest.settle import settle as settle_servoed
 from poro2d.measure.coordination import coordination_number
+from poro2d.measure.fabric import rose
 from poro2d.store import Store
 
 #: the first part of the axial strain, where the side walls only start to follow, left out of
@@ -139,9 +140,11 @@ class Shearing:
     rho: float
     progress: ProgressFn | None = None
     store: Store | None = None
+    roses: list[np.ndarray] = field(default_factory=list, init=False, repr=False)
 
     def run(self) -> tuple[list[BiaxialRow], float]:
-        """The curve's rows and the plate's velocity (m/s)."""
+        """The curve's rows and the plate's velocity (m/s); the contact orientations of every row
+        are kept in ``roses``."""
         sim, s = self.sim, self.settings
         sigma = self.confining_kpa * 1e3
         start: BoxSize = BiaxialBox.size(sim)
@@ -151,11 +154,16 @@ class Shearing:
         steps_per_row = max(1, round(s.record_strain * start.height / (velocity * sim.dt)))
         sim.reset_clock()
 
-        def row(sm: Simulation) -> BiaxialRow:  # the side walls' targets renewed first
-            servo_targets(sm, sigma, s, top=False)
-            return curve_row(sm, start, sm.step_count, self.d50, self.rho, self.strain_rate)
+        def row(sm: Simulation, step: int | None = None) -> BiaxialRow:  # the side walls' targets first
+            if step is None:
+                servo_targets(sm, sigma, s, top=False)
+            contacts = sm.contacts()
+            self.roses.append(rose(contacts))
+            at = sm.step_count if step is None else step
+            return curve_row(sm, start, at, self.d50, self.rho, self.strain_rate, contacts)
 
-        rows = [curve_row(sim, start, 0, self.d50, self.rho, self.strain_rate)]
+        self.roses = []
+        rows = [row(sim, 0)]
 
         def strained(_sim: Simulation | None = None) -> bool:
             return rows[-1].axial_strain >= s.max_strain

@@ -10,9 +10,11 @@ from __future__ import annotations
 
 import functools
 import importlib
+import inspect
 import sys
 
 import typer
+import typer.core
 from rich.console import Console
 
 from poro2d import __version__
@@ -62,6 +64,46 @@ def _register() -> None:
         importlib.import_module(f"poro2d.cli.{name}").register(app)
     for info in app.registered_commands:
         info.callback = _interruptible(info.name or info.callback.__name__, info.callback)
+    for info in _all_commands(app):
+        info.short_help = info.short_help or summary_line(info.help or inspect.getdoc(info.callback))
+
+
+def _all_commands(typer_app: typer.Typer) -> list:
+    """The command infos of ``typer_app`` and of the groups added to it (``plot``)."""
+    infos = list(typer_app.registered_commands)
+    for group in typer_app.registered_groups:
+        infos += _all_commands(group.typer_instance)
+    return infos
+
+
+def summary_line(doc: str | None) -> str | None:
+    """The first paragraph of a command's docstring as one line: the line ``poro2d --help`` lists.
+
+    The rich help keeps a paragraph's line breaks as they are in the source, so a summary
+    wrapped there would break mid-sentence in the list of commands.
+    """
+    if not doc:
+        return None
+    return " ".join(doc.strip().split("\n\n")[0].split())
+
+
+def show_flags_as_flags() -> None:
+    """Leave a flag's type out of the rich help, as the plain help does (``--quiet``, not
+    ``--quiet <bool>``, which reads as if the flag took a value).
+
+    typer's rich help prints a type beside every option, flags included; the rule is set here,
+    once, on its option class, so that every command and ``--help`` itself follow it.
+    """
+    option = getattr(typer.core, "TyperOption", None)
+    typed = getattr(option, "display_type_rich", None)
+    if typed is None or getattr(typed, "leaves_flags_bare", False):
+        return  # a typer without the method, or this module imported again
+
+    def display_type_rich(self, ctx):
+        return None if self.is_flag and not self.count else typed(self, ctx)
+
+    display_type_rich.leaves_flags_bare = True
+    option.display_type_rich = display_type_rich
 
 
 #: what an interrupted command leaves in its --out folder, for the message
@@ -102,6 +144,7 @@ def _interruptible(command: str, callback):
     return run
 
 
+show_flags_as_flags()
 _register()
 
 

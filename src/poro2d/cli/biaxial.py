@@ -172,6 +172,7 @@ def start_and_print(case, stresses: list[float], store, kw: dict, out: Path) -> 
     from poro2d.biaxial import BiaxialSeriesCase, run_biaxial, run_biaxial_series
     from poro2d.biaxial.run import lab_curve
     from poro2d.report.biaxial_figures import draw_biaxial, draw_biaxial_series
+    from poro2d.report.fabric_figures import draw_biaxial_fabric
 
     kw = dict(kw, lab=lab_curve(kw.get("lab")))  # read once: the run records it, the figure draws it
     try:
@@ -182,6 +183,7 @@ def start_and_print(case, stresses: list[float], store, kw: dict, out: Path) -> 
             series = BiaxialSeriesCase(case, stresses, kw.pop("replicates"), kw.pop("lab"))
             result = run_biaxial_series(series, store, **kw)
             draw_biaxial_series(result, store, series.lab)
+        draw_biaxial_fabric(result, store)
     except RuntimeError as exc:
         console.print(f"[bold red]failed:[/] {exc}")
         raise typer.Exit(1) from None

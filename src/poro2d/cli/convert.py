@@ -293,13 +293,20 @@ def _print_table(conv: P.Conversion, extra_inputs: dict, state: LabState | None 
             flags = ", ".join(r.flags + [f"skipped: {r.skipped}"])
         else:
             n2d = f"[red]{r.value:.4f}[/]" if r.value < 0 else f"{r.value:.4f}"
-            flags = ", ".join(r.flags)
+            flags = ", ".join(r.flags) + other_reading(r)
         table.add_row(r.id, r.name, r.equation, n2d, flags)
     console.print(table)
     for w in conv.warnings:
         console.print(f"[yellow]warning:[/] {w}")
     for note in conv.notes:
         console.print(f"note: {note}")
+
+
+def other_reading(result: P.MethodResult) -> str:
+    """`` (solid_fraction: 0.1094)``: Eq. 2 under the reading of nu not chosen, beside the chosen
+    one's flag, since the paper does not settle which one it plotted (docs/conversions.md)."""
+    other = result.details.get("other_reading")
+    return f" ({other['nu_reading']}: {other['n2d']:.4f})" if other else ""
 
 
 _CSV_HEADER = ["n_lab", "n_max", "n_min", "method", "name", "equation", "n2d", "flags", "skipped"]

@@ -94,6 +94,7 @@ def register(app: typer.Typer) -> None:
         from poro2d.critical_state.run import MAX_SEEDS
         from poro2d.errors import InputError, check_int
         from poro2d.report.critical_state_figures import draw_critical_state, draw_critical_state_line
+        from poro2d.report.fabric_figures import draw_critical_state_fabric
 
         rule = CASE_RANGES["pressure_kpa"]
         PRESSURE_RANGE_KPA = (rule.lo, rule.hi)
@@ -134,6 +135,7 @@ def register(app: typer.Typer) -> None:
                     marks=held.marks if held else None, span=held.span if held else None,
                 )  # fmt: skip
                 draw_critical_state_line(result, store)
+            draw_critical_state_fabric(result, store)
         except RuntimeError as exc:
             console.print(f"[bold red]failed:[/] {exc}")
             raise typer.Exit(1) from None
@@ -229,6 +231,9 @@ def print_result(result, out: Path) -> None:
             f"stiffness number kappa = kn / (P t) = {result.stiffness_number:.0f}{held}, mean overlap / d = "
             f"{result.mean_overlap_ratio.text(4)}: an elastic strain of about 1 / kappa in the solid fraction"
         )
+    if result.contact_anisotropy is not None:
+        a_c = result.contact_anisotropy.text()
+        console.print(f"contact anisotropy a_c over the steady window = {a_c} (fabric.png, docs/fabric.md)")
     console.print(f"results in {out}/result.json, series.csv, critical_state.png")
 
 

@@ -126,6 +126,7 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Direct shear tests (the paper's Fig. 8): peak strengths, friction angle, figures."""
         from poro2d.io_utils import check_output_dir
+        from poro2d.report.fabric_figures import draw_shear_fabric
         from poro2d.report.shear_figures import draw_shear_series
         from poro2d.shear.lab import read_lab_csv
         from poro2d.shear.run import ShearSeriesCase, run_shear
@@ -171,6 +172,7 @@ def register(app: typer.Typer) -> None:
             console.print(f"[bold red]failed:[/] {exc}")
             raise typer.Exit(1) from None
         draw_shear_series(result, store, lab_data)
+        draw_shear_fabric(result, store)
         print_result(result, out)
 
 

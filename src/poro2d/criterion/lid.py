@@ -303,5 +303,5 @@ def flat_top(sim: Simulation, width: float) -> Simulation:
     return Simulation(
         particles, walls, sim.contact, gravity=sim.gravity, local_damping=sim.local_damping,
         restitution=sim.restitution, dt=sim.dt, dt_safety=sim.dt_safety, density_scale=sim.density_scale,
-        skin=sim.skin, threads=sim.threads, partitions=sim.partitions,
+        mass_scaling_dt=sim.mass_scaling_dt, skin=sim.skin, threads=sim.threads, partitions=sim.partitions,
     )  # fmt: skip

@@ -437,6 +437,8 @@ class PorosityCriterion:
             failure=failure,
             porosity=porosity,
             time_prepare_s=t_prep,
+            mass_scaling_dt_s=sim.mass_scaling.dt_s,
+            mass_scaled_disks=sim.mass_scaling.disks if sim.mass_scaling.dt_s is not None else None,
         )
         trial.decision = decide(trial, s)
         trial.time_plate_s = time.perf_counter() - t1

@@ -26,12 +26,14 @@ class CriterionResult(TypedResult):
     accepted specimen: ``box_porosity``, the paper's n' of the accepted state (W x plate
     height, the gap under the plate included), and ``interior_porosity`` with its spread
     over the measurement circles, the packing's own porosity (docs/porosity.md says which to
-    use), with the surface under the plate (mean gap in d50, share of the width in contact).
+    use), with the surface under the plate (mean gap in d50, share of the width in contact),
+    and, for a specimen whose light disks' inertial masses were raised in its quasi-static
+    stages, the time step they shared (``mass_scaling_dt_s``) and how many (``mass_scaled_disks``).
     """
 
     OPTIONAL = (
         "box_porosity", "interior_porosity", "interior_porosity_std", "surface_gap_mean_d50",
-        "plate_contact_fraction", "preparation_note",
+        "plate_contact_fraction", "preparation_note", "mass_scaling_dt_s", "mass_scaled_disks",
     )  # fmt: skip
     #: every trial as its row (:class:`~poro2d.criterion.trial.Trial`), the settings and specimen
     #: as the run's own values (their rows the file's ``settings`` and ``specimen``)
@@ -61,6 +63,10 @@ class CriterionResult(TypedResult):
     plate_contact_fraction: float | None = None
     # a wide grading's equilibrium test and why (poro2d.specimen.compaction.preparation_note)
     preparation_note: str | None = None
+    # the accepted specimen's density scaling, only when its light disks' masses were raised:
+    # the time step they share and how many (poro2d.specimen.compaction.mass_scaling_step)
+    mass_scaling_dt_s: float | None = None
+    mass_scaled_disks: int | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """The file's keys; the specimen's preparation rolling friction, when set, stands after its

@@ -150,7 +150,8 @@ class Trial(Record, TypedResult):
     ``ROW`` is the row a trial records, its parts in place: the counts, porosity and convergence
     of its preparation, the wall forces as prepared and after the plate stage under their own
     keys, ``overfull_m`` only when the box was over-full, ``balance_steps`` only for a specimen
-    cycled further to balance, ``accepted_at`` only for a trial accepted when the bracket closed.
+    cycled further to balance, ``accepted_at`` only for a trial accepted when the bracket closed,
+    the density scaling's time step and disks only for a specimen whose masses were raised.
     A trial is the typed result of its file (``trial.json``), and so a part of the criterion's
     result; keys of a row read back that it does not model are kept in ``extra``.
     """
@@ -168,8 +169,12 @@ class Trial(Record, TypedResult):
         "porosity_change", Spliced("check_numbers"), Spliced("porosity"), "checks", "balance_steps",
         Spliced("decision"),
         "time_prepare_s", "time_plate_s", ("accepted_at", "decision.accepted_at"),
+        "mass_scaling_dt_s", "mass_scaled_disks",
     )  # fmt: skip
-    OMITTED = {"overfull_m": 0.0, "accepted_at": None, "balance_steps": None}
+    OMITTED = {
+        "overfull_m": 0.0, "accepted_at": None, "balance_steps": None, "mass_scaling_dt_s": None,
+        "mass_scaled_disks": None,
+    }  # fmt: skip
 
     iteration: int
     trial_porosity: float
@@ -194,6 +199,10 @@ class Trial(Record, TypedResult):
     balance_steps: int | None = None
     time_prepare_s: float | None = None
     time_plate_s: float | None = None
+    #: the time step the light disks' inertial masses were raised for in the specimen's
+    #: quasi-static stages, and how many were (None: true masses; docs/density-scaling.md)
+    mass_scaling_dt_s: float | None = None
+    mass_scaled_disks: int | None = None
     #: the key order of a row read back
     order: tuple[str, ...] | None = field(default=None, repr=False)
 

@@ -18,6 +18,7 @@ from poro2d.critical_state.case import CriticalStateCase
 from poro2d.critical_state.results import CriticalStateTestResult
 from poro2d.critical_state.series import CellSeries
 from poro2d.identity import identity_digest
+from poro2d.measure.fabric import ROSE_FILE, FabricRoses
 from poro2d.store import Fingerprint, ResumableStage, Store, test_stage
 
 #: a run's table of rows, written before its result
@@ -54,7 +55,8 @@ def stored_run(store: Store, case: CriticalStateCase) -> CriticalStateTestResult
     rows = None if data is None else store.read_rows(SERIES_CSV)
     if data is None or not rows:
         return None
-    return replace(CriticalStateTestResult.from_dict(data), series=CellSeries.of_rows(rows))
+    roses = store.read_result(ROSE_FILE, FabricRoses.from_dict)
+    return replace(CriticalStateTestResult.from_dict(data), series=CellSeries.of_rows(rows), roses=roses)
 
 
 __all__ = ["SERIES_CSV", "content_of", "folder_stage", "stored_run"]

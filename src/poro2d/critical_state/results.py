@@ -10,6 +10,7 @@ from poro2d.critical_state.series import CellSeries
 from poro2d.critical_state.steady import SteadyState
 from poro2d.io_utils import Provenance
 from poro2d.labtest.records import ByName, StudyRun, TestSummary, typed_parts
+from poro2d.measure.fabric import FabricRoses
 from poro2d.measure.spread import Spread
 from poro2d.typed_result import NOT_IN_FILE, TypedResult, with_fields
 
@@ -27,7 +28,9 @@ class CriticalStateTestResult(ByName, SteadyState):
     ``stiffness_number`` kappa = kn / (P t) of the contacts at the case's pressure and
     ``mean_overlap_ratio`` the touching contacts' mean overlap over the mean diameter at the
     end (about 1 / kappa: the share of the solid fraction that is the contacts' softness; both
-    absent in files of earlier versions). ``series`` (not in the file): the rows as arrays.
+    absent in files of earlier versions). ``series`` (not in the file): the rows as arrays; ``roses``
+    (not in the file, kept beside it as ``fabric_rose.json``): the contact orientations at the
+    largest stress ratio and at the end.
     """
 
     disks: int
@@ -46,6 +49,7 @@ class CriticalStateTestResult(ByName, SteadyState):
     stiffness_number: float | None = None
     mean_overlap_ratio: float | None = None
     series: CellSeries | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
+    roses: FabricRoses | None = field(default=None, kw_only=True, repr=False, metadata=NOT_IN_FILE)
 
     OPTIONAL: ClassVar[tuple[str, ...]] = ("stiffness_number", "mean_overlap_ratio")
 
@@ -93,7 +97,9 @@ class CriticalStateResult(TypedResult):
     Each number's spread over the seeds (:class:`Spread`), the void ratio (1 - phi) / phi with
     them; ``steady`` only if every seed's window was steady (``note`` says which was not);
     ``stiffness_number`` kappa at the pressure and the mean overlap over d (absent in files of
-    earlier versions). ``tests`` (not in the file): each seed's full result with its series.
+    earlier versions); ``contact_anisotropy``: each seed's mean a_c over the steady window
+    (:mod:`poro2d.measure.fabric`; absent in files of earlier versions). ``tests`` (not in the
+    file): each seed's full result with its series.
     """
 
     seeds: list[int]
@@ -109,11 +115,14 @@ class CriticalStateResult(TypedResult):
     void_ratio: Spread | None = None
     stiffness_number: float | None = None
     mean_overlap_ratio: Spread | None = None
+    contact_anisotropy: Spread | None = None
     tests: list[CriticalStateTestResult] = field(
         default_factory=list, kw_only=True, repr=False, metadata=NOT_IN_FILE
     )
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("void_ratio", "stiffness_number", "mean_overlap_ratio")
+    OPTIONAL: ClassVar[tuple[str, ...]] = (
+        "void_ratio", "stiffness_number", "mean_overlap_ratio", "contact_anisotropy",
+    )  # fmt: skip
 
     def headline(self) -> str:
         """The steady-state friction (tau/sigma and angle) and solid fraction with their spread."""

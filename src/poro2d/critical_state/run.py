@@ -42,6 +42,7 @@ from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
 from poro2d.io_utils import Provenance
 from poro2d.labtest.reporters import CurveRecorder, ProgressReporter, series_reporters
+from poro2d.measure.fabric import ROSE_FILE, FabricRoses, cell_fabric, cell_rose
 from poro2d.store import Store, claimed
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
@@ -56,16 +57,17 @@ Report = Callable[[str, float], None]
 
 def _shear(
     cell, case: CriticalStateCase, rate: float, report: Report | None, store: Store | None = None
-) -> tuple[CellSeries, int, int, float]:
-    """Shear to the case's strain, a row every record_strain; returns the series, steps, rebuilds
-    and the mean overlap over d of the rows' ends in the steady window (a snapshot alone swings
-    with the pressure's fluctuations). With ``case.vtk_every`` and a ``store``, the shear's
-    ParaView series too (:func:`_series`)."""
+) -> tuple[CellSeries, int, int, float, FabricRoses | None]:
+    """Shear to the case's strain, a row every record_strain; returns the series, steps, rebuilds,
+    the mean overlap over d of the rows' ends in the steady window (a snapshot alone swings
+    with the pressure's fluctuations) and the contact orientations at the largest stress ratio
+    and at the end. With ``case.vtk_every`` and a ``store``, the shear's ParaView series too
+    (:func:`_series`)."""
     pressure = case.pressure_kpa * 1e3
     cell.shear(rate, pressure, barostat_gain(cell, case), rate)
     per_row = max(1, round(case.record_strain / (rate * cell.dt)))
     steps = math.ceil(case.strain / (per_row * rate * cell.dt)) * per_row
-    blocks, overlaps, d = [], [], mean_diameter(cell)
+    blocks, overlaps, roses, d = [], [], [], mean_diameter(cell)
 
     def advance(n: int) -> tuple[int, bool]:
         blocks.append(cell.run(n))
@@ -77,13 +79,21 @@ def _shear(
         if c.strain >= case.window_start:
             overlaps.append(mean_overlap_ratio(c))
 
-    recorder = CurveRecorder(per_row, lambda c: row_of(c.strain, blocks[-1], rate, d, case.solid_density))
+    def row(c) -> dict[str, float]:  # the fabric of the cell now, its orientations kept for the rose
+        contacts = c.contacts()
+        roses.append(cell_rose(contacts))
+        return row_of(c.strain, blocks[-1], rate, d, case.solid_density, cell_fabric(contacts, c.n))
+
+    recorder = CurveRecorder(per_row, row)
     share = ProgressReporter(
         per_row, report, "shear", lambda _, k: COMPRESS_SHARE + (1.0 - COMPRESS_SHARE) * k / steps
     )
     drive_blocks(advance, steps, [recorder, Every(per_row, overlap), share, *sheared], cell)
     mean = float(np.mean(overlaps)) if overlaps else mean_overlap_ratio(cell)
-    return CellSeries.of_rows(recorder.rows), steps, sum(b.rebuilds for b in blocks), mean
+    series = CellSeries.of_rows(recorder.rows)
+    at_peak = int(np.argmax(series.stress_ratio)) if len(roses) else 0
+    fabric = FabricRoses.of("gamma", series.gamma, roses, at_peak) if roses else None
+    return series, steps, sum(b.rebuilds for b in blocks), mean, fabric
 
 
 def _series(cell, case: CriticalStateCase, per_row: int, store: Store | None, ran: Callable[[], int]) -> list:
@@ -117,6 +127,8 @@ def run_critical_state(
         done = _compute(case, report, store)
         # the series first: the result, written by the stage, is the marker of a finished run
         store.write_csv(SERIES_CSV, done.series.rows(), header=list(COLUMNS))
+        if done.roses is not None:
+            store.write_result(ROSE_FILE, done.roses)
         folder_stage(store, case).run(lambda: done)
     return done
 
@@ -132,7 +144,7 @@ def _compute(
         cell, case, None if report is None else lambda f: report("compress", COMPRESS_SHARE * f)
     )
     rate = shear_rate(cell, case)
-    series, steps, rebuilds, overlap = _shear(cell, case, rate, report, store)
+    series, steps, rebuilds, overlap, roses = _shear(cell, case, rate, report, store)
     wall = time.perf_counter() - t0
     state = read_steady(series, case.window_start, case.blocks, case.mu_drift_limit, case.solid_drift_limit)
     return CriticalStateTestResult.of(
@@ -153,6 +165,7 @@ def _compute(
         stiffness_number=case.kappa(),
         mean_overlap_ratio=overlap,
         series=series,
+        roses=roses,
     )
 
 
@@ -286,8 +299,23 @@ def study_of(cases, tests, workers, wall, config) -> CriticalStateResult:
         provenance=Provenance.now(),
         void_ratio=Spread.of([void_ratio(t.solid_fraction) for t in tests]),
         stiffness_number=cases[0].kappa(),
+        contact_anisotropy=steady_anisotropy(tests, cases[0].window_start),
         tests=list(tests),
     )
+
+
+def steady_anisotropy(tests: list[CriticalStateTestResult], window_start: float) -> Spread | None:
+    """Each seed's mean contact anisotropy a_c over its steady window, as a spread; None when a
+    series did not record it (a run of an earlier poro2d read back)."""
+    means = []
+    for t in tests:
+        if t.series is None:
+            return None
+        a_c = t.series.a_c[t.series.window(window_start)]
+        if not (a_c.size and np.isfinite(a_c).all()):
+            return None
+        means.append(float(np.mean(a_c)))
+    return Spread.of(means)
 
 
 __all__ = [

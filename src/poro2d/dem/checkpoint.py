@@ -89,6 +89,8 @@ def save(sim: Simulation, path: str | os.PathLike, extra: dict | None = None) ->
             "contact": sim.contact.to_dict(),
             "gravity": list(sim.gravity),
             **{name: getattr(sim, name) for name in _SETTINGS.split()},
+            # only when set: checkpoints of runs with true masses keep their keys
+            **({} if sim.mass_scaling_dt is None else {"mass_scaling_dt": sim.mass_scaling_dt}),
         },
         "extra": extra or {},
     }
@@ -231,7 +233,7 @@ def _build(meta: dict, a: dict[str, np.ndarray], threads: int | None) -> Simulat
     sim = Simulation(
         particles, walls, contact, gravity=tuple(s["gravity"]), local_damping=s["local_damping"],
         restitution=s["restitution"], dt=s["fixed_dt"], dt_safety=s["dt_safety"],
-        density_scale=s["density_scale"], skin=s["skin"],
+        density_scale=s["density_scale"], mass_scaling_dt=s.get("mass_scaling_dt"), skin=s["skin"],
         threads=threads if threads is not None else min(s["threads"], _max_threads()),
         partitions=s.get("partitions", 2),
     )  # fmt: skip

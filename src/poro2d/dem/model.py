@@ -190,3 +190,22 @@ def restitution_to_beta(e: float) -> float:
 
 def inertial_masses(particles: Particles, density_scale: float) -> tuple[np.ndarray, np.ndarray]:
     return particles.mass * density_scale, particles.inertia * density_scale
+
+
+def mass_for_time_step(dt: float, k_sum: float, safety: float) -> float:
+    """The smallest inertial mass whose critical step, times ``safety``, is ``dt``.
+
+    :func:`critical_time_step` solved for the mass: ``m = 3 k_sum (dt / safety)^2 / 2``.
+    """
+    return 1.5 * k_sum * (dt / safety) ** 2
+
+
+def raised_inertia(mass: np.ndarray, inertia: np.ndarray, floor: float) -> tuple[np.ndarray, np.ndarray]:
+    """Inertial masses raised to at least ``floor``, each inertia by its disk's own ratio.
+
+    Scaling a disk's mass and moment of inertia by one ratio keeps it a uniform disk
+    (I = m r^2 / 2), so its rotational frequency falls as its translational one does. The
+    disks already at or above ``floor`` keep their values exactly.
+    """
+    ratio = np.where(mass < floor, floor / mass, 1.0)
+    return np.where(mass < floor, floor, mass), inertia * ratio

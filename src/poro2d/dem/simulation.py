@@ -29,6 +29,8 @@ from poro2d.dem.model import (
     ContactModel,
     critical_time_step,
     inertial_masses,
+    mass_for_time_step,
+    raised_inertia,
     restitution_to_beta,
     single_contact_limit,
 )
@@ -43,7 +45,7 @@ from poro2d.dem.state import (
     Walls,
 )
 from poro2d.dem.stores import ContactStore, DiskMasses, KernelParams, KernelWork
-from poro2d.dem.summary import ContactRecord, EngineSummary, RollingFrictionRecord
+from poro2d.dem.summary import ContactRecord, EngineSummary, MassScalingRecord, RollingFrictionRecord
 from poro2d.errors import InputError, is_number
 
 _THREADING_SET = False
@@ -89,6 +91,27 @@ def _regroup(start: np.ndarray, rows: np.ndarray) -> np.ndarray:
     start[0] = 0
     start[1:] = np.cumsum(np.bincount(rows, minlength=n))
     return np.argsort(rows, kind="stable")
+
+
+@dataclass(frozen=True)
+class MassScaling:
+    """How far a simulation's inertial masses are raised (:meth:`Simulation.set_mass_scaling`).
+
+    ``dt_s``: the time step they are raised for (``None``: true masses); ``disks``: how many
+    disks are heavier than they are; ``largest_ratio``: the largest inertial over true mass;
+    ``added_fraction``: the inertial mass added over the total true mass.
+    """
+
+    dt_s: float | None = None
+    disks: int = 0
+    largest_ratio: float = 1.0
+    added_fraction: float = 0.0
+
+    @classmethod
+    def of(cls, true_mass: np.ndarray, inertial: np.ndarray, dt: float) -> MassScaling:
+        ratio = inertial / true_mass
+        added = float(np.sum(inertial - true_mass) / np.sum(true_mass))
+        return cls(dt, int(np.count_nonzero(ratio > 1.0)), float(ratio.max()), added)
 
 
 class SimulationError(RuntimeError):
@@ -145,6 +168,12 @@ class Simulation:
     density_scale
         Inertial mass multiplier >= 1 (density scaling for quasi-static runs);
         gravity still acts on the true mass. Reported in every output.
+    mass_scaling_dt
+        Time step (s) that every disk's inertial mass is raised for (per-disk density
+        scaling, :meth:`set_mass_scaling`): a disk lighter than the mass whose critical step
+        times ``dt_safety`` is this one takes that mass, and its moment of inertia grows by
+        the same ratio. ``None`` (default): every disk keeps its mass. Gravity acts on the
+        true mass; for quasi-static stages only.
     skin
         Verlet skin (m); default 0.2 x the mean radius.
     threads
@@ -177,6 +206,7 @@ class Simulation:
         dt: float | None = None,
         dt_safety: float = 0.8,
         density_scale: float = 1.0,
+        mass_scaling_dt: float | None = None,
         skin: float | None = None,
         threads: int = 1,
         partitions: int = 2,
@@ -195,6 +225,7 @@ class Simulation:
         if not density_scale >= 1.0:
             raise InputError("density_scale", density_scale, "[1, inf)")
         self.density_scale = float(density_scale)
+        self._mass_scaling_dt = self._checked_scaling_dt(mass_scaling_dt)
         if not 0.0 < dt_safety <= 1.0:
             raise InputError("dt_safety", dt_safety, "(0, 1]")
         self.dt_safety = float(dt_safety)
@@ -226,6 +257,32 @@ class Simulation:
     def fixed_dt(self) -> float | None:
         """The time step given at construction (``None``: chosen from the critical step)."""
         return self._fixed_dt
+
+    @property
+    def mass_scaling_dt(self) -> float | None:
+        """The time step the inertial masses are raised for (``None``: true masses)."""
+        return self._mass_scaling_dt
+
+    @staticmethod
+    def _checked_scaling_dt(dt: float | None) -> float | None:
+        if dt is None:
+            return None
+        if not (is_number(dt) and 0.0 < dt < math.inf):
+            raise InputError("mass_scaling_dt", dt, "(0, inf) s, or None for the true masses")
+        return float(dt)
+
+    def set_mass_scaling(self, dt: float | None) -> None:
+        """Raise the disks' inertial masses for the time step ``dt`` from the next step on.
+
+        A quasi-static stage (settling, a servo plate) may run with the masses and inertias
+        of light disks raised so that all share the step ``dt``: its static equilibria do not
+        move (gravity acts on the true mass, local damping is a fraction of the force), the
+        approach to them does. ``None`` gives every disk its true mass back, for stages whose
+        dynamics matter (shearing at a rate, the inertial number). The time step is chosen
+        again either way (a fixed ``dt`` stays fixed).
+        """
+        self._mass_scaling_dt = self._checked_scaling_dt(dt)
+        self._refresh()
 
     @property
     def local_damping(self) -> float:
@@ -271,15 +328,21 @@ class Simulation:
         p = self.particles
         n = p.n
         m_in, i_in = inertial_masses(p, self.density_scale)
+        k_sum = self.contact.stiffness_sum_bound(p, self.walls)
+        if K.rolling_active(p.mu_r):
+            k_sum *= ROLLING_STIFFNESS_FACTOR
+        self.mass_scaling = MassScaling()
+        if self._mass_scaling_dt is not None and n:
+            floor = mass_for_time_step(self._mass_scaling_dt, k_sum, self.dt_safety)
+            true_m = m_in
+            m_in, i_in = raised_inertia(m_in, i_in, floor)
+            self.mass_scaling = MassScaling.of(true_m, m_in, self._mass_scaling_dt)
         self.masses = DiskMasses(
             mass=np.ascontiguousarray(p.mass),
             inv_mass=np.ascontiguousarray(1.0 / m_in) if n else np.zeros(0),
             inv_inertia=np.ascontiguousarray(1.0 / i_in) if n else np.zeros(0),
         )
         m_min = float(m_in.min()) if n else 1.0
-        k_sum = self.contact.stiffness_sum_bound(p, self.walls)
-        if K.rolling_active(p.mu_r):
-            k_sum *= ROLLING_STIFFNESS_FACTOR
         self.dt_critical = critical_time_step(m_min, k_sum)
         if self._fixed_dt is None:
             self.dt = self.dt_safety * self.dt_critical if math.isfinite(self.dt_critical) else 1e-4
@@ -802,6 +865,16 @@ class Simulation:
             stiffness="ks R^2",
         )
 
+    def _mass_scaling_summary(self) -> MassScalingRecord | None:
+        """The per-disk scaling, only when set (outputs without it stay as they were)."""
+        ms = self.mass_scaling
+        if self._mass_scaling_dt is None:
+            return None
+        return MassScalingRecord(
+            time_step_s=self._mass_scaling_dt, disks_scaled=ms.disks, largest_ratio=ms.largest_ratio,
+            added_mass_fraction=ms.added_fraction, gravity_on="true mass",
+        )  # fmt: skip
+
     def summary(self) -> EngineSummary:
         """Settings that every output file should record (a file's ``engine``)."""
         c = self.contact
@@ -820,6 +893,7 @@ class Simulation:
             dt_mode="fixed" if self._fixed_dt is not None else f"auto (safety {self.dt_safety})",
             density_scale=self.density_scale,
             density_scaling=self.density_scale != 1.0,
+            mass_scaling=self._mass_scaling_summary(),
             skin_m=self.skin,
             threads=self.threads,
             threads_intended=self.effective_threads,

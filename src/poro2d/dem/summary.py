@@ -3,7 +3,8 @@
 :meth:`poro2d.dem.simulation.Simulation.summary` gives it as an :class:`EngineSummary`, a
 typed record whose ``to_dict()`` holds the keys files have always kept under ``engine``, in
 their order; ``from_dict()`` reads those of earlier files back. The rolling frictions are
-written only when some disk has one, so files of runs without it keep the keys they had.
+written only when some disk has one, and the per-disk density scaling only when set, so files
+of runs without them keep the keys they had.
 """
 
 from __future__ import annotations
@@ -38,6 +39,19 @@ class RollingFrictionRecord(TypedResult):
 
 
 @dataclass(eq=False)
+class MassScalingRecord(TypedResult):
+    """Per-disk density scaling (``Simulation.set_mass_scaling``): the time step the light disks'
+    inertial masses were raised for, how many, by how much at most, the inertial mass added over
+    the true total, and that gravity acts on the true mass."""
+
+    time_step_s: float
+    disks_scaled: int
+    largest_ratio: float
+    added_mass_fraction: float
+    gravity_on: str
+
+
+@dataclass(eq=False)
 class EngineSummary(TypedResult):
     """What a simulation ran with: disks, walls, contact law, damping, time step, threads, clock.
 
@@ -46,7 +60,7 @@ class EngineSummary(TypedResult):
     ``time_s`` are the simulation's clock when the summary was taken.
     """
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("rolling_friction",)
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("rolling_friction", "mass_scaling")
 
     n_particles: int
     n_walls: int
@@ -69,11 +83,13 @@ class EngineSummary(TypedResult):
     partitions: int
     step: int
     time_s: float
+    mass_scaling: MassScalingRecord | None = None
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "contact": ContactRecord,
         "rolling_friction": RollingFrictionRecord,
+        "mass_scaling": MassScalingRecord,
     }
 
 
-__all__ = ["ContactRecord", "EngineSummary", "RollingFrictionRecord"]
+__all__ = ["ContactRecord", "EngineSummary", "MassScalingRecord", "RollingFrictionRecord"]

@@ -16,25 +16,30 @@ radii; none writes a file. One module per quantity:
 - ``specimen_state``: porosity and stress in horizontal bands (:func:`specimen_state`);
 - ``stress``: the Love-Weber average stress of the disks in a rectangle;
 - ``coordination``: contacts per disk, with or without rattlers;
+- ``fabric``: contact-orientation and force anisotropies, mechanical coordination (:class:`Fabric`);
 - ``energy``: the kinetic energy of the disks.
 """
 
 from poro2d.measure.coordination import coordination_number
 from poro2d.measure.disks import mass_d50
 from poro2d.measure.energy import kinetic_energy
+from poro2d.measure.fabric import Fabric, cell_fabric, measure_fabric
 from poro2d.measure.porosity import box_porosity, disk_area, porosity_circle, porosity_rect
 from poro2d.measure.specimen_porosity import SpecimenPorosity, measure_specimen
 from poro2d.measure.specimen_state import specimen_state
 from poro2d.measure.stress import average_stress
 
 __all__ = [
+    "Fabric",
     "SpecimenPorosity",
     "average_stress",
     "box_porosity",
+    "cell_fabric",
     "coordination_number",
     "disk_area",
     "kinetic_energy",
     "mass_d50",
+    "measure_fabric",
     "measure_specimen",
     "porosity_circle",
     "porosity_rect",

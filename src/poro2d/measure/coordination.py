@@ -20,6 +20,19 @@ def coordination_number(sim, exclude_rattlers: bool = False) -> float:
     wi = c.i[~pp]
     if not exclude_rattlers:
         return float((2 * len(ii) + len(wi)) / n)
+    return mechanical_coordination(n, ii, jj, wi)[0]
+
+
+def mechanical_coordination(n: int, ii: np.ndarray, jj: np.ndarray, wi: np.ndarray) -> tuple[float, float]:
+    """Contacts per disk among the disks left once the rattlers are out, and the rattlers' share of
+    the ``n`` disks.
+
+    ``ii``, ``jj``: the disks of each disk-disk contact; ``wi``: the disk of each disk-wall
+    contact (it counts once, for the disk). A rattler has fewer than two contacts; removing
+    one may leave a neighbour with fewer, so they are removed until none remains.
+    """
+    if n == 0:
+        return 0.0, 0.0
     alive = np.ones(n, bool)
     while True:
         keep = alive[ii] & alive[jj]
@@ -30,7 +43,7 @@ def coordination_number(sim, exclude_rattlers: bool = False) -> float:
             break
         alive &= ~drop
     m = alive.sum()
-    return float(z[alive].sum() / m) if m else 0.0
+    return (float(z[alive].sum() / m) if m else 0.0), float(1.0 - m / n)
 
 
-__all__ = ["coordination_number"]
+__all__ = ["coordination_number", "mechanical_coordination"]

@@ -28,6 +28,9 @@ from poro2d.store import Store
 #: the figure of one confining stress, and of a series
 FIGURE = "biaxial.png"
 SERIES_FIGURE = "biaxial_series.png"
+#: the axes' labels of the curves
+SIN_PHI = r"$\sin\varphi = (\sigma_1 - \sigma_3) / (\sigma_1 + \sigma_3)$"
+AXIAL_STRAIN = r"axial strain $\varepsilon_1$ (%)"
 
 
 def draw_biaxial(result: BiaxialResult, store: Store, lab: LabCurve | None = None) -> None:
@@ -41,7 +44,8 @@ def draw_biaxial(result: BiaxialResult, store: Store, lab: LabCurve | None = Non
                       "volumetric_strain": lab.volumetric_strain}  # fmt: skip
     plot_biaxial(
         [(f"replicate {k + 1}", t.curve) for k, t in enumerate(result.tests)], store.path(FIGURE),
-        title=f"biaxial test, sigma_3 = {result.confining_stress_kpa:g} kPa, replicates: {result.replicates}",
+        title=rf"biaxial test, $\sigma_3$ = {result.confining_stress_kpa:g} kPa, "
+              f"replicates: {result.replicates}",
         critical=(end_mean, min(starts)), lab=lab_arrays,
         lab_label=f"laboratory ({os.path.basename(lab.source)})" if lab is not None else "laboratory",
     )  # fmt: skip
@@ -92,12 +96,12 @@ def plot_biaxial(
         ax.plot(e1, lab["stress_ratio"], "k--", lw=1.2, label=lab_label)
         if lab.get("volumetric_strain") is not None:
             bx.plot(e1, 100 * np.asarray(lab["volumetric_strain"]), "k--", lw=1.2)
-    ax.set_ylabel("sin(phi) = (sigma_1 - sigma_3) / (sigma_1 + sigma_3)")
+    ax.set_ylabel(SIN_PHI)
     ax.set_title(title, fontsize=10)
     ax.legend(fontsize=8, loc="lower right")
     ax.grid(alpha=0.3)
     bx.axhline(0.0, color="0.6", lw=0.6)
-    bx.set_xlabel("axial strain eps_1 (%)")
+    bx.set_xlabel(AXIAL_STRAIN)
     bx.set_ylabel("volumetric strain eps_v (%)\n(compression +" + ("; dashed: plastic)" if plastic else ")"))
     bx.grid(alpha=0.3)
     fig.tight_layout()
@@ -123,7 +127,7 @@ def plot_biaxial_series(
     colours = {sigma: COLORS[k % len(COLORS)] for k, (sigma, _) in enumerate(curves)}
     for sigma, reps in curves:
         for j, c in enumerate(reps):
-            label = f"sigma_3 = {sigma:g} kPa" if j == 0 else None
+            label = rf"$\sigma_3$ = {sigma:g} kPa" if j == 0 else None
             ax.plot(
                 100 * c["axial_strain"], c["sin_phi"], color=colours[sigma], lw=0.9, alpha=0.8, label=label
             )
@@ -131,11 +135,11 @@ def plot_biaxial_series(
                 100 * c["axial_strain"], 100 * c["volumetric_strain"], color=colours[sigma], lw=0.9, alpha=0.8
             )
     _circles(cx, peaks, colours, envelope)
-    ax.set_xlabel("axial strain eps_1 (%)")
-    ax.set_ylabel("sin(phi) = (sigma_1 - sigma_3) / (sigma_1 + sigma_3)")
+    ax.set_xlabel(AXIAL_STRAIN)
+    ax.set_ylabel(SIN_PHI)
     ax.legend(fontsize=8, loc="lower right")
     bx.axhline(0.0, color="0.6", lw=0.6)
-    bx.set_xlabel("axial strain eps_1 (%)")
+    bx.set_xlabel(AXIAL_STRAIN)
     bx.set_ylabel("volumetric strain eps_v (%) (compression +)")
     for a in axes:
         a.grid(alpha=0.3)
@@ -159,14 +163,14 @@ def _circles(ax, peaks, colours, envelope) -> None:
     if phi is not None:
         sig = np.array([0.0, top])
         ax.plot(sig, c + sig * np.tan(np.radians(phi)), "k--", lw=1.0,
-                label=f"peak envelope: phi = {phi:.1f} deg, c = {c:.1f} kPa")  # fmt: skip
+                label=rf"peak envelope: $\varphi$ = {phi:.1f}°, $c$ = {c:.1f} kPa")  # fmt: skip
         ax.legend(fontsize=8, loc="upper left")
     right = 1.05 * top if top > 0 else 1.0
     ax.set_xlim(0.0, right)
     ax.set_ylim(0.0, 0.55 * right)
     ax.set_aspect("equal", adjustable="box")
-    ax.set_xlabel("normal stress sigma (kPa)")
-    ax.set_ylabel("shear stress tau (kPa)")
+    ax.set_xlabel(r"normal stress $\sigma$ (kPa)")
+    ax.set_ylabel(r"shear stress $\tau$ (kPa)")
 
 
 __all__ = [

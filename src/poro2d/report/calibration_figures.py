@@ -17,7 +17,7 @@ from matplotlib.ticker import FormatStrFormatter
 
 from poro2d.calibration.outputs import FIT_PNG, POSTERIOR_PNG
 from poro2d.report.calibration_report import write_calibration_report
-from poro2d.report.figure_file import new_figure, save_figure
+from poro2d.report.figure_file import BLUE, VERMILION, new_figure, save_figure
 from poro2d.store import Store
 
 
@@ -54,7 +54,7 @@ def plot_calibration_fit(result, lab, curves: dict[float, list], nearest, path: 
     if ends:
         se = [o.normal_stress_kpa for o in ends]
         ax_peak.plot(se, [o.lab for o in ends], "k^", mfc="none", label="laboratory end")
-        ax_peak.plot(se, [o.model for o in ends], "v", color="#2166ac", label="model end")
+        ax_peak.plot(se, [o.model for o in ends], "v", color=BLUE, label="model end")
     ax_peak.set_xlabel("normal stress (kPa)")
     ax_peak.set_ylabel("shear stress (kPa)")
     ax_peak.set_xlim(left=0)
@@ -77,7 +77,7 @@ def plot_calibration_fit(result, lab, curves: dict[float, list], nearest, path: 
 
 def _best_title(ax, result) -> None:
     b = result.best
-    ax.set_title(f"f_p = {b.particle_friction:.3g}, mu_r = {b.rolling_friction:.3g}", fontsize=10)
+    ax.set_title(rf"$f_p$ = {b.particle_friction:.3g}, $\mu_r$ = {b.rolling_friction:.3g}", fontsize=10)
 
 
 def _model_curves(ax, k: int, sigma: float, curves: dict[float, list], scale: float) -> str:
@@ -94,23 +94,23 @@ def _curves_axes(ax, nearest, xlabel: str, ylabel: str) -> None:
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(
-        f"curves at the design point nearest the best (f_p = {nearest.particle_friction:.3g}, "
-        f"mu_r = {nearest.rolling_friction:.3g})",
+        rf"curves at the design point nearest the best ($f_p$ = {nearest.particle_friction:.3g}, "
+        rf"$\mu_r$ = {nearest.rolling_friction:.3g})",
         fontsize=9,
     )
     ax.legend(fontsize=7)
 
 
 def _model_points(ax, s, observed: list) -> None:
-    """The calibrated model's values of ``observed`` at the stresses ``s``, with +-2 noise sd."""
+    """The calibrated model's values of ``observed`` at the stresses ``s``, with two noise sd either side."""
     ax.errorbar(
         s,
         [o.model for o in observed],
         yerr=[2 * o.noise_sd for o in observed],
         fmt="o",
-        color="#b2182b",
+        color=VERMILION,
         capsize=3,
-        label="calibrated model (surrogate, +-2 sd)",
+        label=r"calibrated model (surrogate, $\pm$2 sd)",
     )
 
 
@@ -145,7 +145,7 @@ def plot_biaxial_calibration_fit(
     ax_ratio, ax_curve = axes[0], axes[1]
     for name, marker, label in (("peak_ratio", "s", "peak"), ("end_ratio", "^", "end")):
         _plot_targets(ax_ratio, [o for o in fitted if o.observable == name], marker, label)
-    ax_ratio.set_ylabel("stress ratio (sigma_1 - sigma_3) / (sigma_1 + sigma_3)")
+    ax_ratio.set_ylabel(r"stress ratio $(\sigma_1 - \sigma_3) / (\sigma_1 + \sigma_3)$")
     _best_title(ax_ratio, result)
     for k, sigma in enumerate(lab.confining_stresses()):
         _model_curves(ax_curve, k, sigma, curves, 100)
@@ -175,9 +175,9 @@ def _plot_targets(ax, observed: list, marker: str, label: str) -> None:
     ax.plot(s, [o.lab for o in observed], "k" + marker, mfc="none", label=f"laboratory {label}")
     ax.errorbar(
         s, [o.model for o in observed], yerr=[2 * o.noise_sd for o in observed],
-        fmt=marker, capsize=3, label=f"model {label} (surrogate, +-2 sd)",
+        fmt=marker, capsize=3, label=rf"model {label} (surrogate, $\pm$2 sd)",
     )  # fmt: skip
-    ax.set_xlabel("confining stress sigma_3 (kPa)")
+    ax.set_xlabel(r"confining stress $\sigma_3$ (kPa)")
     ax.set_xlim(left=0)
     ax.legend(fontsize=8)
 
@@ -213,8 +213,8 @@ def plot_calibration_posterior(result, post, path: str | os.PathLike) -> Path:
     ax.xaxis.set_major_formatter(FormatStrFormatter("%g"))
     ax.xaxis.set_minor_formatter(FormatStrFormatter("%g"))
     ax.tick_params(axis="x", which="minor", labelsize=7)
-    ax.set_xlabel("particle friction f_p")
-    ax.set_ylabel("rolling friction mu_r")
+    ax.set_xlabel(r"particle friction $f_p$")
+    ax.set_ylabel(r"rolling friction $\mu_r$")
     ax.set_title(
         f"posterior (correlation {result.posterior.correlation:+.2f}); shaded: "
         f"{result.level:.0%} intervals" + (" (unknown: not shaded)" if result.unidentified else ""),
@@ -227,10 +227,10 @@ def plot_calibration_posterior(result, post, path: str | os.PathLike) -> Path:
 
 #: the label and the key in a result of each axis of a posterior (``post.ranges.axes``)
 _AXES = {
-    "fp": ("particle friction f_p", "particle_friction"),
-    "mu_r": ("rolling friction mu_r", "rolling_friction"),
-    "kn": ("disk kn (N/m)", "particle_kn"),
-    "ks": ("disk ks (N/m)", "particle_ks"),
+    "fp": (r"particle friction $f_p$", "particle_friction"),
+    "mu_r": (r"rolling friction $\mu_r$", "rolling_friction"),
+    "kn": (r"disk $k_n$ (N/m)", "particle_kn"),
+    "ks": (r"disk $k_s$ (N/m)", "particle_ks"),
 }
 #: bins per axis of the corner's histograms
 CORNER_BINS = 30
@@ -282,7 +282,7 @@ def _corner_marginal(ax, result, post, axis: str) -> None:
     interval = getattr(result.intervals, _AXES[axis][1])
     if interval is not None:
         lo, hi = post.ranges.to_unit(*_at_axis(result, post, axis, interval))[:, k]
-        ax.axvspan(lo, hi, color="tab:blue", alpha=0.2)
+        ax.axvspan(lo, hi, color=BLUE, alpha=0.2)
     ax.set_yticks([])
     ax.set_xlim(0, 1)
 

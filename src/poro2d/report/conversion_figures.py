@@ -13,25 +13,35 @@ from matplotlib.figure import Figure
 
 from poro2d import porosity as P
 from poro2d.errors import InputError, check_range
-from poro2d.report.figure_file import new_figure, save_figure
+from poro2d.report.figure_file import (
+    BLUE,
+    BLUISH_GREEN,
+    GREY,
+    ORANGE,
+    REDDISH_PURPLE,
+    SKY_BLUE,
+    VERMILION,
+    new_figure,
+    save_figure,
+)
 
 # name, function of n_lab, style
 _STYLE = {
-    "densest_state": dict(color="tab:blue", ls="-"),
-    "densest_state_modified": dict(color="tab:cyan", ls="-"),
-    "densest_state_modified_alt": dict(color="magenta", ls="--", zorder=5),
-    "loosest_state": dict(color="tab:red", ls="-"),
-    "interval_mapping": dict(color="tab:orange", ls="-"),
-    "combination": dict(color="tab:purple", ls="-"),
-    "lim_lab": dict(color="tab:green", ls="-", lw=3.0, alpha=0.55),
-    "lim_3d": dict(color="tab:brown", ls="-"),
-    "quasi_3d": dict(color="darkgreen", ls=":", lw=2.0),
+    "densest_state": dict(color=BLUE, ls="-"),
+    "densest_state_modified": dict(color=SKY_BLUE, ls="-"),
+    "densest_state_modified_alt": dict(color=REDDISH_PURPLE, ls="--", zorder=5),
+    "loosest_state": dict(color=VERMILION, ls="-"),
+    "interval_mapping": dict(color=ORANGE, ls="-"),
+    "combination": dict(color=REDDISH_PURPLE, ls="-"),
+    "lim_lab": dict(color=BLUISH_GREEN, ls="-", lw=3.0, alpha=0.55),
+    "lim_3d": dict(color=GREY, ls="-"),
+    "quasi_3d": dict(color=BLUISH_GREEN, ls=":", lw=2.0),
     "parabolic": dict(color="black", ls="-", lw=2.2),
 }
 
 
 def _eq2_label(reading: str) -> str:
-    label = f"Densest State modified\n(Eq. 2, nu {reading.replace('_', ' ')})"
+    label = f"Densest State modified\n(Eq. 2, $\\nu$ {reading.replace('_', ' ')})"
     if reading == "solid_fraction":
         label = label[:-1] + "; near LIM 2D-Lab)"
     return label
@@ -64,14 +74,14 @@ def _fig1_curves(
 
 def _fig1_negative_band(ax, lo_y: float, pad: float) -> None:
     """Shade n2D < 0: several methods go negative there, and the reader must see that it is impossible."""
-    ax.axhspan(lo_y - pad, 0.0, color="tab:red", alpha=0.07, lw=0)
+    ax.axhspan(lo_y - pad, 0.0, color=VERMILION, alpha=0.07, lw=0)
     ax.axhline(0.0, color="0.2", lw=1.0)
     ax.text(
         0.99,
         0.02,
-        "n2D < 0: physically impossible",
+        r"$n_{2D} < 0$: physically impossible",
         transform=ax.transAxes,
-        color="tab:red",
+        color=VERMILION,
         fontsize=9,
         ha="right",
         va="bottom",
@@ -87,13 +97,13 @@ def _fig1_mark(ax, mark_n_lab: float, y_text: float) -> None:
 def _mark_line(ax, n_lab: float, y: float, **text) -> None:
     """A dotted vertical line at the user's ``n_lab``, named at height ``y``."""
     ax.axvline(n_lab, color="0.4", ls=":", lw=1.2)
-    ax.text(n_lab, y, f" n_lab = {n_lab:g}", color="0.3", fontsize=9, **text)
+    ax.text(n_lab, y, f" $n_{{Lab}}$ = {n_lab:g}", color="0.3", fontsize=9, **text)
 
 
 def _finish(ax, title: str, **legend) -> None:
     """The axes' labels (laboratory against 2D porosity), ``title``, grid and legend of both figures."""
-    ax.set_xlabel("laboratory porosity n_lab [-]")
-    ax.set_ylabel("2D porosity n2D [-]")
+    ax.set_xlabel(r"laboratory porosity $n_{Lab}$ [-]")
+    ax.set_ylabel(r"2D porosity $n_{2D}$ [-]")
     ax.set_title(title)
     ax.grid(True, alpha=0.3)
     ax.legend(**legend)
@@ -126,7 +136,10 @@ def fig1_relations(
         _fig1_mark(ax, mark_n_lab, hi_y + pad * 0.5)
     ax.set_xlim(n_min, n_max)
     ax.set_ylim(lo_y - pad, hi_y + pad)
-    title = f"Fig. 1: 2D vs laboratory porosity, all methods\n(n_lab,max = {n_max:g}, n_lab,min = {n_min:g})"
+    title = (
+        "Fig. 1: 2D vs laboratory porosity, all methods\n"
+        f"($n_{{Lab,max}}$ = {n_max:g}, $n_{{Lab,min}}$ = {n_min:g})"
+    )
     _finish(
         ax, title, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=9, frameon=False, labelspacing=0.8
     )
@@ -153,9 +166,9 @@ def _fig2_lines(
     )
     l3 = P.lim_3d(x)
     seg = (x >= P.FCC_3D) & (x <= P.SIMPLE_CUBIC_3D)
-    ax.plot(x, l3, color="tab:brown", ls="--", lw=1.2, alpha=0.8)
-    ax.plot(x[seg], l3[seg], color="tab:brown", lw=2.5, label="LIM 2D-3D, solid from FCC to SC")
-    ax.plot(x, P.parabolic(x), color="black", lw=2.2, label="Parabola 0.42 n^2 + 0.25 n (Eq. 12)")
+    ax.plot(x, l3, color=GREY, ls="--", lw=1.2, alpha=0.8)
+    ax.plot(x[seg], l3[seg], color=GREY, lw=2.5, label="LIM 2D-3D, solid from FCC to SC")
+    ax.plot(x, P.parabolic(x), color="black", lw=2.2, label=r"Parabola $0.42\,n^2 + 0.25\,n$ (Eq. 12)")
     return lab, l3
 
 
@@ -172,7 +185,7 @@ def _fig2_construction_points(ax) -> None:
         "o",
         ms=9,
         mfc="none",
-        mec="tab:red",
+        mec=VERMILION,
         mew=2,
         label="construction points of Eq. 12",
     )
@@ -188,7 +201,7 @@ def _fig2_construction_points(ax) -> None:
             textcoords="offset points",
             ha="right" if px > 0 else "left",
             fontsize=8.5,
-            color="tab:red",
+            color=VERMILION,
         )
 
 
@@ -196,17 +209,17 @@ def _fig2_mark(ax, mark_n_lab: float, n_max: float, n_min: float, lattice_exact:
     """The three lines' values at the user's n_lab, printed too: the gap between them is the point."""
     check_range("mark_n_lab", mark_n_lab, 0.0, x_max)
     marks = [
-        ("LIM 2D-3D", float(P.lim_3d(mark_n_lab)), "tab:brown"),
+        ("LIM 2D-3D", float(P.lim_3d(mark_n_lab)), GREY),
         ("parabola", float(P.parabolic(mark_n_lab)), "black"),
         (
             "LIM 2D-Lab",
             float(P.lim_lab(mark_n_lab, n_max, n_min, lattice_exact=lattice_exact)),
-            "tab:green",
+            BLUISH_GREEN,
         ),
     ]
     for _, y, c in marks:
         ax.plot([mark_n_lab], [y], "s", color=c, ms=6, zorder=6)
-    lines = [f"at n_lab = {mark_n_lab:g}:"] + [f"{name}: {y:.3f}" for name, y, _ in marks]
+    lines = [f"at $n_{{Lab}}$ = {mark_n_lab:g}:"] + [f"{name}: {y:.3f}" for name, y, _ in marks]
     ax.text(
         0.98,
         0.04,

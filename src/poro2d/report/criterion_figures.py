@@ -16,6 +16,7 @@ from poro2d.criterion.result import CriterionResult
 from poro2d.errors import InputError
 from poro2d.measure.specimen_porosity import measure_specimen
 from poro2d.measure.specimen_state import specimen_state
+from poro2d.report.figure_file import figure_files
 from poro2d.report.force_chains import plot_simulation_force_chains
 from poro2d.report.specimen_figures import plot_local_porosity, plot_specimen_state
 from poro2d.store import Store, walk
@@ -32,11 +33,11 @@ def draw_criterion(result: CriterionResult, store: Store) -> None:
         folder = trial_store(store, t)
         weight = t.self_weight_n_per_m
         if folder.has(PREPARED[0]):
-            title = f"trial n2D = {t.trial_porosity:.3f}, top plate at H"
+            title = f"trial $n_{{2D}}$ = {t.trial_porosity:.3f}, top plate at $H$"
             _force_figure(folder, PREPARED, width, title, t.forces, weight)
         if folder.has(AFTER_PLATE[0]):
             what = "resting the lid" if t.plate.moved == "lid" else f"moving the top plate {t.plate.moved}"
-            title = f"after {what}: n' = {t.plate.new_porosity:.4f}"
+            title = f"after {what}: $n'$ = {t.plate.new_porosity:.4f}"
             _force_figure(folder, AFTER_PLATE, width, title, t.forces_after, weight)
     _paper_figures(result, store)
     _accepted_figures(result, store, width)
@@ -65,16 +66,17 @@ def _force_figure(folder: Store, state: tuple[str, str], width: float, title: st
     plot_simulation_force_chains(
         sim, folder.path(state[1]), title=title, box=(0.0, 0.0, width, top_height(sim, width)),
         notes=[
-            f"F_top = {forces.f_top_n_per_m:.4g} N/m",
-            f"F_bottom = {forces.f_bottom_n_per_m:.4g} N/m",
-            f"G = {weight:.4g} N/m",
+            f"$F_{{top}}$ = {forces.f_top_n_per_m:.4g} N/m",
+            f"$F_{{bottom}}$ = {forces.f_bottom_n_per_m:.4g} N/m",
+            f"$G$ = {weight:.4g} N/m",
         ],
     )  # fmt: skip
 
 
 def _paper_figures(result: CriterionResult, store: Store) -> None:
     """Fig. 5 (the first trial as prepared), Fig. 6 (the first trial whose top moved) and Fig. 7
-    (the accepted trial, in the state it was accepted on), copied to the top of ``store``."""
+    (the accepted trial, in the state it was accepted on), copied to the top of ``store`` with
+    their SVGs."""
     trials = result.iterations
     if not trials:
         return
@@ -87,8 +89,10 @@ def _paper_figures(result: CriterionResult, store: Store) -> None:
         figure = AFTER_PLATE[1] if found[1] == AFTER_PLATE[0] else PREPARED[1]
         pairs.append((found[0], figure, "fig7_forces_accepted.png"))
     for folder, name, as_name in pairs:
-        if folder.has(name):
-            folder.copy(name, store, as_name)
+        # the figure and its vector twin, each copied when the trial has it
+        for source, target in zip(figure_files(name), figure_files(as_name), strict=True):
+            if folder.has(source.name):
+                folder.copy(source.name, store, target.name)
 
 
 def _accepted_figures(result: CriterionResult, store: Store, width: float) -> None:
@@ -101,14 +105,14 @@ def _accepted_figures(result: CriterionResult, store: Store, width: float) -> No
     n2d = next(t for t in result.iterations if t.decision.accepted).trial_porosity
     top = top_height(sim, width)
     state = specimen_state(sim, width, top, trial_porosity=n2d)
-    title = f"accepted specimen, n2D = {n2d:.3f}: bands of equal height"
+    title = f"accepted specimen, $n_{{2D}}$ = {n2d:.3f}: bands of equal height"
     plot_specimen_state(state, store.path("specimen_state.png"), title=title)
     p = sim.particles
     try:
         m = measure_specimen(p.pos, p.radius, width, top, lid=lid_shape(sim, width))
     except (InputError, RuntimeError):  # no map: the run's specimen_porosity.json says why
         return
-    title = f"accepted specimen, n2D = {n2d:.3f}: local porosity (Laguerre cells)"
+    title = f"accepted specimen, $n_{{2D}}$ = {n2d:.3f}: local porosity (Laguerre cells)"
     plot_local_porosity(p.pos, p.radius, width, top, m, store.path("local_porosity.png"), title=title)
 
 

@@ -31,8 +31,8 @@ LINE_FIGURE = "critical_state_line.png"
 
 def _title(case: CriticalStateCase) -> str:
     return (
-        f"periodic shear: f_p = {case.particle_friction:g}, mu_r = {case.rolling_friction:g}, "
-        f"P = {case.pressure_kpa:g} kPa, I = {case.inertial_number:g}, {case.disks} disks"
+        rf"periodic shear: $f_p$ = {case.particle_friction:g}, $\mu_r$ = {case.rolling_friction:g}, "
+        f"$P$ = {case.pressure_kpa:g} kPa, $I$ = {case.inertial_number:g}, {case.disks} disks"
     )
 
 
@@ -73,11 +73,11 @@ def plot_critical_state(
     if steady is not None:
         ax.axhline(steady[0], color="k", lw=0.8, ls=":", label=f"steady mean {steady[0]:.3f}")
         bx.axhline(steady[1], color="k", lw=0.8, ls=":")
-    ax.set_ylabel("stress ratio tau / sigma_yy")
+    ax.set_ylabel(r"stress ratio $\tau / \sigma_{yy}$")
     ax.set_title(title, fontsize=9)
     ax.legend(fontsize=8, loc="lower right")
     bx.set_ylabel("solid fraction")
-    bx.set_xlabel("shear strain gamma")
+    bx.set_xlabel(r"shear strain $\gamma$")
     fig.tight_layout()
     return save_figure(fig, path)
 
@@ -92,7 +92,7 @@ def plot_critical_state_line(result: Any, path: str | os.PathLike) -> Path:
         p, e = point.mean_stress_kpa, point.void_ratio
         ax.plot(p.values, e.values, ".", color="0.6", ms=4, label="a seed" if k == 0 else None)
         ax.errorbar(p.mean, e.mean, yerr=e.sd or 0.0, fmt="o", color=COLORS[0], ms=6, capsize=3,
-                    label="mean +- sd over seeds" if k == 0 else None)  # fmt: skip
+                    label=r"mean $\pm$ sd over seeds" if k == 0 else None)  # fmt: skip
         sr = point.stress_ratio
         bx.errorbar(p.mean, sr.mean, yerr=sr.sd or 0.0, fmt="o", color=COLORS[1], ms=6, capsize=3)
     lo = min(pt.mean_stress_kpa.min for pt in result.points)
@@ -105,17 +105,17 @@ def plot_critical_state_line(result: Any, path: str | os.PathLike) -> Path:
         ax.axhline(mark.void_ratio, color=COLORS[(k + 2) % len(COLORS)], lw=1.0, ls=style,
                    label=f"{mark.label}: e = {mark.void_ratio:.4f}")  # fmt: skip
     ax.set_xscale("log")
-    ax.set_ylabel("2D void ratio e = (1 - phi) / phi")
+    ax.set_ylabel(r"2D void ratio $e = (1 - \phi) / \phi$ ($\phi$: solid fraction)")
     c = result.case
-    kappa = "" if c.stiffness_number is None else f", kappa = {c.stiffness_number:g} at every p"
+    kappa = "" if c.stiffness_number is None else rf", $\kappa$ = {c.stiffness_number:g} at every $p$"
     ax.set_title(
-        f"critical-state line: f_p = {c.particle_friction:g}, mu_r = {c.rolling_friction:g}, "
-        f"I = {c.inertial_number:g}, {c.disks} disks{kappa}",
+        rf"critical-state line: $f_p$ = {c.particle_friction:g}, $\mu_r$ = {c.rolling_friction:g}, "
+        f"$I$ = {c.inertial_number:g}, {c.disks} disks{kappa}",
         fontsize=9,
     )
     ax.legend(fontsize=8)
-    bx.set_ylabel("tau / sigma_yy")
-    bx.set_xlabel("mean stress p' (kPa)")
+    bx.set_ylabel(r"$\tau / \sigma_{yy}$")
+    bx.set_xlabel(r"mean stress $p'$ (kPa)")
     for axis in (ax, bx):
         axis.grid(alpha=0.3, which="both")
     fig.tight_layout()

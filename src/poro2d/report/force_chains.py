@@ -18,9 +18,9 @@ from matplotlib.patches import Circle
 
 from poro2d.dem.contacts import ContactSet
 from poro2d.errors import InputError, check_range
-from poro2d.report.figure_file import new_figure, save_figure
+from poro2d.report.figure_file import VERMILION, new_figure, save_figure
 
-FORCE_COLOR = "#b2182b"
+FORCE_COLOR = VERMILION
 WALL_COLOR = "#333333"
 
 
@@ -65,10 +65,19 @@ def _contact_lines(contacts: ContactSet, pos: np.ndarray) -> np.ndarray:
     return np.stack([seg_a, seg_b], axis=1)
 
 
+def force_text(value: float) -> str:
+    """A force of the legend as a reader writes it: 5,000 and 2.5, not 5e+03; a power of ten in
+    mathtext beyond a million or below a thousandth."""
+    if value == 0 or 1e-3 <= abs(value) < 1e6:
+        return f"{value:,.0f}" if abs(value) >= 100 else f"{value:.3g}"
+    exponent = int(np.floor(np.log10(abs(value))))
+    return rf"${value / 10**exponent:.3g} \times 10^{{{exponent}}}$"
+
+
 def _legend(ax, ref: float, max_width: float, unit: str) -> None:
     """Three line widths with their force, and the wall, below the drawing."""
     handles = [
-        Line2D([], [], color=FORCE_COLOR, lw=max_width * v / ref, label=f"{v:,.3g} {unit}")
+        Line2D([], [], color=FORCE_COLOR, lw=max_width * v / ref, label=f"{force_text(v)} {unit}")
         for v in (ref, ref / 2, ref / 10)
     ]
     handles.append(Line2D([], [], color=WALL_COLOR, lw=2.5, label="wall"))
@@ -165,4 +174,4 @@ def plot_simulation_force_chains(
     )  # fmt: skip
 
 
-__all__ = ["plot_force_chains", "plot_simulation_force_chains", "wall_segments"]
+__all__ = ["force_text", "plot_force_chains", "plot_simulation_force_chains", "wall_segments"]

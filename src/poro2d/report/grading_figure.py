@@ -18,7 +18,7 @@ import numpy as np
 from matplotlib.ticker import FuncFormatter
 
 from poro2d.grading import GradingCurve, realised_curve
-from poro2d.report.figure_file import DPI, new_figure, save_figure
+from poro2d.report.figure_file import DPI, ORANGE, VERMILION, new_figure, save_figure
 from poro2d.store import Store
 
 
@@ -73,11 +73,11 @@ def grading_figure(
         ax.semilogx(used.sizes * 1e3 / up, used.percent, "-s", color="k", ms=4, label="after the cuts (mass)")
         for name in ("d_min_mm", "d_max_mm"):
             if name in table:
-                ax.axvline(float(table[name]) / up, color="tab:orange", ls="--", lw=1)
-        ax.plot([], [], color="tab:orange", ls="--", label="cuts (d_min_mm, d_max_mm)")
+                ax.axvline(float(table[name]) / up, color=ORANGE, ls="--", lw=1)
+        ax.plot([], [], color=ORANGE, ls="--", label=r"cuts ($d_{min}$, $d_{max}$)")
     if radii is not None and len(radii):
         d = np.geomspace(used.d_min_m, used.d_max_m, 60)
-        ax.semilogx(d * 1e3 / up, drawn_curve(radii, d), color="tab:red", lw=2,
+        ax.semilogx(d * 1e3 / up, drawn_curve(radii, d), color=VERMILION, lw=2,
                     label=f"drawn disks, one specimen ({len(radii)}, by area)")  # fmt: skip
     plain = FuncFormatter(lambda v, _: f"{v:g}")  # 0.2, not 2 x 10^-1
     ax.set_xlabel("laboratory size [mm]")
@@ -88,12 +88,13 @@ def grading_figure(
         top = ax.secondary_xaxis("top", functions=(lambda x: x * up, lambda x: x / up))
         top.xaxis.set_major_formatter(plain)
         top.xaxis.set_minor_formatter(plain)
-        top.set_xlabel(f"disk diameter in the model [mm] (up-scaling x{up:g})")
+        top.set_xlabel(rf"disk diameter in the model [mm] (up-scaling $\times${up:g})")
     # after the secondary axis, which resets the parent's tick labels
     ax.xaxis.set_major_formatter(plain)
     ax.xaxis.set_minor_formatter(plain)
     ax.legend(loc="upper left", fontsize=8)
-    ax.set_title(f"{title}: Cu = {used.uniformity:.2f}, d_max/d_min = {used.d_max_m / used.d_min_m:.0f}")
+    spread = used.d_max_m / used.d_min_m
+    ax.set_title(f"{title}: $C_u$ = {used.uniformity:.2f}, $d_{{max}}/d_{{min}}$ = {spread:.0f}")
     fig.tight_layout()
     return save_figure(fig, path)
 
@@ -107,8 +108,8 @@ def plot_realised(curve: GradingCurve, radii, path: str | os.PathLike, *, title:
 
     fig, ax = new_figure(figsize=(6.4, 4.2), dpi=DPI)
     ax.semilogx(d_mm, curve.percent, "-o", color="k", ms=4, label="requested (by mass)")
-    ax.semilogx(d_mm, realised, "s", color="tab:red", mfc="none", ms=7, label="realised (by area)")
-    ax.set_xlabel("diameter in the model d [mm]")
+    ax.semilogx(d_mm, realised, "s", color=VERMILION, mfc="none", ms=7, label="realised (by area)")
+    ax.set_xlabel(r"diameter in the model $d$ [mm]")
     ax.set_ylabel("percent passing [%]")
     ax.set_ylim(0, 100)
     ax.set_xticks(d_mm, [f"{v:.3g}" for v in d_mm])

@@ -12,6 +12,7 @@ imports none of their classes.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -54,7 +55,7 @@ def build_blocks(
     b = _intro_blocks(summary, crit)
     b += _inputs_blocks(summary, crit)
     b += _conversion_blocks(out, summary.conversions)
-    b += _criterion_blocks(criterion, summary.paper.criterion)
+    b += _criterion_blocks(criterion, summary.paper.criterion, _measured_angle(summary.shear))
     if sensitivity is not None:  # why the paper gets what it gets, when the run holds a sensitivity study
         from poro2d.report.sensitivity_report import report_blocks
 
@@ -81,7 +82,7 @@ def _intro_blocks(summary, crit) -> list[Block]:
     pc = paper.criterion
     its = [r.to_dict() for r in crit.iterations or []]  # each trial's row (its keys are not its fields)
     shear = summary.shear
-    b: list[Block] = [("h1", "poro2d: the paper's case study")]
+    b: list[Block] = [("h1", "poro2d: the paper's case study"), ("note", PAPER_MODE_CAVEAT)]
     b.append((
         "p",
         "Wang, Jacobs and Ziegler, 'A new suggestion for determining 2D porosities in DEM studies': "
@@ -120,6 +121,17 @@ def _intro_blocks(summary, crit) -> list[Block]:
     return b
 
 
+#: what paper mode is and is not, said before any number (the report's first note)
+PAPER_MODE_CAVEAT = (
+    "Paper mode reproduces the paper's procedure, not a soil at its laboratory density: it ignores "
+    "the dry density below except to state nLab, starts from the 2D porosity of Eq. 12 (the "
+    "parabola of nLab) and keeps the porosity the criterion accepts, so the accepted 2D porosity "
+    "is Eq. 12's and the criterion's, whatever density the laboratory specimen had. For a soil at a "
+    "laboratory state (its grading, density and strength), run `poro2d sand` (docs/sand.md); "
+    "`poro2d criterion` in density mode targets a laboratory density (docs/criterion.md)."
+)
+
+
 def _inputs_blocks(summary, crit) -> list[Block]:
     """What is reconstructed or assumed where the paper is silent."""
     spec, pc = crit.specimen, summary.paper.criterion
@@ -144,8 +156,9 @@ def _inputs_blocks(summary, crit) -> list[Block]:
         f"{spec.ratio}.",
         *quick,
         "Direct shear: the shear velocity is far above the laboratory rate of 0.384 mm/min "
-        f"(quasi-static checks below); {_lab_text(summary)} A test ends once its smoothed peak lies "
-        "stop_after_peak (5 mm by default) behind, or at max_displacement (20 mm); each test's "
+        f"(the quasi-static checks are in the direct shear section); {_lab_text(summary)} A test "
+        "ends once its smoothed peak lies stop_after_peak (5 mm by default) behind, or at "
+        "max_displacement (20 mm); each test's "
         "result.json says which (ended_by).",
     ])]  # fmt: skip
 
@@ -211,7 +224,12 @@ def _shown(trial: dict) -> dict:
     return dict(trial, plate_displacement_mm=1e3 * trial["plate_displacement_m"], accepted=accepted)
 
 
-def _criterion_blocks(criterion, pc) -> list[Block]:
+def _measured_angle(shear) -> float | None:
+    """The friction angle this run measured: the Mohr-Coulomb fit of the direct shear peaks (deg)."""
+    return getattr(shear, "friction_angle_deg", None) if shear else None
+
+
+def _criterion_blocks(criterion, pc, phi: float | None = None) -> list[Block]:
     """poro2d's trials beside the paper's, the discussion, Figs. 5-7 and the specimen's state."""
     b: list[Block] = [("h2", "The criterion (Fig. 3)")]
     its = [r.to_dict() for r in criterion.result.iterations or []]  # each trial's row
@@ -236,7 +254,7 @@ def _criterion_blocks(criterion, pc) -> list[Block]:
     for name, cap in CRITERION_CAPTIONS.items():
         if name in criterion.figures:
             b.append(("img", criterion.figures[name], cap))
-    return b + _state_blocks(criterion) + _porosity_blocks(criterion)
+    return b + _state_blocks(criterion, phi) + _porosity_blocks(criterion)
 
 
 def _provenance_blocks(summary, crit) -> list[Block]:
@@ -286,8 +304,9 @@ def _criterion_discussion(its: list[dict], pc) -> list[Block]:
     return out
 
 
-def _state_blocks(criterion) -> list[Block]:
-    """Homogeneity and stress state of the accepted specimen, when the criterion wrote them."""
+def _state_blocks(criterion, phi: float | None = None) -> list[Block]:
+    """Homogeneity and stress state of the accepted specimen, when the criterion wrote them, and its
+    K0 beside Jaky's for the friction angle ``phi`` (deg) the run measured."""
     st = criterion.state
     if st is None:
         return []
@@ -303,11 +322,31 @@ def _state_blocks(criterion) -> list[Block]:
            "(F_top / W plus the weight above; the side walls carry the rest by friction)." if ratio else ""),
     ))  # fmt: skip
     if k0 is not None:
-        b.append(("p", k0_note(k0)))
+        b += k0_blocks(k0, st.k0_sd, phi)
     if "specimen_state.png" in criterion.figures:
         cap = "Porosity and stresses of the accepted specimen, by height"
         b.append(("img", criterion.figures["specimen_state.png"], cap))
     return b
+
+
+def jaky_k0(phi_deg: float) -> float:
+    """Jaky's coefficient of earth pressure at rest, K0 = 1 - sin(phi') (Jaky 1944, Journal of the
+    Society of Hungarian Architects and Engineers 78(22), 355-358), for ``phi_deg`` in degrees."""
+    return 1.0 - math.sin(math.radians(phi_deg))
+
+
+def k0_blocks(k0: float, k0_sd: float | None, phi: float | None) -> list[Block]:
+    """The accepted specimen's K0 beside Jaky's 1 - sin(phi) for the angle the run measured, and why
+    they differ."""
+    sd = f" (sd {k0_sd:.2f} over the bands)" if k0_sd is not None else ""
+    rows = [["K0 = sigma_h / sigma_v of the accepted specimen (Love-Weber stress of its disks, mean over "
+             "the bands)", f"{k0:.2f}{sd}"]]  # fmt: skip
+    if phi is not None:
+        jaky = jaky_k0(phi)
+        rows.append([f"Jaky (1944): K0 = 1 - sin phi, phi = {phi:.1f} deg (this run's direct shear peaks)",
+                     f"{jaky:.2f}"])  # fmt: skip
+        rows.append(["ratio of the two", f"{k0 / jaky:.2f}"])
+    return [("table", ["K0", "value"], rows), ("p", k0_note(k0, None if phi is None else jaky_k0(phi)))]
 
 
 #: K0 of the paper's accepted specimen (seed 0, f_p 3.0) under one-dimensional loading (d sigma_h /
@@ -315,12 +354,21 @@ def _state_blocks(criterion) -> list[Block]:
 #: docs/criterion.md, "K0")
 K0_LOADING = 0.40
 K0_UNLOADED = 0.76
+#: the relative difference within which a K0 is said to agree with Jaky's
+K0_AGREEMENT = 0.15
 
 
-def k0_note(k0: float) -> str:
-    """Why the prepared specimen's K0 is not Jaky's, with the numbers that say so."""
+def k0_note(k0: float, jaky: float | None = None) -> str:
+    """Why the prepared specimen's K0 is or is not Jaky's, with the numbers that say so (``jaky``:
+    Jaky's K0 for the angle the run measured; None: the range for sands)."""
+    if jaky is not None and abs(k0 / jaky - 1.0) <= K0_AGREEMENT:
+        return (
+            f"K0 {k0:.2f} is within {K0_AGREEMENT:.0%} of Jaky's 1 - sin phi ({jaky:.2f} for the angle "
+            "this run measured), the K0 of a normally consolidated soil."
+        )
+    reference = "about 0.4-0.5 for sands" if jaky is None else f"{jaky:.2f} for the angle this run measured"
     return (
-        f"K0 {k0:.2f} is not Jaky's 1 - sin phi (about 0.4-0.5 for sands): that is the K0 of a soil "
+        f"K0 {k0:.2f} is not Jaky's 1 - sin phi ({reference}): that is the K0 of a soil "
         "loaded one-dimensionally from a loose deposit, while this specimen was built by growing its "
         "disks in layers under a lid, which presses them in every direction and locks in a lateral "
         "stress near the vertical one, as in an overconsolidated soil; under self-weight alone "
@@ -408,7 +456,60 @@ def _shear_blocks(shear, figures: dict[str, Path]) -> list[Block]:
     for name, cap in SHEAR_FIGURES.items():
         if name in figures:
             b.append(("img", figures[name], cap))
+    return b + quasi_static_blocks(shear)
+
+
+#: the columns of the quasi-static checks' table, one row per test
+CHECK_COLUMNS = [
+    "normal stress (kPa)", "max inertial number I", "I below the limit",
+    "upper half against shear plane (mean abs. difference / tau)",
+    "largest normal stress error after consolidation",
+    "coordination number at the end", "ended by",
+]  # fmt: skip
+
+
+def quasi_static_blocks(shear) -> list[Block]:
+    """The quasi-static checks each direct shear test recorded: its largest inertial number against
+    the limit, the force balance of the upper half against the shear plane, the servo's normal
+    stress error, and the coordination number at the end of the test."""
+    tests = getattr(shear, "tests", None) or []  # the first specimen's (the summary keeps those)
+    if not tests:
+        return []
+    qs = getattr(shear, "quasi_static", None)
+    b: list[Block] = [("h3", "Quasi-static checks (the first specimen's tests)")]
+    if qs is not None:
+        verdict = "every test below it" if qs.inertial_number_ok else "NOT every test below it"
+        b.append((
+            "p",
+            "Inertial number I (largest over the tests of the first specimen: "
+            f"{_num(qs.max_inertial_number)}; limit {qs.inertial_limit:g}, {verdict}): "
+            f"{qs.inertial_number_definition}. "
+            "The shear force carried by the upper half should equal the force across the shear plane; "
+            "their mean difference over the test, relative to the shear force, says how far the box "
+            "is from equilibrium while it is sheared. The kinetic energy is not recorded by the "
+            "direct shear test: the inertial number and this balance are its checks.",
+        ))  # fmt: skip
+    b.append(("table", CHECK_COLUMNS, [_check_row(t) for t in tests]))
     return b
+
+
+def _check_row(t) -> list:
+    """One test's row of the quasi-static checks."""
+    balance = getattr(t.force_balance, "mean_abs_upper_minus_plane_rel", None)
+    end = getattr(t.end, "coordination_number", None)
+    return [
+        t.normal_stress_kpa, _num(t.max_inertial_number), "yes" if t.inertial_number_ok else "no",
+        _percent(balance), _percent(t.normal_stress_max_error_after_consolidation),
+        _num(end, ".2f"), t.ended_by or "-",
+    ]  # fmt: skip
+
+
+def _num(value, fmt: str = ".2e") -> str:
+    return "-" if value is None else format(value, fmt)
+
+
+def _percent(value) -> str:
+    return "-" if value is None else f"{100 * value:.1f} %"
 
 
 def write_paper_report(out: str | Path, summary, criterion, **parts) -> list[Path]:

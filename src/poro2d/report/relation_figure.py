@@ -16,7 +16,15 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from poro2d import porosity as P
-from poro2d.report.figure_file import new_figure, save_figure
+from poro2d.report.figure_file import (
+    BLUE,
+    BLUISH_GREEN,
+    GREY,
+    REDDISH_PURPLE,
+    VERMILION,
+    new_figure,
+    save_figure,
+)
 from poro2d.store import Store
 from poro2d.sweep.results import RelationResult
 
@@ -49,10 +57,10 @@ def plot_relation(rel, title: str = "") -> Figure:
     _dem_points(ax, rel)
     failed = [p for p in pts if not _finite(p.n2d_dem)]
     for p in failed:
-        ax.axvline(p.n_lab, color="tab:red", ls=":", lw=1.0)
+        ax.axvline(p.n_lab, color=VERMILION, ls=":", lw=1.0)
     ax.set_xlim(x[0], x[-1])
-    ax.set_xlabel("laboratory porosity nLab [-]   (shaded: between n_min and n_max)")
-    ax.set_ylabel("2D porosity n2D [-]")
+    ax.set_xlabel(r"laboratory porosity $n_{Lab}$ [-]   (shaded: between $n_{min}$ and $n_{max}$)")
+    ax.set_ylabel(r"2D porosity $n_{2D}$ [-]")
     head = title or "2D porosity from the criterion vs laboratory porosity"
     sub = f"n_max = {hi:g} (Dr = 0), n_min = {lo:g} (Dr = 1)"
     if rel.mode == "density":
@@ -74,25 +82,26 @@ def _finite(v) -> bool:
 def _method_curves(ax, x: np.ndarray, hi: float, lo: float, fit) -> None:
     """Eq. 12 and the other conversion methods over ``x``, and the parabola fitted to the DEM."""
     curves = (  # label, n2D of nLab, style
-        ("Parabola, Eq. 12 (0.42 n^2 + 0.25 n)", P.parabolic, dict(color="black", lw=2.0)),
-        ("LIM 2D-3D (Sec. 2.2)", P.lim_3d, dict(color="tab:brown", lw=1.4)),
-        ("LIM 2D-Lab (Eqs. 6-7)", lambda v: P.lim_lab(v, hi, lo), dict(color="tab:green", lw=1.4)),
-        ("Densest State (Eq. 1)", P.densest_state, dict(color="tab:blue", lw=1.2, ls="--")),
+        (r"Parabola, Eq. 12 ($0.42\,n^2 + 0.25\,n$)", P.parabolic, dict(color="black", lw=2.0)),
+        ("LIM 2D-3D (Sec. 2.2)", P.lim_3d, dict(color=GREY, lw=1.4)),
+        ("LIM 2D-Lab (Eqs. 6-7)", lambda v: P.lim_lab(v, hi, lo), dict(color=BLUISH_GREEN, lw=1.4)),
+        ("Densest State (Eq. 1)", P.densest_state, dict(color=BLUE, lw=1.2, ls="--")),
     )
     for label, n2d, style in curves:
         ax.plot(x, n2d(x), label=label, **style)
     if fit is not None:
-        label = f"fit to DEM: {fit.a:.3f} n^2 + {fit.b:.3f} n (rms {fit.rms_residual:.4f})"
-        ax.plot(x, fit.a * x * x + fit.b * x, color="tab:red", lw=2.0, ls="-.", label=label)
+        label = rf"fit to DEM: ${fit.a:.3f}\,n^2 + {fit.b:.3f}\,n$ (rms {fit.rms_residual:.4f})"
+        ax.plot(x, fit.a * x * x + fit.b * x, color=VERMILION, lw=2.0, ls="-.", label=label)
 
 
 def _interior_points(ax, ok: list) -> None:
     """The accepted specimens' interior porosity (the packing's own) beside the box porosity."""
     ins = [p for p in ok if _finite(p.n2d_interior)]
     if ins:
+        label = r"DEM interior porosity (2 $d_{50}$ clear of walls, surface; mean $\pm$ sd)"
         ax.errorbar([p.n_lab for p in ins], [p.n2d_interior for p in ins],
-                    yerr=[p.n2d_interior_sd for p in ins], fmt="s", color="tab:purple", ms=6, capsize=3,
-                    label="DEM interior porosity (2 d50 clear of walls, surface; mean +- sd)")  # fmt: skip
+                    yerr=[p.n2d_interior_sd for p in ins], fmt="s", color=REDDISH_PURPLE, ms=6, capsize=3,
+                    label=label)  # fmt: skip
 
 
 def _dem_points(ax, rel) -> None:
@@ -102,20 +111,20 @@ def _dem_points(ax, rel) -> None:
     bad = [p for p in pts if not p.converged and _finite(p.n2d_dem)]
     ox, oy = [p.n_lab for p in ok], [p.n2d_dem for p in ok]
     if ok and rel.mode == "density":
-        label = "DEM criterion, density-controlled (mean accepted n2D +- sd over seeds)"
-        ax.errorbar(ox, oy, yerr=[p.n2d_sd for p in ok], fmt="o", color="tab:red", ms=8, capsize=4,
+        label = r"DEM criterion, density-controlled (mean accepted $n_{2D} \pm$ sd over seeds)"
+        ax.errorbar(ox, oy, yerr=[p.n2d_sd for p in ok], fmt="o", color=VERMILION, ms=8, capsize=4,
                     label=label)  # fmt: skip
         ax.axhline(rel.n2d_max, color="0.4", lw=0.8, ls=":", label="2D extremes (calibrated)")
         ax.axhline(rel.n2d_min, color="0.4", lw=0.8, ls=":")
         _interior_points(ax, ok)
     elif ok:
-        ax.plot(ox, oy, "o", color="tab:red", ms=8, label="DEM criterion (accepted n2D)")
+        ax.plot(ox, oy, "o", color=VERMILION, ms=8, label=r"DEM criterion (accepted $n_{2D}$)")
     if bad:
-        ax.plot([p.n_lab for p in bad], [p.n2d_dem for p in bad], "o", mfc="none", mec="tab:red",
+        ax.plot([p.n_lab for p in bad], [p.n2d_dem for p in bad], "o", mfc="none", mec=VERMILION,
                 mew=1.8, ms=9, label="DEM, not converged (last n')")  # fmt: skip
     for p in pts:
         if _finite(p.n2d_dem):
-            ax.annotate(f"Dr={p.relative_density:.2f}", (p.n_lab, p.n2d_dem),
+            ax.annotate(f"$D_r$={p.relative_density:.2f}", (p.n_lab, p.n2d_dem),
                         textcoords="offset points", xytext=(6, -12), fontsize=8, color="0.25")  # fmt: skip
 
 

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from poro2d.io_utils import as_json, float_or_nan
 from poro2d.report.document import Block
+from poro2d.report.figure_file import BLUE, BLUISH_GREEN, REDDISH_PURPLE, VERMILION, new_figure, save_figure
 
 
 def draw_sensitivity(result, store) -> list[Path]:
@@ -26,22 +27,22 @@ def _ok(p: dict) -> bool:
 
 def plot_sensitivity(sens: dict, stem: Path) -> list[Path]:
     """Two panels, written as ``stem.png`` and ``stem.svg``: n2D against Cu and against mu_prep."""
-    from poro2d.report.figure_file import new_figure, save_figure
-
     sens = as_json(sens)  # the dict of sensitivity.json
     paper = sens["paper"]
     target, tol = float(paper["accepted_porosity"]), float(sens["answer"]["tolerance"])
     fig, (ax1, ax2) = new_figure(1, 2, sharey=True, figsize=(12.0, 5.2), layout="constrained")
     for ax in (ax1, ax2):
-        ax.axhspan(target - tol, target + tol, color="tab:green", alpha=0.12, lw=0)
-        ax.axhline(target, color="tab:green", lw=1.5, label=f"paper: accepted n2D = {target:g} (+- {tol:g})")
+        ax.axhspan(target - tol, target + tol, color=BLUISH_GREEN, alpha=0.12, lw=0)
+        label = rf"paper: accepted $n_{{2D}}$ = {target:g} ($\pm$ {tol:g})"
+        ax.axhline(target, color=BLUISH_GREEN, lw=1.5, label=label)
         ax.grid(True, alpha=0.3)
     _grading_panel(ax1, sens)
     _mu_panel(ax2, sens)
     s = sens["settings"]
     fig.suptitle(
-        f"Accepted 2D porosity, paper protocol (nLab = {s['n_lab']:g}, first trial {s['first_trial']:g} "
-        f"from {s['first_trial_from']}); mean +- sd over {s['seeds']} seed(s)"
+        f"Accepted 2D porosity, paper protocol ($n_{{Lab}}$ = {s['n_lab']:g}, "
+        f"first trial {s['first_trial']:g} "
+        rf"from {s['first_trial_from']}); mean $\pm$ sd over {s['seeds']} seed(s)"
         + ("; quick box" if s.get("quick") else ""),
         fontsize=11,
     )
@@ -59,7 +60,7 @@ def _errorbar(ax, pts: list[dict], x: str, **kw) -> None:
         if p["unconverged"]:
             y = p["n2d_mean"] if _ok(p) else ax.get_ylim()[0]
             ax.annotate(f"{p['n']}/{p['seeds']} converged", (p[x], y), textcoords="offset points",
-                        xytext=(5, 8), fontsize=8, color="tab:red")  # fmt: skip
+                        xytext=(5, 8), fontsize=8, color=VERMILION)  # fmt: skip
 
 
 def _grading_panel(ax, sens: dict) -> None:
@@ -67,28 +68,28 @@ def _grading_panel(ax, sens: dict) -> None:
     family = [p for p in pts if p["cu_nominal"] is not None]
     ref = [p for p in pts if p["cu_nominal"] is None]
     label = "log-linear grading, same mean disk area"
-    _errorbar(ax, family, "cu", fmt="o-", color="tab:blue", ms=7, label=label)
-    _errorbar(ax, ref, "cu", fmt="*", color="tab:red", ms=15,
-              label=f"poro2d's reference grading (Cu = {ref[0]['cu']:.2f})" if ref else None)  # fmt: skip
-    ax.set_xlabel("coefficient of uniformity Cu = d60 / d10 [-]")
-    ax.set_ylabel("accepted 2D porosity n2D [-]")
-    ax.set_title(f"grading width at mu_prep = {sens['settings']['mu_prep']:g}", fontsize=10)
+    _errorbar(ax, family, "cu", fmt="o-", color=BLUE, ms=7, label=label)
+    _errorbar(ax, ref, "cu", fmt="*", color=VERMILION, ms=15,
+              label=f"poro2d's reference grading ($C_u$ = {ref[0]['cu']:.2f})" if ref else None)  # fmt: skip
+    ax.set_xlabel(r"coefficient of uniformity $C_u = d_{60} / d_{10}$ [-]")
+    ax.set_ylabel(r"accepted 2D porosity $n_{2D}$ [-]")
+    ax.set_title(rf"grading width at $\mu_{{prep}}$ = {sens['settings']['mu_prep']:g}", fontsize=10)
     ax.legend(loc="best", fontsize=8.5, frameon=False)
 
 
 def _mu_panel(ax, sens: dict) -> None:
     mu0 = sens["settings"]["mu_prep"]
-    _errorbar(ax, sens["points"]["mu_prep"], "mu_prep", fmt="s-", color="tab:purple", ms=6,
-              label="calibration: n' of the accepted trial (first trial 0.19)")  # fmt: skip
+    _errorbar(ax, sens["points"]["mu_prep"], "mu_prep", fmt="s-", color=REDDISH_PURPLE, ms=6,
+              label=r"calibration: $n'$ of the accepted trial (first trial 0.19)")  # fmt: skip
     # like for like: the measured n' of the paper protocol's accepted trial, beside the calibration's
     ref = [p for p in sens["points"]["grading"] if p["cu_nominal"] is None]
     if ref and math.isfinite(float_or_nan(ref[0].get("measured_mean"))):
         first = sens["settings"]["first_trial"]
         ax.errorbar([mu0], [ref[0]["measured_mean"]], yerr=[float_or_nan(ref[0]["measured_sd"])], fmt="*",
-                    color="tab:red", ms=15, capsize=4,
-                    label=f"paper protocol (first trial {first:g}): n' of the accepted trial")  # fmt: skip
-    ax.axvline(mu0, color="0.3", ls=":", lw=1.2, label=f"paper: mu_prep = {mu0:g}")
-    ax.set_xlabel("preparation friction mu_prep [-]")
+                    color=VERMILION, ms=15, capsize=4,
+                    label=f"paper protocol (first trial {first:g}): $n'$ of the accepted trial")  # fmt: skip
+    ax.axvline(mu0, color="0.3", ls=":", lw=1.2, label=rf"paper: $\mu_{{prep}}$ = {mu0:g}")
+    ax.set_xlabel(r"preparation friction $\mu_{prep}$ [-]")
     ax.set_title("preparation friction, reference grading", fontsize=10)
     ax.legend(loc="best", fontsize=8.5, frameon=False)
 

@@ -22,7 +22,7 @@ from poro2d.errors import InputError
 from poro2d.measure.laguerre import LaguerreCells
 from poro2d.measure.specimen_porosity import PorosityDetails, SpecimenPorosity
 from poro2d.measure.specimen_state import SpecimenStateResult
-from poro2d.report.figure_file import new_figure, save_figure
+from poro2d.report.figure_file import BLUE, BLUISH_GREEN, ORANGE, VERMILION, new_figure, save_figure
 
 #: the local porosity figure writes each circle's value when there are at most this many circles
 MAX_LABELLED_CIRCLES = 60
@@ -36,19 +36,19 @@ def plot_specimen_state(state: SpecimenStateResult, path: str | os.PathLike, tit
     rows = state.bands
     z = np.array([r.z_mid_m for r in rows]) * 1e3
     fig, (a1, a2) = new_figure(1, 2, sharey=True, figsize=(9.0, 4.8), layout="constrained")
-    a1.plot([r.porosity for r in rows], z, "o-", color="tab:blue")
+    _porosity_profile(a1, [r.porosity for r in rows], z)
     a1.axvline(state.porosity_mean, color="0.5", ls=":", lw=1)
-    a1.set_xlabel("porosity of the band [-]")
+    a1.set_xlabel("porosity of the band $n$ [-]")
     a1.set_ylabel("height of the band's middle [mm]")
     a1.set_title(f"porosity: mean {state.porosity_mean:.4f}, range {state.porosity_range:.4f}", fontsize=10)
     kpa = 1e-3
-    a2.plot([r.sigma_v_pa * kpa for r in rows], z, "o-", color="tab:red", label="sigma_v (disks)")
-    a2.plot([r.sigma_h_pa * kpa for r in rows], z, "s-", color="tab:green", label="sigma_h (disks)")
+    a2.plot([r.sigma_v_pa * kpa for r in rows], z, "o-", color=VERMILION, label=r"$\sigma_v$ (disks)")
+    a2.plot([r.sigma_h_pa * kpa for r in rows], z, "s-", color=BLUISH_GREEN, label=r"$\sigma_h$ (disks)")
     a2.plot([r.sigma_v_geostatic_pa * kpa for r in rows], z, "--", color="black",
-            label="geostatic: F_top / W + rho_s g (1 - n) (H - z)")  # fmt: skip
+            label=r"geostatic: $F_{top}/W + \rho_s g (1 - n)(H - z)$")  # fmt: skip
     k0 = state.k0_mean
     a2.set_title(
-        f"stress; K0 = sigma_h / sigma_v: mean {k0:.3f}" if k0 is not None else "stress", fontsize=10
+        rf"stress; $K_0 = \sigma_h / \sigma_v$: mean {k0:.3f}" if k0 is not None else "stress", fontsize=10
     )
     a2.set_xlabel("stress [kPa] (compression positive)")
     a2.legend(fontsize=8, frameon=False, loc="upper right")
@@ -57,6 +57,38 @@ def plot_specimen_state(state: SpecimenStateResult, path: str | os.PathLike, tit
     if title:
         fig.suptitle(title, fontsize=11)
     return save_figure(fig, path)
+
+
+def porosity_axis(porosity: list[float]) -> tuple[float, float]:
+    """The porosity axis of a profile (bands bottom to top), scaled to the packing: the top band counts
+    the gap under the plate, so it sets the axis only when it lies within the spread of the bands
+    below it (at least 0.02) of their range; a margin of 15 % of the range (at least 0.01) either side."""
+    below = porosity[:-1] if len(porosity) > 2 else porosity
+    lo, hi = min(below), max(below)
+    top, reach = porosity[-1], max(hi - lo, 0.02)
+    if lo - reach <= top <= hi + reach:
+        lo, hi = min(lo, top), max(hi, top)
+    pad = max(0.15 * (hi - lo), 0.01)
+    return lo - pad, hi + pad
+
+
+def _porosity_profile(ax, porosity: list[float], z: np.ndarray) -> None:
+    """The porosity per band against height on the packing's scale; a band beyond it (the top one,
+    with the gap under the plate) is not joined to the rest but drawn at the axis' edge as an
+    arrow with its value."""
+    lo, hi = porosity_axis(porosity)
+    n = np.asarray(porosity, dtype=float)
+    inside = (n >= lo) & (n <= hi)
+    ax.plot(np.where(inside, n, np.nan), z, "o-", color=BLUE)
+    ax.set_xlim(lo, hi)
+    for value, h in zip(n[~inside], z[~inside], strict=True):
+        right = value > hi
+        inset = 0.03 * (hi - lo)  # the arrow inside the axes, pointing past its edge
+        edge = hi - inset if right else lo + inset
+        ax.plot([edge], [h], ">" if right else "<", color=VERMILION, ms=9, zorder=5)
+        ax.annotate(f"{value:.3f}\n(gap under\nthe plate)", (edge, h), xytext=(-8 if right else 8, -8),
+                    textcoords="offset points", ha="right" if right else "left", va="top",
+                    fontsize=8, color=VERMILION)  # fmt: skip
 
 
 def plot_local_porosity(
@@ -135,23 +167,23 @@ def _draw_regions(ax, d: PorosityDetails, plate_y: float, width: float) -> list:
     R = d.interior.circle_radius_m * 1e3
     labelled = d.interior.count <= MAX_LABELLED_CIRCLES
     for (cx, cy), value in zip(d.interior.centres * 1e3, d.interior.porosity, strict=True):
-        ax.add_patch(Circle((cx, cy), R, fill=False, edgecolor="red", lw=1.3))
+        ax.add_patch(Circle((cx, cy), R, fill=False, edgecolor=VERMILION, lw=1.3))
         if labelled:
             label_box = {"boxstyle": "round,pad=0.15", "facecolor": "white", "alpha": 0.8, "lw": 0}
             ax.text(cx, cy, f"{value:.3f}", ha="center", va="center", fontsize=7.5, bbox=label_box)
-    ax.plot(d.surface_x * 1e3, d.surface_h * 1e3, color="darkorange", lw=0.9)
+    ax.plot(d.surface_x * 1e3, d.surface_h * 1e3, color=ORANGE, lw=0.9)
     ax.plot([0.0, width * 1e3], [plate_y * 1e3] * 2, color="black", lw=2.5)
     return [
         Line2D([], [], color="black", lw=2.5, label="top plate"),
-        Line2D([], [], color="darkorange", lw=0.9, label="free surface h(x)"),
+        Line2D([], [], color=ORANGE, lw=0.9, label=r"free surface $h(x)$"),
         Line2D([], [], color="0.35", ls="--", lw=1.4, label="interior: margin from walls, surface"),
-        Line2D([], [], color="red", lw=1.3, label="measurement circles (porosity)"),
+        Line2D([], [], color=VERMILION, lw=1.3, label="measurement circles (porosity)"),
     ]
 
 
 def _draw_colorbar(fig, cax, cells) -> None:
     bar = fig.colorbar(cells, cax=cax, orientation="horizontal", extend="both")
-    bar.set_label("local porosity 1 - pi r^2 / cell area [-]", fontsize=9)
+    bar.set_label(r"local porosity $1 - \pi r^2 / A_{cell}$ [-]", fontsize=9)
     cax.set_box_aspect(0.08)
 
 
@@ -161,10 +193,10 @@ def _summary_text(m: SpecimenPorosity) -> str:
     touching = f"{m.plate_touching_disks} disk{'s' if m.plate_touching_disks != 1 else ''}"
     g, mn = m.surface_gap_mean_m * mm, m.surface_gap_mean_d50
     rows = [
-        ("box porosity n' (W x H_plate)", f"{m.box_porosity:.4f}"),
+        ("box porosity n' (W x plate height)", f"{m.box_porosity:.4f}"),
         (
             f"interior, {m.interior_regions} circles",
-            f"{m.interior_porosity:.4f} +/- {m.interior_porosity_std:.4f}",
+            f"{m.interior_porosity:.4f} ± {m.interior_porosity_std:.4f}",
         ),
         (
             "interior rectangle / Laguerre",
@@ -181,4 +213,4 @@ def _summary_text(m: SpecimenPorosity) -> str:
     return "\n".join(f"{label:<{width}}  {value}" for label, value in rows)
 
 
-__all__ = ["MAX_LABELLED_CIRCLES", "plot_local_porosity", "plot_specimen_state"]
+__all__ = ["MAX_LABELLED_CIRCLES", "plot_local_porosity", "plot_specimen_state", "porosity_axis"]

@@ -37,17 +37,19 @@ def plot_strength(rows: list, path: str | os.PathLike) -> Path:
     for k, fp in enumerate(frictions):
         color = COLORS[k % len(COLORS)]
         x, y, e = _series(rows, fp, "peak_friction_angle")
-        ax_phi.errorbar(x, y, yerr=e, color=color, marker="o", capsize=3, label=f"peak, f_p = {fp:g}")
+        ax_phi.errorbar(x, y, yerr=e, color=color, marker="o", capsize=3, label=f"peak, $f_p$ = {fp:g}")
         x, y, e = _series(rows, fp, "residual_friction_angle")
         ax_phi.errorbar(x, y, yerr=e, color=color, marker="s", ls="--", mfc="none", capsize=3,
-                        label=f"residual, f_p = {fp:g}")  # fmt: skip
+                        label=f"residual, $f_p$ = {fp:g}")  # fmt: skip
         x, y, e = _series(rows, fp, "max_dilation_angle")
-        ax_psi.errorbar(x, y, yerr=e, color=color, marker="o", capsize=3, label=f"f_p = {fp:g}")
+        ax_psi.errorbar(x, y, yerr=e, color=color, marker="o", capsize=3, label=f"$f_p$ = {fp:g}")
     n = max((r.specimens for r in rows), default=0)
-    ax_phi.set(xlabel="rolling friction mu_r", ylabel="friction angle (deg)",
-               title=f"Peak and residual friction angle (mean +- sd, {n} specimens)")  # fmt: skip
+    ax_phi.set(xlabel=r"rolling friction $\mu_r$", ylabel=r"friction angle $\varphi$ (°)",
+               title=rf"Peak and residual friction angle (mean $\pm$ sd, {n} specimens)")  # fmt: skip
     ax_psi.set(
-        xlabel="rolling friction mu_r", ylabel="max dilation angle (deg)", title="Largest dilation angle"
+        xlabel=r"rolling friction $\mu_r$",
+        ylabel=r"largest dilation angle $\psi$ (°)",
+        title="Largest dilation angle",
     )
     for ax in (ax_phi, ax_psi):
         ax.grid(alpha=0.3)

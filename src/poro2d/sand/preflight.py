@@ -26,7 +26,14 @@ from poro2d.errors import InputError
 from poro2d.grading import GradingCurve, paper_grading
 from poro2d.porosity import parabolic
 from poro2d.sand.case import SandCase
-from poro2d.specimen.compaction import SpecimenSpec, check_box, check_feasible, estimate_size, time_step
+from poro2d.specimen.compaction import (
+    SpecimenSpec,
+    check_box,
+    check_feasible,
+    estimate_size,
+    grading_mass_scaling_step,
+    time_step,
+)
 from poro2d.typed_result import TypedResult
 
 #: particle-steps per second per core assumed by the estimate: measured 2.0e7 (lid) to 2.7e7
@@ -112,7 +119,11 @@ class Preflight(TypedResult):
     budget_minutes: float | None
     suggestion: str
     notes: list[str] = field(default_factory=list)
+    #: the finest disk's own step, only when the light disks' inertial masses are raised in the
+    #: quasi-static stages (``time_step_s`` is then the step they share; docs/density-scaling.md)
+    time_step_unscaled_s: float | None = None
 
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("time_step_unscaled_s",)
     #: the typed parts, as their classes read them
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "box": BoxPlan,
@@ -336,6 +347,8 @@ class Workload:
     dt_paper: float
     particle_steps: StageEstimate
     seconds: StageEstimate
+    #: the finest disk's own step when the masses are raised (``dt`` the shared one), else None
+    dt_unscaled: float | None = None
 
 
 def workload(case: SandCase, spec: SpecimenSpec, g: GradingCurve, first: float, workers: int) -> Workload:
@@ -345,7 +358,10 @@ def workload(case: SandCase, spec: SpecimenSpec, g: GradingCurve, first: float, 
     fill = crit.get("acceptance", "plate") == "fill"
     window = float(crit.get("force_fraction", 0.01)) if fill else None
     cal = calibration_box(spec, g, case.calibration_disks, first, lid_window=window)
-    dt = time_step(spec, g.d_min_m)
+    # the quasi-static stages step at the density-scaled step when the specimen's disks get one
+    dt_true = time_step(spec, g.d_min_m)
+    scaled = grading_mass_scaling_step(spec, g, first)
+    dt = dt_true if scaled is None else scaled
     dt_paper = time_step(spec, paper_grading().d_min_m)
     n_cal, n_spec = _cases(case)
     cal_spec = replace(spec, width=cal.width, height=cal.height, layers=cal.layers)
@@ -356,7 +372,7 @@ def workload(case: SandCase, spec: SpecimenSpec, g: GradingCurve, first: float, 
     calibration = _seconds(psteps.calibration, n_cal, workers)
     specimens = _seconds(psteps.specimens, n_spec, workers)
     secs = StageEstimate(calibration=calibration, specimens=specimens, total=calibration + specimens)
-    return Workload(full, cal, dt, dt_paper, psteps, secs)
+    return Workload(full, cal, dt, dt_paper, psteps, secs, None if scaled is None else dt_true)
 
 
 def preflight(case: SandCase, *, workers: int = 2, budget_minutes: float | None = None) -> Preflight:
@@ -404,6 +420,7 @@ def preflight(case: SandCase, *, workers: int = 2, budget_minutes: float | None 
         budget_minutes=budget_minutes,
         suggestion=budget_suggestion(case, secs.total, budget_minutes, first, workers),
         notes=notes,
+        time_step_unscaled_s=work.dt_unscaled,
     )
 
 
@@ -420,6 +437,12 @@ def _notes(case: SandCase, jam: Jamming, eq12: float, dt: float, dt_paper: float
         notes.append(
             f"the finest disks set a time step {dt_paper / dt:.1f} times smaller than the paper grading's: "
             "cutting fines (d_min_mm) or up-scaling more shortens every stage"
+        )
+    if case.spec.mass_scaling != "off" and dt > time_step(case.spec, case.grading.d_min_m):
+        notes.append(
+            f"density scaling: the light disks' inertial masses are raised so that every disk steps at "
+            f"{dt:.3g} s in settling and under the lid ({time_step(case.spec, case.grading.d_min_m):.3g} s "
+            'without); [specimen] mass_scaling = "off" keeps the true masses'
         )
     notes += _cut_notes(case)
     crit = case.config.table("criterion")

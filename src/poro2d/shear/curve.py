@@ -18,15 +18,17 @@ from poro2d.dem import Simulation
 from poro2d.dem.contacts import ContactSet
 from poro2d.labtest.curve import CurveRow, curve_of
 from poro2d.labtest.records import typed_parts
+from poro2d.measure.fabric import FABRIC_COLUMNS, Fabric, measure_fabric
 from poro2d.shear.box import UPPER_SIDE_WALLS, SplitBox
 from poro2d.shear.fit import peak, smooth
 from poro2d.shear.parts import EndValues, ForceBalance
 from poro2d.shear.settings import ShearSettings, inertial_number
 from poro2d.store import Store
-from poro2d.typed_result import TypedResult
+from poro2d.typed_result import TypedResult, with_fields
 
 
 @dataclass(eq=False)
+@with_fields(Fabric, after="upper_wall_friction_kpa")
 class ShearRow(CurveRow):
     """One record of a test's curve: a row of ``curve.csv``, its fields the columns in order.
 
@@ -37,6 +39,7 @@ class ShearRow(CurveRow):
     across the shear plane (the normal stress the plane carries; compression positive), and
     ``upper_wall_friction_kpa`` the upward friction of the upper side walls on the disks:
     part of the plate's load that never reaches the plane (NaN in a curve of an earlier poro2d).
+    The fabric of the disks last (:class:`~poro2d.measure.fabric.Fabric`: ``a_c`` ... ``rattler_fraction``).
     """
 
     step: int
@@ -57,7 +60,7 @@ class ShearRow(CurveRow):
 
 
 #: columns a curve of an earlier poro2d lacks: read back as NaN
-LATER_COLUMNS = ("plane_normal_stress_kpa", "upper_wall_friction_kpa")
+LATER_COLUMNS = ("plane_normal_stress_kpa", "upper_wall_friction_kpa", *FABRIC_COLUMNS)
 ShearCurve = curve_of(
     ShearRow, "ShearCurve", __name__, later=LATER_COLUMNS,
     doc="A test's recorded curve: one float array per column of ``curve.csv`` (:data:`CURVE_COLUMNS`; the "
@@ -152,6 +155,7 @@ def curve_row(
         inertial_number=inertial_number(settings.velocity, sigma, rho, settings.shear_zone_factor),
         plane_normal_stress_kpa=pl.across[1] / area / 1e3,
         upper_wall_friction_kpa=-sum(sim.wall_force(w)[1] for w in UPPER_SIDE_WALLS) / area / 1e3,
+        **measure_fabric(c, sim.particles.n).row(),
     )
 
 

@@ -19,6 +19,7 @@ from poro2d.dem import Simulation
 from poro2d.dem.export import frame_of
 from poro2d.dem.reporters import Every, Reporter
 from poro2d.labtest.reporters import Checkpointer, CurveRecorder, ProgressReporter, StopTest, series_reporters
+from poro2d.measure.fabric import FabricRoses, rose
 from poro2d.shear.box import SplitBox
 from poro2d.shear.controllers import ProgressFn, ShearDrive
 from poro2d.shear.curve import ShearRow, curve_row, peak_passed
@@ -74,6 +75,7 @@ class ShearStage:
         self.rho = float(np.mean(self.sim.particles.density)) * self.sim.density_scale
         self.peak = PeakTracker(s.peak_window)
         self.peak.restore(store, PEAK_FRAME, self.rows)
+        self.roses: list[np.ndarray] = []  # the contact orientations of the rows recorded in this run
 
     def _start(self, sim: Simulation) -> tuple[Simulation, list[ShearRow], int, float]:
         """(simulation, rows, step shearing began at, wall time so far): resumed or new."""
@@ -88,6 +90,7 @@ class ShearStage:
     def _row(self, sim: Simulation) -> ShearRow:
         """The curve's row now; its contacts stay for the peak's frame of the same record."""
         self.contacts = sim.contacts()
+        self.roses.append(rose(self.contacts))
         return curve_row(sim, self.box, self.settings, self.contacts, self.y_plate0, self.step0, self.rho)
 
     def _keep_peak(self, sim: Simulation) -> None:
@@ -135,6 +138,16 @@ class ShearStage:
         x = np.array([r.shear_displacement_mm for r in self.rows]) * 1e-3
         tau = np.array([r.shear_stress_kpa for r in self.rows])
         return peak_passed(x, peak(x, tau, s.peak_window).x, s)
+
+    def fabric_roses(self) -> FabricRoses | None:
+        """The contact orientations at the smoothed peak and at the end (the peak's None when it was
+        recorded before the checkpoint this run resumed from); None without rows."""
+        if not self.rows:
+            return None
+        x = np.array([r.shear_displacement_mm for r in self.rows])
+        tau = np.array([r.shear_stress_kpa for r in self.rows])
+        k = peak(1e-3 * x, tau, self.settings.peak_window)[0]
+        return FabricRoses.of("shear_displacement_mm", x, self.roses, k)
 
     def run(self) -> float:
         """Shear to the end; returns the stage's wall time (s), resumed parts included."""

@@ -25,6 +25,7 @@ from poro2d.errors import InputError
 from poro2d.io_utils import Provenance, as_json
 from poro2d.labtest.records import ConsolidationRecord
 from poro2d.measure.coordination import coordination_number
+from poro2d.measure.fabric import ROSE_FILE
 from poro2d.measure.stiffness import (
     contact_kn,
     contacts_of,
@@ -205,6 +206,9 @@ class DirectShearTest:
         result = self._result(stage.rows, info, stage.sim, wall, stage.peak.frame)
         if self.store is not None:
             self.store.write_csv("curve.csv", stage.rows, header=CURVE_COLUMNS)
+            roses = stage.fabric_roses()
+            if roses is not None:
+                self.store.write_result(ROSE_FILE, roses)
             stage.peak.save(self.store, PEAK_FRAME)  # its force chains are drawn from it afterwards
         return result
 

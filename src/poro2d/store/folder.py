@@ -56,6 +56,13 @@ if TYPE_CHECKING:
 R = TypeVar("R")
 
 
+def parquet_engine_available() -> bool:
+    """True where pandas can write Parquet: pyarrow (the ``parquet`` extra) or fastparquet installed."""
+    from importlib.util import find_spec
+
+    return any(find_spec(engine) is not None for engine in ("pyarrow", "fastparquet"))
+
+
 class Store:
     """Result files under one folder, named relative to it.
 
@@ -173,8 +180,16 @@ class Store:
         self.check_intact(name)
         return pd.read_csv(self._root / name, **kw)
 
-    def write_parquet(self, name: str, frame: pd.DataFrame) -> Path:
-        """A pandas table as Parquet (no index), atomically: typed columns for the next reader."""
+    def write_parquet(self, name: str, frame: pd.DataFrame) -> Path | None:
+        """A pandas table as Parquet (no index), atomically: typed columns for the next reader.
+
+        None, and nothing written, where pandas has no Parquet engine (pyarrow comes with the
+        ``parquet`` extra, about 170 MB); a file of that name from an earlier run is removed
+        rather than left behind, out of date.
+        """
+        if not parquet_engine_available():
+            self.remove(name)
+            return None
         path = self._root / name
         with atomic_path(path) as tmp:
             frame.to_parquet(tmp, index=False)

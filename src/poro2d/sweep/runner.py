@@ -3,7 +3,7 @@
 Layout of the sweep's store ``DIR`` (every file through :class:`~poro2d.store.Store`)::
 
     DIR/sweep.json                 config, cases, cluster, counts, provenance
-    DIR/results.csv                one row per case (also results.parquet)
+    DIR/results.csv                one row per case (also results.parquet, where pyarrow is installed)
     DIR/cases/<id>/params.json     the case: kind, parameters, merged config
     DIR/cases/<id>/run/...         what the case kind writes (criterion outputs)
     DIR/cases/<id>/error.txt       traceback of a failed case
@@ -235,11 +235,23 @@ def run_sweep(
         df = table_from_rows(ordered, sweep.axes)
         df["reused"] = [r.extra["reused"] for r in ordered]
         store.write_frame("results.csv", df)
-        store.write_parquet("results.parquet", df)
+        if store.write_parquet("results.parquet", df) is None:
+            say_no_parquet(store)
         summary = _summary(ordered, n_reused, time.perf_counter() - t_start, cluster_info)
         record.update(status="finished", cluster=cluster_info or {}, summary=summary, finished_utc=_now())
         store.write_json("sweep.json", record)
     return replace(SweepResult.from_dict(record), rows=ordered, table=df, store=store)
+
+
+def say_no_parquet(store: Store) -> None:
+    """One line on stderr: the table is in results.csv only, and how to have the Parquet copy too."""
+    from poro2d.console import OutputConsole, shown
+
+    line = (
+        f"note: {store.path('results.parquet')} not written: pyarrow is not installed "
+        '(pip install "poro2d[parquet]"); results.csv holds the same table'
+    )
+    OutputConsole(stderr=True).print(shown(line), highlight=False, soft_wrap=True)  # [parquet] is no markup
 
 
 def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Store, options: RunOptions,
