@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from poro2d.errors import InputError, Ranges, Real, check_fields
+from poro2d.identity import outside_identity
 from poro2d.labtest.settings import (
     NORMAL_STRESS_RANGE_KPA,
     SERVO_AND_WALLS,
@@ -51,6 +52,7 @@ BIAXIAL_RANGES: Ranges = {
     "critical_rate_limit": Real(0.0, 1.0, lo_open=True),
     "probe_unload": Real(*PROBE_UNLOAD_RANGE, or_none=True),
     "stiffness_number": Real(*STIFFNESS_NUMBER_RANGE, or_none=True),
+    **lab_ranges("vtk_every"),
 }
 
 
@@ -80,10 +82,12 @@ class BiaxialSettings(TestSettings):
     contacts' elastic strain (None, the default: no probe; the plastic strains do not need it;
     :mod:`poro2d.biaxial.elastic`); stiffness_number, when given, the
     stiffness number kappa = kn / (sigma_3 t) the disks' kn and ks are scaled to for the test
-    (:mod:`poro2d.biaxial.stiffness`; >= 1000 the rigid-grain limit; None: the specimen's).
+    (:mod:`poro2d.biaxial.stiffness`; >= 1000 the rigid-grain limit; None: the specimen's);
+    vtk_every (steps; 0: none) the shearing's ParaView series (:mod:`poro2d.labtest.vtk_series`),
+    an output outside the test's identity, kept in the files only when asked for.
     """
 
-    OMITTED: ClassVar[dict] = {"probe_unload": None, "stiffness_number": None}
+    OMITTED: ClassVar[dict] = {"probe_unload": None, "stiffness_number": None, "vtk_every": 0}
 
     strain_rate: float | None = None
     max_strain: float = 0.20
@@ -103,6 +107,7 @@ class BiaxialSettings(TestSettings):
     critical_rate_limit: float = 0.1
     probe_unload: float | None = None
     stiffness_number: float | None = None
+    vtk_every: int = outside_identity(0)
 
     def __post_init__(self) -> None:
         check_fields(self, BIAXIAL_RANGES)

@@ -167,7 +167,7 @@ class BiaxialTest:
         info = consolidate(sim, self.box, self.case.confining_kpa, s, self.progress)
         sigma = self.case.confining_kpa
         start = BiaxialBox.size(sim)
-        shearing = Shearing(sim, sigma, s, self.strain_rate, self.d50, self.rho, self.progress)
+        shearing = Shearing(sim, sigma, s, self.strain_rate, self.d50, self.rho, self.progress, self.store)
         rows, velocity = shearing.run()
         curve = BiaxialCurve.of_rows(rows)
         angles = read_angles(curve, sigma, s.smoothing_strain, s.critical_window, s.critical_rate_limit)

@@ -7,6 +7,7 @@ targets (a stress times the current contact length) and read a row.
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from dataclasses import dataclass, field
@@ -18,12 +19,14 @@ from poro2d.biaxial.curve import BiaxialRow, curve_row
 from poro2d.biaxial.settings import BiaxialSettings
 from poro2d.biaxial.stiffness import contact_kn, overlap_ratio, stiffness_number
 from poro2d.dem import Simulation
+from poro2d.dem.export import frame_of
 from poro2d.labtest.records import BoxRecord, ConsolidationRecord
-from poro2d.labtest.reporters import CurveRecorder, ProgressReporter, StopTest
+from poro2d.labtest.reporters import CurveRecorder, ProgressReporter, StopTest, series_reporters
 from poro2d.labtest.settle import ProgressFn, Settled
 from poro2d.labtest.settle import settle as settle_servoed
 from poro2d.measure.coordination import coordination_number
 from poro2d.measure.fabric import rose
+from poro2d.store import Store
 
 #: the first part of the axial strain, where the side walls only start to follow, left out of
 #: the sigma_3 check
@@ -125,7 +128,8 @@ class Shearing:
 
     One row per ``record_strain`` of axial strain (:func:`poro2d.biaxial.curve.curve_row`)
     until the axial strain reaches ``max_strain``; the side walls' targets are renewed at
-    every row (sigma_3 over the current height).
+    every row (sigma_3 over the current height). With ``settings.vtk_every`` and a ``store``, a
+    step of the ParaView series every ``vtk_every`` steps (in ``vtk/``, at the axial strain).
     """
 
     sim: Simulation
@@ -135,6 +139,7 @@ class Shearing:
     d50: float
     rho: float
     progress: ProgressFn | None = None
+    store: Store | None = None
     roses: list[np.ndarray] = field(default_factory=list, init=False, repr=False)
 
     def run(self) -> tuple[list[BiaxialRow], float]:
@@ -171,7 +176,11 @@ class Shearing:
         )
         if not strained():  # then as many rows as reaching max_strain takes
             recorder = CurveRecorder(steps_per_row, row, rows)
-            sim.run(sys.maxsize, reporters=[recorder, share, StopTest(steps_per_row, strained)])
+            series = series_reporters(
+                s.vtk_every, self.store, "axial_strain", sim, frame_of,
+                lambda sm: (sm.step_count, sm.time, math.log(start.height / BiaxialBox.size(sm).height)),
+            )  # fmt: skip
+            sim.run(sys.maxsize, reporters=[recorder, share, *series, StopTest(steps_per_row, strained)])
         return rows, velocity
 
 

@@ -48,6 +48,7 @@ def register(app: typer.Typer) -> None:
         scheduler: str = opt.tests_scheduler(),
         config: Path = opt.config(help="TOML config with a \\[biaxial] table."),
         quiet: bool = opt.quiet(),
+        vtk_every: int = opt.vtk_every(),
     ) -> None:
         """Biaxial tests at one or several confining stresses: peak and critical-state friction angles,
         dilatancy and their spread over replicates; the peak envelope over the stresses."""
@@ -66,7 +67,8 @@ def register(app: typer.Typer) -> None:
         first, n = check_replicates(quick, specimen, seed, replicates, run)
         check_friction_options(particle_friction, rolling_friction)  # the ranges shear takes
         changes = {"max_strain": strain, "strain_rate": strain_rate, "particle_friction": particle_friction,
-                   "rolling_friction": rolling_friction, "stiffness_number": stiffness_number}  # fmt: skip
+                   "rolling_friction": rolling_friction, "stiffness_number": stiffness_number,
+                   **opt.checked_vtk_every(vtk_every)}  # fmt: skip
         options = {k: v for k, v in changes.items() if v is not None}
         settings = build_settings(table, options)
         case = make_case(quick, specimen, stresses[0], first, settings)
@@ -128,6 +130,7 @@ OPTION_NAMES = {
     "max_strain": "--strain",
     "strain_rate": "--strain-rate",
     "stiffness_number": "--stiffness-number",
+    "vtk_every": "--vtk-every",
 }
 
 

@@ -49,6 +49,7 @@ def register(app: typer.Typer) -> None:
         n_min: float = typer.Option(None, "--n-min", help="Density mode: densest laboratory porosity."),
         seeds: int = typer.Option(None, "--seeds", help="Density mode: specimens per state (3)."),
         quiet: bool = opt.quiet(),
+        vtk_every: int = opt.vtk_every(),
     ) -> None:
         """Find the final 2D porosity with the criterion of the paper's Fig. 3.
 
@@ -63,9 +64,10 @@ def register(app: typer.Typer) -> None:
         from poro2d.sweep.density_criterion import run_criterion_modes
 
         check_output_dir("--out", out)  # a bad folder is named before the config is read
+        series = opt.checked_vtk_every(vtk_every)
         case = CriterionCase.from_config(
             config, preset=preset, seed=seed, n_lab=n_lab, trial_porosity=trial, threads=threads, mode=mode,
-            n_max=n_max, n_min=n_min, seeds=seeds,
+            n_max=n_max, n_min=n_min, seeds=seeds, **series,
         )  # fmt: skip
         store = Store(out)
         result = run_criterion_modes(case, store, options=RunOptions(progress=not quiet))

@@ -26,6 +26,7 @@ OPTION_NAMES = {
     "window_start": "--window-start",
     "seed": "--seed",
     "stiffness_number": "--stiffness-number",
+    "vtk_every": "--vtk-every",
     "kn_particle": "--calibrated particle_kn",
     "ks_particle": "--calibrated particle_ks",
 }
@@ -82,6 +83,7 @@ def register(app: typer.Typer) -> None:
         workers: int = opt.tests_workers("seed, at most one per core"),
         scheduler: str = opt.tests_scheduler(),
         quiet: bool = opt.quiet(),
+        vtk_every: int = opt.vtk_every(),
     ) -> None:
         """Steady-state friction tau/sigma and solid fraction of the disks, free of any box."""
         from poro2d.cli.critical_state_held import held_states, print_held
@@ -112,7 +114,7 @@ def register(app: typer.Typer) -> None:
             seed=seed, disks=disks, stiffness_number=stiffness_number,
         )  # fmt: skip
         try:
-            case = CriticalStateCase(grading=curve, **options)
+            case = CriticalStateCase(grading=curve, **options, **opt.checked_vtk_every(vtk_every))
             for p in pressures[1:]:  # each pressure's case checked before any work
                 case.at_pressure(p)
         except InputError as exc:  # named as the option the user typed

@@ -93,3 +93,21 @@ def range_option(flag: str, text: str) -> Any:
 # the porosity conversions' options (convert, plot relations), each with the command's own help
 nu_reading = partial(typer.Option, "--nu-reading")
 lattice_exact = partial(typer.Option, "--lattice-exact")
+
+
+# the ParaView time series of a laboratory test's run (criterion, shear, biaxial, critical-state)
+vtk_every = partial(
+    typer.Option,
+    None,
+    "--vtk-every",
+    help="A ParaView series (vtk/series.pvd), a step every N engine steps (0: none; docs/paraview.md).",
+)
+
+
+def checked_vtk_every(value: int | None) -> dict[str, int]:
+    """``--vtk-every`` as the settings' ``vtk_every`` ({} when not given), refused on one line when
+    negative or beyond any run's steps (:data:`poro2d.labtest.settings.MAX_VTK_EVERY`)."""
+    from poro2d.errors import check_int
+    from poro2d.labtest.settings import MAX_VTK_EVERY
+
+    return {} if value is None else {"vtk_every": check_int("--vtk-every", value, 0, MAX_VTK_EVERY)}

@@ -122,6 +122,7 @@ def register(app: typer.Typer) -> None:
         scheduler: str = opt.tests_scheduler(),
         config: Path = opt.config(help="TOML config with a \\[shear] table."),
         quiet: bool = opt.quiet(),
+        vtk_every: int = opt.vtk_every(),
     ) -> None:
         """Direct shear tests (the paper's Fig. 8): peak strengths, friction angle, figures."""
         from poro2d.io_utils import check_output_dir
@@ -133,6 +134,7 @@ def register(app: typer.Typer) -> None:
 
         check_output_dir("--out", out)
         check_friction_options(particle_friction, rolling_friction)
+        series = opt.checked_vtk_every(vtk_every)
         table, base = load_shear_config(config)
         extra = {k: table.pop(k) for k in list(table) if k in SHEAR_KEYS_EXTRA}
         check_extra_types(extra)
@@ -159,6 +161,7 @@ def register(app: typer.Typer) -> None:
                     stop_after_peak,
                     particle_friction=particle_friction,
                     rolling_friction=rolling_friction,
+                    **series,
                 ),  # fmt: skip
                 lab=lab_data,
                 rate_check=rate_check or bool(extra.get("rate_check", False)),
@@ -215,16 +218,18 @@ def settings_from_options(
     stop_after_peak: float | None = None,
     particle_friction: float | None = None,
     rolling_friction: float | None = None,
+    vtk_every: int | None = None,
 ):
     """ShearSettings from the config's [shear] table, the command line's options winning
-    (--velocity, --max-displacement, --stop-after-peak, --particle-friction, --rolling-friction)."""
+    (--velocity, --max-displacement, --stop-after-peak, --particle-friction, --rolling-friction,
+    --vtk-every)."""
     from poro2d.config import dataclass_from_table
     from poro2d.shear.settings import ShearSettings
 
     return dataclass_from_table(
         ShearSettings, "shear", table, velocity=velocity, max_displacement=max_displacement,
         stop_after_peak=stop_after_peak, particle_friction=particle_friction,
-        rolling_friction=rolling_friction,
+        rolling_friction=rolling_friction, vtk_every=vtk_every,
     )  # fmt: skip
 
 

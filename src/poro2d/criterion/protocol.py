@@ -65,6 +65,7 @@ from poro2d.dem import Simulation
 from poro2d.dem.layout import MisplacedDisk
 from poro2d.grading import GradingCurve
 from poro2d.io_utils import Provenance
+from poro2d.labtest.vtk_series import VtkSeries
 from poro2d.measure.disks import mass_d50
 from poro2d.measure.porosity import box_porosity
 from poro2d.measure.surface import lid_height_at
@@ -313,7 +314,7 @@ class PorosityCriterion:
         if self._stage is None:
             record = self._config_record()
             self._stage = self.store.stage(
-                Fingerprint(record.run, tables={"specimen": SpecimenSpec}),
+                Fingerprint(record.run, tables={"specimen": SpecimenSpec, "criterion": CriterionSettings}),
                 record="config.json",
                 extra={"config": record.config, "provenance": record.provenance},
                 parameter="out",
@@ -356,10 +357,14 @@ class PorosityCriterion:
                       **wall_forces(sim).to_dict())  # fmt: skip
         return sim, rep
 
-    def plate_servo(self) -> PlateServo:
-        """The plate (and lid) servo of step 3, with this run's settings and equilibrium."""
+    def plate_servo(self, folder: Store | None = None) -> PlateServo:
+        """The plate (and lid) servo of step 3, with this run's settings and equilibrium; with
+        ``vtk_every``, its ParaView series kept in the trial's ``folder``."""
         sp = self.spec
-        return PlateServo(self.settings, sp.ratio, sp.equilibrium, sp.height, progress=self.progress)
+        series = VtkSeries.open(folder, "plate_height", 0) if self.settings.vtk_every else None
+        return PlateServo(
+            self.settings, sp.ratio, sp.equilibrium, sp.height, progress=self.progress, series=series
+        )
 
     def _trial(self, k: int, n: float) -> Trial:
         """Trial ``k`` at porosity ``n``: run, or read back from its ``trial.json`` once written."""
@@ -474,7 +479,7 @@ class PorosityCriterion:
         side wall past the in-box check (trial 0.12 of the wide grading at rolling friction 1.0).
         """
         width = self.spec.width
-        servo = self.plate_servo()
+        servo = self.plate_servo(self._trial_store(k, n))
         free = None
         mu_r = self.spec.rolling_friction
         if rises_free_to_roll(f_top, weight, self.settings.force_fraction, overfull, mu_r):

@@ -141,10 +141,12 @@ class CriterionCase:
     def from_config(cls, config: ConfigLike = None, *, preset: str | None = None, seed: int | None = None,
                     n_lab: float | None = None, trial_porosity: float | None = None,
                     threads: int | None = None, mode: str | None = None, n_max: float | None = None,
-                    n_min: float | None = None, seeds: int | None = None) -> CriterionCase:  # fmt: skip
+                    n_min: float | None = None, seeds: int | None = None,
+                    vtk_every: int | None = None) -> CriterionCase:  # fmt: skip
         """The case of ``poro2d criterion``: ``config`` (a dict, a TOML file, or the paper preset
         when None) with the command's options applied, every input checked, the specimen's
-        feasibility too (InputError if not)."""
+        feasibility too (InputError if not); ``vtk_every``: the criterion table's, each trial's
+        plate stage as a ParaView series."""
         from poro2d.criterion.config import build
         from poro2d.criterion.density import lab_relative_density
         from poro2d.specimen.compaction import check_feasible
@@ -153,6 +155,8 @@ class CriterionCase:
         cfg, base = load(config, preset, extra_tables=("relation",))
         if seed is not None:
             cfg["seed"] = check_int("--seed", seed, 0)
+        if vtk_every is not None:
+            cfg["criterion"] = {**cfg.get("criterion", {}), "vtk_every": vtk_every}
         dens = density_settings(cfg, mode, n_max, n_min, seeds, preset=config is None)
         spec, grading, settings, sd = build(
             cfg, base, n_lab=n_lab, trial_porosity=trial_porosity, threads=threads

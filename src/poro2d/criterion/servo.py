@@ -18,7 +18,11 @@ from dataclasses import dataclass
 from poro2d.criterion.lid import FlatPlate, SegmentedLid
 from poro2d.criterion.settings import CriterionSettings
 from poro2d.dem import Simulation
+from poro2d.dem.export import frame_of
+from poro2d.dem.reporters import Reporter
+from poro2d.labtest.reporters import SeriesRecorder
 from poro2d.labtest.settle import StopRule, settle_until
+from poro2d.labtest.vtk_series import VtkSeries
 from poro2d.record import Record
 
 _log = logging.getLogger(__name__)
@@ -83,7 +87,9 @@ class PlateServo:
     ``equilibrium``: when the specimen counts as at equilibrium (its maximum, mean or
     load-bearing unbalanced-force ratio below ``ratio``, as the specimen's preparation
     judged it); ``height``: the box height H, the scale of the allowed plate drift;
-    ``progress``: a bar per approach when True.
+    ``progress``: a bar per approach when True; ``series``: where the approach and settling
+    phases are kept as a ParaView series, a step every ``vtk_every`` steps of the engine's count at
+    the top's height (None: none).
     """
 
     settings: CriterionSettings
@@ -91,6 +97,14 @@ class PlateServo:
     equilibrium: str
     height: float
     progress: bool = False
+    series: VtkSeries | None = None
+
+    def watch(self, sim: Simulation, top: FlatPlate | SegmentedLid) -> list[Reporter]:
+        """The reporter that writes the series during a phase (none without a series)."""
+        if self.series is None:
+            return []
+        clock = lambda sm: (sm.step_count, sm.time, top.height(sm))  # noqa: E731
+        return [SeriesRecorder(self.settings.vtk_every, self.series, frame_of, clock, start=sim.step_count)]
 
     def target(self, sim: Simulation, weight: float) -> float:
         """The force (N) the plate or lid servos to: ``servo_target_fraction`` of the window's limit."""
@@ -168,10 +182,13 @@ class PlateServo:
         top.servo(sim, target, s.servo_max_speed, s.servo_gain)
         label = f"top {top.name} (round {rounds})" if self.progress else False
         steps += settle_until(
-            sim, self._approached(top, target, weight), left(), every=s.check_every, bar=label
-        )
+            sim, self._approached(top, target, weight), left(), every=s.check_every, bar=label,
+            also=self.watch(sim, top),
+        )  # fmt: skip
         top.servo(sim, target, s.settle_max_speed, s.settle_gain)
-        steps += settle_until(sim, self._settled(top, target, weight), left(), every=s.check_every)
+        steps += settle_until(
+            sim, self._settled(top, target, weight), left(), every=s.check_every, also=self.watch(sim, top)
+        )
         top.hold(sim)
         res = sim.solve(self.ratio, min(left(), 20 * s.check_every), measure=self.equilibrium)
         steps += res.steps

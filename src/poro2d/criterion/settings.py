@@ -10,6 +10,8 @@ from dataclasses import dataclass, fields
 from typing import Any, ClassVar
 
 from poro2d.errors import Integer, OneOf, Ranges, Real, check_fields, check_range
+from poro2d.identity import outside_identity
+from poro2d.labtest.settings import lab_ranges
 from poro2d.porosity import PAPER_N_LAB, parabolic
 from poro2d.record import Record
 
@@ -40,6 +42,7 @@ CRITERION_RANGES: Ranges = {
     "generation_tolerance": Real(0.0, 0.05, lo_open=True),
     "balance_tolerance": Real(0.0, 0.5, lo_open=True),
     "acceptance": OneOf(ACCEPTANCE_MODES),
+    **lab_ranges("vtk_every"),
 }
 
 
@@ -49,10 +52,12 @@ class CriterionSettings(Record):
 
     Its row (:meth:`~poro2d.record.Record.to_dict`) is the settings as recorded with results:
     ``refine_tolerance`` only when set and ``acceptance`` only when not "plate", so folders
-    written before the options existed still resume.
+    written before the options existed still resume. ``vtk_every`` (steps; 0: none): each trial's
+    plate stage as a ParaView series (:mod:`poro2d.labtest.vtk_series`), an output outside the
+    run's identity, recorded only when asked for.
     """
 
-    OMITTED: ClassVar[dict[str, Any]] = {"refine_tolerance": None, "acceptance": "plate"}
+    OMITTED: ClassVar[dict[str, Any]] = {"refine_tolerance": None, "acceptance": "plate", "vtk_every": 0}
 
     n_lab: float = PAPER_N_LAB
     trial_porosity: float | None = None
@@ -74,6 +79,7 @@ class CriterionSettings(Record):
     balance_tolerance: float = 0.01
     refine_tolerance: float | None = None
     acceptance: str = "plate"
+    vtk_every: int = outside_identity(0)
 
     @classmethod
     def from_dict(cls, row: dict[str, Any]) -> CriterionSettings:

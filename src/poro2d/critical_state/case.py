@@ -20,7 +20,8 @@ from typing import Any, ClassVar, Self
 from poro2d.dem.contact_law import MAX_ROLLING_FRICTION, series
 from poro2d.errors import InputError, Integer, Real, check_fields
 from poro2d.grading import GradingCurve, paper_grading
-from poro2d.labtest.settings import TestSettings
+from poro2d.identity import outside_identity
+from poro2d.labtest.settings import TestSettings, lab_ranges
 from poro2d.paper_data import TABLE_1
 
 #: disks of the cell: below about 200 the stress ratio's fluctuations swamp its mean; above
@@ -55,6 +56,7 @@ CASE_RANGES = {
     "mu_drift_limit": Real(0.0, 1.0, lo_open=True),
     "stiffness_number": Real(*STIFFNESS_NUMBER_RANGE, or_none=True),
     "solid_drift_limit": Real(0.0, 0.1, lo_open=True),
+    **lab_ranges("vtk_every"),
 }
 
 
@@ -70,7 +72,9 @@ class CriticalStateCase(TestSettings):
     of the cell (slow enough not to ring); record_strain: gamma between two rows of the
     series; blocks: the window is cut into this many blocks for the standard error;
     mu_drift_limit and solid_drift_limit: the largest change over the window (a least-squares
-    slope times its width) of the stress ratio and the solid fraction for a steady state.
+    slope times its width) of the stress ratio and the solid fraction for a steady state;
+    vtk_every (steps; 0: none): the shear's ParaView series (:mod:`poro2d.labtest.vtk_series`), an
+    output outside the run's identity, kept in the files only when asked for.
     """
 
     grading: GradingCurve = field(default_factory=paper_grading)
@@ -93,8 +97,9 @@ class CriticalStateCase(TestSettings):
     mu_drift_limit: float = 0.03
     solid_drift_limit: float = 0.005
     stiffness_number: float | None = None
+    vtk_every: int = outside_identity(0)
 
-    OMITTED: ClassVar[dict] = {"stiffness_number": None}
+    OMITTED: ClassVar[dict] = {"stiffness_number": None, "vtk_every": 0}
 
     def __post_init__(self) -> None:
         if not isinstance(self.grading, GradingCurve):

@@ -39,8 +39,9 @@ def content_of(case: CriticalStateCase) -> dict[str, Any]:
 def folder_stage(store: Store, case: CriticalStateCase) -> ResumableStage:
     """The stage of ``case``'s run in ``store``, bound by ``test.json``."""
     return test_stage(
-        store.root, Fingerprint(content_of(case)), specimen=f"{case.disks} disks of seed {case.seed}",
-        stress=("pressure_kpa", "pressure"), parameter=store.parameter, unrecorded="adopt",
+        store.root, Fingerprint(content_of(case), tables={"settings": CriticalStateCase}),
+        specimen=f"{case.disks} disks of seed {case.seed}", stress=("pressure_kpa", "pressure"),
+        parameter=store.parameter, unrecorded="adopt",
     )  # fmt: skip
 
 

@@ -35,12 +35,13 @@ from poro2d.critical_state.results import (
 )
 from poro2d.critical_state.series import COLUMNS, CellSeries, row_of
 from poro2d.critical_state.steady import read_steady
+from poro2d.dem.export import frame_of_cell
 from poro2d.dem.reporters import Every, drive_blocks
 from poro2d.errors import InputError, check_int
 from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
 from poro2d.io_utils import Provenance
-from poro2d.labtest.reporters import CurveRecorder, ProgressReporter
+from poro2d.labtest.reporters import CurveRecorder, ProgressReporter, series_reporters
 from poro2d.measure.fabric import ROSE_FILE, FabricRoses, cell_fabric, cell_rose
 from poro2d.store import Store, claimed
 
@@ -55,12 +56,13 @@ Report = Callable[[str, float], None]
 
 
 def _shear(
-    cell, case: CriticalStateCase, rate: float, report: Report | None
+    cell, case: CriticalStateCase, rate: float, report: Report | None, store: Store | None = None
 ) -> tuple[CellSeries, int, int, float, FabricRoses | None]:
     """Shear to the case's strain, a row every record_strain; returns the series, steps, rebuilds,
     the mean overlap over d of the rows' ends in the steady window (a snapshot alone swings
     with the pressure's fluctuations) and the contact orientations at the largest stress ratio
-    and at the end."""
+    and at the end. With ``case.vtk_every`` and a ``store``, the shear's ParaView series too
+    (:func:`_series`)."""
     pressure = case.pressure_kpa * 1e3
     cell.shear(rate, pressure, barostat_gain(cell, case), rate)
     per_row = max(1, round(case.record_strain / (rate * cell.dt)))
@@ -70,6 +72,8 @@ def _shear(
     def advance(n: int) -> tuple[int, bool]:
         blocks.append(cell.run(n))
         return n, False
+
+    sheared = _series(cell, case, per_row, store, lambda: sum(b.steps for b in blocks))
 
     def overlap(c) -> None:  # over the steady window's rows
         if c.strain >= case.window_start:
@@ -84,12 +88,21 @@ def _shear(
     share = ProgressReporter(
         per_row, report, "shear", lambda _, k: COMPRESS_SHARE + (1.0 - COMPRESS_SHARE) * k / steps
     )
-    drive_blocks(advance, steps, [recorder, Every(per_row, overlap), share], cell)
+    drive_blocks(advance, steps, [recorder, Every(per_row, overlap), share, *sheared], cell)
     mean = float(np.mean(overlaps)) if overlaps else mean_overlap_ratio(cell)
     series = CellSeries.of_rows(recorder.rows)
     at_peak = int(np.argmax(series.stress_ratio)) if len(roses) else 0
     fabric = FabricRoses.of("gamma", series.gamma, roses, at_peak) if roses else None
     return series, steps, sum(b.rebuilds for b in blocks), mean, fabric
+
+
+def _series(cell, case: CriticalStateCase, per_row: int, store: Store | None, ran: Callable[[], int]) -> list:
+    """The reporters of the shear's ParaView series: a step every ``vtk_every`` steps rounded to
+    whole rows (a row is the mean of the block before it, so a block must end only at rows),
+    at the shear strain gamma; ``ran()``: the steps sheared so far."""
+    every = per_row * max(1, round(case.vtk_every / per_row)) if case.vtk_every else 0
+    clock = lambda c: (ran(), c.time, c.strain)  # noqa: E731
+    return series_reporters(every, store, "shear_strain", cell, frame_of_cell, clock)
 
 
 def run_critical_state(
@@ -111,7 +124,7 @@ def run_critical_state(
         return _compute(case, report)
     done = stored_run(store, case)  # a folder of another case's run is refused here, before any step
     if done is None:
-        done = _compute(case, report)
+        done = _compute(case, report, store)
         # the series first: the result, written by the stage, is the marker of a finished run
         store.write_csv(SERIES_CSV, done.series.rows(), header=list(COLUMNS))
         if done.roses is not None:
@@ -120,15 +133,18 @@ def run_critical_state(
     return done
 
 
-def _compute(case: CriticalStateCase, report: Report | None) -> CriticalStateTestResult:
-    """Build, compress and shear the cell; read its steady state (nothing kept)."""
+def _compute(
+    case: CriticalStateCase, report: Report | None, store: Store | None = None
+) -> CriticalStateTestResult:
+    """Build, compress and shear the cell; read its steady state (only its ParaView series kept in
+    ``store``, when the case asks for one)."""
     t0 = time.perf_counter()
     cell = loose_cell(case)
     compression = compress(
         cell, case, None if report is None else lambda f: report("compress", COMPRESS_SHARE * f)
     )
     rate = shear_rate(cell, case)
-    series, steps, rebuilds, overlap, roses = _shear(cell, case, rate, report)
+    series, steps, rebuilds, overlap, roses = _shear(cell, case, rate, report, store)
     wall = time.perf_counter() - t0
     state = read_steady(series, case.window_start, case.blocks, case.mu_drift_limit, case.solid_drift_limit)
     return CriticalStateTestResult.of(

@@ -1,12 +1,14 @@
 """Reporters: what a run does between its blocks of compiled steps.
 
-A reporter has a ``period`` (steps) and ``report(sim, step) -> stop?``, called at every multiple
-of its period counted from the start of :meth:`~poro2d.dem.Simulation.run` (``step``: the steps
-of this run so far). The engine runs compiled blocks up to the next step any reporter is due at,
-so reporters decide only where blocks end (which changes no number) and what is read there.
-Reporters due at the same step are called in the order given, all of them, and the run stops
-after them when any returned True. The laboratory tests' own reporters (a curve's rows,
-checkpoints, progress, stop tests) are in :mod:`poro2d.labtest.reporters`.
+A reporter has a ``period`` (steps) and ``report(sim, step) -> stop?``, called at every multiple of
+its period counted from the start of :meth:`~poro2d.dem.Simulation.run` (``step``: the steps of
+this run so far), or, for a reporter with a ``start`` (the steps its stage ran before this run, as
+when resumed from a checkpoint), where ``start + step`` is a multiple of its period. The engine
+runs compiled blocks up to the next step any reporter is due at, so reporters decide only where
+blocks end (which changes no number) and what is read there. Reporters due at the same step are
+called in the order given, all of them, and the run stops after them when any returned True. The
+laboratory tests' own reporters (a curve's rows, checkpoints, progress, stop tests) are in
+:mod:`poro2d.labtest.reporters`.
 """
 
 from __future__ import annotations
@@ -53,15 +55,26 @@ def drive_blocks(
     check_reporters(reporters)
     done = 0
     while done < steps:
-        due = min([steps] + [(done // r.period + 1) * r.period for r in reporters])
+        due = min([steps] + [next_due(r, done) for r in reporters])
         ran, stopped = advance(min(block or steps, due - done))
         done += ran
         if stopped:
             break
         # every reporter due is told, even after one asked to stop (a checkpoint before the stop test)
-        if any([r.report(engine, done) for r in reporters if done % r.period == 0]):
+        if any([r.report(engine, done) for r in reporters if (done + _start(r)) % r.period == 0]):
             break
     return done
+
+
+def _start(reporter: Reporter) -> int:
+    """The steps the reporter's stage ran before this run (0 unless it says)."""
+    return getattr(reporter, "start", 0)
+
+
+def next_due(reporter: Reporter, done: int) -> int:
+    """The first step of the run after ``done`` at which ``reporter`` is due."""
+    start = _start(reporter)
+    return ((done + start) // reporter.period + 1) * reporter.period - start
 
 
 def check_reporters(reporters: Sequence[Reporter]) -> None:
@@ -74,4 +87,4 @@ def check_reporters(reporters: Sequence[Reporter]) -> None:
             )
 
 
-__all__ = ["Every", "Reporter", "check_reporters", "drive_blocks"]
+__all__ = ["Every", "Reporter", "check_reporters", "drive_blocks", "next_due"]

@@ -2,9 +2,10 @@
 
 A test's stage runs the engine once with the reporters it needs, each on its own period: the
 curve's rows (:class:`CurveRecorder`), the progress display (:class:`ProgressReporter`), the
-saved state a killed run continues from (:class:`Checkpointer`) and the test that ends the
-stage (:class:`StopTest`). They are called in the order given, so a stage that checkpoints
-before its stop test saves its state at the step it stops at too, as the test's files expect.
+saved state a killed run continues from (:class:`Checkpointer`), the ParaView time series asked
+for (:class:`SeriesRecorder`) and the test that ends the stage (:class:`StopTest`). They are
+called in the order given, so a stage that checkpoints before its stop test saves its state at
+the step it stops at too, as the test's files expect.
 """
 
 from __future__ import annotations
@@ -13,8 +14,9 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from poro2d.dem.reporters import Every
-from poro2d.store import Checkpoints
+from poro2d.dem.reporters import Every, Reporter
+from poro2d.labtest.vtk_series import VtkSeries
+from poro2d.store import Checkpoints, Store
 
 #: ``progress(phase, fraction)``: told how far a stage is, for a progress display
 ProgressFn = Callable[[str, float], None]
@@ -63,8 +65,50 @@ class Checkpointer:
             self.checkpoints.save(sim, extra=self.extra())
 
 
+#: ``clock(engine) -> (stage step, time in s, the test's measure)``: where a stage is now
+ClockFn = Callable[[Any], tuple[int, float, float]]
+
+
+@dataclass
+class SeriesRecorder:
+    """Writes ``frame(engine)`` as a step of ``series`` (at ``clock(engine)``) every ``period``
+    steps of its stage; ``start``: the stage's steps before this run (a run resumed from a
+    checkpoint), so that its steps fall where an uninterrupted run's do. It reads the engine only.
+    """
+
+    period: int
+    series: VtkSeries
+    frame: Callable[[Any], Any]
+    clock: ClockFn
+    start: int = 0
+
+    def report(self, sim: Any, step: int) -> None:
+        stage_step, time, value = self.clock(sim)
+        self.series.write(self.frame(sim), stage_step, time, value)
+
+
+def series_reporters(
+    every: int, store: Store | None, measure: str, engine: Any, frame: Callable[[Any], Any], clock: ClockFn,
+) -> list[Reporter]:  # fmt: skip
+    """The reporters of a stage's ParaView series (:mod:`poro2d.labtest.vtk_series`): none when
+    ``every`` is 0 or nothing is kept (``store`` None); else one :class:`SeriesRecorder` every
+    ``every`` steps, the stage's first state written now when the stage starts afresh.
+    """
+    if not every or store is None:
+        return []
+    start = clock(engine)[0]
+    series = VtkSeries.open(store, measure, start)
+    recorder = SeriesRecorder(every, series, frame, clock, start=start)
+    if start == 0:
+        recorder.report(engine, 0)
+    return [recorder]
+
+
 #: ends the run when ``done(sim)`` says so, asked every ``period`` steps: ``StopTest(period, done)``
 StopTest = Every
 
 
-__all__ = ["Checkpointer", "CurveRecorder", "ProgressFn", "ProgressReporter", "StopTest"]
+__all__ = [
+    "Checkpointer", "ClockFn", "CurveRecorder", "ProgressFn", "ProgressReporter", "SeriesRecorder",
+    "StopTest", "series_reporters",
+]  # fmt: skip

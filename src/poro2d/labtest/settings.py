@@ -21,6 +21,7 @@ from typing import Any, Self
 
 from poro2d.dem.contact_law import MAX_ROLLING_FRICTION
 from poro2d.errors import Integer, Ranges, Real
+from poro2d.identity import outside_fields
 from poro2d.record import Record
 
 #: the normal (or confining) stresses (kPa) a box test may be run at. A contact carries about
@@ -39,6 +40,10 @@ MAX_FRICTION = 10.0
 #: inertial masses up to 1000 times the real ones: the inertial number grows with its root
 MAX_DENSITY_SCALE = 1000.0
 
+#: the longest interval (steps) between two steps of a run's ParaView series: beyond the steps of
+#: any test (the longest run about 4e7 steps), so a larger one is a typo
+MAX_VTK_EVERY = 100_000_000
+
 #: what the settings every box test has may be (a test's table takes them with :func:`lab_ranges`)
 LAB_RANGES: Ranges = {
     "consolidation_ratio": Real(0.0, 1.0, lo_open=True),
@@ -55,6 +60,8 @@ LAB_RANGES: Ranges = {
     "local_damping": Real(0.0, 1.0, hi_open=True, or_none=True),
     "density_scale": Real(1.0, MAX_DENSITY_SCALE),
     "dt_safety": Real(0.0, 1.0, lo_open=True),
+    # steps between two steps of the ParaView series (poro2d.labtest.vtk_series); 0: none
+    "vtk_every": Integer(0, MAX_VTK_EVERY),
 }
 #: the servo and the box's walls, in the order both tests check them
 SERVO_AND_WALLS = ("servo_gain", "servo_integral", "servo_max_speed", "kn_wall", "ks_wall", "friction_wall")
@@ -92,12 +99,14 @@ class TestSettings(Record):
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> Self:
-        """The settings a file keeps, as kept: a setting the file lacks reads as None and is left
-        out when written back; a key of another version is written back after the settings."""
+        """The settings a file keeps, as kept: a setting the file lacks reads as None (one outside
+        the run's identity, an output such as ``vtk_every``, as its default) and is left out when
+        written back; a key of another version is written back after the settings."""
         names = [f.name for f in fields(cls)]  # type: ignore[arg-type]
+        outputs = {f.name: f.default for f in fields(cls) if f.name in outside_fields(cls)}  # type: ignore[arg-type]
         obj = cls.__new__(cls)  # not checked again: a file holds what was run
         for name in names:
-            object.__setattr__(obj, name, data.get(name))
+            object.__setattr__(obj, name, data.get(name, outputs.get(name)))
         object.__setattr__(obj, "_absent", frozenset(n for n in names if n not in data))
         object.__setattr__(obj, "_extra", {k: v for k, v in data.items() if k not in names})
         return obj
@@ -112,6 +121,7 @@ class TestSettings(Record):
 
 
 __all__ = [
-    "LAB_RANGES", "MAX_CONSOLIDATION_STEPS", "MAX_DENSITY_SCALE", "MAX_FRICTION", "MAX_WALL_STIFFNESS",
-    "NORMAL_STRESS_RANGE_KPA", "SERVO_AND_WALLS", "DisksAndEngine", "TestSettings", "lab_ranges",
+    "LAB_RANGES", "MAX_CONSOLIDATION_STEPS", "MAX_DENSITY_SCALE", "MAX_FRICTION", "MAX_VTK_EVERY",
+    "MAX_WALL_STIFFNESS", "NORMAL_STRESS_RANGE_KPA", "SERVO_AND_WALLS", "DisksAndEngine", "TestSettings",
+    "lab_ranges",
 ]  # fmt: skip

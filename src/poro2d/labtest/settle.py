@@ -15,10 +15,11 @@ held for a streak of checks, then the window at equilibrium or a plate that only
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from poro2d.dem import Simulation
+from poro2d.dem.reporters import Reporter
 from poro2d.labtest.reporters import ProgressFn, ProgressReporter, StopTest
 
 #: ``done(sim)``: a stop rule, asked after each block of steps whether the specimen has settled
@@ -31,15 +32,17 @@ SETTLE_CHECK = 500
 def settle_until(
     sim: Simulation, done: StopRule, max_steps: int, *, every: int = SETTLE_CHECK,
     progress: ProgressFn | None = None, phase: str = "consolidating", bar: bool | str = False,
+    also: Sequence[Reporter] = (),
 ) -> int:  # fmt: skip
     """Run ``sim`` (its servos already on) in blocks of ``every`` steps until ``done(sim)``, at most
     ``max_steps`` steps; the steps run.
 
     ``progress``: told ``phase`` and the share of ``max_steps`` run before each check; ``bar``: the
-    engine's own progress bar (:meth:`~poro2d.dem.Simulation.run`), its label when a string.
+    engine's own progress bar (:meth:`~poro2d.dem.Simulation.run`), its label when a string;
+    ``also``: reporters that only read the engine (a ParaView series), before the stop test.
     """
     told = ProgressReporter(every, progress, phase, lambda _, k: min(k / max_steps, 1.0))
-    return sim.run(max_steps, reporters=[told, StopTest(every, done)], progress=bar).steps
+    return sim.run(max_steps, reporters=[told, *also, StopTest(every, done)], progress=bar).steps
 
 
 @dataclass

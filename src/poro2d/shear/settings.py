@@ -8,6 +8,7 @@ from typing import ClassVar
 
 from poro2d.dem.contact_law import MAX_ROLLING_FRICTION  # the engine's bound
 from poro2d.errors import InputError, Ranges, Real, check_fields
+from poro2d.identity import outside_identity
 from poro2d.labtest.settings import (
     MAX_CONSOLIDATION_STEPS,
     MAX_DENSITY_SCALE,
@@ -53,7 +54,7 @@ SHEAR_RANGES: Ranges = {
     "peak_window": Real(0.0, None),
     "shear_zone_factor": Real(0.0, None, lo_open=True),
     "inertial_limit": Real(0.0, None, lo_open=True),
-    **lab_ranges("stress_tolerance"),
+    **lab_ranges("stress_tolerance", "vtk_every"),
 }
 
 
@@ -82,10 +83,12 @@ class ShearSettings(TestSettings):
 
     Its files hold every setting in this order; the disks' stiffnesses ``particle_kn`` and
     ``particle_ks`` only when given, so a test on the specimen's own stiffness keeps the file,
-    and the cache key, it had before they existed.
+    and the cache key, it had before they existed. ``vtk_every`` (steps; 0: none) asks for the
+    shear stage's ParaView series (:mod:`poro2d.labtest.vtk_series`): an output, outside the
+    test's identity, kept in the files only when asked for.
     """
 
-    OMITTED: ClassVar[dict] = {"particle_kn": None, "particle_ks": None}
+    OMITTED: ClassVar[dict] = {"particle_kn": None, "particle_ks": None, "vtk_every": 0}
 
     velocity: float = 0.025
     max_displacement: float = 0.02
@@ -107,6 +110,7 @@ class ShearSettings(TestSettings):
     stress_tolerance: float = 0.02
     particle_kn: float | None = None
     particle_ks: float | None = None
+    vtk_every: int = outside_identity(0)
 
     def __post_init__(self) -> None:
         check_fields(self, SHEAR_RANGES)

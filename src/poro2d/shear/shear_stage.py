@@ -3,7 +3,8 @@
 Every ``record_interval`` of shear displacement one row of the curve is recorded (and,
 with ``keep_peak``, the state kept for the peak's force chains); every
 ``checkpoint_interval`` the whole engine state and the rows so far are saved in
-``shear_checkpoint.npz``, so a killed test continues from there bit for bit. These are the
+``shear_checkpoint.npz``, so a killed test continues from there bit for bit; every
+``vtk_every`` steps, when asked, a step of the ParaView series (``vtk/``). These are the
 stage's reporters on the engine (:mod:`poro2d.labtest.reporters`), with the stop test last.
 """
 
@@ -15,8 +16,9 @@ import time
 import numpy as np
 
 from poro2d.dem import Simulation
+from poro2d.dem.export import frame_of
 from poro2d.dem.reporters import Every, Reporter
-from poro2d.labtest.reporters import Checkpointer, CurveRecorder, ProgressReporter, StopTest
+from poro2d.labtest.reporters import Checkpointer, CurveRecorder, ProgressReporter, StopTest, series_reporters
 from poro2d.measure.fabric import FabricRoses, rose
 from poro2d.shear.box import SplitBox
 from poro2d.shear.controllers import ProgressFn, ShearDrive
@@ -107,7 +109,8 @@ class ShearStage:
 
     def reporters(self, remaining: int) -> list[Reporter]:
         """What a record does, in order: the row, the peak's frame, the progress, a checkpoint every
-        ``ck_every`` records (not at the end: ``remaining`` steps are left to run), the stop test."""
+        ``ck_every`` records (not at the end: ``remaining`` steps are left to run), the stop test;
+        the ParaView series, when asked, on its own period before the stop test."""
         every = self.every
         peak = [Every(every, self._keep_peak)] if self.keep_peak else []
         share = ProgressReporter(
@@ -115,7 +118,14 @@ class ShearStage:
         )
         saved = Checkpointer(every * self.ck_every, self.checkpoints, self._checkpoint, remaining)
         stop = StopTest(every, lambda _: self.peak_passed())
-        return [CurveRecorder(every, self._row, self.rows), *peak, share, saved, stop]
+        series = series_reporters(
+            self.settings.vtk_every, self.store, "shear_displacement", self.sim, frame_of, self._clock
+        )
+        return [CurveRecorder(every, self._row, self.rows), *peak, share, saved, *series, stop]
+
+    def _clock(self, sim: Simulation) -> tuple[int, float, float]:
+        """The stage's step, the engine's time (s) and the shear displacement (m) now."""
+        return sim.step_count - self.step0, sim.time, self.box.shear_displacement(sim)
 
     def peak_passed(self) -> bool:
         """True once the smoothed peak lies ``stop_after_peak`` behind the last record.

@@ -40,7 +40,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
-from poro2d.dem import checkpoint
+from poro2d.dem import checkpoint, export
 from poro2d.errors import InputError
 from poro2d.io_utils import atomic_path, write_csv, write_json
 from poro2d.locks import output_folder
@@ -48,6 +48,7 @@ from poro2d.store import digests
 from poro2d.store.stage import Fingerprint, ResumableStage
 
 if TYPE_CHECKING:
+    import meshio
     import pandas as pd
 
     from poro2d.dem.simulation import Simulation
@@ -216,6 +217,11 @@ class Store:
                 return {k: z[k] for k in z.files}
 
         return self._read(name, arrays, (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile))
+
+    def write_mesh(self, name: str, mesh: meshio.Mesh) -> Path:
+        """A mesh as the VTU file ``name`` for ParaView, atomically (:func:`poro2d.dem.export.write_mesh`)."""
+        export.write_mesh(mesh, self._root / name)
+        return self._written(name)
 
     def save_state(self, name: str, sim: Simulation, extra: dict | None = None) -> Path:
         """A simulation's whole state (:func:`poro2d.dem.checkpoint.save`)."""

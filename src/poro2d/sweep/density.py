@@ -24,6 +24,7 @@ import numpy as np
 
 from poro2d import __version__
 from poro2d.criterion.density import DEFAULT_MUS, Calibration, StateTarget, check_mus
+from poro2d.criterion.settings import CriterionSettings
 from poro2d.errors import check_int
 from poro2d.execute.options import RunOptions
 from poro2d.identity import identity_digest, outside_fields
@@ -138,7 +139,8 @@ def calibration_key(base: CriterionBase) -> str:
     Spaced as these keys were first written, so cached calibrations keep their folders.
     """
     rec = {"base": calibration_base(base).as_config(), "version": __version__}
-    return identity_digest(rec, tables={"base.specimen": SpecimenSpec}, length=16, layout="spaced")
+    tables = {"base.specimen": SpecimenSpec, "base.criterion": CriterionSettings}
+    return identity_digest(rec, tables=tables, length=16, layout="spaced")
 
 
 def first_trial(
