@@ -124,6 +124,7 @@ def test_a_run_keeps_its_result_series_and_figure_in_the_store(tmp_path, monkeyp
     draw_critical_state(result, Store(tmp_path))  # the figure, drawn from the result after the run
     assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith(".")) == [
         "critical_state.png",
+        "critical_state.svg",
         "fabric_rose.json",
         "result.json",
         "series.csv",

@@ -40,6 +40,7 @@ OTHER = {
     "gap": 1e-4,
     "particle_kn": 1e6,
     "particle_ks": 5e5,
+    "mass_scaling": "off",
 }
 
 
