@@ -98,7 +98,14 @@ def print_density(res: DensityStateResult, out: Path) -> None:
         f"{res.seeds_converged}/{res.seeds}", f"{res.n2d_min:.4f}", f"{res.n2d_max:.4f}",
     )  # fmt: skip
     console.print(t)
+    replaced = res.sweeps.seeds_replaced or []  # None in a density.json of an older poro2d
+    for r in replaced:
+        by = "no seed left to replace it" if r.replaced_by is None else f"replaced by seed {r.replaced_by}"
+        console.print(f"seed {r.seed} not accepted ({shown(r.reason)}): {by}", soft_wrap=True)
     console.print(f"results in {out}/density.json (calibration {out}/calibration.json)", soft_wrap=True)
     if not res.converged:
-        console.print(f"[bold red]criterion not converged for every seed[/] (see {out}/states)")
+        asked = res.seeds - sum(r.replaced_by is not None for r in replaced)
+        states = shown(f"{out}/states")
+        console.print(f"[bold red]criterion: {res.seeds_converged} of {asked} seeds accepted[/] "
+                      f"({res.seeds - asked} replaced; see {states})", soft_wrap=True)  # fmt: skip
         raise typer.Exit(1)
