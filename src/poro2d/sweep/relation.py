@@ -381,8 +381,8 @@ def seed_accepted(row: CaseRow | LostCaseRow) -> bool:
 def least_accepted(rows, targets) -> int:
     """The fewest accepted seeds of any state of ``targets``."""
     by_lab = [round(float_or_nan((r.params or {}).get("criterion.n_lab")), 6) for r in rows]
-    return min(sum(seed_accepted(r) for r, n in zip(rows, by_lab, strict=True) if n == round(t.n_lab, 6))
-               for t in targets)  # fmt: skip
+    return min((sum(seed_accepted(r) for r, n in zip(rows, by_lab, strict=True) if n == round(t.n_lab, 6))
+                for t in targets), default=0)  # fmt: skip
 
 
 def replacing_text(rows, more) -> str:
