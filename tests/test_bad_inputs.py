@@ -362,3 +362,27 @@ def test_a_missing_biaxial_lab_file_is_named_as_the_option(tmp_path, capsys):
     refused(["biaxial", "--quick", "--lab", tmp_path / "nope.csv", "--out", out, "--quiet"], capsys,
             "--lab = ", "nope.csv")  # fmt: skip
     assert not out.exists()
+
+
+def test_laboratory_extremes_are_named_as_typed(tmp_path, capsys):
+    """``--n-max nan`` was refused as ``n_max``, a name the user never typed; a config's value is
+    named by its table's key."""
+    out = tmp_path / "o"
+    argv = [
+        "criterion",
+        "--preset",
+        "paper",
+        "--mode",
+        "density",
+        "--n-max",
+        "nan",
+        "--n-min",
+        "0.3",
+        "--out",
+        out,
+    ]
+    refused(argv, capsys, "--n-max = nan")
+    criterion_with(
+        tmp_path, capsys, '[density]\nmode = "density"\nn_max = 1.5\nn_min = 0.3\n', "density.n_max = 1.5"
+    )
+    assert not out.exists()

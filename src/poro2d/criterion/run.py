@@ -117,8 +117,11 @@ def lab_extremes(table: str, t: dict, n_max, n_min, *, preset: bool, hint: str) 
     lo = n_min if n_min is not None else t.get("n_min", P.PAPER_N_MIN if preset else None)
     if hi is None or lo is None:
         raise InputError(f"{table}.n_max/n_min", (hi, lo), "both laboratory extremes", hint)
-    return (check_range("n_max", hi, 0.0, 1.0, lo_open=True, hi_open=True),
-            check_range("n_min", lo, 0.0, 1.0, lo_open=True, hi_open=True))  # fmt: skip
+    # each named as the user gave it: the option, else the table's key
+    hi_name = "--n-max" if n_max is not None else f"{table}.n_max"
+    lo_name = "--n-min" if n_min is not None else f"{table}.n_min"
+    return (check_range(hi_name, hi, 0.0, 1.0, lo_open=True, hi_open=True),
+            check_range(lo_name, lo, 0.0, 1.0, lo_open=True, hi_open=True))  # fmt: skip
 
 
 @dataclass(frozen=True)
