@@ -386,3 +386,11 @@ def test_laboratory_extremes_are_named_as_typed(tmp_path, capsys):
         tmp_path, capsys, '[density]\nmode = "density"\nn_max = 1.5\nn_min = 0.3\n', "density.n_max = 1.5"
     )
     assert not out.exists()
+
+
+@pytest.mark.parametrize(("option", "value"), [("--n-lab", "nan"), ("--trial-porosity", "inf")])
+def test_criterion_options_are_named_as_typed(option, value, tmp_path, capsys):
+    """``--n-lab nan`` was refused as ``n_lab``, a name the user never typed."""
+    out = tmp_path / "o"
+    refused(["criterion", "--preset", "paper", option, value, "--out", out], capsys, f"{option} = ")
+    assert not out.exists()

@@ -163,9 +163,18 @@ class CriterionCase:
         if seed is not None:
             cfg["seed"] = check_int("--seed", seed, 0)
         dens = density_settings(cfg, mode, n_max, n_min, seeds, preset=config is None)
-        spec, grading, settings, sd = build(
-            cfg, base, n_lab=n_lab, trial_porosity=trial_porosity, threads=threads
-        )
+        given = {"n_lab": n_lab, "trial_porosity": trial_porosity, "threads": threads}
+        try:
+            spec, grading, settings, sd = build(cfg, base, **given)
+        except InputError as exc:  # an option's value named as the option the user typed
+            if given.get(exc.parameter) is None:
+                raise
+            option = (
+                "--trial-porosity"
+                if exc.parameter == "trial_porosity"
+                else "--" + exc.parameter.replace("_", "-")
+            )
+            raise InputError(option, exc.value, exc.allowed, exc.hint) from None
         check_feasible(spec, grading, settings.initial_trial())
         if dens.mode == "density":
             _refuse_paper_options(seed, trial_porosity)
