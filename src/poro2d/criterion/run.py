@@ -117,9 +117,9 @@ def lab_extremes(table: str, t: dict, n_max, n_min, *, preset: bool, hint: str) 
     lo = n_min if n_min is not None else t.get("n_min", P.PAPER_N_MIN if preset else None)
     if hi is None or lo is None:
         raise InputError(f"{table}.n_max/n_min", (hi, lo), "both laboratory extremes", hint)
-    # each named as the user gave it: the option, else the table's key
-    hi_name = "--n-max" if n_max is not None else f"{table}.n_max"
-    lo_name = "--n-min" if n_min is not None else f"{table}.n_min"
+    # each named as the user gave it: the argument (the command names its option), else the table's key
+    hi_name = "n_max" if n_max is not None else f"{table}.n_max"
+    lo_name = "n_min" if n_min is not None else f"{table}.n_min"
     return (check_range(hi_name, hi, 0.0, 1.0, lo_open=True, hi_open=True),
             check_range(lo_name, lo, 0.0, 1.0, lo_open=True, hi_open=True))  # fmt: skip
 
@@ -163,18 +163,9 @@ class CriterionCase:
         if seed is not None:
             cfg["seed"] = check_int("--seed", seed, 0)
         dens = density_settings(cfg, mode, n_max, n_min, seeds, preset=config is None)
-        given = {"n_lab": n_lab, "trial_porosity": trial_porosity, "threads": threads}
-        try:
-            spec, grading, settings, sd = build(cfg, base, **given)
-        except InputError as exc:  # an option's value named as the option the user typed
-            if given.get(exc.parameter) is None:
-                raise
-            option = (
-                "--trial-porosity"
-                if exc.parameter == "trial_porosity"
-                else "--" + exc.parameter.replace("_", "-")
-            )
-            raise InputError(option, exc.value, exc.allowed, exc.hint) from None
+        spec, grading, settings, sd = build(
+            cfg, base, n_lab=n_lab, trial_porosity=trial_porosity, threads=threads
+        )
         check_feasible(spec, grading, settings.initial_trial())
         if dens.mode == "density":
             _refuse_paper_options(seed, trial_porosity)
