@@ -345,3 +345,52 @@ def test_coincident_pair_equals_brute_force():
         ]
         got = coincident_pair(pos, rad)
         assert (got[:2] if got else None) == (close[0] if close else None)
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf")])
+def test_a_non_finite_upscale_is_refused_as_not_finite(value):
+    """NaN was refused with the range (0.0, inf], which reads as if inf were allowed (it is not)."""
+    with pytest.raises(InputError, match="upscale.*a finite number > 0"):
+        GradingCurve.from_lists([0.1, 1.0], [0, 100], upscale=value)
+    with pytest.raises(InputError, match="upscale.*a finite number > 0"):
+        GradingCurve((1e-4, 1e-3), (0.0, 100.0), upscale=value)
+
+
+def test_a_missing_biaxial_lab_file_is_named_as_the_option(tmp_path, capsys):
+    """It was named ``lab``, a name the user never typed."""
+    out = tmp_path / "b"
+    refused(["biaxial", "--quick", "--lab", tmp_path / "nope.csv", "--out", out, "--quiet"], capsys,
+            "--lab = ", "nope.csv")  # fmt: skip
+    assert not out.exists()
+
+
+def test_laboratory_extremes_are_named_as_typed(tmp_path, capsys):
+    """``--n-max nan`` was refused as ``n_max``, a name the user never typed; a config's value is
+    named by its table's key."""
+    out = tmp_path / "o"
+    argv = [
+        "criterion",
+        "--preset",
+        "paper",
+        "--mode",
+        "density",
+        "--n-max",
+        "nan",
+        "--n-min",
+        "0.3",
+        "--out",
+        out,
+    ]
+    refused(argv, capsys, "--n-max = nan")
+    criterion_with(
+        tmp_path, capsys, '[density]\nmode = "density"\nn_max = 1.5\nn_min = 0.3\n', "density.n_max = 1.5"
+    )
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(("option", "value"), [("--n-lab", "nan"), ("--trial-porosity", "inf")])
+def test_criterion_options_are_named_as_typed(option, value, tmp_path, capsys):
+    """``--n-lab nan`` was refused as ``n_lab``, a name the user never typed."""
+    out = tmp_path / "o"
+    refused(["criterion", "--preset", "paper", option, value, "--out", out], capsys, f"{option} = ")
+    assert not out.exists()

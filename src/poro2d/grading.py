@@ -37,6 +37,7 @@ __all__ = [
     "MAX_DRAW",
     "PAPER_UPSCALE",
     "GradingCurve",
+    "check_upscale",
     "draw_disks",
     "max_deviation",
     "paper_grading",
@@ -125,6 +126,14 @@ def _interp_log(x: float, sizes: np.ndarray, percent: np.ndarray) -> float:
     return float(np.interp(math.log(x), np.log(sizes), percent))
 
 
+def check_upscale(value) -> float:
+    """The factor every grain size is multiplied by: a finite number > 0 (NaN and inf alike named
+    as not finite: the range (0, inf] would read as if inf were allowed)."""
+    if is_number(value) and not math.isfinite(float(value)):
+        raise InputError("upscale", value, "a finite number > 0")
+    return check_range("upscale", value, 0.0, None, lo_open=True)
+
+
 @dataclass(frozen=True)
 class GradingCurve:
     """A grading curve of model sizes (metres) and percent passing by mass.
@@ -145,7 +154,7 @@ class GradingCurve:
         percent = _as_float_array("percent_passing", self.percent_passing)
         _check_curve(sizes, percent, "sizes_m", "percent_passing", need_zero_start=True)
         percent[-1] = 100.0
-        check_range("upscale", self.upscale, 0.0, None, lo_open=True)
+        check_upscale(self.upscale)
         object.__setattr__(self, "sizes_m", tuple(float(v) for v in sizes))
         object.__setattr__(self, "percent_passing", tuple(float(v) for v in percent))
         object.__setattr__(self, "upscale", float(self.upscale))
@@ -176,9 +185,7 @@ class GradingCurve:
         _check_curve(sizes, percent, "sizes_mm", "percent_passing", need_zero_start=False)
         _check_grain_range("sizes_mm", sizes)
         percent[-1] = 100.0
-        up = check_range("upscale", upscale, 0.0, None, lo_open=True)
-        if not math.isfinite(up):
-            raise InputError("upscale", upscale, "a finite number > 0")
+        up = check_upscale(upscale)
         _check_grain_range("upscale", sizes * up, upscale)
         d = sizes * up / 1000.0
         lo = _cutoff("d_min_mm", d_min_mm)

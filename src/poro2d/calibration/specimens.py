@@ -128,7 +128,8 @@ def preset_specimens(store: Store, *, quick: bool, seed: int, replicates: int, p
     """The paper preset's accepted specimens for ``replicates`` seeds from ``seed``, kept in ``store``.
 
     The criterion runs once on ``seed`` (its ``criterion``), then on the next seeds from its
-    accepted porosity (its ``replicates``); seeds whose criterion does not converge are left out.
+    accepted porosity (its ``replicates``); a seed whose criterion does not converge is replaced by
+    the next unused one (``ReplicateCase.replacements`` at most).
     """
     from poro2d.criterion.replicates import ReplicateCase, run_replicates
 

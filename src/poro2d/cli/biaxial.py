@@ -83,6 +83,9 @@ def register(app: typer.Typer) -> None:
         try:  # a strain rate too fast for the specimen is refused before any test, named as typed
             start_and_print(case, stresses, Store(out), kw, out)
         except InputError as exc:
+            if exc.parameter == "lab":  # the laboratory file, named as the user gave it
+                given = "--lab" if lab is not None else "biaxial.lab"
+                raise InputError(given, exc.value, exc.allowed, exc.hint) from None
             raise as_typed(exc, options, table.settings) from None
 
 

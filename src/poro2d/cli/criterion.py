@@ -15,6 +15,7 @@ import typer
 from poro2d.cli import options as opt
 from poro2d.console import OutputConsole, Table, shown
 from poro2d.criterion.table import print_result
+from poro2d.errors import InputError
 from poro2d.store import Store
 from poro2d.sweep.results import DensityStateResult
 
@@ -26,6 +27,10 @@ PAPER_MODE_NOTE = (
     "does not follow the laboratory density (nLab only sets Eq. 12's first trial); for the answer at "
     "your density give both laboratory extremes (--n-max/--n-min or \\[density]) or use poro2d sand"
 )
+
+#: the option that sets each argument of ``CriterionCase.from_config`` a refusal may name
+OPTION_NAMES = {"n_lab": "--n-lab", "trial_porosity": "--trial-porosity", "threads": "--threads",
+                "n_max": "--n-max", "n_min": "--n-min"}  # fmt: skip
 
 #: --mode's help: both modes, and when each is the default
 MODE_HELP = (
@@ -65,10 +70,15 @@ def register(app: typer.Typer) -> None:
 
         check_output_dir("--out", out)  # a bad folder is named before the config is read
         series = opt.checked_vtk_every(vtk_every)
-        case = CriterionCase.from_config(
-            config, preset=preset, seed=seed, n_lab=n_lab, trial_porosity=trial, threads=threads, mode=mode,
-            n_max=n_max, n_min=n_min, seeds=seeds, **series,
-        )  # fmt: skip
+        given = {"n_lab": n_lab, "trial_porosity": trial, "threads": threads, "n_max": n_max, "n_min": n_min}
+        try:
+            case = CriterionCase.from_config(
+                config, preset=preset, seed=seed, mode=mode, seeds=seeds, **given, **series
+            )
+        except InputError as exc:  # an option's value named as the option the user typed
+            if given.get(exc.parameter) is None:
+                raise
+            raise InputError(OPTION_NAMES[exc.parameter], exc.value, exc.allowed, exc.hint) from None
         store = Store(out)
         result = run_criterion_modes(case, store, options=RunOptions(progress=not quiet))
         if isinstance(result, DensityStateResult):
@@ -100,7 +110,14 @@ def print_density(res: DensityStateResult, out: Path) -> None:
         f"{res.seeds_converged}/{res.seeds}", f"{res.n2d_min:.4f}", f"{res.n2d_max:.4f}",
     )  # fmt: skip
     console.print(t)
+    replaced = res.sweeps.seeds_replaced or []  # None in a density.json of an older poro2d
+    for r in replaced:
+        by = "no seed left to replace it" if r.replaced_by is None else f"replaced by seed {r.replaced_by}"
+        console.print(f"seed {r.seed} not accepted ({shown(r.reason)}): {by}", soft_wrap=True)
     console.print(f"results in {out}/density.json (calibration {out}/calibration.json)", soft_wrap=True)
     if not res.converged:
-        console.print(f"[bold red]criterion not converged for every seed[/] (see {out}/states)")
+        asked = res.seeds - sum(r.replaced_by is not None for r in replaced)
+        states = shown(f"{out}/states")
+        console.print(f"[bold red]criterion: {res.seeds_converged} of {asked} seeds accepted[/] "
+                      f"({res.seeds - asked} replaced; see {states})", soft_wrap=True)  # fmt: skip
         raise typer.Exit(1)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -151,22 +152,23 @@ def register(app: typer.Typer) -> None:
         lab_data = read_lab_csv(lab_path) if lab_path is not None else None  # the run's and the figures'
         store = Store(out)
         try:
-            case = ShearSeriesCase(
-                resolve_path("--specimen", specimen, extra.get("specimen"), base, required=True),
-                resolve_stresses(normal_stress, extra),
-                settings_from_options(
-                    table,
-                    velocity,
-                    max_displacement,
-                    stop_after_peak,
-                    particle_friction=particle_friction,
-                    rolling_friction=rolling_friction,
-                    **series,
-                ),  # fmt: skip
-                lab=lab_data,
-                rate_check=rate_check or bool(extra.get("rate_check", False)),
-                config=recorded,
-            )
+            with options_as_typed(options, table):
+                case = ShearSeriesCase(
+                    resolve_path("--specimen", specimen, extra.get("specimen"), base, required=True),
+                    resolve_stresses(normal_stress, extra),
+                    settings_from_options(
+                        table,
+                        velocity,
+                        max_displacement,
+                        stop_after_peak,
+                        particle_friction=particle_friction,
+                        rolling_friction=rolling_friction,
+                        **series,
+                    ),  # fmt: skip
+                    lab=lab_data,
+                    rate_check=rate_check or bool(extra.get("rate_check", False)),
+                    config=recorded,
+                )
             result = run_shear(case, store, options=run)
         except RuntimeError as exc:
             console.print(f"[bold red]failed:[/] {exc}")
@@ -174,6 +176,24 @@ def register(app: typer.Typer) -> None:
         draw_shear_series(result, store, lab_data)
         draw_shear_fabric(result, store)
         print_result(result, out)
+
+
+@contextmanager
+def options_as_typed(options: dict, table: dict):
+    """A setting's refusal named as the user typed it: ``--velocity`` for an option given,
+    ``shear.velocity`` for a key of the config's table."""
+    from poro2d.errors import InputError
+
+    try:
+        yield
+    except InputError as exc:
+        if options.get(exc.parameter) is not None:
+            name = "--" + exc.parameter.replace("_", "-")
+        elif exc.parameter in table:
+            name = f"shear.{exc.parameter}"
+        else:
+            raise
+        raise InputError(name, exc.value, exc.allowed, exc.hint) from None
 
 
 def resolve_path(option: str, given, from_config: str | None, base: Path | None, required: bool = False):

@@ -54,8 +54,9 @@ def accepted_state(result: CriterionResult, store: Store) -> tuple[Store, str] |
     if accepted is None:
         return None
     folder = trial_store(store, accepted)
-    # a specimen cycled further to balance is taken as it was then, also when the plate stayed
-    moved_last = (accepted.plate.moved in MOVED or accepted.balance_steps) and folder.has("after_plate.npz")
+    # a specimen cycled further to balance or equilibrium is taken as it was then, also when the plate stayed
+    cycled = accepted.balance_steps or accepted.equilibrium_steps
+    moved_last = (accepted.plate.moved in MOVED or cycled) and folder.has("after_plate.npz")
     return folder, "after_plate.npz" if moved_last else "prepared.npz"
 
 

@@ -157,6 +157,33 @@ def just_out_of_balance(checks: Checks, numbers: CheckNumbers, s: CriterionSetti
     return checks.failed == "force_balance" and near
 
 
+#: a specimen built whole whose last preparation stage (the working friction, every disk in) ended
+#: with its unbalanced-force ratio at most this many times ``spec.ratio``, every failed check one of
+#: equilibrium, is still coming to rest: it is cycled further (:func:`equilibrium_budget`) and checked
+#: again before it is refused, as a specimen just out of balance is
+EQUILIBRIUM_MARGIN = 2.0
+#: the checks a specimen still coming to rest may fail; the others say it is broken
+EQUILIBRIUM_CHECKS = ("preparation_converged", "plate_settled", "force_balance")
+#: the preparation's stage of the whole specimen (:func:`~poro2d.specimen.compaction.prepare_specimen`):
+#: a layer that missed equilibrium left the later layers unbuilt, and no further cycling mends that
+WHOLE_SPECIMEN_STAGE = "working friction"
+
+
+def just_out_of_equilibrium(prep: PreparationReport, checks: Checks, spec: SpecimenSpec) -> bool:
+    """Whether the preparation missed equilibrium only in its whole-specimen stage, its ratio within
+    ``EQUILIBRIUM_MARGIN`` of ``spec.ratio``, and no check but one of equilibrium failed."""
+    ratio = prep.failed_ratio
+    failed = {name for name, ok in checks.to_dict().items() if ok is False}
+    near = ratio is not None and ratio <= EQUILIBRIUM_MARGIN * spec.ratio
+    return prep.failed_stage == WHOLE_SPECIMEN_STAGE and near and failed <= set(EQUILIBRIUM_CHECKS)
+
+
+def equilibrium_budget(spec: SpecimenSpec) -> int:
+    """The steps a specimen just out of equilibrium is cycled further, at most: one more stage's
+    budget (``max_steps_per_stage``), so a sand's scaled budget scales it too."""
+    return spec.max_steps_per_stage
+
+
 def balance_budget(s: CriterionSettings) -> int:
     """The steps a specimen just out of balance is cycled further, at most: a sixth of the plate
     stage's budget (100 000 at the default ``max_plate_steps``), so a sand's scaled budget scales it too."""
@@ -229,6 +256,11 @@ def decide(trial: Trial, settings: CriterionSettings) -> Decision:
         reason += (
             f"; the force balance was out by at most {BALANCE_MARGIN:g} x its tolerance: checked again "
             f"after {trial.balance_steps} more steps at rest (at most {balance_budget(s)})"
+        )
+    if trial.equilibrium_steps:
+        reason += (
+            f"; the preparation's unbalanced-force ratio was out by at most {EQUILIBRIUM_MARGIN:g} x its "
+            f"limit: checked again after {trial.equilibrium_steps} more steps (at most max_steps_per_stage)"
         )
     if trial.overfull_m > 0.0:
         reason += "; " + overfull_note(trial.overfull_m)
@@ -382,6 +414,13 @@ class PorosityCriterion:
         overfull = float(prep.overfull_m or 0.0)  # how far the specimen stood above H
         weight = self.spec.self_weight(n)
         forces0 = wall_forces(sim)
+        equilibrium_steps = None
+        near_rest = not prep.converged and just_out_of_equilibrium(
+            prep, self._checks(sim, prep, n, forces0), self.spec
+        )
+        if near_rest:
+            equilibrium_steps, prep = self._cycle_to_equilibrium(sim, k, n, prep)
+            forces0 = wall_forces(sim)  # the specimen the plate stage starts from
         t1 = time.perf_counter()
         failure: StageFailure | None = None
         if not prep.converged:
@@ -432,6 +471,7 @@ class PorosityCriterion:
             check_numbers=numbers,
             checks=checks,
             balance_steps=balance_steps,
+            equilibrium_steps=equilibrium_steps,
             decision=Decision(False, "", False, False, ""),
             overfull_m=overfull,
             failure=failure,
@@ -443,6 +483,26 @@ class PorosityCriterion:
         trial.decision = decide(trial, s)
         trial.time_plate_s = time.perf_counter() - t1
         return trial
+
+    def _checks(self, sim: Simulation, prep: PreparationReport, n: float, forces: WallForces) -> Checks:
+        """The trial's checks on the specimen as it stands."""
+        return specimen_checks(sim, self.spec, prep, n, self._top_at_disks(sim), forces, self.settings)[0]
+
+    def _cycle_to_equilibrium(
+        self, sim: Simulation, k: int, n: float, prep: PreparationReport
+    ) -> tuple[int, PreparationReport]:
+        """Cycle a specimen just out of equilibrium further, the walls held, until its ratio is
+        below ``spec.ratio`` or :func:`equilibrium_budget` is spent; the steps, and the preparation
+        as it then stands (converged when the ratio was reached).
+
+        A specimen that came to rest is kept as ``after_plate.npz``: the trial goes on from it.
+        """
+        spec = self.spec
+        res = sim.solve(spec.ratio, equilibrium_budget(spec), measure=spec.equilibrium)
+        if not res.converged:
+            return res.steps, prep
+        self._after_top(sim, k, n)
+        return res.steps, replace(prep, converged=True)
 
     def _cycle_to_balance(
         self, sim: Simulation, k: int, n: float, prep: PreparationReport

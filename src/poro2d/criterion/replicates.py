@@ -15,9 +15,10 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, replace
 
-from poro2d.console import OutputConsole
+from poro2d.console import OutputConsole, shown
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
 from poro2d.criterion.result import CriterionResult, ReplicateRow, ReplicatesResult
+from poro2d.errors import check_int
 from poro2d.execute import Job, RunOptions
 from poro2d.execute.batch import complete_jobs
 from poro2d.grading import GradingCurve
@@ -27,17 +28,27 @@ from poro2d.store import Store
 
 console = OutputConsole()
 
+#: seeds not accepted replaced by the next unused ones, at most (as ``poro2d sand``'s
+#: ``[sand] replacements``): a seed refused at a threshold is one sample of a chaotic packing
+REPLACEMENTS = 3
+MAX_REPLACEMENTS = 50
+
 
 @dataclass(frozen=True)
 class ReplicateCase:
     """Replicate criterion runs as one value: the specimen, grading and thresholds of the main
-    run, the first trial ``n2d`` (the porosity the main seed accepted) and the ``seeds`` to run."""
+    run, the first trial ``n2d`` (the porosity the main seed accepted) and the ``seeds`` to run;
+    a seed not accepted is replaced by the next unused seed above them, ``replacements`` at most."""
 
     spec: SpecimenSpec
     grading: GradingCurve
     settings: CriterionSettings
     n2d: float
     seeds: tuple[int, ...]
+    replacements: int = REPLACEMENTS
+
+    def __post_init__(self) -> None:
+        check_int("replacements", self.replacements, 0, MAX_REPLACEMENTS)
 
     def criterion(self, seed: int, store: Store) -> PorosityCriterion:
         """Seed ``seed``'s criterion run in ``store``: one numba thread, first trial ``n2d``."""
@@ -71,17 +82,44 @@ def run_replicates(
     """The criterion runs of ``case``'s seeds, each in ``store``'s ``seed<N>``, on ``options``'
     workers (default one per seed, at most one per core) or its running scheduler.
 
-    Returns one summary row per seed (accepted or not, the criterion's message, its sub-store
-    of ``store``), in seed order, and the accepted specimens by label (``seed1``, ...) as
-    the result's ``specimens``.
+    A seed not accepted is replaced by the next unused seed above ``case.seeds`` (``case.replacements``
+    at most), each named in the printout with why; one line says when fewer seeds than asked were
+    accepted. Returns one summary row per seed tried (accepted or not, the criterion's message, its
+    sub-store of ``store``), in seed order, and the accepted specimens by label (``seed1``, ...) as
+    the result's ``specimens``. A run where every seed is accepted tries no other.
     """
-    jobs = [
-        Job(_run_one, (case, sd, store.child(f"seed{sd}")), f"seed {sd}", reports=True) for sd in case.seeds
-    ]
-    rows = complete_jobs(jobs, title="replicate criterion", what="replicate criterion run(s)",
+    rows = _run_seeds(case, case.seeds, store, options)
+    named: set[int] = set()  # the refused seeds the printout has named
+    spare, following = case.replacements, max(case.seeds, default=0) + 1
+    while (short := len(case.seeds) - sum(r.converged for r in rows)) > 0 and spare > 0:
+        more = tuple(range(following, following + min(short, spare)))
+        refused = [r for r in rows if not r.converged and r.seed not in named]
+        say_replaced(refused, more)
+        named.update(r.seed for r in refused)
+        rows += _run_seeds(case, more, store, options)
+        spare, following = spare - len(more), following + len(more)
+    if short > 0:
+        console.print(f"[bold red]only {len(case.seeds) - short} of {len(case.seeds)} replicate seeds "
+                      f"accepted[/] ({len(rows) - len(case.seeds)} replacement(s) tried, at most "
+                      f"{case.replacements})", soft_wrap=True)  # fmt: skip
+    return ReplicatesResult(rows, store=store)
+
+
+def say_replaced(refused: list[ReplicateRow], more: tuple[int, ...]) -> None:
+    """One line per refused seed: why it was not accepted and the seed tried in its place."""
+    for k, row in enumerate(refused):
+        instead = f"seed {more[k]} in its place" if k < len(more) else "no seed left to replace it"
+        console.print(
+            f"  replicate seed {row.seed} not accepted ({shown(row.message)}): {instead}", soft_wrap=True
+        )
+
+
+def _run_seeds(case: ReplicateCase, seeds, store: Store, options: RunOptions) -> list[ReplicateRow]:
+    """The rows of ``seeds``' criterion runs, each in ``store``'s ``seed<N>`` (finished ones read back)."""
+    jobs = [Job(_run_one, (case, sd, store.child(f"seed{sd}")), f"seed {sd}", reports=True) for sd in seeds]
+    return complete_jobs(jobs, title="replicate criterion", what="replicate criterion run(s)",
                          options=options, workers=options.local_workers(len(jobs)),
                          finished=[_stored(*job.args) for job in jobs], done_text=_outcome)  # fmt: skip
-    return ReplicatesResult(rows, store=store)
 
 
 def accepted_and_replicates(
@@ -118,4 +156,11 @@ def _outcome(row: ReplicateRow) -> str:
     return f"{what} ({row.trials} trial(s) in {row.time_s:.0f} s)"
 
 
-__all__ = ["ReplicateCase", "accepted_and_replicates", "run_replicates"]
+__all__ = [
+    "MAX_REPLACEMENTS",
+    "REPLACEMENTS",
+    "ReplicateCase",
+    "accepted_and_replicates",
+    "run_replicates",
+    "say_replaced",
+]

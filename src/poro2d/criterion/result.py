@@ -112,6 +112,16 @@ class ReplicatesResult(TypedResult):
     store: Store | None = field(default=None, kw_only=True, metadata=NOT_IN_FILE)
 
     @property
+    def seeds_used(self) -> list[int]:
+        """The seeds whose specimens were accepted, in seed order."""
+        return [r.seed for r in self.rows if r.converged]
+
+    @property
+    def seeds_replaced(self) -> list[int]:
+        """The seeds tried and not accepted (replaced by the next unused ones while any were left)."""
+        return [r.seed for r in self.rows if not r.converged]
+
+    @property
     def specimens(self) -> SpecimenSet:
         """The accepted specimens by label (``seed1``, ...), each seed's ``specimen.npz``, in seed order."""
         assert self.store is not None

@@ -14,6 +14,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from poro2d.criterion.protocol import CriterionSettings, PorosityCriterion
+from poro2d.criterion.replicates import MAX_REPLACEMENTS, REPLACEMENTS
 from poro2d.criterion.result import CriterionResult
 from poro2d.errors import InputError, check_int, check_range
 from poro2d.execute.options import RunOptions
@@ -46,7 +47,7 @@ def load(
     return load_config(config, preset, extra_tables=extra_tables)
 
 
-DENSITY_KEYS = {"mode", "n_max", "n_min", "mu_prep", "seeds"}
+DENSITY_KEYS = {"mode", "n_max", "n_min", "mu_prep", "seeds", "replacements"}
 
 
 @dataclass(frozen=True)
@@ -55,7 +56,8 @@ class DensitySettings:
 
     ``mu_prep``: the calibration's preparation frictions (None: the defaults); ``n_max``,
     ``n_min``: the laboratory extremes; ``seeds``: specimens per state; ``threads``: the DEM
-    threads the option gave the states' specimens (None: the config's) (density mode only).
+    threads the option gave the states' specimens (None: the config's); ``replacements``: seeds
+    not accepted replaced by the next unused ones, at most (density mode only).
     """
 
     mode: str
@@ -64,6 +66,7 @@ class DensitySettings:
     n_min: float | None = None
     seeds: int | None = None
     threads: int | None = None
+    replacements: int = REPLACEMENTS
 
 
 def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> DensitySettings:
@@ -98,8 +101,11 @@ def density_settings(cfg: dict, mode, n_max, n_min, seeds, *, preset: bool) -> D
     hi, lo = lab_extremes(
         "density", t, n_max, n_min, preset=preset, hint="set them in [density] or with --n-max/--n-min"
     )
-    seeds = check_int("seeds", seeds if seeds is not None else t.get("seeds", 3), 1, 50)
-    return DensitySettings(mode, mu_prep, n_max=hi, n_min=lo, seeds=seeds)
+    if seeds is None:
+        seeds = check_int("density.seeds", t.get("seeds", 3), 1, 50)
+    seeds = check_int("--seeds", seeds, 1, 50)
+    spare = check_int("density.replacements", t.get("replacements", REPLACEMENTS), 0, MAX_REPLACEMENTS)
+    return DensitySettings(mode, mu_prep, n_max=hi, n_min=lo, seeds=seeds, replacements=spare)
 
 
 def lab_extremes(table: str, t: dict, n_max, n_min, *, preset: bool, hint: str) -> tuple[float, float]:
@@ -111,8 +117,11 @@ def lab_extremes(table: str, t: dict, n_max, n_min, *, preset: bool, hint: str) 
     lo = n_min if n_min is not None else t.get("n_min", P.PAPER_N_MIN if preset else None)
     if hi is None or lo is None:
         raise InputError(f"{table}.n_max/n_min", (hi, lo), "both laboratory extremes", hint)
-    return (check_range("n_max", hi, 0.0, 1.0, lo_open=True, hi_open=True),
-            check_range("n_min", lo, 0.0, 1.0, lo_open=True, hi_open=True))  # fmt: skip
+    # each named as the user gave it: the argument (the command names its option), else the table's key
+    hi_name = "n_max" if n_max is not None else f"{table}.n_max"
+    lo_name = "n_min" if n_min is not None else f"{table}.n_min"
+    return (check_range(hi_name, hi, 0.0, 1.0, lo_open=True, hi_open=True),
+            check_range(lo_name, lo, 0.0, 1.0, lo_open=True, hi_open=True))  # fmt: skip
 
 
 @dataclass(frozen=True)

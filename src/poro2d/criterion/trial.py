@@ -150,8 +150,9 @@ class Trial(Record, TypedResult):
     ``ROW`` is the row a trial records, its parts in place: the counts, porosity and convergence
     of its preparation, the wall forces as prepared and after the plate stage under their own
     keys, ``overfull_m`` only when the box was over-full, ``balance_steps`` only for a specimen
-    cycled further to balance, ``accepted_at`` only for a trial accepted when the bracket closed,
-    the density scaling's time step and disks only for a specimen whose masses were raised.
+    cycled further to balance, ``equilibrium_steps`` only for one cycled further to equilibrium
+    after its preparation, ``accepted_at`` only for a trial accepted when the bracket closed, the
+    density scaling's time step and disks only for a specimen whose masses were raised.
     A trial is the typed result of its file (``trial.json``), and so a part of the criterion's
     result; keys of a row read back that it does not model are kept in ``extra``.
     """
@@ -167,13 +168,14 @@ class Trial(Record, TypedResult):
         ("f_bottom_after_n_per_m", "forces_after.f_bottom_n_per_m"),
         ("side_friction_up_after_n_per_m", "forces_after.side_friction_up_n_per_m"),
         "porosity_change", Spliced("check_numbers"), Spliced("porosity"), "checks", "balance_steps",
+        "equilibrium_steps",
         Spliced("decision"),
         "time_prepare_s", "time_plate_s", ("accepted_at", "decision.accepted_at"),
         "mass_scaling_dt_s", "mass_scaled_disks",
     )  # fmt: skip
     OMITTED = {
-        "overfull_m": 0.0, "accepted_at": None, "balance_steps": None, "mass_scaling_dt_s": None,
-        "mass_scaled_disks": None,
+        "overfull_m": 0.0, "accepted_at": None, "balance_steps": None, "equilibrium_steps": None,
+        "mass_scaling_dt_s": None, "mass_scaled_disks": None,
     }  # fmt: skip
 
     iteration: int
@@ -197,6 +199,8 @@ class Trial(Record, TypedResult):
     porosity: PorosityNumbers | None = None
     #: the steps a specimen just out of balance was cycled further (None: it was not)
     balance_steps: int | None = None
+    #: the steps a specimen just out of equilibrium when prepared was cycled further (None: it was not)
+    equilibrium_steps: int | None = None
     time_prepare_s: float | None = None
     time_plate_s: float | None = None
     #: the time step the light disks' inertial masses were raised for in the specimen's

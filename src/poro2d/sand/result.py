@@ -24,7 +24,7 @@ from poro2d.sand.case import SoilRecord
 from poro2d.sand.preflight import Preflight
 from poro2d.sand.profile import StageProfile
 from poro2d.store import Store
-from poro2d.sweep.records import CaseRow, LostCaseRow
+from poro2d.sweep.records import CaseRow, LostCaseRow, SeedReplaced
 from poro2d.typed_result import NOT_IN_FILE, TypedResult
 
 
@@ -71,16 +71,6 @@ class SeedSpecimen(TypedResult):
             folder,
             "" if ok else str(why),
         )
-
-
-@dataclass(eq=False)
-class SeedReplaced(TypedResult):
-    """A seed not accepted at full size (``seeds_replaced`` in ``sand.json``): why, and the seed
-    tried in its place (None once ``[sand] replacements`` were spent)."""
-
-    seed: int
-    reason: str
-    replaced_by: int | None
 
 
 def replaced_seeds(kept: list[SeedSpecimen], requested: int) -> list[SeedReplaced]:

@@ -48,6 +48,7 @@ from poro2d.sweep import density as D
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.output import held
 from poro2d.sweep.records import CalibrationRun, CaseRow, LostCaseRow
+from poro2d.sweep.relation import case_seed, seed_accepted
 
 #: the kind of run an output folder of this command belongs to (poro2d.locks.KIND_SIGNS)
 KIND = "sand"
@@ -230,25 +231,16 @@ def specimen_stage(
     while True:
         sweep = D.StateChecks(case.config, (trial,), tried, grid).sweep
         res = run_sweep(sweep, store.child("states"), options=options)
-        rows = sorted(res.rows, key=_seed)
+        rows = sorted(res.rows, key=case_seed)
         more = min(case.seeds - sum(map(seed_accepted, rows)), case.seeds + case.replacements - tried)
         if more <= 0:
             return rows
-        refused = [_seed(r) for r in rows if not seed_accepted(r)]
+        refused = [case_seed(r) for r in rows if not seed_accepted(r)]
         announce(
             f"seed(s) {', '.join(map(str, refused))} not accepted: trying seed(s) "
             f"{', '.join(map(str, range(tried, tried + more)))} in their place"
         )
         tried += more
-
-
-def _seed(row: CaseRow | LostCaseRow) -> int:
-    return int((row.params or {}).get("seed", 0))
-
-
-def seed_accepted(row: CaseRow | LostCaseRow) -> bool:
-    """Whether a seed's criterion case ended with an accepted specimen."""
-    return row.status == "done" and bool((row.results or {}).get("converged"))
 
 
 def keep_specimens(rows: list[CaseRow | LostCaseRow], store: Store, label: str, soil: dict,
@@ -257,7 +249,7 @@ def keep_specimens(rows: list[CaseRow | LostCaseRow], store: Store, label: str, 
     ``soil.json`` naming the soil and its laboratory state."""
     kept = []
     for r in rows:
-        seed = _seed(r)
+        seed = case_seed(r)
         # the criterion's store of the case
         src = store.child("states", "cases", str(r.case_id), "run")
         folder = None

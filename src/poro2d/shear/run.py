@@ -19,7 +19,7 @@ from poro2d.io_utils import check_output_dir
 from poro2d.shear.lab import LabData, read_lab_csv
 from poro2d.shear.results import ShearSeriesResult
 from poro2d.shear.series import ShearSeries, check_stresses
-from poro2d.shear.settings import ShearSettings
+from poro2d.shear.settings import ShearSettings, half_velocity
 from poro2d.specimen.saved import Specimen
 from poro2d.store import Store, claimed
 
@@ -83,6 +83,8 @@ class ShearSeriesCase:
         set_field("settings", _settings(self.settings))
         if not isinstance(self.rate_check, bool):
             raise InputError("rate_check", self.rate_check, "True or False")
+        if self.rate_check:  # its rerun at half the velocity is refused before the folder is claimed
+            half_velocity(self.settings.velocity)
 
 
 def run_shear(

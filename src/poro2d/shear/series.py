@@ -25,7 +25,7 @@ from poro2d.shear.parts import (
 )
 from poro2d.shear.pool import ShearJob, execute_jobs
 from poro2d.shear.results import ShearSeriesResult, ShearTestResult
-from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings
+from poro2d.shear.settings import NORMAL_STRESS_RANGE_KPA, ShearSettings, half_velocity
 from poro2d.specimen.saved import Specimen
 from poro2d.store import Store
 
@@ -111,12 +111,12 @@ class ShearSeries:
 
     def _jobs(self) -> list[ShearJob]:
         base = ShearCase(self.specimen, self.stresses[0], self.settings)
-        half = base.with_settings(velocity=0.5 * self.settings.velocity)
         jobs = [
             ShearJob(("test", sig), base.at(sig), self._folder(folder_name(sig)), self.keep_peak)
             for sig in self.stresses
         ]
-        if self.rate_check:
+        if self.rate_check:  # the half is made only here: a velocity near the floor runs without it
+            half = base.with_settings(velocity=half_velocity(self.settings.velocity))
             jobs += [
                 ShearJob(("rate", sig), half.at(sig), self._folder("rate_check", folder_name(sig)), False)
                 for sig in self.stresses

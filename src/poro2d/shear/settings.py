@@ -32,13 +32,20 @@ MAX_CHECKPOINTS = 1000
 #: tenth of their diameter at 2 kPa: softer is no longer a soft-contact model) up to 1e10 (as the
 #: walls; the time step falls with its square root)
 PARTICLE_STIFFNESS_RANGE = (1e3, 1e10)
+#: the shear velocity's range (m/s). The floor: at the quick specimen's time step (about 5e-6 s
+#: with Table 1's stiffness) the default 0.02 m of shear at 1e-4 m/s takes 0.02 / (1e-4 x 5e-6)
+#: = 4e7 steps, four times the consolidation's largest budget (MAX_CONSOLIDATION_STEPS): days of
+#: one core, as biaxial's MIN_STRAIN_RATE. A slower test would not end in any run's time and is
+#: refused before any work
+MIN_VELOCITY = 1e-4
+MAX_VELOCITY = 10.0
 
 
 #: what each setting of :class:`ShearSettings` may be (checked in this order); the intervals
 #: are checked against ``max_displacement`` and ``stop_after_peak`` against ``peak_window``
 #: after these
 SHEAR_RANGES: Ranges = {
-    "velocity": Real(0.0, 10.0, lo_open=True),
+    "velocity": Real(MIN_VELOCITY, MAX_VELOCITY),
     # half the width of a 2 m box; a test checks it against its own specimen's half width too
     "max_displacement": Real(0.0, MAX_DISPLACEMENT, lo_open=True),
     "record_interval": Real(0.0, None, lo_open=True),
@@ -132,6 +139,20 @@ class ShearSettings(TestSettings):
             raise InputError(name, interval, f"[max_displacement / {most} = {shortest:.3g}, inf) m")
 
 
+def half_velocity(velocity: float) -> float:
+    """The rate check's rerun velocity, half of ``velocity`` (m/s).
+
+    Refused, naming the velocity the user gave, when the half falls below :data:`MIN_VELOCITY`:
+    the rerun would be a test too slow to end, and the user's velocity alone is allowed.
+    """
+    half = 0.5 * velocity
+    if half < MIN_VELOCITY:
+        allowed = f"[{2 * MIN_VELOCITY:g}, {MAX_VELOCITY:g}] m/s with the rate check"
+        hint = f"its rerun at half the velocity, {half:g} m/s, would be below the floor {MIN_VELOCITY:g} m/s"
+        raise InputError("velocity", velocity, allowed, hint)
+    return half
+
+
 def inertial_number(velocity: float, sigma_pa: float, rho_inertial: float, shear_zone_factor: float) -> float:
     """I = gamma_dot d_mean sqrt(rho / sigma_n) with gamma_dot = v / (k d_mean).
 
@@ -149,9 +170,12 @@ __all__ = [
     "MAX_DENSITY_SCALE",
     "MAX_FRICTION",
     "MAX_ROLLING_FRICTION",
+    "MAX_VELOCITY",
     "MAX_WALL_STIFFNESS",
+    "MIN_VELOCITY",
     "NORMAL_STRESS_RANGE_KPA",
     "PARTICLE_STIFFNESS_RANGE",
     "ShearSettings",
+    "half_velocity",
     "inertial_number",
 ]

@@ -12,6 +12,7 @@ the calibration (:mod:`poro2d.sweep.density`), so that neither imports the other
 
 from __future__ import annotations
 
+from poro2d.console import OutputConsole, shown
 from poro2d.criterion.result import CriterionResult
 from poro2d.criterion.run import KIND, CriterionCase, run_criterion
 from poro2d.errors import InputError
@@ -24,6 +25,8 @@ from poro2d.sweep.records import DensitySweeps
 from poro2d.sweep.relation import RelationSettings, density_relation
 from poro2d.sweep.results import DensityStateResult, RelationResult
 
+console = OutputConsole()
+
 
 def run_density_criterion(
     case: CriterionCase, store: Store | None = None, *, options: RunOptions = RunOptions()
@@ -33,7 +36,8 @@ def run_density_criterion(
     ``case``: a density-mode :class:`~poro2d.criterion.run.CriterionCase` (its ``[density]``
     table or ``from_config(..., mode="density", n_max=..., n_min=...)``). Calibrates the
     grading (cached), maps the case's ``n_lab`` between the laboratory extremes to its 2D target
-    and preparation friction, runs the criterion with them for every seed and writes
+    and preparation friction, runs the criterion with them for every seed (a seed not accepted
+    replaced by the next unused one, ``[density] replacements`` at most, each said on the console) and writes
     ``density.json`` to ``store`` (None: nothing kept but the calibration cache): the accepted
     n2D (mean, sd, per seed), the target, mu_prep and Dr, returned as a
     :class:`~poro2d.sweep.results.DensityStateResult`. ``options``: where the jobs run and
@@ -48,15 +52,22 @@ def run_density_criterion(
     base = CriterionBase(rest, case.base)
     settings = RelationSettings(dens.n_max, dens.n_min, (round(float(case.settings.n_lab), 4),))
     with held(store, kind=KIND) as kept:
-        rel, sweeps = density_relation(base, settings, kept, seeds=dens.seeds,
-                                       mus=dens.mu_prep, options=options)  # fmt: skip
-        result = DensityStateResult.from_dict(_state_record(rel, sweeps, base))
+        spare = {"replacements": dens.replacements, "announce": _say}
+        rel, sweeps = density_relation(base, settings, kept, seeds=dens.seeds, mus=dens.mu_prep,
+                                       options=options, **spare)  # fmt: skip
+        result = DensityStateResult.from_dict(_state_record(rel, sweeps, base, dens.seeds))
         kept.write_result("density.json", result)
     return result
 
 
-def _state_record(rel: RelationResult, sweeps: DensitySweeps, base: CriterionBase) -> dict:
-    """density.json's keys: the one state's point of the relation, its extremes and calibration."""
+def _say(text: str) -> None:
+    """A line of the run (a seed replaced, with why) printed as text: a reason may hold brackets."""
+    console.print(shown(text), soft_wrap=True)
+
+
+def _state_record(rel: RelationResult, sweeps: DensitySweeps, base: CriterionBase, requested: int) -> dict:
+    """density.json's keys: the one state's point of the relation, its extremes and calibration
+    (converged: ``requested`` seeds accepted, replacements counted)."""
     (point,) = rel.points
     return {
         "mode": "density",
@@ -73,7 +84,7 @@ def _state_record(rel: RelationResult, sweeps: DensitySweeps, base: CriterionBas
         "interior_porosity_per_seed": point.n2d_interior_seeds,
         "seeds": point.seeds,
         "seeds_converged": point.seeds_converged,
-        "converged": point.seeds_converged == point.seeds,
+        "converged": point.seeds_converged >= requested,
         "n2d_min": rel.n2d_min,
         "n2d_max": rel.n2d_max,
         "calibration": rel.calibration,

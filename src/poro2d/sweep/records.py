@@ -198,14 +198,29 @@ class CalibrationRun(TypedResult):
 
 
 @dataclass(eq=False)
-class DensitySweeps(TypedResult):
-    """The two sweeps of density mode: the calibration's, the state checks' and their failures."""
+class SeedReplaced(TypedResult):
+    """A seed whose specimen was not accepted (``seeds_replaced`` of ``sand.json`` and of a
+    density-mode criterion's ``density.json``): why, and the seed tried in its place (None once
+    the replacements were spent)."""
 
-    PARTS = {"calibration": CalibrationRun, "states_summary": SweepSummary}
+    seed: int
+    reason: str
+    replaced_by: int | None
+
+
+@dataclass(eq=False)
+class DensitySweeps(TypedResult):
+    """The two sweeps of density mode: the calibration's, the state checks' and their failures;
+    with a seed replaced (one state's checks), the seeds accepted and those replaced."""
+
+    PARTS = {"calibration": CalibrationRun, "states_summary": SweepSummary, "seeds_replaced": SeedReplaced}
+    OPTIONAL = ("seeds_used", "seeds_replaced")
 
     calibration: CalibrationRun
     states_summary: SweepSummary
     failed_cases: int
+    seeds_used: list[int] | None = None
+    seeds_replaced: list[SeedReplaced] | None = None
 
 
 @dataclass(eq=False)
@@ -327,17 +342,18 @@ class Eq12Coefficients(TypedResult):
 
 __all__ = [
     "COMPARE",
-    "Eq12Coefficients",
     "CalibrationRun",
     "CaseEntry",
     "CaseRow",
     "CriterionCaseResults",
-    "LostCaseRow",
     "DensityPoint",
     "DensitySweeps",
+    "Eq12Coefficients",
+    "LostCaseRow",
     "PaperPoint",
     "QuadraticFit",
     "RelationPoint",
+    "SeedReplaced",
     "Spread",
     "SweepSummary",
     "case_row",

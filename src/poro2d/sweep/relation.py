@@ -311,15 +311,21 @@ def density_relation(
     mus=None,
     use_cache: bool = True,
     options: RunOptions = RunOptions(),
+    replacements: int = 0,
+    announce=None,
 ) -> tuple[RelationResult, DensitySweeps]:
     """The density-controlled relation: calibrate, map every state, check it over seeds.
 
     ``base``: the criterion config as read; ``settings``: from :func:`relation_settings`;
     ``store``: where the calibration's record and the states' sweep are kept (the
     calibration's cases in the shared cache with ``use_cache``); ``options``: where the jobs run
-    and whether bars show (:class:`~poro2d.execute.options.RunOptions`). Returns the analysed
-    relation and a record of the two sweeps (calibration source, summaries).
+    and whether bars show (:class:`~poro2d.execute.options.RunOptions`). ``replacements``: while a
+    state has fewer than ``seeds`` accepted, the next seeds are run (for every state), this many
+    at most, each round said through ``announce`` (the relation's states keep 0: none). Returns
+    the analysed relation and a record of the two sweeps (calibration source, summaries; with a
+    replacement tried, ``seeds_used`` and ``seeds_replaced``: one state's seeds).
     """
+    announce = announce or (lambda _text: None)
     from poro2d.criterion.density import DEFAULT_MUS, state_target
     from poro2d.criterion.protocol import trial_grid
     from poro2d.sweep import density as D
@@ -332,22 +338,79 @@ def density_relation(
     crit = states_base.table("criterion")
     # the first trial on the grid the criterion steps on: half the refined tolerance, else the resolution
     resolution = trial_grid(float(crit.get("resolution", 0.01)), crit.get("refine_tolerance"))
-    sweep = D.StateChecks(states_base, targets, seeds, resolution).sweep
-    twins = D.calibration_twins(calibration.sweep, sweep, base.base_dir, Store(cal_info.cases))
-    rows, summary, failed = twins, {"ran": 0, "reused": 0}, []
-    if len(twins) < len(sweep.cases):
-        twin_ids = {row.case_id for row in twins}
-        left = replace(sweep, cases=[c for c in sweep.cases if c.id not in twin_ids])
-        res = run_sweep(left, store.child("states"), options=options)
-        rows, summary, failed = res.rows + rows, res.summary.to_dict(), res.failed
-    summary = dict(summary, from_calibration=len(twins))
+
+    def checked(tried: int):
+        """The state checks of seeds 0 .. tried - 1: those the calibration ran read back, the rest run."""
+        sweep = D.StateChecks(states_base, targets, tried, resolution).sweep
+        twins = D.calibration_twins(calibration.sweep, sweep, base.base_dir, Store(cal_info.cases))
+        rows, summary, failed = twins, {"ran": 0, "reused": 0}, []
+        if len(twins) < len(sweep.cases):
+            twin_ids = {row.case_id for row in twins}
+            left = replace(sweep, cases=[c for c in sweep.cases if c.id not in twin_ids])
+            res = run_sweep(left, store.child("states"), options=options)
+            rows, summary, failed = res.rows + rows, res.summary.to_dict(), res.failed
+        return rows, dict(summary, from_calibration=len(twins)), failed
+
+    tried = seeds
+    rows, summary, failed = checked(tried)
+    while (more := min(seeds - least_accepted(rows, targets), seeds + replacements - tried)) > 0:
+        announce(replacing_text(rows, range(tried, tried + more)))
+        tried += more
+        rows, summary, failed = checked(tried)  # the finished seeds read back, the new ones run
     rel = analyse_states(rows, list(targets), cal, settings.n_max, settings.n_min)
     record = {
         "calibration": cal_info,
         "states_summary": summary,
         "failed_cases": len(failed) + cal_info.failed,
     }
+    if tried > seeds:
+        record |= seeds_record(rows, seeds)
     return rel, DensitySweeps.from_dict(record)
+
+
+def case_seed(row: CaseRow | LostCaseRow) -> int:
+    """The seed a criterion case ran."""
+    return int((row.params or {}).get("seed", 0))
+
+
+def seed_accepted(row: CaseRow | LostCaseRow) -> bool:
+    """Whether a seed's criterion case ended with an accepted specimen."""
+    return row.status == "done" and bool((row.results or {}).get("converged"))
+
+
+def least_accepted(rows, targets) -> int:
+    """The fewest accepted seeds of any state of ``targets``."""
+    by_lab = [round(float_or_nan((r.params or {}).get("criterion.n_lab")), 6) for r in rows]
+    return min((sum(seed_accepted(r) for r, n in zip(rows, by_lab, strict=True) if n == round(t.n_lab, 6))
+                for t in targets), default=0)  # fmt: skip
+
+
+def replacing_text(rows, more) -> str:
+    """The seeds not accepted, each with why, and those tried in their place."""
+    refused = sorted((r for r in rows if not seed_accepted(r)), key=case_seed)
+    why = "; ".join(f"seed {case_seed(r)}: {refusal_reason(r)}" for r in refused)
+    return f"seed(s) not accepted ({why}): trying seed(s) {', '.join(map(str, more))} in their place"
+
+
+def refusal_reason(row: CaseRow | LostCaseRow) -> str:
+    """Why a seed's case gave no specimen: the criterion's message, else the case's error."""
+    return str((row.results or {}).get("message") or row.error or row.status)
+
+
+def seeds_record(rows, requested: int) -> dict:
+    """``seeds_used`` and ``seeds_replaced`` of a single state's checks (seeds from 0, the ones at
+    or past ``requested`` tried in place of those refused, in order)."""
+    ordered = sorted(rows, key=case_seed)
+    extra = [case_seed(r) for r in ordered if case_seed(r) >= requested]
+    refused = [r for r in ordered if not seed_accepted(r)]
+    by = extra + [None] * (len(refused) - len(extra))
+    return {
+        "seeds_used": [case_seed(r) for r in ordered if seed_accepted(r)],
+        "seeds_replaced": [
+            {"seed": case_seed(r), "reason": refusal_reason(r), "replaced_by": b}
+            for r, b in zip(refused, by, strict=False)
+        ],
+    }
 
 
 def relation_state(table, base: CriterionBase, settings: RelationSettings, mode: str):
