@@ -59,6 +59,19 @@ def test_refused_seeds_are_replaced_by_the_next_ones(
     assert len(lines) == len(tried) - 1 and all("in their place" in line for line in lines)
 
 
+def test_the_configs_seed_is_the_first_seed_at_full_size(tmp_path, monkeypatch):
+    # a second run with another first seed draws other specimens (before, seed = 10 was
+    # accepted and the specimens were seeds 0, 1, 2 all the same); replacements follow on from it
+    calls: list[list[int]] = []
+    monkeypatch.setattr(runner, "run_sweep", _fake_sweep({11}, calls))
+    case = load_sand_case({**CFG, "seed": 10, "sand": {"seeds": 3, "replacements": 3}})
+    lines: list[str] = []
+    rows = specimen_stage(case, StateTarget(0.3, 0.5, 0.17, 0.3), Store(tmp_path), None, lines.append)
+    assert calls == [[10, 11, 12], [10, 11, 12, 13]]
+    assert [int(r.params["seed"]) for r in rows if seed_accepted(r)] == [10, 12, 13]
+    assert lines == ["seed(s) 11 not accepted: trying seed(s) 13 in their place"]
+
+
 def test_the_answer_names_the_replaced_seed_and_why():
     kept = [SimpleNamespace(seed=s, accepted=s != 1, message="" if s != 1 else REFUSED) for s in range(4)]
     (gone,) = replaced_seeds(kept, 3)

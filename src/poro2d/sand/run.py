@@ -220,16 +220,18 @@ def specimen_stage(
 
     A seed not accepted is replaced by the next unused seed, at most ``case.replacements`` in
     all, until ``case.seeds`` are accepted: the rows of every seed tried, in seed order. Seeds
-    are tried in order (0, 1, ...), so a rerun reads every finished seed back, replaced ones too.
+    are tried in order from the config's ``seed`` (0 when not given: 0, 1, ...), so a rerun reads
+    every finished seed back, replaced ones too.
     """
     from poro2d.criterion.protocol import trial_grid
     from poro2d.sweep.runner import run_sweep
 
     crit = case.config.table("criterion")
     grid = trial_grid(float(crit.get("resolution", 0.01)), crit.get("refine_tolerance"))
+    first = int(case.config.config.get("seed", 0))  # checked when the case was loaded
     tried = case.seeds
     while True:
-        sweep = D.StateChecks(case.config, (trial,), tried, grid).sweep
+        sweep = D.StateChecks(case.config, (trial,), tried, grid, first_seed=first).sweep
         res = run_sweep(sweep, store.child("states"), options=options)
         rows = sorted(res.rows, key=case_seed)
         more = min(case.seeds - sum(map(seed_accepted, rows)), case.seeds + case.replacements - tried)
@@ -238,7 +240,7 @@ def specimen_stage(
         refused = [case_seed(r) for r in rows if not seed_accepted(r)]
         announce(
             f"seed(s) {', '.join(map(str, refused))} not accepted: trying seed(s) "
-            f"{', '.join(map(str, range(tried, tried + more)))} in their place"
+            f"{', '.join(map(str, range(first + tried, first + tried + more)))} in their place"
         )
         tried += more
 

@@ -333,13 +333,15 @@ class StateChecks:
     """The criterion once per laboratory state and seed, at the state's friction, from its target.
 
     ``base``: the criterion base of the states (density mode's defaults filled in);
-    ``resolution``: the grid the first trials are rounded to (the one the criterion steps on).
+    ``resolution``: the grid the first trials are rounded to (the one the criterion steps on);
+    ``first_seed``: the seeds run are ``first_seed`` and the ``seeds - 1`` after it.
     """
 
     base: CriterionBase
     targets: tuple[StateTarget, ...]
     seeds: int
     resolution: float
+    first_seed: int = 0
 
     @cached_property
     def sweep(self) -> SweepConfig:
@@ -357,7 +359,7 @@ class StateChecks:
                 "seed": s,
             }
             for t in self.targets
-            for s in range(self.seeds)
+            for s in range(self.first_seed, self.first_seed + self.seeds)
         ]
         table = {"kind": "criterion", "title": "density-controlled states", "cases": cases}
         return base.with_tables(criterion=crit).sweep(table, cases)
