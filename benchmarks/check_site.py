@@ -27,6 +27,7 @@ import os
 import re
 import select
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -165,7 +166,12 @@ def served(site: Path, pages: list[str]):
 
 def browse(base: str, timeout: float) -> list[dict]:
     """What the runner page at ``base`` collected of every page, as Chromium rendered them."""
-    with tempfile.TemporaryDirectory() as profile, Browser(Path(profile), timeout) as browser:
+    # Chromium's helper processes may still be writing the profile as the folder goes: what
+    # they leave there is no result
+    with (
+        tempfile.TemporaryDirectory(ignore_cleanup_errors=True) as profile,
+        Browser(Path(profile), timeout) as browser,
+    ):
         session = browser.open(f"{base}/{RUNNER}")
         return browser.evaluate(session, "checkPages()")
 
@@ -191,8 +197,14 @@ class Browser:
             "--disable-background-networking", "--disable-component-update", "--disable-extensions",
             f"--user-data-dir={profile}", "--window-size=1280,4000", "--remote-debugging-pipe", "about:blank",
         ]  # fmt: skip
+        # its own process group, so that the renderer and helper processes end with it
         self.process = subprocess.Popen(
-            cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, close_fds=False, preexec_fn=descriptors
+            cmd,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            close_fds=False,
+            preexec_fn=descriptors,
+            start_new_session=True,
         )
         os.close(to_browser)
         os.close(from_browser)
@@ -202,7 +214,10 @@ class Browser:
         return self
 
     def __exit__(self, *exc) -> None:
-        self.process.kill()
+        try:
+            os.killpg(self.process.pid, signal.SIGKILL)
+        except ProcessLookupError:  # the whole group has already ended
+            pass
         self.process.wait()
         os.close(self.commands)
         os.close(self.answers)

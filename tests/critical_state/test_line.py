@@ -81,7 +81,14 @@ def test_a_line_keeps_a_study_per_pressure_and_its_own_files(tmp_path, monkeypat
     draw_critical_state_line(result, Store(tmp_path))  # the figures, drawn from the result after the run
     names = sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith("."))
     assert (tmp_path / "p50kPa" / "critical_state.png").exists()
-    assert names == ["critical_state_line.png", "line.csv", "p200kPa", "p50kPa", "result.json"]
+    assert names == [
+        "critical_state_line.png",
+        "critical_state_line.svg",
+        "line.csv",
+        "p200kPa",
+        "p50kPa",
+        "result.json",
+    ]
     assert (tmp_path / "p50kPa" / "result.json").exists() and (tmp_path / "p200kPa" / "series.csv").exists()
     data = json.loads((tmp_path / "result.json").read_text())
     assert CriticalStateLineResult.from_dict(data).to_dict() == result.to_dict()

@@ -242,7 +242,7 @@ def _cfg(tmp_path):
         (["--normal-stress", "50,abc"], "--normal-stress"),
         (["--max-displacement", "0.031"], "max_displacement"),
         (["--velocity", "-1"], "velocity"),
-        (["--stop-after-peak", "1e-4"], "stop_after_peak"),
+        (["--stop-after-peak", "1e-4"], "--stop-after-peak"),
     ],
 )
 def test_cli_bad_input(specimen, tmp_path, capsys, extra, needle):

@@ -50,7 +50,7 @@ def test_density_mode_of_the_criterion(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize(
     ("extra", "name"),
-    [(["--mode", "fast"], "mode"), (["--mode", "density", "--n-lab", "0.30"], "n_lab"),
+    [(["--mode", "fast"], "mode"), (["--mode", "density", "--n-lab", "0.30"], "--n-lab"),
      (["--mode", "density", "--seeds", "0"], "seeds")],
 )  # fmt: skip
 def test_density_mode_errors(tmp_path, capsys, extra, name):
