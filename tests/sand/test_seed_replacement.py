@@ -6,11 +6,12 @@ import pytest
 
 from poro2d.criterion.density import StateTarget
 from poro2d.sand import load_sand_case
-from poro2d.sand.result import replaced_seeds
+from poro2d.sand.result import SeedSpecimen, replaced_seeds
 from poro2d.sand.run import seed_accepted, specimen_stage
 from poro2d.store import Store
 from poro2d.sweep import runner
 from poro2d.sweep.records import CaseRow
+from poro2d.sweep.relation import case_seed
 
 REFUSED = "trial 1 (n2D = 0.1720) refused: check force_balance failed"
 LAB = {"e_max": 0.977, "e_min": 0.597, "dr": 0.8}
@@ -70,6 +71,9 @@ def test_the_configs_seed_is_the_first_seed_at_full_size(tmp_path, monkeypatch):
     assert calls == [[10, 11, 12], [10, 11, 12, 13]]
     assert [int(r.params["seed"]) for r in rows if seed_accepted(r)] == [10, 12, 13]
     assert lines == ["seed(s) 11 not accepted: trying seed(s) 13 in their place"]
+    kept = [SeedSpecimen.from_row(case_seed(r), r, "f" if seed_accepted(r) else None) for r in rows]
+    assert [(g.seed, g.replaced_by) for g in replaced_seeds(kept, 3)] == [(11, 13)]
+    assert replaced_seeds([k for k in kept if k.accepted], 3) == []  # none refused: none replaced
 
 
 def test_the_answer_names_the_replaced_seed_and_why():

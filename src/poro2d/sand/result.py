@@ -74,8 +74,9 @@ class SeedSpecimen(TypedResult):
 
 
 def replaced_seeds(kept: list[SeedSpecimen], requested: int) -> list[SeedReplaced]:
-    """The seeds not accepted, in order, each with the seed tried after the requested ones in its place."""
-    extra = [k.seed for k in kept if k.seed >= requested]
+    """The seeds not accepted, in order, each with the seed tried after the requested ones in its place
+    (the seeds run from the config's first seed, so the requested ones are the first ``requested``)."""
+    extra = sorted(k.seed for k in kept)[requested:]
     refused = [k for k in kept if not k.accepted]
     by = extra + [None] * (len(refused) - len(extra))
     return [SeedReplaced(k.seed, k.message, b) for k, b in zip(refused, by, strict=True)]
