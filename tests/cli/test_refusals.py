@@ -92,6 +92,8 @@ CASES = [
     (["relation", "-c", "{d}/mu_empty.toml"], ["relation.mu_prep = []", "2 to 20"]),
     (["relation", "-c", "{d}/mu_high.toml"], ["relation.mu_prep", "5.5 is out of range"]),
     (["relation", "-c", "{d}/mu_huge.toml"], ["relation.mu_prep", "1000000.0 is out of range"]),
+    (["relation", "--quick", "--n-max", "nan"], ["--n-max = nan", "(0.0, 1.0)"]),
+    (["relation", "--quick", "--points", "1"], ["--points = 1", "[2, 50]"]),
     (["relation", "-c", "{d}/mu_text.toml"], ["relation.mu_prep = 'abc'", "[0, 5]"]),
     (["relation", "-c", "{d}/mu_falling.toml"], ["relation.mu_prep", "strictly increasing"]),
     (["relation", "-c", "{d}/n_lab_out.toml"], ["relation.n_lab", "[0.3253, 0.4571]", "0.5 is out"]),

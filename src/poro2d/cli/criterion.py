@@ -15,7 +15,6 @@ import typer
 from poro2d.cli import options as opt
 from poro2d.console import OutputConsole, Table, shown
 from poro2d.criterion.table import print_result
-from poro2d.errors import InputError
 from poro2d.store import Store
 from poro2d.sweep.results import DensityStateResult
 
@@ -71,14 +70,10 @@ def register(app: typer.Typer) -> None:
         check_output_dir("--out", out)  # a bad folder is named before the config is read
         series = opt.checked_vtk_every(vtk_every)
         given = {"n_lab": n_lab, "trial_porosity": trial, "threads": threads, "n_max": n_max, "n_min": n_min}
-        try:
+        with opt.named_as_typed(given, OPTION_NAMES):  # an option's value named as the user typed it
             case = CriterionCase.from_config(
                 config, preset=preset, seed=seed, mode=mode, seeds=seeds, **given, **series
             )
-        except InputError as exc:  # an option's value named as the option the user typed
-            if given.get(exc.parameter) is None:
-                raise
-            raise InputError(OPTION_NAMES[exc.parameter], exc.value, exc.allowed, exc.hint) from None
         store = Store(out)
         result = run_criterion_modes(case, store, options=RunOptions(progress=not quiet))
         if isinstance(result, DensityStateResult):

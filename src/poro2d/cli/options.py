@@ -9,6 +9,7 @@ more.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -111,3 +112,19 @@ def checked_vtk_every(value: int | None) -> dict[str, int]:
     from poro2d.labtest.settings import MAX_VTK_EVERY
 
     return {} if value is None else {"vtk_every": check_int("--vtk-every", value, 0, MAX_VTK_EVERY)}
+
+
+@contextmanager
+def named_as_typed(given: dict[str, Any], names: dict[str, str] | None = None):
+    """A refusal of one of ``given``'s arguments (a Python name, e.g. ``n_max``) raised again naming
+    the option the user typed (``--n-max``, or ``names[parameter]``); a refusal of an argument the
+    user left out (a config's value, named by its key) passes as it is."""
+    from poro2d.errors import InputError
+
+    try:
+        yield
+    except InputError as exc:
+        if given.get(exc.parameter) is None:
+            raise
+        option = (names or {}).get(exc.parameter, "--" + exc.parameter.replace("_", "-"))
+        raise InputError(option, exc.value, exc.allowed, exc.hint) from None

@@ -55,8 +55,9 @@ def relation_cmd(
 
     options = opt.job_options(workers, scheduler, quiet, dashboard)
     check_output_dir("--out", out)  # a bad folder is named before the config is read
-    case = RelationCase.from_config(config, preset=preset, points=points, n_max=n_max, n_min=n_min, mode=mode,
-                                    seeds=seeds, quick=quick)  # fmt: skip
+    given = {"points": points, "n_max": n_max, "n_min": n_min, "seeds": seeds}
+    with opt.named_as_typed(given):  # an option's value named as the user typed it
+        case = RelationCase.from_config(config, preset=preset, mode=mode, quick=quick, **given)
     store = Store(out)
     rel = run_relation(case, store, options=options, announce=banner)
     draw_relation(rel, store)
