@@ -17,10 +17,10 @@ import os
 import sys
 from pathlib import Path
 
-from cycler import cycler
 from matplotlib import rc_context
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.rcsetup import cycler  # matplotlib's own, checked cycler: no separate package to declare
 
 from poro2d.io_utils import atomic_path
 
