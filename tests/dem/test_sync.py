@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import numba
 import numpy as np
 import pytest
@@ -18,6 +20,7 @@ from poro2d.dem.sync import (
     barrier,
     fresh_sync,
     start_handshake,
+    wall_seconds,
 )
 
 
@@ -80,3 +83,11 @@ def test_one_thread_needs_no_partner():
     assert start_handshake(sync, 1)
     barrier(sync, 1)  # returns at once
     assert sync.tolist() == [0] * len(sync)
+
+
+def test_the_handshake_clock_reads_the_calendar_seconds():
+    # the handshake's deadline is read from C's time(NULL): it must be this clock in seconds
+    read = njit(lambda: wall_seconds())
+    before = int(time.time())
+    now = read()
+    assert before <= now <= int(time.time()) + 1

@@ -6,7 +6,10 @@ worker per thread once per kernel call and lets the workers meet at barriers bet
 the phases of each step (:mod:`poro2d.dem.kernels`). numba has no atomics of its own
 on the CPU, so the few this needs are written here as LLVM intrinsics: sequentially
 consistent loads, stores, fetch-and-add and compare-and-swap on ``int64`` array slots,
-plus ``sched_yield`` so a waiting thread gives its core away on a busy machine.
+plus ``sched_yield`` so a waiting thread gives its core away on a busy machine, and the C
+library's ``time`` so that the start handshake gives up after seconds of the clock, not after
+a count of yields (a yield lasts a scheduler slice on a loaded machine: 400 000 of them took
+minutes there).
 
 The shared ``sync`` array (``int64``, :data:`N_SYNC` slots) holds the barrier state,
 the start handshake and the run status that all workers read.
@@ -30,7 +33,10 @@ WAITING, GO, ABORTED = 0, 1, 2
 # waits must not yield: a system call per wait costs more than the wait and slows the
 # thread afterwards (measured: 2 threads went from 1.6x to 1.9x one thread's speed).
 SPINS = 200_000
-START_YIELDS = 400_000  # yields (about 0.2-1 s) before the start handshake gives up
+# Whole seconds of the clock (so START_WAIT_S - 1 to START_WAIT_S of waiting) before the start
+# handshake gives up. Workers that both run arrive within milliseconds; giving up costs only
+# speed, since the call then goes on with one thread and the same numbers.
+START_WAIT_S = 3
 
 
 def _slot_pointer(context, builder, sig, args):
@@ -113,6 +119,19 @@ def sched_yield(typingctx):
     return types.none(), codegen
 
 
+@intrinsic
+def wall_seconds(typingctx):
+    """C ``time(NULL)``: the calendar clock in whole seconds (``time_t`` is 64-bit here)."""
+
+    def codegen(context, builder, sig, args):
+        i8p = ir.IntType(8).as_pointer()
+        fnty = ir.FunctionType(ir.IntType(64), [i8p])
+        fn = cgutils.get_or_insert_function(builder.module, fnty, "time")
+        return builder.call(fn, [ir.Constant(i8p, None)])
+
+    return types.int64(), codegen
+
+
 @njit(cache=True)
 def barrier(sync, nthreads):
     """Wait until all ``nthreads`` workers have arrived (a sense-counting barrier).
@@ -142,7 +161,7 @@ def start_handshake(sync, nthreads):
     A threading layer may run two iterations of a parallel loop one after the other
     on one thread; workers that waited for each other at a barrier would then hang.
     Each worker arrives here first: the last arrival declares GO; a worker that has
-    waited START_YIELDS yields in vain declares ABORTED instead. Exactly one of the
+    waited START_WAIT_S seconds of the clock in vain declares ABORTED instead. Exactly one of the
     two wins (compare-and-swap), and every worker returns the same answer.
     """
     if nthreads <= 1:
@@ -150,12 +169,15 @@ def start_handshake(sync, nthreads):
     if atomic_add(sync, ARRIVED, 1) == nthreads - 1:
         atomic_cas(sync, START, WAITING, GO)
     waited = 0
+    since = 0
     while atomic_load(sync, START) == WAITING:
         waited += 1
-        if waited > SPINS:
+        if waited == SPINS:
+            since = wall_seconds()
+        elif waited > SPINS:
             sched_yield()
-        if waited > SPINS + START_YIELDS:
-            atomic_cas(sync, START, WAITING, ABORTED)
+            if wall_seconds() - since >= START_WAIT_S:
+                atomic_cas(sync, START, WAITING, ABORTED)
     return atomic_load(sync, START) == GO
 
 
