@@ -125,7 +125,8 @@ def fabric_blocks(series: Mapping[str, ShearSeriesResult], figures: Mapping[str,
         if name in figures:
             caption = (
                 f"Contact orientations at the peak and at the end, {t.normal_stress_kpa:g} kPa (first "
-                "specimen), with the second-order Fourier fit"
+                "specimen), with the second-order Fourier fit of that one record's histogram (the table's "
+                "values are smoothed over the peak window)"
             )
             b.append(("img", figures[name], caption))
     return b
