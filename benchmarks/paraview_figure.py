@@ -102,16 +102,25 @@ def draw_pyvista(vtu: Path, strain: float, out: Path) -> None:
     centres["radius"] = disks.point_data["radius"]
     disc = pv.Disc(inner=0.0, outer=0.5, c_res=32)  # ParaView's glyphs have a radius of 0.5
     glyphs = centres.glyph(scale="radius", factor=2.0, orient=False, geom=disc)
+    # each disk's rim as a thin line, so that touching neighbours of one grey are told apart
+    rim = disc.extract_feature_edges(
+        boundary_edges=True, non_manifold_edges=False, feature_edges=False, manifold_edges=False
+    )
+    rims = centres.glyph(scale="radius", factor=2.0, orient=False, geom=rim)
     lines = grid.extract_cells(np.flatnonzero(kind >= 2)).extract_surface(algorithm=None)
     width = 0.06 * float(centres["radius"].min())
     tubes = lines.cell_data_to_point_data().tube(radius=width, scalars="normal_force", radius_factor=8.0)
     plot = pv.Plotter(off_screen=True, window_size=(1100, 1500))
     plot.set_background("white")
     plot.add_mesh(glyphs, color="#d9d9d9", lighting=False)
+    plot.add_mesh(rims, color="#8c8c8c", line_width=1, lighting=False)
     bar = {"title": "normal force f_n (N)", "color": "black", "vertical": True, "position_x": 0.84}
     plot.add_mesh(tubes, scalars="normal_force", cmap="cividis", scalar_bar_args=bar)
     plot.add_mesh(grid.extract_cells(np.flatnonzero(kind == 1)), color="black", line_width=4)
-    plot.add_text(f"biaxial, sigma_3 = 100 kPa, axial strain {strain:.3f}", font_size=12, color="black")
+    title = plot.add_text(
+        f"biaxial, σ₃ = 100 kPa, axial strain ε₁ = {strain:.3f}", font_size=12, color="black"
+    )
+    symbol_font(title.GetTextProperty())
     x0, x1, y0, y1, _, _ = glyphs.bounds
     plot.view_xy()
     plot.camera.parallel_projection = True
@@ -120,6 +129,15 @@ def draw_pyvista(vtu: Path, strain: float, out: Path) -> None:
     plot.camera.parallel_scale = 0.56 * (y1 - y0)
     out.parent.mkdir(parents=True, exist_ok=True)
     plot.screenshot(str(out))
+
+
+def symbol_font(prop) -> None:
+    """Set a VTK text property to matplotlib's DejaVu Sans, which has the Greek letters and
+    subscript digits that VTK's own embedded fonts lack."""
+    from matplotlib import font_manager
+
+    prop.SetFontFamily(4)  # VTK_FONT_FILE: the font is read from the file below
+    prop.SetFontFile(font_manager.findfont("DejaVu Sans"))
 
 
 def main() -> None:

@@ -12,7 +12,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING, ClassVar, NamedTuple
 
 from poro2d.calibration.specimens import paper_criterion
 from poro2d.console import OutputConsole
@@ -23,10 +23,11 @@ from poro2d.io_utils import Provenance
 from poro2d.paper_data import PAPER, QUICK_SHEAR
 from poro2d.shear.lab import LabData, read_lab_csv
 from poro2d.shear.parts import LabRecord, QuasiStatic, ShearTestSummary
-from poro2d.shear.results import ReplicateShearResult
+from poro2d.shear.results import ReplicateShearResult, ShearSeriesResult
 from poro2d.specimen.specimen_set import SpecimenSet
 from poro2d.store import Store, claims
 from poro2d.store.stage import Fingerprint, ResumableStage
+from poro2d.sweep.records import SeedReplaced
 from poro2d.sweep.sensitivity_records import PaperNumbers
 from poro2d.typed_result import TypedResult
 
@@ -123,10 +124,14 @@ class PaperSummary(TypedResult):
     seed (None with one specimen); ``shear``: the pooled fit over the specimens, the first
     specimen's ``tests`` and ``quasi_static``, and ``replicates`` (None when the criterion
     did not converge); ``paper``: what the paper states, for the comparison; ``lab``: the
-    laboratory data given with ``--lab`` (source, kind, peaks), written only then.
+    laboratory data given with ``--lab`` (source, kind, peaks), written only then;
+    ``specimens_asked`` (``--replicates``), ``specimen_seeds`` (the seeds of the specimens sheared,
+    the first seed first) and ``seeds_replaced`` (each replicate seed not accepted, why, and the
+    seed tried in its place: None once the replacements were spent), written once the criterion
+    converged (absent in a summary of an earlier poro2d).
     """
 
-    OPTIONAL = ("lab",)
+    OPTIONAL = ("lab", "specimens_asked", "specimen_seeds", "seeds_replaced")
 
     quick: bool
     seed: int
@@ -138,6 +143,9 @@ class PaperSummary(TypedResult):
     timings: PaperTimings
     provenance: Provenance
     lab: LabRecord | None = None
+    specimens_asked: int | None = None
+    specimen_seeds: list[int] | None = None
+    seeds_replaced: list[SeedReplaced] | None = None
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "conversions": ConversionsRecord,
@@ -148,7 +156,52 @@ class PaperSummary(TypedResult):
         "timings": PaperTimings,
         "provenance": Provenance,
         "lab": LabRecord,
+        "seeds_replaced": SeedReplaced,
     }
+
+    @property
+    def specimens_short(self) -> int:
+        """How many of the specimens asked for were not sheared (0 when not recorded)."""
+        if self.specimens_asked is None or self.specimen_seeds is None:
+            return 0
+        return self.specimens_asked - len(self.specimen_seeds)
+
+
+def replaced_replicates(rows: list[ReplicateRow], asked: int) -> list[SeedReplaced]:
+    """The replicate seeds not accepted among ``rows`` (in seed order), each with the seed tried in
+    its place: the seeds after the ``asked`` first ones take the refused ones' places in turn, as
+    :func:`poro2d.criterion.replicates.run_replicates` tries them; None once they are spent."""
+    refused = [r for r in rows if not r.converged]
+    extra = [r.seed for r in rows[asked:]]
+    by = (extra + [None] * len(refused))[: len(refused)]
+    return [SeedReplaced(r.seed, r.message, b) for r, b in zip(refused, by, strict=True)]
+
+
+def count_specimens(summary: PaperSummary, asked: int) -> None:
+    """Record in ``summary`` the ``asked`` specimens (``--replicates``), the seeds of those sheared
+    and the replicate seeds not accepted; nothing when the criterion did not converge (no specimen)."""
+    if not summary.criterion.converged:
+        return
+    rows = summary.replicate_specimens or []
+    summary.specimens_asked = asked
+    summary.specimen_seeds = [summary.seed, *(r.seed for r in rows if r.converged)]
+    summary.seeds_replaced = replaced_replicates(rows, asked - 1)
+
+
+def specimen_lines(summary: PaperSummary) -> list[str]:
+    """What the answer is over, in words: each replicate seed not accepted with why and what took its
+    place, then how many of the specimens asked for were sheared (nothing when not recorded)."""
+    if summary.specimens_asked is None or summary.specimen_seeds is None:
+        return []
+    lines = [
+        f"replicate seed {r.seed} not accepted ({r.reason}): "
+        + ("no seed left to replace it" if r.replaced_by is None else f"replaced by seed {r.replaced_by}")
+        for r in summary.seeds_replaced or []
+    ]
+    seeds = ", ".join(map(str, summary.specimen_seeds))
+    lines.append(f"{len(summary.specimen_seeds)} of {summary.specimens_asked} specimens asked for were "
+                 f"accepted and sheared (seeds {seeds})")  # fmt: skip
+    return lines
 
 
 def paper_stage(store: Store, quick: bool, seed: int) -> ResumableStage:
@@ -232,7 +285,10 @@ def run_paper(case: PaperCase, store: Store, *, options: RunOptions = RunOptions
     crit = paper_criterion(store, quick, seed, case.threads, options.progress)
     stage = paper_stage(store, quick, seed)
     stage.check()  # and the folder: one of another paper run is refused before anything is written
-    summary, criterion, shear_figures = _run_stages(store, stage, crit, case, progress=options.progress)
+    summary, criterion, shear_figures, shear_series = _run_stages(
+        store, stage, crit, case, progress=options.progress
+    )
+    count_specimens(summary, case.replicates)
     store.write_result("results.json", summary)
     from poro2d.calibration.run import CalibrationResult
     from poro2d.report.paper_report import CALIBRATION_FOLDER, write_paper_report
@@ -240,18 +296,24 @@ def run_paper(case: PaperCase, store: Store, *, options: RunOptions = RunOptions
     # the report takes objects and opens no file: a calibration kept beside the run is read here
     calibration = CalibrationResult.read(store.child(CALIBRATION_FOLDER))
     md, html = write_paper_report(
-        out, summary, criterion, shear_figures=shear_figures, calibration=calibration
+        out,
+        summary,
+        criterion,
+        shear_figures=shear_figures,
+        calibration=calibration,
+        shear_series=shear_series,
     )
     console.print(f"results in {out}/results.json; report: {html} and {md}")
     return summary
 
 
 def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, case: PaperCase, *,
-                progress: bool) -> tuple[PaperSummary, CriterionOutputs, dict]:  # fmt: skip
+                progress: bool) -> tuple[PaperSummary, CriterionOutputs, dict, dict]:  # fmt: skip
     """Conversions, criterion, replicate specimens and direct shear (each read back when done).
 
-    Returns the summary, the criterion's results (its side files read through their classes)
-    and the shear figures written (by the names of the report's ``SHEAR_FIGURES``).
+    Returns the summary, the criterion's results (its side files read through their classes),
+    the shear figures written (by the names of the report's ``SHEAR_FIGURES`` and its fabric
+    section's) and each specimen's shear series with its curves, by label.
     """
     from poro2d.criterion.result import CriterionOutputs
     from poro2d.criterion.table import print_result
@@ -271,6 +333,7 @@ def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, ca
     print_result(result, store.child("criterion"))
     shear = reps = None
     shear_figures: dict[str, Path] = {}
+    shear_series: dict[str, ShearSeriesResult] = {}
     if result.converged:
         t2 = time.perf_counter()
         n2d = result.final_porosity
@@ -279,7 +342,9 @@ def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, ca
         timings["replicates_s"] = time.perf_counter() - t2
         for row in reps or []:
             draw_stored_criterion(store.child("replicates", row.folder))
-        shear, shear_figures = _shear_stage(specimens, store.child("shear"), quick, lab_data, progress)
+        shear, shear_figures, shear_series = _shear_stage(
+            specimens, store.child("shear"), quick, lab_data, progress
+        )
         timings["shear_s"] = time.perf_counter() - t2 - timings["replicates_s"]
     else:
         console.print("[yellow]criterion not converged: direct shear skipped[/]")
@@ -295,7 +360,7 @@ def _run_stages(store: Store, stage: ResumableStage, crit: PorosityCriterion, ca
         provenance=Provenance.now(),
         lab=lab_data.record() if lab_data is not None else None,
     )
-    return summary, CriterionOutputs.read(store.child("criterion"), result), shear_figures
+    return summary, CriterionOutputs.read(store.child("criterion"), result), shear_figures, shear_series
 
 
 def _conversions_stage(store: Store, stage: ResumableStage) -> ConversionsRecord:
@@ -309,10 +374,20 @@ def _conversions_stage(store: Store, stage: ResumableStage) -> ConversionsRecord
     return conv
 
 
-def _shear_stage(specimens: SpecimenSet, store: Store, quick: bool, lab_data,
-                 progress: bool) -> tuple[PaperShear, dict[str, Path]]:  # fmt: skip
-    """Direct shear at the paper's normal stresses on every specimen; the summary over them and
-    the figures written (Fig. 8 over the specimens, the first specimen's curves)."""
+class ShearStage(NamedTuple):
+    """What the direct shear stage hands the report: its summary, the figures written (by the
+    report's names) and each specimen's series with its curves, by label, the first first."""
+
+    summary: PaperShear
+    figures: dict[str, Path]
+    series: dict[str, ShearSeriesResult]
+
+
+def _shear_stage(specimens: SpecimenSet, store: Store, quick: bool, lab_data, progress: bool) -> ShearStage:
+    """Direct shear at the paper's normal stresses on every specimen: the summary over them, the
+    figures written (Fig. 8 over the specimens, the first specimen's curves, fabric and roses) and
+    the series."""
+    from poro2d.report.fabric_figures import draw_shear_fabric
     from poro2d.report.shear_figures import draw_replicate_shear
     from poro2d.shear.replicates import ReplicateShear
     from poro2d.shear.settings import ShearSettings
@@ -326,6 +401,7 @@ def _shear_stage(specimens: SpecimenSet, store: Store, quick: bool, lab_data,
                          options=RunOptions(progress=progress)).run()  # fmt: skip
     draw_replicate_shear(rep, store, lab_data)
     first_label, first = next(iter(rep.series.items()))
+    draw_shear_fabric(first, store.child(first_label))  # nothing for curves without fabric columns
     fit = rep.fit  # None with one normal stress
     phi, c, r2 = (fit.friction_angle_deg, fit.cohesion_kpa, fit.r2) if fit is not None else (None,) * 3
     ci = fit.friction_angle_ci_deg if fit is not None else None
@@ -350,5 +426,19 @@ def _shear_stage(specimens: SpecimenSet, store: Store, quick: bool, lab_data,
         "curves_replicates": store.path("fig8a_shear_curves_replicates.png"),
         "peaks_replicates": store.path("fig8b_peak_strength_replicates.png"),
         "curves_first": store.child(first_label).path("fig8a_shear_curves.png"),
+        **_fabric_figures(first, store.child(first_label)),
     }
-    return summary, figures
+    return ShearStage(summary, figures, rep.series)
+
+
+def _fabric_figures(series: ShearSeriesResult, store: Store) -> dict[str, Path]:
+    """The fabric figures ``series`` has in ``store`` by the report's names (none for curves without
+    fabric columns): its ``fabric.png`` and each test's rose."""
+    from poro2d.report.fabric_figures import CURVE_FIGURE, ROSE_FIGURE
+    from poro2d.report.paper_fabric import FABRIC_CURVES, rose_figure
+
+    found = {FABRIC_CURVES: (store, CURVE_FIGURE)}
+    found.update(
+        {rose_figure(t.normal_stress_kpa): (store.child(t.folder), ROSE_FIGURE) for t in series.tests}
+    )
+    return {name: where.path(file) for name, (where, file) in found.items() if where.has(file)}

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from poro2d.report.document import Block, write_report
+from poro2d.report.paper_fabric import fabric_blocks
 
 #: where ``poro2d calibrate --out`` puts a calibration the paper report shows (``paper-out/calibration``)
 CALIBRATION_FOLDER = "calibration"
@@ -43,13 +44,17 @@ def build_blocks(
     shear_figures: dict[str, Path] | None = None,
     calibration: Any = None,
     sensitivity: Any = None,
+    shear_series: dict | None = None,
 ) -> list[Block]:
-    """The report's blocks: summary, inputs, conversions, criterion, sensitivity, shear, provenance.
+    """The report's blocks: summary, inputs, conversions, criterion, sensitivity, shear, fabric,
+    provenance.
 
     ``summary``: the case study's ``PaperSummary``; ``criterion``: its criterion's results
     (a ``CriterionOutputs``); ``shear_figures``: the shear figures written, by a name of
     :data:`SHEAR_FIGURES`; ``calibration``: a ``CalibrationResult`` kept in
-    ``out/calibration``; ``sensitivity``: a ``SensitivityResult`` to explain the paper's value.
+    ``out/calibration``; ``sensitivity``: a ``SensitivityResult`` to explain the paper's value;
+    ``shear_series``: each specimen's ``ShearSeriesResult`` with its curves, by label, the first
+    specimen first (their fabric's section; its figures among ``shear_figures``).
     """
     crit = criterion.result
     b = _intro_blocks(summary, crit)
@@ -62,6 +67,7 @@ def build_blocks(
         b += report_blocks(sensitivity)
     if summary.shear:
         b += _shear_blocks(summary.shear, shear_figures or {})
+        b += fabric_blocks(shear_series or {}, shear_figures or {})
     b += _calibration_blocks(calibration, out / CALIBRATION_FOLDER)
     b += _provenance_blocks(summary, crit)
     return b
@@ -118,7 +124,24 @@ def _intro_blocks(summary, crit) -> list[Block]:
         rows.append([f"friction angle from peak strengths{label} (deg)", phi, "not stated"])
     b.append(("table", ["quantity", "poro2d", "paper"], rows))
     b.append(("note", crit.message if crit.message is not None else "criterion not run"))
-    return b
+    return b + _specimen_blocks(summary)
+
+
+def _specimen_blocks(summary) -> list[Block]:
+    """How many of the specimens asked for were sheared, and the seeds refused (a summary of an
+    earlier poro2d did not record it: nothing)."""
+    asked, seeds = getattr(summary, "specimens_asked", None), getattr(summary, "specimen_seeds", None)
+    if asked is None or seeds is None:
+        return []
+    refused = [
+        f"replicate seed {r.seed} not accepted ({r.reason}): "
+        + ("no seed left to replace it" if r.replaced_by is None else f"replaced by seed {r.replaced_by}")
+        for r in summary.seeds_replaced or []
+    ]
+    text = f"Specimens sheared: {len(seeds)} of the {asked} asked for (seeds {', '.join(map(str, seeds))})."
+    if len(seeds) < asked:
+        text += " The direct shear results below are over fewer specimens than asked for."
+    return [("note" if len(seeds) < asked else "p", text), *([("ul", refused)] if refused else [])]
 
 
 #: what paper mode is and is not, said before any number (the report's first note)
