@@ -71,6 +71,11 @@ def test_fabric_figures_are_print_ready(tmp_path):
     roses = FabricRoses.of("gamma", np.array([0.0, 1.0]), [hist, hist], peak=0)
     texts = check_print_ready(plot_rose(roses, tmp_path / "rose.png", title=r"$\sigma_3$ = 100 kPa"))
     assert any("a_c" in t for t in texts)
+    # where along the test a rose was taken reads as a quantity, not as the curve's column name
+    shear = FabricRoses.of("shear_displacement_mm", np.array([0.0, 3.25]), [hist, hist], peak=1)
+    texts = check_print_ready(plot_rose(shear, tmp_path / "shear_rose.png", title="direct shear"))
+    assert not any("_mm" in t for t in texts)
+    assert any("3.25 mm" in t for t in texts)
     gamma = np.linspace(0.0, 2.0, 20)
     curve = {"gamma": gamma, "a_c": 0.2 + 0 * gamma, "a_n": 0.3 + 0 * gamma, "a_t": 0.05 + 0 * gamma,
              "z_mech": 3.4 + 0 * gamma}  # fmt: skip

@@ -51,6 +51,20 @@ def _density(rose: Rose) -> tuple[np.ndarray, np.ndarray, float]:
     return edges, np.concatenate([density, density]), width
 
 
+#: a rose's axis column as its title writes it: symbol, unit
+AXIS_SYMBOLS = {
+    "shear_displacement_mm": ("shear displacement $u$", " mm"),
+    "axial_strain": (r"axial strain $\varepsilon_1$", ""),
+    "gamma": (r"shear strain $\gamma$", ""),
+}
+
+
+def axis_at(axis: str, at: float) -> str:
+    """Where along its test a rose was taken, in symbols (``u = 3.2 mm``)."""
+    symbol, unit = AXIS_SYMBOLS.get(axis, (axis.replace("_", " "), ""))
+    return f"{symbol} = {at:.4g}{unit}"
+
+
 def plot_rose(roses: FabricRoses, path: str | os.PathLike, *, title: str) -> Path | None:
     """The rose diagram of the roses at hand (peak, end) with their fitted Fourier density; None
     when neither is at hand."""
@@ -67,7 +81,7 @@ def plot_rose(roses: FabricRoses, path: str | os.PathLike, *, title: str) -> Pat
         )
         ax.plot(theta, fourier_rose(np.degrees(theta), a_c, theta_c), color="k", lw=1.2)
         ax.set_title(
-            f"{name}: {roses.axis} = {rose.at:.4g}, {rose.contacts} contacts\n"
+            f"{name}: {axis_at(roses.axis, rose.at)}, {rose.contacts} contacts\n"
             f"2nd-order fit (line): $a_c$ = {a_c:.3f}, $\\theta_c$ = {theta_c:.0f}$\\degree$", fontsize=8,
         )  # fmt: skip
         ax.set_yticklabels([])
