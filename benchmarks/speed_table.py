@@ -206,7 +206,8 @@ class LammpsBlocks:
         if self.omp is not None:
             self.omp.block(steps)
         if self.mpi is not None:
-            res = time_lammps(self.sim, "MPI-2 block", steps, 1, self.settle, mpi_ranks=2)
+            # a fresh process per block: a tenth of the sessions' settling builds its contacts
+            res = time_lammps(self.sim, "MPI-2 block", steps, 1, max(20, self.settle // 10), mpi_ranks=2)
             self.mpi.append(math.nan if res is None else res["particle_steps_per_s"])
 
     def close(self) -> dict[str, list[float]]:
@@ -253,6 +254,7 @@ def _round_ratios(a: list[float], b: list[float]) -> list[float]:
 
 
 def engine_part(args: argparse.Namespace, machine: dict) -> list[EngineRow]:
+    """Every size in turn; the table is written after each, so a run stopped keeps what it measured."""
     plan = QUICK_PLAN if args.quick else PLAN
     base, _ = paper_simulation(args.out, args.rebuild)
     rows = []
@@ -266,16 +268,22 @@ def engine_part(args: argparse.Namespace, machine: dict) -> list[EngineRow]:
         )  # fmt: skip
         machine["lammps"] = version or machine.get("lammps", "not run")
         print(f"[{size}] done in {time.perf_counter() - t0:.0f} s", flush=True)
-        print(engine_markdown([row]), flush=True)
         rows.append(row)
+        write_table(args.out, machine, rows, [])
+        print(engine_markdown([row]), flush=True)
     return rows
 
 
 # ------------------------------------------------------------------ protocol part
 
 
-def protocol_part(args: argparse.Namespace) -> list[ProtocolRow]:
-    return [time_command(name, cmds[1] if args.quick else cmds[0]) for name, cmds in PROTOCOLS.items()]
+def protocol_part(args: argparse.Namespace, machine: dict, engine: list[EngineRow]) -> list[ProtocolRow]:
+    """Every command in turn, the table written after each (with the engine part's rows)."""
+    rows = []
+    for name, cmds in PROTOCOLS.items():
+        rows.append(time_command(name, cmds[1] if args.quick else cmds[0]))
+        write_table(args.out, machine, engine, rows)
+    return rows
 
 
 def time_command(name: str, words: list[str]) -> ProtocolRow:
@@ -417,7 +425,7 @@ def main(argv: list[str] | None = None) -> int:
         print("numba sees one thread only: the engine part needs 2", file=sys.stderr)
         return 2
     engine = engine_part(args, info) if args.only in ("all", "engine") else []
-    protocols = protocol_part(args) if args.only in ("all", "protocols") else []
+    protocols = protocol_part(args, info, engine) if args.only in ("all", "protocols") else []
     info["uptime_end"] = _uptime()
     md = write_table(args.out, info, engine, protocols)
     print()
