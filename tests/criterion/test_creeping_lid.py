@@ -11,7 +11,7 @@ once held at equilibrium, as before.
 import numpy as np
 import pytest
 
-from poro2d.criterion.lid import CREEP_D50, CREEP_FRICTION, FlatPlate, SegmentedLid, contact_switches
+from poro2d.criterion.lid import CREEP_FRICTION, FlatPlate, SegmentedLid, contact_switches
 from poro2d.criterion.servo import PlateServo
 from poro2d.criterion.settings import CriterionSettings
 from poro2d.dem import checkpoint
@@ -37,14 +37,14 @@ def test_only_a_lid_is_creeping_and_only_when_told():
 def loose():
     """A small frictional (loose) preparation of the paper's grading, looser than it packs by
     itself (0.216 at mu_prep 1.0): the lid comes down onto its surface."""
-    spec = SpecimenSpec(width=0.1, height=0.05, layers=1, friction_prep=1.0)
+    spec = SpecimenSpec(width=0.08, height=0.03, layers=1, friction_prep=1.0)  # about 150 disks
     sim, _ = prepare_specimen(spec, paper_grading(), 0.235, seed=2)
     return spec, sim
 
 
 def _rest(spec, sim0, tmp_path, creeps: bool):
     sim = checkpoint.load(checkpoint.save(sim0, tmp_path / f"creeps{creeps}.npz"))
-    settings = CriterionSettings(acceptance="fill", force_fraction=0.05, max_plate_steps=300_000)
+    settings = CriterionSettings(acceptance="fill", force_fraction=0.05, max_plate_steps=600_000)
     servo = PlateServo(settings, spec.ratio, spec.equilibrium, spec.height)
     weight = float(np.sum(sim.particles.mass)) * 9.81 / sim.particles.thickness
     d50 = mass_d50(sim.particles.radius)
@@ -59,4 +59,4 @@ def test_the_creeping_lid_comes_to_rest_where_the_old_one_does(loose, tmp_path):
     assert old.settled and new.settled
     # the same rest height within a tenth of a grain (the old lid's own drift bound is 1e-4 H)
     assert new.height_m == pytest.approx(old.height_m, abs=0.1 * d50)
-    assert CREEP_D50 * d50 < 0.1 * d50
+    assert new.steps < old.steps  # measured: 133 700 against 169 600

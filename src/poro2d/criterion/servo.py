@@ -191,18 +191,18 @@ class PlateServo:
         )
         if not top.creeps:
             top.hold(sim)
-        # a creeping lid comes to equilibrium still servoed to its force (a held one ended at the
-        # window's edge, the creep having loaded it while the grains came to rest), then is held
+        # a creeping lid comes to equilibrium still servoed to its force, and is held there: held
+        # first, the grains creeping away from it left segments out of contact at equilibrium
         res = sim.solve(self.ratio, min(left(), 20 * s.check_every), measure=self.equilibrium)
-        top.hold(sim)
         steps += res.steps
+        top.hold(sim)
         f = top.force(sim) / t
         _log.debug(
             "plate round %d: F_top %.4g N/m (limit %.4g), held: converged %s ratio %.3g, %d steps",
             rounds, f, cap, res.converged, res.max_ratio, steps,
         )  # fmt: skip
         ok = in_window(f, weight, s.force_fraction) and top.resting(sim, target)
-        return steps, ok, res.measured_ratio
+        return steps, ok and (res.converged or not top.creeps), res.measured_ratio
 
     def holds(self, sim: Simulation, top: FlatPlate | SegmentedLid, target: float, weight: float) -> bool:
         """F_top in the window, with a lid resting on the specimen over most of the width."""
