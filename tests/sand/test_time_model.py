@@ -14,10 +14,10 @@ TOYOURA = {
 
 
 def test_lid_steps_rise_with_the_preparation_friction_between_measured_points():
-    assert PF.lid_steps(0.0) == 17_000 and PF.lid_steps(1.0) == 415_000
+    assert PF.lid_steps(0.0) == 17_000 and PF.lid_steps(1.0) == 255_000
     # halfway between (0.1, 37 000) and (0.5, 71 000) lies mu 0.3: 37 000 + 0.5 x 34 000
     assert PF.lid_steps(0.3) == pytest.approx(54_000)
-    assert PF.lid_steps(5.0) == 415_000  # flat beyond the most frictional point measured
+    assert PF.lid_steps(5.0) == 255_000  # flat beyond the most frictional point measured
 
 
 def test_trials_per_case_are_the_measured_ones_by_stage():
@@ -32,8 +32,8 @@ def test_a_trials_steps_are_its_layers_growth_and_settling_and_its_lid():
     spec = SpecimenSpec(width=0.1, height=0.05, layers=3, growth_increments=40, growth_steps=150)
     # 3 layers x (40 x 150 + 18 000 x 2) at half the paper grading's step
     assert PF.preparation_steps(spec, 2.0) == pytest.approx(3 * (6_000 + 36_000))
-    # 1.5 trials x (126 000 + 415 000 x 2)
-    assert PF.case_steps(spec, 1.0, 1.5, 2.0) == pytest.approx(1.5 * (126_000 + 830_000))
+    # 1.5 trials x (126 000 + 255 000 x 2)
+    assert PF.case_steps(spec, 1.0, 1.5, 2.0) == pytest.approx(1.5 * (126_000 + 510_000))
 
 
 def test_cases_go_to_the_worker_that_frees_first_the_longest_first():
