@@ -126,7 +126,10 @@ class PlateServo:
         F_top checked once more (the final ratio is reported); if it left the window, a new
         round starts. A lid is driven the same way, its segments each to their share of
         the force, and counts as in the window only while it rests on the specimen over
-        most of the width. ``weight``: the self weight G (N/m).
+        most of the width. A creeping lid (a frictional preparation's,
+        :class:`~poro2d.criterion.lid.SegmentedLid`) leaves its approach once near the window,
+        settles until it no longer creeps, comes to equilibrium still servoed and is then held;
+        its round counts only at equilibrium. ``weight``: the self weight G (N/m).
 
         Returns the plate stage's record (:class:`PlateSettle`): whether it settled, the
         steps and rounds, the final unbalanced-force ratio, the displacement and height.
