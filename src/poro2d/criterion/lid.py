@@ -45,6 +45,22 @@ LID_FRICTION = 0.0
 #: median segment carries several times its share while others barely touch)
 TOUCH_SHARE = 0.0
 
+#: a preparation this frictional (mu_prep) or more creeps under the lid for long: its lid is a
+#: creeping lid (:class:`SegmentedLid`). Measured per trial (calibration boxes of Toyoura sand and
+#: CB-Mix-2, 2 800-4 100 disks, at the paper grading's time step): 17 000-37 000 lid steps at mu_prep
+#: 0-0.1, 71 000 at 0.5 and 415 000 at 1.0, where its force flickers in and out of the window
+CREEP_FRICTION = 0.5
+
+#: a creeping lid leaves its brisk approach once it rests under less than this many times the force
+#: window's limit (its gentle servo takes it into the window): on a loose Toyoura surface the
+#: brisk servo kept the lid at 3 to 8 times the limit for hundreds of thousands of steps
+CREEP_SWITCH = 10.0
+
+#: a creeping lid is at rest when its mean height moved less than this many d50 over the servo's
+#: ``settle_checks`` checks: a creep slower than a grain's size over thousands of such windows,
+#: which the held lid's final check at equilibrium then judges
+CREEP_D50 = 0.005
+
 
 @dataclass(frozen=True)
 class LidProfile:
@@ -149,6 +165,8 @@ class FlatPlate:
     consolidation drive it: one rigid wall that moves down to compress."""
 
     name = "plate"
+    #: a plate is judged on its force at every check (:class:`SegmentedLid`'s ``creeps``)
+    creeps = False
 
     def __init__(self, sim: Simulation) -> None:
         self.index = sim.walls.index("top")
@@ -178,14 +196,24 @@ class SegmentedLid:
     """The lid of the fill acceptance (module docstring), driven like the plate.
 
     ``min_share``: the share of the width whose segments must rest on the specimen
-    before the lid counts as resting.
+    before the lid counts as resting. ``creeps``: the lid of a frictional preparation
+    (mu_prep at least ``CREEP_FRICTION``), whose surface creeps for long: the force on a
+    segment there is a fraction of one grain's weight against the grains' shaking, so it
+    flickers in and out of the window at every check. Such a lid ends its approach once it
+    rests over most of the width, and its settling once its height creeps less than
+    ``CREEP_D50`` d50 (:class:`~poro2d.criterion.servo.PlateServo`); the force window is
+    asked of it once held, at equilibrium, as of every lid.
     """
 
     name = "lid"
 
-    def __init__(self, sim: Simulation, width: float, d50: float, min_share: float = 0.75) -> None:
+    def __init__(
+        self, sim: Simulation, width: float, d50: float, min_share: float = 0.75, creeps: bool = False
+    ) -> None:
         self.width = float(width)
         self.min_share = float(min_share)
+        self.creeps = bool(creeps)
+        self.d50 = float(d50)
         if not lid_indices(sim):
             install_lid(sim, width, d50)
 
@@ -208,6 +236,13 @@ class SegmentedLid:
 
     def resting(self, sim: Simulation, total: float) -> bool:
         return touching_share(sim, total, self.width) >= self.min_share
+
+
+def contact_switches(touching: np.ndarray) -> int:
+    """How often a lid went from resting to not or back along a history of checks (``touching``: one
+    flag a check): the chattering of an approach on a surface that creeps away from it."""
+    t = np.asarray(touching, dtype=bool)
+    return int(np.count_nonzero(t[1:] != t[:-1]))
 
 
 def lid_shape(sim: Simulation, width: float) -> tuple[np.ndarray, np.ndarray] | None:

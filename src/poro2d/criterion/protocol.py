@@ -38,6 +38,7 @@ import numpy as np
 
 from poro2d.config import check_finite
 from poro2d.criterion.lid import (
+    CREEP_FRICTION,
     FlatPlate,
     SegmentedLid,
     fill_porosity,
@@ -555,7 +556,8 @@ class PorosityCriterion:
                         "lid", box_porosity(sim.particles.area(), width, first.height_m), first
                     )
                     return stage, self._after_top(sim, k, n)
-            lid = SegmentedLid(sim, width, mass_d50(sim.particles.radius))
+            creeps = self.spec.friction_prep >= CREEP_FRICTION
+            lid = SegmentedLid(sim, width, mass_d50(sim.particles.radius), creeps=creeps)
             settle = servo.settle(sim, weight, lid)
             profile = lid_profile(sim, width)
             stage = PlateStage(

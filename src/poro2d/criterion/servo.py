@@ -15,7 +15,7 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass
 
-from poro2d.criterion.lid import FlatPlate, SegmentedLid
+from poro2d.criterion.lid import CREEP_D50, CREEP_SWITCH, FlatPlate, SegmentedLid
 from poro2d.criterion.settings import CriterionSettings
 from poro2d.dem import Simulation
 from poro2d.dem.export import frame_of
@@ -126,7 +126,10 @@ class PlateServo:
         F_top checked once more (the final ratio is reported); if it left the window, a new
         round starts. A lid is driven the same way, its segments each to their share of
         the force, and counts as in the window only while it rests on the specimen over
-        most of the width. ``weight``: the self weight G (N/m).
+        most of the width. A creeping lid (a frictional preparation's,
+        :class:`~poro2d.criterion.lid.SegmentedLid`) leaves its approach once near the window,
+        settles until it no longer creeps, comes to equilibrium still servoed and is then held;
+        its round counts only at equilibrium. ``weight``: the self weight G (N/m).
 
         Returns the plate stage's record (:class:`PlateSettle`): whether it settled, the
         steps and rounds, the final unbalanced-force ratio, the displacement and height.
@@ -189,16 +192,20 @@ class PlateServo:
         steps += settle_until(
             sim, self._settled(top, target, weight), left(), every=s.check_every, also=self.watch(sim, top)
         )
-        top.hold(sim)
+        if not top.creeps:
+            top.hold(sim)
+        # a creeping lid comes to equilibrium still servoed to its force, and is held there: held
+        # first, the grains creeping away from it left segments out of contact at equilibrium
         res = sim.solve(self.ratio, min(left(), 20 * s.check_every), measure=self.equilibrium)
         steps += res.steps
+        top.hold(sim)
         f = top.force(sim) / t
         _log.debug(
             "plate round %d: F_top %.4g N/m (limit %.4g), held: converged %s ratio %.3g, %d steps",
             rounds, f, cap, res.converged, res.max_ratio, steps,
         )  # fmt: skip
         ok = in_window(f, weight, s.force_fraction) and top.resting(sim, target)
-        return steps, ok, res.measured_ratio
+        return steps, ok and (res.converged or not top.creeps), res.measured_ratio
 
     def holds(self, sim: Simulation, top: FlatPlate | SegmentedLid, target: float, weight: float) -> bool:
         """F_top in the window, with a lid resting on the specimen over most of the width."""
@@ -206,13 +213,25 @@ class PlateServo:
         return in_window(f, weight, self.settings.force_fraction) and top.resting(sim, target)
 
     def _approached(self, top: FlatPlate | SegmentedLid, target: float, weight: float) -> StopRule:
-        """The approach's stop test: F_top in the window for ``window_checks`` checks running."""
+        """The approach's stop test: F_top in the window for ``window_checks`` checks running.
+
+        A creeping lid switches to the gentle servo at the first check that finds it resting on
+        the specimen under less than ``CREEP_SWITCH`` times the window's limit: the brisk servo
+        only bangs its segments on the creeping grains from there (a segment out of contact
+        comes down at full speed), and the gentle one takes the force into the window.
+        """
         s = self.settings
+        need = 1 if top.creeps else s.window_checks
         streak = [0]
 
+        def near(sm: Simulation) -> bool:
+            f = top.force(sm) / sm.particles.thickness
+            return f < CREEP_SWITCH * s.force_fraction * weight and top.resting(sm, target)
+
         def steady(sm: Simulation) -> bool:
-            streak[0] = streak[0] + 1 if self.holds(sm, top, target, weight) else 0
-            return streak[0] >= s.window_checks
+            ok = near(sm) if top.creeps else self.holds(sm, top, target, weight)
+            streak[0] = streak[0] + 1 if ok else 0
+            return streak[0] >= need
 
         return steady
 
@@ -221,8 +240,13 @@ class PlateServo:
 
         At rest means at equilibrium, or a plate that rests in the window while the
         specimen only creeps (its drift over the last ``settle_checks`` checks below
-        ``plate_drift`` x H).
+        ``plate_drift`` x H). A creeping lid (:class:`~poro2d.criterion.lid.SegmentedLid`) is
+        at rest once it rests on the specimen and its drift over those checks is below
+        ``CREEP_D50`` d50, whatever its force at the check: the held lid's force is judged at
+        equilibrium afterwards.
         """
+        if top.creeps:
+            return self._crept(top, target)
         s = self.settings
         calm: list[float] = []
 
@@ -238,6 +262,21 @@ class PlateServo:
             return max(calm[-s.settle_checks :]) - min(calm[-s.settle_checks :]) < s.plate_drift * self.height
 
         return settled
+
+    def _crept(self, lid: SegmentedLid, target: float) -> StopRule:
+        """A creeping lid's settling test: resting at this check, its height within ``CREEP_D50``
+        d50 over the last ``settle_checks`` checks. A check where it rests on less of the width
+        does not start the count again: on a creeping surface the segments' contacts flicker too,
+        while the lid's height tells whether it still moves."""
+        n = self.settings.settle_checks
+        heights: list[float] = []
+
+        def crept(sm: Simulation) -> bool:
+            heights.append(lid.height(sm))
+            calm = len(heights) >= n and max(heights[-n:]) - min(heights[-n:]) < CREEP_D50 * lid.d50
+            return calm and lid.resting(sm, target)
+
+        return crept
 
 
 __all__ = ["PlateServo", "PlateSettle", "in_window", "rises_free_to_roll"]

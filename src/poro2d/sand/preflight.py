@@ -6,12 +6,15 @@ critical step for the lightest disk (:func:`poro2d.specimen.compaction.time_step
 grading's frictionless jamming porosity (:mod:`poro2d.oracles.jamming`, an energy
 minimisation, not a DEM run) places the first trials. The run time is a model:
 
-    particle-steps = disks x steps per trial x trials per case
+    particle-steps of a case = disks x (trials x preparation steps + trials x lid steps(mu_prep))
 
-with the steps per trial measured on this engine (``PLATE_STEPS``, ``SETTLE_STEPS``; both
-scale with 1 / dt, since the lid travels at a set speed and layers settle in physical time)
-and ``THROUGHPUT`` particle-steps per second per core. It is an estimate to choose a box
-and an up-scaling with, printed as such; the run prints its own measured pace.
+fitted to the stages of measured runs (:data:`LID_STEPS`, :data:`SETTLE_STEPS`, the trials
+per case :func:`trials_per_case`; steps scale with 1 / dt, since the lid travels at a set speed
+and layers settle in physical time), ``THROUGHPUT`` particle-steps per second per core (or the
+machine's own, given), and the cases laid out on the workers as the sweep runs them, the
+longest first (:func:`wall_seconds`): the calibration's ends, then the two frictions around
+the state, then the specimens. It is an estimate to choose a box and an up-scaling with,
+printed as such; the run prints its own measured pace.
 """
 
 from __future__ import annotations
@@ -38,16 +41,27 @@ from poro2d.typed_result import TypedResult
 
 #: particle-steps per second per core assumed by the estimate: measured 2.0e7 (lid) to 2.7e7
 #: (preparation) per core with both cores running cases (Toyoura sand, 4 100 and 10 800 disks,
-#: docs/sand.md), less on a machine busy with other work (1.2e7-1.9e7 seen)
+#: docs/sand.md), less on a machine busy with other work (0.6e7-1.2e7 seen); ``throughput`` of
+#: :func:`preflight` takes the machine's own
 THROUGHPUT = 2.0e7
-#: lid/plate steps of one trial at the paper grading's time step (the fill acceptance's lid
-#: approach and settling: 258 000 steps per trial on a uniform fine sand whose step is 0.53 of
-#: the paper grading's, 100 000-140 000 on the paper grading)
-PLATE_STEPS = 136_000
-#: settling steps of one layer after its growth, at the paper grading's time step
-SETTLE_STEPS = 3_000
-#: criterion trials per case: the first trial, then the refined one (fill acceptance, 0.002)
-TRIALS_PER_CASE = 2.0
+#: lid steps of one trial at the paper grading's time step, by preparation friction (mu_prep, steps;
+#: linear between): the mean per trial of the calibration cases of Toyoura sand and CB-Mix-2 in
+#: their calibration boxes (2 seeds each; 2 800-4 100 disks): 17 000, 37 000, 71 000 and 415 000
+#: at 0, 0.1, 0.5 and 1.0 with the lid that chattered; the creeping lid of mu_prep 1.0 took 0.61
+#: of the old lid's steps per trial on small boxes of Toyoura sand (3 seeds, docs/criterion.md),
+#: hence 255 000 (0.5 keeps its measured 71 000, an upper bound)
+LID_STEPS = ((0.0, 17_000), (0.1, 37_000), (0.5, 71_000), (1.0, 255_000))
+#: settling steps of one layer after its growth (the layer's and the working friction's stages),
+#: at the paper grading's time step: 13 600-29 400 measured per layer on the same runs
+SETTLE_STEPS = 18_000
+#: criterion trials per case, measured on the same runs: the dense end accepts its first trial
+#: (4 of 4), the loose end needs 1.5 (its lid pushes the first trial over), the frictions around
+#: the state 2 (refined to 0.002 from the predicted first trial: 1 to 4), the full-size
+#: specimens 1.33 (4 of 6 seeds at their first trial)
+TRIALS_DENSE_END = 1.0
+TRIALS_LOOSE_END = 1.5
+TRIALS_BRACKET = 2.0
+TRIALS_SPECIMEN = 1.33
 #: the jamming reference's disks: enough for phi_J within its seed spread (docs/jamming.md);
 #: a wide grading whose largest disks need a bigger cell gets up to ``JAMMING_MAX_DISKS``
 JAMMING_DISKS = 1500
@@ -122,8 +136,10 @@ class Preflight(TypedResult):
     #: the finest disk's own step, only when the light disks' inertial masses are raised in the
     #: quasi-static stages (``time_step_s`` is then the step they share; docs/density-scaling.md)
     time_step_unscaled_s: float | None = None
+    #: particle-steps per second per core the run time was estimated at (files before it: not said)
+    throughput: float | None = None
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("time_step_unscaled_s",)
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("time_step_unscaled_s", "throughput")
     #: the typed parts, as their classes read them
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "box": BoxPlan,
@@ -253,25 +269,109 @@ def _compute_jamming(grading: GradingCurve, seeds: int) -> Jamming:
     return Jamming(ref.porosity_mean, ref.porosity_std, n, seeds, ref.seconds, note)
 
 
-def _steps_per_trial(spec: SpecimenSpec, dt: float, dt_paper: float) -> float:
-    slow = dt_paper / dt
-    per_layer = spec.growth_increments * spec.growth_steps + SETTLE_STEPS * slow
-    return spec.layers * per_layer + PLATE_STEPS * slow
+def lid_steps(mu: float) -> float:
+    """Lid steps of one trial at the paper grading's time step for preparation friction ``mu``
+    (:data:`LID_STEPS`, linear between its points, flat beyond them)."""
+    mus, steps = zip(*LID_STEPS, strict=True)
+    return float(np.interp(mu, mus, steps))
+
+
+def preparation_steps(spec: SpecimenSpec, slow: float) -> float:
+    """Steps of one trial's preparation: each layer's growth, then its settling (``SETTLE_STEPS`` x
+    ``slow``, the paper grading's time step over this one's)."""
+    return spec.layers * (spec.growth_increments * spec.growth_steps + SETTLE_STEPS * slow)
+
+
+def trials_per_case(mu: float, mus: tuple[float, ...], stage: str) -> float:
+    """Criterion trials a case needs, as measured: the calibration's dense end, loose end or a
+    friction between them (``mus``: the calibration's frictions), or a full-size specimen."""
+    if stage == "specimens":
+        return TRIALS_SPECIMEN
+    if mu <= mus[0]:
+        return TRIALS_DENSE_END
+    return TRIALS_LOOSE_END if mu >= mus[-1] else TRIALS_BRACKET
+
+
+def friction_at_share(u: float, mus: tuple[float, ...]) -> float:
+    """The preparation friction whose n2D lies at the share ``u`` (0 dense, 1 loose) between the
+    two ends: the rise of n2D with friction has one shape across gradings (steep at low friction,
+    flat towards 1; ``FILL_FIRST_TRIALS``), inverted here and bounded by the ends ``mus``."""
+    from poro2d.sweep.density import FILL_FIRST_TRIALS
+
+    mu_ref, n_ref = (np.array(v) for v in zip(*FILL_FIRST_TRIALS, strict=True))
+    shape = (n_ref - n_ref[0]) / (n_ref[-1] - n_ref[0])
+    mu = float(np.interp(min(max(u, 0.0), 1.0), shape, mu_ref))
+    return min(max(mu, mus[0]), mus[-1])
+
+
+def bracket(mus: tuple[float, ...], mu: float) -> list[float]:
+    """The calibration frictions that enclose ``mu``: the ends and its two neighbours."""
+    inner = [m for m in mus if m <= mu][-1:] + [m for m in mus if m > mu][:1]
+    return sorted({mus[0], mus[-1], *inner})
+
+
+def expected_friction(case: SandCase) -> float:
+    """The preparation friction the state will need, before any calibration: its share between
+    the 2D extremes taken as 1 - Dr (:func:`friction_at_share`)."""
+    from poro2d.criterion.density import lab_relative_density
+
+    dr = lab_relative_density(case.lab.n_lab, case.n_max, case.n_min)
+    return friction_at_share(1.0 - dr, case.mus)
+
+
+@dataclass(frozen=True)
+class CasePlan:
+    """The cases of one stage as the estimate counts them: a friction and a seed count each."""
+
+    frictions: tuple[float, ...]
+    seeds: int
+    stage: str
+
+    @property
+    def count(self) -> int:
+        return len(self.frictions) * self.seeds
+
+
+def case_plans(case: SandCase) -> tuple[CasePlan, CasePlan, CasePlan]:
+    """The calibration's ends, the frictions around the state (those that are not ends), the specimens."""
+    mus = case.mus
+    mu = expected_friction(case)
+    inner = tuple(m for m in bracket(mus, mu) if m not in (mus[0], mus[-1]))
+    return (
+        CasePlan((mus[-1], mus[0]), case.calibration_seeds, "calibration"),
+        CasePlan(inner, case.calibration_seeds, "calibration"),
+        CasePlan((mu,), case.seeds, "specimens"),
+    )
+
+
+def case_steps(spec: SpecimenSpec, mu: float, trials: float, slow: float) -> float:
+    """Steps of one case: ``trials`` preparations and lid stages at friction ``mu``."""
+    return trials * (preparation_steps(spec, slow) + lid_steps(mu) * slow)
+
+
+def wall_seconds(cases: list[float], workers: int) -> float:
+    """Wall time of cases of ``cases`` seconds each on ``workers`` cores: the longest first, each
+    to the worker that frees first (as a sweep hands them out), the last to finish."""
+    loads = [0.0] * max(workers, 1)
+    for secs in sorted(cases, reverse=True):
+        loads[loads.index(min(loads))] += secs
+    return max(loads)
 
 
 def _cases(case: SandCase) -> tuple[int, int]:
-    """Calibration cases (the ends and the two frictions around the state, per calibration seed)
-    and specimens."""
-    frictions = min(len(case.mus), 4)
-    return frictions * case.calibration_seeds, case.seeds
+    """Calibration cases (the ends and the frictions around the state, per calibration seed) and
+    specimens."""
+    ends, inner, specimens = case_plans(case)
+    return ends.count + inner.count, specimens.count
 
 
-def _seconds(particle_steps: float, cases: int, workers: int) -> float:
-    """Wall time of ``cases`` equal cases on ``workers`` cores (whole rounds)."""
-    if cases == 0:
-        return 0.0
-    per_case = particle_steps / cases / THROUGHPUT
-    return per_case * math.ceil(cases / workers)
+def _stage(plan: CasePlan, mus: tuple[float, ...], spec: SpecimenSpec, disks: float, slow: float) -> list:
+    """Particle-steps of each case of ``plan`` (``mus``: the calibration's frictions)."""
+    out = []
+    for mu in plan.frictions:
+        steps = case_steps(spec, mu, trials_per_case(mu, mus, plan.stage), slow)
+        out += [disks * steps] * plan.seeds
+    return out
 
 
 def budget_suggestion(
@@ -351,8 +451,12 @@ class Workload:
     dt_unscaled: float | None = None
 
 
-def workload(case: SandCase, spec: SpecimenSpec, g: GradingCurve, first: float, workers: int) -> Workload:
-    """What ``case`` costs with ``spec`` and grading ``g`` from first trial ``first`` (the model above)."""
+def workload(
+    case: SandCase, spec: SpecimenSpec, g: GradingCurve, first: float, workers: int,
+    throughput: float = THROUGHPUT,
+) -> Workload:  # fmt: skip
+    """What ``case`` costs with ``spec`` and grading ``g`` from first trial ``first`` (the model above),
+    at ``throughput`` particle-steps per second per core."""
     crit = case.config.table("criterion")
     full = BoxPlan(spec.width, spec.height, spec.layers, estimate_size(spec, g, first).disks)
     fill = crit.get("acceptance", "plate") == "fill"
@@ -363,20 +467,24 @@ def workload(case: SandCase, spec: SpecimenSpec, g: GradingCurve, first: float, 
     scaled = grading_mass_scaling_step(spec, g, first)
     dt = dt_true if scaled is None else scaled
     dt_paper = time_step(spec, paper_grading().d_min_m)
-    n_cal, n_spec = _cases(case)
+    slow = dt_paper / dt
+    ends, inner, specimens = case_plans(case)
     cal_spec = replace(spec, width=cal.width, height=cal.height, layers=cal.layers)
-    psteps = StageEstimate(
-        calibration=cal.disks * _steps_per_trial(cal_spec, dt, dt_paper) * TRIALS_PER_CASE * n_cal,
-        specimens=full.disks * _steps_per_trial(spec, dt, dt_paper) * TRIALS_PER_CASE * n_spec,
-    )
-    calibration = _seconds(psteps.calibration, n_cal, workers)
-    specimens = _seconds(psteps.specimens, n_spec, workers)
-    secs = StageEstimate(calibration=calibration, specimens=specimens, total=calibration + specimens)
+    work = [_stage(p, case.mus, cal_spec, cal.disks, slow) for p in (ends, inner)]
+    work.append(_stage(specimens, case.mus, spec, full.disks, slow))
+    psteps = StageEstimate(calibration=sum(work[0]) + sum(work[1]), specimens=sum(work[2]))
+    # the ends run before the frictions around the state (which they choose), the specimens last
+    walls = [wall_seconds([w / throughput for w in stage], workers) for stage in work]
+    secs = StageEstimate(calibration=walls[0] + walls[1], specimens=walls[2], total=sum(walls))
     return Workload(full, cal, dt, dt_paper, psteps, secs, None if scaled is None else dt_true)
 
 
-def preflight(case: SandCase, *, workers: int = 2, budget_minutes: float | None = None) -> Preflight:
+def preflight(
+    case: SandCase, *, workers: int = 2, budget_minutes: float | None = None, throughput: float = THROUGHPUT
+) -> Preflight:
     """The pre-flight of ``case``: every number from the grading and the box, no DEM run.
+
+    ``throughput``: particle-steps per second per core of the machine (``THROUGHPUT`` unless given).
 
     Refuses (InputError) a box whose layers cannot hold the largest disk, before the jamming
     porosity is computed (the first trial's wall share in such a box is no porosity: 1.88 in a
@@ -390,7 +498,7 @@ def preflight(case: SandCase, *, workers: int = 2, budget_minutes: float | None 
     crit = case.config.table("criterion")
     first = first_trial(crit, case.mus[0], jam.porosity, wall_share(spec.width, spec.height, g.size_at(50.0)))
     check_feasible(spec, g, first)
-    work = workload(case, spec, g, first, workers)
+    work = workload(case, spec, g, first, workers, throughput)
     full, cal, dt, dt_paper = work.full, work.calibration, work.dt, work.dt_paper
     psteps, secs = work.particle_steps, work.seconds
     n_cal, n_spec = _cases(case)
@@ -421,6 +529,7 @@ def preflight(case: SandCase, *, workers: int = 2, budget_minutes: float | None 
         suggestion=budget_suggestion(case, secs.total, budget_minutes, first, workers),
         notes=notes,
         time_step_unscaled_s=work.dt_unscaled,
+        throughput=throughput,
     )
 
 
@@ -493,6 +602,16 @@ def _cut_notes(case: SandCase) -> list[str]:
 
 __all__ = [
     "THROUGHPUT",
+    "CasePlan",
+    "bracket",
+    "case_plans",
+    "case_steps",
+    "expected_friction",
+    "friction_at_share",
+    "lid_steps",
+    "preparation_steps",
+    "trials_per_case",
+    "wall_seconds",
     "Workload",
     "workload",
     "BoxPlan",

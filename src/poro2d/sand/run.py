@@ -35,7 +35,7 @@ from poro2d.execute.options import RunOptions
 from poro2d.interop.origin import SOIL_FILE
 from poro2d.io_utils import Provenance, check_output_dir
 from poro2d.sand.case import ConfigLike, SandCase, load_sand_case
-from poro2d.sand.preflight import Preflight, StageEstimate, preflight
+from poro2d.sand.preflight import Preflight, StageEstimate, bracket, friction_at_share, preflight
 from poro2d.sand.profile import case_runs, stage_profile
 from poro2d.sand.result import (
     SandCalibration,
@@ -105,25 +105,12 @@ def calibration_config(case: SandCase, pf: Preflight) -> CriterionBase:
 
 
 def predicted_mu(cal_ends: Calibration, n2d_target: float) -> float:
-    """The preparation friction that the two ends predict for ``n2d_target``.
-
-    The rise of n2D with friction has one shape across gradings (steep at low friction,
-    flat towards 1; ``FILL_FIRST_TRIALS``): scaled between the measured ends, it is inverted
-    for the target.
-    """
-    mu_ref, n_ref = (np.array(v) for v in zip(*D.FILL_FIRST_TRIALS, strict=True))
+    """The preparation friction that the two ends predict for ``n2d_target``: its share between
+    the measured ends, through the one shape of n2D against friction (:func:`friction_at_share`)."""
     mus = cal_ends.usable().mus
     lo, hi = cal_ends.n2d_min, cal_ends.n2d_max
-    u = 0.0 if hi <= lo else min(max((n2d_target - lo) / (hi - lo), 0.0), 1.0)
-    shape = (n_ref - n_ref[0]) / (n_ref[-1] - n_ref[0])
-    mu = float(np.interp(u, shape, mu_ref))
-    return min(max(mu, mus[0]), mus[-1])
-
-
-def bracket(mus: tuple[float, ...], mu: float) -> list[float]:
-    """The calibration frictions that enclose ``mu``: the ends and its two neighbours."""
-    inner = [m for m in mus if m <= mu][-1:] + [m for m in mus if m > mu][:1]
-    return sorted({mus[0], mus[-1], *inner})
+    u = 0.0 if hi <= lo else (n2d_target - lo) / (hi - lo)
+    return friction_at_share(u, tuple(mus))
 
 
 def full_box_trial(target: float, dense_end: float | None, cal_dense: float, pf: Preflight) -> float:
