@@ -180,7 +180,7 @@ def test_digests_keep_the_values_that_name_existing_folders():
     # cached calibrations: the version enters the key, so the former formula is restated here
     base = {"specimen": {"threads": 2, "friction_prep": 0.3, "width": 0.1}, "criterion": {"n_lab": 0.3}}
     former = {"base": {"specimen": {"width": 0.1}, "grading": {"preset": "paper"}, "criterion": {}},
-              "version": __version__}  # fmt: skip
+              "version": __version__, "revision": 2}  # fmt: skip
     expected = hashlib.sha256(json.dumps(former, sort_keys=True, default=str).encode()).hexdigest()[:16]
     assert calibration_key(CriterionBase(base)) == expected
 

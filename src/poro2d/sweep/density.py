@@ -132,13 +132,21 @@ def calibration_base(base: CriterionBase) -> CriterionBase:
     return CriterionBase({"specimen": spec, "grading": grading, "criterion": crit}, base.base_dir)
 
 
+#: the revision of the criterion's preparation that a cached calibration was made with, raised
+#: when a change moves its cases' results: 2, the creeping lid of frictional fill preparations
+#: (docs/criterion.md), whose loose-end cases differ from those of the chattering lid before it
+CALIBRATION_REVISION = 2
+
+
 def calibration_key(base: CriterionBase) -> str:
     """The run digest of the calibration's cases: grading, box, contact and criterion settings,
-    and the poro2d version (another version may compute another criterion).
+    the poro2d version and the preparation's revision (another version or revision may compute
+    another criterion, so a calibration cached before it is not read back).
 
     Spaced as these keys were first written, so cached calibrations keep their folders.
     """
     rec = {"base": calibration_base(base).as_config(), "version": __version__}
+    rec["revision"] = CALIBRATION_REVISION
     tables = {"base.specimen": SpecimenSpec, "base.criterion": CriterionSettings}
     return identity_digest(rec, tables=tables, length=16, layout="spaced")
 
