@@ -44,7 +44,16 @@ sys.path.insert(0, str(HERE))
 from bench_engine import TILINGS, paper_simulation, tiled_simulation  # noqa: E402
 
 from poro2d.dem import kernels as K  # noqa: E402
+from poro2d.dem.neighbors import (  # noqa: E402
+    cell_grid,
+    copy_rows,
+    count_pair_rows,
+    count_wall_rows,
+    fill_pair_rows,
+    fill_wall_rows,
+)
 from poro2d.dem.ordering import curve_order, strip_order  # noqa: E402
+from poro2d.dem.partition import partition  # noqa: E402
 from poro2d.dem.records import BodyProps, RollingProps  # noqa: E402
 from poro2d.dem.sync import barrier, fresh_sync, start_handshake  # noqa: E402
 
@@ -86,6 +95,37 @@ def _loop_barriers(reps, sync, nthr):
         if start_handshake(sync, nthr):
             for _ in range(reps):
                 barrier(sync, nthr)
+
+
+@njit
+def _loop_rebuild_part(reps, part, disks, walls, nb, wb, work, prm):
+    """One part of a list rebuild on one thread (``part``: 0 grid, 1 count pairs, 2 count wall
+    pairs, 3 fill pairs with their history, 4 fill wall pairs, 5 copy rows, 6 partitions)."""
+    pos, radius, skin, n = disks.pos, disks.radius, prm[K.SKIN], disks.pos.shape[0]
+    wp0, wp1 = walls.p0, walls.p1
+    cell, members, cstart, ginfo = work.cell, work.members, work.cstart, work.ginfo
+    for _ in range(reps):
+        if part == 0:
+            cell_grid(pos, radius, skin, cell, members, cstart, work.cfill, ginfo)
+        elif part == 1:
+            count_pair_rows(0, n, pos, radius, skin, cell, members, cstart, ginfo, nb.new_start)
+        elif part == 2:
+            count_wall_rows(0, n, pos, radius, skin, wp0, wp1, wb.new_start)
+        elif part == 3:
+            fill_pair_rows(0, n, pos, radius, skin, cell, members, cstart, ginfo, nb.start,
+                           nb.j, nb.fs, nb.new_start, nb.new_j, nb.new_fs, nb.mr, nb.new_mr)  # fmt: skip
+        elif part == 4:
+            fill_wall_rows(0, n, pos, radius, skin, wp0, wp1, wb.start, wb.w, wb.fs, wb.new_start, wb.new_w,
+                           wb.new_fs, wb.mr, wb.new_mr)  # fmt: skip
+        elif part == 5:
+            copy_rows(0, n, nb.new_start, nb.new_j, nb.new_fs, nb.start, nb.j, nb.fs, nb.new_mr, nb.mr)
+        else:
+            w = work
+            partition(n, nb.start, nb.j, wb.start, w.part, w.xstart, w.xpair, w.dlist, w.dstart)
+
+
+REBUILD_PARTS = ("grid", "count pairs", "count wall pairs", "fill pairs + history", "fill wall pairs",
+                 "copy rows", "partitions")  # fmt: skip
 
 
 def _kernel_args(sim):
@@ -142,6 +182,11 @@ def phase_times(sim, reps: int) -> dict:
     res["rebuild"] = _best_per_call(
         lambda r: _loop_rebuild(r, d, w, nb, wb, work, prm, out, rec.levels), max(1, reps // 5), state
     )
+    if rec.levels is None:  # the one cell grid: its parts one by one, in the order a rebuild runs them
+        for q, name in enumerate(REBUILD_PARTS):
+            res[f"  rebuild: {name}"] = _best_per_call(
+                lambda r, q=q: _loop_rebuild_part(r, q, d, w, nb, wb, work, prm), max(1, reps // 5), state
+            )
     for k in range(work.part.shape[0] - 1):
         res[f"force pass, partition {k}"] = _best_per_call(
             lambda r, k=k: _loop_forces(r, k, d, w, nb, wb, work, prm, props, dash, roll, pw_body),
@@ -246,14 +291,14 @@ def step_rates(sim, steps: int, blocks: int, threads=(1, 2)) -> dict:
     }  # fmt: skip
 
 
-def profile_case(sim, steps: int, blocks: int, reps: int) -> dict:
-    before = index_distance(sim)
+def profile_case(sim, steps: int, blocks: int, reps: int, threads=(1, 2)) -> dict:
     t0 = time.perf_counter()
     sim.run(1)
     first_build = time.perf_counter() - t0
-    rates = step_rates(sim, steps, blocks)
+    before = index_distance(sim)
+    rates = step_rates(sim, steps, blocks, threads)
     after = index_distance(sim)
-    phases = phase_times(sim, reps)
+    phases = phase_times(sim, reps) if reps else {}
     return {
         "n": sim.particles.n, "skin_m": sim.skin, "first_step_with_build_s": first_build,
         "rates": rates, "phases": phases, "bytes": force_pass_bytes(sim),
@@ -270,7 +315,7 @@ def show(name: str, r: dict) -> None:
             f"  {t} thread(s): {v['median']:.3e} p-steps/s (blocks {v['min']:.3e}-{v['max']:.3e}), "
             f"rebuilds per block {v['rebuilds']}"
         )
-    step1 = n / r["rates"]["1"]["median"]
+    step1 = n / r["rates"][next(iter(r["rates"]))]["median"]
     print(f"  one step on 1 thread: {step1 * 1e3:.3f} ms")
     for ph, v in r["phases"].items():
         print(
@@ -301,8 +346,11 @@ def main() -> int:
     ap.add_argument("--reps", type=int, default=20, help="repetitions of each phase alone")
     ap.add_argument("--order", choices=("as-built", "strip", "curve"), default="as-built")
     ap.add_argument("--json", default=None, help="write the numbers to this file")
+    ap.add_argument("--threads", default="1,2", help="thread counts of the timed blocks")
+    ap.add_argument("--sort-every", type=int, default=None, help="renumber along the curve every K steps")
     args = ap.parse_args()
     out = Path(args.out)
+    threads = tuple(int(t) for t in args.threads.split(","))
     results = {"copy_bandwidth_gb_s": copy_bandwidth(), "order": args.order, "cases": {}}
     print(f"large-array copy: {results['copy_bandwidth_gb_s']:.1f} GB/s (read + write)")
     for name in [c.strip() for c in args.cases.split(",") if c.strip()]:
@@ -311,8 +359,11 @@ def main() -> int:
         sim = base if small else tiled_simulation(base, *TILINGS[name])
         del base
         renumber(sim, args.order)
+        sim.set_sorting(args.sort_every)
         steps = args.steps * (20 if small else 1)
-        results["cases"][name] = r = profile_case(sim, steps, args.blocks, args.reps * (20 if small else 1))
+        results["cases"][name] = r = profile_case(
+            sim, steps, args.blocks, args.reps * (20 if small else 1), threads
+        )
         show(name, r)
     if args.json:
         Path(args.json).write_text(json.dumps(results, indent=1, default=float))
