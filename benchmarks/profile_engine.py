@@ -20,7 +20,8 @@ copies of it tiled to 25k or 250k) and prints, per case:
 ``--order`` renumbers each case before timing: ``strip`` (the engine's strips, as the
 specimens are built), ``curve`` (the space-filling order within the strips,
 :func:`poro2d.dem.ordering.curve_order`) or ``as-built`` (no renumbering: the tiling's
-order, copy by copy).
+order, copy by copy); ``random`` (a shuffled numbering, seed 0: what an order decays
+towards as the disks mix).
 
     python benchmarks/profile_engine.py --cases paper,250k --steps 200
     python benchmarks/profile_engine.py --cases 250k --order curve --steps 200
@@ -268,6 +269,8 @@ def renumber(sim, order: str) -> None:
         sim.reorder(strip_order(p.pos, p.radius))
     elif order == "curve":
         sim.reorder(curve_order(p.pos, p.radius))
+    elif order == "random":  # the worst case: what a numbering decays towards as disks mix
+        sim.reorder(np.random.default_rng(0).permutation(p.n))
 
 
 def step_rates(sim, steps: int, blocks: int, threads=(1, 2)) -> dict:
@@ -344,7 +347,7 @@ def main() -> int:
     ap.add_argument("--steps", type=int, default=200, help="steps per timed block (the paper case runs 20x)")
     ap.add_argument("--blocks", type=int, default=3)
     ap.add_argument("--reps", type=int, default=20, help="repetitions of each phase alone")
-    ap.add_argument("--order", choices=("as-built", "strip", "curve"), default="as-built")
+    ap.add_argument("--order", choices=("as-built", "strip", "curve", "random"), default="as-built")
     ap.add_argument("--json", default=None, help="write the numbers to this file")
     ap.add_argument("--threads", default="1,2", help="thread counts of the timed blocks")
     ap.add_argument("--sort-every", type=int, default=None, help="renumber along the curve every K steps")
