@@ -25,6 +25,27 @@ import numpy as np
 from poro2d.errors import InputError
 
 
+def _disks(pos, radius) -> tuple[np.ndarray, np.ndarray]:
+    """``pos`` (N, 2) and ``radius`` (N,) as float arrays, refused when of other shapes."""
+    pos = np.asarray(pos, dtype=float)
+    radius = np.asarray(radius, dtype=float)
+    n = pos.shape[0] if pos.ndim == 2 else -1
+    if pos.ndim != 2 or pos.shape[1] != 2:
+        raise InputError("positions", f"shape {pos.shape}", "shape (N, 2)")
+    if radius.shape != (n,):
+        raise InputError("radius", f"shape {radius.shape}", f"shape ({n},)")
+    return pos, radius
+
+
+def _axes(pos: np.ndarray) -> tuple[np.ndarray, int, int]:
+    """The packing's lower corner, the axis across its short side and the one along it."""
+    lo = pos.min(axis=0)
+    span = pos.max(axis=0) - lo
+    # strips run across the short side: in a wide packing they are columns (x fixed)
+    across = 0 if span[0] >= span[1] else 1
+    return lo, across, 1 - across
+
+
 def strip_order(pos: np.ndarray, radius: np.ndarray, width: float | None = None) -> np.ndarray:
     """Indices that number the disks strip by strip across the short side of the packing.
 
@@ -39,24 +60,14 @@ def strip_order(pos: np.ndarray, radius: np.ndarray, width: float | None = None)
     :meth:`poro2d.dem.Simulation.reorder`). Ties keep the current order, so the
     result is the same on every machine.
     """
-    pos = np.asarray(pos, dtype=float)
-    radius = np.asarray(radius, dtype=float)
-    n = pos.shape[0] if pos.ndim == 2 else -1
-    if pos.ndim != 2 or pos.shape[1] != 2:
-        raise InputError("positions", f"shape {pos.shape}", "shape (N, 2)")
-    if radius.shape != (n,):
-        raise InputError("radius", f"shape {radius.shape}", f"shape ({n},)")
-    if n == 0:
+    pos, radius = _disks(pos, radius)
+    if pos.shape[0] == 0:
         return np.zeros(0, dtype=np.int64)
     if width is None:
         width = 4.0 * float(radius.max())
     if not (width > 0.0 and np.isfinite(width)):
         raise InputError("strip width", width, "(0, inf) m")
-    lo = pos.min(axis=0)
-    span = pos.max(axis=0) - lo
-    # strips run across the short side: in a wide packing they are columns (x fixed)
-    across = 0 if span[0] >= span[1] else 1
-    along = 1 - across
+    lo, across, along = _axes(pos)
     strip = np.floor((pos[:, across] - lo[across]) / width)
     return np.lexsort((pos[:, along], strip)).astype(np.int64)
 
@@ -78,24 +89,15 @@ def curve_order(pos: np.ndarray, radius: np.ndarray, square: int = 8) -> np.ndar
     :func:`strip_order` does; it depends on the positions and radii alone (ties: the
     current order), so it is the same on every machine.
     """
-    pos = np.asarray(pos, dtype=float)
-    radius = np.asarray(radius, dtype=float)
-    n = pos.shape[0] if pos.ndim == 2 else -1
-    if pos.ndim != 2 or pos.shape[1] != 2:
-        raise InputError("positions", f"shape {pos.shape}", "shape (N, 2)")
-    if radius.shape != (n,):
-        raise InputError("radius", f"shape {radius.shape}", f"shape ({n},)")
+    pos, radius = _disks(pos, radius)
     if not (isinstance(square, (int, np.integer)) and square >= 1 and square & (square - 1) == 0):
         raise InputError("square", square, "a power of two (1, 2, 4, ...)")
-    if n == 0:
+    if pos.shape[0] == 0:
         return np.zeros(0, dtype=np.int64)
     cell = 2.0 * float(radius.max())
     if not (cell > 0.0 and np.isfinite(cell)):
         raise InputError("radius", float(radius.max()), "(0, inf) m")
-    lo = pos.min(axis=0)
-    span = pos.max(axis=0) - lo
-    across = 0 if span[0] >= span[1] else 1
-    along = 1 - across
+    lo, across, along = _axes(pos)
     a = np.floor((pos[:, across] - lo[across]) / cell).astype(np.int64)
     b = np.floor((pos[:, along] - lo[along]) / cell).astype(np.int64)
     # the curve's x runs along the strip: it leaves each block where the next one begins
