@@ -308,3 +308,12 @@ def test_no_sorting_below_the_disk_count():
     a.run(30)
     b.run(30)
     np.testing.assert_array_equal(a.particles.pos, b.particles.pos)
+
+
+def test_summary_names_the_renumbering_only_when_it_happens():
+    sim = jammed_packing(1)
+    assert "sort_every_steps" not in sim.summary().to_dict()
+    sim.set_sorting(9)  # below sort_min_particles: nothing renumbered, nothing said
+    assert "sort_every_steps" not in sim.summary().to_dict()
+    sim.sort_min_particles = 0
+    assert sim.summary().to_dict()["sort_every_steps"] == 9

@@ -945,4 +945,5 @@ class Simulation:
             partitions=self.partitions,
             step=self.step_count,
             time_s=self.time,
+            sort_every_steps=self.sort_every if self._sorting() else None,
         )
