@@ -109,12 +109,12 @@ def _loop_rebuild_part(reps, part, disks, walls, nb, wb, work, prm):
         if part == 0:
             cell_grid(pos, radius, skin, cell, members, cstart, work.cfill, ginfo)
         elif part == 1:
-            count_pair_rows(0, n, pos, radius, skin, cell, members, cstart, ginfo, nb.new_start)
+            count_pair_rows(0, n, pos, radius, skin, cell, members, cstart, ginfo, nb.new_start, work.cand)
         elif part == 2:
             count_wall_rows(0, n, pos, radius, skin, wp0, wp1, wb.new_start)
         elif part == 3:
-            fill_pair_rows(0, n, pos, radius, skin, cell, members, cstart, ginfo, nb.start,
-                           nb.j, nb.fs, nb.new_start, nb.new_j, nb.new_fs, nb.mr, nb.new_mr)  # fmt: skip
+            fill_pair_rows(0, n, pos, radius, skin, cell, members, cstart, ginfo, nb.start, nb.j, nb.fs,
+                           nb.new_start, nb.new_j, nb.new_fs, nb.mr, nb.new_mr, work.cand)  # fmt: skip
         elif part == 4:
             fill_wall_rows(0, n, pos, radius, skin, wp0, wp1, wb.start, wb.w, wb.fs, wb.new_start, wb.new_w,
                            wb.new_fs, wb.mr, wb.new_mr)  # fmt: skip
