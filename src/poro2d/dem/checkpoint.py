@@ -91,6 +91,7 @@ def save(sim: Simulation, path: str | os.PathLike, extra: dict | None = None) ->
             **{name: getattr(sim, name) for name in _SETTINGS.split()},
             # only when set: checkpoints of runs with true masses keep their keys
             **({} if sim.mass_scaling_dt is None else {"mass_scaling_dt": sim.mass_scaling_dt}),
+            **({} if sim.sort_every is None else {"sort_every": sim.sort_every}),
         },
         "extra": extra or {},
     }
@@ -238,6 +239,7 @@ def _build(meta: dict, a: dict[str, np.ndarray], threads: int | None) -> Simulat
         partitions=s.get("partitions", 2),
     )  # fmt: skip
     sim.dt = s["dt"]  # exactly as saved, whatever the rule that produced it
+    sim.set_sorting(s.get("sort_every"))
     sim.step_count = s["step_count"]
     sim.time = s["time"]
     for name, (store, field) in _SIM_ARRAYS.items():

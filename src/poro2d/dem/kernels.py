@@ -464,6 +464,7 @@ def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out, levels):
     pos_build, sync = work.pos_build, work.sync
     part, xstart, xpair, dlist, dstart = work.part, work.xstart, work.xpair, work.dlist, work.dstart
     cell, members, cstart, cfill, ginfo = work.cell, work.members, work.cstart, work.cfill, work.ginfo
+    cand = work.cand
     skin = prm[SKIN]
     n = pos.shape[0]
     lo = t * n // nthr
@@ -475,7 +476,7 @@ def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out, levels):
             level_grid(pos, radius, skin, levels)
     barrier(sync, nthr)
     if levels is None:
-        count_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, new_start)
+        count_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, new_start, cand)
     else:
         count_level_rows(lo, hi, pos, radius, skin, levels, new_start)
     count_wall_rows(lo, hi, pos, radius, skin, wp0, wp1, wnew_start)
@@ -496,7 +497,7 @@ def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out, levels):
         return False
     if levels is None:
         fill_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, nb_start, nb_j, nb_fs,
-                       new_start, new_j, new_fs, nb_mr, new_mr)  # fmt: skip
+                       new_start, new_j, new_fs, nb_mr, new_mr, cand)  # fmt: skip
     else:
         fill_level_rows(lo, hi, pos, radius, skin, levels, nb_start, nb_j, nb_fs, nb_mr, new_start,
                         new_j, new_fs, new_mr)  # fmt: skip

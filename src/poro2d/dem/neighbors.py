@@ -18,8 +18,13 @@ rows, so the engine's workers run them side by side between barriers
 same, slot for slot.
 
 Scratch storage (all preallocated by the caller, see :func:`grid_scratch`):
-``cell`` and ``members`` (n), ``cstart`` and ``cfill`` (:func:`max_cells` + 1) and
-``ginfo`` (int64, the grid's cell counts).
+``cell`` and ``members`` (n), ``cstart`` and ``cfill`` (:func:`max_cells` + 1),
+``ginfo`` (int64, the grid's cell counts) and ``cand`` (n x :data:`CAND_SLOTS`, or empty).
+
+The counting scan keeps the first :data:`CAND_SLOTS` partners of each row in ``cand``, so
+that filling copies them instead of scanning the nine cells again (a scan is about half of
+a build's time); a row with more partners is scanned again. Either way a row's partners
+are written in the scan's order: the lists are the same, slot for slot.
 
 For wide size ratios the disk-disk rows are built from grids by size level instead
 (:func:`level_grid`, :func:`count_level_rows`, :func:`fill_level_rows`; storage in
@@ -44,6 +49,10 @@ def max_cells(n):
     return 4 * n + 16
 
 
+#: partners per disk the counting scan keeps for the filling (paper grading: 2.4 on average)
+CAND_SLOTS = 8
+
+
 class GridScratch(NamedTuple):
     """The cell grid's storage (int64): see the module doc."""
 
@@ -52,13 +61,17 @@ class GridScratch(NamedTuple):
     cstart: np.ndarray  # (max_cells + 1) first member of each cell
     cfill: np.ndarray  # (max_cells + 1) fill counters
     ginfo: np.ndarray  # (4) the grid's cell counts
+    cand: np.ndarray  # (n * CAND_SLOTS) the partners the counting scan found, row by row
 
 
 def grid_scratch(n: int) -> GridScratch:
     """The grid storage for ``n`` disks."""
     nc = max_cells(n) + 1
     i8 = np.int64
-    return GridScratch(np.zeros(n, i8), np.zeros(n, i8), np.zeros(nc, i8), np.zeros(nc, i8), np.zeros(4, i8))
+    return GridScratch(
+        np.zeros(n, i8), np.zeros(n, i8), np.zeros(nc, i8), np.zeros(nc, i8), np.zeros(4, i8),
+        np.zeros(n * CAND_SLOTS, i8),
+    )  # fmt: skip
 
 
 @njit(cache=True)
@@ -127,8 +140,9 @@ def _members_by_cell(n, ncell, cell, members, cstart, cfill):
 
 
 @njit(inline="always", cache=True)
-def _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, out_j, k0, write):
-    """Count (or write from k0) the partners j > i of disk i; returns the count."""
+def _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, out_j, k0, write, limit):
+    """Count the partners j > i of disk i, writing the first ``limit`` of them from k0 when
+    ``write``; returns the count."""
     c = cell[i]
     cx = c % ncx
     cy = c // ncx
@@ -140,7 +154,7 @@ def _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, out_j, k0, 
         for nx_ in range(max(cx - 1, 0), min(cx + 2, ncx)):
             cc = ny_ * ncx + nx_
             for m in range(cstart[cc], cstart[cc + 1]):
-                k = _take(i, members[m], xi, yi, ri, pos, radius, skin, out_j, k0, k, write)
+                k = _take(i, members[m], xi, yi, ri, pos, radius, skin, out_j, k0, k, write and k < limit)
     return k
 
 
@@ -169,13 +183,15 @@ def _near_wall(px, py, reach, wp0, wp1, w):
 
 
 @njit(cache=True)
-def count_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, new_start):
-    """Candidate partners of rows lo..hi-1 into ``new_start[i + 1]``."""
+def count_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, new_start, cand):
+    """Candidate partners of rows lo..hi-1 into ``new_start[i + 1]``; the first
+    ``CAND_SLOTS`` of each row into ``cand`` (when it is not empty)."""
     ncx = ginfo[0]
     ncy = ginfo[1]
+    slots = cand.shape[0] // max(pos.shape[0], 1)
     for i in range(lo, hi):
         new_start[i + 1] = _scan_row(
-            i, pos, radius, skin, cell, members, cstart, ncx, ncy, new_start, 0, False
+            i, pos, radius, skin, cell, members, cstart, ncx, ncy, cand, i * slots, slots > 0, slots
         )
 
 
@@ -204,15 +220,22 @@ def prefix_rows(n, start):
 @njit(cache=True)
 def fill_pair_rows(
     lo, hi, pos, radius, skin, cell, members, cstart, ginfo, nb_start, nb_j, nb_fs, new_start, new_j, new_fs,
-    nb_mr, new_mr,
+    nb_mr, new_mr, cand,
 ):  # fmt: skip
     """Write rows lo..hi-1 of the new disk-disk list, each pair with its old shear force and
-    rolling moment (or 0)."""
+    rolling moment (or 0): copied from ``cand`` when the counting scan kept the whole row,
+    else scanned again."""
     ncx = ginfo[0]
     ncy = ginfo[1]
+    slots = cand.shape[0] // max(pos.shape[0], 1)
     for i in range(lo, hi):
         k0 = new_start[i]
-        _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, new_j, k0, True)
+        count = new_start[i + 1] - k0
+        if count <= slots:
+            for k in range(count):
+                new_j[k0 + k] = cand[i * slots + k]
+        else:
+            _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, new_j, k0, True, count)
         o0 = nb_start[i]
         o1 = nb_start[i + 1]
         _carry_history(k0, new_start[i + 1], o0, o1, nb_j, nb_fs, nb_mr, new_j, new_fs, new_mr)
@@ -282,7 +305,8 @@ def build_pairs(pos, radius, skin, nb_start, nb_j, nb_fs, new_start, new_j, new_
     g_ginfo = np.zeros(4, dtype=np.int64)
     if levels is None:
         cell_grid(pos, radius, skin, g_cell, g_members, g_cstart, np.empty_like(g_cstart), g_ginfo)
-        count_pair_rows(0, n, pos, radius, skin, g_cell, g_members, g_cstart, g_ginfo, new_start)
+        no_cand = np.zeros(0, dtype=np.int64)  # this stand-alone build scans twice
+        count_pair_rows(0, n, pos, radius, skin, g_cell, g_members, g_cstart, g_ginfo, new_start, no_cand)
     else:
         level_grid(pos, radius, skin, levels)
         count_level_rows(0, n, pos, radius, skin, levels, new_start)
@@ -293,7 +317,7 @@ def build_pairs(pos, radius, skin, nb_start, nb_j, nb_fs, new_start, new_j, new_
     new_mr = np.zeros(nb_j.shape[0])
     if levels is None:
         fill_pair_rows(0, n, pos, radius, skin, g_cell, g_members, g_cstart, g_ginfo, nb_start, nb_j, nb_fs,
-                       new_start, new_j, new_fs, nb_mr, new_mr)  # fmt: skip
+                       new_start, new_j, new_fs, nb_mr, new_mr, np.zeros(0, dtype=np.int64))  # fmt: skip
     else:
         fill_level_rows(0, n, pos, radius, skin, levels, nb_start, nb_j, nb_fs, nb_mr, new_start, new_j,
                         new_fs, new_mr)  # fmt: skip

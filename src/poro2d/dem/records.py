@@ -137,6 +137,7 @@ class WorkArrays(NamedTuple):
     cstart: np.ndarray
     cfill: np.ndarray
     ginfo: np.ndarray
+    cand: np.ndarray
 
 
 class KernelRecords(NamedTuple):
@@ -189,6 +190,6 @@ def kernel_records(
     work_rec = WorkArrays(
         pos_build=work.pos_build, part=work.part, xstart=work.xstart, xpair=nb.cross, dlist=work.dlist,
         dstart=work.dstart, tmax=work.tmax, sync=work.sync, cell=g.cell, members=g.members,
-        cstart=g.cstart, cfill=g.cfill, ginfo=g.ginfo,
+        cstart=g.cstart, cfill=g.cfill, ginfo=g.ginfo, cand=g.cand,
     )  # fmt: skip
     return KernelRecords(disks, walls_rec, nb_rec, wb_rec, work_rec, work.levels)

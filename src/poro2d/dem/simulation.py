@@ -194,6 +194,9 @@ class Simulation:
     #: with fines. Narrower gradings (the paper's 3.5, the built-in wide gradings' 25 and
     #: less) keep the one grid, and so every number they gave before.
     level_ratio = 40.0
+    #: disks below which :meth:`set_sorting` leaves the numbering alone (a small packing's
+    #: arrays stay in cache whatever their order: renumbering there costs and gains nothing)
+    sort_min_particles = 20_000
 
     def __init__(
         self,
@@ -245,6 +248,8 @@ class Simulation:
         self._stepped = False
         self._checked_ratio: float | None = None  # max ratio at the last stop test of a run
         self._n_alloc = -1
+        self.sort_every: int | None = None  # renumbering along the curve: off (set_sorting)
+        self._sorted_at: int | None = None  # the clock's step of the last renumbering
         check_layout(self.particles.pos, self.particles.radius, self.walls)
         self._refresh()
 
@@ -304,6 +309,7 @@ class Simulation:
         self._stepped = self._stepped or self.step_count > 0
         self.step_count = 0
         self.time = 0.0
+        self._sorted_at = None
 
     @property
     def effective_threads(self) -> int:
@@ -493,6 +499,42 @@ class Simulation:
         self._renumber_wall_pairs(new_of_old)
         self.kernel_params.iprm[K.NEED_BUILD] = 1  # rows in the kernel's own order before the next step
 
+    def set_sorting(self, every: int | None) -> None:
+        """Renumber the disks along :func:`~poro2d.dem.ordering.curve_order` every ``every`` steps.
+
+        As disks move, partners drift apart in memory; renumbering them again keeps a
+        large packing's force pass reading from cache (LAMMPS's ``atom_modify sort`` does
+        the same). The renumbering falls before the steps whose clock (``step_count``) is a
+        multiple of ``every``, whatever blocks, reporters or threads a run has, so a run's
+        numbers depend on its state alone; they differ from an unsorted run's by round-off
+        (sums in another order). Packings of fewer than ``sort_min_particles`` disks are
+        never renumbered. ``None`` (the default) turns it off. Disk numbers change at each
+        renumbering: a caller keeping disk indices across a run must not turn it on.
+        """
+        if every is not None and not (isinstance(every, (int, np.integer)) and every >= 1):
+            raise InputError("sort_every", every, "an integer >= 1 (steps), or None for no renumbering")
+        self.sort_every = None if every is None else int(every)
+        self._sorted_at = None
+
+    def _sorting(self) -> bool:
+        return self.sort_every is not None and self.particles.n >= self.sort_min_particles
+
+    def _sort_if_due(self) -> None:
+        """Renumber along the curve when the clock stands on a multiple of ``sort_every``."""
+        if not self._sorting() or self.step_count % self.sort_every or self._sorted_at == self.step_count:
+            return
+        from poro2d.dem.ordering import curve_order
+
+        self.reorder(curve_order(self.particles.pos, self.particles.radius))
+        self._sorted_at = self.step_count
+
+    def _steps_before_sort(self, steps: int) -> int:
+        """``steps``, cut so that a kernel call ends where the next renumbering falls."""
+        if not self._sorting():
+            return steps
+        k = self.sort_every
+        return min(steps, k - self.step_count % k)
+
     def _renumber_pairs(self, new_of_old: np.ndarray) -> None:
         """Disk-disk list in new numbers: rows by the smaller new index, history unchanged.
 
@@ -679,7 +721,9 @@ class Simulation:
         params = self.kernel_params
         out = params.out
         while done < nsteps:
-            self._load_params(nsteps - done, check_every, ratio_target, offset + done, measure)
+            self._sort_if_due()
+            chunk = self._steps_before_sort(nsteps - done)
+            self._load_params(chunk, check_every, ratio_target, offset + done, measure)
             out[:] = 0.0
             K.step_block(self.kernel_records(), params.prm, params.iprm, out)
             self.threads_used = int(out[K.THREADS_USED])
@@ -901,4 +945,5 @@ class Simulation:
             partitions=self.partitions,
             step=self.step_count,
             time_s=self.time,
+            sort_every_steps=self.sort_every if self._sorting() else None,
         )

@@ -57,10 +57,12 @@ class EngineSummary(TypedResult):
 
     ``dt_mode`` says whether the step was fixed or automatic (with its safety factor);
     ``threads_used`` is what the kernel's last call used (0: none yet); ``step`` and
-    ``time_s`` are the simulation's clock when the summary was taken.
+    ``time_s`` are the simulation's clock when the summary was taken. ``sort_every_steps``
+    is there only when the disks are renumbered along the curve every that many steps
+    (:meth:`poro2d.dem.simulation.Simulation.set_sorting`).
     """
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("rolling_friction", "mass_scaling")
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("rolling_friction", "mass_scaling", "sort_every_steps")
 
     n_particles: int
     n_walls: int
@@ -84,6 +86,7 @@ class EngineSummary(TypedResult):
     step: int
     time_s: float
     mass_scaling: MassScalingRecord | None = None
+    sort_every_steps: int | None = None
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "contact": ContactRecord,
