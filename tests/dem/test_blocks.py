@@ -156,3 +156,13 @@ def test_threads_and_blocks_change_nothing_on_a_large_packing():
         runs.append(_state(sim, res))
     assert runs[0]["converged"] and runs[0]["steps"] < 500
     _assert_same(runs[0], runs[1])
+
+
+def test_the_long_running_kernels_release_python_s_lock():
+    # a Dask worker's heartbeat thread must run while a block of steps does (a worker silent
+    # for minutes is restarted by its scheduler): every entry point of a long compiled loop
+    from poro2d.dem import kernels, periodic_kernels
+    from poro2d.oracles import jamming
+
+    for kernel in (kernels._run_threads, kernels.step_block_serial, periodic_kernels.advance, jamming._fire):
+        assert kernel.targetoptions.get("nogil") is True, kernel.py_func.__name__

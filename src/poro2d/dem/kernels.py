@@ -649,7 +649,10 @@ def prepare(disks, nb, wb, work, prm):
     partition(n, nb.start, nb.j, wb.start, work.part, work.xstart, work.xpair, work.dlist, work.dstart)
 
 
-@njit(parallel=True, cache=True)
+# A block runs without Python's lock (nogil): a block can last minutes on a loaded machine, and
+# the worker process's other threads (a Dask worker's heartbeat) must go on meanwhile, or the
+# scheduler takes the silent worker for dead and restarts it, losing its work.
+@njit(parallel=True, nogil=True, cache=True)
 def _run_threads(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll, levels):
     # prepare here, not in a call of its own: each call costs the dispatch of every array
     prepare(disks, nb, wb, work, prm)
@@ -661,7 +664,7 @@ def _run_threads(nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, 
     return ok.sum() == nthr
 
 
-@njit(cache=True)
+@njit(nogil=True, cache=True)
 def step_block_serial(disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll, levels):
     prepare(disks, nb, wb, work, prm)
     _worker(0, 1, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll, levels)

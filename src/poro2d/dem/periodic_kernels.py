@@ -389,7 +389,7 @@ def rebuild(pos, radius, drift, cell, prm, start, pj, pfs, pmr):
     return build_pairs(pos, radius, cell, prm[SKIN], start, pj, pfs, pmr)
 
 
-@njit(cache=True)
+@njit(nogil=True, cache=True)
 def advance(
     nsteps, pos, vel, omega, theta, radius, mass, inv_mass, inv_inertia, drift, pairs, cell, prm, out
 ):

@@ -280,7 +280,7 @@ def _converged(energy, fmax, stats, n, e_zero, f_rel, f_abs):
     return -1
 
 
-@njit(cache=True)
+@njit(nogil=True, cache=True)
 def _fire(pos, rad, mass, lx, ly, skin, e_zero, f_rel, f_abs, max_steps, out):
     """FIRE minimisation of ``pos`` in place; ``out`` = (energy, max force, steps, status, rebuilds)."""
     n = pos.shape[0]
