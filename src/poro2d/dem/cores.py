@@ -1,0 +1,54 @@
+"""Cores lent to the engine between kernel blocks: more threads, never other numbers.
+
+The engine gives the same numbers, bit for bit, on one thread or on up to ``partitions``
+threads (docs/engine.md, "Partitions and threads"), and it sets its thread count afresh at
+every kernel block. So a process that runs one case of many may give that case more threads
+while it runs, when the cores of finished cases fall idle: it installs a *lender*, a
+callable that says how many threads a simulation of this process may take now, and every
+:class:`~poro2d.dem.simulation.Simulation` asks it at its next block. The lender only
+raises a simulation's own ``threads``; the engine still caps the count at its
+``partitions``, at numba's thread pool, and at one thread below ``parallel_min_particles``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+#: the engine's partitions unless a simulation is given others: the most threads a case can use
+#: without a change of round-off
+DEFAULT_PARTITIONS = 2
+
+#: particle-steps of a kernel block while a lender is installed (about a second of one thread's work):
+#: a long run asks the lender again at that pace. Where blocks end changes no number (the kernel
+#: counts its stop tests from the start of the run)
+LEND_BLOCK = 30_000_000
+
+Lender = Callable[[], int]
+
+#: this process's lender (None: no cores lent, every simulation keeps its own ``threads``)
+_lender: Lender | None = None
+
+
+def lend_cores(lender: Lender | None) -> Lender | None:
+    """Install ``lender`` for the simulations of this process (None: none); returns the one before."""
+    global _lender
+    before, _lender = _lender, lender
+    return before
+
+
+def lending() -> bool:
+    """Whether a lender is installed in this process."""
+    return _lender is not None
+
+
+def cores_lent() -> int:
+    """The threads the installed lender grants now (1 without a lender, or when it fails)."""
+    if _lender is None:
+        return 1
+    try:
+        return max(1, int(_lender()))
+    except Exception:  # noqa: BLE001 - a lender that fails lends nothing; the case goes on
+        return 1
+
+
+__all__ = ["DEFAULT_PARTITIONS", "LEND_BLOCK", "Lender", "cores_lent", "lend_cores", "lending"]
