@@ -63,5 +63,6 @@ def test_threads_lent_half_way_change_no_bit(no_lender, monkeypatch):
         if lend:
             assert len(asked) > 2  # asked at each block, not once for the run
     assert used == [1, 2]
+    assert cores.lent_core_seconds() > 0.0  # the 16 steps on two threads, counted
     assert runs[0]["converged"] and np.isfinite(runs[0]["steps"])
     _assert_same(runs[0], runs[1])

@@ -29,11 +29,28 @@ Lender = Callable[[], int]
 _lender: Lender | None = None
 
 
+#: core-seconds the kernel blocks of this process took beyond one thread since the lender was installed
+_lent_seconds = 0.0
+
+
 def lend_cores(lender: Lender | None) -> Lender | None:
-    """Install ``lender`` for the simulations of this process (None: none); returns the one before."""
-    global _lender
-    before, _lender = _lender, lender
+    """Install ``lender`` for the simulations of this process (None: none); returns the one before.
+    The count of lent core-seconds starts again from zero."""
+    global _lender, _lent_seconds
+    before, _lender, _lent_seconds = _lender, lender, 0.0
     return before
+
+
+def note_block(threads: int, seconds: float) -> None:
+    """A kernel block ran ``seconds`` on ``threads`` threads: count what it took beyond one."""
+    global _lent_seconds
+    if _lender is not None:
+        _lent_seconds += max(threads - 1, 0) * seconds
+
+
+def lent_core_seconds() -> float:
+    """Core-seconds taken beyond one thread since the lender was installed (what the cores lent did)."""
+    return _lent_seconds
 
 
 def lending() -> bool:
@@ -51,4 +68,13 @@ def cores_lent() -> int:
         return 1
 
 
-__all__ = ["DEFAULT_PARTITIONS", "LEND_BLOCK", "Lender", "cores_lent", "lend_cores", "lending"]
+__all__ = [
+    "DEFAULT_PARTITIONS",
+    "LEND_BLOCK",
+    "Lender",
+    "cores_lent",
+    "lend_cores",
+    "lending",
+    "lent_core_seconds",
+    "note_block",
+]

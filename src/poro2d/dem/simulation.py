@@ -24,7 +24,7 @@ import numpy as np
 
 from poro2d.dem import kernels as K
 from poro2d.dem.contact_law import PER_BODY, PER_PAIR_TYPE
-from poro2d.dem.cores import DEFAULT_PARTITIONS, LEND_BLOCK, cores_lent, lending
+from poro2d.dem.cores import DEFAULT_PARTITIONS, LEND_BLOCK, cores_lent, lending, note_block
 from poro2d.dem.layout import check_layout
 from poro2d.dem.model import (
     ContactModel,
@@ -680,6 +680,7 @@ class Simulation:
         # one count for the whole block (a lender may change its answer meanwhile)
         self._block_threads = max(1, self.effective_threads)
         numba.set_num_threads(self._block_threads)
+        started = time.perf_counter()
         if self.work.part.shape[0] != self.partitions + 1:
             self._renew_work(self.particles.n)  # partitions changed since allocation
         done = 0
@@ -718,6 +719,7 @@ class Simulation:
                 )
             if status == K.CONVERGED:
                 break
+        note_block(self.threads_used, time.perf_counter() - started)  # what lent cores did (dem.cores)
         return done, status, rebuilds
 
     def run(

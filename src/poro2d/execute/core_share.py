@@ -6,13 +6,15 @@ one thread or on up to its ``partitions`` (docs/engine.md), and sets its thread 
 at each kernel block (:mod:`poro2d.dem.cores`), so those cores can go to the cases still
 running with no number changed. The driver posts the threads per case on a
 :class:`ShareBoard` (one small file in a private temporary folder, on this machine) each time
-a case ends; a case reads it at most once a second through a :class:`ThreadLender`. What the
+a case ends; a case reads it at most once a second through a :class:`ThreadLender`, and takes
+only the threads that have a core free of other processes' work. What the
 cores did is kept as a :class:`WorkerUse`: cases per worker, threads per case over time and
 the idle core-time.
 """
 
 from __future__ import annotations
 
+import os
 import shutil
 import tempfile
 import time
@@ -69,21 +71,66 @@ def share_board() -> Iterator[ShareBoard]:
         shutil.rmtree(folder, ignore_errors=True)
 
 
+class OtherLoad:
+    """The cores that other processes of this machine kept busy since the last look.
+
+    The machine's busy CPU time less this process's own, over the wall time between two
+    looks (psutil's counters; None where they cannot be read: then nothing is held back).
+    """
+
+    def __init__(self) -> None:
+        self.last = self.sample()
+
+    @staticmethod
+    def sample() -> tuple[float, float, float] | None:
+        """(wall, the machine's busy CPU seconds, this process's CPU seconds), or None."""
+        try:
+            import psutil
+
+            cpu, own = psutil.cpu_times(), psutil.Process().cpu_times()
+        except Exception:  # noqa: BLE001 - no psutil, or no counters on this system
+            return None
+        busy = sum(cpu) - cpu.idle - getattr(cpu, "iowait", 0.0)
+        return time.monotonic(), busy, own.user + own.system
+
+    def cores(self) -> float | None:
+        """Other processes' busy cores since the last call (None: unknown)."""
+        now, last = self.sample(), self.last
+        self.last = now
+        if now is None or last is None or now[0] <= last[0]:
+            return None
+        return max((now[1] - last[1]) - (now[2] - last[2]), 0.0) / (now[0] - last[0])
+
+
+def free_cores_allow(posted: int, others: float | None, cores: int) -> int:
+    """The threads a case takes of the ``posted`` ones when other processes keep ``others`` of the
+    machine's ``cores`` busy: a thread without a free core waits for its partner at every step
+    of the engine, and two threads on a shared, loaded core ran at 0.4-0.7 of one thread
+    (benchmarks/README.md), so only threads with a core of their own are taken."""
+    if others is None:
+        return posted
+    return max(1, min(posted, int(cores - others + 0.25)))
+
+
 class ThreadLender:
-    """A case's view of the board: the posted threads, read again at most every ``POLL_S``."""
+    """A case's view of the board: the posted threads, read again at most every ``POLL_S``, and
+    only as many as the machine has free cores for (:func:`free_cores_allow`)."""
 
     def __init__(self, board: ShareBoard) -> None:
         self.board = board
         self.threads = 1
         self.read_at = -float("inf")
+        self.load = OtherLoad()
+        self.cores = os.cpu_count() or 1
 
     def __call__(self) -> int:
         now = time.monotonic()
         if now - self.read_at >= POLL_S:
             self.read_at = now
+            others = self.load.cores()
             posted = self.board.read()
             if posted is not None:
-                self.threads = posted
+                self.threads = free_cores_allow(posted, others, self.cores)
         return self.threads
 
 
@@ -93,10 +140,12 @@ class WorkerUse(TypedResult):
 
     ``workers``: the cores (worker processes) the cases ran on; ``cases``: the cases that ran;
     ``cases_per_worker``: how many each worker ran, by worker; ``threads_over_time``: the
-    engine threads each running case was offered, over the run, as ``[seconds from the start,
-    cases left, threads per case]`` at each change; ``busy_core_s`` and ``idle_core_s``: the
-    core-time of the run's wall time the cases were offered, and what was left idle (a case
-    smaller than the engine's ``parallel_min_particles`` keeps one thread whatever it is offered).
+    engine threads offered to each running case, as ``[seconds from the start, cases left,
+    threads per case]`` at each change; ``busy_core_s``: the core-time the cases took (their
+    time on one thread, and what their threads beyond one took: a case smaller than the
+    engine's ``parallel_min_particles``, or on a machine whose other programs hold the cores,
+    takes fewer than offered); ``idle_core_s``: the rest of the workers' core-time over the
+    run's wall time ``wall_s``.
     """
 
     workers: int
@@ -129,7 +178,6 @@ class CoreClock:
         self.t0 = time.perf_counter()
         self.left = cases
         self.steps: list[list[float]] = []
-        self.busy = 0.0
         self.since = self.t0
         self._post()
 
@@ -143,10 +191,6 @@ class CoreClock:
         if not self.steps or self.steps[-1][1:] != [self.left, threads]:
             self.steps.append([round(self.since - self.t0, 3), self.left, threads])
 
-    def _account(self, now: float) -> None:
-        self.busy += (now - self.since) * min(self.workers, min(self.left, self.workers) * self._threads())
-        self.since = now
-
     def note(self) -> str:
         """The progress line's note: the threads per case, once more than one."""
         threads = self._threads()
@@ -154,26 +198,32 @@ class CoreClock:
 
     def case_ended(self) -> None:
         """One case fewer: the cores of its worker go to the cases left."""
-        self._account(time.perf_counter())
+        self.since = time.perf_counter()
         self.left = max(self.left - 1, 0)
         self._post()
 
-    def use(self, workers_of_cases: list[str]) -> WorkerUse:
-        """The record of the run so far; ``workers_of_cases``: the worker of each case that ran."""
-        self._account(time.perf_counter())
+    def use(self, rows: list) -> WorkerUse:
+        """The record of the run so far; ``rows``: the row of each case that ran (its ``worker``, or
+        ``host`` and ``pid``; its ``time_s`` and the ``lent_core_s`` its threads beyond one took)."""
+        self.since = time.perf_counter()
         wall = self.since - self.t0
         per_worker: dict[str, int] = {}
-        for w in workers_of_cases:
+        busy = 0.0
+        for r in rows:
+            w = r.worker or f"{r.host}:{r.pid}"
             per_worker[w] = per_worker.get(w, 0) + 1
-        return WorkerUse(self.workers, len(workers_of_cases), per_worker, self.steps, wall, self.busy,
-                         max(self.workers * wall - self.busy, 0.0))  # fmt: skip
+            busy += (r.time_s or 0.0) + float(r.extra.get("lent_core_s") or 0.0)
+        return WorkerUse(self.workers, len(rows), per_worker, self.steps, wall, busy,
+                         max(self.workers * wall - busy, 0.0))  # fmt: skip
 
 
 __all__ = [
     "CoreClock",
     "ShareBoard",
+    "OtherLoad",
     "ThreadLender",
     "WorkerUse",
+    "free_cores_allow",
     "share_board",
     "threads_per_case",
     "use_text",

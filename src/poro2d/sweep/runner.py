@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from poro2d.dem.cores import DEFAULT_PARTITIONS, lend_cores
+from poro2d.dem.cores import DEFAULT_PARTITIONS, lend_cores, lending, lent_core_seconds
 from poro2d.execute import Executor, Failed, Job
 from poro2d.execute.core_share import CoreClock, ShareBoard, ThreadLender, WorkerUse, share_board
 from poro2d.execute.dask_cluster import ClusterInfo, pin_numba_threads
@@ -162,6 +162,8 @@ def _done_row(case: dict, store: Store, func, row: dict, t0: float) -> CaseRow:
         )
     results = {str(k): _scalar(v) for k, v in results.items()}
     row.update(status="done", error=None, time_s=time.perf_counter() - t0, finished_utc=_now())
+    if lending():  # the core-time its threads beyond one took (poro2d.execute.core_share)
+        row["lent_core_s"] = lent_core_seconds()
     row["results"] = results
     for stale in (ERROR_TXT, ERROR_JSON):
         store.remove(stale)
@@ -317,7 +319,7 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Sto
                 bar.advance(", ".join(filter(None, [f"{n_failed} failed" if n_failed else "", clock.note()])))
 
             executor.map(jobs, on_done=ended)
-        use = clock.use([rows[c.id].worker or f"{rows[c.id].host}:{rows[c.id].pid}" for c in pending])
+        use = clock.use([rows[c.id] for c in pending])
     return cluster_info, use
 
 
