@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 
 from poro2d.dem import cores
-from poro2d.dem import simulation as S
 from tests.dem.test_blocks import _assert_same, _settling_box, _state
 
 
@@ -36,10 +35,9 @@ def test_a_lender_raises_the_threads_but_not_past_the_partitions(no_lender):
 
 
 @pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="needs 2 numba threads")
-def test_threads_lent_half_way_change_no_bit(no_lender, monkeypatch):
-    # blocks of 16 steps while lending; the lender grants a second thread at its 2nd answer only (two
-    # threads wait for each other at every step on a loaded host: a few steps on them say enough)
-    monkeypatch.setattr(S, "LEND_BLOCK", 16 * 1056)
+def test_threads_lent_half_way_change_no_bit(no_lender):
+    # the lender grants a second thread at its 2nd answer only (two threads wait for each other at
+    # every step on a loaded host: a few steps on them say enough)
     runs, used = [], []
     for lend in (False, True):
         sim = _settling_box(nx=24, ny=44)

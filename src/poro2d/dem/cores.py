@@ -8,6 +8,10 @@ callable that says how many threads a simulation of this process may take now, a
 :class:`~poro2d.dem.simulation.Simulation` asks it at its next block. The lender only
 raises a simulation's own ``threads``; the engine still caps the count at its
 ``partitions``, at numba's thread pool, and at one thread below ``parallel_min_particles``.
+
+A run is not cut into more blocks for it (where a block ends is kept in a checkpoint's kernel
+settings): a case takes lent threads where its run's blocks end anyway, at its reporters (the
+laboratory stages settle in blocks of 500 steps, ``poro2d.labtest.settle``) or at its next run.
 """
 
 from __future__ import annotations
@@ -17,11 +21,6 @@ from collections.abc import Callable
 #: the engine's partitions unless a simulation is given others: the most threads a case can use
 #: without a change of round-off
 DEFAULT_PARTITIONS = 2
-
-#: particle-steps of a kernel block while a lender is installed (about a second of one thread's work):
-#: a long run asks the lender again at that pace. Where blocks end changes no number (the kernel
-#: counts its stop tests from the start of the run)
-LEND_BLOCK = 30_000_000
 
 Lender = Callable[[], int]
 
@@ -70,7 +69,6 @@ def cores_lent() -> int:
 
 __all__ = [
     "DEFAULT_PARTITIONS",
-    "LEND_BLOCK",
     "Lender",
     "cores_lent",
     "lend_cores",

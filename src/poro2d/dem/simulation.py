@@ -24,7 +24,7 @@ import numpy as np
 
 from poro2d.dem import kernels as K
 from poro2d.dem.contact_law import PER_BODY, PER_PAIR_TYPE
-from poro2d.dem.cores import DEFAULT_PARTITIONS, LEND_BLOCK, cores_lent, lending, note_block
+from poro2d.dem.cores import DEFAULT_PARTITIONS, cores_lent, note_block
 from poro2d.dem.layout import check_layout
 from poro2d.dem.model import (
     ContactModel,
@@ -781,8 +781,6 @@ class Simulation:
             bar.start()
             if not reporters:
                 block = max(check_every, min(steps, 2000))
-        if lending():  # a lender may grant more threads while the run goes on: ask it every second or so
-            block = min(block, max(check_every, LEND_BLOCK // max(n, 1)))
 
         def advance(nb: int) -> tuple[int, bool]:
             k, status, block_rebuilds = self._kernel_block(nb, check_every, target, ran["steps"], code)
