@@ -26,9 +26,15 @@ def test_threads_per_case_is_workers_over_cases_capped_at_the_partitions(workers
     assert C.threads_per_case(workers, cases, cap) == threads
 
 
-def test_the_board_is_read_at_most_once_a_second_and_gone_with_its_folder(monkeypatch):
-    now = [100.0]
-    monkeypatch.setattr(C.time, "monotonic", lambda: now[0])
+@pytest.fixture
+def now(monkeypatch) -> list[float]:
+    """The lenders' clock, moved by hand."""
+    t = [100.0]
+    monkeypatch.setattr(C.time, "monotonic", lambda: t[0])
+    return t
+
+
+def test_the_board_is_read_at_most_once_a_second_and_gone_with_its_folder(now):
     with C.share_board() as board:
         lender = C.ThreadLender(board)
         assert lender() == 1  # posted when the board is made
@@ -76,28 +82,20 @@ def test_three_cases_on_two_workers_leave_no_core_idle_when_the_last_takes_two(m
     assert C.WorkerUse.from_dict(use.to_dict()).to_dict() == use.to_dict()
 
 
-@pytest.mark.parametrize(
-    ("posted", "others", "cores", "taken"),
-    [
-        (2, None, 2, 2),  # the machine's load unknown: what is posted
-        (2, 0.1, 2, 2),  # a quiet machine: the idle core is free
-        (2, 0.9, 2, 1),  # another process holds the core: a second thread would wait on it
-        (2, 6.0, 2, 1),  # a loaded machine: one thread, never none
-        (8, 10.5, 16, 5),
-        (1, 0.0, 16, 1),
-    ],
-)
-def test_a_case_takes_only_the_threads_that_have_a_free_core(posted, others, cores, taken):
-    assert C.free_cores_allow(posted, others, cores) == taken
+def test_a_case_takes_only_the_threads_that_have_a_free_core():
+    # (posted, other processes' busy cores, the machine's cores) -> threads taken
+    assert C.free_cores_allow(2, None, 2) == 2  # the machine's load unknown: what is posted
+    assert C.free_cores_allow(2, 0.1, 2) == 2  # a quiet machine: the idle core is free
+    assert C.free_cores_allow(2, 0.9, 2) == 1  # another process holds the core: it would wait on it
+    assert C.free_cores_allow(2, 6.0, 2) == 1  # a loaded machine: one thread, never none
+    assert C.free_cores_allow(8, 10.5, 16) == 5 and C.free_cores_allow(1, 0.0, 16) == 1
 
 
-def test_the_lender_holds_back_threads_while_other_processes_use_the_cores(monkeypatch):
-    now = [0.0]
-    monkeypatch.setattr(C.time, "monotonic", lambda: now[0])
+def test_the_lender_holds_back_threads_while_other_processes_use_the_cores(now, monkeypatch):
     with C.share_board() as board:
+        board.post(2)
         lender = C.ThreadLender(board)
         lender.cores = 2
-        board.post(2)
         monkeypatch.setattr(lender.load, "cores", lambda: 1.8)  # another program runs meanwhile
         assert lender() == 1
         now[0] += C.POLL_S
