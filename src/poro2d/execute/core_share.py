@@ -138,7 +138,8 @@ class ThreadLender:
 class WorkerUse(TypedResult):
     """How a run's workers were used (``worker_use`` of a sweep's summary, of ``sand.json``).
 
-    ``workers``: the cores (worker processes) the cases ran on; ``cases``: the cases that ran;
+    ``workers``: the cores the cases ran on (the worker processes, at most the machine's cores);
+    ``cases``: the cases that ran;
     ``cases_per_worker``: how many each worker ran, by worker; ``threads_over_time``: the
     engine threads offered to each running case, as ``[seconds from the start, cases left,
     threads per case]`` at each change; ``busy_core_s``: the core-time the cases took (their

@@ -290,7 +290,8 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Sto
     with Executor(backend, client=client) as executor, share_board() as board:
         executor.start()
         cluster_info = executor.cluster_info()
-        workers = cluster_info.workers if cluster_info is not None else 1
+        # cores, not workers, are lent: workers beyond the cores (up to two per core) only queue
+        workers = min(cluster_info.workers if cluster_info is not None else 1, os.cpu_count() or 1)
         clock = CoreClock(workers, len(pending), DEFAULT_PARTITIONS, board if lend and workers > 1 else None)
         jobs = [
             Job(compute_case, (asdict(c), cases.child(c.id), KINDS[c.kind], clock.board), c.id,
