@@ -27,7 +27,19 @@ from poro2d.execute import Backend, Executor
 from poro2d.store import digests
 
 #: keys whose values say when, where or how long, never what: left out of every comparison
-VOLATILE = {"provenance", "host", "pid", "hostname", "python", "time_s", "created", "started", "finished"}
+VOLATILE = {
+    "provenance",
+    "host",
+    "pid",
+    "hostname",
+    "python",
+    "time_s",
+    "created",
+    "started",
+    "finished",
+    "worker_use",
+    "lent_core_s",
+}
 #: key endings of rates, which vary between runs of one case (durations: a key with "time" ending "_s")
 VOLATILE_SUFFIXES = ("per_s", "seconds", "elapsed_s")
 

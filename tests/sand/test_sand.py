@@ -202,12 +202,22 @@ def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
     )
     assert not (out / "fig_grading.png").exists()  # drawn from the result, after the run
     draw_grading(res, seen[0][0], Store(out))
-    assert isinstance(res, SandResult) and seen and len(lines) == 2 and "left (estimate)" in lines[0]
+    stages = [line for line in lines if "left (estimate)" in line]
+    assert isinstance(res, SandResult) and seen and len(stages) == 2 and "left (estimate)" in lines[0]
     assert isinstance(StageClock, type)
     assert (out / "preflight.json").is_file() and (out / "fig_grading.png").stat().st_size > 0
     data = json.loads((out / "sand.json").read_text())
     assert data["soil"]["name"] == "tiny paper sand" and data["provenance"]["poro2d_version"]
     assert data["calibration"]["mus"] == [0.0, 0.5]
+    # how the workers were used, stage by stage: every case that ran, on the workers there were
+    use = data["worker_use"]
+    assert {"calibration ends", "specimens"} <= set(use)
+    for stage in use.values():
+        assert sum(stage["cases_per_worker"].values()) == stage["cases"] and stage["idle_core_s"] >= 0.0
+    assert use["specimens"]["cases"] == 2 and any(
+        line.startswith("specimens: 2 case(s) on") for line in lines
+    )
+    assert "| workers, specimens |" in (out / "summary.md").read_text()
     # every seed is recorded, accepted or not, with its folder or the reason it was refused
     assert [r["seed"] for r in data["seed_results"]] == [0, 1]
     assert all(r["accepted"] == bool(r["folder"]) for r in data["seed_results"])

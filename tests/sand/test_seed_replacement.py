@@ -31,7 +31,7 @@ def _fake_sweep(refused: set[int], calls: list[list[int]]):
                     results={"converged": s not in refused, "message": "" if s not in refused else REFUSED})
             for c, s in zip(sweep.cases, seeds, strict=True)
         ]  # fmt: skip
-        return SimpleNamespace(rows=rows[::-1])  # in any order: the stage sorts them by seed
+        return SimpleNamespace(rows=rows[::-1], summary=None)  # in any order: the stage sorts them by seed
 
     return run_sweep
 

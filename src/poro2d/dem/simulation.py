@@ -24,6 +24,7 @@ import numpy as np
 
 from poro2d.dem import kernels as K
 from poro2d.dem.contact_law import PER_BODY, PER_PAIR_TYPE
+from poro2d.dem.cores import DEFAULT_PARTITIONS, cores_lent, note_block
 from poro2d.dem.layout import check_layout
 from poro2d.dem.model import (
     ContactModel,
@@ -212,7 +213,7 @@ class Simulation:
         mass_scaling_dt: float | None = None,
         skin: float | None = None,
         threads: int = 1,
-        partitions: int = 2,
+        partitions: int = DEFAULT_PARTITIONS,
     ) -> None:
         _prefer_openmp()
         self.particles = particles
@@ -241,6 +242,7 @@ class Simulation:
         self.partitions = int(partitions)
         self.threads = self.check_threads(threads)
         self.threads_used = 0  # threads the kernel ran on in its last call (0: not called yet)
+        self._block_threads = 1  # threads asked of the kernel in the current block
         self.step_count = 0
         self.time = 0.0
         # the forces (and so the unbalanced ratios) are those of a step; false before the
@@ -313,10 +315,15 @@ class Simulation:
 
     @property
     def effective_threads(self) -> int:
-        """Threads asked of the kernel: 1 for small systems, else ``threads`` (at most ``partitions``)."""
+        """Threads asked of the kernel: 1 for small systems, else ``threads`` or the cores lent to
+        this process (:mod:`poro2d.dem.cores`), whichever is more, at most ``partitions`` and
+        numba's thread pool: the same numbers on any of these counts."""
         if self.particles.n < self.parallel_min_particles:
             return 1
-        return min(self.threads, self.partitions)
+        import numba
+
+        lent = min(cores_lent(), numba.config.NUMBA_NUM_THREADS)
+        return min(max(self.threads, lent), self.partitions)
 
     # ----------------------------------------------------------------- setup
     @staticmethod
@@ -692,7 +699,7 @@ class Simulation:
         iprm[K.CHECK_EVERY] = check_every
         iprm[K.CHECK_OFFSET] = offset
         iprm[K.MEASURE] = measure
-        iprm[K.THREADS] = self.effective_threads
+        iprm[K.THREADS] = self._block_threads
 
     def kernel_records(self) -> KernelRecords:
         """The kernel's records of the current arrays (views: the kernel advances them in place)."""
@@ -712,7 +719,10 @@ class Simulation:
         """
         import numba
 
-        numba.set_num_threads(max(1, self.effective_threads))
+        # one count for the whole block (a lender may change its answer meanwhile)
+        self._block_threads = max(1, self.effective_threads)
+        numba.set_num_threads(self._block_threads)
+        started = time.perf_counter()
         if self.work.part.shape[0] != self.partitions + 1:
             self._renew_work(self.particles.n)  # partitions changed since allocation
         done = 0
@@ -753,6 +763,7 @@ class Simulation:
                 )
             if status == K.CONVERGED:
                 break
+        note_block(self.threads_used, time.perf_counter() - started)  # what lent cores did (dem.cores)
         return done, status, rebuilds
 
     def run(

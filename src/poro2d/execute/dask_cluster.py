@@ -66,7 +66,9 @@ def start_client(scheduler: str | None, workers: int | None, threads_needed: int
     if scheduler:
         return connect(scheduler), None
     n = workers or os.cpu_count() or 1
-    env = dict(SINGLE_THREAD_ENV, NUMBA_NUM_THREADS=str(max(1, threads_needed)))
+    # threads lent to a case wait passively between kernel blocks: on a shared machine a spinning
+    # OpenMP thread takes the core of another worker's case
+    env = dict(SINGLE_THREAD_ENV, NUMBA_NUM_THREADS=str(max(1, threads_needed)), OMP_WAIT_POLICY="PASSIVE")
     cluster = LocalCluster(
         n_workers=n,
         threads_per_worker=1,

@@ -17,6 +17,7 @@ import numpy as np
 
 from poro2d.criterion.density import Calibration
 from poro2d.critical_state.state_table import StateMapRecord, state_map_lines, state_map_record
+from poro2d.execute.core_share import WorkerUse, use_text
 from poro2d.io_utils import Provenance, float_or_nan
 from poro2d.lab_state import LabState
 from poro2d.labtest.records import ByName
@@ -25,7 +26,7 @@ from poro2d.sand.preflight import Preflight
 from poro2d.sand.profile import StageProfile
 from poro2d.store import Store
 from poro2d.sweep.records import CaseRow, LostCaseRow, SeedReplaced
-from poro2d.typed_result import NOT_IN_FILE, TypedResult
+from poro2d.typed_result import NOT_IN_FILE, Keyed, TypedResult
 
 
 def _stats(values: list[float | None]) -> tuple[float, float]:
@@ -162,6 +163,8 @@ class SandResult(TypedResult):
     provenance: Provenance
     #: both maps at the test stress, with a ``[state]`` table (:mod:`poro2d.critical_state.state_table`)
     state_map: StateMapRecord | None = None
+    #: how each stage's workers were used, by stage (:class:`~poro2d.execute.core_share.WorkerUse`)
+    worker_use: dict[str, WorkerUse] | None = None
     specimens: list[SeedSpecimen] = field(default_factory=list, metadata=NOT_IN_FILE)
 
     #: the typed parts, as their classes read them
@@ -175,8 +178,9 @@ class SandResult(TypedResult):
         "preflight": Preflight,
         "provenance": Provenance,
         "state_map": StateMapRecord,
+        "worker_use": Keyed(WorkerUse),
     }
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("state_map",)
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("state_map", "worker_use")
 
     @classmethod
     def build(
@@ -188,6 +192,7 @@ class SandResult(TypedResult):
         cal_record: SandCalibration,
         kept: list[SeedSpecimen],
         seconds: float,
+        worker_use: dict[str, WorkerUse] | None = None,
     ) -> SandResult:
         inner_m, inner_sd = _stats([k.interior_porosity for k in kept if k.accepted])
         box_m, box_sd = _stats([k.box_porosity for k in kept if k.accepted])
@@ -233,6 +238,7 @@ class SandResult(TypedResult):
             config=case.config.as_config(),
             provenance=Provenance.now(),
             state_map=state_map,
+            worker_use=worker_use,
             specimens=list(kept),
         )
 
@@ -330,6 +336,7 @@ def summary_markdown(res: SandResult, store: Store) -> str:
         f"| dense end, interior (calibration box) | {_fmt(res.calibration.dense_end_interior)} "
         f"(against the jamming porosity {_fmt(jam)}) |",
         f"| wall time | {res.wall_seconds / 60:.1f} min |",
+        *[f"| workers, {stage} | {use_text(use)} |" for stage, use in (res.worker_use or {}).items()],
         *_profile_rows(res),
         "",
         *[line for w in warnings(res) for line in (f"**Note:** {w}", "")],

@@ -31,6 +31,7 @@ import numpy as np
 from poro2d.criterion.density import Calibration, StateTarget, state_target
 from poro2d.errors import InputError
 from poro2d.execute.cluster_options import check_cluster_options
+from poro2d.execute.core_share import WorkerUse, use_text
 from poro2d.execute.options import RunOptions
 from poro2d.interop.origin import SOIL_FILE
 from poro2d.io_utils import Provenance, check_output_dir
@@ -92,6 +93,12 @@ class StageClock:
         return time.perf_counter() - self.t0
 
 
+def say_use(uses: dict[str, WorkerUse], announce: Announce) -> None:
+    """One line per sweep of a stage: how its workers were used."""
+    for stage, use in uses.items():
+        announce(f"{stage}: {use_text(use)}")
+
+
 def _clock(seconds: float) -> str:
     s = int(round(max(seconds, 0.0)))
     return f"{s // 3600:d}:{s % 3600 // 60:02d}:{s % 60:02d}"
@@ -144,20 +151,35 @@ def _calibrate(case, pf, store: Store, mus, record, cal_kw) -> tuple[Calibration
     return D.calibrate(calibration_case(case, pf, mus), store, record=record, **cal_kw)
 
 
+def note_use(uses: dict[str, WorkerUse] | None, stage: str, summary) -> None:
+    """Keep in ``uses`` how the workers of a stage's sweep were used (when its cases ran there)."""
+    use = None if summary is None else summary.worker_use
+    if uses is None or use is None:
+        return
+    name, k = stage, 1
+    while name in uses:  # a stage run again (an end given up, seeds replaced)
+        k += 1
+        name = f"{stage} {k}"
+    uses[name] = use
+
+
 def calibration_stage(
-    case: SandCase, pf: Preflight, store: Store, cal_kw: dict
+    case: SandCase, pf: Preflight, store: Store, cal_kw: dict, uses: dict[str, WorkerUse] | None = None
 ) -> tuple[StateTarget, SandCalibration]:
     """The ends, then the two frictions around the state: its target and friction.
 
-    ``cal_kw``: ``options`` and ``use_cache`` (:func:`poro2d.sweep.density.calibrate`).
+    ``cal_kw``: ``options`` and ``use_cache`` (:func:`poro2d.sweep.density.calibrate`); ``uses``:
+    where each sweep's worker use is kept (:func:`note_use`).
     """
-    cal_ends, usable, ends_info = calibrate_ends(case, pf, store, cal_kw)
+    cal_ends, usable, ends_info = calibrate_ends(case, pf, store, cal_kw, uses)
     ends = [usable[0], usable[-1]]
     first = state_target(case.lab.n_lab, case.n_max, case.n_min, cal_ends)
     mus = bracket(usable, predicted_mu(cal_ends, first.n2d_target))
     cal, info = (
         (cal_ends, ends_info) if mus == ends else _calibrate(case, pf, store, mus, "calibration.json", cal_kw)
     )
+    if mus != ends:
+        note_use(uses, "calibration", info.summary)
     if mus == ends:
         store.write_json(
             "calibration.json", {"calibration": cal.to_dict(), "mus": mus, "note": "the ends only"}
@@ -180,7 +202,7 @@ def calibration_stage(
 
 
 def calibrate_ends(
-    case: SandCase, pf: Preflight, store: Store, cal_kw: dict
+    case: SandCase, pf: Preflight, store: Store, cal_kw: dict, uses: dict[str, WorkerUse] | None = None
 ) -> tuple[Calibration, tuple, CalibrationRun]:
     """The densest and loosest preparations that at least one seed could prepare.
 
@@ -191,6 +213,7 @@ def calibrate_ends(
     lo, hi = 0, len(case.mus) - 1
     while True:
         cal, info = _calibrate(case, pf, store, [case.mus[lo], case.mus[hi]], "calibration_ends.json", cal_kw)
+        note_use(uses, "calibration ends", info.summary)
         ok_lo, ok_hi = cal.accepted(0).size > 0, cal.accepted(1).size > 0
         if ok_lo and ok_hi:
             return cal, case.mus[lo : hi + 1], info
@@ -201,8 +224,9 @@ def calibrate_ends(
 
 
 def specimen_stage(
-    case: SandCase, trial: StateTarget, store: Store, options: RunOptions, announce: Announce = _quiet
-) -> list[CaseRow | LostCaseRow]:
+    case: SandCase, trial: StateTarget, store: Store, options: RunOptions, announce: Announce = _quiet,
+    uses: dict[str, WorkerUse] | None = None,
+) -> list[CaseRow | LostCaseRow]:  # fmt: skip
     """One criterion case per seed at full size, at the state's friction, from ``trial``.
 
     A seed not accepted is replaced by the next unused seed, at most ``case.replacements`` in
@@ -220,6 +244,7 @@ def specimen_stage(
     while True:
         sweep = D.StateChecks(case.config, (trial,), tried, grid, first_seed=first).sweep
         res = run_sweep(sweep, store.child("states"), options=options)
+        note_use(uses, "specimens", res.summary)
         rows = sorted(res.rows, key=case_seed)
         more = min(case.seeds - sum(map(seed_accepted, rows)), case.seeds + case.replacements - tried)
         if more <= 0:
@@ -334,15 +359,20 @@ def _run_sand(case, pf, store, options, use_cache, announce, on_preflight) -> Sa
     t = clock.begin(
         f"calibration: {pf.cases_calibration} cases at most, {pf.calibration_box.disks:.0f} disks each",
     )
-    target, cal_record = calibration_stage(case, pf, store, {"options": options, "use_cache": use_cache})
+    uses: dict[str, WorkerUse] = {}
+    target, cal_record = calibration_stage(
+        case, pf, store, {"options": options, "use_cache": use_cache}, uses
+    )
     clock.end("calibration", t)
+    say_use(uses, announce)
     trial = full_box_trial(target.n2d_target, pf.jamming.porosity, cal_record.n2d_min, pf)
     t = clock.begin(
         f"specimens: {case.seeds} at full size ({pf.box.disks:.0f} disks), "
         f"mu_prep {target.mu_prep:.3f}, first trial {trial:.4f}",
     )
-    rows = specimen_stage(case, replace(target, n2d_target=trial), store, options, announce)
+    rows = specimen_stage(case, replace(target, n2d_target=trial), store, options, announce, uses)
     clock.end("specimens", t)
+    say_use({k: v for k, v in uses.items() if k.startswith("specimens")}, announce)
     kept = keep_specimens(rows, store, _state_label(case), case.soil_record(), case.lab.to_dict())
     cal_ids = [c.id for c in calibration_case(case, pf, [float(m) for m in cal_record.mus]).sweep.cases]
     runs = [c.child("run") for c in walk(store.child("states", "cases"), "*")]
@@ -351,7 +381,7 @@ def _run_sand(case, pf, store, options, use_cache, announce, on_preflight) -> Sa
         time_profile=stage_profile(case_runs(Store(cal_record.cases), cal_ids)),
         specimens_time_profile=stage_profile(runs),
     )
-    result = SandResult.build(case, pf, target, trial, cal_record, kept, clock.elapsed())
+    result = SandResult.build(case, pf, target, trial, cal_record, kept, clock.elapsed(), uses or None)
     write_summary(result, store)
     return result
 

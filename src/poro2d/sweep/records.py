@@ -15,6 +15,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Self
 
+from poro2d.execute.core_share import WorkerUse
 from poro2d.labtest.records import ByName
 from poro2d.typed_result import TypedResult
 
@@ -158,8 +159,12 @@ class SweepSummary(TypedResult):
 
     ``parallel_efficiency``: busy case time over wall time and worker threads (when a
     cluster ran cases); ``from_calibration``: the state checks read back from the
-    calibration's cases (a relation's ``states_summary``).
+    calibration's cases (a relation's ``states_summary``); ``worker_use``: cases per worker,
+    threads per case over time and idle core-time (when cases ran).
     """
+
+    OPTIONAL = ("worker_use",)
+    PARTS = {"worker_use": WorkerUse}
 
     cases: int | None = None
     ran: int | None = None
@@ -171,6 +176,7 @@ class SweepSummary(TypedResult):
     worker_processes: list[str] | None = None
     parallel_efficiency: float | None = None
     from_calibration: int | None = None
+    worker_use: WorkerUse | None = None
 
 
 @dataclass(eq=False)

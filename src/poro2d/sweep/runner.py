@@ -25,13 +25,16 @@ import os
 import socket
 import time
 import traceback
+from contextlib import contextmanager
 from dataclasses import asdict, replace
 from datetime import UTC, datetime
 from typing import Any
 
 import numpy as np
 
+from poro2d.dem.cores import DEFAULT_PARTITIONS, lend_cores, lending, lent_core_seconds
 from poro2d.execute import Executor, Failed, Job
+from poro2d.execute.core_share import CoreClock, ShareBoard, ThreadLender, WorkerUse, share_board
 from poro2d.execute.dask_cluster import ClusterInfo, pin_numba_threads
 from poro2d.execute.options import RunOptions
 from poro2d.io_utils import Provenance
@@ -92,16 +95,29 @@ def finished_row(case: dict, store: Store) -> CaseRow | None:
 
 
 # ------------------------------------------------------------------------ worker side
-def compute_case(case: dict, store: Store, func) -> CaseRow:
+def compute_case(case: dict, store: Store, func, board: ShareBoard | None = None) -> CaseRow:
     """Run one case on a worker; never raises for errors of the case itself.
 
     ``func`` is the kind's callable, shipped with the task so that kinds registered
     at run time (tests, plug-ins) work on any worker. The case folder is held while the
     case runs: a worker left running by a killed sweep may still compute it, and a rerun's
     worker then waits for it and reads its result back instead of writing beside it.
+    ``board``: where the run posts the threads per case when fewer cases than workers remain
+    (:mod:`poro2d.execute.core_share`): the case's simulations take them at their next block.
     """
-    with cache_entry(store.root, parameter="case folder"):
+    with cache_entry(store.root, parameter="case folder"), lent_cores(board):
         return _run_case(case, store, func)
+
+
+@contextmanager
+def lent_cores(board: ShareBoard | None):
+    """The threads posted on ``board`` lent to this process's simulations while the case runs."""
+    before = lend_cores(ThreadLender(board)) if board is not None else None
+    try:
+        yield
+    finally:
+        if board is not None:
+            lend_cores(before)
 
 
 def _run_case(case: dict, store: Store, func) -> CaseRow:
@@ -146,6 +162,8 @@ def _done_row(case: dict, store: Store, func, row: dict, t0: float) -> CaseRow:
         )
     results = {str(k): _scalar(v) for k, v in results.items()}
     row.update(status="done", error=None, time_s=time.perf_counter() - t0, finished_utc=_now())
+    if lending():  # the core-time its threads beyond one took (poro2d.execute.core_share)
+        row["lent_core_s"] = lent_core_seconds()
     row["results"] = results
     for stale in (ERROR_TXT, ERROR_JSON):
         store.remove(stale)
@@ -229,7 +247,9 @@ def run_sweep(
                 rows[c.id] = CaseRow.from_dict(dict(done.to_dict(), status="done", reused=True))
         n_reused = len(rows)
         pending = [c for c in sweep.cases if c.id not in rows]
-        cluster_info = _run_pending(sweep, pending, rows, cases, options, client) if pending else None
+        cluster_info, use = (
+            _run_pending(sweep, pending, rows, cases, options, client) if pending else (None, None)
+        )
         ordered = [type(r).from_dict(dict(r.to_dict(), reused=bool(r.extra.get("reused", False))))
                    for r in (rows[c.id] for c in sweep.cases)]  # fmt: skip
         df = table_from_rows(ordered, sweep.axes)
@@ -237,7 +257,7 @@ def run_sweep(
         store.write_frame("results.csv", df)
         if store.write_parquet("results.parquet", df) is None:
             say_no_parquet(store)
-        summary = _summary(ordered, n_reused, time.perf_counter() - t_start, cluster_info)
+        summary = _summary(ordered, n_reused, time.perf_counter() - t_start, cluster_info, use)
         record.update(status="finished", cluster=cluster_info or {}, summary=summary, finished_utc=_now())
         store.write_json("sweep.json", record)
     return replace(SweepResult.from_dict(record), rows=ordered, table=df, store=store)
@@ -255,23 +275,29 @@ def say_no_parquet(store: Store) -> None:
 
 
 def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Store, options: RunOptions,
-                 client) -> ClusterInfo | None:  # fmt: skip
+                 client) -> tuple[ClusterInfo | None, WorkerUse]:  # fmt: skip
     """Every pending case as a job on ``client`` (or a cluster made for them), its row into ``rows`` (a
     failed task gives an error row); returns what is recorded of the cluster (scheduler, workers,
-    threads, dashboard)."""
+    threads, dashboard) and of its use. On a cluster started here, the cores of finished cases go
+    to the cases still running as engine threads (:mod:`poro2d.execute.core_share`)."""
     from poro2d.progress import CountProgress
 
     threads = max(int((c.config.get("specimen") or {}).get("threads", 1) or 1) for c in pending)
-    jobs = [
-        Job(compute_case, (asdict(c), cases.child(c.id), KINDS[c.kind]), c.id, key=f"{c.kind}-{c.id}",
-            retries=sweep.retries)
-        for c in pending
-    ]  # fmt: skip
+    lend = client is None and options.scheduler is None  # the cores of a cluster started here
     n_reused = len(sweep.cases) - len(pending)
     label = f"sweep ({n_reused} of {len(sweep.cases)} already done)" if n_reused else "sweep"
-    with Executor(options.dask_backend(threads), client=client) as executor:
+    backend = options.dask_backend(max(threads, DEFAULT_PARTITIONS) if lend else threads)
+    with Executor(backend, client=client) as executor, share_board() as board:
         executor.start()
         cluster_info = executor.cluster_info()
+        # cores, not workers, are lent: workers beyond the cores (up to two per core) only queue
+        workers = min(cluster_info.workers if cluster_info is not None else 1, os.cpu_count() or 1)
+        clock = CoreClock(workers, len(pending), DEFAULT_PARTITIONS, board if lend and workers > 1 else None)
+        jobs = [
+            Job(compute_case, (asdict(c), cases.child(c.id), KINDS[c.kind], clock.board), c.id,
+                key=f"{c.kind}-{c.id}", retries=sweep.retries)
+            for c in pending
+        ]  # fmt: skip
         if options.progress and cluster_info is not None and cluster_info.dashboard:
             from poro2d.console import OutputConsole
 
@@ -289,17 +315,21 @@ def _run_pending(sweep: SweepConfig, pending: list[Case], rows: dict, cases: Sto
                         c, cases.child(c.id), exc, f"{outcome.traceback}{type(exc).__name__}: {exc}\n"
                     )
                 rows[c.id] = outcome
+                clock.case_ended()
                 n_failed = sum(r.status == "failed" for r in rows.values())  # a reused case is done
-                bar.advance(f"{n_failed} failed" if n_failed else "")
+                bar.advance(", ".join(filter(None, [f"{n_failed} failed" if n_failed else "", clock.note()])))
 
             executor.map(jobs, on_done=ended)
-    return cluster_info
+        use = clock.use([rows[c.id] for c in pending])
+    return cluster_info, use
 
 
 def _summary(
-    ordered: list[CaseRow | LostCaseRow], n_reused: int, wall: float, cluster_info: ClusterInfo | None
-) -> SweepSummary:
-    """Counts, wall and case time, the worker processes and the parallel efficiency of a sweep."""
+    ordered: list[CaseRow | LostCaseRow], n_reused: int, wall: float, cluster_info: ClusterInfo | None,
+    use: WorkerUse | None = None,
+) -> SweepSummary:  # fmt: skip
+    """Counts, wall and case time, the worker processes, the parallel efficiency of a sweep and how its
+    workers were used."""
     busy = sum(r.time_s or 0.0 for r in ordered if not r.extra["reused"])
     summary = {
         "cases": len(ordered),
@@ -313,6 +343,8 @@ def _summary(
     }
     if cluster_info is not None and cluster_info.threads:
         summary["parallel_efficiency"] = busy / (wall * cluster_info.threads) if wall > 0 else None
+    if use is not None:
+        summary["worker_use"] = use
     return SweepSummary.from_dict(summary)
 
 
