@@ -28,6 +28,12 @@ its own row, its walls, then its cross pairs; for a wall, partition by partition
 With rolling resistance a contact's moment on a disk is its shear moment plus (or, on the
 second disk, minus) its rolling moment, added as one term.
 
+What the steps write: a pair's history (``fs``, ``mr``) at every step; its geometry and
+normal force (``ov``, ``fn``, ``nx``, ``ny``) and the disks' unbalanced forces and moments
+only where they are read: for the cross pairs and deferred disks at every step (phase 2
+reads them), for everything on a stop-check step and on the call's last step (the stop
+test and Python read them). The other steps move less memory; no number depends on it.
+
 Threads: one worker per thread runs all steps of the call, each on its own
 partitions; workers meet at two barriers per step (after phase 1, after phase 2;
 one more on stop-check steps, and a few between the phases of a list rebuild), not at
@@ -175,7 +181,7 @@ def _damped(f, v, damp):
 
 
 @njit(cache=True)
-def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp):
+def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp, stored):
     """Phase 1 on partition k: forces of its rows, advance of its non-deferred disks.
 
     ``props`` holds the disks' (kn, ks, mu) (:class:`~poro2d.dem.records.BodyProps`) when
@@ -185,6 +191,17 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
     they need cost registers in the pair loop (5-7 % of its speed), even when never taken.
     ``roll`` likewise: the bodies' rolling frictions (:class:`~poro2d.dem.records.RollingProps`),
     None when no disk has one, and then no rolling moment is computed or stored.
+
+    ``stored`` (True, or None) says whether this step keeps what only readers after it
+    need: every pair's geometry and normal force (``ov``, ``fn``, ``nx``, ``ny`` of both
+    lists) and every disk's unbalanced force and moment. They drive no later step; they
+    are read by the stop test, by Python after a call, and, for the cross pairs and the
+    deferred disks, by phase 2 of the same step, which therefore get them at every step.
+    The driver asks for them on a check step and on the last step of a call
+    (:func:`_stores_all`). Skipping them elsewhere spares the force pass most of its
+    writes: the pair loop then writes only the history (``fs``, ``mr``). A step that
+    stores writes the normal of every listed pair, touching or not, so what a call leaves
+    does not depend on where earlier calls ended.
 
     Returns the largest squared drift of the disks advanced.
     """
@@ -237,12 +254,18 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
             dy = posf[U2 * j + U1] - yi
             d = math.sqrt(dx * dx + dy * dy)
             ov = ri + radius[j] - d
-            nb_ov[p] = ov
             if ov <= 0.0:
-                nb_fn[p] = 0.0
                 nb_fs[p] = 0.0  # contact lost: history ends
                 if roll is not None:
                     nb_mr[p] = 0.0
+                if stored is not None:  # apart: d >= ri + rj > 0
+                    inv = 1.0 / d
+                    nb_ov[p] = ov
+                    nb_fn[p] = 0.0
+                    nb_nx[p] = dx * inv
+                    nb_ny[p] = dy * inv
+                elif js >= i1:  # a cross pair: phase 2 reads that it is apart
+                    nb_ov[p] = ov
                 continue
             if props is not None:
                 kn, ks, mu = mix(props.kn[i], props.ks[i], props.mu[i], props.kn[j], props.ks[j], props.mu[j])
@@ -265,10 +288,7 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
             fn, fs, fxp, fyp = contact_force(
                 ov, nx, ny, dvx, dvy, ai, aj, wi, wj, nb_fs[p], kn, ks, mu, cn, dt
             )
-            nb_fn[p] = fn
             nb_fs[p] = fs
-            nb_nx[p] = nx
-            nb_ny[p] = ny
             fx += fxp
             fy += fyp
             mi = ai * fs  # the contact's moments on i and on j
@@ -285,6 +305,12 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
                 accf[U3 * j] -= fxp
                 accf[U3 * j + U1] -= fyp
                 accf[U3 * j + U2] += mj
+                if stored is None:
+                    continue
+            nb_ov[p] = ov  # a cross pair's, or on a step that stores them all
+            nb_fn[p] = fn
+            nb_nx[p] = nx
+            nb_ny[p] = ny
         for p_ in range(wb_start[i_], wb_start[i_ + 1]):
             p = np.uint64(p_)
             w = np.uint64(wb_w[p])
@@ -293,12 +319,14 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
             dy = cy - yi
             d = math.sqrt(dx * dx + dy * dy)
             ov = ri - d
-            wb_ov[p] = ov
             if ov <= 0.0:
-                wb_fn[p] = 0.0
                 wb_fs[p] = 0.0
                 if roll is not None:
                     wb_mr[p] = 0.0
+                if stored is not None:
+                    wb_ov[p] = ov
+                    wb_fn[p] = 0.0
+                    wb_nx[p], wb_ny[p] = _wall_normal(dx, dy, d, wp1[w, 0] - wp0[w, 0], wp1[w, 1] - wp0[w, 1])
                 continue
             if pw_body:
                 wkn_, wks_, wmu_ = mix(pkn[i], pks[i], pmu[i], wkn[w], wks[w], wmu[w])
@@ -315,10 +343,12 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
                 ov, nx, ny, wvel[w, 0] - velf[U2 * i], wvel[w, 1] - velf[U2 * i + U1], ai, 0.0, omega[i], 0.0,
                 wb_fs[p], wkn_, wks_, wmu_, cn, dt,
             )  # fmt: skip
-            wb_fn[p] = fn
             wb_fs[p] = fs
-            wb_nx[p] = nx
-            wb_ny[p] = ny
+            if stored is not None:
+                wb_ov[p] = ov
+                wb_fn[p] = fn
+                wb_nx[p] = nx
+                wb_ny[p] = ny
             fx += fxp
             fy += fyp
             mi = ai * fs
@@ -332,9 +362,10 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
             wpart[k, w, WFY] -= fyp
             wpart[k, w, WCOUNT] += 1.0
             wpart[k, w, WKSUM] += wkn_
-        force[i, 0] = fx
-        force[i, 1] = fy
-        moment[i] = mz
+        if stored is not None or xstart[i_ + 1] > xstart[i_]:
+            force[i, 0] = fx
+            force[i, 1] = fy
+            moment[i] = mz
         if xstart[i_ + 1] > xstart[i_]:
             continue  # deferred: the partial sums wait in force and moment for phase 2
         # ready for the next step: the earlier rows of its partition add to this
@@ -447,6 +478,20 @@ def _move_walls(walls, dt):
 
 
 @njit(cache=True)
+def _clear_tail(ov, fn, nx, ny, used, old_used):
+    """Zero the geometry of the slots a shorter list leaves behind (``used`` to ``old_used``).
+
+    They would hold what the last step that stored (see :func:`_phase_forces`) wrote, and
+    which step that was depends on where calls ended; zeros do not.
+    """
+    for p in range(used, old_used):
+        ov[p] = 0.0
+        fn[p] = 0.0
+        nx[p] = 0.0
+        ny[p] = 0.0
+
+
+@njit(cache=True)
 def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out, levels):
     """All workers rebuild the lists together; thread 0 does the serial parts.
 
@@ -491,6 +536,9 @@ def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out, levels):
         if wtotal > wb_w.shape[0]:
             out[NEED_PW] = wtotal
             status = OVERFLOW
+        if status == RUNNING:
+            _clear_tail(nb.ov, nb.fn, nb.nx, nb.ny, total, nb_start[n])
+            _clear_tail(wb.ov, wb.fn, wb.nx, wb.ny, wtotal, wb_start[n])
         atomic_store(sync, STATUS_WORD, status)
     barrier(sync, nthr)
     if atomic_load(sync, STATUS_WORD) != RUNNING:
@@ -563,6 +611,18 @@ def _converged(t, nthr, disks, nb, wb, sync, out, target, measure):
     return atomic_load(sync, STATUS_WORD) == CONVERGED
 
 
+@njit(inline="always", cache=True)
+def _stores_all(step, nsteps, since_check, check_every):
+    """Whether step ``step`` of a call stores every pair's geometry and every disk's force.
+
+    The stop test reads them right after a check step, and Python after the call's last
+    step (contacts, checkpoints, measurements). A call that stops early stops on a check
+    step; one that stops at a full list reports the overflow, and the driver calls again
+    for the steps left, which end on a step that stores.
+    """
+    return step == nsteps - 1 or (check_every > 0 and since_check + 1 == check_every)
+
+
 @njit(cache=True)
 def _report(status, steps, rebuilds, need_build, pos, iprm, out):
     """The call's outcome for the driver, written once by thread 0 after the last step."""
@@ -592,7 +652,7 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, ro
     steps = 0
     rebuilds = 0
     status = RUNNING
-    for _step in range(nsteps):
+    for step in range(nsteps):
         if need_build:
             if not _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out, levels):
                 status = OVERFLOW
@@ -602,10 +662,16 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, ro
         # phase 1: forces; disks without cross pairs advance at once. Both phases stay here:
         # a helper taking the records would add a reference count per array at every step
         dmax = 0.0
+        stores = _stores_all(step, nsteps, since_check, check_every)
         for k in range(k0, k1):
-            d2 = _phase_forces(
-                k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp
-            )
+            if stores:
+                d2 = _phase_forces(
+                    k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp, True
+                )
+            else:
+                d2 = _phase_forces(
+                    k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp, None
+                )
             if d2 > dmax:
                 dmax = d2
         barrier(sync, nthr)

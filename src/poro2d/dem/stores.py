@@ -38,7 +38,11 @@ class ContactStore:
 
     A disk-disk list holds each pair once, in the row of its smaller disk (``other`` the
     larger); a disk-wall list holds the walls near each disk (``other`` a wall number).
-    Slots up to ``used`` are filled; the arrays are ``capacity`` long. When a list build
+    Slots up to ``used`` are filled; the arrays are ``capacity`` long. After a kernel call,
+    ``fs``, ``fn``, ``ov``, ``nx``, ``ny`` and ``mr`` are those of its last step for every
+    filled slot (the normal also for a pair apart), and ``fn``, ``ov``, ``nx``, ``ny`` are 0
+    in the slots a shorter list left behind: the kernel writes them only on the steps that
+    someone reads them after (:mod:`poro2d.dem.kernels`). When a list build
     needs more slots the kernel stops before changing the list and reports how many: the
     driver notes it (:meth:`note_demand`, which sets ``overflow`` and ``needed``), grows
     the store and calls again.
