@@ -62,10 +62,12 @@ from poro2d.dem.sync import barrier, fresh_sync, start_handshake  # noqa: E402
 
 
 @njit
-def _loop_forces(reps, k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body):
+def _loop_forces(reps, k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, stored):
     dt, gx, gy, damp = prm[K.DT], prm[K.GX], prm[K.GY], prm[K.DAMP]
     for _ in range(reps):
-        K._phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp)
+        K._phase_forces(
+            k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp, stored
+        )
 
 
 @njit
@@ -188,12 +190,16 @@ def phase_times(sim, reps: int) -> dict:
             res[f"  rebuild: {name}"] = _best_per_call(
                 lambda r, q=q: _loop_rebuild_part(r, q, d, w, nb, wb, work, prm), max(1, reps // 5), state
             )
-    for k in range(work.part.shape[0] - 1):
-        res[f"force pass, partition {k}"] = _best_per_call(
-            lambda r, k=k: _loop_forces(r, k, d, w, nb, wb, work, prm, props, dash, roll, pw_body),
-            reps,
-            state,
-        )
+    # the pass of most steps (history only), and of a check step or a call's last (everything stored)
+    for stored, label in ((None, ""), (True, ", storing all")):
+        for k in range(work.part.shape[0] - 1):
+            res[f"force pass{label}, partition {k}"] = _best_per_call(
+                lambda r, k=k, s=stored: _loop_forces(
+                    r, k, d, w, nb, wb, work, prm, props, dash, roll, pw_body, s
+                ),
+                reps,
+                state,
+            )
     res["deferred pass"] = _best_per_call(lambda r: _loop_deferred(r, d, nb, work, roll, prm), reps, state)
     res["walls"] = _best_per_call(lambda r: _loop_walls(r, w, 0.0), reps, state)
     sync = fresh_sync()
@@ -207,25 +213,35 @@ def phase_times(sim, reps: int) -> dict:
 
 
 def force_pass_bytes(sim) -> dict:
-    """Bytes the force pass touches per disk (its own row) and per Verlet pair, by array."""
+    """Bytes the force pass of most steps touches per disk (its own row) and per Verlet pair, by array.
+
+    Most steps store no geometry and no unbalanced force (``fn``, ``ov``, ``nx``, ``ny``,
+    ``force``, ``moment``: a check step and a call's last step do, and the few cross pairs
+    and deferred disks at every step); those are counted apart, as ``stored_*``.
+    """
     p = sim.particles
     per_disk = {
         "pos": p.pos.itemsize * 2, "vel": p.vel.itemsize * 2, "omega": 8, "theta": 8, "acc": 24,
-        "force": 16, "moment": 8, "radius": 8, "mass": 8, "inv_mass": 8, "inv_inertia": 8,
+        "radius": 8, "mass": 8, "inv_mass": 8, "inv_inertia": 8,
         "mode": p.mode.itemsize, "pos_build": 16, "nb.start": 8, "wb.start": 8, "xstart": 8,
     }  # fmt: skip
+    stored_disk = {"force": 16, "moment": 8}
     if sim.kernel_params.iprm[K.MODE] == K.PER_BODY:
         per_disk.update({"kn": 8, "ks": 8, "mu": 8})
     nb = sim.pairs
-    per_pair = {"j": nb.other.itemsize, "fs": 8, "fn": 8, "ov": 8, "nx": 8, "ny": 8}
+    per_pair = {"j": nb.other.itemsize, "fs": 8}
+    stored_pair = {"fn": 8, "ov": 8, "nx": 8, "ny": 8}
     if K.rolling_active(p.mu_r):
         per_pair["mr"] = 8
     n, m = p.n, nb.used
     disk_b, pair_b = sum(per_disk.values()), sum(per_pair.values())
+    sdisk_b, spair_b = sum(stored_disk.values()), sum(stored_pair.values())
     return {
         "per_disk": per_disk, "per_pair": per_pair, "bytes_per_disk": disk_b, "bytes_per_pair": pair_b,
+        "stored_per_disk": stored_disk, "stored_per_pair": stored_pair,
         "pairs_per_disk": m / n, "touching_per_disk": len(nb.touching()) / n,
         "step_mb": (n * disk_b + m * pair_b) / 1e6,
+        "stored_step_mb": (n * (disk_b + sdisk_b) + m * (pair_b + spair_b)) / 1e6,
     }  # fmt: skip
 
 
@@ -329,7 +345,7 @@ def show(name: str, r: dict) -> None:
     print(
         f"  force pass: {b['bytes_per_disk']} B per disk, {b['bytes_per_pair']} B per pair, "
         f"{b['pairs_per_disk']:.2f} pairs ({b['touching_per_disk']:.2f} touching) per disk: "
-        f"{b['step_mb']:.1f} MB per step"
+        f"{b['step_mb']:.1f} MB per step ({b['stored_step_mb']:.1f} MB on a step storing all)"
     )
     for when in ("built", "after_steps"):
         d = r["index_distance"][when]
