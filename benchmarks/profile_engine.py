@@ -215,15 +215,17 @@ def phase_times(sim, reps: int) -> dict:
 def force_pass_bytes(sim) -> dict:
     """Bytes the force pass of most steps touches per disk (its own row) and per Verlet pair, by array.
 
-    Most steps store no geometry and no unbalanced force (``fn``, ``ov``, ``nx``, ``ny``,
-    ``force``, ``moment``: a check step and a call's last step do, and the few cross pairs
-    and deferred disks at every step); those are counted apart, as ``stored_*``.
+    A disk's mode and its cross-pair rows are not read: cursors on the few disks held and
+    deferred stand for them. Most steps store no geometry and no unbalanced force (``fn``,
+    ``ov``, ``nx``, ``ny``, ``force``, ``moment``: a check step and a call's last step do,
+    and the few cross pairs and deferred disks at every step); those are counted apart, as
+    ``stored_*``.
     """
     p = sim.particles
     per_disk = {
         "pos": p.pos.itemsize * 2, "vel": p.vel.itemsize * 2, "omega": 8, "theta": 8, "acc": 24,
-        "radius": 8, "mass": 8, "inv_mass": 8, "inv_inertia": 8,
-        "mode": p.mode.itemsize, "pos_build": 16, "nb.start": 8, "wb.start": 8, "xstart": 8,
+        "radius": 8, "mass": 8, "inv_mass": 8, "inv_inertia": 8, "pos_build": 16, "nb.start": 8,
+        "wb.start": 8,
     }  # fmt: skip
     stored_disk = {"force": 16, "moment": 8}
     if sim.kernel_params.iprm[K.MODE] == K.PER_BODY:

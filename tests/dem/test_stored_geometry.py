@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 from poro2d.dem import Every, Particles, Simulation, Walls, checkpoint
+from poro2d.dem.state import FREE
 
 R = 1e-3
 CONTACT_FIELDS = ("start", "other", "fs", "fn", "ov", "nx", "ny", "mr")
@@ -44,9 +45,12 @@ def _box(nx: int = 12, ny: int = 22, per_body: bool = False, **kw) -> Simulation
     )
     w = Walls.box(0.0, 0.0, (nx + 1) * s, pos[:, 1].max() + 2 * R, 1e5, 1e5, 0.3)
     rolling = kw.pop("rolling", 0.0)
+    held = kw.pop("held", False)
     sim = Simulation(p, w, **kw)
     if rolling:
         sim.set_rolling_friction(rolling, walls=rolling)
+    if held:  # every 9th disk held still, in both partitions (the kernel skips their advance)
+        sim.fix_particles(np.arange(n) % 9 == 4)
     sim.set_wall_servo("top", 0.5 * float(p.mass.sum()) * 9.81, (0.0, -1.0), max_speed=0.2, integral=1e-3)
     return sim
 
@@ -89,6 +93,7 @@ VARIANTS = {
     "per_body": ({"per_body": True}, 0.075),
     "dashpot": ({"restitution": 0.5}, 0.06),
     "rolling": ({"rolling": 0.2, "per_body": True}, 0.06),
+    "held": ({"held": True}, 0.03),
 }
 
 
@@ -138,3 +143,18 @@ def test_a_resumed_run_stores_what_the_uninterrupted_one_does(tmp_path):
     checkpoint.save(a, tmp_path / "a.npz")
     checkpoint.save(b, tmp_path / "b.npz")
     assert checkpoint.state_digest(tmp_path / "a.npz") == checkpoint.state_digest(tmp_path / "b.npz")
+
+
+def test_held_disks_stay_and_the_others_move_also_after_their_mode_changed():
+    # the kernel finds the disks not free by a cursor on a list made before each call
+    sim = _box(held=True)
+    start = sim.particles.pos.copy()
+    held = sim.particles.mode != FREE
+    sim.run(3000)
+    pos = sim.particles.pos
+    assert held.sum() > 20 and np.array_equal(pos[held], start[held])
+    assert np.all(pos[~held, 1] < start[~held, 1])  # the free ones fell
+    sim.particles.mode[:] = FREE  # set free between calls: they fall too
+    before = pos.copy()
+    sim.run(3000)
+    assert np.all(sim.particles.pos[held, 1] < before[held, 1])

@@ -208,14 +208,14 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
     # local names for the arrays of the loop (the records' fields, read once)
     pos, vel, theta, omega = disks.pos, disks.vel, disks.theta, disks.omega
     force, moment, acc, radius = disks.force, disks.moment, disks.acc, disks.radius
-    mass, inv_mass, inv_inertia, pmode = disks.mass, disks.inv_mass, disks.inv_inertia, disks.mode
+    mass, inv_mass, inv_inertia = disks.mass, disks.inv_mass, disks.inv_inertia
     pkn, pks, pmu = disks.kn, disks.ks, disks.mu
     wp0, wp1, wvel, wkn, wks, wmu = walls.p0, walls.p1, walls.vel, walls.kn, walls.ks, walls.mu
     wpart = walls.part_sums
     nb_start, nb_j, nb_fs, nb_fn, nb_ov, nb_nx, nb_ny = nb.start, nb.j, nb.fs, nb.fn, nb.ov, nb.nx, nb.ny
     wb_start, wb_w, wb_fs, wb_fn, wb_ov, wb_nx, wb_ny = wb.start, wb.w, wb.fs, wb.fn, wb.ov, wb.nx, wb.ny
     nb_mr, wb_mr = nb.mr, wb.mr
-    pos_build, part, dlist, dstart = work.pos_build, work.part, work.dlist, work.dstart
+    pos_build, part, dlist, dstart, held = work.pos_build, work.part, work.dlist, work.dstart, work.held
     # flat views: an (n, 2) index costs a multiplication by a run-time row length
     posf = pos.reshape(pos.size)
     velf = vel.reshape(vel.size)
@@ -239,6 +239,9 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
     m = dstart[k]
     m1 = dstart[k + 1]
     deferred = dlist[m] if m < m1 else i1
+    # and one on the disks not free (``held``, ascending, n after the last): no per-disk mode
+    h = np.searchsorted(held, i0)
+    hold = held[h]
     dmax = 0.0
     for i_ in range(i0, i1):
         i = np.uint64(i_)  # unsigned indices: no negative-index wrap-around code
@@ -371,6 +374,10 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
             force[i, 0] = fx
             force[i, 1] = fy
             moment[i] = mz
+        free = i_ != hold
+        if not free:
+            h += 1
+            hold = held[h]
         if i_ == deferred:  # the partial sums wait in force and moment for phase 2
             m += 1
             deferred = dlist[m] if m < m1 else i1
@@ -379,7 +386,7 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
         accf[U3 * i] = mass[i] * gx
         accf[U3 * i + U1] = mass[i] * gy
         accf[U3 * i + U2] = 0.0
-        if pmode[i] == FREE:
+        if free:
             velf[U2 * i] += _damped(fx, velf[U2 * i], damp) * inv_mass[i] * dt
             velf[U2 * i + U1] += _damped(fy, velf[U2 * i + U1], damp) * inv_mass[i] * dt
             omega[i] += _damped(mz, omega[i], damp) * inv_inertia[i] * dt
@@ -712,13 +719,18 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, ro
 
 @njit(cache=True)
 def prepare(disks, nb, wb, work, prm):
-    """Before a call: gravity in every accumulator, partitions of the current lists."""
-    acc, mass = disks.acc, disks.mass
+    """Before a call: gravity in every accumulator, the disks not free, partitions of the current lists."""
+    acc, mass, mode, held = disks.acc, disks.mass, disks.mode, work.held
     n = disks.pos.shape[0]
+    h = 0
     for i in range(n):
         acc[i, 0] = mass[i] * prm[GX]
         acc[i, 1] = mass[i] * prm[GY]
         acc[i, 2] = 0.0
+        if mode[i] != FREE:  # modes change between calls only
+            held[h] = i
+            h += 1
+    held[h:] = n
     partition(n, nb.start, nb.j, wb.start, work.part, work.xstart, work.xpair, work.dlist, work.dstart)
 
 

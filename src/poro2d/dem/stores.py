@@ -160,6 +160,7 @@ class KernelWork:
     xstart: np.ndarray  # (n + 1) cross pairs of each disk
     dlist: np.ndarray  # the deferred disks (those with cross pairs)
     dstart: np.ndarray  # (partitions + 1) the deferred disks of each partition
+    held: np.ndarray  # (n + 1) the disks not free (prescribed), ascending, then n to the end
     part_sums: np.ndarray  # (partitions, nw + pad, 4) per-partition wall sums
     tmax: np.ndarray  # (partitions) largest squared drift per thread
     sync: np.ndarray  # barrier and status words (poro2d.dem.sync)
@@ -169,7 +170,7 @@ class KernelWork:
     @classmethod
     def empty(cls, n: int, nw: int, partitions: int, wall_pad: int) -> KernelWork:
         """Zeroed work arrays for ``n`` disks, ``nw`` walls and ``partitions``."""
-        derived = [np.zeros(0)] * 8  # acc .. sync: allocated by renew
+        derived = [np.zeros(0)] * 9  # acc .. sync: allocated by renew
         work = cls(np.zeros((n, 2)), np.zeros((nw, 2)), np.zeros((nw, 2)), *derived, grid_scratch(0))
         work.renew(n, nw, partitions, wall_pad)
         return work
@@ -181,6 +182,7 @@ class KernelWork:
         self.dlist = np.zeros(n, dtype=np.int64)
         self.part = np.zeros(partitions + 1, dtype=np.int64)
         self.dstart = np.zeros(partitions + 1, dtype=np.int64)
+        self.held = np.zeros(n + 1, dtype=np.int64)
         # wall sums per partition, wall_pad rows apart: two threads adding to the same
         # cache line would pass it back and forth at every wall contact
         self.part_sums = np.zeros((partitions, nw + wall_pad, 4))
