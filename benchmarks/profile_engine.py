@@ -62,11 +62,11 @@ from poro2d.dem.sync import barrier, fresh_sync, start_handshake  # noqa: E402
 
 
 @njit
-def _loop_forces(reps, k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, stored):
+def _loop_forces(reps, k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, stored, skip2):
     dt, gx, gy, damp = prm[K.DT], prm[K.GX], prm[K.GY], prm[K.DAMP]
     for _ in range(reps):
         K._phase_forces(
-            k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp, stored
+            k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp, stored, skip2
         )
 
 
@@ -190,12 +190,13 @@ def phase_times(sim, reps: int) -> dict:
             res[f"  rebuild: {name}"] = _best_per_call(
                 lambda r, q=q: _loop_rebuild_part(r, q, d, w, nb, wb, work, prm), max(1, reps // 5), state
             )
-    # the pass of most steps (history only), and of a check step or a call's last (everything stored)
-    for stored, label in ((None, ""), (True, ", storing all")):
+    # the pass of most steps (the history stored, no drift computed), and of a check step
+    # (everything stored, every drift computed)
+    for stored, skip2, label in ((None, np.inf, ""), (True, -1.0, ", check step")):
         for k in range(work.part.shape[0] - 1):
             res[f"force pass{label}, partition {k}"] = _best_per_call(
-                lambda r, k=k, s=stored: _loop_forces(
-                    r, k, d, w, nb, wb, work, prm, props, dash, roll, pw_body, s
+                lambda r, k=k, s=stored, v=skip2: _loop_forces(
+                    r, k, d, w, nb, wb, work, prm, props, dash, roll, pw_body, s, v
                 ),
                 reps,
                 state,
@@ -218,16 +219,16 @@ def force_pass_bytes(sim) -> dict:
     A disk's mode and its cross-pair rows are not read: cursors on the few disks held and
     deferred stand for them. Most steps store no geometry and no unbalanced force (``fn``,
     ``ov``, ``nx``, ``ny``, ``force``, ``moment``: a check step and a call's last step do,
-    and the few cross pairs and deferred disks at every step); those are counted apart, as
+    and the few cross pairs and deferred disks at every step), and read no build position
+    of a disk too slow to need its drift (``pos_build``); those are counted apart, as
     ``stored_*``.
     """
     p = sim.particles
     per_disk = {
         "pos": p.pos.itemsize * 2, "vel": p.vel.itemsize * 2, "omega": 8, "theta": 8, "acc": 24,
-        "radius": 8, "mass": 8, "inv_mass": 8, "inv_inertia": 8, "pos_build": 16, "nb.start": 8,
-        "wb.start": 8,
+        "radius": 8, "mass": 8, "inv_mass": 8, "inv_inertia": 8, "nb.start": 8, "wb.start": 8,
     }  # fmt: skip
-    stored_disk = {"force": 16, "moment": 8}
+    stored_disk = {"force": 16, "moment": 8, "pos_build": 16}
     if sim.kernel_params.iprm[K.MODE] == K.PER_BODY:
         per_disk.update({"kn": 8, "ks": 8, "mu": 8})
     nb = sim.pairs

@@ -181,7 +181,9 @@ def _damped(f, v, damp):
 
 
 @njit(cache=True)
-def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp, stored):
+def _phase_forces(
+    k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp, stored, skip2
+):
     """Phase 1 on partition k: forces of its rows, advance of its non-deferred disks.
 
     ``props`` holds the disks' (kn, ks, mu) (:class:`~poro2d.dem.records.BodyProps`) when
@@ -203,7 +205,12 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
     stores writes the normal of every listed pair, touching or not, so what a call leaves
     does not depend on where earlier calls ended.
 
-    Returns the largest squared drift of the disks advanced.
+    ``skip2``: a disk that moved at a squared speed below it this step cannot have drifted
+    half the skin since the lists were built (:func:`_drift_bound`), so its drift is not
+    computed (its build position not read); -1 computes every disk's.
+
+    Returns the largest squared drift of the disks whose drift was computed, and the largest
+    squared speed of those whose was not (-1 if none).
     """
     # local names for the arrays of the loop (the records' fields, read once)
     pos, vel, theta, omega = disks.pos, disks.vel, disks.theta, disks.omega
@@ -243,6 +250,7 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
     h = np.searchsorted(held, i0)
     hold = held[h]
     dmax = 0.0
+    vskip = -1.0
     for i_ in range(i0, i1):
         i = np.uint64(i_)  # unsigned indices: no negative-index wrap-around code
         fx = accf[U3 * i]
@@ -390,13 +398,19 @@ def _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body
             velf[U2 * i] += _damped(fx, velf[U2 * i], damp) * inv_mass[i] * dt
             velf[U2 * i + U1] += _damped(fy, velf[U2 * i + U1], damp) * inv_mass[i] * dt
             omega[i] += _damped(mz, omega[i], damp) * inv_inertia[i] * dt
-        posf[U2 * i] += velf[U2 * i] * dt
-        posf[U2 * i + U1] += velf[U2 * i + U1] * dt
+        vx = velf[U2 * i]
+        vy = velf[U2 * i + U1]
+        posf[U2 * i] += vx * dt
+        posf[U2 * i + U1] += vy * dt
         theta[i] += omega[i] * dt
-        ddx = posf[U2 * i] - pos_build[i, 0]
-        ddy = posf[U2 * i + U1] - pos_build[i, 1]
-        dmax = max(dmax, ddx * ddx + ddy * ddy)
-    return dmax
+        v2 = vx * vx + vy * vy
+        if v2 < skip2:  # never for a speed not finite
+            vskip = max(vskip, v2)
+        else:
+            ddx = posf[U2 * i] - pos_build[i, 0]
+            ddy = posf[U2 * i + U1] - pos_build[i, 1]
+            dmax = max(dmax, ddx * ddx + ddy * ddy)
+    return dmax, vskip
 
 
 @njit(cache=True)
@@ -582,6 +596,51 @@ def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out, levels):
     return True
 
 
+# relative and absolute (per step, x half the skin) slack of the drift bound: far above the
+# round-off of a position update, of a squared distance and of a square root
+BOUND_REL = 1e-9
+BOUND_ABS = 1e-6
+
+
+@njit(inline="always", cache=True)
+def _skip_below(bound, half_skin, dt):
+    """The squared speed below which a disk cannot drift past ``half_skin`` in one step.
+
+    ``bound`` holds every disk's drift since the lists were built, as of the last step; a
+    disk that then moves at speed v drifts at most ``bound + v dt`` (and a position's
+    round-off, the absolute slack). So the rebuild test needs its drift only above this.
+    -1 when the bound leaves no room (or is not finite): every drift is computed.
+    """
+    room = half_skin * (1.0 - BOUND_REL) - bound - BOUND_ABS * half_skin
+    if not room > 0.0:
+        return -1.0
+    v = room / (dt * (1.0 + BOUND_REL))
+    return v * v * (1.0 - BOUND_REL)
+
+
+@njit(cache=True)
+def _drift_bound(bound, tmax, tskip, nthr, dt, half_skin):
+    """A bound on every disk's drift after this step, from the threads' shared numbers.
+
+    A disk whose drift was computed drifted at most the square root of the largest of those
+    (``tmax``); one whose was not, at most the last bound plus its step (``tskip``, the
+    largest squared speed among them). When every drift was computed, the bound comes
+    down to the largest of them. A disk whose speed is not finite is always computed and
+    left out here (``>`` is false for NaN): the rebuild test takes it as before.
+    """
+    dexact = 0.0
+    vs = -1.0
+    for u in range(nthr):
+        if tmax[u] > dexact:
+            dexact = tmax[u]
+        if tskip[u] > vs:
+            vs = tskip[u]
+    b = math.sqrt(dexact)
+    if vs >= 0.0:
+        b = max(b, bound + math.sqrt(vs) * dt)
+    return b * (1.0 + BOUND_REL) + BOUND_ABS * half_skin
+
+
 @njit(cache=True)
 def _largest_drift(tmax, nthr, wp0, wall_build):
     """Largest squared drift of a disk or wall since the lists were built.
@@ -652,10 +711,13 @@ def _report(status, steps, rebuilds, need_build, pos, iprm, out):
 def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, roll, levels):
     """Run the steps of this call on thread t of nthr: partitions t P / nthr to (t + 1) P / nthr - 1."""
     wp0, wall_build = walls.p0, walls.p0_build
-    part, dstart, tmax, sync = work.part, work.dstart, work.tmax, work.sync
+    part, dstart, tmax, tskip, sync = work.part, work.dstart, work.tmax, work.tskip, work.sync
     dt, gx, gy, damp, target = prm[DT], prm[GX], prm[GY], prm[DAMP], prm[RATIO_TARGET]
     measure, nsteps, check_every = iprm[MEASURE], iprm[NSTEPS], iprm[CHECK_EVERY]
-    lim2 = (0.5 * prm[SKIN]) ** 2
+    half_skin = 0.5 * prm[SKIN]
+    lim2 = half_skin**2
+    # every disk's drift since the last build is at most this: the first step computes all
+    bound = np.inf
     pw_body = iprm[MODE_PW] == PER_BODY
     # steps of the run since its last stop test: the test schedule ignores where calls begin
     since_check = iprm[CHECK_OFFSET] % check_every if check_every > 0 else 0
@@ -673,21 +735,60 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, ro
                 break
             need_build = False
             rebuilds += 1
+            bound = 0.0  # every disk at its build position
         # phase 1: forces; disks without cross pairs advance at once. Both phases stay here:
         # a helper taking the records would add a reference count per array at every step
         dmax = 0.0
+        vskip = -1.0
         stores = _stores_all(step, nsteps, since_check, check_every)
+        check = check_every > 0 and since_check + 1 == check_every
+        # a check step computes every drift: its finiteness test sees them all, as ever
+        skip2 = -1.0 if check else _skip_below(bound, half_skin, dt)
         for k in range(k0, k1):
             if stores:
-                d2 = _phase_forces(
-                    k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp, True
+                d2, v2 = _phase_forces(
+                    k,
+                    disks,
+                    walls,
+                    nb,
+                    wb,
+                    work,
+                    prm,
+                    props,
+                    dash,
+                    roll,
+                    pw_body,
+                    dt,
+                    gx,
+                    gy,
+                    damp,
+                    True,
+                    skip2,
                 )
             else:
-                d2 = _phase_forces(
-                    k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp, None
+                d2, v2 = _phase_forces(
+                    k,
+                    disks,
+                    walls,
+                    nb,
+                    wb,
+                    work,
+                    prm,
+                    props,
+                    dash,
+                    roll,
+                    pw_body,
+                    dt,
+                    gx,
+                    gy,
+                    damp,
+                    None,
+                    skip2,
                 )
             if d2 > dmax:
                 dmax = d2
+            if v2 > vskip:
+                vskip = v2
         barrier(sync, nthr)
         # phase 2: the deferred disks, shared out evenly; thread 0 also moves the walls
         ndef = dstart[npart]
@@ -695,7 +796,8 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, ro
         d2 = _phase_deferred(m0, m1, disks, nb, work, roll, gx, gy, damp, dt)
         if d2 > dmax:
             dmax = d2
-        tmax[t] = dmax
+        tmax[t] = dmax  # after the first barrier: the others read both until then
+        tskip[t] = vskip
         if t == 0:
             _move_walls(walls, dt)
             prm[TIME] += dt
@@ -703,6 +805,7 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, ro
         steps += 1
         since_check += 1
         dmax = _largest_drift(tmax, nthr, wp0, wall_build)
+        bound = _drift_bound(bound, tmax, tskip, nthr, dt, half_skin)
         if dmax > lim2:
             need_build = True
         if check_every > 0 and since_check == check_every:

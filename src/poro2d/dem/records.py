@@ -130,6 +130,7 @@ class WorkArrays(NamedTuple):
     dstart: np.ndarray  # (partitions + 1) the deferred disks of each partition, as rows of dlist
     held: np.ndarray  # (n + 1) the disks not free, ascending, then n to the end (set by prepare)
     tmax: np.ndarray  # (partitions) largest squared drift seen by each thread in a step
+    tskip: np.ndarray  # (partitions) largest squared speed of the disks whose drift a thread skipped
     sync: np.ndarray  # int64 barrier and status words (poro2d.dem.sync)
     # the cell grid of a list build (GridScratch's fields: numba's parallel loop takes a
     # record of arrays as an argument, not a record of records)
@@ -190,7 +191,7 @@ def kernel_records(
     g = work.grid
     work_rec = WorkArrays(
         pos_build=work.pos_build, part=work.part, xstart=work.xstart, xpair=nb.cross, dlist=work.dlist,
-        dstart=work.dstart, held=work.held, tmax=work.tmax, sync=work.sync, cell=g.cell, members=g.members,
-        cstart=g.cstart, cfill=g.cfill, ginfo=g.ginfo, cand=g.cand,
+        dstart=work.dstart, held=work.held, tmax=work.tmax, tskip=work.tskip, sync=work.sync, cell=g.cell,
+        members=g.members, cstart=g.cstart, cfill=g.cfill, ginfo=g.ginfo, cand=g.cand,
     )  # fmt: skip
     return KernelRecords(disks, walls_rec, nb_rec, wb_rec, work_rec, work.levels)

@@ -163,6 +163,7 @@ class KernelWork:
     held: np.ndarray  # (n + 1) the disks not free (prescribed), ascending, then n to the end
     part_sums: np.ndarray  # (partitions, nw + pad, 4) per-partition wall sums
     tmax: np.ndarray  # (partitions) largest squared drift per thread
+    tskip: np.ndarray  # (partitions) largest squared speed per thread of the disks whose drift it skipped
     sync: np.ndarray  # barrier and status words (poro2d.dem.sync)
     grid: GridScratch  # the cell grid of a list build
     levels: LevelScratch | None = None  # the grids by size level (wide gradings), else None
@@ -170,7 +171,7 @@ class KernelWork:
     @classmethod
     def empty(cls, n: int, nw: int, partitions: int, wall_pad: int) -> KernelWork:
         """Zeroed work arrays for ``n`` disks, ``nw`` walls and ``partitions``."""
-        derived = [np.zeros(0)] * 9  # acc .. sync: allocated by renew
+        derived = [np.zeros(0)] * 10  # acc .. sync: allocated by renew
         work = cls(np.zeros((n, 2)), np.zeros((nw, 2)), np.zeros((nw, 2)), *derived, grid_scratch(0))
         work.renew(n, nw, partitions, wall_pad)
         return work
@@ -187,6 +188,7 @@ class KernelWork:
         # cache line would pass it back and forth at every wall contact
         self.part_sums = np.zeros((partitions, nw + wall_pad, 4))
         self.tmax = np.zeros(partitions)
+        self.tskip = np.zeros(partitions)
         self.sync = fresh_sync()
         self.grid = grid_scratch(n)
         if self.levels is not None:
