@@ -564,9 +564,6 @@ def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out, levels):
         if wtotal > wb_w.shape[0]:
             out[NEED_PW] = wtotal
             status = OVERFLOW
-        if status == RUNNING:
-            _clear_tail(nb.ov, nb.fn, nb.nx, nb.ny, total, nb_start[n])
-            _clear_tail(wb.ov, wb.fn, wb.nx, wb.ny, wtotal, wb_start[n])
         atomic_store(sync, STATUS_WORD, status)
     barrier(sync, nthr)
     if atomic_load(sync, STATUS_WORD) != RUNNING:
@@ -723,6 +720,7 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, ro
     since_check = iprm[CHECK_OFFSET] % check_every if check_every > 0 else 0
     need_build = iprm[NEED_BUILD] != 0
     npart = part.shape[0] - 1
+    n = disks.pos.shape[0]
     k0 = t * npart // nthr
     k1 = (t + 1) * npart // nthr
     steps = 0
@@ -730,9 +728,13 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, ro
     status = RUNNING
     for step in range(nsteps):
         if need_build:
+            used, wused = nb.start[n], wb.start[n]
             if not _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out, levels):
                 status = OVERFLOW
                 break
+            if t == 0:  # slots nobody else touches now: the lists end before them
+                _clear_tail(nb.ov, nb.fn, nb.nx, nb.ny, nb.start[n], used)
+                _clear_tail(wb.ov, wb.fn, wb.nx, wb.ny, wb.start[n], wused)
             need_build = False
             rebuilds += 1
             bound = 0.0  # every disk at its build position

@@ -161,17 +161,21 @@ def _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, out_j, k0, 
 @njit(inline="always", cache=True)
 def _take(i, j, xi, yi, ri, pos, radius, skin, out_j, k0, k, write):
     """Count (and write at k0 + k) disk j as a partner of disk i when j > i lies within reach;
-    returns the count so far."""
-    if j <= i:
-        return k
+    returns the count so far.
+
+    Without a branch on the verdict: a cell's members pass and fail in no order, and how
+    numba lays out such branches changes from one compilation to the next (with Python's
+    hash seed), which made a list build's scan twice as slow in some compilations as in
+    others. So j is written whatever the verdict and the count moves on only when it
+    holds: a candidate that fails is overwritten by the next one, or lies past the row.
+    """
     dx = pos[j, 0] - xi
     dy = pos[j, 1] - yi
     reach = ri + radius[j] + skin
-    if dx * dx + dy * dy < reach * reach:
-        if write:
-            out_j[k0 + k] = j
-        return k + 1
-    return k
+    hit = (j > i) & (dx * dx + dy * dy < reach * reach)
+    if write:
+        out_j[k0 + k] = j
+    return k + np.int64(hit)
 
 
 @njit(inline="always", cache=True)
@@ -507,8 +511,8 @@ def level_grid(pos, radius, skin, lv):
 
 
 @njit(inline="always", cache=True)
-def _scan_level_row(i, pos, radius, skin, members, cstart, geo, info, nlev, out_j, k0, write):
-    """Count (or write from k0) the partners j > i of disk i, level by level.
+def _scan_level_row(i, pos, radius, skin, members, cstart, geo, info, nlev, out_j, k0, write, limit):
+    """Count (or write from k0, the first ``limit``) the partners j > i of disk i, level by level.
 
     In each level's grid only the cells that a circle of the largest reach to that level
     touches are read: cell rows within reach, and in each row the run of cells that the
@@ -540,7 +544,7 @@ def _scan_level_row(i, pos, radius, skin, members, cstart, geo, info, nlev, out_
             c0 = row + _cell_index(xi - half - x0, inv, ncx)
             c1 = row + _cell_index(xi + half - x0, inv, ncx)
             for m in range(cstart[c0], cstart[c1 + 1]):
-                k = _take(i, members[m], xi, yi, ri, pos, radius, skin, out_j, k0, k, write)
+                k = _take(i, members[m], xi, yi, ri, pos, radius, skin, out_j, k0, k, write and k < limit)
     return k
 
 
@@ -551,7 +555,7 @@ def count_level_rows(lo, hi, pos, radius, skin, lv, new_start):
     nlev = lv.count[0]
     for i in range(lo, hi):
         new_start[i + 1] = _scan_level_row(
-            i, pos, radius, skin, members, cstart, geo, info, nlev, new_start, 0, False
+            i, pos, radius, skin, members, cstart, geo, info, nlev, new_start, 0, False, 0
         )
 
 
@@ -611,7 +615,7 @@ def fill_level_rows(
     for i in range(lo, hi):
         k0 = new_start[i]
         k1 = new_start[i + 1]
-        _scan_level_row(i, pos, radius, skin, members, cstart, geo, info, nlev, new_j, k0, True)
+        _scan_level_row(i, pos, radius, skin, members, cstart, geo, info, nlev, new_j, k0, True, k1 - k0)
         _sort_row(new_j, k0, k1)
         o0 = nb_start[i]
         o1 = nb_start[i + 1]
