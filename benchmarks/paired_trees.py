@@ -10,6 +10,12 @@ per second of ``Simulation.run``; the answer is the ratio new / old of the two b
 same round and thread count: its median and range over the rounds, with the load average
 seen before and after each block.
 
+How fast numba's code is can depend on the compilation itself: the order of some of its
+work follows Python's hash seed, and a list build's scan was once twice as fast in one
+compilation as in another. So ``--hash-seeds`` compiles each tree once per seed (its own
+numba cache folder per tree and seed, ``PYTHONHASHSEED`` set) and runs ``--rounds`` rounds
+with each: a ratio then compares the two trees, not two draws of the compiler.
+
     python benchmarks/paired_trees.py --old ../before/src --new src --cases paper,250k --rounds 5
 
 A measurement script, not a test: the numbers depend on the machine and its load.
@@ -52,9 +58,13 @@ def worker(case: str, threads: list[int], steps: int, warmup: int, out: Path) ->
     return rates
 
 
-def run_round(src: str, case: str, threads: list[int], out: Path) -> dict:
+def run_round(src: str, case: str, threads: list[int], out: Path, seed: str | None, tree: str) -> dict:
     steps, warmup = PLAN[case]
     env = dict(os.environ, PYTHONPATH=str(Path(src).resolve()), OMP_WAIT_POLICY="PASSIVE")
+    if seed is not None:
+        env.update(
+            PYTHONHASHSEED=seed, NUMBA_CACHE_DIR=str((out / "numba_cache" / f"{tree}-{seed}").resolve())
+        )
     cmd = [sys.executable, str(Path(__file__).resolve()), "--worker", case, "--threads",
            ",".join(map(str, threads)), "--steps", str(steps), "--warmup", str(warmup),
            "--out", str(out)]  # fmt: skip
@@ -67,7 +77,8 @@ def main() -> int:
     ap.add_argument("--old", help="the src folder of the tree before the change")
     ap.add_argument("--new", help="the src folder of the tree with the change")
     ap.add_argument("--cases", default="paper,250k")
-    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--rounds", type=int, default=5, help="rounds (per hash seed, with --hash-seeds)")
+    ap.add_argument("--hash-seeds", default=None, help="compile each tree once per seed: e.g. 0,1,2")
     ap.add_argument("--threads", default="1,2")
     ap.add_argument("--out", default="bench_out", help="where bench_engine.py caches the settled packing")
     ap.add_argument("--json", default=None, help="write every block's numbers to this file")
@@ -85,12 +96,13 @@ def main() -> int:
     results: dict = {}
     for case in [c.strip() for c in args.cases.split(",") if c.strip()]:
         rounds = []
-        for k in range(args.rounds):
+        seeds = args.hash_seeds.split(",") if args.hash_seeds else [None]
+        for k, seed in enumerate(s for s in seeds for _ in range(args.rounds)):
             order = ("old", "new") if k % 2 == 0 else ("new", "old")
-            got = {}
+            got = {"hash_seed": seed}
             for tree in order:
                 tt = threads if k % 2 == 0 else threads[::-1]
-                got[tree] = run_round(getattr(args, tree), case, tt, out)
+                got[tree] = run_round(getattr(args, tree), case, tt, out, seed, tree)
             for tree in order:  # each process ran the tree it was given
                 assert Path(got[tree]["source"]).resolve().parent == Path(getattr(args, tree)).resolve(), got[
                     tree
@@ -101,7 +113,7 @@ def main() -> int:
                 f"({got['new'][str(t)]['rate'] / got['old'][str(t)]['rate']:.3f}x)"
                 for t in threads
             )
-            print(f"[{case}] round {k + 1}: {line}", flush=True)
+            print(f"[{case}] round {k + 1} (hash seed {seed}): {line}", flush=True)
         summary = {}
         for t in threads:
             q = [r["new"][str(t)]["rate"] / r["old"][str(t)]["rate"] for r in rounds]
