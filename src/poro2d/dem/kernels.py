@@ -748,45 +748,11 @@ def _worker(t, nthr, disks, walls, nb, wb, work, prm, iprm, out, props, dash, ro
         skip2 = -1.0 if check else _skip_below(bound, half_skin, dt)
         for k in range(k0, k1):
             if stores:
-                d2, v2 = _phase_forces(
-                    k,
-                    disks,
-                    walls,
-                    nb,
-                    wb,
-                    work,
-                    prm,
-                    props,
-                    dash,
-                    roll,
-                    pw_body,
-                    dt,
-                    gx,
-                    gy,
-                    damp,
-                    True,
-                    skip2,
-                )
+                d2, v2 = _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx,
+                                       gy, damp, True, skip2)  # fmt: skip
             else:
-                d2, v2 = _phase_forces(
-                    k,
-                    disks,
-                    walls,
-                    nb,
-                    wb,
-                    work,
-                    prm,
-                    props,
-                    dash,
-                    roll,
-                    pw_body,
-                    dt,
-                    gx,
-                    gy,
-                    damp,
-                    None,
-                    skip2,
-                )
+                d2, v2 = _phase_forces(k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx,
+                                       gy, damp, None, skip2)  # fmt: skip
             if d2 > dmax:
                 dmax = d2
             if v2 > vskip:
