@@ -615,7 +615,9 @@ class PorosityCriterion:
         n = s.initial_trial()
         note = preparation_note(self.spec, self.grading)
         if note:
-            _log.warning("preparation: %s", note)
+            # a run that talks says it here; a sweep's case (progress off) keeps it in its result,
+            # and the command that ran the sweep says it once (sand's pre-flight notes), not per case
+            _log.log(logging.WARNING if self.progress else logging.INFO, "preparation: %s", note)
         trials: list[Trial] = []
         tried: list[float] = []
         accepted: Trial | None = None
