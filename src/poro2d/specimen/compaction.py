@@ -75,12 +75,20 @@ MASS_SCALING_MODES = ("auto", "on", "off")
 #: the sandy gravel G1-1 (13) lies below 3 (the paper's 1.9, wide_cu4's 3.0), so their
 #: specimens keep their true masses and every number they gave (docs/density-scaling.md)
 MASS_SCALING_TRIGGER = 4.0
+#: ``growth_friction`` unset: a layer grows frictionless where r_mean / r_min exceeds this.
+#: Radius growth wedges a fine between two large disks closing on it: with friction their two
+#: nearly opposite normals hold it, the overlaps grow past its own radius and the fine is shot
+#: out of the box (G1-1, r_mean / r_min 13: every calibration case at mu_prep 0.2 to 1.0 lost
+#: a disk so, with true or raised masses alike, and none at mu_prep 0). Every other built-in
+#: grading and example soil lies below 3 and grows at its preparation friction, as before.
+FRICTIONLESS_GROWTH_TRIGGER = 4.0
 
 
 #: settings recorded with results only when they differ from these defaults (see ``to_dict``)
 OMITTED_AT_DEFAULT = {
     "equilibrium": "max", "settle_drift": None, "settle_window": 10_000, "settle_checks": 3,
     "rolling_friction": 0.0, "rolling_friction_prep": 0.0, "mass_scaling": "auto", "mass_scaling_ratio": 2.0,
+    "growth_friction": None,
 }  # fmt: skip
 
 
@@ -113,6 +121,7 @@ SPECIMEN_RANGES: Ranges = {
     "max_disks": Integer(1, MAX_DRAW),
     "mass_scaling": OneOf(MASS_SCALING_MODES, quoted=True),
     "mass_scaling_ratio": Real(1.0, 100.0),
+    "growth_friction": Real(0, None, or_none=True),
 }
 
 
@@ -166,6 +175,9 @@ class SpecimenSpec(Record):
     # times smaller than the mean one
     mass_scaling: str = "auto"
     mass_scaling_ratio: float = 2.0
+    # the disks' friction while a layer's radii grow (the preparation friction returns for its
+    # settling); None: 0 for a grading above FRICTIONLESS_GROWTH_TRIGGER, else friction_prep
+    growth_friction: float | None = None
 
     def __post_init__(self) -> None:
         check_fields(self, SPECIMEN_RANGES)
@@ -409,6 +421,20 @@ def mass_scaling_step(spec: SpecimenSpec, radii: np.ndarray) -> float | None:
         return None
     r_floor = r_mean / spec.mass_scaling_ratio
     return time_step(spec, 2.0 * r_floor) if r_floor > r_min else None
+
+
+def growth_friction(spec: SpecimenSpec, radii: np.ndarray) -> float:
+    """The friction a layer of the specimen of disks ``radii`` grows at (``spec.growth_friction``).
+
+    Unset: 0 where r_mean / r_min exceeds ``FRICTIONLESS_GROWTH_TRIGGER`` (the radius expansion
+    of a wide grading, frictionless as is usual for it), else the preparation friction, which
+    keeps every narrower grading's numbers.
+    """
+    if spec.growth_friction is not None:
+        return spec.growth_friction
+    if len(radii) and float(np.mean(radii)) > FRICTIONLESS_GROWTH_TRIGGER * float(np.min(radii)):
+        return 0.0
+    return spec.friction_prep
 
 
 def grading_mass_scaling_step(spec: SpecimenSpec, grading: GradingCurve, porosity: float) -> float | None:
@@ -838,7 +864,12 @@ def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.nda
     side_walls_reach(sim, SIDE_WALL_REACH * y_top + 4.0 * float(radii.max()))
     if spec.rolling_friction_prep > 0.0:  # the new disks take it too (they are added with none)
         sim.set_rolling_friction(spec.rolling_friction_prep, walls=spec.rolling_friction_prep)
+    mu_grow = growth_friction(spec, radii)
+    if mu_grow != spec.friction_prep:
+        sim.particles.mu[new] = mu_grow
     steps = _grow(sim, new, radii[idx], plc.scale, spec)
+    if mu_grow != spec.friction_prep:
+        sim.particles.mu[new] = spec.friction_prep  # the preparation's friction for settling
     # renumber the whole packing in strips across its short side (the new layer was
     # appended on top): threads then split it along a short cut (dem.ordering)
     sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
