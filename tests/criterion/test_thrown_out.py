@@ -18,10 +18,11 @@ def test_a_trial_denser_than_its_grading_jams_is_refused_naming_the_cause(tmp_pa
     # 0.06 is within the margin the check before the run lets pass (n_J - 0.05), but in this
     # box a layer's overlaps explode and throw a disk out: before, "disk 74 position is invalid"
     # (with the true masses it was found with: with the fines' masses raised, docs/density-scaling.md,
-    # this trial ends otherwise)
+    # this trial ends otherwise), and with the growth at the preparation friction it was found
+    # with (growing frictionless, the default for this grading, it ends otherwise too)
     cfg = tmp_path / "gravel.toml"
     cfg.write_text(
-        '[specimen]\nwidth = 0.08\nheight = 0.04\nlayers = 2\nmass_scaling = "off"\n'
+        '[specimen]\nwidth = 0.08\nheight = 0.04\nlayers = 2\nmass_scaling = "off"\ngrowth_friction = 0.05\n'
         f'[grading]\ncsv = "{GRAVEL.as_posix()}"\n[criterion]\ntrial_porosity = 0.06\nmax_iterations = 1\n'
     )
     with pytest.raises(SystemExit) as e:
@@ -42,3 +43,13 @@ def test_only_a_disk_position_is_taken_for_a_thrown_out_disk():
     assert note.startswith("disk 850 was thrown out of place") and "(0.304224, 1.08571) m" in note
     assert "n_J = 0.105" in note and "at 0.11 or above" in note
     assert "what this grading jams at" in thrown_out_note(moved, 0.08, None)
+
+
+def test_a_disk_thrown_out_at_a_trial_looser_than_jamming_is_not_blamed_on_density():
+    """G1-1's frictional calibration cases: "trial n2D = 0.1550 being below this grading's
+    jamming porosity n_J = 0.100" (false) and "start looser" (no help) before."""
+    moved = MisplacedDisk("disk 1432 position", (0.0909778, -1.27286), "a centre inside the walls", "beyond")
+    note = thrown_out_note(moved, 0.155, 0.100)
+    assert "being below" not in note and "start looser" not in note
+    assert "is looser than this grading's jamming porosity n_J = 0.100" in note
+    assert "growth_friction = 0" in note

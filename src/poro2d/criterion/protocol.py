@@ -201,11 +201,20 @@ def thrown_out_note(exc: MisplacedDisk, n: float, n_j: float | None) -> str:
     (:func:`~poro2d.specimen.compaction.densest_porosity`), None when no estimate could be made.
     """
     disk = exc.parameter.removesuffix(" position")
+    where = f"{disk} was thrown out of place while the layers were compacted ({exc.hint or exc.allowed}; at {exc.value} m)"
+    if n_j is not None and n >= n_j:
+        # looser than the grading jams: not too much solid, but overlaps grown where disks
+        # could not give way (a fine wedged between large disks by friction while they grew)
+        return (
+            f"{where}: the overlaps of a layer exploded although the trial n2D = {n:.4f} is looser than "
+            f"this grading's jamming porosity n_J = {n_j:.3f}: disks that could not give way while the "
+            "radii grew (a fine wedged between large disks by friction); grow the layers frictionless "
+            "([specimen] growth_friction = 0) or give more growth_increments"
+        )
     jams = "what this grading jams at" if n_j is None else f"this grading's jamming porosity n_J = {n_j:.3f}"
     start = "at or above it" if n_j is None else f"at {math.ceil(n_j * 100) / 100:.2f} or above"
     return (
-        f"{disk} was thrown out of place while the layers were compacted ({exc.hint or exc.allowed}; at "
-        f"{exc.value} m): the overlaps of a layer grown denser than the grading packs exploded, the trial "
+        f"{where}: the overlaps of a layer grown denser than the grading packs exploded, the trial "
         f"n2D = {n:.4f} being below {jams}; start looser: the criterion's trial_porosity "
         f"(--trial-porosity) {start}, or check n_lab"
     )
