@@ -201,7 +201,10 @@ def thrown_out_note(exc: MisplacedDisk, n: float, n_j: float | None) -> str:
     (:func:`~poro2d.specimen.compaction.densest_porosity`), None when no estimate could be made.
     """
     disk = exc.parameter.removesuffix(" position")
-    where = f"{disk} was thrown out of place while the layers were compacted ({exc.hint or exc.allowed}; at {exc.value} m)"
+    where = (
+        f"{disk} was thrown out of place while the layers were compacted ({exc.hint or exc.allowed}; "
+        f"at {exc.value} m)"
+    )
     if n_j is not None and n >= n_j:
         # looser than the grading jams: not too much solid, but overlaps grown where disks
         # could not give way (a fine wedged between large disks by friction while they grew)
