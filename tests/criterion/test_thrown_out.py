@@ -18,11 +18,10 @@ def test_a_trial_denser_than_its_grading_jams_is_refused_naming_the_cause(tmp_pa
     # 0.06 is within the margin the check before the run lets pass (n_J - 0.05), but in this
     # box a layer's overlaps explode and throw a disk out: before, "disk 74 position is invalid"
     # (with the true masses it was found with: with the fines' masses raised, docs/density-scaling.md,
-    # this trial ends otherwise), and with the growth at the preparation friction it was found
-    # with (growing frictionless, the default for this grading, it ends otherwise too)
+    # this trial ends otherwise)
     cfg = tmp_path / "gravel.toml"
     cfg.write_text(
-        '[specimen]\nwidth = 0.08\nheight = 0.04\nlayers = 2\nmass_scaling = "off"\ngrowth_friction = 0.05\n'
+        '[specimen]\nwidth = 0.08\nheight = 0.04\nlayers = 2\nmass_scaling = "off"\n'
         f'[grading]\ncsv = "{GRAVEL.as_posix()}"\n[criterion]\ntrial_porosity = 0.06\nmax_iterations = 1\n'
     )
     with pytest.raises(SystemExit) as e:
