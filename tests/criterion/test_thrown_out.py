@@ -42,3 +42,13 @@ def test_only_a_disk_position_is_taken_for_a_thrown_out_disk():
     assert note.startswith("disk 850 was thrown out of place") and "(0.304224, 1.08571) m" in note
     assert "n_J = 0.105" in note and "at 0.11 or above" in note
     assert "what this grading jams at" in thrown_out_note(moved, 0.08, None)
+
+
+def test_a_disk_thrown_out_at_a_trial_looser_than_jamming_is_not_blamed_on_density():
+    """G1-1's frictional calibration cases: "trial n2D = 0.1550 being below this grading's
+    jamming porosity n_J = 0.100" (false) and "start looser" (no help) before."""
+    moved = MisplacedDisk("disk 1432 position", (0.0909778, -1.27286), "a centre inside the walls", "beyond")
+    note = thrown_out_note(moved, 0.155, 0.100)
+    assert "being below" not in note and "start looser" not in note
+    assert "is looser than this grading's jamming porosity n_J = 0.100" in note
+    assert "growth_friction = 0" in note

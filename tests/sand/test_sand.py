@@ -352,3 +352,33 @@ def test_a_sand_cases_config_and_case_ids_are_pinned():
     assert [c.id for c in calibration.cases] == ids
     states = StateChecks(case.config, (StateTarget(0.3, 0.5, 0.17, 0.3),), 2, 0.001).sweep
     assert [c.id for c in states.cases] == ["aed9d8864d02", "863f868d6f95"]
+
+
+def test_a_wide_gradings_preparation_note_is_said_once_by_the_preflight(tmp_path, monkeypatch, caplog):
+    """A sand run's cases each logged the wide grading's note as a warning: 4-5 copies of a
+    four-line note on the terminal (G1-1). The pre-flight says it once; a case that does not
+    talk (progress off) logs it below warning level."""
+    import logging
+
+    from poro2d.criterion.protocol import PorosityCriterion
+    from poro2d.store import Store
+    from poro2d.sweep.cases import criterion_objects
+
+    monkeypatch.setenv("PORO2D_CACHE", str(tmp_path))
+    monkeypatch.setattr(PF, "JAMMING_DISKS", 200)
+    pf = PF.preflight(load_sand_case(_config(grading={"preset": "wide_cu4"})), workers=1)
+    assert sum(n.startswith("preparation: wide grading") for n in pf.notes) == 1
+    narrow = PF.preflight(load_sand_case(_config()), workers=1)
+    assert not any(n.startswith("preparation:") for n in narrow.notes)
+
+    cfg = {"grading": {"preset": "wide_cu4"}, "specimen": {"width": 0.04, "height": 0.02, "layers": 1}}
+    spec, grading, settings, seed = criterion_objects(cfg)
+    for progress, level in ((False, logging.INFO), (True, logging.WARNING)):
+        caplog.clear()
+        crit = PorosityCriterion(spec, grading, settings, seed=seed, store=Store(tmp_path / str(progress)),
+                                 progress=progress)  # fmt: skip
+        monkeypatch.setattr(crit, "_trial", lambda k, n: (_ for _ in ()).throw(RuntimeError("stop")))
+        with caplog.at_level(logging.INFO, logger="poro2d.criterion.protocol"), pytest.raises(RuntimeError):
+            crit._search()
+        (rec,) = [r for r in caplog.records if r.getMessage().startswith("preparation:")]
+        assert rec.levelno == level

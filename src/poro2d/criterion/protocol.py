@@ -201,11 +201,24 @@ def thrown_out_note(exc: MisplacedDisk, n: float, n_j: float | None) -> str:
     (:func:`~poro2d.specimen.compaction.densest_porosity`), None when no estimate could be made.
     """
     disk = exc.parameter.removesuffix(" position")
+    where = (
+        f"{disk} was thrown out of place while the layers were compacted ({exc.hint or exc.allowed}; "
+        f"at {exc.value} m)"
+    )
+    if n_j is not None and n >= n_j:
+        # looser than the grading jams: not too much solid, but overlaps grown where disks
+        # could not give way (a fine wedged between large disks by friction while they grew)
+        return (
+            f"{where}: the overlaps of a layer exploded although the trial n2D = {n:.4f} is looser than "
+            f"this grading's jamming porosity n_J = {n_j:.3f}: disks that could not give way while the "
+            "radii grew (a fine wedged between large disks by friction); a lower friction_prep, or layers "
+            "grown frictionless ([specimen] growth_friction = 0: every disk stays in the box, but the "
+            "friction then decides only how the layers settle, docs/criterion.md)"
+        )
     jams = "what this grading jams at" if n_j is None else f"this grading's jamming porosity n_J = {n_j:.3f}"
     start = "at or above it" if n_j is None else f"at {math.ceil(n_j * 100) / 100:.2f} or above"
     return (
-        f"{disk} was thrown out of place while the layers were compacted ({exc.hint or exc.allowed}; at "
-        f"{exc.value} m): the overlaps of a layer grown denser than the grading packs exploded, the trial "
+        f"{where}: the overlaps of a layer grown denser than the grading packs exploded, the trial "
         f"n2D = {n:.4f} being below {jams}; start looser: the criterion's trial_porosity "
         f"(--trial-porosity) {start}, or check n_lab"
     )
@@ -615,7 +628,9 @@ class PorosityCriterion:
         n = s.initial_trial()
         note = preparation_note(self.spec, self.grading)
         if note:
-            _log.warning("preparation: %s", note)
+            # a run that talks says it here; a sweep's case (progress off) keeps it in its result,
+            # and the command that ran the sweep says it once (sand's pre-flight notes), not per case
+            _log.log(logging.WARNING if self.progress else logging.INFO, "preparation: %s", note)
         trials: list[Trial] = []
         tried: list[float] = []
         accepted: Trial | None = None

@@ -35,6 +35,7 @@ from poro2d.specimen.compaction import (
     check_feasible,
     estimate_size,
     grading_mass_scaling_step,
+    preparation_note,
     time_step,
 )
 from poro2d.typed_result import TypedResult
@@ -554,6 +555,9 @@ def _notes(case: SandCase, jam: Jamming, eq12: float, dt: float, dt_paper: float
             'without); [specimen] mass_scaling = "off" keeps the true masses'
         )
     notes += _cut_notes(case)
+    prep = preparation_note(case.spec, case.grading)
+    if prep:  # said once here: the cases on the workers keep it in their results
+        notes.append(f"preparation: {prep}")
     crit = case.config.table("criterion")
     if crit.get("acceptance", "plate") == "fill":
         from poro2d.criterion.lid import GRAINS_PER_SEGMENT, SEGMENT_D50
