@@ -41,6 +41,7 @@ OTHER = {
     "particle_kn": 1e6,
     "particle_ks": 5e5,
     "mass_scaling": "off",
+    "growth_friction": 0.0,
 }
 
 
