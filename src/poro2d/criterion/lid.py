@@ -61,6 +61,13 @@ CREEP_SWITCH = 10.0
 #: which the held lid's final check at equilibrium then judges
 CREEP_D50 = 0.005
 
+#: a held creeping lid is accepted with its specimen's unbalanced-force ratio below this many
+#: times the equilibrium ratio: a packing as frictional as mu_prep 1.0 creeps on at ratios of
+#: 1e-3 to 1e-2 while its lid and its density no longer move (relation --preset paper, full box:
+#: 2 of 3 loose-end seeds held at 0.0019 and 0.0030 against 1e-3 were refused after 600 000 lid
+#: steps with F_top inside the window; the lid before the creeping one accepted them)
+CREEP_RATIO = 10.0
+
 
 @dataclass(frozen=True)
 class LidProfile:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import logging
 from dataclasses import dataclass
 
-from poro2d.criterion.lid import CREEP_D50, CREEP_SWITCH, FlatPlate, SegmentedLid
+from poro2d.criterion.lid import CREEP_D50, CREEP_RATIO, CREEP_SWITCH, FlatPlate, SegmentedLid
 from poro2d.criterion.settings import CriterionSettings
 from poro2d.dem import Simulation
 from poro2d.dem.export import frame_of
@@ -205,7 +205,9 @@ class PlateServo:
             rounds, f, cap, res.converged, res.max_ratio, steps,
         )  # fmt: skip
         ok = in_window(f, weight, s.force_fraction) and top.resting(sim, target)
-        return steps, ok and (res.converged or not top.creeps), res.measured_ratio
+        # a creeping lid that stopped creeping is judged held, at a creeping packing's ratio
+        at_rest = res.converged or not top.creeps or res.measured_ratio < CREEP_RATIO * self.ratio
+        return steps, ok and at_rest, res.measured_ratio
 
     def holds(self, sim: Simulation, top: FlatPlate | SegmentedLid, target: float, weight: float) -> bool:
         """F_top in the window, with a lid resting on the specimen over most of the width."""

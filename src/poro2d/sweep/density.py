@@ -134,8 +134,9 @@ def calibration_base(base: CriterionBase) -> CriterionBase:
 
 #: the revision of the criterion's preparation that a cached calibration was made with, raised
 #: when a change moves its cases' results: 2, the creeping lid of frictional fill preparations
-#: (docs/criterion.md), whose loose-end cases differ from those of the chattering lid before it
-CALIBRATION_REVISION = 2
+#: (docs/criterion.md), whose loose-end cases differ from those of the chattering lid before it;
+#: 3, the creeping lid accepted at a creeping packing's ratio (criterion.lid.CREEP_RATIO)
+CALIBRATION_REVISION = 3
 
 
 def calibration_key(base: CriterionBase) -> str:
