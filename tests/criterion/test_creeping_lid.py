@@ -60,3 +60,14 @@ def test_the_creeping_lid_comes_to_rest_where_the_old_one_does(loose, tmp_path):
     # the same rest height within a tenth of a grain (the old lid's own drift bound is 1e-4 H)
     assert new.height_m == pytest.approx(old.height_m, abs=0.1 * d50)
     assert new.steps < old.steps  # measured: 133 700 against 169 600
+
+
+def test_a_held_creeping_lid_counts_its_packing_at_rest_at_a_creeping_ratio():
+    """relation --preset paper refused 2 of 3 loose-end seeds held at ratios 0.0019 and 0.0030
+    (target 1e-3) with F_top inside the window; a flat plate's specimen is judged before."""
+    from poro2d.criterion.lid import CREEP_RATIO
+    from poro2d.criterion.servo import held_at_rest
+
+    assert held_at_rest(False, True, 0.0019, 1e-3) and held_at_rest(False, True, 0.0030, 1e-3)
+    assert not held_at_rest(False, True, CREEP_RATIO * 1e-3, 1e-3)  # still moving: refused
+    assert held_at_rest(True, True, 0.05, 1e-3) and held_at_rest(False, False, 0.05, 1e-3)

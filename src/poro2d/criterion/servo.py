@@ -60,6 +60,16 @@ class PlateSettle(Record):
         )  # fmt: skip
 
 
+def held_at_rest(converged: bool, creeps: bool, ratio: float, target: float) -> bool:
+    """Whether a held top's specimen counts as at rest for the acceptance.
+
+    A flat plate's specimen was judged while the plate settled (equilibrium, or a creep below
+    ``plate_drift`` H); a creeping lid's has stopped creeping under it, and counts at rest at
+    equilibrium or at a creeping packing's ratio, below ``CREEP_RATIO`` x ``target``.
+    """
+    return converged or not creeps or ratio < CREEP_RATIO * target
+
+
 def in_window(f_top: float, weight: float, fraction: float) -> bool:
     """The window of Fig. 3: 0 < F_top < ``fraction`` x G (both per metre of thickness)."""
     return 0.0 < f_top < fraction * weight
@@ -205,9 +215,11 @@ class PlateServo:
             rounds, f, cap, res.converged, res.max_ratio, steps,
         )  # fmt: skip
         ok = in_window(f, weight, s.force_fraction) and top.resting(sim, target)
-        # a creeping lid that stopped creeping is judged held, at a creeping packing's ratio
-        at_rest = res.converged or not top.creeps or res.measured_ratio < CREEP_RATIO * self.ratio
-        return steps, ok and at_rest, res.measured_ratio
+        return (
+            steps,
+            ok and held_at_rest(res.converged, top.creeps, res.measured_ratio, self.ratio),
+            res.measured_ratio,
+        )
 
     def holds(self, sim: Simulation, top: FlatPlate | SegmentedLid, target: float, weight: float) -> bool:
         """F_top in the window, with a lid resting on the specimen over most of the width."""
@@ -281,4 +293,4 @@ class PlateServo:
         return crept
 
 
-__all__ = ["PlateServo", "PlateSettle", "in_window", "rises_free_to_roll"]
+__all__ = ["PlateServo", "PlateSettle", "held_at_rest", "in_window", "rises_free_to_roll"]
