@@ -23,7 +23,7 @@ from poro2d.store import Store
 from poro2d.store.stage import Fingerprint
 from poro2d.sweep.cases import Case, case_id
 from poro2d.sweep.criterion_base import CriterionBase
-from poro2d.sweep.density import _run_key, calibration_key
+from poro2d.sweep.density import CALIBRATION_REVISION, _run_key, calibration_key
 
 #: values for fields whose default (None, 0, a name) cannot simply be scaled
 OTHER = {
@@ -181,7 +181,7 @@ def test_digests_keep_the_values_that_name_existing_folders():
     # cached calibrations: the version enters the key, so the former formula is restated here
     base = {"specimen": {"threads": 2, "friction_prep": 0.3, "width": 0.1}, "criterion": {"n_lab": 0.3}}
     former = {"base": {"specimen": {"width": 0.1}, "grading": {"preset": "paper"}, "criterion": {}},
-              "version": __version__, "revision": 2}  # fmt: skip
+              "version": __version__, "revision": CALIBRATION_REVISION}  # fmt: skip
     expected = hashlib.sha256(json.dumps(former, sort_keys=True, default=str).encode()).hexdigest()[:16]
     assert calibration_key(CriterionBase(base)) == expected
 
