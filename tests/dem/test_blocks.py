@@ -15,14 +15,13 @@ reached after 16 128 steps (well under a second per run).
 
 from __future__ import annotations
 
-import math
-
 import numba
 import numpy as np
 import pytest
 
 from poro2d.dem import Every, Particles, Simulation, Walls
 from poro2d.dem.state import SERVO_ERROR_SUM
+from tests.dem.grids import staggered_rows
 
 R = 1e-3
 STOP_RATIO = 0.12
@@ -34,14 +33,7 @@ def _settling_box(nx: int = 12, ny: int = 22, cls: type[Simulation] = Simulation
     """Disks on a loose staggered grid in a box; the lid is servoed to half their weight."""
     rng = np.random.default_rng(3)
     s = 2.02 * R
-    h = s * math.sqrt(3) / 2
-    pos = np.array(
-        [
-            (s * (i + 0.5 + 0.5 * (j % 2)) + rng.uniform(-0.1, 0.1) * R, s / 2 + h * j)
-            for j in range(ny)
-            for i in range(nx)
-        ]
-    )
+    pos = staggered_rows(nx, ny, R, rng)
     n = len(pos)
     p = Particles(
         pos=pos, radius=R * rng.uniform(0.8, 1.0, n), density=2650.0, thickness=0.01,

@@ -11,12 +11,11 @@ The measurements on known configurations are in ``tests/measure/``.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 
 from poro2d.dem import Particles, Simulation, Walls
+from tests.dem.grids import staggered_rows
 
 R = 1e-3
 
@@ -27,14 +26,7 @@ def _pile(mu_side: float, dt_safety: float, seed: int = 0) -> Simulation:
     rng = np.random.default_rng(seed)
     nx, ny = 12, 25
     s = 2.05 * R
-    h = s * math.sqrt(3) / 2
-    pos = np.array(
-        [
-            (s * (i + 0.25 + 0.5 * (j % 2)) + rng.uniform(-0.02, 0.02) * R, s / 2 + h * j)
-            for j in range(ny)
-            for i in range(nx)
-        ]
-    )
+    pos = staggered_rows(nx, ny, R, rng, spacing=2.05, offset=0.25, jitter=0.02)
     n = len(pos)
     p = Particles(
         pos=pos, radius=R * rng.uniform(0.8, 1.0, n), density=2650.0, thickness=0.01,

@@ -12,14 +12,13 @@ or check steps missed their geometry would move or stop otherwise.
 
 from __future__ import annotations
 
-import math
-
 import numba
 import numpy as np
 import pytest
 
 from poro2d.dem import Every, Particles, Simulation, Walls, checkpoint
 from poro2d.dem.state import FREE
+from tests.dem.grids import staggered_rows
 
 R = 1e-3
 CONTACT_FIELDS = ("start", "other", "fs", "fn", "ov", "nx", "ny", "mr")
@@ -29,14 +28,7 @@ def _box(nx: int = 12, ny: int = 22, per_body: bool = False, **kw) -> Simulation
     """Disks on a loose staggered grid falling into a box, a servo lid pressing on them."""
     rng = np.random.default_rng(5)
     s = 2.02 * R
-    h = s * math.sqrt(3) / 2
-    pos = np.array(
-        [
-            (s * (i + 0.5 + 0.5 * (j % 2)) + rng.uniform(-0.1, 0.1) * R, s / 2 + h * j)
-            for j in range(ny)
-            for i in range(nx)
-        ]
-    )
+    pos = staggered_rows(nx, ny, R, rng)
     n = len(pos)
     # per-body stiffnesses make the kernel mix them per contact (its BodyProps variant)
     kn = rng.uniform(0.8e5, 1.2e5, n) if per_body else 1e5
