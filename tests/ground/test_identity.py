@@ -42,6 +42,7 @@ OTHER = {
     "particle_ks": 5e5,
     "mass_scaling": "off",
     "growth_friction": 0.0,
+    "frictionless_fines": "off",
 }
 
 

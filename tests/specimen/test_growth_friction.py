@@ -1,10 +1,12 @@
-"""The friction a layer grows at (``SpecimenSpec.growth_friction``, ``compaction.growth_friction``).
+"""The friction a layer grows at (``SpecimenSpec.growth_friction``, ``compaction.growth_friction``)
+and its fines' (``SpecimenSpec.frictionless_fines``, ``compaction.growing_fines``).
 
 Radius growth with friction wedges a fine between two large disks closing on it: their nearly
 opposite normals hold it, its overlaps grow past its own radius and it is shot out of the box.
 The sandy gravel G1-1 (r_mean / r_min 13) lost a disk so in every calibration case of ``sand``
-at mu_prep 0.2 to 1.0. ``growth_friction = 0`` keeps its disks in the box; unset, a layer grows
-at its preparation friction, as every number so far was measured.
+at mu_prep 0.2 to 1.0. Its fines growing frictionless (the default for so wide a grading) keep
+every disk in the box, as does ``growth_friction = 0``; a narrower grading grows at its
+preparation friction, as every number of it was measured.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import pytest
 
 from poro2d.errors import InputError
 from poro2d.grading import GradingCurve
-from poro2d.specimen.compaction import SpecimenSpec, growth_friction, prepare_specimen
+from poro2d.specimen.compaction import SpecimenSpec, growing_fines, growth_friction, prepare_specimen
 
 SOILS = Path(__file__).parents[2] / "examples" / "soils"
 
@@ -34,9 +36,26 @@ def test_unset_the_layers_grow_at_the_preparation_friction():
         SpecimenSpec(growth_friction=-0.1)
 
 
-def test_the_setting_is_recorded_only_when_set():
+def test_the_settings_are_recorded_only_when_set():
     assert "growth_friction" not in SpecimenSpec().to_dict()
     assert SpecimenSpec(growth_friction=0.0).to_dict()["growth_friction"] == 0.0
+    assert "frictionless_fines" not in SpecimenSpec().to_dict()
+    assert SpecimenSpec(frictionless_fines="off").to_dict()["frictionless_fines"] == "off"
+    with pytest.raises(InputError, match="frictionless_fines"):
+        SpecimenSpec(frictionless_fines="yes")
+
+
+def test_the_fines_are_below_half_the_mean_radius_of_a_very_wide_grading_only():
+    """r_mean / r_min above 4 (mass scaling's trigger) under "auto"; "on" always, "off" never."""
+    wide = np.array([0.1, 0.2, 0.5, 1.0, 2.0, 3.0])  # r_mean 1.13, r_min 0.1: 11 times finer
+    narrow = np.array([0.3, 0.5, 1.0, 1.2])  # r_mean 0.75: 2.5 times the finest
+    spec = SpecimenSpec()
+    assert growing_fines(spec, wide, wide).tolist() == [True, True, True, False, False, False]
+    assert growing_fines(spec, wide, wide[3:]).tolist() == [False, False, False]
+    assert not growing_fines(spec, narrow, narrow).any()
+    on = replace(spec, frictionless_fines="on")
+    assert growing_fines(on, narrow, narrow).tolist() == [True, False, False, False]
+    assert not growing_fines(replace(spec, frictionless_fines="off"), wide, wide).any()
 
 
 def _inside(sim, spec) -> bool:
@@ -45,15 +64,15 @@ def _inside(sim, spec) -> bool:
     return bool(np.all((x > 0.0) & (x < spec.width) & (y > 0.0)))
 
 
-def test_a_frictionless_growth_keeps_the_gravels_disks_in_the_box():
-    """G1-1 at mu_prep 0.5 in a 0.08 m x 0.04 m box, trial 0.155, seed 0: grown at mu 0.5 (the
-    default) one fine is shot out of the box; grown frictionless none is, and no disk is left
-    frictionless afterwards."""
+def test_frictionless_fines_keep_the_gravels_disks_in_the_box():
+    """G1-1 at mu_prep 0.5 in a 0.08 m x 0.04 m box, trial 0.155, seed 0: every disk grown at mu
+    0.5 (``frictionless_fines = "off"``) one fine is shot out of the box; the fines grown
+    frictionless (the default) or every disk none is, and no disk is left frictionless."""
     spec = SpecimenSpec(width=0.08, height=0.04, layers=1, friction_prep=0.5, max_steps_per_stage=20_000,
                         fallback_steps=5_000, calm_steps=2_000)  # fmt: skip
-    wedged, _ = prepare_specimen(spec, _gravel(), 0.155, seed=0)
+    wedged, _ = prepare_specimen(replace(spec, frictionless_fines="off"), _gravel(), 0.155, seed=0)
     assert not _inside(wedged, spec)
-    free = replace(spec, growth_friction=0.0)
-    sim, _ = prepare_specimen(free, _gravel(), 0.155, seed=0)
-    assert _inside(sim, free)
-    assert np.all(sim.particles.mu == free.friction_particle)
+    for free in (spec, replace(spec, frictionless_fines="off", growth_friction=0.0)):
+        sim, _ = prepare_specimen(free, _gravel(), 0.155, seed=0)
+        assert _inside(sim, free)
+        assert np.all(sim.particles.mu == free.friction_particle)

@@ -135,8 +135,9 @@ def calibration_base(base: CriterionBase) -> CriterionBase:
 #: the revision of the criterion's preparation that a cached calibration was made with, raised
 #: when a change moves its cases' results: 2, the creeping lid of frictional fill preparations
 #: (docs/criterion.md), whose loose-end cases differ from those of the chattering lid before it;
-#: 3, the creeping lid accepted at a creeping packing's ratio (criterion.lid.CREEP_RATIO)
-CALIBRATION_REVISION = 3
+#: 3, the creeping lid accepted at a creeping packing's ratio (criterion.lid.CREEP_RATIO); 4, the
+#: fines of a very wide grading grown frictionless (specimen.compaction.growing_fines)
+CALIBRATION_REVISION = 4
 
 
 def calibration_key(base: CriterionBase) -> str:
