@@ -35,6 +35,7 @@ from poro2d.specimen.compaction import (
     check_feasible,
     estimate_size,
     grading_mass_scaling_step,
+    is_wide,
     preparation_note,
     time_step,
 )
@@ -45,24 +46,35 @@ from poro2d.typed_result import TypedResult
 #: docs/sand.md), less on a machine busy with other work (0.6e7-1.2e7 seen); ``throughput`` of
 #: :func:`preflight` takes the machine's own
 THROUGHPUT = 2.0e7
-#: lid steps of one trial at the paper grading's time step, by preparation friction (mu_prep, steps;
-#: linear between): the mean per trial of the calibration cases of Toyoura sand and CB-Mix-2 in
-#: their calibration boxes (2 seeds each; 2 800-4 100 disks): 17 000, 37 000, 71 000 and 415 000
-#: at 0, 0.1, 0.5 and 1.0 with the lid that chattered; the creeping lid of mu_prep 1.0 took 0.61
-#: of the old lid's steps per trial on small boxes of Toyoura sand (3 seeds, docs/criterion.md),
-#: hence 255 000 (0.5 keeps its measured 71 000, an upper bound)
-LID_STEPS = ((0.0, 17_000), (0.1, 37_000), (0.5, 71_000), (1.0, 255_000))
+#: lid steps of one calibration trial at the paper grading's time step, by preparation friction
+#: (mu_prep, steps; linear between): the mean per trial of the calibration cases of Toyoura sand
+#: with the creeping lid at rest below ``CREEP_RATIO`` (calibration box, 2 seeds, 4 100 disks,
+#: docs/sand.md): 32 000, 24 000 (mu 0.05), 37 000 and 73 000 at 0, 0.05, 0.1 and 1.0; a first
+#: trial's lid comes from far (9 000-114 000), a refined trial's is short (4 000-11 000)
+LID_STEPS = ((0.0, 32_000), (0.1, 37_000), (1.0, 73_000))
+#: lid steps of one full-size specimen's trial: its first trial is the calibration's, so its lid
+#: finds the packing near: 4 000-7 400 at the paper grading's step (Toyoura sand, 3 seeds;
+#: the sandy gravel G1-1, 3 seeds)
+SPECIMEN_LID_STEPS = 6_000
 #: settling steps of one layer after its growth (the layer's and the working friction's stages),
-#: at the paper grading's time step: 13 600-29 400 measured per layer on the same runs
-SETTLE_STEPS = 18_000
+#: at the paper grading's time step: 13 900 (calibration) and 14 600 (specimens) per layer for
+#: Toyoura sand; a wide grading's layers end once settled (``WIDE_PREPARATION``), later: 20 000
+#: (specimens) to 23 500 (calibration) for the sandy gravel G1-1
+SETTLE_STEPS = 14_000
+WIDE_SETTLE_STEPS = 22_000
 #: criterion trials per case, measured on the same runs: the dense end accepts its first trial
-#: (4 of 4), the loose end needs 1.5 (its lid pushes the first trial over), the frictions around
-#: the state 2 (refined to 0.002 from the predicted first trial: 1 to 4), the full-size
-#: specimens 1.33 (4 of 6 seeds at their first trial)
+#: (6 of 6), the loose end needs 1.5 (its lid pushes the first trial over: 1 and 2), the
+#: frictions around the state 2.5 (refined to 0.002 from the predicted first trial: 1 to 4), the
+#: full-size specimens 1.2 (7 of 9 seeds at their first trial)
 TRIALS_DENSE_END = 1.0
 TRIALS_LOOSE_END = 1.5
-TRIALS_BRACKET = 2.0
-TRIALS_SPECIMEN = 1.33
+TRIALS_BRACKET = 2.5
+TRIALS_SPECIMEN = 1.2
+#: what a case's rate is on t engine threads, as a share of one thread's gain: the sweep gives a
+#: case the spare cores when fewer cases than workers remain (its progress says "threads per case
+#: 1 -> 2"); two threads run the engine 1.75-1.94x as fast as one (docs/engine.md), a stage's
+#: checks and list builds less so
+THREAD_EFFICIENCY = 0.7
 #: the jamming reference's disks: enough for phi_J within its seed spread (docs/jamming.md);
 #: a wide grading whose largest disks need a bigger cell gets up to ``JAMMING_MAX_DISKS``
 JAMMING_DISKS = 1500
@@ -270,17 +282,22 @@ def _compute_jamming(grading: GradingCurve, seeds: int) -> Jamming:
     return Jamming(ref.porosity_mean, ref.porosity_std, n, seeds, ref.seconds, note)
 
 
-def lid_steps(mu: float) -> float:
+def lid_steps(mu: float, stage: str = "calibration") -> float:
     """Lid steps of one trial at the paper grading's time step for preparation friction ``mu``
-    (:data:`LID_STEPS`, linear between its points, flat beyond them)."""
+    (:data:`LID_STEPS`, linear between its points, flat beyond them); a full-size specimen's
+    (``stage`` "specimens"): :data:`SPECIMEN_LID_STEPS`."""
+    if stage == "specimens":
+        return float(SPECIMEN_LID_STEPS)
     mus, steps = zip(*LID_STEPS, strict=True)
     return float(np.interp(mu, mus, steps))
 
 
-def preparation_steps(spec: SpecimenSpec, slow: float) -> float:
-    """Steps of one trial's preparation: each layer's growth, then its settling (``SETTLE_STEPS`` x
-    ``slow``, the paper grading's time step over this one's)."""
-    return spec.layers * (spec.growth_increments * spec.growth_steps + SETTLE_STEPS * slow)
+def preparation_steps(spec: SpecimenSpec, slow: float, wide: bool = False) -> float:
+    """Steps of one trial's preparation: each layer's growth, then its settling (``SETTLE_STEPS``,
+    or ``WIDE_SETTLE_STEPS`` for a ``wide`` grading, x ``slow``, the paper grading's time step over
+    this one's)."""
+    settle = WIDE_SETTLE_STEPS if wide else SETTLE_STEPS
+    return spec.layers * (spec.growth_increments * spec.growth_steps + settle * slow)
 
 
 def trials_per_case(mu: float, mus: tuple[float, ...], stage: str) -> float:
@@ -345,18 +362,37 @@ def case_plans(case: SandCase) -> tuple[CasePlan, CasePlan, CasePlan]:
     )
 
 
-def case_steps(spec: SpecimenSpec, mu: float, trials: float, slow: float) -> float:
-    """Steps of one case: ``trials`` preparations and lid stages at friction ``mu``."""
-    return trials * (preparation_steps(spec, slow) + lid_steps(mu) * slow)
+def case_steps(
+    spec: SpecimenSpec, mu: float, trials: float, slow: float, stage: str = "calibration", wide: bool = False
+) -> float:
+    """Steps of one case of ``stage``: ``trials`` preparations and lid stages at friction ``mu``."""
+    return trials * (preparation_steps(spec, slow, wide) + lid_steps(mu, stage) * slow)
+
+
+def thread_gain(threads: int) -> float:
+    """How much faster a case runs on ``threads`` engine threads than on one (``THREAD_EFFICIENCY``)."""
+    return 1.0 + THREAD_EFFICIENCY * (threads - 1)
 
 
 def wall_seconds(cases: list[float], workers: int) -> float:
-    """Wall time of cases of ``cases`` seconds each on ``workers`` cores: the longest first, each
-    to the worker that frees first (as a sweep hands them out), the last to finish."""
-    loads = [0.0] * max(workers, 1)
-    for secs in sorted(cases, reverse=True):
-        loads[loads.index(min(loads))] += secs
-    return max(loads)
+    """Wall time of cases of ``cases`` seconds (on one thread) each on ``workers`` cores.
+
+    As a sweep runs them: the longest first, each to the worker that frees first; once no case
+    waits, the running ones share the cores as engine threads (``workers // running`` each).
+    """
+    cores = max(workers, 1)
+    waiting = sorted(cases, reverse=True)
+    running: list[float] = []  # the one-thread seconds each running case has left
+    wall = 0.0
+    while waiting or running:
+        while waiting and len(running) < cores:
+            running.append(waiting.pop(0))
+        rate = 1.0 if waiting else thread_gain(cores // len(running))
+        first = min(running)
+        wall += first / rate
+        running = [r - first for r in running]
+        running.remove(0.0)
+    return wall
 
 
 def _cases(case: SandCase) -> tuple[int, int]:
@@ -366,11 +402,13 @@ def _cases(case: SandCase) -> tuple[int, int]:
     return ends.count + inner.count, specimens.count
 
 
-def _stage(plan: CasePlan, mus: tuple[float, ...], spec: SpecimenSpec, disks: float, slow: float) -> list:
+def _stage(
+    plan: CasePlan, mus: tuple[float, ...], spec: SpecimenSpec, disks: float, slow: float, wide: bool
+) -> list:
     """Particle-steps of each case of ``plan`` (``mus``: the calibration's frictions)."""
     out = []
     for mu in plan.frictions:
-        steps = case_steps(spec, mu, trials_per_case(mu, mus, plan.stage), slow)
+        steps = case_steps(spec, mu, trials_per_case(mu, mus, plan.stage), slow, plan.stage, wide)
         out += [disks * steps] * plan.seeds
     return out
 
@@ -471,8 +509,9 @@ def workload(
     slow = dt_paper / dt
     ends, inner, specimens = case_plans(case)
     cal_spec = replace(spec, width=cal.width, height=cal.height, layers=cal.layers)
-    work = [_stage(p, case.mus, cal_spec, cal.disks, slow) for p in (ends, inner)]
-    work.append(_stage(specimens, case.mus, spec, full.disks, slow))
+    wide = is_wide(g)
+    work = [_stage(p, case.mus, cal_spec, cal.disks, slow, wide) for p in (ends, inner)]
+    work.append(_stage(specimens, case.mus, spec, full.disks, slow, wide))
     psteps = StageEstimate(calibration=sum(work[0]) + sum(work[1]), specimens=sum(work[2]))
     # the ends run before the frictions around the state (which they choose), the specimens last
     walls = [wall_seconds([w / throughput for w in stage], workers) for stage in work]
