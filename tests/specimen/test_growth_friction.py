@@ -19,7 +19,13 @@ import pytest
 
 from poro2d.errors import InputError
 from poro2d.grading import GradingCurve
-from poro2d.specimen.compaction import SpecimenSpec, growing_fines, growth_friction, prepare_specimen
+from poro2d.specimen.compaction import (
+    SpecimenSpec,
+    growing_fines,
+    growth_friction,
+    prepare_specimen,
+    slides_while_growing,
+)
 
 SOILS = Path(__file__).parents[2] / "examples" / "soils"
 
@@ -45,17 +51,20 @@ def test_the_settings_are_recorded_only_when_set():
         SpecimenSpec(frictionless_fines="yes")
 
 
-def test_the_fines_are_below_half_the_mean_radius_of_a_very_wide_grading_only():
-    """r_mean / r_min above 4 (mass scaling's trigger) under "auto"; "on" always, "off" never."""
+def test_the_fines_of_a_very_wide_grading_only_grow_frictionless():
+    """Below r_mean / 2; only where r_mean / r_min is above 4 (mass scaling's trigger) under
+    "auto"; "on" always, "off" never. The walls slide with them."""
     wide = np.array([0.1, 0.2, 0.5, 1.0, 2.0, 3.0])  # r_mean 1.13, r_min 0.1: 11 times finer
     narrow = np.array([0.3, 0.5, 1.0, 1.2])  # r_mean 0.75: 2.5 times the finest
     spec = SpecimenSpec()
     assert growing_fines(spec, wide, wide).tolist() == [True, True, True, False, False, False]
     assert growing_fines(spec, wide, wide[3:]).tolist() == [False, False, False]
+    assert slides_while_growing(spec, wide) and not slides_while_growing(spec, narrow)
     assert not growing_fines(spec, narrow, narrow).any()
-    on = replace(spec, frictionless_fines="on")
+    on, off = replace(spec, frictionless_fines="on"), replace(spec, frictionless_fines="off")
     assert growing_fines(on, narrow, narrow).tolist() == [True, False, False, False]
-    assert not growing_fines(replace(spec, frictionless_fines="off"), wide, wide).any()
+    assert slides_while_growing(on, narrow)
+    assert not growing_fines(off, wide, wide).any() and not slides_while_growing(off, wide)
 
 
 def _inside(sim, spec) -> bool:
@@ -67,7 +76,7 @@ def _inside(sim, spec) -> bool:
 def test_frictionless_fines_keep_the_gravels_disks_in_the_box():
     """G1-1 at mu_prep 0.5 in a 0.08 m x 0.04 m box, trial 0.155, seed 0: every disk grown at mu
     0.5 (``frictionless_fines = "off"``) one fine is shot out of the box; the fines grown
-    frictionless (the default) or every disk none is, and no disk is left frictionless."""
+    frictionless (the default) or every disk none is, and no disk or wall is left frictionless."""
     spec = SpecimenSpec(width=0.08, height=0.04, layers=1, friction_prep=0.5, max_steps_per_stage=20_000,
                         fallback_steps=5_000, calm_steps=2_000)  # fmt: skip
     wedged, _ = prepare_specimen(replace(spec, frictionless_fines="off"), _gravel(), 0.155, seed=0)
@@ -76,3 +85,4 @@ def test_frictionless_fines_keep_the_gravels_disks_in_the_box():
         sim, _ = prepare_specimen(free, _gravel(), 0.155, seed=0)
         assert _inside(sim, free)
         assert np.all(sim.particles.mu == free.friction_particle)
+        assert np.all(sim.walls.mu == free.friction_wall)

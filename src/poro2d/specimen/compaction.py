@@ -177,9 +177,9 @@ class SpecimenSpec(Record):
     # the disks' friction while a layer's radii grow (the preparation friction returns for its
     # settling); None: friction_prep, the growth the density control is measured with
     growth_friction: float | None = None
-    # the fines (radius below r_mean / FINE_RADIUS_RATIO) grow frictionless, so none is wedged
-    # between two large disks (growing_fines): "auto" for a grading as wide as mass scaling's
-    # trigger, "on" always, "off" never
+    # the fines (radius below r_mean / FINE_RADIUS_RATIO) and the walls are frictionless while a
+    # layer grows, so no fine is wedged by a large disk (growing_fines): "auto" for a grading as
+    # wide as mass scaling's trigger, "on" always, "off" never
     frictionless_fines: str = "auto"
 
     def __post_init__(self) -> None:
@@ -441,26 +441,34 @@ def growth_friction(spec: SpecimenSpec) -> float:
     return spec.friction_prep if spec.growth_friction is None else spec.growth_friction
 
 
-def growing_fines(spec: SpecimenSpec, radii: np.ndarray, grown: np.ndarray) -> np.ndarray:
-    """Which of the disks of radii ``grown`` grow frictionless: a boolean mask.
-
-    A fine closed on by two disks many times larger is held between them by friction (their
-    normals on it are nearly opposite, tan of their angle below mu): growth drives its overlaps
-    past its own radius and it is shot out of the box. Measured on the sandy gravel G1-1
-    (r_max / r_min 186): every calibration case of ``sand`` at mu_prep 0.2 to 1.0 lost a disk.
-    Its contacts slide while it grows, and take ``friction_prep`` for the layer's settling;
-    the coarse skeleton keeps its friction (a contact's is the smaller of its bodies'), so the
-    friction still sets the packing: G1-1 in a 0.19 m box at mu_prep 1.0, trials 0.15, 0.17
-    and 0.19 gave n' 0.168, 0.168 and 0.176, where growing every disk frictionless makes n'
-    follow the trial down (:func:`growth_friction`). The fines are the disks below
-    ``r_mean / FINE_RADIUS_RATIO`` of the specimen's ``radii``.
-    """
+def slides_while_growing(spec: SpecimenSpec, radii: np.ndarray) -> bool:
+    """Whether a layer of the specimen of ``radii`` grows with frictionless fines and walls
+    (``spec.frictionless_fines``: under "auto" where r_mean / r_min exceeds ``MASS_SCALING_TRIGGER``)."""
     if spec.frictionless_fines == "off" or len(radii) == 0:
+        return False
+    wide = float(np.mean(radii)) > MASS_SCALING_TRIGGER * float(np.min(radii))
+    return spec.frictionless_fines == "on" or wide
+
+
+def growing_fines(spec: SpecimenSpec, radii: np.ndarray, grown: np.ndarray) -> np.ndarray:
+    """Which of the disks of radii ``grown`` grow frictionless (a mask), in a specimen of ``radii``.
+
+    A fine closed on by a disk many times larger, against a wall or a third disk, is held there
+    by friction: growth drives its overlap past its own radius and it is shot out of the box.
+    Measured on the sandy gravel G1-1 (r_max / r_min 186): every calibration case of ``sand`` at
+    mu_prep 0.2 to 1.0 lost a disk so. Its overlap in a force chain is F / kn whatever the
+    radii, so the finest disks suffer it first. Those below ``r_mean / FINE_RADIUS_RATIO``
+    slide while their layer grows (and the walls, :func:`slides_while_growing`: a 0.35 mm disk,
+    0.51 r_mean, was pressed into the lid by a 7 mm one until its overlap was 1.8 times its
+    radius), then take ``friction_prep`` for the layer's settling. The coarse skeleton keeps its
+    friction (a contact's is the smaller of its bodies'), so the friction still sets the
+    packing: G1-1 in a 0.19 m box at mu_prep 1.0, trials 0.15, 0.17 and 0.19 gave n' 0.168,
+    0.168 and 0.176. Freeing every disk that friction could wedge against the largest (up to
+    0.38 r_max at mu 1) freed half the solid, and the trial 0.15 was then accepted as it was.
+    """
+    if not slides_while_growing(spec, radii):
         return np.zeros(len(grown), dtype=bool)
-    r_mean, r_min = float(np.mean(radii)), float(np.min(radii))
-    if spec.frictionless_fines == "auto" and r_mean <= MASS_SCALING_TRIGGER * r_min:
-        return np.zeros(len(grown), dtype=bool)
-    return grown < r_mean / FINE_RADIUS_RATIO
+    return grown < float(np.mean(radii)) / FINE_RADIUS_RATIO
 
 
 def grading_mass_scaling_step(spec: SpecimenSpec, grading: GradingCurve, porosity: float) -> float | None:
@@ -890,11 +898,14 @@ def _build_layer(sim, spec: SpecimenSpec, k: int, idx: np.ndarray, radii: np.nda
     side_walls_reach(sim, SIDE_WALL_REACH * y_top + 4.0 * float(radii.max()))
     if spec.rolling_friction_prep > 0.0:  # the new disks take it too (they are added with none)
         sim.set_rolling_friction(spec.rolling_friction_prep, walls=spec.rolling_friction_prep)
-    mu = sim.particles.mu
+    mu, wall_mu = sim.particles.mu, sim.walls.mu.copy()
     mu[new] = growth_friction(spec)
     mu[new[growing_fines(spec, radii, radii[idx])]] = 0.0
+    if slides_while_growing(spec, radii):
+        sim.walls.mu[:] = 0.0
     steps = _grow(sim, new, radii[idx], plc.scale, spec)
     mu[new] = spec.friction_prep  # the preparation's friction for settling
+    sim.walls.mu[:] = wall_mu
     # renumber the whole packing in strips across its short side (the new layer was
     # appended on top): threads then split it along a short cut (dem.ordering)
     sim.reorder(strip_order(sim.particles.pos, sim.particles.radius))
@@ -976,6 +987,7 @@ __all__ = [
     "SpecimenSpec",
     "check_feasible",
     "growing_fines",
+    "slides_while_growing",
     "is_wide",
     "preparation_note",
     "wide_grading_spec",
