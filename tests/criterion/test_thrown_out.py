@@ -17,11 +17,13 @@ GRAVEL = Path(__file__).parents[2] / "examples" / "soils" / "g1-1_sandy_gravel.c
 def test_a_trial_denser_than_its_grading_jams_is_refused_naming_the_cause(tmp_path, capsys):
     # 0.06 is within the margin the check before the run lets pass (n_J - 0.05), but in this
     # box a layer's overlaps explode and throw a disk out: before, "disk 74 position is invalid"
-    # (with the true masses it was found with: with the fines' masses raised, docs/density-scaling.md,
-    # this trial ends otherwise)
+    # (with the true masses and the fines' friction in growth it was found with: with the fines'
+    # masses raised, docs/density-scaling.md, or the fines and walls sliding while the layers grow,
+    # docs/criterion.md, this trial ends otherwise)
     cfg = tmp_path / "gravel.toml"
     cfg.write_text(
         '[specimen]\nwidth = 0.08\nheight = 0.04\nlayers = 2\nmass_scaling = "off"\n'
+        'frictionless_fines = "off"\n'
         f'[grading]\ncsv = "{GRAVEL.as_posix()}"\n[criterion]\ntrial_porosity = 0.06\nmax_iterations = 1\n'
     )
     with pytest.raises(SystemExit) as e:
@@ -51,4 +53,4 @@ def test_a_disk_thrown_out_at_a_trial_looser_than_jamming_is_not_blamed_on_densi
     note = thrown_out_note(moved, 0.155, 0.100)
     assert "being below" not in note and "start looser" not in note
     assert "is looser than this grading's jamming porosity n_J = 0.100" in note
-    assert "growth_friction = 0" in note
+    assert "growth_friction = 0" in note and 'frictionless_fines = "on"' in note

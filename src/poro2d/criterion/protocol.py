@@ -212,9 +212,9 @@ def thrown_out_note(exc: MisplacedDisk, n: float, n_j: float | None) -> str:
             f"{where}: the overlaps of a layer exploded although the trial n2D = {n:.4f} is looser than "
             f"this grading's jamming porosity n_J = {n_j:.3f}: disks that could not give way while the "
             "radii grew (a fine wedged between large disks by friction); a lower friction_prep, the fines "
-            'grown frictionless ([specimen] frictionless_fines = "on", if set "off"), or every disk '
-            "([specimen] growth_friction = 0: every disk stays in the box, but the friction then decides "
-            "only how the layers settle, docs/criterion.md)"
+            'and walls frictionless in growth ([specimen] frictionless_fines = "on", if set "off"), or '
+            "every disk ([specimen] growth_friction = 0: every disk stays in the box, but the friction then "
+            "decides only how the layers settle, docs/criterion.md)"
         )
     jams = "what this grading jams at" if n_j is None else f"this grading's jamming porosity n_J = {n_j:.3f}"
     start = "at or above it" if n_j is None else f"at {math.ceil(n_j * 100) / 100:.2f} or above"
