@@ -196,3 +196,25 @@ def test_specimen_records_keep_their_keys():
 def test_a_record_gives_back_its_spec():
     spec = SpecimenSpec(threads=2, layers=3)
     assert SpecimenSpec.from_dict(json.loads(json.dumps(spec.to_dict()))) == SpecimenSpec(threads=2, layers=3)
+
+
+def test_a_calibration_names_its_grading_file_by_content_not_by_path(tmp_path):
+    """The same curve by a relative path beside the config, by an absolute path, or copied to
+    another folder: one calibration (each computed every case again before)."""
+    rows = "size_mm,percent_passing\n1.0,0\n2.0,50\n4.0,100\n"
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    (tmp_path / "a" / "curve.csv").write_text(rows)
+    (tmp_path / "b" / "copy.csv").write_text(rows)
+    spec = {"width": 0.1}
+    relative = CriterionBase({"specimen": spec, "grading": {"csv": "curve.csv"}}, tmp_path / "a")
+    absolute = CriterionBase(
+        {"specimen": spec, "grading": {"csv": str(tmp_path / "a" / "curve.csv")}}, tmp_path
+    )
+    copied = CriterionBase({"specimen": spec, "grading": {"csv": "copy.csv"}}, tmp_path / "b")
+    assert calibration_key(relative) == calibration_key(absolute) == calibration_key(copied)
+    (tmp_path / "b" / "copy.csv").write_text(rows.replace("2.0,50", "2.0,60"))
+    assert calibration_key(copied) != calibration_key(relative)
+    # the up-scaling stays in the key beside the file's content
+    scaled = CriterionBase({"specimen": spec, "grading": {"csv": "curve.csv", "upscale": 2}}, tmp_path / "a")
+    assert calibration_key(scaled) != calibration_key(relative)

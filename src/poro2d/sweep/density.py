@@ -32,6 +32,7 @@ from poro2d.io_utils import Provenance
 from poro2d.locks import cache_entry
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.store import Store
+from poro2d.store.digests import file_digest
 from poro2d.sweep.cases import Case, SweepConfig, criterion_objects, grid_cases
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.records import CaseRow, LostCaseRow, case_row
@@ -148,9 +149,26 @@ def calibration_key(base: CriterionBase) -> str:
     Spaced as these keys were first written, so cached calibrations keep their folders.
     """
     rec = {"base": calibration_base(base).as_config(), "version": __version__}
+    rec["base"]["grading"] = _grading_by_content(rec["base"]["grading"], base.base_dir)
     rec["revision"] = CALIBRATION_REVISION
     tables = {"base.specimen": SpecimenSpec, "base.criterion": CriterionSettings}
     return identity_digest(rec, tables=tables, length=16, layout="spaced")
+
+
+def _grading_by_content(grading: dict, base_dir: Path | None) -> dict:
+    """The grading table as a calibration's key sees it: a curve file named by its content (its
+    SHA-256), not by its path, so the same curve read from another folder, or given by another
+    path, finds its calibration (a config moved beside its csv, or an absolute path, computed
+    every case again before). A file that cannot be read keeps its path (the run then refuses it)."""
+    csv = grading.get("csv")
+    if not isinstance(csv, str):
+        return grading
+    path = Path(csv) if base_dir is None or Path(csv).is_absolute() else base_dir / csv
+    try:
+        digest = file_digest(path)
+    except OSError:
+        return grading
+    return {**{k: v for k, v in grading.items() if k != "csv"}, "csv_sha256": digest}
 
 
 def first_trial(
