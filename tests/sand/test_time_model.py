@@ -34,8 +34,8 @@ def test_a_trials_steps_are_its_layers_growth_and_settling_and_its_lid():
     spec = SpecimenSpec(width=0.1, height=0.05, layers=3, growth_increments=40, growth_steps=150)
     # 3 layers x (40 x 150 + 14 000 x 2) at half the paper grading's step
     assert PF.preparation_steps(spec, 2.0) == pytest.approx(3 * (6_000 + 28_000))
-    # a wide grading's layers settle longer: 22 000 steps each
-    assert PF.preparation_steps(spec, 2.0, wide=True) == pytest.approx(3 * (6_000 + 44_000))
+    # a wide grading's layers settle longer: 50 000 steps each
+    assert PF.preparation_steps(spec, 2.0, wide=True) == pytest.approx(3 * (6_000 + 100_000))
     # 1.5 trials x (102 000 + 73 000 x 2)
     assert PF.case_steps(spec, 1.0, 1.5, 2.0) == pytest.approx(1.5 * (102_000 + 146_000))
     # a specimen's trial: 1.2 x (102 000 + 6 000 x 2)
