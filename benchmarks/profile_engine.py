@@ -106,17 +106,16 @@ def _loop_rebuild_part(reps, part, disks, walls, nb, wb, work, prm):
     pairs, 3 fill pairs with their history, 4 fill wall pairs, 5 copy rows, 6 partitions)."""
     pos, radius, skin, n = disks.pos, disks.radius, prm[K.SKIN], disks.pos.shape[0]
     wp0, wp1 = walls.p0, walls.p1
-    cell, members, cstart, ginfo, cxyr = work.cell, work.members, work.cstart, work.ginfo, work.cxyr
+    cell, members, cstart, ginfo = work.cell, work.members, work.cstart, work.ginfo
     for _ in range(reps):
         if part == 0:
-            cell_grid(pos, radius, skin, cell, members, cstart, work.cfill, ginfo, cxyr)
+            cell_grid(pos, radius, skin, cell, members, cstart, work.cfill, ginfo)
         elif part == 1:
-            new_start, cand = nb.new_start, work.cand
-            count_pair_rows(0, n, pos, radius, skin, cell, members, cstart, cxyr, ginfo, new_start, cand)
+            count_pair_rows(0, n, pos, radius, skin, cell, members, cstart, ginfo, nb.new_start, work.cand)
         elif part == 2:
             count_wall_rows(0, n, pos, radius, skin, wp0, wp1, wb.new_start)
         elif part == 3:
-            fill_pair_rows(0, n, pos, radius, skin, cell, members, cstart, cxyr, ginfo, nb.start, nb.j, nb.fs,
+            fill_pair_rows(0, n, pos, radius, skin, cell, members, cstart, ginfo, nb.start, nb.j, nb.fs,
                            nb.new_start, nb.new_j, nb.new_fs, nb.mr, nb.new_mr, work.cand)  # fmt: skip
         elif part == 4:
             fill_wall_rows(0, n, pos, radius, skin, wp0, wp1, wb.start, wb.w, wb.fs, wb.new_start, wb.new_w,

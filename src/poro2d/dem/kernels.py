@@ -537,19 +537,19 @@ def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out, levels):
     pos_build, sync = work.pos_build, work.sync
     part, xstart, xpair, dlist, dstart = work.part, work.xstart, work.xpair, work.dlist, work.dstart
     cell, members, cstart, cfill, ginfo = work.cell, work.members, work.cstart, work.cfill, work.ginfo
-    cand, cxyr = work.cand, work.cxyr
+    cand = work.cand
     skin = prm[SKIN]
     n = pos.shape[0]
     lo = t * n // nthr
     hi = (t + 1) * n // nthr
     if t == 0:
         if levels is None:
-            cell_grid(pos, radius, skin, cell, members, cstart, cfill, ginfo, cxyr)
+            cell_grid(pos, radius, skin, cell, members, cstart, cfill, ginfo)
         else:
             level_grid(pos, radius, skin, levels)
     barrier(sync, nthr)
     if levels is None:
-        count_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, cxyr, ginfo, new_start, cand)
+        count_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, new_start, cand)
     else:
         count_level_rows(lo, hi, pos, radius, skin, levels, new_start)
     count_wall_rows(lo, hi, pos, radius, skin, wp0, wp1, wnew_start)
@@ -569,7 +569,7 @@ def _rebuild(t, nthr, disks, walls, nb, wb, work, prm, out, levels):
     if atomic_load(sync, STATUS_WORD) != RUNNING:
         return False
     if levels is None:
-        fill_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, cxyr, ginfo, nb_start, nb_j, nb_fs,
+        fill_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, nb_start, nb_j, nb_fs,
                        new_start, new_j, new_fs, nb_mr, new_mr, cand)  # fmt: skip
     else:
         fill_level_rows(lo, hi, pos, radius, skin, levels, nb_start, nb_j, nb_fs, nb_mr, new_start,

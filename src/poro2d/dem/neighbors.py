@@ -62,7 +62,6 @@ class GridScratch(NamedTuple):
     cfill: np.ndarray  # (max_cells + 1) fill counters
     ginfo: np.ndarray  # (4) the grid's cell counts
     cand: np.ndarray  # (n * CAND_SLOTS) the partners the counting scan found, row by row
-    cxyr: np.ndarray  # (n, 3) float64: x, y and radius of the disks in cell order (as members)
 
 
 def grid_scratch(n: int) -> GridScratch:
@@ -71,14 +70,13 @@ def grid_scratch(n: int) -> GridScratch:
     i8 = np.int64
     return GridScratch(
         np.zeros(n, i8), np.zeros(n, i8), np.zeros(nc, i8), np.zeros(nc, i8), np.zeros(4, i8),
-        np.zeros(n * CAND_SLOTS, i8), np.zeros((n, 3)),
+        np.zeros(n * CAND_SLOTS, i8),
     )  # fmt: skip
 
 
 @njit(cache=True)
-def cell_grid(pos, radius, skin, cell, members, cstart, cfill, ginfo, cxyr):
-    """Bin the disks into square cells of side 2 r_max + skin (members in index order), and copy
-    their positions and radii into ``cxyr`` in that order."""
+def cell_grid(pos, radius, skin, cell, members, cstart, cfill, ginfo):
+    """Bin the disks into square cells of side 2 r_max + skin (members in index order)."""
     n = pos.shape[0]
     if n == 0:
         ginfo[0] = 1
@@ -124,13 +122,6 @@ def cell_grid(pos, radius, skin, cell, members, cstart, cfill, ginfo, cxyr):
         cell[i] = c
         cstart[c + 1] += 1
     _members_by_cell(n, ncell, cell, members, cstart, cfill)
-    # the scan reads a cell's candidates from one run of memory instead of gathering them by
-    # index: at 250k disks the gather missed the cache at most candidates
-    for m in range(n):
-        i = members[m]
-        cxyr[m, 0] = pos[i, 0]
-        cxyr[m, 1] = pos[i, 1]
-        cxyr[m, 2] = radius[i]
     ginfo[0] = ncx
     ginfo[1] = ncy
 
@@ -149,9 +140,9 @@ def _members_by_cell(n, ncell, cell, members, cstart, cfill):
 
 
 @njit(inline="always", cache=True)
-def _scan_row(i, pos, radius, skin, cell, members, cstart, cxyr, ncx, ncy, out_j, k0, write, limit):
+def _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, out_j, k0, write, limit):
     """Count the partners j > i of disk i, writing the first ``limit`` of them from k0 when
-    ``write``; returns the count. The candidates' coordinates are read from ``cxyr``."""
+    ``write``; returns the count."""
     c = cell[i]
     cx = c % ncx
     cy = c // ncx
@@ -163,13 +154,12 @@ def _scan_row(i, pos, radius, skin, cell, members, cstart, cxyr, ncx, ncy, out_j
         for nx_ in range(max(cx - 1, 0), min(cx + 2, ncx)):
             cc = ny_ * ncx + nx_
             for m in range(cstart[cc], cstart[cc + 1]):
-                j, xj, yj, rj = members[m], cxyr[m, 0], cxyr[m, 1], cxyr[m, 2]
-                k = _take(i, j, xi, yi, ri, xj, yj, rj, skin, out_j, k0, k, write and k < limit)
+                k = _take(i, members[m], xi, yi, ri, pos, radius, skin, out_j, k0, k, write and k < limit)
     return k
 
 
 @njit(inline="always", cache=True)
-def _take(i, j, xi, yi, ri, xj, yj, rj, skin, out_j, k0, k, write):
+def _take(i, j, xi, yi, ri, pos, radius, skin, out_j, k0, k, write):
     """Count (and write at k0 + k) disk j as a partner of disk i when j > i lies within reach;
     returns the count so far.
 
@@ -179,9 +169,9 @@ def _take(i, j, xi, yi, ri, xj, yj, rj, skin, out_j, k0, k, write):
     others. So j is written whatever the verdict and the count moves on only when it
     holds: a candidate that fails is overwritten by the next one, or lies past the row.
     """
-    dx = xj - xi
-    dy = yj - yi
-    reach = ri + rj + skin
+    dx = pos[j, 0] - xi
+    dy = pos[j, 1] - yi
+    reach = ri + radius[j] + skin
     hit = (j > i) & (dx * dx + dy * dy < reach * reach)
     if write:
         out_j[k0 + k] = j
@@ -197,7 +187,7 @@ def _near_wall(px, py, reach, wp0, wp1, w):
 
 
 @njit(cache=True)
-def count_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, cxyr, ginfo, new_start, cand):
+def count_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, new_start, cand):
     """Candidate partners of rows lo..hi-1 into ``new_start[i + 1]``; the first
     ``CAND_SLOTS`` of each row into ``cand`` (when it is not empty)."""
     ncx = ginfo[0]
@@ -205,7 +195,7 @@ def count_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, cxyr, ginf
     slots = cand.shape[0] // max(pos.shape[0], 1)
     for i in range(lo, hi):
         new_start[i + 1] = _scan_row(
-            i, pos, radius, skin, cell, members, cstart, cxyr, ncx, ncy, cand, i * slots, slots > 0, slots
+            i, pos, radius, skin, cell, members, cstart, ncx, ncy, cand, i * slots, slots > 0, slots
         )
 
 
@@ -233,8 +223,8 @@ def prefix_rows(n, start):
 
 @njit(cache=True)
 def fill_pair_rows(
-    lo, hi, pos, radius, skin, cell, members, cstart, cxyr, ginfo, nb_start, nb_j, nb_fs, new_start, new_j,
-    new_fs, nb_mr, new_mr, cand,
+    lo, hi, pos, radius, skin, cell, members, cstart, ginfo, nb_start, nb_j, nb_fs, new_start, new_j, new_fs,
+    nb_mr, new_mr, cand,
 ):  # fmt: skip
     """Write rows lo..hi-1 of the new disk-disk list, each pair with its old shear force and
     rolling moment (or 0): copied from ``cand`` when the counting scan kept the whole row,
@@ -249,7 +239,7 @@ def fill_pair_rows(
             for k in range(count):
                 new_j[k0 + k] = cand[i * slots + k]
         else:
-            _scan_row(i, pos, radius, skin, cell, members, cstart, cxyr, ncx, ncy, new_j, k0, True, count)
+            _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, new_j, k0, True, count)
         o0 = nb_start[i]
         o1 = nb_start[i + 1]
         _carry_history(k0, new_start[i + 1], o0, o1, nb_j, nb_fs, nb_mr, new_j, new_fs, new_mr)
@@ -317,13 +307,10 @@ def build_pairs(pos, radius, skin, nb_start, nb_j, nb_fs, new_start, new_j, new_
     g_members = np.empty(n, dtype=np.int64)
     g_cstart = np.empty(max_cells(n) + 1, dtype=np.int64)
     g_ginfo = np.zeros(4, dtype=np.int64)
-    g_cxyr = np.empty((n, 3))
     if levels is None:
-        cell_grid(pos, radius, skin, g_cell, g_members, g_cstart, np.empty_like(g_cstart), g_ginfo, g_cxyr)
+        cell_grid(pos, radius, skin, g_cell, g_members, g_cstart, np.empty_like(g_cstart), g_ginfo)
         no_cand = np.zeros(0, dtype=np.int64)  # this stand-alone build scans twice
-        count_pair_rows(
-            0, n, pos, radius, skin, g_cell, g_members, g_cstart, g_cxyr, g_ginfo, new_start, no_cand
-        )
+        count_pair_rows(0, n, pos, radius, skin, g_cell, g_members, g_cstart, g_ginfo, new_start, no_cand)
     else:
         level_grid(pos, radius, skin, levels)
         count_level_rows(0, n, pos, radius, skin, levels, new_start)
@@ -333,9 +320,8 @@ def build_pairs(pos, radius, skin, nb_start, nb_j, nb_fs, new_start, new_j, new_
     nb_mr = np.zeros(nb_j.shape[0])  # no rolling history in this stand-alone build
     new_mr = np.zeros(nb_j.shape[0])
     if levels is None:
-        no_cand = np.zeros(0, dtype=np.int64)
-        fill_pair_rows(0, n, pos, radius, skin, g_cell, g_members, g_cstart, g_cxyr, g_ginfo, nb_start, nb_j,
-                       nb_fs, new_start, new_j, new_fs, nb_mr, new_mr, no_cand)  # fmt: skip
+        fill_pair_rows(0, n, pos, radius, skin, g_cell, g_members, g_cstart, g_ginfo, nb_start, nb_j, nb_fs,
+                       new_start, new_j, new_fs, nb_mr, new_mr, np.zeros(0, dtype=np.int64))  # fmt: skip
     else:
         fill_level_rows(0, n, pos, radius, skin, levels, nb_start, nb_j, nb_fs, nb_mr, new_start, new_j,
                         new_fs, new_mr)  # fmt: skip
@@ -558,9 +544,7 @@ def _scan_level_row(i, pos, radius, skin, members, cstart, geo, info, nlev, out_
             c0 = row + _cell_index(xi - half - x0, inv, ncx)
             c1 = row + _cell_index(xi + half - x0, inv, ncx)
             for m in range(cstart[c0], cstart[c1 + 1]):
-                j = members[m]
-                xj, yj, rj = pos[j, 0], pos[j, 1], radius[j]
-                k = _take(i, j, xi, yi, ri, xj, yj, rj, skin, out_j, k0, k, write and k < limit)
+                k = _take(i, members[m], xi, yi, ri, pos, radius, skin, out_j, k0, k, write and k < limit)
     return k
 
 

@@ -140,7 +140,6 @@ class WorkArrays(NamedTuple):
     cfill: np.ndarray
     ginfo: np.ndarray
     cand: np.ndarray
-    cxyr: np.ndarray
 
 
 class KernelRecords(NamedTuple):
@@ -193,6 +192,6 @@ def kernel_records(
     work_rec = WorkArrays(
         pos_build=work.pos_build, part=work.part, xstart=work.xstart, xpair=nb.cross, dlist=work.dlist,
         dstart=work.dstart, held=work.held, tmax=work.tmax, tskip=work.tskip, sync=work.sync, cell=g.cell,
-        members=g.members, cstart=g.cstart, cfill=g.cfill, ginfo=g.ginfo, cand=g.cand, cxyr=g.cxyr,
+        members=g.members, cstart=g.cstart, cfill=g.cfill, ginfo=g.ginfo, cand=g.cand,
     )  # fmt: skip
     return KernelRecords(disks, walls_rec, nb_rec, wb_rec, work_rec, work.levels)
