@@ -257,6 +257,12 @@ class DaskCluster:
         if not self.own:
             return
         if self.client is not None:
+            # the workers' work is done: a heartbeat that meets the closing scheduler logs a
+            # traceback from the worker's process (seen under a notebook's cell), noise here
+            try:
+                self.client.run(_silence_distributed_logs)
+            except Exception:  # a client already closed or never connected: nothing to silence
+                pass
             self.client.close()
         if self.local is not None:
             # a finished run's workers are told to stop; on a loaded machine one may take longer
