@@ -420,7 +420,7 @@ def mass_scaling_step(spec: SpecimenSpec, radii: np.ndarray) -> float | None:
     if spec.mass_scaling == "off" or len(radii) == 0:
         return None
     r_mean, r_min = float(np.mean(radii)), float(np.min(radii))
-    if spec.mass_scaling == "auto" and r_mean <= MASS_SCALING_TRIGGER * r_min:
+    if spec.mass_scaling == "auto" and not fines_far_finer(radii):
         return None
     r_floor = r_mean / spec.mass_scaling_ratio
     return time_step(spec, 2.0 * r_floor) if r_floor > r_min else None
@@ -441,13 +441,18 @@ def growth_friction(spec: SpecimenSpec) -> float:
     return spec.friction_prep if spec.growth_friction is None else spec.growth_friction
 
 
+def fines_far_finer(radii: np.ndarray) -> bool:
+    """Whether r_mean / r_min of ``radii`` (not empty) exceeds ``MASS_SCALING_TRIGGER``: the
+    "auto" test of the density scaling and of the frictionless fines."""
+    return float(np.mean(radii)) > MASS_SCALING_TRIGGER * float(np.min(radii))
+
+
 def slides_while_growing(spec: SpecimenSpec, radii: np.ndarray) -> bool:
     """Whether a layer of the specimen of ``radii`` grows with frictionless fines and walls
     (``spec.frictionless_fines``: under "auto" where r_mean / r_min exceeds ``MASS_SCALING_TRIGGER``)."""
     if spec.frictionless_fines == "off" or len(radii) == 0:
         return False
-    wide = float(np.mean(radii)) > MASS_SCALING_TRIGGER * float(np.min(radii))
-    return spec.frictionless_fines == "on" or wide
+    return spec.frictionless_fines == "on" or fines_far_finer(radii)
 
 
 def growing_fines(spec: SpecimenSpec, radii: np.ndarray, grown: np.ndarray) -> np.ndarray:
