@@ -46,6 +46,7 @@ TEXT_MASKS = [
     (re.compile(r"\d+(\.\d+)?\s*(s|min|h|ms)\b"), "<dur>"),
     (re.compile(r"[\d.]+e[+-]?\d+ particle-steps"), "<rate>"),
     (re.compile(r"\b[mp][0-9a-f]{6,14}\b"), "<svg-id>"),  # matplotlib's clip-path, marker ids: random
+    (re.compile(r"\bimage[0-9a-f]{6,14}\b"), "<svg-id>"),  # and its embedded images' ids
     (re.compile(r"(time[^|<]*\|\s*|<td>[^<]*_s</td><td>)[\d.e+-]+"), r"\1<t>"),  # report time rows
 ]
 

@@ -21,9 +21,9 @@ Scratch storage (all preallocated by the caller, see :func:`grid_scratch`):
 ``cell`` and ``members`` (n), ``cstart`` and ``cfill`` (:func:`max_cells` + 1),
 ``ginfo`` (int64, the grid's cell counts) and ``cand`` (n x :data:`CAND_SLOTS`, or empty).
 
-The counting scan keeps the first :data:`CAND_SLOTS` partners of each row in ``cand``, so
-that filling copies them instead of scanning the nine cells again (a scan is about half of
-a build's time); a row with more partners is scanned again. Either way a row's partners
+The counting scan keeps a row's partners in ``cand`` when they are fewer than
+:data:`CAND_SLOTS`, so that filling copies them instead of scanning the nine cells again; a
+row with more partners is scanned again. Either way a row's partners
 are written in the scan's order: the lists are the same, slot for slot.
 
 For wide size ratios the disk-disk rows are built from grids by size level instead
@@ -49,7 +49,8 @@ def max_cells(n):
     return 4 * n + 16
 
 
-#: partners per disk the counting scan keeps for the filling (paper grading: 2.4 on average)
+#: slots per disk for the partners the counting scan keeps for the filling: all but the last,
+#: which takes the candidates past them (paper grading: 2.4 partners on average)
 CAND_SLOTS = 8
 
 
@@ -140,9 +141,18 @@ def _members_by_cell(n, ncell, cell, members, cstart, cfill):
 
 
 @njit(inline="always", cache=True)
-def _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, out_j, k0, write, limit):
-    """Count the partners j > i of disk i, writing the first ``limit`` of them from k0 when
-    ``write``; returns the count."""
+def _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, out_j, k0, last, exact):
+    """Count the partners j > i of disk i in the nine cells around it, writing them to out_j.
+
+    A cell's members are in index order, so those j <= i are stepped over from the cell's
+    end before the scan (about half the candidates, no distance taken). With ``exact`` the
+    partners alone are written, at k0, k0 + 1, ... (the rare rows scanned again). Otherwise
+    every candidate is written, at k0 + min(k, last) with k the partners so far: one that
+    fails is overwritten by the next, and slot k0 + last takes all past the first ``last``
+    partners. Writing whatever the verdict keeps a branch off it (see :func:`_take`), and the
+    clamp keeps the writes in the row without testing k against the row's end: tested, the
+    scan took 3.5 times as long (1.15 ms against 0.32 on the paper packing).
+    """
     c = cell[i]
     cx = c % ncx
     cy = c // ncx
@@ -153,9 +163,29 @@ def _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, out_j, k0, 
     for ny_ in range(max(cy - 1, 0), min(cy + 2, ncy)):
         for nx_ in range(max(cx - 1, 0), min(cx + 2, ncx)):
             cc = ny_ * ncx + nx_
-            for m in range(cstart[cc], cstart[cc + 1]):
-                k = _take(i, members[m], xi, yi, ri, pos, radius, skin, out_j, k0, k, write and k < limit)
+            first = cstart[cc]
+            end = cstart[cc + 1]
+            while end > first and members[end - 1] > i:
+                end -= 1
+            for m in range(end, cstart[cc + 1]):
+                j = members[m]
+                hit = _within_reach(j, xi, yi, ri, pos, radius, skin)
+                if exact:
+                    if hit:
+                        out_j[k0 + k] = j
+                else:
+                    out_j[k0 + min(k, last)] = j
+                k += np.int64(hit)
     return k
+
+
+@njit(inline="always", cache=True)
+def _within_reach(j, xi, yi, ri, pos, radius, skin):
+    """Whether disk j lies within the reach of disk i (centre xi, yi, radius ri)."""
+    dx = pos[j, 0] - xi
+    dy = pos[j, 1] - yi
+    reach = ri + radius[j] + skin
+    return dx * dx + dy * dy < reach * reach
 
 
 @njit(inline="always", cache=True)
@@ -169,10 +199,7 @@ def _take(i, j, xi, yi, ri, pos, radius, skin, out_j, k0, k, write):
     others. So j is written whatever the verdict and the count moves on only when it
     holds: a candidate that fails is overwritten by the next one, or lies past the row.
     """
-    dx = pos[j, 0] - xi
-    dy = pos[j, 1] - yi
-    reach = ri + radius[j] + skin
-    hit = (j > i) & (dx * dx + dy * dy < reach * reach)
+    hit = (j > i) & _within_reach(j, xi, yi, ri, pos, radius, skin)
     if write:
         out_j[k0 + k] = j
     return k + np.int64(hit)
@@ -189,13 +216,16 @@ def _near_wall(px, py, reach, wp0, wp1, w):
 @njit(cache=True)
 def count_pair_rows(lo, hi, pos, radius, skin, cell, members, cstart, ginfo, new_start, cand):
     """Candidate partners of rows lo..hi-1 into ``new_start[i + 1]``; the first
-    ``CAND_SLOTS`` of each row into ``cand`` (when it is not empty)."""
+    ``CAND_SLOTS - 1`` of each row into ``cand`` (when it is not empty; its row's last slot
+    takes the candidates past them)."""
     ncx = ginfo[0]
     ncy = ginfo[1]
     slots = cand.shape[0] // max(pos.shape[0], 1)
+    sink = cand if slots > 0 else np.empty(1, np.int64)
+    last = max(slots - 1, 0)
     for i in range(lo, hi):
         new_start[i + 1] = _scan_row(
-            i, pos, radius, skin, cell, members, cstart, ncx, ncy, cand, i * slots, slots > 0, slots
+            i, pos, radius, skin, cell, members, cstart, ncx, ncy, sink, i * slots, last, False
         )
 
 
@@ -235,11 +265,11 @@ def fill_pair_rows(
     for i in range(lo, hi):
         k0 = new_start[i]
         count = new_start[i + 1] - k0
-        if count <= slots:
+        if count < slots:
             for k in range(count):
                 new_j[k0 + k] = cand[i * slots + k]
         else:
-            _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, new_j, k0, True, count)
+            _scan_row(i, pos, radius, skin, cell, members, cstart, ncx, ncy, new_j, k0, 0, True)
         o0 = nb_start[i]
         o1 = nb_start[i + 1]
         _carry_history(k0, new_start[i + 1], o0, o1, nb_j, nb_fs, nb_mr, new_j, new_fs, new_mr)
