@@ -33,7 +33,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 # steps per timed block and warm-up steps, as bench_engine.py's table times them
-PLAN = {"paper": (3000, 500), "25k": (400, 50), "250k": (100, 10)}
+PLAN = {"paper": (3000, 500), "25k": (400, 500), "250k": (100, 500)}
 
 
 def worker(case: str, threads: list[int], steps: int, warmup: int, out: Path) -> dict:

@@ -251,7 +251,7 @@ def test_kernel_records_hold_the_simulations_arrays():
     assert rec.work.dstart is sim.work.dstart
     assert rec.work.xpair is sim.pairs.cross and rec.disks.inv_mass is sim.masses.inv_mass
     ints = {"mode", "start", "j", "w", "new_start", "new_j", "new_w", "part", "xstart", "xpair",
-            "dlist", "dstart", "held", "sync", "cell", "members", "cstart", "cfill", "ginfo",
+            "dlist", "dstart", "held", "sync", "cell", "members", "cstart", "cfill",
             "cand"}  # fmt: skip
     assert rec.levels is None  # a narrow grading: the one cell grid, no grids by size level
     for record in rec[:-1]:

@@ -51,3 +51,36 @@ def test_kernel_lists_are_the_two_scan_lists_slot_for_slot(ratio, seed):
         assert found == brute_force_pairs(sim.work.pos_build, sim.particles.radius, sim.skin)
         res = sim.run(40)
         assert res.rebuilds > 0  # the next comparison is of a list built again
+
+
+
+
+@pytest.mark.parametrize("past", [1e-4, 1e-7])
+def test_rows_reaching_just_into_the_next_cell_find_their_partner(past):
+    """A row reads only the cells its reach touches. A disk of the largest radius ``past``
+    (of a cell's side) beyond its cell's edge reaches the next cell but one side's width
+    (its reach is 2 r_max + skin, the side itself) by that little: the partner it finds
+    there, a hair inside its reach, is one a range narrowed by rounding would miss."""
+    r, skin = 1e-3, 2e-4
+    size = 2 * r + skin  # the grid's side; the disk at the origin puts the edges at k size
+    pos, pairs = [(0.0, 0.0)], set()
+    for c, lane in ((2, 1.5), (5, 3.5)):
+        for axis in (0, 1):
+            a = np.array([lane, lane]) * size if axis == 0 else np.array([9.5 + lane / 2, 0.0]) * size
+            a[axis] = (c + past) * size
+            b = a.copy()
+            b[axis] += size * (1.0 - 0.5 * past)  # within reach, in cell c + 1
+            pairs.add((len(pos), len(pos) + 1))
+            pos += [tuple(a), tuple(b)]
+    # fillers apart from each other and from the pairs, so that the grid keeps its side
+    pos += [(x * size, y * size) for x in np.arange(0.0, 12.0, 1.1) for y in (8.5, 9.6, 10.7, 11.8)]
+    pos = np.array(pos)
+    radius = np.full(len(pos), r)
+    n, cap = len(pos), 256
+    assert (np.ptp(pos[:, 0]) / size + 1) * (np.ptp(pos[:, 1]) / size + 1) <= 4 * n + 16
+    start, other, fs = np.zeros(n + 1, np.int64), np.zeros(cap, np.int64), np.zeros(cap)
+    new = (np.zeros(n + 1, np.int64), np.zeros(cap, np.int64), np.zeros(cap))
+    total = build_pairs(pos, radius, skin, start, other, fs, *new)
+    rows = np.repeat(np.arange(n), np.diff(start))
+    found = {(int(i), int(j)) for i, j in zip(rows, other[:total], strict=True)}
+    assert found == brute_force_pairs(pos, radius, skin) == pairs
