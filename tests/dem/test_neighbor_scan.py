@@ -53,8 +53,6 @@ def test_kernel_lists_are_the_two_scan_lists_slot_for_slot(ratio, seed):
         assert res.rebuilds > 0  # the next comparison is of a list built again
 
 
-
-
 @pytest.mark.parametrize("past", [1e-4, 1e-7])
 def test_rows_reaching_just_into_the_next_cell_find_their_partner(past):
     """A row reads only the cells its reach touches. A disk of the largest radius ``past``
