@@ -211,6 +211,38 @@ def test_wall_list_equals_brute_force():
     assert build_wall_pairs(pos, rad, skin, w.p0, w.p1, *small) == -len(oracle)
 
 
+def test_wall_list_of_a_segmented_lid_equals_brute_force():
+    """A lid of 40 short segments: a disk is refused by a segment's bounding box before its
+    closest point is taken; disks placed a hair inside and outside the reach of a segment's
+    end and of its middle must still be told apart as the closest point tells them."""
+    rng = np.random.default_rng(4)
+    skin, k, width, top = 2e-4, 40, 0.04, 0.03
+    w = Walls.box(0.0, 0.0, width, top + 0.01, 1e5, 1e5, 0.5)
+    for s in range(k):
+        w.add((s * width / k, top), ((s + 1) * width / k, top), 1e5, 1e5, 0.5, f"lid{s}")
+    pos = list(rng.uniform(0.0, width, (200, 2)) * (1.0, top / width))
+    rad = list(R * rng.uniform(0.5, 2.0, 200))
+    for s in range(k):
+        x_end, reach = s * width / k, R + skin
+        for f in (1.0 - 1e-12, 1.0 + 1e-12):  # beside an end, below a middle, at reach (1 -+ 1e-12)
+            pos += [(x_end - reach * f, top), ((s + 0.5) * width / k, top - reach * f)]
+            rad += [R, R]
+    pos, rad = np.array(pos), np.array(rad)
+    n, cap = len(pos), 4000
+    start, ww, fs, nstart, nw_, nfs = _empty_lists(n, cap)
+    got = build_wall_pairs(pos, rad, skin, w.p0, w.p1, start, ww, fs, nstart, nw_, nfs)
+    oracle = set()
+    for i in range(n):
+        for j in range(w.n):
+            a, b = w.p0[j], w.p1[j]
+            t = np.clip(np.dot(pos[i] - a, b - a) / np.dot(b - a, b - a), 0.0, 1.0)
+            c = a + t * (b - a)
+            if (pos[i, 0] - c[0]) ** 2 + (pos[i, 1] - c[1]) ** 2 < (rad[i] + skin) ** 2:
+                oracle.add((i, j))
+    assert got == len(oracle) and _pairs_of(start, ww, n) == oracle
+    assert len(oracle) > 200  # the disks at reach found their segments
+
+
 # ------------------------------------------------------ capacity growth
 def _falling_heap(seed=1):
     """Disks fall into a box: the number of neighbour pairs grows as they pack."""

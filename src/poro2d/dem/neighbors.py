@@ -239,9 +239,25 @@ def _take(i, j, xi, yi, ri, pos, radius, skin, out_j, k0, k, write):
     return k + np.int64(hit)
 
 
+#: the bounding-box test of a wall widens the reach by this fraction: far above the
+#: round-off of the closest point, so the test never refuses a wall within reach
+_WALL_BOX_PAD = 1e-9
+
+
 @njit(inline="always", cache=True)
 def _near_wall(px, py, reach, wp0, wp1, w):
-    cx, cy = segment_closest(px, py, wp0[w, 0], wp0[w, 1], wp1[w, 0], wp1[w, 1])
+    """Whether the point (px, py) lies within ``reach`` of wall segment ``w``.
+
+    A point farther than the reach from the segment's bounding box is refused without the
+    closest point (a division): a criterion's lid is dozens of segments, and each disk is
+    tested against every wall twice per list build (with 72 walls on the paper packing
+    that count took 0.44 ms, twice a build's pair count).
+    """
+    ax, ay, bx, by = wp0[w, 0], wp0[w, 1], wp1[w, 0], wp1[w, 1]
+    far = reach * (1.0 + _WALL_BOX_PAD)
+    if px < min(ax, bx) - far or px > max(ax, bx) + far or py < min(ay, by) - far or py > max(ay, by) + far:
+        return False
+    cx, cy = segment_closest(px, py, ax, ay, bx, by)
     dx = px - cx
     dy = py - cy
     return dx * dx + dy * dy < reach * reach
