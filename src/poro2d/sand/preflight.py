@@ -41,11 +41,14 @@ from poro2d.specimen.compaction import (
 )
 from poro2d.typed_result import TypedResult
 
-#: particle-steps per second per core assumed by the estimate: measured per worker over whole
-#: runs with both cores running cases, 2.6e7 (Toyoura sand, 4 100 and 10 800 disks) and 2.1e7
-#: (the sandy gravel G1-1, 5 000 and 8 800 disks; docs/sand.md); less on a machine busy with
-#: other work (0.6e7-1.2e7 seen): ``throughput`` of :func:`preflight` takes the machine's own
-THROUGHPUT = 2.3e7
+#: particle-steps per second per core assumed by the estimate, fitted on whole runs with both
+#: cores running cases: the workers' measured pace was 3.0e7 (Toyoura sand, 4 100 and 10 800
+#: disks), 3.1-3.7e7 (the paper's sand), 3.4e7 (CB-Mix-No. 2) after the cheaper list builds,
+#: 2.1-2.7e7 (the sandy gravel G1-1) before them; set below those, since the step count of the
+#: narrow soils' preparations falls short (the paper's sand: 6.2e9 particle-steps against 3.9e9
+#: counted; docs/sand.md). Less on a machine busy with other work (0.6e7-1.2e7 seen):
+#: ``throughput`` of :func:`preflight` takes the machine's own
+THROUGHPUT = 2.6e7
 #: lid steps of one calibration trial at the paper grading's time step, by preparation friction
 #: (mu_prep, steps; linear between): the mean per trial of the calibration cases of Toyoura sand
 #: with the creeping lid at rest below ``CREEP_RATIO`` (calibration box, 2 seeds, 4 100 disks,
