@@ -188,6 +188,20 @@ def test_neighbour_rebuild_carries_history():
     assert len(new & old) > 100 and len(new - old) > 0
 
 
+def _wall_oracle(pos, rad, skin, walls) -> set[tuple[int, int]]:
+    """Every (disk, wall) whose closest wall point lies within the disk's reach: the O(N W) oracle
+    (squared distances, as the kernel compares them, so a disk a hair from its reach is judged alike)."""
+    found = set()
+    for i in range(len(pos)):
+        for k in range(walls.n):
+            a, b = walls.p0[k], walls.p1[k]
+            t = np.clip(np.dot(pos[i] - a, b - a) / np.dot(b - a, b - a), 0.0, 1.0)
+            c = a + t * (b - a)
+            if (pos[i, 0] - c[0]) ** 2 + (pos[i, 1] - c[1]) ** 2 < (rad[i] + skin) ** 2:
+                found.add((i, k))
+    return found
+
+
 def test_wall_list_equals_brute_force():
     rng = np.random.default_rng(9)
     n = 300
@@ -199,13 +213,7 @@ def test_wall_list_equals_brute_force():
     cap = 1000
     start, ww, fs, nstart, nw_, nfs = _empty_lists(n, cap)
     got = build_wall_pairs(pos, rad, skin, w.p0, w.p1, start, ww, fs, nstart, nw_, nfs)
-    oracle = set()
-    for i in range(n):
-        for k in range(w.n):
-            a, b = w.p0[k], w.p1[k]
-            s = np.clip(np.dot(pos[i] - a, b - a) / np.dot(b - a, b - a), 0.0, 1.0)
-            if np.hypot(*(pos[i] - (a + s * (b - a)))) < rad[i] + skin:
-                oracle.add((i, k))
+    oracle = _wall_oracle(pos, rad, skin, w)
     assert got == len(oracle) and _pairs_of(start, ww, n) == oracle
     small = _empty_lists(n, 2)
     assert build_wall_pairs(pos, rad, skin, w.p0, w.p1, *small) == -len(oracle)
@@ -231,14 +239,7 @@ def test_wall_list_of_a_segmented_lid_equals_brute_force():
     n, cap = len(pos), 4000
     start, ww, fs, nstart, nw_, nfs = _empty_lists(n, cap)
     got = build_wall_pairs(pos, rad, skin, w.p0, w.p1, start, ww, fs, nstart, nw_, nfs)
-    oracle = set()
-    for i in range(n):
-        for j in range(w.n):
-            a, b = w.p0[j], w.p1[j]
-            t = np.clip(np.dot(pos[i] - a, b - a) / np.dot(b - a, b - a), 0.0, 1.0)
-            c = a + t * (b - a)
-            if (pos[i, 0] - c[0]) ** 2 + (pos[i, 1] - c[1]) ** 2 < (rad[i] + skin) ** 2:
-                oracle.add((i, j))
+    oracle = _wall_oracle(pos, rad, skin, w)
     assert got == len(oracle) and _pairs_of(start, ww, n) == oracle
     assert len(oracle) > 200  # the disks at reach found their segments
 
