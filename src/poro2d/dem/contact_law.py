@@ -40,6 +40,8 @@ import math
 
 from numba import njit
 
+from poro2d.dem.fma import fma
+
 # contact-model modes
 PER_BODY = 0  # PFC 4.0: kn = kA kB / (kA + kB), mu = min(muA, muB)
 PER_PAIR_TYPE = 1  # PFC 5 style: one (kn, ks, mu) for disk-disk, one for disk-wall
@@ -123,19 +125,26 @@ def contact_force(ov, nx, ny, dvx, dvy, ai, aj, wi, wj, fs_old, kn, ks, mu, cn, 
     which leaves every number as without them); cn the normal dashpot (0 for none).
     Scalars only: helpers that take arrays cost reference counting in the pair loop.
     """
-    vn = -(dvx * nx + dvy * ny)  # approach speed, positive when closing
-    vt = dvx * -ny + dvy * nx - ai * wi - aj * wj
-    fn = kn * ov + cn * vn
+    vn = -fma(dvx, nx, dvy * ny)  # approach speed, positive when closing
+    vt = fma(-aj, wj, fma(-ai, wi, fma(dvy, nx, -(dvx * ny))))
+    fn = fma(cn, vn, kn * ov)
     if fn < 0.0:  # the dashpot may not pull the bodies together
         fn = 0.0
-    fs = fs_old + ks * vt * dt
+    fs = fma(ks * vt, dt, fs_old)
     cap = mu * fn
     # two selects, not a branch: contacts at and below the cap come in no order, and a
     # mispredicted branch per contact costs more. The same numbers as `if fs > cap: cap,
     # elif fs < -cap: -cap`, signed zeros and NaN included, since cap >= 0 (or NaN)
     fs = cap if fs > cap else fs
     fs = -cap if fs < -cap else fs
-    return fn, fs, -fn * nx - fs * ny, -fn * ny + fs * nx
+    fx, fy = contact_components(fn, fs, nx, ny)
+    return fn, fs, fx, fy
+
+
+@njit(inline="always", cache=True)
+def contact_components(fn, fs, nx, ny):
+    """The force ``-Fn n + Fs t`` on ``i`` of a contact, as (fx, fy); ``t = (-n_y, n_x)``."""
+    return fma(-fn, nx, -(fs * ny)), fma(fs, nx, -(fn * ny))
 
 
 @njit(inline="always", cache=True)

@@ -51,6 +51,7 @@ from numba import njit, prange
 
 from poro2d.dem.contact_law import (
     PER_BODY,
+    contact_components,
     contact_force,
     dashpot,
     mix,
@@ -60,6 +61,7 @@ from poro2d.dem.contact_law import (
     rolling_radius,
     segment_closest,
 )
+from poro2d.dem.fma import fma
 from poro2d.dem.neighbors import (
     cell_grid,
     copy_rows,
@@ -180,7 +182,13 @@ def _damped(f, v, damp):
     return f - damp * abs(f) * np.sign(v)
 
 
-@njit(cache=True)
+@njit(inline="always", cache=True)
+def _leap(v, f, damp, inv_m, dt):
+    """Leapfrog: a speed (or spin) ``v`` after a step under the damped force (or moment) ``f``."""
+    return fma(_damped(f, v, damp) * inv_m, dt, v)
+
+
+@njit(cache=True, error_model="numpy")
 def _phase_forces(
     k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp, stored, skip2
 ):
@@ -268,7 +276,7 @@ def _phase_forces(
             j = np.uint64(js)
             dx = posf[U2 * j] - xi
             dy = posf[U2 * j + U1] - yi
-            d = math.sqrt(dx * dx + dy * dy)
+            d = math.sqrt(fma(dx, dx, dy * dy))
             ov = ri + radius[j] - d
             if ov <= 0.0:
                 nb_fs[p] = 0.0  # contact lost: history ends
@@ -295,8 +303,8 @@ def _phase_forces(
             else:
                 nx = 1.0
                 ny = 0.0
-            ai = ri - 0.5 * ov
-            aj = radius[j] - 0.5 * ov
+            ai = fma(-0.5, ov, ri)
+            aj = fma(-0.5, ov, radius[j])
             dvx = velf[U2 * j] - velf[U2 * i]
             dvy = velf[U2 * j + U1] - velf[U2 * i + U1]
             wi = omega[i]
@@ -307,20 +315,23 @@ def _phase_forces(
             nb_fs[p] = fs
             fx += fxp
             fy += fyp
-            mi = ai * fs  # the contact's moments on i and on j
-            mj = aj * fs
+            # the contact's moments: a_i Fs (+ Mr) on i, a_j Fs (- Mr) on j, each lever arm's
+            # product fused into its disk's sum
+            mr = 0.0
             if roll is not None:
                 reff = rolling_radius(ri, radius[j])
                 mur = mix_rolling(mur_i, roll.disk_mu_r[j])
                 mr = rolling_moment(nb_mr[p], ks, reff, wi - wj, dt, mur, fn)
                 nb_mr[p] = mr
-                mi += mr
-                mj -= mr
-            mz += mi
+                mz += mr
+            mz = fma(ai, fs, mz)
             if js < i1:  # a partner in a later partition collects this in phase 2
                 accf[U3 * j] -= fxp
                 accf[U3 * j + U1] -= fyp
-                accf[U3 * j + U2] += mj
+                mj = accf[U3 * j + U2]
+                if roll is not None:
+                    mj -= mr
+                accf[U3 * j + U2] = fma(aj, fs, mj)
                 if stored is None:
                     continue
             nb_ov[p] = ov  # a cross pair's, or on a step that stores them all
@@ -353,7 +364,7 @@ def _phase_forces(
             cn = 0.0
             if dash is not None:
                 cn = dashpot(dash, wkn_, mass[i])
-            ai = ri - 0.5 * ov
+            ai = fma(-0.5, ov, ri)
             nx, ny = _wall_normal(dx, dy, d, wp1[w, 0] - wp0[w, 0], wp1[w, 1] - wp0[w, 1])
             fn, fs, fxp, fyp = contact_force(
                 ov, nx, ny, wvel[w, 0] - velf[U2 * i], wvel[w, 1] - velf[U2 * i + U1], ai, 0.0, omega[i], 0.0,
@@ -367,13 +378,12 @@ def _phase_forces(
                 wb_ny[p] = ny
             fx += fxp
             fy += fyp
-            mi = ai * fs
             if roll is not None:  # a wall does not turn: the disk's spin is the relative one
                 mur = mix_rolling(mur_i, roll.wall_mu_r[w])
                 mr = rolling_moment(wb_mr[p], wks_, ri, omega[i], dt, mur, fn)
                 wb_mr[p] = mr
-                mi += mr
-            mz += mi
+                mz += mr
+            mz = fma(ai, fs, mz)
             wpart[k, w, WFX] -= fxp
             wpart[k, w, WFY] -= fyp
             wpart[k, w, WCOUNT] += 1.0
@@ -395,25 +405,25 @@ def _phase_forces(
         accf[U3 * i + U1] = mass[i] * gy
         accf[U3 * i + U2] = 0.0
         if free:
-            velf[U2 * i] += _damped(fx, velf[U2 * i], damp) * inv_mass[i] * dt
-            velf[U2 * i + U1] += _damped(fy, velf[U2 * i + U1], damp) * inv_mass[i] * dt
-            omega[i] += _damped(mz, omega[i], damp) * inv_inertia[i] * dt
+            velf[U2 * i] = _leap(velf[U2 * i], fx, damp, inv_mass[i], dt)
+            velf[U2 * i + U1] = _leap(velf[U2 * i + U1], fy, damp, inv_mass[i], dt)
+            omega[i] = _leap(omega[i], mz, damp, inv_inertia[i], dt)
         vx = velf[U2 * i]
         vy = velf[U2 * i + U1]
-        posf[U2 * i] += vx * dt
-        posf[U2 * i + U1] += vy * dt
-        theta[i] += omega[i] * dt
-        v2 = vx * vx + vy * vy
+        posf[U2 * i] = fma(vx, dt, posf[U2 * i])
+        posf[U2 * i + U1] = fma(vy, dt, posf[U2 * i + U1])
+        theta[i] = fma(omega[i], dt, theta[i])
+        v2 = fma(vx, vx, vy * vy)
         if v2 < skip2:  # never for a speed not finite
             vskip = max(vskip, v2)
         else:
             ddx = posf[U2 * i] - pos_build[i, 0]
             ddy = posf[U2 * i + U1] - pos_build[i, 1]
-            dmax = max(dmax, ddx * ddx + ddy * ddy)
+            dmax = max(dmax, fma(ddx, ddx, ddy * ddy))
     return dmax, vskip
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _phase_deferred(m0, m1, disks, nb, work, roll, gx, gy, damp, dt):
     """Phase 2: deferred disks ``dlist[m0:m1]`` add their cross pairs and advance.
 
@@ -433,15 +443,14 @@ def _phase_deferred(m0, m1, disks, nb, work, roll, gx, gy, damp, dt):
         mz = moment[i]
         for q in range(xstart[i], xstart[i + 1]):
             p = xpair[q]
-            if nb_ov[p] > 0.0:
-                fn = nb_fn[p]
+            if nb_ov[p] > 0.0:  # the same numbers as phase 1 gives a partner in its partition
                 fs = nb_fs[p]
-                fx -= -fn * nb_nx[p] - fs * nb_ny[p]
-                fy -= -fn * nb_ny[p] + fs * nb_nx[p]
-                mj = (radius[i] - 0.5 * nb_ov[p]) * fs
+                fxp, fyp = contact_components(nb_fn[p], fs, nb_nx[p], nb_ny[p])
+                fx -= fxp
+                fy -= fyp
                 if roll is not None:
-                    mj -= nb_mr[p]
-                mz += mj
+                    mz -= nb_mr[p]
+                mz = fma(fma(-0.5, nb_ov[p], radius[i]), fs, mz)
         force[i, 0] = fx
         force[i, 1] = fy
         moment[i] = mz
@@ -449,15 +458,15 @@ def _phase_deferred(m0, m1, disks, nb, work, roll, gx, gy, damp, dt):
         acc[i, 1] = mass[i] * gy
         acc[i, 2] = 0.0
         if pmode[i] == FREE:
-            vel[i, 0] += _damped(fx, vel[i, 0], damp) * inv_mass[i] * dt
-            vel[i, 1] += _damped(fy, vel[i, 1], damp) * inv_mass[i] * dt
-            omega[i] += _damped(mz, omega[i], damp) * inv_inertia[i] * dt
-        pos[i, 0] += vel[i, 0] * dt
-        pos[i, 1] += vel[i, 1] * dt
-        theta[i] += omega[i] * dt
+            vel[i, 0] = _leap(vel[i, 0], fx, damp, inv_mass[i], dt)
+            vel[i, 1] = _leap(vel[i, 1], fy, damp, inv_mass[i], dt)
+            omega[i] = _leap(omega[i], mz, damp, inv_inertia[i], dt)
+        pos[i, 0] = fma(vel[i, 0], dt, pos[i, 0])
+        pos[i, 1] = fma(vel[i, 1], dt, pos[i, 1])
+        theta[i] = fma(omega[i], dt, theta[i])
         ddx = pos[i, 0] - pos_build[i, 0]
         ddy = pos[i, 1] - pos_build[i, 1]
-        dmax = max(dmax, ddx * ddx + ddy * ddy)
+        dmax = max(dmax, fma(ddx, ddx, ddy * ddy))
     return dmax
 
 
