@@ -4,7 +4,9 @@ It uses only the engine's API from before rolling resistance existed, so the sam
 function runs on both sides of the change: ``tests/data/rolling_off_baseline.npz`` holds
 its arrays as computed by the engine without rolling resistance (commit ab1c351),
 written by ``python3 tests/rolling_baseline.py tests/data/rolling_off_baseline.npz`` with
-that version of poro2d on the path. ``tests/dem/test_rolling_resistance.py`` compares them,
+that version of poro2d on the path. Written again, the same way, when the engine came to
+fuse its products and sums (``dem/fma.py``): every number moved by round-off then, on
+purpose, and the file pins the numbers from there on. ``tests/dem/test_rolling_resistance.py`` compares them,
 bit for bit, with what the current engine computes at ``mu_r = 0``.
 """
 

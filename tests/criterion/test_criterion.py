@@ -36,16 +36,17 @@ def down(tmp_path_factory):
 
 
 def test_accept_at_once(tmp_path):
-    # this small specimen at 0.21 (seed 0) just fills its box: F_top is about 1 % of G
-    # (chaotic packing: another engine sum order may need another trial porosity here)
-    r = _run(tmp_path, 0.21, force_fraction=0.05)
-    assert r.converged and r.final_porosity == 0.21
+    # this small specimen at 0.212 (seed 0) just fills its box: F_top is about 3.6 % of G
+    # (chaotic packing: another engine arithmetic may need another trial porosity here; at
+    # 0.21 the plate carried 1 % of G before the engine fused its products and sums, 17 % since)
+    r = _run(tmp_path, 0.212, force_fraction=0.05)
+    assert r.converged and r.final_porosity == 0.212
     (it,) = [t.to_dict() for t in r.iterations]  # the trial's row
     assert it["plate_moved"] == "no" and it["plate_displacement_m"] == 0.0
     assert 0.0 < it["f_top_n_per_m"] < 0.05 * it["self_weight_n_per_m"]
     assert it["accepted"] and it["porosity_change"] == 0.0
     saved = json.loads((tmp_path / "result.json").read_text())
-    assert saved["final_porosity"] == 0.21 and REQUIRED <= set(saved["iterations"][0])
+    assert saved["final_porosity"] == 0.212 and REQUIRED <= set(saved["iterations"][0])
     for f in ("iterations.csv", "specimen.npz", "fig5_forces_initial_trial.png", "fig7_forces_accepted.png"):
         assert (tmp_path / f).stat().st_size > 0
     assert (tmp_path / "vtu" / "accepted_specimen_contacts.vtu").is_file()
@@ -276,9 +277,15 @@ def test_cli_numbers_do_not_depend_on_progress_display(tmp_path, capsys, monkeyp
     assert f"{it['porosity_change']:.4f}" in row and f"{it['f_top_n_per_m']:.4g}" in row
 
 
+# steps a stage may take: enough for the first layer of the frictionless preparation below,
+# too few for its second (seed 0; chaotic: 29 000 before the engine fused its products and
+# sums, when the second layer then settled and the third did not)
+FRICTIONLESS_STAGE = 5_000
+
+
 def _frictionless(**kw):
-    """Small frictionless preparation whose first layer cannot settle within its step budget."""
-    base = dict(width=0.06, height=0.03, layers=3, friction_prep=0.0, max_steps_per_stage=29_000)
+    """Small frictionless preparation whose second layer cannot settle within its step budget."""
+    base = dict(width=0.06, height=0.03, layers=3, friction_prep=0.0, max_steps_per_stage=FRICTIONLESS_STAGE)
     return SpecimenSpec(**{**base, "fallback_steps": 1000, "calm_steps": 1000, **kw})
 
 
@@ -292,7 +299,7 @@ def test_half_built_frictionless_specimen_is_refused(tmp_path):
     (it,) = [t.to_dict() for t in r.iterations]  # the trial's row
     assert not it["accepted"] and it["refused"] and not it["converged"]
     assert it["failed_stage"] == "layer 2" and it["failed_check"] == "preparation_converged"
-    assert it["failed_max_ratio"] > 1e-3 and it["failed_steps"] == 29_000 + 1000 + 1000 + 1000
+    assert it["failed_max_ratio"] > 1e-3 and it["failed_steps"] == FRICTIONLESS_STAGE + 1000 + 1000 + 1000
     assert it["particle_count"] < it["planned_particle_count"]
     assert it["checks"]["all_disks_present"] is False and it["checks"]["porosity_after_generation"] is False
     assert it["plate_moved"] == "not run" and it["new_porosity"] is None

@@ -9,7 +9,8 @@ from poro2d.specimen.compaction import SpecimenSpec, prepare_specimen
 from poro2d.store import Store
 
 #: layers that end once settled, and a whole-specimen stage of 200 steps with no fallback to
-#: speak of: seed 1's trial 0.21 ends its working-friction stage at an unbalanced-force ratio of 4.2e-3
+#: speak of: seed 1's trial 0.21 ends its working-friction stage at an unbalanced-force ratio of 3.3e-3
+#: (4.2e-3 before the engine fused its products and sums)
 SHORT = dict(
     width=0.06, height=0.03, layers=2, settle_drift=0.1, settle_window=100, settle_checks=1,
     max_steps_per_stage=200, fallback_steps=1, calm_steps=1,
@@ -52,7 +53,7 @@ def test_a_specimen_just_out_of_equilibrium_is_cycled_and_checked_again(missed, 
 
 
 def test_a_specimen_far_out_of_equilibrium_is_refused_without_cycling(missed):
-    ratio = 2e-3
+    ratio = 1e-3
     assert missed > EQUILIBRIUM_MARGIN * ratio
     res = _run(ratio)
     (trial,) = res.iterations

@@ -28,9 +28,11 @@ def test_the_same_seed_gives_the_same_series_bit_for_bit():
         np.testing.assert_array_equal(getattr(a.series, col), getattr(b.series, col))
     assert not np.array_equal(a.series.stress_ratio, other.series.stress_ratio)
     assert a.stress_ratio == b.stress_ratio
-    # the barostat held the pressure and the rate gave the inertial number asked for
-    assert a.normal_stress_kpa == pytest.approx(100.0, rel=0.15)
-    assert a.inertial_number == pytest.approx(1e-2, rel=0.15)
+    # the barostat held the pressure and the rate gave the inertial number asked for, on the
+    # mean of the two seeds: 200 disks at I = 0.01 read one seed's stress to +-20 % (seeds 5-12:
+    # 78-122 kPa, mean 97, measured)
+    assert (a.normal_stress_kpa + other.normal_stress_kpa) / 2 == pytest.approx(100.0, rel=0.15)
+    assert (a.inertial_number + other.inertial_number) / 2 == pytest.approx(1e-2, rel=0.15)
     assert 0.1 < a.stress_ratio < 0.5 and 0.7 < a.solid_fraction < 0.9
 
 

@@ -104,10 +104,12 @@ def test_a_wall_added_after_construction_takes_part():
     sim.run(12_000)  # the lid comes down (2 R at 0.02 m/s) and meets the disks
     assert sim.wall_force("lid")[1] > 0.5 * target
     assert sim.run(80_000, until_ratio=1e-4).converged
-    # the lid holds its target (to the servo's remaining lag); the walls together carry
-    # the disks' weight, the floor more than that (the lid's push, less what the side
-    # walls take by friction)
-    assert sim.wall_force("lid")[1] == pytest.approx(target, rel=0.03)
+    # the stop test weighs the disks, not the servo: the lid may still be closing on its
+    # target (1.085 of it, measured), which it holds once it has caught up (1 + 5e-4 after
+    # 5000 steps more); the walls together carry the disks' weight, the floor more than that
+    # (the lid's push, less what the side walls take by friction)
+    sim.run(10_000)
+    assert sim.wall_force("lid")[1] == pytest.approx(target, rel=1e-3)
     assert sum(sim.wall_force(w)[1] for w in sim.walls.names) == pytest.approx(-weight, rel=1e-3)
     assert -sim.wall_force("bottom")[1] > 1.2 * weight
     assert sim.summary().n_walls == 5

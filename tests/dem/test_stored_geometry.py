@@ -82,7 +82,7 @@ def _settle(sim: Simulation, every: int | None, target: float, threads: int = 1)
 FALL = 20_000
 # the packings' settings, and a mean ratio each reaches on a check step of the second run
 VARIANTS = {
-    "constants": ({}, 0.06),
+    "constants": ({}, 0.07),
     "per_body": ({"per_body": True}, 0.075),
     "dashpot": ({"restitution": 0.5}, 0.06),
     "rolling": ({"rolling": 0.2, "per_body": True}, 0.06),

@@ -166,6 +166,15 @@ class ReferenceDEM:
             pmu_r=p.mu_r, wmu_r=w.rolling_friction(), rolling=rolling,
         )  # fmt: skip
 
+    def follow(self, sim) -> None:
+        """Take the engine's motion (positions, speeds, spins, angles, walls, clock), keep
+        the reference's own contact history: the next :meth:`step` starts where the engine's
+        does, and the histories it carries are its own, from its own contacts."""
+        p, w = sim.particles, sim.walls
+        self.pos[:], self.vel[:], self.theta[:], self.omega[:] = p.pos, p.vel, p.theta, p.omega
+        self.wp0[:], self.wp1[:], self.wvel[:] = w.p0, w.p1, w.vel
+        self.time = sim.time
+
     # ------------------------------------------------------------------ step
     def _disk_pairs(self):
         pos, r = self.pos, self.radius
