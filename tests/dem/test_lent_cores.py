@@ -41,7 +41,7 @@ def test_threads_lent_half_way_change_no_bit(no_lender):
     runs, used = [], []
     for lend in (False, True):
         sim = _settling_box(nx=24, ny=44)
-        sim.run(1100)
+        sim.run(1500)  # then the stop ratio is met within 500 steps (test_blocks.py)
         asked, lent = [], [0]
 
         def lender(asked=asked) -> int:
