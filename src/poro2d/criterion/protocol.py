@@ -147,8 +147,11 @@ def _check_reason(name: str, trial: Trial, settings: CriterionSettings) -> str:
 #: a specimen whose only failed check is the force balance, out by at most this many times
 #: ``balance_tolerance``, is still coming to rest (with local damping a moving specimen does
 #: not balance: damping forces carry the rest); it is cycled further before it is refused.
-#: A full-size seed of Toyoura sand was refused at 1.01 % > 1 %, a calibration seed at 1.46 %
-BALANCE_MARGIN = 2.0
+#: A full-size seed of Toyoura sand was refused at 1.01 % > 1 %, a calibration seed at 1.46 %;
+#: the loose end of a sand's calibration (mu_prep 1, a lid on a creeping, very frictional
+#: packing) at 3.0-6.2 % (Toyoura, seeds 0-2), and cycled it comes to balance: the check is
+#: taken again on the state at rest, so a wider margin accepts nothing it did not check
+BALANCE_MARGIN = 10.0
 
 
 def just_out_of_balance(checks: Checks, numbers: CheckNumbers, s: CriterionSettings) -> bool:
@@ -186,9 +189,11 @@ def equilibrium_budget(spec: SpecimenSpec) -> int:
 
 
 def balance_budget(s: CriterionSettings) -> int:
-    """The steps a specimen just out of balance is cycled further, at most: a sixth of the plate
-    stage's budget (100 000 at the default ``max_plate_steps``), so a sand's scaled budget scales it too."""
-    return s.max_plate_steps // 6
+    """The steps a specimen just out of balance is cycled further, at most: half the plate stage's
+    budget (300 000 at the default ``max_plate_steps``), so a sand's scaled budget scales it too.
+    A creeping frictional packing comes to balance slowly: Toyoura's loose end, seed 0, went from
+    6.2 % to 2.3 % in a sixth of its plate budget and balanced within half of it."""
+    return s.max_plate_steps // 2
 
 
 def thrown_out_note(exc: MisplacedDisk, n: float, n_j: float | None) -> str:
