@@ -25,8 +25,9 @@ stores its force; that partner is *deferred* and collects such forces after all
 partitions are done (phase 2). The order of every sum is therefore fixed by the
 partitions: for a disk, gravity, then the pairs of earlier rows of its partition,
 its own row, its walls, then its cross pairs; for a wall, partition by partition.
-With rolling resistance a contact's moment on a disk is its shear moment plus (or, on the
-second disk, minus) its rolling moment, added as one term.
+With rolling resistance a contact adds its rolling moment to the first disk's sum (and takes
+it from the second's), then its shear moment a Fs, each lever arm's product fused into that
+sum (:mod:`poro2d.dem.fma`).
 
 What the steps write: a pair's history (``fs``, ``mr``) at every step; its geometry and
 normal force (``ov``, ``fn``, ``nx``, ``ny``) and the disks' unbalanced forces and moments
