@@ -210,5 +210,15 @@ def test_an_overfull_first_trial_under_the_lid_leads_to_a_looser_trial(tmp_path)
     assert first["overfull_m"] > 0.0 and first["plate_moved"] == "lid"
     assert not first["refused"] and first["checks"]["disks_inside_box"] and first["disks_outside_box"] == 0
     assert first["new_porosity"] > 0.07
+    # the stage's steps are every step between the prepared specimen and the one after the top
+    # stage: the plate's rise and the lid's rest together
+    from poro2d.dem import checkpoint
+
+    trial = tmp_path / "c" / "trials" / "01_n0.0700"
+    stage = (
+        checkpoint.load(trial / "after_plate.npz").step_count
+        - checkpoint.load(trial / "prepared.npz").step_count
+    )
+    assert first["plate_steps"] == stage
     assert len(res.iterations) == 2 and res.iterations[1].trial_porosity > 0.07
     assert not res.iterations[1].decision.refused

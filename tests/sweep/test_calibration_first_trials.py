@@ -103,3 +103,48 @@ def test_under_the_fill_a_check_at_a_calibration_friction_is_its_calibration_cas
         write_json(tmp_path / "p" / "cases" / c.id / "result.json", row)
     states_p = D.StateChecks(CriterionBase(plate), (loose,), 2, 0.001).sweep
     assert D.calibration_twins(cal_p, states_p, None, Store(tmp_path / "p")) == []
+
+
+# Toyoura sand's calibration box, 30 Nov 2026: the ends' accepted n' at mu_prep 0 and 1
+TOYOURA_ENDS = ((0.0, 0.16325), (1.0, 0.21941))
+
+
+def test_a_friction_between_measured_ends_starts_one_tolerance_looser_than_they_place_it():
+    fill = {"acceptance": "fill", "refine_tolerance": 0.002}
+    (mu_lo, n_lo), (mu_hi, n_hi) = TOYOURA_ENDS
+    for mu, table_share in (
+        (0.05, (0.171 - 0.163) / (0.216 - 0.163)),
+        (0.1, (0.176 - 0.163) / (0.216 - 0.163)),
+    ):
+        placed = n_lo + table_share * (n_hi - n_lo)
+        trial = D.bracket_first_trial(fill, mu, TOYOURA_ENDS)
+        # on the grid (half the tolerance), within half a grid step of the placed value + tolerance
+        assert trial == pytest.approx(round((placed + 0.002) / 0.001) * 0.001)
+        assert trial > placed + 0.0015
+    # the measured answers of that box (seeds 0, 1): 0.1736 / 0.1723 at 0.05, 0.1778 / 0.1788 at 0.1
+    assert D.bracket_first_trial(fill, 0.05, TOYOURA_ENDS) == pytest.approx(0.174)
+    assert D.bracket_first_trial(fill, 0.1, TOYOURA_ENDS) == pytest.approx(0.179)
+    # without a refined tolerance, the paper's 0.005 on its 0.01 grid
+    assert D.bracket_first_trial({"acceptance": "fill"}, 0.05, TOYOURA_ENDS) == pytest.approx(0.18)
+
+
+def test_measured_ends_move_the_frictions_between_them_and_keep_the_ends_cases():
+    cfg = _fill()
+    plain = D.CalibrationCase(CriterionBase(cfg), (0.0, 0.05, 0.1, 1.0), 2)
+    placed = D.CalibrationCase(CriterionBase(cfg), (0.0, 0.05, 0.1, 1.0), 2, ends=TOYOURA_ENDS)
+
+    def by_mu(case):
+        out = {}
+        for c in case.sweep.cases:
+            p = c.params
+            out[p["specimen.friction_prep"], p["seed"]] = (c.id, p["criterion.trial_porosity"])
+        return out
+
+    a, b = by_mu(plain), by_mu(placed)
+    for key in a:
+        if key[0] in (0.0, 1.0):  # the ends: the same cases, already run
+            assert a[key] == b[key]
+        else:
+            assert b[key][1] == D.bracket_first_trial(cfg["criterion"], key[0], TOYOURA_ENDS)
+            assert b[key][0] != a[key][0]
+    assert placed.key == plain.key  # one cache entry: the calibration is the same

@@ -566,18 +566,22 @@ class PorosityCriterion:
             free = servo.relax_rolling(sim, weight, mu_r)
             f_top = FlatPlate(sim).force(sim) / sim.particles.thickness
         if self.settings.acceptance == "fill":
+            before = free  # the plate's stages before the lid: their steps count in the stage's
             if not in_window(f_top, weight, self.settings.force_fraction):
                 # the plate first takes the specimen to the window (a dense trial pushes hard
                 # and swells for long): the lid then only has the surface left to follow
                 first = servo.settle(sim, weight)
+                before = first if before is None else before.then(first)
                 if not first.settled:
                     stage = PlateStage(
-                        "lid", box_porosity(sim.particles.area(), width, first.height_m), first
+                        "lid", box_porosity(sim.particles.area(), width, first.height_m), before
                     )
                     return stage, self._after_top(sim, k, n)
             creeps = self.spec.friction_prep >= CREEP_FRICTION
             lid = SegmentedLid(sim, width, mass_d50(sim.particles.radius), creeps=creeps)
             settle = servo.settle(sim, weight, lid)
+            if before is not None:
+                settle = before.then(settle)
             profile = lid_profile(sim, width)
             stage = PlateStage(
                 "lid", fill_porosity(sim.particles.radius, profile), settle,

@@ -92,10 +92,12 @@ class SandCalibration(TypedResult):
     extremes; ``dropped_ends``: frictions no seed could prepare; ``cases``: the sweep's folder;
     ``interior_by_friction``: interior porosities per friction and seed; the densest
     preparation's own porosity (to hold against the jamming porosity); where the time went
-    in the calibration and in the specimens at full size.
+    in the calibration and in the specimens at full size; ``bracket_ends``: the ends' frictions and
+    accepted n', [[mu, n'], [mu, n']], the frictions between them started from
+    (:func:`poro2d.sweep.density.bracket_first_trial`).
     """
 
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("time_profile", "specimens_time_profile")
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("time_profile", "specimens_time_profile", "bracket_ends")
 
     mus: list[float]
     calibration: Calibration
@@ -108,6 +110,7 @@ class SandCalibration(TypedResult):
     dense_end_interior_sd: float | None
     time_profile: StageProfile | None = None
     specimens_time_profile: StageProfile | None = None
+    bracket_ends: list[list[float]] | None = None
 
     PARTS: ClassVar[dict[str, type[TypedResult]]] = {
         "calibration": Calibration,

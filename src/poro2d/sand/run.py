@@ -137,18 +137,29 @@ def full_box_trial(target: float, dense_end: float | None, cal_dense: float, pf:
     return target - excess * (1.0 - ratio)
 
 
-def calibration_case(case: SandCase, pf: Preflight, mus: list[float]) -> D.CalibrationCase:
+def calibration_case(
+    case: SandCase, pf: Preflight, mus: list[float], ends: D.MeasuredEnds | None = None
+) -> D.CalibrationCase:
     """The calibration at ``mus``, the loosest cases first (its case ids name their folders in the
     cache). Its first trials move with the grading's jamming porosity (the dense end), the
-    calibration box's walls' share and the loose bias (:func:`poro2d.sweep.density.calibrate`)."""
+    calibration box's walls' share and the loose bias (:func:`poro2d.sweep.density.calibrate`);
+    with the ``ends`` measured, the frictions between them start just looser than the ends
+    place them (:func:`poro2d.sweep.density.bracket_first_trial`)."""
     box = pf.calibration_box
     walls = D.wall_share(box.width, box.height, pf.d50_m)
     return D.CalibrationCase(calibration_config(case, pf), tuple(mus), case.calibration_seeds,
-                             pf.jamming.porosity, walls, LOOSE_BIAS, loosest_first=True)  # fmt: skip
+                             pf.jamming.porosity, walls, LOOSE_BIAS, loosest_first=True,
+                             ends=ends)  # fmt: skip
 
 
-def _calibrate(case, pf, store: Store, mus, record, cal_kw) -> tuple[Calibration, CalibrationRun]:
-    return D.calibrate(calibration_case(case, pf, mus), store, record=record, **cal_kw)
+def measured_ends(cal_ends: Calibration) -> D.MeasuredEnds:
+    """The two ends' frictions and accepted n' (the fit of their seeds)."""
+    usable = cal_ends.usable()
+    return (usable.mus[0], cal_ends.n2d_min), (usable.mus[-1], cal_ends.n2d_max)
+
+
+def _calibrate(case, pf, store: Store, mus, record, cal_kw, ends=None) -> tuple[Calibration, CalibrationRun]:
+    return D.calibrate(calibration_case(case, pf, mus, ends), store, record=record, **cal_kw)
 
 
 def note_use(uses: dict[str, WorkerUse] | None, stage: str, summary) -> None:
@@ -175,8 +186,11 @@ def calibration_stage(
     ends = [usable[0], usable[-1]]
     first = state_target(case.lab.n_lab, case.n_max, case.n_min, cal_ends)
     mus = bracket(usable, predicted_mu(cal_ends, first.n2d_target))
+    placed = measured_ends(cal_ends)
     cal, info = (
-        (cal_ends, ends_info) if mus == ends else _calibrate(case, pf, store, mus, "calibration.json", cal_kw)
+        (cal_ends, ends_info)
+        if mus == ends
+        else _calibrate(case, pf, store, mus, "calibration.json", cal_kw, placed)
     )
     if mus != ends:
         note_use(uses, "calibration", info.summary)
@@ -198,6 +212,7 @@ def calibration_stage(
         # the densest preparation's own porosity: to hold against the jamming porosity
         dense_end_interior=float(np.mean(dense)) if dense else None,
         dense_end_interior_sd=float(np.std(dense, ddof=1)) if len(dense) > 1 else None,
+        bracket_ends=[list(placed[0]), list(placed[1])],
     )
 
 
@@ -374,7 +389,10 @@ def _run_sand(case, pf, store, options, use_cache, announce, on_preflight) -> Sa
     clock.end("specimens", t)
     say_use({k: v for k, v in uses.items() if k.startswith("specimens")}, announce)
     kept = keep_specimens(rows, store, _state_label(case), case.soil_record(), case.lab.to_dict())
-    cal_ids = [c.id for c in calibration_case(case, pf, [float(m) for m in cal_record.mus]).sweep.cases]
+    ends = cal_record.bracket_ends
+    placed = None if ends is None else ((ends[0][0], ends[0][1]), (ends[1][0], ends[1][1]))
+    final = calibration_case(case, pf, [float(m) for m in cal_record.mus], placed)
+    cal_ids = [c.id for c in final.sweep.cases]
     runs = [c.child("run") for c in walk(store.child("states", "cases"), "*")]
     cal_record = replace(
         cal_record,

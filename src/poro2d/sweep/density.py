@@ -66,6 +66,8 @@ FILL_FIRST_TRIALS = (
 #: end follows the grading's jamming porosity (0.001-0.007 above it on every grading tried), while
 #: the rise with friction and the walls' share change far less between sands.
 PAPER_JAMMING_POROSITY = 0.1532
+#: two measured ends of a calibration, ((mu_lo, n_lo), (mu_hi, n_hi)): frictions and accepted n'
+MeasuredEnds = tuple[tuple[float, float], tuple[float, float]]
 #: the share of ``FILL_FIRST_TRIALS``' dense end above the jamming porosity (0.163 - 0.1532) that
 #: the loose layer along the walls adds in the paper's box; it scales with the walls' length over
 #: the box's area times d50 (:func:`wall_share`): 0.0098 / (22.7 m^-1 x 4.44 mm)
@@ -171,6 +173,31 @@ def _grading_by_content(grading: dict, base_dir: Path | None) -> dict:
     return {**{k: v for k, v in grading.items() if k != "csv"}, "csv_sha256": digest}
 
 
+def bracket_first_trial(criterion: dict, mu: float, ends: MeasuredEnds) -> float:
+    """The first trial at a friction between two measured ends: on the loose side of its answer.
+
+    ``ends``: ((mu_lo, n_lo), (mu_hi, n_hi)), the accepted n' of the densest and loosest
+    preparations. ``mu`` gets the share between them that ``FILL_FIRST_TRIALS`` gives it between
+    the same frictions, plus the criterion's acceptance tolerance, rounded to its grid. A trial
+    looser than the friction packs costs a preparation and a short lid; a denser one over-fills
+    the box, and the plate and then the lid take 100 000-300 000 steps to let it swell (Toyoura
+    sand's calibration box: 53 and 101 s at mu_prep 0.05 from 0.171, its answer 0.172-0.174).
+    The table's shape puts a friction's answer 0.001-0.003 below the measured one on the gradings
+    tried, so the tolerance on top lands the trial just looser, often within the tolerance.
+    """
+    from poro2d.criterion.protocol import CriterionSettings, round_to, trial_grid
+
+    (mu_lo, n_lo), (mu_hi, n_hi) = ends
+    mu_ref, n_ref = zip(*FILL_FIRST_TRIALS, strict=True)
+    t_lo, t_mu, t_hi = (float(np.interp(m, mu_ref, n_ref)) for m in (mu_lo, mu, mu_hi))
+    share = (t_mu - t_lo) / (t_hi - t_lo)
+    refine = criterion.get("refine_tolerance")
+    paper = criterion.get("porosity_tolerance", CriterionSettings.porosity_tolerance)
+    tol = float(paper if refine is None else refine)
+    grid = trial_grid(float(criterion.get("resolution", CriterionSettings.resolution)), refine)
+    return round_to(n_lo + share * (n_hi - n_lo) + tol, grid)
+
+
 def first_trial(
     criterion: dict,
     mu: float,
@@ -216,6 +243,9 @@ class CalibrationCase:
     :func:`wall_share`) move the first trials (:func:`first_trial`); ``loosest_first`` lists
     the most frictional cases first: they take longest (their lid waits for a creeping
     surface), so the workers start them first and fill in with the quick dense ones.
+    ``ends``: the accepted n' of the two end frictions, once measured: the frictions between
+    them then start from :func:`bracket_first_trial` (the ends keep their own first trials, so
+    their cases are the ones already run).
     """
 
     base: CriterionBase
@@ -225,6 +255,7 @@ class CalibrationCase:
     walls: float | None = None
     loose_bias: float = 0.0
     loosest_first: bool = False
+    ends: MeasuredEnds | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "mus", tuple(check_mus(list(self.mus))))
@@ -252,7 +283,7 @@ class CalibrationCase:
             grid = {"specimen.friction_prep": list(self.mus), "seed": list(range(self.seeds))}
             tables = tables.with_tables(criterion=dict(crit, trial_porosity=CALIBRATION_FIRST_TRIAL))
             return tables.sweep(dict(table, **grid), grid_cases(grid))
-        firsts = {mu: first_trial(crit, mu, self.dense_end, self.walls, self.loose_bias) for mu in self.mus}
+        firsts = {mu: self.first_trial(crit, mu) for mu in self.mus}
         order = sorted(self.mus, reverse=True) if self.loosest_first else self.mus
         cases = [
             {"specimen.friction_prep": mu, "criterion.trial_porosity": firsts[mu], "seed": s}
@@ -260,6 +291,12 @@ class CalibrationCase:
             for s in range(self.seeds)
         ]
         return tables.sweep(dict(table, cases=cases), cases)
+
+    def first_trial(self, crit: dict, mu: float) -> float:
+        """The first trial of the cases at ``mu`` under the fill acceptance (:attr:`sweep`)."""
+        if self.ends is not None and self.ends[0][0] < mu < self.ends[1][0]:
+            return bracket_first_trial(crit, mu, self.ends)
+        return first_trial(crit, mu, self.dense_end, self.walls, self.loose_bias)
 
 
 def _per_friction(rows: list, mus: list[float], seeds: int, key: str) -> list[list[float | None]]:
