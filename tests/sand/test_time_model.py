@@ -26,7 +26,7 @@ def test_trials_per_case_are_the_measured_ones_by_stage():
     mus = (0.0, 0.05, 0.1, 1.0)
     assert PF.trials_per_case(0.0, mus, "calibration") == 1.0  # the dense end
     assert PF.trials_per_case(1.0, mus, "calibration") == 1.5  # the loose end
-    assert PF.trials_per_case(0.1, mus, "calibration") == 2.5  # a friction around the state
+    assert PF.trials_per_case(0.1, mus, "calibration") == 1.5  # a friction around the state
     assert PF.trials_per_case(0.064, mus, "specimens") == 1.2
 
 
