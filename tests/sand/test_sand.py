@@ -382,3 +382,30 @@ def test_a_wide_gradings_preparation_note_is_said_once_by_the_preflight(tmp_path
             crit._search()
         (rec,) = [r for r in caplog.records if r.getMessage().startswith("preparation:")]
         assert rec.levelno == level
+
+
+def test_the_frictions_around_the_state_start_from_the_measured_ends(monkeypatch):
+    """The calibration stage hands the ends it measured to the frictions between them (their
+    first trials, :func:`poro2d.sweep.density.bracket_first_trial`) and records them."""
+    from poro2d.sand import run as R
+    from poro2d.sweep.records import CalibrationRun
+
+    ends = Calibration([0.0, 1.0], [[0.1632, 0.1633], [0.2197, 0.2176]], [0, 1])
+
+    def record(mus):
+        return CalibrationRun("key", "cases", 4, 0, "computed", [[0.16] * 2 for _ in mus])
+
+    monkeypatch.setattr(R, "calibrate_ends", lambda *a, **k: (ends, (0.0, 0.05, 0.1, 1.0), record([0, 1])))
+    handed = []
+
+    def calibrate(case, pf, store, mus, name, cal_kw, placed=None):
+        handed.append((list(mus), placed))
+        samples = [[0.1632 + 0.056 * m**0.5] * 2 for m in mus]  # rising with friction
+        return Calibration(list(mus), samples, [0, 1]), record(mus)
+
+    monkeypatch.setattr(R, "_calibrate", calibrate)
+    case = load_sand_case({**TINY, "sand": {"mu_prep": [0.0, 0.05, 0.1, 1.0]}})
+    _, cal = R.calibration_stage(case, None, None, {})
+    placed = ((0.0, ends.n2d_min), (1.0, ends.n2d_max))
+    assert handed and handed[0][1] == placed and handed[0][0][0] == 0.0 and handed[0][0][-1] == 1.0
+    assert cal.bracket_ends == [[0.0, ends.n2d_min], [1.0, ends.n2d_max]]

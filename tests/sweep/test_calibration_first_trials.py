@@ -148,3 +148,9 @@ def test_measured_ends_move_the_frictions_between_them_and_keep_the_ends_cases()
             assert b[key][1] == D.bracket_first_trial(cfg["criterion"], key[0], TOYOURA_ENDS)
             assert b[key][0] != a[key][0]
     assert placed.key == plain.key  # one cache entry: the calibration is the same
+
+
+def test_ends_where_the_table_is_flat_place_a_friction_halfway():
+    fill = {"acceptance": "fill", "refine_tolerance": 0.002}
+    trial = D.bracket_first_trial(fill, 6.0, ((5.0, 0.220), (8.0, 0.224)))
+    assert trial == pytest.approx(0.224)  # 0.222 halfway, + 0.002

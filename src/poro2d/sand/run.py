@@ -212,7 +212,7 @@ def calibration_stage(
         # the densest preparation's own porosity: to hold against the jamming porosity
         dense_end_interior=float(np.mean(dense)) if dense else None,
         dense_end_interior_sd=float(np.std(dense, ddof=1)) if len(dense) > 1 else None,
-        bracket_ends=[list(placed[0]), list(placed[1])],
+        bracket_ends=[list(end) for end in placed],
     )
 
 
@@ -390,7 +390,7 @@ def _run_sand(case, pf, store, options, use_cache, announce, on_preflight) -> Sa
     say_use({k: v for k, v in uses.items() if k.startswith("specimens")}, announce)
     kept = keep_specimens(rows, store, _state_label(case), case.soil_record(), case.lab.to_dict())
     ends = cal_record.bracket_ends
-    placed = None if ends is None else ((ends[0][0], ends[0][1]), (ends[1][0], ends[1][1]))
+    placed = None if ends is None else tuple(tuple(end) for end in ends)
     final = calibration_case(case, pf, [float(m) for m in cal_record.mus], placed)
     cal_ids = [c.id for c in final.sweep.cases]
     runs = [c.child("run") for c in walk(store.child("states", "cases"), "*")]

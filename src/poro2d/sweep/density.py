@@ -185,17 +185,30 @@ def bracket_first_trial(criterion: dict, mu: float, ends: MeasuredEnds) -> float
     The table's shape puts a friction's answer 0.001-0.003 below the measured one on the gradings
     tried, so the tolerance on top lands the trial just looser, often within the tolerance.
     """
-    from poro2d.criterion.protocol import CriterionSettings, round_to, trial_grid
+    from poro2d.criterion.protocol import CriterionSettings, round_to
 
     (mu_lo, n_lo), (mu_hi, n_hi) = ends
-    mu_ref, n_ref = zip(*FILL_FIRST_TRIALS, strict=True)
-    t_lo, t_mu, t_hi = (float(np.interp(m, mu_ref, n_ref)) for m in (mu_lo, mu, mu_hi))
-    share = (t_mu - t_lo) / (t_hi - t_lo)
+    t_lo, t_mu, t_hi = (_table_trial(m) for m in (mu_lo, mu, mu_hi))
+    # the table is flat beyond its last friction: halfway between ends that lie there
+    share = (t_mu - t_lo) / (t_hi - t_lo) if t_hi > t_lo else 0.5
     refine = criterion.get("refine_tolerance")
     paper = criterion.get("porosity_tolerance", CriterionSettings.porosity_tolerance)
     tol = float(paper if refine is None else refine)
-    grid = trial_grid(float(criterion.get("resolution", CriterionSettings.resolution)), refine)
-    return round_to(n_lo + share * (n_hi - n_lo) + tol, grid)
+    return round_to(n_lo + share * (n_hi - n_lo) + tol, _trial_grid(criterion))
+
+
+def _table_trial(mu: float) -> float:
+    """``FILL_FIRST_TRIALS`` at ``mu`` (linear between its frictions, flat beyond them)."""
+    mu_ref, n_ref = zip(*FILL_FIRST_TRIALS, strict=True)
+    return float(np.interp(mu, mu_ref, n_ref))
+
+
+def _trial_grid(criterion: dict) -> float:
+    """The grid the criterion table ``criterion`` steps its trials on (:func:`trial_grid`)."""
+    from poro2d.criterion.protocol import CriterionSettings, trial_grid
+
+    resolution = float(criterion.get("resolution", CriterionSettings.resolution))
+    return trial_grid(resolution, criterion.get("refine_tolerance"))
 
 
 def first_trial(
@@ -217,19 +230,16 @@ def first_trial(
     packs by itself is over-compressed under the lid, which then may not settle (a start on the
     loose side lets the lid come down onto the specimen instead).
     """
-    from poro2d.criterion.protocol import CriterionSettings, round_to, trial_grid
+    from poro2d.criterion.protocol import round_to
 
     if criterion.get("acceptance", "plate") != "fill":
         return CALIBRATION_FIRST_TRIAL
-    mu_ref, n_ref = zip(*FILL_FIRST_TRIALS, strict=True)
-    grid = trial_grid(float(criterion.get("resolution", CriterionSettings.resolution)),
-                      criterion.get("refine_tolerance"))  # fmt: skip
-    n = float(np.interp(mu, mu_ref, n_ref))
+    n = _table_trial(mu)
     if dense_end is not None:
         n += float(dense_end) - PAPER_JAMMING_POROSITY
     if walls is not None:
         n += float(walls) - PAPER_WALL_SHARE
-    return round_to(n + loose_bias * mu, grid)
+    return round_to(n + loose_bias * mu, _trial_grid(criterion))
 
 
 @dataclass(frozen=True)
