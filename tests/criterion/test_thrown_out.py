@@ -14,12 +14,14 @@ GRAVEL = Path(__file__).parents[2] / "examples" / "soils" / "g1-1_sandy_gravel.c
 
 
 @pytest.mark.slow
-def test_a_trial_denser_than_its_grading_jams_is_refused_naming_the_cause(tmp_path, capsys):
+def test_a_trial_denser_than_its_grading_jams_is_refused_naming_the_cause(tmp_path, capsys, monkeypatch):
     # 0.06 is within the margin the check before the run lets pass (n_J - 0.05), but in this
     # box a layer's overlaps explode and throw a disk out: before, "disk 74 position is invalid"
-    # (with the true masses and the fines' friction in growth it was found with: with the fines'
-    # masses raised, docs/density-scaling.md, or the fines and walls sliding while the layers grow,
-    # docs/criterion.md, this trial ends otherwise)
+    # (with the true masses, the fines' friction in growth and the spec's 40 growth increments it
+    # was found with: with the fines' masses raised, docs/density-scaling.md, the fines and walls
+    # sliding while the layers grow, docs/criterion.md, or increments finer than the finest disk,
+    # compaction.GROWTH_SHARE_OF_FINEST, this trial ends otherwise: an over-full box)
+    monkeypatch.setattr("poro2d.specimen.compaction.GROWTH_SHARE_OF_FINEST", 1e9)
     cfg = tmp_path / "gravel.toml"
     cfg.write_text(
         '[specimen]\nwidth = 0.08\nheight = 0.04\nlayers = 2\nmass_scaling = "off"\n'

@@ -34,6 +34,7 @@ from poro2d.specimen.compaction import (
     check_box,
     check_feasible,
     estimate_size,
+    grading_increments,
     grading_mass_scaling_step,
     is_wide,
     preparation_note,
@@ -504,6 +505,8 @@ def workload(
     """What ``case`` costs with ``spec`` and grading ``g`` from first trial ``first`` (the model above),
     at ``throughput`` particle-steps per second per core."""
     crit = case.config.table("criterion")
+    # a very wide grading's layers grow in more increments than the spec's (growth_increments)
+    spec = replace(spec, growth_increments=grading_increments(spec, g))
     full = BoxPlan(spec.width, spec.height, spec.layers, estimate_size(spec, g, first).disks)
     fill = crit.get("acceptance", "plate") == "fill"
     window = float(crit.get("force_fraction", 0.01)) if fill else None
