@@ -189,6 +189,26 @@ def _leap(v, f, damp, inv_m, dt):
     return fma(_damped(f, v, damp) * inv_m, dt, v)
 
 
+@njit(inline="always", cache=True, error_model="numpy")
+def _pair_ahead(q, q_end, rq, nb_start, nb_j, posf, dx, dy, d, inv):
+    """The geometry of listed pair ``q`` (its row found from ``rq`` on): (row, dx, dy, d, 1 / d).
+
+    Beyond the partition's pairs (``q >= q_end``) the row and geometry given are returned.
+    """
+    if q >= q_end:
+        return rq, dx, dy, d, inv
+    while nb_start[rq + 1] <= q:
+        rq += 1
+    j = np.uint64(nb_j[q])
+    r = np.uint64(rq)
+    U1 = np.uint64(1)
+    U2 = np.uint64(2)
+    dx = posf[U2 * j] - posf[U2 * r]
+    dy = posf[U2 * j + U1] - posf[U2 * r + U1]
+    d = math.sqrt(fma(dx, dx, dy * dy))
+    return rq, dx, dy, d, 1.0 / d
+
+
 @njit(cache=True, error_model="numpy")
 def _phase_forces(
     k, disks, walls, nb, wb, work, prm, props, dash, roll, pw_body, dt, gx, gy, damp, stored, skip2
@@ -260,6 +280,13 @@ def _phase_forces(
     hold = held[h]
     dmax = 0.0
     vskip = -1.0
+    # the pair loop works one pair ahead: the next listed pair's geometry (its square root
+    # and inverse) is computed before this pair's contact law, so the two long-latency
+    # operations no longer wait at the head of each pair's chain (nor after a row's end,
+    # whose loop exit is mispredicted). The next pair is of this row or a later one, whose
+    # disks no earlier row moves: the same numbers as computed in place, bit for bit.
+    q_end = nb_start[i1]
+    rq, ldx, ldy, ld, linv = _pair_ahead(nb_start[i0], q_end, i0, nb_start, nb_j, posf, 0.0, 0.0, 0.0, 0.0)
     for i_ in range(i0, i1):
         i = np.uint64(i_)  # unsigned indices: no negative-index wrap-around code
         fx = accf[U3 * i]
@@ -275,16 +302,17 @@ def _phase_forces(
             p = np.uint64(p_)
             js = nb_j[p]
             j = np.uint64(js)
-            dx = posf[U2 * j] - xi
-            dy = posf[U2 * j + U1] - yi
-            d = math.sqrt(fma(dx, dx, dy * dy))
+            dx = ldx
+            dy = ldy
+            d = ld
+            inv = linv  # 1 / d (inf for d = 0, then not used)
+            rq, ldx, ldy, ld, linv = _pair_ahead(p_ + 1, q_end, rq, nb_start, nb_j, posf, ldx, ldy, ld, linv)
             ov = ri + radius[j] - d
             if ov <= 0.0:
                 nb_fs[p] = 0.0  # contact lost: history ends
                 if roll is not None:
                     nb_mr[p] = 0.0
                 if stored is not None:  # apart: d >= ri + rj > 0
-                    inv = 1.0 / d
                     nb_ov[p] = ov
                     nb_fn[p] = 0.0
                     nb_nx[p] = dx * inv
@@ -298,7 +326,6 @@ def _phase_forces(
             if dash is not None:
                 cn = dashpot(dash, kn, reduced_mass(mass[i], mass[j]))
             if d > 0.0:  # a product by the inverse: one division for both components
-                inv = 1.0 / d
                 nx = dx * inv
                 ny = dy * inv
             else:
