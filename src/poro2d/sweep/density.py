@@ -139,8 +139,10 @@ def calibration_base(base: CriterionBase) -> CriterionBase:
 #: when a change moves its cases' results: 2, the creeping lid of frictional fill preparations
 #: (docs/criterion.md), whose loose-end cases differ from those of the chattering lid before it;
 #: 3, the creeping lid accepted at a creeping packing's ratio (criterion.lid.CREEP_RATIO); 4, the
-#: fines of a very wide grading grown frictionless (specimen.compaction.growing_fines)
-CALIBRATION_REVISION = 4
+#: fines of a very wide grading grown frictionless (specimen.compaction.growing_fines); 5, a very
+#: wide grading's layers grown in increments finer than its finest disk
+#: (specimen.compaction.growth_increments)
+CALIBRATION_REVISION = 5
 
 
 def calibration_key(base: CriterionBase) -> str:
