@@ -92,3 +92,35 @@ def test_replacements_are_checked_where_they_enter():
     with pytest.raises(InputError) as e:
         load_sand_case({**CFG, "sand": {"replacements": -1}})
     assert e.value.parameter == "sand.replacements"
+
+
+def test_the_configs_seed_is_the_first_seed_of_the_calibration_too():
+    # another first seed repeats the whole answer from independent packings: the calibration's
+    # cases at every friction run from it as well (before, they were seeds 0, 1 whatever it was)
+    from poro2d.sand.run import calibration_case
+
+    box = SimpleNamespace(width=0.1, height=0.05, layers=2)
+    pf = SimpleNamespace(calibration_box=box, d50_m=0.002, jamming=SimpleNamespace(porosity=0.155))
+    for seed, expect in ((None, [0, 1]), (10, [10, 11])):
+        given = {} if seed is None else {"seed": seed}
+        case = load_sand_case({**CFG, "sand": {"calibration_seeds": 2}, **given})
+        cal = calibration_case(case, pf, [0.0, 1.0])
+        assert cal.seed_list == expect
+        assert sorted({c.params["seed"] for c in cal.sweep.cases}) == expect
+        assert cal.key == calibration_case(load_sand_case(CFG), pf, [0.0, 1.0]).key  # one cache entry
+
+
+def test_calibration_rows_are_read_by_their_seed():
+    from poro2d.sweep.density import calibration_from_rows
+
+    def row(mu, seed, n):
+        params = {"specimen.friction_prep": mu, "seed": seed}
+        results = {"converged": True, "last_new_porosity": n}
+        done = {"status": "done", "error": None, "results": results}
+        return CaseRow(f"c{mu}-{seed}", "criterion", params, **UNTIMED, **done)
+
+    rows = [row(0.0, 11, 0.161), row(0.0, 10, 0.160), row(1.0, 10, 0.22), row(0.0, 3, 0.5), row(1.0, 12, 0.5)]
+    cal = calibration_from_rows(rows, [0.0, 1.0], [10, 11])
+    assert cal.samples == [[0.160, 0.161], [0.22, None]]  # seeds 3 and 12 are another calibration's
+    assert cal.seeds == [10, 11]
+    assert calibration_from_rows(rows[:1], [0.0, 1.0], 2).samples == [[None, None], [None, None]]

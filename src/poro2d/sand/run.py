@@ -149,7 +149,14 @@ def calibration_case(
     walls = D.wall_share(box.width, box.height, pf.d50_m)
     return D.CalibrationCase(calibration_config(case, pf), tuple(mus), case.calibration_seeds,
                              pf.jamming.porosity, walls, LOOSE_BIAS, loosest_first=True,
-                             ends=ends)  # fmt: skip
+                             ends=ends, first_seed=first_seed(case))  # fmt: skip
+
+
+def first_seed(case: SandCase) -> int:
+    """The config's ``seed`` (0 when not given): the first seed of the calibration's cases at every
+    friction and of the specimens at full size, so that another seed repeats the whole answer
+    from independent packings."""
+    return int(case.config.config.get("seed", 0))  # checked when the case was loaded
 
 
 def measured_ends(cal_ends: Calibration) -> D.MeasuredEnds:
@@ -254,7 +261,7 @@ def specimen_stage(
 
     crit = case.config.table("criterion")
     grid = trial_grid(float(crit.get("resolution", 0.01)), crit.get("refine_tolerance"))
-    first = int(case.config.config.get("seed", 0))  # checked when the case was loaded
+    first = first_seed(case)
     tried = case.seeds
     while True:
         sweep = D.StateChecks(case.config, (trial,), tried, grid, first_seed=first).sweep

@@ -257,7 +257,10 @@ class CalibrationCase:
     surface), so the workers start them first and fill in with the quick dense ones.
     ``ends``: the accepted n' of the two end frictions, once measured: the frictions between
     them then start from :func:`bracket_first_trial` (the ends keep their own first trials, so
-    their cases are the ones already run).
+    their cases are the ones already run). ``first_seed``: the seeds run at every friction are
+    ``first_seed`` and the ``seeds - 1`` after it, so a calibration from another first seed is an
+    independent sample of the same grading (its cases share the cache entry: the seed is a case's
+    parameter, not part of the key).
     """
 
     base: CriterionBase
@@ -268,10 +271,17 @@ class CalibrationCase:
     loose_bias: float = 0.0
     loosest_first: bool = False
     ends: MeasuredEnds | None = None
+    first_seed: int = 0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "mus", tuple(check_mus(list(self.mus))))
         object.__setattr__(self, "seeds", check_seeds(self.seeds))
+        object.__setattr__(self, "first_seed", check_int("seed", self.first_seed, 0, 2**31 - 1))
+
+    @property
+    def seed_list(self) -> list[int]:
+        """The seeds run at every friction, in order."""
+        return list(range(self.first_seed, self.first_seed + self.seeds))
 
     @property
     def key(self) -> str:
@@ -292,7 +302,7 @@ class CalibrationCase:
         table: dict[str, Any] = {"kind": "criterion", "title": "mu_prep -> n2D calibration"}
         crit = tables.table("criterion")
         if crit.get("acceptance", "plate") != "fill":
-            grid = {"specimen.friction_prep": list(self.mus), "seed": list(range(self.seeds))}
+            grid = {"specimen.friction_prep": list(self.mus), "seed": self.seed_list}
             tables = tables.with_tables(criterion=dict(crit, trial_porosity=CALIBRATION_FIRST_TRIAL))
             return tables.sweep(dict(table, **grid), grid_cases(grid))
         firsts = {mu: self.first_trial(crit, mu) for mu in self.mus}
@@ -300,7 +310,7 @@ class CalibrationCase:
         cases = [
             {"specimen.friction_prep": mu, "criterion.trial_porosity": firsts[mu], "seed": s}
             for mu in order
-            for s in range(self.seeds)
+            for s in self.seed_list
         ]
         return tables.sweep(dict(table, cases=cases), cases)
 
@@ -311,23 +321,36 @@ class CalibrationCase:
         return first_trial(crit, mu, self.dense_end, self.walls, self.loose_bias)
 
 
-def _per_friction(rows: list, mus: list[float], seeds: int, key: str) -> list[list[float | None]]:
+Seeds = int | list[int] | tuple[int, ...]
+
+
+def _seed_list(seeds: Seeds) -> list[int]:
+    """The calibration's seeds in order: ``range(seeds)`` for a count, else the list given."""
+    return list(range(seeds)) if isinstance(seeds, int) else [int(s) for s in seeds]
+
+
+def _per_friction(rows: list, mus: list[float], seeds: Seeds, key: str) -> list[list[float | None]]:
     """The results' ``key`` of every accepted calibration case (its n' measured), per friction and
-    seed; None for a case not accepted or not there, or a value that is not a number."""
+    seed (``seeds``: a count from 0, or the seeds in order); None for a case not accepted or not
+    there, or a value that is not a number. Rows of other seeds are left out."""
 
     def finite(v: Any) -> float | None:
         return float(v) if v is not None and math.isfinite(float(v)) else None
 
-    out: list[list[float | None]] = [[None] * seeds for _ in mus]
+    order = {s: k for k, s in enumerate(_seed_list(seeds))}
+    out: list[list[float | None]] = [[None] * len(order) for _ in mus]
     for r in map(case_row, rows):
         p, res = r.params or {}, r.results or {}
-        if r.status == "done" and res.get("converged") and finite(res.get("last_new_porosity")) is not None:
-            out[mus.index(float(p["specimen.friction_prep"]))][int(p["seed"])] = finite(res.get(key))
+        k = order.get(int(p["seed"]))
+        if k is None or r.status != "done" or not res.get("converged"):
+            continue
+        if finite(res.get("last_new_porosity")) is not None:
+            out[mus.index(float(p["specimen.friction_prep"]))][k] = finite(res.get(key))
     return out
 
 
 def interior_by_friction(rows: list[CaseRow | LostCaseRow | dict], mus: list[float],
-                         seeds: int) -> list[list[float | None]]:  # fmt: skip
+                         seeds: Seeds) -> list[list[float | None]]:  # fmt: skip
     """The interior porosity of every calibration case's accepted specimen, per friction and seed.
 
     Beside the calibration's samples (box porosities n'), the packing's own porosity: at the
@@ -337,10 +360,11 @@ def interior_by_friction(rows: list[CaseRow | LostCaseRow | dict], mus: list[flo
 
 
 def calibration_from_rows(
-    rows: list[CaseRow | LostCaseRow | dict], mus: list[float], seeds: int
+    rows: list[CaseRow | LostCaseRow | dict], mus: list[float], seeds: Seeds
 ) -> Calibration:
-    """mu_prep -> n2D: the measured porosity n' of every case's accepted trial, per friction and seed."""
-    return Calibration(list(mus), _per_friction(rows, mus, seeds, "last_new_porosity"), list(range(seeds)))
+    """mu_prep -> n2D: the measured porosity n' of every case's accepted trial, per friction and
+    seed (``seeds``: a count from 0, or the seeds in order)."""
+    return Calibration(list(mus), _per_friction(rows, mus, seeds, "last_new_porosity"), _seed_list(seeds))
 
 
 def calibration_store(case: CalibrationCase, store: Store, *, use_cache: bool = True) -> Store:
@@ -380,7 +404,7 @@ def calibrate(
     """
     from poro2d.sweep.runner import run_sweep
 
-    mus, seeds = list(case.mus), case.seeds
+    mus, seeds = list(case.mus), case.seed_list
     cases = calibration_store(case, store, use_cache=use_cache)
     # another run of the same grading may be computing this entry: wait, then reuse its cases
     with cache_entry(cases.root):
