@@ -322,3 +322,38 @@ def test_without_pyarrow_the_table_is_csv_only_said_once(client, tmp_path, monke
     assert not (tmp_path / "results.parquet").exists()
     err = capsys.readouterr().err
     assert err.count("pyarrow is not installed") == 1 and "poro2d[parquet]" in err
+
+
+def test_a_case_moved_with_its_curve_file_finds_its_folder(tmp_path):
+    """A case's merged config holds its curve file's absolute path: the same curve in another
+    folder is the same case (its calibration cases were all computed again before, in the
+    same cache entry); another curve is another case."""
+    from dataclasses import asdict
+
+    from poro2d.sweep.cases import Case
+    from poro2d.sweep.runner import compute_case, finished_row
+
+    rows = "size_mm,percent_passing\n1.0,0\n2.0,50\n4.0,100\n"
+    files = []
+    for name in ("a", "b", "c"):
+        (tmp_path / name).mkdir()
+        files.append(tmp_path / name / "curve.csv")
+        files[-1].write_text(rows if name != "c" else rows.replace("2.0,50", "2.0,60"))
+    cases = [
+        Case("probe", {"x": 3}, {"probe": {"x": 3, "seconds": 0.0}, "grading": {"csv": str(f)}})
+        for f in files
+    ]
+    assert cases[0].id == cases[1].id != cases[2].id
+    folder = Store(tmp_path / "cases" / cases[0].id)
+    row = compute_case(asdict(cases[0]), folder, probe)
+    assert row.status == "done"
+    assert finished_row(asdict(cases[1]), folder).to_dict() == row.to_dict()  # read back, not run
+    assert compute_case(asdict(cases[1]), folder, probe).to_dict() == row.to_dict()
+    assert (folder.root / "run" / "runs.txt").read_text() == "1"
+    record = json.loads((folder.root / "params.json").read_text())
+    assert record["config"]["grading"]["csv"] == str(files[0])  # the path is kept, not compared
+    assert finished_row(asdict(cases[2]), folder) is None  # another curve in the same folder
+    # a grading without a file is bound as before: its record is the case itself
+    preset = Case("probe", {}, {"probe": {"x": 1, "seconds": 0.0}, "grading": {"preset": "paper"}})
+    compute_case(asdict(preset), Store(tmp_path / "p"), probe)
+    assert json.loads((tmp_path / "p" / "params.json").read_text()) == asdict(preset)

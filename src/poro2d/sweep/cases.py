@@ -160,9 +160,47 @@ def case_id(kind: str, config: dict) -> str:
     """A stable id: the first 12 hex digits of the run digest of the kind and merged config.
 
     The identity rule (:func:`poro2d.identity.identity_digest`) leaves out the settings that
-    change no result, so a rerun with another thread count finds the finished cases.
+    change no result, so a rerun with another thread count finds the finished cases; a grading
+    curve file counts by its content (:func:`grading_by_content`), so a config moved with its
+    csv to another folder finds them too (the merged config holds the file's absolute path).
     """
-    return identity_digest({"kind": kind, "config": config}, tables=config_tables("config."), length=12)
+    view = {"kind": kind, "config": config_by_content(config)}
+    return identity_digest(view, tables=config_tables("config."), length=12)
+
+
+def grading_by_content(grading: Any, base_dir: Path | None = None) -> Any:
+    """A grading table as identities see it: a curve file named by its content (its SHA-256),
+    not by its path, so the same curve read from another folder, or given by another path, is
+    the same input. A file that cannot be read keeps its path (the run then refuses it)."""
+    from poro2d.store.digests import file_digest
+
+    csv = grading.get("csv") if isinstance(grading, dict) else None
+    if not isinstance(csv, str):
+        return grading
+    path = Path(csv) if base_dir is None or Path(csv).is_absolute() else base_dir / csv
+    try:
+        digest = file_digest(path)
+    except OSError:
+        return grading
+    return {**{k: v for k, v in grading.items() if k != "csv"}, "csv_sha256": digest}
+
+
+def case_record(case: dict) -> dict:
+    """A case as its folder records it (``params.json``): with its grading curve file's SHA-256
+    beside the file's path when it has one, so that the folder is bound to the curve, not to
+    where the file lay."""
+    config = case.get("config")
+    by_content = grading_by_content(config.get("grading")) if isinstance(config, dict) else None
+    if not isinstance(by_content, dict) or "csv_sha256" not in by_content:
+        return case
+    return {**case, "grading_csv_sha256": by_content["csv_sha256"]}
+
+
+def config_by_content(config: dict) -> dict:
+    """A case's merged config with its grading by content (:func:`grading_by_content`)."""
+    if "grading" not in config:
+        return config
+    return {**config, "grading": grading_by_content(config["grading"])}
 
 
 def _field_names(cls: type) -> set[str]:

@@ -32,8 +32,7 @@ from poro2d.io_utils import Provenance
 from poro2d.locks import cache_entry
 from poro2d.specimen.compaction import SpecimenSpec
 from poro2d.store import Store
-from poro2d.store.digests import file_digest
-from poro2d.sweep.cases import Case, SweepConfig, criterion_objects, grid_cases
+from poro2d.sweep.cases import Case, SweepConfig, criterion_objects, grading_by_content, grid_cases
 from poro2d.sweep.criterion_base import CriterionBase
 from poro2d.sweep.records import CaseRow, LostCaseRow, case_row
 from poro2d.sweep.results import CalibrationRun
@@ -153,26 +152,10 @@ def calibration_key(base: CriterionBase) -> str:
     Spaced as these keys were first written, so cached calibrations keep their folders.
     """
     rec = {"base": calibration_base(base).as_config(), "version": __version__}
-    rec["base"]["grading"] = _grading_by_content(rec["base"]["grading"], base.base_dir)
+    rec["base"]["grading"] = grading_by_content(rec["base"]["grading"], base.base_dir)
     rec["revision"] = CALIBRATION_REVISION
     tables = {"base.specimen": SpecimenSpec, "base.criterion": CriterionSettings}
     return identity_digest(rec, tables=tables, length=16, layout="spaced")
-
-
-def _grading_by_content(grading: dict, base_dir: Path | None) -> dict:
-    """The grading table as a calibration's key sees it: a curve file named by its content (its
-    SHA-256), not by its path, so the same curve read from another folder, or given by another
-    path, finds its calibration (a config moved beside its csv, or an absolute path, computed
-    every case again before). A file that cannot be read keeps its path (the run then refuses it)."""
-    csv = grading.get("csv")
-    if not isinstance(csv, str):
-        return grading
-    path = Path(csv) if base_dir is None or Path(csv).is_absolute() else base_dir / csv
-    try:
-        digest = file_digest(path)
-    except OSError:
-        return grading
-    return {**{k: v for k, v in grading.items() if k != "csv"}, "csv_sha256": digest}
 
 
 def bracket_first_trial(criterion: dict, mu: float, ends: MeasuredEnds) -> float:
@@ -434,21 +417,21 @@ class StateChecks:
     """The criterion once per laboratory state and seed, at the state's friction, from its target.
 
     ``base``: the criterion base of the states (density mode's defaults filled in);
-    ``resolution``: the grid the first trials are rounded to (the one the criterion steps on);
+    ``resolution``: the grid the first trials are rounded to (the one the criterion steps on),
+    or None for each target itself (to 1e-6): then the first trial, and so the accepted n' that
+    follows it, moves with the target continuously, not by the grid's step;
     ``first_seed``: the seeds run are ``first_seed`` and the ``seeds - 1`` after it.
     """
 
     base: CriterionBase
     targets: tuple[StateTarget, ...]
     seeds: int
-    resolution: float
+    resolution: float | None
     first_seed: int = 0
 
     @cached_property
     def sweep(self) -> SweepConfig:
         """One case per state and seed; the base's own first trial is left out (each case has one)."""
-        from poro2d.criterion.protocol import round_to
-
         base = self.base.without("relation", "sweep", "density")
         crit = base.table("criterion")
         crit.pop("trial_porosity", None)
@@ -456,7 +439,7 @@ class StateChecks:
             {
                 "criterion.n_lab": t.n_lab,
                 "specimen.friction_prep": round(t.mu_prep, 6),
-                "criterion.trial_porosity": round_to(t.n2d_target, self.resolution),
+                "criterion.trial_porosity": self.first_trial(t),
                 "seed": s,
             }
             for t in self.targets
@@ -464,6 +447,14 @@ class StateChecks:
         ]
         table = {"kind": "criterion", "title": "density-controlled states", "cases": cases}
         return base.with_tables(criterion=crit).sweep(table, cases)
+
+    def first_trial(self, t: StateTarget) -> float:
+        """The first trial of a state: its target on the grid, or the target itself."""
+        from poro2d.criterion.protocol import round_to
+
+        if self.resolution is None:
+            return round(t.n2d_target, 6)
+        return round_to(t.n2d_target, self.resolution)
 
 
 def _run_key(case: Case, base_dir: Path | None) -> str:

@@ -41,7 +41,7 @@ from poro2d.io_utils import Provenance
 from poro2d.locks import cache_entry
 from poro2d.store import Store
 from poro2d.store.stage import Fingerprint, ResumableStage
-from poro2d.sweep.cases import KINDS, Case, SweepConfig, axes_of, config_tables
+from poro2d.sweep.cases import KINDS, Case, SweepConfig, axes_of, case_record, config_tables
 from poro2d.sweep.records import CaseRow, LostCaseRow, SweepSummary
 from poro2d.sweep.results import SweepResult
 from poro2d.typed_result import TypedResult
@@ -72,10 +72,13 @@ def case_stage(case: dict, store: Store) -> ResumableStage:
     The binding is the case's kind and merged config, as its id (which names the folder)
     is: the parameters (labels relative to a sweep's base case) and the settings that
     change no result (:mod:`poro2d.identity`) are recorded, not compared, so a rerun with
-    another thread count finds it.
+    another thread count finds it; a grading curve file is compared by its content, its
+    path recorded (:func:`poro2d.sweep.cases.case_record`).
     """
     return store.stage(
-        Fingerprint(case, ignore=("id", "params"), tables=config_tables("config.")),
+        Fingerprint(
+            case_record(case), ignore=("id", "params", "config.grading.csv"), tables=config_tables("config.")
+        ),
         record=PARAMS,
         key=None,
         allowed="a sweep folder whose case folders hold the cases their ids name",
