@@ -124,37 +124,3 @@ def test_calibration_rows_are_read_by_their_seed():
     assert cal.samples == [[0.160, 0.161], [0.22, None]]  # seeds 3 and 12 are another calibration's
     assert cal.seeds == [10, 11]
     assert calibration_from_rows(rows[:1], [0.0, 1.0], 2).samples == [[None, None], [None, None]]
-
-
-def _first_trials(sweep_calls):
-    return sorted({c.config["criterion"]["trial_porosity"] for c in sweep_calls})
-
-
-def test_full_size_specimens_start_from_the_target_itself(tmp_path, monkeypatch):
-    # a specimen accepted at its first trial keeps an n' that follows that trial: a target of
-    # 0.17264 put on the 0.001 grid started at 0.173, and one of 0.17249 at 0.172, a step of
-    # 0.001 in the answer for a shift of 0.00015 in the target
-    seen = []
-
-    def run_sweep(sweep, store, *, options):
-        seen.extend(sweep.cases)
-        return _fake_sweep(set(), [])(sweep, store, options=options)
-
-    monkeypatch.setattr(runner, "run_sweep", run_sweep)
-    case = load_sand_case({**CFG, "sand": {"seeds": 2}})
-    for target in (0.17264, 0.17249):
-        seen.clear()
-        specimen_stage(case, StateTarget(0.3, 0.5, target, 0.3), Store(tmp_path / str(target)), None)
-        assert _first_trials(seen) == [target]
-
-
-def test_state_checks_on_a_grid_round_the_target():
-    from poro2d.sweep.density import StateChecks
-
-    case = load_sand_case(CFG)
-    target = StateTarget(0.3, 0.5, 0.17264, 0.3)
-    on_grid = StateChecks(case.config, (target,), 1, 0.001).sweep.cases
-    off_grid = StateChecks(case.config, (target,), 1, None).sweep.cases
-    assert _first_trials(on_grid) == [0.173]
-    assert _first_trials(off_grid) == [0.17264]
-    assert on_grid[0].id != off_grid[0].id  # another question: another case

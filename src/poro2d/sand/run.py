@@ -256,15 +256,15 @@ def specimen_stage(
     are tried in order from the config's ``seed`` (0 when not given: 0, 1, ...), so a rerun reads
     every finished seed back, replaced ones too.
     """
+    from poro2d.criterion.protocol import trial_grid
     from poro2d.sweep.runner import run_sweep
 
+    crit = case.config.table("criterion")
+    grid = trial_grid(float(crit.get("resolution", 0.01)), crit.get("refine_tolerance"))
     first = first_seed(case)
     tried = case.seeds
     while True:
-        # the first trial is the target itself, off the criterion's grid: a specimen accepted at
-        # its first trial keeps an n' that follows that trial, so a target rounded to the grid
-        # (0.001) moved the answer by the grid's step for a shift of the target a tenth of it
-        sweep = D.StateChecks(case.config, (trial,), tried, None, first_seed=first).sweep
+        sweep = D.StateChecks(case.config, (trial,), tried, grid, first_seed=first).sweep
         res = run_sweep(sweep, store.child("states"), options=options)
         note_use(uses, "specimens", res.summary)
         rows = sorted(res.rows, key=case_seed)
