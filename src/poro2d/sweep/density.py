@@ -417,21 +417,21 @@ class StateChecks:
     """The criterion once per laboratory state and seed, at the state's friction, from its target.
 
     ``base``: the criterion base of the states (density mode's defaults filled in);
-    ``resolution``: the grid the first trials are rounded to (the one the criterion steps on),
-    or None for each target itself (to 1e-6): then the first trial, and so the accepted n' that
-    follows it, moves with the target continuously, not by the grid's step;
+    ``resolution``: the grid the first trials are rounded to (the one the criterion steps on);
     ``first_seed``: the seeds run are ``first_seed`` and the ``seeds - 1`` after it.
     """
 
     base: CriterionBase
     targets: tuple[StateTarget, ...]
     seeds: int
-    resolution: float | None
+    resolution: float
     first_seed: int = 0
 
     @cached_property
     def sweep(self) -> SweepConfig:
         """One case per state and seed; the base's own first trial is left out (each case has one)."""
+        from poro2d.criterion.protocol import round_to
+
         base = self.base.without("relation", "sweep", "density")
         crit = base.table("criterion")
         crit.pop("trial_porosity", None)
@@ -439,7 +439,7 @@ class StateChecks:
             {
                 "criterion.n_lab": t.n_lab,
                 "specimen.friction_prep": round(t.mu_prep, 6),
-                "criterion.trial_porosity": self.first_trial(t),
+                "criterion.trial_porosity": round_to(t.n2d_target, self.resolution),
                 "seed": s,
             }
             for t in self.targets
@@ -447,14 +447,6 @@ class StateChecks:
         ]
         table = {"kind": "criterion", "title": "density-controlled states", "cases": cases}
         return base.with_tables(criterion=crit).sweep(table, cases)
-
-    def first_trial(self, t: StateTarget) -> float:
-        """The first trial of a state: its target on the grid, or the target itself."""
-        from poro2d.criterion.protocol import round_to
-
-        if self.resolution is None:
-            return round(t.n2d_target, 6)
-        return round_to(t.n2d_target, self.resolution)
 
 
 def _run_key(case: Case, base_dir: Path | None) -> str:
