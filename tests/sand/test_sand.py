@@ -226,6 +226,10 @@ def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
     assert prof["trials"] >= 4 and spec_prof["trials"] >= 2
     assert prof["plate"]["steps"] > 0 and prof["prepare"]["particle_steps_per_s"] > 0
     assert res.n2d_min < res.n2d_target < res.n2d_max
+    # the answer's standard error, the calibration's seeds carried through mu_prep (two ends here)
+    assert set(data["answer_error"]) == {"specimens_se", "mu_prep_se", "interior_slope", "calibration_se",
+                                         "answer_se"}  # fmt: skip
+    assert res.answer_error.mu_prep_se is None or res.answer_error.mu_prep_se >= 0.0
     md = (out / "summary.md").read_text()
     accepted = [k for k in res.specimens if k.accepted]
     assert accepted, "no seed accepted"

@@ -10,6 +10,7 @@ from poro2d.lab_state import lab_state_from_table
 from poro2d.report import grading_figure
 from poro2d.sand import run as sand_run
 from poro2d.sand.result import SeedReplaced, SeedSpecimen
+from poro2d.sand.spread import AnswerError
 
 REASON = "trial 1 (n2D = 0.1720) refused: check force_balance failed"
 LAB = {"e_max": 0.977, "e_min": 0.597, "dr": 0.8}
@@ -41,6 +42,7 @@ def _result(accepted: list[int], refused: dict[int, int | None]) -> SimpleNamesp
         jamming_porosity=0.15,
         state_map=None,
         calibration=SimpleNamespace(dropped_ends=[], mus=[0.0, 1.0]),
+        answer_error=AnswerError(0.0003, 0.004, 0.1, 0.0004, 0.0005),
     )
 
 
@@ -69,6 +71,7 @@ def test_the_exit_says_whether_the_seeds_asked_for_were_reached(
     assert exit_code == code
     out = capsys.readouterr().out
     assert f"seed 1 not accepted: {REASON}" in out
+    assert "the answer's standard error 0.0005 (specimens 0.0003; the calibration's seeds 0.0004" in out
     errors = [line for line in out.splitlines() if line.startswith("error:")]
     if code == 0:
         assert errors == [] and "; replaced by seed 3" in out and "(3 of 3 seeds: 0, 2, 3)" in out

@@ -79,6 +79,8 @@ def print_result(res, out: Path) -> None:
             f"({res.seeds_accepted} of {res.seeds} seeds{used_seeds(res)}): the 2D porosity of {shown(head)}",
             soft_wrap=True,
         )
+    if res.answer_error is not None:
+        console.print(f"the answer's {res.answer_error.text()}", soft_wrap=True)
     t = Table(title="poro2d sand")
     for col in ("seed", "accepted", "interior n", "box n'", "disks", "specimen folder"):
         t.add_column(col, justify="right")

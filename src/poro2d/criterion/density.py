@@ -253,6 +253,43 @@ def state_target(n_lab: float, n_max: float, n_min: float, cal: Calibration) -> 
     return StateTarget(n_lab, dr, n2d, cal.mu_for(n2d))
 
 
+def seed_errors(cal: Calibration) -> np.ndarray:
+    """The standard error of each friction's mean n' over its seeds (sd / sqrt(n)), for the usable
+    frictions of ``cal``. A friction with a single accepted seed has no spread of its own: it takes
+    the pooled sd of the frictions with more (NaN when none has two)."""
+    cal = cal.usable()
+    counts = np.array([cal.accepted(k).size for k in range(len(cal.mus))])
+    sd = cal.sd
+    many = counts > 1
+    dof = int(np.sum(counts[many] - 1))
+    pooled = math.sqrt(float(np.sum((counts[many] - 1) * sd[many] ** 2)) / dof) if dof else math.nan
+    return np.where(many, sd, pooled) / np.sqrt(counts)
+
+
+def friction_error(dr: float, cal: Calibration) -> float:
+    """The standard error of the friction that prepares relative density ``dr``, from the
+    calibration's finite seeds (the delta method).
+
+    mu_prep is read off the seed means twice: the two ends set the 2D target (the Dr mapping
+    above) and the frictions around it the inversion (:meth:`Calibration.mu_for`). Each
+    friction's mean is moved by its standard error (:func:`seed_errors`) up and down, mu_prep
+    found again, and the central differences added in quadrature (the frictions' cases are
+    independent packings). NaN when the seeds give no spread.
+    """
+    cal = cal.usable()
+    se = seed_errors(cal)
+
+    def mu_with(k: int, shift: float) -> float:
+        moved = [[v + shift if j == k else v for v in cal.accepted(j)] for j in range(len(cal.mus))]
+        c = Calibration(cal.mus, moved, cal.seeds)
+        return c.mu_for(target_porosity_2d(dr, c.n2d_max, c.n2d_min))
+
+    if not np.all(np.isfinite(se)):
+        return math.nan
+    parts = [(mu_with(k, h) - mu_with(k, -h)) / 2.0 for k, h in enumerate(se) if h > 0.0]
+    return float(math.sqrt(sum(p * p for p in parts)))
+
+
 def check_mus(mus, parameter: str = "density.mu_prep") -> list[float]:
     """Two to 20 preparation frictions in [0, MU_PREP_MAX], strictly increasing (densest first)."""
     return check_number_list(parameter, mus, 0.0, MU_PREP_MAX, min_items=2, max_items=20, increasing=True,
@@ -264,8 +301,10 @@ __all__ = [
     "Calibration",
     "StateTarget",
     "check_mus",
+    "friction_error",
     "isotonic_increasing",
     "lab_relative_density",
+    "seed_errors",
     "state_target",
     "target_porosity_2d",
 ]
