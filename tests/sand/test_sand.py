@@ -230,6 +230,11 @@ def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
     assert set(data["answer_error"]) == {"specimens_se", "mu_prep_se", "interior_slope", "calibration_se",
                                          "answer_se"}  # fmt: skip
     assert res.answer_error.mu_prep_se is None or res.answer_error.mu_prep_se >= 0.0
+    # where the specimens landed: their Dr against the asked one, the interior porosity at the target
+    reached = data["state_reached"]
+    assert reached["relative_density_asked"] == pytest.approx(res.state.relative_density)
+    assert reached["box_target"] == pytest.approx(res.first_trial_full_box)
+    assert reached["box_mean"] == pytest.approx(res.box_porosity_mean)
     md = (out / "summary.md").read_text()
     accepted = [k for k in res.specimens if k.accepted]
     assert accepted, "no seed accepted"
@@ -248,6 +253,8 @@ def test_sand_end_to_end_on_a_tiny_box(tmp_path, monkeypatch):
         .read_text()
         .startswith("soil,upscale,disks,n_lab,e,Dr,mu_prep,interior_porosity")
     )
+    header = (out / "summary.csv").read_text().splitlines()[0]
+    assert header.endswith("seeds_accepted,Dr_reached,interior_at_target,interior_at_target_se")
     # a rerun reads every finished case back: the same numbers
     again = run_sand(load_sand_case(TINY), Store(out), options=QUIET)
     assert again.box_porosity_mean == res.box_porosity_mean

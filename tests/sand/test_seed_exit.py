@@ -43,6 +43,7 @@ def _result(accepted: list[int], refused: dict[int, int | None]) -> SimpleNamesp
         state_map=None,
         calibration=SimpleNamespace(dropped_ends=[], mus=[0.0, 1.0]),
         answer_error=AnswerError(0.0003, 0.004, 0.1, 0.0004, 0.0005),
+        state_reached=None,
     )
 
 

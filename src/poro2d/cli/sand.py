@@ -81,6 +81,8 @@ def print_result(res, out: Path) -> None:
         )
     if res.answer_error is not None:
         console.print(f"the answer's {res.answer_error.text()}", soft_wrap=True)
+    if res.state_reached is not None:
+        console.print(f"the {res.state_reached.text()}", soft_wrap=True)
     t = Table(title="poro2d sand")
     for col in ("seed", "accepted", "interior n", "box n'", "disks", "specimen folder"):
         t.add_column(col, justify="right")

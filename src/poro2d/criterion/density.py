@@ -276,17 +276,30 @@ def friction_error(dr: float, cal: Calibration) -> float:
     found again, and the central differences added in quadrature (the frictions' cases are
     independent packings). NaN when the seeds give no spread.
     """
+    return _seed_delta(cal, lambda c: c.mu_for(target_porosity_2d(dr, c.n2d_max, c.n2d_min)))
+
+
+def target_error(dr: float, cal: Calibration) -> float:
+    """The standard error of the 2D target at relative density ``dr`` (Eq. 12's state mapped
+    onto the calibration's extremes), from the ends' finite seeds: as :func:`friction_error`,
+    the target found again with each friction's mean moved by its standard error."""
+    return _seed_delta(cal, lambda c: target_porosity_2d(dr, c.n2d_max, c.n2d_min))
+
+
+def _seed_delta(cal: Calibration, read) -> float:
+    """The delta method over the calibration's seed means: ``read`` (a number from a calibration)
+    again with each usable friction's mean moved up and down by its standard error, the central
+    differences added in quadrature. NaN when the seeds give no spread."""
     cal = cal.usable()
     se = seed_errors(cal)
 
-    def mu_with(k: int, shift: float) -> float:
-        moved = [[v + shift if j == k else v for v in cal.accepted(j)] for j in range(len(cal.mus))]
-        c = Calibration(cal.mus, moved, cal.seeds)
-        return c.mu_for(target_porosity_2d(dr, c.n2d_max, c.n2d_min))
+    def moved(k: int, shift: float) -> float:
+        samples = [[v + shift if j == k else v for v in cal.accepted(j)] for j in range(len(cal.mus))]
+        return read(Calibration(cal.mus, samples, cal.seeds))
 
     if not np.all(np.isfinite(se)):
         return math.nan
-    parts = [(mu_with(k, h) - mu_with(k, -h)) / 2.0 for k, h in enumerate(se) if h > 0.0]
+    parts = [(moved(k, h) - moved(k, -h)) / 2.0 for k, h in enumerate(se) if h > 0.0]
     return float(math.sqrt(sum(p * p for p in parts)))
 
 
@@ -306,5 +319,6 @@ __all__ = [
     "lab_relative_density",
     "seed_errors",
     "state_target",
+    "target_error",
     "target_porosity_2d",
 ]

@@ -24,6 +24,7 @@ from poro2d.labtest.records import ByName
 from poro2d.sand.case import SoilRecord
 from poro2d.sand.preflight import Preflight
 from poro2d.sand.profile import StageProfile
+from poro2d.sand.reached import StateReached
 from poro2d.sand.spread import AnswerError
 from poro2d.store import Store
 from poro2d.sweep.records import CaseRow, LostCaseRow, SeedReplaced
@@ -171,6 +172,8 @@ class SandResult(TypedResult):
     worker_use: dict[str, WorkerUse] | None = None
     #: the answer's standard error: the specimens' and the calibration's seeds (:mod:`poro2d.sand.spread`)
     answer_error: AnswerError | None = None
+    #: where the specimens landed against the target: the Dr they reached (:mod:`poro2d.sand.reached`)
+    state_reached: StateReached | None = None
     specimens: list[SeedSpecimen] = field(default_factory=list, metadata=NOT_IN_FILE)
 
     #: the typed parts, as their classes read them
@@ -186,8 +189,9 @@ class SandResult(TypedResult):
         "state_map": StateMapRecord,
         "worker_use": Keyed(WorkerUse),
         "answer_error": AnswerError,
+        "state_reached": StateReached,
     }
-    OPTIONAL: ClassVar[tuple[str, ...]] = ("state_map", "worker_use", "answer_error")
+    OPTIONAL: ClassVar[tuple[str, ...]] = ("state_map", "worker_use", "answer_error", "state_reached")
 
     @classmethod
     def build(
@@ -213,6 +217,11 @@ class SandResult(TypedResult):
         error = AnswerError.of(
             target.relative_density, cal_record.calibration, cal_record.mus, cal_record.interior_by_friction,
             target.mu_prep, [k.interior_porosity for k in kept if k.accepted],
+        )  # fmt: skip
+        accepted = [k for k in kept if k.accepted]
+        reached = StateReached.of(
+            target.relative_density, target.n2d_target, trial, cal_record.calibration,
+            [k.box_porosity for k in accepted], [k.interior_porosity for k in accepted],
         )  # fmt: skip
         state_map = (
             None
@@ -251,6 +260,7 @@ class SandResult(TypedResult):
             state_map=state_map,
             worker_use=worker_use,
             answer_error=error,
+            state_reached=reached,
             specimens=list(kept),
         )
 
@@ -293,11 +303,14 @@ class SummaryRow(TypedResult):
     jamming_porosity: float
     seeds: int
     seeds_accepted: int
+    Dr_reached: float
+    interior_at_target: float
+    interior_at_target_se: float
 
     @classmethod
     def of(cls, res: SandResult) -> SummaryRow:
         """The row of a finished run."""
-        st, pf = res.state, res.preflight
+        st, pf, at = res.state, res.preflight, res.state_reached
         return cls(
             res.soil.name,
             res.soil.upscale,
@@ -315,6 +328,10 @@ class SummaryRow(TypedResult):
             res.jamming_porosity,
             res.seeds,
             res.seeds_accepted,
+            # where the specimens landed (NaN without an accepted one, or from an older poro2d)
+            float_or_nan(None if at is None else at.relative_density_reached),
+            float_or_nan(None if at is None else at.interior_at_target),
+            float_or_nan(None if at is None else at.interior_at_target_se),
         )
 
 
@@ -379,11 +396,15 @@ def summary_markdown(res: SandResult, store: Store) -> str:
 
 
 def _error_lines(res: SandResult) -> list[str]:
-    """The answer's standard error under the answer (none in a sand.json of an older poro2d)."""
-    if res.answer_error is None:
-        return []
-    return [f"The answer's {res.answer_error.text()}: another run from other seeds lands within 2.8 "
-            "standard errors of this answer 19 times in 20.", ""]  # fmt: skip
+    """The answer's standard error and the state the specimens reached, under the answer (none in a
+    sand.json of an older poro2d)."""
+    lines = []
+    if res.answer_error is not None:
+        lines += [f"The answer's {res.answer_error.text()}: another run from other seeds lands within 2.8 "
+                  "standard errors of this answer 19 times in 20.", ""]  # fmt: skip
+    if res.state_reached is not None:
+        lines += [f"The {res.state_reached.text()}.", ""]
+    return lines
 
 
 def used_seeds(res: SandResult) -> str:
