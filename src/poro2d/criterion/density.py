@@ -280,9 +280,10 @@ def friction_error(dr: float, cal: Calibration) -> float:
 
 
 def target_error(dr: float, cal: Calibration) -> float:
-    """The standard error of the 2D target at relative density ``dr`` (Eq. 12's state mapped
-    onto the calibration's extremes), from the ends' finite seeds: as :func:`friction_error`,
-    the target found again with each friction's mean moved by its standard error."""
+    """The standard error of the 2D target at relative density ``dr`` (the laboratory's Dr mapped
+    onto the calibration's extremes, :func:`target_porosity_2d`), from the ends' finite seeds: as
+    :func:`friction_error`, the target found again with each friction's mean moved by its
+    standard error."""
     return _seed_delta(cal, lambda c: target_porosity_2d(dr, c.n2d_max, c.n2d_min))
 
 
