@@ -76,4 +76,13 @@ def test_one_specimen_has_no_spread_and_none_has_no_state():
     # a box too small for an interior region: the Dr reached, no interior porosity at the target
     bare, _ = _reached([target - WALLS, target - WALLS], [None, None])
     assert bare.relative_density_reached == pytest.approx(DR) and bare.interior_at_target is None
-    assert "no interior porosity" in bare.text()
+    assert "no interior porosity" in bare.text() and "wide grading" not in bare.text()
+
+
+def test_a_wide_grading_says_its_target_leans_on_the_walls_model():
+    target = target_porosity_2d(DR, CAL.n2d_max, CAL.n2d_min)
+    boxes, interiors = [target - WALLS] * 2, [target - WALLS - 0.012] * 2
+    wide = StateReached.of(DR, target, target - WALLS, CAL, boxes, interiors, wide=True)
+    narrow = StateReached.of(DR, target, target - WALLS, CAL, boxes, interiors)
+    assert wide.wide_grading and "wide grading" in wide.text() and "G1-1" in wide.text()
+    assert wide.interior_at_target == narrow.interior_at_target and "wide" not in narrow.text()

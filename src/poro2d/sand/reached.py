@@ -43,7 +43,9 @@ class StateReached(TypedResult):
     ``target_se``: the target's standard error from the ends' seeds (the calibration box's,
     taken for the full box's); ``interior_at_target``: ``box_target`` - ``walls_offset``, with its
     standard error (the offset's sd / sqrt(n) and ``target_se`` in quadrature; None with one
-    specimen or no spread in the ends).
+    specimen or no spread in the ends); ``wide_grading``: the grading is wide
+    (:func:`poro2d.specimen.compaction.is_wide`), where the walls' share model that moves the
+    target into the full box was measured to fall short (docs/sand.md), and the line says so.
     """
 
     box_target: float
@@ -55,15 +57,17 @@ class StateReached(TypedResult):
     target_se: float | None
     interior_at_target: float | None
     interior_at_target_se: float | None
+    wide_grading: bool = False
 
     @classmethod
     def of(cls, dr: float, n2d_target: float, box_target: float, cal: Calibration,
-           boxes: list[float], interiors: list[float]) -> StateReached | None:  # fmt: skip
+           boxes: list[float], interiors: list[float],
+           wide: bool = False) -> StateReached | None:  # fmt: skip
         """From the state's ``dr``, its 2D target in the calibration box (``n2d_target``) and in
         the full box (``box_target``), the calibration ``cal`` (its extremes and seeds) and the
         accepted specimens' box and interior porosities (in pairs; an interior porosity may be
-        None, in a box too small for an interior region: then no interior porosity at the target).
-        None without an accepted specimen."""
+        None, in a box too small for an interior region: then no interior porosity at the target);
+        ``wide``: whether the grading is wide. None without an accepted specimen."""
 
         def finite(x) -> bool:
             return x is not None and math.isfinite(x)
@@ -89,6 +93,7 @@ class StateReached(TypedResult):
             target_se=float(t_se) if math.isfinite(t_se) else None,
             interior_at_target=None if walls is None else float(box_target) - walls,
             interior_at_target_se=math.hypot(sd / math.sqrt(offset.size), t_se) if known else None,
+            wide_grading=bool(wide),
         )
 
     def text(self) -> str:
@@ -98,12 +103,21 @@ class StateReached(TypedResult):
             f"box n' {self.box_mean:.4f} against the target {self.box_target:.4f}"
         )
         if self.interior_at_target is None:
-            return head + " (no interior region in this box: no interior porosity at the target)"
+            bare = " (no interior region in this box: no interior porosity at the target)"
+            return head + bare + self._caveat()
         se = self.interior_at_target_se
         se_text = "" if se is None else f", standard error {se:.4f}"
         return (
             f"{head}; the interior porosity at the target itself {self.interior_at_target:.4f}{se_text} "
-            f"(the target less the walls' loose layer, {self.walls_offset:.4f})"
+            f"(the target less the walls' loose layer, {self.walls_offset:.4f})" + self._caveat()
+        )
+
+    def _caveat(self) -> str:
+        if not self.wide_grading:
+            return ""
+        return (
+            "; a wide grading: the full box's target comes from a walls' share model that fell short "
+            "on one (G1-1, docs/sand.md), so this Dr and this porosity may be off by a few hundredths in Dr"
         )
 
 

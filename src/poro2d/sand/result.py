@@ -26,6 +26,7 @@ from poro2d.sand.preflight import Preflight
 from poro2d.sand.profile import StageProfile
 from poro2d.sand.reached import StateReached
 from poro2d.sand.spread import AnswerError
+from poro2d.specimen.compaction import is_wide
 from poro2d.store import Store
 from poro2d.sweep.records import CaseRow, LostCaseRow, SeedReplaced
 from poro2d.typed_result import NOT_IN_FILE, Keyed, TypedResult
@@ -222,6 +223,7 @@ class SandResult(TypedResult):
         reached = StateReached.of(
             target.relative_density, target.n2d_target, trial, cal_record.calibration,
             [k.box_porosity for k in accepted], [k.interior_porosity for k in accepted],
+            wide=is_wide(case.grading),
         )  # fmt: skip
         state_map = (
             None
