@@ -206,23 +206,22 @@ class SandResult(TypedResult):
         seconds: float,
         worker_use: dict[str, WorkerUse] | None = None,
     ) -> SandResult:
-        inner_m, inner_sd = _stats([k.interior_porosity for k in kept if k.accepted])
-        box_m, box_sd = _stats([k.box_porosity for k in kept if k.accepted])
+        accepted = [k for k in kept if k.accepted]
+        interiors, boxes = [k.interior_porosity for k in accepted], [k.box_porosity for k in accepted]
+        inner_m, inner_sd = _stats(interiors)
+        box_m, box_sd = _stats(boxes)
         lab = case.lab
         states = [
             AcceptedState.of(k, n_lab=lab.n_lab, relative_density=lab.relative_density, specimen=k.folder)
-            for k in kept
-            if k.accepted
+            for k in accepted
         ]
-        n_ok = sum(k.accepted for k in kept)
+        n_ok = len(accepted)
         error = AnswerError.of(
             target.relative_density, cal_record.calibration, cal_record.mus, cal_record.interior_by_friction,
-            target.mu_prep, [k.interior_porosity for k in kept if k.accepted],
+            target.mu_prep, interiors,
         )  # fmt: skip
-        accepted = [k for k in kept if k.accepted]
         reached = StateReached.of(
-            target.relative_density, target.n2d_target, trial, cal_record.calibration,
-            [k.box_porosity for k in accepted], [k.interior_porosity for k in accepted],
+            target.relative_density, target.n2d_target, trial, cal_record.calibration, boxes, interiors,
             wide=is_wide(case.grading),
         )  # fmt: skip
         state_map = (
@@ -242,7 +241,7 @@ class SandResult(TypedResult):
             solid_fraction_mean=1.0 - inner_m if math.isfinite(inner_m) else math.nan,
             seeds=case.seeds,
             seeds_accepted=n_ok,
-            seeds_used=[k.seed for k in kept if k.accepted],
+            seeds_used=[k.seed for k in accepted],
             seeds_replaced=replaced_seeds(kept, case.seeds),
             converged=n_ok == case.seeds,
             mu_prep=target.mu_prep,
